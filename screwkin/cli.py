@@ -1,0 +1,95 @@
+"""Command line: ``screwkin mobility FILE`` and ``screwkin info FILE``.
+
+A thin edge over the Python API: it parses arguments, calls the same functions
+and prints their results.  Exit codes: 0 success, 1 invalid or unanalysable
+file, 2 usage error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from .errors import ScrewkinError
+
+__all__ = ["main"]
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit code 2
+        self.exit(2, f"screwkin: error: {message}\n")
+
+
+def _names(text):
+    return [n.strip() for n in text.split(",") if n.strip()] if text else None
+
+
+def _parser():
+    p = _Parser(prog="screwkin", description="Screw-theory analysis of spatial mechanisms described in URDF.")
+    p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def common(sp):
+        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file")
+        sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
+        sp.add_argument("--json", action="store_true", help="print one JSON object")
+        sp.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+
+    m = sub.add_parser("mobility", help="degrees of freedom: counts and screw-theory mobility")
+    common(m)
+    m.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    m.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
+    i = sub.add_parser("info", help="topology table: links, joints, loops")
+    common(i)
+    return p
+
+
+def _run(args):
+    from .mechanism import load
+    from .report import mobility_dict, mobility_text, to_jsonable, topology_dict, topology_text
+
+    mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)))
+    if args.command == "info":
+        try:
+            q = mech.assemble().q
+            note = None
+        except ScrewkinError as exc:
+            q = mech.neutral()
+            note = f"not assembled ({exc}); geometry read at the file's configuration"
+        topo = mech.topology(q)
+        if args.json:
+            d = topology_dict(topo)
+            d.update({"file": mech.path, "actuated": mech.actuated, "cut_joints": [c.name for c in mech.cuts],
+                      "coordinates": mech.nv, "assembled": note is None})
+            print(json.dumps(to_jsonable(d), indent=2))
+        else:
+            print(topology_text(topo, f"Topology of {mech.path}"))
+            print(f"actuated: {', '.join(mech.actuated) or 'none declared'}")
+            if note:
+                print(f"note: {note}")
+        return 0
+    result = mech.mobility(output=args.output)
+    if args.json:
+        print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
+    else:
+        print(mobility_text(result))
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return _run(args)
+    except ScrewkinError as exc:
+        if args.debug:
+            raise
+        print(f"screwkin: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:  # pragma: no cover
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

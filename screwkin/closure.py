@@ -1,0 +1,243 @@
+"""Loop-closure equations of cut joints, their Jacobian, and the closure solver.
+
+Every cut joint places a frame F1 on one link and F2 on another; the loop is
+closed when F2 relative to F1 is a motion the joint allows.  The residual rows
+of each joint type are scalar functions of the two world placements; their
+derivatives are written with Pinocchio frame Jacobians expressed in
+LOCAL_WORLD_ALIGNED (linear velocity of the frame origin, angular velocity,
+both in world axes), so the rows of K(q) at a closed configuration are the
+constraint wrenches of the cut joint (the reciprocal screws of the twists it
+allows) in (force, moment) order.
+
+Row kinds (world vectors; o1, o2 frame origins, d = o2 - o1):
+  position along e (a unit vector fixed in F1):  r = e . d
+  alignment of u (fixed in F1) with w (fixed in F2), kept perpendicular:  r = u . w
+  full relative rotation:                         r = log3(R1^T R2)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import AssemblyError
+from .tolerances import DEFAULT, Tolerances
+
+__all__ = ["CutJoint", "ClosureSystem", "Assembly", "perpendicular_basis"]
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+def perpendicular_basis(a):
+    """Two unit vectors completing the unit vector ``a`` to a right-handed basis."""
+    a = np.asarray(a, float)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    b1 = np.cross(a, helper)
+    b1 /= np.linalg.norm(b1)
+    b2 = np.cross(a, b1)
+    return b1, b2
+
+
+@dataclass(frozen=True)
+class CutJoint:
+    """A cut joint bound to a model: frame ids of F1, F2 and its axes.
+
+    axis is expressed in F1, axis2 (universal joints) in F2.
+    """
+
+    name: str
+    type: str
+    dof: int
+    frame1: int
+    frame2: int
+    link1: str
+    link2: str
+    axis: tuple
+    axis2: tuple | None = None
+
+    @property
+    def rows(self) -> int:
+        return 6 - self.dof
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """A configuration that satisfies the closure equations.
+
+    q: joint configuration (Pinocchio's nq-vector);
+    residual: closure residual norm reached [m, rad];
+    iterations: solver iterations used.
+    """
+
+    q: np.ndarray
+    residual: float
+    iterations: int
+
+
+class ClosureSystem:
+    """The loop-closure equations r(q) = 0 of a model with cut joints."""
+
+    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>"):
+        self.model = model
+        self.data = model.createData()
+        self.cuts = list(cuts)
+        self.tol = tolerances
+        self.path = path
+        self.nrows = sum(c.rows for c in self.cuts)
+        self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
+
+    # ------------------------------------------------------------------ residual
+    def _rows(self, solver: bool) -> int:
+        if not solver:
+            return self.nrows
+        extra = {"fixed": 6, "prismatic": 6, "revolute": 1, "continuous": 1, "cylindrical": 1, "planar": 1}
+        return sum(c.rows + extra.get(c.type, 0) for c in self.cuts)
+
+    def evaluate(self, q, jacobian: bool = True, solver: bool = False):
+        """Residual r(q) and, if asked, its Jacobian (rows x nv).
+
+        With ``solver=False`` (default) the rows are the minimal ones (6 - dof per
+        cut joint): at a closed configuration the Jacobian is the constraint
+        Jacobian K whose rows are constraint wrenches.  With ``solver=True`` the
+        orientation rows are replaced by smooth, redundant differences of world
+        vectors (R2 e - R1 e), whose only root is the right one: these are what
+        the closure solver drives to zero from far away.
+        """
+        model, data = self.model, self.data
+        if jacobian:
+            pin.computeJointJacobians(model, data, q)
+        else:
+            pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacements(model, data)
+        nrows = self._rows(solver)
+        r = np.empty(nrows)
+        K = np.zeros((nrows, model.nv)) if jacobian else None
+        i = 0
+        for cut, (b1, b2) in zip(self.cuts, self._basis):
+            M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
+            R1, R2 = M1.rotation, M2.rotation
+            d = M2.translation - M1.translation
+            if jacobian:
+                J1 = pin.getFrameJacobian(model, data, cut.frame1, LWA)
+                J2 = pin.getFrameJacobian(model, data, cut.frame2, LWA)
+                dv, w1, w2 = J2[:3] - J1[:3], J1[3:], J2[3:]
+            a = np.asarray(cut.axis)
+            t = cut.type
+            if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
+                positions = (R1[:, 0], R1[:, 1], R1[:, 2])
+            elif t in ("prismatic", "cylindrical"):
+                positions = (R1 @ b1, R1 @ b2)
+            else:  # planar
+                positions = (R1 @ a,)
+            for e in positions:
+                r[i] = e @ d
+                if jacobian:
+                    K[i] = e @ dv + np.cross(e, d) @ w1
+                i += 1
+            if solver and t != "universal":
+                # R2 v - R1 v for the vectors v that F1 and F2 must share
+                vectors = () if t == "spherical" else (np.eye(3) if t in ("fixed", "prismatic") else (a,))
+                for v in vectors:
+                    u1, u2 = R1 @ v, R2 @ v
+                    r[i:i + 3] = u2 - u1
+                    if jacobian:
+                        K[i:i + 3] = -pin.skew(u2) @ w2 + pin.skew(u1) @ w1
+                    i += 3
+                continue
+            if t in ("fixed", "prismatic"):
+                R = R1.T @ R2
+                r[i:i + 3] = pin.log3(R)
+                if jacobian:
+                    K[i:i + 3] = pin.Jlog3(R) @ R2.T @ (w2 - w1)
+                i += 3
+                continue
+            if t in ("revolute", "continuous", "cylindrical", "planar"):
+                pairs = ((R1 @ b1, R2 @ a), (R1 @ b2, R2 @ a))
+            elif t == "universal":
+                pairs = ((R1 @ a, R2 @ np.asarray(cut.axis2)),)
+            else:  # spherical
+                pairs = ()
+            for u, w in pairs:
+                r[i] = u @ w
+                if jacobian:
+                    K[i] = np.cross(w, u) @ (w2 - w1)
+                i += 1
+        return r, K
+
+    def residual(self, q) -> np.ndarray:
+        return self.evaluate(q, jacobian=False)[0]
+
+    def jacobian(self, q) -> np.ndarray:
+        return self.evaluate(q, jacobian=True)[1]
+
+    def wrong_branch(self, q) -> list:
+        """Cut joints whose aligned axes are antiparallel (a spurious root of the
+        alignment rows: the joint would be assembled upside down)."""
+        self.evaluate(q, jacobian=False)
+        bad = []
+        for cut in self.cuts:
+            if cut.type in ("revolute", "continuous", "cylindrical", "planar"):
+                a = np.asarray(cut.axis)
+                R1 = self.data.oMf[cut.frame1].rotation
+                R2 = self.data.oMf[cut.frame2].rotation
+                if (R1 @ a) @ (R2 @ a) < 0:
+                    bad.append(cut.name)
+        return bad
+
+    # ------------------------------------------------------------------ solving
+    def solve(self, q0, frozen=(), tolerances: Tolerances | None = None, trace=None) -> Assembly:
+        """Solve r(q) = 0 from q0 by damped Newton (Levenberg-Marquardt, minimum-norm steps).
+
+        frozen: velocity indices that must not move (the inputs).
+        trace:  optional callable(iteration, q, r, K, dq) to record the iterations.
+        Raises AssemblyError with the smallest residual reached when it fails.
+        """
+        tol = tolerances or self.tol
+        model = self.model
+        q = np.array(q0, float)
+        if self.nrows == 0:
+            return Assembly(q, 0.0, 0)
+        free = np.setdiff1d(np.arange(model.nv), np.asarray(frozen, int))
+        r, K = self.evaluate(q, solver=True)
+        norm = float(np.linalg.norm(r))
+        best = norm
+        mu = 1e-6
+        it = 0
+        while it < tol.max_iterations:
+            if norm < tol.closure:
+                break
+            it += 1
+            Kf = K[:, free]
+            A = Kf @ Kf.T
+            A[np.diag_indices_from(A)] += mu * max(np.trace(A) / len(A), 1e-12)
+            try:
+                y = np.linalg.solve(A, r)
+            except np.linalg.LinAlgError:
+                y = np.linalg.lstsq(A, r, rcond=None)[0]
+            dq = np.zeros(model.nv)
+            dq[free] = -(Kf.T @ y)
+            q_new = pin.integrate(model, q, dq)
+            r_new = self.evaluate(q_new, jacobian=False, solver=True)[0]
+            n_new = float(np.linalg.norm(r_new))
+            if trace is not None:
+                trace(it, q, r, K, dq)
+            if n_new < norm:
+                q = q_new
+                r, K = self.evaluate(q, solver=True)
+                norm = n_new
+                best = min(best, norm)
+                mu = max(mu / 10.0, 1e-12)
+            else:
+                mu *= 10.0
+                if mu > 1e10:
+                    break
+        if norm >= tol.closure:
+            raise AssemblyError(self.path, best, it)
+        bad = self.wrong_branch(q)
+        if bad:
+            raise AssemblyError(
+                self.path, best, it, detail=f"the solution found assembles {', '.join(bad)} with a reversed axis"
+            )
+        return Assembly(q, norm, it)

@@ -1,0 +1,269 @@
+"""Loading a mechanism file into a :class:`Mechanism`.
+
+A Mechanism is the Pinocchio model of the spanning tree (built by Pinocchio's
+URDF parser), the cut joints bound to frames of that model, the actuated
+joints, and the map between joint names and coordinates.  Analyses (assembly,
+mobility, and later position, velocity and singularity analysis) work on it.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .closure import Assembly, ClosureSystem, CutJoint
+from .description import MechanismSpec, placement, resolve_actuation
+from .errors import MechanismFileError, UsageError
+from .tolerances import DEFAULT, Tolerances
+from .urdf import read_urdf, read_yaml_sidecar
+
+__all__ = ["load", "Mechanism", "Coordinate"]
+
+
+@dataclass(frozen=True)
+class Coordinate:
+    """Where a tree joint's coordinates live in q (nq entries) and in velocities (nv)."""
+
+    joint: str
+    joint_id: int
+    idx_q: int
+    nq: int
+    idx_v: int
+    nv: int
+
+
+def _read_text(path: Path) -> str:
+    if not path.exists():
+        raise MechanismFileError(path, "no such file")
+    if path.is_dir():
+        raise MechanismFileError(path, "is a directory, not a mechanism file")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise MechanismFileError(path, f"cannot read: {exc.strerror}") from None
+    if not raw.strip():
+        raise MechanismFileError(path, "the file is empty")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise MechanismFileError(path, "not a text file (not UTF-8)") from None
+
+
+def _find_sidecar(path: Path):
+    for suffix in (".yaml", ".yml"):
+        cand = path.with_suffix(suffix)
+        if cand.is_file():
+            return cand
+    return None
+
+
+def _axis_letters(t: str):
+    unit = {"X": (1.0, 0, 0), "Y": (0, 1.0, 0), "Z": (0, 0, 1.0)}
+    letters = t.split("_", 1)[1] if "_" in t else "XY"
+    if len(letters) != 2 or any(c not in unit for c in letters):
+        letters = "XY"
+    return np.array(unit[letters[0]]), np.array(unit[letters[1]])
+
+
+def _replace_joints(model, replacements):
+    """Rebuild ``model`` with the sidecar's joint replacements (SPHERICAL,
+    UJOINT_ab / CARDAN as a native universal joint, FIXED as locked)."""
+    rep = dict(replacements)
+    new = pin.Model()
+    new.name = model.name
+    locked = []
+    for jid in range(1, model.njoints):
+        name = model.names[jid]
+        parent = new.getJointId(model.names[model.parents[jid]]) if model.parents[jid] else 0
+        jm = model.joints[jid]
+        t = rep.get(name)
+        if t == "SPHERICAL":
+            jm = pin.JointModelSpherical()
+        elif t and (t.startswith("UJOINT") or t == "CARDAN"):
+            a1, a2 = _axis_letters(t)
+            jm = pin.JointModelUniversal(a1, a2)
+        nid = new.addJoint(parent, jm, model.jointPlacements[jid], name)
+        new.appendBodyToJoint(nid, model.inertias[jid], pin.SE3.Identity())
+        if t == "FIXED":
+            locked.append(nid)
+    for f in list(model.frames)[1:]:
+        parent = new.getJointId(model.names[f.parentJoint]) if f.parentJoint else 0
+        new.addFrame(pin.Frame(f.name, parent, f.parentFrame, f.placement, f.type), False)
+    if locked:
+        new = pin.buildReducedModel(new, locked, pin.neutral(new))
+    return new
+
+
+class Mechanism:
+    """A mechanism: Pinocchio model of the spanning tree, cut joints, actuation.
+
+    Attributes
+    ----------
+    path:       the file it was read from.
+    spec:       the :class:`~screwkin.description.MechanismSpec` read from the file.
+    model:      ``pinocchio.Model`` of the spanning tree (with frames F1, F2 of every cut joint).
+    cuts:       list of :class:`~screwkin.closure.CutJoint`.
+    closure:    the :class:`~screwkin.closure.ClosureSystem` r(q) = 0.
+    coordinates: list of :class:`Coordinate`, one per tree joint with coordinates.
+    actuated:   actuated joint names; ``actuation_source`` says where they came from.
+    """
+
+    def __init__(self, spec: MechanismSpec, model, actuated=None, tolerances: Tolerances = DEFAULT):
+        self.spec = spec
+        self.path = spec.path
+        self.tolerances = tolerances
+        self.model = model
+        self.data = model.createData()
+        self.coordinates = [
+            Coordinate(model.names[j], j, model.idx_qs[j], model.nqs[j], model.idx_vs[j], model.nvs[j])
+            for j in range(1, model.njoints)
+            if model.nvs[j] > 0
+        ]
+        self._coord = {c.joint: c for c in self.coordinates}
+        self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
+        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path)
+        self.set_actuated(actuated)
+        self._assembly = None
+
+    # ------------------------------------------------------------------ binding
+    def _frame_id(self, name: str, what: str) -> int:
+        if not self.model.existFrame(name):
+            raise MechanismFileError(self.path, f"{what} names frame '{name}', which is not in the model")
+        return self.model.getFrameId(name)
+
+    def _bind_cut(self, c) -> CutJoint:
+        ids = []
+        for k, (frame, xyz, rpy) in enumerate(((c.frame1, c.xyz1, c.rpy1), (c.frame2, c.xyz2, c.rpy2)), 1):
+            fid = self._frame_id(frame, f"loop joint '{c.name}'")
+            parent = self.model.frames[fid]
+            frame_placement = parent.placement * placement(xyz, rpy)
+            new = pin.Frame(f"{c.name}@F{k}", parent.parentJoint, fid, frame_placement, pin.FrameType.OP_FRAME)
+            ids.append(self.model.addFrame(new, False))
+        self.data = self.model.createData()
+        return CutJoint(c.name, c.type, c.dof, ids[0], ids[1], c.frame1, c.frame2, tuple(c.axis),
+                        tuple(c.axis2) if c.axis2 is not None else None)
+
+    def set_actuated(self, actuated=None):
+        """Choose the actuated joints (None: the file's declaration)."""
+        names, source = resolve_actuation(self.spec, actuated)
+        unknown = [n for n in names if n not in self._coord]
+        if unknown:
+            known = ", ".join(c.joint for c in self.coordinates)
+            msg = f"actuated joint '{unknown[0]}' is not a moving joint of the mechanism (joints: {known})"
+            if source == "command line":
+                raise UsageError(f"{self.path}: {msg}")
+            raise MechanismFileError(self.path, msg)
+        if len(set(names)) != len(names):
+            raise UsageError(f"{self.path}: an actuated joint is named twice: {', '.join(names)}")
+        self.actuated = names
+        self.actuation_source = source
+
+    # ------------------------------------------------------------------ coordinates
+    @property
+    def nq(self) -> int:
+        return self.model.nq
+
+    @property
+    def nv(self) -> int:
+        return self.model.nv
+
+    def coordinate(self, joint: str) -> Coordinate:
+        try:
+            return self._coord[joint]
+        except KeyError:
+            known = ", ".join(c.joint for c in self.coordinates)
+            raise UsageError(f"{self.path}: no moving joint named '{joint}' (joints: {known})") from None
+
+    def velocity_indices(self, joints) -> np.ndarray:
+        """Velocity (tangent) indices of the named joints, in order."""
+        idx = []
+        for j in joints:
+            c = self.coordinate(j)
+            idx.extend(range(c.idx_v, c.idx_v + c.nv))
+        return np.asarray(idx, int)
+
+    @property
+    def coordinate_names(self) -> list:
+        names = []
+        for c in self.coordinates:
+            names += [c.joint] if c.nv == 1 else [f"{c.joint}[{k}]" for k in range(c.nv)]
+        return names
+
+    def link_frame(self, link: str) -> int:
+        """Frame id of a link (its body frame)."""
+        for fid, f in enumerate(self.model.frames):
+            if f.name == link and f.type == pin.FrameType.BODY:
+                return fid
+        links = ", ".join(self.spec.links)
+        raise UsageError(f"{self.path}: no link named '{link}' (links: {links})")
+
+    def neutral(self) -> np.ndarray:
+        """The configuration written in the file (every joint at zero)."""
+        return pin.neutral(self.model)
+
+    # ------------------------------------------------------------------ analyses
+    def assemble(self, q0=None) -> Assembly:
+        """Close the loops starting from q0 (default: the file's configuration)."""
+        if q0 is None and self._assembly is not None:
+            return self._assembly
+        result = self.closure.solve(self.neutral() if q0 is None else q0)
+        if q0 is None:
+            self._assembly = result
+        return result
+
+    def topology(self, q=None):
+        """The :class:`~screwkin.topology.Topology` (links, joints, compound joints, loops)."""
+        from .topology import build_topology
+
+        return build_topology(self, self.assemble().q if q is None else q)
+
+    def mobility(self, actuated=None, output=None, seed: int = 0):
+        """Mobility analysis; returns a :class:`~screwkin.mobility.MobilityResult`."""
+        from .mobility import analyze_mobility
+
+        if actuated is not None:
+            self.set_actuated(actuated)
+        return analyze_mobility(self, output=output, seed=seed)
+
+    def __repr__(self):
+        return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "
+                f"{len(self.coordinates)} moving tree joints, {len(self.cuts)} cut joints)")
+
+
+def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None) -> Mechanism:
+    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, or SDF).
+
+    yaml:      path of an Extended-URDF sidecar; default: ``<file>.yaml`` when it exists.
+    actuated:  actuated joint names, overriding the file's declaration.
+    warn:      callable receiving each warning (default: print to stderr).
+    """
+    path = Path(path)
+    text = _read_text(path)
+    head = text.lstrip()[:400]
+    if path.suffix.lower() == ".sdf" or "<sdf" in head:
+        from .sdf import read_sdf
+
+        spec = read_sdf(path, text)
+    else:
+        spec = read_urdf(path, text)
+    try:
+        model = pin.buildModelFromXML(spec.urdf_text)
+    except (ValueError, RuntimeError) as exc:
+        first = str(exc).strip().splitlines()[-1].strip() if str(exc).strip() else type(exc).__name__
+        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {first}") from None
+    if yaml is None and spec.format == "urdf":
+        yaml = _find_sidecar(path)
+    if yaml is not None:
+        yaml = Path(yaml)
+        if not yaml.is_file():
+            raise MechanismFileError(yaml, "no such file")
+        read_yaml_sidecar(spec, yaml, [f.name for f in model.frames])
+    if spec.replacements:
+        model = _replace_joints(model, spec.replacements)
+    for w in spec.warnings:
+        (warn or (lambda m: print(f"warning: {path}: {m}", file=sys.stderr)))(w)
+    return Mechanism(spec, model, actuated=actuated, tolerances=tolerances)

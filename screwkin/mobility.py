@@ -1,0 +1,362 @@
+"""Mobility analysis: counting criteria and the rank of the constraint Jacobian.
+
+The counts (Kutzbach, Gruebler, spherical) come from the topology.  The true
+mobility comes from screw theory: at an assembled configuration the rows of the
+constraint Jacobian K are the wrenches the cut joints transmit; the joint rates
+the loops allow are the null space of K, so ``M = nv - rank K`` where nv counts
+the tree-joint velocity coordinates.  The generic rank is the largest rank over
+the assembled configuration and a few nearby assembled configurations, so a
+file drawn in a singular pose does not change the answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import AssemblyError, UsageError
+from .topology import Topology
+
+__all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+def _svd(A):
+    if A.size == 0:
+        return np.zeros(0), np.zeros((A.shape[1], A.shape[1]))
+    _, s, vt = np.linalg.svd(A)
+    return s, vt
+
+
+def rank(A, tol) -> int:
+    """Numerical rank: singular values above rank_rtol * sigma_max and rank_atol."""
+    if A.size == 0:
+        return 0
+    s = np.linalg.svd(A, compute_uv=False)
+    if s.size == 0 or s[0] <= tol.rank_atol:
+        return 0
+    return int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
+
+
+def null_space(A, tol, n=None) -> np.ndarray:
+    """Orthonormal basis (columns) of the null space of A (A has n columns)."""
+    n = A.shape[1] if n is None else n
+    if A.size == 0:
+        return np.eye(n)
+    _, s, vt = np.linalg.svd(A)
+    r = rank(A, tol)
+    return vt[r:].T.copy()
+
+
+@dataclass(frozen=True)
+class OutputMotion:
+    """What a link can do: the dimension and kind of its twist space.
+
+    label: e.g. "3T" (pure translations), "3R" (rotations about one point),
+    "3T1R", "6"; translations: dimension of the pure translations in the
+    twist space; rotations: rank of its angular part; twists: a basis of the
+    space, each (vx, vy, vz, wx, wy, wz) of the link's origin in world axes.
+    """
+
+    link: str
+    dimension: int
+    translations: int
+    rotations: int
+    label: str
+    center: tuple | None
+    twists: tuple
+
+
+@dataclass(frozen=True)
+class IdleMotion:
+    link: str
+    dofs: int
+
+
+@dataclass(frozen=True)
+class MobilityResult:
+    """Every number of a mobility analysis (the CLI prints and serializes these)."""
+
+    path: str
+    topology: Topology
+    coordinates: int  # tree-joint velocity coordinates (nv)
+    constraint_rows: int
+    rank: int
+    mobility: int
+    overconstraint: int
+    idle: tuple  # IdleMotion
+    idle_dofs: int
+    effective_mobility: int
+    actuated: tuple
+    actuation_source: str | None
+    effective_dofs: int | None
+    free_with_inputs_locked: int | None
+    classification: str
+    notes: tuple
+    output: OutputMotion | None
+    residual: float
+    iterations: int
+    samples: int
+    q: np.ndarray = field(repr=False, compare=False)
+
+    @property
+    def kutzbach(self) -> int:
+        return self.topology.kutzbach
+
+    @property
+    def gruebler(self):
+        return self.topology.gruebler
+
+    @property
+    def motion_space(self) -> str:
+        return self.topology.motion_space
+
+    def to_dict(self) -> dict:
+        from .report import mobility_dict
+
+        return mobility_dict(self)
+
+
+def _sample_configurations(mech, q0, rng):
+    """The assembled configuration and a few nearby assembled ones."""
+    tol = mech.tolerances
+    configs = [q0]
+    closure = mech.closure
+    if closure.nrows == 0 and mech.nv == 0:
+        return configs
+    for _ in range(tol.samples):
+        K = closure.jacobian(configs[0])
+        V = null_space(K, tol, mech.nv)
+        if V.shape[1] == 0:
+            break
+        step = V @ rng.normal(size=V.shape[1])
+        step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
+        try:
+            configs.append(closure.solve(pin.integrate(mech.model, configs[0], step)).q)
+        except AssemblyError:
+            continue
+    return configs
+
+
+def _body_frames(mech, topo):
+    """One body frame per link of the topology (not the ground)."""
+    frames = {}
+    for link in topo.links:
+        if link == topo.ground:
+            continue
+        frames[link] = mech.link_frame(link)
+    return frames
+
+
+def _joint_geometry_rows(mech, topo, frames, jac, q):
+    """Rows whose null space is the set of motions keeping every joint's geometry still.
+
+    For each joint and each of its two links: the velocity (seen from that link)
+    of a point of the joint (the centre of S and U joints, a point of the axis
+    of R joints; for P, C and planar joints only its component across the axis,
+    or along the normal, since the point slides), and the rate of each joint
+    axis fixed in that link.  A motion that keeps all of them still changes
+    nothing in how the links are connected: it can only spin links about lines
+    through all their joints, the idle motions.
+    """
+    data = mech.data
+    rows = []
+    for j in topo.joints:
+        if j.type in ("floating",) or j.point is None:
+            continue
+        p = np.asarray(j.point)
+        d = np.asarray(j.direction) if j.direction is not None else None
+        for side, link in enumerate(j.links):
+            if link not in frames:
+                continue  # the ground does not move
+            J = jac[link]
+            o = data.oMf[frames[link]].translation
+            Jp = J[:3] - pin.skew(p - o) @ J[3:]  # velocity of the point seen from this link
+            if j.type in ("prismatic", "cylindrical"):
+                rows.append((np.eye(3) - np.outer(d, d)) @ Jp)
+            elif j.type == "planar":
+                rows.append(d[None, :] @ Jp)
+            else:
+                rows.append(Jp)
+            axes = []
+            if j.type in ("revolute", "continuous", "prismatic", "cylindrical", "planar"):
+                axes = [d]
+            elif j.type == "universal":
+                axes = [d if side == 0 else np.asarray(j.direction2)]
+            for axis in axes:
+                rows.append(-pin.skew(axis) @ J[3:])
+    return rows
+
+
+def _idle(mech, topo, frames, q, V, output_link, tol):
+    """Idle motions: motions that change no joint's geometry.
+
+    Links joined to the rest by a single joint (free tips such as a serial
+    arm's flange) and the output link are excluded: their own motion is an
+    output, not an idle one.  Returns (per-link idle dofs, total idle dofs).
+    """
+    M = V.shape[1]
+    if M == 0 or not frames:
+        return [], 0, np.zeros((M, 0))
+    model, data = mech.model, mech.data
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    jac = {k: pin.getFrameJacobian(model, data, f, LWA) for k, f in frames.items()}
+    rows = _joint_geometry_rows(mech, topo, frames, jac, q)
+    degree = {name: 0 for name in topo.links}
+    for j in topo.joints:
+        for link in set(j.links):
+            degree[link] = degree.get(link, 0) + 1
+    for link, deg in degree.items():
+        if link in frames and (deg <= 1 or link == output_link):
+            rows.append(jac[link])
+    A = np.vstack(rows) @ V if rows else np.zeros((0, M))
+    I = null_space(A, tol, M)
+    idle = []
+    if I.shape[1]:
+        moves = {link: jac[link] @ V @ I for link in frames}
+        # a link takes part in an idle motion when its twist is not negligible
+        # next to the largest one (the basis is only as exact as the assembly)
+        floor = 1e-6 * max(np.linalg.norm(T) for T in moves.values())
+        for link, T in moves.items():
+            s = np.linalg.svd(T, compute_uv=False)
+            k = int(np.sum(s > floor))
+            if k:
+                idle.append(IdleMotion(link, k))
+    return idle, I.shape[1], I
+
+
+def _output_motion(link, T, tol, origin) -> OutputMotion:
+    dim = rank(T, tol)
+    if dim == 0:
+        return OutputMotion(link, 0, 0, 0, "0 (immobile)", None, ())
+    U, s, _ = np.linalg.svd(T, full_matrices=False)
+    basis = U[:, :dim]
+    r = rank(basis[3:], tol)
+    t = dim - r
+    center = None
+    if dim == 6:
+        label = "6"
+    elif t == 0:
+        # pure rotations about one point c: v_o + w x (c - o) = 0 for every twist
+        A = np.vstack([pin.skew(basis[3:, k]) for k in range(dim)])
+        b = np.concatenate([-basis[:3, k] for k in range(dim)])
+        x, *_ = np.linalg.lstsq(A, b, rcond=None)
+        scale = max(np.linalg.norm(basis[:3]), 1.0)
+        if np.linalg.norm(A @ x - b) < 1e-6 * scale:
+            label = f"{r}R"
+            # for one rotation the point is any point of the axis: take the nearest to the origin
+            center = tuple(np.asarray(origin) + x)
+        elif dim == 1:
+            w, v = basis[3:, 0], basis[:3, 0]
+            label = f"1H (screw, pitch {w @ v / (w @ w):.4g} m/rad)"
+        else:
+            label = f"{r}R (screw motions)"
+    else:
+        label = (f"{t}T" if t else "") + (f"{r}R" if r else "")
+    return OutputMotion(link, dim, t, r, label, center, tuple(tuple(col) for col in basis.T))
+
+
+def _classify(n, m, eff, overconstraint, topo, M):
+    notes = []
+    lam_count = topo.count_in_motion_space
+    crit = {"planar": "Gruebler (planar) count", "spherical": "spherical count"}.get(topo.motion_space, "Kutzbach count")
+    if n == 0:
+        kind = "statically determinate structure" if overconstraint == 0 else (
+            f"statically indeterminate structure ({overconstraint} redundant constraint{'s' if overconstraint > 1 else ''})")
+    elif m == 0:
+        kind = f"mechanism with {n} degree{'s' if n > 1 else ''} of freedom (no actuated joints declared)"
+    elif m == n and eff == n:
+        kind = "constrained mechanism (properly actuated)"
+    elif m == n:
+        kind = f"improperly actuated: {m} inputs but they control only {eff} of the {n} degrees of freedom"
+    elif m < n:
+        kind = f"unconstrained (under-actuated): {m} input{'s' if m > 1 else ''} for {n} degrees of freedom"
+    else:
+        kind = f"redundantly actuated: {m} inputs for {n} degree{'s' if n > 1 else ''} of freedom"
+    if lam_count != M:
+        why = []
+        if overconstraint:
+            why.append(f"the mechanism is overconstrained ({overconstraint} redundant constraint"
+                       f"{'s' if overconstraint > 1 else ''}: its special geometry lets it move although the count says it cannot)"
+                       if lam_count < M else f"{overconstraint} constraints are redundant")
+        notes.append(f"The {crit} gives {lam_count} but the screw-theory mobility is {M}"
+                     + (": " + "; ".join(why) if why else "") + ".")
+    if topo.motion_space != "spatial" and topo.kutzbach != M:
+        notes.append(f"The spatial Kutzbach count ({topo.kutzbach}) does not apply: the mechanism is {topo.motion_space}.")
+    if n != M:
+        notes.append(f"{M - n} of the {M} degrees of freedom are idle (a link turning on itself); "
+                     f"{n} remain effective.")
+    if n < 0:  # pragma: no cover - rank-based mobility is never negative
+        kind = "statically indeterminate structure"
+    return kind, tuple(notes)
+
+
+def analyze_mobility(mech, output=None, seed: int = 0) -> MobilityResult:
+    """Mobility of ``mech`` (see the module docstring); output names a link."""
+    tol = mech.tolerances
+    if output is not None:
+        out_frame = mech.link_frame(output)
+    assembly = mech.assemble()
+    rng = np.random.default_rng(seed)
+    configs = _sample_configurations(mech, assembly.q, rng)
+    topo = mech.topology(assembly.q)
+    frames = _body_frames(mech, topo)
+    output_link = None
+    if output is not None:
+        output_link = next((l for l, m in topo.link_members.items() if output in m), output)
+    act_idx = mech.velocity_indices(mech.actuated)
+    best = None
+    for q in configs:
+        K = mech.closure.jacobian(q)
+        rk = rank(K, tol)
+        V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
+        M = V.shape[1]
+        idle, idle_total, I = _idle(mech, mech.topology(q), frames, q, V, output_link, tol)
+        out = None
+        if output is not None:
+            model, data = mech.model, mech.data
+            T = pin.getFrameJacobian(model, data, out_frame, LWA) @ V
+            out = _output_motion(output, T, tol, data.oMf[out_frame].translation)
+        eff = rank(V[act_idx], tol) if len(act_idx) else None
+        key = (rk, -idle_total, out.dimension if out else 0, eff or 0)
+        if best is None or key > best[0]:
+            best = (key, q, K, rk, M, V, idle, idle_total, I, out, eff)
+    _, q, K, rk, M, V, idle, idle_total, I, out, eff = best
+    n = M - idle_total
+    m = len(act_idx)
+    locked = None
+    if m:
+        # motions left with the inputs locked, beyond the idle ones
+        L = null_space(V[act_idx], tol, M)
+        locked = rank(np.hstack([L, I]), tol) - idle_total if L.shape[1] else 0
+    overconstraint = K.shape[0] - rk
+    kind, notes = _classify(n, m, eff if eff is not None else 0, overconstraint, topo, M)
+    if m and locked:
+        notes += (f"With the inputs locked the mechanism can still move ({locked} degree{'s' if locked > 1 else ''} of freedom).",)
+    return MobilityResult(
+        path=mech.path,
+        topology=topo,
+        coordinates=mech.nv,
+        constraint_rows=K.shape[0],
+        rank=rk,
+        mobility=M,
+        overconstraint=overconstraint,
+        idle=tuple(idle),
+        idle_dofs=idle_total,
+        effective_mobility=n,
+        actuated=tuple(mech.actuated),
+        actuation_source=mech.actuation_source,
+        effective_dofs=eff,
+        free_with_inputs_locked=locked,
+        classification=kind,
+        notes=notes,
+        output=out,
+        residual=assembly.residual,
+        iterations=assembly.iterations,
+        samples=len(configs),
+        q=q,
+    )

@@ -1,0 +1,143 @@
+"""Turning results into text tables and JSON-ready dictionaries (the edge)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["mobility_dict", "mobility_text", "topology_dict", "topology_text", "table"]
+
+
+def table(headers, rows) -> str:
+    """A plain-text table with aligned columns."""
+    rows = [[str(c) for c in r] for r in rows]
+    widths = [max(len(str(h)), *(len(r[i]) for r in rows)) if rows else len(str(h)) for i, h in enumerate(headers)]
+    line = "  ".join(str(h).ljust(w) for h, w in zip(headers, widths)).rstrip()
+    out = [line, "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    return "\n".join(out)
+
+
+def _joint_dict(j) -> dict:
+    return {
+        "name": j.name,
+        "type": j.type,
+        "dof": j.dof,
+        "links": list(j.links),
+        "motion": j.motion,
+        "contact": j.contact,
+        "cut": j.cut,
+        "members": list(j.members),
+    }
+
+
+def topology_dict(topo) -> dict:
+    return {
+        "links": topo.n_links,
+        "link_names": list(topo.links),
+        "ground": topo.ground,
+        "joints": [_joint_dict(j) for j in topo.joints],
+        "loops": topo.loops,
+        "motion_space": topo.motion_space,
+        "motion_space_detail": topo.motion_space_detail,
+        "massless_links_in_compound_joints": list(topo.dummy_links),
+    }
+
+
+def mobility_dict(r) -> dict:
+    t = r.topology
+    out = None
+    if r.output is not None:
+        o = r.output
+        out = {
+            "link": o.link,
+            "dimension": o.dimension,
+            "translations": o.translations,
+            "rotations": o.rotations,
+            "label": o.label,
+            "center": list(o.center) if o.center is not None else None,
+            "twists": [list(map(float, tw)) for tw in o.twists],
+        }
+    d = topology_dict(t)
+    d.update({
+        "file": r.path,
+        "kutzbach": t.kutzbach,
+        "gruebler": t.gruebler,
+        "spherical_count": t.spherical_count,
+        "coordinates": r.coordinates,
+        "constraint_rows": r.constraint_rows,
+        "constraint_rank": r.rank,
+        "mobility": r.mobility,
+        "overconstraint": r.overconstraint,
+        "idle_dofs": r.idle_dofs,
+        "idle_links": [{"link": i.link, "dofs": i.dofs} for i in r.idle],
+        "effective_mobility": r.effective_mobility,
+        "effective_dofs": r.effective_dofs,
+        "actuated": list(r.actuated),
+        "actuation_source": r.actuation_source,
+        "free_with_inputs_locked": r.free_with_inputs_locked,
+        "classification": r.classification,
+        "notes": list(r.notes),
+        "output_motion": r.output.label if r.output is not None else None,
+        "output": out,
+        "assembly": {"residual": r.residual, "iterations": r.iterations, "configurations_sampled": r.samples},
+    })
+    return d
+
+
+def topology_text(topo, title: str) -> str:
+    rows = [(j.name if len(j.name) <= 48 else j.name[:45] + "...", j.type, j.dof, f"{j.links[0]} - {j.links[1]}",
+             j.contact, "cut" if j.cut else "") for j in topo.joints]
+    lines = [title, "", table(["joint", "type", "dof", "links", "contact", "loop"], rows), ""]
+    lines.append(f"links N = {topo.n_links} (ground: {topo.ground})   joints J = {topo.n_joints}   "
+                 f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}")
+    if topo.dummy_links:
+        lines.append(f"massless links inside compound joints (not counted): {len(topo.dummy_links)}")
+    lines.append(f"motion space: {topo.motion_space} ({topo.motion_space_detail})")
+    return "\n".join(lines)
+
+
+def mobility_text(r) -> str:
+    t = r.topology
+    lines = [topology_text(t, f"Mobility of {r.path}"), ""]
+    counts = [("Kutzbach (spatial)", f"6(N-1-J) + sum f = 6({t.n_links}-1-{t.n_joints}) + {t.sum_dof}", t.kutzbach)]
+    if t.gruebler is not None:
+        counts.append(("Gruebler (planar)", f"3(N-1-J) + sum f = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}", t.gruebler))
+    if t.spherical_count is not None:
+        counts.append(("spherical", f"3(N-1-J) + sum f = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}", t.spherical_count))
+    lines.append(table(["count", "formula", "value"], counts))
+    lines.append("")
+    rows = [
+        ("joint coordinates", r.coordinates),
+        ("constraint rows (cut joints)", r.constraint_rows),
+        ("rank of constraint Jacobian K", r.rank),
+        ("mobility M = coordinates - rank K", r.mobility),
+        ("overconstraint (rows - rank = M - count)", r.overconstraint),
+        ("idle DOFs", r.idle_dofs),
+        ("effective mobility", r.effective_mobility),
+        ("actuated joints", ", ".join(r.actuated) + (f"  [{r.actuation_source}]" if r.actuated else "") or "none declared"),
+        ("DOFs the actuators control", r.effective_dofs if r.effective_dofs is not None else "-"),
+    ]
+    if r.output is not None:
+        rows.append((f"output link '{r.output.link}' can do", r.output.label))
+    lines.append(table(["screw theory", "value"], rows))
+    if r.idle:
+        lines.append("links in idle motions: " + ", ".join(f"{i.link} ({i.dofs})" for i in r.idle))
+    lines.append("")
+    lines.append(f"classification: {r.classification}")
+    for n in r.notes:
+        lines.append(f"note: {n}")
+    lines.append(f"(assembled: closure residual {r.residual:.2e} after {r.iterations} iterations; "
+                 f"rank taken over {r.samples} assembled configurations)")
+    return "\n".join(lines)
+
+
+def to_jsonable(obj):
+    if isinstance(obj, dict):
+        return {k: to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return obj

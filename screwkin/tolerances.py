@@ -1,0 +1,40 @@
+"""The one place for numerical tolerances.
+
+All analyses take a :class:`Tolerances` object; nothing else in the package
+hard-codes a threshold.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["Tolerances", "DEFAULT"]
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Numerical tolerances, with their units.
+
+    closure:        largest accepted loop-closure residual norm [m, rad].
+    rank_rtol:      singular values below ``rank_rtol * sigma_max`` count as zero [-].
+    rank_atol:      singular values below this always count as zero [same units as the matrix].
+    geometry:       tolerance of geometric tests (parallel or intersecting axes,
+                    concurrent axes, planarity) [m for distances, rad-like for directions].
+    dummy_mass:     a link without geometry and lighter than this is a massless
+                    link that may sit inside a compound joint [kg].
+    max_iterations: iteration limit of the closure solver [-].
+    samples:        nearby assembled configurations sampled for the generic rank [-].
+    sample_step:    size of the random step to a nearby configuration [rad or m].
+    """
+
+    closure: float = 1e-10
+    rank_rtol: float = 1e-8
+    rank_atol: float = 1e-10
+    geometry: float = 1e-6
+    dummy_mass: float = 1e-4
+    max_iterations: int = 200
+    samples: int = 3
+    sample_step: float = 0.05
+
+
+DEFAULT = Tolerances()

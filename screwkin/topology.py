@@ -1,0 +1,444 @@
+"""Topology of a mechanism: links, joints, compound joints, loops, motion space.
+
+Links are rigid bodies: URDF links joined by fixed joints (or by a fixed cut
+joint) are one link, the ground is one link, and the massless, geometry-less
+links inside a recognized compound joint are no link at all.  Chains of 1-DOF
+joints through such massless links are recognized from their geometry at an
+assembled configuration:
+
+- universal: two revolutes whose axes intersect (not parallel);
+- spherical: three revolutes whose axes meet at one point and span space;
+- cylindrical: a revolute and a prismatic along the same line direction.
+
+Joint types and their counts feed the Kutzbach/Gruebler criteria; the motion
+space (planar, spherical, spatial) is detected from the axes, not declared.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+__all__ = ["Joint", "Topology", "build_topology"]
+
+MOTION = {
+    "revolute": "rotation about an axis",
+    "continuous": "rotation about an axis",
+    "prismatic": "translation along an axis",
+    "cylindrical": "rotation about and translation along an axis",
+    "universal": "two rotations about intersecting axes",
+    "spherical": "three rotations about a point",
+    "planar": "planar motion (2 translations, 1 rotation)",
+    "floating": "free motion (6)",
+    "fixed": "none",
+}
+SYMBOL = {
+    "revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical": "C",
+    "universal": "U", "spherical": "S", "planar": "E", "floating": "F", "fixed": "-",
+}
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A kinematic pair of the mechanism (possibly a compound of URDF joints).
+
+    members: the URDF joint names it is made of (one for a simple joint).
+    cut:     True when it is (or contains) a cut joint closing a loop.
+    point, direction: a point on the axis and the axis direction (world, at the
+    analysed configuration); direction is None for spherical/floating joints.
+    """
+
+    name: str
+    type: str
+    dof: int
+    links: tuple
+    members: tuple
+    cut: bool
+    point: tuple | None = None
+    direction: tuple | None = None
+    direction2: tuple | None = None  # universal joints: the axis fixed in links[1]
+
+    @property
+    def motion(self) -> str:
+        return MOTION[self.type]
+
+    @property
+    def contact(self) -> str:
+        """Lower pairs touch over a surface; the formats here express no higher pair."""
+        return "lower pair" if self.type != "universal" else "lower pairs (compound)"
+
+    @property
+    def symbol(self) -> str:
+        return SYMBOL[self.type]
+
+
+@dataclass(frozen=True)
+class Topology:
+    """Links, joints and loops of a mechanism, and its detected motion space."""
+
+    links: tuple  # link names (a merged link is named after its first URDF link)
+    link_members: dict  # link name -> tuple of URDF link names
+    ground: str
+    joints: tuple  # Joint
+    motion_space: str  # "planar" | "spherical" | "spatial"
+    motion_space_detail: str
+    dummy_links: tuple = field(default=())  # URDF links inside compound joints
+
+    @property
+    def n_links(self) -> int:
+        return len(self.links)
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.joints)
+
+    @property
+    def loops(self) -> int:
+        return self.n_joints - self.n_links + 1
+
+    @property
+    def sum_dof(self) -> int:
+        return sum(j.dof for j in self.joints)
+
+    def count(self, lam: int) -> int:
+        """Chebychev-Gruebler-Kutzbach count with motion-space dimension lam."""
+        return lam * (self.n_links - 1 - self.n_joints) + self.sum_dof
+
+    @property
+    def kutzbach(self) -> int:
+        return self.count(6)
+
+    @property
+    def gruebler(self):
+        return self.count(3) if self.motion_space == "planar" else None
+
+    @property
+    def spherical_count(self):
+        return self.count(3) if self.motion_space == "spherical" else None
+
+    @property
+    def count_in_motion_space(self) -> int:
+        return self.count(6 if self.motion_space == "spatial" else 3)
+
+
+class _Union:
+    def __init__(self, items):
+        self.parent = {i: i for i in items}
+
+    def find(self, x):
+        while self.parent[x] != x:
+            self.parent[x] = self.parent[self.parent[x]]
+            x = self.parent[x]
+        return x
+
+    def join(self, a, b):
+        ra, rb = self.find(a), self.find(b)
+        if ra != rb:
+            self.parent[rb] = ra
+
+
+def _frame_link(mech, frame_name: str) -> str:
+    """The URDF link a Pinocchio frame is attached to."""
+    spec = mech.spec
+    if frame_name in spec.links:
+        return frame_name
+    for j in spec.joints:
+        if j.name == frame_name:
+            return j.child
+    model = mech.model
+    fid = model.getFrameId(frame_name)
+    for _ in range(len(model.frames)):
+        f = model.frames[fid]
+        if f.type == pin.FrameType.BODY and f.name in spec.links:
+            return f.name
+        fid = f.parentFrame
+    return spec.root
+
+
+@dataclass
+class _Edge:
+    name: str
+    type: str
+    dof: int
+    a: str
+    b: str
+    cut: bool
+    point: np.ndarray | None
+    direction: np.ndarray | None
+    direction2: np.ndarray | None = None
+
+
+def _edges(mech, q):
+    """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
+    model, data = mech.model, mech.data
+    pin.forwardKinematics(model, data, q)
+    pin.updateFramePlacements(model, data)
+    replaced = dict(mech.spec.replacements)
+    edges, welds = [], []
+    for j in mech.spec.joints:
+        t = j.type
+        rep = replaced.get(j.name)
+        if rep == "SPHERICAL":
+            t = "spherical"
+        elif rep == "FIXED":
+            t = "fixed"
+        elif rep and (rep.startswith("UJOINT") or rep == "CARDAN"):
+            t = "universal"
+        if t == "fixed":
+            welds.append((j.parent, j.child))
+            continue
+        point = direction = None
+        if model.existJointName(j.name):
+            M = data.oMi[model.getJointId(j.name)]
+            point = M.translation.copy()
+            if t in ("revolute", "continuous", "prismatic", "planar"):
+                direction = M.rotation @ np.asarray(j.axis)
+        dof = {"spherical": 3, "universal": 2}.get(t, j.dof)
+        edges.append(_Edge(j.name, t, dof, j.parent, j.child, False, point, direction))
+    for c in mech.cuts:
+        a = _frame_link(mech, c.link1)
+        b = _frame_link(mech, c.link2)
+        if c.type == "fixed":
+            welds.append((a, b))
+            continue
+        M1 = data.oMf[c.frame1]
+        direction = direction2 = None
+        if c.type in ("revolute", "continuous", "prismatic", "cylindrical", "planar", "universal"):
+            direction = M1.rotation @ np.asarray(c.axis)
+        if c.type == "universal":
+            direction2 = data.oMf[c.frame2].rotation @ np.asarray(c.axis2)
+        edges.append(_Edge(c.name, c.type, c.dof, a, b, True, M1.translation.copy(), direction, direction2))
+    return edges, welds
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
+
+
+def _parallel(d1, d2, tol):
+    return np.linalg.norm(np.cross(_unit(d1), _unit(d2))) < tol
+
+
+def _line_distance(p1, d1, p2, d2, tol):
+    n = np.cross(_unit(d1), _unit(d2))
+    if np.linalg.norm(n) < tol:  # parallel: distance between the lines
+        w = p2 - p1
+        return np.linalg.norm(w - (w @ _unit(d1)) * _unit(d1))
+    return abs((p2 - p1) @ _unit(n))
+
+
+def _common_point(points, directions):
+    """Least-squares point closest to all lines; returns (point, largest distance)."""
+    A = np.zeros((3, 3))
+    b = np.zeros(3)
+    for p, d in zip(points, directions):
+        P = np.eye(3) - np.outer(_unit(d), _unit(d))
+        A += P
+        b += P @ p
+    if np.linalg.matrix_rank(A, tol=1e-9) < 3:
+        return None, np.inf
+    c = np.linalg.solve(A, b)
+    dist = max(np.linalg.norm((np.eye(3) - np.outer(_unit(d), _unit(d))) @ (c - p)) for p, d in zip(points, directions))
+    return c, dist
+
+
+def _compound_name(members, kind) -> str:
+    """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
+    import os.path
+
+    prefix = os.path.commonprefix(members)
+    for tail in ("_rev", "rev", "_"):
+        if prefix.endswith(tail):
+            prefix = prefix[: -len(tail)]
+    if len(prefix) >= 3:
+        return f"{prefix}[{SYMBOL[kind]}]"
+    return "+".join(members)
+
+
+def _classify_chain(chain, tol, scale):
+    """The compound type of a chain of 1-DOF edges through massless links, or None."""
+    kinds = [e.type for e in chain]
+    if any(e.direction is None or e.point is None for e in chain):
+        return None
+    lt = tol * max(scale, 1.0)
+    rev = [e for e in chain if e.type in ("revolute", "continuous")]
+    pri = [e for e in chain if e.type == "prismatic"]
+    if len(chain) == 2 and len(rev) == 2:
+        a, b = rev
+        if not _parallel(a.direction, b.direction, tol) and _line_distance(
+            a.point, a.direction, b.point, b.direction, tol
+        ) < lt:
+            return "universal"
+    if len(chain) == 2 and len(rev) == 1 and len(pri) == 1:
+        if _parallel(rev[0].direction, pri[0].direction, tol):
+            return "cylindrical"
+    if len(chain) == 3 and len(rev) == 3:
+        dirs = np.array([_unit(e.direction) for e in rev])
+        if np.linalg.matrix_rank(dirs, tol=tol) == 3:
+            _, dist = _common_point([e.point for e in rev], dirs)
+            if dist < lt:
+                return "spherical"
+    del kinds
+    return None
+
+
+def build_topology(mech, q) -> Topology:
+    """Links, joints (with compound joints recognized) and motion space at configuration q."""
+    tol = mech.tolerances.geometry
+    spec = mech.spec
+    edges, welds = _edges(mech, q)
+    uf = _Union(list(spec.links))
+    for a, b in welds:
+        uf.join(a, b)
+    ground_root = uf.find(spec.root)
+    groups = {}
+    for name in spec.links:
+        groups.setdefault(uf.find(name), []).append(name)
+    # name each rigid body after its first URDF link (the ground after the root link)
+    body_name = {r: (spec.root if r == ground_root else members[0]) for r, members in groups.items()}
+    for e in edges:
+        e.a, e.b = uf.find(e.a), uf.find(e.b)
+    scale = max([np.linalg.norm(e.point) for e in edges if e.point is not None] + [1e-3])
+
+    # massless bodies of degree 2 between 1-DOF joints may be the inside of a compound joint
+    incident = {r: [] for r in groups}
+    for k, e in enumerate(edges):
+        incident[e.a].append(k)
+        incident[e.b].append(k)
+    dm = mech.tolerances.dummy_mass
+
+    def massless(r):
+        return r != ground_root and all(spec.links[m].is_massless(dm) for m in groups[r])
+
+    def one_dof(k):
+        return edges[k].type in ("revolute", "continuous", "prismatic")
+
+    candidates = {r for r in groups if massless(r) and len(incident[r]) == 2 and all(one_dof(k) for k in incident[r])}
+    used_edges, dummies, compounds = set(), set(), []
+    for start in sorted(candidates, key=lambda r: body_name[r]):
+        if start in dummies:
+            continue
+        # grow the run of candidate bodies through start, then read the chain of edges in order
+        run = {start}
+        stack = [start]
+        while stack:
+            r = stack.pop()
+            for k in incident[r]:
+                other = edges[k].b if edges[k].a == r else edges[k].a
+                if other in candidates and other not in run:
+                    run.add(other)
+                    stack.append(other)
+        ends = []
+        for r in run:
+            for k in incident[r]:
+                other = edges[k].b if edges[k].a == r else edges[k].a
+                if other not in run:
+                    ends.append((r, k))
+        if len(ends) != 2:
+            continue
+        # walk from one end to the other
+        chain, r, k = [], ends[0][0], ends[0][1]
+        chain.append(edges[k])
+        prev = k
+        while True:
+            nxt = [x for x in incident[r] if x != prev]
+            k = nxt[0]
+            chain.append(edges[k])
+            other = edges[k].b if edges[k].a == r else edges[k].a
+            if other not in run:
+                break
+            r, prev = other, k
+        outer = [edges[ends[0][1]], edges[ends[1][1]]]
+        end_a = outer[0].a if outer[0].a not in run else outer[0].b
+        end_b = outer[1].a if outer[1].a not in run else outer[1].b
+        kind = _classify_chain(chain, tol, scale)
+        if kind is None:
+            continue
+        dummies |= run
+        used_edges |= {id(e) for e in chain}
+        point = chain[0].point
+        direction = direction2 = None
+        if kind == "cylindrical":
+            direction = next(e.direction for e in chain if e.type != "prismatic")
+        elif kind == "spherical":
+            point, _ = _common_point([e.point for e in chain], [e.direction for e in chain])
+        elif kind == "universal":
+            a, b = chain
+            n = np.cross(_unit(a.direction), _unit(b.direction))
+            # intersection point of the two axes
+            A = np.stack([_unit(a.direction), -_unit(b.direction), n], axis=1)
+            s = np.linalg.lstsq(A, b.point - a.point, rcond=None)[0]
+            point = a.point + s[0] * _unit(a.direction)
+            # the first axis turns with the link at the start of the chain, the second with the end
+            direction, direction2 = a.direction, b.direction
+        compounds.append(
+            Joint(
+                name=_compound_name([e.name for e in chain], kind),
+                type=kind,
+                dof=sum(e.dof for e in chain),
+                links=(body_name[end_a], body_name[end_b]),
+                members=tuple(e.name for e in chain),
+                cut=any(e.cut for e in chain),
+                point=tuple(point) if point is not None else None,
+                direction=tuple(direction) if direction is not None else None,
+                direction2=tuple(direction2) if direction2 is not None else None,
+            )
+        )
+    joints = []
+    for e in edges:
+        if id(e) in used_edges:
+            continue
+        joints.append(
+            Joint(e.name, e.type, e.dof, (body_name[e.a], body_name[e.b]), (e.name,), e.cut,
+                  tuple(e.point) if e.point is not None else None,
+                  tuple(e.direction) if e.direction is not None else None,
+                  tuple(e.direction2) if e.direction2 is not None else None)
+        )
+    joints += compounds
+    links = tuple(body_name[r] for r in groups if r not in dummies)
+    members = {body_name[r]: tuple(groups[r]) for r in groups if r not in dummies}
+    dummy_links = tuple(m for r in dummies for m in groups[r])
+    space, detail = _motion_space(joints, tol, scale)
+    return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links)
+
+
+def _motion_space(joints, tol, scale):
+    """'planar' when every revolute axis is parallel to one normal and every
+    prismatic axis perpendicular to it; 'spherical' when every joint is a
+    rotation about one common point; 'spatial' otherwise."""
+    lt = tol * max(scale, 1.0)
+    if not joints:
+        return "spatial", "no joints"
+    rot = [j for j in joints if j.type in ("revolute", "continuous")]
+    pri = [j for j in joints if j.type == "prismatic"]
+    other = [j for j in joints if j.type not in ("revolute", "continuous", "prismatic", "planar")]
+    planar_pairs = [j for j in joints if j.type == "planar"]
+    if not other:
+        normal = None
+        if rot:
+            normal = _unit(np.asarray(rot[0].direction))
+        elif planar_pairs:
+            normal = _unit(np.asarray(planar_pairs[0].direction))
+        elif len(pri) >= 1:
+            dirs = np.array([_unit(np.asarray(j.direction)) for j in pri])
+            u, s, vt = np.linalg.svd(dirs)
+            if len(s) < 3 or s[-1] < tol:
+                normal = vt[-1]
+        if normal is not None:
+            ok = all(_parallel(normal, np.asarray(j.direction), tol) for j in rot + planar_pairs)
+            ok = ok and all(abs(normal @ _unit(np.asarray(j.direction))) < tol for j in pri)
+            if ok:
+                n = np.round(normal, 6) + 0.0
+                return "planar", f"every revolute axis is parallel to ({n[0]:g}, {n[1]:g}, {n[2]:g}) and every prismatic axis perpendicular to it"
+    if not pri and not planar_pairs and all(j.type in ("revolute", "continuous", "spherical", "universal") for j in joints):
+        lines = [(np.asarray(j.point), np.asarray(j.direction)) for j in rot]
+        if len(lines) >= 2:
+            c, dist = _common_point([p for p, _ in lines], [d for _, d in lines])
+            if c is not None and dist < lt:
+                centres = [np.asarray(j.point) for j in joints if j.type in ("spherical", "universal")]
+                if all(np.linalg.norm(p - c) < lt for p in centres):
+                    cc = np.round(c, 6) + 0.0
+                    return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})"
+    return "spatial", "the joint axes are neither all parallel (planar) nor all concurrent (spherical)"
