@@ -287,8 +287,8 @@ def check_meshes(path, root) -> list:
     base = Path(path).resolve().parent
     missing = []
     for mesh in root.iter("mesh"):
-        uri = mesh.get("filename")
-        if not uri:
+        uri = mesh.get("filename") or (mesh.findtext("uri") or "").strip()
+        if not uri or uri.startswith("model://"):
             continue
         if not any(c.is_file() for c in resolve_uri(uri, base)):
             if uri not in missing:

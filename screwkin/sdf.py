@@ -1,0 +1,209 @@
+"""Reading SDF models, whose joints may form loops.
+
+The PyPI Pinocchio wheel has no SDF parser, so the joint graph is read here,
+cut into a spanning tree (breadth first from the ground) plus cut joints, and
+the tree is written out as URDF text for Pinocchio's URDF parser -- the same
+path every URDF takes.  Each tree link's frame is put at its joint's frame (as
+URDF requires); SDF ``ball`` and ``universal``/``revolute2`` joints in the tree
+become three or two revolutes through massless links, i.e. compound joints.
+
+Supported: poses of links relative to the model, joint poses relative to the
+child link (SDF defaults), joint axes in the joint frame (or the model frame
+with ``use_parent_model_frame`` / ``expressed_in="__model__"``).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+import pinocchio as pin
+
+from .description import CutJointSpec, JointSpec, LinkSpec, MechanismSpec, finite
+from .errors import MechanismFileError
+from .urdf import check_meshes
+from .xmlsafe import parse_xml_text
+
+__all__ = ["read_sdf"]
+
+_TYPES = {"revolute", "continuous", "prismatic", "fixed", "ball", "universal", "revolute2"}
+_CUT = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed",
+        "ball": "spherical", "universal": "universal", "revolute2": "universal"}
+
+
+def _pose(elem, what, problems):
+    if elem is None or not (elem.text or "").strip():
+        return pin.SE3.Identity()
+    rel = elem.get("relative_to")
+    parts = elem.text.split()
+    try:
+        v = [float(p) for p in parts]
+    except ValueError:
+        problems.append(f"{what} <pose> '{elem.text.strip()}' is not 6 numbers")
+        return pin.SE3.Identity()
+    if len(v) != 6 or not finite(v):
+        problems.append(f"{what} <pose> '{elem.text.strip()}' must be 6 finite numbers")
+        return pin.SE3.Identity()
+    if rel not in (None, "", "__model__"):
+        problems.append(f"{what} <pose relative_to='{rel}'> is not supported (only poses relative to the model)")
+    return pin.SE3(pin.rpy.rpyToMatrix(np.array(v[3:])), np.array(v[:3]))
+
+
+def _vec(text, what, problems):
+    try:
+        v = np.array([float(p) for p in (text or "").split()])
+    except ValueError:
+        v = np.zeros(0)
+    if v.shape != (3,) or not finite(v):
+        problems.append(f"{what} '{(text or '').strip()}' must be 3 finite numbers")
+        return np.array([1.0, 0, 0])
+    if np.linalg.norm(v) < 1e-12:
+        problems.append(f"{what}: zero axis")
+        return np.array([1.0, 0, 0])
+    return v / np.linalg.norm(v)
+
+
+def _axis(joint, tag, name, X_joint, problems):
+    a = joint.find(tag)
+    if a is None:
+        return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])
+    xyz = a.find("xyz")
+    v = _vec(xyz.text if xyz is not None else None, f"joint '{name}' <{tag}><xyz>", problems)
+    model_frame = (a.findtext("use_parent_model_frame") or "").strip() == "true" or (
+        xyz is not None and xyz.get("expressed_in") == "__model__")
+    return X_joint.rotation.T @ v if model_frame else v
+
+
+def _fmt(v):
+    return " ".join(f"{x:.17g}" for x in v)
+
+
+def _origin(M):
+    return f'<origin xyz="{_fmt(M.translation)}" rpy="{_fmt(pin.rpy.matrixToRpy(M.rotation))}"/>'
+
+
+def read_sdf(path, text) -> MechanismSpec:
+    root = parse_xml_text(text, path)
+    if root.tag != "sdf":
+        raise MechanismFileError(path, f"not an SDF file: the root element is <{root.tag}>")
+    model = root.find("model")
+    if model is None:
+        model = root.find("world/model")
+    if model is None:
+        raise MechanismFileError(path, "the SDF file has no <model>")
+    problems = []
+    links, poses = {}, {}
+    for e in model.findall("link"):
+        name = e.get("name")
+        if not name or name in links:
+            problems.append(f"a <link> has no name or a duplicate name ('{name}')")
+            continue
+        mass = e.findtext("inertial/mass")
+        try:
+            mass = float(mass) if mass is not None else None
+        except ValueError:
+            problems.append(f"link '{name}' <mass> '{mass}' is not a number")
+            mass = None
+        links[name] = LinkSpec(name, mass, e.find("visual") is not None or e.find("collision") is not None)
+        poses[name] = _pose(e.find("pose"), f"link '{name}'", problems)
+    raw = []
+    for e in model.findall("joint"):
+        name, jtype = e.get("name"), e.get("type")
+        if jtype not in _TYPES:
+            problems.append(f"joint '{name}' has unknown or unsupported type '{jtype}' (supported: {', '.join(sorted(_TYPES))})")
+            continue
+        parent, child = (e.findtext("parent") or "").strip(), (e.findtext("child") or "").strip()
+        for tag, link in (("parent", parent), ("child", child)):
+            if link != "world" and link not in links:
+                problems.append(f"joint '{name}' names {tag} link '{link}', which does not exist")
+        if child == "world":
+            problems.append(f"joint '{name}' has the world as its child")
+        raw.append((name, jtype, parent, child, e))
+    if problems:
+        raise MechanismFileError(path, problems)
+    if any(p == "world" for _, _, p, _, _ in raw):
+        links = {"world": LinkSpec("world", None, False), **links}
+        poses["world"] = pin.SE3.Identity()
+    ground = "world" if "world" in links else next(iter(links), None)
+    if ground is None:
+        raise MechanismFileError(path, "the model has no links")
+    # world pose of every joint frame (SDF: joint pose relative to the child link)
+    joint_pose = {n: poses[c] * _pose(e.find("pose"), f"joint '{n}'", problems) for n, _, _, c, e in raw}
+    axes = {n: (_axis(e, "axis", n, joint_pose[n], problems), _axis(e, "axis2", n, joint_pose[n], problems))
+            for n, _, _, _, e in raw}
+    if problems:
+        raise MechanismFileError(path, problems)
+    # spanning tree, breadth first from the ground
+    adjacency = {name: [] for name in links}
+    for k, (_, _, p, c, _) in enumerate(raw):
+        adjacency[p].append(k)
+        adjacency[c].append(k)
+    frame = {ground: poses[ground]}
+    tree, queue = {}, deque([ground])
+    while queue:
+        link = queue.popleft()
+        for k in adjacency[link]:
+            n, jt, p, c, _ = raw[k]
+            other = c if p == link else p
+            if other in frame or k in tree:
+                continue
+            tree[k] = (link, other)
+            frame[other] = joint_pose[n]
+            queue.append(other)
+    unreached = [n for n in links if n not in frame]
+    if unreached:
+        raise MechanismFileError(path, f"links not connected to '{ground}' by any joint: {', '.join(unreached[:5])}")
+    out = [f'<robot name={quoteattr(model.get("name") or "sdf_model")}>']
+    spec_links = dict(links)
+    joints, cuts = [], []
+
+    def link_xml(name):
+        mass = spec_links[name].mass
+        inertial = (f'<inertial><mass value="{mass:.17g}"/><inertia ixx="1e-9" iyy="1e-9" izz="1e-9" '
+                    f'ixy="0" ixz="0" iyz="0"/></inertial>') if mass else ""
+        return f"<link name={quoteattr(name)}>{inertial}</link>"
+
+    for name in links:
+        out.append(link_xml(name))
+    for k in sorted(tree):
+        n, jt, p, c, _ = raw[k]
+        parent, child = tree[k]  # oriented away from the ground
+        origin = frame[parent].inverse() * joint_pose[n]
+        a1, a2 = axes[n]
+        if jt in ("ball", "universal", "revolute2"):
+            chain = [np.eye(3)[0], np.eye(3)[1], np.eye(3)[2]] if jt == "ball" else [a1, a2]
+            prev = parent
+            for i, ax in enumerate(chain):
+                nxt = child if i == len(chain) - 1 else f"{n}__dummy{i}"
+                if nxt != child:
+                    spec_links[nxt] = LinkSpec(nxt, None, False)
+                    out.append(f"<link name={quoteattr(nxt)}/>")
+                o = _origin(origin) if i == 0 else '<origin xyz="0 0 0" rpy="0 0 0"/>'
+                jn = f"{n}__{i}"
+                out.append(f'<joint name={quoteattr(jn)} type="revolute"><parent link={quoteattr(prev)}/>'
+                           f'<child link={quoteattr(nxt)}/>{o}<axis xyz="{_fmt(ax)}"/>'
+                           f'<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/></joint>')
+                joints.append(JointSpec(jn, "revolute", prev, nxt, tuple(origin.translation) if i == 0 else (0, 0, 0),
+                                        tuple(pin.rpy.matrixToRpy(origin.rotation)) if i == 0 else (0, 0, 0), tuple(ax)))
+                prev = nxt
+            continue
+        urdf_type = "revolute" if jt == "continuous" else jt
+        limit = '<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/>' if jt != "fixed" else ""
+        out.append(f'<joint name={quoteattr(n)} type="{urdf_type}"><parent link={quoteattr(parent)}/>'
+                   f'<child link={quoteattr(child)}/>{_origin(origin)}<axis xyz="{_fmt(a1)}"/>{limit}</joint>')
+        joints.append(JointSpec(n, urdf_type, parent, child, tuple(origin.translation),
+                                tuple(pin.rpy.matrixToRpy(origin.rotation)), tuple(a1)))
+    for k, (n, jt, p, c, _) in enumerate(raw):
+        if k in tree:
+            continue
+        P1 = frame[p].inverse() * joint_pose[n]
+        P2 = frame[c].inverse() * joint_pose[n]
+        a1, a2 = axes[n]
+        cuts.append(CutJointSpec(n, _CUT[jt], p, c, tuple(P1.translation), tuple(pin.rpy.matrixToRpy(P1.rotation)),
+                                 tuple(P2.translation), tuple(pin.rpy.matrixToRpy(P2.rotation)), tuple(a1),
+                                 tuple(a2) if _CUT[jt] == "universal" else None, source="sdf"))
+    out.append("</robot>")
+    return MechanismSpec(path=str(path), name=model.get("name") or "sdf_model", format="sdf",
+                         urdf_text="\n".join(out), links=spec_links, joints=joints, cut_joints=cuts,
+                         warnings=check_meshes(path, model))

@@ -1,0 +1,176 @@
+"""Loading details: loop-joint forms, sidecars, SDF, actuation precedence, compound joints."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+import screwkin
+from conftest import CORPUS, DATA
+from screwkin.cli import main
+
+LINK = ('<link name="{n}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial><visual><geometry><box size="0.01 0.01 0.01"/></geometry></visual></link>')
+DUMMY = '<link name="{n}"/>'
+
+
+def rev(name, parent, child, axis="0 0 1", xyz="0 0 0", rpy="0 0 0", jtype="revolute"):
+    return (f'<joint name="{name}" type="{jtype}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>'
+            f'<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+
+
+def fourbar(loop_children='<link1 link="coupler" xyz="0.12 0 0"/><link2 link="rocker" xyz="0.08 0 0"/>',
+            extra=""):
+    # ground pivots A=(0,0), D=(0.1,0); crank 0.04 at 90 deg; coupler 0.12 and rocker 0.08
+    # placed with the angles of the closed loop (computed from the two circle intersection).
+    B = np.array([0.0, 0.04])
+    D = np.array([0.1, 0.0])
+    d = np.linalg.norm(D - B)
+    a = (0.12**2 - 0.08**2 + d**2) / (2 * d)
+    h = np.sqrt(0.12**2 - a**2)
+    u = (D - B) / d
+    C = B + a * u + h * np.array([-u[1], u[0]])
+    th_c = np.arctan2(*(C - B)[::-1])
+    th_r = np.arctan2(*(C - D)[::-1])
+    body = "".join(LINK.format(n=n) for n in ("ground", "crank", "coupler", "rocker"))
+    body += rev("crank_joint", "ground", "crank", rpy="0 0 1.5707963267948966")
+    body += rev("coupler_joint", "crank", "coupler", xyz="0.04 0 0", rpy=f"0 0 {th_c - np.pi / 2}")
+    body += rev("rocker_joint", "ground", "rocker", xyz="0.1 0 0", rpy=f"0 0 {th_r}")
+    body += f'<loop_joint name="C" type="revolute">{loop_children}<axis xyz="0 0 1"/></loop_joint>'
+    return f'<robot name="fourbar">{body}{extra}</robot>'
+
+
+def test_fourbar_loop_joint_is_closed_in_the_file(tmp_path):
+    p = tmp_path / "fb.urdf"
+    p.write_text(fourbar())
+    mech = screwkin.load(p)
+    a = mech.assemble()
+    assert a.iterations == 0  # the file's configuration is already closed
+    r = mech.mobility()
+    assert (r.mobility, r.topology.gruebler, r.topology.kutzbach) == (1, 1, -2)
+    assert r.topology.motion_space == "planar"
+
+
+def test_second_link1_is_read_as_link2(tmp_path):
+    p = tmp_path / "fb.urdf"
+    p.write_text(fourbar('<link1 link="coupler" xyz="0.12 0 0"/><link1 link="rocker" xyz="0.08 0 0"/>'))
+    seen = []
+    mech = screwkin.load(p, warn=seen.append)
+    assert any("second is read as <link2>" in w for w in seen)
+    assert mech.cuts[0].link2 == "rocker"
+    assert mech.mobility().mobility == 1
+
+
+def test_actuation_precedence(tmp_path):
+    tx = ('<transmission name="t"><type>transmission_interface/SimpleTransmission</type>'
+          '<joint name="rocker_joint"><hardwareInterface>EffortJointInterface</hardwareInterface></joint></transmission>')
+    p = tmp_path / "fb.urdf"
+    p.write_text(fourbar(extra=tx))
+    mech = screwkin.load(p)
+    assert (mech.actuated, mech.actuation_source) == (["rocker_joint"], "transmission")
+    (tmp_path / "fb.yaml").write_text("closed_loop: []\ntype: []\nname_mot: ['crank_joint']\n")
+    mech = screwkin.load(p)
+    assert (mech.actuated, mech.actuation_source) == (["crank_joint"], "yaml name_mot")
+    mech = screwkin.load(p, actuated=["coupler_joint"])
+    assert (mech.actuated, mech.actuation_source) == (["coupler_joint"], "command line")
+
+
+def test_sidecar_joint_replacement_spherical(tmp_path):
+    """The sidecar's joint_name/joint_type turn a revolute into a native
+    spherical joint (3 velocity coordinates)."""
+    src = CORPUS / "5bar_linkage_iso3d"
+    shutil.copy(src / "robot.urdf", tmp_path / "robot.urdf")
+    text = (src / "robot.yaml").read_text()
+    (tmp_path / "robot.yaml").write_text(text + "joint_name: ['freeortho']\njoint_type: ['SPHERICAL']\n")
+    mech = screwkin.load(tmp_path / "robot.urdf", warn=lambda m: None)
+    assert mech.coordinate("freeortho").nv == 3
+    r = mech.mobility()
+    # one revolute (1) became spherical (3): the count and the rank both go up by 2
+    assert r.topology.kutzbach == 4
+    assert r.mobility == 4
+
+
+def test_sdf_four_bar_is_cut_into_tree_plus_loop_joint():
+    mech = screwkin.load(DATA / "fourbar.sdf")
+    assert len(mech.cuts) == 1
+    r = mech.mobility(actuated=["A"], output="rocker")
+    assert r.mobility == 1 and r.topology.gruebler == 1
+    assert r.output.label == "1R"
+    assert r.classification.startswith("constrained")
+
+
+def test_sdf_ball_joints_become_compound_spherical(tmp_path):
+    """RSSR in SDF with two ball joints: the tree ball becomes three revolutes
+    through massless links, recognized again as one spherical joint."""
+    sdf = f"""<sdf version="1.7"><model name="rssr">
+      <link name="base"><pose>0 0 0 0 0 0</pose><visual name="v"/></link>
+      <link name="crank"><pose>0 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+      <link name="rod"><pose>0.05 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+      <link name="rocker"><pose>0.2 0.1 0.1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+      <joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>
+      <joint name="in" type="revolute"><parent>base</parent><child>crank</child><axis><xyz>0 0 1</xyz></axis></joint>
+      <joint name="s1" type="ball"><parent>crank</parent><child>rod</child></joint>
+      <joint name="out" type="revolute"><parent>base</parent><child>rocker</child><axis><xyz>1 0 0</xyz></axis></joint>
+      <joint name="s2" type="ball"><parent>rod</parent><child>rocker</child><pose>0 -0.05 0.05 0 0 0</pose></joint>
+    </model></sdf>"""
+    p = tmp_path / "rssr.sdf"
+    p.write_text(sdf)
+    r = screwkin.load(p).mobility()
+    t = r.topology
+    assert sorted(j.type for j in t.joints) == ["revolute", "revolute", "spherical", "spherical"]
+    assert (t.n_links, t.n_joints, t.kutzbach) == (4, 4, 2)
+    assert (r.mobility, r.idle_dofs) == (2, 1)  # the rod spins about the line through its two ball centres
+    assert [i.link for i in r.idle] == ["rod"]
+
+
+def test_cli_and_api_give_the_same_numbers(capsys):
+    path = CORPUS / "cassie_like" / "robot.urdf"
+    assert main(["mobility", str(path), "--json", "--output", "foot_2"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    r = screwkin.load(path, warn=lambda m: None).mobility(output="foot_2")
+    for key in ("links", "joints", "loops", "kutzbach", "gruebler", "motion_space", "mobility", "overconstraint",
+                "idle_dofs", "effective_dofs", "actuated", "classification", "output_motion"):
+        assert key in d
+    assert d["mobility"] == r.mobility and d["kutzbach"] == r.kutzbach
+    assert d["links"] == r.topology.n_links and d["loops"] == r.topology.loops
+    assert d["idle_dofs"] == r.idle_dofs and d["effective_dofs"] == r.effective_dofs
+    assert d["output_motion"] == r.output.label
+    assert [j["name"] for j in d["joints"]] == [j.name for j in r.topology.joints]
+    assert all(set(j) >= {"name", "type", "dof"} for j in d["joints"])
+
+
+def test_json_nulls_without_actuators_or_output(tmp_path, capsys):
+    p = tmp_path / "fb.urdf"
+    p.write_text(fourbar())
+    assert main(["mobility", str(p), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["effective_dofs"] is None and d["output_motion"] is None and d["actuated"] == []
+    assert d["gruebler"] == 1
+
+
+def test_info_table(capsys, tmp_path):
+    p = tmp_path / "fb.urdf"
+    p.write_text(fourbar())
+    assert main(["info", str(p)]) == 0
+    out = capsys.readouterr().out
+    assert "loops L = J - N + 1 = 1" in out and "crank_joint" in out
+
+
+def test_package_uri_resolves_against_ros_package_path(tmp_path, monkeypatch):
+    pkg = tmp_path / "pkgs" / "mypkg" / "meshes"
+    pkg.mkdir(parents=True)
+    (pkg / "m.stl").write_text("solid x\nendsolid x\n")
+    mesh = '<visual><geometry><mesh filename="package://mypkg/meshes/m.stl"/></geometry></visual>'
+    text = fourbar().replace('<link name="ground">', f'<link name="ground">{mesh}')
+    d = tmp_path / "robot"
+    d.mkdir()
+    (d / "fb.urdf").write_text(text)
+    seen = []
+    screwkin.load(d / "fb.urdf", warn=seen.append)
+    assert any("mesh" in w for w in seen)
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "pkgs"))
+    seen.clear()
+    screwkin.load(d / "fb.urdf", warn=seen.append)
+    assert not seen
