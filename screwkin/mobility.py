@@ -220,7 +220,7 @@ def _idle(mech, topo, frames, q, V, output_link, tol):
         moves = {link: jac[link] @ V @ I for link in frames}
         # a link takes part in an idle motion when its twist is not negligible
         # next to the largest one (the basis is only as exact as the assembly)
-        floor = 1e-6 * max(np.linalg.norm(T) for T in moves.values())
+        floor = tol.motion * max(np.linalg.norm(T) for T in moves.values())
         for link, T in moves.items():
             s = np.linalg.svd(T, compute_uv=False)
             k = int(np.sum(s > floor))
@@ -246,7 +246,7 @@ def _output_motion(link, T, tol, origin) -> OutputMotion:
         b = np.concatenate([-basis[:3, k] for k in range(dim)])
         x, *_ = np.linalg.lstsq(A, b, rcond=None)
         scale = max(np.linalg.norm(basis[:3]), 1.0)
-        if np.linalg.norm(A @ x - b) < 1e-6 * scale:
+        if np.linalg.norm(A @ x - b) < tol.motion * scale:
             label = f"{r}R"
             # for one rotation the point is any point of the axis: take the nearest to the origin
             center = tuple(np.asarray(origin) + x)

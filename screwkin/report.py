@@ -40,6 +40,7 @@ def topology_dict(topo) -> dict:
         "motion_space": topo.motion_space,
         "motion_space_detail": topo.motion_space_detail,
         "massless_links_in_compound_joints": list(topo.dummy_links),
+        "welds": list(topo.welds),
     }
 
 
@@ -90,6 +91,9 @@ def topology_text(topo, title: str) -> str:
     lines = [title, "", table(["joint", "type", "dof", "links", "contact", "loop"], rows), ""]
     lines.append(f"links N = {topo.n_links} (ground: {topo.ground})   joints J = {topo.n_joints}   "
                  f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}")
+    if topo.welds:
+        lines.append(f"loops closed by welds (fixed cut joints, each joining two URDF links into one link): "
+                     f"{', '.join(topo.welds)}")
     if topo.dummy_links:
         lines.append(f"massless links inside compound joints (not counted): {len(topo.dummy_links)}")
     lines.append(f"motion space: {topo.motion_space} ({topo.motion_space_detail})")

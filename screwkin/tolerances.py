@@ -22,6 +22,8 @@ class Tolerances:
                     concurrent axes, planarity) [m for distances, rad-like for directions].
     dummy_mass:     a link without geometry and lighter than this is a massless
                     link that may sit inside a compound joint [kg].
+    motion:         relative size below which a twist counts as no motion, next to
+                    the largest twist of the same analysis [-].
     max_iterations: iteration limit of the closure solver [-].
     samples:        nearby assembled configurations sampled for the generic rank [-].
     sample_step:    size of the random step to a nearby configuration [rad or m].
@@ -32,6 +34,7 @@ class Tolerances:
     rank_atol: float = 1e-10
     geometry: float = 1e-6
     dummy_mass: float = 1e-4
+    motion: float = 1e-6
     max_iterations: int = 200
     samples: int = 3
     sample_step: float = 0.05

@@ -85,6 +85,7 @@ class Topology:
     motion_space: str  # "planar" | "spherical" | "spatial"
     motion_space_detail: str
     dummy_links: tuple = field(default=())  # URDF links inside compound joints
+    welds: tuple = field(default=())  # fixed cut joints: they join two URDF links into one link
 
     @property
     def n_links(self) -> int:
@@ -187,7 +188,7 @@ def _edges(mech, q):
         elif rep and (rep.startswith("UJOINT") or rep == "CARDAN"):
             t = "universal"
         if t == "fixed":
-            welds.append((j.parent, j.child))
+            welds.append((j.parent, j.child, None))
             continue
         point = direction = None
         if model.existJointName(j.name):
@@ -201,7 +202,7 @@ def _edges(mech, q):
         a = _frame_link(mech, c.link1)
         b = _frame_link(mech, c.link2)
         if c.type == "fixed":
-            welds.append((a, b))
+            welds.append((a, b, c.name))
             continue
         M1 = data.oMf[c.frame1]
         direction = direction2 = None
@@ -290,7 +291,7 @@ def build_topology(mech, q) -> Topology:
     spec = mech.spec
     edges, welds = _edges(mech, q)
     uf = _Union(list(spec.links))
-    for a, b in welds:
+    for a, b, _ in welds:
         uf.join(a, b)
     ground_root = uf.find(spec.root)
     groups = {}
@@ -401,7 +402,8 @@ def build_topology(mech, q) -> Topology:
     members = {body_name[r]: tuple(groups[r]) for r in groups if r not in dummies}
     dummy_links = tuple(m for r in dummies for m in groups[r])
     space, detail = _motion_space(joints, tol, scale)
-    return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links)
+    cut_welds = tuple(name for _, _, name in welds if name is not None)
+    return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links, cut_welds)
 
 
 def _motion_space(joints, tol, scale):
