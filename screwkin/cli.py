@@ -11,7 +11,7 @@ import argparse
 import json
 import sys
 
-from .errors import ScrewkinError
+from .errors import ScrewkinError, UsageError
 
 __all__ = ["main"]
 
@@ -42,6 +42,17 @@ def _parser():
     m.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
     i = sub.add_parser("info", help="topology table: links, joints, loops")
     common(i)
+    s = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
+    common(s)
+    s.add_argument("--set", action="append", metavar="NAME=VALUE", required=True,
+                   help="input joint value, SI or with a unit (45deg, 30mm); repeat or comma-separate")
+    s.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
+    s.add_argument("--output", help="link whose pose (and twist) to report")
+    s.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input joint rate [1/s] (units as --set)")
+    s.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
+    s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
+    s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
+    s.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
     return p
 
 
@@ -69,11 +80,37 @@ def _run(args):
             if note:
                 print(f"note: {note}")
         return 0
+    if args.command == "solve":
+        return _solve(mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
     else:
         print(mobility_text(result))
+    return 0
+
+
+def _solve(mech, args):
+    from .position import PositionSolver
+    from .report import position_dict, position_text, to_jsonable, trace_text
+    from .units import parse_assignments
+
+    values = parse_assignments(args.set, "--set")
+    near = parse_assignments([args.near], "--near") if args.near else None
+    rates = parse_assignments(args.rate, "--rate") if args.rate or args.accel else None
+    accels = parse_assignments(args.accel, "--accel") if args.accel else None
+    if args.starts < 0:
+        raise UsageError("--starts must be 0 or more")
+    solver = PositionSolver(mech, list(values), output=args.output)
+    res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace)
+    if args.json:
+        print(json.dumps(to_jsonable(position_dict(res)), indent=2))
+        return 0
+    if args.trace:
+        names = [mech.coordinate_names[k] for k in solver.passive]
+        print(trace_text(res, mech.closure.row_labels(solver=True), names))
+        print()
+    print(position_text(res))
     return 0
 
 

@@ -166,6 +166,80 @@ class ClosureSystem:
                 i += 1
         return r, K
 
+    def bias(self, q, v) -> np.ndarray:
+        """K'(q, v) v: the second time derivative of the (minimal) residual rows
+        along a motion with joint velocity v and zero joint acceleration, from
+        Pinocchio's classical frame accelerations.  Exact for position and
+        alignment rows everywhere and for rotation rows at closed configurations."""
+        model, data = self.model, self.data
+        pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
+        pin.updateFramePlacements(model, data)
+        out = np.empty(self.nrows)
+        i = 0
+
+        def second(u, w, al):  # (d/dt u, d2/dt2 u) for u fixed in a frame turning at w with acceleration al
+            ud = np.cross(w, u)
+            return ud, np.cross(al, u) + np.cross(w, ud)
+
+        for cut, (b1, b2) in zip(self.cuts, self._basis):
+            M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
+            R1, R2 = M1.rotation, M2.rotation
+            d = M2.translation - M1.translation
+            V1 = pin.getFrameVelocity(model, data, cut.frame1, LWA)
+            V2 = pin.getFrameVelocity(model, data, cut.frame2, LWA)
+            A1 = pin.getFrameClassicalAcceleration(model, data, cut.frame1, LWA)
+            A2 = pin.getFrameClassicalAcceleration(model, data, cut.frame2, LWA)
+            w1, w2, al1, al2 = V1.angular, V2.angular, A1.angular, A2.angular
+            dd, ddd = V2.linear - V1.linear, A2.linear - A1.linear
+            a = np.asarray(cut.axis)
+            t = cut.type
+            if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
+                positions = (R1[:, 0], R1[:, 1], R1[:, 2])
+            elif t in ("prismatic", "cylindrical"):
+                positions = (R1 @ b1, R1 @ b2)
+            else:
+                positions = (R1 @ a,)
+            for e in positions:
+                ed, edd = second(e, w1, al1)
+                out[i] = edd @ d + 2 * ed @ dd + e @ ddd
+                i += 1
+            if t in ("fixed", "prismatic"):
+                out[i:i + 3] = pin.Jlog3(R1.T @ R2) @ R2.T @ (al2 - al1 + np.cross(w2, w1))
+                i += 3
+                continue
+            if t in ("revolute", "continuous", "cylindrical", "planar"):
+                pairs = ((R1 @ b1, R2 @ a), (R1 @ b2, R2 @ a))
+            elif t == "universal":
+                pairs = ((R1 @ a, R2 @ np.asarray(cut.axis2)),)
+            else:
+                pairs = ()
+            for u, w in pairs:
+                ud, udd = second(u, w1, al1)
+                wd, wdd = second(w, w2, al2)
+                out[i] = udd @ w + 2 * ud @ wd + u @ wdd
+                i += 1
+        return out
+
+    def row_labels(self, solver: bool = False) -> list:
+        """A name for each residual row: '<cut>:<kind>' (pos = F2 origin along an F1
+        axis, align = axis alignment, rot = rotation vector, vec = vector difference)."""
+        labels = []
+        for cut in self.cuts:
+            t = cut.type
+            n_pos = 3 if t in ("fixed", "revolute", "continuous", "universal", "spherical") else (
+                2 if t in ("prismatic", "cylindrical") else 1)
+            labels += [f"{cut.name}:pos{k}" for k in range(n_pos)]
+            if solver and t != "universal":
+                nvec = 0 if t == "spherical" else (3 if t in ("fixed", "prismatic") else 1)
+                labels += [f"{cut.name}:vec{k}{c}" for k in range(nvec) for c in "xyz"]
+            elif t in ("fixed", "prismatic"):
+                labels += [f"{cut.name}:rot{c}" for c in "xyz"]
+            elif t in ("revolute", "continuous", "cylindrical", "planar"):
+                labels += [f"{cut.name}:align{k}" for k in range(2)]
+            elif t == "universal":
+                labels += [f"{cut.name}:perp"]
+        return labels
+
     def residual(self, q) -> np.ndarray:
         return self.evaluate(q, jacobian=False)[0]
 
@@ -191,7 +265,8 @@ class ClosureSystem:
         """Solve r(q) = 0 from q0 by damped Newton (Levenberg-Marquardt, minimum-norm steps).
 
         frozen: velocity indices that must not move (the inputs).
-        trace:  optional callable(iteration, q, r, K, dq) to record the iterations.
+        trace:  optional callable(iteration, q, r, K, dq, accepted) to record the
+                iterations (r and K in the solver's rows, see ``row_labels``).
         Raises AssemblyError with the smallest residual reached when it fails.
         """
         tol = tolerances or self.tol
@@ -222,7 +297,7 @@ class ClosureSystem:
             r_new = self.evaluate(q_new, jacobian=False, solver=True)[0]
             n_new = float(np.linalg.norm(r_new))
             if trace is not None:
-                trace(it, q, r, K, dq)
+                trace(it, q, r, K, dq, n_new < norm)
             if n_new < norm:
                 q = q_new
                 r, K = self.evaluate(q, solver=True)

@@ -145,3 +145,67 @@ def to_jsonable(obj):
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     return obj
+
+
+def _fmt_vec(v, width=11):
+    return " ".join(f"{x:>{width}.6g}" for x in v)
+
+
+def position_dict(res) -> dict:
+    sols = []
+    for s in res.solutions:
+        d = {"joints": s.joints, "residual": s.residual, "iterations": s.iterations, "singular": s.singular,
+             "sigma_min": s.sigma_min}
+        if s.output_pose is not None:
+            d["output_pose"] = s.output_pose.tolist()
+        if s.rates is not None:
+            d["rates"] = s.rates
+            d["accelerations"] = s.accelerations
+        if s.output_twist is not None:
+            d["output_twist"] = s.output_twist.tolist()
+            d["output_acceleration"] = s.output_acceleration.tolist()
+        sols.append(d)
+    return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
+            "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols}
+
+
+def trace_text(res, row_labels, passive_names) -> str:
+    lines = ["Newton iterations from the first start (rows: closure residual; columns: passive joints)"]
+    for st in res.trace:
+        lines.append(f"\niteration {st.iteration}: |r| = {np.linalg.norm(st.residual):.3e}"
+                     f"{'' if st.accepted else '  (step rejected: damping increased)'}")
+        lines.append("  r  = [" + _fmt_vec(st.residual) + " ]")
+        lines.append("  K  = " + " ".join(f"{n:>11.11}" for n in passive_names))
+        for lab, row in zip(row_labels, st.jacobian):
+            lines.append(f"       {_fmt_vec(row)}   {lab}")
+        lines.append("  dq = [" + _fmt_vec(st.step) + " ]")
+    return "\n".join(lines)
+
+
+def position_text(res, degrees=True) -> str:
+    lines = [f"inputs: " + ", ".join(f"{k} = {v:.6g}" for k, v in res.inputs.items()),
+             f"{len(res.solutions)} assembly mode(s) found from {res.starts} starting configurations"]
+    if res.free_dofs:
+        lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
+                     "the solutions form a continuum and only some are shown")
+    for k, s in enumerate(res.solutions, 1):
+        flag = "  SINGULAR (passive joints not determined: limit position or singularity)" if s.singular else ""
+        lines.append(f"\nsolution {k}: residual {s.residual:.2e}, {s.iterations} iterations, "
+                     f"sigma_min {s.sigma_min:.3g}{flag}")
+        rows = []
+        for name, v in s.joints.items():
+            row = [name, f"{v:.9g}"]
+            row.append(f"{np.degrees(v):.6g} deg" if degrees else "")
+            if s.rates is not None:
+                row += [f"{s.rates.get(name, float('nan')):.6g}", f"{s.accelerations.get(name, float('nan')):.6g}"]
+            rows.append(row)
+        headers = ["joint", "value (SI)", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
+        lines.append(table(headers, rows))
+        if s.output_pose is not None:
+            p = s.output_pose
+            lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m")
+            lines.append("  rotation " + " | ".join(_fmt_vec(r, 0) for r in p[:3, :3]))
+        if s.output_twist is not None:
+            lines.append(f"  twist (v, w) {_fmt_vec(s.output_twist, 0)}")
+            lines.append(f"  acceleration (a, alpha) {_fmt_vec(s.output_acceleration, 0)}")
+    return "\n".join(lines)

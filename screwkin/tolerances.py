@@ -22,6 +22,10 @@ class Tolerances:
                     concurrent axes, planarity) [m for distances, rad-like for directions].
     dummy_mass:     a link without geometry and lighter than this is a massless
                     link that may sit inside a compound joint [kg].
+    singular:       a solution whose passive constraint Jacobian has a relative
+                    smallest singular value below this is flagged singular (a
+                    double root converges only to about the square root of the
+                    closure tolerance, so this is looser than rank_rtol) [-].
     motion:         relative size below which a twist counts as no motion, next to
                     the largest twist of the same analysis [-].
     max_iterations: iteration limit of the closure solver [-].
@@ -35,6 +39,7 @@ class Tolerances:
     geometry: float = 1e-6
     dummy_mass: float = 1e-4
     motion: float = 1e-6
+    singular: float = 1e-4
     max_iterations: int = 200
     samples: int = 3
     sample_step: float = 0.05

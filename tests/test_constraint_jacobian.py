@@ -123,3 +123,18 @@ def test_corpus_jacobian_on_the_manifold(name):
     for h in (1e-3, 1e-4):
         r = mech.closure.residual(pin.integrate(mech.model, q, h * v))
         assert np.linalg.norm(r) < 50 * h * h
+
+
+@pytest.mark.parametrize("jtype", TYPES)
+def test_bias_term_matches_finite_differences_of_K_v(tmp_path, jtype):
+    """K'(q, v) v at an assembled configuration equals the central difference
+    of K(q(t)) v along q(t) = q (+) t v (straight lines in these coordinates)."""
+    mech = bench(tmp_path, jtype)
+    q = mech.assemble().q
+    rng = np.random.default_rng(3)
+    v = rng.normal(size=mech.nv)
+    h = 1e-5
+    Kp = mech.closure.jacobian(pin.integrate(mech.model, q, h * v))
+    Km = mech.closure.jacobian(pin.integrate(mech.model, q, -h * v))
+    expected = (Kp - Km) @ v / (2 * h)
+    np.testing.assert_allclose(mech.closure.bias(q, v), expected, rtol=0, atol=1e-6 * max(1, np.abs(expected).max()))

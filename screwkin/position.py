@@ -1,0 +1,298 @@
+"""Position, velocity and acceleration analysis of closed-loop mechanisms.
+
+Given values of input joints (by default the actuated ones; any joints may be
+chosen instead), the other coordinates follow from the loop-closure equations
+r(q) = 0, solved by damped Newton with the inputs held.  Every assembly mode
+the solver reaches from a deterministic set of starts is reported; two
+solutions are the same mode when every joint centre and the output frame are
+in the same place (idle spins, which move no joint, do not make new modes).
+
+Rates and accelerations come from the differentiated closure equations
+    K q' = 0,        K q'' + K' q' = 0,
+split into input and passive columns, with K' q' from Pinocchio's classical
+frame accelerations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import AssemblyError, UsageError
+from .mobility import null_space, rank
+
+__all__ = ["Solution", "PositionResult", "PositionSolver", "TraceStep"]
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+@dataclass(frozen=True)
+class TraceStep:
+    """One Newton iteration: residual r (solver rows), Jacobian K (free columns), step dq."""
+
+    iteration: int
+    residual: np.ndarray
+    jacobian: np.ndarray
+    step: np.ndarray
+    accepted: bool
+
+
+@dataclass(frozen=True)
+class Solution:
+    """One assembly mode for the given inputs.
+
+    joints:   every joint coordinate name -> value [rad or m] (continuous and
+              revolute angles in (-pi, pi]);
+    residual: closure residual norm [m, rad]; iterations: Newton iterations;
+    singular: the passive joints are not determined to first order (a double
+              root, e.g. a limit position; or a constraint singularity);
+    sigma_min: smallest relevant singular value of the passive constraint
+              Jacobian, relative to the largest;
+    output_pose: 4x4 world pose of the output link, or None;
+    rates / accelerations: coordinate name -> rate [rad/s, m/s] /
+              acceleration [rad/s^2, m/s^2], or None;
+    output_twist / output_acceleration: (v, w) of the output frame origin in
+              world axes; classical acceleration (a, alpha).
+    """
+
+    q: np.ndarray = field(repr=False)
+    joints: dict
+    residual: float
+    iterations: int
+    singular: bool
+    sigma_min: float
+    output_pose: np.ndarray | None = None
+    rates: dict | None = None
+    accelerations: dict | None = None
+    output_twist: np.ndarray | None = None
+    output_acceleration: np.ndarray | None = None
+    qdot: np.ndarray | None = field(default=None, repr=False)
+    qddot: np.ndarray | None = field(default=None, repr=False)
+
+
+@dataclass(frozen=True)
+class PositionResult:
+    inputs: dict
+    input_joints: tuple
+    solutions: tuple
+    starts: int
+    free_dofs: int  # DOFs the inputs leave undetermined (0 when the inputs fix the mechanism)
+    trace: tuple = ()
+    output: str | None = None
+
+    def to_dict(self) -> dict:
+        from .report import position_dict
+
+        return position_dict(self)
+
+
+class PositionSolver:
+    """Solves a mechanism for given input joints; reuses the model and data
+    between calls (build once, solve many times)."""
+
+    def __init__(self, mech, input_joints=None, output=None):
+        self.mech = mech
+        self.model = mech.model
+        self.data = mech.model.createData()
+        names = list(input_joints) if input_joints else list(mech.actuated)
+        if not names:
+            raise UsageError(f"{mech.path}: no input joints: declare actuated joints or give --set NAME=VALUE")
+        for n in names:
+            c = mech.coordinate(n)
+            if c.nv != 1:
+                raise UsageError(f"{mech.path}: joint '{n}' has {c.nv} coordinates; inputs must be 1-DOF joints")
+        self.inputs = names
+        self.frozen = mech.velocity_indices(names)
+        self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
+        self.output = output
+        self.output_frame = mech.link_frame(output) if output else None
+        mob = mech.mobility()
+        self.expected_rank = mob.rank
+        self.idle_dofs = mob.idle_dofs
+        self.mobility = mob.mobility
+        # DOFs left free with the inputs held, beyond the idle ones (0 = inputs determine the mechanism)
+        V = null_space(mech.closure.jacobian(mob.q), mech.tolerances, mech.nv)
+        held = null_space(V[self.frozen], mech.tolerances, V.shape[1]) if V.shape[1] else np.zeros((0, 0))
+        self.free_dofs = max(held.shape[1] - self.idle_dofs, 0) if V.shape[1] else 0
+        self._reference = mob.q
+        self._points = [f for f in range(len(self.model.frames))
+                        if self.model.frames[f].type == pin.FrameType.JOINT]
+        self._points += [c.frame1 for c in mech.cuts]
+        self._revolute = self._angle_coordinates()
+
+    # --------------------------------------------------------------- coordinates
+    def _angle_coordinates(self):
+        """q indices of bounded revolute joints (angles to wrap) and continuous joints."""
+        wrap = []
+        for c in self.mech.coordinates:
+            short = self.model.joints[c.joint_id].shortname()
+            if short.startswith("JointModelR") and "UB" not in short and c.nq == 1:
+                wrap.append(c.idx_q)
+        return np.asarray(wrap, int)
+
+    def set_inputs(self, q, values: dict):
+        q = np.array(q, float)
+        for name, v in values.items():
+            c = self.mech.coordinate(name)
+            if c.nq == 2:
+                q[c.idx_q:c.idx_q + 2] = (np.cos(v), np.sin(v))
+            else:
+                q[c.idx_q] = v
+        return q
+
+    def joint_values(self, q) -> dict:
+        out = {}
+        for c in self.mech.coordinates:
+            if c.nq == 1:
+                v = q[c.idx_q]
+                if c.idx_q in self._revolute:
+                    v = float(np.mod(v + np.pi, 2 * np.pi) - np.pi)
+                out[c.joint] = float(v)
+            elif c.nq == 2 and c.nv == 1:
+                out[c.joint] = float(np.arctan2(q[c.idx_q + 1], q[c.idx_q]))
+            else:
+                for k in range(c.nq):
+                    out[f"{c.joint}[q{k}]"] = float(q[c.idx_q + k])
+        return out
+
+    def _wrap(self, q):
+        q = np.array(q, float)
+        if len(self._revolute):
+            q[self._revolute] = np.mod(q[self._revolute] + np.pi, 2 * np.pi) - np.pi
+        return q
+
+    def _signature(self, q):
+        """World positions of every joint centre (and the output pose): equal for
+        configurations that differ only by idle spins."""
+        pin.framesForwardKinematics(self.model, self.data, q)
+        parts = [self.data.oMf[f].translation for f in self._points]
+        if self.output_frame is not None:
+            parts.append(self.data.oMf[self.output_frame].homogeneous[:3].ravel() * 0.1)
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def _starts(self, count, seed):
+        model = self.model
+        rng = np.random.default_rng(seed)
+        base = pin.neutral(model)
+        starts = [self._reference, base]
+        lo, hi = model.lowerPositionLimit, model.upperPositionLimit
+        for _ in range(count):
+            dq = np.zeros(model.nv)
+            for c in self.mech.coordinates:
+                short = model.joints[c.joint_id].shortname()
+                for k in range(c.nv):
+                    if "JointModelP" in short:
+                        a, b = lo[c.idx_q + k], hi[c.idx_q + k]
+                        a, b = (a, b) if np.isfinite(a) and np.isfinite(b) and b - a < 20 else (-0.5, 0.5)
+                        dq[c.idx_v + k] = rng.uniform(a, b)
+                    else:
+                        dq[c.idx_v + k] = rng.uniform(-np.pi, np.pi)
+            starts.append(pin.integrate(model, base, dq))
+        return starts
+
+    # --------------------------------------------------------------- solving
+    def solve(self, values: dict, near: dict | None = None, rates: dict | None = None,
+              accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False) -> PositionResult:
+        mech = self.mech
+        unknown = [n for n in values if n not in self.inputs]
+        missing = [n for n in self.inputs if n not in values]
+        if unknown or missing:
+            raise UsageError(f"{mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
+                             + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
+        steps = []
+        recorder = (lambda it, q, r, K, dq, ok: steps.append(
+            TraceStep(it, r.copy(), K[:, self.passive].copy(), dq[self.passive].copy(), ok))) if trace else None
+        near_q = None
+        if near:
+            near_q = self.set_inputs(self._reference, {k: v for k, v in near.items() if k in self.inputs})
+            for name, v in near.items():
+                near_q = self.set_inputs(near_q, {name: v}) if mech.coordinate(name).nv == 1 else near_q
+        start_list = ([near_q] if near_q is not None else []) + self._starts(starts, seed)
+        found, best = [], np.inf
+        for k, q0 in enumerate(start_list):
+            q0 = self.set_inputs(q0, values)
+            try:
+                a = mech.closure.solve(q0, frozen=self.frozen, trace=recorder if (trace and k == 0) else None)
+            except AssemblyError as exc:
+                best = min(best, exc.residual)
+                continue
+            q = self._wrap(a.q)
+            sig = self._signature(q)
+            if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
+                continue
+            found.append((sig, q, a))
+        if not found:
+            raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
+                                detail=f"the inputs {self._describe(values)} cannot be reached from "
+                                       f"{len(start_list)} starting configurations")
+        ref = near_q if near_q is not None else self._reference
+        ref_sig = self._signature(ref)
+        found.sort(key=lambda f: float(np.linalg.norm(f[0] - ref_sig)))
+        if near_q is not None:
+            found = found[:1]
+        sols = tuple(self._solution(q, a, rates, accels) for _, q, a in found)
+        return PositionResult(dict(values), tuple(self.inputs), sols, len(start_list), self.free_dofs,
+                              tuple(steps), self.output)
+
+    @staticmethod
+    def _describe(values):
+        return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
+
+    def _solution(self, q, a, rates, accels) -> Solution:
+        mech, tol = self.mech, self.mech.tolerances
+        K = mech.closure.jacobian(q)
+        Kp = K[:, self.passive]
+        s = np.linalg.svd(Kp, compute_uv=False) if Kp.size else np.zeros(0)
+        r_star = self.expected_rank
+        if r_star == 0 or s.size == 0:
+            sigma, singular = 1.0, False
+        else:
+            sigma = float(s[r_star - 1] / s[0]) if len(s) >= r_star else 0.0
+            singular = sigma < tol.singular or rank(K, tol) < r_star
+        pose = twist = acc = qd = qdd = None
+        rate_d = acc_d = None
+        if self.output_frame is not None:
+            pin.framesForwardKinematics(self.model, self.data, q)
+            pose = self.data.oMf[self.output_frame].homogeneous.copy()
+        if rates is not None:
+            qd = self.rates(q, K, rates)
+            rate_d = self._named(qd)
+            qdd = self.accelerations(q, K, qd, accels or {})
+            acc_d = self._named(qdd)
+            if self.output_frame is not None:
+                pin.forwardKinematics(self.model, self.data, q, qd, qdd)
+                pin.updateFramePlacements(self.model, self.data)
+                twist = pin.getFrameVelocity(self.model, self.data, self.output_frame, LWA).vector.copy()
+                acc = pin.getFrameClassicalAcceleration(self.model, self.data, self.output_frame, LWA).vector.copy()
+        return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), sigma, pose,
+                        rate_d, acc_d, twist, acc, qd, qdd)
+
+    def _named(self, v) -> dict:
+        return dict(zip(self.mech.coordinate_names, map(float, v)))
+
+    def _input_vector(self, values: dict):
+        x = np.zeros(len(self.frozen))
+        for k, name in enumerate(self.inputs):
+            x[k] = values.get(name, 0.0)
+        return x
+
+    def rates(self, q, K, values: dict):
+        """Joint rates from K q' = 0 with the input rates given (minimum norm in
+        the passive joints, so idle spins are zero)."""
+        qd = np.zeros(self.mech.nv)
+        qd[self.frozen] = self._input_vector(values)
+        if K.size:
+            qd[self.passive] = -np.linalg.lstsq(K[:, self.passive], K[:, self.frozen] @ qd[self.frozen], rcond=None)[0]
+        return qd
+
+    def accelerations(self, q, K, qd, values: dict):
+        """Joint accelerations from K q'' = -K' q' with the input accelerations given."""
+        qdd = np.zeros(self.mech.nv)
+        qdd[self.frozen] = self._input_vector(values)
+        if K.size:
+            bias = self.mech.closure.bias(q, qd)
+            rhs = -(K[:, self.frozen] @ qdd[self.frozen] + bias)
+            qdd[self.passive] = np.linalg.lstsq(K[:, self.passive], rhs, rcond=None)[0]
+        return qdd
