@@ -53,6 +53,18 @@ def _parser():
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
     s.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    w = sub.add_parser("sweep", help="track one assembly mode along an input motion")
+    common(w)
+    w.add_argument("--input", required=True, help="the input joint to move")
+    w.add_argument("--from", dest="start", required=True, help="first input value (SI or with a unit)")
+    w.add_argument("--to", dest="stop", required=True, help="last input value")
+    w.add_argument("--steps", type=int, default=100, help="number of steps (default 100)")
+    w.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    w.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
+    w.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
+    w.add_argument("--rate", default="1", help="input rate for the joint rates and accelerations (default 1 /s)")
+    w.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
+    w.add_argument("--plot", help="draw the joint values against the input into this PNG file (needs matplotlib)")
     return p
 
 
@@ -82,6 +94,8 @@ def _run(args):
         return 0
     if args.command == "solve":
         return _solve(mech, args)
+    if args.command == "sweep":
+        return _sweep(mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
@@ -112,6 +126,70 @@ def _solve(mech, args):
         print()
     print(position_text(res))
     return 0
+
+
+def _sweep(mech, args):
+    from .planar import identify
+    from .position import PositionSolver
+    from .report import sweep_text, to_jsonable
+    from .sweep import sweep
+    from .units import parse_assignments, parse_value
+
+    fixed = parse_assignments(args.set, "--set")
+    inputs = _names(args.inputs) or (list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
+    solver = PositionSolver(mech, inputs)
+    near = parse_assignments([args.near], "--near") if args.near else None
+    res = sweep(solver, args.input, parse_value(args.start), parse_value(args.stop), args.steps,
+                fixed={k: v for k, v in fixed.items() if k != args.input}, near=near,
+                rate=parse_value(args.rate), progress=True)
+    info = identify(mech, mech.topology(res.q[0]), res.q[0], args.input) if len(inputs) == 1 else None
+    mus = None
+    if info is not None:
+        mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
+    if args.csv:
+        with open(args.csv, "w") as f:
+            f.write(res.csv())
+    if args.plot:
+        _plot(res, args.plot, mus)
+    if args.json:
+        d = res.to_dict()
+        if info is not None:
+            d["linkage"] = info.to_dict()
+            d["transmission_angles"] = mus
+        print(json.dumps(to_jsonable(d), indent=2))
+    else:
+        print(sweep_text(res, info, mus))
+    return 0
+
+
+def _plot(res, path, mus):
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise UsageError("--plot needs matplotlib: pip install matplotlib") from None
+    import numpy as np
+
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 8))
+    for k, name in enumerate(res.names):
+        axes[0].plot(res.values, res.joints[:, k] if res.joints.shape[1] == len(res.names) else res.joints[:, k],
+                     label=name)
+        axes[1].plot(res.values, res.rates[:, k], label=name)
+        axes[2].plot(res.values, res.accelerations[:, k], label=name)
+    axes[0].set_ylabel("joint value [rad, m]")
+    axes[1].set_ylabel(f"rate [1/s] (input rate {res.rate:g})")
+    axes[2].set_ylabel("acceleration")
+    axes[2].set_xlabel(f"{res.input} [rad or m]")
+    axes[0].legend(fontsize=7)
+    if mus is not None:
+        ax = axes[0].twinx()
+        ax.plot(res.values, np.degrees(mus), "k--", label="transmission angle")
+        ax.set_ylabel("transmission angle [deg]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
 
 
 def main(argv=None) -> int:

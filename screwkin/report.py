@@ -209,3 +209,32 @@ def position_text(res, degrees=True) -> str:
             lines.append(f"  twist (v, w) {_fmt_vec(s.output_twist, 0)}")
             lines.append(f"  acceleration (a, alpha) {_fmt_vec(s.output_acceleration, 0)}")
     return "\n".join(lines)
+
+
+def sweep_text(res, info=None, mus=None) -> str:
+    lines = [f"sweep of {res.input} from {res.requested[0]:.6g} to {res.requested[1]:.6g} "
+             f"in {res.requested[2]} steps: {len(res.values)} configurations"]
+    if res.stopped_at is not None:
+        lines.append(f"stopped: branch limit at {res.input} = {res.stopped_at:.10g} "
+                     f"({np.degrees(res.stopped_at):.6g} deg): {res.stop_reason}")
+    if info is not None:
+        lines.append(f"{info.kind}: " + ", ".join(f"{k} {v:.6g} m" for k, v in info.lengths.items()))
+        lines.append(f"  {info.grashof}")
+        if info.input_range:
+            lo, hi = info.input_range
+            lines.append(f"  input range: {lo:.6g} .. {hi:.6g} rad ({np.degrees(lo):.4g} .. {np.degrees(hi):.4g} deg)")
+        else:
+            lines.append("  input range: full turn")
+        if info.limit_inputs:
+            lines.append("  output limit positions at input = " + ", ".join(
+                f"{x:.6g} rad ({np.degrees(x):.4g} deg)" for x in info.limit_inputs))
+        if mus:
+            dev = np.abs(np.degrees(np.asarray(mus)) - 90)
+            k = int(np.argmax(dev))
+            lines.append(f"  transmission angle: {np.degrees(min(mus)):.4g} .. {np.degrees(max(mus)):.4g} deg; "
+                         f"worst {np.degrees(mus[k]):.4g} deg at input {res.values[k]:.6g}")
+    step = max(len(res.values) // 10, 1)
+    rows = [[f"{res.values[k]:.6g}"] + [f"{x:.6g}" for x in res.joints[k]] for k in range(0, len(res.values), step)]
+    lines.append("")
+    lines.append(table(["input"] + list(res.names), rows))
+    return "\n".join(lines)

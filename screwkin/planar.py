@@ -1,0 +1,200 @@
+"""Textbook extras for planar four-bars and slider-cranks driven from a ground joint.
+
+Recognized from the topology (4 links, 4 joints, planar, one loop; four
+revolutes, or three revolutes and a prismatic joint to the ground), with
+lengths measured between joint centres in the plane of motion:
+
+- Grashof class: s + l against p + q (four-bar); full crank rotation when
+  crank + |offset| <= rod (slider-crank);
+- transmission angle mu: four-bar, the angle at the coupler-output joint
+  between coupler and output link; slider-crank, the angle between the rod and
+  the normal of the slide.  90 deg transmits force best in both;
+- the input range, from the circle condition |b - c| <= |BD| <= b + c (or the
+  rod reaching the slide), and the input values at the output's limit
+  positions (input and coupler collinear: dead centres of the output).
+
+Angles are returned as input *joint values* [rad] of the circuit the
+configuration is on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["LinkageInfo", "identify"]
+
+
+@dataclass(frozen=True)
+class LinkageInfo:
+    kind: str  # "four-bar" | "slider-crank"
+    lengths: dict  # [m]
+    grashof: str
+    input_joint: str
+    input_range: tuple | None  # (low, high) joint values; None: the input turns fully
+    limit_inputs: tuple  # input joint values where the output is at a limit position
+    transmission_angle: float  # mu [rad] at the configuration analysed
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "lengths": self.lengths, "grashof": self.grashof,
+                "input_joint": self.input_joint,
+                "input_range": list(self.input_range) if self.input_range else None,
+                "limit_inputs": list(self.limit_inputs), "transmission_angle": self.transmission_angle}
+
+
+def _rot(v, ang):
+    c, s = np.cos(ang), np.sin(ang)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+def _cross(u, v):
+    return u[0] * v[1] - u[1] * v[0]
+
+
+def _angle(v):
+    return float(np.arctan2(v[1], v[0]))
+
+
+def _wrap(x):
+    return float(np.mod(x + np.pi, 2 * np.pi) - np.pi)
+
+
+def _interval(start, end, phi_now, q_in):
+    """Joint values of the angle interval [start, end] (end > start) that contains phi_now."""
+    k = np.floor((phi_now - start) / (2 * np.pi))
+    start, end = start + 2 * np.pi * k, end + 2 * np.pi * k
+    return (q_in + start - phi_now, q_in + end - phi_now)
+
+
+def _circles(p, r, c, s):
+    """Intersections of circle (p, r) and circle (c, s) in the plane."""
+    d = np.linalg.norm(c - p)
+    if d < 1e-15 or d > r + s + 1e-12 or d < abs(r - s) - 1e-12:
+        return []
+    along = (r * r - s * s + d * d) / (2 * d)
+    h = np.sqrt(max(r * r - along * along, 0.0))
+    u = (c - p) / d
+    n = np.array([-u[1], u[0]])
+    return [p + along * u + h * n, p + along * u - h * n]
+
+
+def identify(mech, topo, q, input_joint):
+    """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
+    joint is a ground joint, at the configuration ``topo`` was built at (q)."""
+    if topo.motion_space != "planar" or (topo.n_links, topo.n_joints, topo.loops) != (4, 4, 1):
+        return None
+    joints = {j.name: j for j in topo.joints}
+    inp = joints.get(input_joint)
+    ground = topo.ground
+    if inp is None or ground not in inp.links or inp.type not in ("revolute", "continuous"):
+        return None
+    n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
+    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    e1 = np.cross(n, h)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
+
+    def p2(v):
+        v = np.asarray(v)
+        return np.array([v @ e1, v @ e2])
+
+    def other(link, joint):
+        return next(j for j in topo.joints if j is not joint and link in j.links)
+
+    moving = inp.links[1] if inp.links[0] == ground else inp.links[0]
+    j_b = other(moving, inp)
+    coupler = j_b.links[1] if j_b.links[0] == moving else j_b.links[0]
+    j_c = other(coupler, j_b)
+    j_d = other(ground, inp)
+    coord = mech.coordinate(input_joint)
+    q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
+    A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
+    a, b = np.linalg.norm(B - A), np.linalg.norm(C - B)
+    if j_d.type in ("revolute", "continuous") and j_c.type in ("revolute", "continuous") \
+            and j_b.type in ("revolute", "continuous"):
+        return _four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b)
+    if j_d.type == "prismatic" or j_c.type == "prismatic":
+        slide = j_d if j_d.type == "prismatic" else j_c
+        pin_joint = j_c if slide is j_d else j_d
+        if slide is j_c:  # the prismatic joint is between rod and slider: not the textbook slider-crank
+            return None
+        s = p2(np.asarray(slide.direction) + 0) - p2(np.zeros(3))
+        return _slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s / np.linalg.norm(s), a, b)
+    return None
+
+
+def _four_bar(name, q_in, A, B, C, D, a, b):
+    g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
+    lengths = {"ground": g, "input": a, "coupler": b, "output": c}
+    s, l = min(lengths.values()), max(lengths.values())
+    p_q = g + a + b + c - s - l
+    if abs(s + l - p_q) < 1e-9 * l:
+        cls = "change point (s + l = p + q): the linkage can fold flat"
+    elif s + l > p_q:
+        cls = "non-Grashof (triple rocker): no link turns fully"
+    else:
+        shortest = min((a, 1, "input"), (g, 0, "ground"), (b, 2, "coupler"), (c, 3, "output"))[2]
+        cls = {"input": "Grashof crank-rocker: the input turns fully",
+               "ground": "Grashof double crank (drag link): input and output turn fully",
+               "coupler": "Grashof double rocker: only the coupler turns fully",
+               "output": "Grashof rocker-crank: the output turns fully, the input rocks"}[shortest]
+    u_ad = (D - A) / g
+    phi_now = _angle(_rot(B - A, -_angle(u_ad)))  # input angle from AD
+    circuit = np.sign(_cross(C - B, D - C)) or 1.0
+
+    lo = (a * a + g * g - (b + c) ** 2) / (2 * a * g)
+    hi = (a * a + g * g - (b - c) ** 2) / (2 * a * g)
+    rng = None
+    if hi < 1 and lo > -1:  # two intervals, one for each sign of phi
+        x, y = np.arccos(hi), np.arccos(lo)
+        rng = _interval(x, y, phi_now, q_in) if np.sin(phi_now) >= 0 else _interval(-y, -x, phi_now, q_in)
+    elif lo > -1:  # passes through phi = 0
+        rng = _interval(-np.arccos(lo), np.arccos(lo), phi_now, q_in)
+    elif hi < 1:  # passes through phi = pi
+        rng = _interval(np.arccos(hi), 2 * np.pi - np.arccos(hi), phi_now, q_in)
+    # the output is at a limit where input and coupler are collinear (B on line AC), on this circuit
+    limits = []
+    for dist, folded in ((a + b, False), (abs(b - a), True)):
+        for Cc in _circles(A, dist, D, c):
+            u = (Cc - A) / max(np.linalg.norm(Cc - A), 1e-300)
+            Bc = A - a * u if folded and b > a else A + a * u
+            if (np.sign(_cross(Cc - Bc, D - Cc)) or circuit) != circuit:
+                continue
+            limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
+    mu = float(np.arccos(np.clip(np.dot(B - C, D - C) / (b * c), -1, 1)))
+    return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu)
+
+
+def _slider_crank(name, q_in, A, B, C, s, a, b):
+    nrm = np.array([-s[1], s[0]])
+    e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
+    lengths = {"crank": a, "rod": b, "offset": abs(e)}
+    full = a + abs(e) <= b
+    cls = ("crank turns fully (crank + |offset| <= rod)" if full
+           else "crank cannot turn fully (crank + |offset| > rod): it rocks")
+    phi_now = _angle(np.array([(B - A) @ s, (B - A) @ nrm]))  # crank angle from the slide direction
+
+    rng = None
+    if not full:  # the rod reaches the slide line while |e - a sin(phi)| <= b
+        lo, hi = (e - b) / a, (e + b) / a
+        if lo > -1 and hi < 1:
+            x, y = np.arcsin(lo), np.arcsin(hi)
+            rng = _interval(x, y, phi_now, q_in) if np.cos(phi_now) >= 0 else _interval(np.pi - y, np.pi - x, phi_now, q_in)
+        elif hi < 1:
+            rng = _interval(np.pi - np.arcsin(hi), 2 * np.pi + np.arcsin(hi), phi_now, q_in)
+        elif lo > -1:
+            rng = _interval(np.arcsin(lo), np.pi - np.arcsin(lo), phi_now, q_in)
+    side = np.sign((C - A) @ s) or 1.0
+    limits = []
+    for dist, folded in ((a + b, False), (abs(b - a), True)):
+        if dist < abs(e):
+            continue
+        x = side * np.sqrt(dist * dist - e * e)
+        Cc = A + x * s + e * nrm
+        u = (Cc - A) / np.linalg.norm(Cc - A)
+        Bc = A + (-a if folded and b > a else a) * u
+        limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
+    rod = (C - B) / b
+    mu = float(np.arccos(np.clip(abs(rod @ nrm), 0, 1)))
+    return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
