@@ -1,0 +1,104 @@
+"""Sweeps and the four-bar textbook extras, against closed forms and a second method."""
+
+import numpy as np
+import pytest
+
+import screwkin
+from conftest import fourbar
+from screwkin.cli import main
+from screwkin.planar import identify
+from screwkin.position import PositionSolver
+from screwkin.sweep import sweep
+from test_position import A, B, C, G, rocker_angles, world_angles
+
+STEPS = 360
+
+
+@pytest.fixture
+def mech(tmp_path):
+    p = tmp_path / "fb.urdf"
+    p.write_text(fourbar())
+    return screwkin.load(p)
+
+
+def test_full_crank_turn_stays_on_one_circuit(mech):
+    solver = PositionSolver(mech, ["crank_joint"])
+    res = sweep(solver, "crank_joint", 0.0, 2 * np.pi, STEPS)
+    assert res.stopped_at is None and len(res.values) == STEPS + 1
+    # the circuit of the file's configuration is the upper intersection throughout (closed form)
+    circuit = None
+    for q in res.q[::10]:
+        sol = type("S", (), {"q": q})
+        crank, rocker = world_angles(mech, sol)
+        both = rocker_angles(crank)
+        k = int(np.argmin(np.abs(np.asarray(both) - rocker)))
+        assert abs(both[k] - rocker) < 1e-8  # closure tolerance 1e-10 m over an 0.08 m rocker
+        circuit = k if circuit is None else circuit
+        assert k == circuit
+    # the motion closes on itself after a full turn
+    np.testing.assert_allclose(res.joints[-1][1:], res.joints[0][1:], atol=1e-9)
+
+
+def test_sweep_rates_match_finite_differences_of_positions(mech):
+    solver = PositionSolver(mech, ["crank_joint"])
+    res = sweep(solver, "crank_joint", 0.0, 1.0, 1000)
+    h = res.values[1] - res.values[0]
+    fd = (res.joints[2:] - res.joints[:-2]) / (2 * h)
+    np.testing.assert_allclose(res.rates[1:-1], fd, atol=1e-5)
+    fd2 = (res.rates[2:] - res.rates[:-2]) / (2 * h)
+    np.testing.assert_allclose(res.accelerations[1:-1], fd2, atol=1e-4)
+
+
+def test_limit_positions_are_where_the_rocker_stops(mech):
+    """At the crank angles reported as output limit positions (crank and coupler
+    collinear) the rocker's rate vanishes: checked with the velocity analysis."""
+    q = mech.assemble().q
+    info = identify(mech, mech.topology(q), q, "crank_joint")
+    assert info.grashof.startswith("Grashof crank-rocker") and info.input_range is None
+    assert len(info.limit_inputs) == 2
+    solver = PositionSolver(mech, ["crank_joint"])
+    for x in info.limit_inputs:
+        res = sweep(solver, "crank_joint", 0.0, x, 200)  # stay on the file's circuit
+        assert res.stopped_at is None
+        assert abs(res.rates[-1][res.names.index("rocker_joint")]) < 1e-9
+        assert abs(res.rates[0][res.names.index("rocker_joint")]) > 0.1
+
+
+def test_rocker_input_stops_at_its_range(mech):
+    """Driving the rocker: the sweep stops where the closed-form input range ends."""
+    q = mech.assemble().q
+    info = identify(mech, mech.topology(q), q, "rocker_joint")
+    assert info.grashof.startswith("Grashof rocker-crank")
+    lo, hi = info.input_range
+    # closed form: |AC| = a + b at the limit: cos(phi) = ((a + b)^2 - g^2 - c^2) / (2 g c) in world angles
+    phi = np.arccos(((A + B) ** 2 - G**2 - C**2) / (2 * G * C))
+    offset = world_angles(mech, type("S", (), {"q": mech.neutral()}))[1]
+    assert min(abs(lo + offset - phi), abs(hi + offset - phi)) < 1e-9
+    res = sweep(PositionSolver(mech, ["rocker_joint"]), "rocker_joint", 0.0, -1.5, 150)
+    assert res.stopped_at is not None
+    assert abs(res.stopped_at - lo) < 1e-4
+    assert res.values[-1] >= lo
+
+
+def test_transmission_angle_law_of_cosines(mech):
+    solver = PositionSolver(mech, ["crank_joint"])
+    res = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 36)
+    for q in res.q:
+        info = identify(mech, mech.topology(q), q, "crank_joint")
+        crank = world_angles(mech, type("S", (), {"q": q}))[0]
+        Bp = A * np.array([np.cos(crank), np.sin(crank)])
+        bd2 = np.sum((np.array([G, 0]) - Bp) ** 2)
+        mu = np.arccos((B**2 + C**2 - bd2) / (2 * B * C))
+        assert abs(info.transmission_angle - mu) < 1e-9
+
+
+def test_cli_sweep_csv_and_json(mech, tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", mech.path, "--input", "crank_joint", "--from", "0", "--to", "90deg", "--steps", "9",
+                 "--csv", str(out), "--json"]) == 0
+    import json
+
+    d = json.loads(capsys.readouterr().out)
+    assert d["completed"] and len(d["values"]) == 10 and d["linkage"]["kind"] == "four-bar"
+    lines = out.read_text().splitlines()
+    assert len(lines) == 11 and lines[0].startswith("step,crank_joint_input")
