@@ -53,6 +53,12 @@ def _parser():
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
     s.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    k = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
+    common(k)
+    k.add_argument("--output", required=True, help="the link to place")
+    k.add_argument("--pose", required=True, help='"x y z roll pitch yaw" (m and rad; units allowed, e.g. 30deg)')
+    k.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    k.add_argument("--starts", type=int, default=16, help="random starting configurations (default 16)")
     w = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(w)
     w.add_argument("--input", required=True, help="the input joint to move")
@@ -96,6 +102,8 @@ def _run(args):
         return _solve(mech, args)
     if args.command == "sweep":
         return _sweep(mech, args)
+    if args.command == "ik":
+        return _ik(mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
@@ -125,6 +133,32 @@ def _solve(mech, args):
         print(trace_text(res, mech.closure.row_labels(solver=True), names))
         print()
     print(position_text(res))
+    return 0
+
+
+def _ik(mech, args):
+    import numpy as np
+    import pinocchio as pin
+
+    from .position import inverse_kinematics
+    from .report import position_dict, position_text, to_jsonable
+    from .units import parse_value
+
+    parts = args.pose.replace(",", " ").split()
+    if len(parts) != 6:
+        raise UsageError(f'--pose expects "x y z roll pitch yaw", got "{args.pose}"')
+    v = [parse_value(p) for p in parts]
+    pose = pin.SE3(pin.rpy.rpyToMatrix(np.array(v[3:])), np.array(v[:3]))
+    res = inverse_kinematics(mech, args.output, pose, starts=args.starts)
+    if args.json:
+        print(json.dumps(to_jsonable(position_dict(res)), indent=2))
+    else:
+        print(f"inverse kinematics of '{args.output}' at x y z = {v[0]:.6g} {v[1]:.6g} {v[2]:.6g} m, "
+              f"roll pitch yaw = {v[3]:.6g} {v[4]:.6g} {v[5]:.6g} rad")
+        if mech.actuated:
+            for k, s in enumerate(res.solutions, 1):
+                print(f"solution {k} actuated: " + ", ".join(f"{n} = {s.joints[n]:.9g}" for n in mech.actuated))
+        print(position_text(res).split("\n", 1)[1])
     return 0
 
 

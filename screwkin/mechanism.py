@@ -125,6 +125,11 @@ class Mechanism:
         ]
         self._coord = {c.joint: c for c in self.coordinates}
         self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
+        # a ground frame for targets (inverse kinematics); every frame must exist
+        # before any pinocchio.Data is made from the model
+        self.target_frame = model.addFrame(
+            pin.Frame("screwkin@target", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
+        self.data = model.createData()
         self.closure = ClosureSystem(model, self.cuts, tolerances, self.path)
         self.set_actuated(actuated)
         self._assembly = None

@@ -296,3 +296,54 @@ class PositionSolver:
             rhs = -(K[:, self.frozen] @ qdd[self.frozen] + bias)
             qdd[self.passive] = np.linalg.lstsq(K[:, self.passive], rhs, rcond=None)[0]
         return qdd
+
+
+def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0) -> PositionResult:
+    """Joint values (actuated and passive) that place link ``output`` at ``pose``
+    (a pinocchio.SE3 in the world), for every distinct assembly found.
+
+    The target is one more cut joint, a weld between a ground frame at ``pose``
+    and the output link, solved together with the loop closures.  Raises
+    AssemblyError (saying how close it got) when the pose is unreachable.
+    """
+    from .closure import ClosureSystem, CutJoint
+
+    model = mech.model
+    out_frame = mech.link_frame(output)
+    fid = mech.target_frame  # created with the model: adding frames later would outgrow existing Data
+    frame = model.frames[fid]
+    frame.placement = pose
+    model.frames[fid] = frame
+    target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
+    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path)
+    solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
+    found, best = [], np.inf
+    start_list = solver._starts(starts, seed)
+    for q0 in start_list:
+        try:
+            a = system.solve(q0)
+        except AssemblyError as exc:
+            best = min(best, exc.residual)
+            continue
+        q = solver._wrap(a.q)
+        sig = solver._signature(q)
+        if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
+            continue
+        found.append((sig, q, a, system.jacobian(q)))
+    if not found:
+        xyz = ", ".join(f"{x:.6g}" for x in pose.translation)
+        raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
+                            detail=f"the pose of '{output}' at ({xyz}) is unreachable from "
+                                   f"{len(start_list)} starting configurations")
+    ref = solver._signature(solver._reference)
+    found.sort(key=lambda f: float(np.linalg.norm(f[0] - ref)))
+    sols = []
+    for _, q, a, J in found:
+        s = np.linalg.svd(J, compute_uv=False)
+        needed = mech.nv - solver.idle_dofs
+        sigma = float(s[needed - 1] / s[0]) if 0 < needed <= len(s) else 1.0
+        pin.framesForwardKinematics(model, mech.data, q)
+        sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
+                             sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy()))
+    return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
+                          0, (), output)

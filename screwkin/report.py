@@ -183,7 +183,7 @@ def trace_text(res, row_labels, passive_names) -> str:
 
 
 def position_text(res, degrees=True) -> str:
-    lines = [f"inputs: " + ", ".join(f"{k} = {v:.6g}" for k, v in res.inputs.items()),
+    lines = [f"inputs: " + ", ".join(f"{k} = {v:.6g}" for k, v in res.inputs.items() if isinstance(v, float)),
              f"{len(res.solutions)} assembly mode(s) found from {res.starts} starting configurations"]
     if res.free_dofs:
         lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
