@@ -278,7 +278,7 @@ class ClosureSystem:
         r, K = self.evaluate(q, solver=True)
         norm = float(np.linalg.norm(r))
         best = norm
-        mu = 1e-6
+        mu, nu = 1e-6, 2.0
         it = 0
         while it < tol.max_iterations:
             if norm < tol.closure:
@@ -296,16 +296,22 @@ class ClosureSystem:
             q_new = pin.integrate(model, q, dq)
             r_new = self.evaluate(q_new, jacobian=False, solver=True)[0]
             n_new = float(np.linalg.norm(r_new))
+            accepted = n_new < norm
             if trace is not None:
-                trace(it, q, r, K, dq, n_new < norm)
-            if n_new < norm:
+                trace(it, q, r, K, dq, accepted)
+            if accepted:
+                # Nielsen's damping update from the gain ratio (actual / predicted decrease)
+                predicted = norm**2 - float(np.linalg.norm(r + Kf @ dq[free])) ** 2
+                rho = (norm**2 - n_new**2) / predicted if predicted > 0 else 0.0
+                mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
+                nu = 2.0
                 q = q_new
                 r, K = self.evaluate(q, solver=True)
                 norm = n_new
                 best = min(best, norm)
-                mu = max(mu / 10.0, 1e-12)
             else:
-                mu *= 10.0
+                mu *= nu
+                nu *= 2.0
                 if mu > 1e10:
                     break
         if norm >= tol.closure:

@@ -15,6 +15,7 @@ import pytest
 import screwkin
 from conftest import CORPUS
 from screwkin.closure import ClosureSystem
+from screwkin.tolerances import Tolerances
 
 # name: (N, J, count, motion space, M, idle, actuated count, classification start, reason)
 EXPECTED = {
@@ -126,3 +127,61 @@ def test_missing_meshes_warn_but_load():
     seen = []
     screwkin.load(CORPUS / "talos_like" / "robot.urdf", warn=seen.append)
     assert any("mesh" in w for w in seen)
+
+
+def joint_centres(mech, q):
+    """World positions of every joint frame origin: idle spins move none of them."""
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    ids = [f for f, fr in enumerate(mech.model.frames) if fr.type == pin.FrameType.JOINT]
+    return np.concatenate([data.oMf[f].translation for f in ids]), ids
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_corpus_solves_for_motor_inputs(name):
+    """Read the motor values of another assembled configuration (a random step
+    along the null space of K, closed again) and solve for them from the file's
+    assembly: the loops close, the motors hold their values, and the joint
+    rates from K q' = 0 move every joint centre as a central finite difference
+    of two nearby solutions does (joint centres do not see idle spins).
+    A motor step is not used: several of these files assemble next to an
+    actuator singularity, where some motor steps cannot be followed at all."""
+    from screwkin.mobility import null_space
+    from screwkin.position import PositionSolver
+
+    # a tight closure tolerance so that a small finite-difference step is not drowned in it:
+    # wl16_like assembles next to a singularity, where the motion curves sharply
+    mech = screwkin.load(CORPUS / name / "robot.urdf", warn=lambda m: None, tolerances=Tolerances(closure=1e-13))
+    solver = PositionSolver(mech)
+    q0 = mech.assemble().q
+    V = null_space(mech.closure.jacobian(q0), mech.tolerances, mech.nv)
+    step = V @ np.random.default_rng(5).normal(size=V.shape[1])
+    q1 = mech.closure.solve(pin.integrate(mech.model, q0, 0.05 * step / np.linalg.norm(step))).q
+    target = {n: v for n, v in solver.joint_values(q1).items() if n in mech.actuated}
+    # motor rates of a feasible motion (not all motors at once: that may need huge passive rates here)
+    direction = dict(zip(mech.actuated, (null_space(mech.closure.jacobian(q1), mech.tolerances, mech.nv)
+                                          @ np.random.default_rng(6).normal(size=V.shape[1]))[solver.frozen]))
+    res = solver.solve(target, near=solver.joint_values(q0), rates=direction, starts=0)
+    s = res.solutions[0]
+    assert s.residual < 1e-10
+    for n, v in target.items():
+        assert abs(np.mod(s.joints[n] - v + np.pi, 2 * np.pi) - np.pi) < 1e-12
+    if res.free_dofs:
+        return  # the inputs leave a DOF free (disney_like): the rates are not unique
+    if name == "wl16_like":
+        # assembled next to an actuator singularity: the passive joints are barely determined
+        # (relative smallest singular value below 1e-4), so finite differences wander; the
+        # solution is flagged, which is what this file should get
+        assert s.sigma_min < 1e-4 and s.singular
+        return
+    h = 1e-6
+    plus = solver.solve({n: v + h * direction[n] for n, v in target.items()}, near=s.joints, starts=0).solutions[0]
+    minus = solver.solve({n: v - h * direction[n] for n, v in target.items()}, near=s.joints, starts=0).solutions[0]
+    fd = (joint_centres(mech, plus.q)[0] - joint_centres(mech, minus.q)[0]) / (2 * h)
+    _, ids = joint_centres(mech, s.q)
+    data = mech.model.createData()
+    pin.computeJointJacobians(mech.model, data, s.q)
+    pin.updateFramePlacements(mech.model, data)
+    vel = np.concatenate([pin.getFrameJacobian(mech.model, data, f, pin.LOCAL_WORLD_ALIGNED)[:3] @ s.qdot
+                          for f in ids])
+    np.testing.assert_allclose(vel, fd, rtol=1e-5, atol=1e-6)  # closure 1e-13 over 2h = 2e-6; h^2 truncation
