@@ -53,6 +53,11 @@ def _parser():
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
     s.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    c = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
+    common(c)
+    c.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+    c.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    c.add_argument("--output", help="also the chain to this link")
     k = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(k)
     k.add_argument("--output", required=True, help="the link to place")
@@ -104,6 +109,8 @@ def _run(args):
         return _sweep(mech, args)
     if args.command == "ik":
         return _ik(mech, args)
+    if args.command == "screws":
+        return _screws(mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
@@ -133,6 +140,36 @@ def _solve(mech, args):
         print(trace_text(res, mech.closure.row_labels(solver=True), names))
         print()
     print(position_text(res))
+    return 0
+
+
+def _configuration(mech, args):
+    """The configuration a command analyses: solved for --set values, else the assembled file one."""
+    from .position import PositionSolver
+    from .units import parse_assignments
+
+    values = parse_assignments(getattr(args, "set", None), "--set")
+    near = parse_assignments([args.near], "--near") if getattr(args, "near", None) else None
+    if not values:
+        return mech.assemble().q
+    res = PositionSolver(mech, list(values)).solve(values, near=near)
+    return res.solutions[0].q
+
+
+def _screws(mech, args):
+    from .report import screws_dict, screws_text, to_jsonable
+    from .screws import structure
+
+    q = _configuration(mech, args)
+    st = structure(mech, q, args.output)
+    topo = mech.topology(q)
+    normal = None
+    if topo.motion_space == "planar":
+        normal = next(j.direction for j in topo.joints if j.type in ("revolute", "continuous"))
+    if args.json:
+        print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal)}), indent=2))
+    else:
+        print(screws_text(st, normal))
     return 0
 
 

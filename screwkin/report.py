@@ -148,7 +148,8 @@ def to_jsonable(obj):
 
 
 def _fmt_vec(v, width=11):
-    return " ".join(f"{x:>{width}.6g}" for x in v)
+    """Numbers with 6 significant digits; round-off below 1e-12 shows as 0."""
+    return " ".join(f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:>{width}.6g}" for x in v)
 
 
 def position_dict(res) -> dict:
@@ -237,4 +238,50 @@ def sweep_text(res, info=None, mus=None) -> str:
     rows = [[f"{res.values[k]:.6g}"] + [f"{x:.6g}" for x in res.joints[k]] for k in range(0, len(res.values), step)]
     lines.append("")
     lines.append(table(["input"] + list(res.names), rows))
+    return "\n".join(lines)
+
+
+def screws_dict(structure, normal=None) -> list:
+    from .screws import planar_form, screw_of
+
+    out = []
+    for st in structure:
+        ch = st["chain"]
+        joints = []
+        for k, name in enumerate(ch.joints):
+            d = {"joint": name, "xi0": screw_of(ch.xi0[:, k]).to_dict(), "theta": float(st["theta"][k]),
+                 "xi": screw_of(st["space_jacobian"][:, k]).to_dict()}
+            if normal is not None:
+                d["xi0_planar"] = planar_form(ch.xi0[:, k], normal).tolist()
+                d["xi_planar"] = planar_form(st["space_jacobian"][:, k], normal).tolist()
+            joints.append(d)
+        out.append({"chain": ch.name, "joints": joints, "g0": ch.g0.tolist(), "g": st["g"].tolist(),
+                    "space_jacobian": st["space_jacobian"].tolist(), "body_jacobian": st["body_jacobian"].tolist()})
+    return out
+
+
+def screws_text(structure, normal=None) -> str:
+    from .screws import planar_form, screw_of
+
+    lines = []
+    for st in structure:
+        ch = st["chain"]
+        lines.append(f"chain to {ch.name}:  g(q) = " + " ".join(
+            f"exp([xi{k + 1}] th{k + 1})" for k in range(len(ch.joints))) + " g(0)")
+        rows = []
+        for k, name in enumerate(ch.joints):
+            s0, s = screw_of(ch.xi0[:, k]), screw_of(st["space_jacobian"][:, k])
+            pitch = "inf" if not np.isfinite(s0.pitch) else f"{s0.pitch:.3g}"
+            point = "-" if s0.point is None else _fmt_vec(s0.point, 0)
+            row = [f"xi{k + 1}", name, _fmt_vec(ch.xi0[:, k], 8), _fmt_vec(s0.direction, 0), point, pitch,
+                   f"{st['theta'][k]:.6g}", _fmt_vec(st["space_jacobian"][:, k], 8)]
+            if normal is not None:
+                row.append(_fmt_vec(planar_form(ch.xi0[:, k], normal), 8))
+            rows.append(row)
+        headers = ["", "joint", "xi (v, w) at reference", "axis", "point", "pitch", "theta", "xi' (v, w) now"]
+        if normal is not None:
+            headers.append("(vx, vy, w)")
+        lines.append(table(headers, rows))
+        lines.append("g(0) = " + " | ".join(_fmt_vec(r, 0) for r in ch.g0[:3]))
+        lines.append("")
     return "\n".join(lines)

@@ -1,0 +1,170 @@
+"""Screws of a mechanism: product-of-exponentials structure equations, Jacobians.
+
+For every chain from the ground to a frame (each side of each cut joint, and an
+output link), the structure equation in product-of-exponentials form
+
+    g(q) = exp([xi_1] theta_1) ... exp([xi_n] theta_n) g(0)
+
+with the joint twists xi_i in the reference configuration (the file's, all
+joint values zero), in the space frame, ordered (v, w) as Pinocchio's Motion:
+for a revolute joint with unit axis w through point p, xi = (-w x p, w); for a
+prismatic joint along v, xi = (v, 0).  They are read from Pinocchio's world
+Jacobian at the reference configuration, and the current twists xi'_i at a
+configuration are the columns of the space Jacobian there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import UsageError
+from .mobility import null_space
+
+__all__ = ["Screw", "Chain", "screw_of", "chains", "poe", "structure", "split_jacobians"]
+
+
+@dataclass(frozen=True)
+class Screw:
+    """A twist (v, w) with its axis: direction, the point of the axis nearest the
+    origin, pitch [m/rad] (inf for a pure translation)."""
+
+    twist: tuple
+    direction: tuple
+    point: tuple | None
+    pitch: float
+
+    def to_dict(self) -> dict:
+        return {"twist": list(self.twist), "direction": list(self.direction),
+                "point": list(self.point) if self.point is not None else None,
+                "pitch": self.pitch if np.isfinite(self.pitch) else "inf"}
+
+
+def screw_of(xi) -> Screw:
+    xi = np.asarray(xi, float)
+    v, w = xi[:3], xi[3:]
+    nw = np.linalg.norm(w)
+    if nw < 1e-12:
+        nv = np.linalg.norm(v)
+        return Screw(tuple(xi), tuple(v / nv) if nv > 0 else (0.0, 0.0, 0.0), None, float("inf"))
+    pitch = float(w @ v / nw**2)
+    point = np.cross(w, v) / nw**2
+    return Screw(tuple(xi), tuple(w / nw), tuple(point), pitch)
+
+
+@dataclass(frozen=True)
+class Chain:
+    """A serial chain of tree joints from the ground to a frame."""
+
+    name: str  # e.g. "C@F1", "C@F2", "output platform"
+    frame: int
+    joints: tuple  # joint names, base to tip (1-DOF joints only)
+    columns: tuple  # their velocity indices
+    xi0: np.ndarray  # (6, n) joint twists at the reference configuration
+    g0: np.ndarray  # 4x4 tool frame at the reference configuration
+
+
+def chains(mech, output=None):
+    """One chain per cut-joint side and one to the output link."""
+    model = mech.model
+    targets = []
+    for c in mech.cuts:
+        targets += [(f"{c.name}@F1", c.frame1), (f"{c.name}@F2", c.frame2)]
+    if output:
+        targets.append((f"output {output}", mech.link_frame(output)))
+    q0 = mech.neutral()
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q0)
+    pin.updateFramePlacements(model, data)
+    out = []
+    for name, fid in targets:
+        jid = model.frames[fid].parentJoint
+        support = [j for j in model.supports[jid] if j > 0]
+        joints, cols = [], []
+        for j in support:
+            if model.nvs[j] != 1:
+                raise UsageError(f"{mech.path}: joint '{model.names[j]}' has {model.nvs[j]} DOF: the "
+                                 "product-of-exponentials form here takes 1-DOF joints")
+            joints.append(model.names[j])
+            cols.append(model.idx_vs[j])
+        Js = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.WORLD)
+        out.append(Chain(name, fid, tuple(joints), tuple(cols), Js[:, cols].copy(),
+                         data.oMf[fid].homogeneous.copy()))
+    return out
+
+
+def joint_angles(mech, q, chain):
+    """theta_i: each chain joint's displacement from the reference configuration."""
+    dq = pin.difference(mech.model, mech.neutral(), q)
+    return dq[list(chain.columns)]
+
+
+def poe(chain, theta) -> np.ndarray:
+    """g(theta) = prod exp([xi_i] theta_i) g(0), as a 4x4 matrix."""
+    M = pin.SE3.Identity()
+    for k in range(len(chain.joints)):
+        M = M * pin.exp6(pin.Motion(chain.xi0[:, k] * theta[k]))
+    return M.homogeneous @ chain.g0
+
+
+def structure(mech, q, output=None):
+    """Per chain: reference twists, g(0), current twists (space Jacobian columns at q)."""
+    model = mech.model
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    result = []
+    for ch in chains(mech, output):
+        Js = pin.getFrameJacobian(model, data, ch.frame, pin.ReferenceFrame.WORLD)[:, list(ch.columns)]
+        Jb = pin.getFrameJacobian(model, data, ch.frame, pin.ReferenceFrame.LOCAL)[:, list(ch.columns)]
+        result.append({"chain": ch, "theta": joint_angles(mech, q, ch), "space_jacobian": Js, "body_jacobian": Jb,
+                       "g": data.oMf[ch.frame].homogeneous.copy()})
+    return result
+
+
+def planar_form(xi, normal):
+    """(v_x, v_y, w) of a planar twist in a right-handed basis (e1, e2) of the plane with normal n."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    e1 = np.cross(n, h)
+    e1 /= np.linalg.norm(e1)
+    if abs(n @ np.array([0, 0, 1.0])) > 1 - 1e-12:  # the usual x-y plane: keep x, y
+        e1 = np.array([1.0, 0, 0]) * np.sign(n[2])
+    e2 = np.cross(n, e1)
+    xi = np.asarray(xi)
+    return np.array([xi[:3] @ e1, xi[:3] @ e2, xi[3:] @ n])
+
+
+def split_jacobians(mech, q, output, inputs=None):
+    """Constraint Jacobian split into input and passive columns, and the forward
+    (output twist from input rates) and inverse (input rates from output twist)
+    Jacobians at q.  Output twists are (v, w) of the output frame origin in
+    world axes.  The inverse Jacobian exists when the output motion determines
+    the input rates (parallel manipulators); it is None otherwise."""
+    names = list(inputs or mech.actuated)
+    a = mech.velocity_indices(names)
+    p = np.setdiff1d(np.arange(mech.nv), a)
+    K = mech.closure.jacobian(q)
+    model = mech.model
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    fid = mech.link_frame(output)
+    J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    # q' = S q'_a with K_p q'_p = -K_a q'_a (minimum norm: no idle spins)
+    S = np.zeros((mech.nv, len(a)))
+    S[a] = np.eye(len(a))
+    if K.size:
+        S[p] = -np.linalg.lstsq(K[:, p], K[:, a], rcond=None)[0]
+    forward = J @ S
+    # inverse: [K; J] q' = [0; t]; unique input rates when the output and the loops fix them
+    A = np.vstack([K, J]) if K.size else J
+    N = null_space(A, mech.tolerances, mech.nv)
+    inverse = None
+    if N.size == 0 or np.allclose(N[a], 0, atol=1e-9):
+        pinv = np.linalg.pinv(A)
+        inverse = pinv[a][:, -6:]
+    return {"inputs": names, "K_actuated": K[:, a] if K.size else K, "K_passive": K[:, p] if K.size else K,
+            "forward": forward, "inverse": inverse}
