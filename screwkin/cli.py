@@ -58,6 +58,14 @@ def _parser():
     c.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
     c.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
     c.add_argument("--output", help="also the chain to this link")
+    g = sub.add_parser("singularities", help="classify the singularities of a configuration")
+    common(g)
+    g.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+    g.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    g.add_argument("--output", help="output link (for serial singularities and the output twist)")
+    g.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    g.add_argument("--length", help="characteristic length for mixed translation/rotation measures "
+                                    "(default: RMS spread of the joint centres)")
     k = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(k)
     k.add_argument("--output", required=True, help="the link to place")
@@ -111,6 +119,8 @@ def _run(args):
         return _ik(mech, args)
     if args.command == "screws":
         return _screws(mech, args)
+    if args.command == "singularities":
+        return _singularities(mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
@@ -170,6 +180,20 @@ def _screws(mech, args):
         print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal)}), indent=2))
     else:
         print(screws_text(st, normal))
+    return 0
+
+
+def _singularities(mech, args):
+    from .report import singularity_text, to_jsonable
+    from .singular import classify
+    from .units import parse_value
+
+    q = _configuration(mech, args)
+    rep = classify(mech, q, output=args.output, length=parse_value(args.length) if args.length else None)
+    if args.json:
+        print(json.dumps(to_jsonable(rep.to_dict()), indent=2))
+    else:
+        print(singularity_text(rep))
     return 0
 
 

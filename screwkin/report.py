@@ -285,3 +285,32 @@ def screws_text(structure, normal=None) -> str:
         lines.append("g(0) = " + " | ".join(_fmt_vec(r, 0) for r in ch.g0[:3]))
         lines.append("")
     return "\n".join(lines)
+
+
+def singularity_text(rep) -> str:
+    def yes(b):
+        return "YES" if b else "no"
+
+    lines = [f"inputs: {', '.join(rep.inputs) or 'none declared'}" + (f"   output: {rep.output}" if rep.output else ""),
+             table(["singularity", "present", "relative sigma_min"], [
+                 ("serial / inverse-kinematic (output loses a direction)", yes(rep.serial),
+                  f"{rep.sigmas['serial']:.3g}" if rep.output else "- (no --output)"),
+                 ("actuator / direct-kinematic (moves with inputs locked)", yes(rep.actuator),
+                  f"{rep.sigmas['actuator']:.3g}"),
+                 ("constraint (rank of K drops)", yes(rep.constraint), f"{rep.sigmas['constraint']:.3g}"),
+             ])]
+    lines.append(f"stationary joints (rate forced to zero by the loops): {', '.join(rep.stationary_joints) or 'none'}")
+    if rep.condition is not None:
+        lines.append(f"condition number {rep.condition:.4g}" + (
+            f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
+            + f" (translations divided by the characteristic length L = {rep.length:.4g} m)")
+    for t in rep.singular_twists:
+        lines.append(f"\n{t.kind} singular direction:")
+        if t.joint_rates:
+            lines.append("  joints moving: " + ", ".join(f"{n} {v:+.4g}" for n, v in t.joint_rates.items()))
+        if t.screw is not None:
+            s = t.screw
+            pitch = s["pitch"] if isinstance(s["pitch"], str) else f"{s['pitch']:.4g} m/rad"
+            lines.append(f"  screw: axis direction {_fmt_vec(s['direction'], 0)}, through "
+                         f"{_fmt_vec(s['point'], 0) if s['point'] is not None else '-'}, pitch {pitch}")
+    return "\n".join(lines)
