@@ -84,6 +84,9 @@ def _parser():
     w.add_argument("--rate", default="1", help="input rate for the joint rates and accelerations (default 1 /s)")
     w.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
     w.add_argument("--plot", help="draw the joint values against the input into this PNG file (needs matplotlib)")
+    w.add_argument("--singularities", action="store_true",
+                   help="locate the singular input values along the motion (refined to 1e-9)")
+    w.add_argument("--output", help="output link (serial singularities)")
     return p
 
 
@@ -224,6 +227,8 @@ def _ik(mech, args):
 
 
 def _sweep(mech, args):
+    import numpy as np
+
     from .planar import identify
     from .position import PositionSolver
     from .report import sweep_text, to_jsonable
@@ -241,6 +246,11 @@ def _sweep(mech, args):
     mus = None
     if info is not None:
         mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
+    sing = None
+    if args.singularities:
+        from .sweep import locate_singularities
+
+        sing = locate_singularities(solver, res, output=args.output)
     if args.csv:
         with open(args.csv, "w") as f:
             f.write(res.csv())
@@ -251,9 +261,16 @@ def _sweep(mech, args):
         if info is not None:
             d["linkage"] = info.to_dict()
             d["transmission_angles"] = mus
+        if sing is not None:
+            d["singularities"] = [{"kind": x.kind, "input": x.input, "sigma": x.sigma} for x in sing]
         print(json.dumps(to_jsonable(d), indent=2))
     else:
         print(sweep_text(res, info, mus))
+        if sing is not None:
+            print("\nsingularities along the motion:" if sing else "\nno singularity along the motion")
+            for x in sing:
+                print(f"  {x.kind:<10} at {res.input} = {x.input:.12g} ({np.degrees(x.input):.8g} deg), "
+                      f"relative sigma {x.sigma:.2g}")
     return 0
 
 

@@ -175,6 +175,26 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None) -> Si
                              L, tuple(twists), tuple(inputs), output)
 
 
+def measures(mech, q, g, output=None, length=1.0) -> dict:
+    """The relative smallest singular values of classify(), without the rest (for scans)."""
+    tol = mech.tolerances
+    K = mech.closure.jacobian(q)
+    out = {"constraint": _rel(np.linalg.svd(K, compute_uv=False), g.rank_K) if K.size else 1.0}
+    Kp = K[:, g.p] if K.size else np.zeros((0, 0))
+    out["actuator"] = _rel(np.linalg.svd(Kp, compute_uv=False), g.rank_Kp) if Kp.size and g.rank_Kp else 1.0
+    if output is not None and g.out_dim:
+        model = mech.model
+        data = mech.data
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        J = pin.getFrameJacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+        J[:3] /= length
+        V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
+        s = np.linalg.svd(J @ V, compute_uv=False)
+        out["serial"] = float(s[g.out_dim - 1] / np.linalg.norm(J, 2)) if len(s) >= g.out_dim else 0.0
+    return out
+
+
 def _motion_twist(kind, x, names, J, L):
     x = x / np.linalg.norm(x)
     rates = {n: float(v) for n, v in zip(names, x) if abs(v) > 1e-9}

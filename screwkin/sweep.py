@@ -112,6 +112,103 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
                        np.array(A), tuple(mech.coordinate_names), rate, stopped, reason, (start, stop, steps))
 
 
+@dataclass(frozen=True)
+class SweepSingularity:
+    kind: str  # "serial" | "actuator" | "constraint"
+    input: float  # input value, refined [rad or m]
+    sigma: float  # relative smallest singular value there
+    q: np.ndarray
+
+
+def _matrix(mech, q, kind, g, output, L, V_ref=None):
+    """The matrix whose rank loss defines a singularity of this kind at q."""
+    from .mobility import null_space
+
+    K = mech.closure.jacobian(q)
+    if kind == "constraint":
+        return K
+    if kind == "actuator":
+        return K[:, g.p]
+    data = mech.data
+    pin.computeJointJacobians(mech.model, data, q)
+    pin.updateFramePlacements(mech.model, data)
+    J = pin.getFrameJacobian(mech.model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+    J[:3] /= L
+    N = null_space(K, mech.tolerances, mech.nv) if K.size else np.eye(mech.nv)
+    V = N if V_ref is None else N @ (N.T @ V_ref)  # a basis that varies smoothly with q
+    return J @ V
+
+
+def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e-12):
+    """Singular input values along a sweep, each refined to about 1e-9 or better.
+
+    Each relative smallest singular value is scanned over the sweep; around each
+    local minimum the singular vectors u, v of that step give a smooth signed
+    measure u . M(x) v that changes sign where M loses rank, and Brent's method
+    finds its root (solutions re-closed at a tight tolerance).  Minima that are
+    not zeros (no sign change) are not singular and are dropped.
+    """
+    from dataclasses import replace
+
+    from scipy.optimize import brentq
+
+    from .singular import Generic, characteristic_length, measures
+
+    mech = solver.mech
+    tight = replace(mech.tolerances, closure=1e-14, max_iterations=60)
+    g = Generic(mech, solver.inputs, output)
+    L = characteristic_length(mech, res.q[0])
+    table = [measures(mech, q, g, output, L) for q in res.q]
+    rank_of = {"constraint": g.rank_K, "actuator": g.rank_Kp, "serial": g.out_dim or 0}
+    found = []
+    xs = res.values
+    for kind in table[0]:
+        m = np.array([t[kind] for t in table])
+        r = rank_of[kind]
+        if r == 0:
+            continue
+        for k in range(len(m)):
+            left = m[k - 1] if k > 0 else np.inf
+            right = m[k + 1] if k + 1 < len(m) else np.inf
+            if not (m[k] <= left and m[k] <= right) or m[k] > 0.5:
+                continue
+            q_k = res.q[k]
+            V_ref = None
+            if kind == "serial":
+                from .mobility import null_space
+
+                K = mech.closure.jacobian(q_k)
+                V_ref = null_space(K, mech.tolerances, mech.nv) if K.size else np.eye(mech.nv)
+            U, _, Vt = np.linalg.svd(_matrix(mech, q_k, kind, g, output, L, V_ref))
+            u, v = U[:, r - 1], Vt[r - 1]
+
+            def q_at(x, q_k=q_k):
+                try:
+                    return mech.closure.solve(solver.set_inputs(q_k, {res.input: x}), frozen=solver.frozen,
+                                              tolerances=tight).q
+                except AssemblyError:
+                    return mech.closure.solve(solver.set_inputs(q_k, {res.input: x}), frozen=solver.frozen).q
+
+            def signed(x, u=u, v=v, V_ref=V_ref):
+                return float(u @ _matrix(mech, q_at(x), kind, g, output, L, V_ref) @ v)
+
+            lo, hi = xs[max(k - 1, 0)], xs[min(k + 1, len(xs) - 1)]
+            try:
+                f_lo, f_hi = signed(lo), signed(hi)
+            except AssemblyError:
+                continue
+            if f_lo == 0 or f_hi == 0 or np.sign(f_lo) == np.sign(f_hi):
+                continue
+            x = brentq(signed, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+            q = q_at(x)
+            sigma = measures(mech, q, g, output, L)[kind]
+            if sigma < mech.tolerances.singular and not any(
+                    s.kind == kind and abs(s.input - x) < 1e-7 for s in found):
+                found.append(SweepSingularity(kind, float(x), float(sigma), q))
+    found.sort(key=lambda s: s.input)
+    return found
+
+
 class _Limit(Exception):
     pass
 

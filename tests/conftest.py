@@ -48,3 +48,24 @@ def fourbar(loop_children='<link1 link="coupler" xyz="0.12 0 0"/><link2 link="ro
     return f'<robot name="fourbar">{body}{extra}</robot>'
 
 
+
+
+def slider_crank(a=0.05, b=0.15, e=0.02, theta0=np.radians(60)):
+    """Offset slider-crank: crank a about the origin, rod b, slider on the line y = e
+    (prismatic along x); written closed at crank angle theta0."""
+    B = a * np.array([np.cos(theta0), np.sin(theta0)])
+    x0 = B[0] + np.sqrt(b**2 - (e - B[1]) ** 2)
+    rod = np.arctan2(e - B[1], x0 - B[0])
+    body = "".join(LINK.format(n=n) for n in ("ground", "crank", "rod", "slider"))
+    body += rev("crank_joint", "ground", "crank", rpy=f"0 0 {theta0}")
+    body += rev("rod_joint", "crank", "rod", xyz=f"{a} 0 0", rpy=f"0 0 {rod - theta0}")
+    body += rev("slider_joint", "ground", "slider", axis="1 0 0", xyz=f"{x0} {e} 0", jtype="prismatic")
+    body += (f'<loop_joint name="pin" type="revolute"><link1 link="rod" xyz="{b} 0 0"/>'
+             f'<link2 link="slider" rpy="0 0 {rod}"/><axis xyz="0 0 1"/></loop_joint>')
+    return f'<robot name="slider_crank">{body}</robot>'
+
+
+def planar_3r(l1=0.3, l2=0.25, l3=0.1):
+    body = "".join(LINK.format(n=n) for n in ("base", "l1", "l2", "l3"))
+    body += rev("j1", "base", "l1") + rev("j2", "l1", "l2", xyz=f"{l1} 0 0") + rev("j3", "l2", "l3", xyz=f"{l2} 0 0")
+    return f'<robot name="planar_3r">{body}</robot>'
