@@ -1,0 +1,36 @@
+"""The scripts in examples/ run and print what they promise."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def run(name, *args):
+    p = subprocess.run([sys.executable, str(EXAMPLES / name), *args], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    return p.stdout
+
+
+def test_corpus_survey():
+    out = run("corpus_survey.py")
+    assert "cassie_like" in out and "not assembled" in out  # kangaroo_like's welds cannot close
+
+
+def test_overconstrained():
+    out = run("overconstrained.py")
+    assert "bennett: Kutzbach -2" in out and "screw-theory mobility 1" in out
+
+
+def test_fourbar_motion():
+    out = run("fourbar_motion.py", "72")
+    assert "2 assembly modes" in out and "Grashof crank-rocker" in out
+    assert out.count("rocker stops") == 2
+
+
+@pytest.mark.parametrize("script", sorted(p.name for p in EXAMPLES.glob("*.py")))
+def test_every_example_is_tested(script):
+    assert script in Path(__file__).read_text()
