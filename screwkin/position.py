@@ -70,6 +70,7 @@ class Solution:
     output_acceleration: np.ndarray | None = None
     qdot: np.ndarray | None = field(default=None, repr=False)
     qddot: np.ndarray | None = field(default=None, repr=False)
+    outside_limits: tuple = ()  # joints whose value is outside the file's <limit> (angles compared modulo 2 pi)
 
 
 @dataclass(frozen=True)
@@ -86,6 +87,25 @@ class PositionResult:
         from .report import position_dict
 
         return position_dict(self)
+
+
+def outside_limits(mech, q) -> tuple:
+    """Joints whose value lies outside the position limits of the file."""
+    model = mech.model
+    out = []
+    for c in mech.coordinates:
+        if c.nq != 1:
+            continue
+        lo, hi, v = model.lowerPositionLimit[c.idx_q], model.upperPositionLimit[c.idx_q], q[c.idx_q]
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo <= 0 or (lo <= v <= hi):
+            continue
+        short = model.joints[c.joint_id].shortname()
+        if short.startswith("JointModelR"):  # an angle may sit in the range modulo a turn
+            k = np.ceil((lo - v) / (2 * np.pi))
+            if lo <= v + 2 * np.pi * k <= hi:
+                continue
+        out.append(c.joint)
+    return tuple(out)
 
 
 class PositionSolver:
@@ -229,7 +249,7 @@ class PositionSolver:
                                        f"{len(start_list)} starting configurations")
         ref = near_q if near_q is not None else self._reference
         ref_sig = self._signature(ref)
-        found.sort(key=lambda f: float(np.linalg.norm(f[0] - ref_sig)))
+        found.sort(key=lambda f: (len(outside_limits(mech, f[1])) > 0, float(np.linalg.norm(f[0] - ref_sig))))
         if near_q is not None:
             found = found[:1]
         sols = tuple(self._solution(q, a, rates, accels) for _, q, a in found)
@@ -267,7 +287,7 @@ class PositionSolver:
                 twist = pin.getFrameVelocity(self.model, self.data, self.output_frame, LWA).vector.copy()
                 acc = pin.getFrameClassicalAcceleration(self.model, self.data, self.output_frame, LWA).vector.copy()
         return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), sigma, pose,
-                        rate_d, acc_d, twist, acc, qd, qdd)
+                        rate_d, acc_d, twist, acc, qd, qdd, outside_limits(mech, q))
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
@@ -336,7 +356,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
                             detail=f"the pose of '{output}' at ({xyz}) is unreachable from "
                                    f"{len(start_list)} starting configurations")
     ref = solver._signature(solver._reference)
-    found.sort(key=lambda f: float(np.linalg.norm(f[0] - ref)))
+    found.sort(key=lambda f: (len(outside_limits(mech, f[1])) > 0, float(np.linalg.norm(f[0] - ref))))
     sols = []
     for _, q, a, J in found:
         s = np.linalg.svd(J, compute_uv=False)
@@ -344,6 +364,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
         sigma = float(s[needed - 1] / s[0]) if 0 < needed <= len(s) else 1.0
         pin.framesForwardKinematics(model, mech.data, q)
         sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
-                             sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy()))
+                             sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
+                             outside_limits=outside_limits(mech, q)))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           0, (), output)

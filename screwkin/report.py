@@ -156,7 +156,7 @@ def position_dict(res) -> dict:
     sols = []
     for s in res.solutions:
         d = {"joints": s.joints, "residual": s.residual, "iterations": s.iterations, "singular": s.singular,
-             "sigma_min": s.sigma_min}
+             "sigma_min": s.sigma_min, "outside_limits": list(s.outside_limits)}
         if s.output_pose is not None:
             d["output_pose"] = s.output_pose.tolist()
         if s.rates is not None:
@@ -193,6 +193,8 @@ def position_text(res, degrees=True) -> str:
         flag = "  SINGULAR (passive joints not determined: limit position or singularity)" if s.singular else ""
         lines.append(f"\nsolution {k}: residual {s.residual:.2e}, {s.iterations} iterations, "
                      f"sigma_min {s.sigma_min:.3g}{flag}")
+        if s.outside_limits:
+            lines.append(f"  outside the joint limits of the file: {', '.join(s.outside_limits)}")
         rows = []
         for name, v in s.joints.items():
             row = [name, f"{v:.9g}"]
