@@ -66,6 +66,14 @@ def _parser():
     g.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
     g.add_argument("--length", help="characteristic length for mixed translation/rotation measures "
                                     "(default: RMS spread of the joint centres)")
+    mp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
+    common(mp)
+    mp.add_argument("--x", required=True, metavar="NAME=A:B:N", help="first input, from A to B in N values")
+    mp.add_argument("--y", required=True, metavar="NAME=A:B:N", help="second input")
+    mp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    mp.add_argument("--output", help="output link (serial singularities)")
+    mp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
+    mp.add_argument("--csv", help="the map's data as CSV")
     k = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(k)
     k.add_argument("--output", required=True, help="the link to place")
@@ -124,6 +132,8 @@ def _run(args):
         return _screws(mech, args)
     if args.command == "singularities":
         return _singularities(mech, args)
+    if args.command == "map":
+        return _map(mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
@@ -197,6 +207,52 @@ def _singularities(mech, args):
         print(json.dumps(to_jsonable(rep.to_dict()), indent=2))
     else:
         print(singularity_text(rep))
+    return 0
+
+
+def _range(text, option):
+    from .units import parse_value
+
+    name, sep, rest = text.partition("=")
+    parts = rest.split(":")
+    if not sep or len(parts) != 3:
+        raise UsageError(f"{option} expects NAME=A:B:N, got '{text}'")
+    try:
+        n = int(parts[2])
+    except ValueError:
+        raise UsageError(f"{option}: N must be a whole number, got '{parts[2]}'") from None
+    if n < 2:
+        raise UsageError(f"{option}: N must be at least 2")
+    import numpy as np
+
+    return name.strip(), np.linspace(parse_value(parts[0]), parse_value(parts[1]), n)
+
+
+def _map(mech, args):
+    from .maps import singularity_map
+    from .position import PositionSolver
+    from .report import to_jsonable
+    from .units import parse_assignments
+
+    xn, xs = _range(args.x, "--x")
+    yn, ys = _range(args.y, "--y")
+    fixed = parse_assignments(args.set, "--set")
+    inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
+    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output)
+    if args.png:
+        res.png(args.png)
+    if args.csv:
+        with open(args.csv, "w") as f:
+            f.write(res.csv())
+    if args.json:
+        print(json.dumps(to_jsonable({"x": xn, "y": yn, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
+                                      "kind": res.kind}), indent=2))
+    else:
+        import numpy as np
+
+        finite = res.log_sigma[np.isfinite(res.log_sigma)]
+        print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
+              f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g}" if finite.size else "no point assembled")
     return 0
 
 

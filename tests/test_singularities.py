@@ -108,3 +108,33 @@ def test_cli_singularities_json_keys(tmp_path, capsys):
     assert set(d) >= {"serial", "actuator", "constraint", "stationary_joints", "sigma_min", "condition",
                       "singular_twists"}
     assert d["serial"] is False and d["actuator"] is False and d["constraint"] is False
+
+
+def test_five_bar_map_finds_the_folded_legs(tmp_path):
+    """Five-bar (ground pivots (0,0), (0.1,0), proximal 0.1, distal 0.15, motors drawn at 120 and
+    60 deg): its serial singularities are where a leg is folded or stretched, |O_i P| = 0.05 or
+    0.25 m.  Every grid point the map marks singular (sigma < 10^-2.5) lies next to such a point."""
+    from conftest import ROBOTS
+    from screwkin.maps import singularity_map
+
+    mech = screwkin.load(ROBOTS / "five_bar.urdf")
+    solver = PositionSolver(mech)
+    m = singularity_map(solver, "motor1", np.linspace(1.2, 2.8, 25), "motor2", np.linspace(-0.6, 1.2, 25),
+                        output="distal1")
+    assert np.isfinite(m.log_sigma).all()
+    marked = np.argwhere(m.log_sigma < -2.5)
+    assert len(marked) >= 5
+    for j, i in marked:
+        t1, t2 = np.radians(120) + m.xs[i], np.radians(60) + m.ys[j]
+        data = mech.model.createData()
+        import pinocchio as pin
+
+        pin.framesForwardKinematics(mech.model, data, m.q[j, i])  # the assembly mode the map follows
+        P = data.oMf[mech.cuts[0].frame1].translation[:2]
+        sines = []
+        for O, t in (((0.0, 0.0), t1), ((0.1, 0.0), t2)):
+            A = np.asarray(O) + 0.1 * np.array([np.cos(t), np.sin(t)])
+            u, v = (A - O) / 0.1, (P - A) / np.linalg.norm(P - A)
+            sines.append(abs(u[0] * v[1] - u[1] * v[0]))  # |sin| of the elbow angle
+        assert min(sines) < 0.05  # a leg folded or stretched, within the grid's resolution
+    assert m.csv().count("\n") == 25 * 25 + 1
