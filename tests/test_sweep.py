@@ -102,3 +102,16 @@ def test_cli_sweep_csv_and_json(mech, tmp_path, capsys):
     assert d["completed"] and len(d["values"]) == 10 and d["linkage"]["kind"] == "four-bar"
     lines = out.read_text().splitlines()
     assert len(lines) == 11 and lines[0].startswith("step,crank_joint_input")
+
+
+def test_plot_and_map_pictures(mech, tmp_path):
+    from conftest import ROBOTS
+
+    png = tmp_path / "s.png"
+    assert main(["sweep", mech.path, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "20",
+                 "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    png2, csv = tmp_path / "m.png", tmp_path / "m.csv"
+    assert main(["map", str(ROBOTS / "five_bar.urdf"), "--x", "motor1=0:0.5:6", "--y", "motor2=0:0.5:5",
+                 "--png", str(png2), "--csv", str(csv)]) == 0
+    assert png2.read_bytes()[:4] == b"\x89PNG" and csv.read_text().count("\n") == 31
