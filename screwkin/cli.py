@@ -122,18 +122,10 @@ def _run(args):
             if note:
                 print(f"note: {note}")
         return 0
-    if args.command == "solve":
-        return _solve(mech, args)
-    if args.command == "sweep":
-        return _sweep(mech, args)
-    if args.command == "ik":
-        return _ik(mech, args)
-    if args.command == "screws":
-        return _screws(mech, args)
-    if args.command == "singularities":
-        return _singularities(mech, args)
-    if args.command == "map":
-        return _map(mech, args)
+    handlers = {"solve": _solve, "sweep": _sweep, "ik": _ik, "screws": _screws,
+                "singularities": _singularities, "map": _map}
+    if args.command in handlers:
+        return handlers[args.command](mech, args)
     result = mech.mobility(output=args.output)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))

@@ -40,6 +40,27 @@ def perpendicular_basis(a):
     return b1, b2
 
 
+def _row_vectors(cut, R1, R2, b1, b2):
+    """The world vectors of a cut joint's minimal rows at placements R1, R2:
+    ``positions`` (unit vectors fixed in F1 along which the F2 origin may not move)
+    and alignment ``pairs`` (u fixed in F1, w fixed in F2, kept perpendicular)."""
+    a = np.asarray(cut.axis)
+    t = cut.type
+    if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
+        positions = (R1[:, 0], R1[:, 1], R1[:, 2])
+    elif t in ("prismatic", "cylindrical"):
+        positions = (R1 @ b1, R1 @ b2)
+    else:  # planar
+        positions = (R1 @ a,)
+    if t in ("revolute", "continuous", "cylindrical", "planar"):
+        pairs = ((R1 @ b1, R2 @ a), (R1 @ b2, R2 @ a))
+    elif t == "universal":
+        pairs = ((R1 @ a, R2 @ np.asarray(cut.axis2)),)
+    else:  # fixed and prismatic use a rotation vector; spherical has no orientation row
+        pairs = ()
+    return positions, pairs
+
+
 @dataclass(frozen=True)
 class CutJoint:
     """A cut joint bound to a model: frame ids of F1, F2 and its axes.
@@ -125,12 +146,7 @@ class ClosureSystem:
                 dv, w1, w2 = J2[:3] - J1[:3], J1[3:], J2[3:]
             a = np.asarray(cut.axis)
             t = cut.type
-            if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
-                positions = (R1[:, 0], R1[:, 1], R1[:, 2])
-            elif t in ("prismatic", "cylindrical"):
-                positions = (R1 @ b1, R1 @ b2)
-            else:  # planar
-                positions = (R1 @ a,)
+            positions, pairs = _row_vectors(cut, R1, R2, b1, b2)
             for e in positions:
                 r[i] = e @ d
                 if jacobian:
@@ -153,12 +169,6 @@ class ClosureSystem:
                     K[i:i + 3] = pin.Jlog3(R) @ R2.T @ (w2 - w1)
                 i += 3
                 continue
-            if t in ("revolute", "continuous", "cylindrical", "planar"):
-                pairs = ((R1 @ b1, R2 @ a), (R1 @ b2, R2 @ a))
-            elif t == "universal":
-                pairs = ((R1 @ a, R2 @ np.asarray(cut.axis2)),)
-            else:  # spherical
-                pairs = ()
             for u, w in pairs:
                 r[i] = u @ w
                 if jacobian:
@@ -191,14 +201,8 @@ class ClosureSystem:
             A2 = pin.getFrameClassicalAcceleration(model, data, cut.frame2, LWA)
             w1, w2, al1, al2 = V1.angular, V2.angular, A1.angular, A2.angular
             dd, ddd = V2.linear - V1.linear, A2.linear - A1.linear
-            a = np.asarray(cut.axis)
             t = cut.type
-            if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
-                positions = (R1[:, 0], R1[:, 1], R1[:, 2])
-            elif t in ("prismatic", "cylindrical"):
-                positions = (R1 @ b1, R1 @ b2)
-            else:
-                positions = (R1 @ a,)
+            positions, pairs = _row_vectors(cut, R1, R2, b1, b2)
             for e in positions:
                 ed, edd = second(e, w1, al1)
                 out[i] = edd @ d + 2 * ed @ dd + e @ ddd
@@ -207,12 +211,6 @@ class ClosureSystem:
                 out[i:i + 3] = pin.Jlog3(R1.T @ R2) @ R2.T @ (al2 - al1 + np.cross(w2, w1))
                 i += 3
                 continue
-            if t in ("revolute", "continuous", "cylindrical", "planar"):
-                pairs = ((R1 @ b1, R2 @ a), (R1 @ b2, R2 @ a))
-            elif t == "universal":
-                pairs = ((R1 @ a, R2 @ np.asarray(cut.axis2)),)
-            else:
-                pairs = ()
             for u, w in pairs:
                 ud, udd = second(u, w1, al1)
                 wd, wdd = second(w, w2, al2)

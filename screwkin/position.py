@@ -230,19 +230,9 @@ class PositionSolver:
             for name, v in near.items():
                 near_q = self.set_inputs(near_q, {name: v}) if mech.coordinate(name).nv == 1 else near_q
         start_list = ([near_q] if near_q is not None else []) + self._starts(starts, seed)
-        found, best = [], np.inf
-        for k, q0 in enumerate(start_list):
-            q0 = self.set_inputs(q0, values)
-            try:
-                a = mech.closure.solve(q0, frozen=self.frozen, trace=recorder if (trace and k == 0) else None)
-            except AssemblyError as exc:
-                best = min(best, exc.residual)
-                continue
-            q = self._wrap(a.q)
-            sig = self._signature(q)
-            if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
-                continue
-            found.append((sig, q, a))
+        found, best = self.distinct(
+            mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
+            first_trace=recorder if trace else None)
         if not found:
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
@@ -255,6 +245,24 @@ class PositionSolver:
         sols = tuple(self._solution(q, a, rates, accels) for _, q, a in found)
         return PositionResult(dict(values), tuple(self.inputs), sols, len(start_list), self.free_dofs,
                               tuple(steps), self.output)
+
+    def distinct(self, system, starts, frozen=(), first_trace=None):
+        """Solve ``system`` from every start; keep one solution per assembly mode.
+
+        Returns ([(signature, q, Assembly)], smallest residual of the failures)."""
+        found, best = [], np.inf
+        for k, q0 in enumerate(starts):
+            try:
+                a = system.solve(q0, frozen=frozen, trace=first_trace if k == 0 else None)
+            except AssemblyError as exc:
+                best = min(best, exc.residual)
+                continue
+            q = self._wrap(a.q)
+            sig = self._signature(q)
+            if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
+                continue
+            found.append((sig, q, a))
+        return found, best
 
     @staticmethod
     def _describe(values):
@@ -337,19 +345,9 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
     system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path)
     solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
-    found, best = [], np.inf
     start_list = solver._starts(starts, seed)
-    for q0 in start_list:
-        try:
-            a = system.solve(q0)
-        except AssemblyError as exc:
-            best = min(best, exc.residual)
-            continue
-        q = solver._wrap(a.q)
-        sig = solver._signature(q)
-        if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
-            continue
-        found.append((sig, q, a, system.jacobian(q)))
+    found, best = solver.distinct(system, start_list)
+    found = [(sig, q, a, system.jacobian(q)) for sig, q, a in found]
     if not found:
         xyz = ", ".join(f"{x:.6g}" for x in pose.translation)
         raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
