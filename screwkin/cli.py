@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 
 from .errors import ScrewkinError, UsageError
@@ -74,6 +75,15 @@ def _parser():
     mp.add_argument("--output", help="output link (serial singularities)")
     mp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
     mp.add_argument("--csv", help="the map's data as CSV")
+    v = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
+    common(v)
+    v.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+    v.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    v.add_argument("--output", help="output link: its frame is drawn, singularities are marked on it")
+    v.add_argument("--sweep", metavar="NAME=A:B:N", help="animate the motion of one input (other inputs from --set)")
+    v.add_argument("--html", help="write a self-contained static HTML page of the scene and exit")
+    v.add_argument("--png", help="write a picture of the scene (headless Chromium) and exit")
+    v.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
     k = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(k)
     k.add_argument("--output", required=True, help="the link to place")
@@ -123,7 +133,7 @@ def _run(args):
                 print(f"note: {note}")
         return 0
     handlers = {"solve": _solve, "sweep": _sweep, "ik": _ik, "screws": _screws,
-                "singularities": _singularities, "map": _map}
+                "singularities": _singularities, "map": _map, "view": _view}
     if args.command in handlers:
         return handlers[args.command](mech, args)
     result = mech.mobility(output=args.output)
@@ -246,6 +256,57 @@ def _map(mech, args):
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
               f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g}" if finite.size else "no point assembled")
     return 0
+
+
+def _view(mech, args):
+    import tempfile
+    import time
+
+    from .view import ViewerServer, build_scene, screenshot, show
+
+    q = _configuration(mech, args)
+    motion, singular = None, []
+    if args.sweep:
+        from .position import PositionSolver
+        from .singular import classify
+        from .sweep import locate_singularities, sweep
+        from .units import parse_assignments
+
+        name, values = _range(args.sweep, "--sweep")
+        fixed = {k: v for k, v in parse_assignments(args.set, "--set").items() if k != name}
+        inputs = list(mech.actuated) if name in mech.actuated else [name, *fixed]
+        solver = PositionSolver(mech, inputs)
+        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed)
+        motion = res.q
+        q = res.q[0]
+        for s in locate_singularities(solver, res, output=args.output):
+            rep = classify(mech, s.q, output=args.output)
+            twist = next((t for t in rep.singular_twists if t.kind == s.kind), None)
+            singular.append((s.q, twist))
+            print(f"singular ({s.kind}) at {name} = {s.input:.9g}")
+    scene = build_scene(mech, q, output=args.output, singular=singular)
+    with ViewerServer() as server:
+        show(mech, scene, server.viewer, q, motion=motion)
+        if args.html or args.png:
+            html = server.viewer.static_html()
+            if args.html:
+                with open(args.html, "w") as f:
+                    f.write(html)
+                print(f"wrote {args.html}")
+            if args.png:
+                with tempfile.TemporaryDirectory() as d:
+                    page = os.path.join(d, "scene.html")
+                    with open(page, "w") as f:
+                        f.write(html)
+                    screenshot(page, args.png)
+                print(f"wrote {args.png}")
+            return 0
+        print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
+        try:
+            while True:
+                time.sleep(1)
+        except KeyboardInterrupt:
+            return 0
 
 
 def _ik(mech, args):

@@ -1,0 +1,316 @@
+"""meshcat views of mechanisms: configurations, motions, screws and singular directions.
+
+The scene is a Pinocchio GeometryModel: the links' URDF visuals (meshes when
+found, primitives otherwise), plus what screwkin adds as geometry objects
+attached to the moving joints -- joint axes as thin cylinders (actuated joints
+orange, passive grey, cut joints magenta), stand-ins for links without geometry
+(a ball at the link frame and bars to its joints), the output link's frame,
+and, at singular configurations, the singular screw axis with an arrow.
+Pinocchio's MeshcatVisualizer draws it into any meshcat viewer: the loopback
+server of :class:`ViewerServer`, or a recording stand-in in tests.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import UsageError
+from .urdf import resolve_uri
+from .xmlsafe import parse_xml_text
+
+__all__ = ["COLORS", "build_scene", "show", "ViewerServer", "RecordingViewer", "screenshot"]
+
+COLORS = {
+    "actuated": np.array([1.0, 0.55, 0.0, 1.0]),
+    "passive": np.array([0.55, 0.55, 0.55, 1.0]),
+    "cut": np.array([0.9, 0.0, 0.9, 1.0]),
+    "standin": np.array([0.35, 0.6, 0.9, 1.0]),
+    "screw": np.array([1.0, 0.1, 0.1, 1.0]),
+    "marker": np.array([1.0, 0.9, 0.0, 1.0]),
+    "x": np.array([1.0, 0.0, 0.0, 1.0]),
+    "y": np.array([0.0, 0.8, 0.0, 1.0]),
+    "z": np.array([0.0, 0.0, 1.0, 1.0]),
+}
+
+
+def _coal():
+    import coal
+
+    return coal
+
+
+def _visual_urdf(mech) -> str:
+    """The URDF text with every mesh resolved to an absolute path, and visuals
+    whose mesh cannot be found dropped (their links get stand-ins)."""
+    root = parse_xml_text(mech.spec.urdf_text, mech.path)
+    base = Path(mech.path).resolve().parent
+    for link in root.findall("link"):
+        for tag in ("visual", "collision"):
+            for vis in link.findall(tag):
+                mesh = vis.find("geometry/mesh")
+                if mesh is None:
+                    continue
+                found = [c for c in resolve_uri(mesh.get("filename", ""), base) if c.is_file()]
+                if found:
+                    mesh.set("filename", str(found[0].resolve()))
+                else:
+                    link.remove(vis)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _segment(name, joint, frame, a, b, radius, color):
+    """A cylinder between points a and b (in the frame of joint ``joint``)."""
+    coal = _coal()
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    d = b - a
+    L = float(np.linalg.norm(d))
+    if L < 1e-9:
+        return None
+    z = d / L
+    h = np.array([1.0, 0, 0]) if abs(z[0]) < 0.9 else np.array([0, 1.0, 0])
+    x = np.cross(h, z)
+    x /= np.linalg.norm(x)
+    R = np.column_stack([x, np.cross(z, x), z])
+    obj = pin.GeometryObject(name, joint, frame, pin.SE3(R, (a + b) / 2), coal.Cylinder(radius, L))
+    obj.meshColor = np.asarray(color, float)
+    return obj
+
+
+def _ball(name, joint, frame, p, radius, color):
+    obj = pin.GeometryObject(name, joint, frame, pin.SE3(np.eye(3), np.asarray(p, float)), _coal().Sphere(radius))
+    obj.meshColor = np.asarray(color, float)
+    return obj
+
+
+@dataclass
+class Scene:
+    """A mechanism's scene: the geometry model and what each added object shows."""
+
+    geometry: pin.GeometryModel
+    roles: dict  # geometry object name -> role ("link", "axis:actuated", "axis:passive", "axis:cut", "standin", ...)
+    scale: float  # size of the mechanism [m]
+    center: np.ndarray  # centre of its joints [m]
+
+
+def build_scene(mech, q, output=None, singular=()) -> Scene:
+    """The scene at configuration q (used for the characteristic size of the marks).
+
+    singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
+    output link's origin, and the singular screw axis as a line with an arrow."""
+    model = mech.model
+    geom = pin.buildGeomFromUrdfString(model, _visual_urdf(mech), pin.GeometryType.VISUAL)
+    roles = {o.name: "link" for o in geom.geometryObjects}
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    pts = np.array([data.oMi[j].translation for j in range(model.njoints)])
+    scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
+    center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    r_axis, L_axis = 0.004 * scale, 0.08 * scale
+
+    def add(obj, role):
+        if obj is not None:
+            geom.addGeometryObject(obj)
+            roles[obj.name] = role
+
+    actuated = set(mech.actuated)
+    axis_of = {j.name: np.asarray(j.axis) for j in mech.spec.joints}
+    for c in mech.coordinates:  # joint axes, drawn on the child side of each moving joint
+        jid = c.joint_id
+        frame = model.getFrameId(c.joint) if model.existFrame(c.joint) else 0
+        role = "axis:actuated" if c.joint in actuated else "axis:passive"
+        a = axis_of.get(c.joint)
+        if a is None or c.nv != 1:
+            add(_ball(f"screwkin/axis/{c.joint}", jid, frame, np.zeros(3), 2 * r_axis, COLORS[role[5:]]), role)
+            continue
+        add(_segment(f"screwkin/axis/{c.joint}", jid, frame, -L_axis * a, L_axis * a, r_axis, COLORS[role[5:]]), role)
+    for cut in mech.cuts:  # cut joints: their axis on the F1 side
+        f = model.frames[cut.frame1]
+        a = f.placement.rotation @ np.asarray(cut.axis)
+        p = f.placement.translation
+        if cut.type in ("spherical", "fixed", "universal"):
+            add(_ball(f"screwkin/cut/{cut.name}", f.parentJoint, cut.frame1, p, 2.5 * r_axis, COLORS["cut"]), "axis:cut")
+        else:
+            add(_segment(f"screwkin/cut/{cut.name}", f.parentJoint, cut.frame1, p - L_axis * a, p + L_axis * a,
+                         1.5 * r_axis, COLORS["cut"]), "axis:cut")
+    # stand-ins for links without any visual: a ball at the link frame, bars to the joints it carries
+    with_visual = {model.frames[o.parentFrame].name for o in geom.geometryObjects if roles[o.name] == "link"}
+    dummies = {name for name, link in mech.spec.links.items() if link.is_massless(mech.tolerances.dummy_mass)}
+    for name in mech.spec.links:
+        if name in with_visual or name in dummies or not model.existFrame(name):
+            continue
+        fid = model.getFrameId(name)
+        fr = model.frames[fid]
+        if fr.parentJoint == 0 and name == mech.spec.root:
+            continue
+        add(_ball(f"screwkin/standin/{name}", fr.parentJoint, fid, fr.placement.translation, 3 * r_axis,
+                  COLORS["standin"]), "standin")
+        for j in mech.spec.joints:
+            if j.parent == name and model.existJointName(j.name):
+                child = model.getJointId(j.name)
+                add(_segment(f"screwkin/standin_bar/{name}/{j.name}", fr.parentJoint, fid, fr.placement.translation,
+                             model.jointPlacements[child].translation if model.parents[child] == fr.parentJoint
+                             else fr.placement.translation, 1.5 * r_axis, COLORS["standin"]), "standin")
+    if output is not None:
+        fid = mech.link_frame(output)
+        fr = model.frames[fid]
+        for k, axis in enumerate("xyz"):
+            end = fr.placement.translation + 2 * L_axis * fr.placement.rotation[:, k]
+            add(_segment(f"screwkin/output/{axis}", fr.parentJoint, fid, fr.placement.translation, end, r_axis,
+                         COLORS[axis]), f"output:{axis}")
+    for k, (qs, twist) in enumerate(singular):
+        d = model.createData()
+        pin.framesForwardKinematics(model, d, qs)
+        if output is not None:
+            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, d.oMf[mech.link_frame(output)].translation, 4 * r_axis,
+                      COLORS["marker"]), "singular:marker")
+        if twist is not None and twist.screw is not None and twist.screw.get("point") is not None:
+            s = twist.screw
+            p, u = np.asarray(s["point"]), np.asarray(s["direction"])
+            add(_segment(f"screwkin/singular/{k}/axis", 0, 0, p - 3 * L_axis * u, p + 3 * L_axis * u, r_axis,
+                         COLORS["screw"]), "singular:axis")
+            cone = pin.GeometryObject(f"screwkin/singular/{k}/arrow", 0, 0, pin.SE3(
+                _segment("t", 0, 0, p, p + u, 1, COLORS["screw"]).placement.rotation, p + 3 * L_axis * u),
+                _coal().Cone(3 * r_axis, 6 * r_axis))
+            cone.meshColor = COLORS["screw"]
+            add(cone, "singular:arrow")
+    return Scene(geom, roles, scale, center)
+
+
+class RecordingViewer:
+    """A stand-in for meshcat.Visualizer that records what is sent to it."""
+
+    def __init__(self, root=None, path=""):
+        import meshcat.path
+
+        self._root = root or self
+        self._path = path
+        self.path = meshcat.path.Path(tuple(p for p in path.split("/") if p))
+        if root is None:
+            self.objects, self.transforms, self.properties, self.animation = {}, {}, {}, None
+
+    def __getitem__(self, path):
+        path = path if path.startswith("/") else f"{self._path}/{path}"
+        return RecordingViewer(self._root, path)
+
+    def set_object(self, geometry, material=None):
+        self._root.objects[self._path] = (geometry, material)
+
+    def set_transform(self, matrix=np.eye(4)):
+        self._root.transforms[self._path] = np.asarray(matrix)
+
+    def set_property(self, key, value):
+        self._root.properties[(self._path, key)] = value
+
+    def delete(self):
+        self._root.objects.pop(self._path, None)
+
+    def set_animation(self, animation, play=True, repetitions=1):
+        self._root.animation = animation
+
+    def get_image(self, *args):  # pragma: no cover - present so Pinocchio does not warn
+        raise NotImplementedError
+
+
+def _translation(p):
+    T = np.eye(4)
+    T[:3, 3] = p
+    return T
+
+
+def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
+    """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
+    with ``motion`` (a sequence of configurations) also set a meshcat animation."""
+    from pinocchio.visualize import MeshcatVisualizer
+
+    viz = MeshcatVisualizer(mech.model, pin.GeometryModel(), scene.geometry)
+    viz.initViewer(viewer=viewer)
+    viz.loadViewerModel(rootNodeName="screwkin")
+    viz.display(q)
+    # look at the mechanism from a distance proportional to its size (meshcat's camera frame is y-up)
+    d = 1.1 * scene.scale
+    viewer["/Axes"].set_property("visible", False)
+    viewer["/Cameras/default"].set_transform(_translation(scene.center))
+    viewer["/Cameras/default/rotated/<object>"].set_property("position", [d, 0.7 * d, d])
+    if motion is not None and len(motion):
+        import meshcat.animation
+
+        anim = meshcat.animation.Animation(default_framerate=fps)
+        for k, qk in enumerate(motion):
+            with anim.at_frame(viewer, k) as frame:
+                viz.viewer = frame
+                viz.display(qk)
+        viz.viewer = viewer
+        viewer.set_animation(anim, play=True, repetitions=0)
+    return viz
+
+
+class ViewerServer:
+    """A meshcat server on 127.0.0.1 in a subprocess (see screwkin.viewserver)."""
+
+    def __init__(self):
+        env = dict(os.environ)
+        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "screwkin.viewserver"], stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, env=env, start_new_session=True, text=True)
+        info = {}
+        while len(info) < 2:
+            line = self.proc.stdout.readline()
+            if not line:
+                raise UsageError(f"the meshcat server did not start: {self.proc.stderr.read().strip()[-300:]}")
+            key, _, value = line.strip().partition("=")
+            info[key] = value
+        self.zmq_url, self.web_url = info["zmq_url"], info["web_url"]
+        import contextlib
+        import io
+
+        import meshcat
+
+        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; the CLI says it itself
+            self.viewer = meshcat.Visualizer(zmq_url=self.zmq_url)
+
+    def close(self):
+        self.proc.terminate()
+        try:
+            self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:  # pragma: no cover
+            self.proc.kill()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def chromium():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        for d in os.environ.get("PATH", "").split(os.pathsep):
+            p = Path(d) / name
+            if p.is_file() and os.access(p, os.X_OK):
+                return str(p)
+    return None
+
+
+def screenshot(html_path, png_path, size=(900, 700), budget_ms=8000):
+    """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
+    exe = chromium()
+    if exe is None:
+        raise UsageError("--png needs Chromium (Debian: apt-get install chromium)")
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as profile:
+        cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+               "--enable-unsafe-swiftshader", "--disable-quic", "--no-first-run", "--disable-background-networking",
+               "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}",
+               f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={budget_ms}",
+               f"--screenshot={Path(png_path).resolve()}", Path(html_path).resolve().as_uri()]
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    if not Path(png_path).is_file():
+        raise UsageError(f"Chromium did not write {png_path}: {p.stderr.strip()[-300:]}")
