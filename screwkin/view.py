@@ -131,6 +131,13 @@ def build_scene(mech, q, output=None, singular=()) -> Scene:
             add(_ball(f"screwkin/axis/{c.joint}", jid, frame, np.zeros(3), 2 * r_axis, COLORS[role[5:]]), role)
             continue
         add(_segment(f"screwkin/axis/{c.joint}", jid, frame, -L_axis * a, L_axis * a, r_axis, COLORS[role[5:]]), role)
+        short = model.joints[jid].shortname()
+        if "JointModelP" in short:  # pitch infinite: a translation, drawn with an arrow head
+            seg = _segment("tmp", jid, frame, np.zeros(3), a, 1.0, COLORS[role[5:]])
+            cone = pin.GeometryObject(f"screwkin/axis/{c.joint}/arrow", jid, frame,
+                                      pin.SE3(seg.placement.rotation, L_axis * a), _coal().Cone(3 * r_axis, 6 * r_axis))
+            cone.meshColor = COLORS[role[5:]]
+            add(cone, role)
     for cut in mech.cuts:  # cut joints: their axis on the F1 side
         f = model.frames[cut.frame1]
         a = f.placement.rotation @ np.asarray(cut.axis)
@@ -235,7 +242,7 @@ def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
     viz.loadViewerModel(rootNodeName="screwkin")
     viz.display(q)
     # look at the mechanism from a distance proportional to its size (meshcat's camera frame is y-up)
-    d = 1.1 * scene.scale
+    d = 1.4 * scene.scale
     viewer["/Axes"].set_property("visible", False)
     viewer["/Cameras/default"].set_transform(_translation(scene.center))
     viewer["/Cameras/default/rotated/<object>"].set_property("position", [d, 0.7 * d, d])

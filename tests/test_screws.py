@@ -65,3 +65,23 @@ def test_forward_jacobian_of_a_four_bar_against_finite_differences(tmp_path):
     np.testing.assert_allclose(J["forward"][3:, 0], w_fd, atol=1e-6)
     assert J["inverse"] is not None  # a rocker angle fixes the crank angle of this circuit
     np.testing.assert_allclose(J["inverse"] @ J["forward"], np.eye(1), atol=1e-9)
+
+
+def test_batched_singular_values_match_one_by_one():
+    """The vectorized path (a stack of Jacobians, one SVD call) gives the per-configuration
+    values, and finds the wrist singularity of the 6R arm (theta5 = 0)."""
+    from conftest import ROBOTS
+    from screwkin.batch import frame_jacobians, smallest_singular_values
+
+    mech = screwkin.load(ROBOTS / "arm_6r.urdf")
+    rng = np.random.default_rng(0)
+    Q = rng.uniform(-2, 2, (200, 6))
+    Q[:10, 4] = 0.0
+    fid = mech.link_frame("flange")
+    J = frame_jacobians(mech.model, fid, Q)
+    s = smallest_singular_values(J, scale_translation=0.5)
+    for k in (0, 50, 199):
+        Jk = pin.computeFrameJacobian(mech.model, mech.model.createData(), Q[k], fid, pin.ReferenceFrame.WORLD).copy()
+        Jk[:3] /= 0.5
+        assert abs(np.linalg.svd(Jk, compute_uv=False)[-1] - s[k]) < 1e-12
+    assert (s[:10] < 1e-12).all() and (s[10:] > 1e-6).all()

@@ -115,3 +115,32 @@ def test_plot_and_map_pictures(mech, tmp_path):
     assert main(["map", str(ROBOTS / "five_bar.urdf"), "--x", "motor1=0:0.5:6", "--y", "motor2=0:0.5:5",
                  "--png", str(png2), "--csv", str(csv)]) == 0
     assert png2.read_bytes()[:4] == b"\x89PNG" and csv.read_text().count("\n") == 31
+
+
+def test_slider_crank_closed_form_and_extras(tmp_path):
+    """Offset slider-crank: slider x = a cos(t) + sqrt(b^2 - (e - a sin t)^2); dead centres at
+    atan2(e, sqrt((a + b)^2 - e^2)) and atan2(e, sqrt((b - a)^2 - e^2)) + pi; a + e <= b: full turn."""
+    from conftest import slider_crank
+
+    a, b, e, t0 = 0.05, 0.15, 0.02, np.radians(60)
+    p = tmp_path / "sc.urdf"
+    p.write_text(slider_crank(a, b, e, t0))
+    mech = screwkin.load(p)
+    solver = PositionSolver(mech, ["crank_joint"])
+    res = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 72)
+    x0 = a * np.cos(t0) + np.sqrt(b**2 - (e - a * np.sin(t0)) ** 2)
+    for x_in, joints in zip(res.values, res.joints):
+        t = t0 + x_in
+        x = a * np.cos(t) + np.sqrt(b**2 - (e - a * np.sin(t)) ** 2)
+        assert abs(joints[res.names.index("slider_joint")] - (x - x0)) < 1e-9
+    q = mech.assemble().q
+    info = identify(mech, mech.topology(q), q, "crank_joint")
+    assert info.kind == "slider-crank" and info.grashof.startswith("crank turns fully")
+    assert info.input_range is None
+    dead = sorted(np.mod(np.array([np.arctan2(e, np.sqrt((a + b) ** 2 - e**2)),
+                                   np.arctan2(e, np.sqrt((b - a) ** 2 - e**2)) + np.pi]) - t0 + np.pi, 2 * np.pi) - np.pi)
+    np.testing.assert_allclose(sorted(info.limit_inputs), dead, atol=1e-12)
+    # transmission angle: between the rod and the normal of the slide, 90 deg when the rod lies along the slide
+    B = a * np.array([np.cos(t0), np.sin(t0)])
+    rod = np.array([x0, e]) - B
+    assert abs(info.transmission_angle - np.arccos(abs(rod[1]) / b)) < 1e-12

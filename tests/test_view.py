@@ -120,3 +120,10 @@ def test_static_page_renders_the_mechanism(tmp_path):
     img = np.asarray(Image.open(png).convert("RGB")).astype(int)
     red = (img[..., 0] > 150) & (img[..., 1] < 120) & (img[..., 2] < 100)
     assert red.sum() > 200
+
+
+def test_prismatic_axes_carry_an_arrow():
+    mech = screwkin.load(ROBOTS / "planar_3rpr.urdf")
+    scene = build_scene(mech, mech.assemble().q)
+    arrows = [n for n in scene.roles if n.endswith("/arrow")]
+    assert sorted(arrows) == [f"screwkin/axis/leg{k}/arrow" for k in (1, 2, 3)]
