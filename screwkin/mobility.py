@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from .errors import AssemblyError, UsageError
+from .errors import AssemblyError
 from .topology import Topology
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]

@@ -184,7 +184,7 @@ def trace_text(res, row_labels, passive_names) -> str:
 
 
 def position_text(res, degrees=True) -> str:
-    lines = [f"inputs: " + ", ".join(f"{k} = {v:.6g}" for k, v in res.inputs.items() if isinstance(v, float)),
+    lines = ["inputs: " + ", ".join(f"{k} = {v:.6g}" for k, v in res.inputs.items() if isinstance(v, float)),
              f"{len(res.solutions)} assembly mode(s) found from {res.starts} starting configurations"]
     if res.free_dofs:
         lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
@@ -272,7 +272,7 @@ def screws_text(structure, normal=None) -> str:
             f"exp([xi{k + 1}] th{k + 1})" for k in range(len(ch.joints))) + " g(0)")
         rows = []
         for k, name in enumerate(ch.joints):
-            s0, s = screw_of(ch.xi0[:, k]), screw_of(st["space_jacobian"][:, k])
+            s0 = screw_of(ch.xi0[:, k])
             pitch = "inf" if not np.isfinite(s0.pitch) else f"{s0.pitch:.3g}"
             point = "-" if s0.point is None else _fmt_vec(s0.point, 0)
             row = [f"xi{k + 1}", name, _fmt_vec(ch.xi0[:, k], 8), _fmt_vec(s0.direction, 0), point, pitch,

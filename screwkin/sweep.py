@@ -78,9 +78,8 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     missing = [n for n in others if n not in fixed]
     if missing:
         raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
-    mech, model = solver.mech, solver.model
+    mech = solver.mech
     closure = mech.closure
-    tol = mech.tolerances
     xs = np.linspace(start, stop, steps + 1)
     first = solver.solve({name: xs[0], **fixed}, near=near, starts=8 if near is None else 0)
     q = first.solutions[0].q

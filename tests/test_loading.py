@@ -3,14 +3,12 @@
 import json
 import shutil
 
-import numpy as np
-import pytest
 
 import screwkin
 from conftest import CORPUS, DATA
 from screwkin.cli import main
 
-from conftest import LINK, fourbar, rev  # noqa: E402
+from conftest import fourbar  # noqa: E402
 
 
 def test_fourbar_loop_joint_is_closed_in_the_file(tmp_path):
@@ -75,7 +73,7 @@ def test_sdf_four_bar_is_cut_into_tree_plus_loop_joint():
 def test_sdf_ball_joints_become_compound_spherical(tmp_path):
     """RSSR in SDF with two ball joints: the tree ball becomes three revolutes
     through massless links, recognized again as one spherical joint."""
-    sdf = f"""<sdf version="1.7"><model name="rssr">
+    sdf = """<sdf version="1.7"><model name="rssr">
       <link name="base"><pose>0 0 0 0 0 0</pose><visual name="v"/></link>
       <link name="crank"><pose>0 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
       <link name="rod"><pose>0.05 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
