@@ -26,7 +26,7 @@ from .errors import UsageError
 from .urdf import resolve_uri
 from .xmlsafe import parse_xml_text
 
-__all__ = ["COLORS", "build_scene", "show", "ViewerServer", "RecordingViewer", "screenshot"]
+__all__ = ["COLORS", "build_scene", "show", "view", "ViewerServer", "RecordingViewer", "screenshot"]
 
 COLORS = {
     "actuated": np.array([1.0, 0.55, 0.0, 1.0]),
@@ -321,3 +321,19 @@ def screenshot(html_path, png_path, size=(900, 700), budget_ms=8000):
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     if not Path(png_path).is_file():
         raise UsageError(f"Chromium did not write {png_path}: {p.stderr.strip()[-300:]}")
+
+
+_servers = []  # servers started by view(): they live as long as the Python session (a notebook)
+
+
+def view(mech, q=None, output=None, motion=None, viewer=None):
+    """Show a mechanism (at q, default its assembled configuration) and return the
+    meshcat viewer; in a notebook, ``view(mech, s.q).jupyter_cell()`` embeds it.
+    Without ``viewer`` a loopback-only server is started and kept for the session."""
+    q = mech.assemble().q if q is None else q
+    if viewer is None:
+        server = ViewerServer()
+        _servers.append(server)
+        viewer = server.viewer
+    show(mech, build_scene(mech, q, output=output), viewer, q, motion=motion)
+    return viewer

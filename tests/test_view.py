@@ -127,3 +127,12 @@ def test_prismatic_axes_carry_an_arrow():
     scene = build_scene(mech, mech.assemble().q)
     arrows = [n for n in scene.roles if n.endswith("/arrow")]
     assert sorted(arrows) == [f"screwkin/axis/leg{k}/arrow" for k in (1, 2, 3)]
+
+
+def test_view_helper_uses_the_viewer_it_is_given(delta):
+    from screwkin.view import view
+
+    mech, q = delta
+    v = RecordingViewer()
+    assert view(mech, q, viewer=v) is v
+    assert any(p.startswith("/screwkin/visuals/") for p in v.objects)
