@@ -110,6 +110,105 @@ def serial_scan(n):
     return rows, t_ours, t_floor
 
 
+# ---------------------------------------------------------------- 2. closed-loop forward kinematics
+def _toolbox():
+    """toolbox-parallel-robots without its package __init__ (which needs pinocchio.casadi,
+    absent from the PyPI wheel): the recipe of ../shared/peers.md."""
+    import importlib
+    import importlib.util
+    import types
+
+    spec = importlib.util.find_spec("toolbox_parallel_robots")
+    if spec is None:
+        return None
+    bare = types.ModuleType("toolbox_parallel_robots")
+    bare.__path__ = list(spec.submodule_search_locations)
+    sys.modules["toolbox_parallel_robots"] = bare
+    fk = importlib.import_module("toolbox_parallel_robots.forward_kinematics")
+    am = importlib.import_module("toolbox_parallel_robots.actuation_model")
+    stand_in = types.ModuleType("pinocchio.casadi")
+
+    class Model:  # nothing is an instance of it: mergeq takes its numpy path
+        pass
+
+    stand_in.Model = Model
+    pin.casadi = stand_in
+    return fk, am
+
+
+def closed_loop_fk(names, solves):
+    import yaml
+
+    from screwkin.mobility import null_space
+    from screwkin.position import PositionSolver
+
+    tb = _toolbox()
+    rows = []
+    corpus = ROOT.parent / "shared" / "corpus" / "example-parallel-robots"
+    for name in names:
+        urdf, side = corpus / name / "robot.urdf", corpus / name / "robot.yaml"
+        mech = screwkin.load(urdf, warn=lambda m: None)
+        solver = PositionSolver(mech)
+        q0 = mech.assemble().q
+        rng = np.random.default_rng(3)
+        targets = []
+        V = null_space(mech.closure.jacobian(q0), mech.tolerances, mech.nv)
+        for _ in range(solves):  # motor values of assembled configurations near q0
+            step = V @ rng.normal(size=V.shape[1])
+            q1 = mech.closure.solve(pin.integrate(mech.model, q0, 0.05 * step / np.linalg.norm(step))).q
+            targets.append({n: v for n, v in solver.joint_values(q1).items() if n in mech.actuated})
+        near = solver.joint_values(q0)
+        res_ours = []
+
+        def ours():
+            out = []
+            for t in targets:
+                out.append(solver.solve(t, near=near, starts=0).solutions[0].q)
+            return out
+
+        t_ours, qs = best_of(ours, 1)
+        res_ours = [float(np.linalg.norm(mech.closure.residual(q))) for q in qs]
+        row = [name, t_ours / solves, max(res_ours), None, None]
+        if tb is not None:
+            fk, am = tb
+            model = pin.buildModelFromUrdf(str(urdf))
+            data = model.createData()
+            content = yaml.safe_load(side.read_text())
+            cmodels = []
+            for (a, b), kind in zip(content["closed_loop"], content["type"]):
+                fa, fb = model.frames[model.getFrameId(a)], model.frames[model.getFrameId(b)]
+                ctype = pin.ContactType.CONTACT_3D if kind.lower() == "3d" else pin.ContactType.CONTACT_6D
+                cmodels.append(pin.RigidConstraintModel(ctype, model, fa.parentJoint, fa.placement, fb.parentJoint,
+                                                        fb.placement, pin.ReferenceFrame.LOCAL))
+            cdatas = [c.createData() for c in cmodels]
+            act = am.ActuationModel(model, content["name_mot"])
+            mot_order = content["name_mot"]
+
+            class Start(np.ndarray):  # its `q_prec == []` test breaks on numpy 2 arrays; answer it as intended
+                def __eq__(self, other):
+                    return False if isinstance(other, list) else np.ndarray.__eq__(self, other)
+
+            start = np.asarray(q0).view(Start)
+
+            def theirs():
+                out = []
+                for t in targets:
+                    qm = np.array([t[n] for n in mot_order])
+                    out.append(np.asarray(fk.closedLoopForwardKinematicsScipy(model, data, cmodels, cdatas, act, qm,
+                                                                              q_prec=start)))
+                return out
+
+            import contextlib
+            import io
+
+            with contextlib.redirect_stdout(io.StringIO()):  # SLSQP prints a report per solve
+                t_theirs, qt = best_of(theirs, 1)
+            res_theirs = [float(np.linalg.norm(mech.closure.residual(q))) for q in qt]
+            row[3:] = [t_theirs / solves, max(res_theirs)]
+        rows.append(row)
+    return rows
+
+
 # ---------------------------------------------------------------- 3. sweep throughput
 def sweep_throughput(steps):
     from screwkin.position import PositionSolver
@@ -160,6 +259,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--configs", type=int, default=100000)
     ap.add_argument("--steps", type=int, default=3600)
+    ap.add_argument("--solves", type=int, default=20)
     args = ap.parse_args()
     out = [f"## Run of {date.today()} on {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            f"numpy {np.__version__}, pinocchio {pin.__version__}", ""]
@@ -172,6 +272,17 @@ def main():
         out.append(f"| {name} | {t:.3f} | {1e6 * t / args.configs:.2f} | {ratio:.2f}x | "
                    f"{'-' if err is None else f'{err:.1e}'} |")
     out += ["", f"screwkin / bare floor = {t_ours / t_floor:.2f}", ""]
+    out += ["### 2. Closed-loop forward kinematics on ../shared/corpus robots (same motor targets, same assembled start)",
+            "", "| robot | screwkin per solve [ms] | worst residual | toolbox-parallel-robots (SLSQP) per solve [ms] | "
+            "worst residual | screwkin is faster by |", "|---|---|---|---|---|---|"]
+    for name, t1, r1, t2, r2 in closed_loop_fk(["5bar_linkage", "robot_delta", "cassie_like", "talos_like",
+                                                "digit_like"], args.solves):
+        if t2 is None:
+            out.append(f"| {name} | {1e3 * t1:.2f} | {r1:.1e} | not installed | - | - |")
+        else:
+            out.append(f"| {name} | {1e3 * t1:.2f} | {r1:.1e} | {1e3 * t2:.1f} | {r2:.1e} | {t2 / t1:.2f}x |")
+    out += ["", "Residual: norm of screwkin's minimal closure rows at the returned configuration, the same metric for "
+            "both.", ""]
     out += [f"### 3. Sweep throughput ({args.steps} steps, rates at every step)", "",
             "| mechanism | steps | time [s] | steps per second | worst closure residual |", "|---|---|---|---|---|"]
     for name, n, t, sps, worst in sweep_throughput(args.steps):

@@ -229,10 +229,16 @@ class PositionSolver:
             near_q = self.set_inputs(self._reference, {k: v for k, v in near.items() if k in self.inputs})
             for name, v in near.items():
                 near_q = self.set_inputs(near_q, {name: v}) if mech.coordinate(name).nv == 1 else near_q
-        start_list = ([near_q] if near_q is not None else []) + self._starts(starts, seed)
-        found, best = self.distinct(
-            mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
-            first_trace=recorder if trace else None)
+        found, best = [], np.inf
+        if near_q is not None:  # the mode reached from the given configuration, when Newton gets there
+            found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
+                                        first_trace=recorder if trace else None)
+        start_list = [near_q] if found else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
+        if not found:
+            found, more = self.distinct(
+                mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
+                first_trace=recorder if trace and near_q is None else None)
+            best = min(best, more)
         if not found:
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
