@@ -82,6 +82,7 @@ class PositionResult:
     free_dofs: int  # DOFs the inputs leave undetermined (0 when the inputs fix the mechanism)
     trace: tuple = ()
     output: str | None = None
+    angular: tuple = ()  # names of the coordinates that are angles (the others are lengths)
 
     def to_dict(self) -> dict:
         from .report import position_dict
@@ -151,6 +152,14 @@ class PositionSolver:
             if short.startswith("JointModelR") and "UB" not in short and c.nq == 1:
                 wrap.append(c.idx_q)
         return np.asarray(wrap, int)
+
+    def angular_names(self) -> tuple:
+        """Coordinate names that are angles (revolute and continuous joints)."""
+        names = []
+        for c in self.mech.coordinates:
+            if self.model.joints[c.joint_id].shortname().startswith("JointModelR") and c.nv == 1:
+                names.append(c.joint)
+        return tuple(names)
 
     def set_inputs(self, q, values: dict):
         q = np.array(q, float)
@@ -250,7 +259,7 @@ class PositionSolver:
             found = found[:1]
         sols = tuple(self._solution(q, a, rates, accels) for _, q, a in found)
         return PositionResult(dict(values), tuple(self.inputs), sols, len(start_list), self.free_dofs,
-                              tuple(steps), self.output)
+                              tuple(steps), self.output, self.angular_names())
 
     def distinct(self, system, starts, frozen=(), first_trace=None):
         """Solve ``system`` from every start; keep one solution per assembly mode.
@@ -371,4 +380,4 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
                              sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
                              outside_limits=outside_limits(mech, q)))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
-                          0, (), output)
+                          0, (), output, solver.angular_names())

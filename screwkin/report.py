@@ -198,11 +198,11 @@ def position_text(res, degrees=True) -> str:
         rows = []
         for name, v in s.joints.items():
             row = [name, f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees else "")
+            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else "")
             if s.rates is not None:
                 row += [f"{s.rates.get(name, float('nan')):.6g}", f"{s.accelerations.get(name, float('nan')):.6g}"]
             rows.append(row)
-        headers = ["joint", "value (SI)", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
+        headers = ["joint", "value [rad or m]", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
         lines.append(table(headers, rows))
         if s.output_pose is not None:
             p = s.output_pose
