@@ -187,7 +187,8 @@ def _joint_geometry_rows(mech, topo, frames, jac, q):
             elif j.type == "universal":
                 axes = [d if side == 0 else np.asarray(j.direction2)]
             for axis in axes:
-                rows.append(-pin.skew(axis) @ J[3:])
+                if axis is not None:
+                    rows.append(-pin.skew(np.asarray(axis, float)) @ J[3:])
     return rows
 
 

@@ -190,14 +190,21 @@ def _edges(mech, q):
         if t == "fixed":
             welds.append((j.parent, j.child, None))
             continue
-        point = direction = None
+        point = direction = direction2 = None
         if model.existJointName(j.name):
-            M = data.oMi[model.getJointId(j.name)]
+            jid = model.getJointId(j.name)
+            M = data.oMi[jid]
             point = M.translation.copy()
             if t in ("revolute", "continuous", "prismatic", "planar"):
                 direction = M.rotation @ np.asarray(j.axis)
+            elif t == "universal":  # a native universal joint from a sidecar replacement
+                from .mechanism import _axis_letters
+
+                a1, a2 = _axis_letters(rep)
+                base = data.oMi[model.parents[jid]] * model.jointPlacements[jid]
+                direction, direction2 = base.rotation @ a1, M.rotation @ a2
         dof = {"spherical": 3, "universal": 2}.get(t, j.dof)
-        edges.append(_Edge(j.name, t, dof, j.parent, j.child, False, point, direction))
+        edges.append(_Edge(j.name, t, dof, j.parent, j.child, False, point, direction, direction2))
     for c in mech.cuts:
         a = _frame_link(mech, c.link1)
         b = _frame_link(mech, c.link2)

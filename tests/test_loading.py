@@ -3,12 +3,11 @@
 import json
 import shutil
 
+import pytest
 
 import screwkin
-from conftest import CORPUS, DATA
+from conftest import CORPUS, DATA, fourbar
 from screwkin.cli import main
-
-from conftest import fourbar  # noqa: E402
 
 
 def test_fourbar_loop_joint_is_closed_in_the_file(tmp_path):
@@ -143,3 +142,17 @@ def test_package_uri_resolves_against_ros_package_path(tmp_path, monkeypatch):
     seen.clear()
     screwkin.load(d / "fb.urdf", warn=seen.append)
     assert not seen
+
+
+@pytest.mark.parametrize("kind, coordinates, kutzbach", [("UJOINT_XY", 6, 3), ("CARDAN", 6, 3), ("FIXED", 4, 1)])
+def test_sidecar_joint_replacement_universal_and_fixed(tmp_path, kind, coordinates, kutzbach):
+    """5bar_linkage_iso3d is 5 R + 1 S (Kutzbach 2): a revolute replaced by a universal joint adds
+    one DOF to the count, a fixed one removes the joint and merges its two links (count 1)."""
+    src = CORPUS / "5bar_linkage_iso3d"
+    shutil.copy(src / "robot.urdf", tmp_path / "robot.urdf")
+    (tmp_path / "robot.yaml").write_text((src / "robot.yaml").read_text()
+                                         + f"joint_name: ['freeortho']\njoint_type: ['{kind}']\n")
+    r = screwkin.load(tmp_path / "robot.urdf", warn=lambda m: None).mobility()
+    assert (r.coordinates, r.topology.kutzbach) == (coordinates, kutzbach)
+    if kind != "FIXED":
+        assert r.mobility == kutzbach and "universal" in [j.type for j in r.topology.joints]
