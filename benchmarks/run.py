@@ -25,7 +25,7 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 import screwkin  # noqa: E402
-from screwkin.batch import frame_jacobians, singular_values  # noqa: E402
+from screwkin.batch import SerialJacobians, frame_jacobians  # noqa: E402
 
 
 def best_of(f, repeat=3):
@@ -40,31 +40,48 @@ def best_of(f, repeat=3):
 
 # ---------------------------------------------------------------- 1. serial singularity scan
 def serial_scan(n):
+    """Rows (tool, measure, seconds, max difference from the reference values).  The
+    reference for each measure is numpy on Pinocchio's Jacobian, one configuration at a time."""
     mech = screwkin.load(ROOT / "robots" / "arm_6r.urdf")
     model, fid = mech.model, mech.link_frame("flange")
+    LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
     Q = np.random.default_rng(0).uniform(-np.pi, np.pi, (n, 6))
     data = model.createData()
-
-    def screwkin_batched():
-        J = frame_jacobians(model, fid, Q, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, data)
-        return singular_values(J)[:, -1]
+    sj = SerialJacobians(mech, "flange", LWA)
+    cores = os.cpu_count() or 1
 
     def pinocchio_floor():  # the bare Jacobian loop, no measure
         for q in Q:
-            pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            pin.computeFrameJacobian(model, data, q, fid, LWA)
 
-    def pinocchio_loop_svd():  # Jacobian and one SVD per configuration
-        return np.array([np.linalg.svd(pin.computeFrameJacobian(model, data, q, fid,
-                                                                 pin.ReferenceFrame.LOCAL_WORLD_ALIGNED),
-                                       compute_uv=False)[-1] for q in Q])
-
+    J_ref = frame_jacobians(model, fid, Q, LWA, data)
+    ref = {"sigma_min": np.array([np.linalg.svd(J, compute_uv=False)[-1] for J in J_ref]),
+           "det": np.array([np.linalg.det(J) for J in J_ref])}
+    del J_ref
     rows = []
-    t_ours, s_ours = best_of(screwkin_batched)
-    t_floor, _ = best_of(pinocchio_floor)
-    t_loop, s_loop = best_of(pinocchio_loop_svd, 1)
-    rows.append(("screwkin batched (Pinocchio Jacobians + one stacked SVD)", t_ours, 0.0))
-    rows.append(("bare Pinocchio Jacobian loop, no measure (floor)", t_floor, None))
-    rows.append(("Pinocchio Jacobian + per-configuration SVD", t_loop, float(np.abs(s_loop - s_ours).max())))
+
+    def add(tool, measure, f, repeat=3, scale=1.0, compare=None):
+        t, out = best_of(f, repeat)
+        err = None if out is None else float(np.abs(out - (ref[measure] if compare is None else compare)).max())
+        rows.append((tool, measure, t * scale, err))
+
+    for measure in ("det", "sigma_min"):
+        add("screwkin SerialJacobians, 1 thread", measure, lambda: sj.measures(Q, measure))
+        if measure == "sigma_min":
+            add("screwkin SerialJacobians, method gram, 1 thread", measure,
+                lambda: sj.measures(Q, measure, method="gram"))
+        if cores > 1:
+            add(f"screwkin SerialJacobians, {cores} threads", measure, lambda: sj.measures(Q, measure, workers=cores))
+            if measure == "sigma_min":
+                add(f"screwkin SerialJacobians, method gram, {cores} threads", measure,
+                    lambda: sj.measures(Q, measure, method="gram", workers=cores))
+        stacked = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[:, -1])
+        one = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[-1])
+        add("Pinocchio Jacobian loop + one stacked numpy call", measure,
+            lambda: stacked(frame_jacobians(model, fid, Q, LWA, data)))
+        add("Pinocchio Jacobian loop + numpy per configuration", measure,
+            lambda: np.array([one(pin.computeFrameJacobian(model, data, q, fid, LWA)) for q in Q]), 1)
+    add("bare Pinocchio Jacobian loop, no measure (floor)", "none", lambda: pinocchio_floor(), 3)
 
     # the same arm in the peers: its space screws (w, v) for modern_robotics, an ETS for the toolbox
     from screwkin.screws import chains
@@ -75,39 +92,33 @@ def serial_scan(n):
 
         Slist = np.vstack([ch.xi0[3:], ch.xi0[:3]])  # (w, v) columns
         m = min(n, 20000)
-
-        def mr_scan():
-            out = np.empty(m)
-            for k in range(m):
-                Js = mr.JacobianSpace(Slist, Q[k])
-                out[k] = np.linalg.svd(Js, compute_uv=False)[-1]
-            return out
-
-        t_mr, s_mr = best_of(mr_scan, 1)
-        # modern_robotics gives the space Jacobian (at the world origin): the same singular values
-        # as ours only up to the frame; compare with Pinocchio's WORLD Jacobian instead
-        ref = np.array([np.linalg.svd(pin.computeFrameJacobian(model, data, Q[k], fid, pin.ReferenceFrame.WORLD)[
-            [3, 4, 5, 0, 1, 2]], compute_uv=False)[-1] for k in range(m)])
-        rows.append((f"modern_robotics JacobianSpace + SVD ({m} configurations, scaled to {n})", t_mr * n / m,
-                     float(np.abs(s_mr - ref).max())))
+        # modern_robotics gives the space Jacobian (at the world origin, (w, v) rows): its determinant is
+        # minus ours (three row swaps), its singular values Pinocchio's WORLD Jacobian's
+        world = frame_jacobians(model, fid, Q[:m], pin.ReferenceFrame.WORLD, data)
+        mr_ref = {"det": -np.linalg.det(world), "sigma_min": np.linalg.svd(world, compute_uv=False)[:, -1]}
+        for measure in ("det", "sigma_min"):
+            one = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[-1])
+            add(f"modern_robotics JacobianSpace + numpy per configuration ({m} configurations, scaled)", measure,
+                lambda: np.array([one(mr.JacobianSpace(Slist, Q[k])) for k in range(m)]), 1, n / m, mr_ref[measure])
     except ImportError:
-        rows.append(("modern_robotics: not installed (pip install -e '.[bench]')", np.nan, None))
+        rows.append(("modern_robotics: not installed (pip install -e '.[bench]')", "-", np.nan, None))
     try:
         import roboticstoolbox as rtb
 
         ET = rtb.ET
         ets = (ET.tz(0.3) * ET.Rz() * ET.tx(0.05) * ET.tz(0.1) * ET.Ry() * ET.tz(0.4) * ET.Ry() * ET.tx(0.05)
                * ET.tz(0.02) * ET.Rx() * ET.tx(0.35) * ET.Ry() * ET.Rx() * ET.tx(0.08))
-        robot = rtb.Robot(ets)
-
-        def rtb_scan():
-            return np.array([np.linalg.svd(robot.jacob0(q), compute_uv=False)[-1] for q in Q])
-
-        t_rtb, s_rtb = best_of(rtb_scan, 1)
-        rows.append(("roboticstoolbox-python jacob0 (ETS, C extension) + SVD", t_rtb, float(np.abs(s_rtb - s_ours).max())))
+        # ETS.jacob0 is the toolbox's fastest path (Robot.jacob0 adds about 5 us of Python a call)
+        for measure in ("det", "sigma_min"):
+            one = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[-1])
+            stacked = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[:, -1])
+            add("roboticstoolbox-python ETS.jacob0 (C extension) + numpy per configuration", measure,
+                lambda: np.array([one(ets.jacob0(q)) for q in Q]), 1)
+            add("roboticstoolbox-python ETS.jacob0 (C extension) + one stacked numpy call", measure,
+                lambda: stacked(np.array([ets.jacob0(q) for q in Q])), 1)
     except ImportError:
-        rows.append(("roboticstoolbox-python: not installed", np.nan, None))
-    return rows, t_ours, t_floor
+        rows.append(("roboticstoolbox-python: not installed", "-", np.nan, None))
+    return rows
 
 
 # ---------------------------------------------------------------- 2. closed-loop forward kinematics
@@ -263,15 +274,18 @@ def main():
     args = ap.parse_args()
     out = [f"## Run of {date.today()} on {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            f"numpy {np.__version__}, pinocchio {pin.__version__}", ""]
-    rows, t_ours, t_floor = serial_scan(args.configs)
-    out += [f"### 1. Serial singularity scan: Jacobian + smallest singular value, {args.configs} random configurations "
-            "of robots/arm_6r.urdf", "", "| tool | time [s] | per configuration [us] | screwkin is faster by | "
-            "max difference of sigma_min |", "|---|---|---|---|---|"]
-    for name, t, err in rows:
-        ratio = t / t_ours if np.isfinite(t) else np.nan
-        out.append(f"| {name} | {t:.3f} | {1e6 * t / args.configs:.2f} | {ratio:.2f}x | "
-                   f"{'-' if err is None else f'{err:.1e}'} |")
-    out += ["", f"screwkin / bare floor = {t_ours / t_floor:.2f}", ""]
+    rows = serial_scan(args.configs)
+    out += [f"### 1. Serial singularity scan: Jacobian + a measure, {args.configs} random configurations of "
+            "robots/arm_6r.urdf", "", "| tool | measure | per configuration [us] | time / screwkin 1 thread | "
+            "max difference from numpy on Pinocchio |", "|---|---|---|---|---|"]
+    ours = {m: t for tool, m, t, _ in rows if tool == "screwkin SerialJacobians, 1 thread"}
+    floor = next(t for tool, m, t, _ in rows if m == "none")
+    for tool, m, t, err in rows:
+        base = ours.get(m, ours["det"])
+        ratio = f"{t / base:.2f}x" if np.isfinite(t) else "-"
+        out.append(f"| {tool} | {m} | {1e6 * t / args.configs:.2f} | {ratio} | {'-' if err is None else f'{err:.1e}'} |")
+    out += ["", f"screwkin 1 thread / bare Pinocchio floor: det {ours['det'] / floor:.2f}, "
+            f"sigma_min {ours['sigma_min'] / floor:.2f}", ""]
     out += ["### 2. Closed-loop forward kinematics on ../shared/corpus robots (same motor targets, same assembled start)",
             "", "| robot | screwkin per solve [ms] | worst residual | toolbox-parallel-robots (SLSQP) per solve [ms] | "
             "worst residual | screwkin is faster by |", "|---|---|---|---|---|---|"]
