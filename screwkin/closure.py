@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg.lapack import dposv as _lapack_dposv
 
 from .errors import AssemblyError
 from .tolerances import DEFAULT, Tolerances
@@ -34,6 +35,41 @@ def _cross(a, b):
     """Cross product of two 3-vectors (numpy.cross costs about 35 us a call here: it was
     70% of a sweep step in a profile; this costs about 1 us)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _dposv(A, b):
+    """Solve the symmetric positive definite A y = b (Cholesky, LAPACK dposv: about 1.5 us
+    against 5 us for numpy.linalg.solve at this size).  Returns (y, info)."""
+    _, y, info = _lapack_dposv(A, b)
+    return y, info
+
+
+def _skew(a):
+    """The cross-product matrix [a]x of a 3-vector (a x b = [a]x b)."""
+    return a[_SKEW_INDEX] * _SKEW_SIGN
+
+
+_SKEW_INDEX = np.array([[0, 2, 1], [2, 0, 0], [1, 0, 0]])
+_SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
+
+
+def _skews(U, m=None):
+    """The cross-product matrices of the columns of U (3 x k), stacked (3k x 3); with m,
+    columns j and m + j side by side ((3m x 6): [[u_j]x, [u_m+j]x])."""
+    k = U.shape[1]
+    table = _SKEW_TABLES.get((k, m))
+    if table is None:
+        index = (_SKEW_INDEX[None] + 3 * np.arange(k)[:, None, None]).reshape(3 * k, 3)
+        sign = np.tile(_SKEW_SIGN, (k, 1))
+        if m is not None:
+            index = np.hstack([index[:3 * m], index[3 * m:]])
+            sign = np.hstack([sign[:3 * m], sign[3 * m:]])
+        table = _SKEW_TABLES[(k, m)] = (index, sign)
+    index, sign = table
+    return U.T.ravel()[index] * sign
+
+
+_SKEW_TABLES = {}
 
 
 def perpendicular_basis(a):
@@ -114,13 +150,45 @@ class ClosureSystem:
         self.path = path
         self.nrows = sum(c.rows for c in self.cuts)
         self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
+        self._solver_rows = None
+        self._free = {}  # free velocity indices for each set of frozen ones
+        self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
 
     # ------------------------------------------------------------------ residual
     def _rows(self, solver: bool) -> int:
         if not solver:
             return self.nrows
+        if self._solver_rows is not None:
+            return self._solver_rows
         extra = {"fixed": 6, "prismatic": 6, "revolute": 1, "continuous": 1, "cylindrical": 1, "planar": 1}
-        return sum(c.rows + extra.get(c.type, 0) for c in self.cuts)
+        self._solver_rows = sum(c.rows + extra.get(c.type, 0) for c in self.cuts)
+        return self._solver_rows
+
+    def _plan(self, cut, b1, b2):
+        """Constant parts of a cut joint's rows, in its frames: position axes P (rows, in F1),
+        alignment pairs (u in F1, w in F2), the vectors the solver rows compare, and
+        whether the minimal rows hold a rotation vector."""
+        a = np.asarray(cut.axis, float)
+        t = cut.type
+        if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
+            P = None  # the three axes of F1
+        elif t in ("prismatic", "cylindrical"):
+            P = np.vstack([b1, b2])
+        else:  # planar
+            P = a[None, :]
+        if t in ("revolute", "continuous", "cylindrical", "planar"):
+            pairs = ((b1, a), (b2, a))
+        elif t == "universal":
+            pairs = ((a, np.asarray(cut.axis2, float)),)
+        else:
+            pairs = ()
+        if t == "universal":
+            vectors = None  # the solver keeps the minimal (perpendicularity) row
+        elif t == "spherical":
+            vectors = np.zeros((0, 3))
+        else:
+            vectors = np.eye(3) if t in ("fixed", "prismatic") else a[None, :]
+        return P, pairs, vectors, t in ("fixed", "prismatic")
 
     def evaluate(self, q, jacobian: bool = True, solver: bool = False):
         """Residual r(q) and, if asked, its Jacobian (rows x nv).
@@ -135,40 +203,39 @@ class ClosureSystem:
         model, data = self.model, self.data
         if jacobian:
             pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacements(model, data)
         else:
-            pin.forwardKinematics(model, data, q)
-        pin.updateFramePlacements(model, data)
+            pin.framesForwardKinematics(model, data, q)
         nrows = self._rows(solver)
         r = np.empty(nrows)
-        K = np.zeros((nrows, model.nv)) if jacobian else None
+        K = np.empty((nrows, model.nv)) if jacobian else None
         i = 0
-        for cut, (b1, b2) in zip(self.cuts, self._basis):
+        for cut, (P, pairs, vectors, rotation) in zip(self.cuts, self._plans):
             M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
             R1, R2 = M1.rotation, M2.rotation
             d = M2.translation - M1.translation
             if jacobian:
                 J1 = pin.getFrameJacobian(model, data, cut.frame1, LWA)
                 J2 = pin.getFrameJacobian(model, data, cut.frame2, LWA)
-                dv, w1, w2 = J2[:3] - J1[:3], J1[3:], J2[3:]
-            a = np.asarray(cut.axis)
-            t = cut.type
-            positions, pairs = _row_vectors(cut, R1, R2, b1, b2)
-            for e in positions:
-                r[i] = e @ d
-                if jacobian:
-                    K[i] = e @ dv + _cross(e, d) @ w1
-                i += 1
-            if solver and t != "universal":
-                # R2 v - R1 v for the vectors v that F1 and F2 must share
-                vectors = () if t == "spherical" else (np.eye(3) if t in ("fixed", "prismatic") else (a,))
-                for v in vectors:
-                    u1, u2 = R1 @ v, R2 @ v
-                    r[i:i + 3] = u2 - u1
+                w1, w2 = J1[3:], J2[3:]
+            E = R1.T if P is None else P @ R1.T  # position rows: F1 axes in the world
+            k = len(E)
+            r[i:i + k] = E @ d
+            if jacobian:  # e . (v2 - v1) + (e x d) . w1
+                K[i:i + k] = E @ (J2[:3] - J1[:3] + _skew(d) @ w1)
+            i += k
+            if solver and vectors is not None:
+                # R2 v - R1 v for the vectors v that F1 and F2 must share; derivative
+                # [R1 v]x w1 - [R2 v]x w2, all vectors in one product
+                m = len(vectors)
+                if m:
+                    U1, U2 = (R1, R2) if m == 3 else (R1 @ vectors.T, R2 @ vectors.T)
+                    r[i:i + 3 * m] = (U2 - U1).T.ravel()
                     if jacobian:
-                        K[i:i + 3] = -pin.skew(u2) @ w2 + pin.skew(u1) @ w1
-                    i += 3
+                        K[i:i + 3 * m] = _skews(np.hstack([U1, -U2]), m) @ np.vstack([w1, w2])
+                    i += 3 * m
                 continue
-            if t in ("fixed", "prismatic"):
+            if rotation:
                 R = R1.T @ R2
                 r[i:i + 3] = pin.log3(R)
                 if jacobian:
@@ -176,6 +243,7 @@ class ClosureSystem:
                 i += 3
                 continue
             for u, w in pairs:
+                u, w = R1 @ u, R2 @ w
                 r[i] = u @ w
                 if jacobian:
                     K[i] = _cross(w, u) @ (w2 - w1)
@@ -250,10 +318,12 @@ class ClosureSystem:
     def jacobian(self, q) -> np.ndarray:
         return self.evaluate(q, jacobian=True)[1]
 
-    def wrong_branch(self, q) -> list:
+    def wrong_branch(self, q, placed: bool = False) -> list:
         """Cut joints whose aligned axes are antiparallel (a spurious root of the
-        alignment rows: the joint would be assembled upside down)."""
-        self.evaluate(q, jacobian=False)
+        alignment rows: the joint would be assembled upside down).  placed: the
+        frame placements in self.data are already those of q."""
+        if not placed:
+            pin.framesForwardKinematics(self.model, self.data, q)
         bad = []
         for cut in self.cuts:
             if cut.type in ("revolute", "continuous", "cylindrical", "planar"):
@@ -278,40 +348,51 @@ class ClosureSystem:
         q = np.array(q0, float)
         if self.nrows == 0:
             return Assembly(q, 0.0, 0)
-        free = np.setdiff1d(np.arange(model.nv), np.asarray(frozen, int))
+        frozen = tuple(int(f) for f in np.asarray(frozen, int).ravel())
+        free = self._free.get(frozen)
+        if free is None:
+            free = self._free[frozen] = np.setdiff1d(np.arange(model.nv), np.asarray(frozen, int))
         r, K = self.evaluate(q, solver=True)
-        norm = float(np.linalg.norm(r))
+        last = q  # the configuration whose placements are in self.data
+        norm = float(np.sqrt(r @ r))
         best = norm
-        mu, nu = 1e-6, 2.0
+        mu, nu = 1e-9, 2.0
         it = 0
+        dq = np.zeros(model.nv)
         while it < tol.max_iterations:
             if norm < tol.closure:
                 break
             it += 1
             Kf = K[:, free]
             A = Kf @ Kf.T
-            A[np.diag_indices_from(A)] += mu * max(np.trace(A) / len(A), 1e-12)
-            try:
-                y = np.linalg.solve(A, r)
-            except np.linalg.LinAlgError:
+            diagonal = A.ravel()[:: len(A) + 1]  # a view
+            diagonal += mu * max(diagonal.sum() / len(A), 1e-12)
+            y, info = _dposv(A, r)
+            if info != 0:  # not positive definite in floating point
                 y = np.linalg.lstsq(A, r, rcond=None)[0]
-            dq = np.zeros(model.nv)
+            dq[:] = 0.0
             dq[free] = -(Kf.T @ y)
             q_new = pin.integrate(model, q, dq)
-            r_new = self.evaluate(q_new, jacobian=False, solver=True)[0]
-            n_new = float(np.linalg.norm(r_new))
+            # the Jacobian comes with the residual (one Pinocchio pass): most steps are accepted;
+            # when Newton is about to converge (quadratically: the next residual near norm^2) the
+            # residual alone is computed first, as the Jacobian there is not needed
+            final = norm < 0.1 * np.sqrt(tol.closure)
+            r_new, K_new = self.evaluate(q_new, jacobian=not final, solver=True)
+            last = q_new
+            n_new = float(np.sqrt(r_new @ r_new))
+            if final and tol.closure <= n_new < norm:
+                r_new, K_new = self.evaluate(q_new, solver=True)
             accepted = n_new < norm
             if trace is not None:
-                trace(it, q, r, K, dq, accepted)
+                trace(it, q, r, K, dq.copy(), accepted)
             if accepted:
                 # Nielsen's damping update from the gain ratio (actual / predicted decrease)
-                predicted = norm**2 - float(np.linalg.norm(r + Kf @ dq[free])) ** 2
+                lin = r + Kf @ dq[free]
+                predicted = norm**2 - float(lin @ lin)
                 rho = (norm**2 - n_new**2) / predicted if predicted > 0 else 0.0
                 mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
                 nu = 2.0
-                q = q_new
-                r, K = self.evaluate(q, solver=True)
-                norm = n_new
+                q, r, K, norm = q_new, r_new, K_new, n_new
                 best = min(best, norm)
             else:
                 mu *= nu
@@ -320,7 +401,7 @@ class ClosureSystem:
                     break
         if norm >= tol.closure:
             raise AssemblyError(self.path, best, it)
-        bad = self.wrong_branch(q)
+        bad = self.wrong_branch(q, placed=q is last)
         if bad:
             raise AssemblyError(
                 self.path, best, it, detail=f"the solution found assembles {', '.join(bad)} with a reversed axis"

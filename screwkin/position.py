@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from .closure import Assembly
 from .errors import AssemblyError, UsageError
 from .mobility import null_space, rank
 
@@ -92,21 +93,29 @@ class PositionResult:
 
 def outside_limits(mech, q) -> tuple:
     """Joints whose value lies outside the position limits of the file."""
-    model = mech.model
-    out = []
-    for c in mech.coordinates:
-        if c.nq != 1:
-            continue
-        lo, hi, v = model.lowerPositionLimit[c.idx_q], model.upperPositionLimit[c.idx_q], q[c.idx_q]
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo <= 0 or (lo <= v <= hi):
-            continue
-        short = model.joints[c.joint_id].shortname()
-        if short.startswith("JointModelR"):  # an angle may sit in the range modulo a turn
-            k = np.ceil((lo - v) / (2 * np.pi))
-            if lo <= v + 2 * np.pi * k <= hi:
+    table = getattr(mech, "_limit_table", None)
+    if table is None:  # (names, q indices, lower, upper, is an angle) of the joints with finite limits
+        model = mech.model
+        rows = []
+        for c in mech.coordinates:
+            if c.nq != 1:
                 continue
-        out.append(c.joint)
-    return tuple(out)
+            lo, hi = model.lowerPositionLimit[c.idx_q], model.upperPositionLimit[c.idx_q]
+            if np.isfinite(lo) and np.isfinite(hi) and hi - lo > 0:
+                angle = model.joints[c.joint_id].shortname().startswith("JointModelR")
+                rows.append((c.joint, c.idx_q, lo, hi, angle))
+        names = tuple(r[0] for r in rows)
+        table = mech._limit_table = (names,) + tuple(np.array([r[k] for r in rows]) for k in range(1, 5))
+    names, idx, lo, hi, angle = table
+    if not names:
+        return ()
+    v = np.asarray(q)[idx]
+    out = (v < lo) | (v > hi)
+    if out.any():  # an angle may sit in the range modulo a turn
+        k = np.ceil((lo - v) / (2 * np.pi))
+        shifted = v + 2 * np.pi * k
+        out &= ~(angle & (lo <= shifted) & (shifted <= hi))
+    return tuple(n for n, o in zip(names, out) if o)
 
 
 class PositionSolver:
@@ -142,6 +151,23 @@ class PositionSolver:
                         if self.model.frames[f].type == pin.FrameType.JOINT]
         self._points += [c.frame1 for c in mech.cuts]
         self._revolute = self._angle_coordinates()
+        self._angular = self.angular_names()
+        # joint_values in a few array operations: (name, q index) of 1-coordinate joints, of
+        # continuous joints (cos, sin), and the names of the coordinates of multi-DOF joints
+        single, continuous, multi, self._order = [], [], [], []
+        for c in mech.coordinates:
+            if c.nq == 1:
+                single.append((c.joint, c.idx_q))
+                self._order.append(c.joint)
+            elif c.nq == 2 and c.nv == 1:
+                continuous.append((c.joint, c.idx_q))
+                self._order.append(c.joint)
+            else:
+                multi += [(f"{c.joint}[q{k}]", c.idx_q + k) for k in range(c.nq)]
+                self._order += [n for n, _ in multi[-c.nq:]]
+        self._value_layout = (single, continuous, multi)
+        self._single_idx = np.array([i for _, i in single], int)
+        self._single_wrap = np.isin(self._single_idx, self._revolute)
 
     # --------------------------------------------------------------- coordinates
     def _angle_coordinates(self):
@@ -162,29 +188,42 @@ class PositionSolver:
         return tuple(names)
 
     def set_inputs(self, q, values: dict):
+        """q with the named coordinates set: joint names of 1-DOF joints [rad or m], and the
+        'joint[qk]' names that joint_values gives to the coordinates of multi-DOF joints."""
         q = np.array(q, float)
+        multi = False
         for name, v in values.items():
+            if name.endswith("]") and "[q" in name:
+                joint, k = name[:-1].rsplit("[q", 1)
+                c = self.mech.coordinate(joint)
+                if not k.isdigit() or int(k) >= c.nq:
+                    raise UsageError(f"{self.mech.path}: joint '{joint}' has no coordinate q{k}")
+                q[c.idx_q + int(k)] = v
+                multi = True
+                continue
             c = self.mech.coordinate(name)
-            if c.nq == 2:
+            if c.nq == 2 and c.nv == 1:
                 q[c.idx_q:c.idx_q + 2] = (np.cos(v), np.sin(v))
-            else:
+            elif c.nq == 1:
                 q[c.idx_q] = v
-        return q
+            else:
+                raise UsageError(f"{self.mech.path}: joint '{name}' has {c.nq} coordinates: give them as "
+                                 f"{name}[q0] ... {name}[q{c.nq - 1}]")
+        return pin.normalize(self.model, q) if multi else q
 
     def joint_values(self, q) -> dict:
-        out = {}
-        for c in self.mech.coordinates:
-            if c.nq == 1:
-                v = q[c.idx_q]
-                if c.idx_q in self._revolute:
-                    v = float(np.mod(v + np.pi, 2 * np.pi) - np.pi)
-                out[c.joint] = float(v)
-            elif c.nq == 2 and c.nv == 1:
-                out[c.joint] = float(np.arctan2(q[c.idx_q + 1], q[c.idx_q]))
-            else:
-                for k in range(c.nq):
-                    out[f"{c.joint}[q{k}]"] = float(q[c.idx_q + k])
-        return out
+        """Every joint coordinate name -> value [rad or m]; angles of bounded revolute joints
+        in [-pi, pi), continuous joints as atan2(sin, cos)."""
+        q = np.asarray(q, float)
+        single, continuous, multi = self._value_layout
+        v = q[self._single_idx]
+        v[self._single_wrap] = np.mod(v[self._single_wrap] + np.pi, 2 * np.pi) - np.pi
+        out = dict(zip((n for n, _ in single), v.tolist()))
+        for name, i in continuous:
+            out[name] = float(np.arctan2(q[i + 1], q[i]))
+        for name, i in multi:
+            out[name] = float(q[i])
+        return {n: out[n] for n in self._order}  # in the order of mech.coordinates, as reports list them
 
     def _wrap(self, q):
         q = np.array(q, float)
@@ -222,22 +261,35 @@ class PositionSolver:
         return starts
 
     # --------------------------------------------------------------- solving
+    def _check_inputs(self, values: dict, every: bool = True):
+        unknown = [n for n in values if n not in self.inputs]
+        missing = [n for n in self.inputs if n not in values] if every else []
+        if unknown or missing:
+            raise UsageError(f"{self.mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
+                             + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
+
+    def track(self, values: dict, q) -> Assembly:
+        """The configuration that damped Newton reaches from the configuration ``q`` with the
+        named inputs moved to ``values`` (inputs not named keep their values in q): the
+        closed-loop forward kinematics of a control or simulation loop, in the assembly
+        mode of q when the step is small.  The result is checked like every solution
+        (closure residual below the tolerance, no cut joint assembled upside down);
+        AssemblyError otherwise.  No modes are searched and nothing else is analysed:
+        ``solve`` does that."""
+        self._check_inputs(values, every=False)
+        a = self.mech.closure.solve(self.set_inputs(q, values), frozen=self.frozen)
+        return Assembly(self._wrap(a.q), a.residual, a.iterations)
+
     def solve(self, values: dict, near: dict | None = None, rates: dict | None = None,
               accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False) -> PositionResult:
         mech = self.mech
-        unknown = [n for n in values if n not in self.inputs]
-        missing = [n for n in self.inputs if n not in values]
-        if unknown or missing:
-            raise UsageError(f"{mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
-                             + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
+        self._check_inputs(values)
         steps = []
         recorder = (lambda it, q, r, K, dq, ok: steps.append(
             TraceStep(it, r.copy(), K[:, self.passive].copy(), dq[self.passive].copy(), ok))) if trace else None
         near_q = None
         if near:
-            near_q = self.set_inputs(self._reference, {k: v for k, v in near.items() if k in self.inputs})
-            for name, v in near.items():
-                near_q = self.set_inputs(near_q, {name: v}) if mech.coordinate(name).nv == 1 else near_q
+            near_q = self.set_inputs(self._reference, near)
         found, best = [], np.inf
         if near_q is not None:  # the mode reached from the given configuration, when Newton gets there
             found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
@@ -252,14 +304,16 @@ class PositionSolver:
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
                                        f"{len(start_list)} starting configurations")
-        ref = near_q if near_q is not None else self._reference
-        ref_sig = self._signature(ref)
-        found.sort(key=lambda f: (len(outside_limits(mech, f[1])) > 0, float(np.linalg.norm(f[0] - ref_sig))))
+        if len(found) > 1:
+            ref = near_q if near_q is not None else self._reference
+            ref_sig = self._signature(ref)
+            found = [(self._signature(q) if sig is None else sig, q, a) for sig, q, a in found]
+            found.sort(key=lambda f: (len(outside_limits(mech, f[1])) > 0, float(np.linalg.norm(f[0] - ref_sig))))
         if near_q is not None:
             found = found[:1]
         sols = tuple(self._solution(q, a, rates, accels) for _, q, a in found)
         return PositionResult(dict(values), tuple(self.inputs), sols, len(start_list), self.free_dofs,
-                              tuple(steps), self.output, self.angular_names())
+                              tuple(steps), self.output, self._angular)
 
     def distinct(self, system, starts, frozen=(), first_trace=None):
         """Solve ``system`` from every start; keep one solution per assembly mode.
@@ -273,6 +327,9 @@ class PositionSolver:
                 best = min(best, exc.residual)
                 continue
             q = self._wrap(a.q)
+            if len(starts) == 1:  # nothing to tell apart
+                found.append((None, q, a))
+                continue
             sig = self._signature(q)
             if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
                 continue
@@ -293,7 +350,10 @@ class PositionSolver:
             sigma, singular = 1.0, False
         else:
             sigma = float(s[r_star - 1] / s[0]) if len(s) >= r_star else 0.0
-            singular = sigma < tol.singular or rank(K, tol) < r_star
+            # s_r(K) >= s_r(K_p) = sigma s_1(K_p): when that clears the rank tolerance of K
+            # (bounded through the Frobenius norm), rank K >= r and no second SVD is needed
+            clear = sigma * s[0] > max(tol.rank_rtol * float(np.linalg.norm(K)), tol.rank_atol)
+            singular = sigma < tol.singular or (not clear and rank(K, tol) < r_star)
         pose = twist = acc = qd = qdd = None
         rate_d = acc_d = None
         if self.output_frame is not None:

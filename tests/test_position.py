@@ -150,3 +150,35 @@ def test_near_selects_one_mode(mech):
         one = solver.solve({"crank_joint": 0.5}, near=s.joints)
         assert len(one.solutions) == 1
         np.testing.assert_allclose(one.solutions[0].joints["rocker_joint"], s.joints["rocker_joint"], atol=1e-9)
+
+
+def test_track_follows_each_circuit_against_the_closed_form(mech):
+    """track: Newton from the previous configuration, one crank degree at a time around a
+    full turn, stays on the circuit it starts on (the crank-rocker's circuits never meet)."""
+    solver = PositionSolver(mech, ["crank_joint"])
+    start = solver.solve({"crank_joint": 0.0})
+    for sol in start.solutions:
+        q = sol.q
+        side = None
+        for deg in range(1, 361, 1):
+            theta = np.pi / 2 + np.radians(deg)
+            a = solver.track({"crank_joint": theta - np.pi / 2}, q)
+            assert a.residual < 1e-10
+            crank, rocker = world_angles(mech, a)
+            np.testing.assert_allclose(np.mod(crank - theta + np.pi, 2 * np.pi) - np.pi, 0, atol=1e-12)
+            k = int(np.argmin(np.abs(np.mod(np.array(rocker_angles(theta)) - rocker + np.pi, 2 * np.pi) - np.pi)))
+            side = k if side is None else side
+            assert k == side  # the same root of the closed form all the way round
+            np.testing.assert_allclose(np.mod(rocker - rocker_angles(theta)[k] + np.pi, 2 * np.pi) - np.pi, 0,
+                                       atol=1e-9)
+            q = a.q
+
+
+def test_track_refuses_what_it_cannot_reach(tmp_path):
+    mech = screwkin.load(write(tmp_path, fourbar()))
+    solver = PositionSolver(mech, ["rocker_joint"])
+    q = solver.solve({"rocker_joint": 0.0}).solutions[0].q
+    with pytest.raises(screwkin.AssemblyError):  # rocker pointing right: C beyond the crank's reach (see above)
+        solver.track({"rocker_joint": -rocker_offset(mech)}, q)
+    with pytest.raises(screwkin.UsageError, match="not inputs: crank_joint"):
+        solver.track({"crank_joint": 0.1}, q)
