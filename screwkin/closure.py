@@ -276,11 +276,13 @@ class ClosureSystem:
             w1, w2, al1, al2 = V1.angular, V2.angular, A1.angular, A2.angular
             dd, ddd = V2.linear - V1.linear, A2.linear - A1.linear
             t = cut.type
+            # e fixed in F1: d2/dt2 (e . d) = e . (d'' - 2 w1 x d' - al1 x d + w1 x (w1 x d))
             positions, pairs = _row_vectors(cut, R1, R2, b1, b2)
-            for e in positions:
-                ed, edd = second(e, w1, al1)
-                out[i] = edd @ d + 2 * ed @ dd + e @ ddd
-                i += 1
+            wd = _cross(w1, d)
+            g = ddd - 2.0 * _cross(w1, dd) - _cross(al1, d) + _cross(w1, wd)
+            k = len(positions)
+            out[i:i + k] = np.array(positions) @ g
+            i += k
             if t in ("fixed", "prismatic"):
                 out[i:i + 3] = pin.Jlog3(R1.T @ R2) @ R2.T @ (al2 - al1 + _cross(w2, w1))
                 i += 3

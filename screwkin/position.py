@@ -343,8 +343,7 @@ class PositionSolver:
     def _solution(self, q, a, rates, accels) -> Solution:
         mech, tol = self.mech, self.mech.tolerances
         K = mech.closure.jacobian(q)
-        Kp = K[:, self.passive]
-        s = np.linalg.svd(Kp, compute_uv=False) if Kp.size else np.zeros(0)
+        solve, s = self.passive_solver(K)
         r_star = self.expected_rank
         if r_star == 0 or s.size == 0:
             sigma, singular = 1.0, False
@@ -360,9 +359,9 @@ class PositionSolver:
             pin.framesForwardKinematics(self.model, self.data, q)
             pose = self.data.oMf[self.output_frame].homogeneous.copy()
         if rates is not None:
-            qd = self.rates(q, K, rates)
+            qd = self.rates(q, K, rates, solve)
             rate_d = self._named(qd)
-            qdd = self.accelerations(q, K, qd, accels or {})
+            qdd = self.accelerations(q, K, qd, accels or {}, solve)
             acc_d = self._named(qdd)
             if self.output_frame is not None:
                 pin.forwardKinematics(self.model, self.data, q, qd, qdd)
@@ -381,23 +380,36 @@ class PositionSolver:
             x[k] = values.get(name, 0.0)
         return x
 
-    def rates(self, q, K, values: dict):
+    def passive_solver(self, K):
+        """(solve, s): one SVD of the passive columns of K, reused for rates and accelerations.
+        solve(b) is the minimum-norm least-squares x of K_p x = b (as numpy.linalg.lstsq);
+        s are the singular values of K_p, largest first."""
+        Kp = K[:, self.passive]
+        if Kp.size == 0:
+            return (lambda b: np.zeros(len(self.passive))), np.zeros(0)
+        U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
+        keep = s > np.finfo(float).eps * max(Kp.shape) * s[0] if s.size and s[0] > 0 else np.zeros(len(s), bool)
+        U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
+        return (lambda b: Vt.T @ (inv * (U.T @ b))), s
+
+    def rates(self, q, K, values: dict, solve=None):
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
-        the passive joints, so idle spins are zero)."""
+        the passive joints, so idle spins are zero).  solve: see passive_solver."""
         qd = np.zeros(self.mech.nv)
         qd[self.frozen] = self._input_vector(values)
         if K.size:
-            qd[self.passive] = -np.linalg.lstsq(K[:, self.passive], K[:, self.frozen] @ qd[self.frozen], rcond=None)[0]
+            b = K[:, self.frozen] @ qd[self.frozen]
+            qd[self.passive] = -(solve(b) if solve else np.linalg.lstsq(K[:, self.passive], b, rcond=None)[0])
         return qd
 
-    def accelerations(self, q, K, qd, values: dict):
+    def accelerations(self, q, K, qd, values: dict, solve=None):
         """Joint accelerations from K q'' = -K' q' with the input accelerations given."""
         qdd = np.zeros(self.mech.nv)
         qdd[self.frozen] = self._input_vector(values)
         if K.size:
             bias = self.mech.closure.bias(q, qd)
             rhs = -(K[:, self.frozen] @ qdd[self.frozen] + bias)
-            qdd[self.passive] = np.linalg.lstsq(K[:, self.passive], rhs, rcond=None)[0]
+            qdd[self.passive] = solve(rhs) if solve else np.linalg.lstsq(K[:, self.passive], rhs, rcond=None)[0]
         return qdd
 
 

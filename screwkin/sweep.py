@@ -86,21 +86,22 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     rates_in = {n: 0.0 for n in solver.inputs}
     rates_in[name] = rate
     K = closure.jacobian(q)
-    qd = solver.rates(q, K, rates_in)
-    Q, V, A, X = [q], [qd], [solver.accelerations(q, K, qd, {})], [xs[0]]
+    solve, _ = solver.passive_solver(K)
+    qd = solver.rates(q, K, rates_in, solve)
+    Q, V, A, X = [q], [qd], [solver.accelerations(q, K, qd, {}, solve)], [xs[0]]
     stopped = reason = None
     show = progress and sys.stderr.isatty() and steps >= 200
     for k in range(1, len(xs)):
         x = xs[k]
         try:
-            q_new, qd_new, K_new = _step(solver, q, qd, X[-1], x, name, rate, rates_in)
+            q_new, qd_new, K_new, solve = _step(solver, q, qd, X[-1], x, name, rate, rates_in)
         except _Limit as exc:
             stopped, reason = _locate_limit(solver, q, qd, X[-1], x, name, rate, rates_in), str(exc)
             break
         q, qd = q_new, qd_new
         Q.append(q)
         V.append(qd)
-        A.append(solver.accelerations(q, K_new, qd, {}))
+        A.append(solver.accelerations(q, K_new, qd, {}, solve))
         X.append(x)
         if show and k % max(steps // 50, 1) == 0:
             sys.stderr.write(f"\rsweep {k}/{steps} [{'#' * (50 * k // steps):<50}]")
@@ -222,8 +223,8 @@ def _step(solver, q, qd, x0, x1, name, rate, rates_in):
     except AssemblyError as exc:
         raise _Limit(f"the loops cannot be closed beyond this input (residual {exc.residual:.2g})") from None
     K = mech.closure.jacobian(a.q)
-    Kp = K[:, solver.passive]
-    s = np.linalg.svd(Kp, compute_uv=False) if Kp.size else np.ones(1)
+    solve, s = solver.passive_solver(K)
+    s = s if s.size else np.ones(1)
     r = solver.expected_rank
     if r and (len(s) < r or s[r - 1] / s[0] < mech.tolerances.singular):
         raise _Limit("the passive joints become undetermined (limit position / singular configuration)")
@@ -231,7 +232,7 @@ def _step(solver, q, qd, x0, x1, name, rate, rates_in):
     predicted = np.linalg.norm(qd * dt) + 1e-12
     if jump > max(0.5 * predicted, 1e-6) and jump > 1e-3:
         raise _Limit("the correction jumps to another branch (a limit or singular position lies in this step)")
-    return a.q, solver.rates(a.q, K, rates_in), K
+    return a.q, solver.rates(a.q, K, rates_in, solve), K, solve
 
 
 def _locate_limit(solver, q, qd, x_ok, x_bad, name, rate, rates_in, iterations=40):
@@ -239,7 +240,7 @@ def _locate_limit(solver, q, qd, x_ok, x_bad, name, rate, rates_in, iterations=4
     for _ in range(iterations):
         mid = 0.5 * (x_ok + x_bad)
         try:
-            q, qd, _ = _step(solver, q, qd, x_ok, mid, name, rate, rates_in)
+            q, qd, _, _ = _step(solver, q, qd, x_ok, mid, name, rate, rates_in)
             x_ok = mid
         except _Limit:
             x_bad = mid
