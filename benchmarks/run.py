@@ -240,10 +240,15 @@ def sweep_throughput(steps):
 # ---------------------------------------------------------------- 4. start-up
 def startup():
     robot = ROOT / "robots" / "delta_parallelogram.urdf"
+    # peak RSS from the kernel's high-water mark of this process's own address space (VmHWM):
+    # ru_maxrss of a child started by fork counts the parent's memory at the fork
     code = ("import resource, runpy, sys, time; t = time.perf_counter(); "
             "sys.argv = ['screwkin', 'mobility', sys.argv[1]]; "
             "from screwkin.cli import main; rc = main(); "
-            "print('WALL', time.perf_counter() - t, 'RSS', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)")
+            "hwm = [l for l in open('/proc/self/status') if l.startswith('VmHWM')] "
+            "if sys.platform == 'linux' else []; "
+            "rss = int(hwm[0].split()[1]) if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss; "
+            "print('WALL', time.perf_counter() - t, 'RSS', rss, file=sys.stderr)")
     walls, rss = [], []
     for _ in range(3):
         t = time.perf_counter()

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg.lapack import dposv as _lapack_dposv
 
 from .errors import AssemblyError
 from .tolerances import DEFAULT, Tolerances
@@ -35,13 +34,6 @@ def _cross(a, b):
     """Cross product of two 3-vectors (numpy.cross costs about 35 us a call here: it was
     70% of a sweep step in a profile; this costs about 1 us)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _dposv(A, b):
-    """Solve the symmetric positive definite A y = b (Cholesky, LAPACK dposv: about 1.5 us
-    against 5 us for numpy.linalg.solve at this size).  Returns (y, info)."""
-    _, y, info = _lapack_dposv(A, b)
-    return y, info
 
 
 def _skew(a):
@@ -153,6 +145,13 @@ class ClosureSystem:
         self._solver_rows = None
         self._free = {}  # free velocity indices for each set of frozen ones
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
+        # Pinocchio hands out its frame placements by reference and their rotation and
+        # translation as views of its own memory: read once here, they follow every
+        # forward-kinematics pass on self.data (fetching them costs about 1 us each)
+        self._placements = []
+        for c in self.cuts:
+            M1, M2 = self.data.oMf[c.frame1], self.data.oMf[c.frame2]
+            self._placements.append((M1.rotation, M2.rotation, M1.translation, M2.translation))
 
     # ------------------------------------------------------------------ residual
     def _rows(self, solver: bool) -> int:
@@ -210,10 +209,8 @@ class ClosureSystem:
         r = np.empty(nrows)
         K = np.empty((nrows, model.nv)) if jacobian else None
         i = 0
-        for cut, (P, pairs, vectors, rotation) in zip(self.cuts, self._plans):
-            M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
-            R1, R2 = M1.rotation, M2.rotation
-            d = M2.translation - M1.translation
+        for cut, (P, pairs, vectors, rotation), (R1, R2, t1, t2) in zip(self.cuts, self._plans, self._placements):
+            d = t2 - t1
             if jacobian:
                 J1 = pin.getFrameJacobian(model, data, cut.frame1, LWA)
                 J2 = pin.getFrameJacobian(model, data, cut.frame2, LWA)
@@ -369,8 +366,9 @@ class ClosureSystem:
             A = Kf @ Kf.T
             diagonal = A.ravel()[:: len(A) + 1]  # a view
             diagonal += mu * max(diagonal.sum() / len(A), 1e-12)
-            y, info = _dposv(A, r)
-            if info != 0:  # not positive definite in floating point
+            try:
+                y = np.linalg.solve(A, r)
+            except np.linalg.LinAlgError:  # singular in floating point
                 y = np.linalg.lstsq(A, r, rcond=None)[0]
             dq[:] = 0.0
             dq[free] = -(Kf.T @ y)
