@@ -20,9 +20,11 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from ._pin import compute_frame_jacobian
 from .errors import UsageError
 
-__all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values", "determinants"]
+__all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
+           "singular_value_ratios", "determinants"]
 
 _REFERENCES = {
     pin.ReferenceFrame.WORLD: "world",
@@ -39,7 +41,7 @@ def frame_jacobians(model, frame_id: int, Q, reference=pin.ReferenceFrame.WORLD,
     data = data or model.createData()
     out = np.empty((len(Q), 6, model.nv))
     for k, q in enumerate(Q):
-        out[k] = pin.computeFrameJacobian(model, data, q, frame_id, reference)
+        out[k] = compute_frame_jacobian(model, data, q, frame_id, reference)
     return out
 
 
@@ -200,12 +202,13 @@ class SerialJacobians:
         block by block (the Jacobians of all N are never held at once).
 
         measure: "sigma_min" (smallest singular value, translations divided by
-        ``scale_translation`` [m]) or "det" (determinant; square Jacobians only,
-        frame-independent).  method: see ``smallest_singular_values``.
+        ``scale_translation`` [m]), "sigma_ratio" (smallest over largest) or "det"
+        (determinant; square Jacobians only, frame-independent).
+        method: see ``smallest_singular_values``.
         workers: threads, each taking whole blocks (numpy releases the GIL in its loops).
         """
-        if measure not in ("sigma_min", "det"):
-            raise UsageError(f"unknown measure '{measure}': sigma_min or det")
+        if measure not in ("sigma_min", "sigma_ratio", "det"):
+            raise UsageError(f"unknown measure '{measure}': sigma_min, sigma_ratio or det")
         Q = np.atleast_2d(np.asarray(Q, float))
         if Q.ndim != 2 or Q.shape[1] != self.model.nq:
             raise ValueError(f"expected configurations of shape (N, {self.model.nq}), got {Q.shape}")
@@ -221,6 +224,8 @@ class SerialJacobians:
             J = self._block(np.ascontiguousarray(th[:, start:stop]))
             if measure == "det":
                 out[start:stop] = np.linalg.det(J)
+            elif measure == "sigma_ratio":
+                out[start:stop] = singular_value_ratios(J, scale_translation, method=method)
             else:
                 out[start:stop] = smallest_singular_values(J, scale_translation, method=method)
 
@@ -244,7 +249,7 @@ class SerialJacobians:
         Q = np.array([pin.normalize(model, rng.uniform(lo, hi)) for _ in range(count)])
         ours = self(Q)
         for q, J in zip(Q, ours):
-            ref = pin.computeFrameJacobian(model, data, q, self.frame, self.reference)
+            ref = compute_frame_jacobian(model, data, q, self.frame, self.reference)
             err = float(np.abs(ref - J).max())
             if err > 1e-9 * max(1.0, float(np.abs(ref).max())):  # pragma: no cover - a bug, not an input error
                 raise RuntimeError(f"batched Jacobian differs from Pinocchio's by {err:.1e}")
@@ -274,22 +279,36 @@ def smallest_singular_values(J, scale_translation: float = 1.0, method: str = "s
     sigma_min >= 1e-3 sigma_max; its relative error there is at most about
     eps (sigma_max / sigma_min)^2 < 1e-9; matrices closer to singular take the SVD.
     """
+    return _extreme_singular_values(J, scale_translation, method)[0]
+
+
+def singular_value_ratios(J, scale_translation: float = 1.0, method: str = "svd") -> np.ndarray:
+    """(N,) smallest over largest singular value of each Jacobian (translations divided by
+    ``scale_translation``); methods as ``smallest_singular_values``."""
+    low, high = _extreme_singular_values(J, scale_translation, method)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(high > 0, low / high, 0.0)
+
+
+def _extreme_singular_values(J, scale_translation, method):
     J = np.array(J, float)
     if J.ndim != 3:
         raise ValueError(f"expected a stack of matrices (N, m, n), got shape {J.shape}")
     J[:, :3, :] /= scale_translation
     if method == "svd":
-        return singular_values(J)[:, -1]
+        s = singular_values(J)
+        return s[:, -1], s[:, 0]
     if method != "gram":
         raise UsageError(f"unknown method '{method}': svd or gram")
     if J.shape[1] < J.shape[2]:  # wide: the Gram matrix J^T J is singular; use J J^T
         J = J.transpose(0, 2, 1)
     lam = np.linalg.eigvalsh(np.matmul(J.transpose(0, 2, 1), J))
-    out = np.sqrt(np.maximum(lam[:, 0], 0.0))
+    low, high = np.sqrt(np.maximum(lam[:, 0], 0.0)), np.sqrt(np.maximum(lam[:, -1], 0.0))
     near = lam[:, 0] < _GRAM_KAPPA**2 * lam[:, -1]
     if near.any():
-        out[near] = singular_values(J[near])[:, -1]
-    return out
+        s = singular_values(J[near])
+        low[near], high[near] = s[:, -1], s[:, 0]
+    return low, high
 
 
 _GRAM_KAPPA = 1e-3  # below this sigma_min / sigma_max the Gram eigenvalue loses digits: use the SVD

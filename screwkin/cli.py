@@ -2,7 +2,7 @@
 
 A thin edge over the Python API: it parses arguments, calls the same functions
 and prints their results.  Exit codes: 0 success, 1 invalid or unanalysable
-file, 2 usage error.
+file, 2 usage error, 3 internal error (a bug).
 """
 
 from __future__ import annotations
@@ -75,6 +75,17 @@ def _parser():
     mp.add_argument("--output", help="output link (serial singularities)")
     mp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
     mp.add_argument("--csv", help="the map's data as CSV")
+    sc = sub.add_parser("scan", help="singularity scan of a serial chain over random configurations")
+    common(sc)
+    sc.add_argument("--output", required=True, help="the chain's last link (e.g. the flange)")
+    sc.add_argument("--samples", type=int, default=100000, help="random configurations (default 100000)")
+    sc.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    sc.add_argument("--measure", choices=["sigma_ratio", "det"], default="sigma_ratio",
+                    help="smallest / largest singular value (default) or the determinant (6 joints)")
+    sc.add_argument("--length", help="characteristic length for sigma_ratio (default: RMS spread of the joint "
+                                     "centres)")
+    sc.add_argument("--threads", type=int, help="threads (default: the machine's cores)")
+    sc.add_argument("--csv", help="write every sample (joint values and the measure) to this CSV file")
     v = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
     common(v)
     at_configuration(v)
@@ -130,7 +141,7 @@ def _run(args):
                 print(f"note: {note}")
         return 0
     handlers = {"solve": _solve, "sweep": _sweep, "ik": _ik, "screws": _screws,
-                "singularities": _singularities, "map": _map, "view": _view}
+                "singularities": _singularities, "map": _map, "view": _view, "scan": _scan}
     if args.command in handlers:
         return handlers[args.command](mech, args)
     result = mech.mobility(output=args.output)
@@ -252,6 +263,38 @@ def _map(mech, args):
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
               f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g}" if finite.size else "no point assembled")
+    return 0
+
+
+def _scan(mech, args):
+    import time
+
+    from .report import to_jsonable
+    from .scan import scan
+    from .units import parse_value
+
+    t = time.perf_counter()
+    res = scan(mech, args.output, args.samples, args.seed, args.measure,
+               parse_value(args.length) if args.length else None, args.threads)
+    elapsed = time.perf_counter() - t
+    if args.csv:
+        with open(args.csv, "w") as f:
+            f.write(res.csv())
+    d = res.to_dict()
+    if args.json:
+        print(json.dumps(to_jsonable({"file": mech.path, **d, "seconds": elapsed}), indent=2))
+        return 0
+    what = ("smallest / largest singular value of the output Jacobian (v / L, w), "
+            f"L = {res.length:.4g} m" if res.measure == "sigma_ratio" else "determinant of the output Jacobian (v, w)")
+    worst = ", ".join(f"{n}={v:.6g}" for n, v in d["min_configuration"].items())
+    p = d["percentiles"]
+    print(f"scan of {mech.path}, chain to '{res.output}' ({len(res.joints)} joints): {res.samples} random "
+          f"configurations within the joint limits (seed {res.seed}), {elapsed:.2f} s")
+    print(f"measure: {what}")
+    print(f"  nearest a singularity: {d['min']:.3g} at {worst}")
+    print(f"  |measure| percentiles: 1% {p['1']:.3g}, 5% {p['5']:.3g}, median {p['50']:.3g}; largest {d['max']:.3g}")
+    if d["singular_fraction"] is not None:
+        print(f"  singular (below {res.threshold:g}): {100 * d['singular_fraction']:.3g}% of the configurations")
     return 0
 
 
@@ -422,6 +465,13 @@ def main(argv=None) -> int:
         return exc.exit_code
     except KeyboardInterrupt:  # pragma: no cover
         return 130
+    except Exception as exc:  # a bug in screwkin, not a problem of the input: still one line
+        if args.debug:
+            raise
+        where = getattr(args, "file", None)
+        print(f"screwkin: internal error{f' on {where}' if where else ''}: {type(exc).__name__}: {exc} "
+              "(a bug in screwkin: run again with --debug for the traceback and report it)", file=sys.stderr)
+        return 3
 
 
 if __name__ == "__main__":  # pragma: no cover

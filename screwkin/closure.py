@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ._pin import frame_jacobian
 from .errors import AssemblyError
 from .tolerances import DEFAULT, Tolerances
 
@@ -212,8 +213,8 @@ class ClosureSystem:
         for cut, (P, pairs, vectors, rotation), (R1, R2, t1, t2) in zip(self.cuts, self._plans, self._placements):
             d = t2 - t1
             if jacobian:
-                J1 = pin.getFrameJacobian(model, data, cut.frame1, LWA)
-                J2 = pin.getFrameJacobian(model, data, cut.frame2, LWA)
+                J1 = frame_jacobian(model, data, cut.frame1, LWA)
+                J2 = frame_jacobian(model, data, cut.frame2, LWA)
                 w1, w2 = J1[3:], J2[3:]
             E = R1.T if P is None else P @ R1.T  # position rows: F1 axes in the world
             k = len(E)

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from ._pin import frame_jacobian
 from .errors import AssemblyError
 from .topology import Topology
 
@@ -205,7 +206,7 @@ def _idle(mech, topo, frames, q, V, output_link, tol):
     model, data = mech.model, mech.data
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
-    jac = {k: pin.getFrameJacobian(model, data, f, LWA) for k, f in frames.items()}
+    jac = {k: frame_jacobian(model, data, f, LWA) for k, f in frames.items()}
     rows = _joint_geometry_rows(mech, topo, frames, jac, q)
     degree = {name: 0 for name in topo.links}
     for j in topo.joints:
@@ -320,7 +321,7 @@ def analyze_mobility(mech, output=None, seed: int = 0) -> MobilityResult:
         out = None
         if output is not None:
             model, data = mech.model, mech.data
-            T = pin.getFrameJacobian(model, data, out_frame, LWA) @ V
+            T = frame_jacobian(model, data, out_frame, LWA) @ V
             out = _output_motion(output, T, tol, data.oMf[out_frame].translation)
         eff = rank(V[act_idx], tol) if len(act_idx) else None
         key = (rk, -idle_total, out.dimension if out else 0, eff or 0)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ._pin import frame_jacobian
 from .errors import UsageError
 from .mobility import null_space
 
@@ -89,7 +90,7 @@ def chains(mech, output=None):
                                  "product-of-exponentials form here takes 1-DOF joints")
             joints.append(model.names[j])
             cols.append(model.idx_vs[j])
-        Js = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.WORLD)
+        Js = frame_jacobian(model, data, fid, pin.ReferenceFrame.WORLD)
         out.append(Chain(name, fid, tuple(joints), tuple(cols), Js[:, cols].copy(),
                          data.oMf[fid].homogeneous.copy()))
     return out
@@ -117,8 +118,8 @@ def structure(mech, q, output=None):
     pin.updateFramePlacements(model, data)
     result = []
     for ch in chains(mech, output):
-        Js = pin.getFrameJacobian(model, data, ch.frame, pin.ReferenceFrame.WORLD)[:, list(ch.columns)]
-        Jb = pin.getFrameJacobian(model, data, ch.frame, pin.ReferenceFrame.LOCAL)[:, list(ch.columns)]
+        Js = frame_jacobian(model, data, ch.frame, pin.ReferenceFrame.WORLD)[:, list(ch.columns)]
+        Jb = frame_jacobian(model, data, ch.frame, pin.ReferenceFrame.LOCAL)[:, list(ch.columns)]
         result.append({"chain": ch, "theta": joint_angles(mech, q, ch), "space_jacobian": Js, "body_jacobian": Jb,
                        "g": data.oMf[ch.frame].homogeneous.copy()})
     return result
@@ -152,7 +153,7 @@ def split_jacobians(mech, q, output, inputs=None):
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     fid = mech.link_frame(output)
-    J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    J = frame_jacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
     # q' = S q'_a with K_p q'_p = -K_a q'_a (minimum norm: no idle spins)
     S = np.zeros((mech.nv, len(a)))
     S[a] = np.eye(len(a))

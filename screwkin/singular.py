@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ._pin import frame_jacobian
 from .mobility import null_space, rank
 from .screws import screw_of
 
@@ -129,7 +130,7 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None) -> Si
     J = None
     if output is not None:
         # spatial twists (v at the world origin, w): their screw axes are where they are in the world
-        J = pin.getFrameJacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+        J = frame_jacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
         J[:3] /= L
     if constraint:
         _, _, vt = np.linalg.svd(K)
@@ -187,7 +188,7 @@ def measures(mech, q, g, output=None, length=1.0) -> dict:
         data = mech.data
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
-        J = pin.getFrameJacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+        J = frame_jacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
         J[:3] /= length
         V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
         s = np.linalg.svd(J @ V, compute_uv=False)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ._pin import frame_jacobian
 from .errors import AssemblyError, UsageError
 
 __all__ = ["SweepResult", "sweep"]
@@ -132,7 +133,7 @@ def _matrix(mech, q, kind, g, output, L, V_ref=None):
     data = mech.data
     pin.computeJointJacobians(mech.model, data, q)
     pin.updateFramePlacements(mech.model, data)
-    J = pin.getFrameJacobian(mech.model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+    J = frame_jacobian(mech.model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
     J[:3] /= L
     N = null_space(K, mech.tolerances, mech.nv) if K.size else np.eye(mech.nv)
     V = N if V_ref is None else N @ (N.T @ V_ref)  # a basis that varies smoothly with q

@@ -160,3 +160,34 @@ def test_no_traceback_reaches_the_terminal_and_debug_shows_one(tmp_path):
     assert p.returncode == 1 and "Traceback" not in p.stderr and len(p.stderr.strip().splitlines()) == 1
     p = subprocess.run([sys.executable, "-m", "screwkin", "mobility", path, "--debug"], capture_output=True, text=True)
     assert p.returncode != 0 and "Traceback" in p.stderr
+
+
+ONE_JOINT = ('<robot name="one"><link name="a"/><link name="b"><inertial><mass value="1"/>'
+             '<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+             '<joint name="j" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0 0 0.1"/>'
+             '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+
+
+@pytest.mark.parametrize("argv", [["mobility", "--output", "b"], ["screws", "--output", "b"],
+                                  ["singularities", "--output", "b"], ["scan", "--output", "b", "--samples", "5"],
+                                  ["solve", "--set", "j=0.1", "--output", "b", "--rate", "j=1"],
+                                  ["ik", "--output", "b", "--pose", "0 0 0.1 0 0 0.2"]])
+def test_one_joint_arm(tmp_path, capsys, argv):
+    """Pinocchio returns the frame Jacobian of a one-coordinate model as a 6-vector:
+    every command still works on a single revolute joint."""
+    path = write(tmp_path, ONE_JOINT)
+    code, err = run(capsys, [argv[0], path, *argv[1:]])
+    assert code == 0, err
+
+
+def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
+    import screwkin.mechanism
+
+    def broken(self, output=None):
+        raise ValueError("shapes do not match")
+
+    monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", broken)
+    path = write(tmp_path, GOOD)
+    check(capsys, ["mobility", path], 3, "internal error", "ValueError", "--debug", path=path)
+    with pytest.raises(ValueError):
+        main(["mobility", path, "--debug"])

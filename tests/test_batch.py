@@ -109,3 +109,62 @@ def test_refusals(tmp_path):
                       + "</robot>")
     with pytest.raises(UsageError, match="3 DOF"):
         SerialJacobians(screwkin.load(planar), "b")
+
+
+def test_scan_det_is_the_spherical_wrist_factorization():
+    """arm_6r has a spherical wrist (axes 4, 5, 6 meet at the wrist centre w): the Jacobian
+    at w is block triangular, so |det J| = |det[z_i x (w - p_i)], i = 1..3| |det[z4 z5 z6]|,
+    computed here from Pinocchio's joint placements."""
+    from screwkin.scan import scan
+
+    mech = screwkin.load(ROBOTS / "arm_6r.urdf")
+    res = scan(mech, "flange", samples=3000, seed=7, measure="det")
+    data = mech.model.createData()
+    for q, value in zip(res.Q[:300], res.values[:300]):
+        pin.forwardKinematics(mech.model, data, q)
+        z = [data.oMi[j].rotation[:, "XYZ".index(mech.model.joints[j].shortname()[-1])] for j in range(1, 7)]
+        p = [data.oMi[j].translation for j in range(1, 7)]
+        w = p[4]  # joint 5's origin: the wrist centre
+        arm = np.linalg.det(np.column_stack([np.cross(z[i], w - p[i]) for i in range(3)]))
+        wrist = np.linalg.det(np.column_stack(z[3:]))
+        assert abs(abs(value) - abs(arm * wrist)) < 1e-13
+    assert np.all(np.abs(res.values) <= np.abs(res.values).max())
+
+
+def test_scan_sigma_ratio_matches_pinocchio_and_cli(tmp_path, capsys):
+    import json
+
+    from screwkin.cli import main
+    from screwkin.scan import scan
+
+    mech = screwkin.load(ROBOTS / "arm_6r.urdf")
+    res = scan(mech, "flange", samples=2000, seed=3, length=0.3)
+    ref = pinocchio_jacobians(mech, mech.link_frame("flange"), res.Q[:400], pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    ref[:, :3] /= 0.3
+    s = np.linalg.svd(ref, compute_uv=False)
+    np.testing.assert_allclose(res.values[:400], s[:, -1] / s[:, 0], rtol=1e-12, atol=1e-15)
+    assert main(["scan", str(ROBOTS / "arm_6r.urdf"), "--output", "flange", "--samples", "2000", "--seed", "3",
+                 "--length", "300mm", "--json", "--csv", str(tmp_path / "s.csv")]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["min"] == float(res.values[res.worst]) and d["samples"] == 2000
+    assert d["singular_fraction"] == float(np.mean(res.values < 1e-4))
+    lines = (tmp_path / "s.csv").read_text().splitlines()
+    assert len(lines) == 2001 and lines[0] == "joint1,joint2,joint3,joint4,joint5,joint6,sigma_ratio"
+
+
+def test_scan_refusals(tmp_path, capsys):
+    from conftest import fourbar
+    from screwkin.cli import main
+
+    fb = tmp_path / "fb.urdf"
+    fb.write_text(fourbar())
+    assert main(["scan", str(fb), "--output", "rocker"]) == 2
+    assert "closed loop" in capsys.readouterr().err
+    assert main(["scan", str(ROBOTS / "arm_6r.urdf"), "--output", "link3", "--measure", "det"]) == 2
+    assert "3 joints" in capsys.readouterr().err
+    slide = tmp_path / "slide.urdf"
+    slide.write_text('<robot name="s">' + LINK.format(n="a") + LINK.format(n="b")
+                     + '<joint name="j" type="prismatic"><parent link="a"/><child link="b"/><axis xyz="1 0 0"/>'
+                       '<limit lower="0" upper="0" effort="1" velocity="1"/></joint></robot>')
+    assert main(["scan", str(slide), "--output", "b"]) == 2
+    assert "no finite <limit> range" in capsys.readouterr().err  # URDF requires <limit> here; 0..0 is no range
