@@ -65,6 +65,17 @@ def _skews(U, m=None):
 _SKEW_TABLES = {}
 
 
+def _skews_batch(U, m=None):
+    """_skews for a stack: U (n, 3, k) -> (n, 3k, 3), or (n, 3m, 6) with m."""
+    n, _, k = U.shape
+    table = _SKEW_TABLES.get((k, m))
+    if table is None:
+        _skews(np.zeros((3, k)), m)
+        table = _SKEW_TABLES[(k, m)]
+    index, sign = table
+    return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
+
+
 def perpendicular_basis(a):
     """Two unit vectors completing the unit vector ``a`` to a right-handed basis."""
     a = np.asarray(a, float)
@@ -153,15 +164,14 @@ class ClosureSystem:
         for c in self.cuts:
             M1, M2 = self.data.oMf[c.frame1], self.data.oMf[c.frame2]
             self._placements.append((M1.rotation, M2.rotation, M1.translation, M2.translation))
+        self._groups = self._group()
 
     # ------------------------------------------------------------------ residual
     def _rows(self, solver: bool) -> int:
         if not solver:
             return self.nrows
-        if self._solver_rows is not None:
-            return self._solver_rows
-        extra = {"fixed": 6, "prismatic": 6, "revolute": 1, "continuous": 1, "cylindrical": 1, "planar": 1}
-        self._solver_rows = sum(c.rows + extra.get(c.type, 0) for c in self.cuts)
+        if self._solver_rows is None:
+            self._solver_rows = sum(self._cut_rows(c, True) for c in self.cuts)
         return self._solver_rows
 
     def _plan(self, cut, b1, b2):
@@ -171,7 +181,7 @@ class ClosureSystem:
         a = np.asarray(cut.axis, float)
         t = cut.type
         if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
-            P = None  # the three axes of F1
+            P = np.eye(3)  # the three axes of F1
         elif t in ("prismatic", "cylindrical"):
             P = np.vstack([b1, b2])
         else:  # planar
@@ -190,6 +200,52 @@ class ClosureSystem:
             vectors = np.eye(3) if t in ("fixed", "prismatic") else a[None, :]
         return P, pairs, vectors, t in ("fixed", "prismatic")
 
+    def _group(self):
+        """Cut joints of one type share the layout of their rows: each group is evaluated
+        with stacked arrays (a few numpy calls per group, not per cut joint)."""
+        offsets = {False: 0, True: 0}
+        groups = {}
+        for c, cut in enumerate(self.cuts):
+            P, pairs, vectors, rotation = self._plans[c]
+            g = groups.setdefault(cut.type, {"members": [], "P": [], "U": [], "W": [], "V": [],
+                                             "rows": {False: [], True: []}})
+            g["members"].append(c)
+            g["P"].append(P)
+            g["U"].append([u for u, _ in pairs])
+            g["W"].append([w for _, w in pairs])
+            g["V"].append(vectors)
+            g["rotation"] = rotation
+            for solver in (False, True):
+                n = self._cut_rows(cut, solver)
+                g["rows"][solver].append(np.arange(offsets[solver], offsets[solver] + n))
+                offsets[solver] += n
+        out = []
+        for t, g in groups.items():
+            P = np.array(g["P"])  # (n, k, 3)
+            U = np.array(g["U"]).reshape(len(g["members"]), -1, 3)  # (n, p, 3) pair vectors in F1
+            W = np.array(g["W"]).reshape(len(g["members"]), -1, 3)  # in F2
+            V = None if g["V"][0] is None else np.array(g["V"]).reshape(len(g["members"]), -1, 3)
+            identity = P.shape[1] == 3 and np.allclose(P, np.eye(3))
+            out.append({
+                "type": t, "members": g["members"], "P": None if identity else P, "k": P.shape[1],
+                "U": U.transpose(0, 2, 1), "W": W.transpose(0, 2, 1),  # columns: (n, 3, p)
+                "V": V, "V_identity": V is not None and V.shape[1] == 3 and np.allclose(V, np.eye(3)),
+                "Vt": None if V is None else V.transpose(0, 2, 1), "rotation": g["rotation"],
+                "frames1": [self.cuts[c].frame1 for c in g["members"]],
+                "frames2": [self.cuts[c].frame2 for c in g["members"]],
+                "views": [self._placements[c] for c in g["members"]],
+                "rows": {s_: np.array(g["rows"][s_]) for s_ in (False, True)},
+                "starts": {s_: [int(x[0]) if len(x) else 0 for x in g["rows"][s_]] for s_ in (False, True)},
+            })
+        return out
+
+    @staticmethod
+    def _cut_rows(cut, solver):
+        if not solver:
+            return cut.rows
+        extra = {"fixed": 6, "prismatic": 6, "revolute": 1, "continuous": 1, "cylindrical": 1, "planar": 1}
+        return cut.rows + extra.get(cut.type, 0)
+
     def evaluate(self, q, jacobian: bool = True, solver: bool = False):
         """Residual r(q) and, if asked, its Jacobian (rows x nv).
 
@@ -199,6 +255,9 @@ class ClosureSystem:
         orientation rows are replaced by smooth, redundant differences of world
         vectors (R2 e - R1 e), whose only root is the right one: these are what
         the closure solver drives to zero from far away.
+
+        Rows of cut joint j, in order: positions e . d (e fixed in F1, d = o2 - o1),
+        then (solver) R2 v - R1 v, or (minimal) log3(R1^T R2) or alignments u . w.
         """
         model, data = self.model, self.data
         if jacobian:
@@ -209,44 +268,92 @@ class ClosureSystem:
         nrows = self._rows(solver)
         r = np.empty(nrows)
         K = np.empty((nrows, model.nv)) if jacobian else None
-        i = 0
-        for cut, (P, pairs, vectors, rotation), (R1, R2, t1, t2) in zip(self.cuts, self._plans, self._placements):
+        for g in self._groups:
+            views = g["views"]
+            n = len(views)
+            if n <= 2:  # stacking pays from three cut joints of a type on (measured: 1 cut +7 us, 3 cuts -6 us)
+                for j in range(n):
+                    self._evaluate_one(g, j, r, K, solver)
+                continue
+            R1, R2, t1, t2 = (np.array([v[i] for v in views]) for i in range(4))  # (n, 3, 3), (n, 3)
             d = t2 - t1
+            rows = g["rows"][solver]  # (n, rows per cut joint)
+            k = g["k"]
+            R1t = R1.transpose(0, 2, 1)
+            E = R1t if g["P"] is None else g["P"] @ R1t  # (n, k, 3): position rows, F1 axes in the world
+            r[rows[:, :k]] = (E @ d[:, :, None])[:, :, 0]
             if jacobian:
-                J1 = frame_jacobian(model, data, cut.frame1, LWA)
-                J2 = frame_jacobian(model, data, cut.frame2, LWA)
-                w1, w2 = J1[3:], J2[3:]
-            E = R1.T if P is None else P @ R1.T  # position rows: F1 axes in the world
-            k = len(E)
-            r[i:i + k] = E @ d
-            if jacobian:  # e . (v2 - v1) + (e x d) . w1
-                K[i:i + k] = E @ (J2[:3] - J1[:3] + _skew(d) @ w1)
-            i += k
-            if solver and vectors is not None:
+                J1 = np.array([frame_jacobian(model, data, f, LWA) for f in g["frames1"]])  # (n, 6, nv)
+                J2 = np.array([frame_jacobian(model, data, f, LWA) for f in g["frames2"]])
+                w1, w2 = J1[:, 3:], J2[:, 3:]
+                # e . (v2 - v1) + (e x d) . w1
+                K[rows[:, :k]] = E @ (J2[:, :3] - J1[:, :3] + _skews_batch(d[:, :, None]) @ w1)
+            rest = rows[:, k:]
+            if solver and g["V"] is not None:
+                if g["V"].shape[1] == 0:
+                    continue
                 # R2 v - R1 v for the vectors v that F1 and F2 must share; derivative
-                # [R1 v]x w1 - [R2 v]x w2, all vectors in one product
-                m = len(vectors)
-                if m:
-                    U1, U2 = (R1, R2) if m == 3 else (R1 @ vectors.T, R2 @ vectors.T)
-                    r[i:i + 3 * m] = (U2 - U1).T.ravel()
+                # [R1 v]x w1 - [R2 v]x w2, all vectors of all cut joints in one product
+                U1, U2 = (R1, R2) if g["V_identity"] else (R1 @ g["Vt"], R2 @ g["Vt"])  # (n, 3, m)
+                m = U1.shape[2]
+                r[rest] = (U2 - U1).transpose(0, 2, 1).reshape(n, 3 * m)
+                if jacobian:
+                    K[rest] = _skews_batch(np.concatenate([U1, -U2], axis=2), m) @ np.concatenate([w1, w2], axis=1)
+                continue
+            if g["rotation"]:
+                for j in range(n):
+                    R = R1t[j] @ R2[j]
+                    r[rest[j]] = pin.log3(R)
                     if jacobian:
-                        K[i:i + 3 * m] = _skews(np.hstack([U1, -U2]), m) @ np.vstack([w1, w2])
-                    i += 3 * m
+                        K[rest[j]] = pin.Jlog3(R) @ R2[j].T @ (w2[j] - w1[j])
                 continue
-            if rotation:
-                R = R1.T @ R2
-                r[i:i + 3] = pin.log3(R)
+            if rest.shape[1]:  # alignments u . w, u fixed in F1, w in F2; derivative (w x u) . (w2 - w1)
+                u, w = R1 @ g["U"], R2 @ g["W"]  # (n, 3, p)
+                r[rest] = np.einsum("nip,nip->np", u, w)
                 if jacobian:
-                    K[i:i + 3] = pin.Jlog3(R) @ R2.T @ (w2 - w1)
-                i += 3
-                continue
-            for u, w in pairs:
-                u, w = R1 @ u, R2 @ w
-                r[i] = u @ w
-                if jacobian:
-                    K[i] = _cross(w, u) @ (w2 - w1)
-                i += 1
+                    c = np.stack([w[:, 1] * u[:, 2] - w[:, 2] * u[:, 1], w[:, 2] * u[:, 0] - w[:, 0] * u[:, 2],
+                                  w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]], axis=1)  # (n, 3, p)
+                    K[rest] = c.transpose(0, 2, 1) @ (w2 - w1)
         return r, K
+
+    def _evaluate_one(self, g, j, r, K, solver):
+        """The rows of cut joint j of a group (the same rows as the stacked code, with 2-D
+        arrays: a test checks that both give the same numbers)."""
+        model, data = self.model, self.data
+        R1, R2, t1, t2 = g["views"][j]
+        i = g["starts"][solver][j]  # the cut joint's rows are r[i:i + k] (positions), then the rest
+        d = t2 - t1
+        k = g["k"]
+        E = R1.T if g["P"] is None else g["P"][j] @ R1.T
+        r[i:i + k] = E @ d
+        jacobian = K is not None
+        if jacobian:
+            J1 = frame_jacobian(model, data, g["frames1"][j], LWA)
+            J2 = frame_jacobian(model, data, g["frames2"][j], LWA)
+            w1, w2 = J1[3:], J2[3:]
+            K[i:i + k] = E @ (J2[:3] - J1[:3] + _skew(d) @ w1)
+        i += k
+        if solver and g["V"] is not None:
+            if g["V"].shape[1]:
+                U1, U2 = (R1, R2) if g["V_identity"] else (R1 @ g["Vt"][j], R2 @ g["Vt"][j])
+                m = U1.shape[1]
+                r[i:i + 3 * m] = (U2 - U1).T.ravel()
+                if jacobian:
+                    K[i:i + 3 * m] = _skews(np.hstack([U1, -U2]), m) @ np.vstack([w1, w2])
+            return
+        if g["rotation"]:
+            R = R1.T @ R2
+            r[i:i + 3] = pin.log3(R)
+            if jacobian:
+                K[i:i + 3] = pin.Jlog3(R) @ R2.T @ (w2 - w1)
+            return
+        p = g["U"].shape[2]
+        if p:
+            u, w = R1 @ g["U"][j], R2 @ g["W"][j]  # (3, p)
+            r[i:i + p] = np.einsum("ip,ip->p", u, w)
+            if jacobian:
+                for c in range(p):
+                    K[i + c] = _cross(w[:, c], u[:, c]) @ (w2 - w1)
 
     def bias(self, q, v) -> np.ndarray:
         """K'(q, v) v: the second time derivative of the (minimal) residual rows

@@ -138,3 +138,39 @@ def test_bias_term_matches_finite_differences_of_K_v(tmp_path, jtype):
     Km = mech.closure.jacobian(pin.integrate(mech.model, q, -h * v))
     expected = (Kp - Km) @ v / (2 * h)
     np.testing.assert_allclose(mech.closure.bias(q, v), expected, rtol=0, atol=1e-6 * max(1, np.abs(expected).max()))
+
+
+def test_many_cut_joints_of_mixed_types_are_each_their_own_rows(tmp_path):
+    """From three cut joints of one type on, they are evaluated together with stacked arrays
+    (fewer, one at a time with 2-D arrays): three of every type, in mixed order and with
+    different axes and frames, give for each cut joint the rows it gives alone, and a
+    Jacobian equal to finite differences."""
+    from screwkin.closure import ClosureSystem
+
+    rng = np.random.default_rng(11)
+    loops = []
+    for k, jtype in enumerate(TYPES + TYPES[::-1] + TYPES):
+        axis = rng.normal(size=3)
+        axis2 = '<axis2 xyz="{:.3f} {:.3f} {:.3f}"/>'.format(*np.cross(axis, rng.normal(size=3))) \
+            if jtype == "universal" else ""
+        x1, x2, r1, r2 = (rng.uniform(-0.1, 0.1, 3) for _ in range(4))
+        loops.append(f'<loop_joint name="cut{k}" type="{jtype}">'
+                     f'<link1 link="a4" xyz="{x1[0]} {x1[1]} {x1[2]}" rpy="{r1[0]} {r1[1]} {r1[2]}"/>'
+                     f'<link2 link="b4" xyz="{x2[0]} {x2[1]} {x2[2]}" rpy="{r2[0]} {r2[1]} {r2[2]}"/>'
+                     f'<axis xyz="{axis[0]} {axis[1]} {axis[2]}"/>{axis2}</loop_joint>')
+    path = tmp_path / "many.urdf"
+    path.write_text(BENCH.format(loop="".join(loops)))
+    mech = screwkin.load(path)
+    assert len(mech.cuts) == 24 and all(len(g["members"]) == 3 for g in mech.closure._groups)
+    q = pin.integrate(mech.model, pin.neutral(mech.model), rng.uniform(-1, 1, mech.nv))
+    for solver in (False, True):
+        r, K = mech.closure.evaluate(q, solver=solver)
+        np.testing.assert_allclose(K, fd_jacobian(mech, q, solver), rtol=0, atol=3e-7)
+        i = 0
+        for cut in mech.cuts:
+            alone = ClosureSystem(mech.model, [cut])
+            r1, K1 = alone.evaluate(q, solver=solver)
+            np.testing.assert_allclose(r[i:i + len(r1)], r1, rtol=0, atol=1e-15)
+            np.testing.assert_allclose(K[i:i + len(r1)], K1, rtol=0, atol=1e-15)
+            i += len(r1)
+        assert i == len(r)
