@@ -127,11 +127,17 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None) -> Si
     data = model.createData()
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
-    J = None
+    J = J_out = None
     if output is not None:
-        # spatial twists (v at the world origin, w): their screw axes are where they are in the world
-        J = frame_jacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+        fid = mech.link_frame(output)
+        # spatial twists (v at the world origin, w) for the screws: their axes are where they are in the world
+        J = frame_jacobian(model, data, fid, pin.ReferenceFrame.WORLD).copy()
         J[:3] /= L
+        # the measures from the twist of the output frame's origin (world axes): they must not
+        # depend on where the world origin is
+        J_out = frame_jacobian(model, data, fid, LWA).copy()
+        J_out[:3] /= L
+        origin = data.oMf[fid].translation.copy()
     if constraint:
         _, _, vt = np.linalg.svd(K)
         extra = vt[g.rank_K - 1]
@@ -151,20 +157,20 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None) -> Si
         twists.append(_motion_twist("actuator", x, names, J, L))
     # serial: the output loses a direction of its generic twist space
     sig_s, cond, manip, serial = 1.0, None, None, False
-    if J is not None and g.out_dim:
-        T = J @ V
+    if J_out is not None and g.out_dim:
+        T = J_out @ V
         U, s, _ = np.linalg.svd(T, full_matrices=True)
         # relative to the output Jacobian itself (V is orthonormal, so s <= |J|): stays
         # meaningful when the output stops altogether
-        scale = np.linalg.norm(J, 2)
+        scale = np.linalg.norm(J_out, 2)
         sig_s = float(s[g.out_dim - 1] / scale) if len(s) >= g.out_dim and scale > 0 else 0.0
         serial = sig_s < tol.singular
         kept = s[:g.out_dim]
         cond = float(kept[0] / kept[-1]) if kept[-1] > 0 else float("inf")
         manip = float(np.prod(kept))
-        if serial:
+        if serial:  # the lost direction, as a spatial twist: v at the world origin = v_o - w x o
             lost = U[:, g.out_dim - 1].copy()
-            lost[:3] *= L
+            lost[:3] = lost[:3] * L - np.cross(lost[3:], origin)
             twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost).to_dict()))
     elif Kp.size and g.rank_Kp:
         s = np.linalg.svd(Kp, compute_uv=False)[:g.rank_Kp]
@@ -188,7 +194,7 @@ def measures(mech, q, g, output=None, length=1.0) -> dict:
         data = mech.data
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
-        J = frame_jacobian(model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
+        J = frame_jacobian(model, data, mech.link_frame(output), LWA).copy()  # as in classify
         J[:3] /= length
         V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
         s = np.linalg.svd(J @ V, compute_uv=False)

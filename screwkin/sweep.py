@@ -133,8 +133,8 @@ def _matrix(mech, q, kind, g, output, L, V_ref=None):
     data = mech.data
     pin.computeJointJacobians(mech.model, data, q)
     pin.updateFramePlacements(mech.model, data)
-    J = frame_jacobian(mech.model, data, mech.link_frame(output), pin.ReferenceFrame.WORLD).copy()
-    J[:3] /= L
+    J = frame_jacobian(mech.model, data, mech.link_frame(output), pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).copy()
+    J[:3] /= L  # the output frame origin's twist, as singular.classify measures it
     N = null_space(K, mech.tolerances, mech.nv) if K.size else np.eye(mech.nv)
     V = N if V_ref is None else N @ (N.T @ V_ref)  # a basis that varies smoothly with q
     return J @ V

@@ -138,3 +138,30 @@ def test_five_bar_map_finds_the_folded_legs(tmp_path):
             sines.append(abs(u[0] * v[1] - u[1] * v[0]))  # |sin| of the elbow angle
         assert min(sines) < 0.05  # a leg folded or stretched, within the grid's resolution
     assert m.csv().count("\n") == 25 * 25 + 1
+
+
+def test_serial_measures_do_not_depend_on_where_the_world_origin_is(tmp_path):
+    """The same 6R arm on a base moved 5 m and turned: the same relative singular value,
+    condition and manipulability (from the twist of the output frame's origin), and at a
+    wrist singularity (theta5 = 0) the lost direction's screw axis moves with the arm."""
+    import pinocchio as pin
+    from conftest import ROBOTS
+
+    text = (ROBOTS / "arm_6r.urdf").read_text()
+    moved = text.replace("<robot name=\"arm_6r\">", "<robot name=\"arm_6r\"><link name=\"world\"/>"
+                         "<joint name=\"mount\" type=\"fixed\"><parent link=\"world\"/><child link=\"base\"/>"
+                         "<origin xyz=\"5 -3 2\" rpy=\"0.3 -0.2 1.1\"/></joint>", 1)
+    assert moved != text
+    (tmp_path / "moved.urdf").write_text(moved)
+    here, there = screwkin.load(ROBOTS / "arm_6r.urdf"), screwkin.load(tmp_path / "moved.urdf")
+    M = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.2, 1.1), np.array([5.0, -3.0, 2.0]))
+    for q in (np.array([0.3, -0.5, 0.8, 0.2, 0.7, -0.4]), np.array([0.3, -0.5, 0.8, 0.2, 0.0, -0.4])):
+        a = classify(here, q, inputs=[], output="flange", length=0.3)
+        b = classify(there, q, inputs=[], output="flange", length=0.3)
+        assert a.serial == b.serial
+        np.testing.assert_allclose([b.sigmas["serial"], b.manipulability], [a.sigmas["serial"], a.manipulability],
+                                   rtol=1e-9, atol=1e-13)
+        if a.serial:  # the lost twist's axis, mapped by the base motion
+            ta, tb = (np.array(r.singular_twists[0].twist) for r in (a, b))
+            moved_twist = M.toActionMatrix() @ ta
+            assert min(np.abs(moved_twist - tb).max(), np.abs(moved_twist + tb).max()) < 1e-9
