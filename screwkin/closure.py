@@ -46,10 +46,10 @@ _SKEW_INDEX = np.array([[0, 2, 1], [2, 0, 0], [1, 0, 0]])
 _SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
 
 
-def _skews(U, m=None):
-    """The cross-product matrices of the columns of U (3 x k), stacked (3k x 3); with m,
-    columns j and m + j side by side ((3m x 6): [[u_j]x, [u_m+j]x])."""
-    k = U.shape[1]
+def _skew_table(k, m=None):
+    """Index and sign tables that turn the columns of a 3 x k matrix, flattened column by
+    column, into their stacked cross-product matrices (3k x 3); with m, columns j and m + j
+    side by side (3m x 6)."""
     table = _SKEW_TABLES.get((k, m))
     if table is None:
         index = (_SKEW_INDEX[None] + 3 * np.arange(k)[:, None, None]).reshape(3 * k, 3)
@@ -58,21 +58,23 @@ def _skews(U, m=None):
             index = np.hstack([index[:3 * m], index[3 * m:]])
             sign = np.hstack([sign[:3 * m], sign[3 * m:]])
         table = _SKEW_TABLES[(k, m)] = (index, sign)
-    index, sign = table
-    return U.T.ravel()[index] * sign
+    return table
 
 
 _SKEW_TABLES = {}
 
 
+def _skews(U, m=None):
+    """The cross-product matrices of the columns of U (3 x k), stacked (3k x 3); with m,
+    columns j and m + j side by side ((3m x 6): [[u_j]x, [u_m+j]x])."""
+    index, sign = _skew_table(U.shape[1], m)
+    return U.T.ravel()[index] * sign
+
+
 def _skews_batch(U, m=None):
     """_skews for a stack: U (n, 3, k) -> (n, 3k, 3), or (n, 3m, 6) with m."""
     n, _, k = U.shape
-    table = _SKEW_TABLES.get((k, m))
-    if table is None:
-        _skews(np.zeros((3, k)), m)
-        table = _SKEW_TABLES[(k, m)]
-    index, sign = table
+    index, sign = _skew_table(k, m)
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
 
 
@@ -84,27 +86,6 @@ def perpendicular_basis(a):
     b1 /= np.linalg.norm(b1)
     b2 = np.cross(a, b1)
     return b1, b2
-
-
-def _row_vectors(cut, R1, R2, b1, b2):
-    """The world vectors of a cut joint's minimal rows at placements R1, R2:
-    ``positions`` (unit vectors fixed in F1 along which the F2 origin may not move)
-    and alignment ``pairs`` (u fixed in F1, w fixed in F2, kept perpendicular)."""
-    a = np.asarray(cut.axis)
-    t = cut.type
-    if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
-        positions = (R1[:, 0], R1[:, 1], R1[:, 2])
-    elif t in ("prismatic", "cylindrical"):
-        positions = (R1 @ b1, R1 @ b2)
-    else:  # planar
-        positions = (R1 @ a,)
-    if t in ("revolute", "continuous", "cylindrical", "planar"):
-        pairs = ((R1 @ b1, R2 @ a), (R1 @ b2, R2 @ a))
-    elif t == "universal":
-        pairs = ((R1 @ a, R2 @ np.asarray(cut.axis2)),)
-    else:  # fixed and prismatic use a rotation vector; spherical has no orientation row
-        pairs = ()
-    return positions, pairs
 
 
 @dataclass(frozen=True)
@@ -370,29 +351,26 @@ class ClosureSystem:
             ud = _cross(w, u)
             return ud, _cross(al, u) + _cross(w, ud)
 
-        for cut, (b1, b2) in zip(self.cuts, self._basis):
-            M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
-            R1, R2 = M1.rotation, M2.rotation
-            d = M2.translation - M1.translation
+        for cut, (P, pairs, _, rotation), (R1, R2, t1, t2) in zip(self.cuts, self._plans, self._placements):
+            d = t2 - t1
             V1 = pin.getFrameVelocity(model, data, cut.frame1, LWA)
             V2 = pin.getFrameVelocity(model, data, cut.frame2, LWA)
             A1 = pin.getFrameClassicalAcceleration(model, data, cut.frame1, LWA)
             A2 = pin.getFrameClassicalAcceleration(model, data, cut.frame2, LWA)
             w1, w2, al1, al2 = V1.angular, V2.angular, A1.angular, A2.angular
             dd, ddd = V2.linear - V1.linear, A2.linear - A1.linear
-            t = cut.type
             # e fixed in F1: d2/dt2 (e . d) = e . (d'' - 2 w1 x d' - al1 x d + w1 x (w1 x d))
-            positions, pairs = _row_vectors(cut, R1, R2, b1, b2)
             wd = _cross(w1, d)
             g = ddd - 2.0 * _cross(w1, dd) - _cross(al1, d) + _cross(w1, wd)
-            k = len(positions)
-            out[i:i + k] = np.array(positions) @ g
+            k = len(P)
+            out[i:i + k] = P @ (R1.T @ g)
             i += k
-            if t in ("fixed", "prismatic"):
+            if rotation:
                 out[i:i + 3] = pin.Jlog3(R1.T @ R2) @ R2.T @ (al2 - al1 + _cross(w2, w1))
                 i += 3
                 continue
             for u, w in pairs:
+                u, w = R1 @ u, R2 @ w  # world vectors of the alignment row u . w
                 ud, udd = second(u, w1, al1)
                 wd, wdd = second(w, w2, al2)
                 out[i] = udd @ w + 2 * ud @ wd + u @ wdd
