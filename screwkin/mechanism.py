@@ -133,6 +133,7 @@ class Mechanism:
         self.closure = ClosureSystem(model, self.cuts, tolerances, self.path)
         self.set_actuated(actuated)
         self._assembly = None
+        self._limits = None
 
     # ------------------------------------------------------------------ binding
     def _frame_id(self, name: str, what: str) -> int:
@@ -197,6 +198,22 @@ class Mechanism:
         for c in self.coordinates:
             names += [c.joint] if c.nv == 1 else [f"{c.joint}[{k}]" for k in range(c.nv)]
         return names
+
+    def limited_coordinates(self):
+        """(names, q indices, lower, upper, is an angle) of the one-coordinate joints with a
+        finite <limit> range, as arrays (for checking many configurations quickly)."""
+        if self._limits is None:
+            model, rows = self.model, []
+            for c in self.coordinates:
+                if c.nq != 1:
+                    continue
+                lo, hi = model.lowerPositionLimit[c.idx_q], model.upperPositionLimit[c.idx_q]
+                if np.isfinite(lo) and np.isfinite(hi) and hi - lo > 0:
+                    angle = model.joints[c.joint_id].shortname().startswith("JointModelR")
+                    rows.append((c.joint, c.idx_q, lo, hi, angle))
+            names = tuple(r[0] for r in rows)
+            self._limits = (names,) + tuple(np.array([r[k] for r in rows]) for k in range(1, 5))
+        return self._limits
 
     def link_frame(self, link: str) -> int:
         """Frame id of a link (its body frame)."""

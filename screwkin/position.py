@@ -93,19 +93,7 @@ class PositionResult:
 
 def outside_limits(mech, q) -> tuple:
     """Joints whose value lies outside the position limits of the file."""
-    table = getattr(mech, "_limit_table", None)
-    if table is None:  # (names, q indices, lower, upper, is an angle) of the joints with finite limits
-        model = mech.model
-        rows = []
-        for c in mech.coordinates:
-            if c.nq != 1:
-                continue
-            lo, hi = model.lowerPositionLimit[c.idx_q], model.upperPositionLimit[c.idx_q]
-            if np.isfinite(lo) and np.isfinite(hi) and hi - lo > 0:
-                angle = model.joints[c.joint_id].shortname().startswith("JointModelR")
-                rows.append((c.joint, c.idx_q, lo, hi, angle))
-        names = tuple(r[0] for r in rows)
-        table = mech._limit_table = (names,) + tuple(np.array([r[k] for r in rows]) for k in range(1, 5))
+    table = mech.limited_coordinates()
     names, idx, lo, hi, angle = table
     if not names:
         return ()

@@ -182,3 +182,19 @@ def test_track_refuses_what_it_cannot_reach(tmp_path):
         solver.track({"rocker_joint": -rocker_offset(mech)}, q)
     with pytest.raises(screwkin.UsageError, match="not inputs: crank_joint"):
         solver.track({"crank_joint": 0.1}, q)
+
+
+def test_outside_limits_compares_angles_modulo_a_turn(tmp_path):
+    from conftest import LINK
+    from screwkin.position import outside_limits
+
+    body = "".join(LINK.format(n=n) for n in ("a", "b", "c"))
+    body += ('<joint name="r" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+             '<limit lower="1" upper="3" effort="1" velocity="1"/></joint>'
+             '<joint name="p" type="prismatic"><parent link="b"/><child link="c"/><axis xyz="1 0 0"/>'
+             '<limit lower="-0.5" upper="0.5" effort="1" velocity="1"/></joint>')
+    mech = screwkin.load(write(tmp_path, f'<robot name="lim">{body}</robot>'))
+    assert outside_limits(mech, np.array([2.0, 0.0])) == ()
+    assert outside_limits(mech, np.array([2.0 - 2 * np.pi, 0.0])) == ()  # the same angle, a turn less
+    assert outside_limits(mech, np.array([3.5, 0.0])) == ("r",)  # 3.5 - 2 pi = -2.8: outside either way
+    assert outside_limits(mech, np.array([2.0, 0.5 + 2 * np.pi])) == ("p",)  # a length has no turns
