@@ -26,11 +26,7 @@ from .errors import UsageError
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
            "singular_value_ratios", "determinants"]
 
-_REFERENCES = {
-    pin.ReferenceFrame.WORLD: "world",
-    pin.ReferenceFrame.LOCAL_WORLD_ALIGNED: "local_world_aligned",
-    pin.ReferenceFrame.LOCAL: "local",
-}
+_REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
 
 
 def frame_jacobians(model, frame_id: int, Q, reference=pin.ReferenceFrame.WORLD, data=None) -> np.ndarray:
@@ -136,7 +132,7 @@ class SerialJacobians:
                 continue
             axes[k] = Ra
             points[k] = p + _apply(R, point)
-            coefficients = {"s": sines[k], "v": versines[k]}
+            coefficients = {}  # entries of Rot(a, theta) by their (I, K, K^2) weights
             new = []
             for b, terms in columns:  # column b of R Rot(a, theta) = sum_c R[c] Rot[c, b]
                 acc = None
