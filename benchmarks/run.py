@@ -191,6 +191,16 @@ def closed_loop_fk(names, solves):
             return [solver.solve(t, near=near, starts=0).solutions[0].q for t in targets]
 
         functions = {"track": ours_track, "solve": ours_solve}
+        # the same with the compiled inner loop (screwkin.compiled, numba), on its own copy of the mechanism
+        fast_mech = screwkin.load(urdf, warn=lambda m: None)
+        fast = PositionSolver(fast_mech, compiled=True)
+        if fast.compiled:
+            fast.track(targets[0], q0)  # compile (or load the compiled code from its cache) before timing
+
+            def ours_compiled():
+                return [fast.track(t, q0).q for t in targets]
+
+            functions["compiled"] = ours_compiled
         if tb is not None:
             fk, am = tb
             model = pin.buildModelFromUrdf(str(urdf))
@@ -229,9 +239,11 @@ def closed_loop_fk(names, solves):
         residuals = {k: max(float(np.linalg.norm(mech.closure.residual(q))) for q in out)
                      for k, (_, out) in timed.items()}
         row = [name, timed["track"][0] / solves, residuals["track"], timed["solve"][0] / solves, residuals["solve"],
-               None, None]
+               None, None, None, None]
         if "slsqp" in timed:
-            row[5:] = [timed["slsqp"][0] / solves, residuals["slsqp"]]
+            row[5:7] = [timed["slsqp"][0] / solves, residuals["slsqp"]]
+        if "compiled" in timed:
+            row[7:9] = [timed["compiled"][0] / solves, residuals["compiled"]]
         rows.append(row)
     return rows
 
@@ -244,11 +256,16 @@ def sweep_throughput(steps):
     rows = []
     for name, inp, rng, fixed in (("gough_stewart_6ups", "leg1", (0.0, 0.1), {f"leg{k}": 0.0 for k in range(2, 7)}),
                                   ("delta_parallelogram", "arm1", (0.0, 0.6), {"arm2": 0.0, "arm3": 0.0})):
-        mech = screwkin.load(ROOT / "robots" / f"{name}.urdf")
-        solver = PositionSolver(mech)
-        t, res = best_of(lambda: sweep(solver, inp, rng[0], rng[1], steps, fixed=fixed), 1)
-        worst = max(float(np.linalg.norm(mech.closure.residual(q))) for q in res.q[:: max(steps // 100, 1)])
-        rows.append((name, len(res.values) - 1, t, (len(res.values) - 1) / t, worst))
+        for compiled in (False, True):
+            mech = screwkin.load(ROOT / "robots" / f"{name}.urdf")
+            solver = PositionSolver(mech, compiled=compiled)
+            if compiled and not solver.compiled:
+                continue
+            label = f"{name}{', compiled' if compiled else ''}"
+            sweep(solver, inp, rng[0], rng[1], 10, fixed=fixed)  # warm up (the compiled code loads)
+            t, res = best_of(lambda: sweep(solver, inp, rng[0], rng[1], steps, fixed=fixed), 1)
+            worst = max(float(np.linalg.norm(mech.closure.residual(q))) for q in res.q[:: max(steps // 100, 1)])
+            rows.append((label, len(res.values) - 1, t, (len(res.values) - 1) / t, worst))
     return rows
 
 
@@ -308,18 +325,22 @@ def main():
     out += ["", f"screwkin 1 thread / bare Pinocchio floor: det {ours['det'] / floor:.2f}, "
             f"sigma_min {ours['sigma_min'] / floor:.2f}", ""]
     out += ["### 2. Closed-loop forward kinematics on ../shared/corpus robots (same motor targets, same assembled start)",
-            "", f"{args.solves} solves per robot, best of 3 runs.  `track`: the configuration only (checked); `solve`: "
-            "the full position analysis (joint values, singularity measure, limits).", "",
-            "| robot | screwkin track [ms] | worst residual | screwkin solve [ms] | worst residual | "
-            "toolbox-parallel-robots SLSQP [ms] | worst residual | SLSQP / track | SLSQP / solve |",
-            "|---|---|---|---|---|---|---|---|---|"]
-    for name, t1, r1, t2, r2, t3, r3 in closed_loop_fk(["5bar_linkage", "robot_delta", "cassie_like", "talos_like",
-                                                        "digit_like"], args.solves):
-        head = f"| {name} | {1e3 * t1:.3f} | {r1:.1e} | {1e3 * t2:.3f} | {r2:.1e} |"
+            "", f"{args.solves} solves per robot, best of 3 runs.  `track`: the configuration only (checked); "
+            "`track, compiled`: the same with the inner loop compiled by numba (`PositionSolver(mech, compiled=True)`); "
+            "`solve`: the full position analysis (joint values, singularity measure, limits).", "",
+            "| robot | screwkin track [ms] | worst residual | screwkin track, compiled [ms] | worst residual | "
+            "screwkin solve [ms] | worst residual | toolbox-parallel-robots SLSQP [ms] | worst residual | "
+            "SLSQP / track | SLSQP / track compiled | SLSQP / solve |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, t1, r1, t2, r2, t3, r3, t4, r4 in closed_loop_fk(["5bar_linkage", "robot_delta", "cassie_like",
+                                                                "talos_like", "digit_like"], args.solves):
+        comp = f"{1e3 * t4:.3f} | {r4:.1e}" if t4 is not None else "numba not installed | -"
+        head = f"| {name} | {1e3 * t1:.3f} | {r1:.1e} | {comp} | {1e3 * t2:.3f} | {r2:.1e} |"
         if t3 is None:
-            out.append(head + " not installed | - | - | - |")
+            out.append(head + " not installed | - | - | - | - |")
         else:
-            out.append(head + f" {1e3 * t3:.3f} | {r3:.1e} | {t3 / t1:.1f}x | {t3 / t2:.1f}x |")
+            fast = f"{t3 / t4:.1f}x" if t4 is not None else "-"
+            out.append(head + f" {1e3 * t3:.3f} | {r3:.1e} | {t3 / t1:.1f}x | {fast} | {t3 / t2:.1f}x |")
     out += ["", "Residual: norm of screwkin's minimal closure rows at the returned configuration, the same metric for "
             "both.", ""]
     out += [f"### 3. Sweep throughput ({args.steps} steps, rates at every step)", "",

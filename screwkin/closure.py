@@ -78,6 +78,23 @@ def _skews_batch(U, m=None):
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
 
 
+def _damped_step(K, r, free, mu):
+    """Minimum-norm damped (Levenberg-Marquardt) step on the free columns of K:
+    dq_f = -K_f^T (K_f K_f^T + lambda I)^-1 r with lambda = mu * trace / rows, and the
+    squared residual of the linear model |r + K_f dq_f|^2."""
+    Kf = K[:, free]
+    A = Kf @ Kf.T
+    diagonal = A.ravel()[:: len(A) + 1]  # a view
+    diagonal += mu * max(diagonal.sum() / len(A), 1e-12)
+    try:
+        y = np.linalg.solve(A, r)
+    except np.linalg.LinAlgError:  # singular in floating point
+        y = np.linalg.lstsq(A, r, rcond=None)[0]
+    dqf = -(Kf.T @ y)
+    lin = r + Kf @ dqf
+    return dqf, float(lin @ lin)
+
+
 def perpendicular_basis(a):
     """Two unit vectors completing the unit vector ``a`` to a right-handed basis."""
     a = np.asarray(a, float)
@@ -136,6 +153,7 @@ class ClosureSystem:
         self.nrows = sum(c.rows for c in self.cuts)
         self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
         self._solver_rows = None
+        self._compiled = None  # (kernels, cut kinds, buffers) when accelerate() is on
         self._free = {}  # free velocity indices for each set of frozen ones
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         # Pinocchio hands out its frame placements by reference and their rotation and
@@ -146,6 +164,51 @@ class ClosureSystem:
             M1, M2 = self.data.oMf[c.frame1], self.data.oMf[c.frame2]
             self._placements.append((M1.rotation, M2.rotation, M1.translation, M2.translation))
         self._groups = self._group()
+
+    # ------------------------------------------------------------------ compiled inner loop
+    def accelerate(self, on: bool = True) -> bool:
+        """Solve with the compiled kernels of screwkin.compiled (numba) when it is installed
+        and every cut joint is fixed or spherical; returns whether they are in use."""
+        from . import compiled
+
+        self._compiled = None
+        kinds = compiled.kinds_of(self.cuts) if on else None
+        if kinds is not None and compiled.available():
+            n, nv = len(self.cuts), self.model.nv
+            buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+                       np.empty((n, 6, nv)), np.empty((n, 6, nv)))
+            self._compiled = (compiled.kernels(), kinds, buffers)
+        return self._compiled is not None
+
+    @property
+    def accelerated(self) -> bool:
+        return self._compiled is not None
+
+    def _evaluate_compiled(self, q, jacobian: bool = True):
+        """evaluate(q, jacobian, solver=True) through the compiled kernel (same rows)."""
+        kernels, kinds, (R1, R2, t1, t2, J1, J2) = self._compiled
+        model, data = self.model, self.data
+        if jacobian:
+            pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacements(model, data)
+        else:
+            pin.framesForwardKinematics(model, data, q)
+        for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, self._placements)):
+            R1[j], R2[j], t1[j], t2[j] = a, b, c, d
+            if jacobian:
+                J1[j] = frame_jacobian(model, data, cut.frame1, LWA)
+                J2[j] = frame_jacobian(model, data, cut.frame2, LWA)
+        nrows = self._rows(True)
+        r = np.empty(nrows)
+        K = np.empty((nrows, model.nv)) if jacobian else np.empty((0, model.nv))
+        kernels.cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian)
+        return r, (K if jacobian else None)
+
+    def _step_compiled(self, K, r, free, mu):
+        try:
+            return self._compiled[0].damped_step(K, r, free, mu)
+        except Exception:  # singular in floating point: the numpy step has the least-squares fallback
+            return _damped_step(K, r, free, mu)
 
     # ------------------------------------------------------------------ residual
     def _rows(self, solver: bool) -> int:
@@ -437,7 +500,9 @@ class ClosureSystem:
         free = self._free.get(frozen)
         if free is None:
             free = self._free[frozen] = np.setdiff1d(np.arange(model.nv), np.asarray(frozen, int))
-        r, K = self.evaluate(q, solver=True)
+        evaluate, step = (self._evaluate_compiled, self._step_compiled) if self._compiled else \
+            (lambda q_, jacobian=True: self.evaluate(q_, jacobian, solver=True), _damped_step)
+        r, K = evaluate(q)
         last = q  # the configuration whose placements are in self.data
         norm = float(np.sqrt(r @ r))
         best = norm
@@ -448,33 +513,23 @@ class ClosureSystem:
             if norm < tol.closure:
                 break
             it += 1
-            Kf = K[:, free]
-            A = Kf @ Kf.T
-            diagonal = A.ravel()[:: len(A) + 1]  # a view
-            diagonal += mu * max(diagonal.sum() / len(A), 1e-12)
-            try:
-                y = np.linalg.solve(A, r)
-            except np.linalg.LinAlgError:  # singular in floating point
-                y = np.linalg.lstsq(A, r, rcond=None)[0]
-            dq[:] = 0.0
-            dq[free] = -(Kf.T @ y)
+            dq[free], lin2 = step(K, r, free, mu)
             q_new = pin.integrate(model, q, dq)
             # the Jacobian comes with the residual (one Pinocchio pass): most steps are accepted;
             # when Newton is about to converge (quadratically: the next residual near norm^2) the
             # residual alone is computed first, as the Jacobian there is not needed
             final = norm < 0.1 * np.sqrt(tol.closure)
-            r_new, K_new = self.evaluate(q_new, jacobian=not final, solver=True)
+            r_new, K_new = evaluate(q_new, jacobian=not final)
             last = q_new
             n_new = float(np.sqrt(r_new @ r_new))
             if final and tol.closure <= n_new < norm:
-                r_new, K_new = self.evaluate(q_new, solver=True)
+                r_new, K_new = evaluate(q_new)
             accepted = n_new < norm
             if trace is not None:
                 trace(it, q, r, K, dq.copy(), accepted)
             if accepted:
                 # Nielsen's damping update from the gain ratio (actual / predicted decrease)
-                lin = r + Kf @ dq[free]
-                predicted = norm**2 - float(lin @ lin)
+                predicted = norm**2 - lin2
                 rho = (norm**2 - n_new**2) / predicted if predicted > 0 else 0.0
                 mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
                 nu = 2.0

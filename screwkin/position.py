@@ -110,8 +110,14 @@ class PositionSolver:
     """Solves a mechanism for given input joints; reuses the model and data
     between calls (build once, solve many times)."""
 
-    def __init__(self, mech, input_joints=None, output=None):
+    def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None):
+        """compiled: True to solve the closure equations with the compiled kernels of
+        screwkin.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
+        joints are all fixed or spherical, False for numpy, None to leave the mechanism's
+        setting; ``self.compiled`` says which is used."""
         self.mech = mech
+        if compiled is not None:
+            mech.closure.accelerate(compiled)
         self.model = mech.model
         self.data = mech.model.createData()
         names = list(input_joints) if input_joints else list(mech.actuated)
@@ -156,6 +162,11 @@ class PositionSolver:
         self._value_layout = (single, continuous, multi)
         self._single_idx = np.array([i for _, i in single], int)
         self._single_wrap = np.isin(self._single_idx, self._revolute)
+
+    @property
+    def compiled(self) -> bool:
+        """Whether the closure equations are solved by the compiled kernels."""
+        return self.mech.closure.accelerated
 
     # --------------------------------------------------------------- coordinates
     def _angle_coordinates(self):
