@@ -2,16 +2,16 @@
 
 A damped-Newton iteration on a mechanism with welded (fixed) and spherical cut
 joints -- the 6d and 3d closures of Extended-URDF files -- costs about 38 us in
-numpy, of which Pinocchio's own calls are 3 us: the rest is the overhead of
-numpy calls on 3-vectors.  Here the rows, their Jacobian and the damped step are
+numpy for one weld, of which Pinocchio's own calls are 3 us: the rest is the
+overhead of numpy calls on 3-vectors.  Here the rows, their Jacobian and the damped step are
 loops compiled by numba (cached on disk after the first use): the same numbers
 as ``ClosureSystem.evaluate(q, solver=True)`` and the numpy step (tests check
-both), about three times faster per solve.  Pinocchio still computes every
+both), about 2.5 times faster per solve (benchmarks/README.md).  Pinocchio still computes every
 placement and frame Jacobian.
 
 Used only when asked (``PositionSolver(mech, compiled=True)`` or
 ``mech.closure.accelerate()``): importing numba costs about 0.25 s and the first
-use compiles for a few seconds, which a single command would not win back.
+use compiles for about 8 s, which a single command would not win back.
 """
 
 from __future__ import annotations
