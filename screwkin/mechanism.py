@@ -8,7 +8,10 @@ mobility, and later position, velocity and singularity analysis) work on it.
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -256,6 +259,37 @@ class Mechanism:
                 f"{len(self.coordinates)} moving tree joints, {len(self.cuts)} cut joints)")
 
 
+@contextmanager
+def _native_stderr(box: list):
+    """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no usable stderr: nothing to keep quiet
+        yield
+        return
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            box.append(tmp.read().decode("utf-8", "replace"))
+
+
+def _urdfdom_messages(box: list) -> list:
+    """(level, message) of console_bridge lines such as 'Error:   Joint [j] is ...' (the
+    'at line N in file.cpp' lines that follow them are dropped)."""
+    out = []
+    for line in "".join(box).splitlines():
+        level, sep, message = line.partition(":")
+        if sep and level.strip() in ("Error", "Warning", "Info", "Debug") and message.strip():
+            out.append((level.strip(), message.strip()))
+    return out
+
+
 def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None) -> Mechanism:
     """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, or SDF).
 
@@ -272,11 +306,17 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         spec = read_sdf(path, text)
     else:
         spec = read_urdf(path, text)
+    native = []  # what urdfdom (inside Pinocchio) prints on the process's stderr: kept out of the output
     try:
-        model = pin.buildModelFromXML(spec.urdf_text)
+        with _native_stderr(native):
+            model = pin.buildModelFromXML(spec.urdf_text)
     except (ValueError, RuntimeError) as exc:
         first = str(exc).strip().splitlines()[-1].strip() if str(exc).strip() else type(exc).__name__
+        reasons = [m for level, m in _urdfdom_messages(native) if level == "Error"]
+        if reasons:  # urdfdom's first complaint says more than Pinocchio's summary
+            first = reasons[0]
         raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {first}") from None
+    spec.warnings.extend(f"URDF parser: {m}" for level, m in _urdfdom_messages(native) if level != "Error")
     if yaml is None and spec.format == "urdf":
         yaml = _find_sidecar(path)
     if yaml is not None:

@@ -191,3 +191,15 @@ def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatc
     check(capsys, ["mobility", path], 3, "internal error", "ValueError", "--debug", path=path)
     with pytest.raises(ValueError):
         main(["mobility", path, "--debug"])
+
+
+def test_urdf_parser_complaints_become_the_one_line(tmp_path, capfd):
+    """urdfdom (inside Pinocchio) prints its reasons on the process's stderr; they are kept
+    out of the output and the first one names the problem in screwkin's line."""
+    path = write(tmp_path, '<robot name="s"><link name="a"/><link name="b"/><joint name="j" type="prismatic">'
+                           '<parent link="a"/><child link="b"/><axis xyz="1 0 0"/></joint></robot>')
+    assert main(["mobility", path]) == 1
+    err = capfd.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert path in lines[0] and "PRISMATIC without limits" in lines[0]
