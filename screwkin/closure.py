@@ -188,11 +188,7 @@ class ClosureSystem:
         """evaluate(q, jacobian, solver=True) through the compiled kernel (same rows)."""
         kernels, kinds, (R1, R2, t1, t2, J1, J2) = self._compiled
         model, data = self.model, self.data
-        if jacobian:
-            pin.computeJointJacobians(model, data, q)
-            pin.updateFramePlacements(model, data)
-        else:
-            pin.framesForwardKinematics(model, data, q)
+        self._kinematics(q, jacobian)
         for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, self._placements)):
             R1[j], R2[j], t1[j], t2[j] = a, b, c, d
             if jacobian:
@@ -209,6 +205,14 @@ class ClosureSystem:
             return self._compiled[0].damped_step(K, r, free, mu)
         except Exception:  # singular in floating point: the numpy step has the least-squares fallback
             return _damped_step(K, r, free, mu)
+
+    def _kinematics(self, q, jacobian: bool):
+        """Pinocchio's pass for q: frame placements, and the joint Jacobians if asked."""
+        if jacobian:
+            pin.computeJointJacobians(self.model, self.data, q)
+            pin.updateFramePlacements(self.model, self.data)
+        else:
+            pin.framesForwardKinematics(self.model, self.data, q)
 
     # ------------------------------------------------------------------ residual
     def _rows(self, solver: bool) -> int:
@@ -304,11 +308,7 @@ class ClosureSystem:
         then (solver) R2 v - R1 v, or (minimal) log3(R1^T R2) or alignments u . w.
         """
         model, data = self.model, self.data
-        if jacobian:
-            pin.computeJointJacobians(model, data, q)
-            pin.updateFramePlacements(model, data)
-        else:
-            pin.framesForwardKinematics(model, data, q)
+        self._kinematics(q, jacobian)
         nrows = self._rows(solver)
         r = np.empty(nrows)
         K = np.empty((nrows, model.nv)) if jacobian else None
