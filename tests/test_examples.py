@@ -52,3 +52,13 @@ def test_readme_python_blocks_run(monkeypatch, capsys):
     assert out.splitlines()[0] == "9 6 3T"  # mobility, idle DOFs, output motion of the Delta
     assert namespace["d"].shape == (100000,) and namespace["J"].shape == (100000, 6, 6)
     assert namespace["q"].shape == (namespace["mech"].model.nq,)
+
+
+def test_stewart_motor_loop():
+    import re
+
+    out = run("stewart_motor_loop.py", "100")
+    worst = [float(x) for x in re.findall(r"worst closure residual ([0-9.e+-]+)", out)]
+    assert worst and max(worst) < 1e-10
+    same = re.search(r"same path to ([0-9.e+-]+) m", out)
+    assert same is None or float(same.group(1)) < 1e-12
