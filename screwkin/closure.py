@@ -219,7 +219,7 @@ class ClosureSystem:
         if not solver:
             return self.nrows
         if self._solver_rows is None:
-            self._solver_rows = sum(self._cut_rows(c, True) for c in self.cuts)
+            self._solver_rows = sum(self._cut_rows(c, plan, True) for c, plan in zip(self.cuts, self._plans))
         return self._solver_rows
 
     def _plan(self, cut, b1, b2):
@@ -264,7 +264,7 @@ class ClosureSystem:
             g["V"].append(vectors)
             g["rotation"] = rotation
             for solver in (False, True):
-                n = self._cut_rows(cut, solver)
+                n = self._cut_rows(cut, self._plans[c], solver)
                 g["rows"][solver].append(np.arange(offsets[solver], offsets[solver] + n))
                 offsets[solver] += n
         out = []
@@ -288,11 +288,13 @@ class ClosureSystem:
         return out
 
     @staticmethod
-    def _cut_rows(cut, solver):
+    def _cut_rows(cut, plan, solver):
+        """Rows of one cut joint: 6 - dof minimal ones, or the solver's (positions, then three
+        per shared vector, or the alignments of a universal joint), read from its plan."""
         if not solver:
             return cut.rows
-        extra = {"fixed": 6, "prismatic": 6, "revolute": 1, "continuous": 1, "cylindrical": 1, "planar": 1}
-        return cut.rows + extra.get(cut.type, 0)
+        P, pairs, vectors, _ = plan
+        return len(P) + (len(pairs) if vectors is None else 3 * len(vectors))
 
     def evaluate(self, q, jacobian: bool = True, solver: bool = False):
         """Residual r(q) and, if asked, its Jacobian (rows x nv).

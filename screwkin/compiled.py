@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["available", "kernels", "SPHERICAL", "FIXED"]
+__all__ = ["available", "kernels", "kinds_of", "SPHERICAL", "FIXED"]
 
 SPHERICAL, FIXED = 0, 1  # the cut joint types the kernels know (3 and 12 solver rows)
 _KERNELS = None

@@ -397,8 +397,8 @@ class PositionSolver:
         qd = np.zeros(self.mech.nv)
         qd[self.frozen] = self._input_vector(values)
         if K.size:
-            b = K[:, self.frozen] @ qd[self.frozen]
-            qd[self.passive] = -(solve(b) if solve else np.linalg.lstsq(K[:, self.passive], b, rcond=None)[0])
+            solve = solve or self.passive_solver(K)[0]
+            qd[self.passive] = -solve(K[:, self.frozen] @ qd[self.frozen])
         return qd
 
     def accelerations(self, q, K, qd, values: dict, solve=None):
@@ -407,8 +407,8 @@ class PositionSolver:
         qdd[self.frozen] = self._input_vector(values)
         if K.size:
             bias = self.mech.closure.bias(q, qd)
-            rhs = -(K[:, self.frozen] @ qdd[self.frozen] + bias)
-            qdd[self.passive] = solve(rhs) if solve else np.linalg.lstsq(K[:, self.passive], rhs, rcond=None)[0]
+            solve = solve or self.passive_solver(K)[0]
+            qdd[self.passive] = solve(-(K[:, self.frozen] @ qdd[self.frozen] + bias))
         return qdd
 
 
