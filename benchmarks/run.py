@@ -138,7 +138,7 @@ def serial_scan(n):
 # ---------------------------------------------------------------- 2. closed-loop forward kinematics
 def _toolbox():
     """toolbox-parallel-robots without its package __init__ (which needs pinocchio.casadi,
-    absent from the PyPI wheel): the recipe of ../shared/peers.md."""
+    absent from the PyPI wheel): see benchmarks/README.md."""
     import importlib
     import importlib.util
     import types
@@ -169,7 +169,7 @@ def closed_loop_fk(names, solves):
 
     tb = _toolbox()
     rows = []
-    corpus = ROOT.parent / "shared" / "corpus" / "example-parallel-robots"
+    corpus = ROOT / "robots" / "corpus" / "example-parallel-robots"
     for name in names:
         urdf, side = corpus / name / "robot.urdf", corpus / name / "robot.yaml"
         mech = screwkin.load(urdf, warn=lambda m: None)
@@ -324,7 +324,7 @@ def main():
         out.append(f"| {tool} | {m} | {1e6 * t / args.configs:.2f} | {ratio} | {'-' if err is None else f'{err:.1e}'} |")
     out += ["", f"screwkin 1 thread / bare Pinocchio floor: det {ours['det'] / floor:.2f}, "
             f"sigma_min {ours['sigma_min'] / floor:.2f}", ""]
-    out += ["### 2. Closed-loop forward kinematics on ../shared/corpus robots (same motor targets, same assembled start)",
+    out += ["### 2. Closed-loop forward kinematics on the corpus robots (robots/corpus/) (same motor targets, same assembled start)",
             "", f"{args.solves} solves per robot, best of 3 runs.  `track`: the configuration only (checked); "
             "`track, compiled`: the same with the inner loop compiled by numba (`PositionSolver(mech, compiled=True)`); "
             "`solve`: the full position analysis (joint values, singularity measure, limits).", "",

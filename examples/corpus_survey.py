@@ -1,7 +1,7 @@
 """Survey the mobility of every closed-loop leg in the example-parallel-robots corpus.
 
 Run:  python examples/corpus_survey.py [FOLDER]
-FOLDER defaults to ../shared/corpus/example-parallel-robots next to this checkout.
+FOLDER defaults to robots/corpus/example-parallel-robots (bundled with screwkin).
 
 For each robot it prints the Kutzbach count, the screw-theory mobility (rank of
 the loop-closure constraint Jacobian), the idle DOFs and how the motors relate
@@ -14,11 +14,14 @@ from pathlib import Path
 import screwkin
 from screwkin.report import table
 
-default = Path(__file__).resolve().parents[2] / "shared" / "corpus" / "example-parallel-robots"
+default = Path(__file__).resolve().parents[1] / "robots" / "corpus" / "example-parallel-robots"
 folder = Path(sys.argv[1]) if len(sys.argv) > 1 else default
 
+urdfs = sorted(folder.glob("*/robot.urdf"))
+if not urdfs:
+    sys.exit(f"no */robot.urdf in {folder}")
 rows = []
-for urdf in sorted(folder.glob("*/robot.urdf")):
+for urdf in urdfs:
     mech = screwkin.load(urdf, warn=lambda message: None)  # their meshes are not shipped
     try:
         r = mech.mobility()

@@ -6,7 +6,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 ROBOTS = ROOT / "robots"
 DATA = Path(__file__).resolve().parent / "data"
-CORPUS = ROOT.parent / "shared" / "corpus" / "example-parallel-robots"
+CORPUS = ROBOTS / "corpus" / "example-parallel-robots"  # vendored, BSD-3-Clause (its LICENSE is beside it)
 
 
 @pytest.fixture
