@@ -58,7 +58,7 @@ class SerialJacobians:
 
         if reference not in _REFERENCES:
             raise UsageError(f"unknown reference frame {reference}")
-        self.model, self.reference, self.block = mech.model, reference, int(block)
+        self.mech, self.model, self.reference, self.block = mech, mech.model, reference, int(block)
         self.frame = mech.link_frame(link)
         chain = next(c for c in chains(mech, output=link) if c.name == f"output {link}")
         self.chain = chain
@@ -192,17 +192,23 @@ class SerialJacobians:
         return np.concatenate([self._block(np.ascontiguousarray(th[:, s:s + self.block]))
                                for s in range(0, len(Q), self.block)]) if len(Q) else np.empty((0, 6, len(th)))
 
-    def measures(self, Q, measure: str = "sigma_min", scale_translation: float = 1.0, workers: int = 1,
-                 method: str = "svd") -> np.ndarray:
+    def measures(self, Q, measure: str = "sigma_min", scale_translation: float | None = None, workers: int = 1,
+                 method: str = "svd", point: bool = False) -> np.ndarray:
         """(N,) a singularity measure of the chain Jacobian at each configuration of Q (N, nq),
         block by block (the Jacobians of all N are never held at once).
 
-        measure: "sigma_min" (smallest singular value, translations divided by
-        ``scale_translation`` [m]), "sigma_ratio" (smallest over largest) or "det"
-        (determinant; square Jacobians only, frame-independent).
+        measure: "sigma_min" (smallest singular value), "sigma_ratio" (smallest over largest)
+        or "det" (determinant; square Jacobians only, frame-independent).  For the singular
+        values the Jacobian is made dimensionless as everywhere in screwkin: translations
+        divided by ``scale_translation`` [m] (default: the mechanism's characteristic length
+        ``Mechanism.length``), the columns of sliding joints multiplied by it.
+        point: the frame origin as a point: only the 3 translation rows.
         method: see ``smallest_singular_values``.
         workers: threads, each taking whole blocks (numpy releases the GIL in its loops).
         """
+        scale = float(scale_translation) if scale_translation else self.mech.length
+        slide = np.array([kind == "P" for kind, *_ in self._joints], bool)
+        slide = slide if slide.any() else None
         if measure not in ("sigma_min", "sigma_ratio", "det"):
             raise UsageError(f"unknown measure '{measure}': sigma_min, sigma_ratio or det")
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -218,12 +224,14 @@ class SerialJacobians:
         def run(start):
             stop = min(start + self.block, len(Q))
             J = self._block(np.ascontiguousarray(th[:, start:stop]))
+            if point:
+                J = J[:, :3]
             if measure == "det":
                 out[start:stop] = np.linalg.det(J)
             elif measure == "sigma_ratio":
-                out[start:stop] = singular_value_ratios(J, scale_translation, method=method)
+                out[start:stop] = singular_value_ratios(J, scale, method=method, slide=slide)
             else:
-                out[start:stop] = smallest_singular_values(J, scale_translation, method=method)
+                out[start:stop] = smallest_singular_values(J, scale, method=method, slide=slide)
 
         starts = range(0, len(Q), self.block)
         if workers > 1 and len(starts) > 1:
@@ -266,31 +274,34 @@ def singular_values(J) -> np.ndarray:
     return np.linalg.svd(np.asarray(J), compute_uv=False)
 
 
-def smallest_singular_values(J, scale_translation: float = 1.0, method: str = "svd") -> np.ndarray:
+def smallest_singular_values(J, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
     """(N,) smallest singular value of each Jacobian in the stack, translations divided by a
-    characteristic length ``scale_translation`` [m] so that the values are dimensionless.
+    characteristic length ``scale_translation`` [m] (and the columns of sliding joints, the
+    mask ``slide``, multiplied by it) so that the values are dimensionless.
 
     method "svd": singular values of each matrix (LAPACK gesdd).  method "gram": the
     smallest eigenvalue of J^T J (symmetric eigensolver, about twice as fast), where
     sigma_min >= 1e-3 sigma_max; its relative error there is at most about
     eps (sigma_max / sigma_min)^2 < 1e-9; matrices closer to singular take the SVD.
     """
-    return _extreme_singular_values(J, scale_translation, method)[0]
+    return _extreme_singular_values(J, scale_translation, method, slide)[0]
 
 
-def singular_value_ratios(J, scale_translation: float = 1.0, method: str = "svd") -> np.ndarray:
+def singular_value_ratios(J, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
     """(N,) smallest over largest singular value of each Jacobian (translations divided by
-    ``scale_translation``); methods as ``smallest_singular_values``."""
-    low, high = _extreme_singular_values(J, scale_translation, method)
+    ``scale_translation``, see ``smallest_singular_values``); methods as there."""
+    low, high = _extreme_singular_values(J, scale_translation, method, slide)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(high > 0, low / high, 0.0)
 
 
-def _extreme_singular_values(J, scale_translation, method):
+def _extreme_singular_values(J, scale_translation, method, slide=None):
     J = np.array(J, float)
     if J.ndim != 3:
         raise ValueError(f"expected a stack of matrices (N, m, n), got shape {J.shape}")
     J[:, :3, :] /= scale_translation
+    if slide is not None:
+        J[:, :, slide] *= scale_translation
     if method == "svd":
         s = singular_values(J)
         return s[:, -1], s[:, 0]

@@ -40,23 +40,42 @@ def _parser():
 
     def at_configuration(sp):
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+        angles(sp)
         sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+
+    def angles(sp):
+        sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE",
+                        help="planar mechanisms: an input given as the absolute angle of a link pinned to the "
+                             "ground, from the ground's x axis (e.g. crank=45deg)")
+
+    def scaled(sp, point=True):
+        sp.add_argument("--length", help="characteristic length that makes the measures dimensionless "
+                                         "(default: the mean link length; printed with every measure)")
+        if point:
+            sp.add_argument("--point", action="store_true",
+                            help="analyse the output link's origin as a point (3 translations) instead of its "
+                                 "full motion")
 
     m = sub.add_parser("mobility", help="degrees of freedom: counts and screw-theory mobility")
     common(m)
     m.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
+    m.add_argument("--point", action="store_true", help="the output link's origin as a point (3 translations)")
     i = sub.add_parser("info", help="topology table: links, joints, loops")
     common(i)
     s = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(s)
-    s.add_argument("--set", action="append", metavar="NAME=VALUE", required=True,
+    s.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="input joint value, SI or with a unit (45deg, 30mm); repeat or comma-separate")
+    angles(s)
+    s.add_argument("--all", action="store_true",
+                   help="show every assembly mode, also those the mechanism cannot reach by moving")
     s.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
     s.add_argument("--output", help="link whose pose (and twist) to report")
     s.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input joint rate [1/s] (units as --set)")
     s.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
+    scaled(s, point=False)
     c = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
     common(c)
     at_configuration(c)
@@ -65,8 +84,7 @@ def _parser():
     common(g)
     at_configuration(g)
     g.add_argument("--output", help="output link (for serial singularities and the output twist)")
-    g.add_argument("--length", help="characteristic length for mixed translation/rotation measures "
-                                    "(default: RMS spread of the joint centres)")
+    scaled(g)
     mp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
     common(mp)
     mp.add_argument("--x", required=True, metavar="NAME=A:B:N", help="first input, from A to B in N values")
@@ -75,6 +93,7 @@ def _parser():
     mp.add_argument("--output", help="output link (serial singularities)")
     mp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
     mp.add_argument("--csv", help="the map's data as CSV")
+    scaled(mp)
     sc = sub.add_parser("scan", help="singularity scan of a serial chain over random configurations")
     common(sc)
     sc.add_argument("--output", required=True, help="the chain's last link (e.g. the flange)")
@@ -82,8 +101,7 @@ def _parser():
     sc.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     sc.add_argument("--measure", choices=["sigma_ratio", "det"], default="sigma_ratio",
                     help="smallest / largest singular value (default) or the determinant (6 joints)")
-    sc.add_argument("--length", help="characteristic length for sigma_ratio (default: RMS spread of the joint "
-                                     "centres)")
+    scaled(sc)
     sc.add_argument("--threads", type=int, help="threads (default: the machine's cores)")
     sc.add_argument("--csv", help="write every sample (joint values and the measure) to this CSV file")
     v = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
@@ -93,11 +111,14 @@ def _parser():
     v.add_argument("--sweep", metavar="NAME=A:B:N", help="animate the motion of one input (other inputs from --set)")
     v.add_argument("--html", help="write a self-contained static HTML page of the scene and exit")
     v.add_argument("--png", help="write a picture of the scene (headless Chromium) and exit")
+    scaled(v, point=False)
     k = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(k)
     k.add_argument("--output", required=True, help="the link to place")
     k.add_argument("--pose", required=True, help='"x y z roll pitch yaw" (m and rad; units allowed, e.g. 30deg)')
     k.add_argument("--starts", type=int, default=16, help="random starting configurations (default 16)")
+    k.add_argument("--all", action="store_true",
+                   help="show every assembly mode, also those the mechanism cannot reach by moving")
     w = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(w)
     w.add_argument("--input", required=True, help="the input joint to move")
@@ -113,6 +134,10 @@ def _parser():
     w.add_argument("--singularities", action="store_true",
                    help="locate the singular input values along the motion (refined to 1e-9)")
     w.add_argument("--output", help="output link (serial singularities)")
+    w.add_argument("--turn", action="store_true",
+                   help="pass through limit positions onto the other branch (the input runs back) until the "
+                        "mechanism returns to its start or the input reaches --to")
+    scaled(w)
     return p
 
 
@@ -121,6 +146,10 @@ def _run(args):
     from .report import mobility_dict, mobility_text, to_jsonable, topology_dict, topology_text
 
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)))
+    if getattr(args, "length", None):
+        from .units import parse_value
+
+        mech.length = parse_value(args.length)
     if args.command == "info":
         try:
             q = mech.assemble().q
@@ -144,7 +173,9 @@ def _run(args):
                 "singularities": _singularities, "map": _map, "view": _view, "scan": _scan}
     if args.command in handlers:
         return handlers[args.command](mech, args)
-    result = mech.mobility(output=args.output)
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
+    result = mech.mobility(output=args.output, point=args.point)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
     else:
@@ -157,7 +188,9 @@ def _solve(mech, args):
     from .report import position_dict, position_text, to_jsonable, trace_text
     from .units import parse_assignments
 
-    values = parse_assignments(args.set, "--set")
+    values = _inputs(mech, args)
+    if not values:
+        raise UsageError("solve needs input values: --set NAME=VALUE or --set-angle LINK=ANGLE")
     near = parse_assignments([args.near], "--near") if args.near else None
     rates = parse_assignments(args.rate, "--rate") if args.rate or args.accel else None
     accels = parse_assignments(args.accel, "--accel") if args.accel else None
@@ -166,14 +199,35 @@ def _solve(mech, args):
     solver = PositionSolver(mech, list(values), output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace)
     if args.json:
-        print(json.dumps(to_jsonable(position_dict(res)), indent=2))
+        d = position_dict(res)
+        d["characteristic_length"] = mech.length
+        print(json.dumps(to_jsonable(d), indent=2))
         return 0
     if args.trace:
         names = [mech.coordinate_names[k] for k in solver.passive]
         print(trace_text(res, mech.closure.row_labels(solver=True), names))
         print()
-    print(position_text(res))
+    print(position_text(res, show_all=args.all, length=mech.length))
     return 0
+
+
+def _inputs(mech, args) -> dict:
+    """Input values from --set (joint values) and --set-angle (absolute link angles)."""
+    from .units import parse_assignments
+
+    values = parse_assignments(getattr(args, "set", None), "--set")
+    angles = parse_assignments(getattr(args, "set_angle", None), "--set-angle")
+    if angles:
+        from .planar import LinkAngles
+
+        q = mech.generic_configurations()[1][0]
+        link_angles = LinkAngles(mech, mech.topology(q))
+        for link, angle in angles.items():
+            joint, value = link_angles.joint_value(link, angle)
+            if joint in values:
+                raise UsageError(f"joint '{joint}' is given twice (--set and --set-angle {link})")
+            values[joint] = value
+    return values
 
 
 def _configuration(mech, args):
@@ -181,10 +235,10 @@ def _configuration(mech, args):
     from .position import PositionSolver
     from .units import parse_assignments
 
-    values = parse_assignments(getattr(args, "set", None), "--set")
+    values = _inputs(mech, args)
     near = parse_assignments([args.near], "--near") if getattr(args, "near", None) else None
     if not values:
-        return mech.assemble().q
+        return mech.generic_configurations()[0].q
     res = PositionSolver(mech, list(values)).solve(values, near=near)
     return res.solutions[0].q
 
@@ -209,10 +263,11 @@ def _screws(mech, args):
 def _singularities(mech, args):
     from .report import singularity_text, to_jsonable
     from .singular import classify
-    from .units import parse_value
 
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
     q = _configuration(mech, args)
-    rep = classify(mech, q, output=args.output, length=parse_value(args.length) if args.length else None)
+    rep = classify(mech, q, output=args.output, point=args.point)
     if args.json:
         print(json.dumps(to_jsonable(rep.to_dict()), indent=2))
     else:
@@ -248,7 +303,9 @@ def _map(mech, args):
     yn, ys = _range(args.y, "--y")
     fixed = parse_assignments(args.set, "--set")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
-    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output)
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
+    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output, args.point)
     if args.png:
         res.png(args.png)
     if args.csv:
@@ -256,13 +313,14 @@ def _map(mech, args):
             f.write(res.csv())
     if args.json:
         print(json.dumps(to_jsonable({"x": xn, "y": yn, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
-                                      "kind": res.kind}), indent=2))
+                                      "kind": res.kind, "characteristic_length": mech.length}), indent=2))
     else:
         import numpy as np
 
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
-              f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g}" if finite.size else "no point assembled")
+              f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g} (L = {mech.length:.4g} m)"
+              if finite.size else "no point assembled")
     return 0
 
 
@@ -271,11 +329,9 @@ def _scan(mech, args):
 
     from .report import to_jsonable
     from .scan import scan
-    from .units import parse_value
 
     t = time.perf_counter()
-    res = scan(mech, args.output, args.samples, args.seed, args.measure,
-               parse_value(args.length) if args.length else None, args.threads)
+    res = scan(mech, args.output, args.samples, args.seed, args.measure, None, args.threads, point=args.point)
     elapsed = time.perf_counter() - t
     if args.csv:
         with open(args.csv, "w") as f:
@@ -284,8 +340,9 @@ def _scan(mech, args):
     if args.json:
         print(json.dumps(to_jsonable({"file": mech.path, **d, "seconds": elapsed}), indent=2))
         return 0
-    what = ("smallest / largest singular value of the output Jacobian (v / L, w), "
-            f"L = {res.length:.4g} m" if res.measure == "sigma_ratio" else "determinant of the output Jacobian (v, w)")
+    what = (("smallest / largest singular value of the output origin's velocity Jacobian (a point)"
+             if res.point else "smallest / largest singular value of the output Jacobian (v / L, w)")
+            + f", L = {res.length:.4g} m" if res.measure == "sigma_ratio" else "determinant of the output Jacobian (v, w)")
     worst = ", ".join(f"{n}={v:.6g}" for n, v in d["min_configuration"].items())
     p = d["percentiles"]
     print(f"scan of {mech.path}, chain to '{res.output}' ({len(res.joints)} joints): {res.samples} random "
@@ -368,19 +425,18 @@ def _ik(mech, args):
     else:
         print(f"inverse kinematics of '{args.output}' at x y z = {v[0]:.6g} {v[1]:.6g} {v[2]:.6g} m, "
               f"roll pitch yaw = {v[3]:.6g} {v[4]:.6g} {v[5]:.6g} rad")
+        shown = list(res.solutions) if args.all else list(res.physical) or list(res.solutions)
         if mech.actuated:
-            for k, s in enumerate(res.solutions, 1):
+            for k, s in enumerate(shown, 1):
                 print(f"solution {k} actuated: " + ", ".join(f"{n} = {s.joints[n]:.9g}" for n in mech.actuated))
-        print(position_text(res).split("\n", 1)[1])
+        print(position_text(res, show_all=args.all).split("\n", 1)[1])
     return 0
 
 
 def _sweep(mech, args):
-    import numpy as np
-
     from .planar import identify
     from .position import PositionSolver
-    from .report import sweep_text, to_jsonable
+    from .report import sweep_text, to_jsonable, value_text
     from .sweep import sweep
     from .units import parse_assignments, parse_value
 
@@ -388,18 +444,20 @@ def _sweep(mech, args):
     inputs = _names(args.inputs) or (list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
     solver = PositionSolver(mech, inputs)
     near = parse_assignments([args.near], "--near") if args.near else None
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
     res = sweep(solver, args.input, parse_value(args.start), parse_value(args.stop), args.steps,
                 fixed={k: v for k, v in fixed.items() if k != args.input}, near=near,
-                rate=parse_value(args.rate), progress=True)
+                rate=parse_value(args.rate), progress=True, turn=args.turn)
     info = identify(mech, mech.topology(res.q[0]), res.q[0], args.input) if len(inputs) == 1 else None
     mus = None
     if info is not None:
         mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
-    sing = None
+    sing = list(res.limits)  # the limit positions met are always listed
     if args.singularities:
         from .sweep import locate_singularities
 
-        sing = locate_singularities(solver, res, output=args.output)
+        sing = locate_singularities(solver, res, output=args.output, point=args.point)
     if args.csv:
         with open(args.csv, "w") as f:
             f.write(res.csv())
@@ -410,16 +468,17 @@ def _sweep(mech, args):
         if info is not None:
             d["linkage"] = info.to_dict()
             d["transmission_angles"] = mus
-        if sing is not None:
-            d["singularities"] = [{"kind": x.kind, "input": x.input, "sigma": x.sigma} for x in sing]
+        d["singularities"] = [x.to_dict(mech) for x in sing]
+        d["characteristic_length"] = mech.length
         print(json.dumps(to_jsonable(d), indent=2))
     else:
         print(sweep_text(res, info, mus))
-        if sing is not None:
-            print("\nsingularities along the motion:" if sing else "\nno singularity along the motion")
+        if args.singularities:
+            print(f"\nsingularities along the motion (L = {mech.length:.4g} m):" if sing
+                  else "\nno singularity along the motion")
             for x in sing:
-                print(f"  {x.kind:<10} at {res.input} = {x.input:.12g} ({np.degrees(x.input):.8g} deg), "
-                      f"relative sigma {x.sigma:.2g}")
+                print(f"  {x.kind:<10} at {res.input} = {value_text(res.input, x.input, res.unit == 'rad')}, "
+                      f"relative sigma {x.sigma:.2g}" + ("  (limit position)" if x.limit else ""))
     return 0
 
 

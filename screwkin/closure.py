@@ -133,12 +133,16 @@ class Assembly:
 
     q: joint configuration (Pinocchio's nq-vector);
     residual: closure residual norm reached [m, rad];
-    iterations: solver iterations used.
+    iterations: solver iterations used (from the start that closed);
+    start: which starting configuration closed (e.g. "the file's configuration");
+    starts: how many starting configurations were tried to get there.
     """
 
     q: np.ndarray
     residual: float
     iterations: int
+    start: str = "the given configuration"
+    starts: int = 1
 
 
 class ClosureSystem:
@@ -164,6 +168,15 @@ class ClosureSystem:
             M1, M2 = self.data.oMf[c.frame1], self.data.oMf[c.frame2]
             self._placements.append((M1.rotation, M2.rotation, M1.translation, M2.translation))
         self._groups = self._group()
+        self._position_rows = None
+
+    @property
+    def position_rows(self) -> np.ndarray:
+        """Mask of the minimal rows (``evaluate(solver=False)``) that are positions [m]; the
+        others are dimensionless (angles, alignments)."""
+        if self._position_rows is None:
+            self._position_rows = np.array([":pos" in label for label in self.row_labels()], bool)
+        return self._position_rows
 
     # ------------------------------------------------------------------ compiled inner loop
     def accelerate(self, on: bool = True) -> bool:

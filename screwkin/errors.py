@@ -50,16 +50,17 @@ class AssemblyError(MechanismFileError):
     """The loop-closure equations could not be solved.
 
     ``residual`` is the smallest closure residual norm reached (m and rad mixed,
-    as the constraint rows are), after ``iterations`` Newton iterations.
+    as the constraint rows are), after ``iterations`` Newton iterations (of the
+    best start), from ``starts`` starting configurations when a search was made.
     """
 
-    def __init__(self, path, residual: float, iterations: int, detail: str = ""):
+    def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None):
         self.residual = float(residual)
         self.iterations = int(iterations)
-        msg = (
-            f"cannot assemble the mechanism: the loop-closure residual got down to "
-            f"{self.residual:.3g} after {self.iterations} iterations"
-        )
+        self.starts = starts
+        how = (f"from {starts} starting configurations" if starts and starts > 1
+               else f"after {self.iterations} iterations")
+        msg = f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}"
         if detail:
             msg += f" ({detail})"
         super().__init__(path, msg)

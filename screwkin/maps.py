@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import AssemblyError, UsageError
-from .singular import Generic, characteristic_length, measures
+from .singular import Generic, measures
 
 __all__ = ["SingularityMap", "singularity_map"]
 
@@ -58,15 +58,14 @@ class SingularityMap:
         plt.close(fig)
 
 
-def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None) -> SingularityMap:
+def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
     for n in (x_name, y_name):
         if n not in solver.inputs:
             raise UsageError(f"{mech.path}: '{n}' is not an input ({', '.join(solver.inputs)})")
-    g = Generic(mech, solver.inputs, output)
     q_row = solver.solve({x_name: xs[0], y_name: ys[0], **fixed}).solutions[0].q
-    L = characteristic_length(mech, q_row)
+    g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
     logs = np.full((len(ys), len(xs)), np.nan)
     kinds = np.full((len(ys), len(xs)), "", dtype=object)
     qs = np.full((len(ys), len(xs), mech.nq), np.nan)
@@ -80,7 +79,7 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None) -> 
             if i == 0:
                 q_row = q
             qs[j, i] = q
-            m = {k: v for k, v in measures(mech, q, g, output, L).items()}
+            m = measures(mech, q, g)
             kind = min(m, key=m.get)
             logs[j, i] = np.log10(max(m[kind], 1e-16))
             kinds[j, i] = kind

@@ -20,11 +20,12 @@ import pinocchio as pin
 
 from .closure import Assembly, ClosureSystem, CutJoint
 from .description import MechanismSpec, placement, resolve_actuation
-from .errors import MechanismFileError, UsageError
+from .errors import AssemblyError, MechanismFileError, UsageError
+from .linalg import null_space, rank
 from .tolerances import DEFAULT, Tolerances
 from .urdf import read_urdf, read_yaml_sidecar
 
-__all__ = ["load", "Mechanism", "Coordinate"]
+__all__ = ["load", "Mechanism", "Coordinate", "characteristic_length"]
 
 
 @dataclass(frozen=True)
@@ -101,6 +102,40 @@ def _replace_joints(model, replacements):
     return new
 
 
+def link_lengths(model, cuts) -> list:
+    """The length of each rigid body of the model that has one: the largest distance between
+    two joint centres on it (the origin of the joint that carries it, the origins of the
+    joints it carries, and the frames of the cut joints on it), as written in the file --
+    the same whatever the configuration.  Bodies whose joints all sit at one point (the
+    massless links inside compound joints) have none."""
+    points = {j: [] for j in range(model.njoints)}
+    for j in range(1, model.njoints):
+        points[j].append(np.zeros(3))
+        points[model.parents[j]].append(np.array(model.jointPlacements[j].translation))
+    for c in cuts:
+        for f in (c.frame1, c.frame2):
+            fr = model.frames[f]
+            points[fr.parentJoint].append(np.array(fr.placement.translation))
+    lengths = []
+    for pts in points.values():
+        if len(pts) < 2:
+            continue
+        P = np.array(pts[:200])  # a body carrying more joints than that: its first 200 decide
+        d = float(np.sqrt(np.max(np.sum((P[:, None, :] - P[None, :, :]) ** 2, axis=2))))
+        if d > 1e-9:
+            lengths.append(d)
+    return lengths
+
+
+def characteristic_length(model, cuts) -> float:
+    """The characteristic length L of a mechanism [m]: the mean length of its links
+    (:func:`link_lengths`), 1 m when no link has a length.  Every measure that mixes
+    translations and rotations divides translations by L (and multiplies the rates of
+    sliding joints by it), so it is dimensionless and the same in every command."""
+    lengths = link_lengths(model, cuts)
+    return float(np.mean(lengths)) if lengths else 1.0
+
+
 class Mechanism:
     """A mechanism: Pinocchio model of the spanning tree, cut joints, actuation.
 
@@ -137,6 +172,10 @@ class Mechanism:
         self.set_actuated(actuated)
         self._assembly = None
         self._limits = None
+        self._generic = None
+        self._length = None
+        self._rule_length = characteristic_length(model, self.cuts)
+        self._translational = self._translational_coordinates()
 
     # ------------------------------------------------------------------ binding
     def _frame_id(self, name: str, what: str) -> int:
@@ -195,6 +234,54 @@ class Mechanism:
             idx.extend(range(c.idx_v, c.idx_v + c.nv))
         return np.asarray(idx, int)
 
+    def _value_layout(self):
+        """(1-coordinate joints (name, q index, wrap), continuous joints (name, q index), the
+        coordinates of multi-DOF joints (name, q index), order of the names)."""
+        if getattr(self, "_layout", None) is None:
+            single, continuous, multi, order = [], [], [], []
+            for c in self.coordinates:
+                short = self.model.joints[c.joint_id].shortname()
+                if c.nq == 1:
+                    single.append((c.joint, c.idx_q, short.startswith("JointModelR")))
+                    order.append(c.joint)
+                elif c.nq == 2 and c.nv == 1:
+                    continuous.append((c.joint, c.idx_q))
+                    order.append(c.joint)
+                else:
+                    names = [(f"{c.joint}[q{k}]", c.idx_q + k) for k in range(c.nq)]
+                    multi += names
+                    order += [n for n, _ in names]
+            idx = np.array([i for _, i, _ in single], int)
+            wrap = np.array([w for _, _, w in single], bool)
+            self._angle_v = np.array([self.coordinate(n).idx_v for n, _, w in single if w], int)
+            self._layout = (single, continuous, multi, order, idx, wrap)
+        return self._layout
+
+    def difference(self, q0, q1) -> np.ndarray:
+        """The velocity-space step from q0 to q1 (pinocchio.difference), with the angles of
+        bounded revolute joints taken the short way round (-pi, pi]."""
+        d = pin.difference(self.model, q0, q1)
+        _, _, _, _, idx, wrap = self._value_layout()
+        if wrap.any():
+            v = self._angle_v
+            d[v] = np.mod(d[v] + np.pi, 2 * np.pi) - np.pi
+        return d
+
+    def joint_values(self, q) -> dict:
+        """Every joint coordinate name -> value [rad or m], in the order of the joints:
+        revolute angles in [-pi, pi), continuous joints as atan2(sin, cos), the coordinates
+        of multi-DOF joints as ``joint[qk]``."""
+        q = np.asarray(q, float)
+        single, continuous, multi, order, idx, wrap = self._value_layout()
+        v = q[idx]
+        v[wrap] = np.mod(v[wrap] + np.pi, 2 * np.pi) - np.pi
+        out = dict(zip((n for n, _, _ in single), v.tolist()))
+        for name, i in continuous:
+            out[name] = float(np.arctan2(q[i + 1], q[i]))
+        for name, i in multi:
+            out[name] = float(q[i])
+        return {n: out[n] for n in order}
+
     @property
     def coordinate_names(self) -> list:
         names = []
@@ -230,15 +317,197 @@ class Mechanism:
         """The configuration written in the file (every joint at zero)."""
         return pin.neutral(self.model)
 
+    # ------------------------------------------------------------------ length
+    @property
+    def length(self) -> float:
+        """The characteristic length L [m] that makes mixed translation/rotation measures
+        dimensionless: the mean link length (:func:`characteristic_length`) unless set."""
+        return self._length if self._length is not None else self._rule_length
+
+    @length.setter
+    def length(self, value):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise UsageError(f"{self.path}: the characteristic length must be a positive length, got {value!r}")
+        self._length = None if value is None else float(value)
+
+    @property
+    def length_rule(self) -> str:
+        """How :attr:`length` was chosen, in words."""
+        if self._length is not None:
+            return "given"
+        return "mean link length" if link_lengths(self.model, self.cuts) else "no link has a length: 1 m"
+
+    def _translational_coordinates(self) -> np.ndarray:
+        """Mask of the velocity coordinates that are lengths (prismatic joints, the translations
+        of planar, translation and free-flyer joints)."""
+        mask = np.zeros(self.model.nv, bool)
+        for c in self.coordinates:
+            short = self.model.joints[c.joint_id].shortname()
+            if "JointModelP" in short and "Planar" not in short:
+                mask[c.idx_v:c.idx_v + c.nv] = True
+            elif short in ("JointModelPlanar",):
+                mask[c.idx_v:c.idx_v + 2] = True
+            elif short in ("JointModelTranslation", "JointModelFreeFlyer"):
+                mask[c.idx_v:c.idx_v + 3] = True
+        return mask
+
+    @property
+    def translational(self) -> np.ndarray:
+        """Mask (nv,) of the velocity coordinates that are lengths [m]; the others are angles."""
+        return self._translational
+
+    # ------------------------------------------------------------------ configurations
+    def random_configuration(self, rng, around=None, spread: float = 0.3) -> np.ndarray:
+        """A random configuration.
+
+        Without ``around``: every joint uniform within its limits -- angles over their
+        <limit> range when it is finite and at most a turn, else over a full turn; lengths
+        over their range when finite and at most 100 L, else over [-L, L] (L = :attr:`length`);
+        ball and free joints uniform over the rotations.  With ``around``: that configuration
+        moved by a normal random step of ``spread`` rad (``spread * L`` for lengths)."""
+        model = self.model
+        if around is not None:
+            dq = rng.normal(size=model.nv) * spread
+            dq[self._translational] *= self.length
+            return pin.integrate(model, np.asarray(around, float), dq)
+        L = self.length
+        q = pin.neutral(model)
+        lo_all, hi_all = model.lowerPositionLimit, model.upperPositionLimit
+        for c in self.coordinates:
+            short = model.joints[c.joint_id].shortname()
+            i = c.idx_q
+            if c.nq == 1:
+                lo, hi = float(lo_all[i]), float(hi_all[i])  # Python floats: no overflow warning at +-1.8e308
+                length = bool(self._translational[c.idx_v])
+                wide = 100 * L if length else 2 * np.pi
+                if np.isfinite(lo) and np.isfinite(hi) and 0 < hi - lo <= wide:
+                    q[i] = rng.uniform(lo, hi)
+                elif length:
+                    q[i] = rng.uniform(max(lo, -L), min(hi, L)) if max(lo, -L) < min(hi, L) else rng.uniform(-L, L)
+                else:
+                    q[i] = rng.uniform(-np.pi, np.pi)
+            elif c.nq == 2 and c.nv == 1:  # continuous: (cos, sin)
+                a = rng.uniform(-np.pi, np.pi)
+                q[i:i + 2] = (np.cos(a), np.sin(a))
+            elif short == "JointModelSpherical":
+                v = rng.normal(size=4)
+                q[i:i + 4] = v / np.linalg.norm(v)
+            elif short == "JointModelFreeFlyer":
+                q[i:i + 3] = rng.uniform(-L, L, 3)
+                v = rng.normal(size=4)
+                q[i + 3:i + 7] = v / np.linalg.norm(v)
+            elif short == "JointModelPlanar":
+                a = rng.uniform(-np.pi, np.pi)
+                q[i:i + 4] = (*rng.uniform(-L, L, 2), np.cos(a), np.sin(a))
+            elif short == "JointModelTranslation":
+                q[i:i + 3] = rng.uniform(-L, L, 3)
+            else:  # universal, spherical ZYX, ...: angles over a full turn
+                dq = np.zeros(model.nv)
+                dq[c.idx_v:c.idx_v + c.nv] = rng.uniform(-np.pi, np.pi, c.nv)
+                q[i:i + c.nq] = pin.integrate(model, pin.neutral(model), dq)[i:i + c.nq]
+        return q
+
+    def _keep(self, q, hint, frozen):
+        """q with the coordinates of the joints whose velocity indices are frozen taken from hint."""
+        if not len(frozen):
+            return q
+        frozen = set(int(f) for f in frozen)
+        q = np.array(q, float)
+        for c in self.coordinates:
+            if any(c.idx_v + k in frozen for k in range(c.nv)):
+                q[c.idx_q:c.idx_q + c.nq] = hint[c.idx_q:c.idx_q + c.nq]
+        return q
+
     # ------------------------------------------------------------------ analyses
-    def assemble(self, q0=None) -> Assembly:
-        """Close the loops starting from q0 (default: the file's configuration)."""
-        if q0 is None and self._assembly is not None:
+    def assemble(self, q0=None, frozen=(), seed: int = 0) -> Assembly:
+        """Close the loops: a seeded search, not a single descent.
+
+        The hint ``q0`` (default: the file's configuration, every joint at zero) is tried
+        first; when damped Newton does not close the loops from it (a file drawn with every
+        link along one line has a residual whose gradient vanishes there), perturbations of
+        it and then random configurations within the joint limits are tried, in a fixed
+        order (``seed``), and the first that closes is returned: ``Assembly.start`` says
+        which.  ``frozen`` velocity indices (inputs) keep the hint's values in every start.
+        Raises AssemblyError with the smallest residual reached and the number of starts."""
+        cache = q0 is None and not len(frozen)
+        if cache and self._assembly is not None:
             return self._assembly
-        result = self.closure.solve(self.neutral() if q0 is None else q0)
-        if q0 is None:
-            self._assembly = result
-        return result
+        tol = self.tolerances
+        hint = self.neutral() if q0 is None else np.array(q0, float)
+        given = "the file's configuration" if q0 is None else "the given configuration"
+        rng = np.random.default_rng(seed)
+        total = max(int(tol.assembly_starts), 1) if self.closure.nrows else 1
+        best, best_it = np.inf, 0
+        for k in range(total):
+            if k == 0:
+                q, what = hint, given
+            elif k <= tol.perturbations:
+                q = self.random_configuration(rng, around=hint, spread=0.1 * k)
+                what = f"a perturbation of {given} (start {k + 1} of {total})"
+            else:
+                q = self.random_configuration(rng)
+                what = f"a random configuration within the joint limits (start {k + 1} of {total})"
+            q = self._keep(q, hint, frozen) if k else q
+            try:
+                a = self.closure.solve(q, frozen=frozen)
+            except AssemblyError as exc:
+                if exc.residual < best:
+                    best, best_it = exc.residual, exc.iterations
+                continue
+            result = Assembly(a.q, a.residual, a.iterations, what, k + 1)
+            if cache:
+                self._assembly = result
+            return result
+        starts = (f"{given}, {min(tol.perturbations, total - 1)} perturbations of it and "
+                  f"{max(total - 1 - tol.perturbations, 0)} random configurations within the joint limits"
+                  if total > 1 else given)
+        raise AssemblyError(self.path, best, best_it, detail=starts, starts=total)
+
+    def generic_configurations(self, hint=None, seed: int = 0) -> tuple:
+        """(assembly, configurations): assembled configurations where generic ranks are taken.
+
+        The first configuration the assembly search closes (:meth:`assemble`, from ``hint``
+        when given) may be singular -- a file drawn straight, at a limit position, or on a
+        degenerate branch where links fold onto each other.  So the rank of the constraint
+        Jacobian is taken at it, at ``tolerances.samples`` nearby ones (a random step of
+        ``sample_step`` along the motion the loops allow, closed again) and at the
+        configurations that ``tolerances.generic_starts`` further random starts close; the
+        configurations of the largest rank are returned, the one nearest the first assembly
+        first (``assembly`` is that first one, with where it came from).  Cached."""
+        if self._generic is None:
+            a = self.assemble() if hint is None else self.assemble(hint)
+            tol, closure = self.tolerances, self.closure
+            rng = np.random.default_rng(seed)
+            configs = [a.q]
+            if self.nv:  # a serial chain too: its file configuration may be singular for an output
+                for _ in range(tol.samples):
+                    V = null_space(closure.jacobian(a.q), tol, self.nv)
+                    if V.shape[1] == 0:
+                        break
+                    step = V @ rng.normal(size=V.shape[1])
+                    step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
+                    try:
+                        configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
+                    except AssemblyError:
+                        continue
+                for _ in range(tol.generic_starts):
+                    try:
+                        configs.append(closure.solve(self.random_configuration(rng)).q)
+                    except AssemblyError:
+                        continue
+            ranks = [rank(closure.jacobian(q), tol) if closure.nrows else 0 for q in configs]
+            top = max(ranks)
+            self._generic = (a, tuple(q for q, r in zip(configs, ranks) if r == top), ranks[0] < top, ranks[0], top)
+        return self._generic[:2]
+
+    @property
+    def first_assembly_singular(self):
+        """(True, its rank, the generic rank) when the first configuration the assembly search
+        closed is less constrained than the generic ones (singular or on a degenerate branch);
+        (False, r, r) otherwise.  Needs generic_configurations() first."""
+        if self._generic is None:
+            self.generic_configurations()
+        return self._generic[2:]
 
     def topology(self, q=None):
         """The :class:`~screwkin.topology.Topology` (links, joints, compound joints, loops)."""
@@ -246,13 +515,14 @@ class Mechanism:
 
         return build_topology(self, self.assemble().q if q is None else q)
 
-    def mobility(self, actuated=None, output=None, seed: int = 0):
-        """Mobility analysis; returns a :class:`~screwkin.mobility.MobilityResult`."""
+    def mobility(self, actuated=None, output=None, seed: int = 0, point: bool = False):
+        """Mobility analysis; returns a :class:`~screwkin.mobility.MobilityResult`.
+        point: analyse the output link's origin as a point (its 3 translations)."""
         from .mobility import analyze_mobility
 
         if actuated is not None:
             self.set_actuated(actuated)
-        return analyze_mobility(self, output=output, seed=seed)
+        return analyze_mobility(self, output=output, seed=seed, point=point)
 
     def __repr__(self):
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "

@@ -18,38 +18,12 @@ import pinocchio as pin
 
 from ._pin import frame_jacobian
 from .errors import AssemblyError
+from .linalg import null_space, rank
 from .topology import Topology
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-
-
-def _svd(A):
-    if A.size == 0:
-        return np.zeros(0), np.zeros((A.shape[1], A.shape[1]))
-    _, s, vt = np.linalg.svd(A)
-    return s, vt
-
-
-def rank(A, tol) -> int:
-    """Numerical rank: singular values above rank_rtol * sigma_max and rank_atol."""
-    if A.size == 0:
-        return 0
-    s = np.linalg.svd(A, compute_uv=False)
-    if s.size == 0 or s[0] <= tol.rank_atol:
-        return 0
-    return int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
-
-
-def null_space(A, tol, n=None) -> np.ndarray:
-    """Orthonormal basis (columns) of the null space of A (A has n columns)."""
-    n = A.shape[1] if n is None else n
-    if A.size == 0:
-        return np.eye(n)
-    _, s, vt = np.linalg.svd(A)
-    r = rank(A, tol)
-    return vt[r:].T.copy()
 
 
 @dataclass(frozen=True)
@@ -60,6 +34,8 @@ class OutputMotion:
     "3T1R", "6"; translations: dimension of the pure translations in the
     twist space; rotations: rank of its angular part; twists: a basis of the
     space, each (vx, vy, vz, wx, wy, wz) of the link's origin in world axes.
+    point: the link's origin analysed as a point (its velocities only): then
+    dimension = translations, rotations = 0 and twists are (vx, vy, vz).
     """
 
     link: str
@@ -69,6 +45,7 @@ class OutputMotion:
     label: str
     center: tuple | None
     twists: tuple
+    point: bool = False
 
 
 @dataclass(frozen=True)
@@ -102,6 +79,10 @@ class MobilityResult:
     iterations: int
     samples: int
     q: np.ndarray = field(repr=False, compare=False)
+    redundant_constraints: int = 0  # in the detected motion space: M - (its count); 0 = statically determinate
+    assembly_start: str = "the file's configuration"  # where the assembly search closed the loops
+    starts: int = 1  # starting configurations the search tried
+    configuration: dict = field(default_factory=dict)  # joint values of the configuration analysed
 
     @property
     def kutzbach(self) -> int:
@@ -119,27 +100,6 @@ class MobilityResult:
         from .report import mobility_dict
 
         return mobility_dict(self)
-
-
-def _sample_configurations(mech, q0, rng):
-    """The assembled configuration and a few nearby assembled ones."""
-    tol = mech.tolerances
-    configs = [q0]
-    closure = mech.closure
-    if closure.nrows == 0 and mech.nv == 0:
-        return configs
-    for _ in range(tol.samples):
-        K = closure.jacobian(configs[0])
-        V = null_space(K, tol, mech.nv)
-        if V.shape[1] == 0:
-            break
-        step = V @ rng.normal(size=V.shape[1])
-        step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
-        try:
-            configs.append(closure.solve(pin.integrate(mech.model, configs[0], step)).q)
-        except AssemblyError:
-            continue
-    return configs
 
 
 def _body_frames(mech, topo):
@@ -231,6 +191,15 @@ def _idle(mech, topo, frames, q, V, output_link, tol):
     return idle, I.shape[1], I
 
 
+def _point_motion(link, T, tol) -> OutputMotion:
+    """What the origin of a link can do as a point: the rank of its velocities."""
+    dim = rank(T[:3], tol)
+    if dim == 0:
+        return OutputMotion(link, 0, 0, 0, "0 (immobile)", None, (), True)
+    U, _, _ = np.linalg.svd(T[:3], full_matrices=False)
+    return OutputMotion(link, dim, dim, 0, f"{dim}T", None, tuple(tuple(c) for c in U[:, :dim].T), True)
+
+
 def _output_motion(link, T, tol, origin) -> OutputMotion:
     dim = rank(T, tol)
     if dim == 0:
@@ -263,12 +232,19 @@ def _output_motion(link, T, tol, origin) -> OutputMotion:
 
 
 def _classify(n, m, eff, overconstraint, topo, M):
+    """The classification and notes; a structure (no effective DOF) is statically determinate
+    or not in its detected motion space: a planar triangle is determinate in the plane
+    (Gruebler 0 = M), although 3 of its 5 spatial constraint rows are redundant."""
     notes = []
     lam_count = topo.count_in_motion_space
-    crit = {"planar": "Gruebler (planar) count", "spherical": "spherical count"}.get(topo.motion_space, "Kutzbach count")
+    redundant = M - lam_count
+    space = topo.motion_space
+    crit = {"planar": "Gruebler (planar) count", "spherical": "spherical count"}.get(space, "Kutzbach count")
+    where = f" in the {'plane' if space == 'planar' else 'sphere'}" if space != "spatial" else ""
     if n == 0:
-        kind = "statically determinate structure" if overconstraint == 0 else (
-            f"statically indeterminate structure ({overconstraint} redundant constraint{'s' if overconstraint > 1 else ''})")
+        kind = (f"statically determinate structure{where}" if redundant <= 0 else
+                f"statically indeterminate structure{where} ({redundant} redundant constraint"
+                f"{'s' if redundant > 1 else ''})")
     elif m == 0:
         kind = f"mechanism with {n} degree{'s' if n > 1 else ''} of freedom (no actuated joints declared)"
     elif m == n and eff == n:
@@ -287,8 +263,10 @@ def _classify(n, m, eff, overconstraint, topo, M):
                        if lam_count < M else f"{overconstraint} constraints are redundant")
         notes.append(f"The {crit} gives {lam_count} but the screw-theory mobility is {M}"
                      + (": " + "; ".join(why) if why else "") + ".")
-    if topo.motion_space != "spatial" and topo.kutzbach != M:
-        notes.append(f"The spatial Kutzbach count ({topo.kutzbach}) does not apply: the mechanism is {topo.motion_space}.")
+    if space != "spatial" and topo.kutzbach != M:
+        notes.append(f"The spatial Kutzbach count ({topo.kutzbach}) does not apply: the mechanism is {space}"
+                     + (f" (spatially {overconstraint} of the constraint rows are redundant; {where.strip()} "
+                        f"{max(redundant, 0)})." if overconstraint != redundant else "."))
     if n != M:
         notes.append(f"{M - n} of the {M} degrees of freedom are idle (a link turning on itself); "
                      f"{n} remain effective.")
@@ -297,15 +275,14 @@ def _classify(n, m, eff, overconstraint, topo, M):
     return kind, tuple(notes)
 
 
-def analyze_mobility(mech, output=None, seed: int = 0) -> MobilityResult:
-    """Mobility of ``mech`` (see the module docstring); output names a link."""
+def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False) -> MobilityResult:
+    """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
+    its origin as a point (3 translations) instead of its full motion."""
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)
-    assembly = mech.assemble()
-    rng = np.random.default_rng(seed)
-    configs = _sample_configurations(mech, assembly.q, rng)
-    topo = mech.topology(assembly.q)
+    assembly, configs = mech.generic_configurations(seed=seed)
+    topo = mech.topology(configs[0])
     frames = _body_frames(mech, topo)
     output_link = None
     if output is not None:
@@ -322,7 +299,8 @@ def analyze_mobility(mech, output=None, seed: int = 0) -> MobilityResult:
         if output is not None:
             model, data = mech.model, mech.data
             T = frame_jacobian(model, data, out_frame, LWA) @ V
-            out = _output_motion(output, T, tol, data.oMf[out_frame].translation)
+            out = _point_motion(output, T, tol) if point else _output_motion(
+                output, T, tol, data.oMf[out_frame].translation)
         eff = rank(V[act_idx], tol) if len(act_idx) else None
         key = (rk, -idle_total, out.dimension if out else 0, eff or 0)
         if best is None or key > best[0]:
@@ -339,6 +317,11 @@ def analyze_mobility(mech, output=None, seed: int = 0) -> MobilityResult:
     kind, notes = _classify(n, m, eff if eff is not None else 0, overconstraint, topo, M)
     if m and locked:
         notes += (f"With the inputs locked the mechanism can still move ({locked} degree{'s' if locked > 1 else ''} of freedom).",)
+    first_singular, first_rank, generic_rank = mech.first_assembly_singular
+    if first_singular:
+        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on a "
+                  f"degenerate branch (rank of K {first_rank} < {generic_rank}: mobility {mech.nv - first_rank} "
+                  f"there); the analysis uses assembled configurations of the generic rank.",)
     return MobilityResult(
         path=mech.path,
         topology=topo,
@@ -361,4 +344,8 @@ def analyze_mobility(mech, output=None, seed: int = 0) -> MobilityResult:
         iterations=assembly.iterations,
         samples=len(configs),
         q=q,
+        redundant_constraints=max(M - topo.count_in_motion_space, 0),
+        assembly_start=assembly.start,
+        starts=assembly.starts,
+        configuration=mech.joint_values(q),
     )

@@ -22,8 +22,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
-__all__ = ["LinkageInfo", "identify"]
+from .errors import UsageError
+
+__all__ = ["LinkageInfo", "identify", "LinkAngles", "plane_basis"]
 
 
 @dataclass(frozen=True)
@@ -198,3 +201,107 @@ def _slider_crank(name, q_in, A, B, C, s, a, b):
     rod = (C - B) / b
     mu = float(np.arccos(np.clip(abs(rod @ nrm), 0, 1)))
     return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
+
+
+def plane_basis(normal):
+    """(e1, e2, n): e1 the world x axis projected into the plane (the world y axis when x is
+    normal to it), e2 = n x e1, so angles from e1 are counterclockwise seen from +n."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    for axis in np.eye(3):
+        e1 = axis - (axis @ n) * n
+        if np.linalg.norm(e1) > 1e-6:
+            e1 /= np.linalg.norm(e1)
+            return e1, np.cross(n, e1), n
+    raise ValueError("degenerate normal")  # pragma: no cover
+
+
+class LinkAngles:
+    """Absolute angles of the links of a planar mechanism: the theta_i of the vector-loop
+    method, measured in the plane from the ground's x axis, counterclockwise about the
+    plane's normal (the topology's normal: its +z side, else +y, else +x).
+
+    Each link's vector goes from the centre of the joint that carries it (its joint
+    towards the ground in the file's tree) to the centre of the first other joint on it:
+    the first joint it carries in the file's order, else the first loop joint on it.  A
+    link with no second joint centre (a slider whose pin sits on its own axis, a free
+    tip) is measured by its frame's x axis.  The ground's vector goes from its first
+    joint centre to its first other one."""
+
+    def __init__(self, mech, topo):
+        if topo.motion_space != "planar" or topo.normal is None:
+            raise UsageError(f"{mech.path}: absolute link angles are for planar mechanisms; this one is "
+                             f"{topo.motion_space}")
+        self.mech = mech
+        self.e1, self.e2, self.n = plane_basis(topo.normal)
+        model = mech.model
+        cut_frames = {}
+        for c in mech.cuts:
+            for f in (c.frame1, c.frame2):
+                cut_frames.setdefault(model.frames[f].parentJoint, []).append(f)
+        self.links = {}  # link name -> (start joint id, ("joint" | "frame" | "axis", id))
+        for link in topo.links:
+            fid = mech.link_frame(link)
+            jid = model.frames[fid].parentJoint
+            if link == topo.ground:
+                starts = [k for k in range(1, model.njoints) if model.parents[k] == 0]
+                if not starts:
+                    continue
+                start, candidates = ("joint", starts[0]), [("joint", k) for k in starts[1:]]
+            else:
+                start = ("joint", jid)
+                candidates = [("joint", k) for k in model.children[jid]]
+            candidates += [("frame", f) for f in cut_frames.get(jid, [])]
+            self.links[link] = (start, candidates, fid)
+        self._data = model.createData()
+        ends = self._ends(mech.neutral())
+        self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
+
+    def _point(self, ref):
+        kind, i = ref
+        d = self._data
+        return d.oMi[i].translation if kind == "joint" else d.oMf[i].translation
+
+    def _ends(self, q):
+        """Choose each link's second point: the first candidate away from its first point."""
+        pin.framesForwardKinematics(self.mech.model, self._data, q)
+        out = {}
+        tiny = 1e-9 * self.mech.length
+        for link, (start, candidates, fid) in self.links.items():
+            p0 = self._point(start)
+            out[link] = next((c for c in candidates if np.linalg.norm(self._point(c) - p0) > tiny), ("axis", fid))
+        return out
+
+    def __call__(self, q) -> dict:
+        """link name -> absolute angle [rad] in (-pi, pi]."""
+        pin.framesForwardKinematics(self.mech.model, self._data, q)
+        out = {}
+        for link, (start, end, fid) in self.links.items():
+            if end[0] == "axis":
+                v = self._data.oMf[fid].rotation[:, 0]
+            else:
+                v = self._point(end) - self._point(start)
+            out[link] = float(np.arctan2(v @ self.e2, v @ self.e1))
+        return out
+
+    def joint_value(self, link: str, angle: float) -> tuple:
+        """(joint name, joint value) that gives ``link`` the absolute angle ``angle`` [rad]: the
+        link must turn about the plane's normal on a joint to the ground."""
+        mech, model = self.mech, self.mech.model
+        if link not in self.links:
+            raise UsageError(f"{mech.path}: no moving link named '{link}' (links: {', '.join(self.links)})")
+        start = self.links[link][0]
+        jid = start[1]
+        short = model.joints[jid].shortname()
+        name = model.names[jid]
+        if model.parents[jid] != 0 or not short.startswith("JointModelR") or mech.coordinate(name).nv != 1:
+            raise UsageError(f"{mech.path}: the absolute angle of '{link}' is not the value of one joint (it does "
+                             "not turn on a revolute joint to the ground): set a joint with --set")
+        q = mech.neutral()
+        axis = np.asarray(next(j.axis for j in mech.spec.joints if j.name == name), float)
+        pin.framesForwardKinematics(model, self._data, q)
+        sign = float(np.sign((self._data.oMi[jid].rotation @ axis) @ self.n))
+        if sign == 0:
+            raise UsageError(f"{mech.path}: joint '{name}' does not turn about the plane's normal")
+        theta0 = self(q)[link]
+        value = sign * float(np.mod(angle - theta0 + np.pi, 2 * np.pi) - np.pi)
+        return name, value

@@ -2,10 +2,22 @@
 
 Given values of input joints (by default the actuated ones; any joints may be
 chosen instead), the other coordinates follow from the loop-closure equations
-r(q) = 0, solved by damped Newton with the inputs held.  Every assembly mode
-the solver reaches from a deterministic set of starts is reported; two
-solutions are the same mode when every joint centre and the output frame are
-in the same place (idle spins, which move no joint, do not make new modes).
+r(q) = 0, solved by damped Newton with the inputs held, from the inputs
+themselves: the file's configuration with the inputs set, and random
+configurations within the joint limits with the inputs set (the file's own
+configuration need not close).  Every assembly mode the solver reaches is
+reported once:
+
+- two solutions are the same mode when every joint centre and the output frame
+  are in the same place (idle spins, which move no joint, do not make new modes);
+- a double root (a limit position) is one solution flagged singular, however
+  the starts approached it; solutions joined by a motion with the inputs held (a
+  continuum: the inputs do not determine the mechanism there) are one solution
+  flagged singular and ``continuum``;
+- modes that cannot be reached by moving the mechanism from the reference
+  configuration without passing a singularity are labelled: outside the joint
+  limits, a leg reversed through its pivot, a link that only translates found
+  turned (a mirrored parallelogram).  Solutions without a label come first.
 
 Rates and accelerations come from the differentiated closure equations
     K q' = 0,        K q'' + K' q' = 0,
@@ -15,16 +27,18 @@ frame accelerations.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pinocchio as pin
 
+from ._pin import frame_jacobian
 from .closure import Assembly
 from .errors import AssemblyError, UsageError
-from .mobility import null_space, rank
+from .linalg import null_space, rank
+from .singular import Generic, measures, scaled_jacobians
 
-__all__ = ["Solution", "PositionResult", "PositionSolver", "TraceStep"]
+__all__ = ["Solution", "PositionResult", "PositionSolver", "TraceStep", "inverse_kinematics", "outside_limits"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -48,14 +62,19 @@ class Solution:
               revolute angles in (-pi, pi]);
     residual: closure residual norm [m, rad]; iterations: Newton iterations;
     singular: the passive joints are not determined to first order (a double
-              root, e.g. a limit position; or a constraint singularity);
-    sigma_min: smallest relevant singular value of the passive constraint
-              Jacobian, relative to the largest;
+              root, e.g. a limit position; or a constraint singularity): the
+              actuator or constraint measure of screwkin.singular.measures is
+              below the singular tolerance;
+    sigma_min: the smaller of those two measures (relative singular values);
     output_pose: 4x4 world pose of the output link, or None;
     rates / accelerations: coordinate name -> rate [rad/s, m/s] /
               acceleration [rad/s^2, m/s^2], or None;
     output_twist / output_acceleration: (v, w) of the output frame origin in
-              world axes; classical acceleration (a, alpha).
+              world axes; classical acceleration (a, alpha);
+    labels:   why this mode is not one the mechanism reaches by moving from its
+              reference configuration (empty: it is), each "what: names";
+    continuum: the inputs leave a finite motion here (solutions joined by it were merged);
+    link_angles: planar mechanisms: link name -> absolute angle [rad] (screwkin.planar.LinkAngles).
     """
 
     q: np.ndarray = field(repr=False)
@@ -72,6 +91,25 @@ class Solution:
     qdot: np.ndarray | None = field(default=None, repr=False)
     qddot: np.ndarray | None = field(default=None, repr=False)
     outside_limits: tuple = ()  # joints whose value is outside the file's <limit> (angles compared modulo 2 pi)
+    labels: tuple = ()
+    continuum: bool = False
+    merged: int = 1  # how many distinct solver results this solution stands for
+    link_angles: dict | None = None
+    sigmas: dict | None = None  # screwkin.singular.measures at this configuration
+
+    @property
+    def physical(self) -> bool:
+        """Reached by moving from the reference configuration, within the joint limits."""
+        return not self.labels
+
+    @property
+    def output_position(self):
+        return None if self.output_pose is None else self.output_pose[:3, 3].copy()
+
+    @property
+    def output_rpy(self):
+        """Roll, pitch, yaw [rad] of the output frame (URDF convention: R = Rz(yaw) Ry(pitch) Rx(roll))."""
+        return None if self.output_pose is None else pin.rpy.matrixToRpy(self.output_pose[:3, :3])
 
 
 @dataclass(frozen=True)
@@ -84,6 +122,11 @@ class PositionResult:
     trace: tuple = ()
     output: str | None = None
     angular: tuple = ()  # names of the coordinates that are angles (the others are lengths)
+
+    @property
+    def physical(self) -> tuple:
+        """The solutions without labels (the modes the mechanism reaches by moving)."""
+        return tuple(s for s in self.solutions if s.physical)
 
     def to_dict(self) -> dict:
         from .report import position_dict
@@ -127,57 +170,69 @@ class PositionSolver:
             c = mech.coordinate(n)
             if c.nv != 1:
                 raise UsageError(f"{mech.path}: joint '{n}' has {c.nv} coordinates; inputs must be 1-DOF joints")
+        if len(set(names)) != len(names):
+            raise UsageError(f"{mech.path}: an input joint is named twice: {', '.join(names)}")
         self.inputs = names
         self.frozen = mech.velocity_indices(names)
         self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
         self.output = output
         self.output_frame = mech.link_frame(output) if output else None
-        mob = mech.mobility()
-        self.expected_rank = mob.rank
-        self.idle_dofs = mob.idle_dofs
-        self.mobility = mob.mobility
-        # DOFs left free with the inputs held, beyond the idle ones (0 = inputs determine the mechanism)
-        V = null_space(mech.closure.jacobian(mob.q), mech.tolerances, mech.nv)
-        held = null_space(V[self.frozen], mech.tolerances, V.shape[1]) if V.shape[1] else np.zeros((0, 0))
-        self.free_dofs = max(held.shape[1] - self.idle_dofs, 0) if V.shape[1] else 0
-        self._reference = mob.q
+        self._generic = None
+        self._labelling = None
+        self._angles = False  # LinkAngles, None when not planar, False before the first look
         self._points = [f for f in range(len(self.model.frames))
                         if self.model.frames[f].type == pin.FrameType.JOINT]
         self._points += [c.frame1 for c in mech.cuts]
-        self._revolute = self._angle_coordinates()
         self._angular = self.angular_names()
-        # joint_values in a few array operations: (name, q index) of 1-coordinate joints, of
-        # continuous joints (cos, sin), and the names of the coordinates of multi-DOF joints
-        single, continuous, multi, self._order = [], [], [], []
-        for c in mech.coordinates:
-            if c.nq == 1:
-                single.append((c.joint, c.idx_q))
-                self._order.append(c.joint)
-            elif c.nq == 2 and c.nv == 1:
-                continuous.append((c.joint, c.idx_q))
-                self._order.append(c.joint)
-            else:
-                multi += [(f"{c.joint}[q{k}]", c.idx_q + k) for k in range(c.nq)]
-                self._order += [n for n, _ in multi[-c.nq:]]
-        self._value_layout = (single, continuous, multi)
-        self._single_idx = np.array([i for _, i in single], int)
-        self._single_wrap = np.isin(self._single_idx, self._revolute)
 
     @property
     def compiled(self) -> bool:
         """Whether the closure equations are solved by the compiled kernels."""
         return self.mech.closure.accelerated
 
-    # --------------------------------------------------------------- coordinates
-    def _angle_coordinates(self):
-        """q indices of bounded revolute joints (angles to wrap) and continuous joints."""
-        wrap = []
-        for c in self.mech.coordinates:
-            short = self.model.joints[c.joint_id].shortname()
-            if short.startswith("JointModelR") and "UB" not in short and c.nq == 1:
-                wrap.append(c.idx_q)
-        return np.asarray(wrap, int)
+    # --------------------------------------------------------------- generic data
+    def generic(self, hint=None) -> Generic:
+        """Generic ranks for these inputs and output (screwkin.singular.Generic) over the
+        mechanism's generic configurations; ``hint``: an assembled configuration to start
+        from when the mechanism's own assembly search has not been made."""
+        if self._generic is None:
+            configs = self.mech.generic_configurations(hint=hint)[1]
+            self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
+        return self._generic
 
+    def _reference(self):
+        """The reference configuration (the mechanism's assembled one), or None when the
+        assembly search finds none (the solutions for the inputs then stand in)."""
+        try:
+            return self.generic().configurations[0]
+        except AssemblyError:
+            return None
+
+    @property
+    def expected_rank(self) -> int:
+        """Generic rank of the passive columns of the constraint Jacobian."""
+        return self.generic().rank_Kp
+
+    @property
+    def idle_dofs(self) -> int:
+        return self._mobility().idle_dofs
+
+    @property
+    def mobility(self) -> int:
+        return self._mobility().mobility
+
+    @property
+    def free_dofs(self) -> int:
+        """DOFs left free with the inputs held, beyond the idle ones (0 = the inputs determine
+        the mechanism)."""
+        g = self.generic()
+        return max(len(self.passive) - g.rank_Kp - self.idle_dofs, 0)
+
+    def _mobility(self):
+        self.generic()  # the assembly the mobility analysis starts from
+        return self.mech.mobility()
+
+    # --------------------------------------------------------------- coordinates
     def angular_names(self) -> tuple:
         """Coordinate names that are angles (revolute and continuous joints)."""
         names = []
@@ -211,23 +266,15 @@ class PositionSolver:
         return pin.normalize(self.model, q) if multi else q
 
     def joint_values(self, q) -> dict:
-        """Every joint coordinate name -> value [rad or m]; angles of bounded revolute joints
-        in [-pi, pi), continuous joints as atan2(sin, cos)."""
-        q = np.asarray(q, float)
-        single, continuous, multi = self._value_layout
-        v = q[self._single_idx]
-        v[self._single_wrap] = np.mod(v[self._single_wrap] + np.pi, 2 * np.pi) - np.pi
-        out = dict(zip((n for n, _ in single), v.tolist()))
-        for name, i in continuous:
-            out[name] = float(np.arctan2(q[i + 1], q[i]))
-        for name, i in multi:
-            out[name] = float(q[i])
-        return {n: out[n] for n in self._order}  # in the order of mech.coordinates, as reports list them
+        """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
+        return self.mech.joint_values(q)
 
     def _wrap(self, q):
         q = np.array(q, float)
-        if len(self._revolute):
-            q[self._revolute] = np.mod(q[self._revolute] + np.pi, 2 * np.pi) - np.pi
+        _, _, _, _, idx, wrap = self.mech._value_layout()
+        w = idx[wrap]
+        if len(w):
+            q[w] = np.mod(q[w] + np.pi, 2 * np.pi) - np.pi
         return q
 
     def _signature(self, q):
@@ -240,23 +287,12 @@ class PositionSolver:
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def _starts(self, count, seed):
-        model = self.model
+        """The reference configuration (when there is one), the file's configuration, and
+        ``count`` random configurations within the joint limits."""
         rng = np.random.default_rng(seed)
-        base = pin.neutral(model)
-        starts = [self._reference, base]
-        lo, hi = model.lowerPositionLimit, model.upperPositionLimit
-        for _ in range(count):
-            dq = np.zeros(model.nv)
-            for c in self.mech.coordinates:
-                short = model.joints[c.joint_id].shortname()
-                for k in range(c.nv):
-                    if "JointModelP" in short:
-                        a, b = lo[c.idx_q + k], hi[c.idx_q + k]
-                        a, b = (a, b) if np.isfinite(a) and np.isfinite(b) and b - a < 20 else (-0.5, 0.5)
-                        dq[c.idx_v + k] = rng.uniform(a, b)
-                    else:
-                        dq[c.idx_v + k] = rng.uniform(-np.pi, np.pi)
-            starts.append(pin.integrate(model, base, dq))
+        ref = self._reference()
+        starts = ([ref] if ref is not None else []) + [self.mech.neutral()]
+        starts += [self.mech.random_configuration(rng) for _ in range(count)]
         return starts
 
     # --------------------------------------------------------------- solving
@@ -288,7 +324,8 @@ class PositionSolver:
             TraceStep(it, r.copy(), K[:, self.passive].copy(), dq[self.passive].copy(), ok))) if trace else None
         near_q = None
         if near:
-            near_q = self.set_inputs(self._reference, near)
+            ref = self._reference()
+            near_q = self.set_inputs(mech.neutral() if ref is None else ref, near)
         found, best = [], np.inf
         if near_q is not None:  # the mode reached from the given configuration, when Newton gets there
             found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
@@ -300,18 +337,20 @@ class PositionSolver:
                 first_trace=recorder if trace and near_q is None else None)
             best = min(best, more)
         if not found:
-            raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
+            raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
                                        f"{len(start_list)} starting configurations")
-        if len(found) > 1:
-            ref = near_q if near_q is not None else self._reference
-            ref_sig = self._signature(ref)
-            found = [(self._signature(q) if sig is None else sig, q, a) for sig, q, a in found]
-            found.sort(key=lambda f: (len(outside_limits(mech, f[1])) > 0, float(np.linalg.norm(f[0] - ref_sig))))
+        self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
+        sols = [self._solution(q, a, rates, accels) for _, q, a in found]
+        sols = self._merge(sols)
+        ref = near_q if near_q is not None else self._reference()
+        if len(sols) > 1:
+            ref_sig = self._signature(ref if ref is not None else sols[0].q)
+            sols.sort(key=lambda s: (not s.physical, s.singular,
+                                     float(np.linalg.norm(self._signature(s.q) - ref_sig))))
         if near_q is not None:
-            found = found[:1]
-        sols = tuple(self._solution(q, a, rates, accels) for _, q, a in found)
-        return PositionResult(dict(values), tuple(self.inputs), sols, len(start_list), self.free_dofs,
+            sols = sols[:1]
+        return PositionResult(dict(values), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
                               tuple(steps), self.output, self._angular)
 
     def distinct(self, system, starts, frozen=(), first_trace=None):
@@ -339,25 +378,188 @@ class PositionSolver:
     def _describe(values):
         return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
 
+    # --------------------------------------------------------------- one answer per mode
+    def _merge(self, sols):
+        """Solutions that are one root: a singular solution and others within the accuracy a
+        double root can be computed to (about the square root of the closure tolerance), or
+        joined to it by a motion with the inputs held (a continuum)."""
+        tol = self.mech.tolerances
+        close = 100 * np.sqrt(tol.closure) * self.mech.length
+        groups = []
+        for s in sols:
+            for g in groups:
+                if not (s.singular or g[0].singular):
+                    continue
+                d = self._distance(g[0].q, s.q)
+                if d < close or self._connected(g[0].q, s.q):
+                    g.append(s)
+                    break
+            else:
+                groups.append([s])
+        out = []
+        for g in groups:
+            spread = max([self._distance(g[0].q, s.q) for s in g[1:]], default=0.0)
+            keep = min(g, key=lambda s: s.sigma_min)
+            continuum = spread >= close or (keep.singular and self._moves(keep.q))
+            out.append(replace(keep, singular=keep.singular or len(g) > 1, continuum=continuum,
+                               merged=sum(s.merged for s in g)))
+        return out
+
+    def _moves(self, q, step: float = 1e-3) -> bool:
+        """Whether the mechanism can move a finite distance from q with the inputs held (a
+        continuum), not only to first order (a double root): a step of ``step`` (dimensionless)
+        along each direction the passive joints lost at q, closed again with the inputs frozen,
+        stays where it went (the correction is small next to the step) at a double root the
+        solver pulls it back."""
+        mech, g = self.mech, self.generic()
+        S = scaled_jacobians(mech, q)
+        Kp = S.K[:, g.p]
+        if not Kp.size or g.rank_Kp == 0:
+            return False
+        _, s, vt = np.linalg.svd(Kp)
+        lost = [k for k in range(min(g.rank_Kp, len(s))) if s[k] < mech.tolerances.singular * s[0]]
+        scale = np.where(mech.translational, mech.length, 1.0)
+        for k in lost:
+            for sign in (1.0, -1.0):
+                dq = np.zeros(mech.nv)
+                dq[g.p] = sign * step * vt[k]
+                pred = pin.integrate(self.model, q, dq * scale)
+                try:
+                    got = mech.closure.solve(pred, frozen=self.frozen).q
+                except AssemblyError:
+                    continue
+                back = np.linalg.norm(mech.difference(pred, got) / scale)
+                if back < 0.1 * step:
+                    return True
+        return False
+
+    def _distance(self, q1, q2):
+        return float(np.linalg.norm(self._signature(q1) - self._signature(q2)))
+
+    def _connected(self, q1, q2, pieces: int = 12) -> bool:
+        """Whether q2 is reached from q1 by a motion with the inputs held: a walk of small steps
+        toward q2, each closed again with the inputs frozen, whose corrections stay small next
+        to the step (between two distinct roots the correction pulls the walk back)."""
+        closure, model = self.mech.closure, self.model
+        q = q1
+        for k in range(pieces):
+            step = self.mech.difference(q, q2) / (pieces - k)
+            size = float(np.linalg.norm(step))
+            if size < 1e-12:
+                return True
+            pred = pin.integrate(model, q, step)
+            try:
+                q = closure.solve(pred, frozen=self.frozen).q
+            except AssemblyError:
+                return False
+            if np.linalg.norm(self.mech.difference(pred, q)) > 0.3 * size:
+                return False
+        return float(np.linalg.norm(self.mech.difference(q, q2))) < 1e-6 * max(self.mech.length, 1e-3)
+
+    def _labels(self, q, outside) -> tuple:
+        """Why a solution is not reached by moving from the reference configuration."""
+        labels = [f"outside the joint limits: {', '.join(outside)}"] if outside else []
+        table = self._labelling_table()
+        if table is None:
+            return tuple(labels)
+        legs, turned = table
+        data = self.data
+        pin.framesForwardKinematics(self.model, data, q)
+        reversed_ = [name for name, jid, far, axis, s_ref in legs
+                     if s_ref * ((self._far(far) - data.oMi[self.model.parents[jid]].translation)
+                                 @ (data.oMi[jid].rotation @ axis)) < 0]
+        if reversed_:
+            labels.append(f"legs reversed through their pivots: {', '.join(reversed_)}")
+        turned_ = [link for link, fid, R_ref in turned
+                   if np.linalg.norm(pin.log3(R_ref.T @ data.oMf[fid].rotation)) > 1e-6]
+        if turned_:
+            labels.append(f"turned although they only translate as the mechanism moves (a mirrored assembly): "
+                          f"{', '.join(turned_)}")
+        return tuple(labels)
+
+    def _far(self, far):
+        kind, i = far
+        return self.data.oMi[i].translation if kind == "joint" else self.data.oMf[i].translation
+
+    def _labelling_table(self):
+        """Once: the prismatic legs between a pivot and a far joint (with their signed length at
+        the reference configuration), and the links that only translate (with their reference
+        orientation).  None for mechanisms without loops or without a reference."""
+        if self._labelling is None:
+            mech, model = self.mech, self.model
+            ref = self._reference() if mech.cuts else None
+            if ref is None:
+                self._labelling = False
+                return None
+            data = self.data
+            pin.computeJointJacobians(model, data, ref)
+            pin.updateFramePlacements(model, data)
+            cut_frames = {}
+            for c in mech.cuts:
+                for f in (c.frame1, c.frame2):
+                    cut_frames.setdefault(model.frames[f].parentJoint, []).append(f)
+            axes = {j.name: np.asarray(j.axis, float) for j in mech.spec.joints}
+            legs = []
+            for c in mech.coordinates:
+                parent = model.parents[c.joint_id]
+                if c.nq != 1 or not mech.translational[c.idx_v] or parent == 0 or c.joint not in axes:
+                    continue
+                fars = [("joint", k) for k in model.children[c.joint_id]]
+                fars += [("frame", f) for f in cut_frames.get(c.joint_id, [])]
+                if not fars:
+                    continue
+                axis = axes[c.joint]
+                s_ref = float((self._far(fars[0]) - data.oMi[parent].translation) @ (data.oMi[c.joint_id].rotation @ axis))
+                if abs(s_ref) > 1e-6 * mech.length:
+                    legs.append((c.joint, c.joint_id, fars[0], axis, s_ref))
+            turned = []
+            configs = self.generic().configurations
+            topo = mech.topology(ref)
+            Vs = [null_space(mech.closure.jacobian(q), mech.tolerances, mech.nv) for q in configs]
+            for link in topo.links:
+                if link == topo.ground:
+                    continue
+                fid = mech.link_frame(link)
+                rotates = False
+                for q, V in zip(configs, Vs):
+                    pin.computeJointJacobians(model, data, q)
+                    pin.updateFramePlacements(model, data)
+                    W = frame_jacobian(model, data, fid, LWA)[3:] @ V
+                    if rank(W, mech.tolerances):
+                        rotates = True
+                        break
+                if not rotates:
+                    pin.framesForwardKinematics(model, data, ref)
+                    turned.append((link, fid, data.oMf[fid].rotation.copy()))
+            self._labelling = (legs, turned)
+        return self._labelling or None
+
+    def _link_angles(self, q):
+        if self._angles is False:
+            from .planar import LinkAngles
+
+            self._angles = None
+            ref = self._reference()
+            if ref is not None:
+                topo = self.mech.topology(ref)
+                if topo.motion_space == "planar":
+                    self._angles = LinkAngles(self.mech, topo)
+        return self._angles(q) if self._angles is not None else None
+
+    # --------------------------------------------------------------- one solution
     def _solution(self, q, a, rates, accels) -> Solution:
         mech, tol = self.mech, self.mech.tolerances
+        m = measures(mech, q, self.generic())
+        sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
+        singular = sigma < tol.singular
         K = mech.closure.jacobian(q)
-        solve, s = self.passive_solver(K)
-        r_star = self.expected_rank
-        if r_star == 0 or s.size == 0:
-            sigma, singular = 1.0, False
-        else:
-            sigma = float(s[r_star - 1] / s[0]) if len(s) >= r_star else 0.0
-            # s_r(K) >= s_r(K_p) = sigma s_1(K_p): when that clears the rank tolerance of K
-            # (bounded through the Frobenius norm), rank K >= r and no second SVD is needed
-            clear = sigma * s[0] > max(tol.rank_rtol * float(np.linalg.norm(K)), tol.rank_atol)
-            singular = sigma < tol.singular or (not clear and rank(K, tol) < r_star)
         pose = twist = acc = qd = qdd = None
         rate_d = acc_d = None
         if self.output_frame is not None:
             pin.framesForwardKinematics(self.model, self.data, q)
             pose = self.data.oMf[self.output_frame].homogeneous.copy()
         if rates is not None:
+            solve, _ = self.passive_solver(K)
             qd = self.rates(q, K, rates, solve)
             rate_d = self._named(qd)
             qdd = self.accelerations(q, K, qd, accels or {}, solve)
@@ -367,8 +569,10 @@ class PositionSolver:
                 pin.updateFramePlacements(self.model, self.data)
                 twist = pin.getFrameVelocity(self.model, self.data, self.output_frame, LWA).vector.copy()
                 acc = pin.getFrameClassicalAcceleration(self.model, self.data, self.output_frame, LWA).vector.copy()
-        return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), sigma, pose,
-                        rate_d, acc_d, twist, acc, qd, qdd, outside_limits(mech, q))
+        outside = outside_limits(mech, q)
+        return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), float(sigma), pose,
+                        rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),
+                        link_angles=self._link_angles(q), sigmas=m)
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
@@ -419,6 +623,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     The target is one more cut joint, a weld between a ground frame at ``pose``
     and the output link, solved together with the loop closures.  Raises
     AssemblyError (saying how close it got) when the pose is unreachable.
+    Solutions are labelled and ordered as those of PositionSolver.solve.
     """
     from .closure import ClosureSystem, CutJoint
 
@@ -433,22 +638,25 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
     start_list = solver._starts(starts, seed)
     found, best = solver.distinct(system, start_list)
-    found = [(sig, q, a, system.jacobian(q)) for sig, q, a in found]
     if not found:
         xyz = ", ".join(f"{x:.6g}" for x in pose.translation)
-        raise AssemblyError(mech.path, best, mech.tolerances.max_iterations,
+        raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
                             detail=f"the pose of '{output}' at ({xyz}) is unreachable from "
                                    f"{len(start_list)} starting configurations")
-    ref = solver._signature(solver._reference)
-    found.sort(key=lambda f: (len(outside_limits(mech, f[1])) > 0, float(np.linalg.norm(f[0] - ref))))
+    solver.generic(hint=found[0][1])
+    ref = solver._reference()
+    ref_sig = solver._signature(ref if ref is not None else found[0][1])
+    needed = mech.nv - solver.idle_dofs
     sols = []
-    for _, q, a, J in found:
-        s = np.linalg.svd(J, compute_uv=False)
-        needed = mech.nv - solver.idle_dofs
+    for _, q, a in found:
+        s = np.linalg.svd(system.jacobian(q), compute_uv=False)
         sigma = float(s[needed - 1] / s[0]) if 0 < needed <= len(s) else 1.0
         pin.framesForwardKinematics(model, mech.data, q)
+        outside = outside_limits(mech, q)
         sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
                              sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
-                             outside_limits=outside_limits(mech, q)))
+                             outside_limits=outside, labels=solver._labels(q, outside),
+                             link_angles=solver._link_angles(q)))
+    sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           0, (), output, solver.angular_names())

@@ -80,7 +80,9 @@ def mobility_dict(r) -> dict:
         "notes": list(r.notes),
         "output_motion": r.output.label if r.output is not None else None,
         "output": out,
-        "assembly": {"residual": r.residual, "iterations": r.iterations, "configurations_sampled": r.samples},
+        "redundant_constraints": r.redundant_constraints,
+        "assembly": {"residual": r.residual, "iterations": r.iterations, "configurations_sampled": r.samples,
+                     "start": r.assembly_start, "starts": r.starts, "configuration": r.configuration},
     })
     return d
 
@@ -115,7 +117,9 @@ def mobility_text(r) -> str:
         ("constraint rows (cut joints)", r.constraint_rows),
         ("rank of constraint Jacobian K", r.rank),
         ("mobility M = coordinates - rank K", r.mobility),
-        ("overconstraint (rows - rank = M - count)", r.overconstraint),
+        ("overconstraint, spatial (rows - rank = M - Kutzbach)", r.overconstraint),
+        *([(f"redundant constraints {'in the plane (M - Gruebler)' if t.motion_space == 'planar' else 'on the sphere (M - spherical count)'}",
+            r.redundant_constraints)] if t.motion_space != "spatial" else []),
         ("idle DOFs", r.idle_dofs),
         ("effective mobility", r.effective_mobility),
         ("actuated joints", ", ".join(r.actuated) + (f"  [{r.actuation_source}]" if r.actuated else "") or "none declared"),
@@ -130,8 +134,8 @@ def mobility_text(r) -> str:
     lines.append(f"classification: {r.classification}")
     for n in r.notes:
         lines.append(f"note: {n}")
-    lines.append(f"(assembled: closure residual {r.residual:.2e} after {r.iterations} iterations; "
-                 f"rank taken over {r.samples} assembled configurations)")
+    lines.append(f"(assembled from {r.assembly_start}: closure residual {r.residual:.2e} after {r.iterations} "
+                 f"iterations; generic rank taken over {r.samples} assembled configurations)")
     return "\n".join(lines)
 
 
@@ -156,9 +160,16 @@ def position_dict(res) -> dict:
     sols = []
     for s in res.solutions:
         d = {"joints": s.joints, "residual": s.residual, "iterations": s.iterations, "singular": s.singular,
-             "sigma_min": s.sigma_min, "outside_limits": list(s.outside_limits)}
+             "sigma_min": s.sigma_min, "outside_limits": list(s.outside_limits),
+             "physical": s.physical, "labels": list(s.labels), "continuum": s.continuum, "merged": s.merged}
+        if s.sigmas is not None:
+            d["sigmas"] = s.sigmas
+        if s.link_angles is not None:
+            d["link_angles"] = s.link_angles
         if s.output_pose is not None:
             d["output_pose"] = s.output_pose.tolist()
+            d["output_position"] = s.output_position.tolist()
+            d["output_rpy"] = s.output_rpy.tolist()
         if s.rates is not None:
             d["rates"] = s.rates
             d["accelerations"] = s.accelerations
@@ -167,7 +178,15 @@ def position_dict(res) -> dict:
             d["output_acceleration"] = s.output_acceleration.tolist()
         sols.append(d)
     return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
-            "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols}
+            "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols,
+            "physical_solutions": sum(s.physical for s in res.solutions)}
+
+
+def value_text(name, value, angular) -> str:
+    """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
+    if angular:
+        return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
+    return f"{value:.9g} m"
 
 
 def trace_text(res, row_labels, passive_names) -> str:
@@ -183,18 +202,36 @@ def trace_text(res, row_labels, passive_names) -> str:
     return "\n".join(lines)
 
 
-def position_text(res, degrees=True) -> str:
-    lines = ["inputs: " + ", ".join(f"{k} = {v:.6g}" for k, v in res.inputs.items() if isinstance(v, float)),
-             f"{len(res.solutions)} assembly mode(s) found from {res.starts} starting configurations"]
+def position_text(res, degrees=True, show_all=False, length=None) -> str:
+    """The solutions of a position analysis; without ``show_all`` only the physically meaningful
+    ones (no labels) when there are any, with a line saying how many more exist."""
+    inputs = ", ".join(f"{k} = {value_text(k, v, k in res.angular)}" for k, v in res.inputs.items()
+                       if isinstance(v, float))
+    shown = list(res.solutions) if show_all else [s for s in res.solutions if s.physical] or list(res.solutions)
+    hidden = len(res.solutions) - len(shown)
+    lines = [f"inputs: {inputs}" if inputs else "inputs: -",
+             f"{len(res.solutions)} assembly mode(s) found from {res.starts} starting configurations"
+             + (f"; measures dimensionless with L = {length:.4g} m" if length else "")]
+    if hidden:
+        why = sorted({lab.split(":")[0].split(" (")[0] for s in res.solutions if not s.physical for lab in s.labels})
+        lines.append(f"{hidden} more mode(s) the mechanism cannot reach by moving ({'; '.join(why)}): "
+                     "--all shows them")
     if res.free_dofs:
         lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
                      "the solutions form a continuum and only some are shown")
-    for k, s in enumerate(res.solutions, 1):
-        flag = "  SINGULAR (passive joints not determined: limit position or singularity)" if s.singular else ""
+    for k, s in enumerate(shown, 1):
+        if s.continuum:
+            flag = ("  SINGULAR: these inputs leave a finite motion (a continuum of configurations"
+                    + (f"; {s.merged} solver results lie on it, one is shown)" if s.merged > 1 else ")"))
+        elif s.singular:
+            flag = "  SINGULAR (passive joints not determined: limit position or singularity" + (
+                f"; a double root, reached {s.merged} ways)" if s.merged > 1 else ")")
+        else:
+            flag = ""
         lines.append(f"\nsolution {k}: residual {s.residual:.2e}, {s.iterations} iterations, "
                      f"sigma_min {s.sigma_min:.3g}{flag}")
-        if s.outside_limits:
-            lines.append(f"  outside the joint limits of the file: {', '.join(s.outside_limits)}")
+        for lab in s.labels:
+            lines.append(f"  not reached by moving: {lab}")
         rows = []
         for name, v in s.joints.items():
             row = [name, f"{v:.9g}"]
@@ -204,9 +241,13 @@ def position_text(res, degrees=True) -> str:
             rows.append(row)
         headers = ["joint", "value [rad or m]", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
         lines.append(table(headers, rows))
+        if s.link_angles:
+            lines.append("link angles (absolute, in the plane from the ground's x axis): " + ", ".join(
+                f"{n} {np.degrees(a):.6g} deg" for n, a in s.link_angles.items()))
         if s.output_pose is not None:
             p = s.output_pose
-            lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m")
+            lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m, roll pitch yaw "
+                         f"{_fmt_vec(np.degrees(s.output_rpy), 0)} deg")
             lines.append("  rotation " + " | ".join(_fmt_vec(r, 0) for r in p[:3, :3]))
         if s.output_twist is not None:
             lines.append(f"  twist (v, w) {_fmt_vec(s.output_twist, 0)}")
@@ -215,11 +256,17 @@ def position_text(res, degrees=True) -> str:
 
 
 def sweep_text(res, info=None, mus=None) -> str:
-    lines = [f"sweep of {res.input} from {res.requested[0]:.6g} to {res.requested[1]:.6g} "
-             f"in {res.requested[2]} steps: {len(res.values)} configurations"]
+    angular = res.unit == "rad"
+    lines = [f"sweep of {res.input} from {value_text(res.input, res.requested[0], angular)} to "
+             f"{value_text(res.input, res.requested[1], angular)} in {res.requested[2]} steps"
+             + (", through limit positions (--turn)" if res.turn else "") + f": {len(res.values)} configurations"]
+    for lim in res.limits:
+        lines.append(f"limit position at {res.input} = {value_text(res.input, lim.input, angular)} "
+                     f"(relative sigma {lim.sigma:.2g})" + ("; the motion turns back there" if res.turn else ""))
+    if res.circuit_closed:
+        lines.append("the motion came back to its starting configuration: the whole circuit is traced")
     if res.stopped_at is not None:
-        lines.append(f"stopped: branch limit at {res.input} = {res.stopped_at:.10g} "
-                     f"({np.degrees(res.stopped_at):.6g} deg): {res.stop_reason}")
+        lines.append(f"stopped at {res.input} = {value_text(res.input, res.stopped_at, angular)}: {res.stop_reason}")
     if info is not None:
         lines.append(f"{info.kind}: " + ", ".join(f"{k} {v:.6g} m" for k, v in info.lengths.items()))
         lines.append(f"  {info.grashof}")
@@ -239,7 +286,7 @@ def sweep_text(res, info=None, mus=None) -> str:
     step = max(len(res.values) // 10, 1)
     rows = [[f"{res.values[k]:.6g}"] + [f"{x:.6g}" for x in res.joints[k]] for k in range(0, len(res.values), step)]
     lines.append("")
-    lines.append(table(["input"] + list(res.names), rows))
+    lines.append(table([f"input [{res.unit}]"] + list(res.names), rows))
     return "\n".join(lines)
 
 
@@ -293,7 +340,10 @@ def singularity_text(rep) -> str:
     def yes(b):
         return "YES" if b else "no"
 
-    lines = [f"inputs: {', '.join(rep.inputs) or 'none declared'}" + (f"   output: {rep.output}" if rep.output else ""),
+    out = f"   output: {rep.output}" + (" (its origin as a point)" if rep.point else "") if rep.output else ""
+    lines = [f"inputs: {', '.join(rep.inputs) or 'none declared'}" + out,
+             f"(measures of dimensionless matrices: lengths divided by the characteristic length "
+             f"L = {rep.length:.4g} m)",
              table(["singularity", "present", "relative sigma_min"], [
                  ("serial / inverse-kinematic (output loses a direction)", yes(rep.serial),
                   f"{rep.sigmas['serial']:.3g}" if rep.output else "- (no --output)"),
@@ -305,7 +355,7 @@ def singularity_text(rep) -> str:
     if rep.condition is not None:
         lines.append(f"condition number {rep.condition:.4g}" + (
             f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
-            + f" (translations divided by the characteristic length L = {rep.length:.4g} m)")
+            + f" (L = {rep.length:.4g} m)")
     for t in rep.singular_twists:
         lines.append(f"\n{t.kind} singular direction:")
         if t.joint_rates:

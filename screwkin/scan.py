@@ -37,6 +37,7 @@ class ScanResult:
     Q: np.ndarray  # (N, nq) sampled configurations
     theta: np.ndarray  # (N, n) the chain joints' values [rad or m]
     values: np.ndarray  # (N,) the measure at each
+    point: bool = False  # the output's origin analysed as a point
 
     @property
     def samples(self) -> int:
@@ -58,6 +59,7 @@ class ScanResult:
         return {
             "output": self.output, "joints": list(self.joints), "samples": self.samples, "seed": self.seed,
             "measure": self.measure, "length": self.length if self.measure == "sigma_ratio" else None,
+            "point": self.point,
             "threshold": self.threshold,
             "min": float(self.values[k]), "min_configuration": dict(zip(self.joints, map(float, self.theta[k]))),
             "max": float(self.values[int(np.argmax(a))]),
@@ -72,14 +74,16 @@ class ScanResult:
 
 
 def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str = "sigma_ratio",
-         length: float | None = None, workers: int | None = None, method: str = "svd") -> ScanResult:
+         length: float | None = None, workers: int | None = None, method: str = "svd",
+         point: bool = False) -> ScanResult:
     """Sample ``samples`` configurations of the chain from the ground to ``output``,
     uniform within the joint limits (revolute joints without limits: a full turn), and
     evaluate the measure at each.  Mechanisms with closed loops are refused: their
     configurations are not free to sample (``screwkin map`` and ``sweep --singularities``
-    scan them along their inputs)."""
+    scan them along their inputs).  length: the characteristic length [m] (default
+    ``mech.length``, the same as every other command); point: the output's origin as a
+    point (3 translations; sigma_ratio only)."""
     from .batch import SerialJacobians
-    from .singular import characteristic_length
 
     if measure not in MEASURES:
         raise UsageError(f"unknown measure '{measure}': {' or '.join(MEASURES)}")
@@ -90,6 +94,8 @@ def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str =
                          f"{len(mech.cuts)} closed loop(s): use `screwkin map` or `screwkin sweep --singularities`")
     sj = SerialJacobians(mech, output, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
     chain = sj.chain
+    if measure == "det" and point:
+        raise UsageError("--point takes the sigma_ratio measure (a 3 x n Jacobian has no determinant)")
     if measure == "det" and len(chain.joints) != 6:
         raise UsageError(f"{mech.path}: the chain to '{output}' has {len(chain.joints)} joints: a determinant needs "
                          "six (a square Jacobian); use --measure sigma_ratio")
@@ -114,10 +120,11 @@ def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str =
             Q[:, c.idx_q], Q[:, c.idx_q + 1] = np.cos(x), np.sin(x)
         else:
             Q[:, c.idx_q] = x
-    L = float(length) if length else characteristic_length(mech, mech.neutral())
+    L = float(length) if length else mech.length
     workers = workers or os.cpu_count() or 1
     if measure == "det":
         values = sj.measures(Q, "det", workers=workers)
     else:
-        values = sj.measures(Q, "sigma_ratio", scale_translation=L, workers=workers, method=method)
-    return ScanResult(output, tuple(chain.joints), measure, L, mech.tolerances.singular, seed, Q, theta, values)
+        values = sj.measures(Q, "sigma_ratio", scale_translation=L, workers=workers, method=method, point=point)
+    return ScanResult(output, tuple(chain.joints), measure, L, mech.tolerances.singular, seed, Q, theta, values,
+                      point)

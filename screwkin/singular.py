@@ -6,15 +6,21 @@ and passive joints p, and an output link o:
 - constraint singularity: rank K drops below its generic value: the mobility
   changes or branches meet; the extra motion is reported;
 - actuator (direct-kinematic) singularity: with the inputs locked the passive
-  joints can still move (beyond the idle spins): K_p loses rank;
+  joints can still move (beyond the idle spins): K_p loses rank.  A limit
+  position (a branch limit of a motion along an input) is one;
 - serial (inverse-kinematic) singularity: the output link loses a direction of
   motion: rank(J_o V) drops below its generic value;
-- stationary joints: joints whose rate the loops force to zero (their row of V
-  vanishes), while generically they move.
+- stationary joints: joints whose rate the loops force to zero at this
+  configuration (their row of V vanishes), while at generic configurations they
+  move.
 
-Each measure is a singular value relative to the largest of its matrix; mixed
-translation/rotation quantities are made dimensionless with a characteristic
-length L (translations divided by L), stated in the result.
+Each measure is a singular value relative to the largest of its matrix, taken
+of dimensionless matrices: translations (the position rows of K, the linear
+velocity rows of J_o) are divided by the mechanism's one characteristic length
+L (``Mechanism.length``) and the rates of sliding joints multiplied by it, so
+the numbers do not depend on the unit of length and are the same in every
+command (``solve``'s singular flag comes from :func:`measures` too).  The
+generic ranks are the largest over the mechanism's generic configurations.
 """
 
 from __future__ import annotations
@@ -25,12 +31,14 @@ import numpy as np
 import pinocchio as pin
 
 from ._pin import frame_jacobian
-from .mobility import null_space, rank
+from .linalg import null_space, rank
 from .screws import screw_of
 
-__all__ = ["SingularityReport", "classify"]
+__all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
+           "KINDS"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+KINDS = ("serial", "actuator", "constraint")
 
 
 @dataclass(frozen=True)
@@ -55,6 +63,7 @@ class SingularityReport:
     singular_twists: tuple
     inputs: tuple
     output: str | None
+    point: bool = False  # the output link's origin analysed as a point
 
     def to_dict(self) -> dict:
         return {
@@ -62,21 +71,11 @@ class SingularityReport:
             "stationary_joints": list(self.stationary_joints), "sigma_min": self.sigma_min,
             "sigmas": self.sigmas, "condition": self.condition, "manipulability": self.manipulability,
             "characteristic_length": self.length, "inputs": list(self.inputs), "output": self.output,
+            "point": self.point,
             "singular_twists": [{"kind": t.kind, "joint_rates": t.joint_rates,
                                  "twist": list(t.twist) if t.twist is not None else None, "screw": t.screw}
                                 for t in self.singular_twists],
         }
-
-
-def characteristic_length(mech, q) -> float:
-    """RMS distance of the joint centres from their centroid [m] (at least 1 mm)."""
-    data = mech.model.createData()
-    pin.framesForwardKinematics(mech.model, data, q)
-    pts = np.array([data.oMf[f].translation for f, fr in enumerate(mech.model.frames)
-                    if fr.type == pin.FrameType.JOINT])
-    if len(pts) < 2:
-        return 1.0
-    return max(float(np.sqrt(np.mean(np.sum((pts - pts.mean(0)) ** 2, axis=1)))), 1e-3)
 
 
 def _rel(s, k):
@@ -88,125 +87,159 @@ def _rel(s, k):
     return float(s[k - 1] / s[0])
 
 
-class Generic:
-    """Generic ranks of a mechanism for given inputs and output, measured at the
-    assembled configurations of the mobility analysis."""
+@dataclass(frozen=True)
+class Scaled:
+    """Dimensionless matrices at a configuration: K (minimal rows, position rows / L),
+    J (the output frame origin's twist, linear rows / L; only the linear rows for a point),
+    both with the columns of sliding joints multiplied by L; V an orthonormal basis of the
+    null space of K (rates in the same scaled coordinates)."""
 
-    def __init__(self, mech, inputs, output=None):
-        tol = mech.tolerances
-        mob = mech.mobility(output=output)
-        self.rank_K = mob.rank
-        self.idle = mob.idle_dofs
-        self.a = mech.velocity_indices(inputs)
-        self.p = np.setdiff1d(np.arange(mech.nv), self.a)
-        K = mech.closure.jacobian(mob.q)
-        self.rank_Kp = rank(K[:, self.p], tol) if K.size else 0
-        self.out_dim = mob.output.dimension if mob.output is not None else None
-        V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
-        self.moving = np.linalg.norm(V, axis=1) > 1e-9  # joints that generically move
+    K: np.ndarray
+    J: np.ndarray | None
+    V: np.ndarray
+    L: float
 
 
-def classify(mech, q, inputs=None, output=None, length=None, generic=None) -> SingularityReport:
-    """Classify the configuration q (assembled) for the given inputs and output link."""
-    tol = mech.tolerances
-    inputs = list(inputs or mech.actuated)
-    g = generic or Generic(mech, inputs, output)
-    L = length or characteristic_length(mech, q)
-    names = mech.coordinate_names
+def scaled_jacobians(mech, q, output=None, point: bool = False, length: float | None = None) -> Scaled:
+    """The matrices of :class:`Scaled` at q (assembled)."""
+    L = float(length or mech.length)
+    slide = mech.translational
     K = mech.closure.jacobian(q)
-    nv = mech.nv
     if K.size:
-        sK = np.linalg.svd(K, compute_uv=False)
-        V = null_space(K, tol, nv)
+        K = K.copy()
+        K[mech.closure.position_rows] /= L
+        K[:, slide] *= L
+        V = null_space(K, mech.tolerances, mech.nv)
     else:
-        sK, V = np.zeros(0), np.eye(nv)
-    sig_c = _rel(sK, g.rank_K)
-    constraint = g.rank_K > 0 and sig_c < tol.singular
-    twists = []
-    model = mech.model
-    data = model.createData()
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    J = J_out = None
+        K, V = np.zeros((0, mech.nv)), np.eye(mech.nv)
+    J = None
     if output is not None:
-        fid = mech.link_frame(output)
-        # spatial twists (v at the world origin, w) for the screws: their axes are where they are in the world
-        J = frame_jacobian(model, data, fid, pin.ReferenceFrame.WORLD).copy()
-        J[:3] /= L
-        # the measures from the twist of the output frame's origin (world axes): they must not
-        # depend on where the world origin is
-        J_out = frame_jacobian(model, data, fid, LWA).copy()
-        J_out[:3] /= L
-        origin = data.oMf[fid].translation.copy()
-    if constraint:
-        _, _, vt = np.linalg.svd(K)
-        extra = vt[g.rank_K - 1]
-        twists.append(_motion_twist("constraint", extra, names, J, L))
-    # actuator: K_p loses rank (inputs locked, passive joints still free beyond the idle spins)
-    Kp = K[:, g.p] if K.size else np.zeros((0, len(g.p)))
-    if Kp.size and g.rank_Kp:
-        sKp = np.linalg.svd(Kp, compute_uv=False)
-        sig_a = _rel(sKp, g.rank_Kp)
-    else:
-        sig_a = 1.0
-    actuator = len(inputs) > 0 and sig_a < tol.singular
-    if actuator:
-        _, _, vt = np.linalg.svd(Kp)
-        x = np.zeros(nv)
-        x[g.p] = vt[g.rank_Kp - 1]
-        twists.append(_motion_twist("actuator", x, names, J, L))
-    # serial: the output loses a direction of its generic twist space
-    sig_s, cond, manip, serial = 1.0, None, None, False
-    if J_out is not None and g.out_dim:
-        T = J_out @ V
-        U, s, _ = np.linalg.svd(T, full_matrices=True)
-        # relative to the output Jacobian itself (V is orthonormal, so s <= |J|): stays
-        # meaningful when the output stops altogether
-        scale = np.linalg.norm(J_out, 2)
-        sig_s = float(s[g.out_dim - 1] / scale) if len(s) >= g.out_dim and scale > 0 else 0.0
-        serial = sig_s < tol.singular
-        kept = s[:g.out_dim]
-        cond = float(kept[0] / kept[-1]) if kept[-1] > 0 else float("inf")
-        manip = float(np.prod(kept))
-        if serial:  # the lost direction, as a spatial twist: v at the world origin = v_o - w x o
-            lost = U[:, g.out_dim - 1].copy()
-            lost[:3] = lost[:3] * L - np.cross(lost[3:], origin)
-            twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost).to_dict()))
-    elif Kp.size and g.rank_Kp:
-        s = np.linalg.svd(Kp, compute_uv=False)[:g.rank_Kp]
-        cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
-    stationary = tuple(n for k, n in enumerate(names)
-                       if g.moving[k] and V.shape[1] and np.linalg.norm(V[k]) < 1e-7)
-    sigmas = {"constraint": sig_c, "actuator": sig_a, "serial": sig_s}
-    return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
-                             L, tuple(twists), tuple(inputs), output)
-
-
-def measures(mech, q, g, output=None, length=1.0) -> dict:
-    """The relative smallest singular values of classify(), without the rest (for scans)."""
-    tol = mech.tolerances
-    K = mech.closure.jacobian(q)
-    out = {"constraint": _rel(np.linalg.svd(K, compute_uv=False), g.rank_K) if K.size else 1.0}
-    Kp = K[:, g.p] if K.size else np.zeros((0, 0))
-    out["actuator"] = _rel(np.linalg.svd(Kp, compute_uv=False), g.rank_Kp) if Kp.size and g.rank_Kp else 1.0
-    if output is not None and g.out_dim:
-        model = mech.model
-        data = mech.data
+        model, data = mech.model, mech.data
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
-        J = frame_jacobian(model, data, mech.link_frame(output), LWA).copy()  # as in classify
-        J[:3] /= length
-        V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
-        s = np.linalg.svd(J @ V, compute_uv=False)
-        out["serial"] = float(s[g.out_dim - 1] / np.linalg.norm(J, 2)) if len(s) >= g.out_dim else 0.0
+        J = frame_jacobian(model, data, mech.link_frame(output), LWA).copy()
+        J[:3] /= L
+        J[:, slide] *= L
+        if point:
+            J = J[:3]
+    return Scaled(K, J, V, L)
+
+
+class Generic:
+    """Generic ranks of a mechanism for given inputs and output: the largest over the
+    mechanism's generic configurations (``Mechanism.generic_configurations``), and the
+    joints that move there (a joint whose rate the loops force to zero everywhere is not
+    "stationary" at any one configuration)."""
+
+    def __init__(self, mech, inputs, output=None, point: bool = False, configurations=None):
+        tol = mech.tolerances
+        configs = configurations if configurations is not None else mech.generic_configurations()[1]
+        self.inputs = list(inputs)
+        self.output, self.point = output, point
+        self.a = mech.velocity_indices(self.inputs)
+        self.p = np.setdiff1d(np.arange(mech.nv), self.a)
+        self.rank_K = self.rank_Kp = 0
+        self.out_dim = 0 if output is not None else None
+        self.out_rotations = 0 if output is not None else None
+        self.moving = np.zeros(mech.nv, bool)
+        for q in configs:
+            S = scaled_jacobians(mech, q, output, point)
+            self.rank_K = max(self.rank_K, rank(S.K, tol))
+            self.rank_Kp = max(self.rank_Kp, rank(S.K[:, self.p], tol) if S.K.size else 0)
+            self.moving |= np.linalg.norm(S.V, axis=1) > 1e-6
+            if S.J is not None:
+                T = S.J @ S.V
+                self.out_dim = max(self.out_dim, rank(T, tol))
+                if not point:
+                    self.out_rotations = max(self.out_rotations, rank(T[3:], tol))
+        self.configurations = tuple(configs)
+
+
+def measures(mech, q, g: Generic, length: float | None = None) -> dict:
+    """The relative smallest singular values that decide each kind of singularity at q
+    (1 = far from it, 0 = singular): ``constraint`` of K, ``actuator`` of K_p (the passive
+    columns), ``serial`` of J_o V relative to |J_o| (only with an output).  One function for
+    every command: ``solve``'s singular flag, ``singularities``, sweeps and maps."""
+    S = scaled_jacobians(mech, q, g.output, g.point, length)
+    return _measures(S, g)
+
+
+def _measures(S: Scaled, g: Generic) -> dict:
+    out = {"constraint": _rel(np.linalg.svd(S.K, compute_uv=False), g.rank_K) if S.K.size else 1.0}
+    Kp = S.K[:, g.p] if S.K.size else np.zeros((0, len(g.p)))
+    out["actuator"] = _rel(np.linalg.svd(Kp, compute_uv=False), g.rank_Kp) if Kp.size and g.rank_Kp else 1.0
+    if S.J is not None and g.out_dim:
+        s = np.linalg.svd(S.J @ S.V, compute_uv=False)
+        scale = np.linalg.norm(S.J, 2)  # V is orthonormal: s <= |J|, meaningful when the output stops
+        out["serial"] = float(s[g.out_dim - 1] / scale) if len(s) >= g.out_dim and scale > 0 else 0.0
     return out
 
 
-def _motion_twist(kind, x, names, J, L):
+def classify(mech, q, inputs=None, output=None, length=None, generic=None, point: bool = False) -> SingularityReport:
+    """Classify the configuration q (assembled) for the given inputs and output link.
+    length: the characteristic length [m] (default ``mech.length``); point: the output
+    link's origin as a point (its 3 translations) instead of its full motion."""
+    tol = mech.tolerances
+    inputs = list(inputs if inputs is not None else mech.actuated)
+    g = generic or Generic(mech, inputs, output, point)
+    S = scaled_jacobians(mech, q, output, point, length)
+    L = S.L
+    sig = _measures(S, g)
+    names = mech.coordinate_names
+    slide = mech.translational
+    constraint = g.rank_K > 0 and sig["constraint"] < tol.singular
+    actuator = len(inputs) > 0 and sig["actuator"] < tol.singular
+    serial = "serial" in sig and sig["serial"] < tol.singular
+    twists = []
+    J_world = origin = None
+    if output is not None:
+        model, data = mech.model, mech.data
+        fid = mech.link_frame(output)
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        # spatial twists (v at the world origin, w) for the screws: their axes are where they are in the world
+        J_world = frame_jacobian(model, data, fid, pin.ReferenceFrame.WORLD).copy()
+        origin = data.oMf[fid].translation.copy()
+
+    def unscale(x):  # scaled rates -> joint rates [rad/s, m/s]
+        x = x.copy()
+        x[slide] *= L
+        return x
+
+    if constraint:
+        _, _, vt = np.linalg.svd(S.K)
+        twists.append(_motion_twist("constraint", unscale(vt[g.rank_K - 1]), names, J_world))
+    if actuator:
+        _, _, vt = np.linalg.svd(S.K[:, g.p])
+        x = np.zeros(mech.nv)
+        x[g.p] = vt[g.rank_Kp - 1]
+        twists.append(_motion_twist("actuator", unscale(x), names, J_world))
+    cond = manip = None
+    if S.J is not None and g.out_dim:
+        U, s, _ = np.linalg.svd(S.J @ S.V, full_matrices=True)
+        kept = s[:g.out_dim]
+        cond = float(kept[0] / kept[-1]) if len(kept) == g.out_dim and kept[-1] > 0 else float("inf")
+        manip = float(np.prod(kept))
+        if serial:  # the lost direction, as a spatial twist: v at the world origin = v_o - w x o
+            lost = np.zeros(6)
+            lost[:len(U)] = U[:, g.out_dim - 1]
+            lost[:3] *= L
+            lost[:3] -= np.cross(lost[3:], origin)
+            twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost).to_dict()))
+    elif S.K.size and g.rank_Kp:
+        s = np.linalg.svd(S.K[:, g.p], compute_uv=False)[:g.rank_Kp]
+        cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    stationary = tuple(n for k, n in enumerate(names)
+                       if g.moving[k] and S.V.shape[1] and np.linalg.norm(S.V[k]) < 1e-7)
+    sigmas = {k: sig.get(k, 1.0) for k in KINDS}
+    return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
+                             L, tuple(twists), tuple(inputs), output, point)
+
+
+def _motion_twist(kind, x, names, J):
     x = x / np.linalg.norm(x)
     rates = {n: float(v) for n, v in zip(names, x) if abs(v) > 1e-9}
     if J is None:
         return SingularTwist(kind, rates, None, None)
     t = J @ x
-    t[:3] *= L
     return SingularTwist(kind, rates, tuple(t), screw_of(t).to_dict() if np.linalg.norm(t) > 1e-12 else None)

@@ -1,47 +1,85 @@
-"""Tracking one assembly mode along an input motion (sweeps).
+"""Motion along an input (sweeps): one assembly mode followed by continuation.
 
-Predictor-corrector continuation: the previous solution and its velocity
-predict the next configuration (q + q' dx on the manifold), the closure solver
-corrects it with the input held.  A step whose correction fails, jumps to
-another branch, or lands on a singular configuration marks a limit of the
-branch; the limit input value is located by bisection and the sweep stops
-there, as the physical mechanism would (it cannot be driven past it).
+The solutions of the closure equations with the other inputs held form a curve
+(one DOF; idle spins aside).  It is followed by predictor-corrector steps:
+
+- while the input is a good parameter of the curve (its share of the tangent is
+  large), each step goes to the next value of the input's grid: the previous
+  solution moved along the tangent predicts it, the closure solver corrects it
+  with the input held;
+- where it is not (near a limit position, where the input stops and turns
+  back), the joint with the largest share of the tangent is held instead
+  (local parametrization), so the curve is followed through the turn.
+
+The tangent is the projection of the input's direction onto the null space of
+the constraint Jacobian (idle spins have no part in it), oriented continuously,
+in dimensionless coordinates (lengths divided by the characteristic length).
+A limit position lies where the input's component of the tangent changes sign;
+it is located by Brent's method on the held joint's value, to the precision of
+the closure solver (the input there is accurate to far better than 1e-9, since
+it is extremal), and listed as an actuator singularity (``limit``).  Without
+``turn`` the sweep stops there, as the physical mechanism would; with it the
+sweep goes on along the other branch, the input running back, until the
+mechanism returns to its start (the whole circuit), the input reaches the end
+of the range, or the step budget is spent.
 """
 
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
 
-from ._pin import frame_jacobian
 from .errors import AssemblyError, UsageError
+from .linalg import null_space
+from .singular import Generic, measures, scaled_jacobians
 
-__all__ = ["SweepResult", "sweep"]
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities"]
+
+
+@dataclass(frozen=True)
+class SweepSingularity:
+    kind: str  # "serial" | "actuator" | "constraint"
+    input: float  # input value, refined [rad or m]
+    sigma: float  # relative smallest singular value there
+    q: np.ndarray
+    limit: bool = False  # a limit position: the motion along the input cannot go on past it
+
+    def to_dict(self, mech=None) -> dict:
+        d = {"kind": self.kind, "input": self.input, "sigma": self.sigma, "limit": self.limit}
+        if mech is not None:
+            d["joints"] = mech.joint_values(self.q)
+        return d
 
 
 @dataclass(frozen=True)
 class SweepResult:
     input: str
-    values: np.ndarray  # input values reached [rad or m]
+    values: np.ndarray  # input values reached [rad or m], in the order of the motion
     q: np.ndarray  # (steps, nq)
     joints: np.ndarray  # (steps, n coordinates) joint values, names in `names`
     rates: np.ndarray  # (steps, nv): rates for an input rate of `rate`
     accelerations: np.ndarray  # (steps, nv)
     names: tuple  # coordinate names (velocity coordinates)
     rate: float
-    stopped_at: float | None  # input value of a branch limit, None when the sweep completed
+    stopped_at: float | None  # input value where the motion stopped short of the range, None when complete
     stop_reason: str | None
     requested: tuple  # (from, to, steps)
+    limits: tuple = ()  # SweepSingularity: the limit positions met (located)
+    turn: bool = False  # whether the sweep passed through limit positions
+    circuit_closed: bool = False  # the motion came back to its starting configuration
+    unit: str = "rad"  # the input's unit: "rad" or "m"
 
     def to_dict(self) -> dict:
         return {
-            "input": self.input,
+            "input": self.input, "input_unit": self.unit,
             "from": self.requested[0], "to": self.requested[1], "steps": self.requested[2],
             "completed": self.stopped_at is None,
             "stopped_at": self.stopped_at, "stop_reason": self.stop_reason,
+            "turn": self.turn, "circuit_closed": self.circuit_closed,
+            "singularities": [s.to_dict() for s in self.limits],
             "coordinates": list(self.names),
             "values": self.values.tolist(),
             "joints": self.joints.tolist(),
@@ -60,15 +98,115 @@ class SweepResult:
         return "\n".join(lines) + "\n"
 
 
-def _values(solver, q):
-    return np.array(list(solver.joint_values(q).values()))
+class _Stuck(Exception):
+    pass
+
+
+class _Tracker:
+    """The continuation along one input of a PositionSolver (see the module docstring)."""
+
+    def __init__(self, solver, name):
+        mech = self.mech = solver.mech
+        self.solver, self.model, self.closure = solver, solver.model, mech.closure
+        self.tol = mech.tolerances
+        self.ix = int(mech.velocity_indices([name])[0])
+        others = [n for n in solver.inputs if n != name]
+        self.frozen_other = tuple(int(i) for i in mech.velocity_indices(others))
+        self.free = np.setdiff1d(np.arange(mech.nv), self.frozen_other)
+        self.scale = np.where(mech.translational, mech.length, 1.0)  # scaled rate -> rate
+        # joints that can be held: one-DOF coordinates (revolute, prismatic, continuous)
+        self.holdable = np.zeros(mech.nv, bool)
+        for c in mech.coordinates:
+            if c.nv == 1:
+                self.holdable[c.idx_v] = True
+        self.holdable[list(self.frozen_other)] = False
+
+    def tangent(self, q, previous=None):
+        """Unit tangent of the curve at q in scaled coordinates (nv; zero on the held inputs),
+        oriented like ``previous``: the input's direction projected onto the null space of K."""
+        K = self.closure.jacobian(q)
+        nv = self.mech.nv
+        Ks = (K * self.scale)[:, self.free] if K.size else np.zeros((0, len(self.free)))
+        N = null_space(Ks, self.tol, len(self.free))
+        e = np.zeros(len(self.free))
+        e[np.searchsorted(self.free, self.ix)] = 1.0
+        t = N @ (N.T @ e)
+        if np.linalg.norm(t) < 1e-7 and previous is not None:  # at a limit position itself
+            t = N @ (N.T @ previous[self.free])
+        n = np.linalg.norm(t)
+        if n < 1e-300:
+            raise _Stuck("the mechanism cannot move along this input here")
+        out = np.zeros(nv)
+        out[self.free] = t / n
+        if previous is not None and out @ previous < 0:
+            out = -out
+        return out
+
+    def hold(self, t):
+        """The velocity index of the joint to hold for a step along t: the input when it has a
+        large share of the tangent, else the one-DOF joint with the largest share."""
+        scores = np.where(self.holdable, np.abs(t), -1.0)
+        best = int(np.argmax(scores))
+        return self.ix if abs(t[self.ix]) >= 0.5 * scores[best] else best
+
+    def step(self, q, t, sigma, held):
+        """Move sigma (scaled) along t, hold joint ``held`` there, close the loops again."""
+        pred = pin.integrate(self.model, q, self.scale * t * sigma)
+        try:
+            a = self.closure.solve(pred, frozen=tuple(sorted(set(self.frozen_other) | {held})))
+        except AssemblyError:
+            raise _Stuck("the loops cannot be closed") from None
+        jump = np.linalg.norm(pin.difference(self.model, pred, a.q) / self.scale)
+        if jump > max(0.5 * abs(sigma), 1e-7):
+            raise _Stuck("the correction jumps away from the curve")
+        return a.q
+
+    def at_input(self, q_from, x_from, x, t):
+        """The configuration at input value x, predicted from q_from (input x_from) along t."""
+        dx = (x - x_from) / self.scale[self.ix]
+        if abs(t[self.ix]) < 1e-12:
+            raise _Stuck("the input does not move here")
+        return self.step(q_from, t, dx / t[self.ix], self.ix)
+
+    def input_change(self, q0, q1) -> float:
+        return float(pin.difference(self.model, q0, q1)[self.ix])
+
+    def limit(self, qa, ta, qb, held):
+        """The limit position between qa and qb (the input's tangent component changes sign),
+        with joint ``held`` as the parameter: (configuration, input offset from qa)."""
+        delta = pin.difference(self.model, qa, qb)
+        frozen = tuple(sorted(set(self.frozen_other) | {held}))
+        cache = {}
+
+        def at(s):
+            if s not in cache:
+                cache[s] = self.closure.solve(pin.integrate(self.model, qa, s * delta), frozen=frozen).q
+            return cache[s]
+
+        def f(s):
+            return float(self.tangent(at(s), ta)[self.ix])
+
+        from scipy.optimize import brentq
+
+        fa, fb = float(ta[self.ix]), f(1.0)
+        if fa == 0 or fb == 0 or np.sign(fa) == np.sign(fb):  # pragma: no cover - the caller saw a change
+            s = 1.0
+        else:
+            s = brentq(f, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=100)
+        q = at(s)
+        return q, self.input_change(qa, q)
 
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-          near: dict | None = None, rate: float = 1.0, progress: bool = False) -> SweepResult:
-    """Track one assembly mode while input ``name`` goes from start to stop in ``steps`` steps.
+          near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
+          max_steps: int | None = None) -> SweepResult:
+    """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
+    steps of the input (see the module docstring).
 
     solver: a PositionSolver whose inputs include ``name``; the other inputs stay at ``fixed``.
+    turn: pass through limit positions onto the other branch (the input then runs back);
+    the sweep ends when the mechanism is back at its start, the input reaches ``stop``, or
+    after ``max_steps`` recorded configurations (default 20 * steps + 100).
     """
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -80,90 +218,186 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     if missing:
         raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
     mech = solver.mech
-    closure = mech.closure
-    xs = np.linspace(start, stop, steps + 1)
-    first = solver.solve({name: xs[0], **fixed}, near=near, starts=8 if near is None else 0)
-    q = first.solutions[0].q
+    tr = _Tracker(solver, name)
+    max_steps = max_steps or 20 * steps + 100
+    h = (stop - start) / steps
+    first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
+    q0 = first.solutions[0].q
     rates_in = {n: 0.0 for n in solver.inputs}
     rates_in[name] = rate
-    K = closure.jacobian(q)
-    solve, _ = solver.passive_solver(K)
-    qd = solver.rates(q, K, rates_in, solve)
-    Q, V, A, X = [q], [qd], [solver.accelerations(q, K, qd, {}, solve)], [xs[0]]
+    unit = "m" if mech.translational[tr.ix] else "rad"
+    X, Q = [start], [q0]
+    limits = []
     stopped = reason = None
+    closed = False
+    direction = np.sign(h) or 1.0
     show = progress and sys.stderr.isatty() and steps >= 200
-    for k in range(1, len(xs)):
-        x = xs[k]
-        try:
-            q_new, qd_new, K_new, solve = _step(solver, q, qd, X[-1], x, name, rate, rates_in)
-        except _Limit as exc:
-            stopped, reason = _locate_limit(solver, q, qd, X[-1], x, name, rate, rates_in), str(exc)
-            break
-        q, qd = q_new, qd_new
-        Q.append(q)
-        V.append(qd)
-        A.append(solver.accelerations(q, K_new, qd, {}, solve))
-        X.append(x)
-        if show and k % max(steps // 50, 1) == 0:
-            sys.stderr.write(f"\rsweep {k}/{steps} [{'#' * (50 * k // steps):<50}]")
+    try:
+        t = tr.tangent(q0)
+    except _Stuck as exc:
+        t, stopped, reason = None, start, str(exc)
+    if t is not None and t[tr.ix] * direction < 0:
+        t = -t
+    q, x, k = q0, float(start), 0  # k: index of the last grid value reached (x = start + k h on the grid)
+
+    def grid_between(xa, xb):
+        """Grid values strictly after xa up to xb (inclusive) in the direction of motion, within the range."""
+        if h == 0:
+            return []
+        lo_k = (xa - start) / h
+        hi_k = (xb - start) / h
+        ks = range(int(np.floor(lo_k + 1e-9)) + 1, int(np.floor(hi_k + 1e-9)) + 1) if hi_k > lo_k else \
+            range(int(np.ceil(lo_k - 1e-9)) - 1, int(np.ceil(hi_k - 1e-9)) - 1, -1)
+        return [start + j * h for j in ks]
+
+    def record(qa, xa, ta, qb, xb, tb=None):
+        """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
+        position between them, each predicted from the nearer end (not from a limit position:
+        there the input does not move, pass tb=None for such an end)."""
+        for g in grid_between(xa, xb):
+            if forward() and (g - stop) * direction > 1e-12 * max(1.0, abs(stop)):
+                break
+            near_b = tb is not None and abs(g - xb) < abs(g - xa)
+            try:
+                qg = tr.at_input(qb, xb, g, tb) if near_b else tr.at_input(qa, xa, g, ta)
+            except _Stuck:
+                continue
+            X.append(g)
+            Q.append(qg)
+
+    def record_back(q_lim, x_lim, qb, xb, tb):
+        """After a limit position: the grid values between it and qb, predicted from qb."""
+        for g in grid_between(x_lim, xb):
+            try:
+                qg = tr.at_input(qb, xb, g, tb)
+            except _Stuck:
+                continue
+            X.append(g)
+            Q.append(qg)
+
+    def forward():
+        return direction * np.sign(h) > 0
+
+    def back_at_start():
+        return (turn and forward() and len(X) > 2 and abs(X[-1] - start) < 1e-9 * max(1.0, abs(h))
+                and np.linalg.norm(pin.difference(mech.model, Q[-1], q0) / tr.scale) < 1e-6)
+
+    if h != 0 and t is not None:
+        sigma = abs(h) / tr.scale[tr.ix]
+        while len(X) < max_steps:
+            end_x = float(stop)
+            if forward() and (end_x - x) * direction <= 1e-12 * max(1.0, abs(end_x)):
+                break  # the input reached the end of the range
+            held = tr.hold(t)
+            if held == tr.ix:  # the input is a good parameter: go to its next grid value
+                nxt = grid_between(x, x + direction * abs(h) * 1.000001)
+                target = nxt[0] if nxt else x + direction * abs(h)
+                if forward() and (target - end_x) * direction > 0:
+                    target = end_x
+                try:
+                    q_new = tr.at_input(q, x, target, t)
+                    t_new = tr.tangent(q_new, t)
+                    if t_new[tr.ix] * direction <= 0:
+                        raise _Stuck("a limit position lies in this step")
+                except _Stuck:
+                    held = int(np.argmax(np.where(tr.holdable & (np.arange(mech.nv) != tr.ix), np.abs(t), -1)))
+                    if not tr.holdable[held]:
+                        stopped, reason = x, "the motion cannot go on along this input"
+                        break
+                    sigma = min(sigma, abs(h) / tr.scale[tr.ix]) * 0.5
+                else:
+                    X.append(target)
+                    Q.append(q_new)
+                    q, x, t = q_new, target, t_new
+                    if back_at_start():
+                        closed = True
+                        break
+                    continue
+            # an arc step with a passive joint held
+            try:
+                q_new = tr.step(q, t, sigma, held)
+                t_new = tr.tangent(q_new, t)
+            except _Stuck as exc:
+                sigma *= 0.5
+                if sigma < 1e-10:
+                    stopped, reason = x, f"the motion cannot be continued past this configuration ({exc})"
+                    break
+                continue
+            x_new = x + tr.input_change(q, q_new)
+            if t_new[tr.ix] * t[tr.ix] < 0:  # the input turned back between q and q_new: a limit position
+                q_lim, dx = tr.limit(q, t, q_new, held)
+                x_lim = x + dx
+                record(q, x, t, q_lim, x_lim)
+                sig = measures(mech, q_lim, solver.generic())["actuator"]
+                limits.append(SweepSingularity("actuator", float(x_lim), float(sig), q_lim, limit=True))
+                if not turn:
+                    stopped = float(x_lim)
+                    reason = ("limit position: the passive joints become undetermined (an actuator singularity); "
+                              "the input cannot go further on this branch")
+                    break
+                direction = -direction
+                record_back(q_lim, x_lim, q_new, x_new, t_new)
+            else:
+                record(q, x, t, q_new, x_new, t_new)
+            q, x, t = q_new, x_new, t_new
+            sigma = min(sigma * 1.5, abs(h) / tr.scale[tr.ix])
+            if back_at_start():
+                closed = True
+                break
+            if show:
+                sys.stderr.write(f"\rsweep {min(len(X), steps)}/{steps}")
+        else:
+            stopped, reason = x, f"the step budget ({max_steps} configurations) is spent"
     if show:
         sys.stderr.write("\n")
+    if turn and stopped is None and not closed and (stop - x) * np.sign(h) > 1e-9 * max(1.0, abs(stop)):
+        stopped, reason = x, "the motion did not reach the end of the range"
+    V, A = [], []
+    for qk in Q:
+        K = mech.closure.jacobian(qk)
+        solve, _ = solver.passive_solver(K)
+        qd = solver.rates(qk, K, rates_in, solve)
+        V.append(qd)
+        A.append(solver.accelerations(qk, K, qd, {}, solve))
     Qa = np.array(Q)
-    return SweepResult(name, np.array(X), Qa, np.array([_values(solver, qq) for qq in Q]), np.array(V) / 1.0,
-                       np.array(A), tuple(mech.coordinate_names), rate, stopped, reason, (start, stop, steps))
+    return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
+                       np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
+                       (start, stop, steps), tuple(limits), turn, closed, unit)
 
 
-@dataclass(frozen=True)
-class SweepSingularity:
-    kind: str  # "serial" | "actuator" | "constraint"
-    input: float  # input value, refined [rad or m]
-    sigma: float  # relative smallest singular value there
-    q: np.ndarray
-
-
-def _matrix(mech, q, kind, g, output, L, V_ref=None):
-    """The matrix whose rank loss defines a singularity of this kind at q."""
-    from .mobility import null_space
-
-    K = mech.closure.jacobian(q)
+def _matrix(mech, q, kind, g, V_ref=None):
+    """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""
+    S = scaled_jacobians(mech, q, g.output, g.point)
     if kind == "constraint":
-        return K
+        return S.K
     if kind == "actuator":
-        return K[:, g.p]
-    data = mech.data
-    pin.computeJointJacobians(mech.model, data, q)
-    pin.updateFramePlacements(mech.model, data)
-    J = frame_jacobian(mech.model, data, mech.link_frame(output), pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).copy()
-    J[:3] /= L  # the output frame origin's twist, as singular.classify measures it
-    N = null_space(K, mech.tolerances, mech.nv) if K.size else np.eye(mech.nv)
+        return S.K[:, g.p]
+    N = S.V
     V = N if V_ref is None else N @ (N.T @ V_ref)  # a basis that varies smoothly with q
-    return J @ V
+    return S.J @ V
 
 
-def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e-12):
-    """Singular input values along a sweep, each refined to about 1e-9 or better.
+def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e-12, point: bool = False):
+    """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
+    positions the sweep located, and the other singularities.
 
-    Each relative smallest singular value is scanned over the sweep; around each
-    local minimum the singular vectors u, v of that step give a smooth signed
-    measure u . M(x) v that changes sign where M loses rank, and Brent's method
-    finds its root (solutions re-closed at a tight tolerance).  Minima that are
-    not zeros (no sign change) are not singular and are dropped.
+    Each relative smallest singular value is scanned over the sweep; around each local
+    minimum (between neighbours on one branch, where the input runs one way) the singular
+    vectors u, v of that step give a smooth signed measure u . M(x) v that changes sign where
+    M loses rank, and Brent's method finds its root (solutions re-closed at a tight
+    tolerance).  Minima that are not zeros (no sign change) are not singular and are dropped.
     """
-    from dataclasses import replace
-
     from scipy.optimize import brentq
-
-    from .singular import Generic, characteristic_length, measures
 
     mech = solver.mech
     tight = replace(mech.tolerances, closure=1e-14, max_iterations=60)
-    g = Generic(mech, solver.inputs, output)
-    L = characteristic_length(mech, res.q[0])
-    table = [measures(mech, q, g, output, L) for q in res.q]
+    g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
+    table = [measures(mech, q, g) for q in res.q]
     rank_of = {"constraint": g.rank_K, "actuator": g.rank_Kp, "serial": g.out_dim or 0}
-    found = []
+    found = list(res.limits)
     xs = res.values
-    for kind in table[0]:
+    frozen = solver.frozen
+    for kind in (table[0] if table else {}):
         m = np.array([t[kind] for t in table])
         r = rank_of[kind]
         if r == 0:
@@ -173,27 +407,27 @@ def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e
             right = m[k + 1] if k + 1 < len(m) else np.inf
             if not (m[k] <= left and m[k] <= right) or m[k] > 0.5:
                 continue
+            lo_k, hi_k = max(k - 1, 0), min(k + 1, len(xs) - 1)
+            if (xs[k] - xs[lo_k]) * (xs[hi_k] - xs[k]) < 0:  # a turn between: that limit is listed already
+                continue
             q_k = res.q[k]
             V_ref = None
             if kind == "serial":
-                from .mobility import null_space
-
-                K = mech.closure.jacobian(q_k)
-                V_ref = null_space(K, mech.tolerances, mech.nv) if K.size else np.eye(mech.nv)
-            U, _, Vt = np.linalg.svd(_matrix(mech, q_k, kind, g, output, L, V_ref))
+                V_ref = scaled_jacobians(mech, q_k, output, point).V
+            U, _, Vt = np.linalg.svd(_matrix(mech, q_k, kind, g, V_ref))
             u, v = U[:, r - 1], Vt[r - 1]
 
             def q_at(x, q_k=q_k):
+                q0 = solver.set_inputs(q_k, {res.input: x})
                 try:
-                    return mech.closure.solve(solver.set_inputs(q_k, {res.input: x}), frozen=solver.frozen,
-                                              tolerances=tight).q
+                    return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
                 except AssemblyError:
-                    return mech.closure.solve(solver.set_inputs(q_k, {res.input: x}), frozen=solver.frozen).q
+                    return mech.closure.solve(q0, frozen=frozen).q
 
             def signed(x, u=u, v=v, V_ref=V_ref):
-                return float(u @ _matrix(mech, q_at(x), kind, g, output, L, V_ref) @ v)
+                return float(u @ _matrix(mech, q_at(x), kind, g, V_ref) @ v)
 
-            lo, hi = xs[max(k - 1, 0)], xs[min(k + 1, len(xs) - 1)]
+            lo, hi = sorted((xs[lo_k], xs[hi_k]))
             try:
                 f_lo, f_hi = signed(lo), signed(hi)
             except AssemblyError:
@@ -202,49 +436,9 @@ def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e
                 continue
             x = brentq(signed, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
             q = q_at(x)
-            sigma = measures(mech, q, g, output, L)[kind]
+            sigma = measures(mech, q, g)[kind]
             if sigma < mech.tolerances.singular and not any(
                     s.kind == kind and abs(s.input - x) < 1e-7 for s in found):
                 found.append(SweepSingularity(kind, float(x), float(sigma), q))
     found.sort(key=lambda s: s.input)
     return found
-
-
-class _Limit(Exception):
-    pass
-
-
-def _step(solver, q, qd, x0, x1, name, rate, rates_in):
-    mech, model = solver.mech, solver.model
-    dt = (x1 - x0) / rate
-    q_pred = pin.integrate(model, q, qd * dt)
-    q_pred = solver.set_inputs(q_pred, {name: x1})
-    try:
-        a = mech.closure.solve(q_pred, frozen=solver.frozen)
-    except AssemblyError as exc:
-        raise _Limit(f"the loops cannot be closed beyond this input (residual {exc.residual:.2g})") from None
-    K = mech.closure.jacobian(a.q)
-    solve, s = solver.passive_solver(K)
-    s = s if s.size else np.ones(1)
-    r = solver.expected_rank
-    if r and (len(s) < r or s[r - 1] / s[0] < mech.tolerances.singular):
-        raise _Limit("the passive joints become undetermined (limit position / singular configuration)")
-    jump = np.linalg.norm(pin.difference(model, q_pred, a.q))
-    predicted = np.linalg.norm(qd * dt) + 1e-12
-    if jump > max(0.5 * predicted, 1e-6) and jump > 1e-3:
-        raise _Limit("the correction jumps to another branch (a limit or singular position lies in this step)")
-    return a.q, solver.rates(a.q, K, rates_in, solve), K, solve
-
-
-def _locate_limit(solver, q, qd, x_ok, x_bad, name, rate, rates_in, iterations=40):
-    """Bisection on the input between the last reachable value and the first failure."""
-    for _ in range(iterations):
-        mid = 0.5 * (x_ok + x_bad)
-        try:
-            q, qd, _, _ = _step(solver, q, qd, x_ok, mid, name, rate, rates_in)
-            x_ok = mid
-        except _Limit:
-            x_bad = mid
-        if abs(x_bad - x_ok) < 1e-10:
-            break
-    return 0.5 * (x_ok + x_bad)

@@ -29,6 +29,15 @@ class Tolerances:
     motion:         relative size below which a twist counts as no motion, next to
                     the largest twist of the same analysis [-].
     max_iterations: iteration limit of the closure solver [-].
+    assembly_starts: starting configurations the assembly search tries in all when the
+                    file's configuration does not close the loops: ``perturbations``
+                    random perturbations of it, then random configurations within the
+                    joint limits (seeded: the same file gives the same answer) [-].
+    perturbations:  how many of those are perturbations of the file's configuration [-].
+    generic_starts: further random configurations closed for the generic ranks: the
+                    first configuration that closes may be singular or on a degenerate
+                    branch (a student's straight drawing often is), so ranks are taken
+                    over it, its neighbours and these, and the largest decides [-].
     samples:        nearby assembled configurations sampled for the generic rank [-].
     sample_step:    size of the random step to a nearby configuration [rad or m].
     """
@@ -41,6 +50,9 @@ class Tolerances:
     motion: float = 1e-6
     singular: float = 1e-4
     max_iterations: int = 200
+    assembly_starts: int = 48
+    perturbations: int = 8
+    generic_starts: int = 4
     samples: int = 3
     sample_step: float = 0.05
 

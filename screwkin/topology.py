@@ -86,6 +86,7 @@ class Topology:
     motion_space_detail: str
     dummy_links: tuple = field(default=())  # URDF links inside compound joints
     welds: tuple = field(default=())  # fixed cut joints: they join two URDF links into one link
+    normal: tuple | None = None  # planar: the unit normal of the plane of motion (world axes)
 
     @property
     def n_links(self) -> int:
@@ -408,9 +409,10 @@ def build_topology(mech, q) -> Topology:
     links = tuple(body_name[r] for r in groups if r not in dummies)
     members = {body_name[r]: tuple(groups[r]) for r in groups if r not in dummies}
     dummy_links = tuple(m for r in dummies for m in groups[r])
-    space, detail = _motion_space(joints, tol, scale)
+    space, detail, normal = _motion_space(joints, tol, scale)
     cut_welds = tuple(name for _, _, name in welds if name is not None)
-    return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links, cut_welds)
+    return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links, cut_welds,
+                    normal)
 
 
 def _motion_space(joints, tol, scale):
@@ -419,7 +421,7 @@ def _motion_space(joints, tol, scale):
     rotation about one common point; 'spatial' otherwise."""
     lt = tol * max(scale, 1.0)
     if not joints:
-        return "spatial", "no joints"
+        return "spatial", "no joints", None
     rot = [j for j in joints if j.type in ("revolute", "continuous")]
     pri = [j for j in joints if j.type == "prismatic"]
     other = [j for j in joints if j.type not in ("revolute", "continuous", "prismatic", "planar")]
@@ -439,8 +441,15 @@ def _motion_space(joints, tol, scale):
             ok = all(_parallel(normal, np.asarray(j.direction), tol) for j in rot + planar_pairs)
             ok = ok and all(abs(normal @ _unit(np.asarray(j.direction))) < tol for j in pri)
             if ok:
+                normal = _unit(normal)
+                # one of the two normals, the same whatever the axes' signs: +z, else +y, else +x side
+                for k in (2, 1, 0):
+                    if abs(normal[k]) > 1e-9:
+                        normal = normal * np.sign(normal[k])
+                        break
                 n = np.round(normal, 6) + 0.0
-                return "planar", f"every revolute axis is parallel to ({n[0]:g}, {n[1]:g}, {n[2]:g}) and every prismatic axis perpendicular to it"
+                return ("planar", f"every revolute axis is parallel to ({n[0]:g}, {n[1]:g}, {n[2]:g}) and every "
+                        "prismatic axis perpendicular to it", tuple(normal))
     if not pri and not planar_pairs and all(j.type in ("revolute", "continuous", "spherical", "universal") for j in joints):
         lines = [(np.asarray(j.point), np.asarray(j.direction)) for j in rot]
         if len(lines) >= 2:
@@ -449,5 +458,5 @@ def _motion_space(joints, tol, scale):
                 centres = [np.asarray(j.point) for j in joints if j.type in ("spherical", "universal")]
                 if all(np.linalg.norm(p - c) < lt for p in centres):
                     cc = np.round(c, 6) + 0.0
-                    return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})"
-    return "spatial", "the joint axes are neither all parallel (planar) nor all concurrent (spherical)"
+                    return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
+    return "spatial", "the joint axes are neither all parallel (planar) nor all concurrent (spherical)", None

@@ -183,7 +183,7 @@ def test_one_joint_arm(tmp_path, capsys, argv):
 def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
     import screwkin.mechanism
 
-    def broken(self, output=None):
+    def broken(self, *args, **kwargs):
         raise ValueError("shapes do not match")
 
     monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", broken)

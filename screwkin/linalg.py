@@ -1,0 +1,36 @@
+"""Numerical rank and null spaces with the tolerances of screwkin.Tolerances."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["rank", "null_space", "singular_values"]
+
+
+def singular_values(A) -> np.ndarray:
+    """Singular values of A, largest first (none for an empty matrix)."""
+    A = np.asarray(A, float)
+    if A.size == 0:
+        return np.zeros(0)
+    return np.linalg.svd(A, compute_uv=False)
+
+
+def rank(A, tol) -> int:
+    """Numerical rank: singular values above ``tol.rank_rtol * sigma_max`` and ``tol.rank_atol``."""
+    s = singular_values(A)
+    if s.size == 0 or s[0] <= tol.rank_atol:
+        return 0
+    return int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
+
+
+def null_space(A, tol, n=None) -> np.ndarray:
+    """Orthonormal basis (columns) of the null space of A (A has n columns)."""
+    A = np.asarray(A, float)
+    n = A.shape[1] if n is None else n
+    if A.size == 0:
+        return np.eye(n)
+    _, s, vt = np.linalg.svd(A)
+    if s.size == 0 or s[0] <= tol.rank_atol:
+        return np.eye(n)
+    r = int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
+    return vt[r:].T.copy()
