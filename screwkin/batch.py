@@ -246,7 +246,7 @@ class SerialJacobians:
 
     def _check(self, rng, count):
         model = self.model
-        data = model.createData()
+        data = self.mech.data
         lo = np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi)
         hi = np.where(np.isfinite(model.upperPositionLimit), model.upperPositionLimit, np.pi)
         lo, hi = np.maximum(lo, -np.pi), np.minimum(hi, np.pi)

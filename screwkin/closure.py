@@ -81,16 +81,21 @@ def _skews_batch(U, m=None):
 def _damped_step(K, r, free, mu):
     """Minimum-norm damped (Levenberg-Marquardt) step on the free columns of K:
     dq_f = -K_f^T (K_f K_f^T + lambda I)^-1 r with lambda = mu * trace / rows, and the
-    squared residual of the linear model |r + K_f dq_f|^2."""
+    squared residual of the linear model |r + K_f dq_f|^2.  With more rows than free columns
+    (hundreds of loops) the same step is (K_f^T K_f + lambda I)^-1 K_f^T (-r), a smaller system."""
     Kf = K[:, free]
-    A = Kf @ Kf.T
+    rows, cols = Kf.shape
+    tall = rows > cols
+    A = Kf.T @ Kf if tall else Kf @ Kf.T
     diagonal = A.ravel()[:: len(A) + 1]  # a view
-    diagonal += mu * max(diagonal.sum() / len(A), 1e-12)
+    trace = diagonal.sum()
+    diagonal += mu * max(trace / rows, 1e-12)
+    b = Kf.T @ r if tall else r
     try:
-        y = np.linalg.solve(A, r)
+        y = np.linalg.solve(A, b)
     except np.linalg.LinAlgError:  # singular in floating point
-        y = np.linalg.lstsq(A, r, rcond=None)[0]
-    dqf = -(Kf.T @ y)
+        y = np.linalg.lstsq(A, b, rcond=None)[0]
+    dqf = -y if tall else -(Kf.T @ y)
     lin = r + Kf @ dqf
     return dqf, float(lin @ lin)
 
@@ -148,9 +153,10 @@ class Assembly:
 class ClosureSystem:
     """The loop-closure equations r(q) = 0 of a model with cut joints."""
 
-    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>"):
+    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>", data=None):
+        """data: the pinocchio.Data to compute in (the mechanism's; a new one when None)."""
         self.model = model
-        self.data = model.createData()
+        self.data = model.createData() if data is None else data
         self.cuts = list(cuts)
         self.tol = tolerances
         self.path = path

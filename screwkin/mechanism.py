@@ -155,7 +155,6 @@ class Mechanism:
         self.path = spec.path
         self.tolerances = tolerances
         self.model = model
-        self.data = model.createData()
         self.coordinates = [
             Coordinate(model.names[j], j, model.idx_qs[j], model.nqs[j], model.idx_vs[j], model.nvs[j])
             for j in range(1, model.njoints)
@@ -164,11 +163,14 @@ class Mechanism:
         self._coord = {c.joint: c for c in self.coordinates}
         self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
         # a ground frame for targets (inverse kinematics); every frame must exist
-        # before any pinocchio.Data is made from the model
+        # before the pinocchio.Data is made from the model
         self.target_frame = model.addFrame(
             pin.Frame("screwkin@target", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
+        # ONE Data for every analysis of this mechanism: Pinocchio 4.1 allocates nv^3-sized
+        # tensors in it (one Data of a 500-joint chain: 17 s and 7.9 GB here).  Whoever uses it
+        # runs Pinocchio's pass for its own configuration first.
         self.data = model.createData()
-        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path)
+        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.data)
         self.set_actuated(actuated)
         self._assembly = None
         self._limits = None
@@ -191,7 +193,6 @@ class Mechanism:
             frame_placement = parent.placement * placement(xyz, rpy)
             new = pin.Frame(f"{c.name}@F{k}", parent.parentJoint, fid, frame_placement, pin.FrameType.OP_FRAME)
             ids.append(self.model.addFrame(new, False))
-        self.data = self.model.createData()
         return CutJoint(c.name, c.type, c.dof, ids[0], ids[1], c.frame1, c.frame2, tuple(c.axis),
                         tuple(c.axis2) if c.axis2 is not None else None)
 
@@ -490,7 +491,7 @@ class Mechanism:
                         configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
                     except AssemblyError:
                         continue
-                for _ in range(tol.generic_starts):
+                for _ in range(tol.generic_starts if closure.nrows else 0):  # (for the branches of loops)
                     try:
                         configs.append(closure.solve(self.random_configuration(rng)).q)
                     except AssemblyError:

@@ -24,6 +24,7 @@ from .topology import Topology
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+_FEW_COORDINATES = 60  # above this many joint coordinates, idle motions are analysed at one configuration
 
 
 @dataclass(frozen=True)
@@ -288,23 +289,30 @@ def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False) -> M
     if output is not None:
         output_link = next((l for l, m in topo.link_members.items() if output in m), output)
     act_idx = mech.velocity_indices(mech.actuated)
-    best = None
+    candidates = []
     for q in configs:
         K = mech.closure.jacobian(q)
         rk = rank(K, tol)
         V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
-        M = V.shape[1]
-        idle, idle_total, I = _idle(mech, mech.topology(q), frames, q, V, output_link, tol)
         out = None
         if output is not None:
             model, data = mech.model, mech.data
+            pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacements(model, data)
             T = frame_jacobian(model, data, out_frame, LWA) @ V
             out = _point_motion(output, T, tol) if point else _output_motion(
                 output, T, tol, data.oMf[out_frame].translation)
         eff = rank(V[act_idx], tol) if len(act_idx) else None
-        key = (rk, -idle_total, out.dimension if out else 0, eff or 0)
-        if best is None or key > best[0]:
-            best = (key, q, K, rk, M, V, idle, idle_total, I, out, eff)
+        candidates.append(((rk, out.dimension if out else 0, eff or 0), q, K, rk, V, out, eff))
+    top = max(c[0] for c in candidates)
+    candidates = [c for c in candidates if c[0] == top]
+    if mech.nv > _FEW_COORDINATES:  # the idle motions of a big mechanism: at one generic configuration
+        candidates = candidates[:1]
+    best = None
+    for _, q, K, rk, V, out, eff in candidates:
+        idle, idle_total, I = _idle(mech, mech.topology(q), frames, q, V, output_link, tol)
+        if best is None or idle_total < best[7]:
+            best = (None, q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
     _, q, K, rk, M, V, idle, idle_total, I, out, eff = best
     n = M - idle_total
     m = len(act_idx)

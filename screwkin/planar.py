@@ -252,7 +252,7 @@ class LinkAngles:
                 candidates = [("joint", k) for k in model.children[jid]]
             candidates += [("frame", f) for f in cut_frames.get(jid, [])]
             self.links[link] = (start, candidates, fid)
-        self._data = model.createData()
+        self._data = mech.data
         ends = self._ends(mech.neutral())
         self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
 

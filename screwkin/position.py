@@ -162,7 +162,7 @@ class PositionSolver:
         if compiled is not None:
             mech.closure.accelerate(compiled)
         self.model = mech.model
-        self.data = mech.model.createData()
+        self.data = mech.data
         names = list(input_joints) if input_joints else list(mech.actuated)
         if not names:
             raise UsageError(f"{mech.path}: no input joints: declare actuated joints or give --set NAME=VALUE")
@@ -634,7 +634,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     frame.placement = pose
     model.frames[fid] = frame
     target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
-    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path)
+    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.data)
     solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
     start_list = solver._starts(starts, seed)
     found, best = solver.distinct(system, start_list)

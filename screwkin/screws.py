@@ -76,7 +76,7 @@ def chains(mech, output=None):
     if output:
         targets.append((f"output {output}", mech.link_frame(output)))
     q0 = mech.neutral()
-    data = model.createData()
+    data = mech.data
     pin.computeJointJacobians(model, data, q0)
     pin.updateFramePlacements(model, data)
     out = []
@@ -113,11 +113,12 @@ def poe(chain, theta) -> np.ndarray:
 def structure(mech, q, output=None):
     """Per chain: reference twists, g(0), current twists (space Jacobian columns at q)."""
     model = mech.model
-    data = model.createData()
+    data = mech.data
+    found = chains(mech, output)  # (computed at the reference configuration, in the same Data: first)
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     result = []
-    for ch in chains(mech, output):
+    for ch in found:
         Js = frame_jacobian(model, data, ch.frame, pin.ReferenceFrame.WORLD)[:, list(ch.columns)]
         Jb = frame_jacobian(model, data, ch.frame, pin.ReferenceFrame.LOCAL)[:, list(ch.columns)]
         result.append({"chain": ch, "theta": joint_angles(mech, q, ch), "space_jacobian": Js, "body_jacobian": Jb,
@@ -149,7 +150,7 @@ def split_jacobians(mech, q, output, inputs=None):
     p = np.setdiff1d(np.arange(mech.nv), a)
     K = mech.closure.jacobian(q)
     model = mech.model
-    data = model.createData()
+    data = mech.data
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     fid = mech.link_frame(output)
