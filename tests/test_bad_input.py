@@ -58,8 +58,6 @@ FILE_CASES = {
                     "two parents"),
     "two_roots": (GOOD.replace("</robot>", '<link name="floating_piece"/></robot>'), "do not form one tree"),
     "universal_without_axis2": (GOOD.replace('type="revolute"><link1', 'type="universal"><link1'), "axis2"),
-    "transmission_missing_joint": (GOOD.replace("</robot>", '<transmission name="t"><joint name="ghost"/></transmission></robot>'),
-                                   "'ghost'"),
     "not_words": (GOOD.replace('<origin xyz="0.04 0 0"', '<origin xyz="0.04 zero 0"'), "not 3 numbers"),
 }
 
