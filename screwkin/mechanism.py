@@ -362,6 +362,9 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
     text = _read_text(path)
     root = parse_xml_text(text, path)  # the root element decides the format, not the suffix
     package_dirs = [str(d) for d in package_dirs or ()]
+    for d in package_dirs:
+        if not os.path.isdir(d):
+            raise UsageError(f"package folder {quote(d)} (--package-dir) is not a folder")
     if root.tag == "sdf":
         from .sdf import read_sdf
 

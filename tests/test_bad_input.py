@@ -187,8 +187,11 @@ def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatc
     monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", broken)
     path = write(tmp_path, GOOD)
     check(capsys, ["mobility", path], 3, "internal error", "ValueError", "--debug", path=path)
-    with pytest.raises(ValueError):
-        main(["mobility", path, "--debug"])
+    # --debug (after or before the command): the traceback, then the same line, and still exit 3
+    for argv in (["mobility", path, "--debug"], ["--debug", "mobility", path]):
+        code, err = run(capsys, argv)
+        assert code == 3 and "Traceback" in err and "shapes do not match" in err
+        assert err.strip().splitlines()[-1].startswith("screwkin: internal error")
 
 
 def test_urdf_parser_complaints_become_the_one_line(tmp_path, capfd):
