@@ -54,8 +54,9 @@ def shorten(value, limit: int = QUOTE_LIMIT) -> str:
 
 
 def quote(value, limit: int = QUOTE_LIMIT) -> str:
-    """``'value'`` for a message: :func:`shorten` between single quotes."""
-    return f"'{shorten(value, limit)}'"
+    """``'value'`` for a message: :func:`shorten` between single quotes; a value that is
+    not a string (a YAML list, None) as its bounded repr, without quotes."""
+    return f"'{shorten(value, limit)}'" if isinstance(value, str) else shorten(value, limit)
 
 
 def one_line(text: str, limit: int) -> str:
