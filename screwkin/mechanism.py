@@ -333,7 +333,7 @@ def _native_stderr(box: list):
             os.dup2(saved, 2)
             os.close(saved)
             tmp.seek(0)
-            box.append(tmp.read().decode("utf-8", "replace"))
+            box.append(tmp.read(1 << 20).decode("utf-8", "replace"))  # the first MB says what went wrong
 
 
 def _urdfdom_messages(box: list) -> list:

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .errors import UsageError
+from .errors import MechanismFileError, UsageError, quote, shorten
 from .mechanism import frame_id
 from .urdf import find_mesh
 from .xmlsafe import parse_xml_text
@@ -48,9 +48,9 @@ def _coal():
     return coal
 
 
-def _visual_urdf(mech) -> str:
+def _visual_urdf(mech, unreadable=()) -> str:
     """The URDF text with every mesh resolved to an absolute path, and visuals
-    whose mesh cannot be found dropped (their links get stand-ins)."""
+    whose mesh cannot be found (or is in ``unreadable``) dropped (their links get stand-ins)."""
     root = parse_xml_text(mech.spec.urdf_text, mech.path)
     base = Path(mech.path).resolve().parent
     package_dirs = getattr(mech.spec, "package_dirs", ()) or ()
@@ -61,7 +61,7 @@ def _visual_urdf(mech) -> str:
                 if mesh is None:
                     continue
                 found = find_mesh(mesh.get("filename", ""), base, package_dirs)
-                if found is not None:
+                if found is not None and str(found.resolve()) not in unreadable:
                     mesh.set("filename", str(found.resolve()))
                 else:
                     link.remove(vis)
@@ -139,13 +139,36 @@ class Scene:
     center: np.ndarray  # centre of its joints [m]
 
 
-def build_scene(mech, q, output=None, singular=()) -> Scene:
+def _visual_geometry(mech, warn=None):
+    """Pinocchio's visual GeometryModel of the links; a mesh file that exists but cannot be
+    read (not a mesh, truncated) is a warning and its link is drawn as a stand-in."""
+    import re
+
+    warn = warn or (lambda m: print(f"warning: {shorten(str(mech.path), 200)}: {m}", file=sys.stderr))
+    unreadable = set()
+    while True:
+        try:
+            return pin.buildGeomFromUrdfString(mech.model, _visual_urdf(mech, unreadable), pin.GeometryType.VISUAL)
+        except (ValueError, RuntimeError) as exc:
+            found = re.search(r"Could not load resource (.+)", str(exc))
+            bad = found.group(1).strip() if found else None
+            if not bad or bad in unreadable:
+                lines = [line for line in str(exc).splitlines() if line.strip()]
+                raise MechanismFileError(mech.path, f"the visuals cannot be loaded: "
+                                                    f"{shorten(lines[-1] if lines else type(exc).__name__, 160)}") \
+                    from None
+            unreadable.add(bad)
+            warn(f"mesh {quote(bad, 120)} cannot be read as a mesh: its link is drawn as a stand-in")
+
+
+def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
     """The scene at configuration q (used for the characteristic size of the marks).
 
     singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
-    output link's origin, and the singular screw axis as a line with an arrow."""
+    output link's origin, and the singular screw axis as a line with an arrow.
+    warn: callable receiving each warning (a mesh that cannot be read); default: stderr."""
     model = mech.model
-    geom = pin.buildGeomFromUrdfString(model, _visual_urdf(mech), pin.GeometryType.VISUAL)
+    geom = _visual_geometry(mech, warn)
     roles = {o.name: "link" for o in geom.geometryObjects}
     data = model.createData()
     pin.framesForwardKinematics(model, data, q)

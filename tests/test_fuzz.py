@@ -33,19 +33,24 @@ import yaml
 
 from conftest import CORPUS, ROBOTS
 from screwkin.cli import main
+from screwkin.units import UNITS
 
 SEED = 20240611
 #: Number of URDF mutants (each runs info, mobility and solve) and of YAML-sidecar mutants.
-MUTANTS = 300
-YAML_MUTANTS = 80
+MUTANTS = 200
+YAML_MUTANTS = 48
 
 #: Mutants that still fail in code this test does not own (closure, position, mobility...):
 #: "urdf-<index>:<command>" or "yaml-<index>:<command>" -> what goes wrong.  Each is excluded
 #: from the assertions (and reported); the list should be empty.
 KNOWN_FAILURES: dict[str, str] = {}
 
-BASES = sorted(ROBOTS.glob("*.urdf")) + sorted(CORPUS.glob("*/robot.urdf"))
-YAML_BASES = sorted(CORPUS.glob("*/robot.yaml"))
+#: kangaroo_like is left out: its welds cannot close, so every command on it runs a whole failing
+#: assembly (63 coordinates, 66 rows): it alone took 60 % of this file's time; wl16_like and
+#: digit_like (42 and 27 coordinates) stand for the large files.
+SLOW = {"kangaroo_like"}
+BASES = sorted(ROBOTS.glob("*.urdf")) + sorted(p for p in CORPUS.glob("*/robot.urdf") if p.parent.name not in SLOW)
+YAML_BASES = sorted(p for p in CORPUS.glob("*/robot.yaml") if p.parent.name not in SLOW)
 
 HOSTILE = ["nan", "inf", "-inf", "1e308", "-1e308", "1e-320", "-0", "", " ", "x" * 5000, "0 0 0", "1 2",
            "1 2 3 4", "1e999", "0x10", "1_000", "\u0661", "revolute\nrevolute", "a\x1b[31mb", "\u202e", "-1",
@@ -160,7 +165,7 @@ def _op_many_loops(root, rng):
     if not loops:
         return None
     e = rng.choice(loops)
-    n = rng.choice([3, 20, 250])
+    n = rng.choice([3, 12, 250])
     for k in range(n):
         c = copy.deepcopy(e)
         c.set("name", f"{e.get('name')}_dup{k}")
@@ -210,7 +215,43 @@ def _op_transmission(root, rng):
     return f"transmission naming {name!r}"
 
 
-TREE_OPS = [_op_delete, _op_duplicate, _op_move, _op_swap_names, _op_hostile_value, _op_hostile_value,
+def _op_valid_type(root, rng):
+    """A type change that keeps the file valid: the kinematics change, the file does not break."""
+    joints, loops = root.findall("joint"), root.findall("loop_joint")
+    if not joints and not loops:
+        return None
+    e = rng.choice(joints + loops)
+    if e.tag == "joint":
+        t = rng.choice(["revolute", "continuous", "prismatic", "fixed", "floating", "planar"])
+    else:
+        t = rng.choice(["fixed", "revolute", "prismatic", "cylindrical", "universal", "planar", "spherical"])
+        if t == "universal" and e.find("axis2") is None:
+            ET.SubElement(e, "axis2", xyz="0 1 0")
+    e.set("type", t)
+    return f"<{e.tag} {e.get('name')}> type = {t!r} (valid)"
+
+
+def _op_geometry(root, rng):
+    """Valid but strange geometry: a random axis, a moved or collapsed origin."""
+    elems = [e for e in root.iter() if e.tag in ("axis", "axis2", "origin", "link1", "link2")]
+    if not elems:
+        return None
+    e = rng.choice(elems)
+    if e.tag.startswith("axis"):
+        v = rng.choice(["1 1 1", "0 0 -1", "1e-5 0 0", "0.0446 -0.0825 1.8977", "1 0 1e-12",
+                        " ".join(f"{rng.uniform(-1, 1):.3g}" for _ in range(3))])
+        e.set("xyz", v)
+        return f"<{e.tag} xyz> = {v!r}"
+    factor = rng.choice([0.0, 1e-9, -1.0, 1000.0, 1.5])
+    xyz = [float(x) * factor for x in (e.get("xyz") or "0 0 0").split()] if len(
+        (e.get("xyz") or "0 0 0").split()) == 3 else [0.0, 0.0, 0.0]
+    e.set("xyz", " ".join(repr(x) for x in xyz))
+    if rng.random() < 0.3:
+        e.set("rpy", " ".join(f"{rng.uniform(-7, 7):.4g}" for _ in range(3)))
+    return f"<{e.tag} {e.get('name') or e.get('link') or ''}> xyz scaled by {factor}"
+
+
+TREE_OPS = [_op_valid_type, _op_valid_type, _op_geometry, _op_geometry, _op_delete, _op_duplicate, _op_move, _op_swap_names, _op_hostile_value, _op_hostile_value,
             _op_other_name, _op_joint_like_link, _op_type, _op_many_loops, _op_third_link, _op_numbers,
             _op_numbers, _op_limits, _op_transmission]
 
@@ -424,3 +465,105 @@ def test_yaml_mutant(i, tmp_path, capfd):
     for name, argv in runs.items():
         known = KNOWN_FAILURES.get(f"yaml-{i:03d}:{name}")
         check_contract(argv, capfd, [path, tmp_path / "robot.yaml"], known)
+
+
+# ------------------------------------------------------------------ hypothesis: typed values and sidecars
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=200, deadline=None, database=None)
+@given(st.text(max_size=60))
+def test_parse_value_on_any_text(text):
+    import math
+
+    from screwkin.errors import UsageError
+    from screwkin.units import parse_value
+
+    try:
+        value = parse_value(text)
+    except UsageError as exc:
+        assert "\n" not in str(exc) and len(str(exc)) < 250, str(exc)
+    else:
+        assert math.isfinite(value)
+
+
+@settings(max_examples=200, deadline=None, database=None)
+@given(st.floats(min_value=-1e6, max_value=1e6), st.sampled_from(sorted(UNITS)),
+       st.sampled_from(["", " "]), st.booleans())
+def test_parse_value_reads_numbers_with_units(x, unit, space, upper):
+    from screwkin.units import UNITS, parse_value
+
+    typed = unit.upper() if upper and unit.isascii() else unit
+    assert parse_value(f"{x!r}{space}{typed}") == x * UNITS[unit]
+
+
+_5BAR = CORPUS / "5bar_linkage"
+_FRAMES = ["closedloop1_A", "closedloop1_B", "mot1", "mot2", "end_rod", "effector", "effector_frame"]
+_LEAVES = st.one_of(st.none(), st.booleans(), st.integers(), st.floats(), st.text(max_size=12),
+                    st.sampled_from(_FRAMES + ["3d", "6d", "SPHERICAL", "CARDAN", "FIXED", "UJOINT_XZ"]))
+_VALUES = st.recursive(_LEAVES, lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=4), c, max_size=3),
+                       max_leaves=10)
+_SIDECARS = st.dictionaries(st.sampled_from(["closed_loop", "type", "name_mot", "joint_name", "joint_type", "x"]),
+                            _VALUES, max_size=5)
+
+
+@settings(max_examples=40, deadline=None, database=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(_SIDECARS)
+def test_sidecar_from_any_structure(tmp_path, content):
+    path = tmp_path / "robot.urdf"
+    if not path.exists():
+        path.write_bytes((_5BAR / "robot.urdf").read_bytes())
+    (tmp_path / "robot.yaml").write_text(yaml.safe_dump(content, allow_unicode=True))
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["mobility", str(path), "--json"])
+    lines = [line for line in err.getvalue().splitlines() if not line.startswith("warning: ")]
+    assert code in (0, 1, 2) and "Traceback" not in err.getvalue(), err.getvalue()
+    assert len(lines) <= 1 and all(len(line.replace(str(tmp_path), "D")) <= 340 for line in lines), lines
+    if code == 0:
+        json.loads(out.getvalue(), parse_constant=_no_nan)
+
+
+# ------------------------------------------------------------------ whole processes
+def _screwkin(*args, timeout=120, **kw):
+    return subprocess.run([sys.executable, "-m", "screwkin", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout, **kw)
+
+
+def test_process_closed_stdout_is_quiet():
+    """``screwkin info F | head -1``: exit 141 and nothing on stderr."""
+    p = subprocess.Popen([sys.executable, "-m", "screwkin", "info", ROBOTS / "fourbar_crank_rocker.urdf"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()
+    err = p.stderr.read()
+    assert p.wait(timeout=120) == 141 and err == b"", err
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
+def test_process_fifo_input_does_not_block(tmp_path):
+    fifo = tmp_path / "pipe.urdf"
+    os.mkfifo(fifo)
+    p = _screwkin("mobility", fifo, timeout=60)  # TimeoutExpired would be the failure
+    assert p.returncode == 1 and "is not a regular file" in p.stderr and len(p.stderr.splitlines()) == 1
+
+
+def test_process_native_parser_complaints_stay_one_line(tmp_path):
+    """urdfdom (C++) writes to the process's file descriptor 2: only screwkin's line comes out."""
+    path = tmp_path / "m.urdf"
+    path.write_text('<robot name="s"><link name="a"/><link name="b"/><joint name="j" type="prismatic">'
+                    '<parent link="a"/><child link="b"/><axis xyz="1 0 0"/></joint></robot>')
+    p = _screwkin("info", path)
+    assert p.returncode == 1 and len(p.stderr.splitlines()) == 1 and "PRISMATIC without limits" in p.stderr
+
+
+@pytest.mark.parametrize("i", [1, 2], ids=lambda i: f"urdf-{i:03d}")
+def test_process_mutants(i, tmp_path):
+    """A few mutants as whole processes: what native code or signals do is seen too."""
+    base, path = _write_urdf_mutant(i, tmp_path)
+    p = _screwkin("solve", path, "--set", f"{first_input(base)}=0.1", "--json", "--starts", "2")
+    errors = [line for line in p.stderr.splitlines() if not line.startswith("warning: ")]
+    assert p.returncode in (0, 1, 2) and "Traceback" not in p.stderr and len(errors) <= 1, p.stderr
+    if p.returncode == 0:
+        json.loads(p.stdout, parse_constant=_no_nan)
