@@ -2,13 +2,7 @@
 
 A thin edge over the Python API: it parses arguments, calls the same functions
 and prints their results.  Exit codes: 0 success, 1 invalid or unanalysable
-file, 2 usage error, 3 internal error (a bug), 141 output pipe closed early
-(``screwkin info F | head -1``: the shell's code for a process ended by SIGPIPE,
-as ``cat`` or ``grep`` report it, so ``set -o pipefail`` scripts see screwkin
-like any other tool; nothing is printed).
-
-Errors are one line on stderr, ``screwkin: error: FILE: PROBLEM``; ``--debug``
-(before or after the command) prints the traceback first.
+file, 2 usage error, 3 internal error (a bug).
 """
 
 from __future__ import annotations
@@ -18,13 +12,15 @@ import json
 import os
 import sys
 
-from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
+from .errors import ScrewkinError, UsageError
 
 __all__ = ["main"]
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
+        from .errors import MESSAGE_LIMIT, one_line
+
         self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
 
 
@@ -464,29 +460,29 @@ def _plot(res, path, mus):
     plt.close(fig)
 
 
-def _stdout_to_devnull():
-    """After a BrokenPipeError: point stdout at /dev/null so that the interpreter's last
-    flush does not fail again (https://docs.python.org/3/library/signal.html#note-on-sigpipe)."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    except (OSError, ValueError, AttributeError):  # no real stdout (in-process capture): nothing to redirect
-        pass
-
-
-def _say(line: str) -> None:
-    try:
-        print(line, file=sys.stderr)
-    except (OSError, ValueError):  # stderr closed: nowhere to say it
-        pass
-
-
 def main(argv=None) -> int:
+    """The command line.  Exit codes: 0 success, 1 invalid or unanalysable file, 2 usage
+    error, 3 internal error (a bug: never caused by input), 141 when the reader of the
+    output went away (``screwkin info F | head -1``): the shell's code for a process ended
+    by SIGPIPE, as ``cat`` or ``grep`` report it, so ``set -o pipefail`` scripts see screwkin
+    like any other tool; nothing is printed then.
+
+    Errors are one line on stderr, ``screwkin: error: FILE: PROBLEM``, at most about
+    MESSAGE_LIMIT characters after the path, control characters escaped; ``--debug``
+    (before or after the command) prints the traceback first, with the same exit code.
+    """
     import traceback
     import warnings
 
     import numpy as np
+
+    from .errors import MESSAGE_LIMIT, one_line
+
+    def say(line):
+        try:
+            print(line, file=sys.stderr)
+        except (OSError, ValueError):  # stderr closed: nowhere to say it
+            pass
 
     parser = _parser()
     args = parser.parse_args(argv)
@@ -501,13 +497,18 @@ def main(argv=None) -> int:
             code = _run(args)
         sys.stdout.flush()
         return code
-    except BrokenPipeError:  # the reader of stdout went away (| head): stop quietly
-        _stdout_to_devnull()
+    except BrokenPipeError:  # https://docs.python.org/3/library/signal.html#note-on-sigpipe
+        try:  # stdout to /dev/null, so that the interpreter's last flush does not fail again
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
+        except (OSError, ValueError, AttributeError):  # no real stdout (captured in process): nothing to redirect
+            pass
         return 141
     except ScrewkinError as exc:
         if debug:
             traceback.print_exc()
-        _say(f"screwkin: error: {one_line(str(exc), limit)}")
+        say(f"screwkin: error: {one_line(str(exc), limit)}")
         return exc.exit_code
     except KeyboardInterrupt:  # pragma: no cover
         return 130
@@ -515,8 +516,8 @@ def main(argv=None) -> int:
         if debug:
             traceback.print_exc()
         where = f" on {one_line(paths[0], 200)}" if paths else ""
-        _say(f"screwkin: internal error{where}: {type(exc).__name__}: {one_line(str(exc), 200)} "
-             "(a bug in screwkin: run again with --debug for the traceback and report it)")
+        say(f"screwkin: internal error{where}: {type(exc).__name__}: {one_line(str(exc), 200)} "
+            "(a bug in screwkin: run again with --debug for the traceback and report it)")
         return 3
 
 

@@ -106,6 +106,21 @@ def _unambiguous_cut_frames(model, spec) -> None:
             setattr(c, attr, alias)
 
 
+def _frame_bodies(model) -> dict:
+    """Frame name -> the Pinocchio joint carrying it (of the preferred frame when several share the name)."""
+    rank = {t: k for k, t in enumerate(FRAME_PREFERENCE)}
+    best = {}
+    for f in model.frames:
+        r = rank.get(f.type, len(rank))
+        if f.name not in best or r < best[f.name][0]:
+            best[f.name] = (r, f.parentJoint)
+    return {name: joint for name, (_, joint) in best.items()}
+
+
+#: Most warnings printed for one file (the rest are counted).
+MAX_WARNINGS = 20
+
+
 def _check_cut_bodies(model, spec) -> None:
     """Refuse a cut joint whose two frames are on the same rigid body (fixed together):
     it closes no loop."""
@@ -384,23 +399,25 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         reasons = [m for level, m in _urdfdom_messages(native) if level == "Error"]
         if reasons:  # urdfdom's first complaint says more than Pinocchio's summary
             first = reasons[0]
-        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {shorten(first, 200)}") from None
-    spec.warnings.extend(f"URDF parser: {shorten(m, 200)}" for level, m in _urdfdom_messages(native)
+        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {shorten(first, 120)}") from None
+    spec.warnings.extend(f"URDF parser: {shorten(m, 120)}" for level, m in _urdfdom_messages(native)
                          if level != "Error")
     if yaml is None and spec.format == "urdf":
         yaml = _find_sidecar(path)
     if yaml is not None:
-        yaml = Path(yaml)
-        body = {}
-        for f in model.frames:
-            if f.name not in body:
-                body[f.name] = model.frames[frame_id(model, f.name)].parentJoint
-        read_yaml_sidecar(spec, yaml, [f.name for f in model.frames], body)
+        read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
     if spec.replacements:
         model = _replace_joints(model, spec.replacements)
     check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
     _check_cut_bodies(model, spec)
     _unambiguous_cut_frames(model, spec)
-    for w in spec.warnings:
-        (warn or (lambda m: print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)))(w)
+    shown = spec.warnings
+    if warn is None:  # on the terminal: a bounded number of bounded lines
+        def warn(m):
+            print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
+
+        if len(shown) > MAX_WARNINGS:
+            shown = shown[:MAX_WARNINGS] + [f"and {len(spec.warnings) - MAX_WARNINGS} more warnings"]
+    for w in shown:
+        warn(w)
     return Mechanism(spec, model, actuated=actuated, tolerances=tolerances)

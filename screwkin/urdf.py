@@ -55,7 +55,8 @@ def numbers(text, count, what, problems, default, bound=None, unit="m", low=None
         return tuple(default)
     parts = text.split()
     if len(parts) != count:
-        problems.append(f"{what}: {quote(text)} has {len(parts)} numbers, expected {count}")
+        problems.append(f"{what}: {quote(text)} has {len(parts)} number{'' if len(parts) == 1 else 's'}, "
+                        f"expected {count}")
         return tuple(default)
     if any(_NONFINITE.match(p) for p in parts):
         problems.append(f"{what}: {quote(text)} contains NaN or infinite numbers")
@@ -413,12 +414,13 @@ def find_mesh(uri: str, base: Path, package_dirs=()):
 def check_meshes(path, root, package_dirs=()) -> list:
     """Warnings for mesh files that cannot be found (missing meshes do not fail a load)."""
     base = Path(path).resolve().parent
-    missing = []
+    missing, checked = [], set()
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename") or (mesh.findtext("uri") or "").strip()
-        if not uri or uri.startswith("model://"):
+        if not uri or uri.startswith("model://") or uri in checked:
             continue
-        if uri not in missing and find_mesh(uri, base, package_dirs) is None:
+        checked.add(uri)
+        if find_mesh(uri, base, package_dirs) is None:
             missing.append(uri)
     if not missing:
         return []

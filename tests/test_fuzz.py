@@ -30,6 +30,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from conftest import CORPUS, ROBOTS
 from screwkin.cli import main
@@ -283,7 +285,7 @@ def _text_op(data: bytes, rng):
     return data.replace(b"</robot>", b"<x>" * depth + b"</x>" * depth + b"</robot>"), f"{depth} nested elements"
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def urdf_mutant(i: int):
     """(base file, mutated bytes, description) of URDF mutant i."""
     rng = random.Random(SEED * 1_000_003 + i)
@@ -315,7 +317,7 @@ def _hostile_structure(rng):
                        [[True, False]], [], ["mot1", "mot1"]])
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def yaml_mutant(i: int):
     """(folder of the robot, mutated YAML bytes, description) of sidecar mutant i."""
     rng = random.Random(SEED * 7_000_003 + i)
@@ -392,7 +394,7 @@ def yaml_mutant(i: int):
 
 
 # ------------------------------------------------------------------ the contract
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def first_input(base) -> str:
     """The first actuated joint of the pristine file (else its first moving joint)."""
     import screwkin
@@ -468,9 +470,6 @@ def test_yaml_mutant(i, tmp_path, capfd):
 
 
 # ------------------------------------------------------------------ hypothesis: typed values and sidecars
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
 
 @settings(max_examples=200, deadline=None, database=None)
 @given(st.text(max_size=60))
