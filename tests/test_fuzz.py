@@ -33,7 +33,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import CORPUS, ROBOTS
+from conftest import CORPUS, DATA, ROBOTS
 from screwkin.cli import main
 from screwkin.units import UNITS
 
@@ -41,9 +41,10 @@ SEED = 20240611
 #: Number of URDF mutants (each runs info, mobility and solve) and of YAML-sidecar mutants.
 MUTANTS = 200
 YAML_MUTANTS = 48
+SDF_MUTANTS = 40
 
 #: Mutants that still fail in code this test does not own (closure, position, mobility...):
-#: "urdf-<index>:<command>" or "yaml-<index>:<command>" -> what goes wrong.  Each is excluded
+#: "urdf-<index>:<command>", "sdf-<index>:<command>" or "yaml-<index>:<command>" -> what goes wrong.  Each is excluded
 #: from the assertions (and reported); the list should be empty.
 KNOWN_FAILURES: dict[str, str] = {}
 
@@ -153,7 +154,8 @@ def _op_joint_like_link(root, rng):
 
 
 def _op_type(root, rng):
-    elems = root.findall("joint") + root.findall("loop_joint")
+    elems = list(root.iter("joint")) + list(root.iter("loop_joint"))
+    elems = [e for e in elems if e.get("type") is not None]
     if not elems:
         return None
     e = rng.choice(elems)
@@ -253,7 +255,21 @@ def _op_geometry(root, rng):
     return f"<{e.tag} {e.get('name') or e.get('link') or ''}> xyz scaled by {factor}"
 
 
-TREE_OPS = [_op_valid_type, _op_valid_type, _op_geometry, _op_geometry, _op_delete, _op_duplicate, _op_move, _op_swap_names, _op_hostile_value, _op_hostile_value,
+def _op_hostile_text(root, rng):
+    """SDF keeps its numbers and names in element text: <pose>, <xyz>, <parent>, <mass>."""
+    elems = [e for e in root.iter() if (e.text or "").strip() and len(e) == 0]
+    if not elems:
+        return None
+    e = rng.choice(elems)
+    names = _names(root, "link") + _names(root, "joint")
+    value = rng.choice(HOSTILE + names + ["world", "0 0 0 0 0 1e308", "1 2 3 4 5", "0 0 0 nan 0 0"])
+    e.text = value
+    return f"<{e.tag}> text = {value[:20]!r}"
+
+
+SDF_OPS = [_op_hostile_text, _op_hostile_text, _op_hostile_text, _op_delete, _op_duplicate, _op_move, _op_swap_names,
+           _op_hostile_value, _op_type, _op_type]
+TREE_OPS = [_op_hostile_text, _op_valid_type, _op_valid_type, _op_geometry, _op_geometry, _op_delete, _op_duplicate, _op_move, _op_swap_names, _op_hostile_value, _op_hostile_value,
             _op_other_name, _op_joint_like_link, _op_type, _op_many_loops, _op_third_link, _op_numbers,
             _op_numbers, _op_limits, _op_transmission]
 
@@ -285,22 +301,51 @@ def _text_op(data: bytes, rng):
     return data.replace(b"</robot>", b"<x>" * depth + b"</x>" * depth + b"</robot>"), f"{depth} nested elements"
 
 
-@functools.cache
-def urdf_mutant(i: int):
-    """(base file, mutated bytes, description) of URDF mutant i."""
-    rng = random.Random(SEED * 1_000_003 + i)
-    base = BASES[i % len(BASES)]
-    root = ET.fromstring(base.read_text())
+#: SDF bases: the four-bar of tests/data and an RSSR with ball joints (one in the tree, one cut).
+RSSR_SDF = """<sdf version="1.7"><model name="rssr">
+  <link name="base"><pose>0 0 0 0 0 0</pose><visual name="v"/></link>
+  <link name="crank"><pose>0 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+  <link name="rod"><pose>0.05 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+  <link name="rocker"><pose>0.2 0.1 0.1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+  <joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>
+  <joint name="in" type="revolute"><parent>base</parent><child>crank</child><axis><xyz>0 0 1</xyz></axis></joint>
+  <joint name="s1" type="ball"><parent>crank</parent><child>rod</child></joint>
+  <joint name="out" type="revolute"><parent>base</parent><child>rocker</child><axis><xyz>1 0 0</xyz></axis></joint>
+  <joint name="s2" type="ball"><parent>rod</parent><child>rocker</child><pose>0 -0.05 0.05 0 0 0</pose></joint>
+</model></sdf>"""
+SDF_BASES = {"fourbar.sdf": (DATA / "fourbar.sdf").read_text(), "rssr.sdf": RSSR_SDF}
+
+
+def _mutate(text: str, rng, ops):
+    root = ET.fromstring(text)
     done = []
     for _ in range(rng.choice([1, 1, 1, 2, 3])):
-        d = rng.choice(TREE_OPS)(root, rng)
+        d = rng.choice(ops)(root, rng)
         if d:
             done.append(d)
     data = ET.tostring(root, encoding="unicode").encode()
     if rng.random() < 0.2:
         data, d = _text_op(data, rng)
         done.append(d)
-    return base, data, "; ".join(done) or "unchanged"
+    return data, "; ".join(done) or "unchanged"
+
+
+@functools.cache
+def sdf_mutant(i: int):
+    """(base name, mutated bytes, description) of SDF mutant i."""
+    rng = random.Random(SEED * 3_000_017 + i)
+    name = sorted(SDF_BASES)[i % len(SDF_BASES)]
+    data, what = _mutate(SDF_BASES[name], rng, SDF_OPS)
+    return name, data, what
+
+
+@functools.cache
+def urdf_mutant(i: int):
+    """(base file, mutated bytes, description) of URDF mutant i."""
+    rng = random.Random(SEED * 1_000_003 + i)
+    base = BASES[i % len(BASES)]
+    data, what = _mutate(base.read_text(), rng, TREE_OPS)
+    return base, data, what
 
 
 def describe(i: int) -> str:
@@ -436,7 +481,7 @@ def check_contract(argv, capfd, paths, known=None):
 
 def _write_urdf_mutant(i, tmp_path):
     base, data, _ = urdf_mutant(i)
-    path = tmp_path / "m.urdf"
+    path = tmp_path / f"m{base.suffix}"
     path.write_bytes(data)
     sidecar = base.with_suffix(".yaml")
     if sidecar.is_file():
@@ -453,6 +498,28 @@ def test_urdf_mutant(i, tmp_path, capfd):
     for name, argv in runs.items():
         known = KNOWN_FAILURES.get(f"urdf-{i:03d}:{name}")
         check_contract(argv, capfd, [path, tmp_path / "m.yaml"], known)
+
+
+@functools.cache
+def _sdf_first_input(name) -> str:
+    import tempfile
+
+    path = os.path.join(tempfile.mkdtemp(), name)
+    with open(path, "w") as f:
+        f.write(SDF_BASES[name])
+    return first_input(path)
+
+
+@pytest.mark.parametrize("i", range(SDF_MUTANTS), ids=lambda i: f"sdf-{i:03d}")
+def test_sdf_mutant(i, tmp_path, capfd):
+    name, data, _ = sdf_mutant(i)
+    path = tmp_path / "m.sdf"
+    path.write_bytes(data)
+    first = _sdf_first_input(name)
+    runs = {"info": ["info", str(path)], "mobility": ["mobility", str(path), "--json"],
+            "solve": ["solve", str(path), "--set", f"{first}=0.1", "--json", "--starts", "2"]}
+    for cmd, argv in runs.items():
+        check_contract(argv, capfd, [path], KNOWN_FAILURES.get(f"sdf-{i:03d}:{cmd}"))
 
 
 @pytest.mark.parametrize("i", range(YAML_MUTANTS), ids=lambda i: f"yaml-{i:03d}")
