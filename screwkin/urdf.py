@@ -131,9 +131,9 @@ def _link(elem, problems) -> LinkSpec:
     for origin in elem.findall("*/origin"):
         _origin(origin, f"{what} <origin", problems)
     for shape in elem.findall("*/geometry/*"):
-        for key, count in _GEOMETRY.get(shape.tag, ()):
+        for key, count in _GEOMETRY.get(shape.tag, ()):  # sizes are not negative; a mesh scale may be (mirroring)
             numbers(shape.get(key), count, f"{what} <{shape.tag} {key}>", problems, (0.0,) * count, LIMITS.length,
-                    "m", low=0.0)
+                    "m", low=None if key == "scale" else 0.0)
     has_geometry = elem.find("visual") is not None or elem.find("collision") is not None
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry)
 
