@@ -61,9 +61,12 @@ class Limits:
 
     file_bytes:  20 MB of URDF/SDF text (real URDFs are under 1 MB; generated
                  ones with inline data a few MB).
+    elements:    200,000 XML elements (tiago_dual has 3,851, PR2 2,314).
     yaml_bytes:  1 MB of YAML sidecar (real ones are a few hundred bytes).
     links, joints: 2,000 each (tree and fixed joints; 20 times tiago_dual).
     loop_joints: 200 loop (cut) joints (18 times kangaroo's 11).
+    meshes:      2,000 distinct mesh files looked for when loading (PR2 names 26);
+                 beyond them a missing mesh is not reported (the view still finds each).
     coordinates: 500 moving joint coordinates (nv).  Pinocchio's ``Data`` holds
                  nv x nv x nv tensors: about :func:`data_bytes` = 64 nv^3 bytes
                  (measured: 0.14 GB at nv = 100, 0.6 GB at 200, 4.1 GB and 7.6 s
@@ -84,10 +87,12 @@ class Limits:
     """
 
     file_bytes: int = 20_000_000
+    elements: int = 200_000
     yaml_bytes: int = 1_000_000
     links: int = 2000
     joints: int = 2000
     loop_joints: int = 200
+    meshes: int = 2000
     coordinates: int = 500
     length: float = 1e4
     angle: float = 1e4

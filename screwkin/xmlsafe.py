@@ -14,6 +14,7 @@ Mechanism files are untrusted:
 
 from __future__ import annotations
 
+import io
 import os
 import stat
 import xml.etree.ElementTree as ET
@@ -73,23 +74,32 @@ def read_regular_file(path, max_bytes: int, what: str = "file") -> bytes:
         os.close(fd)
 
 
-def _depth(root) -> int:
-    deepest, stack = 0, [(root, 1)]
-    while stack:
-        elem, d = stack.pop()
-        deepest = max(deepest, d)
-        if d > MAX_DEPTH:
-            break
-        stack.extend((child, d + 1) for child in elem)
-    return deepest
-
-
 def parse_xml_text(text: str, path) -> ET.Element:
-    """Parse ``text`` (the contents of ``path``) and return the root element."""
+    """Parse ``text`` (the contents of ``path``) and return the root element.
+
+    The elements are counted and their nesting measured while parsing, so a file of a
+    million elements is refused after ``LIMITS.elements`` of them, not after building them."""
+    from .description import LIMITS
+
     if not text.strip():
         raise MechanismFileError(path, "the file is empty")
+    root, depth, count = None, 0, 0
     try:
-        root = SafeET.fromstring(text, forbid_dtd=False, forbid_entities=True, forbid_external=True)
+        for event, elem in SafeET.iterparse(io.StringIO(text), events=("start", "end"), forbid_dtd=False,
+                                            forbid_entities=True, forbid_external=True):
+            if event == "end":
+                depth -= 1
+                continue
+            if root is None:
+                root = elem
+            depth += 1
+            count += 1
+            if depth > MAX_DEPTH:
+                raise MechanismFileError(path, f"XML nested deeper than {MAX_DEPTH} elements (refused: no mechanism "
+                                               "file needs it)")
+            if count > LIMITS.elements:
+                raise MechanismFileError(path, f"more than {LIMITS.elements} XML elements (refused: the largest "
+                                               "robots have a few thousand)")
     except defusedxml.EntitiesForbidden:
         raise MechanismFileError(path, "XML entity declarations are not allowed (refused for safety)") from None
     except defusedxml.ExternalReferenceForbidden:
@@ -98,11 +108,8 @@ def parse_xml_text(text: str, path) -> ET.Element:
         raise MechanismFileError(path, "XML document type declarations are not allowed") from None
     except ET.ParseError as exc:
         raise MechanismFileError(path, f"malformed XML: {shorten(str(exc), 120)}") from None
-    except RecursionError:  # pragma: no cover - expat does not recurse; kept as a guard
-        raise MechanismFileError(path, f"XML nested deeper than {MAX_DEPTH} elements") from None
-    if _depth(root) > MAX_DEPTH:
-        raise MechanismFileError(path, f"XML nested deeper than {MAX_DEPTH} elements (refused: no mechanism "
-                                       "file needs it)")
+    if root is None:  # pragma: no cover - expat reports "no element found" first
+        raise MechanismFileError(path, "malformed XML: no element found")
     return root
 
 

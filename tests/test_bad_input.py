@@ -598,3 +598,15 @@ def test_mirrored_mesh_scale_is_fine(tmp_path, capsys):
     text = GOOD.replace('<box size="0.01 0.01 0.01"/>', '<mesh filename="m.stl" scale="-1 1 1"/>', 1)
     code, err = run(capsys, ["info", write(tmp_path, text)])
     assert code == 0 and "plausible" not in err, err
+
+
+def test_too_many_elements_or_meshes(tmp_path, capsys):
+    """A file of 250,000 visuals is refused while it is parsed; 3,000 distinct missing meshes are
+    looked for only up to 2,000 (a load stays quick whatever the file)."""
+    vis = '<visual><geometry><box size="1 1 1"/></geometry></visual>'
+    path = write(tmp_path, GOOD.replace('<link name="crank">', '<link name="crank">' + vis * 70_000))
+    check(capsys, ["info", path], 1, "more than 200000 XML elements", path=path)
+    mesh = '<visual><geometry><mesh filename="package://p/m{k}.stl"/></geometry></visual>'
+    text = GOOD.replace('<link name="crank">', '<link name="crank">' + "".join(mesh.format(k=k) for k in range(3000)))
+    code, err = run(capsys, ["info", write(tmp_path, text, "meshes.urdf")])
+    assert code == 0 and "2000 mesh file(s) not found" in err and "only the first 2000" in err
