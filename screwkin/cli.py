@@ -18,8 +18,10 @@ __all__ = ["main"]
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit code 2
-        self.exit(2, f"screwkin: error: {message}\n")
+    def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
+        from .errors import MESSAGE_LIMIT, one_line
+
+        self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
 
 
 def _names(text):
@@ -35,8 +37,12 @@ def _parser():
         sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file")
         sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
-        sp.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+        # SUPPRESS: when absent after the command, the top-level --debug (before the command) is kept
+        sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks of errors")
         sp.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+        sp.add_argument("--package-dir", action="append", dest="package_dirs", metavar="DIR",
+                        help="folder holding ROS packages (or a package) for package:// meshes, searched before "
+                             "ROS_PACKAGE_PATH; repeatable")
 
     def at_configuration(sp):
         sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
@@ -145,7 +151,8 @@ def _run(args):
     from .mechanism import load
     from .report import mobility_dict, mobility_text, to_jsonable, topology_dict, topology_text
 
-    mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)))
+    mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
+                package_dirs=args.package_dirs)
     if getattr(args, "length", None):
         from .units import parse_value
 
@@ -513,23 +520,63 @@ def _plot(res, path, mus):
 
 
 def main(argv=None) -> int:
+    """The command line.  Exit codes: 0 success, 1 invalid or unanalysable file, 2 usage
+    error, 3 internal error (a bug: never caused by input), 141 when the reader of the
+    output went away (``screwkin info F | head -1``): the shell's code for a process ended
+    by SIGPIPE, as ``cat`` or ``grep`` report it, so ``set -o pipefail`` scripts see screwkin
+    like any other tool; nothing is printed then.
+
+    Errors are one line on stderr, ``screwkin: error: FILE: PROBLEM``, at most about
+    MESSAGE_LIMIT characters after the path, control characters escaped; ``--debug``
+    (before or after the command) prints the traceback first, with the same exit code.
+    """
+    import traceback
+    import warnings
+
+    import numpy as np
+
+    from .errors import MESSAGE_LIMIT, one_line
+
+    def say(line):
+        try:
+            print(line, file=sys.stderr)
+        except (OSError, ValueError):  # stderr closed: nowhere to say it
+            pass
+
     parser = _parser()
     args = parser.parse_args(argv)
+    debug = bool(getattr(args, "debug", False))
+    paths = [str(p) for p in (getattr(args, "file", None), getattr(args, "yaml", None)) if p]
+    limit = MESSAGE_LIMIT + 40 + max((len(p) for p in paths), default=0)  # the problem, "(and N more)", the path
     try:
-        return _run(args)
+        # numpy's floating-point RuntimeWarnings (overflow in a singular configuration...) are not messages for
+        # the user: screwkin reports what matters itself, as "warning: FILE: ..." lines or in the results
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            code = _run(args)
+        sys.stdout.flush()
+        return code
+    except BrokenPipeError:  # https://docs.python.org/3/library/signal.html#note-on-sigpipe
+        try:  # stdout to /dev/null, so that the interpreter's last flush does not fail again
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
+        except (OSError, ValueError, AttributeError):  # no real stdout (captured in process): nothing to redirect
+            pass
+        return 141
     except ScrewkinError as exc:
-        if args.debug:
-            raise
-        print(f"screwkin: error: {exc}", file=sys.stderr)
+        if debug:
+            traceback.print_exc()
+        say(f"screwkin: error: {one_line(str(exc), limit)}")
         return exc.exit_code
     except KeyboardInterrupt:  # pragma: no cover
         return 130
-    except Exception as exc:  # a bug in screwkin, not a problem of the input: still one line
-        if args.debug:
-            raise
-        where = getattr(args, "file", None)
-        print(f"screwkin: internal error{f' on {where}' if where else ''}: {type(exc).__name__}: {exc} "
-              "(a bug in screwkin: run again with --debug for the traceback and report it)", file=sys.stderr)
+    except Exception as exc:  # a bug in screwkin, not a problem of the input: still one line, exit 3
+        if debug:
+            traceback.print_exc()
+        where = f" on {one_line(paths[0], 200)}" if paths else ""
+        say(f"screwkin: internal error{where}: {type(exc).__name__}: {one_line(str(exc), 200)} "
+            "(a bug in screwkin: run again with --debug for the traceback and report it)")
         return 3
 
 

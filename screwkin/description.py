@@ -22,6 +22,9 @@ __all__ = [
     "MechanismSpec",
     "placement",
     "resolve_actuation",
+    "Limits",
+    "LIMITS",
+    "data_bytes",
 ]
 
 #: Degrees of freedom of the URDF joint types Pinocchio's parser knows.
@@ -45,6 +48,67 @@ CUT_JOINT_DOF = {
     "planar": 3,
     "spherical": 3,
 }
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What screwkin accepts from a mechanism file: sizes checked before Pinocchio
+    sees the file, and bounds beyond which a number is a mistake, not a robot.
+
+    Sizes (the largest real robots we know are far inside them: PAL's tiago_dual
+    has 102 links and about 60 moving coordinates, humanoids with hands about 70,
+    the biggest parallel robot of the example corpus, kangaroo, 11 loops):
+
+    file_bytes:  20 MB of URDF/SDF text (real URDFs are under 1 MB; generated
+                 ones with inline data a few MB).
+    elements:    200,000 XML elements (tiago_dual has 3,851, PR2 2,314).
+    yaml_bytes:  1 MB of YAML sidecar (real ones are a few hundred bytes).
+    links, joints: 2,000 each (tree and fixed joints; 20 times tiago_dual).
+    loop_joints: 200 loop (cut) joints (18 times kangaroo's 11).
+    meshes:      2,000 distinct mesh files looked for when loading (PR2 names 26);
+                 beyond them a missing mesh is not reported (the view still finds each).
+    coordinates: 500 moving joint coordinates (nv).  Pinocchio's ``Data`` holds
+                 nv x nv x nv tensors: about :func:`data_bytes` = 64 nv^3 bytes
+                 (measured: 0.14 GB at nv = 100, 0.6 GB at 200, 4.1 GB and 7.6 s
+                 at 400), so a 2,000-link chain would need 512 GB; 500 is 8 GB.
+
+    Magnitudes (checked on every number the file gives; a value beyond them is
+    reported as "not a plausible value"):
+
+    length:  10 km for positions (origin xyz, loop-joint xyz, geometry sizes).
+    angle:   10,000 rad for rpy angles (1,600 turns; real files stay within 2 pi).
+    mass:    1,000 t per link (mining excavators are under 1,000 t); not negative.
+    inertia: 1e10 kg m^2 per component (1,000 t at 100 m).
+    axis_min, axis_max: length of a joint axis vector: Pinocchio normalizes it
+             through its squared norm, which under- or overflows outside about
+             1e-150 .. 1e150; real files write unit vectors (or close: 1.9).
+    Joint <limit> lower/upper may be any finite value with lower <= upper: ROS and
+    Gazebo write +-1e16 and +-1.79769e+308 for "unlimited".
+    """
+
+    file_bytes: int = 20_000_000
+    elements: int = 200_000
+    yaml_bytes: int = 1_000_000
+    links: int = 2000
+    joints: int = 2000
+    loop_joints: int = 200
+    meshes: int = 2000
+    coordinates: int = 500
+    length: float = 1e4
+    angle: float = 1e4
+    mass: float = 1e6
+    inertia: float = 1e10
+    axis_min: float = 1e-6
+    axis_max: float = 1e6
+
+
+#: The limits in force (one place to change them).
+LIMITS = Limits()
+
+
+def data_bytes(nv: int) -> float:
+    """Approximate memory of one ``pinocchio.Data`` for nv velocity coordinates [bytes]."""
+    return 64.0 * nv**3
 
 
 def placement(xyz, rpy):
@@ -131,6 +195,7 @@ class MechanismSpec:
     yaml_path: str | None = None
     replacements: list = field(default_factory=list)  # (joint name, type) from the sidecar
     warnings: list = field(default_factory=list)
+    package_dirs: list = field(default_factory=list)  # --package-dir folders for package:// meshes
 
     @property
     def root(self) -> str:

@@ -1,17 +1,68 @@
-"""Exceptions raised by screwkin.
+"""Exceptions raised by screwkin, and the helpers that keep their messages one short line.
 
 Every error a user can cause derives from :class:`ScrewkinError` and carries the
 facts needed to fix it.  The command line prints ``str(error)`` as one line.
+
+Text taken from a file (names, attribute values) goes into a message only through
+:func:`quote` or :func:`shorten`: at most :data:`QUOTE_LIMIT` characters of it,
+with control characters (newlines, escapes, bidirectional overrides) written as
+Python escapes, so that a hostile file can neither flood the terminal nor
+break the one-line contract.
 """
 
 from __future__ import annotations
+
+import reprlib
 
 __all__ = [
     "ScrewkinError",
     "UsageError",
     "MechanismFileError",
     "AssemblyError",
+    "QUOTE_LIMIT",
+    "MESSAGE_LIMIT",
+    "quote",
+    "shorten",
+    "one_line",
 ]
+
+#: Most characters of a file's text quoted in a message (then "...").
+QUOTE_LIMIT = 80
+#: Most characters of one error message after the file's path (the first problem
+#: is kept whole up to this length; the list of further problems is cut to fit).
+MESSAGE_LIMIT = 300
+
+_repr = reprlib.Repr()
+_repr.maxlevel, _repr.maxlist, _repr.maxtuple, _repr.maxdict = 3, 6, 6, 6
+_repr.maxstring, _repr.maxother = QUOTE_LIMIT, QUOTE_LIMIT
+
+
+def _escape(text: str) -> str:
+    """Control, format and separator characters as Python escapes (``\\n``, ``\\x1b``, ``\\u202e``)."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def shorten(value, limit: int = QUOTE_LIMIT) -> str:
+    """``value`` (a string, or any object by its bounded repr) as at most ``limit``
+    characters plus "...", control characters escaped; never contains a newline."""
+    text = value if isinstance(value, str) else _repr.repr(value)
+    if len(text) > limit:
+        text = text[:limit] + "..."
+    return _escape(text)
+
+
+def quote(value, limit: int = QUOTE_LIMIT) -> str:
+    """``'value'`` for a message: :func:`shorten` between single quotes; a value that is
+    not a string (a YAML list, None) as its bounded repr, without quotes."""
+    return f"'{shorten(value, limit)}'" if isinstance(value, str) else shorten(value, limit)
+
+
+def one_line(text: str, limit: int) -> str:
+    """A whole message made safe for one terminal line (escaped, at most ``limit`` characters)."""
+    text = _escape(str(text))
+    return text if len(text) <= limit else text[: max(limit - 3, 0)] + "..."
 
 
 class ScrewkinError(Exception):
@@ -30,7 +81,8 @@ class MechanismFileError(ScrewkinError):
     """A mechanism file is missing, malformed, or describes something invalid.
 
     ``problems`` holds every problem found in the file (validation collects them
-    all before failing); the message shows the first and counts the rest.
+    all before failing); the message shows the first and counts the rest, within
+    :data:`MESSAGE_LIMIT` characters after the path.
     """
 
     def __init__(self, path, problems):
@@ -39,11 +91,17 @@ class MechanismFileError(ScrewkinError):
         self.path = str(path)
         self.problems = list(problems)
         more = len(self.problems) - 1
-        text = f"{self.path}: {self.problems[0]}"
+        first = one_line(self.problems[0], MESSAGE_LIMIT)
+        text = first
         if more > 0:
-            text += f" (and {more} more problem{'s' if more > 1 else ''}: " + "; ".join(self.problems[1:4])
-            text += ", ...)" if more > 3 else ")"
-        super().__init__(text)
+            tail = f" (and {more} more problem{'s' if more > 1 else ''}: " + "; ".join(
+                _escape(str(p)) for p in self.problems[1:4]) + (", ...)" if more > 3 else ")")
+            room = MESSAGE_LIMIT - len(first)
+            if len(tail) > room:
+                head = f" (and {more} more problem{'s' if more > 1 else ''}"
+                tail = one_line(tail[:-1], max(room - 1, len(head) + 4)) + ")" if room > len(head) + 5 else head + ")"
+            text += tail
+        super().__init__(f"{_escape(self.path)}: {text}")
 
 
 class AssemblyError(MechanismFileError):

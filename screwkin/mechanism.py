@@ -19,13 +19,14 @@ import numpy as np
 import pinocchio as pin
 
 from .closure import Assembly, ClosureSystem, CutJoint
-from .description import MechanismSpec, placement, resolve_actuation
-from .errors import AssemblyError, MechanismFileError, UsageError
+from .description import LIMITS, MechanismSpec, placement, resolve_actuation
+from .errors import AssemblyError, MechanismFileError, UsageError, quote, shorten
 from .linalg import null_space, rank
 from .tolerances import DEFAULT, Tolerances
-from .urdf import read_urdf, read_yaml_sidecar
+from .urdf import check_sizes, read_urdf, read_yaml_sidecar
+from .xmlsafe import parse_xml_text, read_regular_file
 
-__all__ = ["load", "Mechanism", "Coordinate", "characteristic_length"]
+__all__ = ["load", "Mechanism", "Coordinate", "characteristic_length", "frame_id"]
 
 
 @dataclass(frozen=True)
@@ -41,14 +42,8 @@ class Coordinate:
 
 
 def _read_text(path: Path) -> str:
-    if not path.exists():
-        raise MechanismFileError(path, "no such file")
-    if path.is_dir():
-        raise MechanismFileError(path, "is a directory, not a mechanism file")
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise MechanismFileError(path, f"cannot read: {exc.strerror}") from None
+    """The text of a mechanism file: a regular file of at most ``LIMITS.file_bytes``, in UTF-8."""
+    raw = read_regular_file(path, LIMITS.file_bytes, "mechanism file")
     if not raw.strip():
         raise MechanismFileError(path, "the file is empty")
     try:
@@ -58,11 +53,88 @@ def _read_text(path: Path) -> str:
 
 
 def _find_sidecar(path: Path):
+    """``FILE.yaml`` or ``FILE.yml`` beside the file, if there is one (whatever it is:
+    a pipe or a directory of that name is then refused when read, not skipped)."""
     for suffix in (".yaml", ".yml"):
         cand = path.with_suffix(suffix)
-        if cand.is_file():
-            return cand
+        try:
+            if cand.exists():
+                return cand
+        except (OSError, ValueError):
+            continue
     return None
+
+
+#: Frame types in the order a bare name is taken when several frames share it (a URDF
+#: may name a joint like a link: Pinocchio then has a JOINT and a BODY frame of that name).
+FRAME_PREFERENCE = (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.OP_FRAME,
+                    pin.FrameType.SENSOR)
+
+
+def frame_id(model, name: str, prefer=FRAME_PREFERENCE):
+    """Id of the frame named ``name`` (None when there is none).  When several frames
+    share the name, the first of the types in ``prefer`` wins -- by default the BODY
+    frame (the link), where ``model.getFrameId(name)`` raises "Several frames match"."""
+    matches = [k for k, f in enumerate(model.frames) if f.name == name]
+    if not matches:
+        return None
+    if len(matches) > 1:
+        for t in prefer:
+            for k in matches:
+                if model.frames[k].type == t:
+                    return k
+    return matches[0]
+
+
+def _unambiguous_cut_frames(model, spec) -> None:
+    """Give every cut-joint frame name that several Pinocchio frames share (a joint
+    named like a link) an alias frame of its own on the preferred frame, and name the
+    alias in the spec, so that binding by name finds exactly one frame."""
+    counts = {}
+    for f in model.frames:
+        counts[f.name] = counts.get(f.name, 0) + 1
+    for c in spec.cut_joints:
+        for attr in ("frame1", "frame2"):
+            name = getattr(c, attr)
+            if counts.get(name, 0) < 2:
+                continue
+            alias = f"screwkin@{name}"
+            if not model.existFrame(alias):
+                fid = frame_id(model, name)
+                parent = model.frames[fid]
+                model.addFrame(pin.Frame(alias, parent.parentJoint, fid, parent.placement, pin.FrameType.OP_FRAME),
+                               False)
+            setattr(c, attr, alias)
+
+
+def _frame_bodies(model) -> dict:
+    """Frame name -> the Pinocchio joint carrying it (of the preferred frame when several share the name)."""
+    rank = {t: k for k, t in enumerate(FRAME_PREFERENCE)}
+    best = {}
+    for f in model.frames:
+        r = rank.get(f.type, len(rank))
+        if f.name not in best or r < best[f.name][0]:
+            best[f.name] = (r, f.parentJoint)
+    return {name: joint for name, (_, joint) in best.items()}
+
+
+#: Most warnings printed for one file (the rest are counted).
+MAX_WARNINGS = 20
+
+
+def _check_cut_bodies(model, spec) -> None:
+    """Refuse a cut joint whose two frames are on the same rigid body (fixed together):
+    it closes no loop."""
+    for c in spec.cut_joints:
+        f1, f2 = frame_id(model, c.frame1), frame_id(model, c.frame2)
+        if f1 is None or f2 is None:
+            continue  # reported when the cut is bound
+        if model.frames[f1].parentJoint == model.frames[f2].parentJoint:
+            yaml = c.source == "yaml" and spec.yaml_path
+            what = "closed_loop pair" if yaml else f"loop joint {quote(c.name)}"
+            raise MechanismFileError(spec.yaml_path if yaml else spec.path,
+                                     f"{what} connects {quote(c.frame1)} and {quote(c.frame2)}, which are fixed "
+                                     "together (on the same body): it closes no loop")
 
 
 def _axis_letters(t: str):
@@ -547,7 +619,7 @@ def _native_stderr(box: list):
             os.dup2(saved, 2)
             os.close(saved)
             tmp.seek(0)
-            box.append(tmp.read().decode("utf-8", "replace"))
+            box.append(tmp.read(1 << 20).decode("utf-8", "replace"))  # the first MB says what went wrong
 
 
 def _urdfdom_messages(box: list) -> list:
@@ -561,22 +633,34 @@ def _urdfdom_messages(box: list) -> list:
     return out
 
 
-def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None) -> Mechanism:
+def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None) -> Mechanism:
     """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, or SDF).
 
     yaml:      path of an Extended-URDF sidecar; default: ``<file>.yaml`` when it exists.
     actuated:  actuated joint names, overriding the file's declaration.
     warn:      callable receiving each warning (default: print to stderr).
+    package_dirs: folders searched first for ``package://`` meshes (as ``ROS_PACKAGE_PATH``).
+
+    The file is untrusted: see :mod:`screwkin.xmlsafe` and
+    :class:`~screwkin.description.Limits` for what is refused before Pinocchio reads it.
     """
     path = Path(path)
     text = _read_text(path)
-    head = text.lstrip()[:400]
-    if path.suffix.lower() == ".sdf" or "<sdf" in head:
+    root = parse_xml_text(text, path)  # the root element decides the format, not the suffix
+    package_dirs = [str(d) for d in package_dirs or ()]
+    for d in package_dirs:
+        if not os.path.isdir(d):
+            raise UsageError(f"package folder {quote(d)} (--package-dir) is not a folder")
+    if root.tag == "sdf":
         from .sdf import read_sdf
 
-        spec = read_sdf(path, text)
+        spec = read_sdf(path, text, root=root, package_dirs=package_dirs)
+    elif root.tag == "robot" or path.suffix.lower() != ".sdf":
+        spec = read_urdf(path, text, root=root, package_dirs=package_dirs)
     else:
-        spec = read_urdf(path, text)
+        raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>, "
+                                       "expected <sdf>")
+    spec.package_dirs = package_dirs
     native = []  # what urdfdom (inside Pinocchio) prints on the process's stderr: kept out of the output
     try:
         with _native_stderr(native):
@@ -586,17 +670,25 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         reasons = [m for level, m in _urdfdom_messages(native) if level == "Error"]
         if reasons:  # urdfdom's first complaint says more than Pinocchio's summary
             first = reasons[0]
-        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {first}") from None
-    spec.warnings.extend(f"URDF parser: {m}" for level, m in _urdfdom_messages(native) if level != "Error")
+        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {shorten(first, 120)}") from None
+    spec.warnings.extend(f"URDF parser: {shorten(m, 120)}" for level, m in _urdfdom_messages(native)
+                         if level != "Error")
     if yaml is None and spec.format == "urdf":
         yaml = _find_sidecar(path)
     if yaml is not None:
-        yaml = Path(yaml)
-        if not yaml.is_file():
-            raise MechanismFileError(yaml, "no such file")
-        read_yaml_sidecar(spec, yaml, [f.name for f in model.frames])
+        read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
     if spec.replacements:
         model = _replace_joints(model, spec.replacements)
-    for w in spec.warnings:
-        (warn or (lambda m: print(f"warning: {path}: {m}", file=sys.stderr)))(w)
+    check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
+    _check_cut_bodies(model, spec)
+    _unambiguous_cut_frames(model, spec)
+    shown = spec.warnings
+    if warn is None:  # on the terminal: a bounded number of bounded lines
+        def warn(m):
+            print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
+
+        if len(shown) > MAX_WARNINGS:
+            shown = shown[:MAX_WARNINGS] + [f"and {len(spec.warnings) - MAX_WARNINGS} more warnings"]
+    for w in shown:
+        warn(w)
     return Mechanism(spec, model, actuated=actuated, tolerances=tolerances)

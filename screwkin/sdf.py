@@ -20,9 +20,9 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 import pinocchio as pin
 
-from .description import CutJointSpec, JointSpec, LinkSpec, MechanismSpec, finite
-from .errors import MechanismFileError
-from .urdf import check_meshes
+from .description import LIMITS, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
+from .errors import MechanismFileError, quote, shorten
+from .urdf import check_meshes, check_sizes, numbers, unit_axis
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_sdf"]
@@ -36,32 +36,26 @@ def _pose(elem, what, problems):
     if elem is None or not (elem.text or "").strip():
         return pin.SE3.Identity()
     rel = elem.get("relative_to")
+    before = len(problems)
     parts = elem.text.split()
-    try:
-        v = [float(p) for p in parts]
-    except ValueError:
-        problems.append(f"{what} <pose> '{elem.text.strip()}' is not 6 numbers")
+    if len(parts) != 6:
+        problems.append(f"{what} <pose> {quote(elem.text.strip())} must be 6 finite numbers")
         return pin.SE3.Identity()
-    if len(v) != 6 or not finite(v):
-        problems.append(f"{what} <pose> '{elem.text.strip()}' must be 6 finite numbers")
+    xyz = numbers(" ".join(parts[:3]), 3, f"{what} <pose> x y z", problems, (0, 0, 0), LIMITS.length, "m")
+    rpy = numbers(" ".join(parts[3:]), 3, f"{what} <pose> roll pitch yaw", problems, (0, 0, 0), LIMITS.angle, "rad")
+    if len(problems) > before:
         return pin.SE3.Identity()
     if rel not in (None, "", "__model__"):
-        problems.append(f"{what} <pose relative_to='{rel}'> is not supported (only poses relative to the model)")
-    return pin.SE3(pin.rpy.rpyToMatrix(np.array(v[3:])), np.array(v[:3]))
+        problems.append(f"{what} <pose relative_to={quote(rel)}> is not supported (only poses relative to the model)")
+    return pin.SE3(pin.rpy.rpyToMatrix(np.array(rpy)), np.array(xyz))
 
 
 def _vec(text, what, problems):
-    try:
-        v = np.array([float(p) for p in (text or "").split()])
-    except ValueError:
-        v = np.zeros(0)
-    if v.shape != (3,) or not finite(v):
-        problems.append(f"{what} '{(text or '').strip()}' must be 3 finite numbers")
+    before = len(problems)
+    v = numbers((text or "").strip() or "?", 3, what, problems, (1.0, 0, 0))
+    if len(problems) > before:
         return np.array([1.0, 0, 0])
-    if np.linalg.norm(v) < 1e-12:
-        problems.append(f"{what}: zero axis")
-        return np.array([1.0, 0, 0])
-    return v / np.linalg.norm(v)
+    return np.array(unit_axis(v, what, problems))
 
 
 def _axis(joint, tag, name, X_joint, problems):
@@ -69,7 +63,7 @@ def _axis(joint, tag, name, X_joint, problems):
     if a is None:
         return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])
     xyz = a.find("xyz")
-    v = _vec(xyz.text if xyz is not None else None, f"joint '{name}' <{tag}><xyz>", problems)
+    v = _vec(xyz.text if xyz is not None else None, f"joint {quote(name)} <{tag}><xyz>", problems)
     model_frame = (a.findtext("use_parent_model_frame") or "").strip() == "true" or (
         xyz is not None and xyz.get("expressed_in") == "__model__")
     return X_joint.rotation.T @ v if model_frame else v
@@ -83,43 +77,61 @@ def _origin(M):
     return f'<origin xyz="{_fmt(M.translation)}" rpy="{_fmt(pin.rpy.matrixToRpy(M.rotation))}"/>'
 
 
-def read_sdf(path, text) -> MechanismSpec:
-    root = parse_xml_text(text, path)
+def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
+    """Read an SDF file (already loaded as ``text``, parsed as ``root`` when given)."""
+    if root is None:
+        root = parse_xml_text(text, path)
     if root.tag != "sdf":
-        raise MechanismFileError(path, f"not an SDF file: the root element is <{root.tag}>")
+        raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>")
     model = root.find("model")
     if model is None:
         model = root.find("world/model")
     if model is None:
         raise MechanismFileError(path, "the SDF file has no <model>")
+    link_elems, joint_elems = model.findall("link"), model.findall("joint")
+    check_sizes(path, len(link_elems), len(joint_elems), 0)
     problems = []
     links, poses = {}, {}
-    for e in model.findall("link"):
+    for e in link_elems:
         name = e.get("name")
-        if not name or name in links:
-            problems.append(f"a <link> has no name or a duplicate name ('{name}')")
+        if not name or name in links or name == "world":
+            problems.append(f"a <link> has no name, a duplicate name or the reserved name ({quote(name)})")
             continue
         mass = e.findtext("inertial/mass")
-        try:
-            mass = float(mass) if mass is not None else None
-        except ValueError:
-            problems.append(f"link '{name}' <mass> '{mass}' is not a number")
-            mass = None
+        if mass is not None:
+            mass = numbers(mass.strip() or "?", 1, f"link {quote(name)} <mass>", problems, (0.0,), LIMITS.mass,
+                           "kg", low=0.0)[0]
         links[name] = LinkSpec(name, mass, e.find("visual") is not None or e.find("collision") is not None)
-        poses[name] = _pose(e.find("pose"), f"link '{name}'", problems)
+        poses[name] = _pose(e.find("pose"), f"link {quote(name)}", problems)
     raw = []
-    for e in model.findall("joint"):
+    seen = set()
+    for e in joint_elems:
         name, jtype = e.get("name"), e.get("type")
+        if not name:
+            problems.append("a <joint> has no name")
+            continue
+        if name in seen:
+            problems.append(f"joint {quote(name)} is defined twice")
+            continue
+        seen.add(name)
         if jtype not in _TYPES:
-            problems.append(f"joint '{name}' has unknown or unsupported type '{jtype}' (supported: {', '.join(sorted(_TYPES))})")
+            problems.append(f"joint {quote(name)} has unknown or unsupported type {quote(jtype)} "
+                            f"(supported: {', '.join(sorted(_TYPES))})")
             continue
         parent, child = (e.findtext("parent") or "").strip(), (e.findtext("child") or "").strip()
+        bad = False
         for tag, link in (("parent", parent), ("child", child)):
             if link != "world" and link not in links:
-                problems.append(f"joint '{name}' names {tag} link '{link}', which does not exist")
+                problems.append(f"joint {quote(name)} names {tag} link {quote(link)}, which does not exist")
+                bad = True
         if child == "world":
-            problems.append(f"joint '{name}' has the world as its child")
-        raw.append((name, jtype, parent, child, e))
+            problems.append(f"joint {quote(name)} has the world as its child")
+            bad = True
+        if parent == child and not bad:
+            problems.append(f"joint {quote(name)} connects link {quote(parent)} to itself")
+            bad = True
+        if not bad:
+            raw.append((name, jtype, parent, child, e))
     if problems:
         raise MechanismFileError(path, problems)
     if any(p == "world" for _, _, p, _, _ in raw):
@@ -129,7 +141,7 @@ def read_sdf(path, text) -> MechanismSpec:
     if ground is None:
         raise MechanismFileError(path, "the model has no links")
     # world pose of every joint frame (SDF: joint pose relative to the child link)
-    joint_pose = {n: poses[c] * _pose(e.find("pose"), f"joint '{n}'", problems) for n, _, _, c, e in raw}
+    joint_pose = {n: poses[c] * _pose(e.find("pose"), f"joint {quote(n)}", problems) for n, _, _, c, e in raw}
     axes = {n: (_axis(e, "axis", n, joint_pose[n], problems), _axis(e, "axis2", n, joint_pose[n], problems))
             for n, _, _, _, e in raw}
     if problems:
@@ -153,7 +165,10 @@ def read_sdf(path, text) -> MechanismSpec:
             queue.append(other)
     unreached = [n for n in links if n not in frame]
     if unreached:
-        raise MechanismFileError(path, f"links not connected to '{ground}' by any joint: {', '.join(unreached[:5])}")
+        raise MechanismFileError(path, f"links not connected to {quote(ground)} by any joint: "
+                                       f"{', '.join(quote(n, 40) for n in unreached[:5])}")
+    dof = {"revolute": 1, "continuous": 1, "prismatic": 1, "fixed": 0, "ball": 3, "universal": 2, "revolute2": 2}
+    check_sizes(path, len(links), len(raw), len(raw) - len(tree), sum(dof[raw[k][1]] for k in tree))
     out = [f'<robot name={quoteattr(model.get("name") or "sdf_model")}>']
     spec_links = dict(links)
     joints, cuts = [], []
@@ -206,4 +221,5 @@ def read_sdf(path, text) -> MechanismSpec:
     out.append("</robot>")
     return MechanismSpec(path=str(path), name=model.get("name") or "sdf_model", format="sdf",
                          urdf_text="\n".join(out), links=spec_links, joints=joints, cut_joints=cuts,
-                         warnings=check_meshes(path, model))
+                         warnings=check_meshes(path, model, package_dirs),
+                         package_dirs=[str(d) for d in package_dirs or ()])

@@ -3,6 +3,18 @@
 ``45deg`` -> 0.785398... rad, ``30mm`` -> 0.03 m, ``0.5`` -> 0.5 (SI as typed).
 Rates and accelerations take the same suffixes (``90deg`` in ``--rate`` means
 90 deg/s).
+
+Units (a space between number and unit is allowed, ``30 mm``; ASCII units are
+case-insensitive, ``30MM``, ``45Deg``):
+
+* angles: ``rad`` (``radian(s)``), ``mrad``, ``deg`` (``degree(s)``, ``°``),
+  ``turn(s)`` (one full revolution, 2 pi rad);
+* lengths: ``m``, ``cm``, ``mm``, ``um`` (``µm``, ``μm``), ``in`` (``inch``,
+  ``inches``: 25.4 mm), ``ft`` (``foot``, ``feet``: 0.3048 m).
+
+Kilometres are not accepted on purpose (no mechanism is that big: ``1km`` is
+more likely a typo than a value).  Numbers are plain decimal ASCII (``1e-3``,
+``.5``); ``nan``, ``inf`` and ``1_000`` are refused.
 """
 
 from __future__ import annotations
@@ -10,28 +22,42 @@ from __future__ import annotations
 import math
 import re
 
-from .errors import UsageError
+from .errors import UsageError, quote
 
 __all__ = ["parse_value", "parse_assignments", "UNITS"]
 
+_DEG = math.pi / 180.0
 UNITS = {
-    "": 1.0, "rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0,
-    "m": 1.0, "cm": 0.01, "mm": 0.001, "um": 1e-6,
+    "": 1.0,
+    "rad": 1.0, "radian": 1.0, "radians": 1.0, "mrad": 1e-3,
+    "deg": _DEG, "degree": _DEG, "degrees": _DEG, "°": _DEG,
+    "turn": 2 * math.pi, "turns": 2 * math.pi,
+    "m": 1.0, "cm": 0.01, "mm": 0.001, "um": 1e-6, "µm": 1e-6, "μm": 1e-6,
+    "in": 0.0254, "inch": 0.0254, "inches": 0.0254,
+    "ft": 0.3048, "foot": 0.3048, "feet": 0.3048,
 }
-_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zA-Z°]*)\s*$")
+_NUMBER = re.compile(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*\Z")
+
+
+def _unit(text: str):
+    """The factor of a unit as typed (case-insensitive for ASCII units), or None."""
+    if text in UNITS:
+        return UNITS[text]
+    return UNITS.get(text.lower()) if text.isascii() else None
 
 
 def parse_value(text: str) -> float:
     """A number with an optional unit suffix, in SI units."""
     m = _NUMBER.match(text)
     if not m:
-        raise UsageError(f"'{text}' is not a number with an optional unit (e.g. 45deg, 30mm, 0.5)")
-    unit = m.group(2)
-    if unit not in UNITS:
-        raise UsageError(f"unknown unit '{unit}' in '{text}' (known: {', '.join(u for u in UNITS if u)})")
-    value = float(m.group(1)) * UNITS[unit]
+        raise UsageError(f"{quote(text)} is not a number with an optional unit (e.g. 45deg, 30mm, 1in, 0.5)")
+    factor = _unit(m.group(2))
+    if factor is None:
+        known = ", ".join(u for u in ("rad", "mrad", "deg", "°", "turn", "m", "cm", "mm", "um", "in", "ft"))
+        raise UsageError(f"unknown unit {quote(m.group(2), 20)} in {quote(text)} (known: {known})")
+    value = float(m.group(1)) * factor
     if not math.isfinite(value):
-        raise UsageError(f"'{text}' is not a finite number")
+        raise UsageError(f"{quote(text)} is not a finite number")
     return value
 
 
@@ -44,6 +70,6 @@ def parse_assignments(items, option: str) -> dict:
                 continue
             name, sep, value = part.partition("=")
             if not sep or not name.strip():
-                raise UsageError(f"{option} expects NAME=VALUE, got '{part}'")
+                raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
             out[name.strip()] = parse_value(value)
     return out

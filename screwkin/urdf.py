@@ -8,24 +8,28 @@ that every problem is reported with the file's name and all at once.
 
 from __future__ import annotations
 
+import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
 
 from .description import (
     CUT_JOINT_DOF,
+    LIMITS,
     TREE_JOINT_DOF,
     CutJointSpec,
     JointSpec,
     LinkSpec,
     MechanismSpec,
-    finite,
+    data_bytes,
 )
-from .errors import MechanismFileError
-from .xmlsafe import parse_xml_text
+from .errors import MechanismFileError, quote, shorten
+from .xmlsafe import parse_xml_text, read_regular_file
 
-__all__ = ["read_urdf", "read_yaml_sidecar", "numbers", "check_tree", "check_meshes"]
+__all__ = ["read_urdf", "read_yaml_sidecar", "numbers", "unit_axis", "check_tree", "check_meshes", "check_sizes",
+           "resolve_uri", "find_mesh"]
 
 
 class _Problems(list):
@@ -36,48 +40,100 @@ class _Problems(list):
             raise MechanismFileError(path, list(self))
 
 
-def numbers(text, count, what, problems, default):
-    """Parse ``count`` floats from an attribute; record a problem when invalid."""
+# a plain decimal number as urdfdom and SDFormat read it (no "1_000", no non-ASCII digits, no hex)
+_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\Z")
+_NONFINITE = re.compile(r"[-+]?(?:nan|inf|infinity)\Z", re.IGNORECASE)
+
+
+def numbers(text, count, what, problems, default, bound=None, unit="m", low=None):
+    """Parse ``count`` floats from an attribute; record a problem when invalid.
+
+    bound: largest magnitude accepted (see :class:`~screwkin.description.Limits`);
+    low: smallest value accepted (e.g. 0 for a mass).
+    """
     if text is None:
         return tuple(default)
     parts = text.split()
-    try:
-        values = tuple(float(p) for p in parts)
-    except ValueError:
-        problems.append(f"{what}: '{text}' is not {count} numbers")
+    if len(parts) != count:
+        problems.append(f"{what}: {quote(text)} has {len(parts)} number{'' if len(parts) == 1 else 's'}, "
+                        f"expected {count}")
         return tuple(default)
-    if len(values) != count:
-        problems.append(f"{what}: '{text}' has {len(values)} numbers, expected {count}")
+    if any(_NONFINITE.match(p) for p in parts):
+        problems.append(f"{what}: {quote(text)} contains NaN or infinite numbers")
         return tuple(default)
-    if not finite(values):
-        problems.append(f"{what}: '{text}' contains NaN or infinite numbers")
+    if not all(_NUMBER.match(p) for p in parts):
+        problems.append(f"{what}: {quote(text)} is not {count} number{'s' if count > 1 else ''}")
+        return tuple(default)
+    values = tuple(float(p) for p in parts)
+    if not all(math.isfinite(v) for v in values):  # digits beyond the range of a double: 1e999
+        problems.append(f"{what}: {quote(text)} contains NaN or infinite numbers")
+        return tuple(default)
+    if bound is not None and any(abs(v) > bound for v in values):
+        problems.append(f"{what}: {quote(text)} is not a plausible value (beyond {bound:g} {unit})")
+        return tuple(default)
+    if low is not None and any(v < low for v in values):
+        problems.append(f"{what}: {quote(text)} is not a plausible value (below {low:g} {unit})")
         return tuple(default)
     return values
 
 
+def unit_axis(values, what, problems, default=(1.0, 0.0, 0.0)):
+    """``values`` scaled to length 1 (safely: divided by the largest magnitude first);
+    records a problem for a zero axis or one whose length Pinocchio cannot normalize."""
+    v = np.asarray(values, float)
+    big = float(np.max(np.abs(v))) if v.size else 0.0
+    if not big:
+        problems.append(f"{what}: zero axis {quote(' '.join(f'{x:g}' for x in v))}")
+        return tuple(default)
+    length = big * float(np.linalg.norm(v / big))
+    if not LIMITS.axis_min <= length <= LIMITS.axis_max:
+        problems.append(f"{what}: axis {quote(' '.join(f'{x:g}' for x in v))} is not a plausible value "
+                        f"(its length must lie between {LIMITS.axis_min:g} and {LIMITS.axis_max:g})")
+        return tuple(default)
+    u = v / big
+    return tuple(u / np.linalg.norm(u))
+
+
 def _axis(elem, what, problems, default=(1.0, 0.0, 0.0)):
-    if elem is None:
+    if elem is None or elem.get("xyz") is None:  # urdfdom's default: the x axis
         return tuple(default)
+    before = len(problems)
     values = numbers(elem.get("xyz"), 3, f"{what} <{elem.tag} xyz>", problems, default)
-    if np.linalg.norm(values) < 1e-12:
-        problems.append(f"{what}: zero axis '{elem.get('xyz')}'")
+    if len(problems) > before:
         return tuple(default)
-    return tuple(np.asarray(values) / np.linalg.norm(values))
+    return unit_axis(values, what, problems, default)
+
+
+def _origin(elem, what, problems):
+    """xyz and rpy of an ``<origin>`` (or of any element carrying them), checked."""
+    get = (lambda k: elem.get(k)) if elem is not None else (lambda k: None)
+    xyz = numbers(get("xyz"), 3, f"{what} xyz>", problems, (0.0, 0.0, 0.0), LIMITS.length, "m")
+    rpy = numbers(get("rpy"), 3, f"{what} rpy>", problems, (0.0, 0.0, 0.0), LIMITS.angle, "rad")
+    return xyz, rpy
+
+
+_GEOMETRY = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), "sphere": (("radius", 1),),
+             "capsule": (("radius", 1), ("length", 1)), "mesh": (("scale", 3),)}
 
 
 def _link(elem, problems) -> LinkSpec:
     name = elem.get("name")
+    what = f"link {quote(name)}"
     mass = None
     mass_elem = elem.find("inertial/mass")
     if mass_elem is not None:
-        value = numbers(mass_elem.get("value"), 1, f"link '{name}' <mass value>", problems, (0.0,))
+        value = numbers(mass_elem.get("value"), 1, f"{what} <mass value>", problems, (0.0,), LIMITS.mass, "kg",
+                        low=0.0)
         mass = value[0]
     for inertia in elem.findall("inertial/inertia"):
         for key, val in inertia.attrib.items():
-            numbers(val, 1, f"link '{name}' <inertia {key}>", problems, (0.0,))
+            numbers(val, 1, f"{what} <inertia {quote(key, 20)}>", problems, (0.0,), LIMITS.inertia, "kg m^2")
     for origin in elem.findall("*/origin"):
-        numbers(origin.get("xyz"), 3, f"link '{name}' <origin xyz>", problems, (0, 0, 0))
-        numbers(origin.get("rpy"), 3, f"link '{name}' <origin rpy>", problems, (0, 0, 0))
+        _origin(origin, f"{what} <origin", problems)
+    for shape in elem.findall("*/geometry/*"):
+        for key, count in _GEOMETRY.get(shape.tag, ()):  # sizes are not negative; a mesh scale may be (mirroring)
+            numbers(shape.get(key), count, f"{what} <{shape.tag} {key}>", problems, (0.0,) * count, LIMITS.length,
+                    "m", low=None if key == "scale" else 0.0)
     has_geometry = elem.find("visual") is not None or elem.find("collision") is not None
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry)
 
@@ -87,34 +143,35 @@ def _joint(elem, links, problems) -> JointSpec | None:
     if not name:
         problems.append("a <joint> has no name")
         return None
+    what = f"joint {quote(name)}"
     jtype = elem.get("type")
     if jtype not in TREE_JOINT_DOF:
-        problems.append(
-            f"joint '{name}' has unknown type '{jtype}' (known: {', '.join(sorted(TREE_JOINT_DOF))})"
-        )
+        problems.append(f"{what} has unknown type {quote(jtype)} (known: {', '.join(sorted(TREE_JOINT_DOF))})")
         return None
     ends = {}
     for tag in ("parent", "child"):
         e = elem.find(tag)
         link = e.get("link") if e is not None else None
         if not link:
-            problems.append(f"joint '{name}' has no <{tag} link>")
+            problems.append(f"{what} has no <{tag} link>")
             return None
         if link not in links:
-            problems.append(f"joint '{name}' names {tag} link '{link}', which does not exist")
+            problems.append(f"{what} names {tag} link {quote(link)}, which does not exist")
             return None
         ends[tag] = link
-    origin = elem.find("origin")
-    xyz = numbers(origin.get("xyz") if origin is not None else None, 3, f"joint '{name}' <origin xyz>", problems, (0, 0, 0))
-    rpy = numbers(origin.get("rpy") if origin is not None else None, 3, f"joint '{name}' <origin rpy>", problems, (0, 0, 0))
+    xyz, rpy = _origin(elem.find("origin"), f"{what} <origin", problems)
     axis = (1.0, 0.0, 0.0)
     if jtype in ("revolute", "continuous", "prismatic", "planar"):
-        axis = _axis(elem.find("axis"), f"joint '{name}'", problems)
+        axis = _axis(elem.find("axis"), what, problems)
     limit = elem.find("limit")
     if limit is not None:
+        values = {}
         for key in ("lower", "upper", "effort", "velocity"):
             if limit.get(key) is not None:
-                numbers(limit.get(key), 1, f"joint '{name}' <limit {key}>", problems, (0.0,))
+                values[key] = numbers(limit.get(key), 1, f"{what} <limit {key}>", problems, (None,))[0]
+        lo, hi = values.get("lower"), values.get("upper")
+        if jtype in ("revolute", "prismatic") and lo is not None and hi is not None and lo > hi:
+            problems.append(f"{what} <limit>: lower {lo:g} > upper {hi:g}")
     return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis)
 
 
@@ -123,45 +180,62 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
     if not name:
         problems.append("a <loop_joint> has no name")
         return None
+    what = f"loop joint {quote(name)}"
     jtype = elem.get("type")
     if jtype not in CUT_JOINT_DOF:
-        problems.append(
-            f"loop joint '{name}' has unknown type '{jtype}' (known: {', '.join(sorted(CUT_JOINT_DOF))})"
-        )
+        problems.append(f"{what} has unknown type {quote(jtype)} (known: {', '.join(sorted(CUT_JOINT_DOF))})")
         return None
     firsts = elem.findall("link1")
     seconds = elem.findall("link2")
     if len(firsts) == 2 and not seconds:
-        warnings.append(f"loop joint '{name}' has two <link1> children; the second is read as <link2>")
+        warnings.append(f"{what} has two <link1> children; the second is read as <link2>")
         seconds = [firsts[1]]
+        firsts = firsts[:1]
+    if len(firsts) > 1 or len(seconds) > 1:
+        problems.append(f"{what} has {len(firsts)} <link1> and {len(seconds)} <link2> children: "
+                        "it needs exactly one of each")
+        return None
     if len(firsts) < 1 or len(seconds) < 1:
-        problems.append(f"loop joint '{name}' needs a <link1> and a <link2>")
+        problems.append(f"{what} needs a <link1> and a <link2>")
         return None
     sides = []
     for tag, e in (("link1", firsts[0]), ("link2", seconds[0])):
         link = e.get("link")
         if not link:
-            problems.append(f"loop joint '{name}' <{tag}> has no link attribute")
+            problems.append(f"{what} <{tag}> has no link attribute")
             return None
         if link not in links:
-            problems.append(f"loop joint '{name}' names {tag} '{link}', which is not a link of the file")
+            problems.append(f"{what} names {tag} {quote(link)}, which is not a link of the file")
             return None
-        xyz = numbers(e.get("xyz"), 3, f"loop joint '{name}' <{tag} xyz>", problems, (0, 0, 0))
-        rpy = numbers(e.get("rpy"), 3, f"loop joint '{name}' <{tag} rpy>", problems, (0, 0, 0))
+        xyz, rpy = _origin(e, f"{what} <{tag}", problems)
         sides.append((link, xyz, rpy))
-    axis = _axis(elem.find("axis"), f"loop joint '{name}'", problems)
+    axis = _axis(elem.find("axis"), what, problems)
     axis2 = None
     if jtype == "universal":
         a2 = elem.find("axis2")
         if a2 is None:
-            problems.append(f"universal loop joint '{name}' needs an <axis2 xyz> (its second axis, in F2)")
+            problems.append(f"universal {what} needs an <axis2 xyz> (its second axis, in F2)")
             return None
-        axis2 = _axis(a2, f"loop joint '{name}'", problems)
+        axis2 = _axis(a2, what, problems)
     (l1, xyz1, rpy1), (l2, xyz2, rpy2) = sides
     if l1 == l2:
-        problems.append(f"loop joint '{name}' connects link '{l1}' to itself")
+        problems.append(f"{what} connects link {quote(l1)} to itself")
         return None
     return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint")
+
+
+def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: int | None = None):
+    """Refuse a file beyond :data:`~screwkin.description.LIMITS` (before Pinocchio builds anything)."""
+    for count, limit, what in ((links, LIMITS.links, "links"), (joints, LIMITS.joints, "joints"),
+                               (loop_joints, LIMITS.loop_joints, "loop joints")):
+        if count > limit:
+            raise MechanismFileError(path, f"the file has {count} {what}; screwkin reads at most {limit} "
+                                           "(a limit against runaway files: no real robot comes near it)")
+    if coordinates is not None and coordinates > LIMITS.coordinates:
+        raise MechanismFileError(
+            path, f"the mechanism has {coordinates} moving joint coordinates; screwkin analyses at most "
+                  f"{LIMITS.coordinates} (Pinocchio's data for {coordinates} joint coordinates needs about "
+                  f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
 def check_tree(path, links, joints, problems):
@@ -170,8 +244,8 @@ def check_tree(path, links, joints, problems):
     for j in joints:
         if j.child in parent_of:
             problems.append(
-                f"link '{j.child}' has two parents ('{parent_of[j.child][0]}' through joint "
-                f"'{parent_of[j.child][1]}' and '{j.parent}' through joint '{j.name}'); "
+                f"link {quote(j.child)} has two parents ({quote(parent_of[j.child][0])} through joint "
+                f"{quote(parent_of[j.child][1])} and {quote(j.parent)} through joint {quote(j.name)}); "
                 "a closed loop must be written as a <loop_joint>"
             )
         else:
@@ -183,68 +257,75 @@ def check_tree(path, links, joints, problems):
         problems.append("the joints form a cycle: no link is the root")
     elif len(roots) > 1:
         problems.append(
-            f"the links do not form one tree: {len(roots)} links have no parent joint ({', '.join(roots[:5])})"
+            f"the links do not form one tree: {len(roots)} links have no parent joint "
+            f"({', '.join(quote(r, 40) for r in roots[:5])}{', ...' if len(roots) > 5 else ''})"
         )
     else:
-        # every link must reach the root without cycling
+        # every link must reach the root without cycling (links already known to reach it are not walked again)
+        reaches = set(roots)
         for start in links:
-            seen = set()
+            path_links = []
             link = start
-            while link in parent_of:
-                if link in seen:
-                    problems.append(f"the joints form a cycle through link '{start}'")
+            while link not in reaches:
+                if link in path_links:
+                    problems.append(f"the joints form a cycle through link {quote(start)}")
                     return
-                seen.add(link)
+                path_links.append(link)
                 link = parent_of[link][0]
+            reaches.update(path_links)
 
 
-def read_urdf(path: Path, text: str) -> MechanismSpec:
-    """Read a URDF file (already loaded as ``text``) into a :class:`MechanismSpec`."""
-    root = parse_xml_text(text, path)
+def _coordinates(joints) -> int:
+    return sum(TREE_JOINT_DOF[j.type] for j in joints)
+
+
+def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpec:
+    """Read a URDF file (already loaded as ``text``, and parsed as ``root`` when given)
+    into a :class:`MechanismSpec`.  package_dirs: folders searched for ``package://`` meshes."""
+    if root is None:
+        root = parse_xml_text(text, path)
     if root.tag != "robot":
-        raise MechanismFileError(path, f"not a URDF file: the root element is <{root.tag}>, expected <robot>")
+        raise MechanismFileError(path, f"not a URDF file: the root element is <{shorten(root.tag, 40)}>, "
+                                       "expected <robot>")
+    link_elems, joint_elems, loop_elems = root.findall("link"), root.findall("joint"), root.findall("loop_joint")
+    check_sizes(path, len(link_elems), len(joint_elems), len(loop_elems))
     problems = _Problems()
     warnings = []
     links = {}
-    for elem in root.findall("link"):
+    for elem in link_elems:
         name = elem.get("name")
         if not name:
             problems.append("a <link> has no name")
             continue
         if name in links:
-            problems.append(f"link '{name}' is defined twice")
+            problems.append(f"link {quote(name)} is defined twice")
             continue
         links[name] = _link(elem, problems)
     joints = []
     seen = set()
-    for elem in root.findall("joint"):
+    for elem in joint_elems:
         j = _joint(elem, links, problems)
         if j is None:
             continue
         if j.name in seen:
-            problems.append(f"joint '{j.name}' is defined twice")
+            problems.append(f"joint {quote(j.name)} is defined twice")
         seen.add(j.name)
         joints.append(j)
     problems.fail_if_any(path)
     check_tree(path, links, joints, problems)
+    problems.fail_if_any(path)
+    check_sizes(path, len(links), len(joints), len(loop_elems), _coordinates(joints))
     cuts = []
-    for elem in root.findall("loop_joint"):
+    for elem in loop_elems:
         c = _loop_joint(elem, links, problems, warnings)
         if c is not None:
             if c.name in seen:
-                problems.append(f"loop joint '{c.name}' has the name of another joint")
+                problems.append(f"loop joint {quote(c.name)} has the name of another joint")
             seen.add(c.name)
             cuts.append(c)
-    transmissions = []
-    for t in root.findall("transmission"):
-        for j in t.findall("joint"):
-            jn = j.get("name")
-            if jn not in {x.name for x in joints}:
-                problems.append(f"transmission '{t.get('name')}' names joint '{jn}', which is not a tree joint")
-            elif jn not in transmissions:
-                transmissions.append(jn)
+    transmissions = _transmissions(root, joints, {c.name for c in cuts}, warnings)
     problems.fail_if_any(path)
-    warnings += check_meshes(path, root)
+    warnings += check_meshes(path, root, package_dirs)
     return MechanismSpec(
         path=str(path),
         name=root.get("name") or Path(path).stem,
@@ -255,24 +336,68 @@ def read_urdf(path: Path, text: str) -> MechanismSpec:
         cut_joints=cuts,
         transmissions=transmissions,
         warnings=warnings,
+        package_dirs=[str(d) for d in package_dirs or ()],
     )
 
 
-def resolve_uri(uri: str, base: Path):
-    """Candidate paths of a mesh URI: ``package://`` against the file's folder
-    and ``ROS_PACKAGE_PATH``, ``file://`` as is, relative paths against the file."""
+def _transmissions(root, joints, loop_names, warnings) -> list:
+    """Joint names of the ``<transmission>`` elements, in order.  A transmission naming a
+    fixed joint, a loop joint or a joint not in the file is a warning, and is ignored
+    (ROS files often carry transmissions of fixed or removed joints: PR2, Kinova, TALOS)."""
+    types = {j.name: j.type for j in joints}
+    names = []
+    for t in root.findall("transmission"):
+        tname = t.get("name")
+        for j in t.findall("joint"):
+            jn = j.get("name")
+            why = None
+            if not jn:
+                why = "a joint without a name"
+            elif jn in loop_names:
+                why = f"joint {quote(jn)}, which is a loop joint (not an input)"
+            elif jn not in types:
+                why = f"joint {quote(jn)}, which is not in the file"
+            elif types[jn] == "fixed":
+                why = f"joint {quote(jn)}, which is fixed"
+            if why:
+                warnings.append(f"transmission {quote(tname)} names {why}: ignored")
+            elif jn not in names:
+                names.append(jn)
+    return names
+
+
+def _is_file(p: Path) -> bool:
+    """Path.is_file that answers False for names the system refuses (too long, NUL bytes)."""
+    try:
+        return p.is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def _roots(base: Path, package_dirs=()) -> list:
+    roots = [Path(d) for d in package_dirs or ()]
+    roots += [base, *list(base.parents)[:2]]
+    roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    out = []
+    for r in roots:
+        if r not in out:
+            out.append(r)
+    return out
+
+
+def resolve_uri(uri: str, base: Path, package_dirs=(), roots=None):
+    """Candidate paths of a mesh URI: ``package://`` against ``package_dirs`` (the
+    ``--package-dir`` folders), the file's folder and the two above it, and
+    ``ROS_PACKAGE_PATH`` (``roots``: those folders, when already known); ``file://``
+    as is, relative paths against the file."""
     if uri.startswith("package://"):
         rest = uri[len("package://"):]
         package, _, inside = rest.partition("/")
         inside = inside.lstrip("/")
-        roots = [base, *base.parents[:2]]
-        roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
         cands = []
-        for r in roots:
+        for r in roots if roots is not None else _roots(base, package_dirs):
             if package:
                 cands += [r / package / inside, r / inside]
-                if r.name == package:
-                    cands.append(r / inside)
             else:
                 cands.append(r / inside)
         return cands
@@ -282,88 +407,168 @@ def resolve_uri(uri: str, base: Path):
     return [p if p.is_absolute() else base / p]
 
 
-def check_meshes(path, root) -> list:
+def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
+    """The first existing file among the candidates of ``uri``, or None."""
+    return next((c for c in resolve_uri(uri, base, package_dirs, roots) if _is_file(c)), None)
+
+
+def check_meshes(path, root, package_dirs=()) -> list:
     """Warnings for mesh files that cannot be found (missing meshes do not fail a load)."""
     base = Path(path).resolve().parent
-    missing = []
+    roots = _roots(base, package_dirs)
+    missing, checked = [], set()
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename") or (mesh.findtext("uri") or "").strip()
-        if not uri or uri.startswith("model://"):
+        if not uri or uri.startswith("model://") or uri in checked:
             continue
-        if not any(c.is_file() for c in resolve_uri(uri, base)):
-            if uri not in missing:
-                missing.append(uri)
+        if len(checked) >= LIMITS.meshes:
+            break
+        checked.add(uri)
+        if find_mesh(uri, base, package_dirs, roots) is None:
+            missing.append(uri)
     if not missing:
         return []
-    shown = ", ".join(missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
-    return [f"{len(missing)} mesh file(s) not found (views will use stand-ins): {shown}"]
+    shown = ", ".join(quote(m, 60) for m in missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
+    msg = f"{len(missing)} mesh file(s) not found (views will use stand-ins): {shown}"
+    if len(checked) >= LIMITS.meshes:
+        msg += f" (only the first {LIMITS.meshes} mesh files were looked for)"
+    if any(m.startswith("package://") for m in missing):
+        looked = ", ".join(shorten(str(r), 60) for r in roots[:4]) + (f" and {len(roots) - 4} more" if len(roots) > 4
+                                                                        else "")
+        msg += f"; looked for packages in {looked} (set ROS_PACKAGE_PATH or use --package-dir DIR)"
+    return [msg]
 
 
 _YAML_TYPES = {"6d": "fixed", "3d": "spherical"}
+_REPLACEMENTS = "SPHERICAL, FIXED, CARDAN, UJOINT, UJOINT_XY or CARDAN_XY (two different axes of X, Y, Z)"
 
 
-def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names) -> None:
+def _replacement_type(t) -> str | None:
+    """The canonical replacement type, or None when unknown (UJOINT letters must be two different axes)."""
+    t = t.upper()
+    if t in ("SPHERICAL", "FIXED", "CARDAN", "UJOINT"):
+        return t
+    for prefix in ("UJOINT_", "CARDAN_"):
+        if t.startswith(prefix):
+            letters = t[len(prefix):]
+            if len(letters) == 2 and set(letters) <= set("XYZ") and letters[0] != letters[1]:
+                return "UJOINT_" + letters
+    return None
+
+
+def _string_list(content, key, problems, what="joint names"):
+    """content[key] as a list of strings (None when absent), with a problem for anything else."""
+    value = content.get(key)
+    if value is None:
+        return None
+    if not isinstance(value, list):
+        problems.append(f"{key} must be a list of {what}, got {quote(value)}")
+        return []
+    out = []
+    for k, item in enumerate(value, 1):
+        if not isinstance(item, str):
+            problems.append(f"{key} entry {k} is {quote(item)}, not a string (write names in quotes)")
+            continue
+        out.append(item)
+    return out
+
+
+def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names, frame_body=None) -> None:
     """Add the loops, actuation and joint replacements of an Extended-URDF sidecar.
 
     ``frame_names`` are the frames of the Pinocchio model of the tree: the YAML
-    names frames, not links.
-    """
-    import yaml
+    names frames, not links.  ``frame_body`` (optional) maps a frame name to the
+    Pinocchio joint that carries it: a pair of frames on the same body closes no loop.
 
+    The YAML is untrusted: at most ``LIMITS.yaml_bytes``, UTF-8, no aliases (no
+    "billion laughs"), no tags beyond plain data, and every field's type checked.
+    """
+    from .xmlsafe import load_yaml_text
+
+    raw = read_regular_file(yaml_path, LIMITS.yaml_bytes, "YAML sidecar")
     try:
-        content = yaml.safe_load(Path(yaml_path).read_text())
-    except yaml.YAMLError as exc:
-        first = str(exc).splitlines()[0]
-        raise MechanismFileError(yaml_path, f"malformed YAML: {first}") from None
-    except OSError as exc:
-        raise MechanismFileError(yaml_path, f"cannot read: {exc.strerror}") from None
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise MechanismFileError(yaml_path, "not a text file (not UTF-8)") from None
+    content = load_yaml_text(text, yaml_path)
     if content is None:
         content = {}
     if not isinstance(content, dict):
-        raise MechanismFileError(yaml_path, "expected a mapping with closed_loop, type, name_mot")
+        raise MechanismFileError(yaml_path, f"expected a mapping with closed_loop, type, name_mot, got {quote(content)}")
     problems = _Problems()
-    pairs = content.get("closed_loop") or []
-    types = content.get("type") or ["6d"] * len(pairs)
-    if not isinstance(pairs, list) or not isinstance(types, list):
-        raise MechanismFileError(yaml_path, "closed_loop and type must be lists")
+    known = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
+    for key in content:
+        if not isinstance(key, str):
+            problems.append(f"a key is {quote(key)}, not a name (known keys: {', '.join(known)})")
+            break
+    pairs = content.get("closed_loop")
+    pairs = [] if pairs is None else pairs
+    if not isinstance(pairs, list):
+        raise MechanismFileError(yaml_path, f"closed_loop must be a list of [frame, frame] pairs, got {quote(pairs)}")
+    types = content.get("type")
+    types = ["6d"] * len(pairs) if types is None else types
+    if not isinstance(types, list):
+        raise MechanismFileError(yaml_path, f"type must be a list of '3d' or '6d', got {quote(types)}")
+    if len(pairs) > LIMITS.loop_joints:
+        raise MechanismFileError(yaml_path, f"closed_loop has {len(pairs)} pairs; screwkin reads at most "
+                                            f"{LIMITS.loop_joints} loop joints")
     if len(types) != len(pairs):
         problems.append(f"closed_loop has {len(pairs)} pairs but type has {len(types)} entries")
     frames = set(frame_names)
+    frame_body = frame_body or {}
     for k, pair in enumerate(pairs):
-        if not (isinstance(pair, (list, tuple)) and len(pair) == 2):
-            problems.append(f"closed_loop entry {k + 1} is not a pair of frame names: {pair!r}")
+        if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(x, str) for x in pair)):
+            problems.append(f"closed_loop entry {k + 1} is not a pair of frame names: {quote(pair)}")
             continue
-        a, b = (str(x) for x in pair)
-        for f in (a, b):
-            if f not in frames:
-                problems.append(f"closed_loop names frame '{f}', which is not in the URDF")
-        ctype = str(types[k]).lower() if k < len(types) else "6d"
-        if ctype not in _YAML_TYPES:
-            problems.append(f"closed_loop type '{types[k]}' is unknown (known: 3d, 6d)")
+        a, b = pair
+        missing = [f for f in (a, b) if f not in frames]
+        for f in missing:
+            problems.append(f"closed_loop names frame {quote(f)}, which is not in the URDF")
+        if a == b:
+            problems.append(f"closed_loop entry {k + 1} pairs frame {quote(a)} with itself")
+            continue
+        if not missing and frame_body.get(a) is not None and frame_body.get(a) == frame_body.get(b):
+            problems.append(f"closed_loop entry {k + 1} pairs frames {quote(a)} and {quote(b)}, which are fixed "
+                            "together (on the same body): it closes no loop")
+            continue
+        ctype = types[k] if k < len(types) else "6d"
+        if not isinstance(ctype, str) or ctype.lower() not in _YAML_TYPES:
+            problems.append(f"closed_loop type {quote(ctype)} is unknown (known: 3d, 6d)")
             continue
         spec.cut_joints.append(
-            CutJointSpec(name=f"{a}~{b}", type=_YAML_TYPES[ctype], frame1=a, frame2=b, source="yaml")
+            CutJointSpec(name=f"{a}~{b}", type=_YAML_TYPES[ctype.lower()], frame1=a, frame2=b, source="yaml")
         )
-    names = content.get("name_mot")
-    joint_names = {j.name for j in spec.joints}
+    joint_types = {j.name: j.type for j in spec.joints}
+    names = _string_list(content, "name_mot", problems)
     if names is not None:
-        if not isinstance(names, list):
-            problems.append("name_mot must be a list of joint names")
-        else:
-            for n in names:
-                if n not in joint_names:
-                    problems.append(f"name_mot names joint '{n}', which is not in the URDF")
-            spec.yaml_actuated = [str(n) for n in names]
-    jn = content.get("joint_name") or []
-    jt = content.get("joint_type") or []
+        for n in names:
+            if n not in joint_types:
+                problems.append(f"name_mot names joint {quote(n)}, which is not in the URDF")
+            elif joint_types[n] == "fixed":
+                problems.append(f"name_mot names joint {quote(n)}, which is fixed (a motor drives a moving joint)")
+        spec.yaml_actuated = names
+    jn = _string_list(content, "joint_name", problems) or []
+    jt = _string_list(content, "joint_type", problems, "joint types") or []
     if len(jn) != len(jt):
         problems.append(f"joint_name has {len(jn)} entries but joint_type has {len(jt)}")
+    replaced = set()
     for n, t in zip(jn, jt):
-        if n not in joint_names:
-            problems.append(f"joint_name names joint '{n}', which is not in the URDF")
-        t = str(t).upper()
-        if t not in ("SPHERICAL", "FIXED") and not t.startswith(("UJOINT", "CARDAN")):
-            problems.append(f"joint_type '{t}' is unknown (known: SPHERICAL, FIXED, CARDAN, UJOINT_XY, ...)")
-        spec.replacements.append((str(n), t))
+        canonical = _replacement_type(t)
+        if canonical is None:
+            problems.append(f"joint_type {quote(t)} is unknown (known: {_REPLACEMENTS})")
+            continue
+        if n not in joint_types:
+            problems.append(f"joint_name names joint {quote(n)}, which is not in the URDF")
+            continue
+        if n in replaced:
+            problems.append(f"joint_name names joint {quote(n)} twice")
+            continue
+        replaced.add(n)
+        if joint_types[n] == "fixed":
+            if canonical != "FIXED":
+                problems.append(f"joint_name names joint {quote(n)}, which is fixed: a {canonical} replacement "
+                                "must name a moving joint")
+            continue
+        spec.replacements.append((n, canonical))
     problems.fail_if_any(yaml_path)
     spec.yaml_path = str(yaml_path)

@@ -22,8 +22,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .errors import UsageError
-from .urdf import resolve_uri
+from .errors import MechanismFileError, UsageError, quote, shorten
+from .mechanism import frame_id
+from .urdf import find_mesh
 from .xmlsafe import parse_xml_text
 
 __all__ = ["COLORS", "build_scene", "show", "view", "ViewerServer", "RecordingViewer", "screenshot"]
@@ -47,23 +48,61 @@ def _coal():
     return coal
 
 
-def _visual_urdf(mech) -> str:
+def _visual_urdf(mech, unreadable=()) -> str:
     """The URDF text with every mesh resolved to an absolute path, and visuals
-    whose mesh cannot be found dropped (their links get stand-ins)."""
+    whose mesh cannot be found (or is in ``unreadable``) dropped (their links get stand-ins)."""
     root = parse_xml_text(mech.spec.urdf_text, mech.path)
     base = Path(mech.path).resolve().parent
+    package_dirs = getattr(mech.spec, "package_dirs", ()) or ()
     for link in root.findall("link"):
         for tag in ("visual", "collision"):
             for vis in link.findall(tag):
                 mesh = vis.find("geometry/mesh")
                 if mesh is None:
                     continue
-                found = [c for c in resolve_uri(mesh.get("filename", ""), base) if c.is_file()]
-                if found:
-                    mesh.set("filename", str(found[0].resolve()))
+                found = find_mesh(mesh.get("filename", ""), base, package_dirs)
+                if found is not None and str(found.resolve()) not in unreadable:
+                    mesh.set("filename", str(found.resolve()))
                 else:
                     link.remove(vis)
     return ET.tostring(root, encoding="unicode")
+
+
+_JOINT_FIRST = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.BODY, pin.FrameType.OP_FRAME)
+
+
+def _body_frame(model, name):
+    """The BODY frame of link ``name`` (a joint may have the same name), or None."""
+    fid = frame_id(model, name)
+    return fid if fid is not None and model.frames[fid].type == pin.FrameType.BODY else None
+
+
+def _owner_link(mech, frame_name):
+    """The link a cut joint's side is on: the link itself, or the child link of a joint named so (sidecars)."""
+    if frame_name in mech.spec.links:
+        return frame_name
+    return next((j.child for j in mech.spec.joints if j.name == frame_name), None)
+
+
+def _standin_points(mech) -> dict:
+    """link -> (its BODY frame id, [(target, point)]): the centres of its child joints and its loop-joint
+    frames, expressed like the frame's placement (in the frame of the Pinocchio joint carrying the link)."""
+    model = mech.model
+    out = {}
+    for name in mech.spec.links:
+        fid = _body_frame(model, name)
+        if fid is not None:
+            out[name] = (fid, [])
+    for j in mech.spec.joints:  # a child joint's origin is given in the parent link's frame
+        if j.parent in out:
+            fid, points = out[j.parent]
+            points.append((j.name, model.frames[fid].placement.act(np.asarray(j.xyz, float))))
+    for cut in mech.cuts:
+        for link, side in ((cut.link1, cut.frame1), (cut.link2, cut.frame2)):
+            owner = _owner_link(mech, link.removeprefix("screwkin@"))
+            if owner in out and model.frames[side].parentJoint == model.frames[out[owner][0]].parentJoint:
+                out[owner][1].append((cut.name, model.frames[side].placement.translation.copy()))
+    return out
 
 
 def _segment(name, joint, frame, a, b, radius, color):
@@ -100,13 +139,36 @@ class Scene:
     center: np.ndarray  # centre of its joints [m]
 
 
-def build_scene(mech, q, output=None, singular=()) -> Scene:
+def _visual_geometry(mech, warn=None):
+    """Pinocchio's visual GeometryModel of the links; a mesh file that exists but cannot be
+    read (not a mesh, truncated) is a warning and its link is drawn as a stand-in."""
+    import re
+
+    warn = warn or (lambda m: print(f"warning: {shorten(str(mech.path), 200)}: {m}", file=sys.stderr))
+    unreadable = set()
+    while True:
+        try:
+            return pin.buildGeomFromUrdfString(mech.model, _visual_urdf(mech, unreadable), pin.GeometryType.VISUAL)
+        except (ValueError, RuntimeError) as exc:
+            found = re.search(r"Could not load resource (.+)", str(exc))
+            bad = found.group(1).strip() if found else None
+            if not bad or bad in unreadable:
+                lines = [line for line in str(exc).splitlines() if line.strip()]
+                raise MechanismFileError(mech.path, f"the visuals cannot be loaded: "
+                                                    f"{shorten(lines[-1] if lines else type(exc).__name__, 160)}") \
+                    from None
+            unreadable.add(bad)
+            warn(f"mesh {quote(bad, 120)} cannot be read as a mesh: its link is drawn as a stand-in")
+
+
+def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
     """The scene at configuration q (used for the characteristic size of the marks).
 
     singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
-    output link's origin, and the singular screw axis as a line with an arrow."""
+    output link's origin, and the singular screw axis as a line with an arrow.
+    warn: callable receiving each warning (a mesh that cannot be read); default: stderr."""
     model = mech.model
-    geom = pin.buildGeomFromUrdfString(model, _visual_urdf(mech), pin.GeometryType.VISUAL)
+    geom = _visual_geometry(mech, warn)
     roles = {o.name: "link" for o in geom.geometryObjects}
     data = mech.data
     pin.framesForwardKinematics(model, data, q)
@@ -124,7 +186,8 @@ def build_scene(mech, q, output=None, singular=()) -> Scene:
     axis_of = {j.name: np.asarray(j.axis) for j in mech.spec.joints}
     for c in mech.coordinates:  # joint axes, drawn on the child side of each moving joint
         jid = c.joint_id
-        frame = model.getFrameId(c.joint) if model.existFrame(c.joint) else 0
+        frame = frame_id(model, c.joint, prefer=_JOINT_FIRST)
+        frame = 0 if frame is None else frame
         role = "axis:actuated" if c.joint in actuated else "axis:passive"
         a = axis_of.get(c.joint)
         if a is None or c.nv != 1:
@@ -147,24 +210,23 @@ def build_scene(mech, q, output=None, singular=()) -> Scene:
         else:
             add(_segment(f"screwkin/cut/{cut.name}", f.parentJoint, cut.frame1, p - L_axis * a, p + L_axis * a,
                          1.5 * r_axis, COLORS["cut"]), "axis:cut")
-    # stand-ins for links without any visual: a ball at the link frame, bars to the joints it carries
+    # stand-ins for links without any visual: a ball at the link frame (its parent joint's centre) and bars
+    # to the centres of its child joints and to its loop-joint frames
     with_visual = {model.frames[o.parentFrame].name for o in geom.geometryObjects if roles[o.name] == "link"}
-    dummies = {name for name, link in mech.spec.links.items() if link.is_massless(mech.tolerances.dummy_mass)}
-    for name in mech.spec.links:
-        if name in with_visual or name in dummies or not model.existFrame(name):
+    for name, (fid, points) in _standin_points(mech).items():
+        if name in with_visual:
             continue
-        fid = model.getFrameId(name)
         fr = model.frames[fid]
-        if fr.parentJoint == 0 and name == mech.spec.root:
-            continue
-        add(_ball(f"screwkin/standin/{name}", fr.parentJoint, fid, fr.placement.translation, 3 * r_axis,
-                  COLORS["standin"]), "standin")
-        for j in mech.spec.joints:
-            if j.parent == name and model.existJointName(j.name):
-                child = model.getJointId(j.name)
-                add(_segment(f"screwkin/standin_bar/{name}/{j.name}", fr.parentJoint, fid, fr.placement.translation,
-                             model.jointPlacements[child].translation if model.parents[child] == fr.parentJoint
-                             else fr.placement.translation, 1.5 * r_axis, COLORS["standin"]), "standin")
+        origin = fr.placement.translation
+        if not any(np.linalg.norm(p - origin) > 1e-9 for _, p in points) and \
+                mech.spec.links[name].is_massless(mech.tolerances.dummy_mass):
+            continue  # no length, no mass, no geometry: the inside of a compound joint
+        if not (fr.parentJoint == 0 and name == mech.spec.root):  # the ground keeps its bars, not a ball
+            add(_ball(f"screwkin/standin/{name}", fr.parentJoint, fid, origin, 3 * r_axis, COLORS["standin"]),
+                "standin")
+        for target, p in points:
+            add(_segment(f"screwkin/standin_bar/{name}/{target}", fr.parentJoint, fid, origin, p, 1.5 * r_axis,
+                         COLORS["standin"]), "standin")
     if output is not None:
         fid = mech.link_frame(output)
         fr = model.frames[fid]

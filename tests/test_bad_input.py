@@ -1,8 +1,12 @@
 """Bad input: one line naming the file and the problem, exit 1 (file) or 2 (usage), no traceback."""
 
+import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import fourbar
@@ -58,8 +62,6 @@ FILE_CASES = {
                     "two parents"),
     "two_roots": (GOOD.replace("</robot>", '<link name="floating_piece"/></robot>'), "do not form one tree"),
     "universal_without_axis2": (GOOD.replace('type="revolute"><link1', 'type="universal"><link1'), "axis2"),
-    "transmission_missing_joint": (GOOD.replace("</robot>", '<transmission name="t"><joint name="ghost"/></transmission></robot>'),
-                                   "'ghost'"),
     "not_words": (GOOD.replace('<origin xyz="0.04 0 0"', '<origin xyz="0.04 zero 0"'), "not 3 numbers"),
 }
 
@@ -189,8 +191,11 @@ def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatc
     monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", broken)
     path = write(tmp_path, GOOD)
     check(capsys, ["mobility", path], 3, "internal error", "ValueError", "--debug", path=path)
-    with pytest.raises(ValueError):
-        main(["mobility", path, "--debug"])
+    # --debug (after or before the command): the traceback, then the same line, and still exit 3
+    for argv in (["mobility", path, "--debug"], ["--debug", "mobility", path]):
+        code, err = run(capsys, argv)
+        assert code == 3 and "Traceback" in err and "shapes do not match" in err
+        assert err.strip().splitlines()[-1].startswith("screwkin: internal error")
 
 
 def test_urdf_parser_complaints_become_the_one_line(tmp_path, capfd):
@@ -203,3 +208,405 @@ def test_urdf_parser_complaints_become_the_one_line(tmp_path, capfd):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in err, err
     assert path in lines[0] and "PRISMATIC without limits" in lines[0]
+
+
+# ---------------------------------------------------------------------------------------------
+# Regressions of the fuzzing campaign (3,815 runs on 1,682 mutated files): one test per signature.
+
+CORPUS_5BAR = Path(__file__).resolve().parents[1] / "robots" / "corpus" / "example-parallel-robots" / "5bar_linkage"
+FOURBAR = Path(__file__).resolve().parents[1] / "robots" / "fourbar_crank_rocker.urdf"
+
+
+def five_bar(tmp_path, sidecar: str | bytes):
+    """The corpus 5-bar (closed by its YAML sidecar) with the sidecar replaced."""
+    path = tmp_path / "robot.urdf"
+    path.write_bytes((CORPUS_5BAR / "robot.urdf").read_bytes())
+    y = tmp_path / "robot.yaml"
+    y.write_bytes(sidecar if isinstance(sidecar, bytes) else sidecar.encode())
+    return str(path), str(y)
+
+
+LOOP = "closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: ['6d']\n"
+
+
+@pytest.mark.parametrize("sidecar, word", [
+    (LOOP + "name_mot: [['mot1'], ['mot2']]\n", "name_mot entry 1 is ['mot1'], not a string"),
+    (LOOP + "name_mot: {mot1: 1}\n", "name_mot must be a list"),
+    (LOOP + "name_mot: [yes]\n", "name_mot entry 1 is True"),
+    ("closed_loop: [[['a'], 'b']]\ntype: ['6d']\n", "not a pair of frame names"),
+    ("closed_loop: {a: b}\n", "closed_loop must be a list"),
+    ("closed_loop: [['closedloop1_A', 'closedloop1_B']]\ntype: [['6d']]\n", "closed_loop type ['6d'] is unknown"),
+    (LOOP + "joint_name: [[1]]\njoint_type: ['SPHERICAL']\n", "joint_name entry 1"),
+    (LOOP + "joint_name: ['mot1']\njoint_type: ['UJOINT_XX']\n", "joint_type 'UJOINT_XX' is unknown"),
+    ("- just\n- a list\n", "expected a mapping"),
+])
+def test_yaml_fields_of_the_wrong_type(tmp_path, capsys, sidecar, word):
+    path, y = five_bar(tmp_path, sidecar)
+    check(capsys, ["mobility", path], 1, word, path=y)
+
+
+def test_yaml_alias_bomb_is_refused_in_one_short_line(tmp_path, capsys):
+    bomb = "a: &a [x,x,x,x,x,x,x,x,x]\n" + "".join(
+        f"{n}: &{n} [{','.join([f'*{p}'] * 9)}]\n" for p, n in zip("abcdefgh", "bcdefghi")) + "name_mot: *i\n"
+    assert len(bomb) < 400  # 9**9 = 387 million x's once expanded
+    path, y = five_bar(tmp_path, bomb)
+    line = check(capsys, ["mobility", path], 1, "aliases", "not allowed", path=y)
+    assert len(line) < 300
+
+
+def test_yaml_too_big_or_too_deep(tmp_path, capsys):
+    path, y = five_bar(tmp_path, LOOP + "# " + "x" * 1_100_000 + "\n")
+    check(capsys, ["mobility", path], 1, "at most 1 MB", path=y)
+    path, y = five_bar(tmp_path, "name_mot: " + "[" * 5000 + "]" * 5000 + "\n")
+    check(capsys, ["mobility", path], 1, "malformed YAML", "nested deeper", path=y)
+    path, y = five_bar(tmp_path, "name_mot: [" + "9" * 5000 + "]\n")
+    check(capsys, ["mobility", path], 1, "malformed YAML", path=y)
+
+
+def test_yaml_not_utf8(tmp_path, capsys):
+    path, y = five_bar(tmp_path, b"\xff\xfe" + LOOP.encode())
+    check(capsys, ["mobility", path], 1, "not UTF-8", path=y)
+
+
+def test_yaml_pair_of_a_frame_with_itself(tmp_path, capsys):
+    path, y = five_bar(tmp_path, "closed_loop: [['closedloop1_A', 'closedloop1_A']]\ntype: ['6d']\n")
+    check(capsys, ["mobility", path], 1, "pairs frame 'closedloop1_A' with itself", path=y)
+
+
+def test_yaml_pair_of_frames_fixed_together(tmp_path, capsys):
+    # end_rod and effector are joined by the fixed joint effector_frame
+    path, y = five_bar(tmp_path, "closed_loop: [['end_rod', 'effector']]\ntype: ['6d']\n")
+    check(capsys, ["mobility", path], 1, "'end_rod' and 'effector'", "fixed together", path=y)
+
+
+@pytest.mark.parametrize("kind", ["CARDAN", "SPHERICAL", "UJOINT_XZ"])
+def test_yaml_replacement_of_a_fixed_joint(tmp_path, capsys, kind):
+    path, y = five_bar(tmp_path, LOOP + f"joint_name: ['effector_frame']\njoint_type: ['{kind}']\n")
+    check(capsys, ["mobility", path], 1, "'effector_frame', which is fixed", "must name a moving joint", path=y)
+
+
+def test_loop_joint_between_links_fixed_together(tmp_path, capsys):
+    text = GOOD.replace('name="rocker_joint" type="revolute"', 'name="rocker_joint" type="fixed"')
+    text = text.replace('<link1 link="coupler"', '<link1 link="ground"')
+    path = write(tmp_path, text)
+    check(capsys, ["mobility", path], 1, "loop joint 'C'", "fixed together", path=path)
+
+
+def test_third_link_child_of_a_loop_joint(tmp_path, capsys):
+    path = write(tmp_path, fourbar('<link1 link="coupler" xyz="0.12 0 0"/><link2 link="rocker" xyz="0.08 0 0"/>'
+                                   '<link2 link="ground"/>'))
+    check(capsys, ["mobility", path], 1, "1 <link1> and 2 <link2>", "exactly one", path=path)
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ('<axis xyz="0 0 1"/><limit', '<axis xyz="0 0 1e308"/><limit', ("axis '0 0 1e+308'", "not a plausible value")),
+    ('<axis xyz="0 0 1"/><limit', '<axis xyz="1e-200 0 0"/><limit', ("not a plausible value",)),
+    ('<origin xyz="0.04 0 0"', '<origin xyz="1e5 0 0"', ("'1e5 0 0' is not a plausible value", "beyond 10000 m")),
+    ('rpy="0 0 1.5707963267948966"', 'rpy="0 0 1e300"', ("not a plausible value", "rad")),
+    ('<mass value="1"/>', '<mass value="-1"/>', ("<mass value>", "below 0 kg")),
+    ('<mass value="1"/>', '<mass value="1e9"/>', ("<mass value>", "beyond 1e+06 kg")),
+    ('ixx="1"', 'ixx="1e300"', ("<inertia 'ixx'>",)),
+    ('<box size="0.01 0.01 0.01"/>', '<box size="1e308 1 1"/>', ("<box size>",)),
+    ('<origin xyz="0.04 0 0"', '<origin xyz="\u0661 0 0"', ("is not 3 numbers",)),
+    ('<origin xyz="0.04 0 0"', '<origin xyz="1_0 0 0"', ("is not 3 numbers",)),
+])
+def test_implausible_numbers(tmp_path, capsys, old, new, words):
+    assert old in GOOD
+    path = write(tmp_path, GOOD.replace(old, new, 1))
+    check(capsys, ["mobility", path], 1, *words, path=path)
+
+
+def test_axis_is_normalized_whatever_its_length(tmp_path):
+    import screwkin
+
+    p = write(tmp_path, GOOD.replace('<axis xyz="0 0 1"/><limit', '<axis xyz="0 0 1e5"/><limit', 1))
+    assert screwkin.load(p).spec.joints[0].axis == (0.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("lo, hi, code, word", [
+    ("1e308", "-1e308", 1, "joint 'crank_joint' <limit>: lower 1e+308 > upper -1e+308"),
+    ("0.5", "0.1", 1, "joint 'crank_joint' <limit>: lower 0.5 > upper 0.1"),
+    ("nan", "1", 1, "NaN or infinite"),
+    ("-1.79769e+308", "1.79769e+308", 0, None),  # ROS/Gazebo's "unlimited"
+    ("-1e16", "1e16", 0, None),
+])
+def test_limits(tmp_path, capsys, lo, hi, code, word):
+    text = GOOD.replace('<limit lower="-3" upper="3"', f'<limit lower="{lo}" upper="{hi}"', 1)
+    path = write(tmp_path, text)
+    argv = ["solve", path, "--set", "crank_joint=0.1", "--json"]
+    if code:
+        check(capsys, argv, code, word, path=path)
+    else:
+        got, err = run(capsys, argv)
+        assert got == 0, err
+
+
+def test_prismatic_limits_swapped(tmp_path, capsys):
+    from conftest import slider_crank
+
+    text = slider_crank().replace('jtype="prismatic"', "")
+    text = text.replace('type="prismatic"><parent link="ground"/><child link="slider"/>',
+                        'type="prismatic"><parent link="ground"/><child link="slider"/>')
+    i = text.index('name="slider_joint"')
+    j = text.index("<limit", i)
+    text = text[:j] + text[j:].replace('lower="-3" upper="3"', 'lower="1e308" upper="-1e308"', 1)
+    path = write(tmp_path, text)
+    check(capsys, ["solve", path, "--set", "crank_joint=0.1"], 1, "joint 'slider_joint' <limit>: lower", path=path)
+
+
+def test_mesh_file_name_too_long_is_a_missing_mesh(tmp_path, capsys):
+    name = "m" * 304
+    text = GOOD.replace('<box size="0.01 0.01 0.01"/>', f'<mesh filename="package://pkg/{name}.stl"/>', 1)
+    code, err = run(capsys, ["mobility", write(tmp_path, text)])
+    assert code == 0 and "mesh file(s) not found" in err and "..." in err
+    assert max(len(line) for line in err.splitlines()) < 600
+
+
+def test_joint_named_like_a_link_loads_and_gives_the_same_answer(tmp_path, capsys):
+    """Pinocchio then has a JOINT and a BODY frame of that name: the loop joint binds
+    to the link (BODY frame), and the answer equals the one of the renamed file."""
+    a, b = write(tmp_path, GOOD, "a.urdf"), write(tmp_path, GOOD.replace("crank_joint", "coupler"), "b.urdf")
+    renamed = _json(capsys, ["mobility", a, "--json"]).replace(a, "F")
+    same = _json(capsys, ["mobility", b, "--json"]).replace(b, "F")
+    assert json.loads(renamed)["mobility"] == 1
+    # the same report, but for the joint's name ("coupler" is also the link's name: compare word by word)
+    words = [w for w in renamed.split('"')]
+    other = [w for w in same.split('"')]
+    assert len(words) == len(other)
+    assert all(x == y or (x, y) == ("crank_joint", "coupler") for x, y in zip(words, other))
+    # and every command that binds frames by name works on it
+    path = write(tmp_path, GOOD.replace("crank_joint", "coupler"), "c.urdf")
+    for argv in (["info", path], ["solve", path, "--set", "coupler=0.3"], ["screws", path]):
+        code, err = run(capsys, argv)
+        assert code == 0, err
+
+
+def _json(capsys, argv):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return out
+
+
+def test_hundred_duplicate_loop_joints_do_not_hang(tmp_path, capsys):
+    import time
+
+    loop = '<loop_joint name="D{k}" type="revolute"><link1 link="coupler" xyz="0.12 0 0"/>' \
+           '<link2 link="rocker" xyz="0.08 0 0"/><axis xyz="0 0 1"/></loop_joint>'
+    path = write(tmp_path, fourbar(extra="".join(loop.format(k=k) for k in range(100))))
+    t = time.perf_counter()
+    out = json.loads(_json(capsys, ["mobility", path, "--json"]))
+    assert out["mobility"] == 1
+    assert time.perf_counter() - t < 60
+    path = write(tmp_path, fourbar(extra="".join(loop.format(k=k) for k in range(250))), "many.urdf")
+    check(capsys, ["mobility", path], 1, "251 loop joints", "at most 200", path=path)
+
+
+def chain(n, name="l"):
+    body = f'<robot name="chain"><link name="{name}0"/>'
+    for k in range(1, n + 1):
+        body += (f'<link name="{name}{k}"/><joint name="j{k}" type="revolute"><parent link="{name}{k - 1}"/>'
+                 f'<child link="{name}{k}"/><origin xyz="0.1 0 0"/><axis xyz="0 0 1"/>'
+                 '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+    return body + "</robot>"
+
+
+@pytest.mark.parametrize("n, words", [(2000, ("2001 links", "at most 2000")), (5000, ("5001 links",)),
+                                      (600, ("600 moving joint coordinates", "at most 500", "13.8 GB"))])
+def test_huge_chains_are_refused_before_pinocchio(tmp_path, capsys, n, words):
+    path = write(tmp_path, chain(n))
+    check(capsys, ["info", path], 1, *words, path=path)
+
+
+def test_file_too_big(tmp_path, capsys):
+    path = tmp_path / "big.urdf"
+    with open(path, "w") as f:
+        f.write(GOOD.replace("</robot>", ""))
+        f.write("<!--" + "x" * 21_000_000 + "--></robot>")
+    check(capsys, ["info", str(path)], 1, "at most 20 MB", path=str(path))
+
+
+def test_nested_xml_is_refused(tmp_path, capsys):
+    path = write(tmp_path, GOOD.replace("</robot>", "<x>" * 1000 + "</x>" * 1000 + "</robot>"))
+    check(capsys, ["info", path], 1, "nested deeper than 100", path=path)
+
+
+def test_sdf_in_a_comment_does_not_make_an_sdf_file(tmp_path, capsys):
+    path = write(tmp_path, "<!-- converted from an <sdf version='1.7'> model -->\n" + GOOD)
+    out = json.loads(_json(capsys, ["mobility", path, "--json"]))
+    assert out["mobility"] == 1
+    path = write(tmp_path, GOOD, "m.sdf")  # a URDF named .sdf is read as what it is
+    assert json.loads(_json(capsys, ["mobility", path, "--json"]))["mobility"] == 1
+
+
+def test_numpy_warnings_stay_off_stderr(tmp_path, capsys, monkeypatch):
+    import warnings
+
+    import numpy as np
+
+    import screwkin.mechanism
+
+    original = screwkin.mechanism.Mechanism.mobility
+
+    def noisy(self, *a, **k):
+        np.float64(1.0) / np.zeros(1)  # divide by zero: RuntimeWarning unless silenced
+        warnings.warn("Mean of empty slice", RuntimeWarning)
+        return original(self, *a, **k)
+
+    monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", noisy)
+    code, err = run(capsys, ["mobility", write(tmp_path, GOOD)])
+    assert code == 0 and err == "", err
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
+def test_named_pipes_are_refused_not_waited_on(tmp_path, capsys):
+    fifo = tmp_path / "pipe.urdf"
+    os.mkfifo(fifo)
+    check(capsys, ["info", str(fifo)], 1, "is not a regular file", path=str(fifo))
+    path = write(tmp_path, GOOD)
+    os.mkfifo(tmp_path / "m.yaml")  # the sidecar beside the file
+    check(capsys, ["info", path], 1, "is not a regular file", path=str(tmp_path / "m.yaml"))
+    os.remove(tmp_path / "m.yaml")
+    os.mkfifo(tmp_path / "other.yaml")
+    check(capsys, ["info", path, "--yaml", str(tmp_path / "other.yaml")], 1, "is not a regular file")
+
+
+def test_debug_before_the_command(tmp_path, capsys):
+    path = write(tmp_path, "<robot")
+    for argv in (["--debug", "mobility", path], ["mobility", path, "--debug"]):
+        code, err = run(capsys, argv)
+        assert code == 1 and "Traceback" in err and err.strip().splitlines()[-1].startswith("screwkin: error:")
+    code, err = run(capsys, ["mobility", path])
+    assert code == 1 and "Traceback" not in err
+
+
+def test_broken_pipe_is_quiet(tmp_path):
+    """``screwkin info F | head -1``: the reader goes away; no message, exit 141 (as if SIGPIPE)."""
+    p = subprocess.Popen([sys.executable, "-m", "screwkin", "info", str(FOURBAR)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    p.stdout.close()  # before screwkin writes anything
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=120) == 141, err
+    assert err == ""
+
+
+def test_hostile_text_in_messages_is_short_and_one_line(tmp_path, capsys):
+    big = "r" * 200_000
+    path = write(tmp_path, GOOD.replace('name="coupler_joint" type="revolute"', f'name="coupler_joint" type="{big}"'))
+    line = check(capsys, ["mobility", path], 1, "unknown type 'rrrr", "...", path=path)
+    assert len(line) < 300 + len(path)
+    path = write(tmp_path, GOOD.replace('name="coupler_joint" type="revolute"',
+                                        'name="coupler_joint" type="revolute&#10;revolute&#8238;x"'))
+    check(capsys, ["mobility", path], 1, r"'revolute\nrevolute\u202ex'", path=path)
+
+
+# ---------------------------------------------------------------------------------------------
+# Forgiving where a user would expect it
+
+def test_transmission_of_a_fixed_or_missing_joint_is_a_warning(tmp_path, capsys):
+    tx = ('<transmission name="t_ghost"><joint name="ghost"/></transmission>'
+          '<transmission name="t_crank"><joint name="crank_joint"/></transmission>')
+    text = fourbar(extra=tx).replace(
+        "</robot>", '<link name="tool"/><joint name="tool_joint" type="fixed"><parent link="rocker"/>'
+                    '<child link="tool"/></joint><transmission name="t_tool"><joint name="tool_joint"/>'
+                    "</transmission></robot>")
+    path = write(tmp_path, text)
+    code, err = run(capsys, ["info", path])
+    assert code == 0, err
+    assert f"warning: {path}: transmission 't_ghost' names joint 'ghost', which is not in the file: ignored" in err
+    assert "transmission 't_tool' names joint 'tool_joint', which is fixed: ignored" in err
+    import screwkin
+
+    assert screwkin.load(path, warn=lambda m: None).actuated == ["crank_joint"]
+    # a name on the command line that is not a moving joint stays a usage error
+    code, err = run(capsys, ["mobility", path, "--actuated", "tool_joint"])
+    assert code == 2 and "'tool_joint'" in err.strip().splitlines()[-1]
+
+
+def test_missing_meshes_say_where_and_package_dir_finds_them(tmp_path, capsys):
+    mesh = '<visual><geometry><mesh filename="package://my_robot/meshes/base.stl"/></geometry></visual>'
+    text = GOOD.replace('<link name="ground">', f'<link name="ground">{mesh}')
+    path = write(tmp_path, text)
+    code, err = run(capsys, ["info", path])
+    assert code == 0 and "package://my_robot/meshes/base.stl" in err
+    assert "looked for packages in" in err and "ROS_PACKAGE_PATH" in err and "--package-dir DIR" in err
+    pkgs = tmp_path / "somewhere" / "src"
+    (pkgs / "my_robot" / "meshes").mkdir(parents=True)
+    (pkgs / "my_robot" / "meshes" / "base.stl").write_text("solid x\nendsolid x\n")
+    code, err = run(capsys, ["info", path, "--package-dir", str(pkgs)])
+    assert code == 0 and "mesh" not in err, err
+    code, err = run(capsys, ["info", path, "--package-dir", str(tmp_path / "nowhere")])
+    assert code == 2 and "is not a folder" in err
+    import screwkin
+    from screwkin.view import _visual_urdf
+
+    mech = screwkin.load(path, package_dirs=[pkgs], warn=lambda m: None)
+    assert str((pkgs / "my_robot" / "meshes" / "base.stl").resolve()) in _visual_urdf(mech)
+
+
+@pytest.mark.parametrize("text, value", [
+    ("1in", 0.0254), ("2 inch", 0.0508), ("1ft", 0.3048), ("30 mm", 0.03), ("30MM", 0.03), ("3cm", 0.03),
+    ("5um", 5e-6), ("2 m", 2.0), ("45deg", np.pi / 4), ("45 DEG", np.pi / 4), ("90°", np.pi / 2),
+    ("0.5 rad", 0.5), ("500mrad", 0.5), ("0.25turn", np.pi / 2), ("-.5", -0.5), ("1e-3", 1e-3),
+])
+def test_units_users_type(text, value):
+    from screwkin.units import parse_value
+
+    assert abs(parse_value(text) - value) < 1e-12
+
+
+@pytest.mark.parametrize("text, word", [("1km", "unknown unit 'km'"), ("nan", "not a number"),
+                                        ("1e999", "not a finite"), ("12parsecs", "unknown unit"),
+                                        ("\u0661", "not a number")])
+def test_units_refused(text, word):
+    from screwkin.errors import UsageError
+    from screwkin.units import parse_value
+
+    with pytest.raises(UsageError, match=word):
+        parse_value(text)
+
+
+def test_view_draws_bare_links_with_stand_ins(tmp_path):
+    """Links with neither visual nor inertial still show: a ball at each joint centre and bars
+    to the joint centres and loop-joint frames on them (only zero-length links inside compound
+    joints are left out)."""
+    import re
+
+    import screwkin
+    from screwkin.view import RecordingViewer, build_scene, show
+
+    bare = re.sub(r'<link name="(\w+)">.*?</link>', r'<link name="\1"/>', GOOD)
+    # a zero-length massless link between two joints at the same point: inside a compound joint
+    bare = bare.replace('<child link="rocker"/>', '<child link="knuckle"/>').replace(
+        "</robot>", '<link name="knuckle"/><joint name="k" type="revolute"><parent link="knuckle"/>'
+                    '<child link="rocker"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" '
+                    'velocity="1"/></joint></robot>')
+    path = write(tmp_path, bare)
+    mech = screwkin.load(path)
+    scene = build_scene(mech, mech.assemble().q)
+    balls = {n.split("/", 2)[2] for n in scene.roles if n.startswith("screwkin/standin/")}
+    bars = {n.split("/", 2)[2] for n in scene.roles if n.startswith("screwkin/standin_bar/")}
+    assert balls == {"crank", "coupler", "rocker"}
+    assert {"crank/coupler_joint", "coupler/C", "rocker/C", "ground/rocker_joint"} <= bars
+    assert not any(b.startswith("knuckle") for b in bars)
+    viewer = RecordingViewer()
+    show(mech, scene, viewer, mech.assemble().q)
+    assert any("standin" in p for p in viewer.objects)
+
+
+def test_mirrored_mesh_scale_is_fine(tmp_path, capsys):
+    text = GOOD.replace('<box size="0.01 0.01 0.01"/>', '<mesh filename="m.stl" scale="-1 1 1"/>', 1)
+    code, err = run(capsys, ["info", write(tmp_path, text)])
+    assert code == 0 and "plausible" not in err, err
+
+
+def test_too_many_elements_or_meshes(tmp_path, capsys):
+    """A file of 250,000 visuals is refused while it is parsed; 3,000 distinct missing meshes are
+    looked for only up to 2,000 (a load stays quick whatever the file)."""
+    vis = '<visual><geometry><box size="1 1 1"/></geometry></visual>'
+    path = write(tmp_path, GOOD.replace('<link name="crank">', '<link name="crank">' + vis * 70_000))
+    check(capsys, ["info", path], 1, "more than 200000 XML elements", path=path)
+    mesh = '<visual><geometry><mesh filename="package://p/m{k}.stl"/></geometry></visual>'
+    text = GOOD.replace('<link name="crank">', '<link name="crank">' + "".join(mesh.format(k=k) for k in range(3000)))
+    code, err = run(capsys, ["info", write(tmp_path, text, "meshes.urdf")])
+    assert code == 0 and "2000 mesh file(s) not found" in err and "only the first 2000" in err
