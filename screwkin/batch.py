@@ -61,6 +61,8 @@ class SerialJacobians:
         self.mech, self.model, self.reference, self.block = mech, mech.model, reference, int(block)
         self.frame = mech.link_frame(link)
         chain = next(c for c in chains(mech, output=link) if c.name == f"output {link}")
+        if not chain.joints:
+            raise UsageError(f"{mech.path}: no moving joint lies between the ground and '{link}'")
         self.chain = chain
         model = self.model
         self._cols = list(chain.columns)

@@ -254,12 +254,14 @@ def _screws(mech, args):
     from .report import screws_dict, screws_text, to_jsonable
     from .screws import structure
 
+    if not mech.cuts and not args.output:
+        raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
     q = _configuration(mech, args)
     st = structure(mech, q, args.output)
     topo = mech.topology(q)
     normal = None
     if topo.motion_space == "planar":
-        normal = next(j.direction for j in topo.joints if j.type in ("revolute", "continuous"))
+        normal = topo.normal
     if args.json:
         print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal)}), indent=2))
     else:

@@ -86,27 +86,6 @@ def frame_id(model, name: str, prefer=FRAME_PREFERENCE):
     return matches[0]
 
 
-def _unambiguous_cut_frames(model, spec) -> None:
-    """Give every cut-joint frame name that several Pinocchio frames share (a joint
-    named like a link) an alias frame of its own on the preferred frame, and name the
-    alias in the spec, so that binding by name finds exactly one frame."""
-    counts = {}
-    for f in model.frames:
-        counts[f.name] = counts.get(f.name, 0) + 1
-    for c in spec.cut_joints:
-        for attr in ("frame1", "frame2"):
-            name = getattr(c, attr)
-            if counts.get(name, 0) < 2:
-                continue
-            alias = f"screwkin@{name}"
-            if not model.existFrame(alias):
-                fid = frame_id(model, name)
-                parent = model.frames[fid]
-                model.addFrame(pin.Frame(alias, parent.parentJoint, fid, parent.placement, pin.FrameType.OP_FRAME),
-                               False)
-            setattr(c, attr, alias)
-
-
 def _frame_bodies(model) -> dict:
     """Frame name -> the Pinocchio joint carrying it (of the preferred frame when several share the name)."""
     rank = {t: k for k, t in enumerate(FRAME_PREFERENCE)}
@@ -253,9 +232,10 @@ class Mechanism:
 
     # ------------------------------------------------------------------ binding
     def _frame_id(self, name: str, what: str) -> int:
-        if not self.model.existFrame(name):
-            raise MechanismFileError(self.path, f"{what} names frame '{name}', which is not in the model")
-        return self.model.getFrameId(name)
+        fid = frame_id(self.model, name)
+        if fid is None:
+            raise MechanismFileError(self.path, f"{what} names frame {quote(name)}, which is not in the model")
+        return fid
 
     def _bind_cut(self, c) -> CutJoint:
         ids = []
@@ -681,7 +661,6 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         model = _replace_joints(model, spec.replacements)
     check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
     _check_cut_bodies(model, spec)
-    _unambiguous_cut_frames(model, spec)
     shown = spec.warnings
     if warn is None:  # on the terminal: a bounded number of bounded lines
         def warn(m):

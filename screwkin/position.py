@@ -635,6 +635,8 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     model.frames[fid] = frame
     target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
     system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.data)
+    if not mech.coordinates:
+        raise UsageError(f"{mech.path}: the mechanism has no moving joint: nothing to solve for")
     solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
     start_list = solver._starts(starts, seed)
     found, best = solver.distinct(system, start_list)

@@ -140,14 +140,19 @@ def mobility_text(r) -> str:
 
 
 def to_jsonable(obj):
+    """Plain Python for json.dumps: numpy values as numbers and lists, and every number that is
+    not finite (a condition number of a singular matrix, a map point that does not assemble)
+    as null: JSON has no NaN or Infinity."""
     if isinstance(obj, dict):
         return {k: to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.generic):
-        return obj.item()
     if isinstance(obj, np.ndarray):
-        return obj.tolist()
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
     return obj
 
 

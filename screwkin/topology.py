@@ -149,8 +149,10 @@ def _frame_link(mech, frame_name: str) -> str:
     for j in spec.joints:
         if j.name == frame_name:
             return j.child
+    from .mechanism import frame_id
+
     model = mech.model
-    fid = model.getFrameId(frame_name)
+    fid = frame_id(model, frame_name)
     for _ in range(len(model.frames)):
         f = model.frames[fid]
         if f.type == pin.FrameType.BODY and f.name in spec.links:

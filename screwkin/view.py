@@ -99,7 +99,7 @@ def _standin_points(mech) -> dict:
             points.append((j.name, model.frames[fid].placement.act(np.asarray(j.xyz, float))))
     for cut in mech.cuts:
         for link, side in ((cut.link1, cut.frame1), (cut.link2, cut.frame2)):
-            owner = _owner_link(mech, link.removeprefix("screwkin@"))
+            owner = _owner_link(mech, link)
             if owner in out and model.frames[side].parentJoint == model.frames[out[owner][0]].parentJoint:
                 out[owner][1].append((cut.name, model.frames[side].placement.translation.copy()))
     return out
