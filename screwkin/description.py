@@ -18,6 +18,7 @@ __all__ = [
     "CUT_JOINT_DOF",
     "LinkSpec",
     "JointSpec",
+    "Coupling",
     "CutJointSpec",
     "MechanismSpec",
     "placement",
@@ -146,10 +147,23 @@ class JointSpec:
     xyz: tuple = (0.0, 0.0, 0.0)
     rpy: tuple = (0.0, 0.0, 0.0)
     axis: tuple = (1.0, 0.0, 0.0)
+    mimic: tuple | None = None  # (joint, multiplier, offset) of a URDF <mimic>, as written
 
     @property
     def dof(self) -> int:
         return TREE_JOINT_DOF[self.type]
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """A coupling of joint values: ``joint = multiplier * mimics + offset`` [rad or m], from
+    URDF ``<mimic>`` elements (a chain of mimics resolved to the first joint of the chain).
+    The coupled joint has no coordinate of its own."""
+
+    joint: str
+    mimics: str
+    multiplier: float
+    offset: float
 
 
 @dataclass
@@ -196,6 +210,7 @@ class MechanismSpec:
     replacements: list = field(default_factory=list)  # (joint name, type) from the sidecar
     warnings: list = field(default_factory=list)
     package_dirs: list = field(default_factory=list)  # --package-dir folders for package:// meshes
+    couplings: list = field(default_factory=list)  # Coupling, from <mimic>
 
     @property
     def root(self) -> str:

@@ -124,24 +124,84 @@ def _axis_letters(t: str):
     return np.array(unit[letters[0]]), np.array(unit[letters[1]])
 
 
-def _replace_joints(model, replacements):
-    """Rebuild ``model`` with the sidecar's joint replacements (SPHERICAL,
-    UJOINT_ab / CARDAN as a native universal joint, FIXED as locked)."""
+_UNBOUNDED = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
+              "JointModelRUBZ": pin.JointModelRZ}
+
+
+def _revolute_for(jm):
+    """The one-coordinate revolute joint model about the axis of an unbounded (continuous)
+    revolute joint model, or None for other joint models."""
+    short = jm.shortname()
+    if short in _UNBOUNDED:
+        return _UNBOUNDED[short]()
+    if short == "JointModelRevoluteUnboundedUnaligned":  # its axis: the angular part of its motion subspace
+        jd = jm.createData()
+        jm.calc(jd, np.array([1.0, 0.0]))
+        return pin.JointModelRevoluteUnaligned(np.asarray(jd.S, float).ravel()[3:6].copy())
+    return None
+
+
+def _order(model, first=()):
+    """The model's joints in a depth-first order with, among siblings, the subtrees that hold a
+    joint of ``first`` before the others: Pinocchio needs a mimicked joint before its mimics."""
+    children = {j: [] for j in range(model.njoints)}
+    for j in range(1, model.njoints):
+        children[model.parents[j]].append(j)
+    first = set(first)
+    holds = {}
+
+    def mark(j):
+        holds[j] = model.names[j] in first or any([mark(c) for c in children[j]])
+        return holds[j]
+
+    mark(0)
+    order, stack = [], [0]
+    while stack:
+        j = stack.pop()
+        if j:
+            order.append(j)
+        kids = sorted(children[j], key=lambda c: (not holds[c], c))
+        stack.extend(reversed(kids))
+    return order
+
+
+def _rebuild(model, replacements=(), first=()):
+    """The model with continuous joints as revolute joints without limits (one coordinate, the
+    angle, which counts turns: Pinocchio's (cos, sin) pair cannot, and a gear train or a lead
+    screw turned twice must move twice as far), the sidecar's joint replacements (SPHERICAL,
+    UJOINT_ab / CARDAN_ab as a native universal joint, FIXED as locked), and the joints named in
+    ``first`` (mimicked ones) ordered before their mimics.  The limits of the other
+    one-coordinate joints are kept."""
     rep = dict(replacements)
+    order = _order(model, first)
+    if not rep and order == list(range(1, model.njoints)) and not any(
+            _revolute_for(model.joints[j]) is not None for j in range(1, model.njoints)):
+        return model
     new = pin.Model()
     new.name = model.name
     locked = []
-    for jid in range(1, model.njoints):
+    inf = np.inf
+    for jid in order:
         name = model.names[jid]
         parent = new.getJointId(model.names[model.parents[jid]]) if model.parents[jid] else 0
         jm = model.joints[jid]
         t = rep.get(name)
+        lo = hi = None
         if t == "SPHERICAL":
             jm = pin.JointModelSpherical()
-        elif t and (t.startswith("UJOINT") or t == "CARDAN"):
+        elif t and t.startswith(("UJOINT", "CARDAN")):
             a1, a2 = _axis_letters(t)
             jm = pin.JointModelUniversal(a1, a2)
-        nid = new.addJoint(parent, jm, model.jointPlacements[jid], name)
+        elif _revolute_for(jm) is not None:
+            jm, lo, hi = _revolute_for(jm), -inf, inf
+        elif model.nqs[jid] == 1:
+            lo, hi = model.lowerPositionLimit[model.idx_qs[jid]], model.upperPositionLimit[model.idx_qs[jid]]
+        if lo is not None:
+            i = model.idx_vs[jid]
+            nid = new.addJoint(parent, jm, model.jointPlacements[jid], name, model.effortLimit[i:i + 1],
+                               model.velocityLimit[i:i + 1], np.array([lo]), np.array([hi]))
+        else:
+            nid = new.addJoint(parent, jm, model.jointPlacements[jid], name)
         new.appendBodyToJoint(nid, model.inertias[jid], pin.SE3.Identity())
         if t == "FIXED":
             locked.append(nid)
@@ -151,6 +211,28 @@ def _replace_joints(model, replacements):
     if locked:
         new = pin.buildReducedModel(new, locked, pin.neutral(new))
     return new
+
+
+def _couple(model, couplings, path):
+    """The model with each coupled joint turned into a Pinocchio mimic joint (no coordinate of
+    its own; its motion is m times its primary's plus o)."""
+    for c in couplings:
+        if not (model.existJointName(c.joint) and model.existJointName(c.mimics)):
+            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}, which the model "
+                                           "does not have as a moving joint (a sidecar replaced it?)")
+        a, b = model.getJointId(c.mimics), model.getJointId(c.joint)
+        if a > b:  # the primary lies below its mimic in the tree: no order puts it first
+            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}, a joint further from "
+                                           "the ground on its own branch: Pinocchio cannot couple them that way round")
+        if model.nvs[a] != 1 or model.nvs[b] != 1:
+            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}: both must be "
+                                           "one-coordinate joints in the model")
+        try:
+            model = pin.transformJointIntoMimic(model, a, b, c.multiplier, c.offset)
+        except (ValueError, RuntimeError) as exc:
+            raise MechanismFileError(path, f"Pinocchio cannot make joint {quote(c.joint)} mimic "
+                                           f"{quote(c.mimics)}: {shorten(str(exc).splitlines()[-1], 100)}") from None
+    return model
 
 
 def link_lengths(model, cuts) -> list:
@@ -212,6 +294,8 @@ class Mechanism:
             if model.nvs[j] > 0
         ]
         self._coord = {c.joint: c for c in self.coordinates}
+        self.couplings = tuple(spec.couplings)  # <mimic> joints: no coordinate of their own
+        self._coupled = {c.joint: c for c in self.couplings}
         self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
         # a ground frame for targets (inverse kinematics); every frame must exist
         # before the pinocchio.Data is made from the model
@@ -252,6 +336,11 @@ class Mechanism:
         """Choose the actuated joints (None: the file's declaration)."""
         names, source = resolve_actuation(self.spec, actuated)
         unknown = [n for n in names if n not in self._coord]
+        if unknown and unknown[0] in self._coupled:
+            c = self._coupled[unknown[0]]
+            msg = (f"actuated joint {quote(unknown[0])} mimics {quote(c.mimics)}: it moves with it and cannot be "
+                   "an input of its own")
+            raise (UsageError(f"{self.path}: {msg}") if source == "command line" else MechanismFileError(self.path, msg))
         if unknown:
             known = ", ".join(c.joint for c in self.coordinates)
             msg = f"actuated joint '{unknown[0]}' is not a moving joint of the mechanism (joints: {known})"
@@ -276,6 +365,11 @@ class Mechanism:
         try:
             return self._coord[joint]
         except KeyError:
+            if joint in self._coupled:
+                c = self._coupled[joint]
+                raise UsageError(f"{self.path}: joint {quote(joint)} mimics {quote(c.mimics)} ({joint} = "
+                                 f"{c.multiplier:g} {c.mimics} + {c.offset:g}): it has no value of its own; "
+                                 f"give {quote(c.mimics)}") from None
             known = ", ".join(c.joint for c in self.coordinates)
             raise UsageError(f"{self.path}: no moving joint named '{joint}' (joints: {known})") from None
 
@@ -309,6 +403,21 @@ class Mechanism:
             self._angle_v = np.array([self.coordinate(n).idx_v for n, _, w in single if w], int)
             self._layout = (single, continuous, multi, order, idx, wrap)
         return self._layout
+
+    def coupled_values(self, q) -> dict:
+        """The value of every coupled (<mimic>) joint: multiplier * its primary's + offset
+        [rad or m]; angles in [-pi, pi)."""
+        out = {}
+        for c in self.couplings:
+            p = self.coordinate(c.mimics)
+            v = c.multiplier * float(q[p.idx_q]) + c.offset
+            if self._revolute_like(c.joint):
+                v = float(np.mod(v + np.pi, 2 * np.pi) - np.pi)
+            out[c.joint] = v
+        return out
+
+    def _revolute_like(self, joint: str) -> bool:
+        return next((j.type for j in self.spec.joints if j.name == joint), "") in ("revolute", "continuous")
 
     def difference(self, q0, q1) -> np.ndarray:
         """The velocity-space step from q0 to q1 (pinocchio.difference), with the angles of
@@ -657,8 +766,8 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         yaml = _find_sidecar(path)
     if yaml is not None:
         read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
-    if spec.replacements:
-        model = _replace_joints(model, spec.replacements)
+    model = _rebuild(model, spec.replacements, first={c.mimics for c in spec.couplings})
+    model = _couple(model, spec.couplings, path)
     check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
     _check_cut_bodies(model, spec)
     shown = spec.warnings

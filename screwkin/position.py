@@ -96,6 +96,7 @@ class Solution:
     merged: int = 1  # how many distinct solver results this solution stands for
     link_angles: dict | None = None
     sigmas: dict | None = None  # screwkin.singular.measures at this configuration
+    coupled: dict | None = None  # <mimic> joints' values [rad or m] (they have no coordinate)
 
     @property
     def physical(self) -> bool:
@@ -122,6 +123,7 @@ class PositionResult:
     trace: tuple = ()
     output: str | None = None
     angular: tuple = ()  # names of the coordinates that are angles (the others are lengths)
+    angular_coupled: tuple = ()  # names of the coupled (mimic) joints that are angles
 
     @property
     def physical(self) -> tuple:
@@ -241,6 +243,9 @@ class PositionSolver:
                 names.append(c.joint)
         return tuple(names)
 
+    def _angular_coupled(self) -> tuple:
+        return tuple(c.joint for c in self.mech.couplings if self.mech._revolute_like(c.joint))
+
     def set_inputs(self, q, values: dict):
         """q with the named coordinates set: joint names of 1-DOF joints [rad or m], and the
         'joint[qk]' names that joint_values gives to the coordinates of multi-DOF joints."""
@@ -351,7 +356,7 @@ class PositionSolver:
         if near_q is not None:
             sols = sols[:1]
         return PositionResult(dict(values), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
-                              tuple(steps), self.output, self._angular)
+                              tuple(steps), self.output, self._angular, self._angular_coupled())
 
     def distinct(self, system, starts, frozen=(), first_trace=None):
         """Solve ``system`` from every start; keep one solution per assembly mode.
@@ -572,7 +577,7 @@ class PositionSolver:
         outside = outside_limits(mech, q)
         return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), float(sigma), pose,
                         rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),
-                        link_angles=self._link_angles(q), sigmas=m)
+                        link_angles=self._link_angles(q), sigmas=m, coupled=mech.coupled_values(q) or None)
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
@@ -658,7 +663,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
         sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
                              sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
                              outside_limits=outside, labels=solver._labels(q, outside),
-                             link_angles=solver._link_angles(q)))
+                             link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
-                          0, (), output, solver.angular_names())
+                          0, (), output, solver.angular_names(), solver._angular_coupled())

@@ -41,6 +41,8 @@ def topology_dict(topo) -> dict:
         "motion_space_detail": topo.motion_space_detail,
         "massless_links_in_compound_joints": list(topo.dummy_links),
         "welds": list(topo.welds),
+        "couplings": [{"joint": c.joint, "mimics": c.mimics, "multiplier": c.multiplier, "offset": c.offset}
+                      for c in topo.couplings],
     }
 
 
@@ -92,7 +94,11 @@ def topology_text(topo, title: str) -> str:
              j.contact, "cut" if j.cut else "") for j in topo.joints]
     lines = [title, "", table(["joint", "type", "dof", "links", "contact", "loop"], rows), ""]
     lines.append(f"links N = {topo.n_links} (ground: {topo.ground})   joints J = {topo.n_joints}   "
-                 f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}")
+                 f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}"
+                 + (f"   couplings C = {len(topo.couplings)}" if topo.couplings else ""))
+    for c in topo.couplings:
+        lines.append(f"coupling (mimic): {c.joint} = {c.multiplier:g} x {c.mimics} + {c.offset:g}: "
+                     f"{c.joint} is no degree of freedom of its own")
     if topo.welds:
         lines.append(f"loops closed by welds (fixed cut joints, each joining two URDF links into one link): "
                      f"{', '.join(topo.welds)}")
@@ -105,11 +111,15 @@ def topology_text(topo, title: str) -> str:
 def mobility_text(r) -> str:
     t = r.topology
     lines = [topology_text(t, f"Mobility of {r.path}"), ""]
-    counts = [("Kutzbach (spatial)", f"6(N-1-J) + sum f = 6({t.n_links}-1-{t.n_joints}) + {t.sum_dof}", t.kutzbach)]
+    c, cv = (" - C", f" - {len(t.couplings)}") if t.couplings else ("", "")
+    counts = [("Kutzbach (spatial)", f"6(N-1-J) + sum f{c} = 6({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
+               t.kutzbach)]
     if t.gruebler is not None:
-        counts.append(("Gruebler (planar)", f"3(N-1-J) + sum f = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}", t.gruebler))
+        counts.append(("Gruebler (planar)", f"3(N-1-J) + sum f{c} = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
+                       t.gruebler))
     if t.spherical_count is not None:
-        counts.append(("spherical", f"3(N-1-J) + sum f = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}", t.spherical_count))
+        counts.append(("spherical", f"3(N-1-J) + sum f{c} = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
+                       t.spherical_count))
     lines.append(table(["count", "formula", "value"], counts))
     lines.append("")
     rows = [
@@ -171,6 +181,8 @@ def position_dict(res) -> dict:
             d["sigmas"] = s.sigmas
         if s.link_angles is not None:
             d["link_angles"] = s.link_angles
+        if s.coupled:
+            d["coupled_joints"] = s.coupled
         if s.output_pose is not None:
             d["output_pose"] = s.output_pose.tolist()
             d["output_position"] = s.output_position.tolist()
@@ -246,6 +258,10 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
             rows.append(row)
         headers = ["joint", "value [rad or m]", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
         lines.append(table(headers, rows))
+        if s.coupled:
+            lines.append("coupled (mimic) joints: " + ", ".join(
+                f"{n} = {v:.9g}" + (f" ({np.degrees(v):.6g} deg)" if n in res.angular_coupled else "")
+                for n, v in s.coupled.items()))
         if s.link_angles:
             lines.append("link angles (absolute, in the plane from the ground's x axis): " + ", ".join(
                 f"{n} {np.degrees(a):.6g} deg" for n, a in s.link_angles.items()))

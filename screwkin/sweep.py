@@ -71,6 +71,7 @@ class SweepResult:
     turn: bool = False  # whether the sweep passed through limit positions
     circuit_closed: bool = False  # the motion came back to its starting configuration
     unit: str = "rad"  # the input's unit: "rad" or "m"
+    coupled: dict | None = None  # <mimic> joint -> its values along the sweep
 
     def to_dict(self) -> dict:
         return {
@@ -85,15 +86,18 @@ class SweepResult:
             "joints": self.joints.tolist(),
             "rates": self.rates.tolist(),
             "accelerations": self.accelerations.tolist(),
+            **({"coupled_joints": {k: v.tolist() for k, v in self.coupled.items()}} if self.coupled else {}),
         }
 
     def csv(self) -> str:
+        coupled = self.coupled or {}
         head = ["step", self.input + "_input"] + list(self.names) + [f"d_{n}" for n in self.names] + [
-            f"dd_{n}" for n in self.names]
+            f"dd_{n}" for n in self.names] + list(coupled)
         lines = [",".join(head)]
         for k in range(len(self.values)):
             row = [str(k), f"{self.values[k]:.12g}"] + [f"{x:.12g}" for x in self.joints[k]]
             row += [f"{x:.12g}" for x in self.rates[k]] + [f"{x:.12g}" for x in self.accelerations[k]]
+            row += [f"{v[k]:.12g}" for v in coupled.values()]
             lines.append(",".join(row))
         return "\n".join(lines) + "\n"
 
@@ -360,9 +364,13 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         V.append(qd)
         A.append(solver.accelerations(qk, K, qd, {}, solve))
     Qa = np.array(Q)
+    coupled = None
+    if mech.couplings:
+        values = [mech.coupled_values(qq) for qq in Q]
+        coupled = {c.joint: np.array([v[c.joint] for v in values]) for c in mech.couplings}
     return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
                        np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
-                       (start, stop, steps), tuple(limits), turn, closed, unit)
+                       (start, stop, steps), tuple(limits), turn, closed, unit, coupled)
 
 
 def _matrix(mech, q, kind, g, V_ref=None):

@@ -87,6 +87,7 @@ class Topology:
     dummy_links: tuple = field(default=())  # URDF links inside compound joints
     welds: tuple = field(default=())  # fixed cut joints: they join two URDF links into one link
     normal: tuple | None = None  # planar: the unit normal of the plane of motion (world axes)
+    couplings: tuple = field(default=())  # description.Coupling: <mimic> joints, one constraint each
 
     @property
     def n_links(self) -> int:
@@ -105,8 +106,9 @@ class Topology:
         return sum(j.dof for j in self.joints)
 
     def count(self, lam: int) -> int:
-        """Chebychev-Gruebler-Kutzbach count with motion-space dimension lam."""
-        return lam * (self.n_links - 1 - self.n_joints) + self.sum_dof
+        """Chebychev-Gruebler-Kutzbach count with motion-space dimension lam, less one for each
+        coupling (a mimic joint's value follows another's): lam (N - 1 - J) + sum f - C."""
+        return lam * (self.n_links - 1 - self.n_joints) + self.sum_dof - len(self.couplings)
 
     @property
     def kutzbach(self) -> int:
@@ -414,7 +416,7 @@ def build_topology(mech, q) -> Topology:
     space, detail, normal = _motion_space(joints, tol, scale)
     cut_welds = tuple(name for _, _, name in welds if name is not None)
     return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links, cut_welds,
-                    normal)
+                    normal, tuple(mech.couplings))
 
 
 def _motion_space(joints, tol, scale):

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .description import (
+    Coupling,
     CUT_JOINT_DOF,
     LIMITS,
     TREE_JOINT_DOF,
@@ -172,7 +173,17 @@ def _joint(elem, links, problems) -> JointSpec | None:
         lo, hi = values.get("lower"), values.get("upper")
         if jtype in ("revolute", "prismatic") and lo is not None and hi is not None and lo > hi:
             problems.append(f"{what} <limit>: lower {lo:g} > upper {hi:g}")
-    return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis)
+    mimic = None
+    m = elem.find("mimic")
+    if m is not None:
+        target = m.get("joint")
+        if not target:
+            problems.append(f"{what} <mimic> has no joint attribute")
+        else:
+            mult = numbers(m.get("multiplier"), 1, f"{what} <mimic multiplier>", problems, (1.0,))[0]
+            off = numbers(m.get("offset"), 1, f"{what} <mimic offset>", problems, (0.0,))[0]
+            mimic = (target, mult, off)
+    return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic)
 
 
 def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
@@ -262,17 +273,18 @@ def check_tree(path, links, joints, problems):
         )
     else:
         # every link must reach the root without cycling (links already known to reach it are not walked again)
+        # (linear in the number of links: every link is walked once)
         reaches = set(roots)
         for start in links:
-            path_links = []
+            on_path = set()
             link = start
             while link not in reaches:
-                if link in path_links:
+                if link in on_path:
                     problems.append(f"the joints form a cycle through link {quote(start)}")
                     return
-                path_links.append(link)
+                on_path.add(link)
                 link = parent_of[link][0]
-            reaches.update(path_links)
+            reaches |= on_path
 
 
 def _coordinates(joints) -> int:
@@ -323,7 +335,9 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
                 problems.append(f"loop joint {quote(c.name)} has the name of another joint")
             seen.add(c.name)
             cuts.append(c)
-    transmissions = _transmissions(root, joints, {c.name for c in cuts}, warnings)
+    couplings = _couplings(joints, problems)
+    transmissions = _transmissions(root, joints, {c.name for c in cuts}, warnings,
+                                   {c.joint: c.mimics for c in couplings})
     problems.fail_if_any(path)
     warnings += check_meshes(path, root, package_dirs)
     return MechanismSpec(
@@ -337,13 +351,56 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
         transmissions=transmissions,
         warnings=warnings,
         package_dirs=[str(d) for d in package_dirs or ()],
+        couplings=couplings,
     )
 
 
-def _transmissions(root, joints, loop_names, warnings) -> list:
+_MOVING_1DOF = ("revolute", "continuous", "prismatic")
+
+
+def _couplings(joints, problems) -> list:
+    """The ``<mimic>`` couplings, each resolved to the first joint of its chain (a gear train
+    written 'idler mimics input, output mimics idler' couples the output to the input):
+    j = m * k + o with k = m' * p + o' gives j = (m m') p + (m o' + o)."""
+    by_name = {j.name: j for j in joints}
+    raw = {}
+    for j in joints:
+        if j.mimic is None:
+            continue
+        target, mult, off = j.mimic
+        if j.type not in _MOVING_1DOF:
+            problems.append(f"joint {quote(j.name)} is {j.type}: only revolute, continuous and prismatic joints "
+                            "can mimic another")
+        elif target == j.name:
+            problems.append(f"joint {quote(j.name)} mimics itself")
+        elif target not in by_name:
+            problems.append(f"joint {quote(j.name)} mimics {quote(target)}, which is not a joint of the file")
+        elif by_name[target].type not in _MOVING_1DOF:
+            problems.append(f"joint {quote(j.name)} mimics {quote(target)}, which is {by_name[target].type}")
+        else:
+            raw[j.name] = (target, mult, off)
+    out = []
+    for name in raw:
+        target, mult, off = raw[name]
+        seen = {name}
+        while target in raw:
+            if target in seen:
+                problems.append(f"the <mimic> couplings of joint {quote(name)} go round in a circle")
+                break
+            seen.add(target)
+            t2, m2, o2 = raw[target]
+            target, mult, off = t2, mult * m2, mult * o2 + off
+        else:
+            out.append(Coupling(name, target, float(mult), float(off)))
+    return out
+
+
+def _transmissions(root, joints, loop_names, warnings, mimics=None) -> list:
     """Joint names of the ``<transmission>`` elements, in order.  A transmission naming a
-    fixed joint, a loop joint or a joint not in the file is a warning, and is ignored
-    (ROS files often carry transmissions of fixed or removed joints: PR2, Kinova, TALOS)."""
+    fixed joint, a loop joint, a joint that mimics another (it moves with that one) or a
+    joint not in the file is a warning, and is ignored (ROS files often carry transmissions
+    of fixed or removed joints: PR2, Kinova, TALOS)."""
+    mimics = mimics or {}
     types = {j.name: j.type for j in joints}
     names = []
     for t in root.findall("transmission"):
@@ -359,6 +416,8 @@ def _transmissions(root, joints, loop_names, warnings) -> list:
                 why = f"joint {quote(jn)}, which is not in the file"
             elif types[jn] == "fixed":
                 why = f"joint {quote(jn)}, which is fixed"
+            elif jn in mimics:
+                why = f"joint {quote(jn)}, which mimics {quote(mimics[jn])} (it moves with it)"
             if why:
                 warnings.append(f"transmission {quote(tname)} names {why}: ignored")
             elif jn not in names:
