@@ -148,13 +148,10 @@ def _order(model, first=()):
     for j in range(1, model.njoints):
         children[model.parents[j]].append(j)
     first = set(first)
-    holds = {}
-
-    def mark(j):
-        holds[j] = model.names[j] in first or any([mark(c) for c in children[j]])
-        return holds[j]
-
-    mark(0)
+    holds = {j: model.names[j] in first for j in range(model.njoints)}
+    for j in range(model.njoints - 1, 0, -1):  # children come after their parents in Pinocchio's order
+        if holds[j]:
+            holds[model.parents[j]] = True
     order, stack = [], [0]
     while stack:
         j = stack.pop()

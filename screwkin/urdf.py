@@ -335,7 +335,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
                 problems.append(f"loop joint {quote(c.name)} has the name of another joint")
             seen.add(c.name)
             cuts.append(c)
-    couplings = _couplings(joints, problems)
+    couplings = _couplings(joints, problems, warnings)
     transmissions = _transmissions(root, joints, {c.name for c in cuts}, warnings,
                                    {c.joint: c.mimics for c in couplings})
     problems.fail_if_any(path)
@@ -358,25 +358,32 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
 _MOVING_1DOF = ("revolute", "continuous", "prismatic")
 
 
-def _couplings(joints, problems) -> list:
+def _couplings(joints, problems, warnings) -> list:
     """The ``<mimic>`` couplings, each resolved to the first joint of its chain (a gear train
     written 'idler mimics input, output mimics idler' couples the output to the input):
-    j = m * k + o with k = m' * p + o' gives j = (m m') p + (m o' + o)."""
+    j = m * k + o with k = m' * p + o' gives j = (m m') p + (m o' + o).  A <mimic> that cannot
+    couple anything -- on a fixed joint, naming a joint not in the file or a fixed one, naming
+    itself, or going round in a circle -- is a warning, and the joint moves on its own (real
+    files carry such leftovers: TALOS's reduced models, Alex's hands)."""
     by_name = {j.name: j for j in joints}
     raw = {}
     for j in joints:
         if j.mimic is None:
             continue
         target, mult, off = j.mimic
+        why = None
         if j.type not in _MOVING_1DOF:
-            problems.append(f"joint {quote(j.name)} is {j.type}: only revolute, continuous and prismatic joints "
-                            "can mimic another")
+            why = f"joint {quote(j.name)} is {j.type}: its <mimic> is ignored"
         elif target == j.name:
-            problems.append(f"joint {quote(j.name)} mimics itself")
+            why = f"joint {quote(j.name)} mimics itself: the <mimic> is ignored"
         elif target not in by_name:
-            problems.append(f"joint {quote(j.name)} mimics {quote(target)}, which is not a joint of the file")
+            why = (f"joint {quote(j.name)} mimics {quote(target)}, which is not a joint of the file: the <mimic> "
+                   f"is ignored and {quote(j.name)} moves on its own")
         elif by_name[target].type not in _MOVING_1DOF:
-            problems.append(f"joint {quote(j.name)} mimics {quote(target)}, which is {by_name[target].type}")
+            why = (f"joint {quote(j.name)} mimics {quote(target)}, which is {by_name[target].type}: the <mimic> is "
+                   f"ignored and {quote(j.name)} moves on its own")
+        if why:
+            warnings.append(why)
         else:
             raw[j.name] = (target, mult, off)
     out = []
@@ -385,7 +392,7 @@ def _couplings(joints, problems) -> list:
         seen = {name}
         while target in raw:
             if target in seen:
-                problems.append(f"the <mimic> couplings of joint {quote(name)} go round in a circle")
+                warnings.append(f"the <mimic> couplings of joint {quote(name)} go round in a circle: ignored")
                 break
             seen.add(target)
             t2, m2, o2 = raw[target]
