@@ -25,7 +25,7 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 import screwkin  # noqa: E402
-from screwkin.batch import SerialJacobians, frame_jacobians  # noqa: E402
+from screwkin.analysis.batch import SerialJacobians, frame_jacobians  # noqa: E402
 
 
 def interleaved(functions: dict, repeat=3):
@@ -98,7 +98,7 @@ def serial_scan(n):
     add("bare Pinocchio Jacobian loop, no measure (floor)", "none", lambda: pinocchio_floor(), 3)
 
     # the same arm in the peers: its space screws (w, v) for modern_robotics, an ETS for the toolbox
-    from screwkin.screws import chains
+    from screwkin.analysis.screws import chains
 
     ch = next(c for c in chains(mech, output="flange") if c.name.startswith("output"))
     try:
@@ -164,8 +164,8 @@ def _toolbox():
 def closed_loop_fk(names, solves):
     import yaml
 
-    from screwkin.mobility import null_space
-    from screwkin.position import PositionSolver
+    from screwkin.model.linalg import null_space
+    from screwkin.analysis.position import PositionSolver
 
     tb = _toolbox()
     rows = []
@@ -191,7 +191,7 @@ def closed_loop_fk(names, solves):
             return [solver.solve(t, near=near, starts=0).solutions[0].q for t in targets]
 
         functions = {"track": ours_track, "solve": ours_solve}
-        # the same with the compiled inner loop (screwkin.compiled, numba), on its own copy of the mechanism
+        # the same with the compiled inner loop (screwkin.model.compiled, numba), on its own copy of the mechanism
         fast_mech = screwkin.load(urdf, warn=lambda m: None)
         fast = PositionSolver(fast_mech, compiled=True)
         if fast.compiled:
@@ -250,8 +250,8 @@ def closed_loop_fk(names, solves):
 
 # ---------------------------------------------------------------- 3. sweep throughput
 def sweep_throughput(steps):
-    from screwkin.position import PositionSolver
-    from screwkin.sweep import sweep
+    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.sweep import sweep
 
     rows = []
     for name, inp, rng, fixed in (("gough_stewart_6ups", "leg1", (0.0, 0.1), {f"leg{k}": 0.0 for k in range(2, 7)}),
@@ -287,8 +287,8 @@ def startup():
         p = subprocess.run([sys.executable, "-c", code, str(robot)], capture_output=True, text=True)
         walls.append(time.perf_counter() - t)
         rss.append(int(p.stderr.split("RSS")[1].split()[0]))
-    imp = subprocess.run([sys.executable, "-X", "importtime", "-c", "import screwkin.cli, screwkin.mechanism, "
-                          "screwkin.mobility"], capture_output=True, text=True).stderr.splitlines()
+    imp = subprocess.run([sys.executable, "-X", "importtime", "-c", "import screwkin.cli, screwkin.model.mechanism, "
+                          "screwkin.analysis.mobility"], capture_output=True, text=True).stderr.splitlines()
     total = {}
     for line in imp:
         if "|" not in line or "cumulative" in line:

@@ -4,21 +4,58 @@
 >>> mech = screwkin.load("robots/fourbar_crank_rocker.urdf")
 >>> mech.mobility().mobility
 1
+
+The package is laid out by layer, imports running one way (README, "How the code is
+laid out"): ``files`` (text -> description) <- ``model`` (the Pinocchio model, loops,
+topology) <- ``analysis`` (results) <- ``present`` (text, JSON, pictures, views) <-
+``cli``.  This module is the public API on top of them.
 """
 
+from .analysis.batch import SerialJacobians
+from .analysis.mobility import (
+    IdleMotion,
+    MobilityResult,
+    OutputMotion,
+    analyze_mobility,
+)
+from .analysis.position import (
+    PositionResult,
+    PositionSolver,
+    Solution,
+    inverse_kinematics,
+)
+from .analysis.scan import ScanResult, scan
+from .analysis.singular import SingularityReport, classify
+from .analysis.sweep import SweepResult, SweepSingularity, locate_singularities, sweep
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
-from .mechanism import Mechanism, load
-from .mobility import MobilityResult, OutputMotion
+from .model import loader as _loader
+from .model import mechanism as _mechanism
+from .model.topology import Joint, Topology
+from .present.report import to_dict
 from .tolerances import Tolerances
-from .topology import Joint, Topology
 
 __all__ = [
     "load",
     "Mechanism",
     "MobilityResult",
     "OutputMotion",
+    "IdleMotion",
     "Topology",
     "Joint",
+    "PositionSolver",
+    "PositionResult",
+    "Solution",
+    "inverse_kinematics",
+    "SingularityReport",
+    "classify",
+    "SweepResult",
+    "SweepSingularity",
+    "sweep",
+    "locate_singularities",
+    "ScanResult",
+    "scan",
+    "SerialJacobians",
+    "to_dict",
     "Tolerances",
     "ScrewkinError",
     "UsageError",
@@ -26,3 +63,23 @@ __all__ = [
     "AssemblyError",
 ]
 __version__ = "0.1.0"
+
+
+class Mechanism(_mechanism.Mechanism):
+    """A mechanism (screwkin.model.mechanism.Mechanism) with the analysis asked most often
+    as a method: ``mech.mobility()``."""
+
+    def mobility(self, actuated=None, output=None, seed: int = 0, point: bool = False) -> MobilityResult:
+        """Mobility analysis (screwkin.analysis.mobility.analyze_mobility); actuated: actuated
+        joint names overriding the file's; point: the output link's origin as a point."""
+        if actuated is not None:
+            self.set_actuated(actuated)
+        return analyze_mobility(self, output=output, seed=seed, point=point)
+
+
+def load(path, yaml=None, actuated=None, tolerances: Tolerances = _loader.DEFAULT, warn=None,
+         package_dirs=None) -> Mechanism:
+    """Read a mechanism file (URDF with <loop_joint> or a YAML sidecar, or SDF) into a
+    :class:`Mechanism`; see screwkin.model.loader.load for the arguments."""
+    return _loader.load(path, yaml=yaml, actuated=actuated, tolerances=tolerances, warn=warn,
+                        package_dirs=package_dirs, cls=Mechanism)

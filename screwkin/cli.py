@@ -11,15 +11,56 @@ import argparse
 import json
 import os
 import sys
+import tempfile
+import time
+import traceback
+import warnings
 
-from .errors import ScrewkinError, UsageError
+import numpy as np
+import pinocchio as pin
+
+from .analysis.maps import singularity_map
+from .analysis.mobility import analyze_mobility
+from .analysis.planar import LinkAngles, identify
+from .analysis.position import PositionSolver, inverse_kinematics
+from .analysis.scan import scan
+from .analysis.screws import structure
+from .analysis.singular import classify
+from .analysis.sweep import locate_singularities, sweep
+from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
+from .model.loader import load
+from .present.plots import map_png, sweep_plot
+from .present.report import (
+    linkage_dict,
+    map_csv,
+    mobility_dict,
+    mobility_text,
+    position_dict,
+    position_text,
+    scan_csv,
+    scan_dict,
+    screws_dict,
+    screws_text,
+    singularity_dict,
+    singularity_text,
+    sweep_csv,
+    sweep_dict,
+    sweep_singularity_dict,
+    sweep_text,
+    to_jsonable,
+    topology_dict,
+    topology_text,
+    trace_text,
+    value_text,
+)
+from .present.view import ViewerServer, build_scene, screenshot, show
+from .units import parse_assignments, parse_value
 
 __all__ = ["main"]
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
-        from .errors import MESSAGE_LIMIT, one_line
 
         self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
 
@@ -148,13 +189,9 @@ def _parser():
 
 
 def _run(args):
-    from .mechanism import load
-    from .report import mobility_dict, mobility_text, to_jsonable, topology_dict, topology_text
-
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs)
     if getattr(args, "length", None):
-        from .units import parse_value
 
         mech.length = parse_value(args.length)
     if args.command == "info":
@@ -182,7 +219,7 @@ def _run(args):
         return handlers[args.command](mech, args)
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
-    result = mech.mobility(output=args.output, point=args.point)
+    result = analyze_mobility(mech, output=args.output, point=args.point)
     if args.json:
         print(json.dumps(to_jsonable(mobility_dict(result)), indent=2))
     else:
@@ -191,10 +228,6 @@ def _run(args):
 
 
 def _solve(mech, args):
-    from .position import PositionSolver
-    from .report import position_dict, position_text, to_jsonable, trace_text
-    from .units import parse_assignments
-
     values = _inputs(mech, args)
     if not values:
         raise UsageError("solve needs input values: --set NAME=VALUE or --set-angle LINK=ANGLE")
@@ -220,12 +253,10 @@ def _solve(mech, args):
 
 def _inputs(mech, args) -> dict:
     """Input values from --set (joint values) and --set-angle (absolute link angles)."""
-    from .units import parse_assignments
 
     values = parse_assignments(getattr(args, "set", None), "--set")
     angles = parse_assignments(getattr(args, "set_angle", None), "--set-angle")
     if angles:
-        from .planar import LinkAngles
 
         q = mech.generic_configurations()[1][0]
         link_angles = LinkAngles(mech, mech.topology(q))
@@ -239,8 +270,6 @@ def _inputs(mech, args) -> dict:
 
 def _configuration(mech, args):
     """The configuration a command analyses: solved for --set values, else the assembled file one."""
-    from .position import PositionSolver
-    from .units import parse_assignments
 
     values = _inputs(mech, args)
     near = parse_assignments([args.near], "--near") if getattr(args, "near", None) else None
@@ -251,9 +280,6 @@ def _configuration(mech, args):
 
 
 def _screws(mech, args):
-    from .report import screws_dict, screws_text, to_jsonable
-    from .screws import structure
-
     if not mech.cuts and not args.output:
         raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
     q = _configuration(mech, args)
@@ -270,23 +296,18 @@ def _screws(mech, args):
 
 
 def _singularities(mech, args):
-    from .report import singularity_text, to_jsonable
-    from .singular import classify
-
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
     q = _configuration(mech, args)
     rep = classify(mech, q, output=args.output, point=args.point)
     if args.json:
-        print(json.dumps(to_jsonable(rep.to_dict()), indent=2))
+        print(json.dumps(to_jsonable(singularity_dict(rep)), indent=2))
     else:
         print(singularity_text(rep))
     return 0
 
 
 def _range(text, option):
-    from .units import parse_value
-
     name, sep, rest = text.partition("=")
     parts = rest.split(":")
     if not sep or len(parts) != 3:
@@ -297,17 +318,11 @@ def _range(text, option):
         raise UsageError(f"{option}: N must be a whole number, got '{parts[2]}'") from None
     if n < 2:
         raise UsageError(f"{option}: N must be at least 2")
-    import numpy as np
 
     return name.strip(), np.linspace(parse_value(parts[0]), parse_value(parts[1]), n)
 
 
 def _map(mech, args):
-    from .maps import singularity_map
-    from .position import PositionSolver
-    from .report import to_jsonable
-    from .units import parse_assignments
-
     xn, xs = _range(args.x, "--x")
     yn, ys = _range(args.y, "--y")
     fixed = parse_assignments(args.set, "--set")
@@ -316,15 +331,14 @@ def _map(mech, args):
         raise UsageError("--point needs --output LINK")
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output, args.point)
     if args.png:
-        res.png(args.png)
+        map_png(res, args.png)
     if args.csv:
         with open(args.csv, "w") as f:
-            f.write(res.csv())
+            f.write(map_csv(res))
     if args.json:
         print(json.dumps(to_jsonable({"x": xn, "y": yn, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
                                       "kind": res.kind, "characteristic_length": mech.length}), indent=2))
     else:
-        import numpy as np
 
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
@@ -334,18 +348,13 @@ def _map(mech, args):
 
 
 def _scan(mech, args):
-    import time
-
-    from .report import to_jsonable
-    from .scan import scan
-
     t = time.perf_counter()
     res = scan(mech, args.output, args.samples, args.seed, args.measure, None, args.threads, point=args.point)
     elapsed = time.perf_counter() - t
     if args.csv:
         with open(args.csv, "w") as f:
-            f.write(res.csv())
-    d = res.to_dict()
+            f.write(scan_csv(res))
+    d = scan_dict(res)
     if args.json:
         print(json.dumps(to_jsonable({"file": mech.path, **d, "seconds": elapsed}), indent=2))
         return 0
@@ -365,18 +374,9 @@ def _scan(mech, args):
 
 
 def _view(mech, args):
-    import tempfile
-    import time
-
-    from .view import ViewerServer, build_scene, screenshot, show
-
     q = _configuration(mech, args)
     motion, singular = None, []
     if args.sweep:
-        from .position import PositionSolver
-        from .singular import classify
-        from .sweep import locate_singularities, sweep
-        from .units import parse_assignments
 
         name, values = _range(args.sweep, "--sweep")
         fixed = {k: v for k, v in parse_assignments(args.set, "--set").items() if k != name}
@@ -416,13 +416,6 @@ def _view(mech, args):
 
 
 def _ik(mech, args):
-    import numpy as np
-    import pinocchio as pin
-
-    from .position import inverse_kinematics
-    from .report import position_dict, position_text, to_jsonable
-    from .units import parse_value
-
     parts = args.pose.replace(",", " ").split()
     if len(parts) != 6:
         raise UsageError(f'--pose expects "x y z roll pitch yaw", got "{args.pose}"')
@@ -443,12 +436,6 @@ def _ik(mech, args):
 
 
 def _sweep(mech, args):
-    from .planar import identify
-    from .position import PositionSolver
-    from .report import sweep_text, to_jsonable, value_text
-    from .sweep import sweep
-    from .units import parse_assignments, parse_value
-
     fixed = parse_assignments(args.set, "--set")
     inputs = _names(args.inputs) or (list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
     solver = PositionSolver(mech, inputs)
@@ -464,20 +451,19 @@ def _sweep(mech, args):
         mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
     sing = list(res.limits)  # the limit positions met are always listed
     if args.singularities:
-        from .sweep import locate_singularities
 
         sing = locate_singularities(solver, res, output=args.output, point=args.point)
     if args.csv:
         with open(args.csv, "w") as f:
-            f.write(res.csv())
+            f.write(sweep_csv(res))
     if args.plot:
-        _plot(res, args.plot, mus)
+        sweep_plot(res, args.plot, mus)
     if args.json:
-        d = res.to_dict()
+        d = sweep_dict(res, mech)
         if info is not None:
-            d["linkage"] = info.to_dict()
+            d["linkage"] = linkage_dict(info)
             d["transmission_angles"] = mus
-        d["singularities"] = [x.to_dict(mech) for x in sing]
+        d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
         d["characteristic_length"] = mech.length
         print(json.dumps(to_jsonable(d), indent=2))
     else:
@@ -491,36 +477,6 @@ def _sweep(mech, args):
     return 0
 
 
-def _plot(res, path, mus):
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise UsageError("--plot needs matplotlib: pip install matplotlib") from None
-    import numpy as np
-
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 8))
-    for k, name in enumerate(res.names):
-        axes[0].plot(res.values, res.joints[:, k] if res.joints.shape[1] == len(res.names) else res.joints[:, k],
-                     label=name)
-        axes[1].plot(res.values, res.rates[:, k], label=name)
-        axes[2].plot(res.values, res.accelerations[:, k], label=name)
-    axes[0].set_ylabel("joint value [rad, m]")
-    axes[1].set_ylabel(f"rate [1/s] (input rate {res.rate:g})")
-    axes[2].set_ylabel("acceleration")
-    axes[2].set_xlabel(f"{res.input} [rad or m]")
-    axes[0].legend(fontsize=7)
-    if mus is not None:
-        ax = axes[0].twinx()
-        ax.plot(res.values, np.degrees(mus), "k--", label="transmission angle")
-        ax.set_ylabel("transmission angle [deg]")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-
-
 def main(argv=None) -> int:
     """The command line.  Exit codes: 0 success, 1 invalid or unanalysable file, 2 usage
     error, 3 internal error (a bug: never caused by input), 141 when the reader of the
@@ -532,12 +488,8 @@ def main(argv=None) -> int:
     MESSAGE_LIMIT characters after the path, control characters escaped; ``--debug``
     (before or after the command) prints the traceback first, with the same exit code.
     """
-    import traceback
-    import warnings
 
-    import numpy as np
 
-    from .errors import MESSAGE_LIMIT, one_line
 
     def say(line):
         try:

@@ -16,9 +16,9 @@ from scipy.optimize import brentq
 import screwkin
 from conftest import DATA
 from screwkin.cli import main
-from screwkin.position import PositionSolver
-from screwkin.singular import classify
-from screwkin.sweep import sweep
+from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.singular import classify
+from screwkin.analysis.sweep import sweep
 
 STUDENT = DATA / "student"
 IN = 0.0254
@@ -338,7 +338,7 @@ def test_one_characteristic_length_everywhere(capsys):
     q = arm.neutral()
     for k, v in enumerate(values, 1):
         q[arm.coordinate(f"joint{k}").idx_q] = v
-    from screwkin.batch import SerialJacobians
+    from screwkin.analysis.batch import SerialJacobians
 
     api = SerialJacobians(arm, "flange").measures(q[None], "sigma_ratio")[0]
     sing = classify(arm, q, output="flange", inputs=[])
@@ -374,7 +374,7 @@ def test_3rpr_inverse_kinematics_labels_reversed_legs():
     mech = screwkin.load(DATA.parent.parent / "robots" / "planar_3rpr.urdf")
     home = mech.model.createData()
     pin.framesForwardKinematics(mech.model, home, mech.neutral())
-    from screwkin.position import inverse_kinematics
+    from screwkin.analysis.position import inverse_kinematics
 
     res = inverse_kinematics(mech, "platform", home.oMf[mech.link_frame("platform")])
     first = res.solutions[0]

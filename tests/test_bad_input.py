@@ -183,12 +183,12 @@ def test_one_joint_arm(tmp_path, capsys, argv):
 
 
 def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
-    import screwkin.mechanism
+    import screwkin.cli
 
-    def broken(self, *args, **kwargs):
+    def broken(*args, **kwargs):
         raise ValueError("shapes do not match")
 
-    monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", broken)
+    monkeypatch.setattr(screwkin.cli, "analyze_mobility", broken)
     path = write(tmp_path, GOOD)
     check(capsys, ["mobility", path], 3, "internal error", "ValueError", "--debug", path=path)
     # --debug (after or before the command): the traceback, then the same line, and still exit 3
@@ -444,16 +444,16 @@ def test_numpy_warnings_stay_off_stderr(tmp_path, capsys, monkeypatch):
 
     import numpy as np
 
-    import screwkin.mechanism
+    import screwkin.cli
 
-    original = screwkin.mechanism.Mechanism.mobility
+    original = screwkin.cli.analyze_mobility
 
-    def noisy(self, *a, **k):
+    def noisy(*a, **k):
         np.float64(1.0) / np.zeros(1)  # divide by zero: RuntimeWarning unless silenced
         warnings.warn("Mean of empty slice", RuntimeWarning)
-        return original(self, *a, **k)
+        return original(*a, **k)
 
-    monkeypatch.setattr(screwkin.mechanism.Mechanism, "mobility", noisy)
+    monkeypatch.setattr(screwkin.cli, "analyze_mobility", noisy)
     code, err = run(capsys, ["mobility", write(tmp_path, GOOD)])
     assert code == 0 and err == "", err
 
@@ -538,7 +538,7 @@ def test_missing_meshes_say_where_and_package_dir_finds_them(tmp_path, capsys):
     code, err = run(capsys, ["info", path, "--package-dir", str(tmp_path / "nowhere")])
     assert code == 2 and "is not a folder" in err
     import screwkin
-    from screwkin.view import _visual_urdf
+    from screwkin.present.view import _visual_urdf
 
     mech = screwkin.load(path, package_dirs=[pkgs], warn=lambda m: None)
     assert str((pkgs / "my_robot" / "meshes" / "base.stl").resolve()) in _visual_urdf(mech)
@@ -573,7 +573,7 @@ def test_view_draws_bare_links_with_stand_ins(tmp_path):
     import re
 
     import screwkin
-    from screwkin.view import RecordingViewer, build_scene, show
+    from screwkin.present.view import RecordingViewer, build_scene, show
 
     bare = re.sub(r'<link name="(\w+)">.*?</link>', r'<link name="\1"/>', GOOD)
     # a zero-length massless link between two joints at the same point: inside a compound joint

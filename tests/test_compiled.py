@@ -1,4 +1,4 @@
-"""The compiled inner loop (screwkin.compiled, numba) gives the numpy loop's numbers."""
+"""The compiled inner loop (screwkin.model.compiled, numba) gives the numpy loop's numbers."""
 
 import numpy as np
 import pinocchio as pin
@@ -6,7 +6,7 @@ import pytest
 from conftest import CORPUS, ROBOTS, fourbar
 
 import screwkin
-from screwkin.position import PositionSolver
+from screwkin.analysis.position import PositionSolver
 
 pytest.importorskip("numba")
 

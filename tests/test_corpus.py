@@ -14,7 +14,7 @@ import pytest
 
 import screwkin
 from conftest import CORPUS
-from screwkin.closure import ClosureSystem
+from screwkin.model.closure import ClosureSystem
 from screwkin.tolerances import Tolerances
 
 # name: (N, J, count, motion space, M, idle, actuated count, classification start, reason)
@@ -146,8 +146,8 @@ def test_corpus_solves_for_motor_inputs(name):
     of two nearby solutions does (joint centres do not see idle spins).
     A motor step is not used: several of these files assemble next to an
     actuator singularity, where some motor steps cannot be followed at all."""
-    from screwkin.mobility import null_space
-    from screwkin.position import PositionSolver
+    from screwkin.model.linalg import null_space
+    from screwkin.analysis.position import PositionSolver
 
     # a tight closure tolerance so that a small finite-difference step is not drowned in it:
     # wl16_like assembles next to a singularity, where the motion curves sharply

@@ -11,10 +11,10 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin._pin import compute_frame_jacobian
+from screwkin.model._pin import compute_frame_jacobian
 from screwkin.cli import main
-from screwkin.position import PositionSolver
-from screwkin.sweep import sweep
+from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.sweep import sweep
 
 GRIPPER = ROBOTS / "gripper_arm_mimic.urdf"
 

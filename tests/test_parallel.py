@@ -15,10 +15,10 @@ from scipy.optimize import brentq
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.position import PositionSolver, inverse_kinematics
-from screwkin.screws import split_jacobians
-from screwkin.singular import classify
-from screwkin.sweep import sweep
+from screwkin.analysis.position import PositionSolver, inverse_kinematics
+from screwkin.analysis.screws import split_jacobians
+from screwkin.analysis.singular import classify
+from screwkin.analysis.sweep import sweep
 
 
 def load(name, **kw):

@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 
 import screwkin
+from screwkin.present.report import map_csv
 from conftest import fourbar, planar_3r, slider_crank
 from screwkin.cli import main
-from screwkin.position import PositionSolver
-from screwkin.singular import classify
-from screwkin.sweep import locate_singularities, sweep
+from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.singular import classify
+from screwkin.analysis.sweep import locate_singularities, sweep
 from test_position import A, B, C, G
 
 
@@ -57,7 +58,7 @@ def test_four_bar_output_limits_located_along_a_sweep(tmp_path):
 
 
 def test_four_bar_rocker_input_dead_centre_is_an_actuator_singularity(tmp_path):
-    from screwkin.planar import identify
+    from screwkin.analysis.planar import identify
 
     mech = load(tmp_path, fourbar(), actuated=["rocker_joint"])
     q = mech.assemble().q
@@ -115,7 +116,7 @@ def test_five_bar_map_finds_the_folded_legs(tmp_path):
     60 deg): its serial singularities are where a leg is folded or stretched, |O_i P| = 0.05 or
     0.25 m.  Every grid point the map marks singular (sigma < 10^-2.5) lies next to such a point."""
     from conftest import ROBOTS
-    from screwkin.maps import singularity_map
+    from screwkin.analysis.maps import singularity_map
 
     mech = screwkin.load(ROBOTS / "five_bar.urdf")
     solver = PositionSolver(mech)
@@ -137,7 +138,7 @@ def test_five_bar_map_finds_the_folded_legs(tmp_path):
             u, v = (A - O) / 0.1, (P - A) / np.linalg.norm(P - A)
             sines.append(abs(u[0] * v[1] - u[1] * v[0]))  # |sin| of the elbow angle
         assert min(sines) < 0.05  # a leg folded or stretched, within the grid's resolution
-    assert m.csv().count("\n") == 25 * 25 + 1
+    assert map_csv(m).count("\n") == 25 * 25 + 1
 
 
 def test_serial_measures_do_not_depend_on_where_the_world_origin_is(tmp_path):

@@ -7,7 +7,7 @@ import pytest
 import screwkin
 from conftest import CORPUS, ROBOTS
 from screwkin.cli import main
-from screwkin.view import COLORS, RecordingViewer, ViewerServer, build_scene, chromium, show
+from screwkin.present.view import COLORS, RecordingViewer, ViewerServer, build_scene, chromium, show
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def test_scene_contents_and_colours(delta):
 def test_every_drawn_transform_matches_the_solved_configuration(delta):
     """What is sent to meshcat for each object equals Pinocchio's placement of its
     joint at the solved configuration times the object's placement on it."""
-    from screwkin.position import PositionSolver
+    from screwkin.analysis.position import PositionSolver
 
     mech, _ = delta
     s = PositionSolver(mech).solve({"arm1": 0.2, "arm2": -0.1, "arm3": 0.05}).solutions[0]
@@ -57,8 +57,8 @@ def test_every_drawn_transform_matches_the_solved_configuration(delta):
 
 
 def test_motion_becomes_a_meshcat_animation(delta):
-    from screwkin.position import PositionSolver
-    from screwkin.sweep import sweep
+    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.sweep import sweep
 
     mech, q = delta
     res = sweep(PositionSolver(mech), "arm1", 0.0, 0.3, 12, fixed={"arm2": 0.0, "arm3": 0.0})
@@ -114,7 +114,7 @@ def test_static_page_renders_the_mechanism(tmp_path):
     html, png = tmp_path / "delta.html", tmp_path / "delta.png"
     assert main(["view", str(ROBOTS / "delta_parallelogram.urdf"), "--output", "platform", "--html", str(html)]) == 0
     assert html.stat().st_size > 10000 and "<html" in html.read_text()[:2000].lower()
-    from screwkin.view import screenshot
+    from screwkin.present.view import screenshot
 
     screenshot(html, png)
     img = np.asarray(Image.open(png).convert("RGB")).astype(int)
@@ -130,7 +130,7 @@ def test_prismatic_axes_carry_an_arrow():
 
 
 def test_view_helper_uses_the_viewer_it_is_given(delta):
-    from screwkin.view import view
+    from screwkin.present.view import view
 
     mech, q = delta
     v = RecordingViewer()

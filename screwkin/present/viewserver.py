@@ -2,7 +2,7 @@
 
 meshcat's own server listens on every interface (it passes no address to
 tornado); this one binds its web server and its ZMQ socket to 127.0.0.1.
-Run as ``python -m screwkin.viewserver``: it prints ``zmq_url=...`` and
+Run as ``python -m screwkin.present.viewserver``: it prints ``zmq_url=...`` and
 ``web_url=...`` and serves until terminated.
 """
 

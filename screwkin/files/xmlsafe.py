@@ -3,7 +3,7 @@
 Mechanism files are untrusted:
 
 * only regular files are read (a FIFO or a device would block or never end), and
-  at most a bounded number of bytes (:data:`~screwkin.description.LIMITS`);
+  at most a bounded number of bytes (:data:`~screwkin.files.description.LIMITS`);
 * XML: external entities are never resolved and any entity declaration (the
   basis of "billion laughs" expansion bombs) is refused before anything is
   expanded -- defusedxml does this on top of the standard library parser; the
@@ -22,8 +22,10 @@ from pathlib import Path
 
 import defusedxml
 import defusedxml.ElementTree as SafeET
+import yaml
 
-from .errors import MechanismFileError, shorten
+from ..errors import MechanismFileError, shorten
+from .description import LIMITS
 
 __all__ = ["parse_xml_text", "read_regular_file", "load_yaml_text", "MAX_DEPTH"]
 
@@ -79,7 +81,6 @@ def parse_xml_text(text: str, path) -> ET.Element:
 
     The elements are counted and their nesting measured while parsing, so a file of a
     million elements is refused after ``LIMITS.elements`` of them, not after building them."""
-    from .description import LIMITS
 
     if not text.strip():
         raise MechanismFileError(path, "the file is empty")
@@ -114,7 +115,6 @@ def parse_xml_text(text: str, path) -> ET.Element:
 
 
 def _safe_loader():
-    import yaml
 
     class _NoAliasLoader(yaml.SafeLoader):
         """SafeLoader without aliases (``*a``) and with a bounded nesting depth."""
@@ -140,7 +140,6 @@ def _safe_loader():
 
 def load_yaml_text(text: str, path):
     """The plain data of a YAML document from a user (see the module's notes)."""
-    import yaml
 
     loader = _safe_loader()(text)
     try:

@@ -20,9 +20,10 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 import pinocchio as pin
 
+from ..errors import MechanismFileError, quote, shorten
 from .description import LIMITS, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
-from .errors import MechanismFileError, quote, shorten
-from .urdf import check_meshes, check_sizes, numbers, unit_axis
+from .meshes import check_meshes
+from .urdf import check_sizes, numbers, unit_axis
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_sdf"]

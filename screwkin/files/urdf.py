@@ -9,31 +9,30 @@ that every problem is reported with the file's name and all at once.
 from __future__ import annotations
 
 import math
-import os
 import re
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import MechanismFileError, quote, shorten
 from .description import (
-    Coupling,
     CUT_JOINT_DOF,
     LIMITS,
     TREE_JOINT_DOF,
+    Coupling,
     CutJointSpec,
     JointSpec,
     LinkSpec,
     MechanismSpec,
     data_bytes,
 )
-from .errors import MechanismFileError, quote, shorten
-from .xmlsafe import parse_xml_text, read_regular_file
+from .meshes import check_meshes
+from .xmlsafe import parse_xml_text
 
-__all__ = ["read_urdf", "read_yaml_sidecar", "numbers", "unit_axis", "check_tree", "check_meshes", "check_sizes",
-           "resolve_uri", "find_mesh"]
+__all__ = ["read_urdf", "numbers", "unit_axis", "check_tree", "check_sizes", "Problems"]
 
 
-class _Problems(list):
+class Problems(list):
     """Collects every problem of a file before failing."""
 
     def fail_if_any(self, path):
@@ -49,7 +48,7 @@ _NONFINITE = re.compile(r"[-+]?(?:nan|inf|infinity)\Z", re.IGNORECASE)
 def numbers(text, count, what, problems, default, bound=None, unit="m", low=None):
     """Parse ``count`` floats from an attribute; record a problem when invalid.
 
-    bound: largest magnitude accepted (see :class:`~screwkin.description.Limits`);
+    bound: largest magnitude accepted (see :class:`~screwkin.files.description.Limits`);
     low: smallest value accepted (e.g. 0 for a mass).
     """
     if text is None:
@@ -236,7 +235,7 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
 
 
 def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: int | None = None):
-    """Refuse a file beyond :data:`~screwkin.description.LIMITS` (before Pinocchio builds anything)."""
+    """Refuse a file beyond :data:`~screwkin.files.description.LIMITS` (before Pinocchio builds anything)."""
     for count, limit, what in ((links, LIMITS.links, "links"), (joints, LIMITS.joints, "joints"),
                                (loop_joints, LIMITS.loop_joints, "loop joints")):
         if count > limit:
@@ -301,7 +300,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
                                        "expected <robot>")
     link_elems, joint_elems, loop_elems = root.findall("link"), root.findall("joint"), root.findall("loop_joint")
     check_sizes(path, len(link_elems), len(joint_elems), len(loop_elems))
-    problems = _Problems()
+    problems = Problems()
     warnings = []
     links = {}
     for elem in link_elems:
@@ -432,209 +431,3 @@ def _transmissions(root, joints, loop_names, warnings, mimics=None) -> list:
     return names
 
 
-def _is_file(p: Path) -> bool:
-    """Path.is_file that answers False for names the system refuses (too long, NUL bytes)."""
-    try:
-        return p.is_file()
-    except (OSError, ValueError):
-        return False
-
-
-def _roots(base: Path, package_dirs=()) -> list:
-    roots = [Path(d) for d in package_dirs or ()]
-    roots += [base, *list(base.parents)[:2]]
-    roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-    out = []
-    for r in roots:
-        if r not in out:
-            out.append(r)
-    return out
-
-
-def resolve_uri(uri: str, base: Path, package_dirs=(), roots=None):
-    """Candidate paths of a mesh URI: ``package://`` against ``package_dirs`` (the
-    ``--package-dir`` folders), the file's folder and the two above it, and
-    ``ROS_PACKAGE_PATH`` (``roots``: those folders, when already known); ``file://``
-    as is, relative paths against the file."""
-    if uri.startswith("package://"):
-        rest = uri[len("package://"):]
-        package, _, inside = rest.partition("/")
-        inside = inside.lstrip("/")
-        cands = []
-        for r in roots if roots is not None else _roots(base, package_dirs):
-            if package:
-                cands += [r / package / inside, r / inside]
-            else:
-                cands.append(r / inside)
-        return cands
-    if uri.startswith("file://"):
-        return [Path(uri[len("file://"):])]
-    p = Path(uri)
-    return [p if p.is_absolute() else base / p]
-
-
-def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
-    """The first existing file among the candidates of ``uri``, or None."""
-    return next((c for c in resolve_uri(uri, base, package_dirs, roots) if _is_file(c)), None)
-
-
-def check_meshes(path, root, package_dirs=()) -> list:
-    """Warnings for mesh files that cannot be found (missing meshes do not fail a load)."""
-    base = Path(path).resolve().parent
-    roots = _roots(base, package_dirs)
-    missing, checked = [], set()
-    for mesh in root.iter("mesh"):
-        uri = mesh.get("filename") or (mesh.findtext("uri") or "").strip()
-        if not uri or uri.startswith("model://") or uri in checked:
-            continue
-        if len(checked) >= LIMITS.meshes:
-            break
-        checked.add(uri)
-        if find_mesh(uri, base, package_dirs, roots) is None:
-            missing.append(uri)
-    if not missing:
-        return []
-    shown = ", ".join(quote(m, 60) for m in missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
-    msg = f"{len(missing)} mesh file(s) not found (views will use stand-ins): {shown}"
-    if len(checked) >= LIMITS.meshes:
-        msg += f" (only the first {LIMITS.meshes} mesh files were looked for)"
-    if any(m.startswith("package://") for m in missing):
-        looked = ", ".join(shorten(str(r), 60) for r in roots[:4]) + (f" and {len(roots) - 4} more" if len(roots) > 4
-                                                                        else "")
-        msg += f"; looked for packages in {looked} (set ROS_PACKAGE_PATH or use --package-dir DIR)"
-    return [msg]
-
-
-_YAML_TYPES = {"6d": "fixed", "3d": "spherical"}
-_REPLACEMENTS = "SPHERICAL, FIXED, CARDAN, UJOINT, UJOINT_XY or CARDAN_XY (two different axes of X, Y, Z)"
-
-
-def _replacement_type(t) -> str | None:
-    """The canonical replacement type, or None when unknown (UJOINT letters must be two different axes)."""
-    t = t.upper()
-    if t in ("SPHERICAL", "FIXED", "CARDAN", "UJOINT"):
-        return t
-    for prefix in ("UJOINT_", "CARDAN_"):
-        if t.startswith(prefix):
-            letters = t[len(prefix):]
-            if len(letters) == 2 and set(letters) <= set("XYZ") and letters[0] != letters[1]:
-                return "UJOINT_" + letters
-    return None
-
-
-def _string_list(content, key, problems, what="joint names"):
-    """content[key] as a list of strings (None when absent), with a problem for anything else."""
-    value = content.get(key)
-    if value is None:
-        return None
-    if not isinstance(value, list):
-        problems.append(f"{key} must be a list of {what}, got {quote(value)}")
-        return []
-    out = []
-    for k, item in enumerate(value, 1):
-        if not isinstance(item, str):
-            problems.append(f"{key} entry {k} is {quote(item)}, not a string (write names in quotes)")
-            continue
-        out.append(item)
-    return out
-
-
-def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names, frame_body=None) -> None:
-    """Add the loops, actuation and joint replacements of an Extended-URDF sidecar.
-
-    ``frame_names`` are the frames of the Pinocchio model of the tree: the YAML
-    names frames, not links.  ``frame_body`` (optional) maps a frame name to the
-    Pinocchio joint that carries it: a pair of frames on the same body closes no loop.
-
-    The YAML is untrusted: at most ``LIMITS.yaml_bytes``, UTF-8, no aliases (no
-    "billion laughs"), no tags beyond plain data, and every field's type checked.
-    """
-    from .xmlsafe import load_yaml_text
-
-    raw = read_regular_file(yaml_path, LIMITS.yaml_bytes, "YAML sidecar")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise MechanismFileError(yaml_path, "not a text file (not UTF-8)") from None
-    content = load_yaml_text(text, yaml_path)
-    if content is None:
-        content = {}
-    if not isinstance(content, dict):
-        raise MechanismFileError(yaml_path, f"expected a mapping with closed_loop, type, name_mot, got {quote(content)}")
-    problems = _Problems()
-    known = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
-    for key in content:
-        if not isinstance(key, str):
-            problems.append(f"a key is {quote(key)}, not a name (known keys: {', '.join(known)})")
-            break
-    pairs = content.get("closed_loop")
-    pairs = [] if pairs is None else pairs
-    if not isinstance(pairs, list):
-        raise MechanismFileError(yaml_path, f"closed_loop must be a list of [frame, frame] pairs, got {quote(pairs)}")
-    types = content.get("type")
-    types = ["6d"] * len(pairs) if types is None else types
-    if not isinstance(types, list):
-        raise MechanismFileError(yaml_path, f"type must be a list of '3d' or '6d', got {quote(types)}")
-    if len(pairs) > LIMITS.loop_joints:
-        raise MechanismFileError(yaml_path, f"closed_loop has {len(pairs)} pairs; screwkin reads at most "
-                                            f"{LIMITS.loop_joints} loop joints")
-    if len(types) != len(pairs):
-        problems.append(f"closed_loop has {len(pairs)} pairs but type has {len(types)} entries")
-    frames = set(frame_names)
-    frame_body = frame_body or {}
-    for k, pair in enumerate(pairs):
-        if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(x, str) for x in pair)):
-            problems.append(f"closed_loop entry {k + 1} is not a pair of frame names: {quote(pair)}")
-            continue
-        a, b = pair
-        missing = [f for f in (a, b) if f not in frames]
-        for f in missing:
-            problems.append(f"closed_loop names frame {quote(f)}, which is not in the URDF")
-        if a == b:
-            problems.append(f"closed_loop entry {k + 1} pairs frame {quote(a)} with itself")
-            continue
-        if not missing and frame_body.get(a) is not None and frame_body.get(a) == frame_body.get(b):
-            problems.append(f"closed_loop entry {k + 1} pairs frames {quote(a)} and {quote(b)}, which are fixed "
-                            "together (on the same body): it closes no loop")
-            continue
-        ctype = types[k] if k < len(types) else "6d"
-        if not isinstance(ctype, str) or ctype.lower() not in _YAML_TYPES:
-            problems.append(f"closed_loop type {quote(ctype)} is unknown (known: 3d, 6d)")
-            continue
-        spec.cut_joints.append(
-            CutJointSpec(name=f"{a}~{b}", type=_YAML_TYPES[ctype.lower()], frame1=a, frame2=b, source="yaml")
-        )
-    joint_types = {j.name: j.type for j in spec.joints}
-    names = _string_list(content, "name_mot", problems)
-    if names is not None:
-        for n in names:
-            if n not in joint_types:
-                problems.append(f"name_mot names joint {quote(n)}, which is not in the URDF")
-            elif joint_types[n] == "fixed":
-                problems.append(f"name_mot names joint {quote(n)}, which is fixed (a motor drives a moving joint)")
-        spec.yaml_actuated = names
-    jn = _string_list(content, "joint_name", problems) or []
-    jt = _string_list(content, "joint_type", problems, "joint types") or []
-    if len(jn) != len(jt):
-        problems.append(f"joint_name has {len(jn)} entries but joint_type has {len(jt)}")
-    replaced = set()
-    for n, t in zip(jn, jt):
-        canonical = _replacement_type(t)
-        if canonical is None:
-            problems.append(f"joint_type {quote(t)} is unknown (known: {_REPLACEMENTS})")
-            continue
-        if n not in joint_types:
-            problems.append(f"joint_name names joint {quote(n)}, which is not in the URDF")
-            continue
-        if n in replaced:
-            problems.append(f"joint_name names joint {quote(n)} twice")
-            continue
-        replaced.add(n)
-        if joint_types[n] == "fixed":
-            if canonical != "FIXED":
-                problems.append(f"joint_name names joint {quote(n)}, which is fixed: a {canonical} replacement "
-                                "must name a moving joint")
-            continue
-        spec.replacements.append((n, canonical))
-    problems.fail_if_any(yaml_path)
-    spec.yaml_path = str(yaml_path)

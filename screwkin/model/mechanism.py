@@ -8,25 +8,21 @@ mobility, and later position, velocity and singularity analysis) work on it.
 
 from __future__ import annotations
 
-import os
-import sys
-import tempfile
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
+from ..errors import AssemblyError, MechanismFileError, UsageError, quote
+from ..files.description import MechanismSpec, placement, resolve_actuation
+from ..tolerances import DEFAULT, Tolerances
+from ._pin import frame_id
 from .closure import Assembly, ClosureSystem, CutJoint
-from .description import LIMITS, MechanismSpec, placement, resolve_actuation
-from .errors import AssemblyError, MechanismFileError, UsageError, quote, shorten
 from .linalg import null_space, rank
-from .tolerances import DEFAULT, Tolerances
-from .urdf import check_sizes, read_urdf, read_yaml_sidecar
-from .xmlsafe import parse_xml_text, read_regular_file
+from .topology import build_topology
 
-__all__ = ["load", "Mechanism", "Coordinate", "characteristic_length", "frame_id"]
+__all__ = ["Mechanism", "Coordinate", "characteristic_length", "link_lengths"]
 
 
 @dataclass(frozen=True)
@@ -39,197 +35,6 @@ class Coordinate:
     nq: int
     idx_v: int
     nv: int
-
-
-def _read_text(path: Path) -> str:
-    """The text of a mechanism file: a regular file of at most ``LIMITS.file_bytes``, in UTF-8."""
-    raw = read_regular_file(path, LIMITS.file_bytes, "mechanism file")
-    if not raw.strip():
-        raise MechanismFileError(path, "the file is empty")
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise MechanismFileError(path, "not a text file (not UTF-8)") from None
-
-
-def _find_sidecar(path: Path):
-    """``FILE.yaml`` or ``FILE.yml`` beside the file, if there is one (whatever it is:
-    a pipe or a directory of that name is then refused when read, not skipped)."""
-    for suffix in (".yaml", ".yml"):
-        cand = path.with_suffix(suffix)
-        try:
-            if cand.exists():
-                return cand
-        except (OSError, ValueError):
-            continue
-    return None
-
-
-#: Frame types in the order a bare name is taken when several frames share it (a URDF
-#: may name a joint like a link: Pinocchio then has a JOINT and a BODY frame of that name).
-FRAME_PREFERENCE = (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.OP_FRAME,
-                    pin.FrameType.SENSOR)
-
-
-def frame_id(model, name: str, prefer=FRAME_PREFERENCE):
-    """Id of the frame named ``name`` (None when there is none).  When several frames
-    share the name, the first of the types in ``prefer`` wins -- by default the BODY
-    frame (the link), where ``model.getFrameId(name)`` raises "Several frames match"."""
-    matches = [k for k, f in enumerate(model.frames) if f.name == name]
-    if not matches:
-        return None
-    if len(matches) > 1:
-        for t in prefer:
-            for k in matches:
-                if model.frames[k].type == t:
-                    return k
-    return matches[0]
-
-
-def _frame_bodies(model) -> dict:
-    """Frame name -> the Pinocchio joint carrying it (of the preferred frame when several share the name)."""
-    rank = {t: k for k, t in enumerate(FRAME_PREFERENCE)}
-    best = {}
-    for f in model.frames:
-        r = rank.get(f.type, len(rank))
-        if f.name not in best or r < best[f.name][0]:
-            best[f.name] = (r, f.parentJoint)
-    return {name: joint for name, (_, joint) in best.items()}
-
-
-#: Most warnings printed for one file (the rest are counted).
-MAX_WARNINGS = 20
-
-
-def _check_cut_bodies(model, spec) -> None:
-    """Refuse a cut joint whose two frames are on the same rigid body (fixed together):
-    it closes no loop."""
-    for c in spec.cut_joints:
-        f1, f2 = frame_id(model, c.frame1), frame_id(model, c.frame2)
-        if f1 is None or f2 is None:
-            continue  # reported when the cut is bound
-        if model.frames[f1].parentJoint == model.frames[f2].parentJoint:
-            yaml = c.source == "yaml" and spec.yaml_path
-            what = "closed_loop pair" if yaml else f"loop joint {quote(c.name)}"
-            raise MechanismFileError(spec.yaml_path if yaml else spec.path,
-                                     f"{what} connects {quote(c.frame1)} and {quote(c.frame2)}, which are fixed "
-                                     "together (on the same body): it closes no loop")
-
-
-def _axis_letters(t: str):
-    unit = {"X": (1.0, 0, 0), "Y": (0, 1.0, 0), "Z": (0, 0, 1.0)}
-    letters = t.split("_", 1)[1] if "_" in t else "XY"
-    if len(letters) != 2 or any(c not in unit for c in letters):
-        letters = "XY"
-    return np.array(unit[letters[0]]), np.array(unit[letters[1]])
-
-
-_UNBOUNDED = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
-              "JointModelRUBZ": pin.JointModelRZ}
-
-
-def _revolute_for(jm):
-    """The one-coordinate revolute joint model about the axis of an unbounded (continuous)
-    revolute joint model, or None for other joint models."""
-    short = jm.shortname()
-    if short in _UNBOUNDED:
-        return _UNBOUNDED[short]()
-    if short == "JointModelRevoluteUnboundedUnaligned":  # its axis: the angular part of its motion subspace
-        jd = jm.createData()
-        jm.calc(jd, np.array([1.0, 0.0]))
-        return pin.JointModelRevoluteUnaligned(np.asarray(jd.S, float).ravel()[3:6].copy())
-    return None
-
-
-def _order(model, first=()):
-    """The model's joints in a depth-first order with, among siblings, the subtrees that hold a
-    joint of ``first`` before the others: Pinocchio needs a mimicked joint before its mimics."""
-    children = {j: [] for j in range(model.njoints)}
-    for j in range(1, model.njoints):
-        children[model.parents[j]].append(j)
-    first = set(first)
-    holds = {j: model.names[j] in first for j in range(model.njoints)}
-    for j in range(model.njoints - 1, 0, -1):  # children come after their parents in Pinocchio's order
-        if holds[j]:
-            holds[model.parents[j]] = True
-    order, stack = [], [0]
-    while stack:
-        j = stack.pop()
-        if j:
-            order.append(j)
-        kids = sorted(children[j], key=lambda c: (not holds[c], c))
-        stack.extend(reversed(kids))
-    return order
-
-
-def _rebuild(model, replacements=(), first=()):
-    """The model with continuous joints as revolute joints without limits (one coordinate, the
-    angle, which counts turns: Pinocchio's (cos, sin) pair cannot, and a gear train or a lead
-    screw turned twice must move twice as far), the sidecar's joint replacements (SPHERICAL,
-    UJOINT_ab / CARDAN_ab as a native universal joint, FIXED as locked), and the joints named in
-    ``first`` (mimicked ones) ordered before their mimics.  The limits of the other
-    one-coordinate joints are kept."""
-    rep = dict(replacements)
-    order = _order(model, first)
-    if not rep and order == list(range(1, model.njoints)) and not any(
-            _revolute_for(model.joints[j]) is not None for j in range(1, model.njoints)):
-        return model
-    new = pin.Model()
-    new.name = model.name
-    locked = []
-    inf = np.inf
-    for jid in order:
-        name = model.names[jid]
-        parent = new.getJointId(model.names[model.parents[jid]]) if model.parents[jid] else 0
-        jm = model.joints[jid]
-        t = rep.get(name)
-        lo = hi = None
-        if t == "SPHERICAL":
-            jm = pin.JointModelSpherical()
-        elif t and t.startswith(("UJOINT", "CARDAN")):
-            a1, a2 = _axis_letters(t)
-            jm = pin.JointModelUniversal(a1, a2)
-        elif _revolute_for(jm) is not None:
-            jm, lo, hi = _revolute_for(jm), -inf, inf
-        elif model.nqs[jid] == 1:
-            lo, hi = model.lowerPositionLimit[model.idx_qs[jid]], model.upperPositionLimit[model.idx_qs[jid]]
-        if lo is not None:
-            i = model.idx_vs[jid]
-            nid = new.addJoint(parent, jm, model.jointPlacements[jid], name, model.effortLimit[i:i + 1],
-                               model.velocityLimit[i:i + 1], np.array([lo]), np.array([hi]))
-        else:
-            nid = new.addJoint(parent, jm, model.jointPlacements[jid], name)
-        new.appendBodyToJoint(nid, model.inertias[jid], pin.SE3.Identity())
-        if t == "FIXED":
-            locked.append(nid)
-    for f in list(model.frames)[1:]:
-        parent = new.getJointId(model.names[f.parentJoint]) if f.parentJoint else 0
-        new.addFrame(pin.Frame(f.name, parent, f.parentFrame, f.placement, f.type), False)
-    if locked:
-        new = pin.buildReducedModel(new, locked, pin.neutral(new))
-    return new
-
-
-def _couple(model, couplings, path):
-    """The model with each coupled joint turned into a Pinocchio mimic joint (no coordinate of
-    its own; its motion is m times its primary's plus o)."""
-    for c in couplings:
-        if not (model.existJointName(c.joint) and model.existJointName(c.mimics)):
-            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}, which the model "
-                                           "does not have as a moving joint (a sidecar replaced it?)")
-        a, b = model.getJointId(c.mimics), model.getJointId(c.joint)
-        if a > b:  # the primary lies below its mimic in the tree: no order puts it first
-            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}, a joint further from "
-                                           "the ground on its own branch: Pinocchio cannot couple them that way round")
-        if model.nvs[a] != 1 or model.nvs[b] != 1:
-            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}: both must be "
-                                           "one-coordinate joints in the model")
-        try:
-            model = pin.transformJointIntoMimic(model, a, b, c.multiplier, c.offset)
-        except (ValueError, RuntimeError) as exc:
-            raise MechanismFileError(path, f"Pinocchio cannot make joint {quote(c.joint)} mimic "
-                                           f"{quote(c.mimics)}: {shorten(str(exc).splitlines()[-1], 100)}") from None
-    return model
 
 
 def link_lengths(model, cuts) -> list:
@@ -272,10 +77,10 @@ class Mechanism:
     Attributes
     ----------
     path:       the file it was read from.
-    spec:       the :class:`~screwkin.description.MechanismSpec` read from the file.
+    spec:       the :class:`~screwkin.files.description.MechanismSpec` read from the file.
     model:      ``pinocchio.Model`` of the spanning tree (with frames F1, F2 of every cut joint).
-    cuts:       list of :class:`~screwkin.closure.CutJoint`.
-    closure:    the :class:`~screwkin.closure.ClosureSystem` r(q) = 0.
+    cuts:       list of :class:`~screwkin.model.closure.CutJoint`.
+    closure:    the :class:`~screwkin.model.closure.ClosureSystem` r(q) = 0.
     coordinates: list of :class:`Coordinate`, one per tree joint with coordinates.
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """
@@ -308,6 +113,8 @@ class Mechanism:
         self._limits = None
         self._generic = None
         self._length = None
+        self._layout = None
+        self.cache = {}  # results analyses derive from this mechanism (cleared when actuation or length change)
         self._rule_length = characteristic_length(model, self.cuts)
         self._translational = self._translational_coordinates()
 
@@ -348,6 +155,8 @@ class Mechanism:
             raise UsageError(f"{self.path}: an actuated joint is named twice: {', '.join(names)}")
         self.actuated = names
         self.actuation_source = source
+        if hasattr(self, "cache"):
+            self.cache.clear()
 
     # ------------------------------------------------------------------ coordinates
     @property
@@ -381,7 +190,7 @@ class Mechanism:
     def _value_layout(self):
         """(1-coordinate joints (name, q index, wrap), continuous joints (name, q index), the
         coordinates of multi-DOF joints (name, q index), order of the names)."""
-        if getattr(self, "_layout", None) is None:
+        if self._layout is None:
             single, continuous, multi, order = [], [], [], []
             for c in self.coordinates:
                 short = self.model.joints[c.joint_id].shortname()
@@ -488,6 +297,7 @@ class Mechanism:
         if value is not None and not (np.isfinite(value) and value > 0):
             raise UsageError(f"{self.path}: the characteristic length must be a positive length, got {value!r}")
         self._length = None if value is None else float(value)
+        self.cache.clear()
 
     @property
     def length_rule(self) -> str:
@@ -669,111 +479,12 @@ class Mechanism:
         return self._generic[2:]
 
     def topology(self, q=None):
-        """The :class:`~screwkin.topology.Topology` (links, joints, compound joints, loops)."""
-        from .topology import build_topology
-
-        return build_topology(self, self.assemble().q if q is None else q)
-
-    def mobility(self, actuated=None, output=None, seed: int = 0, point: bool = False):
-        """Mobility analysis; returns a :class:`~screwkin.mobility.MobilityResult`.
-        point: analyse the output link's origin as a point (its 3 translations)."""
-        from .mobility import analyze_mobility
-
-        if actuated is not None:
-            self.set_actuated(actuated)
-        return analyze_mobility(self, output=output, seed=seed, point=point)
+        """The :class:`~screwkin.model.topology.Topology` (links, joints, compound joints, loops)
+        at q (default: a generic assembled configuration)."""
+        return build_topology(self, self.generic_configurations()[1][0] if q is None else q)
 
     def __repr__(self):
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "
                 f"{len(self.coordinates)} moving tree joints, {len(self.cuts)} cut joints)")
 
 
-@contextmanager
-def _native_stderr(box: list):
-    """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError):  # no usable stderr: nothing to keep quiet
-        yield
-        return
-    with tempfile.TemporaryFile() as tmp:
-        os.dup2(tmp.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            tmp.seek(0)
-            box.append(tmp.read(1 << 20).decode("utf-8", "replace"))  # the first MB says what went wrong
-
-
-def _urdfdom_messages(box: list) -> list:
-    """(level, message) of console_bridge lines such as 'Error:   Joint [j] is ...' (the
-    'at line N in file.cpp' lines that follow them are dropped)."""
-    out = []
-    for line in "".join(box).splitlines():
-        level, sep, message = line.partition(":")
-        if sep and level.strip() in ("Error", "Warning", "Info", "Debug") and message.strip():
-            out.append((level.strip(), message.strip()))
-    return out
-
-
-def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None) -> Mechanism:
-    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, or SDF).
-
-    yaml:      path of an Extended-URDF sidecar; default: ``<file>.yaml`` when it exists.
-    actuated:  actuated joint names, overriding the file's declaration.
-    warn:      callable receiving each warning (default: print to stderr).
-    package_dirs: folders searched first for ``package://`` meshes (as ``ROS_PACKAGE_PATH``).
-
-    The file is untrusted: see :mod:`screwkin.xmlsafe` and
-    :class:`~screwkin.description.Limits` for what is refused before Pinocchio reads it.
-    """
-    path = Path(path)
-    text = _read_text(path)
-    root = parse_xml_text(text, path)  # the root element decides the format, not the suffix
-    package_dirs = [str(d) for d in package_dirs or ()]
-    for d in package_dirs:
-        if not os.path.isdir(d):
-            raise UsageError(f"package folder {quote(d)} (--package-dir) is not a folder")
-    if root.tag == "sdf":
-        from .sdf import read_sdf
-
-        spec = read_sdf(path, text, root=root, package_dirs=package_dirs)
-    elif root.tag == "robot" or path.suffix.lower() != ".sdf":
-        spec = read_urdf(path, text, root=root, package_dirs=package_dirs)
-    else:
-        raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>, "
-                                       "expected <sdf>")
-    spec.package_dirs = package_dirs
-    native = []  # what urdfdom (inside Pinocchio) prints on the process's stderr: kept out of the output
-    try:
-        with _native_stderr(native):
-            model = pin.buildModelFromXML(spec.urdf_text)
-    except (ValueError, RuntimeError) as exc:
-        first = str(exc).strip().splitlines()[-1].strip() if str(exc).strip() else type(exc).__name__
-        reasons = [m for level, m in _urdfdom_messages(native) if level == "Error"]
-        if reasons:  # urdfdom's first complaint says more than Pinocchio's summary
-            first = reasons[0]
-        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {shorten(first, 120)}") from None
-    spec.warnings.extend(f"URDF parser: {shorten(m, 120)}" for level, m in _urdfdom_messages(native)
-                         if level != "Error")
-    if yaml is None and spec.format == "urdf":
-        yaml = _find_sidecar(path)
-    if yaml is not None:
-        read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
-    model = _rebuild(model, spec.replacements, first={c.mimics for c in spec.couplings})
-    model = _couple(model, spec.couplings, path)
-    check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
-    _check_cut_bodies(model, spec)
-    shown = spec.warnings
-    if warn is None:  # on the terminal: a bounded number of bounded lines
-        def warn(m):
-            print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
-
-        if len(shown) > MAX_WARNINGS:
-            shown = shown[:MAX_WARNINGS] + [f"and {len(spec.warnings) - MAX_WARNINGS} more warnings"]
-    for w in shown:
-        warn(w)
-    return Mechanism(spec, model, actuated=actuated, tolerances=tolerances)

@@ -4,7 +4,7 @@ Where in its joint space does a serial arm lose a direction of motion of its
 output link?  The chain's output Jacobian (twist (v, w) of the output frame
 origin, world axes, translations divided by a characteristic length L) is
 evaluated at many random configurations by the batched structure equations of
-screwkin.batch, with one of two measures:
+screwkin.analysis.batch, with one of two measures:
 
 - ``sigma_ratio``: smallest over largest singular value (1 isotropic, 0 singular),
   the measure ``screwkin singularities`` reports for serial singularities;
@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .errors import UsageError
+from ..errors import UsageError
+from .batch import SerialJacobians
 
 __all__ = ["ScanResult", "scan"]
 
@@ -53,25 +54,6 @@ class ScanResult:
             return None
         return float(np.mean(self.values < self.threshold))
 
-    def to_dict(self) -> dict:
-        k = self.worst
-        a = np.abs(self.values)
-        return {
-            "output": self.output, "joints": list(self.joints), "samples": self.samples, "seed": self.seed,
-            "measure": self.measure, "length": self.length if self.measure == "sigma_ratio" else None,
-            "point": self.point,
-            "threshold": self.threshold,
-            "min": float(self.values[k]), "min_configuration": dict(zip(self.joints, map(float, self.theta[k]))),
-            "max": float(self.values[int(np.argmax(a))]),
-            "percentiles": {p: float(np.percentile(a, float(p))) for p in ("1", "5", "50")},
-            "singular_fraction": self.singular_fraction(),
-        }
-
-    def csv(self) -> str:
-        head = ",".join(self.joints) + f",{self.measure}"
-        rows = np.column_stack([self.theta, self.values])
-        return head + "\n" + "\n".join(",".join(f"{x:.12g}" for x in row) for row in rows) + "\n"
-
 
 def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str = "sigma_ratio",
          length: float | None = None, workers: int | None = None, method: str = "svd",
@@ -83,7 +65,6 @@ def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str =
     scan them along their inputs).  length: the characteristic length [m] (default
     ``mech.length``, the same as every other command); point: the output's origin as a
     point (3 translations; sigma_ratio only)."""
-    from .batch import SerialJacobians
 
     if measure not in MEASURES:
         raise UsageError(f"unknown measure '{measure}': {' or '.join(MEASURES)}")

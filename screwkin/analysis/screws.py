@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._pin import frame_jacobian
-from .errors import UsageError
-from .mobility import null_space
+from ..errors import UsageError
+from ..model._pin import frame_jacobian
+from ..model.linalg import null_space
 
 __all__ = ["Screw", "Chain", "screw_of", "chains", "poe", "structure", "split_jacobians"]
 
@@ -36,11 +36,6 @@ class Screw:
     direction: tuple
     point: tuple | None
     pitch: float
-
-    def to_dict(self) -> dict:
-        return {"twist": list(self.twist), "direction": list(self.direction),
-                "point": list(self.point) if self.point is not None else None,
-                "pitch": self.pitch if np.isfinite(self.pitch) else "inf"}
 
 
 def screw_of(xi) -> Screw:

@@ -32,8 +32,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from .errors import AssemblyError, UsageError
-from .linalg import null_space
+from ..errors import AssemblyError, UsageError
+from ..model.linalg import null_space
 from .singular import Generic, measures, scaled_jacobians
 
 __all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities"]
@@ -46,12 +46,6 @@ class SweepSingularity:
     sigma: float  # relative smallest singular value there
     q: np.ndarray
     limit: bool = False  # a limit position: the motion along the input cannot go on past it
-
-    def to_dict(self, mech=None) -> dict:
-        d = {"kind": self.kind, "input": self.input, "sigma": self.sigma, "limit": self.limit}
-        if mech is not None:
-            d["joints"] = mech.joint_values(self.q)
-        return d
 
 
 @dataclass(frozen=True)
@@ -72,34 +66,6 @@ class SweepResult:
     circuit_closed: bool = False  # the motion came back to its starting configuration
     unit: str = "rad"  # the input's unit: "rad" or "m"
     coupled: dict | None = None  # <mimic> joint -> its values along the sweep
-
-    def to_dict(self) -> dict:
-        return {
-            "input": self.input, "input_unit": self.unit,
-            "from": self.requested[0], "to": self.requested[1], "steps": self.requested[2],
-            "completed": self.stopped_at is None,
-            "stopped_at": self.stopped_at, "stop_reason": self.stop_reason,
-            "turn": self.turn, "circuit_closed": self.circuit_closed,
-            "singularities": [s.to_dict() for s in self.limits],
-            "coordinates": list(self.names),
-            "values": self.values.tolist(),
-            "joints": self.joints.tolist(),
-            "rates": self.rates.tolist(),
-            "accelerations": self.accelerations.tolist(),
-            **({"coupled_joints": {k: v.tolist() for k, v in self.coupled.items()}} if self.coupled else {}),
-        }
-
-    def csv(self) -> str:
-        coupled = self.coupled or {}
-        head = ["step", self.input + "_input"] + list(self.names) + [f"d_{n}" for n in self.names] + [
-            f"dd_{n}" for n in self.names] + list(coupled)
-        lines = [",".join(head)]
-        for k in range(len(self.values)):
-            row = [str(k), f"{self.values[k]:.12g}"] + [f"{x:.12g}" for x in self.joints[k]]
-            row += [f"{x:.12g}" for x in self.rates[k]] + [f"{x:.12g}" for x in self.accelerations[k]]
-            row += [f"{v[k]:.12g}" for v in coupled.values()]
-            lines.append(",".join(row))
-        return "\n".join(lines) + "\n"
 
 
 class _Stuck(Exception):
@@ -242,7 +208,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         t, stopped, reason = None, start, str(exc)
     if t is not None and t[tr.ix] * direction < 0:
         t = -t
-    q, x, k = q0, float(start), 0  # k: index of the last grid value reached (x = start + k h on the grid)
+    q, x = q0, float(start)
 
     def grid_between(xa, xb):
         """Grid values strictly after xa up to xb (inclusive) in the direction of motion, within the range."""

@@ -1,10 +1,26 @@
-"""Turning results into text tables and JSON-ready dictionaries (the edge)."""
+"""Turning results into text tables, JSON-ready dictionaries and CSV (the edge).
+
+Analysis results (screwkin.analysis) are plain data; this is the one place that knows
+how they are written out, for the command line and for ``screwkin.to_dict``.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["mobility_dict", "mobility_text", "topology_dict", "topology_text", "table"]
+from ..analysis.maps import SingularityMap
+from ..analysis.mobility import MobilityResult
+from ..analysis.planar import LinkageInfo
+from ..analysis.position import PositionResult
+from ..analysis.scan import ScanResult
+from ..analysis.screws import Screw, planar_form, screw_of
+from ..analysis.singular import SingularityReport
+from ..analysis.sweep import SweepResult, SweepSingularity
+from ..model.topology import Topology
+
+__all__ = ["to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
+           "position_text", "singularity_dict", "singularity_text", "sweep_dict", "sweep_csv", "sweep_text",
+           "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable"]
 
 
 def table(headers, rows) -> str:
@@ -312,15 +328,13 @@ def sweep_text(res, info=None, mus=None) -> str:
 
 
 def screws_dict(structure, normal=None) -> list:
-    from .screws import planar_form, screw_of
-
     out = []
     for st in structure:
         ch = st["chain"]
         joints = []
         for k, name in enumerate(ch.joints):
-            d = {"joint": name, "xi0": screw_of(ch.xi0[:, k]).to_dict(), "theta": float(st["theta"][k]),
-                 "xi": screw_of(st["space_jacobian"][:, k]).to_dict()}
+            d = {"joint": name, "xi0": screw_dict(screw_of(ch.xi0[:, k])), "theta": float(st["theta"][k]),
+                 "xi": screw_dict(screw_of(st["space_jacobian"][:, k]))}
             if normal is not None:
                 d["xi0_planar"] = planar_form(ch.xi0[:, k], normal).tolist()
                 d["xi_planar"] = planar_form(st["space_jacobian"][:, k], normal).tolist()
@@ -331,8 +345,6 @@ def screws_dict(structure, normal=None) -> list:
 
 
 def screws_text(structure, normal=None) -> str:
-    from .screws import planar_form, screw_of
-
     lines = []
     for st in structure:
         ch = st["chain"]
@@ -383,7 +395,118 @@ def singularity_text(rep) -> str:
             lines.append("  joints moving: " + ", ".join(f"{n} {v:+.4g}" for n, v in t.joint_rates.items()))
         if t.screw is not None:
             s = t.screw
-            pitch = s["pitch"] if isinstance(s["pitch"], str) else f"{s['pitch']:.4g} m/rad"
-            lines.append(f"  screw: axis direction {_fmt_vec(s['direction'], 0)}, through "
-                         f"{_fmt_vec(s['point'], 0) if s['point'] is not None else '-'}, pitch {pitch}")
+            pitch = f"{s.pitch:.4g} m/rad" if np.isfinite(s.pitch) else "inf (a translation)"
+            lines.append(f"  screw: axis direction {_fmt_vec(s.direction, 0)}, through "
+                         f"{_fmt_vec(s.point, 0) if s.point is not None else '-'}, pitch {pitch}")
     return "\n".join(lines)
+
+
+# ------------------------------------------------------------------ results as dictionaries
+def screw_dict(s: Screw) -> dict:
+    return {"twist": list(s.twist), "direction": list(s.direction),
+            "point": list(s.point) if s.point is not None else None,
+            "pitch": s.pitch if np.isfinite(s.pitch) else "inf"}
+
+
+def singularity_dict(rep: SingularityReport) -> dict:
+    return {
+        "serial": rep.serial, "actuator": rep.actuator, "constraint": rep.constraint,
+        "stationary_joints": list(rep.stationary_joints), "sigma_min": rep.sigma_min,
+        "sigmas": rep.sigmas, "condition": rep.condition, "manipulability": rep.manipulability,
+        "characteristic_length": rep.length, "inputs": list(rep.inputs), "output": rep.output,
+        "point": rep.point,
+        "singular_twists": [{"kind": t.kind, "joint_rates": t.joint_rates,
+                             "twist": list(t.twist) if t.twist is not None else None,
+                             "screw": screw_dict(t.screw) if t.screw is not None else None}
+                            for t in rep.singular_twists],
+    }
+
+
+def linkage_dict(info: LinkageInfo) -> dict:
+    return {"kind": info.kind, "lengths": info.lengths, "grashof": info.grashof, "input_joint": info.input_joint,
+            "input_range": list(info.input_range) if info.input_range else None,
+            "limit_inputs": list(info.limit_inputs), "transmission_angle": info.transmission_angle}
+
+
+def sweep_singularity_dict(s: SweepSingularity, mech=None) -> dict:
+    d = {"kind": s.kind, "input": s.input, "sigma": s.sigma, "limit": s.limit}
+    if mech is not None:
+        d["joints"] = mech.joint_values(s.q)
+    return d
+
+
+def sweep_dict(res: SweepResult, mech=None) -> dict:
+    return {
+        "input": res.input, "input_unit": res.unit,
+        "from": res.requested[0], "to": res.requested[1], "steps": res.requested[2],
+        "completed": res.stopped_at is None,
+        "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
+        "turn": res.turn, "circuit_closed": res.circuit_closed,
+        "singularities": [sweep_singularity_dict(s, mech) for s in res.limits],
+        "coordinates": list(res.names),
+        "values": res.values.tolist(),
+        "joints": res.joints.tolist(),
+        "rates": res.rates.tolist(),
+        "accelerations": res.accelerations.tolist(),
+        **({"coupled_joints": {k: v.tolist() for k, v in res.coupled.items()}} if res.coupled else {}),
+    }
+
+
+def sweep_csv(res: SweepResult) -> str:
+    coupled = res.coupled or {}
+    head = ["step", res.input + "_input"] + list(res.names) + [f"d_{n}" for n in res.names] + [
+        f"dd_{n}" for n in res.names] + list(coupled)
+    lines = [",".join(head)]
+    for k in range(len(res.values)):
+        row = [str(k), f"{res.values[k]:.12g}"] + [f"{x:.12g}" for x in res.joints[k]]
+        row += [f"{x:.12g}" for x in res.rates[k]] + [f"{x:.12g}" for x in res.accelerations[k]]
+        row += [f"{v[k]:.12g}" for v in coupled.values()]
+        lines.append(",".join(row))
+    return "\n".join(lines) + "\n"
+
+
+def scan_dict(res: ScanResult) -> dict:
+    k = res.worst
+    a = np.abs(res.values)
+    return {
+        "output": res.output, "joints": list(res.joints), "samples": res.samples, "seed": res.seed,
+        "measure": res.measure, "length": res.length if res.measure == "sigma_ratio" else None,
+        "point": res.point, "threshold": res.threshold,
+        "min": float(res.values[k]), "min_configuration": dict(zip(res.joints, map(float, res.theta[k]))),
+        "max": float(res.values[int(np.argmax(a))]),
+        "percentiles": {p: float(np.percentile(a, float(p))) for p in ("1", "5", "50")},
+        "singular_fraction": res.singular_fraction(),
+    }
+
+
+def scan_csv(res: ScanResult) -> str:
+    head = ",".join(res.joints) + f",{res.measure}"
+    rows = np.column_stack([res.theta, res.values])
+    return head + "\n" + "\n".join(",".join(f"{x:.12g}" for x in row) for row in rows) + "\n"
+
+
+def map_dict(res: SingularityMap) -> dict:
+    return {"x": res.x_name, "y": res.y_name, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
+            "kind": res.kind}
+
+
+def map_csv(res: SingularityMap) -> str:
+    lines = [f"{res.x_name},{res.y_name},log10_sigma_min,kind"]
+    for j, y in enumerate(res.ys):
+        for i, x in enumerate(res.xs):
+            lines.append(f"{x:.12g},{y:.12g},{res.log_sigma[j, i]:.6g},{res.kind[j, i]}")
+    return "\n".join(lines) + "\n"
+
+
+_DICTS = {MobilityResult: mobility_dict, PositionResult: position_dict, SingularityReport: singularity_dict,
+          SweepResult: sweep_dict, SweepSingularity: sweep_singularity_dict, ScanResult: scan_dict,
+          LinkageInfo: linkage_dict, Screw: screw_dict, SingularityMap: map_dict, Topology: topology_dict}
+
+
+def to_dict(result) -> dict:
+    """What ``--json`` prints for a result of screwkin's analyses, as plain Python (numbers,
+    strings, lists, dictionaries; None for numbers that are not finite)."""
+    for cls, fn in _DICTS.items():
+        if isinstance(result, cls):
+            return to_jsonable(fn(result))
+    raise TypeError(f"no dictionary form for {type(result).__name__}")

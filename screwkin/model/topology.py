@@ -16,10 +16,14 @@ space (planar, spherical, spatial) is detected from the axes, not declared.
 
 from __future__ import annotations
 
+import os.path
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+
+from ..files.sidecar import axis_letters
+from ._pin import frame_id
 
 __all__ = ["Joint", "Topology", "build_topology"]
 
@@ -151,7 +155,6 @@ def _frame_link(mech, frame_name: str) -> str:
     for j in spec.joints:
         if j.name == frame_name:
             return j.child
-    from .mechanism import frame_id
 
     model = mech.model
     fid = frame_id(model, frame_name)
@@ -203,9 +206,7 @@ def _edges(mech, q):
             if t in ("revolute", "continuous", "prismatic", "planar"):
                 direction = M.rotation @ np.asarray(j.axis)
             elif t == "universal":  # a native universal joint from a sidecar replacement
-                from .mechanism import _axis_letters
-
-                a1, a2 = _axis_letters(rep)
+                a1, a2 = axis_letters(rep)
                 base = data.oMi[model.parents[jid]] * model.jointPlacements[jid]
                 direction, direction2 = base.rotation @ a1, M.rotation @ a2
         dof = {"spherical": 3, "universal": 2}.get(t, j.dof)
@@ -259,7 +260,6 @@ def _common_point(points, directions):
 
 def _compound_name(members, kind) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
-    import os.path
 
     prefix = os.path.commonprefix(members)
     for tail in ("_rev", "rev", "_"):

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from .errors import UsageError
+from ..errors import UsageError
 
 __all__ = ["LinkageInfo", "identify", "LinkAngles", "plane_basis"]
 
@@ -38,12 +38,6 @@ class LinkageInfo:
     input_range: tuple | None  # (low, high) joint values; None: the input turns fully
     limit_inputs: tuple  # input joint values where the output is at a limit position
     transmission_angle: float  # mu [rad] at the configuration analysed
-
-    def to_dict(self) -> dict:
-        return {"kind": self.kind, "lengths": self.lengths, "grashof": self.grashof,
-                "input_joint": self.input_joint,
-                "input_range": list(self.input_range) if self.input_range else None,
-                "limit_inputs": list(self.limit_inputs), "transmission_angle": self.transmission_angle}
 
 
 def _rot(v, ang):

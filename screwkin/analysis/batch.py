@@ -17,11 +17,14 @@ The measures (singular values, determinants) are one numpy call on the whole sta
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pinocchio as pin
 
-from ._pin import compute_frame_jacobian
-from .errors import UsageError
+from ..errors import UsageError
+from ..model._pin import compute_frame_jacobian
+from .screws import chains
 
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
            "singular_value_ratios", "determinants"]
@@ -54,7 +57,6 @@ class SerialJacobians:
 
     def __init__(self, mech, link: str, reference=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
                  check: int = 4):
-        from .screws import chains
 
         if reference not in _REFERENCES:
             raise UsageError(f"unknown reference frame {reference}")
@@ -237,8 +239,6 @@ class SerialJacobians:
 
         starts = range(0, len(Q), self.block)
         if workers > 1 and len(starts) > 1:
-            from concurrent.futures import ThreadPoolExecutor
-
             with ThreadPoolExecutor(workers) as pool:
                 list(pool.map(run, starts))
         else:

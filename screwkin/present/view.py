@@ -12,9 +12,13 @@ server of :class:`ViewerServer`, or a recording stand-in in tests.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import re
 import subprocess
 import sys
+import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,10 +26,10 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .errors import MechanismFileError, UsageError, quote, shorten
-from .mechanism import frame_id
-from .urdf import find_mesh
-from .xmlsafe import parse_xml_text
+from ..errors import MechanismFileError, UsageError, quote, shorten
+from ..files.meshes import find_mesh
+from ..files.xmlsafe import parse_xml_text
+from ..model._pin import frame_id
 
 __all__ = ["COLORS", "build_scene", "show", "view", "ViewerServer", "RecordingViewer", "screenshot"]
 
@@ -142,7 +146,6 @@ class Scene:
 def _visual_geometry(mech, warn=None):
     """Pinocchio's visual GeometryModel of the links; a mesh file that exists but cannot be
     read (not a mesh, truncated) is a warning and its link is drawn as a stand-in."""
-    import re
 
     warn = warn or (lambda m: print(f"warning: {shorten(str(mech.path), 200)}: {m}", file=sys.stderr))
     unreadable = set()
@@ -240,9 +243,9 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
         if output is not None:
             add(_ball(f"screwkin/singular/{k}/marker", 0, 0, d.oMf[mech.link_frame(output)].translation, 4 * r_axis,
                       COLORS["marker"]), "singular:marker")
-        if twist is not None and twist.screw is not None and twist.screw.get("point") is not None:
+        if twist is not None and twist.screw is not None and twist.screw.point is not None:
             s = twist.screw
-            p, u = np.asarray(s["point"]), np.asarray(s["direction"])
+            p, u = np.asarray(s.point), np.asarray(s.direction)
             add(_segment(f"screwkin/singular/{k}/axis", 0, 0, p - 3 * L_axis * u, p + 3 * L_axis * u, r_axis,
                          COLORS["screw"]), "singular:axis")
             cone = pin.GeometryObject(f"screwkin/singular/{k}/arrow", 0, 0, pin.SE3(
@@ -322,11 +325,11 @@ def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
 
 
 class ViewerServer:
-    """A meshcat server on 127.0.0.1 in a subprocess (see screwkin.viewserver)."""
+    """A meshcat server on 127.0.0.1 in a subprocess (see screwkin.present.viewserver)."""
 
     def __init__(self):
         env = dict(os.environ)
-        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "screwkin.viewserver"], stdout=subprocess.PIPE,
+        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "screwkin.present.viewserver"], stdout=subprocess.PIPE,
                                      stderr=subprocess.PIPE, env=env, start_new_session=True, text=True)
         info = {}
         while len(info) < 2:
@@ -336,8 +339,6 @@ class ViewerServer:
             key, _, value = line.strip().partition("=")
             info[key] = value
         self.zmq_url, self.web_url = info["zmq_url"], info["web_url"]
-        import contextlib
-        import io
 
         import meshcat
 
@@ -372,7 +373,6 @@ def screenshot(html_path, png_path, size=(900, 700), budget_ms=8000):
     exe = chromium()
     if exe is None:
         raise UsageError("--png needs Chromium (Debian: apt-get install chromium)")
-    import tempfile
 
     with tempfile.TemporaryDirectory() as profile:
         cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",

@@ -22,3 +22,25 @@ def frame_jacobian(model, data, frame: int, reference):
 def compute_frame_jacobian(model, data, q, frame: int, reference):
     """pinocchio.computeFrameJacobian as a (6, nv) matrix."""
     return pin.computeFrameJacobian(model, data, q, frame, reference).reshape(6, model.nv)
+
+
+#: Frame types in the order a bare name is taken when several frames share it (a URDF
+#: may name a joint like a link: Pinocchio then has a JOINT and a BODY frame of that name).
+FRAME_PREFERENCE = (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.OP_FRAME,
+                    pin.FrameType.SENSOR)
+
+
+def frame_id(model, name: str, prefer=FRAME_PREFERENCE):
+    """Id of the frame named ``name`` (None when there is none).  When several frames
+    share the name, the first of the types in ``prefer`` wins -- by default the BODY
+    frame (the link), where ``model.getFrameId(name)`` raises "Several frames match"."""
+    matches = [k for k, f in enumerate(model.frames) if f.name == name]
+    if not matches:
+        return None
+    if len(matches) > 1:
+        for t in prefer:
+            for k in matches:
+                if model.frames[k].type == t:
+                    return k
+    return matches[0]
+

@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 __all__ = [
     "TREE_JOINT_DOF",
@@ -114,7 +115,6 @@ def data_bytes(nv: int) -> float:
 
 def placement(xyz, rpy):
     """The pinocchio.SE3 of a URDF ``<origin xyz rpy>``."""
-    import pinocchio as pin
 
     return pin.SE3(pin.rpy.rpyToMatrix(np.asarray(rpy, float)), np.asarray(xyz, float))
 

@@ -16,10 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ._pin import frame_jacobian
-from .errors import AssemblyError
-from .linalg import null_space, rank
-from .topology import Topology
+from ..model._pin import frame_jacobian
+from ..model.linalg import null_space, rank
+from ..model.topology import Topology
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
 
@@ -96,11 +95,6 @@ class MobilityResult:
     @property
     def motion_space(self) -> str:
         return self.topology.motion_space
-
-    def to_dict(self) -> dict:
-        from .report import mobility_dict
-
-        return mobility_dict(self)
 
 
 def _body_frames(mech, topo):
@@ -278,7 +272,14 @@ def _classify(n, m, eff, overconstraint, topo, M):
 
 def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
-    its origin as a point (3 translations) instead of its full motion."""
+    its origin as a point (3 translations) instead of its full motion.  Kept in ``mech.cache``."""
+    key = ("mobility", tuple(mech.actuated), output, seed, point)
+    if key not in mech.cache:
+        mech.cache[key] = _analyze(mech, output, seed, point)
+    return mech.cache[key]
+
+
+def _analyze(mech, output, seed, point) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)

@@ -22,9 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ..errors import AssemblyError
+from ..tolerances import DEFAULT, Tolerances
+from . import compiled
 from ._pin import frame_jacobian
-from .errors import AssemblyError
-from .tolerances import DEFAULT, Tolerances
 
 __all__ = ["CutJoint", "ClosureSystem", "Assembly", "perpendicular_basis"]
 
@@ -186,9 +187,8 @@ class ClosureSystem:
 
     # ------------------------------------------------------------------ compiled inner loop
     def accelerate(self, on: bool = True) -> bool:
-        """Solve with the compiled kernels of screwkin.compiled (numba) when it is installed
+        """Solve with the compiled kernels of screwkin.model.compiled (numba) when it is installed
         and every cut joint is fixed or spherical; returns whether they are in use."""
-        from . import compiled
 
         self._compiled = None
         kinds = compiled.kinds_of(self.cuts) if on else None

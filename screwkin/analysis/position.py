@@ -32,10 +32,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pinocchio as pin
 
-from ._pin import frame_jacobian
-from .closure import Assembly
-from .errors import AssemblyError, UsageError
-from .linalg import null_space, rank
+from ..errors import AssemblyError, UsageError
+from ..model._pin import frame_jacobian
+from ..model.closure import Assembly, ClosureSystem, CutJoint
+from ..model.linalg import null_space, rank
+from .mobility import analyze_mobility
+from .planar import LinkAngles
 from .singular import Generic, measures, scaled_jacobians
 
 __all__ = ["Solution", "PositionResult", "PositionSolver", "TraceStep", "inverse_kinematics", "outside_limits"]
@@ -63,7 +65,7 @@ class Solution:
     residual: closure residual norm [m, rad]; iterations: Newton iterations;
     singular: the passive joints are not determined to first order (a double
               root, e.g. a limit position; or a constraint singularity): the
-              actuator or constraint measure of screwkin.singular.measures is
+              actuator or constraint measure of screwkin.analysis.singular.measures is
               below the singular tolerance;
     sigma_min: the smaller of those two measures (relative singular values);
     output_pose: 4x4 world pose of the output link, or None;
@@ -74,7 +76,7 @@ class Solution:
     labels:   why this mode is not one the mechanism reaches by moving from its
               reference configuration (empty: it is), each "what: names";
     continuum: the inputs leave a finite motion here (solutions joined by it were merged);
-    link_angles: planar mechanisms: link name -> absolute angle [rad] (screwkin.planar.LinkAngles).
+    link_angles: planar mechanisms: link name -> absolute angle [rad] (screwkin.analysis.planar.LinkAngles).
     """
 
     q: np.ndarray = field(repr=False)
@@ -95,7 +97,7 @@ class Solution:
     continuum: bool = False
     merged: int = 1  # how many distinct solver results this solution stands for
     link_angles: dict | None = None
-    sigmas: dict | None = None  # screwkin.singular.measures at this configuration
+    sigmas: dict | None = None  # screwkin.analysis.singular.measures at this configuration
     coupled: dict | None = None  # <mimic> joints' values [rad or m] (they have no coordinate)
 
     @property
@@ -130,11 +132,6 @@ class PositionResult:
         """The solutions without labels (the modes the mechanism reaches by moving)."""
         return tuple(s for s in self.solutions if s.physical)
 
-    def to_dict(self) -> dict:
-        from .report import position_dict
-
-        return position_dict(self)
-
 
 def outside_limits(mech, q) -> tuple:
     """Joints whose value lies outside the position limits of the file."""
@@ -157,7 +154,7 @@ class PositionSolver:
 
     def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None):
         """compiled: True to solve the closure equations with the compiled kernels of
-        screwkin.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
+        screwkin.model.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
         joints are all fixed or spherical, False for numpy, None to leave the mechanism's
         setting; ``self.compiled`` says which is used."""
         self.mech = mech
@@ -194,7 +191,7 @@ class PositionSolver:
 
     # --------------------------------------------------------------- generic data
     def generic(self, hint=None) -> Generic:
-        """Generic ranks for these inputs and output (screwkin.singular.Generic) over the
+        """Generic ranks for these inputs and output (screwkin.analysis.singular.Generic) over the
         mechanism's generic configurations; ``hint``: an assembled configuration to start
         from when the mechanism's own assembly search has not been made."""
         if self._generic is None:
@@ -232,7 +229,7 @@ class PositionSolver:
 
     def _mobility(self):
         self.generic()  # the assembly the mobility analysis starts from
-        return self.mech.mobility()
+        return analyze_mobility(self.mech)
 
     # --------------------------------------------------------------- coordinates
     def angular_names(self) -> tuple:
@@ -541,8 +538,6 @@ class PositionSolver:
 
     def _link_angles(self, q):
         if self._angles is False:
-            from .planar import LinkAngles
-
             self._angles = None
             ref = self._reference()
             if ref is not None:
@@ -630,8 +625,6 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     AssemblyError (saying how close it got) when the pose is unreachable.
     Solutions are labelled and ordered as those of PositionSolver.solve.
     """
-    from .closure import ClosureSystem, CutJoint
-
     model = mech.model
     out_frame = mech.link_frame(output)
     fid = mech.target_frame  # created with the model: adding frames later would outgrow existing Data

@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._pin import frame_jacobian
-from .linalg import null_space, rank
+from ..model._pin import frame_jacobian
+from ..model.linalg import null_space, rank
 from .screws import screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
@@ -46,7 +46,7 @@ class SingularTwist:
     kind: str  # "actuator" | "serial" | "constraint"
     joint_rates: dict  # joint name -> rate of the motion (unit norm)
     twist: tuple | None  # output twist (v, w) of that motion, or the lost direction
-    screw: dict | None
+    screw: object | None  # screwkin.analysis.screws.Screw of the twist
 
 
 @dataclass(frozen=True)
@@ -64,18 +64,6 @@ class SingularityReport:
     inputs: tuple
     output: str | None
     point: bool = False  # the output link's origin analysed as a point
-
-    def to_dict(self) -> dict:
-        return {
-            "serial": self.serial, "actuator": self.actuator, "constraint": self.constraint,
-            "stationary_joints": list(self.stationary_joints), "sigma_min": self.sigma_min,
-            "sigmas": self.sigmas, "condition": self.condition, "manipulability": self.manipulability,
-            "characteristic_length": self.length, "inputs": list(self.inputs), "output": self.output,
-            "point": self.point,
-            "singular_twists": [{"kind": t.kind, "joint_rates": t.joint_rates,
-                                 "twist": list(t.twist) if t.twist is not None else None, "screw": t.screw}
-                                for t in self.singular_twists],
-        }
 
 
 def _rel(s, k):
@@ -225,7 +213,7 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
             lost[:len(U)] = U[:, g.out_dim - 1]
             lost[:3] *= L
             lost[:3] -= np.cross(lost[3:], origin)
-            twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost).to_dict()))
+            twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost)))
     elif S.K.size and g.rank_Kp:
         s = np.linalg.svd(S.K[:, g.p], compute_uv=False)[:g.rank_Kp]
         cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
@@ -242,4 +230,4 @@ def _motion_twist(kind, x, names, J):
     if J is None:
         return SingularTwist(kind, rates, None, None)
     t = J @ x
-    return SingularTwist(kind, rates, tuple(t), screw_of(t).to_dict() if np.linalg.norm(t) > 1e-12 else None)
+    return SingularTwist(kind, rates, tuple(t), screw_of(t) if np.linalg.norm(t) > 1e-12 else None)

@@ -1,0 +1,284 @@
+"""Loading a mechanism file into a :class:`~screwkin.model.mechanism.Mechanism`.
+
+The file becomes a description (screwkin.files); Pinocchio's URDF parser builds the
+model of the spanning tree from its URDF text; the model is rebuilt once where
+screwkin needs it otherwise (continuous joints as revolute joints without limits,
+the sidecar's joint replacements, mimicked joints before their mimics) and the
+<mimic> couplings are made Pinocchio mimic joints; the cut joints are bound to it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import MechanismFileError, UsageError, quote, shorten
+from ..files.description import LIMITS
+from ..files.sdf import read_sdf
+from ..files.sidecar import axis_letters, read_yaml_sidecar
+from ..files.urdf import check_sizes, read_urdf
+from ..files.xmlsafe import parse_xml_text, read_regular_file
+from ..tolerances import DEFAULT, Tolerances
+from ._pin import FRAME_PREFERENCE, frame_id
+from .mechanism import Mechanism
+
+__all__ = ["load"]
+
+
+def _read_text(path: Path) -> str:
+    """The text of a mechanism file: a regular file of at most ``LIMITS.file_bytes``, in UTF-8."""
+    raw = read_regular_file(path, LIMITS.file_bytes, "mechanism file")
+    if not raw.strip():
+        raise MechanismFileError(path, "the file is empty")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise MechanismFileError(path, "not a text file (not UTF-8)") from None
+
+
+def _find_sidecar(path: Path):
+    """``FILE.yaml`` or ``FILE.yml`` beside the file, if there is one (whatever it is:
+    a pipe or a directory of that name is then refused when read, not skipped)."""
+    for suffix in (".yaml", ".yml"):
+        cand = path.with_suffix(suffix)
+        try:
+            if cand.exists():
+                return cand
+        except (OSError, ValueError):
+            continue
+    return None
+
+
+def _frame_bodies(model) -> dict:
+    """Frame name -> the Pinocchio joint carrying it (of the preferred frame when several share the name)."""
+    rank = {t: k for k, t in enumerate(FRAME_PREFERENCE)}
+    best = {}
+    for f in model.frames:
+        r = rank.get(f.type, len(rank))
+        if f.name not in best or r < best[f.name][0]:
+            best[f.name] = (r, f.parentJoint)
+    return {name: joint for name, (_, joint) in best.items()}
+
+
+#: Most warnings printed for one file (the rest are counted).
+MAX_WARNINGS = 20
+
+
+def _check_cut_bodies(model, spec) -> None:
+    """Refuse a cut joint whose two frames are on the same rigid body (fixed together):
+    it closes no loop."""
+    for c in spec.cut_joints:
+        f1, f2 = frame_id(model, c.frame1), frame_id(model, c.frame2)
+        if f1 is None or f2 is None:
+            continue  # reported when the cut is bound
+        if model.frames[f1].parentJoint == model.frames[f2].parentJoint:
+            yaml = c.source == "yaml" and spec.yaml_path
+            what = "closed_loop pair" if yaml else f"loop joint {quote(c.name)}"
+            raise MechanismFileError(spec.yaml_path if yaml else spec.path,
+                                     f"{what} connects {quote(c.frame1)} and {quote(c.frame2)}, which are fixed "
+                                     "together (on the same body): it closes no loop")
+
+
+_UNBOUNDED = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointModelRY,
+              "JointModelRUBZ": pin.JointModelRZ}
+
+
+def _revolute_for(jm):
+    """The one-coordinate revolute joint model about the axis of an unbounded (continuous)
+    revolute joint model, or None for other joint models."""
+    short = jm.shortname()
+    if short in _UNBOUNDED:
+        return _UNBOUNDED[short]()
+    if short == "JointModelRevoluteUnboundedUnaligned":  # its axis: the angular part of its motion subspace
+        jd = jm.createData()
+        jm.calc(jd, np.array([1.0, 0.0]))
+        return pin.JointModelRevoluteUnaligned(np.asarray(jd.S, float).ravel()[3:6].copy())
+    return None
+
+
+def _order(model, first=()):
+    """The model's joints in a depth-first order with, among siblings, the subtrees that hold a
+    joint of ``first`` before the others: Pinocchio needs a mimicked joint before its mimics."""
+    children = {j: [] for j in range(model.njoints)}
+    for j in range(1, model.njoints):
+        children[model.parents[j]].append(j)
+    first = set(first)
+    holds = {j: model.names[j] in first for j in range(model.njoints)}
+    for j in range(model.njoints - 1, 0, -1):  # children come after their parents in Pinocchio's order
+        if holds[j]:
+            holds[model.parents[j]] = True
+    order, stack = [], [0]
+    while stack:
+        j = stack.pop()
+        if j:
+            order.append(j)
+        kids = sorted(children[j], key=lambda c: (not holds[c], c))
+        stack.extend(reversed(kids))
+    return order
+
+
+def _rebuild(model, replacements=(), first=()):
+    """The model with continuous joints as revolute joints without limits (one coordinate, the
+    angle, which counts turns: Pinocchio's (cos, sin) pair cannot, and a gear train or a lead
+    screw turned twice must move twice as far), the sidecar's joint replacements (SPHERICAL,
+    UJOINT_ab / CARDAN_ab as a native universal joint, FIXED as locked), and the joints named in
+    ``first`` (mimicked ones) ordered before their mimics.  The limits of the other
+    one-coordinate joints are kept."""
+    rep = dict(replacements)
+    order = _order(model, first)
+    if not rep and order == list(range(1, model.njoints)) and not any(
+            _revolute_for(model.joints[j]) is not None for j in range(1, model.njoints)):
+        return model
+    new = pin.Model()
+    new.name = model.name
+    locked = []
+    inf = np.inf
+    for jid in order:
+        name = model.names[jid]
+        parent = new.getJointId(model.names[model.parents[jid]]) if model.parents[jid] else 0
+        jm = model.joints[jid]
+        t = rep.get(name)
+        lo = hi = None
+        if t == "SPHERICAL":
+            jm = pin.JointModelSpherical()
+        elif t and t.startswith(("UJOINT", "CARDAN")):
+            a1, a2 = axis_letters(t)
+            jm = pin.JointModelUniversal(a1, a2)
+        elif _revolute_for(jm) is not None:
+            jm, lo, hi = _revolute_for(jm), -inf, inf
+        elif model.nqs[jid] == 1:
+            lo, hi = model.lowerPositionLimit[model.idx_qs[jid]], model.upperPositionLimit[model.idx_qs[jid]]
+        if lo is not None:
+            i = model.idx_vs[jid]
+            nid = new.addJoint(parent, jm, model.jointPlacements[jid], name, model.effortLimit[i:i + 1],
+                               model.velocityLimit[i:i + 1], np.array([lo]), np.array([hi]))
+        else:
+            nid = new.addJoint(parent, jm, model.jointPlacements[jid], name)
+        new.appendBodyToJoint(nid, model.inertias[jid], pin.SE3.Identity())
+        if t == "FIXED":
+            locked.append(nid)
+    for f in list(model.frames)[1:]:
+        parent = new.getJointId(model.names[f.parentJoint]) if f.parentJoint else 0
+        new.addFrame(pin.Frame(f.name, parent, f.parentFrame, f.placement, f.type), False)
+    if locked:
+        new = pin.buildReducedModel(new, locked, pin.neutral(new))
+    return new
+
+
+def _couple(model, couplings, path):
+    """The model with each coupled joint turned into a Pinocchio mimic joint (no coordinate of
+    its own; its motion is m times its primary's plus o)."""
+    for c in couplings:
+        if not (model.existJointName(c.joint) and model.existJointName(c.mimics)):
+            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}, which the model "
+                                           "does not have as a moving joint (a sidecar replaced it?)")
+        a, b = model.getJointId(c.mimics), model.getJointId(c.joint)
+        if a > b:  # the primary lies below its mimic in the tree: no order puts it first
+            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}, a joint further from "
+                                           "the ground on its own branch: Pinocchio cannot couple them that way round")
+        if model.nvs[a] != 1 or model.nvs[b] != 1:
+            raise MechanismFileError(path, f"joint {quote(c.joint)} mimics {quote(c.mimics)}: both must be "
+                                           "one-coordinate joints in the model")
+        try:
+            model = pin.transformJointIntoMimic(model, a, b, c.multiplier, c.offset)
+        except (ValueError, RuntimeError) as exc:
+            raise MechanismFileError(path, f"Pinocchio cannot make joint {quote(c.joint)} mimic "
+                                           f"{quote(c.mimics)}: {shorten(str(exc).splitlines()[-1], 100)}") from None
+    return model
+
+
+@contextmanager
+def _native_stderr(box: list):
+    """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no usable stderr: nothing to keep quiet
+        yield
+        return
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            box.append(tmp.read(1 << 20).decode("utf-8", "replace"))  # the first MB says what went wrong
+
+
+def _urdfdom_messages(box: list) -> list:
+    """(level, message) of console_bridge lines such as 'Error:   Joint [j] is ...' (the
+    'at line N in file.cpp' lines that follow them are dropped)."""
+    out = []
+    for line in "".join(box).splitlines():
+        level, sep, message = line.partition(":")
+        if sep and level.strip() in ("Error", "Warning", "Info", "Debug") and message.strip():
+            out.append((level.strip(), message.strip()))
+    return out
+
+
+def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None,
+         cls=Mechanism) -> Mechanism:
+    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, or SDF).
+
+    yaml:      path of an Extended-URDF sidecar; default: ``<file>.yaml`` when it exists.
+    actuated:  actuated joint names, overriding the file's declaration.
+    warn:      callable receiving each warning (default: print to stderr).
+    package_dirs: folders searched first for ``package://`` meshes (as ``ROS_PACKAGE_PATH``).
+
+    The file is untrusted: see :mod:`screwkin.files.xmlsafe` and
+    :class:`~screwkin.files.description.Limits` for what is refused before Pinocchio reads it.
+    """
+    path = Path(path)
+    text = _read_text(path)
+    root = parse_xml_text(text, path)  # the root element decides the format, not the suffix
+    package_dirs = [str(d) for d in package_dirs or ()]
+    for d in package_dirs:
+        if not os.path.isdir(d):
+            raise UsageError(f"package folder {quote(d)} (--package-dir) is not a folder")
+    if root.tag == "sdf":
+        spec = read_sdf(path, text, root=root, package_dirs=package_dirs)
+    elif root.tag == "robot" or path.suffix.lower() != ".sdf":
+        spec = read_urdf(path, text, root=root, package_dirs=package_dirs)
+    else:
+        raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>, "
+                                       "expected <sdf>")
+    spec.package_dirs = package_dirs
+    native = []  # what urdfdom (inside Pinocchio) prints on the process's stderr: kept out of the output
+    try:
+        with _native_stderr(native):
+            model = pin.buildModelFromXML(spec.urdf_text)
+    except (ValueError, RuntimeError) as exc:
+        first = str(exc).strip().splitlines()[-1].strip() if str(exc).strip() else type(exc).__name__
+        reasons = [m for level, m in _urdfdom_messages(native) if level == "Error"]
+        if reasons:  # urdfdom's first complaint says more than Pinocchio's summary
+            first = reasons[0]
+        raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {shorten(first, 120)}") from None
+    spec.warnings.extend(f"URDF parser: {shorten(m, 120)}" for level, m in _urdfdom_messages(native)
+                         if level != "Error")
+    if yaml is None and spec.format == "urdf":
+        yaml = _find_sidecar(path)
+    if yaml is not None:
+        read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
+    model = _rebuild(model, spec.replacements, first={c.mimics for c in spec.couplings})
+    model = _couple(model, spec.couplings, path)
+    check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
+    _check_cut_bodies(model, spec)
+    shown = spec.warnings
+    if warn is None:  # on the terminal: a bounded number of bounded lines
+        def warn(m):
+            print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
+
+        if len(shown) > MAX_WARNINGS:
+            shown = shown[:MAX_WARNINGS] + [f"and {len(spec.warnings) - MAX_WARNINGS} more warnings"]
+    for w in shown:
+        warn(w)
+    return cls(spec, model, actuated=actuated, tolerances=tolerances)
+

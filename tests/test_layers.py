@@ -1,0 +1,133 @@
+"""The package's imports run one way: files <- model <- analysis <- present <- cli (the public
+API in screwkin/__init__.py on top), with the base modules (errors, tolerances, units) under
+all of them.  An ast walk over screwkin/ finds every import, module level or not."""
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
+LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "analysis": 3, "present": 4,
+          "cli": 5, "__main__": 6, "__init__": 6}
+# third-party imports a function may make lazily: optional, or heavy and needed by one command
+# (measured cold: scipy.optimize 0.62 s, pinocchio.visualize 0.42 s; every command pays ~0.3 s in all)
+LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize"}
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports(path: Path):
+    """(imported screwkin module, line, inside a function) for every import in the file."""
+    here = module_name(path)
+    package = here if path.name == "__init__.py" else here.rsplit(".", 1)[0]
+    tree = ast.parse(path.read_text())
+    in_function = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+            in_function |= {id(n) for n in ast.walk(node) if n is not node}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[:len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            targets = [target]
+            if not node.module:  # "from . import compiled"
+                targets = [f"{target}.{a.name}" for a in node.names]
+            for t in targets:
+                yield t, node.lineno, id(node) in in_function
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                yield a.name, node.lineno, id(node) in in_function
+
+
+def layer(module: str) -> int:
+    parts = module.split(".")
+    return LAYERS["__init__"] if len(parts) == 1 else LAYERS[parts[1]]
+
+
+def graph():
+    edges = {}
+    for path in PACKAGE.rglob("*.py"):
+        name = module_name(path)
+        edges[name] = [(t, line, lazy) for t, line, lazy in imports(path)]
+    return edges
+
+
+GRAPH = graph()
+
+
+def test_every_module_has_a_layer():
+    for name in GRAPH:
+        assert name == "screwkin" or name.split(".")[1] in LAYERS, name
+
+
+def test_imports_never_go_up_a_layer():
+    bad = []
+    for name, targets in GRAPH.items():
+        for t, line, _ in targets:
+            if t == "screwkin" or t.startswith("screwkin."):
+                if layer(t) > layer(name):
+                    bad.append(f"{name}:{line} imports {t}")
+    assert not bad, "\n".join(bad)
+
+
+def find_cycle(edges):
+    """A cycle of the directed graph {node: targets} as a list of nodes, or None."""
+    state = {}
+
+    def visit(n, stack):
+        state[n] = 1
+        for m in sorted(edges.get(n, ())):
+            if state.get(m) == 1:
+                return stack[stack.index(m):] + [m]
+            if m not in state:
+                found = visit(m, stack + [m])
+                if found:
+                    return found
+        state[n] = 2
+        return None
+
+    for n in sorted(edges):
+        if n not in state:
+            found = visit(n, [n])
+            if found:
+                return found
+    return None
+
+
+def test_no_import_cycle():
+    edges = {n: {t for t, _, _ in ts if t in GRAPH} for n, ts in GRAPH.items()}
+    assert find_cycle(edges) is None, " -> ".join(find_cycle(edges))
+
+
+def test_the_cycle_finder_finds_cycles():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b", "c"}, "b": {"c"}, "c": set()}) is None
+
+
+def test_no_function_imports_a_screwkin_module_or_a_common_library():
+    bad = []
+    for name, targets in GRAPH.items():
+        for t, line, lazy in targets:
+            if lazy and t.split(".")[0] not in LAZY and t not in LAZY:
+                bad.append(f"{name}:{line} imports {t} inside a function")
+    assert not bad, "\n".join(bad)
+
+
+def test_analysis_results_do_not_format_themselves():
+    """Results are plain data: the text, JSON and CSV forms live in screwkin/present/."""
+    bad = []
+    for path in (PACKAGE / "analysis").glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ClassDef):
+                for item in node.body:
+                    if isinstance(item, ast.FunctionDef) and item.name in ("to_dict", "to_json", "csv", "png", "text"):
+                        bad.append(f"{path.name}: {node.name}.{item.name}")
+    assert not bad, bad
+
+
