@@ -116,7 +116,8 @@ def _joint_geometry_rows(mech, topo, frames, jac, q):
     or along the normal, since the point slides), and the rate of each joint
     axis fixed in that link.  A motion that keeps all of them still changes
     nothing in how the links are connected: it can only spin links about lines
-    through all their joints, the idle motions.
+    through all their joints, the idle motions.  Higher pairs and screws: the relative twist
+    of their two links (rolling, sliding along a profile or turning a screw moves the contact).
     """
     data = mech.data
     rows = []
@@ -125,6 +126,16 @@ def _joint_geometry_rows(mech, topo, frames, jac, q):
             continue
         p = np.asarray(j.point)
         d = np.asarray(j.direction) if j.direction is not None else None
+        if j.type in ("rolling", "gear", "contact", "helical"):
+            twists = []
+            for link in j.links:
+                if link not in frames:
+                    twists.append(np.zeros((6, mech.nv)))
+                    continue
+                J, o = jac[link], data.oMf[frames[link]].translation
+                twists.append(np.vstack([J[:3] - pin.skew(p - o) @ J[3:], J[3:]]))
+            rows.append(twists[1] - twists[0])
+            continue
         for side, link in enumerate(j.links):
             if link not in frames:
                 continue  # the ground does not move
@@ -252,10 +263,10 @@ def _classify(n, m, eff, overconstraint, topo, M):
         kind = f"redundantly actuated: {m} inputs for {n} degree{'s' if n > 1 else ''} of freedom"
     if lam_count != M:
         why = []
-        if overconstraint:
-            why.append(f"the mechanism is overconstrained ({overconstraint} redundant constraint"
-                       f"{'s' if overconstraint > 1 else ''}: its special geometry lets it move although the count says it cannot)"
-                       if lam_count < M else f"{overconstraint} constraints are redundant")
+        if redundant > 0:
+            why.append(f"the mechanism is overconstrained ({redundant} redundant constraint"
+                       f"{'s' if redundant > 1 else ''}{where}: its special geometry lets it move although the count "
+                       "says it cannot)")
         notes.append(f"The {crit} gives {lam_count} but the screw-theory mobility is {M}"
                      + (": " + "; ".join(why) if why else "") + ".")
     if space != "spatial" and topo.kutzbach != M:

@@ -49,7 +49,17 @@ CUT_JOINT_DOF = {
     "universal": 2,
     "planar": 3,
     "spherical": 3,
+    "helical": 1,  # screw pair: turns by t about the axis and moves lead * t / 2 pi along it
+    "rolling": 1,  # two circles (or a circle on a line) rolling without slip, in a plane
+    "gear": 1,  # the same with pitch circles
+    "contact": 2,  # profiles sliding on each other in a plane (cam, pin in a slot): one row besides the plane's
 }
+
+#: Cut-joint types that are not lower pairs (or, helical, need a coupling of unwrapped angles).
+HIGHER_PAIRS = ("helical", "rolling", "gear", "contact")
+
+#: Profile shapes of a sliding contact.
+PROFILE_SHAPES = ("circle", "line", "point")
 
 
 @dataclass(frozen=True)
@@ -187,6 +197,14 @@ class CutJointSpec:
     axis: tuple = (1.0, 0.0, 0.0)
     axis2: tuple | None = None
     source: str = "loop_joint"
+    # higher pairs: rolling/gear radii [m] (radius1 inf: a line along F1's x axis), "external" or
+    # "internal" contact; contact profiles (shape, radius); helical lead [m per turn]
+    radius1: float | None = None
+    radius2: float | None = None
+    contact: str = "external"
+    profile1: tuple | None = None  # (shape, radius or None)
+    profile2: tuple | None = None
+    lead: float | None = None
 
     @property
     def dof(self) -> int:

@@ -17,7 +17,9 @@ import numpy as np
 from ..errors import MechanismFileError, quote, shorten
 from .description import (
     CUT_JOINT_DOF,
+    HIGHER_PAIRS,
     LIMITS,
+    PROFILE_SHAPES,
     TREE_JOINT_DOF,
     Coupling,
     CutJointSpec,
@@ -138,16 +140,25 @@ def _link(elem, problems) -> LinkSpec:
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry)
 
 
-def _joint(elem, links, problems) -> JointSpec | None:
+def _name_and_type(elem, tag, kind, types, problems):
+    """(name, type, 'kind NAME') of a <joint> or <loop_joint>, or None after recording why."""
     name = elem.get("name")
     if not name:
-        problems.append("a <joint> has no name")
+        problems.append(f"a <{tag}> has no name")
         return None
-    what = f"joint {quote(name)}"
+    what = f"{kind} {quote(name)}"
     jtype = elem.get("type")
-    if jtype not in TREE_JOINT_DOF:
-        problems.append(f"{what} has unknown type {quote(jtype)} (known: {', '.join(sorted(TREE_JOINT_DOF))})")
+    if jtype not in types:
+        problems.append(f"{what} has unknown type {quote(jtype)} (known: {', '.join(sorted(types))})")
         return None
+    return name, jtype, what
+
+
+def _joint(elem, links, problems) -> JointSpec | None:
+    head = _name_and_type(elem, "joint", "joint", TREE_JOINT_DOF, problems)
+    if head is None:
+        return None
+    name, jtype, what = head
     ends = {}
     for tag in ("parent", "child"):
         e = elem.find(tag)
@@ -186,15 +197,10 @@ def _joint(elem, links, problems) -> JointSpec | None:
 
 
 def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
-    name = elem.get("name")
-    if not name:
-        problems.append("a <loop_joint> has no name")
+    head = _name_and_type(elem, "loop_joint", "loop joint", CUT_JOINT_DOF, problems)
+    if head is None:
         return None
-    what = f"loop joint {quote(name)}"
-    jtype = elem.get("type")
-    if jtype not in CUT_JOINT_DOF:
-        problems.append(f"{what} has unknown type {quote(jtype)} (known: {', '.join(sorted(CUT_JOINT_DOF))})")
-        return None
+    name, jtype, what = head
     firsts = elem.findall("link1")
     seconds = elem.findall("link2")
     if len(firsts) == 2 and not seconds:
@@ -231,7 +237,89 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
     if l1 == l2:
         problems.append(f"{what} connects link {quote(l1)} to itself")
         return None
-    return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint")
+    extra = _higher_pair(elem, jtype, what, axis, problems) if jtype in HIGHER_PAIRS else {}
+    if extra is None:
+        return None
+    return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint", **extra)
+
+
+def _radius(text, what, problems, allow_inf=False):
+    """A radius [m]: a positive number, or (a straight line) 'inf' where allowed."""
+    if text is None:
+        problems.append(f"{what} is missing")
+        return None
+    if allow_inf and text.strip().lower() in ("inf", "+inf", "infinity"):
+        return float("inf")
+    value = numbers(text, 1, what, problems, (None,))[0]
+    if value is not None and not value > 0:
+        problems.append(f"{what} must be positive, got {shorten(text, 40)}")
+        return None
+    return value
+
+
+def _higher_pair(elem, jtype, what, axis, problems) -> dict | None:
+    """The parameters of a rolling, gear, contact or helical loop joint, checked."""
+    n0 = len(problems)
+    out = {}
+    ex = np.array([1.0, 0.0, 0.0])
+    if jtype in ("rolling", "gear"):
+        r = elem.find("rolling")
+        if r is None:
+            r = elem.find("gear")
+        if r is None:
+            problems.append(f"{jtype} {what} needs a <{'gear' if jtype == 'gear' else 'rolling'} radius1=... "
+                            "radius2=.../> (the two circles; radius1=\"inf\" for a straight line)")
+            return None
+        r1 = _radius(r.get("radius1"), f"{what} radius1", problems, allow_inf=True)
+        r2 = _radius(r.get("radius2"), f"{what} radius2", problems)
+        contact = (r.get("contact") or "external").strip().lower()
+        if contact not in ("external", "internal"):
+            problems.append(f"{what} contact {quote(contact)} is unknown (external or internal)")
+        elif contact == "internal" and r1 is not None and r2 is not None and not r2 < r1:
+            problems.append(f"{what}: internal contact needs radius2 < radius1 (circle 2 runs inside circle 1), "
+                            f"got {r2:g} and {r1:g}")
+        elif contact == "internal" and r1 == float("inf"):
+            problems.append(f"{what}: a circle cannot run inside a straight line (radius1 inf, contact internal)")
+        if r1 is not None and np.isinf(r1) and abs(float(np.dot(axis, ex))) > 1e-6:
+            problems.append(f"{what}: the line is F1's x axis, so the <axis> (the plane's normal) must be "
+                            "perpendicular to it")
+        out = {"radius1": r1, "radius2": r2, "contact": contact}
+    elif jtype == "contact":
+        profiles = []
+        for k in (1, 2):
+            e = elem.find(f"profile{k}")
+            if e is None:
+                problems.append(f"contact {what} needs a <profile{k} shape=.../> (circle, line or point)")
+                return None
+            shape = (e.get("shape") or "").strip().lower()
+            if shape not in PROFILE_SHAPES:
+                problems.append(f"{what} <profile{k}> has unknown shape {quote(e.get('shape'))} "
+                                f"(known: {', '.join(PROFILE_SHAPES)})")
+                return None
+            radius = _radius(e.get("radius"), f"{what} <profile{k} radius>", problems) if shape == "circle" else None
+            if shape == "line" and abs(float(np.dot(axis, ex))) > 1e-6:
+                problems.append(f"{what}: a line profile is its frame's x axis, so the <axis> (the plane's normal) "
+                                "must be perpendicular to it")
+            profiles.append((shape, radius))
+        shapes = (profiles[0][0], profiles[1][0])
+        if shapes in (("line", "line"), ("point", "point")):
+            problems.append(f"{what}: profiles {shapes[0]} and {shapes[1]} make no sliding contact "
+                            "(two points are a revolute joint, two lines a prismatic one)")
+            return None
+        contact = (elem.find("profile2").get("contact") or elem.get("contact") or "external").strip().lower()
+        if contact not in ("external", "internal"):
+            problems.append(f"{what} contact {quote(contact)} is unknown (external or internal)")
+        out = {"profile1": profiles[0], "profile2": profiles[1], "contact": contact}
+    elif jtype == "helical":
+        e = elem.find("pitch")
+        if e is None or e.get("lead") is None:
+            problems.append(f"helical {what} needs a <pitch lead=\"...\"/> (translation per turn, m)")
+            return None
+        lead = numbers(e.get("lead"), 1, f"{what} <pitch lead>", problems, (None,))[0]
+        if lead is not None and lead == 0:
+            problems.append(f"{what} <pitch lead> is 0: a screw with no lead is a revolute joint")
+        out = {"lead": lead}
+    return None if len(problems) > n0 else out
 
 
 def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: int | None = None):

@@ -27,7 +27,7 @@ from ..tolerances import DEFAULT, Tolerances
 from . import compiled
 from ._pin import frame_jacobian
 
-__all__ = ["CutJoint", "ClosureSystem", "Assembly", "perpendicular_basis"]
+__all__ = ["CutJoint", "CouplingRow", "ContactRow", "ClosureSystem", "Assembly", "perpendicular_basis"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -127,10 +127,49 @@ class CutJoint:
     link2: str
     axis: tuple
     axis2: tuple | None = None
+    pair: str | None = None  # a higher pair built on this cut joint: "rolling", "gear", "helical", "contact"
 
     @property
     def rows(self) -> int:
         return 6 - self.dof
+
+
+@dataclass(frozen=True)
+class CouplingRow:
+    """A linear relation of one-coordinate joints, sum c_k q_k + c0 = 0 [m]: the no-slip condition
+    of a rolling pair (r1 a1 + r2 a2 = 0) or the lead of a screw pair (advance - lead turn / 2 pi
+    = 0), written in the unwrapped coordinates of the pair's virtual joints, so that it holds over
+    any number of turns.  Its Jacobian row is constant and it adds nothing to K'q'."""
+
+    name: str
+    kind: str  # "roll" | "lead"
+    terms: tuple  # ((q index, v index, coefficient), ...)
+    constant: float = 0.0
+
+
+@dataclass(frozen=True)
+class ContactRow:
+    """Two profiles touching in the plane that a planar cut joint between F1 and F2 keeps them in:
+    a circle (centre at the frame's origin), a line (the frame's x axis) or a point (the origin)
+    [m].  circle-line and line-circle: the centre's distance from the line equals the radius;
+    point-line, line-point: the point on the line (a pin in a slot); circle-circle: the distance
+    of the centres equals r1 + r2, or |r1 - r2| inside; point-circle, circle-point: the point on
+    the circle.  normal: a line's normal in the plane, in its frame (axis x e_x)."""
+
+    name: str
+    frame1: int
+    frame2: int
+    shape1: str
+    radius1: float | None
+    shape2: str
+    radius2: float | None
+    internal: bool
+    normal: tuple
+
+    def target(self) -> float:
+        if self.shape1 == "circle" and self.shape2 == "circle":
+            return abs(self.radius1 - self.radius2) if self.internal else self.radius1 + self.radius2
+        return self.radius1 if self.shape1 == "circle" else (self.radius2 or 0.0)
 
 
 @dataclass(frozen=True)
@@ -154,14 +193,17 @@ class Assembly:
 class ClosureSystem:
     """The loop-closure equations r(q) = 0 of a model with cut joints."""
 
-    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>", data=None):
-        """data: the pinocchio.Data to compute in (the mechanism's; a new one when None)."""
+    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>", data=None,
+                 extra=()):
+        """data: the pinocchio.Data to compute in (the mechanism's; a new one when None);
+        extra: CouplingRow and ContactRow of higher pairs, after the cut joints' rows."""
         self.model = model
         self.data = model.createData() if data is None else data
         self.cuts = list(cuts)
+        self.extra = list(extra)
         self.tol = tolerances
         self.path = path
-        self.nrows = sum(c.rows for c in self.cuts)
+        self.nrows = sum(c.rows for c in self.cuts) + len(self.extra)
         self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
         self._solver_rows = None
         self._compiled = None  # (kernels, cut kinds, buffers) when accelerate() is on
@@ -191,7 +233,7 @@ class ClosureSystem:
         and every cut joint is fixed or spherical; returns whether they are in use."""
 
         self._compiled = None
-        kinds = compiled.kinds_of(self.cuts) if on else None
+        kinds = compiled.kinds_of(self.cuts) if on and not self.extra else None
         if kinds is not None and compiled.available():
             n, nv = len(self.cuts), self.model.nv
             buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
@@ -239,6 +281,7 @@ class ClosureSystem:
             return self.nrows
         if self._solver_rows is None:
             self._solver_rows = sum(self._cut_rows(c, plan, True) for c, plan in zip(self.cuts, self._plans))
+            self._solver_rows += len(self.extra)
         return self._solver_rows
 
     def _plan(self, cut, b1, b2):
@@ -379,7 +422,75 @@ class ClosureSystem:
                     c = np.stack([w[:, 1] * u[:, 2] - w[:, 2] * u[:, 1], w[:, 2] * u[:, 0] - w[:, 0] * u[:, 2],
                                   w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]], axis=1)  # (n, 3, p)
                     K[rest] = c.transpose(0, 2, 1) @ (w2 - w1)
+        if self.extra:
+            self._evaluate_extra(q, r, K, nrows - len(self.extra))
         return r, K
+
+    def _evaluate_extra(self, q, r, K, i):
+        """The rows of the higher pairs (CouplingRow, ContactRow) from row i on."""
+        for k, e in enumerate(self.extra, i):
+            if isinstance(e, CouplingRow):
+                r[k] = sum(c * q[iq] for iq, _, c in e.terms) + e.constant
+                if K is not None:
+                    K[k] = 0.0
+                    for _, iv, c in e.terms:
+                        K[k, iv] += c
+                continue
+            value, grad = self._contact(e, K is not None)
+            r[k] = value
+            if K is not None:
+                K[k] = grad
+
+    def _contact(self, e, jacobian):
+        """(value, Jacobian row or None) of a ContactRow at the placements in self.data."""
+        model, data = self.model, self.data
+        M1, M2 = data.oMf[e.frame1], data.oMf[e.frame2]
+        J1 = frame_jacobian(model, data, e.frame1, LWA) if jacobian else None
+        J2 = frame_jacobian(model, data, e.frame2, LWA) if jacobian else None
+        if "line" in (e.shape1, e.shape2):
+            # s = (o_a - o_b) . m_b, the line on frame b (its normal m_b turns with it), the other at a
+            on2 = e.shape2 == "line"
+            Ma, Mb = (M1, M2) if on2 else (M2, M1)
+            Ja, Jb = (J1, J2) if on2 else (J2, J1)
+            m = Mb.rotation @ np.asarray(e.normal)
+            delta = Ma.translation - Mb.translation
+            s = float(delta @ m)
+            point = (e.shape1 if on2 else e.shape2) == "point"
+            sign = 1.0 if point or s >= 0 else -1.0
+            value = sign * s - (0.0 if point else e.target())
+            if not jacobian:
+                return value, None
+            return value, sign * (m @ (Ja[:3] - Jb[:3]) + _cross(m, delta) @ Jb[3:])
+        delta = M2.translation - M1.translation
+        dist = float(np.sqrt(delta @ delta))
+        value = dist - e.target()
+        if not jacobian:
+            return value, None
+        return value, (delta / max(dist, 1e-300)) @ (J2[:3] - J1[:3])
+
+    def _contact_bias(self, e):
+        """d2/dt2 of a ContactRow along the motion in self.data (velocities, classical accelerations)."""
+        model, data = self.model, self.data
+        M = (data.oMf[e.frame1], data.oMf[e.frame2])
+        V = [pin.getFrameVelocity(model, data, f, LWA) for f in (e.frame1, e.frame2)]
+        A = [pin.getFrameClassicalAcceleration(model, data, f, LWA) for f in (e.frame1, e.frame2)]
+        if "line" in (e.shape1, e.shape2):
+            a, b = (0, 1) if e.shape2 == "line" else (1, 0)
+            m = M[b].rotation @ np.asarray(e.normal)
+            w, al = V[b].angular, A[b].angular
+            delta = M[a].translation - M[b].translation
+            dd = V[a].linear - V[b].linear
+            ddd = A[a].linear - A[b].linear
+            md = _cross(w, m)
+            mdd = _cross(al, m) + _cross(w, md)
+            s2 = ddd @ m + 2 * dd @ md + delta @ mdd
+            point = (e.shape1 if b == 1 else e.shape2) == "point"
+            return s2 if point or delta @ m >= 0 else -s2
+        delta = M[1].translation - M[0].translation
+        dd = V[1].linear - V[0].linear
+        ddd = A[1].linear - A[0].linear
+        d = float(np.sqrt(delta @ delta))
+        return (ddd @ delta + dd @ dd) / d - (delta @ dd) ** 2 / d**3
 
     def _evaluate_one(self, g, j, r, K, solver):
         """The rows of cut joint j of a group (the same rows as the stacked code, with 2-D
@@ -459,6 +570,9 @@ class ClosureSystem:
                 wd, wdd = second(w, w2, al2)
                 out[i] = udd @ w + 2 * ud @ wd + u @ wdd
                 i += 1
+        for e in self.extra:  # a coupling is linear in the coordinates: nothing
+            out[i] = 0.0 if isinstance(e, CouplingRow) else self._contact_bias(e)
+            i += 1
         return out
 
     def row_labels(self, solver: bool = False) -> list:
@@ -479,6 +593,8 @@ class ClosureSystem:
                 labels += [f"{cut.name}:align{k}" for k in range(2)]
             elif t == "universal":
                 labels += [f"{cut.name}:perp"]
+        for e in self.extra:  # lengths [m]: position rows for the dimensionless measures
+            labels.append(f"{e.name}:pos-{e.kind if isinstance(e, CouplingRow) else 'contact'}")
         return labels
 
     def residual(self, q) -> np.ndarray:

@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MechanismFileError, UsageError, quote, shorten
-from ..files.description import LIMITS
+from ..files.description import LIMITS, placement
 from ..files.sdf import read_sdf
 from ..files.sidecar import axis_letters, read_yaml_sidecar
 from ..files.urdf import check_sizes, read_urdf
@@ -193,6 +193,66 @@ def _couple(model, couplings, path):
     return model
 
 
+def _in_plane(axis):
+    """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
+    a, and a x u."""
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    for e in np.eye(3):
+        u = e - (e @ a) * a
+        if np.linalg.norm(u) > 1e-6:
+            u /= np.linalg.norm(u)
+            return a, u, np.cross(a, u)
+    raise ValueError("degenerate axis")  # pragma: no cover
+
+
+def _virtual_pairs(model, spec) -> None:
+    """Give every rolling, gear and helical loop joint the massless chain of its equivalent
+    linkage, from F1 on its first link, whose coordinates are the pair's unwrapped angles (and
+    advance); the loop closes with a weld from the chain's end frame ``NAME@end`` to F2, and a
+    coupling row (model.closure.CouplingRow) relates the coordinates:
+
+    - two circles (radii r1, r2; R = r1 + r2 outside, r1 - r2 inside): a revolute at F1's
+      origin (coordinate a1: the contact direction in F1, from its x axis), then, at distance R
+      along it, a revolute (a2 = -its coordinate: the contact direction in F2) whose frame is
+      turned by pi outside, so that a1 = a2 = 0 puts the points on both x axes in contact;
+      no slip r1 a1 + r2 a2 = 0 outside, r1 a1 - r2 a2 = 0 inside;
+    - a circle on a line (F1's x axis; radius1 inf): a slide along the line (x, the contact
+      point) and, r2 beside it on the side of -y, a revolute (a2 = -its coordinate); x + r2 a2 = 0;
+    - a screw: a revolute about the axis (turn) then a slide along it (advance);
+      advance = lead turn / 2 pi.
+    """
+    for c in spec.cut_joints:
+        if c.type not in ("rolling", "gear", "helical"):
+            continue
+        fid = frame_id(model, c.frame1)
+        if fid is None:
+            continue  # reported when the cut joint is bound
+        parent = model.frames[fid]
+        P = parent.placement * placement(c.xyz1, c.rpy1)
+        a, u, n = _in_plane(c.axis)
+        inf, zero = np.array([-np.inf]), np.array([np.inf])
+
+        def add(joint_parent, jm, M, name):
+            jid = model.addJoint(joint_parent, jm, M, name, np.zeros(1), np.zeros(1), inf, zero)
+            model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
+            return jid
+
+        if c.type == "helical":
+            v1 = add(parent.parentJoint, pin.JointModelRevoluteUnaligned(a), P, f"{c.name}.turn")
+            v2 = add(v1, pin.JointModelPrismaticUnaligned(a), pin.SE3.Identity(), f"{c.name}.advance")
+        elif np.isinf(c.radius1):
+            v1 = add(parent.parentJoint, pin.JointModelPrismaticUnaligned(u), P, f"{c.name}.x")
+            M = pin.SE3(pin.exp3(a * np.pi / 2), -c.radius2 * n)
+            v2 = add(v1, pin.JointModelRevoluteUnaligned(a), M, f"{c.name}.a2")
+        else:
+            outside = c.contact != "internal"
+            R = c.radius1 + c.radius2 if outside else c.radius1 - c.radius2
+            v1 = add(parent.parentJoint, pin.JointModelRevoluteUnaligned(a), P, f"{c.name}.a1")
+            M = pin.SE3(pin.exp3(a * np.pi) if outside else np.eye(3), R * u)
+            v2 = add(v1, pin.JointModelRevoluteUnaligned(a), M, f"{c.name}.a2")
+        model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
+
+
 @contextmanager
 def _native_stderr(box: list):
     """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
@@ -269,6 +329,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
     model = _rebuild(model, spec.replacements, first={c.mimics for c in spec.couplings})
     model = _couple(model, spec.couplings, path)
+    _virtual_pairs(model, spec)
     check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
     _check_cut_bodies(model, spec)
     shown = spec.warnings

@@ -18,7 +18,7 @@ from ..errors import AssemblyError, MechanismFileError, UsageError, quote
 from ..files.description import MechanismSpec, placement, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import frame_id
-from .closure import Assembly, ClosureSystem, CutJoint
+from .closure import Assembly, ClosureSystem, ContactRow, CouplingRow, CutJoint
 from .linalg import null_space, rank
 from .topology import build_topology
 
@@ -98,6 +98,8 @@ class Mechanism:
         self._coord = {c.joint: c for c in self.coordinates}
         self.couplings = tuple(spec.couplings)  # <mimic> joints: no coordinate of their own
         self._coupled = {c.joint: c for c in self.couplings}
+        self.extra_rows = []  # rows of higher pairs (model.closure.CouplingRow / ContactRow)
+        self.virtual_joints = {}  # higher pair -> the coordinates of its virtual chain
         self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
         # a ground frame for targets (inverse kinematics); every frame must exist
         # before the pinocchio.Data is made from the model
@@ -107,7 +109,7 @@ class Mechanism:
         # tensors in it (one Data of a 500-joint chain: 17 s and 7.9 GB here).  Whoever uses it
         # runs Pinocchio's pass for its own configuration first.
         self.data = model.createData()
-        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.data)
+        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.data, extra=self.extra_rows)
         self.set_actuated(actuated)
         self._assembly = None
         self._limits = None
@@ -126,15 +128,45 @@ class Mechanism:
         return fid
 
     def _bind_cut(self, c) -> CutJoint:
+        """The cut joint's frames F1, F2 on the model, and what closes the loop there: the cut
+        joint itself; for a rolling, gear or helical pair a weld from its virtual chain's end
+        (screwkin.model.loader._virtual_pairs) to F2 and a coupling row; for a sliding contact a
+        planar joint and a contact row."""
         ids = []
         for k, (frame, xyz, rpy) in enumerate(((c.frame1, c.xyz1, c.rpy1), (c.frame2, c.xyz2, c.rpy2)), 1):
-            fid = self._frame_id(frame, f"loop joint '{c.name}'")
+            fid = self._frame_id(frame, f"loop joint {quote(c.name)}")
             parent = self.model.frames[fid]
             frame_placement = parent.placement * placement(xyz, rpy)
             new = pin.Frame(f"{c.name}@F{k}", parent.parentJoint, fid, frame_placement, pin.FrameType.OP_FRAME)
             ids.append(self.model.addFrame(new, False))
-        return CutJoint(c.name, c.type, c.dof, ids[0], ids[1], c.frame1, c.frame2, tuple(c.axis),
-                        tuple(c.axis2) if c.axis2 is not None else None)
+        axis, axis2 = tuple(c.axis), tuple(c.axis2) if c.axis2 is not None else None
+        if c.type in ("rolling", "gear", "helical"):
+            names = [self.model.names[j] for j in range(1, self.model.njoints)
+                     if self.model.names[j].startswith(f"{c.name}.")]
+            coord = {n.split(".", 1)[1]: self._coord[n] for n in names}
+            self.virtual_joints[c.name] = tuple(names)
+            if c.type == "helical":  # advance - lead turn / 2 pi = 0
+                terms = ((coord["advance"], 1.0), (coord["turn"], -c.lead / (2 * np.pi)))
+                kind = "lead"
+            elif np.isinf(c.radius1):  # x + r2 a2 = 0 with a2 = -q
+                terms = ((coord["x"], 1.0), (coord["a2"], -c.radius2))
+                kind = "roll"
+            else:  # r1 a1 + r2 a2 = 0 outside, r1 a1 - r2 a2 = 0 inside, with a2 = -q
+                sign = -1.0 if c.contact != "internal" else 1.0
+                terms = ((coord["a1"], c.radius1), (coord["a2"], sign * c.radius2))
+                kind = "roll"
+            self.extra_rows.append(CouplingRow(c.name, kind, tuple((k.idx_q, k.idx_v, v) for k, v in terms)))
+            end = self.model.getFrameId(f"{c.name}@end")
+            return CutJoint(c.name, "fixed", 0, end, ids[1], c.frame1, c.frame2, axis, None, pair=c.type)
+        if c.type == "contact":
+            a = np.asarray(c.axis, float)
+            normal = np.cross(a / np.linalg.norm(a), [1.0, 0.0, 0.0])
+            normal = normal / max(np.linalg.norm(normal), 1e-300)
+            (s1, r1), (s2, r2) = c.profile1, c.profile2
+            self.extra_rows.append(ContactRow(c.name, ids[0], ids[1], s1, r1, s2, r2, c.contact == "internal",
+                                              tuple(normal)))
+            return CutJoint(c.name, "planar", 3, ids[0], ids[1], c.frame1, c.frame2, axis, None, pair="contact")
+        return CutJoint(c.name, c.type, c.dof, ids[0], ids[1], c.frame1, c.frame2, axis, axis2)
 
     def set_actuated(self, actuated=None):
         """Choose the actuated joints (None: the file's declaration)."""

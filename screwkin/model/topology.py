@@ -22,26 +22,35 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from ..files.description import CUT_JOINT_DOF
 from ..files.sidecar import axis_letters
 from ._pin import frame_id
 
 __all__ = ["Joint", "Topology", "build_topology"]
 
 MOTION = {
-    "revolute": "rotation about an axis",
-    "continuous": "rotation about an axis",
-    "prismatic": "translation along an axis",
-    "cylindrical": "rotation about and translation along an axis",
-    "universal": "two rotations about intersecting axes",
-    "spherical": "three rotations about a point",
-    "planar": "planar motion (2 translations, 1 rotation)",
-    "floating": "free motion (6)",
+    "revolute": "rotation",
+    "continuous": "rotation",
+    "prismatic": "translation",
+    "cylindrical": "rotation and translation",
+    "universal": "two rotations",
+    "spherical": "spherical (three rotations)",
+    "planar": "planar (two translations, one rotation)",
+    "helical": "helical (screw)",
+    "rolling": "rolling",
+    "gear": "rolling (gear teeth)",
+    "contact": "rolling and sliding",
+    "floating": "free",
     "fixed": "none",
 }
 SYMBOL = {
-    "revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical": "C",
-    "universal": "U", "spherical": "S", "planar": "E", "floating": "F", "fixed": "-",
+    "revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical": "C", "universal": "U", "spherical": "S",
+    "planar": "E", "helical": "H", "rolling": "Ro", "gear": "G", "contact": "Ct", "floating": "F", "fixed": "-",
 }
+#: Pairs whose elements touch along a line or at a point (the others over a surface).
+HIGHER = ("rolling", "gear", "contact")
+#: Pairs whose relative motion is planar, with their axis as the plane's normal.
+PLANAR_PAIRS = ("planar", "rolling", "gear", "contact")
 
 
 @dataclass(frozen=True)
@@ -63,15 +72,26 @@ class Joint:
     point: tuple | None = None
     direction: tuple | None = None
     direction2: tuple | None = None  # universal joints: the axis fixed in links[1]
+    profile: str | None = None  # sliding contacts: "circle-line", "point-line", ...
 
     @property
     def motion(self) -> str:
+        """The relative motion the pair allows, in words."""
         return MOTION[self.type]
 
     @property
+    def pair(self) -> str:
+        """'lower' (elements touching over a surface) or 'higher' (along a line or at a point)."""
+        return "higher" if self.type in HIGHER else "lower"
+
+    @property
     def contact(self) -> str:
-        """Lower pairs touch over a surface; the formats here express no higher pair."""
-        return "lower pair" if self.type != "universal" else "lower pairs (compound)"
+        """How its elements touch: 'surface' for lower pairs (a screw too); 'line' for rolling
+        cylinders, gear teeth and cams; 'point' where a point profile (a knife edge, a pin) meets
+        a curve (both seen in the plane of motion)."""
+        if self.type not in HIGHER:
+            return "surface" + (", compound" if len(self.members) > 1 else "")
+        return "point" if self.profile and "point" in self.profile else "line"
 
     @property
     def symbol(self) -> str:
@@ -108,6 +128,21 @@ class Topology:
     @property
     def sum_dof(self) -> int:
         return sum(j.dof for j in self.joints)
+
+    @property
+    def full_joints(self) -> int:
+        """J1 of the planar count: joints of one DOF (lower pairs, pure rolling, gears)."""
+        return sum(1 for j in self.joints if j.dof == 1)
+
+    @property
+    def half_joints(self) -> int:
+        """J2 of the planar count: joints of two DOF in the plane (sliding contacts: cams, slots)."""
+        return sum(1 for j in self.joints if j.dof == 2)
+
+    @property
+    def textbook_planar(self) -> bool:
+        """Whether the planar count can be written 3(N - 1) - 2 J1 - J2 (every joint J1 or J2)."""
+        return self.motion_space == "planar" and all(j.dof in (1, 2) for j in self.joints)
 
     def count(self, lam: int) -> int:
         """Chebychev-Gruebler-Kutzbach count with motion-space dimension lam, less one for each
@@ -177,6 +212,7 @@ class _Edge:
     point: np.ndarray | None
     direction: np.ndarray | None
     direction2: np.ndarray | None = None
+    profile: str | None = None
 
 
 def _edges(mech, q):
@@ -211,9 +247,17 @@ def _edges(mech, q):
                 direction, direction2 = base.rotation @ a1, M.rotation @ a2
         dof = {"spherical": 3, "universal": 2}.get(t, j.dof)
         edges.append(_Edge(j.name, t, dof, j.parent, j.child, False, point, direction, direction2))
+    specs = {s.name: s for s in mech.spec.cut_joints}
     for c in mech.cuts:
         a = _frame_link(mech, c.link1)
         b = _frame_link(mech, c.link2)
+        if c.pair is not None:  # one higher (or screw) pair between the two links, at F1
+            M1 = data.oMf[model.getFrameId(f"{c.name}@F1")]
+            s = specs.get(c.name)
+            profile = f"{s.profile1[0]}-{s.profile2[0]}" if s is not None and s.profile1 else None
+            edges.append(_Edge(c.name, c.pair, CUT_JOINT_DOF[c.pair], a, b, True, M1.translation.copy(),
+                               M1.rotation @ np.asarray(c.axis), None, profile))
+            continue
         if c.type == "fixed":
             welds.append((a, b, c.name))
             continue
@@ -270,8 +314,9 @@ def _compound_name(members, kind) -> str:
     return "+".join(members)
 
 
-def _classify_chain(chain, tol, scale):
-    """The compound type of a chain of 1-DOF edges through massless links, or None."""
+def _classify_chain(chain, tol, scale, coupled=frozenset()):
+    """The compound type of a chain of 1-DOF edges through massless links, or None.
+    coupled: the pairs of joint names one of which mimics the other."""
     kinds = [e.type for e in chain]
     if any(e.direction is None or e.point is None for e in chain):
         return None
@@ -286,6 +331,9 @@ def _classify_chain(chain, tol, scale):
             return "universal"
     if len(chain) == 2 and len(rev) == 1 and len(pri) == 1:
         if _parallel(rev[0].direction, pri[0].direction, tol):
+            # a prismatic joint that mimics the revolute on its axis (or the other way) is a screw
+            if frozenset((rev[0].name, pri[0].name)) in coupled:
+                return "helical"
             return "cylindrical"
     if len(chain) == 3 and len(rev) == 3:
         dirs = np.array([_unit(e.direction) for e in rev])
@@ -329,6 +377,8 @@ def build_topology(mech, q) -> Topology:
         return edges[k].type in ("revolute", "continuous", "prismatic")
 
     candidates = {r for r in groups if massless(r) and len(incident[r]) == 2 and all(one_dof(k) for k in incident[r])}
+    coupled = frozenset(frozenset((c.joint, c.mimics)) for c in mech.couplings)
+    consumed = set()
     used_edges, dummies, compounds = set(), set(), []
     for start in sorted(candidates, key=lambda r: body_name[r]):
         if start in dummies:
@@ -366,7 +416,7 @@ def build_topology(mech, q) -> Topology:
         outer = [edges[ends[0][1]], edges[ends[1][1]]]
         end_a = outer[0].a if outer[0].a not in run else outer[0].b
         end_b = outer[1].a if outer[1].a not in run else outer[1].b
-        kind = _classify_chain(chain, tol, scale)
+        kind = _classify_chain(chain, tol, scale, coupled)
         if kind is None:
             continue
         dummies |= run
@@ -386,11 +436,13 @@ def build_topology(mech, q) -> Topology:
             point = a.point + s[0] * _unit(a.direction)
             # the first axis turns with the link at the start of the chain, the second with the end
             direction, direction2 = a.direction, b.direction
+        if kind == "helical":  # its coupling is the screw's lead: counted in the pair, not again
+            consumed |= {c for c in mech.couplings if {c.joint, c.mimics} == {e.name for e in chain}}
         compounds.append(
             Joint(
                 name=_compound_name([e.name for e in chain], kind),
                 type=kind,
-                dof=sum(e.dof for e in chain),
+                dof=sum(e.dof for e in chain) - (1 if kind == "helical" else 0),
                 links=(body_name[end_a], body_name[end_b]),
                 members=tuple(e.name for e in chain),
                 cut=any(e.cut for e in chain),
@@ -407,7 +459,7 @@ def build_topology(mech, q) -> Topology:
             Joint(e.name, e.type, e.dof, (body_name[e.a], body_name[e.b]), (e.name,), e.cut,
                   tuple(e.point) if e.point is not None else None,
                   tuple(e.direction) if e.direction is not None else None,
-                  tuple(e.direction2) if e.direction2 is not None else None)
+                  tuple(e.direction2) if e.direction2 is not None else None, e.profile)
         )
     joints += compounds
     links = tuple(body_name[r] for r in groups if r not in dummies)
@@ -416,7 +468,7 @@ def build_topology(mech, q) -> Topology:
     space, detail, normal = _motion_space(joints, tol, scale)
     cut_welds = tuple(name for _, _, name in welds if name is not None)
     return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links, cut_welds,
-                    normal, tuple(mech.couplings))
+                    normal, tuple(c for c in mech.couplings if c not in consumed))
 
 
 def _motion_space(joints, tol, scale):
@@ -428,8 +480,8 @@ def _motion_space(joints, tol, scale):
         return "spatial", "no joints", None
     rot = [j for j in joints if j.type in ("revolute", "continuous")]
     pri = [j for j in joints if j.type == "prismatic"]
-    other = [j for j in joints if j.type not in ("revolute", "continuous", "prismatic", "planar")]
-    planar_pairs = [j for j in joints if j.type == "planar"]
+    other = [j for j in joints if j.type not in ("revolute", "continuous", "prismatic") + PLANAR_PAIRS]
+    planar_pairs = [j for j in joints if j.type in PLANAR_PAIRS]
     if not other:
         normal = None
         if rot:

@@ -41,6 +41,7 @@ def _joint_dict(j) -> dict:
         "links": list(j.links),
         "motion": j.motion,
         "contact": j.contact,
+        "pair": j.pair,
         "cut": j.cut,
         "members": list(j.members),
     }
@@ -81,6 +82,8 @@ def mobility_dict(r) -> dict:
         "file": r.path,
         "kutzbach": t.kutzbach,
         "gruebler": t.gruebler,
+        "J1": t.full_joints,
+        "J2": t.half_joints,
         "spherical_count": t.spherical_count,
         "coordinates": r.coordinates,
         "constraint_rows": r.constraint_rows,
@@ -106,12 +109,15 @@ def mobility_dict(r) -> dict:
 
 
 def topology_text(topo, title: str) -> str:
-    rows = [(j.name if len(j.name) <= 48 else j.name[:45] + "...", j.type, j.dof, f"{j.links[0]} - {j.links[1]}",
-             j.contact, "cut" if j.cut else "") for j in topo.joints]
-    lines = [title, "", table(["joint", "type", "dof", "links", "contact", "loop"], rows), ""]
+    rows = [(j.name if len(j.name) <= 48 else j.name[:45] + "...", j.type, j.dof, j.motion, f"{j.pair} ({j.contact})",
+             f"{j.links[0]} - {j.links[1]}", "cut" if j.cut else "") for j in topo.joints]
+    lines = [title, "", table(["joint", "type", "dof", "motion", "pair (contact)", "links", "loop"], rows), ""]
     lines.append(f"links N = {topo.n_links} (ground: {topo.ground})   joints J = {topo.n_joints}   "
                  f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}"
                  + (f"   couplings C = {len(topo.couplings)}" if topo.couplings else ""))
+    if topo.textbook_planar:
+        lines.append(f"full joints J1 = {topo.full_joints} (one DOF: lower pairs, rolling)   "
+                     f"half joints J2 = {topo.half_joints} (two DOF: sliding contacts)")
     for c in topo.couplings:
         lines.append(f"coupling (mimic): {c.joint} = {c.multiplier:g} x {c.mimics} + {c.offset:g}: "
                      f"{c.joint} is no degree of freedom of its own")
@@ -133,6 +139,10 @@ def mobility_text(r) -> str:
     if t.gruebler is not None:
         counts.append(("Gruebler (planar)", f"3(N-1-J) + sum f{c} = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
                        t.gruebler))
+        if t.textbook_planar:
+            counts.append(("Gruebler, as the textbooks write it",
+                           f"3(N-1) - 2 J1 - J2{c} = 3({t.n_links}-1) - 2*{t.full_joints} - {t.half_joints}{cv}",
+                           3 * (t.n_links - 1) - 2 * t.full_joints - t.half_joints - len(t.couplings)))
     if t.spherical_count is not None:
         counts.append(("spherical", f"3(N-1-J) + sum f{c} = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
                        t.spherical_count))

@@ -40,6 +40,7 @@ COLORS = {
     "standin": np.array([0.35, 0.6, 0.9, 1.0]),
     "screw": np.array([1.0, 0.1, 0.1, 1.0]),
     "marker": np.array([1.0, 0.9, 0.0, 1.0]),
+    "pair": np.array([0.1, 0.6, 0.6, 1.0]),
     "x": np.array([1.0, 0.0, 0.0, 1.0]),
     "y": np.array([0.0, 0.8, 0.0, 1.0]),
     "z": np.array([0.0, 0.0, 1.0, 1.0]),
@@ -133,6 +134,65 @@ def _ball(name, joint, frame, p, radius, color):
     return obj
 
 
+def _disc(name, joint, frame, M, radius, color, alpha=0.35):
+    """A thin disc of ``radius`` whose normal is the z axis of the placement M (a pitch circle or
+    a circular profile), see-through so the links stay visible."""
+    obj = pin.GeometryObject(name, joint, frame, M, _coal().Cylinder(radius, 0.05 * radius))
+    obj.meshColor = np.array([*color[:3], alpha])
+    return obj
+
+
+def _pair_geometry(mech, cut, spec, r_axis, L_axis):
+    """What a higher pair looks like: pitch circles (rolling, gears; a pitch line for a rack),
+    profiles (circles as discs, lines as slots, points as pins) and a screw's helix of its lead."""
+    model = mech.model
+    out = []
+    color = COLORS["pair"]
+    frames = [model.getFrameId(f"{cut.name}@F{k}") for k in (1, 2)]
+    a = np.asarray(cut.axis, float) / np.linalg.norm(cut.axis)
+    turn = _segment("t", 0, 0, np.zeros(3), a, 1.0, color).placement.rotation  # z along the axis
+
+    def side(k):
+        f = model.frames[frames[k]]
+        return f.parentJoint, frames[k], f.placement
+
+    if spec.type in ("rolling", "gear"):
+        for k, r in ((0, spec.radius1), (1, spec.radius2)):
+            joint, frame, P = side(k)
+            if np.isinf(r):  # the pitch line: F1's x axis
+                out.append(_segment(f"screwkin/pair/{cut.name}/line", joint, frame, P.act(np.array([-6 * L_axis, 0, 0])),
+                                    P.act(np.array([6 * L_axis, 0, 0])), r_axis, color))
+                continue
+            out.append(_disc(f"screwkin/pair/{cut.name}/circle{k + 1}", joint, frame, P * pin.SE3(turn, np.zeros(3)), r,
+                             color))
+    elif spec.type == "contact":
+        for k, (shape, r) in enumerate((spec.profile1, spec.profile2)):
+            joint, frame, P = side(k)
+            name = f"screwkin/pair/{cut.name}/{shape}{k + 1}"
+            if shape == "circle":
+                out.append(_disc(name, joint, frame, P * pin.SE3(turn, np.zeros(3)), r, color))
+            elif shape == "line":  # a slot or a flat face: the frame's x axis
+                out.append(_segment(name, joint, frame, P.act(np.array([-4 * L_axis, 0, 0])),
+                                    P.act(np.array([4 * L_axis, 0, 0])), 1.5 * r_axis, color))
+            else:
+                out.append(_ball(name, joint, frame, P.translation, 2.5 * r_axis, color))
+    elif spec.type == "helical":  # two turns of a helix of the screw's lead, around its axis
+        joint, frame, P = side(0)
+        b1 = np.cross(a, [1.0, 0, 0] if abs(a[0]) < 0.9 else [0, 1.0, 0])
+        b1 /= np.linalg.norm(b1)
+        b2 = np.cross(a, b1)
+        radius = 2 * L_axis / 3
+        ts = np.linspace(0.0, 4 * np.pi, 49)
+        pts = [P.act(radius * (np.cos(s) * b1 + np.sin(s) * b2) + spec.lead * s / (2 * np.pi) * a) for s in ts]
+        for k in range(len(pts) - 1):
+            obj = _segment(f"screwkin/pair/{cut.name}/helix{k}", joint, frame, pts[k], pts[k + 1], 0.6 * r_axis, color)
+            if obj is not None:
+                out.append(obj)
+        out.append(_segment(f"screwkin/pair/{cut.name}/axis", joint, frame, P.act(-L_axis * a),
+                            P.act((2 * spec.lead + L_axis) * a), r_axis, color))
+    return [o for o in out if o is not None]
+
+
 @dataclass
 class Scene:
     """A mechanism's scene: the geometry model and what each added object shows."""
@@ -187,7 +247,10 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
 
     actuated = set(mech.actuated)
     axis_of = {j.name: np.asarray(j.axis) for j in mech.spec.joints}
+    virtual = {n for names in mech.virtual_joints.values() for n in names}
     for c in mech.coordinates:  # joint axes, drawn on the child side of each moving joint
+        if c.joint in virtual:
+            continue  # the equivalent linkage of a higher pair: drawn as the pair below
         jid = c.joint_id
         frame = frame_id(model, c.joint, prefer=_JOINT_FIRST)
         frame = 0 if frame is None else frame
@@ -204,10 +267,15 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
                                       pin.SE3(seg.placement.rotation, L_axis * a), _coal().Cone(3 * r_axis, 6 * r_axis))
             cone.meshColor = COLORS[role[5:]]
             add(cone, role)
+    specs = {s.name: s for s in mech.spec.cut_joints}
     for cut in mech.cuts:  # cut joints: their axis on the F1 side
         f = model.frames[cut.frame1]
         a = f.placement.rotation @ np.asarray(cut.axis)
         p = f.placement.translation
+        if cut.pair is not None:
+            for obj in _pair_geometry(mech, cut, specs[cut.name], r_axis, L_axis):
+                add(obj, "pair")
+            continue
         if cut.type in ("spherical", "fixed", "universal"):
             add(_ball(f"screwkin/cut/{cut.name}", f.parentJoint, cut.frame1, p, 2.5 * r_axis, COLORS["cut"]), "axis:cut")
         else:
