@@ -58,6 +58,17 @@ from .units import parse_assignments, parse_value
 
 __all__ = ["main"]
 
+#: Commands in modules of their own: each has NEEDS_MECHANISM, add_parser(sub, common, scaled)
+#: and run(mech, args) -> exit code (mech is None when it needs none).
+COMMANDS = ()
+_COMMAND_MODULES = {}
+
+
+def _register(*modules):
+    global COMMANDS
+    COMMANDS = tuple(modules)
+    _COMMAND_MODULES.update({m.NAME: m for m in modules})
+
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
@@ -74,7 +85,13 @@ def _parser():
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    def common(sp):
+    def common(sp, mechanism: bool = True):
+        """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
+        if not mechanism:
+            sp.add_argument("--json", action="store_true", help="print one JSON object")
+            sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                            help="show tracebacks of errors")
+            return
         sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file")
         sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
@@ -185,10 +202,15 @@ def _parser():
                    help="pass through limit positions onto the other branch (the input runs back) until the "
                         "mechanism returns to its start or the input reaches --to")
     scaled(w)
+    for command in COMMANDS:  # the commands kept in modules of their own (screwkin/commands/)
+        command.add_parser(sub, common, scaled)
     return p
 
 
 def _run(args):
+    command = _COMMAND_MODULES.get(args.command)
+    if command is not None and not command.NEEDS_MECHANISM:
+        return command.run(None, args)
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs)
     if getattr(args, "length", None):
@@ -215,6 +237,8 @@ def _run(args):
         return 0
     handlers = {"solve": _solve, "sweep": _sweep, "ik": _ik, "screws": _screws,
                 "singularities": _singularities, "map": _map, "view": _view, "scan": _scan}
+    if command is not None:
+        return command.run(mech, args)
     if args.command in handlers:
         return handlers[args.command](mech, args)
     if args.point and not args.output:
