@@ -66,7 +66,7 @@ _COMMAND_MODULES = {}
 
 def _register(*modules):
     global COMMANDS
-    COMMANDS = tuple(modules)
+    COMMANDS = COMMANDS + tuple(modules)
     _COMMAND_MODULES.update({m.NAME: m for m in modules})
 
 
@@ -557,6 +557,9 @@ def main(argv=None) -> int:
             "(a bug in screwkin: run again with --debug for the traceback and report it)")
         return 3
 
+
+# the commands in modules of their own, one line each:
+# _register(<module imported from .commands>)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
