@@ -21,12 +21,14 @@ import pinocchio as pin
 
 from .analysis.maps import singularity_map
 from .analysis.mobility import analyze_mobility
-from .analysis.planar import LinkAngles, identify
+from .analysis.planar import identify
 from .analysis.position import PositionSolver, inverse_kinematics
 from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
+from .commands import statics as statics_command
+from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
@@ -214,7 +216,6 @@ def _run(args):
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs)
     if getattr(args, "length", None):
-
         mech.length = parse_value(args.length)
     if args.command == "info":
         try:
@@ -252,7 +253,7 @@ def _run(args):
 
 
 def _solve(mech, args):
-    values = _inputs(mech, args)
+    values = inputs(mech, args)
     if not values:
         raise UsageError("solve needs input values: --set NAME=VALUE or --set-angle LINK=ANGLE")
     near = parse_assignments([args.near], "--near") if args.near else None
@@ -275,38 +276,10 @@ def _solve(mech, args):
     return 0
 
 
-def _inputs(mech, args) -> dict:
-    """Input values from --set (joint values) and --set-angle (absolute link angles)."""
-
-    values = parse_assignments(getattr(args, "set", None), "--set")
-    angles = parse_assignments(getattr(args, "set_angle", None), "--set-angle")
-    if angles:
-
-        q = mech.generic_configurations()[1][0]
-        link_angles = LinkAngles(mech, mech.topology(q))
-        for link, angle in angles.items():
-            joint, value = link_angles.joint_value(link, angle)
-            if joint in values:
-                raise UsageError(f"joint '{joint}' is given twice (--set and --set-angle {link})")
-            values[joint] = value
-    return values
-
-
-def _configuration(mech, args):
-    """The configuration a command analyses: solved for --set values, else the assembled file one."""
-
-    values = _inputs(mech, args)
-    near = parse_assignments([args.near], "--near") if getattr(args, "near", None) else None
-    if not values:
-        return mech.generic_configurations()[0].q
-    res = PositionSolver(mech, list(values)).solve(values, near=near)
-    return res.solutions[0].q
-
-
 def _screws(mech, args):
     if not mech.cuts and not args.output:
         raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
-    q = _configuration(mech, args)
+    q = configuration(mech, args)
     st = structure(mech, q, args.output)
     topo = mech.topology(q)
     normal = None
@@ -322,7 +295,7 @@ def _screws(mech, args):
 def _singularities(mech, args):
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
-    q = _configuration(mech, args)
+    q = configuration(mech, args)
     rep = classify(mech, q, output=args.output, point=args.point)
     if args.json:
         print(json.dumps(to_jsonable(singularity_dict(rep)), indent=2))
@@ -363,7 +336,6 @@ def _map(mech, args):
         print(json.dumps(to_jsonable({"x": xn, "y": yn, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
                                       "kind": res.kind, "characteristic_length": mech.length}), indent=2))
     else:
-
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
               f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g} (L = {mech.length:.4g} m)"
@@ -398,10 +370,9 @@ def _scan(mech, args):
 
 
 def _view(mech, args):
-    q = _configuration(mech, args)
+    q = configuration(mech, args)
     motion, singular = None, []
     if args.sweep:
-
         name, values = _range(args.sweep, "--sweep")
         fixed = {k: v for k, v in parse_assignments(args.set, "--set").items() if k != name}
         inputs = list(mech.actuated) if name in mech.actuated else [name, *fixed]
@@ -475,7 +446,6 @@ def _sweep(mech, args):
         mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
     sing = list(res.limits)  # the limit positions met are always listed
     if args.singularities:
-
         sing = locate_singularities(solver, res, output=args.output, point=args.point)
     if args.csv:
         with open(args.csv, "w") as f:
@@ -559,7 +529,7 @@ def main(argv=None) -> int:
 
 
 # the commands in modules of their own, one line each:
-# _register(<module imported from .commands>)
+_register(statics_command)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -1,0 +1,82 @@
+"""Statics results (screwkin.analysis.statics) as text and JSON-ready dictionaries."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..analysis.statics import Leg, StaticsResult
+from .report import screw_dict, table
+
+__all__ = ["statics_dict", "statics_text"]
+
+
+def _screw_text(s) -> str:
+    pitch = f"pitch {s.pitch:.4g} m" if np.isfinite(s.pitch) else "pitch inf (a couple)"
+    point = "" if s.point is None else " through (" + ", ".join(f"{x:.4g}" for x in s.point) + ")"
+    return "axis (" + ", ".join(f"{x:.4g}" for x in s.direction) + ")" + point + ", " + pitch
+
+
+def leg_dict(leg: Leg) -> dict:
+    return {"joints": list(leg.joints), "actuated": list(leg.actuated), "twists": leg.twists,
+            "constraint_wrenches": [{"wrench": list(w), "screw": screw_dict(s)}
+                                    for w, s in zip(leg.constraint_wrenches, leg.constraint_screws)],
+            "transmission_wrenches": [{"wrench": list(w), "screw": screw_dict(s)}
+                                      for w, s in zip(leg.transmission_wrenches, leg.transmission_screws)]}
+
+
+def statics_dict(r: StaticsResult, legs=None) -> dict:
+    d = {"inputs": list(r.inputs), "efforts": r.efforts, "units": r.units, "wrench": list(r.wrench),
+         "output": r.output, "gravity": r.gravity, "equilibrium": r.equilibrium, "unbalanced": r.unbalanced,
+         "reactions": [{"joint": x.joint, "kind": x.kind, "wrench": list(x.wrench), "determinate": x.determinate}
+                       for x in r.reactions],
+         "indeterminate": r.indeterminate, "singular": r.singular, "sigma_actuator": r.sigma_actuator,
+         "amplification": r.amplification, "characteristic_length": r.length,
+         "constraint_forces": [{"row": k, "value": v} for k, v in r.constraint_forces]}
+    if legs is not None:
+        d["legs"] = [leg_dict(leg) for leg in legs]
+    return d
+
+
+def _num(x, fmt=".6g"):
+    return "?" if x is None else f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:{fmt}}"
+
+
+def statics_text(r: StaticsResult, legs=None) -> str:
+    load = []
+    if r.output is not None and any(r.wrench):
+        f, m = r.wrench[:3], r.wrench[3:]
+        load.append(f"wrench on '{r.output}' at its frame's origin: force ({', '.join(_num(x) for x in f)}) N, "
+                    f"moment ({', '.join(_num(x) for x in m)}) N m (world axes)")
+    if r.gravity:
+        load.append("the links' weights (Pinocchio's gravity, from the inertials)")
+    lines = ["load: " + ("; ".join(load) if load else "none")]
+    if not r.equilibrium:
+        lines.append(f"NO EQUILIBRIUM: the inputs ({', '.join(r.inputs) or 'none'}) cannot hold this load "
+                     f"(unbalanced generalized force {r.unbalanced:.3g})")
+    if r.inputs:
+        lines.append("")
+        lines.append(table(["actuator", "effort"], [
+            (n, "indeterminate (redundant actuation)" if r.efforts[n] is None else f"{_num(r.efforts[n])} {r.units[n]}")
+            for n in r.inputs]))
+        if r.singular:
+            lines.append(f"near an actuator singularity (relative sigma {r.sigma_actuator:.2g}): the efforts grow "
+                         f"without bound as the mechanism approaches it; amplification {r.amplification:.3g}")
+        elif r.amplification is not None:
+            lines.append(f"amplification |efforts| / |load| = {r.amplification:.3g} (lengths made dimensionless by "
+                         f"L = {r.length:.4g} m; actuator sigma {r.sigma_actuator:.3g})")
+    rows = [(x.joint, x.kind, *(_num(v, ".5g") for v in x.wrench)) for x in r.reactions]
+    lines.append("")
+    lines.append("joint reactions: what the parent side exerts on the child side, at each joint's origin, world axes")
+    lines.append(table(["joint", "kind", "fx [N]", "fy", "fz", "mx [N m]", "my", "mz"], rows))
+    if r.indeterminate:
+        lines.append(f"'?': not determined by statics ({r.indeterminate} redundant constraint or actuator "
+                     "direction(s): an overconstrained linkage, or a planar one's out-of-plane components)")
+    for k, leg in enumerate(legs or (), 1):
+        lines.append("")
+        lines.append(f"leg {k}: joints {', '.join(leg.joints)}; actuated {', '.join(leg.actuated) or 'none'}; "
+                     f"the leg alone lets the platform move in {leg.twists} direction(s)")
+        for s in leg.constraint_screws:
+            lines.append(f"  constraint wrench: {_screw_text(s)}")
+        for s in leg.transmission_screws:
+            lines.append(f"  transmission wrench: {_screw_text(s)}")
+    return "\n".join(lines)
