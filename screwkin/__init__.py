@@ -78,8 +78,9 @@ class Mechanism(_mechanism.Mechanism):
 
 
 def load(path, yaml=None, actuated=None, tolerances: Tolerances = _loader.DEFAULT, warn=None,
-         package_dirs=None) -> Mechanism:
-    """Read a mechanism file (URDF with <loop_joint> or a YAML sidecar, or SDF) into a
-    :class:`Mechanism`; see screwkin.model.loader.load for the arguments."""
+         package_dirs=None, args=None) -> Mechanism:
+    """Read a mechanism file (URDF with <loop_joint> or a YAML sidecar, SDF, or a xacro file
+    with its arguments ``args``, e.g. ``{"crank": "30mm"}``) into a :class:`Mechanism`; see
+    screwkin.model.loader.load for the arguments."""
     return _loader.load(path, yaml=yaml, actuated=actuated, tolerances=tolerances, warn=warn,
-                        package_dirs=package_dirs, cls=Mechanism)
+                        package_dirs=package_dirs, cls=Mechanism, args=args)

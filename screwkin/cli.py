@@ -30,6 +30,7 @@ from .analysis.sweep import locate_singularities, sweep
 from .commands import statics as statics_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
+from .files.xacro import parse_args as parse_xacro_args
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
 from .present.report import (
@@ -94,7 +95,10 @@ def _parser():
             sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                             help="show tracebacks of errors")
             return
-        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file")
+        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar), SDF, or xacro file")
+        sp.add_argument("--arg", action="append", dest="xacro_args", metavar="NAME=VALUE",
+                        help="xacro argument of a .xacro file (units allowed, e.g. crank=30mm: given in SI); "
+                             "repeatable")
         sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
         # SUPPRESS: when absent after the command, the top-level --debug (before the command) is kept
@@ -214,7 +218,7 @@ def _run(args):
     if command is not None and not command.NEEDS_MECHANISM:
         return command.run(None, args)
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
-                package_dirs=args.package_dirs)
+                package_dirs=args.package_dirs, args=parse_xacro_args(args.xacro_args))
     if getattr(args, "length", None):
         mech.length = parse_value(args.length)
     if args.command == "info":

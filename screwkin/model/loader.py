@@ -23,6 +23,8 @@ from ..files.description import LIMITS, placement
 from ..files.sdf import read_sdf
 from ..files.sidecar import axis_letters, read_yaml_sidecar
 from ..files.urdf import check_sizes, read_urdf
+from ..files.xacro import expand as expand_xacro
+from ..files.xacro import is_xacro
 from ..files.xmlsafe import parse_xml_text, read_regular_file
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import FRAME_PREFERENCE, frame_id
@@ -284,21 +286,41 @@ def _urdfdom_messages(box: list) -> list:
     return out
 
 
+def _print_warning(path):
+    def warn(m):
+        print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
+
+    return warn
+
+
 def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None,
-         cls=Mechanism) -> Mechanism:
-    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, or SDF).
+         cls=Mechanism, args=None, text=None) -> Mechanism:
+    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, SDF, or a xacro
+    file that expands to such a URDF).
 
     yaml:      path of an Extended-URDF sidecar; default: ``<file>.yaml`` when it exists.
     actuated:  actuated joint names, overriding the file's declaration.
     warn:      callable receiving each warning (default: print to stderr).
     package_dirs: folders searched first for ``package://`` meshes (as ``ROS_PACKAGE_PATH``).
+    args:      xacro arguments {name: value} (numbers, or text such as ``"30mm"``: SI); only
+               for xacro files (name ending in ``.xacro``, or declaring the xacro namespace).
+    text:      the file's text, when already read (``path`` still names it in messages and
+               locates its sidecar, meshes and includes).
 
-    The file is untrusted: see :mod:`screwkin.files.xmlsafe` and
-    :class:`~screwkin.files.description.Limits` for what is refused before Pinocchio reads it.
+    The file is untrusted: see :mod:`screwkin.files.xmlsafe`, :mod:`screwkin.files.xacro`
+    and :class:`~screwkin.files.description.Limits` for what is refused before Pinocchio
+    reads it.
     """
     path = Path(path)
-    text = _read_text(path)
+    text = _read_text(path) if text is None else text
     root = parse_xml_text(text, path)  # the root element decides the format, not the suffix
+    expansion_warnings = []
+    if is_xacro(path, text):
+        text = expand_xacro(path, text, args, root=root, warn=expansion_warnings.append)
+        root = parse_xml_text(text, path)
+    elif args:
+        raise UsageError(f"{path}: xacro arguments (--arg) are given but the file is not a xacro file (its name "
+                         "does not end in .xacro and it does not declare the xacro namespace)")
     package_dirs = [str(d) for d in package_dirs or ()]
     for d in package_dirs:
         if not os.path.isdir(d):
@@ -311,6 +333,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>, "
                                        "expected <sdf>")
     spec.package_dirs = package_dirs
+    spec.warnings[:0] = expansion_warnings
     native = []  # what urdfdom (inside Pinocchio) prints on the process's stderr: kept out of the output
     try:
         with _native_stderr(native):
@@ -334,9 +357,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
     _check_cut_bodies(model, spec)
     shown = spec.warnings
     if warn is None:  # on the terminal: a bounded number of bounded lines
-        def warn(m):
-            print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
-
+        warn = _print_warning(path)
         if len(shown) > MAX_WARNINGS:
             shown = shown[:MAX_WARNINGS] + [f"and {len(spec.warnings) - MAX_WARNINGS} more warnings"]
     for w in shown:

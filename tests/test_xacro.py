@@ -1,0 +1,278 @@
+"""Families of mechanisms as xacro files (robots/fourbar.urdf.xacro, robots/delta.urdf.xacro):
+each expands to the same mechanism as the plain URDF it generalizes, arguments (with units)
+change it, and hostile xacro files are one-line errors (exit 1), never code run, files read
+outside the folder, or a hang."""
+
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import screwkin
+from conftest import ROBOTS
+from screwkin.analysis.planar import identify
+from screwkin.cli import main
+from screwkin.files.xacro import XacroEvaluationError, check_expression, evaluate, parse_args
+from screwkin.model.mechanism import link_lengths
+
+FOURBAR = ROBOTS / "fourbar.urdf.xacro"
+DELTA = ROBOTS / "delta.urdf.xacro"
+HEAD = '<?xml version="1.0"?>\n<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+LINK = ('<link name="{n}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial></link>')
+
+
+def linkage(mech):
+    q = mech.generic_configurations()[1][0]
+    return identify(mech, mech.topology(q), q, "crank_joint")
+
+
+def test_fourbar_family_default_is_the_plain_crank_rocker():
+    plain = screwkin.load(ROBOTS / "fourbar_crank_rocker.urdf")
+    family = screwkin.load(FOURBAR)
+    a, b = linkage(plain), linkage(family)
+    assert a.grashof == b.grashof
+    for k in a.lengths:
+        assert b.lengths[k] == pytest.approx(a.lengths[k], abs=1e-12)
+    ma, mb = plain.mobility(output="rocker"), family.mobility(output="rocker")
+    assert (ma.mobility, ma.output.label, ma.gruebler) == (mb.mobility, mb.output.label, mb.gruebler) == (1, "1R", 1)
+    # the file's configuration closes the loop
+    assert np.abs(family.closure.residual(family.neutral())).max() < 1e-12
+
+
+def test_fourbar_arguments_with_units_change_the_lengths():
+    mech = screwkin.load(FOURBAR, args={"crank": "30mm", "coupler": 0.2, "rocker": "300 mm", "ground": "0.1"})
+    info = linkage(mech)
+    assert info.lengths == pytest.approx({"ground": 0.1, "input": 0.03, "coupler": 0.2, "output": 0.3}, abs=1e-12)
+    assert info.grashof.startswith("non-Grashof")  # 0.03 + 0.3 > 0.1 + 0.2
+    assert np.abs(mech.closure.residual(mech.neutral())).max() < 1e-12
+    drawn = screwkin.load(FOURBAR, args={"theta": "60deg"})
+    a = drawn.model.jointPlacements[drawn.model.getJointId("crank_joint")]
+    assert math.atan2(a.rotation[1, 0], a.rotation[0, 0]) == pytest.approx(math.pi / 3)
+
+
+def test_delta_family_default_is_the_plain_delta():
+    plain = screwkin.load(ROBOTS / "delta_parallelogram.urdf")
+    family = screwkin.load(DELTA)
+    assert set(plain.model.names) == set(family.model.names)
+    for j in range(1, plain.model.njoints):
+        k = family.model.getJointId(plain.model.names[j])
+        assert family.model.jointPlacements[k].isApprox(plain.model.jointPlacements[j], 1e-12)
+        assert family.model.joints[k].shortname() == plain.model.joints[j].shortname()
+    assert [c.name for c in family.cuts] == [c.name for c in plain.cuts]
+    for c, d in zip(family.cuts, plain.cuts):
+        for f, g in ((c.frame1, d.frame1), (c.frame2, d.frame2)):
+            assert family.model.frames[f].placement.isApprox(plain.model.frames[g].placement, 1e-12)
+    assert sorted(link_lengths(family.model, family.cuts)) == pytest.approx(
+        sorted(link_lengths(plain.model, plain.cuts)), abs=1e-12)
+    r = family.mobility(output="platform")
+    assert (r.mobility, r.idle_dofs, r.effective_mobility, r.output.label) == (9, 6, 3, "3T")
+    assert family.actuated == plain.actuated == ["arm1", "arm2", "arm3"]
+
+
+def test_delta_with_longer_rods_closes_its_loops():
+    mech = screwkin.load(DELTA, args={"arm": "250mm", "rod": "0.5", "arm_angle": "20deg"})
+    assert np.abs(mech.closure.residual(mech.neutral())).max() < 1e-12
+    platform = mech.model.frames[mech.link_frame("platform")]
+    data = mech.model.createData()
+    import pinocchio as pin
+    pin.framesForwardKinematics(mech.model, data, mech.neutral())
+    z = data.oMf[mech.link_frame("platform")].translation[2]
+    h = 0.15 + 0.25 * math.cos(math.radians(20)) - 0.04
+    assert z == pytest.approx(-0.25 * math.sin(math.radians(20)) - math.sqrt(0.25 - h * h), abs=1e-12)
+    assert platform is not None
+    r = mech.mobility(output="platform")
+    assert (r.effective_mobility, r.output.label) == (3, "3T")
+
+
+def test_cli_takes_arg(capsys):
+    assert main(["mobility", str(FOURBAR), "--arg", "crank=30mm", "--arg", "coupler=0.11", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["mobility"] == 1
+    assert main(["info", str(DELTA), "--arg", "rod=0.45"]) == 0
+    assert "platform" in capsys.readouterr().out
+
+
+def test_parse_args():
+    assert parse_args(["a=30mm", "b=0.1", "c=left_", "n=3"]) == {"a": "0.03", "b": "0.1", "c": "left_", "n": "3"}
+    with pytest.raises(screwkin.UsageError, match="NAME=VALUE"):
+        parse_args(["a"])
+    with pytest.raises(screwkin.UsageError, match="twice"):
+        parse_args(["a=1", "a=2"])
+    with pytest.raises(screwkin.UsageError, match="not a xacro argument name"):
+        parse_args(["a-b=1"])
+
+
+# ------------------------------------------------------------------ the expression subset
+@pytest.mark.parametrize("expr, value", [
+    ("1 + 2 * 3", 7), ("2 ** 10", 1024), ("sqrt(16)", 4.0), ("math.sin(math.pi / 2)", 1.0),
+    ("atan2(1, 1) * 4", math.pi), ("max(1, 2.5, -3)", 2.5), ("abs(-2)", 2), ("pow(2, 3)", 8),
+    ("'a' + 'b'", "ab"), ("1 if 2 > 1 else 0", 1), ("not 0 and 3", 3), ("radians(180)", math.pi),
+    ("x * 2", 0.2), ("floor(2.5) + ceil(2.5)", 5), ("log(math.e)", 1.0), ("1 < 2 <= 2", True),
+])
+def test_expressions_in_the_subset(expr, value):
+    check_expression(expr)
+    assert evaluate(expr, {"x": 0.1}) == pytest.approx(value)
+
+
+HOSTILE_EXPRESSIONS = [
+    "__import__('os').system('echo hacked')", "().__class__", "().__class__.__bases__[0].__subclasses__()",
+    "open('/etc/passwd').read()", "python.type(1)", "xacro.load_yaml('x.yaml')", "load_yaml('x.yaml')",
+    "[1, 2]", "{'a': 1}", "(lambda: 1)()", "f'{x}'", "x[0]", "eval('1')", "exec('1')", "getattr(x, 'y')",
+    "type(1)", "str(1)", "math.__dict__", "_secret", "(x := 1)", "1 in [1]", "[i for i in range(10)]",
+    "sin(x=1)", "globals()", "vars()", "x.real",
+]
+
+
+@pytest.mark.parametrize("expr", HOSTILE_EXPRESSIONS)
+def test_hostile_expressions_are_refused(expr):
+    with pytest.raises(ValueError, match="only numbers"):
+        check_expression(expr)
+    with pytest.raises(XacroEvaluationError):
+        evaluate(expr, {"x": 1.0, "python": {}, "xacro": {}})
+
+
+@pytest.mark.parametrize("expr", ["9 ** 9 ** 9", "10 ** 400", "'a' * 1000000000", "'%999999999s' % 1",
+                                  "exp(1000)", "2 ** 64 ** 2", "pow(10, 10 ** 10)"])
+def test_expensive_expressions_fail_fast(expr):
+    t = time.perf_counter()
+    try:
+        v = evaluate(expr, {})
+        assert not isinstance(v, int) or abs(v) <= 2**63  # a float (inf), never a huge integer
+    except XacroEvaluationError:
+        pass
+    assert time.perf_counter() - t < 0.5
+
+
+@given(st.text(max_size=200))
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+def test_any_text_is_evaluated_or_refused(text):
+    try:
+        evaluate(text, {"a": 1.0, "b": "x"})
+    except (XacroEvaluationError, NameError, ArithmeticError, ValueError, TypeError):
+        pass
+
+
+# ------------------------------------------------------------------ hostile files: one line, exit 1
+def fourbar_with(extra_head="", body_extra="", prolog=""):
+    """A small valid xacro four-bar (no loop joint: a serial chain is enough) with extras."""
+    return (f'{prolog}{HEAD}{extra_head}<xacro:arg name="l" default="0.1"/>'
+            + LINK.format(n="base") + LINK.format(n="arm")
+            + '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/>'
+              '<origin xyz="$(arg l) 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+              f'</joint>{body_extra}</robot>')
+
+
+HOSTILE_FILES = {
+    "import": ('<link name="${__import__(\'os\').system(\'touch /tmp/screwkin_hacked\')}"/>', "__import__"),
+    "class": ('<link name="${().__class__}"/>', "attribute access"),
+    "subclasses": ('<link name="${().__class__.__bases__[0].__subclasses__()}"/>', "a call of"),
+    "env": ('<link name="$(env HOME)"/>', "only $(arg NAME)"),
+    "optenv": ('<link name="$(optenv HOME x)"/>', "only $(arg NAME)"),
+    "find": ('<link name="$(find x)"/>', "only $(arg NAME)"),
+    "eval": ('<link name="$(eval 1 + 1)"/>', "only $(arg NAME)"),
+    "dirname": ('<link name="$(dirname)"/>', "only $(arg NAME)"),
+    "cwd": ('<link name="$(cwd)"/>', "only $(arg NAME)"),
+    "env_in_expression": ('<link name="${$(env HOME)}"/>', "only $(arg NAME)"),
+    "load_yaml": ('<xacro:property name="p" value="${load_yaml(\'/etc/passwd\')}"/>', "load_yaml"),
+    "xacro_load_yaml": ('<xacro:property name="p" value="${xacro.load_yaml(\'x.yaml\')}"/>', "load_yaml"),
+    "include_passwd": ('<xacro:include filename="/etc/passwd"/>', "outside the folder"),
+    "include_parent": ('<xacro:include filename="../../../../etc/hostname"/>', "outside the folder"),
+    "include_glob": ('<xacro:include filename="*.xacro"/>', "wildcards"),
+    "computed_include_outside": ('<xacro:include filename="${\'/etc/\' + \'passwd\'}"/>', "outside the folder"),
+    "string_bomb": ('<xacro:property name="p" value="${\'a\' * 1000000000}"/><link name="${p}"/>', "on text"),
+    "power_bomb": ('<origin xyz="${9 ** 9 ** 9}"/>', "overflow"),
+    "undefined": ('<link name="${nothere}"/>', "nothere"),
+    "bad_arg_use": ('<link name="$(arg missing)"/>', "'missing' has no value"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE_FILES))
+def test_hostile_xacro_files(tmp_path, capsys, case):
+    extra, word = HOSTILE_FILES[case]
+    path = tmp_path / "m.urdf.xacro"
+    path.write_text(fourbar_with(body_extra=extra))
+    code = main(["info", str(path)])
+    err = capsys.readouterr().err
+    assert code == 1, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(f"screwkin: error: {path}: "), lines[0]
+    assert word in lines[0], lines[0]
+    assert len(lines[0]) < 400 + len(str(path))
+    assert not (tmp_path / "screwkin_hacked").exists()
+
+
+def test_entities_depth_and_size(tmp_path, capsys):
+    cases = {
+        "entity": (fourbar_with(prolog='<!DOCTYPE r [<!ENTITY a "aaaaaaaaaa">]>\n').replace(
+            '<?xml version="1.0"?>\n', ""), "entity"),
+        "deep": (fourbar_with(body_extra="<a>" * 200 + "</a>" * 200), "nested deeper"),
+    }
+    for name, (text, word) in cases.items():
+        path = tmp_path / f"{name}.urdf.xacro"
+        path.write_text(text)
+        assert main(["info", str(path)]) == 1, name
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and word in err, err
+    huge = tmp_path / "huge.urdf.xacro"
+    with open(huge, "wb") as f:
+        f.truncate(25_000_000)
+    assert main(["info", str(huge)]) == 1
+    assert "MB" in capsys.readouterr().err
+
+
+def test_macro_bomb_and_recursion_are_bounded(tmp_path, capsys):
+    # each macro calls the one before twice: 2**30 copies if unbounded
+    macros = '<xacro:macro name="m0"><link name="x"/></xacro:macro>' + "".join(
+        f'<xacro:macro name="m{k}"><xacro:m{k - 1}/><xacro:m{k - 1}/></xacro:macro>' for k in range(1, 31))
+    cases = {"bomb": (macros + "<xacro:m30/>", "more than 5000 macro calls"),
+             "recursive": ('<xacro:macro name="r"><xacro:r/></xacro:macro><xacro:r/>', "nested too deeply"),
+             "self_include": ('<xacro:include filename="self.urdf.xacro"/>', "files included")}
+    for name, (extra, word) in cases.items():
+        path = tmp_path / "self.urdf.xacro"
+        path.write_text(fourbar_with(body_extra=extra))
+        t = time.perf_counter()
+        assert main(["info", str(path)]) == 1, name
+        assert time.perf_counter() - t < 10
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and word in err, (name, err)
+
+
+def test_includes_beside_the_file_work(tmp_path, capsys):
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "arm.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="arm" params="n">'
+        + LINK.format(n="${n}") + "</xacro:macro></robot>")
+    path = tmp_path / "m.urdf.xacro"
+    path.write_text(f'{HEAD}<xacro:include filename="parts/arm.xacro"/>' + LINK.format(n="base")
+                    + '<xacro:arm n="arm"/><joint name="j" type="revolute"><parent link="base"/><child link="arm"/>'
+                      '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+    assert main(["info", str(path)]) == 0, capsys.readouterr().err
+    assert "arm" in capsys.readouterr().out
+    (tmp_path / "parts" / "arm.xacro").write_text('<!DOCTYPE r [<!ENTITY a "b">]><robot/>')
+    assert main(["info", str(path)]) == 1
+    assert "entity" in capsys.readouterr().err
+
+
+def test_arguments_errors(tmp_path, capsys):
+    path = tmp_path / "m.urdf.xacro"
+    path.write_text(fourbar_with(extra_head='<xacro:arg name="needed"/>'))
+    assert main(["info", str(path)]) == 1
+    assert "'needed' has no default" in capsys.readouterr().err
+    assert main(["info", str(path), "--arg", "needed=1"]) == 0
+    capsys.readouterr()
+    assert main(["info", str(path), "--arg", "needed=1", "--arg", "typo=2"]) == 2
+    assert "declares no xacro argument 'typo'" in capsys.readouterr().err
+    assert main(["info", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--arg", "a=1"]) == 2
+    assert "not a xacro file" in capsys.readouterr().err
+
+
+def test_a_design_that_does_not_close_is_an_assembly_error():
+    mech = screwkin.load(FOURBAR, args={"ground": 0.5})  # 0.5 > 0.04 + 0.12 + 0.08
+    with pytest.raises(screwkin.AssemblyError):
+        mech.assemble()
