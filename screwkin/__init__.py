@@ -26,6 +26,8 @@ from .analysis.position import (
 )
 from .analysis.scan import ScanResult, scan
 from .analysis.singular import SingularityReport, classify
+from .analysis.study import StudyResult, pareto_front
+from .analysis.study import run_study as _run_study
 from .analysis.sweep import SweepResult, SweepSingularity, locate_singularities, sweep
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
 from .model import loader as _loader
@@ -54,6 +56,9 @@ __all__ = [
     "locate_singularities",
     "ScanResult",
     "scan",
+    "study",
+    "StudyResult",
+    "pareto_front",
     "SerialJacobians",
     "to_dict",
     "Tolerances",
@@ -84,3 +89,12 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = _loader.DEFAUL
     screwkin.model.loader.load for the arguments."""
     return _loader.load(path, yaml=yaml, actuated=actuated, tolerances=tolerances, warn=warn,
                         package_dirs=package_dirs, cls=Mechanism, args=args)
+
+
+def study(spec, scheduler=None, workers=None, progress=None, timeout: float = 10.0, base=None) -> StudyResult:
+    """Run a design-space study (what ``screwkin study`` runs): ``spec`` a spec file's path or
+    a dict as the YAML (its ``file`` relative to ``base``); on a LocalCluster of ``workers``
+    processes, or on the dask.distributed cluster at ``scheduler`` (``tcp://host:port``);
+    ``workers=0`` in this process.  Returns a StudyResult: ``.rows`` (dicts, SI), ``.table``
+    (columns); screwkin.present.study writes CSV, Parquet, text and plots."""
+    return _run_study(spec, scheduler=scheduler, workers=workers, progress=progress, timeout=timeout, base=base)

@@ -28,6 +28,7 @@ from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
 from .commands import statics as statics_command
+from .commands import study as study_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
@@ -534,6 +535,7 @@ def main(argv=None) -> int:
 
 # the commands in modules of their own, one line each:
 _register(statics_command)
+_register(study_command)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

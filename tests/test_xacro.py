@@ -9,14 +9,19 @@ import time
 
 import numpy as np
 import pytest
+from conftest import ROBOTS
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import screwkin
-from conftest import ROBOTS
 from screwkin.analysis.planar import identify
 from screwkin.cli import main
-from screwkin.files.xacro import XacroEvaluationError, check_expression, evaluate, parse_args
+from screwkin.files.xacro import (
+    XacroEvaluationError,
+    check_expression,
+    evaluate,
+    parse_args,
+)
 from screwkin.model.mechanism import link_lengths
 
 FOURBAR = ROBOTS / "fourbar.urdf.xacro"

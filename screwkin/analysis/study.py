@@ -1,0 +1,563 @@
+"""Design-space studies: the designs of a family (a xacro file over its arguments), the
+metrics of each, run on Dask.
+
+The designs are the grid of the parameters' values (first parameter slowest), or
+``designs`` random or Latin-hypercube draws (``seed``).  Each design is loaded (the xacro
+expanded with its values, in SI), assembled, and its metrics computed (:data:`METRICS`);
+a design that fails -- the file refuses the values, the loops do not close, it is not a
+four-bar for ``grashof`` -- is a row whose ``error`` says why, with its metric columns
+empty: a study never loses a run to one design.
+
+Designs run in chunks, many per Dask task (:func:`run_chunk`), on a ``LocalCluster`` of
+processes on 127.0.0.1 by default or on an existing cluster (``scheduler="tcp://..."``);
+results come back in design order.  Every design is computed from its values alone (fresh
+mechanism, seeded searches), so the table is the same whatever the number of workers,
+the chunks or the scheduler.  ``workers=0`` runs the chunks in this process (no Dask).
+
+Values are SI: lengths in m, angles in rad (the transmission angles too; the CSV that
+people read gives degrees: screwkin.present.study).
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import os
+import time
+import uuid
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import AssemblyError, ScrewkinError, UsageError, one_line, quote
+from ..files.description import LIMITS
+from ..files.study import StudySpec, read_study_spec, study_spec
+from ..files.xmlsafe import read_regular_file
+from ..model.loader import load
+from .mobility import analyze_mobility
+from .planar import identify
+from .position import PositionSolver
+
+__all__ = [
+    "COLUMNS",
+    "METRICS",
+    "StudyResult",
+    "default_workers",
+    "designs",
+    "pareto_front",
+    "run_chunk",
+    "run_study",
+]
+
+#: The columns each metric fills (keys of the rows, SI values).
+COLUMNS = {
+    "mobility": ("mobility", "mobility_count", "motion_space", "overconstraint", "idle_dofs", "effective_mobility",
+                 "output_motion"),
+    "grashof": ("linkage", "grashof", "grashof_margin"),
+    "transmission_angle": ("transmission_angle_min", "transmission_angle_max"),
+    "workspace_volume": ("workspace_dimension", "workspace_volume"),
+    "singularity_free_volume": ("workspace_dimension", "singularity_free_volume"),
+    "conditioning": ("conditioning_min", "conditioning_mean"),
+}
+
+#: Short Grashof classes, from the start of analysis.planar's class sentences.
+_GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
+            ("Grashof crank-rocker", "crank-rocker"), ("Grashof double crank", "double-crank"),
+            ("Grashof double rocker", "double-rocker"), ("Grashof rocker-crank", "rocker-crank"),
+            ("crank turns fully", "crank-turns"), ("crank cannot turn fully", "crank-rocks"))
+
+#: Relative margin at the ends of a limited input range (limit positions) in the transmission sweep.
+RANGE_MARGIN = 1e-9
+
+
+def default_workers() -> int:
+    """Workers of the local cluster by default: the cores, at most 4."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    return max(1, min(cores, 4))
+
+
+# ------------------------------------------------------------------ the designs
+def _steps(low: float, high: float, n: int) -> tuple:
+    """n values from low to high, both ends exact (low (1 - t) + high t: 0.02..0.06 in 3 gives 0.04,
+    where numpy's linspace gives 0.039999999999999994)."""
+    if n == 1:
+        return (float(low),)
+    return tuple(float(low * (1 - k / (n - 1)) + high * (k / (n - 1))) for k in range(n))
+
+
+def designs(spec: StudySpec) -> list:
+    """The parameter values of every design (tuples in the order of ``spec.parameters``, SI)."""
+    params = spec.parameters
+    if spec.sampling == "grid":
+        axes = [p.values if p.values is not None else _steps(p.low, p.high, p.samples) for p in params]
+        return [tuple(float(v) for v in combo) for combo in itertools.product(*axes)]
+    n = spec.designs
+    rng = np.random.default_rng(spec.seed)
+    columns = []
+    for p in params:
+        if spec.sampling == "random":
+            u = rng.uniform(size=n)
+        else:  # Latin hypercube: one draw in each of n equal strata, strata in random order
+            u = (rng.permutation(n) + rng.uniform(size=n)) / n
+        if p.values is not None:
+            k = np.minimum((u * len(p.values)).astype(int), len(p.values) - 1)
+            columns.append([float(p.values[i]) for i in k])
+        else:
+            columns.append([float(p.low + x * (p.high - p.low)) for x in u])
+    return list(zip(*columns)) if columns else []
+
+
+# ------------------------------------------------------------------ one design
+@dataclass(frozen=True)
+class _Task:
+    """What a worker needs for the designs of a study (picklable: sent with every chunk)."""
+
+    file: str
+    text: str  # the file's text, read once by the client: every design sees the same file
+    args: dict
+    parameters: tuple
+    metrics: tuple
+    input: str | None
+    output: str | None
+    point: bool
+    workspace: dict
+    steps: int
+
+
+class _Design:
+    """One loaded design and what its metrics share (assembly, linkage, workspace)."""
+
+    def __init__(self, task: _Task, mech):
+        self.task, self.mech = task, mech
+        self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
+        self._linkage = None
+        self._workspace = None
+
+    @property
+    def input(self) -> str:
+        if self.task.input:
+            self.mech.coordinate(self.task.input)  # a UsageError naming the joints when unknown
+            return self.task.input
+        if len(self.mech.actuated) != 1:
+            raise UsageError(f"the file declares {len(self.mech.actuated)} actuated joints: give input: JOINT "
+                             "in the study")
+        return self.mech.actuated[0]
+
+    def linkage(self):
+        if self._linkage is None:
+            info = identify(self.mech, self.mech.topology(self.q), self.q, self.input)
+            if info is None:
+                raise UsageError(f"not a planar four-bar or slider-crank driven by a revolute joint to the ground "
+                                 f"({quote(self.input)}): no Grashof class or transmission angle")
+            self._linkage = info
+        return self._linkage
+
+    def workspace(self):
+        if self._workspace is None:
+            try:
+                # until merged: screwkin.analysis.workspace (the lead's); tests/test_layers.py allows this lazy import
+                from .workspace import workspace
+            except ImportError:
+                raise UsageError("the workspace metrics need screwkin.analysis.workspace, which this screwkin "
+                                 "lacks") from None
+            ws = self.task.workspace
+            self._workspace = workspace(self.mech, self.task.output, point=ws.get("point", False),
+                                        resolution=ws.get("resolution"), threshold=ws.get("threshold", 0.01),
+                                        length=ws.get("length"))
+        return self._workspace
+
+
+def _mobility(d: _Design) -> dict:
+    r = analyze_mobility(d.mech, output=d.task.output, point=d.task.point)
+    return {"mobility": r.mobility, "mobility_count": r.topology.count_in_motion_space,
+            "motion_space": r.motion_space, "overconstraint": r.overconstraint, "idle_dofs": r.idle_dofs,
+            "effective_mobility": r.effective_mobility, "output_motion": r.output.label if r.output else None}
+
+
+def _grashof(d: _Design) -> dict:
+    info = d.linkage()
+    short = next((s for prefix, s in _GRASHOF if info.grashof.startswith(prefix)), None)
+    if short is None:  # pragma: no cover - a class sentence of planar.py this table does not know
+        raise RuntimeError(f"unknown Grashof class {info.grashof!r}")
+    L = info.lengths
+    if info.kind == "four-bar":
+        values = sorted(L.values())
+        margin = values[1] + values[2] - values[0] - values[3]  # (p + q) - (s + l)
+    else:
+        margin = L["rod"] - L["crank"] - L["offset"]
+    return {"linkage": info.kind, "grashof": short, "grashof_margin": float(margin)}
+
+
+def _transmission(d: _Design) -> dict:
+    """Smallest and largest transmission angle over the input's motion: the input at
+    ``steps`` + 1 values over a full turn (or over its range, ends taken RANGE_MARGIN of the
+    range inside the limit positions), each configuration tracked from the previous one (or
+    solved anew when tracking fails) and checked; the angles of all of them at once from
+    their joint centres (:func:`_angles`), which at the assembled configuration must equal
+    analysis.planar.identify's."""
+    info = d.linkage()
+    mech, name, steps = d.mech, d.input, d.task.steps
+    coord = mech.coordinate(name)
+    x0 = float(d.q[coord.idx_q]) if coord.nq == 1 else float(np.arctan2(d.q[coord.idx_q + 1], d.q[coord.idx_q]))
+    solver = PositionSolver(mech, [name])
+    if info.input_range is None:
+        paths = [x0 + np.linspace(0.0, 2 * np.pi, steps + 1)]
+    else:
+        lo, hi = info.input_range
+        margin = RANGE_MARGIN * (hi - lo)
+        lo, hi = lo + margin, hi - margin
+        x0 = min(max(x0, lo), hi)
+        up = max(2, round(steps * (hi - x0) / (hi - lo)) + 1)
+        paths = [np.linspace(x0, hi, up), np.linspace(x0, lo, max(2, steps + 2 - up))]
+    Q = []
+    for path in paths:
+        q = d.q
+        for k, x in enumerate(path):
+            try:
+                q = solver.track({name: float(x)}, q).q
+            except AssemblyError:
+                if k == 0:
+                    raise
+                q = solver.solve({name: float(x)}, starts=8).solutions[0].q  # checked, or AssemblyError
+            Q.append(q)
+    mus = _angles(d, info, Q)
+    return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max())}
+
+
+def _angles(d: _Design, info, Q) -> np.ndarray:
+    """Transmission angles [rad] at the configurations Q (rows) of the linkage ``info``
+    describes (at d.q): from the centres of its joints, found as identify finds them."""
+    mech, name = d.mech, d.input
+    topo = mech.topology(d.q)
+    joints = {j.name: j for j in topo.joints}
+
+    def other(link, joint):
+        return next(j for j in topo.joints if j is not joint and link in j.links)
+
+    inp = joints[name]
+    moving = inp.links[1] if inp.links[0] == topo.ground else inp.links[0]
+    j_b = other(moving, inp)
+    coupler = j_b.links[1] if j_b.links[0] == moving else j_b.links[0]
+    j_c = other(coupler, j_b)
+    j_d = other(topo.ground, inp)
+    getters = []
+    cuts = {c.name: c for c in mech.cuts}
+    for j in (inp, j_b, j_c, j_d):
+        if j.cut and j.name in cuts:
+            getters.append(("frame", cuts[j.name].frame1))
+        elif not j.cut and len(j.members) == 1 and mech.model.existJointName(j.members[0]):
+            getters.append(("joint", mech.model.getJointId(j.members[0])))
+        else:  # a compound joint: the slow way, identify at each configuration
+            return np.array([identify(mech, mech.topology(q), q, name).transmission_angle for q in Q])
+    model, data = mech.model, mech.model.createData()
+    Q = [d.q, *Q]  # the first, where identify measured it: the check
+    P = np.empty((len(Q), 4, 3))
+    for k, q in enumerate(Q):
+        pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacements(model, data)
+        for i, (kind, ident) in enumerate(getters):
+            P[k, i] = data.oMf[ident].translation if kind == "frame" else data.oMi[ident].translation
+    n = np.asarray(inp.direction, float)
+    n /= np.linalg.norm(n)
+
+    def planar(v):  # v projected into the plane of motion
+        return v - (v @ n)[..., None] * n
+
+    _, B, C, D = (P[:, i] for i in range(4))
+    if info.kind == "four-bar":
+        u, w = planar(B - C), planar(D - C)
+        cos = np.einsum("ij,ij->i", u, w) / (np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1))
+        mus = np.arccos(np.clip(cos, -1.0, 1.0))
+    else:  # slider-crank: the rod against the normal of the slide
+        s = planar(np.asarray(j_d.direction if j_d.type == "prismatic" else j_c.direction, float))
+        s /= np.linalg.norm(s)
+        nrm = np.cross(n, s)
+        rod = planar(C - B)
+        rod /= np.linalg.norm(rod, axis=1)[:, None]
+        mus = np.arccos(np.clip(np.abs(rod @ nrm), 0.0, 1.0))
+    if not np.isclose(mus[0], info.transmission_angle, atol=1e-9):  # pragma: no cover - the two ways must agree
+        raise RuntimeError(f"transmission angle {mus[0]!r} from the joint centres, {info.transmission_angle!r} "
+                           "from analysis.planar.identify")
+    return mus
+
+
+def _workspace_volume(d: _Design) -> dict:
+    w = d.workspace()
+    return {"workspace_dimension": w.dimension, "workspace_volume": w.volume}
+
+
+def _singularity_free_volume(d: _Design) -> dict:
+    w = d.workspace()
+    return {"workspace_dimension": w.dimension, "singularity_free_volume": w.free_volume}
+
+
+def _conditioning(d: _Design) -> dict:
+    w = d.workspace()
+    return {"conditioning_min": w.conditioning_min, "conditioning_mean": w.conditioning_mean}
+
+
+#: metric name -> function of a loaded, assembled design returning its columns (COLUMNS).
+METRICS = {"mobility": _mobility, "grashof": _grashof, "transmission_angle": _transmission,
+           "workspace_volume": _workspace_volume, "singularity_free_volume": _singularity_free_volume,
+           "conditioning": _conditioning}
+
+
+def metric_columns(metrics) -> tuple:
+    """The metric columns of a study, in order, each once."""
+    out = []
+    for m in metrics:
+        out += [c for c in COLUMNS[m] if c not in out]
+    return tuple(out)
+
+
+def _reason(exc, path: str) -> str:
+    """The one-line reason of a design's failure, without the file's path every row shares."""
+    text = str(exc)
+    for prefix in (f"{path}: ", f"{Path(path).name}: "):
+        text = text.removeprefix(prefix)
+    return one_line(text, 400)
+
+
+def _evaluate(task: _Task, index: int, values: tuple) -> dict:
+    row = {"design": index, **dict(zip(task.parameters, values))}
+    columns = metric_columns(task.metrics)
+    row.update(dict.fromkeys(columns))
+    row["error"] = None
+    try:
+        args = dict(task.args)
+        args.update({n: repr(float(v)) for n, v in zip(task.parameters, values)})
+        mech = load(task.file, text=task.text, args=args, warn=lambda m: None)
+        d = _Design(task, mech)
+        computed = {}
+        for m in task.metrics:
+            computed.update(METRICS[m](d))
+        row.update(computed)
+    except ScrewkinError as exc:
+        row["error"] = _reason(exc, task.file)
+    except Exception as exc:  # noqa: BLE001 - a bug (or a missing module on a worker): the row says it, the run goes on
+        row["error"] = f"internal error: {type(exc).__name__}: {one_line(str(exc), 300)}"
+    return row
+
+
+def run_chunk(task: _Task, chunk) -> list:
+    """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes."""
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return [_evaluate(task, i, v) for i, v in chunk]
+
+
+# ------------------------------------------------------------------ the study
+@dataclass(frozen=True)
+class StudyResult:
+    """The rows of a study, in design order: ``design`` (its index), the parameters' values,
+    the metric columns (None when failed or not applicable) and ``error`` (None, or why the
+    design failed).  SI values."""
+
+    spec: StudySpec
+    parameters: tuple  # parameter names
+    columns: tuple  # metric columns
+    rows: tuple  # dicts
+    seconds: float
+    workers: int
+    scheduler: str  # "in process", "local cluster" or the scheduler's address
+    chunks: int = 0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def table(self) -> dict:
+        """Column name -> list of values in design order (design, parameters, metrics, error)."""
+        names = ("design", *self.parameters, *self.columns, "error")
+        return {n: [r[n] for r in self.rows] for n in names}
+
+    @property
+    def failed(self) -> tuple:
+        return tuple(r for r in self.rows if r["error"] is not None)
+
+    @property
+    def succeeded(self) -> tuple:
+        return tuple(r for r in self.rows if r["error"] is None)
+
+
+def _task(spec: StudySpec) -> _Task:
+    raw = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
+    return _Task(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
+                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps)
+
+
+def _resolve(name: str, keys) -> str | None:
+    for cand in (name, name.removesuffix("_deg")):
+        if cand in keys:
+            return cand
+    return None
+
+
+def pareto_front(result: StudyResult, goals=None) -> list:
+    """Indices (into result.rows) of the designs on the Pareto front of two columns:
+    ``goals`` ((column, "max" | "min"), (column, "max" | "min")), default the spec's
+    ``pareto``.  Rows without both values are left out; the front is ordered by the first
+    column.  A design is on it when no other is at least as good in both and better in one."""
+    goals = goals or result.spec.pareto
+    if not goals:
+        raise UsageError(f"{result.spec.path}: no pareto columns: give pareto: {{maximize: [...], minimize: [...]}}")
+    keys = (*result.parameters, *result.columns)
+    cols = []
+    for name, goal in goals:
+        key = _resolve(name, keys)
+        if key is None or goal not in ("max", "min"):
+            raise UsageError(f"{result.spec.path}: pareto column {quote(name)} is not a column of this study "
+                             f"(columns: {', '.join(keys)})")
+        cols.append((key, 1.0 if goal == "max" else -1.0))
+    pts = []
+    for k, r in enumerate(result.rows):
+        vals = [r[c] for c, _ in cols]
+        if r["error"] is None and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                                      for v in vals):
+            pts.append((k, vals[0] * cols[0][1], vals[1] * cols[1][1]))
+    front = [k for k, a, b in pts
+             if not any((a2 >= a and b2 >= b) and (a2 > a or b2 > b) for _, a2, b2 in pts)]
+    return sorted(front, key=lambda k: result.rows[k][cols[0][0]])
+
+
+def _chunks(items: list, size: int) -> list:
+    return [items[i:i + size] for i in range(0, len(items), size)]
+
+
+def _check_pareto(spec: StudySpec) -> None:
+    if spec.pareto:
+        keys = (*(p.name for p in spec.parameters), *metric_columns(spec.metrics))
+        for name, _ in spec.pareto:
+            if _resolve(name, keys) is None:
+                raise UsageError(f"{spec.path}: pareto column {quote(name)} is not a column of this study "
+                                 f"(columns: {', '.join(keys)})")
+
+
+def run_study(spec, scheduler: str | None = None, workers: int | None = None, progress=None,
+              timeout: float = 10.0, base=None) -> StudyResult:
+    """Run a study: ``spec`` a StudySpec, a spec file's path, or a dict (its ``file``
+    relative to ``base``, default the current folder).
+
+    scheduler: address of a running dask.distributed scheduler (``tcp://host:port``);
+               None: a LocalCluster of ``workers`` processes (default :func:`default_workers`)
+               on 127.0.0.1, closed at the end; ``workers=0``: in this process, no Dask.
+    progress:  callable(done, total, failed) called as chunks complete.
+    timeout:   seconds to reach the scheduler and its first worker (UsageError after).
+    """
+    if isinstance(spec, dict):
+        spec = study_spec(spec, "<dict>", Path(base) if base is not None else None)
+    elif not isinstance(spec, StudySpec):
+        spec = read_study_spec(spec)
+    _check_pareto(spec)
+    if scheduler is not None and workers is not None:
+        raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
+        raise UsageError(f"workers must be a whole number, 0 or more (0: in this process), got {workers!r}")
+    if not timeout > 0:
+        raise UsageError(f"the timeout must be positive, got {timeout!r}")
+    task = _task(spec)
+    values = designs(spec)
+    n_workers = default_workers() if workers is None and scheduler is None else (workers or 1)
+    size = spec.chunk or max(1, min(64, math.ceil(len(values) / (4 * max(n_workers, 1)))))
+    chunks = _chunks(list(enumerate(values)), size)
+    t0 = time.perf_counter()
+    if progress:
+        progress(0, len(values), 0)
+    if scheduler is None and workers == 0:
+        results, failed = [], 0
+        for k, chunk in enumerate(chunks):
+            results.append(run_chunk(task, chunk))
+            failed += sum(r["error"] is not None for r in results[-1])
+            if progress:
+                progress(sum(len(c) for c in chunks[:k + 1]), len(values), failed)
+        where, used = "in process", 1
+    else:
+        results, used, where = _on_dask(task, chunks, len(values), scheduler, workers or n_workers, timeout,
+                                        progress)
+    rows = tuple(r for chunk_rows in results for r in chunk_rows)
+    return StudyResult(spec, task.parameters, metric_columns(spec.metrics), rows, time.perf_counter() - t0, used,
+                       where, len(chunks))
+
+
+def _scheduler_address(address: str) -> str:
+    if not isinstance(address, str) or "://" not in address or address.split("://", 1)[0] not in ("tcp", "tls"):
+        raise UsageError(f"--scheduler expects tcp://HOST:PORT (or tls://), got {quote(address)}")
+    return address
+
+
+def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
+    """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
+    workers, where)."""
+    from distributed import (  # 0.4-0.9 s to import: only studies need it
+        Client,
+        LocalCluster,
+        as_completed,
+    )
+
+    cluster = client = None
+    futures = []
+    try:
+        if scheduler is not None:
+            address = _scheduler_address(scheduler)
+            try:
+                client = Client(address, timeout=timeout)
+                client.wait_for_workers(1, timeout=timeout)
+            except (OSError, TimeoutError) as exc:
+                what = "has no worker" if client is not None else "cannot be reached"
+                raise UsageError(f"the dask scheduler at {quote(address)} {what} within {timeout:g} s "
+                                 f"({one_line(str(exc) or type(exc).__name__, 160)})") from None
+            used, where = len(client.scheduler_info().get("workers", {})) or 1, address
+        else:
+            with warnings.catch_warnings():  # "Port 8787 is already in use": its HTTP routes then take another
+                warnings.filterwarnings("ignore", message="Port .* is already in use")
+                # processes on 127.0.0.1 only (the scheduler's HTTP routes too: no dashboard address given)
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+            client = Client(cluster, timeout=timeout)
+            used, where = workers, "local cluster"
+        token = uuid.uuid4().hex[:12]
+        futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
+                   for k, chunk in enumerate(chunks)]
+        index = {f.key: k for k, f in enumerate(futures)}
+        results = [None] * len(chunks)
+        done = failed = 0
+        for fut in as_completed(futures):
+            k = index[fut.key]
+            try:
+                results[k] = fut.result()
+            except Exception as exc:  # noqa: BLE001 - the task failed as a whole (its worker died): rows say it
+                reason = f"the task of designs {chunks[k][0][0]}-{chunks[k][-1][0]} failed on its worker: " \
+                         f"{type(exc).__name__}: {one_line(str(exc), 200)}"
+                results[k] = [_failed_row(task, i, v, reason) for i, v in chunks[k]]
+            done += len(chunks[k])
+            failed += sum(r["error"] is not None for r in results[k])
+            if progress:
+                progress(done, total, failed)
+        futures = []
+        return results, used, where
+    finally:
+        if client is not None:
+            if futures:  # interrupted: take the study's tasks off the cluster
+                try:
+                    client.cancel(futures)
+                except Exception:  # noqa: BLE001, S110 - closing anyway
+                    pass
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _failed_row(task, index, values, reason) -> dict:
+    row = {"design": index, **dict(zip(task.parameters, values))}
+    row.update(dict.fromkeys(metric_columns(task.metrics)))
+    row["error"] = reason
+    return row

@@ -1,0 +1,303 @@
+"""A study's results for people: the table (CSV, or Parquet with pyarrow), a text summary,
+JSON, plots (metrics against parameters, the Pareto front of two metrics) and the
+progress bar.
+
+The rows of screwkin.analysis.study are SI (angles in rad); the table people read names
+its columns with their units where they are not SI's obvious ones: the transmission
+angles are ``transmission_angle_min_deg`` and ``transmission_angle_max_deg`` (degrees),
+``grashof_margin_m`` is (p + q) - (s + l) in metres.  Parameters keep their names (the
+values are the SI values given to the xacro file).
+"""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import io
+import math
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.study import pareto_front
+from ..errors import UsageError, quote
+from .plots import _pyplot
+from .report import to_jsonable
+
+__all__ = [
+    "DISPLAY",
+    "Progress",
+    "check_table_path",
+    "metrics_png",
+    "pareto_png",
+    "study_csv",
+    "study_dict",
+    "study_text",
+    "table_columns",
+    "write_table",
+]
+
+#: Row key -> (column name in the table, factor from SI).
+DISPLAY = {
+    "transmission_angle_min": ("transmission_angle_min_deg", 180.0 / math.pi),
+    "transmission_angle_max": ("transmission_angle_max_deg", 180.0 / math.pi),
+    "grashof_margin": ("grashof_margin_m", 1.0),
+}
+
+
+def _display(key):
+    return DISPLAY.get(key, (key, 1.0))
+
+
+def table_columns(result) -> list:
+    """[(row key, table column name, factor)] in the table's order."""
+    keys = ("design", *result.parameters, *result.columns, "error")
+    return [(k, *_display(k)) for k in keys]
+
+
+def _cell(v, factor):
+    if v is None:
+        return None
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        v = float(v) * factor if factor != 1.0 else float(v)
+        return v if math.isfinite(v) else None
+    return v
+
+
+def _rows(result):
+    cols = table_columns(result)
+    return [[_cell(r[k], f) for k, _, f in cols] for r in result.rows], [name for _, name, _ in cols]
+
+
+def study_csv(result) -> str:
+    """The table as CSV: one row per design, in design order; empty cells for missing values;
+    floats written exactly (shortest round-trip form)."""
+    rows, names = _rows(result)
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow(names)
+    for row in rows:
+        w.writerow(["" if v is None else ("true" if v is True else "false" if v is False else
+                                          repr(v) if isinstance(v, float) else v) for v in row])
+    return out.getvalue()
+
+
+def check_table_path(path) -> None:
+    """Refuse an output the table cannot be written to, before the study runs."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".csv", ".parquet"):
+        raise UsageError(f"-o {quote(str(path))}: the table is written as .csv or .parquet")
+    if suffix == ".parquet" and importlib.util.find_spec("pyarrow") is None:
+        raise UsageError(f"-o {quote(str(path))}: Parquet needs pyarrow (pip install pyarrow); write a .csv instead")
+    folder = Path(path).resolve().parent
+    if not folder.is_dir():
+        raise UsageError(f"-o {quote(str(path))}: the folder {quote(str(folder), 200)} does not exist")
+
+
+def write_table(result, path) -> None:
+    """The table into ``path``: CSV, or Parquet (``.parquet``, needs pyarrow)."""
+    check_table_path(path)
+    if Path(path).suffix.lower() == ".csv":
+        Path(path).write_text(study_csv(result))
+        return
+    import pyarrow as pa  # optional: only for Parquet
+    import pyarrow.parquet as pq
+
+    rows, names = _rows(result)
+    pq.write_table(pa.table({n: [row[i] for row in rows] for i, n in enumerate(names)}), str(path))
+
+
+def study_dict(result) -> dict:
+    """What ``--json`` prints: the study, the rows (SI, as the Python API gives them) and,
+    when the spec names two columns, the designs on the Pareto front."""
+    spec = result.spec
+    d = {
+        "spec": spec.path, "file": str(spec.file), "sampling": spec.sampling, "seed": spec.seed,
+        "parameters": list(result.parameters), "metrics": list(spec.metrics), "columns": list(result.columns),
+        "designs": len(result.rows), "analysed": len(result.succeeded), "failed": len(result.failed),
+        "seconds": result.seconds, "workers": result.workers, "scheduler": result.scheduler, "chunks": result.chunks,
+        "units": "SI (m, rad; workspace volumes in m^workspace_dimension)",
+        "rows": [dict(r) for r in result.rows],
+    }
+    if spec.pareto and result.succeeded:
+        d["pareto"] = {"columns": [{"column": c, "goal": g} for c, g in spec.pareto],
+                       "designs": [result.rows[k]["design"] for k in pareto_front(result)]}
+    return to_jsonable(d)
+
+
+def _fmt(v):
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+#: Most rows the text output lists (the table file has them all).
+TEXT_ROWS = 40
+
+
+def study_text(result, table_path=None) -> str:
+    """A summary: counts, the failures' reasons, each metric's range and the design reaching
+    each end; the rows themselves when there are few."""
+    spec = result.spec
+    n, ok, bad = len(result.rows), result.succeeded, result.failed
+    what = (f"grid over {', '.join(result.parameters)}" if spec.sampling == "grid"
+            else f"{spec.sampling} sampling of {', '.join(result.parameters)} (seed {spec.seed})")
+    lines = [(f"study of {spec.file} ({what}): {n} designs, {len(ok)} analysed, {len(bad)} failed; "
+              f"{result.seconds:.2f} s on {result.workers} worker{'s' if result.workers != 1 else ''} "
+              f"({result.scheduler})")]
+    if bad:
+        reasons = Counter(r["error"] for r in bad)
+        lines.append("failed designs:")
+        for reason, count in reasons.most_common(5):
+            lines.append(f"  {count} x {reason}")
+        if len(reasons) > 5:
+            lines.append(f"  ... and {len(reasons) - 5} other reasons")
+    cols = table_columns(result)
+    params = [(k, name, f) for k, name, f in cols if k in result.parameters]
+    for k, name, f in cols:
+        if k not in result.columns:
+            continue
+        vals = [(r, _cell(r[k], f)) for r in ok if r[k] is not None]
+        if not vals:
+            continue
+        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for _, v in vals):
+            lo = min(vals, key=lambda t: t[1])
+            hi = max(vals, key=lambda t: t[1])
+
+            def at(r):
+                return ", ".join(f"{p}={_fmt(r[pk])}" for pk, p, _ in params)
+
+            if lo[1] == hi[1]:
+                lines.append(f"{name}: {_fmt(lo[1])} in all {len(vals)}")
+            else:
+                lines.append(f"{name}: {_fmt(lo[1])} (design {lo[0]['design']}: {at(lo[0])}) .. "
+                             f"{_fmt(hi[1])} (design {hi[0]['design']}: {at(hi[0])})")
+        else:
+            counts = Counter(str(v) for _, v in vals)
+            lines.append(f"{name}: " + ", ".join(f"{v} {c}" for v, c in counts.most_common()))
+    if spec.pareto and ok:
+        front = pareto_front(result)
+        names = [f"{g} {_display(c)[0] if c in DISPLAY else c}" for c, g in spec.pareto]
+        lines.append(f"Pareto front ({', '.join(names)}): designs {', '.join(str(result.rows[k]['design']) for k in front)}")
+    rows, names = _rows(result)
+    if n <= TEXT_ROWS:
+        table = [names] + [[_fmt(v) for v in row] for row in rows]
+        widths = [max(len(row[i]) for row in table) for i in range(len(names) - 1)]
+        lines.append("")
+        for row in table:
+            lines.append("  ".join(c.ljust(w) for c, w in zip(row[:-1], widths)) + ("  " + row[-1] if row[-1] != "-"
+                                                                                     else ""))
+    elif table_path is None:
+        lines.append(f"({n} rows: write them with -o results.csv)")
+    if table_path is not None:
+        lines.append(f"table: {table_path}")
+    return "\n".join(line.rstrip() for line in lines)
+
+
+def _numeric(result):
+    """[(row key, label, factor)] of the metric columns with numbers."""
+    out = []
+    for k, name, f in table_columns(result):
+        if k in result.columns and k != "workspace_dimension":
+            vals = [r[k] for r in result.succeeded if r[k] is not None]
+            if vals and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+                out.append((k, name, f))
+    return out
+
+
+def metrics_png(result, path) -> None:
+    """Each numeric metric against each parameter (one panel per pair; failed designs left out)."""
+    plt = _pyplot("--plot")
+    numeric = _numeric(result)
+    params = list(result.parameters)
+    if not numeric:
+        raise UsageError("--plot: no design has a numeric metric to draw")
+    ok = result.succeeded
+    # a metric with one value for every design (a four-bar family's mobility) gets no panel, only a mention
+    constant = [(k, name, f) for k, name, f in numeric if len({r[k] for r in ok if r[k] is not None}) == 1]
+    metrics = [m for m in numeric if m not in constant] or numeric
+    same = ", ".join(f"{name} = {_fmt(_cell(next(r[k] for r in ok if r[k] is not None), f))}"
+                     for k, name, f in constant if (k, name, f) not in metrics)
+    fig, axes = plt.subplots(len(metrics), len(params), squeeze=False,
+                             figsize=(3.2 * len(params) + 0.5, 2.6 * len(metrics) + 0.5))
+    for i, (k, name, f) in enumerate(metrics):
+        for j, p in enumerate(params):
+            ax = axes[i][j]
+            xs = [r[p] for r in ok if r[k] is not None]
+            ys = [r[k] * f for r in ok if r[k] is not None]
+            ax.plot(xs, ys, "o", ms=3, alpha=0.7)
+            if i == len(metrics) - 1:
+                ax.set_xlabel(p)
+            if j == 0:
+                ax.set_ylabel(name, fontsize=8)
+    title = f"{Path(result.spec.file).name}: {len(ok)} of {len(result.rows)} designs analysed"
+    fig.suptitle(title + (f"\nin all: {same}" if same else ""), fontsize=9)
+    fig.tight_layout(rect=(0, 0, 1, 0.96 if same else 0.98))
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def pareto_png(result, path, goals=None) -> None:
+    """The designs in the plane of two columns, the Pareto front drawn over them."""
+    plt = _pyplot("--plot")
+    goals = goals or result.spec.pareto
+    front = pareto_front(result, goals)
+    keys = (*result.parameters, *result.columns)
+    (a, ga), (b, gb) = [(c if c in keys else c.removesuffix("_deg"), g) for c, g in goals]
+    fa, fb = _display(a)[1], _display(b)[1]
+    pts = [(r[a] * fa, r[b] * fb) for r in result.succeeded if r[a] is not None and r[b] is not None]
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    if pts:
+        ax.plot(*zip(*pts), "o", ms=3, color="0.6", label="designs")
+    fx = [result.rows[k][a] * fa for k in front]
+    fy = [result.rows[k][b] * fb for k in front]
+    ax.plot(fx, fy, "o-", color="C3", label="Pareto front")
+    for k, x, y in zip(front, fx, fy):
+        ax.annotate(str(result.rows[k]["design"]), (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    ax.set_xlabel(f"{_display(a)[0]} ({ga})")
+    ax.set_ylabel(f"{_display(b)[0]} ({gb})")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+class Progress:
+    """A progress bar on a terminal (``stream``, default stderr), redrawn as chunks finish;
+    nothing when the stream is not a terminal (the caller prints a final line)."""
+
+    def __init__(self, stream=None, width: int = 30):
+        self.stream = stream or sys.stderr
+        try:
+            self.tty = self.stream.isatty()
+        except (AttributeError, ValueError):
+            self.tty = False
+        self.width = width
+        self.t0 = time.perf_counter()
+        self.shown = False
+
+    def __call__(self, done: int, total: int, failed: int) -> None:
+        if not self.tty:
+            return
+        filled = int(self.width * done / max(total, 1))
+        elapsed = time.perf_counter() - self.t0
+        eta = elapsed / done * (total - done) if done else 0.0
+        self.stream.write(f"\rstudy [{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} designs, "
+                          f"{failed} failed, {elapsed:.0f} s, {eta:.0f} s left ")
+        self.stream.flush()
+        self.shown = True
+
+    def finish(self, line: str) -> None:
+        if self.shown:
+            self.stream.write("\r\x1b[K")
+        self.stream.write(line + "\n")
+        self.stream.flush()

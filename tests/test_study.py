@@ -1,0 +1,354 @@
+"""Design-space studies (screwkin study): the four-bar family over its link lengths, on a
+local Dask cluster and on a scheduler and workers started here as separate processes
+(loopback only); every Grashof class checked against the closed-form inequality, failing
+designs kept as rows with their reason, the same table whatever runs it, and bad specs as
+one-line usage errors."""
+
+import io
+import itertools
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from conftest import ROBOTS
+
+import screwkin
+from screwkin.analysis.study import (
+    StudyResult,
+    _task,
+    designs,
+    pareto_front,
+    run_chunk,
+    run_study,
+)
+from screwkin.cli import main
+from screwkin.files.study import study_spec
+from screwkin.present.study import Progress, study_csv
+
+ROOT = Path(__file__).resolve().parents[1]
+GROUND = 0.1
+CRANKS, COUPLERS, ROCKERS = [0.021, 0.047, 0.093, 0.152], [0.052, 0.117, 0.198], [0.032, 0.081, 0.187]
+FAMILY = {
+    "file": str(ROBOTS / "fourbar.urdf.xacro"),
+    "args": {"ground": GROUND},
+    "parameters": {"crank": {"values": CRANKS}, "coupler": {"values": COUPLERS}, "rocker": {"values": ROCKERS}},
+    "metrics": ["mobility", "grashof"],
+    "input": "crank_joint",
+}
+
+
+def expected_class(g, a, b, c):
+    """Grashof's inequality on the lengths, and which link is shortest."""
+    lengths = {"ground": g, "input": a, "coupler": b, "output": c}
+    s, l = min(lengths.values()), max(lengths.values())
+    p_q = sum(lengths.values()) - s - l
+    if abs(s + l - p_q) < 1e-9 * l:
+        return "change-point"
+    if s + l > p_q:
+        return "non-Grashof"
+    return {"input": "crank-rocker", "ground": "double-crank", "coupler": "double-rocker",
+            "output": "rocker-crank"}[min(lengths, key=lengths.get)]
+
+
+def closes(g, a, b, c):
+    """B D (crank end to rocker pivot) ranges over [|g - a|, g + a] and must lie in [|b - c|, b + c]."""
+    return max(abs(b - c), abs(g - a)) <= min(b + c, g + a)
+
+
+@pytest.fixture(scope="module")
+def local():
+    """The family on a LocalCluster of 2 worker processes."""
+    return run_study(FAMILY, workers=2)
+
+
+def test_grashof_classes_match_the_closed_form(local):
+    rows = local.rows
+    assert len(rows) == 36 and [r["design"] for r in rows] == list(range(36))
+    assert [(r["crank"], r["coupler"], r["rocker"]) for r in rows] == list(itertools.product(CRANKS, COUPLERS,
+                                                                                              ROCKERS))
+    seen = set()
+    for r in rows:
+        g, a, b, c = GROUND, r["crank"], r["coupler"], r["rocker"]
+        if not closes(g, a, b, c):
+            assert r["error"] is not None and "cannot assemble" in r["error"], r
+            assert r["grashof"] is None and r["mobility"] is None
+            continue
+        assert r["error"] is None, r
+        assert r["grashof"] == expected_class(g, a, b, c), r
+        lengths = sorted((g, a, b, c))
+        assert r["grashof_margin"] == pytest.approx(lengths[1] + lengths[2] - lengths[0] - lengths[3], abs=1e-12)
+        assert (r["mobility"], r["mobility_count"], r["motion_space"], r["idle_dofs"]) == (1, 1, "planar", 0)
+        seen.add(r["grashof"])
+    assert seen == {"crank-rocker", "double-crank", "double-rocker", "rocker-crank", "non-Grashof"}
+    assert len(local.failed) == 3
+    assert local.workers == 2 and local.scheduler == "local cluster"
+
+
+def _wait_for(path, proc, timeout=60):
+    t = time.perf_counter()
+    while time.perf_counter() - t < timeout:
+        if path.exists() and path.stat().st_size:
+            return json.loads(path.read_text())
+        if proc.poll() is not None:
+            raise RuntimeError(f"the scheduler exited: {proc.stderr.read()[-2000:]}")
+        time.sleep(0.1)
+    raise TimeoutError("no scheduler file")
+
+
+def test_a_separate_scheduler_and_workers_give_the_same_table(local, tmp_path):
+    """dask scheduler + 2 dask workers as processes of their own, on 127.0.0.1 only."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT),  # the workers import this checkout's screwkin
+               OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")  # as a nanny sets them
+    sched_file = tmp_path / "scheduler.json"
+    procs = []
+    try:
+        procs.append(subprocess.Popen(
+            [sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+             "--scheduler-file", str(sched_file)], env=env, cwd=tmp_path, stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE, text=True))
+        address = _wait_for(sched_file, procs[0])["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        for _ in range(2):
+            procs.append(subprocess.Popen(
+                [sys.executable, "-m", "dask", "worker", address, "--host", "127.0.0.1", "--no-nanny",
+                 "--nthreads", "1", "--no-dashboard"], env=env, cwd=tmp_path, stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL))
+        import distributed
+
+        with distributed.Client(address, timeout=30) as client:
+            client.wait_for_workers(2, timeout=60)
+        remote = run_study(FAMILY, scheduler=address, timeout=30)
+    finally:
+        for p in reversed(procs):  # workers, then the scheduler they report to (no nanny: one process each)
+            p.terminate()
+            try:
+                p.wait(timeout=3)
+            except subprocess.TimeoutExpired:  # a graceful close that waits on its peers: no need here
+                p.kill()
+                p.wait()
+    assert remote.scheduler == address and remote.workers == 2
+    assert remote.rows == local.rows  # the same values, to the last bit
+    assert study_csv(remote) == study_csv(local)
+
+
+def test_in_process_gives_the_same_rows(local):
+    """A chunk run here (no Dask) gives the rows the local cluster's workers gave."""
+    spec = study_spec(FAMILY)
+    chunk = [(i, v) for i, v in enumerate(designs(spec)) if i in (0, 3, 4, 35)]  # 0 does not close
+    assert run_chunk(_task(spec), chunk) == [local.rows[i] for i, _ in chunk]
+
+
+def test_failing_designs_are_rows_with_their_reason():
+    spec = dict(FAMILY, parameters={"crank": {"values": [0.0, 0.04, -0.01]}, "ground": {"values": [0.1, 0.5]}},
+                args={}, metrics=["mobility", "grashof", "transmission_angle"], transmission={"steps": 12})
+    res = run_study(spec, workers=0)
+    by = {(r["crank"], r["ground"]): r for r in res.rows}
+    assert len(res.rows) == 6
+    assert "division by zero" in by[(0.0, 0.1)]["error"]  # the xacro file's own arithmetic
+    assert "not a plausible value" in by[(-0.01, 0.1)]["error"]  # a negative length
+    assert "cannot assemble" in by[(0.04, 0.5)]["error"]  # 0.5 > 0.04 + 0.12 + 0.08: the loop cannot close
+    ok = by[(0.04, 0.1)]
+    assert ok["error"] is None and ok["grashof"] == "crank-rocker"
+    for r in res.failed:
+        assert all(r[c] is None for c in res.columns)
+        assert "\n" not in r["error"] and not r["error"].startswith(str(ROBOTS))
+    table = res.table
+    assert table["error"][2] is None and table["design"] == list(range(6))
+
+
+def test_not_a_fourbar_is_an_error_row():
+    spec = {"file": str(ROBOTS / "delta.urdf.xacro"), "parameters": {"rod": {"values": [0.4, 0.1]}},
+            "metrics": ["mobility", "grashof"], "input": "arm1"}
+    res = run_study(spec, workers=0)
+    assert "not a planar four-bar" in res.rows[0]["error"]
+    assert "math domain error" in res.rows[1]["error"]  # rods too short to reach the platform
+
+
+def mu_range(g, a, b, c):
+    """Transmission angles at the ends of the reachable B D range (mu grows with B D)."""
+    lo, hi = max(abs(b - c), abs(g - a)), min(b + c, g + a)
+
+    def mu(d):
+        return math.degrees(math.acos(max(-1.0, min(1.0, (b * b + c * c - d * d) / (2 * b * c)))))
+
+    return mu(lo), mu(hi)
+
+
+def test_transmission_angles_match_the_closed_form():
+    spec = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "args": {"ground": 0.1},
+            "parameters": {"crank": {"values": [0.04, 0.05]}, "coupler": {"values": [0.12, 0.11]},
+                           "rocker": {"values": [0.08, 0.19]}},
+            "metrics": ["transmission_angle"], "transmission": {"steps": 360}}
+    res = run_study(spec, workers=0)
+    for r in res.rows:
+        assert r["error"] is None, r
+        lo, hi = mu_range(0.1, r["crank"], r["coupler"], r["rocker"])
+        full_turn = expected_class(0.1, r["crank"], r["coupler"], r["rocker"]) == "crank-rocker"
+        tol = 0.05 if full_turn else 0.01  # a full turn in 1 deg steps may miss an extreme by a little
+        assert math.degrees(r["transmission_angle_min"]) == pytest.approx(lo, abs=tol), r
+        assert math.degrees(r["transmission_angle_max"]) == pytest.approx(hi, abs=tol), r
+
+
+# ------------------------------------------------------------------ designs and the front
+def test_sampling_is_seeded_and_in_range():
+    base = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "metrics": ["mobility"],
+            "parameters": {"crank": {"min": "20mm", "max": "60mm"}, "coupler": {"values": [0.1, 0.12, 0.14]}}}
+    for sampling in ("random", "lhs"):
+        spec = study_spec(dict(base, sampling=sampling, designs=12, seed=3))
+        d = designs(spec)
+        assert d == designs(spec) and len(d) == 12
+        assert all(0.02 <= a <= 0.06 and b in (0.1, 0.12, 0.14) for a, b in d)
+        assert d != designs(study_spec(dict(base, sampling=sampling, designs=12, seed=4)))
+    lhs = [a for a, _ in designs(study_spec(dict(base, sampling="lhs", designs=8)))]
+    assert sorted(int((a - 0.02) / 0.005) for a in lhs) == list(range(8))  # one in each eighth of the range
+    grid = study_spec(dict(base, parameters={"crank": {"min": "20mm", "max": "60mm", "samples": 3}}))
+    assert designs(grid) == [(0.02,), (0.04,), (0.06,)]
+
+
+def test_pareto_front():
+    spec = study_spec({"file": str(ROBOTS / "fourbar.urdf.xacro"), "metrics": ["transmission_angle"],
+                       "parameters": {"crank": {"values": [1, 2, 3, 4, 5]}},
+                       "pareto": {"maximize": ["transmission_angle_min_deg"], "minimize": ["transmission_angle_max"]}})
+    pts = [(0.5, 2.0), (0.6, 2.5), (0.4, 1.5), (0.3, 2.0), (None, None)]
+    rows = tuple({"design": k, "crank": k + 1, "transmission_angle_min": a, "transmission_angle_max": b,
+                  "error": None if a is not None else "x"} for k, (a, b) in enumerate(pts))
+    res = StudyResult(spec, ("crank",), ("transmission_angle_min", "transmission_angle_max"), rows, 0.0, 1, "x")
+    assert pareto_front(res) == [2, 0, 1]  # (0.3, 2.0) is beaten by (0.5, 2.0); ordered by the first column
+
+
+def test_python_api():
+    res = screwkin.study({"file": "fourbar.urdf.xacro", "parameters": {"crank": {"values": [0.03, 0.04]}},
+                          "metrics": ["grashof"]}, workers=0, base=ROBOTS)
+    assert isinstance(res, screwkin.StudyResult)
+    assert res.table["grashof"] == ["crank-rocker", "crank-rocker"]
+    assert res.columns == ("linkage", "grashof", "grashof_margin")
+
+
+def test_progress_bar_only_on_a_terminal():
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty, plain = Tty(), io.StringIO()
+    for stream in (tty, plain):
+        p = Progress(stream)
+        p(3, 10, 1)
+        p(10, 10, 1)
+        p.finish("study: done")
+    assert "\rstudy [" in tty.getvalue() and "10/10 designs, 1 failed" in tty.getvalue()
+    assert plain.getvalue() == "study: done\n"
+
+
+# ------------------------------------------------------------------ the command line
+def write_spec(tmp_path, data, name="study.yaml"):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(data) if not isinstance(data, str) else data)
+    return str(path)
+
+
+SMALL = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "args": {"ground": 0.1},
+         "parameters": {"crank": {"min": "20mm", "max": "40mm", "samples": 2}, "rocker": {"values": [0.08, 0.1]}},
+         "metrics": ["mobility", "grashof", "transmission_angle"], "transmission": {"steps": 24}, "output": "rocker",
+         "pareto": {"maximize": ["transmission_angle_min_deg", "grashof_margin"]}}
+
+
+def test_cli_study(tmp_path, capsys):
+    spec = write_spec(tmp_path, SMALL)
+    out_csv, prefix = tmp_path / "r.csv", tmp_path / "fig"
+    assert main(["study", spec, "--workers", "0", "-o", str(out_csv), "--plot", str(prefix)]) == 0
+    cap = capsys.readouterr()
+    assert "4 designs, 4 analysed, 0 failed" in cap.out and "Pareto front" in cap.out
+    assert cap.err.count("\n") == 1 and cap.err.startswith("study: 4 designs in ")  # no bar: not a terminal
+    text = out_csv.read_text().splitlines()
+    assert text[0].split(",")[:3] == ["design", "crank", "rocker"]
+    assert "transmission_angle_min_deg" in text[0] and "grashof_margin_m" in text[0]
+    assert len(text) == 5
+    assert (tmp_path / "fig-metrics.png").stat().st_size > 1000
+    assert (tmp_path / "fig-pareto.png").stat().st_size > 1000
+    assert main(["study", spec, "--workers", "0", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["designs"] == 4 and d["rows"][0]["crank"] == 0.02 and "pareto" in d
+    assert d["rows"][0]["transmission_angle_min"] < math.pi  # radians in JSON (SI), degrees in the CSV
+
+
+def test_cli_all_designs_failing_is_exit_1(tmp_path, capsys):
+    spec = write_spec(tmp_path, dict(SMALL, parameters={"crank": {"values": [0.0]}}, pareto=None))
+    assert main(["study", spec, "--workers", "0"]) == 1
+    assert "1 x xacro: float division by zero" in capsys.readouterr().out
+
+
+BAD_SPECS = {
+    "unknown_metric": (dict(SMALL, metrics=["mobility", "speed"]), "unknown metric 'speed'"),
+    "missing_file": (dict(SMALL, file="nowhere.urdf.xacro"), "does not exist"),
+    "bad_range": (dict(SMALL, parameters={"crank": {"min": 0.3, "max": 0.1, "samples": 3}}), "bad range"),
+    "unknown_key": (dict(SMALL, sampler="grid"), "unknown key 'sampler'"),
+    "unknown_parameter": (dict(SMALL, parameters={"crankk": {"values": [0.1]}}), "not an argument"),
+    "bad_unit": (dict(SMALL, parameters={"crank": {"values": ["3 parsecs"]}}), "unknown unit"),
+    "no_samples": (dict(SMALL, parameters={"crank": {"min": 0.1, "max": 0.2}}), "needs samples"),
+    "random_without_designs": (dict(SMALL, sampling="random"), "needs designs"),
+    "bad_sampling": (dict(SMALL, sampling="sobol"), "sampling must be one of"),
+    "pareto_column": (dict(SMALL, pareto={"maximize": ["speed", "grashof_margin"]}), "not a column"),
+    "workspace_without_output": ({k: v for k, v in dict(SMALL, metrics=["conditioning"]).items() if k != "output"},
+                                 "need output"),
+    "not_a_mapping": ("- a\n- b\n", "a study is a mapping"),
+    "malformed": ("file: [unclosed\n", "malformed YAML"),
+    "alias": ("a: &x [1]\nb: *x\n", "aliases"),
+    "too_many": (dict(SMALL, parameters={"crank": {"min": 0.01, "max": 0.1, "samples": 1000},
+                                         "rocker": {"min": 0.01, "max": 0.1, "samples": 1001}}), "at most"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_SPECS))
+def test_bad_specs_are_usage_errors(tmp_path, capsys, case):
+    data, word = BAD_SPECS[case]
+    spec = write_spec(tmp_path, data)
+    assert main(["study", spec, "--workers", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"screwkin: error: {spec}: "), err
+    assert word in err[0], err[0]
+
+
+def test_cli_usage_errors(tmp_path, capsys):
+    spec = write_spec(tmp_path, SMALL)
+    cases = [
+        (["study", str(tmp_path / "absent.yaml")], "no such file"),
+        (["study", spec, "--scheduler", "127.0.0.1:8786"], "tcp://HOST:PORT"),
+        (["study", spec, "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers is for the local cluster"),
+        (["study", spec, "--workers", "-1"], "0 or more"),
+        (["study", spec, "-o", str(tmp_path / "r.xlsx")], ".csv or .parquet"),
+        (["study", spec, "-o", str(tmp_path / "no" / "r.csv")], "does not exist"),
+        (["study", spec, "--pareto", "max:a"], "--pareto expects"),
+    ]
+    try:
+        import pyarrow  # noqa: F401
+    except ImportError:
+        cases.append((["study", spec, "-o", str(tmp_path / "r.parquet")], "needs pyarrow"))
+    for argv, word in cases:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and word in err[0], (argv, err)
+
+
+def test_unreachable_scheduler_fails_fast(tmp_path, capsys):
+    spec = write_spec(tmp_path, SMALL)
+    t = time.perf_counter()
+    assert main(["study", spec, "--scheduler", "tcp://127.0.0.1:9", "--timeout", "1"]) == 2
+    assert time.perf_counter() - t < 15
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot be reached" in err[0], err
+
+
+def test_study_table_is_plain_numbers():
+    res = run_study(dict(SMALL, pareto=None), workers=0)
+    lines = study_csv(res).splitlines()
+    for line in lines[1:]:
+        cells = line.split(",")
+        assert float(cells[1]) in (0.02, 0.04)
+        assert np.isfinite(float(cells[-2]))
