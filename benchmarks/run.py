@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 import screwkin  # noqa: E402
 from screwkin.analysis.batch import SerialJacobians, frame_jacobians  # noqa: E402
+from study import report as study_report  # noqa: E402  (benchmarks/study.py, beside this file)
 
 
 def interleaved(functions: dict, repeat=3):
@@ -309,6 +310,7 @@ def main():
     ap.add_argument("--configs", type=int, default=100000)
     ap.add_argument("--steps", type=int, default=3600)
     ap.add_argument("--solves", type=int, default=50)
+    ap.add_argument("--designs", type=int, default=48, help="designs of the study throughput benchmark")
     args = ap.parse_args()
     out = [f"## Run of {date.today()} on {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            f"numpy {np.__version__}, pinocchio {pin.__version__}", ""]
@@ -352,6 +354,7 @@ def main():
             f"wall {wall:.2f} s (best of 3, process start to exit), peak RSS {rss / 1024:.0f} MiB; "
             f"load {parts[0] * 1e3:.0f} ms, assembly {parts[1] * 1e3:.0f} ms, mobility analysis {parts[2] * 1e3:.0f} ms; "
             "largest imports (cumulative us): " + ", ".join(f"{k} {v}" for k, v in top)]
+    out += [""] + study_report(args.designs)
     print("\n".join(out))
 
 
