@@ -1,12 +1,13 @@
 """Function generation with a four-bar (Freudenstein).
 
-The crank (input, angle phi from the ground line A0 -> B0) and the rocker (output, angle
-psi from the same line) of a four-bar with ground d, crank a, coupler b and rocker c obey
+The crank (input, angle phi) and the rocker (output, angle psi) of a four-bar with ground
+d, crank a, coupler b and rocker c, both angles from the ground line taken from the
+rocker's pivot B0 = (0, 0) towards the crank's pivot A0 = (d, 0) (the x axis), obey
 
     K1 cos(phi) - K2 cos(psi) + K3 = cos(phi - psi),
-    K1 = d / c,  K2 = d / a,  K3 = (a^2 - b^2 + c^2 + d^2) / (2 a c),
+    K1 = d / c,  K2 = d / a,  K3 = (a^2 - b^2 + c^2 + d^2) / (2 a c)
 
-(the coupler's length |B - A| = b with A = a (cos phi, sin phi), B = (d, 0) + c (cos psi,
+(the coupler's length |B - A| = b with A = (d, 0) + a (cos phi, sin phi), B = c (cos psi,
 sin psi)), linear in K.  y = f(x) on [x0, x1] is mapped to phi on the input range and psi
 on the output range (phi linear in x, psi linear in y); three precision points give K
 exactly (a 3 x 3 linear solve), more give it by least squares.  A negative a or c is a
@@ -110,8 +111,9 @@ def freudenstein(phi, psi):
     r = np.cos(phi - psi)
     if len(phi) == 3:
         if abs(np.linalg.det(M)) < 1e-12:
-            raise SynthesisError(WHAT, "the three precision points give a singular Freudenstein system "
-                                       "(two input or output angles coincide): change the ranges")
+            raise SynthesisError(WHAT, f"the Freudenstein equations of the three precision points are not independent "
+                                       f"(determinant {np.linalg.det(M):.2g}): change the ranges or the function (psi "
+                                       "= phi + a constant is done by any parallelogram)")
         return tuple(float(k) for k in np.linalg.solve(M, r))
     K, *_ = np.linalg.lstsq(M, r, rcond=None)
     return tuple(float(k) for k in K)
@@ -123,9 +125,9 @@ def _generated(K, d, phi, sigma):
     K1, K2, K3 = K
     a, c = d / K2, d / K1
     b2 = a * a + c * c + d * d - 2 * a * c * K3
-    A = a * np.stack([np.cos(phi), np.sin(phi)], axis=-1)  # a signed: the pin of a reversed crank
-    B, h2 = circle_b(A, math.sqrt(max(b2, 0.0)), (d, 0.0), abs(c), sigma)
-    psi = np.arctan2(B[..., 1], B[..., 0] - d) + (math.pi if c < 0 else 0.0)
+    A = np.array([d, 0.0]) + a * np.stack([np.cos(phi), np.sin(phi)], axis=-1)  # a signed: a reversed crank
+    B, h2 = circle_b(A, math.sqrt(max(b2, 0.0)), (0.0, 0.0), abs(c), sigma)
+    psi = np.arctan2(B[..., 1], B[..., 0]) + (math.pi if c < 0 else 0.0)
     return np.where(h2 >= 0, psi, np.nan), A, B
 
 
@@ -179,8 +181,8 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
         raise SynthesisError(WHAT, f"Freudenstein gives K = ({K1:.6g}, {K2:.6g}, {K3:.6g}): the coupler's squared "
                                    f"length {b2:.3g} is not positive, no four-bar; change the ranges")
     b = math.sqrt(b2)
-    A0, B0 = np.zeros(2), np.array([d, 0.0])
-    A1 = a * np.array([math.cos(phi[0]), math.sin(phi[0])])
+    A0, B0 = np.array([d, 0.0]), np.zeros(2)
+    A1 = A0 + a * np.array([math.cos(phi[0]), math.sin(phi[0])])
     B1 = B0 + c * np.array([math.cos(psi[0]), math.sin(psi[0])])
     if not np.isclose(np.hypot(*(B1 - A1)), b, rtol=1e-9, atol=0):  # least squares: the first point on the circle
         sigma1 = None
@@ -201,7 +203,7 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     comment = (f"Four-bar synthesized by screwkin for function generation (Freudenstein): the rocker's angle psi "
                f"follows\ny = {text} for x in [{x0:.9g}, {x1:.9g}] while the crank's angle phi runs through "
                f"[{math.degrees(p0):.9g}, {math.degrees(p1):.9g}] deg,\npsi through [{math.degrees(s0):.9g}, "
-               f"{math.degrees(s1):.9g}] deg (both from the ground line A0 -> B0, the x axis).\n"
+               f"{math.degrees(s1):.9g}] deg (both from the x axis: from the rocker's pivot B0 to the crank's A0).\n"
                f"{points} precision points ({spacing} spacing): x = " + ", ".join(f"{x:.9g}" for x in xs)
                + f".\nK1 = {K1:.12g}, K2 = {K2:.12g}, K3 = {K3:.12g}; lengths [m]: ground {L['ground']:.9g}, "
                f"crank {L['crank']:.9g}, coupler {L['coupler']:.9g}, rocker {L['rocker']:.9g}.\n"
@@ -217,7 +219,7 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     defects = []
     if not np.all(np.isfinite(gen)):
         defects.append("the linkage does not assemble over the whole input range (a limit position inside it)")
-    sig = [float(branch(a * np.array([math.cos(p), math.sin(p)]),
+    sig = [float(branch(A0 + a * np.array([math.cos(p), math.sin(p)]),
                         B0 + c * np.array([math.cos(s), math.sin(s)]), B0)) for p, s in zip(phi, psi)]
     if len(phi) == 3 and len(set(sig)) > 1:
         defects.append("branch defect: the precision points lie on different assembly modes")

@@ -33,6 +33,7 @@ import math
 
 import numpy as np
 
+from ...errors import UsageError
 from .designs import Design, Dyad, FourBar, MotionResult, SynthesisError, Target
 from .fourbar import angle, branch, fourbar_linkage, pose_matrix, travel_analysis, wrap
 
@@ -311,7 +312,7 @@ def _check_poses(poses):
     for i, j in itertools.combinations(range(len(poses)), 2):
         a, b = poses[i], poses[j]
         if math.hypot(a[0] - b[0], a[1] - b[1]) < 1e-9 * L and abs(float(wrap(a[2] - b[2]))) < 1e-9:
-            raise SynthesisError(WHAT, f"positions {i + 1} and {j + 1} are the same pose: give distinct poses")
+            raise UsageError(f"--poses: positions {i + 1} and {j + 1} are the same pose: give distinct poses")
 
 
 def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 24) -> MotionResult:
@@ -323,17 +324,17 @@ def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 2
     poses = [tuple(float(x) for x in p) for p in poses]
     n = len(poses)
     if n < 3 or n > 5:
-        raise SynthesisError(WHAT, f"motion generation takes 3, 4 or 5 poses, got {n}")
+        raise UsageError(f"--poses: motion generation takes 3, 4 or 5 poses, got {n}")
     _check_poses(poses)
     pole_list = tuple((i, j, tuple(map(float, P))) for i, j, P in poles(poses))
     curves = ()
     if n == 3:
         if (pivots is None) == (moving is None):
-            raise SynthesisError(WHAT, "three positions need the two fixed pivots (--pivots) or the two moving "
-                                       "pivots (--moving)")
+            raise UsageError("three positions need the two fixed pivots (--pivots) or the two moving pivots "
+                             "(--moving), not both")
         given = pivots if pivots is not None else moving
         if len(given) != 2:
-            raise SynthesisError(WHAT, f"give two pivots, got {len(given)}")
+            raise UsageError(f"--{'pivots' if pivots is not None else 'moving'}: give two pivots, got {len(given)}")
         R1, p1 = pose_matrix(poses[0])
         dyads = []
         for g in given:
@@ -350,8 +351,8 @@ def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 2
         ranked = ()
     else:
         if pivots is not None or moving is not None:
-            raise SynthesisError(WHAT, "--pivots and --moving apply to three positions; four and five positions are "
-                                       "solved by Burmester theory (choose a pair with --pick)")
+            raise UsageError("--pivots and --moving apply to three positions; four and five positions are solved by "
+                             "Burmester theory (choose a pair with --pick)")
         if n == 4:
             dyads = list(candidates(poses, count))
             C, W, _, _ = centre_point_curve(poses, 720, 3 * scale_of(poses))
@@ -368,8 +369,7 @@ def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 2
         if pick is not None:
             i, j = pick
             if not (0 <= i < len(dyads) and 0 <= j < len(dyads)) or i == j:
-                raise SynthesisError(WHAT, f"--pick {i},{j}: give two different candidates between 0 and "
-                                           f"{len(dyads) - 1}")
+                raise UsageError(f"--pick {i},{j}: give two different candidates between 0 and {len(dyads) - 1}")
             ranked = ()
         else:
             ranked = tuple(rank_pairs(poses, dyads))
