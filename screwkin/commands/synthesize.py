@@ -141,12 +141,10 @@ def _keep(tmp, out):
 
 def run(mech, args) -> int:
     kind = args.kind
-    for other, dests in _OPTIONS.items():
-        if other == kind:
-            continue
-        for dest in dests - _OPTIONS[kind]:
-            if _given(args, dest):
-                raise UsageError(f"{_option(dest)} applies to 'synthesize {other}', not to 'synthesize {kind}'")
+    for dest in sorted(set().union(*_OPTIONS.values()) - _OPTIONS[kind]):
+        if _given(args, dest):
+            takers = " and ".join(f"'synthesize {k}'" for k, dests in _OPTIONS.items() if dest in dests)
+            raise UsageError(f"{_option(dest)} applies to {takers}, not to 'synthesize {kind}'")
     if kind == "chains":
         return _chains(args)
     if not args.out:

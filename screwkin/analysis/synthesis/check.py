@@ -208,7 +208,7 @@ def _follow(design: Design, solver, probe, configs, steps):
                 continue
             res, covered = follow(direction, reach)
             runs[direction] = (res, covered)
-            mus += [probe.mu(q) for q in res.q]
+            mus += [probe.mu(q) for q in res.q]  # the sweep's grid ends at the range's ends
             if res.stopped_at is not None and covered < reach - 1e-9:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
                                f"{math.degrees(res.stopped_at):.6g} deg: the linkage cannot run through it")
@@ -227,7 +227,10 @@ def _follow(design: Design, solver, probe, configs, steps):
         return 0, travel, mus, defects
     outcomes = []
     for direction in (1, -1):
-        res, covered = follow(direction, TWO_PI)
+        # as far as the farthest position this way round (a full turn when one sits at the start's input)
+        travels = [float(np.mod(direction * (t.input - u1), TWO_PI)) for t in targets[1:]]
+        reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > 1e-9 else TWO_PI
+        res, covered = follow(direction, reach)
         status, travel = [], [0.0]
         for k in range(1, n):
             d = float(np.mod(direction * (targets[k].input - u1), TWO_PI))
@@ -237,8 +240,8 @@ def _follow(design: Design, solver, probe, configs, steps):
             elif _locate(design, solver, probe, res, u1 + direction * d, configs[k]):
                 status.append(("reached", d))
                 travel.append(d)
-            elif d < 1e-9 and _locate(design, solver, probe, res, u1 + direction * TWO_PI, configs[k]) \
-                    and covered >= TWO_PI - 1e-9:
+            elif d < 1e-9 and covered >= TWO_PI - 1e-9 \
+                    and _locate(design, solver, probe, res, u1 + direction * TWO_PI, configs[k]):
                 status.append(("reached", TWO_PI))
                 travel.append(TWO_PI)
             else:
@@ -248,8 +251,11 @@ def _follow(design: Design, solver, probe, configs, steps):
         ordered = all(a < b for a, b in zip(got, got[1:]))
         far = max(got)
         mus = [probe.mu(q) for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + 1e-12]
+        mus += [probe.mu(configs[k]) for k, t in enumerate(travel) if t is not None]  # the ends exactly
         missing = sum(t is None for t in travel)
         outcomes.append(((missing, not ordered), direction, status, travel, mus))
+        if not missing and ordered:  # every position, in order: the other way round is not needed
+            break
     outcomes.sort(key=lambda o: o[0])
     (missing, disordered), direction, status, travel, mus = outcomes[0]
     defects = []
@@ -264,8 +270,10 @@ def _follow(design: Design, solver, probe, configs, steps):
                                f"({math.degrees(targets[k].input):+.6g} deg from {label[0]}) with the linkage in "
                                f"another assembly mode: {label[k]} is on another branch than {label[0]}")
             if "limit" in kinds:
-                stops = sorted({math.degrees(s[1]) for s in seen if s[0] == "limit" and s[1] is not None})
-                where = f" (the crank stops at {', '.join(f'{x:.6g}' for x in stops)} deg)" if stops else ""
+                stops = sorted({s[1] - u1 for s in seen if s[0] == "limit" and s[1] is not None})
+                where = (" (the crank stops " + ", ".join(
+                    f"{math.degrees(abs(x)):.6g} deg {'counterclockwise' if x > 0 else 'clockwise'}" for x in stops)
+                         + f" from {label[0]})") if stops else ""
                 defects.append(f"{label[k]} lies beyond a limit position{where}: the crank cannot turn from "
                                f"{label[0]} to it")
         if any(any(s[0] == "reached" for s in [o[2][k - 1] for o in outcomes]) and status[k - 1][0] != "reached"

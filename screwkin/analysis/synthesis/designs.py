@@ -140,7 +140,7 @@ class PathResult:
     crank_angles: tuple  # crank joint values at the points, from the first [rad]
     errors: tuple  # distance from each point to the coupler point there [m]
     starts: int
-    converged: int  # starts that reached every point within the tolerance
+    converged: int  # polished starts that reached every point within the tolerance
     tolerance: float
     design: Design
 

@@ -10,8 +10,10 @@ crank must turn from one to the next on one branch, sigma fixed per start).  The
 position is the circle intersection of screwkin.analysis.synthesis.fourbar.
 
 scipy.optimize.least_squares is run from ``starts`` seeded starts (both branches, both
-directions of the crank); of the results that reach every point within the tolerance the
-one with the best transmission angle along the motion is kept, else the one closest.
+directions of the crank), briefly, and the ``polish`` best of them (those not far above the
+best) to round-off; of the
+results that reach every point within the tolerance the one with the best transmission
+angle along the motion is kept, else the one closest.
 (pylinkage, on PyPI, searches coupler orientations on a grid for three to five points and
 needs Python 3.11; this needs neither.)
 """
@@ -34,39 +36,62 @@ _BETWEEN = np.array([0.25, 0.5, 0.75])
 
 
 def _unpack(x, timing, direction):
-    A0, B0 = x[0:2], x[2:4]
-    a, b, c, p, q, th1 = x[4:10]
+    """The parameters of one design (x: (n,)) or of many (x: (m, n)), as arrays with the design
+    index first: A0, B0 (m, 2), a, b, c, p, q (m,), crank angles th (m, N)."""
+    X = np.atleast_2d(x)
+    A0, B0 = X[:, 0:2], X[:, 2:4]
+    a, b, c, p, q, th1 = X[:, 4:10].T
     if timing is not None:
-        th = th1 + timing
+        th = th1[:, None] + timing[None, :]
     else:
-        th = th1 + direction * np.concatenate([[0.0], np.cumsum(x[10:])])
+        steps = np.cumsum(X[:, 10:], axis=1)
+        th = th1[:, None] + direction * np.concatenate([np.zeros((len(X), 1)), steps], axis=1)
     return A0, B0, a, b, c, p, q, th
 
 
 def coupler_points(A0, B0, a, b, c, p, q, th, sigma):
-    """Coupler point (..., 2) at crank angles th, with the assembly measure h2 (< 0: apart)."""
-    A = np.asarray(A0) + a * np.stack([np.cos(th), np.sin(th)], axis=-1)
-    B, h2 = circle_b(A, b, B0, c, sigma)
-    u = (B - A) / b
+    """Coupler point at crank angles th (..., N) of designs whose parameters (A0, B0 (..., 2); a,
+    b, c, p, q scalars or (...,)) broadcast against them: (P (..., N, 2), h2 (..., N): < 0 where
+    the linkage does not assemble, A, B)."""
+    a, b, c, p, q = (np.asarray(v, float)[..., None] for v in (a, b, c, p, q))
+    A = np.asarray(A0, float)[..., None, :] + a[..., None] * np.stack([np.cos(th), np.sin(th)], axis=-1)
+    B, h2 = circle_b(A, b, np.asarray(B0, float)[..., None, :], c, sigma)
+    u = (B - A) / b[..., None]
     n = np.stack([-u[..., 1], u[..., 0]], axis=-1)
-    return A + p * u + q * n, h2, A, B
+    return A + p[..., None] * u + q[..., None] * n, h2, A, B
 
 
-def _residuals(x, pts, timing, direction, sigma, L):
-    A0, B0, a, b, c, p, q, th = _unpack(x, timing, direction)
-    P, _, A, _ = coupler_points(A0, B0, a, b, c, p, q, th, sigma)
-    r = ((P - pts) / L).ravel()
-    mid = th[:-1, None] + (th[1:] - th[:-1])[:, None] * _BETWEEN[None, :]
-    every = np.concatenate([th, mid.ravel()])
-    Am = np.asarray(A0) + a * np.stack([np.cos(every), np.sin(every)], axis=-1)
-    d = np.hypot(*(np.asarray(B0) - Am).T)
-    apart = np.maximum(d - (b + c), 0.0) + np.maximum(abs(b - c) - d, 0.0)
-    travel = abs(th[-1] - th[0])
-    return np.concatenate([r, 10 * apart / L, [max(travel - 0.98 * TWO_PI, 0.0)]])
+def _residuals(X, pts, timing, direction, sigma, L):
+    """Residuals of designs X (m, n) -> (m, residuals): the distances to the points (over L),
+    how far apart the circles are at and between the points (weighted), a turn exceeded."""
+    A0, B0, a, b, c, p, q, th = _unpack(X, timing, direction)
+    P, _, _, _ = coupler_points(A0, B0, a, b, c, p, q, th, sigma)
+    r = ((P - pts[None]) / L).reshape(len(th), -1)
+    mid = th[:, :-1, None] + (th[:, 1:] - th[:, :-1])[:, :, None] * _BETWEEN[None, None, :]
+    every = np.concatenate([th, mid.reshape(len(th), -1)], axis=1)
+    Am = A0[:, None, :] + a[:, None, None] * np.stack([np.cos(every), np.sin(every)], axis=-1)
+    d = np.hypot(*np.moveaxis(B0[:, None, :] - Am, -1, 0))
+    apart = np.maximum(d - (b + c)[:, None], 0.0) + np.maximum(np.abs(b - c)[:, None] - d, 0.0)
+    travel = np.abs(th[:, -1] - th[:, 0])
+    return np.concatenate([r, 10 * apart / L, np.maximum(travel - 0.98 * TWO_PI, 0.0)[:, None]], axis=1)
+
+
+def _problem(pts, timing, direction, sigma, L):
+    """(fun, jac) for scipy: the Jacobian by central differences, all 2n designs in one call."""
+    def fun(x):
+        return _residuals(x[None], pts, timing, direction, sigma, L)[0]
+
+    def jac(x):
+        h = 1e-7 * np.maximum(np.abs(x), L)
+        E = np.diag(h)
+        R = _residuals(np.concatenate([x + E, x - E]), pts, timing, direction, sigma, L)
+        return ((R[: len(x)] - R[len(x):]) / (2 * h)[:, None]).T
+
+    return fun, jac
 
 
 def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolerance: float = 1e-6,
-                    name: str = "synthesized_path") -> PathResult:
+                    name: str = "synthesized_path", polish: int = 6) -> PathResult:
     """A four-bar whose coupler point passes through ``points`` ((x, y) [m]), in that order,
     with the crank angles ``timing`` (relative to the first point [rad]) when given."""
     from scipy.optimize import least_squares
@@ -103,7 +128,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
     if timing is None:
         lo += [0.01] * (n - 1)
         hi += [TWO_PI] * (n - 1)
-    results = []
+    results, rough = [], []
     for k in range(starts):
         sigma = 1.0 if k % 2 == 0 else -1.0
         direction = 1.0 if (k // 2) % 2 == 0 else -1.0
@@ -114,13 +139,24 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
             total = rng.uniform(0.5, 0.9) * TWO_PI
             x0 += list(np.maximum(total * chords / chords.sum(), 0.02))
         x0 = np.clip(np.array(x0, float), np.array(lo) + 1e-12, np.array(hi) - 1e-12)
-        try:
-            sol = least_squares(_residuals, x0, bounds=(lo, hi), args=(pts, timing, direction, sigma, L),
-                                x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=150 * len(x0))
+        fun, jac = _problem(pts, timing, direction, sigma, L)
+        try:  # a first descent, short: starts that end in a local minimum stop early
+            sol = least_squares(fun, x0, jac=jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
+                                gtol=1e-10, max_nfev=30 * len(x0))
         except (ValueError, FloatingPointError):  # pragma: no cover - a degenerate start
             continue
+        rough.append((float(sol.cost), sol.x, sigma, direction))
+    rough.sort(key=lambda r: r[0])
+    enough = 10 * rough[0][0] + 0.5 * n * (tolerance / L) ** 2 if rough else 0.0
+    for cost, x1, sigma, direction in rough[:polish]:  # the most promising, polished to round-off
+        if cost > enough:  # a local minimum far above the best: not worth polishing
+            continue
+        fun, jac = _problem(pts, timing, direction, sigma, L)
+        sol = least_squares(fun, x1, jac=jac, bounds=(lo, hi), x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                            max_nfev=50 * len(x1))
         A0, B0, a, b, c, p, q, th = _unpack(sol.x, timing, direction)
-        P, h2, A, B = coupler_points(A0, B0, a, b, c, p, q, th, sigma)
+        P, h2, A, B = (v[0] for v in coupler_points(A0, B0, a, b, c, p, q, th, sigma))
+        th = th[0]
         if np.any(h2 < 0):
             continue
         errors = np.hypot(*(P - pts).T)
