@@ -12,6 +12,7 @@ OUT, so OUT is the checked file and a rejected result leaves no file.
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
 from dataclasses import replace
@@ -24,6 +25,7 @@ from ..analysis.synthesis.function import synthesize_function
 from ..analysis.synthesis.motion import motion_design, synthesize_motion
 from ..analysis.synthesis.path import synthesize_path
 from ..errors import UsageError, quote
+from ..files.description import LIMITS
 from ..files.writer import write_urdf
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
@@ -119,9 +121,23 @@ def _range(text, option):
     return parse_value(parts[0]), parse_value(parts[1])
 
 
+def _plausible(design, kind):
+    """A linkage whose numbers a file can hold: finite, and within the 10 km the reader accepts."""
+    fb = design.fourbar
+    values = [*fb.A0, *fb.A, *fb.B, *fb.B0, *(fb.tool or ())]
+    if not all(math.isfinite(v) for v in values):
+        raise SynthesisError(f"synthesize {kind}", "the linkage found has no finite dimensions (the positions are "
+                                                   "degenerate or too far apart)")
+    big = max(abs(v) for v in values)
+    if big > LIMITS.length:
+        raise SynthesisError(f"synthesize {kind}", f"the linkage found reaches {big:.3g} m from the origin, beyond "
+                                                   f"the {LIMITS.length:g} m a mechanism file may hold")
+
+
 def _realize(design, out, tolerance=None):
     """Write design's URDF under a temporary name beside ``out``, check it there; returns
     (check, temporary path)."""
+    _plausible(design, design.kind)
     folder = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(folder):
         raise UsageError(f"-o {quote(str(out))}: the folder {quote(folder)} does not exist")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..analysis.synthesis.designs import Check, ChainsResult, FunctionResult, MotionResult, PathResult
 from ..analysis.synthesis.fourbar import tool_local
 from .report import table, to_jsonable
@@ -149,8 +151,11 @@ def synthesis_text(result, check: Check, file) -> str:
         how = "least squares" if result.least_squares else "exact (3 x 3 linear solve)"
         out.append(f"{len(result.x)} precision points ({result.spacing} spacing), {how}: "
                    f"K1 = {result.K[0]:.9g}, K2 = {result.K[1]:.9g}, K3 = {result.K[2]:.9g}")
-        out.append(f"structural error: largest {_fmt(math.degrees(result.max_structural_error), 4)} deg over the range; "
-                   "at the precision points " + ", ".join(f"{math.degrees(e):.2g}" for e in result.error_at_points)
+        where = "over the range" if np.all(np.isfinite(result.structural_error)) else \
+            "where the linkage assembles"
+        out.append(f"structural error: largest {_fmt(math.degrees(result.max_structural_error), 4)} deg {where}; "
+                   "at the precision points " + ", ".join(f"{math.degrees(e):.2g}" if math.isfinite(e) else "(none)"
+                                                          for e in result.error_at_points)
                    + " deg")
     elif isinstance(result, PathResult):
         timing = "crank angles prescribed (--timing)" if result.timing is not None else "crank angles free"
@@ -186,8 +191,10 @@ def synthesis_text(result, check: Check, file) -> str:
         else:
             want = f"psi {_fmt(math.degrees(t.value[0]))} deg"
             err = f"{math.degrees(p.error):.2g} deg"
+        if not math.isfinite(p.error):
+            err = "not assembled"
         rows.append([t.label, f"{_fmt(math.degrees(t.input))}", want, "yes" if p.reached else "NO", err,
-                     f"{p.residual:.2g}", f"{p.closed_form_error:.2g}",
+                     f"{p.residual:.2g}", f"{p.closed_form_error:.2g}" if math.isfinite(p.closed_form_error) else "-",
                      "-" if travel is None else _fmt(math.degrees(travel), 5)])
     out.append("  " + table(["position", "crank [deg]", "target", "reached", "error", "residual",
                              "vs closed form [m]", "travel [deg]"], rows).replace("\n", "\n  "))
@@ -195,8 +202,10 @@ def synthesis_text(result, check: Check, file) -> str:
         out.append("DEFECTS:")
         out += [f"  - {x}" for x in check.defects]
         out.append("not valid: the linkage does not do what was asked as written (see the defects)")
-    else:
+    elif all(p.reached for p in check.precision):
         out.append("no defect: every precision position is reached, on one branch, in the order given")
+    else:
+        out.append("no defect: the positions are approximated (least squares), on one branch, in the order given")
     return "\n".join(out)
 
 

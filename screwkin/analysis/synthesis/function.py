@@ -144,6 +144,8 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     (p0, p1), (s0, s1) = map(float, input_range), map(float, output_range)
     if p0 == p1 or s0 == s1:
         raise UsageError("--input-range and --output-range must not be empty (A:B with A != B)")
+    if abs(p1 - p0) >= 2 * math.pi or abs(s1 - s0) >= 2 * math.pi:
+        raise UsageError("--input-range and --output-range must each span less than a turn")
     if points < 3:
         raise UsageError(f"--points: at least 3 precision points, got {points}")
     if spacing not in ("chebyshev", "even"):

@@ -330,8 +330,8 @@ def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 2
     curves = ()
     if n == 3:
         if (pivots is None) == (moving is None):
-            raise UsageError("three positions need the two fixed pivots (--pivots) or the two moving pivots "
-                             "(--moving), not both")
+            raise UsageError("three positions need either the two fixed pivots (--pivots) or the two moving pivots "
+                             "(--moving)")
         given = pivots if pivots is not None else moving
         if len(given) != 2:
             raise UsageError(f"--{'pivots' if pivots is not None else 'moving'}: give two pivots, got {len(given)}")
