@@ -374,7 +374,7 @@ def test_errors_are_one_line(tmp_path, capsys):
         (["--poses", "0,0,0; 1,2; 3,4,5", "--pivots", "0,0; 1,0"], 2, "has 2 numbers, expected 3"),
         (["--poses", "0,0,10deg; 1,0,0; 0,0,10deg", "--pivots", "0,0; 1,0"], 2, "positions 1 and 3 are the same"),
         (["--poses", "0,0,1zz; 1,0,0; 2,0,0", "--pivots", "0,0; 1,0"], 2, "unknown unit"),
-        (["--poses", good], 2, "need the two fixed pivots"),
+        (["--poses", good], 2, "need either the two fixed pivots"),
         (["--poses", good, "--pivots", "0,0; 1,0", "--links", "4"], 2, "applies to 'synthesize chains'"),
         # a pure translation moves every point on a line: no circle, no dyad
         (["--poses", "0,0,0; 0.1,0,0; 0.2,0,0", "--moving", "0,0; 0,0.1"], 1, "moves on a straight line"),
