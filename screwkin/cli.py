@@ -27,6 +27,7 @@ from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
+from .commands import grasp
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
@@ -560,6 +561,7 @@ def main(argv=None) -> int:
 
 # the commands in modules of their own, one line each:
 # _register(<module imported from .commands>)
+_register(grasp)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
