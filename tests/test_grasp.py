@@ -488,3 +488,19 @@ def test_hostile_grasp_files_never_reach_an_internal_error(tmp_path, capsys, con
     assert len(err.strip().splitlines()) <= 1 and "Traceback" not in err
     if code == 0:
         json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+
+
+def test_the_documented_example_is_the_bundled_one_and_says_what_screwkin_prints(capsys):
+    import re
+
+    import yaml
+
+    docs = (ROOT / "docs" / "format.md").read_text()
+    section = docs[docs.index("## 11. Grasps"):]
+    block = re.search(r"```yaml\n(.*?)```", section, re.S).group(1)
+    assert yaml.safe_load(block) == yaml.safe_load((ROOT / "examples" / "grasp_box.yaml").read_text())
+    assert main(["grasp", str(ROOT / "examples" / "grasp_box.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert "rank G = 6 of 6" in out and "dim null(G) = 2" in out and "5.88%" in out
+    assert "epsilon = 0.107488" in out and "L = 0.04625 m" in out
+    assert "5.9 %" in section and "epsilon 0.107 with L = 0.04625 m" in section

@@ -130,8 +130,8 @@ def grasp_text(r: GraspResult) -> str:
     lines += _certificate_lines(r)
     lines += _quality_lines(r)
     if r.exact_cones:
-        lines.append("friction cones: exact (" + ("planar cones have two edges" if spec.planar
-                                                  else "polyhedral") + "); cone error 0")
+        lines.append("friction cones: exact (frictionless contacts, mu = 0 and planar cones are polyhedral); "
+                     "cone error 0")
     else:
         lines.append(f"friction cones: {r.facets}-facet pyramids" + (
             f" (refined from --facets {r.facets_requested})" if r.facets != r.facets_requested else "")
@@ -150,7 +150,7 @@ def _certificate_lines(r: GraspResult):
         return []
     if c.kind == "internal_force":
         out = [f"  certificate: an internal force strictly inside every cone (found with the {c.cones} cones), "
-               f"G f = 0 to {c.residual:.2g}, total normal force 1 N:"]
+               f"|G f| = {c.residual:.2g}, total normal force 1 N:"]
         spatial = not r.spec.planar
         shown = c.contact_forces[:50]
         body = []
