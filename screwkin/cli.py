@@ -27,9 +27,9 @@ from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
+from .commands import grasp, synthesize
 from .commands import statics as statics_command
 from .commands._common import configuration, inputs
-from .commands import synthesize
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
@@ -532,6 +532,7 @@ def main(argv=None) -> int:
 # the commands in modules of their own, one line each:
 _register(statics_command)
 _register(synthesize)
+_register(grasp)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
