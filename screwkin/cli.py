@@ -29,6 +29,7 @@ from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
 from .commands import grasp, synthesize
 from .commands import statics as statics_command
+from .commands import workspace as workspace_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .model.loader import load
@@ -533,6 +534,7 @@ def main(argv=None) -> int:
 _register(statics_command)
 _register(synthesize)
 _register(grasp)
+_register(workspace_command)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
