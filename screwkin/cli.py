@@ -56,7 +56,7 @@ from .present.report import (
     trace_text,
     value_text,
 )
-from .present.view import ViewerServer, build_scene, screenshot, show
+from .present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from .units import parse_assignments, parse_value
 
 __all__ = ["main"]
@@ -391,16 +391,17 @@ def _view(mech, args):
         show(mech, scene, server.viewer, q, motion=motion)
         if args.html or args.png:
             html = server.viewer.static_html()
+            title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
             if args.html:
                 with open(args.html, "w") as f:
-                    f.write(html)
+                    f.write(page(html, scene, title))
                 print(f"wrote {args.html}")
             if args.png:
                 with tempfile.TemporaryDirectory() as d:
-                    page = os.path.join(d, "scene.html")
-                    with open(page, "w") as f:
-                        f.write(html)
-                    screenshot(page, args.png)
+                    path = os.path.join(d, "scene.html")
+                    with open(path, "w") as f:
+                        f.write(page(html, scene, title, controls=False, size=PICTURE))
+                    screenshot(path, args.png)
                 print(f"wrote {args.png}")
             return 0
         print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
