@@ -21,6 +21,7 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from html import escape
 from pathlib import Path
 
 import numpy as np
@@ -519,7 +520,6 @@ def page(html: str, scene: Scene, title: str | None = None, controls: bool = Tru
     per kind of thing drawn, and ``title`` above them); ``controls=False`` hides meshcat's
     control panel and ``size`` (width, height) [px] fixes the drawing's size, for pictures
     (headless Chromium's viewport is not its window's size)."""
-    from html import escape
 
     rows = []
     entries = legend_entries(scene)
