@@ -453,7 +453,8 @@ def _sweep(mech, args):
         with open(args.csv, "w") as f:
             f.write(sweep_csv(res))
     if args.plot:
-        sweep_plot(res, args.plot, mus)
+        sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational,
+                   title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
     if args.json:
         d = sweep_dict(res, mech)
         if info is not None:
