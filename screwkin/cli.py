@@ -31,11 +31,14 @@ from .commands import grasp, synthesize
 from .commands import statics as statics_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
+from .model.joint_types import JOINT_TYPES
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
 from .present.report import (
     linkage_dict,
     map_csv,
+    joint_types_dict,
+    joint_types_text,
     mobility_dict,
     mobility_text,
     position_dict,
@@ -88,14 +91,15 @@ def _parser():
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    def common(sp, mechanism: bool = True):
+    def common(sp, mechanism: bool = True, optional_file: bool = False):
         """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
         if not mechanism:
             sp.add_argument("--json", action="store_true", help="print one JSON object")
             sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                             help="show tracebacks of errors")
             return
-        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file")
+        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file",
+                        **({"nargs": "?"} if optional_file else {}))
         sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
         # SUPPRESS: when absent after the command, the top-level --debug (before the command) is kept
@@ -127,8 +131,10 @@ def _parser():
     common(m)
     m.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
     m.add_argument("--point", action="store_true", help="the output link's origin as a point (3 translations)")
-    i = sub.add_parser("info", help="topology table: links, joints, loops")
-    common(i)
+    i = sub.add_parser("info", help="topology table: links, joints, loops (--joint-types: the joint vocabulary)")
+    common(i, optional_file=True)
+    i.add_argument("--joint-types", action="store_true",
+                   help="list every joint type screwkin knows (DOF, motion, pair, contact); needs no FILE")
     s = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(s)
     s.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -214,6 +220,14 @@ def _run(args):
     command = _COMMAND_MODULES.get(args.command)
     if command is not None and not command.NEEDS_MECHANISM:
         return command.run(None, args)
+    if args.command == "info" and args.joint_types:
+        if args.json:
+            print(json.dumps({"joint_types": joint_types_dict(JOINT_TYPES)}, indent=2))
+        else:
+            print(joint_types_text(JOINT_TYPES))
+        return 0
+    if args.file is None:
+        raise UsageError(f"{args.command} needs a FILE" + (" (or --joint-types)" if args.command == "info" else ""))
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs)
     if getattr(args, "length", None):
