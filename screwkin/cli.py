@@ -32,11 +32,14 @@ from .commands import statics as statics_command
 from .commands import workspace as workspace_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
+from .model.joint_types import JOINT_TYPES
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
 from .present.report import (
     linkage_dict,
     map_csv,
+    joint_types_dict,
+    joint_types_text,
     mobility_dict,
     mobility_text,
     position_dict,
@@ -57,7 +60,7 @@ from .present.report import (
     trace_text,
     value_text,
 )
-from .present.view import ViewerServer, build_scene, screenshot, show
+from .present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from .units import parse_assignments, parse_value
 
 __all__ = ["main"]
@@ -89,14 +92,15 @@ def _parser():
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    def common(sp, mechanism: bool = True):
+    def common(sp, mechanism: bool = True, optional_file: bool = False):
         """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
         if not mechanism:
             sp.add_argument("--json", action="store_true", help="print one JSON object")
             sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                             help="show tracebacks of errors")
             return
-        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file")
+        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar) or SDF file",
+                        **({"nargs": "?"} if optional_file else {}))
         sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
         # SUPPRESS: when absent after the command, the top-level --debug (before the command) is kept
@@ -128,8 +132,10 @@ def _parser():
     common(m)
     m.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
     m.add_argument("--point", action="store_true", help="the output link's origin as a point (3 translations)")
-    i = sub.add_parser("info", help="topology table: links, joints, loops")
-    common(i)
+    i = sub.add_parser("info", help="topology table: links, joints, loops (--joint-types: the joint vocabulary)")
+    common(i, optional_file=True)
+    i.add_argument("--joint-types", action="store_true",
+                   help="list every joint type screwkin knows (DOF, motion, pair, contact); needs no FILE")
     s = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(s)
     s.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -215,6 +221,14 @@ def _run(args):
     command = _COMMAND_MODULES.get(args.command)
     if command is not None and not command.NEEDS_MECHANISM:
         return command.run(None, args)
+    if args.command == "info" and args.joint_types:
+        if args.json:
+            print(json.dumps({"joint_types": joint_types_dict(JOINT_TYPES)}, indent=2))
+        else:
+            print(joint_types_text(JOINT_TYPES))
+        return 0
+    if args.file is None:
+        raise UsageError(f"{args.command} needs a FILE" + (" (or --joint-types)" if args.command == "info" else ""))
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs)
     if getattr(args, "length", None):
@@ -392,16 +406,17 @@ def _view(mech, args):
         show(mech, scene, server.viewer, q, motion=motion)
         if args.html or args.png:
             html = server.viewer.static_html()
+            title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
             if args.html:
                 with open(args.html, "w") as f:
-                    f.write(html)
+                    f.write(page(html, scene, title))
                 print(f"wrote {args.html}")
             if args.png:
                 with tempfile.TemporaryDirectory() as d:
-                    page = os.path.join(d, "scene.html")
-                    with open(page, "w") as f:
-                        f.write(html)
-                    screenshot(page, args.png)
+                    path = os.path.join(d, "scene.html")
+                    with open(path, "w") as f:
+                        f.write(page(html, scene, title, controls=False, size=PICTURE))
+                    screenshot(path, args.png)
                 print(f"wrote {args.png}")
             return 0
         print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
@@ -453,7 +468,8 @@ def _sweep(mech, args):
         with open(args.csv, "w") as f:
             f.write(sweep_csv(res))
     if args.plot:
-        sweep_plot(res, args.plot, mus)
+        sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational,
+                   title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
     if args.json:
         d = sweep_dict(res, mech)
         if info is not None:
