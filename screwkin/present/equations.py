@@ -105,7 +105,7 @@ def equations_text(res) -> str:
     num = ", ".join(f"{k} {name}" for name, k in sorted(res.numbers.items(), key=lambda t: t[1]))
     lines = [f"Vector-loop equations of {res.path} (planar, normal ({', '.join(_fmt(x) for x in res.normal)}))",
              f"links: {num}", ""]
-    rows = [[greek(n), s.link, s.kind, _fmt(s.value) + (" rad" if s.kind == "angle" else " m"), s.role, s.meaning]
+    rows = [[greek(n), s.link, s.kind, _fmt(s.value) + (" rad" if s.kind == "angle" else " m"), s.role, greek(s.meaning)]
             for n, s in res.symbols.items()]
     lines.append(table(["symbol", "link", "kind", "value", "role", "meaning"], rows))
     lines.append("vectors: " + "; ".join(f"{v.name} = {greek(v.length)} at {greek(v.angle)}" for v in res.vectors))
