@@ -65,7 +65,6 @@ def test_equations_close_and_their_matrices_are_the_numerical_jacobians(name):
     h = 1e-6
     for k, sym in enumerate(res.inputs):
         joint, sigma = res.input_joints[sym]
-        c = mech.coordinate(joint)
         v0 = solver.joint_values(q)[joint]
         plus = vl.values(solver.track({joint: v0 + h}, q).q)
         minus = vl.values(solver.track({joint: v0 - h}, q).q)
@@ -76,7 +75,6 @@ def test_equations_close_and_their_matrices_are_the_numerical_jacobians(name):
         assert dw == pytest.approx(sigma * np.eye(len(res.inputs))[k], abs=1e-6)
         assert A @ dz == pytest.approx(B @ dw, abs=1e-7 * max(1.0, np.abs(B).max())), (name, joint)
         assert res.rates[:, k] * sigma == pytest.approx(dz, rel=1e-5, abs=1e-7)
-        del c
 
 
 @pytest.mark.parametrize("name", ["fourbar_crank_rocker", "slider_crank_offset", "watt_sixbar"])
