@@ -27,6 +27,7 @@ from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
+from .commands import equations as equations_command
 from .commands import grasp, synthesize
 from .commands import statics as statics_command
 from .commands import workspace as workspace_command
@@ -149,6 +150,12 @@ def _parser():
     s.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
+    s.add_argument("--start", action="append", metavar="NAME=VALUE,...",
+                   help="planar: Newton on the vector-loop equations (screwkin equations) from these estimates of "
+                        "the unknowns: symbols (theta3, x4), link names (their angles) or passive joint values")
+    s.add_argument("--iterations", type=int, metavar="K",
+                   help="with --start: exactly K Newton iterations, each printed (residual, Jacobian, step, "
+                        "estimates); without it Newton goes on to convergence")
     scaled(s, point=False)
     c = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
     common(c)
@@ -277,6 +284,8 @@ def _solve(mech, args):
     accels = parse_assignments(args.accel, "--accel") if args.accel else None
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
+    if args.start or args.iterations is not None:
+        return equations_command.solve_from_start(mech, args, values)
     solver = PositionSolver(mech, list(values), output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace)
     if args.json:
@@ -551,6 +560,7 @@ _register(statics_command)
 _register(synthesize)
 _register(grasp)
 _register(workspace_command)
+_register(equations_command)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -10,8 +10,8 @@ LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "ana
           "commands": 5, "cli": 5, "__main__": 6, "__init__": 6}
 # third-party imports a function may make lazily: optional, or heavy and needed by one command
 # (measured cold: scipy.optimize 0.62 s, pinocchio.visualize 0.42 s, networkx 0.15 s; every command pays ~0.3 s
-# in all)
-LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize", "networkx"}
+# in all; sympy 0.5 s, for the equations only)
+LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize", "networkx", "sympy"}
 
 
 def module_name(path: Path) -> str:
