@@ -27,7 +27,7 @@ from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
-from .commands import grasp, synthesize
+from .commands import draw, grasp, synthesize
 from .commands import statics as statics_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
@@ -533,6 +533,7 @@ def main(argv=None) -> int:
 _register(statics_command)
 _register(synthesize)
 _register(grasp)
+_register(draw)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
