@@ -27,8 +27,8 @@ from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
+from .commands import draw, grasp, synthesize
 from .commands import equations as equations_command
-from .commands import grasp, synthesize
 from .commands import statics as statics_command
 from .commands import workspace as workspace_command
 from .commands._common import configuration, inputs
@@ -561,6 +561,7 @@ _register(synthesize)
 _register(grasp)
 _register(workspace_command)
 _register(equations_command)
+_register(draw)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
