@@ -27,16 +27,22 @@ from .analysis.scan import scan
 from .analysis.screws import structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
+from .commands import draw, grasp, synthesize
+from .commands import equations as equations_command
 from .commands import statics as statics_command
 from .commands import study as study_command
+from .commands import workspace as workspace_command
 from .commands._common import configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
+from .model.joint_types import JOINT_TYPES
 from .model.loader import load
 from .present.plots import map_png, sweep_plot
 from .present.report import (
     linkage_dict,
     map_csv,
+    joint_types_dict,
+    joint_types_text,
     mobility_dict,
     mobility_text,
     position_dict,
@@ -57,7 +63,7 @@ from .present.report import (
     trace_text,
     value_text,
 )
-from .present.view import ViewerServer, build_scene, screenshot, show
+from .present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from .units import parse_assignments, parse_value
 
 __all__ = ["main"]
@@ -89,14 +95,15 @@ def _parser():
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    def common(sp, mechanism: bool = True):
+    def common(sp, mechanism: bool = True, optional_file: bool = False):
         """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
         if not mechanism:
             sp.add_argument("--json", action="store_true", help="print one JSON object")
             sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                             help="show tracebacks of errors")
             return
-        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar), SDF, or xacro file")
+        sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar), SDF, or xacro file",
+                        **({"nargs": "?"} if optional_file else {}))
         sp.add_argument("--arg", action="append", dest="xacro_args", metavar="NAME=VALUE",
                         help="xacro argument of a .xacro file (units allowed, e.g. crank=30mm: given in SI); "
                              "repeatable")
@@ -131,8 +138,10 @@ def _parser():
     common(m)
     m.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
     m.add_argument("--point", action="store_true", help="the output link's origin as a point (3 translations)")
-    i = sub.add_parser("info", help="topology table: links, joints, loops")
-    common(i)
+    i = sub.add_parser("info", help="topology table: links, joints, loops (--joint-types: the joint vocabulary)")
+    common(i, optional_file=True)
+    i.add_argument("--joint-types", action="store_true",
+                   help="list every joint type screwkin knows (DOF, motion, pair, contact); needs no FILE")
     s = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(s)
     s.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -146,6 +155,12 @@ def _parser():
     s.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
+    s.add_argument("--start", action="append", metavar="NAME=VALUE,...",
+                   help="planar: Newton on the vector-loop equations (screwkin equations) from these estimates of "
+                        "the unknowns: symbols (theta3, x4), link names (their angles) or passive joint values")
+    s.add_argument("--iterations", type=int, metavar="K",
+                   help="with --start: exactly K Newton iterations, each printed (residual, Jacobian, step, "
+                        "estimates); without it Newton goes on to convergence")
     scaled(s, point=False)
     c = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
     common(c)
@@ -218,6 +233,14 @@ def _run(args):
     command = _COMMAND_MODULES.get(args.command)
     if command is not None and not command.NEEDS_MECHANISM:
         return command.run(None, args)
+    if args.command == "info" and args.joint_types:
+        if args.json:
+            print(json.dumps({"joint_types": joint_types_dict(JOINT_TYPES)}, indent=2))
+        else:
+            print(joint_types_text(JOINT_TYPES))
+        return 0
+    if args.file is None:
+        raise UsageError(f"{args.command} needs a FILE" + (" (or --joint-types)" if args.command == "info" else ""))
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs, args=parse_xacro_args(args.xacro_args))
     if getattr(args, "length", None):
@@ -266,6 +289,8 @@ def _solve(mech, args):
     accels = parse_assignments(args.accel, "--accel") if args.accel else None
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
+    if args.start or args.iterations is not None:
+        return equations_command.solve_from_start(mech, args, values)
     solver = PositionSolver(mech, list(values), output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace)
     if args.json:
@@ -395,16 +420,17 @@ def _view(mech, args):
         show(mech, scene, server.viewer, q, motion=motion)
         if args.html or args.png:
             html = server.viewer.static_html()
+            title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
             if args.html:
                 with open(args.html, "w") as f:
-                    f.write(html)
+                    f.write(page(html, scene, title))
                 print(f"wrote {args.html}")
             if args.png:
                 with tempfile.TemporaryDirectory() as d:
-                    page = os.path.join(d, "scene.html")
-                    with open(page, "w") as f:
-                        f.write(html)
-                    screenshot(page, args.png)
+                    path = os.path.join(d, "scene.html")
+                    with open(path, "w") as f:
+                        f.write(page(html, scene, title, controls=False, size=PICTURE))
+                    screenshot(path, args.png)
                 print(f"wrote {args.png}")
             return 0
         print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
@@ -456,7 +482,8 @@ def _sweep(mech, args):
         with open(args.csv, "w") as f:
             f.write(sweep_csv(res))
     if args.plot:
-        sweep_plot(res, args.plot, mus)
+        sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational,
+                   title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
     if args.json:
         d = sweep_dict(res, mech)
         if info is not None:
@@ -536,6 +563,11 @@ def main(argv=None) -> int:
 # the commands in modules of their own, one line each:
 _register(statics_command)
 _register(study_command)
+_register(synthesize)
+_register(grasp)
+_register(workspace_command)
+_register(equations_command)
+_register(draw)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -46,11 +46,17 @@ def _escape(text: str) -> str:
 
 def shorten(value, limit: int = QUOTE_LIMIT) -> str:
     """``value`` (a string, or any object by its bounded repr) as at most ``limit``
-    characters plus "...", control characters escaped; never contains a newline."""
+    characters plus "...", control characters escaped (the limit counts the escapes:
+    ``\U0001d246`` is ten characters); never contains a newline."""
     text = value if isinstance(value, str) else _repr.repr(value)
-    if len(text) > limit:
-        text = text[:limit] + "..."
-    return _escape(text)
+    out, used = [], 0
+    for c in text[: limit + 1]:
+        e = c if c.isprintable() else repr(c)[1:-1]
+        if used + len(e) > limit:
+            return "".join(out) + "..."
+        out.append(e)
+        used += len(e)
+    return "".join(out) + ("..." if len(text) > limit + 1 else "")
 
 
 def quote(value, limit: int = QUOTE_LIMIT) -> str:

@@ -9,14 +9,12 @@ PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
 LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "analysis": 3, "present": 4,
           "commands": 5, "cli": 5, "__main__": 6, "__init__": 6}
 # third-party imports a function may make lazily: optional, or heavy and needed by one command
-# (measured cold: scipy.optimize 0.62 s, pinocchio.visualize 0.42 s; every command pays ~0.3 s in all)
+# (measured cold: scipy.optimize 0.62 s, pinocchio.visualize 0.42 s, networkx 0.15 s; every command pays ~0.3 s
+# in all; sympy 0.5 s, for the equations only)
 # xacro (28 ms, and it replaces minidom's pretty printer when imported) only for .xacro files
 # distributed (0.4-0.9 s) and pyarrow (optional: parquet tables) only for studies
-LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize", "xacro", "distributed", "dask",
-        "pyarrow",
-        # until merged: the study's workspace metrics import the lead's analysis/workspace.py lazily (not on
-        # this branch yet); make it a module-level import in analysis/study.py at the merge and drop this entry
-        "screwkin.analysis.workspace"}
+LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize", "networkx", "sympy", "xacro",
+        "distributed", "dask", "pyarrow"}
 
 
 def module_name(path: Path) -> str:

@@ -108,7 +108,7 @@ def test_server_binds_only_to_loopback():
 @pytest.mark.skipif(chromium() is None, reason="Chromium is not installed (.ci/run installs it)")
 def test_static_page_renders_the_mechanism(tmp_path):
     """The static HTML page, opened in headless Chromium, shows the red arms of the
-    Delta on meshcat's blue background."""
+    Delta on screwkin's grey background."""
     from PIL import Image
 
     html, png = tmp_path / "delta.html", tmp_path / "delta.png"

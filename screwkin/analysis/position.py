@@ -40,7 +40,7 @@ from .mobility import analyze_mobility
 from .planar import LinkAngles
 from .singular import Generic, measures, scaled_jacobians
 
-__all__ = ["Solution", "PositionResult", "PositionSolver", "TraceStep", "inverse_kinematics", "outside_limits"]
+__all__ = ["within_limits", "Solution", "PositionResult", "PositionSolver", "TraceStep", "inverse_kinematics", "outside_limits"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -135,17 +135,31 @@ class PositionResult:
 
 def outside_limits(mech, q) -> tuple:
     """Joints whose value lies outside the position limits of the file."""
-    table = mech.limited_coordinates()
-    names, idx, lo, hi, angle = table
+    names = mech.limited_coordinates()[0]
     if not names:
         return ()
-    v = np.asarray(q)[idx]
+    out = _outside(mech, np.asarray(q)[None])[0]
+    return tuple(n for n, o in zip(names, out) if o)
+
+
+def within_limits(mech, Q) -> np.ndarray:
+    """(N,) True where every joint of the configurations Q (N, nq) is within its limits (an
+    angle may sit in its range modulo a turn): outside_limits for a stack."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    if not mech.limited_coordinates()[0]:
+        return np.ones(len(Q), bool)
+    return ~_outside(mech, Q).any(axis=1)
+
+
+def _outside(mech, Q) -> np.ndarray:
+    """(N, limited joints) True where a joint lies outside its limits."""
+    _, idx, lo, hi, angle = mech.limited_coordinates()
+    v = Q[:, idx]
     out = (v < lo) | (v > hi)
     if out.any():  # an angle may sit in the range modulo a turn
-        k = np.ceil((lo - v) / (2 * np.pi))
-        shifted = v + 2 * np.pi * k
+        shifted = v + 2 * np.pi * np.ceil((lo - v) / (2 * np.pi))
         out &= ~(angle & (lo <= shifted) & (shifted <= hi))
-    return tuple(n for n, o in zip(names, out) if o)
+    return out
 
 
 class PositionSolver:
@@ -632,7 +646,9 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     frame.placement = pose
     model.frames[fid] = frame
     target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
-    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.data)
+    # the higher pairs' rows too: without them a gear or cam would be free to slip
+    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.data,
+                           extra=mech.extra_rows)
     if not mech.coordinates:
         raise UsageError(f"{mech.path}: the mechanism has no moving joint: nothing to solve for")
     solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)

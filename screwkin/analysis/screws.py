@@ -24,7 +24,7 @@ from ..errors import UsageError
 from ..model._pin import frame_jacobian
 from ..model.linalg import null_space
 
-__all__ = ["Screw", "Chain", "screw_of", "chains", "poe", "structure", "split_jacobians"]
+__all__ = ["Screw", "Chain", "screw_of", "chains", "chains_to", "poe", "structure", "split_jacobians"]
 
 
 @dataclass(frozen=True)
@@ -64,12 +64,18 @@ class Chain:
 
 def chains(mech, output=None):
     """One chain per cut-joint side and one to the output link."""
-    model = mech.model
     targets = []
     for c in mech.cuts:
         targets += [(f"{c.name}@F1", c.frame1), (f"{c.name}@F2", c.frame2)]
     if output:
         targets.append((f"output {output}", mech.link_frame(output)))
+    return chains_to(mech, targets)
+
+
+def chains_to(mech, targets) -> list:
+    """The chain from the ground to each frame of ``targets`` ((name, frame id) pairs), read
+    at the reference configuration (every joint at zero)."""
+    model = mech.model
     q0 = mech.neutral()
     data = mech.data
     pin.computeJointJacobians(model, data, q0)

@@ -31,11 +31,12 @@ import numpy as np
 import pinocchio as pin
 
 from ..model._pin import frame_jacobian
+from ..model.closure import perpendicular_basis
 from ..model.linalg import null_space, rank
 from .screws import screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
-           "KINDS"]
+           "KINDS", "GramLoop", "loop_twists", "gram_cofactors"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 KINDS = ("serial", "actuator", "constraint")
@@ -64,6 +65,7 @@ class SingularityReport:
     inputs: tuple
     output: str | None
     point: bool = False  # the output link's origin analysed as a point
+    gram: tuple = ()  # GramLoop: the Gram-matrix cofactors of each loop's joint twists
 
 
 def _rel(s, k):
@@ -221,7 +223,133 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
                        if g.moving[k] and S.V.shape[1] and np.linalg.norm(S.V[k]) < 1e-7)
     sigmas = {k: sig.get(k, 1.0) for k in KINDS}
     return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
-                             L, tuple(twists), tuple(inputs), output, point)
+                             L, tuple(twists), tuple(inputs), output, point, gram_cofactors(mech, q, L))
+
+
+@dataclass(frozen=True)
+class GramLoop:
+    """The Gram-matrix cofactors of one loop's joint twists (Murray, Li and Sastry).
+
+    The loop closed by cut joint ``loop`` through the spanning tree has joint twists
+    xi_1..xi_n (the columns of S, 6 x n: the tree joints on either side of the cut and the cut
+    joint's own freedoms, world axes, linear parts divided by L and sliding columns multiplied
+    by it: dimensionless); its velocity constraint is S theta' = 0.  With G = S^T S and the
+    loop's own mobility ``nullity`` = n - rank S equal to 1, adj(G) = c v v^T (v the unit vector
+    spanning the null space, c > 0 the product of G's nonzero eigenvalues), so the diagonal
+    cofactor C_ii = det(G without row and column i) = c v_i^2 vanishes exactly when joint i is
+    stationary: theta_i' = 0 in every motion of the loop.  With nullity 0 or more than 1 every
+    C_ii is 0 identically and says nothing: ``cofactors`` is then empty and ``note`` says why."""
+
+    loop: str  # the cut joint that closes it
+    joints: tuple  # column names (coordinate names; a cut joint's freedoms "cut[k]")
+    nullity: int  # n - rank S: the loop's mobility on its own
+    cofactors: dict  # joint -> C_ii
+    relative: dict  # joint -> C_ii / sum_j C_jj = v_i^2
+    zero: tuple  # joints whose cofactor is zero: v_i^2 < STATIONARY^2 (|v_i| < 1e-7, as stationary_joints)
+    note: str | None = None
+
+
+STATIONARY = 1e-7  # |v_i| below this: joint i's rate is zero (the threshold of stationary_joints too)
+
+
+def _cut_twists(mech, cut, data):
+    """The cut joint's freedoms as world twists (v at the world origin, w): [(name, twist, sliding)],
+    or None for a higher pair (its loop closes through an equivalent linkage and coupling rows)."""
+    if cut.pair is not None:
+        return None
+    M1 = data.oMf[cut.frame1]
+    a = M1.rotation @ (np.asarray(cut.axis, float) / np.linalg.norm(cut.axis))
+    p = M1.translation
+
+    def rot(u):
+        return np.concatenate([-np.cross(u, p), u]), False
+
+    def slide(u):
+        return np.concatenate([u, np.zeros(3)]), True
+
+    if cut.type in ("revolute", "continuous"):
+        out = [rot(a)]
+    elif cut.type == "prismatic":
+        out = [slide(a)]
+    elif cut.type == "cylindrical":
+        out = [rot(a), slide(a)]
+    elif cut.type == "universal":
+        a2 = data.oMf[cut.frame2].rotation @ np.asarray(cut.axis2, float)
+        out = [rot(a), rot(a2 / np.linalg.norm(a2))]
+    elif cut.type == "spherical":
+        out = [rot(e) for e in np.eye(3)]
+    elif cut.type == "planar":
+        b1, b2 = perpendicular_basis(a)
+        out = [slide(b1), slide(b2), rot(a)]
+    elif cut.type == "fixed":
+        out = []
+    else:  # pragma: no cover - every lower-pair cut joint type is above
+        return None
+    if len(out) == 1:
+        return [(cut.name, *out[0])]
+    return [(f"{cut.name}[{k}]", *t) for k, t in enumerate(out)]
+
+
+def loop_twists(mech, q, cut, length=None):
+    """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
+    its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
+    says why) when the loop has a higher pair or a joint without one twist per coordinate."""
+    model, data = mech.model, mech.data
+    L = float(length or mech.length)
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    J1 = frame_jacobian(model, data, cut.frame1, pin.ReferenceFrame.WORLD)
+    J2 = frame_jacobian(model, data, cut.frame2, pin.ReferenceFrame.WORLD)
+    sides = []
+    for f in (cut.frame1, cut.frame2):
+        sides.append({j for j in model.supports[model.frames[f].parentJoint] if j > 0})
+    names, cols, slide = [], [], []
+    coord_names = mech.coordinate_names
+    for c in mech.coordinates:
+        on1, on2 = c.joint_id in sides[0], c.joint_id in sides[1]
+        if on1 == on2:
+            continue  # not in the loop, or on the common path from the ground (it cancels)
+        for k in range(c.idx_v, c.idx_v + c.nv):
+            names.append(coord_names[k])
+            cols.append(J1[:, k] if on1 else -J2[:, k])
+            slide.append(bool(mech.translational[k]))
+    extra = _cut_twists(mech, cut, data)
+    if extra is None:
+        return names, None, f"the loop closes through the {cut.pair} pair's equivalent linkage: not computed"
+    for name, t, sl in extra:
+        names.append(name)
+        cols.append(t)
+        slide.append(sl)
+    S = np.array(cols, float).T.reshape(6, len(cols))
+    S[:3] /= L
+    S[:, np.array(slide, bool)] *= L
+    return names, S, None
+
+
+def gram_cofactors(mech, q, length=None) -> tuple:
+    """GramLoop for each loop (one per cut joint: the fundamental loops of the spanning tree)."""
+    tol = mech.tolerances
+    out = []
+    for cut in mech.cuts:
+        names, S, note = loop_twists(mech, q, cut, length)
+        if S is None:
+            out.append(GramLoop(cut.name, tuple(names), -1, {}, {}, (), note))
+            continue
+        n = S.shape[1]
+        nullity = n - rank(S, tol)
+        if nullity != 1:
+            why = ("the loop is rigid on its own (no motion): every cofactor is nonzero" if nullity == 0 else
+                   f"the loop has {nullity} freedoms on its own: adj(G) = 0, every cofactor vanishes identically")
+            out.append(GramLoop(cut.name, tuple(names), nullity, {}, {}, (), why))
+            continue
+        G = S.T @ S
+        C = np.array([np.linalg.det(np.delete(np.delete(G, i, 0), i, 1)) for i in range(n)])
+        total = float(C.sum())
+        rel = C / total if total > 0 else np.zeros(n)
+        cof = {nm: float(c) for nm, c in zip(names, C)}
+        out.append(GramLoop(cut.name, tuple(names), 1, cof, {nm: float(r) for nm, r in zip(names, rel)},
+                            tuple(nm for nm, r in zip(names, rel) if r < STATIONARY ** 2)))
+    return tuple(out)
 
 
 def _motion_twist(kind, x, names, J):

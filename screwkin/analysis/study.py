@@ -41,6 +41,7 @@ from ..model.loader import load
 from .mobility import analyze_mobility
 from .planar import identify
 from .position import PositionSolver
+from .workspace import workspace
 
 __all__ = [
     "COLUMNS",
@@ -161,12 +162,6 @@ class _Design:
 
     def workspace(self):
         if self._workspace is None:
-            try:
-                # until merged: screwkin.analysis.workspace (the lead's); tests/test_layers.py allows this lazy import
-                from .workspace import workspace
-            except ImportError:
-                raise UsageError("the workspace metrics need screwkin.analysis.workspace, which this screwkin "
-                                 "lacks") from None
             ws = self.task.workspace
             self._workspace = workspace(self.mech, self.task.output, point=ws.get("point", False),
                                         resolution=ws.get("resolution"), threshold=ws.get("threshold", 0.01),

@@ -220,6 +220,13 @@ class ClosureSystem:
         self._position_rows = None
 
     @property
+    def plans(self) -> list:
+        """Per cut joint, the constant parts of its rows (see ``_plan``): position axes P in F1,
+        alignment pairs (u in F1, w in F2), the vectors the solver rows compare (None: the
+        alignments instead), and whether the minimal rows hold a rotation vector."""
+        return list(self._plans)
+
+    @property
     def position_rows(self) -> np.ndarray:
         """Mask of the minimal rows (``evaluate(solver=False)``) that are positions [m]; the
         others are dimensionless (angles, alignments)."""

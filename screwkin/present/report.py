@@ -19,7 +19,7 @@ from ..analysis.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 
 __all__ = ["to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
-           "position_text", "singularity_dict", "singularity_text", "sweep_dict", "sweep_csv", "sweep_text",
+           "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable"]
 
 
@@ -395,6 +395,15 @@ def singularity_text(rep) -> str:
                  ("constraint (rank of K drops)", yes(rep.constraint), f"{rep.sigmas['constraint']:.3g}"),
              ])]
     lines.append(f"stationary joints (rate forced to zero by the loops): {', '.join(rep.stationary_joints) or 'none'}")
+    for g in getattr(rep, "gram", ()):
+        lines.append(f"\nloop closed by {g.loop}: Gram matrix G = S^T S of its {len(g.joints)} joint twists "
+                     f"(dimensionless, L = {rep.length:.4g} m)" + (f", loop mobility {g.nullity}" if g.nullity >= 0 else ""))
+        if not g.cofactors:
+            lines.append(f"  cofactors: {g.note}")
+            continue
+        lines.append(table(["joint", "cofactor C_ii", "C_ii / sum C_jj (= v_i^2)", "stationary"],
+                           [(n, f"{g.cofactors[n]:.6g}", f"{g.relative[n]:.6g}", "YES (C_ii = 0)" if n in g.zero else
+                             "no") for n in g.joints]))
     if rep.condition is not None:
         lines.append(f"condition number {rep.condition:.4g}" + (
             f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
@@ -418,6 +427,17 @@ def screw_dict(s: Screw) -> dict:
             "pitch": s.pitch if np.isfinite(s.pitch) else "inf"}
 
 
+def _gram_dict(loops) -> dict:
+    """gram_loops: every loop's cofactors; gram_cofactors, gram_zero, gram_loop: those of the first
+    loop with one freedom of its own (the single loop of a one-loop mechanism)."""
+    first = next((g for g in loops if g.cofactors), None)
+    return {"gram_loops": [{"loop": g.loop, "joints": list(g.joints), "nullity": g.nullity, "cofactors": g.cofactors,
+                            "relative": g.relative, "zero": list(g.zero), "note": g.note} for g in loops],
+            "gram_loop": first.loop if first else None,
+            "gram_cofactors": dict(first.cofactors) if first else {},
+            "gram_zero": list(first.zero) if first else []}
+
+
 def singularity_dict(rep: SingularityReport) -> dict:
     return {
         "serial": rep.serial, "actuator": rep.actuator, "constraint": rep.constraint,
@@ -425,6 +445,7 @@ def singularity_dict(rep: SingularityReport) -> dict:
         "sigmas": rep.sigmas, "condition": rep.condition, "manipulability": rep.manipulability,
         "characteristic_length": rep.length, "inputs": list(rep.inputs), "output": rep.output,
         "point": rep.point,
+        **_gram_dict(getattr(rep, "gram", ())),
         "singular_twists": [{"kind": t.kind, "joint_rates": t.joint_rates,
                              "twist": list(t.twist) if t.twist is not None else None,
                              "screw": screw_dict(t.screw) if t.screw is not None else None}
@@ -520,3 +541,18 @@ def to_dict(result) -> dict:
         if isinstance(result, cls):
             return to_jsonable(fn(result))
     raise TypeError(f"no dictionary form for {type(result).__name__}")
+
+
+# ------------------------------------------------------------------ the joint vocabulary
+def joint_types_dict(types) -> list:
+    """``info --joint-types --json``: one object per kinematic pair screwkin knows."""
+    return [{"name": t.name, "symbol": t.symbol, "dof": t.dof, "motion": t.motion, "pair": t.pair,
+             "contact": t.contact, "type": t.type, "written": t.written} for t in types]
+
+
+def joint_types_text(types) -> str:
+    """``info --joint-types``: the table of kinematic pairs."""
+    rows = [(t.name, t.symbol, t.dof, t.pair, t.contact, t.motion) for t in types]
+    return ("Joint types screwkin knows (DOF of the relative motion; the higher pairs' in their plane):\n"
+            + table(["joint", "symbol", "DOF", "pair", "contact", "motion"], rows)
+            + "\n\n" + table(["joint", "written in a file as (docs/format.md)"], [(t.name, t.written) for t in types]))

@@ -2,8 +2,8 @@
 
 The scene is a Pinocchio GeometryModel: the links' URDF visuals (meshes when
 found, primitives otherwise), plus what screwkin adds as geometry objects
-attached to the moving joints -- joint axes as thin cylinders (actuated joints
-orange, passive grey, cut joints magenta), stand-ins for links without geometry
+attached to the moving joints -- joint axes as thin cylinders with a ball at the
+joint's centre (actuated joints orange, passive grey, cut joints magenta), stand-ins for links without geometry
 (a ball at the link frame and bars to its joints), the output link's frame,
 and, at singular configurations, the singular screw axis with an arrow.
 Pinocchio's MeshcatVisualizer draws it into any meshcat viewer: the loopback
@@ -21,6 +21,7 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from html import escape
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +32,7 @@ from ..files.meshes import find_mesh
 from ..files.xmlsafe import parse_xml_text
 from ..model._pin import frame_id
 
-__all__ = ["COLORS", "build_scene", "show", "view", "ViewerServer", "RecordingViewer", "screenshot"]
+__all__ = ["COLORS", "build_scene", "show", "page", "fit_camera", "legend_entries", "view", "ViewerServer", "RecordingViewer", "screenshot"]
 
 COLORS = {
     "actuated": np.array([1.0, 0.55, 0.0, 1.0]),
@@ -201,6 +202,34 @@ class Scene:
     roles: dict  # geometry object name -> role ("link", "axis:actuated", "axis:passive", "axis:cut", "standin", ...)
     scale: float  # size of the mechanism [m]
     center: np.ndarray  # centre of its joints [m]
+    points: np.ndarray | None = None  # (n, 3): the corners of every drawn object's box, world, at q [m]
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3): the world bounding box (min, max corners) of everything drawn [m]."""
+        pts = self.points if self.points is not None and len(self.points) else self.center[None]
+        return np.array([pts.min(axis=0), pts.max(axis=0)])
+
+
+def _corner_points(model, data, geom, q) -> np.ndarray:
+    """Points that bound the drawn geometry at q: the joint centres and the corners of each
+    object's own bounding box placed where its joint puts it (meshes as loaded, scale included)."""
+    pin.forwardKinematics(model, data, q)
+    pts = [data.oMi[j].translation for j in range(model.njoints)]
+    signs = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
+    for obj in geom.geometryObjects:
+        g = obj.geometry
+        try:
+            g.computeLocalAABB()
+            lo, hi = np.asarray(g.aabb_local.min_, float), np.asarray(g.aabb_local.max_, float)
+        except (AttributeError, RuntimeError):  # pragma: no cover - a shape coal cannot bound: its origin
+            lo = hi = np.zeros(3)
+        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+            lo = hi = np.zeros(3)
+        M = data.oMi[obj.parentJoint] * obj.placement
+        corners = lo + signs * (hi - lo)
+        pts.extend(corners @ M.rotation.T + M.translation)
+    return np.asarray(pts)
 
 
 def _visual_geometry(mech, warn=None):
@@ -260,6 +289,8 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
             add(_ball(f"screwkin/axis/{c.joint}", jid, frame, np.zeros(3), 2 * r_axis, COLORS[role[5:]]), role)
             continue
         add(_segment(f"screwkin/axis/{c.joint}", jid, frame, -L_axis * a, L_axis * a, r_axis, COLORS[role[5:]]), role)
+        add(_ball(f"screwkin/joint/{c.joint}", jid, frame, np.zeros(3), 6 * r_axis, COLORS[role[5:]]),
+            "joint:" + role[5:])  # the joint's centre, seen from any side
         short = model.joints[jid].shortname()
         if "JointModelP" in short:  # pitch infinite: a translation, drawn with an arrow head
             seg = _segment("tmp", jid, frame, np.zeros(3), a, 1.0, COLORS[role[5:]])
@@ -321,7 +352,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
                 _coal().Cone(3 * r_axis, 6 * r_axis))
             cone.meshColor = COLORS["screw"]
             add(cone, "singular:arrow")
-    return Scene(geom, roles, scale, center)
+    return Scene(geom, roles, scale, center, _corner_points(model, data, geom, q))
 
 
 class RecordingViewer:
@@ -365,6 +396,61 @@ def _translation(p):
     return T
 
 
+#: The page a picture is taken of: a neutral background (light grey, faintly graded), 900 x 700 pixels
+BACKGROUND = {"top_color": [0.97, 0.97, 0.97], "bottom_color": [0.85, 0.85, 0.86]}
+PICTURE = (900, 700)
+FOV = 75.0  # meshcat's default camera: vertical field of view [deg]
+VIEW = np.array([1.0, -1.0, 0.7])  # default direction from the mechanism to the camera (world, z up)
+
+
+def view_direction(bounds) -> np.ndarray:
+    """The direction (world, unit) from the mechanism to the camera: VIEW, or, for a flat mechanism
+    (its box thinner than a fifth of its size along one axis), mostly along that axis, tilted a
+    little so that the world's z stays the picture's up."""
+    ext = np.ptp(np.asarray(bounds, float), axis=0)
+    d = VIEW / np.linalg.norm(VIEW)
+    k = int(np.argmin(ext))
+    if ext[k] < 0.2 * ext.max():
+        n = np.zeros(3)
+        n[k] = 1.0 if d[k] >= 0 else -1.0
+        side = d - (d @ n) * n
+        d = n + 0.45 * side / np.linalg.norm(side)
+    return d / np.linalg.norm(d)
+
+
+def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], fill=0.7):
+    """Target and position (world) of a perspective camera looking along -direction, z up, at
+    which the points fill the fraction ``fill`` of the frame along its tighter dimension: the
+    target is moved (a few fixed-point steps) until the points' projected extent is centred, and
+    the distance is the smallest for which every point lies within ``fill`` of the half-frame."""
+    P = np.atleast_2d(np.asarray(points, float))
+    u = np.asarray(direction, float) / np.linalg.norm(direction)
+    up = np.array([0.0, 0.0, 1.0])
+    right = np.cross(-u, up)
+    if np.linalg.norm(right) < 1e-9:  # looking along z: any right will do
+        right = np.array([1.0, 0.0, 0.0])
+    right /= np.linalg.norm(right)
+    cam_up = np.cross(right, -u)
+    tan_v = np.tan(np.radians(fov_deg) / 2)
+    tan_h = tan_v * aspect
+    t = 0.5 * (P.min(axis=0) + P.max(axis=0))
+    x, y = (P - t) @ right, (P - t) @ cam_up
+    t = t + right * 0.5 * (x.max() + x.min()) + cam_up * 0.5 * (y.max() + y.min())  # centred, seen from afar
+    for _ in range(20):  # then centred in perspective: the near side looks bigger
+        x, y, z = (P - t) @ right, (P - t) @ cam_up, (P - t) @ u
+        D = float(np.max(z + np.maximum(np.abs(x) / (fill * tan_h), np.abs(y) / (fill * tan_v))))
+        D = max(D, 1e-3, 1.05 * float(z.max()))
+        sx, sy = x / (D - z), y / (D - z)  # tangents of the angles off the axis
+        mx, my = 0.5 * (sx.max() + sx.min()), 0.5 * (sy.max() + sy.min())
+        if abs(mx) < 1e-4 * tan_h and abs(my) < 1e-4 * tan_v:
+            break
+        t = t + right * mx * D + cam_up * my * D
+    x, y, z = (P - t) @ right, (P - t) @ cam_up, (P - t) @ u
+    D = float(np.max(z + np.maximum(np.abs(x) / (fill * tan_h), np.abs(y) / (fill * tan_v))))
+    D = max(D, 1e-3, 1.05 * float(z.max()))
+    return t, t + D * u
+
+
 def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
     """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
     with ``motion`` (a sequence of configurations) also set a meshcat animation."""
@@ -374,11 +460,22 @@ def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
     viz.initViewer(viewer=viewer)
     viz.loadViewerModel(rootNodeName="screwkin")
     viz.display(q)
-    # look at the mechanism from a distance proportional to its size (meshcat's camera frame is y-up)
-    d = 1.4 * scene.scale
+    # a neutral background, no grid nor world axes, and the camera fitted to what is drawn.  meshcat's orbit
+    # controls look at the world origin (its camera sits in the frame /Cameras/default/rotated, y up: world
+    # (x, y, z) is (x, z, -y) there), so the scene is moved instead: /screwkin carries the target to the origin
     viewer["/Axes"].set_property("visible", False)
-    viewer["/Cameras/default"].set_transform(_translation(scene.center))
-    viewer["/Cameras/default/rotated/<object>"].set_property("position", [d, 0.7 * d, d])
+    viewer["/Grid"].set_property("visible", False)
+    for key, value in BACKGROUND.items():
+        viewer["/Background"].set_property(key, value)
+    pts = scene.points if scene.points is not None else scene.center[None]
+    target, eye = fit_camera(pts, view_direction(scene.bounds))
+    w = eye - target
+    dist = float(np.linalg.norm(w))
+    viewer["screwkin"].set_transform(_translation(-target))  # beside the visuals: /meshcat/screwkin
+    camera = viewer["/Cameras/default/rotated/<object>"]
+    camera.set_property("position", [float(w[0]), float(w[2]), float(-w[1])])
+    camera.set_property("near", dist / 100)
+    camera.set_property("far", dist * 100)
     if motion is not None and len(motion):
         import meshcat.animation
 
@@ -390,6 +487,73 @@ def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
         viz.viewer = viewer
         viewer.set_animation(anim, play=True, repetitions=0)
     return viz
+
+
+#: Legend entries: (label, colour key, the roles that show it), in the legend's order
+LEGEND = (
+    ("actuated joints", "actuated", ("axis:actuated", "joint:actuated")),
+    ("passive joints", "passive", ("axis:passive", "joint:passive")),
+    ("cut (loop) joints", "cut", ("axis:cut",)),
+    ("higher pairs", "pair", ("pair",)),
+    ("links without geometry", "standin", ("standin",)),
+    ("output link: frame x", "x", ("output:x",)),
+    ("y", "y", ("output:y",)),
+    ("z", "z", ("output:z",)),
+    ("singular configuration", "marker", ("singular:marker",)),
+    ("singular screw axis", "screw", ("singular:axis",)),
+)
+
+
+def _css(color) -> str:
+    r, g, b = (int(round(255 * float(c))) for c in color[:3])
+    return f"rgb({r},{g},{b})"
+
+
+def legend_entries(scene: Scene) -> list:
+    """(label, CSS colour) for each kind of thing the scene shows."""
+    present = set(scene.roles.values())
+    return [(label, _css(COLORS[key])) for label, key, roles in LEGEND if present & set(roles)]
+
+
+def page(html: str, scene: Scene, title: str | None = None, controls: bool = True, size=None) -> str:
+    """meshcat's static page with screwkin's legend (a small box, bottom left: a coloured marker
+    per kind of thing drawn, and ``title`` above them); ``controls=False`` hides meshcat's
+    control panel and ``size`` (width, height) [px] fixes the drawing's size, for pictures
+    (headless Chromium's viewport is not its window's size)."""
+
+    rows = []
+    entries = legend_entries(scene)
+    k = 0
+    while k < len(entries):
+        label, color = entries[k]
+        if label.startswith("output link"):  # x, y, z on one line
+            marks = "".join(f'<span class="sk-mark" style="background:{c}"></span>{escape(lab[-1])} '
+                            for lab, c in entries[k:k + 3])
+            rows.append(f'<div class="sk-row">{marks}<span>output link frame</span></div>')
+            k += 3
+            continue
+        rows.append(f'<div class="sk-row"><span class="sk-mark" style="background:{color}"></span>'
+                    f'{escape(label)}</div>')
+        k += 1
+    head = f'<div class="sk-title">{escape(title)}</div>' if title else ""
+    legend = f'<div id="screwkin-legend">{head}{"".join(rows)}</div>'
+    style = """<style>
+#screwkin-legend {position: absolute; left: 12px; bottom: 12px; padding: 6px 10px; z-index: 10;
+  background: rgba(255,255,255,0.85); border: 1px solid #bbb; border-radius: 4px;
+  font: 13px/1.5 'DejaVu Sans', Arial, sans-serif; color: #222;}
+#screwkin-legend .sk-title {font-weight: bold; margin-bottom: 2px;}
+#screwkin-legend .sk-mark {display: inline-block; width: 11px; height: 11px; border-radius: 50%;
+  margin-right: 6px; vertical-align: -1px; border: 1px solid rgba(0,0,0,0.35);}
+""" + ("" if controls else ".dg, .dg.main, .dg.ac {display: none !important;}\n") + "</style>"
+    if size is not None:  # a picture: the pane and the camera's aspect fixed, whatever the browser's window does
+        w, h = (int(v) for v in size)
+        style += (f"<style>#meshcat-pane {{width: {w}px !important; height: {h}px !important;}}</style>"
+                  f"<script>(function () {{ function fit() {{ viewer.set_3d_pane_size({w}, {h}); }} fit();"
+                  f" requestAnimationFrame(fit); window.addEventListener('load', fit); window.addEventListener('resize', fit);"
+                  f" setTimeout(fit, 50); }})();</script>")
+    at = html.rfind("</body>")
+    at = len(html) if at < 0 else at
+    return html[:at] + style + legend + html[at:]
 
 
 class ViewerServer:
@@ -436,7 +600,7 @@ def chromium():
     return None
 
 
-def screenshot(html_path, png_path, size=(900, 700), budget_ms=8000):
+def screenshot(html_path, png_path, size=PICTURE, budget_ms=8000):
     """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
     exe = chromium()
     if exe is None:

@@ -1,0 +1,182 @@
+"""``screwkin equations``: the course-solution equations in symbols (vector loops, velocity and
+acceleration matrices, det A and where it vanishes); and ``solve --start``: Newton on those
+equations from a person's estimates, iteration by iteration."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+
+from ..analysis.equations import VectorLoops, equations, newton
+from ..analysis.position import PositionSolver
+from ..errors import AssemblyError, UsageError
+from ..present.equations import Units, equations_dict, equations_text, greek, newton_dict, newton_text
+from ..present.report import position_dict, position_text, to_jsonable
+from ..units import UNITS, parse_value
+from ._common import configuration, inputs
+
+NAME = "equations"
+NEEDS_MECHANISM = True
+
+_ANGLE_UNITS = {"deg", "degree", "degrees", "°"}
+_LENGTH_UNITS = {"m", "cm", "mm", "um", "µm", "μm", "in", "inch", "inches", "ft", "foot", "feet"}
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser(NAME, help="the loop equations in symbols: vector loops, velocity and acceleration "
+                                   "matrices, det A and its singular conditions")
+    common(sp)
+    sp.add_argument("--input", action="append", metavar="NAME",
+                    help="input joint (repeat or comma-separate; default: the --set joints, else the actuated ones)")
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE", help="an input as a link's absolute angle")
+    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    sp.add_argument("--output", help="spatial mechanisms: also the chain to this link")
+
+
+def _input_names(mech, args):
+    names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
+    if names:
+        return names
+    return list(inputs(mech, args)) or list(mech.actuated)
+
+
+def run(mech, args) -> int:
+    names = _input_names(mech, args)
+    q = configuration(mech, args)
+    res = equations(mech, q, names, output=args.output)
+    if args.json:
+        print(json.dumps(to_jsonable(equations_dict(res)), indent=2))
+    else:
+        print(equations_text(res))
+    return 0
+
+
+# ------------------------------------------------------------------ solve --start
+def _typed(items, option):
+    """[(name, value in SI, unit typed)] from NAME=VALUE items."""
+    out = []
+    for item in items or []:
+        for part in item.split(","):
+            if not part.strip():
+                continue
+            name, sep, value = part.partition("=")
+            if not sep or not name.strip():
+                raise UsageError(f"{option} expects NAME=VALUE, got '{part.strip()[:80]}'")
+            m = re.match(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*(\S*)\s*$", value)
+            unit = m.group(1) if m else ""
+            out.append((name.strip(), parse_value(value), unit))
+    return out
+
+
+def _needed_joints(loops, name):
+    """The tree joints whose values place the quantity ``name`` (the joints from the ground to the
+    links it is measured on)."""
+    mech = loops.mech
+    model = mech.model
+    info = loops.symbol_info[name]
+    if info.kind == "angle":
+        links = [info.link]
+    else:
+        joint = next(j for j, t in loops.slide_terms.items() if t["x"].name == name)
+        links = [loops.slides[joint]["guide"], loops.slides[joint]["slider"]]
+    out = set()
+    for lk in links:
+        jid = model.frames[mech.link_frame(lk)].parentJoint
+        out |= {model.names[j] for j in model.supports[jid] if j > 0}
+    return out
+
+
+def solve_from_start(mech, args, values) -> int:
+    """``solve --start ...``: Newton on the loop equations from the estimates typed."""
+    if args.iterations is not None and args.iterations < 1:
+        raise UsageError("--iterations must be 1 or more")
+    if not args.start:
+        raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
+    q_ref = mech.generic_configurations()[0].q
+    loops = VectorLoops(mech, q_ref, list(values))
+    solver = PositionSolver(mech, list(values))
+    q_in = solver.set_inputs(q_ref, values)
+    typed = _typed(args.start, "--start")
+    by_link = {}
+    for n in loops.variables:
+        info = loops.symbol_info[n]
+        if info.kind == "angle":
+            by_link[info.link] = n
+    symbols, joints, units = {}, {}, {}
+    joint_names = set(mech.coordinate_names)
+    for name, v, unit in typed:
+        if name in loops.input_joints or name in values:
+            raise UsageError(f"{mech.path}: '{name}' is an input: give its value with --set")
+        if name in loops.unknowns:
+            symbols[name] = v
+        elif name in by_link:
+            symbols[by_link[name]] = v
+            name = by_link[name]
+        elif name in joint_names:
+            joints[name] = v
+            continue
+        else:
+            valid = ", ".join(list(loops.unknowns) + [lk for lk, n in by_link.items() if n in loops.unknowns])
+            raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{name[:80]}' "
+                             f"(unknowns of the loop equations: {valid}; or passive joint names)")
+        units[name] = unit
+    start = loops.values(solver.set_inputs(q_in, joints)) if joints else {}
+    covered = set(symbols)
+    if joints:
+        given = set(joints) | set(values)
+        covered |= {n for n in loops.unknowns if _needed_joints(loops, n) <= given}
+    missing = [n for n in loops.unknowns if n not in covered]
+    if missing:
+        raise UsageError(f"{mech.path}: --start gives no estimate of {', '.join(missing)} "
+                         f"(links {', '.join(loops.symbol_info[n].link for n in missing)})")
+    start = {n: symbols.get(n, start.get(n)) for n in loops.unknowns}
+    input_values = loops.values(q_in)
+    held = {n: input_values[n] for n in loops.input_syms}
+    res = newton(loops, held, start, args.iterations)
+
+    typed_units = [u.lower() for _, _, u in typed + _typed(args.set, "--set") + _typed(args.set_angle, "--set-angle")]
+    degrees = any(u in _ANGLE_UNITS for u in typed_units)
+    lengths = {n: (u, UNITS[u]) for n, u in units.items()
+               if u and u in _LENGTH_UNITS and loops.symbol_info[n].kind != "angle"}
+    show = Units(degrees, lengths)
+    trace_wanted = args.trace or args.iterations is not None
+    if args.iterations is not None or not res.closes:
+        if args.json:
+            print(json.dumps(to_jsonable({"file": mech.path, **newton_dict(res)}), indent=2))
+        else:
+            print(newton_text(res, loops.symbol_info, show, mech.path))
+        if args.iterations is None:  # asked to converge and it did not: an error, not a result
+            raise AssemblyError(mech.path, res.residual, len(res.steps),
+                                detail="Newton from the given estimates did not converge"
+                                       + (f": {res.stopped}" if res.stopped else ""))
+        return 0
+    # converged: the configuration it reached, closed and reported as solve reports it
+    q = loops.configuration(res.values)
+    pres = solver.solve(values, near=mech.joint_values(q), starts=args.starts)
+    got = loops.values(pres.solutions[0].q)
+    far = [n for n in loops.unknowns
+           if abs(np.angle(np.exp(1j * (got[n] - res.values[n]))) if loops.symbol_info[n].kind == "angle"
+                  else got[n] - res.values[n]) > 1e-6 * max(mech.length, 1.0)]
+    if far:  # pragma: no cover - the polished configuration left Newton's root
+        raise AssemblyError(mech.path, res.residual, len(res.steps),
+                            detail=f"the configuration of Newton's root does not close as solved ({', '.join(far)})")
+    if args.json:
+        d = position_dict(pres)
+        d["characteristic_length"] = mech.length
+        d["newton"] = newton_dict(res)
+        d["trace"] = d["newton"]["trace"]
+        print(json.dumps(to_jsonable(d), indent=2))
+        return 0
+    if trace_wanted:
+        print(newton_text(res, loops.symbol_info, show, mech.path))
+        print()
+    else:
+        print(f"Newton on the vector-loop equations from the estimates given: {len(res.steps)} iterations to "
+              f"|F| = {res.residual:.3g} m: " + ", ".join(
+                  f"{greek(n)} = {show.value(n, loops.symbol_info[n].kind, v)}" for n, v in res.values.items()))
+        print()
+    print(position_text(pres, show_all=True, length=mech.length))
+    return 0

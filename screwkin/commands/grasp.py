@@ -1,0 +1,44 @@
+"""``screwkin grasp GRASP.yaml``: grasp map, form and force closure with a certificate,
+internal forces and the Ferrari-Canny quality of contacts on one object."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from ..analysis.grasp import GRASP_TOLERANCES, analyze_grasp
+from ..errors import UsageError, quote
+from ..files.grasp import read_grasp
+from ..present.grasp import grasp_dict, grasp_text
+from ..units import parse_value
+
+NAME = "grasp"
+NEEDS_MECHANISM = False
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser(NAME, help="grasp analysis: grasp map, form and force closure, internal forces, quality")
+    sp.add_argument("file", metavar="GRASP.yaml", help="contacts on one object (docs/format.md, 'Grasps')")
+    common(sp, mechanism=False)
+    sp.add_argument("--facets", type=int, default=8,
+                    help="facets of the pyramids that stand for circular friction cones (default 8; refined up to "
+                         f"{GRASP_TOLERANCES.max_facets} when the answer is ambiguous)")
+    sp.add_argument("--length", help="characteristic length L dividing the moments (default: the mean distance "
+                                     "of the contacts from their centroid; printed with the quality)")
+
+
+def run(mech, args) -> int:
+    if not 3 <= args.facets <= GRASP_TOLERANCES.max_facets:
+        raise UsageError(f"--facets {args.facets}: give 3 to {GRASP_TOLERANCES.max_facets}")
+    length = None
+    if args.length is not None:
+        length = parse_value(args.length)
+        if not (math.isfinite(length) and 0 < length <= 1e4):
+            raise UsageError(f"--length {quote(args.length)}: give a positive length up to 10 km")
+    spec = read_grasp(args.file)
+    result = analyze_grasp(spec, facets=args.facets, length=length)
+    if args.json:
+        print(json.dumps(grasp_dict(result), indent=2))
+    else:
+        print(grasp_text(result))
+    return 0

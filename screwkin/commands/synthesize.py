@@ -1,0 +1,301 @@
+"""``screwkin synthesize KIND ... -o OUT.urdf``: linkage synthesis (issue 14).
+
+KIND is ``motion`` (rigid-body guidance through 3-5 poses), ``function`` (Freudenstein),
+``path`` (a coupler point through points) or ``chains`` (type and number synthesis).  Each
+writes URDF that every other command loads, and checks it with screwkin's own analyses
+before reporting it (screwkin.analysis.synthesis.check): a result with a defect is reported
+with the defect; ``--reject-defects`` leaves such results out and fails (exit 1) when
+nothing is left.  A file is checked under a temporary name beside OUT and then renamed to
+OUT, so OUT is the checked file and a rejected result leaves no file.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+from ..analysis.synthesis.chains import chain_linkage, enumerate_chains
+from ..analysis.synthesis.check import check_chain_file, check_design
+from ..analysis.synthesis.designs import SynthesisError
+from ..analysis.synthesis.function import synthesize_function
+from ..analysis.synthesis.motion import motion_design, synthesize_motion
+from ..analysis.synthesis.path import synthesize_path
+from ..errors import UsageError, quote
+from ..files.description import LIMITS
+from ..files.writer import write_urdf
+from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
+from ..present.synthesis_plots import burmester_png
+from ..units import parse_value
+
+NAME = "synthesize"
+NEEDS_MECHANISM = False
+KINDS = ("motion", "function", "path", "chains")
+#: Ranked pairs of Burmester dyads checked with screwkin before giving up on a defect-free one.
+PAIRS_CHECKED = 6
+
+_OPTIONS = {  # which options each kind takes (dest names)
+    "motion": {"poses", "pivots", "moving", "pick", "candidates", "png"},
+    "function": {"function", "x_range", "input_range", "output_range", "points", "spacing", "ground"},
+    "path": {"points", "timing", "starts", "seed", "tolerance"},
+    "chains": {"links", "dof", "prismatic", "planar"},
+}
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser("synthesize", help="synthesize a planar linkage (motion, function, path) or enumerate "
+                                           "kinematic chains; writes URDF checked with screwkin")
+    sp.add_argument("kind", choices=KINDS, help="what to synthesize")
+    common(sp, mechanism=False)
+    sp.add_argument("-o", "--output", dest="out", metavar="OUT",
+                    help="the URDF to write (chains: a folder, one file per mechanism)")
+    sp.add_argument("--reject-defects", action="store_true",
+                    help="leave out results with a defect (branch, order, limit position, a missed position); "
+                         "exit 1 when none is left")
+    m = sp.add_argument_group("motion")
+    m.add_argument("--poses", metavar='"x,y,th; ..."',
+                   help="3 to 5 poses of the coupler frame (m; th in rad, or with deg)")
+    m.add_argument("--pivots", metavar='"x,y; x,y"', help="three poses: the two fixed pivots (crank's first)")
+    m.add_argument("--moving", metavar='"x,y; x,y"',
+                   help="three poses: the two moving pivots in the coupler frame (crank's first)")
+    m.add_argument("--pick", metavar="I,J", help="four or five poses: the candidates for crank and rocker")
+    m.add_argument("--candidates", type=int, default=24,
+                   help="four poses: lines through a pole that trace the candidates (default 24)")
+    m.add_argument("--png", help="draw the centre-point and circle-point curves (needs matplotlib)")
+    f = sp.add_argument_group("function")
+    f.add_argument("--function", help='y = f(x), e.g. "log(x)" (x, numbers, + - * / **, sin cos tan exp log '
+                                      'sqrt abs, pi, e)')
+    f.add_argument("--x-range", metavar="X0:X1", help="the range of x")
+    f.add_argument("--input-range", metavar="A:B", help="the crank's angle range (rad, or with deg)")
+    f.add_argument("--output-range", metavar="C:D", help="the rocker's angle range (rad, or with deg)")
+    f.add_argument("--spacing", choices=("chebyshev", "even"), default="chebyshev",
+                   help="precision points (default chebyshev)")
+    f.add_argument("--ground", default="0.1", help="ground length A0B0 (default 0.1 m)")
+    p = sp.add_argument_group("path (and function)")
+    p.add_argument("--points", help='path: the points "x,y; x,y; ..."; function: the number of precision points '
+                                    "(default 3; more: least squares)")
+    p.add_argument("--timing", metavar='"a, b, ..."', help="path: the crank angle at each point (from any zero)")
+    p.add_argument("--starts", type=int, default=24, help="path: least-squares starts (default 24)")
+    p.add_argument("--seed", type=int, default=0, help="path: seed of the starts (default 0)")
+    p.add_argument("--tolerance", default="1e-6",
+                   help="path: a point is reached within this distance (default 1e-6 m)")
+    c = sp.add_argument_group("chains")
+    c.add_argument("--links", type=int, help="number of links (the ground included)")
+    c.add_argument("--dof", type=int, help="degrees of freedom")
+    c.add_argument("--prismatic", type=int, default=0, help="how many joints are prismatic (default 0)")
+    c.add_argument("--planar", action="store_true", help="planar chains (the only kind enumerated)")
+
+
+def _given(args, dest) -> bool:
+    defaults = {"candidates": 24, "spacing": "chebyshev", "ground": "0.1", "starts": 24, "seed": 0,
+                "tolerance": "1e-6", "prismatic": 0, "planar": False}
+    return getattr(args, dest) not in (None, defaults.get(dest))
+
+
+def _option(dest):
+    return "--" + dest.replace("_", "-")
+
+
+def _numbers(text, option, count=None):
+    """'x,y; x,y' -> [[x, y], [x, y]] (each number with an optional unit)."""
+    groups = [g for g in text.split(";") if g.strip()]
+    if not groups:
+        raise UsageError(f"{option}: no values in {quote(text)}")
+    out = []
+    for g in groups:
+        parts = [x for x in g.replace(",", " ").split()]
+        if count is not None and len(parts) != count:
+            raise UsageError(f"{option}: {quote(g.strip())} has {len(parts)} numbers, expected {count} "
+                             f"(write {'x,y,theta' if count == 3 else 'x,y'}; separated by ;)")
+        out.append([parse_value(x) for x in parts])
+    return out
+
+
+def _range(text, option):
+    parts = text.split(":") if text else []
+    if len(parts) != 2:
+        raise UsageError(f"{option} expects A:B, got {quote(text or '')}")
+    return parse_value(parts[0]), parse_value(parts[1])
+
+
+def _plausible(design, kind):
+    """A linkage whose numbers a file can hold: finite, and within the 10 km the reader accepts."""
+    fb = design.fourbar
+    values = [*fb.A0, *fb.A, *fb.B, *fb.B0, *(fb.tool or ())]
+    if not all(math.isfinite(v) for v in values):
+        raise SynthesisError(f"synthesize {kind}", "the linkage found has no finite dimensions (the positions are "
+                                                   "degenerate or too far apart)")
+    big = max(abs(v) for v in values)
+    if big > LIMITS.length:
+        raise SynthesisError(f"synthesize {kind}", f"the linkage found reaches {big:.3g} m from the origin, beyond "
+                                                   f"the {LIMITS.length:g} m a mechanism file may hold")
+
+
+def _realize(design, out, tolerance=None):
+    """Write design's URDF under a temporary name beside ``out``, check it there; returns
+    (check, temporary path)."""
+    _plausible(design, design.kind)
+    folder = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(folder):
+        raise UsageError(f"-o {quote(str(out))}: the folder {quote(folder)} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=".screwkin-", suffix=".urdf", dir=folder)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(write_urdf(design.linkage))
+    try:
+        return check_design(design, tmp, tolerance=tolerance), tmp
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def _keep(tmp, out):
+    os.replace(tmp, out)
+
+
+def run(mech, args) -> int:
+    kind = args.kind
+    for dest in sorted(set().union(*_OPTIONS.values()) - _OPTIONS[kind]):
+        if _given(args, dest):
+            takers = " and ".join(f"'synthesize {k}'" for k, dests in _OPTIONS.items() if dest in dests)
+            raise UsageError(f"{_option(dest)} applies to {takers}, not to 'synthesize {kind}'")
+    if kind == "chains":
+        return _chains(args)
+    if not args.out:
+        raise UsageError(f"synthesize {kind} needs -o OUT.urdf (the file to write)")
+    if kind == "motion":
+        result, check, tmp = _motion(args)
+    elif kind == "function":
+        result, check, tmp = _function(args)
+    else:
+        result, check, tmp = _path(args)
+    if args.reject_defects and not check.valid:
+        os.unlink(tmp)
+        raise SynthesisError(f"synthesize {kind}", "every result has a defect (--reject-defects): "
+                                                   + "; ".join(check.defects))
+    _keep(tmp, args.out)
+    check = replace(check, file=str(args.out))
+    if args.json:
+        print(json.dumps(synthesis_dict(result, check, args.out), indent=2))
+    else:
+        print(synthesis_text(result, check, args.out))
+    return 0
+
+
+def _motion(args):
+    if not args.poses:
+        raise UsageError('synthesize motion needs --poses "x,y,theta; x,y,theta; x,y,theta"')
+    poses = _numbers(args.poses, "--poses", 3)
+    pivots = _numbers(args.pivots, "--pivots", 2) if args.pivots else None
+    moving = _numbers(args.moving, "--moving", 2) if args.moving else None
+    pick = None
+    if args.pick:
+        try:
+            pick = tuple(int(x) for x in args.pick.split(","))
+        except ValueError:
+            raise UsageError(f"--pick expects I,J (two candidate numbers), got {quote(args.pick)}") from None
+        if len(pick) != 2:
+            raise UsageError(f"--pick expects I,J (two candidate numbers), got {quote(args.pick)}")
+    if args.candidates < 4:
+        raise UsageError("--candidates must be at least 4")
+    result = synthesize_motion(poses, pivots, moving, pick, args.candidates)
+    if args.png:
+        burmester_png(result, args.png)
+    if not result.ranked:
+        check, tmp = _realize(result.design, args.out)
+        return result, check, tmp
+    first = None
+    for i, j, _, _ in result.ranked[:PAIRS_CHECKED]:
+        design = result.design if (i, j) == tuple(result.pick) else \
+            motion_design(result.poses, result.candidates[i], result.candidates[j])
+        check, tmp = _realize(design, args.out)
+        if check.valid:
+            if first is not None:
+                os.unlink(first[2])
+            return replace(result, pick=(i, j), design=design), check, tmp
+        if first is None:
+            first = (replace(result, pick=(i, j), design=design), check, tmp)
+        else:
+            os.unlink(tmp)
+    return first
+
+
+def _function(args):
+    missing = [o for o, v in (("--function", args.function), ("--x-range", args.x_range),
+                              ("--input-range", args.input_range), ("--output-range", args.output_range)) if not v]
+    if missing:
+        raise UsageError(f"synthesize function needs {', '.join(missing)}")
+    points = 3
+    if args.points:
+        try:
+            points = int(args.points)
+        except ValueError:
+            raise UsageError(f"--points: for function generation, the number of precision points, got "
+                             f"{quote(args.points)}") from None
+        if points > 200:
+            raise UsageError("--points: at most 200 precision points")
+    result = synthesize_function(args.function, _range(args.x_range, "--x-range"),
+                                 _range(args.input_range, "--input-range"), _range(args.output_range, "--output-range"),
+                                 points, args.spacing, parse_value(args.ground))
+    check, tmp = _realize(result.design, args.out)
+    if result.defects and not check.defects:  # the closed form saw a defect that screwkin's check did not
+        check = replace(check, defects=tuple(f"closed form: {d}" for d in result.defects))
+    return result, check, tmp
+
+
+def _path(args):
+    if not args.points:
+        raise UsageError('synthesize path needs --points "x,y; x,y; x,y; ..."')
+    points = _numbers(args.points, "--points", 2)
+    timing = None
+    if args.timing:
+        timing = [parse_value(x) for x in args.timing.replace(";", ",").split(",") if x.strip()]
+    tolerance = parse_value(args.tolerance)
+    if not tolerance > 0:
+        raise UsageError("--tolerance must be a positive length")
+    result = synthesize_path(points, timing, args.starts, args.seed, tolerance)
+    check, tmp = _realize(result.design, args.out, tolerance=tolerance)
+    return result, check, tmp
+
+
+def _chains(args):
+    if args.links is None or args.dof is None:
+        raise UsageError("synthesize chains needs --links N and --dof F")
+    result = enumerate_chains(args.links, args.dof, args.prismatic)
+    directory = None
+    if args.out:
+        directory = Path(args.out)
+        if directory.exists() and not directory.is_dir():
+            raise UsageError(f"-o {quote(str(directory))}: chains are written to a folder, and this is a file")
+        directory.mkdir(parents=True, exist_ok=True)
+        files = []
+        for c in result.chains:
+            for g in c.inversions:
+                path = directory / f"chain{c.index:02d}_ground{g}.urdf"
+                checked = None
+                for seed in range(4):  # generic proportions: another seed when the first is special
+                    path.write_text(write_urdf(chain_linkage(c, g, seed=seed, dof=args.dof)))
+                    checked = check_chain_file(path, c.index, g, args.dof)
+                    if not checked.problem:
+                        break
+                if checked.problem and args.reject_defects:
+                    path.unlink()
+                    continue
+                files.append(checked)
+        result = replace(result, files=tuple(files))
+        if args.reject_defects and not files and result.chains:
+            raise SynthesisError("synthesize chains", "every written mechanism had a problem (--reject-defects)")
+    if not result.chains:
+        raise SynthesisError("synthesize chains", f"no planar chain of {args.links} links and {args.dof} DOF "
+                                                  f"with {args.prismatic} prismatic joints (every candidate has a "
+                                                  "separable part, a degenerate sub-chain or a locked loop)")
+    if args.json:
+        print(json.dumps(chains_dict(result, directory), indent=2))
+    else:
+        print(chains_text(result, directory))
+    return 0
+
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

@@ -1,0 +1,114 @@
+"""``screwkin workspace``: where an output link can go at a constant orientation (or its origin
+with any), the part free of singularities, and the conditioning over it."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+
+import numpy as np
+import pinocchio as pin
+
+from ..analysis.workspace import DEFAULT_THRESHOLD, workspace
+from ..errors import UsageError
+from ..present.report import to_jsonable
+from ..present.view import ViewerServer, build_scene, screenshot, show
+from ..present.workspace import workspace_cloud, workspace_csv, workspace_dict, workspace_png, workspace_text
+from ..units import parse_value
+
+NAME = "workspace"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser(NAME, help="workspace of an output link: volume, singularity-free part, conditioning")
+    common(sp)
+    sp.add_argument("--output", required=True, help="the link whose workspace to find (e.g. the platform)")
+    sp.add_argument("--point", action="store_true",
+                    help="the link's origin as a point, any orientation (default: the link at a constant orientation)")
+    sp.add_argument("--orientation", metavar='"ROLL PITCH YAW"',
+                    help="the constant orientation (rad, or with units: 10deg); default: the link's orientation in "
+                         "the assembled configuration")
+    sp.add_argument("--resolution", metavar="H", help="grid step (m, or with units: 5mm); default: about 24 steps "
+                                                      "across the workspace in 3-D, 120 in a plane")
+    sp.add_argument("--bounds", metavar="LO:HI,...", help="range along each grid axis, world coordinates (e.g. "
+                                                          "-0.3:0.3,-0.3:0.3,-0.6:-0.1; units allowed)")
+    sp.add_argument("--threshold", type=float, default=DEFAULT_THRESHOLD,
+                    help=f"smallest actuator and serial measure of a singularity-free point (default {DEFAULT_THRESHOLD})")
+    sp.add_argument("--method", choices=["grid", "sampling"],
+                    help="grid: inverse kinematics on a grid (default); sampling: random joint values (serial chains, "
+                         "--point; the default there)")
+    sp.add_argument("--samples", type=int, default=200_000, help="joint configurations of the sampling method "
+                                                                 "(default 200000)")
+    sp.add_argument("--seed", type=int, default=0, help="random seed of the sampling method (default 0)")
+    sp.add_argument("--png", help="slices of the workspace coloured by conditioning, PNG (needs matplotlib)")
+    sp.add_argument("--csv", help="every reached point: position, measures, joint values")
+    sp.add_argument("--html", help="the mechanism and the workspace as a meshcat point cloud, static HTML page")
+    sp.add_argument("--cloud-png", dest="cloud_png", help="a picture of that scene (headless Chromium)")
+    scaled(sp, point=False)
+
+
+def _bounds(text):
+    if text is None:
+        return None
+    ranges = []
+    for part in text.split(","):
+        lo, sep, hi = part.strip().partition(":")
+        if not sep:
+            raise UsageError(f"--bounds expects LO:HI ranges separated by commas, got {text!r}")
+        ranges.append((parse_value(lo.strip()), parse_value(hi.strip())))
+    return np.array(ranges)
+
+
+def _orientation(text):
+    if text is None:
+        return None
+    parts = text.replace(",", " ").split()
+    if len(parts) != 3:
+        raise UsageError(f'--orientation expects "roll pitch yaw", got {len(parts)} numbers')
+    return pin.rpy.rpyToMatrix(np.array([parse_value(p) for p in parts]))
+
+
+def run(mech, args) -> int:
+    if args.samples < 1:
+        raise UsageError(f"--samples must be positive, got {args.samples}")
+    length = parse_value(args.length) if args.length else None
+    res = workspace(mech, args.output, point=args.point, orientation=_orientation(args.orientation),
+                    resolution=parse_value(args.resolution) if args.resolution else None, bounds=_bounds(args.bounds),
+                    threshold=args.threshold, length=length, method=args.method, samples=args.samples,
+                    seed=args.seed)
+    wrote = []
+    if args.csv:
+        columns = [(c.joint, c.idx_q) for c in mech.coordinates if c.nq == 1]
+        workspace_csv(res, args.csv, columns)
+        wrote.append(args.csv)
+    if args.png:
+        workspace_png(res, args.png)
+        wrote.append(args.png)
+    if args.html or args.cloud_png:
+        q = res.configurations[0] if res.configurations is not None else mech.generic_configurations()[0].q
+        with ViewerServer() as server:
+            show(mech, build_scene(mech, q, output=args.output), server.viewer, q)
+            workspace_cloud(res, server.viewer)
+            html = server.viewer.static_html()
+        if args.html:
+            with open(args.html, "w") as f:
+                f.write(html)
+            wrote.append(args.html)
+        if args.cloud_png:
+            with tempfile.TemporaryDirectory() as d:
+                page = os.path.join(d, "workspace.html")
+                with open(page, "w") as f:
+                    f.write(html)
+                screenshot(page, args.cloud_png)
+            wrote.append(args.cloud_png)
+    if args.json:
+        d = workspace_dict(res)
+        d["wrote"] = wrote
+        print(json.dumps(to_jsonable(d), indent=2))
+    else:
+        print(workspace_text(res))
+        for w in wrote:
+            print(f"wrote {w}")
+    return 0

@@ -1,0 +1,260 @@
+"""Synthesis results as JSON-ready dictionaries and readable text.
+
+Every kind has the same core (the contract of issue 14): ``kind``, ``file``, ``links`` (link
+name -> dimensions), ``pivots``, ``precision`` (each precision position or point with
+``reached`` and ``residual``), ``grashof``, ``transmission_angle_range`` [deg], ``defects``
+(strings, empty when none) and ``valid``; each kind adds its own keys beside them.  Numbers
+stay SI (m, rad) in the results; keys ending in ``_deg`` and the text give degrees.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..analysis.synthesis.designs import Check, ChainsResult, FunctionResult, MotionResult, PathResult
+from ..analysis.synthesis.fourbar import tool_local
+from .report import table, to_jsonable
+
+__all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
+
+
+def _deg(x):
+    return None if x is None else math.degrees(x)
+
+
+def _pt(p):
+    return [float(p[0]), float(p[1])]
+
+
+def _target_dict(t) -> dict:
+    if t.kind == "pose":
+        return {"x": t.value[0], "y": t.value[1], "theta_deg": _deg(t.value[2])}
+    if t.kind == "point":
+        return {"x": t.value[0], "y": t.value[1]}
+    return {"psi_deg": _deg(t.value[0])}
+
+
+def _value_dict(kind, v) -> dict | None:
+    if not v:
+        return None
+    if kind == "pose":
+        return {"x": v[0], "y": v[1], "theta_deg": _deg(v[2])}
+    if kind == "point":
+        return {"x": v[0], "y": v[1]}
+    return {"psi_deg": _deg(v[0])}
+
+
+def _core(kind, design, check: Check, file) -> dict:
+    fb = design.fourbar
+    L = fb.lengths
+    links = {"ground": {"length": L["ground"]}, "crank": {"length": L["crank"]},
+             "coupler": {"length": L["coupler"]}, "rocker": {"length": L["rocker"]}}
+    if fb.tool is not None:
+        u, v, gamma = tool_local(fb)
+        what = "frame" if kind == "motion" else "point"
+        links["coupler"][what] = {"x": u, "y": v, **({"angle_deg": _deg(gamma)} if kind == "motion" else {})}
+    precision = []
+    for p in check.precision:
+        d = {"label": p.target.label, "target": _target_dict(p.target), "input_deg": _deg(p.target.input),
+             "reached": p.reached, "residual": p.residual, "value": _value_dict(p.target.kind, p.value),
+             "error": p.error, "closed_form_error": p.closed_form_error}
+        if p.target.kind == "pose":
+            d["angle_error_deg"] = _deg(p.angle_error)
+        if p.target.kind == "angle":
+            d["error_deg"] = _deg(p.error)
+        precision.append(d)
+    mu = check.transmission_range
+    return {
+        "kind": kind,
+        "file": str(file),
+        "links": links,
+        "pivots": {"A0": _pt(fb.A0), "B0": _pt(fb.B0), "A": _pt(fb.A), "B": _pt(fb.B)},
+        "precision": precision,
+        "grashof": check.grashof,
+        "transmission_angle_range": [math.degrees(mu[0]), math.degrees(mu[1])] if mu else None,
+        "defects": list(check.defects),
+        "valid": check.valid,
+        "check": {"assembled_iterations": check.assembled_iterations, "tolerance": check.tolerance,
+                  "direction": {1: "counterclockwise", -1: "clockwise", 0: None}[check.direction],
+                  "travel_deg": [_deg(t) for t in check.travel]},
+    }
+
+
+def _dyad_dict(k, d) -> dict:
+    return {"index": k, "fixed": _pt(d.fixed), "moving": _pt(d.moving), "moving_local": _pt(d.local),
+            "length": d.length}
+
+
+def synthesis_dict(result, check: Check, file) -> dict:
+    """The JSON object of a motion, function or path result and its check."""
+    design = result.design
+    out = _core(design.kind, design, check, file)
+    if isinstance(result, MotionResult):
+        out.update({
+            "method": result.method,
+            "poses": [{"x": p[0], "y": p[1], "theta_deg": _deg(p[2])} for p in result.poses],
+            "candidates": [_dyad_dict(k, d) for k, d in enumerate(result.candidates)],
+            "pick": list(result.pick),
+            "poles": [{"positions": [i + 1, j + 1], "point": _pt(P)} for i, j, P in result.poles],
+        })
+    elif isinstance(result, FunctionResult):
+        out.update({
+            "function": result.function, "x_range": list(result.x_range),
+            "input_range_deg": [_deg(x) for x in result.input_range],
+            "output_range_deg": [_deg(x) for x in result.output_range],
+            "spacing": result.spacing, "least_squares": result.least_squares,
+            "precision_x": list(result.x), "phi_deg": [_deg(x) for x in result.phi],
+            "psi_deg": [_deg(x) for x in result.psi], "K": list(result.K),
+            "structural_error_deg": {"max": _deg(result.max_structural_error),
+                                     "at_precision_points": [_deg(e) for e in result.error_at_points]},
+        })
+    elif isinstance(result, PathResult):
+        out.update({
+            "points": [list(p) for p in result.points],
+            "timing_deg": None if result.timing is None else [_deg(t) for t in result.timing],
+            "crank_angles_deg": [_deg(t) for t in result.crank_angles],
+            "errors": list(result.errors), "starts": result.starts, "converged": result.converged,
+            "tolerance": result.tolerance,
+        })
+    return to_jsonable(out)
+
+
+def _fmt(x, digits=6):
+    return f"{(0.0 if abs(x) < 1e-15 else x) + 0.0:.{digits}g}"
+
+
+def synthesis_text(result, check: Check, file) -> str:
+    """A readable report of a motion, function or path result and its check."""
+    d = synthesis_dict(result, check, file)
+    design = result.design
+    out = []
+    kind = design.kind
+    title = {"motion": "Motion generation (rigid-body guidance)", "function": "Function generation (Freudenstein)",
+             "path": "Path generation"}[kind]
+    out.append(f"{title}: wrote {file}")
+    if isinstance(result, MotionResult):
+        out.append(f"method: {result.method}")
+        if len(result.candidates) > 2 or result.ranked:
+            rows = [[k, f"({_fmt(c.fixed[0])}, {_fmt(c.fixed[1])})", f"({_fmt(c.moving[0])}, {_fmt(c.moving[1])})",
+                     _fmt(c.length)] for k, c in enumerate(result.candidates)]
+            out.append(f"candidate dyads ({len(rows)}; --pick CRANK,ROCKER chooses two):")
+            out.append("  " + table(["#", "fixed pivot (centre point) [m]", "moving pivot (circle point) [m]",
+                                     "length [m]"], rows).replace("\n", "\n  "))
+        out.append(f"chosen: crank = candidate {result.pick[0]}, rocker = candidate {result.pick[1]}")
+    elif isinstance(result, FunctionResult):
+        out.append(f"y = {result.function} on x in [{_fmt(result.x_range[0])}, {_fmt(result.x_range[1])}]; crank "
+                   f"phi {_fmt(math.degrees(result.input_range[0]))} .. {_fmt(math.degrees(result.input_range[1]))} "
+                   f"deg, rocker psi {_fmt(math.degrees(result.output_range[0]))} .. "
+                   f"{_fmt(math.degrees(result.output_range[1]))} deg")
+        how = "least squares" if result.least_squares else "exact (3 x 3 linear solve)"
+        out.append(f"{len(result.x)} precision points ({result.spacing} spacing), {how}: "
+                   f"K1 = {result.K[0]:.9g}, K2 = {result.K[1]:.9g}, K3 = {result.K[2]:.9g}")
+        where = "over the range" if np.all(np.isfinite(result.structural_error)) else \
+            "where the linkage assembles"
+        out.append(f"structural error: largest {_fmt(math.degrees(result.max_structural_error), 4)} deg {where}; "
+                   "at the precision points " + ", ".join(f"{math.degrees(e):.2g}" if math.isfinite(e) else "(none)"
+                                                          for e in result.error_at_points)
+                   + " deg")
+    elif isinstance(result, PathResult):
+        timing = "crank angles prescribed (--timing)" if result.timing is not None else "crank angles free"
+        out.append(f"{len(result.points)} points, {timing}; least squares from {result.starts} starts, "
+                   f"{result.converged} reached every point within {_fmt(result.tolerance, 3)} m")
+    links = d["links"]
+    out.append("links [m]: " + ", ".join(f"{n} {_fmt(v['length'])}" for n, v in links.items()))
+    if "frame" in links["coupler"] or "point" in links["coupler"]:
+        t = links["coupler"].get("frame") or links["coupler"].get("point")
+        extra = f", {_fmt(t['angle_deg'])} deg" if "angle_deg" in t else ""
+        out.append(f"coupler {'frame' if 'frame' in links['coupler'] else 'point'} in the coupler's frame (origin A, x "
+                   f"along AB): ({_fmt(t['x'])}, {_fmt(t['y'])}) m{extra}")
+    pv = d["pivots"]
+    out.append("pivots [m] (at the first position): " + ", ".join(f"{k} ({_fmt(v[0])}, {_fmt(v[1])})"
+                                                                   for k, v in pv.items()))
+    out.append(f"Grashof: {d['grashof'] or 'not identified'}")
+    mu = d["transmission_angle_range"]
+    out.append("transmission angle over the motion: " + (f"{mu[0]:.4g} .. {mu[1]:.4g} deg" if mu else "not measured")
+               + (f" (crank turning {d['check']['direction']})" if d["check"]["direction"] else ""))
+    out.append("")
+    out.append(f"checked with screwkin on {file} (loaded, solved at each precision position, followed by sweep):")
+    out.append(f"  drawn closed: {'yes' if check.assembled_iterations == 0 else 'no'} (assembly Newton iterations "
+               f"{check.assembled_iterations})")
+    rows = []
+    for p, travel in zip(check.precision, list(check.travel) + [None] * len(check.precision)):
+        t = p.target
+        if t.kind == "pose":
+            want = f"({_fmt(t.value[0])}, {_fmt(t.value[1])}, {_fmt(math.degrees(t.value[2]))} deg)"
+            err = f"{p.error:.2g} m, {math.degrees(p.angle_error):.2g} deg"
+        elif t.kind == "point":
+            want = f"({_fmt(t.value[0])}, {_fmt(t.value[1])})"
+            err = f"{p.error:.2g} m"
+        else:
+            want = f"psi {_fmt(math.degrees(t.value[0]))} deg"
+            err = f"{math.degrees(p.error):.2g} deg"
+        if not math.isfinite(p.error):
+            err = "not assembled"
+        rows.append([t.label, f"{_fmt(math.degrees(t.input))}", want, "yes" if p.reached else "NO", err,
+                     f"{p.residual:.2g}", f"{p.closed_form_error:.2g}" if math.isfinite(p.closed_form_error) else "-",
+                     "-" if travel is None else _fmt(math.degrees(travel), 5)])
+    out.append("  " + table(["position", "crank [deg]", "target", "reached", "error", "residual",
+                             "vs closed form [m]", "travel [deg]"], rows).replace("\n", "\n  "))
+    if check.defects:
+        out.append("DEFECTS:")
+        out += [f"  - {x}" for x in check.defects]
+        out.append("not valid: the linkage does not do what was asked as written (see the defects)")
+    elif all(p.reached for p in check.precision):
+        out.append("no defect: every precision position is reached, on one branch, in the order given")
+    else:
+        out.append("no defect: the positions are approximated (least squares), on one branch, in the order given")
+    return "\n".join(out)
+
+
+def chains_dict(result: ChainsResult, directory=None) -> dict:
+    files = {(f.chain, f.ground): f for f in result.files}
+    chains = []
+    for c in result.chains:
+        mechs = []
+        for g, orbit in zip(c.inversions, c.orbits):
+            f = files.get((c.index, g))
+            mechs.append({"ground": g, "equivalent_grounds": list(orbit),
+                          "file": f.file if f else None, "mobility": f.mobility if f else None,
+                          "assembled_iterations": f.assembled_iterations if f else None,
+                          "problem": f.problem if f else None})
+        chains.append({"index": c.index, "name": c.name, "links": c.links,
+                       "joints": [{"links": [u, v], "type": k} for u, v, k in c.joints],
+                       "joints_per_link": list(c.degrees), "automorphisms": c.automorphisms, "mechanisms": mechs})
+    defects = [f"chain {f.chain}, ground link{f.ground}: {f.problem}" for f in result.files if f.problem]
+    return to_jsonable({
+        "kind": "chains", "file": None if directory is None else str(directory), "links": {}, "pivots": {},
+        "precision": [], "grashof": None, "transmission_angle_range": None, "defects": defects,
+        "valid": not defects,
+        "chain_links": result.links, "dof": result.dof, "prismatic": result.prismatic, "joints": result.joints,
+        "gruebler": f"3({result.links} - 1) - 2 x {result.joints} = {result.dof}",
+        "count": len(result.chains), "mechanisms": sum(len(c.inversions) for c in result.chains),
+        "chains": chains, "files": [f.file for f in result.files], "graphs_examined": result.candidates,
+    })
+
+
+def chains_text(result: ChainsResult, directory=None) -> str:
+    d = chains_dict(result, directory)
+    kinds = f", {result.prismatic} of them prismatic" if result.prismatic else ""
+    out = [f"planar kinematic chains of {result.links} links and {result.dof} DOF: {result.joints} one-DOF joints"
+           f"{kinds} (Gruebler {d['gruebler']}); 2-connected, no degenerate sub-chain",
+           f"{d['count']} distinct chain{'s' if d['count'] != 1 else ''}, {d['mechanisms']} mechanism"
+           f"{'s' if d['mechanisms'] != 1 else ''} (inversions: a ground link per class of links under the chain's "
+           "automorphisms)"]
+    for c in d["chains"]:
+        joints = " ".join(f"{j['links'][0]}-{j['links'][1]}{'' if j['type'] == 'R' else '(P)'}" for j in c["joints"])
+        out.append(f"  {c['index']:>3}. {c['name']}: joints {joints}; {c['automorphisms']} automorphism"
+                   f"{'s' if c['automorphisms'] != 1 else ''}; grounds {', '.join(str(m['ground']) for m in c['mechanisms'])}")
+        for m in c["mechanisms"]:
+            if m["file"]:
+                status = f"mobility {m['mobility']}" + (f"  PROBLEM: {m['problem']}" if m["problem"] else ", drawn closed")
+                out.append(f"        ground link{m['ground']}: {m['file']} ({status})")
+    if result.files:
+        out.append(f"wrote {len(result.files)} files to {directory}, each loaded and checked with screwkin "
+                   "(drawn closed, mobility by the constraint rank)")
+    if d["defects"]:
+        out.append("DEFECTS:")
+        out += [f"  - {x}" for x in d["defects"]]
+    return "\n".join(out)

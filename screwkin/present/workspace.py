@@ -1,0 +1,189 @@
+"""Workspaces (screwkin.analysis.workspace) as text, JSON-ready dictionaries, CSV, pictures
+(slices with matplotlib) and a meshcat point cloud."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pinocchio as pin
+
+from ..analysis.workspace import WorkspaceResult
+from .plots import _pyplot
+from .report import table
+
+__all__ = ["workspace_dict", "workspace_text", "workspace_csv", "workspace_png", "workspace_cloud", "AXIS_NAMES"]
+
+AXIS_NAMES = ("x", "y", "z")
+
+
+def _unit(dim: int) -> str:
+    return "m^3" if dim == 3 else "m^2"
+
+
+def axis_labels(r: WorkspaceResult) -> list:
+    """Names of the grid axes: x, y, z when they are world axes, else u, v (in-plane)."""
+    out = []
+    for k, a in enumerate(r.axes):
+        i = int(np.argmax(np.abs(a)))
+        out.append(AXIS_NAMES[i] if abs(a[i]) > 1 - 1e-12 else "uv"[k])
+    return out
+
+
+def workspace_dict(r: WorkspaceResult) -> dict:
+    d = {
+        "file": r.path, "output": r.output, "point": r.point, "method": r.method, "dimension": r.dimension,
+        "volume": r.volume, "volume_unit": _unit(r.dimension), "volume_cells": r.volume_cells,
+        "free_volume": r.free_volume, "free_fraction": r.free_volume / r.volume if r.volume > 0 else None,
+        "conditioning_min": r.conditioning_min, "conditioning_mean": r.conditioning_mean,
+        "threshold": r.threshold, "characteristic_length": r.length, "inputs": list(r.inputs),
+        "resolution": r.resolution, "axes": r.axes, "axis_names": axis_labels(r), "origin": r.origin,
+        "bounds": r.bounds, "points": int(len(r.index)), "free_points": int(r.free.sum()),
+        "boundary_points": int(len(r.boundary)), "free_boundary_points": int(len(r.free_boundary)),
+        "solves": r.solves, "samples": r.samples, "truncated": r.truncated, "notes": list(r.notes),
+        "orientation": None if r.orientation is None else r.orientation,
+        "orientation_rpy": None if r.orientation is None else pin.rpy.matrixToRpy(r.orientation),
+    }
+    if len(r.index):
+        worst = int(np.argmin(r.measures["conditioning"]))
+        d["worst_conditioned_point"] = r.positions[worst]
+    return d
+
+
+def workspace_text(r: WorkspaceResult) -> str:
+    dim, unit = r.dimension, _unit(r.dimension)
+    names = axis_labels(r)
+    if r.method == "grid":
+        what = (f"origin of '{r.output}' (any orientation)" if r.point else
+                f"'{r.output}' at the constant orientation roll pitch yaw "
+                + " ".join(f"{np.degrees(a):.4g}" for a in pin.rpy.matrixToRpy(r.orientation)) + " deg")
+        how = (f"inverse kinematics on a {dim}-D grid of {r.resolution:.4g} m from the output's position in the "
+               f"assembled configuration: {len(r.index)} points reached, {r.solves} configurations solved")
+    else:
+        what = f"origin of '{r.output}' (any orientation)"
+        how = f"{r.samples} random joint configurations counted in cells of {r.resolution:.4g} m"
+    lines = [f"Workspace of the {what}", f"  {r.path}", f"  method: {how}"]
+    if dim == 2:
+        plane = np.cross(r.axes[0], r.axes[1])
+        lines.append("  in the plane through (" + ", ".join(f"{x:.4g}" for x in r.origin) + ") with normal ("
+                     + ", ".join(f"{x:.4g}" for x in plane) + ")")
+    rows = [[n, f"{lo:.6g}", f"{hi:.6g}", f"{hi - lo:.6g}"] for n, (lo, hi) in zip(names, r.bounds)]
+    lines += ["", table(["axis", "from [m]", "to [m]", "extent [m]"], rows), ""]
+    frac = r.free_volume / r.volume if r.volume > 0 else 0.0
+    measure = ("the scan measure (smallest over largest singular value of the point's Jacobian; best of each cell)"
+               if r.method == "sampling" else
+               "smallest relative singular values of the passive constraint columns (actuator) and of the output's "
+               "motion (serial)")
+    rows = [
+        [f"volume [{unit}]", f"{r.volume:.6g}",
+         "runs along the last axis extended to the boundary by bisection" if r.method == "grid" else "cells hit"],
+        [f"volume, grid cells [{unit}]", f"{r.volume_cells:.6g}", "points reached x cell size"],
+        [f"singularity-free volume [{unit}]", f"{r.free_volume:.6g}", f"{100 * frac:.1f} % of the volume: measures "
+                                                                      f">= {r.threshold:g}"],
+        ["conditioning, worst (free part)", _num(r.conditioning_min), "1/condition number of the input -> output map"],
+        ["conditioning, mean (free part)", _num(r.conditioning_mean), f"lengths divided by L = {r.length:.6g} m"],
+    ]
+    lines += [table(["quantity", "value", "how"], rows), "", f"  singular measures: {measure}",
+              f"  inputs: {', '.join(r.inputs)}"]
+    if len(r.boundary):
+        lines.append(f"  boundary located at {len(r.boundary)} points (bisection to {r.resolution / 128:.2g} m), "
+                     f"the threshold crossed at {len(r.free_boundary)}")
+    if r.truncated:
+        lines.append("  warning: the bounds cut the workspace: the volumes are of the part within them")
+    lines += [f"  note: {n}" for n in r.notes]
+    return "\n".join(lines)
+
+
+def _num(x):
+    return "-" if x is None else f"{x:.4g}"
+
+
+def workspace_csv(r: WorkspaceResult, path, joint_columns=None):
+    """One row per reached point (cell): world position, grid index, measures, free; with
+    ``joint_columns`` ((name, q index) pairs) the joint values of the grid's solutions."""
+    joint_columns = list(joint_columns or []) if r.configurations is not None else []
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["x", "y", "z"] + [f"i_{n}" for n in axis_labels(r)]
+                   + ["actuator", "serial", "conditioning", "free"] + [n for n, _ in joint_columns])
+        for k in range(len(r.index)):
+            row = [f"{x:.9g}" for x in r.positions[k]] + [int(i) for i in r.index[k]]
+            row += [f"{r.measures[m][k]:.6g}" for m in ("actuator", "serial", "conditioning")] + [int(r.free[k])]
+            row += [f"{r.configurations[k, iq]:.9g}" for _, iq in joint_columns]
+            w.writerow(row)
+
+
+def workspace_png(r: WorkspaceResult, path: str):
+    """The conditioning over the workspace: the plane itself (2-D), or three slices through
+    the grid point nearest the workspace's centroid (3-D); the located boundary in black,
+    where the measures cross the threshold in red."""
+    plt = _pyplot("--png")
+    names = axis_labels(r)
+    h = r.resolution
+    cond = r.measures["conditioning"]
+    if r.dimension == 2:
+        fig, ax = plt.subplots(figsize=(7, 6))
+        panels = [(ax, 0, 1, np.ones(len(r.index), bool), None)]
+    else:
+        fig, axs = plt.subplots(1, 3, figsize=(15, 5))
+        c = np.round(np.mean(r.index, axis=0)).astype(int)
+        panels = []
+        for ax, (a, b, n) in zip(axs, ((0, 1, 2), (0, 2, 1), (1, 2, 0))):
+            panels.append((ax, a, b, r.index[:, n] == c[n], (n, c[n])))
+    coords = r.coordinates
+    mesh = None
+    for ax, a, b, sel, cut in panels:
+        if not sel.any():
+            continue
+        ia, ib = r.index[sel, a], r.index[sel, b]
+        grid = np.full((ib.max() - ib.min() + 1, ia.max() - ia.min() + 1), np.nan)
+        grid[ib - ib.min(), ia - ia.min()] = cond[sel]
+        ca, cb = coords[sel, a], coords[sel, b]
+        extent = (ca.min() - h / 2, ca.min() + (grid.shape[1] - 0.5) * h, cb.min() - h / 2,
+                  cb.min() + (grid.shape[0] - 0.5) * h)
+        mesh = ax.imshow(grid, origin="lower", extent=extent, cmap="viridis", vmin=0,
+                         vmax=max(float(np.nanmax(cond)), 1e-12), interpolation="nearest")
+        notfree = sel & ~r.free
+        if notfree.any():
+            ax.plot(coords[notfree, a], coords[notfree, b], "x", color="0.5", ms=3, label=f"measure < {r.threshold:g}")
+        for pts, style, label in ((r.boundary, "k.", "boundary (located)"),
+                                  (r.free_boundary, "r.", f"threshold {r.threshold:g} crossed")):
+            if len(pts):
+                P = pts @ r.axes.T
+                near = np.ones(len(P), bool) if cut is None else np.abs(P[:, cut[0]] - (r.axes[cut[0]] @ r.origin
+                                                                                          + cut[1] * h)) < h / 2
+                if near.any():
+                    ax.plot(P[near, a], P[near, b], style, ms=2, label=label)
+        ax.set_xlabel(f"{names[a]} [m]")
+        ax.set_ylabel(f"{names[b]} [m]")
+        ax.set_aspect("equal")
+        title = "" if cut is None else f"slice {names[cut[0]]} = {r.axes[cut[0]] @ r.origin + cut[1] * h:.4g} m"
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=7, loc="upper right")
+    if mesh is not None:
+        fig.colorbar(mesh, ax=[p[0] for p in panels], label="conditioning (1 / condition number)", shrink=0.8)
+    what = "point" if r.point else "pose"
+    fig.suptitle(f"workspace of '{r.output}' ({what}): {r.volume:.4g} {_unit(r.dimension)}, "
+                 f"singularity-free {r.free_volume:.4g}", fontsize=10)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def workspace_cloud(r: WorkspaceResult, viewer, size=None):
+    """The reached points as a meshcat point cloud, coloured by conditioning (viridis-like
+    ramp from dark blue to yellow), points below the threshold grey."""
+    import meshcat.geometry as g
+
+    cond = r.measures["conditioning"]
+    top = max(float(cond.max()), 1e-12) if len(cond) else 1.0
+    t = np.clip(cond / top, 0, 1)[:, None]
+    dark, light = np.array([0.27, 0.0, 0.33]), np.array([0.99, 0.91, 0.14])
+    colors = (1 - t) * dark + t * light
+    colors[~r.free] = 0.6
+    points = g.PointCloud(position=r.positions.T.astype(np.float32), color=colors.T.astype(np.float32),
+                          size=float(size or r.resolution * 0.6))
+    viewer["workspace/points"].set_object(points)
+    if len(r.boundary):
+        viewer["workspace/boundary"].set_object(g.PointCloud(
+            position=r.boundary.T.astype(np.float32), color=np.zeros((3, len(r.boundary)), np.float32),
+            size=float(size or r.resolution * 0.3)))
