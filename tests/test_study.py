@@ -4,6 +4,7 @@ local Dask cluster and on a scheduler and workers started here as separate proce
 designs kept as rows with their reason, the same table whatever runs it, and bad specs as
 one-line usage errors."""
 
+import dataclasses
 import io
 import itertools
 import json
@@ -20,9 +21,13 @@ import yaml
 from conftest import ROBOTS
 
 import screwkin
+import screwkin.analysis.study as st
 from screwkin.analysis.study import (
+    _GRASHOF,
     StudyResult,
+    _collect,
     _task,
+    design_args,
     designs,
     pareto_front,
     run_chunk,
@@ -30,7 +35,8 @@ from screwkin.analysis.study import (
 )
 from screwkin.cli import main
 from screwkin.files.study import study_spec
-from screwkin.present.study import Progress, study_csv
+from screwkin.files.xacro import expand
+from screwkin.present.study import Progress, study_csv, study_text
 
 ROOT = Path(__file__).resolve().parents[1]
 GROUND = 0.1
@@ -352,3 +358,114 @@ def test_study_table_is_plain_numbers():
         cells = line.split(",")
         assert float(cells[1]) in (0.02, 0.04)
         assert np.isfinite(float(cells[-2]))
+
+
+# ------------------------------------------------------------------ traceable rows
+def _json(capsys, argv):
+    assert main(argv) == 0, argv
+    return json.loads(capsys.readouterr().out)
+
+
+def test_rows_equal_the_single_commands_on_the_expanded_file(local, tmp_path, capsys):
+    """A study's row is what mobility and sweep say of that design: given --arg with the row's
+    values, or run on the URDF the xacro file expands to with them."""
+    task = _task(study_spec(FAMILY))
+    text = (ROBOTS / "fourbar.urdf.xacro").read_text()
+    checked = 0
+    for r in local.rows:
+        if r["error"] is not None or r["design"] % 4:
+            continue
+        args = design_args(task, (r["crank"], r["coupler"], r["rocker"]))
+        urdf = tmp_path / f"design{r['design']}.urdf"
+        urdf.write_text(expand(ROBOTS / "fourbar.urdf.xacro", text, args))
+        by_arg = [str(ROBOTS / "fourbar.urdf.xacro")] + [x for n, v in args.items() for x in ("--arg", f"{n}={v}")]
+        for target in (by_arg, [str(urdf)]):
+            m = _json(capsys, ["mobility", *target, "--json"])
+            assert (m["mobility"], m["motion_space"], m["overconstraint"], m["idle_dofs"]) == \
+                (r["mobility"], r["motion_space"], r["overconstraint"], r["idle_dofs"])
+            s = _json(capsys, ["sweep", *target, "--input", "crank_joint", "--from", "0", "--to", "1turn",
+                               "--steps", "72", "--json"])
+            assert next(short for prefix, short in _GRASHOF if s["linkage"]["grashof"].startswith(prefix)) \
+                == r["grashof"]
+        checked += 1
+    assert checked >= 5
+
+
+def test_transmission_angles_are_those_of_sweep(capsys):
+    """A crank-rocker's transmission angles over a full turn against sweep's along the same turn."""
+    spec = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "args": {"ground": 0.1},
+            "parameters": {"crank": {"values": [0.035]}}, "metrics": ["transmission_angle"],
+            "transmission": {"steps": 720}}
+    r = run_study(spec, workers=0).rows[0]
+    s = _json(capsys, ["sweep", str(ROBOTS / "fourbar.urdf.xacro"), "--arg", "ground=0.1", "--arg", "crank=0.035",
+                       "--input", "crank_joint", "--from", "0", "--to", "1turn", "--steps", "720", "--json"])
+    mus = s["transmission_angles"]
+    assert r["transmission_angle_min"] == pytest.approx(min(mus), abs=2e-3)
+    assert r["transmission_angle_max"] == pytest.approx(max(mus), abs=2e-3)
+
+
+def test_workspace_metrics_equal_screwkin_workspace(capsys):
+    """The workspace columns of a Delta design are screwkin workspace's numbers for it, to the bit."""
+    spec = {"file": str(ROBOTS / "delta.urdf.xacro"), "parameters": {"rod": {"values": [0.45, 0.1]}},
+            "metrics": ["workspace_volume", "singularity_free_volume", "conditioning"], "output": "platform",
+            "workspace": {"resolution": "60mm"}}
+    res = run_study(spec, workers=0)
+    r, bad = res.rows
+    assert r["error"] is None and r["workspace_dimension"] == 3
+    assert "math domain error" in bad["error"] and bad["workspace_volume"] is None
+    w = _json(capsys, ["workspace", str(ROBOTS / "delta.urdf.xacro"), "--arg", "rod=0.45", "--output", "platform",
+                       "--resolution", "60mm", "--json"])
+    assert (r["workspace_volume"], r["singularity_free_volume"], r["conditioning_min"], r["conditioning_mean"]) == \
+        (w["volume"], w["free_volume"], w["conditioning_min"], w["conditioning_mean"])
+    assert "grid of step 0.06 m" in study_text(res)
+
+
+# ------------------------------------------------------------------ a study never hangs
+def test_a_design_past_its_timeout_is_a_failed_row(monkeypatch):
+    calls = []
+
+    def slow(d):
+        calls.append(d)
+        time.sleep(30 if len(calls) == 2 else 0)  # the second design: interrupted by the alarm
+        return {"linkage": "four-bar", "grashof": "x", "grashof_margin": 1.0}
+
+    monkeypatch.setitem(st.METRICS, "grashof", slow)
+    spec = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "parameters": {"crank": {"values": [0.03, 0.04]}},
+            "metrics": ["grashof"], "timeout": 1.5}
+    t = time.perf_counter()
+    res = run_study(spec, workers=0)
+    assert time.perf_counter() - t < 10
+    ok, late = res.rows
+    assert ok["error"] is None and ok["grashof"] == "x"
+    assert late["error"].startswith("timed out") and late["grashof"] is None and late["grashof_margin"] is None
+
+
+def _stuck_chunk(task, chunk):
+    time.sleep(4)
+    return [{"design": i} for i, _ in chunk]
+
+
+def test_a_stalled_cluster_gives_failed_rows_not_a_hang():
+    """No chunk finishing within the designs' timeouts (plus a grace) ends the study: every
+    unfinished chunk is cancelled and its rows are failures that say so."""
+    import distributed  # (as above: only these tests start a cluster)
+
+    task = dataclasses.replace(_task(study_spec(FAMILY)), timeout=0.2)
+    chunks = [[(0, (0.021, 0.052, 0.032))], [(1, (0.021, 0.052, 0.081))]]
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as client:
+        futures = [client.submit(_stuck_chunk, task, c, pure=False) for c in chunks]
+        t = time.perf_counter()
+        results = _collect(client, task, chunks, futures, 2, None, distributed.wait, grace=0.5)
+        assert time.perf_counter() - t < 3
+    rows = [r for rs in results for r in rs]
+    assert [r["design"] for r in rows] == [0, 1]
+    assert all(r["error"].startswith("timed out") and r["grashof"] is None for r in rows)
+
+
+def test_spec_timeout_and_workspace_resolution_are_checked(tmp_path, capsys):
+    for data, word in ((dict(SMALL, timeout=0), "timeout must be"),
+                       (dict(SMALL, metrics=["workspace_volume"]), "need workspace: {resolution: H}")):
+        spec = write_spec(tmp_path, data)
+        assert main(["study", spec, "--workers", "0"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and word in err[0], err

@@ -22,8 +22,11 @@ from __future__ import annotations
 
 import itertools
 import logging
+import contextlib
 import math
 import os
+import signal
+import threading
 import time
 import uuid
 import warnings
@@ -41,11 +44,12 @@ from ..model.loader import load
 from .mobility import analyze_mobility
 from .planar import identify
 from .position import PositionSolver
-from .workspace import workspace
+from .workspace import DEFAULT_THRESHOLD, workspace
 
 __all__ = [
     "COLUMNS",
     "METRICS",
+    "DesignTimeout",
     "StudyResult",
     "default_workers",
     "designs",
@@ -73,6 +77,51 @@ _GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
 
 #: Relative margin at the ends of a limited input range (limit positions) in the transmission sweep.
 RANGE_MARGIN = 1e-9
+#: Seconds a Dask cluster may go without finishing any chunk beyond what its designs' timeouts allow
+#: (starting workers, importing screwkin, moving the rows) before the unfinished chunks are given up.
+STALL_GRACE = 60.0
+
+
+class DesignTimeout(ScrewkinError):
+    """A design ran past the study's timeout (its row is failed, its metrics empty)."""
+
+
+class _Clock:
+    """The deadline of one design, checked between its steps (loading, assembly, each metric,
+    each configuration of the transmission sweep)."""
+
+    def __init__(self, seconds: float):
+        self.seconds = seconds
+        self.end = time.perf_counter() + seconds
+
+    def check(self) -> None:
+        if time.perf_counter() > self.end:
+            raise DesignTimeout(f"timed out: the design took more than {self.seconds:g} s (the study's timeout "
+                                "per design)")
+
+
+@contextlib.contextmanager
+def _alarm(seconds: float):
+    """In the main thread (a study in this process): SIGALRM raises DesignTimeout after ``seconds``
+    even inside a step that never reaches a check (Python code between two C calls).  Elsewhere
+    (a Dask worker's thread) nothing: the checks and the client's stall watch bound the design."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def fire(signum, frame):
+        raise DesignTimeout(f"timed out: the design took more than {seconds:g} s (the study's timeout per design)")
+
+    previous = signal.signal(signal.SIGALRM, fire)
+    t0 = time.perf_counter()
+    old_delay, old_interval = signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        if old_delay > 0:  # someone else's timer (pytest-timeout ...): put it back with what is left of it
+            signal.setitimer(signal.ITIMER_REAL, max(old_delay - (time.perf_counter() - t0), 1e-3), old_interval)
 
 
 def default_workers() -> int:
@@ -130,14 +179,16 @@ class _Task:
     point: bool
     workspace: dict
     steps: int
+    timeout: float = 120.0  # seconds per design
 
 
 class _Design:
     """One loaded design and what its metrics share (assembly, linkage, workspace)."""
 
-    def __init__(self, task: _Task, mech):
-        self.task, self.mech = task, mech
+    def __init__(self, task: _Task, mech, clock: _Clock):
+        self.task, self.mech, self.clock = task, mech, clock
         self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
+        clock.check()
         self._linkage = None
         self._workspace = None
 
@@ -163,9 +214,11 @@ class _Design:
     def workspace(self):
         if self._workspace is None:
             ws = self.task.workspace
+            # what `screwkin workspace FILE --output LINK [--point] --resolution H [--threshold T] [--length L]`
+            # computes for this design (the spec checked that a resolution is given)
             self._workspace = workspace(self.mech, self.task.output, point=ws.get("point", False),
-                                        resolution=ws.get("resolution"), threshold=ws.get("threshold", 0.01),
-                                        length=ws.get("length"))
+                                        resolution=ws["resolution"],
+                                        threshold=ws.get("threshold", DEFAULT_THRESHOLD), length=ws.get("length"))
         return self._workspace
 
 
@@ -215,6 +268,7 @@ def _transmission(d: _Design) -> dict:
     for path in paths:
         q = d.q
         for k, x in enumerate(path):
+            d.clock.check()
             try:
                 q = solver.track({name: float(x)}, q).q
             except AssemblyError:
@@ -320,20 +374,30 @@ def _reason(exc, path: str) -> str:
     return one_line(text, 400)
 
 
+def design_args(task: _Task, values: tuple) -> dict:
+    """The xacro arguments of one design, as text: what ``--arg NAME=VALUE`` gives the file (a
+    parameter's SI value written as repr(float), so the single commands reproduce a row exactly)."""
+    args = dict(task.args)
+    args.update({n: repr(float(v)) for n, v in zip(task.parameters, values)})
+    return args
+
+
 def _evaluate(task: _Task, index: int, values: tuple) -> dict:
     row = {"design": index, **dict(zip(task.parameters, values))}
     columns = metric_columns(task.metrics)
     row.update(dict.fromkeys(columns))
     row["error"] = None
+    clock = _Clock(task.timeout)
     try:
-        args = dict(task.args)
-        args.update({n: repr(float(v)) for n, v in zip(task.parameters, values)})
-        mech = load(task.file, text=task.text, args=args, warn=lambda m: None)
-        d = _Design(task, mech)
-        computed = {}
-        for m in task.metrics:
-            computed.update(METRICS[m](d))
-        row.update(computed)
+        with _alarm(task.timeout):
+            mech = load(task.file, text=task.text, args=design_args(task, values), warn=lambda m: None)
+            clock.check()
+            d = _Design(task, mech, clock)
+            computed = {}
+            for m in task.metrics:
+                computed.update(METRICS[m](d))
+                clock.check()  # a metric that ran past the deadline (one long workspace grid) fails the row
+        row.update(computed)  # all metrics or none: a failed design never shows a number
     except ScrewkinError as exc:
         row["error"] = _reason(exc, task.file)
     except Exception as exc:  # noqa: BLE001 - a bug (or a missing module on a worker): the row says it, the run goes on
@@ -387,7 +451,7 @@ def _task(spec: StudySpec) -> _Task:
     except UnicodeDecodeError:
         raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
     return _Task(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
-                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps)
+                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps, spec.timeout)
 
 
 def _resolve(name: str, keys) -> str | None:
@@ -495,7 +559,7 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
     from distributed import (  # 0.4-0.9 s to import: only studies need it
         Client,
         LocalCluster,
-        as_completed,
+        wait,
     )
 
     cluster = client = None
@@ -522,22 +586,7 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
         token = uuid.uuid4().hex[:12]
         futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
                    for k, chunk in enumerate(chunks)]
-        index = {f.key: k for k, f in enumerate(futures)}
-        results = [None] * len(chunks)
-        done = failed = 0
-        for fut in as_completed(futures):
-            k = index[fut.key]
-            try:
-                results[k] = fut.result()
-            except Exception as exc:  # noqa: BLE001 - the task failed as a whole (its worker died): rows say it
-                reason = f"the task of designs {chunks[k][0][0]}-{chunks[k][-1][0]} failed on its worker: " \
-                         f"{type(exc).__name__}: {one_line(str(exc), 200)}"
-                results[k] = [_failed_row(task, i, v, reason) for i, v in chunks[k]]
-            done += len(chunks[k])
-            failed += sum(r["error"] is not None for r in results[k])
-            if progress:
-                progress(done, total, failed)
-        futures = []
+        results, futures = _collect(client, task, chunks, futures, total, progress, wait), []
         return results, used, where
     finally:
         if client is not None:
@@ -549,6 +598,45 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
             client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _collect(client, task, chunks, futures, total, progress, wait, grace: float = STALL_GRACE) -> list:
+    """The rows of every chunk's future, in chunk order.  A chunk whose task failed as a whole
+    (its worker died) is rows with that reason.  When no chunk finishes for the longest
+    chunk's designs' timeouts plus ``grace`` seconds, the chunks still running are past their
+    timeouts (a design stuck where its checks cannot see it): every unfinished chunk is
+    cancelled and its rows say so -- the study ends, it never hangs."""
+    index = {f.key: k for k, f in enumerate(futures)}
+    results = [None] * len(chunks)
+    done = failed = 0
+    stall = max(len(c) for c in chunks) * task.timeout + grace
+    pending = set(futures)
+    while pending:
+        try:
+            finished, pending = wait(list(pending), timeout=stall, return_when="FIRST_COMPLETED")
+        except TimeoutError:
+            finished = ()
+        if not finished:
+            reason = (f"timed out: no part of the study finished for {stall:g} s (timeout {task.timeout:g} s per "
+                      "design); this design's task was cancelled unfinished")
+            client.cancel(list(pending))
+            finished, pending = [(f, reason) for f in pending], set()
+        for item in finished:
+            fut, reason = item if isinstance(item, tuple) else (item, None)
+            k = index[fut.key]
+            if reason is None:
+                try:
+                    results[k] = fut.result()
+                except Exception as exc:  # noqa: BLE001 - the task failed as a whole (its worker died): rows say it
+                    reason = (f"the task of designs {chunks[k][0][0]}-{chunks[k][-1][0]} failed on its worker: "
+                              f"{type(exc).__name__}: {one_line(str(exc), 200)}")
+            if reason is not None:
+                results[k] = [_failed_row(task, i, v, reason) for i, v in chunks[k]]
+            done += len(chunks[k])
+            failed += sum(r["error"] is not None for r in results[k])
+            if progress:
+                progress(done, total, failed)
+    return results
 
 
 def _failed_row(task, index, values, reason) -> dict:

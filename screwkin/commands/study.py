@@ -40,6 +40,9 @@ def add_parser(sub, common, scaled):
                     help="the two columns of the Pareto front and their goals (overrides the spec's pareto)")
     sp.add_argument("--timeout", type=float, default=10.0,
                     help="seconds to reach the scheduler and a worker (default 10)")
+    sp.add_argument("--design-timeout", type=float, metavar="S",
+                    help="seconds one design may take before its row is a failure (overrides the spec's timeout; "
+                         "default 120)")
 
 
 def _pareto(text):
@@ -62,6 +65,10 @@ def run(mech, args) -> int:
     spec = read_study_spec(args.spec)
     if args.pareto:
         spec = replace(spec, pareto=_pareto(args.pareto))
+    if args.design_timeout is not None:
+        if not 0 < args.design_timeout <= 86400:
+            raise UsageError(f"--design-timeout must be more than 0 s and at most 86400, got {args.design_timeout:g}")
+        spec = replace(spec, timeout=float(args.design_timeout))
     progress = Progress()
     result = run_study(spec, scheduler=args.scheduler, workers=args.workers, progress=progress,
                        timeout=args.timeout)

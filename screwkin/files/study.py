@@ -31,7 +31,8 @@ from .description import LIMITS
 from .xacro import declared_args, normalize_args
 from .xmlsafe import load_yaml_text, read_regular_file
 
-__all__ = ["MAX_DESIGNS", "METRICS", "SAMPLINGS", "Parameter", "StudySpec", "read_study_spec", "study_spec"]
+__all__ = ["DESIGN_TIMEOUT", "MAX_DESIGNS", "METRICS", "SAMPLINGS", "WORKSPACE_METRICS", "Parameter", "StudySpec",
+           "read_study_spec", "study_spec"]
 
 #: The metrics a study may ask for (what each computes: screwkin.analysis.study).
 METRICS = ("mobility", "grashof", "transmission_angle", "workspace_volume", "singularity_free_volume",
@@ -41,8 +42,12 @@ SAMPLINGS = ("grid", "random", "lhs")
 MAX_DESIGNS = 1_000_000
 #: Most values one parameter's list or range gives.
 MAX_VALUES = 100_000
+#: Seconds one design may take by default (the spec's ``timeout``); a design over it is a failed row.
+DESIGN_TIMEOUT = 120.0
+#: The metrics computed from screwkin.analysis.workspace (they need ``workspace: {resolution: H}``).
+WORKSPACE_METRICS = ("workspace_volume", "singularity_free_volume", "conditioning")
 _KEYS = ("file", "args", "parameters", "sampling", "designs", "seed", "metrics", "input", "output", "point",
-         "workspace", "transmission", "pareto", "chunk")
+         "workspace", "transmission", "pareto", "chunk", "timeout")
 _WORKSPACE_KEYS = ("point", "resolution", "threshold", "length")
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
@@ -78,6 +83,7 @@ class StudySpec:
     transmission_steps: int = 180  # transmission_angle: input values sampled over the input's range
     pareto: tuple | None = None  # ((metric, "max"|"min"), (metric, "max"|"min"))
     chunk: int | None = None  # designs per task (default: chosen from the number of designs and workers)
+    timeout: float = DESIGN_TIMEOUT  # seconds per design: over it, the design is a failed row
 
 
 def _fail(where, message):
@@ -252,9 +258,14 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
     if point and not data.get("output"):
         _fail(where, "point needs output: LINK")
     workspace = _workspace(data.get("workspace"), where)
-    if any(m in metrics for m in ("workspace_volume", "singularity_free_volume", "conditioning")) \
-            and not data.get("output"):
-        _fail(where, "the workspace metrics need output: LINK (the link whose workspace is measured)")
+    if any(m in metrics for m in WORKSPACE_METRICS):
+        if not data.get("output"):
+            _fail(where, "the workspace metrics need output: LINK (the link whose workspace is measured)")
+        if "resolution" not in workspace:
+            # one grid step for every design, so that their volumes compare; screwkin workspace's own default
+            # (about 24 steps across, from a first pass) takes 5-20 s per design and differs between designs
+            _fail(where, "the workspace metrics need workspace: {resolution: H}, the grid step of every design "
+                         "(e.g. 20mm: a 3-D grid of about (size / H)^3 inverse kinematics per design)")
     transmission = data.get("transmission") or {}
     if not isinstance(transmission, dict) or set(transmission) - {"steps"}:
         _fail(where, f"transmission must be a mapping with steps, got {quote(transmission)}")
@@ -262,8 +273,13 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
     chunk = data.get("chunk")
     if chunk is not None:
         chunk = _count(chunk, where, "chunk", 1, 100_000)
+    timeout = data.get("timeout", DESIGN_TIMEOUT)
+    if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 86400:
+        _fail(where, f"timeout must be the seconds one design may take, more than 0 and at most 86400, got "
+                     f"{quote(timeout)}")
     spec = StudySpec(where, path, tuple(parameters), metrics, sampling, designs, seed, fixed, data.get("input"),
-                     data.get("output"), point, workspace, steps, _pareto(data.get("pareto"), where), chunk)
+                     data.get("output"), point, workspace, steps, _pareto(data.get("pareto"), where), chunk,
+                     float(timeout))
     _check_arguments(spec, where)
     return spec
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..analysis.study import pareto_front
 from ..errors import UsageError, quote
+from ..files.study import WORKSPACE_METRICS
 from .plots import _pyplot
 from .report import to_jsonable
 
@@ -124,12 +125,17 @@ def study_dict(result) -> dict:
         "designs": len(result.rows), "analysed": len(result.succeeded), "failed": len(result.failed),
         "seconds": result.seconds, "workers": result.workers, "scheduler": result.scheduler, "chunks": result.chunks,
         "units": "SI (m, rad; workspace volumes in m^workspace_dimension)",
+        "timeout": spec.timeout, "workspace": dict(spec.workspace) if _workspace_metrics(result) else None,
         "rows": [dict(r) for r in result.rows],
     }
     if spec.pareto and result.succeeded:
         d["pareto"] = {"columns": [{"column": c, "goal": g} for c, g in spec.pareto],
                        "designs": [result.rows[k]["design"] for k in pareto_front(result)]}
     return to_jsonable(d)
+
+
+def _workspace_metrics(result) -> bool:
+    return any(m in WORKSPACE_METRICS for m in result.spec.metrics)
 
 
 def _fmt(v):
@@ -153,7 +159,13 @@ def study_text(result, table_path=None) -> str:
             else f"{spec.sampling} sampling of {', '.join(result.parameters)} (seed {spec.seed})")
     lines = [(f"study of {spec.file} ({what}): {n} designs, {len(ok)} analysed, {len(bad)} failed; "
               f"{result.seconds:.2f} s on {result.workers} worker{'s' if result.workers != 1 else ''} "
-              f"({result.scheduler})")]
+              f"({result.scheduler}), timeout {spec.timeout:g} s per design")]
+    if _workspace_metrics(result):
+        ws = spec.workspace
+        lines.append(f"workspace metrics of {result.spec.output!r}"
+                     + (" (its origin as a point)" if ws.get("point") else " (at its assembled orientation)")
+                     + f" on a grid of step {ws['resolution']:g} m (the spec's workspace resolution), threshold "
+                     + f"{ws.get('threshold', 0.01):g}")
     if bad:
         reasons = Counter(r["error"] for r in bad)
         lines.append("failed designs:")
