@@ -417,6 +417,7 @@ def test_workspace_metrics_equal_screwkin_workspace(capsys):
                        "--resolution", "60mm", "--json"])
     assert (r["workspace_volume"], r["singularity_free_volume"], r["conditioning_min"], r["conditioning_mean"]) == \
         (w["volume"], w["free_volume"], w["conditioning_min"], w["conditioning_mean"])
+    assert r["workspace_truncated"] is w["truncated"] is False
     assert "grid of step 0.06 m" in study_text(res)
 
 

@@ -64,8 +64,8 @@ COLUMNS = {
                  "output_motion"),
     "grashof": ("linkage", "grashof", "grashof_margin"),
     "transmission_angle": ("transmission_angle_min", "transmission_angle_max"),
-    "workspace_volume": ("workspace_dimension", "workspace_volume"),
-    "singularity_free_volume": ("workspace_dimension", "singularity_free_volume"),
+    "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated"),
+    "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated"),
     "conditioning": ("conditioning_min", "conditioning_mean"),
 }
 
@@ -339,12 +339,14 @@ def _angles(d: _Design, info, Q) -> np.ndarray:
 
 def _workspace_volume(d: _Design) -> dict:
     w = d.workspace()
-    return {"workspace_dimension": w.dimension, "workspace_volume": w.volume}
+    # truncated: MAX_POINTS cut the grid (a resolution too fine for the workspace): the volumes are lower bounds
+    return {"workspace_dimension": w.dimension, "workspace_volume": w.volume, "workspace_truncated": w.truncated}
 
 
 def _singularity_free_volume(d: _Design) -> dict:
     w = d.workspace()
-    return {"workspace_dimension": w.dimension, "singularity_free_volume": w.free_volume}
+    return {"workspace_dimension": w.dimension, "singularity_free_volume": w.free_volume,
+            "workspace_truncated": w.truncated}
 
 
 def _conditioning(d: _Design) -> dict:
