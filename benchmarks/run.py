@@ -80,16 +80,18 @@ def serial_scan(n):
         err = None if out is None else float(np.abs(out - (ref[measure] if compare is None else compare)).max())
         rows.append((tool, measure, t * scale, err))
 
+    # (scale_translation=1.0: singular values in SI units, as the references; screwkin's
+    # commands make them dimensionless with the mechanism's length)
     for measure in ("det", "sigma_min"):
-        add("screwkin SerialJacobians, 1 thread", measure, lambda: sj.measures(Q, measure))
+        add("screwkin SerialJacobians, 1 thread", measure, lambda: sj.measures(Q, measure, scale_translation=1.0))
         if measure == "sigma_min":
             add("screwkin SerialJacobians, method gram, 1 thread", measure,
-                lambda: sj.measures(Q, measure, method="gram"))
+                lambda: sj.measures(Q, measure, scale_translation=1.0, method="gram"))
         if cores > 1:
-            add(f"screwkin SerialJacobians, {cores} threads", measure, lambda: sj.measures(Q, measure, workers=cores))
+            add(f"screwkin SerialJacobians, {cores} threads", measure, lambda: sj.measures(Q, measure, scale_translation=1.0, workers=cores))
             if measure == "sigma_min":
                 add(f"screwkin SerialJacobians, method gram, {cores} threads", measure,
-                    lambda: sj.measures(Q, measure, method="gram", workers=cores))
+                    lambda: sj.measures(Q, measure, scale_translation=1.0, method="gram", workers=cores))
         stacked = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[:, -1])
         one = np.linalg.det if measure == "det" else (lambda J: np.linalg.svd(J, compute_uv=False)[-1])
         add("Pinocchio Jacobian loop + one stacked numpy call", measure,

@@ -412,3 +412,43 @@ def test_a_straight_knee_is_a_singularity_of_the_foot_position(tmp_path, capsys)
     assert not classify(mech, q, output="foot", inputs=[], point=True).serial
     d = run_json(capsys, ["scan", str(p), "--output", "foot", "--point", "--samples", "20000"])
     assert d["point"] and d["min"] < 0.02 and abs(d["min_configuration"]["kfe"]) < 0.05
+
+
+JOINT_STYLE_LOOP = """<robot name="student_fourbar">
+  <link name="ground"/><link name="crank"/><link name="coupler"/><link name="rocker"/><link name="rocker_tip"/>
+  <joint name="A" type="revolute"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/>
+    <limit lower="-6.3" upper="6.3" effort="1" velocity="1"/></joint>
+  <joint name="B" type="revolute"><parent link="crank"/><child link="coupler"/><origin xyz="0.05 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-6.3" upper="6.3" effort="1" velocity="1"/></joint>
+  <joint name="C" type="revolute"><parent link="coupler"/><child link="rocker"/><origin xyz="0.07 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-6.3" upper="6.3" effort="1" velocity="1"/></joint>
+  <joint name="rt" type="fixed"><parent link="rocker"/><child link="rocker_tip"/><origin xyz="0.09 0 0"/></joint>
+  <loop_joint name="D" type="revolute"><parent link="ground"/><child link="rocker_tip"/>
+    <origin xyz="0.06 0 0"/><axis xyz="0 0 1"/></loop_joint>
+  <transmission name="t"><joint name="A"/></transmission>
+</robot>"""
+
+
+def test_loop_joint_written_like_a_joint(tmp_path):
+    """A newcomer writes the loop joint as a <joint> (parent, child, origin in the parent): read
+    as link1 = parent at the origin, link2 = the child's own frame.  Four-bar 0.05/0.07/0.09,
+    ground 0.06, crank at 45 deg: the rocker's direction from D by the law of cosines."""
+    import numpy as np
+
+    import screwkin
+    from screwkin.analysis.position import PositionSolver
+
+    path = tmp_path / "fourbar.urdf"
+    path.write_text(JOINT_STYLE_LOOP)
+    m = screwkin.load(path)
+    assert len(m.cuts) == 1
+    res = PositionSolver(m).solve({"A": np.radians(45)})
+    B = 0.05 * np.array([np.cos(np.radians(45)), np.sin(np.radians(45))])
+    D = np.array([0.06, 0.0])
+    BD = np.linalg.norm(B - D)
+    base = np.arctan2(*(B - D)[::-1])
+    alpha = np.arccos((0.09**2 + BD**2 - 0.07**2) / (2 * 0.09 * BD))
+    # the rocker's x axis points from C to D: its angle is that of D -> C turned by pi
+    expected = sorted(np.degrees(np.angle(np.exp(1j * (base + s * alpha + np.pi)))) for s in (1, -1))
+    got = sorted(np.degrees(np.angle(np.exp(1j * s.link_angles["rocker"]))) for s in res.solutions)
+    assert np.allclose(got, expected, atol=1e-6)

@@ -25,7 +25,7 @@ import pinocchio as pin
 from ..errors import UsageError
 from ..model._pin import compute_frame_jacobian
 from ..model.closure import ClosureSystem, CouplingRow, CutJoint
-from .screws import chains, chains_to
+from .screws import chains
 
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
            "singular_value_ratios", "determinants", "BatchClosure", "Unbatchable", "damped_steps",

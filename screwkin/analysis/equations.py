@@ -661,7 +661,6 @@ class VectorLoops:
 
     # ------------------------------------------------------------------ result
     def result(self) -> PlanarEquations:
-        sp = self.sp
         values = self.values(self.q)
         A, B = self.matrices(values)
         d, conds, words = self.determinant()

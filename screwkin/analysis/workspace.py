@@ -33,6 +33,8 @@ linear interpolation.
 
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -554,9 +556,9 @@ def _grid(mech, output, point, orientation, measures, resolution, bounds, thresh
         # what is asked is then where its origin goes
         res = _grid(mech, output, True, None, _Measures(mech, output, True, inputs, L), resolution, bounds,
                     threshold, L, inputs)
-        res.notes.insert(0, f"'{output}' moves over no area at a constant orientation: the workspace of its "
-                            "origin with any orientation (as --point)")
-        return res
+        note = (f"'{output}' moves over no area at a constant orientation: the workspace of its origin with "
+                "any orientation (as --point)")
+        return dataclasses.replace(res, notes=(note,) + tuple(res.notes))
     if dim < 2:
         what = "its origin" if point else f"'{output}' at a constant orientation"
         raise UsageError(f"{mech.path}: {what} moves along {'a curve' if dim == 1 else 'no direction'} "

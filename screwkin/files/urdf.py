@@ -211,8 +211,16 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
         problems.append(f"{what} has {len(firsts)} <link1> and {len(seconds)} <link2> children: "
                         "it needs exactly one of each")
         return None
+    parent, child = elem.findall("parent"), elem.findall("child")
+    if not firsts and not seconds and len(parent) == 1 and len(child) == 1:
+        # written like a <joint>: <parent link>, <child link>, <origin> in the parent; the joint
+        # frame meets the child's own frame when the loop is closed, as a tree joint places it
+        origin = elem.find("origin")
+        firsts = [{"link": parent[0].get("link"), "xyz": None if origin is None else origin.get("xyz"),
+                   "rpy": None if origin is None else origin.get("rpy")}]
+        seconds = [{"link": child[0].get("link")}]  # (read with .get, as the elements are)
     if len(firsts) < 1 or len(seconds) < 1:
-        problems.append(f"{what} needs a <link1> and a <link2>")
+        problems.append(f"{what} needs a <link1> and a <link2> (or a <parent> and a <child> as a <joint> has)")
         return None
     sides = []
     for tag, e in (("link1", firsts[0]), ("link2", seconds[0])):

@@ -74,12 +74,13 @@ def workspace_text(r: WorkspaceResult) -> str:
                if r.method == "sampling" else
                "smallest relative singular values of the passive constraint columns (actuator) and of the output's "
                "motion (serial)")
+    size = "area" if r.dimension == 2 else "volume"  # (the JSON keys say volume for both, with volume_unit)
     rows = [
-        [f"volume [{unit}]", f"{r.volume:.6g}",
+        [f"{size} [{unit}]", f"{r.volume:.6g}",
          "runs along the last axis extended to the boundary by bisection" if r.method == "grid" else "cells hit"],
-        [f"volume, grid cells [{unit}]", f"{r.volume_cells:.6g}", "points reached x cell size"],
-        [f"singularity-free volume [{unit}]", f"{r.free_volume:.6g}", f"{100 * frac:.1f} % of the volume: measures "
-                                                                      f">= {r.threshold:g}"],
+        [f"{size}, grid cells [{unit}]", f"{r.volume_cells:.6g}", "points reached x cell size"],
+        [f"singularity-free {size} [{unit}]", f"{r.free_volume:.6g}",
+         f"{100 * frac:.1f} % of the {size}: measures >= {r.threshold:g}"],
         ["conditioning, worst (free part)", _num(r.conditioning_min), "1/condition number of the input -> output map"],
         ["conditioning, mean (free part)", _num(r.conditioning_mean), f"lengths divided by L = {r.length:.6g} m"],
     ]

@@ -187,7 +187,7 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     A1 = A0 + a * np.array([math.cos(phi[0]), math.sin(phi[0])])
     B1 = B0 + c * np.array([math.cos(psi[0]), math.sin(psi[0])])
     if not np.isclose(np.hypot(*(B1 - A1)), b, rtol=1e-9, atol=0):  # least squares: the first point on the circle
-        sigma1 = None
+        sigma1, best = None, 0.0
         for sg in (1.0, -1.0):
             g, _, _ = _generated(K, d, phi[:1], sg)
             if np.isfinite(g[0]) and (sigma1 is None or abs(wrap(g[0] - psi[0])) < abs(wrap(best - psi[0]))):
