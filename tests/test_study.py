@@ -456,7 +456,7 @@ def test_a_stalled_cluster_gives_failed_rows_not_a_hang():
     with distributed.Client(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as client:
         futures = [client.submit(_stuck_chunk, task, c, pure=False) for c in chunks]
         t = time.perf_counter()
-        results = _collect(client, task, chunks, futures, 2, None, distributed.wait, grace=0.5)
+        results = _collect(client, task, chunks, futures, 2, None, distributed.as_completed, grace=0.5)
         assert time.perf_counter() - t < 3
     rows = [r for rs in results for r in rs]
     assert [r["design"] for r in rows] == [0, 1]

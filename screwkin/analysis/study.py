@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import asyncio
 import contextlib
 import math
 import os
@@ -561,7 +562,7 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
     from distributed import (  # 0.4-0.9 s to import: only studies need it
         Client,
         LocalCluster,
-        wait,
+        as_completed,
     )
 
     cluster = client = None
@@ -588,7 +589,7 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
         token = uuid.uuid4().hex[:12]
         futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
                    for k, chunk in enumerate(chunks)]
-        results, futures = _collect(client, task, chunks, futures, total, progress, wait), []
+        results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
         return results, used, where
     finally:
         if client is not None:
@@ -602,7 +603,8 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
             cluster.close()
 
 
-def _collect(client, task, chunks, futures, total, progress, wait, grace: float = STALL_GRACE) -> list:
+def _collect(client, task, chunks, futures, total, progress, as_completed, grace: float = STALL_GRACE,
+             poll: float = 0.05) -> list:
     """The rows of every chunk's future, in chunk order.  A chunk whose task failed as a whole
     (its worker died) is rows with that reason.  When no chunk finishes for the longest
     chunk's designs' timeouts plus ``grace`` seconds, the chunks still running are past their
@@ -611,25 +613,29 @@ def _collect(client, task, chunks, futures, total, progress, wait, grace: float 
     index = {f.key: k for k, f in enumerate(futures)}
     results = [None] * len(chunks)
     done = failed = 0
-    stall = max(len(c) for c in chunks) * task.timeout + grace
-    pending = set(futures)
-    while pending:
-        try:
-            finished, pending = wait(list(pending), timeout=stall, return_when="FIRST_COMPLETED")
-        except TimeoutError:
-            finished = ()
-        if not finished:
+    stall = max((len(c) for c in chunks), default=1) * task.timeout + grace
+    ac = as_completed(futures)
+    last = time.perf_counter()
+    while done < total:
+        batch = [(f, None) for f in ac.next_batch(block=False)]
+        if not batch:
+            if time.perf_counter() - last <= stall:
+                time.sleep(poll)
+                continue
             reason = (f"timed out: no part of the study finished for {stall:g} s (timeout {task.timeout:g} s per "
                       "design); this design's task was cancelled unfinished")
-            client.cancel(list(pending))
-            finished, pending = [(f, reason) for f in pending], set()
-        for item in finished:
-            fut, reason = item if isinstance(item, tuple) else (item, None)
+            unfinished = [f for f in futures if results[index[f.key]] is None]
+            client.cancel(unfinished)
+            batch = [(f, reason) for f in unfinished]
+        last = time.perf_counter()
+        for fut, reason in batch:
             k = index[fut.key]
+            if results[k] is not None:
+                continue
             if reason is None:
                 try:
                     results[k] = fut.result()
-                except Exception as exc:  # noqa: BLE001 - the task failed as a whole (its worker died): rows say it
+                except (Exception, asyncio.CancelledError) as exc:  # noqa: BLE001 - the task failed as a whole
                     reason = (f"the task of designs {chunks[k][0][0]}-{chunks[k][-1][0]} failed on its worker: "
                               f"{type(exc).__name__}: {one_line(str(exc), 200)}")
             if reason is not None:
