@@ -5,16 +5,22 @@ equations from a person's estimates, iteration by iteration."""
 from __future__ import annotations
 
 import json
-import re
 
 import numpy as np
 
 from ..analysis.equations import VectorLoops, equations, newton
 from ..analysis.position import PositionSolver
 from ..errors import AssemblyError, UsageError
-from ..present.equations import Units, equations_dict, equations_text, greek, newton_dict, newton_text
+from ..present.equations import (
+    Units,
+    equations_dict,
+    equations_text,
+    greek,
+    newton_dict,
+    newton_text,
+)
 from ..present.report import position_dict, position_text, to_jsonable
-from ..units import UNITS, parse_value
+from ..units import UNITS, parse_typed_assignments
 from ._common import configuration, inputs
 
 NAME = "equations"
@@ -57,18 +63,7 @@ def run(mech, args) -> int:
 # ------------------------------------------------------------------ solve --start
 def _typed(items, option):
     """[(name, value in SI, unit typed)] from NAME=VALUE items."""
-    out = []
-    for item in items or []:
-        for part in item.split(","):
-            if not part.strip():
-                continue
-            name, sep, value = part.partition("=")
-            if not sep or not name.strip():
-                raise UsageError(f"{option} expects NAME=VALUE, got '{part.strip()[:80]}'")
-            m = re.match(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*(\S*)\s*$", value)
-            unit = m.group(1) if m else ""
-            out.append((name.strip(), parse_value(value), unit))
-    return out
+    return parse_typed_assignments(items, option)
 
 
 def _needed_joints(loops, name):
