@@ -164,13 +164,14 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     """Newton's iterations on the loop equations from the estimates ``how`` describes."""
     s = Section("newton", "Newton iterations")
     s.blocks.append(Text(how))
-    rows = [[st.iteration, ", ".join(f"{greek(n)} = {Units(True).value(n, symbols[n].kind, st.before[n])}"
+    show = Units(True, {n: ("mm", 1e-3) for n in res.unknowns if symbols[n].kind != "angle"})  # deg and mm
+    rows = [[st.iteration, ", ".join(f"{greek(n)} = {show.value(n, symbols[n].kind, st.before[n])}"
                                      for n in res.unknowns),
              f"{np.linalg.norm(st.residual):.3e}",
-             ", ".join(f"d{greek(n)} = {Units(True).step(n, symbols[n].kind, d)}" for n, d in zip(res.unknowns, st.step))]
+             ", ".join(f"d{greek(n)} = {show.step(n, symbols[n].kind, d)}" for n, d in zip(res.unknowns, st.step))]
             for st in res.steps]
     s.blocks.append(Table(["iteration", "estimates", "|F| [m]", "step"], rows, "newton"))
-    s.blocks.append(Code(newton_text(res, symbols, Units(True), path)))
+    s.blocks.append(Code(newton_text(res, symbols, show, path)))
     return s
 
 
