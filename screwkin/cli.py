@@ -29,6 +29,7 @@ from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
 from .commands import draw, grasp, synthesize
 from .commands import equations as equations_command
+from .commands import report as report_command
 from .commands import statics as statics_command
 from .commands import workspace as workspace_command
 from .commands._common import configuration, inputs
@@ -562,6 +563,7 @@ _register(grasp)
 _register(workspace_command)
 _register(equations_command)
 _register(draw)
+_register(report_command)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -84,17 +84,10 @@ def _needed_joints(loops, name):
     return out
 
 
-def solve_from_start(mech, args, values) -> int:
-    """``solve --start ...``: Newton on the loop equations from the estimates typed."""
-    if args.iterations is not None and args.iterations < 1:
-        raise UsageError("--iterations must be 1 or more")
-    if not args.start:
-        raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
-    q_ref = mech.generic_configurations()[0].q
-    loops = VectorLoops(mech, q_ref, list(values))
-    solver = PositionSolver(mech, list(values))
-    q_in = solver.set_inputs(q_ref, values)
-    typed = _typed(args.start, "--start")
+def start_estimates(mech, loops, solver, q_in, values, typed):
+    """The estimates of every unknown of the loop equations from ``--start`` items (``_typed``):
+    symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
+    returns (symbol -> estimate, symbol -> unit typed)."""
     by_link = {}
     for n in loops.variables:
         info = loops.symbol_info[n]
@@ -128,6 +121,21 @@ def solve_from_start(mech, args, values) -> int:
         raise UsageError(f"{mech.path}: --start gives no estimate of {', '.join(missing)} "
                          f"(links {', '.join(loops.symbol_info[n].link for n in missing)})")
     start = {n: symbols.get(n, start.get(n)) for n in loops.unknowns}
+    return start, units
+
+
+def solve_from_start(mech, args, values) -> int:
+    """``solve --start ...``: Newton on the loop equations from the estimates typed."""
+    if args.iterations is not None and args.iterations < 1:
+        raise UsageError("--iterations must be 1 or more")
+    if not args.start:
+        raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
+    q_ref = mech.generic_configurations()[0].q
+    loops = VectorLoops(mech, q_ref, list(values))
+    solver = PositionSolver(mech, list(values))
+    q_in = solver.set_inputs(q_ref, values)
+    typed = _typed(args.start, "--start")
+    start, units = start_estimates(mech, loops, solver, q_in, values, typed)
     input_values = loops.values(q_in)
     held = {n: input_values[n] for n in loops.input_syms}
     res = newton(loops, held, start, args.iterations)
