@@ -19,6 +19,7 @@ import warnings
 import numpy as np
 import pinocchio as pin
 
+from .analysis.ellipsoids import ellipsoids
 from .analysis.maps import singularity_map
 from .analysis.mobility import analyze_mobility
 from .analysis.planar import identify
@@ -29,6 +30,7 @@ from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
 from .commands import draw, grasp, synthesize
 from .commands import equations as equations_command
+from .commands import report as report_command
 from .commands import statics as statics_command
 from .commands import study as study_command
 from .commands import workspace as workspace_command
@@ -37,12 +39,13 @@ from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
 from .model.joint_types import JOINT_TYPES
 from .model.loader import load
+from .present.ellipsoids import ellipsoids_dict, ellipsoids_text
 from .present.plots import map_png, sweep_plot
 from .present.report import (
-    linkage_dict,
-    map_csv,
     joint_types_dict,
     joint_types_text,
+    linkage_dict,
+    map_csv,
     mobility_dict,
     mobility_text,
     position_dict,
@@ -170,6 +173,8 @@ def _parser():
     common(g)
     at_configuration(g)
     g.add_argument("--output", help="output link (for serial singularities and the output twist)")
+    g.add_argument("--ellipsoids", action="store_true",
+                   help="the output's velocity and force ellipsoids for the inputs (needs --output)")
     scaled(g)
     mp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
     common(mp)
@@ -325,12 +330,21 @@ def _screws(mech, args):
 def _singularities(mech, args):
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
+    if args.ellipsoids and not args.output:
+        raise UsageError("--ellipsoids needs --output LINK")
     q = configuration(mech, args)
     rep = classify(mech, q, output=args.output, point=args.point)
+    ell = ellipsoids(mech, q, args.output, point=args.point) if args.ellipsoids else None
     if args.json:
-        print(json.dumps(to_jsonable(singularity_dict(rep)), indent=2))
+        d = singularity_dict(rep)
+        if ell is not None:
+            d["ellipsoids"] = ellipsoids_dict(ell)
+        print(json.dumps(to_jsonable(d), indent=2))
     else:
         print(singularity_text(rep))
+        if ell is not None:
+            print()
+            print(ellipsoids_text(ell))
     return 0
 
 
@@ -568,6 +582,7 @@ _register(grasp)
 _register(workspace_command)
 _register(equations_command)
 _register(draw)
+_register(report_command)
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -61,9 +61,10 @@ def parse_value(text: str) -> float:
     return value
 
 
-def parse_assignments(items, option: str) -> dict:
-    """``["a=45deg", "b=0.1,c=2mm"]`` -> ``{"a": 0.785..., "b": 0.1, "c": 0.002}``."""
-    out = {}
+def parse_typed_assignments(items, option: str) -> list:
+    """``["a=45deg", "b=0.1,c=2mm"]`` -> ``[("a", 0.785..., "deg"), ("b", 0.1, ""), ("c", 0.002, "mm")]``:
+    each value in SI with the unit as typed (to answer in the units a person used)."""
+    out = []
     for item in items or []:
         for part in item.split(","):
             if not part.strip():
@@ -71,5 +72,11 @@ def parse_assignments(items, option: str) -> dict:
             name, sep, value = part.partition("=")
             if not sep or not name.strip():
                 raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
-            out[name.strip()] = parse_value(value)
+            m = re.match(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*(\S*)\s*$", value)
+            out.append((name.strip(), parse_value(value), m.group(1) if m else ""))
     return out
+
+
+def parse_assignments(items, option: str) -> dict:
+    """``["a=45deg", "b=0.1,c=2mm"]`` -> ``{"a": 0.785..., "b": 0.1, "c": 0.002}``."""
+    return {name: value for name, value, _ in parse_typed_assignments(items, option)}

@@ -200,6 +200,7 @@ class SingularSearch:
     found: tuple  # SingularConfiguration, by input value
     turned: bool  # the sweep passed limit positions onto the other branch
     circuit_closed: bool
+    motion: object = None  # the SweepResult followed (joint values, rates, accelerations along the range)
 
 
 def letters(k: int) -> str:
@@ -564,4 +565,4 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
     out = tuple(SingularConfiguration(s.kind, s.input, s.sigma, s.q, s.limit, output if s.kind == "serial" else None)
                 for s in found)
     return SingularSearch(input_joint, res.unit, float(start), float(stop), output, fixed, out, bool(res.limits),
-                          res.circuit_closed)
+                          res.circuit_closed, res)

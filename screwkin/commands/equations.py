@@ -5,16 +5,22 @@ equations from a person's estimates, iteration by iteration."""
 from __future__ import annotations
 
 import json
-import re
 
 import numpy as np
 
 from ..analysis.equations import VectorLoops, equations, newton
 from ..analysis.position import PositionSolver
 from ..errors import AssemblyError, UsageError
-from ..present.equations import Units, equations_dict, equations_text, greek, newton_dict, newton_text
+from ..present.equations import (
+    Units,
+    equations_dict,
+    equations_text,
+    greek,
+    newton_dict,
+    newton_text,
+)
 from ..present.report import position_dict, position_text, to_jsonable
-from ..units import UNITS, parse_value
+from ..units import UNITS, parse_typed_assignments
 from ._common import configuration, inputs
 
 NAME = "equations"
@@ -57,18 +63,7 @@ def run(mech, args) -> int:
 # ------------------------------------------------------------------ solve --start
 def _typed(items, option):
     """[(name, value in SI, unit typed)] from NAME=VALUE items."""
-    out = []
-    for item in items or []:
-        for part in item.split(","):
-            if not part.strip():
-                continue
-            name, sep, value = part.partition("=")
-            if not sep or not name.strip():
-                raise UsageError(f"{option} expects NAME=VALUE, got '{part.strip()[:80]}'")
-            m = re.match(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*(\S*)\s*$", value)
-            unit = m.group(1) if m else ""
-            out.append((name.strip(), parse_value(value), unit))
-    return out
+    return parse_typed_assignments(items, option)
 
 
 def _needed_joints(loops, name):
@@ -89,17 +84,10 @@ def _needed_joints(loops, name):
     return out
 
 
-def solve_from_start(mech, args, values) -> int:
-    """``solve --start ...``: Newton on the loop equations from the estimates typed."""
-    if args.iterations is not None and args.iterations < 1:
-        raise UsageError("--iterations must be 1 or more")
-    if not args.start:
-        raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
-    q_ref = mech.generic_configurations()[0].q
-    loops = VectorLoops(mech, q_ref, list(values))
-    solver = PositionSolver(mech, list(values))
-    q_in = solver.set_inputs(q_ref, values)
-    typed = _typed(args.start, "--start")
+def start_estimates(mech, loops, solver, q_in, values, typed):
+    """The estimates of every unknown of the loop equations from ``--start`` items (``_typed``):
+    symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
+    returns (symbol -> estimate, symbol -> unit typed)."""
     by_link = {}
     for n in loops.variables:
         info = loops.symbol_info[n]
@@ -133,6 +121,21 @@ def solve_from_start(mech, args, values) -> int:
         raise UsageError(f"{mech.path}: --start gives no estimate of {', '.join(missing)} "
                          f"(links {', '.join(loops.symbol_info[n].link for n in missing)})")
     start = {n: symbols.get(n, start.get(n)) for n in loops.unknowns}
+    return start, units
+
+
+def solve_from_start(mech, args, values) -> int:
+    """``solve --start ...``: Newton on the loop equations from the estimates typed."""
+    if args.iterations is not None and args.iterations < 1:
+        raise UsageError("--iterations must be 1 or more")
+    if not args.start:
+        raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
+    q_ref = mech.generic_configurations()[0].q
+    loops = VectorLoops(mech, q_ref, list(values))
+    solver = PositionSolver(mech, list(values))
+    q_in = solver.set_inputs(q_ref, values)
+    typed = _typed(args.start, "--start")
+    start, units = start_estimates(mech, loops, solver, q_in, values, typed)
     input_values = loops.values(q_in)
     held = {n: input_values[n] for n in loops.input_syms}
     res = newton(loops, held, start, args.iterations)

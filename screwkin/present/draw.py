@@ -20,6 +20,7 @@ import os
 import numpy as np
 
 from ..errors import UsageError
+from .plots import _pyplot
 
 __all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label"]
 
@@ -29,14 +30,7 @@ _TYPE_WORD = {"revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical
 
 
 def _plt():
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise UsageError("drawing needs matplotlib: pip install matplotlib") from None
-    return plt
+    return _pyplot("drawing")
 
 
 def value_label(name, value, unit) -> str:

@@ -20,7 +20,8 @@ from ..model.topology import Topology
 
 __all__ = ["to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
-           "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable"]
+           "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
+           "screw_theory_rows", "joint_rows"]
 
 
 def table(headers, rows) -> str:
@@ -108,10 +109,18 @@ def mobility_dict(r) -> dict:
     return d
 
 
+#: The columns of :func:`joint_rows`
+JOINT_COLUMNS = ("joint", "type", "dof", "motion", "pair (contact)", "links", "loop")
+
+
+def joint_rows(topo, limit: int = 48) -> list:
+    """One row per joint of a Topology (columns JOINT_COLUMNS); names longer than ``limit`` shortened."""
+    return [(j.name if len(j.name) <= limit else j.name[:limit - 3] + "...", j.type, j.dof, j.motion,
+             f"{j.pair} ({j.contact})", f"{j.links[0]} - {j.links[1]}", "cut" if j.cut else "") for j in topo.joints]
+
+
 def topology_text(topo, title: str) -> str:
-    rows = [(j.name if len(j.name) <= 48 else j.name[:45] + "...", j.type, j.dof, j.motion, f"{j.pair} ({j.contact})",
-             f"{j.links[0]} - {j.links[1]}", "cut" if j.cut else "") for j in topo.joints]
-    lines = [title, "", table(["joint", "type", "dof", "motion", "pair (contact)", "links", "loop"], rows), ""]
+    lines = [title, "", table(list(JOINT_COLUMNS), joint_rows(topo)), ""]
     lines.append(f"links N = {topo.n_links} (ground: {topo.ground})   joints J = {topo.n_joints}   "
                  f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}"
                  + (f"   couplings C = {len(topo.couplings)}" if topo.couplings else ""))
@@ -130,9 +139,9 @@ def topology_text(topo, title: str) -> str:
     return "\n".join(lines)
 
 
-def mobility_text(r) -> str:
-    t = r.topology
-    lines = [topology_text(t, f"Mobility of {r.path}"), ""]
+def count_rows(t) -> list:
+    """(count, formula with the numbers put in, value) for a Topology: Kutzbach, and Gruebler (both
+    ways the textbooks write it) or the spherical count where they apply."""
     c, cv = (" - C", f" - {len(t.couplings)}") if t.couplings else ("", "")
     counts = [("Kutzbach (spatial)", f"6(N-1-J) + sum f{c} = 6({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
                t.kutzbach)]
@@ -146,8 +155,12 @@ def mobility_text(r) -> str:
     if t.spherical_count is not None:
         counts.append(("spherical", f"3(N-1-J) + sum f{c} = 3({t.n_links}-1-{t.n_joints}) + {t.sum_dof}{cv}",
                        t.spherical_count))
-    lines.append(table(["count", "formula", "value"], counts))
-    lines.append("")
+    return counts
+
+
+def screw_theory_rows(r) -> list:
+    """(quantity, value) rows of the screw-theory mobility of a MobilityResult."""
+    t = r.topology
     rows = [
         ("joint coordinates", r.coordinates),
         ("constraint rows (cut joints)", r.constraint_rows),
@@ -163,6 +176,15 @@ def mobility_text(r) -> str:
     ]
     if r.output is not None:
         rows.append((f"output link '{r.output.link}' can do", r.output.label))
+    return rows
+
+
+def mobility_text(r) -> str:
+    t = r.topology
+    lines = [topology_text(t, f"Mobility of {r.path}"), ""]
+    lines.append(table(["count", "formula", "value"], count_rows(t)))
+    lines.append("")
+    rows = screw_theory_rows(r)
     lines.append(table(["screw theory", "value"], rows))
     if r.idle:
         lines.append("links in idle motions: " + ", ".join(f"{i.link} ({i.dofs})" for i in r.idle))

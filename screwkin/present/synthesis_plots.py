@@ -9,20 +9,9 @@ import math
 import numpy as np
 
 from ..analysis.synthesis.designs import MotionResult
-from ..errors import UsageError
+from .plots import _pyplot
 
 __all__ = ["burmester_png"]
-
-
-def _pyplot(option):
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        raise UsageError(f"{option} needs matplotlib: pip install matplotlib") from None
-    return plt
 
 
 def burmester_png(result: MotionResult, path: str):

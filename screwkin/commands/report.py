@@ -1,0 +1,354 @@
+"""``screwkin report FILE --html F`` (and/or ``--md F``): one document of everything screwkin
+says about a mechanism at one configuration -- topology and joint table, the counts with
+their formulas, the equations, Newton's iterations, positions, velocities and accelerations,
+the singular configurations with their drawings, the sweep plot and a view.
+
+Each section comes from the analysis the command of its own runs (info/mobility, equations,
+solve --start, solve, draw --singular, sweep --plot, view --png); one that cannot be made for
+this mechanism (no planar loops, no single input, no Chromium) says why in the document
+instead, and the rest is still written."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from importlib import metadata
+
+import numpy as np
+
+from ..analysis.equations import VectorLoops, equations, newton
+from ..analysis.mobility import analyze_mobility
+from ..analysis.planar import identify
+from ..analysis.position import PositionSolver
+from ..analysis.skeleton import default_output, kinematic_chain, singular_configurations, skeleton
+from ..errors import ScrewkinError, UsageError
+from ..present.document import (
+    Document,
+    Figure,
+    equations_section,
+    figure_bytes,
+    html,
+    markdown,
+    motion_section,
+    newton_section,
+    note_section,
+    singular_section,
+    sweep_section,
+    topology_section,
+    view_section,
+)
+from ..present.draw import draw_chain, draw_mechanism, value_label
+from ..present.equations import equations_dict, newton_dict
+from ..present.plots import sweep_figure
+from ..present.report import mobility_dict, position_dict
+from ..present.view import PICTURE, ViewerServer, build_scene, chromium, page, screenshot, show
+from ..units import parse_assignments
+from ._common import inputs
+from .draw import _kind_text, _wrapped
+from .equations import _typed, start_estimates
+
+NAME = "report"
+NEEDS_MECHANISM = True
+
+#: The default estimates of Newton's iterations: the solved unknowns, angles turned by this much ...
+START_ANGLE = np.radians(10.0)
+#: ... lengths (slider coordinates) increased by this fraction (of the characteristic length when 0)
+START_FRACTION = 0.10
+
+
+def _version() -> str:
+    """The version of screwkin installed (the package's metadata, as pip shows it)."""
+    try:
+        return metadata.version("screwkin")
+    except metadata.PackageNotFoundError:  # pragma: no cover - run from a source tree never installed
+        return "unknown (not installed)"
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser(NAME, help="one self-contained document (HTML and/or Markdown): topology, counts, equations, "
+                                   "Newton iterations, motion, singular configurations with drawings, sweep, view")
+    common(sp)
+    sp.add_argument("--html", metavar="F.html", help="write the document as one self-contained HTML page")
+    sp.add_argument("--md", metavar="F.md", help="write the document as Markdown, its pictures in F_files/ beside it")
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE", help="an input as a link's absolute angle")
+    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    sp.add_argument("--input", action="append", metavar="NAME",
+                    help="input joint (repeat or comma-separate; default: the --set joints, else the actuated ones)")
+    sp.add_argument("--sweep", metavar="NAME",
+                    help="the input moved for the singular configurations and the sweep plot (default: the only "
+                         "input; the others are held at their values)")
+    sp.add_argument("--start", action="append", metavar="NAME=VALUE,...",
+                    help="planar: the estimates Newton iterates from (as solve --start; default: the solved "
+                         "unknowns, angles +10 deg and lengths +10 %%)")
+    sp.add_argument("--iterations", type=int, metavar="K", help="exactly K Newton iterations (default: to convergence)")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 /s each)")
+    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
+    sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
+    sp.add_argument("--steps", type=int, default=360, help="steps over the input's range (default 360)")
+    sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
+
+
+def _writable(path, option):
+    if not path:
+        raise UsageError(f"{option} needs a file name")
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise UsageError(f"cannot write {path}: it is a folder")
+    if not os.path.isdir(folder):
+        raise UsageError(f"cannot write {path}: no folder {folder}")
+    if not os.access(folder, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
+        raise UsageError(f"cannot write {path}: permission denied")
+
+
+def _write(path, data: bytes):
+    try:
+        with open(path, "wb") as f:
+            f.write(data)
+    except OSError as exc:
+        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+def _input_names(mech, args, given):
+    names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
+    names = names or list(given) or list(mech.actuated)
+    for n in names:
+        mech.coordinate(n)  # a usage error when unknown
+    extra = [n for n in given if n not in names]
+    if extra:
+        raise UsageError(f"{mech.path}: --set {', '.join(extra)}: not an input ({', '.join(names)})")
+    return names
+
+
+def _attempt(notes, what, fn):
+    """fn() or None, the reason it could not be made kept in notes[what]."""
+    try:
+        return fn()
+    except ScrewkinError as exc:
+        notes[what] = str(exc)
+        return None
+
+
+def run(mech, args) -> int:
+    targets = [(p, o) for p, o in ((args.html, "--html"), (args.md, "--md")) if p is not None]
+    if not targets:
+        raise UsageError(f"{mech.path}: report writes a document: give --html F.html and/or --md F.md")
+    for path, option in targets:
+        _writable(path, option)
+    if args.steps < 4:
+        raise UsageError(f"{mech.path}: --steps must be at least 4")
+    if args.iterations is not None and args.iterations < 1:
+        raise UsageError("--iterations must be 1 or more")
+    given = inputs(mech, args)
+    names = _input_names(mech, args, given)
+    near = parse_assignments([args.near], "--near") if args.near else None
+    q0 = mech.generic_configurations()[0].q
+    if args.output:
+        mech.link_frame(args.output)
+    rates = parse_assignments(args.rate, "--rate") or {n: 1.0 for n in names}
+    accels = parse_assignments(args.accel, "--accel") or None
+    notes, data, sections = {}, {"file": str(mech.path), "screwkin": _version()}, []
+
+    # ---- the configuration: solved for the inputs (their file values when none are set)
+    pres, q = None, q0
+    values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
+    if names:
+        solver = PositionSolver(mech, names, output=args.output)
+        pres = solver.solve(values, near=near if (near or given) else mech.joint_values(q0), rates=rates,
+                            accels=accels)
+        q = pres.solutions[0].q
+        data["solve"] = position_dict(pres)
+    topo = mech.topology(q)
+    units = {n: ("rad" if not mech.translational[mech.coordinate_names.index(n)] else "m") for n in names}
+    configuration = (", ".join(value_label(n, v, units[n]) for n, v in values.items())
+                     + ("" if given else " (the file's values)")) if names else "the file's assembled configuration"
+    data["configuration"] = values
+
+    # ---- topology, counts, mobility, drawings of the configuration
+    mob = _attempt(notes, "mobility", lambda: analyze_mobility(mech, output=args.output))
+    if mob is not None:
+        data["mobility"] = mobility_dict(mob)
+    figures = []
+    skel = _attempt(notes, "skeleton", lambda: skeleton(mech, q, names))
+    if skel is not None:
+        fig = draw_mechanism(skel, title=f"{os.path.basename(str(mech.path))}: {configuration}",
+                             subtitle=None if skel.planar else f"schematic projection of a {skel.motion_space} mechanism")
+        figures.append(Figure(figure_bytes(fig), "svg", "skeleton diagram at the configuration analysed", "skeleton"))
+    chain = _attempt(notes, "chain", lambda: kinematic_chain(mech, q, names))
+    if chain is not None:
+        figures.append(Figure(figure_bytes(draw_chain(chain)), "svg", "kinematic chain: links as nodes, joints as "
+                                                                      "edges", "chain"))
+    sections.append(topology_section(topo, mob, figures))
+
+    # ---- equations
+    loops = eq = None
+    if topo.motion_space == "planar":
+        loops = _attempt(notes, "equations", lambda: VectorLoops(mech, q, names or None))
+        eq = loops.result() if loops is not None else None
+    else:
+        output = args.output or (default_output(mech, names[0], q) if names and not mech.cuts else None)
+        eq = _attempt(notes, "equations", lambda: equations(mech, q, names, output=output))
+    if eq is not None:
+        sections.append(equations_section(eq))
+        data["equations"] = equations_dict(eq)
+    else:
+        sections.append(note_section("equations", "Equations", f"no equations: {notes.get('equations')}"))
+
+    # ---- Newton from an estimate
+    sections.append(_newton(mech, args, loops, q, values, names, notes, data))
+
+    # ---- positions, velocities, accelerations
+    if pres is not None:
+        given_rates = "input rates " + ", ".join(f"{n} = {v:g}" for n, v in rates.items()) + \
+                      (" /s (default: 1 each)" if not args.rate else " /s") + \
+                      (", input accelerations as given" if accels else ", input accelerations 0")
+        sections.append(motion_section(pres, given_rates, mech.length))
+    else:
+        sections.append(note_section("motion", "Positions, velocities and accelerations",
+                                     "no input joint (none declared actuated, none given with --input or --set): "
+                                     "nothing to solve for"))
+
+    # ---- singular configurations and the sweep
+    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data)
+
+    # ---- the view
+    sections.append(_view(mech, args, q, data))
+
+    facts = [("file", str(mech.path)), ("screwkin", _version()), ("configuration", configuration),
+             ("inputs", ", ".join(names) or "none"), ("motion space", topo.motion_space)]
+    if args.output:
+        facts.append(("output", args.output))
+    data["notes"] = notes
+    doc = Document(f"screwkin report: {os.path.basename(str(mech.path))}", facts, sections, data)
+    written = []
+    if args.html:
+        _write(args.html, html(doc).encode("utf-8"))
+        written.append(args.html)
+    if args.md:
+        stem = os.path.splitext(os.path.basename(args.md))[0] or "report"
+        folder = f"{stem}_files"
+        text, files = markdown(doc, folder)
+        where = os.path.join(os.path.dirname(args.md), folder)
+        try:
+            os.makedirs(where, exist_ok=True)
+        except OSError as exc:
+            raise UsageError(f"cannot write {where}: {exc.strerror or exc}") from None
+        for name, blob in files.items():
+            _write(os.path.join(where, name), blob)
+        _write(args.md, text.encode("utf-8"))
+        written.append(args.md)
+    if args.json:
+        print(json.dumps({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],
+                          "omitted": notes}, indent=2))
+    else:
+        for path in written:
+            print(f"wrote {path}")
+        for what, why in notes.items():
+            print(f"note: {what}: {why}")
+    return 0
+
+
+def _newton(mech, args, loops, q, values, names, notes, data):
+    title = "Newton iterations"
+    if loops is None:
+        why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
+                                         "vector-loop equations only (solve --trace shows the closure solver's)"
+        return note_section("newton", title, why)
+    solved = loops.values(q)
+    if args.start:
+        typed = _typed(args.start, "--start")
+        solver = PositionSolver(mech, names)
+        start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), values, typed)
+        how = "from the estimates given with --start: " + ", ".join(f"{n}={v}" for n, v, _ in typed)
+    else:
+        start = {}
+        for n in loops.unknowns:
+            v = solved[n]
+            if loops.symbol_info[n].kind == "angle":
+                start[n] = v + START_ANGLE
+            else:
+                start[n] = v + START_FRACTION * (abs(v) if abs(v) > 1e-9 * mech.length else mech.length)
+        how = (f"from a default estimate: the solved unknowns, each angle +{np.degrees(START_ANGLE):g} deg and each "
+               f"length +{100 * START_FRACTION:g} % (of L = {mech.length:.4g} m when 0); give --start NAME=VALUE,... "
+               "for other estimates")
+    held = {n: solved[n] for n in loops.input_syms}
+    res = newton(loops, held, start, args.iterations)
+    far = [n for n in loops.unknowns
+           if abs(np.angle(np.exp(1j * (res.values[n] - solved[n]))) if loops.symbol_info[n].kind == "angle"
+                  else res.values[n] - solved[n]) > 1e-6 * max(mech.length, 1.0)]
+    how += (f". {len(res.steps)} iteration(s) to |F| = {res.residual:.3g} m"
+            + ("; the values reached are the solved configuration's" if res.closes and not far else
+               f"; the values reached differ from the solved configuration's ({', '.join(far)}: another "
+               "assembly mode)" if res.closes else "; the loops are not closed by the last estimates"))
+    data["newton"] = newton_dict(res)
+    return newton_section(res, loops.symbol_info, how, str(mech.path))
+
+
+def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
+    conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
+    moved = args.sweep or (names[0] if len(names) == 1 else None)
+    if moved is None:
+        why = ("no input joint: nothing to move" if not names else
+               f"{len(names)} inputs ({', '.join(names)}): give --sweep NAME to move one of them, the others held")
+        return [note_section("singular", "Singular configurations", f"not located: {why}"),
+                note_section("sweep", "Sweep of the input", f"no sweep: {why}")]
+    search = _attempt(notes, "singular configurations", lambda: singular_configurations(
+        mech, moved, output=args.output, q=q, steps=args.steps,
+        fixed={k: v for k, v in given.items() if k != moved}, near=mech.joint_values(q)))
+    if search is None:
+        why = notes["singular configurations"]
+        return [note_section("singular", "Singular configurations", f"not located: {why}"),
+                note_section("sweep", "Sweep of the input", f"no sweep: {why}")]
+    figures, descriptions, found = [], [], []
+    base = os.path.basename(str(mech.path))
+    for k, s in enumerate(search.found, 1):
+        at = value_label(search.input, _wrapped(s.input, search.unit), search.unit)
+        what = _kind_text(s)
+        skel = skeleton(mech, s.q, [search.input, *search.fixed])
+        fig = draw_mechanism(skel, title=f"{base}: singular configuration {k} of {len(search.found)} at {at}",
+                             subtitle=what)
+        figures.append(Figure(figure_bytes(fig), "svg", f"singular configuration {k}: {what} at {at}", "singular"))
+        descriptions.append(what)
+        found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input, "sigma": s.sigma,
+                      "description": what})
+    data["singular_configurations"] = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
+                                       "output": search.output, "found": found}
+    out = [singular_section(search, figures, descriptions, conditions)]
+    res = search.motion
+    mus = None
+    info = identify(mech, mech.topology(q), q, moved)
+    if info is not None:
+        mus = [identify(mech, mech.topology(x), x, moved).transmission_angle for x in res.q]
+    fig = sweep_figure(res, mus, singularities=search.found, linear=mech.translational,
+                       title=f"{base}: {moved} over its range")
+    out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"joint values, rates and accelerations "
+                                                                      f"against {moved}", "sweep")))
+    data["sweep"] = {"input": moved, "steps": len(res.values) - 1, "values": res.values, "names": list(res.names),
+                     "joints": res.joints}
+    return out
+
+
+def _view(mech, args, q, data):
+    if args.no_view:
+        return view_section(None, "the view is left out (--no-view)")
+    if chromium() is None:
+        data["view"] = False
+        return view_section(None, "no view: headless Chromium is not installed (Debian: apt-get install chromium); "
+                                  "screwkin view FILE shows the mechanism in meshcat")
+    try:
+        scene = build_scene(mech, q, output=args.output)
+        with ViewerServer() as server, tempfile.TemporaryDirectory() as d:
+            show(mech, scene, server.viewer, q)
+            path, png = os.path.join(d, "scene.html"), os.path.join(d, "scene.png")
+            with open(path, "w") as f:
+                f.write(page(server.viewer.static_html(), scene, os.path.basename(str(mech.path)), controls=False,
+                             size=PICTURE))
+            screenshot(path, png)
+            with open(png, "rb") as f:
+                blob = f.read()
+    except (ScrewkinError, OSError, RuntimeError) as exc:  # the view is an extra: the document goes on without it
+        data["view"] = False
+        return view_section(None, f"no view: {exc}")
+    data["view"] = True
+    return view_section(blob)
