@@ -34,7 +34,7 @@ from .commands import report as report_command
 from .commands import statics as statics_command
 from .commands import study as study_command
 from .commands import workspace as workspace_command
-from .commands._common import configuration, inputs
+from .commands._common import add_angle_option, add_configuration_options, configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
 from .model.joint_types import JOINT_TYPES
@@ -119,15 +119,7 @@ def _parser():
                         help="folder holding ROS packages (or a package) for package:// meshes, searched before "
                              "ROS_PACKAGE_PATH; repeatable")
 
-    def at_configuration(sp):
-        sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
-        angles(sp)
-        sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
-
-    def angles(sp):
-        sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE",
-                        help="planar mechanisms: an input given as the absolute angle of a link pinned to the "
-                             "ground, from the ground's x axis (e.g. crank=45deg)")
+    at_configuration, angles = add_configuration_options, add_angle_option
 
     def scaled(sp, point=True):
         sp.add_argument("--length", help="characteristic length that makes the measures dimensionless "

@@ -7,7 +7,21 @@ from ..analysis.position import PositionSolver
 from ..errors import UsageError
 from ..units import parse_assignments
 
-__all__ = ["inputs", "configuration"]
+__all__ = ["inputs", "configuration", "add_configuration_options", "add_angle_option"]
+
+
+def add_angle_option(sp):
+    """--set-angle: an input as a link's absolute angle (planar mechanisms)."""
+    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE",
+                    help="planar mechanisms: an input given as the absolute angle of a link pinned to the "
+                         "ground, from the ground's x axis (e.g. crank=45deg)")
+
+
+def add_configuration_options(sp):
+    """--set, --set-angle and --near: the configuration a command analyses (see configuration)."""
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
+    add_angle_option(sp)
+    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
 
 
 def inputs(mech, args) -> dict:

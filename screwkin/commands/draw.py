@@ -20,7 +20,7 @@ from ..present.draw import (
     value_label,
 )
 from ..present.report import to_jsonable
-from ._common import configuration, inputs
+from ._common import add_configuration_options, configuration, inputs
 
 NAME = "draw"
 NEEDS_MECHANISM = True
@@ -35,9 +35,7 @@ _KIND = {
 def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
     common(sp)
-    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
-    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE", help="an input as a link's absolute angle")
-    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    add_configuration_options(sp)
     sp.add_argument("--png", metavar="F.png", help="write the drawing as PNG")
     sp.add_argument("--svg", metavar="F.svg", help="write the drawing as SVG")
     sp.add_argument("--angles", action="store_true", help="annotate the absolute link angles (planar mechanisms)")

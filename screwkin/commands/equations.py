@@ -21,7 +21,7 @@ from ..present.equations import (
 )
 from ..present.report import position_dict, position_text, to_jsonable
 from ..units import UNITS, parse_typed_assignments
-from ._common import configuration, inputs
+from ._common import add_configuration_options, configuration, inputs
 
 NAME = "equations"
 NEEDS_MECHANISM = True
@@ -36,9 +36,7 @@ def add_parser(sub, common, scaled):
     common(sp)
     sp.add_argument("--input", action="append", metavar="NAME",
                     help="input joint (repeat or comma-separate; default: the --set joints, else the actuated ones)")
-    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
-    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE", help="an input as a link's absolute angle")
-    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    add_configuration_options(sp)
     sp.add_argument("--output", help="spatial mechanisms: also the chain to this link")
 
 

@@ -44,7 +44,7 @@ from ..present.plots import sweep_figure
 from ..present.report import mobility_dict, position_dict
 from ..present.view import PICTURE, ViewerServer, build_scene, chromium, page, screenshot, show
 from ..units import parse_assignments
-from ._common import inputs
+from ._common import add_configuration_options, inputs
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
 
@@ -71,9 +71,7 @@ def add_parser(sub, common, scaled):
     common(sp)
     sp.add_argument("--html", metavar="F.html", help="write the document as one self-contained HTML page")
     sp.add_argument("--md", metavar="F.md", help="write the document as Markdown, its pictures in F_files/ beside it")
-    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
-    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE", help="an input as a link's absolute angle")
-    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    add_configuration_options(sp)
     sp.add_argument("--input", action="append", metavar="NAME",
                     help="input joint (repeat or comma-separate; default: the --set joints, else the actuated ones)")
     sp.add_argument("--sweep", metavar="NAME",

@@ -10,7 +10,7 @@ from ..errors import UsageError
 from ..present.report import to_jsonable
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
-from ._common import configuration
+from ._common import add_configuration_options, configuration
 
 NAME = "statics"
 NEEDS_MECHANISM = True
@@ -19,9 +19,7 @@ NEEDS_MECHANISM = True
 def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="actuator efforts and joint reactions holding a load; legs' wrenches")
     common(sp)
-    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
-    sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE", help="an input as a link's absolute angle")
-    sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    add_configuration_options(sp)
     sp.add_argument("--output", help="the link the wrench is applied to (at its frame's origin, world axes)")
     sp.add_argument("--wrench", help='"fx fy fz mx my mz": force [N] and moment [N m]')
     sp.add_argument("--gravity", action="store_true", help="also the links' weights (from the file's inertials)")
