@@ -1,3 +1,7 @@
+import contextlib
+import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -69,3 +73,40 @@ def planar_3r(l1=0.3, l2=0.25, l3=0.1):
     body = "".join(LINK.format(n=n) for n in ("base", "l1", "l2", "l3"))
     body += rev("j1", "base", "l1") + rev("j2", "l1", "l2", xyz=f"{l1} 0 0") + rev("j3", "l2", "l3", xyz=f"{l2} 0 0")
     return f'<robot name="planar_3r">{body}</robot>'
+
+
+def circles(p, r, c, s):
+    """Both intersections of circle (p, r) and circle (c, s) in the plane."""
+    d = np.linalg.norm(c - p)
+    along = (r * r - s * s + d * d) / (2 * d)
+    h = np.sqrt(r * r - along * along)
+    u = (c - p) / d
+    n = np.array([-u[1], u[0]])
+    return [p + along * u + h * n, p + along * u - h * n]
+
+
+def screwkin_cli(*args, timeout=300):
+    """``python -m screwkin ARGS`` in a process of its own: (returncode, stdout, stderr) as run."""
+    return subprocess.run([sys.executable, "-m", "screwkin", *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@contextlib.contextmanager
+def no_hang(seconds):
+    """Fail the test (TimeoutError) if the block runs past ``seconds``: a guard against a hang or
+    a blow-up (a work bound that does not hold), not a speed measurement -- speed is measured in
+    benchmarks/.  Where SIGALRM is missing the block simply runs."""
+    if not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def fire(signum, frame):
+        raise TimeoutError(f"still running after {seconds} s: a hang or an unbounded computation")
+
+    previous = signal.signal(signal.SIGALRM, fire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)

@@ -11,14 +11,14 @@ import json
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import DATA, circles
 from scipy.optimize import brentq
 
 import screwkin
-from conftest import DATA
-from screwkin.cli import main
 from screwkin.analysis.position import PositionSolver
 from screwkin.analysis.singular import classify
 from screwkin.analysis.sweep import sweep
+from screwkin.cli import main
 
 STUDENT = DATA / "student"
 IN = 0.0254
@@ -31,16 +31,6 @@ def load(name):
 def run_json(capsys, argv):
     assert main(argv + ["--json"]) == 0
     return json.loads(capsys.readouterr().out)
-
-
-def circles(p, r, c, s):
-    """Both intersections of circle (p, r) and circle (c, s) in the plane."""
-    d = np.linalg.norm(c - p)
-    along = (r * r - s * s + d * d) / (2 * d)
-    h = np.sqrt(r * r - along * along)
-    u = (c - p) / d
-    n = np.array([-u[1], u[0]])
-    return [p + along * u + h * n, p + along * u - h * n]
 
 
 def fmt(values):

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import fourbar
+from conftest import fourbar, no_hang
 from screwkin.cli import main
 
 GOOD = fourbar()
@@ -389,15 +389,12 @@ def _json(capsys, argv):
 
 
 def test_hundred_duplicate_loop_joints_do_not_hang(tmp_path, capsys):
-    import time
-
     loop = '<loop_joint name="D{k}" type="revolute"><link1 link="coupler" xyz="0.12 0 0"/>' \
            '<link2 link="rocker" xyz="0.08 0 0"/><axis xyz="0 0 1"/></loop_joint>'
     path = write(tmp_path, fourbar(extra="".join(loop.format(k=k) for k in range(100))))
-    t = time.perf_counter()
-    out = json.loads(_json(capsys, ["mobility", path, "--json"]))
+    with no_hang(120):
+        out = json.loads(_json(capsys, ["mobility", path, "--json"]))
     assert out["mobility"] == 1
-    assert time.perf_counter() - t < 60
     path = write(tmp_path, fourbar(extra="".join(loop.format(k=k) for k in range(250))), "many.urdf")
     check(capsys, ["mobility", path], 1, "251 loop joints", "at most 200", path=path)
 

@@ -2,11 +2,10 @@
 checked on a planar 2R arm against the singular values of its closed-form Jacobian."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from conftest import ROBOTS, screwkin_cli
 
 ARM = """<robot name="arm2r">
   <link name="base"/><link name="upper"/><link name="fore"/><link name="hand"/>
@@ -18,15 +17,11 @@ ARM = """<robot name="arm2r">
 </robot>"""
 
 
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "screwkin", *args], capture_output=True, text=True, timeout=120)
-
-
 def test_planar_2r_point_ellipsoid_against_closed_form(tmp_path):
     path = tmp_path / "arm.urdf"
     path.write_text(ARM)
     t1, t2 = 0.3, 1.1
-    out = run("singularities", str(path), "--set", f"shoulder={t1}", "--set", f"elbow={t2}", "--output", "hand",
+    out = screwkin_cli("singularities", str(path), "--set", f"shoulder={t1}", "--set", f"elbow={t2}", "--output", "hand",
               "--point", "--ellipsoids", "--length", "0.5", "--json")
     assert out.returncode == 0, out.stderr
     e = json.loads(out.stdout)["ellipsoids"]
@@ -39,14 +34,11 @@ def test_planar_2r_point_ellipsoid_against_closed_form(tmp_path):
     finite = [f for f in e["force_semi_axes"] if f is not None]
     assert np.allclose(sorted(finite), sorted(1 / s), rtol=1e-9)
     assert e["isotropy"] == pytest.approx(0.0)  # the z direction is not reached: rank 2 of 3
-    text = run("singularities", str(path), "--set", f"shoulder={t1}", "--set", f"elbow={t2}", "--output", "hand",
+    text = screwkin_cli("singularities", str(path), "--set", f"shoulder={t1}", "--set", f"elbow={t2}", "--output", "hand",
                "--point", "--ellipsoids", "--length", "0.5")
     assert "velocity and force ellipsoids" in text.stdout and "inf" in text.stdout
 
 
 def test_ellipsoids_need_an_output():
-    from pathlib import Path
-
-    robots = Path(__file__).resolve().parents[1] / "robots"
-    out = run("singularities", str(robots / "gough_stewart_6ups.urdf"), "--ellipsoids")
+    out = screwkin_cli("singularities", str(ROBOTS / "gough_stewart_6ups.urdf"), "--ellipsoids")
     assert out.returncode == 2 and "--output" in out.stderr and len(out.stderr.strip().splitlines()) == 1

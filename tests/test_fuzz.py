@@ -30,10 +30,10 @@ import xml.etree.ElementTree as ET
 
 import pytest
 import yaml
+from conftest import CORPUS, DATA, ROBOTS
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import CORPUS, DATA, ROBOTS
 from screwkin.cli import main
 from screwkin.units import UNITS
 
@@ -301,20 +301,8 @@ def _text_op(data: bytes, rng):
     return data.replace(b"</robot>", b"<x>" * depth + b"</x>" * depth + b"</robot>"), f"{depth} nested elements"
 
 
-#: SDF bases: the four-bar of tests/data and an RSSR with ball joints (one in the tree, one cut).
-RSSR_SDF = """<sdf version="1.7"><model name="rssr">
-  <link name="base"><pose>0 0 0 0 0 0</pose><visual name="v"/></link>
-  <link name="crank"><pose>0 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
-  <link name="rod"><pose>0.05 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
-  <link name="rocker"><pose>0.2 0.1 0.1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
-  <joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>
-  <joint name="in" type="revolute"><parent>base</parent><child>crank</child><axis><xyz>0 0 1</xyz></axis></joint>
-  <joint name="s1" type="ball"><parent>crank</parent><child>rod</child></joint>
-  <joint name="out" type="revolute"><parent>base</parent><child>rocker</child><axis><xyz>1 0 0</xyz></axis></joint>
-  <joint name="s2" type="ball"><parent>rod</parent><child>rocker</child><pose>0 -0.05 0.05 0 0 0</pose></joint>
-</model></sdf>"""
-SDF_BASES = {"fourbar.sdf": (DATA / "fourbar.sdf").read_text(), "rssr.sdf": RSSR_SDF}
-
+#: SDF bases in tests/data: the four-bar and an RSSR with ball joints (one in the tree, one cut).
+SDF_BASES = {name: (DATA / name).read_text() for name in ("fourbar.sdf", "rssr.sdf")}
 
 def _mutate(text: str, rng, ops):
     root = ET.fromstring(text)

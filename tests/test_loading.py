@@ -4,9 +4,9 @@ import json
 import shutil
 
 import pytest
+from conftest import CORPUS, DATA, fourbar
 
 import screwkin
-from conftest import CORPUS, DATA, fourbar
 from screwkin.cli import main
 
 
@@ -69,23 +69,10 @@ def test_sdf_four_bar_is_cut_into_tree_plus_loop_joint():
     assert r.classification.startswith("constrained")
 
 
-def test_sdf_ball_joints_become_compound_spherical(tmp_path):
+def test_sdf_ball_joints_become_compound_spherical():
     """RSSR in SDF with two ball joints: the tree ball becomes three revolutes
     through massless links, recognized again as one spherical joint."""
-    sdf = """<sdf version="1.7"><model name="rssr">
-      <link name="base"><pose>0 0 0 0 0 0</pose><visual name="v"/></link>
-      <link name="crank"><pose>0 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
-      <link name="rod"><pose>0.05 0 0 0 0 0</pose><inertial><mass>1</mass></inertial></link>
-      <link name="rocker"><pose>0.2 0.1 0.1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
-      <joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>
-      <joint name="in" type="revolute"><parent>base</parent><child>crank</child><axis><xyz>0 0 1</xyz></axis></joint>
-      <joint name="s1" type="ball"><parent>crank</parent><child>rod</child></joint>
-      <joint name="out" type="revolute"><parent>base</parent><child>rocker</child><axis><xyz>1 0 0</xyz></axis></joint>
-      <joint name="s2" type="ball"><parent>rod</parent><child>rocker</child><pose>0 -0.05 0.05 0 0 0</pose></joint>
-    </model></sdf>"""
-    p = tmp_path / "rssr.sdf"
-    p.write_text(sdf)
-    r = screwkin.load(p).mobility()
+    r = screwkin.load(DATA / "rssr.sdf").mobility()  # (also a base of the SDF fuzz test)
     t = r.topology
     assert sorted(j.type for j in t.joints) == ["revolute", "revolute", "spherical", "spherical"]
     assert (t.n_links, t.n_joints, t.kutzbach) == (4, 4, 2)

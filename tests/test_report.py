@@ -9,7 +9,6 @@ import json
 import re
 import subprocess
 import tempfile
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import circles
 
 import screwkin
 from screwkin.analysis.synthesis.check import check_design
@@ -26,16 +27,6 @@ B0 = np.array([0.09, 0.02])
 CRANK, COUPLER, ROCKER = 0.035, 0.11, 0.075
 FRAME = np.array([0.04, 0.025])  # the guided frame's origin in the coupler (origin A, x along AB)
 TURN = math.radians(15.0)  # and its x axis, turned from AB
-
-
-def circles(p, r, c, s):
-    """Both intersections of circle (p, r) and circle (c, s) in the plane."""
-    d = np.linalg.norm(c - p)
-    along = (r * r - s * s + d * d) / (2 * d)
-    h = np.sqrt(r * r - along * along)
-    u = (c - p) / d
-    n = np.array([-u[1], u[0]])
-    return [p + along * u + h * n, p + along * u - h * n]
 
 
 def rot(t):

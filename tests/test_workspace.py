@@ -10,21 +10,17 @@ Also the batched closure rows against ClosureSystem's, the IK of a geared mechan
 CLI's outputs and one-line errors."""
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import ROBOTS, screwkin_cli
 
 import screwkin
 from screwkin.analysis.batch import BatchClosure
 from screwkin.analysis.position import inverse_kinematics
 from screwkin.analysis.workspace import workspace
 from screwkin.errors import UsageError
-
-ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 
 
 def lens(r1, r2, d):
@@ -36,10 +32,6 @@ def lens(r1, r2, d):
     a1 = r1 * r1 * np.arccos((d * d + r1 * r1 - r2 * r2) / (2 * d * r1))
     a2 = r2 * r2 * np.arccos((d * d + r2 * r2 - r1 * r1) / (2 * d * r2))
     return a1 + a2 - 0.5 * np.sqrt((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2))
-
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "screwkin", *args], capture_output=True, text=True, timeout=300)
 
 
 # ---------------------------------------------------------------------------------- five-bar
@@ -215,7 +207,7 @@ def test_inverse_kinematics_keeps_the_gear_mesh():
         for s in res.solutions:
             assert s.joints["rack_joint"] == pytest.approx(dx, abs=1e-9)
             assert s.joints["pinion_joint"] == pytest.approx(-dx / 0.04, abs=1e-7)
-    out = run("ik", str(ROBOTS / "rack_pinion.urdf"), "--output", "rack", "--pose", "-0.14 0.04 0 0 0 0", "--json")
+    out = screwkin_cli("ik", str(ROBOTS / "rack_pinion.urdf"), "--output", "rack", "--pose", "-0.14 0.04 0 0 0 0", "--json")
     assert out.returncode == 0, out.stderr
     joints = json.loads(out.stdout)["solutions"][0]["joints"]
     assert joints["pinion_joint"] == pytest.approx(-joints["rack_joint"] / 0.04, abs=1e-7)
@@ -224,7 +216,7 @@ def test_inverse_kinematics_keeps_the_gear_mesh():
 # ------------------------------------------------------------------------------------------ CLI
 def test_cli_json_png_csv(tmp_path):
     png, csv = tmp_path / "w.png", tmp_path / "w.csv"
-    out = run("workspace", str(ROBOTS / "five_bar.urdf"), "--output", "tip", "--point", "--resolution", "1cm",
+    out = screwkin_cli("workspace", str(ROBOTS / "five_bar.urdf"), "--output", "tip", "--point", "--resolution", "1cm",
               "--json", "--png", str(png), "--csv", str(csv))
     assert out.returncode == 0, out.stderr
     d = json.loads(out.stdout)
@@ -248,12 +240,12 @@ def test_cli_json_png_csv(tmp_path):
     (["--output", "tip", "--samples", "0"], 2, "samples"),
 ])
 def test_cli_errors_are_one_line(args, code, words):
-    out = run("workspace", str(ROBOTS / "five_bar.urdf"), *args)
+    out = screwkin_cli("workspace", str(ROBOTS / "five_bar.urdf"), *args)
     assert out.returncode == code, out.stderr
     assert len(out.stderr.strip().splitlines()) == 1 and "Traceback" not in out.stderr
     assert words in out.stderr
 
 
 def test_one_dof_mechanism_is_told_to_sweep():
-    out = run("workspace", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--output", "coupler", "--point")
+    out = screwkin_cli("workspace", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--output", "coupler", "--point")
     assert out.returncode == 2 and "sweep" in out.stderr

@@ -5,11 +5,10 @@ outside the folder, or a hang."""
 
 import json
 import math
-import time
 
 import numpy as np
 import pytest
-from conftest import ROBOTS
+from conftest import ROBOTS, no_hang
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -144,13 +143,12 @@ def test_hostile_expressions_are_refused(expr):
 @pytest.mark.parametrize("expr", ["9 ** 9 ** 9", "10 ** 400", "'a' * 1000000000", "'%999999999s' % 1",
                                   "exp(1000)", "2 ** 64 ** 2", "pow(10, 10 ** 10)"])
 def test_expensive_expressions_fail_fast(expr):
-    t = time.perf_counter()
-    try:
-        v = evaluate(expr, {})
-        assert not isinstance(v, int) or abs(v) <= 2**63  # a float (inf), never a huge integer
-    except XacroEvaluationError:
-        pass
-    assert time.perf_counter() - t < 0.5
+    with no_hang(10):  # refused before it is computed: 9 ** 9 ** 9 would run for hours
+        try:
+            v = evaluate(expr, {})
+            assert not isinstance(v, int) or abs(v) <= 2**63  # a float (inf), never a huge integer
+        except XacroEvaluationError:
+            pass
 
 
 @given(st.text(max_size=200))
@@ -241,9 +239,8 @@ def test_macro_bomb_and_recursion_are_bounded(tmp_path, capsys):
     for name, (extra, word) in cases.items():
         path = tmp_path / "self.urdf.xacro"
         path.write_text(fourbar_with(body_extra=extra))
-        t = time.perf_counter()
-        assert main(["info", str(path)]) == 1, name
-        assert time.perf_counter() - t < 10
+        with no_hang(60):  # 2**30 macro copies if unbounded
+            assert main(["info", str(path)]) == 1, name
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and word in err, (name, err)
 
