@@ -34,6 +34,7 @@ from .commands import report as report_command
 from .commands import statics as statics_command
 from .commands import study as study_command
 from .commands import workspace as workspace_command
+from .commands._options import BOUNDS, check_parsed, count
 from .commands._common import add_angle_option, add_configuration_options, configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
@@ -67,7 +68,7 @@ from .present.report import (
     value_text,
 )
 from .present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
-from .units import parse_assignments, parse_value
+from .units import parse_assignments, parse_length, parse_value
 
 __all__ = ["main"]
 
@@ -87,6 +88,15 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
 
         self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
+
+    def parse_known_args(self, args=None, namespace=None):
+        # every (sub)parser checks its own options: no empty values, outputs writable (commands/_options.py)
+        ns, rest = super().parse_known_args(args, namespace)
+        try:
+            check_parsed(self, ns)
+        except UsageError as exc:
+            self.error(str(exc))
+        return ns, rest
 
 
 def _names(text):
@@ -149,11 +159,11 @@ def _parser():
     s.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input joint rate [1/s] (units as --set)")
     s.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
-    s.add_argument("--starts", type=int, default=24, help="random starting configurations (default 24)")
+    s.add_argument("--starts", type=count("starts"), default=24, help="random starting configurations (default 24)")
     s.add_argument("--start", action="append", metavar="NAME=VALUE,...",
                    help="planar: Newton on the vector-loop equations (screwkin equations) from these estimates of "
                         "the unknowns: symbols (theta3, x4), link names (their angles) or passive joint values")
-    s.add_argument("--iterations", type=int, metavar="K",
+    s.add_argument("--iterations", type=count("iterations"), metavar="K",
                    help="with --start: exactly K Newton iterations, each printed (residual, Jacobian, step, "
                         "estimates); without it Newton goes on to convergence")
     scaled(s, point=False)
@@ -180,12 +190,12 @@ def _parser():
     sc = sub.add_parser("scan", help="singularity scan of a serial chain over random configurations")
     common(sc)
     sc.add_argument("--output", required=True, help="the chain's last link (e.g. the flange)")
-    sc.add_argument("--samples", type=int, default=100000, help="random configurations (default 100000)")
-    sc.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    sc.add_argument("--samples", type=count("samples"), default=100000, help="random configurations (default 100000)")
+    sc.add_argument("--seed", type=count("seed"), default=0, help="random seed (default 0)")
     sc.add_argument("--measure", choices=["sigma_ratio", "det"], default="sigma_ratio",
                     help="smallest / largest singular value (default) or the determinant (6 joints)")
     scaled(sc)
-    sc.add_argument("--threads", type=int, help="threads (default: the machine's cores)")
+    sc.add_argument("--threads", type=count("threads"), help="threads (default: the machine's cores)")
     sc.add_argument("--csv", help="write every sample (joint values and the measure) to this CSV file")
     v = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
     common(v)
@@ -199,7 +209,7 @@ def _parser():
     common(k)
     k.add_argument("--output", required=True, help="the link to place")
     k.add_argument("--pose", required=True, help='"x y z roll pitch yaw" (m and rad; units allowed, e.g. 30deg)')
-    k.add_argument("--starts", type=int, default=16, help="random starting configurations (default 16)")
+    k.add_argument("--starts", type=count("starts"), default=16, help="random starting configurations (default 16)")
     k.add_argument("--all", action="store_true",
                    help="show every assembly mode, also those the mechanism cannot reach by moving")
     w = sub.add_parser("sweep", help="track one assembly mode along an input motion")
@@ -207,7 +217,7 @@ def _parser():
     w.add_argument("--input", required=True, help="the input joint to move")
     w.add_argument("--from", dest="start", required=True, help="first input value (SI or with a unit)")
     w.add_argument("--to", dest="stop", required=True, help="last input value")
-    w.add_argument("--steps", type=int, default=100, help="number of steps (default 100)")
+    w.add_argument("--steps", type=count("steps"), default=100, help="number of steps (default 100, at most 100,000)")
     w.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     w.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     w.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
@@ -241,7 +251,9 @@ def _run(args):
     mech = load(args.file, yaml=args.yaml, actuated=_names(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs, args=parse_xacro_args(args.xacro_args))
     if getattr(args, "length", None):
-        mech.length = parse_value(args.length)
+        mech.length = parse_length(args.length, "--length")
+    if isinstance(getattr(args, "output", None), str):  # every command's output link exists (sweep, draw...)
+        mech.link_frame(args.output)
     if args.command == "info":
         try:
             q = mech.assemble().q
@@ -346,11 +358,9 @@ def _range(text, option):
     if not sep or len(parts) != 3:
         raise UsageError(f"{option} expects NAME=A:B:N, got '{text}'")
     try:
-        n = int(parts[2])
-    except ValueError:
-        raise UsageError(f"{option}: N must be a whole number, got '{parts[2]}'") from None
-    if n < 2:
-        raise UsageError(f"{option}: N must be at least 2")
+        n = count("grid")(parts[2])
+    except argparse.ArgumentTypeError as exc:
+        raise UsageError(f"{option}: N {exc}") from None
 
     return name.strip(), np.linspace(parse_value(parts[0]), parse_value(parts[1]), n)
 
@@ -358,6 +368,9 @@ def _range(text, option):
 def _map(mech, args):
     xn, xs = _range(args.x, "--x")
     yn, ys = _range(args.y, "--y")
+    if xs.size * ys.size > BOUNDS["grid_total"][1]:
+        raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
+                         f"at most {BOUNDS['grid_total'][1]:,}")
     fixed = parse_assignments(args.set, "--set")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
     if args.point and not args.output:

@@ -24,7 +24,7 @@ import re
 
 from .errors import UsageError, quote
 
-__all__ = ["parse_value", "parse_assignments", "UNITS"]
+__all__ = ["parse_value", "parse_length", "parse_assignments", "UNITS", "unit_kind", "LENGTH_RANGE"]
 
 _DEG = math.pi / 180.0
 UNITS = {
@@ -36,6 +36,19 @@ UNITS = {
     "in": 0.0254, "inch": 0.0254, "inches": 0.0254,
     "ft": 0.3048, "foot": 0.3048, "feet": 0.3048,
 }
+_ANGLES = {"rad", "radian", "radians", "mrad", "deg", "degree", "degrees", "°", "turn", "turns"}
+#: The smallest and largest characteristic length, grid step or other mechanism length a person may type [m]:
+#: below a nanometre the measures divided by it overflow; no mechanism is 10 km long.
+LENGTH_RANGE = (1e-9, 1e4)
+
+
+def unit_kind(unit: str):
+    """'angle', 'length', or None for a bare number (SI of whatever is asked)."""
+    if not unit:
+        return None
+    return "angle" if (unit if unit in UNITS else unit.lower()) in _ANGLES else "length"
+
+
 _NUMBER = re.compile(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*\Z")
 
 
@@ -46,8 +59,10 @@ def _unit(text: str):
     return UNITS.get(text.lower()) if text.isascii() else None
 
 
-def parse_value(text: str) -> float:
-    """A number with an optional unit suffix, in SI units."""
+def parse_value(text: str, kind: str | None = None, option: str | None = None) -> float:
+    """A number with an optional unit suffix, in SI units.  With ``kind`` ('angle' or
+    'length'), a unit of the other kind is a usage error naming ``option``
+    (``--length 90deg`` is not 1.571 m)."""
     m = _NUMBER.match(text)
     if not m:
         raise UsageError(f"{quote(text)} is not a number with an optional unit (e.g. 45deg, 30mm, 1in, 0.5)")
@@ -58,6 +73,20 @@ def parse_value(text: str) -> float:
     value = float(m.group(1)) * factor
     if not math.isfinite(value):
         raise UsageError(f"{quote(text)} is not a finite number")
+    found = unit_kind(m.group(2))
+    if kind is not None and found is not None and found != kind:
+        where = f"{option} " if option else ""
+        raise UsageError(f"{where}{quote(text)}: {m.group(2)} is a unit of {found}, {where.strip() or 'this value'} "
+                         f"takes a {kind}")
+    return value
+
+
+def parse_length(text: str, option: str) -> float:
+    """A length a person types (``30mm``, ``0.1``), positive and within :data:`LENGTH_RANGE`."""
+    value = parse_value(text, "length", option)
+    lo, hi = LENGTH_RANGE
+    if not lo <= value <= hi:
+        raise UsageError(f"{option} {quote(text)}: give a length from {lo:g} m to {hi:g} m")
     return value
 
 

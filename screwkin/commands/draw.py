@@ -21,6 +21,7 @@ from ..present.draw import (
 )
 from ..present.report import to_jsonable
 from ._common import add_configuration_options, configuration, inputs
+from ._options import count
 
 NAME = "draw"
 NEEDS_MECHANISM = True
@@ -45,7 +46,8 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--input", help="--singular: the input joint moved (default: the first actuated joint)")
     sp.add_argument("--output", help="--singular: the output link whose serial singularities (limit positions) are "
                                      "sought (default: a four-bar's rocker, a slider-crank's slider)")
-    sp.add_argument("--steps", type=int, default=360, help="--singular: steps over the input's range (default 360)")
+    sp.add_argument("--steps", type=count("figure_steps"), default=360,
+                    help="--singular: steps over the input's range (default 360, at most 20,000)")
 
 
 def _targets(mech, args) -> list:

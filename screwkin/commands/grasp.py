@@ -4,13 +4,12 @@ internal forces and the Ferrari-Canny quality of contacts on one object."""
 from __future__ import annotations
 
 import json
-import math
 
 from ..analysis.grasp import GRASP_TOLERANCES, analyze_grasp
-from ..errors import UsageError, quote
+from ..errors import UsageError
 from ..files.grasp import read_grasp
 from ..present.grasp import grasp_dict, grasp_text
-from ..units import parse_value
+from ..units import parse_length
 
 NAME = "grasp"
 NEEDS_MECHANISM = False
@@ -32,9 +31,7 @@ def run(mech, args) -> int:
         raise UsageError(f"--facets {args.facets}: give 3 to {GRASP_TOLERANCES.max_facets}")
     length = None
     if args.length is not None:
-        length = parse_value(args.length)
-        if not (math.isfinite(length) and 0 < length <= 1e4):
-            raise UsageError(f"--length {quote(args.length)}: give a positive length up to 10 km")
+        length = parse_length(args.length, "--length")
     spec = read_grasp(args.file)
     result = analyze_grasp(spec, facets=args.facets, length=length)
     if args.json:

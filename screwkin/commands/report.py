@@ -47,6 +47,7 @@ from ..units import parse_assignments
 from ._common import add_configuration_options, inputs
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
+from ._options import count
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -80,11 +81,12 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--start", action="append", metavar="NAME=VALUE,...",
                     help="planar: the estimates Newton iterates from (as solve --start; default: the solved "
                          "unknowns, angles +10 deg and lengths +10 %%)")
-    sp.add_argument("--iterations", type=int, metavar="K", help="exactly K Newton iterations (default: to convergence)")
+    sp.add_argument("--iterations", type=count("iterations"), metavar="K", help="exactly K Newton iterations (default: to convergence)")
     sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 /s each)")
     sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
     sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
-    sp.add_argument("--steps", type=int, default=360, help="steps over the input's range (default 360)")
+    sp.add_argument("--steps", type=count("figure_steps"), default=360,
+                    help="steps over the input's range (default 360, at most 20,000)")
     sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
 
 

@@ -30,6 +30,7 @@ from ..files.writer import write_urdf
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
+from ._options import count
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -62,7 +63,7 @@ def add_parser(sub, common, scaled):
     m.add_argument("--moving", metavar='"x,y; x,y"',
                    help="three poses: the two moving pivots in the coupler frame (crank's first)")
     m.add_argument("--pick", metavar="I,J", help="four or five poses: the candidates for crank and rocker")
-    m.add_argument("--candidates", type=int, default=24,
+    m.add_argument("--candidates", type=count("candidates"), default=24,
                    help="four poses: lines through a pole that trace the candidates (default 24)")
     m.add_argument("--png", help="draw the centre-point and circle-point curves (needs matplotlib)")
     f = sp.add_argument_group("function")
@@ -78,8 +79,8 @@ def add_parser(sub, common, scaled):
     p.add_argument("--points", help='path: the points "x,y; x,y; ..."; function: the number of precision points '
                                     "(default 3; more: least squares)")
     p.add_argument("--timing", metavar='"a, b, ..."', help="path: the crank angle at each point (from any zero)")
-    p.add_argument("--starts", type=int, default=24, help="path: least-squares starts (default 24)")
-    p.add_argument("--seed", type=int, default=0, help="path: seed of the starts (default 0)")
+    p.add_argument("--starts", type=count("starts"), default=24, help="path: least-squares starts (default 24)")
+    p.add_argument("--seed", type=count("seed"), default=0, help="path: seed of the starts (default 0)")
     p.add_argument("--tolerance", default="1e-6",
                    help="path: a point is reached within this distance (default 1e-6 m)")
     c = sp.add_argument_group("chains")

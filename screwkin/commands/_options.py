@@ -1,0 +1,98 @@
+"""What every command line is checked for before any work starts.
+
+* **Counts are bounded.** Every count a person types (steps, starts, samples,
+  threads, iterations) has a documented range: ``count(lo, hi)`` is its argparse
+  type, so ``--steps 100000000`` is a usage error naming the bound, not an hour
+  of work.
+* **Empty is not the default.** ``--length=`` or ``--resolution ''`` are usage
+  errors (argparse would pass the empty string on, and most commands read it
+  as "not given").
+* **Outputs can be written.** Every file a command will write (``--csv``,
+  ``--png``, ``--svg``, ``--plot``, ``--html``, ``--md``, ``-o`` ...) is checked
+  before the work starts: its folder exists and is writable and the path is not
+  a folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+from ..errors import UsageError, quote
+
+__all__ = ["count", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+
+#: The bounds of the counts people type, (smallest, largest), by what they count.
+BOUNDS = {
+    "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest
+    "figure_steps": (2, 20_000),      # draw --singular / report --steps: a search for singular configurations
+    "starts": (0, 1_000),             # solve / ik / synthesize --starts: random starting configurations
+    "iterations": (0, 1_000),         # solve / report --iterations: Newton iterations shown
+    "samples": (1, 10_000_000),       # scan --samples (100,000 take about 0.3 s)
+    "threads": (1, 256),              # scan --threads
+    "grid": (2, 2_000),               # map / view --sweep N: values along one input
+    "grid_total": (4, 100_000),       # map: both inputs together (about 25 s on the five-bar)
+    "facets": (3, 1_000),             # grasp --facets: edges of a friction cone's pyramid
+    "candidates": (1, 10_000),        # synthesize --candidates
+    "links": (2, 12),                 # synthesize chains --links
+    "dof": (0, 10),                   # synthesize chains --dof
+    "seed": (0, 2**32 - 1),           # random seeds (numpy's range)
+}
+
+
+def count(what: str):
+    """argparse type of a count bounded by ``BOUNDS[what]`` (whole numbers only)."""
+    lo, hi = BOUNDS[what]
+
+    def parse(text: str) -> int:
+        try:
+            n = int(text.strip())
+        except (ValueError, AttributeError):
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {quote(text, 40)}") from None
+        if not lo <= n <= hi:
+            raise argparse.ArgumentTypeError(f"must be between {lo:,} and {hi:,}, got {n:,}")
+        return n
+
+    parse.__name__ = f"count ({lo:,} to {hi:,})"  # argparse names the type in its messages
+    return parse
+
+
+#: Destinations of options that name a file a command writes (or a prefix of such files).
+OUTPUT_DESTS = ("csv", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate")
+
+
+def _option_name(action) -> str:
+    longs = [s for s in action.option_strings if s.startswith("--")]
+    return (longs or action.option_strings or [action.dest])[0]
+
+
+def check_outputs(parser, args) -> None:
+    """Refuse, before any work, an output file whose folder is missing or not writable, or that is a folder."""
+    for action in parser._actions:
+        if action.dest not in OUTPUT_DESTS or not action.option_strings:
+            continue
+        value = getattr(args, action.dest, None)
+        if not isinstance(value, str):
+            continue
+        name = _option_name(action)
+        if os.path.isdir(value):
+            raise UsageError(f"{name} {quote(value, 200)}: is a folder, not a file to write")
+        folder = os.path.dirname(os.path.abspath(value))
+        if not os.path.isdir(folder):
+            raise UsageError(f"{name} {quote(value, 200)}: the folder {quote(folder, 200)} does not exist")
+        if not os.access(folder, os.W_OK):
+            raise UsageError(f"{name} {quote(value, 200)}: the folder {quote(folder, 200)} is not writable")
+
+
+def check_parsed(parser, args) -> None:
+    """Refuse empty option values, then unwritable outputs (see the module's docstring)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            continue
+        value = getattr(args, action.dest, None)
+        values = value if isinstance(value, list) else [value]
+        for v in values:
+            if isinstance(v, str) and not v.strip():
+                name = _option_name(action) if action.option_strings else action.dest.upper()
+                raise UsageError(f"{name}: empty value (leave the option out for its default)")
+    check_outputs(parser, args)

@@ -1,0 +1,144 @@
+"""Issue 22, 'hangs' and 'silent acceptances': every count a person types has a bound, an empty
+value is not the default, every output is checked before the work starts, an output link must
+exist, lengths have a kind and a sane range.  Each case must answer in one line, exit 2, at once
+(``no_hang`` guards against the work starting; the bounds are in commands/_options.BOUNDS)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import ROBOTS, no_hang
+from screwkin.cli import main
+from screwkin.commands._options import BOUNDS
+
+FOURBAR = str(ROBOTS / "fourbar_crank_rocker.urdf")
+FIVEBAR = str(ROBOTS / "five_bar.urdf")
+ARM = str(ROBOTS / "arm_6r.urdf")
+SWEEP = ["sweep", FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "4"]
+
+
+def run(argv, capsys):
+    """main(argv) in process: (exit code, stderr); argparse's own exits included."""
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exc:
+        code = exc.code
+    err = capsys.readouterr().err
+    return code, err
+
+
+def refused(argv, capsys, *words, seconds=20):
+    with no_hang(seconds):
+        code, err = run(argv, capsys)
+    assert code == 2, (argv, code, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("screwkin: error:"), err
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    return lines[0]
+
+
+HUGE = [
+    (["sweep", FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "100000000"], "100,000"),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--starts", "1000000"], "1,000"),
+    (["ik", ARM, "--output", "flange", "--pose", "0.3 0 0.3 0 0 0", "--starts", "1000000"], "1,000"),
+    (["draw", FOURBAR, "--png", "x.png", "--singular", "--steps", "100000000"], "20,000"),
+    (["report", FOURBAR, "--md", "x.md", "--steps", "100000000"], "20,000"),
+    (["scan", ARM, "--output", "flange", "--samples", "100000000000"], "10,000,000"),
+    (["scan", ARM, "--output", "flange", "--threads", "1000000"], "256"),
+    (["scan", ARM, "--output", "flange", "--seed", "-1"], "4,294,967,295"),
+    (["map", FIVEBAR, "--x", "motor1=0:1:1000000", "--y", "motor2=0:1:10"], "2,000"),
+    (["map", FIVEBAR, "--x", "motor1=0:1:1000", "--y", "motor2=0:1:1000"], "100,000"),
+    (["view", FOURBAR, "--sweep", "crank_joint=0:1:100000000", "--html", "x.html"], "2,000"),
+    (["synthesize", "path", "--points", "0,0; 1,0; 1,1; 0,1; 0.5,0.5", "--starts", "100000000"], "1,000"),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--start", "rocker=1", "--iterations", "100000000"], "1,000"),
+]
+
+
+@pytest.mark.parametrize("argv,bound", HUGE, ids=[" ".join(a[:1] + a[-2:]) for a, _ in HUGE])
+def test_huge_counts_are_refused_with_their_bound(argv, bound, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    refused(argv, capsys, bound)
+
+
+def test_bounds_are_whole_numbers():
+    for what, (lo, hi) in BOUNDS.items():
+        assert isinstance(lo, int) and isinstance(hi, int) and 0 <= lo < hi, what
+
+
+@pytest.mark.parametrize("argv,option", [
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--length="], "--length"),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--length", "  "], "--length"),
+    (["solve", FOURBAR, "--set="], "--set"),
+    (SWEEP + ["--rate="], "--rate"),
+    (["workspace", FIVEBAR, "--output", "tip", "--resolution", ""], "--resolution"),
+    (["mobility", ""], "FILE"),
+    (["mobility", FIVEBAR, "--output="], "--output"),
+])
+def test_empty_values_are_errors_not_defaults(argv, option, capsys):
+    refused(argv, capsys, option, "empty value")
+
+
+@pytest.mark.parametrize("extra", [["--csv"], ["--plot"]])
+def test_sweep_outputs_checked_before_the_work(extra, capsys, tmp_path):
+    missing = tmp_path / "missing" / "out.file"
+    refused(SWEEP + extra + [missing], capsys, extra[0], "does not exist")
+    refused(SWEEP + extra + [tmp_path], capsys, extra[0], "is a folder")
+    assert not (tmp_path / "missing").exists()
+
+
+@pytest.mark.parametrize("argv,option", [
+    (["draw", FOURBAR, "--svg"], "--svg"),
+    (["draw", FOURBAR, "--png"], "--png"),
+    (["report", FOURBAR, "--html"], "--html"),
+    (["report", FOURBAR, "--md"], "--md"),
+    (["map", FIVEBAR, "--x", "motor1=0:1:3", "--y", "motor2=0:1:3", "--csv"], "--csv"),
+    (["scan", ARM, "--output", "flange", "--samples", "10", "--csv"], "--csv"),
+    (["view", FOURBAR, "--html"], "--html"),
+    (["workspace", FIVEBAR, "--output", "tip", "--csv"], "--csv"),
+    (["synthesize", "chains", "--links", "4", "--dof", "1", "-o"], "--output"),
+])
+def test_every_output_is_checked_before_the_work(argv, option, capsys, tmp_path):
+    refused(argv + [tmp_path / "no" / "such" / "file"], capsys, option, "does not exist")
+    refused(argv + [tmp_path], capsys, option, "is a folder")
+
+
+@pytest.mark.parametrize("argv", [
+    SWEEP + ["--output", "no_such_link"],
+    ["draw", FOURBAR, "--svg", "x.svg", "--output", "no_such_link"],
+    ["solve", FOURBAR, "--set", "crank_joint=1", "--output", "no_such_link"],
+])
+def test_an_output_link_must_exist(argv, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    line = refused(argv, capsys, "no link named 'no_such_link'")
+    for link in ("ground", "crank", "coupler", "rocker"):  # the links that exist are listed
+        assert link in line
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+@pytest.mark.parametrize("value,words", [
+    ("5e-324", ["1e-09 m"]),        # a subnormal: the measures divided by it overflowed (SVD did not converge)
+    ("0", ["1e-09 m"]),
+    ("-1", ["1e-09 m"]),
+    ("1e9", ["10000 m"]),
+    ("90deg", ["unit of angle", "takes a length"]),
+    ("1turn", ["unit of angle"]),
+])
+def test_lengths_have_a_kind_and_a_range(value, words, capsys):
+    refused(["solve", FOURBAR, "--set", "crank_joint=1", "--length", value], capsys, "--length", *words)
+
+
+def test_a_length_in_range_with_a_unit_is_taken_in_si(capsys):
+    import json
+
+    code = main(["solve", FOURBAR, "--set", "crank_joint=1", "--length", "90mm", "--json"])
+    assert code == 0
+    assert json.loads(capsys.readouterr().out)["characteristic_length"] == pytest.approx(0.09, abs=1e-15)
+
+
+def test_counts_at_their_bounds_are_accepted(capsys, tmp_path):
+    # the bound itself is a valid value: a two-point grid per axis (the smallest) maps
+    code = main(["map", FIVEBAR, "--x", "motor1=0:1:2", "--y", "motor2=0:1:2", "--csv", str(tmp_path / "m.csv")])
+    assert code == 0
+    rows = (tmp_path / "m.csv").read_text().strip().splitlines()
+    assert len(rows) == 1 + 4  # the header and 2 x 2 configurations
