@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 import tempfile
 import time
@@ -34,7 +35,7 @@ from .commands import report as report_command
 from .commands import statics as statics_command
 from .commands import study as study_command
 from .commands import workspace as workspace_command
-from .commands._options import BOUNDS, check_parsed, count
+from .commands._options import BOUNDS, check_parsed, count, screwkin_version
 from .commands._common import add_angle_option, add_configuration_options, configuration, inputs
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
@@ -85,6 +86,11 @@ def _register(*modules):
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # a value that starts with a minus and a digit is a value, units and all: --to -90deg, --from -1e-3
+        self._negative_number_matcher = re.compile(r"^-\.?[0-9]")
+
     def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
 
         self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
@@ -106,7 +112,9 @@ def _names(text):
 def _parser():
     p = _Parser(prog="screwkin", description="Screw-theory analysis of spatial mechanisms described in URDF.")
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
-    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    p.add_argument("--version", action="version", version=f"screwkin {screwkin_version()}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser, title="commands",
+                           metavar="COMMAND")
 
     def common(sp, mechanism: bool = True, optional_file: bool = False):
         """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
@@ -543,6 +551,9 @@ def main(argv=None) -> int:
             pass
 
     parser = _parser()
+    if not (sys.argv[1:] if argv is None else argv):  # bare `screwkin`: what it can do, a line a command
+        print(parser.format_help())
+        return 0
     args = parser.parse_args(argv)
     debug = bool(getattr(args, "debug", False))
     paths = [str(p) for p in (getattr(args, "file", None), getattr(args, "yaml", None)) if p]

@@ -142,3 +142,28 @@ def test_counts_at_their_bounds_are_accepted(capsys, tmp_path):
     assert code == 0
     rows = (tmp_path / "m.csv").read_text().strip().splitlines()
     assert len(rows) == 1 + 4  # the header and 2 x 2 configurations
+
+
+def test_negative_values_with_units_are_values_not_options(capsys):
+    import json
+
+    import numpy as np
+
+    code = main(["sweep", FOURBAR, "--input", "crank_joint", "--from", "-90deg", "--to", "-1e-3", "--steps", "2",
+                 "--json"])
+    assert code == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["values"][0] == pytest.approx(-np.pi / 2, abs=1e-12) and d["values"][-1] == pytest.approx(-1e-3)
+
+
+def test_version_and_bare_command_list(capsys):
+    from importlib import metadata
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.strip() == f"screwkin {metadata.version('screwkin')}"
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    for command in ("mobility", "solve", "sweep", "singularities", "draw", "report", "workspace", "study"):
+        assert f"\n    {command} " in out or f"\n    {command}\n" in out, command

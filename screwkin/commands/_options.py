@@ -17,10 +17,19 @@ from __future__ import annotations
 
 import argparse
 import os
+from importlib import metadata
 
 from ..errors import UsageError, quote
 
-__all__ = ["count", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+__all__ = ["screwkin_version", "count", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+
+def screwkin_version() -> str:
+    """The version of screwkin installed (the package's metadata, as pip shows it)."""
+    try:
+        return metadata.version("screwkin")
+    except metadata.PackageNotFoundError:  # pragma: no cover - run from a source tree never installed
+        return "unknown (not installed)"
+
 
 #: The bounds of the counts people type, (smallest, largest), by what they count.
 BOUNDS = {

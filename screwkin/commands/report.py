@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from importlib import metadata
 
 import numpy as np
 
@@ -47,7 +46,7 @@ from ..units import parse_assignments
 from ._common import add_configuration_options, inputs
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
-from ._options import count
+from ._options import count, screwkin_version
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -56,14 +55,6 @@ NEEDS_MECHANISM = True
 START_ANGLE = np.radians(10.0)
 #: ... lengths (slider coordinates) increased by this fraction (of the characteristic length when 0)
 START_FRACTION = 0.10
-
-
-def _version() -> str:
-    """The version of screwkin installed (the package's metadata, as pip shows it)."""
-    try:
-        return metadata.version("screwkin")
-    except metadata.PackageNotFoundError:  # pragma: no cover - run from a source tree never installed
-        return "unknown (not installed)"
 
 
 def add_parser(sub, common, scaled):
@@ -148,7 +139,7 @@ def run(mech, args) -> int:
         mech.link_frame(args.output)
     rates = parse_assignments(args.rate, "--rate") or {n: 1.0 for n in names}
     accels = parse_assignments(args.accel, "--accel") or None
-    notes, data, sections = {}, {"file": str(mech.path), "screwkin": _version()}, []
+    notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
 
     # ---- the configuration: solved for the inputs (their file values when none are set)
     pres, q = None, q0
@@ -215,7 +206,7 @@ def run(mech, args) -> int:
     # ---- the view
     sections.append(_view(mech, args, q, data))
 
-    facts = [("file", str(mech.path)), ("screwkin", _version()), ("configuration", configuration),
+    facts = [("file", str(mech.path)), ("screwkin", screwkin_version()), ("configuration", configuration),
              ("inputs", ", ".join(names) or "none"), ("motion space", topo.motion_space)]
     if args.output:
         facts.append(("output", args.output))
