@@ -36,7 +36,14 @@ from .commands import statics as statics_command
 from .commands import study as study_command
 from .commands import workspace as workspace_command
 from .commands._options import BOUNDS, check_parsed, count, screwkin_version
-from .commands._common import add_angle_option, add_configuration_options, configuration, inputs
+from .commands._common import (
+    add_angle_option,
+    add_configuration_options,
+    configuration,
+    inputs,
+    joint_assignments,
+    joint_value,
+)
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
 from .model.joint_types import JOINT_TYPES
@@ -69,7 +76,7 @@ from .present.report import (
     value_text,
 )
 from .present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
-from .units import parse_assignments, parse_length, parse_value
+from .units import parse_length, parse_value
 
 __all__ = ["main"]
 
@@ -301,9 +308,9 @@ def _solve(mech, args):
     values = inputs(mech, args)
     if not values:
         raise UsageError("solve needs input values: --set NAME=VALUE or --set-angle LINK=ANGLE")
-    near = parse_assignments([args.near], "--near") if args.near else None
-    rates = parse_assignments(args.rate, "--rate") if args.rate or args.accel else None
-    accels = parse_assignments(args.accel, "--accel") if args.accel else None
+    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    rates = joint_assignments(mech, args.rate, "--rate", rate=True) if args.rate or args.accel else None
+    accels = joint_assignments(mech, args.accel, "--accel", rate=True) if args.accel else None
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
@@ -379,7 +386,7 @@ def _map(mech, args):
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")
-    fixed = parse_assignments(args.set, "--set")
+    fixed = joint_assignments(mech, args.set, "--set")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
@@ -431,7 +438,7 @@ def _view(mech, args):
     motion, singular = None, []
     if args.sweep:
         name, values = _range(args.sweep, "--sweep")
-        fixed = {k: v for k, v in parse_assignments(args.set, "--set").items() if k != name}
+        fixed = {k: v for k, v in joint_assignments(mech, args.set, "--set").items() if k != name}
         inputs = list(mech.actuated) if name in mech.actuated else [name, *fixed]
         solver = PositionSolver(mech, inputs)
         res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed)
@@ -489,13 +496,15 @@ def _ik(mech, args):
 
 
 def _sweep(mech, args):
-    fixed = parse_assignments(args.set, "--set")
+    fixed = joint_assignments(mech, args.set, "--set")
     inputs = _names(args.inputs) or (list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
     solver = PositionSolver(mech, inputs)
-    near = parse_assignments([args.near], "--near") if args.near else None
+    near = joint_assignments(mech, [args.near], "--near") if args.near else None
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
-    res = sweep(solver, args.input, parse_value(args.start), parse_value(args.stop), args.steps,
+    start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
+                                                                                      (args.stop, "--to")))
+    res = sweep(solver, args.input, start, stop, args.steps,
                 fixed={k: v for k, v in fixed.items() if k != args.input}, near=near,
                 rate=parse_value(args.rate), progress=True, turn=args.turn)
     info = identify(mech, mech.topology(res.q[0]), res.q[0], args.input) if len(inputs) == 1 else None
@@ -554,7 +563,10 @@ def main(argv=None) -> int:
     if not (sys.argv[1:] if argv is None else argv):  # bare `screwkin`: what it can do, a line a command
         print(parser.format_help())
         return 0
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # usage errors (2), --help and --version (0): main(argv) returns its code
+        return exc.code if isinstance(exc.code, int) else 2
     debug = bool(getattr(args, "debug", False))
     paths = [str(p) for p in (getattr(args, "file", None), getattr(args, "yaml", None)) if p]
     limit = MESSAGE_LIMIT + 40 + max((len(p) for p in paths), default=0)  # the problem, "(and N more)", the path

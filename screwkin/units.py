@@ -24,7 +24,7 @@ import re
 
 from .errors import UsageError, quote
 
-__all__ = ["parse_value", "parse_length", "parse_assignments", "UNITS", "unit_kind", "LENGTH_RANGE"]
+__all__ = ["parse_value", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "unit_kind", "LENGTH_RANGE"]
 
 _DEG = math.pi / 180.0
 UNITS = {
@@ -90,6 +90,12 @@ def parse_length(text: str, option: str) -> float:
     return value
 
 
+def parse_typed_value(text: str) -> tuple:
+    """``"-90deg"`` -> ``(-1.5707..., "deg")``: the value in SI and the unit as typed ("" when bare)."""
+    value = parse_value(text)
+    return value, _NUMBER.match(text).group(2)
+
+
 def parse_typed_assignments(items, option: str) -> list:
     """``["a=45deg", "b=0.1,c=2mm"]`` -> ``[("a", 0.785..., "deg"), ("b", 0.1, ""), ("c", 0.002, "mm")]``:
     each value in SI with the unit as typed (to answer in the units a person used)."""
@@ -101,8 +107,7 @@ def parse_typed_assignments(items, option: str) -> list:
             name, sep, value = part.partition("=")
             if not sep or not name.strip():
                 raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
-            m = re.match(r"\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*(\S*)\s*$", value)
-            out.append((name.strip(), parse_value(value), m.group(1) if m else ""))
+            out.append((name.strip(), *parse_typed_value(value)))
     return out
 
 

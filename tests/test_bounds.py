@@ -83,7 +83,7 @@ def test_empty_values_are_errors_not_defaults(argv, option, capsys):
 def test_sweep_outputs_checked_before_the_work(extra, capsys, tmp_path):
     missing = tmp_path / "missing" / "out.file"
     refused(SWEEP + extra + [missing], capsys, extra[0], "does not exist")
-    refused(SWEEP + extra + [tmp_path], capsys, extra[0], "is a folder")
+    refused(SWEEP + extra + [tmp_path], capsys, extra[0], "it is a folder")
     assert not (tmp_path / "missing").exists()
 
 
@@ -100,7 +100,7 @@ def test_sweep_outputs_checked_before_the_work(extra, capsys, tmp_path):
 ])
 def test_every_output_is_checked_before_the_work(argv, option, capsys, tmp_path):
     refused(argv + [tmp_path / "no" / "such" / "file"], capsys, option, "does not exist")
-    refused(argv + [tmp_path], capsys, option, "is a folder")
+    refused(argv + [tmp_path], capsys, option, "it is a folder")
 
 
 @pytest.mark.parametrize("argv", [
@@ -159,11 +159,40 @@ def test_negative_values_with_units_are_values_not_options(capsys):
 def test_version_and_bare_command_list(capsys):
     from importlib import metadata
 
-    with pytest.raises(SystemExit) as exc:
-        main(["--version"])
-    assert exc.value.code == 0
+    assert main(["--version"]) == 0
     assert capsys.readouterr().out.strip() == f"screwkin {metadata.version('screwkin')}"
     assert main([]) == 0
     out = capsys.readouterr().out
     for command in ("mobility", "solve", "sweep", "singularities", "draw", "report", "workspace", "study"):
         assert f"\n    {command} " in out or f"\n    {command}\n" in out, command
+
+
+# ---- joint values take their kind from the joint (issue 24 item 5, the part the bounds need)
+
+SLIDER = str(ROBOTS / "slider_crank_offset.urdf")
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["solve", FOURBAR, "--set", "crank_joint=30mm"], ["--set", "angle joint", "mm is a unit of length"]),
+    (["solve", SLIDER, "--set", "crank_joint=1,slider_joint=30deg"], ["length joint", "deg is a unit of angle"]),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--rate", "crank_joint=2mm"], ["--rate", "angle joint"]),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--near", "rocker_joint=1in"], ["--near", "angle joint"]),
+    (SWEEP[:7] + ["30mm"], ["--to", "angle joint"]),
+    (["solve", FOURBAR, "--set-angle", "crank=3mm"], ["--set-angle", "unit of length"]),
+])
+def test_a_unit_of_the_wrong_kind_is_refused(argv, words, capsys):
+    refused(argv, capsys, *words)
+
+
+def test_a_bare_angle_beyond_a_turn_warns_and_is_radians(capsys):
+    import json
+
+    import numpy as np
+
+    assert main(["solve", FOURBAR, "--set", "crank_joint=30", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "30 rad = 1718.87 deg" in captured.err and "write 30deg" in captured.err
+    crank = json.loads(captured.out)["solutions"][0]["joints"]["crank_joint"]
+    assert crank == pytest.approx(np.mod(30 + np.pi, 2 * np.pi) - np.pi, abs=1e-9)  # 30 rad, wrapped
+    assert main(["solve", FOURBAR, "--set", "crank_joint=6", "--json"]) == 0
+    assert "warning" not in capsys.readouterr().err  # within a turn: no warning

@@ -5,9 +5,48 @@ from __future__ import annotations
 from ..analysis.planar import LinkAngles
 from ..analysis.position import PositionSolver
 from ..errors import UsageError
-from ..units import parse_assignments
+import math
+import sys
 
-__all__ = ["inputs", "configuration", "add_configuration_options", "add_angle_option"]
+from ..errors import quote, shorten
+from ..units import parse_typed_assignments, parse_typed_value, unit_kind
+
+__all__ = ["inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+           "joint_value", "value_kind"]
+
+
+def value_kind(mech, joint: str):
+    """'angle' or 'length': what a value of this one-coordinate joint is; None when it is no such
+    joint (a multi-coordinate joint's ``j[q0]``, an unknown name: the analysis names the problem)."""
+    c = next((c for c in mech.coordinates if c.joint == joint), None)
+    if c is None or c.nv != 1:
+        return None
+    return "length" if mech.translational[c.idx_v] else "angle"
+
+
+def _checked(mech, name, value, unit, option, text, rate=False):
+    kind = value_kind(mech, name)
+    found = unit_kind(unit)
+    if kind and found and found != kind:
+        raise UsageError(f"{option} {text}: {quote(name)} is {'an' if kind == 'angle' else 'a'} "
+                         f"{kind} joint, {unit} is a unit of {found}")
+    if kind == "angle" and not unit and not rate and abs(value) > 2 * math.pi:
+        print(f"warning: {option} {shorten(name, 60)}={value:g} is read as {value:g} rad = "
+              f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
+    return value
+
+
+def joint_assignments(mech, items, option: str, rate: bool = False) -> dict:
+    """``NAME=VALUE,...`` of joints: SI values; a unit of the wrong kind for the joint (``crank=30mm``)
+    is a usage error, a bare angle of more than a turn is read as radians with a warning."""
+    return {name: _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", rate)
+            for name, value, unit in parse_typed_assignments(items, option)}
+
+
+def joint_value(mech, joint: str, text: str, option: str) -> float:
+    """One value of ``joint`` typed after ``option`` (``--from -90deg``), checked like joint_assignments."""
+    value, unit = parse_typed_value(text)
+    return _checked(mech, joint, value, unit, option, quote(text, 60))
 
 
 def add_angle_option(sp):
@@ -27,8 +66,12 @@ def add_configuration_options(sp):
 def inputs(mech, args) -> dict:
     """Input values from --set (joint values) and --set-angle (absolute link angles)."""
 
-    values = parse_assignments(getattr(args, "set", None), "--set")
-    angles = parse_assignments(getattr(args, "set_angle", None), "--set-angle")
+    values = joint_assignments(mech, getattr(args, "set", None), "--set")
+    angles = {}
+    for name, value, unit in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
+        if unit_kind(unit) == "length":
+            raise UsageError(f"--set-angle {quote(name)}: {unit} is a unit of length, --set-angle takes an angle")
+        angles[name] = value
     if angles:
         q = mech.generic_configurations()[1][0]
         link_angles = LinkAngles(mech, mech.topology(q))
@@ -44,7 +87,7 @@ def configuration(mech, args):
     """The configuration a command analyses: solved for --set values, else the assembled file one."""
 
     values = inputs(mech, args)
-    near = parse_assignments([args.near], "--near") if getattr(args, "near", None) else None
+    near = joint_assignments(mech, [args.near], "--near") if getattr(args, "near", None) else None
     if not values:
         return mech.generic_configurations()[0].q
     res = PositionSolver(mech, list(values)).solve(values, near=near)

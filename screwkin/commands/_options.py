@@ -21,7 +21,7 @@ from importlib import metadata
 
 from ..errors import UsageError, quote
 
-__all__ = ["screwkin_version", "count", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+__all__ = ["screwkin_version", "check_writable", "count", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
 
 def screwkin_version() -> str:
     """The version of screwkin installed (the package's metadata, as pip shows it)."""
@@ -75,22 +75,23 @@ def _option_name(action) -> str:
     return (longs or action.option_strings or [action.dest])[0]
 
 
+def check_writable(path: str, option: str) -> None:
+    """Refuse an output file that cannot be written: a folder, in a missing folder, without permission."""
+    where = f"{option} {quote(path, 200)}"
+    if os.path.isdir(path):
+        raise UsageError(f"{where}: cannot write, it is a folder, not a file")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise UsageError(f"{where}: cannot write, the folder {quote(folder, 200)} does not exist")
+    if not os.access(folder, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
+        raise UsageError(f"{where}: cannot write, permission denied")
+
+
 def check_outputs(parser, args) -> None:
     """Refuse, before any work, an output file whose folder is missing or not writable, or that is a folder."""
     for action in parser._actions:
-        if action.dest not in OUTPUT_DESTS or not action.option_strings:
-            continue
-        value = getattr(args, action.dest, None)
-        if not isinstance(value, str):
-            continue
-        name = _option_name(action)
-        if os.path.isdir(value):
-            raise UsageError(f"{name} {quote(value, 200)}: is a folder, not a file to write")
-        folder = os.path.dirname(os.path.abspath(value))
-        if not os.path.isdir(folder):
-            raise UsageError(f"{name} {quote(value, 200)}: the folder {quote(folder, 200)} does not exist")
-        if not os.access(folder, os.W_OK):
-            raise UsageError(f"{name} {quote(value, 200)}: the folder {quote(folder, 200)} is not writable")
+        if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
+            check_writable(getattr(args, action.dest), _option_name(action))
 
 
 def check_parsed(parser, args) -> None:

@@ -42,11 +42,10 @@ from ..present.equations import equations_dict, newton_dict
 from ..present.plots import sweep_figure
 from ..present.report import mobility_dict, position_dict
 from ..present.view import PICTURE, ViewerServer, build_scene, chromium, page, screenshot, show
-from ..units import parse_assignments
-from ._common import add_configuration_options, inputs
+from ._common import add_configuration_options, inputs, joint_assignments
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
-from ._options import count, screwkin_version
+from ._options import check_writable, count, screwkin_version
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -84,13 +83,7 @@ def add_parser(sub, common, scaled):
 def _writable(path, option):
     if not path:
         raise UsageError(f"{option} needs a file name")
-    folder = os.path.dirname(os.path.abspath(path))
-    if os.path.isdir(path):
-        raise UsageError(f"cannot write {path}: it is a folder")
-    if not os.path.isdir(folder):
-        raise UsageError(f"cannot write {path}: no folder {folder}")
-    if not os.access(folder, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
-        raise UsageError(f"cannot write {path}: permission denied")
+    check_writable(path, option)
 
 
 def _write(path, data: bytes):
@@ -133,12 +126,12 @@ def run(mech, args) -> int:
         raise UsageError("--iterations must be 1 or more")
     given = inputs(mech, args)
     names = _input_names(mech, args, given)
-    near = parse_assignments([args.near], "--near") if args.near else None
+    near = joint_assignments(mech, [args.near], "--near") if args.near else None
     q0 = mech.generic_configurations()[0].q
     if args.output:
         mech.link_frame(args.output)
-    rates = parse_assignments(args.rate, "--rate") or {n: 1.0 for n in names}
-    accels = parse_assignments(args.accel, "--accel") or None
+    rates = joint_assignments(mech, args.rate, "--rate", rate=True) or {n: 1.0 for n in names}
+    accels = joint_assignments(mech, args.accel, "--accel", rate=True) or None
     notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
 
     # ---- the configuration: solved for the inputs (their file values when none are set)
