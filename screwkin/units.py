@@ -104,7 +104,7 @@ def parse_typed_assignments(items, option: str) -> list:
         for part in item.split(","):
             if not part.strip():
                 continue
-            name, sep, value = part.partition("=")
+            name, sep, value = part.rpartition("=")  # a value has no '=', a name may (=SUM(A1) is a name)
             if not sep or not name.strip():
                 raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
             out.append((name.strip(), *parse_typed_value(value)))

@@ -30,7 +30,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 import yaml
-from conftest import CORPUS, DATA, ROBOTS
+from conftest import CORPUS, DATA, ROBOTS, fourbar, no_hang
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -578,6 +578,85 @@ def test_sidecar_from_any_structure(tmp_path, content):
     assert len(lines) <= 1 and all(len(line.replace(str(tmp_path), "D")) <= 340 for line in lines), lines
     if code == 0:
         json.loads(out.getvalue(), parse_constant=_no_nan)
+
+
+# ------------------------------------------------------------------ hostile command lines (issue 22)
+#: Values typed into options: huge and negative counts, empty values, subnormals, units of the wrong kind,
+#: spreadsheet formulas, names with dots, commas and newlines, paths that cannot be written.
+OPTION_VALUES = ["", " ", "0", "-1", "1", "3", "100000000", "1e9", "5e-324", "nan", "inf", "1e308", "30mm",
+                 "90deg", "-90deg", "1_000", "0x10", "=1+1", "a,b", "a\nb", "a.b", "1turn", "-0"]
+OUTPUT_VALUES = ["missing/out.file", ".", "out.csv", "=HYPERLINK(x).csv"]
+_FOURBAR = str(ROBOTS / "fourbar_crank_rocker.urdf")
+_FIVE = str(ROBOTS / "five_bar.urdf")
+_ARM = str(ROBOTS / "arm_6r.urdf")
+#: Command lines with one slot ({v}: a value, {o}: an output path) each filled from the lists above.
+COMMAND_LINES = [
+    ["sweep", _FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "{v}"],
+    ["sweep", _FOURBAR, "--input", "crank_joint", "--from", "{v}", "--to", "1", "--steps", "3"],
+    ["sweep", _FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "3", "--rate", "{v}"],
+    ["sweep", _FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "3", "--csv", "{o}"],
+    ["sweep", _FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "3", "--output", "{v}"],
+    ["solve", _FOURBAR, "--set", "crank_joint={v}", "--json"],
+    ["solve", _FOURBAR, "--set", "crank_joint=1", "--starts", "{v}", "--json"],
+    ["solve", _FOURBAR, "--set", "crank_joint=1", "--length", "{v}", "--json"],
+    ["solve", _FOURBAR, "--set", "crank_joint=1", "--near", "rocker_joint={v}", "--json"],
+    ["solve", _FOURBAR, "--set", "crank_joint=1", "--start", "rocker={v}", "--iterations", "2"],
+    ["map", _FIVE, "--x", "motor1=0:1:{v}", "--y", "motor2=0:1:3", "--json"],
+    ["map", _FIVE, "--x", "motor1=0:1:3", "--y", "motor2=0:1:3", "--csv", "{o}"],
+    ["scan", _ARM, "--output", "flange", "--samples", "{v}", "--json"],
+    ["scan", _ARM, "--output", "flange", "--samples", "10", "--seed", "{v}", "--json"],
+    ["draw", _FOURBAR, "--svg", "{o}"],
+    ["draw", _FOURBAR, "--svg", "d.svg", "--singular", "--steps", "{v}"],
+    ["singularities", _FOURBAR, "--set", "crank_joint={v}", "--output", "rocker", "--json"],
+    ["ik", _ARM, "--output", "flange", "--pose", "0.3 0 0.3 0 0 {v}", "--starts", "2", "--json"],
+    ["synthesize", "chains", "--links", "{v}", "--dof", "1", "--json"],
+    ["mobility", _FIVE, "--output", "{v}", "--json"],
+]
+CLI_MUTANTS = 80
+
+
+@functools.cache
+def command_line(i: int):
+    rng = random.Random(SEED * 7 + i)
+    template = COMMAND_LINES[i % len(COMMAND_LINES)]
+    value, out = rng.choice(OPTION_VALUES), rng.choice(OUTPUT_VALUES)
+    return [a.replace("{v}", value).replace("{o}", out) for a in template]
+
+
+@pytest.mark.parametrize("i", range(CLI_MUTANTS), ids=lambda i: f"cli-{i:03d}")
+def test_hostile_command_line(i, tmp_path, capfd, monkeypatch):
+    """Every command line above answers within its bound: exit 0, 1 or 2, one error line, no traceback."""
+    monkeypatch.chdir(tmp_path)
+    argv = command_line(i)
+    with no_hang(60):
+        check_contract(argv, capfd, [_FOURBAR, _FIVE, _ARM])
+
+
+#: Names people (or hostile files) give links and joints: dots, commas, newlines are names, not syntax.
+HOSTILE_NAMES = ["mesh.2", "a.x", "a,b", "=SUM(A1:A9)", "+cmd", "@x", "<script>alert(1)</script>", "j;rm -rf",
+                 "crank\u00e9", "a b"]
+
+
+@pytest.mark.parametrize("name", HOSTILE_NAMES)
+def test_hostile_names_through_the_commands(name, tmp_path, capfd, monkeypatch):
+    """A four-bar whose crank joint and coupler link carry the name: info, mobility, solve and a sweep to CSV
+    keep the contract, and the CSV has rows of one length with the name intact in its header."""
+    import csv
+    from xml.sax.saxutils import quoteattr
+
+    monkeypatch.chdir(tmp_path)
+    text = fourbar().replace('name="crank_joint"', f"name={quoteattr(name)}")
+    path = tmp_path / "named.urdf"
+    path.write_text(text)
+    for argv in (["info", path, "--json"], ["mobility", path, "--json"],
+                 *([["solve", path, "--set", f"{name}=1", "--json"]] if "," not in name else []),  # NAME=V,...
+                 ["sweep", path, "--input", name, "--from", "0", "--to", "1", "--steps", "3", "--csv", "s.csv"]):
+        with no_hang(60):
+            code = check_contract([str(a) for a in argv], capfd, [path])
+        assert code == 0, (name, argv)
+    rows = list(csv.reader(open(tmp_path / "s.csv", newline="")))
+    assert len({len(r) for r in rows}) == 1 and len(rows) == 1 + 4
+    assert any(name in cell for cell in rows[0])
 
 
 # ------------------------------------------------------------------ whole processes
