@@ -36,6 +36,7 @@ from ..errors import AssemblyError, UsageError
 from ..model._pin import frame_jacobian
 from ..model.closure import Assembly, ClosureSystem, CutJoint
 from ..model.linalg import null_space, rank
+from ..model.state import KinematicState, angular_loop_joints
 from .mobility import analyze_mobility
 from .planar import LinkAngles
 from .singular import Generic, measures, scaled_jacobians
@@ -99,6 +100,10 @@ class Solution:
     link_angles: dict | None = None
     sigmas: dict | None = None  # screwkin.analysis.singular.measures at this configuration
     coupled: dict | None = None  # <mimic> joints' values [rad or m] (they have no coordinate)
+    loop_joints: dict | None = None  # one-coordinate loop (cut) joints: value [rad or m] (model/state.py)
+    loop_rates: dict | None = None  # ... their rates [rad/s or m/s]
+    loop_accelerations: dict | None = None  # ... and accelerations [rad/s^2 or m/s^2]
+    links: dict | None = None  # link name -> absolute motion (see link_motions)
 
     @property
     def physical(self) -> bool:
@@ -115,6 +120,30 @@ class Solution:
         return None if self.output_pose is None else pin.rpy.matrixToRpy(self.output_pose[:3, :3])
 
 
+def link_motions(state, angles=None, normal=None) -> dict:
+    """Every moving link's absolute motion at a state: ``position`` (and, with rates, ``velocity``,
+    ``acceleration``) of its frame origin [m, m/s, m/s^2], ``omega`` and ``alpha`` [rad/s, rad/s^2];
+    planar mechanisms (``normal`` given): ``angle`` [rad] from ``angles`` (the vector-loop angles of
+    LinkAngles) and omega, alpha as numbers about the plane's normal, else 3-vectors (world axes)."""
+    mech = state.mech
+    out = {}
+    for link in mech.spec.links:
+        try:
+            fid = mech.link_frame(link)
+        except UsageError:  # a link merged away (massless, inside a compound joint): no frame of its own
+            continue
+        if mech.model.frames[fid].parentJoint == 0:
+            continue  # the ground and what is welded to it
+        d = state.link_motion(link)
+        if normal is not None:
+            if angles is not None and link in angles:
+                d["angle"] = angles[link]
+            if "omega" in d:
+                d["omega"], d["alpha"] = float(d["omega"] @ normal), float(d["alpha"] @ normal)
+        out[link] = d
+    return out
+
+
 @dataclass(frozen=True)
 class PositionResult:
     inputs: dict
@@ -126,6 +155,7 @@ class PositionResult:
     output: str | None = None
     angular: tuple = ()  # names of the coordinates that are angles (the others are lengths)
     angular_coupled: tuple = ()  # names of the coupled (mimic) joints that are angles
+    angular_loop: tuple = ()  # names of the loop (cut) joints with a coordinate that is an angle
 
     @property
     def physical(self) -> tuple:
@@ -367,7 +397,8 @@ class PositionSolver:
         if near_q is not None:
             sols = sols[:1]
         return PositionResult(dict(values), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
-                              tuple(steps), self.output, self._angular, self._angular_coupled())
+                              tuple(steps), self.output, self._angular, self._angular_coupled(),
+                              angular_loop_joints(self.mech))
 
     def distinct(self, system, starts, frozen=(), first_trace=None):
         """Solve ``system`` from every start; keep one solution per assembly mode.
@@ -550,6 +581,11 @@ class PositionSolver:
             self._labelling = (legs, turned)
         return self._labelling or None
 
+    def _plane_normal(self):
+        if self._angles is False:
+            self._link_angles(self.mech.neutral())
+        return None if self._angles is None else self._angles.n
+
     def _link_angles(self, q):
         if self._angles is False:
             self._angles = None
@@ -569,24 +605,25 @@ class PositionSolver:
         K = mech.closure.jacobian(q)
         pose = twist = acc = qd = qdd = None
         rate_d = acc_d = None
-        if self.output_frame is not None:
-            pin.framesForwardKinematics(self.model, self.data, q)
-            pose = self.data.oMf[self.output_frame].homogeneous.copy()
         if rates is not None:
             solve, _ = self.passive_solver(K)
             qd = self.rates(q, K, rates, solve)
             rate_d = self._named(qd)
             qdd = self.accelerations(q, K, qd, accels or {}, solve)
             acc_d = self._named(qdd)
-            if self.output_frame is not None:
-                pin.forwardKinematics(self.model, self.data, q, qd, qdd)
-                pin.updateFramePlacements(self.model, self.data)
-                twist = pin.getFrameVelocity(self.model, self.data, self.output_frame, LWA).vector.copy()
-                acc = pin.getFrameClassicalAcceleration(self.model, self.data, self.output_frame, LWA).vector.copy()
+        state = KinematicState(mech, q, qd, qdd)  # every quantity below is read from this one state
+        if self.output_frame is not None:
+            pose = state.frame_pose(self.output_frame)
+            if rates is not None:
+                twist, acc = state.frame_twist(self.output_frame), state.frame_acceleration(self.output_frame)
         outside = outside_limits(mech, q)
+        angles = self._link_angles(q)
         return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), float(sigma), pose,
                         rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),
-                        link_angles=self._link_angles(q), sigmas=m, coupled=mech.coupled_values(q) or None)
+                        link_angles=angles, sigmas=m, coupled=mech.coupled_values(q) or None,
+                        loop_joints=state.loop_joints or None, loop_rates=state.loop_rates or None,
+                        loop_accelerations=state.loop_accelerations or None,
+                        links=link_motions(state, angles, self._plane_normal()))
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
@@ -675,4 +712,5 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
                              link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
-                          0, (), output, solver.angular_names(), solver._angular_coupled())
+                          0, (), output, solver.angular_names(), solver._angular_coupled(),
+                          angular_loop_joints(mech))

@@ -231,6 +231,12 @@ def position_dict(res) -> dict:
             d["link_angles"] = s.link_angles
         if s.coupled:
             d["coupled_joints"] = s.coupled
+        if s.loop_joints:
+            d["loop_joints"] = s.loop_joints
+            if s.loop_rates is not None:
+                d["loop_rates"], d["loop_accelerations"] = s.loop_rates, s.loop_accelerations
+        if s.links:
+            d["links"] = s.links
         if s.output_pose is not None:
             d["output_pose"] = s.output_pose.tolist()
             d["output_position"] = s.output_position.tolist()
@@ -265,6 +271,33 @@ def trace_text(res, row_labels, passive_names) -> str:
             lines.append(f"       {_fmt_vec(row)}   {lab}")
         lines.append("  dq = [" + _fmt_vec(st.step) + " ]")
     return "\n".join(lines)
+
+
+def links_table(links: dict) -> str:
+    """Absolute link motion: a planar mechanism's angle, omega, alpha about the plane's normal, or
+    a spatial one's |omega|, |alpha|; the frame origin's speed and acceleration magnitude."""
+    planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
+    rows = []
+    for name, m in links.items():
+        if planar:
+            row = [name, f"{np.degrees(m['angle']):.6g}" if "angle" in m else ""]
+            if "omega" in m:
+                row += [f"{m['omega']:.6g}", f"{m['alpha']:.6g}"]
+        else:
+            row = [name, ""] + ([f"{np.linalg.norm(m['omega']):.6g}", f"{np.linalg.norm(m['alpha']):.6g}"]
+                                if "omega" in m else [])
+        if "velocity" in m:
+            row += [f"{np.linalg.norm(m['velocity']):.6g}", f"{np.linalg.norm(m['acceleration']):.6g}"]
+        rows.append(row)
+    rated = any("omega" in m for m in links.values())
+    if planar:
+        head = ["link", "angle [deg]"] + (["omega [rad/s]", "alpha [rad/s^2]"] if rated else [])
+    else:
+        head = ["link", ""] + (["|omega| [rad/s]", "|alpha| [rad/s^2]"] if rated else [])
+    head += ["|v origin| [m/s]", "|a origin| [m/s^2]"] if rated else []
+    title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
+             if planar else "absolute link motion (world frame)")
+    return title + "\n" + table(head, rows)
 
 
 def position_text(res, degrees=True, show_all=False, length=None) -> str:
@@ -304,6 +337,12 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
             if s.rates is not None:
                 row += [f"{s.rates.get(name, float('nan')):.6g}", f"{s.accelerations.get(name, float('nan')):.6g}"]
             rows.append(row)
+        for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
+            row = [f"{name} (loop)", f"{v:.9g}"]
+            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else "")
+            if s.loop_rates is not None:
+                row += [f"{s.loop_rates[name]:.6g}", f"{s.loop_accelerations[name]:.6g}"]
+            rows.append(row)
         headers = ["joint", "value [rad or m]", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
         lines.append(table(headers, rows))
         if s.coupled:
@@ -313,6 +352,8 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
         if s.link_angles:
             lines.append("link angles (absolute, in the plane from the ground's x axis): " + ", ".join(
                 f"{n} {np.degrees(a):.6g} deg" for n, a in s.link_angles.items()))
+        if s.links and any("angle" in m or "omega" in m for m in s.links.values()):
+            lines.append(links_table(s.links))
         if s.output_pose is not None:
             p = s.output_pose
             lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m, roll pitch yaw "

@@ -1,0 +1,182 @@
+"""One configuration's kinematic quantities, computed once in a Pinocchio ``Data`` of its own.
+
+``KinematicState(mech, q, qd, qdd)`` is an immutable value: forward kinematics (positions,
+and rates and accelerations when ``qd``/``qdd`` are given) run once, lazily, in a ``Data`` that
+belongs to the state, so that nothing depends on what another analysis left in ``mech.data``
+and threads may share a mechanism.  From it every quantity people ask for is read:
+
+* every link's absolute pose, and the velocity and classical acceleration of its frame origin
+  with its angular velocity and acceleration (world axes; twists in (linear, angular) order);
+* any point fixed on a link (coordinates in the link's frame): position, velocity, acceleration;
+* the coordinates of the loop (cut) joints: the value of a one-coordinate ``<loop_joint>`` as a
+  tree joint's value is read -- zero where its frames F1 and F2 coincide as written, the angle
+  of F2 about the axis (revolute, continuous) or the displacement of F2's origin along the axis
+  (prismatic), both measured in F1 -- with its rate and acceleration.
+
+Units: m, rad, s.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+import pinocchio as pin
+
+__all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints"]
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+#: The loop-joint types whose coordinate a state reports (one coordinate along or about the axis).
+LOOP_COORDINATE_TYPES = ("revolute", "continuous", "prismatic")
+
+
+def loop_coordinate_cuts(mech) -> tuple:
+    """The cut joints whose coordinate a state reports: one coordinate, no higher pair built on them."""
+    return tuple(c for c in mech.cuts if c.type in LOOP_COORDINATE_TYPES and c.dof == 1 and not c.pair)
+
+
+def angular_loop_joints(mech) -> tuple:
+    """Names of the reported loop-joint coordinates that are angles."""
+    return tuple(c.name for c in loop_coordinate_cuts(mech) if c.type != "prismatic")
+
+
+class PointMotion:
+    """Position [m], velocity [m/s] and classical acceleration [m/s^2] of a point, world axes
+    (velocity and acceleration None when the state has no rates)."""
+
+    __slots__ = ("position", "velocity", "acceleration")
+
+    def __init__(self, position, velocity=None, acceleration=None):
+        self.position, self.velocity, self.acceleration = position, velocity, acceleration
+
+    def __repr__(self):
+        return f"PointMotion(position={self.position}, velocity={self.velocity}, acceleration={self.acceleration})"
+
+
+class KinematicState:
+    """The kinematics of ``mech`` at ``q`` (and rates ``qd``, accelerations ``qdd``: tangent
+    vectors of the model, (nv,)).  Read-only; every quantity is computed on first use."""
+
+    def __init__(self, mech, q, qd=None, qdd=None):
+        self.mech = mech
+        self.q = np.array(q, float)
+        self.qd = None if qd is None else np.array(qd, float)
+        self.qdd = None if qd is None else np.zeros(mech.nv) if qdd is None else np.array(qdd, float)
+        for a in (self.q, self.qd, self.qdd):
+            if a is not None:
+                a.setflags(write=False)
+
+    # ------------------------------------------------------------------ Pinocchio, once
+    @cached_property
+    def _data(self):
+        model = self.mech.model
+        data = model.createData()
+        if self.qd is None:
+            pin.framesForwardKinematics(model, data, self.q)
+        else:
+            pin.forwardKinematics(model, data, self.q, self.qd, self.qdd)
+            pin.updateFramePlacements(model, data)
+        return data
+
+    @property
+    def has_rates(self) -> bool:
+        return self.qd is not None
+
+    def frame_pose(self, fid: int) -> np.ndarray:
+        """4x4 world pose of a frame."""
+        return self._data.oMf[fid].homogeneous.copy()
+
+    def frame_twist(self, fid: int) -> np.ndarray:
+        """(v, w) of the frame's origin, world axes [m/s, rad/s]."""
+        return pin.getFrameVelocity(self.mech.model, self._data, fid, LWA).vector.copy()
+
+    def frame_acceleration(self, fid: int) -> np.ndarray:
+        """Classical acceleration (a, alpha) of the frame's origin, world axes [m/s^2, rad/s^2]."""
+        return pin.getFrameClassicalAcceleration(self.mech.model, self._data, fid, LWA).vector.copy()
+
+    # ------------------------------------------------------------------ links and points
+    def link_pose(self, link: str) -> np.ndarray:
+        return self.frame_pose(self.mech.link_frame(link))
+
+    def point(self, link: str, local=(0.0, 0.0, 0.0)) -> PointMotion:
+        """Motion of the point with coordinates ``local`` [m] in ``link``'s frame."""
+        fid = self.mech.link_frame(link)
+        M = self._data.oMf[fid]
+        r = M.rotation @ np.asarray(local, float)  # from the frame origin to the point, world axes
+        p = M.translation + r
+        if not self.has_rates:
+            return PointMotion(p)
+        v, w = np.split(self.frame_twist(fid), 2)
+        a, alpha = np.split(self.frame_acceleration(fid), 2)
+        return PointMotion(p, v + np.cross(w, r), a + np.cross(alpha, r) + np.cross(w, np.cross(w, r)))
+
+    def link_motion(self, link: str) -> dict:
+        """position, velocity, acceleration of the link frame's origin; omega, alpha (vectors)."""
+        fid = self.mech.link_frame(link)
+        out = {"position": self._data.oMf[fid].translation.copy()}
+        if self.has_rates:
+            v, w = np.split(self.frame_twist(fid), 2)
+            a, alpha = np.split(self.frame_acceleration(fid), 2)
+            out.update(velocity=v, acceleration=a, omega=w, alpha=alpha)
+        return out
+
+    # ------------------------------------------------------------------ loop-joint coordinates
+    def _cut_frames(self, cut):
+        d = self._data
+        M1, M2 = d.oMf[cut.frame1], d.oMf[cut.frame2]
+        axis = M1.rotation @ np.asarray(cut.axis, float)
+        return M1, M2, axis / np.linalg.norm(axis)
+
+    def loop_value(self, cut) -> float:
+        """The coordinate of a one-coordinate cut joint [rad or m] (see the module's docstring)."""
+        M1, M2, axis = self._cut_frames(cut)
+        if cut.type == "prismatic":
+            return float((M2.translation - M1.translation) @ axis)
+        R = M1.rotation.T @ M2.rotation  # F2 in F1: a rotation about the axis (in F1) when closed
+        a = np.asarray(cut.axis, float) / np.linalg.norm(cut.axis)
+        # R = cos t I + sin t [a]x + (1 - cos t) a a^T: sin t from its antisymmetric part along a,
+        # cos t = (trace R - a^T R a) / 2
+        s = 0.5 * a @ np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+        c = 0.5 * (np.trace(R) - a @ R @ a)
+        return float(np.arctan2(s, c))
+
+    def loop_rate(self, cut) -> float:
+        """d/dt of loop_value [rad/s or m/s] (needs rates)."""
+        M1, M2, axis = self._cut_frames(cut)
+        v1, w1 = np.split(self.frame_twist(cut.frame1), 2)
+        v2, w2 = np.split(self.frame_twist(cut.frame2), 2)
+        if cut.type == "prismatic":
+            return float((v2 - v1) @ axis + (M2.translation - M1.translation) @ np.cross(w1, axis))
+        return float((w2 - w1) @ axis)
+
+    def loop_acceleration(self, cut) -> float:
+        """d^2/dt^2 of loop_value [rad/s^2 or m/s^2] (needs rates)."""
+        M1, M2, axis = self._cut_frames(cut)
+        v1, w1 = np.split(self.frame_twist(cut.frame1), 2)
+        v2, w2 = np.split(self.frame_twist(cut.frame2), 2)
+        a1, al1 = np.split(self.frame_acceleration(cut.frame1), 2)
+        a2, al2 = np.split(self.frame_acceleration(cut.frame2), 2)
+        da = np.cross(w1, axis)  # d axis / dt
+        dda = np.cross(al1, axis) + np.cross(w1, da)
+        if cut.type == "prismatic":
+            r = M2.translation - M1.translation
+            return float((a2 - a1) @ axis + 2.0 * (v2 - v1) @ da + r @ dda)
+        return float((al2 - al1) @ axis + (w2 - w1) @ da)
+
+    @cached_property
+    def loop_cuts(self) -> tuple:
+        """The cut joints whose coordinate is reported (loop_coordinate_cuts)."""
+        return loop_coordinate_cuts(self.mech)
+
+    @cached_property
+    def loop_joints(self) -> dict:
+        """Cut joint name -> value [rad or m]."""
+        return {c.name: self.loop_value(c) for c in self.loop_cuts}
+
+    @cached_property
+    def loop_rates(self) -> dict | None:
+        return {c.name: self.loop_rate(c) for c in self.loop_cuts} if self.has_rates else None
+
+    @cached_property
+    def loop_accelerations(self) -> dict | None:
+        return {c.name: self.loop_acceleration(c) for c in self.loop_cuts} if self.has_rates else None
