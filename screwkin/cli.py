@@ -23,7 +23,8 @@ import pinocchio as pin
 from .analysis.ellipsoids import ellipsoids
 from .analysis.maps import singularity_map
 from .analysis.mobility import analyze_mobility
-from .analysis.planar import identify
+from .analysis.motion import motion_along
+from .analysis.planar import LinkAngles, identify
 from .analysis.position import PositionSolver, inverse_kinematics
 from .analysis.scan import scan
 from .analysis.screws import structure
@@ -39,16 +40,19 @@ from .commands._options import BOUNDS, check_parsed, count, screwkin_version
 from .commands._common import (
     add_angle_option,
     add_configuration_options,
+    add_point_option,
     configuration,
     inputs,
     joint_assignments,
     joint_value,
+    named_points,
 )
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
 from .model.joint_types import JOINT_TYPES
 from .model.loader import load
 from .present.ellipsoids import ellipsoids_dict, ellipsoids_text
+from .present.motion import motion_dict
 from .present.plots import map_png, sweep_plot
 from .present.report import (
     joint_types_dict,
@@ -150,9 +154,8 @@ def _parser():
         sp.add_argument("--length", help="characteristic length that makes the measures dimensionless "
                                          "(default: the mean link length; printed with every measure)")
         if point:
-            sp.add_argument("--point", action="store_true",
-                            help="analyse the output link's origin as a point (3 translations) instead of its "
-                                 "full motion")
+            add_point_option(sp, "--point alone: analyse the output link's origin as a point (3 translations) "
+                                 "instead of its full motion")
 
     m = sub.add_parser("mobility", help="degrees of freedom: counts and screw-theory mobility")
     common(m)
@@ -171,6 +174,7 @@ def _parser():
                    help="show every assembly mode, also those the mechanism cannot reach by moving")
     s.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
     s.add_argument("--output", help="link whose pose (and twist) to report")
+    add_point_option(s)
     s.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input joint rate [1/s] (units as --set)")
     s.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
     s.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
@@ -316,7 +320,8 @@ def _solve(mech, args):
     if args.start or args.iterations is not None:
         return equations_command.solve_from_start(mech, args, values)
     solver = PositionSolver(mech, list(values), output=args.output)
-    res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace)
+    res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
+                       points=named_points(mech, args))
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length
@@ -507,7 +512,11 @@ def _sweep(mech, args):
     res = sweep(solver, args.input, start, stop, args.steps,
                 fixed={k: v for k, v in fixed.items() if k != args.input}, near=near,
                 rate=parse_value(args.rate), progress=True, turn=args.turn)
-    info = identify(mech, mech.topology(res.q[0]), res.q[0], args.input) if len(inputs) == 1 else None
+    topo = mech.topology(res.q[0])
+    angles = LinkAngles(mech, topo) if topo.motion_space == "planar" and topo.normal is not None else None
+    motion = motion_along(mech, res.q, res.rates, res.accelerations, named_points(mech, args), angles,
+                          None if angles is None else angles.n)
+    info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 else None
     mus = None
     if info is not None:
         mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
@@ -527,6 +536,7 @@ def _sweep(mech, args):
             d["transmission_angles"] = mus
         d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
         d["characteristic_length"] = mech.length
+        d.update(motion_dict(motion))
         print(json.dumps(to_jsonable(d), indent=2))
     else:
         print(sweep_text(res, info, mus))

@@ -144,3 +144,82 @@ def test_solve_json_and_text_report_loop_joints_and_links(tmp_path, capsys):
     assert main(["solve", str(path), "--set", "crank_joint=30deg", "--rate", "crank_joint=10"]) == 0
     out = capsys.readouterr().out
     assert "guide (loop)" in out and "absolute link motion" in out and "omega [rad/s]" in out
+
+
+@pytest.mark.parametrize("crank_deg", [40.0, 160.0, 290.0])
+def test_coupler_point_against_circle_intersections(crank_deg, capsys):
+    """--point P=coupler:60mm,20mm: the file writes the coupler frame at B along the world x axis with
+    C at (0.11388, 0.03783) in it, so the frame is turned by -atan2(0.03783, 0.11388) from B->C."""
+    a, b, c, d, w2 = 0.04, 0.12, 0.08, 0.1, 2.0
+    offset = -np.arctan2(0.03783022050962147, 0.1138809659960496)
+    local = np.array([0.06, 0.02])
+    t2 = np.radians(crank_deg)
+    t0 = np.radians(60.0)  # the crank as written: B = (0.02, 0.034641)
+    argv = ["solve", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", f"crank_joint={crank_deg - 60}deg",
+            "--rate", f"crank_joint={w2}", "--point", "P=coupler:60mm,20mm", "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    B, D = a * np.array([np.cos(t2), np.sin(t2)]), np.array([d, 0.0])
+    assert np.isclose(t0, np.arctan2(0.03464101615137755, 0.02))
+    for sol in out["solutions"]:
+        p = sol["points"]["P"]
+        assert p["link"] == "coupler"
+        # which closed-form mode: the C that the reported coupler angle points at
+        t3 = sol["links"]["coupler"]["angle"]
+        C = min(circles(B, b, D, c), key=lambda X: np.linalg.norm(X - B - b * np.array([np.cos(t3), np.sin(t3)])))
+        t3 = np.arctan2(*(C - B)[::-1])
+        t4 = np.arctan2(*(C - D)[::-1])
+        w3, w4, a3, a4 = _fourbar_rates(a, b, c, t2, t3, t4, w2)
+        f = t3 + offset
+        r = np.array([[np.cos(f), -np.sin(f)], [np.sin(f), np.cos(f)]]) @ local
+        vB, aB = a * w2 * np.array([-np.sin(t2), np.cos(t2)]), -a * w2**2 * np.array([np.cos(t2), np.sin(t2)])
+        perp = np.array([-r[1], r[0]])
+        assert p["position"] == pytest.approx([*(B + r), 0.0], abs=1e-10)
+        assert p["velocity"] == pytest.approx([*(vB + w3 * perp), 0.0], abs=1e-9)
+        assert p["acceleration"] == pytest.approx([*(aB + a3 * perp - w3**2 * r), 0.0], abs=1e-8)
+
+
+@pytest.mark.parametrize("spec,words", [
+    ("P=nolink:1,2,3", "no link named 'nolink'"),
+    ("P=coupler:1deg,2,3", "unit of angle"),
+    ("P=coupler:1", "NAME=LINK:x,y,z"),
+    ("coupler:1,2", "NAME=LINK:x,y,z"),
+])
+def test_bad_points_are_usage_errors(spec, words, capsys):
+    argv = ["solve", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", "crank_joint=1", "--point", spec]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1
+
+
+def test_point_alone_keeps_its_old_meaning(capsys):
+    """sweep --point (no value) still analyses the output link's origin as a point."""
+    argv = ["sweep", str(ROBOTS / "five_bar.urdf"), "--input", "motor1", "--from", "0", "--to", "0.2",
+            "--steps", "2", "--set", "motor2=1", "--output", "tip", "--point", "--singularities", "--json"]
+    assert main(argv) == 0
+    json.loads(capsys.readouterr().out)
+
+
+def test_sweep_reports_the_slider_and_the_links_at_every_step(tmp_path, capsys):
+    """sweep of the crank through 0..270 deg at 1 rad/s: the guide's x, x', x'' at every step are the closed
+    form's at the crank's absolute angle; a coupler point's path is one entry per step."""
+    path = tmp_path / "slider.urdf"
+    path.write_text(SLIDER)
+    argv = ["sweep", str(path), "--input", "crank_joint", "--from", "0", "--to", "270deg", "--steps", "27",
+            "--point", "M=rod:60mm,0", "--json"]
+    assert main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    (x, xd, xdd), (phi, phid, _) = _slider_closed_form()
+    theta0 = np.arctan2(A_Y, A_X)
+    n = len(d["values"])
+    assert n == 28 and len(d["points"]["M"]["position"]) == n and len(d["links"]["rod"]["omega"]) == n
+    for k, v in enumerate(d["values"]):
+        t = v + theta0
+        assert d["loop_joints"]["guide"][k] == pytest.approx(x(t, 1.0), abs=1e-9)
+        assert d["loop_rates"]["guide"][k] == pytest.approx(xd(t, 1.0), abs=1e-8)
+        assert d["loop_accelerations"]["guide"][k] == pytest.approx(xdd(t, 1.0), abs=1e-7)
+        assert d["links"]["rod"]["omega"][k] == pytest.approx(phid(t, 1.0), abs=1e-8)
+        A = np.hypot(A_X, A_Y) * np.array([np.cos(t), np.sin(t)])
+        f = phi(t, 1.0) - np.arctan2(B_REL[1], B_REL[0])  # the rod frame: B_REL in it points along A -> B
+        M = A + 0.06 * np.array([np.cos(f), np.sin(f)])
+        assert d["points"]["M"]["position"][k] == pytest.approx([*M, 0.0], abs=1e-9)

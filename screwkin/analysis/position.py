@@ -38,6 +38,7 @@ from ..model.closure import Assembly, ClosureSystem, CutJoint
 from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, angular_loop_joints
 from .mobility import analyze_mobility
+from .motion import link_motions, point_motions
 from .planar import LinkAngles
 from .singular import Generic, measures, scaled_jacobians
 
@@ -103,7 +104,8 @@ class Solution:
     loop_joints: dict | None = None  # one-coordinate loop (cut) joints: value [rad or m] (model/state.py)
     loop_rates: dict | None = None  # ... their rates [rad/s or m/s]
     loop_accelerations: dict | None = None  # ... and accelerations [rad/s^2 or m/s^2]
-    links: dict | None = None  # link name -> absolute motion (see link_motions)
+    links: dict | None = None  # link name -> absolute motion (analysis.motion.link_motions)
+    points: dict | None = None  # named points -> their motion (analysis.motion.point_motions)
 
     @property
     def physical(self) -> bool:
@@ -118,30 +120,6 @@ class Solution:
     def output_rpy(self):
         """Roll, pitch, yaw [rad] of the output frame (URDF convention: R = Rz(yaw) Ry(pitch) Rx(roll))."""
         return None if self.output_pose is None else pin.rpy.matrixToRpy(self.output_pose[:3, :3])
-
-
-def link_motions(state, angles=None, normal=None) -> dict:
-    """Every moving link's absolute motion at a state: ``position`` (and, with rates, ``velocity``,
-    ``acceleration``) of its frame origin [m, m/s, m/s^2], ``omega`` and ``alpha`` [rad/s, rad/s^2];
-    planar mechanisms (``normal`` given): ``angle`` [rad] from ``angles`` (the vector-loop angles of
-    LinkAngles) and omega, alpha as numbers about the plane's normal, else 3-vectors (world axes)."""
-    mech = state.mech
-    out = {}
-    for link in mech.spec.links:
-        try:
-            fid = mech.link_frame(link)
-        except UsageError:  # a link merged away (massless, inside a compound joint): no frame of its own
-            continue
-        if mech.model.frames[fid].parentJoint == 0:
-            continue  # the ground and what is welded to it
-        d = state.link_motion(link)
-        if normal is not None:
-            if angles is not None and link in angles:
-                d["angle"] = angles[link]
-            if "omega" in d:
-                d["omega"], d["alpha"] = float(d["omega"] @ normal), float(d["alpha"] @ normal)
-        out[link] = d
-    return out
 
 
 @dataclass(frozen=True)
@@ -362,7 +340,10 @@ class PositionSolver:
         return Assembly(self._wrap(a.q), a.residual, a.iterations)
 
     def solve(self, values: dict, near: dict | None = None, rates: dict | None = None,
-              accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False) -> PositionResult:
+              accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False,
+              points=()) -> PositionResult:
+        """Every assembly mode for the input ``values`` (see the class).  ``points``: motion.Point
+        objects whose position (and velocity, acceleration with ``rates``) each solution reports."""
         mech = self.mech
         self._check_inputs(values)
         steps = []
@@ -387,7 +368,7 @@ class PositionSolver:
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
                                        f"{len(start_list)} starting configurations")
         self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
-        sols = [self._solution(q, a, rates, accels) for _, q, a in found]
+        sols = [self._solution(q, a, rates, accels, points) for _, q, a in found]
         sols = self._merge(sols)
         ref = near_q if near_q is not None else self._reference()
         if len(sols) > 1:
@@ -597,7 +578,7 @@ class PositionSolver:
         return self._angles(q) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def _solution(self, q, a, rates, accels) -> Solution:
+    def _solution(self, q, a, rates, accels, points=()) -> Solution:
         mech, tol = self.mech, self.mech.tolerances
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
@@ -623,7 +604,8 @@ class PositionSolver:
                         link_angles=angles, sigmas=m, coupled=mech.coupled_values(q) or None,
                         loop_joints=state.loop_joints or None, loop_rates=state.loop_rates or None,
                         loop_accelerations=state.loop_accelerations or None,
-                        links=link_motions(state, angles, self._plane_normal()))
+                        links=link_motions(state, angles, self._plane_normal()),
+                        points=point_motions(state, points) or None)
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))

@@ -2,17 +2,59 @@
 
 from __future__ import annotations
 
+from ..analysis.motion import Point
 from ..analysis.planar import LinkAngles
 from ..analysis.position import PositionSolver
 from ..errors import UsageError
+import argparse
 import math
 import sys
 
 from ..errors import quote, shorten
-from ..units import parse_typed_assignments, parse_typed_value, unit_kind
+from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 
-__all__ = ["inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind"]
+
+
+class PointOption(argparse.Action):
+    """``--point`` alone: the output link's origin analysed as a point (``args.point = True``, as
+    before); ``--point NAME=LINK:x,y,z``: a named point on a link (``args.points``), repeatable."""
+
+    def __call__(self, parser, namespace, value, option_string=None):
+        if value is None:
+            namespace.point = True
+        else:
+            namespace.points = [*(getattr(namespace, "points", None) or []), value]
+
+
+def add_point_option(sp, origin_help: str | None = None):
+    """--point: named points NAME=LINK:x,y,z (and, with ``origin_help``, --point alone as before)."""
+    sp.set_defaults(point=False, points=None)
+    help = ("a point on a link, NAME=LINK:x,y,z in the link's frame (units allowed: P=coupler:60mm,20mm,0); "
+            "its position, velocity and acceleration are reported; repeatable")
+    if origin_help:
+        help = f"{origin_help}; or {help}"
+    sp.add_argument("--point", nargs="?", action=PointOption, metavar="NAME=LINK:x,y,z", help=help)
+
+
+def named_points(mech, args) -> tuple:
+    """The analysis.motion.Point objects of --point NAME=LINK:x,y,z (links checked, names unique)."""
+    out, seen = [], set()
+    for text in getattr(args, "points", None) or []:
+        name, sep, rest = text.rpartition("=")
+        link, sep2, coords = rest.partition(":")
+        parts = [c for c in coords.replace(" ", ",").split(",") if c.strip()]
+        if not sep or not sep2 or not name.strip() or not link.strip() or len(parts) not in (2, 3):
+            raise UsageError(f"--point expects NAME=LINK:x,y,z (or x,y in the plane z = 0), got {quote(text, 80)}")
+        name, link = name.strip(), link.strip()
+        if name in seen:
+            raise UsageError(f"--point: the name {quote(name)} is given twice")
+        seen.add(name)
+        mech.link_frame(link)  # a clear error for an unknown link
+        local = tuple(parse_value(c, "length", f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
+        out.append(Point(name, link, local))
+    return tuple(out)
 
 
 def value_kind(mech, joint: str):

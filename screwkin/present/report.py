@@ -17,21 +17,14 @@ from ..analysis.screws import Screw, planar_form, screw_of
 from ..analysis.singular import SingularityReport
 from ..analysis.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
+from .motion import links_table, points_table
+from .tables import fmt_vec as _fmt_vec
+from .tables import table
 
 __all__ = ["to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
            "screw_theory_rows", "joint_rows"]
-
-
-def table(headers, rows) -> str:
-    """A plain-text table with aligned columns."""
-    rows = [[str(c) for c in r] for r in rows]
-    widths = [max(len(str(h)), *(len(r[i]) for r in rows)) if rows else len(str(h)) for i, h in enumerate(headers)]
-    line = "  ".join(str(h).ljust(w) for h, w in zip(headers, widths)).rstrip()
-    out = [line, "  ".join("-" * w for w in widths)]
-    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
-    return "\n".join(out)
 
 
 def _joint_dict(j) -> dict:
@@ -214,11 +207,6 @@ def to_jsonable(obj):
     return obj
 
 
-def _fmt_vec(v, width=11):
-    """Numbers with 6 significant digits; round-off below 1e-12 shows as 0."""
-    return " ".join(f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:>{width}.6g}" for x in v)
-
-
 def position_dict(res) -> dict:
     sols = []
     for s in res.solutions:
@@ -237,6 +225,8 @@ def position_dict(res) -> dict:
                 d["loop_rates"], d["loop_accelerations"] = s.loop_rates, s.loop_accelerations
         if s.links:
             d["links"] = s.links
+        if s.points:
+            d["points"] = s.points
         if s.output_pose is not None:
             d["output_pose"] = s.output_pose.tolist()
             d["output_position"] = s.output_position.tolist()
@@ -271,33 +261,6 @@ def trace_text(res, row_labels, passive_names) -> str:
             lines.append(f"       {_fmt_vec(row)}   {lab}")
         lines.append("  dq = [" + _fmt_vec(st.step) + " ]")
     return "\n".join(lines)
-
-
-def links_table(links: dict) -> str:
-    """Absolute link motion: a planar mechanism's angle, omega, alpha about the plane's normal, or
-    a spatial one's |omega|, |alpha|; the frame origin's speed and acceleration magnitude."""
-    planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
-    rows = []
-    for name, m in links.items():
-        if planar:
-            row = [name, f"{np.degrees(m['angle']):.6g}" if "angle" in m else ""]
-            if "omega" in m:
-                row += [f"{m['omega']:.6g}", f"{m['alpha']:.6g}"]
-        else:
-            row = [name, ""] + ([f"{np.linalg.norm(m['omega']):.6g}", f"{np.linalg.norm(m['alpha']):.6g}"]
-                                if "omega" in m else [])
-        if "velocity" in m:
-            row += [f"{np.linalg.norm(m['velocity']):.6g}", f"{np.linalg.norm(m['acceleration']):.6g}"]
-        rows.append(row)
-    rated = any("omega" in m for m in links.values())
-    if planar:
-        head = ["link", "angle [deg]"] + (["omega [rad/s]", "alpha [rad/s^2]"] if rated else [])
-    else:
-        head = ["link", ""] + (["|omega| [rad/s]", "|alpha| [rad/s^2]"] if rated else [])
-    head += ["|v origin| [m/s]", "|a origin| [m/s^2]"] if rated else []
-    title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
-             if planar else "absolute link motion (world frame)")
-    return title + "\n" + table(head, rows)
 
 
 def position_text(res, degrees=True, show_all=False, length=None) -> str:
@@ -354,6 +317,8 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
                 f"{n} {np.degrees(a):.6g} deg" for n, a in s.link_angles.items()))
         if s.links and any("angle" in m or "omega" in m for m in s.links.values()):
             lines.append(links_table(s.links))
+        if s.points:
+            lines.append(points_table(s.points))
         if s.output_pose is not None:
             p = s.output_pose
             lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m, roll pitch yaw "

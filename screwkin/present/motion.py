@@ -1,0 +1,56 @@
+"""Absolute motion in the user's quantities as text and JSON: links, named points, loop joints
+(the results of analysis/motion.py and the solutions of analysis/position.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .tables import fmt_vec, table
+
+__all__ = ["links_table", "points_table", "motion_dict"]
+
+
+def links_table(links: dict) -> str:
+    """Absolute link motion: a planar mechanism's angle, omega, alpha about the plane's normal, or
+    a spatial one's |omega|, |alpha|; the frame origin's speed and acceleration magnitude."""
+    planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
+    rows = []
+    for name, m in links.items():
+        if planar:
+            row = [name, f"{np.degrees(m['angle']):.6g}" if "angle" in m else ""]
+            if "omega" in m:
+                row += [f"{m['omega']:.6g}", f"{m['alpha']:.6g}"]
+        else:
+            row = [name, ""] + ([f"{np.linalg.norm(m['omega']):.6g}", f"{np.linalg.norm(m['alpha']):.6g}"]
+                                if "omega" in m else [])
+        if "velocity" in m:
+            row += [f"{np.linalg.norm(m['velocity']):.6g}", f"{np.linalg.norm(m['acceleration']):.6g}"]
+        rows.append(row)
+    rated = any("omega" in m for m in links.values())
+    if planar:
+        head = ["link", "angle [deg]"] + (["omega [rad/s]", "alpha [rad/s^2]"] if rated else [])
+    else:
+        head = ["link", ""] + (["|omega| [rad/s]", "|alpha| [rad/s^2]"] if rated else [])
+    head += ["|v origin| [m/s]", "|a origin| [m/s^2]"] if rated else []
+    title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
+             if planar else "absolute link motion (world frame)")
+    return title + "\n" + table(head, rows)
+
+
+def points_table(points: dict) -> str:
+    """Named points: position [m], velocity [m/s], acceleration [m/s^2], world axes."""
+    rows = []
+    for name, m in points.items():
+        row = [name, m["link"], fmt_vec(m["position"], 0)]
+        if "velocity" in m:
+            row += [fmt_vec(m["velocity"], 0), fmt_vec(m["acceleration"], 0)]
+        rows.append(row)
+    head = ["point", "link", "position [m]"] + (["velocity [m/s]", "acceleration [m/s^2]"]
+                                                 if any("velocity" in m for m in points.values()) else [])
+    return "points (world axes)\n" + table(head, rows)
+
+
+def motion_dict(m) -> dict:
+    """A sweep's analysis.motion.MotionAlong as JSON-ready lists, one entry per step."""
+    return {"loop_joints": m.loop_joints, "loop_rates": m.loop_rates, "loop_accelerations": m.loop_accelerations,
+            "links": m.links, "points": m.points}

@@ -1,0 +1,20 @@
+"""Plain-text tables and number formatting shared by every text report."""
+
+from __future__ import annotations
+
+__all__ = ["table", "fmt_vec"]
+
+
+def table(headers, rows) -> str:
+    """A plain-text table with aligned columns."""
+    rows = [[str(c) for c in r] for r in rows]
+    widths = [max(len(str(h)), *(len(r[i]) for r in rows)) if rows else len(str(h)) for i, h in enumerate(headers)]
+    line = "  ".join(str(h).ljust(w) for h, w in zip(headers, widths)).rstrip()
+    out = [line, "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+    return "\n".join(out)
+
+
+def fmt_vec(v, width=11):
+    """Numbers with 6 significant digits; round-off below 1e-12 shows as 0."""
+    return " ".join(f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:>{width}.6g}" for x in v)
