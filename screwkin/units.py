@@ -98,16 +98,26 @@ def parse_typed_value(text: str) -> tuple:
 
 def parse_typed_assignments(items, option: str) -> list:
     """``["a=45deg", "b=0.1,c=2mm"]`` -> ``[("a", 0.785..., "deg"), ("b", 0.1, ""), ("c", 0.002, "mm")]``:
-    each value in SI with the unit as typed (to answer in the units a person used)."""
+    each value in SI with the unit as typed (to answer in the units a person used).  Several names
+    may share one value: ``"leg1,leg2,leg3=0.41"`` gives each of the three 0.41."""
     out = []
     for item in items or []:
+        pending = []  # names before a comma, waiting for the value of the next NAME=VALUE
         for part in item.split(","):
             if not part.strip():
                 continue
             name, sep, value = part.rpartition("=")  # a value has no '=', a name may (=SUM(A1) is a name)
-            if not sep or not name.strip():
+            if not sep:
+                pending.append(part.strip())
+                continue
+            if not name.strip():
                 raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
-            out.append((name.strip(), *parse_typed_value(value)))
+            typed = parse_typed_value(value)
+            out += [(n, *typed) for n in (*pending, name.strip())]
+            pending = []
+        if pending:
+            raise UsageError(f"{option} expects NAME=VALUE (or NAME,NAME=VALUE), got {quote(item)}: "
+                             f"no value for {quote(', '.join(pending))}")
     return out
 
 

@@ -356,7 +356,10 @@ def test_delta_modes_that_keep_the_platform_orientation_come_first(capsys):
         assert s["labels"]
     assert main(["solve", path, "--set", "arm1=0.1,arm2=0,arm3=-0.1", "--output", "platform"]) == 0
     text = capsys.readouterr().out
-    assert f"{len(d['solutions']) - len(phys)} more mode(s)" in text and "--all" in text
+    n = len(d["solutions"])  # the count reads as the total: "of the 7, 1 reachable ...; 6 not"
+    assert f"{n} assembly modes found" in text
+    assert f"of the {n}, {len(phys)} reachable by moving" in text and f"{n - len(phys)} not (" in text
+    assert "--all" in text
     assert text.count("\nsolution ") == len(phys)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tables import fmt_vec, table
+from .tables import column_text, fmt_vec, table
 
 __all__ = ["links_table", "points_table", "motion_dict"]
 
@@ -14,24 +14,24 @@ def links_table(links: dict) -> str:
     """Absolute link motion: a planar mechanism's angle, omega, alpha about the plane's normal, or
     a spatial one's |omega|, |alpha|; the frame origin's speed and acceleration magnitude."""
     planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
-    rows = []
-    for name, m in links.items():
-        if planar:
-            row = [name, f"{np.degrees(m['angle']):.6g}" if "angle" in m else ""]
-            if "omega" in m:
-                row += [f"{m['omega']:.6g}", f"{m['alpha']:.6g}"]
-        else:
-            row = [name, ""] + ([f"{np.linalg.norm(m['omega']):.6g}", f"{np.linalg.norm(m['alpha']):.6g}"]
-                                if "omega" in m else [])
-        if "velocity" in m:
-            row += [f"{np.linalg.norm(m['velocity']):.6g}", f"{np.linalg.norm(m['acceleration']):.6g}"]
-        rows.append(row)
     rated = any("omega" in m for m in links.values())
+    names = list(links)
+    cols = []
     if planar:
         head = ["link", "angle [deg]"] + (["omega [rad/s]", "alpha [rad/s^2]"] if rated else [])
+        cols.append(column_text([np.degrees(links[n].get("angle", np.nan)) for n in names], absolute=1e-9))
+        if rated:
+            cols += [column_text([links[n]["omega"] for n in names]), column_text([links[n]["alpha"] for n in names])]
     else:
-        head = ["link", ""] + (["|omega| [rad/s]", "|alpha| [rad/s^2]"] if rated else [])
-    head += ["|v origin| [m/s]", "|a origin| [m/s^2]"] if rated else []
+        head = ["link"] + (["|omega| [rad/s]", "|alpha| [rad/s^2]"] if rated else ["position [m]"])
+        if rated:
+            cols += [column_text([np.linalg.norm(links[n][k]) for n in names]) for k in ("omega", "alpha")]
+        else:
+            cols.append([fmt_vec(links[n]["position"], 0) for n in names])
+    if rated:
+        head += ["|v origin| [m/s]", "|a origin| [m/s^2]"]
+        cols += [column_text([np.linalg.norm(links[n][k]) for n in names]) for k in ("velocity", "acceleration")]
+    rows = [[n] + [("" if c[i] == "nan" else c[i]) for c in cols] for i, n in enumerate(names)]
     title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
              if planar else "absolute link motion (world frame)")
     return title + "\n" + table(head, rows)

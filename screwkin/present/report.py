@@ -270,13 +270,14 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
                        if isinstance(v, float))
     shown = list(res.solutions) if show_all else [s for s in res.solutions if s.physical] or list(res.solutions)
     hidden = len(res.solutions) - len(shown)
+    n = len(res.solutions)
     lines = [f"inputs: {inputs}" if inputs else "inputs: -",
-             f"{len(res.solutions)} assembly mode(s) found from {res.starts} starting configurations"
+             f"{n} assembly mode{'s' if n != 1 else ''} found from {res.starts} starting configurations"
              + (f"; measures dimensionless with L = {length:.4g} m" if length else "")]
     if hidden:
         why = sorted({lab.split(":")[0].split(" (")[0] for s in res.solutions if not s.physical for lab in s.labels})
-        lines.append(f"{hidden} more mode(s) the mechanism cannot reach by moving ({'; '.join(why)}): "
-                     "--all shows them")
+        lines.append(f"of the {n}, {n - hidden} reachable by moving from the drawn configuration and shown; "
+                     f"{hidden} not ({'; '.join(why)}): --all shows them")
     if res.free_dofs:
         lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
                      "the solutions form a continuum and only some are shown")
@@ -312,7 +313,7 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
             lines.append("coupled (mimic) joints: " + ", ".join(
                 f"{n} = {v:.9g}" + (f" ({np.degrees(v):.6g} deg)" if n in res.angular_coupled else "")
                 for n, v in s.coupled.items()))
-        if s.link_angles:
+        if s.link_angles and not s.links:
             lines.append("link angles (absolute, in the plane from the ground's x axis): " + ", ".join(
                 f"{n} {np.degrees(a):.6g} deg" for n, a in s.link_angles.items()))
         if s.links and any("angle" in m or "omega" in m for m in s.links.values()):

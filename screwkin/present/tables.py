@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["table", "fmt_vec"]
+__all__ = ["table", "fmt_vec", "column_text"]
 
 
 def table(headers, rows) -> str:
@@ -18,3 +18,11 @@ def table(headers, rows) -> str:
 def fmt_vec(v, width=11):
     """Numbers with 6 significant digits; round-off below 1e-12 shows as 0."""
     return " ".join(f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:>{width}.6g}" for x in v)
+
+
+def column_text(values, relative: float = 1e-9, absolute: float = 1e-12) -> list:
+    """A column of numbers with 6 significant digits, each below ``relative`` x the column's largest
+    magnitude (or below ``absolute``) written as 0: round-off is not a value (1.6e-15 deg is 0)."""
+    big = max((abs(v) for v in values if v == v), default=0.0)
+    tiny = max(absolute, relative * big)
+    return [f"{(0.0 if abs(v) < tiny else v) + 0.0:.6g}" for v in values]
