@@ -313,8 +313,8 @@ def _solve(mech, args):
     if not values:
         raise UsageError("solve needs input values: --set NAME=VALUE or --set-angle LINK=ANGLE")
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
-    rates = joint_assignments(mech, args.rate, "--rate", rate=True) if args.rate or args.accel else None
-    accels = joint_assignments(mech, args.accel, "--accel", rate=True) if args.accel else None
+    rates = joint_assignments(mech, args.rate, "--rate", order=1) if args.rate or args.accel else None
+    accels = joint_assignments(mech, args.accel, "--accel", order=2) if args.accel else None
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
@@ -484,7 +484,7 @@ def _ik(mech, args):
     parts = args.pose.replace(",", " ").split()
     if len(parts) != 6:
         raise UsageError(f'--pose expects "x y z roll pitch yaw", got "{args.pose}"')
-    v = [parse_value(p) for p in parts]
+    v = [parse_value(p, "length" if k < 3 else "angle", "--pose") for k, p in enumerate(parts)]
     pose = pin.SE3(pin.rpy.rpyToMatrix(np.array(v[3:])), np.array(v[:3]))
     res = inverse_kinematics(mech, args.output, pose, starts=args.starts)
     if args.json:
@@ -511,7 +511,7 @@ def _sweep(mech, args):
                                                                                       (args.stop, "--to")))
     res = sweep(solver, args.input, start, stop, args.steps,
                 fixed={k: v for k, v in fixed.items() if k != args.input}, near=near,
-                rate=parse_value(args.rate), progress=True, turn=args.turn)
+                rate=joint_value(mech, args.input, args.rate, "--rate", order=1), progress=True, turn=args.turn)
     topo = mech.topology(res.q[0])
     angles = LinkAngles(mech, topo) if topo.motion_space == "planar" and topo.normal is not None else None
     motion = motion_along(mech, res.q, res.rates, res.accelerations, named_points(mech, args), angles,

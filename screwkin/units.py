@@ -9,8 +9,15 @@ case-insensitive, ``30MM``, ``45Deg``):
 
 * angles: ``rad`` (``radian(s)``), ``mrad``, ``deg`` (``degree(s)``, ``°``),
   ``turn(s)`` (one full revolution, 2 pi rad);
-* lengths: ``m``, ``cm``, ``mm``, ``um`` (``µm``, ``μm``), ``in`` (``inch``,
-  ``inches``: 25.4 mm), ``ft`` (``foot``, ``feet``: 0.3048 m).
+* lengths: ``m``, ``cm``, ``mm``, ``um`` (``µm``, ``μm``), ``nm``, ``in`` (``inch``,
+  ``inches``: 25.4 mm), ``ft`` (``foot``, ``feet``: 0.3048 m);
+* rates: ``rad/s``, ``deg/s``, ``rpm`` (``rev/min``), ``rev/s``; ``m/s``, ``mm/s``, ``cm/s``;
+* accelerations: ``rad/s^2``, ``deg/s^2``; ``m/s^2``, ``mm/s^2`` (``s2`` for ``s^2``);
+* forces and moments: ``N``, ``kN``, ``mN``; ``Nm`` (``N*m``, ``N.m``), ``kNm``, ``Nmm``.
+
+Every unit has a kind (:data:`UNIT_TABLE`); where a value's kind is known (a joint's value,
+a length, a rate) a unit of another kind is a usage error.  An angle or length given for a
+rate keeps its old meaning (``--rate crank=90deg`` is 90 deg/s).
 
 Kilometres are not accepted on purpose (no mechanism is that big: ``1km`` is
 more likely a typo than a value).  Numbers are plain decimal ASCII (``1e-3``,
@@ -24,29 +31,54 @@ import re
 
 from .errors import UsageError, quote
 
-__all__ = ["parse_value", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "unit_kind", "LENGTH_RANGE"]
+__all__ = ["parse_value", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "UNIT_TABLE",
+           "unit_kind", "LENGTH_RANGE"]
 
 _DEG = math.pi / 180.0
-UNITS = {
-    "": 1.0,
-    "rad": 1.0, "radian": 1.0, "radians": 1.0, "mrad": 1e-3,
-    "deg": _DEG, "degree": _DEG, "degrees": _DEG, "°": _DEG,
-    "turn": 2 * math.pi, "turns": 2 * math.pi,
-    "m": 1.0, "cm": 0.01, "mm": 0.001, "um": 1e-6, "µm": 1e-6, "μm": 1e-6,
-    "in": 0.0254, "inch": 0.0254, "inches": 0.0254,
-    "ft": 0.3048, "foot": 0.3048, "feet": 0.3048,
+_TURN = 2 * math.pi
+#: unit -> (factor to SI, kind).  Kinds: angle, length, angular rate, linear rate, angular
+#: acceleration, linear acceleration, force, moment.
+UNIT_TABLE = {
+    "rad": (1.0, "angle"), "radian": (1.0, "angle"), "radians": (1.0, "angle"), "mrad": (1e-3, "angle"),
+    "deg": (_DEG, "angle"), "degree": (_DEG, "angle"), "degrees": (_DEG, "angle"), "°": (_DEG, "angle"),
+    "turn": (_TURN, "angle"), "turns": (_TURN, "angle"), "rev": (_TURN, "angle"),
+    "m": (1.0, "length"), "cm": (0.01, "length"), "mm": (0.001, "length"), "um": (1e-6, "length"),
+    "µm": (1e-6, "length"), "μm": (1e-6, "length"), "nm": (1e-9, "length"),
+    "in": (0.0254, "length"), "inch": (0.0254, "length"), "inches": (0.0254, "length"),
+    "ft": (0.3048, "length"), "foot": (0.3048, "length"), "feet": (0.3048, "length"),
+    "rad/s": (1.0, "angular rate"), "deg/s": (_DEG, "angular rate"), "rpm": (_TURN / 60.0, "angular rate"),
+    "rev/s": (_TURN, "angular rate"), "rev/min": (_TURN / 60.0, "angular rate"),
+    "m/s": (1.0, "linear rate"), "mm/s": (1e-3, "linear rate"), "cm/s": (1e-2, "linear rate"),
+    "rad/s^2": (1.0, "angular acceleration"), "deg/s^2": (_DEG, "angular acceleration"),
+    "rad/s2": (1.0, "angular acceleration"), "deg/s2": (_DEG, "angular acceleration"),
+    "m/s^2": (1.0, "linear acceleration"), "mm/s^2": (1e-3, "linear acceleration"),
+    "m/s2": (1.0, "linear acceleration"), "mm/s2": (1e-3, "linear acceleration"),
+    "N": (1.0, "force"), "kN": (1e3, "force"), "mN": (1e-3, "force"),
+    "Nm": (1.0, "moment"), "N*m": (1.0, "moment"), "N.m": (1.0, "moment"), "kNm": (1e3, "moment"),
+    "Nmm": (1e-3, "moment"), "N*mm": (1e-3, "moment"),
 }
-_ANGLES = {"rad", "radian", "radians", "mrad", "deg", "degree", "degrees", "°", "turn", "turns"}
+UNITS = {"": 1.0, **{u: f for u, (f, _) in UNIT_TABLE.items()}}
+_CASE = {u.lower(): u for u in UNIT_TABLE if u.isascii()}  # "KN" -> "kN", "RPM" -> "rpm"
+for _u in list(_CASE):  # a unit written in lower case is itself when it exists so ("nm": nanometre, not N m)
+    if _u in UNIT_TABLE:
+        _CASE[_u] = _u
 #: The smallest and largest characteristic length, grid step or other mechanism length a person may type [m]:
 #: below a nanometre the measures divided by it overflow; no mechanism is 10 km long.
 LENGTH_RANGE = (1e-9, 1e4)
 
 
+def _canonical(unit: str):
+    if unit in UNIT_TABLE:
+        return unit
+    return _CASE.get(unit.lower()) if unit.isascii() else None
+
+
 def unit_kind(unit: str):
-    """'angle', 'length', or None for a bare number (SI of whatever is asked)."""
+    """The kind of a unit ('angle', 'length', 'angular rate', ...), or None for a bare number."""
     if not unit:
         return None
-    return "angle" if (unit if unit in UNITS else unit.lower()) in _ANGLES else "length"
+    u = _canonical(unit)
+    return UNIT_TABLE[u][1] if u else None
 
 
 _NUMBER = re.compile(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*\Z")
@@ -54,9 +86,10 @@ _NUMBER = re.compile(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?
 
 def _unit(text: str):
     """The factor of a unit as typed (case-insensitive for ASCII units), or None."""
-    if text in UNITS:
-        return UNITS[text]
-    return UNITS.get(text.lower()) if text.isascii() else None
+    if not text:
+        return 1.0
+    u = _canonical(text)
+    return UNIT_TABLE[u][0] if u else None
 
 
 def parse_value(text: str, kind: str | None = None, option: str | None = None) -> float:
@@ -68,7 +101,8 @@ def parse_value(text: str, kind: str | None = None, option: str | None = None) -
         raise UsageError(f"{quote(text)} is not a number with an optional unit (e.g. 45deg, 30mm, 1in, 0.5)")
     factor = _unit(m.group(2))
     if factor is None:
-        known = ", ".join(u for u in ("rad", "mrad", "deg", "°", "turn", "m", "cm", "mm", "um", "in", "ft"))
+        known = ", ".join(u for u in ("rad", "mrad", "deg", "°", "turn", "m", "cm", "mm", "um", "in", "ft", "rpm",
+                                      "deg/s", "mm/s", "m/s^2", "N", "kN", "N*m"))
         raise UsageError(f"unknown unit {quote(m.group(2), 20)} in {quote(text)} (known: {known})")
     value = float(m.group(1)) * factor
     if not math.isfinite(value):
@@ -77,7 +111,7 @@ def parse_value(text: str, kind: str | None = None, option: str | None = None) -
     if kind is not None and found is not None and found != kind:
         where = f"{option} " if option else ""
         raise UsageError(f"{where}{quote(text)}: {m.group(2)} is a unit of {found}, {where.strip() or 'this value'} "
-                         f"takes a {kind}")
+                         f"takes {'an' if kind[0] in 'aeiou' else 'a'} {kind}")
     return value
 
 

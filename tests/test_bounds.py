@@ -5,6 +5,7 @@ exist, lengths have a kind and a sane range.  Each case must answer in one line,
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from conftest import ROBOTS, no_hang
@@ -196,3 +197,30 @@ def test_a_bare_angle_beyond_a_turn_warns_and_is_radians(capsys):
     assert crank == pytest.approx(np.mod(30 + np.pi, 2 * np.pi) - np.pi, abs=1e-9)  # 30 rad, wrapped
     assert main(["solve", FOURBAR, "--set", "crank_joint=6", "--json"]) == 0
     assert "warning" not in capsys.readouterr().err  # within a turn: no warning
+
+
+@pytest.mark.parametrize("text,si", [
+    ("60rpm", 2 * 3.141592653589793), ("1 rev/s", 2 * 3.141592653589793), ("90deg/s", 3.141592653589793 / 2),
+    ("3rad/s", 3.0), ("20mm/s", 0.02), ("2m/s^2", 2.0), ("500mm/s2", 0.5), ("180deg/s^2", 3.141592653589793),
+    ("2kN", 2000.0), ("3N*m", 3.0), ("3Nm", 3.0), ("1500Nmm", 1.5), ("5nm", 5e-9), ("5NM", 5e-9), ("2KN", 2000.0),
+])
+def test_units_of_rates_accelerations_forces_and_moments(text, si):
+    from screwkin.units import parse_value
+
+    assert parse_value(text) == pytest.approx(si, rel=1e-15)
+
+
+def test_rates_take_rate_units_and_wrenches_force_and_moment_units(capsys):
+    import json
+
+    assert main(["solve", FOURBAR, "--set", "crank_joint=30deg", "--rate", "crank_joint=60rpm", "--json"]) == 0
+    sol = json.loads(capsys.readouterr().out)["solutions"][0]
+    assert sol["rates"]["crank_joint"] == pytest.approx(2 * np.pi, abs=1e-12)
+    assert sol["links"]["crank"]["omega"] == pytest.approx(2 * np.pi, abs=1e-12)
+    refused(["solve", FOURBAR, "--set", "crank_joint=10rpm"], capsys, "unit of angular rate", "takes angle")
+    refused(["solve", FOURBAR, "--set", "crank_joint=1", "--accel", "crank_joint=2rpm"], capsys, "angular rate")
+    refused(["solve", FOURBAR, "--set", "crank_joint=1", "--rate", "crank_joint=2mm/s"], capsys, "linear rate")
+    refused(["statics", FOURBAR, "--output", "rocker", "--wrench", "0 0 0 0 0 2N"], capsys, "takes a moment")
+    refused(["statics", FOURBAR, "--output", "rocker", "--wrench", "1Nm 0 0 0 0 2"], capsys, "takes a force")
+    refused(SWEEP + ["--rate", "2mm/s"], capsys, "--rate", "linear rate")
+    refused(["ik", ARM, "--output", "flange", "--pose", "0.3 0 0.3 0 0 5mm"], capsys, "takes an angle")

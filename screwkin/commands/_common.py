@@ -66,29 +66,39 @@ def value_kind(mech, joint: str):
     return "length" if mech.translational[c.idx_v] else "angle"
 
 
-def _checked(mech, name, value, unit, option, text, rate=False):
+#: The kinds of unit a joint's value, rate (order 1) and acceleration (order 2) take: an angle or a length
+#: given for a rate or an acceleration keeps its old meaning (--rate crank=90deg is 90 deg/s).
+_KINDS = {("angle", 0): ("angle",), ("angle", 1): ("angle", "angular rate"),
+          ("angle", 2): ("angle", "angular acceleration"), ("length", 0): ("length",),
+          ("length", 1): ("length", "linear rate"), ("length", 2): ("length", "linear acceleration")}
+_WHAT = {0: "value", 1: "rate", 2: "acceleration"}
+
+
+def _checked(mech, name, value, unit, option, text, order=0):
     kind = value_kind(mech, name)
     found = unit_kind(unit)
-    if kind and found and found != kind:
-        raise UsageError(f"{option} {text}: {quote(name)} is {'an' if kind == 'angle' else 'a'} "
-                         f"{kind} joint, {unit} is a unit of {found}")
-    if kind == "angle" and not unit and not rate and abs(value) > 2 * math.pi:
+    if kind and found and found not in _KINDS[kind, order]:
+        raise UsageError(f"{option} {text}: {quote(name)} is {'an' if kind == 'angle' else 'a'} {kind} joint, "
+                         f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
+    if kind == "angle" and not unit and not order and abs(value) > 2 * math.pi:
         print(f"warning: {option} {shorten(name, 60)}={value:g} is read as {value:g} rad = "
               f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
     return value
 
 
-def joint_assignments(mech, items, option: str, rate: bool = False) -> dict:
-    """``NAME=VALUE,...`` of joints: SI values; a unit of the wrong kind for the joint (``crank=30mm``)
-    is a usage error, a bare angle of more than a turn is read as radians with a warning."""
-    return {name: _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", rate)
+def joint_assignments(mech, items, option: str, order: int = 0) -> dict:
+    """``NAME=VALUE,...`` of joints (order 0), their rates (1) or accelerations (2): SI values; a unit
+    of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error, a
+    bare angle of more than a turn is read as radians with a warning."""
+    return {name: _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", order)
             for name, value, unit in parse_typed_assignments(items, option)}
 
 
-def joint_value(mech, joint: str, text: str, option: str) -> float:
-    """One value of ``joint`` typed after ``option`` (``--from -90deg``), checked like joint_assignments."""
+def joint_value(mech, joint: str, text: str, option: str, order: int = 0) -> float:
+    """One value (rate: order 1) of ``joint`` typed after ``option`` (``--from -90deg``), checked like
+    joint_assignments."""
     value, unit = parse_typed_value(text)
-    return _checked(mech, joint, value, unit, option, quote(text, 60))
+    return _checked(mech, joint, value, unit, option, quote(text, 60), order)
 
 
 def add_angle_option(sp):

@@ -130,8 +130,8 @@ def run(mech, args) -> int:
     q0 = mech.generic_configurations()[0].q
     if args.output:
         mech.link_frame(args.output)
-    rates = joint_assignments(mech, args.rate, "--rate", rate=True) or {n: 1.0 for n in names}
-    accels = joint_assignments(mech, args.accel, "--accel", rate=True) or None
+    rates = joint_assignments(mech, args.rate, "--rate", order=1) or {n: 1.0 for n in names}
+    accels = joint_assignments(mech, args.accel, "--accel", order=2) or None
     notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
 
     # ---- the configuration: solved for the inputs (their file values when none are set)

@@ -32,7 +32,7 @@ def run(mech, args) -> int:
         parts = args.wrench.replace(",", " ").split()
         if len(parts) != 6:
             raise UsageError(f'--wrench expects "fx fy fz mx my mz", got {len(parts)} numbers')
-        wrench = [parse_value(p) for p in parts]
+        wrench = [parse_value(p, "force" if k < 3 else "moment", "--wrench") for k, p in enumerate(parts)]
         if args.output is None:
             raise UsageError("--wrench needs --output LINK (the link it is applied to)")
     q = configuration(mech, args)

@@ -239,7 +239,7 @@ def _function(args):
             raise UsageError("--points: at most 200 precision points")
     result = synthesize_function(args.function, _range(args.x_range, "--x-range"),
                                  _range(args.input_range, "--input-range"), _range(args.output_range, "--output-range"),
-                                 points, args.spacing, parse_value(args.ground))
+                                 points, args.spacing, parse_value(args.ground, "length", "--ground"))
     check, tmp = _realize(result.design, args.out)
     if result.defects and not check.defects:  # the closed form saw a defect that screwkin's check did not
         check = replace(check, defects=tuple(f"closed form: {d}" for d in result.defects))
