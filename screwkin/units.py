@@ -5,7 +5,8 @@ Rates and accelerations take the same suffixes (``90deg`` in ``--rate`` means
 90 deg/s).
 
 Units (a space between number and unit is allowed, ``30 mm``; ASCII units are
-case-insensitive, ``30MM``, ``45Deg``):
+case-insensitive, ``30MM``, ``45Deg``, ``2KN``, except where two differ by case only:
+``nm`` is a nanometre, ``Nm`` a newton metre, and ``NM`` is an error):
 
 * angles: ``rad`` (``radian(s)``), ``mrad``, ``deg`` (``degree(s)``, ``°``),
   ``turn(s)`` (one full revolution, 2 pi rad);
@@ -58,10 +59,11 @@ UNIT_TABLE = {
     "Nmm": (1e-3, "moment"), "N*mm": (1e-3, "moment"),
 }
 UNITS = {"": 1.0, **{u: f for u, (f, _) in UNIT_TABLE.items()}}
-_CASE = {u.lower(): u for u in UNIT_TABLE if u.isascii()}  # "KN" -> "kN", "RPM" -> "rpm"
-for _u in list(_CASE):  # a unit written in lower case is itself when it exists so ("nm": nanometre, not N m)
-    if _u in UNIT_TABLE:
-        _CASE[_u] = _u
+_CASE = {}  # lower case -> the unit ("KN" -> "kN", "RPM" -> "rpm"), or a tuple when two units differ by case only
+for _u in UNIT_TABLE:
+    if _u.isascii():
+        _CASE.setdefault(_u.lower(), []).append(_u)
+_CASE = {k: v[0] if len(v) == 1 else tuple(v) for k, v in _CASE.items()}
 #: The smallest and largest characteristic length, grid step or other mechanism length a person may type [m]:
 #: below a nanometre the measures divided by it overflow; no mechanism is 10 km long.
 LENGTH_RANGE = (1e-9, 1e4)
@@ -70,7 +72,11 @@ LENGTH_RANGE = (1e-9, 1e4)
 def _canonical(unit: str):
     if unit in UNIT_TABLE:
         return unit
-    return _CASE.get(unit.lower()) if unit.isascii() else None
+    u = _CASE.get(unit.lower()) if unit.isascii() else None
+    if isinstance(u, tuple):  # NM: nanometre or newton metre -- not a guess
+        raise UsageError(f"unit {quote(unit, 20)} is ambiguous: write {' or '.join(u)} ("
+                         + ", ".join(UNIT_TABLE[x][1] for x in u) + ")")
+    return u
 
 
 def unit_kind(unit: str):
