@@ -527,7 +527,8 @@ def _sweep(mech, args):
         with open(args.csv, "w") as f:
             f.write(sweep_csv(res))
     if args.plot:
-        sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational,
+        sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
+                   normal=None if angles is None else angles.n,
                    title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
     if args.json:
         d = sweep_dict(res, mech)

@@ -223,3 +223,37 @@ def test_sweep_reports_the_slider_and_the_links_at_every_step(tmp_path, capsys):
         f = phi(t, 1.0) - np.arctan2(B_REL[1], B_REL[0])  # the rod frame: B_REL in it points along A -> B
         M = A + 0.06 * np.array([np.cos(f), np.sin(f)])
         assert d["points"]["M"]["position"][k] == pytest.approx([*M, 0.0], abs=1e-9)
+
+
+def test_sweep_plot_shows_absolute_link_motion_and_point_paths(tmp_path):
+    """The planar sweep plot draws the links' absolute angle/omega/alpha (the vector-loop angle of the
+    coupler, unwrapped) and the slider's loop coordinate, and a panel with the point's path in mm."""
+    pytest.importorskip("matplotlib")
+    from screwkin.analysis.motion import Point, motion_along
+    from screwkin.analysis.planar import LinkAngles
+    from screwkin.analysis.sweep import sweep
+    from screwkin.present.plots import absolute_series, sweep_figure
+
+    path = tmp_path / "slider.urdf"
+    path.write_text(SLIDER)
+    mech = load(str(path))
+    solver = PositionSolver(mech, ["crank_joint"])
+    res = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 36)
+    topo = mech.topology(res.q[0])
+    angles = LinkAngles(mech, topo)
+    motion = motion_along(mech, res.q, res.rates, res.accelerations, (Point("M", "rod", (0.06, 0.0, 0.0)),),
+                          angles, angles.n)
+    series, lengths = absolute_series(res, motion, mech.translational)
+    assert series.names == ("crank (angle)", "rod (angle)", "guide (loop)")  # the slider block does not turn
+    assert list(lengths) == [False, False, True]
+    (x, xd, _), (phi, phid, _) = _slider_closed_form()
+    t = np.asarray(res.values) + np.arctan2(A_Y, A_X)
+    assert series.joints[:, 2] == pytest.approx([x(tk, 1.0) for tk in t], abs=1e-9)
+    assert series.rates[:, 1] == pytest.approx([phid(tk, 1.0) for tk in t], abs=1e-8)
+    xy = np.asarray(motion.points["M"]["position"])[:, :2]
+    fig = sweep_figure(series, linear=lengths, paths={"M": xy}, absolute=True)
+    line = next(ln for ax in fig.axes for ln in ax.get_lines() if ln.get_label() == "M (path)")
+    assert np.allclose(line.get_xdata(), 1000 * xy[:, 0]) and np.allclose(line.get_ydata(), 1000 * xy[:, 1])
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

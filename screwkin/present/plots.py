@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..errors import UsageError
@@ -34,7 +36,7 @@ def _nearest_turn(angle, along):
     return float(cand[np.argmin(np.abs(cand - along))])
 
 
-def sweep_figure(res, mus=None, singularities=(), title=None, linear=None):
+def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute=False):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
     in degrees on the left axis, lengths in mm on a right axis of their own (dashed); every
@@ -53,10 +55,28 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None):
     if joints.ndim == 2 and joints.shape[1] == n and len(joints):
         joints[:, ~linear] = np.unwrap(joints[:, ~linear], axis=0)
     scale = np.where(linear, 1000.0, 180.0 / np.pi)  # mm, deg
-    rows = [("joint value", joints, "deg", "mm"),
-            (f"rate (input rate {res.rate:g} {'rad' if x_deg else 'm'}/s)", np.asarray(res.rates), "deg/s", "mm/s"),
-            ("acceleration", np.asarray(res.accelerations), "deg/s²", "mm/s²")]
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 9))
+    first = "absolute angle, position" if absolute else "joint value"
+    rates_what = "omega, rate" if absolute else "rate"
+    rows = [(first, joints, "deg", "mm"),
+            (f"{rates_what} (input rate {res.rate:g} {'rad' if x_deg else 'm'}/s)", np.asarray(res.rates), "deg/s",
+             "mm/s"),
+            ("alpha, acceleration" if absolute else "acceleration", np.asarray(res.accelerations), "deg/s²", "mm/s²")]
+    if paths:
+        fig = plt.figure(figsize=(8, 13))
+        grid = fig.add_gridspec(4, 1, height_ratios=[1, 1, 1, 1.4])
+        axes = [fig.add_subplot(grid[0])]
+        axes += [fig.add_subplot(grid[k], sharex=axes[0]) for k in (1, 2)]
+        path_ax = fig.add_subplot(grid[3])
+        for k, (name, xy) in enumerate(paths.items()):
+            path_ax.plot(1000 * xy[:, 0], 1000 * xy[:, 1], color=f"C{k}", label=f"{name} (path)")
+            path_ax.plot(1000 * xy[0, 0], 1000 * xy[0, 1], "o", color=f"C{k}", markersize=4)
+        path_ax.set_aspect("equal", adjustable="datalim")
+        path_ax.set_xlabel("x [mm] (in the plane)")
+        path_ax.set_ylabel("y [mm]")
+        path_ax.legend(fontsize=7, loc="best")
+        path_ax.set_title("point paths (a dot at the first step)", fontsize=9)
+    else:
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 9))
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for r, (what, data, a_unit, l_unit) in enumerate(rows):
         ax = axes[r]
@@ -96,11 +116,53 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None):
     return fig
 
 
-def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None):
-    """Joint values, rates and accelerations against the input (SweepResult), into a PNG
-    (see :func:`sweep_figure` for what is drawn)."""
+def absolute_series(res, motion, linear=None):
+    """The sweep's curves in absolute quantities (issue 24): for a planar mechanism each link that
+    turns (its vector-loop angle, omega, alpha about the plane's normal) and each slider coordinate
+    (prismatic tree or loop joint: position, rate, acceleration); ``res`` with those as its
+    ``names``/``joints``/``rates``/``accelerations``, and their length mask.  None when there are no
+    absolute angles (a spatial mechanism): the joints are drawn then."""
+    links = {n: m for n, m in (motion.links if motion is not None else {}).items() if "angle" in m}
+    if not links:
+        return None
+    names, values, rates, accs, lengths = [], [], [], [], []
+    for name, m in links.items():
+        angle = np.unwrap(np.asarray(m["angle"], float))
+        if np.ptp(angle) < 1e-9 and np.ptp(np.asarray(m["omega"], float)) < 1e-9:
+            continue  # a link that does not turn (a slider block): its position is the slider's coordinate
+        names.append(f"{name} (angle)")
+        values.append(angle), rates.append(np.asarray(m["omega"])), accs.append(np.asarray(m["alpha"]))
+        lengths.append(False)
+    mask = np.zeros(len(res.names), bool) if linear is None or len(linear) != len(res.names) else np.asarray(linear)
+    for k in np.flatnonzero(mask):
+        names.append(res.names[k])
+        values.append(res.joints[:, k]), rates.append(res.rates[:, k]), accs.append(res.accelerations[:, k])
+        lengths.append(True)
+    for name, v in motion.loop_joints.items():
+        if name not in motion.angular_loop:
+            names.append(f"{name} (loop)")
+            values.append(v), rates.append(motion.loop_rates[name]), accs.append(motion.loop_accelerations[name])
+            lengths.append(True)
+    stack = lambda cols: np.stack(cols, axis=1) if cols else np.zeros((len(res.values), 0))  # noqa: E731
+    return replace(res, names=tuple(names), joints=stack(values), rates=stack(rates),
+                   accelerations=stack(accs)), np.array(lengths, bool)
+
+
+def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
+    """A sweep into a PNG (see :func:`sweep_figure` for what is drawn): for a planar mechanism with
+    ``motion`` (analysis.motion.MotionAlong) the links' absolute angle, omega and alpha and the
+    sliders' coordinates, else the joint values; the named points' paths in a fourth panel."""
     plt = _pyplot("--plot")
-    fig = sweep_figure(res, mus, singularities, title, linear)
+    absolute = absolute_series(res, motion, linear)
+    if absolute is not None:
+        res, linear = absolute
+    paths = {}
+    if motion is not None and motion.points:
+        from ..analysis.planar import plane_basis
+
+        e1, e2, _ = plane_basis(normal if normal is not None else (0.0, 0.0, 1.0))
+        paths = {n: np.asarray(p["position"]) @ np.stack([e1, e2], axis=1) for n, p in motion.points.items()}
+    fig = sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None)
     fig.savefig(path, dpi=100)
     plt.close(fig)
 
