@@ -118,13 +118,17 @@ class AssemblyError(MechanismFileError):
     best start), from ``starts`` starting configurations when a search was made.
     """
 
-    def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None):
+    def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None,
+                 reason: str | None = None):
         self.residual = float(residual)
         self.iterations = int(iterations)
         self.starts = starts
+        self.reason = reason
         how = (f"from {starts} starting configurations" if starts and starts > 1
                else f"after {self.iterations} iterations")
-        msg = f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}"
+        msg = (f"cannot assemble the mechanism: {reason}; the loop-closure residual got down to "
+               f"{self.residual:.3g} {how}" if reason else
+               f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}")
         if detail:
             msg += f" ({detail})"
         super().__init__(path, msg)

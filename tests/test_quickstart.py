@@ -52,3 +52,26 @@ def test_quickstart_runs_verbatim(tmp_path):
     for name in ("sweep.png", "fourbar.svg", "fourbar.html"):
         assert (work / name).stat().st_size > 1000, name
     assert "Grashof crank-rocker" in out and re.search(r"\nP\s+coupler\s", out)
+
+
+def test_a_loop_that_cannot_close_is_explained_in_its_lengths(tmp_path, capsys):
+    """The quick start's four-bar with its ground at 0.25 m: 0.25 > 0.04 + 0.12 + 0.08 = 0.24, said so."""
+    from screwkin.cli import main
+
+    text = quickstart().split("<<'EOF'\n", 1)[1].split("\nEOF\n", 1)[0]
+    assert '<origin xyz="0.10 0 0"/>' in text
+    path = tmp_path / "long.urdf"
+    path.write_text(text.replace('<origin xyz="0.10 0 0"/>', '<origin xyz="0.25 0 0"/>'))
+    assert main(["mobility", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "loop B cannot close, ground 0.25 m > " in err and f"= {0.04 + 0.12 + 0.08:.6g} m" in err
+    for link in ("crank", "coupler", "rocker"):
+        assert link in err.split("ground 0.25 m > ", 1)[1].split("=", 1)[0]
+
+
+def test_closable_bundled_mechanisms_have_no_closure_obstacle():
+    from screwkin import load
+
+    for name in ("fourbar_crank_rocker", "fourbar_non_grashof", "five_bar", "watt_sixbar", "stephenson_sixbar",
+                 "planar_3rrr", "bennett", "rssr"):
+        assert load(str(ROOT / "robots" / f"{name}.urdf")).closure_obstacle() is None, name
