@@ -260,3 +260,22 @@ def test_bad_output_is_a_usage_error(args, message, tmp_path, capsys, monkeypatc
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err and FOURBAR in err
     assert not list(tmp_path.iterdir())
+
+
+def test_the_users_joint_letters_are_kept_and_links_numbered_once(tmp_path):
+    """The quick start's four-bar names its joints O2, A, O4 and B (the loop joint): the drawing keeps
+    them; equations numbers the links as draw does (ground 1, crank 2, coupler 3, rocker 4)."""
+    from screwkin.analysis.equations import equations
+
+    text = (ROBOTS.parent / "README.md").read_text().split("cat > fourbar.urdf <<'EOF'\n", 1)[1].split("\nEOF\n")[0]
+    path = tmp_path / "fourbar.urdf"
+    path.write_text(text)
+    mech, q = assembled(str(path))
+    skel = skeleton(mech, q)
+    assert {j.letter: j.name for j in skel.joints} == {"O2": "O2", "A": "A", "O4": "O4", "B": "B"}
+    numbers = {lk.name: lk.number for lk in skel.links}
+    assert numbers == {"ground": 1, "crank": 2, "coupler": 3, "rocker": 4}
+    assert equations(mech, q).numbers == numbers
+    # a mechanism whose joint names are long keeps the textbook letters A, B, C, D
+    mech, q = assembled(FOURBAR)
+    assert sorted(j.letter for j in skeleton(mech, q).joints) == ["A", "B", "C", "D"]

@@ -2,8 +2,9 @@
 
 Planar mechanisms of revolute and prismatic joints: the vector-loop method.
 
-- Links are numbered as a textbook does: the ground 1, the others 2, 3, ... in the file's
-  order.  Each moving link has one absolute angle theta_k (the ``link_angles`` of
+- Links are numbered as a textbook does and as ``screwkin draw`` numbers them
+  (screwkin.analysis.skeleton.numbering): the ground 1, then 2, 3, ... along the chain from the
+  input.  Each moving link has one absolute angle theta_k (the ``link_angles`` of
   ``solve``: screwkin.analysis.planar.LinkAngles, counterclockwise about the plane's normal
   from the ground's x axis); links joined by prismatic joints turn together and share the
   angle of the lowest-numbered one (the ground's links: constant angles).
@@ -53,6 +54,7 @@ import pinocchio as pin
 from ..errors import MechanismFileError, UsageError
 from ..model.linalg import rank
 from .planar import LinkAngles
+from .skeleton import numbering
 from .screws import structure
 from .singular import Generic, classify, scaled_jacobians
 
@@ -219,9 +221,8 @@ class VectorLoops:
             mech.coordinate(n)  # an unknown name is a one-line UsageError
         self.angles = LinkAngles(mech, topo)
         self.e1, self.e2, self.n = self.angles.e1, self.angles.e2, self.angles.n
-        ground = topo.ground
-        order = [ground] + [lk for lk in topo.links if lk != ground]
-        self.numbers = {lk: k + 1 for k, lk in enumerate(order)}
+        # the one link numbering of screwkin (draw, report, equations): ground 1, then along the chain from the input
+        self.numbers = dict(numbering(topo, self.inputs_joints)[0])
         self._build_classes()
         self._measure()
         self._build_loops()

@@ -20,6 +20,7 @@ projected onto the plane of the two largest principal directions of its joint ce
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -203,6 +204,11 @@ class SingularSearch:
     motion: object = None  # the SweepResult followed (joint values, rates, accelerations along the range)
 
 
+#: Joint names of at most this many letters and digits, the first a capital (A, B, O2, O4), are kept as
+#: the joints' letters in drawings.
+SHORT_NAME = 3
+
+
 def letters(k: int) -> str:
     """0 -> A, 25 -> Z, 26 -> AA, ..."""
     s = ""
@@ -219,16 +225,28 @@ def _is_input(joint, inputs) -> bool:
 
 def numbering(topo, inputs=()) -> tuple:
     """(link name -> number, joint name -> letter, joints in letter order) for a topology:
-    ground 1 and a depth-first walk from it (see the module docstring)."""
+    ground 1 and a depth-first walk from it (see the module docstring).  A joint whose name is at
+    most SHORT_NAME letters and digits, the first a capital (A, B, O2), keeps it as its letter; the others are lettered
+    A, B, C, ... skipping the letters so taken."""
     inputs = set(inputs)
     order = sorted(range(len(topo.joints)),
                    key=lambda k: (not _is_input(topo.joints[k], inputs), topo.joints[k].cut, k))
     joints = [topo.joints[k] for k in order]
     number, letter, lettered = {topo.ground: 1}, {}, []
+    # the user's own short joint names (A, B, O2, O4: up to 3 characters) are their letters; the others
+    # get the next free letter (a legend names them)
+    own = {j.name for j in joints if re.fullmatch(rf"[A-Z][A-Za-z0-9]{{0,{SHORT_NAME - 1}}}", j.name)}
+    taken, next_letter = set(own), [0]
 
     def mark(j):
         if j.name not in letter:
-            letter[j.name] = letters(len(lettered))
+            if j.name in own:
+                letter[j.name] = j.name
+            else:
+                while letters(next_letter[0]) in taken:
+                    next_letter[0] += 1
+                letter[j.name] = letters(next_letter[0])
+                taken.add(letter[j.name])
             lettered.append(j)
 
     def visit(link):
