@@ -257,3 +257,39 @@ def test_sweep_plot_shows_absolute_link_motion_and_point_paths(tmp_path):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+@pytest.mark.parametrize("crank_deg", [30.0, 100.0, 215.0, 320.0])
+def test_four_bar_diagonal_construction_by_the_law_of_cosines(crank_deg, capsys):
+    """issue 25 item 1: z^2 = a^2 + d^2 - 2ad cos t2; cos beta = (z^2 + d^2 - a^2) / 2zd;
+    cos alpha = (z^2 + c^2 - b^2) / 2zc; cos mu = (b^2 + c^2 - z^2) / 2bc; and theta4 = 180 - beta -+ alpha."""
+    a, b, c, d = 0.04, 0.12, 0.08, 0.1
+    t2 = np.radians(crank_deg)
+    argv = ["solve", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", f"crank_joint={crank_deg - 60}deg", "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    z = np.sqrt(a * a + d * d - 2 * a * d * np.cos(t2))
+    beta = np.arccos((z * z + d * d - a * a) / (2 * z * d))
+    alpha = np.arccos((z * z + c * c - b * b) / (2 * z * c))
+    mu = np.arccos((b * b + c * c - z * z) / (2 * b * c))
+    for sol in out["solutions"]:
+        fb = sol["four_bar"]
+        assert fb["diagonal"] == pytest.approx(z, abs=1e-12)
+        assert fb["beta"] == pytest.approx(beta, abs=1e-9) and fb["alpha"] == pytest.approx(alpha, abs=1e-9)
+        assert fb["transmission_angle"] == pytest.approx(mu, abs=1e-9)
+        t4 = sol["links"]["rocker"]["angle"]
+        s = 1.0 if np.sin(t2) >= 0 else -1.0  # the crank tip above or below the ground line
+        options = [s * (np.pi - beta) + alpha, s * (np.pi - beta) - alpha]
+        assert min(abs(np.mod(t4 - o + np.pi, 2 * np.pi) - np.pi) for o in options) < 1e-8  # arccos near 0: 1e-9
+
+
+def test_slider_crank_transmission_angle_per_solution(tmp_path, capsys):
+    """mu is the angle between the rod and the normal of the slide: 90 deg - |phi|, phi the rod's angle."""
+    path = tmp_path / "slider.urdf"
+    path.write_text(SLIDER)
+    assert main(["solve", str(path), "--set", "crank_joint=40deg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for sol in out["solutions"]:
+        phi = sol["links"]["rod"]["angle"]
+        expected = np.pi / 2 - abs(np.arcsin(np.sin(phi)))
+        assert sol["slider_crank"]["transmission_angle"] == pytest.approx(expected, abs=1e-9)

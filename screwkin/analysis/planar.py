@@ -38,6 +38,19 @@ class LinkageInfo:
     input_range: tuple | None  # (low, high) joint values; None: the input turns fully
     limit_inputs: tuple  # input joint values where the output is at a limit position
     transmission_angle: float  # mu [rad] at the configuration analysed
+    # four-bar: the textbook's diagonal construction at the configuration analysed: diagonal z from the
+    # crank tip to the output pivot [m]; at the output pivot, alpha between the diagonal and the output
+    # link and beta between the diagonal and the ground link [rad, 0..pi]
+    diagonal: float | None = None
+    alpha: float | None = None
+    beta: float | None = None
+
+    def construction(self) -> dict:
+        """JSON-ready: four-bar {transmission_angle, diagonal, alpha, beta}; slider-crank {transmission_angle}."""
+        d = {"kind": self.kind, "transmission_angle": self.transmission_angle}
+        if self.diagonal is not None:
+            d.update(diagonal=self.diagonal, alpha=self.alpha, beta=self.beta)
+        return d
 
 
 def _rot(v, ang):
@@ -160,7 +173,12 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
                 continue
             limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
     mu = float(np.arccos(np.clip(np.dot(B - C, D - C) / (b * c), -1, 1)))
-    return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu)
+    z = float(np.linalg.norm(B - D))
+    alpha = beta = None
+    if z > 0:  # (the diagonal vanishes when the crank tip sits on the output pivot)
+        alpha = float(np.arccos(np.clip(np.dot(B - D, C - D) / (z * c), -1, 1)))
+        beta = float(np.arccos(np.clip(np.dot(B - D, A - D) / (z * g), -1, 1)))
+    return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu, z, alpha, beta)
 
 
 def _slider_crank(name, q_in, A, B, C, s, a, b):

@@ -39,7 +39,7 @@ from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, angular_loop_joints
 from .mobility import analyze_mobility
 from .motion import link_motions, point_motions
-from .planar import LinkAngles
+from .planar import LinkAngles, identify
 from .singular import Generic, measures, scaled_jacobians
 
 __all__ = ["within_limits", "Solution", "PositionResult", "PositionSolver", "TraceStep", "inverse_kinematics", "outside_limits"]
@@ -106,6 +106,7 @@ class Solution:
     loop_accelerations: dict | None = None  # ... and accelerations [rad/s^2 or m/s^2]
     links: dict | None = None  # link name -> absolute motion (analysis.motion.link_motions)
     points: dict | None = None  # named points -> their motion (analysis.motion.point_motions)
+    linkage: dict | None = None  # a four-bar's diagonal construction (mu, z, alpha, beta) or a slider-crank's mu
 
     @property
     def physical(self) -> bool:
@@ -562,6 +563,13 @@ class PositionSolver:
             self._labelling = (legs, turned)
         return self._labelling or None
 
+    def _linkage(self, q):
+        """A four-bar's or slider-crank's textbook construction at q (planar.identify), or None."""
+        if len(self.inputs) != 1 or self._plane_normal() is None or len(self.mech.cuts) != 1:
+            return None
+        info = identify(self.mech, self.mech.topology(q), q, self.inputs[0])
+        return None if info is None else info.construction()
+
     def _plane_normal(self):
         if self._angles is False:
             self._link_angles(self.mech.neutral())
@@ -605,7 +613,7 @@ class PositionSolver:
                         loop_joints=state.loop_joints or None, loop_rates=state.loop_rates or None,
                         loop_accelerations=state.loop_accelerations or None,
                         links=link_motions(state, angles, self._plane_normal()),
-                        points=point_motions(state, points) or None)
+                        points=point_motions(state, points) or None, linkage=self._linkage(q))
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))

@@ -7,7 +7,7 @@ import numpy as np
 
 from .tables import column_text, fmt_vec, table
 
-__all__ = ["links_table", "points_table", "motion_dict"]
+__all__ = ["links_table", "points_table", "motion_dict", "linkage_construction_text"]
 
 
 def links_table(links: dict) -> str:
@@ -48,6 +48,18 @@ def points_table(points: dict) -> str:
     head = ["point", "link", "position [m]"] + (["velocity [m/s]", "acceleration [m/s^2]"]
                                                  if any("velocity" in m for m in points.values()) else [])
     return "points (world axes)\n" + table(head, rows)
+
+
+def linkage_construction_text(d: dict) -> str:
+    """The textbook's construction of a four-bar (diagonal z, its angles at the output pivot) or
+    a slider-crank's transmission angle, in degrees."""
+    mu = f"transmission angle mu = {np.degrees(d['transmission_angle']):.6g} deg"
+    if d.get("diagonal") is None:
+        return f"{d['kind']}: {mu}"
+    angles = "" if d.get("alpha") is None else (f", at the output pivot alpha = {np.degrees(d['alpha']):.6g} deg "
+                                                 f"(diagonal to output link), beta = {np.degrees(d['beta']):.6g} deg "
+                                                 "(diagonal to ground link)")
+    return f"four-bar: {mu}, diagonal z (crank tip to output pivot) = {d['diagonal']:.6g} m{angles}"
 
 
 def motion_dict(m) -> dict:

@@ -17,7 +17,7 @@ from ..analysis.screws import Screw, planar_form, screw_of
 from ..analysis.singular import SingularityReport
 from ..analysis.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
-from .motion import links_table, points_table
+from .motion import linkage_construction_text, links_table, points_table
 from .tables import fmt_vec as _fmt_vec
 from .tables import table
 
@@ -227,6 +227,8 @@ def position_dict(res) -> dict:
             d["links"] = s.links
         if s.points:
             d["points"] = s.points
+        if s.linkage:
+            d["four_bar" if s.linkage["kind"] == "four-bar" else "slider_crank"] = s.linkage
         if s.output_pose is not None:
             d["output_pose"] = s.output_pose.tolist()
             d["output_position"] = s.output_position.tolist()
@@ -320,6 +322,8 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
             lines.append(links_table(s.links))
         if s.points:
             lines.append(points_table(s.points))
+        if s.linkage:
+            lines.append(linkage_construction_text(s.linkage))
         if s.output_pose is not None:
             p = s.output_pose
             lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m, roll pitch yaw "
