@@ -27,7 +27,7 @@ from .analysis.motion import motion_along
 from .analysis.planar import LinkAngles, identify
 from .analysis.position import PositionSolver, inverse_kinematics
 from .analysis.scan import scan
-from .analysis.screws import structure
+from .analysis.screws import loop_screws, structure
 from .analysis.singular import classify
 from .analysis.sweep import locate_singularities, sweep
 from .commands import draw, grasp, synthesize
@@ -58,6 +58,8 @@ from .present.report import (
     joint_types_dict,
     joint_types_text,
     linkage_dict,
+    loops_dict,
+    loops_text,
     map_csv,
     mobility_dict,
     mobility_text,
@@ -344,10 +346,14 @@ def _screws(mech, args):
     normal = None
     if topo.motion_space == "planar":
         normal = topo.normal
+    loops = loop_screws(mech)
     if args.json:
-        print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal)}), indent=2))
+        print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal),
+                                      "loops": loops_dict(loops, normal)}), indent=2))
     else:
         print(screws_text(st, normal))
+        if loops:
+            print(loops_text(loops, normal))
     return 0
 
 

@@ -5,7 +5,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import CORPUS, fourbar
+from conftest import CORPUS, DATA, fourbar
 from screwkin.analysis.screws import chains, planar_form, poe, screw_of, split_jacobians, structure
 
 
@@ -85,3 +85,43 @@ def test_batched_singular_values_match_one_by_one():
         Jk[:3] /= 0.5
         assert abs(np.linalg.svd(Jk, compute_uv=False)[-1] - s[k]) < 1e-12
     assert (s[:10] < 1e-12).all() and (s[10:] > 1e-6).all()
+
+
+def test_every_joint_of_a_loop_the_cut_joint_included(capsys):
+    """issue 25 item 4: the R-R-P-R loop of tests/data/student/rrpr.urdf (A at the origin, B at the crank tip
+    (0.1, 0), D at (0.1, 0), the slide cut along x): the loop lists D, the cut slide, then B and A backwards,
+    with the twists written by hand, and the product of their exponentials is the identity at solved
+    configurations (Pinocchio's exp6, the cut joint's value from the kinematic state)."""
+    import json
+
+    import numpy as np
+    import pinocchio as pin
+
+    from screwkin import load
+    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.screws import loop_product, loop_screws
+    from screwkin.cli import main
+    from screwkin.model.state import KinematicState
+
+    path = str(DATA / "student" / "rrpr.urdf")
+    mech = load(path)
+    (loop,) = loop_screws(mech)
+    assert loop.joints == ("D", "slide", "B", "A") and loop.signs == (1, 1, -1, -1) and loop.closed_at_reference
+    by_hand = {"D": [0, -0.1, 0, 0, 0, 1], "slide": [1, 0, 0, 0, 0, 0], "B": [0, -0.1, 0, 0, 0, 1],
+               "A": [0, 0, 0, 0, 0, 1]}  # revolute (-w x p, w), prismatic (v, 0)
+    for k, name in enumerate(loop.joints):
+        np.testing.assert_allclose(loop.xi0[:, k], by_hand[name], atol=1e-12)
+    cut = mech.cuts[0]
+    for a in (0.4, 1.3, -2.0):
+        for sol in PositionSolver(mech, ["A"]).solve({"A": a}).solutions:
+            dq = dict(zip(mech.coordinate_names, pin.difference(mech.model, mech.neutral(), sol.q)))
+            theta = [KinematicState(mech, sol.q).loop_value(cut) if n == "slide" else dq[n] for n in loop.joints]
+            np.testing.assert_allclose(loop_product(loop, theta), np.eye(4), atol=1e-9)
+    assert main(["screws", path, "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert [j["joint"] for j in d["loops"][0]["joints"]] == ["D", "slide", "B", "A"]
+    assert d["loops"][0]["joints"][1]["cut"] is True
+    assert d["loops"][0]["joints"][0]["xi0_planar"] == pytest.approx([0, -0.1, 1])
+    assert main(["screws", path]) == 0
+    assert "exp([xi_D] th_D) exp([xi_slide] th_slide) exp(-[xi_B] th_B) exp(-[xi_A] th_A) = I" in \
+        capsys.readouterr().out

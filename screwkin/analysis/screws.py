@@ -24,7 +24,8 @@ from ..errors import UsageError
 from ..model._pin import frame_jacobian
 from ..model.linalg import null_space
 
-__all__ = ["Screw", "Chain", "screw_of", "chains", "chains_to", "poe", "structure", "split_jacobians"]
+__all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
+           "loop_product", "split_jacobians"]
 
 
 @dataclass(frozen=True)
@@ -125,6 +126,82 @@ def structure(mech, q, output=None):
         result.append({"chain": ch, "theta": joint_angles(mech, q, ch), "space_jacobian": Js, "body_jacobian": Jb,
                        "g": data.oMf[ch.frame].homogeneous.copy()})
     return result
+
+
+@dataclass(frozen=True)
+class LoopScrews:
+    """A loop written as the product of exponentials of all its joints, the cut joint included:
+
+        exp([xi_1] th_1) ... exp([xi_k] th_k) exp([xi_c] th_c) exp(-[xi'_m] th'_m) ... exp(-[xi'_1] th'_1) = I
+
+    from the ground side of F1 (the tree joints that carry link1, base to tip, less those shared
+    with F2's side), the cut joint, then F2's side back down (its joints' angles counted against
+    the loop's direction: sign -1).  Twists in the space frame at the reference configuration (the
+    file's, every joint zero), where the identity holds when the file is drawn closed."""
+
+    cut: str
+    joints: tuple  # joint names in loop order
+    signs: tuple  # +1 along the loop, -1 for F2's side
+    xi0: np.ndarray  # (6, n) twists at the reference configuration, in loop order
+    closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
+
+
+def _cut_twist(mech, c, data) -> np.ndarray | None:
+    """The cut joint's space twist at the configuration in ``data``: (-w x p, w) for a revolute
+    about the axis through F1's origin, (v, 0) for a prismatic along it; None for other types."""
+    M = data.oMf[c.frame1]
+    a = M.rotation @ np.asarray(c.axis, float)
+    a = a / np.linalg.norm(a)
+    if c.type in ("revolute", "continuous"):
+        return np.concatenate([-np.cross(a, M.translation), a])
+    if c.type == "prismatic":
+        return np.concatenate([a, np.zeros(3)])
+    return None
+
+
+def loop_screws(mech) -> list:
+    """A LoopScrews for each one-coordinate cut joint (revolute, continuous, prismatic; no higher pair)."""
+    model, data = mech.model, model_data(mech)
+    q0 = mech.neutral()
+    pin.computeJointJacobians(model, data, q0)
+    pin.updateFramePlacements(model, data)
+    out = []
+    for c in mech.cuts:
+        if c.pair or c.dof != 1:
+            continue
+        xi_c = _cut_twist(mech, c, data)
+        if xi_c is None:
+            continue
+        sides = []
+        for f in (c.frame1, c.frame2):
+            jid = model.frames[f].parentJoint
+            sides.append([j for j in model.supports[jid] if j > 0])
+        shared = set(sides[0]) & set(sides[1])
+        one, two = ([j for j in side if j not in shared] for side in sides)
+        if any(model.nvs[j] != 1 for j in one + two):
+            continue  # the product of exponentials here takes 1-DOF joints
+        Jw = {j: frame_jacobian(model, data, f, pin.ReferenceFrame.WORLD)
+              for f, side in ((c.frame1, one), (c.frame2, two)) for j in side}
+        cols = [Jw[j][:, model.idx_vs[j]] for j in one] + [xi_c] + [Jw[j][:, model.idx_vs[j]] for j in reversed(two)]
+        names = [model.names[j] for j in one] + [c.name] + [model.names[j] for j in reversed(two)]
+        signs = [1] * (len(one) + 1) + [-1] * len(two)
+        closed = data.oMf[c.frame1].isApprox(data.oMf[c.frame2], mech.tolerances.geometry)
+        out.append(LoopScrews(c.name, tuple(names), tuple(signs), np.array(cols).T.copy(), bool(closed)))
+    return out
+
+
+def loop_product(loop: LoopScrews, theta) -> np.ndarray:
+    """The left side of the loop's equation, a 4x4 matrix, for joint displacements ``theta`` in loop
+    order (the cut joint's as model.state.KinematicState.loop_value); the identity when the loop closes."""
+    M = pin.SE3.Identity()
+    for k in range(len(loop.joints)):
+        M = M * pin.exp6(pin.Motion(loop.signs[k] * loop.xi0[:, k] * theta[k]))
+    return M.homogeneous
+
+
+def model_data(mech):
+    """A Data of its own for an analysis (nothing left in, or read from, the mechanism's shared Data)."""
+    return mech.model.createData()
 
 
 def planar_form(xi, normal):

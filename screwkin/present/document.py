@@ -26,7 +26,14 @@ import numpy as np
 
 from ..analysis.equations import PlanarEquations
 from .equations import Units, equations_text, greek, newton_text
-from .report import JOINT_COLUMNS, count_rows, joint_rows, screw_theory_rows, screws_text, to_jsonable
+from .report import (
+    JOINT_COLUMNS,
+    count_rows,
+    joint_rows,
+    screw_theory_rows,
+    screws_text,
+    to_jsonable,
+)
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",

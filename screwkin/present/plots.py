@@ -6,6 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..analysis.planar import plane_basis
 from ..errors import UsageError
 
 __all__ = ["sweep_plot", "sweep_figure", "map_png"]
@@ -158,8 +159,6 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
         res, linear = absolute
     paths = {}
     if motion is not None and motion.points:
-        from ..analysis.planar import plane_basis
-
         e1, e2, _ = plane_basis(normal if normal is not None else (0.0, 0.0, 1.0))
         paths = {n: np.asarray(p["position"]) @ np.stack([e1, e2], axis=1) for n, p in motion.points.items()}
     fig = sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None)

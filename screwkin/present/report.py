@@ -13,15 +13,16 @@ from ..analysis.mobility import MobilityResult
 from ..analysis.planar import LinkageInfo
 from ..analysis.position import PositionResult
 from ..analysis.scan import ScanResult
-from ..analysis.screws import Screw, planar_form, screw_of
+from ..analysis.screws import Screw
 from ..analysis.singular import SingularityReport
 from ..analysis.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from .motion import linkage_construction_text, links_table, points_table
+from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
 from .tables import fmt_vec as _fmt_vec
 from .tables import table
 
-__all__ = ["to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
+__all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
            "screw_theory_rows", "joint_rows"]
@@ -370,48 +371,6 @@ def sweep_text(res, info=None, mus=None) -> str:
     return "\n".join(lines)
 
 
-def screws_dict(structure, normal=None) -> list:
-    out = []
-    for st in structure:
-        ch = st["chain"]
-        joints = []
-        for k, name in enumerate(ch.joints):
-            d = {"joint": name, "xi0": screw_dict(screw_of(ch.xi0[:, k])), "theta": float(st["theta"][k]),
-                 "xi": screw_dict(screw_of(st["space_jacobian"][:, k]))}
-            if normal is not None:
-                d["xi0_planar"] = planar_form(ch.xi0[:, k], normal).tolist()
-                d["xi_planar"] = planar_form(st["space_jacobian"][:, k], normal).tolist()
-            joints.append(d)
-        out.append({"chain": ch.name, "joints": joints, "g0": ch.g0.tolist(), "g": st["g"].tolist(),
-                    "space_jacobian": st["space_jacobian"].tolist(), "body_jacobian": st["body_jacobian"].tolist()})
-    return out
-
-
-def screws_text(structure, normal=None) -> str:
-    lines = []
-    for st in structure:
-        ch = st["chain"]
-        lines.append(f"chain to {ch.name}:  g(q) = " + " ".join(
-            f"exp([xi{k + 1}] th{k + 1})" for k in range(len(ch.joints))) + " g(0)")
-        rows = []
-        for k, name in enumerate(ch.joints):
-            s0 = screw_of(ch.xi0[:, k])
-            pitch = "inf" if not np.isfinite(s0.pitch) else f"{s0.pitch:.3g}"
-            point = "-" if s0.point is None else _fmt_vec(s0.point, 0)
-            row = [f"xi{k + 1}", name, _fmt_vec(ch.xi0[:, k], 8), _fmt_vec(s0.direction, 0), point, pitch,
-                   f"{st['theta'][k]:.6g}", _fmt_vec(st["space_jacobian"][:, k], 8)]
-            if normal is not None:
-                row.append(_fmt_vec(planar_form(ch.xi0[:, k], normal), 8))
-            rows.append(row)
-        headers = ["", "joint", "xi (v, w) at reference", "axis", "point", "pitch", "theta", "xi' (v, w) now"]
-        if normal is not None:
-            headers.append("(vx, vy, w)")
-        lines.append(table(headers, rows))
-        lines.append("g(0) = " + " | ".join(_fmt_vec(r, 0) for r in ch.g0[:3]))
-        lines.append("")
-    return "\n".join(lines)
-
-
 def singularity_text(rep) -> str:
     def yes(b):
         return "YES" if b else "no"
@@ -454,12 +413,6 @@ def singularity_text(rep) -> str:
 
 
 # ------------------------------------------------------------------ results as dictionaries
-def screw_dict(s: Screw) -> dict:
-    return {"twist": list(s.twist), "direction": list(s.direction),
-            "point": list(s.point) if s.point is not None else None,
-            "pitch": s.pitch if np.isfinite(s.pitch) else "inf"}
-
-
 def _gram_dict(loops) -> dict:
     """gram_loops: every loop's cofactors; gram_cofactors, gram_zero, gram_loop: those of the first
     loop with one freedom of its own (the single loop of a one-loop mechanism)."""

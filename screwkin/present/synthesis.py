@@ -13,7 +13,13 @@ import math
 
 import numpy as np
 
-from ..analysis.synthesis.designs import Check, ChainsResult, FunctionResult, MotionResult, PathResult
+from ..analysis.synthesis.designs import (
+    ChainsResult,
+    Check,
+    FunctionResult,
+    MotionResult,
+    PathResult,
+)
 from ..analysis.synthesis.fourbar import tool_local
 from .report import table, to_jsonable
 
