@@ -40,6 +40,7 @@ from .commands._options import BOUNDS, check_parsed, count, screwkin_version
 from .commands._common import (
     add_angle_option,
     add_configuration_options,
+    add_length_option,
     add_point_option,
     configuration,
     inputs,
@@ -172,6 +173,7 @@ def _parser():
     s.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="input joint value, SI or with a unit (45deg, 30mm); repeat or comma-separate")
     angles(s)
+    add_length_option(s)
     s.add_argument("--all", action="store_true",
                    help="show every assembly mode, also those the mechanism cannot reach by moving")
     s.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
@@ -313,7 +315,7 @@ def _run(args):
 def _solve(mech, args):
     values = inputs(mech, args)
     if not values:
-        raise UsageError("solve needs input values: --set NAME=VALUE or --set-angle LINK=ANGLE")
+        raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
     rates = joint_assignments(mech, args.rate, "--rate", order=1) if args.rate or args.accel else None
     accels = joint_assignments(mech, args.accel, "--accel", order=2) if args.accel else None

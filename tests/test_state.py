@@ -293,3 +293,35 @@ def test_slider_crank_transmission_angle_per_solution(tmp_path, capsys):
         phi = sol["links"]["rod"]["angle"]
         expected = np.pi / 2 - abs(np.arcsin(np.sin(phi)))
         assert sol["slider_crank"]["transmission_angle"] == pytest.approx(expected, abs=1e-9)
+
+
+def test_stewart_leg_lengths_set_and_reported_between_u_and_s_centres(capsys):
+    """issue 24 item 4: --set-length leg1,...,leg6=0.7; each leg k >= 2 ends at its base U centre (joint basek_a's
+    origin) and its platform S centre (ballk's link2 point in the platform frame), read from the file here: the
+    distance between them at the solved platform pose is 0.7 m, and each reported leg length is 0.7."""
+    import xml.etree.ElementTree as ET
+
+    path = ROBOTS / "gough_stewart_6ups.urdf"
+    root = ET.parse(path).getroot()
+    base = {j.get("name"): np.array(j.find("origin").get("xyz").split(), float) for j in root.iter("joint")
+            if j.find("origin") is not None}
+    spheres = {lj.get("name"): np.array(lj.find("link2").get("xyz").split(), float) for lj in root.iter("loop_joint")}
+    argv = ["solve", str(path), "--set-length", "leg1,leg2,leg3,leg4,leg5,leg6=700mm", "--output", "platform",
+            "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["solutions"]
+    for sol in out["solutions"]:
+        assert sol["leg_lengths"] == pytest.approx({f"leg{k}": 0.7 for k in range(1, 7)}, abs=1e-9)
+        T = np.array(sol["output_pose"])
+        for k in range(2, 7):
+            s_world = T[:3, :3] @ spheres[f"ball{k}"] + T[:3, 3]
+            assert np.linalg.norm(s_world - base[f"base{k}_a"]) == pytest.approx(0.7, abs=1e-9)
+
+
+def test_leg_length_errors(capsys):
+    path = str(ROBOTS / "gough_stewart_6ups.urdf")
+    assert main(["solve", path, "--set-length", "leg1=30deg"]) == 2
+    assert "a leg length is a length" in capsys.readouterr().err
+    assert main(["solve", path, "--set-length", "base1_a=0.5"]) == 2
+    assert "not a prismatic joint between two joint centres" in capsys.readouterr().err

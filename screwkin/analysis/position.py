@@ -107,6 +107,7 @@ class Solution:
     links: dict | None = None  # link name -> absolute motion (analysis.motion.link_motions)
     points: dict | None = None  # named points -> their motion (analysis.motion.point_motions)
     linkage: dict | None = None  # a four-bar's diagonal construction (mu, z, alpha, beta) or a slider-crank's mu
+    leg_lengths: dict | None = None  # prismatic joint -> distance between the joint centres its leg connects [m]
 
     @property
     def physical(self) -> bool:
@@ -613,7 +614,8 @@ class PositionSolver:
                         loop_joints=state.loop_joints or None, loop_rates=state.loop_rates or None,
                         loop_accelerations=state.loop_accelerations or None,
                         links=link_motions(state, angles, self._plane_normal()),
-                        points=point_motions(state, points) or None, linkage=self._linkage(q))
+                        points=point_motions(state, points) or None, linkage=self._linkage(q),
+                        leg_lengths=state.leg_lengths or None)
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
@@ -699,7 +701,8 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
         sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
                              sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
                              outside_limits=outside, labels=solver._labels(q, outside),
-                             link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None))
+                             link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None,
+                             leg_lengths=KinematicState(mech, q).leg_lengths or None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           0, (), output, solver.angular_names(), solver._angular_coupled(),

@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..analysis.motion import Point
 from ..analysis.planar import LinkAngles
 from ..analysis.position import PositionSolver
+from ..model.state import value_for_leg_length
 from ..errors import UsageError
 import argparse
 import math
@@ -13,7 +14,7 @@ import sys
 from ..errors import quote, shorten
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 
-__all__ = ["PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind"]
 
 
@@ -108,10 +109,18 @@ def add_angle_option(sp):
                          "ground, from the ground's x axis (e.g. crank=45deg)")
 
 
+def add_length_option(sp):
+    """--set-length: an input given as the length of a prismatic leg."""
+    sp.add_argument("--set-length", action="append", metavar="JOINT=LENGTH",
+                    help="a prismatic input given as its leg's length, the distance between the joint centres it "
+                         "connects (e.g. leg1=0.418 or 418mm)")
+
+
 def add_configuration_options(sp):
-    """--set, --set-angle and --near: the configuration a command analyses (see configuration)."""
+    """--set, --set-angle, --set-length and --near: the configuration a command analyses (see configuration)."""
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
     add_angle_option(sp)
+    add_length_option(sp)
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
 
 
@@ -119,6 +128,12 @@ def inputs(mech, args) -> dict:
     """Input values from --set (joint values) and --set-angle (absolute link angles)."""
 
     values = joint_assignments(mech, getattr(args, "set", None), "--set")
+    for name, value, unit in parse_typed_assignments(getattr(args, "set_length", None), "--set-length"):
+        if unit_kind(unit) not in (None, "length"):
+            raise UsageError(f"--set-length {quote(name)}: {unit} is a unit of {unit_kind(unit)}, a leg length is a length")
+        if name in values:
+            raise UsageError(f"joint {quote(name)} is given twice (--set and --set-length)")
+        values[name] = value_for_leg_length(mech, name, value)
     angles = {}
     for name, value, unit in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
         if unit_kind(unit) == "length":

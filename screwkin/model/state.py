@@ -23,7 +23,10 @@ from functools import cached_property
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints"]
+from ..errors import UsageError, quote
+
+__all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints",
+           "leg_ends", "value_for_leg_length"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: The loop-joint types whose coordinate a state reports (one coordinate along or about the axis).
@@ -38,6 +41,72 @@ def loop_coordinate_cuts(mech) -> tuple:
 def angular_loop_joints(mech) -> tuple:
     """Names of the reported loop-joint coordinates that are angles."""
     return tuple(c.name for c in loop_coordinate_cuts(mech) if c.type != "prismatic")
+
+
+def _point_ref(data, ref):
+    kind, i = ref
+    return data.oMi[i].translation if kind == "joint" else data.oMf[i].translation
+
+
+def leg_ends(mech) -> dict:
+    """Prismatic tree joint -> (start, end): the joint centres the leg connects, as ("joint", id) or
+    ("frame", id): the centre of the joint that carries the prismatic joint's parent link, and the
+    first centre on its child link (a joint it carries, else a cut joint's frame on it) away from the
+    prismatic joint's origin.  A leg length is the distance between the two (a Stewart leg's U to S)."""
+    model, data = mech.model, mech.model.createData()
+    pin.framesForwardKinematics(model, data, mech.neutral())
+    tiny = mech.tolerances.geometry
+    out = {}
+    for c in mech.coordinates:
+        jid = c.joint_id
+        short = model.joints[jid].shortname()
+        if c.nv != 1 or "JointModelP" not in short or "Planar" in short:
+            continue
+        parent = model.parents[jid]
+        start = ("joint", parent) if parent > 0 else None
+        if start is None:
+            continue
+        origin = data.oMi[jid].translation
+        candidates = [("joint", k) for k in model.children[jid]]
+        candidates += [("frame", f) for cut in mech.cuts for f in (cut.frame1, cut.frame2)
+                       if model.frames[f].parentJoint == jid]
+        end = next((r for r in candidates if np.linalg.norm(_point_ref(data, r) - origin) > tiny), None)
+        if end is not None:
+            out[c.joint] = (start, end)
+    return out
+
+
+def value_for_leg_length(mech, joint: str, length: float) -> float:
+    """The prismatic joint's value [m] that makes its leg ``length`` [m] long: with d0 the vector
+    between the leg's ends at value 0 and u the joint's axis (both in the parent link's frame, where
+    only this joint moves the end), |d0 + x u| = length, the root that extends the leg."""
+    ends = leg_ends(mech).get(joint)
+    if ends is None:
+        raise UsageError(f"{mech.path}: {quote(joint)} is not a prismatic joint between two joint centres "
+                         "(no leg length to set)")
+    model, data = mech.model, mech.model.createData()
+    q = mech.neutral()
+    pin.framesForwardKinematics(model, data, q)
+    c = mech.coordinate(joint)
+    parent = model.parents[c.joint_id]
+    R = data.oMi[parent].rotation
+    start, end = (_point_ref(data, r) for r in ends)
+    d0 = R.T @ (end - start)
+    u = R.T @ (data.oMi[c.joint_id].rotation @ _prismatic_axis(model.joints[c.joint_id]))
+    b = float(d0 @ u)
+    disc = b * b - float(d0 @ d0) + length * length
+    if disc < 0:
+        raise UsageError(f"{mech.path}: leg {quote(joint)} cannot be {length:.6g} m long: its ends stay "
+                         f"{np.sqrt(float(d0 @ d0) - b * b):.6g} m apart across its axis")
+    return -b + float(np.sqrt(disc))
+
+
+def _prismatic_axis(joint) -> np.ndarray:
+    short = joint.shortname()
+    for tail, axis in (("X", (1.0, 0, 0)), ("Y", (0, 1.0, 0)), ("Z", (0, 0, 1.0))):
+        if short.endswith("P" + tail):
+            return np.array(axis)
+    return np.asarray(joint.extract().axis, float)
 
 
 class PointMotion:
@@ -162,6 +231,12 @@ class KinematicState:
             r = M2.translation - M1.translation
             return float((a2 - a1) @ axis + 2.0 * (v2 - v1) @ da + r @ dda)
         return float((al2 - al1) @ axis + (w2 - w1) @ da)
+
+    @cached_property
+    def leg_lengths(self) -> dict:
+        """Prismatic joint -> the distance between the joint centres its leg connects [m] (leg_ends)."""
+        return {j: float(np.linalg.norm(_point_ref(self._data, e) - _point_ref(self._data, s)))
+                for j, (s, e) in leg_ends(self.mech).items()}
 
     @cached_property
     def loop_cuts(self) -> tuple:

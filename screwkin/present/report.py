@@ -228,6 +228,8 @@ def position_dict(res) -> dict:
             d["links"] = s.links
         if s.points:
             d["points"] = s.points
+        if s.leg_lengths:
+            d["leg_lengths"] = s.leg_lengths
         if s.linkage:
             d["four_bar" if s.linkage["kind"] == "four-bar" else "slider_crank"] = s.linkage
         if s.output_pose is not None:
@@ -325,6 +327,9 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
             lines.append(points_table(s.points))
         if s.linkage:
             lines.append(linkage_construction_text(s.linkage))
+        if s.leg_lengths:
+            lines.append("leg lengths (between the joint centres each prismatic joint connects): " + ", ".join(
+                f"{n} {v:.9g} m" for n, v in s.leg_lengths.items()))
         if s.output_pose is not None:
             p = s.output_pose
             lines.append(f"output '{res.output}' position {_fmt_vec(p[:3, 3], 0)} m, roll pitch yaw "
