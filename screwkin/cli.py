@@ -500,6 +500,9 @@ def _ik(mech, args):
     else:
         print(f"inverse kinematics of '{args.output}' at x y z = {v[0]:.6g} {v[1]:.6g} {v[2]:.6g} m, "
               f"roll pitch yaw = {v[3]:.6g} {v[4]:.6g} {v[5]:.6g} rad")
+        print(f"search: damped Newton on the loops and the pose from {res.starts} starting configurations (the "
+              f"assembled and the file's configurations, and random ones within the joint limits): {len(res.solutions)} distinct "
+              f"branch{'es' if len(res.solutions) != 1 else ''} found; not exhaustive, --starts N tries more")
         shown = list(res.solutions) if args.all else list(res.physical) or list(res.solutions)
         if mech.actuated:
             for k, s in enumerate(shown, 1):
