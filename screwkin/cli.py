@@ -23,7 +23,7 @@ import pinocchio as pin
 from .analysis.ellipsoids import ellipsoids
 from .analysis.maps import singularity_map
 from .analysis.mobility import analyze_mobility
-from .analysis.motion import motion_along
+from .analysis.motion import motion_along, strokes
 from .analysis.planar import LinkAngles, identify
 from .analysis.position import PositionSolver, inverse_kinematics
 from .analysis.scan import scan
@@ -53,7 +53,7 @@ from .files.xacro import parse_args as parse_xacro_args
 from .model.joint_types import JOINT_TYPES
 from .model.loader import load
 from .present.ellipsoids import ellipsoids_dict, ellipsoids_text
-from .present.motion import motion_dict
+from .present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from .present.plots import map_png, sweep_plot
 from .present.report import (
     joint_types_dict,
@@ -75,6 +75,7 @@ from .present.report import (
     sweep_csv,
     sweep_dict,
     sweep_singularity_dict,
+    sweep_rows,
     sweep_text,
     to_jsonable,
     topology_dict,
@@ -83,7 +84,7 @@ from .present.report import (
     value_text,
 )
 from .present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
-from .units import parse_length, parse_value
+from .units import parse_length, parse_typed_value, parse_value, unit_kind
 
 __all__ = ["main"]
 
@@ -246,6 +247,7 @@ def _parser():
     w.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
     w.add_argument("--rate", default="1", help="input rate for the joint rates and accelerations (default 1 /s)")
     w.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
+    w.add_argument("--rows", metavar="N|all", help="rows of the text tables (default about 11; all: every step)")
     w.add_argument("--plot", help="draw the joint values against the input into this PNG file (needs matplotlib)")
     w.add_argument("--singularities", action="store_true",
                    help="locate the singular input values along the motion (refined to 1e-9)")
@@ -511,6 +513,15 @@ def _ik(mech, args):
     return 0
 
 
+def _rows(text):
+    if text is None or text.strip().lower() == "all":
+        return None if text is None else "all"
+    try:
+        return count("figure_steps")(text)
+    except argparse.ArgumentTypeError as exc:
+        raise UsageError(f"--rows: {exc} (or all)") from None
+
+
 def _sweep(mech, args):
     fixed = joint_assignments(mech, args.set, "--set")
     inputs = _names(args.inputs) or (list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
@@ -528,6 +539,7 @@ def _sweep(mech, args):
     motion = motion_along(mech, res.q, res.rates, res.accelerations, named_points(mech, args), angles,
                           None if angles is None else angles.n)
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 else None
+    slider_strokes = strokes(res, motion, mech)
     mus = None
     if info is not None:
         mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
@@ -549,9 +561,22 @@ def _sweep(mech, args):
         d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
+        d["strokes"] = strokes_dict(slider_strokes)
         print(json.dumps(to_jsonable(d), indent=2))
     else:
-        print(sweep_text(res, info, mus))
+        rows = sweep_rows(len(res.values), _rows(args.rows))
+        typed_deg = any(unit_kind(parse_typed_value(t)[1]) == "angle" and "deg" in t.lower()
+                        for t in (args.start, args.stop))
+        linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
+            else []
+        print(sweep_text(res, info, mus, rows=_rows(args.rows), degrees=typed_deg and res.unit == "rad",
+                         linear_names=linear_names))
+        for line in strokes_text(slider_strokes, res.unit == "rad"):
+            print(line)
+        table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad")
+        if table_text:
+            print()
+            print(table_text)
         if args.singularities:
             print(f"\nsingularities along the motion (L = {mech.length:.4g} m):" if sing
                   else "\nno singularity along the motion")

@@ -325,3 +325,23 @@ def test_leg_length_errors(capsys):
     assert "a leg length is a length" in capsys.readouterr().err
     assert main(["solve", path, "--set-length", "base1_a=0.5"]) == 2
     assert "not a prismatic joint between two joint centres" in capsys.readouterr().err
+
+
+def test_stroke_and_time_ratio_of_an_offset_slider_crank(tmp_path, capsys):
+    """Stroke sqrt((a + b)^2 - e^2) - sqrt((b - a)^2 - e^2); the crank turns 180 deg -+ (asin(e / (b - a)) -
+    asin(e / (a + b))) between the dead centres (the textbook's quick-return angle)."""
+    path = tmp_path / "slider.urdf"
+    path.write_text(SLIDER)
+    a, b, e = np.hypot(A_X, A_Y), np.hypot(*B_REL), E
+    stroke = np.sqrt((a + b) ** 2 - e * e) - np.sqrt((b - a) ** 2 - e * e)
+    delta = np.arcsin(e / (b - a)) - np.arcsin(e / (a + b))
+    argv = ["sweep", str(path), "--input", "crank_joint", "--from", "0", "--to", "360deg", "--steps", "72", "--json"]
+    assert main(argv) == 0
+    (st,) = json.loads(capsys.readouterr().out)["strokes"]
+    assert st["coordinate"] == "guide"
+    assert st["stroke"] == pytest.approx(stroke, abs=1e-7)
+    assert sorted(st["crank_angles"]) == pytest.approx([np.pi - delta, np.pi + delta], abs=1e-5)
+    assert st["time_ratio"] == pytest.approx((np.pi + delta) / (np.pi - delta), abs=1e-5)
+    assert main(argv[:-1] + ["--rows", "all"]) == 0
+    out = capsys.readouterr().out
+    assert "joint values at 73 of the 73 configurations" in out and "time ratio" in out

@@ -23,7 +23,8 @@ import numpy as np
 from ..errors import UsageError
 from ..model.state import KinematicState, loop_coordinate_cuts
 
-__all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "moving_links"]
+__all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "moving_links", "Stroke",
+           "strokes"]
 
 
 @dataclass(frozen=True)
@@ -117,3 +118,68 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
                           if key not in ("link", "local")}}
     return MotionAlong(loops, loop_rates, loop_accs, links, pts,
                        tuple(c.name for c in cuts if c.type != "prismatic"))
+
+
+@dataclass(frozen=True)
+class Stroke:
+    """A slider's travel along a motion: ``stroke`` = largest - smallest coordinate [m], the input values
+    at its two ends, and, for a crank that turned a whole turn, the time ratio of the two strokes at a
+    constant crank speed (the larger crank angle over the smaller; 1 for a centred slider-crank)."""
+
+    coordinate: str
+    stroke: float
+    low_at: float
+    high_at: float
+    time_ratio: float | None
+    crank_angles: tuple | None  # (forward, return) crank angles [rad] when time_ratio is known
+
+
+def _extrema(x, p, dp):
+    """(input value, coordinate) at each zero of dp/dx along the samples: the cubic Hermite
+    interpolant of p on each bracket whose slope changes sign (accurate to O(h^4)), its vertex."""
+    out = []
+    for k in range(len(x) - 1):
+        if not (dp[k] == 0.0 or dp[k] * dp[k + 1] < 0):
+            continue
+        h = x[k + 1] - x[k]
+        p0, p1, m0, m1 = p[k], p[k + 1], dp[k] * h, dp[k + 1] * h
+        # p(t) = (2t^3 - 3t^2 + 1) p0 + (t^3 - 2t^2 + t) m0 + (-2t^3 + 3t^2) p1 + (t^3 - t^2) m1, t in [0, 1]
+        a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1
+        b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
+        roots = np.roots([a, b, m0]) if abs(a) > 0 else np.array([-m0 / b]) if b else np.array([0.0])
+        t = next((float(r.real) for r in roots if abs(r.imag) < 1e-12 and -1e-9 <= r.real <= 1 + 1e-9), 0.5)
+        value = ((2 * t**3 - 3 * t**2 + 1) * p0 + (t**3 - 2 * t**2 + t) * m0 + (-2 * t**3 + 3 * t**2) * p1
+                 + (t**3 - t**2) * m1)
+        out.append((float(x[k] + t * h), float(value)))
+    return out
+
+
+def strokes(res, motion, mech) -> list:
+    """A Stroke for each slider coordinate (prismatic tree joint or prismatic loop joint) of a sweep
+    ``res`` (analysis.sweep.SweepResult) with its MotionAlong."""
+    series = []
+    for k, name in enumerate(res.names):
+        c = next((c for c in mech.coordinates if c.joint == name), None)
+        if c is not None and c.nv == 1 and mech.translational[c.idx_v]:
+            series.append((name, res.joints[:, k], res.rates[:, k]))
+    for name, v in motion.loop_joints.items():
+        if name not in motion.angular_loop:
+            series.append((name, v, motion.loop_rates[name]))
+    x = np.asarray(res.values, float)
+    turned = res.unit == "rad" and res.stopped_at is None and abs(x[-1] - x[0]) >= 2 * np.pi * (1 - 1e-9)
+    out = []
+    for name, values, rates in series:
+        values, slope = np.asarray(values, float), np.asarray(rates, float) / (res.rate or 1.0)
+        ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + _extrema(x, values, slope)
+        lo, hi = min(ends, key=lambda e: e[1]), max(ends, key=lambda e: e[1])
+        ratio = angles = None
+        if turned:
+            z = [a for a, _ in _extrema(x, values, slope) if a < x[0] + 2 * np.pi * (1 - 1e-12)]  # one turn
+            if len(z) == 2:
+                d = abs(z[1] - z[0])
+                mid = int(np.clip(np.searchsorted(x, (z[0] + z[1]) / 2), 0, len(x) - 1))
+                fwd, back = (d, 2 * np.pi - d) if slope[mid] > 0 else (2 * np.pi - d, d)
+                angles = (fwd, back)
+                ratio = max(fwd, back) / min(fwd, back)
+        out.append(Stroke(name, hi[1] - lo[1], lo[0], hi[0], ratio, angles))
+    return out

@@ -7,7 +7,7 @@ import numpy as np
 
 from .tables import column_text, fmt_vec, table
 
-__all__ = ["links_table", "points_table", "motion_dict", "linkage_construction_text"]
+__all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_table", "points_table", "motion_dict", "linkage_construction_text"]
 
 
 def links_table(links: dict) -> str:
@@ -66,3 +66,49 @@ def motion_dict(m) -> dict:
     """A sweep's analysis.motion.MotionAlong as JSON-ready lists, one entry per step."""
     return {"loop_joints": m.loop_joints, "loop_rates": m.loop_rates, "loop_accelerations": m.loop_accelerations,
             "links": m.links, "points": m.points}
+
+
+def strokes_dict(strokes) -> list:
+    return [{"coordinate": st.coordinate, "stroke": st.stroke, "low_at": st.low_at, "high_at": st.high_at,
+             "time_ratio": st.time_ratio, "crank_angles": list(st.crank_angles) if st.crank_angles else None}
+            for st in strokes]
+
+
+def strokes_text(strokes, angular: bool) -> list:
+    """A line per slider: its stroke, where its ends are reached, and the time ratio."""
+    def at(x):
+        return f"{np.degrees(x):.6g} deg" if angular else f"{1000 * x:.6g} mm"
+
+    lines = []
+    for st in strokes:
+        line = (f"slider {st.coordinate}: stroke {1000 * st.stroke:.6g} mm (ends at input {at(st.low_at)} and "
+                f"{at(st.high_at)})")
+        if st.time_ratio is not None:
+            line += (f"; time ratio {st.time_ratio:.6g} (crank turns {np.degrees(st.crank_angles[0]):.6g} deg "
+                     f"forward, {np.degrees(st.crank_angles[1]):.6g} deg back)")
+        lines.append(line)
+    return lines
+
+
+def motion_rows_text(res, motion, rows, degrees: bool) -> str:
+    """The sweep's absolute quantities at the rows shown: the input (in deg when typed so), each turning
+    link's angle [deg], each slider (loop) coordinate [mm] and each point's position [mm]."""
+    cols, head = [], []
+    for name, m in motion.links.items():
+        if "angle" in m and np.ptp(np.unwrap(m["angle"])) > 1e-9:
+            head.append(f"{name} [deg]")
+            cols.append(column_text(np.degrees(np.asarray(m["angle"]))))
+    for name, v in motion.loop_joints.items():
+        angular = name in motion.angular_loop
+        head.append(f"{name} [{'deg' if angular else 'mm'}]")
+        cols.append(column_text(np.degrees(v) if angular else 1000 * np.asarray(v)))
+    for name, p in motion.points.items():
+        xy = 1000 * np.asarray(p["position"])
+        head += [f"{name} x [mm]", f"{name} y [mm]"]
+        cols += [column_text(xy[:, 0], absolute=1e-9), column_text(xy[:, 1], absolute=1e-9)]
+    if not cols:
+        return ""
+    x = np.degrees(res.values) if degrees else np.asarray(res.values)
+    unit = "deg" if degrees else res.unit
+    body = [[f"{x[k]:.6g}"] + [c[k] for c in cols] for k in rows]
+    return "absolute motion\n" + table([f"input [{unit}]"] + head, body)

@@ -20,7 +20,7 @@ from ..model.topology import Topology
 from .motion import linkage_construction_text, links_table, points_table
 from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
 from .tables import fmt_vec as _fmt_vec
-from .tables import table
+from .tables import column_text, table
 
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
@@ -341,8 +341,23 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
     return "\n".join(lines)
 
 
-def sweep_text(res, info=None, mus=None) -> str:
+def sweep_rows(n: int, rows=None) -> list:
+    """The steps a sweep's tables show: ``rows`` None -> about 11 evenly spaced (the last included),
+    "all" -> every step, a number -> about that many."""
+    if rows == "all":
+        return list(range(n))
+    want = 11 if rows is None else max(int(rows), 2)
+    if n <= want:
+        return list(range(n))
+    idx = sorted(set(np.linspace(0, n - 1, want).round().astype(int).tolist()))
+    return idx
+
+
+def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linear_names=()) -> str:
+    """The sweep's summary and a table of joint values (``rows``: see sweep_rows; ``degrees``: the
+    input and the angles in deg, the coordinates in ``linear_names`` staying in m)."""
     angular = res.unit == "rad"
+    linear = set(linear_names or ())
     lines = [f"sweep of {res.input} from {value_text(res.input, res.requested[0], angular)} to "
              f"{value_text(res.input, res.requested[1], angular)} in {res.requested[2]} steps"
              + (", through limit positions (--turn)" if res.turn else "") + f": {len(res.values)} configurations"]
@@ -369,10 +384,17 @@ def sweep_text(res, info=None, mus=None) -> str:
             k = int(np.argmax(dev))
             lines.append(f"  transmission angle: {np.degrees(min(mus)):.4g} .. {np.degrees(max(mus)):.4g} deg; "
                          f"worst {np.degrees(mus[k]):.4g} deg at input {res.values[k]:.6g}")
-    step = max(len(res.values) // 10, 1)
-    rows = [[f"{res.values[k]:.6g}"] + [f"{x:.6g}" for x in res.joints[k]] for k in range(0, len(res.values), step)]
+    shown = sweep_rows(len(res.values), rows)
+    n = len(res.values)
+    x = np.degrees(res.values) if degrees else np.asarray(res.values)
+    cols = [column_text([np.degrees(res.joints[k][j]) if degrees and name not in linear else res.joints[k][j]
+                         for k in shown], absolute=1e-9) for j, name in enumerate(res.names)]
+    body = [[f"{x[k]:.6g}"] + [c[i] for c in cols] for i, k in enumerate(shown)]
     lines.append("")
-    lines.append(table([f"input [{res.unit}]"] + list(res.names), rows))
+    lines.append(f"joint values at {len(shown)} of the {n} configurations"
+                 + ("" if len(shown) == n else " (--rows all shows every one, --rows N about N)")
+                 + (": angles in deg" if degrees else ""))
+    lines.append(table([f"input [{'deg' if degrees else res.unit}]"] + list(res.names), body))
     return "\n".join(lines)
 
 
