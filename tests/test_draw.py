@@ -279,3 +279,24 @@ def test_the_users_joint_letters_are_kept_and_links_numbered_once(tmp_path):
     # a mechanism whose joint names are long keeps the textbook letters A, B, C, D
     mech, q = assembled(FOURBAR)
     assert sorted(j.letter for j in skeleton(mech, q).joints) == ["A", "B", "C", "D"]
+
+
+def test_trace_draws_a_coupler_curve_through_the_solved_point(tmp_path, capsys):
+    """draw --point P=coupler:60mm,20mm --trace P: the path starts at the point solve reports and closes
+    after a whole crank turn; the SVG carries it (gid trace:P)."""
+    import json
+
+    svg = tmp_path / "t.svg"
+    argv = ["draw", FOURBAR, "--set", "crank_joint=30deg", "--point", "P=coupler:60mm,20mm", "--trace", "P",
+            "--svg", str(svg), "--json", "--steps", "180"]
+    assert main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    path = np.array(d["traces"]["P"]["path"])
+    assert d["traces"]["P"]["stopped_at"] is None and len(path) == 181
+    assert main(["solve", FOURBAR, "--set", "crank_joint=30deg", "--point", "P=coupler:60mm,20mm", "--json"]) == 0
+    p = json.loads(capsys.readouterr().out)["solutions"][0]["points"]["P"]["position"]
+    np.testing.assert_allclose(path[0], p[:2], atol=1e-9)
+    np.testing.assert_allclose(path[-1], path[0], atol=1e-9)  # a crank-rocker's coupler curve closes
+    assert 'id="trace:P"' in svg.read_text()
+    assert main(["draw", FOURBAR, "--svg", str(svg), "--trace", "Q"]) == 2
+    assert "no --point Q=LINK:x,y,z" in capsys.readouterr().err

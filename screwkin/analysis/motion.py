@@ -183,3 +183,4 @@ def strokes(res, motion, mech) -> list:
                 ratio = max(fwd, back) / min(fwd, back)
         out.append(Stroke(name, hi[1] - lo[1], lo[0], hi[0], ratio, angles))
     return out
+

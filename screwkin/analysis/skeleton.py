@@ -27,11 +27,13 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from .motion import motion_along
 from .planar import LinkAngles, plane_basis
 from .position import PositionSolver
 from .sweep import locate_singularities, sweep
 
 __all__ = [
+    "trace_points",
     "ChainEdge",
     "ChainNode",
     "KinematicChain",
@@ -584,3 +586,17 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
                 for s in found)
     return SingularSearch(input_joint, res.unit, float(start), float(stop), output, fixed, out, bool(res.limits),
                           res.circuit_closed, res)
+
+
+def trace_points(mech, q, input_name: str, points, steps: int = 360, fixed=None):
+    """The paths of ``points`` while ``input_name`` turns a whole turn (or, for a slider or an input
+    that cannot turn, runs to its limit position) from its value at ``q``, on the assembly mode of
+    ``q``: (SweepResult, MotionAlong).  The sweep is analysis.sweep's, so its limits are reported."""
+    fixed = dict(fixed or {})
+    solver = PositionSolver(mech, [input_name, *[n for n in fixed if n != input_name]])
+    start = mech.joint_values(q)[input_name]
+    c = mech.coordinate(input_name)
+    stop = start + (2 * np.pi if not mech.translational[c.idx_v] else mech.length)
+    near = {n: v for n, v in mech.joint_values(q).items() if n != input_name and n not in fixed}
+    res = sweep(solver, input_name, start, stop, steps, fixed=fixed, near=near)
+    return res, motion_along(mech, res.q, res.rates, res.accelerations, points)

@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from ..analysis.skeleton import kinematic_chain, singular_configurations, skeleton
+from ..analysis.skeleton import kinematic_chain, singular_configurations, skeleton, trace_points
 from ..errors import UsageError
 from ..present.draw import (
     chain_dict,
@@ -20,7 +20,7 @@ from ..present.draw import (
     value_label,
 )
 from ..present.report import to_jsonable
-from ._common import add_configuration_options, configuration, inputs
+from ._common import add_configuration_options, add_point_option, configuration, inputs, named_points
 from ._options import count
 
 NAME = "draw"
@@ -47,7 +47,11 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--output", help="--singular: the output link whose serial singularities (limit positions) are "
                                      "sought (default: a four-bar's rocker, a slider-crank's slider)")
     sp.add_argument("--steps", type=count("figure_steps"), default=360,
-                    help="--singular: steps over the input's range (default 360, at most 20,000)")
+                    help="--singular and --trace: steps over the input's range (default 360, at most 20,000)")
+    add_point_option(sp)
+    sp.add_argument("--trace", action="append", metavar="NAME",
+                    help="draw the path of the --point NAME over a whole turn of the input (or up to its limit "
+                         "position) on the skeleton; repeatable")
 
 
 def _targets(mech, args) -> list:
@@ -86,6 +90,28 @@ def _kind_text(s) -> str:
         return (f"serial singularity of '{s.output}': its limit position (a dead centre when driven from it)"
                 if s.output else "serial singularity")
     return _KIND.get(s.kind, s.kind)
+
+
+def _traces(mech, args, q, input_names, given, skel) -> dict:
+    """--trace NAME: name -> (the point's path in the drawing's plane (N, 2) [m], where the input stopped)."""
+    if not args.trace:
+        return {}
+    points = {p.name: p for p in named_points(mech, args)}
+    for name in args.trace:
+        if name not in points:
+            raise UsageError(f"{mech.path}: --trace {name}: no --point {name}=LINK:x,y,z was given")
+    if not input_names:
+        raise UsageError(f"{mech.path}: --trace needs an input to move: declare actuated joints or give --set NAME=VALUE")
+    res, motion = trace_points(mech, q, input_names[0], [points[n] for n in args.trace], args.steps,
+                               {k: v for k, v in given.items() if k != input_names[0]})
+    e1, e2, _ = skel.basis
+    out = {}
+    for name in args.trace:
+        P = np.asarray(motion.points[name]["position"])
+        out[name] = (np.stack([P @ np.asarray(e1), P @ np.asarray(e2)], axis=1), res.stopped_at)
+        if res.stopped_at is not None and not args.json:
+            print(f"path of {name}: {input_names[0]} stopped at {res.stopped_at:.6g} ({res.stop_reason})")
+    return out
 
 
 def run(mech, args) -> int:
@@ -133,12 +159,16 @@ def run(mech, args) -> int:
     else:
         skel = skeleton(mech, q, input_names)
         space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
+        traces = _traces(mech, args, q, input_names, given, skel)
         for path in targets:
             fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), angles=args.angles,
-                                 subtitle=("" if skel.planar else space.strip(" ()")) or None)
+                                 subtitle=("" if skel.planar else space.strip(" ()")) or None,
+                                 traces={n: xy for n, (xy, _) in traces.items()})
             save_figure(fig, path)
             written.append(path)
         report = skeleton_dict(skel)
+        if traces:
+            report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
     if args.json:
         report["files"] = written
         print(json.dumps(to_jsonable(report), indent=2))

@@ -66,7 +66,8 @@ def _frame(fig, ax, points, r):
     ax.set_axis_off()
 
 
-def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitle: str | None = None):
+def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitle: str | None = None,
+                   traces: dict | None = None):
     """The skeleton diagram of a :class:`~screwkin.analysis.skeleton.Skeleton` as a matplotlib
     Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
     higher pairs as their profiles, binary links as bars, ternary and larger links as filled
@@ -243,6 +244,13 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
                     ha="left" if u[0] >= 0 else "right", va="bottom" if u[1] >= 0 else "top", zorder=7,
                     gid=f"anglelabel:{n}")
 
+    for k, (name, xy) in enumerate((traces or {}).items()):  # named points' paths (draw --trace)
+        xy = np.asarray(xy, float)
+        ax.plot(xy[:, 0], xy[:, 1], color=f"C{k}", lw=1.2, ls="--", zorder=2.5, gid=f"trace:{name}",
+                label=f"path of {name}")
+        ax.plot(*xy[0], "o", color=f"C{k}", markersize=4, zorder=6, gid=f"tracepoint:{name}")
+        ax.annotate(name, xy[0], xytext=(4, 4), textcoords="offset points", fontsize=8, color=f"C{k}")
+        points += [tuple(p) for p in xy]
     _frame(fig, ax, points, r)
     fig.suptitle(title or os.path.basename(skel.path), fontsize=11, x=0.36, y=0.97)
     if subtitle:
