@@ -278,3 +278,53 @@ def test_a_design_that_does_not_close_is_an_assembly_error():
     mech = screwkin.load(FOURBAR, args={"ground": 0.5})  # 0.5 > 0.04 + 0.12 + 0.08
     with pytest.raises(screwkin.AssemblyError):
         mech.assemble()
+
+
+def _doubling_blocks(levels: int) -> str:
+    """issue 22 item 1: each block property inserts the previous one twice; no macro is called."""
+    blocks = ['<xacro:property name="b0"><link name="x"/></xacro:property>']
+    blocks += [f'<xacro:property name="b{k}"><xacro:insert_block name="b{k - 1}"/>'
+               f'<xacro:insert_block name="b{k - 1}"/></xacro:property>' for k in range(1, levels + 1)]
+    return ('<?xml version="1.0"?><robot name="bomb" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+            + "".join(blocks) + f'<xacro:insert_block name="b{levels}"/></robot>')
+
+
+def _doubling_strings(levels: int) -> str:
+    props = ['<xacro:property name="s0" value="aaaaaaaaaaaaaaaa"/>']
+    props += [f'<xacro:property name="s{k}" value="${{s{k - 1}}}${{s{k - 1}}}"/>' for k in range(1, levels + 1)]
+    return ('<?xml version="1.0"?><robot name="s" xmlns:xacro="http://www.ros.org/wiki/xacro">' + "".join(props)
+            + f'<link name="${{s{levels}}}"/></robot>')
+
+
+@pytest.mark.parametrize("levels", [16, 30])
+def test_property_blocks_that_double_are_refused_at_once(levels, tmp_path, capsys):
+    path = tmp_path / "bomb.urdf.xacro"
+    path.write_text(_doubling_blocks(levels))
+    assert len(path.read_bytes()) < 4000
+    with no_hang(10):  # minutes (16 levels) or forever (30) when only the final size was checked
+        assert main(["info", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "more than 5000 copies" in err and len(err.strip().splitlines()) == 1
+
+
+def test_properties_whose_text_doubles_are_refused_at_once(tmp_path, capsys):
+    path = tmp_path / "strings.urdf.xacro"
+    path.write_text(_doubling_strings(40))  # 16 * 2**40 characters if concatenated
+    with no_hang(10):
+        assert main(["info", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "text grows past 10000 characters" in err and len(err.strip().splitlines()) == 1
+
+
+def test_blocks_inserted_a_few_times_still_expand(tmp_path, capsys):
+    """The bound is on copies, not on insert_block: a block property inserted twice (4 links) expands."""
+    path = tmp_path / "ok.urdf.xacro"
+    text = _doubling_blocks(2).replace('<link name="x"/>', '<link name="x${n}"/>')
+    text = text.replace('<robot name="bomb" xmlns:xacro="http://www.ros.org/wiki/xacro">',
+                        '<robot name="ok" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="n" '
+                        'value="0"/>')
+    path.write_text(text)
+    from screwkin.files.xacro import expand
+
+    out = expand(path, path.read_text())
+    assert out.count('<link name="x0"/>') == 4
