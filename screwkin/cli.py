@@ -548,7 +548,7 @@ def _sweep(mech, args):
         sing = locate_singularities(solver, res, output=args.output, point=args.point)
     if args.csv:
         with open(args.csv, "w") as f:
-            f.write(sweep_csv(res))
+            f.write(sweep_csv(res, motion))
     if args.plot:
         sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
                    normal=None if angles is None else angles.n,

@@ -662,6 +662,8 @@ def test_hostile_names_through_the_commands(name, tmp_path, capfd, monkeypatch):
     rows = list(csv.reader(open(tmp_path / "s.csv", newline="")))
     assert len({len(r) for r in rows}) == 1 and len(rows) == 1 + 4
     assert any(name in cell for cell in rows[0])
+    assert not any(cell.startswith(("=", "+", "@")) for row in rows for cell in row)  # no spreadsheet formula
+    assert all(cell.startswith("'") for cell in rows[0] if name in cell and name.startswith(("=", "+", "@")))
 
 
 # ------------------------------------------------------------------ whole processes

@@ -603,7 +603,7 @@ def _counted_copies(state: _State, path):
             state.copies += 1
             state.copied += len(clone.getElementsByTagName("*")) + 1
             if state.copies > MAX_COPIES or state.copied > LIMITS.elements:
-                raise MechanismFileError(path, f"the xacro blocks and macros make more than "
+                raise MechanismFileError(path, "the xacro blocks and macros make more than "
                                                + (f"{MAX_COPIES} copies" if state.copies > MAX_COPIES else
                                                   f"{LIMITS.elements} elements")
                                                + " (refused: blocks that insert each other twice?)")

@@ -19,8 +19,8 @@ from ..analysis.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from .motion import linkage_construction_text, links_table, points_table
 from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
+from .tables import column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
-from .tables import column_text, table
 
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
@@ -496,17 +496,33 @@ def sweep_dict(res: SweepResult, mech=None) -> dict:
     }
 
 
-def sweep_csv(res: SweepResult) -> str:
+def sweep_csv(res: SweepResult, motion=None) -> str:
+    """One row per step: the input, every joint value, rate and acceleration, the coupled joints; with
+    ``motion`` (analysis.motion.MotionAlong) the loop joints, each link's absolute angle (planar) and
+    each named point's x, y, z [m]."""
     coupled = res.coupled or {}
     head = ["step", res.input + "_input"] + list(res.names) + [f"d_{n}" for n in res.names] + [
         f"dd_{n}" for n in res.names] + list(coupled)
-    lines = [",".join(head)]
+    extra = []
+    if motion is not None:
+        for name, v in motion.loop_joints.items():
+            extra += [(f"{name} (loop)", v), (f"d_{name} (loop)", motion.loop_rates[name]),
+                      (f"dd_{name} (loop)", motion.loop_accelerations[name])]
+        for name, m in motion.links.items():
+            if "angle" in m:
+                extra += [(f"{name} angle", m["angle"]), (f"{name} omega", m["omega"]), (f"{name} alpha", m["alpha"])]
+        for name, p in motion.points.items():
+            P = np.asarray(p["position"])
+            extra += [(f"{name} {ax}", P[:, i]) for i, ax in enumerate("xyz")]
+    head += [n for n, _ in extra]
+    rows = []
     for k in range(len(res.values)):
         row = [str(k), f"{res.values[k]:.12g}"] + [f"{x:.12g}" for x in res.joints[k]]
         row += [f"{x:.12g}" for x in res.rates[k]] + [f"{x:.12g}" for x in res.accelerations[k]]
         row += [f"{v[k]:.12g}" for v in coupled.values()]
-        lines.append(",".join(row))
-    return "\n".join(lines) + "\n"
+        row += [f"{float(v[k]):.12g}" for _, v in extra]
+        rows.append(row)
+    return csv_text(head, rows)
 
 
 def scan_dict(res: ScanResult) -> dict:
@@ -524,9 +540,8 @@ def scan_dict(res: ScanResult) -> dict:
 
 
 def scan_csv(res: ScanResult) -> str:
-    head = ",".join(res.joints) + f",{res.measure}"
     rows = np.column_stack([res.theta, res.values])
-    return head + "\n" + "\n".join(",".join(f"{x:.12g}" for x in row) for row in rows) + "\n"
+    return csv_text([*res.joints, res.measure], ([f"{x:.12g}" for x in row] for row in rows))
 
 
 def map_dict(res: SingularityMap) -> dict:
@@ -535,11 +550,9 @@ def map_dict(res: SingularityMap) -> dict:
 
 
 def map_csv(res: SingularityMap) -> str:
-    lines = [f"{res.x_name},{res.y_name},log10_sigma_min,kind"]
-    for j, y in enumerate(res.ys):
-        for i, x in enumerate(res.xs):
-            lines.append(f"{x:.12g},{y:.12g},{res.log_sigma[j, i]:.6g},{res.kind[j, i]}")
-    return "\n".join(lines) + "\n"
+    rows = ([f"{x:.12g}", f"{y:.12g}", f"{res.log_sigma[j, i]:.6g}", res.kind[j, i]]
+            for j, y in enumerate(res.ys) for i, x in enumerate(res.xs))
+    return csv_text([res.x_name, res.y_name, "log10_sigma_min", "kind"], rows)
 
 
 _DICTS = {MobilityResult: mobility_dict, PositionResult: position_dict, SingularityReport: singularity_dict,

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-__all__ = ["table", "fmt_vec", "column_text"]
+import csv
+import io
+
+__all__ = ["table", "fmt_vec", "column_text", "csv_cell", "csv_text"]
 
 
 def table(headers, rows) -> str:
@@ -26,3 +29,29 @@ def column_text(values, relative: float = 1e-9, absolute: float = 1e-12) -> list
     big = max((abs(v) for v in values if v == v), default=0.0)
     tiny = max(absolute, relative * big)
     return [f"{(0.0 if abs(v) < tiny else v) + 0.0:.6g}" for v in values]
+
+
+#: What a spreadsheet reads as the start of a formula in a text cell (CSV injection).
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_cell(value):
+    """A cell for a CSV written from untrusted names: numbers as they are; a text that a spreadsheet
+    would run as a formula (=, +, -, @, tab, CR first) gets a leading apostrophe."""
+    if isinstance(value, str) and value.startswith(_FORMULA):
+        try:
+            float(value)
+        except ValueError:
+            return "'" + value
+    return value
+
+
+def csv_text(header, rows) -> str:
+    """CSV text (csv.writer: names with commas, quotes or newlines are quoted) with every cell through
+    :func:`csv_cell`; one line per row."""
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow([csv_cell(h) for h in header])
+    for row in rows:
+        w.writerow([csv_cell(c) for c in row])
+    return out.getvalue()

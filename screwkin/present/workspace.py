@@ -3,14 +3,13 @@
 
 from __future__ import annotations
 
-import csv
-
 import numpy as np
 import pinocchio as pin
 
 from ..analysis.workspace import WorkspaceResult
 from .plots import _pyplot
 from .report import table
+from .tables import csv_text
 
 __all__ = ["workspace_dict", "workspace_text", "workspace_csv", "workspace_png", "workspace_cloud", "AXIS_NAMES"]
 
@@ -103,15 +102,16 @@ def workspace_csv(r: WorkspaceResult, path, joint_columns=None):
     """One row per reached point (cell): world position, grid index, measures, free; with
     ``joint_columns`` ((name, q index) pairs) the joint values of the grid's solutions."""
     joint_columns = list(joint_columns or []) if r.configurations is not None else []
+    head = (["x", "y", "z"] + [f"i_{n}" for n in axis_labels(r)] + ["actuator", "serial", "conditioning", "free"]
+            + [n for n, _ in joint_columns])
+    rows = []
+    for k in range(len(r.index)):
+        row = [f"{x:.9g}" for x in r.positions[k]] + [int(i) for i in r.index[k]]
+        row += [f"{r.measures[m][k]:.6g}" for m in ("actuator", "serial", "conditioning")] + [int(r.free[k])]
+        row += [f"{r.configurations[k, iq]:.9g}" for _, iq in joint_columns]
+        rows.append(row)
     with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["x", "y", "z"] + [f"i_{n}" for n in axis_labels(r)]
-                   + ["actuator", "serial", "conditioning", "free"] + [n for n, _ in joint_columns])
-        for k in range(len(r.index)):
-            row = [f"{x:.9g}" for x in r.positions[k]] + [int(i) for i in r.index[k]]
-            row += [f"{r.measures[m][k]:.6g}" for m in ("actuator", "serial", "conditioning")] + [int(r.free[k])]
-            row += [f"{r.configurations[k, iq]:.9g}" for _, iq in joint_columns]
-            w.writerow(row)
+        f.write(csv_text(head, rows))
 
 
 def workspace_png(r: WorkspaceResult, path: str):
