@@ -21,6 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from .analysis.ellipsoids import ellipsoids
+from .analysis.gram_symbolic import symbolic_gram
 from .analysis.maps import singularity_map
 from .analysis.mobility import analyze_mobility
 from .analysis.motion import motion_along, strokes
@@ -53,6 +54,7 @@ from .files.xacro import parse_args as parse_xacro_args
 from .model.joint_types import JOINT_TYPES
 from .model.loader import load
 from .present.ellipsoids import ellipsoids_dict, ellipsoids_text
+from .present.screws import gram_symbolic_dict, gram_symbolic_text
 from .present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from .present.plots import map_png, sweep_plot
 from .present.report import (
@@ -201,6 +203,9 @@ def _parser():
     g.add_argument("--output", help="output link (for serial singularities and the output twist)")
     g.add_argument("--ellipsoids", action="store_true",
                    help="the output's velocity and force ellipsoids for the inputs (needs --output)")
+    g.add_argument("--symbolic", action="store_true",
+                   help="planar loops: each joint's Gram cofactor as a formula in the symbols of screwkin equations, "
+                        "and where it vanishes (the joint is stationary)")
     scaled(g)
     mp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
     common(mp)
@@ -369,16 +374,22 @@ def _singularities(mech, args):
     q = configuration(mech, args)
     rep = classify(mech, q, output=args.output, point=args.point)
     ell = ellipsoids(mech, q, args.output, point=args.point) if args.ellipsoids else None
+    gram = symbolic_gram(mech, q, list(inputs(mech, args)) or None) if args.symbolic else None
     if args.json:
         d = singularity_dict(rep)
         if ell is not None:
             d["ellipsoids"] = ellipsoids_dict(ell)
+        if gram is not None:
+            d["gram_symbolic"] = gram_symbolic_dict(gram)
         print(json.dumps(to_jsonable(d), indent=2))
     else:
         print(singularity_text(rep))
         if ell is not None:
             print()
             print(ellipsoids_text(ell))
+        if gram is not None:
+            print()
+            print(gram_symbolic_text(gram))
     return 0
 
 

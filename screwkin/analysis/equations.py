@@ -468,9 +468,11 @@ class VectorLoops:
         self.symbol_info, self.sym, self.variables = {}, {}, []
         self.vec, self.slide_terms, self.used_r, self.used_x = {}, {}, {}, {}
         self.loops, self.F = [], []
+        self.loop_twists = []  # per loop: [(joint, (vx, vy, w))] planar twists, the loop's first joint at 0
         for links, joints in self._cycles():
             m = len(links)
             terms, fx, fy = [], sp.Integer(0), sp.Integer(0)
+            twists = [] if joints[-1].type == "prismatic" else [(joints[-1].name, (0, 0, 1))]
             for i in range(m):
                 link, j_in, j_out = links[i], joints[i - 1], joints[i]
                 got = self._vector(link, (j_in.name, link), (j_out.name, link))
@@ -483,14 +485,18 @@ class VectorLoops:
                     t = self._slide(j_out.name)
                     sign = 1 if self.slides[j_out.name]["guide"] == link else -1
                     c, s = sp.cos(t["angle"]), sp.sin(t["angle"])
+                    twists.append((j_out.name, (c, s, 0)))  # a sliding twist: the guide's direction
                     pre = "" if sign > 0 else "-"
                     terms.append(f"{pre}x{t['name']}*u{t['name']}")
                     fx += sign * (t["x"] * c - t["e"] * s)
                     fy += sign * (t["x"] * s + t["e"] * c)
                     if t["e"] != 0:
                         terms.append(f"{pre}e{t['name']}*n{t['name']}")
+                elif i < m - 1:  # a revolute at (fx, fy) from the loop's first joint: (y, -x, 1)
+                    twists.append((j_out.name, (fy, -fx, 1)))
             self.loops.append(LoopEquation(tuple(links), tuple(j.name for j in joints), tuple(terms),
                                            (str(fx), str(fy))))
+            self.loop_twists.append(twists)
             self.F += [fx, fy]
 
     def _build_inputs(self):

@@ -9,7 +9,7 @@ from ..analysis.screws import Screw, planar_form, screw_of
 from .tables import fmt_vec as _fmt_vec
 from .tables import table
 
-__all__ = ["screw_dict", "screws_dict", "screws_text", "loops_dict", "loops_text"]
+__all__ = ["gram_symbolic_dict", "gram_symbolic_text", "screw_dict", "screws_dict", "screws_text", "loops_dict", "loops_text"]
 
 
 def screw_dict(s: Screw) -> dict:
@@ -93,4 +93,21 @@ def screws_text(structure, normal=None) -> str:
         lines.append(table(headers, rows))
         lines.append("g(0) = " + " | ".join(_fmt_vec(r, 0) for r in ch.g0[:3]))
         lines.append("")
+    return "\n".join(lines)
+
+
+def gram_symbolic_dict(loops) -> list:
+    return [{"joints": list(lp.joints), "cofactors": lp.cofactors, "zero_when": {k: list(v) for k, v in
+                                                                               lp.zero_when.items()},
+             "note": lp.note} for lp in loops]
+
+
+def gram_symbolic_text(loops) -> str:
+    """Each loop's Gram cofactors in symbols and where they vanish (the joint is stationary)."""
+    lines = ["Gram cofactors in symbols (the symbols of screwkin equations; C = 0: the joint is stationary)"]
+    for lp in loops:
+        lines.append(f"loop {' - '.join(lp.joints)}" + (f": {lp.note}" if lp.note else ""))
+        for name, expr in lp.cofactors.items():
+            where = "; ".join(lp.zero_when[name]) or "never 0"
+            lines.append(f"  C_{name} = {expr}   (0 where {where})")
     return "\n".join(lines)
