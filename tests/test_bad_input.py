@@ -181,12 +181,12 @@ def test_one_joint_arm(tmp_path, capsys, argv):
 
 
 def test_internal_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
-    import screwkin.cli
+    import screwkin.commands.mobility
 
     def broken(*args, **kwargs):
         raise ValueError("shapes do not match")
 
-    monkeypatch.setattr(screwkin.cli, "analyze_mobility", broken)
+    monkeypatch.setattr(screwkin.commands.mobility, "analyze_mobility", broken)
     path = write(tmp_path, GOOD)
     check(capsys, ["mobility", path], 3, "internal error", "ValueError", "--debug", path=path)
     # --debug (after or before the command): the traceback, then the same line, and still exit 3
@@ -439,16 +439,16 @@ def test_numpy_warnings_stay_off_stderr(tmp_path, capsys, monkeypatch):
 
     import numpy as np
 
-    import screwkin.cli
+    import screwkin.commands.mobility
 
-    original = screwkin.cli.analyze_mobility
+    original = screwkin.commands.mobility.analyze_mobility
 
     def noisy(*a, **k):
         np.float64(1.0) / np.zeros(1)  # divide by zero: RuntimeWarning unless silenced
         warnings.warn("Mean of empty slice", RuntimeWarning)
         return original(*a, **k)
 
-    monkeypatch.setattr(screwkin.cli, "analyze_mobility", noisy)
+    monkeypatch.setattr(screwkin.commands.mobility, "analyze_mobility", noisy)
     code, err = run(capsys, ["mobility", write(tmp_path, GOOD)])
     assert code == 0 and err == "", err
 

@@ -2,19 +2,22 @@
 
 from __future__ import annotations
 
-from ..analysis.motion import Point
-from ..analysis.planar import LinkAngles
-from ..analysis.position import PositionSolver
-from ..model.state import value_for_leg_length
-from ..errors import UsageError
 import argparse
+import json
 import math
 import sys
 
-from ..errors import quote, shorten
-from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
+import numpy as np
 
-__all__ = ["add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+from ..analysis.motion import Point
+from ..analysis.planar import LinkAngles
+from ..analysis.position import PositionSolver
+from ..errors import UsageError, quote, shorten
+from ..model.state import value_for_leg_length
+from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
+from ._options import count
+
+__all__ = ["names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind"]
 
 
@@ -159,3 +162,60 @@ def configuration(mech, args):
         return mech.generic_configurations()[0].q
     res = PositionSolver(mech, list(values)).solve(values, near=near)
     return res.solutions[0].q
+
+
+def names_list(text):
+    """``"a, b,c"`` -> ``["a", "b", "c"]``; None for no text."""
+    return [n.strip() for n in text.split(",") if n.strip()] if text else None
+
+
+def parse_range(text, option):
+    """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"])."""
+    name, sep, rest = text.partition("=")
+    parts = rest.split(":")
+    if not sep or len(parts) != 3:
+        raise UsageError(f"{option} expects NAME=A:B:N, got {quote(text, 80)}")
+    try:
+        n = count("grid")(parts[2])
+    except argparse.ArgumentTypeError as exc:
+        raise UsageError(f"{option}: N {exc}") from None
+    return name.strip(), np.linspace(parse_value(parts[0]), parse_value(parts[1]), n)
+
+
+def add_common(sp, mechanism: bool = True, optional_file: bool = False):
+    """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
+    if not mechanism:
+        sp.add_argument("--json", action="store_true", help="print one JSON object")
+        sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks of errors")
+        return
+    sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar), SDF, or xacro file",
+                    **({"nargs": "?"} if optional_file else {}))
+    sp.add_argument("--arg", action="append", dest="xacro_args", metavar="NAME=VALUE",
+                    help="xacro argument of a .xacro file (units allowed, e.g. crank=30mm: given in SI); repeatable")
+    sp.add_argument("--yaml", help="Extended-URDF sidecar (default: FILE with .yaml suffix, if present)")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+    # SUPPRESS: when absent after the command, the top-level --debug (before the command) is kept
+    sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks of errors")
+    sp.add_argument("--actuated", help="actuated joints, comma separated (overrides the file)")
+    sp.add_argument("--package-dir", action="append", dest="package_dirs", metavar="DIR",
+                    help="folder holding ROS packages (or a package) for package:// meshes, searched before "
+                         "ROS_PACKAGE_PATH; repeatable")
+
+
+def add_scaled(sp, point=True):
+    """--length (the characteristic length of the dimensionless measures) and --point."""
+    sp.add_argument("--length", help="characteristic length that makes the measures dimensionless "
+                                     "(default: the mean link length; printed with every measure)")
+    if point:
+        add_point_option(sp, "--point alone: analyse the output link's origin as a point (3 translations) "
+                             "instead of its full motion")
+
+
+def emit(args, data, text) -> int:
+    """Print ``data`` as one JSON object (--json; to_jsonable applied by the caller's data) or ``text``
+    (a string, or a callable making it, so that text-only work is skipped for --json); exit code 0."""
+    if getattr(args, "json", False):
+        print(json.dumps(data() if callable(data) else data, indent=2))
+    else:
+        print(text() if callable(text) else text)
+    return 0

@@ -9,7 +9,12 @@ import os
 
 import numpy as np
 
-from ..analysis.skeleton import kinematic_chain, singular_configurations, skeleton, trace_points
+from ..analysis.skeleton import (
+    kinematic_chain,
+    singular_configurations,
+    skeleton,
+    trace_points,
+)
 from ..errors import UsageError
 from ..present.draw import (
     chain_dict,
@@ -20,7 +25,13 @@ from ..present.draw import (
     value_label,
 )
 from ..present.report import to_jsonable
-from ._common import add_configuration_options, add_point_option, configuration, inputs, named_points
+from ._common import (
+    add_configuration_options,
+    add_point_option,
+    configuration,
+    inputs,
+    named_points,
+)
 from ._options import count
 
 NAME = "draw"

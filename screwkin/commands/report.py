@@ -20,7 +20,12 @@ from ..analysis.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
 from ..analysis.planar import identify
 from ..analysis.position import PositionSolver
-from ..analysis.skeleton import default_output, kinematic_chain, singular_configurations, skeleton
+from ..analysis.skeleton import (
+    default_output,
+    kinematic_chain,
+    singular_configurations,
+    skeleton,
+)
 from ..errors import ScrewkinError, UsageError
 from ..present.document import (
     Document,
@@ -41,11 +46,19 @@ from ..present.draw import draw_chain, draw_mechanism, value_label
 from ..present.equations import equations_dict, newton_dict
 from ..present.plots import sweep_figure
 from ..present.report import mobility_dict, position_dict
-from ..present.view import PICTURE, ViewerServer, build_scene, chromium, page, screenshot, show
+from ..present.view import (
+    PICTURE,
+    ViewerServer,
+    build_scene,
+    chromium,
+    page,
+    screenshot,
+    show,
+)
 from ._common import add_configuration_options, inputs, joint_assignments
+from ._options import check_writable, count, screwkin_version
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
-from ._options import check_writable, count, screwkin_version
 
 NAME = "report"
 NEEDS_MECHANISM = True

@@ -14,7 +14,13 @@ from ..analysis.workspace import DEFAULT_THRESHOLD, workspace
 from ..errors import UsageError
 from ..present.report import to_jsonable
 from ..present.view import ViewerServer, build_scene, screenshot, show
-from ..present.workspace import workspace_cloud, workspace_csv, workspace_dict, workspace_png, workspace_text
+from ..present.workspace import (
+    workspace_cloud,
+    workspace_csv,
+    workspace_dict,
+    workspace_png,
+    workspace_text,
+)
 from ..units import parse_value
 
 NAME = "workspace"

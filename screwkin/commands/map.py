@@ -1,0 +1,65 @@
+"""screwkin map: map of the smallest singular value over two inputs."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..analysis.maps import singularity_map
+from ..analysis.position import PositionSolver
+from ..errors import UsageError
+from ..present.plots import map_png
+from ..present.report import (
+    map_csv,
+    to_jsonable,
+)
+from ._common import (
+    joint_assignments,
+    parse_range,
+)
+from ._options import BOUNDS
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
+
+NAME = "map"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
+    common(sp)
+    sp.add_argument("--x", required=True, metavar="NAME=A:B:N", help="first input, from A to B in N values")
+    sp.add_argument("--y", required=True, metavar="NAME=A:B:N", help="second input")
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    sp.add_argument("--output", help="output link (serial singularities)")
+    sp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
+    sp.add_argument("--csv", help="the map's data as CSV")
+    scaled(sp)
+
+
+def run(mech, args) -> int:
+    xn, xs = parse_range(args.x, "--x")
+    yn, ys = parse_range(args.y, "--y")
+    if xs.size * ys.size > BOUNDS["grid_total"][1]:
+        raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
+                         f"at most {BOUNDS['grid_total'][1]:,}")
+    fixed = joint_assignments(mech, args.set, "--set")
+    inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
+    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output, args.point)
+    if args.png:
+        map_png(res, args.png)
+    if args.csv:
+        with open(args.csv, "w") as f:
+            f.write(map_csv(res))
+    if args.json:
+        print(json.dumps(to_jsonable({"x": xn, "y": yn, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
+                                      "kind": res.kind, "characteristic_length": mech.length}), indent=2))
+    else:
+        finite = res.log_sigma[np.isfinite(res.log_sigma)]
+        print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
+              f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g} (L = {mech.length:.4g} m)"
+              if finite.size else "no point assembled")
+    return 0

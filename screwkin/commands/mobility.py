@@ -1,0 +1,27 @@
+"""screwkin mobility: degrees of freedom, the counts and the screw-theory mobility."""
+
+from __future__ import annotations
+
+from ..analysis.mobility import analyze_mobility
+from ..errors import UsageError
+from ..present.report import mobility_dict, mobility_text, to_jsonable
+from ._common import emit
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
+
+NAME = "mobility"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser(NAME, help="degrees of freedom: counts and screw-theory mobility")
+    common(sp)
+    sp.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
+    sp.add_argument("--point", action="store_true", help="the output link's origin as a point (3 translations)")
+
+
+def run(mech, args) -> int:
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
+    result = analyze_mobility(mech, output=args.output, point=args.point)
+    return emit(args, lambda: to_jsonable(mobility_dict(result)), lambda: mobility_text(result))

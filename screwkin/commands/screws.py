@@ -1,0 +1,51 @@
+"""screwkin screws: product-of-exponentials structure equations and joint screws."""
+
+from __future__ import annotations
+
+import json
+
+from ..analysis.screws import loop_screws, structure
+from ..errors import UsageError
+from ..present.report import (
+    loops_dict,
+    loops_text,
+    screws_dict,
+    screws_text,
+    to_jsonable,
+)
+from ._common import (
+    add_configuration_options,
+    configuration,
+)
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
+
+NAME = "screws"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
+    common(sp)
+    add_configuration_options(sp)
+    sp.add_argument("--output", help="also the chain to this link")
+
+
+def run(mech, args) -> int:
+    if not mech.cuts and not args.output:
+        raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
+    q = configuration(mech, args)
+    st = structure(mech, q, args.output)
+    topo = mech.topology(q)
+    normal = None
+    if topo.motion_space == "planar":
+        normal = topo.normal
+    loops = loop_screws(mech)
+    if args.json:
+        print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal),
+                                      "loops": loops_dict(loops, normal)}), indent=2))
+    else:
+        print(screws_text(st, normal))
+        if loops:
+            print(loops_text(loops, normal))
+    return 0

@@ -1,0 +1,67 @@
+"""screwkin singularities: classify the singularities of a configuration."""
+
+from __future__ import annotations
+
+import json
+
+from ..analysis.ellipsoids import ellipsoids
+from ..analysis.gram_symbolic import symbolic_gram
+from ..analysis.singular import classify
+from ..errors import UsageError
+from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text
+from ..present.report import (
+    singularity_dict,
+    singularity_text,
+    to_jsonable,
+)
+from ..present.screws import gram_symbolic_dict, gram_symbolic_text
+from ._common import (
+    add_configuration_options,
+    configuration,
+    inputs,
+)
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
+
+NAME = "singularities"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser("singularities", help="classify the singularities of a configuration")
+    common(sp)
+    add_configuration_options(sp)
+    sp.add_argument("--output", help="output link (for serial singularities and the output twist)")
+    sp.add_argument("--ellipsoids", action="store_true",
+                   help="the output's velocity and force ellipsoids for the inputs (needs --output)")
+    sp.add_argument("--symbolic", action="store_true",
+                   help="planar loops: each joint's Gram cofactor as a formula in the symbols of screwkin equations, "
+                        "and where it vanishes (the joint is stationary)")
+    scaled(sp)
+
+
+def run(mech, args) -> int:
+    if args.point and not args.output:
+        raise UsageError("--point needs --output LINK")
+    if args.ellipsoids and not args.output:
+        raise UsageError("--ellipsoids needs --output LINK")
+    q = configuration(mech, args)
+    rep = classify(mech, q, output=args.output, point=args.point)
+    ell = ellipsoids(mech, q, args.output, point=args.point) if args.ellipsoids else None
+    gram = symbolic_gram(mech, q, list(inputs(mech, args)) or None) if args.symbolic else None
+    if args.json:
+        d = singularity_dict(rep)
+        if ell is not None:
+            d["ellipsoids"] = ellipsoids_dict(ell)
+        if gram is not None:
+            d["gram_symbolic"] = gram_symbolic_dict(gram)
+        print(json.dumps(to_jsonable(d), indent=2))
+    else:
+        print(singularity_text(rep))
+        if ell is not None:
+            print()
+            print(ellipsoids_text(ell))
+        if gram is not None:
+            print()
+            print(gram_symbolic_text(gram))
+    return 0

@@ -1,0 +1,81 @@
+"""screwkin solve: position, velocity and acceleration for given input values."""
+
+from __future__ import annotations
+
+import json
+
+from ..analysis.position import PositionSolver
+from ..errors import UsageError
+from ..present.report import (
+    position_dict,
+    position_text,
+    to_jsonable,
+    trace_text,
+)
+from . import equations as equations_command
+from ._common import (
+    add_angle_option,
+    add_length_option,
+    add_point_option,
+    inputs,
+    joint_assignments,
+    named_points,
+)
+from ._options import count
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
+
+NAME = "solve"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
+    common(sp)
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="input joint value, SI or with a unit (45deg, 30mm); repeat or comma-separate")
+    add_angle_option(sp)
+    add_length_option(sp)
+    sp.add_argument("--all", action="store_true",
+                   help="show every assembly mode, also those the mechanism cannot reach by moving")
+    sp.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
+    sp.add_argument("--output", help="link whose pose (and twist) to report")
+    add_point_option(sp)
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input joint rate [1/s] (units as --set)")
+    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
+    sp.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
+    sp.add_argument("--starts", type=count("starts"), default=24, help="random starting configurations (default 24)")
+    sp.add_argument("--start", action="append", metavar="NAME=VALUE,...",
+                   help="planar: Newton on the vector-loop equations (screwkin equations) from these estimates of "
+                        "the unknowns: symbols (theta3, x4), link names (their angles) or passive joint values")
+    sp.add_argument("--iterations", type=count("iterations"), metavar="K",
+                   help="with --start: exactly K Newton iterations, each printed (residual, Jacobian, step, "
+                        "estimates); without it Newton goes on to convergence")
+    scaled(sp, point=False)
+
+
+def run(mech, args) -> int:
+    values = inputs(mech, args)
+    if not values:
+        raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
+    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    rates = joint_assignments(mech, args.rate, "--rate", order=1) if args.rate or args.accel else None
+    accels = joint_assignments(mech, args.accel, "--accel", order=2) if args.accel else None
+    if args.starts < 0:
+        raise UsageError("--starts must be 0 or more")
+    if args.start or args.iterations is not None:
+        return equations_command.solve_from_start(mech, args, values)
+    solver = PositionSolver(mech, list(values), output=args.output)
+    res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
+                       points=named_points(mech, args))
+    if args.json:
+        d = position_dict(res)
+        d["characteristic_length"] = mech.length
+        print(json.dumps(to_jsonable(d), indent=2))
+        return 0
+    if args.trace:
+        names = [mech.coordinate_names[k] for k in solver.passive]
+        print(trace_text(res, mech.closure.row_labels(solver=True), names))
+        print()
+    print(position_text(res, show_all=args.all, length=mech.length))
+    return 0
