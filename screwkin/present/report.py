@@ -17,6 +17,7 @@ from ..analysis.screws import Screw, planar_form, screw_of
 from ..analysis.singular import SingularityReport
 from ..analysis.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
+from .csvcells import csv_text
 
 __all__ = ["to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
@@ -509,13 +510,13 @@ def sweep_csv(res: SweepResult) -> str:
     coupled = res.coupled or {}
     head = ["step", res.input + "_input"] + list(res.names) + [f"d_{n}" for n in res.names] + [
         f"dd_{n}" for n in res.names] + list(coupled)
-    lines = [",".join(head)]
+    rows = [head]
     for k in range(len(res.values)):
         row = [str(k), f"{res.values[k]:.12g}"] + [f"{x:.12g}" for x in res.joints[k]]
         row += [f"{x:.12g}" for x in res.rates[k]] + [f"{x:.12g}" for x in res.accelerations[k]]
         row += [f"{v[k]:.12g}" for v in coupled.values()]
-        lines.append(",".join(row))
-    return "\n".join(lines) + "\n"
+        rows.append(row)
+    return csv_text(rows)
 
 
 def scan_dict(res: ScanResult) -> dict:
@@ -533,9 +534,8 @@ def scan_dict(res: ScanResult) -> dict:
 
 
 def scan_csv(res: ScanResult) -> str:
-    head = ",".join(res.joints) + f",{res.measure}"
     rows = np.column_stack([res.theta, res.values])
-    return head + "\n" + "\n".join(",".join(f"{x:.12g}" for x in row) for row in rows) + "\n"
+    return csv_text([[*res.joints, res.measure], *([f"{x:.12g}" for x in row] for row in rows)])
 
 
 def map_dict(res: SingularityMap) -> dict:
@@ -544,11 +544,11 @@ def map_dict(res: SingularityMap) -> dict:
 
 
 def map_csv(res: SingularityMap) -> str:
-    lines = [f"{res.x_name},{res.y_name},log10_sigma_min,kind"]
+    rows = [[res.x_name, res.y_name, "log10_sigma_min", "kind"]]
     for j, y in enumerate(res.ys):
         for i, x in enumerate(res.xs):
-            lines.append(f"{x:.12g},{y:.12g},{res.log_sigma[j, i]:.6g},{res.kind[j, i]}")
-    return "\n".join(lines) + "\n"
+            rows.append([f"{x:.12g}", f"{y:.12g}", f"{res.log_sigma[j, i]:.6g}", res.kind[j, i]])
+    return csv_text(rows)
 
 
 _DICTS = {MobilityResult: mobility_dict, PositionResult: position_dict, SingularityReport: singularity_dict,

@@ -11,9 +11,7 @@ values are the SI values given to the xacro file).
 
 from __future__ import annotations
 
-import csv
 import importlib.util
-import io
 import math
 import sys
 import time
@@ -25,6 +23,7 @@ import numpy as np
 from ..analysis.study import pareto_front
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
+from .csvcells import csv_text
 from .plots import _pyplot
 from .report import to_jsonable
 
@@ -81,13 +80,9 @@ def study_csv(result) -> str:
     """The table as CSV: one row per design, in design order; empty cells for missing values;
     floats written exactly (shortest round-trip form)."""
     rows, names = _rows(result)
-    out = io.StringIO()
-    w = csv.writer(out, lineterminator="\n")
-    w.writerow(names)
-    for row in rows:
-        w.writerow(["" if v is None else ("true" if v is True else "false" if v is False else
-                                          repr(v) if isinstance(v, float) else v) for v in row])
-    return out.getvalue()
+    return csv_text([names] + [["" if v is None else ("true" if v is True else "false" if v is False else
+                                                       repr(v) if isinstance(v, float) else v) for v in row]
+                               for row in rows])
 
 
 def check_table_path(path) -> None:

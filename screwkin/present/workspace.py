@@ -3,12 +3,12 @@
 
 from __future__ import annotations
 
-import csv
 
 import numpy as np
 import pinocchio as pin
 
 from ..analysis.workspace import WorkspaceResult
+from .csvcells import write_csv
 from .plots import _pyplot
 from .report import table
 
@@ -103,15 +103,14 @@ def workspace_csv(r: WorkspaceResult, path, joint_columns=None):
     """One row per reached point (cell): world position, grid index, measures, free; with
     ``joint_columns`` ((name, q index) pairs) the joint values of the grid's solutions."""
     joint_columns = list(joint_columns or []) if r.configurations is not None else []
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["x", "y", "z"] + [f"i_{n}" for n in axis_labels(r)]
-                   + ["actuator", "serial", "conditioning", "free"] + [n for n, _ in joint_columns])
-        for k in range(len(r.index)):
-            row = [f"{x:.9g}" for x in r.positions[k]] + [int(i) for i in r.index[k]]
-            row += [f"{r.measures[m][k]:.6g}" for m in ("actuator", "serial", "conditioning")] + [int(r.free[k])]
-            row += [f"{r.configurations[k, iq]:.9g}" for _, iq in joint_columns]
-            w.writerow(row)
+    rows = [["x", "y", "z"] + [f"i_{n}" for n in axis_labels(r)]
+            + ["actuator", "serial", "conditioning", "free"] + [n for n, _ in joint_columns]]
+    for k in range(len(r.index)):
+        row = [f"{x:.9g}" for x in r.positions[k]] + [int(i) for i in r.index[k]]
+        row += [f"{r.measures[m][k]:.6g}" for m in ("actuator", "serial", "conditioning")] + [int(r.free[k])]
+        row += [f"{r.configurations[k, iq]:.9g}" for _, iq in joint_columns]
+        rows.append(row)
+    write_csv(path, rows)
 
 
 def workspace_png(r: WorkspaceResult, path: str):
