@@ -301,7 +301,9 @@ def html(doc: Document) -> str:
         parts.append(f'<section id="{escape(s.id)}"><h2>{escape(s.title)}</h2>')
         parts += [_html_block(b) for b in s.blocks]
         parts.append("</section>")
-    data = json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True).replace("</", "<\\/")
+    # < > & as JSON escapes: no name can close the script element or open a comment in it
+    data = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True)
+            .replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026"))
     parts.append(f'<script type="application/json" id="screwkin-data">{data}</script>')
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
