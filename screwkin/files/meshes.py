@@ -4,6 +4,13 @@
 folders of ``ROS_PACKAGE_PATH`` and the ``--package-dir`` folders; ``file://`` and
 relative paths as written.  A missing mesh is a warning (views draw stand-ins),
 never a failure.
+
+Mesh files are read only from inside the robot file's folder tree, the
+``--package-dir`` and ``ROS_PACKAGE_PATH`` folders, and the package the file
+sits in (the folder, at most two above it, named like a ``package://`` URI's
+package), after symbolic links and ``..`` are resolved; ``package://NAME/...``
+stays inside NAME's folder.  A mesh elsewhere is a warning and is not read (a
+hostile file cannot get another file's bytes into a ``view --html`` page).
 """
 
 from __future__ import annotations
@@ -14,7 +21,7 @@ from pathlib import Path
 from ..errors import quote, shorten
 from .description import LIMITS
 
-__all__ = ["resolve_uri", "find_mesh", "check_meshes"]
+__all__ = ["resolve_uri", "find_mesh", "locate_mesh", "check_meshes"]
 
 
 def _is_file(p: Path) -> bool:
@@ -58,16 +65,64 @@ def resolve_uri(uri: str, base: Path, package_dirs=(), roots=None):
     return [p if p.is_absolute() else base / p]
 
 
+def _real(p: Path):
+    """p with symbolic links and ``..`` resolved, or None when the system refuses it."""
+    try:
+        return Path(os.path.realpath(p))
+    except (OSError, ValueError):
+        return None
+
+
+def _inside(p: Path, folder) -> bool:
+    folder = _real(Path(folder))
+    return folder is not None and p.is_relative_to(folder)
+
+
+def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool:
+    """Whether the mesh candidate ``cand`` (``real`` once resolved) may be read: inside the file's folder,
+    a --package-dir or ROS_PACKAGE_PATH folder, or the package the file is in; a ``package://NAME/``
+    candidate also inside that package's folder (``package://NAME/../x`` does not leave it)."""
+    folders = [base, *(package_dirs or ())]
+    folders += [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    if uri.startswith("package://"):
+        package = uri[len("package://"):].partition("/")[0]
+        # the package's own folder: cand is root/NAME/inside or root/inside (both written so)
+        inside = uri[len("package://"):].partition("/")[2].lstrip("/")
+        depth = len(Path(inside).parts) if inside else 0
+        pkg_root = cand
+        for _ in range(depth):
+            pkg_root = pkg_root.parent
+        if not _inside(real, pkg_root):
+            return False
+        own = [a for a in [base, *list(base.parents)[:2]] if package and a.name == package]
+        folders += own
+    return any(_inside(real, f) for f in folders)
+
+
+def locate_mesh(uri: str, base: Path, package_dirs=(), roots=None):
+    """(the first existing, allowed file among the candidates of ``uri`` or None, the resolved path
+    of an existing candidate that was refused because it lies outside the allowed folders, or None)."""
+    refused = None
+    for c in resolve_uri(uri, base, package_dirs, roots):
+        if not _is_file(c):
+            continue
+        real = _real(c)
+        if real is not None and _allowed(uri, c, real, base, package_dirs):
+            return c, None
+        refused = refused or real or c
+    return None, refused
+
+
 def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
-    """The first existing file among the candidates of ``uri``, or None."""
-    return next((c for c in resolve_uri(uri, base, package_dirs, roots) if _is_file(c)), None)
+    """The first existing file among the candidates of ``uri`` inside the allowed folders, or None."""
+    return locate_mesh(uri, base, package_dirs, roots)[0]
 
 
 def check_meshes(path, root, package_dirs=()) -> list:
     """Warnings for mesh files that cannot be found (missing meshes do not fail a load)."""
     base = Path(path).resolve().parent
     roots = _roots(base, package_dirs)
-    missing, checked = [], set()
+    missing, outside, checked = [], [], set()
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename") or (mesh.findtext("uri") or "").strip()
         if not uri or uri.startswith("model://") or uri in checked:
@@ -75,10 +130,17 @@ def check_meshes(path, root, package_dirs=()) -> list:
         if len(checked) >= LIMITS.meshes:
             break
         checked.add(uri)
-        if find_mesh(uri, base, package_dirs, roots) is None:
+        found, refused = locate_mesh(uri, base, package_dirs, roots)
+        if refused is not None and found is None:
+            outside.append(uri)
+        elif found is None:
             missing.append(uri)
+    warnings = [f"mesh {quote(m, 120)} is outside the robot's folder and the package folders "
+                f"(--package-dir, ROS_PACKAGE_PATH): not read, views draw a stand-in" for m in outside[:3]]
+    if len(outside) > 3:
+        warnings.append(f"{len(outside) - 3} more mesh file(s) outside the robot's folder and the package folders")
     if not missing:
-        return []
+        return warnings
     shown = ", ".join(quote(m, 60) for m in missing[:3]) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
     msg = f"{len(missing)} mesh file(s) not found (views will use stand-ins): {shown}"
     if len(checked) >= LIMITS.meshes:
@@ -87,5 +149,5 @@ def check_meshes(path, root, package_dirs=()) -> list:
         looked = ", ".join(shorten(str(r), 60) for r in roots[:4]) + (f" and {len(roots) - 4} more" if len(roots) > 4
                                                                         else "")
         msg += f"; looked for packages in {looked} (set ROS_PACKAGE_PATH or use --package-dir DIR)"
-    return [msg]
+    return warnings + [msg]
 

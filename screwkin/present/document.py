@@ -308,15 +308,28 @@ def html(doc: Document) -> str:
         parts.append(f'<section id="{escape(s.id)}"><h2>{escape(s.title)}</h2>')
         parts += [_html_block(b) for b in s.blocks]
         parts.append("</section>")
-    data = json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True).replace("</", "<\\/")
+    # < > & as JSON escapes: no name can close the script element or open a comment in it
+    data = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True)
+            .replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026"))
     parts.append(f'<script type="application/json" id="screwkin-data">{data}</script>')
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
 
 
 # ------------------------------------------------------------------ Markdown
+def _md_text(t) -> str:
+    """Text for Markdown: HTML escaped (a Markdown viewer renders raw HTML: a link named
+    ``<script>`` must stay text) and Markdown's emphasis, code and link characters escaped."""
+    return escape(re.sub(r"([*`\\\[\]])", r"\\\1", str(t)), quote=False)
+
+
 def _md_cell(c) -> str:
-    return re.sub(r"([*`\\])", r"\\\1", str(c)).replace("|", "\\|").replace("\n", " ")
+    return _md_text(c).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+
+
+def _fence(text) -> str:
+    """A code fence longer than any run of backticks in ``text``."""
+    return "`" * max(3, 1 + max((len(r) for r in re.findall(r"`+", text)), default=0))
 
 
 def _md_table(headers, rows) -> str:
@@ -329,24 +342,24 @@ def markdown(doc: Document, folder: str) -> tuple:
     """(Markdown text, {file name in ``folder``: bytes}): the pictures and data.json go into
     ``folder`` (a name relative to the Markdown file), which the text links to."""
     files = {}
-    lines = [f"# {doc.title}", "", _md_table(["", ""], doc.facts), ""]
+    lines = [f"# {_md_cell(doc.title)}", "", _md_table(["", ""], doc.facts), ""]
     for s in doc.sections:
-        lines += [f"## {s.title}", ""]
+        lines += [f"## {_md_cell(s.title)}", ""]
         for b in s.blocks:
             if isinstance(b, Text):
-                lines.append(re.sub(r"([*`\\])", r"\\\1", b.text))
+                lines.append(_md_text(b.text))
             elif isinstance(b, Note):
-                lines.append("> " + re.sub(r"([*`\\])", r"\\\1", b.text))
+                lines.append("> " + _md_text(b.text).replace("\n", "\n> "))
             elif isinstance(b, Code):
-                lines += ["```text", b.text, "```"]
+                lines += [_fence(b.text) + "text", b.text, _fence(b.text)]
             elif isinstance(b, Table):
                 lines.append(_md_table(b.headers, b.rows))
             elif isinstance(b, Figure):
                 name = f"{len(files) + 1:02d}-{b.role}.{b.fmt}"
                 files[name] = b.data
-                lines.append(f"![{b.caption}]({folder}/{name})")
+                lines.append(f"![{_md_cell(b.caption)}]({folder}/{name})")
                 lines.append("")
-                lines.append(f"*{b.caption}*")
+                lines.append(f"*{_md_cell(b.caption)}*")
             lines.append("")
     files["data.json"] = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True) + "\n").encode()
     lines.append(f"The results as JSON: [{folder}/data.json]({folder}/data.json)")
