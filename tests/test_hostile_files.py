@@ -1,0 +1,123 @@
+"""Hostile and huge inputs, round 2 (issue 22): work that doubles without a macro call, names
+with dots, misspelt sidecar keys, XML comments holding ``--``.  Every case is either refused with
+one line naming the file (exit 1) or gives the numbers the plain file gives."""
+
+import pytest
+
+from conftest import no_hang
+from screwkin.cli import main
+from screwkin.errors import MechanismFileError
+from screwkin.files import xacro as xacro_module
+from screwkin.files.description import LIMITS
+from screwkin.files.xacro import MAX_STRING, XacroInternalError, expand
+
+HEAD = '<?xml version="1.0"?>\n<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+
+
+def doubling_blocks(levels: int) -> str:
+    """b0 one link; bK two copies of bK-1; then b{levels} inserted: 2**levels links."""
+    lines = [HEAD, '<xacro:property name="b0"><link name="l"/></xacro:property>\n']
+    for k in range(1, levels + 1):
+        lines.append(f'<xacro:property name="b{k}"><xacro:insert_block name="b{k - 1}"/>'
+                     f'<xacro:insert_block name="b{k - 1}"/></xacro:property>\n')
+    lines.append(f'<xacro:insert_block name="b{levels}"/>\n</robot>\n')
+    return "".join(lines)
+
+
+def doubling_text(levels: int) -> str:
+    """s0 eight characters; sK is "${sK-1}${sK-1}": 8 * 2**levels characters."""
+    lines = [HEAD, '<xacro:property name="s0" value="abcdefgh"/>\n']
+    for k in range(1, levels + 1):
+        lines.append(f'<xacro:property name="s{k}" value="${{s{k - 1}}}${{s{k - 1}}}"/>\n')
+    lines.append(f'<link name="${{s{levels}}}"/>\n</robot>\n')
+    return "".join(lines)
+
+
+def test_a_small_doubling_of_blocks_expands(tmp_path):
+    # 3 levels: 2**3 = 8 copies of the one link (the size check counts, it does not forbid)
+    path = tmp_path / "d3.urdf.xacro"
+    text = doubling_blocks(3)
+    assert expand(path, text).count('<link name="l"/>') == 8
+
+
+def test_insert_block_twice_still_expands(tmp_path):
+    text = (HEAD + '<xacro:property name="part"><link name="a"/><link name="b"/></xacro:property>\n'
+            '<xacro:macro name="two" params="*body"><xacro:insert_block name="body"/>'
+            '<xacro:insert_block name="body"/></xacro:macro>\n'
+            '<xacro:insert_block name="part"/><xacro:insert_block name="part"/>\n'
+            '<xacro:two><link name="c"/></xacro:two>\n</robot>\n')
+    out = expand(tmp_path / "twice.urdf.xacro", text)
+    assert out.count('<link name="a"/>') == 2 and out.count('<link name="b"/>') == 2
+    assert out.count('<link name="c"/>') == 2
+
+
+@pytest.mark.parametrize("levels", [16, 30])
+def test_doubling_blocks_are_refused_at_once(tmp_path, levels):
+    # 2**16 links alone are 65,536 copies plus the blocks' own elements: past the 200,000-element bound.
+    # Before the bound this ran for minutes (16 levels) and forever (30). The guard is against
+    # that blow-up, not a speed measurement.
+    path = tmp_path / f"d{levels}.urdf.xacro"
+    text = doubling_blocks(levels)
+    assert len(text) < 4000  # a small file
+    with no_hang(5), pytest.raises(MechanismFileError) as info:
+        expand(path, text)
+    message = str(info.value)
+    assert str(path) in message and f"{LIMITS.elements}" in message and "insert_block" in message
+    assert "\n" not in message
+
+
+def test_doubling_blocks_exit_1_on_the_command_line(tmp_path, capsys):
+    path = tmp_path / "d30.urdf.xacro"
+    path.write_text(doubling_blocks(30))
+    with no_hang(5):
+        code = main(["mobility", str(path)])
+    err = capsys.readouterr().err.strip()
+    assert code == 1 and len(err.splitlines()) == 1
+    assert err.startswith("screwkin: error: ") and str(path) in err and "more than 200000 elements" in err
+
+
+def test_small_doubling_text_expands(tmp_path):
+    out = expand(tmp_path / "t3.urdf.xacro", doubling_text(3))
+    assert '<link name="' + "abcdefgh" * 8 + '"/>' in out
+
+
+@pytest.mark.parametrize("levels", [12, 40])
+def test_doubling_text_is_refused(tmp_path, levels):
+    # 8 * 2**11 = 16,384 > 10,000 characters: refused at the eleventh level, long before 8 * 2**40
+    path = tmp_path / "t.urdf.xacro"
+    with no_hang(5), pytest.raises(MechanismFileError) as info:
+        expand(path, doubling_text(levels))
+    message = str(info.value)
+    assert str(path) in message and f"more than {MAX_STRING} characters" in message and "\n" not in message
+
+
+def test_a_bug_inside_xacro_is_an_internal_error_not_the_files(tmp_path, monkeypatch, capsys):
+    import xacro
+
+    def broken(*args, **kwargs):
+        raise KeyError("boom")
+
+    monkeypatch.setattr(xacro, "grab_property", broken)
+    path = tmp_path / "ok.urdf.xacro"
+    path.write_text(HEAD + '<xacro:property name="a" value="1"/><link name="l"/>\n</robot>\n')
+    with pytest.raises(XacroInternalError, match="internal error in the xacro expansion"):
+        expand(path, path.read_text())
+    assert main(["mobility", str(path)]) == 3
+    err = capsys.readouterr().err
+    assert "internal error" in err and "xacro expansion" in err and "KeyError" in err
+
+
+def test_the_files_mistake_inside_xacro_stays_exit_1(tmp_path, capsys):
+    path = tmp_path / "bad.urdf.xacro"
+    path.write_text(HEAD + '<xacro:insert_block name="nowhere"/><link name="l"/>\n</robot>\n')
+    assert main(["mobility", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "Undefined block" in err and str(path) in err and "internal error" not in err
+
+
+def test_the_interpreter_lives_in_its_own_module():
+    # the split of files/xacro.py keeps the public names where callers import them
+    from screwkin.files import xacro_eval
+
+    assert xacro_module.evaluate is xacro_eval.evaluate
+    assert xacro_module.check_expression is xacro_eval.check_expression
