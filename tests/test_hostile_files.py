@@ -121,3 +121,65 @@ def test_the_interpreter_lives_in_its_own_module():
 
     assert xacro_module.evaluate is xacro_eval.evaluate
     assert xacro_module.check_expression is xacro_eval.check_expression
+
+
+# ------------------------------------------------------------------ names with dots
+DOTTED = {  # file -> (its actuated joint, an input value, {loop joint: a name with dots})
+    "rack_pinion.urdf": ("pinion_joint", 0.3, {"mesh": "mesh.2"}),
+    # "a" and "a.x": the virtual joints of "a" (a.a1, a.a2) must not take those of "a.x" (a.x.a1, a.x.a2)
+    "gear_train_idler.urdf": ("input_joint", 0.3, {"mesh1": "a", "mesh2": "a.x"}),
+    "lead_screw_jack.urdf": ("screw_joint", 2.0, {"thread": "thread.x.turn"}),
+    "friction_wheels.urdf": ("wheel2_joint", 0.4, {"wheels": "w.a1"}),
+}
+SCALARS = ("loops", "kutzbach", "gruebler", "coordinates", "constraint_rows", "constraint_rank", "mobility",
+           "overconstraint", "effective_mobility", "classification", "redundant_constraints")
+
+
+def cli_json(capsys, argv):
+    import json
+
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return json.loads(out)
+
+
+@pytest.mark.parametrize("name", sorted(DOTTED))
+def test_loop_joint_names_with_dots(tmp_path, capsys, name):
+    from conftest import ROBOTS
+
+    joint, value, renames = DOTTED[name]
+    text = (ROBOTS / name).read_text()
+    for old, new in renames.items():
+        assert f'<loop_joint name="{old}"' in text
+        text = text.replace(f'<loop_joint name="{old}"', f'<loop_joint name="{new}"')
+    dotted = tmp_path / name
+    dotted.write_text(text)
+    plain = cli_json(capsys, ["mobility", str(ROBOTS / name), "--json"])
+    renamed = cli_json(capsys, ["mobility", str(dotted), "--json"])
+    assert {k: renamed[k] for k in SCALARS} == {k: plain[k] for k in SCALARS}
+    assert plain["mobility"] == 1
+    argv = ["solve", "--set", f"{joint}={value}", "--json"]
+    plain = cli_json(capsys, [argv[0], str(ROBOTS / name), *argv[1:]])["solutions"]
+    renamed = cli_json(capsys, [argv[0], str(dotted), *argv[1:]])["solutions"]
+    assert len(plain) == len(renamed) >= 1
+    for a, b in zip(plain, renamed):
+        expected = {}
+        for k, v in a["joints"].items():  # the virtual joints carry the loop joint's new name
+            loop, dot, role = k.partition(".")
+            expected[f"{renames[loop]}.{role}" if dot and loop in renames else k] = v
+        assert b["joints"].keys() == expected.keys()
+        for k, v in expected.items():
+            assert b["joints"][k] == pytest.approx(v, abs=1e-9)
+
+
+def test_a_joint_named_like_a_virtual_joint_is_refused(tmp_path, capsys):
+    from conftest import ROBOTS
+
+    text = (ROBOTS / "rack_pinion.urdf").read_text().replace('<joint name="rack_joint"', '<joint name="mesh.x"')
+    text = text.replace('<joint name="rack_joint"/>', '<joint name="mesh.x"/>')
+    path = tmp_path / "clash.urdf"
+    path.write_text(text)
+    assert main(["mobility", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert str(path) in err and "'mesh.x'" in err and "rename" in err and "internal error" not in err
