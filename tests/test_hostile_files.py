@@ -183,3 +183,52 @@ def test_a_joint_named_like_a_virtual_joint_is_refused(tmp_path, capsys):
     assert main(["mobility", str(path)]) == 1
     err = capsys.readouterr().err
     assert str(path) in err and "'mesh.x'" in err and "rename" in err and "internal error" not in err
+
+
+# ------------------------------------------------------------------ misspelt sidecar keys
+FIVE_BAR = "corpus/example-parallel-robots/5bar_linkage"
+
+
+def five_bar_with(tmp_path, yaml_text):
+    import shutil
+
+    from conftest import ROBOTS
+
+    folder = tmp_path / "fivebar"
+    folder.mkdir()
+    shutil.copy(ROBOTS / FIVE_BAR / "robot.urdf", folder / "robot.urdf")
+    (folder / "robot.yaml").write_text(yaml_text)
+    return folder / "robot.urdf"
+
+
+def test_the_five_bar_sidecar_gives_mobility_3(tmp_path, capsys):
+    # the collection's 5bar_linkage (tests/test_corpus.py): planar, Gruebler 3(6-1-6)+6 = 3 with its
+    # loop; without the loop the open tree has its 6 joints free (M = 6)
+    path = five_bar_with(tmp_path, "closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: ['mot1', 'mot2']\n")
+    result = cli_json(capsys, ["mobility", str(path), "--json"])
+    assert result["loops"] == 1 and result["mobility"] == 3
+
+
+def test_a_misspelt_sidecar_key_warns_with_the_right_one(tmp_path, capsys):
+    path = five_bar_with(tmp_path, "closed_loops: [['closedloop1_A', 'closedloop1_B']]\nname_mot: ['mot1', 'mot2']\n")
+    assert main(["mobility", str(path), "--json"]) == 0
+    out, err = capsys.readouterr()
+    warning = [line for line in err.splitlines() if "closed_loops" in line]
+    assert len(warning) == 1 and warning[0].startswith("warning: ")
+    assert str(path.with_suffix(".yaml")) in warning[0] and "did you mean 'closed_loop'?" in warning[0]
+
+
+def test_a_misspelt_key_is_named_first_when_the_sidecar_fails(tmp_path, capsys):
+    path = five_bar_with(tmp_path, "closed_loops: [['closedloop1_A', 'closedloop1_B']]\ntype: ['6d']\n")
+    assert main(["mobility", str(path)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"screwkin: error: {path.with_suffix('.yaml')}: unknown key 'closed_loops' (did you mean "
+                          "'closed_loop'?)")
+    assert "0 pairs but type has 1" in err and len(err.splitlines()) == 1
+
+
+def test_an_unknown_key_far_from_any_lists_the_known_ones(tmp_path, capsys):
+    path = five_bar_with(tmp_path, "closed_loop: [['closedloop1_A', 'closedloop1_B']]\nzzz: 1\n")
+    assert main(["mobility", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert "unknown key 'zzz'" in err and "known keys: closed_loop, type, name_mot, joint_name, joint_type" in err
