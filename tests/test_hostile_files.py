@@ -232,3 +232,42 @@ def test_an_unknown_key_far_from_any_lists_the_known_ones(tmp_path, capsys):
     assert main(["mobility", str(path)]) == 0
     err = capsys.readouterr().err
     assert "unknown key 'zzz'" in err and "known keys: closed_loop, type, name_mot, joint_name, joint_type" in err
+
+
+# ------------------------------------------------------------------ XML comments holding "--"
+GOOD_URDF = ('<?xml version="1.0"?>\n<robot name="r">\n  <link name="base"/>\n  <link name="arm"/>\n'
+             '  {comment}\n  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>'
+             '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>\n</robot>\n')
+
+
+@pytest.mark.parametrize("comment, line, opened", [
+    ("<!-- the arm -- 40 mm -->", 5, 5),
+    ("<!-- an arrow --->", 5, 5),
+    ("<!--\n  several lines\n  a--b\n  -->", 7, 5),
+])
+def test_double_hyphen_in_a_comment_is_named(tmp_path, capsys, comment, line, opened):
+    path = tmp_path / "r.urdf"
+    path.write_text(GOOD_URDF.format(comment=comment))
+    assert main(["mobility", str(path)]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err == (f"screwkin: error: {path}: malformed XML: a comment cannot contain '--' (line {line}, in the "
+                   f"comment opened at line {opened}): write it without the double hyphen")
+
+
+def test_double_hyphen_outside_comments_is_fine(tmp_path, capsys):
+    # "--" in text and attributes is well-formed XML; a closed comment before another error is not blamed
+    path = tmp_path / "r.urdf"
+    path.write_text(GOOD_URDF.format(comment="<!-- fine --><!----><a_text>-- not a comment</a_text>"))
+    assert main(["mobility", str(path)]) == 0
+    capsys.readouterr()
+    path.write_text(GOOD_URDF.format(comment="<!-- fine --><a></b>"))
+    assert main(["mobility", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "mismatched tag" in err and "comment" not in err
+
+
+def test_double_hyphen_in_a_xacro_comment(tmp_path, capsys):
+    path = tmp_path / "r.urdf.xacro"
+    path.write_text(HEAD + '<!-- width -- in metres -->\n<link name="l"/>\n</robot>\n')
+    assert main(["mobility", str(path)]) == 1
+    assert "a comment cannot contain '--' (line 3" in capsys.readouterr().err
