@@ -271,3 +271,18 @@ def test_double_hyphen_in_a_xacro_comment(tmp_path, capsys):
     path.write_text(HEAD + '<!-- width -- in metres -->\n<link name="l"/>\n</robot>\n')
     assert main(["mobility", str(path)]) == 1
     assert "a comment cannot contain '--' (line 3" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("body, missing", [
+    ('<xacro:attribute name="a"/>', "xacro:attribute: missing attribute 'value'"),
+    ("<xacro:macro/>", "xacro:macro: missing attribute 'name'"),
+    ("<xacro:unless/>", "xacro:unless: missing attribute 'value'"),
+    ("<xacro:call/>", "xacro:call: missing attribute 'macro'"),
+    ("<xacro:insert_block/>", "xacro:insert_block: missing attribute 'name'"),
+])
+def test_a_missing_xacro_attribute_is_the_files_mistake(tmp_path, capsys, body, missing):
+    # xacro raises RuntimeError (not XacroException) for these: still the file's mistake, exit 1
+    path = tmp_path / "m.urdf.xacro"
+    path.write_text(HEAD + body + '<link name="l"/>\n</robot>\n')
+    assert main(["mobility", str(path)]) == 1
+    assert capsys.readouterr().err.strip() == f"screwkin: error: {path}: xacro: {missing}"

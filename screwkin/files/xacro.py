@@ -281,7 +281,7 @@ def _one_line(exc) -> str:
 def _patched(xacro, state: _State, path):
     """Replace xacro's evaluator, substitutions, includes and macro calls while expanding."""
     original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",
-                                                "handle_macro_call", "eval_all", "eval_text")}
+                                                "handle_macro_call", "eval_all", "eval_text", "reqd_attrs")}
 
     def safe_eval(expr, globals, locals=None):
         try:
@@ -365,6 +365,13 @@ def _patched(xacro, state: _State, path):
                                        "joining copies of each other?)")
         return result
 
+    def reqd_attrs(tag, names):
+        # xacro's xmlutils raises RuntimeError for a missing attribute: the file's mistake, not a bug
+        try:
+            return original["reqd_attrs"](tag, names)
+        except RuntimeError as exc:
+            raise xacro.XacroException(str(exc)) from None
+
     def handle_macro_call(node, macros, symbols):
         if node.tagName.startswith("xacro:"):
             state.calls += 1
@@ -388,7 +395,7 @@ def _patched(xacro, state: _State, path):
 
     replaced = {"safe_eval": safe_eval, "eval_extension": eval_extension, "get_include_files": get_include_files,
                 "parse": parse, "handle_macro_call": handle_macro_call, "eval_all": eval_all,
-                "eval_text": eval_text}
+                "eval_text": eval_text, "reqd_attrs": reqd_attrs}
     return original, replaced
 
 
