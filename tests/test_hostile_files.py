@@ -3,8 +3,8 @@ with dots, misspelt sidecar keys, XML comments holding ``--``.  Every case is ei
 one line naming the file (exit 1) or gives the numbers the plain file gives."""
 
 import pytest
-
 from conftest import no_hang
+
 from screwkin.cli import main
 from screwkin.errors import MechanismFileError
 from screwkin.files import xacro as xacro_module
@@ -212,7 +212,7 @@ def test_the_five_bar_sidecar_gives_mobility_3(tmp_path, capsys):
 def test_a_misspelt_sidecar_key_warns_with_the_right_one(tmp_path, capsys):
     path = five_bar_with(tmp_path, "closed_loops: [['closedloop1_A', 'closedloop1_B']]\nname_mot: ['mot1', 'mot2']\n")
     assert main(["mobility", str(path), "--json"]) == 0
-    out, err = capsys.readouterr()
+    err = capsys.readouterr().err
     warning = [line for line in err.splitlines() if "closed_loops" in line]
     assert len(warning) == 1 and warning[0].startswith("warning: ")
     assert str(path.with_suffix(".yaml")) in warning[0] and "did you mean 'closed_loop'?" in warning[0]

@@ -236,7 +236,7 @@ def _virtual_pairs(model, spec) -> None:
 
         roles = virtual_roles(c)
 
-        def add(joint_parent, jm, M, role):
+        def add(joint_parent, jm, M, role, c=c):  # called at once, in this iteration
             name = virtual_joint_name(c.name, role)
             if model.existJointName(name):
                 raise MechanismFileError(spec.path, f"joint {quote(name)} is also the name of a coordinate of loop "
