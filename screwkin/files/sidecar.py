@@ -7,6 +7,7 @@ and nesting, and every field's type is checked before it is used.
 
 from __future__ import annotations
 
+import difflib
 from pathlib import Path
 
 import numpy as np
@@ -77,11 +78,16 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names, frame_b
     if not isinstance(content, dict):
         raise MechanismFileError(yaml_path, f"expected a mapping with closed_loop, type, name_mot, got {quote(content)}")
     problems = Problems()
+    unknown = []  # notes on keys that are not the format's
     known = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
     for key in content:
         if not isinstance(key, str):
             problems.append(f"a key is {quote(key)}, not a name (known keys: {', '.join(known)})")
             break
+        if key not in known:  # ignored, but said: a misspelt closed_loop would silently drop every loop
+            close = difflib.get_close_matches(key, known, n=1)
+            hint = f"did you mean {quote(close[0])}?" if close else f"known keys: {', '.join(known)}"
+            unknown.append(f"unknown key {quote(key, 40)} ({hint})")
     pairs = content.get("closed_loop")
     pairs = [] if pairs is None else pairs
     if not isinstance(pairs, list):
@@ -151,7 +157,10 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names, frame_b
                                 "must name a moving joint")
             continue
         spec.replacements.append((n, canonical))
+    if problems:  # the misspelt key is likely the cause (closed_loops: then "0 pairs but type has 1")
+        problems[:0] = unknown
     problems.fail_if_any(yaml_path)
+    spec.warnings.extend(f"YAML sidecar {yaml_path}: {note} is ignored" for note in unknown)
     spec.yaml_path = str(yaml_path)
 
 

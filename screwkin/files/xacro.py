@@ -15,14 +15,20 @@ size, no entities, bounded nesting):
   ``$(arg NAME)``; ``load_yaml`` and includes of files outside the file's folder are
   refused;
 * while xacro runs, its evaluator is replaced by an interpreter of that same subset
-  (:func:`evaluate`): nothing reaches ``eval``, strings are only concatenated and
+  (:func:`evaluate`, in :mod:`.xacro_eval`): nothing reaches ``eval``, strings are only concatenated and
   stay under :data:`MAX_STRING` characters, integers beyond 2**63 become floats
   (``9**9**9`` is an overflow, not an hour of work), and the text an argument puts into
   an expression is checked like the file's own; its ``$(...)`` handler accepts ``arg``
   only; its includes are read with the same bounds and checks (at most
   :data:`MAX_INCLUDES` files, all inside the first file's folder, no wildcards);
   macro expansion is bounded (at most :data:`MAX_MACRO_CALLS` calls and ``LIMITS.elements``
-  elements copied in all).
+  elements copied in all), and so are the copies ``xacro:insert_block`` makes: before a
+  block is copied, the size it expands to (its blocks inserted in it, recursively) is
+  counted against the same bound, so a block of two copies of a block of two copies ...
+  is refused at once, not after minutes of copying.
+
+A ``XacroException`` of xacro is the file's mistake (exit 1); any other exception from
+inside the xacro package is reported as an internal error of the xacro expansion (exit 3).
 
 xacro keeps its state in module globals, so one expansion runs at a time in a process
 (a lock); a study runs designs in separate processes.
@@ -30,15 +36,12 @@ xacro keeps its state in module globals, so one expansion runs at a time in a pr
 
 from __future__ import annotations
 
-import ast
 import contextlib
 import io
 import math
-import operator
 import os
 import re
 import threading
-import xml.dom.minidom
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -48,36 +51,26 @@ import defusedxml.minidom
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..units import parse_value
 from .description import LIMITS
+from .xacro_eval import (
+    FUNCTIONS,
+    MAX_STRING,
+    XacroEvaluationError,
+    check_expression,
+    evaluate,
+)
 from .xmlsafe import parse_xml_text, read_regular_file
 
-__all__ = ["FUNCTIONS", "MAX_INCLUDES", "MAX_STRING", "check_expression", "declared_args", "evaluate", "expand",
-           "is_xacro", "normalize_args", "parse_args"]
+__all__ = ["FUNCTIONS", "MAX_INCLUDES", "MAX_STRING", "XacroEvaluationError", "XacroInternalError", "check_expression", "declared_args",
+           "evaluate", "expand", "is_xacro", "normalize_args", "parse_args"]
 
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro")
 #: Most files one expansion reads (the first one and its includes).
 MAX_INCLUDES = 50
-#: Most characters of one ``${...}`` expression, and of a string an expression computes.
-MAX_EXPRESSION = 2000
-MAX_STRING = 10_000
-#: Integers beyond this magnitude become floats in expressions.
-MAX_INT = 2**63
 #: Most characters of an argument's value.
 MAX_ARG = 1000
 #: Most macro calls one expansion makes (a Delta makes 17; robots of a hundred links a few hundred).
 MAX_MACRO_CALLS = 5000
-#: Most deep copies of elements one expansion makes (macro bodies and inserted blocks; each costs xacro
-#: about 0.2 ms to evaluate, so this bounds a file's expansion to about a second).
-MAX_COPIES = 5000
 
-#: The functions an expression may call, by name or as ``math.NAME``.
-FUNCTIONS = {
-    "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
-    "atan": math.atan, "atan2": math.atan2, "sqrt": math.sqrt, "radians": math.radians,
-    "degrees": math.degrees, "exp": math.exp, "log": math.log, "floor": math.floor, "ceil": math.ceil,
-    "abs": None, "min": None, "max": None, "pow": None,  # ours, below (numbers only, bounded)
-}
-#: The constants ``math.NAME`` may name (``pi`` alone is xacro's own global).
-CONSTANTS = {"pi": math.pi, "e": math.e, "tau": math.tau}
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 # xacro's lexer (xacro.LEXER): $$( and $${ escape, ${...} up to the first }, $(...) up to the first )
@@ -150,235 +143,6 @@ def parse_args(items, option: str = "--arg") -> dict:
     return normalize_args(out, option)
 
 
-# ------------------------------------------------------------------ the expression subset
-_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
-           ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod, ast.Pow: None}
-_COMPARE = {ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le,
-            ast.Gt: operator.gt, ast.GtE: operator.ge}
-_UNARY = {ast.UAdd: operator.pos, ast.USub: operator.neg, ast.Not: operator.not_}
-_ALLOWED = "numbers, names, arithmetic, comparisons, and/or/not, 'a if c else b' and math functions"
-
-
-class _Refused(Exception):
-    pass
-
-
-def _function_name(node):
-    """The name of the function a call may call (``sin`` or ``math.sin``), or None."""
-    if isinstance(node, ast.Name) and node.id in FUNCTIONS:
-        return node.id
-    if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "math" \
-            and node.attr in FUNCTIONS:
-        return node.attr
-    return None
-
-
-def _describe(node) -> str:
-    if isinstance(node, ast.Attribute):
-        return f"attribute access '.{shorten(node.attr, 30)}'"
-    if isinstance(node, ast.Call):
-        try:
-            return f"a call of '{shorten(ast.unparse(node.func), 40)}'"
-        except Exception:  # noqa: BLE001  # pragma: no cover - unparse of a parsed tree
-            return "a call"
-    if isinstance(node, ast.Name):
-        return f"the name '{shorten(node.id, 30)}'"
-    if isinstance(node, (ast.BinOp, ast.UnaryOp, ast.Compare)):
-        op = getattr(node, "op", None) or node.ops[0]
-        return f"the operator {type(op).__name__}"
-    return type(node).__name__
-
-
-def _check_node(node) -> None:
-    if isinstance(node, ast.Expression):
-        return _check_node(node.body)
-    if isinstance(node, ast.Constant):
-        if not isinstance(node.value, (int, float, str, bool)) or isinstance(node.value, complex):
-            raise _Refused(f"the constant {shorten(repr(node.value), 30)}")
-        return None
-    if isinstance(node, ast.Name):
-        if node.id.startswith("_"):
-            raise _Refused(f"the name '{shorten(node.id, 30)}' (names starting with _ are refused)")
-        return None
-    if isinstance(node, ast.Attribute):
-        if isinstance(node.value, ast.Name) and node.value.id == "math" and node.attr in CONSTANTS:
-            return None
-        raise _Refused(_describe(node))
-    if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        _check_node(node.left)
-        return _check_node(node.right)
-    if isinstance(node, ast.UnaryOp) and type(node.op) in _UNARY:
-        return _check_node(node.operand)
-    if isinstance(node, ast.BoolOp):
-        for v in node.values:
-            _check_node(v)
-        return None
-    if isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
-        _check_node(node.left)
-        for c in node.comparators:
-            _check_node(c)
-        return None
-    if isinstance(node, ast.IfExp):
-        for v in (node.test, node.body, node.orelse):
-            _check_node(v)
-        return None
-    if isinstance(node, ast.Call):
-        if _function_name(node.func) is None:
-            raise _Refused(_describe(node))
-        if node.keywords or any(isinstance(a, ast.Starred) for a in node.args):
-            raise _Refused("keyword or starred arguments")
-        for a in node.args:
-            _check_node(a)
-        return None
-    raise _Refused(_describe(node))
-
-
-def _parse_expression(expr: str):
-    """The checked syntax tree of an expression (raises _Refused)."""
-    if len(expr) > MAX_EXPRESSION:
-        raise _Refused(f"an expression of {len(expr)} characters (at most {MAX_EXPRESSION})")
-    if "load_yaml" in expr:
-        raise _Refused("load_yaml (xacro's YAML loading)")
-    try:
-        tree = ast.parse(expr.strip(), mode="eval")
-    except SyntaxError as exc:
-        raise _Refused(f"invalid syntax ({shorten(exc.msg or '', 60)})") from None
-    except (RecursionError, MemoryError, ValueError):
-        raise _Refused("an expression nested too deeply") from None
-    try:
-        _check_node(tree)
-    except RecursionError:
-        raise _Refused("an expression nested too deeply") from None
-    return tree
-
-
-def check_expression(expr: str) -> None:
-    """Raise ValueError (with what is refused) unless ``expr`` is in the subset."""
-    try:
-        _parse_expression(expr)
-    except _Refused as exc:
-        raise ValueError(f"xacro expression {quote(expr, 60)} uses {exc}: only {_ALLOWED} are allowed") from None
-
-
-def _number(x):
-    return isinstance(x, (int, float)) and not isinstance(x, complex)
-
-
-def _bounded(x):
-    if isinstance(x, bool):
-        return x
-    if isinstance(x, int) and abs(x) > MAX_INT:
-        return float(x)
-    if isinstance(x, str) and len(x) > MAX_STRING:
-        raise _Refused(f"a string of more than {MAX_STRING} characters")
-    return x
-
-
-def _power(a, b):
-    if not (_number(a) and _number(b)):
-        raise _Refused("** on text")
-    if isinstance(a, int) and isinstance(b, int) and not isinstance(a, bool) and 0 <= b <= 64:
-        return _bounded(a ** b)
-    return float(a) ** float(b)  # OverflowError when too large
-
-
-def _call(name, args):
-    if not all(_number(a) for a in args):
-        raise _Refused(f"{name}() of text")
-    if name == "abs":
-        if len(args) != 1:
-            raise TypeError("abs() takes one argument")
-        return abs(args[0])
-    if name in ("min", "max"):
-        if not args:
-            raise TypeError(f"{name}() needs at least one argument")
-        return (min if name == "min" else max)(args)
-    if name == "pow":
-        if len(args) != 2:
-            raise TypeError("pow() takes two arguments")
-        return _power(*args)
-    return _bounded(FUNCTIONS[name](*args))
-
-
-class _Interpreter:
-    """Evaluates a checked tree with names looked up in xacro's symbol table."""
-
-    def __init__(self, symbols):
-        self.symbols = symbols
-
-    def value(self, node):
-        if isinstance(node, ast.Expression):
-            return self.value(node.body)
-        if isinstance(node, ast.Constant):
-            return _bounded(node.value)
-        if isinstance(node, ast.Name):
-            try:
-                v = self.symbols[node.id]
-            except KeyError:
-                raise NameError(f"name '{node.id}' is not defined") from None
-            if isinstance(v, bool) or _number(v) or isinstance(v, str):
-                return v
-            raise _Refused(f"the name '{shorten(node.id, 30)}', which is not a number or text")
-        if isinstance(node, ast.Attribute):  # math.pi, math.e, math.tau (checked)
-            return CONSTANTS[node.attr]
-        if isinstance(node, ast.BinOp):
-            a, b = self.value(node.left), self.value(node.right)
-            if isinstance(node.op, ast.Pow):
-                return _power(a, b)
-            if isinstance(a, str) or isinstance(b, str):
-                if isinstance(node.op, ast.Add) and isinstance(a, str) and isinstance(b, str):
-                    return _bounded(a + b)
-                raise _Refused(f"the operator {type(node.op).__name__} on text (text is only joined with +)")
-            return _bounded(_BINARY[type(node.op)](a, b))
-        if isinstance(node, ast.UnaryOp):
-            v = self.value(node.operand)
-            if isinstance(v, str) and not isinstance(node.op, ast.Not):
-                raise _Refused("a sign on text")
-            return _UNARY[type(node.op)](v)
-        if isinstance(node, ast.BoolOp):
-            and_ = isinstance(node.op, ast.And)
-            v = None
-            for item in node.values:
-                v = self.value(item)
-                if bool(v) != and_:
-                    return v
-            return v
-        if isinstance(node, ast.Compare):
-            left = self.value(node.left)
-            for op, right_node in zip(node.ops, node.comparators):
-                right = self.value(right_node)
-                if isinstance(left, str) != isinstance(right, str) and type(op) not in (ast.Eq, ast.NotEq):
-                    raise _Refused("an order comparison of text with a number")
-                if not _COMPARE[type(op)](left, right):
-                    return False
-                left = right
-            return True
-        if isinstance(node, ast.IfExp):
-            return self.value(node.body) if self.value(node.test) else self.value(node.orelse)
-        if isinstance(node, ast.Call):
-            return _call(_function_name(node.func), [self.value(a) for a in node.args])
-        raise _Refused(_describe(node))  # pragma: no cover - checked before
-
-
-class XacroEvaluationError(Exception):
-    """An expression xacro asked to evaluate is refused or fails (xacro adds its context)."""
-
-
-def evaluate(expr: str, symbols=None):
-    """The value of a ``${...}`` expression (its inside) with names from ``symbols`` (a
-    mapping; xacro's symbol table while expanding): the subset of :func:`check_expression`,
-    evaluated without ``eval``."""
-    try:
-        tree = _parse_expression(expr)
-        return _Interpreter({} if symbols is None else symbols).value(tree)
-    except _Refused as exc:
-        raise XacroEvaluationError(f"refused: {exc} (only {_ALLOWED} are allowed)") from None
-    except RecursionError:
-        raise XacroEvaluationError("properties defined through each other too deeply") from None
-    except OverflowError:
-        raise XacroEvaluationError("a number too large (overflow)") from None
-
-
 # ------------------------------------------------------------------ checking the files
 @dataclass
 class _State:
@@ -391,7 +155,6 @@ class _State:
     declared: dict = field(default_factory=dict)  # name -> default text or None
     copied: int = 0  # elements copied by macro expansion
     calls: int = 0
-    copies: int = 0  # deep copies of elements (macro bodies, inserted blocks)
 
 
 def _check_text(text: str, path, state: _State) -> None:
@@ -518,16 +281,7 @@ def _one_line(exc) -> str:
 def _patched(xacro, state: _State, path):
     """Replace xacro's evaluator, substitutions, includes and macro calls while expanding."""
     original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",
-                                                "handle_macro_call", "eval_text")}
-
-    def eval_text(text, symbols):
-        # "${s}${s}" is concatenated here, by xacro, not by our interpreter: a property defined as twice the
-        # previous one doubles at each level (2**40 characters from a 2 kB file)
-        result = original["eval_text"](text, symbols)
-        if isinstance(result, str) and len(result) > max(MAX_STRING, len(text)):
-            raise xacro.XacroException(f"text grows past {MAX_STRING} characters by substitution (refused: "
-                                       "properties that double?)")
-        return result
+                                                "handle_macro_call", "eval_all", "eval_text", "reqd_attrs")}
 
     def safe_eval(expr, globals, locals=None):
         try:
@@ -562,6 +316,62 @@ def _patched(xacro, state: _State, path):
         _check_tree(root, target, state, follow=False)
         return _dom(text, target)
 
+    def block_named(name, symbols):
+        """The block ``xacro:insert_block name=...`` inserts (a property block or a macro's block
+        parameter), or None."""
+        for key in ("**" + name, "*" + name):
+            if key in symbols:
+                block = symbols[key]
+                return block if hasattr(block, "getElementsByTagName") else None
+        return None
+
+    def block_size(block, symbols, seen, memo):
+        """Elements one copy of ``block`` expands to, its own insert_blocks expanded (capped)."""
+        size = 0
+        for elem in [block, *block.getElementsByTagName("*")] if block.nodeType == block.ELEMENT_NODE else []:
+            if elem.tagName != "xacro:insert_block":
+                size += 1
+                continue
+            inner = block_named(elem.getAttribute("name"), symbols)
+            if inner is None or id(inner) in seen:
+                continue  # undefined (xacro says so) or inserted in itself (nested too deeply)
+            if id(inner) not in memo:
+                memo[id(inner)] = block_size(inner, symbols, seen | {id(inner)}, memo)
+            size += memo[id(inner)]
+            if size > LIMITS.elements:
+                break
+        return size
+
+    def eval_all(node, macros, symbols):
+        child = node.firstChild
+        while child is not None:
+            if child.nodeType == child.ELEMENT_NODE and child.tagName == "xacro:insert_block":
+                block = block_named(child.getAttribute("name"), symbols)
+                if block is not None:
+                    state.copied += block_size(block, symbols, frozenset({id(block)}), {})
+                    if state.copied > LIMITS.elements:
+                        raise MechanismFileError(path, f"xacro:insert_block copies expand to more than "
+                                                       f"{LIMITS.elements} elements (refused: blocks inserted in "
+                                                       "blocks double at each level)")
+            child = child.nextSibling
+        return original["eval_all"](node, macros, symbols)
+
+    def eval_text(text, symbols):
+        # xacro joins the values of a text's ${...} and $(...) outside the evaluator: bound them here
+        # (a property "${s}${s}" of a property "${s}${s}" of ... doubles at each level)
+        result = original["eval_text"](text, symbols)
+        if isinstance(result, str) and len(result) > max(MAX_STRING, len(text)):  # grown by substitution
+            raise xacro.XacroException(f"refused: a text of more than {MAX_STRING} characters (properties "
+                                       "joining copies of each other?)")
+        return result
+
+    def reqd_attrs(tag, names):
+        # xacro's xmlutils raises RuntimeError for a missing attribute: the file's mistake, not a bug
+        try:
+            return original["reqd_attrs"](tag, names)
+        except RuntimeError as exc:
+            raise xacro.XacroException(str(exc)) from None
+
     def handle_macro_call(node, macros, symbols):
         if node.tagName.startswith("xacro:"):
             state.calls += 1
@@ -584,36 +394,14 @@ def _patched(xacro, state: _State, path):
         return original["handle_macro_call"](node, macros, symbols)
 
     replaced = {"safe_eval": safe_eval, "eval_extension": eval_extension, "get_include_files": get_include_files,
-                "parse": parse, "handle_macro_call": handle_macro_call, "eval_text": eval_text}
+                "parse": parse, "handle_macro_call": handle_macro_call, "eval_all": eval_all,
+                "eval_text": eval_text, "reqd_attrs": reqd_attrs}
     return original, replaced
 
 
-@contextlib.contextmanager
-def _counted_copies(state: _State, path):
-    """While xacro runs, every deep copy of an element (an ``insert_block`` of a block property or a
-    macro's block parameter, a macro body) adds its elements to ``state.copied``; past LIMITS.elements
-    the expansion stops at once.  Property blocks that insert the previous one twice double at each
-    level without a single macro call: 16 levels are 65,536 copies from a 1.9 kB file."""
-    element = xml.dom.minidom.Element
-    original = element.cloneNode
-
-    def cloneNode(self, deep):
-        clone = original(self, deep)
-        if deep:
-            state.copies += 1
-            state.copied += len(clone.getElementsByTagName("*")) + 1
-            if state.copies > MAX_COPIES or state.copied > LIMITS.elements:
-                raise MechanismFileError(path, "the xacro blocks and macros make more than "
-                                               + (f"{MAX_COPIES} copies" if state.copies > MAX_COPIES else
-                                                  f"{LIMITS.elements} elements")
-                                               + " (refused: blocks that insert each other twice?)")
-        return clone
-
-    element.cloneNode = cloneNode
-    try:
-        yield
-    finally:
-        element.cloneNode = original
+class XacroInternalError(RuntimeError):
+    """An exception inside the xacro package that is not a ``XacroException`` (the file's
+    mistakes are): a bug, reported as an internal error (exit 3), not as the file's fault."""
 
 
 def _dom(text: str, path):
@@ -658,7 +446,7 @@ def expand(path, text: str, args=None, root=None, warn=None) -> str:
             for k, f in replaced.items():
                 setattr(xacro, k, f)
             xacro.init_stacks(str(path))
-            with contextlib.redirect_stderr(output), contextlib.redirect_stdout(output), _counted_copies(state, path):
+            with contextlib.redirect_stderr(output), contextlib.redirect_stdout(output):
                 xacro.process_doc(doc, mappings=dict(given), verbosity=0)
             result = doc.toxml()
         except MechanismFileError:
@@ -667,8 +455,9 @@ def expand(path, text: str, args=None, root=None, warn=None) -> str:
             raise MechanismFileError(path, "xacro: macros or properties nested too deeply (recursive?)") from None
         except xacro.XacroException as exc:
             raise MechanismFileError(path, f"xacro: {shorten(_one_line(exc), 240)}") from None
-        except Exception as exc:  # noqa: BLE001 - xacro's own errors are not all XacroException (RuntimeError, KeyError...)
-            raise MechanismFileError(path, f"xacro: {type(exc).__name__}: {shorten(_one_line(exc), 200)}") from None
+        except Exception as exc:  # not a XacroException: not the file's mistake, a bug (xacro's or screwkin's)
+            raise XacroInternalError(f"internal error in the xacro expansion of {path}: {type(exc).__name__}: "
+                                     f"{shorten(_one_line(exc), 200)}") from exc
         finally:
             for k, f in original.items():
                 setattr(xacro, k, f)

@@ -108,10 +108,31 @@ def parse_xml_text(text: str, path) -> ET.Element:
     except defusedxml.DTDForbidden:  # pragma: no cover - forbid_dtd is False
         raise MechanismFileError(path, "XML document type declarations are not allowed") from None
     except ET.ParseError as exc:
+        dashes = _dashes_in_comment(text, *getattr(exc, "position", (0, 0)))
+        if dashes is not None:
+            raise MechanismFileError(path, f"malformed XML: a comment cannot contain '--' (line {dashes[0]}, in the "
+                                           f"comment opened at line {dashes[1]}): write it without the double "
+                                           "hyphen") from None
         raise MechanismFileError(path, f"malformed XML: {shorten(str(exc), 120)}") from None
     if root is None:  # pragma: no cover - expat reports "no element found" first
         raise MechanismFileError(path, "malformed XML: no element found")
     return root
+
+
+def _dashes_in_comment(text: str, line: int, column: int):
+    """(line of the ``--``, line of its ``<!--``) when the parse error at (line, column) is a
+    ``--`` inside a comment (XML forbids it; expat says only "invalid token"), else None."""
+    if line < 1:
+        return None
+    lines = text.splitlines(keepends=True)
+    offset = sum(len(x) for x in lines[:line - 1]) + column
+    start = text.rfind("<!--", 0, offset)
+    if start < 0:
+        return None
+    dashes = text.find("--", start + 4, offset + 1)
+    if dashes < 0 or text.startswith("-->", dashes):  # no "--" before the error, or the comment was closed
+        return None
+    return text.count("\n", 0, dashes) + 1, text.count("\n", 0, start) + 1
 
 
 def _safe_loader():

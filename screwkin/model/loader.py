@@ -28,7 +28,7 @@ from ..files.xacro import is_xacro
 from ..files.xmlsafe import parse_xml_text, read_regular_file
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import FRAME_PREFERENCE, frame_id
-from .mechanism import Mechanism
+from .mechanism import Mechanism, virtual_joint_name, virtual_roles
 
 __all__ = ["load"]
 
@@ -234,24 +234,30 @@ def _virtual_pairs(model, spec) -> None:
         a, u, n = _in_plane(c.axis)
         inf, zero = np.array([-np.inf]), np.array([np.inf])
 
-        def add(joint_parent, jm, M, name):
+        roles = virtual_roles(c)
+
+        def add(joint_parent, jm, M, role, c=c):  # called at once, in this iteration
+            name = virtual_joint_name(c.name, role)
+            if model.existJointName(name):
+                raise MechanismFileError(spec.path, f"joint {quote(name)} is also the name of a coordinate of loop "
+                                                    f"joint {quote(c.name)} ({c.type}): rename one of them")
             jid = model.addJoint(joint_parent, jm, M, name, np.zeros(1), np.zeros(1), inf, zero)
             model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
             return jid
 
         if c.type == "helical":
-            v1 = add(parent.parentJoint, pin.JointModelRevoluteUnaligned(a), P, f"{c.name}.turn")
-            v2 = add(v1, pin.JointModelPrismaticUnaligned(a), pin.SE3.Identity(), f"{c.name}.advance")
+            v1 = add(parent.parentJoint, pin.JointModelRevoluteUnaligned(a), P, roles[0])
+            v2 = add(v1, pin.JointModelPrismaticUnaligned(a), pin.SE3.Identity(), roles[1])
         elif np.isinf(c.radius1):
-            v1 = add(parent.parentJoint, pin.JointModelPrismaticUnaligned(u), P, f"{c.name}.x")
+            v1 = add(parent.parentJoint, pin.JointModelPrismaticUnaligned(u), P, roles[0])
             M = pin.SE3(pin.exp3(a * np.pi / 2), -c.radius2 * n)
-            v2 = add(v1, pin.JointModelRevoluteUnaligned(a), M, f"{c.name}.a2")
+            v2 = add(v1, pin.JointModelRevoluteUnaligned(a), M, roles[1])
         else:
             outside = c.contact != "internal"
             R = c.radius1 + c.radius2 if outside else c.radius1 - c.radius2
-            v1 = add(parent.parentJoint, pin.JointModelRevoluteUnaligned(a), P, f"{c.name}.a1")
+            v1 = add(parent.parentJoint, pin.JointModelRevoluteUnaligned(a), P, roles[0])
             M = pin.SE3(pin.exp3(a * np.pi) if outside else np.eye(3), R * u)
-            v2 = add(v1, pin.JointModelRevoluteUnaligned(a), M, f"{c.name}.a2")
+            v2 = add(v1, pin.JointModelRevoluteUnaligned(a), M, roles[1])
         model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
 
 

@@ -25,6 +25,20 @@ from .topology import build_topology
 __all__ = ["Mechanism", "Coordinate", "characteristic_length", "link_lengths"]
 
 
+def virtual_roles(c) -> tuple:
+    """The roles of the virtual joints of a rolling, gear or helical loop joint ``c``, in chain order."""
+    if c.type == "helical":
+        return ("turn", "advance")
+    if np.isinf(c.radius1):
+        return ("x", "a2")
+    return ("a1", "a2")
+
+
+def virtual_joint_name(loop_joint: str, role: str) -> str:
+    """The model's name of the virtual joint of ``loop_joint`` in ``role`` (``mesh.a1``)."""
+    return f"{loop_joint}.{role}"
+
+
 @dataclass(frozen=True)
 class Coordinate:
     """Where a tree joint's coordinates live in q (nq entries) and in velocities (nv)."""
@@ -153,9 +167,11 @@ class Mechanism:
             ids.append(self.model.addFrame(new, False))
         axis, axis2 = tuple(c.axis), tuple(c.axis2) if c.axis2 is not None else None
         if c.type in ("rolling", "gear", "helical"):
-            names = [self.model.names[j] for j in range(1, self.model.njoints)
-                     if self.model.names[j].startswith(f"{c.name}.")]
-            coord = {n.split(".", 1)[1]: self._coord[n] for n in names}
+            # the joints loader._virtual_pairs named, by role: names are built, never parsed (a loop
+            # joint's name may hold dots, and "a" and "a.x" may both be loop joints)
+            roles = virtual_roles(c)
+            names = [virtual_joint_name(c.name, role) for role in roles]
+            coord = {role: self._coord[name] for role, name in zip(roles, names)}
             self.virtual_joints[c.name] = tuple(names)
             if c.type == "helical":  # advance - lead turn / 2 pi = 0
                 terms = ((coord["advance"], 1.0), (coord["turn"], -c.lead / (2 * np.pi)))
