@@ -327,7 +327,7 @@ def test_cli_usage_errors(tmp_path, capsys):
         (["study", str(tmp_path / "absent.yaml")], "no such file"),
         (["study", spec, "--scheduler", "127.0.0.1:8786"], "tcp://HOST:PORT"),
         (["study", spec, "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers is for the local cluster"),
-        (["study", spec, "--workers", "-1"], "0 or more"),
+        (["study", spec, "--workers", "-1"], "between 0 and 64"),
         (["study", spec, "-o", str(tmp_path / "r.xlsx")], ".csv or .parquet"),
         (["study", spec, "-o", str(tmp_path / "no" / "r.csv")], "does not exist"),
         (["study", spec, "--pareto", "max:a"], "--pareto expects"),

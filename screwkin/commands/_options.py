@@ -21,7 +21,7 @@ from importlib import metadata
 
 from ..errors import UsageError, quote
 
-__all__ = ["screwkin_version", "check_writable", "count", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+__all__ = ["screwkin_version", "check_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
 
 def screwkin_version() -> str:
     """The version of screwkin installed (the package's metadata, as pip shows it)."""
@@ -46,7 +46,27 @@ BOUNDS = {
     "links": (2, 12),                 # synthesize chains --links
     "dof": (0, 10),                   # synthesize chains --dof
     "seed": (0, 2**32 - 1),           # random seeds (numpy's range)
+    "workers": (0, 64),               # study --workers: processes of the local cluster
 }
+#: The bounds of the durations people type [s], (smallest, largest).
+SECONDS = {"timeout": (0.1, 3600.0), "design_timeout": (0.1, 86400.0)}
+
+
+def seconds(what: str):
+    """argparse type of a duration in seconds bounded by ``SECONDS[what]`` (a finite number)."""
+    lo, hi = SECONDS[what]
+
+    def parse(text: str) -> float:
+        try:
+            x = float(text.strip())
+        except (ValueError, AttributeError):
+            raise argparse.ArgumentTypeError(f"expected seconds, got {quote(text, 40)}") from None
+        if not lo <= x <= hi:  # nan fails both comparisons
+            raise argparse.ArgumentTypeError(f"must be between {lo:g} and {hi:g} s, got {quote(text, 40)}")
+        return x
+
+    parse.__name__ = f"seconds ({lo:g} to {hi:g})"
+    return parse
 
 
 def count(what: str):

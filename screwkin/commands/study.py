@@ -18,6 +18,7 @@ from ..present.study import (
     study_text,
     write_table,
 )
+from ._options import count, seconds
 
 NAME = "study"
 NEEDS_MECHANISM = False
@@ -29,8 +30,9 @@ def add_parser(sub, common, scaled):
     common(sp, mechanism=False)
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="a running dask.distributed scheduler, tcp://HOST:PORT (default: a local cluster)")
-    sp.add_argument("--workers", type=int, metavar="N",
-                    help="processes of the local cluster (default: the cores, at most 4; 0: in this process)")
+    sp.add_argument("--workers", type=count("workers"), metavar="N",
+                    help="processes of the local cluster (default: the cores, at most 4; 0: in this process; "
+                         "at most 64)")
     sp.add_argument("-o", "--output", dest="table", metavar="FILE",
                     help="write the table: results.csv, or results.parquet (needs pyarrow)")
     sp.add_argument("--plot", metavar="PREFIX",
@@ -38,9 +40,9 @@ def add_parser(sub, common, scaled):
                          "PREFIX-pareto.png (needs matplotlib)")
     sp.add_argument("--pareto", metavar="max:COL,min:COL",
                     help="the two columns of the Pareto front and their goals (overrides the spec's pareto)")
-    sp.add_argument("--timeout", type=float, default=10.0,
+    sp.add_argument("--timeout", type=seconds("timeout"), default=10.0,
                     help="seconds to reach the scheduler and a worker (default 10)")
-    sp.add_argument("--design-timeout", type=float, metavar="S",
+    sp.add_argument("--design-timeout", type=seconds("design_timeout"), metavar="S",
                     help="seconds one design may take before its row is a failure (overrides the spec's timeout; "
                          "default 120)")
 

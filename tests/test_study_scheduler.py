@@ -1,0 +1,95 @@
+"""study --scheduler at an address where no Dask scheduler answers (issue 22 item 3): the client read the
+peer's first 8 bytes as a frame length and tried to allocate 3 EiB (exit 3, MemoryError).  Each hostile
+peer here runs on 127.0.0.1 in a thread of the test, bounded in time; the answer must be one line, exit 2,
+within the guard."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+
+import pytest
+
+from conftest import ROOT, no_hang
+from screwkin.cli import main
+
+SPEC = str(ROOT / "examples" / "fourbar_study.yaml")
+
+
+class Peer:
+    """A loopback server that answers every connection with ``reply`` (None: accepts and says nothing)."""
+
+    def __init__(self, reply):
+        self.reply = reply
+        self.sock = socket.socket()
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.listen(8)
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.stop = time.time() + 30
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self):
+        held = []
+        while time.time() < self.stop:
+            try:
+                conn, _ = self.sock.accept()
+            except (socket.timeout, OSError):
+                continue
+            if self.reply is not None:
+                try:
+                    conn.sendall(self.reply)
+                except OSError:
+                    pass
+            held.append(conn)
+        for c in held:
+            c.close()
+
+    def close(self):
+        self.stop = 0
+        self.thread.join(timeout=5)
+        self.sock.close()
+
+
+@pytest.mark.parametrize("reply,words", [
+    (b"\xff" * 8, "announces 18446744073709551615 bytes"),
+    (b"HTTP/1.1 400 Bad Request\r\n\r\n", "not a Dask scheduler"),
+    (b"\x10\x00\x00\x00\x00\x00\x00\x00" + b"\x01\x00\x00\x00\x00\x00\x00\x00" + b"\xff" * 8,
+     "announces 18446744073709551615 bytes of frames"),
+    (None, "no handshake within 2 s"),
+])
+def test_a_peer_that_is_no_scheduler_is_named_so(reply, words, capsys):
+    peer = Peer(reply)
+    try:
+        with no_hang(30):
+            code = main(["study", SPEC, "--scheduler", f"tcp://127.0.0.1:{peer.port}", "--timeout", "2"])
+    finally:
+        peer.close()
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert words in err
+
+
+@pytest.mark.parametrize("address,words", [
+    ("tcp://127.0.0.1:1;touch X", "the port must be a number"),
+    ("tcp://127.0.0.1", "the port must be a number"),
+    ("tcp://127.0.0.1:99999", "the port must be a number"),
+    ("http://127.0.0.1:8786", "expects tcp://HOST:PORT"),
+    ("tcp://a b:1", "not a host name"),
+])
+def test_malformed_addresses_are_usage_errors(address, words, capsys):
+    assert main(["study", SPEC, "--scheduler", address]) == 2
+    assert words in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--workers", "1000000"], "between 0 and 64"),
+    (["--timeout", "nan"], "between 0.1 and 3600 s"),
+    (["--design-timeout", "-1"], "between 0.1 and 86400 s"),
+])
+def test_study_counts_and_durations_are_bounded(argv, words, capsys):
+    with no_hang(10):
+        assert main(["study", SPEC, *argv]) == 2
+    assert words in capsys.readouterr().err
