@@ -93,3 +93,41 @@ def test_study_counts_and_durations_are_bounded(argv, words, capsys):
     with no_hang(10):
         assert main(["study", SPEC, *argv]) == 2
     assert words in capsys.readouterr().err
+
+
+# ---- workspace: what a typed number asks for is estimated before the work (issue 22 items 6, 10, 11)
+from conftest import CORPUS, ROBOTS  # noqa: E402
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["workspace", str(ROBOTS / "delta_parallelogram.urdf"), "--output", "platform", "--point", "--resolution", "1mm"],
+     "would solve about"),
+    (["workspace", str(ROBOTS / "five_bar.urdf"), "--output", "tip", "--point", "--resolution", "1um"],
+     "use --resolution"),
+    (["workspace", str(ROBOTS / "arm_6r.urdf"), "--output", "flange", "--point", "--method", "sampling",
+      "--samples", "100000000"], "between 1 and 5,000,000"),
+    (["workspace", str(ROBOTS / "quick_return_slot.urdf"), "--output", "slotted", "--point"],
+     "batched solver does not take these yet"),
+    (["workspace", str(ROBOTS / "five_bar.urdf"), "--output", "tip", "--resolution", "0"], "from 1e-09 m"),
+    (["workspace", str(ROBOTS / "five_bar.urdf"), "--output", "tip", "--orientation", "30mm 0 0"],
+     "unit of length"),
+])
+def test_workspace_refuses_what_it_cannot_do_before_the_work(argv, words, capsys):
+    with no_hang(30):
+        code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.mark.slow
+def test_workspace_honours_its_time_limit_and_says_the_result_is_cut(capsys):
+    """wl16_like at 100 mm ran past 60 s: with --timeout 3 it stops and marks the result truncated."""
+    import json
+
+    path = CORPUS / "wl16_like" / "robot.urdf"
+    with no_hang(60):
+        code = main(["workspace", str(path), "--output", "foot_part", "--resolution", "100mm", "--timeout", "3",
+                     "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["truncated"] is True
+    assert any("time limit" in n for n in out["notes"])

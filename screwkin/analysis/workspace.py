@@ -34,7 +34,7 @@ linear interpolation.
 from __future__ import annotations
 
 import dataclasses
-
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,10 +46,13 @@ from .batch import BatchClosure, SerialJacobians, Unbatchable, damped_steps
 from .position import within_limits
 from .singular import Generic
 
-__all__ = ["WorkspaceResult", "workspace", "DEFAULT_THRESHOLD", "MAX_POINTS"]
+__all__ = ["WorkspaceResult", "workspace", "DEFAULT_THRESHOLD", "MAX_POINTS", "MAX_ESTIMATE"]
 
 DEFAULT_THRESHOLD = 0.01
 MAX_POINTS = 2_000_000  # reached grid points (or sampling cells) before a workspace stops
+#: Most grid points a --resolution may ask for, estimated from a first coarse pass before the work starts
+#: (a grid point costs about 0.1 to 1 ms: this bounds a grid to about a minute or two).
+MAX_ESTIMATE = 200_000
 _BLOCK = 4096  # configurations per batched solve
 _BISECTIONS = 5  # boundary located to h / 32
 _SUBSTEPS = 8  # at most this many substeps for a grid step near a fold (see _Grid.substeps)
@@ -212,6 +215,8 @@ class _Grid:
 
     def __init__(self, mech, output, point, orientation, q_seed, p_seed, axes, h, lo, hi, frozen=()):
         self.mech, self.axes, self.h = mech, axes, float(h)
+        self.deadline = None  # time.monotonic() past which the growth stops (the result marked truncated)
+        self.timed_out = False
         self.p_seed = p_seed
         self.R = np.eye(3) if orientation is None else orientation
         self.closure = BatchClosure(mech, target=(output, "point" if point else "pose"))
@@ -333,6 +338,12 @@ class _Grid:
             n[todo] *= 2
         return Qn, ok, sigma
 
+    def _late(self) -> bool:
+        """Past the deadline: the growth stops here and the result says it was cut."""
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            self.truncated = self.timed_out = True
+        return self.timed_out
+
     def fill(self):
         """{grid index: configuration} of the points reached, filled wave by wave (also
         ``self.sigma``: index -> relative singular value of the rows' Jacobian there)."""
@@ -356,6 +367,8 @@ class _Grid:
                         continue
                     cand[n] = idx
             if not cand:
+                break
+            if self._late():
                 break
             if len(solved) + len(cand) > MAX_POINTS:
                 self.truncated = True
@@ -394,7 +407,7 @@ class _Grid:
             ends[i] = (0.0, solved[i])  # the run meets the bounds
         current = [i for i in current if lo <= i[axis] + direction[axis] <= hi]
         while current:
-            if len(solved) + len(current) > MAX_POINTS:
+            if len(solved) + len(current) > MAX_POINTS or self._late():
                 self.truncated = True
                 for i in current:
                     ends[i] = (0.0, solved[i])
@@ -451,7 +464,8 @@ class _Grid:
 # --------------------------------------------------------------------------------------- main
 def workspace(mech, output: str, point: bool = False, orientation=None, resolution: float | None = None,
               bounds=None, threshold: float = DEFAULT_THRESHOLD, length: float | None = None,
-              method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None) -> WorkspaceResult:
+              method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None,
+              timeout: float | None = None) -> WorkspaceResult:
     """The workspace of link ``output`` (see the module's text).
 
     point: its origin as a point (orientation free); else at a constant ``orientation`` (a 3x3
@@ -483,10 +497,15 @@ def workspace(mech, output: str, point: bool = False, orientation=None, resoluti
     if not inputs:
         raise UsageError(f"{mech.path}: the mechanism has no moving joint")
     L = float(length or mech.length)
-    measures = _Measures(mech, output, point, inputs, L)
+    try:
+        measures = _Measures(mech, output, point, inputs, L)
+    except Unbatchable as e:  # the batched rows do not represent it (sliding contacts, multi-coordinate joints)
+        raise UsageError(f"{e}: the workspace's batched solver does not take these yet (solve, sweep and ik do)") \
+            from None
     if method == "sampling":
         return _sampling(mech, output, measures, resolution, bounds, threshold, L, samples, seed, inputs)
-    return _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs)
+    deadline = None if timeout is None else time.monotonic() + float(timeout)
+    return _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs, deadline)
 
 
 def _seed(mech, output, point, orientation):
@@ -543,7 +562,8 @@ def _index_bounds(bounds, p_seed, axes, h, dim):
     return list(lo), list(hi)
 
 
-def _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs) -> WorkspaceResult:
+def _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs,
+          deadline=None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"), check=3)  # checks the rows once
     except Unbatchable as e:
@@ -555,7 +575,7 @@ def _grid(mech, output, point, orientation, measures, resolution, bounds, thresh
         # the link cannot keep its orientation and move over an area (a five-bar's distal link):
         # what is asked is then where its origin goes
         res = _grid(mech, output, True, None, _Measures(mech, output, True, inputs, L), resolution, bounds,
-                    threshold, L, inputs)
+                    threshold, L, inputs, deadline)
         note = (f"'{output}' moves over no area at a constant orientation: the workspace of its origin with "
                 "any orientation (as --point)")
         return dataclasses.replace(res, notes=(note,) + tuple(res.notes))
@@ -566,16 +586,27 @@ def _grid(mech, output, point, orientation, measures, resolution, bounds, thresh
                          "use sweep" + ("" if point else ", or --point"))
     axes = _grid_axes(directions)
     notes = []
-    if resolution is None:  # a coarse pass for the extent, then ~24 (3-D) or ~120 (2-D) steps across it
-        h0 = L / 4.0
+    h0 = L / 4.0
+    if resolution is None or resolution < h0:  # a coarse pass: the extent, or the work a fine grid would be
         lo, hi = _index_bounds(bounds, p_seed, axes, h0, dim)
         coarse = _Grid(mech, output, point, R, q_seed, p_seed, axes, h0, lo, hi)
+        coarse.deadline = deadline
         idx = np.array(list(coarse.fill()), int)
-        extent = (idx.max(axis=0) - idx.min(axis=0) + 2) * h0
-        resolution = float(extent.max()) / (24.0 if dim == 3 else 120.0)
-        notes.append(f"resolution {resolution:.4g} m chosen from a first pass at {h0:.4g} m")
+        if resolution is None:  # ~24 (3-D) or ~120 (2-D) steps across the extent
+            extent = (idx.max(axis=0) - idx.min(axis=0) + 2) * h0
+            resolution = float(extent.max()) / (24.0 if dim == 3 else 120.0)
+            notes.append(f"resolution {resolution:.4g} m chosen from a first pass at {h0:.4g} m")
+        else:
+            estimate = len(idx) * (h0 / resolution) ** dim
+            if estimate > MAX_ESTIMATE:
+                least = h0 * (len(idx) / MAX_ESTIMATE) ** (1.0 / dim)
+                least = float(f"{least * 1.05:.2g}")
+                raise UsageError(f"--resolution {resolution:.4g} m would solve about {estimate:.2g} grid points "
+                                 f"(a first pass at {h0:.3g} m reached {len(idx)}), limit {MAX_ESTIMATE:,}: use "
+                                 f"--resolution {least:g} or more, or --bounds")
     lo, hi = _index_bounds(bounds, p_seed, axes, resolution, dim)
     grid = _Grid(mech, output, point, R, q_seed, p_seed, axes, resolution, lo, hi)
+    grid.deadline = deadline
     solved = grid.fill()
     # runs along the last axis, completed and extended to the boundary by bisection
     h = resolution
@@ -634,6 +665,10 @@ def _grid(mech, output, point, orientation, measures, resolution, bounds, thresh
     truncated = grid.truncated and bounds is not None or len(index) >= MAX_POINTS
     if grid.truncated and bounds is None and len(index) < MAX_POINTS:
         truncated = False
+    if grid.timed_out:
+        truncated = True
+        notes.append(f"stopped at the time limit (--timeout) after {len(index)} points: the volumes are lower "
+                     "bounds, not the workspace's")
     positions = p_seed + (index * h) @ axes
     c = axes @ p_seed
     rng = np.array([[c[a] + index[:, a].min() * h, c[a] + index[:, a].max() * h] for a in range(dim)])

@@ -47,6 +47,7 @@ BOUNDS = {
     "dof": (0, 10),                   # synthesize chains --dof
     "seed": (0, 2**32 - 1),           # random seeds (numpy's range)
     "workers": (0, 64),               # study --workers: processes of the local cluster
+    "workspace_samples": (1, 5_000_000),  # workspace --method sampling --samples
 }
 #: The bounds of the durations people type [s], (smallest, largest).
 SECONDS = {"timeout": (0.1, 3600.0), "design_timeout": (0.1, 86400.0)}

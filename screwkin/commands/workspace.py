@@ -21,7 +21,8 @@ from ..present.workspace import (
     workspace_png,
     workspace_text,
 )
-from ..units import parse_value
+from ..units import parse_length, parse_value
+from ._options import count, seconds
 
 NAME = "workspace"
 NEEDS_MECHANISM = True
@@ -45,9 +46,11 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--method", choices=["grid", "sampling"],
                     help="grid: inverse kinematics on a grid (default); sampling: random joint values (serial chains, "
                          "--point; the default there)")
-    sp.add_argument("--samples", type=int, default=200_000, help="joint configurations of the sampling method "
+    sp.add_argument("--samples", type=count("workspace_samples"), default=200_000, help="joint configurations of the sampling method "
                                                                  "(default 200000)")
-    sp.add_argument("--seed", type=int, default=0, help="random seed of the sampling method (default 0)")
+    sp.add_argument("--seed", type=count("seed"), default=0, help="random seed of the sampling method (default 0)")
+    sp.add_argument("--timeout", type=seconds("timeout"), default=60.0,
+                    help="seconds the grid may grow (default 60): past them it stops and the result says it is cut")
     sp.add_argument("--png", help="slices of the workspace coloured by conditioning, PNG (needs matplotlib)")
     sp.add_argument("--csv", help="every reached point: position, measures, joint values")
     sp.add_argument("--html", help="the mechanism and the workspace as a meshcat point cloud, static HTML page")
@@ -73,17 +76,17 @@ def _orientation(text):
     parts = text.replace(",", " ").split()
     if len(parts) != 3:
         raise UsageError(f'--orientation expects "roll pitch yaw", got {len(parts)} numbers')
-    return pin.rpy.rpyToMatrix(np.array([parse_value(p) for p in parts]))
+    return pin.rpy.rpyToMatrix(np.array([parse_value(p, "angle", "--orientation") for p in parts]))
 
 
 def run(mech, args) -> int:
     if args.samples < 1:
         raise UsageError(f"--samples must be positive, got {args.samples}")
-    length = parse_value(args.length) if args.length else None
+    length = parse_length(args.length, "--length") if args.length else None
     res = workspace(mech, args.output, point=args.point, orientation=_orientation(args.orientation),
-                    resolution=parse_value(args.resolution) if args.resolution else None, bounds=_bounds(args.bounds),
-                    threshold=args.threshold, length=length, method=args.method, samples=args.samples,
-                    seed=args.seed)
+                    resolution=parse_length(args.resolution, "--resolution") if args.resolution else None,
+                    bounds=_bounds(args.bounds), threshold=args.threshold, length=length, method=args.method,
+                    samples=args.samples, seed=args.seed, timeout=args.timeout)
     wrote = []
     if args.csv:
         columns = [(c.joint, c.idx_q) for c in mech.coordinates if c.nq == 1]

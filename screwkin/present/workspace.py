@@ -89,7 +89,10 @@ def workspace_text(r: WorkspaceResult) -> str:
         lines.append(f"  boundary located at {len(r.boundary)} points (bisection to {r.resolution / 128:.2g} m), "
                      f"the threshold crossed at {len(r.free_boundary)}")
     if r.truncated:
-        lines.append("  warning: the bounds cut the workspace: the volumes are of the part within them")
+        timed = any("time limit" in n for n in r.notes)
+        lines.append("  warning: " + ("the time limit cut the workspace: the volumes are of the part reached"
+                                      if timed else "the bounds cut the workspace: the volumes are of the part "
+                                                    "within them"))
     lines += [f"  note: {n}" for n in r.notes]
     return "\n".join(lines)
 
