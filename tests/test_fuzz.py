@@ -638,7 +638,7 @@ def test_hostile_command_line(i, tmp_path, capfd, monkeypatch):
 
 
 #: Names people (or hostile files) give links and joints: dots, commas, newlines are names, not syntax.
-HOSTILE_NAMES = ["mesh.2", "a.x", "a,b", "=SUM(A1:A9)", "+cmd", "@x", "<script>alert(1)</script>", "j;rm -rf",
+HOSTILE_NAMES = ["mesh.2", "a.x", "a,b", "a\nb", "=SUM(A1:A9)", "+cmd", "@x", "<script>alert(1)</script>", "j;rm -rf",
                  "crank\u00e9", "a b"]
 
 
@@ -708,3 +708,53 @@ def test_process_mutants(i, tmp_path):
     assert p.returncode in (0, 1, 2) and "Traceback" not in p.stderr and len(errors) <= 1, p.stderr
     if p.returncode == 0:
         json.loads(p.stdout, parse_constant=_no_nan)
+
+
+# ------------------------------------------------------------------ hostile files of issue 22
+MESH_ROUTES = ["../outside/secret.obj", "../../outside/secret.obj", "package://robot/../outside/secret.obj",
+               "package://outside/secret.obj", "file:///etc/passwd", "/etc/passwd", "link.obj"]
+
+
+@pytest.mark.parametrize("route", MESH_ROUTES)
+def test_mesh_paths_that_leave_the_folder(route, tmp_path, capfd, monkeypatch):
+    """A mesh outside the robot's folder (by .., package://, file://, an absolute path or a symlink) is
+    never read: the view's page holds none of its bytes, and the contract holds."""
+    import base64
+
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    token = "CANARY-" + "7f3a9c" * 4
+    (outside / "secret.obj").write_text(f"# {token}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    (robot / "link.obj").symlink_to(outside / "secret.obj")
+    mesh = f'<visual><geometry><mesh filename="{route}"/></geometry></visual>'
+    text = fourbar().replace('<link name="crank">', f'<link name="crank">{mesh}', 1)
+    if mesh not in text:
+        text = fourbar().replace("</robot>", f'<link name="extra">{mesh}</link><joint name="fix" type="fixed">'
+                                             '<parent link="ground"/><child link="extra"/></joint></robot>')
+    path = robot / "robot.urdf"
+    path.write_text(text)
+    monkeypatch.chdir(tmp_path)
+    with no_hang(60):
+        code = check_contract(["view", str(path), "--html", str(tmp_path / "v.html")], capfd, [path])
+    if code == 0:
+        page = (tmp_path / "v.html").read_text(errors="replace")
+        assert token not in page and base64.b64encode(token.encode()).decode()[:24] not in page
+
+
+@pytest.mark.parametrize("levels", [8, 16, 24])
+def test_xacro_doubling_generators(levels, tmp_path, capfd):
+    """Block properties and text properties that double at each level: refused in one line, at once."""
+    blocks = ['<xacro:property name="b0"><link name="x"/></xacro:property>']
+    blocks += [f'<xacro:property name="b{k}"><xacro:insert_block name="b{k - 1}"/>'
+               f'<xacro:insert_block name="b{k - 1}"/></xacro:property>' for k in range(1, levels + 1)]
+    texts = ['<xacro:property name="s0" value="abcdefgh"/>']
+    texts += [f'<xacro:property name="s{k}" value="${{s{k - 1}}}${{s{k - 1}}}"/>' for k in range(1, levels + 1)]
+    for body, tail in (("".join(blocks), f'<xacro:insert_block name="b{levels}"/>'),
+                       ("".join(texts), f'<link name="${{s{levels}}}"/>')):
+        path = tmp_path / "f.urdf.xacro"
+        path.write_text('<?xml version="1.0"?><robot name="d" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                        f"{body}{tail}</robot>")
+        with no_hang(20):
+            check_contract(["info", str(path)], capfd, [path])
