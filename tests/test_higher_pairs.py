@@ -206,3 +206,36 @@ def test_bad_higher_pair_values_are_one_line_errors(tmp_path, capsys, text, word
     assert main(["info", str(p)]) == 1
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and word in err and str(p) in err, err
+
+
+@pytest.mark.parametrize("typed,theta", [("720deg", 4 * np.pi), ("90deg", np.pi / 2), ("-1.5turn", -3 * np.pi),
+                                         ("1000deg", np.radians(1000))])
+def test_a_screw_counts_turns(typed, theta, capsys):
+    """issue 25 item 13: robots/lead_screw_jack.urdf, lead 5 mm: |lift| = lead * |theta| / 2 pi over any number
+    of turns (the file's convention: lift = -lead theta / 2 pi, as at 90 deg), one solution, the input as typed."""
+    import json
+
+    from screwkin.cli import main
+
+    assert main(["solve", str(ROBOTS / "lead_screw_jack.urdf"), "--set", f"screw_joint={typed}", "--all",
+                 "--json"]) == 0
+    (sol,) = json.loads(capsys.readouterr().out)["solutions"]
+    assert sol["joints"]["lift"] == pytest.approx(-0.005 * theta / (2 * np.pi), abs=1e-9)
+    assert sol["joints"]["screw_joint"] == pytest.approx(theta, abs=1e-12)
+
+
+@pytest.mark.parametrize("deg", [30.0, 390.0, 750.0, -500.0])
+def test_a_gear_train_counts_turns(deg, capsys):
+    """robots/gear_train_idler.urdf: input 0.05, idler 0.03, output 0.08 m pitch radii: the output turns
+    deg * 0.05 / 0.08 the same way (two external meshes), modulo a turn as the joint is reported."""
+    import json
+
+    from screwkin.cli import main
+
+    assert main(["solve", str(ROBOTS / "gear_train_idler.urdf"), "--set", f"input_joint={deg}deg", "--json"]) == 0
+    sols = json.loads(capsys.readouterr().out)["solutions"]
+    assert len(sols) == 1
+    out = np.degrees(sols[0]["joints"]["output_joint"])
+    at_zero = 0.0  # the file's output at input 0 (the gears are drawn at zero)
+    expected = at_zero + deg * 0.05 / 0.08
+    assert np.mod(out - expected + 180, 360) - 180 == pytest.approx(0, abs=1e-7)

@@ -124,6 +124,14 @@ class Solution:
         return None if self.output_pose is None else pin.rpy.matrixToRpy(self.output_pose[:3, :3])
 
 
+def _axis(joint) -> np.ndarray:
+    short = joint.shortname()
+    for tail, axis in (("X", (1.0, 0, 0)), ("Y", (0, 1.0, 0)), ("Z", (0, 0, 1.0))):
+        if short.endswith(("R" + tail, "RUB" + tail)):
+            return np.array(axis)
+    return np.asarray(joint.extract().axis, float)
+
+
 @dataclass(frozen=True)
 class PositionResult:
     inputs: dict
@@ -291,6 +299,47 @@ class PositionSolver:
                                  f"{name}[q0] ... {name}[q{c.nq - 1}]")
         return pin.normalize(self.model, q) if multi else q
 
+    def _whole_turns(self, values) -> dict:
+        """Input name -> the whole turns [rad] of a revolute input's typed value, when the mechanism has
+        higher pairs whose coupling rows count turns (screws, gears): 720deg is not 0 there."""
+        if not self.mech.counted_turns:
+            return {}
+        out = {}
+        for name, v in values.items():
+            c = next((c for c in self.mech.coordinates if c.joint == name and c.nq == 1), None)
+            if c is not None and self.model.joints[c.joint_id].shortname().startswith("JointModelR"):
+                w = float(v - (np.mod(v + np.pi, 2 * np.pi) - np.pi))
+                if abs(w) > 0:
+                    out[name] = w
+        return out
+
+    def _engaged(self, found, values):
+        """The solutions whose counted angles (a screw's turn, a gear's roll) continue the assembled
+        configuration's: each predicted from there by the loops' rates (linear for screws and gears) and
+        kept when within half a turn of it; the others differ by whole turns of a thread or a tooth
+        that no motion from the file's configuration reaches."""
+        try:
+            ref = self.mech.assemble().q
+        except AssemblyError:
+            return found
+        dv = {n: float(values[n]) - float(self.mech.joint_values(ref).get(n, 0.0)) for n in self.inputs}
+        qd = self.rates(ref, self.mech.closure.jacobian(ref), dv)
+        counted = sorted(self.mech.counted_turns)
+        vidx = [next(c.idx_v for c in self.mech.coordinates if c.idx_q == t) for t in counted]
+        pred = np.array([ref[t] for t in counted]) + qd[vidx]
+        off = [float(np.max(np.abs(np.array([q[t] for t in counted]) - pred))) for _, q, _ in found]
+        kept = [f for f, d in zip(found, off) if d < np.pi]
+        return kept or [found[int(np.argmin(off))]]
+
+    def _turn_on(self, q, whole: dict, typed: dict):
+        """(q, assembly) of the solution ``q`` found within a turn, turned on by the inputs' whole turns:
+        the loops' rates per unit input move every joint and every counted angle linearly (exactly, for
+        gears and screws), then Newton closes at the typed inputs."""
+        K = self.mech.closure.jacobian(q)
+        qd = self.rates(q, K, {n: whole.get(n, 0.0) for n in self.inputs})
+        a = self.mech.closure.solve(self.set_inputs(pin.integrate(self.model, q, qd), typed), frozen=self.frozen)
+        return a.q, Assembly(a.q, a.residual, a.iterations)
+
     def joint_values(self, q) -> dict:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
@@ -348,6 +397,8 @@ class PositionSolver:
         objects whose position (and velocity, acceleration with ``rates``) each solution reports."""
         mech = self.mech
         self._check_inputs(values)
+        typed, whole = dict(values), self._whole_turns(values)
+        values = {n: v - whole.get(n, 0.0) for n, v in values.items()}  # solved within a turn, then turned on
         steps = []
         recorder = (lambda it, q, r, K, dq, ok: steps.append(
             TraceStep(it, r.copy(), K[:, self.passive].copy(), dq[self.passive].copy(), ok))) if trace else None
@@ -369,8 +420,12 @@ class PositionSolver:
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
                                        f"{len(start_list)} starting configurations")
+        if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
+            found = self._engaged(found, values)
+        if whole:
+            found = [(k, *self._turn_on(q, whole, typed)) for k, q, _ in found]
         self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
-        sols = [self._solution(q, a, rates, accels, points) for _, q, a in found]
+        sols = [self._solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
         sols = self._merge(sols)
         ref = near_q if near_q is not None else self._reference()
         if len(sols) > 1:
@@ -587,7 +642,7 @@ class PositionSolver:
         return self._angles(q) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def _solution(self, q, a, rates, accels, points=()) -> Solution:
+    def _solution(self, q, a, rates, accels, points=(), typed=None) -> Solution:
         mech, tol = self.mech, self.mech.tolerances
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
@@ -608,7 +663,11 @@ class PositionSolver:
                 twist, acc = state.frame_twist(self.output_frame), state.frame_acceleration(self.output_frame)
         outside = outside_limits(mech, q)
         angles = self._link_angles(q)
-        return Solution(q, self.joint_values(q), a.residual, a.iterations, bool(singular), float(sigma), pose,
+        joints = self.joint_values(q)
+        for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
+            if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < 1e-9:
+                joints[name] = float(v)
+        return Solution(q, joints, a.residual, a.iterations, bool(singular), float(sigma), pose,
                         rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),
                         link_angles=angles, sigmas=m, coupled=mech.coupled_values(q) or None,
                         loop_joints=state.loop_joints or None, loop_rates=state.loop_rates or None,

@@ -255,7 +255,9 @@ class Mechanism:
             for c in self.coordinates:
                 short = self.model.joints[c.joint_id].shortname()
                 if c.nq == 1:
-                    single.append((c.joint, c.idx_q, short.startswith("JointModelR")))
+                    # a higher pair's virtual angle (a screw's turn, a gear's roll) counts turns: never wrapped
+                    wrap = short.startswith("JointModelR") and c.idx_q not in self.counted_turns
+                    single.append((c.joint, c.idx_q, wrap))
                     order.append(c.joint)
                 elif c.nq == 2 and c.nv == 1:
                     continuous.append((c.joint, c.idx_q))
@@ -269,6 +271,19 @@ class Mechanism:
             self._angle_v = np.array([self.coordinate(n).idx_v for n, _, w in single if w], int)
             self._layout = (single, continuous, multi, order, idx, wrap)
         return self._layout
+
+    @property
+    def counted_turns(self) -> frozenset:
+        """q indices of the higher pairs' virtual revolute joints (a helical pair's turn, a rolling pair's
+        angles): their coupling rows are linear in the unwrapped angle, so a value is never taken modulo
+        a turn (two turns of a 5 mm lead screw lift 10 mm, not 0)."""
+        out = set()
+        for row in self.extra_rows:
+            for iq, _, _ in getattr(row, "terms", ()):
+                jid = next(c.joint_id for c in self.coordinates if c.idx_q == iq)
+                if self.model.joints[jid].shortname().startswith("JointModelR"):
+                    out.add(iq)
+        return frozenset(out)
 
     def coupled_values(self, q) -> dict:
         """The value of every coupled (<mimic>) joint: multiplier * its primary's + offset
