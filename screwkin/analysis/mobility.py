@@ -263,10 +263,13 @@ def _classify(n, m, eff, overconstraint, topo, M):
         kind = f"redundantly actuated: {m} inputs for {n} degree{'s' if n > 1 else ''} of freedom"
     if lam_count != M:
         why = []
-        if redundant > 0:
+        if redundant > 0 and M > 0 and lam_count <= 0:
             why.append(f"the mechanism is overconstrained ({redundant} redundant constraint"
                        f"{'s' if redundant > 1 else ''}{where}: its special geometry lets it move although the count "
                        "says it cannot)")
+        elif redundant > 0:
+            why.append(f"{redundant} constraint{'s are' if redundant > 1 else ' is'} redundant{where}: the count "
+                       f"takes {'them' if redundant > 1 else 'it'} as independent")
         notes.append(f"The {crit} gives {lam_count} but the screw-theory mobility is {M}"
                      + (": " + "; ".join(why) if why else "") + ".")
     if space != "spatial" and topo.kutzbach != M:

@@ -51,6 +51,8 @@ SYMBOL = {
 HIGHER = ("rolling", "gear", "contact")
 #: Pairs whose relative motion is planar, with their axis as the plane's normal.
 PLANAR_PAIRS = ("planar", "rolling", "gear", "contact")
+#: Joint types whose elements do not touch (the pair column says none, as info --joint-types does).
+NO_CONTACT = ("floating", "fixed")
 
 
 @dataclass(frozen=True)
@@ -81,7 +83,10 @@ class Joint:
 
     @property
     def pair(self) -> str:
-        """'lower' (elements touching over a surface) or 'higher' (along a line or at a point)."""
+        """'lower' (elements touching over a surface), 'higher' (along a line or at a point), or 'none'
+        for a floating joint (no contact at all) and a weld, as ``info --joint-types`` lists them."""
+        if self.type in NO_CONTACT:
+            return "none"
         return "higher" if self.type in HIGHER else "lower"
 
     @property
@@ -89,6 +94,8 @@ class Joint:
         """How its elements touch: 'surface' for lower pairs (a screw too); 'line' for rolling
         cylinders, gear teeth and cams; 'point' where a point profile (a knife edge, a pin) meets
         a curve (both seen in the plane of motion)."""
+        if self.type in NO_CONTACT:
+            return "none"
         if self.type not in HIGHER:
             return "surface" + (", compound" if len(self.members) > 1 else "")
         return "point" if self.profile and "point" in self.profile else "line"

@@ -1,0 +1,33 @@
+"""Details a course gets wrong otherwise (issue 25 'wrong details'), each against what the question says."""
+
+from __future__ import annotations
+
+import json
+
+from conftest import DATA
+from screwkin.cli import main
+
+FLOATING = ('<robot name="f"><link name="base"/><link name="body"/>'
+            '<joint name="free" type="floating"><parent link="base"/><child link="body"/></joint></robot>')
+
+
+def test_a_floating_joint_is_no_pair_as_the_joint_types_table_says(tmp_path, capsys):
+    """item 8: the topology table said 'lower (surface)'; info --joint-types says none."""
+    path = tmp_path / "f.urdf"
+    path.write_text(FLOATING)
+    assert main(["info", "--joint-types", "--json"]) == 0
+    table = {t["name"]: t for t in json.loads(capsys.readouterr().out)["joint_types"]}
+    assert main(["info", str(path), "--json"]) == 0
+    (joint,) = json.loads(capsys.readouterr().out)["joints"]
+    assert (joint["pair"], joint["contact"]) == (table["floating"]["pair"], table["floating"]["contact"]) == \
+        ("none", "none")
+
+
+def test_a_braced_structure_is_not_said_to_move(capsys):
+    """item 12: a triangle braced by one more bar, M = 0 with one redundant constraint: no note may say that
+    its geometry lets it move."""
+    assert main(["mobility", str(DATA / "student" / "triangle_and_bar.urdf"), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["mobility"] == 0
+    assert not any("lets it move" in n for n in d["notes"])
+    assert any("redundant" in n for n in d["notes"])
