@@ -31,3 +31,14 @@ def test_a_braced_structure_is_not_said_to_move(capsys):
     assert d["mobility"] == 0
     assert not any("lets it move" in n for n in d["notes"])
     assert any("redundant" in n for n in d["notes"])
+
+
+def test_a_certificate_below_the_force_tolerance_is_a_pure_moment():
+    """item 17: force (0, -3.46e-07) N beside a moment of 1 N m was printed with a line of action through a
+    point 144 km away; it is a pure moment about the plane's normal."""
+    from screwkin.present.grasp import wrench_axis
+
+    ax = wrench_axis([0.0, -3.46e-7, 1.0], planar=True)
+    assert ax["point"] is None and ax["pitch"] == "inf" and list(ax["direction"]) == [0.0, 0.0, 1.0]
+    ax = wrench_axis([0.2, 0.0, 1.0], planar=True)  # a real force: its line is y = -m / fx = -5 m
+    assert ax["point"][1] == -5.0 or abs(ax["point"][1] + 5.0) < 1e-12

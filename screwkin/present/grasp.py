@@ -8,6 +8,7 @@ import numpy as np
 
 from ..analysis.grasp import GraspResult
 from ..analysis.screws import screw_of
+from ..tolerances import DEFAULT
 from .report import table, to_jsonable
 
 __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]
@@ -29,11 +30,22 @@ def _rows(planar):
     return ["fx", "fy", "mz"] if planar else ["fx", "fy", "fz", "mx", "my", "mz"]
 
 
+def pure_moment(w, planar: bool) -> np.ndarray:
+    """The wrench with a force below the motion tolerance (relative to the wrench) set to zero: a
+    force of 3e-7 N beside a moment of 1 N m is round-off, and its line of action (through a point
+    144 km away) is no answer: it is a pure moment."""
+    w = np.array(w, float)
+    k = 2 if planar else 3
+    if np.linalg.norm(w[:k]) <= DEFAULT.motion * max(np.linalg.norm(w), 1e-300):
+        w[:k] = 0.0
+    return w
+
+
 def wrench_axis(w, planar: bool) -> dict:
     """The line of action of a wrench (force, moment): direction of the force, the point of the
     line nearest the origin, pitch = f . m / |f|^2 [m]; a pure moment (no force) has direction
     the moment's, no point and pitch inf.  Planar wrenches (fx, fy, mz) as spatial ones."""
-    w = np.asarray(w, float)
+    w = pure_moment(np.asarray(w, float), planar)
     f, m = (np.array([w[0], w[1], 0.0]), np.array([0.0, 0.0, w[2]])) if planar else (w[:3], w[3:])
     s = screw_of(np.concatenate([m, f]))  # a twist's (v, w) is a wrench's (m, f): the same axis
     return {"direction": list(s.direction), "point": list(s.point) if s.point is not None else None,
@@ -56,7 +68,7 @@ def _certificate_dict(r: GraspResult):
                 "contact_forces": [{"contact": f.contact, "normal": f.normal, "tangential": list(f.tangential),
                                     "torsion": f.torsion, "force": list(f.force), "friction_ratio": f.friction_ratio,
                                     "torsion_ratio": f.torsion_ratio} for f in c.contact_forces]}
-    return {"unresisted_wrench": c.unresisted_wrench, "opposite_unresisted_too": c.both_signs,
+    return {"unresisted_wrench": pure_moment(c.unresisted_wrench, r.spec.planar).tolist(), "opposite_unresisted_too": c.both_signs,
             "axis": wrench_axis(c.unresisted_wrench, r.spec.planar), "margin": c.margin, "cones": c.cones}
 
 
@@ -164,7 +176,7 @@ def _certificate_lines(r: GraspResult):
         if len(c.contact_forces) > len(shown):
             out.append(f"    ... and {len(c.contact_forces) - len(shown)} more contacts (all in --json)")
         return out
-    w = c.unresisted_wrench
+    w = pure_moment(c.unresisted_wrench, r.spec.planar)
     k = 2 if r.spec.planar else 3
     ax = wrench_axis(w, r.spec.planar)
     where = (f"a pure moment about {_vec(ax['direction'])}" if ax["point"] is None else
