@@ -42,3 +42,11 @@ def test_a_certificate_below_the_force_tolerance_is_a_pure_moment():
     assert ax["point"] is None and ax["pitch"] == "inf" and list(ax["direction"]) == [0.0, 0.0, 1.0]
     ax = wrench_axis([0.2, 0.0, 1.0], planar=True)  # a real force: its line is y = -m / fx = -5 m
     assert ax["point"][1] == -5.0 or abs(ax["point"][1] + 5.0) < 1e-12
+
+
+def test_an_offset_of_round_off_is_no_symbol(capsys):
+    """item 10: a slider whose pin lies on its guide up to the closure's round-off (2.7e-11 m at a double
+    root, here 5.5e-11 m at the R-R-P-R's drawn configuration) has no offset symbol e."""
+    assert main(["equations", str(DATA / "student" / "rrpr.urdf"), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert not [name for name in d["symbols"] if name.startswith("e")]

@@ -405,7 +405,8 @@ class VectorLoops:
                              f"guide on '{g}' to the centre of {sl['to']} on '{s}'")
         self.variables.append(x.name)
         e = 0
-        if abs(sl["e"]) > 1e-12 * max(self.mech.length, 1e-9):
+        # an offset below the geometric tolerance is round-off of a loop closed at a double root: zero
+        if abs(sl["e"]) > self.mech.tolerances.geometry * max(self.mech.length, 1.0):
             e = self._new_symbol(f"e{k}{suffix}", g, "length", sl["e"], "constant",
                                  f"offset of the centre of {sl['to']} from the guide line of x{k}{suffix} "
                                  f"(along n{k}{suffix}, u{k}{suffix} turned +90 deg)")
