@@ -50,3 +50,24 @@ def test_an_offset_of_round_off_is_no_symbol(capsys):
     assert main(["equations", str(DATA / "student" / "rrpr.urdf"), "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert not [name for name in d["symbols"] if name.startswith("e")]
+
+
+def test_motion_space_sentences_say_what_the_axes_are(tmp_path, capsys):
+    """item 9: a coaxial screw pair (lead_screw_jack: the screw's revolute, the carriage's slide and the helical
+    pair on one line) was told its axes are 'neither parallel nor concurrent'; three revolutes through one point
+    are spherical."""
+    from conftest import ROBOTS
+
+    assert main(["info", str(ROBOTS / "lead_screw_jack.urdf"), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["motion_space"] == "spatial" and "every joint axis lies on one line" in d["motion_space_detail"]
+    inert = '<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    links = "".join(f'<link name="l{k}">{inert}</link>' for k in (1, 2, 3))
+    joints = "".join(f'<joint name="{n}" type="continuous"><parent link="{p}"/><child link="{c}"/>'
+                     f'<origin xyz="{o}"/><axis xyz="{a}"/></joint>'
+                     for n, p, c, o, a in (("a", "base", "l1", "0 0 0.1", "0 0 1"), ("b", "l1", "l2", "0 0 0", "1 0 0"),
+                                           ("c", "l2", "l3", "0 0 0", "0 1 0")))
+    path = tmp_path / "ball.urdf"
+    path.write_text(f'<robot name="b"><link name="base"/>{links}{joints}</robot>')
+    assert main(["info", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["motion_space"] == "spherical"

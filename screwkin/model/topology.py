@@ -522,4 +522,19 @@ def _motion_space(joints, tol, scale):
                 if all(np.linalg.norm(p - c) < lt for p in centres):
                     cc = np.round(c, 6) + 0.0
                     return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
+    axial = [j for j in joints if j.direction is not None and j.point is not None]
+    if len(axial) == len(joints) and len(axial) >= 2:  # every joint's axis on one line: a screw, a slide along it
+        p0, d0 = np.asarray(axial[0].point, float), _unit(np.asarray(axial[0].direction, float))
+        on_line = all(_parallel(d0, np.asarray(j.direction), tol)
+                      and np.linalg.norm(np.cross(np.asarray(j.point, float) - p0, d0)) < lt for j in axial)
+        if on_line:
+            types = sorted({j.type for j in axial})
+            return ("spatial", f"every joint axis lies on one line ({', '.join(types)}): the motion is a rotation "
+                               "about and a translation along it, which neither the planar nor the spherical count "
+                               "describes", None)
+    parallel = all(_parallel(_unit(np.asarray(rot[0].direction)), np.asarray(j.direction), tol) for j in rot) \
+        if rot else False
+    if parallel and pri:
+        return ("spatial", "the revolute axes are parallel but a prismatic axis is not perpendicular to them (not "
+                           "planar), and they meet in no point (not spherical)", None)
     return "spatial", "the joint axes are neither all parallel (planar) nor all concurrent (spherical)", None
