@@ -71,3 +71,12 @@ def test_motion_space_sentences_say_what_the_axes_are(tmp_path, capsys):
     path.write_text(f'<robot name="b"><link name="base"/>{links}{joints}</robot>')
     assert main(["info", str(path), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["motion_space"] == "spherical"
+
+
+def test_stationary_joints_and_the_gram_table_agree(capsys):
+    """item 6: at the R-R-P-R's drawn configuration (B on D, the slotted link free) the Gram table's zero
+    cofactors and the 'stationary joints' line come from one set of motions: the cut joint 'slide' included."""
+    assert main(["singularities", str(DATA / "student" / "rrpr.urdf"), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    zero = set(d["gram_zero"])
+    assert zero == {"A", "slide"} and zero <= set(d["stationary_joints"])

@@ -33,6 +33,7 @@ import pinocchio as pin
 from ..model._pin import frame_jacobian
 from ..model.closure import perpendicular_basis
 from ..model.linalg import null_space, rank
+from ..model.state import KinematicState, loop_coordinate_cuts
 from .screws import screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
@@ -220,7 +221,15 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
         s = np.linalg.svd(S.K[:, g.p], compute_uv=False)[:g.rank_Kp]
         cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
     stationary = tuple(n for k, n in enumerate(names)
-                       if g.moving[k] and S.V.shape[1] and np.linalg.norm(S.V[k]) < 1e-7)
+                       if g.moving[k] and S.V.shape[1] and np.linalg.norm(S.V[k]) < STATIONARY)
+    # the loop (cut) joints too, from the same motions: a cut joint's rate is its F2's twist relative to F1
+    # along its axis (model.state), zero in every motion of the null space (so the Gram table agrees)
+    if S.V.shape[1]:
+        states = [KinematicState(mech, q, unscale(S.V[:, i])) for i in range(S.V.shape[1])]
+        for c in loop_coordinate_cuts(mech):
+            scale = L if c.type == "prismatic" else 1.0
+            if max(abs(st.loop_rate(c)) for st in states) / scale < STATIONARY:
+                stationary += (c.name,)
     sigmas = {k: sig.get(k, 1.0) for k in KINDS}
     return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
                              L, tuple(twists), tuple(inputs), output, point, gram_cofactors(mech, q, L))
