@@ -80,3 +80,21 @@ def test_stationary_joints_and_the_gram_table_agree(capsys):
     d = json.loads(capsys.readouterr().out)
     zero = set(d["gram_zero"])
     assert zero == {"A", "slide"} and zero <= set(d["stationary_joints"])
+
+
+def test_a_planar_mechanisms_lost_direction_lies_in_its_plane(capsys):
+    """item 11: the planar 3-RPR with leg 1 at zero length (its U and the wrist coincide) loses a platform
+    translation in the plane (along the line the zero leg can no longer push: perpendicular to nothing out of
+    the plane); the printed direction has no z component and is a translation, not an axis 1e8 m away."""
+    from conftest import ROBOTS
+
+    argv = ["singularities", str(ROBOTS / "planar_3rpr.urdf"), "--set-length", "leg1=0,leg2=0.3,"
+            "leg3=0.3", "--output", "platform", "--json"]
+    assert main(argv) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["serial"]
+    for tw in d["singular_twists"]:  # planar twists (vx, vy, 0, 0, 0, wz): nothing out of the plane
+        t = tw["twist"]
+        assert abs(t[2]) < 1e-9 and abs(t[3]) < 1e-9 and abs(t[4]) < 1e-9, tw
+    (serial,) = [t for t in d["singular_twists"] if t["kind"] == "serial"]
+    assert serial["screw"]["pitch"] == "inf"  # a translation in the plane, not an axis 1e7 m away

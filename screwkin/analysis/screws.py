@@ -39,11 +39,18 @@ class Screw:
     pitch: float
 
 
-def screw_of(xi) -> Screw:
+#: With a characteristic length L, a twist whose rotation moves points within L by less than this fraction of
+#: its translation (|w| L < TRANSLATION_RATIO |v|: an axis a million lengths away) is a pure translation.
+TRANSLATION_RATIO = 1e-6
+
+
+def screw_of(xi, length: float | None = None) -> Screw:
+    """The screw of a twist (v, w); with ``length`` [m] a rotation about an axis farther than
+    length / TRANSLATION_RATIO is read as the translation it is (round-off near a singularity)."""
     xi = np.asarray(xi, float)
     v, w = xi[:3], xi[3:]
     nw = np.linalg.norm(w)
-    if nw < 1e-12:
+    if nw < 1e-12 or (length is not None and nw * length < TRANSLATION_RATIO * np.linalg.norm(v)):
         nv = np.linalg.norm(v)
         return Screw(tuple(xi), tuple(v / nv) if nv > 0 else (0.0, 0.0, 0.0), None, float("inf"))
     pitch = float(w @ v / nw**2)

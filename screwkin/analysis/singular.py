@@ -216,7 +216,12 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
             lost[:len(U)] = U[:, g.out_dim - 1]
             lost[:3] *= L
             lost[:3] -= np.cross(lost[3:], origin)
-            twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost)))
+            topo = mech.topology(q)
+            normal = topo.normal if topo.motion_space == "planar" else None
+            if normal is not None:  # a planar mechanism's lost direction lies in its plane: (vx, vy, wz) only
+                n = np.asarray(normal, float) / np.linalg.norm(normal)
+                lost = np.concatenate([lost[:3] - (lost[:3] @ n) * n, (lost[3:] @ n) * n])
+            twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost, L)))
     elif S.K.size and g.rank_Kp:
         s = np.linalg.svd(S.K[:, g.p], compute_uv=False)[:g.rank_Kp]
         cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
