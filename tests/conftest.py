@@ -131,3 +131,43 @@ def pytest_sessionfinish(session, exitstatus):
     if _ci_skips:
         print(f"\n{len(_ci_skips)} test(s) skipped for something CI installs:\n  " + "\n  ".join(_ci_skips[:20]))
         session.exitstatus = 1
+
+
+# ---- markers: a fast subset of about a minute is `pytest -m "not slow"` (issue 23 item 7)
+#: Tests of several seconds each (measured with --durations on the 2-core machine), by node id.
+SLOW_TESTS = {
+    "test_study.py::test_workspace_metrics_equal_screwkin_workspace",
+    "test_workspace.py::test_delta_volume_against_monte_carlo_on_the_closed_form",
+    "test_workspace.py::test_cli_json_png_csv",
+    "test_workspace.py::test_sampling_spherical_shell_of_an_elbow_arm",
+    "test_workspace.py::test_five_bar_area_is_the_annuli_intersection",
+    "test_fresh_clone.py::test_tests_on_bundled_data_pass_in_the_clone",
+    "test_gram_cofactors.py::test_fourbar_rocker_at_its_limit_is_stationary_and_the_cli_reports_it",
+    "test_gram_cofactors.py::test_slider_crank_dead_centre_slider_cofactor_is_zero",
+    "test_examples.py::test_stewart_motor_loop",
+    "test_examples.py::test_readme_python_blocks_run",
+    "test_examples.py::test_corpus_survey",
+    "test_synthesis.py::test_four_positions_burmester_pick_and_five_positions_find_the_linkage",
+}
+#: Fuzz mutants beyond the first of each kind run in the slow tier (the first ones keep every operation).
+FAST_MUTANTS = 20
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        node = item.nodeid.split("tests/", 1)[-1]
+        base = node.split("[", 1)[0]
+        if base in SLOW_TESTS:
+            item.add_marker(pytest.mark.slow)
+        if "local" in getattr(item, "fixturenames", ()) or base.endswith(("separate_scheduler_and_workers_give_the"
+                                                                          "_same_table",
+                                                                          "stalled_cluster_gives_failed_rows_not_a_hang")):
+            item.add_marker(pytest.mark.cluster)
+            item.add_marker(pytest.mark.slow)
+        if any(m.name == "skipif" and "Chromium" in str(m.kwargs.get("reason", "")) for m in item.iter_markers()):
+            item.add_marker(pytest.mark.chromium)
+            item.add_marker(pytest.mark.slow)
+        if base.startswith("test_fuzz.py::test_") and "_mutant" in base and "[" in node:
+            index = node.rsplit("-", 1)[-1].rstrip("]")
+            if index.isdigit() and int(index) >= FAST_MUTANTS:
+                item.add_marker(pytest.mark.slow)
