@@ -66,6 +66,12 @@ class SweepResult:
     circuit_closed: bool = False  # the motion came back to its starting configuration
     unit: str = "rad"  # the input's unit: "rad" or "m"
     coupled: dict | None = None  # <mimic> joint -> its values along the sweep
+    skipped: tuple = ()  # input values on the grid the motion passed but could not solve at (holes)
+
+    @property
+    def completed(self) -> bool:
+        """The whole range, every grid value on it: not stopped short, no hole."""
+        return self.stopped_at is None and not self.skipped
 
 
 class _Stuck(Exception):
@@ -220,6 +226,8 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             range(int(np.ceil(lo_k - 1e-9)) - 1, int(np.ceil(hi_k - 1e-9)) - 1, -1)
         return [start + j * h for j in ks]
 
+    skipped = []  # grid values of the input the motion passed but could not be solved at
+
     def record(qa, xa, ta, qb, xb, tb=None):
         """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
         position between them, each predicted from the nearer end (not from a limit position:
@@ -231,6 +239,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             try:
                 qg = tr.at_input(qb, xb, g, tb) if near_b else tr.at_input(qa, xa, g, ta)
             except _Stuck:
+                skipped.append(float(g))  # said in the result: never a hole in a motion marked complete
                 continue
             X.append(g)
             Q.append(qg)
@@ -241,6 +250,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             try:
                 qg = tr.at_input(qb, xb, g, tb)
             except _Stuck:
+                skipped.append(float(g))
                 continue
             X.append(g)
             Q.append(qg)
@@ -336,7 +346,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         coupled = {c.joint: np.array([v[c.joint] for v in values]) for c in mech.couplings}
     return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
                        np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
-                       (start, stop, steps), tuple(limits), turn, closed, unit, coupled)
+                       (start, stop, steps), tuple(limits), turn, closed, unit, coupled, tuple(skipped))
 
 
 def _matrix(mech, q, kind, g, V_ref=None):

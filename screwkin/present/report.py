@@ -368,6 +368,11 @@ def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linea
         lines.append("the motion came back to its starting configuration: the whole circuit is traced")
     if res.stopped_at is not None:
         lines.append(f"stopped at {res.input} = {value_text(res.input, res.stopped_at, angular)}: {res.stop_reason}")
+    if res.skipped:
+        lo, hi = min(res.skipped), max(res.skipped)
+        lines.append(f"not solved at {len(res.skipped)} input value{'s' if len(res.skipped) > 1 else ''} the motion "
+                     f"passed ({value_text(res.input, lo, angular)} .. {value_text(res.input, hi, angular)}): "
+                     "they are left out of the tables, and the sweep is not complete")
     if info is not None:
         lines.append(f"{info.kind}: " + ", ".join(f"{k} {v:.6g} m" for k, v in info.lengths.items()))
         lines.append(f"  {info.grashof}")
@@ -483,7 +488,7 @@ def sweep_dict(res: SweepResult, mech=None) -> dict:
     return {
         "input": res.input, "input_unit": res.unit,
         "from": res.requested[0], "to": res.requested[1], "steps": res.requested[2],
-        "completed": res.stopped_at is None,
+        "completed": res.completed, "skipped": list(res.skipped),
         "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
         "turn": res.turn, "circuit_closed": res.circuit_closed,
         "singularities": [sweep_singularity_dict(s, mech) for s in res.limits],

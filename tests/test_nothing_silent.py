@@ -1,0 +1,21 @@
+"""Nothing silent (issue 23 item 4): a sweep with holes is not complete, and says where."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from conftest import ROBOTS
+from screwkin import load
+from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.sweep import sweep
+from screwkin.present.report import sweep_dict, sweep_text
+
+
+def test_a_sweep_with_holes_is_not_complete_and_says_where():
+    mech = load(str(ROBOTS / "fourbar_crank_rocker.urdf"))
+    res = sweep(PositionSolver(mech, ["crank_joint"]), "crank_joint", 0.0, 1.0, 10)
+    assert res.completed and sweep_dict(res, mech)["completed"] is True and sweep_dict(res, mech)["skipped"] == []
+    holed = dataclasses.replace(res, skipped=(0.3, 0.4))
+    d = sweep_dict(holed, mech)
+    assert d["completed"] is False and d["skipped"] == [0.3, 0.4]
+    assert "not solved at 2 input values the motion passed" in sweep_text(holed)
