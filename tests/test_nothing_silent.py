@@ -19,3 +19,14 @@ def test_a_sweep_with_holes_is_not_complete_and_says_where():
     d = sweep_dict(holed, mech)
     assert d["completed"] is False and d["skipped"] == [0.3, 0.4]
     assert "not solved at 2 input values the motion passed" in sweep_text(holed)
+
+
+def test_generic_configurations_are_cached_on_their_arguments():
+    """Mechanism.mobility(seed=...) had no effect once topology() ran: the cache ignored hint and seed."""
+    mech = load(str(ROBOTS / "fourbar_crank_rocker.urdf"))
+    first = mech.generic_configurations()
+    assert mech.generic_configurations() is not None and mech.generic_configurations()[1] is first[1]
+    other = mech.generic_configurations(seed=7)
+    assert len(other[1]) >= 1
+    assert any(not (a.shape == b.shape and (a == b).all()) for a, b in zip(first[1], other[1])) or \
+        len(first[1]) != len(other[1])  # another seed: another sample of configurations

@@ -227,7 +227,8 @@ class PositionSolver:
         mechanism's generic configurations; ``hint``: an assembled configuration to start
         from when the mechanism's own assembly search has not been made."""
         if self._generic is None:
-            configs = self.mech.generic_configurations(hint=hint)[1]
+            # the hint only starts a search not made yet (the mechanism's own result is reused when it exists)
+            configs = self.mech.generic_configurations(hint=None if self.mech.generic_known else hint)[1]
             self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
         return self._generic
 

@@ -140,6 +140,7 @@ class Mechanism:
         self._assembly = None
         self._limits = None
         self._generic = None
+        self._generic_cache = {}  # (hint, seed) -> generic_configurations' result
         self._length = None
         self._layout = None
         self.cache = {}  # results analyses derive from this mechanism (cleared when actuation or length change)
@@ -555,6 +556,11 @@ class Mechanism:
         return next((f.name for f in self.model.frames if f.parentJoint == jid and f.type == pin.FrameType.BODY),
                     self.model.names[jid])
 
+    @property
+    def generic_known(self) -> bool:
+        """Whether generic_configurations() has been computed (with any hint or seed)."""
+        return self._generic is not None
+
     def generic_configurations(self, hint=None, seed: int = 0) -> tuple:
         """(assembly, configurations): assembled configurations where generic ranks are taken.
 
@@ -566,31 +572,36 @@ class Mechanism:
         configurations that ``tolerances.generic_starts`` further random starts close; the
         configurations of the largest rank are returned, the one nearest the first assembly
         first (``assembly`` is that first one, with where it came from).  Cached."""
+        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed))
+        if key in self._generic_cache:  # keyed on its arguments: another hint or seed is another search
+            return self._generic_cache[key][:2]
+        a = self.assemble() if hint is None else self.assemble(hint)
+        tol, closure = self.tolerances, self.closure
+        rng = np.random.default_rng(seed)
+        configs = [a.q]
+        if self.nv:  # a serial chain too: its file configuration may be singular for an output
+            for _ in range(tol.samples):
+                V = null_space(closure.jacobian(a.q), tol, self.nv)
+                if V.shape[1] == 0:
+                    break
+                step = V @ rng.normal(size=V.shape[1])
+                step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
+                try:
+                    configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
+                except AssemblyError:
+                    continue
+            for _ in range(tol.generic_starts if closure.nrows else 0):  # (for the branches of loops)
+                try:
+                    configs.append(closure.solve(self.random_configuration(rng)).q)
+                except AssemblyError:
+                    continue
+        ranks = [rank(closure.jacobian(q), tol) if closure.nrows else 0 for q in configs]
+        top = max(ranks)
+        found = (a, tuple(q for q, r in zip(configs, ranks) if r == top), ranks[0] < top, ranks[0], top)
+        self._generic_cache[key] = found
         if self._generic is None:
-            a = self.assemble() if hint is None else self.assemble(hint)
-            tol, closure = self.tolerances, self.closure
-            rng = np.random.default_rng(seed)
-            configs = [a.q]
-            if self.nv:  # a serial chain too: its file configuration may be singular for an output
-                for _ in range(tol.samples):
-                    V = null_space(closure.jacobian(a.q), tol, self.nv)
-                    if V.shape[1] == 0:
-                        break
-                    step = V @ rng.normal(size=V.shape[1])
-                    step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
-                    try:
-                        configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
-                    except AssemblyError:
-                        continue
-                for _ in range(tol.generic_starts if closure.nrows else 0):  # (for the branches of loops)
-                    try:
-                        configs.append(closure.solve(self.random_configuration(rng)).q)
-                    except AssemblyError:
-                        continue
-            ranks = [rank(closure.jacobian(q), tol) if closure.nrows else 0 for q in configs]
-            top = max(ranks)
-            self._generic = (a, tuple(q for q, r in zip(configs, ranks) if r == top), ranks[0] < top, ranks[0], top)
-        return self._generic[:2]
+            self._generic = found  # the first one computed: what first_assembly_singular reports on
+        return found[:2]
 
     @property
     def first_assembly_singular(self):
