@@ -30,3 +30,22 @@ def test_generic_configurations_are_cached_on_their_arguments():
     assert len(other[1]) >= 1
     assert any(not (a.shape == b.shape and (a == b).all()) for a, b in zip(first[1], other[1])) or \
         len(first[1]) != len(other[1])  # another seed: another sample of configurations
+
+
+def test_output_is_the_same_whatever_the_hash_seed():
+    """The table order of info and mobility on the Delta and the Stewart platform changed with PYTHONHASHSEED
+    (compound joints were read from sets)."""
+    import os
+    import subprocess
+    import sys
+
+    for robot in ("delta_parallelogram.urdf", "gough_stewart_6ups.urdf"):
+        for command in ("info", "mobility"):
+            outs = set()
+            for seed in ("1", "2"):
+                env = dict(os.environ, PYTHONHASHSEED=seed)
+                p = subprocess.run([sys.executable, "-m", "screwkin", command, str(ROBOTS / robot), "--json"],
+                                   capture_output=True, text=True, env=env, timeout=120)
+                assert p.returncode == 0, p.stderr
+                outs.add(p.stdout)
+            assert len(outs) == 1, (robot, command)

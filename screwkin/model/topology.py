@@ -401,7 +401,7 @@ def build_topology(mech, q) -> Topology:
                     run.add(other)
                     stack.append(other)
         ends = []
-        for r in run:
+        for r in sorted(run, key=lambda r: body_name[r]):  # not set order: the same output whatever the hash seed
             for k in incident[r]:
                 other = edges[k].b if edges[k].a == r else edges[k].a
                 if other not in run:
@@ -471,7 +471,7 @@ def build_topology(mech, q) -> Topology:
     joints += compounds
     links = tuple(body_name[r] for r in groups if r not in dummies)
     members = {body_name[r]: tuple(groups[r]) for r in groups if r not in dummies}
-    dummy_links = tuple(m for r in dummies for m in groups[r])
+    dummy_links = tuple(m for r in sorted(dummies, key=lambda r: body_name[r]) for m in groups[r])
     space, detail, normal = _motion_space(joints, tol, scale)
     cut_welds = tuple(name for _, _, name in welds if name is not None)
     return Topology(links, members, body_name[ground_root], tuple(joints), space, detail, dummy_links, cut_welds,
