@@ -49,3 +49,36 @@ def test_output_is_the_same_whatever_the_hash_seed():
                 assert p.returncode == 0, p.stderr
                 outs.add(p.stdout)
             assert len(outs) == 1, (robot, command)
+
+
+def test_mode_k_is_chosen_and_said(tmp_path, capsys):
+    """--mode K on the commands that analyse one configuration; with several modes the text says which one
+    (stderr) and the JSON has mode {index, of}. The crank-rocker at a 90 deg crank: the rocker's absolute angle
+    in each mode by the law of cosines (crank 0.04, coupler 0.12, rocker 0.08, ground 0.1)."""
+    import json
+
+    import numpy as np
+
+    from screwkin.cli import main
+
+    a, b, c, d = 0.04, 0.12, 0.08, 0.1
+    A, D = np.array([0.0, a]), np.array([d, 0.0])  # crank at 90 deg (the file draws it at 60 deg)
+    z = np.linalg.norm(A - D)
+    towards = np.arctan2(*(A - D)[::-1])
+    gamma = np.arccos((c * c + z * z - b * b) / (2 * c * z))
+    expected = {round(float(np.degrees(np.mod(t + np.pi, 2 * np.pi) - np.pi)), 6) for t in (towards - gamma,
+                                                                                           towards + gamma)}
+    seen = set()
+    for k in (1, 2):
+        argv = ["draw", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", "crank_joint=30deg", "--mode", str(k),
+                "--svg", str(tmp_path / f"m{k}.svg"), "--json"]
+        assert main(argv) == 0
+        out = json.loads(capsys.readouterr().out)
+        assert out["mode"] == {"index": k, "of": 2}
+        seen.add(round(float(np.degrees(out["link_angles"]["4"])), 6))  # link 4: the rocker (ground 1)
+    assert seen == expected
+    assert main(["singularities", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", "crank_joint=30deg"]) == 0
+    assert "note: assembly mode 1 of 2 (others: --mode 2, or --near)" in capsys.readouterr().err
+    assert main(["singularities", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", "crank_joint=30deg",
+                 "--mode", "3"]) == 2
+    assert "give 2 assembly modes" in capsys.readouterr().err

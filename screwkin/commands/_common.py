@@ -17,7 +17,7 @@ from ..model.state import value_for_leg_length
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind"]
 
 
@@ -125,6 +125,8 @@ def add_configuration_options(sp):
     add_angle_option(sp)
     add_length_option(sp)
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    sp.add_argument("--mode", type=count("mode"), metavar="K",
+                    help="the K-th assembly mode of the --set inputs (as solve lists them; default 1)")
 
 
 def inputs(mech, args) -> dict:
@@ -154,14 +156,37 @@ def inputs(mech, args) -> dict:
 
 
 def configuration(mech, args):
-    """The configuration a command analyses: solved for --set values, else the assembled file one."""
-
+    """The configuration a command analyses: solved for --set values (the assembly mode --mode K, else the
+    first: the one nearest the file's or --near's), else the assembled file one.  When there are several
+    modes, a line on stderr says which one is analysed and how to get the others, and ``args.mode_chosen``
+    holds {"index": K, "of": N} for the JSON (commands add it as "mode")."""
     values = inputs(mech, args)
     near = joint_assignments(mech, [args.near], "--near") if getattr(args, "near", None) else None
+    wanted = getattr(args, "mode", None)
+    args.mode_chosen = None
     if not values:
+        if wanted not in (None, 1):
+            raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
+                             "choose among the modes of those inputs")
         return mech.generic_configurations()[0].q
     res = PositionSolver(mech, list(values)).solve(values, near=near)
-    return res.solutions[0].q
+    n = len(res.solutions)
+    k = wanted or 1
+    if k > n:
+        raise UsageError(f"--mode {k}: these inputs give {n} assembly mode{'s' if n != 1 else ''}")
+    if n > 1:
+        args.mode_chosen = {"index": k, "of": n}
+        others = ", ".join(f"--mode {j}" for j in range(1, n + 1) if j != k)
+        if not getattr(args, "json", False):
+            print(f"note: assembly mode {k} of {n} (others: {others}, or --near)", file=sys.stderr)
+    return res.solutions[k - 1].q
+
+
+def with_mode(args, d: dict) -> dict:
+    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes."""
+    if getattr(args, "mode_chosen", None):
+        d["mode"] = args.mode_chosen
+    return d
 
 
 def names_list(text):

@@ -46,6 +46,7 @@ BOUNDS = {
     "links": (2, 12),                 # synthesize chains --links
     "dof": (0, 10),                   # synthesize chains --dof
     "seed": (0, 2**32 - 1),           # random seeds (numpy's range)
+    "mode": (1, 1_000),               # --mode K: an assembly mode
     "workers": (0, 64),               # study --workers: processes of the local cluster
     "workspace_samples": (1, 5_000_000),  # workspace --method sampling --samples
 }

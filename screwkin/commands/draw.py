@@ -31,6 +31,7 @@ from ._common import (
     configuration,
     inputs,
     named_points,
+    with_mode,
 )
 from ._options import count
 
@@ -177,7 +178,7 @@ def run(mech, args) -> int:
                                  traces={n: xy for n, (xy, _) in traces.items()})
             save_figure(fig, path)
             written.append(path)
-        report = skeleton_dict(skel)
+        report = with_mode(args, skeleton_dict(skel))
         if traces:
             report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
     if args.json:

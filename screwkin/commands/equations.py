@@ -21,7 +21,7 @@ from ..present.equations import (
 )
 from ..present.report import position_dict, position_text, to_jsonable
 from ..units import UNITS, parse_typed_assignments
-from ._common import add_configuration_options, configuration, inputs
+from ._common import add_configuration_options, configuration, inputs, with_mode
 
 NAME = "equations"
 NEEDS_MECHANISM = True
@@ -52,7 +52,7 @@ def run(mech, args) -> int:
     q = configuration(mech, args)
     res = equations(mech, q, names, output=args.output)
     if args.json:
-        print(json.dumps(to_jsonable(equations_dict(res)), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
     else:
         print(equations_text(res))
     return 0

@@ -16,6 +16,7 @@ from ..present.report import (
 from ._common import (
     add_configuration_options,
     configuration,
+    with_mode,
 )
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -42,8 +43,8 @@ def run(mech, args) -> int:
         normal = topo.normal
     loops = loop_screws(mech)
     if args.json:
-        print(json.dumps(to_jsonable({"motion_space": topo.motion_space, "chains": screws_dict(st, normal),
-                                      "loops": loops_dict(loops, normal)}), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, {"motion_space": topo.motion_space, "chains": screws_dict(st, normal),
+                                      "loops": loops_dict(loops, normal)})), indent=2))
     else:
         print(screws_text(st, normal))
         if loops:

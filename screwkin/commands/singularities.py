@@ -19,6 +19,7 @@ from ._common import (
     add_configuration_options,
     configuration,
     inputs,
+    with_mode,
 )
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -55,7 +56,7 @@ def run(mech, args) -> int:
             d["ellipsoids"] = ellipsoids_dict(ell)
         if gram is not None:
             d["gram_symbolic"] = gram_symbolic_dict(gram)
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
     else:
         print(singularity_text(rep))
         if ell is not None:

@@ -10,7 +10,7 @@ from ..errors import UsageError
 from ..present.report import to_jsonable
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
-from ._common import add_configuration_options, configuration
+from ._common import add_configuration_options, configuration, with_mode
 
 NAME = "statics"
 NEEDS_MECHANISM = True
@@ -39,7 +39,7 @@ def run(mech, args) -> int:
     result = statics(mech, q, output=args.output, wrench=wrench, gravity=args.gravity)
     leg_list = legs(mech, q, args.output) if args.output is not None and mech.cuts else None
     if args.json:
-        print(json.dumps(to_jsonable(statics_dict(result, leg_list)), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, statics_dict(result, leg_list))), indent=2))
     else:
         print(statics_text(result, leg_list))
     return 0
