@@ -171,3 +171,12 @@ def test_talos_has_no_phantom_gripper_dofs():
     assert mimics == 12 == len(r.topology.couplings)
     assert r.mobility == mech.nv == plain.nv - mimics == 32
     assert len(r.actuated) == 32 and r.classification.startswith("constrained")
+
+
+@pytest.mark.skipif(ROBOT_DATA is None, reason="example-robot-data is not installed (pip install example-robot-data)")
+def test_meshes_of_pip_installed_description_packages_are_found(tmp_path):
+    """issue 24 item 9: the Panda's package://example-robot-data/robots/... meshes are found where pip put them
+    (cmeel.prefix/share), without --package-dir: no 'mesh file(s) not found' warning."""
+    seen = []
+    screwkin.load(str(ROBOT_DATA / "panda_description" / "urdf" / "panda.urdf"), warn=seen.append)
+    assert not any("not found" in w for w in seen), seen[:1]

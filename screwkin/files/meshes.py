@@ -16,6 +16,7 @@ hostile file cannot get another file's bytes into a ``view --html`` page).
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 from ..errors import quote, shorten
@@ -32,10 +33,25 @@ def _is_file(p: Path) -> bool:
         return False
 
 
+def installed_package_roots() -> list:
+    """Folders where pip-installed description packages keep their ROS packages: ``cmeel.prefix/share``
+    beside the installed Python packages (example-robot-data: ``package://example-robot-data/robots/...``)."""
+    out = []
+    for entry in sys.path:
+        share = Path(entry or ".") / "cmeel.prefix" / "share"
+        try:
+            if share.is_dir() and share not in out:
+                out.append(share)
+        except OSError:
+            continue
+    return out
+
+
 def _roots(base: Path, package_dirs=()) -> list:
     roots = [Path(d) for d in package_dirs or ()]
     roots += [base, *list(base.parents)[:2]]
     roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    roots += installed_package_roots()
     out = []
     for r in roots:
         if r not in out:
@@ -84,6 +100,7 @@ def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool
     candidate also inside that package's folder (``package://NAME/../x`` does not leave it)."""
     folders = [base, *(package_dirs or ())]
     folders += [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    folders += installed_package_roots()
     if uri.startswith("package://"):
         package = uri[len("package://"):].partition("/")[0]
         # the package's own folder: cand is root/NAME/inside or root/inside (both written so)
