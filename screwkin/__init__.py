@@ -18,11 +18,11 @@ from .analysis.mobility import (
     OutputMotion,
     analyze_mobility,
 )
+from .analysis.ik import inverse_kinematics
 from .analysis.position import (
     PositionResult,
     PositionSolver,
     Solution,
-    inverse_kinematics,
 )
 from .analysis.scan import ScanResult, scan
 from .analysis.singular import SingularityReport, classify

@@ -367,7 +367,7 @@ def test_3rpr_inverse_kinematics_labels_reversed_legs():
     mech = screwkin.load(DATA.parent.parent / "robots" / "planar_3rpr.urdf")
     home = mech.model.createData()
     pin.framesForwardKinematics(mech.model, home, mech.neutral())
-    from screwkin.analysis.position import inverse_kinematics
+    from screwkin.analysis.ik import inverse_kinematics
 
     res = inverse_kinematics(mech, "platform", home.oMf[mech.link_frame("platform")])
     first = res.solutions[0]

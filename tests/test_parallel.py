@@ -15,7 +15,8 @@ from scipy.optimize import brentq
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.position import PositionSolver, inverse_kinematics
+from screwkin.analysis.ik import inverse_kinematics
+from screwkin.analysis.position import PositionSolver
 from screwkin.analysis.screws import split_jacobians
 from screwkin.analysis.singular import classify
 from screwkin.analysis.sweep import sweep

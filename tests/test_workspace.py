@@ -18,7 +18,7 @@ from conftest import ROBOTS, screwkin_cli
 
 import screwkin
 from screwkin.analysis.batch import BatchClosure
-from screwkin.analysis.position import inverse_kinematics
+from screwkin.analysis.ik import inverse_kinematics
 from screwkin.analysis.workspace import workspace
 from screwkin.errors import UsageError
 

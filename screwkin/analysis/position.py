@@ -34,15 +34,16 @@ import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
 from ..model._pin import frame_jacobian
-from ..model.closure import Assembly, ClosureSystem, CutJoint
+from ..model.closure import Assembly
 from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, angular_loop_joints
 from .mobility import analyze_mobility
 from .motion import link_motions, point_motions
+from .turns import engaged, turn_on, whole_turns
 from .planar import LinkAngles, identify
 from .singular import Generic, measures, scaled_jacobians
 
-__all__ = ["within_limits", "Solution", "PositionResult", "PositionSolver", "TraceStep", "inverse_kinematics", "outside_limits"]
+__all__ = ["within_limits", "Solution", "PositionResult", "PositionSolver", "TraceStep", "outside_limits"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -122,14 +123,6 @@ class Solution:
     def output_rpy(self):
         """Roll, pitch, yaw [rad] of the output frame (URDF convention: R = Rz(yaw) Ry(pitch) Rx(roll))."""
         return None if self.output_pose is None else pin.rpy.matrixToRpy(self.output_pose[:3, :3])
-
-
-def _axis(joint) -> np.ndarray:
-    short = joint.shortname()
-    for tail, axis in (("X", (1.0, 0, 0)), ("Y", (0, 1.0, 0)), ("Z", (0, 0, 1.0))):
-        if short.endswith(("R" + tail, "RUB" + tail)):
-            return np.array(axis)
-    return np.asarray(joint.extract().axis, float)
 
 
 @dataclass(frozen=True)
@@ -300,47 +293,6 @@ class PositionSolver:
                                  f"{name}[q0] ... {name}[q{c.nq - 1}]")
         return pin.normalize(self.model, q) if multi else q
 
-    def _whole_turns(self, values) -> dict:
-        """Input name -> the whole turns [rad] of a revolute input's typed value, when the mechanism has
-        higher pairs whose coupling rows count turns (screws, gears): 720deg is not 0 there."""
-        if not self.mech.counted_turns:
-            return {}
-        out = {}
-        for name, v in values.items():
-            c = next((c for c in self.mech.coordinates if c.joint == name and c.nq == 1), None)
-            if c is not None and self.model.joints[c.joint_id].shortname().startswith("JointModelR"):
-                w = float(v - (np.mod(v + np.pi, 2 * np.pi) - np.pi))
-                if abs(w) > 0:
-                    out[name] = w
-        return out
-
-    def _engaged(self, found, values):
-        """The solutions whose counted angles (a screw's turn, a gear's roll) continue the assembled
-        configuration's: each predicted from there by the loops' rates (linear for screws and gears) and
-        kept when within half a turn of it; the others differ by whole turns of a thread or a tooth
-        that no motion from the file's configuration reaches."""
-        try:
-            ref = self.mech.assemble().q
-        except AssemblyError:
-            return found
-        dv = {n: float(values[n]) - float(self.mech.joint_values(ref).get(n, 0.0)) for n in self.inputs}
-        qd = self.rates(ref, self.mech.closure.jacobian(ref), dv)
-        counted = sorted(self.mech.counted_turns)
-        vidx = [next(c.idx_v for c in self.mech.coordinates if c.idx_q == t) for t in counted]
-        pred = np.array([ref[t] for t in counted]) + qd[vidx]
-        off = [float(np.max(np.abs(np.array([q[t] for t in counted]) - pred))) for _, q, _ in found]
-        kept = [f for f, d in zip(found, off) if d < np.pi]
-        return kept or [found[int(np.argmin(off))]]
-
-    def _turn_on(self, q, whole: dict, typed: dict):
-        """(q, assembly) of the solution ``q`` found within a turn, turned on by the inputs' whole turns:
-        the loops' rates per unit input move every joint and every counted angle linearly (exactly, for
-        gears and screws), then Newton closes at the typed inputs."""
-        K = self.mech.closure.jacobian(q)
-        qd = self.rates(q, K, {n: whole.get(n, 0.0) for n in self.inputs})
-        a = self.mech.closure.solve(self.set_inputs(pin.integrate(self.model, q, qd), typed), frozen=self.frozen)
-        return a.q, Assembly(a.q, a.residual, a.iterations)
-
     def joint_values(self, q) -> dict:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
@@ -398,7 +350,7 @@ class PositionSolver:
         objects whose position (and velocity, acceleration with ``rates``) each solution reports."""
         mech = self.mech
         self._check_inputs(values)
-        typed, whole = dict(values), self._whole_turns(values)
+        typed, whole = dict(values), whole_turns(self, values)
         values = {n: v - whole.get(n, 0.0) for n, v in values.items()}  # solved within a turn, then turned on
         steps = []
         recorder = (lambda it, q, r, K, dq, ok: steps.append(
@@ -422,9 +374,9 @@ class PositionSolver:
                                 detail=f"the inputs {self._describe(values)} cannot be reached from "
                                        f"{len(start_list)} starting configurations")
         if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
-            found = self._engaged(found, values)
+            found = engaged(self, found, values)
         if whole:
-            found = [(k, *self._turn_on(q, whole, typed)) for k, q, _ in found]
+            found = [(k, *turn_on(self, q, whole, typed)) for k, q, _ in found]
         self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
         sols = [self._solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
         sols = self._merge(sols)
@@ -717,53 +669,3 @@ class PositionSolver:
             solve = solve or self.passive_solver(K)[0]
             qdd[self.passive] = solve(-(K[:, self.frozen] @ qdd[self.frozen] + bias))
         return qdd
-
-
-def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0) -> PositionResult:
-    """Joint values (actuated and passive) that place link ``output`` at ``pose``
-    (a pinocchio.SE3 in the world), for every distinct assembly found.
-
-    The target is one more cut joint, a weld between a ground frame at ``pose``
-    and the output link, solved together with the loop closures.  Raises
-    AssemblyError (saying how close it got) when the pose is unreachable.
-    Solutions are labelled and ordered as those of PositionSolver.solve.
-    """
-    model = mech.model
-    out_frame = mech.link_frame(output)
-    fid = mech.target_frame  # created with the model: adding frames later would outgrow existing Data
-    frame = model.frames[fid]
-    frame.placement = pose
-    model.frames[fid] = frame
-    target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
-    # the higher pairs' rows too: without them a gear or cam would be free to slip
-    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.data,
-                           extra=mech.extra_rows)
-    if not mech.coordinates:
-        raise UsageError(f"{mech.path}: the mechanism has no moving joint: nothing to solve for")
-    solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
-    start_list = solver._starts(starts, seed)
-    found, best = solver.distinct(system, start_list)
-    if not found:
-        xyz = ", ".join(f"{x:.6g}" for x in pose.translation)
-        raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
-                            detail=f"the pose of '{output}' at ({xyz}) is unreachable from "
-                                   f"{len(start_list)} starting configurations")
-    solver.generic(hint=found[0][1])
-    ref = solver._reference()
-    ref_sig = solver._signature(ref if ref is not None else found[0][1])
-    needed = mech.nv - solver.idle_dofs
-    sols = []
-    for _, q, a in found:
-        s = np.linalg.svd(system.jacobian(q), compute_uv=False)
-        sigma = float(s[needed - 1] / s[0]) if 0 < needed <= len(s) else 1.0
-        pin.framesForwardKinematics(model, mech.data, q)
-        outside = outside_limits(mech, q)
-        sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
-                             sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
-                             outside_limits=outside, labels=solver._labels(q, outside),
-                             link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None,
-                             leg_lengths=KinematicState(mech, q).leg_lengths or None))
-    sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
-    return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
-                          0, (), output, solver.angular_names(), solver._angular_coupled(),
-                          angular_loop_joints(mech))

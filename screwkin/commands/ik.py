@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pinocchio as pin
 
-from ..analysis.position import inverse_kinematics
+from ..analysis.ik import inverse_kinematics
 from ..errors import UsageError
 from ..present.report import (
     position_dict,
