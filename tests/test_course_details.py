@@ -98,3 +98,25 @@ def test_a_planar_mechanisms_lost_direction_lies_in_its_plane(capsys):
         assert abs(t[2]) < 1e-9 and abs(t[3]) < 1e-9 and abs(t[4]) < 1e-9, tw
     (serial,) = [t for t in d["singular_twists"] if t["kind"] == "serial"]
     assert serial["screw"]["pitch"] == "inf"  # a translation in the plane, not an axis 1e7 m away
+
+
+def test_a_position_inside_the_cranks_range_is_no_limit_defect(tmp_path, capsys):
+    """item 7: the crank of this double rocker stops where coupler and rocker fold (|A B0| = rocker - coupler);
+    by the law of cosines on its pivots that is about 1.2 deg clockwise of position 1, and position 2 sits at
+    1.19 deg clockwise: inside. It was reported beyond a limit (the sweep's last grid value, not the located
+    limit, bounded what it covered); position 3's defects are real and stay."""
+    import numpy as np
+
+    argv = ["synthesize", "motion", "--poses", "0,0,0; 0.04,0.02,20deg; 0.07,0.06,45deg", "--pivots",
+            "-0.03,-0.08; 0.10,-0.06", "-o", str(tmp_path / "syn.urdf"), "--json"]
+    main(argv)
+    d = json.loads(capsys.readouterr().out)
+    p = {k: np.array(v) for k, v in d["pivots"].items()}
+    crank, ground = np.linalg.norm(p["A"] - p["A0"]), np.linalg.norm(p["B0"] - p["A0"])
+    coupler, rocker = np.linalg.norm(p["B"] - p["A"]), np.linalg.norm(p["B"] - p["B0"])
+    at_1 = np.arccos(np.dot(p["A"] - p["A0"], p["B0"] - p["A0"]) / (crank * ground))  # crank from the ground line
+    folded = np.arccos((crank**2 + ground**2 - (rocker - coupler) ** 2) / (2 * crank * ground))
+    room = np.degrees(at_1 - folded)  # how far the crank turns clockwise before the fold
+    assert 1.19015 < room < 1.3
+    assert not any("position 2" in x for x in d["defects"])
+    assert any("position 3" in x for x in d["defects"])

@@ -198,6 +198,8 @@ def _follow(design: Design, solver, probe, configs, steps):
         count = max(int(round(steps * reach / TWO_PI)), 4)
         res = sweep(solver, name, u1, u1 + direction * reach, count, near=near)
         covered = float(np.max(direction * (res.values - u1))) if len(res.values) else 0.0
+        if res.stopped_at is not None:  # up to the located limit position, not only the last grid value before it
+            covered = max(covered, float(direction * (res.stopped_at - u1)))
         return res, covered
 
     if design.span is not None:  # the motion is the input range: both ways from the first position
