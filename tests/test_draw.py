@@ -300,3 +300,25 @@ def test_trace_draws_a_coupler_curve_through_the_solved_point(tmp_path, capsys):
     assert 'id="trace:P"' in svg.read_text()
     assert main(["draw", FOURBAR, "--svg", str(svg), "--trace", "Q"]) == 2
     assert "no --point Q=LINK:x,y,z" in capsys.readouterr().err
+
+
+def test_singular_figures_at_one_input_say_which_mode(tmp_path, capsys, monkeypatch):
+    """issue 25 item 16: two singular configurations at the same input value (two modes of another loop) got
+    the same caption; each now says which of the modes at that input it is."""
+    import dataclasses
+    import json
+
+    import screwkin.commands.draw as draw_command
+
+    real = draw_command.singular_configurations
+
+    def doubled(*args, **kwargs):
+        search = real(*args, **kwargs)
+        return dataclasses.replace(search, found=(search.found[0], search.found[0]) + tuple(search.found[1:]))
+
+    monkeypatch.setattr(draw_command, "singular_configurations", doubled)
+    assert main(["draw", FOURBAR, "--singular", "--png", str(tmp_path / "s.png"), "--json"]) == 0
+    found = json.loads(capsys.readouterr().out)["singular_configurations"]
+    assert "assembly mode 1 of the 2 at this input" in found[0]["title"]
+    assert "assembly mode 2 of the 2 at this input" in found[1]["title"]
+    assert "assembly mode" not in found[2]["title"]

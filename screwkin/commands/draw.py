@@ -147,11 +147,17 @@ def run(mech, args) -> int:
         search = singular_configurations(mech, name, output=args.output, q=q, steps=args.steps,
                                          fixed={k: v for k, v in given.items() if k != name})
         found = []
+        same, seen = {}, {}  # configurations found at one input value: the modes of another loop, said so
+        for s in search.found:
+            same.setdefault(round(float(s.input), 9), []).append(s)
         for k, s in enumerate(search.found, 1):
             skel = skeleton(mech, s.q, [search.input, *search.fixed])
             at = value_label(search.input, _wrapped(s.input, search.unit), search.unit)
-            fig = draw_mechanism(skel, title=_title(mech, f"singular configuration {k} of {len(search.found)} at {at}"),
-                                 angles=args.angles, subtitle=_kind_text(s))
+            key = round(float(s.input), 9)
+            seen[key] = seen.get(key, 0) + 1
+            mode = f", assembly mode {seen[key]} of the {len(same[key])} at this input" if len(same[key]) > 1 else ""
+            title = f"singular configuration {k} of {len(search.found)} at {at}{mode}"
+            fig = draw_mechanism(skel, title=_title(mech, title), angles=args.angles, subtitle=_kind_text(s))
             files = []
             for path in targets:
                 out = _suffixed(path, k)
@@ -160,7 +166,7 @@ def run(mech, args) -> int:
             written += files
             found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
                           "input_wrapped": _wrapped(s.input, search.unit), "sigma": s.sigma, "files": files,
-                          "description": _kind_text(s)})
+                          "description": _kind_text(s), "title": title})
             if not args.json:
                 print(f"{_kind_text(s)} at {at}: wrote {', '.join(files)}")
         report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
