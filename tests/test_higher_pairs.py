@@ -219,7 +219,9 @@ def test_a_screw_counts_turns(typed, theta, capsys):
 
     assert main(["solve", str(ROBOTS / "lead_screw_jack.urdf"), "--set", f"screw_joint={typed}", "--all",
                  "--json"]) == 0
-    (sol,) = json.loads(capsys.readouterr().out)["solutions"]
+    out = json.loads(capsys.readouterr().out)
+    assert out["inputs"]["screw_joint"] == pytest.approx(theta, abs=1e-12)  # the header's input, as typed
+    (sol,) = out["solutions"]
     assert sol["joints"]["lift"] == pytest.approx(-0.005 * theta / (2 * np.pi), abs=1e-9)
     assert sol["joints"]["screw_joint"] == pytest.approx(theta, abs=1e-12)
 

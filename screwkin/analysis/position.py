@@ -387,7 +387,7 @@ class PositionSolver:
                                      float(np.linalg.norm(self._signature(s.q) - ref_sig))))
         if near_q is not None:
             sols = sols[:1]
-        return PositionResult(dict(values), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
+        return PositionResult(dict(typed), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
                               tuple(steps), self.output, self._angular, self._angular_coupled(),
                               angular_loop_joints(self.mech))
 
