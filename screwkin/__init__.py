@@ -12,13 +12,13 @@ topology) <- ``analysis`` (results) <- ``present`` (text, JSON, pictures, views)
 """
 
 from .analysis.batch import SerialJacobians
+from .analysis.ik import inverse_kinematics
 from .analysis.mobility import (
     IdleMotion,
     MobilityResult,
     OutputMotion,
     analyze_mobility,
 )
-from .analysis.ik import inverse_kinematics
 from .analysis.position import (
     PositionResult,
     PositionSolver,

@@ -44,3 +44,12 @@ def frame_id(model, name: str, prefer=FRAME_PREFERENCE):
                     return k
     return matches[0]
 
+
+def joint_axis(joint) -> np.ndarray:
+    """The axis of a one-coordinate revolute or prismatic joint model in its own frame: x, y or z for
+    the aligned models (RX, RUBZ, PY ...), the model's own axis for the unaligned ones."""
+    short = joint.shortname()
+    for tail, axis in (("X", (1.0, 0.0, 0.0)), ("Y", (0.0, 1.0, 0.0)), ("Z", (0.0, 0.0, 1.0))):
+        if short.endswith(("R" + tail, "RUB" + tail, "P" + tail)):
+            return np.array(axis)
+    return np.asarray(joint.extract().axis, float)

@@ -18,6 +18,7 @@ from ..errors import AssemblyError, MechanismFileError, UsageError, quote
 from ..files.description import MechanismSpec, placement, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import frame_id
+from .closability import closure_obstacle
 from .closure import Assembly, ClosureSystem, ContactRow, CouplingRow, CutJoint
 from .linalg import null_space, rank
 from .topology import build_topology
@@ -83,18 +84,6 @@ def characteristic_length(model, cuts) -> float:
     sliding joints by it), so it is dimensionless and the same in every command."""
     lengths = link_lengths(model, cuts)
     return float(np.mean(lengths)) if lengths else 1.0
-
-
-def _revolute_axis(joint) -> np.ndarray:
-    """The axis of a revolute joint model, in its frame (RX, RY, RZ, or the unaligned axis)."""
-    short = joint.shortname()
-    if short.endswith(("RX", "RUBX")):
-        return np.array([1.0, 0.0, 0.0])
-    if short.endswith(("RY", "RUBY")):
-        return np.array([0.0, 1.0, 0.0])
-    if short.endswith(("RZ", "RUBZ")):
-        return np.array([0.0, 0.0, 1.0])
-    return np.asarray(joint.extract().axis, float)
 
 
 class Mechanism:
@@ -509,52 +498,8 @@ class Mechanism:
         raise AssemblyError(self.path, best, best_it, detail=starts, starts=total, reason=self.closure_obstacle())
 
     def closure_obstacle(self) -> str | None:
-        """Why a loop of revolute joints with parallel axes (a four-bar, a planar n-bar) cannot close,
-        in its links' lengths: its longest side is longer than the others together ("ground 0.2 m >
-        crank + coupler + rocker = 0.18 m"); None when no such loop is found too long.  The sides are
-        the distances between consecutive joint axes on each link, fixed by the file."""
-        model, data = self.model, self.model.createData()
-        pin.framesForwardKinematics(model, data, self.neutral())
-        for c in self.cuts:
-            if c.type not in ("revolute", "continuous") or c.pair:
-                continue
-            j1, j2 = (model.frames[f].parentJoint for f in (c.frame1, c.frame2))
-            s1, s2 = list(model.supports[j1]), list(model.supports[j2])
-            common = [j for j in s1 if j in s2]
-            path1 = [j for j in reversed(s1) if j not in common]  # from link1's joint towards the root
-            path2 = [j for j in s2 if j not in common]  # from the root towards link2's joint
-            joints = path1 + path2
-            if not joints or any(not model.joints[j].shortname().startswith("JointModelR") for j in joints):
-                continue
-            axis = data.oMf[c.frame1].rotation @ np.asarray(c.axis, float)
-            axes = [data.oMi[j].rotation @ _revolute_axis(model.joints[j]) for j in joints]
-            if any(np.linalg.norm(np.cross(axis, a)) > self.tolerances.geometry for a in axes):
-                continue  # not planar: no side-length test
-            n = axis / np.linalg.norm(axis)
-
-            def flat(p):
-                return p - (p @ n) * n
-
-            points = [flat(data.oMf[c.frame1].translation)] + [flat(data.oMi[j].translation) for j in joints]
-            points.append(flat(data.oMf[c.frame2].translation))
-            names = [self._link_of_joint(j) for j in path1]
-            ground = self._link_of_joint(common[-1]) if common and common[-1] > 0 else self.spec.root
-            names = names + [ground] + [self._link_of_joint(j) for j in path2]
-            sides = [float(np.linalg.norm(points[k + 1] - points[k])) for k in range(len(points) - 1)]
-            if len(sides) != len(names):
-                continue
-            longest = int(np.argmax(sides))
-            others = sum(sides) - sides[longest]
-            if sides[longest] > others + self.tolerances.geometry:
-                rest = " + ".join(nm for k, nm in enumerate(names) if k != longest)
-                return (f"loop {c.name} cannot close, {names[longest]} {sides[longest]:.6g} m > {rest} = "
-                        f"{others:.6g} m (no side of a closed loop is longer than the others together)")
-        return None
-
-    def _link_of_joint(self, jid: int) -> str:
-        """The link a tree joint carries (its child body's link)."""
-        return next((f.name for f in self.model.frames if f.parentJoint == jid and f.type == pin.FrameType.BODY),
-                    self.model.names[jid])
+        """Why a loop of parallel revolutes cannot close, in its links' lengths (model.closability)."""
+        return closure_obstacle(self)
 
     @property
     def generic_known(self) -> bool:

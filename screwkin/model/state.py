@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError, quote
+from ._pin import joint_axis
 
 __all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints",
            "leg_ends", "value_for_leg_length"]
@@ -92,21 +93,13 @@ def value_for_leg_length(mech, joint: str, length: float) -> float:
     R = data.oMi[parent].rotation
     start, end = (_point_ref(data, r) for r in ends)
     d0 = R.T @ (end - start)
-    u = R.T @ (data.oMi[c.joint_id].rotation @ _prismatic_axis(model.joints[c.joint_id]))
+    u = R.T @ (data.oMi[c.joint_id].rotation @ joint_axis(model.joints[c.joint_id]))
     b = float(d0 @ u)
     disc = b * b - float(d0 @ d0) + length * length
     if disc < 0:
         raise UsageError(f"{mech.path}: leg {quote(joint)} cannot be {length:.6g} m long: its ends stay "
                          f"{np.sqrt(float(d0 @ d0) - b * b):.6g} m apart across its axis")
     return -b + float(np.sqrt(disc))
-
-
-def _prismatic_axis(joint) -> np.ndarray:
-    short = joint.shortname()
-    for tail, axis in (("X", (1.0, 0, 0)), ("Y", (0, 1.0, 0)), ("Z", (0, 0, 1.0))):
-        if short.endswith("P" + tail):
-            return np.array(axis)
-    return np.asarray(joint.extract().axis, float)
 
 
 class PointMotion:
