@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import socket
 import threading
-import time
 
 import pytest
 
@@ -27,13 +26,14 @@ class Peer:
         self.sock.listen(8)
         self.sock.settimeout(0.2)
         self.port = self.sock.getsockname()[1]
-        self.stop = time.time() + 30
+        self.rounds = 150  # accept() waits 0.2 s a round: the server ends by itself after at most 30 s
         self.thread = threading.Thread(target=self._serve, daemon=True)
         self.thread.start()
 
     def _serve(self):
         held = []
-        while time.time() < self.stop:
+        while self.rounds > 0:
+            self.rounds -= 1
             try:
                 conn, _ = self.sock.accept()
             except (socket.timeout, OSError):
@@ -48,7 +48,7 @@ class Peer:
             c.close()
 
     def close(self):
-        self.stop = 0
+        self.rounds = 0
         self.thread.join(timeout=5)
         self.sock.close()
 
