@@ -110,8 +110,6 @@ def main(argv=None) -> int:
     (before or after the command) prints the traceback first, with the same exit code.
     """
 
-
-
     def say(line):
         try:
             print(line, file=sys.stderr)

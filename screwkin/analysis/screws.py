@@ -22,10 +22,11 @@ import pinocchio as pin
 
 from ..errors import UsageError
 from ..model._pin import frame_jacobian
+from ..model.closure import perpendicular_basis
 from ..model.linalg import null_space
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
-           "loop_product", "split_jacobians"]
+           "loop_product", "split_jacobians", "cut_twists"]
 
 
 @dataclass(frozen=True)
@@ -153,17 +154,42 @@ class LoopScrews:
     closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
 
 
-def _cut_twist(mech, c, data) -> np.ndarray | None:
-    """The cut joint's space twist at the configuration in ``data``: (-w x p, w) for a revolute
-    about the axis through F1's origin, (v, 0) for a prismatic along it; None for other types."""
-    M = data.oMf[c.frame1]
-    a = M.rotation @ np.asarray(c.axis, float)
-    a = a / np.linalg.norm(a)
-    if c.type in ("revolute", "continuous"):
-        return np.concatenate([-np.cross(a, M.translation), a])
-    if c.type == "prismatic":
-        return np.concatenate([a, np.zeros(3)])
-    return None
+def cut_twists(mech, cut, data):
+    """The cut joint's freedoms as world twists (v at the world origin, w): [(name, twist, sliding)],
+    or None for a higher pair (its loop closes through an equivalent linkage and coupling rows)."""
+    if cut.pair is not None:
+        return None
+    M1 = data.oMf[cut.frame1]
+    a = M1.rotation @ (np.asarray(cut.axis, float) / np.linalg.norm(cut.axis))
+    p = M1.translation
+
+    def rot(u):
+        return np.concatenate([-np.cross(u, p), u]), False
+
+    def slide(u):
+        return np.concatenate([u, np.zeros(3)]), True
+
+    if cut.type in ("revolute", "continuous"):
+        out = [rot(a)]
+    elif cut.type == "prismatic":
+        out = [slide(a)]
+    elif cut.type == "cylindrical":
+        out = [rot(a), slide(a)]
+    elif cut.type == "universal":
+        a2 = data.oMf[cut.frame2].rotation @ np.asarray(cut.axis2, float)
+        out = [rot(a), rot(a2 / np.linalg.norm(a2))]
+    elif cut.type == "spherical":
+        out = [rot(e) for e in np.eye(3)]
+    elif cut.type == "planar":
+        b1, b2 = perpendicular_basis(a)
+        out = [slide(b1), slide(b2), rot(a)]
+    elif cut.type == "fixed":
+        out = []
+    else:  # pragma: no cover - every lower-pair cut joint type is above
+        return None
+    if len(out) == 1:
+        return [(cut.name, *out[0])]
+    return [(f"{cut.name}[{k}]", *t) for k, t in enumerate(out)]
 
 
 def loop_screws(mech) -> list:
@@ -176,9 +202,10 @@ def loop_screws(mech) -> list:
     for c in mech.cuts:
         if c.pair or c.dof != 1:
             continue
-        xi_c = _cut_twist(mech, c, data)
-        if xi_c is None:
+        twists = cut_twists(mech, c, data)  # [(name, twist, sliding)] of the cut joint's freedoms
+        if not twists or len(twists) != 1:
             continue
+        xi_c = twists[0][1]
         sides = []
         for f in (c.frame1, c.frame2):
             jid = model.frames[f].parentJoint

@@ -31,10 +31,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..model._pin import frame_jacobian
-from ..model.closure import perpendicular_basis
 from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, loop_coordinate_cuts
-from .screws import screw_of
+from .screws import cut_twists, screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
            "KINDS", "GramLoop", "loop_twists", "gram_cofactors"]
@@ -266,44 +265,6 @@ class GramLoop:
 STATIONARY = 1e-7  # |v_i| below this: joint i's rate is zero (the threshold of stationary_joints too)
 
 
-def _cut_twists(mech, cut, data):
-    """The cut joint's freedoms as world twists (v at the world origin, w): [(name, twist, sliding)],
-    or None for a higher pair (its loop closes through an equivalent linkage and coupling rows)."""
-    if cut.pair is not None:
-        return None
-    M1 = data.oMf[cut.frame1]
-    a = M1.rotation @ (np.asarray(cut.axis, float) / np.linalg.norm(cut.axis))
-    p = M1.translation
-
-    def rot(u):
-        return np.concatenate([-np.cross(u, p), u]), False
-
-    def slide(u):
-        return np.concatenate([u, np.zeros(3)]), True
-
-    if cut.type in ("revolute", "continuous"):
-        out = [rot(a)]
-    elif cut.type == "prismatic":
-        out = [slide(a)]
-    elif cut.type == "cylindrical":
-        out = [rot(a), slide(a)]
-    elif cut.type == "universal":
-        a2 = data.oMf[cut.frame2].rotation @ np.asarray(cut.axis2, float)
-        out = [rot(a), rot(a2 / np.linalg.norm(a2))]
-    elif cut.type == "spherical":
-        out = [rot(e) for e in np.eye(3)]
-    elif cut.type == "planar":
-        b1, b2 = perpendicular_basis(a)
-        out = [slide(b1), slide(b2), rot(a)]
-    elif cut.type == "fixed":
-        out = []
-    else:  # pragma: no cover - every lower-pair cut joint type is above
-        return None
-    if len(out) == 1:
-        return [(cut.name, *out[0])]
-    return [(f"{cut.name}[{k}]", *t) for k, t in enumerate(out)]
-
-
 def loop_twists(mech, q, cut, length=None):
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
@@ -327,7 +288,7 @@ def loop_twists(mech, q, cut, length=None):
             names.append(coord_names[k])
             cols.append(J1[:, k] if on1 else -J2[:, k])
             slide.append(bool(mech.translational[k]))
-    extra = _cut_twists(mech, cut, data)
+    extra = cut_twists(mech, cut, data)
     if extra is None:
         return names, None, f"the loop closes through the {cut.pair} pair's equivalent linkage: not computed"
     for name, t, sl in extra:

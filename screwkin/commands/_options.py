@@ -23,6 +23,7 @@ from ..errors import UsageError, quote
 
 __all__ = ["screwkin_version", "check_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
 
+
 def screwkin_version() -> str:
     """The version of screwkin installed (the package's metadata, as pip shows it)."""
     try:
