@@ -194,7 +194,8 @@ def cut_twists(mech, cut, data):
 
 def loop_screws(mech) -> list:
     """A LoopScrews for each one-coordinate cut joint (revolute, continuous, prismatic; no higher pair)."""
-    model, data = mech.model, model_data(mech)
+    model = mech.model
+    data = model.createData()  # a Data of its own: nothing left in, or read from, mech.data
     q0 = mech.neutral()
     pin.computeJointJacobians(model, data, q0)
     pin.updateFramePlacements(model, data)
@@ -231,11 +232,6 @@ def loop_product(loop: LoopScrews, theta) -> np.ndarray:
     for k in range(len(loop.joints)):
         M = M * pin.exp6(pin.Motion(loop.signs[k] * loop.xi0[:, k] * theta[k]))
     return M.homogeneous
-
-
-def model_data(mech):
-    """A Data of its own for an analysis (nothing left in, or read from, the mechanism's shared Data)."""
-    return mech.model.createData()
 
 
 def planar_form(xi, normal):
