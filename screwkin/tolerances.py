@@ -29,6 +29,11 @@ class Tolerances:
     motion:         relative size below which a twist counts as no motion, next to
                     the largest twist of the same analysis [-].
     max_iterations: iteration limit of the closure solver [-].
+    lm_damping:     initial damping of the damped-Newton (Levenberg-Marquardt) step, relative to
+                    the mean squared row norm of the Jacobian (model/newton.py): small, so that
+                    Newton converges quadratically from a good start [-].
+    lm_damping_min: the damping is never lowered below this by accepted steps [-].
+    lm_damping_max: a solver whose damping grows past this (every step refused) gives up [-].
     assembly_starts: starting configurations the assembly search tries in all when the
                     file's configuration does not close the loops: ``perturbations``
                     random perturbations of it, then random configurations within the
@@ -50,6 +55,9 @@ class Tolerances:
     motion: float = 1e-6
     singular: float = 1e-4
     max_iterations: int = 200
+    lm_damping: float = 1e-9
+    lm_damping_min: float = 1e-12
+    lm_damping_max: float = 1e10
     assembly_starts: int = 48
     perturbations: int = 8
     generic_starts: int = 4

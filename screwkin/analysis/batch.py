@@ -8,9 +8,10 @@ Two ways to the Jacobians of a stack of configurations:
   chain from the ground to a frame (screws.chains: joint twists and the home
   placement read from Pinocchio), evaluated for thousands of configurations per
   numpy call.  Python pays its overhead once per joint per block of
-  configurations instead of once per configuration.  It is checked against
-  Pinocchio's Jacobians at random configurations when it is built, and refuses
-  chains it cannot represent (joints with more than one DOF, helical joints).
+  configurations instead of once per configuration.  Its Jacobians equal
+  Pinocchio's (tests/test_batch.py; ``check=N`` compares them again when it is
+  built), and it refuses chains it cannot represent (joints with more than one
+  DOF, helical joints).
 
 The measures (singular values, determinants) are one numpy call on the whole stack.
 """
@@ -24,7 +25,9 @@ import pinocchio as pin
 
 from ..errors import UsageError
 from ..model._pin import compute_frame_jacobian
+from ..model import newton
 from ..model.closure import ClosureSystem, CouplingRow, CutJoint
+from ..model.newton import damped_steps  # noqa: F401 - the batched step, exported here as before
 from .screws import chains
 
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
@@ -58,7 +61,7 @@ class SerialJacobians:
     """
 
     def __init__(self, mech, link: str | None, reference=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
-                 check: int = 4, chain=None):
+                 check: int = 0, chain=None):
         """chain: a screws.Chain to any frame instead of the one to ``link``'s body frame."""
 
         if reference not in _REFERENCES:
@@ -367,8 +370,8 @@ class TreeKinematics:
     joint's placement once: Pinocchio's forwardKinematics written for N configurations).  Each
     joint costs one matrix product of its parent's N rotations with a constant 3 x 11 matrix
     (Rodrigues' formula split into constant parts, the placement's translation and the axis)
-    and a few elementwise operations.  Joint axes and placements are Pinocchio's; BatchClosure
-    checks the rows built on them against Pinocchio's."""
+    and a few elementwise operations.  Joint axes and placements are Pinocchio's; the rows
+    BatchClosure builds on them equal ClosureSystem's (tests/test_newton.py)."""
 
     _AXES = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1),
              "JointModelPX": (1, 0, 0), "JointModelPY": (0, 1, 0), "JointModelPZ": (0, 0, 1)}
@@ -484,9 +487,10 @@ class BatchClosure:
     instead of one Pinocchio pass and one linear solve per configuration.
 
     Frame placements and Jacobians come from the product-of-exponentials structure equations
-    of the chains from the ground to each cut-joint frame (SerialJacobians); the rows are
-    checked against ClosureSystem.evaluate, at random configurations for the solver's rows and
-    at the mechanism's closed ones for the constraint Jacobian, when the object is built.
+    of the chains from the ground to each cut-joint frame (SerialJacobians).  The rows equal
+    ClosureSystem.evaluate's (tests/test_newton.py compares them on every batchable robot);
+    ``check=N`` compares them again at N random configurations when the object is built (a
+    debugging aid: the program does not check at run time).
 
     target: None, or (link, "pose" | "point"): one more cut joint, a weld ("pose") or a ball
     joint ("point") between the output link and a ground frame whose placement is given per
@@ -496,7 +500,7 @@ class BatchClosure:
     Raises Unbatchable for what it does not represent.
     """
 
-    def __init__(self, mech, target=None, check: int = 3):
+    def __init__(self, mech, target=None, check: int = 0):
         model = mech.model
         self.mech, self.model = mech, model
         if model.nq != model.nv:
@@ -665,7 +669,7 @@ class BatchClosure:
         tgt = targets
         r, K = self.evaluate(Q, tgt)
         norm = np.linalg.norm(r, axis=1)
-        mu, nu = np.full(N, 1e-9), np.full(N, 2.0)
+        mu, nu = np.full(N, tol.lm_damping), np.full(N, newton.NU)
         active = norm >= tol.closure
         for _ in range(max_it):
             idx = np.flatnonzero(active)
@@ -674,26 +678,20 @@ class BatchClosure:
             its[idx] += 1
             Kf = K[idx][:, :, free]
             ri = r[idx]
-            dqf, lin2 = damped_steps(Kf, ri, mu[idx])
+            dqf, lin2 = newton.damped_steps(Kf, ri, mu[idx])
             Qn = Q[idx].copy()
             Qn[:, free] += dqf
             sub = None if tgt is None else (tgt[0][idx], tgt[1])
             rn, Kn = self.evaluate(Qn, sub)
             nn = np.linalg.norm(rn, axis=1)
             ok = nn < norm[idx]
-            # Nielsen's damping update from the gain ratio (actual / predicted decrease)
-            n0 = norm[idx]
-            predicted = n0**2 - lin2
-            with np.errstate(divide="ignore", invalid="ignore"):
-                rho = np.where(predicted > 0, (n0**2 - nn**2) / predicted, 0.0)
+            rho = newton.gain_ratio(norm[idx], nn, lin2)
             a = idx[ok]
-            mu[a] = np.maximum(mu[a] * np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho[ok] - 1.0) ** 3), 1e-12)
-            nu[a] = 2.0
+            mu[a], nu[a] = newton.accept(mu[a], rho[ok], tol)
             Q[a], r[a], K[a], norm[a] = Qn[ok], rn[ok], Kn[ok], nn[ok]
             b = idx[~ok]
-            mu[b] *= nu[b]
-            nu[b] *= 2.0
-            active[idx] = (norm[idx] >= tol.closure) & (mu[idx] <= 1e10)
+            mu[b], nu[b] = newton.refuse(mu[b], nu[b])
+            active[idx] = (norm[idx] >= tol.closure) & ~newton.given_up(mu[idx], tol)
         converged = norm < tol.closure
         if converged.any():
             c = np.flatnonzero(converged)
@@ -755,26 +753,6 @@ def _cross_columns(a, W) -> np.ndarray:
     """a x w for every column w of W: a (N, 3), W (N, 3, n) -> (N, 3, n)."""
     a0, a1, a2 = a[:, 0, None], a[:, 1, None], a[:, 2, None]
     return np.stack([a1 * W[:, 2] - a2 * W[:, 1], a2 * W[:, 0] - a0 * W[:, 2], a0 * W[:, 1] - a1 * W[:, 0]], axis=1)
-
-
-def damped_steps(Kf, r, mu):
-    """model.closure._damped_step for a stack: Kf (N, m, n), r (N, m), mu (N,) ->
-    (steps (N, n), squared residuals of the linear model (N,))."""
-    N, m, n = Kf.shape
-    tall = m > n
-    Kt = Kf.transpose(0, 2, 1)
-    A = Kt @ Kf if tall else Kf @ Kt
-    size = A.shape[1]
-    trace = np.trace(A, axis1=1, axis2=2)
-    A[:, np.arange(size), np.arange(size)] += (mu * np.maximum(trace / m, 1e-12))[:, None]
-    b = (Kt @ r[:, :, None])[:, :, 0] if tall else r
-    try:
-        y = np.linalg.solve(A, b[:, :, None])[:, :, 0]
-    except np.linalg.LinAlgError:  # one of them singular in floating point: least squares for all
-        y = np.stack([np.linalg.lstsq(Ai, bi, rcond=None)[0] for Ai, bi in zip(A, b)])
-    dq = -y if tall else -(Kt @ y[:, :, None])[:, :, 0]
-    lin = r + (Kf @ dq[:, :, None])[:, :, 0]
-    return dq, np.einsum("ni,ni->n", lin, lin)
 
 
 def _log3(R) -> np.ndarray:

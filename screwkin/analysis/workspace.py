@@ -255,7 +255,7 @@ class _Grid:
         r0, K = self.closure.evaluate(Q, (P_to, self.R))
         r1 = self.closure.evaluate(Q, (P_from, self.R), jacobian=False)[0]
         dr = r0 - r1  # the rows' change from moving the target alone
-        return Q + damped_steps(K, dr, np.full(len(Q), 1e-9))[0], K
+        return Q + damped_steps(K, dr, np.full(len(Q), self.mech.tolerances.lm_damping))[0], K
 
     def _scaled(self, K):
         """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L."""
@@ -565,7 +565,7 @@ def _index_bounds(bounds, p_seed, axes, h, dim):
 def _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs,
           deadline=None) -> WorkspaceResult:
     try:
-        BatchClosure(mech, target=(output, "point" if point else "pose"), check=3)  # checks the rows once
+        BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
     except Unbatchable as e:
         raise UsageError(f"{e}: the workspace's batched solver does not take these yet") from None
     q_seed, p_seed, R = _seed(mech, output, point, orientation)

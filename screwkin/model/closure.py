@@ -24,7 +24,7 @@ import pinocchio as pin
 
 from ..errors import AssemblyError
 from ..tolerances import DEFAULT, Tolerances
-from . import compiled
+from . import compiled, newton
 from ._pin import frame_jacobian
 
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "ClosureSystem", "Assembly", "perpendicular_basis"]
@@ -77,28 +77,6 @@ def _skews_batch(U, m=None):
     n, _, k = U.shape
     index, sign = _skew_table(k, m)
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
-
-
-def _damped_step(K, r, free, mu):
-    """Minimum-norm damped (Levenberg-Marquardt) step on the free columns of K:
-    dq_f = -K_f^T (K_f K_f^T + lambda I)^-1 r with lambda = mu * trace / rows, and the
-    squared residual of the linear model |r + K_f dq_f|^2.  With more rows than free columns
-    (hundreds of loops) the same step is (K_f^T K_f + lambda I)^-1 K_f^T (-r), a smaller system."""
-    Kf = K[:, free]
-    rows, cols = Kf.shape
-    tall = rows > cols
-    A = Kf.T @ Kf if tall else Kf @ Kf.T
-    diagonal = A.ravel()[:: len(A) + 1]  # a view
-    trace = diagonal.sum()
-    diagonal += mu * max(trace / rows, 1e-12)
-    b = Kf.T @ r if tall else r
-    try:
-        y = np.linalg.solve(A, b)
-    except np.linalg.LinAlgError:  # singular in floating point
-        y = np.linalg.lstsq(A, b, rcond=None)[0]
-    dqf = -y if tall else -(Kf.T @ y)
-    lin = r + Kf @ dqf
-    return dqf, float(lin @ lin)
 
 
 def perpendicular_basis(a):
@@ -272,7 +250,7 @@ class ClosureSystem:
         try:
             return self._compiled[0].damped_step(K, r, free, mu)
         except Exception:  # singular in floating point: the numpy step has the least-squares fallback
-            return _damped_step(K, r, free, mu)
+            return newton.damped_step(K, r, free, mu)
 
     def _kinematics(self, q, jacobian: bool):
         """Pinocchio's pass for q: frame placements, and the joint Jacobians if asked."""
@@ -692,12 +670,12 @@ class ClosureSystem:
         if free is None:
             free = self._free[frozen] = np.setdiff1d(np.arange(model.nv), np.asarray(frozen, int))
         evaluate, step = (self._evaluate_compiled, self._step_compiled) if self._compiled else \
-            (lambda q_, jacobian=True: self.evaluate(q_, jacobian, solver=True), _damped_step)
+            (lambda q_, jacobian=True: self.evaluate(q_, jacobian, solver=True), newton.damped_step)
         r, K = evaluate(q)
         last = q  # the configuration whose placements are in self.data
         norm = float(np.sqrt(r @ r))
         best = norm
-        mu, nu = 1e-9, 2.0
+        mu, nu = tol.lm_damping, newton.NU
         it = 0
         dq = np.zeros(model.nv)
         while it < tol.max_iterations:
@@ -719,17 +697,12 @@ class ClosureSystem:
             if trace is not None:
                 trace(it, q, r, K, dq.copy(), accepted)
             if accepted:
-                # Nielsen's damping update from the gain ratio (actual / predicted decrease)
-                predicted = norm**2 - lin2
-                rho = (norm**2 - n_new**2) / predicted if predicted > 0 else 0.0
-                mu = max(mu * max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), 1e-12)
-                nu = 2.0
+                mu, nu = newton.accept(mu, newton.gain_ratio(norm, n_new, lin2), tol)
                 q, r, K, norm = q_new, r_new, K_new, n_new
                 best = min(best, norm)
             else:
-                mu *= nu
-                nu *= 2.0
-                if mu > 1e10:
+                mu, nu = newton.refuse(mu, nu)
+                if newton.given_up(mu, tol):
                     break
         if norm >= tol.closure:
             raise AssemblyError(self.path, best, it)

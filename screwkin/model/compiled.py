@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .newton import TRACE_FLOOR
+
 __all__ = ["available", "kernels", "kinds_of", "SPHERICAL", "FIXED"]
 
 SPHERICAL, FIXED = 0, 1  # the cut joint types the kernels know (3 and 12 solver rows)
@@ -85,22 +87,25 @@ def _build():
 
     @nb.njit(cache=True)
     def damped_step(K, r, free, mu):
-        """Minimum-norm damped step on the free columns: dq_f = -K_f^T (K_f K_f^T + lambda I)^-1 r
-        with lambda = mu * trace / rows; also |r + K_f dq_f|^2 (the linear model's residual)."""
+        """model.newton.damped_step, compiled: the minimum-norm damped step on the free columns
+        (the smaller of the two normal systems) and |r + K_f dq_f|^2 (the linear model's residual)."""
         m, nf = K.shape[0], free.shape[0]
         Kf = np.empty((m, nf))
         for a in range(m):
             for b in range(nf):
                 Kf[a, b] = K[a, free[b]]
-        A = Kf @ Kf.T
+        tall = m > nf
+        A = Kf.T @ Kf if tall else Kf @ Kf.T
         trace = 0.0
-        for a in range(m):
+        for a in range(A.shape[0]):
             trace += A[a, a]
-        damping = mu * max(trace / m, 1e-12)
-        for a in range(m):
+        damping = mu * max(trace / m, TRACE_FLOOR)
+        for a in range(A.shape[0]):
             A[a, a] += damping
-        y = np.linalg.solve(A, r)
-        dqf = -(Kf.T @ y)
+        if tall:
+            dqf = -np.linalg.solve(A, Kf.T @ r)
+        else:
+            dqf = -(Kf.T @ np.linalg.solve(A, r))
         lin = r + Kf @ dqf
         return dqf, lin @ lin
 

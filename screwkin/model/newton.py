@@ -1,0 +1,101 @@
+"""The one damped-Newton (Levenberg-Marquardt) step of every closure solver.
+
+The single solver (model.closure.ClosureSystem.solve), the batched one
+(analysis.batch.BatchClosure.solve) and the compiled kernel (model.compiled)
+take the same step with the same constants:
+
+- the step is the minimum-norm damped step on the free columns of K,
+  ``dq_f = -K_f^T (K_f K_f^T + lambda I)^-1 r`` with ``lambda = mu * trace / rows``
+  (with more rows than free columns the same step is
+  ``(K_f^T K_f + lambda I)^-1 K_f^T (-r)``, a smaller system);
+- the damping ``mu`` starts at ``Tolerances.lm_damping``; an accepted step
+  updates it from the gain ratio rho (actual over predicted decrease of the
+  squared residual) by Nielsen's rule, never below ``Tolerances.lm_damping_min``;
+  a refused one multiplies it by nu (2, 4, 8, ...); past
+  ``Tolerances.lm_damping_max`` the solver gives up.
+
+The residual rows may be evaluated one configuration at a time (Pinocchio),
+for a stack (numpy) or compiled (numba); tests compare the three, the program
+does not at run time.  Every function here works on one configuration or, where
+named so, on a stack of them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["TRACE_FLOOR", "damped_step", "damped_steps", "gain_ratio", "accept", "refuse", "NU"]
+
+#: Division guard: the damping is relative to the mean squared row norm, which is never taken
+#: below this (a zero Jacobian) [same units as K^2].
+TRACE_FLOOR = 1e-12
+
+#: Nielsen's factor on the damping after a refused step starts at this and doubles.
+NU = 2.0
+
+
+def damped_step(K, r, free, mu):
+    """The damped step of one configuration on the free columns of K (rows, nv): the step on
+    those columns and the squared residual of the linear model |r + K_f dq_f|^2."""
+    Kf = K[:, free]
+    rows, cols = Kf.shape
+    tall = rows > cols
+    A = Kf.T @ Kf if tall else Kf @ Kf.T
+    diagonal = A.ravel()[:: len(A) + 1]  # a view
+    diagonal += mu * max(diagonal.sum() / rows, TRACE_FLOOR)
+    b = Kf.T @ r if tall else r
+    try:
+        y = np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:  # singular in floating point
+        y = np.linalg.lstsq(A, b, rcond=None)[0]
+    dqf = -y if tall else -(Kf.T @ y)
+    lin = r + Kf @ dqf
+    return dqf, float(lin @ lin)
+
+
+def damped_steps(Kf, r, mu):
+    """damped_step for a stack, on columns already chosen: Kf (N, m, n), r (N, m), mu (N,) ->
+    (steps (N, n), squared residuals of the linear model (N,))."""
+    N, m, n = Kf.shape
+    tall = m > n
+    Kt = Kf.transpose(0, 2, 1)
+    A = Kt @ Kf if tall else Kf @ Kt
+    size = A.shape[1]
+    trace = np.trace(A, axis1=1, axis2=2)
+    A[:, np.arange(size), np.arange(size)] += (mu * np.maximum(trace / m, TRACE_FLOOR))[:, None]
+    b = (Kt @ r[:, :, None])[:, :, 0] if tall else r
+    try:
+        y = np.linalg.solve(A, b[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:  # one of them singular in floating point: least squares for all
+        y = np.stack([np.linalg.lstsq(Ai, bi, rcond=None)[0] for Ai, bi in zip(A, b)])
+    dq = -y if tall else -(Kt @ y[:, :, None])[:, :, 0]
+    lin = r + (Kf @ dq[:, :, None])[:, :, 0]
+    return dq, np.einsum("ni,ni->n", lin, lin)
+
+
+def gain_ratio(norm, new_norm, linear_squared):
+    """Actual over predicted decrease of the squared residual (scalars or arrays); 0 where
+    the linear model predicts no decrease."""
+    norm, new_norm, linear_squared = np.asarray(norm), np.asarray(new_norm), np.asarray(linear_squared)
+    predicted = norm**2 - linear_squared
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho = np.where(predicted > 0, (norm**2 - new_norm**2) / predicted, 0.0)
+    return rho if rho.ndim else float(rho)
+
+
+def accept(mu, rho, tol):
+    """The damping after an accepted step of gain ratio rho (Nielsen), and nu reset:
+    (mu, nu); scalars or arrays."""
+    mu = np.maximum(np.asarray(mu) * np.maximum(1.0 / 3.0, 1.0 - (2.0 * np.asarray(rho) - 1.0) ** 3),
+                    tol.lm_damping_min)
+    return (mu if mu.ndim else float(mu)), NU
+
+
+def refuse(mu, nu):
+    """The damping after a refused step, and the next factor: (mu * nu, 2 nu)."""
+    return mu * nu, nu * 2.0
+
+
+def given_up(mu, tol):
+    """Whether the damping has grown past the point where the solver stops (scalar or array)."""
+    return mu > tol.lm_damping_max
