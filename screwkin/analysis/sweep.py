@@ -36,7 +36,7 @@ from ..errors import AssemblyError, UsageError
 from ..model.linalg import null_space
 from .singular import Generic, measures, scaled_jacobians
 
-__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities"]
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour"]
 
 
 @dataclass(frozen=True)
@@ -173,13 +173,43 @@ class _Tracker:
         return q, self.input_change(qa, q)
 
 
+class Neighbour:
+    """One continuation step along input ``name`` of a PositionSolver, from a configuration to
+    a nearby input value on the same branch: the sweep's predictor along the curve's tangent,
+    its corrector and its branch tests (a correction that jumps away from the curve, or a
+    limit position between the two values, refuses the step).  Maps walk their grids with it."""
+
+    def __init__(self, solver, name: str):
+        self._tr = _Tracker(solver, name)
+
+    def __call__(self, q, x_from: float, x_to: float):
+        """The configuration at input value x_to on q's branch (q at x_from), or None."""
+        tr = self._tr
+        direction = np.sign(x_to - x_from)
+        if direction == 0:
+            return q
+        try:
+            t = tr.tangent(q)
+            if t[tr.ix] * direction < 0:
+                t = -t
+            q_new = tr.at_input(q, x_from, x_to, t)
+            if tr.tangent(q_new, t)[tr.ix] * direction <= 0:
+                return None  # a limit position lies between the two values
+        except _Stuck:
+            return None
+        return q_new
+
+
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
-          max_steps: int | None = None) -> SweepResult:
+          max_steps: int | None = None, q_start=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
 
     solver: a PositionSolver whose inputs include ``name``; the other inputs stay at ``fixed``.
+    q_start: a configuration of the assembly mode to follow (a neighbour's, in a map or a
+    study): the loops are closed from it at the first input value (raises AssemblyError when
+    they cannot be); without it the mode is ``solver.solve``'s first at ``start`` (near ``near``).
     turn: pass through limit positions onto the other branch (the input then runs back);
     the sweep ends when the mechanism is back at its start, the input reaches ``stop``, or
     after ``max_steps`` recorded configurations (default 20 * steps + 100).
@@ -197,8 +227,11 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     tr = _Tracker(solver, name)
     max_steps = max_steps or 20 * steps + 100
     h = (stop - start) / steps
-    first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
-    q0 = first.solutions[0].q
+    if q_start is not None:
+        q0 = solver.track({name: start, **fixed}, q_start).q
+    else:
+        first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
+        q0 = first.solutions[0].q
     rates_in = {n: 0.0 for n in solver.inputs}
     rates_in[name] = rate
     unit = "m" if mech.translational[tr.ix] else "rad"

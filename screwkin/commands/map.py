@@ -12,6 +12,7 @@ from ..errors import UsageError
 from ..present.plots import map_png
 from ..present.report import (
     map_csv,
+    map_dict,
     to_jsonable,
 )
 from ._common import (
@@ -55,11 +56,12 @@ def run(mech, args) -> int:
         with open(args.csv, "w") as f:
             f.write(map_csv(res))
     if args.json:
-        print(json.dumps(to_jsonable({"x": xn, "y": yn, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
-                                      "kind": res.kind, "characteristic_length": mech.length}), indent=2))
+        print(json.dumps(to_jsonable({**map_dict(res), "characteristic_length": mech.length}), indent=2))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
-        print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} assembled; "
+        print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} on the mapped assembly mode; "
               f"log10 sigma_min from {finite.min():.3g} to {finite.max():.3g} (L = {mech.length:.4g} m)"
               if finite.size else "no point assembled")
+        for note in res.notes:
+            print(note)
     return 0

@@ -25,7 +25,7 @@ from .tables import fmt_vec as _fmt_vec
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
-           "screw_theory_rows", "joint_rows"]
+           "screw_theory_rows", "joint_rows", "nan_to_none"]
 
 
 def _joint_dict(j) -> dict:
@@ -191,21 +191,32 @@ def mobility_text(r) -> str:
     return "\n".join(lines)
 
 
-def to_jsonable(obj):
-    """Plain Python for json.dumps: numpy values as numbers and lists, and every number that is
-    not finite (a condition number of a singular matrix, a map point that does not assemble)
-    as null: JSON has no NaN or Infinity."""
+def to_jsonable(obj, _where: str = ""):
+    """Plain Python for json.dumps: numpy values as numbers and lists; an infinite number (the
+    condition number of a singular matrix, an unbounded effort) as the string "inf" or "-inf",
+    since JSON has no Infinity.  A NaN is a bug, never an answer: RuntimeError naming where it
+    sits (a value that does not exist -- a map cell off the branch -- is None, written so by
+    the analysis that knows why)."""
     if isinstance(obj, dict):
-        return {k: to_jsonable(v) for k, v in obj.items()}
+        return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
+        return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
     if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
+        return to_jsonable(obj.tolist(), _where)
     if isinstance(obj, np.generic):
         obj = obj.item()
     if isinstance(obj, float) and not np.isfinite(obj):
-        return None
+        if np.isnan(obj):
+            raise RuntimeError(f"internal error: NaN in the JSON output at {_where.lstrip('.') or 'the top'}")
+        return "inf" if obj > 0 else "-inf"
     return obj
+
+
+def nan_to_none(a) -> list:
+    """An array whose NaN entries mean 'no value here' (said so by its analysis) as nested lists
+    with None there, for to_jsonable."""
+    a = np.asarray(a, float)
+    return np.where(np.isnan(a), None, a.astype(object)).tolist()
 
 
 def position_dict(res) -> dict:
@@ -550,13 +561,17 @@ def scan_csv(res: ScanResult) -> str:
 
 
 def map_dict(res: SingularityMap) -> dict:
-    return {"x": res.x_name, "y": res.y_name, "xs": res.xs, "ys": res.ys, "log10_sigma_min": res.log_sigma,
-            "kind": res.kind}
+    """A map as JSON: cells off the mapped branch are null in log10_sigma_min and false in
+    ``reached``; ``notes`` says where the continuation stopped."""
+    reached = res.reached if res.reached is not None else np.isfinite(res.log_sigma)
+    return {"x": res.x_name, "y": res.y_name, "xs": res.xs, "ys": res.ys,
+            "log10_sigma_min": nan_to_none(res.log_sigma), "kind": res.kind, "reached": reached,
+            "off_branch": int(reached.size - reached.sum()), "notes": list(res.notes)}
 
 
 def map_csv(res: SingularityMap) -> str:
-    rows = ([f"{x:.12g}", f"{y:.12g}", f"{res.log_sigma[j, i]:.6g}", res.kind[j, i]]
-            for j, y in enumerate(res.ys) for i, x in enumerate(res.xs))
+    rows = ([f"{x:.12g}", f"{y:.12g}", f"{res.log_sigma[j, i]:.6g}" if np.isfinite(res.log_sigma[j, i]) else "",
+             res.kind[j, i]] for j, y in enumerate(res.ys) for i, x in enumerate(res.xs))
     return csv_text([res.x_name, res.y_name, "log10_sigma_min", "kind"], rows)
 
 

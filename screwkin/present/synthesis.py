@@ -27,7 +27,8 @@ __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
 
 def _deg(x):
-    return None if x is None else math.degrees(x)
+    """Degrees; None where there is no value (None, or NaN: the linkage does not assemble there)."""
+    return None if x is None or x != x else math.degrees(x)
 
 
 def _pt(p):
