@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
 from ..model.closure import ClosureSystem, CutJoint
@@ -51,13 +50,13 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     for _, q, a in found:
         s = np.linalg.svd(system.jacobian(q), compute_uv=False)
         sigma = float(s[needed - 1] / s[0]) if 0 < needed <= len(s) else 1.0
-        pin.framesForwardKinematics(model, mech.data, q)
+        state = KinematicState(mech, q)
         outside = outside_limits(mech, q)
         sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
-                             sigma < mech.tolerances.singular, sigma, mech.data.oMf[out_frame].homogeneous.copy(),
+                             sigma < mech.tolerances.singular, sigma, state.frame_pose(out_frame),
                              outside_limits=outside, labels=solver._labels(q, outside),
                              link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None,
-                             leg_lengths=KinematicState(mech, q).leg_lengths or None))
+                             leg_lengths=state.leg_lengths or None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           0, (), output, solver.angular_names(), solver._angular_coupled(),

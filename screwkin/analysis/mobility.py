@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..model._pin import frame_jacobian
 from ..model.linalg import null_space, rank
+from ..model.state import KinematicState
 from ..model.topology import Topology
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
@@ -107,7 +107,7 @@ def _body_frames(mech, topo):
     return frames
 
 
-def _joint_geometry_rows(mech, topo, frames, jac, q):
+def _joint_geometry_rows(mech, topo, frames, jac, state):
     """Rows whose null space is the set of motions keeping every joint's geometry still.
 
     For each joint and each of its two links: the velocity (seen from that link)
@@ -119,7 +119,6 @@ def _joint_geometry_rows(mech, topo, frames, jac, q):
     through all their joints, the idle motions.  Higher pairs and screws: the relative twist
     of their two links (rolling, sliding along a profile or turning a screw moves the contact).
     """
-    data = mech.data
     rows = []
     for j in topo.joints:
         if j.type in ("floating",) or j.point is None:
@@ -132,7 +131,7 @@ def _joint_geometry_rows(mech, topo, frames, jac, q):
                 if link not in frames:
                     twists.append(np.zeros((6, mech.nv)))
                     continue
-                J, o = jac[link], data.oMf[frames[link]].translation
+                J, o = jac[link], state.frame_placement(frames[link]).translation
                 twists.append(np.vstack([J[:3] - pin.skew(p - o) @ J[3:], J[3:]]))
             rows.append(twists[1] - twists[0])
             continue
@@ -140,7 +139,7 @@ def _joint_geometry_rows(mech, topo, frames, jac, q):
             if link not in frames:
                 continue  # the ground does not move
             J = jac[link]
-            o = data.oMf[frames[link]].translation
+            o = state.frame_placement(frames[link]).translation
             Jp = J[:3] - pin.skew(p - o) @ J[3:]  # velocity of the point seen from this link
             if j.type in ("prismatic", "cylindrical"):
                 rows.append((np.eye(3) - np.outer(d, d)) @ Jp)
@@ -169,11 +168,9 @@ def _idle(mech, topo, frames, q, V, output_link, tol):
     M = V.shape[1]
     if M == 0 or not frames:
         return [], 0, np.zeros((M, 0))
-    model, data = mech.model, mech.data
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    jac = {k: frame_jacobian(model, data, f, LWA) for k, f in frames.items()}
-    rows = _joint_geometry_rows(mech, topo, frames, jac, q)
+    state = KinematicState(mech, q)
+    jac = {k: state.frame_jacobian(f, LWA) for k, f in frames.items()}
+    rows = _joint_geometry_rows(mech, topo, frames, jac, state)
     degree = {name: 0 for name in topo.links}
     for j in topo.joints:
         for link in set(j.links):
@@ -311,12 +308,10 @@ def _analyze(mech, output, seed, point) -> MobilityResult:
         V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
         out = None
         if output is not None:
-            model, data = mech.model, mech.data
-            pin.computeJointJacobians(model, data, q)
-            pin.updateFramePlacements(model, data)
-            T = frame_jacobian(model, data, out_frame, LWA) @ V
+            state = KinematicState(mech, q)
+            T = state.frame_jacobian(out_frame, LWA) @ V
             out = _point_motion(output, T, tol) if point else _output_motion(
-                output, T, tol, data.oMf[out_frame].translation)
+                output, T, tol, state.frame_placement(out_frame).translation)
         eff = rank(V[act_idx], tol) if len(act_idx) else None
         candidates.append(((rk, out.dimension if out else 0, eff or 0), q, K, rk, V, out, eff))
     top = max(c[0] for c in candidates)

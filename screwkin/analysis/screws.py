@@ -21,9 +21,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
-from ..model._pin import frame_jacobian
 from ..model.closure import perpendicular_basis
 from ..model.linalg import null_space
+from ..model.state import KinematicState
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
            "loop_product", "split_jacobians", "cut_twists"]
@@ -85,10 +85,7 @@ def chains_to(mech, targets) -> list:
     """The chain from the ground to each frame of ``targets`` ((name, frame id) pairs), read
     at the reference configuration (every joint at zero)."""
     model = mech.model
-    q0 = mech.neutral()
-    data = mech.data
-    pin.computeJointJacobians(model, data, q0)
-    pin.updateFramePlacements(model, data)
+    state = KinematicState(mech, mech.neutral())
     out = []
     for name, fid in targets:
         jid = model.frames[fid].parentJoint
@@ -100,9 +97,8 @@ def chains_to(mech, targets) -> list:
                                  "product-of-exponentials form here takes 1-DOF joints")
             joints.append(model.names[j])
             cols.append(model.idx_vs[j])
-        Js = frame_jacobian(model, data, fid, pin.ReferenceFrame.WORLD)
-        out.append(Chain(name, fid, tuple(joints), tuple(cols), Js[:, cols].copy(),
-                         data.oMf[fid].homogeneous.copy()))
+        Js = state.frame_jacobian(fid, pin.ReferenceFrame.WORLD)
+        out.append(Chain(name, fid, tuple(joints), tuple(cols), Js[:, cols].copy(), state.frame_pose(fid)))
     return out
 
 
@@ -122,17 +118,13 @@ def poe(chain, theta) -> np.ndarray:
 
 def structure(mech, q, output=None):
     """Per chain: reference twists, g(0), current twists (space Jacobian columns at q)."""
-    model = mech.model
-    data = mech.data
-    found = chains(mech, output)  # (computed at the reference configuration, in the same Data: first)
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
+    state = KinematicState(mech, q)
     result = []
-    for ch in found:
-        Js = frame_jacobian(model, data, ch.frame, pin.ReferenceFrame.WORLD)[:, list(ch.columns)]
-        Jb = frame_jacobian(model, data, ch.frame, pin.ReferenceFrame.LOCAL)[:, list(ch.columns)]
+    for ch in chains(mech, output):  # at the reference configuration, in a state of its own
+        Js = state.frame_jacobian(ch.frame, pin.ReferenceFrame.WORLD)[:, list(ch.columns)]
+        Jb = state.frame_jacobian(ch.frame, pin.ReferenceFrame.LOCAL)[:, list(ch.columns)]
         result.append({"chain": ch, "theta": joint_angles(mech, q, ch), "space_jacobian": Js, "body_jacobian": Jb,
-                       "g": data.oMf[ch.frame].homogeneous.copy()})
+                       "g": state.frame_pose(ch.frame)})
     return result
 
 
@@ -154,12 +146,13 @@ class LoopScrews:
     closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
 
 
-def cut_twists(mech, cut, data):
-    """The cut joint's freedoms as world twists (v at the world origin, w): [(name, twist, sliding)],
-    or None for a higher pair (its loop closes through an equivalent linkage and coupling rows)."""
+def cut_twists(mech, cut, state):
+    """The cut joint's freedoms at the configuration of ``state`` (a model.state.KinematicState) as
+    world twists (v at the world origin, w): [(name, twist, sliding)], or None for a higher pair (its
+    loop closes through an equivalent linkage and coupling rows)."""
     if cut.pair is not None:
         return None
-    M1 = data.oMf[cut.frame1]
+    M1 = state.frame_placement(cut.frame1)
     a = M1.rotation @ (np.asarray(cut.axis, float) / np.linalg.norm(cut.axis))
     p = M1.translation
 
@@ -176,7 +169,7 @@ def cut_twists(mech, cut, data):
     elif cut.type == "cylindrical":
         out = [rot(a), slide(a)]
     elif cut.type == "universal":
-        a2 = data.oMf[cut.frame2].rotation @ np.asarray(cut.axis2, float)
+        a2 = state.frame_placement(cut.frame2).rotation @ np.asarray(cut.axis2, float)
         out = [rot(a), rot(a2 / np.linalg.norm(a2))]
     elif cut.type == "spherical":
         out = [rot(e) for e in np.eye(3)]
@@ -195,15 +188,12 @@ def cut_twists(mech, cut, data):
 def loop_screws(mech) -> list:
     """A LoopScrews for each one-coordinate cut joint (revolute, continuous, prismatic; no higher pair)."""
     model = mech.model
-    data = model.createData()  # a Data of its own: nothing left in, or read from, mech.data
-    q0 = mech.neutral()
-    pin.computeJointJacobians(model, data, q0)
-    pin.updateFramePlacements(model, data)
+    state = KinematicState(mech, mech.neutral())
     out = []
     for c in mech.cuts:
         if c.pair or c.dof != 1:
             continue
-        twists = cut_twists(mech, c, data)  # [(name, twist, sliding)] of the cut joint's freedoms
+        twists = cut_twists(mech, c, state)  # [(name, twist, sliding)] of the cut joint's freedoms
         if not twists or len(twists) != 1:
             continue
         xi_c = twists[0][1]
@@ -215,12 +205,12 @@ def loop_screws(mech) -> list:
         one, two = ([j for j in side if j not in shared] for side in sides)
         if any(model.nvs[j] != 1 for j in one + two):
             continue  # the product of exponentials here takes 1-DOF joints
-        Jw = {j: frame_jacobian(model, data, f, pin.ReferenceFrame.WORLD)
+        Jw = {j: state.frame_jacobian(f, pin.ReferenceFrame.WORLD)
               for f, side in ((c.frame1, one), (c.frame2, two)) for j in side}
         cols = [Jw[j][:, model.idx_vs[j]] for j in one] + [xi_c] + [Jw[j][:, model.idx_vs[j]] for j in reversed(two)]
         names = [model.names[j] for j in one] + [c.name] + [model.names[j] for j in reversed(two)]
         signs = [1] * (len(one) + 1) + [-1] * len(two)
-        closed = data.oMf[c.frame1].isApprox(data.oMf[c.frame2], mech.tolerances.geometry)
+        closed = state.frame_placement(c.frame1).isApprox(state.frame_placement(c.frame2), mech.tolerances.geometry)
         out.append(LoopScrews(c.name, tuple(names), tuple(signs), np.array(cols).T.copy(), bool(closed)))
     return out
 
@@ -257,12 +247,7 @@ def split_jacobians(mech, q, output, inputs=None):
     a = mech.velocity_indices(names)
     p = np.setdiff1d(np.arange(mech.nv), a)
     K = mech.closure.jacobian(q)
-    model = mech.model
-    data = mech.data
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    fid = mech.link_frame(output)
-    J = frame_jacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    J = KinematicState(mech, q).link_jacobian(output, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
     # q' = S q'_a with K_p q'_p = -K_a q'_a (minimum norm: no idle spins)
     S = np.zeros((mech.nv, len(a)))
     S[a] = np.eye(len(a))

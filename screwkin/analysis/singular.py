@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..model._pin import frame_jacobian
 from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, loop_coordinate_cuts
 from .screws import cut_twists, screw_of
@@ -104,10 +103,7 @@ def scaled_jacobians(mech, q, output=None, point: bool = False, length: float | 
         K, V = np.zeros((0, mech.nv)), np.eye(mech.nv)
     J = None
     if output is not None:
-        model, data = mech.model, mech.data
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        J = frame_jacobian(model, data, mech.link_frame(output), LWA).copy()
+        J = KinematicState(mech, q).link_jacobian(output, LWA)
         J[:3] /= L
         J[:, slide] *= L
         if point:
@@ -183,13 +179,11 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
     twists = []
     J_world = origin = None
     if output is not None:
-        model, data = mech.model, mech.data
+        state = KinematicState(mech, q)
         fid = mech.link_frame(output)
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
         # spatial twists (v at the world origin, w) for the screws: their axes are where they are in the world
-        J_world = frame_jacobian(model, data, fid, pin.ReferenceFrame.WORLD).copy()
-        origin = data.oMf[fid].translation.copy()
+        J_world = state.frame_jacobian(fid, pin.ReferenceFrame.WORLD)
+        origin = state.frame_placement(fid).translation
 
     def unscale(x):  # scaled rates -> joint rates [rad/s, m/s]
         x = x.copy()
@@ -269,12 +263,11 @@ def loop_twists(mech, q, cut, length=None):
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
     says why) when the loop has a higher pair or a joint without one twist per coordinate."""
-    model, data = mech.model, mech.data
+    model = mech.model
     L = float(length or mech.length)
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    J1 = frame_jacobian(model, data, cut.frame1, pin.ReferenceFrame.WORLD)
-    J2 = frame_jacobian(model, data, cut.frame2, pin.ReferenceFrame.WORLD)
+    state = KinematicState(mech, q)
+    J1 = state.frame_jacobian(cut.frame1, pin.ReferenceFrame.WORLD)
+    J2 = state.frame_jacobian(cut.frame2, pin.ReferenceFrame.WORLD)
     sides = []
     for f in (cut.frame1, cut.frame2):
         sides.append({j for j in model.supports[model.frames[f].parentJoint] if j > 0})
@@ -288,7 +281,7 @@ def loop_twists(mech, q, cut, length=None):
             names.append(coord_names[k])
             cols.append(J1[:, k] if on1 else -J2[:, k])
             slide.append(bool(mech.translational[k]))
-    extra = cut_twists(mech, cut, data)
+    extra = cut_twists(mech, cut, state)
     if extra is None:
         return names, None, f"the loop closes through the {cut.pair} pair's equivalent linkage: not computed"
     for name, t, sl in extra:

@@ -34,9 +34,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
-from ..model._pin import frame_jacobian
 from ..model.linalg import null_space, rank
-from .screws import Screw, screw_of
+from ..model.state import KinematicState
+from .screws import Screw, cut_twists, screw_of
 from .singular import Generic, measures
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw"]
@@ -84,7 +84,8 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     """Actuator efforts and joint reactions holding ``wrench`` (force, moment) [N, N m] applied to
     ``output`` at its frame's origin (world axes) and, with ``gravity``, the links' weights,
     at the assembled configuration q.  See the module docstring."""
-    model, data, tol = mech.model, mech.data, mech.tolerances
+    model, tol = mech.model, mech.tolerances
+    data = model.createData()  # a Data of this computation's own: nothing read from or left in mech.data
     inputs = list(mech.actuated if inputs is None else inputs)
     if wrench is not None and output is None:
         raise UsageError(f"{mech.path}: a wrench needs the output link it is applied to (--output)")
@@ -99,9 +100,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
         b += pin.computeGeneralizedGravity(model, data, q)
     J_o = None
     if output is not None:
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        J_o = frame_jacobian(model, data, mech.link_frame(output), LWA)
+        J_o = KinematicState(mech, q).link_jacobian(output, LWA)
         b -= J_o.T @ w
     E = np.zeros((nv, len(a_idx)))
     E[a_idx, np.arange(len(a_idx))] = 1.0
@@ -154,7 +153,9 @@ def _reactions(mech, q, lam, w, output, gravity, N_lam):
 
 def _joint_wrenches(mech, q, lam, w, output, gravity) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam."""
-    model, data = mech.model, mech.data
+    model = mech.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
     rows = mech.closure.row_wrenches(q)
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
 
@@ -241,21 +242,20 @@ def legs(mech, q, output, inputs=None) -> tuple:
     leg allows: t with t = J_c q'_L + A_c a_c for each of its connections c (J_c: the twist of
     that connection's body at the platform origin from the leg's joints; A_c: the relative
     twists the cut joint allows), over the leg's joint rates q'_L."""
-    model, data, tol = mech.model, mech.data, mech.tolerances
+    model, tol = mech.model, mech.tolerances
+    state = KinematicState(mech, q)
     inputs = set(mech.actuated if inputs is None else inputs)
     fid = mech.link_frame(output)
     body = model.frames[fid].parentJoint
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    o = data.oMf[fid].translation.copy()
+    o = state.frame_placement(fid).translation
     coords = {c.joint_id: c for c in mech.coordinates}
 
     def support(joint):
         return [j for j in model.supports[joint] if j in coords]
 
     def at_platform(frame):  # frame Jacobian as the twist of the frame's body at the platform origin
-        J = frame_jacobian(model, data, frame, LWA).copy()
-        J[:3] += np.cross(J[3:].T, o - data.oMf[frame].translation).T  # v_o = v_p + w x (o - p)
+        J = state.frame_jacobian(frame, LWA)
+        J[:3] += np.cross(J[3:].T, o - state.frame_placement(frame).translation).T  # v_o = v_p + w x (o - p)
         return J
 
     branches = [{"joints": set(support(body)), "ends": [(fid, None)]}]
@@ -281,7 +281,7 @@ def legs(mech, q, output, inputs=None) -> tuple:
         def allowed(locked):
             blocks, n_extra = [], []
             for frame, cut in leg["ends"]:
-                A = _cut_twists(mech, cut, o) if cut is not None else np.zeros((6, 0))
+                A = _cut_twists(mech, cut, o, state) if cut is not None else np.zeros((6, 0))
                 blocks.append((at_platform(frame), A))
                 n_extra.append(A.shape[1])
             free_cols = [c for c in cols if c not in (act if locked else [])]
@@ -314,34 +314,10 @@ def legs(mech, q, output, inputs=None) -> tuple:
     return tuple(out)
 
 
-def _cut_twists(mech, cut, o) -> np.ndarray:
-    """The relative twists a cut joint allows, at the platform origin o in world axes (6 x k)."""
-    data = mech.data
-    M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
-    p = M2.translation
-    a = M1.rotation @ np.asarray(cut.axis, float)
-    e = np.eye(3)
-
-    def rot(u):
-        return np.r_[np.cross(u, o - p), u]
-
-    def tra(u):
-        return np.r_[u, np.zeros(3)]
-
-    t = cut.pair or cut.type
-    if t in ("revolute", "continuous"):
-        cols = [rot(a)]
-    elif t == "prismatic":
-        cols = [tra(a)]
-    elif t == "cylindrical":
-        cols = [rot(a), tra(a)]
-    elif t == "universal":
-        cols = [rot(a), rot(M2.rotation @ np.asarray(cut.axis2, float))]
-    elif t == "spherical":
-        cols = [rot(u) for u in e]
-    elif t == "planar":
-        b = np.linalg.svd(a[None, :])[2][1:]
-        cols = [tra(b[0]), tra(b[1]), rot(a)]
-    else:  # fixed, and higher pairs (their equivalent linkage's joints belong to the leg)
-        cols = []
+def _cut_twists(mech, cut, o, state) -> np.ndarray:
+    """The relative twists a cut joint allows (analysis.screws.cut_twists), moved to the platform
+    origin o, world axes (6 x k); none for a higher pair (its equivalent linkage's joints belong
+    to the leg)."""
+    twists = cut_twists(mech, cut, state) or []
+    cols = [np.r_[t[:3] + np.cross(t[3:], o), t[3:]] for _, t, _ in twists]  # v_o = v_0 + w x o
     return np.array(cols).T if cols else np.zeros((6, 0))

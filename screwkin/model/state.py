@@ -8,6 +8,8 @@ and threads may share a mechanism.  From it every quantity people ask for is rea
 * every link's absolute pose, and the velocity and classical acceleration of its frame origin
   with its angular velocity and acceleration (world axes; twists in (linear, angular) order);
 * any point fixed on a link (coordinates in the link's frame): position, velocity, acceleration;
+* frame and joint placements, frame Jacobians (joint Jacobians computed once), the tree
+  joints' values by name, the constraint Jacobian K of the loops and K'q';
 * the coordinates of the loop (cut) joints: the value of a one-coordinate ``<loop_joint>`` as a
   tree joint's value is read -- zero where its frames F1 and F2 coincide as written, the angle
   of F2 about the axis (revolute, continuous) or the displacement of F2's origin along the axis
@@ -24,7 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError, quote
-from ._pin import joint_axis
+from ._pin import frame_jacobian, joint_axis
 
 __all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints",
            "leg_ends", "value_for_leg_length"]
@@ -140,9 +142,53 @@ class KinematicState:
             pin.updateFramePlacements(model, data)
         return data
 
+    @cached_property
+    def _jacobians(self):
+        """The state's Data with the joint Jacobians computed (once, on first use)."""
+        model, data = self.mech.model, self._data
+        if model.nv:
+            pin.computeJointJacobians(model, data, self.q)
+            pin.updateFramePlacements(model, data)
+        return data
+
     @property
     def has_rates(self) -> bool:
         return self.qd is not None
+
+    def frame_placement(self, fid: int):
+        """World placement of a frame (pinocchio.SE3, a copy)."""
+        return pin.SE3(self._data.oMf[fid])
+
+    def joint_placement(self, jid: int):
+        """World placement of a joint's frame (pinocchio.SE3, a copy)."""
+        return pin.SE3(self._data.oMi[jid])
+
+    def frame_jacobian(self, fid: int, reference=LWA) -> np.ndarray:
+        """(6, nv) Jacobian of a frame in (linear, angular) order, in ``reference``
+        (LOCAL_WORLD_ALIGNED by default: the frame origin's velocity and the angular
+        velocity, world axes; WORLD: the spatial twist at the world origin) [m/rad, 1]."""
+        return frame_jacobian(self.mech.model, self._jacobians, fid, reference).copy()
+
+    def link_jacobian(self, link: str, reference=LWA) -> np.ndarray:
+        return self.frame_jacobian(self.mech.link_frame(link), reference)
+
+    @cached_property
+    def joint_values(self) -> dict:
+        """Tree coordinate name -> value [rad or m] (Mechanism.joint_values)."""
+        return self.mech.joint_values(self.q)
+
+    @cached_property
+    def constraint_jacobian(self) -> np.ndarray:
+        """K (rows of the loops and higher pairs, nv): K q' = 0 for the motions they allow
+        (model.closure, computed in the closure's own Data and copied here)."""
+        return np.array(self.mech.closure.jacobian(self.q), float)
+
+    @cached_property
+    def constraint_bias(self) -> np.ndarray:
+        """K' q' (needs rates): the loops' accelerations satisfy K q'' = -K' q'."""
+        if not self.has_rates:
+            raise ValueError("the state has no rates: K' q' needs them")
+        return np.array(self.mech.closure.bias(self.q, self.qd), float)
 
     def frame_pose(self, fid: int) -> np.ndarray:
         """4x4 world pose of a frame."""

@@ -224,9 +224,9 @@ class _Edge:
 
 def _edges(mech, q):
     """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
-    model, data = mech.model, mech.data
-    pin.forwardKinematics(model, data, q)
-    pin.updateFramePlacements(model, data)
+    model = mech.model
+    data = model.createData()  # a Data of its own: nothing read from or left in mech.data
+    pin.framesForwardKinematics(model, data, q)
     replaced = dict(mech.spec.replacements)
     edges, welds = [], []
     for j in mech.spec.joints:
