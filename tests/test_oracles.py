@@ -1,0 +1,144 @@
+"""Independent oracles for what screwkin computes: values taken from outside the code under test.
+
+Loop rows: Pinocchio's own constraint models (``RigidConstraintModel`` with CONTACT_6D for a
+weld / fixed cut joint, CONTACT_3D for a ball / spherical one) and finite differences on the
+manifold (``pin.integrate``) of a residual written here from the frame placements alone.
+"""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import screwkin
+from conftest import CORPUS, ROBOTS
+
+LOCAL = pin.ReferenceFrame.LOCAL
+
+# files whose cut joints are all fixed (6 rows each) or all spherical (3 rows each)
+WELDED = [CORPUS / n / "robot.urdf" for n in ("cassie_like", "robot_delta", "5bar_linkage", "talos_like", "digit_like")]
+BALLS = [CORPUS / "5bar_linkage_iso3d" / "robot.urdf", ROBOTS / "gough_stewart_6ups.urdf",
+         ROBOTS / "delta_parallelogram.urdf", ROBOTS / "rssr.urdf"]
+
+
+def _name(path):
+    return path.parent.name if path.name == "robot.urdf" else path.stem
+
+
+def _configurations(mech, n_random=3, seed=5):
+    """Generic closed configurations (screwkin's own search: only where the rows are compared,
+    never what they are compared with), then ones off the closure manifold: a random step of
+    up to 0.5 rad (or m) per joint from a closed one, so that no cut frame turns near pi
+    relative to the other (where log3 and its finite differences lose their digits)."""
+    _, closed = mech.generic_configurations()
+    rng = np.random.default_rng(seed)
+    free = [pin.integrate(mech.model, closed[k % len(closed)], rng.uniform(-0.5, 0.5, mech.nv))
+            for k in range(n_random)]
+    return [(q, True) for q in closed[:3]] + [(q, False) for q in free]
+
+
+def _pin_rows(model, data, contact_type, j1, M1, j2, M2):
+    """Pinocchio's constraint Jacobian (LOCAL) of a constraint between placement M1 on joint j1
+    and M2 on joint j2, at the configuration data was computed at (calc first: see
+    /work/shared/pinocchio-notes.md)."""
+    cm = pin.RigidConstraintModel(contact_type, model, j1, M1, j2, M2, LOCAL)
+    cd = cm.createData()
+    cm.calc(model, data, cd)
+    return pin.getConstraintJacobian(model, data, cm, cd)
+
+
+def _oracle_K(mech, q, mapped=True):
+    """The stacked constraint Jacobian that Pinocchio's constraint models give, mapped onto the
+    rows screwkin documents (positions R1^T (o2 - o1), then log3(R1^T R2) for a weld) by a map T
+    written here in closed form.
+
+    Pinocchio's LOCAL 6-D rows are minus the motion of frame 2 relative to frame 1, expressed
+    in frame 1 at its origin, -(1X2 V2 - V1) (the sign opposite to a log6(1M2) residual).
+    With (R, p) = 1M2 the rows of d/dt (R1^T (o2 - o1), log3 R) are T (-K_pin),
+    T = [[I, -[p]x], [0, Jlog3(R) R^T]].
+    A 3-D contact compares the velocities of two points; screwkin's rows differentiate
+    R1^T (o2 - o1), the motion of o2 relative to the body of frame 1, so the oracle's point on
+    body 1 is the one at o2 now (the same frame when the loop is closed).
+
+    mapped=False: Pinocchio's rows as they come, for the cut frames as written (no T, no
+    moved point), whose row space is the loop's constraint wrenches at a closed configuration."""
+    model = mech.model
+    data = model.createData()
+    pin.computeJointJacobians(model, data, q)
+    pin.framesForwardKinematics(model, data, q)
+    blocks = []
+    for cut in mech.cuts:
+        f1, f2 = model.frames[cut.frame1], model.frames[cut.frame2]
+        oM1, oM2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
+        if cut.type == "fixed":
+            K = -_pin_rows(model, data, pin.ContactType.CONTACT_6D, f1.parentJoint, f1.placement,
+                           f2.parentJoint, f2.placement)
+            M = oM1.inverse() * oM2
+            T = np.eye(6)
+            T[:3, 3:] = -pin.skew(M.translation)
+            T[3:, 3:] = pin.Jlog3(M.rotation) @ M.rotation.T
+            blocks.append(T @ K if mapped else K)
+        elif cut.type == "spherical" and not mapped:
+            blocks.append(-_pin_rows(model, data, pin.ContactType.CONTACT_3D, f1.parentJoint, f1.placement,
+                                     f2.parentJoint, f2.placement))
+        elif cut.type == "spherical":
+            at_o2 = data.oMi[f1.parentJoint].inverse() * pin.SE3(oM1.rotation, oM2.translation)
+            blocks.append(-_pin_rows(model, data, pin.ContactType.CONTACT_3D, f1.parentJoint, at_o2,
+                                     f2.parentJoint, f2.placement))
+        else:
+            raise AssertionError(f"no oracle here for a {cut.type} cut joint")
+    return np.vstack(blocks)
+
+
+def _residual_here(mech, q):
+    """The weld and ball rows written from the frame placements alone (not screwkin's closure
+    code): R1^T (o2 - o1), and log3(R1^T R2) for a weld."""
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    rows = []
+    for cut in mech.cuts:
+        M = data.oMf[cut.frame1].inverse() * data.oMf[cut.frame2]
+        rows.append(M.translation)
+        if cut.type == "fixed":
+            rows.append(pin.log3(M.rotation))
+    return np.concatenate(rows)
+
+
+def _fd(mech, q, h=1e-6):
+    cols = []
+    for i in range(mech.nv):
+        e = np.zeros(mech.nv)
+        e[i] = h
+        cols.append((_residual_here(mech, pin.integrate(mech.model, q, e))
+                     - _residual_here(mech, pin.integrate(mech.model, q, -e))) / (2 * h))
+    return np.stack(cols, axis=1)
+
+
+def _projector(K, rtol=1e-9):
+    u, s, vt = np.linalg.svd(K)
+    rank = int((s > rtol * s[0]).sum())
+    return vt[:rank].T @ vt[:rank], rank
+
+
+@pytest.mark.parametrize("path", WELDED + BALLS, ids=_name)
+def test_loop_rows_equal_pinocchios_constraint_models(path):
+    mech = screwkin.load(path, warn=lambda m: None)
+    assert mech.cuts and not mech.closure.extra
+    assert {c.type for c in mech.cuts} == ({"fixed"} if path in WELDED else {"spherical"})
+    assert mech.closure.nrows == sum(6 if c.type == "fixed" else 3 for c in mech.cuts)
+    for q, closed in _configurations(mech):
+        K = mech.closure.jacobian(q)
+        oracle = _oracle_K(mech, q)
+        assert K.shape == oracle.shape
+        scale = max(1.0, np.abs(oracle).max())
+        np.testing.assert_allclose(K, oracle, rtol=0, atol=1e-10 * scale)
+        # the same rows as finite differences on the manifold of the residual written here
+        np.testing.assert_allclose(oracle, _fd(mech, q), rtol=0, atol=2e-7 * scale)
+        if not closed:
+            assert np.linalg.norm(_residual_here(mech, q)) > 1e-2  # off the manifold: T is not I
+        else:
+            assert np.linalg.norm(_residual_here(mech, q)) < 1e-9
+            # closed: Pinocchio's rows as they come, with no map, span the same row space
+            P, rank = _projector(K)
+            P_pin, rank_pin = _projector(_oracle_K(mech, q, mapped=False))
+            assert rank == rank_pin
+            np.testing.assert_allclose(P, P_pin, rtol=0, atol=1e-8)
