@@ -142,3 +142,50 @@ def test_loop_rows_equal_pinocchios_constraint_models(path):
             P_pin, rank_pin = _projector(_oracle_K(mech, q, mapped=False))
             assert rank == rank_pin
             np.testing.assert_allclose(P, P_pin, rtol=0, atol=1e-8)
+
+
+# ---------------------------------------------------------------------------------------------
+# Product of exponentials against modern_robotics (Lynch and Park's own code)
+
+def _serial_chains(path, output):
+    from screwkin.analysis.screws import structure
+
+    mech = screwkin.load(path, warn=lambda m: None)
+    rng = np.random.default_rng(2)
+    for _ in range(4):
+        q = pin.integrate(mech.model, pin.neutral(mech.model), rng.uniform(-2, 2, mech.nv))
+        yield mech, q, structure(mech, q, output)
+
+
+def _wv(twists):
+    """(v, w) rows (Pinocchio, screwkin) to (w, v) rows (modern_robotics)."""
+    return np.vstack([twists[3:], twists[:3]])
+
+
+@pytest.mark.parametrize("path, output", [(ROBOTS / "arm_6r.urdf", "flange"), (ROBOTS / "planar_3rpr.urdf", None),
+                                          (ROBOTS / "bennett.urdf", None)], ids=["arm_6r", "planar_3rpr", "bennett"])
+def test_product_of_exponentials_equals_modern_robotics(path, output):
+    """screwkin's space screws S_i and home placement M of each chain, given to
+    ``mr.FKinSpace(M, Slist, theta)``, give Pinocchio's forward kinematics of the frame, and
+    ``mr.JacobianSpace(Slist, theta)`` gives screwkin's space Jacobian, at random configurations."""
+    mr = pytest.importorskip("modern_robotics", reason="modern_robotics is not installed (the test extra has it)")
+    from screwkin.analysis.screws import poe
+
+    seen = 0
+    for mech, q, chains in _serial_chains(path, output):
+        data = mech.model.createData()
+        pin.framesForwardKinematics(mech.model, data, q)
+        for entry in chains:
+            ch, theta = entry["chain"], entry["theta"]
+            assert len(ch.joints) == len(theta)
+            if not ch.joints:  # a cut frame on the ground: no screws, M itself
+                np.testing.assert_allclose(ch.g0, data.oMf[ch.frame].homogeneous, rtol=0, atol=1e-12)
+                continue
+            S = _wv(ch.xi0)
+            T_mr = mr.FKinSpace(ch.g0, S, theta)
+            np.testing.assert_allclose(T_mr, data.oMf[ch.frame].homogeneous, rtol=0, atol=1e-9)
+            np.testing.assert_allclose(poe(ch, theta), T_mr, rtol=0, atol=1e-9)
+            np.testing.assert_allclose(_wv(entry["space_jacobian"]), mr.JacobianSpace(S, theta), rtol=0, atol=1e-9)
+            np.testing.assert_allclose(entry["g"], T_mr, rtol=0, atol=1e-9)
+            seen += 1
+    assert seen >= 4  # chains of 2 to 6 joints checked
