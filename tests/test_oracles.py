@@ -189,3 +189,70 @@ def test_product_of_exponentials_equals_modern_robotics(path, output):
             np.testing.assert_allclose(entry["g"], T_mr, rtol=0, atol=1e-9)
             seen += 1
     assert seen >= 4  # chains of 2 to 6 joints checked
+
+
+# ---------------------------------------------------------------------------------------------
+# Bennett's input torque by virtual work: the mechanism moved along its one DOF
+
+BENNETT_LOAD = np.array([1.0, 2.0, 3.0, 0.1, 0.2, 0.3])  # (force [N], moment [N m]) on link3, world axes
+
+
+def _nearest(mech, solutions, q):
+    return min((s.q for s in solutions), key=lambda x: np.linalg.norm(pin.difference(mech.model, q, x)))
+
+
+def _virtual_work_torque(mech, theta, output="link3", wrench=BENNETT_LOAD, h=1e-5):
+    """tau at joint1 = theta holding ``wrench`` on ``output``: the mechanism closed at theta and
+    at theta +- h (the same assembly mode: the solutions nearest), the output frame's
+    displacement twist by central differences of log6 from the middle placement, turned to world
+    axes at the frame's origin (the load's convention), and power balance tau h + w . twist = 0."""
+    from screwkin.analysis.position import PositionSolver
+
+    solver = PositionSolver(mech, ["joint1"])
+    q0 = solver.solve({"joint1": theta}).solutions[0].q
+    qp = _nearest(mech, solver.solve({"joint1": theta + h}).solutions, q0)
+    qm = _nearest(mech, solver.solve({"joint1": theta - h}).solutions, q0)
+    for x in (q0, qp, qm):
+        assert np.linalg.norm(mech.closure.residual(x)) < 1e-10
+    # the step moved the mechanism along its one DOF by about h, not onto another mode
+    assert np.linalg.norm(pin.difference(mech.model, qm, qp)) < 100 * h
+    data = mech.model.createData()
+    fid = mech.link_frame(output)
+
+    def placement(q):
+        pin.framesForwardKinematics(mech.model, data, q)
+        return data.oMf[fid].copy()
+
+    M0 = placement(q0)
+    body = (pin.log6(M0.inverse() * placement(qp)).vector - pin.log6(M0.inverse() * placement(qm)).vector) / (2 * h)
+    R = M0.rotation
+    twist = np.r_[R @ body[:3], R @ body[3:]]  # (linear velocity of the frame's origin, angular), world axes
+    return q0, -twist @ wrench
+
+
+@pytest.mark.parametrize("theta", [0.3, 1.1, -0.8])
+def test_bennett_input_torque_by_virtual_work(theta):
+    from screwkin.analysis.statics import statics
+
+    mech = screwkin.load(ROBOTS / "bennett.urdf")
+    assert list(mech.actuated) == ["joint1"]
+    q0, expected = _virtual_work_torque(mech, theta)
+    assert abs(expected) > 1e-3  # a load that the input feels
+    r = statics(mech, q0, output="link3", wrench=BENNETT_LOAD)
+    assert r.equilibrium and r.indeterminate == 3
+    assert r.efforts["joint1"] == pytest.approx(expected, rel=1e-6)
+
+
+def test_bennett_statics_command_gives_the_virtual_work_torque(capsys):
+    from screwkin.cli import main
+
+    mech = screwkin.load(ROBOTS / "bennett.urdf")
+    _, expected = _virtual_work_torque(mech, 0.7)
+    load = " ".join(map(str, BENNETT_LOAD))
+    assert main(["statics", str(ROBOTS / "bennett.urdf"), "--set", "joint1=0.7", "--output", "link3",
+                 "--wrench", load, "--json"]) == 0
+    import json
+
+    out = json.loads(capsys.readouterr().out)
+    assert out["units"]["joint1"] == "N m"
+    assert out["efforts"]["joint1"] == pytest.approx(expected, rel=1e-6)

@@ -110,7 +110,7 @@ def test_an_overconstrained_linkage_is_statically_indeterminate():
     q = mech.generic_configurations()[1][0]
     r = statics(mech, q, output="link3", wrench=[1, 2, 3, 0.1, 0.2, 0.3])
     assert r.equilibrium and r.indeterminate == 3
-    assert r.efforts["joint1"] is not None
+    assert isinstance(r.efforts["joint1"], float)  # its value: test_oracles.py, by virtual work
     assert any(None in x.wrench for x in r.reactions)
     # a planar linkage: in-plane components determined, out-of-plane ones not
     r = statics(load("fourbar_crank_rocker"), load("fourbar_crank_rocker").generic_configurations()[1][0],
