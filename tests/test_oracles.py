@@ -256,3 +256,91 @@ def test_bennett_statics_command_gives_the_virtual_work_torque(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["units"]["joint1"] == "N m"
     assert out["efforts"]["joint1"] == pytest.approx(expected, rel=1e-6)
+
+
+# ---------------------------------------------------------------------------------------------
+# A Gough-Stewart platform's legs: lines and twist spaces in closed form from the file's centres
+
+def _stewart_centres(path):
+    """From the file itself (xml): base U centres B_k and U first axes (the base is the world),
+    and the platform's S centres p_k in the platform frame (leg 1's ball is the platform's
+    origin; legs 2..6 are loop joints with link2 on the platform)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    joints = {j.get("name"): j for j in root.iter("joint")}
+    loops = {j.get("name"): j for j in root.iter("loop_joint")}
+
+    def vec(el, attr):
+        return np.array([float(x) for x in el.get(attr).split()])
+
+    B = [vec(joints[f"base{k}_a"].find("origin"), "xyz") for k in range(1, 7)]
+    A1 = [vec(joints[f"base{k}_a"].find("axis"), "xyz") for k in range(1, 7)]
+    p = [np.zeros(3)] + [vec(loops[f"ball{k}"].find("link2"), "xyz") for k in range(2, 7)]
+    assert all(loops[f"ball{k}"].find("link2").get("link") == "platform" for k in range(2, 7))
+    return B, [a / np.linalg.norm(a) for a in A1], p
+
+
+def _rotation_twist(u, c, o):
+    """Twist (v at o, w) of a rotation about the unit axis u through the point c."""
+    return np.r_[np.cross(u, o - c), u]
+
+
+def test_stewart_transmission_wrenches_are_the_leg_lines_reciprocal_to_the_passive_joints():
+    """Each leg k is U-P-S: its line (unit d_k from the U centre B_k to the S centre P_k, moment
+    (P_k - o) x d_k about the platform origin o) is the one wrench reciprocal to the five passive
+    twists (rotations about the U's axes a1 and a1 x d_k through B_k, and about three axes
+    through P_k), and is what the locked actuator transmits.  Everything here is written from
+    the file's joint centres and the platform placement (Pinocchio's forward kinematics)."""
+    from screwkin.analysis.statics import legs
+
+    path = ROBOTS / "gough_stewart_6ups.urdf"
+    mech = screwkin.load(path)
+    B, A1, p_local = _stewart_centres(path)
+    data = mech.model.createData()
+    for q in mech.generic_configurations()[1][:3]:
+        pin.framesForwardKinematics(mech.model, data, q)
+        oMp = data.oMf[mech.link_frame("platform")]
+        o = oMp.translation
+        found = {leg.actuated: leg for leg in legs(mech, q, "platform")}
+        assert sorted(found) == [(f"leg{k}",) for k in range(1, 7)]
+        for k in range(6):
+            P = oMp.act(p_local[k])
+            d = (P - B[k]) / np.linalg.norm(P - B[k])
+            line = np.r_[d, np.cross(P - o, d)]
+            a1 = A1[k]
+            a2 = np.cross(a1, d) / np.linalg.norm(np.cross(a1, d))  # the U's second axis: across a1 and the leg
+            passive = np.array([_rotation_twist(a1, B[k], o), _rotation_twist(a2, B[k], o)]
+                               + [_rotation_twist(e, P, o) for e in np.eye(3)]).T
+            assert np.linalg.matrix_rank(passive, tol=1e-9) == 5
+            np.testing.assert_allclose(line @ passive, 0.0, rtol=0, atol=1e-12)  # the closed form holds
+            leg = found[(f"leg{k + 1}",)]
+            assert leg.twists == 6 and leg.constraint_wrenches == ()
+            (w,) = np.asarray(leg.transmission_wrenches)
+            w = w / np.linalg.norm(w[:3]) * np.sign(w[:3] @ d)
+            np.testing.assert_allclose(w, line, rtol=0, atol=1e-9)
+            np.testing.assert_allclose(w @ passive, 0.0, rtol=0, atol=1e-9)
+            assert w @ np.r_[d, np.zeros(3)] == pytest.approx(1.0)  # the actuator's own twist: not reciprocal
+
+
+# the platform twist spaces in closed form, at the platform origin, (v, w): translations (3T), or
+# translations in the xy plane of the planar files and rotations about z (2T1R)
+_3T = np.hstack([np.eye(3), np.zeros((3, 3))])
+_2T1R = np.array([[1.0, 0, 0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 1.0]])
+
+
+@pytest.mark.parametrize("name, space", [("delta_parallelogram", _3T), ("tsai_3upu", _3T),
+                                         ("planar_3rrr", _2T1R), ("planar_3rpr", _2T1R)])
+def test_legs_constraint_wrenches_are_reciprocal_to_the_closed_form_platform_twists(name, space):
+    """Every leg's constraint wrench w satisfies w . t = 0 for every platform twist t of the
+    closed-form space, and together they leave exactly that space (rank 6 - 3); screwkin's
+    mobility of the platform is the same space."""
+    from screwkin.analysis.statics import legs
+
+    mech = screwkin.load(ROBOTS / f"{name}.urdf")
+    for q in mech.generic_configurations()[1][:2]:
+        W = np.array([c for leg in legs(mech, q, "platform") for c in leg.constraint_wrenches])
+        np.testing.assert_allclose(W @ space.T, 0.0, rtol=0, atol=1e-9)
+        assert np.linalg.matrix_rank(W, tol=1e-8) == 3
+    twists = np.array(mech.mobility(output="platform").output.twists)  # (3, 6), rows
+    assert np.linalg.matrix_rank(np.vstack([twists, space]), tol=1e-8) == 3
