@@ -68,7 +68,7 @@ def test_delta_family_default_is_the_plain_delta():
         assert family.model.jointPlacements[k].isApprox(plain.model.jointPlacements[j], 1e-12)
         assert family.model.joints[k].shortname() == plain.model.joints[j].shortname()
     assert [c.name for c in family.cuts] == [c.name for c in plain.cuts]
-    for c, d in zip(family.cuts, plain.cuts):
+    for c, d in zip(family.cuts, plain.cuts, strict=True):
         for f, g in ((c.frame1, d.frame1), (c.frame2, d.frame2)):
             assert family.model.frames[f].placement.isApprox(plain.model.frames[g].placement, 1e-12)
     assert sorted(link_lengths(family.model, family.cuts)) == pytest.approx(
