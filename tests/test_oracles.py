@@ -13,6 +13,7 @@ import screwkin
 from conftest import CORPUS, ROBOTS
 
 LOCAL = pin.ReferenceFrame.LOCAL
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 # files whose cut joints are all fixed (6 rows each) or all spherical (3 rows each)
 WELDED = [CORPUS / n / "robot.urdf" for n in ("cassie_like", "robot_delta", "5bar_linkage", "talos_like", "digit_like")]
@@ -36,17 +37,22 @@ def _configurations(mech, n_random=3, seed=5):
     return [(q, True) for q in closed[:3]] + [(q, False) for q in free]
 
 
-def _pin_rows(model, data, contact_type, j1, M1, j2, M2):
-    """Pinocchio's constraint Jacobian (LOCAL) of a constraint between placement M1 on joint j1
-    and M2 on joint j2, at the configuration data was computed at (calc first: see
-    /work/shared/pinocchio-notes.md)."""
-    cm = pin.RigidConstraintModel(contact_type, model, j1, M1, j2, M2, LOCAL)
+def _pin_rows(model, data, contact_type, j1, M1, j2, M2, reference):
+    """Pinocchio's constraint Jacobian of a constraint between placement M1 on joint j1 and M2
+    on joint j2, at the configuration data was computed at (calc first: see
+    /work/shared/pinocchio-notes.md), in the axes of the constraint's frame 1: LOCAL rows as
+    they come, LOCAL_WORLD_ALIGNED rows (world axes) turned by that frame's rotation."""
+    cm = pin.RigidConstraintModel(contact_type, model, j1, M1, j2, M2, reference)
     cd = cm.createData()
     cm.calc(model, data, cd)
-    return pin.getConstraintJacobian(model, data, cm, cd)
+    K = pin.getConstraintJacobian(model, data, cm, cd)
+    if reference == LOCAL:
+        return K
+    R1 = (data.oMi[j1] * M1).rotation
+    return np.kron(np.eye(len(K) // 3), R1.T) @ K
 
 
-def _oracle_K(mech, q, mapped=True):
+def _oracle_K(mech, q, reference=LOCAL, mapped=True):
     """The stacked constraint Jacobian that Pinocchio's constraint models give, mapped onto the
     rows screwkin documents (positions R1^T (o2 - o1), then log3(R1^T R2) for a weld) by a map T
     written here in closed form.
@@ -71,7 +77,7 @@ def _oracle_K(mech, q, mapped=True):
         oM1, oM2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
         if cut.type == "fixed":
             K = -_pin_rows(model, data, pin.ContactType.CONTACT_6D, f1.parentJoint, f1.placement,
-                           f2.parentJoint, f2.placement)
+                           f2.parentJoint, f2.placement, reference)
             M = oM1.inverse() * oM2
             T = np.eye(6)
             T[:3, 3:] = -pin.skew(M.translation)
@@ -79,11 +85,11 @@ def _oracle_K(mech, q, mapped=True):
             blocks.append(T @ K if mapped else K)
         elif cut.type == "spherical" and not mapped:
             blocks.append(-_pin_rows(model, data, pin.ContactType.CONTACT_3D, f1.parentJoint, f1.placement,
-                                     f2.parentJoint, f2.placement))
+                                     f2.parentJoint, f2.placement, reference))
         elif cut.type == "spherical":
             at_o2 = data.oMi[f1.parentJoint].inverse() * pin.SE3(oM1.rotation, oM2.translation)
             blocks.append(-_pin_rows(model, data, pin.ContactType.CONTACT_3D, f1.parentJoint, at_o2,
-                                     f2.parentJoint, f2.placement))
+                                     f2.parentJoint, f2.placement, reference))
         else:
             raise AssertionError(f"no oracle here for a {cut.type} cut joint")
     return np.vstack(blocks)
@@ -119,15 +125,16 @@ def _projector(K, rtol=1e-9):
     return vt[:rank].T @ vt[:rank], rank
 
 
+@pytest.mark.parametrize("reference", [LOCAL, LWA], ids=["LOCAL", "LOCAL_WORLD_ALIGNED"])
 @pytest.mark.parametrize("path", WELDED + BALLS, ids=_name)
-def test_loop_rows_equal_pinocchios_constraint_models(path):
+def test_loop_rows_equal_pinocchios_constraint_models(path, reference):
     mech = screwkin.load(path, warn=lambda m: None)
     assert mech.cuts and not mech.closure.extra
     assert {c.type for c in mech.cuts} == ({"fixed"} if path in WELDED else {"spherical"})
     assert mech.closure.nrows == sum(6 if c.type == "fixed" else 3 for c in mech.cuts)
     for q, closed in _configurations(mech):
         K = mech.closure.jacobian(q)
-        oracle = _oracle_K(mech, q)
+        oracle = _oracle_K(mech, q, reference)
         assert K.shape == oracle.shape
         scale = max(1.0, np.abs(oracle).max())
         np.testing.assert_allclose(K, oracle, rtol=0, atol=1e-10 * scale)
@@ -139,7 +146,7 @@ def test_loop_rows_equal_pinocchios_constraint_models(path):
             assert np.linalg.norm(_residual_here(mech, q)) < 1e-9
             # closed: Pinocchio's rows as they come, with no map, span the same row space
             P, rank = _projector(K)
-            P_pin, rank_pin = _projector(_oracle_K(mech, q, mapped=False))
+            P_pin, rank_pin = _projector(_oracle_K(mech, q, reference, mapped=False))
             assert rank == rank_pin
             np.testing.assert_allclose(P, P_pin, rtol=0, atol=1e-8)
 
