@@ -1,9 +1,14 @@
 """Independent oracles for what screwkin computes: values taken from outside the code under test.
 
-Loop rows: Pinocchio's own constraint models (``RigidConstraintModel`` with CONTACT_6D for a
-weld / fixed cut joint, CONTACT_3D for a ball / spherical one) and finite differences on the
-manifold (``pin.integrate``) of a residual written here from the frame placements alone.
+- loop rows: Pinocchio's own constraint models (``RigidConstraintModel`` with CONTACT_6D for a
+  weld / fixed cut joint, CONTACT_3D for a ball / spherical one) and finite differences on the
+  manifold (``pin.integrate``) of a residual written here from the frame placements alone;
+- the product of exponentials: modern_robotics' ``FKinSpace`` and ``JacobianSpace``;
+- statics: Bennett's input torque by virtual work (the mechanism moved along its one DOF);
+- legs' wrenches: lines and twist spaces written in closed form from the file's joint centres.
 """
+
+import json
 
 import numpy as np
 import pinocchio as pin
@@ -258,8 +263,6 @@ def test_bennett_statics_command_gives_the_virtual_work_torque(capsys):
     load = " ".join(map(str, BENNETT_LOAD))
     assert main(["statics", str(ROBOTS / "bennett.urdf"), "--set", "joint1=0.7", "--output", "link3",
                  "--wrench", load, "--json"]) == 0
-    import json
-
     out = json.loads(capsys.readouterr().out)
     assert out["units"]["joint1"] == "N m"
     assert out["efforts"]["joint1"] == pytest.approx(expected, rel=1e-6)
