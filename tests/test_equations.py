@@ -98,7 +98,7 @@ def test_acceleration_terms_against_second_differences(name):
     c = vl.acceleration_terms(mid, zd, [sigma])
     assert res.A_value @ zdd == pytest.approx(c, rel=1e-5, abs=1e-8)
     # and the same c from the JSON strings
-    vals = {**all_values(vl, q), **{f"{n}_d": v for n, v in zip(res.unknowns, zd)}, f"{res.inputs[0]}_d": sigma}
+    vals = {**all_values(vl, q), **{f"{n}_d": v for n, v in zip(res.unknowns, zd, strict=True)}, f"{res.inputs[0]}_d": sigma}
     assert [evaluate(e, vals) for e in res.acceleration_terms] == pytest.approx(c, rel=1e-12, abs=1e-15)
 
 

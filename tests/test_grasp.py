@@ -89,7 +89,7 @@ def check_internal_force(r, contacts):
     f = cert.internal_force
     assert np.abs(r.grasp_map @ f).max() < 1e-9
     total_f, total_m = np.zeros(3), np.zeros(3)
-    for c, cf in zip(contacts, cert.contact_forces):
+    for c, cf in zip(contacts, cert.contact_forces, strict=True):
         p = np.array(c["point"] + [0.0] * (3 - len(c["point"])))
         n = np.array(c["normal"] + [0.0] * (3 - len(c["normal"])), float)
         n /= np.linalg.norm(n)
@@ -300,7 +300,7 @@ def test_the_lazy_hull_gives_the_whole_hulls_epsilon_in_space():
     scale = np.array([1, 1, 1, 1 / r.length, 1 / r.length, 1 / r.length])
     for circumscribed, value in ((False, r.quality.epsilon), (True, r.quality.epsilon_upper)):
         pts = []
-        for c, b in zip(contacts, blocks):
+        for c, b in zip(contacts, blocks, strict=True):
             Gi = G[:, b] * scale[:, None]
             if c["model"] == "frictionless":
                 pts.append(Gi[:, 0])

@@ -163,7 +163,7 @@ def test_loop_joint_names_with_dots(tmp_path, capsys, name):
     plain = cli_json(capsys, [argv[0], str(ROBOTS / name), *argv[1:]])["solutions"]
     renamed = cli_json(capsys, [argv[0], str(dotted), *argv[1:]])["solutions"]
     assert len(plain) == len(renamed) >= 1
-    for a, b in zip(plain, renamed):
+    for a, b in zip(plain, renamed, strict=True):
         expected = {}
         for k, v in a["joints"].items():  # the virtual joints carry the loop joint's new name
             loop, dot, role = k.partition(".")

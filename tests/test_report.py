@@ -136,7 +136,7 @@ def test_one_drawing_per_singular_configuration(fourbar_report, capsys, tmp_path
     assert page.count('<figure class="singular">') == n
     rows = _table(page, "singular")
     assert len(rows) == n
-    for row, s in zip(rows, drawn["singular_configurations"]):
+    for row, s in zip(rows, drawn["singular_configurations"], strict=True):
         assert float(row[2].split()[0]) == pytest.approx(np.degrees(s["input_wrapped"]), abs=1e-3)
     assert page.count('<figure class="sweep">') == 1
     assert page.count('<figure class="skeleton">') == 1

@@ -114,7 +114,7 @@ def test_every_joint_of_a_loop_the_cut_joint_included(capsys):
     cut = mech.cuts[0]
     for a in (0.4, 1.3, -2.0):
         for sol in PositionSolver(mech, ["A"]).solve({"A": a}).solutions:
-            dq = dict(zip(mech.coordinate_names, pin.difference(mech.model, mech.neutral(), sol.q)))
+            dq = dict(zip(mech.coordinate_names, pin.difference(mech.model, mech.neutral(), sol.q), strict=True))
             theta = [KinematicState(mech, sol.q).loop_value(cut) if n == "slide" else dq[n] for n in loop.joints]
             np.testing.assert_allclose(loop_product(loop, theta), np.eye(4), atol=1e-9)
     assert main(["screws", path, "--json"]) == 0

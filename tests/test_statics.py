@@ -48,7 +48,7 @@ def test_stewart_leg_forces_are_the_inverse_of_the_leg_lines():
         np.testing.assert_allclose([r.efforts[f"leg{k}"] for k in range(1, 7)], f, rtol=1e-9, atol=1e-9)
         assert all(x.determinate for x in r.reactions)
         # each leg's transmission wrench is its line: a pure force along s_k through p_k
-        for leg, (p, s) in zip(legs(mech, q, "platform"), lines):
+        for leg, (p, s) in zip(legs(mech, q, "platform"), lines, strict=True):
             (screw,) = leg.transmission_screws
             assert leg.constraint_wrenches == () and screw.pitch == pytest.approx(0.0, abs=1e-9)
             assert abs(abs(np.dot(screw.direction, s)) - 1) < 1e-9
@@ -110,7 +110,7 @@ def test_an_overconstrained_linkage_is_statically_indeterminate():
     q = mech.generic_configurations()[1][0]
     r = statics(mech, q, output="link3", wrench=[1, 2, 3, 0.1, 0.2, 0.3])
     assert r.equilibrium and r.indeterminate == 3
-    assert r.efforts["joint1"] is not None
+    assert isinstance(r.efforts["joint1"], float)  # its value: test_oracles.py, by virtual work
     assert any(None in x.wrench for x in r.reactions)
     # a planar linkage: in-plane components determined, out-of-plane ones not
     r = statics(load("fourbar_crank_rocker"), load("fourbar_crank_rocker").generic_configurations()[1][0],

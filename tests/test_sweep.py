@@ -129,7 +129,7 @@ def test_slider_crank_closed_form_and_extras(tmp_path):
     solver = PositionSolver(mech, ["crank_joint"])
     res = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 72)
     x0 = a * np.cos(t0) + np.sqrt(b**2 - (e - a * np.sin(t0)) ** 2)
-    for x_in, joints in zip(res.values, res.joints):
+    for x_in, joints in zip(res.values, res.joints, strict=True):
         t = t0 + x_in
         x = a * np.cos(t) + np.sqrt(b**2 - (e - a * np.sin(t)) ** 2)
         assert abs(joints[res.names.index("slider_joint")] - (x - x0)) < 1e-9

@@ -39,7 +39,8 @@ def test_non_grashof_limits_marked_and_every_curve_in_the_legend():
     verticals = sorted({float(ln.get_xdata()[0]) for ln in top.get_lines() if np.ptp(np.asarray(ln.get_xdata(), float)) == 0})
     expected = sorted(float(np.degrees(s.input)) for s in limits)
     xs = np.asarray(curves[0].get_xdata())
-    for v, e in zip(verticals, expected):
+    assert len(verticals) == len(expected) == 2  # one marker per limit position, no more, no fewer
+    for v, e in zip(verticals, expected, strict=True):
         assert abs((v - e + 180) % 360 - 180) < 1e-6  # the same angle
         assert xs.min() - 3 <= v <= xs.max() + 3  # and on the plotted range (within a step of 2.9 deg)
     # degrees: the input's own curve is the x axis itself

@@ -105,7 +105,7 @@ def test_three_positions_recover_the_moving_pivots_and_solve_reaches_each_pose(t
     assert mech.assemble().iterations == 0
     assert mech.mobility().mobility == 1
     # screwkin solve reaches each pose (one of its assembly modes) to 1e-9
-    for (pose, _, _), t in zip(placed, thetas):
+    for (pose, _, _), t in zip(placed, thetas, strict=True):
         got = solved_poses(capsys, out, float(t - thetas[0]))
         best = min(got, key=lambda s: math.hypot(s[0] - pose[0], s[1] - pose[1]))
         assert math.hypot(best[0] - pose[0], best[1] - pose[1]) < 1e-9
@@ -251,7 +251,7 @@ def test_freudenstein_coefficients_and_structural_error(tmp_path, capsys):
         A = A0f + a * np.array([math.cos(ph), math.sin(ph)])
         return [angle(B - B0f) + (math.pi if c < 0 else 0.0) for B in circles(A, b, B0f, abs(c))]
 
-    for ph, ps in zip(phi, psi):
+    for ph, ps in zip(phi, psi, strict=True):
         assert min(abs(wrap(g - ps)) for g in generated(ph)) < 1e-12
     mids = (x[:-1] + x[1:]) / 2
     errs = [min(abs(wrap(g - np.radians(240 + 90 * math.log(m) / math.log(2)))) for g in generated(
@@ -259,7 +259,7 @@ def test_freudenstein_coefficients_and_structural_error(tmp_path, capsys):
     assert min(errs) > 1e-6 and max(errs) <= math.radians(d["structural_error_deg"]["max"]) + 1e-12
     # the written file, solved by screwkin, gives the rocker angle at each precision point to 1e-9
     assert d["valid"] and all(p["reached"] and p["error_deg"] < 1e-7 for p in d["precision"])
-    for ph, ps in zip(phi, psi):
+    for ph, ps in zip(phi, psi, strict=True):
         sol = run_json(capsys, ["solve", str(out), "--set", f"crank_joint={float(ph - phi[0])!r}"])["solutions"]
         rockers = [s["link_angles"]["rocker"] + (math.pi if c < 0 else 0.0) for s in sol]
         assert min(abs(wrap(r - ps)) for r in rockers) < 1e-9
@@ -304,7 +304,7 @@ def test_path_through_points_of_a_known_coupler_curve(tmp_path, capsys):
     a, b, c = (d["links"][k]["length"] for k in ("crank", "coupler", "rocker"))
     u, v = d["links"]["coupler"]["point"]["x"], d["links"]["coupler"]["point"]["y"]
     t1 = angle(np.array(d["pivots"]["A"]) - A0p)
-    for (px, py), t in zip(points, thetas):
+    for (px, py), t in zip(points, thetas, strict=True):
         value = t - thetas[0]
         sol = run_json(capsys, ["solve", str(out), "--set", f"crank_joint={float(value)!r}", "--output", "coupler_point",
                                   "--starts", "2"])

@@ -68,7 +68,7 @@ def test_delta_family_default_is_the_plain_delta():
         assert family.model.jointPlacements[k].isApprox(plain.model.jointPlacements[j], 1e-12)
         assert family.model.joints[k].shortname() == plain.model.joints[j].shortname()
     assert [c.name for c in family.cuts] == [c.name for c in plain.cuts]
-    for c, d in zip(family.cuts, plain.cuts):
+    for c, d in zip(family.cuts, plain.cuts, strict=True):
         for f, g in ((c.frame1, d.frame1), (c.frame2, d.frame2)):
             assert family.model.frames[f].placement.isApprox(plain.model.frames[g].placement, 1e-12)
     assert sorted(link_lengths(family.model, family.cuts)) == pytest.approx(
@@ -328,3 +328,114 @@ def test_blocks_inserted_a_few_times_still_expand(tmp_path, capsys):
 
     out = expand(path, path.read_text())
     assert out.count('<link name="x0"/>') == 4
+
+
+# ---- the contract with the xacro internals that screwkin/files/xacro.py replaces and calls
+# (xacro keeps them as module globals; a release that renames one, changes its parameters or
+# stops looking it up as a global would leave a hole in the checks: these tests name the version)
+
+def _xacro():
+    import importlib.metadata
+
+    import xacro
+
+    return xacro, importlib.metadata.version("xacro")
+
+
+def _positional(fn):
+    import inspect
+
+    params = [p for p in inspect.signature(fn).parameters.values()
+              if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    return len([p for p in params if p.default is p.empty]), len(params)
+
+
+def _global_names(module):
+    """Every name the module's functions and methods look up as a global (nested code included)."""
+    import inspect
+    import types
+
+    names, stack = set(), [obj.__code__ for obj in vars(module).values() if inspect.isfunction(obj)]
+    stack += [f.__code__ for cls in vars(module).values() if inspect.isclass(cls)
+              for f in vars(cls).values() if inspect.isfunction(f)]
+    while stack:
+        code = stack.pop()
+        names |= set(code.co_names)
+        stack += [c for c in code.co_consts if isinstance(c, types.CodeType)]
+    return names
+
+
+def test_xacro_internals_that_screwkin_replaces_keep_their_shape():
+    """Each function screwkin swaps in (files/xacro.py: _patched) exists in the xacro module,
+    takes the same positional parameters as xacro's own (xacro's calls must bind to the
+    replacement, and the replacement forwards to the original), and is looked up by xacro's own
+    code as a module global (so that the swap takes effect)."""
+    from screwkin.files.xacro import _patched, _prepare
+
+    xacro, version = _xacro()
+    text = FOURBAR.read_text()
+    original, replaced = _patched(xacro, _prepare(FOURBAR, text), FOURBAR)
+    assert set(original) == set(replaced) == {"safe_eval", "eval_extension", "get_include_files", "parse",
+                                              "handle_macro_call", "eval_all", "eval_text", "reqd_attrs"}
+    used = _global_names(xacro)
+    for name, fn in replaced.items():
+        theirs = getattr(xacro, name, None)
+        assert callable(theirs), f"xacro {version} has no function {name}: screwkin/files/xacro.py replaces it"
+        assert _positional(fn) == _positional(theirs), (
+            f"xacro {version}: {name} takes {_positional(theirs)} (required, all) positional parameters, "
+            f"screwkin's replacement {_positional(fn)}")
+        assert name in used, f"xacro {version} no longer calls {name} as a module global: replacing it does nothing"
+
+
+def test_xacro_internals_that_screwkin_calls_keep_their_shape():
+    """The state, functions and classes files/xacro.py reads or calls, as it uses them."""
+    import inspect
+
+    xacro, version = _xacro()
+    where = f"xacro {version} (screwkin/files/xacro.py relies on it)"
+    assert issubclass(xacro.XacroException, Exception), where
+    assert isinstance(xacro.substitution_args_context, dict), where
+    assert isinstance(xacro.all_includes, list) and isinstance(xacro.verbosity, int), where
+    assert hasattr(xacro, "filestack"), where
+    inspect.signature(xacro.init_stacks).bind("file.xacro")
+    inspect.signature(xacro.process_doc).bind(None, mappings={}, verbosity=0)
+    assert _positional(xacro.resolve_macro) == (3, 3), where
+
+
+def test_xacro_resolve_macro_returns_the_macro_with_its_body(monkeypatch):
+    """screwkin counts a macro's elements from ``xacro.resolve_macro(name, macros,
+    symbols)[2].body`` (and takes an error there as "no body": the count would then be skipped
+    silently), so the shape is checked here on a real expansion."""
+    xacro, version = _xacro()
+    seen = []
+    real = xacro.resolve_macro
+
+    def spy(*args):
+        result = real(*args)
+        seen.append(result)
+        return result
+
+    monkeypatch.setattr(xacro, "resolve_macro", spy)
+    screwkin.load(DELTA)  # three legs from one macro
+    assert seen, f"xacro {version} expanded the Delta's macro without resolve_macro"
+    for result in seen:
+        assert isinstance(result, tuple) and len(result) == 3, f"xacro {version}: resolve_macro returns {result!r}"
+        assert hasattr(result[2].body, "getElementsByTagName"), f"xacro {version}: the macro's body is not a DOM node"
+
+
+@pytest.mark.parametrize("text", ["a ${x} b", "$${x} $$(arg a) ${1+2}$(arg a)", "${'}'} x", "$(arg a) ${a}} $", "$$$${y}",
+                                  "plain", "${a}${b}", "$ {a} $(a b c) ${ x }"])
+def test_xacro_lexer_splits_as_screwkin_checks(text):
+    """Before xacro sees a file, screwkin checks every ${...} and $(...) it finds with its own
+    regular expression (files/xacro.py: _TOKENS); xacro's lexer (xacro.LEXER) must find the same ones."""
+    from screwkin.files.xacro import _TOKENS
+
+    xacro, version = _xacro()
+    lex = xacro.QuickLexer(xacro.LEXER)
+    lex.lex(text)
+    theirs = []
+    while lex.peek():
+        kind, token = lex.next()
+        if kind != lex.TEXT:
+            theirs.append(token)
+    assert theirs == [m.group(0) for m in _TOKENS.finditer(text)], f"xacro {version}'s lexer on {text!r}"
