@@ -235,3 +235,61 @@ def test_bad_options_are_usage_errors(args, capsys):
     code = main(["dynamics", str(FOURBAR), "--input", "crank_joint", "--speed", "60rpm", *args])
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+def _mjcf_fourbar():
+    """The four-bar of fourbar_inertial.urdf written as MuJoCo writes a loop: a tree of bodies with
+    hinges, and an <equality><connect> between a site on the coupler's end and one on the rocker's."""
+    def inertial(name, L):
+        m = MASS[name]
+        return f'<inertial pos="{L / 2!r} 0 0" mass="{m!r}" diaginertia="1e-6 {m * L * L / 12!r} {m * L * L / 12!r}"/>'
+
+    return f'''<mujoco><option gravity="0 {-G!r} 0" jacobian="dense"/>
+      <worldbody>
+        <body name="crank">{inertial("crank", A)}<joint name="crank_joint" type="hinge" axis="0 0 1"/>
+          <body name="coupler" pos="{A!r} 0 0">{inertial("coupler", B)}
+            <joint name="coupler_joint" type="hinge" axis="0 0 1"/><site name="B1" pos="{B!r} 0 0"/></body></body>
+        <body name="rocker" pos="{D!r} 0 0">{inertial("rocker", C)}
+          <joint name="rocker_joint" type="hinge" axis="0 0 1"/><site name="B2" pos="{C!r} 0 0"/></body>
+      </worldbody>
+      <equality><connect site1="B1" site2="B2"/></equality></mujoco>'''
+
+
+def test_mujoco_needs_the_input_torque_screwkin_predicts():
+    """MuJoCo as the oracle: at each of screwkin's (q, q', q''), MuJoCo's inverse dynamics of the tree
+    (mj_inverse, equality constraints off) projected onto the motions its connect constraint allows
+    (the null space of its constraint Jacobian efc_J) is the input torque; that Jacobian has the rank
+    screwkin reports, and MuJoCo sees the loop closed."""
+    mujoco = pytest.importorskip("mujoco")
+    model = mujoco.MjModel.from_xml_string(_mjcf_fourbar())
+    data = mujoco.MjData(model)
+    mech = screwkin.load(FOURBAR)
+    r = dynamics(mech, "crank_joint", 2 * np.pi * 90 / 60, 0.0, 2 * np.pi, 24, gravity=(0, -G, 0))
+    names = ["crank_joint", "coupler_joint", "rocker_joint"]
+    sv = [mech.coordinate(n).idx_v for n in names]
+    sq = [mech.coordinate(n).idx_q for n in names]
+    mv = [int(model.jnt_dofadr[model.joint(n).id]) for n in names]
+    mq = [int(model.jnt_qposadr[model.joint(n).id]) for n in names]
+    rank = mech.mobility().rank
+    for k in range(len(r.values)):
+        data.qpos[mq], data.qvel[mv] = r.q[k][sq], r.rates[k][sv]
+        model.opt.disableflags = 0
+        mujoco.mj_forward(model, data)
+        J = data.efc_J.reshape(data.nefc, model.nv).copy()
+        assert np.abs(data.efc_pos).max() < 1e-9  # the loop closed where screwkin closed it
+        s = np.linalg.svd(J, compute_uv=False)
+        assert int(np.sum(s > 1e-9 * s[0])) == rank == 2
+        model.opt.disableflags = int(mujoco.mjtDisableBit.mjDSBL_EQUALITY)
+        data.qacc[mv] = r.accelerations[k][sv]
+        mujoco.mj_inverse(model, data)
+        N = np.linalg.svd(J)[2][rank:].T  # the joint rates the connect allows
+        tau = float(N[:, 0] @ data.qfrc_inverse / N[mv[0], 0])
+        assert r.efforts["crank_joint"][k] == pytest.approx(tau, rel=1e-8, abs=1e-10)
+    model.opt.disableflags = 0
+
+
+def test_mimic_couplings_are_refused_in_one_line(capsys):
+    """Pinocchio's inverse dynamics has no mimic joints: a file error naming the coupling, not a traceback."""
+    code = main(["dynamics", str(ROBOTS / "gear_train_idler_mimic.urdf"), "--input", "input_joint", "--speed", "1"])
+    err = capsys.readouterr().err
+    assert code == 1 and "<mimic>" in err and len(err.strip().splitlines()) == 1

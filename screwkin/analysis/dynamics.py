@@ -218,6 +218,10 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     g = np.asarray(gravity, float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
+    if mech.couplings:  # Pinocchio 4.1's RNEA refuses its mimic joints
+        c = mech.couplings[0]
+        raise MechanismFileError(mech.path, f"dynamics does not take <mimic> couplings yet ({quote(c.joint)} mimics "
+                                            f"{quote(c.mimics)}): Pinocchio's inverse dynamics has no mimic joints")
     notes = list(check_inertias(mech))
     fixed = dict(fixed or {})
     if inputs is None:
