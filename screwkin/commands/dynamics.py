@@ -12,7 +12,7 @@ from ..errors import UsageError, quote
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
-from ._common import add_point_option, joint_assignments, joint_value, named_points, names_list, value_kind
+from ._common import joint_assignments, joint_value, named_points, names_list, value_kind
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -38,7 +38,10 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--load", action="append", metavar="LINK:FX,FY,FZ,MX,MY,MZ",
                     help="a constant wrench on a link at its frame's origin (or on a --point by its name), "
                          "force [N] and moment [N*m] in world axes, units allowed (10N, 2kN, 0.5Nm); repeatable")
-    add_point_option(sp)
+    sp.set_defaults(point=False)
+    sp.add_argument("--point", action="append", dest="points", metavar="NAME=LINK:x,y,z",
+                    help="a named point on a link, in the link's frame (units allowed: P=coupler:60mm,20mm,0), for "
+                         "--load NAME:...; repeatable")
     sp.add_argument("--cs", default="0.05",
                     help="coefficient of speed fluctuation of the flywheel figure (default 0.05)")
     sp.add_argument("--csv", help="write the efforts, energies, shaking wrench and reactions per step to this CSV file")
@@ -97,19 +100,21 @@ def run(mech, args) -> int:
         raise UsageError(f"--input {quote(args.input)} slides: give its range with --from and --to")
     start = 0.0 if args.start is None else joint_value(mech, args.input, args.start, "--from")
     stop = start + 2 * math.pi if args.stop is None else joint_value(mech, args.input, args.stop, "--to")
-    degrees = kind == "angle" and (not typed or any(unit_kind(parse_typed_value(t)[1]) == "angle"
-                                                    and "deg" in t.lower() for t in typed))
+    # the input shown in the unit typed (the first --from/--to with a unit of its kind; SI when typed bare),
+    # degrees when no range is typed
+    units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
+    shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
     points = named_points(mech, args)
     res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
                    gravity=_gravity(args.gravity), loads=_loads(mech, args.load, points), cs=_cs(args.cs),
                    progress=True)
     if args.csv:
         with open(args.csv, "w") as f:
-            f.write(dynamics_csv(res, degrees))
+            f.write(dynamics_csv(res, shown))
     if args.plot:
-        dynamics_plot(res, args.plot, degrees, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
+        dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:
         print(json.dumps(to_jsonable(dynamics_dict(res)), indent=2))
     else:
-        print(dynamics_text(res, degrees, args.speed))
+        print(dynamics_text(res, shown, args.speed))
     return 0

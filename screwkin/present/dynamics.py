@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.dynamics import COMPONENTS, DynamicsResult
+from ..units import parse_value
 from .plots import _pyplot
 from .report import sweep_rows
 from .tables import column_text, csv_text, table
@@ -17,11 +18,12 @@ REACTION_POINT = ("what the parent side (link1 of a cut joint) exerts on the chi
 SHAKING_POINT = "what the moving links exert on the ground: force, and moment about the world origin, world axes"
 
 
-def _input_scale(r: DynamicsResult, degrees: bool):
-    """(factor, unit) of the input values as shown."""
-    if r.unit == "rad":
-        return (180.0 / np.pi, "deg") if degrees else (1.0, "rad")
-    return 1.0, "m"
+def _input_scale(r: DynamicsResult, shown: str | None):
+    """(factor from SI, unit) of the input values as shown: in ``shown`` (a unit of the input's
+    kind as a person typed it: deg, mm, in), else in SI."""
+    if shown:
+        return 1.0 / parse_value(f"1{shown}"), shown
+    return 1.0, r.unit
 
 
 def _list(a):
@@ -60,8 +62,8 @@ def _effort_header(r, name):
     return f"{name} [{r.effort_units[name].replace(' ', '*')}]"
 
 
-def dynamics_text(r: DynamicsResult, degrees: bool = False, speed_text: str | None = None) -> str:
-    f, u = _input_scale(r, degrees)
+def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str | None = None) -> str:
+    f, u = _input_scale(r, shown)
     rate = "rad/s" if r.unit == "rad" else "m/s"
     speed = f"{speed_text} ({r.speed:.6g} {rate})" if speed_text else f"{r.speed:.6g} {rate}"
     lines = [f"{r.input} driven at the constant speed {speed}, {len(r.values)} configurations"]
@@ -121,8 +123,8 @@ def dynamics_text(r: DynamicsResult, degrees: bool = False, speed_text: str | No
     return "\n".join(lines)
 
 
-def dynamics_csv(r: DynamicsResult, degrees: bool = False) -> str:
-    f, u = _input_scale(r, degrees)
+def dynamics_csv(r: DynamicsResult, shown: str | None = None) -> str:
+    f, u = _input_scale(r, shown)
     header = [f"{r.input} [{u}]"] + [_effort_header(r, n) for n in r.inputs] + [
         "kinetic energy [J]", "potential energy [J]", "input power [W]"]
     header += [f"shaking {c} [{'N' if c[0] == 'f' else 'N*m'}]" for c in COMPONENTS]
@@ -139,10 +141,10 @@ def dynamics_csv(r: DynamicsResult, degrees: bool = False) -> str:
     return csv_text(header, rows)
 
 
-def dynamics_plot(r: DynamicsResult, path: str, degrees: bool = False, title: str | None = None) -> None:
+def dynamics_plot(r: DynamicsResult, path: str, shown: str | None = None, title: str | None = None) -> None:
     """The input efforts against the input (one curve per actuator, the mean dashed) into a PNG."""
     plt = _pyplot("--plot")
-    f, u = _input_scale(r, degrees)
+    f, u = _input_scale(r, shown)
     fig, ax = plt.subplots(figsize=(8, 4.5))
     x = r.values * f
     for name in r.inputs:
