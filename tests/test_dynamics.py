@@ -300,3 +300,35 @@ def test_mimic_couplings_are_refused_in_one_line(capsys):
 def test_the_input_is_shown_in_the_unit_typed(range_, shown, capsys):
     assert main(["dynamics", str(FOURBAR), "--input", "crank_joint", "--speed", "1", "--steps", "2", *range_]) == 0
     assert f"crank_joint [{shown}]" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name, load_on", [("bennett", "link3"), ("quick_return_slot", "slotted")])
+def test_shaking_wrench_is_the_momentum_balance(name, load_on):
+    """The wrench on the ground (force, moment about the world origin) is the moving bodies' weights
+    and the load less the rate of change of their momentum, each body's Newton-Euler
+    I a + v x* I v from Pinocchio's forward kinematics at the same (q, q', q''): on a spatial
+    overconstrained loop with a cut joint at the ground (Bennett) and a planar slot."""
+    mech = screwkin.load(ROBOTS / f"{name}.urdf")
+    g = np.array([0.3, -G, -2.0])
+    w = np.array([1.0, 2.0, -3.0, 0.1, 0.2, 0.3])
+    r = dynamics(mech, mech.actuated[0], 3.0, 0.1, 1.1, 4, gravity=tuple(g), loads=(Load(load_on, tuple(w)),))
+    model, data = mech.model, mech.data
+    for k in range(len(r.values)):
+        pin.forwardKinematics(model, data, r.q[k], r.rates[k], r.accelerations[k])
+        pin.updateFramePlacements(model, data)
+        o = data.oMf[mech.link_frame(load_on)].translation
+        force, moment = w[:3].copy(), w[3:] + np.cross(o, w[:3])
+        for i in range(1, model.njoints):
+            inertia, M = model.inertias[i], data.oMi[i]
+            c = M.act(inertia.lever)
+            dh = M.act(inertia * data.a[i] + data.v[i].cross(inertia * data.v[i]))
+            force += inertia.mass * g - dh.linear
+            moment += np.cross(c, inertia.mass * g) - dh.angular
+        np.testing.assert_allclose(r.shaking_force[k], force, rtol=0, atol=1e-9 * np.abs(force).max())
+        np.testing.assert_allclose(r.shaking_moment[k], moment, rtol=0, atol=1e-9 * np.abs(force).max())
+
+
+def test_sdf_is_refused_since_its_inertias_are_not_read(capsys):
+    code = main(["dynamics", str(DATA / "fourbar.sdf"), "--input", "A", "--speed", "1"])
+    err = capsys.readouterr().err
+    assert code == 1 and "SDF" in err and len(err.strip().splitlines()) == 1
