@@ -12,6 +12,7 @@ topology) <- ``analysis`` (results) <- ``present`` (text, JSON, pictures, views)
 """
 
 from .analysis.batch import SerialJacobians
+from .analysis.dynamics import DynamicsResult, Load, dynamics
 from .analysis.ik import inverse_kinematics
 from .analysis.mobility import (
     IdleMotion,
@@ -54,6 +55,9 @@ __all__ = [
     "SweepSingularity",
     "sweep",
     "locate_singularities",
+    "dynamics",
+    "DynamicsResult",
+    "Load",
     "ScanResult",
     "scan",
     "study",

@@ -20,6 +20,7 @@ import numpy as np
 
 from .commands import (
     draw,
+    dynamics,
     equations,
     grasp,
     ik,
@@ -48,8 +49,8 @@ from .units import parse_length
 __all__ = ["main", "COMMANDS"]
 
 #: The commands, in the order `screwkin` lists them.
-COMMANDS = (mobility, info, solve, screws, singularities, map, scan, view, ik, sweep, statics, study, synthesize,
-            grasp, workspace, equations, draw, report)
+COMMANDS = (mobility, info, solve, screws, singularities, map, scan, view, ik, sweep, statics, dynamics, study,
+            synthesize, grasp, workspace, equations, draw, report)
 _COMMAND_MODULES = {m.NAME: m for m in COMMANDS}
 
 

@@ -39,7 +39,8 @@ from ..model.state import KinematicState
 from .screws import Screw, cut_twists, screw_of
 from .singular import Generic, measures
 
-__all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw"]
+__all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
+           "reaction_table"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -80,6 +81,29 @@ def _load_norm(w, L) -> float:
     return float(np.linalg.norm(np.r_[np.asarray(w[:3]) * L, w[3:]]))
 
 
+def balance(mech, K, a_idx, b) -> tuple:
+    """The balance of generalized forces E tau + K^T lambda = b (E: the columns of the actuated
+    velocity indices ``a_idx``; K: the closure Jacobian, rows as ClosureSystem writes them; b:
+    the generalized force the tree needs [N, N m]), solved in the least-squares, minimum-norm
+    sense by SVD with screwkin's rank tolerance.  Returns (tau, lambda, N, unbalanced, scale):
+    N (unknowns x dim) spans the null space of [E, K^T] (what the balance leaves open: redundant
+    constraint rows, redundant actuation), unbalanced = |[E, K^T] x - b|, scale the size of the
+    system (for a relative test of unbalanced)."""
+    tol = mech.tolerances
+    nv = mech.nv
+    E = np.zeros((nv, len(a_idx)))
+    E[a_idx, np.arange(len(a_idx))] = 1.0
+    A = np.hstack([E, K.T]) if K.size else E
+    U, s, Vt = np.linalg.svd(A, full_matrices=True) if A.size else (np.eye(nv), np.zeros(0), np.eye(0))
+    r = int(np.sum(s > max(tol.rank_rtol * (s[0] if s.size else 0), tol.rank_atol))) if s.size else 0
+    x = Vt[:r].T @ ((U[:, :r].T @ b) / s[:r]) if r else np.zeros(A.shape[1])
+    N = Vt[r:].T  # (unknowns, dim null)
+    unbalanced = float(np.linalg.norm(A @ x - b))
+    scale = max(float(np.linalg.norm(b)), float(np.abs(A).max()) if A.size else 1.0, 1e-12)
+    m = len(a_idx)
+    return x[:m], x[m:], N, unbalanced, scale
+
+
 def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = False) -> StaticsResult:
     """Actuator efforts and joint reactions holding ``wrench`` (force, moment) [N, N m] applied to
     ``output`` at its frame's origin (world axes) and, with ``gravity``, the links' weights,
@@ -102,18 +126,8 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     if output is not None:
         J_o = KinematicState(mech, q).link_jacobian(output, LWA)
         b -= J_o.T @ w
-    E = np.zeros((nv, len(a_idx)))
-    E[a_idx, np.arange(len(a_idx))] = 1.0
-    A = np.hstack([E, K.T]) if K.size else E
-    # least squares by SVD with screwkin's rank tolerance; the null space is what statics leaves open
-    U, s, Vt = np.linalg.svd(A, full_matrices=True) if A.size else (np.eye(nv), np.zeros(0), np.eye(0))
-    r = int(np.sum(s > max(tol.rank_rtol * (s[0] if s.size else 0), tol.rank_atol))) if s.size else 0
-    x = Vt[:r].T @ ((U[:, :r].T @ b) / s[:r]) if r else np.zeros(A.shape[1])
-    N = Vt[r:].T  # (unknowns, dim null)
-    unbalanced = float(np.linalg.norm(A @ x - b))
-    scale = max(float(np.linalg.norm(b)), float(np.abs(A).max()) if A.size else 1.0, 1e-12)
+    tau, lam, N, unbalanced, scale = balance(mech, K, a_idx, b)
     m = len(a_idx)
-    tau, lam = x[:m], x[m:]
     free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
     efforts, units = {}, {}
     for k, (name, iv) in enumerate(zip(inputs, a_idx)):
@@ -136,25 +150,37 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
 def _reactions(mech, q, lam, w, output, gravity, N_lam):
     """Reactions of every joint for constraint forces lam (and the load), and whether each is
     determined: it must not change along the null directions N_lam of the constraint forces."""
-    base = _joint_wrenches(mech, q, lam, w, output, gravity)
-    free = {name: np.zeros(6) for name in base}
-    if N_lam is not None and N_lam.size:
-        for k in range(N_lam.shape[1]):
-            for name, value in _joint_wrenches(mech, q, N_lam[:, k], None, None, False).items():
-                free[name] = np.maximum(free[name], np.abs(value[1]))
-    size = max([float(np.linalg.norm(v[1])) for v in base.values()] + [1.0])
+    loads = [(mech.link_frame(output), np.asarray(w, float))] if w is not None else []
     out = []
-    for name, (kind, wrench) in base.items():
-        open_ = free[name] > 1e-7 * size  # components that change along the indeterminate directions
+    for name, (kind, wrench, open_) in reaction_table(mech, q, lam, loads, gravity, N_lam).items():
         out.append(Reaction(name, kind, tuple(None if o else float(x) for x, o in zip(wrench, open_)),
                             not open_.any()))
     return tuple(out)
 
 
-def _joint_wrenches(mech, q, lam, w, output, gravity) -> dict:
-    """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam."""
+def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
+    """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
+    constraint forces lam, and the mask of its components that change along the null
+    directions N_lam of the constraint forces (not determined by the balance)."""
+    base = joint_wrenches(mech, q, lam, loads, gravity, v, a)
+    free = {name: np.zeros(6) for name in base}
+    if N_lam is not None and N_lam.size:
+        for k in range(N_lam.shape[1]):
+            for name, value in joint_wrenches(mech, q, N_lam[:, k], (), False).items():
+                free[name] = np.maximum(free[name], np.abs(value[1]))
+    size = max([float(np.linalg.norm(x[1])) for x in base.values()] + [1.0])
+    # components that change along the indeterminate directions
+    return {name: (kind, wrench, free[name] > 1e-7 * size) for name, (kind, wrench) in base.items()}
+
+
+def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dict:
+    """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
+    ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
+    links' weights with ``gravity`` (model.gravity) and, with v and a, the motion's inertial
+    forces (Pinocchio's RNEA at (q, v, a)): what the parent side (link1 of a cut joint) exerts
+    on the child side (link2)."""
     model = mech.model
-    data = model.createData()
+    data = model.createData()  # a Data of its own: nothing read from or left in mech.data
     pin.framesForwardKinematics(model, data, q)
     rows = mech.closure.row_wrenches(q)
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
@@ -172,8 +198,8 @@ def _joint_wrenches(mech, q, lam, w, output, gravity) -> dict:
             continue
         apply(fa, wa * value)
         apply(fb, wb * value)
-    if w is not None:  # the load acts on the output link
-        apply(mech.link_frame(output), np.asarray(w, float))
+    for frame, wrench in loads:  # the loads, each on its link
+        apply(frame, np.asarray(wrench, float))
     # each cut joint: the wrench its rows exert on link2, at F2's origin
     labels = mech.closure.row_labels()
     for (fa, wa, fb, wb), value, label in zip(rows, lam, labels):
@@ -190,7 +216,7 @@ def _joint_wrenches(mech, q, lam, w, output, gravity) -> dict:
     if not gravity:
         model.gravity = pin.Motion.Zero()
     try:
-        pin.rnea(model, data, q, zero_v, zero_v, fext)
+        pin.rnea(model, data, q, zero_v if v is None else v, zero_v if a is None else a, fext)
     finally:
         model.gravity = saved
     virtual = {n for names in mech.virtual_joints.values() for n in names}

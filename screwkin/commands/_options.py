@@ -35,6 +35,7 @@ def screwkin_version() -> str:
 #: The bounds of the counts people type, (smallest, largest), by what they count.
 BOUNDS = {
     "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest
+    "dynamics_steps": (1, 20_000),    # dynamics --steps: 1.2 ms a step on a four-bar, 4.5 on a six-bar (90 s at most)
     "figure_steps": (2, 20_000),      # draw --singular / report --steps: a search for singular configurations
     "starts": (0, 1_000),             # solve / ik / synthesize --starts: random starting configurations
     "iterations": (0, 1_000),         # solve / report --iterations: Newton iterations shown

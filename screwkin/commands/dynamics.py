@@ -1,0 +1,120 @@
+"""``screwkin dynamics``: the efforts, joint reactions, shaking forces, kinetic energy and flywheel of
+a mechanism driven at constant input speed (inverse dynamics of the closed chain)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+
+from ..analysis.dynamics import Load, dynamics
+from ..errors import UsageError, quote
+from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
+from ..present.report import to_jsonable
+from ..units import parse_typed_value, parse_value, unit_kind
+from ._common import joint_assignments, joint_value, named_points, names_list, value_kind
+from ._options import count
+
+__all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
+
+NAME = "dynamics"
+NEEDS_MECHANISM = True
+
+
+def add_parser(sub, common, scaled):
+    sp = sub.add_parser(NAME, help="input efforts, joint reactions, shaking forces and flywheel at constant input speed")
+    common(sp)
+    sp.add_argument("--input", required=True, help="the input joint driven at constant speed")
+    sp.add_argument("--speed", required=True, help="its constant speed (60rpm, 90deg/s, 2rad/s, 50mm/s; SI bare)")
+    sp.add_argument("--from", dest="start", help="first input value (default 0 for a turning input)")
+    sp.add_argument("--to", dest="stop", help="last input value (default 360deg for a turning input)")
+    sp.add_argument("--steps", type=count("dynamics_steps"), default=72,
+                    help="number of steps (default 72, at most 20,000)")
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
+    sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
+    sp.add_argument("--gravity", metavar="GX,GY,GZ",
+                    help="gravity [m/s^2] in world axes, e.g. 0,0,-9.81 (default: none)")
+    sp.add_argument("--load", action="append", metavar="LINK:FX,FY,FZ,MX,MY,MZ",
+                    help="a constant wrench on a link at its frame's origin (or on a --point by its name), "
+                         "force [N] and moment [N*m] in world axes, units allowed (10N, 2kN, 0.5Nm); repeatable")
+    sp.set_defaults(point=False)
+    sp.add_argument("--point", action="append", dest="points", metavar="NAME=LINK:x,y,z",
+                    help="a named point on a link, in the link's frame (units allowed: P=coupler:60mm,20mm,0), for "
+                         "--load NAME:...; repeatable")
+    sp.add_argument("--cs", default="0.05",
+                    help="coefficient of speed fluctuation of the flywheel figure (default 0.05)")
+    sp.add_argument("--csv", help="write the efforts, energies, shaking wrench and reactions per step to this CSV file")
+    sp.add_argument("--plot", help="draw the input effort against the input into this PNG file (needs matplotlib)")
+
+
+def _gravity(text):
+    if text is None:
+        return (0.0, 0.0, 0.0)
+    parts = [p for p in text.replace(" ", ",").split(",") if p.strip()]
+    if len(parts) != 3:
+        raise UsageError(f"--gravity expects GX,GY,GZ, got {quote(text, 60)}")
+    return tuple(parse_value(p, "linear acceleration", "--gravity") for p in parts)
+
+
+def _loads(mech, items, points) -> tuple:
+    by_name = {p.name: p for p in points}
+    out = []
+    for text in items or []:
+        target, sep, rest = text.rpartition(":")
+        parts = [p for p in rest.replace(" ", ",").split(",") if p.strip()]
+        if not sep or not target.strip() or len(parts) != 6:
+            raise UsageError(f"--load expects LINK:FX,FY,FZ,MX,MY,MZ (6 numbers), got {quote(text, 80)}")
+        target = target.strip()
+        wrench = tuple(parse_value(p, "force" if k < 3 else "moment", "--load") for k, p in enumerate(parts))
+        if target in by_name:
+            p = by_name[target]
+            out.append(Load(p.link, wrench, tuple(p.local), p.name))
+        else:
+            mech.link_frame(target)  # a clear error for an unknown link
+            out.append(Load(target, wrench))
+    return tuple(out)
+
+
+def _cs(text):
+    try:
+        cs = float(text)
+    except ValueError:
+        raise UsageError(f"--cs expects a number, got {quote(text, 40)}") from None
+    if not 0 < cs < 2:  # nan fails both
+        raise UsageError(f"--cs must lie between 0 and 2 (e.g. 0.05), got {quote(text, 40)}")
+    return cs
+
+
+def run(mech, args) -> int:
+    fixed = joint_assignments(mech, args.set, "--set")
+    inputs = names_list(args.inputs) or None
+    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    kind = value_kind(mech, args.input)
+    if kind is None:
+        mech.coordinate(args.input)  # a clear error for an unknown joint
+        raise UsageError(f"--input {quote(args.input)}: dynamics drives a one-coordinate joint (revolute, prismatic)")
+    speed = joint_value(mech, args.input, args.speed, "--speed", order=1)
+    typed = [t for t in (args.start, args.stop) if t is not None]
+    if kind == "length" and len(typed) < 2:
+        raise UsageError(f"--input {quote(args.input)} slides: give its range with --from and --to")
+    start = 0.0 if args.start is None else joint_value(mech, args.input, args.start, "--from")
+    stop = start + 2 * math.pi if args.stop is None else joint_value(mech, args.input, args.stop, "--to")
+    # the input shown in the unit typed (the first --from/--to with a unit of its kind; SI when typed bare),
+    # degrees when no range is typed
+    units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
+    shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
+    points = named_points(mech, args)
+    res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
+                   gravity=_gravity(args.gravity), loads=_loads(mech, args.load, points), cs=_cs(args.cs),
+                   progress=True)
+    if args.csv:
+        with open(args.csv, "w") as f:
+            f.write(dynamics_csv(res, shown))
+    if args.plot:
+        dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
+    if args.json:
+        print(json.dumps(to_jsonable(dynamics_dict(res)), indent=2))
+    else:
+        print(dynamics_text(res, shown, args.speed))
+    return 0
