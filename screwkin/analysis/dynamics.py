@@ -147,15 +147,15 @@ def _gravity(model, g):
         model.gravity = saved
 
 
-def _load_wrenches(mech, loads) -> list:
+def _load_wrenches(mech, loads, data) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the placements in
-    mech.data (the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
+    ``data`` (the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []
     for ld in loads:
         fid = mech.link_frame(ld.link)
         w = np.asarray(ld.wrench, float)
         if ld.point is not None:
-            M = mech.data.oMf[fid]
+            M = data.oMf[fid]
             arm = M.rotation @ np.asarray(ld.point, float)
             w = np.r_[w[:3], w[3:] + np.cross(arm, w[:3])]
         out.append((fid, w))
@@ -235,7 +235,8 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     solver = PositionSolver(mech, inputs)
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
                 near=near, rate=speed, progress=progress)
-    model, data = mech.model, mech.data
+    model = mech.model
+    data = model.createData()  # a Data of its own: nothing read from or left in mech.data
     a_idx = mech.velocity_indices(inputs)
     m = len(a_idx)
     n = len(res.values)
@@ -251,7 +252,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             b = pin.rnea(model, data, q, v, a).copy()
             pin.computeJointJacobians(model, data, q)
             pin.updateFramePlacements(model, data)
-            frames = _load_wrenches(mech, loads)
+            frames = _load_wrenches(mech, loads, data)
             for fid, w in frames:
                 J = frame_jacobian(model, data, fid, LWA)
                 b -= J.T @ w
@@ -266,7 +267,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
                 reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
                 kinds[name] = kind
                 open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
-            # data holds q's placements again (reaction_table ends with a forward pass)
+            # data holds q's placements (its own Data: reaction_table computes in another)
             for name, (kind, wrench, _) in table.items():
                 if kind == "tree" and name in ground_tree:
                     sign, origin = -1.0, data.oMi[mech.coordinate(name).joint_id].translation
