@@ -10,7 +10,7 @@ Two methods:
   mechanism).  From the output's position in the mechanism's assembled configuration the
   grid is filled outwards, wave by wave: each new point is solved (loop closures, the target,
   joint limits) from the solution at a neighbour, all points of a wave in one batched Newton
-  solve (analysis.batch.BatchClosure).  A solution must continue its neighbour's: it may not
+  solve (analysis.batch_closure.BatchClosure).  A solution must continue its neighbour's: it may not
   jump to another working mode (another branch of a leg), so the workspace is the one of
   the assembly mode the file is drawn in.  Along the grid's last axis every run of reached
   points is extended to the boundary by bisection (solved too), and the volume is the sum of
@@ -42,7 +42,9 @@ import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
 from ..model.linalg import rank
-from .batch import BatchClosure, SerialJacobians, Unbatchable, damped_steps
+from ..model.newton import damped_steps
+from .batch import SerialJacobians
+from .batch_closure import BatchClosure, Unbatchable
 from .position import within_limits
 from .singular import Generic
 
