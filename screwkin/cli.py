@@ -21,6 +21,7 @@ import numpy as np
 from .commands import (
     draw,
     equations,
+    export,
     grasp,
     ik,
     info,
@@ -49,7 +50,7 @@ __all__ = ["main", "COMMANDS"]
 
 #: The commands, in the order `screwkin` lists them.
 COMMANDS = (mobility, info, solve, screws, singularities, map, scan, view, ik, sweep, statics, study, synthesize,
-            grasp, workspace, equations, draw, report)
+            grasp, workspace, equations, draw, report, export)
 _COMMAND_MODULES = {m.NAME: m for m in COMMANDS}
 
 
