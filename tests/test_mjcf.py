@@ -17,7 +17,7 @@ FREE, BALL, SLIDE, HINGE = (int(t) for t in (mujoco.mjtJoint.mjJNT_FREE, mujoco.
                                              mujoco.mjtJoint.mjJNT_SLIDE, mujoco.mjtJoint.mjJNT_HINGE))
 
 MJCF = DATA / "mjcf"
-FILES = ["fourbar.xml", "slider_crank.xml", "delta_rss.xml", "tilted_defaults.xml"]
+FILES = ["fourbar.xml", "slider_crank.xml", "delta_rss.xml", "tilted_defaults.xml", "real_file_sections.xml"]
 
 
 def _mj(path):
@@ -97,7 +97,7 @@ def mujoco_mobility(path):
 
 
 @pytest.mark.parametrize("name, expected", [("fourbar.xml", 1), ("slider_crank.xml", 1), ("delta_rss.xml", 9),
-                                            ("tilted_defaults.xml", 3)])
+                                            ("tilted_defaults.xml", 3), ("real_file_sections.xml", 4)])
 def test_mobility_equals_mujocos_constraint_rank(name, expected):
     r = screwkin.load(MJCF / name, warn=lambda w: None).mobility()
     free, nv = mujoco_mobility(MJCF / name)
@@ -134,12 +134,14 @@ def test_cli_mobility_and_solve(capsys):
     assert any(abs(v["guide"] - (x - 0.15)) < 1e-9 for v in values)
 
 
-def test_geom_inertia_is_said(capsys):
+def test_what_is_not_read_is_said(capsys):
     assert main(["info", str(MJCF / "delta_rss.xml")]) == 0
+    assert "have geoms but no <inertial>" not in capsys.readouterr().err  # each body with geoms has one
+    assert main(["info", str(MJCF / "real_file_sections.xml")]) == 0
     err = capsys.readouterr().err
-    assert "have geoms but no <inertial>" not in err  # every body with geoms has an <inertial>
-    assert main(["info", str(MJCF / "fourbar.xml")]) == 0
-    assert "have geoms but no <inertial>" not in capsys.readouterr().err
+    assert "4 bodies ('crank', 'coupler', 'rocker', ...) have geoms but no <inertial>" in err
+    assert "joint 'bj' (ball) has a range: its cone of rotation is not read" in err
+    assert "<tendon> elements are not read" in err
 
 
 BAD = [
@@ -167,3 +169,34 @@ def test_unsupported_elements_are_one_line_errors(tmp_path, capsys, body, extra,
     assert main(["mobility", str(f)]) == 1
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err and str(f) in err
+
+
+INLINE = [  # (worldbody, equality): mobility checked against MuJoCo's nv - rank
+    # a weld to the world (body2 omitted, relpose from qpos0) locks a hinged bar
+    ('<body name="a" euler="10 20 30"><joint name="j" axis="0 1 1"/><inertial pos="0.1 0 0" mass="1" '
+     'diaginertia="1 1 1"/></body>', '<weld body1="a" anchor="0.1 0 0"/>'),
+    # a slider on a rail welded to a hinged arm through two joints in one body (joint pos off the origin)
+    ('<body name="arm" pos="0 0 0.1"><joint name="h1" pos="0.02 0 0" axis="0 0 1"/><joint name="h2" '
+     'pos="0 0.03 0" axis="1 0 0"/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>'
+     '<body name="rail" pos="0.1 0 0.1"><joint name="s" type="slide" axis="1 0 0"/><inertial pos="0 0 0" '
+     'mass="1" diaginertia="1 1 1"/></body>', '<connect body1="arm" body2="rail" anchor="0.1 0 0"/>'),
+]
+
+
+@pytest.mark.parametrize("bodies, equality", INLINE)
+def test_inline_models_against_mujoco(tmp_path, bodies, equality):
+    f = tmp_path / "m.xml"
+    f.write_text(f"<mujoco><worldbody>{bodies}</worldbody><equality>{equality}</equality></mujoco>")
+    free, _ = mujoco_mobility(f)
+    mech = screwkin.load(f, warn=lambda w: None)
+    assert mech.mobility().mobility == free
+    m, d = _mj(f)
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        qpos = random_qpos(m, rng)
+        d.qpos[:] = qpos
+        mujoco.mj_kinematics(m, d)
+        pin.framesForwardKinematics(mech.model, mech.data, screwkin_q(mech, m, qpos))
+        for b in range(1, m.nbody):
+            M = mech.data.oMf[mech.link_frame(_name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
+            np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-9)

@@ -293,6 +293,8 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 limit = f'<limit lower="{lo:.17g}" upper="{hi:.17g}" effort="0" velocity="0"/>'
             elif jt == "ball":
                 replacements.append((jn, "SPHERICAL"))
+                if a.get("range") is not None and a.get("limited", "auto") != "false":
+                    r.warnings.append(f"{jw} (ball) has a range: its cone of rotation is not read (unlimited here)")
             out.append(f'<joint name={quoteattr(jn)} type="{utype}"><parent link={quoteattr(prev)}/>'
                        f'<child link={quoteattr(child)}/>{_origin(origin)}<axis xyz="{_fmt(axis)}"/>{limit}</joint>')
             joints.append(JointSpec(jn, utype, prev, child, tuple(origin.translation),
