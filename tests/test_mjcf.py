@@ -112,7 +112,7 @@ def test_what_is_read():
     assert [c.name for c in mech.spec.cut_joints] == ["pivot"] and mech.spec.cut_joints[0].frame2 == "world"
     assert [(c.joint, c.mimics, c.multiplier) for c in mech.spec.couplings] == [
         ("finger_b_slide", "finger_a_slide", -1.0)]
-    assert mech.actuated == ["crank_joint", "wrist", "finger_a_slide"]
+    assert (mech.actuated, mech.actuation_source) == (["crank_joint", "wrist", "finger_a_slide"], "mjcf actuator")
     i = mech.coordinate("wrist").idx_q  # range="-90 90" in degrees
     assert (mech.model.lowerPositionLimit[i], mech.model.upperPositionLimit[i]) == pytest.approx((-np.pi / 2,
                                                                                                   np.pi / 2))

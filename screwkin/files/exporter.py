@@ -35,7 +35,7 @@ from .description import Coupling
 from .writer import _f, _v
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
-           "TINY_MASS"]
+           "TINY_MASS", "coupling_about"]
 
 #: Mass [kg] (and inertia 1e-3 of it [kg m^2]) given to a moving body without one, which MuJoCo
 #: refuses; below Tolerances.dummy_mass, so screwkin still reads such a body as massless.
