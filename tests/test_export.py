@@ -63,6 +63,22 @@ def test_round_trip(tmp_path, capsys, name, inputs, setting):
     mujoco.mj_forward(m, d)
     J = d.efc_J.reshape(d.nefc, m.nv)
     assert m.nv - np.linalg.matrix_rank(J, tol=1e-9) == M
+    # inertias (Pinocchio's, of each moving joint's body, in its child link's frame) and actuators
+    for j in original.spec.joints:
+        if j.type == "fixed" or not original.model.existJointName(j.name):
+            continue
+        inertia = original.model.inertias[original.model.getJointId(j.name)]
+        if inertia.mass == 0:
+            continue
+        b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, j.child)
+        assert m.body_mass[b] == pytest.approx(inertia.mass, rel=1e-12)
+        np.testing.assert_allclose(m.body_ipos[b], inertia.lever, atol=1e-12)
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, m.body_iquat[b])
+        R = R.reshape(3, 3)
+        np.testing.assert_allclose(R @ np.diag(m.body_inertia[b]) @ R.T, inertia.inertia, atol=1e-12)
+    driven = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, m.actuator_trnid[a][0]) for a in range(m.nu)]
+    assert driven == list(original.actuated)
     back = screwkin.load(out_x, warn=lambda w: None)
     solutions = _solutions(back, shifted)
     assert solutions and d.ne >= 3

@@ -200,3 +200,12 @@ def test_inline_models_against_mujoco(tmp_path, bodies, equality):
         for b in range(1, m.nbody):
             M = mech.data.oMf[mech.link_frame(_name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
             np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-9)
+
+
+def test_sizes_are_bounded(tmp_path, capsys):
+    from screwkin.files.description import LIMITS
+    f = tmp_path / "many.xml"
+    bodies = "".join(f'<body name="b{k}"><joint name="j{k}"/></body>' for k in range(LIMITS.links + 1))
+    f.write_text(f"<mujoco><worldbody>{bodies}</worldbody></mujoco>")
+    assert main(["info", str(f)]) == 1
+    assert f"screwkin reads at most {LIMITS.links}" in capsys.readouterr().err
