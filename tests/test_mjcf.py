@@ -159,6 +159,10 @@ BAD = [
     ('<body name="a" quat="1 0 0 0" euler="0 0 1"><joint name="j"/></body>', "", "more than one orientation"),
     ('<body name="a"><joint name="j"/></body>', '<actuator><motor tendon="t"/></actuator>',
      "acts on a tendon, not a joint"),
+    ('<body name="a"><joint name="j"/></body>', '<include file="other.xml"/>', "<include> is not supported"),
+    ('<body name="a"><joint name="j" class="nope"/></body>', "", "names default class 'nope', which is not defined"),
+    ('<body name="a"><joint name="j"/></body>', '<equality><joint joint1="j"/></equality>',
+     "has no joint2: locking a joint at a value is not supported"),
 ]
 
 
@@ -209,3 +213,21 @@ def test_sizes_are_bounded(tmp_path, capsys):
     f.write_text(f"<mujoco><worldbody>{bodies}</worldbody></mujoco>")
     assert main(["info", str(f)]) == 1
     assert f"screwkin reads at most {LIMITS.links}" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("compiler", ['<compiler eulerseq="zXy"/>', '<compiler eulerseq="XYZ" angle="radian"/>'])
+def test_euler_sequences_as_mujoco(tmp_path, compiler):
+    f = tmp_path / "e.xml"
+    f.write_text(f'<mujoco>{compiler}<worldbody><body name="a" pos="0.1 0.2 0.3" euler="0.3 -0.7 1.1">'
+                 '<joint name="j" axis="0 1 0"/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>'
+                 '<body name="b" pos="0.1 0 0" euler="1 2 3" xyaxes="1 1 0 0 1 1">'
+                 '</body></body></worldbody></mujoco>')
+    assert main(["info", str(f)]) == 1  # two orientations on b
+    f.write_text(f.read_text().replace(' xyaxes="1 1 0 0 1 1"', ""))
+    mech = screwkin.load(f, warn=lambda w: None)
+    m, d = _mj(f)
+    mujoco.mj_kinematics(m, d)
+    pin.framesForwardKinematics(mech.model, mech.data, mech.neutral())
+    for name in ("a", "b"):
+        b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        np.testing.assert_allclose(mech.data.oMf[mech.link_frame(name)].rotation, d.xmat[b].reshape(3, 3), atol=1e-12)
