@@ -134,3 +134,24 @@ def test_what_cannot_be_written(tmp_path, capsys):
     assert "ball joint: URDF has none" in capsys.readouterr().err
     assert main(["export", str(ROBOTS / "fourbar_crank_rocker.urdf")]) == 2
     assert "export needs --mjcf" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("path", [ROBOTS / "tsai_3upu.urdf",  # universal cut joints: bodies with two hinges
+                                  ROBOTS.parent / "tests" / "data" / "student" / "rrpr.urdf",  # prismatic cut
+                                  ROBOTS / "gripper_arm_mimic.urdf",  # <mimic>: <equality><joint>
+                                  ROBOTS / "gough_stewart_6ups.urdf"])
+def test_mobility_survives_export(tmp_path, path):
+    out_x, out_u = tmp_path / "o.xml", tmp_path / "o.urdf"
+    assert main(["export", str(path), "--mjcf", str(out_x), "--urdf", str(out_u), "--json"]) == 0
+    original = screwkin.load(path, warn=lambda w: None)
+    M = original.mobility().mobility
+    for out in (out_x, out_u):
+        back = screwkin.load(out, warn=lambda w: None)
+        assert back.mobility().mobility == M
+        assert [(c.joint, c.mimics, c.multiplier) for c in back.spec.couplings] == [
+            (c.joint, c.mimics, c.multiplier) for c in original.spec.couplings]
+    m = mujoco.MjModel.from_xml_path(str(out_x))
+    d = mujoco.MjData(m)
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
+    mujoco.mj_forward(m, d)
+    assert m.nv - np.linalg.matrix_rank(d.efc_J.reshape(d.nefc, m.nv), tol=1e-9) == M
