@@ -10,7 +10,7 @@ equality that names the world explicitly (``body2="world"``: "Model does not hav
 named world"), which MuJoCo accepts and real files use, and it does not give the plain
 description (cut joints, couplings, inputs) the rest of screwkin reads.
 
-What is read (docs/format.md, section MJCF): ``<compiler angle eulerseq>``, ``<default>``
+What is read (docs/format.md, section 4b): ``<compiler angle eulerseq>``, ``<default>``
 classes (joint and site attributes; ``childclass``/``class``), every ``<worldbody>``'s bodies
 with ``pos`` and one orientation (``quat``, ``axisangle``, ``euler``, ``xyaxes``, ``zaxis``),
 their joints (``hinge``, ``slide``, ``ball``, ``free``; ``pos``, ``axis``, ``range``),

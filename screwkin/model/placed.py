@@ -19,7 +19,7 @@ from ..errors import MechanismFileError, quote
 from ..files.exporter import PlacedBody, PlacedCut, PlacedJoint, PlacedMechanism, coupling_about
 from .topology import _frame_link
 
-__all__ = ["placed", "WRITABLE_CUTS"]
+__all__ = ["placed", "check_closed", "WRITABLE_CUTS"]
 
 #: Cut-joint types the writers can express (the higher pairs cannot).
 WRITABLE_CUTS = ("fixed", "revolute", "continuous", "prismatic", "cylindrical", "universal", "planar", "spherical")
@@ -61,6 +61,9 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
         parent = None if j.parent == root else j.parent
         X = world[j.parent].inverse() * world[j.child] if parent is not None else world[j.child]
         t = rep.get(j.name) or j.type
+        if t == "planar":
+            raise MechanismFileError(mech.path, f"joint {quote(j.name)} is a planar tree joint: {fmt} export writes "
+                                                "revolute, prismatic, ball, floating and fixed joints")
         if t.startswith(("UJOINT", "CARDAN")):
             raise MechanismFileError(mech.path, f"joint {quote(j.name)} is a universal joint (sidecar {t}): "
                                                 f"write it as two revolutes to export it as {fmt}")
