@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import ROBOTS
+from conftest import CORPUS, ROBOTS
 from screwkin.analysis.position import PositionSolver
 from screwkin.cli import main
 
@@ -134,12 +134,19 @@ def test_what_cannot_be_written(tmp_path, capsys):
     assert "ball joint: URDF has none" in capsys.readouterr().err
     assert main(["export", str(ROBOTS / "fourbar_crank_rocker.urdf")]) == 2
     assert "export needs --mjcf" in capsys.readouterr().err
+    planar = tmp_path / "planar.urdf"
+    planar.write_text('<robot name="p"><link name="g"/><link name="b"/><joint name="pj" type="planar">'
+                      '<parent link="g"/><child link="b"/><axis xyz="0 0 1"/></joint></robot>')
+    assert main(["export", str(planar), "--mjcf", str(tmp_path / "p.xml")]) == 1
+    assert "joint 'pj' is a planar tree joint" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("path", [ROBOTS / "tsai_3upu.urdf",  # universal cut joints: bodies with two hinges
                                   ROBOTS.parent / "tests" / "data" / "student" / "rrpr.urdf",  # prismatic cut
                                   ROBOTS / "gripper_arm_mimic.urdf",  # <mimic>: <equality><joint>
-                                  ROBOTS / "gough_stewart_6ups.urdf"])
+                                  ROBOTS / "gough_stewart_6ups.urdf",
+                                  # Extended-URDF sidecars: 6d and 3d closures between frames, empty limits
+                                  CORPUS / "robot_delta" / "robot.urdf", CORPUS / "cassie_like" / "robot.urdf"])
 def test_mobility_survives_export(tmp_path, path):
     out_x, out_u = tmp_path / "o.xml", tmp_path / "o.urdf"
     assert main(["export", str(path), "--mjcf", str(out_x), "--urdf", str(out_u), "--json"]) == 0

@@ -48,6 +48,7 @@ def run(mech, args) -> int:
         if not out:
             continue
         pm = placed(mech, q, fmt, comment=comment)
+        notes += [n for n in pm.notes if n not in notes]
         if fmt == "MJCF":
             _write(out, write_mjcf(pm))
             for c in pm.cuts:

@@ -96,6 +96,7 @@ class PlacedMechanism:
     actuated: tuple = ()
     comment: str = ""
     length: float = 0.1  # [m] between a revolute cut's two connects
+    notes: tuple = ()  # what the placing changed, one line each (said by the command)
 
 
 def _se3(pos, quat):

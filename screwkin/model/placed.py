@@ -56,7 +56,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     bodies = []
     if root != "world":
         bodies.append(PlacedBody(root, None, tuple(world[root].translation), _quat(world[root].rotation)))
-    values = {}
+    values, empty = {}, []
     for j in spec.joints:
         parent = None if j.parent == root else j.parent
         X = world[j.parent].inverse() * world[j.child] if parent is not None else world[j.child]
@@ -85,7 +85,10 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
                 values[j.name] = value
                 lo, hi = model.lowerPositionLimit[coord.idx_q], model.upperPositionLimit[coord.idx_q]
                 if abs(lo) < _NO_LIMIT and abs(hi) < _NO_LIMIT:
-                    rng = (float(lo - value), float(hi - value))
+                    if hi > lo:
+                        rng = (float(lo - value), float(hi - value))
+                    else:
+                        empty.append(j.name)
             joint = PlacedJoint(j.name, kind, tuple(float(a) for a in j.axis), rng)
             # Pinocchio's inertia of the joint's body, in the joint's frame: the child link's frame
             I = model.frames[mech.link_frame(j.child)].placement.actInv(model.inertias[jid])
@@ -110,8 +113,12 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     for cp in spec.couplings:
         primary = values.get(cp.mimics, 0.0)
         couplings.append(coupling_about(cp, primary, cp.multiplier * primary + cp.offset))
+    notes = ()
+    if empty:
+        notes = (f"{len(empty)} joints with empty limits (lower = upper: {', '.join(quote(n, 30) for n in empty[:3])}"
+                 f"{', ...' if len(empty) > 3 else ''}) are written unlimited, as screwkin moves them",)
     return PlacedMechanism(spec.name, tuple(bodies), tuple(cuts), tuple(couplings), tuple(mech.actuated), comment,
-                           length if length else mech.length)
+                           length if length else mech.length, notes)
 
 
 def check_closed(mech, q, tol: float) -> float:
