@@ -286,8 +286,8 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                                      else LIMITS.angle, "m" if jt == "slide" else "")
                     if jt == "hinge":
                         lo, hi = r.angle(lo), r.angle(hi)
-                    if lo >= hi:
-                        p.append(f"{jw} range: lower {lo:g} is not below upper {hi:g}")
+                    if lo > hi:
+                        p.append(f"{jw} range: lower {lo:g} is above upper {hi:g}")
                 elif jt == "hinge":
                     utype = "continuous"
                 limit = f'<limit lower="{lo:.17g}" upper="{hi:.17g}" effort="0" velocity="0"/>'
