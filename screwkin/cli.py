@@ -22,6 +22,7 @@ from .commands import (
     draw,
     dynamics,
     equations,
+    export,
     grasp,
     ik,
     info,
@@ -50,7 +51,7 @@ __all__ = ["main", "COMMANDS"]
 
 #: The commands, in the order `screwkin` lists them.
 COMMANDS = (mobility, info, solve, screws, singularities, map, scan, view, ik, sweep, statics, dynamics, study,
-            synthesize, grasp, workspace, equations, draw, report)
+            synthesize, grasp, workspace, equations, draw, report, export)
 _COMMAND_MODULES = {m.NAME: m for m in COMMANDS}
 
 

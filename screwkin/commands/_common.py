@@ -213,7 +213,7 @@ def add_common(sp, mechanism: bool = True, optional_file: bool = False):
         sp.add_argument("--json", action="store_true", help="print one JSON object")
         sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks of errors")
         return
-    sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar), SDF, or xacro file",
+    sp.add_argument("file", help="URDF (with <loop_joint> or a YAML sidecar), SDF, MJCF, or xacro file",
                     **({"nargs": "?"} if optional_file else {}))
     sp.add_argument("--arg", action="append", dest="xacro_args", metavar="NAME=VALUE",
                     help="xacro argument of a .xacro file (units allowed, e.g. crank=30mm: given in SI); repeatable")

@@ -91,7 +91,7 @@ def count(what: str):
 
 
 #: Destinations of options that name a file a command writes (or a prefix of such files).
-OUTPUT_DESTS = ("csv", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate")
+OUTPUT_DESTS = ("csv", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate", "mjcf", "urdf")
 
 
 def _option_name(action) -> str:

@@ -241,7 +241,7 @@ def resolve_actuation(spec: MechanismSpec, actuated=None):
     """The actuated joint names and where they were declared.
 
     Precedence: the caller's list (the command line), the YAML ``name_mot``,
-    then ROS ``<transmission>`` elements.  Returns ``(names, source)``;
+    then ROS ``<transmission>`` elements (an MJCF file's actuators on joints).  Returns ``(names, source)``;
     ``([], None)`` when nothing declares inputs.
     """
     if actuated:
@@ -249,7 +249,7 @@ def resolve_actuation(spec: MechanismSpec, actuated=None):
     if spec.yaml_actuated:
         return list(spec.yaml_actuated), "yaml name_mot"
     if spec.transmissions:
-        return list(spec.transmissions), "transmission"
+        return list(spec.transmissions), "mjcf actuator" if spec.format == "mjcf" else "transmission"
     return [], None
 
 

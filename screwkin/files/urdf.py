@@ -393,7 +393,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
         root = parse_xml_text(text, path)
     if root.tag != "robot":
         raise MechanismFileError(path, f"not a URDF file: the root element is <{shorten(root.tag, 40)}>, "
-                                       "expected <robot>")
+                                       "expected <robot> (MJCF: <mujoco>, SDF: <sdf>)")
     link_elems, joint_elems, loop_elems = root.findall("link"), root.findall("joint"), root.findall("loop_joint")
     check_sizes(path, len(link_elems), len(joint_elems), len(loop_elems))
     problems = Problems()

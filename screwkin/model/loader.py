@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..files.description import LIMITS, placement
+from ..files.mjcf import read_mjcf
 from ..files.sdf import read_sdf
 from ..files.sidecar import axis_letters, read_yaml_sidecar
 from ..files.urdf import check_sizes, read_urdf
@@ -301,8 +302,8 @@ def _print_warning(path):
 
 def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None,
          cls=Mechanism, args=None, text=None) -> Mechanism:
-    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, SDF, or a xacro
-    file that expands to such a URDF).
+    """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, SDF, MJCF, or a
+    xacro file that expands to such a URDF).
 
     yaml:      path of an Extended-URDF sidecar; default: ``<file>.yaml`` when it exists.
     actuated:  actuated joint names, overriding the file's declaration.
@@ -333,6 +334,8 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
             raise UsageError(f"package folder {quote(d)} (--package-dir) is not a folder")
     if root.tag == "sdf":
         spec = read_sdf(path, text, root=root, package_dirs=package_dirs)
+    elif root.tag == "mujoco":
+        spec = read_mjcf(path, text, root=root, package_dirs=package_dirs)
     elif root.tag == "robot" or path.suffix.lower() != ".sdf":
         spec = read_urdf(path, text, root=root, package_dirs=package_dirs)
     else:

@@ -1,0 +1,275 @@
+"""Writing a mechanism placed at one configuration as MJCF (MuJoCo) or URDF text.
+
+The input is plain data -- bodies placed in their parents at that configuration, each with
+its joint, the cut joints with their frames, couplings and inputs -- made by
+:func:`screwkin.model.placed.placed`; this module knows nothing of solving.  The file's
+configuration (MJCF's qpos0, URDF's all-zero) is the one given, so a loop closed there is
+closed in the file, and MuJoCo's equalities, which take their second point from qpos0,
+hold where they should.
+
+MJCF has only point (``connect``) and frame (``weld``) equalities.  Cut joints become:
+
+- spherical: a ``connect`` at F1;
+- fixed: a ``weld`` with ``relpose`` (body2's pose in body1) written out;
+- revolute, continuous: two ``connect``s, at F1 and one ``length`` further along the axis
+  (MJCF has no hinge equality): 6 rows of rank 5 (one redundant, which MuJoCo's soft
+  constraints accept);
+- prismatic, cylindrical, universal, planar: a massless body on link1 at F1 carrying the
+  joint's own motions (slide, hinge + slide, two hinges, two slides + hinge), named after
+  the cut joint, welded to link2: the loop's rows exactly, with one more body and as many
+  more coordinates as the joint has degrees of freedom.
+
+A planar loop keeps its out-of-plane rows (MuJoCo has no planar equality): they are
+redundant there, as in screwkin's own count.  Visual geometry is not written.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+import pinocchio as pin
+
+from .description import Coupling
+from .writer import _f, _v
+
+__all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
+           "TINY_MASS", "coupling_about"]
+
+#: Mass [kg] (and inertia 1e-3 of it [kg m^2]) given to a moving body without one, which MuJoCo
+#: refuses; below Tolerances.dummy_mass, so screwkin still reads such a body as massless.
+TINY_MASS = 1e-6
+
+
+@dataclass(frozen=True)
+class PlacedJoint:
+    """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (the
+    joint sits at the body's origin); range [rad or m] about the written configuration, None:
+    unlimited."""
+
+    name: str
+    type: str
+    axis: tuple = (0.0, 0.0, 1.0)
+    range: tuple | None = None
+
+
+@dataclass(frozen=True)
+class PlacedBody:
+    """A body placed in its parent (None: the world) by pos [m] and quat (w, x, y, z); its
+    inertia about the centre of mass com, in the body's axes (ixx, iyy, izz, ixy, ixz, iyz)."""
+
+    name: str
+    parent: str | None
+    pos: tuple
+    quat: tuple
+    joint: PlacedJoint | None = None
+    mass: float = 0.0
+    com: tuple = (0.0, 0.0, 0.0)
+    inertia: tuple = (0.0,) * 6
+
+
+@dataclass(frozen=True)
+class PlacedCut:
+    """A cut joint: F1 on body1 and F2 on body2 (pos, quat in the body), axis in F1, axis2 in
+    F2; rel: F2 seen from F1 at the written configuration (pos, quat)."""
+
+    name: str
+    type: str
+    body1: str
+    pos1: tuple
+    quat1: tuple
+    body2: str
+    pos2: tuple
+    quat2: tuple
+    axis: tuple
+    axis2: tuple | None
+    rel: tuple
+
+
+@dataclass(frozen=True)
+class PlacedMechanism:
+    name: str
+    bodies: tuple  # PlacedBody, parents before children
+    cuts: tuple = ()  # PlacedCut
+    couplings: tuple = ()  # Coupling (offsets about the written configuration)
+    actuated: tuple = ()
+    comment: str = ""
+    length: float = 0.1  # [m] between a revolute cut's two connects
+    notes: tuple = ()  # what the placing changed, one line each (said by the command)
+
+
+def _se3(pos, quat):
+    w, x, y, z = quat
+    return pin.SE3(pin.Quaternion(w, x, y, z).normalized().matrix(), np.asarray(pos, float))
+
+
+def _quat(M):
+    q = pin.Quaternion(M.rotation)
+    return (q.w, q.x, q.y, q.z)
+
+
+def _children(pm):
+    kids = {}
+    for b in pm.bodies:
+        kids.setdefault(b.parent, []).append(b)
+    return kids
+
+
+def _comment(text):
+    return "<!--\n" + text.replace("--", "- -").rstrip() + "\n-->" if text else ""
+
+
+def _mj_inertial(mass, com, inertia, moving):
+    if mass <= 0:
+        if not moving:
+            return ""
+        mass, com, inertia = TINY_MASS, (0, 0, 0), (TINY_MASS * 1e-3,) * 3 + (0.0,) * 3
+    return f'<inertial pos="{_v(*com)}" mass="{_f(mass)}" fullinertia="{_v(*inertia)}"/>'
+
+
+def _mj_joint(j):
+    if j.type == "free":
+        return f"<freejoint name={quoteattr(j.name)}/>"
+    rng = f' range="{_v(*j.range)}"' if j.range is not None else ""
+    axis = "" if j.type == "ball" else f' axis="{_v(*j.axis)}"'
+    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{axis}{rng}/>"
+
+
+_AUX = {"prismatic": ("slide",), "cylindrical": ("hinge", "slide"), "universal": ("hinge", "hinge"),
+        "planar": ("slide", "slide", "hinge")}
+
+
+def _aux_axes(c):
+    """The axes (in F1) of the aux body's joints for a cut joint of type in _AUX."""
+    a = np.asarray(c.axis, float)
+    if c.type == "planar":
+        u = np.cross(a, [1.0, 0, 0]) if abs(a[0]) < 0.9 else np.cross(a, [0, 1.0, 0])
+        u /= np.linalg.norm(u)
+        return (tuple(u), tuple(np.cross(a, u)), tuple(a))
+    if c.type == "universal":  # axis2 is fixed in F2: in F1's axes at the written configuration
+        R = _se3(c.rel[0], c.rel[1]).rotation
+        return (tuple(a), tuple(R @ np.asarray(c.axis2, float)))
+    return (tuple(a),) * len(_AUX[c.type])
+
+
+def write_mjcf(pm: PlacedMechanism) -> str:
+    """MJCF text of ``pm`` (see the module docstring)."""
+    kids = _children(pm)
+    aux = {}  # body1 -> cuts whose aux body it carries
+    for c in pm.cuts:
+        if c.type in _AUX:
+            aux.setdefault(c.body1, []).append(c)
+    out = [_comment(pm.comment), f"<mujoco model={quoteattr(pm.name)}>",
+           '  <compiler angle="radian" autolimits="true"/>', "  <worldbody>"]
+
+    def aux_bodies(name, pad):
+        for c in aux.get(name, ()):
+            out.append(f'{pad}<body name={quoteattr(c.name + "~F1")} pos="{_v(*c.pos1)}" quat="{_v(*c.quat1)}">')
+            for k, (t, ax) in enumerate(zip(_AUX[c.type], _aux_axes(c))):
+                jn = c.name if len(_AUX[c.type]) == 1 else f"{c.name}.{k}"
+                out.append(f"{pad}  <joint name={quoteattr(jn)} type=\"{t}\" axis=\"{_v(*ax)}\"/>")
+            out.append(f"{pad}  {_mj_inertial(0, 0, 0, True)}")
+            out.append(f"{pad}</body>")
+
+    def body(b, depth):
+        pad = "  " * depth
+        out.append(f'{pad}<body name={quoteattr(b.name)} pos="{_v(*b.pos)}" quat="{_v(*b.quat)}">')
+        moving = b.joint is not None and b.joint.type != "fixed"
+        if moving:
+            out.append(f"{pad}  {_mj_joint(b.joint)}")
+        inertial = _mj_inertial(b.mass, b.com, b.inertia, moving)
+        if inertial:
+            out.append(f"{pad}  {inertial}")
+        aux_bodies(b.name, pad + "  ")
+        for k in kids.get(b.name, ()):
+            body(k, depth + 1)
+        out.append(f"{pad}</body>")
+
+    aux_bodies("world", "    ")
+    for b in kids.get(None, ()):
+        body(b, 2)
+    out.append("  </worldbody>")
+    eq = []
+    for c in pm.cuts:
+        if c.type == "spherical":
+            eq.append(f"<connect name={quoteattr(c.name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
+                      f'anchor="{_v(*c.pos1)}"/>')
+        elif c.type in ("revolute", "continuous"):
+            F1 = _se3(c.pos1, c.quat1)
+            far = F1.act(pm.length * np.asarray(c.axis, float))
+            for name, p in ((c.name, c.pos1), (f"{c.name}~axis", far)):
+                eq.append(f"<connect name={quoteattr(name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
+                          f'anchor="{_v(*p)}"/>')
+        else:  # fixed: body2 in body1; an aux body: body2 in the aux body, which is at F1 at qpos0
+            F1 = pin.SE3.Identity() if c.type in _AUX else _se3(c.pos1, c.quat1)
+            F2 = _se3(c.pos2, c.quat2)
+            rel = F1 * _se3(*c.rel) * F2.inverse()
+            body1 = c.name + "~F1" if c.type in _AUX else c.body1
+            eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else c.name + '~weld')} "
+                      f"body1={quoteattr(body1)} body2={quoteattr(c.body2)} anchor=\"{_v(*c.pos2)}\" "
+                      f'relpose="{_v(*rel.translation, *_quat(rel))}"/>')
+    for cp in pm.couplings:
+        eq.append(f"<joint joint1={quoteattr(cp.joint)} joint2={quoteattr(cp.mimics)} "
+                  f'polycoef="{_v(cp.offset, cp.multiplier, 0, 0, 0)}"/>')
+    if eq:
+        out += ["  <equality>"] + [f"    {e}" for e in eq] + ["  </equality>"]
+    if pm.actuated:
+        out += ["  <actuator>"] + [f"    <motor name={quoteattr(a + '_motor')} joint={quoteattr(a)}/>"
+                                   for a in pm.actuated] + ["  </actuator>"]
+    out.append("</mujoco>")
+    return "\n".join(x for x in out if x) + "\n"
+
+
+_URDF_TYPE = {"slide": "prismatic", "free": "floating", "fixed": "fixed"}
+
+
+def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
+    """URDF text of ``pm`` with ``<loop_joint>``s (docs/format.md), the tree rooted at link
+    ``root`` (the bodies without a parent hang from it).  Ball joints have no URDF form: the
+    caller refuses them first."""
+    coupled = {c.joint: c for c in pm.couplings}
+    out = [_comment(pm.comment), f"<robot name={quoteattr(pm.name)}>", f"  <link name={quoteattr(root)}/>"]
+    joints = []
+    for b in pm.bodies:
+        if b.name == root:
+            continue
+        inertial = ""
+        if b.mass > 0:
+            xx, yy, zz, xy, xz, yz = b.inertia
+            inertial = (f'<inertial><origin xyz="{_v(*b.com)}"/><mass value="{_f(b.mass)}"/><inertia ixx="{_f(xx)}" '
+                        f'iyy="{_f(yy)}" izz="{_f(zz)}" ixy="{_f(xy)}" ixz="{_f(xz)}" iyz="{_f(yz)}"/></inertial>')
+        out.append(f"  <link name={quoteattr(b.name)}>{inertial}</link>")
+        j = b.joint or PlacedJoint(f"{b.name}__fixed", "fixed")
+        t = _URDF_TYPE.get(j.type) or ("revolute" if j.range is not None else "continuous")
+        rpy = pin.rpy.matrixToRpy(_se3(b.pos, b.quat).rotation)
+        text = (f"  <joint name={quoteattr(j.name)} type=\"{t}\"><parent link={quoteattr(b.parent or root)}/>"
+                f"<child link={quoteattr(b.name)}/><origin xyz=\"{_v(*b.pos)}\" rpy=\"{_v(*rpy)}\"/>")
+        if t in ("revolute", "continuous", "prismatic"):
+            lo, hi = j.range if j.range is not None else (-1e9, 1e9)
+            text += f'<axis xyz="{_v(*j.axis)}"/><limit lower="{_f(lo)}" upper="{_f(hi)}" effort="0" velocity="0"/>'
+        if j.name in coupled:
+            cp = coupled[j.name]
+            text += f'<mimic joint={quoteattr(cp.mimics)} multiplier="{_f(cp.multiplier)}" offset="{_f(cp.offset)}"/>'
+        joints.append(text + "</joint>")
+    out += joints
+    for c in pm.cuts:
+        r1, r2 = (pin.rpy.matrixToRpy(_se3(c.pos1 if k == 1 else c.pos2, c.quat1 if k == 1 else c.quat2).rotation)
+                  for k in (1, 2))
+        text = (f"  <loop_joint name={quoteattr(c.name)} type=\"{c.type}\"><link1 link={quoteattr(c.body1)} "
+                f'xyz="{_v(*c.pos1)}" rpy="{_v(*r1)}"/><link2 link={quoteattr(c.body2)} xyz="{_v(*c.pos2)}" '
+                f'rpy="{_v(*r2)}"/><axis xyz="{_v(*c.axis)}"/>')
+        if c.axis2 is not None:
+            text += f'<axis2 xyz="{_v(*c.axis2)}"/>'
+        out.append(text + "</loop_joint>")
+    for name in pm.actuated:
+        out.append(f"  <transmission name={quoteattr('t_' + name)}><type>transmission_interface/SimpleTransmission"
+                   f"</type><joint name={quoteattr(name)}><hardwareInterface>hardware_interface/EffortJointInterface"
+                   "</hardwareInterface></joint></transmission>")
+    out.append("</robot>")
+    return "\n".join(x for x in out if x) + "\n"
+
+
+def coupling_about(c: Coupling, primary_value: float, joint_value: float) -> Coupling:
+    """The coupling ``joint = m primary + o`` in coordinates measured from the given values."""
+    return Coupling(c.joint, c.mimics, c.multiplier, c.multiplier * primary_value + c.offset - joint_value)
