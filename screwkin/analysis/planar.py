@@ -14,19 +14,21 @@ lengths measured between joint centres in the plane of motion:
   positions (input and coupler collinear: dead centres of the output).
 
 Angles are returned as input *joint values* [rad] of the circuit the
-configuration is on.
+configuration is on.  :func:`transmission_angles` gives mu at a stack of configurations
+from one identification (the joint centres by forward kinematics, the angles all at once).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from ..model.geometry import line_angle, vector_angle
 
-__all__ = ["LinkageInfo", "identify", "LinkAngles", "plane_basis"]
+__all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles", "plane_basis"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +46,11 @@ class LinkageInfo:
     diagonal: float | None = None
     alpha: float | None = None
     beta: float | None = None
+    # where transmission_angles finds the centres of the joints A (input), B, C, D at any
+    # configuration, the plane's normal and the slide's direction (slider-crank), in the world
+    centres: tuple = field(default=(), compare=False, repr=False)
+    normal: tuple | None = field(default=None, compare=False, repr=False)
+    slide: tuple | None = field(default=None, compare=False, repr=False)
 
     def construction(self) -> dict:
         """JSON-ready: four-bar {transmission_angle, diagonal, alpha, beta}; slider-crank {transmission_angle}."""
@@ -121,17 +128,65 @@ def identify(mech, topo, q, input_joint):
     q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
     A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
     a, b = np.linalg.norm(B - A), np.linalg.norm(C - B)
+    where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
     if j_d.type in ("revolute", "continuous") and j_c.type in ("revolute", "continuous") \
             and j_b.type in ("revolute", "continuous"):
-        return _four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b)
+        return replace(_four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b), **where)
     if j_d.type == "prismatic" or j_c.type == "prismatic":
         slide = j_d if j_d.type == "prismatic" else j_c
         pin_joint = j_c if slide is j_d else j_d
         if slide is j_c:  # the prismatic joint is between rod and slider: not the textbook slider-crank
             return None
         s = p2(np.asarray(slide.direction) + 0) - p2(np.zeros(3))
-        return _slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s / np.linalg.norm(s), a, b)
+        s = s / np.linalg.norm(s)
+        return replace(_slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s, a, b),
+                       slide=tuple(s[0] * e1 + s[1] * e2), **where)
     return None
+
+
+def _locator(mech, joint):
+    """How to find ``joint``'s centre at any configuration: ("frame", id) of a cut joint's F1,
+    ("joint", id) of a simple tree joint, or ("topology", name) for a compound joint (its
+    centre is the topology's, rebuilt at each configuration)."""
+    cuts = {c.name: c for c in mech.cuts}
+    if joint.cut and joint.name in cuts:
+        return ("frame", cuts[joint.name].frame1)
+    if not joint.cut and len(joint.members) == 1 and mech.model.existJointName(joint.members[0]):
+        return ("joint", mech.model.getJointId(joint.members[0]))
+    return ("topology", joint.name)
+
+
+def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
+    """Transmission angles mu [rad] of the linkage ``info`` (from :func:`identify`, computed
+    once) at the configurations Q (N, nq): shape (N,).  Four-bar: the angle at the
+    coupler-output joint C between C -> B and C -> D; slider-crank: the angle between the rod
+    B -> C and the normal of the slide; both in the plane of motion."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    P = np.empty((len(Q), 4, 3))
+    model, data = mech.model, mech.model.createData()
+    for k, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        topo = None
+        for i, (kind, ident) in enumerate(info.centres):
+            if kind == "frame":
+                P[k, i] = data.oMf[ident].translation
+            elif kind == "joint":
+                P[k, i] = data.oMi[ident].translation
+            else:
+                topo = topo or mech.topology(q)
+                P[k, i] = next(j.point for j in topo.joints if j.name == ident)
+    return _transmission(info.kind, P, np.asarray(info.normal, float),
+                         None if info.slide is None else np.asarray(info.slide, float))
+
+
+def _transmission(kind, P, n, slide=None):
+    """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
+    unit normal n (slide: the slide's unit direction, slider-crank)."""
+    P = P - (P @ n)[..., None] * n
+    B, C, D = P[..., 1, :], P[..., 2, :], P[..., 3, :]
+    if kind == "four-bar":
+        return vector_angle(B - C, D - C)
+    return line_angle(C - B, np.cross(n, slide))
 
 
 def _four_bar(name, q_in, A, B, C, D, a, b):
@@ -172,7 +227,7 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
             if (np.sign(_cross(Cc - Bc, D - Cc)) or circuit) != circuit:
                 continue
             limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
-    mu = float(np.arccos(np.clip(np.dot(B - C, D - C) / (b * c), -1, 1)))
+    mu = float(vector_angle(B - C, D - C))
     z = float(np.linalg.norm(B - D))
     alpha = beta = None
     if z > 0:  # (the diagonal vanishes when the crank tip sits on the output pivot)
@@ -210,8 +265,7 @@ def _slider_crank(name, q_in, A, B, C, s, a, b):
         u = (Cc - A) / np.linalg.norm(Cc - A)
         Bc = A + (-a if folded and b > a else a) * u
         limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
-    rod = (C - B) / b
-    mu = float(np.arccos(np.clip(abs(rod @ nrm), 0, 1)))
+    mu = float(line_angle(C - B, nrm))
     return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
 
 

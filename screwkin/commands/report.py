@@ -18,7 +18,7 @@ import numpy as np
 
 from ..analysis.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
-from ..analysis.planar import identify
+from ..analysis.planar import identify, transmission_angles
 from ..analysis.position import PositionSolver
 from ..analysis.skeleton import (
     default_output,
@@ -316,7 +316,7 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
     mus = None
     info = identify(mech, mech.topology(q), q, moved)
     if info is not None:
-        mus = [identify(mech, mech.topology(x), x, moved).transmission_angle for x in res.q]
+        mus = transmission_angles(mech, info, res.q).tolist()
     fig = sweep_figure(res, mus, singularities=search.found, linear=mech.translational,
                        title=f"{base}: {moved} over its range")
     out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"joint values, rates and accelerations "

@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from ...files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
+from ...model.geometry import vector_angle
 from .designs import FourBar
 
 __all__ = ["angle", "wrap", "rotate", "pose_matrix", "circle_b", "branch", "tool_local", "positions",
@@ -103,9 +104,7 @@ def positions(fb: FourBar, theta, sigma):
 def transmission(A, B, B0):
     """mu [rad]: the angle at B between B -> A and B -> B0."""
     A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
-    p, q = A - B, B0 - B
-    cross = p[..., 0] * q[..., 1] - p[..., 1] * q[..., 0]
-    return np.abs(np.arctan2(cross, (p * q).sum(axis=-1)))
+    return vector_angle(A - B, B0 - B)
 
 
 def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
