@@ -2,8 +2,6 @@
 the law of cosines (four-bar) and the slider-crank's closed form, written here."""
 
 import numpy as np
-import pytest
-
 import screwkin
 from conftest import ROBOTS
 from screwkin.analysis.planar import identify, transmission_angles
@@ -59,12 +57,3 @@ def test_one_configuration_and_not_a_linkage():
     five = screwkin.load(ROBOTS / "five_bar.urdf")
     q = five.assemble().q
     assert identify(five, five.topology(q), q, five.actuated[0]) is None
-
-
-@pytest.mark.parametrize("u, w, angle", [((1.0, 0.0), (0.0, 3.0), np.pi / 2), ((1.0, 0.0), (-1.0, 1e-9), np.pi - 1e-9),
-                                         ((0.0, 0.0, 2.0), (0.0, 1.0, 1.0), np.pi / 4)])
-def test_vector_angle(u, w, angle):
-    from screwkin.model.geometry import line_angle, vector_angle
-
-    assert abs(float(vector_angle(u, w)) - angle) < 1e-15
-    assert abs(float(line_angle(u, w)) - min(angle, np.pi - angle)) < 1e-15

@@ -26,9 +26,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
-from ..model.geometry import line_angle, vector_angle
+from ..model.geometry import (circle_intersections, cross2, line_angle, line_circle, perpendicular_basis, plane_basis,
+                              vector_angle)
 
-__all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles", "plane_basis"]
+__all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
 
 @dataclass(frozen=True)
@@ -65,10 +66,6 @@ def _rot(v, ang):
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
 
 
-def _cross(u, v):
-    return u[0] * v[1] - u[1] * v[0]
-
-
 def _angle(v):
     return float(np.arctan2(v[1], v[0]))
 
@@ -84,18 +81,6 @@ def _interval(start, end, phi_now, q_in):
     return (q_in + start - phi_now, q_in + end - phi_now)
 
 
-def _circles(p, r, c, s):
-    """Intersections of circle (p, r) and circle (c, s) in the plane."""
-    d = np.linalg.norm(c - p)
-    if d < 1e-15 or d > r + s + 1e-12 or d < abs(r - s) - 1e-12:
-        return []
-    along = (r * r - s * s + d * d) / (2 * d)
-    h = np.sqrt(max(r * r - along * along, 0.0))
-    u = (c - p) / d
-    n = np.array([-u[1], u[0]])
-    return [p + along * u + h * n, p + along * u - h * n]
-
-
 def identify(mech, topo, q, input_joint):
     """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
     joint is a ground joint, at the configuration ``topo`` was built at (q)."""
@@ -107,10 +92,7 @@ def identify(mech, topo, q, input_joint):
     if inp is None or ground not in inp.links or inp.type not in ("revolute", "continuous"):
         return None
     n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
-    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    e1 = np.cross(n, h)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(n, e1)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
+    e1, e2 = perpendicular_basis(n)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
 
     def p2(v):
         v = np.asarray(v)
@@ -206,7 +188,7 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
                "output": "Grashof rocker-crank: the output turns fully, the input rocks"}[shortest]
     u_ad = (D - A) / g
     phi_now = _angle(_rot(B - A, -_angle(u_ad)))  # input angle from AD
-    circuit = np.sign(_cross(C - B, D - C)) or 1.0
+    circuit = np.sign(cross2(C - B, D - C)) or 1.0
 
     lo = (a * a + g * g - (b + c) ** 2) / (2 * a * g)
     hi = (a * a + g * g - (b - c) ** 2) / (2 * a * g)
@@ -221,10 +203,10 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
     # the output is at a limit where input and coupler are collinear (B on line AC), on this circuit
     limits = []
     for dist, folded in ((a + b, False), (abs(b - a), True)):
-        for Cc in _circles(A, dist, D, c):
+        for Cc in circle_intersections(A, dist, D, c, slack=1e-12, concentric=1e-15):
             u = (Cc - A) / max(np.linalg.norm(Cc - A), 1e-300)
             Bc = A - a * u if folded and b > a else A + a * u
-            if (np.sign(_cross(Cc - Bc, D - Cc)) or circuit) != circuit:
+            if (np.sign(cross2(Cc - Bc, D - Cc)) or circuit) != circuit:
                 continue
             limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
     mu = float(vector_angle(B - C, D - C))
@@ -258,27 +240,15 @@ def _slider_crank(name, q_in, A, B, C, s, a, b):
     side = np.sign((C - A) @ s) or 1.0
     limits = []
     for dist, folded in ((a + b, False), (abs(b - a), True)):
-        if dist < abs(e):
+        meets = line_circle(A + e * nrm, s, A, dist)  # the slider's pin where the rod and crank are in line
+        if not meets:
             continue
-        x = side * np.sqrt(dist * dist - e * e)
-        Cc = A + x * s + e * nrm
+        Cc = meets[1] if side > 0 else meets[0]
         u = (Cc - A) / np.linalg.norm(Cc - A)
         Bc = A + (-a if folded and b > a else a) * u
         limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
     mu = float(line_angle(C - B, nrm))
     return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
-
-
-def plane_basis(normal):
-    """(e1, e2, n): e1 the world x axis projected into the plane (the world y axis when x is
-    normal to it), e2 = n x e1, so angles from e1 are counterclockwise seen from +n."""
-    n = np.asarray(normal, float) / np.linalg.norm(normal)
-    for axis in np.eye(3):
-        e1 = axis - (axis @ n) * n
-        if np.linalg.norm(e1) > 1e-6:
-            e1 /= np.linalg.norm(e1)
-            return e1, np.cross(n, e1), n
-    raise ValueError("degenerate normal")  # pragma: no cover
 
 
 class LinkAngles:

@@ -22,7 +22,7 @@ import pinocchio as pin
 
 from ..errors import UsageError
 from ..model._pin import frame_jacobian
-from ..model.closure import perpendicular_basis
+from ..model.geometry import perpendicular_basis
 from ..model.linalg import null_space
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
@@ -237,9 +237,7 @@ def loop_product(loop: LoopScrews, theta) -> np.ndarray:
 def planar_form(xi, normal):
     """(v_x, v_y, w) of a planar twist in a right-handed basis (e1, e2) of the plane with normal n."""
     n = np.asarray(normal, float) / np.linalg.norm(normal)
-    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    e1 = np.cross(n, h)
-    e1 /= np.linalg.norm(e1)
+    e1 = perpendicular_basis(n)[0]
     if abs(n @ np.array([0, 0, 1.0])) > 1 - 1e-12:  # the usual x-y plane: keep x, y
         e1 = np.array([1.0, 0, 0]) * np.sign(n[2])
     e2 = np.cross(n, e1)

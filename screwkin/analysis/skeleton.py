@@ -27,8 +27,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from ..model.geometry import line_foot, plane_basis
 from .motion import motion_along
-from .planar import LinkAngles, plane_basis
+from .planar import LinkAngles
 from .position import PositionSolver
 from .sweep import locate_singularities, sweep
 
@@ -485,11 +486,9 @@ def _contact_point(a, b, internal):
     if b.shape == "point":
         return cb
     if a.shape == "line" and b.shape == "circle":
-        d = np.array(a.direction)
-        return ca + ((cb - ca) @ d) * d
+        return line_foot(cb, ca, a.direction)
     if b.shape == "line" and a.shape == "circle":
-        d = np.array(b.direction)
-        return cb + ((ca - cb) @ d) * d
+        return line_foot(ca, cb, b.direction)
     u = cb - ca
     dist = np.linalg.norm(u)
     if dist < 1e-300:

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..analysis.planar import plane_basis
+from ..model.geometry import plane_basis
 from ..errors import UsageError
 
 __all__ = ["sweep_plot", "sweep_figure", "map_png"]

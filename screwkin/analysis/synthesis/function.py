@@ -29,7 +29,8 @@ import numpy as np
 
 from ...errors import UsageError, quote
 from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
-from .fourbar import branch, circle_b, fourbar_linkage, wrap
+from ...model.geometry import circle_circle
+from .fourbar import branch, fourbar_linkage, wrap
 
 __all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "FUNCTIONS"]
 
@@ -126,7 +127,7 @@ def _generated(K, d, phi, sigma):
     a, c = d / K2, d / K1
     b2 = a * a + c * c + d * d - 2 * a * c * K3
     A = np.array([d, 0.0]) + a * np.stack([np.cos(phi), np.sin(phi)], axis=-1)  # a signed: a reversed crank
-    B, h2 = circle_b(A, math.sqrt(max(b2, 0.0)), (0.0, 0.0), abs(c), sigma)
+    B, h2 = circle_circle(A, math.sqrt(max(b2, 0.0)), (0.0, 0.0), abs(c), sigma)
     psi = np.arctan2(B[..., 1], B[..., 0]) + (math.pi if c < 0 else 0.0)
     return np.where(h2 >= 0, psi, np.nan), A, B
 

@@ -26,7 +26,8 @@ import numpy as np
 
 from ...errors import UsageError
 from .designs import Design, FourBar, PathResult, SynthesisError, Target
-from .fourbar import circle_b, fourbar_linkage, travel_analysis, wrap
+from ...model.geometry import circle_circle
+from .fourbar import fourbar_linkage, travel_analysis, wrap
 
 __all__ = ["synthesize_path", "coupler_points"]
 
@@ -55,7 +56,7 @@ def coupler_points(A0, B0, a, b, c, p, q, th, sigma):
     the linkage does not assemble, A, B)."""
     a, b, c, p, q = (np.asarray(v, float)[..., None] for v in (a, b, c, p, q))
     A = np.asarray(A0, float)[..., None, :] + a[..., None] * np.stack([np.cos(th), np.sin(th)], axis=-1)
-    B, h2 = circle_b(A, b, np.asarray(B0, float)[..., None, :], c, sigma)
+    B, h2 = circle_circle(A, b, np.asarray(B0, float)[..., None, :], c, sigma)
     u = (B - A) / b[..., None]
     n = np.stack([-u[..., 1], u[..., 0]], axis=-1)
     return A + p[..., None] * u + q[..., None] * n, h2, A, B
