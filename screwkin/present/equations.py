@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 
-from ..analysis.equations import PlanarEquations
+from ..analysis.vector_loops import PlanarEquations
 from .report import screws_dict, screws_text, table
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
