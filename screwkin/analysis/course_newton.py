@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UsageError
+from ..model.geometry import TINY
 
 __all__ = ["NewtonStep", "NewtonResult", "newton"]
 
@@ -63,7 +64,7 @@ def newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> N
             raise UsageError(f"{mech.path}: {A.shape[0]} equations in {A.shape[1]} unknowns: Newton needs as many "
                              "inputs as the mechanism has degrees of freedom")
         s = np.linalg.svd(A, compute_uv=False)
-        if not np.all(np.isfinite(A)) or s[-1] <= 1e-12 * max(s[0], 1e-300):
+        if not np.all(np.isfinite(A)) or s[-1] <= mech.tolerances.zero * max(s[0], TINY):
             stopped = f"the Jacobian is singular at iteration {it} (det A = {np.linalg.det(A):.3g})"
             break
         dz = np.linalg.solve(A, -r)

@@ -113,7 +113,7 @@ def identify(mech, topo, q, input_joint):
     where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
     if j_d.type in ("revolute", "continuous") and j_c.type in ("revolute", "continuous") \
             and j_b.type in ("revolute", "continuous"):
-        return replace(_four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b), **where)
+        return replace(_four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b, mech.tolerances), **where)
     if j_d.type == "prismatic" or j_c.type == "prismatic":
         slide = j_d if j_d.type == "prismatic" else j_c
         pin_joint = j_c if slide is j_d else j_d
@@ -171,12 +171,12 @@ def _transmission(kind, P, n, slide=None):
     return line_angle(C - B, np.cross(n, slide))
 
 
-def _four_bar(name, q_in, A, B, C, D, a, b):
+def _four_bar(name, q_in, A, B, C, D, a, b, tol):
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     s, l = min(lengths.values()), max(lengths.values())
     p_q = g + a + b + c - s - l
-    if abs(s + l - p_q) < 1e-9 * l:
+    if abs(s + l - p_q) < tol.equal * l:
         cls = "change point (s + l = p + q): the linkage can fold flat"
     elif s + l > p_q:
         cls = "non-Grashof (triple rocker): no link turns fully"
@@ -203,7 +203,7 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
     # the output is at a limit where input and coupler are collinear (B on line AC), on this circuit
     limits = []
     for dist, folded in ((a + b, False), (abs(b - a), True)):
-        for Cc in circle_intersections(A, dist, D, c, slack=1e-12, concentric=1e-15):
+        for Cc in circle_intersections(A, dist, D, c, slack=tol.zero, concentric=1e-15):
             u = (Cc - A) / max(np.linalg.norm(Cc - A), 1e-300)
             Bc = A - a * u if folded and b > a else A + a * u
             if (np.sign(cross2(Cc - Bc, D - Cc)) or circuit) != circuit:

@@ -121,12 +121,17 @@ class PlanarEquations:
     notes: tuple
 
 
+#: Guard: the characteristic length taken at least this [m] where a length is compared with it.
+LENGTH_FLOOR = 1e-9
+
+
 def _wrap(a):
     return float(np.mod(a + np.pi, 2 * np.pi) - np.pi)
 
 
-def _exact_angle(sp, value, tol=1e-10):
-    """An exact multiple of pi/2 when ``value`` is one (within tol), else None."""
+def _exact_angle(sp, value, tol):
+    """An exact multiple of pi/2 when ``value`` is one (within tol [rad]: the closure tolerance,
+    to which the configuration measured is closed), else None."""
     k = round(value / (np.pi / 2))
     if abs(value - k * np.pi / 2) < tol:
         return sp.Integer(k) * sp.pi / 2
@@ -279,7 +284,7 @@ class VectorLoops:
         return "" if n == 0 else _SUFFIX[n]
 
     def _constant_angle(self, name, link, value, meaning):
-        exact = _exact_angle(self.sp, value)
+        exact = _exact_angle(self.sp, value, self.mech.tolerances.closure)
         if exact is not None:
             return exact
         return self._new_symbol(name, link, "angle", value, "constant", meaning)
@@ -294,7 +299,8 @@ class VectorLoops:
             return (v, 1) if v["from"] == ka else (v, -1)
         d = self.anchor[kb] - self.anchor[ka]
         length = float(np.linalg.norm(d))
-        if length < 1e-12 * max(self.mech.length, 1e-9):
+        tol = self.mech.tolerances
+        if length < tol.zero * max(self.mech.length, LENGTH_FLOOR):
             return None
         phi = float(np.arctan2(d[1], d[0]))
         k = self.numbers[link]
@@ -303,18 +309,18 @@ class VectorLoops:
         start, end, sign = ka, kb, 1
         rep = self.rep[link]
         if rep == self.topo.ground:
-            if not -np.pi / 2 < phi <= np.pi / 2 + 1e-12:  # ground vectors point to +x, as drawn in books
+            if not -np.pi / 2 < phi <= np.pi / 2 + tol.zero:  # ground vectors point to +x, as drawn in books
                 start, end, sign, phi = kb, ka, -1, _wrap(phi + np.pi)
             angle = self._constant_angle(f"theta{k}{suffix}", link, phi, f"constant angle of {name} on the ground")
         else:
             alpha = _wrap(phi - self.theta_q[rep])
-            if abs(alpha) > np.pi / 2 + 1e-12:
+            if abs(alpha) > np.pi / 2 + tol.zero:
                 start, end, sign, alpha = kb, ka, -1, _wrap(alpha + np.pi)
             theta = self._theta(link)
-            if abs(alpha) < 1e-10:
+            if abs(alpha) < tol.closure:
                 angle = theta
             else:
-                exact = _exact_angle(sp, alpha)
+                exact = _exact_angle(sp, alpha, tol.closure)
                 off = exact if exact is not None else self._new_symbol(
                     f"alpha{k}{suffix}", link, "angle", alpha, "constant",
                     f"constant angle of {name} from theta{self.numbers[rep]} (fixed in link '{link}')")
@@ -342,10 +348,10 @@ class VectorLoops:
         else:
             off = _wrap(phi - self.theta_q[rep])
             theta = self._theta(g)
-            if abs(off) < 1e-10:
+            if abs(off) < self.mech.tolerances.closure:
                 angle = theta
             else:
-                exact = _exact_angle(self.sp, off)
+                exact = _exact_angle(self.sp, off, self.mech.tolerances.closure)
                 angle = theta + (exact if exact is not None else self._new_symbol(
                     f"beta{k}{suffix}", g, "angle", off, "constant",
                     f"constant angle of the guide of x{k}{suffix} from theta{self.numbers[rep]}"))
@@ -523,7 +529,7 @@ class VectorLoops:
         if A.shape[0] == A.shape[1] and A.size:
             det_value = float(np.linalg.det(A))
             s = np.linalg.svd(A, compute_uv=False)
-            if s[-1] > 1e-9 * s[0]:
+            if s[-1] > self.mech.tolerances.equal * s[0]:  # A not singular: sigma_min not zero next to sigma_max
                 rates = np.linalg.solve(A, B)
         vectors = tuple(Vector(v["name"], v["link"], v["from"][0], v["to"][0], str(v["length"]), str(v["angle"]))
                         for v in self.vec.values())
