@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..files.grasp import GraspSpec
+from ..tolerances import DEFAULT
 
 __all__ = ["GraspTolerances", "GRASP_TOLERANCES", "ContactForce", "Certificate", "GraspQuality", "GraspResult",
            "contact_frame", "grasp_map", "characteristic_length", "generators", "cone_error", "analyze_grasp"]
@@ -227,7 +228,7 @@ def characteristic_length(spec: GraspSpec):
     P = np.array([c.point for c in spec.contacts], float)
     L = float(np.mean(np.linalg.norm(P - P.mean(axis=0), axis=1)))
     scale = max(1.0, float(np.abs(P).max()))
-    if not L > 1e-9 * scale:
+    if not L > DEFAULT.equal * scale:
         return 1.0, "1 m: the contacts are at one point"
     return L, "the mean distance of the contacts from their centroid"
 
@@ -549,7 +550,7 @@ def _epsilon(W, tol):
         worst = np.argmax(support, axis=0)
         h = support[worst, np.arange(len(order))]
         upper = min(upper, float(h.min()))
-        over = h - b[order] > 1e-12 * scale
+        over = h - b[order] > DEFAULT.zero * scale
         lower = max(float(b[order[0]]), 0.0)
         if not over[0]:
             return (lower, lower, None) if lower > 0 else \

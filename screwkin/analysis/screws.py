@@ -24,6 +24,7 @@ from ..errors import UsageError
 from ..model._pin import frame_jacobian
 from ..model.geometry import perpendicular_basis
 from ..model.linalg import null_space
+from ..tolerances import DEFAULT
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
            "loop_product", "split_jacobians", "cut_twists"]
@@ -51,7 +52,7 @@ def screw_of(xi, length: float | None = None) -> Screw:
     xi = np.asarray(xi, float)
     v, w = xi[:3], xi[3:]
     nw = np.linalg.norm(w)
-    if nw < 1e-12 or (length is not None and nw * length < TRANSLATION_RATIO * np.linalg.norm(v)):
+    if nw < DEFAULT.zero or (length is not None and nw * length < TRANSLATION_RATIO * np.linalg.norm(v)):
         nv = np.linalg.norm(v)
         return Screw(tuple(xi), tuple(v / nv) if nv > 0 else (0.0, 0.0, 0.0), None, float("inf"))
     pitch = float(w @ v / nw**2)
@@ -238,7 +239,7 @@ def planar_form(xi, normal):
     """(v_x, v_y, w) of a planar twist in a right-handed basis (e1, e2) of the plane with normal n."""
     n = np.asarray(normal, float) / np.linalg.norm(normal)
     e1 = perpendicular_basis(n)[0]
-    if abs(n @ np.array([0, 0, 1.0])) > 1 - 1e-12:  # the usual x-y plane: keep x, y
+    if abs(n @ np.array([0, 0, 1.0])) > 1 - DEFAULT.zero:  # the usual x-y plane: keep x, y
         e1 = np.array([1.0, 0, 0]) * np.sign(n[2])
     e2 = np.cross(n, e1)
     xi = np.asarray(xi)

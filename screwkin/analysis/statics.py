@@ -146,7 +146,8 @@ def _reactions(mech, q, lam, w, output, gravity, N_lam):
     size = max([float(np.linalg.norm(v[1])) for v in base.values()] + [1.0])
     out = []
     for name, (kind, wrench) in base.items():
-        open_ = free[name] > mech.tolerances.indeterminate * size  # components that change along the indeterminate directions
+        # components that change along the indeterminate directions
+        open_ = free[name] > mech.tolerances.indeterminate * size
         out.append(Reaction(name, kind, tuple(None if o else float(x) for x, o in zip(wrench, open_)),
                             not open_.any()))
     return tuple(out)

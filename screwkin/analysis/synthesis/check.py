@@ -184,12 +184,13 @@ def _locate(design, solver, probe, res, x, q_target):
     A, B = probe.pins(q)
     A_t, B_t = probe.pins(q_target)
     size = max(design.fourbar.lengths.values())
-    return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < 1e-6 * size
+    return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
 def _follow(design: Design, solver, probe, configs, steps):
     """(direction, travel per position, transmission angles along the motion, defects)."""
     name = design.input_joint
+    tol = probe.mech.tolerances
     targets = design.targets
     n = len(targets)
     label = [t.label or f"position {k + 1}" for k, t in enumerate(targets)]
@@ -208,19 +209,19 @@ def _follow(design: Design, solver, probe, configs, steps):
         defects, travel, mus = [], [0.0] + [None] * (n - 1), []
         runs = {}
         for direction, reach in ((1, design.span[1] - u1), (-1, u1 - design.span[0])):
-            if reach <= 1e-12:
+            if reach <= tol.zero:
                 continue
             res, covered = follow(direction, reach)
             runs[direction] = (res, covered)
             mus += probe.mus(res.q)  # the sweep's grid ends at the range's ends
-            if res.stopped_at is not None and covered < reach - 1e-9:
+            if res.stopped_at is not None and covered < reach - tol.equal:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
                                f"{math.degrees(res.stopped_at):.6g} deg: the linkage cannot run through it")
         for k in range(1, n):
             d = targets[k].input - u1
             direction = 1 if d >= 0 else -1
             res, covered = runs.get(direction, (None, 0.0))
-            if res is None or abs(d) > covered + 1e-9:
+            if res is None or abs(d) > covered + tol.equal:
                 defects.append(f"{label[k]} lies beyond a limit position: the input stops before "
                                f"{math.degrees(targets[k].input):.6g} deg")
             elif _locate(design, solver, probe, res, targets[k].input, configs[k]):
@@ -233,18 +234,18 @@ def _follow(design: Design, solver, probe, configs, steps):
     for direction in (1, -1):
         # as far as the farthest position this way round (a full turn when one sits at the start's input)
         travels = [float(np.mod(direction * (t.input - u1), TWO_PI)) for t in targets[1:]]
-        reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > 1e-9 else TWO_PI
+        reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > tol.equal else TWO_PI
         res, covered = follow(direction, reach)
         status, travel = [], [0.0]
         for k in range(1, n):
             d = float(np.mod(direction * (targets[k].input - u1), TWO_PI))
-            if d > covered + 1e-9:
+            if d > covered + tol.equal:
                 status.append(("limit", res.stopped_at))
                 travel.append(None)
             elif _locate(design, solver, probe, res, u1 + direction * d, configs[k]):
                 status.append(("reached", d))
                 travel.append(d)
-            elif d < 1e-9 and covered >= TWO_PI - 1e-9 \
+            elif d < tol.equal and covered >= TWO_PI - tol.equal \
                     and _locate(design, solver, probe, res, u1 + direction * TWO_PI, configs[k]):
                 status.append(("reached", TWO_PI))
                 travel.append(TWO_PI)
@@ -254,7 +255,7 @@ def _follow(design: Design, solver, probe, configs, steps):
         got = [t for t in travel if t is not None]
         ordered = all(a < b for a, b in zip(got, got[1:]))
         far = max(got)
-        mus = probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + 1e-12])
+        mus = probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + tol.zero])
         mus += probe.mus([configs[k] for k, t in enumerate(travel) if t is not None])  # the ends exactly
         missing = sum(t is None for t in travel)
         outcomes.append(((missing, not ordered), direction, status, travel, mus))

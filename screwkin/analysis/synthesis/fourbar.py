@@ -20,6 +20,7 @@ import numpy as np
 
 from ...files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
 from ...model.geometry import circle_circle, cross2, vector_angle
+from ...tolerances import DEFAULT
 from .designs import FourBar
 
 __all__ = ["angle", "wrap", "rotate", "pose_matrix", "branch", "tool_local", "positions",
@@ -176,8 +177,8 @@ def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None 
     tc, tab, tr = angle(A - A0), angle(B - A), angle(B - B0)
     u, v, gamma = tool_local(fb)
     coupler_points = [(0.0, 0.0), (L["coupler"], 0.0)]
-    if tool and fb.tool is not None and math.hypot(u, v) > 1e-9 * max(L.values()) \
-            and math.hypot(u - L["coupler"], v) > 1e-9 * max(L.values()):
+    if tool and fb.tool is not None and math.hypot(u, v) > DEFAULT.equal * max(L.values()) \
+            and math.hypot(u - L["coupler"], v) > DEFAULT.equal * max(L.values()):
         coupler_points.append((u, v))
     links = [PlanarLink("ground", (tuple(A0), tuple(B0))),
              PlanarLink("crank", ((0.0, 0.0), (L["crank"], 0.0))),

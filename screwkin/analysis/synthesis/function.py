@@ -28,8 +28,9 @@ import math
 import numpy as np
 
 from ...errors import UsageError, quote
-from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
 from ...model.geometry import circle_circle
+from ...tolerances import DEFAULT
+from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
 from .fourbar import branch, fourbar_linkage, wrap
 
 __all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "FUNCTIONS"]
@@ -111,7 +112,7 @@ def freudenstein(phi, psi):
     M = np.stack([np.cos(phi), -np.cos(psi), np.ones_like(phi)], axis=1)
     r = np.cos(phi - psi)
     if len(phi) == 3:
-        if abs(np.linalg.det(M)) < 1e-12:
+        if abs(np.linalg.det(M)) < DEFAULT.zero:
             raise SynthesisError(WHAT, f"the Freudenstein equations of the three precision points are not independent "
                                        f"(determinant {np.linalg.det(M):.2g}): change the ranges or the function (psi "
                                        "= phi + a constant is done by any parallelogram)")
@@ -174,7 +175,7 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     phi, psi = phi_of(xs), psi_of(ys)
     K = freudenstein(phi, psi)
     K1, K2, K3 = K
-    if abs(K1) < 1e-9 or abs(K2) < 1e-9:
+    if abs(K1) < DEFAULT.equal or abs(K2) < DEFAULT.equal:
         raise SynthesisError(WHAT, f"Freudenstein gives K1 = {K1:.3g}, K2 = {K2:.3g}: a link of infinite length; "
                                    "change the ranges or the precision points")
     d = ground

@@ -25,8 +25,9 @@ import math
 import numpy as np
 
 from ...errors import UsageError
-from .designs import Design, FourBar, PathResult, SynthesisError, Target
 from ...model.geometry import circle_circle
+from ...tolerances import DEFAULT
+from .designs import Design, FourBar, PathResult, SynthesisError, Target
 from .fourbar import fourbar_linkage, travel_analysis, wrap
 
 __all__ = ["synthesize_path", "coupler_points"]
@@ -108,14 +109,14 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
         raise UsageError("--points: the points are all the same")
     for i in range(n):
         for j in range(i):
-            if np.hypot(*(pts[i] - pts[j])) < 1e-9 * L:
+            if np.hypot(*(pts[i] - pts[j])) < DEFAULT.equal * L:
                 raise UsageError(f"--points: points {j + 1} and {i + 1} are the same")
     if timing is not None:
         timing = np.asarray(timing, float)
         if len(timing) != n:
             raise UsageError(f"--timing: give one crank angle per point ({n}), got {len(timing)}")
         timing = timing - timing[0]
-        if np.any(np.abs(np.diff(timing)) < 1e-9):
+        if np.any(np.abs(np.diff(timing)) < DEFAULT.equal):
             raise UsageError("--timing: two points have the same crank angle")
         if not (np.all(np.diff(timing) > 0) or np.all(np.diff(timing) < 0)) or abs(timing[-1]) >= TWO_PI:
             raise UsageError("--timing: the crank angles must run one way and within one turn")
