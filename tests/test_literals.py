@@ -12,8 +12,10 @@ PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
 SMALL = 1e-3
 
 #: file (relative to screwkin/) -> comparisons with a bare small literal still allowed there.
-#: The first seven are being rewritten elsewhere (the solver and continuation); the others
-#: hold guards and round-off tests not yet named.
+#: The first seven are being rewritten elsewhere (the solver and continuation) and keep their
+#: counts of the day this test was written; synthesis/motion.py holds four thresholds of its
+#: own (collinear precision points, Newton's step, two roots the same, a circle's spread);
+#: loader.py (MJCF), view.py and draw.py are in other hands this round.
 ALLOWED = {
     "model/closure.py": 0,
     "analysis/batch.py": 6,
@@ -22,40 +24,10 @@ ALLOWED = {
     "analysis/maps.py": 0,
     "analysis/workspace.py": 3,
     "model/state.py": 0,
-    "analysis/course_newton.py": 0,
-    "analysis/grasp.py": 0,
-    "analysis/motion.py": 0,
-    "analysis/planar.py": 0,
-    "analysis/position.py": 0,
-    "analysis/screws.py": 0,
-    "analysis/singular.py": 0,
-    "analysis/skeleton.py": 0,
-    "analysis/statics.py": 0,
-    "analysis/synthesis/check.py": 0,
-    "analysis/synthesis/fourbar.py": 0,
-    "analysis/synthesis/function.py": 0,
     "analysis/synthesis/motion.py": 4,
-    "analysis/synthesis/path.py": 0,
-    "analysis/vector_loops.py": 0,
-    "commands/equations.py": 1,
-    "commands/report.py": 2,
-    "files/urdf.py": 2,
-    "files/writer.py": 1,
     "model/loader.py": 1,
-    "model/mechanism.py": 1,
-    "model/topology.py": 2,
-    "present/document.py": 1,
     "present/draw.py": 3,
-    "present/ellipsoids.py": 1,
-    "present/equations.py": 1,
-    "present/grasp.py": 3,
-    "present/motion.py": 1,
-    "present/plots.py": 2,
-    "present/statics.py": 1,
-    "present/synthesis.py": 1,
-    "present/tables.py": 1,
     "present/view.py": 5,
-    "present/workspace.py": 1,
 }
 
 
