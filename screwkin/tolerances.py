@@ -1,7 +1,9 @@
 """The one place for numerical tolerances.
 
 All analyses take a :class:`Tolerances` object; nothing else in the package
-hard-codes a threshold.
+hard-codes a threshold.  Division guards (``max(x, TINY)``) and display cut-offs are named
+module constants where they are used; tests/test_literals.py fails on a new comparison
+against a bare small literal.
 """
 
 from __future__ import annotations
@@ -19,7 +21,10 @@ class Tolerances:
     rank_rtol:      singular values below ``rank_rtol * sigma_max`` count as zero [-].
     rank_atol:      singular values below this always count as zero [same units as the matrix].
     geometry:       tolerance of geometric tests (parallel or intersecting axes,
-                    concurrent axes, planarity) [m for distances, rad-like for directions].
+                    concurrent axes, planarity; two configurations, assembly modes or
+                    points the same, a link turned, a joint tilted out of the plane)
+                    [m for distances (times the characteristic length where it says so),
+                    rad-like for directions].
     dummy_mass:     a link without geometry and lighter than this is a massless
                     link that may sit inside a compound joint [kg].
     singular:       a solution whose passive constraint Jacobian has a relative
@@ -45,6 +50,20 @@ class Tolerances:
                     over it, its neighbours and these, and the largest decides [-].
     samples:        nearby assembled configurations sampled for the generic rank [-].
     sample_step:    size of the random step to a nearby configuration [rad or m].
+    moves:          a joint moves (in the generic configurations) where its row of the
+                    dimensionless motion basis is longer than this [-].
+    stationary:     a joint is stationary (its rate forced to zero by the loops; its loop's
+                    Gram cofactor zero) where its dimensionless rate is below this [-].
+    equal:          two values reached by different routes (a closed form and a solve, the
+                    ends of a range, a travel and a precision position) are the same when
+                    they differ by less than this, relative to their scale (1 below 1) [-].
+    zero:           a value is zero up to the round-off of exact arithmetic when it is below
+                    this, relative to its scale (an exactly known constant, a step of nothing,
+                    a singular 2x2 system) [-].
+    balanced:       statics: the loads balance when the residual of the balance is below
+                    this times their size [-].
+    indeterminate:  statics: an effort or reaction is indeterminate when the part of it the
+                    indeterminate directions change is above this times its size [-].
     """
 
     closure: float = 1e-10
@@ -63,6 +82,12 @@ class Tolerances:
     generic_starts: int = 4
     samples: int = 3
     sample_step: float = 0.05
+    moves: float = 1e-6
+    stationary: float = 1e-7
+    equal: float = 1e-9
+    zero: float = 1e-12
+    balanced: float = 1e-8
+    indeterminate: float = 1e-7
 
 
 DEFAULT = Tolerances()

@@ -15,7 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import UsageError
-from .equations import SIMPLIFY_OPS, VectorLoops
+from .det_conditions import SIMPLIFY_OPS, condition
+from .vector_loops import VectorLoops
 
 __all__ = ["SymbolicGramLoop", "symbolic_gram"]
 
@@ -67,7 +68,7 @@ def symbolic_gram(mech, q, inputs=None) -> tuple:
                 base = f.base if f.is_Pow else f
                 present = sorted(base.free_symbols & variables, key=lambda s: order.index(s.name))
                 if present:
-                    cond = loops._condition(base, present)[0]
+                    cond = condition(loops, base, present)[0]
                     if cond not in conds:
                         conds.append(cond)
             zero[name] = tuple(conds)

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..files.grasp import GraspSpec
+from ..tolerances import DEFAULT
 from .grasp_map import (  # noqa: F401 - the grasp map's functions, exported here as before
     exact_cones,
     generator_matrix,
@@ -428,7 +429,7 @@ def _epsilon(W, tol):
         worst = np.argmax(support, axis=0)
         h = support[worst, np.arange(len(order))]
         upper = min(upper, float(h.min()))
-        over = h - b[order] > 1e-12 * scale
+        over = h - b[order] > DEFAULT.zero * scale
         lower = max(float(b[order[0]]), 0.0)
         if not over[0]:
             return (lower, lower, None) if lower > 0 else \

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from ..files.grasp import GraspSpec
+from ..tolerances import DEFAULT
 
 __all__ = ["contact_frame", "contact_columns", "grasp_map", "characteristic_length", "scaled_points", "cone_error",
            "exact_cones", "generators", "generator_matrix"]
@@ -81,7 +82,7 @@ def characteristic_length(spec: GraspSpec):
     P = np.array([c.point for c in spec.contacts], float)
     L = float(np.mean(np.linalg.norm(P - P.mean(axis=0), axis=1)))
     scale = max(1.0, float(np.abs(P).max()))
-    if not L > 1e-9 * scale:
+    if not L > DEFAULT.equal * scale:
         return 1.0, "1 m: the contacts are at one point"
     return L, "the mean distance of the contacts from their centroid"
 

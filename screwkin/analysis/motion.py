@@ -134,7 +134,7 @@ class Stroke:
     crank_angles: tuple | None  # (forward, return) crank angles [rad] when time_ratio is known
 
 
-def _extrema(x, p, dp):
+def _extrema(x, p, dp, tol):
     """(input value, coordinate) at each zero of dp/dx along the samples: the cubic Hermite
     interpolant of p on each bracket whose slope changes sign (accurate to O(h^4)), its vertex."""
     out = []
@@ -147,7 +147,8 @@ def _extrema(x, p, dp):
         a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1
         b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
         roots = np.roots([a, b, m0]) if abs(a) > 0 else np.array([-m0 / b]) if b else np.array([0.0])
-        t = next((float(r.real) for r in roots if abs(r.imag) < 1e-12 and -1e-9 <= r.real <= 1 + 1e-9), 0.5)
+        t = next((float(r.real) for r in roots
+                  if abs(r.imag) < tol.zero and -tol.equal <= r.real <= 1 + tol.equal), 0.5)
         value = ((2 * t**3 - 3 * t**2 + 1) * p0 + (t**3 - 2 * t**2 + t) * m0 + (-2 * t**3 + 3 * t**2) * p1
                  + (t**3 - t**2) * m1)
         out.append((float(x[k] + t * h), float(value)))
@@ -166,15 +167,16 @@ def strokes(res, motion, mech) -> list:
         if name not in motion.angular_loop:
             series.append((name, v, motion.loop_rates[name]))
     x = np.asarray(res.values, float)
-    turned = res.unit == "rad" and res.stopped_at is None and abs(x[-1] - x[0]) >= 2 * np.pi * (1 - 1e-9)
+    tol = mech.tolerances
+    turned = res.unit == "rad" and res.stopped_at is None and abs(x[-1] - x[0]) >= 2 * np.pi * (1 - tol.equal)
     out = []
     for name, values, rates in series:
         values, slope = np.asarray(values, float), np.asarray(rates, float) / (res.rate or 1.0)
-        ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + _extrema(x, values, slope)
+        ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + _extrema(x, values, slope, tol)
         lo, hi = min(ends, key=lambda e: e[1]), max(ends, key=lambda e: e[1])
         ratio = angles = None
         if turned:
-            z = [a for a, _ in _extrema(x, values, slope) if a < x[0] + 2 * np.pi * (1 - 1e-12)]  # one turn
+            z = [a for a, _ in _extrema(x, values, slope, tol) if a < x[0] + 2 * np.pi * (1 - tol.zero)]  # one turn
             if len(z) == 2:
                 d = abs(z[1] - z[0])
                 mid = int(np.clip(np.searchsorted(x, (z[0] + z[1]) / 2), 0, len(x) - 1))

@@ -14,19 +14,22 @@ lengths measured between joint centres in the plane of motion:
   positions (input and coupler collinear: dead centres of the output).
 
 Angles are returned as input *joint values* [rad] of the circuit the
-configuration is on.
+configuration is on.  :func:`transmission_angles` gives mu at a stack of configurations
+from one identification (the joint centres by forward kinematics, the angles all at once).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from ..model.geometry import (circle_intersections, cross2, line_angle, line_circle, perpendicular_basis, plane_basis,
+                              vector_angle)
 
-__all__ = ["LinkageInfo", "identify", "LinkAngles", "plane_basis"]
+__all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +47,11 @@ class LinkageInfo:
     diagonal: float | None = None
     alpha: float | None = None
     beta: float | None = None
+    # where transmission_angles finds the centres of the joints A (input), B, C, D at any
+    # configuration, the plane's normal and the slide's direction (slider-crank), in the world
+    centres: tuple = field(default=(), compare=False, repr=False)
+    normal: tuple | None = field(default=None, compare=False, repr=False)
+    slide: tuple | None = field(default=None, compare=False, repr=False)
 
     def construction(self) -> dict:
         """JSON-ready: four-bar {transmission_angle, diagonal, alpha, beta}; slider-crank {transmission_angle}."""
@@ -56,10 +64,6 @@ class LinkageInfo:
 def _rot(v, ang):
     c, s = np.cos(ang), np.sin(ang)
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
-
-
-def _cross(u, v):
-    return u[0] * v[1] - u[1] * v[0]
 
 
 def _angle(v):
@@ -77,18 +81,6 @@ def _interval(start, end, phi_now, q_in):
     return (q_in + start - phi_now, q_in + end - phi_now)
 
 
-def _circles(p, r, c, s):
-    """Intersections of circle (p, r) and circle (c, s) in the plane."""
-    d = np.linalg.norm(c - p)
-    if d < 1e-15 or d > r + s + 1e-12 or d < abs(r - s) - 1e-12:
-        return []
-    along = (r * r - s * s + d * d) / (2 * d)
-    h = np.sqrt(max(r * r - along * along, 0.0))
-    u = (c - p) / d
-    n = np.array([-u[1], u[0]])
-    return [p + along * u + h * n, p + along * u - h * n]
-
-
 def identify(mech, topo, q, input_joint):
     """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
     joint is a ground joint, at the configuration ``topo`` was built at (q)."""
@@ -100,10 +92,7 @@ def identify(mech, topo, q, input_joint):
     if inp is None or ground not in inp.links or inp.type not in ("revolute", "continuous"):
         return None
     n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
-    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    e1 = np.cross(n, h)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(n, e1)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
+    e1, e2 = perpendicular_basis(n)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
 
     def p2(v):
         v = np.asarray(v)
@@ -121,25 +110,73 @@ def identify(mech, topo, q, input_joint):
     q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
     A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
     a, b = np.linalg.norm(B - A), np.linalg.norm(C - B)
+    where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
     if j_d.type in ("revolute", "continuous") and j_c.type in ("revolute", "continuous") \
             and j_b.type in ("revolute", "continuous"):
-        return _four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b)
+        return replace(_four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b, mech.tolerances), **where)
     if j_d.type == "prismatic" or j_c.type == "prismatic":
         slide = j_d if j_d.type == "prismatic" else j_c
         pin_joint = j_c if slide is j_d else j_d
         if slide is j_c:  # the prismatic joint is between rod and slider: not the textbook slider-crank
             return None
         s = p2(np.asarray(slide.direction) + 0) - p2(np.zeros(3))
-        return _slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s / np.linalg.norm(s), a, b)
+        s = s / np.linalg.norm(s)
+        return replace(_slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s, a, b),
+                       slide=tuple(s[0] * e1 + s[1] * e2), **where)
     return None
 
 
-def _four_bar(name, q_in, A, B, C, D, a, b):
+def _locator(mech, joint):
+    """How to find ``joint``'s centre at any configuration: ("frame", id) of a cut joint's F1,
+    ("joint", id) of a simple tree joint, or ("topology", name) for a compound joint (its
+    centre is the topology's, rebuilt at each configuration)."""
+    cuts = {c.name: c for c in mech.cuts}
+    if joint.cut and joint.name in cuts:
+        return ("frame", cuts[joint.name].frame1)
+    if not joint.cut and len(joint.members) == 1 and mech.model.existJointName(joint.members[0]):
+        return ("joint", mech.model.getJointId(joint.members[0]))
+    return ("topology", joint.name)
+
+
+def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
+    """Transmission angles mu [rad] of the linkage ``info`` (from :func:`identify`, computed
+    once) at the configurations Q (N, nq): shape (N,).  Four-bar: the angle at the
+    coupler-output joint C between C -> B and C -> D; slider-crank: the angle between the rod
+    B -> C and the normal of the slide; both in the plane of motion."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    P = np.empty((len(Q), 4, 3))
+    model, data = mech.model, mech.model.createData()
+    for k, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        topo = None
+        for i, (kind, ident) in enumerate(info.centres):
+            if kind == "frame":
+                P[k, i] = data.oMf[ident].translation
+            elif kind == "joint":
+                P[k, i] = data.oMi[ident].translation
+            else:
+                topo = topo or mech.topology(q)
+                P[k, i] = next(j.point for j in topo.joints if j.name == ident)
+    return _transmission(info.kind, P, np.asarray(info.normal, float),
+                         None if info.slide is None else np.asarray(info.slide, float))
+
+
+def _transmission(kind, P, n, slide=None):
+    """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
+    unit normal n (slide: the slide's unit direction, slider-crank)."""
+    P = P - (P @ n)[..., None] * n
+    B, C, D = P[..., 1, :], P[..., 2, :], P[..., 3, :]
+    if kind == "four-bar":
+        return vector_angle(B - C, D - C)
+    return line_angle(C - B, np.cross(n, slide))
+
+
+def _four_bar(name, q_in, A, B, C, D, a, b, tol):
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     s, l = min(lengths.values()), max(lengths.values())
     p_q = g + a + b + c - s - l
-    if abs(s + l - p_q) < 1e-9 * l:
+    if abs(s + l - p_q) < tol.equal * l:
         cls = "change point (s + l = p + q): the linkage can fold flat"
     elif s + l > p_q:
         cls = "non-Grashof (triple rocker): no link turns fully"
@@ -151,7 +188,7 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
                "output": "Grashof rocker-crank: the output turns fully, the input rocks"}[shortest]
     u_ad = (D - A) / g
     phi_now = _angle(_rot(B - A, -_angle(u_ad)))  # input angle from AD
-    circuit = np.sign(_cross(C - B, D - C)) or 1.0
+    circuit = np.sign(cross2(C - B, D - C)) or 1.0
 
     lo = (a * a + g * g - (b + c) ** 2) / (2 * a * g)
     hi = (a * a + g * g - (b - c) ** 2) / (2 * a * g)
@@ -166,13 +203,13 @@ def _four_bar(name, q_in, A, B, C, D, a, b):
     # the output is at a limit where input and coupler are collinear (B on line AC), on this circuit
     limits = []
     for dist, folded in ((a + b, False), (abs(b - a), True)):
-        for Cc in _circles(A, dist, D, c):
+        for Cc in circle_intersections(A, dist, D, c, slack=tol.zero, concentric=1e-15):
             u = (Cc - A) / max(np.linalg.norm(Cc - A), 1e-300)
             Bc = A - a * u if folded and b > a else A + a * u
-            if (np.sign(_cross(Cc - Bc, D - Cc)) or circuit) != circuit:
+            if (np.sign(cross2(Cc - Bc, D - Cc)) or circuit) != circuit:
                 continue
             limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
-    mu = float(np.arccos(np.clip(np.dot(B - C, D - C) / (b * c), -1, 1)))
+    mu = float(vector_angle(B - C, D - C))
     z = float(np.linalg.norm(B - D))
     alpha = beta = None
     if z > 0:  # (the diagonal vanishes when the crank tip sits on the output pivot)
@@ -203,28 +240,15 @@ def _slider_crank(name, q_in, A, B, C, s, a, b):
     side = np.sign((C - A) @ s) or 1.0
     limits = []
     for dist, folded in ((a + b, False), (abs(b - a), True)):
-        if dist < abs(e):
+        meets = line_circle(A + e * nrm, s, A, dist)  # the slider's pin where the rod and crank are in line
+        if not meets:
             continue
-        x = side * np.sqrt(dist * dist - e * e)
-        Cc = A + x * s + e * nrm
+        Cc = meets[1] if side > 0 else meets[0]
         u = (Cc - A) / np.linalg.norm(Cc - A)
         Bc = A + (-a if folded and b > a else a) * u
         limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
-    rod = (C - B) / b
-    mu = float(np.arccos(np.clip(abs(rod @ nrm), 0, 1)))
+    mu = float(line_angle(C - B, nrm))
     return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
-
-
-def plane_basis(normal):
-    """(e1, e2, n): e1 the world x axis projected into the plane (the world y axis when x is
-    normal to it), e2 = n x e1, so angles from e1 are counterclockwise seen from +n."""
-    n = np.asarray(normal, float) / np.linalg.norm(normal)
-    for axis in np.eye(3):
-        e1 = axis - (axis @ n) * n
-        if np.linalg.norm(e1) > 1e-6:
-            e1 /= np.linalg.norm(e1)
-            return e1, np.cross(n, e1), n
-    raise ValueError("degenerate normal")  # pragma: no cover
 
 
 class LinkAngles:

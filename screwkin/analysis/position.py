@@ -407,7 +407,7 @@ class PositionSolver:
                 found.append((None, q, a))
                 continue
             sig = self._signature(q)
-            if any(np.max(np.abs(sig - s)) < 1e-6 for s, *_ in found):
+            if any(np.max(np.abs(sig - s)) < self.mech.tolerances.geometry for s, *_ in found):
                 continue
             found.append((sig, q, a))
         return found, best
@@ -483,7 +483,7 @@ class PositionSolver:
         for k in range(pieces):
             step = self.mech.difference(q, q2) / (pieces - k)
             size = float(np.linalg.norm(step))
-            if size < 1e-12:
+            if size < self.mech.tolerances.zero:
                 return True
             pred = pin.integrate(model, q, step)
             try:
@@ -492,7 +492,8 @@ class PositionSolver:
                 return False
             if np.linalg.norm(self.mech.difference(pred, q)) > 0.3 * size:
                 return False
-        return float(np.linalg.norm(self.mech.difference(q, q2))) < 1e-6 * max(self.mech.length, 1e-3)
+        gap = float(np.linalg.norm(self.mech.difference(q, q2)))
+        return gap < self.mech.tolerances.geometry * max(self.mech.length, 1e-3)
 
     def _labels(self, q, outside) -> tuple:
         """Why a solution is not reached by moving from the reference configuration."""
@@ -509,7 +510,7 @@ class PositionSolver:
         if reversed_:
             labels.append(f"legs reversed through their pivots: {', '.join(reversed_)}")
         turned_ = [link for link, fid, R_ref in turned
-                   if np.linalg.norm(pin.log3(R_ref.T @ data.oMf[fid].rotation)) > 1e-6]
+                   if np.linalg.norm(pin.log3(R_ref.T @ data.oMf[fid].rotation)) > self.mech.tolerances.geometry]
         if turned_:
             labels.append(f"turned although they only translate as the mechanism moves (a mirrored assembly): "
                           f"{', '.join(turned_)}")
@@ -548,7 +549,7 @@ class PositionSolver:
                     continue
                 axis = axes[c.joint]
                 s_ref = float((self._far(fars[0]) - data.oMi[parent].translation) @ (data.oMi[c.joint_id].rotation @ axis))
-                if abs(s_ref) > 1e-6 * mech.length:
+                if abs(s_ref) > mech.tolerances.geometry * mech.length:
                     legs.append((c.joint, c.joint_id, fars[0], axis, s_ref))
             turned = []
             configs = self.generic().configurations
@@ -618,7 +619,7 @@ class PositionSolver:
         angles = self._link_angles(q)
         joints = self.joint_values(q)
         for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
-            if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < 1e-9:
+            if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < tol.equal:
                 joints[name] = float(v)
         return Solution(q, joints, a.residual, a.iterations, bool(singular), float(sigma), pose,
                         rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),

@@ -21,9 +21,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
-from ..model.closure import perpendicular_basis
+from ..model.geometry import perpendicular_basis
 from ..model.linalg import null_space
 from ..model.state import KinematicState
+from ..tolerances import DEFAULT
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
            "loop_product", "split_jacobians", "cut_twists"]
@@ -51,7 +52,7 @@ def screw_of(xi, length: float | None = None) -> Screw:
     xi = np.asarray(xi, float)
     v, w = xi[:3], xi[3:]
     nw = np.linalg.norm(w)
-    if nw < 1e-12 or (length is not None and nw * length < TRANSLATION_RATIO * np.linalg.norm(v)):
+    if nw < DEFAULT.zero or (length is not None and nw * length < TRANSLATION_RATIO * np.linalg.norm(v)):
         nv = np.linalg.norm(v)
         return Screw(tuple(xi), tuple(v / nv) if nv > 0 else (0.0, 0.0, 0.0), None, float("inf"))
     pitch = float(w @ v / nw**2)
@@ -227,10 +228,8 @@ def loop_product(loop: LoopScrews, theta) -> np.ndarray:
 def planar_form(xi, normal):
     """(v_x, v_y, w) of a planar twist in a right-handed basis (e1, e2) of the plane with normal n."""
     n = np.asarray(normal, float) / np.linalg.norm(normal)
-    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    e1 = np.cross(n, h)
-    e1 /= np.linalg.norm(e1)
-    if abs(n @ np.array([0, 0, 1.0])) > 1 - 1e-12:  # the usual x-y plane: keep x, y
+    e1 = perpendicular_basis(n)[0]
+    if abs(n @ np.array([0, 0, 1.0])) > 1 - DEFAULT.zero:  # the usual x-y plane: keep x, y
         e1 = np.array([1.0, 0, 0]) * np.sign(n[2])
     e2 = np.cross(n, e1)
     xi = np.asarray(xi)

@@ -32,6 +32,7 @@ import pinocchio as pin
 
 from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, loop_coordinate_cuts
+from ..tolerances import DEFAULT
 from .screws import cut_twists, screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
@@ -132,7 +133,7 @@ class Generic:
             S = scaled_jacobians(mech, q, output, point)
             self.rank_K = max(self.rank_K, rank(S.K, tol))
             self.rank_Kp = max(self.rank_Kp, rank(S.K[:, self.p], tol) if S.K.size else 0)
-            self.moving |= np.linalg.norm(S.V, axis=1) > 1e-6
+            self.moving |= np.linalg.norm(S.V, axis=1) > tol.moves
             if S.J is not None:
                 T = S.J @ S.V
                 self.out_dim = max(self.out_dim, rank(T, tol))
@@ -192,12 +193,12 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
 
     if constraint:
         _, _, vt = np.linalg.svd(S.K)
-        twists.append(_motion_twist("constraint", unscale(vt[g.rank_K - 1]), names, J_world))
+        twists.append(_motion_twist("constraint", unscale(vt[g.rank_K - 1]), names, J_world, tol))
     if actuator:
         _, _, vt = np.linalg.svd(S.K[:, g.p])
         x = np.zeros(mech.nv)
         x[g.p] = vt[g.rank_Kp - 1]
-        twists.append(_motion_twist("actuator", unscale(x), names, J_world))
+        twists.append(_motion_twist("actuator", unscale(x), names, J_world, tol))
     cond = manip = None
     if S.J is not None and g.out_dim:
         U, s, _ = np.linalg.svd(S.J @ S.V, full_matrices=True)
@@ -219,14 +220,14 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
         s = np.linalg.svd(S.K[:, g.p], compute_uv=False)[:g.rank_Kp]
         cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
     stationary = tuple(n for k, n in enumerate(names)
-                       if g.moving[k] and S.V.shape[1] and np.linalg.norm(S.V[k]) < STATIONARY)
+                       if g.moving[k] and S.V.shape[1] and np.linalg.norm(S.V[k]) < tol.stationary)
     # the loop (cut) joints too, from the same motions: a cut joint's rate is its F2's twist relative to F1
     # along its axis (model.state), zero in every motion of the null space (so the Gram table agrees)
     if S.V.shape[1]:
         states = [KinematicState(mech, q, unscale(S.V[:, i])) for i in range(S.V.shape[1])]
         for c in loop_coordinate_cuts(mech):
             scale = L if c.type == "prismatic" else 1.0
-            if max(abs(st.loop_rate(c)) for st in states) / scale < STATIONARY:
+            if max(abs(st.loop_rate(c)) for st in states) / scale < tol.stationary:
                 stationary += (c.name,)
     sigmas = {k: sig.get(k, 1.0) for k in KINDS}
     return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
@@ -252,11 +253,13 @@ class GramLoop:
     nullity: int  # n - rank S: the loop's mobility on its own
     cofactors: dict  # joint -> C_ii
     relative: dict  # joint -> C_ii / sum_j C_jj = v_i^2
-    zero: tuple  # joints whose cofactor is zero: v_i^2 < STATIONARY^2 (|v_i| < 1e-7, as stationary_joints)
+    zero: tuple  # joints whose cofactor is zero: v_i^2 < stationary^2 (Tolerances.stationary, as stationary_joints)
     note: str | None = None
 
 
-STATIONARY = 1e-7  # |v_i| below this: joint i's rate is zero (the threshold of stationary_joints too)
+#: |v_i| below this: joint i's rate is zero, by default (Tolerances.stationary, the threshold of
+#: stationary_joints and of the zero Gram cofactors; a mechanism's own tolerances decide).
+STATIONARY = DEFAULT.stationary
 
 
 def loop_twists(mech, q, cut, length=None):
@@ -316,14 +319,16 @@ def gram_cofactors(mech, q, length=None) -> tuple:
         rel = C / total if total > 0 else np.zeros(n)
         cof = {nm: float(c) for nm, c in zip(names, C)}
         out.append(GramLoop(cut.name, tuple(names), 1, cof, {nm: float(r) for nm, r in zip(names, rel)},
-                            tuple(nm for nm, r in zip(names, rel) if r < STATIONARY ** 2)))
+                            tuple(nm for nm, r in zip(names, rel) if r < tol.stationary ** 2)))
     return tuple(out)
 
 
-def _motion_twist(kind, x, names, J):
+def _motion_twist(kind, x, names, J, tol):
+    """The motion x (any length) as a SingularTwist: its rates (those not zero next to the unit
+    vector: above Tolerances.equal), its twist and screw (none for a zero twist)."""
     x = x / np.linalg.norm(x)
-    rates = {n: float(v) for n, v in zip(names, x) if abs(v) > 1e-9}
+    rates = {n: float(v) for n, v in zip(names, x) if abs(v) > tol.equal}
     if J is None:
         return SingularTwist(kind, rates, None, None)
     t = J @ x
-    return SingularTwist(kind, rates, tuple(t), screw_of(t) if np.linalg.norm(t) > 1e-12 else None)
+    return SingularTwist(kind, rates, tuple(t), screw_of(t) if np.linalg.norm(t) > tol.zero else None)

@@ -27,8 +27,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from ..model.geometry import TINY, line_foot, plane_basis
 from .motion import motion_along
-from .planar import LinkAngles, plane_basis
+from .planar import LinkAngles
 from .position import PositionSolver
 from .sweep import locate_singularities, sweep
 
@@ -336,7 +337,7 @@ def _basis(mech, topo, centres):
     k = int(np.argmax(np.abs(n)))
     n = n * np.sign(n[k])
     e1, e2, n = plane_basis(n)
-    if e2[2] < -1e-9:  # the world's +z drawn upwards where it can be
+    if e2[2] < -mech.tolerances.equal:  # the world's +z drawn upwards where it can be
         e1, e2, n = plane_basis(-n)
     return (e1, e2, n), False
 
@@ -358,7 +359,8 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
         return (float(np.asarray(v) @ e1), float(np.asarray(v) @ e2))
 
     values = mech.joint_values(q)
-    tol = 1e-6 * mech.length
+    tolerances = mech.tolerances
+    tol = tolerances.geometry * mech.length
     specs = {s.name: s for s in mech.spec.cut_joints}
     joints, profiles = [], []
     for j in ordered:
@@ -369,9 +371,9 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
         if axis is not None:
             u = axis / np.linalg.norm(axis)
             tilt = float(np.arccos(np.clip(abs(u @ n), 0.0, 1.0)))
-            if j.type == "prismatic" or (not planar and tilt > 1e-6):
+            if j.type == "prismatic" or (not planar and tilt > tolerances.geometry):
                 d = np.array([u @ e1, u @ e2])
-                if np.linalg.norm(d) > 1e-9:
+                if np.linalg.norm(d) > tolerances.equal:
                     direction = tuple(float(x) for x in d / np.linalg.norm(d))
         point = p2(b) if j.type == "prismatic" else p2(a)
         if j.cut and j.type in ("rolling", "gear", "contact") and j.name in specs:
@@ -390,7 +392,7 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
             shape, outline = "ground", tuple(pts)
         elif len(pts) >= 3:
             hull = _hull([(round(x, 12), round(y, 12)) for x, y in pts])
-            if len(hull) >= 3 and _area(hull) > 1e-6 * mech.length ** 2:
+            if len(hull) >= 3 and _area(hull) > tolerances.geometry * mech.length ** 2:
                 shape, outline = "polygon", tuple(hull)
             else:
                 shape, outline = "bar", _extremes(pts)
@@ -485,14 +487,12 @@ def _contact_point(a, b, internal):
     if b.shape == "point":
         return cb
     if a.shape == "line" and b.shape == "circle":
-        d = np.array(a.direction)
-        return ca + ((cb - ca) @ d) * d
+        return line_foot(cb, ca, a.direction)
     if b.shape == "line" and a.shape == "circle":
-        d = np.array(b.direction)
-        return cb + ((ca - cb) @ d) * d
+        return line_foot(ca, cb, b.direction)
     u = cb - ca
     dist = np.linalg.norm(u)
-    if dist < 1e-300:
+    if dist < TINY:  # division guard
         return ca
     u = u / dist
     return ca + a.radius * u  # on circle 1 towards circle 2's centre (outside, or inside it: internal)
@@ -542,7 +542,7 @@ def input_range(mech, name, q) -> tuple:
     lo, hi = float(mech.model.lowerPositionLimit[c.idx_q]), float(mech.model.upperPositionLimit[c.idx_q])
     x = float(q[c.idx_q])
     if short.startswith("JointModelR"):
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo >= 2 * np.pi - 1e-9:
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo >= 2 * np.pi - mech.tolerances.equal:
             return x, x + 2 * np.pi
         return lo, hi
     L = mech.length

@@ -131,7 +131,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
     efforts, units = {}, {}
     for k, (name, iv) in enumerate(zip(inputs, a_idx)):
-        efforts[name] = None if free_tau[k] > 1e-7 else float(tau[k])
+        efforts[name] = None if free_tau[k] > tol.indeterminate else float(tau[k])
         units[name] = "N" if mech.translational[iv] else "N m"
     reactions = _reactions(mech, q, lam, w if output is not None else None, output, gravity, N[m:] if N.size else None)
     L = mech.length
@@ -142,7 +142,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     amp = float(np.linalg.norm(scaled_tau) / load) if load > 0 and m else None
     labels = mech.closure.row_labels()
     return StaticsResult(tuple(inputs), efforts, units, tuple(w.tolist()), output, gravity,
-                         unbalanced <= 1e-8 * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
+                         unbalanced <= tol.balanced * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
                          bool(inputs) and sig < tol.singular, float(sig), amp, L,
                          tuple(zip(labels, map(float, lam))))
 
@@ -170,7 +170,7 @@ def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
                 free[name] = np.maximum(free[name], np.abs(value[1]))
     size = max([float(np.linalg.norm(x[1])) for x in base.values()] + [1.0])
     # components that change along the indeterminate directions
-    return {name: (kind, wrench, free[name] > 1e-7 * size) for name, (kind, wrench) in base.items()}
+    return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
 def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dict:
@@ -332,7 +332,7 @@ def legs(mech, q, output, inputs=None) -> tuple:
         # transmission: in W_locked, outside span(W): the part of W_locked orthogonal to W
         P = W_locked - W @ (W.T @ W_locked) if W.size else W_locked
         Ut, st, _ = np.linalg.svd(P, full_matrices=False) if P.size else (np.zeros((6, 0)), np.zeros(0), None)
-        trans = Ut[:, st > 1e-8] if st.size else np.zeros((6, 0))
+        trans = Ut[:, st > tol.rank_rtol] if st.size else np.zeros((6, 0))  # rank of P (orthonormal columns)
         names = tuple(coords[j].joint for j in joints)
         out.append(Leg(names, tuple(n for n in names if n in inputs), rank(T, tol),
                        tuple(tuple(map(float, c)) for c in W.T), tuple(tuple(map(float, c)) for c in trans.T),

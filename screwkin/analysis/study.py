@@ -35,7 +35,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 
 from ..errors import AssemblyError, ScrewkinError, UsageError, one_line, quote
 from ..files.description import LIMITS
@@ -43,7 +42,7 @@ from ..files.study import StudySpec, read_study_spec, study_spec
 from ..files.xmlsafe import read_regular_file
 from ..model.loader import load
 from .mobility import analyze_mobility
-from .planar import identify
+from .planar import identify, transmission_angles
 from .position import PositionSolver
 from .scheduler import probe_scheduler, scheduler_address
 from .workspace import DEFAULT_THRESHOLD, workspace
@@ -249,9 +248,8 @@ def _transmission(d: _Design) -> dict:
     """Smallest and largest transmission angle over the input's motion: the input at
     ``steps`` + 1 values over a full turn (or over its range, ends taken RANGE_MARGIN of the
     range inside the limit positions), each configuration tracked from the previous one (or
-    solved anew when tracking fails) and checked; the angles of all of them at once from
-    their joint centres (:func:`_angles`), which at the assembled configuration must equal
-    analysis.planar.identify's."""
+    solved anew when tracking fails) and checked; the angles of all of them at once
+    (analysis.planar.transmission_angles)."""
     info = d.linkage()
     mech, name, steps = d.mech, d.input, d.task.steps
     coord = mech.coordinate(name)
@@ -278,65 +276,8 @@ def _transmission(d: _Design) -> dict:
                     raise
                 q = solver.solve({name: float(x)}, starts=8).solutions[0].q  # checked, or AssemblyError
             Q.append(q)
-    mus = _angles(d, info, Q)
+    mus = transmission_angles(mech, info, Q)
     return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max())}
-
-
-def _angles(d: _Design, info, Q) -> np.ndarray:
-    """Transmission angles [rad] at the configurations Q (rows) of the linkage ``info``
-    describes (at d.q): from the centres of its joints, found as identify finds them."""
-    mech, name = d.mech, d.input
-    topo = mech.topology(d.q)
-    joints = {j.name: j for j in topo.joints}
-
-    def other(link, joint):
-        return next(j for j in topo.joints if j is not joint and link in j.links)
-
-    inp = joints[name]
-    moving = inp.links[1] if inp.links[0] == topo.ground else inp.links[0]
-    j_b = other(moving, inp)
-    coupler = j_b.links[1] if j_b.links[0] == moving else j_b.links[0]
-    j_c = other(coupler, j_b)
-    j_d = other(topo.ground, inp)
-    getters = []
-    cuts = {c.name: c for c in mech.cuts}
-    for j in (inp, j_b, j_c, j_d):
-        if j.cut and j.name in cuts:
-            getters.append(("frame", cuts[j.name].frame1))
-        elif not j.cut and len(j.members) == 1 and mech.model.existJointName(j.members[0]):
-            getters.append(("joint", mech.model.getJointId(j.members[0])))
-        else:  # a compound joint: the slow way, identify at each configuration
-            return np.array([identify(mech, mech.topology(q), q, name).transmission_angle for q in Q])
-    model, data = mech.model, mech.model.createData()
-    Q = [d.q, *Q]  # the first, where identify measured it: the check
-    P = np.empty((len(Q), 4, 3))
-    for k, q in enumerate(Q):
-        pin.forwardKinematics(model, data, q)
-        pin.updateFramePlacements(model, data)
-        for i, (kind, ident) in enumerate(getters):
-            P[k, i] = data.oMf[ident].translation if kind == "frame" else data.oMi[ident].translation
-    n = np.asarray(inp.direction, float)
-    n /= np.linalg.norm(n)
-
-    def planar(v):  # v projected into the plane of motion
-        return v - (v @ n)[..., None] * n
-
-    _, B, C, D = (P[:, i] for i in range(4))
-    if info.kind == "four-bar":
-        u, w = planar(B - C), planar(D - C)
-        cos = np.einsum("ij,ij->i", u, w) / (np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1))
-        mus = np.arccos(np.clip(cos, -1.0, 1.0))
-    else:  # slider-crank: the rod against the normal of the slide
-        s = planar(np.asarray(j_d.direction if j_d.type == "prismatic" else j_c.direction, float))
-        s /= np.linalg.norm(s)
-        nrm = np.cross(n, s)
-        rod = planar(C - B)
-        rod /= np.linalg.norm(rod, axis=1)[:, None]
-        mus = np.arccos(np.clip(np.abs(rod @ nrm), 0.0, 1.0))
-    if not np.isclose(mus[0], info.transmission_angle, atol=1e-9):  # pragma: no cover - the two ways must agree
-        raise RuntimeError(f"transmission angle {mus[0]!r} from the joint centres, {info.transmission_angle!r} "
-                           "from analysis.planar.identify")
-    return mus
 
 
 def _workspace_volume(d: _Design) -> dict:

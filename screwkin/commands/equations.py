@@ -160,7 +160,7 @@ def solve_from_start(mech, args, values) -> int:
     got = loops.values(pres.solutions[0].q)
     far = [n for n in loops.unknowns
            if abs(np.angle(np.exp(1j * (got[n] - res.values[n]))) if loops.symbol_info[n].kind == "angle"
-                  else got[n] - res.values[n]) > 1e-6 * max(mech.length, 1.0)]
+                  else got[n] - res.values[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
     if far:  # pragma: no cover - the polished configuration left Newton's root
         raise AssemblyError(mech.path, res.residual, len(res.steps),
                             detail=f"the configuration of Newton's root does not close as solved ({', '.join(far)})")

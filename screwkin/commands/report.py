@@ -18,7 +18,7 @@ import numpy as np
 
 from ..analysis.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
-from ..analysis.planar import identify
+from ..analysis.planar import identify, transmission_angles
 from ..analysis.position import PositionSolver
 from ..analysis.skeleton import (
     default_output,
@@ -265,7 +265,8 @@ def _newton(mech, args, loops, q, values, names, notes, data):
             if loops.symbol_info[n].kind == "angle":
                 start[n] = v + START_ANGLE
             else:
-                start[n] = v + START_FRACTION * (abs(v) if abs(v) > 1e-9 * mech.length else mech.length)
+                size = abs(v) if abs(v) > mech.tolerances.equal * mech.length else mech.length
+                start[n] = v + START_FRACTION * size
         how = (f"from a default estimate: the solved unknowns, each angle +{np.degrees(START_ANGLE):g} deg and each "
                f"length +{100 * START_FRACTION:g} % (of L = {mech.length:.4g} m when 0); give --start NAME=VALUE,... "
                "for other estimates")
@@ -273,7 +274,7 @@ def _newton(mech, args, loops, q, values, names, notes, data):
     res = newton(loops, held, start, args.iterations)
     far = [n for n in loops.unknowns
            if abs(np.angle(np.exp(1j * (res.values[n] - solved[n]))) if loops.symbol_info[n].kind == "angle"
-                  else res.values[n] - solved[n]) > 1e-6 * max(mech.length, 1.0)]
+                  else res.values[n] - solved[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
     how += (f". {len(res.steps)} iteration(s) to |F| = {res.residual:.3g} m"
             + ("; the values reached are the solved configuration's" if res.closes and not far else
                f"; the values reached differ from the solved configuration's ({', '.join(far)}: another "
@@ -316,7 +317,7 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
     mus = None
     info = identify(mech, mech.topology(q), q, moved)
     if info is not None:
-        mus = [identify(mech, mech.topology(x), x, moved).transmission_angle for x in res.q]
+        mus = transmission_angles(mech, info, res.q).tolist()
     fig = sweep_figure(res, mus, singularities=search.found, linear=mech.translational,
                        title=f"{base}: {moved} over its range")
     out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"joint values, rates and accelerations "

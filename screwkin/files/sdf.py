@@ -14,7 +14,6 @@ with ``use_parent_model_frame`` / ``expressed_in="__model__"``).
 
 from __future__ import annotations
 
-from collections import deque
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -76,6 +75,20 @@ def _fmt(v):
 
 def _origin(M):
     return f'<origin xyz="{_fmt(M.translation)}" rpy="{_fmt(pin.rpy.matrixToRpy(M.rotation))}"/>'
+
+
+def _spanning_tree(links, edges, ground) -> dict:
+    """The breadth-first spanning tree from ``ground`` of the graph of ``links`` joined by
+    ``edges`` (parent, child) (a multigraph: two joints may join the same links): joint
+    index -> (link towards the ground, link away from it), in the order reached; of parallel
+    joints the first in the file.  The other joints are the cut joints."""
+    import networkx as nx
+
+    graph = nx.MultiGraph()
+    graph.add_nodes_from(links)
+    for k, (p, c) in enumerate(edges):
+        graph.add_edge(p, c, key=k)
+    return {min(graph[link][other]): (link, other) for link, other in nx.bfs_edges(graph, ground)}
 
 
 def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
@@ -147,23 +160,10 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
             for n, _, _, _, e in raw}
     if problems:
         raise MechanismFileError(path, problems)
-    # spanning tree, breadth first from the ground
-    adjacency = {name: [] for name in links}
-    for k, (_, _, p, c, _) in enumerate(raw):
-        adjacency[p].append(k)
-        adjacency[c].append(k)
+    tree = _spanning_tree(links, [(p, c) for _, _, p, c, _ in raw], ground)
     frame = {ground: poses[ground]}
-    tree, queue = {}, deque([ground])
-    while queue:
-        link = queue.popleft()
-        for k in adjacency[link]:
-            n, jt, p, c, _ = raw[k]
-            other = c if p == link else p
-            if other in frame or k in tree:
-                continue
-            tree[k] = (link, other)
-            frame[other] = joint_pose[n]
-            queue.append(other)
+    for k, (_, child) in tree.items():
+        frame[child] = joint_pose[raw[k][0]]
     unreached = [n for n in links if n not in frame]
     if unreached:
         raise MechanismFileError(path, f"links not connected to {quote(ground)} by any joint: "

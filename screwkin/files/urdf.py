@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MechanismFileError, quote, shorten
+from ..tolerances import DEFAULT
 from .description import (
     CUT_JOINT_DOF,
     HIGHER_PAIRS,
@@ -288,7 +289,7 @@ def _higher_pair(elem, jtype, what, axis, problems) -> dict | None:
                             f"got {r2:g} and {r1:g}")
         elif contact == "internal" and r1 == float("inf"):
             problems.append(f"{what}: a circle cannot run inside a straight line (radius1 inf, contact internal)")
-        if r1 is not None and np.isinf(r1) and abs(float(np.dot(axis, ex))) > 1e-6:
+        if r1 is not None and np.isinf(r1) and abs(float(np.dot(axis, ex))) > DEFAULT.geometry:
             problems.append(f"{what}: the line is F1's x axis, so the <axis> (the plane's normal) must be "
                             "perpendicular to it")
         out = {"radius1": r1, "radius2": r2, "contact": contact}
@@ -305,7 +306,7 @@ def _higher_pair(elem, jtype, what, axis, problems) -> dict | None:
                                 f"(known: {', '.join(PROFILE_SHAPES)})")
                 return None
             radius = _radius(e.get("radius"), f"{what} <profile{k} radius>", problems) if shape == "circle" else None
-            if shape == "line" and abs(float(np.dot(axis, ex))) > 1e-6:
+            if shape == "line" and abs(float(np.dot(axis, ex))) > DEFAULT.geometry:
                 problems.append(f"{what}: a line profile is its frame's x axis, so the <axis> (the plane's normal) "
                                 "must be perpendicular to it")
             profiles.append((shape, radius))

@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from ..tolerances import DEFAULT
+
 __all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf"]
 
 _COLOURS = ((0.35, 0.35, 0.35), (0.85, 0.3, 0.2), (0.2, 0.5, 0.85), (0.2, 0.7, 0.3), (0.85, 0.65, 0.1),
@@ -153,7 +155,7 @@ def write_urdf(linkage: PlanarLinkage) -> str:
         parts = []
         for p, q in _bars(lk.points):
             length = math.dist(p, q)
-            if length <= 1e-12:
+            if length <= DEFAULT.zero:
                 continue
             c = ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2)
             ang = math.atan2(q[1] - p[1], q[0] - p[0])

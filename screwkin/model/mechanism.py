@@ -72,7 +72,7 @@ def link_lengths(model, cuts) -> list:
             continue
         P = np.array(pts[:200])  # a body carrying more joints than that: its first 200 decide
         d = float(np.sqrt(np.max(np.sum((P[:, None, :] - P[None, :, :]) ** 2, axis=2))))
-        if d > 1e-9:
+        if d > DEFAULT.equal:  # a body whose joints are not all at one point
             lengths.append(d)
     return lengths
 

@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from ..files.description import CUT_JOINT_DOF
 from ..files.sidecar import axis_letters
+from ..tolerances import DEFAULT
 from ._pin import frame_id
 
 __all__ = ["Joint", "Topology", "build_topology"]
@@ -302,7 +303,7 @@ def _common_point(points, directions):
         P = np.eye(3) - np.outer(_unit(d), _unit(d))
         A += P
         b += P @ p
-    if np.linalg.matrix_rank(A, tol=1e-9) < 3:
+    if np.linalg.matrix_rank(A, tol=DEFAULT.equal) < 3:  # the lines are parallel: no common point
         return None, np.inf
     c = np.linalg.solve(A, b)
     dist = max(np.linalg.norm((np.eye(3) - np.outer(_unit(d), _unit(d))) @ (c - p)) for p, d in zip(points, directions))
@@ -507,7 +508,7 @@ def _motion_space(joints, tol, scale):
                 normal = _unit(normal)
                 # one of the two normals, the same whatever the axes' signs: +z, else +y, else +x side
                 for k in (2, 1, 0):
-                    if abs(normal[k]) > 1e-9:
+                    if abs(normal[k]) > DEFAULT.equal:
                         normal = normal * np.sign(normal[k])
                         break
                 n = np.round(normal, 6) + 0.0

@@ -24,8 +24,9 @@ from html import escape
 
 import numpy as np
 
-from ..analysis.equations import PlanarEquations
+from ..analysis.vector_loops import PlanarEquations
 from .equations import Units, equations_text, greek, newton_text
+from .tables import shown
 from .report import (
     JOINT_COLUMNS,
     count_rows,
@@ -108,7 +109,7 @@ def figure_bytes(fig, fmt: str = "svg") -> bytes:
 
 # ------------------------------------------------------------------ numbers as people read them
 def _g(x, digits=6) -> str:
-    return f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:.{digits}g}"
+    return f"{shown(x):.{digits}g}"
 
 
 def _wrap(angle) -> float:

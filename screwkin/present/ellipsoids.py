@@ -10,8 +10,12 @@ from .report import table
 __all__ = ["ellipsoids_dict", "ellipsoids_text"]
 
 
+#: Display: an axis component below this rounds to 0.000 in the .3f format and is left out.
+SHOWN_COMPONENT = 5e-4
+
+
 def _axis(v, rows) -> str:
-    parts = [f"{x:+.3f} {name}" for x, name in zip(v, rows) if abs(x) >= 5e-4]
+    parts = [f"{x:+.3f} {name}" for x, name in zip(v, rows) if abs(x) >= SHOWN_COMPONENT]
     return ", ".join(parts) or "0"
 
 

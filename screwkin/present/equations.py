@@ -8,8 +8,9 @@ import re
 
 import numpy as np
 
-from ..analysis.equations import PlanarEquations
+from ..analysis.vector_loops import PlanarEquations
 from .report import screws_dict, screws_text, table
+from .tables import shown
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
 
@@ -25,7 +26,7 @@ def greek(text: str) -> str:
 
 
 def _fmt(x):
-    return f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:.6g}"
+    return f"{shown(x):.6g}"
 
 
 def _matrix_text(name, rows, indent="  "):

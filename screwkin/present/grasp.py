@@ -8,8 +8,10 @@ import numpy as np
 
 from ..analysis.grasp import GraspResult
 from ..analysis.screws import screw_of
+from ..model.geometry import TINY
 from ..tolerances import DEFAULT
 from .report import table, to_jsonable
+from .tables import SHOWN_ZERO, shown
 
 __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]
 
@@ -18,8 +20,8 @@ TEXT_COLUMNS = 16
 
 
 def _num(x) -> str:
-    """6 significant digits, round-off below 1e-12 as 0."""
-    return f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:.6g}"
+    """6 significant digits, round-off (below tables.SHOWN_ZERO) as 0."""
+    return f"{shown(x):.6g}"
 
 
 def _vec(v) -> str:
@@ -36,7 +38,7 @@ def pure_moment(w, planar: bool) -> np.ndarray:
     144 km away) is no answer: it is a pure moment."""
     w = np.array(w, float)
     k = 2 if planar else 3
-    if np.linalg.norm(w[:k]) <= DEFAULT.motion * max(np.linalg.norm(w), 1e-300):
+    if np.linalg.norm(w[:k]) <= DEFAULT.motion * max(np.linalg.norm(w), TINY):
         w[:k] = 0.0
     return w
 
@@ -105,7 +107,7 @@ def _yes(b) -> str:
 
 
 def _percent(x) -> str:
-    return "-" if x is None else f"{100 * (0.0 if x < 1e-12 else x):.3g}%"
+    return "-" if x is None else f"{100 * (0.0 if x < SHOWN_ZERO else x):.3g}%"
 
 
 def grasp_text(r: GraspResult) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import DEFAULT
 from .tables import column_text, fmt_vec, table
 
 __all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_table", "points_table", "motion_dict", "linkage_construction_text"]
@@ -95,7 +96,7 @@ def motion_rows_text(res, motion, rows, degrees: bool) -> str:
     link's angle [deg], each slider (loop) coordinate [mm] and each point's position [mm]."""
     cols, head = [], []
     for name, m in motion.links.items():
-        if "angle" in m and np.ptp(np.unwrap(m["angle"])) > 1e-9:
+        if "angle" in m and np.ptp(np.unwrap(m["angle"])) > DEFAULT.equal:  # the link turns
             head.append(f"{name} [deg]")
             cols.append(column_text(np.degrees(np.asarray(m["angle"]))))
     for name, v in motion.loop_joints.items():

@@ -6,8 +6,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..analysis.planar import plane_basis
 from ..errors import UsageError
+from ..model.geometry import plane_basis
+from ..tolerances import DEFAULT
 
 __all__ = ["sweep_plot", "sweep_figure", "map_png"]
 
@@ -129,7 +130,7 @@ def absolute_series(res, motion, linear=None):
     names, values, rates, accs, lengths = [], [], [], [], []
     for name, m in links.items():
         angle = np.unwrap(np.asarray(m["angle"], float))
-        if np.ptp(angle) < 1e-9 and np.ptp(np.asarray(m["omega"], float)) < 1e-9:
+        if np.ptp(angle) < DEFAULT.equal and np.ptp(np.asarray(m["omega"], float)) < DEFAULT.equal:
             continue  # a link that does not turn (a slider block): its position is the slider's coordinate
         names.append(f"{name} (angle)")
         values.append(angle), rates.append(np.asarray(m["omega"])), accs.append(np.asarray(m["alpha"]))

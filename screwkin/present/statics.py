@@ -6,6 +6,7 @@ import numpy as np
 
 from ..analysis.statics import Leg, StaticsResult
 from .report import screw_dict, table
+from .tables import shown
 
 __all__ = ["statics_dict", "statics_text"]
 
@@ -38,7 +39,7 @@ def statics_dict(r: StaticsResult, legs=None) -> dict:
 
 
 def _num(x, fmt=".6g"):
-    return "?" if x is None else f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:{fmt}}"
+    return "?" if x is None else f"{shown(x):{fmt}}"
 
 
 def statics_text(r: StaticsResult, legs=None) -> str:

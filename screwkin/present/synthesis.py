@@ -22,6 +22,7 @@ from ..analysis.synthesis.designs import (
 )
 from ..analysis.synthesis.fourbar import tool_local
 from .report import table, to_jsonable
+from .tables import shown
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
@@ -128,8 +129,13 @@ def synthesis_dict(result, check: Check, file) -> dict:
     return to_jsonable(out)
 
 
+#: Display cut-off of synthesis numbers: below this in magnitude they are written as 0 (the closed
+#: forms are exact to round-off, tighter than tables.SHOWN_ZERO).
+SYNTHESIS_ZERO = 1e-15
+
+
 def _fmt(x, digits=6):
-    return f"{(0.0 if abs(x) < 1e-15 else x) + 0.0:.{digits}g}"
+    return f"{shown(x, SYNTHESIS_ZERO):.{digits}g}"
 
 
 def synthesis_text(result, check: Check, file) -> str:

@@ -5,7 +5,10 @@ from __future__ import annotations
 import csv
 import io
 
-__all__ = ["table", "fmt_vec", "column_text", "csv_cell", "csv_text"]
+__all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO"]
+
+#: Display cut-off: a number smaller than this in magnitude is written as 0 (round-off is not a value).
+SHOWN_ZERO = 1e-12
 
 
 def table(headers, rows) -> str:
@@ -18,9 +21,14 @@ def table(headers, rows) -> str:
     return "\n".join(out)
 
 
+def shown(x, below: float = SHOWN_ZERO) -> float:
+    """x as written: 0.0 where its magnitude is below ``below``, and never -0.0."""
+    return (0.0 if abs(x) < below else x) + 0.0
+
+
 def fmt_vec(v, width=11):
-    """Numbers with 6 significant digits; round-off below 1e-12 shows as 0."""
-    return " ".join(f"{(0.0 if abs(x) < 1e-12 else x) + 0.0:>{width}.6g}" for x in v)
+    """Numbers with 6 significant digits; round-off below SHOWN_ZERO shows as 0."""
+    return " ".join(f"{shown(x):>{width}.6g}" for x in v)
 
 
 def column_text(values, relative: float = 1e-9, absolute: float = 1e-12) -> list:

@@ -7,6 +7,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..analysis.workspace import WorkspaceResult
+from ..tolerances import DEFAULT
 from .plots import _pyplot
 from .report import table
 from .tables import csv_text
@@ -25,7 +26,7 @@ def axis_labels(r: WorkspaceResult) -> list:
     out = []
     for k, a in enumerate(r.axes):
         i = int(np.argmax(np.abs(a)))
-        out.append(AXIS_NAMES[i] if abs(a[i]) > 1 - 1e-12 else "uv"[k])
+        out.append(AXIS_NAMES[i] if abs(a[i]) > 1 - DEFAULT.zero else "uv"[k])
     return out
 
 

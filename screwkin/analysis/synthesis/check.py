@@ -33,11 +33,11 @@ import pinocchio as pin
 from ...errors import AssemblyError, ScrewkinError
 from ...model.loader import load
 from ..mobility import analyze_mobility
-from ..planar import identify
+from ..planar import identify, transmission_angles
 from ..position import PositionSolver
 from ..sweep import sweep
 from .designs import Check, ChainFile, Design, PrecisionCheck
-from .fourbar import positions, transmission, wrap
+from .fourbar import positions, wrap
 
 __all__ = ["check_design", "check_chain_file", "TOLERANCE"]
 
@@ -55,8 +55,8 @@ class _Probe:
         self.out = mech.link_frame(design.output_link)
         jid = {mech.model.names[k]: k for k in range(1, mech.model.njoints)}
         self.jA = jid.get("coupler_joint")
-        self.jB0 = jid.get("rocker_joint")
         self.fB = mech.cuts[0].frame1 if mech.cuts else None
+        self.linkage = None  # analysis.planar.identify's LinkageInfo, set at the first position
 
     def value(self, q):
         pin.framesForwardKinematics(self.model, self.data, q)
@@ -77,12 +77,13 @@ class _Probe:
             return math.hypot(v[0] - t[0], v[1] - t[1]), 0.0
         return abs(float(wrap(v[0] - t[0]))), 0.0
 
-    def mu(self, q):
-        pin.framesForwardKinematics(self.model, self.data, q)
-        A = self.data.oMi[self.jA].translation[:2]
-        B0 = self.data.oMi[self.jB0].translation[:2]
-        B = self.data.oMf[self.fB].translation[:2]
-        return float(transmission(A, B, B0))
+    def mus(self, Q) -> list:
+        """Transmission angles [rad] at the configurations Q (analysis.planar.transmission_angles
+        of the file's four-bar as identified at the first position); none when it was not
+        identified (the check then says the angle was not measured)."""
+        if self.linkage is None or not len(Q):
+            return []
+        return transmission_angles(self.mech, self.linkage, Q).tolist()
 
     def pins(self, q):
         pin.framesForwardKinematics(self.model, self.data, q)
@@ -157,6 +158,7 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
     grashof, lengths = None, {}
     if q_first is not None:
         info = identify(mech, mech.topology(q_first), q_first, name)
+        probe.linkage = info
         if info is not None:
             grashof, lengths = info.grashof, dict(info.lengths)
     direction, travel, mus = 0, (), []
@@ -182,12 +184,13 @@ def _locate(design, solver, probe, res, x, q_target):
     A, B = probe.pins(q)
     A_t, B_t = probe.pins(q_target)
     size = max(design.fourbar.lengths.values())
-    return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < 1e-6 * size
+    return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
 def _follow(design: Design, solver, probe, configs, steps):
     """(direction, travel per position, transmission angles along the motion, defects)."""
     name = design.input_joint
+    tol = probe.mech.tolerances
     targets = design.targets
     n = len(targets)
     label = [t.label or f"position {k + 1}" for k, t in enumerate(targets)]
@@ -206,19 +209,19 @@ def _follow(design: Design, solver, probe, configs, steps):
         defects, travel, mus = [], [0.0] + [None] * (n - 1), []
         runs = {}
         for direction, reach in ((1, design.span[1] - u1), (-1, u1 - design.span[0])):
-            if reach <= 1e-12:
+            if reach <= tol.zero:
                 continue
             res, covered = follow(direction, reach)
             runs[direction] = (res, covered)
-            mus += [probe.mu(q) for q in res.q]  # the sweep's grid ends at the range's ends
-            if res.stopped_at is not None and covered < reach - 1e-9:
+            mus += probe.mus(res.q)  # the sweep's grid ends at the range's ends
+            if res.stopped_at is not None and covered < reach - tol.equal:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
                                f"{math.degrees(res.stopped_at):.6g} deg: the linkage cannot run through it")
         for k in range(1, n):
             d = targets[k].input - u1
             direction = 1 if d >= 0 else -1
             res, covered = runs.get(direction, (None, 0.0))
-            if res is None or abs(d) > covered + 1e-9:
+            if res is None or abs(d) > covered + tol.equal:
                 defects.append(f"{label[k]} lies beyond a limit position: the input stops before "
                                f"{math.degrees(targets[k].input):.6g} deg")
             elif _locate(design, solver, probe, res, targets[k].input, configs[k]):
@@ -231,18 +234,18 @@ def _follow(design: Design, solver, probe, configs, steps):
     for direction in (1, -1):
         # as far as the farthest position this way round (a full turn when one sits at the start's input)
         travels = [float(np.mod(direction * (t.input - u1), TWO_PI)) for t in targets[1:]]
-        reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > 1e-9 else TWO_PI
+        reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > tol.equal else TWO_PI
         res, covered = follow(direction, reach)
         status, travel = [], [0.0]
         for k in range(1, n):
             d = float(np.mod(direction * (targets[k].input - u1), TWO_PI))
-            if d > covered + 1e-9:
+            if d > covered + tol.equal:
                 status.append(("limit", res.stopped_at))
                 travel.append(None)
             elif _locate(design, solver, probe, res, u1 + direction * d, configs[k]):
                 status.append(("reached", d))
                 travel.append(d)
-            elif d < 1e-9 and covered >= TWO_PI - 1e-9 \
+            elif d < tol.equal and covered >= TWO_PI - tol.equal \
                     and _locate(design, solver, probe, res, u1 + direction * TWO_PI, configs[k]):
                 status.append(("reached", TWO_PI))
                 travel.append(TWO_PI)
@@ -252,8 +255,8 @@ def _follow(design: Design, solver, probe, configs, steps):
         got = [t for t in travel if t is not None]
         ordered = all(a < b for a, b in zip(got, got[1:]))
         far = max(got)
-        mus = [probe.mu(q) for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + 1e-12]
-        mus += [probe.mu(configs[k]) for k, t in enumerate(travel) if t is not None]  # the ends exactly
+        mus = probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + tol.zero])
+        mus += probe.mus([configs[k] for k, t in enumerate(travel) if t is not None])  # the ends exactly
         missing = sum(t is None for t in travel)
         outcomes.append(((missing, not ordered), direction, status, travel, mus))
         if not missing and ordered:  # every position, in order: the other way round is not needed

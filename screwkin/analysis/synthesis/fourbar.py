@@ -19,9 +19,11 @@ import math
 import numpy as np
 
 from ...files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
+from ...model.geometry import circle_circle, cross2, vector_angle
+from ...tolerances import DEFAULT
 from .designs import FourBar
 
-__all__ = ["angle", "wrap", "rotate", "pose_matrix", "circle_b", "branch", "tool_local", "positions",
+__all__ = ["angle", "wrap", "rotate", "pose_matrix", "branch", "tool_local", "positions",
            "transmission", "travel_analysis", "fourbar_linkage", "crank_angle"]
 
 TWO_PI = 2 * math.pi
@@ -49,25 +51,7 @@ def pose_matrix(pose):
 def branch(A, B, B0):
     """sigma: +1 when B lies left of the line A -> B0, -1 right (arrays broadcast)."""
     A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
-    u, w = B0 - A, B - A
-    return np.sign(u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0])
-
-
-def circle_b(A, b, B0, c, sigma):
-    """B for crank pins A (..., 2): (B, h2) with h2 < 0 where the circles do not meet (B is
-    then the nearest point, h clipped to 0)."""
-    A = np.asarray(A, float)
-    B0 = np.asarray(B0, float)
-    w = B0 - A
-    d = np.hypot(w[..., 0], w[..., 1])
-    d = np.where(d < 1e-300, 1e-300, d)
-    u = w / d[..., None]
-    n = np.stack([-u[..., 1], u[..., 0]], axis=-1)
-    along = (b * b - c * c + d * d) / (2 * d)
-    h2 = b * b - along * along
-    h = np.sqrt(np.maximum(h2, 0.0))
-    B = A + along[..., None] * u + (sigma * h)[..., None] * n
-    return B, h2
+    return np.sign(cross2(B0 - A, B - A))
 
 
 def crank_angle(fb: FourBar) -> float:
@@ -92,7 +76,7 @@ def positions(fb: FourBar, theta, sigma):
     a, b, c = lengths["crank"], lengths["coupler"], lengths["rocker"]
     A0 = np.array(fb.A0, float)
     A = A0 + a * np.stack([np.cos(theta), np.sin(theta)], axis=-1)
-    B, h2 = circle_b(A, b, fb.B0, c, sigma)
+    B, h2 = circle_circle(A, b, fb.B0, c, sigma)  # h2 < 0: the circles do not meet
     phi = np.arctan2(B[..., 1] - A[..., 1], B[..., 0] - A[..., 0])
     u, v, gamma = tool_local(fb)
     x = A[..., 0] + u * np.cos(phi) - v * np.sin(phi)
@@ -103,9 +87,7 @@ def positions(fb: FourBar, theta, sigma):
 def transmission(A, B, B0):
     """mu [rad]: the angle at B between B -> A and B -> B0."""
     A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
-    p, q = A - B, B0 - B
-    cross = p[..., 0] * q[..., 1] - p[..., 1] * q[..., 0]
-    return np.abs(np.arctan2(cross, (p * q).sum(axis=-1)))
+    return vector_angle(A - B, B0 - B)
 
 
 def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
@@ -195,8 +177,8 @@ def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None 
     tc, tab, tr = angle(A - A0), angle(B - A), angle(B - B0)
     u, v, gamma = tool_local(fb)
     coupler_points = [(0.0, 0.0), (L["coupler"], 0.0)]
-    if tool and fb.tool is not None and math.hypot(u, v) > 1e-9 * max(L.values()) \
-            and math.hypot(u - L["coupler"], v) > 1e-9 * max(L.values()):
+    if tool and fb.tool is not None and math.hypot(u, v) > DEFAULT.equal * max(L.values()) \
+            and math.hypot(u - L["coupler"], v) > DEFAULT.equal * max(L.values()):
         coupler_points.append((u, v))
     links = [PlanarLink("ground", (tuple(A0), tuple(B0))),
              PlanarLink("crank", ((0.0, 0.0), (L["crank"], 0.0))),

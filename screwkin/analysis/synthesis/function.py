@@ -28,8 +28,10 @@ import math
 import numpy as np
 
 from ...errors import UsageError, quote
+from ...model.geometry import circle_circle
+from ...tolerances import DEFAULT
 from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
-from .fourbar import branch, circle_b, fourbar_linkage, wrap
+from .fourbar import branch, fourbar_linkage, wrap
 
 __all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "FUNCTIONS"]
 
@@ -110,7 +112,7 @@ def freudenstein(phi, psi):
     M = np.stack([np.cos(phi), -np.cos(psi), np.ones_like(phi)], axis=1)
     r = np.cos(phi - psi)
     if len(phi) == 3:
-        if abs(np.linalg.det(M)) < 1e-12:
+        if abs(np.linalg.det(M)) < DEFAULT.zero:
             raise SynthesisError(WHAT, f"the Freudenstein equations of the three precision points are not independent "
                                        f"(determinant {np.linalg.det(M):.2g}): change the ranges or the function (psi "
                                        "= phi + a constant is done by any parallelogram)")
@@ -126,7 +128,7 @@ def _generated(K, d, phi, sigma):
     a, c = d / K2, d / K1
     b2 = a * a + c * c + d * d - 2 * a * c * K3
     A = np.array([d, 0.0]) + a * np.stack([np.cos(phi), np.sin(phi)], axis=-1)  # a signed: a reversed crank
-    B, h2 = circle_b(A, math.sqrt(max(b2, 0.0)), (0.0, 0.0), abs(c), sigma)
+    B, h2 = circle_circle(A, math.sqrt(max(b2, 0.0)), (0.0, 0.0), abs(c), sigma)
     psi = np.arctan2(B[..., 1], B[..., 0]) + (math.pi if c < 0 else 0.0)
     return np.where(h2 >= 0, psi, np.nan), A, B
 
@@ -173,7 +175,7 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     phi, psi = phi_of(xs), psi_of(ys)
     K = freudenstein(phi, psi)
     K1, K2, K3 = K
-    if abs(K1) < 1e-9 or abs(K2) < 1e-9:
+    if abs(K1) < DEFAULT.equal or abs(K2) < DEFAULT.equal:
         raise SynthesisError(WHAT, f"Freudenstein gives K1 = {K1:.3g}, K2 = {K2:.3g}: a link of infinite length; "
                                    "change the ranges or the precision points")
     d = ground

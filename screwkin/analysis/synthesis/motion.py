@@ -34,6 +34,8 @@ import math
 import numpy as np
 
 from ...errors import UsageError
+from ...model.geometry import TINY
+from ...tolerances import DEFAULT
 from .designs import Design, Dyad, FourBar, MotionResult, SynthesisError, Target
 from .fourbar import angle, branch, fourbar_linkage, pose_matrix, travel_analysis, wrap
 
@@ -68,7 +70,7 @@ def moving_pivot(poses, A0, what=WHAT):
     M = _rows(poses[:3], A0)
     G, r = M[:, :2], M[:, 2]
     scale = scale_of(poses)
-    if abs(np.linalg.det(G)) < 1e-12 * max(np.abs(G).max(), 1e-300) ** 2 or np.abs(G).max() < 1e-12 * scale:
+    if abs(np.linalg.det(G)) < DEFAULT.zero * max(np.abs(G).max(), TINY) ** 2 or np.abs(G).max() < DEFAULT.zero * scale:
         raise SynthesisError(what, f"no moving pivot for the fixed pivot ({A0[0]:.6g}, {A0[1]:.6g}): it is a pole "
                                    "of the displacements or the positions are degenerate; move the pivot")
     return np.linalg.solve(G, r)
@@ -98,7 +100,7 @@ def poles(poses) -> list:
         R = Rj @ Ri.T
         t = pj - R @ pi
         M = np.eye(2) - R
-        if abs(np.linalg.det(M)) > 1e-12:
+        if abs(np.linalg.det(M)) > DEFAULT.zero:
             out.append((i, j, np.linalg.solve(M, t)))
     return out
 
@@ -109,7 +111,7 @@ def _base_pole(poses):
     best = None
     for k in range(1, len(poses)):
         turn = abs(float(wrap(poses[k][2] - poses[0][2])))
-        if turn > 1e-9 and (best is None or turn > best[0]):
+        if turn > DEFAULT.equal and (best is None or turn > best[0]):
             best = (turn, k)
     if best is None:
         raise SynthesisError(WHAT, "the coupler does not turn between the positions (pure translations): "
@@ -140,8 +142,8 @@ def centre_point_curve(poses, directions: int = 360, bound: float | None = None)
     out_c, out_idx = [], []
     for k, (c1, c2, c3) in enumerate(coef):
         roots = np.roots([c3, c2, c1]) if abs(c3) > 0 or abs(c2) > 0 else np.array([])
-        for t in sorted(r.real for r in roots if abs(r.imag) <= 1e-9 * max(abs(r), 1.0)):
-            if abs(t) < 1e-9 * L:
+        for t in sorted(r.real for r in roots if abs(r.imag) <= DEFAULT.equal * max(abs(r), 1.0)):
+            if abs(t) < DEFAULT.equal * L:
                 continue
             A0 = P + t * e[k]
             if np.hypot(*(A0 - centre)) <= bound:
@@ -203,7 +205,7 @@ def burmester_points(poses, seeds: int = 360) -> tuple:
             J[:, 0, j] = (_D(first, X + dX) - _D(first, X - dX)) / (2 * h)
             J[:, 1, j] = (_D(second, X + dX) - _D(second, X - dX)) / (2 * h)
         det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
-        ok = np.abs(det) > 1e-300
+        ok = np.abs(det) > TINY  # division guard
         step = np.zeros_like(X)
         step[ok, 0] = (J[ok, 1, 1] * F[ok, 0] - J[ok, 0, 1] * F[ok, 1]) / det[ok]
         step[ok, 1] = (-J[ok, 1, 0] * F[ok, 0] + J[ok, 0, 0] * F[ok, 1]) / det[ok]
@@ -217,16 +219,16 @@ def burmester_points(poses, seeds: int = 360) -> tuple:
     for x in X:
         if not np.all(np.isfinite(x)) or np.hypot(*x) > 1e3 * L:
             continue
-        if any(np.hypot(*(x - P)) < 1e-6 * L for P in pole_pts):
+        if any(np.hypot(*(x - P)) < DEFAULT.geometry * L for P in pole_pts):
             continue
         if any(np.hypot(*(x - y)) < 1e-7 * L for y in found):
             continue
         M = _rows(poses, x)
         G, r = M[:, :2], M[:, 2]
         a, *_ = np.linalg.lstsq(G, r, rcond=None)
-        if np.linalg.matrix_rank(G, tol=1e-9 * max(np.abs(G).max(), 1e-300)) < 2:
+        if np.linalg.matrix_rank(G, tol=DEFAULT.equal * max(np.abs(G).max(), TINY)) < 2:
             continue
-        if np.abs(G @ a - r).max() > 1e-9 * max(np.abs(r).max(), L * L):
+        if np.abs(G @ a - r).max() > DEFAULT.equal * max(np.abs(r).max(), L * L):
             continue
         # the five positions of the moving pivot on one circle about x
         R1, p1 = pose_matrix(poses[0])
@@ -311,7 +313,7 @@ def _check_poses(poses):
     L = scale_of(poses)
     for i, j in itertools.combinations(range(len(poses)), 2):
         a, b = poses[i], poses[j]
-        if math.hypot(a[0] - b[0], a[1] - b[1]) < 1e-9 * L and abs(float(wrap(a[2] - b[2]))) < 1e-9:
+        if math.hypot(a[0] - b[0], a[1] - b[1]) < DEFAULT.equal * L and abs(float(wrap(a[2] - b[2]))) < DEFAULT.equal:
             raise UsageError(f"--poses: positions {i + 1} and {j + 1} are the same pose: give distinct poses")
 
 

@@ -25,8 +25,10 @@ import math
 import numpy as np
 
 from ...errors import UsageError
+from ...model.geometry import circle_circle
+from ...tolerances import DEFAULT
 from .designs import Design, FourBar, PathResult, SynthesisError, Target
-from .fourbar import circle_b, fourbar_linkage, travel_analysis, wrap
+from .fourbar import fourbar_linkage, travel_analysis, wrap
 
 __all__ = ["synthesize_path", "coupler_points"]
 
@@ -55,7 +57,7 @@ def coupler_points(A0, B0, a, b, c, p, q, th, sigma):
     the linkage does not assemble, A, B)."""
     a, b, c, p, q = (np.asarray(v, float)[..., None] for v in (a, b, c, p, q))
     A = np.asarray(A0, float)[..., None, :] + a[..., None] * np.stack([np.cos(th), np.sin(th)], axis=-1)
-    B, h2 = circle_b(A, b, np.asarray(B0, float)[..., None, :], c, sigma)
+    B, h2 = circle_circle(A, b, np.asarray(B0, float)[..., None, :], c, sigma)
     u = (B - A) / b[..., None]
     n = np.stack([-u[..., 1], u[..., 0]], axis=-1)
     return A + p[..., None] * u + q[..., None] * n, h2, A, B
@@ -107,14 +109,14 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
         raise UsageError("--points: the points are all the same")
     for i in range(n):
         for j in range(i):
-            if np.hypot(*(pts[i] - pts[j])) < 1e-9 * L:
+            if np.hypot(*(pts[i] - pts[j])) < DEFAULT.equal * L:
                 raise UsageError(f"--points: points {j + 1} and {i + 1} are the same")
     if timing is not None:
         timing = np.asarray(timing, float)
         if len(timing) != n:
             raise UsageError(f"--timing: give one crank angle per point ({n}), got {len(timing)}")
         timing = timing - timing[0]
-        if np.any(np.abs(np.diff(timing)) < 1e-9):
+        if np.any(np.abs(np.diff(timing)) < DEFAULT.equal):
             raise UsageError("--timing: two points have the same crank angle")
         if not (np.all(np.diff(timing) > 0) or np.all(np.diff(timing) < 0)) or abs(timing[-1]) >= TWO_PI:
             raise UsageError("--timing: the crank angles must run one way and within one turn")

@@ -1,0 +1,147 @@
+"""Plane and point geometry on plain arrays: bases of a plane, circle and line
+intersections, angles between vectors and lines.
+
+Functions take ndarrays of points or vectors of shape (..., 2) or (..., 3) and broadcast
+over the leading axes where they say so; lengths in the caller's unit (m), angles in rad.
+Nothing here knows of mechanisms.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
+           "line_circle", "vector_angle", "line_angle"]
+
+#: Division guard: the distance between two circles' centres is taken at least this [m].
+TINY = 1e-300  # division guard
+#: A normal's projection of a world axis shorter than this is not used as the plane's first axis [-].
+AXIS_IN_PLANE = 1e-6
+
+
+def perpendicular_basis(a):
+    """Two unit vectors (b1, b2) completing the unit vector ``a`` to a right-handed basis
+    (b1, b2, a): b1 = a x h / |a x h| with h the world x axis (y when a is near x), b2 = a x b1.
+
+    >>> [v.tolist() for v in perpendicular_basis([0.0, 0.0, 1.0])]
+    [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]
+    """
+    a = np.asarray(a, float)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    b1 = np.cross(a, helper)
+    b1 /= np.linalg.norm(b1)
+    b2 = np.cross(a, b1)
+    return b1, b2
+
+
+def plane_basis(normal):
+    """(e1, e2, n): e1 the world x axis projected into the plane (the world y axis when x is
+    normal to it), e2 = n x e1, so angles from e1 are counterclockwise seen from +n.
+
+    >>> [v.tolist() for v in plane_basis([0.0, 0.0, 2.0])]
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    for axis in np.eye(3):
+        e1 = axis - (axis @ n) * n
+        if np.linalg.norm(e1) > AXIS_IN_PLANE:
+            e1 /= np.linalg.norm(e1)
+            return e1, np.cross(n, e1), n
+    raise ValueError("degenerate normal")  # pragma: no cover
+
+
+def cross2(u, w):
+    """The z component of u x w for plane vectors (..., 2): > 0 when w turns counterclockwise from u."""
+    u, w = np.asarray(u, float), np.asarray(w, float)
+    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
+
+
+def circle_circle(p, r, c, s, side):
+    """The intersection of the circle (centre p, radius r) and the circle (c, s) in the plane
+    on the ``side`` (+1: left of the line p -> c, -1: right), broadcast over points (..., 2):
+    (X, h2), h2 the squared distance of X from the line p -> c; h2 < 0 where the circles do
+    not meet (X is then the point of that line the intersections would straddle).
+
+    >>> X, h2 = circle_circle([0.0, 0.0], 5.0, [8.0, 0.0], 5.0, 1)
+    >>> X.tolist(), float(h2)
+    ([4.0, 3.0], 9.0)
+    """
+    p, c = np.asarray(p, float), np.asarray(c, float)
+    w = c - p
+    d = np.hypot(w[..., 0], w[..., 1])
+    d = np.where(d < TINY, TINY, d)
+    u = w / d[..., None]
+    n = np.stack([-u[..., 1], u[..., 0]], axis=-1)
+    along = (r * r - s * s + d * d) / (2 * d)
+    h2 = r * r - along * along
+    h = np.sqrt(np.maximum(h2, 0.0))
+    return p + along[..., None] * u + (side * h)[..., None] * n, h2
+
+
+def circle_intersections(p, r, c, s, slack=0.0, concentric=0.0) -> list:
+    """The points where the circles (p, r) and (c, s) in the plane meet: [left of p -> c,
+    right], the same point twice where they touch, [] where they do not meet (the centres
+    closer than ``concentric``, or farther than r + s + slack, or nearer than |r - s| - slack).
+
+    >>> [X.tolist() for X in circle_intersections([0.0, 0.0], 5.0, [8.0, 0.0], 5.0)]
+    [[4.0, 3.0], [4.0, -3.0]]
+    """
+    p, c = np.asarray(p, float), np.asarray(c, float)
+    d = np.linalg.norm(c - p)
+    if d < concentric or d > r + s + slack or d < abs(r - s) - slack:
+        return []
+    return [circle_circle(p, r, c, s, side)[0] for side in (1.0, -1.0)]
+
+
+def line_foot(x, point, direction):
+    """The point of the line through ``point`` along the unit vector ``direction`` nearest x.
+
+    >>> line_foot([3.0, 4.0], [0.0, 1.0], [1.0, 0.0]).tolist()
+    [3.0, 1.0]
+    """
+    x, point, direction = (np.asarray(v, float) for v in (x, point, direction))
+    return point + ((x - point) @ direction) * direction
+
+
+def line_circle(point, direction, centre, radius) -> list:
+    """The points where the line through ``point`` along the unit vector ``direction`` meets the
+    circle (sphere) (centre, radius): [behind, ahead] along ``direction`` (the foot twice where it
+    touches), [] where it passes farther than the radius.
+
+    >>> [X.tolist() for X in line_circle([0.0, 3.0], [1.0, 0.0], [0.0, 0.0], 5.0)]
+    [[-4.0, 3.0], [4.0, 3.0]]
+    """
+    direction = np.asarray(direction, float)
+    foot = line_foot(centre, point, direction)
+    h2 = radius * radius - float(np.sum((foot - np.asarray(centre, float)) ** 2))
+    if h2 < 0:
+        return []
+    h = np.sqrt(h2)
+    return [foot - h * direction, foot + h * direction]
+
+
+def _cross_norm(u, w):
+    if u.shape[-1] == 2:
+        return np.abs(cross2(u, w))
+    return np.linalg.norm(np.cross(u, w), axis=-1)
+
+
+def vector_angle(u, w):
+    """The angle between vectors u and w, in [0, pi] [rad] (atan2 of |u x w| and u . w: exact
+    near 0 and pi, where arccos of the cosine is not).
+
+    >>> float(vector_angle([1.0, 0.0], [0.0, 2.0]))  # doctest: +ELLIPSIS
+    1.5707963...
+    """
+    u, w = np.asarray(u, float), np.asarray(w, float)
+    return np.arctan2(_cross_norm(u, w), np.sum(u * w, axis=-1))
+
+
+def line_angle(u, w):
+    """The angle between the lines along u and w, in [0, pi/2] [rad].
+
+    >>> float(line_angle([1.0, 0.0], [-1.0, 1.0]))  # doctest: +ELLIPSIS
+    0.785398...
+    """
+    u, w = np.asarray(u, float), np.asarray(w, float)
+    return np.arctan2(_cross_norm(u, w), np.abs(np.sum(u * w, axis=-1)))
