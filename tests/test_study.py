@@ -200,6 +200,7 @@ def test_transmission_angles_match_the_closed_form():
         tol = 0.05 if full_turn else 0.01  # a full turn in 1 deg steps may miss an extreme by a little
         assert math.degrees(r["transmission_angle_min"]) == pytest.approx(lo, abs=tol), r
         assert math.degrees(r["transmission_angle_max"]) == pytest.approx(hi, abs=tol), r
+        assert r["transmission_restarts"] == 0, r  # one unbroken motion: the continuation never restarted
 
 
 # ------------------------------------------------------------------ designs and the front
@@ -392,7 +393,8 @@ def test_rows_equal_the_single_commands_on_the_expanded_file(local, tmp_path, ca
 
 
 def test_transmission_angles_are_those_of_sweep(capsys):
-    """A crank-rocker's transmission angles over a full turn against sweep's along the same turn."""
+    """A crank-rocker's transmission angles over a full turn against sweep's along the same turn: the
+    study follows the motion with the sweep's continuation, so the same grid gives the same angles."""
     spec = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "args": {"ground": 0.1},
             "parameters": {"crank": {"values": [0.035]}}, "metrics": ["transmission_angle"],
             "transmission": {"steps": 720}}
@@ -400,8 +402,9 @@ def test_transmission_angles_are_those_of_sweep(capsys):
     s = _json(capsys, ["sweep", str(ROBOTS / "fourbar.urdf.xacro"), "--arg", "ground=0.1", "--arg", "crank=0.035",
                        "--input", "crank_joint", "--from", "0", "--to", "1turn", "--steps", "720", "--json"])
     mus = s["transmission_angles"]
-    assert r["transmission_angle_min"] == pytest.approx(min(mus), abs=2e-3)
-    assert r["transmission_angle_max"] == pytest.approx(max(mus), abs=2e-3)
+    assert r["transmission_angle_min"] == pytest.approx(min(mus), abs=1e-9)
+    assert r["transmission_angle_max"] == pytest.approx(max(mus), abs=1e-9)
+    assert r["transmission_restarts"] == 0
 
 
 def test_workspace_metrics_equal_screwkin_workspace(capsys):

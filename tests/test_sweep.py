@@ -144,3 +144,36 @@ def test_slider_crank_closed_form_and_extras(tmp_path):
     B = a * np.array([np.cos(t0), np.sin(t0)])
     rod = np.array([x0, e]) - B
     assert abs(info.transmission_angle - np.arccos(abs(rod[1]) / b)) < 1e-12
+
+
+def test_grid_values_next_to_a_limit_position_are_reached(tmp_path):
+    """A triple rocker (ground 0.10, crank 0.04, coupler 0.12, rocker 0.19: non-Grashof) driven to
+    within 1e-8 rad of its limit position.  There the tangent predictor overshoots the bend of the
+    curve; the value is found on the arc step's own parametrization instead of being skipped.
+    Checked in lengths: at the limit the crank tip A is rocker - coupler = 0.07 m from the rocker
+    pivot (the law of cosines' bound); at the last value every bar keeps its length."""
+    import pinocchio as pin
+    from pathlib import Path
+    robots = Path(__file__).resolve().parents[1] / "robots"
+    m = screwkin.load(robots / "fourbar.urdf.xacro", args={"crank": "0.04", "coupler": "0.12", "rocker": "0.19"})
+    solver = PositionSolver(m, ["crank_joint"])
+    first = sweep(solver, "crank_joint", 0.0, 6.0, 60)
+    assert first.stopped_at is not None and len(first.limits) == 1
+    data = m.model.createData()
+
+    def pins(q):
+        pin.framesForwardKinematics(m.model, data, q)
+        A = data.oMi[m.model.getJointId("coupler_joint")].translation
+        B = data.oMf[m.closure.cuts[0].frame1].translation
+        return A, B
+
+    A, _ = pins(first.limits[0].q)
+    assert np.linalg.norm(A - np.array([0.10, 0, 0])) == pytest.approx(0.07, abs=1e-7)
+    end = first.stopped_at - 1e-8
+    res = sweep(solver, "crank_joint", 0.0, end, 300)
+    assert res.completed and not res.skipped and len(res.values) == 301
+    assert res.values[-1] == pytest.approx(end, abs=1e-12)
+    A, B = pins(res.q[-1])
+    assert np.linalg.norm(A) == pytest.approx(0.04, abs=1e-12)
+    assert np.linalg.norm(B - A) == pytest.approx(0.12, abs=1e-9)
+    assert np.linalg.norm(B - np.array([0.10, 0, 0])) == pytest.approx(0.19, abs=1e-9)

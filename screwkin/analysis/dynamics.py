@@ -39,6 +39,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, UsageError, quote
 from ..model._pin import frame_jacobian
+from ..tolerances import DEFAULT
 from .position import PositionSolver
 from .statics import balance, reaction_table
 from .sweep import sweep
@@ -184,7 +185,7 @@ def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
     span = abs(values[-1] - values[0]) if len(values) > 1 else 0.0
     if unit != "rad":
         return Flywheel(cs, omega, None, None, "a flywheel needs a turning input (this one slides)")
-    if not completed or span < 2 * np.pi * (1 - 1e-9):
+    if not completed or span < 2 * np.pi * (1 - DEFAULT.equal):
         return Flywheel(cs, omega, None, None, "a flywheel needs the input over a whole turn (--from 0 --to 360deg)")
     if tau is None or not np.all(np.isfinite(tau)):
         return Flywheel(cs, omega, None, None, "the input effort is not determined")
@@ -260,7 +261,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             K = mech.closure.jacobian(q)
             tau, lam, N, unbalanced[k], scale[k] = balance(mech, K, a_idx, b)
             free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
-            efforts[k] = np.where(free_tau > 1e-7, np.nan, tau)
+            efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
             indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
             table = reaction_table(mech, q, lam, frames, True, N[m:] if N.size else None, v, a)
             for name, (kind, wrench, is_open) in table.items():
@@ -303,7 +304,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         notes.append(f"the motion stopped at {input} = {res.stopped_at:.6g} {res.unit}: {res.stop_reason}")
     if res.skipped:
         notes.append(f"{len(res.skipped)} input value(s) of the grid could not be solved and are left out")
-    stuck = unbalanced > 1e-8 * scale
+    stuck = unbalanced > mech.tolerances.balanced * scale
     if np.any(stuck):
         notes.append(f"at {int(np.sum(stuck))} step(s) the inputs cannot drive the motion "
                      f"(largest unbalanced generalized force {unbalanced.max():.3g}): near a singularity")

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import AssemblyError, ScrewkinError, UsageError, one_line, quote
+from ..errors import ScrewkinError, UsageError, one_line, quote
 from ..files.description import LIMITS
 from ..files.study import StudySpec, read_study_spec, study_spec
 from ..files.xmlsafe import read_regular_file
@@ -45,6 +45,7 @@ from .mobility import analyze_mobility
 from .planar import identify, transmission_angles
 from .position import PositionSolver
 from .scheduler import probe_scheduler, scheduler_address
+from .sweep import sweep
 from .workspace import DEFAULT_THRESHOLD, workspace
 
 __all__ = [
@@ -64,7 +65,7 @@ COLUMNS = {
     "mobility": ("mobility", "mobility_count", "motion_space", "overconstraint", "idle_dofs", "effective_mobility",
                  "output_motion"),
     "grashof": ("linkage", "grashof", "grashof_margin"),
-    "transmission_angle": ("transmission_angle_min", "transmission_angle_max"),
+    "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts"),
     "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated"),
     "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated"),
     "conditioning": ("conditioning_min", "conditioning_mean"),
@@ -247,9 +248,11 @@ def _grashof(d: _Design) -> dict:
 def _transmission(d: _Design) -> dict:
     """Smallest and largest transmission angle over the input's motion: the input at
     ``steps`` + 1 values over a full turn (or over its range, ends taken RANGE_MARGIN of the
-    range inside the limit positions), each configuration tracked from the previous one (or
-    solved anew when tracking fails) and checked; the angles of all of them at once
-    (analysis.planar.transmission_angles)."""
+    range inside the limit positions), followed from the design's assembled configuration by the
+    sweep's continuation (analysis.sweep: one assembly mode, one circuit); the angles of all of
+    them at once (analysis.planar.transmission_angles).  Where the continuation stops short, it
+    restarts at the next value from the mode nearest the last configuration reached, and
+    ``transmission_restarts`` counts how often it had to (0: one unbroken motion)."""
     info = d.linkage()
     mech, name, steps = d.mech, d.input, d.task.steps
     coord = mech.coordinate(name)
@@ -264,20 +267,30 @@ def _transmission(d: _Design) -> dict:
         x0 = min(max(x0, lo), hi)
         up = max(2, round(steps * (hi - x0) / (hi - lo)) + 1)
         paths = [np.linspace(x0, hi, up), np.linspace(x0, lo, max(2, steps + 2 - up))]
-    Q = []
+    Q, restarts = [], 0
     for path in paths:
-        q = d.q
-        for k, x in enumerate(path):
+        q, k = d.q, 0
+        while k < len(path) - 1:
             d.clock.check()
-            try:
-                q = solver.track({name: float(x)}, q).q
-            except AssemblyError:
-                if k == 0:
-                    raise
-                q = solver.solve({name: float(x)}, starts=8).solutions[0].q  # checked, or AssemblyError
-            Q.append(q)
+            res = sweep(solver, name, float(path[k]), float(path[-1]), len(path) - 1 - k, q_start=q)
+            Q += list(res.q)
+            if res.completed:
+                break
+            # stopped short (or holes): restart at the next grid value after the last one reached,
+            # in the mode nearest the last configuration (said in transmission_restarts)
+            h = (path[-1] - path[k]) / (len(path) - 1 - k)
+            reached = int(np.floor((res.values[-1] - path[k]) / h + 1e-9)) if len(res.values) else 0
+            k = k + max(reached, 0) + 1
+            if k >= len(path):
+                break
+            near = solver.joint_values(res.q[-1] if len(res.q) else q)
+            q = solver.solve({name: float(path[k])}, near=near, starts=8).solutions[0].q  # checked, or AssemblyError
+            restarts += 1
+            if k == len(path) - 1:
+                Q.append(q)
     mus = transmission_angles(mech, info, Q)
-    return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max())}
+    return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max()),
+            "transmission_restarts": restarts}
 
 
 def _workspace_volume(d: _Design) -> dict:

@@ -84,6 +84,7 @@ class _Tracker:
     def __init__(self, solver, name):
         mech = self.mech = solver.mech
         self.solver, self.model, self.closure = solver, solver.model, mech.closure
+        self.name = name
         self.tol = mech.tolerances
         self.ix = int(mech.velocity_indices([name])[0])
         others = [n for n in solver.inputs if n != name]
@@ -143,6 +144,44 @@ class _Tracker:
         if abs(t[self.ix]) < 1e-12:
             raise _Stuck("the input does not move here")
         return self.step(q_from, t, dx / t[self.ix], self.ix)
+
+    def on_arc(self, qa, xa, qb, held, x):
+        """The configuration at input value x on the arc from qa (input xa) to qb, followed with
+        joint ``held`` as the parameter (the input changes monotonically along it: no limit
+        position strictly between): Brent's method on the held joint's share of the way.  Near a
+        limit position the tangent predictor of ``at_input`` overshoots the curve's bend; this
+        does not.  Raises _Stuck when x is not between the ends."""
+        delta = pin.difference(self.model, qa, qb)
+        frozen = tuple(sorted(set(self.frozen_other) | {held}))
+        xb = xa + self.input_change(qa, qb)
+        if (x - xa) * (x - xb) > 0:
+            raise _Stuck("the value is not on this arc")
+        cache = {0.0: qa, 1.0: qb}
+
+        def at(u):
+            if u not in cache:
+                try:
+                    cache[u] = self.closure.solve(pin.integrate(self.model, qa, u * delta), frozen=frozen).q
+                except AssemblyError:
+                    raise _Stuck("the loops cannot be closed on the arc") from None
+            return cache[u]
+
+        def f(u):
+            return xa + self.input_change(qa, at(u)) - x
+
+        from scipy.optimize import brentq
+
+        fa, fb = f(0.0), f(1.0)
+        if fa == 0:
+            return qa
+        if fb == 0:
+            return qb
+        if np.sign(fa) == np.sign(fb):
+            raise _Stuck("the value is not on this arc")
+        u = brentq(f, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=100)
+        # polish at the exact input value (the held joint then follows)
+        return self.closure.solve(self.solver.set_inputs(at(u), {self.name: x}), frozen=tuple(
+            sorted(set(self.frozen_other) | {self.ix}))).q
 
     def input_change(self, q0, q1) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
@@ -261,32 +300,45 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
 
     skipped = []  # grid values of the input the motion passed but could not be solved at
 
-    def record(qa, xa, ta, qb, xb, tb=None):
+    def solved(g, first, arc):
+        """The configuration at grid value g: ``first()`` (the tangent predictor), else the arc of
+        the step it lies on (``arc``: (qa, xa, qb, held), near a limit position), else None."""
+        try:
+            return first()
+        except _Stuck:
+            pass
+        if arc is not None:
+            try:
+                return tr.on_arc(*arc[:2], arc[2], arc[3], g)
+            except _Stuck:
+                pass
+        return None
+
+    def keep(g, qg):
+        if qg is None:
+            skipped.append(float(g))  # said in the result: never a hole in a motion marked complete
+        else:
+            X.append(g)
+            Q.append(qg)
+
+    def record(qa, xa, ta, qb, xb, tb=None, held=None):
         """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
         position between them, each predicted from the nearer end (not from a limit position:
-        there the input does not move, pass tb=None for such an end)."""
+        there the input does not move, pass tb=None for such an end); where the predictor fails
+        (the curve bends near a limit position) on the arc step's own parametrization (held)."""
+        arc = (qa, xa, qb, held) if held is not None and held != tr.ix else None
         for g in grid_between(xa, xb):
             if forward() and (g - stop) * direction > 1e-12 * max(1.0, abs(stop)):
                 break
             near_b = tb is not None and abs(g - xb) < abs(g - xa)
-            try:
-                qg = tr.at_input(qb, xb, g, tb) if near_b else tr.at_input(qa, xa, g, ta)
-            except _Stuck:
-                skipped.append(float(g))  # said in the result: never a hole in a motion marked complete
-                continue
-            X.append(g)
-            Q.append(qg)
+            keep(g, solved(g, (lambda g=g: tr.at_input(qb, xb, g, tb)) if near_b else
+                           (lambda g=g: tr.at_input(qa, xa, g, ta)), arc))
 
-    def record_back(q_lim, x_lim, qb, xb, tb):
+    def record_back(q_lim, x_lim, qb, xb, tb, held=None):
         """After a limit position: the grid values between it and qb, predicted from qb."""
+        arc = (q_lim, x_lim, qb, held) if held is not None and held != tr.ix else None
         for g in grid_between(x_lim, xb):
-            try:
-                qg = tr.at_input(qb, xb, g, tb)
-            except _Stuck:
-                skipped.append(float(g))
-                continue
-            X.append(g)
-            Q.append(qg)
+            keep(g, solved(g, lambda g=g: tr.at_input(qb, xb, g, tb), arc))
 
     def forward():
         return direction * np.sign(h) > 0
@@ -340,18 +392,20 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             if t_new[tr.ix] * t[tr.ix] < 0:  # the input turned back between q and q_new: a limit position
                 q_lim, dx = tr.limit(q, t, q_new, held)
                 x_lim = x + dx
-                record(q, x, t, q_lim, x_lim)
+                record(q, x, t, q_lim, x_lim, held=held)
                 sig = measures(mech, q_lim, solver.generic())["actuator"]
                 limits.append(SweepSingularity("actuator", float(x_lim), float(sig), q_lim, limit=True))
                 if not turn:
+                    if forward() and (x_lim - stop) * direction >= 0:
+                        break  # the limit lies at or past the end of the range: every value was reached
                     stopped = float(x_lim)
                     reason = ("limit position: the passive joints become undetermined (an actuator singularity); "
                               "the input cannot go further on this branch")
                     break
                 direction = -direction
-                record_back(q_lim, x_lim, q_new, x_new, t_new)
+                record_back(q_lim, x_lim, q_new, x_new, t_new, held=held)
             else:
-                record(q, x, t, q_new, x_new, t_new)
+                record(q, x, t, q_new, x_new, t_new, held=held)
             q, x, t = q_new, x_new, t_new
             sigma = min(sigma * 1.5, abs(h) / tr.scale[tr.ix])
             if back_at_start():

@@ -28,6 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MechanismFileError, quote, shorten
+from ..tolerances import DEFAULT
 from .description import LIMITS, Coupling, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
 from .urdf import Problems, check_sizes, numbers, unit_axis
 from .xmlsafe import parse_xml_text
@@ -131,7 +132,7 @@ class _Reader:
         n0 = len(self.problems)
         if k == "quat":
             q = self.vec(a[k], 4, f"{what} quat", (1, 0, 0, 0), 1e6, "")
-            if len(self.problems) > n0 or not np.linalg.norm(q) > 1e-12:
+            if len(self.problems) > n0 or not np.linalg.norm(q) > DEFAULT.zero:
                 if len(self.problems) == n0:
                     self.problems.append(f"{what} quat is zero")
                 return np.eye(3)
@@ -151,7 +152,7 @@ class _Reader:
             v = self.vec(a[k], 6, f"{what} xyaxes", (1, 0, 0, 0, 1, 0), 1e6, "")
             x = np.asarray(unit_axis(v[:3], f"{what} xyaxes", self.problems))
             y = v[3:] - (v[3:] @ x) * x
-            if not np.linalg.norm(y) > 1e-9:
+            if not np.linalg.norm(y) > DEFAULT.equal:
                 self.problems.append(f"{what} xyaxes: the two axes are parallel")
                 return np.eye(3)
             y /= np.linalg.norm(y)
@@ -160,7 +161,7 @@ class _Reader:
                                  self.problems, (0.0, 0.0, 1.0)))
         c = np.cross([0, 0, 1.0], z)
         s = np.linalg.norm(c)
-        if s < 1e-12:
+        if s < DEFAULT.zero:
             return np.eye(3) if z[2] > 0 else pin.exp3(np.array([math.pi, 0, 0]))
         return pin.exp3(c / s * math.atan2(s, z[2]))
 

@@ -25,6 +25,7 @@ import pinocchio as pin
 from ..errors import AssemblyError
 from ..tolerances import DEFAULT, Tolerances
 from . import compiled, newton
+from .geometry import perpendicular_basis  # noqa: F401 - exported here as before
 from ._pin import frame_jacobian
 
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "ClosureSystem", "Assembly", "perpendicular_basis"]
@@ -77,16 +78,6 @@ def _skews_batch(U, m=None):
     n, _, k = U.shape
     index, sign = _skew_table(k, m)
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
-
-
-def perpendicular_basis(a):
-    """Two unit vectors completing the unit vector ``a`` to a right-handed basis."""
-    a = np.asarray(a, float)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    b1 = np.cross(a, helper)
-    b1 /= np.linalg.norm(b1)
-    b2 = np.cross(a, b1)
-    return b1, b2
 
 
 @dataclass(frozen=True)

@@ -214,7 +214,7 @@ def _numeric(result):
     """[(row key, label, factor)] of the metric columns with numbers."""
     out = []
     for k, name, f in table_columns(result):
-        if k in result.columns and k != "workspace_dimension":
+        if k in result.columns and k not in ("workspace_dimension", "transmission_restarts"):
             vals = [r[k] for r in result.succeeded if r[k] is not None]
             if vals and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
                 out.append((k, name, f))
