@@ -273,7 +273,7 @@ class SerialJacobians:
 
     def _check(self, rng, count):
         model = self.model
-        data = self.mech.data
+        data = self.mech.scratch_data()
         lo = np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi)
         hi = np.where(np.isfinite(model.upperPositionLimit), model.upperPositionLimit, np.pi)
         lo, hi = np.maximum(lo, -np.pi), np.minimum(hi, np.pi)

@@ -39,7 +39,7 @@ class TreeKinematics:
         self.model = model
         if model.nq != model.nv:
             raise Unbatchable(f"{mech.path}: joints of more than one coordinate")
-        data = model.createData() if model.njoints < 64 else mech.data
+        data = mech.scratch_data()
         q0 = pin.neutral(model)
         self.joints = []  # (parent, kind "R" | "P", constant 3 x 11 matrix, idx_q)
         for j in range(1, model.njoints):
@@ -177,7 +177,8 @@ class BatchClosure:
             self.target = (link, kind)
         self.cuts = cuts
         # a ClosureSystem of the same cut joints: its plans give the rows, it checks ours
-        self.system = ClosureSystem(model, cuts, mech.tolerances, mech.path, data=mech.data, extra=mech.extra_rows)
+        self.system = ClosureSystem(model, cuts, mech.tolerances, mech.path, data=mech.scratch_data(),
+                                    extra=mech.extra_rows)
         self.nrows = self.system.nrows
         self.solver_rows = self.system._rows(True)
         # which of the solver's rows are lengths [m] (positions; the couplings of rolling and screw
@@ -371,8 +372,9 @@ class BatchClosure:
             for q, is_closed in [(q, False) for q in Q] + [(q, True) for q in closed]:
                 targets = None
                 if self.target is not None:
-                    pin.framesForwardKinematics(model, mech.data, q)
-                    M = mech.data.oMf[self.cuts[-1].frame2]
+                    data = mech.scratch_data()
+                    pin.framesForwardKinematics(model, data, q)
+                    M = data.oMf[self.cuts[-1].frame2]
                     placement = M if is_closed else pin.SE3(M.rotation, M.translation + 0.01)
                     frame.placement = placement
                     model.frames[mech.target_frame] = frame

@@ -237,7 +237,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
                 near=near, rate=speed, progress=progress)
     model = mech.model
-    data = model.createData()  # a Data of its own: nothing read from or left in mech.data
+    data = mech.scratch_data()
     a_idx = mech.velocity_indices(inputs)
     m = len(a_idx)
     n = len(res.values)

@@ -30,7 +30,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     model.frames[fid] = frame
     target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
     # the higher pairs' rows too: without them a gear or cam would be free to slip
-    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.data,
+    system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, data=mech.scratch_data(),
                            extra=mech.extra_rows)
     if not mech.coordinates:
         raise UsageError(f"{mech.path}: the mechanism has no moving joint: nothing to solve for")

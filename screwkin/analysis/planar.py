@@ -145,7 +145,7 @@ def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
     B -> C and the normal of the slide; both in the plane of motion."""
     Q = np.atleast_2d(np.asarray(Q, float))
     P = np.empty((len(Q), 4, 3))
-    model, data = mech.model, mech.model.createData()
+    model, data = mech.model, mech.scratch_data()
     for k, q in enumerate(Q):
         pin.framesForwardKinematics(model, data, q)
         topo = None
@@ -288,7 +288,7 @@ class LinkAngles:
                 candidates = [("joint", k) for k in model.children[jid]]
             candidates += [("frame", f) for f in cut_frames.get(jid, [])]
             self.links[link] = (start, candidates, fid)
-        self._data = mech.data
+        self._data = mech.scratch_data()
         ends = self._ends(mech.neutral())
         self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
 

@@ -186,7 +186,7 @@ class PositionSolver:
         if compiled is not None:
             mech.closure.accelerate(compiled)
         self.model = mech.model
-        self.data = mech.data
+        self.data = mech.scratch_data()
         names = list(input_joints) if input_joints else list(mech.actuated)
         if not names:
             raise UsageError(f"{mech.path}: no input joints: declare actuated joints or give --set NAME=VALUE")

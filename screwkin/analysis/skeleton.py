@@ -24,10 +24,10 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from ..errors import UsageError
 from ..model.geometry import TINY, line_foot, plane_basis
+from ..model.state import KinematicState
 from .motion import motion_along
 from .planar import LinkAngles
 from .position import PositionSolver
@@ -272,26 +272,25 @@ def numbering(topo, inputs=()) -> tuple:
     return number, letter, tuple(lettered)
 
 
-def _frame_point(mech, name):
-    fid = mech.model.getFrameId(name)
-    return mech.data.oMf[fid]
+def _frame_point(state, name):
+    return state.frame_placement(state.mech.model.getFrameId(name))
 
 
-def _joint_ends(mech, j):
+def _joint_ends(state, j):
     """(point on links[0], point on links[1], axis or None) of a topology joint, in the world, at
-    the configuration whose frame placements are in mech.data."""
-    model, data = mech.model, mech.data
+    the configuration of ``state`` (a model.state.KinematicState)."""
+    model = state.mech.model
     p = np.asarray(j.point, float) if j.point is not None else None
     axis = np.asarray(j.direction, float) if j.direction is not None else None
     if len(j.members) == 1:
         name = j.members[0]
         if j.cut:
-            a, b = _frame_point(mech, f"{name}@F1"), _frame_point(mech, f"{name}@F2")
+            a, b = _frame_point(state, f"{name}@F1"), _frame_point(state, f"{name}@F2")
             return a.translation.copy(), b.translation.copy(), axis
         if model.existJointName(name):
             jid = model.getJointId(name)
-            child = data.oMi[jid].translation.copy()
-            parent = (data.oMi[model.parents[jid]] * model.jointPlacements[jid]).translation.copy()
+            child = state.joint_placement(jid).translation.copy()
+            parent = (state.joint_placement(model.parents[jid]) * model.jointPlacements[jid]).translation.copy()
             return parent, child, axis
     return p, p, axis
 
@@ -348,10 +347,9 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
     q = np.asarray(q, float)
     inputs = list(inputs) if inputs else list(mech.actuated)
     topo = mech.topology(q)
-    model, data = mech.model, mech.data
-    pin.framesForwardKinematics(model, data, q)
+    state = KinematicState(mech, q)
     number, letter, ordered = numbering(topo, inputs)
-    ends3 = {j.name: _joint_ends(mech, j) for j in ordered}
+    ends3 = {j.name: _joint_ends(state, j) for j in ordered}
     centres = [p for a, b, _ in ends3.values() for p in (a, b) if p is not None]
     (e1, e2, n), planar = _basis(mech, topo, centres)
 
@@ -366,7 +364,7 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
     for j in ordered:
         a, b, axis = ends3[j.name]
         if a is None:  # no geometry (a floating joint): at the child's frame
-            a = b = data.oMf[mech.link_frame(j.links[1])].translation.copy()
+            a = b = state.frame_placement(mech.link_frame(j.links[1])).translation.copy()
         direction, tilt = None, 0.0
         if axis is not None:
             u = axis / np.linalg.norm(axis)
@@ -377,7 +375,7 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
                     direction = tuple(float(x) for x in d / np.linalg.norm(d))
         point = p2(b) if j.type == "prismatic" else p2(a)
         if j.cut and j.type in ("rolling", "gear", "contact") and j.name in specs:
-            point, pair_profiles = _higher_pair(mech, specs[j.name], letter[j.name],
+            point, pair_profiles = _higher_pair(state, specs[j.name], letter[j.name],
                                                 (number[j.links[0]], number[j.links[1]]), p2, e1, e2)
             profiles += pair_profiles
         value = values.get(j.members[0]) if len(j.members) == 1 else None
@@ -401,7 +399,7 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
         elif len(pts) == 1 and any(s.type in ("prismatic", "cylindrical") for s in mine):
             shape, outline = "block", tuple(pts)
         else:
-            shape, outline = _stub(mech, name, pts, p2, tol)
+            shape, outline = _stub(state, name, pts, p2, tol)
         links.append(SkeletonLink(number[name], name, shape, outline, tuple(s.letter for s in mine),
                                   name == topo.ground))
     allpts = [p for s in joints for p in (s.point, *s.ends)] + [p for lk in links for p in lk.outline]
@@ -442,15 +440,15 @@ def _extremes(pts):
     return (tuple(P[int(np.argmin(s))]), tuple(P[int(np.argmax(s))]))
 
 
-def _stub(mech, name, pts, p2, tol):
+def _stub(state, name, pts, p2, tol):
     """A link with one joint centre: drawn to its frame's origin, else its centre of mass,
     else a short stub along its frame's x axis."""
+    mech = state.mech
+    M = state.frame_placement(mech.link_frame(name))
     if not pts:
-        M = mech.data.oMf[mech.link_frame(name)]
         return "point", (p2(M.translation),)
-    M = mech.data.oMf[mech.link_frame(name)]
     jid = mech.model.frames[mech.link_frame(name)].parentJoint
-    cands = [p2(M.translation), p2(mech.data.oMi[jid].act(mech.model.inertias[jid].lever))]
+    cands = [p2(M.translation), p2(state.joint_placement(jid).act(mech.model.inertias[jid].lever))]
     for c in cands:
         if np.hypot(c[0] - pts[0][0], c[1] - pts[0][1]) > 100 * tol:
             return "stub", (pts[0], c)
@@ -459,9 +457,9 @@ def _stub(mech, name, pts, p2, tol):
     return "stub", (pts[0], end)
 
 
-def _higher_pair(mech, spec, letter, nums, p2, e1, e2):
+def _higher_pair(state, spec, letter, nums, p2, e1, e2):
     """(contact point, profiles) of a rolling, gear or contact pair in the plane."""
-    F1, F2 = _frame_point(mech, f"{spec.name}@F1"), _frame_point(mech, f"{spec.name}@F2")
+    F1, F2 = _frame_point(state, f"{spec.name}@F1"), _frame_point(state, f"{spec.name}@F2")
     c1, c2 = np.array(p2(F1.translation)), np.array(p2(F2.translation))
 
     def along_x(M):

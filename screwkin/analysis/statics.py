@@ -109,7 +109,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     ``output`` at its frame's origin (world axes) and, with ``gravity``, the links' weights,
     at the assembled configuration q.  See the module docstring."""
     model, tol = mech.model, mech.tolerances
-    data = model.createData()  # a Data of this computation's own: nothing read from or left in mech.data
+    data = mech.scratch_data()
     inputs = list(mech.actuated if inputs is None else inputs)
     if wrench is not None and output is None:
         raise UsageError(f"{mech.path}: a wrench needs the output link it is applied to (--output)")
@@ -180,7 +180,7 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dic
     forces (Pinocchio's RNEA at (q, v, a)): what the parent side (link1 of a cut joint) exerts
     on the child side (link2)."""
     model = mech.model
-    data = model.createData()  # a Data of its own: nothing read from or left in mech.data
+    data = mech.scratch_data()
     pin.framesForwardKinematics(model, data, q)
     rows = mech.closure.row_wrenches(q)
     fext = [pin.Force.Zero() for _ in range(model.njoints)]

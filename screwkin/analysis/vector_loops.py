@@ -216,7 +216,7 @@ class VectorLoops:
         """World positions of the joint centres at q; the anchors (points fixed in a link) of
         each joint on each of its links, as (frame id, local point) for forward kinematics."""
         mech, topo = self.mech, self.topo
-        model, data = mech.model, mech.data
+        model, data = mech.model, mech.scratch_data()
         pin.framesForwardKinematics(model, data, self.q)
         self.theta_q = self.angles(self.q)
         self.frames = {lk: mech.link_frame(lk) for lk in topo.links}
@@ -475,7 +475,7 @@ class VectorLoops:
         kinematics of the anchors (the loops need not close at q)."""
         mech = self.mech
         th = self.angles(q)
-        data = mech.data
+        data = mech.scratch_data()
         pin.framesForwardKinematics(mech.model, data, q)
         out = {}
         for n in self.variables:

@@ -42,6 +42,7 @@ import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
 from ..model.linalg import rank
+from ..model.state import KinematicState
 from .batch import SerialJacobians
 from .batch_closure import BatchClosure, Unbatchable
 from .position import within_limits
@@ -163,10 +164,7 @@ def _translations(mech, q, output, point) -> np.ndarray:
     constant orientation unless ``point``: the linear part of the output twists that the loops
     allow with no rotation."""
     fid = mech.link_frame(output)
-    model, data = mech.model, mech.data
-    pin.computeJointJacobians(model, data, q)
-    pin.updateFramePlacements(model, data)
-    J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    J = KinematicState(mech, q).frame_jacobian(fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
     K = mech.closure.jacobian(q) if mech.closure.nrows else np.zeros((0, mech.nv))
     V = null_motions(K, mech)
     T = J @ V
@@ -237,8 +235,7 @@ def _seed(mech, output, point, orientation):
     # a wrist with aligned axes): then the nearest generic one, where the rows' rank is largest
     best = None
     for q in [assembly.q] + list(generic):
-        pin.framesForwardKinematics(mech.model, mech.data, q)
-        M = mech.data.oMf[fid]
+        M = KinematicState(mech, q).frame_placement(fid)
         K = bc.evaluate(q[None], (M.translation[None], M.rotation))[1][0]
         k = rank(K, mech.tolerances)
         if best is None or k > best[0]:

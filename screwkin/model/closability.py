@@ -16,7 +16,7 @@ def closure_obstacle(mech) -> str | None:
     in its links' lengths: its longest side is longer than the others together ("ground 0.2 m >
     crank + coupler + rocker = 0.18 m"); None when no such loop is found too long.  The sides are
     the distances between consecutive joint axes on each link, fixed by the file."""
-    model, data = mech.model, mech.model.createData()
+    model, data = mech.model, mech.scratch_data()
     pin.framesForwardKinematics(model, data, mech.neutral())
     for c in mech.cuts:
         if c.type not in ("revolute", "continuous") or c.pair:

@@ -17,6 +17,7 @@ Row kinds (world vectors; o1, o2 frame origins, d = o2 - o1):
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -159,6 +160,15 @@ class Assembly:
     starts: int = 1
 
 
+class _Workspace:
+    """One thread's Data of a ClosureSystem, with the views into it that the rows read."""
+
+    __slots__ = ("data", "placements", "groups", "buffers")
+
+    def __init__(self, data, placements):
+        self.data, self.placements, self.groups, self.buffers = data, placements, None, None
+
+
 class ClosureSystem:
     """The loop-closure equations r(q) = 0 of a model with cut joints."""
 
@@ -167,7 +177,8 @@ class ClosureSystem:
         """data: the pinocchio.Data to compute in (the mechanism's; a new one when None);
         extra: CouplingRow and ContactRow of higher pairs, after the cut joints' rows."""
         self.model = model
-        self.data = model.createData() if data is None else data
+        self._first_data = model.createData() if data is None else data
+        self._local = threading.local()  # per thread: its Data, the placements' views, the row groups
         self.cuts = list(cuts)
         self.extra = list(extra)
         self.tol = tolerances
@@ -178,15 +189,39 @@ class ClosureSystem:
         self._compiled = None  # (kernels, cut kinds, buffers) when accelerate() is on
         self._free = {}  # free velocity indices for each set of frozen ones
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
-        # Pinocchio hands out its frame placements by reference and their rotation and
-        # translation as views of its own memory: read once here, they follow every
-        # forward-kinematics pass on self.data (fetching them costs about 1 us each)
-        self._placements = []
-        for c in self.cuts:
-            M1, M2 = self.data.oMf[c.frame1], self.data.oMf[c.frame2]
-            self._placements.append((M1.rotation, M2.rotation, M1.translation, M2.translation))
-        self._groups = self._group()
+        self._owner = threading.get_ident()
         self._position_rows = None
+
+    # ------------------------------------------------------------------ per-thread workspace
+    def _workspace(self):
+        """This thread's Data, the views of its cut frames' placements and the row groups built
+        on them: threads may share a mechanism (each computes in a Data of its own; the thread that
+        built the system uses the Data it was given).  Pinocchio hands out its frame placements by
+        reference and their rotation and translation as views of its own memory: read once here,
+        they follow every forward-kinematics pass on that Data (fetching them costs about 1 us)."""
+        ws = getattr(self._local, "ws", None)
+        if ws is None:
+            data = self._first_data if threading.get_ident() == self._owner else self.model.createData()
+            placements = []
+            for c in self.cuts:
+                M1, M2 = data.oMf[c.frame1], data.oMf[c.frame2]
+                placements.append((M1.rotation, M2.rotation, M1.translation, M2.translation))
+            ws = self._local.ws = _Workspace(data, placements)
+            ws.groups = self._group(placements)
+        return ws
+
+    @property
+    def data(self):
+        """The pinocchio.Data this thread computes in."""
+        return self._workspace().data
+
+    @property
+    def _placements(self):
+        return self._workspace().placements
+
+    @property
+    def _groups(self):
+        return self._workspace().groups
 
     @property
     def plans(self) -> list:
@@ -211,10 +246,7 @@ class ClosureSystem:
         self._compiled = None
         kinds = compiled.kinds_of(self.cuts) if on and not self.extra else None
         if kinds is not None and compiled.available():
-            n, nv = len(self.cuts), self.model.nv
-            buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
-                       np.empty((n, 6, nv)), np.empty((n, 6, nv)))
-            self._compiled = (compiled.kernels(), kinds, buffers)
+            self._compiled = (compiled.kernels(), kinds)
         return self._compiled is not None
 
     @property
@@ -223,8 +255,14 @@ class ClosureSystem:
 
     def _evaluate_compiled(self, q, jacobian: bool = True):
         """evaluate(q, jacobian, solver=True) through the compiled kernel (same rows)."""
-        kernels, kinds, (R1, R2, t1, t2, J1, J2) = self._compiled
-        model, data = self.model, self.data
+        kernels, kinds = self._compiled
+        ws = self._workspace()
+        if ws.buffers is None:  # this thread's buffers for the kernel
+            n, nv = len(self.cuts), self.model.nv
+            ws.buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+                          np.empty((n, 6, nv)), np.empty((n, 6, nv)))
+        R1, R2, t1, t2, J1, J2 = ws.buffers
+        model, data = self.model, ws.data
         self._kinematics(q, jacobian)
         for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, self._placements)):
             R1[j], R2[j], t1[j], t2[j] = a, b, c, d
@@ -286,7 +324,7 @@ class ClosureSystem:
             vectors = np.eye(3) if t in ("fixed", "prismatic") else a[None, :]
         return P, pairs, vectors, t in ("fixed", "prismatic")
 
-    def _group(self):
+    def _group(self, placements):
         """Cut joints of one type share the layout of their rows: each group is evaluated
         with stacked arrays (a few numpy calls per group, not per cut joint)."""
         offsets = {False: 0, True: 0}
@@ -319,7 +357,7 @@ class ClosureSystem:
                 "Vt": None if V is None else V.transpose(0, 2, 1), "rotation": g["rotation"],
                 "frames1": [self.cuts[c].frame1 for c in g["members"]],
                 "frames2": [self.cuts[c].frame2 for c in g["members"]],
-                "views": [self._placements[c] for c in g["members"]],
+                "views": [placements[c] for c in g["members"]],
                 "rows": {s_: np.array(g["rows"][s_]) for s_ in (False, True)},
                 "starts": {s_: [int(x[0]) if len(x) else 0 for x in g["rows"][s_]] for s_ in (False, True)},
             })

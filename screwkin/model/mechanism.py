@@ -86,6 +86,10 @@ def characteristic_length(model, cuts) -> float:
     return float(np.mean(lengths)) if lengths else 1.0
 
 
+#: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data).
+SHARED_DATA_NV = 120
+
+
 class Mechanism:
     """A mechanism: Pinocchio model of the spanning tree, cut joints, actuation.
 
@@ -120,11 +124,13 @@ class Mechanism:
         # before the pinocchio.Data is made from the model
         self.target_frame = model.addFrame(
             pin.Frame("screwkin@target", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
-        # ONE Data for every analysis of this mechanism: Pinocchio 4.1 allocates nv^3-sized
-        # tensors in it (one Data of a 500-joint chain: 17 s and 7.9 GB here).  Whoever uses it
-        # runs Pinocchio's pass for its own configuration first.
+        # The mechanism's own Data: Pinocchio 4.1 allocates nv^3-sized tensors in one (a Data of a
+        # 500-joint chain: 17 s and 7.9 GB here, 0.2 s at 200 joints, 1 ms at 30).  Computations
+        # take a Data of their own from scratch_data(); only models past SHARED_DATA_NV
+        # coordinates hand this one out (each user then runs Pinocchio's pass first).
         self.data = model.createData()
-        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.data, extra=self.extra_rows)
+        self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.scratch_data(),
+                                     extra=self.extra_rows)
         self.set_actuated(actuated)
         self._assembly = None
         self._limits = None
@@ -137,6 +143,17 @@ class Mechanism:
         self._translational = self._translational_coordinates()
 
     # ------------------------------------------------------------------ binding
+    @property
+    def shares_data(self) -> bool:
+        """Whether the model is too large for a Data per computation (see scratch_data)."""
+        return self.model.nv > SHARED_DATA_NV
+
+    def scratch_data(self):
+        """A pinocchio.Data for one computation, so that no result depends on what another left
+        in a Data it shares: a new one, except past SHARED_DATA_NV coordinates, where a Data costs
+        seconds and gigabytes and the mechanism's own is handed out (its user runs its pass first)."""
+        return self.data if self.shares_data else self.model.createData()
+
     def _frame_id(self, name: str, what: str) -> int:
         fid = frame_id(self.model, name)
         if fid is None:

@@ -131,25 +131,32 @@ class KinematicState:
                 a.setflags(write=False)
 
     # ------------------------------------------------------------------ Pinocchio, once
-    @cached_property
-    def _data(self):
+    def _pass(self, data, jacobians: bool):
         model = self.mech.model
-        data = model.createData()
         if self.qd is None:
             pin.framesForwardKinematics(model, data, self.q)
         else:
             pin.forwardKinematics(model, data, self.q, self.qd, self.qdd)
             pin.updateFramePlacements(model, data)
-        return data
-
-    @cached_property
-    def _jacobians(self):
-        """The state's Data with the joint Jacobians computed (once, on first use)."""
-        model, data = self.mech.model, self._data
-        if model.nv:
+        if jacobians and model.nv:
             pin.computeJointJacobians(model, data, self.q)
             pin.updateFramePlacements(model, data)
         return data
+
+    @cached_property
+    def _own(self):
+        """This state's Data, with its pass and the joint Jacobians (computed once)."""
+        return self._pass(self.mech.scratch_data(), True)
+
+    @property
+    def _data(self):
+        """The Data the state reads: its own; for a model too large for a Data per computation
+        (Mechanism.shares_data) the mechanism's shared one, the pass run again at each read."""
+        return self._pass(self.mech.data, True) if self.mech.shares_data else self._own
+
+    @property
+    def _jacobians(self):
+        return self._data
 
     @property
     def has_rates(self) -> bool:

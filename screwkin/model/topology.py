@@ -226,7 +226,7 @@ class _Edge:
 def _edges(mech, q):
     """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
     model = mech.model
-    data = model.createData()  # a Data of its own: nothing read from or left in mech.data
+    data = mech.scratch_data()
     pin.framesForwardKinematics(model, data, q)
     replaced = dict(mech.spec.replacements)
     edges, welds = [], []

@@ -50,7 +50,7 @@ class _Probe:
     """What the check reads off a configuration of the written four-bar."""
 
     def __init__(self, mech, design: Design):
-        self.mech, self.model, self.data = mech, mech.model, mech.data
+        self.mech, self.model, self.data = mech, mech.model, mech.scratch_data()
         self.design = design
         self.out = mech.link_frame(design.output_link)
         jid = {mech.model.names[k]: k for k in range(1, mech.model.njoints)}
