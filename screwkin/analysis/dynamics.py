@@ -31,7 +31,6 @@ I = dE / (Cs omega^2).
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -138,16 +137,6 @@ def check_inertias(mech) -> tuple:
     return ()
 
 
-@contextmanager
-def _gravity(model, g):
-    saved = pin.Motion(model.gravity)
-    model.gravity = pin.Motion(np.asarray(g, float), np.zeros(3))
-    try:
-        yield
-    finally:
-        model.gravity = saved
-
-
 def _load_wrenches(mech, loads, data) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the placements in
     ``data`` (the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
@@ -247,41 +236,41 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     T, V, P_in, P_load, unbalanced, scale = (np.zeros(n) for _ in range(6))
     indeterminate = 0
     ground_tree, ground_cuts = _ground_sides(mech)
-    with _gravity(model, g):
-        for k in range(n):
-            q, v, a = res.q[k], res.rates[k], res.accelerations[k]
-            b = pin.rnea(model, data, q, v, a).copy()
-            pin.computeJointJacobians(model, data, q)
-            pin.updateFramePlacements(model, data)
-            frames = _load_wrenches(mech, loads, data)
-            for fid, w in frames:
-                J = frame_jacobian(model, data, fid, LWA)
-                b -= J.T @ w
-                P_load[k] += float(w @ (J @ v))
-            K = mech.closure.jacobian(q)
-            tau, lam, N, unbalanced[k], scale[k] = balance(mech, K, a_idx, b)
-            free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
-            efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
-            indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
-            table = reaction_table(mech, q, lam, frames, True, N[m:] if N.size else None, v, a)
-            for name, (kind, wrench, is_open) in table.items():
-                reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
-                kinds[name] = kind
-                open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
-            # data holds q's placements (its own Data: reaction_table computes in another)
-            for name, (kind, wrench, _) in table.items():
-                if kind == "tree" and name in ground_tree:
-                    sign, origin = -1.0, data.oMi[mech.coordinate(name).joint_id].translation
-                elif kind == "cut" and name in ground_cuts:
-                    cut = next(c for c in mech.cuts if c.name == name)
-                    sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation
-                else:
-                    continue
-                shaking_f[k] += sign * wrench[:3]
-                shaking_m[k] += sign * (wrench[3:] + np.cross(origin, wrench[:3]))
-            T[k] = pin.computeKineticEnergy(model, data, q, v)
-            V[k] = pin.computePotentialEnergy(model, data, q)
-            P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
+    gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
+    for k in range(n):
+        q, v, a = res.q[k], res.rates[k], res.accelerations[k]
+        b = pin.rnea(gmodel, data, q, v, a).copy()
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        frames = _load_wrenches(mech, loads, data)
+        for fid, w in frames:
+            J = frame_jacobian(model, data, fid, LWA)
+            b -= J.T @ w
+            P_load[k] += float(w @ (J @ v))
+        K = mech.closure.jacobian(q)
+        tau, lam, N, unbalanced[k], scale[k] = balance(mech, K, a_idx, b)
+        free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
+        efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
+        indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
+        table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
+        for name, (kind, wrench, is_open) in table.items():
+            reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
+            kinds[name] = kind
+            open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
+        # data holds q's placements (its own Data: reaction_table computes in another)
+        for name, (kind, wrench, _) in table.items():
+            if kind == "tree" and name in ground_tree:
+                sign, origin = -1.0, data.oMi[mech.coordinate(name).joint_id].translation
+            elif kind == "cut" and name in ground_cuts:
+                cut = next(c for c in mech.cuts if c.name == name)
+                sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation
+            else:
+                continue
+            shaking_f[k] += sign * wrench[:3]
+            shaking_m[k] += sign * (wrench[3:] + np.cross(origin, wrench[:3]))
+        T[k] = pin.computeKineticEnergy(model, data, q, v)
+        V[k] = pin.computePotentialEnergy(gmodel, data, q)
+        P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
     units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}
     eff = {name: efforts[:, j] for j, name in enumerate(inputs)}
     peak = {name: float(np.max(np.abs(y))) if np.all(np.isfinite(y)) else None for name, y in eff.items()}

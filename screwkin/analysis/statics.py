@@ -176,7 +176,7 @@ def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
 def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
-    links' weights with ``gravity`` (model.gravity) and, with v and a, the motion's inertial
+    links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
     forces (Pinocchio's RNEA at (q, v, a)): what the parent side (link1 of a cut joint) exerts
     on the child side (link2)."""
     model = mech.model
@@ -212,13 +212,8 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dic
         elif fa == total[0]:
             total[1] = total[1] + wa * value
     zero_v = np.zeros(model.nv)
-    saved = pin.Motion(model.gravity)
-    if not gravity:
-        model.gravity = pin.Motion.Zero()
-    try:
-        pin.rnea(model, data, q, zero_v if v is None else v, zero_v if a is None else a, fext)
-    finally:
-        model.gravity = saved
+    g = model.gravity.linear if gravity is True else np.zeros(3) if gravity is False else np.asarray(gravity, float)
+    pin.rnea(mech.model_with_gravity(g), data, q, zero_v if v is None else v, zero_v if a is None else a, fext)
     virtual = {n for names in mech.virtual_joints.values() for n in names}
     out = {}
     for c in mech.coordinates:

@@ -8,6 +8,8 @@ mobility, and later position, velocity and singularity analysis) work on it.
 
 from __future__ import annotations
 
+import threading
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -129,6 +131,8 @@ class Mechanism:
         # take a Data of their own from scratch_data(); only models past SHARED_DATA_NV
         # coordinates hand this one out (each user then runs Pinocchio's pass first).
         self.data = model.createData()
+        self._gravity_models = {}  # (gx, gy, gz) -> a copy of the model with that gravity
+        self._models_lock = threading.Lock()
         self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.scratch_data(),
                                      extra=self.extra_rows)
         self.set_actuated(actuated)
@@ -153,6 +157,19 @@ class Mechanism:
         in a Data it shares: a new one, except past SHARED_DATA_NV coordinates, where a Data costs
         seconds and gigabytes and the mechanism's own is handed out (its user runs its pass first)."""
         return self.data if self.shares_data else self.model.createData()
+
+    def model_with_gravity(self, g):
+        """The Pinocchio model with gravity ``g`` (gx, gy, gz) [m/s^2] (RNEA, gravity terms and
+        potential energy read model.gravity): a copy made once per g, so that no computation
+        changes the model another is reading (threads may share a mechanism)."""
+        key = tuple(float(x) for x in np.asarray(g, float).ravel())
+        with self._models_lock:
+            model = self._gravity_models.get(key)
+            if model is None:
+                model = pin.Model(self.model)
+                model.gravity = pin.Motion(np.array(key), np.zeros(3))
+                self._gravity_models[key] = model
+        return model
 
     def _frame_id(self, name: str, what: str) -> int:
         fid = frame_id(self.model, name)
