@@ -27,25 +27,23 @@ frame accelerations.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
-from ..model._pin import frame_jacobian
 from ..model.closure import Assembly
-from ..model.linalg import null_space, rank
 from ..model.state import KinematicState, angular_loop_joints
+from . import modes
 from .mobility import analyze_mobility
 from .motion import link_motions, point_motions
 from .turns import engaged, turn_on, whole_turns
 from .planar import LinkAngles, identify
-from .singular import Generic, measures, scaled_jacobians
+from .singular import Generic, measures
 
 __all__ = ["within_limits", "Solution", "PositionResult", "PositionSolver", "TraceStep", "outside_limits"]
 
-LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 @dataclass(frozen=True)
@@ -418,160 +416,18 @@ class PositionSolver:
 
     # --------------------------------------------------------------- one answer per mode
     def _merge(self, sols):
-        """Solutions that are one root: a singular solution and others within the accuracy a
-        double root can be computed to (about the square root of the closure tolerance), or
-        joined to it by a motion with the inputs held (a continuum)."""
-        tol = self.mech.tolerances
-        close = 100 * np.sqrt(tol.closure) * self.mech.length
-        groups = []
-        for s in sols:
-            for g in groups:
-                if not (s.singular or g[0].singular):
-                    continue
-                d = self._distance(g[0].q, s.q)
-                if d < close or self._connected(g[0].q, s.q):
-                    g.append(s)
-                    break
-            else:
-                groups.append([s])
-        out = []
-        for g in groups:
-            spread = max([self._distance(g[0].q, s.q) for s in g[1:]], default=0.0)
-            keep = min(g, key=lambda s: s.sigma_min)
-            continuum = spread >= close or (keep.singular and self._moves(keep.q))
-            out.append(replace(keep, singular=keep.singular or len(g) > 1, continuum=continuum,
-                               merged=sum(s.merged for s in g)))
-        return out
-
-    def _moves(self, q, step: float = 1e-3) -> bool:
-        """Whether the mechanism can move a finite distance from q with the inputs held (a
-        continuum), not only to first order (a double root): a step of ``step`` (dimensionless)
-        along each direction the passive joints lost at q, closed again with the inputs frozen,
-        stays where it went (the correction is small next to the step) at a double root the
-        solver pulls it back."""
-        mech, g = self.mech, self.generic()
-        S = scaled_jacobians(mech, q)
-        Kp = S.K[:, g.p]
-        if not Kp.size or g.rank_Kp == 0:
-            return False
-        _, s, vt = np.linalg.svd(Kp)
-        lost = [k for k in range(min(g.rank_Kp, len(s))) if s[k] < mech.tolerances.singular * s[0]]
-        scale = np.where(mech.translational, mech.length, 1.0)
-        for k in lost:
-            for sign in (1.0, -1.0):
-                dq = np.zeros(mech.nv)
-                dq[g.p] = sign * step * vt[k]
-                pred = pin.integrate(self.model, q, dq * scale)
-                try:
-                    got = mech.closure.solve(pred, frozen=self.frozen).q
-                except AssemblyError:
-                    continue
-                back = np.linalg.norm(mech.difference(pred, got) / scale)
-                if back < 0.1 * step:
-                    return True
-        return False
+        """Solutions that are one root merged (analysis.modes.merge)."""
+        return modes.merge(self, sols)
 
     def _distance(self, q1, q2):
         return float(np.linalg.norm(self._signature(q1) - self._signature(q2)))
 
-    def _connected(self, q1, q2, pieces: int = 12) -> bool:
-        """Whether q2 is reached from q1 by a motion with the inputs held: a walk of small steps
-        toward q2, each closed again with the inputs frozen, whose corrections stay small next
-        to the step (between two distinct roots the correction pulls the walk back)."""
-        closure, model = self.mech.closure, self.model
-        q = q1
-        for k in range(pieces):
-            step = self.mech.difference(q, q2) / (pieces - k)
-            size = float(np.linalg.norm(step))
-            if size < self.mech.tolerances.zero:
-                return True
-            pred = pin.integrate(model, q, step)
-            try:
-                q = closure.solve(pred, frozen=self.frozen).q
-            except AssemblyError:
-                return False
-            if np.linalg.norm(self.mech.difference(pred, q)) > 0.3 * size:
-                return False
-        gap = float(np.linalg.norm(self.mech.difference(q, q2)))
-        return gap < self.mech.tolerances.geometry * max(self.mech.length, 1e-3)
-
     def _labels(self, q, outside) -> tuple:
-        """Why a solution is not reached by moving from the reference configuration."""
-        labels = [f"outside the joint limits: {', '.join(outside)}"] if outside else []
-        table = self._labelling_table()
-        if table is None:
-            return tuple(labels)
-        legs, turned = table
-        data = self.data
-        pin.framesForwardKinematics(self.model, data, q)
-        reversed_ = [name for name, jid, far, axis, s_ref in legs
-                     if s_ref * ((self._far(far) - data.oMi[self.model.parents[jid]].translation)
-                                 @ (data.oMi[jid].rotation @ axis)) < 0]
-        if reversed_:
-            labels.append(f"legs reversed through their pivots: {', '.join(reversed_)}")
-        turned_ = [link for link, fid, R_ref in turned
-                   if np.linalg.norm(pin.log3(R_ref.T @ data.oMf[fid].rotation)) > self.mech.tolerances.geometry]
-        if turned_:
-            labels.append(f"turned although they only translate as the mechanism moves (a mirrored assembly): "
-                          f"{', '.join(turned_)}")
-        return tuple(labels)
-
-    def _far(self, far):
-        kind, i = far
-        return self.data.oMi[i].translation if kind == "joint" else self.data.oMf[i].translation
-
-    def _labelling_table(self):
-        """Once: the prismatic legs between a pivot and a far joint (with their signed length at
-        the reference configuration), and the links that only translate (with their reference
-        orientation).  None for mechanisms without loops or without a reference."""
+        """Why a solution is not reached by moving from the reference configuration
+        (analysis.modes.ModeLabels)."""
         if self._labelling is None:
-            mech, model = self.mech, self.model
-            ref = self._reference() if mech.cuts else None
-            if ref is None:
-                self._labelling = False
-                return None
-            data = self.data
-            pin.computeJointJacobians(model, data, ref)
-            pin.updateFramePlacements(model, data)
-            cut_frames = {}
-            for c in mech.cuts:
-                for f in (c.frame1, c.frame2):
-                    cut_frames.setdefault(model.frames[f].parentJoint, []).append(f)
-            axes = {j.name: np.asarray(j.axis, float) for j in mech.spec.joints}
-            legs = []
-            for c in mech.coordinates:
-                parent = model.parents[c.joint_id]
-                if c.nq != 1 or not mech.translational[c.idx_v] or parent == 0 or c.joint not in axes:
-                    continue
-                fars = [("joint", k) for k in model.children[c.joint_id]]
-                fars += [("frame", f) for f in cut_frames.get(c.joint_id, [])]
-                if not fars:
-                    continue
-                axis = axes[c.joint]
-                s_ref = float((self._far(fars[0]) - data.oMi[parent].translation) @ (data.oMi[c.joint_id].rotation @ axis))
-                if abs(s_ref) > mech.tolerances.geometry * mech.length:
-                    legs.append((c.joint, c.joint_id, fars[0], axis, s_ref))
-            turned = []
-            configs = self.generic().configurations
-            topo = mech.topology(ref)
-            Vs = [null_space(mech.closure.jacobian(q), mech.tolerances, mech.nv) for q in configs]
-            for link in topo.links:
-                if link == topo.ground:
-                    continue
-                fid = mech.link_frame(link)
-                rotates = False
-                for q, V in zip(configs, Vs):
-                    pin.computeJointJacobians(model, data, q)
-                    pin.updateFramePlacements(model, data)
-                    W = frame_jacobian(model, data, fid, LWA)[3:] @ V
-                    if rank(W, mech.tolerances):
-                        rotates = True
-                        break
-                if not rotates:
-                    pin.framesForwardKinematics(model, data, ref)
-                    turned.append((link, fid, data.oMf[fid].rotation.copy()))
-            self._labelling = (legs, turned)
-        return self._labelling or None
+            self._labelling = modes.ModeLabels(self)
+        return self._labelling(q, outside)
 
     def _linkage(self, q):
         """A four-bar's or slider-crank's textbook construction at q (planar.identify), or None."""
