@@ -18,146 +18,19 @@ Row kinds (world vectors; o1, o2 frame origins, d = o2 - o1):
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 
-from ..errors import AssemblyError
 from ..tolerances import DEFAULT, Tolerances
 from . import compiled, newton
-from .geometry import perpendicular_basis  # noqa: F401 - exported here as before
+from .cuts import Assembly, ContactRow, CouplingRow, CutJoint  # noqa: F401 - exported here as before
+from .geometry import cross3, perpendicular_basis, skew, skews, skews_batch
 from ._pin import frame_jacobian
 
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "ClosureSystem", "Assembly", "perpendicular_basis"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-
-
-def _cross(a, b):
-    """Cross product of two 3-vectors (numpy.cross costs about 35 us a call here: it was
-    70% of a sweep step in a profile; this costs about 1 us)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _skew(a):
-    """The cross-product matrix [a]x of a 3-vector (a x b = [a]x b)."""
-    return a[_SKEW_INDEX] * _SKEW_SIGN
-
-
-_SKEW_INDEX = np.array([[0, 2, 1], [2, 0, 0], [1, 0, 0]])
-_SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
-
-
-def _skew_table(k, m=None):
-    """Index and sign tables that turn the columns of a 3 x k matrix, flattened column by
-    column, into their stacked cross-product matrices (3k x 3); with m, columns j and m + j
-    side by side (3m x 6)."""
-    table = _SKEW_TABLES.get((k, m))
-    if table is None:
-        index = (_SKEW_INDEX[None] + 3 * np.arange(k)[:, None, None]).reshape(3 * k, 3)
-        sign = np.tile(_SKEW_SIGN, (k, 1))
-        if m is not None:
-            index = np.hstack([index[:3 * m], index[3 * m:]])
-            sign = np.hstack([sign[:3 * m], sign[3 * m:]])
-        table = _SKEW_TABLES[(k, m)] = (index, sign)
-    return table
-
-
-_SKEW_TABLES = {}
-
-
-def _skews(U, m=None):
-    """The cross-product matrices of the columns of U (3 x k), stacked (3k x 3); with m,
-    columns j and m + j side by side ((3m x 6): [[u_j]x, [u_m+j]x])."""
-    index, sign = _skew_table(U.shape[1], m)
-    return U.T.ravel()[index] * sign
-
-
-def _skews_batch(U, m=None):
-    """_skews for a stack: U (n, 3, k) -> (n, 3k, 3), or (n, 3m, 6) with m."""
-    n, _, k = U.shape
-    index, sign = _skew_table(k, m)
-    return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
-
-
-@dataclass(frozen=True)
-class CutJoint:
-    """A cut joint bound to a model: frame ids of F1, F2 and its axes.
-
-    axis is expressed in F1, axis2 (universal joints) in F2.
-    """
-
-    name: str
-    type: str
-    dof: int
-    frame1: int
-    frame2: int
-    link1: str
-    link2: str
-    axis: tuple
-    axis2: tuple | None = None
-    pair: str | None = None  # a higher pair built on this cut joint: "rolling", "gear", "helical", "contact"
-
-    @property
-    def rows(self) -> int:
-        return 6 - self.dof
-
-
-@dataclass(frozen=True)
-class CouplingRow:
-    """A linear relation of one-coordinate joints, sum c_k q_k + c0 = 0 [m]: the no-slip condition
-    of a rolling pair (r1 a1 + r2 a2 = 0) or the lead of a screw pair (advance - lead turn / 2 pi
-    = 0), written in the unwrapped coordinates of the pair's virtual joints, so that it holds over
-    any number of turns.  Its Jacobian row is constant and it adds nothing to K'q'."""
-
-    name: str
-    kind: str  # "roll" | "lead"
-    terms: tuple  # ((q index, v index, coefficient), ...)
-    constant: float = 0.0
-
-
-@dataclass(frozen=True)
-class ContactRow:
-    """Two profiles touching in the plane that a planar cut joint between F1 and F2 keeps them in:
-    a circle (centre at the frame's origin), a line (the frame's x axis) or a point (the origin)
-    [m].  circle-line and line-circle: the centre's distance from the line equals the radius;
-    point-line, line-point: the point on the line (a pin in a slot); circle-circle: the distance
-    of the centres equals r1 + r2, or |r1 - r2| inside; point-circle, circle-point: the point on
-    the circle.  normal: a line's normal in the plane, in its frame (axis x e_x)."""
-
-    name: str
-    frame1: int
-    frame2: int
-    shape1: str
-    radius1: float | None
-    shape2: str
-    radius2: float | None
-    internal: bool
-    normal: tuple
-
-    def target(self) -> float:
-        if self.shape1 == "circle" and self.shape2 == "circle":
-            return abs(self.radius1 - self.radius2) if self.internal else self.radius1 + self.radius2
-        return self.radius1 if self.shape1 == "circle" else (self.radius2 or 0.0)
-
-
-@dataclass(frozen=True)
-class Assembly:
-    """A configuration that satisfies the closure equations.
-
-    q: joint configuration (Pinocchio's nq-vector);
-    residual: closure residual norm reached [m, rad];
-    iterations: solver iterations used (from the start that closed);
-    start: which starting configuration closed (e.g. "the file's configuration");
-    starts: how many starting configurations were tried to get there.
-    """
-
-    q: np.ndarray
-    residual: float
-    iterations: int
-    start: str = "the given configuration"
-    starts: int = 1
 
 
 class _Workspace:
@@ -409,7 +282,7 @@ class ClosureSystem:
                 J2 = np.array([frame_jacobian(model, data, f, LWA) for f in g["frames2"]])
                 w1, w2 = J1[:, 3:], J2[:, 3:]
                 # e . (v2 - v1) + (e x d) . w1
-                K[rows[:, :k]] = E @ (J2[:, :3] - J1[:, :3] + _skews_batch(d[:, :, None]) @ w1)
+                K[rows[:, :k]] = E @ (J2[:, :3] - J1[:, :3] + skews_batch(d[:, :, None]) @ w1)
             rest = rows[:, k:]
             if solver and g["V"] is not None:
                 if g["V"].shape[1] == 0:
@@ -420,7 +293,7 @@ class ClosureSystem:
                 m = U1.shape[2]
                 r[rest] = (U2 - U1).transpose(0, 2, 1).reshape(n, 3 * m)
                 if jacobian:
-                    K[rest] = _skews_batch(np.concatenate([U1, -U2], axis=2), m) @ np.concatenate([w1, w2], axis=1)
+                    K[rest] = skews_batch(np.concatenate([U1, -U2], axis=2), m) @ np.concatenate([w1, w2], axis=1)
                 continue
             if g["rotation"]:
                 for j in range(n):
@@ -474,7 +347,7 @@ class ClosureSystem:
             value = sign * s - (0.0 if point else e.target())
             if not jacobian:
                 return value, None
-            return value, sign * (m @ (Ja[:3] - Jb[:3]) + _cross(m, delta) @ Jb[3:])
+            return value, sign * (m @ (Ja[:3] - Jb[:3]) + cross3(m, delta) @ Jb[3:])
         delta = M2.translation - M1.translation
         dist = float(np.sqrt(delta @ delta))
         value = dist - e.target()
@@ -495,8 +368,8 @@ class ClosureSystem:
             delta = M[a].translation - M[b].translation
             dd = V[a].linear - V[b].linear
             ddd = A[a].linear - A[b].linear
-            md = _cross(w, m)
-            mdd = _cross(al, m) + _cross(w, md)
+            md = cross3(w, m)
+            mdd = cross3(al, m) + cross3(w, md)
             s2 = ddd @ m + 2 * dd @ md + delta @ mdd
             point = (e.shape1 if b == 1 else e.shape2) == "point"
             return s2 if point or delta @ m >= 0 else -s2
@@ -521,7 +394,7 @@ class ClosureSystem:
             J1 = frame_jacobian(model, data, g["frames1"][j], LWA)
             J2 = frame_jacobian(model, data, g["frames2"][j], LWA)
             w1, w2 = J1[3:], J2[3:]
-            K[i:i + k] = E @ (J2[:3] - J1[:3] + _skew(d) @ w1)
+            K[i:i + k] = E @ (J2[:3] - J1[:3] + skew(d) @ w1)
         i += k
         if solver and g["V"] is not None:
             if g["V"].shape[1]:
@@ -529,7 +402,7 @@ class ClosureSystem:
                 m = U1.shape[1]
                 r[i:i + 3 * m] = (U2 - U1).T.ravel()
                 if jacobian:
-                    K[i:i + 3 * m] = _skews(np.hstack([U1, -U2]), m) @ np.vstack([w1, w2])
+                    K[i:i + 3 * m] = skews(np.hstack([U1, -U2]), m) @ np.vstack([w1, w2])
             return
         if g["rotation"]:
             R = R1.T @ R2
@@ -543,7 +416,7 @@ class ClosureSystem:
             r[i:i + p] = np.einsum("ip,ip->p", u, w)
             if jacobian:
                 for c in range(p):
-                    K[i + c] = _cross(w[:, c], u[:, c]) @ (w2 - w1)
+                    K[i + c] = cross3(w[:, c], u[:, c]) @ (w2 - w1)
 
     def bias(self, q, v) -> np.ndarray:
         """K'(q, v) v: the second time derivative of the (minimal) residual rows
@@ -557,8 +430,8 @@ class ClosureSystem:
         i = 0
 
         def second(u, w, al):  # (d/dt u, d2/dt2 u) for u fixed in a frame turning at w with acceleration al
-            ud = _cross(w, u)
-            return ud, _cross(al, u) + _cross(w, ud)
+            ud = cross3(w, u)
+            return ud, cross3(al, u) + cross3(w, ud)
 
         for cut, (P, pairs, _, rotation), (R1, R2, t1, t2) in zip(self.cuts, self._plans, self._placements):
             d = t2 - t1
@@ -569,13 +442,13 @@ class ClosureSystem:
             w1, w2, al1, al2 = V1.angular, V2.angular, A1.angular, A2.angular
             dd, ddd = V2.linear - V1.linear, A2.linear - A1.linear
             # e fixed in F1: d2/dt2 (e . d) = e . (d'' - 2 w1 x d' - al1 x d + w1 x (w1 x d))
-            wd = _cross(w1, d)
-            g = ddd - 2.0 * _cross(w1, dd) - _cross(al1, d) + _cross(w1, wd)
+            wd = cross3(w1, d)
+            g = ddd - 2.0 * cross3(w1, dd) - cross3(al1, d) + cross3(w1, wd)
             k = len(P)
             out[i:i + k] = P @ (R1.T @ g)
             i += k
             if rotation:
-                out[i:i + 3] = pin.Jlog3(R1.T @ R2) @ R2.T @ (al2 - al1 + _cross(w2, w1))
+                out[i:i + 3] = pin.Jlog3(R1.T @ R2) @ R2.T @ (al2 - al1 + cross3(w2, w1))
                 i += 3
                 continue
             for u, w in pairs:
@@ -630,14 +503,14 @@ class ClosureSystem:
             R1, R2 = M1.rotation, M2.rotation
             d = M2.translation - M1.translation
             for e in P @ R1.T:  # e . d, e fixed in F1: d(e . d) = e . (v2 - v1) + (e x d) . w1
-                pair(cut.frame1, np.r_[-e, _cross(e, d)], cut.frame2, np.r_[e, zero])
+                pair(cut.frame1, np.r_[-e, cross3(e, d)], cut.frame2, np.r_[e, zero])
             if rotation:  # log3(R1^T R2): Jlog3 R2^T (w2 - w1)
                 C = pin.Jlog3(R1.T @ R2) @ R2.T
                 for c in C:
                     pair(cut.frame1, np.r_[zero, -c], cut.frame2, np.r_[zero, c])
                 continue
             for u, w in pairs:  # u . w: (w x u) . (w2 - w1)
-                c = _cross(R2 @ w, R1 @ u)
+                c = cross3(R2 @ w, R1 @ u)
                 pair(cut.frame1, np.r_[zero, -c], cut.frame2, np.r_[zero, c])
         for e in self.extra:
             if isinstance(e, CouplingRow):
@@ -651,7 +524,7 @@ class ClosureSystem:
                 delta = Ma.translation - Mb.translation
                 point = (e.shape1 if on2 else e.shape2) == "point"
                 sign = 1.0 if point or delta @ m >= 0 else -1.0
-                pair(fa, sign * np.r_[m, zero], fb, sign * np.r_[-m, _cross(m, delta)])
+                pair(fa, sign * np.r_[m, zero], fb, sign * np.r_[-m, cross3(m, delta)])
                 continue
             delta = M2.translation - M1.translation
             u = delta / max(float(np.linalg.norm(delta)), 1e-300)
@@ -682,62 +555,23 @@ class ClosureSystem:
 
     # ------------------------------------------------------------------ solving
     def solve(self, q0, frozen=(), tolerances: Tolerances | None = None, trace=None) -> Assembly:
-        """Solve r(q) = 0 from q0 by damped Newton (Levenberg-Marquardt, minimum-norm steps).
+        """Solve r(q) = 0 from q0 by damped Newton (model.newton.solve: Levenberg-Marquardt,
+        minimum-norm steps).  frozen: velocity indices that must not move (the inputs); trace:
+        optional callable(iteration, q, r, K, dq, accepted) recording the iterations (r and K in
+        the solver's rows, see ``row_labels``).  Raises AssemblyError with the smallest residual
+        reached when it fails, or when the solution assembles a cut joint upside down."""
+        return newton.solve(self, q0, frozen, tolerances or self.tol, trace)
 
-        frozen: velocity indices that must not move (the inputs).
-        trace:  optional callable(iteration, q, r, K, dq, accepted) to record the
-                iterations (r and K in the solver's rows, see ``row_labels``).
-        Raises AssemblyError with the smallest residual reached when it fails.
-        """
-        tol = tolerances or self.tol
-        model = self.model
-        q = np.array(q0, float)
-        if self.nrows == 0:
-            return Assembly(q, 0.0, 0)
-        frozen = tuple(int(f) for f in np.asarray(frozen, int).ravel())
+    def free_columns(self, frozen: tuple) -> np.ndarray:
+        """The velocity indices not in ``frozen`` (cached per set of frozen ones)."""
         free = self._free.get(frozen)
         if free is None:
-            free = self._free[frozen] = np.setdiff1d(np.arange(model.nv), np.asarray(frozen, int))
-        evaluate, step = (self._evaluate_compiled, self._step_compiled) if self._compiled else \
-            (lambda q_, jacobian=True: self.evaluate(q_, jacobian, solver=True), newton.damped_step)
-        r, K = evaluate(q)
-        last = q  # the configuration whose placements are in self.data
-        norm = float(np.sqrt(r @ r))
-        best = norm
-        mu, nu = tol.lm_damping, newton.NU
-        it = 0
-        dq = np.zeros(model.nv)
-        while it < tol.max_iterations:
-            if norm < tol.closure:
-                break
-            it += 1
-            dq[free], lin2 = step(K, r, free, mu)
-            q_new = pin.integrate(model, q, dq)
-            # the Jacobian comes with the residual (one Pinocchio pass): most steps are accepted;
-            # when Newton is about to converge (quadratically: the next residual near norm^2) the
-            # residual alone is computed first, as the Jacobian there is not needed
-            final = norm < 0.1 * np.sqrt(tol.closure)
-            r_new, K_new = evaluate(q_new, jacobian=not final)
-            last = q_new
-            n_new = float(np.sqrt(r_new @ r_new))
-            if final and tol.closure <= n_new < norm:
-                r_new, K_new = evaluate(q_new)
-            accepted = n_new < norm
-            if trace is not None:
-                trace(it, q, r, K, dq.copy(), accepted)
-            if accepted:
-                mu, nu = newton.accept(mu, newton.gain_ratio(norm, n_new, lin2), tol)
-                q, r, K, norm = q_new, r_new, K_new, n_new
-                best = min(best, norm)
-            else:
-                mu, nu = newton.refuse(mu, nu)
-                if newton.given_up(mu, tol):
-                    break
-        if norm >= tol.closure:
-            raise AssemblyError(self.path, best, it)
-        bad = self.wrong_branch(q, placed=q is last)
-        if bad:
-            raise AssemblyError(
-                self.path, best, it, detail=f"the solution found assembles {', '.join(bad)} with a reversed axis"
-            )
-        return Assembly(q, norm, it)
+            free = self._free[frozen] = np.setdiff1d(np.arange(self.model.nv), np.asarray(frozen, int))
+        return free
+
+    def solver_pass(self):
+        """(evaluate(q, jacobian=True) -> (r, K) in the solver's rows, step(K, r, free, mu)):
+        compiled when accelerate() is on, else numpy."""
+        if self._compiled:
+            return self._evaluate_compiled, self._step_compiled
+        return (lambda q_, jacobian=True: self.evaluate(q_, jacobian, solver=True)), newton.damped_step

@@ -23,8 +23,12 @@ named so, on a stack of them.
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
-__all__ = ["TRACE_FLOOR", "damped_step", "damped_steps", "gain_ratio", "accept", "refuse", "NU"]
+from ..errors import AssemblyError
+from .cuts import Assembly
+
+__all__ = ["TRACE_FLOOR", "damped_step", "damped_steps", "gain_ratio", "accept", "refuse", "given_up", "solve", "NU"]
 
 #: Division guard: the damping is relative to the mean squared row norm, which is never taken
 #: below this (a zero Jacobian) [same units as K^2].
@@ -99,3 +103,54 @@ def refuse(mu, nu):
 def given_up(mu, tol):
     """Whether the damping has grown past the point where the solver stops (scalar or array)."""
     return mu > tol.lm_damping_max
+
+
+def solve(system, q0, frozen, tol, trace=None) -> Assembly:
+    """Damped Newton on a model.closure.ClosureSystem from q0 with the velocity indices
+    ``frozen`` held: the step and damping above, Tolerances ``tol`` (closure, max_iterations and
+    the lm_ fields).  When Newton is about to converge quadratically (the next residual near
+    norm^2) the residual alone is computed first, as the Jacobian there is not needed."""
+    model = system.model
+    q = np.array(q0, float)
+    if system.nrows == 0:
+        return Assembly(q, 0.0, 0)
+    frozen = tuple(int(f) for f in np.asarray(frozen, int).ravel())
+    free = system.free_columns(frozen)
+    evaluate, step = system.solver_pass()
+    r, K = evaluate(q)
+    last = q  # the configuration whose placements are in the system's Data
+    norm = float(np.sqrt(r @ r))
+    best = norm
+    mu, nu = tol.lm_damping, NU
+    it = 0
+    dq = np.zeros(model.nv)
+    while it < tol.max_iterations:
+        if norm < tol.closure:
+            break
+        it += 1
+        dq[free], lin2 = step(K, r, free, mu)
+        q_new = pin.integrate(model, q, dq)
+        final = norm < 0.1 * np.sqrt(tol.closure)
+        r_new, K_new = evaluate(q_new, jacobian=not final)
+        last = q_new
+        n_new = float(np.sqrt(r_new @ r_new))
+        if final and tol.closure <= n_new < norm:
+            r_new, K_new = evaluate(q_new)
+        accepted = n_new < norm
+        if trace is not None:
+            trace(it, q, r, K, dq.copy(), accepted)
+        if accepted:
+            mu, nu = accept(mu, gain_ratio(norm, n_new, lin2), tol)
+            q, r, K, norm = q_new, r_new, K_new, n_new
+            best = min(best, norm)
+        else:
+            mu, nu = refuse(mu, nu)
+            if given_up(mu, tol):
+                break
+    if norm >= tol.closure:
+        raise AssemblyError(system.path, best, it)
+    bad = system.wrong_branch(q, placed=q is last)
+    if bad:
+        raise AssemblyError(system.path, best, it,
+                            detail=f"the solution found assembles {', '.join(bad)} with a reversed axis")
+    return Assembly(q, norm, it)

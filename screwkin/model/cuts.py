@@ -1,0 +1,91 @@
+"""What a closure system closes: the cut joints bound to a model (frames F1, F2 and axes), the
+linear couplings of rolling and screw pairs, the contacts of profiles in a plane, and the closed
+configuration a solve returns.  Plain frozen data; model.closure evaluates their rows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly"]
+
+
+@dataclass(frozen=True)
+class CutJoint:
+    """A cut joint bound to a model: frame ids of F1, F2 and its axes.
+
+    axis is expressed in F1, axis2 (universal joints) in F2.
+    """
+
+    name: str
+    type: str
+    dof: int
+    frame1: int
+    frame2: int
+    link1: str
+    link2: str
+    axis: tuple
+    axis2: tuple | None = None
+    pair: str | None = None  # a higher pair built on this cut joint: "rolling", "gear", "helical", "contact"
+
+    @property
+    def rows(self) -> int:
+        return 6 - self.dof
+
+
+@dataclass(frozen=True)
+class CouplingRow:
+    """A linear relation of one-coordinate joints, sum c_k q_k + c0 = 0 [m]: the no-slip condition
+    of a rolling pair (r1 a1 + r2 a2 = 0) or the lead of a screw pair (advance - lead turn / 2 pi
+    = 0), written in the unwrapped coordinates of the pair's virtual joints, so that it holds over
+    any number of turns.  Its Jacobian row is constant and it adds nothing to K'q'."""
+
+    name: str
+    kind: str  # "roll" | "lead"
+    terms: tuple  # ((q index, v index, coefficient), ...)
+    constant: float = 0.0
+
+
+@dataclass(frozen=True)
+class ContactRow:
+    """Two profiles touching in the plane that a planar cut joint between F1 and F2 keeps them in:
+    a circle (centre at the frame's origin), a line (the frame's x axis) or a point (the origin)
+    [m].  circle-line and line-circle: the centre's distance from the line equals the radius;
+    point-line, line-point: the point on the line (a pin in a slot); circle-circle: the distance
+    of the centres equals r1 + r2, or |r1 - r2| inside; point-circle, circle-point: the point on
+    the circle.  normal: a line's normal in the plane, in its frame (axis x e_x)."""
+
+    name: str
+    frame1: int
+    frame2: int
+    shape1: str
+    radius1: float | None
+    shape2: str
+    radius2: float | None
+    internal: bool
+    normal: tuple
+
+    def target(self) -> float:
+        if self.shape1 == "circle" and self.shape2 == "circle":
+            return abs(self.radius1 - self.radius2) if self.internal else self.radius1 + self.radius2
+        return self.radius1 if self.shape1 == "circle" else (self.radius2 or 0.0)
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """A configuration that satisfies the closure equations.
+
+    q: joint configuration (Pinocchio's nq-vector);
+    residual: closure residual norm reached [m, rad];
+    iterations: solver iterations used (from the start that closed);
+    start: which starting configuration closed (e.g. "the file's configuration");
+    starts: how many starting configurations were tried to get there.
+    """
+
+    q: np.ndarray
+    residual: float
+    iterations: int
+    start: str = "the given configuration"
+    starts: int = 1
