@@ -12,8 +12,6 @@ server of :class:`ViewerServer`, or a recording stand-in in tests.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import re
 import subprocess
@@ -31,6 +29,7 @@ from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..files.meshes import find_mesh
 from ..files.xmlsafe import parse_xml_text
 from ..model._pin import frame_id
+from .viewserver import ViewerServer
 
 __all__ = ["COLORS", "build_scene", "show", "page", "fit_camera", "legend_entries", "view", "ViewerServer", "RecordingViewer", "screenshot"]
 
@@ -554,41 +553,6 @@ def page(html: str, scene: Scene, title: str | None = None, controls: bool = Tru
     at = html.rfind("</body>")
     at = len(html) if at < 0 else at
     return html[:at] + style + legend + html[at:]
-
-
-class ViewerServer:
-    """A meshcat server on 127.0.0.1 in a subprocess (see screwkin.present.viewserver)."""
-
-    def __init__(self):
-        env = dict(os.environ)
-        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "screwkin.present.viewserver"], stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, env=env, start_new_session=True, text=True)
-        info = {}
-        while len(info) < 2:
-            line = self.proc.stdout.readline()
-            if not line:
-                raise UsageError(f"the meshcat server did not start: {self.proc.stderr.read().strip()[-300:]}")
-            key, _, value = line.strip().partition("=")
-            info[key] = value
-        self.zmq_url, self.web_url = info["zmq_url"], info["web_url"]
-
-        import meshcat
-
-        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; the CLI says it itself
-            self.viewer = meshcat.Visualizer(zmq_url=self.zmq_url)
-
-    def close(self):
-        self.proc.terminate()
-        try:
-            self.proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:  # pragma: no cover
-            self.proc.kill()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def chromium():
