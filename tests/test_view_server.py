@@ -49,19 +49,19 @@ def group_alive(pgid) -> bool:
     return True
 
 
-def start_view(port):
+def start_view(port, *extra, ready="meshcat: "):
     """``python -m screwkin view FILE --port P`` in a process group of its own, once it says it
     serves and the port answers (at most 600 waits of a second for its line)."""
-    proc = subprocess.Popen([sys.executable, "-m", "screwkin", "view", FILE, "--port", str(port)],
+    proc = subprocess.Popen([sys.executable, "-m", "screwkin", "view", FILE, "--port", str(port), *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     for _ in range(600):
         if proc.poll() is not None:
             pytest.fail(f"screwkin view ended before serving: {proc.stderr.read()[-500:]}")
-        ready, _, _ = select.select([proc.stdout], [], [], 1.0)
-        if ready:
+        readable, _, _ = select.select([proc.stdout], [], [], 1.0)
+        if readable:
             line = proc.stdout.readline()
-            if line.startswith("meshcat: "):
-                assert f":{port}/" in line
+            if line.startswith(ready):
+                assert f":{port}" in line
                 assert answers(port)
                 return proc
     os.killpg(proc.pid, signal.SIGKILL)
@@ -108,6 +108,33 @@ def test_the_server_ends_when_the_command_is_killed():
     wait_free(port, pgid)
     assert not group_alive(pgid), "the meshcat server outlived the killed command"
     assert port_is_free(port)
+
+
+@pytest.mark.slow
+def test_sigterm_stops_the_interactive_view_too():
+    pytest.importorskip("viser")
+    port = free_port()
+    proc = start_view(port, "--interactive", ready="interactive view: ")
+    assert listening(port) == ["0100007F"]
+    proc.send_signal(signal.SIGTERM)
+    try:
+        out, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        pytest.fail("screwkin view --interactive did not end after SIGTERM")
+    assert proc.returncode == 0, err
+    assert f"stopped by SIGTERM: the server on port {port} is closed" in out
+    assert not group_alive(proc.pid)
+    assert listening(port) == [] and port_is_free(port)
+
+
+def test_interactive_without_viser_says_how_to_install_it(capsys, monkeypatch):
+    from screwkin.cli import main
+
+    monkeypatch.setitem(sys.modules, "viser", None)
+    assert main(["view", FILE, "--interactive"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pip install viser" in err[0]
 
 
 def test_a_port_in_use_is_a_usage_error():
