@@ -341,9 +341,11 @@ def _basis(mech, topo, centres):
     return (e1, e2, n), False
 
 
-def skeleton(mech, q, inputs=None) -> Skeleton:
+def skeleton(mech, q, inputs=None, basis=None) -> Skeleton:
     """The :class:`Skeleton` of ``mech`` at configuration ``q``; ``inputs``: the input joints
-    (default: the actuated ones), marked and listed with their values."""
+    (default: the actuated ones), marked and listed with their values; ``basis``: the drawing
+    plane (e1, e2, n) of another skeleton (the frames of an animation: a spatial mechanism's
+    projection plane is otherwise fitted to each configuration)."""
     q = np.asarray(q, float)
     inputs = list(inputs) if inputs else list(mech.actuated)
     topo = mech.topology(q)
@@ -352,6 +354,8 @@ def skeleton(mech, q, inputs=None) -> Skeleton:
     ends3 = {j.name: _joint_ends(state, j) for j in ordered}
     centres = [p for a, b, _ in ends3.values() for p in (a, b) if p is not None]
     (e1, e2, n), planar = _basis(mech, topo, centres)
+    if basis is not None:
+        e1, e2, n = (np.asarray(v, float) for v in basis)
 
     def p2(v):
         return (float(np.asarray(v) @ e1), float(np.asarray(v) @ e2))

@@ -37,6 +37,7 @@ BOUNDS = {
     "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest
     "dynamics_steps": (1, 20_000),    # dynamics --steps: 1.2 ms a step on a four-bar, 4.5 on a six-bar (90 s at most)
     "figure_steps": (2, 20_000),      # draw --singular / report --steps: a search for singular configurations
+    "animation_steps": (1, 1_000),    # draw --animate --steps: frames drawn (steps + 1), about 0.1 s each
     "starts": (0, 1_000),             # solve / ik / synthesize --starts: random starting configurations
     "iterations": (0, 1_000),         # solve / report --iterations: Newton iterations shown
     "samples": (1, 10_000_000),       # scan --samples (100,000 take about 0.3 s)

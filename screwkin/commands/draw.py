@@ -4,18 +4,23 @@ the input's range (``--singular``)."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 
 import numpy as np
 
+from ..analysis.motion import motion_along
+from ..analysis.position import PositionSolver
+from ..analysis.sweep import sweep
 from ..analysis.skeleton import (
     kinematic_chain,
     singular_configurations,
     skeleton,
     trace_points,
 )
-from ..errors import UsageError
+from ..errors import UsageError, quote
+from ..present.animate import animation_format, write_animation
 from ..present.draw import (
     chain_dict,
     draw_chain,
@@ -25,15 +30,18 @@ from ..present.draw import (
     value_label,
 )
 from ..present.report import to_jsonable
+from ..units import parse_typed_value, parse_value
 from ._common import (
     add_configuration_options,
     add_point_option,
     configuration,
     inputs,
+    joint_assignments,
+    joint_value,
     named_points,
     with_mode,
 )
-from ._options import count
+from ._options import BOUNDS, count
 
 NAME = "draw"
 NEEDS_MECHANISM = True
@@ -58,12 +66,30 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--input", help="--singular: the input joint moved (default: the first actuated joint)")
     sp.add_argument("--output", help="--singular: the output link whose serial singularities (limit positions) are "
                                      "sought (default: a four-bar's rocker, a slider-crank's slider)")
-    sp.add_argument("--steps", type=count("figure_steps"), default=360,
-                    help="--singular and --trace: steps over the input's range (default 360, at most 20,000)")
+    sp.add_argument("--steps", type=count("figure_steps"), default=None,
+                    help="--singular and --trace: steps over the input's range (default 360, at most 20,000); "
+                         "--animate: steps from --from to --to (default 60, at most 1,000)")
     add_point_option(sp)
     sp.add_argument("--trace", action="append", metavar="NAME",
                     help="draw the path of the --point NAME over a whole turn of the input (or up to its limit "
                          "position) on the skeleton; repeatable")
+    sp.add_argument("--animate", metavar="OUT.gif|OUT.mp4",
+                    help="write an animation of the skeleton while --input goes --from A --to B in --steps N "
+                         "(GIF with Pillow; MP4 with imageio-ffmpeg); --point paths are traced")
+    sp.add_argument("--from", dest="start", help="--animate: the input's first value (units allowed: -30deg, 5mm)")
+    sp.add_argument("--to", dest="stop", help="--animate: the input's last value")
+    sp.add_argument("--fps", type=frame_rate, default=20.0, help="--animate: frames per second (default 20, 1 to 60)")
+
+
+def frame_rate(text: str) -> float:
+    """argparse type of --fps: a number of frames per second from 1 to 60."""
+    try:
+        fps = float(text.strip())
+    except (ValueError, AttributeError):
+        raise argparse.ArgumentTypeError(f"expected frames per second, got {quote(text, 20)}") from None
+    if not 1.0 <= fps <= 60.0:  # nan fails both comparisons
+        raise argparse.ArgumentTypeError(f"must be from 1 to 60 frames per second, got {quote(text, 20)}")
+    return fps
 
 
 def _targets(mech, args) -> list:
@@ -127,9 +153,14 @@ def _traces(mech, args, q, input_names, given, skel) -> dict:
 
 
 def run(mech, args) -> int:
+    if args.animate:
+        return _animate(mech, args)
+    if args.start is not None or args.stop is not None:
+        raise UsageError(f"{mech.path}: --from and --to go with --animate OUT.gif")
     targets = _targets(mech, args)
     if args.chain and args.singular:
         raise UsageError(f"{mech.path}: --chain and --singular are separate drawings; give one of them")
+    args.steps = 360 if args.steps is None else args.steps
     if args.steps < 4:
         raise UsageError(f"{mech.path}: --steps must be at least 4")
     given = inputs(mech, args)
@@ -198,3 +229,70 @@ def run(mech, args) -> int:
 
 def _wrapped(value, unit):
     return value if unit == "m" else float(np.mod(value + np.pi, 2 * np.pi) - np.pi)
+
+
+def _typed(name, value, unit, linear) -> str:
+    """'crank = 30 deg' in the unit the person typed (rad or m when bare)."""
+    unit = unit or ("m" if linear else "rad")
+    return f"{name} = {value / parse_value('1' + unit):.5g} {unit}"
+
+
+def _animate(mech, args) -> int:
+    """draw --animate OUT: the skeleton along a sweep of --input from --from to --to."""
+    ext = animation_format(args.animate)
+    if args.png or args.svg or args.chain or args.singular or args.trace:
+        raise UsageError(f"{mech.path}: --animate writes one animation: leave out --png, --svg, --chain, --singular "
+                         "and --trace (--point paths are traced in the animation)")
+    if args.start is None or args.stop is None:
+        raise UsageError(f"{mech.path}: --animate needs --from A and --to B (the input's range)")
+    steps = 60 if args.steps is None else args.steps
+    lo, hi = BOUNDS["animation_steps"]
+    if not lo <= steps <= hi:
+        raise UsageError(f"{mech.path}: --animate --steps must be from {lo} to {hi:,} (frames: steps + 1), got {steps}")
+    given = inputs(mech, args)
+    name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
+    if name is None:
+        raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")
+    unit = parse_typed_value(args.start)[1]
+    start = joint_value(mech, name, args.start, "--from")
+    stop = joint_value(mech, name, args.stop, "--to")
+    unit = unit or parse_typed_value(args.stop)[1]
+    fixed = {k: v for k, v in given.items() if k != name}
+    input_names = list(mech.actuated) if name in mech.actuated else [name, *fixed]
+    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    res = sweep(PositionSolver(mech, input_names), name, start, stop, steps, fixed=fixed, near=near)
+    linear = res.unit == "m"
+    qs, values = list(res.q), list(res.values)
+    limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= 1e-9), None)
+    if limit is not None:  # the last frame: the mechanism at the limit position itself
+        qs.append(limit.q)
+        values.append(limit.input)
+    if res.stopped_at is not None and not args.json:
+        print(f"{name} stopped at {_typed(name, res.stopped_at, unit, linear).split(' = ')[1]} ({res.stop_reason}): "
+              f"{len(qs)} frames, not the {steps + 1} asked")
+    if res.skipped and not args.json:
+        print(f"{len(res.skipped)} input value(s) on the way could not be solved: no frame for them")
+    first = skeleton(mech, qs[0], input_names)
+    skels = [first, *(skeleton(mech, q, input_names, basis=first.basis) for q in qs[1:])]
+    points = named_points(mech, args)
+    traces = {}
+    if points:
+        motion = motion_along(mech, np.asarray(qs), np.zeros((len(qs), mech.nv)), np.zeros((len(qs), mech.nv)), points)
+        e1, e2, _ = (np.asarray(v) for v in first.basis)
+        for p in points:
+            P = np.asarray(motion.points[p.name]["position"])
+            traces[p.name] = np.stack([P @ e1, P @ e2], axis=1)
+    titles = [_title(mech, _typed(name, x, unit, linear)) for x in values]
+    if limit is not None:
+        titles[-1] += " (limit position)"
+    space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
+    n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space)
+    if args.json:
+        print(json.dumps(to_jsonable({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
+                                      "input": name, "unit": res.unit, "values": values,
+                                      "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
+                                      "traces": {k: xy.tolist() for k, xy in traces.items()}}), indent=2))
+    else:
+        print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit, linear)} "
+              f"to {_typed(name, values[-1], unit, linear).split(' = ')[1]}")
+    return 0

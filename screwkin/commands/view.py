@@ -2,18 +2,28 @@
 
 from __future__ import annotations
 
+import argparse
+import contextlib
 import os
+import signal
 import tempfile
 import time
 
+from ..analysis.interactive import Interactive
 from ..analysis.position import PositionSolver
 from ..analysis.singular import classify
 from ..analysis.sweep import locate_singularities, sweep
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
+from ..errors import UsageError, quote
+from ..present.interactive import InteractiveView, viser_module
+from ..present.viewplanar import colour_links, link_colours, planar_basis
 from ._common import (
     add_configuration_options,
+    add_point_option,
     configuration,
+    inputs,
     joint_assignments,
+    named_points,
     parse_range,
 )
 
@@ -31,10 +41,51 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--sweep", metavar="NAME=A:B:N", help="animate the motion of one input (other inputs from --set)")
     sp.add_argument("--html", help="write a self-contained static HTML page of the scene and exit")
     sp.add_argument("--png", help="write a picture of the scene (headless Chromium) and exit")
+    sp.add_argument("--interactive", action="store_true",
+                    help="a page with a slider per input (viser: pip install viser): the loops re-solved as they "
+                         "move, the assembly modes, singularity warnings, the output pose and --points")
+    add_point_option(sp)
+    sp.add_argument("--port", type=port_number, help="the web page's port on 127.0.0.1 (default: the first free one "
+                                                     "from 7000); a port in use is an error")
     scaled(sp, point=False)
 
 
+def port_number(text: str) -> int:
+    """argparse type of a TCP port a person types: 1024 to 65535 (no privileged port)."""
+    try:
+        port = int(text.strip())
+    except (ValueError, AttributeError):
+        raise argparse.ArgumentTypeError(f"expected a port number, got {quote(text, 20)}") from None
+    if not 1024 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"must be from 1024 to 65535, got {port}")
+    return port
+
+
+@contextlib.contextmanager
+def _stopped_by_signals():
+    """SIGTERM and SIGHUP end the command as Ctrl-C (SIGINT) does: a KeyboardInterrupt raised in the
+    main thread, so that every ``with`` (the meshcat server among them) closes what it opened.  A
+    second signal while closing is ignored; the previous handlers come back afterwards."""
+    stopping = []
+
+    def stop(signum, frame):
+        if not stopping:
+            stopping.append(signum)
+            raise KeyboardInterrupt
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
+    try:
+        yield stopping
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+
+
 def run(mech, args) -> int:
+    if args.interactive:
+        return _interactive(mech, args)
+    if getattr(args, "points", None):
+        raise UsageError(f"{mech.path}: --point goes with --interactive (its position is read out there)")
     q = configuration(mech, args)
     motion, singular = None, []
     if args.sweep:
@@ -51,26 +102,78 @@ def run(mech, args) -> int:
             singular.append((s.q, twist))
             print(f"singular ({s.kind}) at {name} = {s.input:.9g}")
     scene = build_scene(mech, q, output=args.output, singular=singular)
-    with ViewerServer() as server:
-        show(mech, scene, server.viewer, q, motion=motion)
-        if args.html or args.png:
-            html = server.viewer.static_html()
-            title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
-            if args.html:
-                with open(args.html, "w") as f:
-                    f.write(page(html, scene, title))
-                print(f"wrote {args.html}")
-            if args.png:
-                with tempfile.TemporaryDirectory() as d:
-                    path = os.path.join(d, "scene.html")
-                    with open(path, "w") as f:
-                        f.write(page(html, scene, title, controls=False, size=PICTURE))
-                    screenshot(path, args.png)
-                print(f"wrote {args.png}")
-            return 0
-        print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
+    serving = False
+    with _stopped_by_signals() as stopping:
         try:
+            with ViewerServer(port=args.port) as server:
+                show(mech, scene, server.viewer, q, motion=motion)
+                if args.html or args.png:
+                    _pictures(mech, args, server, scene)
+                    return 0
+                print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
+                serving = True
+                while True:
+                    time.sleep(1)
+        except KeyboardInterrupt:
+            if not serving:
+                raise
+    if stopping:
+        print(f"stopped by {signal.Signals(stopping[0]).name}: the meshcat server on port {server.port} is closed",
+              flush=True)
+    return 0
+
+
+def _pictures(mech, args, server, scene):
+    html = server.viewer.static_html()
+    title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
+    if args.html:
+        with open(args.html, "w") as f:
+            f.write(page(html, scene, title))
+        print(f"wrote {args.html}")
+    if args.png:
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "scene.html")
+            with open(path, "w") as f:
+                f.write(page(html, scene, title, controls=False, size=PICTURE))
+            screenshot(path, args.png)
+        print(f"wrote {args.png}")
+
+
+def _interactive(mech, args) -> int:
+    """view --interactive: the viser page, served until a signal stops it."""
+    if args.sweep or args.html or args.png:
+        raise UsageError(f"{mech.path}: --interactive is a live page: leave out --sweep, --html and --png")
+    viser_module()  # a clear message before any work when viser is missing
+    given = inputs(mech, args)
+    names = list(mech.actuated) or list(given)
+    extra = [n for n in given if n not in names]
+    if extra:
+        raise UsageError(f"{mech.path}: --set {', '.join(extra)}: not an input (inputs: {', '.join(names) or 'none'})")
+    values = None
+    if given:
+        missing = [n for n in names if n not in given]
+        if missing:
+            raise UsageError(f"{mech.path}: give every input a starting value with --set (missing: {', '.join(missing)})")
+        values = given
+    live = Interactive(mech, names, values=values, mode=args.mode or 1, output=args.output,
+                       points=named_points(mech, args))
+    q = live.state.q
+    scene = build_scene(mech, q, output=args.output)
+    if planar_basis(mech, q) is not None:
+        colour_links(scene, link_colours(mech, q))
+    serving = False
+    with _stopped_by_signals() as stopping:
+        view = InteractiveView(mech, live, scene, port=args.port, title=os.path.basename(mech.path))
+        try:
+            print(f"interactive view: {view.url}  (Ctrl-C to stop)", flush=True)
+            serving = True
             while True:
                 time.sleep(1)
         except KeyboardInterrupt:
-            return 0
+            if not serving:
+                raise
+        finally:
+            view.close()
+    if stopping:
+        print(f"stopped by {signal.Signals(stopping[0]).name}: the server on port {view.port} is closed", flush=True)
+    return 0

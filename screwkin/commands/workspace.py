@@ -98,7 +98,9 @@ def run(mech, args) -> int:
     if args.html or args.cloud_png:
         q = res.configurations[0] if res.configurations is not None else mech.generic_configurations()[0].q
         with ViewerServer() as server:
-            show(mech, build_scene(mech, q, output=args.output), server.viewer, q)
+            scene = build_scene(mech, q, output=args.output)
+            scene.points = np.vstack([scene.points, res.positions])  # framed to the mechanism and its cloud
+            show(mech, scene, server.viewer, q)
             workspace_cloud(res, server.viewer)
             html = server.viewer.static_html()
         if args.html:

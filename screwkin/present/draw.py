@@ -55,31 +55,35 @@ def _unit(v):
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _frame(fig, ax, points, r):
-    """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol."""
+def _frame(fig, ax, points, r, limits=None):
+    """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
+    ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
     lo, hi = P.min(axis=0) - 3 * r, P.max(axis=0) + 3 * r
     pad = 0.08 * max(hi - lo)
-    ax.set_xlim(lo[0] - pad, hi[0] + pad)
-    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    (x0, x1), (y0, y1) = limits if limits is not None else ((lo[0] - pad, hi[0] + pad), (lo[1] - pad, hi[1] + pad))
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
     ax.set_aspect("equal", adjustable="box")
     ax.set_axis_off()
 
 
 def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitle: str | None = None,
-                   traces: dict | None = None):
+                   traces: dict | None = None, size: float | None = None, limits=None):
     """The skeleton diagram of a :class:`~screwkin.analysis.skeleton.Skeleton` as a matplotlib
     Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
     higher pairs as their profiles, binary links as bars, ternary and larger links as filled
     polygons, links numbered (ground 1) and joints lettered with a legend to the file's
     names, the input joints marked with a curved arrow (a straight one for a sliding input),
-    and with ``angles`` the absolute link angles (planar mechanisms)."""
+    and with ``angles`` the absolute link angles (planar mechanisms).  ``size`` [m] (default the
+    skeleton's) sets the symbols' scale and ``limits`` ((x0, x1), (y0, y1)) [m] the framing: the
+    frames of an animation share both."""
     plt = _plt()
     from matplotlib.patches import Arc, Circle, FancyArrowPatch, Polygon, Rectangle
 
     fig = plt.figure(figsize=(10, 6.4))
     ax = fig.add_axes([0.03, 0.06, 0.66, 0.82])
-    r = 0.022 * skel.size  # pin radius: the unit of every symbol
+    r = 0.022 * (size or skel.size)  # pin radius: the unit of every symbol
     colour = _colours(len(skel.links))
     links = {lk.number: lk for lk in skel.links}
     points = []
@@ -251,7 +255,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
         ax.plot(*xy[0], "o", color=f"C{k}", markersize=4, zorder=6, gid=f"tracepoint:{name}")
         ax.annotate(name, xy[0], xytext=(4, 4), textcoords="offset points", fontsize=8, color=f"C{k}")
         points += [tuple(p) for p in xy]
-    _frame(fig, ax, points, r)
+    _frame(fig, ax, points, r, limits)
     fig.suptitle(title or os.path.basename(skel.path), fontsize=11, x=0.36, y=0.97)
     if subtitle:
         fig.text(0.36, 0.905, subtitle, ha="center", va="center", fontsize=8.5, color="0.3")

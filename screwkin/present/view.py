@@ -12,8 +12,6 @@ server of :class:`ViewerServer`, or a recording stand-in in tests.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import re
 import subprocess
@@ -31,6 +29,8 @@ from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..files.meshes import find_mesh
 from ..files.xmlsafe import parse_xml_text
 from ..model._pin import frame_id
+from .viewplanar import colour_links, link_colours, planar_basis, top_view
+from .viewserver import ViewerServer
 
 __all__ = ["COLORS", "build_scene", "show", "page", "fit_camera", "legend_entries", "view", "ViewerServer", "RecordingViewer", "screenshot"]
 
@@ -453,9 +453,13 @@ def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], f
 
 def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
     """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
-    with ``motion`` (a sequence of configurations) also set a meshcat animation."""
+    with ``motion`` (a sequence of configurations) also set a meshcat animation.  A planar
+    mechanism is seen along its plane's normal, orthographic, a colour per link (viewplanar)."""
     from pinocchio.visualize import MeshcatVisualizer
 
+    basis = planar_basis(mech, q)
+    if basis is not None:
+        colour_links(scene, link_colours(mech, q))
     viz = MeshcatVisualizer(mech.model, pin.GeometryModel(), scene.geometry)
     viz.initViewer(viewer=viewer)
     viz.loadViewerModel(rootNodeName="screwkin")
@@ -468,14 +472,17 @@ def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
     for key, value in BACKGROUND.items():
         viewer["/Background"].set_property(key, value)
     pts = scene.points if scene.points is not None else scene.center[None]
-    target, eye = fit_camera(pts, view_direction(scene.bounds))
-    w = eye - target
-    dist = float(np.linalg.norm(w))
-    viewer["screwkin"].set_transform(_translation(-target))  # beside the visuals: /meshcat/screwkin
-    camera = viewer["/Cameras/default/rotated/<object>"]
-    camera.set_property("position", [float(w[0]), float(w[2]), float(-w[1])])
-    camera.set_property("near", dist / 100)
-    camera.set_property("far", dist * 100)
+    if basis is not None:
+        top_view(viewer, pts, basis, PICTURE[0] / PICTURE[1])
+    else:
+        target, eye = fit_camera(pts, view_direction(scene.bounds))
+        w = eye - target
+        dist = float(np.linalg.norm(w))
+        viewer["screwkin"].set_transform(_translation(-target))  # beside the visuals: /meshcat/screwkin
+        camera = viewer["/Cameras/default/rotated/<object>"]
+        camera.set_property("position", [float(w[0]), float(w[2]), float(-w[1])])
+        camera.set_property("near", dist / 100)
+        camera.set_property("far", dist * 100)
     if motion is not None and len(motion):
         import meshcat.animation
 
@@ -554,41 +561,6 @@ def page(html: str, scene: Scene, title: str | None = None, controls: bool = Tru
     at = html.rfind("</body>")
     at = len(html) if at < 0 else at
     return html[:at] + style + legend + html[at:]
-
-
-class ViewerServer:
-    """A meshcat server on 127.0.0.1 in a subprocess (see screwkin.present.viewserver)."""
-
-    def __init__(self):
-        env = dict(os.environ)
-        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "screwkin.present.viewserver"], stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, env=env, start_new_session=True, text=True)
-        info = {}
-        while len(info) < 2:
-            line = self.proc.stdout.readline()
-            if not line:
-                raise UsageError(f"the meshcat server did not start: {self.proc.stderr.read().strip()[-300:]}")
-            key, _, value = line.strip().partition("=")
-            info[key] = value
-        self.zmq_url, self.web_url = info["zmq_url"], info["web_url"]
-
-        import meshcat
-
-        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; the CLI says it itself
-            self.viewer = meshcat.Visualizer(zmq_url=self.zmq_url)
-
-    def close(self):
-        self.proc.terminate()
-        try:
-            self.proc.wait(timeout=5)
-        except subprocess.TimeoutExpired:  # pragma: no cover
-            self.proc.kill()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def chromium():

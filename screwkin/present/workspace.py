@@ -187,8 +187,8 @@ def workspace_cloud(r: WorkspaceResult, viewer, size=None):
     colors[~r.free] = 0.6
     points = g.PointCloud(position=r.positions.T.astype(np.float32), color=colors.T.astype(np.float32),
                           size=float(size or r.resolution * 0.6))
-    viewer["workspace/points"].set_object(points)
+    viewer["screwkin/workspace/points"].set_object(points)
     if len(r.boundary):
-        viewer["workspace/boundary"].set_object(g.PointCloud(
+        viewer["screwkin/workspace/boundary"].set_object(g.PointCloud(
             position=r.boundary.T.astype(np.float32), color=np.zeros((3, len(r.boundary)), np.float32),
             size=float(size or r.resolution * 0.3)))

@@ -1,0 +1,196 @@
+"""``view --interactive``: the mechanism in the browser with a control per input, through viser
+(an optional package: ``pip install viser``, the ``view`` extra), which serves its own client
+page (no CDN: it works offline) and calls Python back as a control moves.
+
+Why viser rather than meshcat and a page of our own: viser has the GUI controls (sliders,
+dropdowns, text) with Python callbacks, and Pinocchio 4.1 ships a ViserVisualizer that draws a
+GeometryModel (screwkin's scene) into it; meshcat would need a hand-written page and a second
+channel for the controls.
+
+The logic (inputs -> configuration, modes, singularity, limit positions) is
+:class:`screwkin.analysis.interactive.Interactive`; this module only wires it to the controls:
+a slider per input labelled with the joint's name over its range (degrees or millimetres), a
+dropdown of the assembly modes at the current inputs, a status line (a warning near a
+singularity, the reason a move was refused: the slider goes back), and a readout of the output
+pose and of the named points.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import socket
+import threading
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import UsageError
+from .view import fit_camera, view_direction
+from .viewplanar import planar_basis
+
+__all__ = ["InteractiveView", "viser_module"]
+
+
+def viser_module():
+    """viser, or a usage error saying how to install it."""
+    try:
+        import viser
+    except ImportError:
+        raise UsageError("view --interactive needs viser: pip install viser (or pip install 'screwkin[view]')") from None
+    return viser
+
+
+def _visualizer_class():
+    import coal
+    import trimesh
+    from pinocchio.visualize import ViserVisualizer
+
+    class Visualizer(ViserVisualizer):
+        """Pinocchio's ViserVisualizer, which also draws cones (screwkin's arrow heads)."""
+
+        def loadViewerGeometryObject(self, geometry_object, prefix="", color=None):
+            geom = geometry_object.geometry
+            if not isinstance(geom, coal.Cone):
+                return super().loadViewerGeometryObject(geometry_object, prefix, color)
+            name = f"{prefix}/{geometry_object.name}" if prefix else geometry_object.name
+            h = 2.0 * geom.halfLength
+            mesh = trimesh.creation.cone(radius=geom.radius, height=h)
+            mesh.apply_translation([0.0, 0.0, -0.5 * h])  # coal's cone is centred on its origin
+            c = color or geometry_object.meshColor
+            self.frames[name] = self.viewer.scene.add_mesh_simple(name, mesh.vertices, mesh.faces, color=c[:3],
+                                                                  opacity=c[3])
+
+    return Visualizer
+
+
+def _shown(value, unit) -> float:
+    return value * 1000.0 if unit == "m" else math.degrees(value)
+
+
+def _si(shown, unit) -> float:
+    return shown / 1000.0 if unit == "m" else math.radians(shown)
+
+
+class InteractiveView:
+    """The viser server of ``view --interactive`` (127.0.0.1 only) for an Interactive state and
+    a scene (screwkin.present.view.build_scene); ``port``: default 8080.  The controls are
+    ``sliders`` (input name -> slider), ``modes`` (the dropdown), ``status`` and ``readout``."""
+
+    def __init__(self, mech, live, scene, port: int | None = None, title: str = "screwkin"):
+        viser = viser_module()
+        self.mech, self.live = mech, live
+        if port is not None:  # viser takes the next free port when the one asked is in use: check it first
+            with socket.socket() as probe:
+                try:
+                    probe.bind(("127.0.0.1", port))
+                except OSError as exc:
+                    raise UsageError(f"port {port} cannot be used on 127.0.0.1: {exc.strerror or exc}") from None
+        with contextlib.redirect_stdout(io.StringIO()):  # viser's banner: the command says the URL itself
+            self.server = viser.ViserServer(host="127.0.0.1", port=port or 8080, label=title, verbose=False)
+        self.port = self.server.get_port()
+        if port is not None and self.port != port:  # taken between the check and the server's start
+            self.close()
+            raise UsageError(f"port {port} cannot be used on 127.0.0.1: it was taken")
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.server.scene.configure_environment_map(None)  # the presets are sent on demand: none is needed
+        self.viz = _visualizer_class()(mech.model, pin.GeometryModel(), scene.geometry)
+        self.viz.initViewer(viewer=self.server, open=False)
+        self.viz.loadViewerModel(rootNodeName="screwkin")
+        self._camera(scene, planar_basis(mech, live.state.q))
+        self._lock = threading.RLock()
+        self._busy = False
+        gui = self.server.gui
+        self.sliders = {}
+        for c in live.controls:
+            unit = "mm" if c.unit == "m" else "deg"
+            lo, hi = _shown(c.low, c.unit), _shown(c.high, c.unit)
+            step = 0.1 if c.unit == "rad" else max((hi - lo) / 1000.0, 1e-3)
+            slider = gui.add_slider(c.name, min=lo, max=hi, step=step,
+                                    initial_value=float(np.clip(_shown(live.state.inputs[c.name], c.unit), lo, hi)),
+                                    hint=f"{c.name} [{unit}]")
+            slider.on_update(self._moved(c.name, c.unit))
+            self.sliders[c.name] = slider
+        self.modes = gui.add_dropdown("assembly mode", self._mode_names(), initial_value=self._mode_name())
+        self.modes.on_update(self._switched)
+        self.status = gui.add_markdown("")
+        self.readout = gui.add_markdown("")
+        self._show()
+
+    def _camera(self, scene, basis):
+        """The first view: the mechanism framed (fit_camera, as view's pictures), along the plane's
+        normal for a planar mechanism (its drawing's y up), else from view's usual direction."""
+        pts = scene.points if scene.points is not None else scene.center[None]
+        direction = np.asarray(basis[2], float) if basis is not None else view_direction(scene.bounds)
+        target, eye = fit_camera(pts, direction, aspect=1.5)
+        cam = self.server.initial_camera
+        cam.look_at = tuple(float(v) for v in target)
+        cam.position = tuple(float(v) for v in eye)
+        cam.up = tuple(float(v) for v in (basis[1] if basis is not None else (0.0, 0.0, 1.0)))
+        dist = float(np.linalg.norm(eye - target))
+        cam.near, cam.far = dist / 100, dist * 100
+
+    # ------------------------------------------------------------------ callbacks
+    def _mode_names(self) -> list:
+        return [f"mode {k}" for k in range(1, self.live.state.modes + 1)] or ["mode 1"]
+
+    def _mode_name(self) -> str:
+        return f"mode {max(self.live.state.mode, 1)}"
+
+    def _moved(self, name, unit):
+        def callback(event):
+            with self._lock:
+                if self._busy:
+                    return
+                self._busy = True
+                try:
+                    self.live.move(name, _si(float(self.sliders[name].value), unit))
+                    if not self.live.state.moved:  # refused: the slider goes back to where the mechanism is
+                        self.sliders[name].value = _shown(self.live.state.inputs[name], unit)
+                    self._show()
+                finally:
+                    self._busy = False
+        return callback
+
+    def _switched(self, event):
+        with self._lock:
+            if self._busy:
+                return
+            self._busy = True
+            try:
+                self.live.switch(int(str(self.modes.value).split()[-1]))
+                self._show()
+            finally:
+                self._busy = False
+
+    # ------------------------------------------------------------------ display
+    def _show(self):
+        s = self.live.state
+        self.viz.display(s.q)
+        names = self._mode_names()
+        if list(self.modes.options) != names:
+            self.modes.options = names
+        if self.modes.value != self._mode_name():
+            self.modes.value = self._mode_name()
+        lines = []
+        if s.message:
+            lines.append(f"**stopped:** {s.message}")
+        if s.singular:
+            lines.append(f"**warning: singular configuration** (relative sigma_min {s.sigma:.2g} below "
+                         f"{self.mech.tolerances.singular:g})")
+        lines.append(f"relative sigma_min {s.sigma:.3g}; assembly mode {s.mode or '?'} of {s.modes}")
+        self.status.content = "  \n".join(lines)
+        out = []
+        if s.output_pose is not None:
+            p = s.output_pose[:3, 3] * 1000.0
+            rpy = np.degrees(pin.rpy.matrixToRpy(s.output_pose[:3, :3]))
+            out.append(f"**{self.live.output}**: x {p[0]:.2f}, y {p[1]:.2f}, z {p[2]:.2f} mm; "
+                       f"roll {rpy[0]:.2f}, pitch {rpy[1]:.2f}, yaw {rpy[2]:.2f} deg")
+        for name, p in s.points.items():
+            out.append(f"**{name}**: x {p[0] * 1000:.2f}, y {p[1] * 1000:.2f}, z {p[2] * 1000:.2f} mm")
+        self.readout.content = "  \n".join(out)
+
+    def close(self):
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.server.stop()

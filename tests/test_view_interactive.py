@@ -1,0 +1,248 @@
+"""view --interactive (issue 27.1): the state behind the controls (screwkin.analysis.interactive)
+and the viser page wired to it.  A control moved gives the configuration `solve` gives at that
+input, on the assembly mode the mechanism was in (the sign of the triangle B C D of the
+four-bar, written here); switching modes keeps every loop closed (the two frames of each cut
+joint coincide, read from Pinocchio's kinematics); a limit position (law of cosines) stops a
+move and leaves the mechanism where it was."""
+
+import math
+import socket
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import screwkin
+from conftest import ROBOTS
+from screwkin.analysis.interactive import Interactive
+from screwkin.analysis.motion import Point
+from screwkin.analysis.position import PositionSolver
+
+FOURBAR = ROBOTS / "fourbar_crank_rocker.urdf"
+NON_GRASHOF = ROBOTS / "fourbar_non_grashof.urdf"  # input 0.08 drawn at 70 deg, ground 0.1, coupler 0.09, output 0.075
+LIMIT = math.degrees(math.acos((0.08 ** 2 + 0.1 ** 2 - 0.165 ** 2) / (2 * 0.08 * 0.1))) - 70  # coupler, output in line
+
+
+def cut_gaps(mech, q) -> list:
+    """Distance between the two frames of every cut joint [m] (0 when the loop is closed)."""
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    return [float(np.linalg.norm(data.oMf[c.frame1].translation - data.oMf[c.frame2].translation)) for c in mech.cuts]
+
+
+def branch(mech, q) -> float:
+    """The four-bar's assembly mode: the sign of the triangle B (crank tip), C (coupler-rocker pin), D (rocker pivot)."""
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, q)
+    B = data.oMi[mech.model.getJointId("coupler_joint")].translation
+    D = data.oMi[mech.model.getJointId("rocker_joint")].translation
+    C = data.oMf[mech.cuts[0].frame1].translation
+    return float(np.sign(np.cross(C - B, D - B)[2]))
+
+
+def same_configuration(mech, q1, q2) -> bool:
+    a, b = mech.joint_values(q1), mech.joint_values(q2)
+    return all(abs(math.remainder(a[k] - b[k], 2 * math.pi)) < 1e-7 for k in a)
+
+
+@pytest.fixture(scope="module")
+def fourbar():
+    return screwkin.load(FOURBAR)
+
+
+@pytest.mark.parametrize("mode", [1, 2])
+def test_moving_a_control_gives_solves_configuration_on_the_same_mode(fourbar, mode):
+    mech = fourbar
+    live = Interactive(mech, mode=mode)
+    sign = branch(mech, live.state.q)
+    for value in (1.0, 2.5, -2.0, 0.3):  # a crank turns: back and forth over most of a turn
+        s = live.move("crank_joint", value)
+        assert s.moved and s.message is None
+        assert s.inputs == {"crank_joint": value}
+        sols = PositionSolver(mech).solve({"crank_joint": value}).solutions
+        assert len(sols) == 2
+        match = [k for k, sol in enumerate(sols) if same_configuration(mech, sol.q, s.q)]
+        assert len(match) == 1  # one of solve's configurations at this input ...
+        assert branch(mech, sols[match[0]].q) == sign  # ... the one on the mode it started on
+        assert s.mode == match[0] + 1 and s.modes == 2
+        assert max(cut_gaps(mech, s.q)) < 1e-9
+
+
+def test_a_five_bar_moves_each_input_on_its_own():
+    mech = screwkin.load(ROBOTS / "five_bar.urdf")
+    live = Interactive(mech, output="tip")
+    start = dict(live.state.inputs)
+    s = live.move("motor1", start["motor1"] + 0.2)
+    assert s.moved and s.inputs["motor2"] == start["motor2"]
+    sols = PositionSolver(mech).solve(dict(s.inputs)).solutions
+    assert any(same_configuration(mech, sol.q, s.q) for sol in sols)
+    assert max(cut_gaps(mech, s.q)) < 1e-9
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, s.q)
+    np.testing.assert_allclose(s.output_pose, data.oMf[mech.link_frame("tip")].homogeneous, atol=1e-12)
+
+
+@pytest.mark.parametrize("path", [FOURBAR, ROBOTS / "five_bar.urdf", ROBOTS / "gough_stewart_6ups.urdf"])
+def test_switching_modes_keeps_the_loops_closed(path):
+    mech = screwkin.load(path)
+    live = Interactive(mech)
+    assert live.state.modes >= 2
+    for k in range(live.state.modes, 0, -1):
+        s = live.switch(k)
+        assert s.mode == k and s.moved
+        assert max(cut_gaps(mech, s.q)) < 1e-8
+        joints = mech.joint_values(s.q)
+        for name, value in live.state.inputs.items():  # the inputs stay where they were
+            assert abs(math.remainder(joints[name] - value, 2 * math.pi)) < 1e-9
+    assert not live.switch(live.state.modes + 1).moved
+
+
+def test_a_limit_position_stops_the_move_and_nothing_moves():
+    mech = screwkin.load(NON_GRASHOF)
+    live = Interactive(mech)
+    before = live.state
+    s = live.move("input_joint", math.radians(90))
+    assert not s.moved
+    assert f"stopped at {LIMIT:.6g} deg" in s.message and "limit position" in s.message
+    np.testing.assert_array_equal(s.q, before.q)
+    assert s.inputs == before.inputs
+    ok = live.move("input_joint", math.radians(LIMIT - 5))  # short of it: it moves
+    assert ok.moved and ok.message is None and not ok.singular
+
+
+def test_the_warning_comes_at_the_limit_position():
+    """Started at the limit position itself (the law of cosines' value): singular, and it moves away."""
+    mech = screwkin.load(NON_GRASHOF)
+    live = Interactive(mech, values={"input_joint": math.radians(LIMIT)})
+    assert live.state.singular and live.state.sigma < mech.tolerances.singular
+    s = live.move("input_joint", math.radians(LIMIT - 20))
+    assert s.moved and not s.singular and s.sigma > 100 * mech.tolerances.singular
+
+
+def test_points_are_read_out_where_the_link_puts_them(fourbar):
+    mech = fourbar
+    live = Interactive(mech, output="rocker", points=[Point("P", "coupler", (0.06, 0.02, 0.0))])
+    s = live.move("crank_joint", 1.2)
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, s.q)
+    np.testing.assert_allclose(s.points["P"], data.oMf[mech.link_frame("coupler")].act(np.array([0.06, 0.02, 0.0])),
+                               atol=1e-12)
+
+
+def test_controls_span_the_limits_or_a_turn(fourbar):
+    (c,) = Interactive(fourbar).controls
+    assert c.name == "crank_joint" and c.unit == "rad"
+    assert c.high - c.low == pytest.approx(2 * math.pi)  # the file's limits span more than a turn: a turn
+    stewart = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
+    controls = Interactive(stewart).controls
+    assert [c.name for c in controls] == list(stewart.actuated)
+    for c in controls:
+        k = stewart.coordinate(c.name).idx_q
+        assert c.unit == "m"
+        assert (c.low, c.high) == (stewart.model.lowerPositionLimit[k], stewart.model.upperPositionLimit[k])
+
+
+# ----------------------------------------------------------------------------- the viser page
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def page(fourbar):
+    pytest.importorskip("viser")
+    from screwkin.present.interactive import InteractiveView
+    from screwkin.present.view import build_scene
+
+    live = Interactive(fourbar, output="rocker")
+    view = InteractiveView(fourbar, live, build_scene(fourbar, live.state.q), port=free_port())
+    yield view
+    view.close()
+
+
+def test_the_page_has_a_control_per_input_and_moves_the_mechanism(page, fourbar):
+    assert list(page.sliders) == ["crank_joint"]
+    slider = page.sliders["crank_joint"]
+    slider.value = 60.0  # degrees, as the page shows them: callbacks run as when the browser moves it
+    s = page.live.state
+    assert s.moved and s.inputs["crank_joint"] == pytest.approx(math.radians(60))
+    sols = PositionSolver(fourbar).solve({"crank_joint": math.radians(60)}).solutions
+    assert same_configuration(fourbar, sols[0].q, s.q)
+    assert "rocker" in page.readout.content
+    page.modes.value = "mode 2"
+    assert page.live.state.mode == 2 and max(cut_gaps(fourbar, page.live.state.q)) < 1e-8
+
+
+def test_a_refused_move_puts_the_slider_back():
+    pytest.importorskip("viser")
+    mech = screwkin.load(NON_GRASHOF)
+    from screwkin.present.interactive import InteractiveView
+    from screwkin.present.view import build_scene
+
+    live = Interactive(mech)
+    view = InteractiveView(mech, live, build_scene(mech, live.state.q), port=free_port())
+    try:
+        view.sliders["input_joint"].value = 90.0
+        assert not live.state.moved
+        assert view.sliders["input_joint"].value == pytest.approx(0.0)
+        assert "stopped" in view.status.content and "limit position" in view.status.content
+    finally:
+        view.close()
+
+
+def test_the_page_is_served_offline_on_loopback(page):
+    from urllib.request import urlopen
+
+    from test_view import listening
+
+    assert listening(page.port) == ["0100007F"]
+    with urlopen(page.url, timeout=10) as r:
+        html = r.read().decode()
+    assert "<html" in html.lower()
+    assert "<script src=\"http" not in html and "<link rel=\"stylesheet\" href=\"http" not in html  # nothing fetched
+
+
+def test_a_port_in_use_is_refused(fourbar):
+    pytest.importorskip("viser")
+    from screwkin.errors import UsageError
+    from screwkin.present.interactive import InteractiveView
+    from screwkin.present.view import build_scene
+
+    live = Interactive(fourbar)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        with pytest.raises(UsageError, match="cannot be used"):
+            InteractiveView(fourbar, live, build_scene(fourbar, live.state.q), port=s.getsockname()[1])
+
+
+@pytest.mark.slow
+def test_the_page_loads_offline_in_chromium_with_a_control_per_input(tmp_path):
+    """Headless Chromium, every host name but the loopback address unresolvable: the page
+    viser serves builds its controls, one named after each input of the five-bar."""
+    import subprocess
+
+    from screwkin.present.view import chromium
+
+    if chromium() is None:
+        pytest.skip("Chromium is not installed (.ci/run installs it)")
+    pytest.importorskip("viser")
+    from screwkin.present.interactive import InteractiveView
+    from screwkin.present.view import build_scene
+
+    mech = screwkin.load(ROBOTS / "five_bar.urdf")
+    live = Interactive(mech, output="tip")
+    view = InteractiveView(mech, live, build_scene(mech, live.state.q), port=free_port())
+    try:
+        p = subprocess.run([chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+                            "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
+                            "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
+                            f"--user-data-dir={tmp_path}", "--virtual-time-budget=15000", "--dump-dom", view.url],
+                           capture_output=True, text=True, timeout=120)
+    finally:
+        view.close()
+    dom = p.stdout
+    for name in ("motor1", "motor2", "assembly mode", "relative sigma_min", "tip"):
+        assert name in dom, name
