@@ -17,7 +17,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
 from ..model.state import KinematicState
@@ -128,7 +127,7 @@ class Interactive:
         c = self.solver._signature(q)
         d = [float(np.linalg.norm(self.solver._signature(m) - c)) for m in modes]
         k = int(np.argmin(d)) if d else -1
-        return k + 1 if k >= 0 and d[k] <= 1e-6 * self.mech.length * math.sqrt(max(len(c), 1)) else 0
+        return k + 1 if k >= 0 and d[k] <= self.mech.tolerances.geometry * self.mech.length * math.sqrt(max(len(c), 1)) else 0
 
     # ------------------------------------------------------------------ state
     def _state(self, q, mode=None, moved=True, message=None) -> LiveState:
@@ -139,8 +138,7 @@ class Interactive:
         sigma = float(min(m["actuator"], m["constraint"])) if g.rank_K or g.rank_Kp else 1.0
         pose = None
         if self.output is not None:
-            pin.framesForwardKinematics(mech.model, mech.data, q)
-            pose = mech.data.oMf[mech.link_frame(self.output)].homogeneous.copy()
+            pose = KinematicState(mech, q).link_pose(self.output)
         points = {}
         if self.points:
             st = KinematicState(mech, q)

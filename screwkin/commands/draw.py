@@ -263,7 +263,7 @@ def _animate(mech, args) -> int:
     res = sweep(PositionSolver(mech, input_names), name, start, stop, steps, fixed=fixed, near=near)
     linear = res.unit == "m"
     qs, values = list(res.q), list(res.values)
-    limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= 1e-9), None)
+    limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= mech.tolerances.equal), None)
     if limit is not None:  # the last frame: the mechanism at the limit position itself
         qs.append(limit.q)
         values.append(limit.input)

@@ -262,7 +262,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
     model = mech.model
     geom = _visual_geometry(mech, warn)
     roles = {o.name: "link" for o in geom.geometryObjects}
-    data = mech.data
+    data = mech.scratch_data()
     pin.framesForwardKinematics(model, data, q)
     pts = np.array([data.oMi[j].translation for j in range(model.njoints)])
     scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
@@ -337,7 +337,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
             add(_segment(f"screwkin/output/{axis}", fr.parentJoint, fid, fr.placement.translation, end, r_axis,
                          COLORS[axis]), f"output:{axis}")
     for k, (qs, twist) in enumerate(singular):
-        d = mech.data
+        d = mech.scratch_data()
         pin.framesForwardKinematics(model, d, qs)
         if output is not None:
             add(_ball(f"screwkin/singular/{k}/marker", 0, 0, d.oMf[mech.link_frame(output)].translation, 4 * r_axis,
