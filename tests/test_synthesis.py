@@ -11,6 +11,7 @@ import pytest
 from conftest import circles
 
 import screwkin
+from screwkin.analysis.skeleton import numbering
 from screwkin.analysis.synthesis.check import check_design
 from screwkin.analysis.synthesis.designs import Dyad
 from screwkin.analysis.synthesis.function import parse_function
@@ -343,8 +344,8 @@ def test_slider_crank_family_and_written_chains(tmp_path, capsys):
     assert d["count"] == 1 and d["chains"][0]["name"].startswith("slider-crank")
     joints = d["chains"][0]["joints"]
     assert sorted(j["type"] for j in joints) == ["P", "R", "R", "R"]
-    # as a graph the slider and its guide are alike: two inversions (textbooks draw four)
-    assert d["mechanisms"] == 2 and d["valid"] and len(d["files"]) == 2
+    # a slide's guide and block are different elements: the four textbook inversions
+    assert d["mechanisms"] == 4 and d["valid"] and len(d["files"]) == 4
     two = run_json(capsys, ["synthesize", "chains", "--links", "4", "--dof", "1", "--prismatic", "2"])
     assert two["count"] == 2  # RRPP (sliders adjacent) and RPRP
     # every written mechanism loads, is drawn closed and has mobility 1 by screwkin's constraint rank
@@ -355,6 +356,32 @@ def test_slider_crank_family_and_written_chains(tmp_path, capsys):
         r = mech.mobility()
         assert mech.assemble().iterations == 0 and r.mobility == 1
         assert r.topology.loops == len(mech.cuts)  # one loop joint per independent loop
+        # the file's link names are the numbers screwkin draw gives the links (the ground link1)
+        number, _, _ = numbering(r.topology, list(mech.actuated))
+        assert all(name == f"link{k}" for name, k in number.items()), number
+
+
+def test_slide_inversions_are_the_textbooks(capsys):
+    """Slider-crank chain: frame (the guide), crank (next to the frame), coupler (next to the block)
+    and block grounded -- four mechanisms; double slider with adjacent slides: the guide of both
+    (elliptical trammel), a block (Scotch yoke), the link joining the blocks (Oldham coupling)."""
+    d = run_json(capsys, ["synthesize", "chains", "--links", "4", "--dof", "1", "--prismatic", "1"])
+    chain = d["chains"][0]
+    (u, v), guide = next((tuple(j["links"]), j["guide"]) for j in chain["joints"] if j["type"] == "P")
+    block = v if guide == u else u
+    neighbours = {x: {y for j in chain["joints"] for y in j["links"] if x in j["links"] and y != x} for x in range(4)}
+    crank = next(x for x in neighbours[guide] if x != block)
+    coupler = next(x for x in neighbours[block] if x != guide)
+    assert sorted(m["ground"] for m in chain["mechanisms"]) == sorted([guide, crank, coupler, block])
+    d = run_json(capsys, ["synthesize", "chains", "--links", "4", "--dof", "1", "--prismatic", "2"])
+    rrpp = next(c for c in d["chains"] if "adjacent" in c["name"])
+    slides = [j for j in rrpp["joints"] if j["type"] == "P"]
+    common = slides[0]["guide"]
+    assert all(j["guide"] == common for j in slides)  # the link carrying both slides guides them
+    blocks = {x for j in slides for x in j["links"] if x != common}
+    rod = ({0, 1, 2, 3} - blocks - {common}).pop()
+    grounds = [m["ground"] for m in rrpp["mechanisms"]]
+    assert len(grounds) == 3 and common in grounds and rod in grounds and len(blocks & set(grounds)) == 1
 
 
 # ------------------------------------------------------------------ the command line

@@ -20,6 +20,7 @@ from ..analysis.synthesis.designs import (
     MotionResult,
     PathResult,
 )
+from ..analysis.synthesis.chains import guides_of
 from ..analysis.synthesis.fourbar import tool_local
 from .report import table, to_jsonable
 from .tables import shown
@@ -233,10 +234,12 @@ def chains_dict(result: ChainsResult, directory=None) -> dict:
                           "file": f.file if f else None, "mobility": f.mobility if f else None,
                           "assembled_iterations": f.assembled_iterations if f else None,
                           "problem": f.problem if f else None})
+        guides = guides_of(c.links, c.joints)
         chains.append({"index": c.index, "name": c.name, "links": c.links,
-                       "joints": [{"links": [u, v], "type": k} for u, v, k in c.joints],
+                       "joints": [{"links": [u, v], "type": k, **({"guide": guides[(u, v)]} if k == "P" else {})}
+                                  for u, v, k in c.joints],
                        "joints_per_link": list(c.degrees), "automorphisms": c.automorphisms, "mechanisms": mechs})
-    defects = [f"chain {f.chain}, ground link{f.ground}: {f.problem}" for f in result.files if f.problem]
+    defects = [f"chain {f.chain}, chain link {f.ground} grounded: {f.problem}" for f in result.files if f.problem]
     return to_jsonable({
         "kind": "chains", "file": None if directory is None else str(directory), "links": {}, "pivots": {},
         "precision": [], "grashof": None, "transmission_angle_range": None, "defects": defects,
@@ -257,13 +260,14 @@ def chains_text(result: ChainsResult, directory=None) -> str:
            f"{'s' if d['mechanisms'] != 1 else ''} (inversions: a ground link per class of links under the chain's "
            "automorphisms)"]
     for c in d["chains"]:
-        joints = " ".join(f"{j['links'][0]}-{j['links'][1]}{'' if j['type'] == 'R' else '(P)'}" for j in c["joints"])
+        joints = " ".join(f"{j['links'][0]}-{j['links'][1]}" + ("" if j["type"] == "R" else f"(P, guide {j['guide']})")
+                          for j in c["joints"])
         out.append(f"  {c['index']:>3}. {c['name']}: joints {joints}; {c['automorphisms']} automorphism"
                    f"{'s' if c['automorphisms'] != 1 else ''}; grounds {', '.join(str(m['ground']) for m in c['mechanisms'])}")
         for m in c["mechanisms"]:
             if m["file"]:
                 status = f"mobility {m['mobility']}" + (f"  PROBLEM: {m['problem']}" if m["problem"] else ", drawn closed")
-                out.append(f"        ground link{m['ground']}: {m['file']} ({status})")
+                out.append(f"        chain link {m['ground']} grounded: {m['file']} ({status})")
     if result.files:
         out.append(f"wrote {len(result.files)} files to {directory}, each loaded and checked with screwkin "
                    "(drawn closed, mobility by the constraint rank)")

@@ -22,9 +22,14 @@ chain's automorphisms; an assignment is dropped when a loop of the chain has few
 revolute joints (the loop could not turn: its one revolute joint, or all, would be locked).
 
 The mechanisms of a chain are its inversions: a choice of ground link, up to the chain's
-automorphisms (links in one orbit make the same mechanism).  Counted on the graph, so the
-slider-crank chain has two (grounding a link beside the slider is, as a graph, the same as
-grounding the slider; textbooks count four, telling the slider from its guide by shape).
+automorphisms (links in one orbit make the same mechanism).  A prismatic joint has two
+different elements, as textbooks draw them: the guide (a slot or rod) and the block sliding in
+it; the automorphisms keep each block a block, so the slider-crank chain has its four
+inversions (frame, crank, coupler or block grounded) and the double-slider chain with adjacent
+sliders its three (elliptical trammel: the guide of both blocks grounded; Scotch yoke: a
+block; Oldham coupling: the link joining the blocks).  Each guide is the end of its joint with
+more prismatic joints on it (then more joints, then the lower link number): the link that
+carries two slides is their common guide.
 
 Each mechanism is described for a file (screwkin.files.writer) with generic proportions:
 the links placed by a seeded spring layout of the graph, each joint near the middle of the
@@ -44,7 +49,7 @@ from ...errors import UsageError
 from ...files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
 from .designs import Chain, ChainsResult
 
-__all__ = ["enumerate_chains", "chain_linkage", "MAX_LINKS"]
+__all__ = ["enumerate_chains", "chain_linkage", "guides_of", "MAX_LINKS"]
 
 #: The largest chain enumerated (10 links, F = 1: 230 chains, already some seconds).
 MAX_LINKS = 10
@@ -121,10 +126,24 @@ def _invariant(g):
     return tuple(sorted((deg[v], tuple(sorted(deg[u] for u in g[v]))) for v in g.nodes))
 
 
-def _automorphisms(g, kinds=None):
-    """Every automorphism of chain g (node permutations as dicts), keeping joint kinds."""
-    from networkx.algorithms.isomorphism import GraphMatcher, categorical_edge_match
+def _automorphisms(g, kinds=None, guides=None):
+    """Every automorphism of chain g (node permutations as dicts), keeping joint kinds and, with
+    ``guides`` (prismatic joint -> its guide link), which element of each prismatic joint is the
+    guide and which the block."""
+    import networkx as nx
+    from networkx.algorithms.isomorphism import DiGraphMatcher, GraphMatcher, categorical_edge_match
 
+    if guides is not None:
+        d = nx.DiGraph()
+        d.add_nodes_from(g.nodes)
+        for (u, v), k in kinds.items():
+            if k == "P":
+                guide = guides[(u, v)]
+                d.add_edge(guide, v if guide == u else u, kind="P")  # guide -> block
+            else:
+                d.add_edge(u, v, kind="R")
+                d.add_edge(v, u, kind="R")
+        return list(DiGraphMatcher(d, d, edge_match=categorical_edge_match("kind", "R")).isomorphisms_iter())
     if kinds is not None:
         for (u, v), k in kinds.items():
             g.edges[u, v]["kind"] = k
@@ -132,6 +151,18 @@ def _automorphisms(g, kinds=None):
     else:
         matcher = GraphMatcher(g, g)
     return list(matcher.isomorphisms_iter())
+
+
+def guides_of(links: int, joints) -> dict:
+    """Prismatic joint (u, v) -> its guide link (the module docstring's rule)."""
+    slides, degree = [0] * links, [0] * links
+    for u, v, k in joints:
+        degree[u] += 1
+        degree[v] += 1
+        if k == "P":
+            slides[u] += 1
+            slides[v] += 1
+    return {(u, v): max((u, v), key=lambda x: (slides[x], degree[x], -x)) for u, v, k in joints if k == "P"}
 
 
 def _orbits(n, autos):
@@ -199,7 +230,8 @@ def enumerate_chains(links: int, dof: int, prismatic: int = 0) -> ChainsResult:
                     continue
                 assignments.append({e: ("P" if e in p else "R") for e in edges})
         for kinds in assignments:
-            autos = _automorphisms(_graph(links, edges), kinds if prismatic else None)
+            guides = guides_of(links, [(u, v, kinds[(u, v)]) for u, v in edges]) if prismatic else None
+            autos = _automorphisms(_graph(links, edges), kinds if prismatic else None, guides)
             orbits = _orbits(links, autos)
             chains.append(Chain(len(chains) + 1, _name(links, degrees, edges, kinds), links,
                                 tuple((u, v, kinds[(u, v)]) for u, v in edges), degrees, len(autos),
@@ -207,11 +239,30 @@ def enumerate_chains(links: int, dof: int, prismatic: int = 0) -> ChainsResult:
     return ChainsResult(links, dof, prismatic, joints, tuple(chains), (), looked)
 
 
+def _drawing_numbers(ground: int, joints) -> dict:
+    """Chain link -> the number screwkin's drawings give it (analysis.skeleton.numbering: the
+    ground 1, then a depth-first walk from it over the joints in their order -- inputs first,
+    then tree joints, then loop joints)."""
+    number = {ground: 1}
+
+    def visit(link):
+        for u, v in joints:
+            if link in (u, v):
+                other = v if link == u else u
+                if other not in number:
+                    number[other] = len(number) + 1
+                    visit(other)
+
+    visit(ground)
+    return number
+
+
 def chain_linkage(chain: Chain, ground: int, size: float = 0.1, seed: int = 0, dof: int = 1) -> PlanarLinkage:
     """The file description of ``chain`` with link ``ground`` fixed (see the module docstring):
-    links 'link0' ... (the ground keeps its number), tree joints 'j<u>_<v>' from a
-    breadth-first spanning tree from the ground, loop joints for the other joints; the
-    first ``dof`` joints on the ground are actuated."""
+    links 'link1' ... numbered as screwkin draw numbers them (the ground link1), tree joints
+    'j<u>_<v>' (chain link numbers) from a breadth-first spanning tree from the ground, loop joints
+    for the other joints; the first ``dof`` joints on the ground are actuated; each prismatic
+    joint's block drawn as a block around it."""
     import networkx as nx
 
     n = chain.links
@@ -227,7 +278,6 @@ def chain_linkage(chain: Chain, ground: int, size: float = 0.1, seed: int = 0, d
         points[(u, v)] = mid + rng.normal(scale=0.2 * span, size=2)
         a = rng.uniform(0, np.pi)
         axes[(u, v)] = (math.cos(a), math.sin(a), 0.0)
-    name = lambda v: f"link{v}"  # noqa: E731
     origin = {ground: np.zeros(2)}
     parent_joint = {}
     order = [ground]
@@ -238,17 +288,31 @@ def chain_linkage(chain: Chain, ground: int, size: float = 0.1, seed: int = 0, d
         origin[v] = points[e]
         parent_joint[v] = (u, e)
         order.append(v)
+    tree_order = [parent_joint[v][1] for v in order[1:]]
+    on_ground = sorted((e for e in tree_order if ground in e), key=lambda e: kinds[e] != "R")
+    actuated_edges = on_ground[:dof]
+    number = _drawing_numbers(ground, actuated_edges + [e for e in tree_order if e not in actuated_edges]
+                              + [e for e in sorted(points) if e not in tree])
+    name = lambda v: f"link{number[v]}"  # noqa: E731 - the number screwkin draw gives the link
+    guides = guides_of(n, chain.joints)
+    blocks = {}  # link -> the point of a prismatic joint it is the block of
+    for e, guide in guides.items():
+        block = e[1] if guide == e[0] else e[0]
+        blocks.setdefault(block, e)
     link_points = {v: [] for v in g.nodes}
+    for v, e in blocks.items():  # a block is drawn around its first point: its slide's
+        link_points[v].append(tuple(points[e] - origin[v]))
     for v in g.nodes:
         if v != ground:
-            link_points[v].append(tuple(points[parent_joint[v][1]] - origin[v]))
+            q = tuple(points[parent_joint[v][1]] - origin[v])
+            if q not in link_points[v]:
+                link_points[v].append(q)
     for e, p in points.items():
         for v in e:
             q = tuple(p - origin[v])
             if q not in link_points[v]:
                 link_points[v].append(q)
-    links = [PlanarLink(name(v), tuple(link_points[v]), slider=(v != ground and kinds[parent_joint[v][1]] == "P"))
-             for v in order]
+    links = [PlanarLink(name(v), tuple(link_points[v]), slider=v in blocks) for v in order]
     joints, loops = [], []
     for v in order[1:]:
         u, e = parent_joint[v]
@@ -264,12 +328,14 @@ def chain_linkage(chain: Chain, ground: int, size: float = 0.1, seed: int = 0, d
         loops.append(PlanarLoopJoint(f"j{u}_{v}", jt, name(u), tuple(points[e] - origin[u]), name(v),
                                      tuple(points[e] - origin[v]), 0.0, 0.0,
                                      axes[e] if jt == "prismatic" else (0.0, 0.0, 1.0)))
-    on_ground = [j for j in joints if j.parent == name(ground)]
-    on_ground.sort(key=lambda j: j.type != "revolute")
-    actuated = tuple(j.name for j in on_ground[:dof])
+    actuated = tuple(f"j{e[0]}_{e[1]}" for e in actuated_edges)
+    slides = "; ".join(f"j{u}_{v}: {name(guides[(u, v)])} is the guide, {name(v if guides[(u, v)] == u else u)} "
+                       "the block" for u, v, k in chain.joints if k == "P")
     comment = (f"{chain.name}: {n} links, {len(chain.joints)} joints "
                f"({', '.join(f'{u}-{v} {k}' for u, v, k in chain.joints)}), written by screwkin synthesize chains\n"
-               f"with link{ground} as the ground (one of its {len(chain.inversions)} inversions) and generic "
-               f"proportions (seed {seed}), drawn closed.")
+               f"with chain link {ground} as the ground (one of its {len(chain.inversions)} inversions) and generic "
+               f"proportions (seed {seed}), drawn closed.\nLinks are named by the numbers screwkin draw gives them "
+               f"(the ground link1): " + ", ".join(f"chain link {v} = {name(v)}" for v in sorted(number))
+               + (f".\nSlides: {slides}." if slides else "."))
     return PlanarLinkage(f"chain{chain.index}_ground{ground}", tuple(links), tuple(joints), tuple(loops), actuated,
                          comment)
