@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import json
+import math
+
+import numpy as np
+import pytest
 
 from conftest import DATA
 from screwkin.cli import main
@@ -120,3 +124,45 @@ def test_a_position_inside_the_cranks_range_is_no_limit_defect(tmp_path, capsys)
     assert 1.19015 < room < 1.3
     assert not any("position 2" in x for x in d["defects"])
     assert any("position 3" in x for x in d["defects"])
+
+
+def test_inclined_guide_coordinates(capsys):
+    """item 18: a slider on a guide through O2 inclined 30 deg (crank 0.1 m, rod 0.3 m).  solve says the slider's
+    coordinate is a distance along the guide and gives the guide's angle; --start takes the textbook's horizontal
+    coordinate x4h of the slider's centre and turns it into the distance along the guide, x4 = x4h / cos 30 deg;
+    one Newton step from there is the one written out here."""
+    path = str(DATA / "student" / "inclined_slider_crank.urdf")
+    assert main(["solve", path, "--set", "O2=60deg"]) == 0
+    out = capsys.readouterr().out
+    assert "slide" in out and "along the guide at 30 deg" in out
+    assert main(["solve", path, "--set", "O2=60deg", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["solutions"][0]["guide_angles"]["slide"] == pytest.approx(math.pi / 6, abs=1e-12)
+    assert main(["solve", path, "--set", "O2=60deg", "--start", "rod=20deg,x4h=0.33", "--iterations", "1",
+                 "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    x4 = 0.33 / math.cos(math.pi / 6)
+    assert d["start"]["x4"] == pytest.approx(x4, abs=1e-12)
+    # the hand step: F = r2 e(t2) + r3 e(t3) - x4 u(30 deg), A = dF/d(t3, x4), dz = -A^-1 F
+    t2, t3, b = math.pi / 3, math.radians(20), math.pi / 6
+    F = np.array([0.1 * math.cos(t2) + 0.3 * math.cos(t3) - x4 * math.cos(b),
+                  0.1 * math.sin(t2) + 0.3 * math.sin(t3) - x4 * math.sin(b)])
+    A = np.array([[-0.3 * math.sin(t3), -math.cos(b)], [0.3 * math.cos(t3), -math.sin(b)]])
+    dz = np.linalg.solve(A, -F)
+    step = d["trace"][0]
+    np.testing.assert_allclose(step["residual"], F, rtol=0, atol=1e-12)
+    assert d["values"]["x4"] == pytest.approx(x4 + dz[1], abs=1e-12)
+
+
+
+def test_a_horizontal_guide_has_no_vertical_start(tmp_path, capsys):
+    """item 18: the vertical coordinate of a slider on a horizontal guide cannot say where along the guide it is."""
+    text = (DATA / "student" / "inclined_slider_crank.urdf").read_text()
+    path = tmp_path / "horizontal.urdf"
+    path.write_text(text.replace('rpy="0 0 0.5235987755982988"', 'rpy="0 0 0"'))
+    assert main(["solve", str(path), "--set", "O2=60deg", "--start", "rod=20deg,x4v=0.1"]) == 2
+    err = capsys.readouterr().err
+    assert "the guide of x4 is horizontal" in err and "x4h" in err
+    assert main(["solve", str(path), "--set", "O2=60deg", "--start", "rod=20deg,x4h=0.33", "--iterations", "1",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["start"]["x4"] == pytest.approx(0.33, abs=1e-12)

@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from ..model._pin import joint_axis
 from ..model.geometry import (circle_intersections, cross2, line_angle, line_circle, perpendicular_basis, plane_basis,
                               vector_angle)
 
@@ -317,6 +318,22 @@ class LinkAngles:
             else:
                 v = self._point(end) - self._point(start)
             out[link] = float(np.arctan2(v @ self.e2, v @ self.e1))
+        return out
+
+    def guides(self, state) -> dict:
+        """Prismatic joint (tree or loop) -> the angle of its slide in the plane [rad], from the
+        ground's x axis, counterclockwise about the plane's normal, at the configuration of
+        ``state`` (a model.state.KinematicState): a slider coordinate is a distance along it."""
+        mech, model = self.mech, self.mech.model
+        out = {}
+        for c in mech.coordinates:
+            if c.nq == 1 and c.nv == 1 and mech.translational[c.idx_v]:
+                u = state.joint_placement(c.joint_id).rotation @ joint_axis(model.joints[c.joint_id])
+                out[c.joint] = float(np.arctan2(u @ self.e2, u @ self.e1))
+        for cut in mech.cuts:
+            if cut.type == "prismatic" and cut.pair is None:
+                u = state.frame_placement(cut.frame1).rotation @ np.asarray(cut.axis, float)
+                out[cut.name] = float(np.arctan2(u @ self.e2, u @ self.e1))
         return out
 
     def joint_value(self, link: str, angle: float) -> tuple:

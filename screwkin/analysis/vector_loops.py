@@ -369,6 +369,22 @@ class VectorLoops:
         self.slide_terms[joint] = term
         return term
 
+    def ground_guide(self, x_name: str):
+        """(beta, e) of the slider coordinate ``x_name`` when its guide is on the ground: the
+        guide's constant angle from the ground's x axis [rad] and the offset of the slider's
+        centre from the guide line [m] (the slider's centre is at from + x u + e n); None for a
+        guide on a moving link or an unknown name."""
+        for term in self.slide_terms.values():
+            if term["x"].name != x_name:
+                continue
+            angle, e = term["angle"], term["e"]
+            if angle.free_symbols - {sym for sym in angle.free_symbols if str(sym).startswith("beta")}:
+                return None  # the guide turns with a link
+            beta = float(angle.subs({sym: self.symbol_info[str(sym)].value for sym in angle.free_symbols}))
+            offset = float(self.symbol_info[str(e)].value) if e != 0 else 0.0
+            return beta, offset
+        return None
+
     # ------------------------------------------------------------------ loops
     def _build_loops(self):
         sp = self.sp

@@ -98,6 +98,22 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             raise UsageError(f"{mech.path}: '{name}' is an input: give its value with --set")
         if name in loops.unknowns:
             symbols[name] = v
+        elif name[-1:] in ("h", "v") and name[:-1] in loops.unknowns and loops.symbol_info[name[:-1]].kind == "slider":
+            # the textbook's horizontal (h) or vertical (v) coordinate of the slider's centre, measured
+            # from the same joint centre, for a guide on the ground: from + x u + e n, read along x or y
+            guide = loops.ground_guide(name[:-1])
+            if guide is None:
+                raise UsageError(f"{mech.path}: --start {name}: the guide of {name[:-1]} turns with a link; give "
+                                 f"{name[:-1]}, the distance along the guide")
+            beta, e = guide
+            c, s_ = (np.cos(beta), -np.sin(beta)) if name[-1] == "h" else (np.sin(beta), np.cos(beta))
+            if abs(c) < mech.tolerances.geometry:
+                other = "v" if name[-1] == "h" else "h"
+                raise UsageError(f"{mech.path}: --start {name}: the guide of {name[:-1]} is "
+                                 f"{'vertical' if name[-1] == 'h' else 'horizontal'}; give {name[:-1]}{other} or "
+                                 f"{name[:-1]}")
+            name = name[:-1]
+            symbols[name] = (v - e * s_) / c
         elif name in by_link:
             symbols[by_link[name]] = v
             name = by_link[name]

@@ -21,6 +21,7 @@ from .motion import linkage_construction_text, links_table, points_table
 from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
 from .tables import column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
+from ..tolerances import DEFAULT
 
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
@@ -241,6 +242,8 @@ def position_dict(res) -> dict:
             d["points"] = s.points
         if s.leg_lengths:
             d["leg_lengths"] = s.leg_lengths
+        if s.guide_angles:
+            d["guide_angles"] = s.guide_angles
         if s.linkage:
             d["four_bar" if s.linkage["kind"] == "four-bar" else "slider_crank"] = s.linkage
         if s.output_pose is not None:
@@ -311,15 +314,21 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
         for lab in s.labels:
             lines.append(f"  not reached by moving: {lab}")
         rows = []
+        guides = {n: a for n, a in (s.guide_angles or {}).items()  # a slide not along the ground's x axis
+                  if abs(np.sin(a)) > DEFAULT.equal}
+
+        def along(name):
+            return f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
+
         for name, v in s.joints.items():
             row = [name, f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else "")
+            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else along(name))
             if s.rates is not None:
                 row += [f"{s.rates.get(name, float('nan')):.6g}", f"{s.accelerations.get(name, float('nan')):.6g}"]
             rows.append(row)
         for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
             row = [f"{name} (loop)", f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else "")
+            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
             if s.loop_rates is not None:
                 row += [f"{s.loop_rates[name]:.6g}", f"{s.loop_accelerations[name]:.6g}"]
             rows.append(row)
