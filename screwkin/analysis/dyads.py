@@ -251,7 +251,13 @@ def _root(disc, clamp):
 
 def _evaluate(geo, p: DyadPlan, xs, start, branch, clamp=None):
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
-    clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit)."""
+    clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
+    Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        return _evaluate_all(geo, p, xs, start, branch, clamp)
+
+
+def _evaluate_all(geo, p, xs, start, branch, clamp):
     xs = np.asarray(xs, float)
     zero = Jet(np.zeros(len(xs)))
     poses = {p.groups[0]: _Pose(zero, zero, zero)}
@@ -424,7 +430,7 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
     last_x = float(start)
     first = True
     while True:
-        if count >= max_steps:
+        if count >= max_steps:  # (the tracker stops at its last step, which may lie past the last grid value)
             stopped, reason = last_x, f"the step budget ({max_steps} configurations) is spent"
             break
         if h == 0 and not first:

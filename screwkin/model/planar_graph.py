@@ -26,7 +26,8 @@ class _Pair:
 @dataclass(frozen=True)
 class DyadPlan:
     """How a planar mechanism decomposes with its inputs held (topology only; the geometry is
-    read at q0 by ``_Geometry``): the group (links welded by held inputs) of every body, the
+    read at q0 by screwkin.analysis.dyads): the group (links welded by held inputs and fixed loop
+    joints) of every body, the
     swept input joint and the dyads in solving order as (kind, A, B, C) pair indices."""
 
     groups: tuple  # group of every body (model joint index)
@@ -46,9 +47,9 @@ def _pairs(mech):
             return f"joint {model.names[j]} is a {short}, not a revolute or prismatic joint"
         out.append((model.names[j], kind, model.parents[j], j, j))
     for c in mech.cuts:
-        if c.pair is not None or c.type not in ("revolute", "continuous", "prismatic"):
+        if c.pair is not None or c.type not in ("revolute", "continuous", "prismatic", "fixed"):
             return f"loop joint {c.name} is a {c.pair or c.type} joint"
-        kind = "P" if c.type == "prismatic" else "R"
+        kind = {"prismatic": "P", "fixed": "W"}.get(c.type, "R")  # W: a weld, the two links are one
         out.append((c.name, kind, model.frames[c.frame1].parentJoint, model.frames[c.frame2].parentJoint, None))
     return out
 
@@ -71,13 +72,13 @@ def plan(mech, inputs, name):
         return b
 
     held = set(inputs) - {name}
-    for pname, _, b1, b2, _ in found:
-        if pname in held:
-            parent[root(b1)] = root(b2)
+    welds = [(b1, b2) for pname, kind, b1, b2, tree in found if kind == "W" or (tree is not None and pname in held)]
+    for b1, b2 in welds:
+        parent[root(b1)] = root(b2)
     groups = tuple(root(b) for b in range(nb))
     pairs, swept = [], None
     for pname, kind, b1, b2, tree in found:
-        if pname in held:
+        if kind == "W" or (tree is not None and pname in held):
             continue
         g = (groups[b1], groups[b2])
         if g[0] == g[1]:

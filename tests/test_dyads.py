@@ -1,0 +1,169 @@
+"""The closed-form planar sweep (analysis/dyads.py) against the tracker it stands in for, and
+against circle intersections written here.
+
+Both run with a tight closure tolerance (1e-13): the tracker's corrector then lands within
+about 1e-12 of the curve, also next to limit positions where the default 1e-10 leaves it
+1e-8 away (the curve is a square root of the input there), so the two can be compared to 1e-9.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import screwkin
+from conftest import CORPUS, ROBOTS
+from screwkin.analysis.dyads import planar_sweep
+from screwkin.analysis.motion import Point, motion_along
+from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.sweep import sweep
+from screwkin.model.planar_graph import DyadPlan, plan
+from screwkin.tolerances import Tolerances
+
+TIGHT = Tolerances(closure=1e-13)
+
+
+def load(name):
+    return screwkin.load(ROBOTS / name, tolerances=TIGHT, warn=lambda *a, **k: None)
+
+
+def assert_same(mech, fast, slow, points=()):
+    """Every field of two SweepResults equal: values, q (on the manifold), rates and accelerations
+    to 1e-9 (relative where they are large, next to a limit position), limits, the stop."""
+    assert fast.values.shape == slow.values.shape, (len(fast.values), len(slow.values))
+    np.testing.assert_allclose(fast.values, slow.values, rtol=0, atol=1e-12)
+    dq = np.array([pin.difference(mech.model, a, b) for a, b in zip(fast.q, slow.q)])
+    assert np.abs(dq).max() < 1e-9
+    np.testing.assert_allclose(fast.joints, slow.joints, rtol=0, atol=1e-9)
+    for a, b in ((fast.rates, slow.rates), (fast.accelerations, slow.accelerations)):
+        assert np.all(np.abs(a - b) <= 1e-9 * (1 + np.abs(b))), np.abs(a - b).max()
+    assert fast.names == slow.names and fast.unit == slow.unit and fast.rate == slow.rate
+    assert fast.requested == slow.requested and fast.turn == slow.turn
+    assert fast.circuit_closed == slow.circuit_closed and fast.skipped == slow.skipped == ()
+    assert (fast.stopped_at is None) == (slow.stopped_at is None)
+    if fast.stop_reason and "budget" in fast.stop_reason:
+        # the tracker stops where its last (arc) step ended, up to one grid step past the last value
+        # it recorded; the closed form at that last value
+        h = (slow.requested[1] - slow.requested[0]) / slow.requested[2]
+        assert fast.stopped_at == fast.values[-1]
+        assert abs(slow.stopped_at - slow.values[-1]) <= abs(h) + 1e-12
+    elif fast.stopped_at is not None:
+        assert abs(fast.stopped_at - slow.stopped_at) < 1e-9
+    assert fast.stop_reason == slow.stop_reason
+    assert len(fast.limits) == len(slow.limits)
+    for a, b in zip(fast.limits, slow.limits):
+        assert (a.kind, a.limit) == (b.kind, b.limit) == ("actuator", True)
+        assert abs(a.input - b.input) < 1e-9
+        assert np.abs(pin.difference(mech.model, a.q, b.q)).max() < 1e-6  # the tracker's Brent on a held joint
+        assert a.sigma < 1e-6 and b.sigma < 1e-6
+    if points:
+        ma = motion_along(mech, fast.q, fast.rates, fast.accelerations, points)
+        mb = motion_along(mech, slow.q, slow.rates, slow.accelerations, points)
+        for p in points:
+            for key in ("position", "velocity", "acceleration"):
+                a, b = ma.points[p.name][key], mb.points[p.name][key]
+                assert np.all(np.abs(a - b) <= 1e-9 * (1 + np.abs(b)))
+
+
+def both(mech, inputs, name, start, stop, steps, **kw):
+    solver = PositionSolver(mech, inputs)
+    q0 = solver.solve({name: start, **kw.get("fixed", {})}, starts=8).solutions[0].q
+    assert planar_sweep(solver, name, q0, start, stop, steps, kw.get("rate", 1.0), kw.get("turn", False),
+                        kw.get("max_steps")) is not None, "the closed form does not apply"
+    return sweep(solver, name, start, stop, steps, **kw), sweep(solver, name, start, stop, steps, closed_form=False, **kw)
+
+
+CASES = [  # file, inputs, swept, from, to, steps, options
+    ("fourbar_crank_rocker.urdf", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 90, {"rate": 3.0}),
+    ("fourbar_crank_rocker.urdf", ["crank_joint"], "crank_joint", 1.0, -1.0, 20, {}),
+    ("fourbar_crank_rocker.urdf", ["rocker_joint"], "rocker_joint", 1.1, -1.0, 60, {}),  # a limit: stops there
+    ("fourbar_crank_rocker.urdf", ["rocker_joint"], "rocker_joint", 1.1, -1.0, 30, {"turn": True, "max_steps": 150}),
+    ("fourbar_non_grashof.urdf", ["input_joint"], "input_joint", 0.0, 2 * np.pi, 60, {"turn": True}),
+    ("fourbar.urdf.xacro", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 40, {}),
+    ("slider_crank_offset.urdf", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 72, {"rate": -2.0}),
+    ("slider_crank_offset.urdf", ["slider_joint"], "slider_joint", 0.0, -0.1, 50, {}),  # the crank's dead centre
+    ("slider_crank_offset.urdf", ["slider_joint"], "slider_joint", 0.0, -0.1, 25, {"turn": True, "max_steps": 120}),
+    ("stephenson_sixbar.urdf", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 45, {}),
+    ("watt_sixbar.urdf", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 45, {}),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[f"{c[0]}:{c[2]}:{c[5]}{'+turn' if c[6].get('turn') else ''}"
+                                             for c in CASES])
+def test_closed_form_is_the_tracker(case):
+    name, inputs, swept, start, stop, steps, kw = case
+    mech = load(name)
+    fast, slow = both(mech, inputs, swept, start, stop, steps, **kw)
+    assert_same(mech, fast, slow)
+    assert len(fast.values) > 5
+
+
+def test_closed_form_is_the_tracker_with_points_and_a_limit():
+    mech = load("fourbar_crank_rocker.urdf")
+    fast, slow = both(mech, ["rocker_joint"], "rocker_joint", 1.1, -1.0, 40)
+    assert fast.stopped_at is not None and len(fast.limits) == 1
+    assert_same(mech, fast, slow, points=(Point("tip", "coupler", (0.06, 0.02, 0.0)),))
+
+
+def test_five_bar_with_its_other_motor_held():
+    mech = load("five_bar.urdf")
+    solver = PositionSolver(mech)
+    m2 = solver.joint_values(mech.assemble().q)["motor2"]
+    fast, slow = both(mech, ["motor1", "motor2"], "motor1", 0.0, 0.6, 30, fixed={"motor2": m2})
+    assert_same(mech, fast, slow)
+
+
+def test_four_bar_positions_are_the_circle_intersections():
+    """fourbar_crank_rocker.urdf: ground pivots O1 = 0, O2 = (0.1, 0); crank 0.04 (at 60 deg when
+    its joint is 0), coupler 0.12, rocker 0.08.  The coupler-rocker joint B is where the circles
+    about the crank tip and about O2 meet; the rocker's joint value is B's angle about O2 less
+    its angle at the file's configuration; rates from central differences of the same formula."""
+    mech = screwkin.load(ROBOTS / "fourbar_crank_rocker.urdf")
+    solver = PositionSolver(mech, ["crank_joint"])
+    res = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 360, rate=2.0)
+    O2, a, b, c = np.array([0.1, 0.0]), 0.04, 0.12, 0.08
+    B_file = np.array([0.03388096599604964, 0.07247123666099901])  # the loop joint on the rocker, rocker frame
+
+    def rocker(q):
+        A = a * np.stack([np.cos(np.pi / 3 + q), np.sin(np.pi / 3 + q)], -1)
+        w = O2 - A
+        d = np.linalg.norm(w, axis=-1, keepdims=True)
+        along = (d ** 2 + b ** 2 - c ** 2) / (2 * d)
+        h = np.sqrt(b ** 2 - along ** 2)
+        perp = np.stack([-w[..., 1], w[..., 0]], -1) / d
+        B = A + along * w / d + h * perp  # the branch the file is drawn on (B above AO2)
+        ang = np.arctan2(B[..., 1] - O2[1], B[..., 0] - O2[0]) - np.arctan2(B_file[1], B_file[0])
+        return np.mod(ang + np.pi, 2 * np.pi) - np.pi
+
+    iv = mech.coordinate("rocker_joint").idx_v
+    np.testing.assert_allclose(res.joints[:, iv], rocker(res.values), rtol=0, atol=1e-12)
+    e = 1e-5
+    fd = (rocker(res.values + e) - rocker(res.values - e)) / (2 * e)
+    fdd = (rocker(res.values + e) - 2 * rocker(res.values) + rocker(res.values - e)) / e ** 2
+    np.testing.assert_allclose(res.rates[:, iv], 2.0 * fd, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(res.accelerations[:, iv], 4.0 * fdd, rtol=0, atol=1e-4)
+    residual = max(np.linalg.norm(mech.closure.residual(q)) for q in res.q)
+    assert residual < 1e-13
+
+
+def test_plans_and_reasons():
+    """What decomposes, and what the tracker keeps (a triad, a spatial loop, a higher pair)."""
+    assert [d[0] for d in plan(load("slider_crank_offset.urdf"), ["crank_joint"], "crank_joint").dyads] == ["RRP"]
+    assert [d[0] for d in plan(load("watt_sixbar.urdf"), ["crank_joint"], "crank_joint").dyads] == ["RRR", "RRR"]
+    assert "class-II dyad" in plan(load("planar_3rrr.urdf"), ["motor1", "motor2", "motor3"], "motor1")
+    assert "spherical" in plan(load("rssr.urdf"), ["crank_joint"], "crank_joint")
+    assert "higher pairs" in plan(load("cam_followers.urdf"), ["cam_joint"], "cam_joint")
+    five = screwkin.load(CORPUS / "5bar_linkage" / "robot.urdf", warn=lambda *a, **k: None)
+    assert not isinstance(plan(five, ["mot1", "mot2"], "mot1"), DyadPlan)  # its pin link: a triad here
+
+
+def test_spatial_loops_keep_the_tracker():
+    """The Bennett linkage is an RRR 'dyad' by its graph, but its axes are not parallel: no closed form."""
+    mech = load("bennett.urdf")
+    solver = PositionSolver(mech, ["joint1"])
+    q0 = solver.solve({"joint1": 0.3}, starts=8).solutions[0].q
+    assert isinstance(plan(mech, ["joint1"], "joint1"), DyadPlan)
+    assert planar_sweep(solver, "joint1", q0, 0.3, 0.5, 4) is None
+    res = sweep(solver, "joint1", 0.3, 0.5, 4)
+    assert res.completed and len(res.values) == 5
