@@ -86,6 +86,7 @@ CASES = [  # file, inputs, swept, from, to, steps, options
     ("slider_crank_offset.urdf", ["slider_joint"], "slider_joint", 0.0, -0.1, 25, {"turn": True, "max_steps": 120}),
     ("stephenson_sixbar.urdf", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 45, {}),
     ("watt_sixbar.urdf", ["crank_joint"], "crank_joint", 0.0, 2 * np.pi, 45, {}),
+    ("strider.urdf", ["crank_joint"], "crank_joint", 0.0, -2 * np.pi, 36, {}),
 ]
 
 
@@ -167,3 +168,40 @@ def test_spatial_loops_keep_the_tracker():
     assert planar_sweep(solver, "joint1", q0, 0.3, 0.5, 4) is None
     res = sweep(solver, "joint1", 0.3, 0.5, 4)
     assert res.completed and len(res.values) == 5
+
+
+def test_strider_feet_are_pylinkages():
+    """robots/strider.urdf against pylinkage's own Strider (its docs/examples/strider.py, built here
+    with its components; one pylinkage unit = 0.1 m): both feet over a whole turn of the crank,
+    turning clockwise by one degree a step as pylinkage's does."""
+    pytest.importorskip("pylinkage")
+    from pylinkage.actuators import Crank
+    from pylinkage.components import Ground
+    from pylinkage.dyads import FixedDyad, RRRDyad
+    from pylinkage.simulation import Linkage
+
+    n = 360
+    A, Y = Ground(0, 0, name="A"), Ground(0, 1, name="Y")
+    B = FixedDyad(anchor1=A, anchor2=Y, distance=2, angle=-np.pi / 4, name="B")
+    Bp = FixedDyad(anchor1=A, anchor2=Y, distance=2, angle=np.pi / 4, name="Bp")
+    C = Crank(anchor=A, radius=1, angular_velocity=-2 * np.pi / n, name="C")
+    D = RRRDyad(anchor1=Bp, anchor2=C.output, distance1=1.8, distance2=2.6, name="D")
+    E = RRRDyad(anchor1=B, anchor2=C.output, distance1=1.8, distance2=2.6, name="E")
+    F = FixedDyad(anchor1=C.output, anchor2=E, distance=1.4, angle=-(np.pi + 0.2), name="F")
+    G = FixedDyad(anchor1=C.output, anchor2=D, distance=1.4, angle=np.pi + 0.2, name="G")
+    H = RRRDyad(anchor1=D, anchor2=F, distance1=2.5, distance2=1.8, name="H")
+    I_ = RRRDyad(anchor1=E, anchor2=G, distance1=2.5, distance2=1.8, name="I")
+    strider = Linkage([A, Y, B, Bp, C, D, E, F, G, H, I_], name="Strider")
+    strider.set_coords([(0, 0), (0, 1), (1.41, 1.41), (-1.41, 1.41), (0, -1), (-2.25, 0), (2.25, 0),
+                        (-1.4, -1.2), (1.4, -1.2), (-2.7, -2.7), (2.7, -2.7)])
+    theirs = 0.1 * np.array([[step[9], step[10]] for step in strider.step(iterations=n)])  # (n, 2 feet, 2)
+
+    mech = screwkin.load(ROBOTS / "strider.urdf")
+    res = sweep(PositionSolver(mech), "crank_joint", 0.0, -2 * np.pi, n)
+    assert res.completed and len(res.values) == n + 1
+    # the feet: the loop joints left_foot (H) and right_foot (I), on the tibiae
+    cut = {c.name: c for c in mech.spec.cut_joints}
+    feet = (Point("H", "left_tibia", tuple(cut["left_foot"].xyz1)), Point("I", "right_tibia", tuple(cut["right_foot"].xyz1)))
+    m = motion_along(mech, res.q[1:], res.rates[1:], res.accelerations[1:], feet)
+    ours = np.stack([m.points["H"]["position"][:, :2], m.points["I"]["position"][:, :2]], 1)
+    np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-9)
