@@ -205,3 +205,34 @@ def test_strider_feet_are_pylinkages():
     m = motion_along(mech, res.q[1:], res.rates[1:], res.accelerations[1:], feet)
     ours = np.stack([m.points["H"]["position"][:, :2], m.points["I"]["position"][:, :2]], 1)
     np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name,link", [("slider_crank_offset.urdf", "rod"), ("fourbar_crank_rocker.urdf", "coupler")])
+def test_batched_motion_and_transmission_angles_are_the_per_state_ones(name, link):
+    """What `screwkin sweep` reports along the motion, computed on the stacks (motion_along,
+    transmission_angles), equals the one-configuration functions (KinematicState, identify) at
+    every step."""
+    from screwkin.analysis.motion import link_motions, point_motions
+    from screwkin.analysis.planar import LinkAngles, identify, transmission_angles
+    from screwkin.model.state import KinematicState
+
+    mech = screwkin.load(ROBOTS / name)
+    res = sweep(PositionSolver(mech), "crank_joint", 0.0, 2 * np.pi, 24, rate=3.0)
+    topo = mech.topology(res.q[0])
+    angles = LinkAngles(mech, topo)
+    pts = (Point("P", link, (0.03, 0.01, 0.0)),)
+    m = motion_along(mech, res.q, res.rates, res.accelerations, pts, angles, angles.n)
+    mus = transmission_angles(mech, topo, res.q, "crank_joint")
+    for k, (q, v, a) in enumerate(zip(res.q, res.rates, res.accelerations)):
+        st = KinematicState(mech, q, v, a)
+        for ln, d in link_motions(st, angles(q), angles.n).items():
+            assert list(d) == list(m.links[ln])
+            for key, val in d.items():
+                np.testing.assert_allclose(m.links[ln][key][k], val, rtol=0, atol=1e-12)
+        for key in ("position", "velocity", "acceleration"):
+            np.testing.assert_allclose(m.points["P"][key][k], point_motions(st, pts)["P"][key], rtol=0, atol=1e-12)
+        for c, val in st.loop_joints.items():
+            assert abs(m.loop_joints[c][k] - val) < 1e-12
+            assert abs(m.loop_rates[c][k] - st.loop_rates[c]) < 1e-12
+            assert abs(m.loop_accelerations[c][k] - st.loop_accelerations[c]) < 1e-12
+        assert abs(mus[k] - identify(mech, mech.topology(q), q, "crank_joint").transmission_angle) < 1e-12

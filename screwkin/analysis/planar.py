@@ -25,8 +25,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
+from .batch import TreeKinematics, Unbatchable
 
-__all__ = ["LinkageInfo", "identify", "LinkAngles", "plane_basis"]
+__all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles", "plane_basis"]
 
 
 @dataclass(frozen=True)
@@ -89,9 +90,9 @@ def _circles(p, r, c, s):
     return [p + along * u + h * n, p + along * u - h * n]
 
 
-def identify(mech, topo, q, input_joint):
-    """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
-    joint is a ground joint, at the configuration ``topo`` was built at (q)."""
+def _roles(topo, input_joint):
+    """(plane normal n, input joint, crank-coupler joint j_b, coupler-output joint j_c, output-ground
+    joint j_d) of a planar four-bar or slider-crank driven from a ground joint, else None."""
     if topo.motion_space != "planar" or (topo.n_links, topo.n_joints, topo.loops) != (4, 4, 1):
         return None
     joints = {j.name: j for j in topo.joints}
@@ -100,14 +101,6 @@ def identify(mech, topo, q, input_joint):
     if inp is None or ground not in inp.links or inp.type not in ("revolute", "continuous"):
         return None
     n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
-    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
-    e1 = np.cross(n, h)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(n, e1)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
-
-    def p2(v):
-        v = np.asarray(v)
-        return np.array([v @ e1, v @ e2])
 
     def other(link, joint):
         return next(j for j in topo.joints if j is not joint and link in j.links)
@@ -115,8 +108,27 @@ def identify(mech, topo, q, input_joint):
     moving = inp.links[1] if inp.links[0] == ground else inp.links[0]
     j_b = other(moving, inp)
     coupler = j_b.links[1] if j_b.links[0] == moving else j_b.links[0]
-    j_c = other(coupler, j_b)
-    j_d = other(ground, inp)
+    return n, inp, j_b, other(coupler, j_b), other(ground, inp)
+
+
+def _in_plane(n):
+    """p2: world vectors -> plane coordinates (e1, e2), (e1, e2, n) right-handed: positive joint
+    rotation is counterclockwise."""
+    h = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    e1 = np.cross(n, h)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    return lambda v: np.asarray(v) @ np.stack([e1, e2], axis=-1)
+
+
+def identify(mech, topo, q, input_joint):
+    """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
+    joint is a ground joint, at the configuration ``topo`` was built at (q)."""
+    roles = _roles(topo, input_joint)
+    if roles is None:
+        return None
+    n, inp, j_b, j_c, j_d = roles
+    p2 = _in_plane(n)
     coord = mech.coordinate(input_joint)
     q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
     A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
@@ -132,6 +144,43 @@ def identify(mech, topo, q, input_joint):
         s = p2(np.asarray(slide.direction) + 0) - p2(np.zeros(3))
         return _slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s / np.linalg.norm(s), a, b)
     return None
+
+
+def transmission_angles(mech, topo, Q, input_joint):
+    """identify(mech, topology at q, q, input_joint).transmission_angle for every row of Q, at once
+    (the joints' points from one batched forward-kinematics pass); None where ``identify`` gives
+    None at Q's first configuration (``topo``'s) or for compound joints."""
+    info = identify(mech, topo, Q[0], input_joint)
+    roles = _roles(topo, input_joint)
+    if info is None or any(len(j.members) != 1 for j in roles[1:]):
+        return None
+    n, inp, j_b, j_c, j_d = roles
+    model = mech.model
+    cuts = {c.name: c for c in mech.cuts}
+    frames = []
+    for j in (j_b, j_c, j_d):
+        name = j.members[0]
+        frames.append(cuts[name].frame1 if name in cuts else model.getFrameId(name, pin.FrameType.JOINT))
+    try:
+        placed = TreeKinematics(mech).frames(Q, frames, jacobian=False)
+        pts = [placed[f][1] for f in frames]
+    except Unbatchable:
+        data = mech.data
+        pts = [np.empty((len(Q), 3)) for _ in frames]
+        for k, q in enumerate(Q):
+            pin.framesForwardKinematics(model, data, q)
+            for p, f in zip(pts, frames):
+                p[k] = data.oMf[f].translation
+    p2 = _in_plane(n)
+    B, C, D = (p2(p) for p in pts)
+    b = np.linalg.norm(C - B, axis=1)
+    if info.kind == "four-bar":
+        c = np.linalg.norm(D - C, axis=1)
+        return np.arccos(np.clip(np.einsum("ij,ij->i", B - C, D - C) / (b * c), -1, 1))
+    s = p2(np.asarray(j_d.direction) + 0) - p2(np.zeros(3))
+    s = s / np.linalg.norm(s)
+    nrm = np.array([-s[1], s[0]])
+    return np.arccos(np.clip(np.abs((C - B) / b[:, None] @ nrm), 0, 1))
 
 
 def _four_bar(name, q_in, A, B, C, D, a, b):

@@ -7,7 +7,7 @@ import json
 import os
 
 from ..analysis.motion import motion_along, strokes
-from ..analysis.planar import LinkAngles, identify
+from ..analysis.planar import LinkAngles, identify, transmission_angles
 from ..analysis.position import PositionSolver
 from ..analysis.sweep import locate_singularities, sweep
 from ..errors import UsageError
@@ -90,7 +90,9 @@ def run(mech, args) -> int:
     slider_strokes = strokes(res, motion, mech)
     mus = None
     if info is not None:
-        mus = [identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
+        batch = transmission_angles(mech, topo, res.q, args.input)  # None: compound joints
+        mus = batch.tolist() if batch is not None else [
+            identify(mech, mech.topology(q), q, args.input).transmission_angle for q in res.q]
     sing = list(res.limits)  # the limit positions met are always listed
     if args.singularities:
         sing = locate_singularities(solver, res, output=args.output, point=args.point)

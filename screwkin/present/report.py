@@ -200,6 +200,8 @@ def to_jsonable(obj):
     if isinstance(obj, (list, tuple)):
         return [to_jsonable(v) for v in obj]
     if isinstance(obj, np.ndarray):
+        if obj.dtype.kind == "f" and np.isfinite(obj).all():  # (a sweep's arrays: one C call, not a call a number)
+            return obj.tolist()
         return to_jsonable(obj.tolist())
     if isinstance(obj, np.generic):
         obj = obj.item()
