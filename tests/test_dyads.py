@@ -236,3 +236,53 @@ def test_batched_motion_and_transmission_angles_are_the_per_state_ones(name, lin
             assert abs(m.loop_rates[c][k] - st.loop_rates[c]) < 1e-12
             assert abs(m.loop_accelerations[c][k] - st.loop_accelerations[c]) < 1e-12
         assert abs(mus[k] - identify(mech, mech.topology(q), q, "crank_joint").transmission_angle) < 1e-12
+
+
+def inverted_slider_crank(a=0.04, d=0.1, theta0=np.radians(60)):
+    """Crank a about the origin; its tip B carries a block (revolute) that slides in the slot of a
+    rocker pivoted at D = (d, 0): the block and the rocker are an RPR dyad."""
+    from conftest import LINK, rev
+
+    B = a * np.array([np.cos(theta0), np.sin(theta0)])
+    u = B - np.array([d, 0.0])
+    phi, L = np.arctan2(u[1], u[0]), np.linalg.norm(u)
+    body = "".join(LINK.format(n=n) for n in ("ground", "crank", "block", "rocker"))
+    body += rev("crank_joint", "ground", "crank", rpy=f"0 0 {theta0}", jtype="continuous")
+    body += rev("block_joint", "crank", "block", xyz=f"{a} 0 0", rpy=f"0 0 {phi - theta0}")
+    body += rev("rocker_joint", "ground", "rocker", xyz=f"{d} 0 0", rpy=f"0 0 {phi}")
+    body += (f'<loop_joint name="slot" type="prismatic"><link1 link="rocker" xyz="{L} 0 0"/>'
+             f'<link2 link="block"/><axis xyz="1 0 0"/></loop_joint>')
+    return f'<robot name="inverted_slider_crank">{body}</robot>'
+
+
+def swapped_slider_crank():
+    """conftest's slider-crank with its loop joint written from the slider's side: a PRR dyad."""
+    from conftest import slider_crank
+
+    text = slider_crank()
+    start = text.index('<loop_joint name="pin"')
+    end = text.index("</loop_joint>") + len("</loop_joint>")
+    loop = text[start:end]
+    link1 = loop[loop.index("<link1"):loop.index("/>", loop.index("<link1")) + 2]
+    link2 = loop[loop.index("<link2"):loop.index("/>", loop.index("<link2")) + 2]
+    swapped = loop.replace(link1, "@1").replace(link2, link1.replace("link1", "link2")).replace(
+        "@1", link2.replace("link2", "link1"))
+    return text[:start] + swapped + text[end:]
+
+
+@pytest.mark.parametrize("make,kind,swept,span,kw", [
+    (inverted_slider_crank, "RPR", "crank_joint", 2 * np.pi, {}),
+    (swapped_slider_crank, "PRR", "crank_joint", 2 * np.pi, {}),
+    (inverted_slider_crank, "RRP", "rocker_joint", 1.5, {}),  # its slide on the moving rocker; a limit
+    (inverted_slider_crank, "RRP", "rocker_joint", 1.5, {"turn": True, "max_steps": 100})])
+def test_slider_dyads_are_the_tracker(tmp_path, make, kind, swept, span, kw):
+    path = tmp_path / "m.urdf"
+    path.write_text(make())
+    mech = screwkin.load(path, tolerances=TIGHT, warn=lambda *a, **k: None)
+    p = plan(mech, [swept], swept)
+    assert [d[0] for d in p.dyads] == [kind]
+    solver = PositionSolver(mech, [swept])
+    x0 = solver.joint_values(mech.assemble().q)[swept]
+    fast, slow = both(mech, [swept], swept, x0, x0 + span, 40, **kw)
+    assert_same(mech, fast, slow)
+    assert len(fast.values) > 10
