@@ -286,3 +286,19 @@ def test_slider_dyads_are_the_tracker(tmp_path, make, kind, swept, span, kw):
     fast, slow = both(mech, [swept], swept, x0, x0 + span, 40, **kw)
     assert_same(mech, fast, slow)
     assert len(fast.values) > 10
+
+
+def test_json_text_is_json_dumps_with_indent():
+    """The sweep's JSON writer gives json.dumps(..., indent=2) character for character."""
+    import json
+
+    from screwkin.present.report import json_text, to_jsonable
+
+    mech = load("slider_crank_offset.urdf")
+    res = sweep(PositionSolver(mech), "crank_joint", 0.0, 2 * np.pi, 12)
+    sample = to_jsonable({
+        "values": res.values, "q": res.q, "rows": res.q.tolist(), "empty": [], "none": {}, "mixed": [1, 2.5, None],
+        "ints": [1, 2], "flags": [True, False], "text": 'a "quoted"\nline', "nan": [float("nan"), 1.0],
+        "nested": {"deep": [[1.0, 2.0], [3.0]], "ragged": [[1.0], []], 3: "int key"}, "tiny": [1e-300, -0.0, 1e20]})
+    for obj in (sample, [], {}, 1.5, "x", [[1.0, 2.0]], {"a": [{"b": [1.0]}]}):
+        assert json_text(obj) == json.dumps(obj, indent=2)

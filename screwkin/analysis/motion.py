@@ -119,15 +119,18 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
             R[k, i], t[k, i] = M.rotation, M.translation
             tw[k, i] = pin.getFrameVelocity(model, data, f, LWA).vector
             ac[k, i] = pin.getFrameClassicalAcceleration(model, data, f, LWA).vector
-    named = [angles(q) for q in Q] if (angles is not None and normal is not None) else None
+    named = None
+    if angles is not None and normal is not None:
+        named = angles.batch(Q) if hasattr(angles, "batch") else {
+            link: np.array([a[link] for a in map(angles, Q)]) for link in (angles(Q[0]) if len(Q) else ())}
     out_links = {}
     for link, f in zip(links, link_f):
         i = col[f]
         d = {"position": t[:, i].copy(), "velocity": tw[:, i, :3].copy(), "acceleration": ac[:, i, :3].copy(),
              "omega": tw[:, i, 3:].copy(), "alpha": ac[:, i, 3:].copy()}
         if normal is not None:
-            if named is not None and named and link in named[0]:
-                d["angle"] = np.array([a[link] for a in named], float)
+            if named is not None and link in named:
+                d["angle"] = np.asarray(named[link], float)
             d["omega"], d["alpha"] = d["omega"] @ normal, d["alpha"] @ normal
         out_links[link] = d
     pts = {}
