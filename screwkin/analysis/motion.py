@@ -24,8 +24,6 @@ import pinocchio as pin
 from ..errors import UsageError
 from ..model.state import loop_coordinate_cuts
 
-LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "moving_links", "Stroke",
            "strokes"]
 
@@ -109,16 +107,7 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     point_f = [mech.link_frame(p.link) for p in points]
     frames = list(dict.fromkeys(link_f + point_f + [f for c in cuts for f in (c.frame1, c.frame2)]))
     col = {f: i for i, f in enumerate(frames)}
-    N, F = len(Q), len(frames)
-    R, t = np.empty((N, F, 3, 3)), np.empty((N, F, 3))
-    tw, ac = np.empty((N, F, 6)), np.empty((N, F, 6))  # (v, w), (a, alpha): world axes at the origin
-    for k in range(N):
-        pin.forwardKinematics(model, data, Q[k], V[k], A[k])
-        for i, f in enumerate(frames):
-            M = pin.updateFramePlacement(model, data, f)
-            R[k, i], t[k, i] = M.rotation, M.translation
-            tw[k, i] = pin.getFrameVelocity(model, data, f, LWA).vector
-            ac[k, i] = pin.getFrameClassicalAcceleration(model, data, f, LWA).vector
+    R, t, tw, ac = _frame_motions(model, data, frames, Q, V, A)
     named = None
     if angles is not None and normal is not None:
         named = angles.batch(Q) if hasattr(angles, "batch") else {
@@ -169,6 +158,41 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
             loop_accs[c.name] = dot(al2 - al1, axis) + dot(w2 - w1, da)
     return MotionAlong(loops, loop_rates, loop_accs, out_links, pts,
                        tuple(c.name for c in cuts if c.type != "prismatic"))
+
+
+def _frame_motions(model, data, frames, Q, V, A):
+    """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
+    (a, alpha) of the frames' origins in world axes (N, F, 6) -- what pin.getFrameVelocity and
+    pin.getFrameClassicalAcceleration give in LOCAL_WORLD_ALIGNED -- from one forwardKinematics a
+    step, the joints' placements, spatial velocities and accelerations read once and the frames'
+    placed on the stacks."""
+    parents = [model.frames[f].parentJoint for f in frames]
+    joints = sorted(set(parents) - {0})
+    N, J = len(Q), len(joints)
+    Rj, pj, vj, aj = np.empty((N, J, 3, 3)), np.empty((N, J, 3)), np.empty((N, J, 6)), np.empty((N, J, 6))
+    for k in range(N):
+        pin.forwardKinematics(model, data, Q[k], V[k], A[k])
+        for i, j in enumerate(joints):
+            M = data.oMi[j]
+            Rj[k, i], pj[k, i], vj[k, i], aj[k, i] = M.rotation, M.translation, data.v[j].vector, data.a[j].vector
+    F = len(frames)
+    R, t = np.empty((N, F, 3, 3)), np.empty((N, F, 3))
+    tw, ac = np.zeros((N, F, 6)), np.zeros((N, F, 6))
+    for i, (f, j) in enumerate(zip(frames, parents)):
+        X = model.frames[f].placement
+        if j == 0:  # on the ground
+            R[:, i], t[:, i] = X.rotation, X.translation
+            continue
+        c = joints.index(j)
+        Rc, x = Rj[:, c], X.translation
+        R[:, i], t[:, i] = Rc @ X.rotation, pj[:, c] + Rc @ x
+        v, w, a, al = vj[:, c, :3], vj[:, c, 3:], aj[:, c, :3], aj[:, c, 3:]
+        vo = v + np.cross(w, x)  # the frame origin's velocity, joint axes
+        ao = a + np.cross(al, x) + np.cross(w, vo)  # its classical acceleration
+        for out, (lin, ang) in ((tw, (vo, w)), (ac, (ao, al))):
+            out[:, i, :3] = np.einsum("nij,nj->ni", Rc, lin)
+            out[:, i, 3:] = np.einsum("nij,nj->ni", Rc, ang)
+    return R, t, tw, ac
 
 
 @dataclass(frozen=True)
