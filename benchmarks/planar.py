@@ -4,8 +4,8 @@ rational_linkages and a numpy closed form (the floor).
     pip install -e '.[bench]'
     python benchmarks/planar.py [--repeat 5] [--quick]
 
-Each contestant runs ``repeat`` times in alternation (after one warm-up call: imports, numba
-compilation); the table gives the median and the best.  The machines are shared and noisy:
+Each contestant runs ``repeat`` times (after one warm-up call: imports, numba compilation), the
+peers of one motion in alternation, round after round; the table gives the median and the best.  The machines are shared and noisy:
 read the ratios, measured in the same run.  Motions:
 
 - pylinkage 1.3's four-bar (crank 1, coupler 3, rocker 3, ground 4), 10,000 crank angles:
@@ -129,19 +129,28 @@ def main(argv=None) -> int:
         fn()  # warm-up
         rows[label] = ([timed(fn) for _ in range(repeat)], note)
 
-    contest("four-bar: numpy closed form (floor)", lambda: closed_form_fourbar(), note="positions, omega, alpha")
-    contest("four-bar: pylinkage fourbar().step", lambda: list(fourbar(
-        crank=1.0, coupler=3.0, rocker=3.0, ground=4.0, omega=2 * np.pi / N4).step(iterations=N4)),
-        note="positions")
-    contest("four-bar: screwkin.sweep (API)", lambda: sweep(fb_solver, "crank_joint", 0.0, 2 * np.pi, N4),
-            note="q, rates, accelerations")
+    def rounds(*entries, repeat=args.repeat):
+        """(label, fn, note) entries measured in alternation, ``repeat`` rounds (after a warm-up each)."""
+        for label, fn, note in entries:
+            fn()
+            rows[label] = ([], note)
+        for _ in range(repeat):
+            for label, fn, _ in entries:
+                rows[label][0].append(timed(fn))
+
+    rounds(("four-bar: numpy closed form (floor)", lambda: closed_form_fourbar(), "positions, omega, alpha"),
+           ("four-bar: pylinkage fourbar().step", lambda: list(fourbar(
+               crank=1.0, coupler=3.0, rocker=3.0, ground=4.0, omega=2 * np.pi / N4).step(iterations=N4)),
+            "positions"),
+           ("four-bar: screwkin.sweep (API)", lambda: sweep(fb_solver, "crank_joint", 0.0, 2 * np.pi, N4),
+            "q, rates, accelerations"))
     if not args.quick:
         contest("four-bar: screwkin.sweep, tracker (closed_form=False)",
                 lambda: sweep(fb_solver, "crank_joint", 0.0, 2 * np.pi, N4, closed_form=False), repeat=1,
                 note="q, rates, accelerations")
-    contest("Strider: pylinkage Linkage.step", lambda: pylinkage_strider(), note="positions")
-    contest("Strider: screwkin.sweep (API)", lambda: sweep(st_solver, "crank_joint", 0.0, -2 * np.pi, 360),
-            note="q, rates, accelerations")
+    rounds(("Strider: pylinkage Linkage.step", lambda: pylinkage_strider(), "positions"),
+           ("Strider: screwkin.sweep (API)", lambda: sweep(st_solver, "crank_joint", 0.0, -2 * np.pi, 360),
+            "q, rates, accelerations"))
     contest("Strider: screwkin, its start solve(starts=8) alone", lambda: st_solver.solve({"crank_joint": 0.0},
                                                                                             starts=8))
     if not args.quick:
@@ -180,9 +189,9 @@ def main(argv=None) -> int:
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, cwd=ROOT,
                        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
 
-    contest("shell: python script importing pylinkage, 10,000 steps, JSON", lambda: shell(py), note="positions")
-    contest("shell: screwkin sweep --steps 10000 --json", lambda: shell(cli),
-            note="q, rates, accelerations, link and point motion, transmission angles")
+    rounds(("shell: python script importing pylinkage, 10,000 steps, JSON", lambda: shell(py), "positions"),
+           ("shell: screwkin sweep --steps 10000 --json", lambda: shell(cli),
+            "q, rates, accelerations, link and point motion, transmission angles"))
     contest("shell: python -c 'import screwkin.cli' (start-up)", lambda: shell([env_py, "-c", "import screwkin.cli"]))
 
     print("| motion and tool | computes | median [ms] | best [ms] |")
