@@ -79,11 +79,11 @@ class TreeKinematics:
                                np.hstack([frame.placement.rotation, frame.placement.translation[:, None]]).T.copy())
         return self._frames[f]
 
-    def frames(self, Q, frame_ids) -> dict:
+    def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
         frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
         velocity columns ``cols`` of the joints that move it (J and cols None for a frame
-        fixed to the ground)."""
+        fixed to the ground, and without ``jacobian``)."""
         model = self.model
         Q = np.atleast_2d(np.asarray(Q, float))
         N = len(Q)
@@ -115,7 +115,7 @@ class TreeKinematics:
             XT = CfT @ RTs[jid]
             Rf = XT[0:3].reshape(3, N, 3).transpose(1, 2, 0)
             pf = ps[jid] + XT[3].reshape(N, 3)
-            support = self._support(jid)
+            support = self._support(jid) if jacobian else None
             if not support:
                 out[f] = (Rf, pf, None, None)
                 continue
@@ -203,10 +203,11 @@ class BatchClosure:
             self._check(np.random.default_rng(0), check)
 
     # ------------------------------------------------------------------ frames
-    def _frames(self, Q):
+    def _frames(self, Q, jacobian: bool = True):
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n) LOCAL_WORLD_ALIGNED on the chain's
-        columns, columns (n,))}; J and the columns None for a frame on the ground."""
-        return self.tree.frames(Q, self._frame_ids)
+        columns, columns (n,))}; J and the columns None for a frame on the ground (and for
+        every frame without ``jacobian``)."""
+        return self.tree.frames(Q, self._frame_ids, jacobian)
 
     def _placements(self, c, frames, targets, N):
         """(R1, t1, J1, cols1, R2, t2, J2, cols2) of cut joint c (J None: the frame does not move)."""
@@ -234,7 +235,7 @@ class BatchClosure:
         N, nv = len(Q), self.model.nv
         if self.target is not None and targets is None:
             raise ValueError("this closure has a target: give its placements")
-        frames = self._frames(Q)
+        frames = self._frames(Q, jacobian)
         nrows = self.solver_rows if solver else self.nrows
         r = np.empty((N, nrows))
         K = np.zeros((N, nrows, nv)) if jacobian else None

@@ -19,9 +19,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import UsageError
-from ..model.state import KinematicState, loop_coordinate_cuts
+from ..model.state import loop_coordinate_cuts
 
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "moving_links", "Stroke",
            "strokes"]
@@ -93,31 +94,105 @@ class MotionAlong:
 
 def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAlong:
     """The absolute motion at each configuration Q[k] with rates V[k] and accelerations A[k];
-    ``angles``: a callable q -> link angles (LinkAngles) for planar mechanisms, with ``normal``."""
+    ``angles``: a callable q -> link angles (LinkAngles) for planar mechanisms, with ``normal``.
+
+    The quantities of KinematicState (link_motions, point_motions, loop_value, loop_rate,
+    loop_acceleration) for every step: one Pinocchio pass a step gives the frames' placements,
+    velocities and classical accelerations, and the formulas run on the stacks."""
+    model = mech.model
+    data = model.createData()
     cuts = loop_coordinate_cuts(mech)
-    steps = []
-    for q, v, a in zip(Q, V, A):
-        st = KinematicState(mech, q, v, a)
-        steps.append((st, link_motions(st, angles(q) if angles is not None else None, normal),
-                      point_motions(st, points)))
-
-    def stack(values):
-        return np.array(values, float)
-
-    loops = {c.name: stack([s.loop_value(c) for s, _, _ in steps]) for c in cuts}
-    loop_rates = {c.name: stack([s.loop_rate(c) for s, _, _ in steps]) for c in cuts}
-    loop_accs = {c.name: stack([s.loop_acceleration(c) for s, _, _ in steps]) for c in cuts}
-    links = {}
-    for link in (steps[0][1] if steps else {}):
-        links[link] = {key: stack([m[link][key] for _, m, _ in steps]) for key in steps[0][1][link]}
+    links = moving_links(mech)
+    link_f = [mech.link_frame(link) for link in links]
+    point_f = [mech.link_frame(p.link) for p in points]
+    frames = list(dict.fromkeys(link_f + point_f + [f for c in cuts for f in (c.frame1, c.frame2)]))
+    col = {f: i for i, f in enumerate(frames)}
+    R, t, tw, ac = _frame_motions(model, data, frames, Q, V, A)
+    named = None
+    if angles is not None and normal is not None:
+        named = angles.batch(Q) if hasattr(angles, "batch") else {
+            link: np.array([a[link] for a in map(angles, Q)]) for link in (angles(Q[0]) if len(Q) else ())}
+    out_links = {}
+    for link, f in zip(links, link_f):
+        i = col[f]
+        d = {"position": t[:, i].copy(), "velocity": tw[:, i, :3].copy(), "acceleration": ac[:, i, :3].copy(),
+             "omega": tw[:, i, 3:].copy(), "alpha": ac[:, i, 3:].copy()}
+        if normal is not None:
+            if named is not None and link in named:
+                d["angle"] = np.asarray(named[link], float)
+            d["omega"], d["alpha"] = d["omega"] @ normal, d["alpha"] @ normal
+        out_links[link] = d
     pts = {}
-    for p in points:
-        first = steps[0][2][p.name] if steps else {}
-        pts[p.name] = {"link": p.link, "local": list(p.local),
-                       **{key: stack([m[p.name][key] for _, _, m in steps]) for key in first
-                          if key not in ("link", "local")}}
-    return MotionAlong(loops, loop_rates, loop_accs, links, pts,
+    for p, f in zip(points, point_f):
+        i = col[f]
+        r = R[:, i] @ np.asarray(p.local, float)
+        w, al = tw[:, i, 3:], ac[:, i, 3:]
+        pts[p.name] = {"link": p.link, "local": list(p.local), "position": t[:, i] + r,
+                       "velocity": tw[:, i, :3] + np.cross(w, r),
+                       "acceleration": ac[:, i, :3] + np.cross(al, r) + np.cross(w, np.cross(w, r))}
+    loops, loop_rates, loop_accs = {}, {}, {}
+    for c in cuts:
+        i1, i2 = col[c.frame1], col[c.frame2]
+        R1, R2 = R[:, i1], R[:, i2]
+        axis = R1 @ np.asarray(c.axis, float)
+        axis = axis / np.linalg.norm(axis, axis=1, keepdims=True)
+        (v1, w1), (v2, w2) = (tw[:, i1, :3], tw[:, i1, 3:]), (tw[:, i2, :3], tw[:, i2, 3:])
+        (a1, al1), (a2, al2) = (ac[:, i1, :3], ac[:, i1, 3:]), (ac[:, i2, :3], ac[:, i2, 3:])
+        da = np.cross(w1, axis)  # d axis / dt
+        dda = np.cross(al1, axis) + np.cross(w1, da)
+
+        def dot(x, y):
+            return np.einsum("ij,ij->i", x, y)
+
+        if c.type == "prismatic":
+            r = t[:, i2] - t[:, i1]
+            loops[c.name] = dot(r, axis)
+            loop_rates[c.name] = dot(v2 - v1, axis) + dot(r, np.cross(w1, axis))
+            loop_accs[c.name] = dot(a2 - a1, axis) + 2.0 * dot(v2 - v1, da) + dot(r, dda)
+        else:  # R = F2 in F1, a rotation about the axis: sin from its antisymmetric part, cos from its trace
+            Rr = R1.transpose(0, 2, 1) @ R2
+            a = np.asarray(c.axis, float) / np.linalg.norm(c.axis)
+            anti = np.stack([Rr[:, 2, 1] - Rr[:, 1, 2], Rr[:, 0, 2] - Rr[:, 2, 0], Rr[:, 1, 0] - Rr[:, 0, 1]], axis=1)
+            loops[c.name] = np.arctan2(0.5 * anti @ a, 0.5 * (np.trace(Rr, axis1=1, axis2=2) - (Rr @ a) @ a))
+            loop_rates[c.name] = dot(w2 - w1, axis)
+            loop_accs[c.name] = dot(al2 - al1, axis) + dot(w2 - w1, da)
+    return MotionAlong(loops, loop_rates, loop_accs, out_links, pts,
                        tuple(c.name for c in cuts if c.type != "prismatic"))
+
+
+def _frame_motions(model, data, frames, Q, V, A):
+    """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
+    (a, alpha) of the frames' origins in world axes (N, F, 6) -- what pin.getFrameVelocity and
+    pin.getFrameClassicalAcceleration give in LOCAL_WORLD_ALIGNED -- from one forwardKinematics a
+    step, the joints' placements, spatial velocities and accelerations read once and the frames'
+    placed on the stacks."""
+    parents = [model.frames[f].parentJoint for f in frames]
+    joints = sorted(set(parents) - {0})
+    N, J = len(Q), len(joints)
+    Rj, pj, vj, aj = np.empty((N, J, 3, 3)), np.empty((N, J, 3)), np.empty((N, J, 6)), np.empty((N, J, 6))
+    for k in range(N):
+        pin.forwardKinematics(model, data, Q[k], V[k], A[k])
+        for i, j in enumerate(joints):
+            M = data.oMi[j]
+            Rj[k, i], pj[k, i], vj[k, i], aj[k, i] = M.rotation, M.translation, data.v[j].vector, data.a[j].vector
+    F = len(frames)
+    R, t = np.empty((N, F, 3, 3)), np.empty((N, F, 3))
+    tw, ac = np.zeros((N, F, 6)), np.zeros((N, F, 6))
+    for i, (f, j) in enumerate(zip(frames, parents)):
+        X = model.frames[f].placement
+        if j == 0:  # on the ground
+            R[:, i], t[:, i] = X.rotation, X.translation
+            continue
+        c = joints.index(j)
+        Rc, x = Rj[:, c], X.translation
+        R[:, i], t[:, i] = Rc @ X.rotation, pj[:, c] + Rc @ x
+        v, w, a, al = vj[:, c, :3], vj[:, c, 3:], aj[:, c, :3], aj[:, c, 3:]
+        vo = v + np.cross(w, x)  # the frame origin's velocity, joint axes
+        ao = a + np.cross(al, x) + np.cross(w, vo)  # its classical acceleration
+        for out, (lin, ang) in ((tw, (vo, w)), (ac, (ao, al))):
+            out[:, i, :3] = np.einsum("nij,nj->ni", Rc, lin)
+            out[:, i, 3:] = np.einsum("nij,nj->ni", Rc, ang)
+    return R, t, tw, ac
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ from ..errors import UsageError
 from ..model._pin import joint_axis
 from ..model.geometry import (circle_intersections, cross2, line_angle, line_circle, perpendicular_basis, plane_basis,
                               vector_angle)
+from .batch_closure import TreeKinematics, Unbatchable
 
 __all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
@@ -334,6 +335,31 @@ class LinkAngles:
             if cut.type == "prismatic" and cut.pair is None:
                 u = state.frame_placement(cut.frame1).rotation @ np.asarray(cut.axis, float)
                 out[cut.name] = float(np.arctan2(u @ self.e2, u @ self.e1))
+        return out
+
+    def batch(self, Q) -> dict:
+        """link name -> (N,) absolute angles [rad] at every row of Q: __call__ on the stack, from one
+        batched forward-kinematics pass (a loop over Q where the tree has joints of two coordinates)."""
+        Q = np.atleast_2d(Q)
+        refs = {r for start, end, fid in self.links.values() for r in (start, end if end[0] != "axis" else ("frame", fid))}
+        model = self.mech.model
+        fids = {r: (r[1] if r[0] == "frame" else model.getFrameId(model.names[r[1]], pin.FrameType.JOINT)) for r in refs}
+        try:
+            placed = TreeKinematics(self.mech).frames(Q, sorted(set(fids.values())), jacobian=False)
+        except Unbatchable:
+            rows = [self(q) for q in Q]
+            return {link: np.array([r[link] for r in rows]) for link in self.links}
+        out = {}
+        for link, (start, end, fid) in self.links.items():
+            if end[0] == "axis":
+                v = placed[fids[("frame", fid)]][0][:, :, 0]
+            else:
+                v = placed[fids[end]][1] - placed[fids[start]][1]
+            out[link] = np.arctan2(v @ self.e2, v @ self.e1)
+        first = self(Q[0])  # a link along -e1 (+-pi) could come out with the other sign: then the loop
+        if any(abs(out[link][0] - first[link]) > self.mech.tolerances.equal for link in out):
+            rows = [self(q) for q in Q]
+            return {link: np.array([r[link] for r in rows]) for link in self.links}
         return out
 
     def joint_value(self, link: str, angle: float) -> tuple:

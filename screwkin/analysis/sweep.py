@@ -34,6 +34,7 @@ import pinocchio as pin
 
 from ..errors import AssemblyError, UsageError
 from ..model.linalg import null_space
+from .dyads import planar_sweep
 from .singular import Generic, measures, scaled_jacobians
 
 __all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour"]
@@ -241,7 +242,7 @@ class Neighbour:
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
-          max_steps: int | None = None, q_start=None) -> SweepResult:
+          max_steps: int | None = None, q_start=None, closed_form: bool = True) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
 
@@ -252,6 +253,8 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     turn: pass through limit positions onto the other branch (the input then runs back);
     the sweep ends when the mechanism is back at its start, the input reaches ``stop``, or
     after ``max_steps`` recorded configurations (default 20 * steps + 100).
+    closed_form: a planar mechanism made of dyads is solved at every grid value at once
+    (screwkin.analysis.dyads), the same result; False: always the tracker.
     """
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -271,6 +274,13 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     else:
         first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
         q0 = first.solutions[0].q
+    if closed_form:
+        f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
+        if f is not None:
+            limits = tuple(SweepSingularity("actuator", x, s, q, limit=True) for x, s, q in f.limits)
+            return SweepResult(name, f.values, f.q, f.joints, f.rates, f.accelerations, tuple(mech.coordinate_names),
+                               rate, f.stopped_at, f.stop_reason, (start, stop, steps), limits, turn,
+                               f.circuit_closed, f.unit)
     rates_in = {n: 0.0 for n in solver.inputs}
     rates_in[name] = rate
     unit = "m" if mech.translational[tr.ix] else "rad"

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 
 from ..analysis.motion import motion_along, strokes
@@ -14,6 +13,7 @@ from ..errors import UsageError
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.plots import sweep_plot
 from ..present.report import (
+    json_text,
     linkage_dict,
     sweep_csv,
     sweep_dict,
@@ -110,7 +110,7 @@ def run(mech, args) -> int:
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
         d["strokes"] = strokes_dict(slider_strokes)
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_text(to_jsonable(d)))
     else:
         rows = sweep_rows(len(res.values), _rows(args.rows))
         typed_deg = any(unit_kind(parse_typed_value(t)[1]) == "angle" and "deg" in t.lower()

@@ -6,6 +6,9 @@ how they are written out, for the command line and for ``screwkin.to_dict``.
 
 from __future__ import annotations
 
+import json
+import math
+
 import numpy as np
 
 from ..analysis.maps import SingularityMap
@@ -201,8 +204,12 @@ def to_jsonable(obj, _where: str = ""):
     if isinstance(obj, dict):
         return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
+        if isinstance(obj, list) and _numbers(obj):  # finite floats only: nothing to convert
+            return obj
         return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
     if isinstance(obj, np.ndarray):
+        if obj.dtype.kind == "f" and np.isfinite(obj).all():  # (a sweep's arrays: one C call, not a call a number)
+            return obj.tolist()
         return to_jsonable(obj.tolist(), _where)
     if isinstance(obj, np.generic):
         obj = obj.item()
@@ -218,6 +225,35 @@ def nan_to_none(a) -> list:
     with None there, for to_jsonable."""
     a = np.asarray(a, float)
     return np.where(np.isnan(a), None, a.astype(object)).tolist()
+
+
+def json_text(obj, indent: int = 2, _level: int = 0) -> str:
+    """json.dumps(obj, indent=indent) of to_jsonable's output, character for character, with the
+    lists of numbers (a sweep's tens of thousands of values) written in one join each instead of
+    json's pure-Python encoder (the one it uses with indent), which takes seconds on them."""
+    pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):
+        if not obj:
+            return "{}"
+        items = (f"{inner}{json.dumps(k)}: {json_text(v, indent, _level + 1)}" for k, v in obj.items())
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if isinstance(obj, (list, tuple)):
+        if not obj:
+            return "[]"
+        if _numbers(obj):
+            return "[\n" + inner + (",\n" + inner).join(map(float.__repr__, obj)) + "\n" + pad + "]"
+        if all(isinstance(v, list) and v and _numbers(v) for v in obj):  # rows of numbers (vectors along a sweep)
+            deeper = inner + " " * indent
+            sep = ",\n" + deeper
+            rows = ("[\n" + deeper + sep.join(map(float.__repr__, v)) + "\n" + inner + "]" for v in obj)
+            return "[\n" + inner + (",\n" + inner).join(rows) + "\n" + pad + "]"
+        return "[\n" + ",\n".join(inner + json_text(v, indent, _level + 1) for v in obj) + "\n" + pad + "]"
+    return json.dumps(obj, indent=indent).replace("\n", "\n" + pad)
+
+
+def _numbers(values) -> bool:
+    """A list of finite floats only (two loops in C)."""
+    return set(map(type, values)) == {float} and all(map(math.isfinite, values))
 
 
 def position_dict(res) -> dict:
