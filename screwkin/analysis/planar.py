@@ -213,10 +213,10 @@ def _four_bar(name, q_in, A, B, C, D, a, b, tol):
             limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
     mu = float(vector_angle(B - C, D - C))
     z = float(np.linalg.norm(B - D))
-    alpha = beta = None
-    if z > 0:  # (the diagonal vanishes when the crank tip sits on the output pivot)
-        alpha = float(np.arccos(np.clip(np.dot(B - D, C - D) / (z * c), -1, 1)))
-        beta = float(np.arccos(np.clip(np.dot(B - D, A - D) / (z * g), -1, 1)))
+    # an angle with a vanishing side has no value (None, not NaN): the diagonal vanishes when the crank
+    # tip sits on the output pivot, the output link or the ground when their two pivots coincide
+    alpha = float(vector_angle(B - D, C - D)) if z > 0 and c > 0 else None
+    beta = float(vector_angle(B - D, A - D)) if z > 0 and g > 0 else None
     return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu, z, alpha, beta)
 
 
