@@ -39,7 +39,7 @@ def study_throughput(designs: int = 48, repeat: int = 2):
     the three in alternation, ``repeat`` rounds."""
     from distributed import Client, LocalCluster
 
-    from screwkin.analysis.study import run_study
+    from screwkin.parallel.study import run_study
 
     spec = family(designs)
     clusters = {}

@@ -28,7 +28,7 @@ from .analysis.position import (
 from .analysis.scan import ScanResult, scan
 from .analysis.singular import SingularityReport, classify
 from .analysis.study import StudyResult, pareto_front
-from .analysis.study import run_study as _run_study
+from .parallel.study import run_study as _run_study
 from .analysis.sweep import SweepResult, SweepSingularity, locate_singularities, sweep
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
 from .model import loader as _loader

@@ -1,4 +1,4 @@
-"""The package's imports run one way: files <- model <- analysis <- present <- cli (the public
+"""The package's imports run one way: files <- model <- analysis <- present and parallel <- cli (the public
 API in screwkin/__init__.py on top), with the base modules (errors, tolerances, units) under
 all of them.  An ast walk over screwkin/ finds every import, module level or not."""
 
@@ -7,7 +7,7 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
 LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "analysis": 3, "present": 4,
-          "commands": 5, "cli": 5, "__main__": 6, "__init__": 6}
+          "parallel": 4, "commands": 5, "cli": 5, "__main__": 6, "__init__": 6}
 # third-party imports a function may make lazily: optional, or heavy and needed by one command
 # (measured cold: scipy.optimize 0.62 s, pinocchio.visualize 0.42 s, networkx 0.15 s; every command pays ~0.3 s
 # in all; sympy 0.5 s, for the equations only)

@@ -25,15 +25,14 @@ import screwkin.analysis.study as st
 from screwkin.analysis.study import (
     _GRASHOF,
     StudyResult,
-    _collect,
-    _task,
     design_args,
     designs,
     pareto_front,
     run_chunk,
-    run_study,
+    study_task,
 )
 from screwkin.cli import main
+from screwkin.parallel.study import _collect, run_study
 from screwkin.files.study import study_spec
 from screwkin.files.xacro import expand
 from screwkin.present.study import Progress, study_csv, study_text
@@ -148,7 +147,7 @@ def test_in_process_gives_the_same_rows(local):
     """A chunk run here (no Dask) gives the rows the local cluster's workers gave."""
     spec = study_spec(FAMILY)
     chunk = [(i, v) for i, v in enumerate(designs(spec)) if i in (0, 3, 4, 35)]  # 0 does not close
-    assert run_chunk(_task(spec), chunk) == [local.rows[i] for i, _ in chunk]
+    assert run_chunk(study_task(spec), chunk) == [local.rows[i] for i, _ in chunk]
 
 
 def test_failing_designs_are_rows_with_their_reason():
@@ -370,7 +369,7 @@ def _json(capsys, argv):
 def test_rows_equal_the_single_commands_on_the_expanded_file(local, tmp_path, capsys):
     """A study's row is what mobility and sweep say of that design: given --arg with the row's
     values, or run on the URDF the xacro file expands to with them."""
-    task = _task(study_spec(FAMILY))
+    task = study_task(study_spec(FAMILY))
     text = (ROBOTS / "fourbar.urdf.xacro").read_text()
     checked = 0
     for r in local.rows:
@@ -454,7 +453,7 @@ def test_a_stalled_cluster_gives_failed_rows_not_a_hang():
     unfinished chunk is cancelled and its rows are failures that say so."""
     import distributed  # (as above: only these tests start a cluster)
 
-    task = dataclasses.replace(_task(study_spec(FAMILY)), timeout=0.2)
+    task = dataclasses.replace(study_task(study_spec(FAMILY)), timeout=0.2)
     chunks = [[(0, (0.021, 0.052, 0.032))], [(1, (0.021, 0.052, 0.081))]]
     with distributed.Client(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as client:
         futures = [client.submit(_stuck_chunk, task, c, pure=False) for c in chunks]

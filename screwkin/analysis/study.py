@@ -1,5 +1,5 @@
-"""Design-space studies: the designs of a family (a xacro file over its arguments), the
-metrics of each, run on Dask.
+"""Design-space studies: the designs of a family (a xacro file over its arguments) and the
+metrics of each (running many of them at once, on Dask, is screwkin.parallel.study).
 
 The designs are the grid of the parameters' values (first parameter slowest), or
 ``designs`` random or Latin-hypercube draws (``seed``).  Each design is loaded (the xacro
@@ -8,11 +8,8 @@ a design that fails -- the file refuses the values, the loops do not close, it i
 four-bar for ``grashof`` -- is a row whose ``error`` says why, with its metric columns
 empty: a study never loses a run to one design.
 
-Designs run in chunks, many per Dask task (:func:`run_chunk`), on a ``LocalCluster`` of
-processes on 127.0.0.1 by default or on an existing cluster (``scheduler="tcp://..."``);
-results come back in design order.  Every design is computed from its values alone (fresh
-mechanism, seeded searches), so the table is the same whatever the number of workers,
-the chunks or the scheduler.  ``workers=0`` runs the chunks in this process (no Dask).
+A chunk of designs is computed by :func:`run_chunk`, each design from its values alone (fresh
+mechanism, seeded searches), so the table is the same whatever runs the chunks.
 
 Values are SI: lengths in m, angles in rad (the transmission angles too; the CSV that
 people read gives degrees: screwkin.present.study).
@@ -20,16 +17,12 @@ people read gives degrees: screwkin.present.study).
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import itertools
-import logging
 import math
-import os
 import signal
 import threading
 import time
-import uuid
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,13 +31,12 @@ import numpy as np
 
 from ..errors import ScrewkinError, UsageError, one_line, quote
 from ..files.description import LIMITS
-from ..files.study import StudySpec, read_study_spec, study_spec
+from ..files.study import StudySpec
 from ..files.xmlsafe import read_regular_file
 from ..model.loader import load
 from .mobility import analyze_mobility
 from .planar import identify, transmission_angles
 from .position import PositionSolver
-from .scheduler import probe_scheduler, scheduler_address
 from .sweep import sweep
 from .workspace import DEFAULT_THRESHOLD, workspace
 
@@ -53,11 +45,13 @@ __all__ = [
     "METRICS",
     "DesignTimeout",
     "StudyResult",
-    "default_workers",
     "designs",
     "pareto_front",
     "run_chunk",
-    "run_study",
+    "study_task",
+    "check_pareto",
+    "failed_row",
+    "metric_columns",
 ]
 
 #: The columns each metric fills (keys of the rows, SI values).
@@ -79,9 +73,6 @@ _GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
 
 #: Relative margin at the ends of a limited input range (limit positions) in the transmission sweep.
 RANGE_MARGIN = 1e-9
-#: Seconds a Dask cluster may go without finishing any chunk beyond what its designs' timeouts allow
-#: (starting workers, importing screwkin, moving the rows) before the unfinished chunks are given up.
-STALL_GRACE = 60.0
 
 
 class DesignTimeout(ScrewkinError):
@@ -124,15 +115,6 @@ def _alarm(seconds: float):
         signal.signal(signal.SIGALRM, previous)
         if old_delay > 0:  # someone else's timer (pytest-timeout ...): put it back with what is left of it
             signal.setitimer(signal.ITIMER_REAL, max(old_delay - (time.perf_counter() - t0), 1e-3), old_interval)
-
-
-def default_workers() -> int:
-    """Workers of the local cluster by default: the cores, at most 4."""
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        cores = os.cpu_count() or 1
-    return max(1, min(cores, 4))
 
 
 # ------------------------------------------------------------------ the designs
@@ -402,7 +384,7 @@ class StudyResult:
         return tuple(r for r in self.rows if r["error"] is None)
 
 
-def _task(spec: StudySpec) -> _Task:
+def study_task(spec: StudySpec) -> _Task:
     raw = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")
     try:
         text = raw.decode("utf-8-sig")
@@ -446,11 +428,7 @@ def pareto_front(result: StudyResult, goals=None) -> list:
     return sorted(front, key=lambda k: result.rows[k][cols[0][0]])
 
 
-def _chunks(items: list, size: int) -> list:
-    return [items[i:i + size] for i in range(0, len(items), size)]
-
-
-def _check_pareto(spec: StudySpec) -> None:
+def check_pareto(spec: StudySpec) -> None:
     if spec.pareto:
         keys = (*(p.name for p in spec.parameters), *metric_columns(spec.metrics))
         for name, _ in spec.pareto:
@@ -459,145 +437,7 @@ def _check_pareto(spec: StudySpec) -> None:
                                  f"(columns: {', '.join(keys)})")
 
 
-def run_study(spec, scheduler: str | None = None, workers: int | None = None, progress=None,
-              timeout: float = 10.0, base=None) -> StudyResult:
-    """Run a study: ``spec`` a StudySpec, a spec file's path, or a dict (its ``file``
-    relative to ``base``, default the current folder).
-
-    scheduler: address of a running dask.distributed scheduler (``tcp://host:port``);
-               None: a LocalCluster of ``workers`` processes (default :func:`default_workers`)
-               on 127.0.0.1, closed at the end; ``workers=0``: in this process, no Dask.
-    progress:  callable(done, total, failed) called as chunks complete.
-    timeout:   seconds to reach the scheduler and its first worker (UsageError after).
-    """
-    if isinstance(spec, dict):
-        spec = study_spec(spec, "<dict>", Path(base) if base is not None else None)
-    elif not isinstance(spec, StudySpec):
-        spec = read_study_spec(spec)
-    _check_pareto(spec)
-    if scheduler is not None and workers is not None:
-        raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
-        raise UsageError(f"workers must be a whole number, 0 or more (0: in this process), got {workers!r}")
-    if not timeout > 0:
-        raise UsageError(f"the timeout must be positive, got {timeout!r}")
-    task = _task(spec)
-    values = designs(spec)
-    n_workers = default_workers() if workers is None and scheduler is None else (workers or 1)
-    size = spec.chunk or max(1, min(64, math.ceil(len(values) / (4 * max(n_workers, 1)))))
-    chunks = _chunks(list(enumerate(values)), size)
-    t0 = time.perf_counter()
-    if progress:
-        progress(0, len(values), 0)
-    if scheduler is None and workers == 0:
-        results, failed = [], 0
-        for k, chunk in enumerate(chunks):
-            results.append(run_chunk(task, chunk))
-            failed += sum(r["error"] is not None for r in results[-1])
-            if progress:
-                progress(sum(len(c) for c in chunks[:k + 1]), len(values), failed)
-        where, used = "in process", 1
-    else:
-        results, used, where = _on_dask(task, chunks, len(values), scheduler, workers or n_workers, timeout,
-                                        progress)
-    rows = tuple(r for chunk_rows in results for r in chunk_rows)
-    return StudyResult(spec, task.parameters, metric_columns(spec.metrics), rows, time.perf_counter() - t0, used,
-                       where, len(chunks))
-
-
-def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
-    """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
-    workers, where)."""
-    from distributed import (  # 0.4-0.9 s to import: only studies need it
-        Client,
-        LocalCluster,
-        as_completed,
-    )
-
-    cluster = client = None
-    futures = []
-    try:
-        if scheduler is not None:
-            address = scheduler_address(scheduler)
-            probe_scheduler(address, timeout)
-            try:
-                client = Client(address, timeout=timeout)
-                client.wait_for_workers(1, timeout=timeout)
-            except (OSError, TimeoutError) as exc:
-                what = "has no worker" if client is not None else "cannot be reached"
-                raise UsageError(f"the dask scheduler at {quote(address)} {what} within {timeout:g} s "
-                                 f"({one_line(str(exc) or type(exc).__name__, 160)})") from None
-            used, where = len(client.scheduler_info().get("workers", {})) or 1, address
-        else:
-            with warnings.catch_warnings():  # "Port 8787 is already in use": its HTTP routes then take another
-                warnings.filterwarnings("ignore", message="Port .* is already in use")
-                # processes on 127.0.0.1 only (the scheduler's HTTP routes too: no dashboard address given)
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                       dashboard_address=None, silence_logs=logging.ERROR)
-            client = Client(cluster, timeout=timeout)
-            used, where = workers, "local cluster"
-        token = uuid.uuid4().hex[:12]
-        futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
-                   for k, chunk in enumerate(chunks)]
-        results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
-        return results, used, where
-    finally:
-        if client is not None:
-            if futures:  # interrupted: take the study's tasks off the cluster
-                try:
-                    client.cancel(futures)
-                except Exception:  # noqa: BLE001, S110 - closing anyway
-                    pass
-            client.close()
-        if cluster is not None:
-            cluster.close()
-
-
-def _collect(client, task, chunks, futures, total, progress, as_completed, grace: float = STALL_GRACE,
-             poll: float = 0.05) -> list:
-    """The rows of every chunk's future, in chunk order.  A chunk whose task failed as a whole
-    (its worker died) is rows with that reason.  When no chunk finishes for the longest
-    chunk's designs' timeouts plus ``grace`` seconds, the chunks still running are past their
-    timeouts (a design stuck where its checks cannot see it): every unfinished chunk is
-    cancelled and its rows say so -- the study ends, it never hangs."""
-    index = {f.key: k for k, f in enumerate(futures)}
-    results = [None] * len(chunks)
-    done = failed = 0
-    stall = max((len(c) for c in chunks), default=1) * task.timeout + grace
-    ac = as_completed(futures)
-    last = time.perf_counter()
-    while done < total:
-        batch = [(f, None) for f in ac.next_batch(block=False)]
-        if not batch:
-            if time.perf_counter() - last <= stall:
-                time.sleep(poll)
-                continue
-            reason = (f"timed out: no part of the study finished for {stall:g} s (timeout {task.timeout:g} s per "
-                      "design); this design's task was cancelled unfinished")
-            unfinished = [f for f in futures if results[index[f.key]] is None]
-            client.cancel(unfinished)
-            batch = [(f, reason) for f in unfinished]
-        last = time.perf_counter()
-        for fut, reason in batch:
-            k = index[fut.key]
-            if results[k] is not None:
-                continue
-            if reason is None:
-                try:
-                    results[k] = fut.result()
-                except (Exception, asyncio.CancelledError) as exc:  # noqa: BLE001 - the task failed as a whole
-                    reason = (f"the task of designs {chunks[k][0][0]}-{chunks[k][-1][0]} failed on its worker: "
-                              f"{type(exc).__name__}: {one_line(str(exc), 200)}")
-            if reason is not None:
-                results[k] = [_failed_row(task, i, v, reason) for i, v in chunks[k]]
-            done += len(chunks[k])
-            failed += sum(r["error"] is not None for r in results[k])
-            if progress:
-                progress(done, total, failed)
-    return results
-
-
-def _failed_row(task, index, values, reason) -> dict:
+def failed_row(task, index, values, reason) -> dict:
     row = {"design": index, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(metric_columns(task.metrics)))
     row["error"] = reason

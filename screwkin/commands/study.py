@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
-from ..analysis.study import run_study
+from ..parallel.study import run_study
 from ..errors import UsageError, quote
 from ..files.study import read_study_spec
 from ..present.study import (

@@ -1,0 +1,190 @@
+"""Studies run in parallel: the designs of a study (screwkin.analysis.study: one design's
+metrics from its values alone) in chunks, on a ``LocalCluster`` of processes on 127.0.0.1 by
+default, an existing dask.distributed cluster (``scheduler="tcp://..."``, probed first:
+screwkin.parallel.scheduler), or in this process (``workers=0``).  Results come back in design
+order whatever the workers, chunks or scheduler; a chunk that stalls past the designs' time
+limits and a grace is given up, its designs failed rows that say why.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import math
+import os
+import time
+import uuid
+import warnings
+from pathlib import Path
+
+from ..analysis.study import (
+    StudyResult,
+    StudySpec,
+    check_pareto,
+    designs,
+    failed_row,
+    metric_columns,
+    run_chunk,
+    study_task,
+)
+from ..errors import UsageError, one_line, quote
+from ..files.study import read_study_spec, study_spec
+from .scheduler import probe_scheduler, scheduler_address
+
+__all__ = ["run_study", "default_workers", "STALL_GRACE"]
+
+
+#: Seconds a Dask cluster may go without finishing any chunk beyond what its designs' timeouts allow
+#: (starting workers, importing screwkin, moving the rows) before the unfinished chunks are given up.
+STALL_GRACE = 60.0
+
+
+def default_workers() -> int:
+    """Workers of the local cluster by default: the cores, at most 4."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    return max(1, min(cores, 4))
+
+
+def _chunks(items: list, size: int) -> list:
+    return [items[i:i + size] for i in range(0, len(items), size)]
+
+
+def run_study(spec, scheduler: str | None = None, workers: int | None = None, progress=None,
+              timeout: float = 10.0, base=None) -> StudyResult:
+    """Run a study: ``spec`` a StudySpec, a spec file's path, or a dict (its ``file``
+    relative to ``base``, default the current folder).
+
+    scheduler: address of a running dask.distributed scheduler (``tcp://host:port``);
+               None: a LocalCluster of ``workers`` processes (default :func:`default_workers`)
+               on 127.0.0.1, closed at the end; ``workers=0``: in this process, no Dask.
+    progress:  callable(done, total, failed) called as chunks complete.
+    timeout:   seconds to reach the scheduler and its first worker (UsageError after).
+    """
+    if isinstance(spec, dict):
+        spec = study_spec(spec, "<dict>", Path(base) if base is not None else None)
+    elif not isinstance(spec, StudySpec):
+        spec = read_study_spec(spec)
+    check_pareto(spec)
+    if scheduler is not None and workers is not None:
+        raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
+        raise UsageError(f"workers must be a whole number, 0 or more (0: in this process), got {workers!r}")
+    if not timeout > 0:
+        raise UsageError(f"the timeout must be positive, got {timeout!r}")
+    task = study_task(spec)
+    values = designs(spec)
+    n_workers = default_workers() if workers is None and scheduler is None else (workers or 1)
+    size = spec.chunk or max(1, min(64, math.ceil(len(values) / (4 * max(n_workers, 1)))))
+    chunks = _chunks(list(enumerate(values)), size)
+    t0 = time.perf_counter()
+    if progress:
+        progress(0, len(values), 0)
+    if scheduler is None and workers == 0:
+        results, failed = [], 0
+        for k, chunk in enumerate(chunks):
+            results.append(run_chunk(task, chunk))
+            failed += sum(r["error"] is not None for r in results[-1])
+            if progress:
+                progress(sum(len(c) for c in chunks[:k + 1]), len(values), failed)
+        where, used = "in process", 1
+    else:
+        results, used, where = _on_dask(task, chunks, len(values), scheduler, workers or n_workers, timeout,
+                                        progress)
+    rows = tuple(r for chunk_rows in results for r in chunk_rows)
+    return StudyResult(spec, task.parameters, metric_columns(spec.metrics), rows, time.perf_counter() - t0, used,
+                       where, len(chunks))
+
+
+def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
+    """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
+    workers, where)."""
+    from distributed import (  # 0.4-0.9 s to import: only studies need it
+        Client,
+        LocalCluster,
+        as_completed,
+    )
+
+    cluster = client = None
+    futures = []
+    try:
+        if scheduler is not None:
+            address = scheduler_address(scheduler)
+            probe_scheduler(address, timeout)
+            try:
+                client = Client(address, timeout=timeout)
+                client.wait_for_workers(1, timeout=timeout)
+            except (OSError, TimeoutError) as exc:
+                what = "has no worker" if client is not None else "cannot be reached"
+                raise UsageError(f"the dask scheduler at {quote(address)} {what} within {timeout:g} s "
+                                 f"({one_line(str(exc) or type(exc).__name__, 160)})") from None
+            used, where = len(client.scheduler_info().get("workers", {})) or 1, address
+        else:
+            with warnings.catch_warnings():  # "Port 8787 is already in use": its HTTP routes then take another
+                warnings.filterwarnings("ignore", message="Port .* is already in use")
+                # processes on 127.0.0.1 only (the scheduler's HTTP routes too: no dashboard address given)
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+            client = Client(cluster, timeout=timeout)
+            used, where = workers, "local cluster"
+        token = uuid.uuid4().hex[:12]
+        futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
+                   for k, chunk in enumerate(chunks)]
+        results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
+        return results, used, where
+    finally:
+        if client is not None:
+            if futures:  # interrupted: take the study's tasks off the cluster
+                try:
+                    client.cancel(futures)
+                except Exception:  # noqa: BLE001, S110 - closing anyway
+                    pass
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _collect(client, task, chunks, futures, total, progress, as_completed, grace: float = STALL_GRACE,
+             poll: float = 0.05) -> list:
+    """The rows of every chunk's future, in chunk order.  A chunk whose task failed as a whole
+    (its worker died) is rows with that reason.  When no chunk finishes for the longest
+    chunk's designs' timeouts plus ``grace`` seconds, the chunks still running are past their
+    timeouts (a design stuck where its checks cannot see it): every unfinished chunk is
+    cancelled and its rows say so -- the study ends, it never hangs."""
+    index = {f.key: k for k, f in enumerate(futures)}
+    results = [None] * len(chunks)
+    done = failed = 0
+    stall = max((len(c) for c in chunks), default=1) * task.timeout + grace
+    ac = as_completed(futures)
+    last = time.perf_counter()
+    while done < total:
+        batch = [(f, None) for f in ac.next_batch(block=False)]
+        if not batch:
+            if time.perf_counter() - last <= stall:
+                time.sleep(poll)
+                continue
+            reason = (f"timed out: no part of the study finished for {stall:g} s (timeout {task.timeout:g} s per "
+                      "design); this design's task was cancelled unfinished")
+            unfinished = [f for f in futures if results[index[f.key]] is None]
+            client.cancel(unfinished)
+            batch = [(f, reason) for f in unfinished]
+        last = time.perf_counter()
+        for fut, reason in batch:
+            k = index[fut.key]
+            if results[k] is not None:
+                continue
+            if reason is None:
+                try:
+                    results[k] = fut.result()
+                except (Exception, asyncio.CancelledError) as exc:  # noqa: BLE001 - the task failed as a whole
+                    reason = (f"the task of designs {chunks[k][0][0]}-{chunks[k][-1][0]} failed on its worker: "
+                              f"{type(exc).__name__}: {one_line(str(exc), 200)}")
+            if reason is not None:
+                results[k] = [failed_row(task, i, v, reason) for i, v in chunks[k]]
+            done += len(chunks[k])
+            failed += sum(r["error"] is not None for r in results[k])
+            if progress:
+                progress(done, total, failed)
+    return results
