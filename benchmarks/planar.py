@@ -114,8 +114,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     import screwkin
-    from screwkin.analysis.position import PositionSolver
-    from screwkin.analysis.sweep import sweep
+    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.motion.sweep import sweep
 
     fb = screwkin.load(ROOT / "robots" / "fourbar.urdf.xacro", args=FOURBAR)
     fb_solver = PositionSolver(fb)

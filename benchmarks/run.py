@@ -25,7 +25,7 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 import screwkin  # noqa: E402
-from screwkin.analysis.batch import SerialJacobians, frame_jacobians  # noqa: E402
+from screwkin.analysis.singularities.batch import SerialJacobians, frame_jacobians  # noqa: E402
 from study import report as study_report  # noqa: E402  (benchmarks/study.py, beside this file)
 
 
@@ -168,7 +168,7 @@ def closed_loop_fk(names, solves):
     import yaml
 
     from screwkin.model.linalg import null_space
-    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.motion.position import PositionSolver
 
     tb = _toolbox()
     rows = []
@@ -253,8 +253,8 @@ def closed_loop_fk(names, solves):
 
 # ---------------------------------------------------------------- 3. sweep throughput
 def sweep_throughput(steps):
-    from screwkin.analysis.position import PositionSolver
-    from screwkin.analysis.sweep import sweep
+    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.motion.sweep import sweep
 
     rows = []
     for name, inp, rng, fixed in (("gough_stewart_6ups", "leg1", (0.0, 0.1), {f"leg{k}": 0.0 for k in range(2, 7)}),

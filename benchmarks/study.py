@@ -76,7 +76,7 @@ def study_throughput(designs: int = 48, repeat: int = 2):
 
 
 def _import():
-    import screwkin.analysis.study  # noqa: F401
+    import screwkin.analysis.design.study  # noqa: F401
 
 
 def report(designs: int = 48, repeat: int = 2) -> list:

@@ -1,4 +1,4 @@
-"""Batched inverse kinematics (screwkin.analysis.batch.BatchClosure, what the workspace grid
+"""Batched inverse kinematics (screwkin.analysis.singularities.batch.BatchClosure, what the workspace grid
 uses) against one ClosureSystem solve per point (what every other command uses), on the same
 problems: the Delta's platform moved by 1 cm in a random direction from an assembled
 configuration, Newton from that configuration.  Then `screwkin workspace` end to end.
@@ -18,8 +18,8 @@ import pinocchio as pin
 
 import screwkin
 import screwkin.errors
-from screwkin.analysis.batch import BatchClosure
-from screwkin.analysis.workspace import workspace
+from screwkin.analysis.singularities.batch import BatchClosure
+from screwkin.analysis.design.workspace import workspace
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 

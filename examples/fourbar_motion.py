@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 import screwkin
-from screwkin.analysis.planar import identify
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.sweep import locate_singularities, sweep
+from screwkin.analysis.motion.planar import identify
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.motion.sweep import locate_singularities, sweep
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 steps = int(sys.argv[1]) if len(sys.argv) > 1 else 180

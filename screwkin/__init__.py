@@ -11,25 +11,21 @@ topology) <- ``analysis`` (results) <- ``present`` (text, JSON, pictures, views)
 ``cli``.  This module is the public API on top of them.
 """
 
-from .analysis.batch import SerialJacobians
-from .analysis.dynamics import DynamicsResult, Load, dynamics
-from .analysis.ik import inverse_kinematics
+from .analysis.singularities.batch import SerialJacobians
+from .analysis.forces.dynamics import DynamicsResult, Load, dynamics
+from .analysis.motion.ik import inverse_kinematics
 from .analysis.mobility import (
     IdleMotion,
     MobilityResult,
     OutputMotion,
     analyze_mobility,
 )
-from .analysis.position import (
-    PositionResult,
-    PositionSolver,
-    Solution,
-)
-from .analysis.scan import ScanResult, scan
-from .analysis.singular import SingularityReport, classify
-from .analysis.study import StudyResult, pareto_front
+from .analysis.motion.position import PositionResult, PositionSolver, Solution
+from .analysis.singularities.scan import ScanResult, scan
+from .analysis.singularities.singular import SingularityReport, classify
+from .analysis.design.study import StudyResult, pareto_front
 from .parallel.study import run_study as _run_study
-from .analysis.sweep import SweepResult, SweepSingularity, locate_singularities, sweep
+from .analysis.motion.sweep import SweepResult, SweepSingularity, locate_singularities, sweep
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
 from .model import loader as _loader
 from .model import mechanism as _mechanism

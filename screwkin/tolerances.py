@@ -50,6 +50,8 @@ class Tolerances:
                     over it, its neighbours and these, and the largest decides [-].
     samples:        nearby assembled configurations sampled for the generic rank [-].
     sample_step:    size of the random step to a nearby configuration [rad or m].
+    near_far:       a --near value the chosen mode misses by more than this is said to be missed
+                    [rad for angles, times the characteristic length for lengths].
     moves:          a joint moves (in the generic configurations) where its row of the
                     dimensionless motion basis is longer than this [-].
     stationary:     a joint is stationary (its rate forced to zero by the loops; its loop's
@@ -82,6 +84,7 @@ class Tolerances:
     generic_starts: int = 4
     samples: int = 3
     sample_step: float = 0.05
+    near_far: float = 0.5
     moves: float = 1e-6
     stationary: float = 1e-7
     equal: float = 1e-9

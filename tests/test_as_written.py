@@ -15,9 +15,9 @@ from conftest import DATA, circles
 from scipy.optimize import brentq
 
 import screwkin
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.singular import classify
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 
 STUDENT = DATA / "student"
@@ -329,7 +329,7 @@ def test_one_characteristic_length_everywhere(capsys):
     q = arm.neutral()
     for k, v in enumerate(values, 1):
         q[arm.coordinate(f"joint{k}").idx_q] = v
-    from screwkin.analysis.batch import SerialJacobians
+    from screwkin.analysis.singularities.batch import SerialJacobians
 
     api = SerialJacobians(arm, "flange").measures(q[None], "sigma_ratio")[0]
     sing = classify(arm, q, output="flange", inputs=[])
@@ -368,7 +368,7 @@ def test_3rpr_inverse_kinematics_labels_reversed_legs():
     mech = screwkin.load(DATA.parent.parent / "robots" / "planar_3rpr.urdf")
     home = mech.model.createData()
     pin.framesForwardKinematics(mech.model, home, mech.neutral())
-    from screwkin.analysis.ik import inverse_kinematics
+    from screwkin.analysis.motion.ik import inverse_kinematics
 
     res = inverse_kinematics(mech, "platform", home.oMf[mech.link_frame("platform")])
     first = res.solutions[0]
@@ -430,7 +430,7 @@ def test_loop_joint_written_like_a_joint(tmp_path):
     import numpy as np
 
     import screwkin
-    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.motion.position import PositionSolver
 
     path = tmp_path / "fourbar.urdf"
     path.write_text(JOINT_STYLE_LOOP)

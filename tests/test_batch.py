@@ -6,7 +6,7 @@ import pytest
 from conftest import LINK, ROBOTS, rev
 
 import screwkin
-from screwkin.analysis.batch import SerialJacobians, determinants, smallest_singular_values
+from screwkin.analysis.singularities.batch import SerialJacobians, determinants, smallest_singular_values
 from screwkin.errors import UsageError
 
 REFS = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
@@ -116,7 +116,7 @@ def test_scan_det_is_the_spherical_wrist_factorization():
     """arm_6r has a spherical wrist (axes 4, 5, 6 meet at the wrist centre w): the Jacobian
     at w is block triangular, so |det J| = |det[z_i x (w - p_i)], i = 1..3| |det[z4 z5 z6]|,
     computed here from Pinocchio's joint placements."""
-    from screwkin.analysis.scan import scan
+    from screwkin.analysis.singularities.scan import scan
 
     mech = screwkin.load(ROBOTS / "arm_6r.urdf")
     res = scan(mech, "flange", samples=3000, seed=7, measure="det")
@@ -141,7 +141,7 @@ def test_scan_sigma_ratio_matches_pinocchio_and_cli(tmp_path, capsys):
     import json
 
     from screwkin.cli import main
-    from screwkin.analysis.scan import scan
+    from screwkin.analysis.singularities.scan import scan
 
     mech = screwkin.load(ROBOTS / "arm_6r.urdf")
     res = scan(mech, "flange", samples=2000, seed=3, length=0.3)

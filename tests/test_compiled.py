@@ -6,7 +6,7 @@ import pytest
 from conftest import CORPUS, ROBOTS, fourbar
 
 import screwkin
-from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.motion.position import PositionSolver
 
 pytest.importorskip("numba")
 

@@ -13,8 +13,8 @@ import screwkin
 from conftest import ROBOTS
 from screwkin.model._pin import compute_frame_jacobian
 from screwkin.cli import main
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.motion.sweep import sweep
 
 GRIPPER = ROBOTS / "gripper_arm_mimic.urdf"
 

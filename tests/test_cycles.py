@@ -1,4 +1,4 @@
-"""analysis.cycles.fundamental_cycles: L = J - N + 1 loops (Euler's count for a connected
+"""analysis.course.cycles.fundamental_cycles: L = J - N + 1 loops (Euler's count for a connected
 graph), each a closed walk whose joints join consecutive links, every joint outside the
 tree closing exactly one of them."""
 
@@ -6,7 +6,7 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.cycles import fundamental_cycles
+from screwkin.analysis.course.cycles import fundamental_cycles
 
 
 @pytest.mark.parametrize("name, loops", [("fourbar_crank_rocker.urdf", 1), ("stephenson_sixbar.urdf", 2),

@@ -11,12 +11,7 @@ import pytest
 from conftest import ROBOTS
 
 import screwkin
-from screwkin.analysis.skeleton import (
-    kinematic_chain,
-    letters,
-    singular_configurations,
-    skeleton,
-)
+from screwkin.analysis.course.skeleton import kinematic_chain, letters, singular_configurations, skeleton
 from screwkin.cli import main
 from screwkin.present.draw import draw_chain, draw_mechanism
 
@@ -265,7 +260,7 @@ def test_bad_output_is_a_usage_error(args, message, tmp_path, capsys, monkeypatc
 def test_the_users_joint_letters_are_kept_and_links_numbered_once(tmp_path):
     """The quick start's four-bar names its joints O2, A, O4 and B (the loop joint): the drawing keeps
     them; equations numbers the links as draw does (ground 1, crank 2, coupler 3, rocker 4)."""
-    from screwkin.analysis.equations import equations
+    from screwkin.analysis.course.equations import equations
 
     text = (ROBOTS.parent / "README.md").read_text().split("cat > fourbar.urdf <<'EOF'\n", 1)[1].split("\nEOF\n")[0]
     path = tmp_path / "fourbar.urdf"

@@ -1,4 +1,4 @@
-"""The closed-form planar sweep (analysis/dyads.py) against the tracker it stands in for, and
+"""The closed-form planar sweep (analysis/motion/dyads.py) against the tracker it stands in for, and
 against circle intersections written here.
 
 Both run with a tight closure tolerance (1e-13): the tracker's corrector then lands within
@@ -14,10 +14,10 @@ import pytest
 
 import screwkin
 from conftest import CORPUS, ROBOTS
-from screwkin.analysis.dyads import planar_sweep
-from screwkin.analysis.motion import Point, motion_along
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.motion.dyads import planar_sweep
+from screwkin.analysis.motion.links import Point, motion_along
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.motion.sweep import sweep
 from screwkin.model.planar_graph import DyadPlan, plan
 from screwkin.tolerances import Tolerances
 
@@ -212,8 +212,8 @@ def test_batched_motion_and_transmission_angles_are_the_per_state_ones(name, lin
     """What `screwkin sweep` reports along the motion, computed on the stacks (motion_along,
     transmission_angles), equals the one-configuration functions (KinematicState, identify) at
     every step."""
-    from screwkin.analysis.motion import link_motions, point_motions
-    from screwkin.analysis.planar import LinkAngles, identify, transmission_angles
+    from screwkin.analysis.motion.links import link_motions, point_motions
+    from screwkin.analysis.motion.planar import LinkAngles, identify, transmission_angles
     from screwkin.model.state import KinematicState
 
     mech = screwkin.load(ROBOTS / name)

@@ -11,8 +11,8 @@ import pytest
 
 import screwkin
 from conftest import DATA, ROBOTS
-from screwkin.analysis.dynamics import Load, dynamics
-from screwkin.analysis.statics import statics
+from screwkin.analysis.forces.dynamics import Load, dynamics
+from screwkin.analysis.forces.statics import statics
 from screwkin.cli import main
 
 FOURBAR = DATA / "fourbar_inertial.urdf"

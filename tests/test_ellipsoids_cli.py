@@ -1,4 +1,4 @@
-"""singularities --ellipsoids: the numbers of screwkin.analysis.ellipsoids on the command line,
+"""singularities --ellipsoids: the numbers of screwkin.analysis.singularities.ellipsoids on the command line,
 checked on a planar 2R arm against the singular values of its closed-form Jacobian."""
 
 import json

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import sympy
 
-from screwkin.analysis.equations import VectorLoops, equations
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.course.equations import VectorLoops, equations
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 from screwkin.model.loader import load
 

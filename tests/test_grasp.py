@@ -22,7 +22,13 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull
 
 from conftest import ROOT
-from screwkin.analysis.grasp import GraspTolerances, analyze_grasp, contact_frame, cone_error, grasp_map
+from screwkin.analysis.forces.grasp import (
+    GraspTolerances,
+    analyze_grasp,
+    contact_frame,
+    cone_error,
+    grasp_map,
+)
 from screwkin.cli import main
 from screwkin.errors import MechanismFileError
 from screwkin.files.grasp import parse_grasp, read_grasp

@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from screwkin.analysis.maps import singularity_map
+from screwkin.analysis.singularities.maps import singularity_map
 
 from conftest import screwkin_cli
 

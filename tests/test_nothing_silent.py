@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 
 from conftest import ROBOTS
 from screwkin import load
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.motion.sweep import sweep
 from screwkin.present.report import sweep_dict, sweep_text
 
 
@@ -82,3 +83,46 @@ def test_mode_k_is_chosen_and_said(tmp_path, capsys):
     assert main(["singularities", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", "crank_joint=30deg",
                  "--mode", "3"]) == 2
     assert "give 2 assembly modes" in capsys.readouterr().err
+
+
+def test_a_near_value_the_mode_misses_is_said(tmp_path, capsys):
+    """issue 23 item 3: --near names only the rocker, at 170 deg; with the crank at 30 deg the four-bar's modes put
+    the rocker at 55.27 or -89.30 deg (law of cosines), so the mode found is far from the value given: said, in the
+    text and in JSON, with the value it has."""
+    import math
+
+    from screwkin.cli import main
+
+    path = tmp_path / "fourbar.urdf"
+    path.write_text(QUICK_FOURBAR)
+    g, a, b, c, t2 = 0.10, 0.04, 0.12, 0.08, math.radians(30)
+    A = (a * math.cos(t2), a * math.sin(t2))
+    d = math.hypot(g - A[0], A[1])
+    gamma = math.acos((c * c + d * d - b * b) / (2 * c * d))  # at O4 between O4->A and O4->B
+    phi = math.atan2(A[1], A[0] - g)
+    rockers = sorted(math.degrees(phi + s * gamma) for s in (1, -1))
+    assert main(["solve", str(path), "--set", "O2=30deg", "--near", "O4=170deg", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    (note,) = d["notes"]
+    got = math.degrees(d["solutions"][0]["joints"]["O4"])
+    assert min(abs(got - r) for r in rockers) < 1e-6 and "--near O4=170 deg" in note and f"{got:.4g} deg" in note
+    assert main(["solve", str(path), "--set", "O2=30deg", "--near", "O4=60deg", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["notes"] == []  # 55.27 deg is near 60 deg: nothing to say
+    assert main(["singularities", str(path), "--set", "O2=30deg", "--near", "O4=170deg"]) == 0
+    assert "--near O4=170 deg: the assembly mode found has O4" in capsys.readouterr().err
+
+
+QUICK_FOURBAR = """<?xml version="1.0"?>
+<robot name="my_fourbar">
+  <link name="ground"/> <link name="crank"/> <link name="coupler"/> <link name="rocker"/>
+  <joint name="O2" type="continuous"><parent link="ground"/> <child link="crank"/> <origin xyz="0 0 0"/>
+    <axis xyz="0 0 1"/></joint>
+  <joint name="A" type="continuous"><parent link="crank"/> <child link="coupler"/> <origin xyz="0.04 0 0"/>
+    <axis xyz="0 0 1"/></joint>
+  <joint name="O4" type="continuous"><parent link="ground"/> <child link="rocker"/> <origin xyz="0.10 0 0"/>
+    <axis xyz="0 0 1"/></joint>
+  <loop_joint name="B" type="revolute"><link1 link="coupler" xyz="0.12 0 0"/> <link2 link="rocker" xyz="0.08 0 0"/>
+    <axis xyz="0 0 1"/></loop_joint>
+  <transmission name="motor"><joint name="O2"/></transmission>
+</robot>
+"""

@@ -218,7 +218,7 @@ def _virtual_work_torque(mech, theta, output="link3", wrench=BENNETT_LOAD, h=1e-
     at theta +- h (the same assembly mode: the solutions nearest), the output frame's
     displacement twist by central differences of log6 from the middle placement, turned to world
     axes at the frame's origin (the load's convention), and power balance tau h + w . twist = 0."""
-    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.motion.position import PositionSolver
 
     solver = PositionSolver(mech, ["joint1"])
     q0 = solver.solve({"joint1": theta}).solutions[0].q
@@ -244,7 +244,7 @@ def _virtual_work_torque(mech, theta, output="link3", wrench=BENNETT_LOAD, h=1e-
 
 @pytest.mark.parametrize("theta", [0.3, 1.1, -0.8])
 def test_bennett_input_torque_by_virtual_work(theta):
-    from screwkin.analysis.statics import statics
+    from screwkin.analysis.forces.statics import statics
 
     mech = screwkin.load(ROBOTS / "bennett.urdf")
     assert list(mech.actuated) == ["joint1"]
@@ -302,7 +302,7 @@ def test_stewart_transmission_wrenches_are_the_leg_lines_reciprocal_to_the_passi
     twists (rotations about the U's axes a1 and a1 x d_k through B_k, and about three axes
     through P_k), and is what the locked actuator transmits.  Everything here is written from
     the file's joint centres and the platform placement (Pinocchio's forward kinematics)."""
-    from screwkin.analysis.statics import legs
+    from screwkin.analysis.forces.statics import legs
 
     path = ROBOTS / "gough_stewart_6ups.urdf"
     mech = screwkin.load(path)
@@ -345,7 +345,7 @@ def test_legs_constraint_wrenches_are_reciprocal_to_the_closed_form_platform_twi
     """Every leg's constraint wrench w satisfies w . t = 0 for every platform twist t of the
     closed-form space, and together they leave exactly that space (rank 6 - 3); screwkin's
     mobility of the platform is the same space."""
-    from screwkin.analysis.statics import legs
+    from screwkin.analysis.forces.statics import legs
 
     mech = screwkin.load(ROBOTS / f"{name}.urdf")
     for q in mech.generic_configurations()[1][:2]:

@@ -15,11 +15,11 @@ from scipy.optimize import brentq
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.ik import inverse_kinematics
-from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.motion.ik import inverse_kinematics
+from screwkin.analysis.motion.position import PositionSolver
 from screwkin.analysis.screws import split_jacobians
-from screwkin.analysis.singular import classify
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.motion.sweep import sweep
 
 
 def load(name, **kw):

@@ -9,7 +9,7 @@ import pytest
 import screwkin
 from conftest import fourbar
 from screwkin.cli import main
-from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.motion.position import PositionSolver
 
 G, A, B, C = 0.10, 0.04, 0.12, 0.08  # ground, crank, coupler, rocker of conftest.fourbar()
 
@@ -186,7 +186,7 @@ def test_track_refuses_what_it_cannot_reach(tmp_path):
 
 def test_outside_limits_compares_angles_modulo_a_turn(tmp_path):
     from conftest import LINK
-    from screwkin.analysis.position import outside_limits
+    from screwkin.analysis.motion.position import outside_limits
 
     body = "".join(LINK.format(n=n) for n in ("a", "b", "c"))
     body += ('<joint name="r" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'

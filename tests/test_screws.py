@@ -49,7 +49,7 @@ def test_revolute_twist_and_planar_form(tmp_path):
 
 
 def test_forward_jacobian_of_a_four_bar_against_finite_differences(tmp_path):
-    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.motion.position import PositionSolver
 
     p = tmp_path / "fb.urdf"
     p.write_text(fourbar())
@@ -71,7 +71,7 @@ def test_batched_singular_values_match_one_by_one():
     """The vectorized path (a stack of Jacobians, one SVD call) gives the per-configuration
     values, and finds the wrist singularity of the 6R arm (theta5 = 0)."""
     from conftest import ROBOTS
-    from screwkin.analysis.batch import frame_jacobians, smallest_singular_values
+    from screwkin.analysis.singularities.batch import frame_jacobians, smallest_singular_values
 
     mech = screwkin.load(ROBOTS / "arm_6r.urdf")
     rng = np.random.default_rng(0)
@@ -98,7 +98,7 @@ def test_every_joint_of_a_loop_the_cut_joint_included(capsys):
     import pinocchio as pin
 
     from screwkin import load
-    from screwkin.analysis.position import PositionSolver
+    from screwkin.analysis.motion.position import PositionSolver
     from screwkin.analysis.screws import loop_product, loop_screws
     from screwkin.cli import main
     from screwkin.model.state import KinematicState

@@ -9,9 +9,9 @@ import screwkin
 from screwkin.present.report import map_csv
 from conftest import fourbar, planar_3r, slider_crank
 from screwkin.cli import main
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.singular import classify
-from screwkin.analysis.sweep import locate_singularities, sweep
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.motion.sweep import locate_singularities, sweep
 from test_position import A, B, C, G
 
 
@@ -58,7 +58,7 @@ def test_four_bar_output_limits_located_along_a_sweep(tmp_path):
 
 
 def test_four_bar_rocker_input_dead_centre_is_an_actuator_singularity(tmp_path):
-    from screwkin.analysis.planar import identify
+    from screwkin.analysis.motion.planar import identify
 
     mech = load(tmp_path, fourbar(), actuated=["rocker_joint"])
     q = mech.assemble().q
@@ -116,7 +116,7 @@ def test_five_bar_map_finds_the_folded_legs(tmp_path):
     60 deg): its serial singularities are where a leg is folded or stretched, |O_i P| = 0.05 or
     0.25 m.  Every grid point the map marks singular (sigma < 10^-2.5) lies next to such a point."""
     from conftest import ROBOTS
-    from screwkin.analysis.maps import singularity_map
+    from screwkin.analysis.singularities.maps import singularity_map
 
     mech = screwkin.load(ROBOTS / "five_bar.urdf")
     solver = PositionSolver(mech)

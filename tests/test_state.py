@@ -17,7 +17,7 @@ import sympy as sp
 
 from conftest import ROBOTS, circles
 from screwkin import load
-from screwkin.analysis.position import PositionSolver
+from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
 from screwkin.model.state import KinematicState
 
@@ -229,9 +229,9 @@ def test_sweep_plot_shows_absolute_link_motion_and_point_paths(tmp_path):
     """The planar sweep plot draws the links' absolute angle/omega/alpha (the vector-loop angle of the
     coupler, unwrapped) and the slider's loop coordinate, and a panel with the point's path in mm."""
     pytest.importorskip("matplotlib")
-    from screwkin.analysis.motion import Point, motion_along
-    from screwkin.analysis.planar import LinkAngles
-    from screwkin.analysis.sweep import sweep
+    from screwkin.analysis.motion.links import Point, motion_along
+    from screwkin.analysis.motion.planar import LinkAngles
+    from screwkin.analysis.motion.sweep import sweep
     from screwkin.present.plots import absolute_series, sweep_figure
 
     path = tmp_path / "slider.urdf"

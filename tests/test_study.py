@@ -21,8 +21,8 @@ import yaml
 from conftest import ROBOTS
 
 import screwkin
-import screwkin.analysis.study as st
-from screwkin.analysis.study import (
+import screwkin.analysis.design.study as st
+from screwkin.analysis.design.study import (
     _GRASHOF,
     StudyResult,
     design_args,

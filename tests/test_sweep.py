@@ -6,9 +6,9 @@ import pytest
 import screwkin
 from conftest import fourbar
 from screwkin.cli import main
-from screwkin.analysis.planar import identify
-from screwkin.analysis.position import PositionSolver
-from screwkin.analysis.sweep import sweep
+from screwkin.analysis.motion.planar import identify
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.motion.sweep import sweep
 from test_position import A, B, C, G, rocker_angles, world_angles
 
 STEPS = 360

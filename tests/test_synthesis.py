@@ -11,11 +11,11 @@ import pytest
 from conftest import circles
 
 import screwkin
-from screwkin.analysis.skeleton import numbering
-from screwkin.analysis.synthesis.check import check_design
-from screwkin.analysis.synthesis.designs import Dyad
-from screwkin.analysis.synthesis.function import parse_function
-from screwkin.analysis.synthesis.motion import motion_design
+from screwkin.analysis.course.skeleton import numbering
+from screwkin.analysis.design.synthesis.check import check_design
+from screwkin.analysis.design.synthesis.designs import Dyad
+from screwkin.analysis.design.synthesis.function import parse_function
+from screwkin.analysis.design.synthesis.motion import motion_design
 from screwkin.cli import main
 from screwkin.errors import UsageError
 from screwkin.files.writer import write_urdf

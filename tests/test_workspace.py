@@ -17,9 +17,9 @@ import pytest
 from conftest import ROBOTS, screwkin_cli
 
 import screwkin
-from screwkin.analysis.batch import BatchClosure
-from screwkin.analysis.ik import inverse_kinematics
-from screwkin.analysis.workspace import workspace
+from screwkin.analysis.singularities.batch import BatchClosure
+from screwkin.analysis.motion.ik import inverse_kinematics
+from screwkin.analysis.design.workspace import workspace
 from screwkin.errors import UsageError
 
 

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import screwkin
-from screwkin.analysis.planar import identify
+from screwkin.analysis.motion.planar import identify
 from screwkin.cli import main
 from screwkin.files.xacro import (
     XacroEvaluationError,

@@ -9,9 +9,9 @@ import sys
 
 import numpy as np
 
-from ..analysis.motion import Point
-from ..analysis.planar import LinkAngles
-from ..analysis.position import PositionSolver
+from ..analysis.motion.links import Point
+from ..analysis.motion.planar import LinkAngles
+from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
 from ..model.state import value_for_leg_length
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
@@ -43,7 +43,7 @@ def add_point_option(sp, origin_help: str | None = None):
 
 
 def named_points(mech, args) -> tuple:
-    """The analysis.motion.Point objects of --point NAME=LINK:x,y,z (links checked, names unique)."""
+    """The analysis.motion.links.Point objects of --point NAME=LINK:x,y,z (links checked, names unique)."""
     out, seen = [], set()
     for text in getattr(args, "points", None) or []:
         name, sep, rest = text.rpartition("=")
@@ -170,6 +170,8 @@ def configuration(mech, args):
                              "choose among the modes of those inputs")
         return mech.generic_configurations()[0].q
     res = PositionSolver(mech, list(values)).solve(values, near=near)
+    for note in res.notes:  # a --near value the mode found lies far from
+        print(f"note: {note}", file=sys.stderr)
     n = len(res.solutions)
     k = wanted or 1
     if k > n:

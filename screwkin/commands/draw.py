@@ -10,15 +10,10 @@ import os
 
 import numpy as np
 
-from ..analysis.motion import motion_along
-from ..analysis.position import PositionSolver
-from ..analysis.sweep import sweep
-from ..analysis.skeleton import (
-    kinematic_chain,
-    singular_configurations,
-    skeleton,
-    trace_points,
-)
+from ..analysis.motion.links import motion_along
+from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import sweep
+from ..analysis.course.skeleton import kinematic_chain, singular_configurations, skeleton, trace_points
 from ..errors import UsageError, quote
 from ..present.animate import animation_format, write_animation
 from ..present.draw import (

@@ -7,7 +7,7 @@ import json
 import math
 import os
 
-from ..analysis.dynamics import Load, dynamics
+from ..analysis.forces.dynamics import Load, dynamics
 from ..errors import UsageError, quote
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.report import to_jsonable

@@ -8,8 +8,8 @@ import json
 
 import numpy as np
 
-from ..analysis.equations import VectorLoops, equations, newton
-from ..analysis.position import PositionSolver
+from ..analysis.course.equations import VectorLoops, equations, newton
+from ..analysis.motion.position import PositionSolver
 from ..errors import AssemblyError, UsageError
 from ..present.equations import (
     Units,

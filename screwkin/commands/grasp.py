@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 
-from ..analysis.grasp import GRASP_TOLERANCES, analyze_grasp
+from ..analysis.forces.grasp import GRASP_TOLERANCES, analyze_grasp
 from ..errors import UsageError
 from ..files.grasp import read_grasp
 from ..present.grasp import grasp_dict, grasp_text

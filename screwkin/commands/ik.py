@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pinocchio as pin
 
-from ..analysis.ik import inverse_kinematics
+from ..analysis.motion.ik import inverse_kinematics
 from ..errors import UsageError
 from ..present.report import (
     position_dict,

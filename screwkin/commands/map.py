@@ -6,8 +6,8 @@ import json
 
 import numpy as np
 
-from ..analysis.maps import singularity_map
-from ..analysis.position import PositionSolver
+from ..analysis.singularities.maps import singularity_map
+from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError
 from ..present.plots import map_png
 from ..present.report import (

@@ -16,16 +16,11 @@ import tempfile
 
 import numpy as np
 
-from ..analysis.equations import VectorLoops, equations, newton
+from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
-from ..analysis.planar import identify, transmission_angles
-from ..analysis.position import PositionSolver
-from ..analysis.skeleton import (
-    default_output,
-    kinematic_chain,
-    singular_configurations,
-    skeleton,
-)
+from ..analysis.motion.planar import identify, transmission_angles
+from ..analysis.motion.position import PositionSolver
+from ..analysis.course.skeleton import default_output, kinematic_chain, singular_configurations, skeleton
 from ..errors import ScrewkinError, UsageError
 from ..present.document import (
     Document,

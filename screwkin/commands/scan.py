@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import time
 
-from ..analysis.scan import scan
+from ..analysis.singularities.scan import scan
 from ..present.report import (
     scan_csv,
     scan_dict,

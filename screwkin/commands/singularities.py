@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 
-from ..analysis.ellipsoids import ellipsoids
-from ..analysis.gram_symbolic import symbolic_gram
-from ..analysis.singular import classify
+from ..analysis.singularities.ellipsoids import ellipsoids
+from ..analysis.singularities.gram_symbolic import symbolic_gram
+from ..analysis.singularities.singular import classify
 from ..errors import UsageError
 from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text
 from ..present.report import (

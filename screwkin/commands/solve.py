@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from ..analysis.position import PositionSolver
+from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError
 from ..present.report import (
     position_dict,

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 
-from ..analysis.statics import legs, statics
+from ..analysis.forces.statics import legs, statics
 from ..errors import UsageError
 from ..present.report import to_jsonable
 from ..present.statics import statics_dict, statics_text

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import os
 
-from ..analysis.motion import motion_along, strokes
-from ..analysis.planar import LinkAngles, identify, transmission_angles
-from ..analysis.position import PositionSolver
-from ..analysis.sweep import locate_singularities, sweep
+from ..analysis.motion.links import motion_along, strokes
+from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
+from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import locate_singularities, sweep
 from ..errors import UsageError
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.plots import sweep_plot

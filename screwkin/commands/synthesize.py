@@ -3,7 +3,7 @@
 KIND is ``motion`` (rigid-body guidance through 3-5 poses), ``function`` (Freudenstein),
 ``path`` (a coupler point through points) or ``chains`` (type and number synthesis).  Each
 writes URDF that every other command loads, and checks it with screwkin's own analyses
-before reporting it (screwkin.analysis.synthesis.check): a result with a defect is reported
+before reporting it (screwkin.analysis.design.synthesis.check): a result with a defect is reported
 with the defect; ``--reject-defects`` leaves such results out and fails (exit 1) when
 nothing is left.  A file is checked under a temporary name beside OUT and then renamed to
 OUT, so OUT is the checked file and a rejected result leaves no file.
@@ -18,12 +18,12 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from ..analysis.synthesis.chains import chain_linkage, enumerate_chains
-from ..analysis.synthesis.check import check_chain_file, check_design
-from ..analysis.synthesis.designs import SynthesisError
-from ..analysis.synthesis.function import synthesize_function
-from ..analysis.synthesis.motion import motion_design, synthesize_motion
-from ..analysis.synthesis.path import synthesize_path
+from ..analysis.design.synthesis.chains import chain_linkage, enumerate_chains
+from ..analysis.design.synthesis.check import check_chain_file, check_design
+from ..analysis.design.synthesis.designs import SynthesisError
+from ..analysis.design.synthesis.function import synthesize_function
+from ..analysis.design.synthesis.motion import motion_design, synthesize_motion
+from ..analysis.design.synthesis.path import synthesize_path
 from ..errors import UsageError, quote
 from ..files.description import LIMITS
 from ..files.writer import write_urdf

@@ -9,10 +9,10 @@ import signal
 import tempfile
 import time
 
-from ..analysis.interactive import Interactive
-from ..analysis.position import PositionSolver
-from ..analysis.singular import classify
-from ..analysis.sweep import locate_singularities, sweep
+from ..analysis.motion.interactive import Interactive
+from ..analysis.motion.position import PositionSolver
+from ..analysis.singularities.singular import classify
+from ..analysis.motion.sweep import locate_singularities, sweep
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module

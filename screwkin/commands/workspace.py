@@ -10,7 +10,7 @@ import tempfile
 import numpy as np
 import pinocchio as pin
 
-from ..analysis.workspace import DEFAULT_THRESHOLD, workspace
+from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
 from ..errors import UsageError
 from ..present.report import to_jsonable
 from ..present.view import ViewerServer, build_scene, screenshot, show

@@ -34,7 +34,7 @@ from .xmlsafe import load_yaml_text, read_regular_file
 __all__ = ["DESIGN_TIMEOUT", "MAX_DESIGNS", "METRICS", "SAMPLINGS", "WORKSPACE_METRICS", "Parameter", "StudySpec",
            "read_study_spec", "study_spec"]
 
-#: The metrics a study may ask for (what each computes: screwkin.analysis.study).
+#: The metrics a study may ask for (what each computes: screwkin.analysis.design.study).
 METRICS = ("mobility", "grashof", "transmission_angle", "workspace_volume", "singularity_free_volume",
            "conditioning")
 SAMPLINGS = ("grid", "random", "lhs")
@@ -44,7 +44,7 @@ MAX_DESIGNS = 1_000_000
 MAX_VALUES = 100_000
 #: Seconds one design may take by default (the spec's ``timeout``); a design over it is a failed row.
 DESIGN_TIMEOUT = 120.0
-#: The metrics computed from screwkin.analysis.workspace (they need ``workspace: {resolution: H}``).
+#: The metrics computed from screwkin.analysis.design.workspace (they need ``workspace: {resolution: H}``).
 WORKSPACE_METRICS = ("workspace_volume", "singularity_free_volume", "conditioning")
 _KEYS = ("file", "args", "parameters", "sampling", "designs", "seed", "metrics", "input", "output", "point",
          "workspace", "transmission", "pareto", "chunk", "timeout")

@@ -1,7 +1,7 @@
 """The one damped-Newton (Levenberg-Marquardt) step of every closure solver.
 
 The single solver (model.closure.ClosureSystem.solve), the batched one
-(analysis.batch_closure.BatchClosure.solve) and the compiled kernel (model.compiled)
+(analysis.motion.batch_closure.BatchClosure.solve) and the compiled kernel (model.compiled)
 take the same step with the same constants:
 
 - the step is the minimum-norm damped step on the free columns of K,

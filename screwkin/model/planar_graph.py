@@ -1,7 +1,7 @@
 """A planar mechanism's decomposition into its swept input and class-II dyads (Assur groups
 of two links and three joints), from the topology alone: which links the held inputs weld
 together (groups), then, from the ground, the swept input joint and dyads whose two outer
-joints sit on groups already placed.  The geometry is read by screwkin.analysis.dyads.
+joints sit on groups already placed.  The geometry is read by screwkin.analysis.motion.dyads.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ class _Pair:
 @dataclass(frozen=True)
 class DyadPlan:
     """How a planar mechanism decomposes with its inputs held (topology only; the geometry is
-    read at q0 by screwkin.analysis.dyads): the group (links welded by held inputs and fixed loop
+    read at q0 by screwkin.analysis.motion.dyads): the group (links welded by held inputs and fixed loop
     joints) of every body, the
     swept input joint and the dyads in solving order as (kind, A, B, C) pair indices."""
 

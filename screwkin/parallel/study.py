@@ -1,4 +1,4 @@
-"""Studies run in parallel: the designs of a study (screwkin.analysis.study: one design's
+"""Studies run in parallel: the designs of a study (screwkin.analysis.design.study: one design's
 metrics from its values alone) in chunks, on a ``LocalCluster`` of processes on 127.0.0.1 by
 default, an existing dask.distributed cluster (``scheduler="tcp://..."``, probed first:
 screwkin.parallel.scheduler), or in this process (``workers=0``).  Results come back in design
@@ -17,7 +17,7 @@ import uuid
 import warnings
 from pathlib import Path
 
-from ..analysis.study import (
+from ..analysis.design.study import (
     StudyResult,
     StudySpec,
     check_pareto,

@@ -24,7 +24,7 @@ from html import escape
 
 import numpy as np
 
-from ..analysis.vector_loops import PlanarEquations
+from ..analysis.course.vector_loops import PlanarEquations
 from .equations import Units, equations_text, greek, newton_text
 from .tables import shown
 from .report import (

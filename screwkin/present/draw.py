@@ -1,5 +1,5 @@
 """Skeleton diagrams and kinematic-chain graphs with matplotlib (the Agg backend: files, never
-a window), in textbook notation, from the plain data of :mod:`screwkin.analysis.skeleton`.
+a window), in textbook notation, from the plain data of :mod:`screwkin.analysis.course.skeleton`.
 
 Every symbol carries a gid that names what it stands for, so a program (a test, a report)
 can find it in the returned Figure: ``link:N`` one artist per link (a bar, a polygon, a
@@ -70,7 +70,7 @@ def _frame(fig, ax, points, r, limits=None):
 
 def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitle: str | None = None,
                    traces: dict | None = None, size: float | None = None, limits=None):
-    """The skeleton diagram of a :class:`~screwkin.analysis.skeleton.Skeleton` as a matplotlib
+    """The skeleton diagram of a :class:`~screwkin.analysis.course.skeleton.Skeleton` as a matplotlib
     Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
     higher pairs as their profiles, binary links as bars, ternary and larger links as filled
     polygons, links numbered (ground 1) and joints lettered with a legend to the file's
@@ -321,7 +321,7 @@ def _legend(fig, links, joints):
 
 
 def draw_chain(chain, title: str | None = None):
-    """The kinematic chain (:class:`~screwkin.analysis.skeleton.KinematicChain`) as a Figure: a
+    """The kinematic chain (:class:`~screwkin.analysis.course.skeleton.KinematicChain`) as a Figure: a
     node per link (a circle for a link with at most two joints, a triangle for a ternary link,
     a square for a quaternary one ...; the ground hatched), an edge per joint labelled with its
     letter and type (R, P, S, U, rolling, contact, ...), several joints between two links as

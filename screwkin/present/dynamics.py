@@ -1,11 +1,11 @@
-"""Dynamics results (screwkin.analysis.dynamics) as text, JSON-ready dictionaries, CSV and a plot
+"""Dynamics results (screwkin.analysis.forces.dynamics) as text, JSON-ready dictionaries, CSV and a plot
 of the effort against the input."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..analysis.dynamics import COMPONENTS, DynamicsResult
+from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
 from ..units import parse_value
 from .plots import _pyplot
 from .report import sweep_rows

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..analysis.ellipsoids import Ellipsoids
+from ..analysis.singularities.ellipsoids import Ellipsoids
 from .report import table
 
 __all__ = ["ellipsoids_dict", "ellipsoids_text"]

@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 
-from ..analysis.vector_loops import PlanarEquations
+from ..analysis.course.vector_loops import PlanarEquations
 from .report import screws_dict, screws_text, table
 from .tables import shown
 

@@ -1,4 +1,4 @@
-"""A grasp analysis (screwkin.analysis.grasp.GraspResult) as text and as a JSON-ready dictionary."""
+"""A grasp analysis (screwkin.analysis.forces.grasp.GraspResult) as text and as a JSON-ready dictionary."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..analysis.grasp import GraspResult
+from ..analysis.forces.grasp import GraspResult
 from ..analysis.screws import screw_of
 from ..model.geometry import TINY
 from ..tolerances import DEFAULT

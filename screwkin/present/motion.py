@@ -1,5 +1,5 @@
 """Absolute motion in the user's quantities as text and JSON: links, named points, loop joints
-(the results of analysis/motion.py and the solutions of analysis/position.py)."""
+(the results of analysis/motion/links.py and the solutions of analysis/motion/position.py)."""
 
 from __future__ import annotations
 
@@ -64,7 +64,7 @@ def linkage_construction_text(d: dict) -> str:
 
 
 def motion_dict(m) -> dict:
-    """A sweep's analysis.motion.MotionAlong as JSON-ready lists, one entry per step."""
+    """A sweep's analysis.motion.links.MotionAlong as JSON-ready lists, one entry per step."""
     return {"loop_joints": m.loop_joints, "loop_rates": m.loop_rates, "loop_accelerations": m.loop_accelerations,
             "links": m.links, "points": m.points}
 

@@ -152,7 +152,7 @@ def absolute_series(res, motion, linear=None):
 
 def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
     """A sweep into a PNG (see :func:`sweep_figure` for what is drawn): for a planar mechanism with
-    ``motion`` (analysis.motion.MotionAlong) the links' absolute angle, omega and alpha and the
+    ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle, omega and alpha and the
     sliders' coordinates, else the joint values; the named points' paths in a fourth panel."""
     plt = _pyplot("--plot")
     absolute = absolute_series(res, motion, linear)

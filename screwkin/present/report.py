@@ -6,25 +6,23 @@ how they are written out, for the command line and for ``screwkin.to_dict``.
 
 from __future__ import annotations
 
-import json
-import math
-
 import numpy as np
 
-from ..analysis.maps import SingularityMap
+from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
-from ..analysis.planar import LinkageInfo
-from ..analysis.position import PositionResult
-from ..analysis.scan import ScanResult
+from ..analysis.motion.planar import LinkageInfo
+from ..analysis.motion.position import PositionResult
+from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
-from ..analysis.singular import SingularityReport
-from ..analysis.sweep import SweepResult, SweepSingularity
+from ..analysis.singularities.singular import SingularityReport
+from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from .motion import linkage_construction_text, links_table, points_table
 from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
 from .tables import column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
 from ..tolerances import DEFAULT
+from .jsonout import json_text, nan_to_none, to_jsonable  # noqa: F401 - json_text exported here as before
 
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
@@ -195,67 +193,6 @@ def mobility_text(r) -> str:
     return "\n".join(lines)
 
 
-def to_jsonable(obj, _where: str = ""):
-    """Plain Python for json.dumps: numpy values as numbers and lists; an infinite number (the
-    condition number of a singular matrix, an unbounded effort) as the string "inf" or "-inf",
-    since JSON has no Infinity.  A NaN is a bug, never an answer: RuntimeError naming where it
-    sits (a value that does not exist -- a map cell off the branch -- is None, written so by
-    the analysis that knows why)."""
-    if isinstance(obj, dict):
-        return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        if isinstance(obj, list) and _numbers(obj):  # finite floats only: nothing to convert
-            return obj
-        return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
-    if isinstance(obj, np.ndarray):
-        if obj.dtype.kind == "f" and np.isfinite(obj).all():  # (a sweep's arrays: one C call, not a call a number)
-            return obj.tolist()
-        return to_jsonable(obj.tolist(), _where)
-    if isinstance(obj, np.generic):
-        obj = obj.item()
-    if isinstance(obj, float) and not np.isfinite(obj):
-        if np.isnan(obj):
-            raise RuntimeError(f"internal error: NaN in the JSON output at {_where.lstrip('.') or 'the top'}")
-        return "inf" if obj > 0 else "-inf"
-    return obj
-
-
-def nan_to_none(a) -> list:
-    """An array whose NaN entries mean 'no value here' (said so by its analysis) as nested lists
-    with None there, for to_jsonable."""
-    a = np.asarray(a, float)
-    return np.where(np.isnan(a), None, a.astype(object)).tolist()
-
-
-def json_text(obj, indent: int = 2, _level: int = 0) -> str:
-    """json.dumps(obj, indent=indent) of to_jsonable's output, character for character, with the
-    lists of numbers (a sweep's tens of thousands of values) written in one join each instead of
-    json's pure-Python encoder (the one it uses with indent), which takes seconds on them."""
-    pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
-    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):
-        if not obj:
-            return "{}"
-        items = (f"{inner}{json.dumps(k)}: {json_text(v, indent, _level + 1)}" for k, v in obj.items())
-        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
-    if isinstance(obj, (list, tuple)):
-        if not obj:
-            return "[]"
-        if _numbers(obj):
-            return "[\n" + inner + (",\n" + inner).join(map(float.__repr__, obj)) + "\n" + pad + "]"
-        if all(isinstance(v, list) and v and _numbers(v) for v in obj):  # rows of numbers (vectors along a sweep)
-            deeper = inner + " " * indent
-            sep = ",\n" + deeper
-            rows = ("[\n" + deeper + sep.join(map(float.__repr__, v)) + "\n" + inner + "]" for v in obj)
-            return "[\n" + inner + (",\n" + inner).join(rows) + "\n" + pad + "]"
-        return "[\n" + ",\n".join(inner + json_text(v, indent, _level + 1) for v in obj) + "\n" + pad + "]"
-    return json.dumps(obj, indent=indent).replace("\n", "\n" + pad)
-
-
-def _numbers(values) -> bool:
-    """A list of finite floats only (two loops in C)."""
-    return set(map(type, values)) == {float} and all(map(math.isfinite, values))
-
-
 def position_dict(res) -> dict:
     sols = []
     for s in res.solutions:
@@ -295,7 +232,7 @@ def position_dict(res) -> dict:
         sols.append(d)
     return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
             "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols,
-            "physical_solutions": sum(s.physical for s in res.solutions)}
+            "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes)}
 
 
 def value_text(name, value, angular) -> str:
@@ -333,6 +270,8 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
         why = sorted({lab.split(":")[0].split(" (")[0] for s in res.solutions if not s.physical for lab in s.labels})
         lines.append(f"of the {n}, {n - hidden} reachable by moving from the drawn configuration and shown; "
                      f"{hidden} not ({'; '.join(why)}): --all shows them")
+    for note in res.notes:
+        lines.append(f"note: {note}")
     if res.free_dofs:
         lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
                      "the solutions form a continuum and only some are shown")
@@ -559,7 +498,7 @@ def sweep_dict(res: SweepResult, mech=None) -> dict:
 
 def sweep_csv(res: SweepResult, motion=None) -> str:
     """One row per step: the input, every joint value, rate and acceleration, the coupled joints; with
-    ``motion`` (analysis.motion.MotionAlong) the loop joints, each link's absolute angle (planar) and
+    ``motion`` (analysis.motion.links.MotionAlong) the loop joints, each link's absolute angle (planar) and
     each named point's x, y, z [m]."""
     coupled = res.coupled or {}
     head = ["step", res.input + "_input"] + list(res.names) + [f"d_{n}" for n in res.names] + [

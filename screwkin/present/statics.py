@@ -1,10 +1,10 @@
-"""Statics results (screwkin.analysis.statics) as text and JSON-ready dictionaries."""
+"""Statics results (screwkin.analysis.forces.statics) as text and JSON-ready dictionaries."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..analysis.statics import Leg, StaticsResult
+from ..analysis.forces.statics import Leg, StaticsResult
 from .report import screw_dict, table
 from .tables import shown
 

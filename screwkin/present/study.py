@@ -2,7 +2,7 @@
 JSON, plots (metrics against parameters, the Pareto front of two metrics) and the
 progress bar.
 
-The rows of screwkin.analysis.study are SI (angles in rad); the table people read names
+The rows of screwkin.analysis.design.study are SI (angles in rad); the table people read names
 its columns with their units where they are not SI's obvious ones: the transmission
 angles are ``transmission_angle_min_deg`` and ``transmission_angle_max_deg`` (degrees),
 ``grashof_margin_m`` is (p + q) - (s + l) in metres.  Parameters keep their names (the
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.study import pareto_front
+from ..analysis.design.study import pareto_front
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from .plots import _pyplot

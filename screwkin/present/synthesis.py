@@ -13,15 +13,9 @@ import math
 
 import numpy as np
 
-from ..analysis.synthesis.designs import (
-    ChainsResult,
-    Check,
-    FunctionResult,
-    MotionResult,
-    PathResult,
-)
-from ..analysis.synthesis.chains import guides_of
-from ..analysis.synthesis.fourbar import tool_local
+from ..analysis.design.synthesis.designs import ChainsResult, Check, FunctionResult, MotionResult, PathResult
+from ..analysis.design.synthesis.chains import guides_of
+from ..analysis.design.synthesis.fourbar import tool_local
 from .report import table, to_jsonable
 from .tables import shown
 

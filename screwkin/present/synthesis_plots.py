@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from ..analysis.synthesis.designs import MotionResult
+from ..analysis.design.synthesis.designs import MotionResult
 from .plots import _pyplot
 
 __all__ = ["burmester_png"]

@@ -1,14 +1,14 @@
 """Planar mechanisms seen as planar in meshcat (``view``'s pictures): an orthographic camera on
 the plane's normal, the drawing plane's axes as the picture's (the skeleton diagram's e1 to the
-right, e2 up: :func:`screwkin.analysis.planar.plane_basis`), and one colour per link, the
+right, e2 up: :func:`screwkin.analysis.motion.planar.plane_basis`), and one colour per link, the
 colours and numbers of ``screwkin draw`` (ground dark grey)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..analysis.planar import plane_basis
-from ..analysis.skeleton import numbering
+from ..analysis.motion.planar import plane_basis
+from ..analysis.course.skeleton import numbering
 from .draw import _colours
 
 __all__ = ["GROUND", "planar_basis", "link_colours", "colour_links", "top_view"]

@@ -1,4 +1,4 @@
-"""Workspaces (screwkin.analysis.workspace) as text, JSON-ready dictionaries, CSV, pictures
+"""Workspaces (screwkin.analysis.design.workspace) as text, JSON-ready dictionaries, CSV, pictures
 (slices with matplotlib) and a meshcat point cloud."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ..analysis.workspace import WorkspaceResult
+from ..analysis.design.workspace import WorkspaceResult
 from ..tolerances import DEFAULT
 from .plots import _pyplot
 from .report import table

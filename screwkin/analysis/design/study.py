@@ -1,0 +1,444 @@
+"""Design-space studies: the designs of a family (a xacro file over its arguments) and the
+metrics of each (running many of them at once, on Dask, is screwkin.parallel.study).
+
+The designs are the grid of the parameters' values (first parameter slowest), or
+``designs`` random or Latin-hypercube draws (``seed``).  Each design is loaded (the xacro
+expanded with its values, in SI), assembled, and its metrics computed (:data:`METRICS`);
+a design that fails -- the file refuses the values, the loops do not close, it is not a
+four-bar for ``grashof`` -- is a row whose ``error`` says why, with its metric columns
+empty: a study never loses a run to one design.
+
+A chunk of designs is computed by :func:`run_chunk`, each design from its values alone (fresh
+mechanism, seeded searches), so the table is the same whatever runs the chunks.
+
+Values are SI: lengths in m, angles in rad (the transmission angles too; the CSV that
+people read gives degrees: screwkin.present.study).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import math
+import signal
+import threading
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import ScrewkinError, UsageError, one_line, quote
+from ...files.description import LIMITS
+from ...files.study import StudySpec
+from ...files.xmlsafe import read_regular_file
+from ...model.loader import load
+from ..mobility import analyze_mobility
+from ..motion.planar import identify, transmission_angles
+from ..motion.position import PositionSolver
+from ..motion.sweep import sweep
+from .workspace import DEFAULT_THRESHOLD, workspace
+
+__all__ = [
+    "COLUMNS",
+    "METRICS",
+    "DesignTimeout",
+    "StudyResult",
+    "designs",
+    "pareto_front",
+    "run_chunk",
+    "study_task",
+    "check_pareto",
+    "failed_row",
+    "metric_columns",
+]
+
+#: The columns each metric fills (keys of the rows, SI values).
+COLUMNS = {
+    "mobility": ("mobility", "mobility_count", "motion_space", "overconstraint", "idle_dofs", "effective_mobility",
+                 "output_motion"),
+    "grashof": ("linkage", "grashof", "grashof_margin"),
+    "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts"),
+    "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated"),
+    "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated"),
+    "conditioning": ("conditioning_min", "conditioning_mean"),
+}
+
+#: Short Grashof classes, from the start of analysis.motion.planar's class sentences.
+_GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
+            ("Grashof crank-rocker", "crank-rocker"), ("Grashof double crank", "double-crank"),
+            ("Grashof double rocker", "double-rocker"), ("Grashof rocker-crank", "rocker-crank"),
+            ("crank turns fully", "crank-turns"), ("crank cannot turn fully", "crank-rocks"))
+
+#: Relative margin at the ends of a limited input range (limit positions) in the transmission sweep.
+RANGE_MARGIN = 1e-9
+
+
+class DesignTimeout(ScrewkinError):
+    """A design ran past the study's timeout (its row is failed, its metrics empty)."""
+
+
+class _Clock:
+    """The deadline of one design, checked between its steps (loading, assembly, each metric,
+    each configuration of the transmission sweep)."""
+
+    def __init__(self, seconds: float):
+        self.seconds = seconds
+        self.end = time.perf_counter() + seconds
+
+    def check(self) -> None:
+        if time.perf_counter() > self.end:
+            raise DesignTimeout(f"timed out: the design took more than {self.seconds:g} s (the study's timeout "
+                                "per design)")
+
+
+@contextlib.contextmanager
+def _alarm(seconds: float):
+    """In the main thread (a study in this process): SIGALRM raises DesignTimeout after ``seconds``
+    even inside a step that never reaches a check (Python code between two C calls).  Elsewhere
+    (a Dask worker's thread) nothing: the checks and the client's stall watch bound the design."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def fire(signum, frame):
+        raise DesignTimeout(f"timed out: the design took more than {seconds:g} s (the study's timeout per design)")
+
+    previous = signal.signal(signal.SIGALRM, fire)
+    t0 = time.perf_counter()
+    old_delay, old_interval = signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        if old_delay > 0:  # someone else's timer (pytest-timeout ...): put it back with what is left of it
+            signal.setitimer(signal.ITIMER_REAL, max(old_delay - (time.perf_counter() - t0), 1e-3), old_interval)
+
+
+# ------------------------------------------------------------------ the designs
+def _steps(low: float, high: float, n: int) -> tuple:
+    """n values from low to high, both ends exact (low (1 - t) + high t: 0.02..0.06 in 3 gives 0.04,
+    where numpy's linspace gives 0.039999999999999994)."""
+    if n == 1:
+        return (float(low),)
+    return tuple(float(low * (1 - k / (n - 1)) + high * (k / (n - 1))) for k in range(n))
+
+
+def designs(spec: StudySpec) -> list:
+    """The parameter values of every design (tuples in the order of ``spec.parameters``, SI)."""
+    params = spec.parameters
+    if spec.sampling == "grid":
+        axes = [p.values if p.values is not None else _steps(p.low, p.high, p.samples) for p in params]
+        return [tuple(float(v) for v in combo) for combo in itertools.product(*axes)]
+    n = spec.designs
+    rng = np.random.default_rng(spec.seed)
+    columns = []
+    for p in params:
+        if spec.sampling == "random":
+            u = rng.uniform(size=n)
+        else:  # Latin hypercube: one draw in each of n equal strata, strata in random order
+            u = (rng.permutation(n) + rng.uniform(size=n)) / n
+        if p.values is not None:
+            k = np.minimum((u * len(p.values)).astype(int), len(p.values) - 1)
+            columns.append([float(p.values[i]) for i in k])
+        else:
+            columns.append([float(p.low + x * (p.high - p.low)) for x in u])
+    return list(zip(*columns)) if columns else []
+
+
+# ------------------------------------------------------------------ one design
+@dataclass(frozen=True)
+class _Task:
+    """What a worker needs for the designs of a study (picklable: sent with every chunk)."""
+
+    file: str
+    text: str  # the file's text, read once by the client: every design sees the same file
+    args: dict
+    parameters: tuple
+    metrics: tuple
+    input: str | None
+    output: str | None
+    point: bool
+    workspace: dict
+    steps: int
+    timeout: float = 120.0  # seconds per design
+
+
+class _Design:
+    """One loaded design and what its metrics share (assembly, linkage, workspace)."""
+
+    def __init__(self, task: _Task, mech, clock: _Clock):
+        self.task, self.mech, self.clock = task, mech, clock
+        self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
+        clock.check()
+        self._linkage = None
+        self._workspace = None
+
+    @property
+    def input(self) -> str:
+        if self.task.input:
+            self.mech.coordinate(self.task.input)  # a UsageError naming the joints when unknown
+            return self.task.input
+        if len(self.mech.actuated) != 1:
+            raise UsageError(f"the file declares {len(self.mech.actuated)} actuated joints: give input: JOINT "
+                             "in the study")
+        return self.mech.actuated[0]
+
+    def linkage(self):
+        if self._linkage is None:
+            info = identify(self.mech, self.mech.topology(self.q), self.q, self.input)
+            if info is None:
+                raise UsageError(f"not a planar four-bar or slider-crank driven by a revolute joint to the ground "
+                                 f"({quote(self.input)}): no Grashof class or transmission angle")
+            self._linkage = info
+        return self._linkage
+
+    def workspace(self):
+        if self._workspace is None:
+            ws = self.task.workspace
+            # what `screwkin workspace FILE --output LINK [--point] --resolution H [--threshold T] [--length L]`
+            # computes for this design (the spec checked that a resolution is given)
+            self._workspace = workspace(self.mech, self.task.output, point=ws.get("point", False),
+                                        resolution=ws["resolution"],
+                                        threshold=ws.get("threshold", DEFAULT_THRESHOLD), length=ws.get("length"))
+        return self._workspace
+
+
+def _mobility(d: _Design) -> dict:
+    r = analyze_mobility(d.mech, output=d.task.output, point=d.task.point)
+    return {"mobility": r.mobility, "mobility_count": r.topology.count_in_motion_space,
+            "motion_space": r.motion_space, "overconstraint": r.overconstraint, "idle_dofs": r.idle_dofs,
+            "effective_mobility": r.effective_mobility, "output_motion": r.output.label if r.output else None}
+
+
+def _grashof(d: _Design) -> dict:
+    info = d.linkage()
+    short = next((s for prefix, s in _GRASHOF if info.grashof.startswith(prefix)), None)
+    if short is None:  # pragma: no cover - a class sentence of planar.py this table does not know
+        raise RuntimeError(f"unknown Grashof class {info.grashof!r}")
+    L = info.lengths
+    if info.kind == "four-bar":
+        values = sorted(L.values())
+        margin = values[1] + values[2] - values[0] - values[3]  # (p + q) - (s + l)
+    else:
+        margin = L["rod"] - L["crank"] - L["offset"]
+    return {"linkage": info.kind, "grashof": short, "grashof_margin": float(margin)}
+
+
+def _transmission(d: _Design) -> dict:
+    """Smallest and largest transmission angle over the input's motion: the input at
+    ``steps`` + 1 values over a full turn (or over its range, ends taken RANGE_MARGIN of the
+    range inside the limit positions), followed from the design's assembled configuration by the
+    sweep's continuation (analysis.motion.sweep: one assembly mode, one circuit); the angles of all of
+    them at once (analysis.motion.planar.transmission_angles).  Where the continuation stops short, it
+    restarts at the next value from the mode nearest the last configuration reached, and
+    ``transmission_restarts`` counts how often it had to (0: one unbroken motion)."""
+    info = d.linkage()
+    mech, name, steps = d.mech, d.input, d.task.steps
+    coord = mech.coordinate(name)
+    x0 = float(d.q[coord.idx_q]) if coord.nq == 1 else float(np.arctan2(d.q[coord.idx_q + 1], d.q[coord.idx_q]))
+    solver = PositionSolver(mech, [name])
+    if info.input_range is None:
+        paths = [x0 + np.linspace(0.0, 2 * np.pi, steps + 1)]
+    else:
+        lo, hi = info.input_range
+        margin = RANGE_MARGIN * (hi - lo)
+        lo, hi = lo + margin, hi - margin
+        x0 = min(max(x0, lo), hi)
+        up = max(2, round(steps * (hi - x0) / (hi - lo)) + 1)
+        paths = [np.linspace(x0, hi, up), np.linspace(x0, lo, max(2, steps + 2 - up))]
+    Q, restarts = [], 0
+    for path in paths:
+        q, k = d.q, 0
+        while k < len(path) - 1:
+            d.clock.check()
+            res = sweep(solver, name, float(path[k]), float(path[-1]), len(path) - 1 - k, q_start=q)
+            Q += list(res.q)
+            if res.completed:
+                break
+            # stopped short (or holes): restart at the next grid value after the last one reached,
+            # in the mode nearest the last configuration (said in transmission_restarts)
+            h = (path[-1] - path[k]) / (len(path) - 1 - k)
+            reached = int(np.floor((res.values[-1] - path[k]) / h + 1e-9)) if len(res.values) else 0
+            k = k + max(reached, 0) + 1
+            if k >= len(path):
+                break
+            near = solver.joint_values(res.q[-1] if len(res.q) else q)
+            q = solver.solve({name: float(path[k])}, near=near, starts=8).solutions[0].q  # checked, or AssemblyError
+            restarts += 1
+            if k == len(path) - 1:
+                Q.append(q)
+    mus = transmission_angles(mech, info, Q)
+    return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max()),
+            "transmission_restarts": restarts}
+
+
+def _workspace_volume(d: _Design) -> dict:
+    w = d.workspace()
+    # truncated: MAX_POINTS cut the grid (a resolution too fine for the workspace): the volumes are lower bounds
+    return {"workspace_dimension": w.dimension, "workspace_volume": w.volume, "workspace_truncated": w.truncated}
+
+
+def _singularity_free_volume(d: _Design) -> dict:
+    w = d.workspace()
+    return {"workspace_dimension": w.dimension, "singularity_free_volume": w.free_volume,
+            "workspace_truncated": w.truncated}
+
+
+def _conditioning(d: _Design) -> dict:
+    w = d.workspace()
+    return {"conditioning_min": w.conditioning_min, "conditioning_mean": w.conditioning_mean}
+
+
+#: metric name -> function of a loaded, assembled design returning its columns (COLUMNS).
+METRICS = {"mobility": _mobility, "grashof": _grashof, "transmission_angle": _transmission,
+           "workspace_volume": _workspace_volume, "singularity_free_volume": _singularity_free_volume,
+           "conditioning": _conditioning}
+
+
+def metric_columns(metrics) -> tuple:
+    """The metric columns of a study, in order, each once."""
+    out = []
+    for m in metrics:
+        out += [c for c in COLUMNS[m] if c not in out]
+    return tuple(out)
+
+
+def _reason(exc, path: str) -> str:
+    """The one-line reason of a design's failure, without the file's path every row shares."""
+    text = str(exc)
+    for prefix in (f"{path}: ", f"{Path(path).name}: "):
+        text = text.removeprefix(prefix)
+    return one_line(text, 400)
+
+
+def design_args(task: _Task, values: tuple) -> dict:
+    """The xacro arguments of one design, as text: what ``--arg NAME=VALUE`` gives the file (a
+    parameter's SI value written as repr(float), so the single commands reproduce a row exactly)."""
+    args = dict(task.args)
+    args.update({n: repr(float(v)) for n, v in zip(task.parameters, values)})
+    return args
+
+
+def _evaluate(task: _Task, index: int, values: tuple) -> dict:
+    row = {"design": index, **dict(zip(task.parameters, values))}
+    columns = metric_columns(task.metrics)
+    row.update(dict.fromkeys(columns))
+    row["error"] = None
+    clock = _Clock(task.timeout)
+    try:
+        with _alarm(task.timeout):
+            mech = load(task.file, text=task.text, args=design_args(task, values), warn=lambda m: None)
+            clock.check()
+            d = _Design(task, mech, clock)
+            computed = {}
+            for m in task.metrics:
+                computed.update(METRICS[m](d))
+                clock.check()  # a metric that ran past the deadline (one long workspace grid) fails the row
+        row.update(computed)  # all metrics or none: a failed design never shows a number
+    except ScrewkinError as exc:
+        row["error"] = _reason(exc, task.file)
+    except Exception as exc:  # noqa: BLE001 - a bug (or a missing module on a worker): the row says it, the run goes on
+        row["error"] = f"internal error: {type(exc).__name__}: {one_line(str(exc), 300)}"
+    return row
+
+
+def run_chunk(task: _Task, chunk) -> list:
+    """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes."""
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return [_evaluate(task, i, v) for i, v in chunk]
+
+
+# ------------------------------------------------------------------ the study
+@dataclass(frozen=True)
+class StudyResult:
+    """The rows of a study, in design order: ``design`` (its index), the parameters' values,
+    the metric columns (None when failed or not applicable) and ``error`` (None, or why the
+    design failed).  SI values."""
+
+    spec: StudySpec
+    parameters: tuple  # parameter names
+    columns: tuple  # metric columns
+    rows: tuple  # dicts
+    seconds: float
+    workers: int
+    scheduler: str  # "in process", "local cluster" or the scheduler's address
+    chunks: int = 0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def table(self) -> dict:
+        """Column name -> list of values in design order (design, parameters, metrics, error)."""
+        names = ("design", *self.parameters, *self.columns, "error")
+        return {n: [r[n] for r in self.rows] for n in names}
+
+    @property
+    def failed(self) -> tuple:
+        return tuple(r for r in self.rows if r["error"] is not None)
+
+    @property
+    def succeeded(self) -> tuple:
+        return tuple(r for r in self.rows if r["error"] is None)
+
+
+def study_task(spec: StudySpec) -> _Task:
+    raw = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
+    return _Task(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
+                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps, spec.timeout)
+
+
+def _resolve(name: str, keys) -> str | None:
+    for cand in (name, name.removesuffix("_deg")):
+        if cand in keys:
+            return cand
+    return None
+
+
+def pareto_front(result: StudyResult, goals=None) -> list:
+    """Indices (into result.rows) of the designs on the Pareto front of two columns:
+    ``goals`` ((column, "max" | "min"), (column, "max" | "min")), default the spec's
+    ``pareto``.  Rows without both values are left out; the front is ordered by the first
+    column.  A design is on it when no other is at least as good in both and better in one."""
+    goals = goals or result.spec.pareto
+    if not goals:
+        raise UsageError(f"{result.spec.path}: no pareto columns: give pareto: {{maximize: [...], minimize: [...]}}")
+    keys = (*result.parameters, *result.columns)
+    cols = []
+    for name, goal in goals:
+        key = _resolve(name, keys)
+        if key is None or goal not in ("max", "min"):
+            raise UsageError(f"{result.spec.path}: pareto column {quote(name)} is not a column of this study "
+                             f"(columns: {', '.join(keys)})")
+        cols.append((key, 1.0 if goal == "max" else -1.0))
+    pts = []
+    for k, r in enumerate(result.rows):
+        vals = [r[c] for c, _ in cols]
+        if r["error"] is None and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                                      for v in vals):
+            pts.append((k, vals[0] * cols[0][1], vals[1] * cols[1][1]))
+    front = [k for k, a, b in pts
+             if not any((a2 >= a and b2 >= b) and (a2 > a or b2 > b) for _, a2, b2 in pts)]
+    return sorted(front, key=lambda k: result.rows[k][cols[0][0]])
+
+
+def check_pareto(spec: StudySpec) -> None:
+    if spec.pareto:
+        keys = (*(p.name for p in spec.parameters), *metric_columns(spec.metrics))
+        for name, _ in spec.pareto:
+            if _resolve(name, keys) is None:
+                raise UsageError(f"{spec.path}: pareto column {quote(name)} is not a column of this study "
+                                 f"(columns: {', '.join(keys)})")
+
+
+def failed_row(task, index, values, reason) -> dict:
+    row = {"design": index, **dict(zip(task.parameters, values))}
+    row.update(dict.fromkeys(metric_columns(task.metrics)))
+    row["error"] = reason
+    return row

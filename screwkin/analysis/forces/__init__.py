@@ -1,0 +1,1 @@
+"""What a mechanism carries: statics, dynamics and grasps."""

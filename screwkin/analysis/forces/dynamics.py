@@ -1,0 +1,303 @@
+"""Inverse dynamics of mechanisms driven at constant input speed: what the actuators must exert
+along a motion, what every joint carries, what the ground feels, and the flywheel it takes.
+
+The motion is screwkin's sweep (analysis/motion/sweep.py) with the input rate set to the speed: the
+rates are those of that speed and the accelerations those of a constant speed (the input's
+acceleration is zero).  At each step, with q, v = q' and a = q'':
+
+    E tau_a + K^T lambda = RNEA(q, v, a) - sum_k J_k^T w_k
+
+the tree's inverse dynamics by Pinocchio's RNEA (gravity in model.gravity, the links' inertias
+from the file's <inertial>), the loads w_k (force, moment at their link frame's origin, world
+axes; J_k that origin's frame Jacobian, LOCAL_WORLD_ALIGNED), the loop constraint forces lambda
+of the closure rows K (model/closure.py) and the actuator efforts tau_a (torques of revolute,
+forces of prismatic inputs).  It is solved as statics solves it (analysis.forces.statics.balance):
+least squares, minimum norm; where the constraint rows are redundant (an overconstrained
+linkage, a planar loop's out-of-plane rows) the null space of [E, K^T] holds self-stresses of
+the loops: the efforts stay unique, the reactions given are the minimum-norm ones, and the
+components that change along that null space are named.
+
+Reactions: the wrench each joint carries, what the parent side (link1 of a cut joint) exerts on
+the child side (link2), (force, moment) at the joint's origin (F2's origin for a cut joint),
+world axes (analysis.forces.statics.joint_wrenches with the motion's inertial forces).  The shaking
+wrench is what the moving links exert on the ground: minus the sum of the reactions of the
+joints the ground is the parent (or link1) of, plus those it is the child (link2) of, with the
+moments taken about the world origin.  The flywheel: with the input effort tau(theta) over one
+whole turn at mean speed omega, the energy fluctuation is
+dE = max - min of the integral of (tau - tau_mean) d theta, and the flywheel inertia that keeps
+the coefficient of speed fluctuation Cs = (omega_max - omega_min) / omega_mean is
+I = dE / (Cs omega^2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ...errors import MechanismFileError, UsageError, quote
+from ...model._pin import frame_jacobian
+from ...tolerances import DEFAULT
+from ..motion.position import PositionSolver
+from .statics import balance, reaction_table
+from ..motion.sweep import sweep
+
+__all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
+
+
+@dataclass(frozen=True)
+class Load:
+    """A constant wrench on a link: (fx, fy, fz, mx, my, mz) [N, N m] in world axes, the force
+    applied at ``point`` (in the link's frame [m]; the frame's origin when None)."""
+
+    link: str
+    wrench: tuple
+    point: tuple | None = None
+    name: str | None = None  # the named point it acts at, as typed
+
+
+@dataclass(frozen=True)
+class Flywheel:
+    """The flywheel a cycle needs: energy fluctuation [J] of the input effort over one turn and
+    the inertia [kg m^2] for the coefficient of speed fluctuation ``cs`` at mean speed ``omega``
+    [rad/s]; inertia None (with ``reason``) where it is not defined."""
+
+    cs: float
+    omega: float
+    energy_fluctuation: float | None
+    inertia: float | None
+    reason: str | None = None
+
+
+@dataclass(frozen=True)
+class DynamicsResult:
+    input: str
+    unit: str  # "rad" or "m": the input's unit
+    speed: float  # the input's constant speed [rad/s or m/s]
+    values: np.ndarray  # (n,) input values [rad or m]
+    q: np.ndarray  # (n, nq)
+    rates: np.ndarray  # (n, nv)
+    accelerations: np.ndarray  # (n, nv)
+    inputs: tuple  # the actuated joints whose efforts are given
+    efforts: dict  # joint -> (n,) [N m or N]; nan where redundant actuation leaves it open
+    effort_units: dict  # joint -> "N m" or "N"
+    reactions: dict  # joint -> (n, 6) (force [N], moment [N m]) at the joint's origin, world axes
+    reaction_kinds: dict  # joint -> "tree" or "cut"
+    open_components: dict  # joint -> components ("fx", ...) not determined (minimum-norm values given)
+    indeterminate: int  # dimension of the null space of [E, K^T] (largest along the motion)
+    shaking_force: np.ndarray  # (n, 3) what the moving links exert on the ground [N]
+    shaking_moment: np.ndarray  # (n, 3) its moment about the world origin [N m]
+    kinetic_energy: np.ndarray  # (n,) [J]
+    potential_energy: np.ndarray  # (n,) of gravity [J] (zero reference at the world origin)
+    input_power: np.ndarray  # (n,) sum of actuator effort x rate [W]
+    load_power: np.ndarray  # (n,) power of the loads [W]
+    unbalanced: np.ndarray  # (n,) |E tau + K^T lambda - b|: what the inputs cannot drive
+    peak: dict  # joint -> max |effort|
+    mean: dict  # joint -> mean effort over the input range
+    rms: dict  # joint -> root mean square effort over the input range
+    flywheel: Flywheel
+    gravity: tuple  # [m/s^2]
+    loads: tuple  # Load
+    completed: bool  # the motion covered the whole range
+    notes: tuple  # one line each: what was chosen, what is left open
+
+
+def check_inertias(mech) -> tuple:
+    """Each moving body needs a mass (and an SDF file's inertias are not read: refused): a moving link without <inertial> on a body none of whose links
+    has one is a MechanismFileError naming it, except a link with no geometry either (the inside of a
+    compound joint), taken as massless and returned, named, in a note."""
+    if mech.spec.format == "sdf":  # files/sdf.py keeps each link's mass only, at its origin
+        raise MechanismFileError(mech.path, "dynamics needs the links' inertias, and screwkin reads only the masses of "
+                                            "an SDF file (not their <pose> and <inertia>): write it as URDF")
+    model = mech.model
+    bodies = {}
+    for name, link in mech.spec.links.items():
+        try:
+            fid = mech.link_frame(name)
+        except UsageError:
+            continue
+        bodies.setdefault(model.frames[fid].parentJoint, []).append(link)
+    virtual = {n for names in mech.virtual_joints.values() for n in names}
+    massless = []
+    for joint, links in bodies.items():
+        if joint == 0 or model.names[joint] in virtual or any(x.mass is not None for x in links):
+            continue
+        with_geometry = [x.name for x in links if x.has_geometry]
+        if with_geometry:
+            raise MechanismFileError(mech.path, f"link {quote(with_geometry[0])} moves but has no <inertial> "
+                                                "(mass and inertia): dynamics needs one on every moving link")
+        massless += [x.name for x in links]
+    if massless:
+        return (f"taken as massless (no <inertial>, no geometry: the inside of a compound joint): "
+                f"{', '.join(massless)}",)
+    return ()
+
+
+def _load_wrenches(mech, loads, data) -> list:
+    """(frame id, wrench at the frame's origin, world axes) of each load at the placements in
+    ``data`` (the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
+    out = []
+    for ld in loads:
+        fid = mech.link_frame(ld.link)
+        w = np.asarray(ld.wrench, float)
+        if ld.point is not None:
+            M = data.oMf[fid]
+            arm = M.rotation @ np.asarray(ld.point, float)
+            w = np.r_[w[:3], w[3:] + np.cross(arm, w[:3])]
+        out.append((fid, w))
+    return out
+
+
+def _ground_sides(mech) -> tuple:
+    """(tree joints whose parent is the ground, {cut joint: +1 when its link2 is on the ground,
+    -1 when its link1 is})."""
+    model = mech.model
+    tree = {c.joint for c in mech.coordinates if model.parents[c.joint_id] == 0}
+    cuts = {}
+    for cut in mech.cuts:
+        on1 = model.frames[cut.frame1].parentJoint == 0
+        on2 = model.frames[cut.frame2].parentJoint == 0
+        if on2 and not on1:
+            cuts[cut.name] = 1.0
+        elif on1 and not on2:
+            cuts[cut.name] = -1.0
+    return tree, cuts
+
+
+def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
+    """The flywheel figure from the input effort tau over the input values (see the module)."""
+    omega = abs(speed)
+    span = abs(values[-1] - values[0]) if len(values) > 1 else 0.0
+    if unit != "rad":
+        return Flywheel(cs, omega, None, None, "a flywheel needs a turning input (this one slides)")
+    if not completed or span < 2 * np.pi * (1 - DEFAULT.equal):
+        return Flywheel(cs, omega, None, None, "a flywheel needs the input over a whole turn (--from 0 --to 360deg)")
+    if tau is None or not np.all(np.isfinite(tau)):
+        return Flywheel(cs, omega, None, None, "the input effort is not determined")
+    x = values - values[0]
+    work = np.r_[0.0, np.cumsum(0.5 * (tau[1:] + tau[:-1]) * np.diff(x))]  # integral of tau d theta
+    mean = work[-1] / x[-1]
+    excess = work - mean * x
+    de = float(excess.max() - excess.min())
+    if omega == 0:
+        return Flywheel(cs, omega, de, None, "at zero speed no flywheel smooths anything")
+    return Flywheel(cs, omega, de, de / (cs * omega**2))
+
+
+def _range_mean(values, y) -> float:
+    """The mean of y over the input range (trapezoid rule: a sample at each end of a whole
+    turn counts once); the plain mean for a single value."""
+    if len(values) < 2 or values[-1] == values[0]:
+        return float(np.mean(y))
+    return float(np.trapezoid(y, values) / (values[-1] - values[0]))
+
+
+def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
+             fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
+             cs: float = 0.05, progress: bool = False) -> DynamicsResult:
+    """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
+    in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
+
+    inputs: the actuated joints (default: the mechanism's actuated joints when ``input`` is one
+    of them, else ``input`` and the joints of ``fixed``); fixed: the other inputs' values;
+    gravity: (gx, gy, gz) [m/s^2]; loads: Load; cs: the coefficient of speed fluctuation of the
+    flywheel figure (0 < cs < 2)."""
+    if not 0 < cs < 2:
+        raise UsageError(f"the coefficient of speed fluctuation must lie between 0 and 2, got {cs:g}")
+    g = np.asarray(gravity, float)
+    if g.shape != (3,) or not np.all(np.isfinite(g)):
+        raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
+    if mech.couplings:  # Pinocchio 4.1's RNEA refuses its mimic joints
+        c = mech.couplings[0]
+        raise MechanismFileError(mech.path, f"dynamics does not take <mimic> couplings yet ({quote(c.joint)} mimics "
+                                            f"{quote(c.mimics)}): Pinocchio's inverse dynamics has no mimic joints")
+    notes = list(check_inertias(mech))
+    fixed = dict(fixed or {})
+    if inputs is None:
+        inputs = list(mech.actuated) if input in mech.actuated else [input, *[n for n in fixed if n != input]]
+    inputs = list(inputs)
+    for ld in loads:
+        mech.link_frame(ld.link)  # a clear error for an unknown link
+    solver = PositionSolver(mech, inputs)
+    res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
+                near=near, rate=speed, progress=progress)
+    model = mech.model
+    data = mech.scratch_data()
+    a_idx = mech.velocity_indices(inputs)
+    m = len(a_idx)
+    n = len(res.values)
+    efforts = np.full((n, m), np.nan)
+    reactions, kinds, open_ = {}, {}, {}
+    shaking_f, shaking_m = np.zeros((n, 3)), np.zeros((n, 3))
+    T, V, P_in, P_load, unbalanced, scale = (np.zeros(n) for _ in range(6))
+    indeterminate = 0
+    ground_tree, ground_cuts = _ground_sides(mech)
+    gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
+    for k in range(n):
+        q, v, a = res.q[k], res.rates[k], res.accelerations[k]
+        b = pin.rnea(gmodel, data, q, v, a).copy()
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        frames = _load_wrenches(mech, loads, data)
+        for fid, w in frames:
+            J = frame_jacobian(model, data, fid, LWA)
+            b -= J.T @ w
+            P_load[k] += float(w @ (J @ v))
+        K = mech.closure.jacobian(q)
+        tau, lam, N, unbalanced[k], scale[k] = balance(mech, K, a_idx, b)
+        free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
+        efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
+        indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
+        table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
+        for name, (kind, wrench, is_open) in table.items():
+            reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
+            kinds[name] = kind
+            open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
+        # data holds q's placements (its own Data: reaction_table computes in another)
+        for name, (kind, wrench, _) in table.items():
+            if kind == "tree" and name in ground_tree:
+                sign, origin = -1.0, data.oMi[mech.coordinate(name).joint_id].translation
+            elif kind == "cut" and name in ground_cuts:
+                cut = next(c for c in mech.cuts if c.name == name)
+                sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation
+            else:
+                continue
+            shaking_f[k] += sign * wrench[:3]
+            shaking_m[k] += sign * (wrench[3:] + np.cross(origin, wrench[:3]))
+        T[k] = pin.computeKineticEnergy(model, data, q, v)
+        V[k] = pin.computePotentialEnergy(gmodel, data, q)
+        P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
+    units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}
+    eff = {name: efforts[:, j] for j, name in enumerate(inputs)}
+    peak = {name: float(np.max(np.abs(y))) if np.all(np.isfinite(y)) else None for name, y in eff.items()}
+    rms = {name: float(np.sqrt(_range_mean(res.values, y**2))) if np.all(np.isfinite(y)) else None
+           for name, y in eff.items()}
+    mean = {name: _range_mean(res.values, y) if np.all(np.isfinite(y)) else None for name, y in eff.items()}
+    completed = res.completed
+    fly = _flywheel(res.values, eff.get(input), speed, res.unit, cs, completed)
+    if not np.any(g):
+        notes.append("gravity: none (give --gravity 0,0,-9.81 for the links' weights)")
+    open_names = {name: tuple(c for c, o in zip(COMPONENTS, mask) if o) for name, mask in open_.items()}
+    if indeterminate:
+        varying = "; ".join(f"{name} {' '.join(c)}" for name, c in open_names.items() if c)
+        notes.append(f"the loop constraints are redundant: the balance has a null space of dimension {indeterminate} "
+                     f"(self-stresses of the loops); the efforts are unique where given, the reactions are the "
+                     f"minimum-norm ones" + (f", these components are not determined: {varying}" if varying else ""))
+    if any(v is None for v in peak.values()):
+        notes.append("redundant actuation: the efforts marked nan are not determined (minimum-norm split not given)")
+    if res.stopped_at is not None:
+        notes.append(f"the motion stopped at {input} = {res.stopped_at:.6g} {res.unit}: {res.stop_reason}")
+    if res.skipped:
+        notes.append(f"{len(res.skipped)} input value(s) of the grid could not be solved and are left out")
+    stuck = unbalanced > mech.tolerances.balanced * scale
+    if np.any(stuck):
+        notes.append(f"at {int(np.sum(stuck))} step(s) the inputs cannot drive the motion "
+                     f"(largest unbalanced generalized force {unbalanced.max():.3g}): near a singularity")
+    return DynamicsResult(input, res.unit, float(speed), res.values, res.q, res.rates, res.accelerations,
+                          tuple(inputs), eff, units, reactions, kinds, open_names, indeterminate, shaking_f,
+                          shaking_m, T, V, P_in, P_load, unbalanced, peak, mean, rms, fly, tuple(map(float, g)),
+                          tuple(loads), completed, tuple(notes))

@@ -1,0 +1,344 @@
+"""Statics of mechanisms: what the actuators must exert to hold a load, what the joints carry,
+and the wrenches that legs transmit and impose.
+
+Equilibrium at an assembled configuration q (virtual work through the closure equations):
+
+    E_a tau_a + K^T lambda = g(q) - J_o^T w
+
+with tau_a the actuator efforts (torques of revolute, forces of prismatic actuators), lambda
+the constraint forces of the loop-closure rows, g(q) Pinocchio's generalized gravity (with
+``gravity``), w the wrench (force, moment) applied to the output link at its frame's origin,
+world axes, and J_o that origin's frame Jacobian (LOCAL_WORLD_ALIGNED).  The system is solved
+in the least-squares sense by SVD; a residual means the inputs cannot hold the load.  Where
+the system has a null space (redundant constraints of an overconstrained linkage, redundant
+actuation), the quantities that change along it are statically indeterminate: they are
+reported as such, not as a number.
+
+Joint reactions: the wrench each tree joint transmits comes from Pinocchio's RNEA with the
+load and the constraint forces applied as external forces (its joint torques must then be the
+actuator efforts and zero elsewhere: checked); a cut joint carries its rows' constraint
+wrenches (ClosureSystem.row_wrenches).
+
+Legs of a parallel mechanism: the constraint wrenches of a leg are the wrenches reciprocal to
+every platform twist the leg alone allows; its transmission wrenches are those reciprocal to
+the twists it allows with its actuated joints free but not to the ones with them locked,
+i.e. what a locked actuator transmits.  The platform's twist space is reciprocal to all legs'
+constraint wrenches together.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ...errors import UsageError
+from ...model.linalg import null_space, rank
+from ...model.state import KinematicState
+from ..screws import Screw, cut_twists, screw_of
+from ..singularities.singular import Generic, measures
+
+__all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
+           "reaction_table"]
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+@dataclass(frozen=True)
+class Reaction:
+    """The wrench a joint carries: what the parent side (link1 of a cut joint) exerts on the
+    child side (link2), (fx, fy, fz, mx, my, mz) [N, N m] at the joint's origin in world axes;
+    each component that statics does not determine is None (a planar linkage's out-of-plane
+    components, the redundant ones of an overconstrained linkage)."""
+
+    joint: str
+    kind: str  # "tree" or "cut"
+    wrench: tuple
+    determinate: bool  # every component determined
+
+
+@dataclass(frozen=True)
+class StaticsResult:
+    inputs: tuple  # the actuated joints, in order
+    efforts: dict  # actuated joint -> effort [N m or N], None where indeterminate
+    units: dict  # actuated joint -> "N m" or "N"
+    wrench: tuple  # the applied wrench (force, moment) at the output frame's origin, world axes
+    output: str | None
+    gravity: bool
+    equilibrium: bool  # the inputs can hold the load
+    unbalanced: float  # |A x - b|, the generalized force the inputs cannot balance [N, N m]
+    reactions: tuple  # Reaction
+    indeterminate: int  # dimension of the statically indeterminate part (redundant constraints and inputs)
+    singular: bool  # near an actuator singularity: efforts grow without bound
+    sigma_actuator: float  # the actuator measure (screwkin.analysis.singularities.singular.measures)
+    amplification: float | None  # |efforts| / |load| with lengths made dimensionless by L (N m both)
+    length: float  # the characteristic length L [m]
+    constraint_forces: tuple  # (row label, lambda) of the closure rows
+
+
+def _load_norm(w, L) -> float:
+    return float(np.linalg.norm(np.r_[np.asarray(w[:3]) * L, w[3:]]))
+
+
+def balance(mech, K, a_idx, b) -> tuple:
+    """The balance of generalized forces E tau + K^T lambda = b (E: the columns of the actuated
+    velocity indices ``a_idx``; K: the closure Jacobian, rows as ClosureSystem writes them; b:
+    the generalized force the tree needs [N, N m]), solved in the least-squares, minimum-norm
+    sense by SVD with screwkin's rank tolerance.  Returns (tau, lambda, N, unbalanced, scale):
+    N (unknowns x dim) spans the null space of [E, K^T] (what the balance leaves open: redundant
+    constraint rows, redundant actuation), unbalanced = |[E, K^T] x - b|, scale the size of the
+    system (for a relative test of unbalanced)."""
+    tol = mech.tolerances
+    nv = mech.nv
+    E = np.zeros((nv, len(a_idx)))
+    E[a_idx, np.arange(len(a_idx))] = 1.0
+    A = np.hstack([E, K.T]) if K.size else E
+    U, s, Vt = np.linalg.svd(A, full_matrices=True) if A.size else (np.eye(nv), np.zeros(0), np.eye(0))
+    r = int(np.sum(s > max(tol.rank_rtol * (s[0] if s.size else 0), tol.rank_atol))) if s.size else 0
+    x = Vt[:r].T @ ((U[:, :r].T @ b) / s[:r]) if r else np.zeros(A.shape[1])
+    N = Vt[r:].T  # (unknowns, dim null)
+    unbalanced = float(np.linalg.norm(A @ x - b))
+    scale = max(float(np.linalg.norm(b)), float(np.abs(A).max()) if A.size else 1.0, 1e-12)
+    m = len(a_idx)
+    return x[:m], x[m:], N, unbalanced, scale
+
+
+def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = False) -> StaticsResult:
+    """Actuator efforts and joint reactions holding ``wrench`` (force, moment) [N, N m] applied to
+    ``output`` at its frame's origin (world axes) and, with ``gravity``, the links' weights,
+    at the assembled configuration q.  See the module docstring."""
+    model, tol = mech.model, mech.tolerances
+    data = mech.scratch_data()
+    inputs = list(mech.actuated if inputs is None else inputs)
+    if wrench is not None and output is None:
+        raise UsageError(f"{mech.path}: a wrench needs the output link it is applied to (--output)")
+    w = np.zeros(6) if wrench is None else np.asarray(wrench, float)
+    if w.shape != (6,) or not np.all(np.isfinite(w)):
+        raise UsageError("the wrench must be 6 finite numbers: fx fy fz mx my mz")
+    a_idx = mech.velocity_indices(inputs)
+    nv = mech.nv
+    K = mech.closure.jacobian(q)
+    b = np.zeros(nv)
+    if gravity:
+        b += pin.computeGeneralizedGravity(model, data, q)
+    J_o = None
+    if output is not None:
+        J_o = KinematicState(mech, q).link_jacobian(output, LWA)
+        b -= J_o.T @ w
+    tau, lam, N, unbalanced, scale = balance(mech, K, a_idx, b)
+    m = len(a_idx)
+    free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
+    efforts, units = {}, {}
+    for k, (name, iv) in enumerate(zip(inputs, a_idx)):
+        efforts[name] = None if free_tau[k] > tol.indeterminate else float(tau[k])
+        units[name] = "N" if mech.translational[iv] else "N m"
+    reactions = _reactions(mech, q, lam, w if output is not None else None, output, gravity, N[m:] if N.size else None)
+    L = mech.length
+    g = Generic(mech, inputs, None, configurations=mech.generic_configurations()[1])
+    sig = measures(mech, q, g)["actuator"] if inputs else 1.0
+    load = _load_norm(w, L) + (float(np.linalg.norm(pin.computeGeneralizedGravity(model, data, q))) if gravity else 0.0)
+    scaled_tau = [abs(t) * (L if mech.translational[iv] else 1.0) for t, iv in zip(tau, a_idx)]
+    amp = float(np.linalg.norm(scaled_tau) / load) if load > 0 and m else None
+    labels = mech.closure.row_labels()
+    return StaticsResult(tuple(inputs), efforts, units, tuple(w.tolist()), output, gravity,
+                         unbalanced <= tol.balanced * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
+                         bool(inputs) and sig < tol.singular, float(sig), amp, L,
+                         tuple(zip(labels, map(float, lam))))
+
+
+def _reactions(mech, q, lam, w, output, gravity, N_lam):
+    """Reactions of every joint for constraint forces lam (and the load), and whether each is
+    determined: it must not change along the null directions N_lam of the constraint forces."""
+    loads = [(mech.link_frame(output), np.asarray(w, float))] if w is not None else []
+    out = []
+    for name, (kind, wrench, open_) in reaction_table(mech, q, lam, loads, gravity, N_lam).items():
+        out.append(Reaction(name, kind, tuple(None if o else float(x) for x, o in zip(wrench, open_)),
+                            not open_.any()))
+    return tuple(out)
+
+
+def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
+    """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
+    constraint forces lam, and the mask of its components that change along the null
+    directions N_lam of the constraint forces (not determined by the balance)."""
+    base = joint_wrenches(mech, q, lam, loads, gravity, v, a)
+    free = {name: np.zeros(6) for name in base}
+    if N_lam is not None and N_lam.size:
+        for k in range(N_lam.shape[1]):
+            for name, value in joint_wrenches(mech, q, N_lam[:, k], (), False).items():
+                free[name] = np.maximum(free[name], np.abs(value[1]))
+    size = max([float(np.linalg.norm(x[1])) for x in base.values()] + [1.0])
+    # components that change along the indeterminate directions
+    return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
+
+
+def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dict:
+    """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
+    ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
+    links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
+    forces (Pinocchio's RNEA at (q, v, a)): what the parent side (link1 of a cut joint) exerts
+    on the child side (link2)."""
+    model = mech.model
+    data = mech.scratch_data()
+    pin.framesForwardKinematics(model, data, q)
+    rows = mech.closure.row_wrenches(q)
+    fext = [pin.Force.Zero() for _ in range(model.njoints)]
+
+    def apply(frame, wrench_at_origin):
+        """Add a wrench (force, moment about the frame's origin, world axes) to the frame's body."""
+        f = model.frames[frame]
+        o = data.oMf[frame].translation
+        force, moment = wrench_at_origin[:3], wrench_at_origin[3:] + np.cross(o, wrench_at_origin[:3])
+        fext[f.parentJoint] += data.oMi[f.parentJoint].actInv(pin.Force(force, moment))
+
+    cut = {}
+    for (fa, wa, fb, wb), value in zip(rows, lam):
+        if fa is None:
+            continue
+        apply(fa, wa * value)
+        apply(fb, wb * value)
+    for frame, wrench in loads:  # the loads, each on its link
+        apply(frame, np.asarray(wrench, float))
+    # each cut joint: the wrench its rows exert on link2, at F2's origin
+    labels = mech.closure.row_labels()
+    for (fa, wa, fb, wb), value, label in zip(rows, lam, labels):
+        if fa is None:
+            continue
+        name = label.split(":", 1)[0]
+        total = cut.setdefault(name, [fb, np.zeros(6)])
+        if fb == total[0]:  # (a contact row may name its frames the other way round)
+            total[1] = total[1] + wb * value
+        elif fa == total[0]:
+            total[1] = total[1] + wa * value
+    zero_v = np.zeros(model.nv)
+    g = model.gravity.linear if gravity is True else np.zeros(3) if gravity is False else np.asarray(gravity, float)
+    pin.rnea(mech.model_with_gravity(g), data, q, zero_v if v is None else v, zero_v if a is None else a, fext)
+    virtual = {n for names in mech.virtual_joints.values() for n in names}
+    out = {}
+    for c in mech.coordinates:
+        if c.joint in virtual:
+            continue
+        jid = c.joint_id
+        f = data.f[jid]  # transmitted from the parent into joint jid's body, in the joint frame
+        M = data.oMi[jid]
+        out[c.joint] = ("tree", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
+    pin.framesForwardKinematics(model, data, q)
+    for name, (frame, wrench) in cut.items():
+        out[name] = ("cut", wrench)
+    return out
+
+
+# ------------------------------------------------------------------ legs
+@dataclass(frozen=True)
+class Leg:
+    """A leg of a parallel mechanism: the joints between the ground and the platform on one
+    branch, the constraint wrenches it imposes on the platform and the transmission wrenches
+    of its actuators, as 6-vectors (force, moment) at the platform frame's origin and as screws
+    (axes in the world)."""
+
+    joints: tuple
+    actuated: tuple
+    twists: int  # dimension of the platform twists the leg alone allows
+    constraint_wrenches: tuple  # 6-vectors
+    transmission_wrenches: tuple
+    constraint_screws: tuple  # Screw
+    transmission_screws: tuple
+
+
+def wrench_screw(wrench, point) -> Screw:
+    """The screw of a wrench (force, moment about ``point``): axis along the force through the
+    line of action, pitch m . f / |f|^2 (inf for a pure moment)."""
+    w = np.asarray(wrench, float)
+    f, m0 = w[:3], w[3:] + np.cross(np.asarray(point, float), w[:3])  # moment about the world origin
+    return screw_of(np.r_[m0, f])
+
+
+def legs(mech, q, output, inputs=None) -> tuple:
+    """The legs between the ground and the ``output`` link (see Leg), at the assembled q.
+
+    A leg is the set of tree joints on the branches that reach the platform -- the platform's
+    own tree path, and each cut joint on the platform with the tree path to its other side --
+    merged where branches share a joint (a Delta's arm carries two rods).  The platform twists a
+    leg allows: t with t = J_c q'_L + A_c a_c for each of its connections c (J_c: the twist of
+    that connection's body at the platform origin from the leg's joints; A_c: the relative
+    twists the cut joint allows), over the leg's joint rates q'_L."""
+    model, tol = mech.model, mech.tolerances
+    state = KinematicState(mech, q)
+    inputs = set(mech.actuated if inputs is None else inputs)
+    fid = mech.link_frame(output)
+    body = model.frames[fid].parentJoint
+    o = state.frame_placement(fid).translation
+    coords = {c.joint_id: c for c in mech.coordinates}
+
+    def support(joint):
+        return [j for j in model.supports[joint] if j in coords]
+
+    def at_platform(frame):  # frame Jacobian as the twist of the frame's body at the platform origin
+        J = state.frame_jacobian(frame, LWA)
+        J[:3] += np.cross(J[3:].T, o - state.frame_placement(frame).translation).T  # v_o = v_p + w x (o - p)
+        return J
+
+    branches = [{"joints": set(support(body)), "ends": [(fid, None)]}]
+    for cut in mech.cuts:
+        for mine, other in ((cut.frame2, cut.frame1), (cut.frame1, cut.frame2)):
+            if model.frames[mine].parentJoint == body and model.frames[other].parentJoint != body:
+                branches.append({"joints": set(support(model.frames[other].parentJoint)), "ends": [(other, cut)]})
+    merged = []
+    for br in branches:
+        for leg in merged:
+            if leg["joints"] & br["joints"]:
+                leg["joints"] |= br["joints"]
+                leg["ends"] += br["ends"]
+                break
+        else:
+            merged.append({"joints": set(br["joints"]), "ends": list(br["ends"])})
+    out = []
+    for leg in merged:
+        joints = sorted(leg["joints"])
+        cols = [coords[j].idx_v for j in joints]
+        act = [coords[j].idx_v for j in joints if coords[j].joint in inputs]
+
+        def allowed(locked):
+            blocks, n_extra = [], []
+            for frame, cut in leg["ends"]:
+                A = _cut_twists(mech, cut, o, state) if cut is not None else np.zeros((6, 0))
+                blocks.append((at_platform(frame), A))
+                n_extra.append(A.shape[1])
+            free_cols = [c for c in cols if c not in (act if locked else [])]
+            # unknowns: t (6), the leg's free joint rates, each connection's a_c
+            n = 6 + len(free_cols) + sum(n_extra)
+            rows, start = [], 6 + len(free_cols)
+            for (J, A), k in zip(blocks, n_extra):
+                M = np.zeros((6, n))
+                M[:, :6] = np.eye(6)
+                M[:, 6:6 + len(free_cols)] = -J[:, free_cols]
+                M[:, start:start + k] = -A
+                start += k
+                rows.append(M)
+            Z = null_space(np.vstack(rows), tol, n)
+            T = Z[:6]
+            return T[:, np.linalg.norm(T, axis=0) > 0] if T.size else np.zeros((6, 0))
+
+        T = allowed(False)
+        W = null_space(T.T, tol, 6) if T.size else np.eye(6)  # reciprocal: w . t = 0
+        T_locked = allowed(True)
+        W_locked = null_space(T_locked.T, tol, 6) if T_locked.size else np.eye(6)
+        # transmission: in W_locked, outside span(W): the part of W_locked orthogonal to W
+        P = W_locked - W @ (W.T @ W_locked) if W.size else W_locked
+        Ut, st, _ = np.linalg.svd(P, full_matrices=False) if P.size else (np.zeros((6, 0)), np.zeros(0), None)
+        trans = Ut[:, st > tol.rank_rtol] if st.size else np.zeros((6, 0))  # rank of P (orthonormal columns)
+        names = tuple(coords[j].joint for j in joints)
+        out.append(Leg(names, tuple(n for n in names if n in inputs), rank(T, tol),
+                       tuple(tuple(map(float, c)) for c in W.T), tuple(tuple(map(float, c)) for c in trans.T),
+                       tuple(wrench_screw(c, o) for c in W.T), tuple(wrench_screw(c, o) for c in trans.T)))
+    return tuple(out)
+
+
+def _cut_twists(mech, cut, o, state) -> np.ndarray:
+    """The relative twists a cut joint allows (analysis.screws.cut_twists), moved to the platform
+    origin o, world axes (6 x k); none for a higher pair (its equivalent linkage's joints belong
+    to the leg)."""
+    twists = cut_twists(mech, cut, state) or []
+    cols = [np.r_[t[:3] + np.cross(t[3:], o), t[3:]] for _, t, _ in twists]  # v_o = v_0 + w x o
+    return np.array(cols).T if cols else np.zeros((6, 0))

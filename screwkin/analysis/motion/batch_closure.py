@@ -1,0 +1,428 @@
+"""Loop-closure rows and damped Newton for stacks of configurations (the workspace's inverse
+kinematics, batched continuation): ``TreeKinematics`` computes the placements and Jacobians of
+frames of a tree of 1-DOF joints for N configurations in one pass down the tree, and
+``BatchClosure`` builds on them the same rows, in the same order, as model.closure.ClosureSystem
+and moves every configuration by the one damped-Newton step of model/newton.py.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from ...model import newton
+from ...model.closure import ClosureSystem, CouplingRow, CutJoint
+
+__all__ = ["TreeKinematics", "BatchClosure", "Unbatchable"]
+
+
+class Unbatchable(Exception):
+    """The mechanism holds something the batched closure does not represent (joints of more
+    than one coordinate, <mimic> joints, helical joints, sliding contacts): the caller solves
+    one configuration at a time with model.closure.ClosureSystem instead."""
+
+
+class TreeKinematics:
+    """Placements and LOCAL_WORLD_ALIGNED Jacobians of frames of a tree of 1-DOF revolute and
+    prismatic joints for stacks of configurations: one pass down the tree per stack (each
+    joint's placement once: Pinocchio's forwardKinematics written for N configurations).  Each
+    joint costs one matrix product of its parent's N rotations with a constant 3 x 11 matrix
+    (Rodrigues' formula split into constant parts, the placement's translation and the axis)
+    and a few elementwise operations.  Joint axes and placements are Pinocchio's; the rows
+    BatchClosure builds on them equal ClosureSystem's (tests/test_newton.py)."""
+
+    _AXES = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1),
+             "JointModelPX": (1, 0, 0), "JointModelPY": (0, 1, 0), "JointModelPZ": (0, 0, 1)}
+
+    def __init__(self, mech):
+        model = mech.model
+        self.model = model
+        if model.nq != model.nv:
+            raise Unbatchable(f"{mech.path}: joints of more than one coordinate")
+        data = mech.scratch_data()
+        q0 = pin.neutral(model)
+        self.joints = []  # (parent, kind "R" | "P", constant 3 x 11 matrix, idx_q)
+        for j in range(1, model.njoints):
+            short = model.joints[j].shortname()
+            if model.nvs[j] != 1 or not (short in self._AXES or short.endswith(("RevoluteUnaligned",
+                                                                               "PrismaticUnaligned"))):
+                raise Unbatchable(f"{mech.path}: joint '{model.names[j]}' ({short}) is not a 1-DOF revolute or "
+                                  "prismatic joint (a <mimic> joint, a helical or multi-DOF joint)")
+            kind = "P" if ("PrismaticUnaligned" in short or short.startswith("JointModelP")) else "R"
+            if short in self._AXES:
+                axis = np.array(self._AXES[short], float)
+            else:  # the motion subspace in the joint's own frame at q0
+                S = pin.computeJointJacobian(model, data, q0, j)[:, model.idx_vs[j]]
+                axis = S[3:] if kind == "R" else S[:3]
+                axis = axis / np.linalg.norm(axis)
+            M = model.jointPlacements[j]
+            K = pin.skew(axis)
+            C = np.hstack([M.rotation, M.rotation @ K, M.rotation @ K @ K, M.translation[:, None],
+                           (M.rotation @ axis)[:, None]])
+            self.joints.append((model.parents[j], kind, C.T.copy(), model.idx_qs[j]))
+        self.supports = {}
+        self._frames = {}
+
+    def _support(self, jid):
+        """(joint ids, which are revolute, velocity columns) of the joints moving joint jid."""
+        if jid not in self.supports:
+            sup = [int(j) for j in self.model.supports[jid] if j > 0]
+            self.supports[jid] = (np.array(sup, int), np.array([self.joints[j - 1][1] == "R" for j in sup], bool),
+                                  np.array([self.model.idx_vs[j] for j in sup], int)) if sup else None
+        return self.supports[jid]
+
+    def _frame(self, f):
+        """(parent joint, [R | t]^T of the frame's placement) of frame f."""
+        if f not in self._frames:
+            frame = self.model.frames[f]
+            self._frames[f] = (frame.parentJoint,
+                               np.hstack([frame.placement.rotation, frame.placement.translation[:, None]]).T.copy())
+        return self._frames[f]
+
+    def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
+        """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
+        frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
+        velocity columns ``cols`` of the joints that move it (J and cols None for a frame
+        fixed to the ground, and without ``jacobian``)."""
+        model = self.model
+        Q = np.atleast_2d(np.asarray(Q, float))
+        N = len(Q)
+        # rotations kept transposed and flattened: RT[j, 3 n + i] = R[n][i, j], so that a child's
+        # is one product with the parent's, C^T RT (11 x 3N), and the rest is on contiguous rows
+        RTs = [np.tile(np.eye(3), N)] + [None] * (model.njoints - 1)
+        ps = [np.zeros((N, 3))] + [None] * (model.njoints - 1)
+        ws = [None] * model.njoints  # joint axes (directions) in the world, (N, 3)
+        # sin and 1 - cos of every coordinate from the half-angle tangent (numpy's tan is vectorized,
+        # its sin and cos are not), each repeated for the 3 entries of a column of a rotation
+        t = np.tan(0.5 * Q.T)  # (nq, N)
+        den = 2.0 / (1.0 + t * t)
+        sines, versines = np.repeat(t * den, 3, axis=1), np.repeat(t * t * den, 3, axis=1)  # (nq, 3N)
+        for j, (parent, kind, C, iq) in enumerate(self.joints, start=1):
+            XT = C @ RTs[parent]  # (C is kept transposed)
+            pos = ps[parent] + XT[9].reshape(N, 3)
+            w = XT[10].reshape(N, 3)
+            if kind == "R":  # A Rot(a, th) = A + sin(th) A [a]x + (1 - cos(th)) A [a]x^2, A = R_parent R_placement
+                RT = XT[0:3] + sines[iq] * XT[3:6] + versines[iq] * XT[6:9]
+            else:
+                RT = XT[0:3]
+                pos = pos + w * Q[:, iq, None]
+            RTs[j], ps[j], ws[j] = RT, pos, w
+        Wall = np.stack([np.zeros((N, 3))] + ws[1:], axis=2)  # (N, 3, njoints)
+        Pall = np.stack(ps, axis=2)
+        out = {}
+        for f in frame_ids:
+            jid, CfT = self._frame(f)
+            XT = CfT @ RTs[jid]
+            Rf = XT[0:3].reshape(3, N, 3).transpose(1, 2, 0)
+            pf = ps[jid] + XT[3].reshape(N, 3)
+            support = self._support(jid) if jacobian else None
+            if not support:
+                out[f] = (Rf, pf, None, None)
+                continue
+            sup, revolute, cols = support
+            W = Wall[:, :, sup]  # (N, 3, n) the joints' axes
+            D = pf[:, :, None] - Pall[:, :, sup]  # from a point of each axis to the frame's origin
+            J = np.empty((N, 6, len(sup)))
+            # revolute: (w x d, w); prismatic: (w, 0)
+            J[:, 0] = W[:, 1] * D[:, 2] - W[:, 2] * D[:, 1]
+            J[:, 1] = W[:, 2] * D[:, 0] - W[:, 0] * D[:, 2]
+            J[:, 2] = W[:, 0] * D[:, 1] - W[:, 1] * D[:, 0]
+            J[:, 3:] = W
+            if not revolute.all():
+                J[:, :3, ~revolute] = W[:, :, ~revolute]
+                J[:, 3:, ~revolute] = 0.0
+            out[f] = (Rf, pf, J, cols)
+        return out
+
+
+_TARGET_KINDS = {"pose": ("fixed", 0), "point": ("spherical", 3)}
+
+
+class BatchClosure:
+    """The loop-closure rows of ``mech`` (the same rows, in the same order, as its
+    model.closure.ClosureSystem) for many configurations at once, and a damped-Newton solver
+    that moves all of them together: every iteration is a few numpy calls on the whole stack
+    instead of one Pinocchio pass and one linear solve per configuration.
+
+    Frame placements and Jacobians come from the product-of-exponentials structure equations
+    of the chains from the ground to each cut-joint frame (SerialJacobians).  The rows equal
+    ClosureSystem.evaluate's (tests/test_newton.py compares them on every batchable robot);
+    ``check=N`` compares them again at N random configurations when the object is built (a
+    debugging aid: the program does not check at run time).
+
+    target: None, or (link, "pose" | "point"): one more cut joint, a weld ("pose") or a ball
+    joint ("point") between the output link and a ground frame whose placement is given per
+    configuration (``targets``: origins (N, 3), and a rotation (3, 3) shared by all) -- the
+    inverse kinematics of a workspace grid.
+
+    Raises Unbatchable for what it does not represent.
+    """
+
+    def __init__(self, mech, target=None, check: int = 0):
+        model = mech.model
+        self.mech, self.model = mech, model
+        if model.nq != model.nv:
+            raise Unbatchable(f"{mech.path}: joints of more than one coordinate")
+        if any(not isinstance(e, CouplingRow) for e in mech.extra_rows):
+            raise Unbatchable(f"{mech.path}: sliding contacts (higher pairs)")
+        if any(model.nvs[j] != 1 for j in range(1, model.njoints)):
+            raise Unbatchable(f"{mech.path}: a joint that is not a 1-DOF joint (or a <mimic> joint)")
+        cuts = list(mech.cuts)
+        self.target = None
+        if target is not None:
+            link, kind = target
+            ctype, dof = _TARGET_KINDS[kind]
+            cuts.append(CutJoint("target", ctype, dof, mech.target_frame, mech.link_frame(link), "world", link,
+                                 (1.0, 0.0, 0.0)))
+            self.target = (link, kind)
+        self.cuts = cuts
+        # a ClosureSystem of the same cut joints: its plans give the rows, it checks ours
+        self.system = ClosureSystem(model, cuts, mech.tolerances, mech.path, data=mech.scratch_data(),
+                                    extra=mech.extra_rows)
+        self.nrows = self.system.nrows
+        self.solver_rows = self.system._rows(True)
+        # which of the solver's rows are lengths [m] (positions; the couplings of rolling and screw
+        # pairs), the others dimensionless
+        mask = []
+        for c, (P, pairs, vectors, _) in zip(cuts, self.system.plans):
+            rest = self.system._cut_rows(c, (P, pairs, vectors, None), True) - len(P)
+            mask += [True] * len(P) + [False] * rest
+        self.solver_position_rows = np.array(mask + [True] * len(mech.extra_rows), bool)
+        frames = []
+        for c in cuts:
+            for f in (c.frame1, c.frame2):
+                if f != mech.target_frame and f not in frames:
+                    frames.append(f)
+        self._frame_ids = frames
+        self.tree = TreeKinematics(mech)
+        self.couplings = [(np.array([iq for iq, _, _ in e.terms]), np.array([iv for _, iv, _ in e.terms]),
+                           np.array([c for _, _, c in e.terms]), e.constant) for e in mech.extra_rows]
+        self._revolute_cuts = [(k, np.asarray(c.axis, float)) for k, c in enumerate(cuts)
+                               if c.type in ("revolute", "continuous", "cylindrical", "planar")]
+        if check:
+            self._check(np.random.default_rng(0), check)
+
+    # ------------------------------------------------------------------ frames
+    def _frames(self, Q, jacobian: bool = True):
+        """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n) LOCAL_WORLD_ALIGNED on the chain's
+        columns, columns (n,))}; J and the columns None for a frame on the ground (and for
+        every frame without ``jacobian``)."""
+        return self.tree.frames(Q, self._frame_ids, jacobian)
+
+    def _placements(self, c, frames, targets, N):
+        """(R1, t1, J1, cols1, R2, t2, J2, cols2) of cut joint c (J None: the frame does not move)."""
+        if c.frame1 == self.mech.target_frame:
+            t, Rt = targets
+            first = (np.broadcast_to(np.asarray(Rt, float), (N, 3, 3)), np.asarray(t, float), None, None)
+        else:
+            first = frames[c.frame1]
+        return first + frames[c.frame2]
+
+    # ------------------------------------------------------------------ rows
+    def evaluate(self, Q, targets=None, jacobian: bool = True):
+        """The solver's rows (ClosureSystem.evaluate(solver=True)) of every configuration:
+        r (N, rows) and K (N, rows, nv) (None without ``jacobian``)."""
+        return self._rows(Q, targets, jacobian, solver=True)
+
+    def constraint_jacobians(self, Q, targets=None) -> np.ndarray:
+        """The minimal rows' Jacobian K (N, rows, nv) (ClosureSystem.jacobian) of configurations
+        that close the loops: a rotation vector's rows use the derivative of log3 at the
+        identity, which they are at within the closure tolerance."""
+        return self._rows(Q, targets, True, solver=False)[1]
+
+    def _rows(self, Q, targets, jacobian, solver):
+        Q = np.atleast_2d(np.asarray(Q, float))
+        N, nv = len(Q), self.model.nv
+        if self.target is not None and targets is None:
+            raise ValueError("this closure has a target: give its placements")
+        frames = self._frames(Q, jacobian)
+        nrows = self.solver_rows if solver else self.nrows
+        r = np.empty((N, nrows))
+        K = np.zeros((N, nrows, nv)) if jacobian else None
+
+        def add(rows, cols, A):  # K[:, rows, cols] += A (N, len(rows), len(cols))
+            if cols is not None:
+                K[:, rows, cols] += A
+
+        i = 0
+        for c, (P, pairs, vectors, rotation) in zip(self.cuts, self.system.plans):
+            R1, t1, J1, c1, R2, t2, J2, c2 = self._placements(c, frames, targets, N)
+            d = t2 - t1
+            E = _rows_times(np.asarray(P, float), R1.transpose(0, 2, 1))  # (N, k, 3): position rows, world axes
+            k = E.shape[1]
+            r[:, i:i + k] = _apply_rows(E, d)
+            rows = slice(i, i + k)
+            if jacobian:  # e . (v2 - v1) + (e x d) . w1 = e . (v2 - v1 + d x w1)
+                if J2 is not None:
+                    add(rows, c2, _times(E, J2[:, :3]))
+                if J1 is not None:
+                    add(rows, c1, _times(E, _cross_columns(d, J1[:, 3:]) - J1[:, :3]))
+            i += k
+            if solver and vectors is not None:
+                for v in np.asarray(vectors, float):  # R2 v - R1 v; derivative (R1 v) x w1 - (R2 v) x w2
+                    U1, U2 = R1 @ v, R2 @ v
+                    r[:, i:i + 3] = U2 - U1
+                    if jacobian:
+                        if J1 is not None:
+                            add(slice(i, i + 3), c1, _cross_columns(U1, J1[:, 3:]))
+                        if J2 is not None:
+                            add(slice(i, i + 3), c2, -_cross_columns(U2, J2[:, 3:]))
+                    i += 3
+                continue
+            if rotation:  # log3(R1^T R2), derivative Jlog3 R2^T (w2 - w1) with Jlog3 = I at closure
+                r[:, i:i + 3] = _log3(R1.transpose(0, 2, 1) @ R2)
+                if jacobian:
+                    R2t = R2.transpose(0, 2, 1)
+                    if J2 is not None:
+                        add(slice(i, i + 3), c2, _times(R2t, J2[:, 3:]))
+                    if J1 is not None:
+                        add(slice(i, i + 3), c1, -_times(R2t, J1[:, 3:]))
+                i += 3
+                continue
+            for u0, w0 in pairs:  # alignments u . w; derivative (w x u) . (w2 - w1)
+                u, w = R1 @ np.asarray(u0, float), R2 @ np.asarray(w0, float)
+                r[:, i] = np.einsum("ni,ni->n", u, w)
+                if jacobian:
+                    wu = np.cross(w, u)[:, None, :]
+                    if J2 is not None:
+                        add(slice(i, i + 1), c2, _times(wu, J2[:, 3:]))
+                    if J1 is not None:
+                        add(slice(i, i + 1), c1, -_times(wu, J1[:, 3:]))
+                i += 1
+        for iq, iv, coef, const in self.couplings:
+            r[:, i] = Q[:, iq] @ coef + const
+            if jacobian:
+                for v, cf in zip(iv, coef):
+                    K[:, i, v] += cf
+            i += 1
+        return r, K
+
+    def reversed_axes(self, Q) -> np.ndarray:
+        """(N,) True where a revolute (cylindrical, planar) cut joint is assembled with its two
+        axes opposed: a root of the rows that is not the joint (ClosureSystem.wrong_branch)."""
+        Q = np.atleast_2d(np.asarray(Q, float))
+        bad = np.zeros(len(Q), bool)
+        if not self._revolute_cuts:
+            return bad
+        frames = self._frames(Q)
+        for k, a in self._revolute_cuts:
+            c = self.cuts[k]
+            R1, R2 = frames[c.frame1][0], frames[c.frame2][0]  # (a target is never a revolute cut joint)
+            bad |= np.einsum("ni,ni->n", R1 @ a, R2 @ a) < 0
+        return bad
+
+    # ------------------------------------------------------------------ solving
+    def solve(self, Q0, targets=None, frozen=(), tolerances=None, iterations: int | None = None):
+        """Damped Newton (Levenberg-Marquardt, minimum-norm steps, the damping of each
+        configuration its own) from every row of Q0 at once, as ClosureSystem.solve does for
+        one.  frozen: velocity indices that do not move (inputs).  Returns (Q, converged (N,),
+        residual norms (N,), iterations (N,)); a configuration that converges with a reversed
+        revolute cut joint counts as not converged."""
+        tol = tolerances or self.mech.tolerances
+        max_it = int(iterations if iterations is not None else tol.max_iterations)
+        Q = np.array(np.atleast_2d(Q0), float)
+        N, nv = Q.shape[0], self.model.nv
+        free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
+        its = np.zeros(N, int)
+        if self.solver_rows == 0 or N == 0:
+            return Q, np.ones(N, bool), np.zeros(N), its
+        tgt = targets
+        r, K = self.evaluate(Q, tgt)
+        norm = np.linalg.norm(r, axis=1)
+        mu, nu = np.full(N, tol.lm_damping), np.full(N, newton.NU)
+        active = norm >= tol.closure
+        for _ in range(max_it):
+            idx = np.flatnonzero(active)
+            if not len(idx):
+                break
+            its[idx] += 1
+            Kf = K[idx][:, :, free]
+            ri = r[idx]
+            dqf, lin2 = newton.damped_steps(Kf, ri, mu[idx])
+            Qn = Q[idx].copy()
+            Qn[:, free] += dqf
+            sub = None if tgt is None else (tgt[0][idx], tgt[1])
+            rn, Kn = self.evaluate(Qn, sub)
+            nn = np.linalg.norm(rn, axis=1)
+            ok = nn < norm[idx]
+            rho = newton.gain_ratio(norm[idx], nn, lin2)
+            a = idx[ok]
+            mu[a], nu[a] = newton.accept(mu[a], rho[ok], tol)
+            Q[a], r[a], K[a], norm[a] = Qn[ok], rn[ok], Kn[ok], nn[ok]
+            b = idx[~ok]
+            mu[b], nu[b] = newton.refuse(mu[b], nu[b])
+            active[idx] = (norm[idx] >= tol.closure) & ~newton.given_up(mu[idx], tol)
+        converged = norm < tol.closure
+        if converged.any():
+            c = np.flatnonzero(converged)
+            converged[c] &= ~self.reversed_axes(Q[c])
+        return Q, converged, norm, its
+
+    # ------------------------------------------------------------------ self-check
+    def _check(self, rng, count):
+        """Our rows against ClosureSystem's: at random configurations (solver rows) and at the
+        mechanism's closed configurations (constraint Jacobian)."""
+        mech, model, system = self.mech, self.model, self.system
+        lo = np.maximum(np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi), -np.pi)
+        hi = np.minimum(np.where(np.isfinite(model.upperPositionLimit), model.upperPositionLimit, np.pi), np.pi)
+        Q = rng.uniform(lo, hi, size=(count, model.nq))
+        closed = [mech.generic_configurations()[0].q] if mech.cuts or mech.extra_rows else []
+        frame = model.frames[mech.target_frame]
+        saved = frame.placement.copy()
+        try:
+            for q, is_closed in [(q, False) for q in Q] + [(q, True) for q in closed]:
+                targets = None
+                if self.target is not None:
+                    data = mech.scratch_data()
+                    pin.framesForwardKinematics(model, data, q)
+                    M = data.oMf[self.cuts[-1].frame2]
+                    placement = M if is_closed else pin.SE3(M.rotation, M.translation + 0.01)
+                    frame.placement = placement
+                    model.frames[mech.target_frame] = frame
+                    targets = (placement.translation[None], placement.rotation)
+                if is_closed:
+                    ours, ref = self.constraint_jacobians(q[None], targets)[0], system.jacobian(q)
+                else:
+                    r, K = self.evaluate(q[None], targets)
+                    r_ref, K_ref = system.evaluate(q, True, solver=True)
+                    ours, ref = np.hstack([r[0][:, None], K[0]]), np.hstack([r_ref[:, None], K_ref])
+                err = float(np.abs(ours - ref).max()) if ref.size else 0.0
+                if err > 1e-8 * max(1.0, float(np.abs(ref).max()) if ref.size else 1.0):  # pragma: no cover - a bug
+                    raise RuntimeError(f"{mech.path}: batched closure rows differ from ClosureSystem's by {err:.1e}")
+        finally:
+            frame.placement = saved
+            model.frames[mech.target_frame] = frame
+
+
+def _times(A, B) -> np.ndarray:
+    """A @ B for stacks A (N, k, 3), B (N, 3, n): three broadcast products (numpy's stacked
+    matmul on 3-long inner products costs several times more)."""
+    return A[:, :, 0, None] * B[:, None, 0] + A[:, :, 1, None] * B[:, None, 1] + A[:, :, 2, None] * B[:, None, 2]
+
+
+def _rows_times(P, Rt) -> np.ndarray:
+    """P @ Rt for a constant P (k, 3) and a stack Rt (N, 3, 3)."""
+    return np.einsum("ki,nij->nkj", P, Rt)
+
+
+def _apply_rows(E, d) -> np.ndarray:
+    """E @ d for stacks E (N, k, 3), d (N, 3)."""
+    return E[:, :, 0] * d[:, 0, None] + E[:, :, 1] * d[:, 1, None] + E[:, :, 2] * d[:, 2, None]
+
+
+def _cross_columns(a, W) -> np.ndarray:
+    """a x w for every column w of W: a (N, 3), W (N, 3, n) -> (N, 3, n)."""
+    a0, a1, a2 = a[:, 0, None], a[:, 1, None], a[:, 2, None]
+    return np.stack([a1 * W[:, 2] - a2 * W[:, 1], a2 * W[:, 0] - a0 * W[:, 2], a0 * W[:, 1] - a1 * W[:, 0]], axis=1)
+
+
+def _log3(R) -> np.ndarray:
+    """Rotation vectors of a stack of rotations (N, 3, 3) (pinocchio.log3 for each; angles
+    below pi)."""
+    c = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    theta = np.arccos(c)
+    s = np.sin(theta)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.where(theta < 1e-8, 0.5 + theta**2 / 12.0, theta / (2.0 * s))
+    v = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], axis=1)
+    return v * f[:, None]

@@ -1,0 +1,528 @@
+"""Planar motions in closed form: a sweep solved for every input value at once.
+
+A planar mechanism (every revolute axis parallel to one normal n, every prismatic axis
+in the plane) whose other inputs are held is split, when it can be, into the swept
+input joint and class-II Assur groups (dyads: two links, three joints), in an order
+where each dyad's two outer joints sit on links already placed:
+
+- RRR: the inner joint B at the intersection of the circles about A and C;
+- RRP / PRR: the circle about the revolute outer joint and the line of the slide;
+- RPR: the two links turn together; the slide's offset from the line AC is fixed.
+
+Every link is written as a planar displacement from the configuration q0 the sweep
+starts from (``solver.solve``'s first solution, as ``sweep`` chooses it): a rotation
+theta about n and a translation t, so that a material point at x0 (plane coordinates
+at q0) is at R(theta) x0 + t.  Each dyad's branch (the sign of its square root) is
+read off q0 and kept; a dyad's discriminant reaching zero between grid values is a
+limit position, located by Brent's method on it.  The quantities are carried as
+second-order jets (value, d/dx, d2/dx2 in the input x), so that the joint rates and
+accelerations are the exact derivatives of the closed form: q' rate and q'' rate^2
+(input acceleration zero, other inputs held), what PositionSolver.rates and
+.accelerations give for a mechanism the inputs determine.
+
+``plan`` says why a mechanism does not decompose (then ``sweep`` runs its tracker);
+``planar_sweep`` reproduces ``sweep``'s result (limits, turns, circuit, budget) from
+the closed form, every configuration checked by its closure residual first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ...model.planar_graph import DyadPlan, plan
+from .batch_closure import BatchClosure, Unbatchable
+from .planar import plane_basis
+from ..singularities.singular import measures
+
+__all__ = ["Jet", "ClosedFormSweep", "planar_sweep", "joint_values"]
+
+_PARALLEL = 1e-9  # |axis x n| (or |axis . n| of a slide) accepted as parallel (normal) [-]
+_NEAR_LIMIT = 1e-8  # a relative discriminant at q0 below this: q0 is (nearly) a limit position; not handled [-]
+
+
+class Jet:
+    """A value with its first and second derivatives along the input x (numpy arrays)."""
+
+    __slots__ = ("v", "d", "dd")
+
+    def __init__(self, v, d=0.0, dd=0.0):
+        self.v, self.d, self.dd = v, d, dd
+
+    def __add__(self, o):
+        if isinstance(o, Jet):
+            return Jet(self.v + o.v, self.d + o.d, self.dd + o.dd)
+        return Jet(self.v + o, self.d, self.dd)
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return Jet(-self.v, -self.d, -self.dd)
+
+    def __sub__(self, o):
+        return self + (-o)
+
+    def __rsub__(self, o):
+        return (-self) + o
+
+    def __mul__(self, o):
+        if isinstance(o, Jet):
+            return Jet(self.v * o.v, self.d * o.v + self.v * o.d, self.dd * o.v + 2 * self.d * o.d + self.v * o.dd)
+        return Jet(self.v * o, self.d * o, self.dd * o)
+
+    __rmul__ = __mul__
+
+    def inverse(self):
+        f = 1.0 / self.v
+        return Jet(f, -self.d * f * f, (2 * self.d * self.d * f - self.dd) * f * f)
+
+    def __truediv__(self, o):
+        return self * o.inverse() if isinstance(o, Jet) else self * (1.0 / o)
+
+    def sqrt(self):
+        f = np.sqrt(self.v)
+        return Jet(f, self.d / (2 * f), self.dd / (2 * f) - self.d * self.d / (4 * f ** 3))
+
+    def cos(self):
+        c, s = np.cos(self.v), np.sin(self.v)
+        return Jet(c, -s * self.d, -c * self.d * self.d - s * self.dd)
+
+    def sin(self):
+        c, s = np.cos(self.v), np.sin(self.v)
+        return Jet(s, c * self.d, -s * self.d * self.d + c * self.dd)
+
+    @staticmethod
+    def atan2(y, x):
+        r2 = x.v * x.v + y.v * y.v
+        num = x.v * y.d - y.v * x.d
+        dr2 = 2 * (x.v * x.d + y.v * y.d)
+        return Jet(np.arctan2(y.v, x.v), num / r2, (x.v * y.dd - y.v * x.dd) / r2 - num * dr2 / (r2 * r2))
+
+
+class _Pose:
+    """A link's planar displacement from q0: x -> R(th) x + t (jets)."""
+
+    __slots__ = ("th", "c", "s", "tx", "ty")
+
+    def __init__(self, th, tx, ty):
+        self.th, self.c, self.s, self.tx, self.ty = th, th.cos(), th.sin(), tx, ty
+
+    def rotate(self, u):
+        return self.c * u[0] - self.s * u[1], self.s * u[0] + self.c * u[1]
+
+    def __call__(self, p):
+        x, y = self.rotate(p)
+        return x + self.tx, y + self.ty
+
+    @classmethod
+    def through(cls, th, point, p0):
+        """The displacement turning by th that takes the q0 point p0 to ``point``."""
+        c, s = th.cos(), th.sin()
+        return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
+
+
+def _turn(u0, u):
+    """The angle from the constant vector u0 to the jet vector u, in (-pi, pi]."""
+    return Jet.atan2(u[1] * u0[0] - u[0] * u0[1], u[0] * u0[0] + u[1] * u0[1])
+
+
+class _Geometry:
+    """The plan's joints read at q0: plane basis, points and slide directions in plane
+    coordinates, axis signs, the branch of each dyad."""
+
+    def __init__(self, mech, p: DyadPlan, q0):
+        model, data = mech.model, mech.scratch_data()
+        pin.computeJointJacobians(model, data, q0)
+        pin.updateFramePlacements(model, data)
+        axes, points = [], []  # per pair: (on the side of its first group, of its second)
+        for pr in p.pairs:
+            if pr.tree is not None:
+                col = data.J[:, model.idx_vs[pr.tree]]
+                v, w = col[:3], col[3:]
+                if pr.kind == "R":
+                    x = np.cross(w, v) / (w @ w)
+                    axes.append((w, w))
+                else:
+                    x = data.oMi[pr.tree].translation.copy()
+                    axes.append((v, v))
+                points.append((x, x))
+            else:  # each side from its own frame: exact on its link, whatever q0's closure residual
+                cut = next(c for c in mech.cuts if c.name == pr.name)
+                M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
+                a = np.asarray(cut.axis, float)
+                axes.append((M1.rotation @ a, M2.rotation @ a))
+                points.append((M1.translation.copy(), M2.translation.copy()))
+        axes = [tuple(a / np.linalg.norm(a) for a in both) for both in axes]
+        n = next((a[0] for a, pr in zip(axes, p.pairs) if pr.kind == "R"), None)
+        self.ok = n is not None
+        if not self.ok:
+            self.reason = "no revolute joint: no plane"
+            return
+        for a, pr in zip((a for both in axes for a in both), (pr for pr in p.pairs for _ in (0, 1))):
+            if (pr.kind == "R" and np.linalg.norm(np.cross(a, n)) > _PARALLEL) or (pr.kind == "P" and abs(a @ n) > _PARALLEL):
+                self.ok, self.reason = False, f"joint {pr.name} is out of the plane of the others"
+                return
+        e1, e2, n = plane_basis(n)
+        self.pairs = p.pairs
+        self._points = [tuple(np.array([e1 @ x, e2 @ x]) for x in both) for both in points]
+        self._dirs = [tuple(np.array([e1 @ a, e2 @ a]) for a in both) for both in axes]
+        self.signs = [float(np.sign(a[0] @ n)) for a in axes]
+        self.branch = []
+        for (kinds, ia, ib, ic), (g1, g2) in zip(p.dyads, p.order[1:]):
+            d = _solve_dyad(self, kinds, ia, ib, ic, g1, g2, None, None, None, probe=True)
+            if not (abs(d) > _NEAR_LIMIT):
+                self.ok, self.reason = False, "the start is at (or next to) a limit position"
+                return
+            self.branch.append(float(np.sign(d)))
+
+    def point(self, i, g):
+        """Pair i's point (plane coordinates at q0) on the link of group g."""
+        return self._points[i][self.pairs[i].groups.index(g)]
+
+    def other(self, i, g):
+        """Pair i's point on the link of its group other than g."""
+        return self._points[i][1 - self.pairs[i].groups.index(g)]
+
+    def dir(self, i, g):
+        """Pair i's axis (a slide's direction, plane coordinates at q0) on the link of group g."""
+        return self._dirs[i][self.pairs[i].groups.index(g)]
+
+
+def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clamp=False):
+    """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
+    pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
+    signed branch value at q0 instead (no poses)."""
+    if kinds == "PRR":  # the mirror of RRP
+        out = _solve_dyad(geo, "RRP", ic, ib, ia, g2, g1, pc, pa, sigma, probe, clamp)
+        return out if probe else ((out[0][1], out[0][0]), out[1])
+    A1, B1, B2, C2 = geo.point(ia, g1), geo.point(ib, g1), geo.point(ib, g2), geo.point(ic, g2)
+    AK, CK = geo.other(ia, g1), geo.other(ic, g2)
+    if probe:
+        if kinds == "RRR":
+            w, u = CK - AK, B1 - A1
+            return (w[0] * u[1] - w[1] * u[0]) / (np.linalg.norm(w) * np.linalg.norm(u))
+        if kinds == "RRP":  # b = d . (B - A) relative to r1
+            return geo.dir(ic, g2) @ (B2 - AK) / np.linalg.norm(B1 - A1)
+        return geo.dir(ib, g1) @ (C2 - A1) / np.linalg.norm(C2 - A1)  # RPR
+    if kinds == "RRR":
+        A, C = pa(AK), pc(CK)
+        r1s, r2s = float((B1 - A1) @ (B1 - A1)), float((B2 - C2) @ (B2 - C2))
+        w = (C[0] - A[0], C[1] - A[1])
+        d2 = w[0] * w[0] + w[1] * w[1]
+        a = (d2 + (r1s - r2s)) / (2.0 * d2)
+        disc = d2.inverse() * r1s - a * a
+        h = _root(disc, clamp) * sigma
+        B = (A[0] + a * w[0] - h * w[1], A[1] + a * w[1] + h * w[0])
+        th1 = _turn(B1 - A1, (B[0] - A[0], B[1] - A[1]))
+        th2 = _turn(B2 - C2, (B[0] - C[0], B[1] - C[1]))
+        return (_Pose.through(th1, A, A1), _Pose.through(th2, C, C2)), disc.v * d2.v / r1s
+    if kinds == "RRP":  # B on g2 slides along a line of C's other link
+        A, P = pa(AK), pc(B2)
+        dd = pc.rotate(geo.dir(ic, g2))
+        e = (P[0] - A[0], P[1] - A[1])
+        r1s = float((B1 - A1) @ (B1 - A1))
+        b = dd[0] * e[0] + dd[1] * e[1]
+        disc = b * b - (e[0] * e[0] + e[1] * e[1] - r1s)
+        s = _root(disc, clamp) * sigma - b
+        B = (P[0] + s * dd[0], P[1] + s * dd[1])
+        th1 = _turn(B1 - A1, (B[0] - A[0], B[1] - A[1]))
+        return (_Pose.through(th1, A, A1), _Pose.through(pc.th, B, B2)), disc.v / r1s
+    # RPR: both links turn by the same angle; C - A = R(th) (C2 - A1 + s d)
+    A, C = pa(AK), pc(CK)
+    d0, v0 = geo.dir(ib, g1), C2 - A1
+    w = (C[0] - A[0], C[1] - A[1])
+    b = float(d0 @ v0)
+    v0s = float(v0 @ v0)
+    disc = (w[0] * w[0] + w[1] * w[1]) + (b * b - v0s)
+    s = _root(disc, clamp) * sigma - b
+    u = (s * d0[0] + v0[0], s * d0[1] + v0[1])
+    th = Jet.atan2(u[0] * w[1] - u[1] * w[0], u[0] * w[0] + u[1] * w[1])
+    return (_Pose.through(th, A, A1), _Pose.through(th, C, C2)), disc.v / v0s
+
+
+def _root(disc, clamp):
+    """The square root of a discriminant (NaN where it is negative); clamp: of max(disc, 0),
+    values only (at a limit position, where the derivatives are infinite)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
+
+
+def _evaluate(geo, p: DyadPlan, xs, start, branch, clamp=None):
+    """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
+    clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
+    Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        return _evaluate_all(geo, p, xs, start, branch, clamp)
+
+
+def _evaluate_all(geo, p, xs, start, branch, clamp):
+    xs = np.asarray(xs, float)
+    zero = Jet(np.zeros(len(xs)))
+    poses = {p.groups[0]: _Pose(zero, zero, zero)}
+    sw = p.pairs[p.swept]
+    delta = Jet(xs - start, 1.0, 0.0)
+    k, u = p.order[0]
+    g = poses[k]
+    if sw.kind == "R":
+        a0 = geo.point(p.swept, k)
+        turn = delta * geo.signs[p.swept] * (1.0 if k == sw.groups[0] else -1.0)
+        poses[u] = _Pose.through(g.th + turn, g(a0), a0)
+    else:
+        o0, d0 = geo.point(p.swept, k), geo.dir(p.swept, k)
+        step = delta * (1.0 if k == sw.groups[0] else -1.0)
+        poses[u] = _Pose.through(g.th, g((step * d0[0] + o0[0], step * d0[1] + o0[1])), o0)
+    discs = np.empty((len(p.dyads), len(xs)))
+    for i, ((kinds, ia, ib, ic), (g1, g2)) in enumerate(zip(p.dyads, p.order[1:])):
+        pa_group = next(g for g in p.pairs[ia].groups if g != g1)
+        pc_group = next(g for g in p.pairs[ic].groups if g != g2)
+        (p1, p2), discs[i] = _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, poses[pa_group], poses[pc_group],
+                                         branch[i], clamp=clamp == i)
+        poses[g1], poses[g2] = p1, p2
+    return poses, discs
+
+
+class _Layout:
+    """Where each tree joint's coordinate comes from: the groups of its two links, its kind."""
+
+    def __init__(self, mech, p: DyadPlan, geo, q0):
+        model = mech.model
+        self.rows = []  # (idx_q, nq, idx_v, kind, parent group, child group, pair index or None)
+        by_tree = {pr.tree: i for i, pr in enumerate(p.pairs) if pr.tree is not None}
+        for j in range(1, model.njoints):
+            i = by_tree.get(j)  # None: a held input (both links in one group)
+            self.rows.append((model.idx_qs[j], model.nqs[j], model.idx_vs[j], p.pairs[i].kind if i is not None else None,
+                              p.groups[model.parents[j]], p.groups[j], i))
+        self.geo, self.q0, self.nq, self.nv = geo, q0, model.nq, model.nv
+        self.wrapped = [(iq, iv) for iq, nq, iv, kind, _, _, _ in self.rows if kind == "R" and nq == 1]
+
+    def __call__(self, poses, N, rate):
+        """(Q (N, nq) with the one-coordinate angles not yet unwrapped, rates, accelerations)."""
+        geo, q0 = self.geo, self.q0
+        Q = np.tile(q0, (N, 1))
+        V, A = np.zeros((N, self.nv)), np.zeros((N, self.nv))
+        for iq, nq, iv, kind, gp, gc, i in self.rows:
+            if kind is None:
+                continue
+            pp, pc = poses[gp], poses[gc]
+            if kind == "R":
+                rel = (pc.th - pp.th) * geo.signs[i]
+                if nq == 2:
+                    ang = np.arctan2(q0[iq + 1], q0[iq]) + rel.v
+                    Q[:, iq], Q[:, iq + 1] = np.cos(ang), np.sin(ang)
+                else:
+                    Q[:, iq] = q0[iq] + rel.v
+            else:
+                o0, d0 = geo.point(i, gp), geo.dir(i, gp)
+                (xc, yc), (xp, yp) = pc(o0), pp(o0)
+                dx, dy = xc - xp, yc - yp
+                # d0 . R(-th_p) (g_c(o0) - g_p(o0))
+                rel = (pp.c * dx + pp.s * dy) * d0[0] + (pp.c * dy - pp.s * dx) * d0[1]
+                Q[:, iq] = q0[iq] + rel.v
+            V[:, iv] = rel.d * rate
+            A[:, iv] = rel.dd * rate * rate
+        return Q, V, A
+
+
+class _Unwrap:
+    """Makes the one-coordinate revolute angles continuous along the motion: each new sample
+    takes the turn (2 pi k) nearest to the previous one moved by its rates (trapezoid)."""
+
+    def __init__(self, wrapped):
+        self.cols = np.array([iq for iq, _ in wrapped], int)
+        self._iv = np.array([iv for _, iv in wrapped], int)
+        self.last = None  # (raw, slope, x, turns) of the last sample
+
+    def __call__(self, Q, V, xs, rate):
+        if not len(self.cols) or not len(xs):
+            return Q
+        raw = Q[:, self.cols]
+        slope = V[:, self._iv] / rate if rate else np.zeros_like(raw)
+        if self.last is None:
+            self.last = (raw[0], slope[0], xs[0], np.zeros(len(self.cols)))
+        r0, s0, x0, k0 = self.last
+        rr = np.vstack([r0, raw])
+        ss = np.vstack([s0, slope])
+        xx = np.concatenate([[x0], xs])
+        with np.errstate(invalid="ignore"):
+            pred = 0.5 * (ss[1:] + ss[:-1]) * np.diff(xx)[:, None]
+        pred = np.where(np.isfinite(pred), pred, 0.0)
+        k = np.round((pred - np.diff(rr, axis=0)) / (2 * np.pi))
+        turns = k0 + np.cumsum(k, axis=0)
+        Q = Q.copy()
+        Q[:, self.cols] = raw + 2 * np.pi * turns
+        self.last = (raw[-1], slope[-1], xs[-1], turns[-1])
+        return Q
+
+
+@dataclass(frozen=True)
+class ClosedFormSweep:
+    """What ``sweep`` reports, from the closed form (screwkin.analysis.motion.sweep.SweepResult's fields)."""
+
+    values: np.ndarray  # input values in the order of the motion [rad or m]
+    q: np.ndarray  # (steps, nq)
+    joints: np.ndarray  # (steps, names) Mechanism.joint_values
+    rates: np.ndarray  # (steps, nv)
+    accelerations: np.ndarray  # (steps, nv)
+    stopped_at: float | None
+    stop_reason: str | None
+    limits: tuple  # (input value, relative sigma of K_p, q) of each limit position met
+    circuit_closed: bool
+    unit: str
+
+
+_LIMIT_REASON = ("limit position: the passive joints become undetermined (an actuator singularity); "
+                 "the input cannot go further on this branch")
+
+
+def _ready(solver, name, q0):
+    """(plan, geometry, layout) for sweeping ``name`` from q0, or None when the closed form does not apply."""
+    mech = solver.mech
+    key = ("dyads.plan", tuple(solver.inputs), name)
+    if key not in mech.cache:
+        mech.cache[key] = plan(mech, solver.inputs, name)
+    p = mech.cache[key]
+    if isinstance(p, str):
+        return None
+    geo = _Geometry(mech, p, q0)
+    if not geo.ok:
+        return None
+    return p, geo, _Layout(mech, p, geo, q0)
+
+
+def _residuals_ok(mech, Q) -> bool:
+    """Every configuration closes the loops within the closure tolerance (batched where it can be)."""
+    tol = mech.tolerances.closure
+    if not len(Q) or not mech.cuts:
+        return True
+    try:
+        bc = mech.cache.get("dyads.batch")
+        if bc is None:
+            bc = mech.cache["dyads.batch"] = BatchClosure(mech, check=0)
+        r = bc.evaluate(Q, jacobian=False)[0]
+        return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
+    except Unbatchable:
+        return all(np.linalg.norm(mech.closure.residual(q)) <= tol for q in Q)
+
+
+def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
+    """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
+    the mechanism does not decompose into dyads, or where the result would not be sweep's
+    (two limits between grid values, a configuration not closing the loops)."""
+    ready = _ready(solver, name, q0)
+    if ready is None:
+        return None
+    p, geo, layout = ready
+    mech = solver.mech
+    max_steps = max_steps or 20 * steps + 100
+    h = (stop - start) / steps
+    scale = np.where(mech.translational, mech.length, 1.0)
+    branch = list(geo.branch)
+    unwrap = _Unwrap(layout.wrapped)
+    Xs, Qs, Vs, As, limits = [], [], [], [], []
+    count, k_pos, forward = 0, 0.0, True
+    stopped = reason = None
+    closed = False
+    last_x = float(start)
+    first = True
+    while True:
+        if count >= max_steps:  # (the tracker stops at its last step, which may lie past the last grid value)
+            stopped, reason = last_x, f"the step budget ({max_steps} configurations) is spent"
+            break
+        if h == 0 and not first:
+            break
+        budget = max_steps - count
+        if forward:
+            j0 = int(np.floor(k_pos + 1e-9)) + 1
+            js = np.arange(0 if first else j0, steps + 1)[:budget]
+            if not len(js):
+                break
+        else:
+            j0 = int(np.ceil(k_pos - 1e-9)) - 1
+            js = np.arange(j0, j0 - budget, -1)
+        xs = start + js * h
+        if forward and js[-1] == steps and (xs[-1] - stop) * np.sign(h) > 0:
+            xs[-1] = stop
+        if h == 0:
+            xs = xs[:1]
+        poses, discs = _evaluate(geo, p, xs, start, branch)
+        bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(p.dyads) else np.zeros(0, int)
+        n_ok = int(bad[0]) if len(bad) else len(xs)
+        if first and n_ok == 0:
+            return None
+        if n_ok:
+            sub = {g: _Pose(_take(q.th, n_ok), _take(q.tx, n_ok), _take(q.ty, n_ok)) for g, q in poses.items()}
+            Q, V, A = layout(sub, n_ok, rate)
+            Q = unwrap(Q, V, xs[:n_ok], rate)
+            xs_ok = xs[:n_ok]
+            if turn and forward and not first:  # back at the start: the circuit is closed
+                at = np.flatnonzero(np.abs(xs_ok - start) < mech.tolerances.equal * max(1.0, abs(h)))
+                for i in at:
+                    if count + i + 1 > 2 and np.linalg.norm(pin.difference(mech.model, Q[i], q0) / scale) < mech.tolerances.geometry:
+                        n_ok, closed = int(i) + 1, True
+                        Q, V, A, xs_ok = Q[:n_ok], V[:n_ok], A[:n_ok], xs_ok[:n_ok]
+                        break
+            Xs.append(xs_ok), Qs.append(Q), Vs.append(V), As.append(A)
+            count += n_ok
+            last_x = float(xs_ok[-1])
+            k_pos = (last_x - start) / h if h else 0.0
+        first = False
+        if closed:
+            break
+        if n_ok == len(xs):
+            continue  # the end of the range (forward), or the budget (back): said at the top
+        # a limit position between last_x and xs[n_ok]
+        lo, hi = last_x, float(xs[n_ok])
+
+        def worst(x):
+            d = _evaluate(geo, p, [x], start, branch)[1][:, 0]
+            return float(np.min(np.where(np.isnan(d), -1.0, d)))
+
+        if not worst(lo) > 0:
+            return None  # two limit positions within one step of the grid
+        from scipy.optimize import brentq  # (here: importing scipy.optimize takes 0.3 s, a sweep 20 ms)
+
+        x_lim = brentq(worst, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+        d_lim = _evaluate(geo, p, [x_lim], start, branch)[1][:, 0]
+        which = int(np.argmin(np.abs(np.where(np.isnan(d_lim), np.inf, d_lim))))
+        poses = _evaluate(geo, p, [x_lim], start, branch, clamp=which)[0]
+        Q, V, _ = layout(poses, 1, rate)
+        q_lim = unwrap(Q, V, np.array([x_lim]), rate)[0]
+        if not _residuals_ok(mech, q_lim[None]):
+            return None
+        sig = measures(mech, q_lim, solver.generic())["actuator"]
+        limits.append((float(x_lim), float(sig), q_lim))
+        if not turn:
+            stopped, reason = float(x_lim), _LIMIT_REASON
+            break
+        branch[which] = -branch[which]
+        forward = not forward
+        k_pos = (x_lim - start) / h
+        last_x = float(x_lim)
+    X = np.concatenate(Xs)
+    Q, V, A = np.vstack(Qs), np.vstack(Vs), np.vstack(As)
+    if not _residuals_ok(mech, Q):
+        return None
+    if turn and stopped is None and not closed and (stop - last_x) * np.sign(h) > mech.tolerances.equal * max(1.0, abs(stop)):
+        stopped, reason = last_x, "the motion did not reach the end of the range"
+    unit = "m" if p.pairs[p.swept].kind == "P" else "rad"
+    return ClosedFormSweep(X, Q, joint_values(mech, Q), V, A, stopped, reason, tuple(limits), closed, unit)
+
+
+def _take(j, n):
+    return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))
+
+
+def joint_values(mech, Q) -> np.ndarray:
+    """Mechanism.joint_values of every row of Q, as an array (N, names) in its order."""
+    single, continuous, multi, order, idx, wrap = mech._value_layout()
+    cols = {}
+    for (n, i, w) in single:
+        v = Q[:, i]
+        cols[n] = np.mod(v + np.pi, 2 * np.pi) - np.pi if w else v
+    for n, i in continuous:
+        cols[n] = np.arctan2(Q[:, i + 1], Q[:, i])
+    for n, i in multi:
+        cols[n] = Q[:, i]
+    return np.column_stack([cols[n] for n in order]) if order else np.zeros((len(Q), 0))

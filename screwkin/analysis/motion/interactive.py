@@ -1,0 +1,189 @@
+"""The state behind an interactive view (``view --interactive``): input values -> configuration,
+kept on one assembly mode as the inputs move, with the modes at the current inputs, the
+singularity measure, and the output pose and named points to read out.  No browser, no
+printing: a GUI (screwkin.present.interactive) calls :meth:`Interactive.move` and
+:meth:`Interactive.switch` and shows the :class:`LiveState` they return.
+
+Moving an input is analysis.motion.sweep's continuation from the current configuration to the new
+value (the other inputs held), in steps of at most ``MAX_STEP`` (an angle) or ``MAX_STEP``
+times the characteristic length (a slide): the assembly mode is kept as a physical mechanism
+keeps it, and a limit position met on the way is located and stops the move.  A move that
+cannot be completed changes nothing: the state says where and why it stopped.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import AssemblyError, UsageError
+from ...model.state import KinematicState
+from .links import point_motions
+from .position import PositionSolver
+from ..singularities.singular import measures
+from .sweep import sweep
+
+__all__ = ["Control", "LiveState", "Interactive", "MAX_STEP"]
+
+MAX_STEP = math.radians(2.0)  # largest continuation step [rad]; for a slide, this times the characteristic length
+
+
+@dataclass(frozen=True)
+class Control:
+    """One input's control: the joint, its unit ("rad" or "m") and range [rad or m] (the file's
+    <limit>, else a turn either side of its starting value for an angle, the characteristic
+    length either side for a slide)."""
+
+    name: str
+    unit: str
+    low: float
+    high: float
+    start: float
+
+
+@dataclass(frozen=True)
+class LiveState:
+    """Where the mechanism is.
+
+    q: the configuration; inputs: input name -> value [rad or m] (as moved: not wrapped);
+    mode: its index (1-based) among the ``modes`` assembly modes solve finds at these inputs
+    (0: none of them matched); sigma: the relative smallest singular value of the actuator and
+    constraint measures (analysis.singularities.singular.measures), singular when below Tolerances.singular;
+    output_pose: 4x4 world pose of the output link (or None); points: name -> world position [m];
+    moved: the last request was carried out; message: why not (a limit position, an input the
+    loops cannot reach), or None."""
+
+    q: np.ndarray
+    inputs: dict
+    mode: int
+    modes: int
+    sigma: float
+    singular: bool
+    output_pose: np.ndarray | None
+    points: dict
+    moved: bool = True
+    message: str | None = None
+
+
+class Interactive:
+    """Inputs -> configuration for a GUI, one assembly mode followed as the inputs move.
+
+    inputs: the input joints (default: the actuated ones); values: their starting values
+    (default: the file's assembled configuration's); mode: the starting assembly mode (1-based,
+    as solve lists them); output: the output link whose pose is read out; points:
+    analysis.motion.links.Point objects read out."""
+
+    def __init__(self, mech, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,
+                 points=()):
+        self.mech = mech
+        self.solver = PositionSolver(mech, list(inputs) if inputs else None, output=output)
+        self.inputs = tuple(self.solver.inputs)
+        if not self.inputs:
+            raise UsageError(f"{mech.path}: no input to move: declare actuated joints or give --inputs")
+        self.output, self.points = output, tuple(points)
+        if values is None:
+            q0 = mech.assemble().q
+            joints = mech.joint_values(q0)
+            values = {n: joints[n] for n in self.inputs}
+        self._values = {n: float(values[n]) for n in self.inputs}
+        self.controls = tuple(self._control(n, self._values[n]) for n in self.inputs)
+        self._modes = None
+        modes = self.modes()
+        if not 1 <= mode <= len(modes):
+            raise UsageError(f"--mode {mode}: these inputs give {len(modes)} assembly mode{'s' if len(modes) != 1 else ''}")
+        self.state = self._state(modes[mode - 1], mode)
+
+    # ------------------------------------------------------------------ controls
+    def _control(self, name, start) -> Control:
+        mech = self.mech
+        c = mech.coordinate(name)
+        linear = bool(mech.translational[c.idx_v])
+        lo = hi = None
+        if c.nq == 1:
+            lo, hi = float(mech.model.lowerPositionLimit[c.idx_q]), float(mech.model.upperPositionLimit[c.idx_q])
+        span = mech.length if linear else math.pi
+        if lo is None or not (np.isfinite(lo) and np.isfinite(hi)) or hi - lo <= 0 or (not linear and hi - lo > 2 * math.pi):
+            lo, hi = start - span, start + span  # no usable <limit>: a turn (or a characteristic length) around
+        return Control(name, "m" if linear else "rad", lo, hi, float(start))
+
+    def control(self, name) -> Control:
+        found = next((c for c in self.controls if c.name == name), None)
+        if found is None:
+            raise UsageError(f"{self.mech.path}: '{name}' is not an input ({', '.join(self.inputs)})")
+        return found
+
+    # ------------------------------------------------------------------ modes
+    def modes(self) -> list:
+        """The assembly modes' configurations at the current inputs (solve's order), cached until they move."""
+        if self._modes is None:
+            self._modes = [s.q for s in self.solver.solve(dict(self._values)).solutions]
+        return self._modes
+
+    def _mode_of(self, q, modes) -> int:
+        """The index (1-based) of the mode whose joint centres and cut-joint frames are where q's are
+        (PositionSolver's signature: idle spins aside); 0 when none is."""
+        c = self.solver._signature(q)
+        d = [float(np.linalg.norm(self.solver._signature(m) - c)) for m in modes]
+        k = int(np.argmin(d)) if d else -1
+        return k + 1 if k >= 0 and d[k] <= self.mech.tolerances.geometry * self.mech.length * math.sqrt(max(len(c), 1)) else 0
+
+    # ------------------------------------------------------------------ state
+    def _state(self, q, mode=None, moved=True, message=None) -> LiveState:
+        mech = self.mech
+        modes = self.modes()
+        m = measures(mech, q, self.solver.generic())
+        g = self.solver.generic()
+        sigma = float(min(m["actuator"], m["constraint"])) if g.rank_K or g.rank_Kp else 1.0
+        pose = None
+        if self.output is not None:
+            pose = KinematicState(mech, q).link_pose(self.output)
+        points = {}
+        if self.points:
+            st = KinematicState(mech, q)
+            points = {n: np.asarray(p["position"], float) for n, p in point_motions(st, self.points).items()}
+        return LiveState(np.array(q, float), dict(self._values), self._mode_of(q, modes) if mode is None else mode,
+                         len(modes), sigma, sigma < mech.tolerances.singular, pose, points, moved, message)
+
+    def _refused(self, message) -> LiveState:
+        s = self.state
+        self.state = LiveState(s.q, s.inputs, s.mode, s.modes, s.sigma, s.singular, s.output_pose, s.points, False,
+                               message)
+        return self.state
+
+    def move(self, name: str, value: float) -> LiveState:
+        """Move input ``name`` to ``value`` [rad or m] by continuation from the current
+        configuration (the other inputs held): the new state, or the unchanged one with a
+        message when a limit position (or an unreachable input) stops the motion on the way."""
+        ctl = self.control(name)
+        value = float(value)
+        start = self._values[name]
+        if value == start:
+            return self.state
+        step = MAX_STEP * (self.mech.length if ctl.unit == "m" else 1.0)
+        steps = max(1, math.ceil(abs(value - start) / step))
+        fixed = {n: v for n, v in self._values.items() if n != name}
+        near = self.mech.joint_values(self.state.q)
+        try:
+            res = sweep(self.solver, name, start, value, steps, fixed=fixed, near=near)
+        except AssemblyError as exc:
+            return self._refused(f"{name} cannot move from here: {exc}")
+        if res.stopped_at is not None or res.skipped:
+            where = res.stopped_at if res.stopped_at is not None else res.skipped[0]
+            shown = f"{math.degrees(where):.6g} deg" if ctl.unit == "rad" else f"{where * 1000:.6g} mm"
+            why = res.stop_reason or "the loops cannot be closed there"
+            return self._refused(f"{name} stopped at {shown}: {why}; nothing moved")
+        self._values[name] = value
+        self._modes = None
+        self.state = self._state(res.q[-1])
+        return self.state
+
+    def switch(self, mode: int) -> LiveState:
+        """Go to the assembly mode ``mode`` (1-based) of the current inputs."""
+        modes = self.modes()
+        if not 1 <= mode <= len(modes):
+            return self._refused(f"mode {mode}: these inputs give {len(modes)} assembly mode"
+                                 f"{'s' if len(modes) != 1 else ''}")
+        self.state = self._state(modes[mode - 1], mode)
+        return self.state

@@ -1,0 +1,393 @@
+"""Textbook extras for planar four-bars and slider-cranks driven from a ground joint.
+
+Recognized from the topology (4 links, 4 joints, planar, one loop; four
+revolutes, or three revolutes and a prismatic joint to the ground), with
+lengths measured between joint centres in the plane of motion:
+
+- Grashof class: s + l against p + q (four-bar); full crank rotation when
+  crank + |offset| <= rod (slider-crank);
+- transmission angle mu: four-bar, the angle at the coupler-output joint
+  between coupler and output link; slider-crank, the angle between the rod and
+  the normal of the slide.  90 deg transmits force best in both;
+- the input range, from the circle condition |b - c| <= |BD| <= b + c (or the
+  rod reaching the slide), and the input values at the output's limit
+  positions (input and coupler collinear: dead centres of the output).
+
+Angles are returned as input *joint values* [rad] of the circuit the
+configuration is on.  :func:`transmission_angles` gives mu at a stack of configurations
+from one identification (the joint centres by forward kinematics, the angles all at once).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pinocchio as pin
+
+from ...errors import UsageError
+from ...model._pin import joint_axis
+from ...model.geometry import (
+    circle_intersections,
+    cross2,
+    line_angle,
+    line_circle,
+    perpendicular_basis,
+    plane_basis,
+    vector_angle,
+)
+from .batch_closure import TreeKinematics, Unbatchable
+
+__all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
+
+
+@dataclass(frozen=True)
+class LinkageInfo:
+    kind: str  # "four-bar" | "slider-crank"
+    lengths: dict  # [m]
+    grashof: str
+    input_joint: str
+    input_range: tuple | None  # (low, high) joint values; None: the input turns fully
+    limit_inputs: tuple  # input joint values where the output is at a limit position
+    transmission_angle: float  # mu [rad] at the configuration analysed
+    # four-bar: the textbook's diagonal construction at the configuration analysed: diagonal z from the
+    # crank tip to the output pivot [m]; at the output pivot, alpha between the diagonal and the output
+    # link and beta between the diagonal and the ground link [rad, 0..pi]
+    diagonal: float | None = None
+    alpha: float | None = None
+    beta: float | None = None
+    # where transmission_angles finds the centres of the joints A (input), B, C, D at any
+    # configuration, the plane's normal and the slide's direction (slider-crank), in the world
+    centres: tuple = field(default=(), compare=False, repr=False)
+    normal: tuple | None = field(default=None, compare=False, repr=False)
+    slide: tuple | None = field(default=None, compare=False, repr=False)
+
+    def construction(self) -> dict:
+        """JSON-ready: four-bar {transmission_angle, diagonal, alpha, beta}; slider-crank {transmission_angle}."""
+        d = {"kind": self.kind, "transmission_angle": self.transmission_angle}
+        if self.diagonal is not None:
+            d.update(diagonal=self.diagonal, alpha=self.alpha, beta=self.beta)
+        return d
+
+
+def _rot(v, ang):
+    c, s = np.cos(ang), np.sin(ang)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+def _angle(v):
+    return float(np.arctan2(v[1], v[0]))
+
+
+def _wrap(x):
+    return float(np.mod(x + np.pi, 2 * np.pi) - np.pi)
+
+
+def _interval(start, end, phi_now, q_in):
+    """Joint values of the angle interval [start, end] (end > start) that contains phi_now."""
+    k = np.floor((phi_now - start) / (2 * np.pi))
+    start, end = start + 2 * np.pi * k, end + 2 * np.pi * k
+    return (q_in + start - phi_now, q_in + end - phi_now)
+
+
+def identify(mech, topo, q, input_joint):
+    """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
+    joint is a ground joint, at the configuration ``topo`` was built at (q)."""
+    if topo.motion_space != "planar" or (topo.n_links, topo.n_joints, topo.loops) != (4, 4, 1):
+        return None
+    joints = {j.name: j for j in topo.joints}
+    inp = joints.get(input_joint)
+    ground = topo.ground
+    if inp is None or ground not in inp.links or inp.type not in ("revolute", "continuous"):
+        return None
+    n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
+    e1, e2 = perpendicular_basis(n)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
+
+    def p2(v):
+        v = np.asarray(v)
+        return np.array([v @ e1, v @ e2])
+
+    def other(link, joint):
+        return next(j for j in topo.joints if j is not joint and link in j.links)
+
+    moving = inp.links[1] if inp.links[0] == ground else inp.links[0]
+    j_b = other(moving, inp)
+    coupler = j_b.links[1] if j_b.links[0] == moving else j_b.links[0]
+    j_c = other(coupler, j_b)
+    j_d = other(ground, inp)
+    coord = mech.coordinate(input_joint)
+    q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
+    A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
+    a, b = np.linalg.norm(B - A), np.linalg.norm(C - B)
+    where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
+    if j_d.type in ("revolute", "continuous") and j_c.type in ("revolute", "continuous") \
+            and j_b.type in ("revolute", "continuous"):
+        return replace(_four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b, mech.tolerances), **where)
+    if j_d.type == "prismatic" or j_c.type == "prismatic":
+        slide = j_d if j_d.type == "prismatic" else j_c
+        pin_joint = j_c if slide is j_d else j_d
+        if slide is j_c:  # the prismatic joint is between rod and slider: not the textbook slider-crank
+            return None
+        s = p2(np.asarray(slide.direction) + 0) - p2(np.zeros(3))
+        s = s / np.linalg.norm(s)
+        return replace(_slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s, a, b),
+                       slide=tuple(s[0] * e1 + s[1] * e2), **where)
+    return None
+
+
+def _locator(mech, joint):
+    """How to find ``joint``'s centre at any configuration: ("frame", id) of a cut joint's F1,
+    ("joint", id) of a simple tree joint, or ("topology", name) for a compound joint (its
+    centre is the topology's, rebuilt at each configuration)."""
+    cuts = {c.name: c for c in mech.cuts}
+    if joint.cut and joint.name in cuts:
+        return ("frame", cuts[joint.name].frame1)
+    if not joint.cut and len(joint.members) == 1 and mech.model.existJointName(joint.members[0]):
+        return ("joint", mech.model.getJointId(joint.members[0]))
+    return ("topology", joint.name)
+
+
+def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
+    """Transmission angles mu [rad] of the linkage ``info`` (from :func:`identify`, computed
+    once) at the configurations Q (N, nq): shape (N,).  Four-bar: the angle at the
+    coupler-output joint C between C -> B and C -> D; slider-crank: the angle between the rod
+    B -> C and the normal of the slide; both in the plane of motion."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    P = np.empty((len(Q), 4, 3))
+    model, data = mech.model, mech.scratch_data()
+    for k, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        topo = None
+        for i, (kind, ident) in enumerate(info.centres):
+            if kind == "frame":
+                P[k, i] = data.oMf[ident].translation
+            elif kind == "joint":
+                P[k, i] = data.oMi[ident].translation
+            else:
+                topo = topo or mech.topology(q)
+                P[k, i] = next(j.point for j in topo.joints if j.name == ident)
+    return _transmission(info.kind, P, np.asarray(info.normal, float),
+                         None if info.slide is None else np.asarray(info.slide, float))
+
+
+def _transmission(kind, P, n, slide=None):
+    """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
+    unit normal n (slide: the slide's unit direction, slider-crank)."""
+    P = P - (P @ n)[..., None] * n
+    B, C, D = P[..., 1, :], P[..., 2, :], P[..., 3, :]
+    if kind == "four-bar":
+        return vector_angle(B - C, D - C)
+    return line_angle(C - B, np.cross(n, slide))
+
+
+def _four_bar(name, q_in, A, B, C, D, a, b, tol):
+    g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
+    lengths = {"ground": g, "input": a, "coupler": b, "output": c}
+    s, l = min(lengths.values()), max(lengths.values())
+    p_q = g + a + b + c - s - l
+    if abs(s + l - p_q) < tol.equal * l:
+        cls = "change point (s + l = p + q): the linkage can fold flat"
+    elif s + l > p_q:
+        cls = "non-Grashof (triple rocker): no link turns fully"
+    else:
+        shortest = min((a, 1, "input"), (g, 0, "ground"), (b, 2, "coupler"), (c, 3, "output"))[2]
+        cls = {"input": "Grashof crank-rocker: the input turns fully",
+               "ground": "Grashof double crank (drag link): input and output turn fully",
+               "coupler": "Grashof double rocker: only the coupler turns fully",
+               "output": "Grashof rocker-crank: the output turns fully, the input rocks"}[shortest]
+    u_ad = (D - A) / g
+    phi_now = _angle(_rot(B - A, -_angle(u_ad)))  # input angle from AD
+    circuit = np.sign(cross2(C - B, D - C)) or 1.0
+
+    lo = (a * a + g * g - (b + c) ** 2) / (2 * a * g)
+    hi = (a * a + g * g - (b - c) ** 2) / (2 * a * g)
+    rng = None
+    if hi < 1 and lo > -1:  # two intervals, one for each sign of phi
+        x, y = np.arccos(hi), np.arccos(lo)
+        rng = _interval(x, y, phi_now, q_in) if np.sin(phi_now) >= 0 else _interval(-y, -x, phi_now, q_in)
+    elif lo > -1:  # passes through phi = 0
+        rng = _interval(-np.arccos(lo), np.arccos(lo), phi_now, q_in)
+    elif hi < 1:  # passes through phi = pi
+        rng = _interval(np.arccos(hi), 2 * np.pi - np.arccos(hi), phi_now, q_in)
+    # the output is at a limit where input and coupler are collinear (B on line AC), on this circuit
+    limits = []
+    for dist, folded in ((a + b, False), (abs(b - a), True)):
+        for Cc in circle_intersections(A, dist, D, c, slack=tol.zero, concentric=1e-15):
+            u = (Cc - A) / max(np.linalg.norm(Cc - A), 1e-300)
+            Bc = A - a * u if folded and b > a else A + a * u
+            if (np.sign(cross2(Cc - Bc, D - Cc)) or circuit) != circuit:
+                continue
+            limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
+    mu = float(vector_angle(B - C, D - C))
+    z = float(np.linalg.norm(B - D))
+    # an angle with a vanishing side has no value (None, not NaN): the diagonal vanishes when the crank
+    # tip sits on the output pivot, the output link or the ground when their two pivots coincide
+    alpha = float(vector_angle(B - D, C - D)) if z > 0 and c > 0 else None
+    beta = float(vector_angle(B - D, A - D)) if z > 0 and g > 0 else None
+    return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu, z, alpha, beta)
+
+
+def _slider_crank(name, q_in, A, B, C, s, a, b):
+    nrm = np.array([-s[1], s[0]])
+    e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
+    lengths = {"crank": a, "rod": b, "offset": abs(e)}
+    full = a + abs(e) <= b
+    cls = ("crank turns fully (crank + |offset| <= rod)" if full
+           else "crank cannot turn fully (crank + |offset| > rod): it rocks")
+    phi_now = _angle(np.array([(B - A) @ s, (B - A) @ nrm]))  # crank angle from the slide direction
+
+    rng = None
+    if not full:  # the rod reaches the slide line while |e - a sin(phi)| <= b
+        lo, hi = (e - b) / a, (e + b) / a
+        if lo > -1 and hi < 1:
+            x, y = np.arcsin(lo), np.arcsin(hi)
+            rng = _interval(x, y, phi_now, q_in) if np.cos(phi_now) >= 0 else _interval(np.pi - y, np.pi - x, phi_now, q_in)
+        elif hi < 1:
+            rng = _interval(np.pi - np.arcsin(hi), 2 * np.pi + np.arcsin(hi), phi_now, q_in)
+        elif lo > -1:
+            rng = _interval(np.arcsin(lo), np.pi - np.arcsin(lo), phi_now, q_in)
+    side = np.sign((C - A) @ s) or 1.0
+    limits = []
+    for dist, folded in ((a + b, False), (abs(b - a), True)):
+        meets = line_circle(A + e * nrm, s, A, dist)  # the slider's pin where the rod and crank are in line
+        if not meets:
+            continue
+        Cc = meets[1] if side > 0 else meets[0]
+        u = (Cc - A) / np.linalg.norm(Cc - A)
+        Bc = A + (-a if folded and b > a else a) * u
+        limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
+    mu = float(line_angle(C - B, nrm))
+    return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
+
+
+class LinkAngles:
+    """Absolute angles of the links of a planar mechanism: the theta_i of the vector-loop
+    method, measured in the plane from the ground's x axis, counterclockwise about the
+    plane's normal (the topology's normal: its +z side, else +y, else +x).
+
+    Each link's vector goes from the centre of the joint that carries it (its joint
+    towards the ground in the file's tree) to the centre of the first other joint on it:
+    the first joint it carries in the file's order, else the first loop joint on it.  A
+    link with no second joint centre (a slider whose pin sits on its own axis, a free
+    tip) is measured by its frame's x axis.  The ground's vector goes from its first
+    joint centre to its first other one."""
+
+    def __init__(self, mech, topo):
+        if topo.motion_space != "planar" or topo.normal is None:
+            raise UsageError(f"{mech.path}: absolute link angles are for planar mechanisms; this one is "
+                             f"{topo.motion_space}")
+        self.mech = mech
+        self.e1, self.e2, self.n = plane_basis(topo.normal)
+        model = mech.model
+        cut_frames = {}
+        for c in mech.cuts:
+            for f in (c.frame1, c.frame2):
+                cut_frames.setdefault(model.frames[f].parentJoint, []).append(f)
+        self.links = {}  # link name -> (start joint id, ("joint" | "frame" | "axis", id))
+        for link in topo.links:
+            fid = mech.link_frame(link)
+            jid = model.frames[fid].parentJoint
+            if link == topo.ground:
+                starts = [k for k in range(1, model.njoints) if model.parents[k] == 0]
+                if not starts:
+                    continue
+                start, candidates = ("joint", starts[0]), [("joint", k) for k in starts[1:]]
+            else:
+                start = ("joint", jid)
+                candidates = [("joint", k) for k in model.children[jid]]
+            candidates += [("frame", f) for f in cut_frames.get(jid, [])]
+            self.links[link] = (start, candidates, fid)
+        self._data = mech.scratch_data()
+        ends = self._ends(mech.neutral())
+        self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
+
+    def _point(self, ref):
+        kind, i = ref
+        d = self._data
+        return d.oMi[i].translation if kind == "joint" else d.oMf[i].translation
+
+    def _ends(self, q):
+        """Choose each link's second point: the first candidate away from its first point."""
+        pin.framesForwardKinematics(self.mech.model, self._data, q)
+        out = {}
+        tiny = 1e-9 * self.mech.length
+        for link, (start, candidates, fid) in self.links.items():
+            p0 = self._point(start)
+            out[link] = next((c for c in candidates if np.linalg.norm(self._point(c) - p0) > tiny), ("axis", fid))
+        return out
+
+    def __call__(self, q) -> dict:
+        """link name -> absolute angle [rad] in (-pi, pi]."""
+        pin.framesForwardKinematics(self.mech.model, self._data, q)
+        out = {}
+        for link, (start, end, fid) in self.links.items():
+            if end[0] == "axis":
+                v = self._data.oMf[fid].rotation[:, 0]
+            else:
+                v = self._point(end) - self._point(start)
+            out[link] = float(np.arctan2(v @ self.e2, v @ self.e1))
+        return out
+
+    def guides(self, state) -> dict:
+        """Prismatic joint (tree or loop) -> the angle of its slide in the plane [rad], from the
+        ground's x axis, counterclockwise about the plane's normal, at the configuration of
+        ``state`` (a model.state.KinematicState): a slider coordinate is a distance along it."""
+        mech, model = self.mech, self.mech.model
+        out = {}
+        for c in mech.coordinates:
+            if c.nq == 1 and c.nv == 1 and mech.translational[c.idx_v]:
+                u = state.joint_placement(c.joint_id).rotation @ joint_axis(model.joints[c.joint_id])
+                out[c.joint] = float(np.arctan2(u @ self.e2, u @ self.e1))
+        for cut in mech.cuts:
+            if cut.type == "prismatic" and cut.pair is None:
+                u = state.frame_placement(cut.frame1).rotation @ np.asarray(cut.axis, float)
+                out[cut.name] = float(np.arctan2(u @ self.e2, u @ self.e1))
+        return out
+
+    def batch(self, Q) -> dict:
+        """link name -> (N,) absolute angles [rad] at every row of Q: __call__ on the stack, from one
+        batched forward-kinematics pass (a loop over Q where the tree has joints of two coordinates)."""
+        Q = np.atleast_2d(Q)
+        refs = {r for start, end, fid in self.links.values() for r in (start, end if end[0] != "axis" else ("frame", fid))}
+        model = self.mech.model
+        fids = {r: (r[1] if r[0] == "frame" else model.getFrameId(model.names[r[1]], pin.FrameType.JOINT)) for r in refs}
+        try:
+            placed = TreeKinematics(self.mech).frames(Q, sorted(set(fids.values())), jacobian=False)
+        except Unbatchable:
+            rows = [self(q) for q in Q]
+            return {link: np.array([r[link] for r in rows]) for link in self.links}
+        out = {}
+        for link, (start, end, fid) in self.links.items():
+            if end[0] == "axis":
+                v = placed[fids[("frame", fid)]][0][:, :, 0]
+            else:
+                v = placed[fids[end]][1] - placed[fids[start]][1]
+            out[link] = np.arctan2(v @ self.e2, v @ self.e1)
+        first = self(Q[0])  # a link along -e1 (+-pi) could come out with the other sign: then the loop
+        if any(abs(out[link][0] - first[link]) > self.mech.tolerances.equal for link in out):
+            rows = [self(q) for q in Q]
+            return {link: np.array([r[link] for r in rows]) for link in self.links}
+        return out
+
+    def joint_value(self, link: str, angle: float) -> tuple:
+        """(joint name, joint value) that gives ``link`` the absolute angle ``angle`` [rad]: the
+        link must turn about the plane's normal on a joint to the ground."""
+        mech, model = self.mech, self.mech.model
+        if link not in self.links:
+            raise UsageError(f"{mech.path}: no moving link named '{link}' (links: {', '.join(self.links)})")
+        start = self.links[link][0]
+        jid = start[1]
+        short = model.joints[jid].shortname()
+        name = model.names[jid]
+        if model.parents[jid] != 0 or not short.startswith("JointModelR") or mech.coordinate(name).nv != 1:
+            raise UsageError(f"{mech.path}: the absolute angle of '{link}' is not the value of one joint (it does "
+                             "not turn on a revolute joint to the ground): set a joint with --set")
+        q = mech.neutral()
+        axis = np.asarray(next(j.axis for j in mech.spec.joints if j.name == name), float)
+        pin.framesForwardKinematics(model, self._data, q)
+        sign = float(np.sign((self._data.oMi[jid].rotation @ axis) @ self.n))
+        if sign == 0:
+            raise UsageError(f"{mech.path}: joint '{name}' does not turn about the plane's normal")
+        theta0 = self(q)[link]
+        value = sign * float(np.mod(angle - theta0 + np.pi, 2 * np.pi) - np.pi)
+        return name, value

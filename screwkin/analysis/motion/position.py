@@ -1,0 +1,549 @@
+"""Position, velocity and acceleration analysis of closed-loop mechanisms.
+
+Given values of input joints (by default the actuated ones; any joints may be
+chosen instead), the other coordinates follow from the loop-closure equations
+r(q) = 0, solved by damped Newton with the inputs held, from the inputs
+themselves: the file's configuration with the inputs set, and random
+configurations within the joint limits with the inputs set (the file's own
+configuration need not close).  Every assembly mode the solver reaches is
+reported once:
+
+- two solutions are the same mode when every joint centre and the output frame
+  are in the same place (idle spins, which move no joint, do not make new modes);
+- a double root (a limit position) is one solution flagged singular, however
+  the starts approached it; solutions joined by a motion with the inputs held (a
+  continuum: the inputs do not determine the mechanism there) are one solution
+  flagged singular and ``continuum``;
+- modes that cannot be reached by moving the mechanism from the reference
+  configuration without passing a singularity are labelled: outside the joint
+  limits, a leg reversed through its pivot, a link that only translates found
+  turned (a mirrored parallelogram).  Solutions without a label come first.
+
+Rates and accelerations come from the differentiated closure equations
+    K q' = 0,        K q'' + K' q' = 0,
+split into input and passive columns, with K' q' from Pinocchio's classical
+frame accelerations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from ...errors import AssemblyError, UsageError
+from ...model.closure import Assembly
+from ...model.state import KinematicState, angular_loop_joints
+from . import modes
+from ..mobility import analyze_mobility
+from .links import link_motions, point_motions
+from .turns import engaged, turn_on, whole_turns
+from .planar import LinkAngles, identify
+from ..singularities.singular import Generic, measures
+
+__all__ = ["within_limits", "Solution", "PositionResult", "PositionSolver", "TraceStep", "outside_limits"]
+
+
+
+@dataclass(frozen=True)
+class TraceStep:
+    """One Newton iteration: residual r (solver rows), Jacobian K (free columns), step dq."""
+
+    iteration: int
+    residual: np.ndarray
+    jacobian: np.ndarray
+    step: np.ndarray
+    accepted: bool
+
+
+@dataclass(frozen=True)
+class Solution:
+    """One assembly mode for the given inputs.
+
+    joints:   every joint coordinate name -> value [rad or m] (continuous and
+              revolute angles in (-pi, pi]);
+    residual: closure residual norm [m, rad]; iterations: Newton iterations;
+    singular: the passive joints are not determined to first order (a double
+              root, e.g. a limit position; or a constraint singularity): the
+              actuator or constraint measure of screwkin.analysis.singularities.singular.measures is
+              below the singular tolerance;
+    sigma_min: the smaller of those two measures (relative singular values);
+    output_pose: 4x4 world pose of the output link, or None;
+    rates / accelerations: coordinate name -> rate [rad/s, m/s] /
+              acceleration [rad/s^2, m/s^2], or None;
+    output_twist / output_acceleration: (v, w) of the output frame origin in
+              world axes; classical acceleration (a, alpha);
+    labels:   why this mode is not one the mechanism reaches by moving from its
+              reference configuration (empty: it is), each "what: names";
+    continuum: the inputs leave a finite motion here (solutions joined by it were merged);
+    link_angles: planar mechanisms: link name -> absolute angle [rad] (screwkin.analysis.motion.planar.LinkAngles).
+    """
+
+    q: np.ndarray = field(repr=False)
+    joints: dict
+    residual: float
+    iterations: int
+    singular: bool
+    sigma_min: float
+    output_pose: np.ndarray | None = None
+    rates: dict | None = None
+    accelerations: dict | None = None
+    output_twist: np.ndarray | None = None
+    output_acceleration: np.ndarray | None = None
+    qdot: np.ndarray | None = field(default=None, repr=False)
+    qddot: np.ndarray | None = field(default=None, repr=False)
+    outside_limits: tuple = ()  # joints whose value is outside the file's <limit> (angles compared modulo 2 pi)
+    labels: tuple = ()
+    continuum: bool = False
+    merged: int = 1  # how many distinct solver results this solution stands for
+    link_angles: dict | None = None
+    sigmas: dict | None = None  # screwkin.analysis.singularities.singular.measures at this configuration
+    coupled: dict | None = None  # <mimic> joints' values [rad or m] (they have no coordinate)
+    loop_joints: dict | None = None  # one-coordinate loop (cut) joints: value [rad or m] (model/state.py)
+    loop_rates: dict | None = None  # ... their rates [rad/s or m/s]
+    loop_accelerations: dict | None = None  # ... and accelerations [rad/s^2 or m/s^2]
+    links: dict | None = None  # link name -> absolute motion (analysis.motion.links.link_motions)
+    points: dict | None = None  # named points -> their motion (analysis.motion.links.point_motions)
+    linkage: dict | None = None  # a four-bar's diagonal construction (mu, z, alpha, beta) or a slider-crank's mu
+    leg_lengths: dict | None = None  # prismatic joint -> distance between the joint centres its leg connects [m]
+    guide_angles: dict | None = None  # planar: prismatic joint (tree or loop) -> its slide's angle from the ground's x [rad]
+
+    @property
+    def physical(self) -> bool:
+        """Reached by moving from the reference configuration, within the joint limits."""
+        return not self.labels
+
+    @property
+    def output_position(self):
+        return None if self.output_pose is None else self.output_pose[:3, 3].copy()
+
+    @property
+    def output_rpy(self):
+        """Roll, pitch, yaw [rad] of the output frame (URDF convention: R = Rz(yaw) Ry(pitch) Rx(roll))."""
+        return None if self.output_pose is None else pin.rpy.matrixToRpy(self.output_pose[:3, :3])
+
+
+@dataclass(frozen=True)
+class PositionResult:
+    inputs: dict
+    input_joints: tuple
+    solutions: tuple
+    starts: int
+    free_dofs: int  # DOFs the inputs leave undetermined (0 when the inputs fix the mechanism)
+    trace: tuple = ()
+    output: str | None = None
+    angular: tuple = ()  # names of the coordinates that are angles (the others are lengths)
+    angular_coupled: tuple = ()  # names of the coupled (mimic) joints that are angles
+    angular_loop: tuple = ()  # names of the loop (cut) joints with a coordinate that is an angle
+    notes: tuple = ()  # what the solver chose that the user should know (a --near value it missed)
+
+    @property
+    def physical(self) -> tuple:
+        """The solutions without labels (the modes the mechanism reaches by moving)."""
+        return tuple(s for s in self.solutions if s.physical)
+
+
+def outside_limits(mech, q) -> tuple:
+    """Joints whose value lies outside the position limits of the file."""
+    names = mech.limited_coordinates()[0]
+    if not names:
+        return ()
+    out = _outside(mech, np.asarray(q)[None])[0]
+    return tuple(n for n, o in zip(names, out) if o)
+
+
+def within_limits(mech, Q) -> np.ndarray:
+    """(N,) True where every joint of the configurations Q (N, nq) is within its limits (an
+    angle may sit in its range modulo a turn): outside_limits for a stack."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    if not mech.limited_coordinates()[0]:
+        return np.ones(len(Q), bool)
+    return ~_outside(mech, Q).any(axis=1)
+
+
+def _outside(mech, Q) -> np.ndarray:
+    """(N, limited joints) True where a joint lies outside its limits."""
+    _, idx, lo, hi, angle = mech.limited_coordinates()
+    v = Q[:, idx]
+    out = (v < lo) | (v > hi)
+    if out.any():  # an angle may sit in the range modulo a turn
+        shifted = v + 2 * np.pi * np.ceil((lo - v) / (2 * np.pi))
+        out &= ~(angle & (lo <= shifted) & (shifted <= hi))
+    return out
+
+
+class PositionSolver:
+    """Solves a mechanism for given input joints; reuses the model and data
+    between calls (build once, solve many times)."""
+
+    def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None):
+        """compiled: True to solve the closure equations with the compiled kernels of
+        screwkin.model.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
+        joints are all fixed or spherical, False for numpy, None to leave the mechanism's
+        setting; ``self.compiled`` says which is used."""
+        self.mech = mech
+        if compiled is not None:
+            mech.closure.accelerate(compiled)
+        self.model = mech.model
+        self.data = mech.scratch_data()
+        names = list(input_joints) if input_joints else list(mech.actuated)
+        if not names:
+            raise UsageError(f"{mech.path}: no input joints: declare actuated joints or give --set NAME=VALUE")
+        for n in names:
+            c = mech.coordinate(n)
+            if c.nv != 1:
+                raise UsageError(f"{mech.path}: joint '{n}' has {c.nv} coordinates; inputs must be 1-DOF joints")
+        if len(set(names)) != len(names):
+            raise UsageError(f"{mech.path}: an input joint is named twice: {', '.join(names)}")
+        self.inputs = names
+        self.frozen = mech.velocity_indices(names)
+        self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
+        self.output = output
+        self.output_frame = mech.link_frame(output) if output else None
+        self._generic = None
+        self._labelling = None
+        self._angles = False  # LinkAngles, None when not planar, False before the first look
+        self._points = [f for f in range(len(self.model.frames))
+                        if self.model.frames[f].type == pin.FrameType.JOINT]
+        self._points += [c.frame1 for c in mech.cuts]
+        self._angular = self.angular_names()
+
+    @property
+    def compiled(self) -> bool:
+        """Whether the closure equations are solved by the compiled kernels."""
+        return self.mech.closure.accelerated
+
+    # --------------------------------------------------------------- generic data
+    def generic(self, hint=None) -> Generic:
+        """Generic ranks for these inputs and output (screwkin.analysis.singularities.singular.Generic) over the
+        mechanism's generic configurations; ``hint``: an assembled configuration to start
+        from when the mechanism's own assembly search has not been made."""
+        if self._generic is None:
+            # the hint only starts a search not made yet (the mechanism's own result is reused when it exists)
+            configs = self.mech.generic_configurations(hint=None if self.mech.generic_known else hint)[1]
+            self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
+        return self._generic
+
+    def _reference(self):
+        """The reference configuration (the mechanism's assembled one), or None when the
+        assembly search finds none (the solutions for the inputs then stand in)."""
+        try:
+            return self.generic().configurations[0]
+        except AssemblyError:
+            return None
+
+    @property
+    def expected_rank(self) -> int:
+        """Generic rank of the passive columns of the constraint Jacobian."""
+        return self.generic().rank_Kp
+
+    @property
+    def idle_dofs(self) -> int:
+        return self._mobility().idle_dofs
+
+    @property
+    def mobility(self) -> int:
+        return self._mobility().mobility
+
+    @property
+    def free_dofs(self) -> int:
+        """DOFs left free with the inputs held, beyond the idle ones (0 = the inputs determine
+        the mechanism)."""
+        g = self.generic()
+        return max(len(self.passive) - g.rank_Kp - self.idle_dofs, 0)
+
+    def _mobility(self):
+        self.generic()  # the assembly the mobility analysis starts from
+        return analyze_mobility(self.mech)
+
+    # --------------------------------------------------------------- coordinates
+    def angular_names(self) -> tuple:
+        """Coordinate names that are angles (revolute and continuous joints)."""
+        names = []
+        for c in self.mech.coordinates:
+            if self.model.joints[c.joint_id].shortname().startswith("JointModelR") and c.nv == 1:
+                names.append(c.joint)
+        return tuple(names)
+
+    def _angular_coupled(self) -> tuple:
+        return tuple(c.joint for c in self.mech.couplings if self.mech._revolute_like(c.joint))
+
+    def set_inputs(self, q, values: dict):
+        """q with the named coordinates set: joint names of 1-DOF joints [rad or m], and the
+        'joint[qk]' names that joint_values gives to the coordinates of multi-DOF joints."""
+        q = np.array(q, float)
+        multi = False
+        for name, v in values.items():
+            if name.endswith("]") and "[q" in name:
+                joint, k = name[:-1].rsplit("[q", 1)
+                c = self.mech.coordinate(joint)
+                if not k.isdigit() or int(k) >= c.nq:
+                    raise UsageError(f"{self.mech.path}: joint '{joint}' has no coordinate q{k}")
+                q[c.idx_q + int(k)] = v
+                multi = True
+                continue
+            c = self.mech.coordinate(name)
+            if c.nq == 2 and c.nv == 1:
+                q[c.idx_q:c.idx_q + 2] = (np.cos(v), np.sin(v))
+            elif c.nq == 1:
+                q[c.idx_q] = v
+            else:
+                raise UsageError(f"{self.mech.path}: joint '{name}' has {c.nq} coordinates: give them as "
+                                 f"{name}[q0] ... {name}[q{c.nq - 1}]")
+        return pin.normalize(self.model, q) if multi else q
+
+    def joint_values(self, q) -> dict:
+        """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
+        return self.mech.joint_values(q)
+
+    def _wrap(self, q):
+        q = np.array(q, float)
+        _, _, _, _, idx, wrap = self.mech._value_layout()
+        w = idx[wrap]
+        if len(w):
+            q[w] = np.mod(q[w] + np.pi, 2 * np.pi) - np.pi
+        return q
+
+    def _signature(self, q):
+        """World positions of every joint centre (and the output pose): equal for
+        configurations that differ only by idle spins."""
+        pin.framesForwardKinematics(self.model, self.data, q)
+        parts = [self.data.oMf[f].translation for f in self._points]
+        if self.output_frame is not None:
+            parts.append(self.data.oMf[self.output_frame].homogeneous[:3].ravel() * 0.1)
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def _starts(self, count, seed):
+        """The reference configuration (when there is one), the file's configuration, and
+        ``count`` random configurations within the joint limits."""
+        rng = np.random.default_rng(seed)
+        ref = self._reference()
+        starts = ([ref] if ref is not None else []) + [self.mech.neutral()]
+        starts += [self.mech.random_configuration(rng) for _ in range(count)]
+        return starts
+
+    # --------------------------------------------------------------- solving
+    def _check_inputs(self, values: dict, every: bool = True):
+        unknown = [n for n in values if n not in self.inputs]
+        missing = [n for n in self.inputs if n not in values] if every else []
+        if unknown or missing:
+            raise UsageError(f"{self.mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
+                             + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
+
+    def track(self, values: dict, q) -> Assembly:
+        """The configuration that damped Newton reaches from the configuration ``q`` with the
+        named inputs moved to ``values`` (inputs not named keep their values in q): the
+        closed-loop forward kinematics of a control or simulation loop, in the assembly
+        mode of q when the step is small.  The result is checked like every solution
+        (closure residual below the tolerance, no cut joint assembled upside down);
+        AssemblyError otherwise.  No modes are searched and nothing else is analysed:
+        ``solve`` does that."""
+        self._check_inputs(values, every=False)
+        a = self.mech.closure.solve(self.set_inputs(q, values), frozen=self.frozen)
+        return Assembly(self._wrap(a.q), a.residual, a.iterations)
+
+    def solve(self, values: dict, near: dict | None = None, rates: dict | None = None,
+              accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False,
+              points=()) -> PositionResult:
+        """Every assembly mode for the input ``values`` (see the class).  ``points``: motion.Point
+        objects whose position (and velocity, acceleration with ``rates``) each solution reports."""
+        mech = self.mech
+        self._check_inputs(values)
+        typed, whole = dict(values), whole_turns(self, values)
+        values = {n: v - whole.get(n, 0.0) for n, v in values.items()}  # solved within a turn, then turned on
+        steps = []
+        recorder = (lambda it, q, r, K, dq, ok: steps.append(
+            TraceStep(it, r.copy(), K[:, self.passive].copy(), dq[self.passive].copy(), ok))) if trace else None
+        near_q = None
+        if near:
+            ref = self._reference()
+            near_q = self.set_inputs(mech.neutral() if ref is None else ref, near)
+        found, best = [], np.inf
+        if near_q is not None:  # the mode reached from the given configuration, when Newton gets there
+            found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
+                                        first_trace=recorder if trace else None)
+        start_list = [near_q] if found else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
+        if not found:
+            found, more = self.distinct(
+                mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
+                first_trace=recorder if trace and near_q is None else None)
+            best = min(best, more)
+        if not found:
+            raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
+                                detail=f"the inputs {self._describe(values)} cannot be reached from "
+                                       f"{len(start_list)} starting configurations")
+        if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
+            found = engaged(self, found, values)
+        if whole:
+            found = [(k, *turn_on(self, q, whole, typed)) for k, q, _ in found]
+        self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
+        sols = [self._solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
+        sols = self._merge(sols)
+        ref = near_q if near_q is not None else self._reference()
+        if len(sols) > 1:
+            ref_sig = self._signature(ref if ref is not None else sols[0].q)
+            sols.sort(key=lambda s: (not s.physical, s.singular,
+                                     float(np.linalg.norm(self._signature(s.q) - ref_sig))))
+        notes = ()
+        if near_q is not None:
+            sols = sols[:1]
+            notes = self._missed_near(near, sols[0])
+        return PositionResult(dict(typed), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
+                              tuple(steps), self.output, self._angular, self._angular_coupled(),
+                              angular_loop_joints(self.mech), notes)
+
+    def _missed_near(self, near: dict, sol) -> tuple:
+        """A line for each --near value the mode found lies far from (Tolerances.near_far): the joints
+        --near does not name are free, so the mode nearest the given ones may not be near them."""
+        tol, out = self.mech.tolerances, []
+        for name, want in near.items():
+            got = sol.joints.get(name)
+            if got is None:
+                continue
+            angle = name in self._angular
+            miss = abs(float(np.angle(np.exp(1j * (got - want))))) if angle else abs(got - want)
+            if miss > tol.near_far * (1.0 if angle else self.mech.length):
+                shown = (lambda v: f"{np.degrees(v):.4g} deg") if angle else (lambda v: f"{v:.4g} m")
+                out.append(f"--near {name}={shown(want)}: the assembly mode found has {name} = {shown(got)} "
+                           f"(the nearest these inputs allow; the joints --near does not name were free)")
+        return tuple(out)
+
+    def distinct(self, system, starts, frozen=(), first_trace=None):
+        """Solve ``system`` from every start; keep one solution per assembly mode.
+
+        Returns ([(signature, q, Assembly)], smallest residual of the failures)."""
+        found, best = [], np.inf
+        for k, q0 in enumerate(starts):
+            try:
+                a = system.solve(q0, frozen=frozen, trace=first_trace if k == 0 else None)
+            except AssemblyError as exc:
+                best = min(best, exc.residual)
+                continue
+            q = self._wrap(a.q)
+            if len(starts) == 1:  # nothing to tell apart
+                found.append((None, q, a))
+                continue
+            sig = self._signature(q)
+            if any(np.max(np.abs(sig - s)) < self.mech.tolerances.geometry for s, *_ in found):
+                continue
+            found.append((sig, q, a))
+        return found, best
+
+    @staticmethod
+    def _describe(values):
+        return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
+
+    # --------------------------------------------------------------- one answer per mode
+    def _merge(self, sols):
+        """Solutions that are one root merged (analysis.motion.modes.merge)."""
+        return modes.merge(self, sols)
+
+    def _distance(self, q1, q2):
+        return float(np.linalg.norm(self._signature(q1) - self._signature(q2)))
+
+    def _labels(self, q, outside) -> tuple:
+        """Why a solution is not reached by moving from the reference configuration
+        (analysis.motion.modes.ModeLabels)."""
+        if self._labelling is None:
+            self._labelling = modes.ModeLabels(self)
+        return self._labelling(q, outside)
+
+    def _linkage(self, q):
+        """A four-bar's or slider-crank's textbook construction at q (planar.identify), or None."""
+        if len(self.inputs) != 1 or self._plane_normal() is None or len(self.mech.cuts) != 1:
+            return None
+        info = identify(self.mech, self.mech.topology(q), q, self.inputs[0])
+        return None if info is None else info.construction()
+
+    def _plane_normal(self):
+        if self._angles is False:
+            self._link_angles(self.mech.neutral())
+        return None if self._angles is None else self._angles.n
+
+    def _link_angles(self, q):
+        if self._angles is False:
+            self._angles = None
+            ref = self._reference()
+            if ref is not None:
+                topo = self.mech.topology(ref)
+                if topo.motion_space == "planar":
+                    self._angles = LinkAngles(self.mech, topo)
+        return self._angles(q) if self._angles is not None else None
+
+    # --------------------------------------------------------------- one solution
+    def _solution(self, q, a, rates, accels, points=(), typed=None) -> Solution:
+        mech, tol = self.mech, self.mech.tolerances
+        m = measures(mech, q, self.generic())
+        sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
+        singular = sigma < tol.singular
+        K = mech.closure.jacobian(q)
+        pose = twist = acc = qd = qdd = None
+        rate_d = acc_d = None
+        if rates is not None:
+            solve, _ = self.passive_solver(K)
+            qd = self.rates(q, K, rates, solve)
+            rate_d = self._named(qd)
+            qdd = self.accelerations(q, K, qd, accels or {}, solve)
+            acc_d = self._named(qdd)
+        state = KinematicState(mech, q, qd, qdd)  # every quantity below is read from this one state
+        if self.output_frame is not None:
+            pose = state.frame_pose(self.output_frame)
+            if rates is not None:
+                twist, acc = state.frame_twist(self.output_frame), state.frame_acceleration(self.output_frame)
+        outside = outside_limits(mech, q)
+        angles = self._link_angles(q)
+        joints = self.joint_values(q)
+        for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
+            if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < tol.equal:
+                joints[name] = float(v)
+        return Solution(q, joints, a.residual, a.iterations, bool(singular), float(sigma), pose,
+                        rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),
+                        link_angles=angles, sigmas=m, coupled=mech.coupled_values(q) or None,
+                        loop_joints=state.loop_joints or None, loop_rates=state.loop_rates or None,
+                        loop_accelerations=state.loop_accelerations or None,
+                        links=link_motions(state, angles, self._plane_normal()),
+                        points=point_motions(state, points) or None, linkage=self._linkage(q),
+                        leg_lengths=state.leg_lengths or None,
+                        guide_angles=(self._angles.guides(state) or None) if self._angles else None)
+
+    def _named(self, v) -> dict:
+        return dict(zip(self.mech.coordinate_names, map(float, v)))
+
+    def _input_vector(self, values: dict):
+        x = np.zeros(len(self.frozen))
+        for k, name in enumerate(self.inputs):
+            x[k] = values.get(name, 0.0)
+        return x
+
+    def passive_solver(self, K):
+        """(solve, s): one SVD of the passive columns of K, reused for rates and accelerations.
+        solve(b) is the minimum-norm least-squares x of K_p x = b (as numpy.linalg.lstsq);
+        s are the singular values of K_p, largest first."""
+        Kp = K[:, self.passive]
+        if Kp.size == 0:
+            return (lambda b: np.zeros(len(self.passive))), np.zeros(0)
+        U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
+        keep = s > np.finfo(float).eps * max(Kp.shape) * s[0] if s.size and s[0] > 0 else np.zeros(len(s), bool)
+        U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
+        return (lambda b: Vt.T @ (inv * (U.T @ b))), s
+
+    def rates(self, q, K, values: dict, solve=None):
+        """Joint rates from K q' = 0 with the input rates given (minimum norm in
+        the passive joints, so idle spins are zero).  solve: see passive_solver."""
+        qd = np.zeros(self.mech.nv)
+        qd[self.frozen] = self._input_vector(values)
+        if K.size:
+            solve = solve or self.passive_solver(K)[0]
+            qd[self.passive] = -solve(K[:, self.frozen] @ qd[self.frozen])
+        return qd
+
+    def accelerations(self, q, K, qd, values: dict, solve=None):
+        """Joint accelerations from K q'' = -K' q' with the input accelerations given."""
+        qdd = np.zeros(self.mech.nv)
+        qdd[self.frozen] = self._input_vector(values)
+        if K.size:
+            bias = self.mech.closure.bias(q, qd)
+            solve = solve or self.passive_solver(K)[0]
+            qdd[self.passive] = solve(-(K[:, self.frozen] @ qdd[self.frozen] + bias))
+        return qdd

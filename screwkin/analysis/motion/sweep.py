@@ -1,0 +1,525 @@
+"""Motion along an input (sweeps): one assembly mode followed by continuation.
+
+The solutions of the closure equations with the other inputs held form a curve
+(one DOF; idle spins aside).  It is followed by predictor-corrector steps:
+
+- while the input is a good parameter of the curve (its share of the tangent is
+  large), each step goes to the next value of the input's grid: the previous
+  solution moved along the tangent predicts it, the closure solver corrects it
+  with the input held;
+- where it is not (near a limit position, where the input stops and turns
+  back), the joint with the largest share of the tangent is held instead
+  (local parametrization), so the curve is followed through the turn.
+
+The tangent is the projection of the input's direction onto the null space of
+the constraint Jacobian (idle spins have no part in it), oriented continuously,
+in dimensionless coordinates (lengths divided by the characteristic length).
+A limit position lies where the input's component of the tangent changes sign;
+it is located by Brent's method on the held joint's value, to the precision of
+the closure solver (the input there is accurate to far better than 1e-9, since
+it is extremal), and listed as an actuator singularity (``limit``).  Without
+``turn`` the sweep stops there, as the physical mechanism would; with it the
+sweep goes on along the other branch, the input running back, until the
+mechanism returns to its start (the whole circuit), the input reaches the end
+of the range, or the step budget is spent.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pinocchio as pin
+
+from ...errors import AssemblyError, UsageError
+from ...model.linalg import null_space
+from .dyads import planar_sweep
+from ..singularities.singular import Generic, measures, scaled_jacobians
+
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour"]
+
+
+@dataclass(frozen=True)
+class SweepSingularity:
+    kind: str  # "serial" | "actuator" | "constraint"
+    input: float  # input value, refined [rad or m]
+    sigma: float  # relative smallest singular value there
+    q: np.ndarray
+    limit: bool = False  # a limit position: the motion along the input cannot go on past it
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    input: str
+    values: np.ndarray  # input values reached [rad or m], in the order of the motion
+    q: np.ndarray  # (steps, nq)
+    joints: np.ndarray  # (steps, n coordinates) joint values, names in `names`
+    rates: np.ndarray  # (steps, nv): rates for an input rate of `rate`
+    accelerations: np.ndarray  # (steps, nv)
+    names: tuple  # coordinate names (velocity coordinates)
+    rate: float
+    stopped_at: float | None  # input value where the motion stopped short of the range, None when complete
+    stop_reason: str | None
+    requested: tuple  # (from, to, steps)
+    limits: tuple = ()  # SweepSingularity: the limit positions met (located)
+    turn: bool = False  # whether the sweep passed through limit positions
+    circuit_closed: bool = False  # the motion came back to its starting configuration
+    unit: str = "rad"  # the input's unit: "rad" or "m"
+    coupled: dict | None = None  # <mimic> joint -> its values along the sweep
+    skipped: tuple = ()  # input values on the grid the motion passed but could not solve at (holes)
+
+    @property
+    def completed(self) -> bool:
+        """The whole range, every grid value on it: not stopped short, no hole."""
+        return self.stopped_at is None and not self.skipped
+
+
+class _Stuck(Exception):
+    pass
+
+
+class _Tracker:
+    """The continuation along one input of a PositionSolver (see the module docstring)."""
+
+    def __init__(self, solver, name):
+        mech = self.mech = solver.mech
+        self.solver, self.model, self.closure = solver, solver.model, mech.closure
+        self.name = name
+        self.tol = mech.tolerances
+        self.ix = int(mech.velocity_indices([name])[0])
+        others = [n for n in solver.inputs if n != name]
+        self.frozen_other = tuple(int(i) for i in mech.velocity_indices(others))
+        self.free = np.setdiff1d(np.arange(mech.nv), self.frozen_other)
+        self.scale = np.where(mech.translational, mech.length, 1.0)  # scaled rate -> rate
+        # joints that can be held: one-DOF coordinates (revolute, prismatic, continuous)
+        self.holdable = np.zeros(mech.nv, bool)
+        for c in mech.coordinates:
+            if c.nv == 1:
+                self.holdable[c.idx_v] = True
+        self.holdable[list(self.frozen_other)] = False
+
+    def tangent(self, q, previous=None):
+        """Unit tangent of the curve at q in scaled coordinates (nv; zero on the held inputs),
+        oriented like ``previous``: the input's direction projected onto the null space of K."""
+        K = self.closure.jacobian(q)
+        nv = self.mech.nv
+        Ks = (K * self.scale)[:, self.free] if K.size else np.zeros((0, len(self.free)))
+        N = null_space(Ks, self.tol, len(self.free))
+        e = np.zeros(len(self.free))
+        e[np.searchsorted(self.free, self.ix)] = 1.0
+        t = N @ (N.T @ e)
+        if np.linalg.norm(t) < 1e-7 and previous is not None:  # at a limit position itself
+            t = N @ (N.T @ previous[self.free])
+        n = np.linalg.norm(t)
+        if n < 1e-300:
+            raise _Stuck("the mechanism cannot move along this input here")
+        out = np.zeros(nv)
+        out[self.free] = t / n
+        if previous is not None and out @ previous < 0:
+            out = -out
+        return out
+
+    def hold(self, t):
+        """The velocity index of the joint to hold for a step along t: the input when it has a
+        large share of the tangent, else the one-DOF joint with the largest share."""
+        scores = np.where(self.holdable, np.abs(t), -1.0)
+        best = int(np.argmax(scores))
+        return self.ix if abs(t[self.ix]) >= 0.5 * scores[best] else best
+
+    def step(self, q, t, sigma, held):
+        """Move sigma (scaled) along t, hold joint ``held`` there, close the loops again."""
+        pred = pin.integrate(self.model, q, self.scale * t * sigma)
+        try:
+            a = self.closure.solve(pred, frozen=tuple(sorted(set(self.frozen_other) | {held})))
+        except AssemblyError:
+            raise _Stuck("the loops cannot be closed") from None
+        jump = np.linalg.norm(pin.difference(self.model, pred, a.q) / self.scale)
+        if jump > max(0.5 * abs(sigma), 1e-7):
+            raise _Stuck("the correction jumps away from the curve")
+        return a.q
+
+    def at_input(self, q_from, x_from, x, t):
+        """The configuration at input value x, predicted from q_from (input x_from) along t."""
+        dx = (x - x_from) / self.scale[self.ix]
+        if abs(t[self.ix]) < 1e-12:
+            raise _Stuck("the input does not move here")
+        return self.step(q_from, t, dx / t[self.ix], self.ix)
+
+    def on_arc(self, qa, xa, qb, held, x):
+        """The configuration at input value x on the arc from qa (input xa) to qb, followed with
+        joint ``held`` as the parameter (the input changes monotonically along it: no limit
+        position strictly between): Brent's method on the held joint's share of the way.  Near a
+        limit position the tangent predictor of ``at_input`` overshoots the curve's bend; this
+        does not.  Raises _Stuck when x is not between the ends."""
+        delta = pin.difference(self.model, qa, qb)
+        frozen = tuple(sorted(set(self.frozen_other) | {held}))
+        xb = xa + self.input_change(qa, qb)
+        if (x - xa) * (x - xb) > 0:
+            raise _Stuck("the value is not on this arc")
+        cache = {0.0: qa, 1.0: qb}
+
+        def at(u):
+            if u not in cache:
+                try:
+                    cache[u] = self.closure.solve(pin.integrate(self.model, qa, u * delta), frozen=frozen).q
+                except AssemblyError:
+                    raise _Stuck("the loops cannot be closed on the arc") from None
+            return cache[u]
+
+        def f(u):
+            return xa + self.input_change(qa, at(u)) - x
+
+        from scipy.optimize import brentq
+
+        fa, fb = f(0.0), f(1.0)
+        if fa == 0:
+            return qa
+        if fb == 0:
+            return qb
+        if np.sign(fa) == np.sign(fb):
+            raise _Stuck("the value is not on this arc")
+        u = brentq(f, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=100)
+        # polish at the exact input value (the held joint then follows)
+        return self.closure.solve(self.solver.set_inputs(at(u), {self.name: x}), frozen=tuple(
+            sorted(set(self.frozen_other) | {self.ix}))).q
+
+    def input_change(self, q0, q1) -> float:
+        return float(pin.difference(self.model, q0, q1)[self.ix])
+
+    def limit(self, qa, ta, qb, held):
+        """The limit position between qa and qb (the input's tangent component changes sign),
+        with joint ``held`` as the parameter: (configuration, input offset from qa)."""
+        delta = pin.difference(self.model, qa, qb)
+        frozen = tuple(sorted(set(self.frozen_other) | {held}))
+        cache = {}
+
+        def at(s):
+            if s not in cache:
+                cache[s] = self.closure.solve(pin.integrate(self.model, qa, s * delta), frozen=frozen).q
+            return cache[s]
+
+        def f(s):
+            return float(self.tangent(at(s), ta)[self.ix])
+
+        from scipy.optimize import brentq
+
+        fa, fb = float(ta[self.ix]), f(1.0)
+        if fa == 0 or fb == 0 or np.sign(fa) == np.sign(fb):  # pragma: no cover - the caller saw a change
+            s = 1.0
+        else:
+            s = brentq(f, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=100)
+        q = at(s)
+        return q, self.input_change(qa, q)
+
+
+class Neighbour:
+    """One continuation step along input ``name`` of a PositionSolver, from a configuration to
+    a nearby input value on the same branch: the sweep's predictor along the curve's tangent,
+    its corrector and its branch tests (a correction that jumps away from the curve, or a
+    limit position between the two values, refuses the step).  Maps walk their grids with it."""
+
+    def __init__(self, solver, name: str):
+        self._tr = _Tracker(solver, name)
+
+    def __call__(self, q, x_from: float, x_to: float):
+        """The configuration at input value x_to on q's branch (q at x_from), or None."""
+        tr = self._tr
+        direction = np.sign(x_to - x_from)
+        if direction == 0:
+            return q
+        try:
+            t = tr.tangent(q)
+            if t[tr.ix] * direction < 0:
+                t = -t
+            q_new = tr.at_input(q, x_from, x_to, t)
+            if tr.tangent(q_new, t)[tr.ix] * direction <= 0:
+                return None  # a limit position lies between the two values
+        except _Stuck:
+            return None
+        return q_new
+
+
+def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
+          near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
+          max_steps: int | None = None, q_start=None, closed_form: bool = True) -> SweepResult:
+    """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
+    steps of the input (see the module docstring).
+
+    solver: a PositionSolver whose inputs include ``name``; the other inputs stay at ``fixed``.
+    q_start: a configuration of the assembly mode to follow (a neighbour's, in a map or a
+    study): the loops are closed from it at the first input value (raises AssemblyError when
+    they cannot be); without it the mode is ``solver.solve``'s first at ``start`` (near ``near``).
+    turn: pass through limit positions onto the other branch (the input then runs back);
+    the sweep ends when the mechanism is back at its start, the input reaches ``stop``, or
+    after ``max_steps`` recorded configurations (default 20 * steps + 100).
+    closed_form: a planar mechanism made of dyads is solved at every grid value at once
+    (screwkin.analysis.motion.dyads), the same result; False: always the tracker.
+    """
+    if steps < 1:
+        raise UsageError("a sweep needs at least 1 step")
+    if name not in solver.inputs:
+        raise UsageError(f"{solver.mech.path}: '{name}' is not one of the inputs ({', '.join(solver.inputs)})")
+    fixed = dict(fixed or {})
+    others = [n for n in solver.inputs if n != name]
+    missing = [n for n in others if n not in fixed]
+    if missing:
+        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
+    mech = solver.mech
+    tr = _Tracker(solver, name)
+    max_steps = max_steps or 20 * steps + 100
+    h = (stop - start) / steps
+    if q_start is not None:
+        q0 = solver.track({name: start, **fixed}, q_start).q
+    else:
+        first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
+        q0 = first.solutions[0].q
+    if closed_form:
+        f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
+        if f is not None:
+            limits = tuple(SweepSingularity("actuator", x, s, q, limit=True) for x, s, q in f.limits)
+            return SweepResult(name, f.values, f.q, f.joints, f.rates, f.accelerations, tuple(mech.coordinate_names),
+                               rate, f.stopped_at, f.stop_reason, (start, stop, steps), limits, turn,
+                               f.circuit_closed, f.unit)
+    rates_in = {n: 0.0 for n in solver.inputs}
+    rates_in[name] = rate
+    unit = "m" if mech.translational[tr.ix] else "rad"
+    X, Q = [start], [q0]
+    limits = []
+    stopped = reason = None
+    closed = False
+    direction = np.sign(h) or 1.0
+    show = progress and sys.stderr.isatty() and steps >= 200
+    try:
+        t = tr.tangent(q0)
+    except _Stuck as exc:
+        t, stopped, reason = None, start, str(exc)
+    if t is not None and t[tr.ix] * direction < 0:
+        t = -t
+    q, x = q0, float(start)
+
+    def grid_between(xa, xb):
+        """Grid values strictly after xa up to xb (inclusive) in the direction of motion, within the range."""
+        if h == 0:
+            return []
+        lo_k = (xa - start) / h
+        hi_k = (xb - start) / h
+        ks = range(int(np.floor(lo_k + 1e-9)) + 1, int(np.floor(hi_k + 1e-9)) + 1) if hi_k > lo_k else \
+            range(int(np.ceil(lo_k - 1e-9)) - 1, int(np.ceil(hi_k - 1e-9)) - 1, -1)
+        return [start + j * h for j in ks]
+
+    skipped = []  # grid values of the input the motion passed but could not be solved at
+
+    def solved(g, first, arc):
+        """The configuration at grid value g: ``first()`` (the tangent predictor), else the arc of
+        the step it lies on (``arc``: (qa, xa, qb, held), near a limit position), else None."""
+        try:
+            return first()
+        except _Stuck:
+            pass
+        if arc is not None:
+            try:
+                return tr.on_arc(*arc[:2], arc[2], arc[3], g)
+            except _Stuck:
+                pass
+        return None
+
+    def keep(g, qg):
+        if qg is None:
+            skipped.append(float(g))  # said in the result: never a hole in a motion marked complete
+        else:
+            X.append(g)
+            Q.append(qg)
+
+    def record(qa, xa, ta, qb, xb, tb=None, held=None):
+        """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
+        position between them, each predicted from the nearer end (not from a limit position:
+        there the input does not move, pass tb=None for such an end); where the predictor fails
+        (the curve bends near a limit position) on the arc step's own parametrization (held)."""
+        arc = (qa, xa, qb, held) if held is not None and held != tr.ix else None
+        for g in grid_between(xa, xb):
+            if forward() and (g - stop) * direction > 1e-12 * max(1.0, abs(stop)):
+                break
+            near_b = tb is not None and abs(g - xb) < abs(g - xa)
+            keep(g, solved(g, (lambda g=g: tr.at_input(qb, xb, g, tb)) if near_b else
+                           (lambda g=g: tr.at_input(qa, xa, g, ta)), arc))
+
+    def record_back(q_lim, x_lim, qb, xb, tb, held=None):
+        """After a limit position: the grid values between it and qb, predicted from qb."""
+        arc = (q_lim, x_lim, qb, held) if held is not None and held != tr.ix else None
+        for g in grid_between(x_lim, xb):
+            keep(g, solved(g, lambda g=g: tr.at_input(qb, xb, g, tb), arc))
+
+    def forward():
+        return direction * np.sign(h) > 0
+
+    def back_at_start():
+        return (turn and forward() and len(X) > 2 and abs(X[-1] - start) < 1e-9 * max(1.0, abs(h))
+                and np.linalg.norm(pin.difference(mech.model, Q[-1], q0) / tr.scale) < 1e-6)
+
+    if h != 0 and t is not None:
+        sigma = abs(h) / tr.scale[tr.ix]
+        while len(X) < max_steps:
+            end_x = float(stop)
+            if forward() and (end_x - x) * direction <= 1e-12 * max(1.0, abs(end_x)):
+                break  # the input reached the end of the range
+            held = tr.hold(t)
+            if held == tr.ix:  # the input is a good parameter: go to its next grid value
+                nxt = grid_between(x, x + direction * abs(h) * 1.000001)
+                target = nxt[0] if nxt else x + direction * abs(h)
+                if forward() and (target - end_x) * direction > 0:
+                    target = end_x
+                try:
+                    q_new = tr.at_input(q, x, target, t)
+                    t_new = tr.tangent(q_new, t)
+                    if t_new[tr.ix] * direction <= 0:
+                        raise _Stuck("a limit position lies in this step")
+                except _Stuck:
+                    held = int(np.argmax(np.where(tr.holdable & (np.arange(mech.nv) != tr.ix), np.abs(t), -1)))
+                    if not tr.holdable[held]:
+                        stopped, reason = x, "the motion cannot go on along this input"
+                        break
+                    sigma = min(sigma, abs(h) / tr.scale[tr.ix]) * 0.5
+                else:
+                    X.append(target)
+                    Q.append(q_new)
+                    q, x, t = q_new, target, t_new
+                    if back_at_start():
+                        closed = True
+                        break
+                    continue
+            # an arc step with a passive joint held
+            try:
+                q_new = tr.step(q, t, sigma, held)
+                t_new = tr.tangent(q_new, t)
+            except _Stuck as exc:
+                sigma *= 0.5
+                if sigma < 1e-10:
+                    stopped, reason = x, f"the motion cannot be continued past this configuration ({exc})"
+                    break
+                continue
+            x_new = x + tr.input_change(q, q_new)
+            if t_new[tr.ix] * t[tr.ix] < 0:  # the input turned back between q and q_new: a limit position
+                q_lim, dx = tr.limit(q, t, q_new, held)
+                x_lim = x + dx
+                record(q, x, t, q_lim, x_lim, held=held)
+                sig = measures(mech, q_lim, solver.generic())["actuator"]
+                limits.append(SweepSingularity("actuator", float(x_lim), float(sig), q_lim, limit=True))
+                if not turn:
+                    if forward() and (x_lim - stop) * direction >= 0:
+                        break  # the limit lies at or past the end of the range: every value was reached
+                    stopped = float(x_lim)
+                    reason = ("limit position: the passive joints become undetermined (an actuator singularity); "
+                              "the input cannot go further on this branch")
+                    break
+                direction = -direction
+                record_back(q_lim, x_lim, q_new, x_new, t_new, held=held)
+            else:
+                record(q, x, t, q_new, x_new, t_new, held=held)
+            q, x, t = q_new, x_new, t_new
+            sigma = min(sigma * 1.5, abs(h) / tr.scale[tr.ix])
+            if back_at_start():
+                closed = True
+                break
+            if show:
+                sys.stderr.write(f"\rsweep {min(len(X), steps)}/{steps}")
+        else:
+            stopped, reason = x, f"the step budget ({max_steps} configurations) is spent"
+    if show:
+        sys.stderr.write("\n")
+    if turn and stopped is None and not closed and (stop - x) * np.sign(h) > 1e-9 * max(1.0, abs(stop)):
+        stopped, reason = x, "the motion did not reach the end of the range"
+    V, A = [], []
+    for qk in Q:
+        K = mech.closure.jacobian(qk)
+        solve, _ = solver.passive_solver(K)
+        qd = solver.rates(qk, K, rates_in, solve)
+        V.append(qd)
+        A.append(solver.accelerations(qk, K, qd, {}, solve))
+    Qa = np.array(Q)
+    coupled = None
+    if mech.couplings:
+        values = [mech.coupled_values(qq) for qq in Q]
+        coupled = {c.joint: np.array([v[c.joint] for v in values]) for c in mech.couplings}
+    return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
+                       np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
+                       (start, stop, steps), tuple(limits), turn, closed, unit, coupled, tuple(skipped))
+
+
+def _matrix(mech, q, kind, g, V_ref=None):
+    """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""
+    S = scaled_jacobians(mech, q, g.output, g.point)
+    if kind == "constraint":
+        return S.K
+    if kind == "actuator":
+        return S.K[:, g.p]
+    N = S.V
+    V = N if V_ref is None else N @ (N.T @ V_ref)  # a basis that varies smoothly with q
+    return S.J @ V
+
+
+def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e-12, point: bool = False):
+    """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
+    positions the sweep located, and the other singularities.
+
+    Each relative smallest singular value is scanned over the sweep; around each local
+    minimum (between neighbours on one branch, where the input runs one way) the singular
+    vectors u, v of that step give a smooth signed measure u . M(x) v that changes sign where
+    M loses rank, and Brent's method finds its root (solutions re-closed at a tight
+    tolerance).  Minima that are not zeros (no sign change) are not singular and are dropped.
+    """
+    from scipy.optimize import brentq
+
+    mech = solver.mech
+    tight = replace(mech.tolerances, closure=1e-14, max_iterations=60)
+    g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
+    table = [measures(mech, q, g) for q in res.q]
+    rank_of = {"constraint": g.rank_K, "actuator": g.rank_Kp, "serial": g.out_dim or 0}
+    found = list(res.limits)
+    xs = res.values
+    frozen = solver.frozen
+    for kind in (table[0] if table else {}):
+        m = np.array([t[kind] for t in table])
+        r = rank_of[kind]
+        if r == 0:
+            continue
+        for k in range(len(m)):
+            left = m[k - 1] if k > 0 else np.inf
+            right = m[k + 1] if k + 1 < len(m) else np.inf
+            if not (m[k] <= left and m[k] <= right) or m[k] > 0.5:
+                continue
+            lo_k, hi_k = max(k - 1, 0), min(k + 1, len(xs) - 1)
+            if (xs[k] - xs[lo_k]) * (xs[hi_k] - xs[k]) < 0:  # a turn between: that limit is listed already
+                continue
+            q_k = res.q[k]
+            V_ref = None
+            if kind == "serial":
+                V_ref = scaled_jacobians(mech, q_k, output, point).V
+            U, _, Vt = np.linalg.svd(_matrix(mech, q_k, kind, g, V_ref))
+            u, v = U[:, r - 1], Vt[r - 1]
+
+            def q_at(x, q_k=q_k):
+                q0 = solver.set_inputs(q_k, {res.input: x})
+                try:
+                    return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
+                except AssemblyError:
+                    return mech.closure.solve(q0, frozen=frozen).q
+
+            def signed(x, u=u, v=v, V_ref=V_ref):
+                return float(u @ _matrix(mech, q_at(x), kind, g, V_ref) @ v)
+
+            lo, hi = sorted((xs[lo_k], xs[hi_k]))
+            try:
+                f_lo, f_hi = signed(lo), signed(hi)
+            except AssemblyError:
+                continue
+            if f_lo == 0 or f_hi == 0 or np.sign(f_lo) == np.sign(f_hi):
+                continue
+            x = brentq(signed, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+            q = q_at(x)
+            sigma = measures(mech, q, g)[kind]
+            if sigma < mech.tolerances.singular and not any(
+                    s.kind == kind and abs(s.input - x) < 1e-7 for s in found):
+                found.append(SweepSingularity(kind, float(x), float(sigma), q))
+    found.sort(key=lambda s: s.input)
+    return found

@@ -1,0 +1,61 @@
+"""Screws and gears count turns: the whole turns typed for a revolute input (720deg), carried through the
+higher pairs whose coupling rows are linear in unwrapped angles (a lead screw's turn, a gear's roll).
+
+A solve finds the modes within a turn, keeps those whose counted angles continue the assembled
+configuration's (the thread a nut engages, the tooth a gear meets, as the file draws them), then turns
+them on by the inputs' whole turns along the loops' rates before Newton closes at the typed values.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from ...errors import AssemblyError
+from ...model.closure import Assembly
+
+__all__ = ["whole_turns", "engaged", "turn_on"]
+
+
+def whole_turns(solver, values) -> dict:
+    """Input name -> the whole turns [rad] of a revolute input's typed value, when the mechanism has
+    higher pairs whose coupling rows count turns (screws, gears): 720deg is not 0 there."""
+    if not solver.mech.counted_turns:
+        return {}
+    out = {}
+    for name, v in values.items():
+        c = next((c for c in solver.mech.coordinates if c.joint == name and c.nq == 1), None)
+        if c is not None and solver.model.joints[c.joint_id].shortname().startswith("JointModelR"):
+            w = float(v - (np.mod(v + np.pi, 2 * np.pi) - np.pi))
+            if abs(w) > 0:
+                out[name] = w
+    return out
+
+
+def engaged(solver, found, values):
+    """The solutions whose counted angles (a screw's turn, a gear's roll) continue the assembled
+    configuration's: each predicted from there by the loops' rates (linear for screws and gears) and
+    kept when within half a turn of it; the others differ by whole turns of a thread or a tooth
+    that no motion from the file's configuration reaches."""
+    try:
+        ref = solver.mech.assemble().q
+    except AssemblyError:
+        return found
+    dv = {n: float(values[n]) - float(solver.mech.joint_values(ref).get(n, 0.0)) for n in solver.inputs}
+    qd = solver.rates(ref, solver.mech.closure.jacobian(ref), dv)
+    counted = sorted(solver.mech.counted_turns)
+    vidx = [next(c.idx_v for c in solver.mech.coordinates if c.idx_q == t) for t in counted]
+    pred = np.array([ref[t] for t in counted]) + qd[vidx]
+    off = [float(np.max(np.abs(np.array([q[t] for t in counted]) - pred))) for _, q, _ in found]
+    kept = [f for f, d in zip(found, off) if d < np.pi]
+    return kept or [found[int(np.argmin(off))]]
+
+
+def turn_on(solver, q, whole: dict, typed: dict):
+    """(q, assembly) of the solution ``q`` found within a turn, turned on by the inputs' whole turns:
+    the loops' rates per unit input move every joint and every counted angle linearly (exactly, for
+    gears and screws), then Newton closes at the typed inputs."""
+    K = solver.mech.closure.jacobian(q)
+    qd = solver.rates(q, K, {n: whole.get(n, 0.0) for n in solver.inputs})
+    a = solver.mech.closure.solve(solver.set_inputs(pin.integrate(solver.model, q, qd), typed), frozen=solver.frozen)
+    return a.q, Assembly(a.q, a.residual, a.iterations)

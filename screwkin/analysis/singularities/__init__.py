@@ -1,0 +1,1 @@
+"""Where a mechanism loses control or stiffness: singularity measures, ellipsoids, maps and scans."""

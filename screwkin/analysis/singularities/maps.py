@@ -1,0 +1,80 @@
+"""Singularity maps over two inputs: log10 of the smallest relative singular value on a grid.
+
+One assembly mode is mapped: the first solution at the grid's first corner, and
+from it every cell that continuation reaches, each from a neighbour already
+reached (one input changes), by the sweep's step (analysis.motion.sweep.Neighbour:
+tangent predictor, corrector, branch tests).  A step that would jump to another
+branch or cross a limit position is refused, so a cell is either on the mapped
+branch or marked off it (``reached`` False, NaN, no kind): near a fold no cell
+of another mode is ever mixed in.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import UsageError
+from .singular import Generic, measures
+from ..motion.sweep import Neighbour
+
+__all__ = ["SingularityMap", "singularity_map"]
+
+
+@dataclass(frozen=True)
+class SingularityMap:
+    x_name: str
+    y_name: str
+    xs: np.ndarray
+    ys: np.ndarray
+    log_sigma: np.ndarray  # (len(ys), len(xs)): log10 of the smallest relative singular value (NaN off the branch)
+    kind: np.ndarray  # (len(ys), len(xs)) object array: which singularity the minimum belongs to ("" off the branch)
+    q: np.ndarray  # (len(ys), len(xs), nq) configurations (NaN off the branch)
+    reached: np.ndarray | None = None  # (len(ys), len(xs)) bool: the cell lies on the mapped branch
+    notes: tuple = ()  # what the continuation could not reach, in words
+
+    @property
+    def off_branch(self) -> int:
+        """Cells the mapped assembly mode does not reach by continuation."""
+        return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
+
+
+def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False) -> SingularityMap:
+    mech = solver.mech
+    fixed = dict(fixed or {})
+    for n in (x_name, y_name):
+        if n not in solver.inputs:
+            raise UsageError(f"{mech.path}: '{n}' is not an input ({', '.join(solver.inputs)})")
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+    q_first = solver.solve({x_name: xs[0], y_name: ys[0], **fixed}).solutions[0].q
+    g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
+    logs = np.full((len(ys), len(xs)), np.nan)
+    kinds = np.full((len(ys), len(xs)), "", dtype=object)
+    qs = np.full((len(ys), len(xs), mech.nq), np.nan)
+    reached = np.zeros((len(ys), len(xs)), bool)
+    steps = {x_name: Neighbour(solver, x_name), y_name: Neighbour(solver, y_name)}
+    grids = {x_name: xs, y_name: ys}
+    queue = deque([(0, 0)])
+    qs[0, 0], reached[0, 0] = q_first, True
+    while queue:  # breadth first: each cell from its nearest reached neighbour
+        j, i = queue.popleft()
+        for dj, di in ((0, 1), (1, 0), (0, -1), (-1, 0)):
+            jn, in_ = j + dj, i + di
+            if not (0 <= jn < len(ys) and 0 <= in_ < len(xs)) or reached[jn, in_]:
+                continue
+            name, a, b = (x_name, i, in_) if di else (y_name, j, jn)
+            q = steps[name](qs[j, i], float(grids[name][a]), float(grids[name][b]))
+            if q is not None:
+                qs[jn, in_], reached[jn, in_] = q, True
+                queue.append((jn, in_))
+    for j, i in zip(*np.nonzero(reached)):
+        m = measures(mech, qs[j, i], g)
+        kind = min(m, key=m.get)
+        logs[j, i] = np.log10(max(m[kind], 1e-16))
+        kinds[j, i] = kind
+    off = int(reached.size - reached.sum())
+    notes = (f"{off} of {reached.size} points are not reached from the first one by continuation on its "
+             "assembly mode (another mode, past a limit position, or not assembled): left blank",) if off else ()
+    return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes)

@@ -1,0 +1,75 @@
+"""JSON as screwkin writes it: numpy values as plain numbers and lists; an infinite number as the
+string "inf" or "-inf" (JSON has no Infinity); a NaN refused as the bug it is (a value that does not
+exist is None, written so by the analysis that knows why); and the indented text of json.dumps
+written fast for the long lists of numbers a sweep holds.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+__all__ = ["to_jsonable", "nan_to_none", "json_text"]
+
+
+def to_jsonable(obj, _where: str = ""):
+    """Plain Python for json.dumps: numpy values as numbers and lists; an infinite number (the
+    condition number of a singular matrix, an unbounded effort) as the string "inf" or "-inf",
+    since JSON has no Infinity.  A NaN is a bug, never an answer: RuntimeError naming where it
+    sits (a value that does not exist -- a map cell off the branch -- is None, written so by
+    the analysis that knows why)."""
+    if isinstance(obj, dict):
+        return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        if isinstance(obj, list) and _numbers(obj):  # finite floats only: nothing to convert
+            return obj
+        return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind == "f" and np.isfinite(obj).all():  # (a sweep's arrays: one C call, not a call a number)
+            return obj.tolist()
+        return to_jsonable(obj.tolist(), _where)
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not np.isfinite(obj):
+        if np.isnan(obj):
+            raise RuntimeError(f"internal error: NaN in the JSON output at {_where.lstrip('.') or 'the top'}")
+        return "inf" if obj > 0 else "-inf"
+    return obj
+
+
+def nan_to_none(a) -> list:
+    """An array whose NaN entries mean 'no value here' (said so by its analysis) as nested lists
+    with None there, for to_jsonable."""
+    a = np.asarray(a, float)
+    return np.where(np.isnan(a), None, a.astype(object)).tolist()
+
+
+def json_text(obj, indent: int = 2, _level: int = 0) -> str:
+    """json.dumps(obj, indent=indent) of to_jsonable's output, character for character, with the
+    lists of numbers (a sweep's tens of thousands of values) written in one join each instead of
+    json's pure-Python encoder (the one it uses with indent), which takes seconds on them."""
+    pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):
+        if not obj:
+            return "{}"
+        items = (f"{inner}{json.dumps(k)}: {json_text(v, indent, _level + 1)}" for k, v in obj.items())
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if isinstance(obj, (list, tuple)):
+        if not obj:
+            return "[]"
+        if _numbers(obj):
+            return "[\n" + inner + (",\n" + inner).join(map(float.__repr__, obj)) + "\n" + pad + "]"
+        if all(isinstance(v, list) and v and _numbers(v) for v in obj):  # rows of numbers (vectors along a sweep)
+            deeper = inner + " " * indent
+            sep = ",\n" + deeper
+            rows = ("[\n" + deeper + sep.join(map(float.__repr__, v)) + "\n" + inner + "]" for v in obj)
+            return "[\n" + inner + (",\n" + inner).join(rows) + "\n" + pad + "]"
+        return "[\n" + ",\n".join(inner + json_text(v, indent, _level + 1) for v in obj) + "\n" + pad + "]"
+    return json.dumps(obj, indent=indent).replace("\n", "\n" + pad)
+
+
+def _numbers(values) -> bool:
+    """A list of finite floats only (two loops in C)."""
+    return set(map(type, values)) == {float} and all(map(math.isfinite, values))
