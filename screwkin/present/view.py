@@ -28,6 +28,7 @@ import pinocchio as pin
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..files.meshes import find_mesh
 from ..files.xmlsafe import parse_xml_text
+from ..model.geometry import perpendicular_basis
 from ..model._pin import frame_id
 from .viewplanar import colour_links, link_colours, planar_basis, top_view
 from .viewserver import ViewerServer
@@ -120,10 +121,7 @@ def _segment(name, joint, frame, a, b, radius, color):
     if L < 1e-9:
         return None
     z = d / L
-    h = np.array([1.0, 0, 0]) if abs(z[0]) < 0.9 else np.array([0, 1.0, 0])
-    x = np.cross(h, z)
-    x /= np.linalg.norm(x)
-    R = np.column_stack([x, np.cross(z, x), z])
+    R = np.column_stack([*perpendicular_basis(z), z])  # (b1, b2, z) right-handed; the cylinder is round
     obj = pin.GeometryObject(name, joint, frame, pin.SE3(R, (a + b) / 2), coal.Cylinder(radius, L))
     obj.meshColor = np.asarray(color, float)
     return obj
@@ -179,9 +177,7 @@ def _pair_geometry(mech, cut, spec, r_axis, L_axis):
                 out.append(_ball(name, joint, frame, P.translation, 2.5 * r_axis, color))
     elif spec.type == "helical":  # two turns of a helix of the screw's lead, around its axis
         joint, frame, P = side(0)
-        b1 = np.cross(a, [1.0, 0, 0] if abs(a[0]) < 0.9 else [0, 1.0, 0])
-        b1 /= np.linalg.norm(b1)
-        b2 = np.cross(a, b1)
+        b1, b2 = perpendicular_basis(a)
         radius = 2 * L_axis / 3
         ts = np.linspace(0.0, 4 * np.pi, 49)
         pts = [P.act(radius * (np.cos(s) * b1 + np.sin(s) * b2) + spec.lead * s / (2 * np.pi) * a) for s in ts]
