@@ -50,6 +50,8 @@ class Tolerances:
                     over it, its neighbours and these, and the largest decides [-].
     samples:        nearby assembled configurations sampled for the generic rank [-].
     sample_step:    size of the random step to a nearby configuration [rad or m].
+    max_step:       the longest continuation step a sweep takes [rad, or characteristic lengths]: a
+                    coarser grid is followed by shorter steps between its values [-].
     near_far:       a --near value the chosen mode misses by more than this is said to be missed
                     [rad for angles, times the characteristic length for lengths].
     moves:          a joint moves (in the generic configurations) where its row of the
@@ -84,6 +86,7 @@ class Tolerances:
     generic_starts: int = 4
     samples: int = 3
     sample_step: float = 0.05
+    max_step: float = 0.1
     near_far: float = 0.5
     moves: float = 1e-6
     stationary: float = 1e-7

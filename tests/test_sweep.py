@@ -177,3 +177,28 @@ def test_grid_values_next_to_a_limit_position_are_reached(tmp_path):
     assert np.linalg.norm(A) == pytest.approx(0.04, abs=1e-12)
     assert np.linalg.norm(B - A) == pytest.approx(0.12, abs=1e-9)
     assert np.linalg.norm(B - np.array([0.10, 0, 0])) == pytest.approx(0.19, abs=1e-9)
+
+
+def test_a_coarse_grid_follows_the_same_branch_and_ends():
+    """A non-Grashof four-bar driven from its output link, 3 grid steps over 4.2 rad (a step of 80 deg):
+    the tracker ran on without end here (its step budget counted only recorded values), and a coarse
+    step could jump across the curve's bend to the other branch.  Now it steps at most
+    Tolerances.max_step between grid values: the same limit positions and circuits as a grid 40 times
+    finer, found within a bounded amount of work."""
+    from pathlib import Path
+
+    from conftest import no_hang
+
+    m = screwkin.load(Path(__file__).resolve().parents[1] / "robots" / "fourbar_non_grashof.urdf")
+    solver = PositionSolver(m, ["output_joint"])
+    for a, b, turn in ((-2.1, 2.1, False), (-4.2, 0.0, False), (1.0, 5.2, False), (2.0, 6.2, True)):
+        with no_hang(30):
+            coarse = sweep(solver, "output_joint", a, b, 3, turn=turn, closed_form=False)
+        fine = sweep(solver, "output_joint", a, b, 120, turn=turn, closed_form=False)
+        assert (coarse.stopped_at is None) == (fine.stopped_at is None)
+        if fine.stopped_at is not None:
+            assert coarse.stopped_at == pytest.approx(fine.stopped_at, abs=1e-8)
+        assert coarse.circuit_closed == fine.circuit_closed
+        for x, q in zip(coarse.values, coarse.q):  # every coarse configuration is one the fine grid passes
+            same = [qf for xf, qf in zip(fine.values, fine.q) if abs(xf - x) < 1e-12]
+            assert not same or min(np.abs(qf - q).max() for qf in same) < 1e-6

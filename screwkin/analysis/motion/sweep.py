@@ -37,7 +37,11 @@ from ...model.linalg import null_space
 from .dyads import planar_sweep
 from ..singularities.singular import Generic, measures, scaled_jacobians
 
-__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour"]
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour", "CONTINUATION_ROUNDS"]
+
+#: Continuation steps a sweep may take per configuration it records (a bound on its work: a motion that
+#: bends too sharply for any step the corrector accepts stops, said so, instead of running on).
+CONTINUATION_ROUNDS = 50
 
 
 @dataclass(frozen=True)
@@ -358,17 +362,30 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
                 and np.linalg.norm(pin.difference(mech.model, Q[-1], q0) / tr.scale) < 1e-6)
 
     if h != 0 and t is not None:
-        sigma = abs(h) / tr.scale[tr.ix]
+        # the longest step taken (scaled): a grid step, at most Tolerances.max_step -- a coarse grid is
+        # followed by shorter steps, so that no step jumps across a bend of the curve to another branch
+        longest = min(abs(h) / tr.scale[tr.ix], mech.tolerances.max_step)
+        sigma = longest
+        rounds = 0
         while len(X) < max_steps:
+            rounds += 1
+            if rounds > CONTINUATION_ROUNDS * max_steps:  # a bound on the work, whatever the grid
+                stopped, reason = x, (f"the continuation made no progress in {rounds - 1} steps (the motion bends "
+                                      "too sharply for the steps it can take here)")
+                break
             end_x = float(stop)
             if forward() and (end_x - x) * direction <= 1e-12 * max(1.0, abs(end_x)):
                 break  # the input reached the end of the range
             held = tr.hold(t)
-            if held == tr.ix:  # the input is a good parameter: go to its next grid value
+            if held == tr.ix:  # the input is a good parameter: go to its next grid value, or toward it
                 nxt = grid_between(x, x + direction * abs(h) * 1.000001)
                 target = nxt[0] if nxt else x + direction * abs(h)
                 if forward() and (target - end_x) * direction > 0:
                     target = end_x
+                reach = sigma * tr.scale[tr.ix]  # after a refused step, toward the grid value by shorter steps
+                on_grid = abs(target - x) <= reach * (1 + 1e-9)
+                if not on_grid:
+                    target = x + direction * reach
                 try:
                     q_new = tr.at_input(q, x, target, t)
                     t_new = tr.tangent(q_new, t)
@@ -379,11 +396,13 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
                     if not tr.holdable[held]:
                         stopped, reason = x, "the motion cannot go on along this input"
                         break
-                    sigma = min(sigma, abs(h) / tr.scale[tr.ix]) * 0.5
+                    sigma = min(sigma, longest) * 0.5
                 else:
-                    X.append(target)
-                    Q.append(q_new)
+                    if on_grid:
+                        X.append(target)
+                        Q.append(q_new)
                     q, x, t = q_new, target, t_new
+                    sigma = min(sigma * 1.5, longest)
                     if back_at_start():
                         closed = True
                         break
@@ -417,7 +436,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             else:
                 record(q, x, t, q_new, x_new, t_new, held=held)
             q, x, t = q_new, x_new, t_new
-            sigma = min(sigma * 1.5, abs(h) / tr.scale[tr.ix])
+            sigma = min(sigma * 1.5, longest)
             if back_at_start():
                 closed = True
                 break
