@@ -232,16 +232,23 @@ class Neighbour:
         direction = np.sign(x_to - x_from)
         if direction == 0:
             return q
+        # in steps of at most Tolerances.max_step (scaled), as the sweep takes them
+        pieces = int(np.ceil(abs(x_to - x_from) / (tr.tol.max_step * tr.scale[tr.ix])))
         try:
             t = tr.tangent(q)
             if t[tr.ix] * direction < 0:
                 t = -t
-            q_new = tr.at_input(q, x_from, x_to, t)
-            if tr.tangent(q_new, t)[tr.ix] * direction <= 0:
-                return None  # a limit position lies between the two values
+            x = x_from
+            for k in range(1, pieces + 1):
+                x_next = x_to if k == pieces else x_from + (x_to - x_from) * k / pieces
+                q = tr.at_input(q, x, x_next, t)
+                t_next = tr.tangent(q, t)
+                if t_next[tr.ix] * direction <= 0:
+                    return None  # a limit position lies between the two values
+                x, t = x_next, t_next
         except _Stuck:
             return None
-        return q_new
+        return q
 
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
