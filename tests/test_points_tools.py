@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import fourbar, screwkin_cli
+from conftest import circles, fourbar, screwkin_cli
 
 L1, L2 = 0.4, 0.25
 ARM = """<robot name="arm2r">
@@ -159,3 +159,32 @@ def test_bad_points_and_tools_are_usage_errors(arm, args, message):
     r = screwkin_cli(*[a.format(arm=arm) for a in args])
     assert r.returncode == 2, (r.stdout, r.stderr)
     assert message in r.stderr and "Traceback" not in r.stderr
+
+
+def test_report_lists_the_points_of_its_solutions(four_bar, tmp_path):
+    md = tmp_path / "r.md"
+    r = screwkin_cli("report", four_bar, "--actuated", "crank_joint", "--set-angle", "crank=100deg", "--rate",
+                     "crank_joint=10", "--point", "P=coupler:60mm,20mm,0", "--md", str(md), "--no-view")
+    assert r.returncode == 0, r.stderr
+    rows = [line for line in md.read_text().splitlines() if line.startswith("| P | coupler |")]
+    assert len(rows) == 2  # one per assembly mode
+
+    def numbers(cell):
+        return np.array([float(x) for x in cell.strip().strip("()").split(",")])
+
+    # closed form: B on the crank at 100 deg, C where the coupler (0.12) meets the rocker (0.08) about D
+    th2, w2 = np.radians(100), 10.0
+    B, D = 0.04 * np.array([np.cos(th2), np.sin(th2)]), np.array([0.1, 0.0])
+    expected = []
+    for C in circles(B, 0.12, D, 0.08):
+        th3, th4 = np.arctan2(*(C - B)[::-1]), np.arctan2(*(C - D)[::-1])
+        P = B + rot(th3) @ np.array([0.06, 0.02])
+        w3 = w2 * 0.04 * np.sin(th4 - th2) / (0.12 * np.sin(th3 - th4))
+        k_cross = np.array([[0, -1], [1, 0]])
+        expected.append((P, w2 * k_cross @ B + w3 * k_cross @ (P - B)))
+    for row in rows:
+        cells = row.strip("|").split("|")
+        p, v = numbers(cells[2])[:2], numbers(cells[3])[:2]
+        P, V = min(expected, key=lambda e: np.linalg.norm(e[0] - p))
+        assert p == pytest.approx(P, rel=1e-5, abs=1e-9)
+        assert v == pytest.approx(V, rel=1e-5, abs=1e-9)
