@@ -188,3 +188,14 @@ def test_report_lists_the_points_of_its_solutions(four_bar, tmp_path):
         P, V = min(expected, key=lambda e: np.linalg.norm(e[0] - p))
         assert p == pytest.approx(P, rel=1e-5, abs=1e-9)
         assert v == pytest.approx(V, rel=1e-5, abs=1e-9)
+
+
+def test_serial_singularity_of_a_point_is_where_its_jacobian_drops_rank(arm):
+    # the arm stretched along x (the file's configuration): J_p = [[-y, -y], [x, x - 0.4]] for P = (x, y)
+    off = run_json("singularities", arm, "--point", "P=fore:0.25,0.05,0")  # det = -0.05 * (0.65 - 0.4) + 0.05 * 0.65
+    assert off["serial"] is False
+    assert off["manipulability"] == pytest.approx(abs(-0.05 * 0.25 + 0.05 * 0.65) / off["characteristic_length"] ** 2)
+    on = run_json("singularities", arm, "--point", "P=fore:0.25,0,0")  # on the line of the arm: it cannot move along it
+    assert on["serial"] is True
+    (lost,) = [t for t in on["singular_twists"] if t["kind"] == "serial"]
+    assert np.abs(lost["screw"]["direction"]) == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)
