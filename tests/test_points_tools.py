@@ -199,3 +199,22 @@ def test_serial_singularity_of_a_point_is_where_its_jacobian_drops_rank(arm):
     assert on["serial"] is True
     (lost,) = [t for t in on["singular_twists"] if t["kind"] == "serial"]
     assert np.abs(lost["screw"]["direction"]) == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)
+
+
+def test_scan_of_a_named_point_finds_where_it_lines_up_with_the_shoulder(arm):
+    # det J_p = 0.4 |p| sin(elbow + phi) for P at |p|, angle phi on 'fore': singular at elbow = -phi (or pi - phi)
+    d = run_json("scan", arm, "--point", "P=fore:0.25,0.05,0", "--samples", "5000")
+    assert d["output"] == "P" and d["point"] is True
+    elbow = d["min_configuration"]["elbow"]
+    assert abs(np.sin(elbow + np.arctan2(0.05, 0.25))) < 0.01
+    assert d["min"] < 1e-3
+
+
+def test_map_takes_a_named_point_as_its_output(tmp_path):
+    from conftest import ROBOTS
+
+    d = run_json("map", str(ROBOTS / "five_bar.urdf"), "--x", "motor1=-1:1:3", "--y", "motor2=-1:1:3", "--point",
+                 "P=distal1:0.05,0,0")
+    plain = run_json("map", str(ROBOTS / "five_bar.urdf"), "--x", "motor1=-1:1:3", "--y", "motor2=-1:1:3")
+    assert np.array(d["reached"]).shape == (3, 3)
+    assert d["kind"] != plain["kind"] or d["log10_sigma_min"] != plain["log10_sigma_min"]  # the point's serial measure counts
