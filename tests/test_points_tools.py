@@ -218,3 +218,21 @@ def test_map_takes_a_named_point_as_its_output(tmp_path):
     plain = run_json("map", str(ROBOTS / "five_bar.urdf"), "--x", "motor1=-1:1:3", "--y", "motor2=-1:1:3")
     assert np.array(d["reached"]).shape == (3, 3)
     assert d["kind"] != plain["kind"] or d["log10_sigma_min"] != plain["log10_sigma_min"]  # the point's serial measure counts
+
+
+def test_the_tool_jacobian_is_the_link_jacobian_shifted_to_the_tool(four_bar):
+    from screwkin.model.state import KinematicState, place_tool
+
+    mech = screwkin.load(four_bar)
+    q = mech.generic_configurations()[0].q
+    before = KinematicState(mech, q)
+    J, M = before.link_jacobian("coupler"), before.frame_placement(mech.link_frame("coupler"))
+    tool = pin.SE3(pin.rpy.rpyToMatrix(0.1, 0.2, 0.3), np.array([0.06, 0.02, 0.01]))
+    name = place_tool(mech, "tip", "coupler", tool)
+    after = KinematicState(mech, q)
+    r = M.rotation @ tool.translation  # link origin -> tool origin, world axes
+    skew = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+    expected = np.vstack([J[:3] - skew @ J[3:], J[3:]])  # v_tool = v_o + w x r
+    assert after.link_jacobian(name) == pytest.approx(expected, abs=1e-12)
+    placed = after.frame_placement(mech.link_frame(name))
+    assert placed.homogeneous == pytest.approx((M * tool).homogeneous, abs=1e-12)
