@@ -8,17 +8,18 @@ import math
 import sys
 
 import numpy as np
+import pinocchio as pin
 
 from ..analysis.motion.links import Point
 from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
-from ..model.state import value_for_leg_length
+from ..model.state import KinematicState, place_tool, value_for_leg_length
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
 __all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
-           "joint_value", "value_kind"]
+           "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line"]
 
 
 class PointOption(argparse.Action):
@@ -59,6 +60,82 @@ def named_points(mech, args) -> tuple:
         local = tuple(parse_value(c, "length", f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
         out.append(Point(name, link, local))
     return tuple(out)
+
+
+def add_tool_option(sp):
+    """--tool x,y,z[,roll,pitch,yaw]: the output frame moved on the output link."""
+    sp.add_argument("--tool", metavar="x,y,z[,roll,pitch,yaw]",
+                    help="a tool frame on the --output link, placed in the link's frame (units allowed: "
+                         "0,0,60mm or 0.1,0,0,0,0,90deg): its pose, twist and Jacobian replace the link frame's")
+
+
+def parse_tool(text: str):
+    """``x,y,z[,roll,pitch,yaw]`` (m and rad, units allowed) -> a pinocchio.SE3 in the link's frame."""
+    parts = [c for c in text.replace(" ", ",").split(",") if c.strip()]
+    if len(parts) not in (3, 6):
+        raise UsageError(f"--tool expects x,y,z or x,y,z,roll,pitch,yaw, got {len(parts)} numbers in {quote(text, 80)}")
+    v = [parse_value(c, "length" if k < 3 else "angle", "--tool") for k, c in enumerate(parts)]
+    rpy = np.array(v[3:] if len(v) == 6 else [0.0, 0.0, 0.0])
+    return pin.SE3(pin.rpy.rpyToMatrix(rpy), np.array(v[:3]))
+
+
+def output_frame(mech, args, required: bool = False):
+    """The output a command analyses, from --output, --tool and a named --point: ``(name, point)``.
+
+    ``--tool`` moves the output frame onto the --output link (named ``LINK@tool``); a named
+    ``--point NAME=LINK:x,y,z`` makes that point the output (its link's orientation, analysed as a
+    point: ``point`` is True); ``--point`` alone keeps its meaning (the output link's origin as a point).
+    ``name`` is what mech.link_frame takes (None when no output is given and none is ``required``)."""
+    output, tool = getattr(args, "output", None), getattr(args, "tool", None)
+    named = named_points(mech, args)
+    if len(named) > 1:
+        raise UsageError(f"--point: this command takes one named point as its output, got {len(named)}")
+    if named:
+        p = named[0]
+        if tool is not None:
+            raise UsageError("--tool and a named --point both move the output frame: give one of them")
+        if output is not None and output != p.link:
+            raise UsageError(f"--point {p.name} is on {quote(p.link)}, not on the --output link {quote(output)}")
+        return place_tool(mech, p.name, p.link, pin.SE3(np.eye(3), np.asarray(p.local, float))), True
+    if output is None:
+        if tool is not None:
+            raise UsageError("--tool needs --output LINK (the link the tool is on)")
+        if required:
+            raise UsageError("give --output LINK (or a named --point NAME=LINK:x,y,z)")
+        return None, bool(getattr(args, "point", False))
+    if tool is not None:
+        return place_tool(mech, f"{output}@tool", output, parse_tool(tool)), bool(getattr(args, "point", False))
+    return output, bool(getattr(args, "point", False))
+
+
+def output_frame_dict(mech, q, jacobian: bool = False, point: bool = False) -> dict | None:
+    """JSON of the placed output frame (model.state.place_tool) at q: its name, link, placement on the
+    link (x, y, z, roll, pitch, yaw) and world pose (position, rotation); with ``jacobian`` its frame
+    Jacobian (world axes, rows (v, w) of its origin; only v for a ``point``: J_p = J_v - [r]x J_w, one
+    column a velocity coordinate); None when none is placed."""
+    if mech.tool is None:
+        return None
+    name, link, X = mech.tool
+    state = KinematicState(mech, q)
+    M = state.frame_placement(mech.tool_frame)
+    out = {"name": name, "link": link, "local": [*X.translation.tolist(), *pin.rpy.matrixToRpy(X.rotation).tolist()],
+           "position": M.translation.tolist(), "rotation": M.rotation.tolist()}
+    if jacobian:
+        J = state.frame_jacobian(mech.tool_frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        out["jacobian"] = (J[:3] if point else J).tolist()
+        out["jacobian_columns"] = list(mech.coordinate_names)
+    return out
+
+
+def output_frame_line(frame: dict, point: bool) -> str:
+    """One line saying which frame is the output (output_frame_dict), where it is on its link and in the world."""
+    x = ", ".join(f"{v:.6g}" for v in frame["local"][:3])
+    w = ", ".join(f"{v:.6g}" for v in frame["position"])
+    if point:
+        return f"output: the point {quote(frame['name'])} at ({x}) m on {quote(frame['link'])}, in the world at ({w}) m"
+    rpy = ", ".join(f"{math.degrees(v):.6g}" for v in frame["local"][3:])
+    return (f"output: the tool frame {quote(frame['name'])} at ({x}) m, roll pitch yaw ({rpy}) deg on "
+            f"{quote(frame['link'])}, in the world at ({w}) m")
 
 
 def value_kind(mech, joint: str):

@@ -17,6 +17,7 @@ from ..present.report import (
 )
 from ._common import (
     joint_assignments,
+    output_frame,
     parse_range,
 )
 from ._options import BOUNDS
@@ -47,9 +48,10 @@ def run(mech, args) -> int:
                          f"at most {BOUNDS['grid_total'][1]:,}")
     fixed = joint_assignments(mech, args.set, "--set")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
-    if args.point and not args.output:
+    output, point = output_frame(mech, args)  # a named --point is the output
+    if point and not output:
         raise UsageError("--point needs --output LINK")
-    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output, args.point)
+    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point)
     if args.png:
         map_png(res, args.png)
     if args.csv:

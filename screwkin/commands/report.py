@@ -50,7 +50,7 @@ from ..present.view import (
     screenshot,
     show,
 )
-from ._common import add_configuration_options, inputs, joint_assignments
+from ._common import add_configuration_options, add_point_option, inputs, joint_assignments, named_points
 from ._options import check_writable, count, screwkin_version
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
@@ -83,6 +83,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 /s each)")
     sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
     sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
+    add_point_option(sp)
     sp.add_argument("--steps", type=count("figure_steps"), default=360,
                     help="steps over the input's range (default 360, at most 20,000)")
     sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
@@ -138,6 +139,7 @@ def run(mech, args) -> int:
     q0 = mech.generic_configurations()[0].q
     if args.output:
         mech.link_frame(args.output)
+    points = named_points(mech, args)
     rates = joint_assignments(mech, args.rate, "--rate", order=1) or {n: 1.0 for n in names}
     accels = joint_assignments(mech, args.accel, "--accel", order=2) or None
     notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
@@ -148,7 +150,7 @@ def run(mech, args) -> int:
     if names:
         solver = PositionSolver(mech, names, output=args.output)
         pres = solver.solve(values, near=near if (near or given) else mech.joint_values(q0), rates=rates,
-                            accels=accels)
+                            accels=accels, points=points)
         q = pres.solutions[0].q
         data["solve"] = position_dict(pres)
     topo = mech.topology(q)
@@ -199,7 +201,7 @@ def run(mech, args) -> int:
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "
-                                     "nothing to solve for"))
+                                     "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
 
     # ---- singular configurations and the sweep
     sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data)

@@ -11,6 +11,7 @@ from ..present.report import (
     scan_dict,
     to_jsonable,
 )
+from ._common import output_frame
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -22,7 +23,7 @@ NEEDS_MECHANISM = True
 def add_parser(sub, common, scaled):
     sp = sub.add_parser("scan", help="singularity scan of a serial chain over random configurations")
     common(sp)
-    sp.add_argument("--output", required=True, help="the chain's last link (e.g. the flange)")
+    sp.add_argument("--output", help="the chain's last link (e.g. the flange; or give a named --point)")
     sp.add_argument("--samples", type=count("samples"), default=100000, help="random configurations (default 100000)")
     sp.add_argument("--seed", type=count("seed"), default=0, help="random seed (default 0)")
     sp.add_argument("--measure", choices=["sigma_ratio", "det"], default="sigma_ratio",
@@ -34,7 +35,8 @@ def add_parser(sub, common, scaled):
 
 def run(mech, args) -> int:
     t = time.perf_counter()
-    res = scan(mech, args.output, args.samples, args.seed, args.measure, None, args.threads, point=args.point)
+    output, point = output_frame(mech, args, required=True)  # a named --point is the output
+    res = scan(mech, output, args.samples, args.seed, args.measure, None, args.threads, point=point)
     elapsed = time.perf_counter() - t
     if args.csv:
         with open(args.csv, "w") as f:

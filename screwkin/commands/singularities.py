@@ -17,8 +17,12 @@ from ..present.report import (
 from ..present.screws import gram_symbolic_dict, gram_symbolic_text
 from ._common import (
     add_configuration_options,
+    add_tool_option,
     configuration,
     inputs,
+    output_frame,
+    output_frame_dict,
+    output_frame_line,
     with_mode,
 )
 
@@ -38,26 +42,33 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--symbolic", action="store_true",
                    help="planar loops: each joint's Gram cofactor as a formula in the symbols of screwkin equations, "
                         "and where it vanishes (the joint is stationary)")
+    add_tool_option(sp)
     scaled(sp)
 
 
 def run(mech, args) -> int:
-    if args.point and not args.output:
+    output, point = output_frame(mech, args)
+    if point and not output:
         raise UsageError("--point needs --output LINK")
-    if args.ellipsoids and not args.output:
+    if args.ellipsoids and not output:
         raise UsageError("--ellipsoids needs --output LINK")
     q = configuration(mech, args)
-    rep = classify(mech, q, output=args.output, point=args.point)
-    ell = ellipsoids(mech, q, args.output, point=args.point) if args.ellipsoids else None
+    rep = classify(mech, q, output=output, point=point)
+    ell = ellipsoids(mech, q, output, point=point) if args.ellipsoids else None
+    frame = output_frame_dict(mech, q, jacobian=True, point=point)
     gram = symbolic_gram(mech, q, list(inputs(mech, args)) or None) if args.symbolic else None
     if args.json:
         d = singularity_dict(rep)
+        if frame is not None:  # the named point or tool frame analysed as the output
+            d["output_frame"] = frame
         if ell is not None:
             d["ellipsoids"] = ellipsoids_dict(ell)
         if gram is not None:
             d["gram_symbolic"] = gram_symbolic_dict(gram)
         print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
     else:
+        if frame is not None:
+            print(output_frame_line(frame, point))
         print(singularity_text(rep))
         if ell is not None:
             print()

@@ -5,12 +5,24 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
+
 from ..analysis.forces.statics import legs, statics
 from ..errors import UsageError
+from ..model.state import KinematicState
 from ..present.report import to_jsonable
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
-from ._common import add_configuration_options, configuration, with_mode
+from ._common import (
+    add_configuration_options,
+    add_point_option,
+    add_tool_option,
+    configuration,
+    output_frame,
+    output_frame_dict,
+    output_frame_line,
+    with_mode,
+)
 
 NAME = "statics"
 NEEDS_MECHANISM = True
@@ -20,7 +32,10 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="actuator efforts and joint reactions holding a load; legs' wrenches")
     common(sp)
     add_configuration_options(sp)
-    sp.add_argument("--output", help="the link the wrench is applied to (at its frame's origin, world axes)")
+    sp.add_argument("--output", help="the link the wrench is applied to (at its frame's origin, world axes; at the "
+                                     "--tool's origin or the named --point with those)")
+    add_tool_option(sp)
+    add_point_option(sp)
     sp.add_argument("--wrench", help='"fx fy fz mx my mz": force [N] and moment [N m]')
     sp.add_argument("--gravity", action="store_true", help="also the links' weights (from the file's inertials)")
     sp.add_argument("--length", help="characteristic length for the amplification (default: mean link length)")
@@ -33,13 +48,26 @@ def run(mech, args) -> int:
         if len(parts) != 6:
             raise UsageError(f'--wrench expects "fx fy fz mx my mz", got {len(parts)} numbers')
         wrench = [parse_value(p, "force" if k < 3 else "moment", "--wrench") for k, p in enumerate(parts)]
-        if args.output is None:
-            raise UsageError("--wrench needs --output LINK (the link it is applied to)")
+        if args.output is None and not args.points:
+            raise UsageError("--wrench needs --output LINK (the link it is applied to) or a named --point")
+    output, _ = output_frame(mech, args)
     q = configuration(mech, args)
-    result = statics(mech, q, output=args.output, wrench=wrench, gravity=args.gravity)
-    leg_list = legs(mech, q, args.output) if args.output is not None and mech.cuts else None
+    result = statics(mech, q, output=output, wrench=wrench, gravity=args.gravity)
+    leg_list = legs(mech, q, output) if output is not None and mech.cuts else None
+    frame = output_frame_dict(mech, q)
+    if frame is not None:  # the load at the point (tool origin) is, at the link frame's origin, m_o = m + r x f
+        o = KinematicState(mech, q).link_motion(frame["link"])["position"]
+        f, m = np.asarray(result.wrench[:3]), np.asarray(result.wrench[3:])
+        frame["wrench_at_link_origin"] = [*f.tolist(), *(m + np.cross(np.asarray(frame["position"]) - o, f)).tolist()]
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, statics_dict(result, leg_list))), indent=2))
+        d = statics_dict(result, leg_list)
+        if frame is not None:
+            d["output_frame"] = frame
+        print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
     else:
+        if frame is not None:
+            moved = " ".join(f"{v:.6g}" for v in frame["wrench_at_link_origin"])
+            print(output_frame_line(frame, args.tool is None) + f"; the load there is, at {frame['link']}'s "
+                  f"origin, (fx fy fz mx my mz) = {moved} (N, N m)")
         print(statics_text(result, leg_list))
     return 0

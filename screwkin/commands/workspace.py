@@ -22,6 +22,7 @@ from ..present.workspace import (
     workspace_text,
 )
 from ..units import parse_length, parse_value
+from ._common import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count, seconds
 
 NAME = "workspace"
@@ -31,9 +32,10 @@ NEEDS_MECHANISM = True
 def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="workspace of an output link: volume, singularity-free part, conditioning")
     common(sp)
-    sp.add_argument("--output", required=True, help="the link whose workspace to find (e.g. the platform)")
-    sp.add_argument("--point", action="store_true",
-                    help="the link's origin as a point, any orientation (default: the link at a constant orientation)")
+    sp.add_argument("--output", help="the link whose workspace to find (e.g. the platform; or its --tool frame's)")
+    add_point_option(sp, "--point alone: the link's origin (the --tool's origin) as a point, any orientation "
+                         "(default: the link at a constant orientation)")
+    add_tool_option(sp)
     sp.add_argument("--orientation", metavar='"ROLL PITCH YAW"',
                     help="the constant orientation (rad, or with units: 10deg); default: the link's orientation in "
                          "the assembled configuration")
@@ -83,7 +85,11 @@ def run(mech, args) -> int:
     if args.samples < 1:
         raise UsageError(f"--samples must be positive, got {args.samples}")
     length = parse_length(args.length, "--length") if args.length else None
-    res = workspace(mech, args.output, point=args.point, orientation=_orientation(args.orientation),
+    output, point = output_frame(mech, args, required=True)
+    if args.points and args.orientation is not None:
+        raise UsageError("--orientation: a named --point has no orientation of its own (its workspace is its "
+                         "positions); use --tool x,y,z for a frame at that place")
+    res = workspace(mech, output, point=point, orientation=_orientation(args.orientation),
                     resolution=parse_length(args.resolution, "--resolution") if args.resolution else None,
                     bounds=_bounds(args.bounds), threshold=args.threshold, length=length, method=args.method,
                     samples=args.samples, seed=args.seed, timeout=args.timeout)
@@ -98,7 +104,7 @@ def run(mech, args) -> int:
     if args.html or args.cloud_png:
         q = res.configurations[0] if res.configurations is not None else mech.generic_configurations()[0].q
         with ViewerServer() as server:
-            scene = build_scene(mech, q, output=args.output)
+            scene = build_scene(mech, q, output=mech.tool[1] if mech.tool else args.output)
             scene.points = np.vstack([scene.points, res.positions])  # framed to the mechanism and its cloud
             show(mech, scene, server.viewer, q)
             workspace_cloud(res, server.viewer)
@@ -114,11 +120,18 @@ def run(mech, args) -> int:
                     f.write(html)
                 screenshot(page, args.cloud_png)
             wrote.append(args.cloud_png)
+    frame = None
+    if mech.tool is not None:  # the named point or tool frame whose workspace it is, in the assembled configuration
+        frame = output_frame_dict(mech, mech.generic_configurations()[0].q)
     if args.json:
         d = workspace_dict(res)
         d["wrote"] = wrote
+        if frame is not None:
+            d["output_frame"] = frame
         print(json.dumps(to_jsonable(d), indent=2))
     else:
+        if frame is not None:
+            print(output_frame_line(frame, bool(args.points)))
         print(workspace_text(res))
         for w in wrote:
             print(f"wrote {w}")

@@ -126,6 +126,10 @@ class Mechanism:
         # before the pinocchio.Data is made from the model
         self.target_frame = model.addFrame(
             pin.Frame("screwkin@target", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
+        # the output frame a command may move onto a link (--tool, a named --point): model.state.place_tool
+        self.tool_frame = model.addFrame(
+            pin.Frame("screwkin@tool", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
+        self.tool = None  # (name, link, placement on the link) once placed
         # The mechanism's own Data: Pinocchio 4.1 allocates nv^3-sized tensors in one (a Data of a
         # 500-joint chain: 17 s and 7.9 GB here, 0.2 s at 200 joints, 1 ms at 30).  Computations
         # take a Data of their own from scratch_data(); only models past SHARED_DATA_NV
@@ -373,7 +377,9 @@ class Mechanism:
         return self._limits
 
     def link_frame(self, link: str) -> int:
-        """Frame id of a link (its body frame)."""
+        """Frame id of a link (its body frame), or of the tool placed under its name (model.state.place_tool)."""
+        if self.tool is not None and link == self.tool[0]:
+            return self.tool_frame
         for fid, f in enumerate(self.model.frames):
             if f.name == link and f.type == pin.FrameType.BODY:
                 return fid

@@ -29,11 +29,30 @@ from ..errors import UsageError, quote
 from ._pin import frame_jacobian, joint_axis
 
 __all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints",
-           "leg_ends", "value_for_leg_length"]
+           "leg_ends", "value_for_leg_length", "place_tool"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: The loop-joint types whose coordinate a state reports (one coordinate along or about the axis).
 LOOP_COORDINATE_TYPES = ("revolute", "continuous", "prismatic")
+
+
+def place_tool(mech, name: str, link: str, placement) -> str:
+    """Move the mechanism's output frame (``mech.tool_frame``) onto ``link`` at ``placement`` (a
+    pinocchio.SE3 in the link's frame: a tool, or a named point with the link's orientation), under
+    ``name``: from then on ``mech.link_frame(name)`` is that frame, and every analysis that takes an
+    output link (its pose, twist, frame Jacobian) takes it.  Called once by a command, before the
+    analysis (the frame exists from the start, so every Data made from the model has it)."""
+    if name in mech.spec.links:
+        raise UsageError(f"{mech.path}: the output frame's name {quote(name)} is a link's name; choose another")
+    body = mech.link_frame(link)
+    frame = mech.model.frames[mech.tool_frame]
+    frame.name = name
+    frame.parentJoint = mech.model.frames[body].parentJoint
+    frame.parentFrame = body
+    frame.placement = mech.model.frames[body].placement * placement
+    mech.model.frames[mech.tool_frame] = frame
+    mech.tool = (name, link, placement)
+    return name
 
 
 def loop_coordinate_cuts(mech) -> tuple:

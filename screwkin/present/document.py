@@ -184,7 +184,7 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
 
 
 def motion_section(pres, rates_text: str, length: float) -> Section:
-    """The assembly modes for the inputs: joint values, rates and accelerations, link angles."""
+    """The assembly modes for the inputs: joint values, rates and accelerations, link angles, named points."""
     s = Section("motion", "Positions, velocities and accelerations")
     inputs = ", ".join(f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items())
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
@@ -205,6 +205,13 @@ def motion_section(pres, rates_text: str, length: float) -> Section:
             s.blocks.append(Table(["link", "absolute angle [rad]", "[deg]"],
                                   [[lk, f"{a:.9g}", f"{np.degrees(a):.6g}"] for lk, a in sol.link_angles.items()],
                                   f"link-angles-{k}"))
+        if sol.points:  # named points (--point NAME=LINK:x,y,z), world axes
+            def vec(x):
+                return "" if x is None else "(" + ", ".join(_g(c) for c in x) + ")"
+
+            s.blocks.append(Table(["point", "link", "position [m]", "velocity [m/s]", "acceleration [m/s^2]"],
+                                  [[n, m["link"], vec(m["position"]), vec(m.get("velocity")), vec(m.get("acceleration"))]
+                                   for n, m in sol.points.items()], f"points-{k}"))
         if sol.output_pose is not None:
             p, rpy = sol.output_position, sol.output_rpy
             s.blocks.append(Text(f"output '{pres.output}': position {' '.join(_g(1000 * x) for x in p)} mm, roll pitch "

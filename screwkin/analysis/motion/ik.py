@@ -14,12 +14,15 @@ from .position import PositionResult, PositionSolver, Solution, outside_limits
 __all__ = ["inverse_kinematics"]
 
 
-def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0) -> PositionResult:
+def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
+                       position_only: bool = False) -> PositionResult:
     """Joint values (actuated and passive) that place link ``output`` at ``pose``
-    (a pinocchio.SE3 in the world), for every distinct assembly found.
+    (a pinocchio.SE3 in the world), for every distinct assembly found; with ``position_only``
+    only its frame's origin at the pose's translation (any orientation).  ``output`` may name
+    the tool frame placed by model.state.place_tool (a tool, a named point).
 
-    The target is one more cut joint, a weld between a ground frame at ``pose``
-    and the output link, solved together with the loop closures.  Raises
+    The target is one more cut joint, a weld (a ball joint for ``position_only``) between a
+    ground frame at ``pose`` and the output frame, solved together with the loop closures.  Raises
     AssemblyError (saying how close it got) when the pose is unreachable.
     Solutions are labelled and ordered as those of PositionSolver.solve.
     """
@@ -31,7 +34,8 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
     frame = model.frames[fid]
     frame.placement = pose
     model.frames[fid] = frame
-    target = CutJoint("target", "fixed", 0, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
+    ctype, dof = ("spherical", 3) if position_only else ("fixed", 0)
+    target = CutJoint("target", ctype, dof, fid, out_frame, "world", output, (1.0, 0.0, 0.0))
     # the higher pairs' rows too: without them a gear or cam would be free to slip
     system = ClosureSystem(model, list(mech.cuts) + [target], mech.tolerances, mech.path, extra=mech.extra_rows)
     if not mech.coordinates:
@@ -60,6 +64,6 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0)
                              link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None,
                              leg_lengths=state.leg_lengths or None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
-    return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
+    return PositionResult({"position": pose.translation.tolist()} if position_only else {"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           0, (), output, solver.angular_names(), solver._angular_coupled(),
                           angular_loop_joints(mech))
