@@ -100,3 +100,11 @@ def test_json_writes_infinity_as_a_string_and_refuses_nan():
     assert to_jsonable({"a": [1.0, float("inf"), -np.inf]}) == {"a": [1.0, "inf", "-inf"]}
     with pytest.raises(RuntimeError, match=r"NaN in the JSON output at b\[1\]"):
         to_jsonable({"b": np.array([0.0, np.nan])})
+
+
+def test_a_map_needs_two_different_inputs(wide_five_bar):
+    """The same joint on both axes (it was an IndexError, exit 3) or also held by --set: usage errors."""
+    p = screwkin_cli("map", str(wide_five_bar), "--x", "motor1=0:1:3", "--y", "motor1=0:1:3")
+    assert p.returncode == 2 and "name the same input 'motor1'" in p.stderr
+    p = screwkin_cli("map", str(wide_five_bar), "--x", "motor1=0:1:3", "--y", "motor2=0:1:3", "--set", "motor2=0.1")
+    assert p.returncode == 2 and "given by --x/--y and by --set" in p.stderr
