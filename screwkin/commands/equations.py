@@ -145,7 +145,7 @@ def solve_from_start(mech, args, values) -> int:
     if not args.start:
         raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
     q_ref = mech.generic_configurations()[0].q
-    loops = VectorLoops(mech, q_ref, list(values))
+    loops = VectorLoops(mech, q_ref, list(values), higher=True)
     solver = PositionSolver(mech, list(values))
     q_in = solver.set_inputs(q_ref, values)
     typed = _typed(args.start, "--start")
@@ -171,7 +171,7 @@ def solve_from_start(mech, args, values) -> int:
                                        + (f": {res.stopped}" if res.stopped else ""))
         return 0
     # converged: the configuration it reached, closed and reported as solve reports it
-    q = loops.configuration(res.values)
+    q = loops.configuration({**held, **res.values})
     pres = solver.solve(values, near=mech.joint_values(q), starts=args.starts)
     got = loops.values(pres.solutions[0].q)
     far = [n for n in loops.unknowns
