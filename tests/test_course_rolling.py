@@ -196,3 +196,48 @@ def test_internal_rolling_law_and_velocities(inside, deg):
                    coord(mech, qp, "slide") - coord(mech, qm, "slide")]) / (2 * h)
     A, B = loops.matrices(loops.values(q))
     assert A @ dz == pytest.approx((B @ [1.0]).tolist(), rel=1e-6, abs=1e-9)  # O(h^2) = 1e-8 off
+
+
+PLANETARY = """<?xml version="1.0"?>
+<robot name="planetary">
+  <link name="ground"/>
+  <link name="arm"><inertial><mass value="0.1"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="planet"><inertial><mass value="0.1"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="arm_joint" type="continuous">
+    <parent link="ground"/><child link="arm"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/>
+  </joint>
+  <joint name="planet_joint" type="continuous">
+    <parent link="arm"/><child link="planet"/><origin xyz="0.03 0 0"/><axis xyz="0 0 1"/>
+  </joint>
+  <loop_joint name="ring" type="gear">
+    <link1 link="ground" xyz="0 0 0"/>
+    <link2 link="planet" xyz="0 0 0"/>
+    <axis xyz="0 0 1"/>
+    <gear radius1="0.05" radius2="0.02" contact="internal"/>
+  </loop_joint>
+  <transmission name="t"><joint name="arm_joint"/></transmission>
+</robot>
+"""
+
+
+def test_planet_on_an_arm_inside_a_fixed_ring(tmp_path, capsys):
+    """A planet (pitch radius 0.02) on an arm of 0.03 inside a fixed ring (0.05): the loop fixes the line of centres
+    to the arm, and the law 0.05 (0 - theta_arm) - 0.02 (theta_p - theta_arm) = 0 gives theta_p = -1.5 theta_arm."""
+    path = tmp_path / "planetary.urdf"
+    path.write_text(PLANETARY)
+    mech, q0, loops, solver = built(str(path), ["arm_joint"])
+    res = loops.result()
+    assert res.unknowns == ("theta3",) and res.pairs[0].in_system and res.A_value.shape == (1, 1)
+    for deg in (-70.0, 50.0):
+        q = solved(mech, solver, "arm_joint", np.radians(deg), q0)
+        assert np.abs(loops.residual(loops.values(q))).max() < 1e-10
+        A, B = loops.matrices(loops.values(q))
+        assert A @ [-1.5] == pytest.approx((B @ [1.0]).tolist(), abs=1e-12)
+    # one Newton step by hand: F = 0.05 (0 - t2) - 0.02 (t3 - t2), linear in t3: one step lands on -1.5 t2
+    assert main(["solve", str(path), "--set", "arm_joint=40deg", "--start", "theta3=10deg", "--iterations", "1",
+                 "--json"]) == 0
+    (it,) = json.loads(capsys.readouterr().out)["trace"]
+    t2, t3 = np.radians(40.0), np.radians(10.0)
+    F = 0.05 * (0 - t2) - 0.02 * (t3 - t2)
+    assert it["residual"] == pytest.approx([F], abs=1e-12) and it["jacobian"][0] == pytest.approx([-0.02], abs=1e-15)
+    assert it["values"]["theta3"] == pytest.approx(-1.5 * t2, abs=1e-12)

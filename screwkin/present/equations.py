@@ -70,10 +70,13 @@ def _pairs_text(res) -> list:
         if p.kind == "rack":
             lines.append(f"  u{a}{b} = unit vector of the pitch line (fixed in link {a}), n{a}{b} = u{a}{b} turned +90 deg, "
                          f"x{a}{b} the contact point along it; in the loop: {greek(p.substitution)}")
-        elif p.substitution is not None:
+        elif not p.in_system:
             lines.append(f"  e{a}{b} = unit vector of the line of centres at θ{a}{b}; in the loop: {greek(p.substitution)}")
-        else:
+        elif p.substitution is None:
             lines.append(f"  θ{a}{b} is constant (both centres fixed on one link): the law is the loop's equation")
+        else:
+            lines.append(f"  the rest of the loop turns the line of centres, {greek(p.substitution)}, and fixes the centre "
+                         "distance: the law is the loop's equation")
     return lines
 
 

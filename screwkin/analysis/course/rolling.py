@@ -22,9 +22,10 @@ c_ab (an arc length [m]) is measured at the configuration the equations are buil
 0 where the marks on both pitch circles touch there.  These are the coupling rows
 r1 a1 +- r2 a2 = 0 (x + r2 a2 = 0) of model.closure.CouplingRow written in the links' angles.
 
-When everything else in a pair's loop is fixed (two gears pinned to one frame), the line of
-centres does not turn: theta_ab is a constant, the loop's vector equation holds for every
-motion, and the no-slip law itself is the loop's equation.
+When the rest of a pair's loop fixes the line of centres -- it is constant (two gears pinned to
+one frame), or one link's vector (a planet pinned to an arm: theta_ab is the arm's angle) --
+the loop holds the centre distance as the pair does: its vector equation holds for every
+motion, and the no-slip law with that theta_ab is the loop's equation.
 """
 
 from __future__ import annotations
@@ -181,7 +182,7 @@ def virtual_coordinates(loops, q, values, before):
             q[j1.idx_q] = loops.q[j1.idx_q] + delta(rec["x_expr"])
             q[j2.idx_q] = loops.q[j2.idx_q] - s * (d_u - d_b)
         else:
-            d_k = 0.0 if rec.get("fixed") else delta(rec["expr"])
+            d_k = delta(rec["fixed"] if rec.get("fixed") is not None else rec["expr"])
             q[j1.idx_q] = loops.q[j1.idx_q] + s * (d_k - d_a)
             q[j2.idx_q] = loops.q[j2.idx_q] - s * (d_k - d_b)
     return q
@@ -229,37 +230,59 @@ def turns_through_pairs(loops, q, values):
     return out
 
 
-def substitute_pairs(loops, number, rows, crossed):
-    """The loop's rows with each rolling pair's line-of-centres angle replaced: by its no-slip
-    expression in the links' angles; or, where nothing else in the loop moves (two gears
-    pinned to one link), by its constant value, the vector rows (identities then) replaced
-    by the no-slip law."""
+def _line_of_centres(loops, rows, hold, rec):
+    """The angle of the pair's line of centres as the rest of its loop fixes it, or None: where
+    the rest is constant (two gears pinned to one link) or one link's vector (a planet's arm),
+    the loop fixes the centre distance as the pair does and theta_ab follows the rest alone."""
     sp = loops.sp
     variables = {loops.sym[n] for n in loops.variables}
-    holds = {h for _, h, _ in crossed if h is not None}
-    fixed = len(crossed) == 1 and holds and not any(r.free_symbols & variables for r in rows)
+    values = {**loops.constants_now(), **{loops.sym[n]: loops.symbol_info[n].value for n in loops.variables}}
+    kx = rows[0].coeff(sp.cos(hold))
+    rx, ry = sp.expand(rows[0].subs(sp.cos(hold), 0)), sp.expand(rows[1].subs(sp.sin(hold), 0))
+    if not (rx.free_symbols | ry.free_symbols) & variables:
+        return loops._constant_angle(str(rec["tk"]), rec["a"], rec["tk_q"],
+                                     f"constant angle of the line of centres of '{rec['name']}'")
+    terms = sp.Add.make_args(rx)
+    cosines = [f for f in sp.Mul.make_args(terms[0]) if isinstance(f, sp.cos)] if len(terms) == 1 else []
+    if len(cosines) != 1:
+        return None
+    phi = cosines[0].args[0]
+    k = sp.simplify(rx / sp.cos(phi))
+    if k.free_symbols & variables or sp.simplify(ry - k * sp.sin(phi)) != 0:
+        return None
+    # sign R e(theta_ab) + k e(phi) = 0: theta_ab = phi (opposite signs) or phi + pi, within whole turns of the angle
+    # measured (so that the offset of the law stays the one measured)
+    flip = 0 if float(kx.subs(values)) * float(k.subs(values)) < 0 else sp.pi
+    here = float((phi + flip).subs(values))
+    return phi + flip + 2 * sp.pi * int(np.round((rec["tk_q"] - here) / (2 * np.pi)))
+
+
+def substitute_pairs(loops, number, rows, crossed):
+    """The loop's rows with each rolling pair's line-of-centres angle replaced: by its no-slip
+    expression in the links' angles; or, where the rest of the loop fixes the line of centres
+    (two gears pinned to one link, a planet on an arm: screwkin.analysis.course.rolling), by
+    that, the vector rows (identities then) replaced by the no-slip law."""
+    holds = [h for _, h, _ in crossed if h is not None]
+    tk = _line_of_centres(loops, rows, holds[0], crossed[0][0]) if len(crossed) == 1 and holds else None
     out = []
     for rec, hold, pair in crossed:
         if hold is None:
             loops.pairs.append(pair)
             continue
-        if fixed:
-            tk = loops._constant_angle(str(rec["tk"]), rec["a"], rec["tk_q"],
-                                      f"constant angle of the line of centres of '{rec['name']}'")
-            rec["fixed"] = True
-            rows = [r.subs(hold, tk) for r in rows]
-            law = rec["law_expr"].subs(rec["tk"], tk)
-            out.append(law)
-            loops.pairs.append(RollingPair(pair.name, pair.kind, pair.links, pair.law, None, True))
-            loops.pair_notes.append(f"loop {number}: nothing but the pair '{rec['name']}' moves in it, its line of "
-                                   f"centres {rec['tk']} is fixed and its vector equation holds for every motion: "
-                                   "the no-slip law is the loop's equation")
+        if tk is not None:
+            rec["fixed"] = tk
+            out.append(rec["law_expr"].subs(rec["tk"], tk))
+            loops.pairs.append(RollingPair(pair.name, pair.kind, pair.links, pair.law,
+                                           None if not tk.free_symbols - set(loops.constants_now()) else
+                                           f"{rec['tk']} = {tk}", True))
+            loops.pair_notes.append(f"loop {number}: the rest of the loop fixes the line of centres of the pair "
+                                    f"'{rec['name']}' ({rec['tk']} = {tk}) and its centre distance, as the pair does: "
+                                    "its vector equation holds for every motion and the no-slip law is the loop's "
+                                    "equation")
         else:
             rows = [r.subs(hold, rec["expr"]) for r in rows]
             loops.pairs.append(pair)
-    if fixed:
-        return out
-    return rows
+    return out if tk is not None else rows
 
 
 def unwrapped(loops, link, angle, q):

@@ -195,6 +195,10 @@ class VectorLoops:
         """An exact multiple of pi/2 (sympy) when ``value`` [rad] is one, else None."""
         return _exact_angle(self.sp, value, self.mech.tolerances.closure)
 
+    def constants_now(self) -> dict:
+        """The constant symbols made so far -> their values (the loops are still being built)."""
+        return {self.sym[n]: s.value for n, s in self.symbol_info.items() if s.role == "constant"}
+
     def _p2(self, v):
         v = np.asarray(v, float)
         return np.array([v @ self.e1, v @ self.e2])
