@@ -241,3 +241,18 @@ def test_planet_on_an_arm_inside_a_fixed_ring(tmp_path, capsys):
     F = 0.05 * (0 - t2) - 0.02 * (t3 - t2)
     assert it["residual"] == pytest.approx([F], abs=1e-12) and it["jacobian"][0] == pytest.approx([-0.02], abs=1e-15)
     assert it["values"]["theta3"] == pytest.approx(-1.5 * t2, abs=1e-12)
+
+
+def test_acceleration_terms_match_second_differences_of_solutions(wheels):
+    """A z'' = B w'' + c with the crank turning uniformly (w' = 1, w'' = 0): z'' from second central differences
+    of screwkin's solutions (h = 0.01 rad: its solutions close to ~1e-11 m, O(h^2) ~ 1e-4 relative)."""
+    mech, q0, loops, solver = wheels
+    t, h = np.radians(20.0), 1e-2
+    qs = [solved(mech, solver, "wheel2_joint", v, q0) for v in (t - h, t, t + h)]
+    z = np.array([[coord(mech, q, "wheel3_joint"), coord(mech, q, "slide")] for q in qs])
+    zd, zdd = (z[2] - z[0]) / (2 * h), (z[2] - 2 * z[1] + z[0]) / h ** 2
+    values = loops.values(qs[1])
+    A, _ = loops.matrices(values)
+    c = loops.acceleration_terms(values, np.linalg.solve(A, loops.matrices(values)[1] @ [1.0]), [1.0])
+    assert A @ zdd == pytest.approx(c.tolist(), rel=1e-3, abs=1e-7)
+    assert np.linalg.solve(A, loops.matrices(values)[1] @ [1.0]) == pytest.approx(zd.tolist(), rel=1e-3)
