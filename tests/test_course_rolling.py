@@ -256,3 +256,11 @@ def test_acceleration_terms_match_second_differences_of_solutions(wheels):
     c = loops.acceleration_terms(values, np.linalg.solve(A, loops.matrices(values)[1] @ [1.0]), [1.0])
     assert A @ zdd == pytest.approx(c.tolist(), rel=1e-3, abs=1e-7)
     assert np.linalg.solve(A, loops.matrices(values)[1] @ [1.0]) == pytest.approx(zd.tolist(), rel=1e-3)
+
+
+def test_newton_on_the_rack_beyond_a_turn_reports_the_rack_where_the_law_puts_it(capsys):
+    assert main(["solve", RACK, "--set", "pinion_joint=400deg", "--start", "x3=0.1", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    # x3 from the pinion's centre to the rack's joint (drawn at 0.15 along -x): 0.15 + 0.04 t; the rack joint -0.04 t
+    assert d["newton"]["values"]["x3"] == pytest.approx(0.15 + 0.04 * np.radians(400.0), abs=1e-12)
+    assert d["solutions"][0]["joints"]["rack_joint"] == pytest.approx(-0.04 * np.radians(400.0), abs=1e-10)
