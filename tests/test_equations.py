@@ -304,10 +304,10 @@ def test_spatial_mechanisms_get_the_structure_equations(capsys):
 @pytest.mark.parametrize("robot,code,words", [
     ("cam_followers", 1, "is a contact pair"),
     ("quick_return_slot", 1, "is a contact pair"),
-    ("gear_train_idler", 1, "is a gear pair"),
     ("gripper_arm_mimic", 1, "<mimic>"),
 ])
 def test_planar_mechanisms_beyond_the_vector_loops_are_one_line_errors(capsys, robot, code, words):
+    # rolling and gear pairs are taken now: tests/test_course_rolling.py
     got, out, err = run_cli(["equations", str(ROBOTS / f"{robot}.urdf")], capsys)
     assert got == code and words in err and err.count("\n") == 1
 

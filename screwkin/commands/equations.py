@@ -5,6 +5,7 @@ equations from a person's estimates, iteration by iteration."""
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 
@@ -138,6 +139,18 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
     return start, units
 
 
+def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
+    """solve's configuration near q (Newton's root), the loop symbols there, and the unknowns
+    in which it differs from Newton's root."""
+    near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}
+    pres = solver.solve(values, near=near, starts=starts)
+    got = loops.values(pres.solutions[0].q)
+    far = [n for n in loops.unknowns
+           if abs(np.angle(np.exp(1j * (got[n] - res.values[n]))) if loops.symbol_info[n].kind == "angle"
+                  else got[n] - res.values[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
+    return pres, got, far
+
+
 def solve_from_start(mech, args, values) -> int:
     """``solve --start ...``: Newton on the loop equations from the estimates typed."""
     if args.iterations is not None and args.iterations < 1:
@@ -145,7 +158,7 @@ def solve_from_start(mech, args, values) -> int:
     if not args.start:
         raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
     q_ref = mech.generic_configurations()[0].q
-    loops = VectorLoops(mech, q_ref, list(values))
+    loops = VectorLoops(mech, q_ref, list(values), higher=True)
     solver = PositionSolver(mech, list(values))
     q_in = solver.set_inputs(q_ref, values)
     typed = _typed(args.start, "--start")
@@ -171,12 +184,19 @@ def solve_from_start(mech, args, values) -> int:
                                        + (f": {res.stopped}" if res.stopped else ""))
         return 0
     # converged: the configuration it reached, closed and reported as solve reports it
-    q = loops.configuration(res.values)
-    pres = solver.solve(values, near=mech.joint_values(q), starts=args.starts)
-    got = loops.values(pres.solutions[0].q)
-    far = [n for n in loops.unknowns
-           if abs(np.angle(np.exp(1j * (got[n] - res.values[n]))) if loops.symbol_info[n].kind == "angle"
-                  else got[n] - res.values[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
+    q = loops.configuration({**held, **res.values})
+    pres, got, far = _solved_near(mech, loops, solver, values, q, res, args.starts)
+    if far and loops.pairs:  # the solver turns a pair's virtual joints on by the input's whole turns: near without them
+        virtual = {n for names in mech.virtual_joints.values() for n in names}
+        print(f"note: solve's configuration near Newton's root differs in {', '.join(far)}; solved again near it "
+              "without the rolling pairs' virtual joints", file=sys.stderr)
+        pres, got, far = _solved_near(mech, loops, solver, values, q, res, args.starts, skip=virtual)
+    if far and loops.pairs:  # solve placed the gears otherwise (its count of a pair's turns): say so, no table
+        raise AssemblyError(mech.path, res.residual, len(res.steps),
+                            detail="Newton's root closes the loop equations (" + ", ".join(
+                                f"{n} = {res.values[n]:.6g}" for n in far) + ") but solve's configuration at these "
+                            "inputs has " + ", ".join(f"{n} = {got[n]:.6g}" for n in far) + ": it counts a rolling "
+                            "pair's turns otherwise (give --iterations K to see Newton's steps alone)")
     if far:  # pragma: no cover - the polished configuration left Newton's root
         raise AssemblyError(mech.path, res.residual, len(res.steps),
                             detail=f"the configuration of Newton's root does not close as solved ({', '.join(far)})")

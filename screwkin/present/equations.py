@@ -14,7 +14,7 @@ from .tables import shown
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
 
-_GREEK = (("theta", "θ"), ("alpha", "α"), ("beta", "β"))
+_GREEK = (("theta", "θ"), ("alpha", "α"), ("beta", "β"), ("rho", "ρ"))
 
 
 def greek(text: str) -> str:
@@ -56,6 +56,30 @@ def _vector_equation(terms):
     return (out or "0") + " = 0"
 
 
+def _pair_vectors(res) -> set:
+    """The unit vectors named in the loops' terms by rolling and gear pairs (u32 of a rack's pitch line)."""
+    return {f"u{res.numbers[p.links[0]]}{res.numbers[p.links[1]]}" for p in res.pairs if p.kind == "rack"}
+
+
+def _pairs_text(res) -> list:
+    lines = []
+    for p in res.pairs:
+        a, b = (res.numbers[lk] for lk in p.links)
+        lines.append(f"{'rack-and-pinion' if p.kind == 'rack' else p.kind + ' rolling'} pair '{p.name}' "
+                     f"({p.links[0]} {a}, {p.links[1]} {b}): no slip {greek(p.law)}")
+        if p.kind == "rack":
+            lines.append(f"  u{a}{b} = unit vector of the pitch line (fixed in link {a}), n{a}{b} = u{a}{b} turned +90 deg, "
+                         f"x{a}{b} the contact point along it; in the loop: {greek(p.substitution)}")
+        elif not p.in_system:
+            lines.append(f"  e{a}{b} = unit vector of the line of centres at θ{a}{b}; in the loop: {greek(p.substitution)}")
+        elif p.substitution is None:
+            lines.append(f"  θ{a}{b} is constant (both centres fixed on one link): the law is the loop's equation")
+        else:
+            lines.append(f"  the rest of the loop turns the line of centres, {greek(p.substitution)}, and fixes the centre "
+                         "distance: the law is the loop's equation")
+    return lines
+
+
 def equations_dict(res) -> dict:
     if not isinstance(res, PlanarEquations):
         return {"file": res.path, "motion_space": res.motion_space, "chains": screws_dict(res.chains),
@@ -91,6 +115,9 @@ def equations_dict(res) -> dict:
         "at_configuration": {"A": res.A_value.tolist(), "B": res.B_value.tolist(), "det_A": res.det_A_value,
                              "unknown_rates_per_input_rate": None if res.rates is None else res.rates.tolist()},
         "notes": list(res.notes),
+        **({"pairs": [{"name": p.name, "kind": p.kind, "links": list(p.links), "no_slip": p.law,
+                       "substitution": p.substitution, "in_equations": p.in_system} for p in res.pairs]}
+           if res.pairs else {}),
     }
 
 
@@ -110,15 +137,19 @@ def equations_text(res) -> str:
             for n, s in res.symbols.items()]
     lines.append(table(["symbol", "link", "kind", "value", "role", "meaning"], rows))
     lines.append("vectors: " + "; ".join(f"{v.name} = {greek(v.length)} at {greek(v.angle)}" for v in res.vectors))
-    slides = sorted({t.lstrip("-").split("*")[1] for lp in res.loops for t in lp.terms if "*u" in t})
+    slides = sorted({t.lstrip("-").split("*")[1] for lp in res.loops for t in lp.terms if "*u" in t} - _pair_vectors(res))
     if slides:
         lines.append("guides: " + "; ".join(f"{u} = unit vector of the guide of x{u[1:]}, n{u[1:]} = {u} turned +90 deg"
                                            for u in slides))
+    lines += _pairs_text(res)
     for k, lp in enumerate(res.loops, 1):
         lines.append(f"\nloop {k}: {' -> '.join(lp.links)} -> {lp.links[0]}  (joints {', '.join(lp.joints)})")
         lines.append(f"  {greek(_vector_equation(lp.terms))}")
-        lines.append(f"  x: {greek(lp.equations[0])} = 0")
-        lines.append(f"  y: {greek(lp.equations[1])} = 0")
+        if len(lp.equations) == 2:
+            lines.append(f"  x: {greek(lp.equations[0])} = 0")
+            lines.append(f"  y: {greek(lp.equations[1])} = 0")
+        else:  # a pair's no-slip law stands for the loop (screwkin.analysis.course.rolling)
+            lines += [f"  no slip: {greek(e)} = 0" for e in lp.equations]
     known = [n for n, s in res.symbols.items() if s.role == "constant"]
     lines.append("")
     lines.append(f"known: {', '.join(greek(n) for n in known)} (constants); "

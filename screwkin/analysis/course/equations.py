@@ -64,9 +64,10 @@ def _spatial(mech, q, inputs, output) -> SpatialEquations:
 
 def equations(mech, q, inputs=None, output=None):
     """The equations at the assembled configuration q: :class:`PlanarEquations` for planar
-    mechanisms of revolute and prismatic joints, :class:`SpatialEquations` for spatial and
+    mechanisms of revolute and prismatic joints, rolling and gear pairs (the no-slip law
+    substituted: screwkin.analysis.course.rolling), :class:`SpatialEquations` for spatial and
     spherical ones."""
     topo = mech.topology(q)
     if topo.motion_space != "planar":
         return _spatial(mech, q, list(inputs) if inputs else list(mech.actuated), output)
-    return VectorLoops(mech, q, inputs).result()
+    return VectorLoops(mech, q, inputs, higher=True).result()

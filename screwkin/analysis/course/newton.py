@@ -61,8 +61,10 @@ def newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> N
             break
         A, _ = loops.matrices(values)
         if A.shape[0] != A.shape[1]:
+            held = (" (or a rolling pair's centre distance is held by its loop as well, in a way the loop "
+                    "equations do not reduce)") if getattr(loops, "pairs", None) and A.shape[0] > A.shape[1] else ""
             raise UsageError(f"{mech.path}: {A.shape[0]} equations in {A.shape[1]} unknowns: Newton needs as many "
-                             "inputs as the mechanism has degrees of freedom")
+                             f"inputs as the mechanism has degrees of freedom{held}")
         s = np.linalg.svd(A, compute_uv=False)
         if not np.all(np.isfinite(A)) or s[-1] <= mech.tolerances.zero * max(s[0], TINY):
             stopped = f"the Jacobian is singular at iteration {it} (det A = {np.linalg.det(A):.3g})"

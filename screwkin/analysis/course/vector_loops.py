@@ -1,4 +1,5 @@
-"""The vector-loop equations of a planar mechanism of revolute and prismatic joints, in
+"""The vector-loop equations of a planar mechanism of revolute and prismatic joints (and, with
+``higher=True``, rolling, gear and rack-and-pinion pairs: screwkin.analysis.course.rolling), in
 symbols (sympy): the course solution's planar method (screwkin.analysis.course.equations).
 
 - Links are numbered as a textbook does and as ``screwkin draw`` numbers them
@@ -49,13 +50,15 @@ import pinocchio as pin
 from ...errors import MechanismFileError, UsageError
 from .cycles import fundamental_cycles
 from .det_conditions import SIMPLIFY_OPS, determinant
+from .placing import LOWER, configuration
+from .placing import wrap as _wrap
+from .rolling import (HIGHER, drop_constant_rows, measure_pairs, pair_term, substitute_pairs, turns_through_pairs,
+                      unwrapped, virtual_coordinates)
 from ..motion.planar import LinkAngles
 from .skeleton import numbering
 
 __all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations", "VectorLoops", "LOWER", "SIMPLIFY_OPS"]
 
-#: The joints the vector-loop equations take.
-LOWER = ("revolute", "continuous", "prismatic")
 _SUFFIX = "abcdefghijklmnopqrstuvwxyz"
 
 
@@ -119,14 +122,11 @@ class PlanarEquations:
     det_A_value: float | None
     rates: np.ndarray | None  # A^-1 B: unknown rates per unit input rate (columns: inputs); None when A is singular
     notes: tuple
+    pairs: tuple = ()  # RollingPair: the no-slip laws of rolling and gear pairs
 
 
 #: Guard: the characteristic length taken at least this [m] where a length is compared with it.
 LENGTH_FLOOR = 1e-9
-
-
-def _wrap(a):
-    return float(np.mod(a + np.pi, 2 * np.pi) - np.pi)
 
 
 def _exact_angle(sp, value, tol):
@@ -144,7 +144,8 @@ class VectorLoops:
     joints.  Holds the sympy expressions and their numerical forms; ``result()`` gives the
     plain :class:`PlanarEquations`."""
 
-    def __init__(self, mech, q, inputs=None):
+    def __init__(self, mech, q, inputs=None, higher=False):
+        """``higher``: take rolling and gear pairs (screwkin.analysis.course.rolling) too."""
         import sympy as sp
 
         self.sp = sp
@@ -152,11 +153,13 @@ class VectorLoops:
         self.q = np.array(q, float)
         topo = mech.topology(q)
         self.topo = topo
+        self.tree = {j.name: j for j in topo.joints if not j.cut}
         path = mech.path
         if topo.motion_space != "planar":
             raise UsageError(f"{path}: the vector-loop equations are for planar mechanisms; this one is "
                              f"{topo.motion_space}")
-        other = [j for j in topo.joints if j.type not in LOWER]
+        self.higher = bool(higher)
+        other = [j for j in topo.joints if j.type not in LOWER and not (self.higher and j.type in HIGHER)]
         if other:
             j = other[0]
             raise MechanismFileError(path, f"the vector-loop equations take revolute and prismatic joints; "
@@ -184,6 +187,18 @@ class VectorLoops:
         self._build_matrices()
 
     # ------------------------------------------------------------------ geometry
+    @staticmethod
+    def wrap(a):
+        return _wrap(a)
+
+    def exact_angle(self, value):
+        """An exact multiple of pi/2 (sympy) when ``value`` [rad] is one, else None."""
+        return _exact_angle(self.sp, value, self.mech.tolerances.closure)
+
+    def constants_now(self) -> dict:
+        """The constant symbols made so far -> their values (the loops are still being built)."""
+        return {self.sym[n]: s.value for n, s in self.symbol_info.items() if s.role == "constant"}
+
     def _p2(self, v):
         v = np.asarray(v, float)
         return np.array([v @ self.e1, v @ self.e2])
@@ -235,6 +250,8 @@ class VectorLoops:
             self.anchor[key] = self._p2(point)
             self.local[key] = (fid, data.oMf[fid].actInv(np.asarray(point, float)))
 
+        self.keep = keep
+
         for j in topo.joints:
             if j.type in ("revolute", "continuous"):
                 for lk in j.links:
@@ -260,6 +277,7 @@ class VectorLoops:
             self.slides[j.name] = {"guide": g, "slider": s, "u": u, "x": float(d @ u), "e": float(d @ nrm),
                                    "u_local": u_local, "from": ja.name if ja is not None else j.name,
                                    "to": jb.name if jb is not None else j.name}
+        self.pair_geometry = measure_pairs(self, data)  # rolling and gear pairs: their centres, radii
 
     # ------------------------------------------------------------------ symbols
     def _new_symbol(self, name, link, kind, value, role, meaning):
@@ -389,12 +407,14 @@ class VectorLoops:
     def _build_loops(self):
         sp = self.sp
         self.symbol_info, self.sym, self.variables = {}, {}, []
-        self.vec, self.slide_terms, self.used_r, self.used_x = {}, {}, {}, {}
+        self.vec, self.slide_terms, self.used_r, self.used_x, self.used_rho = {}, {}, {}, {}, {}
         self.loops, self.F = [], []
+        self.pairs, self.pair_notes = [], []
         self.loop_twists = []  # per loop: [(joint, (vx, vy, w))] planar twists, the loop's first joint at 0
         for links, joints in fundamental_cycles(self.topo):
             m = len(links)
             terms, fx, fy = [], sp.Integer(0), sp.Integer(0)
+            crossed = []  # (pair record, placeholder symbol) of the rolling pairs crossed
             twists = [] if joints[-1].type == "prismatic" else [(joints[-1].name, (0, 0, 1))]
             for i in range(m):
                 link, j_in, j_out = links[i], joints[i - 1], joints[i]
@@ -404,7 +424,16 @@ class VectorLoops:
                     terms.append(("" if sign > 0 else "-") + v["name"])
                     fx += sign * v["length"] * sp.cos(v["angle"])
                     fy += sign * v["length"] * sp.sin(v["angle"])
-                if j_out.type == "prismatic":  # crossing it from links[i] to links[i + 1]
+                if j_out.type in HIGHER:  # a rolling or gear pair: its no-slip law (analysis.course.rolling)
+                    rec = self.pair_geometry[j_out.name]
+                    hold = sp.Dummy(f"k_{j_out.name}") if rec["kind"] != "rack" else None
+                    px, py, names, pair = pair_term(self, rec, hold)
+                    sign = 1 if rec["a"] == link else -1
+                    fx += sign * px
+                    fy += sign * py
+                    terms += [(("" if sign > 0 else "-") + t).replace("--", "") for t in names]
+                    crossed.append((rec, hold, pair))
+                elif j_out.type == "prismatic":  # crossing it from links[i] to links[i + 1]
                     t = self._slide(j_out.name)
                     sign = 1 if self.slides[j_out.name]["guide"] == link else -1
                     c, s = sp.cos(t["angle"]), sp.sin(t["angle"])
@@ -417,10 +446,13 @@ class VectorLoops:
                         terms.append(f"{pre}e{t['name']}*n{t['name']}")
                 elif i < m - 1:  # a revolute at (fx, fy) from the loop's first joint: (y, -x, 1)
                     twists.append((j_out.name, (fy, -fx, 1)))
+            rows = [fx, fy]
+            if crossed:
+                rows = substitute_pairs(self, len(self.loops) + 1, rows, crossed)
             self.loops.append(LoopEquation(tuple(links), tuple(j.name for j in joints), tuple(terms),
-                                           (str(fx), str(fy))))
+                                           tuple(str(r) for r in rows)))
             self.loop_twists.append(twists)
-            self.F += [fx, fy]
+            self.F += rows
 
     def _build_inputs(self):
         """The symbol each input joint sets, and d symbol / d joint value."""
@@ -460,6 +492,8 @@ class VectorLoops:
 
     def _build_matrices(self):
         sp = self.sp
+        if self.pairs:
+            drop_constant_rows(self)
         F = sp.Matrix(self.F)
         z = [self.sym[n] for n in self.unknowns]
         w = [self.sym[n] for n in self.input_syms]
@@ -497,7 +531,9 @@ class VectorLoops:
         for n in self.variables:
             info = self.symbol_info[n]
             if info.kind == "angle":
-                out[n] = th[info.link]
+                out[n] = th[info.link] if not self.pairs else unwrapped(self, info.link, th[info.link], q)
+        if self.pairs:  # a link turned through a pair: its turns counted by the pair's virtual joints
+            out = turns_through_pairs(self, q, out)
         for joint, t in self.slide_terms.items():
             sl = self.slides[joint]
             g, s = sl["guide"], sl["slider"]
@@ -560,47 +596,10 @@ class VectorLoops:
             tuple(tuple(str(e) for e in self.Am.row(i)) for i in range(self.Am.shape[0])),
             tuple(tuple(str(e) for e in self.Bm.row(i)) for i in range(self.Bm.shape[0])),
             tuple(str(e) for e in self.cm), None if d is None else str(d), conds, words, A, B, det_value, rates,
-            tuple(notes))
+            tuple(notes + self.pair_notes), tuple(self.pairs))
 
     # ------------------------------------------------------------------ configurations
     def configuration(self, values: dict) -> np.ndarray:
-        """A joint configuration whose link angles and slider coordinates are ``values``: each
-        tree joint's value from the relative angle (revolute) or the slider coordinate
-        (prismatic) it carries, calibrated at the configuration the equations were built at.
-        The loops close there when ``values`` solve the equations."""
-        mech, q0 = self.mech, self.q
-        v0 = self.values(q0)
-        theta0 = self.theta_q
-        q = np.array(q0, float)
-        slide_of = {j: t["x"].name for j, t in self.slide_terms.items()}
-
-        def angle(link, vals, th):
-            r = self.rep[link]
-            name = f"theta{self.numbers[r]}"
-            if r == self.topo.ground or name not in vals:
-                return th[link]
-            return vals[name] + _wrap(th[link] - th[r])
-
-        for j in self.topo.joints:
-            if j.cut or j.type not in LOWER:
-                continue
-            c = mech.coordinate(j.name)
-            if j.type == "prismatic":
-                name = slide_of.get(j.name)
-                if name is None or name not in values:
-                    continue
-                sigma = float(np.sign(self._p2(j.direction) @ self.slides[j.name]["u"]))
-                delta = sigma * (values[name] - v0[name])
-                q[c.idx_q] = q0[c.idx_q] + delta
-                continue
-            parent, child = j.links
-            sign = float(np.sign(np.asarray(j.direction) @ self.n))
-            rel0 = angle(child, v0, theta0) - angle(parent, v0, theta0)
-            rel = angle(child, values, theta0) - angle(parent, values, theta0)
-            delta = sign * _wrap(rel - rel0)
-            if c.nq == 2:
-                a = float(np.arctan2(q0[c.idx_q + 1], q0[c.idx_q])) + delta
-                q[c.idx_q:c.idx_q + 2] = (np.cos(a), np.sin(a))
-            else:
-                q[c.idx_q] = q0[c.idx_q] + delta
-        return q
+        """A joint configuration whose link angles and slider coordinates are ``values``
+        (screwkin.analysis.course.placing)."""
+        return configuration(self, values)
