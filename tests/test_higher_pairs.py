@@ -2,6 +2,7 @@
 textbook counts, closed forms written here, and finite differences on the manifold."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -241,3 +242,19 @@ def test_a_gear_train_counts_turns(deg, capsys):
     at_zero = 0.0  # the file's output at input 0 (the gears are drawn at zero)
     expected = at_zero + deg * 0.05 / 0.08
     assert np.mod(out - expected + 180, 360) - 180 == pytest.approx(0, abs=1e-7)
+
+
+@pytest.mark.parametrize("deg", [100, 160, -160, 200, 390, -150, -400, 720])
+def test_gear_train_output_is_the_ratio_times_the_input(deg):
+    """Input 0.05 m, idler 0.03 m, output 0.08 m: output = (r1 / r3) input = 0.625 input, the idler reversing
+    twice, whatever the input (within a turn or beyond).  At 160 deg solve gave 35 deg (the idler's two meshes
+    counted its turn differently: no start reached the counted angles of the motion from the file's drawing)."""
+    import math
+
+    m = screwkin.load(Path(__file__).resolve().parents[1] / "robots" / "gear_train_idler.urdf")
+    res = screwkin.PositionSolver(m).solve({"input_joint": math.radians(deg)})
+    (sol,) = res.solutions
+    out = math.degrees(sol.joints["output_joint"])
+    want = 0.625 * deg
+    assert abs((out - want + 180.0) % 360.0 - 180.0) < 1e-6
+    assert math.degrees(sol.joints["mesh2.a2"]) == pytest.approx(want, abs=1e-6)  # the counted angle: every turn

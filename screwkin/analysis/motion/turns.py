@@ -48,7 +48,19 @@ def engaged(solver, found, values):
     pred = np.array([ref[t] for t in counted]) + qd[vidx]
     off = [float(np.max(np.abs(np.array([q[t] for t in counted]) - pred))) for _, q, _ in found]
     kept = [f for f, d in zip(found, off) if d < np.pi]
-    return kept or [found[int(np.argmin(off))]]
+    if kept:
+        return kept
+    # no start reached the counted angles the motion from the file's configuration gives (a start lies
+    # within a turn of each, the motion may not: an idler's two meshes count its turn each on its own):
+    # Newton from that motion's linear prediction (exact for gears and screws on fixed centres)
+    q_pred = solver.set_inputs(pin.integrate(solver.model, ref, qd), values)
+    try:
+        a = solver.mech.closure.solve(q_pred, frozen=solver.frozen)
+    except AssemblyError:
+        return [found[int(np.argmin(off))]]
+    if float(np.max(np.abs(np.array([a.q[t] for t in counted]) - pred))) < np.pi:
+        return [(solver._signature(a.q), a.q, a)]
+    return [found[int(np.argmin(off))]]
 
 
 def turn_on(solver, q, whole: dict, typed: dict):
