@@ -20,7 +20,7 @@ from ...errors import UsageError
 from .singular import Generic, measures
 from ..motion.sweep import Neighbour
 
-__all__ = ["SingularityMap", "singularity_map"]
+__all__ = ["SingularityMap", "singularity_map", "seams"]
 
 
 @dataclass(frozen=True)
@@ -34,6 +34,7 @@ class SingularityMap:
     q: np.ndarray  # (len(ys), len(xs), nq) configurations (NaN off the branch)
     reached: np.ndarray | None = None  # (len(ys), len(xs)) bool: the cell lies on the mapped branch
     notes: tuple = ()  # what the continuation could not reach, in words
+    seams: np.ndarray | None = None  # (k, 4) int: j, i, j2, i2 of neighbouring reached cells on different sheets
 
     @property
     def off_branch(self) -> int:
@@ -74,7 +75,30 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
         kind = min(m, key=m.get)
         logs[j, i] = np.log10(max(m[kind], 1e-16))
         kinds[j, i] = kind
+    seam = seams(mech, qs, reached)
     off = int(reached.size - reached.sum())
     notes = (f"{off} of {reached.size} points are not reached from the first one by continuation on its "
              "assembly mode (another mode, past a limit position, or not assembled): left blank",) if off else ()
-    return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes)
+    if len(seam):
+        notes += (f"{len(seam)} pairs of neighbouring points lie on different sheets of the mode (their "
+                  f"configurations differ by more than {mech.tolerances.near_far:g} rad: continuation went "
+                  "round a singular point on both sides): a seam between them",)
+    return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
+
+
+def seams(mech, qs, reached) -> np.ndarray:
+    """Neighbouring reached cells (one input step apart) whose configurations differ by more than
+    Tolerances.near_far (rad; lengths over the characteristic length): the map's mode is one sheet
+    of the solutions only up to these seams (continuation round a singular point can come back on
+    another sheet).  (k, 4) int rows j, i, j2, i2."""
+    out = []
+    for dj, di in ((0, 1), (1, 0)):
+        for j, i in zip(*np.nonzero(reached)):
+            jn, in_ = j + dj, i + di
+            if jn >= reached.shape[0] or in_ >= reached.shape[1] or not reached[jn, in_]:
+                continue
+            d = mech.difference(qs[j, i], qs[jn, in_])
+            d[mech.translational] /= mech.length
+            if np.linalg.norm(d) > mech.tolerances.near_far:
+                out.append((j, i, jn, in_))
+    return np.array(out, int).reshape(-1, 4)

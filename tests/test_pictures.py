@@ -1,0 +1,77 @@
+"""The pictures a newcomer found weak (issue 27 item 5): titles, axes in the units typed, blank
+cells off the mapped mode drawn as a hatched region with a legend entry of their own."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import screwkin
+from screwkin.analysis.singularities.maps import singularity_map
+
+from conftest import screwkin_cli
+
+pytest.importorskip("matplotlib")
+ROBOTS = Path(__file__).resolve().parents[1] / "robots"
+
+
+@pytest.fixture(scope="module")
+def wide_five_bar(tmp_path_factory):
+    """robots/five_bar.urdf with its motors 0.3 m apart: most of the grid cannot be assembled."""
+    text = (ROBOTS / "five_bar.urdf").read_text()
+    assert text.count('<origin xyz="0.1 0 0" rpy="0 0 0"/>') == 1
+    path = tmp_path_factory.mktemp("pictures") / "five_bar_wide.urdf"
+    path.write_text(text.replace('<origin xyz="0.1 0 0" rpy="0 0 0"/>', '<origin xyz="0.3 0 0" rpy="0 0 0"/>'))
+    return path
+
+
+def test_map_png_is_titled_in_the_typed_units(wide_five_bar, tmp_path):
+    from PIL import Image
+
+    out = tmp_path / "map.png"
+    p = screwkin_cli("map", str(wide_five_bar), "--x", "motor1=-180deg:180deg:13",
+                     "--y", "motor2=-3.14159:-2.5:5", "--png", str(out))
+    assert p.returncode == 0, p.stderr
+    info = Image.open(out).info
+    title = info["Title"]
+    assert info["Description"] == "x: motor1 [deg]; y: motor2 [rad]"  # a bare angle is in radians
+    assert "five_bar" in title and "motor1" in title and "motor2" in title
+
+
+def test_map_figure_axes_legend_and_masked_cells(wide_five_bar):
+    import matplotlib.pyplot as plt
+
+    from screwkin.present.plots import map_figure
+
+    mech = screwkin.load(wide_five_bar)
+    xs = np.linspace(-np.pi, np.pi, 13)
+    res = singularity_map(screwkin.PositionSolver(mech), "motor1", xs, "motor2", xs)
+    assert (~res.reached).any() and res.reached.any()
+    fig = map_figure(res, "deg", "deg", title="t")
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "motor1 [deg]" and ax.get_ylabel() == "motor2 [deg]"
+    lo, hi = ax.get_xlim()  # degrees: 180 deg and half a 30 deg cell
+    np.testing.assert_allclose([lo, hi], [-195.0, 195.0], rtol=0, atol=1e-9)
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "not reached on this assembly mode" in labels
+    mesh = next(c for c in ax.collections if hasattr(c, "get_array") and c.get_array() is not None
+                and np.ma.getmaskarray(c.get_array()).size == res.reached.size)
+    np.testing.assert_array_equal(np.ma.getmaskarray(mesh.get_array()).reshape(res.reached.shape), ~res.reached)
+    plt.close(fig)
+
+
+def test_map_seams_join_neighbours_on_different_sheets():
+    """Around the five-bar's singular point the mode is two sheets: the elbow angles of two
+    neighbouring cells differ by tens of degrees across a seam, by a few degrees elsewhere."""
+    mech = screwkin.load(ROBOTS / "five_bar.urdf")
+    xs = np.radians(np.linspace(-60, 200, 21))
+    ys = np.radians(np.linspace(-160, 100, 21))
+    res = singularity_map(screwkin.PositionSolver(mech), "motor1", xs, "motor2", ys)
+    assert len(res.seams) > 0 and any("seam" in n for n in res.notes)
+    names = mech.coordinate_names
+    elbows = [names.index("elbow1"), names.index("elbow2")]
+    for j, i, j2, i2 in res.seams:
+        d = np.angle(np.exp(1j * (res.q[j, i, elbows] - res.q[j2, i2, elbows])))
+        assert np.abs(d).max() > 0.3  # rad: 17 deg, where a 13 deg input step moves an elbow less
