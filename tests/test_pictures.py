@@ -75,3 +75,25 @@ def test_map_seams_join_neighbours_on_different_sheets():
     for j, i, j2, i2 in res.seams:
         d = np.angle(np.exp(1j * (res.q[j, i, elbows] - res.q[j2, i2, elbows])))
         assert np.abs(d).max() > 0.3  # rad: 17 deg, where a 13 deg input step moves an elbow less
+
+
+def _panda():
+    from test_couplings import ROBOT_DATA
+
+    if ROBOT_DATA is None:
+        pytest.skip("example-robot-data is not installed (pip install example-robot-data)")
+    return ROBOT_DATA / "panda_description" / "urdf" / "panda.urdf"
+
+
+def test_panda_legend_says_no_actuation_is_declared():
+    """example-robot-data's panda.urdf has no <transmission>: its motors are not 'passive joints'."""
+    from screwkin.present.view import build_scene, legend_entries
+
+    path = _panda()
+    assert "<transmission" not in path.read_text()
+    mech = screwkin.load(str(path), warn=lambda _: None)
+    labels = [label for label, _ in legend_entries(build_scene(mech, mech.assemble().q, warn=lambda _: None))]
+    assert "joints (no actuation declared)" in labels and "passive joints" not in labels
+    mech.set_actuated(["panda_joint1"])  # declared on the command line: the others are passive again
+    labels = [label for label, _ in legend_entries(build_scene(mech, mech.assemble().q, warn=lambda _: None))]
+    assert "actuated joints" in labels and "passive joints" in labels
