@@ -97,3 +97,61 @@ def test_panda_legend_says_no_actuation_is_declared():
     mech.set_actuated(["panda_joint1"])  # declared on the command line: the others are passive again
     labels = [label for label, _ in legend_entries(build_scene(mech, mech.assemble().q, warn=lambda _: None))]
     assert "actuated joints" in labels and "passive joints" in labels
+
+
+@pytest.fixture(scope="module")
+def small_study():
+    """Four-bars with the crank typed in mm: one not assembled (ground 0.5 m > 0.04 + 0.12 + 0.08)."""
+    from screwkin.parallel.study import run_study
+
+    spec = {"file": str(ROBOTS / "fourbar.urdf.xacro"), "input": "crank_joint", "output": "rocker",
+            "parameters": {"crank": {"values": ["20mm", "40mm"]}, "ground": {"values": [0.1, 0.5]}},
+            "metrics": ["grashof", "transmission_angle"], "transmission": {"steps": 12},
+            "pareto": {"maximize": ["transmission_angle_min_deg", "grashof_margin"]}}
+    return run_study(spec, workers=0)
+
+
+def test_study_metrics_plot_has_units_and_colours_by_class_and_failure(small_study):
+    import matplotlib.colors as mcolors
+    import matplotlib.pyplot as plt
+
+    from screwkin.present.study import FAILED_COLOR, metrics_figure
+
+    res = small_study
+    assert res.failed and res.succeeded
+    fig = metrics_figure(res)
+    axes = fig.axes
+    assert axes[-2].get_xlabel() == "crank [mm]"
+    assert axes[-1].get_xlabel().startswith("ground (as given")
+    ylabels = {ax.get_ylabel() for ax in axes if ax.get_ylabel()}
+    assert {"Grashof margin (p+q)-(s+l) [mm]", "smallest transmission angle [deg]"} <= ylabels
+    crank_margin = axes[0]  # first row: grashof_margin against crank
+    assert crank_margin.get_ylabel().startswith("Grashof margin")
+    lines = {line.get_label(): line for line in crank_margin.get_lines()}
+    fails = lines["failed"]
+    np.testing.assert_allclose(sorted(fails.get_xdata()), sorted(1000 * r["crank"] for r in res.failed), rtol=0,
+                               atol=1e-9)
+    assert mcolors.same_color(fails.get_color(), FAILED_COLOR)
+    for cls in {r["grashof"] for r in res.succeeded}:
+        rows = [r for r in res.succeeded if r["grashof"] == cls]
+        # the margin (p + q) - (s + l) of a four-bar with links 0.1 (ground), crank, 0.12, 0.08 -- in mm
+        want = sorted(1000 * (sum(ls) - 2 * (min(ls) + max(ls)))  # p + q = sum - (s + l)
+                      for ls in ([r["ground"], r["crank"], 0.12, 0.08] for r in rows))
+        np.testing.assert_allclose(sorted(lines[cls].get_ydata()), want, rtol=0, atol=1e-6)
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "failed" in legend and set(legend) >= {r["grashof"] for r in res.succeeded}
+    plt.close(fig)
+
+
+def test_study_pareto_plot_has_units_and_counts_the_failed(small_study):
+    import matplotlib.pyplot as plt
+
+    from screwkin.present.study import pareto_figure
+
+    fig = pareto_figure(small_study)
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "smallest transmission angle [deg] (maximize)"
+    assert ax.get_ylabel() == "Grashof margin (p+q)-(s+l) [mm] (maximize)"
+    assert f"{len(small_study.failed)} failed (not drawn)" in ax.get_title()
+    assert ax.get_legend().get_title().get_text() == "Grashof class"
+    plt.close(fig)
