@@ -155,3 +155,35 @@ def test_study_pareto_plot_has_units_and_counts_the_failed(small_study):
     assert f"{len(small_study.failed)} failed (not drawn)" in ax.get_title()
     assert ax.get_legend().get_title().get_text() == "Grashof class"
     plt.close(fig)
+
+
+def test_stewart_workspace_slices_are_readable():
+    """Three slices of the Gough-Stewart platform's workspace in mm: each panel's image holds the
+    conditioning of the reached grid points of its slice, at their coordinates."""
+    import matplotlib.pyplot as plt
+
+    from screwkin.analysis.design.workspace import workspace
+    from screwkin.present.workspace import workspace_figure
+
+    mech = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
+    r = workspace(mech, "platform", resolution=0.1)
+    assert r.dimension == 3
+    fig = workspace_figure(r)
+    panels = [ax for ax in fig.axes if ax.get_images()]
+    assert len(panels) == 3
+    assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in panels] == [("x [mm]", "y [mm]"), ("x [mm]", "z [mm]"),
+                                                                     ("y [mm]", "z [mm]")]
+    centre = np.round(np.mean(r.index, axis=0)).astype(int)
+    for ax, n in zip(panels, (2, 1, 0)):
+        at = 1000 * (r.origin[n] + centre[n] * r.resolution)  # the grid's axes are the world's for a 3-D grid
+        assert ax.get_title() == f"slice {'xyz'[n]} = {at:.1f} mm"
+        shown = ax.get_images()[0].get_array()
+        sel = r.index[:, n] == centre[n]
+        np.testing.assert_allclose(np.sort(shown.compressed()), np.sort(r.measures["conditioning"][sel]), rtol=0,
+                                   atol=0)
+        lo, hi = ax.get_xlim()  # the slice fits its panel: every reached point of it inside, in mm
+        a = (0, 0, 1)[(2, 1, 0).index(n)]
+        assert lo < 1000 * r.positions[sel, a].min() and 1000 * r.positions[sel, a].max() < hi
+    assert fig.legends and "boundary (located)" in [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "gough_stewart_6ups" in fig._suptitle.get_text()
+    plt.close(fig)
