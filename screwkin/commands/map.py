@@ -16,11 +16,10 @@ from ..present.report import (
     map_dict,
     to_jsonable,
 )
-from ..units import parse_typed_value
 from ._common import (
     joint_assignments,
     parse_range,
-    value_kind,
+    typed_unit,
 )
 from ._options import BOUNDS
 
@@ -54,7 +53,7 @@ def run(mech, args) -> int:
         raise UsageError("--point needs --output LINK")
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, args.output, args.point)
     if args.png:
-        units = (_typed_unit(mech, xn, args.x), _typed_unit(mech, yn, args.y))
+        units = (typed_unit(mech, xn, args.x), typed_unit(mech, yn, args.y))
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
         map_png(res, args.png, *units, title=title)
     if args.csv:
@@ -71,12 +70,3 @@ def run(mech, args) -> int:
             print(note)
     return 0
 
-
-def _typed_unit(mech, name: str, text: str) -> str:
-    """The unit an axis is drawn in: the one typed with the range's first value (``crank=0deg:360deg:61``
-    -> 'deg'), else with its last, else the SI unit of the joint's kind (rad or m)."""
-    for part in text.partition("=")[2].split(":")[:2]:
-        unit = parse_typed_value(part)[1]
-        if unit:
-            return unit
-    return "m" if value_kind(mech, name) == "length" else "rad"
