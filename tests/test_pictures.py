@@ -70,6 +70,9 @@ def test_map_seams_join_neighbours_on_different_sheets():
     ys = np.radians(np.linspace(-160, 100, 21))
     res = singularity_map(screwkin.PositionSolver(mech), "motor1", xs, "motor2", ys)
     assert len(res.seams) > 0 and any("seam" in n for n in res.notes)
+    from screwkin.present.report import map_dict
+
+    assert map_dict(res)["seams"] == res.seams.tolist()
     names = mech.coordinate_names
     elbows = [names.index("elbow1"), names.index("elbow2")]
     for j, i, j2, i2 in res.seams:
