@@ -123,7 +123,7 @@ class InteractiveView:
         self.status = gui.add_markdown("")
         self.readout = gui.add_markdown("")
         self.paths = {}  # point name -> the viser handle of its traced path (two positions or more)
-        self._dot = 0.01 * float(scene.scale)
+        self._dot = 0.025 * float(scene.scale)  # the dot where each point is now [m]
         self._show()
 
     def _camera(self, scene, basis):
