@@ -190,3 +190,14 @@ def test_stewart_workspace_slices_are_readable():
     assert fig.legends and "boundary (located)" in [t.get_text() for t in fig.legends[0].get_texts()]
     assert "gough_stewart_6ups" in fig._suptitle.get_text()
     plt.close(fig)
+
+
+def test_a_volume_axis_has_the_designs_dimension():
+    from types import SimpleNamespace
+
+    from screwkin.present.study import _label
+
+    planar = SimpleNamespace(succeeded=({"workspace_dimension": 2},) * 3)
+    mixed = SimpleNamespace(succeeded=({"workspace_dimension": 2}, {"workspace_dimension": 3}))
+    assert _label("workspace_volume", planar) == ("workspace volume [m^2]", 1.0)
+    assert _label("singularity_free_volume", mixed)[0] == "singularity-free volume [m^d]"

@@ -235,16 +235,22 @@ LABELS = {
     "overconstraint": ("overconstraint [constraints]", 1.0),
     "idle_dofs": ("idle DOFs [DOF]", 1.0),
     "effective_mobility": ("effective mobility [DOF]", 1.0),
-    "workspace_volume": ("workspace volume [m^dim]", 1.0),
-    "singularity_free_volume": ("singularity-free volume [m^dim]", 1.0),
+    "workspace_volume": ("workspace volume [m^{dim}]", 1.0),
+    "singularity_free_volume": ("singularity-free volume [m^{dim}]", 1.0),
     "conditioning_min": ("smallest conditioning [-]", 1.0),
     "conditioning_mean": ("mean conditioning [-]", 1.0),
 }
 FAILED_COLOR = "crimson"
 
 
-def _label(key):
-    return LABELS.get(key, (_display(key)[0], _display(key)[1]))
+def _label(key, result=None):
+    """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
+    dimension (m^2 or m^3; m^d when they differ)."""
+    label, factor = LABELS.get(key, (_display(key)[0], _display(key)[1]))
+    if "{dim}" in label:
+        dims = {r.get("workspace_dimension") for r in (result.succeeded if result is not None else ())} - {None}
+        label = label.replace("{dim}", str(dims.pop()) if len(dims) == 1 else "d")
+    return label, factor
 
 
 def _parameter_axis(result, name):
@@ -291,7 +297,7 @@ def metrics_figure(result):
                              figsize=(3.2 * len(params) + 0.5, 2.6 * len(metrics) + 1.0))
     handles = {}
     for i, (k, _name, _f) in enumerate(metrics):
-        label, f = _label(k)
+        label, f = _label(k, result)
         for j, p in enumerate(params):
             ax = axes[i][j]
             plabel, pf = _parameter_axis(result, p)
@@ -337,7 +343,7 @@ def pareto_figure(result, goals=None):
     front = pareto_front(result, goals)
     keys = (*result.parameters, *result.columns)
     (a, ga), (b, gb) = [(c if c in keys else c.removesuffix("_deg").removesuffix("_m"), g) for c, g in goals]
-    axis = {c: _parameter_axis(result, c) if c in result.parameters else _label(c) for c in (a, b)}
+    axis = {c: _parameter_axis(result, c) if c in result.parameters else _label(c, result) for c in (a, b)}
     (la, fa), (lb, fb) = axis[a], axis[b]
     classes = _classes(result)
     fig, ax = plt.subplots(figsize=(6.5, 4.8))
