@@ -246,3 +246,62 @@ def test_the_page_loads_offline_in_chromium_with_a_control_per_input(tmp_path):
     dom = p.stdout
     for name in ("motor1", "motor2", "assembly mode", "relative sigma_min", "tip"):
         assert name in dom, name
+
+
+# ----------------------------------------------------------------------------- traced paths
+
+def test_a_points_traced_path_holds_solves_positions_at_the_inputs_passed(fourbar):
+    """After moves, the path of a point is its position, computed by Pinocchio at the configuration
+    solve gives (same mode) at each recorded input value; it starts at the first state, ends at the
+    current one, and a mode switch starts it again."""
+    mech = fourbar
+    local = np.array([0.06, 0.02, 0.0])
+    live = Interactive(mech, points=[Point("P", "coupler", tuple(local))])
+    sign = branch(mech, live.state.q)
+    for value in (0.6, -0.4, 1.5):
+        assert live.move("crank_joint", value).moved
+    path, inputs = live.path("P"), live.path_inputs()
+    assert len(path) == len(inputs) > 4  # the continuation's steps, not only the three ends
+    assert inputs[-1]["crank_joint"] == pytest.approx(1.5)
+    np.testing.assert_allclose(path[-1], live.state.points["P"], rtol=0, atol=1e-12)
+    data = mech.model.createData()
+    solver = PositionSolver(mech)
+    for pos, x in zip(path, inputs):
+        sols = [s.q for s in solver.solve(x).solutions if branch(mech, s.q) == sign]
+        assert len(sols) == 1
+        pin.framesForwardKinematics(mech.model, data, sols[0])
+        np.testing.assert_allclose(pos, data.oMf[mech.link_frame("coupler")].act(local), rtol=0, atol=1e-8)
+    live.switch(2 if live.state.mode == 1 else 1)
+    assert len(live.path("P")) == 1
+    with pytest.raises(screwkin.errors.UsageError, match="no point named 'Q'"):
+        live.path("Q")
+
+
+def test_the_path_is_bounded(fourbar, monkeypatch):
+    import screwkin.analysis.motion.interactive as mod
+
+    monkeypatch.setattr(mod, "MAX_PATH", 7)
+    live = Interactive(fourbar, points=[Point("P", "coupler", (0.06, 0.02, 0.0))])
+    live.move("crank_joint", 1.0)  # about 29 steps of 2 deg
+    assert len(live.path("P")) == 7
+    assert live.path_inputs()[-1]["crank_joint"] == pytest.approx(1.0)
+
+
+def test_the_page_draws_a_polyline_per_point(fourbar):
+    pytest.importorskip("viser")
+    from screwkin.present.interactive import InteractiveView
+    from screwkin.present.view import build_scene
+
+    live = Interactive(fourbar, points=[Point("P", "coupler", (0.06, 0.02, 0.0)), Point("R", "rocker", (0.05, 0, 0))])
+    view = InteractiveView(fourbar, live, build_scene(fourbar, live.state.q), port=free_port())
+    try:
+        assert view.paths == {}  # one position each: nothing to draw yet
+        view.sliders["crank_joint"].value = 40.0
+        for name in ("P", "R"):
+            path = live.path(name)
+            segs = np.asarray(view.paths[name].points)
+            assert segs.shape == (len(path) - 1, 2, 3)
+            np.testing.assert_allclose(segs[:, 0], path[:-1], rtol=0, atol=1e-6)  # float32 on the wire
+            np.testing.assert_allclose(segs[-1, 1], live.state.points[name], rtol=0, atol=1e-6)
+    finally:
+        view.close()

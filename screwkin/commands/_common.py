@@ -273,6 +273,16 @@ def names_list(text):
     return [n.strip() for n in text.split(",") if n.strip()] if text else None
 
 
+def typed_unit(mech, name: str, text: str) -> str:
+    """The unit to answer a ``NAME=A:B:N`` range in: the one typed with A (``crank=0deg:360deg:61`` ->
+    'deg'), else with B, else the SI unit of the joint's kind (rad or m)."""
+    for part in text.partition("=")[2].split(":")[:2]:
+        unit = parse_typed_value(part)[1]
+        if unit:
+            return unit
+    return "m" if value_kind(mech, name) == "length" else "rad"
+
+
 def parse_range(text, option):
     """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"])."""
     name, sep, rest = text.partition("=")

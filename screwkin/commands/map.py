@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from ._common import (
     joint_assignments,
     output_frame,
     parse_range,
+    typed_unit,
 )
 from ._options import BOUNDS
 
@@ -58,7 +60,9 @@ def run(mech, args) -> int:
         raise UsageError("--point needs --output LINK")
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point)
     if args.png:
-        map_png(res, args.png)
+        units = (typed_unit(mech, xn, args.x), typed_unit(mech, yn, args.y))
+        title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
+        map_png(res, args.png, *units, title=title)
     if args.csv:
         with open(args.csv, "w") as f:
             f.write(map_csv(res))
@@ -72,3 +76,4 @@ def run(mech, args) -> int:
         for note in res.notes:
             print(note)
     return 0
+

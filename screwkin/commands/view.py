@@ -16,6 +16,8 @@ from ..analysis.motion.sweep import locate_singularities, sweep
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
+from ..present.player import with_player
+from ..units import parse_value
 from ..present.viewplanar import colour_links, link_colours, planar_basis
 from ._common import (
     add_configuration_options,
@@ -25,6 +27,7 @@ from ._common import (
     joint_assignments,
     named_points,
     parse_range,
+    typed_unit,
 )
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -87,7 +90,7 @@ def run(mech, args) -> int:
     if getattr(args, "points", None):
         raise UsageError(f"{mech.path}: --point goes with --interactive (its position is read out there)")
     q = configuration(mech, args)
-    motion, singular = None, []
+    motion, singular, frames = None, [], None
     if args.sweep:
         name, values = parse_range(args.sweep, "--sweep")
         fixed = {k: v for k, v in joint_assignments(mech, args.set, "--set").items() if k != name}
@@ -96,6 +99,8 @@ def run(mech, args) -> int:
         res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed)
         motion = res.q
         q = res.q[0]
+        unit = typed_unit(mech, name, args.sweep)
+        frames = [f"{name} = {v / parse_value(f'1{unit}'):.4g} {unit}" for v in res.values]
         for s in locate_singularities(solver, res, output=args.output):
             rep = classify(mech, s.q, output=args.output)
             twist = next((t for t in rep.singular_twists if t.kind == s.kind), None)
@@ -106,9 +111,9 @@ def run(mech, args) -> int:
     with _stopped_by_signals() as stopping:
         try:
             with ViewerServer(port=args.port) as server:
-                show(mech, scene, server.viewer, q, motion=motion)
+                show(mech, scene, server.viewer, q, motion=motion, fps=FPS)
                 if args.html or args.png:
-                    _pictures(mech, args, server, scene)
+                    _pictures(mech, args, server, scene, frames)
                     return 0
                 print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
                 serving = True
@@ -123,12 +128,17 @@ def run(mech, args) -> int:
     return 0
 
 
-def _pictures(mech, args, server, scene):
+#: Frames per second of a sweep's animation
+FPS = 30
+
+
+def _pictures(mech, args, server, scene, frames=None):
+    """--html (with a play/scrub bar when ``frames``, the text of each animation frame) and --png."""
     html = server.viewer.static_html()
     title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
     if args.html:
         with open(args.html, "w") as f:
-            f.write(page(html, scene, title))
+            f.write(with_player(page(html, scene, title), frames, FPS) if frames else page(html, scene, title))
         print(f"wrote {args.html}")
     if args.png:
         with tempfile.TemporaryDirectory() as d:

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import MechanismFileError, UsageError, quote
-from ..units import parse_value
+from ..units import parse_typed_value, parse_value
 from .description import LIMITS
 from .xacro import declared_args, normalize_args
 from .xmlsafe import load_yaml_text, read_regular_file
@@ -62,6 +62,13 @@ class Parameter:
     low: float | None = None
     high: float | None = None
     samples: int | None = None
+    unit: str = ""  # the unit its values were typed in (the first one typed: "mm", "deg"), "" when bare
+
+
+def _typed_unit(items) -> str:
+    """The first unit typed among a parameter's values ("" when every value is a bare number)."""
+    units = (parse_typed_value(v)[1] for v in items if isinstance(v, str))  # checked by _value already
+    return next((u for u in units if u), "")
 
 
 @dataclass(frozen=True)
@@ -113,7 +120,7 @@ def _count(v, where, what, low=1, high=MAX_DESIGNS):
 def _parameter(name, item, where, sampling) -> Parameter:
     what = f"parameter {quote(name)}"
     if not isinstance(item, dict):
-        return Parameter(name, values=(_value(item, where, what),))
+        return Parameter(name, values=(_value(item, where, what),), unit=_typed_unit((item,)))
     unknown = [k for k in item if k not in ("min", "max", "samples", "values")]
     if unknown:
         _fail(where, f"{what}: unknown key {quote(unknown[0])} (a range is min, max, samples; a list is values)")
@@ -125,7 +132,8 @@ def _parameter(name, item, where, sampling) -> Parameter:
             _fail(where, f"{what}: values must be a non-empty list, got {quote(values)}")
         if len(values) > MAX_VALUES:
             _fail(where, f"{what}: more than {MAX_VALUES} values")
-        return Parameter(name, values=tuple(_value(v, where, f"{what} value") for v in values))
+        return Parameter(name, values=tuple(_value(v, where, f"{what} value") for v in values),
+                         unit=_typed_unit(values))
     if "min" not in item or "max" not in item:
         _fail(where, f"{what}: a range needs min and max (or give values: [...])")
     low, high = _value(item["min"], where, f"{what} min"), _value(item["max"], where, f"{what} max")
@@ -140,7 +148,7 @@ def _parameter(name, item, where, sampling) -> Parameter:
             _fail(where, f"{what}: 1 sample cannot span min {low:g} to max {high:g} (give 2 or more, or one value)")
     elif samples is not None:
         _count(samples, where, f"{what} samples", 1, MAX_VALUES)  # accepted, unused: designs says how many
-    return Parameter(name, low=low, high=high, samples=samples)
+    return Parameter(name, low=low, high=high, samples=samples, unit=_typed_unit((item["min"], item["max"])))
 
 
 def _metrics(value, where):

@@ -11,8 +11,9 @@ The logic (inputs -> configuration, modes, singularity, limit positions) is
 :class:`screwkin.analysis.motion.interactive.Interactive`; this module only wires it to the controls:
 a slider per input labelled with the joint's name over its range (degrees or millimetres), a
 dropdown of the assembly modes at the current inputs, a status line (a warning near a
-singularity, the reason a move was refused: the slider goes back), and a readout of the output
-pose and of the named points.
+singularity, the reason a move was refused: the slider goes back), a readout of the output
+pose and of the named points, and each named point's traced path (Interactive.path: a polyline
+per point, its colour in the readout, a dot where the point is now).
 """
 
 from __future__ import annotations
@@ -63,6 +64,11 @@ def _visualizer_class():
                                                                   opacity=c[3])
 
     return Visualizer
+
+
+#: Colours of the traced paths, one per named point in turn (RGB 0-255; matplotlib's tab10)
+PATH_COLORS = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189), (140, 86, 75),
+               (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207))
 
 
 def _shown(value, unit) -> float:
@@ -116,6 +122,8 @@ class InteractiveView:
         self.modes.on_update(self._switched)
         self.status = gui.add_markdown("")
         self.readout = gui.add_markdown("")
+        self.paths = {}  # point name -> the viser handle of its traced path (two positions or more)
+        self._dot = 0.025 * float(scene.scale)  # the dot where each point is now [m]
         self._show()
 
     def _camera(self, scene, basis):
@@ -187,9 +195,27 @@ class InteractiveView:
             rpy = np.degrees(pin.rpy.matrixToRpy(s.output_pose[:3, :3]))
             out.append(f"**{self.live.output}**: x {p[0]:.2f}, y {p[1]:.2f}, z {p[2]:.2f} mm; "
                        f"roll {rpy[0]:.2f}, pitch {rpy[1]:.2f}, yaw {rpy[2]:.2f} deg")
-        for name, p in s.points.items():
-            out.append(f"**{name}**: x {p[0] * 1000:.2f}, y {p[1] * 1000:.2f}, z {p[2] * 1000:.2f} mm")
+        for k, (name, p) in enumerate(s.points.items()):
+            r, g, b = PATH_COLORS[k % len(PATH_COLORS)]
+            out.append(f"**{name}** <span style='color:rgb({r},{g},{b})'>(path)</span>: "
+                       f"x {p[0] * 1000:.2f}, y {p[1] * 1000:.2f}, z {p[2] * 1000:.2f} mm")
         self.readout.content = "  \n".join(out)
+        self._trace(s)
+
+    def _trace(self, s):
+        """Each named point's traced path as line segments between its successive positions."""
+        scene = self.server.scene
+        for k, name in enumerate(s.points):
+            color = PATH_COLORS[k % len(PATH_COLORS)]
+            path = self.live.path(name)
+            scene.add_icosphere(f"/screwkin_paths/{name}/now", radius=self._dot, color=color,
+                                position=tuple(float(v) for v in s.points[name]))
+            if len(path) >= 2:
+                segments = np.stack([path[:-1], path[1:]], axis=1).astype(np.float32)
+                self.paths[name] = scene.add_line_segments(f"/screwkin_paths/{name}/path", segments, colors=color,
+                                                           thickness=2.0, thickness_units="screen")
+            elif name in self.paths:  # a mode switch started the path again
+                self.paths.pop(name).remove()
 
     def close(self):
         with contextlib.redirect_stdout(io.StringIO()):

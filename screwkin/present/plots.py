@@ -9,8 +9,9 @@ import numpy as np
 from ..errors import UsageError
 from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
+from ..units import parse_value
 
-__all__ = ["sweep_plot", "sweep_figure", "map_png"]
+__all__ = ["sweep_plot", "sweep_figure", "map_png", "map_figure"]
 
 
 def _pyplot(option):
@@ -167,20 +168,67 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
     plt.close(fig)
 
 
-def map_png(res, path: str):
-    """A singularity map (SingularityMap) as a heat map with the singular curves."""
+def _axis(values, unit):
+    """SI values in ``unit`` (a unit of screwkin.units as typed, any case: 'deg', 'MM'; bare: SI)."""
+    return np.asarray(values, float) / (parse_value(f"1{unit}") if unit else 1.0)
+
+
+def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):
+    """The figure of :func:`map_png` (matplotlib, not yet saved): log10 of the smallest relative
+    singular value over the two inputs, with the axes in ``x_unit`` and ``y_unit`` (the units the
+    user typed: 'deg', 'mm', ...; SI values are divided by the unit's factor), the curve
+    sigma = 1e-2, and the cells the continuation did not reach on the mapped assembly mode
+    (``res.reached`` False) blank and hatched, with a legend entry of their own -- no colour is
+    drawn across the jump between two modes."""
     plt = _pyplot("--png")
+    from matplotlib.patches import Patch
+
     fig, ax = plt.subplots(figsize=(7, 5.5))
-    X, Y = np.meshgrid(res.xs, res.ys)
-    mesh = ax.pcolormesh(X, Y, res.log_sigma, shading="auto", cmap="viridis")
+    xs, ys = _axis(res.xs, x_unit), _axis(res.ys, y_unit)
+    X, Y = np.meshgrid(xs, ys)
+    reached = np.isfinite(res.log_sigma) if res.reached is None else np.asarray(res.reached, bool)
+    shown = np.ma.masked_where(~reached | ~np.isfinite(res.log_sigma), res.log_sigma)
+    from matplotlib.patches import Rectangle
+
+    hx0 = abs(xs[1] - xs[0]) / 2 if len(xs) > 1 else 0.5
+    hy0 = abs(ys[1] - ys[0]) / 2 if len(ys) > 1 else 0.5
+    ax.add_patch(Rectangle((xs.min() - hx0, ys.min() - hy0), np.ptp(xs) + 2 * hx0, np.ptp(ys) + 2 * hy0,
+                           facecolor="0.92", edgecolor="0.6", hatch="//", linewidth=0.0, zorder=0))
+    mesh = ax.pcolormesh(X, Y, shown, shading="nearest", cmap="viridis", zorder=1)
     fig.colorbar(mesh, ax=ax, label="log10 smallest relative singular value")
-    finite = res.log_sigma[np.isfinite(res.log_sigma)]
-    if finite.size and finite.min() < -2:
-        ax.contour(X, Y, res.log_sigma, levels=[-2.0], colors="white", linewidths=1.2)
-        ax.plot([], [], color="white", label="singular (sigma < 1e-2)")
-        ax.legend(loc="upper right", facecolor="0.3", labelcolor="white")
-    ax.set_xlabel(f"{res.x_name} [rad or m]")
-    ax.set_ylabel(f"{res.y_name} [rad or m]")
+    handles = []
+    if (~reached).any():
+        handles.append(Patch(facecolor="0.92", edgecolor="0.6", hatch="//", label="not reached on this assembly mode"))
+    seams = getattr(res, "seams", None)
+    if seams is not None and len(seams):
+        from matplotlib.collections import LineCollection
+
+        hx = np.diff(xs).mean() / 2 if len(xs) > 1 else 0.5
+        hy = np.diff(ys).mean() / 2 if len(ys) > 1 else 0.5
+        segs = []
+        for j, i, j2, i2 in seams:
+            xm, ym = (xs[i] + xs[i2]) / 2, (ys[j] + ys[j2]) / 2
+            segs.append([(xm, ym - hy), (xm, ym + hy)] if i2 != i else [(xm - hx, ym), (xm + hx, ym)])
+        ax.add_collection(LineCollection(segs, colors="red", linewidths=2.0))
+        handles.append(Patch(facecolor="red", edgecolor="red", label="seam: neighbours on different sheets"))
+    finite = shown.compressed()
+    if finite.size and finite.min() < -2 < finite.max():
+        ax.contour(X, Y, shown, levels=[-2.0], colors="white", linewidths=1.2)
+        handles.append(Patch(facecolor="0.3", edgecolor="white", label="singular (sigma < 1e-2): white curve"))
+    if handles:
+        ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.9)
+    ax.set_xlabel(f"{res.x_name} [{x_unit}]")
+    ax.set_ylabel(f"{res.y_name} [{y_unit}]")
+    ax.set_title(title or f"singularity map over {res.x_name} and {res.y_name}", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    return fig
+
+
+def map_png(res, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):
+    """A singularity map (SingularityMap) as a heat map with the singular curves (see :func:`map_figure`)."""
+    plt = _pyplot("--png")
+    fig = map_figure(res, x_unit, y_unit, title)
+    ax = fig.axes[0]
+    fig.savefig(path, dpi=100, metadata={"Title": ax.get_title(),
+                                         "Description": f"x: {ax.get_xlabel()}; y: {ax.get_ylabel()}"})
     plt.close(fig)

@@ -23,6 +23,7 @@ import numpy as np
 from ..analysis.design.study import pareto_front
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
+from ..units import parse_value
 from .plots import _pyplot
 from .report import to_jsonable
 from .tables import csv_text
@@ -31,7 +32,10 @@ __all__ = [
     "DISPLAY",
     "Progress",
     "check_table_path",
+    "LABELS",
+    "metrics_figure",
     "metrics_png",
+    "pareto_figure",
     "pareto_png",
     "study_csv",
     "study_dict",
@@ -221,8 +225,62 @@ def _numeric(result):
     return out
 
 
-def metrics_png(result, path) -> None:
-    """Each numeric metric against each parameter (one panel per pair; failed designs left out)."""
+#: Metric key -> (axis label with its unit, factor from SI) on the study's plots
+LABELS = {
+    "transmission_angle_min": ("smallest transmission angle [deg]", 180.0 / math.pi),
+    "transmission_angle_max": ("largest transmission angle [deg]", 180.0 / math.pi),
+    "grashof_margin": ("Grashof margin (p+q)-(s+l) [mm]", 1000.0),
+    "mobility": ("mobility [DOF]", 1.0),
+    "mobility_count": ("mobility by counting [DOF]", 1.0),
+    "overconstraint": ("overconstraint [constraints]", 1.0),
+    "idle_dofs": ("idle DOFs [DOF]", 1.0),
+    "effective_mobility": ("effective mobility [DOF]", 1.0),
+    "workspace_volume": ("workspace volume [m^{dim}]", 1.0),
+    "singularity_free_volume": ("singularity-free volume [m^{dim}]", 1.0),
+    "conditioning_min": ("smallest conditioning [-]", 1.0),
+    "conditioning_mean": ("mean conditioning [-]", 1.0),
+}
+FAILED_COLOR = "crimson"
+
+
+def _label(key, result=None):
+    """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
+    dimension (m^2 or m^3; m^d when they differ)."""
+    label, factor = LABELS.get(key, (_display(key)[0], _display(key)[1]))
+    if "{dim}" in label:
+        dims = {r.get("workspace_dimension") for r in (result.succeeded if result is not None else ())} - {None}
+        label = label.replace("{dim}", str(dims.pop()) if len(dims) == 1 else "d")
+    return label, factor
+
+
+def _parameter_axis(result, name):
+    """(axis label, factor from SI) of a parameter: in the unit its values were typed in (the study
+    file's ``30mm``), else as given (xacro arguments are SI, the file does not say m or rad)."""
+    unit = next((getattr(p, "unit", "") for p in result.spec.parameters if p.name == name), "")
+    if unit:
+        return f"{name} [{unit}]", 1.0 / parse_value(f"1{unit}")
+    return f"{name} (as given, SI: no unit typed)", 1.0
+
+
+def _classes(result):
+    """The colour of each design (row index -> (class, colour)): its Grashof class when the study
+    has one, failed designs in FAILED_COLOR."""
+    out = {}
+    names = sorted({r["grashof"] for r in result.succeeded if r.get("grashof")})
+    colors = {n: f"C{k}" for k, n in enumerate(names)}
+    for k, r in enumerate(result.rows):
+        if r["error"] is not None:
+            out[k] = ("failed", FAILED_COLOR)
+        else:
+            c = r.get("grashof")
+            out[k] = (c, colors[c]) if c else ("analysed", "C0")
+    return out
+
+
+def metrics_figure(result):
+    """The figure of :func:`metrics_png` (not yet saved): each numeric metric against each parameter,
+    one panel per pair, axes with their units, points coloured by Grashof class (when the study has
+    it), failed designs as crosses along the bottom of each panel at their parameter values."""
     plt = _pyplot("--plot")
     numeric = _numeric(result)
     params = list(result.parameters)
@@ -234,47 +292,91 @@ def metrics_png(result, path) -> None:
     metrics = [m for m in numeric if m not in constant] or numeric
     same = ", ".join(f"{name} = {_fmt(_cell(next(r[k] for r in ok if r[k] is not None), f))}"
                      for k, name, f in constant if (k, name, f) not in metrics)
+    classes = _classes(result)
     fig, axes = plt.subplots(len(metrics), len(params), squeeze=False,
-                             figsize=(3.2 * len(params) + 0.5, 2.6 * len(metrics) + 0.5))
-    for i, (k, name, f) in enumerate(metrics):
+                             figsize=(3.2 * len(params) + 0.5, 2.6 * len(metrics) + 1.0))
+    handles = {}
+    for i, (k, _name, _f) in enumerate(metrics):
+        label, f = _label(k, result)
         for j, p in enumerate(params):
             ax = axes[i][j]
-            xs = [r[p] for r in ok if r[k] is not None]
-            ys = [r[k] * f for r in ok if r[k] is not None]
-            ax.plot(xs, ys, "o", ms=3, alpha=0.7)
+            plabel, pf = _parameter_axis(result, p)
+            for cls in dict.fromkeys(c for c, _ in classes.values()):
+                rows = [r for n, r in enumerate(result.rows) if classes[n][0] == cls and r[k] is not None
+                        and r["error"] is None]
+                if rows:
+                    (h,) = ax.plot([r[p] * pf for r in rows], [r[k] * f for r in rows], "o", ms=4, alpha=0.8,
+                                   color=next(c for n, (c2, c) in classes.items() if c2 == cls), label=cls)
+                    handles.setdefault(cls, h)
+            failed = [r for r in result.rows if r["error"] is not None]
+            if failed:
+                (h,) = ax.plot([r[p] * pf for r in failed], [0.0] * len(failed), "x", ms=6,
+                               color=FAILED_COLOR, label="failed", transform=ax.get_xaxis_transform(), clip_on=False)
+                handles.setdefault("failed", h)
             if i == len(metrics) - 1:
-                ax.set_xlabel(p)
+                ax.set_xlabel(plabel, fontsize=8)
             if j == 0:
-                ax.set_ylabel(name, fontsize=8)
+                ax.set_ylabel(label, fontsize=8)
     title = f"{Path(result.spec.file).name}: {len(ok)} of {len(result.rows)} designs analysed"
     fig.suptitle(title + (f"\nin all: {same}" if same else ""), fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 0.96 if same else 0.98))
-    fig.savefig(path, dpi=100)
+    if len(handles) > 1 or "failed" in handles:
+        fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=min(len(handles), 4), fontsize=8,
+                   title="Grashof class" if any(r.get("grashof") for r in ok) else None, title_fontsize=8)
+    fig.tight_layout(rect=(0, 0.06 if len(handles) > 1 or "failed" in handles else 0, 1, 0.96 if same else 0.98))
+    return fig
+
+
+def metrics_png(result, path) -> None:
+    """Each numeric metric against each parameter (see :func:`metrics_figure`)."""
+    plt = _pyplot("--plot")
+    fig = metrics_figure(result)
+    fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
     plt.close(fig)
 
 
-def pareto_png(result, path, goals=None) -> None:
-    """The designs in the plane of two columns, the Pareto front drawn over them."""
+def pareto_figure(result, goals=None):
+    """The figure of :func:`pareto_png` (not yet saved): the designs in the plane of two columns with
+    their units, coloured by Grashof class (when the study has it), the Pareto front drawn over them;
+    the failed designs, which have no place in this plane, counted in the title."""
     plt = _pyplot("--plot")
     goals = goals or result.spec.pareto
     front = pareto_front(result, goals)
     keys = (*result.parameters, *result.columns)
-    (a, ga), (b, gb) = [(c if c in keys else c.removesuffix("_deg"), g) for c, g in goals]
-    fa, fb = _display(a)[1], _display(b)[1]
-    pts = [(r[a] * fa, r[b] * fb) for r in result.succeeded if r[a] is not None and r[b] is not None]
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    if pts:
-        ax.plot(*zip(*pts), "o", ms=3, color="0.6", label="designs")
+    (a, ga), (b, gb) = [(c if c in keys else c.removesuffix("_deg").removesuffix("_m"), g) for c, g in goals]
+    axis = {c: _parameter_axis(result, c) if c in result.parameters else _label(c, result) for c in (a, b)}
+    (la, fa), (lb, fb) = axis[a], axis[b]
+    classes = _classes(result)
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    for cls in dict.fromkeys(c for c, _ in classes.values()):
+        if cls == "failed":
+            continue
+        rows = [r for n, r in enumerate(result.rows) if classes[n][0] == cls and r[a] is not None and r[b] is not None]
+        if rows:
+            ax.plot([r[a] * fa for r in rows], [r[b] * fb for r in rows], "o", ms=4, alpha=0.8,
+                    color=next(c for c2, c in classes.values() if c2 == cls),
+                    label=cls if cls != "analysed" else "designs")
     fx = [result.rows[k][a] * fa for k in front]
     fy = [result.rows[k][b] * fb for k in front]
-    ax.plot(fx, fy, "o-", color="C3", label="Pareto front")
+    ax.plot(fx, fy, "-", color="k", linewidth=1.0, label="Pareto front")
+    ax.plot(fx, fy, "o", ms=7, markerfacecolor="none", markeredgecolor="k")
     for k, x, y in zip(front, fx, fy):
         ax.annotate(str(result.rows[k]["design"]), (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
-    ax.set_xlabel(f"{_display(a)[0]} ({ga})")
-    ax.set_ylabel(f"{_display(b)[0]} ({gb})")
-    ax.legend(fontsize=8)
+    ax.set_xlabel(f"{la} ({ga}imize)" if ga in ("max", "min") else f"{la} ({ga})")
+    ax.set_ylabel(f"{lb} ({gb}imize)" if gb in ("max", "min") else f"{lb} ({gb})")
+    nfail = len(result.failed)
+    ax.set_title(f"{Path(result.spec.file).name}: {len(result.succeeded)} designs"
+                 + (f", {nfail} failed (not drawn)" if nfail else ""), fontsize=9)
+    ax.legend(fontsize=8, title="Grashof class" if any(r.get("grashof") for r in result.succeeded) else None,
+              title_fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    return fig
+
+
+def pareto_png(result, path, goals=None) -> None:
+    """The designs in the plane of two columns, the Pareto front drawn over them (see :func:`pareto_figure`)."""
+    plt = _pyplot("--plot")
+    fig = pareto_figure(result, goals)
+    fig.savefig(path, dpi=100, metadata={"Title": fig.axes[0].get_title()})
     plt.close(fig)
 
 

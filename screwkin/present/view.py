@@ -199,6 +199,7 @@ class Scene:
     scale: float  # size of the mechanism [m]
     center: np.ndarray  # centre of its joints [m]
     points: np.ndarray | None = None  # (n, 3): the corners of every drawn object's box, world, at q [m]
+    declared: bool = True  # the file (or --actuated) names the actuated joints; False: none declared
 
     @property
     def bounds(self) -> np.ndarray:
@@ -348,7 +349,8 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
                 _coal().Cone(3 * r_axis, 6 * r_axis))
             cone.meshColor = COLORS["screw"]
             add(cone, "singular:arrow")
-    return Scene(geom, roles, scale, center, _corner_points(model, data, geom, q))
+    return Scene(geom, roles, scale, center, _corner_points(model, data, geom, q),
+                 declared=getattr(mech, "actuation_source", None) is not None)
 
 
 class RecordingViewer:
@@ -513,9 +515,11 @@ def _css(color) -> str:
 
 
 def legend_entries(scene: Scene) -> list:
-    """(label, CSS colour) for each kind of thing the scene shows."""
+    """(label, CSS colour) for each kind of thing the scene shows; a file that declares no actuation
+    (no transmissions, no name_mot) has "joints (no actuation declared)", not passive joints."""
     present = set(scene.roles.values())
-    return [(label, _css(COLORS[key])) for label, key, roles in LEGEND if present & set(roles)]
+    return [("joints (no actuation declared)" if key == "passive" and not scene.declared else label, _css(COLORS[key]))
+            for label, key, roles in LEGEND if present & set(roles)]
 
 
 def page(html: str, scene: Scene, title: str | None = None, controls: bool = True, size=None) -> str:

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 
@@ -12,7 +14,7 @@ from .plots import _pyplot
 from .report import table
 from .tables import csv_text
 
-__all__ = ["workspace_dict", "workspace_text", "workspace_csv", "workspace_png", "workspace_cloud", "AXIS_NAMES"]
+__all__ = ["workspace_dict", "workspace_text", "workspace_csv", "workspace_png", "workspace_figure", "workspace_cloud", "AXIS_NAMES"]
 
 AXIS_NAMES = ("x", "y", "z")
 
@@ -118,59 +120,88 @@ def workspace_csv(r: WorkspaceResult, path, joint_columns=None):
         f.write(csv_text(head, rows))
 
 
-def workspace_png(r: WorkspaceResult, path: str):
-    """The conditioning over the workspace: the plane itself (2-D), or three slices through
-    the grid point nearest the workspace's centroid (3-D); the located boundary in black,
-    where the measures cross the threshold in red."""
+def workspace_figure(r: WorkspaceResult, title: str | None = None):
+    """The figure of :func:`workspace_png` (matplotlib, not yet saved): the conditioning over the
+    plane itself (2-D), or three slices through the grid point nearest the workspace's centroid
+    (3-D: the platform of a Stewart platform), each slice in mm on equal axes, the colour scale over
+    the values reached (its range in the colour bar's label), the located boundary in black, where
+    the measures cross the threshold in red; one legend for all the panels, below them."""
     plt = _pyplot("--png")
+    from matplotlib.lines import Line2D
+
     names = axis_labels(r)
     h = r.resolution
     cond = r.measures["conditioning"]
+    mm = 1000.0
     if r.dimension == 2:
-        fig, ax = plt.subplots(figsize=(7, 6))
+        fig, ax = plt.subplots(figsize=(7.5, 7), layout="constrained")
         panels = [(ax, 0, 1, np.ones(len(r.index), bool), None)]
     else:
-        fig, axs = plt.subplots(1, 3, figsize=(15, 5))
+        fig, axs = plt.subplots(1, 3, figsize=(16, 6.2), layout="constrained")
         c = np.round(np.mean(r.index, axis=0)).astype(int)
-        panels = []
-        for ax, (a, b, n) in zip(axs, ((0, 1, 2), (0, 2, 1), (1, 2, 0))):
-            panels.append((ax, a, b, r.index[:, n] == c[n], (n, c[n])))
+        panels = [(ax, a, b, r.index[:, n] == c[n], (n, c[n])) for ax, (a, b, n) in zip(axs, ((0, 1, 2), (0, 2, 1),
+                                                                                              (1, 2, 0)))]
     coords = r.coordinates
+    finite = cond[np.isfinite(cond)]
+    lo = float(finite.min()) if finite.size else 0.0
+    hi = max(float(finite.max()) if finite.size else 1.0, lo + 1e-12)
     mesh = None
+    legend = {}
     for ax, a, b, sel, cut in panels:
         if not sel.any():
+            ax.set_axis_off()
             continue
         ia, ib = r.index[sel, a], r.index[sel, b]
         grid = np.full((ib.max() - ib.min() + 1, ia.max() - ia.min() + 1), np.nan)
         grid[ib - ib.min(), ia - ia.min()] = cond[sel]
         ca, cb = coords[sel, a], coords[sel, b]
-        extent = (ca.min() - h / 2, ca.min() + (grid.shape[1] - 0.5) * h, cb.min() - h / 2,
-                  cb.min() + (grid.shape[0] - 0.5) * h)
-        mesh = ax.imshow(grid, origin="lower", extent=extent, cmap="viridis", vmin=0,
-                         vmax=max(float(np.nanmax(cond)), 1e-12), interpolation="nearest")
+        extent = tuple(mm * v for v in (ca.min() - h / 2, ca.min() + (grid.shape[1] - 0.5) * h, cb.min() - h / 2,
+                                        cb.min() + (grid.shape[0] - 0.5) * h))
+        mesh = ax.imshow(grid, origin="lower", extent=extent, cmap="viridis", vmin=lo, vmax=hi,
+                         interpolation="nearest")
         notfree = sel & ~r.free
         if notfree.any():
-            ax.plot(coords[notfree, a], coords[notfree, b], "x", color="0.5", ms=3, label=f"measure < {r.threshold:g}")
-        for pts, style, label in ((r.boundary, "k.", "boundary (located)"),
-                                  (r.free_boundary, "r.", f"threshold {r.threshold:g} crossed")):
+            ax.plot(mm * coords[notfree, a], mm * coords[notfree, b], "x", color="0.5", ms=4)
+            legend[f"measure < {r.threshold:g}"] = Line2D([], [], marker="x", color="0.5", linestyle="")
+        for pts, color, label in ((r.boundary, "k", "boundary (located)"),
+                                  (r.free_boundary, "r", f"threshold {r.threshold:g} crossed")):
             if len(pts):
                 P = pts @ r.axes.T
                 near = np.ones(len(P), bool) if cut is None else np.abs(P[:, cut[0]] - (r.axes[cut[0]] @ r.origin
                                                                                           + cut[1] * h)) < h / 2
                 if near.any():
-                    ax.plot(P[near, a], P[near, b], style, ms=2, label=label)
-        ax.set_xlabel(f"{names[a]} [m]")
-        ax.set_ylabel(f"{names[b]} [m]")
+                    ax.plot(mm * P[near, a], mm * P[near, b], ".", color=color, ms=4)
+                    legend[label] = Line2D([], [], marker=".", color=color, linestyle="", ms=6)
+        pad = 0.6 * h * mm
+        ax.set_xlim(extent[0] - pad, extent[1] + pad)
+        ax.set_ylim(extent[2] - pad, extent[3] + pad)
+        ax.set_xlabel(f"{names[a]} [mm]", fontsize=11)
+        ax.set_ylabel(f"{names[b]} [mm]", fontsize=11)
         ax.set_aspect("equal")
-        title = "" if cut is None else f"slice {names[cut[0]]} = {r.axes[cut[0]] @ r.origin + cut[1] * h:.4g} m"
-        ax.set_title(title, fontsize=9)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.grid(True, color="0.85", linewidth=0.5)
+        ax.set_axisbelow(True)
+        ax.tick_params(labelsize=9)
+        if cut is not None:
+            at = mm * (r.axes[cut[0]] @ r.origin + cut[1] * h)
+            ax.set_title(f"slice {names[cut[0]]} = {at:.1f} mm", fontsize=11)
     if mesh is not None:
-        fig.colorbar(mesh, ax=[p[0] for p in panels], label="conditioning (1 / condition number)", shrink=0.8)
-    what = "point" if r.point else "pose"
-    fig.suptitle(f"workspace of '{r.output}' ({what}): {r.volume:.4g} {_unit(r.dimension)}, "
-                 f"singularity-free {r.free_volume:.4g}", fontsize=10)
-    fig.savefig(path, dpi=100)
+        fig.colorbar(mesh, ax=[p[0] for p in panels], shrink=0.85,
+                     label=f"conditioning (1 / condition number): {lo:.3g} to {hi:.3g}")
+    if legend:
+        fig.legend(list(legend.values()), list(legend), loc="outside lower center", ncol=len(legend), fontsize=10)
+    what = ("a point, orientation free" if r.point else "position at fixed orientation"
+            if r.dimension == 3 and r.orientation is not None else "pose")
+    fig.suptitle(title or (f"{Path(str(r.path)).stem}: workspace of '{r.output}' ({what})\n{r.volume:.4g} "
+                           f"{_unit(r.dimension)}, singularity-free {r.free_volume:.4g} {_unit(r.dimension)}, "
+                           f"grid step {mm * h:.3g} mm"), fontsize=12)
+    return fig
+
+
+def workspace_png(r: WorkspaceResult, path: str):
+    """The conditioning over the workspace, in slices (see :func:`workspace_figure`)."""
+    plt = _pyplot("--png")
+    fig = workspace_figure(r)
+    fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
     plt.close(fig)
 
 

@@ -9,11 +9,16 @@ value (the other inputs held), in steps of at most ``MAX_STEP`` (an angle) or ``
 times the characteristic length (a slide): the assembly mode is kept as a physical mechanism
 keeps it, and a limit position met on the way is located and stops the move.  A move that
 cannot be completed changes nothing: the state says where and why it stopped.
+
+The named points leave traced paths: each point's position at every continuation step of the
+moves carried out (at most ``MAX_PATH`` positions: the oldest are dropped), with the input values
+of each step.  Switching the assembly mode jumps: the paths start again there.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,9 +30,10 @@ from .position import PositionSolver
 from ..singularities.singular import measures
 from .sweep import sweep
 
-__all__ = ["Control", "LiveState", "Interactive", "MAX_STEP"]
+__all__ = ["Control", "LiveState", "Interactive", "MAX_STEP", "MAX_PATH"]
 
 MAX_STEP = math.radians(2.0)  # largest continuation step [rad]; for a slide, this times the characteristic length
+MAX_PATH = 2000  # positions kept in a point's traced path (the oldest dropped first): ten turns of 2 deg steps
 
 
 @dataclass(frozen=True)
@@ -94,6 +100,29 @@ class Interactive:
         if not 1 <= mode <= len(modes):
             raise UsageError(f"--mode {mode}: these inputs give {len(modes)} assembly mode{'s' if len(modes) != 1 else ''}")
         self.state = self._state(modes[mode - 1], mode)
+        self._trace = deque(maxlen=MAX_PATH)  # (inputs, {point: position}) per step
+        self._record(self.state.inputs, self.state.points)
+
+    # ------------------------------------------------------------------ traced paths
+    def _record(self, inputs, points):
+        if self.points:
+            self._trace.append((dict(inputs), {n: np.array(p, float) for n, p in points.items()}))
+
+    def path(self, name: str) -> np.ndarray:
+        """(k, 3) world positions [m] of point ``name`` along the moves since the start or the last
+        mode switch, oldest first (at most MAX_PATH)."""
+        if name not in {p.name for p in self.points}:
+            known = ", ".join(p.name for p in self.points) or "none"
+            raise UsageError(f"{self.mech.path}: no point named '{name}' is traced (points: {known})")
+        return np.array([pts[name] for _, pts in self._trace], float).reshape(-1, 3)
+
+    def path_inputs(self) -> list:
+        """The input values (name -> value [rad or m]) at each position of :meth:`path`."""
+        return [dict(inputs) for inputs, _ in self._trace]
+
+    def _positions(self, q) -> dict:
+        return {n: np.asarray(p["position"], float)
+                for n, p in point_motions(KinematicState(self.mech, q), self.points).items()}
 
     # ------------------------------------------------------------------ controls
     def _control(self, name, start) -> Control:
@@ -139,10 +168,7 @@ class Interactive:
         pose = None
         if self.output is not None:
             pose = KinematicState(mech, q).link_pose(self.output)
-        points = {}
-        if self.points:
-            st = KinematicState(mech, q)
-            points = {n: np.asarray(p["position"], float) for n, p in point_motions(st, self.points).items()}
+        points = self._positions(q) if self.points else {}
         return LiveState(np.array(q, float), dict(self._values), self._mode_of(q, modes) if mode is None else mode,
                          len(modes), sigma, sigma < mech.tolerances.singular, pose, points, moved, message)
 
@@ -174,9 +200,13 @@ class Interactive:
             shown = f"{math.degrees(where):.6g} deg" if ctl.unit == "rad" else f"{where * 1000:.6g} mm"
             why = res.stop_reason or "the loops cannot be closed there"
             return self._refused(f"{name} stopped at {shown}: {why}; nothing moved")
+        for x, qk in zip(res.values[1:-1], res.q[1:-1]):  # the steps on the way, then the end's state
+            if self.points:
+                self._record({**fixed, name: float(x)}, self._positions(qk))
         self._values[name] = value
         self._modes = None
         self.state = self._state(res.q[-1])
+        self._record(self.state.inputs, self.state.points)
         return self.state
 
     def switch(self, mode: int) -> LiveState:
@@ -186,4 +216,6 @@ class Interactive:
             return self._refused(f"mode {mode}: these inputs give {len(modes)} assembly mode"
                                  f"{'s' if len(modes) != 1 else ''}")
         self.state = self._state(modes[mode - 1], mode)
+        self._trace.clear()  # a jump to another mode: the paths start again here
+        self._record(self.state.inputs, self.state.points)
         return self.state

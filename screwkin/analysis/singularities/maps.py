@@ -20,7 +20,7 @@ from ...errors import UsageError
 from .singular import Generic, measures
 from ..motion.sweep import Neighbour
 
-__all__ = ["SingularityMap", "singularity_map"]
+__all__ = ["SingularityMap", "singularity_map", "seams"]
 
 
 @dataclass(frozen=True)
@@ -34,6 +34,7 @@ class SingularityMap:
     q: np.ndarray  # (len(ys), len(xs), nq) configurations (NaN off the branch)
     reached: np.ndarray | None = None  # (len(ys), len(xs)) bool: the cell lies on the mapped branch
     notes: tuple = ()  # what the continuation could not reach, in words
+    seams: np.ndarray | None = None  # (k, 4) int: j, i, j2, i2 of neighbouring reached cells on different sheets
 
     @property
     def off_branch(self) -> int:
@@ -74,7 +75,43 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
         kind = min(m, key=m.get)
         logs[j, i] = np.log10(max(m[kind], 1e-16))
         kinds[j, i] = kind
+    seam = seams(mech, qs, reached, steps[x_name], steps[y_name], xs, ys)
     off = int(reached.size - reached.sum())
     notes = (f"{off} of {reached.size} points are not reached from the first one by continuation on its "
              "assembly mode (another mode, past a limit position, or not assembled): left blank",) if off else ()
-    return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes)
+    if len(seam):
+        notes += (f"{len(seam)} pairs of neighbouring points lie on different sheets of the mode (their "
+                  f"configurations differ by more than {mech.tolerances.near_far:g} rad: continuation from one "
+                  "does not arrive at the other): a seam between them",)
+    return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
+
+
+def _apart(mech, q1, q2) -> float:
+    d = mech.difference(q1, q2)
+    d[mech.translational] /= mech.length
+    return float(np.linalg.norm(d))
+
+
+def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.ndarray:
+    """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
+    their configurations differ by more than Tolerances.near_far (rad; lengths over the
+    characteristic length) and -- when the steps (analysis.motion.sweep.Neighbour along x and y) and
+    grids are given -- continuation from one does not arrive at the other (a steep but continuous
+    stretch near a singular point is no seam).  Continuation round a singular point can come back on
+    another sheet: the map's mode is one sheet only up to these seams.  (k, 4) int rows j, i, j2, i2."""
+    out = []
+    tol = mech.tolerances.near_far
+    for (dj, di), step, grid in (((0, 1), step_x, xs), ((1, 0), step_y, ys)):
+        for j, i in zip(*np.nonzero(reached)):
+            jn, in_ = j + dj, i + di
+            if jn >= reached.shape[0] or in_ >= reached.shape[1] or not reached[jn, in_]:
+                continue
+            if _apart(mech, qs[j, i], qs[jn, in_]) <= tol:
+                continue
+            if step is not None:
+                a, b = (i, in_) if di else (j, jn)
+                q = step(qs[j, i], float(grid[a]), float(grid[b]))
+                if q is not None and _apart(mech, q, qs[jn, in_]) <= tol:
+                    continue
+            out.append((j, i, jn, in_))
+    return np.array(out, int).reshape(-1, 4)
