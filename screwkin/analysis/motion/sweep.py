@@ -390,7 +390,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
                 if forward() and (target - end_x) * direction > 0:
                     target = end_x
                 reach = sigma * tr.scale[tr.ix]  # after a refused step, toward the grid value by shorter steps
-                on_grid = abs(target - x) <= reach * (1 + 1e-9)
+                on_grid = abs(target - x) <= reach * (1 + mech.tolerances.equal)
                 if not on_grid:
                     target = x + direction * reach
                 try:
