@@ -68,6 +68,8 @@ class SweepResult:
     unit: str = "rad"  # the input's unit: "rad" or "m"
     coupled: dict | None = None  # <mimic> joint -> its values along the sweep
     skipped: tuple = ()  # input values on the grid the motion passed but could not solve at (holes)
+    method: str = "tracker"  # how it was computed: "closed form" (dyads), "tracker", "batched" (see notes)
+    notes: tuple = ()  # one line each: what the computation chose or fell back to
 
     @property
     def completed(self) -> bool:
@@ -280,7 +282,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             limits = tuple(SweepSingularity("actuator", x, s, q, limit=True) for x, s, q in f.limits)
             return SweepResult(name, f.values, f.q, f.joints, f.rates, f.accelerations, tuple(mech.coordinate_names),
                                rate, f.stopped_at, f.stop_reason, (start, stop, steps), limits, turn,
-                               f.circuit_closed, f.unit)
+                               f.circuit_closed, f.unit, method="closed form")
     rates_in = {n: 0.0 for n in solver.inputs}
     rates_in[name] = rate
     unit = "m" if mech.translational[tr.ix] else "rad"

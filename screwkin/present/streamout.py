@@ -1,0 +1,71 @@
+"""A sweep written a chunk at a time: CSV (the rows of report.sweep_csv) and Parquet (pyarrow).
+
+Each chunk (a SweepResult with its MotionAlong) is appended and let go, so a sweep of millions
+of steps is written in bounded memory.  The CSV is the one ``sweep --csv`` writes in memory, row
+for row; the Parquet file has the same columns (``step`` int64, the others float64), one row
+group per chunk.  pyarrow is optional: without it, asking for Parquet is a usage error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import UsageError
+from .report import sweep_columns, sweep_csv
+
+__all__ = ["SweepWriter", "parquet_available"]
+
+
+def parquet_available() -> bool:
+    try:
+        import pyarrow  # noqa: F401
+        import pyarrow.parquet  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class SweepWriter:
+    """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written)."""
+
+    def __init__(self, csv: str | None = None, parquet: str | None = None):
+        if parquet and not parquet_available():
+            raise UsageError(f"--parquet {parquet}: writing Parquet needs pyarrow (pip install pyarrow); "
+                             "--csv writes the same columns")
+        self._csv = open(csv, "w") if csv else None
+        self._parquet_path, self._pq = parquet, None
+        self.rows = 0
+
+    def write(self, res, motion=None) -> None:
+        if self._csv is not None:
+            self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
+        if self._parquet_path:
+            self._write_parquet(res, motion)
+        self.rows += len(res.values)
+
+    def _write_parquet(self, res, motion):
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        head, cols = sweep_columns(res, motion)
+        names = ["step"] + head
+        arrays = [pa.array(np.arange(self.rows, self.rows + len(res.values), dtype=np.int64))]
+        arrays += [pa.array(np.ascontiguousarray(c, dtype=float)) for c in cols]
+        table = pa.Table.from_arrays(arrays, names=names)
+        if self._pq is None:
+            self._pq = pq.ParquetWriter(self._parquet_path, table.schema)
+        self._pq.write_table(table)
+
+    def close(self) -> None:
+        if self._csv is not None:
+            self._csv.close()
+            self._csv = None
+        if self._pq is not None:
+            self._pq.close()
+            self._pq = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
