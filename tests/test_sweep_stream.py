@@ -117,3 +117,53 @@ def test_streamed_sweeps_refuse_what_they_cannot_do(mech, tmp_path, monkeypatch,
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and all(w in err[0] for w in words), err
     assert not (tmp_path / "x.csv").exists()
+
+
+# ---------------------------------------------------------------- batched continuation (issue 26 item 2)
+
+def tight(path):
+    """The robot with the closure solved to 1e-13: the tracker and the batched corrector then each
+    land within 1e-13 of the same curve, so their answers can be compared to 1e-9 (at the default
+    1e-10 the two differ by the solvers' stopping points: rates by ~1e-9, accelerations ~1e-7)."""
+    from dataclasses import replace
+
+    from conftest import ROBOTS
+    from screwkin.tolerances import DEFAULT
+
+    return screwkin.load(ROBOTS / path, tolerances=replace(DEFAULT, closure=1e-13))
+
+
+def relative(a, b):
+    return float(np.max(np.abs(a - b) / np.maximum(1.0, np.abs(a)))) if np.size(a) else 0.0
+
+
+def test_batched_bennett_is_the_tracker():
+    mech = tight("bennett.urdf")
+    solver = PositionSolver(mech, list(mech.actuated))
+    tracker = sweep(solver, "joint1", 0.0, 2 * np.pi, 300, closed_form=False, batch=False)
+    batched = sweep(solver, "joint1", 0.0, 2 * np.pi, 300)
+    assert (tracker.method, batched.method, batched.notes) == ("tracker", "batched", ())
+    assert batched.completed and len(batched.values) == len(tracker.values) == 301
+    assert relative(tracker.values, batched.values) < 1e-12
+    assert max(np.abs(pin.difference(mech.model, a, b)).max() for a, b in zip(tracker.q, batched.q)) < 1e-9
+    assert relative(tracker.rates, batched.rates) < 1e-9
+    assert relative(tracker.accelerations, batched.accelerations) < 1e-9
+
+
+def test_batched_rssr_meets_its_limit_position_as_the_tracker_and_says_so():
+    """The RSSR's crank stops at a limit position: the batched corrector fails next to it and hands
+    that chunk to the tracker (a note), which locates the limit.  The coupler's spin about its own
+    axis is idle (the balls' three angles are not determined by the input): compared are the input
+    and the rocker, which are."""
+    mech = tight("rssr.urdf")
+    solver = PositionSolver(mech, list(mech.actuated))
+    tracker = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 400, closed_form=False, batch=False)
+    batched = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 400)
+    assert batched.method == "batched" and tracker.stopped_at is not None
+    assert len(batched.notes) == 1 and "per-step tracker" in batched.notes[0]
+    assert batched.stopped_at == pytest.approx(tracker.stopped_at, abs=1e-9)
+    assert batched.stop_reason == tracker.stop_reason and len(batched.limits) == len(tracker.limits) == 1
+    assert relative(tracker.values, batched.values) < 1e-12
+    cols = [mech.coordinate_names.index(n) for n in ("crank_joint", "rocker_joint")]
+    for what in ("q", "rates", "accelerations"):
+        assert relative(getattr(tracker, what)[:, cols], getattr(batched, what)[:, cols]) < 1e-9, what

@@ -204,6 +204,8 @@ def run(mech, args) -> int:
                          linear_names=linear_names))
         for line in strokes_text(slider_strokes, res.unit == "rad"):
             print(line)
+        for n in res.notes:
+            print(f"note: {n}")
         table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad")
         if table_text:
             print()

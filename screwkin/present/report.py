@@ -486,6 +486,7 @@ def sweep_dict(res: SweepResult, mech=None) -> dict:
         "completed": res.completed, "skipped": list(res.skipped),
         "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
         "turn": res.turn, "circuit_closed": res.circuit_closed,
+        "method": res.method, "notes": list(res.notes),
         "singularities": [sweep_singularity_dict(s, mech) for s in res.limits],
         "coordinates": list(res.names),
         "values": res.values.tolist(),
