@@ -93,6 +93,8 @@ def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback):
         sig = (xs - x) / tr.scale[tr.ix] / t[tr.ix]  # predicted steps along the tangent (scaled)
         pred = q[None] + (tr.scale * t)[None] * sig[:, None]  # (nq == nv: integrate is a sum)
         Qc, ok, _, _ = bc.solve(pred, frozen=frozen)
+        ok &= np.all(np.isfinite(Qc), axis=1)
+        Qc[~ok] = pred[~ok]  # (refused below; finite for the tangents)
         jump = np.linalg.norm((Qc - pred) / tr.scale, axis=1)
         ok &= jump <= np.maximum(0.5 * np.abs(sig), _JUMP_FLOOR)
         U = _tangents(bc, tr, Qc)
@@ -125,8 +127,12 @@ def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback):
                 stopped, reason = res.stopped_at, res.stop_reason
                 break
             q, x = Q[-1], X[-1]
-            t = tr.tangent(q, t)
             u = _tangents(bc, tr, q[None])[0]
+            nu = np.linalg.norm(u)
+            if not nu > 0:
+                stopped, reason = x, "the mechanism cannot move along this input here"
+                break
+            t = u / nu if u @ t >= 0 else -u / nu
             k += m
             size = 16
             continue
