@@ -167,3 +167,23 @@ def test_batched_rssr_meets_its_limit_position_as_the_tracker_and_says_so():
     cols = [mech.coordinate_names.index(n) for n in ("crank_joint", "rocker_joint")]
     for what in ("q", "rates", "accelerations"):
         assert relative(getattr(tracker, what)[:, cols], getattr(batched, what)[:, cols]) < 1e-9, what
+
+
+@pytest.mark.parametrize("robot", ["bennett.urdf", "rssr.urdf", "gough_stewart_6ups.urdf"])
+def test_batched_rates_are_the_solvers_rates(robot):
+    """motion_rates at a batched sweep's configurations: PositionSolver.rates and .accelerations of
+    each configuration (minimum norm where the coupler spins idle)."""
+    from conftest import ROBOTS
+    from screwkin.analysis.motion.batch_sweep import batch_closure, motion_rates
+
+    mech = screwkin.load(ROBOTS / robot)
+    inputs = list(mech.actuated)
+    solver = PositionSolver(mech, inputs)
+    res = sweep(solver, inputs[0], 0.0, 0.05, 10, fixed={n: 0.0 for n in inputs[1:]}, rate=2.0)
+    assert res.method == "batched"
+    V, A = motion_rates(solver, batch_closure(mech), res.q, {inputs[0]: 2.0})
+    for q, v, a in zip(res.q, V, A):
+        K = mech.closure.jacobian(q)
+        qd = solver.rates(q, K, {inputs[0]: 2.0})
+        assert relative(qd, v) < 1e-10
+        assert relative(solver.accelerations(q, K, qd, {}), a) < 1e-10

@@ -26,7 +26,7 @@ import pinocchio as pin
 
 from .batch_closure import BatchClosure, Unbatchable
 
-__all__ = ["batch_closure", "batched_motion", "SMALLEST", "LARGEST"]
+__all__ = ["batch_closure", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
 
 SMALLEST, LARGEST = 4, 256  # grid values a chunk: it starts at 16 and doubles while it goes well
 _JUMP_FLOOR = 1e-7  # the smallest correction always accepted (scaled), as sweep._Tracker.step's [-]
@@ -138,3 +138,32 @@ def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback):
             continue
         size = max(SMALLEST, size // 2)
     return X, Q, limits, stopped, reason, skipped, notes
+
+
+def motion_rates(solver, bc, Q, values: dict):
+    """Joint rates and accelerations (N, nv) at the closed configurations Q for the input rates
+    ``values`` (input accelerations zero): PositionSolver.rates and .accelerations of every row,
+    the constraint Jacobians and the minimum-norm passive solves batched (BatchClosure's rows,
+    the same as ClosureSystem.jacobian's), the bias K' q' Pinocchio's, a configuration at a time."""
+    mech = solver.mech
+    Q = np.atleast_2d(np.asarray(Q, float))
+    N, nv = len(Q), mech.nv
+    fr, pa = np.asarray(solver.frozen, int), np.asarray(solver.passive, int)
+    V, A = np.zeros((N, nv)), np.zeros((N, nv))
+    V[:, fr] = solver._input_vector(values)
+    K = bc.constraint_jacobians(Q) if N else np.zeros((0, 0, nv))
+    if not N or K.shape[1] == 0 or not len(pa):
+        return V, A
+    Kp = K[:, :, pa]
+    U, s, Vt = np.linalg.svd(Kp, full_matrices=False)
+    cut = np.finfo(float).eps * max(Kp.shape[1:]) * s[:, :1]
+    keep = (s > cut) & (s[:, :1] > 0)
+    inv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+
+    def solve(B):  # minimum-norm least squares of Kp x = B, row by row (PositionSolver.passive_solver)
+        return np.einsum("nkp,nk->np", Vt, inv * np.einsum("nmk,nm->nk", U, B))
+
+    V[:, pa] = -solve(np.einsum("nmf,nf->nm", K[:, :, fr], V[:, fr]))
+    bias = np.array([mech.closure.bias(q, v) for q, v in zip(Q, V)])
+    A[:, pa] = solve(-bias)
+    return V, A

@@ -34,7 +34,7 @@ import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model.linalg import null_space
-from .batch_sweep import batched_motion
+from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .dyads import planar_sweep
 from ..singularities.singular import Generic, measures, scaled_jacobians
 
@@ -450,13 +450,17 @@ def _finish(solver, name, X, Q, rate, stopped, reason, requested, limits, turn, 
     mech = solver.mech
     rates_in = {n: 0.0 for n in solver.inputs}
     rates_in[name] = rate
-    V, A = [], []
-    for qk in Q:
-        K = mech.closure.jacobian(qk)
-        solve, _ = solver.passive_solver(K)
-        qd = solver.rates(qk, K, rates_in, solve)
-        V.append(qd)
-        A.append(solver.accelerations(qk, K, qd, {}, solve))
+    bc = batch_closure(mech) if method == "batched" else None
+    if bc is not None:
+        V, A = motion_rates(solver, bc, Q, rates_in)
+    else:
+        V, A = [], []
+        for qk in Q:
+            K = mech.closure.jacobian(qk)
+            solve, _ = solver.passive_solver(K)
+            qd = solver.rates(qk, K, rates_in, solve)
+            V.append(qd)
+            A.append(solver.accelerations(qk, K, qd, {}, solve))
     Qa = np.array(Q)
     coupled = None
     if mech.couplings:
