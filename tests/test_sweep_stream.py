@@ -187,3 +187,24 @@ def test_batched_rates_are_the_solvers_rates(robot):
         qd = solver.rates(q, K, {inputs[0]: 2.0})
         assert relative(qd, v) < 1e-10
         assert relative(solver.accelerations(q, K, qd, {}), a) < 1e-10
+
+
+@pytest.mark.parametrize("robot", ["fourbar_crank_rocker.urdf", "slider_crank_offset.urdf", "bennett.urdf",
+                                   "gough_stewart_6ups.urdf"])
+def test_frame_motions_on_stacks_are_pinocchios(robot):
+    """TreeKinematics.motions (what motion_along uses for a tree of 1-DOF joints) against Pinocchio's
+    forwardKinematics a configuration at a time (links._frame_motions) at random joint positions,
+    rates and accelerations: placements, velocities, classical accelerations of every frame."""
+    from conftest import ROBOTS
+    from screwkin.analysis.motion.batch_closure import TreeKinematics
+    from screwkin.analysis.motion.links import _frame_motions
+
+    mech = screwkin.load(ROBOTS / robot)
+    model = mech.model
+    rng = np.random.default_rng(7)
+    Q, V, A = rng.uniform(-3, 3, (50, model.nq)), rng.normal(size=(50, model.nv)), rng.normal(size=(50, model.nv))
+    frames = list(range(model.nframes))
+    ref = _frame_motions(model, model.createData(), frames, Q, V, A)
+    ours = TreeKinematics(mech).motions(Q, V, A, frames)
+    for name, a, b in zip(("R", "t", "velocity", "acceleration"), ref, ours):
+        assert np.max(np.abs(a - b)) < 1e-12, name
