@@ -208,3 +208,14 @@ def test_frame_motions_on_stacks_are_pinocchios(robot):
     ours = TreeKinematics(mech).motions(Q, V, A, frames)
     for name, a, b in zip(("R", "t", "velocity", "acceleration"), ref, ours):
         assert np.max(np.abs(a - b)) < 1e-12, name
+
+
+def test_parquet_without_pyarrow_is_a_usage_error(mech, tmp_path, monkeypatch, capsys):
+    import screwkin.present.streamout as streamout
+
+    monkeypatch.setattr(streamout, "parquet_available", lambda: False)
+    out = tmp_path / "s.parquet"
+    code = main(["sweep", mech.path, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "5",
+                 "--parquet", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "needs pyarrow" in err[0] and not out.exists()

@@ -103,14 +103,14 @@ def _streamed(args) -> bool:
 
 def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
-    angles = points = None
+    angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
+    topo = None
     pieces, methods, notes, limits, skipped = 0, [], [], [], 0
     last = None
     with SweepWriter(args.csv, args.parquet) as out:
         for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, near=near, rate=rate,
                                   chunk=chunk):
-            if points is None:
-                points = named_points(mech, args)
+            if topo is None:
                 topo = mech.topology(piece.q[0])
                 if topo.motion_space == "planar" and topo.normal is not None:
                     angles = LinkAngles(mech, topo)

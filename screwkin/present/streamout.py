@@ -32,12 +32,14 @@ class SweepWriter:
         if parquet and not parquet_available():
             raise UsageError(f"--parquet {parquet}: writing Parquet needs pyarrow (pip install pyarrow); "
                              "--csv writes the same columns")
-        self._csv = open(csv, "w") if csv else None
+        self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
         self._parquet_path, self._pq = parquet, None
         self.rows = 0
 
     def write(self, res, motion=None) -> None:
-        if self._csv is not None:
+        if self._csv_path:
+            if self._csv is None:
+                self._csv = open(self._csv_path, "w")
             self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
         if self._parquet_path:
             self._write_parquet(res, motion)
