@@ -160,6 +160,8 @@ def run(mech, args) -> int:
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
                                                                                       (args.stop, "--to")))
     rate = joint_value(mech, args.input, args.rate, "--rate", order=1)
+    if args.parquet:
+        SweepWriter.require_parquet(args.parquet)  # before any work
     others = {k: v for k, v in fixed.items() if k != args.input}
     if _streamed(args):
         return _run_streamed(mech, args, solver, start, stop, others, near, rate)

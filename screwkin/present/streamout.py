@@ -29,12 +29,18 @@ class SweepWriter:
     """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written)."""
 
     def __init__(self, csv: str | None = None, parquet: str | None = None):
-        if parquet and not parquet_available():
-            raise UsageError(f"--parquet {parquet}: writing Parquet needs pyarrow (pip install pyarrow); "
-                             "--csv writes the same columns")
+        if parquet:
+            self.require_parquet(parquet)
         self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
         self._parquet_path, self._pq = parquet, None
         self.rows = 0
+
+    @staticmethod
+    def require_parquet(path: str) -> None:
+        """Refuse --parquet without pyarrow (a usage error naming it)."""
+        if not parquet_available():
+            raise UsageError(f"--parquet {path}: writing Parquet needs pyarrow (pip install pyarrow); "
+                             "--csv writes the same columns")
 
     def write(self, res, motion=None) -> None:
         if self._csv_path:
