@@ -34,7 +34,9 @@ def screwkin_version() -> str:
 
 #: The bounds of the counts people type, (smallest, largest), by what they count.
 BOUNDS = {
-    "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest
+    "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest (text, JSON, plots)
+    "streamed_steps": (1, 10_000_000),  # sweep --steps writing --csv/--parquet alone, in chunks (a four-bar: ~10 s a million)
+    "chunk": (1, 1_000_000),          # sweep --chunk: steps computed and written at a time
     "dynamics_steps": (1, 20_000),    # dynamics --steps: 1.2 ms a step on a four-bar, 4.5 on a six-bar (90 s at most)
     "figure_steps": (2, 20_000),      # draw --singular / report --steps: a search for singular configurations
     "animation_steps": (1, 1_000),    # draw --animate --steps: frames drawn (steps + 1), about 0.1 s each
@@ -92,7 +94,7 @@ def count(what: str):
 
 
 #: Destinations of options that name a file a command writes (or a prefix of such files).
-OUTPUT_DESTS = ("csv", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate", "mjcf", "urdf")
+OUTPUT_DESTS = ("csv", "parquet", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate", "mjcf", "urdf")
 
 
 def _option_name(action) -> str:

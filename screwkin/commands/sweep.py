@@ -8,14 +8,15 @@ import os
 from ..analysis.motion.links import motion_along, strokes
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
 from ..analysis.motion.sweep import locate_singularities, sweep
 from ..errors import UsageError
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.plots import sweep_plot
+from ..present.streamout import SweepWriter
 from ..present.report import (
     json_text,
     linkage_dict,
-    sweep_csv,
     sweep_dict,
     sweep_rows,
     sweep_singularity_dict,
@@ -30,7 +31,7 @@ from ._common import (
     named_points,
     names_list,
 )
-from ._options import count
+from ._options import BOUNDS, count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -44,12 +45,18 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--input", required=True, help="the input joint to move")
     sp.add_argument("--from", dest="start", required=True, help="first input value (SI or with a unit)")
     sp.add_argument("--to", dest="stop", required=True, help="last input value")
-    sp.add_argument("--steps", type=count("steps"), default=100, help="number of steps (default 100, at most 100,000)")
+    sp.add_argument("--steps", type=_steps, default=100,
+                    help="number of steps (default 100, at most 100,000; up to 10,000,000 when the sweep only "
+                         "writes --csv/--parquet, computed and written in chunks)")
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
     sp.add_argument("--rate", default="1", help="input rate for the joint rates and accelerations (default 1 /s)")
     sp.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
+    sp.add_argument("--parquet", help="write the same columns as --csv to this Parquet file (needs pyarrow)")
+    sp.add_argument("--chunk", type=count("chunk"),
+                    help=f"compute and write --csv/--parquet this many steps at a time, in bounded memory "
+                         f"(the default, {DEFAULT_CHUNK:,}, when --steps is over 100,000); prints a summary only")
     sp.add_argument("--rows", metavar="N|all", help="rows of the text tables (default about 11; all: every step)")
     sp.add_argument("--plot", help="draw the joint values against the input into this PNG file (needs matplotlib)")
     sp.add_argument("--singularities", action="store_true",
@@ -59,6 +66,79 @@ def add_parser(sub, common, scaled):
                    help="pass through limit positions onto the other branch (the input runs back) until the "
                         "mechanism returns to its start or the input reaches --to")
     scaled(sp)
+
+
+def _steps(text):
+    """--steps: 1 to 100,000, or to 10,000,000 for a streamed sweep (checked again in run)."""
+    lo, hi = BOUNDS["steps"]
+    try:
+        return count("streamed_steps")(text)
+    except argparse.ArgumentTypeError as exc:
+        if "between" not in str(exc):
+            raise
+        raise argparse.ArgumentTypeError(
+            f"must be between {lo:,} and {hi:,} (up to {BOUNDS['streamed_steps'][1]:,} when the sweep only writes "
+            f"--csv or --parquet), got {text.strip()}") from None
+
+
+_NOT_STREAMED = (("json", "--json"), ("plot", "--plot"), ("singularities", "--singularities"), ("turn", "--turn"),
+                 ("rows", "--rows"))
+
+
+def _streamed(args) -> bool:
+    """Whether this sweep is computed and written in chunks; refuses what a streamed sweep cannot do."""
+    lo, hi = BOUNDS["steps"]
+    if args.chunk is None and args.steps <= hi:
+        return False
+    why = f"--steps {args.steps:,} (over {hi:,})" if args.chunk is None else "--chunk"
+    if not (args.csv or args.parquet):
+        raise UsageError(f"--steps: must be between {lo:,} and {hi:,} for text, JSON and plots, got {args.steps:,}; "
+                         f"up to {BOUNDS['streamed_steps'][1]:,} steps are written in chunks to --csv or --parquet")
+    for dest, option in _NOT_STREAMED:
+        if getattr(args, dest):
+            raise UsageError(f"{option}: not available with {why}: the sweep is computed and written to "
+                             f"--csv/--parquet in chunks, {hi:,} steps at most otherwise")
+    return True
+
+
+def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
+    chunk = args.chunk or DEFAULT_CHUNK
+    angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
+    topo = None
+    pieces, methods, notes, limits, skipped = 0, [], [], [], 0
+    last = None
+    with SweepWriter(args.csv, args.parquet) as out:
+        for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, near=near, rate=rate,
+                                  chunk=chunk):
+            if topo is None:
+                topo = mech.topology(piece.q[0])
+                if topo.motion_space == "planar" and topo.normal is not None:
+                    angles = LinkAngles(mech, topo)
+            motion = motion_along(mech, piece.q, piece.rates, piece.accelerations, points, angles,
+                                  None if angles is None else angles.n)
+            out.write(piece, motion)
+            pieces += 1
+            if piece.method not in methods:
+                methods.append(piece.method)
+            notes += [n for n in piece.notes if n not in notes]
+            limits += list(piece.limits)
+            skipped += len(piece.skipped)
+            last = piece
+        rows = out.rows
+    rad = last.unit == "rad"
+    files = " and ".join(f for f in (args.csv, args.parquet) if f)
+    print(f"sweep of {args.input} from {value_text(args.input, start, rad)} to {value_text(args.input, stop, rad)} "
+          f"in {args.steps:,} steps, computed and written in {pieces} chunk{'s' if pieces > 1 else ''} of at most "
+          f"{chunk:,} steps ({', '.join(methods)}): {rows:,} rows written to {files}")
+    for n in notes:
+        print(f"note: {n}")
+    for x in limits:
+        print(f"limit position at {args.input} = {value_text(args.input, x.input, rad)}, relative sigma {x.sigma:.2g}")
+    if last.stopped_at is not None:
+        print(f"stopped at {args.input} = {value_text(args.input, last.stopped_at, rad)}: {last.stop_reason}")
+    if skipped:
+        print(f"{skipped} grid value{'s' if skipped > 1 else ''} passed but not solved (holes in the motion)")
+    return 0
 
 
 def _rows(text):
@@ -79,9 +159,14 @@ def run(mech, args) -> int:
         raise UsageError("--point needs --output LINK")
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
                                                                                       (args.stop, "--to")))
-    res = sweep(solver, args.input, start, stop, args.steps,
-                fixed={k: v for k, v in fixed.items() if k != args.input}, near=near,
-                rate=joint_value(mech, args.input, args.rate, "--rate", order=1), progress=True, turn=args.turn)
+    rate = joint_value(mech, args.input, args.rate, "--rate", order=1)
+    if args.parquet:
+        SweepWriter.require_parquet(args.parquet)  # before any work
+    others = {k: v for k, v in fixed.items() if k != args.input}
+    if _streamed(args):
+        return _run_streamed(mech, args, solver, start, stop, others, near, rate)
+    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, near=near, rate=rate, progress=True,
+                turn=args.turn)
     topo = mech.topology(res.q[0])
     angles = LinkAngles(mech, topo) if topo.motion_space == "planar" and topo.normal is not None else None
     motion = motion_along(mech, res.q, res.rates, res.accelerations, named_points(mech, args), angles,
@@ -94,9 +179,9 @@ def run(mech, args) -> int:
     sing = list(res.limits)  # the limit positions met are always listed
     if args.singularities:
         sing = locate_singularities(solver, res, output=args.output, point=args.point)
-    if args.csv:
-        with open(args.csv, "w") as f:
-            f.write(sweep_csv(res, motion))
+    if args.csv or args.parquet:
+        with SweepWriter(args.csv, args.parquet) as out:
+            out.write(res, motion)
     if args.plot:
         sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
                    normal=None if angles is None else angles.n,
@@ -121,6 +206,8 @@ def run(mech, args) -> int:
                          linear_names=linear_names))
         for line in strokes_text(slider_strokes, res.unit == "rad"):
             print(line)
+        for n in res.notes:
+            print(f"note: {n}")
         table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad")
         if table_text:
             print()

@@ -486,6 +486,7 @@ def sweep_dict(res: SweepResult, mech=None) -> dict:
         "completed": res.completed, "skipped": list(res.skipped),
         "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
         "turn": res.turn, "circuit_closed": res.circuit_closed,
+        "method": res.method, "notes": list(res.notes),
         "singularities": [sweep_singularity_dict(s, mech) for s in res.limits],
         "coordinates": list(res.names),
         "values": res.values.tolist(),
@@ -496,33 +497,45 @@ def sweep_dict(res: SweepResult, mech=None) -> dict:
     }
 
 
-def sweep_csv(res: SweepResult, motion=None) -> str:
-    """One row per step: the input, every joint value, rate and acceleration, the coupled joints; with
+def sweep_columns(res: SweepResult, motion=None) -> tuple:
+    """(header, columns): the input, every joint value, rate and acceleration, the coupled joints; with
     ``motion`` (analysis.motion.links.MotionAlong) the loop joints, each link's absolute angle (planar) and
-    each named point's x, y, z [m]."""
+    each named point's x, y, z [m].  Columns are float arrays, one value per step (the step number
+    is not among them)."""
     coupled = res.coupled or {}
-    head = ["step", res.input + "_input"] + list(res.names) + [f"d_{n}" for n in res.names] + [
+    head = [res.input + "_input"] + list(res.names) + [f"d_{n}" for n in res.names] + [
         f"dd_{n}" for n in res.names] + list(coupled)
-    extra = []
+    n = len(res.values)
+    cols = [np.asarray(res.values, float)]
+    for M in (res.joints, res.rates, res.accelerations):
+        M = np.asarray(M, float).reshape(n, -1)
+        cols += [M[:, i] for i in range(M.shape[1])]
+    cols += [np.asarray(v, float) for v in coupled.values()]
     if motion is not None:
         for name, v in motion.loop_joints.items():
-            extra += [(f"{name} (loop)", v), (f"d_{name} (loop)", motion.loop_rates[name]),
-                      (f"dd_{name} (loop)", motion.loop_accelerations[name])]
+            head += [f"{name} (loop)", f"d_{name} (loop)", f"dd_{name} (loop)"]
+            cols += [np.asarray(x, float) for x in (v, motion.loop_rates[name], motion.loop_accelerations[name])]
         for name, m in motion.links.items():
             if "angle" in m:
-                extra += [(f"{name} angle", m["angle"]), (f"{name} omega", m["omega"]), (f"{name} alpha", m["alpha"])]
+                head += [f"{name} angle", f"{name} omega", f"{name} alpha"]
+                cols += [np.asarray(m[k], float) for k in ("angle", "omega", "alpha")]
         for name, p in motion.points.items():
-            P = np.asarray(p["position"])
-            extra += [(f"{name} {ax}", P[:, i]) for i, ax in enumerate("xyz")]
-    head += [n for n, _ in extra]
-    rows = []
-    for k in range(len(res.values)):
-        row = [str(k), f"{res.values[k]:.12g}"] + [f"{x:.12g}" for x in res.joints[k]]
-        row += [f"{x:.12g}" for x in res.rates[k]] + [f"{x:.12g}" for x in res.accelerations[k]]
-        row += [f"{v[k]:.12g}" for v in coupled.values()]
-        row += [f"{float(v[k]):.12g}" for _, v in extra]
-        rows.append(row)
-    return csv_text(head, rows)
+            P = np.asarray(p["position"], float)
+            head += [f"{name} {ax}" for ax in "xyz"]
+            cols += [P[:, i] for i in range(3)]
+    return head, cols
+
+
+def sweep_csv(res: SweepResult, motion=None, first_step: int = 0, header: bool = True) -> str:
+    """One row per step (see :func:`sweep_columns`), numbered from ``first_step``, every value with 12
+    significant digits; ``header`` False: the rows alone (a chunk of a streamed sweep)."""
+    head, cols = sweep_columns(res, motion)
+    top = csv_text(["step"] + head, []) if header else ""
+    if not len(res.values):
+        return top
+    fmt = "%d," + ",".join(["%.12g"] * len(cols)) + "\n"
+    M = np.column_stack(cols).tolist()
+    return top + "".join([fmt % (first_step + k, *row) for k, row in enumerate(M)])
 
 
 def scan_dict(res: ScanResult) -> dict:

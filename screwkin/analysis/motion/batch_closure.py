@@ -79,13 +79,10 @@ class TreeKinematics:
                                np.hstack([frame.placement.rotation, frame.placement.translation[:, None]]).T.copy())
         return self._frames[f]
 
-    def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
-        """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
-        frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
-        velocity columns ``cols`` of the joints that move it (J and cols None for a frame
-        fixed to the ground, and without ``jacobian``)."""
+    def _pass(self, Q):
+        """(RTs, ps, ws) of every joint (index 0 the ground) for the configurations Q (N, nq):
+        rotations transposed and flattened (3, 3N), origins (N, 3), axes in the world (N, 3)."""
         model = self.model
-        Q = np.atleast_2d(np.asarray(Q, float))
         N = len(Q)
         # rotations kept transposed and flattened: RT[j, 3 n + i] = R[n][i, j], so that a child's
         # is one product with the parent's, C^T RT (11 x 3N), and the rest is on contiguous rows
@@ -107,6 +104,56 @@ class TreeKinematics:
                 RT = XT[0:3]
                 pos = pos + w * Q[:, iq, None]
             RTs[j], ps[j], ws[j] = RT, pos, w
+        return RTs, ps, ws
+
+    def motions(self, Q, V, A, frame_ids):
+        """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
+        (a, alpha) of the frames' origins in world axes (N, F, 6) for joint positions Q, rates V and
+        accelerations A (N, nv): links._frame_motions' result (Pinocchio's forwardKinematics a step,
+        LOCAL_WORLD_ALIGNED), by the recursions down the tree on the stacks.  A revolute joint's
+        axis w turns with its parent: omega += w q', alpha += w q'' + omega_p x w q'; a prismatic
+        joint slides its origin: v += w q', a += w q'' + 2 omega_p x w q'."""
+        Q, V, A = (np.atleast_2d(np.asarray(x, float)) for x in (Q, V, A))
+        N = len(Q)
+        RTs, ps, ws = self._pass(Q)
+        zero = np.zeros((N, 3))
+        om, vel, al, acc = [zero], [zero], [zero], [zero]
+        for j, (parent, kind, _, iq) in enumerate(self.joints, start=1):
+            w, r = ws[j], ps[j] - ps[parent]
+            wp, alp = om[parent], al[parent]
+            wr = np.cross(wp, r)
+            v = vel[parent] + wr
+            a = acc[parent] + np.cross(alp, r) + np.cross(wp, wr)
+            wqd, wqdd = w * V[:, iq, None], w * A[:, iq, None]  # (nq == nv: iq is the velocity index)
+            if kind == "R":
+                o, alpha = wp + wqd, alp + wqdd + np.cross(wp, wqd)
+            else:
+                o, alpha = wp, alp
+                v, a = v + wqd, a + wqdd + 2.0 * np.cross(wp, wqd)
+            om.append(o), vel.append(v), al.append(alpha), acc.append(a)
+        F = len(frame_ids)
+        R, t = np.empty((N, F, 3, 3)), np.empty((N, F, 3))
+        tw, ac = np.empty((N, F, 6)), np.empty((N, F, 6))
+        for i, f in enumerate(frame_ids):
+            jid, CfT = self._frame(f)
+            XT = CfT @ RTs[jid]
+            R[:, i] = XT[0:3].reshape(3, N, 3).transpose(1, 2, 0)
+            t[:, i] = ps[jid] + XT[3].reshape(N, 3)
+            r = t[:, i] - ps[jid]
+            wr = np.cross(om[jid], r)
+            tw[:, i, :3], tw[:, i, 3:] = vel[jid] + wr, om[jid]
+            ac[:, i, :3] = acc[jid] + np.cross(al[jid], r) + np.cross(om[jid], wr)
+            ac[:, i, 3:] = al[jid]
+        return R, t, tw, ac
+
+    def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
+        """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
+        frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
+        velocity columns ``cols`` of the joints that move it (J and cols None for a frame
+        fixed to the ground, and without ``jacobian``)."""
+        Q = np.atleast_2d(np.asarray(Q, float))
+        N = len(Q)
+        RTs, ps, ws = self._pass(Q)
         Wall = np.stack([np.zeros((N, 3))] + ws[1:], axis=2)  # (N, 3, njoints)
         Pall = np.stack(ps, axis=2)
         out = {}

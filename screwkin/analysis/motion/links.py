@@ -23,6 +23,7 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model.state import loop_coordinate_cuts
+from .batch_closure import TreeKinematics, Unbatchable
 
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "moving_links", "Stroke",
            "strokes"]
@@ -107,7 +108,8 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     point_f = [mech.link_frame(p.link) for p in points]
     frames = list(dict.fromkeys(link_f + point_f + [f for c in cuts for f in (c.frame1, c.frame2)]))
     col = {f: i for i, f in enumerate(frames)}
-    R, t, tw, ac = _frame_motions(model, data, frames, Q, V, A)
+    tree = _tree(mech) if len(Q) else None
+    R, t, tw, ac = tree.motions(Q, V, A, frames) if tree is not None else _frame_motions(model, data, frames, Q, V, A)
     named = None
     if angles is not None and normal is not None:
         named = angles.batch(Q) if hasattr(angles, "batch") else {
@@ -158,6 +160,18 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
             loop_accs[c.name] = dot(al2 - al1, axis) + dot(w2 - w1, da)
     return MotionAlong(loops, loop_rates, loop_accs, out_links, pts,
                        tuple(c.name for c in cuts if c.type != "prismatic"))
+
+
+def _tree(mech):
+    """The mechanism's TreeKinematics (cached: the frames' motions on stacks), None when its joints
+    are not all 1-DOF revolute or prismatic (then Pinocchio a step: _frame_motions)."""
+    key = "links.tree"
+    if key not in mech.cache:
+        try:
+            mech.cache[key] = TreeKinematics(mech)
+        except Unbatchable:
+            mech.cache[key] = None
+    return mech.cache[key]
 
 
 def _frame_motions(model, data, frames, Q, V, A):

@@ -34,6 +34,7 @@ import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model.linalg import null_space
+from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .dyads import planar_sweep
 from ..singularities.singular import Generic, measures, scaled_jacobians
 
@@ -72,6 +73,8 @@ class SweepResult:
     unit: str = "rad"  # the input's unit: "rad" or "m"
     coupled: dict | None = None  # <mimic> joint -> its values along the sweep
     skipped: tuple = ()  # input values on the grid the motion passed but could not solve at (holes)
+    method: str = "tracker"  # how it was computed: "closed form" (dyads), "tracker", "batched" (see notes)
+    notes: tuple = ()  # one line each: what the computation chose or fell back to
 
     @property
     def completed(self) -> bool:
@@ -253,7 +256,7 @@ class Neighbour:
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
-          max_steps: int | None = None, q_start=None, closed_form: bool = True) -> SweepResult:
+          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
 
@@ -266,6 +269,9 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     after ``max_steps`` recorded configurations (default 20 * steps + 100).
     closed_form: a planar mechanism made of dyads is solved at every grid value at once
     (screwkin.analysis.motion.dyads), the same result; False: always the tracker.
+    batch: without turn, a mechanism the closed form does not cover is corrected a chunk of grid
+    values at a time (screwkin.analysis.motion.batch_sweep), the tracker taking the chunks that
+    fail (said in ``notes``); False: the per-step tracker.
     """
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -291,9 +297,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             limits = tuple(SweepSingularity("actuator", x, s, q, limit=True) for x, s, q in f.limits)
             return SweepResult(name, f.values, f.q, f.joints, f.rates, f.accelerations, tuple(mech.coordinate_names),
                                rate, f.stopped_at, f.stop_reason, (start, stop, steps), limits, turn,
-                               f.circuit_closed, f.unit)
-    rates_in = {n: 0.0 for n in solver.inputs}
-    rates_in[name] = rate
+                               f.circuit_closed, f.unit, method="closed form")
     unit = "m" if mech.translational[tr.ix] else "rad"
     X, Q = [start], [q0]
     limits = []
@@ -307,6 +311,13 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         t, stopped, reason = None, start, str(exc)
     if t is not None and t[tr.ix] * direction < 0:
         t = -t
+    if batch and not turn and h != 0 and t is not None:
+        b = batched_motion(solver, tr, q0, t, start, stop, steps, lambda qa, xa, xb, n: sweep(
+            solver, name, xa, xb, n, fixed=fixed, rate=rate, q_start=qa, closed_form=False, batch=False))
+        if b is not None:
+            X, Q, limits, stopped, reason, skipped, notes = b
+            return _finish(solver, name, X, Q, rate, stopped, reason, (start, stop, steps), limits, False, False,
+                           unit, skipped, "batched", notes)
     q, x = q0, float(start)
 
     def grid_between(xa, xb):
@@ -455,13 +466,27 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         sys.stderr.write("\n")
     if turn and stopped is None and not closed and (stop - x) * np.sign(h) > 1e-9 * max(1.0, abs(stop)):
         stopped, reason = x, "the motion did not reach the end of the range"
-    V, A = [], []
-    for qk in Q:
-        K = mech.closure.jacobian(qk)
-        solve, _ = solver.passive_solver(K)
-        qd = solver.rates(qk, K, rates_in, solve)
-        V.append(qd)
-        A.append(solver.accelerations(qk, K, qd, {}, solve))
+    return _finish(solver, name, X, Q, rate, stopped, reason, (start, stop, steps), limits, turn, closed, unit,
+                   skipped)
+
+
+def _finish(solver, name, X, Q, rate, stopped, reason, requested, limits, turn, closed, unit, skipped,
+            method="tracker", notes=()):
+    """The SweepResult of the configurations Q at input values X: rates and accelerations at each."""
+    mech = solver.mech
+    rates_in = {n: 0.0 for n in solver.inputs}
+    rates_in[name] = rate
+    bc = batch_closure(mech) if method == "batched" else None
+    if bc is not None:
+        V, A = motion_rates(solver, bc, Q, rates_in)
+    else:
+        V, A = [], []
+        for qk in Q:
+            K = mech.closure.jacobian(qk)
+            solve, _ = solver.passive_solver(K)
+            qd = solver.rates(qk, K, rates_in, solve)
+            V.append(qd)
+            A.append(solver.accelerations(qk, K, qd, {}, solve))
     Qa = np.array(Q)
     coupled = None
     if mech.couplings:
@@ -469,7 +494,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         coupled = {c.joint: np.array([v[c.joint] for v in values]) for c in mech.couplings}
     return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
                        np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
-                       (start, stop, steps), tuple(limits), turn, closed, unit, coupled, tuple(skipped))
+                       requested, tuple(limits), turn, closed, unit, coupled, tuple(skipped), method, tuple(notes))
 
 
 def _matrix(mech, q, kind, g, V_ref=None):

@@ -1,0 +1,79 @@
+"""A sweep written a chunk at a time: CSV (the rows of report.sweep_csv) and Parquet (pyarrow).
+
+Each chunk (a SweepResult with its MotionAlong) is appended and let go, so a sweep of millions
+of steps is written in bounded memory.  The CSV is the one ``sweep --csv`` writes in memory, row
+for row; the Parquet file has the same columns (``step`` int64, the others float64), one row
+group per chunk.  pyarrow is optional: without it, asking for Parquet is a usage error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import UsageError
+from .report import sweep_columns, sweep_csv
+
+__all__ = ["SweepWriter", "parquet_available"]
+
+
+def parquet_available() -> bool:
+    try:
+        import pyarrow  # noqa: F401
+        import pyarrow.parquet  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+class SweepWriter:
+    """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written)."""
+
+    def __init__(self, csv: str | None = None, parquet: str | None = None):
+        if parquet:
+            self.require_parquet(parquet)
+        self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
+        self._parquet_path, self._pq = parquet, None
+        self.rows = 0
+
+    @staticmethod
+    def require_parquet(path: str) -> None:
+        """Refuse --parquet without pyarrow (a usage error naming it)."""
+        if not parquet_available():
+            raise UsageError(f"--parquet {path}: writing Parquet needs pyarrow (pip install pyarrow); "
+                             "--csv writes the same columns")
+
+    def write(self, res, motion=None) -> None:
+        if self._csv_path:
+            if self._csv is None:
+                self._csv = open(self._csv_path, "w")
+            self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
+        if self._parquet_path:
+            self._write_parquet(res, motion)
+        self.rows += len(res.values)
+
+    def _write_parquet(self, res, motion):
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        head, cols = sweep_columns(res, motion)
+        names = ["step"] + head
+        arrays = [pa.array(np.arange(self.rows, self.rows + len(res.values), dtype=np.int64))]
+        arrays += [pa.array(np.ascontiguousarray(c, dtype=float)) for c in cols]
+        table = pa.Table.from_arrays(arrays, names=names)
+        if self._pq is None:
+            self._pq = pq.ParquetWriter(self._parquet_path, table.schema)
+        self._pq.write_table(table)
+
+    def close(self) -> None:
+        if self._csv is not None:
+            self._csv.close()
+            self._csv = None
+        if self._pq is not None:
+            self._pq.close()
+            self._pq = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
