@@ -311,7 +311,9 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         t, stopped, reason = None, start, str(exc)
     if t is not None and t[tr.ix] * direction < 0:
         t = -t
-    if batch and not turn and h != 0 and t is not None:
+    # batched only on grids no coarser than the longest step the tracker takes (Tolerances.max_step): a
+    # chunk corrected at once cannot take the shorter steps a coarse grid needs across a bend
+    if batch and not turn and h != 0 and t is not None and abs(h) / tr.scale[tr.ix] <= mech.tolerances.max_step:
         b = batched_motion(solver, tr, q0, t, start, stop, steps, lambda qa, xa, xb, n: sweep(
             solver, name, xa, xb, n, fixed=fixed, rate=rate, q_start=qa, closed_form=False, batch=False))
         if b is not None:
