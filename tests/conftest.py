@@ -117,7 +117,7 @@ def no_hang(seconds):
 #: Skip reasons that mean "something .ci/run installs is missing": under CI=true such a skip fails the run.
 CI_PROVIDES = ("Chromium is not installed", "example-robot-data is not installed", "No module named 'numba'",
                "No module named 'matplotlib'", "could not import 'numba'", "could not import 'matplotlib'",
-               "modern_robotics is not installed")
+               "modern_robotics is not installed", "pylinkage is not installed")
 _ci_skips = []
 
 

@@ -174,7 +174,7 @@ def test_strider_feet_are_pylinkages():
     """robots/strider.urdf against pylinkage's own Strider (its docs/examples/strider.py, built here
     with its components; one pylinkage unit = 0.1 m): both feet over a whole turn of the crank,
     turning clockwise by one degree a step as pylinkage's does."""
-    pytest.importorskip("pylinkage")
+    pytest.importorskip("pylinkage", reason="pylinkage is not installed (the test extra has it)")
     from pylinkage.actuators import Crank
     from pylinkage.components import Ground
     from pylinkage.dyads import FixedDyad, RRRDyad

@@ -107,21 +107,13 @@ def run(mech, args) -> int:
             singular.append((s.q, twist))
             print(f"singular ({s.kind}) at {name} = {s.input:.9g}")
     scene = build_scene(mech, q, output=args.output, singular=singular)
-    serving = False
     with _stopped_by_signals() as stopping:
-        try:
-            with ViewerServer(port=args.port) as server:
-                show(mech, scene, server.viewer, q, motion=motion, fps=FPS)
-                if args.html or args.png:
-                    _pictures(mech, args, server, scene, frames)
-                    return 0
-                print(f"meshcat: {server.web_url}  (Ctrl-C to stop)", flush=True)
-                serving = True
-                while True:
-                    time.sleep(1)
-        except KeyboardInterrupt:
-            if not serving:
-                raise
+        with ViewerServer(port=args.port) as server:
+            show(mech, scene, server.viewer, q, motion=motion, fps=FPS)
+            if args.html or args.png:
+                _pictures(mech, args, server, scene, frames)
+                return 0
+            _serve_until_stopped(f"meshcat: {server.web_url}")
     if stopping:
         print(f"stopped by {signal.Signals(stopping[0]).name}: the meshcat server on port {server.port} is closed",
               flush=True)
@@ -171,19 +163,24 @@ def _interactive(mech, args) -> int:
     scene = build_scene(mech, q, output=args.output)
     if planar_basis(mech, q) is not None:
         colour_links(scene, link_colours(mech, q))
-    serving = False
     with _stopped_by_signals() as stopping:
         view = InteractiveView(mech, live, scene, port=args.port, title=os.path.basename(mech.path))
         try:
-            print(f"interactive view: {view.url}  (Ctrl-C to stop)", flush=True)
-            serving = True
-            while True:
-                time.sleep(1)
-        except KeyboardInterrupt:
-            if not serving:
-                raise
+            _serve_until_stopped(f"interactive view: {view.url}")
         finally:
             view.close()
     if stopping:
         print(f"stopped by {signal.Signals(stopping[0]).name}: the server on port {view.port} is closed", flush=True)
     return 0
+
+
+def _serve_until_stopped(where: str) -> None:
+    """Say where the page is served and wait until Ctrl-C (or SIGTERM/SIGHUP, which
+    _stopped_by_signals turns into the same interrupt) ends the serving; an interrupt before
+    the page is served propagates from the caller."""
+    print(f"{where}  (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(1)
+    except KeyboardInterrupt:
+        return
