@@ -38,7 +38,8 @@ from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .dyads import planar_sweep
 from ..singularities.singular import Generic, measures, scaled_jacobians
 
-__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour", "CONTINUATION_ROUNDS"]
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "locate_singularities", "Neighbour", "CONTINUATION_ROUNDS",
+           "drawn_start"]
 
 #: Continuation steps a sweep may take per configuration it records (a bound on its work: a motion that
 #: bends too sharply for any step the corrector accepts stops, said so, instead of running on).
@@ -254,6 +255,29 @@ class Neighbour:
         return q
 
 
+def drawn_start(solver, values: dict):
+    """The configuration the file is drawn in, when it is already at the input ``values`` and is the
+    mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
+    the drawing of those), found without solve's search from random starts (a sweep from the drawn
+    position: 1 ms, not 13 ms, for the Strider); None otherwise."""
+    ref = solver._reference()
+    if ref is None:
+        return None
+    drawn = solver.joint_values(ref)
+    angular, tol = set(solver.angular_names()), solver.mech.tolerances
+    for n, v in values.items():
+        if n not in drawn:
+            return None
+        d = drawn[n] - v
+        if abs(float(np.angle(np.exp(1j * d))) if n in angular else d) > tol.equal:
+            return None
+    sol = solver.solve(values, near=drawn, starts=0).solutions[0]
+    far = np.linalg.norm(solver._signature(sol.q) - solver._signature(ref))
+    if not sol.physical or sol.singular or far > tol.geometry * solver.mech.length:
+        return None
+    return sol.q
+
+
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
           max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True) -> SweepResult:
@@ -289,8 +313,10 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     if q_start is not None:
         q0 = solver.track({name: start, **fixed}, q_start).q
     else:
-        first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
-        q0 = first.solutions[0].q
+        q0 = drawn_start(solver, {name: start, **fixed}) if near is None else None
+        if q0 is None:
+            first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
+            q0 = first.solutions[0].q
     if closed_form:
         f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
         if f is not None:
