@@ -297,8 +297,8 @@ class _Layout:
         self.geo, self.q0, self.nq, self.nv = geo, q0, model.nq, model.nv
         self.wrapped = [(iq, iv) for iq, nq, iv, kind, _, _, _ in self.rows if kind == "R" and nq == 1]
 
-    def __call__(self, poses, N, rate):
-        """(Q (N, nq) with the one-coordinate angles not yet unwrapped, rates, accelerations)."""
+    def __call__(self, poses, N):
+        """(Q (N, nq) with the one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2 (N, nv))."""
         geo, q0 = self.geo, self.q0
         Q = np.tile(q0, (N, 1))
         V, A = np.zeros((N, self.nv)), np.zeros((N, self.nv))
@@ -320,25 +320,31 @@ class _Layout:
                 # d0 . R(-th_p) (g_c(o0) - g_p(o0))
                 rel = (pp.c * dx + pp.s * dy) * d0[0] + (pp.c * dy - pp.s * dx) * d0[1]
                 Q[:, iq] = q0[iq] + rel.v
-            V[:, iv] = rel.d * rate
-            A[:, iv] = rel.dd * rate * rate
+            V[:, iv] = rel.d
+            A[:, iv] = rel.dd
         return Q, V, A
 
 
 class _Unwrap:
     """Makes the one-coordinate revolute angles continuous along the motion: each new sample
-    takes the turn (2 pi k) nearest to the previous one moved by its rates (trapezoid)."""
+    takes the turn (2 pi k) nearest to the previous one moved by its slopes d angle / dx
+    (trapezoid).  ``ambiguous``: a step turned a joint by more than a quarter turn, where the
+    choice could be wrong (a coarse grid; next to a limit, where the slope is infinite)."""
+
+    _SAFE = np.pi / 2  # the largest turn between two samples taken as unambiguous [rad]
 
     def __init__(self, wrapped):
         self.cols = np.array([iq for iq, _ in wrapped], int)
         self._iv = np.array([iv for _, iv in wrapped], int)
         self.last = None  # (raw, slope, x, turns) of the last sample
+        self.ambiguous = False
 
-    def __call__(self, Q, V, xs, rate):
+    def __call__(self, Q, D, xs):
+        """Q with its angles unwrapped; D (N, nv): dq/dx."""
         if not len(self.cols) or not len(xs):
             return Q
         raw = Q[:, self.cols]
-        slope = V[:, self._iv] / rate if rate else np.zeros_like(raw)
+        slope = D[:, self._iv]
         if self.last is None:
             self.last = (raw[0], slope[0], xs[0], np.zeros(len(self.cols)))
         r0, s0, x0, k0 = self.last
@@ -349,6 +355,8 @@ class _Unwrap:
             pred = 0.5 * (ss[1:] + ss[:-1]) * np.diff(xx)[:, None]
         pred = np.where(np.isfinite(pred), pred, 0.0)
         k = np.round((pred - np.diff(rr, axis=0)) / (2 * np.pi))
+        if np.any(np.abs(np.diff(rr, axis=0) + 2 * np.pi * k) > self._SAFE):
+            self.ambiguous = True
         turns = k0 + np.cumsum(k, axis=0)
         Q = Q.copy()
         Q[:, self.cols] = raw + 2 * np.pi * turns
@@ -453,8 +461,8 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
             return None
         if n_ok:
             sub = {g: _Pose(_take(q.th, n_ok), _take(q.tx, n_ok), _take(q.ty, n_ok)) for g, q in poses.items()}
-            Q, V, A = layout(sub, n_ok, rate)
-            Q = unwrap(Q, V, xs[:n_ok], rate)
+            Q, D, DD = layout(sub, n_ok)
+            Q, V, A = unwrap(Q, D, xs[:n_ok]), D * rate, DD * rate * rate
             xs_ok = xs[:n_ok]
             if turn and forward and not first:  # back at the start: the circuit is closed
                 at = np.flatnonzero(np.abs(xs_ok - start) < mech.tolerances.equal * max(1.0, abs(h)))
@@ -487,8 +495,8 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
         d_lim = _evaluate(geo, p, [x_lim], start, branch)[1][:, 0]
         which = int(np.argmin(np.abs(np.where(np.isnan(d_lim), np.inf, d_lim))))
         poses = _evaluate(geo, p, [x_lim], start, branch, clamp=which)[0]
-        Q, V, _ = layout(poses, 1, rate)
-        q_lim = unwrap(Q, V, np.array([x_lim]), rate)[0]
+        Q, D, _ = layout(poses, 1)
+        q_lim = unwrap(Q, D, np.array([x_lim]))[0]
         if not _residuals_ok(mech, q_lim[None]):
             return None
         sig = measures(mech, q_lim, solver.generic())["actuator"]
@@ -500,6 +508,8 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
         forward = not forward
         k_pos = (x_lim - start) / h
         last_x = float(x_lim)
+    if unwrap.ambiguous:
+        return None  # the tracker, which follows the turns of every joint step by step
     X = np.concatenate(Xs)
     Q, V, A = np.vstack(Qs), np.vstack(Vs), np.vstack(As)
     if not _residuals_ok(mech, Q):
