@@ -305,3 +305,14 @@ def test_the_page_draws_a_polyline_per_point(fourbar):
             np.testing.assert_allclose(segs[-1, 1], live.state.points[name], rtol=0, atol=1e-6)
     finally:
         view.close()
+
+
+def test_a_value_beyond_the_controls_range_is_refused(fourbar):
+    """A request past a control's range (a typed value, not the slider) moves nothing and says why."""
+    live = Interactive(fourbar)
+    ctl = live.control("crank_joint")
+    before = live.state.q.copy()
+    s = live.move("crank_joint", ctl.high + 1.0)
+    assert not s.moved and "outside its control's range" in s.message
+    np.testing.assert_array_equal(s.q, before)
+    assert live.move("crank_joint", ctl.start + 0.2).moved  # a value inside still moves

@@ -187,12 +187,14 @@ class Interactive:
         start = self._values[name]
         if value == start:
             return self.state
+        if not ctl.low <= value <= ctl.high:
+            return self._refused(f"{name}: {value:.6g} {ctl.unit} is outside its control's range "
+                                 f"[{ctl.low:.6g}, {ctl.high:.6g}] {ctl.unit}; nothing moved")
         step = MAX_STEP * (self.mech.length if ctl.unit == "m" else 1.0)
         steps = max(1, math.ceil(abs(value - start) / step))
         fixed = {n: v for n, v in self._values.items() if n != name}
-        near = self.mech.joint_values(self.state.q)
-        try:
-            res = sweep(self.solver, name, start, value, steps, fixed=fixed, near=near)
+        try:  # continued from the current configuration: its assembly mode is kept
+            res = sweep(self.solver, name, start, value, steps, fixed=fixed, q_start=self.state.q)
         except AssemblyError as exc:
             return self._refused(f"{name} cannot move from here: {exc}")
         if res.stopped_at is not None or res.skipped:
