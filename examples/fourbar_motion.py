@@ -15,7 +15,8 @@ import numpy as np
 import screwkin
 from screwkin.analysis.motion.planar import identify
 from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.motion.sweep import locate_singularities, sweep
+from screwkin.analysis.motion.singular_points import locate_singularities
+from screwkin.analysis.motion.sweep import sweep
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 steps = int(sys.argv[1]) if len(sys.argv) > 1 else 180

@@ -25,7 +25,8 @@ from .analysis.singularities.scan import ScanResult, scan
 from .analysis.singularities.singular import SingularityReport, classify
 from .analysis.design.study import StudyResult, pareto_front
 from .parallel.study import run_study as _run_study
-from .analysis.motion.sweep import SweepResult, SweepSingularity, locate_singularities, sweep
+from .analysis.motion.singular_points import locate_singularities
+from .analysis.motion.sweep import SweepResult, SweepSingularity, sweep
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
 from .model import loader as _loader
 from .model import mechanism as _mechanism

@@ -11,7 +11,8 @@ import pytest
 from conftest import ROBOTS
 
 import screwkin
-from screwkin.analysis.course.skeleton import kinematic_chain, letters, singular_configurations, skeleton
+from screwkin.analysis.course.figures import singular_configurations
+from screwkin.analysis.course.skeleton import kinematic_chain, letters, skeleton
 from screwkin.cli import main
 from screwkin.present.draw import draw_chain, draw_mechanism
 

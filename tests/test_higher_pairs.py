@@ -11,7 +11,8 @@ import pytest
 import screwkin
 from conftest import ROBOTS
 from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.motion.sweep import locate_singularities, sweep
+from screwkin.analysis.motion.singular_points import locate_singularities
+from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 
 

@@ -13,7 +13,8 @@ import numpy as np
 from ..analysis.motion.links import motion_along
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.sweep import sweep
-from ..analysis.course.skeleton import kinematic_chain, singular_configurations, skeleton, trace_points
+from ..analysis.course.figures import singular_configurations, trace_points
+from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
 from ..present.animate import animation_format, write_animation
 from ..present.draw import (

@@ -20,7 +20,8 @@ from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.motion.position import PositionSolver
-from ..analysis.course.skeleton import default_output, kinematic_chain, singular_configurations, skeleton
+from ..analysis.course.figures import default_output, singular_configurations
+from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import ScrewkinError, UsageError
 from ..present.document import (
     Document,

@@ -9,7 +9,8 @@ from ..analysis.motion.links import motion_along, strokes
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
-from ..analysis.motion.sweep import locate_singularities, sweep
+from ..analysis.motion.singular_points import locate_singularities
+from ..analysis.motion.sweep import sweep
 from ..errors import UsageError
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.plots import sweep_plot

@@ -12,7 +12,8 @@ import time
 from ..analysis.motion.interactive import Interactive
 from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.singular import classify
-from ..analysis.motion.sweep import locate_singularities, sweep
+from ..analysis.motion.singular_points import locate_singularities
+from ..analysis.motion.sweep import sweep
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module

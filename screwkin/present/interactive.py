@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
-from .view import fit_camera, view_direction
+from .camera import fit_camera, view_direction
 from .viewplanar import planar_basis
 
 __all__ = ["InteractiveView", "viser_module"]

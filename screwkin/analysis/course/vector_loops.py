@@ -42,7 +42,6 @@ pay for it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
@@ -53,76 +52,14 @@ from .det_conditions import SIMPLIFY_OPS, determinant
 from .placing import LOWER, configuration
 from .placing import wrap as _wrap
 from .rolling import (HIGHER, drop_constant_rows, measure_pairs, pair_term, substitute_pairs, turns_through_pairs,
-                      unwrapped, virtual_coordinates)
+                      unwrapped)
 from ..motion.planar import LinkAngles
 from .skeleton import numbering
+from .symbols import LoopEquation, PlanarEquations, Symbol, Vector  # noqa: F401 - exported here as before
 
 __all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations", "VectorLoops", "LOWER", "SIMPLIFY_OPS"]
 
 _SUFFIX = "abcdefghijklmnopqrstuvwxyz"
-
-
-@dataclass(frozen=True)
-class Symbol:
-    """A quantity of the equations: ``kind`` "angle" [rad], "length" [m] or "slider" [m]
-    (a slider coordinate); ``role`` "constant", "input" or "unknown"; ``value`` at the
-    configuration analysed; ``meaning`` in words."""
-
-    name: str
-    link: str
-    kind: str
-    value: float
-    role: str
-    meaning: str
-
-
-@dataclass(frozen=True)
-class Vector:
-    """A link vector of the loops: its name, the link, the joint centres it joins, its
-    length and angle as expressions (sympy syntax)."""
-
-    name: str
-    link: str
-    start: str
-    end: str
-    length: str
-    angle: str
-
-
-@dataclass(frozen=True)
-class LoopEquation:
-    """One independent loop: the links and joints walked, the vector equation (terms summed
-    to zero) and its x and y components (sympy expressions equal to zero)."""
-
-    links: tuple
-    joints: tuple
-    terms: tuple  # e.g. ("r2", "r3", "-x4*u4", "-e4*n4")
-    equations: tuple  # (x component, y component)
-
-
-@dataclass(frozen=True)
-class PlanarEquations:
-    path: str
-    normal: tuple
-    numbers: dict  # link name -> textbook number (ground 1)
-    loops: tuple  # LoopEquation
-    vectors: tuple  # Vector
-    symbols: dict  # name -> Symbol
-    inputs: tuple  # input symbols, in the order of the input joints
-    input_joints: dict  # input symbol -> (joint name, d symbol / d joint value: +1 or -1)
-    unknowns: tuple
-    A: tuple  # rows of strings
-    B: tuple
-    acceleration_terms: tuple  # c, strings (rates as NAME_d)
-    det_A: str | None
-    singular_conditions: tuple  # strings: "sin(theta3 - theta4) = 0: theta3 = theta4 or theta4 + pi"
-    singular_words: tuple  # the same in words
-    A_value: np.ndarray  # A and B at the configuration
-    B_value: np.ndarray
-    det_A_value: float | None
-    rates: np.ndarray | None  # A^-1 B: unknown rates per unit input rate (columns: inputs); None when A is singular
-    notes: tuple
-    pairs: tuple = ()  # RollingPair: the no-slip laws of rolling and gear pairs
 
 
 #: Guard: the characteristic length taken at least this [m] where a length is compared with it.
