@@ -181,3 +181,16 @@ def pytest_collection_modifyitems(config, items):
             index = node.rsplit("-", 1)[-1].rstrip("]")
             if index.isdigit() and int(index) >= FAST_MUTANTS:
                 item.add_marker(pytest.mark.slow)
+
+
+@pytest.fixture(scope="module")
+def wide_five_bar(tmp_path_factory):
+    """robots/five_bar.urdf with its motors 0.3 m apart (0.1 in the file): where the elbows are more
+    than 0.3 m apart it cannot be assembled, so most of a map's grid is not reached (test_maps,
+    test_pictures)."""
+    text = (ROBOTS / "five_bar.urdf").read_text()
+    assert text.count('<origin xyz="0.1 0 0" rpy="0 0 0"/>') == 1
+    path = tmp_path_factory.mktemp("wide_five_bar") / "five_bar_wide.urdf"
+    path.write_text(text.replace('<origin xyz="0.1 0 0" rpy="0 0 0"/>', '<origin xyz="0.3 0 0" rpy="0 0 0"/>'))
+    return path
+

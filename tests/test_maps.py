@@ -23,15 +23,6 @@ ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 R1, R2 = 0.1, 0.15  # proximal and distal lengths of robots/five_bar.urdf
 
 
-@pytest.fixture(scope="module")
-def wide_five_bar(tmp_path_factory):
-    text = (ROBOTS / "five_bar.urdf").read_text()
-    assert text.count('<origin xyz="0.1 0 0" rpy="0 0 0"/>') == 1
-    path = tmp_path_factory.mktemp("map") / "five_bar_wide.urdf"
-    path.write_text(text.replace('<origin xyz="0.1 0 0" rpy="0 0 0"/>', '<origin xyz="0.3 0 0" rpy="0 0 0"/>'))
-    return path
-
-
 def elbows(t1, t2):
     """Elbow centres in the plane: B1 = R(t1) (-0.05, 0.0866), B2 = (0.3, 0) + R(t2) (0.05, 0.0866)."""
     def rot(t, v):

@@ -17,16 +17,6 @@ pytest.importorskip("matplotlib")
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 
 
-@pytest.fixture(scope="module")
-def wide_five_bar(tmp_path_factory):
-    """robots/five_bar.urdf with its motors 0.3 m apart: most of the grid cannot be assembled."""
-    text = (ROBOTS / "five_bar.urdf").read_text()
-    assert text.count('<origin xyz="0.1 0 0" rpy="0 0 0"/>') == 1
-    path = tmp_path_factory.mktemp("pictures") / "five_bar_wide.urdf"
-    path.write_text(text.replace('<origin xyz="0.1 0 0" rpy="0 0 0"/>', '<origin xyz="0.3 0 0" rpy="0 0 0"/>'))
-    return path
-
-
 def test_map_png_is_titled_in_the_typed_units(wide_five_bar, tmp_path):
     from PIL import Image
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import ROBOTS
+from conftest import ROBOTS, no_hang
 
 import screwkin
 import screwkin.analysis.design.study as st
@@ -344,9 +344,8 @@ def test_cli_usage_errors(tmp_path, capsys):
 
 def test_unreachable_scheduler_fails_fast(tmp_path, capsys):
     spec = write_spec(tmp_path, SMALL)
-    t = time.perf_counter()
-    assert main(["study", spec, "--scheduler", "tcp://127.0.0.1:9", "--timeout", "1"]) == 2
-    assert time.perf_counter() - t < 15
+    with no_hang(15):  # a guard against a hang, not a speed measurement
+        assert main(["study", spec, "--scheduler", "tcp://127.0.0.1:9", "--timeout", "1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot be reached" in err[0], err
 
