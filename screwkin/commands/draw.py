@@ -16,6 +16,7 @@ from ..analysis.motion.sweep import sweep
 from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
+from ..model.geometry import wrap_angle
 from ..present.animate import animation_format, write_animation
 from ..present.draw import (
     chain_dict,
@@ -224,7 +225,7 @@ def run(mech, args) -> int:
 
 
 def _wrapped(value, unit):
-    return value if unit == "m" else float(np.mod(value + np.pi, 2 * np.pi) - np.pi)
+    return value if unit == "m" else wrap_angle(value)
 
 
 def _typed(name, value, unit, linear) -> str:

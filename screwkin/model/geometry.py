@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
-           "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch"]
+           "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle"]
 
 #: Division guard: the distance between two circles' centres is taken at least this [m].
 TINY = 1e-300  # division guard
@@ -124,6 +124,16 @@ def _cross_norm(u, w):
     if u.shape[-1] == 2:
         return np.abs(cross2(u, w))
     return np.linalg.norm(np.cross(u, w), axis=-1)
+
+
+def wrap_angle(a):
+    """An angle [rad] brought into [-pi, pi) (a float for a number, an array for an array).
+
+    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2
+    True
+    """
+    w = np.mod(np.asarray(a, float) + np.pi, 2 * np.pi) - np.pi
+    return float(w) if w.ndim == 0 else w
 
 
 def vector_angle(u, w):

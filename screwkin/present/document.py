@@ -25,6 +25,7 @@ from html import escape
 import numpy as np
 
 from ..analysis.course.vector_loops import PlanarEquations
+from ..model.geometry import wrap_angle as _wrap
 from .equations import Units, equations_text, greek, newton_text
 from .tables import shown
 from .report import (
@@ -110,11 +111,6 @@ def figure_bytes(fig, fmt: str = "svg") -> bytes:
 # ------------------------------------------------------------------ numbers as people read them
 def _g(x, digits=6) -> str:
     return f"{shown(x):.{digits}g}"
-
-
-def _wrap(angle) -> float:
-    """An angle in [-pi, pi), as the drawings' titles give it."""
-    return float(np.mod(angle + np.pi, 2 * np.pi) - np.pi)
 
 
 def _reading(value, angular: bool) -> str:

@@ -8,6 +8,7 @@ import numpy as np
 from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
 from ..units import parse_value
 from .plots import _pyplot
+from .jsonout import nan_to_none
 from .report import sweep_rows
 from .tables import column_text, csv_text, table
 
@@ -27,7 +28,9 @@ def _input_scale(r: DynamicsResult, shown: str | None):
 
 
 def _list(a):
-    return [None if not np.isfinite(x) else float(x) for x in np.asarray(a, float).ravel()]
+    """A flat list of numbers, None where the analysis leaves a value undetermined (NaN: an effort
+    of redundant actuation) -- present.jsonout.nan_to_none on the flattened array."""
+    return nan_to_none(np.asarray(a, float).ravel())
 
 
 def dynamics_dict(r: DynamicsResult) -> dict:

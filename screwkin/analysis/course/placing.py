@@ -7,17 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...model.geometry import wrap_angle as wrap
 from .rolling import virtual_coordinates
 
 __all__ = ["LOWER", "configuration", "wrap"]
 
 #: The joints the vector-loop equations take (besides rolling and gear pairs).
 LOWER = ("revolute", "continuous", "prismatic")
-
-
-def wrap(a):
-    """An angle [rad] in [-pi, pi)."""
-    return float(np.mod(a + np.pi, 2 * np.pi) - np.pi)
 
 
 def configuration(loops, values: dict) -> np.ndarray:

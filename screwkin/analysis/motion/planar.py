@@ -27,6 +27,7 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import joint_axis
+from ...model.geometry import wrap_angle as _wrap
 from ...model.geometry import (
     circle_intersections,
     cross2,
@@ -77,10 +78,6 @@ def _rot(v, ang):
 
 def _angle(v):
     return float(np.arctan2(v[1], v[0]))
-
-
-def _wrap(x):
-    return float(np.mod(x + np.pi, 2 * np.pi) - np.pi)
 
 
 def _interval(start, end, phi_now, q_in):
