@@ -32,7 +32,7 @@ import numpy as np
 import pinocchio as pin
 
 from .description import Coupling
-from .writer import _f, _v
+from .writer import number_text, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
            "TINY_MASS", "coupling_about"]
@@ -125,14 +125,14 @@ def _mj_inertial(mass, com, inertia, moving):
         if not moving:
             return ""
         mass, com, inertia = TINY_MASS, (0, 0, 0), (TINY_MASS * 1e-3,) * 3 + (0.0,) * 3
-    return f'<inertial pos="{_v(*com)}" mass="{_f(mass)}" fullinertia="{_v(*inertia)}"/>'
+    return f'<inertial pos="{vector_text(*com)}" mass="{number_text(mass)}" fullinertia="{vector_text(*inertia)}"/>'
 
 
 def _mj_joint(j):
     if j.type == "free":
         return f"<freejoint name={quoteattr(j.name)}/>"
-    rng = f' range="{_v(*j.range)}"' if j.range is not None else ""
-    axis = "" if j.type == "ball" else f' axis="{_v(*j.axis)}"'
+    rng = f' range="{vector_text(*j.range)}"' if j.range is not None else ""
+    axis = "" if j.type == "ball" else f' axis="{vector_text(*j.axis)}"'
     return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{axis}{rng}/>"
 
 
@@ -165,16 +165,16 @@ def write_mjcf(pm: PlacedMechanism) -> str:
 
     def aux_bodies(name, pad):
         for c in aux.get(name, ()):
-            out.append(f'{pad}<body name={quoteattr(c.name + "~F1")} pos="{_v(*c.pos1)}" quat="{_v(*c.quat1)}">')
+            out.append(f'{pad}<body name={quoteattr(c.name + "~F1")} pos="{vector_text(*c.pos1)}" quat="{vector_text(*c.quat1)}">')
             for k, (t, ax) in enumerate(zip(_AUX[c.type], _aux_axes(c))):
                 jn = c.name if len(_AUX[c.type]) == 1 else f"{c.name}.{k}"
-                out.append(f"{pad}  <joint name={quoteattr(jn)} type=\"{t}\" axis=\"{_v(*ax)}\"/>")
+                out.append(f"{pad}  <joint name={quoteattr(jn)} type=\"{t}\" axis=\"{vector_text(*ax)}\"/>")
             out.append(f"{pad}  {_mj_inertial(0, 0, 0, True)}")
             out.append(f"{pad}</body>")
 
     def body(b, depth):
         pad = "  " * depth
-        out.append(f'{pad}<body name={quoteattr(b.name)} pos="{_v(*b.pos)}" quat="{_v(*b.quat)}">')
+        out.append(f'{pad}<body name={quoteattr(b.name)} pos="{vector_text(*b.pos)}" quat="{vector_text(*b.quat)}">')
         moving = b.joint is not None and b.joint.type != "fixed"
         if moving:
             out.append(f"{pad}  {_mj_joint(b.joint)}")
@@ -194,24 +194,24 @@ def write_mjcf(pm: PlacedMechanism) -> str:
     for c in pm.cuts:
         if c.type == "spherical":
             eq.append(f"<connect name={quoteattr(c.name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
-                      f'anchor="{_v(*c.pos1)}"/>')
+                      f'anchor="{vector_text(*c.pos1)}"/>')
         elif c.type in ("revolute", "continuous"):
             F1 = _se3(c.pos1, c.quat1)
             far = F1.act(pm.length * np.asarray(c.axis, float))
             for name, p in ((c.name, c.pos1), (f"{c.name}~axis", far)):
                 eq.append(f"<connect name={quoteattr(name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
-                          f'anchor="{_v(*p)}"/>')
+                          f'anchor="{vector_text(*p)}"/>')
         else:  # fixed: body2 in body1; an aux body: body2 in the aux body, which is at F1 at qpos0
             F1 = pin.SE3.Identity() if c.type in _AUX else _se3(c.pos1, c.quat1)
             F2 = _se3(c.pos2, c.quat2)
             rel = F1 * _se3(*c.rel) * F2.inverse()
             body1 = c.name + "~F1" if c.type in _AUX else c.body1
             eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else c.name + '~weld')} "
-                      f"body1={quoteattr(body1)} body2={quoteattr(c.body2)} anchor=\"{_v(*c.pos2)}\" "
-                      f'relpose="{_v(*rel.translation, *_quat(rel))}"/>')
+                      f"body1={quoteattr(body1)} body2={quoteattr(c.body2)} anchor=\"{vector_text(*c.pos2)}\" "
+                      f'relpose="{vector_text(*rel.translation, *_quat(rel))}"/>')
     for cp in pm.couplings:
         eq.append(f"<joint joint1={quoteattr(cp.joint)} joint2={quoteattr(cp.mimics)} "
-                  f'polycoef="{_v(cp.offset, cp.multiplier, 0, 0, 0)}"/>')
+                  f'polycoef="{vector_text(cp.offset, cp.multiplier, 0, 0, 0)}"/>')
     if eq:
         out += ["  <equality>"] + [f"    {e}" for e in eq] + ["  </equality>"]
     if pm.actuated:
@@ -237,30 +237,30 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         inertial = ""
         if b.mass > 0:
             xx, yy, zz, xy, xz, yz = b.inertia
-            inertial = (f'<inertial><origin xyz="{_v(*b.com)}"/><mass value="{_f(b.mass)}"/><inertia ixx="{_f(xx)}" '
-                        f'iyy="{_f(yy)}" izz="{_f(zz)}" ixy="{_f(xy)}" ixz="{_f(xz)}" iyz="{_f(yz)}"/></inertial>')
+            inertial = (f'<inertial><origin xyz="{vector_text(*b.com)}"/><mass value="{number_text(b.mass)}"/><inertia ixx="{number_text(xx)}" '
+                        f'iyy="{number_text(yy)}" izz="{number_text(zz)}" ixy="{number_text(xy)}" ixz="{number_text(xz)}" iyz="{number_text(yz)}"/></inertial>')
         out.append(f"  <link name={quoteattr(b.name)}>{inertial}</link>")
         j = b.joint or PlacedJoint(f"{b.name}__fixed", "fixed")
         t = _URDF_TYPE.get(j.type) or ("revolute" if j.range is not None else "continuous")
         rpy = pin.rpy.matrixToRpy(_se3(b.pos, b.quat).rotation)
         text = (f"  <joint name={quoteattr(j.name)} type=\"{t}\"><parent link={quoteattr(b.parent or root)}/>"
-                f"<child link={quoteattr(b.name)}/><origin xyz=\"{_v(*b.pos)}\" rpy=\"{_v(*rpy)}\"/>")
+                f"<child link={quoteattr(b.name)}/><origin xyz=\"{vector_text(*b.pos)}\" rpy=\"{vector_text(*rpy)}\"/>")
         if t in ("revolute", "continuous", "prismatic"):
             lo, hi = j.range if j.range is not None else (-1e9, 1e9)
-            text += f'<axis xyz="{_v(*j.axis)}"/><limit lower="{_f(lo)}" upper="{_f(hi)}" effort="0" velocity="0"/>'
+            text += f'<axis xyz="{vector_text(*j.axis)}"/><limit lower="{number_text(lo)}" upper="{number_text(hi)}" effort="0" velocity="0"/>'
         if j.name in coupled:
             cp = coupled[j.name]
-            text += f'<mimic joint={quoteattr(cp.mimics)} multiplier="{_f(cp.multiplier)}" offset="{_f(cp.offset)}"/>'
+            text += f'<mimic joint={quoteattr(cp.mimics)} multiplier="{number_text(cp.multiplier)}" offset="{number_text(cp.offset)}"/>'
         joints.append(text + "</joint>")
     out += joints
     for c in pm.cuts:
         r1, r2 = (pin.rpy.matrixToRpy(_se3(c.pos1 if k == 1 else c.pos2, c.quat1 if k == 1 else c.quat2).rotation)
                   for k in (1, 2))
         text = (f"  <loop_joint name={quoteattr(c.name)} type=\"{c.type}\"><link1 link={quoteattr(c.body1)} "
-                f'xyz="{_v(*c.pos1)}" rpy="{_v(*r1)}"/><link2 link={quoteattr(c.body2)} xyz="{_v(*c.pos2)}" '
-                f'rpy="{_v(*r2)}"/><axis xyz="{_v(*c.axis)}"/>')
+                f'xyz="{vector_text(*c.pos1)}" rpy="{vector_text(*r1)}"/><link2 link={quoteattr(c.body2)} xyz="{vector_text(*c.pos2)}" '
+                f'rpy="{vector_text(*r2)}"/><axis xyz="{vector_text(*c.axis)}"/>')
         if c.axis2 is not None:
-            text += f'<axis2 xyz="{_v(*c.axis2)}"/>'
+            text += f'<axis2 xyz="{vector_text(*c.axis2)}"/>'
         out.append(text + "</loop_joint>")
     for name in pm.actuated:
         out.append(f"  <transmission name={quoteattr('t_' + name)}><type>transmission_interface/SimpleTransmission"

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 from ..tolerances import DEFAULT
 
-__all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf"]
+__all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf", "number_text", "vector_text"]
 
 _COLOURS = ((0.35, 0.35, 0.35), (0.85, 0.3, 0.2), (0.2, 0.5, 0.85), (0.2, 0.7, 0.3), (0.85, 0.65, 0.1),
             (0.6, 0.3, 0.75), (0.1, 0.7, 0.7), (0.9, 0.45, 0.6))
@@ -85,13 +85,13 @@ class PlanarLinkage:
     colours: dict = field(default_factory=dict)  # link name -> (r, g, b)
 
 
-def _f(x) -> str:
+def number_text(x) -> str:
     x = float(x)
     return repr(0.0 if x == 0 else x)
 
 
-def _v(*xs) -> str:
-    return " ".join(_f(x) for x in xs)
+def vector_text(*xs) -> str:
+    return " ".join(number_text(x) for x in xs)
 
 
 def _bars(points):
@@ -144,10 +144,10 @@ def write_urdf(linkage: PlanarLinkage) -> str:
     out.append(f'<robot name="{linkage.name}">')
     for k, lk in enumerate(linkage.links):
         r, g, b = linkage.colours.get(lk.name, _COLOURS[k % len(_COLOURS)])
-        material = f'<material name="m_{lk.name}"><color rgba="{_v(r, g, b, 1)}"/></material>'
+        material = f'<material name="m_{lk.name}"><color rgba="{vector_text(r, g, b, 1)}"/></material>'
         out.append(f'  <link name="{lk.name}">')
         if lk.frame_only:
-            out.append(f'    <visual><geometry><sphere radius="{_f(0.6 * w)}"/></geometry>{material}</visual>')
+            out.append(f'    <visual><geometry><sphere radius="{number_text(0.6 * w)}"/></geometry>{material}</visual>')
             out.append("  </link>")
             continue
         mass = 0.0
@@ -159,19 +159,19 @@ def write_urdf(linkage: PlanarLinkage) -> str:
                 continue
             c = ((p[0] + q[0]) / 2, (p[1] + q[1]) / 2)
             ang = math.atan2(q[1] - p[1], q[0] - p[0])
-            out.append(f'    <visual><origin xyz="{_v(c[0], c[1], 0)}" rpy="{_v(0, 0, ang)}"/>'
-                       f'<geometry><box size="{_v(length, w, w)}"/></geometry>{material}</visual>')
+            out.append(f'    <visual><origin xyz="{vector_text(c[0], c[1], 0)}" rpy="{vector_text(0, 0, ang)}"/>'
+                       f'<geometry><box size="{vector_text(length, w, w)}"/></geometry>{material}</visual>')
             m = linkage.density * length
             parts.append((m, c, length))
             mass += m
             mx += m * c[0]
             my += m * c[1]
         for p in lk.points:
-            out.append(f'    <visual><origin xyz="{_v(p[0], p[1], 0)}"/><geometry><cylinder radius="{_f(0.7 * w)}" '
-                       f'length="{_f(1.5 * w)}"/></geometry>{material}</visual>')
+            out.append(f'    <visual><origin xyz="{vector_text(p[0], p[1], 0)}"/><geometry><cylinder radius="{number_text(0.7 * w)}" '
+                       f'length="{number_text(1.5 * w)}"/></geometry>{material}</visual>')
         if lk.slider and lk.points:
             p = lk.points[0]
-            out.append(f'    <visual><origin xyz="{_v(p[0], p[1], 0)}"/><geometry><box size="{_v(3 * w, 2 * w, 2 * w)}"/>'
+            out.append(f'    <visual><origin xyz="{vector_text(p[0], p[1], 0)}"/><geometry><box size="{vector_text(3 * w, 2 * w, 2 * w)}"/>'
                        f'</geometry>{material}</visual>')
             m = linkage.density * 3 * w
             parts.append((m, (float(p[0]), float(p[1])), 3 * w))
@@ -183,23 +183,23 @@ def write_urdf(linkage: PlanarLinkage) -> str:
             izz = sum(m * (length**2 / 12 + (c[0] - cx) ** 2 + (c[1] - cy) ** 2) for m, c, length in parts)
             izz += mass * w * w / 6
             ixx = iyy = izz / 2 + mass * w * w / 12
-            out.append(f'    <inertial><origin xyz="{_v(cx, cy, 0)}"/><mass value="{_f(mass)}"/>'
-                       f'<inertia ixx="{_f(ixx)}" iyy="{_f(iyy)}" izz="{_f(izz)}" ixy="0" ixz="0" iyz="0"/>'
+            out.append(f'    <inertial><origin xyz="{vector_text(cx, cy, 0)}"/><mass value="{number_text(mass)}"/>'
+                       f'<inertia ixx="{number_text(ixx)}" iyy="{number_text(iyy)}" izz="{number_text(izz)}" ixy="0" ixz="0" iyz="0"/>'
                        "</inertial>")
         out.append("  </link>")
     for j in linkage.joints:
         out.append(f'  <joint name="{j.name}" type="{j.type}">')
         out.append(f'    <parent link="{j.parent}"/><child link="{j.child}"/>')
-        out.append(f'    <origin xyz="{_v(j.xyz[0], j.xyz[1], 0)}" rpy="{_v(0, 0, j.angle)}"/>')
+        out.append(f'    <origin xyz="{vector_text(j.xyz[0], j.xyz[1], 0)}" rpy="{vector_text(0, 0, j.angle)}"/>')
         if j.type != "fixed":
-            out.append(f'    <axis xyz="{_v(*j.axis)}"/>')
-            out.append(f'    <limit lower="{_f(j.lower)}" upper="{_f(j.upper)}" effort="100" velocity="10"/>')
+            out.append(f'    <axis xyz="{vector_text(*j.axis)}"/>')
+            out.append(f'    <limit lower="{number_text(j.lower)}" upper="{number_text(j.upper)}" effort="100" velocity="10"/>')
         out.append("  </joint>")
     for c in linkage.loop_joints:
         out.append(f'  <loop_joint name="{c.name}" type="{c.type}">')
-        out.append(f'    <link1 link="{c.link1}" xyz="{_v(c.xyz1[0], c.xyz1[1], 0)}" rpy="{_v(0, 0, c.angle1)}"/>')
-        out.append(f'    <link2 link="{c.link2}" xyz="{_v(c.xyz2[0], c.xyz2[1], 0)}" rpy="{_v(0, 0, c.angle2)}"/>')
-        out.append(f'    <axis xyz="{_v(*c.axis)}"/>')
+        out.append(f'    <link1 link="{c.link1}" xyz="{vector_text(c.xyz1[0], c.xyz1[1], 0)}" rpy="{vector_text(0, 0, c.angle1)}"/>')
+        out.append(f'    <link2 link="{c.link2}" xyz="{vector_text(c.xyz2[0], c.xyz2[1], 0)}" rpy="{vector_text(0, 0, c.angle2)}"/>')
+        out.append(f'    <axis xyz="{vector_text(*c.axis)}"/>')
         out.append("  </loop_joint>")
     for name in linkage.actuated:
         out.append(f'  <transmission name="t_{name}">')

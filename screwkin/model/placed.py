@@ -17,7 +17,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote
 from ..files.exporter import PlacedBody, PlacedCut, PlacedJoint, PlacedMechanism, coupling_about
-from .topology import _frame_link
+from .topology import frame_link
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS"]
 
@@ -101,7 +101,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     for c, s in zip(mech.cuts, spec.cut_joints):
         F = []
         for fid, frame in ((c.frame1, c.link1), (c.frame2, c.link2)):
-            link = _frame_link(mech, frame)
+            link = frame_link(mech, frame)
             F.append((link, world[link].inverse() * data.oMf[fid]))
         (b1, F1), (b2, F2) = F
         rel = data.oMf[c.frame1].inverse() * data.oMf[c.frame2]

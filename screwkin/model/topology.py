@@ -27,7 +27,7 @@ from ..files.sidecar import axis_letters
 from ..tolerances import DEFAULT
 from ._pin import frame_id
 
-__all__ = ["Joint", "Topology", "build_topology"]
+__all__ = ["Joint", "Topology", "build_topology", "frame_link"]
 
 MOTION = {
     "revolute": "rotation",
@@ -190,7 +190,7 @@ class _Union:
             self.parent[rb] = ra
 
 
-def _frame_link(mech, frame_name: str) -> str:
+def frame_link(mech, frame_name: str) -> str:
     """The URDF link a Pinocchio frame is attached to."""
     spec = mech.spec
     if frame_name in spec.links:
@@ -257,8 +257,8 @@ def _edges(mech, q):
         edges.append(_Edge(j.name, t, dof, j.parent, j.child, False, point, direction, direction2))
     specs = {s.name: s for s in mech.spec.cut_joints}
     for c in mech.cuts:
-        a = _frame_link(mech, c.link1)
-        b = _frame_link(mech, c.link2)
+        a = frame_link(mech, c.link1)
+        b = frame_link(mech, c.link2)
         if c.pair is not None:  # one higher (or screw) pair between the two links, at F1
             M1 = data.oMf[model.getFrameId(f"{c.name}@F1")]
             s = specs.get(c.name)
