@@ -11,7 +11,8 @@ import os
 import numpy as np
 
 from ..errors import UsageError, quote
-from .draw import _plt, draw_mechanism
+from .draw import draw_mechanism
+from .plots import pyplot
 
 __all__ = ["FORMATS", "animation_format", "write_animation"]
 
@@ -42,7 +43,7 @@ def animation_format(path: str) -> str:
 def _limits(skeletons, titles, traces, size, angles):
     """The framing of the whole motion: the union of the limits each frame would take alone
     (whole paths drawn), so that every frame is drawn in the same window."""
-    plt = _plt()
+    plt = pyplot("--animate")
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
     for skel, title in zip(skeletons, titles):
         fig = draw_mechanism(skel, title=title, traces=traces, size=size, angles=angles)
@@ -69,7 +70,7 @@ def write_animation(path: str, skeletons, titles, traces: dict | None = None, fp
     traces = {n: np.asarray(xy, float) for n, xy in (traces or {}).items()}
     size = max(s.size for s in skeletons)
     limits = _limits(skeletons, titles, traces, size, angles)
-    plt = _plt()
+    plt = pyplot("--animate")
     frames = []
     writer = None
     try:

@@ -20,9 +20,9 @@ import os
 import numpy as np
 
 from ..errors import UsageError
-from .plots import _pyplot
+from .plots import pyplot
 
-__all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label"]
+__all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label", "number_colours"]
 
 _TYPE_WORD = {"revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical": "C", "universal": "U",
               "spherical": "S", "planar": "E", "helical": "H", "rolling": "rolling", "gear": "gear",
@@ -30,7 +30,7 @@ _TYPE_WORD = {"revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical
 
 
 def _plt():
-    return _pyplot("drawing")
+    return pyplot("drawing")
 
 
 def value_label(name, value, unit) -> str:
@@ -44,7 +44,9 @@ def _short(name, n=26):
     return name if len(name) <= n else name[: n - 1] + "~"
 
 
-def _colours(n):
+def number_colours(n):
+    """Link number -> colour (2 .. n + 1; the ground, 1, is drawn grey): the colours drawings and the
+    planar view share."""
     cycle = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
     return {k: cycle[(k - 2) % len(cycle)] for k in range(2, n + 2)}
 
@@ -84,7 +86,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
     fig = plt.figure(figsize=(10, 6.4))
     ax = fig.add_axes([0.03, 0.06, 0.66, 0.82])
     r = 0.022 * (size or skel.size)  # pin radius: the unit of every symbol
-    colour = _colours(len(skel.links))
+    colour = number_colours(len(skel.links))
     links = {lk.number: lk for lk in skel.links}
     points = []
 

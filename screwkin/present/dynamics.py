@@ -7,7 +7,7 @@ import numpy as np
 
 from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
 from ..units import parse_value
-from .plots import _pyplot
+from .plots import pyplot
 from .jsonout import nan_to_none
 from .report import sweep_rows
 from .tables import column_text, csv_text, table
@@ -146,7 +146,7 @@ def dynamics_csv(r: DynamicsResult, shown: str | None = None) -> str:
 
 def dynamics_plot(r: DynamicsResult, path: str, shown: str | None = None, title: str | None = None) -> None:
     """The input efforts against the input (one curve per actuator, the mean dashed) into a PNG."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     f, u = _input_scale(r, shown)
     fig, ax = plt.subplots(figsize=(8, 4.5))
     x = r.values * f

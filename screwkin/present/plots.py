@@ -11,10 +11,10 @@ from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
 from ..units import parse_value
 
-__all__ = ["sweep_plot", "sweep_figure", "map_png", "map_figure"]
+__all__ = ["sweep_plot", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
 
-def _pyplot(option):
+def pyplot(option):
     try:
         import matplotlib
 
@@ -47,7 +47,7 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     positions and those of ``--singularities``) is a vertical line, with its kind in the legend.
     linear: mask of the coordinates that are lengths (``Mechanism.translational``; default: none).
     mus: the transmission angle at each step [rad], drawn in degrees with the joint angles."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     n = len(res.names)
     linear = np.zeros(n, bool) if linear is None or len(linear) != n else np.asarray(linear, bool)
     x_deg = res.unit == "rad"
@@ -155,7 +155,7 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
     """A sweep into a PNG (see :func:`sweep_figure` for what is drawn): for a planar mechanism with
     ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle, omega and alpha and the
     sliders' coordinates, else the joint values; the named points' paths in a fourth panel."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     absolute = absolute_series(res, motion, linear)
     if absolute is not None:
         res, linear = absolute
@@ -180,7 +180,7 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
     sigma = 1e-2, and the cells the continuation did not reach on the mapped assembly mode
     (``res.reached`` False) blank and hatched, with a legend entry of their own -- no colour is
     drawn across the jump between two modes."""
-    plt = _pyplot("--png")
+    plt = pyplot("--png")
     from matplotlib.patches import Patch
 
     fig, ax = plt.subplots(figsize=(7, 5.5))
@@ -226,7 +226,7 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
 
 def map_png(res, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):
     """A singularity map (SingularityMap) as a heat map with the singular curves (see :func:`map_figure`)."""
-    plt = _pyplot("--png")
+    plt = pyplot("--png")
     fig = map_figure(res, x_unit, y_unit, title)
     ax = fig.axes[0]
     fig.savefig(path, dpi=100, metadata={"Title": ax.get_title(),

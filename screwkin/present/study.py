@@ -24,7 +24,7 @@ from ..analysis.design.study import pareto_front
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import parse_value
-from .plots import _pyplot
+from .plots import pyplot
 from .report import to_jsonable
 from .tables import csv_text
 
@@ -281,7 +281,7 @@ def metrics_figure(result):
     """The figure of :func:`metrics_png` (not yet saved): each numeric metric against each parameter,
     one panel per pair, axes with their units, points coloured by Grashof class (when the study has
     it), failed designs as crosses along the bottom of each panel at their parameter values."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     numeric = _numeric(result)
     params = list(result.parameters)
     if not numeric:
@@ -328,7 +328,7 @@ def metrics_figure(result):
 
 def metrics_png(result, path) -> None:
     """Each numeric metric against each parameter (see :func:`metrics_figure`)."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     fig = metrics_figure(result)
     fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
     plt.close(fig)
@@ -338,7 +338,7 @@ def pareto_figure(result, goals=None):
     """The figure of :func:`pareto_png` (not yet saved): the designs in the plane of two columns with
     their units, coloured by Grashof class (when the study has it), the Pareto front drawn over them;
     the failed designs, which have no place in this plane, counted in the title."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     goals = goals or result.spec.pareto
     front = pareto_front(result, goals)
     keys = (*result.parameters, *result.columns)
@@ -374,7 +374,7 @@ def pareto_figure(result, goals=None):
 
 def pareto_png(result, path, goals=None) -> None:
     """The designs in the plane of two columns, the Pareto front drawn over them (see :func:`pareto_figure`)."""
-    plt = _pyplot("--plot")
+    plt = pyplot("--plot")
     fig = pareto_figure(result, goals)
     fig.savefig(path, dpi=100, metadata={"Title": fig.axes[0].get_title()})
     plt.close(fig)

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..analysis.design.synthesis.designs import MotionResult
-from .plots import _pyplot
+from .plots import pyplot
 
 __all__ = ["burmester_png"]
 
@@ -17,7 +17,7 @@ __all__ = ["burmester_png"]
 def burmester_png(result: MotionResult, path: str):
     """The curves of a four- or five-position MotionResult (three positions: the poses and
     the four-bar only) into a PNG."""
-    plt = _pyplot("--png")
+    plt = pyplot("--png")
     fig, ax = plt.subplots(figsize=(8, 7))
     styles = (("tab:blue", "tab:orange"), ("tab:cyan", "tab:red"))
     for k, (C, W) in enumerate(result.curves):

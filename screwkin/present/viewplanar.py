@@ -9,7 +9,7 @@ import numpy as np
 
 from ..analysis.motion.planar import plane_basis
 from ..analysis.course.skeleton import numbering
-from .draw import _colours
+from .draw import number_colours
 
 __all__ = ["GROUND", "planar_basis", "link_colours", "colour_links", "top_view"]
 
@@ -34,7 +34,7 @@ def link_colours(mech, q) -> dict:
     (links numbered from the ground along the chain, the actuated joints first); the ground (joint 0) grey."""
     topo = mech.topology(q)
     number = numbering(topo, mech.actuated)[0]
-    palette = _colours(len(number))
+    palette = number_colours(len(number))
     out = {0: GROUND}
     for name, k in sorted(number.items(), key=lambda item: item[1]):
         if k == 1:

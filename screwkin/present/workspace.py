@@ -10,7 +10,7 @@ import pinocchio as pin
 
 from ..analysis.design.workspace import WorkspaceResult
 from ..tolerances import DEFAULT
-from .plots import _pyplot
+from .plots import pyplot
 from .report import table
 from .tables import csv_text
 
@@ -126,7 +126,7 @@ def workspace_figure(r: WorkspaceResult, title: str | None = None):
     (3-D: the platform of a Stewart platform), each slice in mm on equal axes, the colour scale over
     the values reached (its range in the colour bar's label), the located boundary in black, where
     the measures cross the threshold in red; one legend for all the panels, below them."""
-    plt = _pyplot("--png")
+    plt = pyplot("--png")
     from matplotlib.lines import Line2D
 
     names = axis_labels(r)
@@ -199,7 +199,7 @@ def workspace_figure(r: WorkspaceResult, title: str | None = None):
 
 def workspace_png(r: WorkspaceResult, path: str):
     """The conditioning over the workspace, in slices (see :func:`workspace_figure`)."""
-    plt = _pyplot("--png")
+    plt = pyplot("--png")
     fig = workspace_figure(r)
     fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
     plt.close(fig)
