@@ -22,7 +22,6 @@ from there; a chunk of the smallest size that still fails is handed to the per-s
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 
 from .batch_closure import BatchClosure, Unbatchable
 

@@ -49,8 +49,8 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
                             detail=f"the pose of '{output}' at ({xyz}) is unreachable from "
                                    f"{len(start_list)} starting configurations")
     solver.generic(hint=found[0][1])
-    ref = solver._reference()
-    ref_sig = solver._signature(ref if ref is not None else found[0][1])
+    ref = solver.reference()
+    ref_sig = solver.signature(ref if ref is not None else found[0][1])
     needed = mech.nv - solver.idle_dofs
     sols = []
     for _, q, a in found:
@@ -63,7 +63,7 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
                              outside_limits=outside, labels=solver._labels(q, outside),
                              link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None,
                              leg_lengths=state.leg_lengths or None))
-    sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver._signature(s.q) - ref_sig))))
+    sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
     return PositionResult({"position": pose.translation.tolist()} if position_only else {"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           0, (), output, solver.angular_names(), solver._angular_coupled(),
                           angular_loop_joints(mech))

@@ -153,8 +153,8 @@ class Interactive:
     def _mode_of(self, q, modes) -> int:
         """The index (1-based) of the mode whose joint centres and cut-joint frames are where q's are
         (PositionSolver's signature: idle spins aside); 0 when none is."""
-        c = self.solver._signature(q)
-        d = [float(np.linalg.norm(self.solver._signature(m) - c)) for m in modes]
+        c = self.solver.signature(q)
+        d = [float(np.linalg.norm(self.solver.signature(m) - c)) for m in modes]
         k = int(np.argmin(d)) if d else -1
         return k + 1 if k >= 0 and d[k] <= self.mech.tolerances.geometry * self.mech.length * math.sqrt(max(len(c), 1)) else 0
 

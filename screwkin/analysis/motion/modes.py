@@ -111,7 +111,7 @@ class ModeLabels:
         mech, model = solver.mech, solver.model
         self.mech, self.model = mech, model
         self.legs, self.turned = [], []
-        ref = solver._reference() if mech.cuts else None
+        ref = solver.reference() if mech.cuts else None
         self.active = ref is not None
         if not self.active:
             return

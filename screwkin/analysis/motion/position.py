@@ -225,7 +225,7 @@ class PositionSolver:
             self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
         return self._generic
 
-    def _reference(self):
+    def reference(self):
         """The reference configuration (the mechanism's assembled one), or None when the
         assembly search finds none (the solutions for the inputs then stand in)."""
         try:
@@ -305,7 +305,7 @@ class PositionSolver:
             q[w] = np.mod(q[w] + np.pi, 2 * np.pi) - np.pi
         return q
 
-    def _signature(self, q):
+    def signature(self, q):
         """World positions of every joint centre (and the output pose): equal for
         configurations that differ only by idle spins."""
         pin.framesForwardKinematics(self.model, self.data, q)
@@ -318,7 +318,7 @@ class PositionSolver:
         """The reference configuration (when there is one), the file's configuration, and
         ``count`` random configurations within the joint limits."""
         rng = np.random.default_rng(seed)
-        ref = self._reference()
+        ref = self.reference()
         starts = ([ref] if ref is not None else []) + [self.mech.neutral()]
         starts += [self.mech.random_configuration(rng) for _ in range(count)]
         return starts
@@ -357,7 +357,7 @@ class PositionSolver:
             TraceStep(it, r.copy(), K[:, self.passive].copy(), dq[self.passive].copy(), ok))) if trace else None
         near_q = None
         if near:
-            ref = self._reference()
+            ref = self.reference()
             near_q = self.set_inputs(mech.neutral() if ref is None else ref, near)
         found, best = [], np.inf
         if near_q is not None:  # the mode reached from the given configuration, when Newton gets there
@@ -380,11 +380,11 @@ class PositionSolver:
         self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
         sols = [self._solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
         sols = self._merge(sols)
-        ref = near_q if near_q is not None else self._reference()
+        ref = near_q if near_q is not None else self.reference()
         if len(sols) > 1:
-            ref_sig = self._signature(ref if ref is not None else sols[0].q)
+            ref_sig = self.signature(ref if ref is not None else sols[0].q)
             sols.sort(key=lambda s: (not s.physical, s.singular,
-                                     float(np.linalg.norm(self._signature(s.q) - ref_sig))))
+                                     float(np.linalg.norm(self.signature(s.q) - ref_sig))))
         notes = ()
         if near_q is not None:
             sols = sols[:1]
@@ -424,7 +424,7 @@ class PositionSolver:
             if len(starts) == 1:  # nothing to tell apart
                 found.append((None, q, a))
                 continue
-            sig = self._signature(q)
+            sig = self.signature(q)
             if any(np.max(np.abs(sig - s)) < self.mech.tolerances.geometry for s, *_ in found):
                 continue
             found.append((sig, q, a))
@@ -440,7 +440,7 @@ class PositionSolver:
         return modes.merge(self, sols)
 
     def _distance(self, q1, q2):
-        return float(np.linalg.norm(self._signature(q1) - self._signature(q2)))
+        return float(np.linalg.norm(self.signature(q1) - self.signature(q2)))
 
     def _labels(self, q, outside) -> tuple:
         """Why a solution is not reached by moving from the reference configuration
@@ -464,7 +464,7 @@ class PositionSolver:
     def _link_angles(self, q):
         if self._angles is False:
             self._angles = None
-            ref = self._reference()
+            ref = self.reference()
             if ref is not None:
                 topo = self.mech.topology(ref)
                 if topo.motion_space == "planar":

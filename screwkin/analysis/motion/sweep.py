@@ -260,7 +260,7 @@ def drawn_start(solver, values: dict):
     mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
     the drawing of those), found without solve's search from random starts (a sweep from the drawn
     position: 1 ms, not 13 ms, for the Strider); None otherwise."""
-    ref = solver._reference()
+    ref = solver.reference()
     if ref is None:
         return None
     drawn = solver.joint_values(ref)
@@ -272,7 +272,7 @@ def drawn_start(solver, values: dict):
         if abs(float(np.angle(np.exp(1j * d))) if n in angular else d) > tol.equal:
             return None
     sol = solver.solve(values, near=drawn, starts=0).solutions[0]
-    far = np.linalg.norm(solver._signature(sol.q) - solver._signature(ref))
+    far = np.linalg.norm(solver.signature(sol.q) - solver.signature(ref))
     if not sol.physical or sol.singular or far > tol.geometry * solver.mech.length:
         return None
     return sol.q

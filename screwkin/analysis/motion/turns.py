@@ -59,7 +59,7 @@ def engaged(solver, found, values):
     except AssemblyError:
         return [found[int(np.argmin(off))]]
     if float(np.max(np.abs(np.array([a.q[t] for t in counted]) - pred))) < np.pi:
-        return [(solver._signature(a.q), a.q, a)]
+        return [(solver.signature(a.q), a.q, a)]
     return [found[int(np.argmin(off))]]
 
 
