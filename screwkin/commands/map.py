@@ -48,12 +48,7 @@ def run(mech, args) -> int:
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")
-    if xn == yn:
-        raise UsageError(f"--x and --y name the same input '{xn}': a map needs two inputs")
     fixed = joint_assignments(mech, args.set, "--set")
-    twice = sorted({xn, yn} & set(fixed))
-    if twice:
-        raise UsageError(f"{', '.join(twice)} is given by --x/--y and by --set: a map input is not also held")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
     output, point = output_frame(mech, args)  # a named --point is the output
     if point and not output:

@@ -45,6 +45,11 @@ class SingularityMap:
 def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
+    if x_name == y_name:
+        raise UsageError(f"--x and --y name the same input '{x_name}': a map needs two inputs")
+    twice = sorted({x_name, y_name} & set(fixed))
+    if twice:
+        raise UsageError(f"{', '.join(twice)} is given by --x/--y and by --set: a map input is not also held")
     for n in (x_name, y_name):
         if n not in solver.inputs:
             raise UsageError(f"{mech.path}: '{n}' is not an input ({', '.join(solver.inputs)})")
