@@ -32,6 +32,7 @@ import numpy as np
 import pinocchio as pin
 
 from .description import Coupling
+from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
@@ -100,13 +101,11 @@ class PlacedMechanism:
 
 
 def _se3(pos, quat):
-    w, x, y, z = quat
-    return pin.SE3(pin.Quaternion(w, x, y, z).normalized().matrix(), np.asarray(pos, float))
+    return pin.SE3(quat_matrix(quat), np.asarray(pos, float))
 
 
 def _quat(M):
-    q = pin.Quaternion(M.rotation)
-    return (q.w, q.x, q.y, q.z)
+    return matrix_quat(M.rotation)
 
 
 def _children(pm):

@@ -31,6 +31,7 @@ from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
 from .description import LIMITS, Coupling, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
 from .urdf import Problems, check_sizes, numbers, unit_axis
+from .writer import vector_text
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_mjcf", "quat_matrix", "matrix_quat"]
@@ -46,11 +47,9 @@ _PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor
 
 
 def quat_matrix(q) -> np.ndarray:
-    """The rotation matrix of MuJoCo's quaternion (w, x, y, z), normalised."""
-    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    """The rotation matrix of MuJoCo's quaternion (w, x, y, z), normalised (Pinocchio's)."""
+    w, x, y, z = (float(v) for v in q)
+    return pin.Quaternion(w, x, y, z).normalized().matrix()
 
 
 def matrix_quat(R) -> tuple:
@@ -60,7 +59,7 @@ def matrix_quat(R) -> tuple:
 
 
 def _fmt(v):
-    return " ".join(f"{float(x):.17g}" for x in v)
+    return vector_text(*v)
 
 
 def _origin(M):

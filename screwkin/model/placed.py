@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote
 from ..files.exporter import PlacedBody, PlacedCut, PlacedJoint, PlacedMechanism, coupling_about
+from ..files.mjcf import matrix_quat
 from .topology import frame_link
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS"]
@@ -26,11 +27,6 @@ WRITABLE_CUTS = ("fixed", "revolute", "continuous", "prismatic", "cylindrical", 
 
 #: A joint limit beyond this [rad or m] is no limit (files write 1e9 or 1e16 for "none").
 _NO_LIMIT = 1e6
-
-
-def _quat(R):
-    q = pin.Quaternion(np.asarray(R, float))
-    return (q.w, q.x, q.y, q.z)
 
 
 def _inertia(I):
@@ -55,7 +51,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     root = spec.root
     bodies = []
     if root != "world":
-        bodies.append(PlacedBody(root, None, tuple(world[root].translation), _quat(world[root].rotation)))
+        bodies.append(PlacedBody(root, None, tuple(world[root].translation), matrix_quat(world[root].rotation)))
     values, empty = {}, []
     for j in spec.joints:
         parent = None if j.parent == root else j.parent
@@ -95,7 +91,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
             mass, com, inertia = float(I.mass), tuple(I.lever), _inertia(I)
         elif t in ("fixed", "FIXED"):
             joint = PlacedJoint(j.name, "fixed")
-        bodies.append(PlacedBody(j.child, parent, tuple(X.translation), _quat(X.rotation), joint, mass, com,
+        bodies.append(PlacedBody(j.child, parent, tuple(X.translation), matrix_quat(X.rotation), joint, mass, com,
                                  inertia))
     cuts = []
     for c, s in zip(mech.cuts, spec.cut_joints):
@@ -105,10 +101,10 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
             F.append((link, world[link].inverse() * data.oMf[fid]))
         (b1, F1), (b2, F2) = F
         rel = data.oMf[c.frame1].inverse() * data.oMf[c.frame2]
-        cuts.append(PlacedCut(s.name, s.type, b1, tuple(F1.translation), _quat(F1.rotation), b2,
-                              tuple(F2.translation), _quat(F2.rotation), tuple(s.axis),
+        cuts.append(PlacedCut(s.name, s.type, b1, tuple(F1.translation), matrix_quat(F1.rotation), b2,
+                              tuple(F2.translation), matrix_quat(F2.rotation), tuple(s.axis),
                               tuple(s.axis2) if s.axis2 is not None else None,
-                              (tuple(rel.translation), _quat(rel.rotation))))
+                              (tuple(rel.translation), matrix_quat(rel.rotation))))
     couplings = []
     for cp in spec.couplings:
         primary = values.get(cp.mimics, 0.0)
