@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
 
-from ..analysis.motion.ik import inverse_kinematics
+from ..analysis.motion.ik import branches, inverse_kinematics
 from ..errors import UsageError, quote
 from ..present.report import (
     position_dict,
@@ -56,8 +57,11 @@ def run(mech, args) -> int:
     res = inverse_kinematics(mech, output, pose, starts=args.starts, position_only=n == 3)
     # the output frame (point, tool) on its link; each solution's output_pose is that frame's
     frame = output_frame_dict(mech, res.solutions[0].q) if mech.tool is not None else None
+    count = branches(mech, res)
     if args.json:
         d = position_dict(res)
+        d["branches"] = {"found": count.found, "at_most": count.at_most, "why": count.why or None,
+                         "legs": [{"joints": list(j), "found": k, "at_most": m} for j, k, m in count.legs]}
         if frame is not None:
             d["output_frame"] = {k: frame[k] for k in ("name", "link", "local")}
         print(json.dumps(to_jsonable(d), indent=2))
@@ -66,12 +70,28 @@ def run(mech, args) -> int:
             print(output_frame_line(frame, args.tool is None).split(", in the world")[0])
         target = (f"roll pitch yaw = {v[3]:.6g} {v[4]:.6g} {v[5]:.6g} rad" if n == 6 else "any orientation")
         print(f"inverse kinematics of '{output}' at x y z = {v[0]:.6g} {v[1]:.6g} {v[2]:.6g} m, {target}")
+        if res.free_dofs:  # the continuum first: what follows are samples of it
+            print(f"note: the target leaves {res.free_dofs} degree{'s' if res.free_dofs != 1 else ''} of freedom free"
+                  + (" (a position alone: the output may turn)" if n == 3 else "")
+                  + f": the solutions form a continuum; the {len(res.solutions)} below are samples of it")
         print(f"search: damped Newton on the loops and the pose from {res.starts} starting configurations (the "
-              f"assembled and the file's configurations, and random ones within the joint limits): {len(res.solutions)} distinct "
-              f"branch{'es' if len(res.solutions) != 1 else ''} found; not exhaustive, --starts N tries more")
+              f"assembled and the file's configurations, and random ones within the joint limits): "
+              + _found_text(count, res.free_dofs))
         shown = list(res.solutions) if args.all else list(res.physical) or list(res.solutions)
         if mech.actuated:
             for k, s in enumerate(shown, 1):
                 print(f"solution {k} actuated: " + ", ".join(f"{n} = {s.joints[n]:.9g}" for n in mech.actuated))
-        print(position_text(res, show_all=args.all).split("\n", 1)[1])
+        # the continuum was said first: not again in the table's header
+        print(position_text(replace(res, free_dofs=0), show_all=args.all).split("\n", 1)[1])
     return 0
+
+
+def _found_text(count, free: int) -> str:
+    """'8 distinct branches found (legs: 2 x 2 x 2) of at most 8 (why): all of them', or how far from it."""
+    n = count.found
+    what = ("solution" if n == 1 else "solutions") if free else ("branch" if n == 1 else "branches")
+    text = f"{n} distinct {what} found"
+    if count.legs and count.at_most is not None:
+        text += " (legs: " + " x ".join(str(k) for _, k, _ in count.legs) + f") of at most {count.at_most} ({count.why})"
+        return text + (": all of them" if count.complete else "; --starts N tries more")
+    return text + "; not exhaustive, --starts N tries more"

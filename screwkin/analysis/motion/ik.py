@@ -7,11 +7,16 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
+from dataclasses import dataclass
+
 from ...model.closure import ClosureSystem, CutJoint
+from ...model.geometry import wrap_angle
+from ...model.linalg import rank
 from ...model.state import KinematicState, angular_loop_joints
+from ...model.topology import frame_link
 from .position import PositionResult, PositionSolver, Solution, outside_limits
 
-__all__ = ["inverse_kinematics"]
+__all__ = ["inverse_kinematics", "Branches", "branches"]
 
 
 def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
@@ -52,10 +57,13 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     ref = solver.reference()
     ref_sig = solver.signature(ref if ref is not None else found[0][1])
     needed = mech.nv - solver.idle_dofs
+    # what the target leaves free beyond the idle DOFs (a position alone on a planar platform: its turn)
+    free = max(needed - max(rank(system.jacobian(q), mech.tolerances) for _, q, _ in found), 0)
     sols = []
     for _, q, a in found:
         s = np.linalg.svd(system.jacobian(q), compute_uv=False)
-        sigma = float(s[needed - 1] / s[0]) if 0 < needed <= len(s) else 1.0
+        k = needed - free  # a continuum left by the target is no singularity: the rank it keeps
+        sigma = float(s[k - 1] / s[0]) if 0 < k <= len(s) else 1.0
         state = KinematicState(mech, q)
         outside = outside_limits(mech, q)
         sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
@@ -65,5 +73,67 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
                              leg_lengths=state.leg_lengths or None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
     return PositionResult({"position": pose.translation.tolist()} if position_only else {"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
-                          0, (), output, solver.angular_names(), solver._angular_coupled(),
+                          free, (), output, solver.angular_names(), solver._angular_coupled(),
                           angular_loop_joints(mech))
+
+
+@dataclass(frozen=True)
+class Branches:
+    """How many inverse-kinematics branches a result holds, against how many there can be.
+
+    found:   distinct solutions found;
+    legs:    per leg (a chain of links between the ground and the output link), its joint names and
+             how many distinct settings of them the solutions hold;
+    at_most: the most there can be, where known (every leg a planar dyad: two circle or line
+             intersections at most, one with two sliders), else None;
+    why:     that bound in words ("" when unknown)."""
+
+    found: int
+    legs: tuple  # ((joint names), distinct settings found, at most or None)
+    at_most: int | None
+    why: str
+
+    @property
+    def complete(self) -> bool:
+        """Every branch the bound allows was found."""
+        return self.at_most is not None and self.found >= self.at_most
+
+
+def branches(mech, res: PositionResult) -> Branches:
+    """Count the branches of an inverse-kinematics result leg by leg.  A leg is a connected set of
+    links once the ground and the output link are taken away; with the output placed, each leg's
+    joints are solved on their own, so the branches are the combinations of the legs' settings.
+    A planar leg of three one-DOF joints (a dyad: two unknowns) has at most two closures (one when
+    two of its joints slide)."""
+    import networkx as nx
+
+    n = len(res.solutions)
+    if res.free_dofs or not res.output or not res.solutions:
+        return Branches(n, (), None, "")
+    topo = mech.topology(res.solutions[0].q)
+    member_of = {m: name for name, members in topo.link_members.items() for m in members}
+    out = member_of.get(frame_link(mech, res.output))
+    graph = nx.Graph()
+    graph.add_nodes_from(lk for lk in topo.links if lk not in (topo.ground, out))
+    graph.add_edges_from(j.links for j in topo.joints if all(lk in graph for lk in j.links))
+    legs = []
+    tol = mech.tolerances.geometry
+    for comp in sorted(nx.connected_components(graph), key=lambda c: min(topo.links.index(lk) for lk in c)):
+        joints = [j for j in topo.joints if set(j.links) & comp]
+        names = [m for j in joints for m in j.members if m in res.solutions[0].joints]
+        angular = np.array([m in res.angular or m in res.angular_loop for m in names], bool)
+        settings = []
+        for s in res.solutions:
+            v = np.array([s.joints[m] for m in names])
+            d = [v - w for w in settings]
+            if not any(np.all(np.abs(np.where(angular, wrap_angle(e), e)) <= tol) for e in d):
+                settings.append(v)
+        dyad = (topo.motion_space == "planar" and len(joints) == 3
+                and all(j.dof == 1 and j.type in ("revolute", "continuous", "prismatic") for j in joints))
+        most = (1 if sum(j.type == "prismatic" for j in joints) >= 2 else 2) if dyad else None
+        legs.append((tuple(names), len(settings), most))
+    if len(legs) < 2 or any(m is None for _, _, m in legs):
+        return Branches(n, tuple(legs), None, "")
+    return Branches(n, tuple(legs), int(np.prod([m for _, _, m in legs])),
+                    "each leg a planar dyad: two circle or line intersections at most")
+
