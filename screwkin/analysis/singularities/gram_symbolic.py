@@ -3,7 +3,8 @@
 The loops and symbols are those of ``screwkin equations`` (analysis/course/equations.py): each loop's
 joints in the order walked, each revolute's planar twist (y, -x, 1) at its centre (x, y) written
 as a sum of the loop's link vectors from its first joint, each prismatic joint's (cos b, sin b, 0)
-along its guide.  With S the 3 x n matrix of a loop's twists and G = S^T S, the cofactor
+along its guide, each rolling or gear pair's (y, -x, 1) at its contact point (rolling without slip
+turns one link about it relative to the other; the no-slip law put in, as equations does).  With S the 3 x n matrix of a loop's twists and G = S^T S, the cofactor
 C_i = det(G without row and column i) vanishes exactly where joint i is stationary in the loop's
 one-freedom motion (see analysis.singularities.singular.GramLoop); for n = 4 it is det(S without column i)^2.
 The zero set does not depend on where the origin is put (a change of origin multiplies S by a
@@ -42,7 +43,8 @@ def _simplified(sp, expr):
 
 def symbolic_gram(mech, q, inputs=None) -> tuple:
     """A SymbolicGramLoop for each independent loop of a planar mechanism of revolute and
-    prismatic joints (the loops of screwkin equations), at the assembled configuration q."""
+    prismatic joints, rolling and gear pairs (the loops of screwkin equations), at the assembled
+    configuration q."""
     if mech.topology(q).motion_space != "planar":
         raise UsageError(f"{mech.path}: --symbolic writes planar loops' cofactors (this mechanism is not planar)")
     loops = VectorLoops(mech, q, inputs)
