@@ -327,3 +327,27 @@ def test_report_writes_the_rolling_pairs_equations_and_a_hand_newton_step(tmp_pa
     # is measured there, so the residual agrees to that and the step to it over sigma_min(J) ~ 0.01
     assert it["residual"] == pytest.approx(F.tolist(), abs=1e-10)
     assert it["step"] == pytest.approx(dz.tolist(), abs=1e-8)
+
+
+def test_symbolic_gram_cofactors_of_gear_loops_are_the_hand_formulas(capsys):
+    """A loop of two gears pinned to one frame has three joints but one freedom (the contact on the line of
+    centres, Kennedy): its cofactors are the 2 x 2 Gram determinants.  By hand, centres O_a = (0, 0) and
+    O_b = (d, 0), contact (rho_a, 0): twists (0, 0, 1), (0, -d, 1), (0, -rho_a, 1); C_a = Gram(O_b, P) = (d - rho_a)^2
+    = rho_b^2, C_b = Gram(O_a, P) = rho_a^2, C_P = Gram(O_a, O_b) = d^2.  A rack on a pinion at the origin, the contact
+    (0, rho): twists (0, 0, 1), (+-1, 0, 0), (rho, 0, 1): C_pinion = 1, C_rack = rho^2, C_mesh = 1."""
+    import sympy as sp
+    assert main(["singularities", GEARS, "--symbolic", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)["gram_symbolic"][0]
+    assert main(["equations", GEARS, "--json"]) == 0
+    values = {n: s["value"] for n, s in json.loads(capsys.readouterr().out)["symbols"].items()}
+    assert values["r1"] == pytest.approx(values["rho2"] + values["rho3"], abs=1e-12)  # the gears touch
+    r1, rho2 = sp.symbols("r1 rho2", real=True)
+    hand = {"input_joint": (r1 - rho2) ** 2, "idler_joint": rho2 ** 2, "mesh1": r1 ** 2}  # input: rho2, d = r1
+    for joint, formula in hand.items():
+        got = sp.sympify(first["cofactors"][joint], locals={"r1": r1, "rho2": rho2})
+        assert sp.simplify(got - formula) == 0, (joint, first["cofactors"][joint])
+        assert first["zero_when"][joint] == []
+    assert main(["singularities", RACK, "--symbolic", "--json"]) == 0
+    (loop,) = json.loads(capsys.readouterr().out)["gram_symbolic"]
+    assert {j: sp.sympify(c) for j, c in loop["cofactors"].items()} == {
+        "pinion_joint": 1, "rack_joint": sp.Symbol("rho2") ** 2, "mesh": 1}

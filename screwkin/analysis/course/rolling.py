@@ -101,7 +101,8 @@ def pair_term(loops, rec, placeholder=None):
     record; ``placeholder``: a sympy symbol to stand for theta_ab (replaced later).  Sets
     rec["contact"]: the contact point from link a's anchor (circle a's centre: rho_a along the
     line of centres; a rack's point: x_ab along the line), where the pair's relative motion is
-    a rotation (no slip: the contact point is the instantaneous centre)."""
+    a rotation (no slip: the contact point is the instantaneous centre); a rack's also
+    rec["facing"]: the contact point from the pinion's centre (rho_b n)."""
     sp = loops.sp
     a, b = rec["a"], rec["b"]
     na, nb = loops.numbers[a], loops.numbers[b]
@@ -137,7 +138,8 @@ def pair_term(loops, rec, placeholder=None):
         tu_q = theta_q(a) + beta
         c = offset(rec["x"] - rec["r2"] * (theta_q(b) - tu_q))
         x = rb * (tb - tu) + c
-        rec.update({"x_expr": x, "tu": tu, "ta": ta, "tb": tb, "contact": (x * sp.cos(tu), x * sp.sin(tu))})
+        rec.update({"x_expr": x, "tu": tu, "ta": ta, "tb": tb, "contact": (x * sp.cos(tu), x * sp.sin(tu)),
+                    "facing": (-rb * sp.sin(tu), rb * sp.cos(tu))})
         name = f"x{na}{nb}"
         law = f"{name} = {x}"
         fx = x * sp.cos(tu) + rb * sp.sin(tu)

@@ -369,10 +369,17 @@ class VectorLoops:
                     hold = sp.Dummy(f"k_{j_out.name}") if rec["kind"] != "rack" else None
                     px, py, names, pair = pair_term(self, rec, hold)
                     sign = 1 if rec["a"] == link else -1
-                    # a revolute at the contact point (the instantaneous centre of rolling without slip)
-                    ax, ay = (fx, fy) if sign > 0 else (fx - px, fy - py)  # link a's anchor of the pair
-                    cx, cy = ax + rec["contact"][0], ay + rec["contact"][1]
-                    twists.append((j_out.name, (cy, -cx, 1)))
+                    # a revolute at the contact point (the instantaneous centre of rolling without slip); a
+                    # rack's from the pinion's centre, reached by the loop's own vectors (the rest of the loop
+                    # walked back when the walk crosses from the rack: put in below)
+                    if rec["kind"] == "rack":
+                        nx, ny = rec["facing"]
+                        twists.append((j_out.name, (fy + ny, -(fx + nx), 1)) if sign < 0 else
+                                      (j_out.name, ("after", fx + px, fy + py, nx, ny)))
+                    else:
+                        ax, ay = (fx, fy) if sign > 0 else (fx - px, fy - py)  # link a's anchor of the pair
+                        cx, cy = ax + rec["contact"][0], ay + rec["contact"][1]
+                        twists.append((j_out.name, (cy, -cx, 1)))
                     fx += sign * px
                     fy += sign * py
                     terms += [(("" if sign > 0 else "-") + t).replace("--", "") for t in names]
@@ -391,6 +398,9 @@ class VectorLoops:
                 elif i < m - 1:  # a revolute at (fx, fy) from the loop's first joint: (y, -x, 1)
                     twists.append((j_out.name, (fy, -fx, 1)))
             rows = [fx, fy]
+            # the pinion's centre after crossing a rack: the loop back from there, -(the rest of the walk)
+            twists = [(n, t) if not isinstance(t[0], str) else (n, (t[2] - fy + t[4], -(t[1] - fx + t[3]), 1))
+                      for n, t in twists]
             if crossed:
                 rows, twists = substitute_pairs(self, len(self.loops) + 1, rows, crossed, twists)
             self.loops.append(LoopEquation(tuple(links), tuple(j.name for j in joints), tuple(terms),
