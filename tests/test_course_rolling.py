@@ -23,7 +23,7 @@ X0 = 0.008 + np.sqrt(0.03 ** 2 - 0.008 ** 2)
 def built(path, inputs):
     mech = load(path)
     q0 = mech.generic_configurations()[0].q
-    return mech, q0, VectorLoops(mech, q0, inputs, higher=True), PositionSolver(mech, inputs)
+    return mech, q0, VectorLoops(mech, q0, inputs), PositionSolver(mech, inputs)
 
 
 def solved(mech, solver, name, value, q0):
@@ -264,3 +264,90 @@ def test_newton_on_the_rack_beyond_a_turn_reports_the_rack_where_the_law_puts_it
     # x3 from the pinion's centre to the rack's joint (drawn at 0.15 along -x): 0.15 + 0.04 t; the rack joint -0.04 t
     assert d["newton"]["values"]["x3"] == pytest.approx(0.15 + 0.04 * np.radians(400.0), abs=1e-12)
     assert d["solutions"][0]["joints"]["rack_joint"] == pytest.approx(-0.04 * np.radians(400.0), abs=1e-10)
+
+
+def _sympy(text):
+    """A formula as screwkin writes it (sympy syntax), its symbols real."""
+    import sympy as sp
+    names = {n: sp.Symbol(n, real=True) for n in ("rho2", "rho3", "c23", "theta2", "theta3", "x4")}
+    return sp.sympify(text, locals=names), names
+
+
+def test_symbolic_gram_cofactors_of_friction_wheels_are_the_hand_formulas(capsys):
+    """singularities --symbolic takes the rolling pair (it refused it): the pair is a revolute at the contact point
+    (no slip: the instantaneous centre).  By hand, origin at O2, t = theta23 the line of centres: twists (y, -x, 1)
+    of O2 (0, 0), of disc 3's centre (x4, 0) and of the contact (x4 - rho3 cos t, -rho3 sin t), the slide's (1, 0, 0);
+    C_i = det(S without column i)^2."""
+    import sympy as sp
+    assert main(["singularities", WHEELS, "--symbolic", "--json"]) == 0
+    (loop,) = json.loads(capsys.readouterr().out)["gram_symbolic"]
+    assert sorted(loop["joints"]) == ["slide", "wheel2_joint", "wheel3_joint", "wheels"]
+    _, s = _sympy("0")
+    t = (s["rho2"] * s["theta2"] + s["rho3"] * s["theta3"] - s["c23"]) / (s["rho2"] + s["rho3"])
+    hand = {"wheel2_joint": s["rho3"] ** 2 * sp.cos(t) ** 2,
+            "slide": s["rho3"] ** 2 * s["x4"] ** 2 * sp.sin(t) ** 2,
+            "wheel3_joint": (s["x4"] - s["rho3"] * sp.cos(t)) ** 2,
+            "wheels": s["x4"] ** 2}
+    for joint, formula in hand.items():
+        got, _ = _sympy(loop["cofactors"][joint])
+        assert sp.simplify(got - formula) == 0, (joint, loop["cofactors"][joint])
+    assert loop["zero_when"]["wheels"] == ["x4 = 0"]
+
+
+def test_report_writes_the_rolling_pairs_equations_and_a_hand_newton_step(tmp_path, capsys):
+    """report's Equations and Newton sections take the rolling pair through the equations' one path: det A is
+    rho3 cos theta23 by hand (A = dF/d(theta3, x4) of the loop below) and one Newton step from the estimates given
+    is the hand step of test_one_newton_step_on_friction_wheels_is_the_hand_computation."""
+    import sympy as sp
+    md = tmp_path / "f.md"
+    code = main(["report", WHEELS, "--md", str(md), "--no-view", "--set", "wheel2_joint=60deg",
+                 "--start", "theta3=-100deg,x4=0.035", "--iterations", "1", "--steps", "36"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "vector-loop equations take" not in out + err
+    text = md.read_text()
+    assert "## Equations" in text and "## Newton iterations" in text
+    assert "no slip ρ2*(θ2 - θ23) + ρ3*(θ3 - θ23) = c23" in text
+    data = json.loads((tmp_path / "f_files" / "data.json").read_text())
+    det, s = _sympy(data["equations"]["det_A"])
+    t = (s["rho2"] * s["theta2"] + s["rho3"] * s["theta3"] - s["c23"]) / (s["rho2"] + s["rho3"])
+    assert sp.simplify(det - s["rho3"] * sp.cos(t)) == 0
+    # the hand step (theta2 of the link: 45 deg at joint 0; c from the drawing, as in the test above)
+    t2_0, t3_0 = np.radians(45.0), 0.0
+    tk_0 = np.arctan2(-0.008, X0 - 0.008)
+    c = R2 * (t2_0 - tk_0) + R3 * (t3_0 - tk_0)
+    r2, R = np.hypot(0.008, 0.008), R2 + R3
+    t2, t3, x4 = np.radians(60.0 + 45.0), np.radians(-100.0), 0.035
+    tk = (R2 * t2 + R3 * t3 - c) / R
+    F = np.array([x4 - r2 * np.cos(t2) - R * np.cos(tk), -r2 * np.sin(t2) - R * np.sin(tk)])
+    J = np.array([[R3 * np.sin(tk), 1.0], [-R3 * np.cos(tk), 0.0]])
+    dz = np.linalg.solve(J, -F)
+    (it,) = data["newton"]["trace"]
+    # report builds the equations at the solved configuration (closed to the closure tolerance, ~1e-12 m here): c23
+    # is measured there, so the residual agrees to that and the step to it over sigma_min(J) ~ 0.01
+    assert it["residual"] == pytest.approx(F.tolist(), abs=1e-10)
+    assert it["step"] == pytest.approx(dz.tolist(), abs=1e-8)
+
+
+def test_symbolic_gram_cofactors_of_gear_loops_are_the_hand_formulas(capsys):
+    """A loop of two gears pinned to one frame has three joints but one freedom (the contact on the line of
+    centres, Kennedy): its cofactors are the 2 x 2 Gram determinants.  By hand, centres O_a = (0, 0) and
+    O_b = (d, 0), contact (rho_a, 0): twists (0, 0, 1), (0, -d, 1), (0, -rho_a, 1); C_a = Gram(O_b, P) = (d - rho_a)^2
+    = rho_b^2, C_b = Gram(O_a, P) = rho_a^2, C_P = Gram(O_a, O_b) = d^2.  A rack on a pinion at the origin, the contact
+    (0, rho): twists (0, 0, 1), (+-1, 0, 0), (rho, 0, 1): C_pinion = 1, C_rack = rho^2, C_mesh = 1."""
+    import sympy as sp
+    assert main(["singularities", GEARS, "--symbolic", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)["gram_symbolic"][0]
+    assert main(["equations", GEARS, "--json"]) == 0
+    values = {n: s["value"] for n, s in json.loads(capsys.readouterr().out)["symbols"].items()}
+    assert values["r1"] == pytest.approx(values["rho2"] + values["rho3"], abs=1e-12)  # the gears touch
+    r1, rho2 = sp.symbols("r1 rho2", real=True)
+    hand = {"input_joint": (r1 - rho2) ** 2, "idler_joint": rho2 ** 2, "mesh1": r1 ** 2}  # input: rho2, d = r1
+    for joint, formula in hand.items():
+        got = sp.sympify(first["cofactors"][joint], locals={"r1": r1, "rho2": rho2})
+        assert sp.simplify(got - formula) == 0, (joint, first["cofactors"][joint])
+        assert first["zero_when"][joint] == []
+    assert main(["singularities", RACK, "--symbolic", "--json"]) == 0
+    (loop,) = json.loads(capsys.readouterr().out)["gram_symbolic"]
+    assert {j: sp.sympify(c) for j, c in loop["cofactors"].items()} == {
+        "pinion_joint": 1, "rack_joint": sp.Symbol("rho2") ** 2, "mesh": 1}

@@ -158,7 +158,7 @@ def solve_from_start(mech, args, values) -> int:
     if not args.start:
         raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
     q_ref = mech.generic_configurations()[0].q
-    loops = VectorLoops(mech, q_ref, list(values), higher=True)
+    loops = VectorLoops(mech, q_ref, list(values))
     solver = PositionSolver(mech, list(values))
     q_in = solver.set_inputs(q_ref, values)
     typed = _typed(args.start, "--start")

@@ -26,6 +26,7 @@ from ..files.description import CUT_JOINT_DOF
 from ..files.sidecar import axis_letters
 from ..tolerances import DEFAULT
 from ._pin import frame_id
+from .six_bar import six_bar_inversion
 
 __all__ = ["Joint", "Topology", "build_topology", "frame_link"]
 
@@ -172,6 +173,15 @@ class Topology:
     @property
     def count_in_motion_space(self) -> int:
         return self.count(6 if self.motion_space == "spatial" else 3)
+
+    @property
+    def six_bar(self) -> str | None:
+        """The inversion of a planar six-bar of revolute and prismatic joints ("Watt I" ...
+        "Stephenson III", by the graph: screwkin.model.six_bar), else None."""
+        if self.motion_space != "planar" or self.couplings or \
+                any(j.type not in ("revolute", "continuous", "prismatic") for j in self.joints):
+            return None
+        return six_bar_inversion([tuple(j.links) for j in self.joints], self.ground)
 
 
 class _Union:

@@ -5,6 +5,7 @@ constraint rank, idle and effective DOFs) and the output's motion.
 
 from __future__ import annotations
 
+from ..model.six_bar import INVERSIONS
 from .tables import table
 
 __all__ = ["topology_dict", "mobility_dict", "JOINT_COLUMNS", "joint_rows", "topology_text", "count_rows",
@@ -34,6 +35,7 @@ def topology_dict(topo) -> dict:
         "loops": topo.loops,
         "motion_space": topo.motion_space,
         "motion_space_detail": topo.motion_space_detail,
+        "six_bar": topo.six_bar,  # "Watt I" ... "Stephenson III" (model.six_bar), None for other mechanisms
         "massless_links_in_compound_joints": list(topo.dummy_links),
         "welds": list(topo.welds),
         "couplings": [{"joint": c.joint, "mimics": c.mimics, "multiplier": c.multiplier, "offset": c.offset}
@@ -113,6 +115,8 @@ def topology_text(topo, title: str) -> str:
     if topo.dummy_links:
         lines.append(f"massless links inside compound joints (not counted): {len(topo.dummy_links)}")
     lines.append(f"motion space: {topo.motion_space} ({topo.motion_space_detail})")
+    if topo.six_bar:
+        lines.append(f"six-bar: {topo.six_bar}: {INVERSIONS[topo.six_bar]} ('{topo.ground}')")
     return "\n".join(lines)
 
 

@@ -108,6 +108,6 @@ def gram_symbolic_text(loops) -> str:
     for lp in loops:
         lines.append(f"loop {' - '.join(lp.joints)}" + (f": {lp.note}" if lp.note else ""))
         for name, expr in lp.cofactors.items():
-            where = "; ".join(lp.zero_when[name]) or "never 0"
-            lines.append(f"  C_{name} = {expr}   (0 where {where})")
+            where = "; ".join(lp.zero_when[name])
+            lines.append(f"  C_{name} = {expr}   ({'0 where ' + where if where else 'never 0'})")
     return "\n".join(lines)

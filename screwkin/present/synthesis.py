@@ -222,9 +222,10 @@ def chains_dict(result: ChainsResult, directory=None) -> dict:
     chains = []
     for c in result.chains:
         mechs = []
-        for g, orbit in zip(c.inversions, c.orbits):
+        names = c.inversion_names or (None,) * len(c.inversions)
+        for g, orbit, name in zip(c.inversions, c.orbits, names):
             f = files.get((c.index, g))
-            mechs.append({"ground": g, "equivalent_grounds": list(orbit),
+            mechs.append({"ground": g, "inversion": name, "equivalent_grounds": list(orbit),
                           "file": f.file if f else None, "mobility": f.mobility if f else None,
                           "assembled_iterations": f.assembled_iterations if f else None,
                           "problem": f.problem if f else None})
@@ -257,11 +258,14 @@ def chains_text(result: ChainsResult, directory=None) -> str:
         joints = " ".join(f"{j['links'][0]}-{j['links'][1]}" + ("" if j["type"] == "R" else f"(P, guide {j['guide']})")
                           for j in c["joints"])
         out.append(f"  {c['index']:>3}. {c['name']}: joints {joints}; {c['automorphisms']} automorphism"
-                   f"{'s' if c['automorphisms'] != 1 else ''}; grounds {', '.join(str(m['ground']) for m in c['mechanisms'])}")
+                   f"{'s' if c['automorphisms'] != 1 else ''}; grounds "
+                   + ", ".join(str(m["ground"]) + (f" ({m['inversion']})" if m["inversion"] else "")
+                               for m in c["mechanisms"]))
         for m in c["mechanisms"]:
             if m["file"]:
                 status = f"mobility {m['mobility']}" + (f"  PROBLEM: {m['problem']}" if m["problem"] else ", drawn closed")
-                out.append(f"        chain link {m['ground']} grounded: {m['file']} ({status})")
+                name = f" ({m['inversion']})" if m["inversion"] else ""
+                out.append(f"        chain link {m['ground']} grounded{name}: {m['file']} ({status})")
     if result.files:
         out.append(f"wrote {len(result.files)} files to {directory}, each loaded and checked with screwkin "
                    "(drawn closed, mobility by the constraint rank)")

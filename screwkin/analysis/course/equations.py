@@ -70,4 +70,4 @@ def equations(mech, q, inputs=None, output=None):
     topo = mech.topology(q)
     if topo.motion_space != "planar":
         return _spatial(mech, q, list(inputs) if inputs else list(mech.actuated), output)
-    return VectorLoops(mech, q, inputs, higher=True).result()
+    return VectorLoops(mech, q, inputs).result()

@@ -98,7 +98,11 @@ def _times(radius, angle, line):
 
 def pair_term(loops, rec, placeholder=None):
     """(fx, fy, term names) of crossing the pair from link a to link b, and the RollingPair
-    record; ``placeholder``: a sympy symbol to stand for theta_ab (replaced later)."""
+    record; ``placeholder``: a sympy symbol to stand for theta_ab (replaced later).  Sets
+    rec["contact"]: the contact point from link a's anchor (circle a's centre: rho_a along the
+    line of centres; a rack's point: x_ab along the line), where the pair's relative motion is
+    a rotation (no slip: the contact point is the instantaneous centre); a rack's also
+    rec["facing"]: the contact point from the pinion's centre (rho_b n)."""
     sp = loops.sp
     a, b = rec["a"], rec["b"]
     na, nb = loops.numbers[a], loops.numbers[b]
@@ -134,7 +138,8 @@ def pair_term(loops, rec, placeholder=None):
         tu_q = theta_q(a) + beta
         c = offset(rec["x"] - rec["r2"] * (theta_q(b) - tu_q))
         x = rb * (tb - tu) + c
-        rec.update({"x_expr": x, "tu": tu, "ta": ta, "tb": tb})
+        rec.update({"x_expr": x, "tu": tu, "ta": ta, "tb": tb, "contact": (x * sp.cos(tu), x * sp.sin(tu)),
+                    "facing": (-rb * sp.sin(tu), rb * sp.cos(tu))})
         name = f"x{na}{nb}"
         law = f"{name} = {x}"
         fx = x * sp.cos(tu) + rb * sp.sin(tu)
@@ -152,7 +157,7 @@ def pair_term(loops, rec, placeholder=None):
     expr = (ra * ta + s * rb * tb - c) / R
     t = placeholder if placeholder is not None else expr
     rec.update({"expr": expr, "law_expr": ra * (ta - tk) + s * rb * (tb - tk) - c, "tk": tk, "tk_q": tk_q,
-                "ta": ta, "tb": tb})
+                "ta": ta, "tb": tb, "contact": (ra * sp.cos(t), ra * sp.sin(t))})
     return R * sp.cos(t), R * sp.sin(t), [f"({R})*e{na}{nb}"], RollingPair(
         rec["name"], rec["kind"], (a, b), law, f"{name} = {expr}", False)
 
@@ -257,13 +262,16 @@ def _line_of_centres(loops, rows, hold, rec):
     return phi + flip + 2 * sp.pi * int(np.round((rec["tk_q"] - here) / (2 * np.pi)))
 
 
-def substitute_pairs(loops, number, rows, crossed):
+def substitute_pairs(loops, number, rows, crossed, twists=()):
     """The loop's rows with each rolling pair's line-of-centres angle replaced: by its no-slip
     expression in the links' angles; or, where the rest of the loop fixes the line of centres
     (two gears pinned to one link, a planet on an arm: screwkin.analysis.course.rolling), by
-    that, the vector rows (identities then) replaced by the no-slip law."""
+    that, the vector rows (identities then) replaced by the no-slip law.  ``twists``: the loop's
+    planar twists [(joint, (vx, vy, w))], returned with the same angle put in (rows, twists)."""
     holds = [h for _, h, _ in crossed if h is not None]
     tk = _line_of_centres(loops, rows, holds[0], crossed[0][0]) if len(crossed) == 1 and holds else None
+    put = {hold: (tk if tk is not None else rec["expr"]) for rec, hold, _ in crossed if hold is not None}
+    twists = [(name, tuple(loops.sp.sympify(e).subs(put) for e in t)) for name, t in twists]
     out = []
     for rec, hold, pair in crossed:
         if hold is None:
@@ -282,7 +290,7 @@ def substitute_pairs(loops, number, rows, crossed):
         else:
             rows = [r.subs(hold, rec["expr"]) for r in rows]
             loops.pairs.append(pair)
-    return out if tk is not None else rows
+    return (out if tk is not None else rows), twists
 
 
 def unwrapped(loops, link, angle, q):

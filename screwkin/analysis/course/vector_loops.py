@@ -1,5 +1,5 @@
-"""The vector-loop equations of a planar mechanism of revolute and prismatic joints (and, with
-``higher=True``, rolling, gear and rack-and-pinion pairs: screwkin.analysis.course.rolling), in
+"""The vector-loop equations of a planar mechanism of revolute and prismatic joints, rolling, gear
+and rack-and-pinion pairs (the no-slip law substituted: screwkin.analysis.course.rolling), in
 symbols (sympy): the course solution's planar method (screwkin.analysis.course.equations).
 
 - Links are numbered as a textbook does and as ``screwkin draw`` numbers them
@@ -76,13 +76,14 @@ def _exact_angle(sp, value, tol):
 
 
 class VectorLoops:
-    """The loop equations of a planar mechanism of revolute and prismatic joints, built at an
-    assembled configuration q (where every constant is measured), for the given input
+    """The loop equations of a planar mechanism of revolute and prismatic joints and rolling and
+    gear pairs, built at an assembled configuration q (where every constant is measured), for the given input
     joints.  Holds the sympy expressions and their numerical forms; ``result()`` gives the
     plain :class:`PlanarEquations`."""
 
-    def __init__(self, mech, q, inputs=None, higher=False):
-        """``higher``: take rolling and gear pairs (screwkin.analysis.course.rolling) too."""
+    def __init__(self, mech, q, inputs=None):
+        """Every command that writes these equations (equations, solve --start, singularities
+        --symbolic, report) builds them here: rolling and gear pairs included."""
         import sympy as sp
 
         self.sp = sp
@@ -95,11 +96,11 @@ class VectorLoops:
         if topo.motion_space != "planar":
             raise UsageError(f"{path}: the vector-loop equations are for planar mechanisms; this one is "
                              f"{topo.motion_space}")
-        self.higher = bool(higher)
-        other = [j for j in topo.joints if j.type not in LOWER and not (self.higher and j.type in HIGHER)]
+        other = [j for j in topo.joints if j.type not in LOWER and j.type not in HIGHER]
         if other:
             j = other[0]
-            raise MechanismFileError(path, f"the vector-loop equations take revolute and prismatic joints; "
+            raise MechanismFileError(path, f"the vector-loop equations take revolute and prismatic joints, rolling "
+                                           f"and gear pairs; "
                                            f"'{j.name}' is a {j.type} pair (screwkin screws gives the "
                                            "product-of-exponentials structure equations)")
         if topo.couplings:
@@ -352,7 +353,9 @@ class VectorLoops:
             m = len(links)
             terms, fx, fy = [], sp.Integer(0), sp.Integer(0)
             crossed = []  # (pair record, placeholder symbol) of the rolling pairs crossed
-            twists = [] if joints[-1].type == "prismatic" else [(joints[-1].name, (0, 0, 1))]
+            # the joint closing the walk sits at the loop's origin (a pair's twist is put where the walk crosses it)
+            twists = [] if joints[-1].type == "prismatic" or joints[-1].type in HIGHER else \
+                [(joints[-1].name, (0, 0, 1))]
             for i in range(m):
                 link, j_in, j_out = links[i], joints[i - 1], joints[i]
                 got = self._vector(link, (j_in.name, link), (j_out.name, link))
@@ -366,6 +369,17 @@ class VectorLoops:
                     hold = sp.Dummy(f"k_{j_out.name}") if rec["kind"] != "rack" else None
                     px, py, names, pair = pair_term(self, rec, hold)
                     sign = 1 if rec["a"] == link else -1
+                    # a revolute at the contact point (the instantaneous centre of rolling without slip); a
+                    # rack's from the pinion's centre, reached by the loop's own vectors (the rest of the loop
+                    # walked back when the walk crosses from the rack: put in below)
+                    if rec["kind"] == "rack":
+                        nx, ny = rec["facing"]
+                        twists.append((j_out.name, (fy + ny, -(fx + nx), 1)) if sign < 0 else
+                                      (j_out.name, ("after", fx + px, fy + py, nx, ny)))
+                    else:
+                        ax, ay = (fx, fy) if sign > 0 else (fx - px, fy - py)  # link a's anchor of the pair
+                        cx, cy = ax + rec["contact"][0], ay + rec["contact"][1]
+                        twists.append((j_out.name, (cy, -cx, 1)))
                     fx += sign * px
                     fy += sign * py
                     terms += [(("" if sign > 0 else "-") + t).replace("--", "") for t in names]
@@ -384,8 +398,11 @@ class VectorLoops:
                 elif i < m - 1:  # a revolute at (fx, fy) from the loop's first joint: (y, -x, 1)
                     twists.append((j_out.name, (fy, -fx, 1)))
             rows = [fx, fy]
+            # the pinion's centre after crossing a rack: the loop back from there, -(the rest of the walk)
+            twists = [(n, t) if not isinstance(t[0], str) else (n, (t[2] - fy + t[4], -(t[1] - fx + t[3]), 1))
+                      for n, t in twists]
             if crossed:
-                rows = substitute_pairs(self, len(self.loops) + 1, rows, crossed)
+                rows, twists = substitute_pairs(self, len(self.loops) + 1, rows, crossed, twists)
             self.loops.append(LoopEquation(tuple(links), tuple(j.name for j in joints), tuple(terms),
                                            tuple(str(r) for r in rows)))
             self.loop_twists.append(twists)

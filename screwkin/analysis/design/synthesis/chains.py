@@ -15,7 +15,8 @@ Graphs are grown one joint at a time from N bare links, each level reduced to on
 isomorphism class, a graph dropped as soon as it holds a structure (more joints only make it
 stiffer) or its links short of two joints outnumber what the remaining joints can give them.
 Published counts: one 4-link chain (the four-bar), two 6-link chains (Watt: the two ternary
-links joined; Stephenson: not), sixteen 8-link chains, all with F = 1.
+links joined; Stephenson: not), sixteen 8-link chains, all with F = 1.  The six-bars' inversions
+are named by their graphs (Watt I, II; Stephenson I, II, III: screwkin.model.six_bar).
 
 With K prismatic joints, every way of making K of the joints prismatic is taken up to the
 chain's automorphisms; an assignment is dropped when a loop of the chain has fewer than two
@@ -47,6 +48,7 @@ import numpy as np
 
 from ....errors import UsageError
 from ....files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
+from ....model.six_bar import INVERSIONS, six_bar_chain, six_bar_inversion
 from .designs import Chain, ChainsResult
 
 __all__ = ["enumerate_chains", "chain_linkage", "guides_of", "MAX_LINKS"]
@@ -192,9 +194,8 @@ def _name(links, degrees, edges, kinds):
         adjacent = bool(set(p[0]) & set(p[1]))
         base = "double-slider chain, sliders adjacent (RRPP)" if adjacent else \
             "double-slider chain, sliders opposite (RPRP)"
-    elif links == 6 and sorted(degrees) == [2, 2, 2, 2, 3, 3]:
-        t = [v for v, d in enumerate(degrees) if d == 3]
-        base = "Watt chain" if (min(t), max(t)) in edges else "Stephenson chain"
+    elif six_bar_chain(edges):
+        base = f"{six_bar_chain(edges)} chain"
     else:
         base = f"{links}-link chain"
     return f"{base} ({makeup})"
@@ -235,7 +236,8 @@ def enumerate_chains(links: int, dof: int, prismatic: int = 0) -> ChainsResult:
             orbits = _orbits(links, autos)
             chains.append(Chain(len(chains) + 1, _name(links, degrees, edges, kinds), links,
                                 tuple((u, v, kinds[(u, v)]) for u, v in edges), degrees, len(autos),
-                                tuple(o[0] for o in orbits), orbits))
+                                tuple(o[0] for o in orbits), orbits,
+                                tuple(six_bar_inversion(edges, o[0]) for o in orbits)))
     return ChainsResult(links, dof, prismatic, joints, tuple(chains), (), looked)
 
 
@@ -331,9 +333,11 @@ def chain_linkage(chain: Chain, ground: int, size: float = 0.1, seed: int = 0, d
     actuated = tuple(f"j{e[0]}_{e[1]}" for e in actuated_edges)
     slides = "; ".join(f"j{u}_{v}: {name(guides[(u, v)])} is the guide, {name(v if guides[(u, v)] == u else u)} "
                        "the block" for u, v, k in chain.joints if k == "P")
+    names = dict(zip(chain.inversions, chain.inversion_names))
+    named = f": {names[ground]}, {INVERSIONS[names[ground]]}" if names.get(ground) else ""
     comment = (f"{chain.name}: {n} links, {len(chain.joints)} joints "
                f"({', '.join(f'{u}-{v} {k}' for u, v, k in chain.joints)}), written by screwkin synthesize chains\n"
-               f"with chain link {ground} as the ground (one of its {len(chain.inversions)} inversions) and generic "
+               f"with chain link {ground} as the ground (one of its {len(chain.inversions)} inversions{named}) and generic "
                f"proportions (seed {seed}), drawn closed.\nLinks are named by the numbers screwkin draw gives them "
                f"(the ground link1): " + ", ".join(f"chain link {v} = {name(v)}" for v in sorted(number))
                + (f".\nSlides: {slides}." if slides else "."))

@@ -190,6 +190,7 @@ class Chain:
     automorphisms: int
     inversions: tuple  # one ground link per class of links under the chain's automorphisms
     orbits: tuple  # the classes themselves
+    inversion_names: tuple = ()  # per inversion: "Watt I" ... "Stephenson III" (model.six_bar), else None
 
 
 @dataclass(frozen=True)
