@@ -121,3 +121,12 @@ def test_info_and_mobility_name_the_six_bars_in_robots(path, name, capsys):
     assert f"six-bar: {name}: " in capsys.readouterr().out
     assert main(["info", "robots/friction_wheels.urdf", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["six_bar"] is None
+
+
+def test_synthesize_chains_writes_into_an_existing_folder(tmp_path, capsys):
+    """-o names a folder for chains: an existing one is used (it was refused as 'a folder, not a file')."""
+    from screwkin.cli import main
+
+    assert main(["synthesize", "chains", "--links", "4", "--dof", "1", "-o", str(tmp_path)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["chain01_ground0.urdf"]
+    assert "wrote 1 file to" in capsys.readouterr().out

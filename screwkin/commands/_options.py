@@ -118,6 +118,8 @@ def check_outputs(parser, args) -> None:
     """Refuse, before any work, an output file whose folder is missing or not writable, or that is a folder."""
     for action in parser._actions:
         if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
+            if getattr(args, "kind", None) == "chains":  # synthesize chains writes into a folder (made if missing)
+                continue
             check_writable(getattr(args, action.dest), _option_name(action))
 
 

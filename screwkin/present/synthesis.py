@@ -267,7 +267,7 @@ def chains_text(result: ChainsResult, directory=None) -> str:
                 name = f" ({m['inversion']})" if m["inversion"] else ""
                 out.append(f"        chain link {m['ground']} grounded{name}: {m['file']} ({status})")
     if result.files:
-        out.append(f"wrote {len(result.files)} files to {directory}, each loaded and checked with screwkin "
+        out.append(f"wrote {len(result.files)} file{'s' if len(result.files) != 1 else ''} to {directory}, each loaded and checked with screwkin "
                    "(drawn closed, mobility by the constraint rank)")
     if d["defects"]:
         out.append("DEFECTS:")
