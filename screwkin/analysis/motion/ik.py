@@ -7,14 +7,14 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ...model.closure import ClosureSystem, CutJoint
 from ...model.geometry import wrap_angle
 from ...model.linalg import rank
 from ...model.state import KinematicState, angular_loop_joints
 from ...model.topology import frame_link
-from .position import PositionResult, PositionSolver, Solution, outside_limits
+from .position import PositionResult, PositionSolver
 
 __all__ = ["inverse_kinematics", "Branches", "branches"]
 
@@ -64,13 +64,9 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
         s = np.linalg.svd(system.jacobian(q), compute_uv=False)
         k = needed - free  # a continuum left by the target is no singularity: the rank it keeps
         sigma = float(s[k - 1] / s[0]) if 0 < k <= len(s) else 1.0
-        state = KinematicState(mech, q)
-        outside = outside_limits(mech, q)
-        sols.append(Solution(q, solver.joint_values(q), a.residual, a.iterations,
-                             sigma < mech.tolerances.singular, sigma, state.frame_pose(out_frame),
-                             outside_limits=outside, labels=solver._labels(q, outside),
-                             link_angles=solver._link_angles(q), coupled=mech.coupled_values(q) or None,
-                             leg_lengths=state.leg_lengths or None))
+        # every quantity as solve reports it (loop joints, links, leg lengths), singular by the ik system
+        sols.append(replace(solver.solution(q, a), singular=sigma < mech.tolerances.singular, sigma_min=sigma,
+                            output_pose=KinematicState(mech, q).frame_pose(out_frame), sigmas=None))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
     return PositionResult({"position": pose.translation.tolist()} if position_only else {"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           free, (), output, solver.angular_names(), solver._angular_coupled(),

@@ -378,7 +378,7 @@ class PositionSolver:
         if whole:
             found = [(k, *turn_on(self, q, whole, typed)) for k, q, _ in found]
         self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
-        sols = [self._solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
+        sols = [self.solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
         sols = self._merge(sols)
         ref = near_q if near_q is not None else self.reference()
         if len(sols) > 1:
@@ -472,7 +472,9 @@ class PositionSolver:
         return self._angles(q) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def _solution(self, q, a, rates, accels, points=(), typed=None) -> Solution:
+    def solution(self, q, a, rates=None, accels=None, points=(), typed=None) -> Solution:
+        """One assembly mode at the closed configuration q (a: its model.closure.Assembly), every quantity
+        read from one KinematicState; rates and accelerations when input rates are given."""
         mech, tol = self.mech, self.mech.tolerances
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
