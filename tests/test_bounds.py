@@ -97,11 +97,18 @@ def test_sweep_outputs_checked_before_the_work(extra, capsys, tmp_path):
     (["scan", ARM, "--output", "flange", "--samples", "10", "--csv"], "--csv"),
     (["view", FOURBAR, "--html"], "--html"),
     (["workspace", FIVEBAR, "--output", "tip", "--csv"], "--csv"),
-    (["synthesize", "chains", "--links", "4", "--dof", "1", "-o"], "--output"),
 ])
 def test_every_output_is_checked_before_the_work(argv, option, capsys, tmp_path):
     refused(argv + [tmp_path / "no" / "such" / "file"], capsys, option, "does not exist")
     refused(argv + [tmp_path], capsys, option, "it is a folder")
+
+
+def test_a_folder_output_is_checked_before_the_work(capsys, tmp_path):
+    """synthesize chains writes into a folder: an existing one is used, a file or a missing parent refused."""
+    argv = ["synthesize", "chains", "--links", "4", "--dof", "1", "-o"]
+    refused(argv + [tmp_path / "no" / "such" / "folder"], capsys, "--output", "does not exist")
+    (tmp_path / "f").write_text("")
+    refused(argv + [tmp_path / "f"], capsys, "--output", "it is a file")
 
 
 @pytest.mark.parametrize("argv", [

@@ -21,7 +21,7 @@ from importlib import metadata
 
 from ..errors import UsageError, quote
 
-__all__ = ["screwkin_version", "check_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+__all__ = ["screwkin_version", "check_writable", "check_folder_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
 
 
 def screwkin_version() -> str:
@@ -114,11 +114,24 @@ def check_writable(path: str, option: str) -> None:
         raise UsageError(f"{where}: cannot write, permission denied")
 
 
+def check_folder_writable(path: str, option: str) -> None:
+    """Refuse an output folder that cannot be made or written: a file, in a missing folder, without permission."""
+    where = f"{option} {quote(path, 200)}"
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise UsageError(f"{where}: cannot write, it is a file; this output is a folder")
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(path) and not os.path.isdir(parent):
+        raise UsageError(f"{where}: cannot write, the folder {quote(parent, 200)} does not exist")
+    if not os.access(path if os.path.isdir(path) else parent, os.W_OK):
+        raise UsageError(f"{where}: cannot write, permission denied")
+
+
 def check_outputs(parser, args) -> None:
     """Refuse, before any work, an output file whose folder is missing or not writable, or that is a folder."""
     for action in parser._actions:
         if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
             if getattr(args, "kind", None) == "chains":  # synthesize chains writes into a folder (made if missing)
+                check_folder_writable(getattr(args, action.dest), _option_name(action))
                 continue
             check_writable(getattr(args, action.dest), _option_name(action))
 
