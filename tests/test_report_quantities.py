@@ -11,6 +11,7 @@ differentiating in t (t' = w, t'' = 0), the rod's absolute angle phi = atan2(e -
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from conftest import ROBOTS
 import screwkin
 from screwkin.analysis.motion.planar import LinkAngles
 from screwkin.analysis.motion.position import PositionSolver
+from screwkin.cli import main
 
 SLIDER_CRANK = str(ROBOTS / "slider_crank_offset.urdf")
 R, L, E, X0 = 0.05, 0.15, 0.02, 0.1731791173126931
@@ -54,3 +56,77 @@ def test_link_angles_do_not_move_with_a_prismatic_child():
     np.testing.assert_allclose(batch["ground"], math.atan2(E, X0), rtol=0, atol=1e-12)
     for q, rod in zip(qs, batch["rod"]):
         assert rod == pytest.approx(angles(q)["rod"], abs=1e-12)
+
+
+PHI0 = math.atan2(-0.02330127018922193, 0.1481791173126931)  # the rod's pin in the rod's frame (loop_joint link1)
+
+
+def _md_tables(text: str, section: str) -> list:
+    """The Markdown tables of ``section`` (## title), each as {first cell: row cells}, with its header."""
+    body = text.split(f"## {section}\n", 1)[1].split("\n## ", 1)[0]
+    out = []
+    for block in re.split(r"\n\s*\n", body):
+        lines = [ln for ln in block.splitlines() if ln.startswith("|")]
+        if len(lines) < 3:
+            continue
+        cells = [[c.strip().replace("\\", "") for c in ln.strip("|").split(" | ")] for ln in lines]
+        out.append((cells[0], {r[0]: r for r in cells[2:]}))
+    return out
+
+
+@pytest.fixture(scope="module", params=[30.0, -30.0])
+def report(request, tmp_path_factory):
+    """The report at crank_joint = 30 deg (crank at 90 deg: the rod translates) and -30 deg, 10 rad/s."""
+    d = tmp_path_factory.mktemp("quantities")
+    md = d / "r.md"
+    assert main(["report", SLIDER_CRANK, "--set", f"crank_joint={request.param}deg", "--rate", "crank_joint=10",
+                 "--point", "P=rod:0.05,0,0", "--steps", "72", "--no-view", "--md", str(md)]) == 0
+    data = json.loads((d / "r_files" / "data.json").read_text())
+    return request.param, md.read_text(), data
+
+
+def test_markdown_tables_against_the_closed_form(report):
+    deg, text, _ = report
+    x, xd, xdd, phi, omega, alpha = closed_form(DRAWN + math.radians(deg), 10.0)
+    tables = _md_tables(text, "Positions, velocities and accelerations")
+    (jh, joints), (lh, links) = tables[0], tables[1]
+    assert jh[:2] == ["joint", "value [rad or m]"] and jh[3].startswith("rate") and lh[:4] == [
+        "link", "angle [deg]", "omega [rad/s]", "alpha [rad/s^2]"]
+    s = joints["slider_joint"]
+    assert float(s[1]) == pytest.approx(x - X0, abs=1e-9)
+    assert float(s[3]) == pytest.approx(xd, rel=1e-5, abs=1e-9)
+    assert float(s[4]) == pytest.approx(xdd, rel=1e-5, abs=1e-9)
+    loop = joints["rod_slider (loop)"]  # the loop joint is a coordinate like the others
+    assert float(loop[1]) == pytest.approx(PHI0 - phi, abs=1e-8)
+    assert float(loop[3]) == pytest.approx(-omega, rel=1e-5, abs=1e-9)
+    assert float(loop[4]) == pytest.approx(-alpha, rel=1e-5, abs=1e-9)
+    assert "ground" not in links and set(links) == {"crank", "rod", "slider"}
+    rod = links["rod"]
+    assert float(rod[1]) == pytest.approx(math.degrees(phi), abs=1e-4)
+    assert float(rod[2]) == pytest.approx(omega, rel=1e-5, abs=1e-9)
+    assert float(rod[3]) == pytest.approx(alpha, rel=1e-5, abs=1e-9)
+    assert float(links["crank"][2]) == pytest.approx(10.0)
+    assert float(links["slider"][4]) == pytest.approx(abs(xd), rel=1e-5)  # |v origin| of the slider: its speed
+    assert "input rates crank_joint = 10 rad/s" in text
+
+
+def test_data_json_against_the_closed_form_and_solve(report, capsys):
+    deg, _, data = report
+    x, xd, xdd, phi, omega, alpha = closed_form(DRAWN + math.radians(deg), 10.0)
+    sol = data["solve"]["solutions"][0]
+    # the closure converges to about 1e-11 m: the closed form's values to 1e-9
+    assert sol["joints"]["slider_joint"] == pytest.approx(x - X0, abs=1e-9)
+    assert sol["rates"]["slider_joint"] == pytest.approx(xd, abs=1e-8)
+    assert sol["accelerations"]["slider_joint"] == pytest.approx(xdd, abs=1e-7)
+    assert sol["loop_joints"]["rod_slider"] == pytest.approx(PHI0 - phi, abs=1e-8)
+    rod = sol["links"]["rod"]
+    assert (rod["angle"], rod["omega"], rod["alpha"]) == pytest.approx((phi, omega, alpha), abs=1e-7)
+    assert "ground" not in sol["links"]
+    assert sol["points"]["P"]["link"] == "rod"
+    capsys.readouterr()
+    assert main(["solve", SLIDER_CRANK, "--set", f"crank_joint={deg}deg", "--rate", "crank_joint=10",
+                 "--point", "P=rod:0.05,0,0", "--json"]) == 0
+    solved = json.loads(capsys.readouterr().out)
+    assert set(solved["solutions"][0]) <= set(sol)  # every key solve writes, the report writes too
+    assert {"joints", "rates", "accelerations", "links", "points"} <= set(sol)
+    assert data["solve"]["characteristic_length"] == solved["characteristic_length"]

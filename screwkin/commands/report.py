@@ -51,7 +51,15 @@ from ..present.view import (
     screenshot,
     show,
 )
-from ._common import add_configuration_options, add_point_option, inputs, joint_assignments, named_points
+from ..units import parse_typed_assignments, parse_value, unit_kind
+from ._common import (
+    add_configuration_options,
+    add_point_option,
+    inputs,
+    joint_assignments,
+    named_points,
+    value_kind,
+)
 from ._options import check_writable, count, screwkin_version
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
@@ -154,6 +162,7 @@ def run(mech, args) -> int:
                             accels=accels, points=points)
         q = pres.solutions[0].q
         data["solve"] = position_dict(pres)
+        data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
     topo = mech.topology(q)
     units = {n: ("rad" if not mech.translational[mech.coordinate_names.index(n)] else "m") for n in names}
     configuration = (", ".join(value_label(n, v, units[n]) for n, v in values.items())
@@ -195,8 +204,7 @@ def run(mech, args) -> int:
 
     # ---- positions, velocities, accelerations
     if pres is not None:
-        given_rates = "input rates " + ", ".join(f"{n} = {v:g}" for n, v in rates.items()) + \
-                      (" /s (default: 1 each)" if not args.rate else " /s") + \
+        given_rates = "input rates " + _rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
         sections.append(motion_section(pres, given_rates, mech.length))
     else:
@@ -242,6 +250,23 @@ def run(mech, args) -> int:
         for what, why in notes.items():
             print(f"note: {what}: {why}")
     return 0
+
+
+def _rates_text(mech, args, rates) -> str:
+    """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``), or the default 1 in SI."""
+    si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
+    if not args.rate:
+        return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
+    typed = {n: unit for n, _, unit in parse_typed_assignments(args.rate, "--rate")}
+
+    def shown(n, v):
+        unit = typed.get(n)
+        if not unit:
+            return f"{n} = {v:.6g} {si[n]}"
+        label = unit + "/s" if unit_kind(unit) in ("angle", "length") else unit  # --rate crank=90deg: 90 deg/s
+        return f"{n} = {v / parse_value('1' + unit):.6g} {label} ({v:.6g} {si[n]})"
+
+    return ", ".join(shown(n, v) for n, v in rates.items())
 
 
 def _newton(mech, args, loops, q, values, names, notes, data):

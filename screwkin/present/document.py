@@ -28,12 +28,14 @@ from ..analysis.course.vector_loops import PlanarEquations
 from ..model.geometry import wrap_angle as _wrap
 from .equations import Units, equations_text, greek, newton_text
 from .tables import shown
+from .motion import linkage_construction_text, links_rows, points_rows
 from .report import (
     JOINT_COLUMNS,
     count_rows,
     joint_rows,
     screw_theory_rows,
     screws_text,
+    solution_rows,
     to_jsonable,
 )
 
@@ -180,7 +182,9 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
 
 
 def motion_section(pres, rates_text: str, length: float) -> Section:
-    """The assembly modes for the inputs: joint values, rates and accelerations, link angles, named points."""
+    """The assembly modes for the inputs: every coordinate (loop joints too) with its rate and acceleration,
+    the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
+    present/motion.links_rows and points_rows)."""
     s = Section("motion", "Positions, velocities and accelerations")
     inputs = ", ".join(f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items())
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
@@ -189,25 +193,15 @@ def motion_section(pres, rates_text: str, length: float) -> Section:
         what = "" if sol.physical else f" (not reached by moving: {'; '.join(sol.labels)})"
         s.blocks.append(Text(f"solution {k}{what}: closure residual {sol.residual:.3g}, sigma_min {sol.sigma_min:.3g}"
                              + (" (singular)" if sol.singular else "")))
-        rows = []
-        for n, v in sol.joints.items():
-            ang = n in pres.angular
-            rate = "" if sol.rates is None else _g(sol.rates[n], 9)
-            acc = "" if sol.accelerations is None else _g(sol.accelerations[n], 9)
-            rows.append([n, f"{v:.9g}", _reading(v, ang), rate, acc])
-        s.blocks.append(Table(["joint", "value [rad or m]", "value", "rate [1/s]", "acceleration [1/s^2]"], rows,
-                              f"solution-{k}"))
-        if sol.link_angles:
-            s.blocks.append(Table(["link", "absolute angle [rad]", "[deg]"],
-                                  [[lk, f"{a:.9g}", f"{np.degrees(a):.6g}"] for lk, a in sol.link_angles.items()],
-                                  f"link-angles-{k}"))
+        s.blocks.append(Table(*solution_rows(pres, sol), f"solution-{k}"))  # solve's joint table, loop joints too
+        if sol.links and any("angle" in m or "omega" in m for m in sol.links.values()):
+            title, head, rows = links_rows(sol.links)  # the moving links, as solve lists them
+            s.blocks += [Text(title), Table(head, rows, f"links-{k}")]
         if sol.points:  # named points (--point NAME=LINK:x,y,z), world axes
-            def vec(x):
-                return "" if x is None else "(" + ", ".join(_g(c) for c in x) + ")"
-
-            s.blocks.append(Table(["point", "link", "position [m]", "velocity [m/s]", "acceleration [m/s^2]"],
-                                  [[n, m["link"], vec(m["position"]), vec(m.get("velocity")), vec(m.get("acceleration"))]
-                                   for n, m in sol.points.items()], f"points-{k}"))
+            title, head, rows = points_rows(sol.points)
+            s.blocks += [Text(title), Table(head, rows, f"points-{k}")]
+        if sol.linkage:
+            s.blocks.append(Text(linkage_construction_text(sol.linkage)))
         if sol.output_pose is not None:
             p, rpy = sol.output_position, sol.output_rpy
             s.blocks.append(Text(f"output '{pres.output}': position {' '.join(_g(1000 * x) for x in p)} mm, roll pitch "

@@ -8,12 +8,15 @@ import numpy as np
 from ..tolerances import DEFAULT
 from .tables import column_text, fmt_vec, table
 
-__all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_table", "points_table", "motion_dict", "linkage_construction_text"]
+__all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "links_table", "points_rows",
+           "points_table", "motion_dict", "linkage_construction_text"]
 
 
-def links_table(links: dict) -> str:
-    """Absolute link motion: a planar mechanism's angle, omega, alpha about the plane's normal, or
-    a spatial one's |omega|, |alpha|; the frame origin's speed and acceleration magnitude."""
+def links_rows(links: dict) -> tuple:
+    """(title, headers, rows) of absolute link motion -- the moving links only, never the ground: a
+    planar mechanism's angle, omega, alpha about the plane's normal, or a spatial one's |omega|,
+    |alpha|; the frame origin's speed and acceleration magnitude.  The one links table of ``solve``'s
+    text and ``report``'s document."""
     planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
     rated = any("omega" in m for m in links.values())
     names = list(links)
@@ -35,11 +38,18 @@ def links_table(links: dict) -> str:
     rows = [[n] + [("" if c[i] == "nan" else c[i]) for c in cols] for i, n in enumerate(names)]
     title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
              if planar else "absolute link motion (world frame)")
+    return title, head, rows
+
+
+def links_table(links: dict) -> str:
+    """:func:`links_rows` as a text table under its title."""
+    title, head, rows = links_rows(links)
     return title + "\n" + table(head, rows)
 
 
-def points_table(points: dict) -> str:
-    """Named points: position [m], velocity [m/s], acceleration [m/s^2], world axes."""
+def points_rows(points: dict) -> tuple:
+    """(title, headers, rows) of named points: position [m], velocity [m/s], acceleration [m/s^2],
+    world axes (the one points table of ``solve``'s text and ``report``'s document)."""
     rows = []
     for name, m in points.items():
         row = [name, m["link"], fmt_vec(m["position"], 0)]
@@ -48,7 +58,13 @@ def points_table(points: dict) -> str:
         rows.append(row)
     head = ["point", "link", "position [m]"] + (["velocity [m/s]", "acceleration [m/s^2]"]
                                                  if any("velocity" in m for m in points.values()) else [])
-    return "points (world axes)\n" + table(head, rows)
+    return "points (world axes)", head, rows
+
+
+def points_table(points: dict) -> str:
+    """:func:`points_rows` as a text table under its title."""
+    title, head, rows = points_rows(points)
+    return title + "\n" + table(head, rows)
 
 
 def linkage_construction_text(d: dict) -> str:

@@ -102,6 +102,40 @@ def trace_text(res, row_labels, passive_names) -> str:
     return "\n".join(lines)
 
 
+def solution_rows(res, s, degrees: bool = True) -> tuple:
+    """(headers, rows) of one solution's coordinates -- every tree joint, then every loop (cut) joint
+    as ``NAME (loop)`` -- with value [rad or m], the angle in deg (a slide not along the ground's x
+    axis: its guide's angle), rate and acceleration when solved with rates.  The one joint table of
+    ``solve``'s text and ``report``'s document."""
+    rows = []
+    guides = {n: a for n, a in (s.guide_angles or {}).items()  # a slide not along the ground's x axis
+              if abs(np.sin(a)) > DEFAULT.equal}
+
+    def along(name):
+        return f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
+
+    rates, accs = [], []
+    for name, v in s.joints.items():
+        row = [name, f"{v:.9g}"]
+        row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else along(name))
+        rows.append(row)
+        if s.rates is not None:
+            rates.append(s.rates.get(name, float("nan")))
+            accs.append(s.accelerations.get(name, float("nan")))
+    for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
+        row = [f"{name} (loop)", f"{v:.9g}"]
+        row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
+        rows.append(row)
+        if s.rates is not None:
+            rates.append(s.loop_rates[name] if s.loop_rates is not None else float("nan"))
+            accs.append(s.loop_accelerations[name] if s.loop_accelerations is not None else float("nan"))
+    if s.rates is not None:  # round-off (a loop joint's 4e-16 rad/s) written as 0
+        rows = [row + [r, a] for row, r, a in zip(rows, column_text(rates), column_text(accs))]
+    headers = ["joint", "value [rad or m]", "(deg)"] + (["rate [rad/s or m/s]", "acceleration [rad/s^2 or m/s^2]"]
+                                                        if s.rates is not None else [])
+    return headers, rows
+
+
 def position_text(res, degrees=True, show_all=False, length=None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist."""
@@ -135,27 +169,7 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
                      f"sigma_min {s.sigma_min:.3g}{flag}")
         for lab in s.labels:
             lines.append(f"  not reached by moving: {lab}")
-        rows = []
-        guides = {n: a for n, a in (s.guide_angles or {}).items()  # a slide not along the ground's x axis
-                  if abs(np.sin(a)) > DEFAULT.equal}
-
-        def along(name):
-            return f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
-
-        for name, v in s.joints.items():
-            row = [name, f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else along(name))
-            if s.rates is not None:
-                row += [f"{s.rates.get(name, float('nan')):.6g}", f"{s.accelerations.get(name, float('nan')):.6g}"]
-            rows.append(row)
-        for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
-            row = [f"{name} (loop)", f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
-            if s.loop_rates is not None:
-                row += [f"{s.loop_rates[name]:.6g}", f"{s.loop_accelerations[name]:.6g}"]
-            rows.append(row)
-        headers = ["joint", "value [rad or m]", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
-        lines.append(table(headers, rows))
+        lines.append(table(*solution_rows(res, s, degrees)))
         if s.coupled:
             lines.append("coupled (mimic) joints: " + ", ".join(
                 f"{n} = {v:.9g}" + (f" ({np.degrees(v):.6g} deg)" if n in res.angular_coupled else "")
