@@ -130,3 +130,28 @@ def test_data_json_against_the_closed_form_and_solve(report, capsys):
     assert set(solved["solutions"][0]) <= set(sol)  # every key solve writes, the report writes too
     assert {"joints", "rates", "accelerations", "links", "points"} <= set(sol)
     assert data["solve"]["characteristic_length"] == solved["characteristic_length"]
+
+
+def test_sweep_section_strokes_and_time_ratio_are_sweeps(report, capsys):
+    """The stroke of the offset slider-crank, sqrt((l+r)^2 - e^2) - sqrt((l-r)^2 - e^2), and its time ratio:
+    the dead centres are at crank angles asin(e/(l+r)) (extended) and pi + asin(e/(l-r)) (folded), so the
+    crank turns pi - asin(e/(l+r)) + asin(e/(l-r)) one way and the rest of the turn back."""
+    _, text, data = report
+    stroke = math.sqrt((L + R) ** 2 - E**2) - math.sqrt((L - R) ** 2 - E**2)
+    one_way = math.pi - math.asin(E / (L + R)) + math.asin(E / (L - R))
+    ratio = max(one_way, 2 * math.pi - one_way) / min(one_way, 2 * math.pi - one_way)
+    (st,) = data["sweep"]["strokes"]
+    assert st["coordinate"] == "slider_joint"
+    assert st["stroke"] == pytest.approx(stroke, rel=1e-6)
+    assert st["time_ratio"] == pytest.approx(ratio, rel=1e-5)
+    section = text.split("## Sweep of the input\n", 1)[1].split("\n## ", 1)[0]
+    capsys.readouterr()
+    assert main(["sweep", SLIDER_CRANK, "--input", "crank_joint", "--steps", "72", "--from", "0", "--to", "360deg"]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("slider slider_joint: stroke"))
+    assert line.split(" (ends")[0] in section  # the same stroke, written by the same function
+    assert float(re.search(r"time ratio ([0-9.]+)", section).group(1)) == pytest.approx(ratio, rel=1e-5)
+    # the sweep's absolute quantities per step, as sweep --json has them, and the figure says what it shows
+    sw = data["sweep"]
+    assert {"links", "loop_joints", "points", "coordinates", "joints", "rates", "accelerations"} <= set(sw)
+    assert "ground" not in sw["links"] and len(sw["links"]["rod"]["omega"]) == len(sw["values"])
+    assert "the links' absolute angle, omega and alpha" in section

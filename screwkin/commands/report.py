@@ -18,6 +18,7 @@ import numpy as np
 
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
+from ..analysis.motion.links import strokes, sweep_motion
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.motion.position import PositionSolver
 from ..analysis.course.figures import default_output, singular_configurations
@@ -40,7 +41,8 @@ from ..present.document import (
 )
 from ..present.draw import draw_chain, draw_mechanism, value_label
 from ..present.equations import equations_dict, newton_dict
-from ..present.plots import sweep_figure
+from ..present.motion import motion_dict, strokes_dict, strokes_text
+from ..present.plots import absolute_series, motion_figure
 from ..present.report import mobility_dict, position_dict
 from ..present.view import (
     PICTURE,
@@ -341,12 +343,17 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
     info = identify(mech, mech.topology(q), q, moved)
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()
-    fig = sweep_figure(res, mus, singularities=search.found, linear=mech.translational,
-                       title=f"{base}: {moved} over its range")
-    out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"joint values, rates and accelerations "
-                                                                      f"against {moved}", "sweep")))
+    motion = sweep_motion(mech, res, named_points(mech, args))  # what sweep shows: links, loop joints, points
+    slider_strokes = strokes(res, motion, mech)
+    fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
+                        title=f"{base}: {moved} over its range")
+    what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(
+        res, motion, mech.translational) is not None else "joint values, rates and accelerations")
+    out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"{what} against {moved}", "sweep"),
+                             strokes_text(slider_strokes, res.unit == "rad")))
     data["sweep"] = {"input": moved, "steps": len(res.values) - 1, "values": res.values, "names": list(res.names),
-                     "joints": res.joints}
+                     "coordinates": list(res.names), "joints": res.joints, "rates": res.rates, "accelerations": res.accelerations,
+                     "input_rate": res.rate, **motion_dict(motion), "strokes": strokes_dict(slider_strokes)}
     return out
 
 

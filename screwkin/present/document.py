@@ -232,13 +232,16 @@ def singular_section(search, figures, descriptions, conditions=()) -> Section:
     return s
 
 
-def sweep_section(search, figure) -> Section:
+def sweep_section(search, figure, lines=()) -> Section:
+    """The input moved over its range: the figure, and ``lines`` (each slider's stroke and time ratio,
+    present/motion.strokes_text, as sweep prints them)."""
     s = Section("sweep", "Sweep of the input")
     res = search.motion
     x = _reading(res.values[-1], res.unit != "m") if len(res.values) else "-"
     s.blocks.append(Text(f"{search.input} moved in {len(res.values) - 1} steps (one assembly mode followed"
                          + (", through limit positions" if res.limits else "") + f"; last value {x})"
                          + (f"; stopped: {res.stop_reason}" if res.stopped_at is not None else "")))
+    s.blocks += [Text(line) for line in lines]
     s.blocks.append(figure)
     return s
 
