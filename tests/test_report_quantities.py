@@ -155,3 +155,34 @@ def test_sweep_section_strokes_and_time_ratio_are_sweeps(report, capsys):
     assert {"links", "loop_joints", "points", "coordinates", "joints", "rates", "accelerations"} <= set(sw)
     assert "ground" not in sw["links"] and len(sw["links"]["rod"]["omega"]) == len(sw["values"])
     assert "the links' absolute angle, omega and alpha" in section
+
+
+def test_tables_in_the_units_typed(tmp_path, capsys):
+    """--rate crank_joint=90deg (deg/s): omega, rates in deg/s and alpha in deg/s^2, in report and solve alike;
+    --rate 10rpm: omega in rpm.  The values are the closed form's converted by hand here."""
+    w = math.radians(90.0)
+    x, xd, xdd, phi, omega, alpha = closed_form(DRAWN - math.radians(30.0), w)
+    md = tmp_path / "u.md"
+    args = ["--set", "crank_joint=-30deg", "--rate", "crank_joint=90deg", "--point", "P=rod:0.05,0,0"]
+    assert main(["report", SLIDER_CRANK, *args, "--steps", "8", "--no-view", "--md", str(md)]) == 0
+    text = md.read_text()
+    (jh, joints), (lh, links), (ph, _) = _md_tables(text, "Positions, velocities and accelerations")[:3]
+    assert jh[3:] == ["rate [deg/s or m/s]", "acceleration [deg/s^2 or m/s^2]"]
+    assert lh[2:4] == ["omega [deg/s]", "alpha [deg/s^2]"] and ph[3:] == ["velocity [m/s]", "acceleration [m/s^2]"]
+    assert float(links["rod"][2]) == pytest.approx(math.degrees(omega), rel=1e-5)
+    assert float(links["rod"][3]) == pytest.approx(math.degrees(alpha), rel=1e-5)
+    assert float(joints["crank_joint"][3]) == pytest.approx(90.0)
+    assert float(joints["slider_joint"][3]) == pytest.approx(xd, rel=1e-5)  # a length's rate stays m/s
+    assert "input rates crank_joint = 90 deg/s (1.5708 rad/s)" in text
+    capsys.readouterr()
+    assert main(["solve", SLIDER_CRANK, *args]) == 0
+    solved = capsys.readouterr().out
+    rod = next(ln.split() for ln in solved.splitlines() if ln.startswith("rod "))
+    assert [float(c) for c in rod[2:4]] == pytest.approx([math.degrees(omega), math.degrees(alpha)], rel=1e-5)
+    assert "|".join(links["rod"][1:]) == "|".join(rod[1:])  # the one table builder
+    capsys.readouterr()
+    assert main(["solve", SLIDER_CRANK, "--set", "crank_joint=-30deg", "--rate", "crank_joint=10rpm"]) == 0
+    solved = capsys.readouterr().out
+    assert "omega [rpm]" in solved and "rate [rpm or m/s]" in solved
+    crank = next(ln.split() for ln in solved.splitlines() if ln.startswith("crank "))
+    assert float(crank[2]) == pytest.approx(10.0)

@@ -60,6 +60,7 @@ from ._common import (
     inputs,
     joint_assignments,
     named_points,
+    rate_units,
     value_kind,
 )
 from ._options import check_writable, count, screwkin_version
@@ -208,7 +209,7 @@ def run(mech, args) -> int:
     if pres is not None:
         given_rates = "input rates " + _rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
-        sections.append(motion_section(pres, given_rates, mech.length))
+        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args)))
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "

@@ -27,7 +27,7 @@ import numpy as np
 from ..analysis.course.vector_loops import PlanarEquations
 from ..model.geometry import wrap_angle as _wrap
 from .equations import Units, equations_text, greek, newton_text
-from .tables import shown
+from .tables import RateUnits, shown
 from .motion import linkage_construction_text, links_rows, points_rows
 from .report import (
     JOINT_COLUMNS,
@@ -181,10 +181,10 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     return s
 
 
-def motion_section(pres, rates_text: str, length: float) -> Section:
+def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits()) -> Section:
     """The assembly modes for the inputs: every coordinate (loop joints too) with its rate and acceleration,
     the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
-    present/motion.links_rows and points_rows)."""
+    present/motion.links_rows and points_rows), rates in ``units`` (those typed)."""
     s = Section("motion", "Positions, velocities and accelerations")
     inputs = ", ".join(f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items())
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
@@ -193,12 +193,12 @@ def motion_section(pres, rates_text: str, length: float) -> Section:
         what = "" if sol.physical else f" (not reached by moving: {'; '.join(sol.labels)})"
         s.blocks.append(Text(f"solution {k}{what}: closure residual {sol.residual:.3g}, sigma_min {sol.sigma_min:.3g}"
                              + (" (singular)" if sol.singular else "")))
-        s.blocks.append(Table(*solution_rows(pres, sol), f"solution-{k}"))  # solve's joint table, loop joints too
+        s.blocks.append(Table(*solution_rows(pres, sol, units=units), f"solution-{k}"))  # solve's joint table, loop joints too
         if sol.links and any("angle" in m or "omega" in m for m in sol.links.values()):
-            title, head, rows = links_rows(sol.links)  # the moving links, as solve lists them
+            title, head, rows = links_rows(sol.links, units)  # the moving links, as solve lists them
             s.blocks += [Text(title), Table(head, rows, f"links-{k}")]
         if sol.points:  # named points (--point NAME=LINK:x,y,z), world axes
-            title, head, rows = points_rows(sol.points)
+            title, head, rows = points_rows(sol.points, units)
             s.blocks += [Text(title), Table(head, rows, f"points-{k}")]
         if sol.linkage:
             s.blocks.append(Text(linkage_construction_text(sol.linkage)))
