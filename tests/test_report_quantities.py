@@ -154,6 +154,11 @@ def test_sweep_section_strokes_and_time_ratio_are_sweeps(report, capsys):
     sw = data["sweep"]
     assert {"links", "loop_joints", "points", "coordinates", "joints", "rates", "accelerations"} <= set(sw)
     assert "ground" not in sw["links"] and len(sw["links"]["rod"]["omega"]) == len(sw["values"])
+    # the sweep starts at the configuration analysed, at the input rate of the positions section (10 rad/s)
+    deg = report[0]
+    *_, omega, alpha = closed_form(DRAWN + math.radians(deg), 10.0)
+    assert sw["input_rate"] == 10.0 and sw["values"][0] == pytest.approx(math.radians(deg))
+    assert (sw["links"]["rod"]["omega"][0], sw["links"]["rod"]["alpha"][0]) == pytest.approx((omega, alpha), abs=1e-7)
     assert "the links' absolute angle, omega and alpha" in section
 
 

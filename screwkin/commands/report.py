@@ -216,7 +216,7 @@ def run(mech, args) -> int:
                                      "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
 
     # ---- singular configurations and the sweep
-    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data)
+    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates)
 
     # ---- the view
     sections.append(_view(mech, args, q, data))
@@ -309,7 +309,7 @@ def _newton(mech, args, loops, q, values, names, notes, data):
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
+def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -319,7 +319,8 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
                 note_section("sweep", "Sweep of the input", f"no sweep: {why}")]
     search = _attempt(notes, "singular configurations", lambda: singular_configurations(
         mech, moved, output=args.output, q=q, steps=args.steps,
-        fixed={k: v for k, v in given.items() if k != moved}, near=mech.joint_values(q)))
+        fixed={k: v for k, v in given.items() if k != moved}, near=mech.joint_values(q),
+        rate=rates.get(moved) or 1.0))  # the positions section's input rate (a rate 0 gives no strokes: 1)
     if search is None:
         why = notes["singular configurations"]
         return [note_section("singular", "Singular configurations", f"not located: {why}"),

@@ -238,7 +238,8 @@ def sweep_section(search, figure, lines=()) -> Section:
     s = Section("sweep", "Sweep of the input")
     res = search.motion
     x = _reading(res.values[-1], res.unit != "m") if len(res.values) else "-"
-    s.blocks.append(Text(f"{search.input} moved in {len(res.values) - 1} steps (one assembly mode followed"
+    s.blocks.append(Text(f"{search.input} moved in {len(res.values) - 1} steps at {res.rate:g} "
+                         f"{'rad/s' if res.unit != 'm' else 'm/s'} (one assembly mode followed"
                          + (", through limit positions" if res.limits else "") + f"; last value {x})"
                          + (f"; stopped: {res.stop_reason}" if res.stopped_at is not None else "")))
     s.blocks += [Text(line) for line in lines]
