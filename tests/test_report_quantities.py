@@ -146,7 +146,8 @@ def test_sweep_section_strokes_and_time_ratio_are_sweeps(report, capsys):
     assert st["time_ratio"] == pytest.approx(ratio, rel=1e-5)
     section = text.split("## Sweep of the input\n", 1)[1].split("\n## ", 1)[0]
     capsys.readouterr()
-    assert main(["sweep", SLIDER_CRANK, "--input", "crank_joint", "--steps", "72", "--from", "0", "--to", "360deg"]) == 0
+    assert main(["sweep", SLIDER_CRANK, "--input", "crank_joint", "--steps", "72", "--from", "0",
+                 "--to", "360deg"]) == 0
     line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("slider slider_joint: stroke"))
     assert line.split(" (ends")[0] in section  # the same stroke, written by the same function
     assert float(re.search(r"time ratio ([0-9.]+)", section).group(1)) == pytest.approx(ratio, rel=1e-5)

@@ -354,7 +354,8 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
     out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"{what} against {moved}", "sweep"),
                              strokes_text(slider_strokes, res.unit == "rad")))
     data["sweep"] = {"input": moved, "steps": len(res.values) - 1, "values": res.values, "names": list(res.names),
-                     "coordinates": list(res.names), "joints": res.joints, "rates": res.rates, "accelerations": res.accelerations,
+                     "coordinates": list(res.names), "joints": res.joints, "rates": res.rates,
+                     "accelerations": res.accelerations,
                      "input_rate": res.rate, **motion_dict(motion), "strokes": strokes_dict(slider_strokes)}
     return out
 

@@ -193,7 +193,8 @@ def motion_section(pres, rates_text: str, length: float, units: RateUnits = Rate
         what = "" if sol.physical else f" (not reached by moving: {'; '.join(sol.labels)})"
         s.blocks.append(Text(f"solution {k}{what}: closure residual {sol.residual:.3g}, sigma_min {sol.sigma_min:.3g}"
                              + (" (singular)" if sol.singular else "")))
-        s.blocks.append(Table(*solution_rows(pres, sol, units=units), f"solution-{k}"))  # solve's joint table, loop joints too
+        # solve's joint table (loop joints too), links and points tables
+        s.blocks.append(Table(*solution_rows(pres, sol, units=units), f"solution-{k}"))
         if sol.links and any("angle" in m or "omega" in m for m in sol.links.values()):
             title, head, rows = links_rows(sol.links, units)  # the moving links, as solve lists them
             s.blocks += [Text(title), Table(head, rows, f"links-{k}")]
