@@ -92,7 +92,7 @@ def add_parser(sub, common, scaled):
                     help="planar: the estimates Newton iterates from (as solve --start; default: the solved "
                          "unknowns, angles +10 deg and lengths +10 %%)")
     sp.add_argument("--iterations", type=count("iterations"), metavar="K", help="exactly K Newton iterations (default: to convergence)")
-    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 /s each)")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 rad/s or m/s each; the tables in the unit typed: 10rpm, 90deg/s)")
     sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
     sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
     add_point_option(sp)
