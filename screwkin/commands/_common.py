@@ -15,6 +15,7 @@ from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
 from ..model.state import KinematicState, place_tool, value_for_leg_length
+from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
@@ -281,6 +282,13 @@ def typed_unit(mech, name: str, text: str) -> str:
         if unit:
             return unit
     return "m" if value_kind(mech, name) == "length" else "rad"
+
+
+def rate_units(args) -> RateUnits:
+    """The units solve's and report's tables write rates and accelerations in: those typed with --rate
+    and --accel (``10rpm``: omega in rpm; ``90deg``: deg/s and deg/s^2; ``5mm/s``: mm/s), SI otherwise."""
+    return RateUnits.typed([u for _, _, u in parse_typed_assignments(getattr(args, "rate", None), "--rate")],
+                           [u for _, _, u in parse_typed_assignments(getattr(args, "accel", None), "--accel")])
 
 
 def parse_range(text, option):

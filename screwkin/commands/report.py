@@ -18,6 +18,7 @@ import numpy as np
 
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
+from ..analysis.motion.links import strokes, sweep_motion
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.motion.position import PositionSolver
 from ..analysis.course.figures import default_output, singular_configurations
@@ -40,7 +41,8 @@ from ..present.document import (
 )
 from ..present.draw import draw_chain, draw_mechanism, value_label
 from ..present.equations import equations_dict, newton_dict
-from ..present.plots import sweep_figure
+from ..present.motion import motion_dict, strokes_dict, strokes_text
+from ..present.plots import absolute_series, motion_figure
 from ..present.report import mobility_dict, position_dict
 from ..present.view import (
     PICTURE,
@@ -51,7 +53,16 @@ from ..present.view import (
     screenshot,
     show,
 )
-from ._common import add_configuration_options, add_point_option, inputs, joint_assignments, named_points
+from ..units import parse_typed_assignments, parse_value, unit_kind
+from ._common import (
+    add_configuration_options,
+    add_point_option,
+    inputs,
+    joint_assignments,
+    named_points,
+    rate_units,
+    value_kind,
+)
 from ._options import check_writable, count, screwkin_version
 from .draw import _kind_text, _wrapped
 from .equations import _typed, start_estimates
@@ -81,7 +92,7 @@ def add_parser(sub, common, scaled):
                     help="planar: the estimates Newton iterates from (as solve --start; default: the solved "
                          "unknowns, angles +10 deg and lengths +10 %%)")
     sp.add_argument("--iterations", type=count("iterations"), metavar="K", help="exactly K Newton iterations (default: to convergence)")
-    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 /s each)")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 rad/s or m/s each; the tables in the unit typed: 10rpm, 90deg/s)")
     sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
     sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
     add_point_option(sp)
@@ -154,6 +165,7 @@ def run(mech, args) -> int:
                             accels=accels, points=points)
         q = pres.solutions[0].q
         data["solve"] = position_dict(pres)
+        data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
     topo = mech.topology(q)
     units = {n: ("rad" if not mech.translational[mech.coordinate_names.index(n)] else "m") for n in names}
     configuration = (", ".join(value_label(n, v, units[n]) for n, v in values.items())
@@ -195,17 +207,16 @@ def run(mech, args) -> int:
 
     # ---- positions, velocities, accelerations
     if pres is not None:
-        given_rates = "input rates " + ", ".join(f"{n} = {v:g}" for n, v in rates.items()) + \
-                      (" /s (default: 1 each)" if not args.rate else " /s") + \
+        given_rates = "input rates " + _rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
-        sections.append(motion_section(pres, given_rates, mech.length))
+        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args)))
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "
                                      "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
 
     # ---- singular configurations and the sweep
-    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data)
+    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates)
 
     # ---- the view
     sections.append(_view(mech, args, q, data))
@@ -242,6 +253,23 @@ def run(mech, args) -> int:
         for what, why in notes.items():
             print(f"note: {what}: {why}")
     return 0
+
+
+def _rates_text(mech, args, rates) -> str:
+    """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``), or the default 1 in SI."""
+    si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
+    if not args.rate:
+        return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
+    typed = {n: unit for n, _, unit in parse_typed_assignments(args.rate, "--rate")}
+
+    def shown(n, v):
+        unit = typed.get(n)
+        if not unit:
+            return f"{n} = {v:.6g} {si[n]}"
+        label = unit + "/s" if unit_kind(unit) in ("angle", "length") else unit  # --rate crank=90deg: 90 deg/s
+        return f"{n} = {v / parse_value('1' + unit):.6g} {label} ({v:.6g} {si[n]})"
+
+    return ", ".join(shown(n, v) for n, v in rates.items())
 
 
 def _newton(mech, args, loops, q, values, names, notes, data):
@@ -281,7 +309,7 @@ def _newton(mech, args, loops, q, values, names, notes, data):
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
+def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -291,7 +319,8 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
                 note_section("sweep", "Sweep of the input", f"no sweep: {why}")]
     search = _attempt(notes, "singular configurations", lambda: singular_configurations(
         mech, moved, output=args.output, q=q, steps=args.steps,
-        fixed={k: v for k, v in given.items() if k != moved}, near=mech.joint_values(q)))
+        fixed={k: v for k, v in given.items() if k != moved}, near=mech.joint_values(q),
+        rate=rates.get(moved) or 1.0))  # the positions section's input rate (a rate 0 gives no strokes: 1)
     if search is None:
         why = notes["singular configurations"]
         return [note_section("singular", "Singular configurations", f"not located: {why}"),
@@ -316,12 +345,18 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data):
     info = identify(mech, mech.topology(q), q, moved)
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()
-    fig = sweep_figure(res, mus, singularities=search.found, linear=mech.translational,
-                       title=f"{base}: {moved} over its range")
-    out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"joint values, rates and accelerations "
-                                                                      f"against {moved}", "sweep")))
+    motion = sweep_motion(mech, res, named_points(mech, args))  # what sweep shows: links, loop joints, points
+    slider_strokes = strokes(res, motion, mech)
+    fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
+                        title=f"{base}: {moved} over its range")
+    what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(
+        res, motion, mech.translational) is not None else "joint values, rates and accelerations")
+    out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"{what} against {moved}", "sweep"),
+                             strokes_text(slider_strokes, res.unit == "rad")))
     data["sweep"] = {"input": moved, "steps": len(res.values) - 1, "values": res.values, "names": list(res.names),
-                     "joints": res.joints}
+                     "coordinates": list(res.names), "joints": res.joints, "rates": res.rates,
+                     "accelerations": res.accelerations,
+                     "input_rate": res.rate, **motion_dict(motion), "strokes": strokes_dict(slider_strokes)}
     return out
 
 

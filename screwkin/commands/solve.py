@@ -20,6 +20,7 @@ from ._common import (
     inputs,
     joint_assignments,
     named_points,
+    rate_units,
 )
 from ._options import count
 
@@ -77,5 +78,5 @@ def run(mech, args) -> int:
         names = [mech.coordinate_names[k] for k in solver.passive]
         print(trace_text(res, mech.closure.row_labels(solver=True), names))
         print()
-    print(position_text(res, show_all=args.all, length=mech.length))
+    print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args)))
     return 0

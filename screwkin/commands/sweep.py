@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from ..analysis.motion.links import motion_along, strokes
+from ..analysis.motion.links import motion_along, strokes, sweep_motion
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
@@ -169,9 +169,7 @@ def run(mech, args) -> int:
     res = sweep(solver, args.input, start, stop, args.steps, fixed=others, near=near, rate=rate, progress=True,
                 turn=args.turn)
     topo = mech.topology(res.q[0])
-    angles = LinkAngles(mech, topo) if topo.motion_space == "planar" and topo.normal is not None else None
-    motion = motion_along(mech, res.q, res.rates, res.accelerations, named_points(mech, args), angles,
-                          None if angles is None else angles.n)
+    motion = sweep_motion(mech, res, named_points(mech, args))
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 else None
     slider_strokes = strokes(res, motion, mech)
     mus = None
@@ -185,7 +183,6 @@ def run(mech, args) -> int:
             out.write(res, motion)
     if args.plot:
         sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
-                   normal=None if angles is None else angles.n,
                    title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
     if args.json:
         d = sweep_dict(res, mech)

@@ -27,13 +27,15 @@ import numpy as np
 from ..analysis.course.vector_loops import PlanarEquations
 from ..model.geometry import wrap_angle as _wrap
 from .equations import Units, equations_text, greek, newton_text
-from .tables import shown
+from .tables import RateUnits, shown
+from .motion import linkage_construction_text, links_rows, points_rows
 from .report import (
     JOINT_COLUMNS,
     count_rows,
     joint_rows,
     screw_theory_rows,
     screws_text,
+    solution_rows,
     to_jsonable,
 )
 
@@ -179,8 +181,10 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     return s
 
 
-def motion_section(pres, rates_text: str, length: float) -> Section:
-    """The assembly modes for the inputs: joint values, rates and accelerations, link angles, named points."""
+def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits()) -> Section:
+    """The assembly modes for the inputs: every coordinate (loop joints too) with its rate and acceleration,
+    the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
+    present/motion.links_rows and points_rows), rates in ``units`` (those typed)."""
     s = Section("motion", "Positions, velocities and accelerations")
     inputs = ", ".join(f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items())
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
@@ -189,25 +193,16 @@ def motion_section(pres, rates_text: str, length: float) -> Section:
         what = "" if sol.physical else f" (not reached by moving: {'; '.join(sol.labels)})"
         s.blocks.append(Text(f"solution {k}{what}: closure residual {sol.residual:.3g}, sigma_min {sol.sigma_min:.3g}"
                              + (" (singular)" if sol.singular else "")))
-        rows = []
-        for n, v in sol.joints.items():
-            ang = n in pres.angular
-            rate = "" if sol.rates is None else _g(sol.rates[n], 9)
-            acc = "" if sol.accelerations is None else _g(sol.accelerations[n], 9)
-            rows.append([n, f"{v:.9g}", _reading(v, ang), rate, acc])
-        s.blocks.append(Table(["joint", "value [rad or m]", "value", "rate [1/s]", "acceleration [1/s^2]"], rows,
-                              f"solution-{k}"))
-        if sol.link_angles:
-            s.blocks.append(Table(["link", "absolute angle [rad]", "[deg]"],
-                                  [[lk, f"{a:.9g}", f"{np.degrees(a):.6g}"] for lk, a in sol.link_angles.items()],
-                                  f"link-angles-{k}"))
+        # solve's joint table (loop joints too), links and points tables
+        s.blocks.append(Table(*solution_rows(pres, sol, units=units), f"solution-{k}"))
+        if sol.links and any("angle" in m or "omega" in m for m in sol.links.values()):
+            title, head, rows = links_rows(sol.links, units)  # the moving links, as solve lists them
+            s.blocks += [Text(title), Table(head, rows, f"links-{k}")]
         if sol.points:  # named points (--point NAME=LINK:x,y,z), world axes
-            def vec(x):
-                return "" if x is None else "(" + ", ".join(_g(c) for c in x) + ")"
-
-            s.blocks.append(Table(["point", "link", "position [m]", "velocity [m/s]", "acceleration [m/s^2]"],
-                                  [[n, m["link"], vec(m["position"]), vec(m.get("velocity")), vec(m.get("acceleration"))]
-                                   for n, m in sol.points.items()], f"points-{k}"))
+            title, head, rows = points_rows(sol.points, units)
+            s.blocks += [Text(title), Table(head, rows, f"points-{k}")]
+        if sol.linkage:
+            s.blocks.append(Text(linkage_construction_text(sol.linkage)))
         if sol.output_pose is not None:
             p, rpy = sol.output_position, sol.output_rpy
             s.blocks.append(Text(f"output '{pres.output}': position {' '.join(_g(1000 * x) for x in p)} mm, roll pitch "
@@ -238,13 +233,17 @@ def singular_section(search, figures, descriptions, conditions=()) -> Section:
     return s
 
 
-def sweep_section(search, figure) -> Section:
+def sweep_section(search, figure, lines=()) -> Section:
+    """The input moved over its range: the figure, and ``lines`` (each slider's stroke and time ratio,
+    present/motion.strokes_text, as sweep prints them)."""
     s = Section("sweep", "Sweep of the input")
     res = search.motion
     x = _reading(res.values[-1], res.unit != "m") if len(res.values) else "-"
-    s.blocks.append(Text(f"{search.input} moved in {len(res.values) - 1} steps (one assembly mode followed"
+    s.blocks.append(Text(f"{search.input} moved in {len(res.values) - 1} steps at {res.rate:g} "
+                         f"{'rad/s' if res.unit != 'm' else 'm/s'} (one assembly mode followed"
                          + (", through limit positions" if res.limits else "") + f"; last value {x})"
                          + (f"; stopped: {res.stop_reason}" if res.stopped_at is not None else "")))
+    s.blocks += [Text(line) for line in lines]
     s.blocks.append(figure)
     return s
 

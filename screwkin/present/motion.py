@@ -6,49 +6,72 @@ from __future__ import annotations
 import numpy as np
 
 from ..tolerances import DEFAULT
-from .tables import column_text, fmt_vec, table
+from .tables import RateUnits, column_text, fmt_vec, table
 
-__all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_table", "points_table", "motion_dict", "linkage_construction_text"]
+__all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "links_table", "points_rows",
+           "points_table", "motion_dict", "linkage_construction_text"]
 
 
-def links_table(links: dict) -> str:
-    """Absolute link motion: a planar mechanism's angle, omega, alpha about the plane's normal, or
-    a spatial one's |omega|, |alpha|; the frame origin's speed and acceleration magnitude."""
+def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
+    """(title, headers, rows) of absolute link motion -- the moving links only, never the ground: a
+    planar mechanism's angle, omega, alpha about the plane's normal, or a spatial one's |omega|,
+    |alpha|; the frame origin's speed and acceleration magnitude; rates in ``units`` (those typed).
+    The one links table of ``solve``'s text and ``report``'s document."""
     planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
     rated = any("omega" in m for m in links.values())
     names = list(links)
     cols = []
+    w, al, v, a = units.rate(False), units.acceleration(False), units.rate(True), units.acceleration(True)
+
+    def column(key, unit, norm=False):
+        return column_text([units.of(np.linalg.norm(links[n][key]) if norm else links[n][key], unit) for n in names])
+
     if planar:
-        head = ["link", "angle [deg]"] + (["omega [rad/s]", "alpha [rad/s^2]"] if rated else [])
+        head = ["link", "angle [deg]"] + ([f"omega [{w}]", f"alpha [{al}]"] if rated else [])
         cols.append(column_text([np.degrees(links[n].get("angle", np.nan)) for n in names], absolute=1e-9))
         if rated:
-            cols += [column_text([links[n]["omega"] for n in names]), column_text([links[n]["alpha"] for n in names])]
+            cols += [column("omega", w), column("alpha", al)]
     else:
-        head = ["link"] + (["|omega| [rad/s]", "|alpha| [rad/s^2]"] if rated else ["position [m]"])
+        head = ["link"] + ([f"|omega| [{w}]", f"|alpha| [{al}]"] if rated else ["position [m]"])
         if rated:
-            cols += [column_text([np.linalg.norm(links[n][k]) for n in names]) for k in ("omega", "alpha")]
+            cols += [column("omega", w, True), column("alpha", al, True)]
         else:
             cols.append([fmt_vec(links[n]["position"], 0) for n in names])
     if rated:
-        head += ["|v origin| [m/s]", "|a origin| [m/s^2]"]
-        cols += [column_text([np.linalg.norm(links[n][k]) for n in names]) for k in ("velocity", "acceleration")]
+        head += [f"|v origin| [{v}]", f"|a origin| [{a}]"]
+        cols += [column("velocity", v, True), column("acceleration", a, True)]
     rows = [[n] + [("" if c[i] == "nan" else c[i]) for c in cols] for i, n in enumerate(names)]
     title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
              if planar else "absolute link motion (world frame)")
+    return title, head, rows
+
+
+def links_table(links: dict, units: RateUnits = RateUnits()) -> str:
+    """:func:`links_rows` as a text table under its title."""
+    title, head, rows = links_rows(links, units)
     return title + "\n" + table(head, rows)
 
 
-def points_table(points: dict) -> str:
-    """Named points: position [m], velocity [m/s], acceleration [m/s^2], world axes."""
+def points_rows(points: dict, units: RateUnits = RateUnits()) -> tuple:
+    """(title, headers, rows) of named points: position [m], velocity, acceleration (m/s, m/s^2 or the
+    units typed), world axes (the one points table of ``solve``'s text and ``report``'s document)."""
+    v, a = units.rate(True), units.acceleration(True)
     rows = []
     for name, m in points.items():
         row = [name, m["link"], fmt_vec(m["position"], 0)]
         if "velocity" in m:
-            row += [fmt_vec(m["velocity"], 0), fmt_vec(m["acceleration"], 0)]
+            row += [fmt_vec(units.of(np.asarray(m["velocity"], float), v), 0),
+                    fmt_vec(units.of(np.asarray(m["acceleration"], float), a), 0)]
         rows.append(row)
-    head = ["point", "link", "position [m]"] + (["velocity [m/s]", "acceleration [m/s^2]"]
+    head = ["point", "link", "position [m]"] + ([f"velocity [{v}]", f"acceleration [{a}]"]
                                                  if any("velocity" in m for m in points.values()) else [])
-    return "points (world axes)\n" + table(head, rows)
+    return "points (world axes)", head, rows
+
+
+def points_table(points: dict, units: RateUnits = RateUnits()) -> str:
+    """:func:`points_rows` as a text table under its title."""
+    title, head, rows = points_rows(points, units)
+    return title + "\n" + table(head, rows)
 
 
 def linkage_construction_text(d: dict) -> str:

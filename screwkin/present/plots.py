@@ -11,7 +11,7 @@ from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
 from ..units import parse_value
 
-__all__ = ["sweep_plot", "sweep_figure", "map_png", "map_figure", "pyplot"]
+__all__ = ["sweep_plot", "motion_figure", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
 
 def pyplot(option):
@@ -151,19 +151,26 @@ def absolute_series(res, motion, linear=None):
                    accelerations=stack(accs)), np.array(lengths, bool)
 
 
-def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
-    """A sweep into a PNG (see :func:`sweep_figure` for what is drawn): for a planar mechanism with
-    ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle, omega and alpha and the
-    sliders' coordinates, else the joint values; the named points' paths in a fourth panel."""
-    plt = pyplot("--plot")
+def motion_figure(res, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
+    """The figure of a sweep (matplotlib, not yet saved; see :func:`sweep_figure` for what is drawn): for
+    a planar mechanism with ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle,
+    omega and alpha and the sliders' coordinates, else the joint values; the named points' paths in a
+    fourth panel (in the plane of ``normal``, default the motion's).  ``sweep --plot`` and ``report``."""
     absolute = absolute_series(res, motion, linear)
     if absolute is not None:
         res, linear = absolute
     paths = {}
     if motion is not None and motion.points:
+        normal = normal if normal is not None else motion.normal
         e1, e2, _ = plane_basis(normal if normal is not None else (0.0, 0.0, 1.0))
         paths = {n: np.asarray(p["position"]) @ np.stack([e1, e2], axis=1) for n, p in motion.points.items()}
-    fig = sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None)
+    return sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None)
+
+
+def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
+    """A sweep into a PNG: :func:`motion_figure`, saved."""
+    plt = pyplot("--plot")
+    fig = motion_figure(res, mus, singularities, title, linear, motion, normal)
     fig.savefig(path, dpi=100)
     plt.close(fig)
 

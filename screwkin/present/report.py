@@ -19,7 +19,7 @@ from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from .motion import linkage_construction_text, links_table, points_table
 from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
-from .tables import column_text, csv_text, table
+from .tables import RateUnits, column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
 from ..tolerances import DEFAULT
 from .jsonout import json_text, nan_to_none, to_jsonable  # noqa: F401 - json_text exported here as before
@@ -102,9 +102,49 @@ def trace_text(res, row_labels, passive_names) -> str:
     return "\n".join(lines)
 
 
-def position_text(res, degrees=True, show_all=False, length=None) -> str:
+def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
+    """(headers, rows) of one solution's coordinates -- every tree joint, then every loop (cut) joint
+    as ``NAME (loop)`` -- with value [rad or m], the angle in deg (a slide not along the ground's x
+    axis: its guide's angle), rate and acceleration when solved with rates, in ``units`` (those typed
+    with --rate/--accel; SI by default).  The one joint table of ``solve``'s text and ``report``'s
+    document."""
+    rows = []
+    guides = {n: a for n, a in (s.guide_angles or {}).items()  # a slide not along the ground's x axis
+              if abs(np.sin(a)) > DEFAULT.equal}
+
+    def along(name):
+        return f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
+
+    rates, accs = [], []
+    for name, v in s.joints.items():
+        row = [name, f"{v:.9g}"]
+        row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else along(name))
+        rows.append(row)
+        if s.rates is not None:
+            linear = name not in res.angular
+            rates.append(units.of(s.rates.get(name, float("nan")), units.rate(linear)))
+            accs.append(units.of(s.accelerations.get(name, float("nan")), units.acceleration(linear)))
+    for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
+        row = [f"{name} (loop)", f"{v:.9g}"]
+        row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
+        rows.append(row)
+        if s.rates is not None:
+            linear = name not in res.angular_loop
+            rates.append(units.of(s.loop_rates[name], units.rate(linear)) if s.loop_rates else float("nan"))
+            accs.append(units.of(s.loop_accelerations[name], units.acceleration(linear))
+                        if s.loop_accelerations else float("nan"))
+    if s.rates is not None:  # round-off (a loop joint's 4e-16 rad/s) written as 0
+        rows = [row + [r, a] for row, r, a in zip(rows, column_text(rates), column_text(accs))]
+    headers = ["joint", "value [rad or m]", "(deg)"] + (
+        [f"rate [{units.rate(False)} or {units.rate(True)}]",
+         f"acceleration [{units.acceleration(False)} or {units.acceleration(True)}]"] if s.rates is not None else [])
+    return headers, rows
+
+
+def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits()) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
-    ones (no labels) when there are any, with a line saying how many more exist."""
+    ones (no labels) when there are any, with a line saying how many more exist; rates and
+    accelerations in ``units`` (those typed with --rate/--accel)."""
     inputs = ", ".join(f"{k} = {value_text(k, v, k in res.angular)}" for k, v in res.inputs.items()
                        if isinstance(v, float))
     shown = list(res.solutions) if show_all else [s for s in res.solutions if s.physical] or list(res.solutions)
@@ -135,27 +175,7 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
                      f"sigma_min {s.sigma_min:.3g}{flag}")
         for lab in s.labels:
             lines.append(f"  not reached by moving: {lab}")
-        rows = []
-        guides = {n: a for n, a in (s.guide_angles or {}).items()  # a slide not along the ground's x axis
-                  if abs(np.sin(a)) > DEFAULT.equal}
-
-        def along(name):
-            return f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
-
-        for name, v in s.joints.items():
-            row = [name, f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular else along(name))
-            if s.rates is not None:
-                row += [f"{s.rates.get(name, float('nan')):.6g}", f"{s.accelerations.get(name, float('nan')):.6g}"]
-            rows.append(row)
-        for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
-            row = [f"{name} (loop)", f"{v:.9g}"]
-            row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
-            if s.loop_rates is not None:
-                row += [f"{s.loop_rates[name]:.6g}", f"{s.loop_accelerations[name]:.6g}"]
-            rows.append(row)
-        headers = ["joint", "value [rad or m]", "(deg)"] + (["rate", "acceleration"] if s.rates is not None else [])
-        lines.append(table(headers, rows))
+        lines.append(table(*solution_rows(res, s, degrees, units)))
         if s.coupled:
             lines.append("coupled (mimic) joints: " + ", ".join(
                 f"{n} = {v:.9g}" + (f" ({np.degrees(v):.6g} deg)" if n in res.angular_coupled else "")
@@ -164,9 +184,9 @@ def position_text(res, degrees=True, show_all=False, length=None) -> str:
             lines.append("link angles (absolute, in the plane from the ground's x axis): " + ", ".join(
                 f"{n} {np.degrees(a):.6g} deg" for n, a in s.link_angles.items()))
         if s.links and any("angle" in m or "omega" in m for m in s.links.values()):
-            lines.append(links_table(s.links))
+            lines.append(links_table(s.links, units))
         if s.points:
-            lines.append(points_table(s.points))
+            lines.append(points_table(s.points, units))
         if s.linkage:
             lines.append(linkage_construction_text(s.linkage))
         if s.leg_lengths:

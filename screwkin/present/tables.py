@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import csv
 import io
+from dataclasses import dataclass
 
-__all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO"]
+from ..units import parse_value, unit_kind
+
+__all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits"]
 
 #: Display cut-off: a number smaller than this in magnitude is written as 0 (round-off is not a value).
 SHOWN_ZERO = 1e-12
@@ -37,6 +40,60 @@ def column_text(values, relative: float = 1e-9, absolute: float = 1e-12) -> list
     big = max((abs(v) for v in values if v == v), default=0.0)
     tiny = max(absolute, relative * big)
     return [f"{(0.0 if abs(v) < tiny else v) + 0.0:.6g}" for v in values]
+
+
+@dataclass(frozen=True)
+class RateUnits:
+    """The units a table writes rates and accelerations in: SI unless a person typed others with
+    ``--rate``/``--accel`` (:meth:`typed`).  Values stay SI everywhere else (JSON, analysis)."""
+
+    angular_rate: str = "rad/s"
+    angular_acceleration: str = "rad/s^2"
+    linear_rate: str = "m/s"
+    linear_acceleration: str = "m/s^2"
+
+    #: a unit typed -> (field, display unit): an angle or a length given for a rate keeps its old meaning
+    #: (--rate crank=90deg is 90 deg/s); degrees typed for a rate show accelerations in deg/s^2 too
+    _RATE = {"deg": ("deg/s", "deg/s^2"), "deg/s": ("deg/s", "deg/s^2"), "rpm": ("rpm", None),
+             "rev/min": ("rpm", None), "rev/s": ("rev/s", None), "mm": ("mm/s", "mm/s^2"),
+             "mm/s": ("mm/s", "mm/s^2"), "cm": ("cm/s", None), "cm/s": ("cm/s", None)}
+    _ACCEL = {"deg": "deg/s^2", "deg/s^2": "deg/s^2", "deg/s2": "deg/s^2", "mm": "mm/s^2", "mm/s^2": "mm/s^2",
+              "mm/s2": "mm/s^2"}
+
+    @classmethod
+    def typed(cls, rate_units=(), accel_units=()) -> "RateUnits":
+        """The units of the first rate and acceleration typed of each kind (angular, linear); SI for
+        the kinds typed bare or in SI."""
+        out = {}
+        for unit in rate_units:
+            shown = cls._RATE.get(unit) or cls._RATE.get(unit.lower())
+            kind = unit_kind(unit)
+            if shown is None or kind is None:
+                continue
+            linear = kind in ("length", "linear rate")
+            out.setdefault("linear_rate" if linear else "angular_rate", shown[0])
+            if shown[1]:
+                out.setdefault("linear_acceleration" if linear else "angular_acceleration", shown[1])
+        for unit in accel_units:
+            shown, kind = cls._ACCEL.get(unit) or cls._ACCEL.get(unit.lower()), unit_kind(unit)
+            if shown and kind:
+                key = "linear_acceleration" if kind in ("length", "linear acceleration") else "angular_acceleration"
+                out[key] = shown  # an acceleration typed wins over one implied by a rate
+        return cls(**out)
+
+    def rate(self, linear: bool) -> str:
+        return self.linear_rate if linear else self.angular_rate
+
+    def acceleration(self, linear: bool) -> str:
+        return self.linear_acceleration if linear else self.angular_acceleration
+
+    @staticmethod
+    def of(value: float, unit: str) -> float:
+        """An SI value in ``unit`` (rad/s -> rpm ...)."""
+        return value / parse_value("1" + unit)
+
+    def is_si(self) -> bool:
+        return self == RateUnits()
 
 
 #: What a spreadsheet reads as the start of a formula in a text cell (CSV injection).

@@ -88,14 +88,15 @@ def input_range(mech, name, q) -> tuple:
 
 
 def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=None, steps: int = 360,
-                            near=None) -> SingularSearch:
+                            near=None, rate: float = 1.0) -> SingularSearch:
     """The singular configurations along ``input_joint``'s range (:func:`input_range` from q,
     the assembled configuration by default): one assembly mode followed by screwkin.analysis.
     sweep.sweep through limit positions (``turn``) and located by locate_singularities (the
     limit positions, and the serial singularities of ``output`` -- by default
     :func:`default_output`: a four-bar's rocker, whose limit positions are the crank and
     coupler collinear -- and the constraint ones).  ``fixed``: the other inputs' values
-    (default: their values at q)."""
+    (default: their values at q); ``rate``: the input's constant rate [rad/s or m/s] the motion's rates
+    and accelerations are for."""
     inputs = list(mech.actuated)
     if input_joint is None:
         if not inputs:
@@ -116,7 +117,7 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
     start, stop = input_range(mech, input_joint, q)
     if near is None:
         near = values
-    res = sweep(solver, input_joint, start, stop, steps, fixed=fixed, near=near, turn=True)
+    res = sweep(solver, input_joint, start, stop, steps, fixed=fixed, near=near, turn=True, rate=rate)
     found = locate_singularities(solver, res, output=output)
     out = tuple(SingularConfiguration(s.kind, s.input, s.sigma, s.q, s.limit, output if s.kind == "serial" else None)
                 for s in found)

@@ -24,9 +24,10 @@ import pinocchio as pin
 from ...errors import UsageError
 from ...model.state import loop_coordinate_cuts
 from .batch_closure import TreeKinematics, Unbatchable
+from .planar import LinkAngles
 
-__all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "moving_links", "Stroke",
-           "strokes"]
+__all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "sweep_motion", "moving_links",
+           "Stroke", "strokes"]
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,7 @@ class MotionAlong:
     links: dict  # link -> {angle?, omega, alpha, position, velocity, acceleration}: (steps,) or (steps, 3)
     points: dict  # name -> {link, local, position, velocity, acceleration}: (steps, 3)
     angular_loop: tuple  # loop joints whose coordinate is an angle
+    normal: tuple | None = None  # planar mechanisms: the plane's normal omega and alpha are about
 
 
 def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAlong:
@@ -159,7 +161,21 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
             loop_rates[c.name] = dot(w2 - w1, axis)
             loop_accs[c.name] = dot(al2 - al1, axis) + dot(w2 - w1, da)
     return MotionAlong(loops, loop_rates, loop_accs, out_links, pts,
-                       tuple(c.name for c in cuts if c.type != "prismatic"))
+                       tuple(c.name for c in cuts if c.type != "prismatic"),
+                       None if normal is None else tuple(float(x) for x in normal))
+
+
+def sweep_motion(mech, res, points=()) -> MotionAlong:
+    """The absolute motion along a sweep ``res`` (analysis.motion.sweep.SweepResult): a planar
+    mechanism's (its topology at the first step) with the vector-loop angles of LinkAngles, omega and
+    alpha about the plane's normal; a spatial one's as vectors.  What ``sweep`` and ``report`` show."""
+    angles = None
+    if len(res.q):
+        topo = mech.topology(res.q[0])
+        if topo.motion_space == "planar" and topo.normal is not None:
+            angles = LinkAngles(mech, topo)
+    return motion_along(mech, res.q, res.rates, res.accelerations, points, angles,
+                        None if angles is None else angles.n)
 
 
 def _tree(mech):

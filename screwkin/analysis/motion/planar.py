@@ -267,7 +267,10 @@ class LinkAngles:
     the first joint it carries in the file's order, else the first loop joint on it.  A
     link with no second joint centre (a slider whose pin sits on its own axis, a free
     tip) is measured by its frame's x axis.  The ground's vector goes from its first
-    joint centre to its first other one."""
+    joint centre to its first other one.  A joint a link carries is placed where it is
+    mounted on that link (its placement in the parent, before its own motion): a prismatic
+    child's slide does not turn its parent (the ground of a slider-crank kept a constant
+    angle only while the slider stood still)."""
 
     def __init__(self, mech, topo):
         if topo.motion_space != "planar" or topo.normal is None:
@@ -288,10 +291,10 @@ class LinkAngles:
                 starts = [k for k in range(1, model.njoints) if model.parents[k] == 0]
                 if not starts:
                     continue
-                start, candidates = ("joint", starts[0]), [("joint", k) for k in starts[1:]]
+                start, candidates = ("mount", starts[0]), [("mount", k) for k in starts[1:]]
             else:
                 start = ("joint", jid)
-                candidates = [("joint", k) for k in model.children[jid]]
+                candidates = [("mount", k) for k in model.children[jid]]
             candidates += [("frame", f) for f in cut_frames.get(jid, [])]
             self.links[link] = (start, candidates, fid)
         self._data = mech.scratch_data()
@@ -299,8 +302,12 @@ class LinkAngles:
         self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
 
     def _point(self, ref):
+        """("joint", i): joint i's centre, moved with it; ("mount", i): where joint i sits on its
+        parent (fixed in the parent whatever joint i's value); ("frame", f): frame f's origin."""
         kind, i = ref
         d = self._data
+        if kind == "mount":
+            return d.oMi[self.mech.model.parents[i]].act(self.mech.model.jointPlacements[i].translation)
         return d.oMi[i].translation if kind == "joint" else d.oMf[i].translation
 
     def _ends(self, q):
@@ -347,18 +354,33 @@ class LinkAngles:
         Q = np.atleast_2d(Q)
         refs = {r for start, end, fid in self.links.values() for r in (start, end if end[0] != "axis" else ("frame", fid))}
         model = self.mech.model
-        fids = {r: (r[1] if r[0] == "frame" else model.getFrameId(model.names[r[1]], pin.FrameType.JOINT)) for r in refs}
+
+        def joint_of(r):  # the joint whose placement carries the point: a mount sits on the parent's
+            return model.parents[r[1]] if r[0] == "mount" else r[1]
+
+        fids = {r: (r[1] if r[0] == "frame" else model.getFrameId(model.names[joint_of(r)], pin.FrameType.JOINT))
+                for r in refs if r[0] == "frame" or joint_of(r) != 0}
         try:
             placed = TreeKinematics(self.mech).frames(Q, sorted(set(fids.values())), jacobian=False)
         except Unbatchable:
             rows = [self(q) for q in Q]
             return {link: np.array([r[link] for r in rows]) for link in self.links}
+
+        def point(r):
+            if r[0] != "mount":
+                return placed[fids[r]][1]
+            t = np.asarray(model.jointPlacements[r[1]].translation, float)
+            if r not in fids:  # mounted on the ground
+                return np.broadcast_to(t, (len(Q), 3))
+            R, p = placed[fids[r]][:2]
+            return p + R @ t
+
         out = {}
         for link, (start, end, fid) in self.links.items():
             if end[0] == "axis":
                 v = placed[fids[("frame", fid)]][0][:, :, 0]
             else:
-                v = placed[fids[end]][1] - placed[fids[start]][1]
+                v = point(end) - point(start)
             out[link] = np.arctan2(v @ self.e2, v @ self.e1)
         first = self(Q[0])  # a link along -e1 (+-pi) could come out with the other sign: then the loop
         if any(abs(out[link][0] - first[link]) > self.mech.tolerances.equal for link in out):
