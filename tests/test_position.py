@@ -133,7 +133,9 @@ def test_cli_solve_json_contract(mech, capsys):
     assert len(d["solutions"]) == 2
     for s in d["solutions"]:
         assert set(s) >= {"joints", "residual", "iterations", "singular", "rates", "accelerations"}
-        assert set(s["joints"]) == {"crank_joint", "coupler_joint", "rocker_joint"}
+        # every coordinate, the loop joint too (issue 24: loop joints are coordinates under their names)
+        assert set(s["joints"]) == {"crank_joint", "coupler_joint", "rocker_joint"} | set(s["loop_joints"])
+        assert set(s["rates"]) == set(s["joints"]) == set(s["accelerations"])
         assert s["residual"] < 1e-10
 
 

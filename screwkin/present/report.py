@@ -43,7 +43,8 @@ __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_tex
 def position_dict(res) -> dict:
     sols = []
     for s in res.solutions:
-        d = {"joints": s.joints, "residual": s.residual, "iterations": s.iterations, "singular": s.singular,
+        # every coordinate under its name, loop joints too (also kept apart under "loop_joints")
+        d = {"joints": _with_loop(s.joints, s.loop_joints), "residual": s.residual, "iterations": s.iterations, "singular": s.singular,
              "sigma_min": s.sigma_min, "outside_limits": list(s.outside_limits),
              "physical": s.physical, "labels": list(s.labels), "continuum": s.continuum, "merged": s.merged}
         if s.sigmas is not None:
@@ -71,8 +72,8 @@ def position_dict(res) -> dict:
             d["output_position"] = s.output_position.tolist()
             d["output_rpy"] = s.output_rpy.tolist()
         if s.rates is not None:
-            d["rates"] = s.rates
-            d["accelerations"] = s.accelerations
+            d["rates"] = _with_loop(s.rates, s.loop_rates)
+            d["accelerations"] = _with_loop(s.accelerations, s.loop_accelerations)
         if s.output_twist is not None:
             d["output_twist"] = s.output_twist.tolist()
             d["output_acceleration"] = s.output_acceleration.tolist()
@@ -80,6 +81,11 @@ def position_dict(res) -> dict:
     return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
             "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols,
             "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes)}
+
+
+def _with_loop(tree: dict, loop: dict | None) -> dict:
+    """Tree coordinates, then the loop joints' (one dict, as the user names them)."""
+    return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
 def value_text(name, value, angular) -> str:
