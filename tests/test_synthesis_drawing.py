@@ -100,3 +100,29 @@ def test_a_broken_target_refuses_the_file_naming_the_problem(designs, tmp_path, 
     assert main(["mobility", str(bad)]) == 1
     err = capsys.readouterr().err
     assert "bad.urdf" in err and says in err and "Traceback" not in err
+
+
+# ------------------------------------------------------------------ function generation as typed
+
+
+def test_function_targets_are_reported_in_the_angles_typed(designs, capsys, tmp_path):
+    _, report = designs["function"]
+    x0, x1, p0, p1, s0, s1 = 1.0, 2.0, 0.0, 60.0, 0.0, 90.0
+    xs = (x0 + x1) / 2 - (x1 - x0) / 2 * np.cos((2 * np.arange(1, 4) - 1) * np.pi / 6)  # Chebyshev, n = 3
+    phi = p0 + (xs - x0) / (x1 - x0) * (p1 - p0)
+    psi = s0 + (np.log(xs) - math.log(x0)) / (math.log(x1) - math.log(x0)) * (s1 - s0)
+    typed = [p["as_typed"] for p in report["precision"]]
+    np.testing.assert_allclose([t["x"] for t in typed], xs, rtol=0, atol=1e-12)
+    np.testing.assert_allclose([t["phi_deg"] for t in typed], phi, rtol=0, atol=1e-9)
+    np.testing.assert_allclose([t["psi_deg"] for t in typed], psi, rtol=0, atol=1e-9)
+    np.testing.assert_allclose([t["psi_reached_deg"] for t in typed], psi, rtol=0, atol=1e-9)  # 3 points: exact
+    assert all(0.0 <= t["psi_deg"] <= 90.0 for t in typed)  # inside --output-range, not -171 deg
+    for key in ("target", "input_deg", "value", "error_deg"):  # the existing keys are kept
+        assert key in report["precision"][0]
+    # the text's table says the same numbers
+    assert main(["synthesize", "function", "--function", "log(x)", "--x-range", "1:2", "--input-range", "0:60deg",
+                 "--output-range", "0:90deg", "-o", str(tmp_path / "f.urdf")]) == 0
+    text = capsys.readouterr().out
+    for ph, ps in zip(phi, psi):
+        assert f"phi {ph:.6g} deg -> psi {ps:.6g} deg" in text
+    assert "psi -1" not in text
