@@ -126,3 +126,121 @@ def test_function_targets_are_reported_in_the_angles_typed(designs, capsys, tmp_
     for ph, ps in zip(phi, psi):
         assert f"phi {ph:.6g} deg -> psi {ps:.6g} deg" in text
     assert "psi -1" not in text
+
+
+# ------------------------------------------------------------------ what `screwkin draw FILE` shows
+
+
+def _figure_targets(path):
+    """The Figure draw_mechanism makes of ``path`` with its targets: {gid: artist}."""
+    from screwkin.analysis.course.skeleton import skeleton
+    from screwkin.present.draw import draw_mechanism
+    from screwkin.present.draw_targets import design_marks
+    from screwkin.present.plots import pyplot
+
+    mech = screwkin.load(path)
+    q = mech.assemble().q
+    skel = skeleton(mech, q)
+    fig = draw_mechanism(skel, marks=design_marks(mech, q, skel)[1])
+    found = {a.get_gid(): a for a in fig.findobj() if a.get_gid()}
+    pyplot("test").close(fig)
+    return found
+
+
+def test_the_drawing_marks_each_pose_where_it_was_typed_with_the_frame_reached(designs):
+    path, _ = designs["motion"]
+    artists = _figure_targets(path)
+    for k, (x, y, th) in enumerate(POSES, 1):
+        np.testing.assert_allclose(np.ravel(artists[f"target:{k}"].get_data()), (x, y), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(np.ravel(artists[f"reached:{k}"].get_data()), (x, y), rtol=0, atol=1e-9)
+        (p, tip) = artists[f"targetaxis:{k}"]._posA_posB
+        assert math.atan2(tip[1] - p[1], tip[0] - p[0]) == pytest.approx(th, abs=1e-12)
+        (p, tip) = artists[f"reachedaxis:{k}"]._posA_posB
+        assert math.atan2(tip[1] - p[1], tip[0] - p[0]) == pytest.approx(th, abs=1e-9)
+        assert artists[f"targetlabel:{k}"].get_text() == str(k)
+    # the linkage ghosted at positions 2 and 3 (position 1 is the one drawn)
+    assert {g.split(":")[1] for g in artists if g.startswith("ghost:")} == {"2", "3"}
+
+
+def _written_fourbar(path):
+    """The four-bar as its URDF writes it: pivots, lengths, the coupler point in the coupler's
+    frame, the crank's and the rocker's angles at the drawn configuration."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    joints = {j.get("name"): j for j in root.findall("joint")}
+
+    def origin(j):
+        o = j.find("origin")
+        return np.array([float(v) for v in o.get("xyz").split()[:2]]), float(o.get("rpy").split()[2])
+
+    A0, crank0 = origin(joints["crank_joint"])
+    B0, rocker0 = origin(joints["rocker_joint"])
+    a = origin(joints["coupler_joint"])[0][0]
+    loop = root.find("loop_joint")
+    b = float(loop.find("link1").get("xyz").split()[0])
+    c = float(loop.find("link2").get("xyz").split()[0])
+    uv, _ = origin(joints["coupler_point_joint"])
+    return A0, B0, a, b, c, uv, crank0, rocker0
+
+
+def _coupler_point(fourbar, theta, sigma):
+    """The coupler point at crank angle theta by circle intersection, on the side sigma of A -> B0."""
+    A0, B0, a, b, c, uv, _, _ = fourbar
+    A = A0 + a * np.array([math.cos(theta), math.sin(theta)])
+    for B in circles(A, b, B0, c):
+        d1, d2 = B0 - A, B - A
+        if np.sign(d1[0] * d2[1] - d1[1] * d2[0]) == sigma:
+            phi = math.atan2(*(B - A)[::-1])
+            return A + np.array([[math.cos(phi), -math.sin(phi)], [math.sin(phi), math.cos(phi)]]) @ uv
+    raise AssertionError("no intersection on that side")
+
+
+def test_the_coupler_curve_passes_through_each_point_at_the_crank_angle_the_table_reports(designs, capsys, tmp_path):
+    path, report = designs["path"]
+    fourbar = _written_fourbar(path)
+    A0, B0, a, b, c, uv, crank0, rocker0 = fourbar
+    A = A0 + a * np.array([math.cos(crank0), math.sin(crank0)])
+    B = B0 + c * np.array([math.cos(rocker0), math.sin(rocker0)])
+    assert abs(np.hypot(*(B - A)) - b) < 1e-12  # the file is drawn closed
+    sigma = np.sign((B0 - A)[0] * (B - A)[1] - (B0 - A)[1] * (B - A)[0])
+    svg = tmp_path / "p.svg"
+    drawn, _ = run_json(capsys, ["draw", str(path), "--svg", str(svg)])
+    curve = np.array(drawn["traces"]["curve of coupler_point"]["path"])
+    assert len(curve) > 300  # a whole turn of the crank (a crank-rocker), not only the points
+    assert all(f'id="target:{k}"' in svg.read_text() for k in range(1, 6))
+    for k, (entry, mark) in enumerate(zip(report["precision"], drawn["targets"])):
+        theta = crank0 + math.radians(entry["input_deg"])  # the table's crank angle, from the drawn configuration
+        P = _coupler_point(fourbar, theta, sigma)
+        np.testing.assert_allclose(P, POINTS[k], rtol=0, atol=1e-9)  # the design does what was asked
+        np.testing.assert_allclose(mark["target"], POINTS[k], rtol=0, atol=0)  # drawn where typed
+        np.testing.assert_allclose(mark["reached"], P, rtol=0, atol=1e-9)
+        i = mark["curve_index"]
+        np.testing.assert_allclose(curve[i], P, rtol=0, atol=1e-9)  # the curve passes through it there
+        turns = (mark["curve_input"] - math.radians(entry["input_deg"])) / (2 * math.pi)
+        assert turns == pytest.approx(round(turns), abs=1e-12)
+    # every vertex of the drawn curve is on the coupler curve (within the spacing of 3,600 samples of it)
+    sample = np.array([_coupler_point(fourbar, t, sigma) for t in np.linspace(0, 2 * math.pi, 3601)])
+    spacing = float(np.max(np.hypot(*np.diff(sample, axis=0).T)))
+    gaps = [float(np.min(np.hypot(*(sample - p).T))) for p in curve]
+    assert max(gaps) <= spacing
+
+
+def test_function_targets_are_drawn_along_the_rocker_at_the_angles_typed(designs, capsys, tmp_path):
+    path, report = designs["function"]
+    drawn, _ = run_json(capsys, ["draw", str(path), "--png", str(tmp_path / "f.png")])
+    assert [m["kind"] for m in drawn["targets"]] == ["angle"] * 3
+    for mark, entry in zip(drawn["targets"], report["precision"]):
+        psi = math.radians(entry["as_typed"]["psi_deg"])
+        u = np.array(mark["direction"])
+        assert abs(u[0] * math.sin(psi) - u[1] * math.cos(psi)) < 1e-12  # along the rocker's line at psi
+        np.testing.assert_allclose(mark["reached_direction"], u, rtol=0, atol=1e-9)
+        assert f"psi {entry['as_typed']['psi_deg']:.5g} deg" in mark["label"]
+
+
+def test_no_targets_leaves_them_out_and_says_so_otherwise(designs, capsys, tmp_path):
+    path, _ = designs["motion"]
+    assert main(["draw", str(path), "--png", str(tmp_path / "a.png")]) == 0
+    assert "drawn with the 3 target poses" in capsys.readouterr().out
+    drawn, _ = run_json(capsys, ["draw", str(path), "--png", str(tmp_path / "b.png"), "--no-targets"])
+    assert "targets" not in drawn

@@ -26,6 +26,7 @@ from ..present.draw import (
     skeleton_dict,
     value_label,
 )
+from ..present.draw_targets import design_marks
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value
 from ._common import (
@@ -70,6 +71,9 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--trace", action="append", metavar="NAME",
                     help="draw the path of the --point NAME over a whole turn of the input (or up to its limit "
                          "position) on the skeleton; repeatable")
+    sp.add_argument("--no-targets", dest="targets", action="store_false",
+                    help="leave out the targets a synthesized file states (<screwkin:targets>: drawn by default, "
+                         "with the linkage at each precision position and a path's coupler curve)")
     sp.add_argument("--animate", metavar="OUT.gif|OUT.mp4",
                     help="write an animation of the skeleton while --input goes --from A --to B in --steps N "
                          "(GIF with Pillow; MP4 with imageio-ffmpeg); --point paths are traced")
@@ -149,6 +153,37 @@ def _traces(mech, args, q, input_names, given, skel) -> dict:
     return out
 
 
+def _design(mech, args, q, input_names, skel):
+    """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
+    precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None)."""
+    if not mech.spec.targets or not args.targets:
+        return None, None
+    found, marks = design_marks(mech, q, skel, input_names, steps=args.steps)
+    ghosts = sum(m["ghost"] is not None for m in marks)
+    missed = [m for m in marks if m["reached"] is None]
+    if not args.json:
+        kinds = sorted({m["kind"] for m in marks})
+        print(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>; "
+              f"--no-targets leaves them out), the linkage ghosted at {ghosts} precision position(s)")
+        for m in missed:
+            print(f"target {m['number']} ({m['label']}): the linkage does not assemble at {m['input']} = "
+                  f"{m['value']:.6g}: nothing reached drawn")
+    curve = None
+    if found.curve is not None:
+        e1, e2, _ = (np.asarray(v, float) for v in skel.basis)
+        name = f"curve of {next(m['link'] for m in marks if m['kind'] == 'point')}"
+        curve = (name, np.stack([found.curve @ e1, found.curve @ e2], axis=1), found.stopped_at)
+        for m, i in zip(marks, found.on_curve):  # where the curve passes each target, for --json
+            m["curve_index"] = i
+            m["curve_input"] = None if i is None else float(found.curve_inputs[i])
+        off = [m["number"] for m, i in zip(marks, found.on_curve) if m["kind"] == "point" and i is None]
+        if not args.json and found.stopped_at is not None:
+            print(f"{name}: the input stopped at {found.stopped_at:.6g} ({found.stop_reason})")
+        if not args.json and off:
+            print(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
+    return marks, curve
+
+
 def run(mech, args) -> int:
     if args.animate:
         return _animate(mech, args)
@@ -206,15 +241,20 @@ def run(mech, args) -> int:
         skel = skeleton(mech, q, input_names)
         space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
         traces = _traces(mech, args, q, input_names, given, skel)
+        marks, curve = _design(mech, args, q, input_names, skel)
+        if curve is not None:
+            traces[curve[0]] = curve[1:]
         for path in targets:
             fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), angles=args.angles,
                                  subtitle=("" if skel.planar else space.strip(" ()")) or None,
-                                 traces={n: xy for n, (xy, _) in traces.items()})
+                                 traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
             save_figure(fig, path)
             written.append(path)
         report = with_mode(args, skeleton_dict(skel))
         if traces:
             report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
+        if marks:
+            report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
     if args.json:
         report["files"] = written
         print(json.dumps(to_jsonable(report), indent=2))

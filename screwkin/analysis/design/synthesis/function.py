@@ -218,8 +218,8 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
                            f"point {k + 1} (x = {x:.6g})")
                     for k, (x, ph, ps) in enumerate(zip(xs, phi, psi)))
     lo, hi = sorted((p0 - phi[0], p1 - phi[0]))
-    labels = [f"{t.label}: phi {math.degrees(ph):.6g} deg, psi {math.degrees(ps):.6g} deg (as typed)"
-              for t, ph, ps in zip(targets, phi, psi)]
+    labels = [f"x = {x:.5g}: phi {math.degrees(ph):.5g} deg, psi {math.degrees(ps):.5g} deg"  # as typed
+              for x, ph, ps in zip(xs, phi, psi)]
     design = stored(Design("function", fb, linkage, targets, "crank_joint", "rocker", (float(lo), float(hi)),
                            exact=points == 3), labels)
     defects = []
