@@ -244,3 +244,18 @@ def test_no_targets_leaves_them_out_and_says_so_otherwise(designs, capsys, tmp_p
     assert "drawn with the 3 target poses" in capsys.readouterr().out
     drawn, _ = run_json(capsys, ["draw", str(path), "--png", str(tmp_path / "b.png"), "--no-targets"])
     assert "targets" not in drawn
+
+
+def test_synthesize_draw_writes_the_design_with_its_targets(tmp_path, capsys):
+    out, svg = tmp_path / "p.urdf", tmp_path / "p.svg"
+    report, _ = run_json(capsys, ["synthesize", "path", "--points", POINTS_TEXT, "-o", str(out), "--draw", str(svg)])
+    assert report["drawing"]["file"] == str(svg) and svg.stat().st_size > 0
+    for mark, xy in zip(report["drawing"]["targets"], POINTS):
+        np.testing.assert_allclose(mark["target"], xy, rtol=0, atol=0)
+        np.testing.assert_allclose(mark["reached"], xy, rtol=0, atol=1e-9)
+    for key in ("kind", "file", "links", "pivots", "precision", "valid"):  # the existing keys are kept
+        assert key in report
+    assert main(["synthesize", "path", "--points", POINTS_TEXT, "-o", str(out), "--draw", str(tmp_path / "p.gif")]) == 2
+    assert "--draw expects a file name ending in .png or .svg" in capsys.readouterr().err
+    assert main(["synthesize", "chains", "--links", "4", "--dof", "1", "--draw", str(svg)]) == 2
+    assert "not to 'synthesize chains'" in capsys.readouterr().err

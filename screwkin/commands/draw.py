@@ -153,21 +153,20 @@ def _traces(mech, args, q, input_names, given, skel) -> dict:
     return out
 
 
-def _design(mech, args, q, input_names, skel):
+def _design(mech, q, input_names, skel, steps, say=None, hint=""):
     """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
-    precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None)."""
-    if not mech.spec.targets or not args.targets:
-        return None, None
-    found, marks = design_marks(mech, q, skel, input_names, steps=args.steps)
+    precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
+    ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
+    say = say or (lambda _line: None)
+    found, marks = design_marks(mech, q, skel, input_names, steps=steps)
     ghosts = sum(m["ghost"] is not None for m in marks)
-    missed = [m for m in marks if m["reached"] is None]
-    if not args.json:
-        kinds = sorted({m["kind"] for m in marks})
-        print(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>; "
-              f"--no-targets leaves them out), the linkage ghosted at {ghosts} precision position(s)")
-        for m in missed:
-            print(f"target {m['number']} ({m['label']}): the linkage does not assemble at {m['input']} = "
-                  f"{m['value']:.6g}: nothing reached drawn")
+    kinds = sorted({m["kind"] for m in marks})
+    say(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>{hint}), "
+        f"the linkage ghosted at {ghosts} precision position(s)")
+    for m in marks:
+        if m["reached"] is None:
+            say(f"target {m['number']} ({m['label']}): the linkage does not assemble at {m['input']} = "
+                f"{m['value']:.6g}: nothing reached drawn")
     curve = None
     if found.curve is not None:
         e1, e2, _ = (np.asarray(v, float) for v in skel.basis)
@@ -177,11 +176,25 @@ def _design(mech, args, q, input_names, skel):
             m["curve_index"] = i
             m["curve_input"] = None if i is None else float(found.curve_inputs[i])
         off = [m["number"] for m, i in zip(marks, found.on_curve) if m["kind"] == "point" and i is None]
-        if not args.json and found.stopped_at is not None:
-            print(f"{name}: the input stopped at {found.stopped_at:.6g} ({found.stop_reason})")
-        if not args.json and off:
-            print(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
+        if found.stopped_at is not None:
+            say(f"{name}: the input stopped at {found.stopped_at:.6g} ({found.stop_reason})")
+        if off:
+            say(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
     return marks, curve
+
+
+def draw_design(mech, paths, steps: int = 360, say=None) -> list:
+    """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
+    ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
+    q = mech.assemble().q
+    input_names = list(mech.actuated)
+    skel = skeleton(mech, q, input_names)
+    marks, curve = (None, None) if not mech.spec.targets else _design(mech, q, input_names, skel, steps, say)
+    traces = {} if curve is None else {curve[0]: curve[1]}
+    for path in paths:
+        fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), traces=traces, marks=marks)
+        save_figure(fig, path)
+    return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
 def run(mech, args) -> int:
@@ -241,7 +254,10 @@ def run(mech, args) -> int:
         skel = skeleton(mech, q, input_names)
         space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
         traces = _traces(mech, args, q, input_names, given, skel)
-        marks, curve = _design(mech, args, q, input_names, skel)
+        marks, curve = (None, None)
+        if mech.spec.targets and args.targets:
+            marks, curve = _design(mech, q, input_names, skel, args.steps, None if args.json else print,
+                                   "; --no-targets leaves them out")
         if curve is not None:
             traces[curve[0]] = curve[1:]
         for path in targets:
