@@ -259,3 +259,15 @@ def test_synthesize_draw_writes_the_design_with_its_targets(tmp_path, capsys):
     assert "--draw expects a file name ending in .png or .svg" in capsys.readouterr().err
     assert main(["synthesize", "chains", "--links", "4", "--dof", "1", "--draw", str(svg)]) == 2
     assert "not to 'synthesize chains'" in capsys.readouterr().err
+
+
+def test_the_guided_frame_is_tied_to_the_coupler_pins_as_one_rigid_body(designs, capsys, tmp_path):
+    path, report = designs["motion"]
+    drawn, _ = run_json(capsys, ["draw", str(path), "--png", str(tmp_path / "m.png")])
+    A, B = np.array(report["pivots"]["A"]), np.array(report["pivots"]["B"])
+    u = np.array(POSES[0][:2])
+    want = sorted([np.hypot(*(A - u)), np.hypot(*(B - u))])  # frame origin to the coupler's pins, as synthesized
+    for mark in drawn["targets"]:
+        assert len(mark["carrier"]) == 2
+        got = sorted(np.hypot(*(np.array(c) - mark["reached"])) for c in mark["carrier"])
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)

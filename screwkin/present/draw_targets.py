@@ -4,8 +4,9 @@ target angle as a numbered ray from its pivot; the frame the linkage reaches the
 arrow, or a dot), and the linkage ghosted at the other precision positions.  Every artist has
 a gid a program can find: ``target:K`` (the target's origin, a marker whose data are the
 target's coordinates in the drawing's plane), ``targetaxis:K``, ``targetlabel:K``,
-``reached:K`` (the reached frame's origin), ``reachedaxis:K``, ``ghost:K:N`` (link N at
-position K); K counts from 1 in the file's order.
+``reached:K`` (the reached frame's origin), ``reachedaxis:K``, ``carrier:K`` (dotted lines from it to
+the pins of the link that carries it), ``ghost:K:N`` (link N at position K); K counts from 1 in the
+file's order.
 """
 
 from __future__ import annotations
@@ -29,7 +30,16 @@ def design_marks(mech, q, skel, inputs=None, steps: int = 360):
     for k, t in enumerate(found.targets):
         if t.q is not None and float(np.max(np.abs(mech.difference(q, t.q)))) > mech.tolerances.equal:
             ghosts[k] = skeleton(mech, t.q, inputs, basis=skel.basis)
-    return found, target_marks(found, skel.basis, ghosts)
+    marks = target_marks(found, skel.basis, ghosts)
+    welded = {j.child: j.parent for j in mech.spec.joints if j.type == "fixed"}
+    for k, m in enumerate(marks):  # the pins of the link that carries a guided frame or a coupler point
+        carrier = m["link"]
+        while carrier in welded:
+            carrier = welded[carrier]
+        at = ghosts.get(k, skel) if found.targets[k].q is not None else None
+        outline = next((lk.outline for lk in at.links if lk.name == carrier), ()) if at is not None else ()
+        m["carrier"] = [list(map(float, p)) for p in outline] if m["kind"] != "angle" and carrier != m["link"] else []
+    return found, marks
 
 
 def target_marks(design, basis, skeletons=None) -> list:
@@ -91,6 +101,9 @@ def draw_targets(ax, marks, r, size, colour_of) -> list:
             start = tip if m["kind"] == "angle" else p
         if m["reached"] is not None:
             q = np.asarray(m["reached"], float)
+            for c in m.get("carrier", ()):  # the guided frame (coupler point) tied to its link's pins
+                ax.plot([c[0], q[0]], [c[1], q[1]], ":", color="0.45", lw=0.8, zorder=1.3, gid=f"carrier:{k}",
+                        label="carrier")
             ax.plot(*q, "o", color="black", ms=3, zorder=6.6, gid=f"reached:{k}", label="reached")
             if m["reached_direction"] is not None:
                 tip = q + arrow * np.asarray(m["reached_direction"], float)
