@@ -271,3 +271,13 @@ def test_the_guided_frame_is_tied_to_the_coupler_pins_as_one_rigid_body(designs,
         assert len(mark["carrier"]) == 2
         got = sorted(np.hypot(*(np.array(c) - mark["reached"])) for c in mark["carrier"])
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+
+
+@pytest.mark.slow
+def test_the_report_of_a_synthesized_file_has_the_targets_figure(designs, capsys, tmp_path):
+    path, _ = designs["path"]
+    html = tmp_path / "p.html"
+    assert main(["report", str(path), "--html", str(html)]) == 0
+    capsys.readouterr()
+    text = html.read_text()
+    assert text.count('class="targets"') == 1 and "the 5 targets the file states" in text
