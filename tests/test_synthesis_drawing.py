@@ -281,3 +281,47 @@ def test_the_report_of_a_synthesized_file_has_the_targets_figure(designs, capsys
     capsys.readouterr()
     text = html.read_text()
     assert text.count('class="targets"') == 1 and "the 5 targets the file states" in text
+
+
+def test_too_many_targets_or_a_pose_without_its_angle_refuse_the_file(designs, tmp_path, capsys):
+    from screwkin.files.description import LIMITS
+
+    path, _ = designs["motion"]
+    text = path.read_text()
+    one = re.search(r"    <screwkin:target [^\n]*/>\n", text).group(0)
+    many = tmp_path / "many.urdf"
+    many.write_text(text.replace(one, one * (LIMITS.targets + 1), 1))
+    assert main(["mobility", str(many)]) == 1
+    assert f"screwkin reads at most {LIMITS.targets}" in capsys.readouterr().err
+    bare = tmp_path / "bare.urdf"
+    bare.write_text(text.replace(one, re.sub(r' yaw="[^"]*"', "", one), 1))
+    assert main(["mobility", str(bare)]) == 1
+    assert "a pose target needs yaw" in capsys.readouterr().err
+
+
+def test_a_curve_that_cannot_turn_fully_runs_between_both_limit_positions(designs, capsys, tmp_path):
+    """The function generator is a triple rocker: a point target before the first position (crank
+    turned back) is met on the curve too, traced back to the other limit position."""
+    import xml.etree.ElementTree as ET
+
+    path, _ = designs["function"]
+    root = ET.parse(path).getroot()
+    joints = {j.get("name"): j for j in root.findall("joint")}
+    A0 = np.array([float(v) for v in joints["crank_joint"].find("origin").get("xyz").split()[:2]])
+    crank0 = float(joints["crank_joint"].find("origin").get("rpy").split()[2])
+    a = float(joints["coupler_joint"].find("origin").get("xyz").split()[0])
+    text = path.read_text()
+    extra = ""
+    for v in (-0.1, 0.5):  # the coupler's frame origin is the crank pin A: A0 + a (cos, sin)(crank0 + v)
+        A = A0 + a * np.array([math.cos(crank0 + v), math.sin(crank0 + v)])
+        extra += (f'    <screwkin:target kind="point" link="coupler" input="crank_joint" value="{v!r}" '
+                  f'xyz="{float(A[0])!r} {float(A[1])!r} 0" label="pin at {v}"/>\n')
+    both = tmp_path / "both.urdf"
+    both.write_text(text.replace("  </screwkin:targets>", extra + "  </screwkin:targets>", 1))
+    drawn, _ = run_json(capsys, ["draw", str(both), "--png", str(tmp_path / "b.png")])
+    trace = drawn["traces"]["curve of coupler"]
+    assert len(trace["stopped_at"]) == 2  # a limit position each way
+    curve = np.array(trace["path"])
+    for mark in drawn["targets"][3:]:
+        np.testing.assert_allclose(curve[mark["curve_index"]], mark["target"], rtol=0, atol=1e-9)
+        assert mark["curve_input"] == pytest.approx(mark["value"], abs=1e-12)

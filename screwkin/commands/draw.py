@@ -171,13 +171,15 @@ def _design(mech, q, input_names, skel, steps, say=None, hint=""):
     if found.curve is not None:
         e1, e2, _ = (np.asarray(v, float) for v in skel.basis)
         name = f"curve of {next(m['link'] for m in marks if m['kind'] == 'point')}"
-        curve = (name, np.stack([found.curve @ e1, found.curve @ e2], axis=1), found.stopped_at)
+        stops = [x for x, _ in found.stops if x is not None]
+        curve = (name, np.stack([found.curve @ e1, found.curve @ e2], axis=1), stops or None)
         for m, i in zip(marks, found.on_curve):  # where the curve passes each target, for --json
             m["curve_index"] = i
             m["curve_input"] = None if i is None else float(found.curve_inputs[i])
         off = [m["number"] for m, i in zip(marks, found.on_curve) if m["kind"] == "point" and i is None]
-        if found.stopped_at is not None:
-            say(f"{name}: the input stopped at {found.stopped_at:.6g} ({found.stop_reason})")
+        for x, why in found.stops:
+            if x is not None:
+                say(f"{name}: the input stops at {x:.6g} ({why}): the curve runs between its limit positions")
         if off:
             say(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
     return marks, curve

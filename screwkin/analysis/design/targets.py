@@ -14,8 +14,9 @@ import pinocchio as pin
 
 from ...errors import AssemblyError
 from ..course.figures import trace_points
-from ..motion.links import Point
+from ..motion.links import Point, motion_along
 from ..motion.position import PositionSolver
+from ..motion.sweep import sweep
 
 __all__ = ["TargetReached", "DesignTargets", "design_targets", "polished", "POLISH_CLOSURE"]
 
@@ -56,7 +57,7 @@ class TargetReached:
 class DesignTargets:
     """Every target of a file with the configuration it is drawn at, and for point targets
     ``curve``: the target link's origin along a whole turn of the input from the drawn
-    configuration (or to where it stops, ``stopped_at``/``stop_reason``), world [m] (N, 3), at
+    configuration, or between the limit positions that stop it each way (``stops``), world [m] (N, 3), at
     the input values ``curve_inputs``, the precision inputs on the way included (``on_curve``:
     the curve's index of each target, None where the motion does not get there on this branch)."""
 
@@ -64,8 +65,7 @@ class DesignTargets:
     curve: np.ndarray | None = field(default=None, repr=False)
     curve_inputs: np.ndarray | None = field(default=None, repr=False)
     on_curve: tuple = ()
-    stopped_at: float | None = None
-    stop_reason: str | None = None
+    stops: tuple = ()  # ((input value, reason) or (None, None)) where the motion stopped: back, then forward
 
 
 def _frame(mech, data, fid, q):
@@ -113,24 +113,39 @@ def design_targets(mech, q, steps: int = 360) -> DesignTargets:
     if not points:
         return DesignTargets(tuple(reached))
     link, name = points[0].link, points[0].input
-    res, motion = trace_points(mech, q, name, [Point("target", link, (0.0, 0.0, 0.0))], steps)
-    curve = np.asarray(motion.points["target"]["position"], float)
+    point = Point("target", link, (0.0, 0.0, 0.0))
+    res, motion = trace_points(mech, q, name, [point], steps)
     values = np.asarray(res.values, float)
-    start = float(values[0])
-    covered = float(res.stopped_at) if res.stopped_at is not None else float(values[-1])
+    curve = np.asarray(motion.points["target"]["position"], float)
+    Q = list(res.q)
     linear = bool(mech.translational[mech.coordinate(name).idx_v])
     solver = PositionSolver(mech, [name])
+    stops = [(res.stopped_at, res.stop_reason)]
+    if res.stopped_at is not None:  # the input cannot turn fully: the motion runs back to the other limit too
+        start = float(values[0])
+        near = {n: v for n, v in mech.joint_values(q).items() if n != name}
+        back = sweep(solver, name, start, start - (mech.length if linear else TWO_PI), steps, near=near)
+        if len(back.values) > 1:
+            along = motion_along(mech, back.q, back.rates, back.accelerations, [point])
+            values = np.concatenate([np.asarray(back.values, float)[:0:-1], values])
+            curve = np.concatenate([np.asarray(along.points["target"]["position"], float)[:0:-1], curve])
+            Q = list(back.q)[:0:-1] + Q
+        stops.insert(0, (back.stopped_at, back.stop_reason))
+    ends = [float(values.min()), float(values.max())] + [float(x) for x, _ in stops if x is not None]
+    lo, hi = min(ends), max(ends)
     fid = mech.link_frame(link)
     extra = []  # (input, point, target index): each precision input met along the traced motion, on its branch
     for k, spec in enumerate(specs):
         if spec.kind != "point" or spec.link != link or spec.input != name:
             continue
-        u = spec.value if linear else start + (spec.value - start) % TWO_PI
-        if not min(start, covered) <= u <= max(start, covered):
+        turns = (0,) if linear else range(math.floor((lo - spec.value) / TWO_PI), math.ceil((hi - spec.value) / TWO_PI) + 1)
+        met = [spec.value + TWO_PI * m for m in turns if lo <= spec.value + TWO_PI * m <= hi]
+        if not met:
             continue
+        u = met[0]
         j = int(np.argmin(np.abs(values - u)))
         try:
-            q_u = polished(mech, solver, solver.track({name: u}, res.q[j]).q)[0]
+            q_u = polished(mech, solver, solver.track({name: u}, Q[j]).q)[0]
         except AssemblyError:
             continue
         extra.append((u, _frame(mech, data, fid, q_u)[0], k))
@@ -139,4 +154,4 @@ def design_targets(mech, q, steps: int = 360) -> DesignTargets:
     order = np.argsort(inputs, kind="stable")
     where = {int(np.nonzero(order == len(values) + i)[0][0]): k for i, (_, _, k) in enumerate(extra)}
     on_curve = tuple(next((i for i, k in where.items() if k == t), None) for t in range(len(specs)))
-    return DesignTargets(tuple(reached), xyz[order], inputs[order], on_curve, res.stopped_at, res.stop_reason)
+    return DesignTargets(tuple(reached), xyz[order], inputs[order], on_curve, tuple(stops))
