@@ -325,3 +325,22 @@ def test_a_curve_that_cannot_turn_fully_runs_between_both_limit_positions(design
     for mark in drawn["targets"][3:]:
         np.testing.assert_allclose(curve[mark["curve_index"]], mark["target"], rtol=0, atol=1e-9)
         assert mark["curve_input"] == pytest.approx(mark["value"], abs=1e-12)
+
+
+def test_a_function_generators_limit_position_is_said_in_the_crank_angle_typed(tmp_path, capsys):
+    """x**2 over phi 30..200 deg: the crank meets a limit position inside the range; the defect
+    names it as typed too, where Freudenstein's four-bar (its K, ground 0.1 m) has A, B, B0 collinear."""
+    report, _ = run_json(capsys, ["synthesize", "function", "--function", "x**2", "--x-range", "0:1",
+                                  "--input-range", "30deg:200deg", "--output-range", "200deg:300deg",
+                                  "-o", str(tmp_path / "f.urdf")])
+    (defect,) = [d for d in report["defects"] if "cut short" in d]
+    phi = math.radians(float(re.search(r"\(phi ([-0-9.e+]+) deg as typed\)", defect).group(1)))
+    K1, K2, K3 = report["K"]
+    d = 0.1
+    a, c = d / K2, d / K1
+    b = math.sqrt(a * a + c * c + d * d - 2 * a * c * K3)
+    reach = math.hypot(d + a * math.cos(phi), a * math.sin(phi))  # |A - B0|, B0 at the origin
+    # the message gives phi to 6 digits (within 5e-5 deg at 30 deg); |d reach / d phi| <= a d / reach
+    tol = a * d / reach * math.radians(1e-4) + 1e-9
+    assert min(abs(reach - (b + abs(c))), abs(reach - abs(b - abs(c)))) < tol
+    assert 30 < math.degrees(phi) < 200

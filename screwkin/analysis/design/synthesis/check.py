@@ -200,6 +200,9 @@ def _follow(design: Design, solver, probe, configs, steps):
             covered = max(covered, float(direction * (res.stopped_at - u1)))
         return res, covered
 
+    def typed(x):  # function generation: the crank's angle as typed beside the file's
+        return "" if design.input_offset is None else f" (phi {math.degrees(x + design.input_offset):.6g} deg as typed)"
+
     if design.span is not None:  # the motion is the input range: both ways from the first position
         defects, travel, mus = [], [0.0] + [None] * (n - 1), []
         runs = {}
@@ -211,14 +214,15 @@ def _follow(design: Design, solver, probe, configs, steps):
             mus += probe.mus(res.q)  # the sweep's grid ends at the range's ends
             if res.stopped_at is not None and covered < reach - tol.equal:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
-                               f"{math.degrees(res.stopped_at):.6g} deg: the linkage cannot run through it")
+                               f"{math.degrees(res.stopped_at):.6g} deg{typed(res.stopped_at)}: the linkage cannot "
+                               "run through it")
         for k in range(1, n):
             d = targets[k].input - u1
             direction = 1 if d >= 0 else -1
             res, covered = runs.get(direction, (None, 0.0))
             if res is None or abs(d) > covered + tol.equal:
                 defects.append(f"{label[k]} lies beyond a limit position: the input stops before "
-                               f"{math.degrees(targets[k].input):.6g} deg")
+                               f"{math.degrees(targets[k].input):.6g} deg{typed(targets[k].input)}")
             elif _locate(design, solver, probe, res, targets[k].input, configs[k]):
                 travel[k] = abs(d)
             else:

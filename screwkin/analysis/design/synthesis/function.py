@@ -221,7 +221,7 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     labels = [f"x = {x:.5g}: phi {math.degrees(ph):.5g} deg, psi {math.degrees(ps):.5g} deg"  # as typed
               for x, ph, ps in zip(xs, phi, psi)]
     design = stored(Design("function", fb, linkage, targets, "crank_joint", "rocker", (float(lo), float(hi)),
-                           exact=points == 3), labels)
+                           exact=points == 3, input_offset=float(phi[0])), labels)
     defects = []
     if not np.all(np.isfinite(gen)):
         defects.append("the linkage does not assemble over the whole input range (a limit position inside it)")
