@@ -207,6 +207,9 @@ def run(mech, args) -> int:
     targets = _targets(mech, args)
     if args.chain and args.singular:
         raise UsageError(f"{mech.path}: --chain and --singular are separate drawings; give one of them")
+    if (args.chain or args.singular) and mech.spec.targets and args.targets and not args.json:
+        print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
+              f"(draw without --{'chain' if args.chain else 'singular'}), not here")
     args.steps = 360 if args.steps is None else args.steps
     if args.steps < 4:
         raise UsageError(f"{mech.path}: --steps must be at least 4")
@@ -304,6 +307,9 @@ def _animate(mech, args) -> int:
     lo, hi = BOUNDS["animation_steps"]
     if not lo <= steps <= hi:
         raise UsageError(f"{mech.path}: --animate --steps must be from {lo} to {hi:,} (frames: steps + 1), got {steps}")
+    if mech.spec.targets and not args.json:
+        print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
+              "(draw --png/--svg), not in the animation")
     given = inputs(mech, args)
     name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
     if name is None:
