@@ -13,6 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError
+from ...model.geometry import wrap_angle
 from ..course.figures import trace_points
 from ..motion.links import Point, motion_along
 from ..motion.position import PositionSolver
@@ -74,15 +75,11 @@ def _frame(mech, data, fid, q):
     return tuple(float(v) for v in M.translation), float(math.atan2(M.rotation[1, 0], M.rotation[0, 0]))
 
 
-def _wrap(x: float) -> float:
-    return float((x + math.pi) % TWO_PI - math.pi)
-
-
 def _error(spec, position, yaw):
     if spec.kind == "angle":
-        return abs(_wrap(yaw - spec.yaw)), 0.0
+        return abs(wrap_angle(yaw - spec.yaw)), 0.0
     err = math.dist(position, spec.xyz)
-    return err, (abs(_wrap(yaw - spec.yaw)) if spec.kind == "pose" else 0.0)
+    return err, (abs(wrap_angle(yaw - spec.yaw)) if spec.kind == "pose" else 0.0)
 
 
 def design_targets(mech, q, steps: int = 360) -> DesignTargets:
@@ -138,7 +135,8 @@ def design_targets(mech, q, steps: int = 360) -> DesignTargets:
     for k, spec in enumerate(specs):
         if spec.kind != "point" or spec.link != link or spec.input != name:
             continue
-        turns = (0,) if linear else range(math.floor((lo - spec.value) / TWO_PI), math.ceil((hi - spec.value) / TWO_PI) + 1)
+        turns = (0,) if linear else range(math.floor((lo - spec.value) / TWO_PI),
+                                          math.ceil((hi - spec.value) / TWO_PI) + 1)
         met = [spec.value + TWO_PI * m for m in turns if lo <= spec.value + TWO_PI * m <= hi]
         if not met:
             continue
