@@ -344,3 +344,18 @@ def test_a_function_generators_limit_position_is_said_in_the_crank_angle_typed(t
     tol = a * d / reach * math.radians(1e-4) + 1e-9
     assert min(abs(reach - (b + abs(c))), abs(reach - abs(b - abs(c)))) < tol
     assert 30 < math.degrees(phi) < 200
+
+
+def test_many_targets_are_all_marked_and_twelve_numbered(tmp_path, capsys):
+    from screwkin.present.draw_targets import NUMBERED
+
+    out = tmp_path / "f.urdf"
+    assert main(["synthesize", "function", "--function", "log(x)", "--x-range", "1:2", "--input-range", "0:60deg",
+                 "--output-range", "0:90deg", "--points", "20", "-o", str(out)]) == 0
+    capsys.readouterr()
+    artists = _figure_targets(out)
+    assert sum(g.startswith("target:") for g in artists) == 20  # every target marked
+    labels = sorted(int(g.split(":")[1]) for g in artists if g.startswith("targetlabel:"))
+    assert len(labels) == NUMBERED and labels[0] == 1 and labels[-1] == 20
+    assert main(["draw", str(out), "--png", str(tmp_path / "f.png")]) == 0
+    assert f"{NUMBERED} of them numbered, evenly chosen" in capsys.readouterr().out

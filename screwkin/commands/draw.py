@@ -161,7 +161,9 @@ def _design(mech, q, input_names, skel, steps, say=None, hint=""):
     found, marks = design_marks(mech, q, skel, input_names, steps=steps)
     ghosts = sum(m["ghost"] is not None for m in marks)
     kinds = sorted({m["kind"] for m in marks})
-    say(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>{hint}), "
+    numbered = sum(m["numbered"] for m in marks)
+    which = f"; {numbered} of them numbered, evenly chosen" if numbered < len(marks) else ""
+    say(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>{hint}{which}), "
         f"the linkage ghosted at {ghosts} precision position(s)")
     for m in marks:
         if m["reached"] is None:

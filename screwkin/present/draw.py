@@ -323,8 +323,12 @@ def _legend(fig, links, joints, marks=None):
             tags.append("loop")
         lines.append(f" {j.letter:>2}  {_short(j.name)}  {', '.join(tags)}  {j.links[0]}-{j.links[1]}")
     if marks:
+        listed = [m for m in marks if m.get("numbered", True)]
         lines += ["", "targets (purple; black: reached)"]
-        lines += [f" {m['number']:>2}  {_short(m['label'], 42)}" for m in marks]
+        if len(listed) < len(marks):
+            lines.append(f" {len(listed)} of the {len(marks)} numbered")
+        width = len(str(len(marks)))
+        lines += [f" {m['number']:>{max(width, 2)}}  {_short(m['label'], 42 - width)}" for m in listed]
     size = 8 if len(lines) <= 40 else max(3.0, 8 * 40 / len(lines))
     fig.text(0.71, 0.88, "\n".join(lines), ha="left", va="top", family="monospace", fontsize=size, gid="legend")
 

@@ -1,7 +1,8 @@
 """A synthesized design's targets on its skeleton drawing (present/draw.py): each target pose as a
 numbered arrow at its origin along its x axis, each target point as a numbered cross, each
 target angle as a numbered ray from its pivot; the frame the linkage reaches there (a thin dark
-arrow, or a dot), and the linkage ghosted at the other precision positions.  Every artist has
+arrow, or a dot), and the linkage ghosted at the other precision positions (at most NUMBERED
+targets numbered and ghosted, evenly chosen; the others marked only).  Every artist has
 a gid a program can find: ``target:K`` (the target's origin, a marker whose data are the
 target's coordinates in the drawing's plane), ``targetaxis:K``, ``targetlabel:K``,
 ``reached:K`` (the reached frame's origin), ``reachedaxis:K``, ``carrier:K`` (dotted lines from it to
@@ -16,9 +17,12 @@ import numpy as np
 from ..analysis.course.skeleton import skeleton
 from ..analysis.design.targets import design_targets
 
-__all__ = ["design_marks", "target_marks", "draw_targets"]
+__all__ = ["design_marks", "target_marks", "draw_targets", "NUMBERED"]
 
 TARGET_COLOUR = "#6a3d9a"
+#: At most this many targets are numbered, listed and ghosted (evenly chosen, the first and the last
+#: among them); the others are marked only (function generation may have 200 precision points).
+NUMBERED = 12
 
 
 def design_marks(mech, q, skel, inputs=None, steps: int = 360):
@@ -26,11 +30,15 @@ def design_marks(mech, q, skel, inputs=None, steps: int = 360):
     the marks (target_marks) with the linkage's skeleton at each precision position other than the
     one drawn (in skel's plane, ``inputs`` marked)."""
     found = design_targets(mech, q, steps=steps)
+    n = len(found.targets)
+    shown = set(range(n)) if n <= NUMBERED else {int(i) for i in np.linspace(0, n - 1, NUMBERED).round()}
     ghosts = {}
     for k, t in enumerate(found.targets):
-        if t.q is not None and float(np.max(np.abs(mech.difference(q, t.q)))) > mech.tolerances.equal:
+        if k in shown and t.q is not None and float(np.max(np.abs(mech.difference(q, t.q)))) > mech.tolerances.equal:
             ghosts[k] = skeleton(mech, t.q, inputs, basis=skel.basis)
     marks = target_marks(found, skel.basis, ghosts)
+    for k, m in enumerate(marks):
+        m["numbered"] = k in shown
     welded = {j.child: j.parent for j in mech.spec.joints if j.type == "fixed"}
     for k, m in enumerate(marks):  # the pins of the link that carries a guided frame or a coupler point
         carrier = m["link"]
@@ -94,9 +102,10 @@ def draw_targets(ax, marks, r, size, colour_of) -> list:
             ax.plot(*p, "s" if m["kind"] == "pose" else "D", color=TARGET_COLOUR, ms=5, zorder=6.5, gid=f"target:{k}",
                     label=f"target {m['kind']}")
             tip = p + arrow * np.asarray(m["direction"], float)
-            ax.add_patch(FancyArrowPatch(tuple(p), tuple(tip), arrowstyle="-|>", mutation_scale=14, lw=2.4,
-                                         color=TARGET_COLOUR, alpha=0.55, zorder=6.4, gid=f"targetaxis:{k}",
-                                         label="target axis"))
+            bold = m.get("numbered", True)
+            ax.add_patch(FancyArrowPatch(tuple(p), tuple(tip), arrowstyle="-|>", mutation_scale=14 if bold else 6,
+                                         lw=2.4 if bold else 0.6, color=TARGET_COLOUR, alpha=0.55, zorder=6.4,
+                                         gid=f"targetaxis:{k}", label="target axis"))
             points.append(tuple(tip))
             start = tip if m["kind"] == "angle" else p
         if m["reached"] is not None:
@@ -105,11 +114,12 @@ def draw_targets(ax, marks, r, size, colour_of) -> list:
                 ax.plot([c[0], q[0]], [c[1], q[1]], ":", color="0.45", lw=0.8, zorder=1.3, gid=f"carrier:{k}",
                         label="carrier")
             ax.plot(*q, "o", color="black", ms=3, zorder=6.6, gid=f"reached:{k}", label="reached")
-            if m["reached_direction"] is not None:
+            if m["reached_direction"] is not None and m.get("numbered", True):
                 tip = q + arrow * np.asarray(m["reached_direction"], float)
                 ax.add_patch(FancyArrowPatch(tuple(q), tuple(tip), arrowstyle="-|>", mutation_scale=9, lw=0.9,
                                              color="black", zorder=6.7, gid=f"reachedaxis:{k}", label="reached axis"))
-        ax.annotate(str(k), tuple(start), xytext=(-9, 6), textcoords="offset points", fontsize=9, fontweight="bold",
-                    color=TARGET_COLOUR, zorder=8, gid=f"targetlabel:{k}")
+        if m.get("numbered", True):
+            ax.annotate(str(k), tuple(start), xytext=(-9, 6), textcoords="offset points", fontsize=9,
+                        fontweight="bold", color=TARGET_COLOUR, zorder=8, gid=f"targetlabel:{k}")
         points.append(tuple(p))
     return points
