@@ -359,3 +359,16 @@ def test_many_targets_are_all_marked_and_twelve_numbered(tmp_path, capsys):
     assert len(labels) == NUMBERED and labels[0] == 1 and labels[-1] == 20
     assert main(["draw", str(out), "--png", str(tmp_path / "f.png")]) == 0
     assert f"{NUMBERED} of them numbered, evenly chosen" in capsys.readouterr().out
+
+
+def test_check_urdf_parses_the_file_with_its_targets(designs):
+    import shutil
+    import subprocess
+
+    tool = shutil.which("check_urdf")
+    if tool is None:
+        pytest.skip("urdfdom's check_urdf is not installed")
+    for kind in ("motion", "path", "function"):
+        path, _ = designs[kind]
+        done = subprocess.run([tool, str(path)], capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0 and "Successfully Parsed XML" in done.stdout, done.stderr
