@@ -26,6 +26,7 @@ from ..present.draw import (
     skeleton_dict,
     value_label,
 )
+from ..present.draw_targets import design_marks
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value
 from ._common import (
@@ -70,6 +71,9 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--trace", action="append", metavar="NAME",
                     help="draw the path of the --point NAME over a whole turn of the input (or up to its limit "
                          "position) on the skeleton; repeatable")
+    sp.add_argument("--no-targets", dest="targets", action="store_false",
+                    help="leave out the targets a synthesized file states (<screwkin:targets>: drawn by default, "
+                         "with the linkage at each precision position and a path's coupler curve)")
     sp.add_argument("--animate", metavar="OUT.gif|OUT.mp4",
                     help="write an animation of the skeleton while --input goes --from A --to B in --steps N "
                          "(GIF with Pillow; MP4 with imageio-ffmpeg); --point paths are traced")
@@ -149,6 +153,54 @@ def _traces(mech, args, q, input_names, given, skel) -> dict:
     return out
 
 
+def _design(mech, q, input_names, skel, steps, say=None, hint=""):
+    """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
+    precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
+    ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
+    say = say or (lambda _line: None)
+    found, marks = design_marks(mech, q, skel, input_names, steps=steps)
+    ghosts = sum(m["ghost"] is not None for m in marks)
+    kinds = sorted({m["kind"] for m in marks})
+    numbered = sum(m["numbered"] for m in marks)
+    which = f"; {numbered} of them numbered, evenly chosen" if numbered < len(marks) else ""
+    say(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>{hint}{which}), "
+        f"the linkage ghosted at {ghosts} precision position(s)")
+    for m in marks:
+        if m["reached"] is None:
+            say(f"target {m['number']} ({m['label']}): the linkage does not assemble at {m['input']} = "
+                f"{m['value']:.6g}: nothing reached drawn")
+    curve = None
+    if found.curve is not None:
+        e1, e2, _ = (np.asarray(v, float) for v in skel.basis)
+        name = f"curve of {next(m['link'] for m in marks if m['kind'] == 'point')}"
+        stops = [x for x, _ in found.stops if x is not None]
+        curve = (name, np.stack([found.curve @ e1, found.curve @ e2], axis=1), stops or None)
+        for m, i in zip(marks, found.on_curve):  # where the curve passes each target, for --json
+            m["curve_index"] = i
+            m["curve_input"] = None if i is None else float(found.curve_inputs[i])
+        off = [m["number"] for m, i in zip(marks, found.on_curve) if m["kind"] == "point" and i is None]
+        for x, why in found.stops:
+            if x is not None:
+                say(f"{name}: the input stops at {x:.6g} ({why}): the curve runs between its limit positions")
+        if off:
+            say(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
+    return marks, curve
+
+
+def draw_design(mech, paths, steps: int = 360, say=None) -> list:
+    """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
+    ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
+    q = mech.assemble().q
+    input_names = list(mech.actuated)
+    skel = skeleton(mech, q, input_names)
+    marks, curve = (None, None) if not mech.spec.targets else _design(mech, q, input_names, skel, steps, say)
+    traces = {} if curve is None else {curve[0]: curve[1]}
+    for path in paths:
+        fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), traces=traces, marks=marks)
+        save_figure(fig, path)
+    return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
+
+
 def run(mech, args) -> int:
     if args.animate:
         return _animate(mech, args)
@@ -157,6 +209,9 @@ def run(mech, args) -> int:
     targets = _targets(mech, args)
     if args.chain and args.singular:
         raise UsageError(f"{mech.path}: --chain and --singular are separate drawings; give one of them")
+    if (args.chain or args.singular) and mech.spec.targets and args.targets and not args.json:
+        print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
+              f"(draw without --{'chain' if args.chain else 'singular'}), not here")
     args.steps = 360 if args.steps is None else args.steps
     if args.steps < 4:
         raise UsageError(f"{mech.path}: --steps must be at least 4")
@@ -206,15 +261,23 @@ def run(mech, args) -> int:
         skel = skeleton(mech, q, input_names)
         space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
         traces = _traces(mech, args, q, input_names, given, skel)
+        marks, curve = (None, None)
+        if mech.spec.targets and args.targets:
+            marks, curve = _design(mech, q, input_names, skel, args.steps, None if args.json else print,
+                                   "; --no-targets leaves them out")
+        if curve is not None:
+            traces[curve[0]] = curve[1:]
         for path in targets:
             fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), angles=args.angles,
                                  subtitle=("" if skel.planar else space.strip(" ()")) or None,
-                                 traces={n: xy for n, (xy, _) in traces.items()})
+                                 traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
             save_figure(fig, path)
             written.append(path)
         report = with_mode(args, skeleton_dict(skel))
         if traces:
             report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
+        if marks:
+            report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
     if args.json:
         report["files"] = written
         print(json.dumps(to_jsonable(report), indent=2))
@@ -246,6 +309,9 @@ def _animate(mech, args) -> int:
     lo, hi = BOUNDS["animation_steps"]
     if not lo <= steps <= hi:
         raise UsageError(f"{mech.path}: --animate --steps must be from {lo} to {hi:,} (frames: steps + 1), got {steps}")
+    if mech.spec.targets and not args.json:
+        print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
+              "(draw --png/--svg), not in the animation")
     given = inputs(mech, args)
     name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
     if name is None:

@@ -64,7 +64,7 @@ from ._common import (
     value_kind,
 )
 from ._options import check_writable, count, screwkin_version
-from .draw import _kind_text, _wrapped
+from .draw import _design, _kind_text, _wrapped
 from .equations import _typed, start_estimates
 
 NAME = "report"
@@ -182,6 +182,15 @@ def run(mech, args) -> int:
         fig = draw_mechanism(skel, title=f"{os.path.basename(str(mech.path))}: {configuration}",
                              subtitle=None if skel.planar else f"schematic projection of a {skel.motion_space} mechanism")
         figures.append(Figure(figure_bytes(fig), "svg", "skeleton diagram at the configuration analysed", "skeleton"))
+        if mech.spec.targets:  # a synthesized design: what it was asked to do, as `draw FILE` shows it
+            design = _attempt(notes, "targets", lambda: _design(mech, q, names, skel, 360))
+            if design is not None:
+                marks, curve = design
+                fig = draw_mechanism(skel, title=f"{os.path.basename(str(mech.path))}: the design's targets",
+                                     traces={} if curve is None else {curve[0]: curve[1]}, marks=marks)
+                figures.append(Figure(figure_bytes(fig), "svg", f"the {len(marks)} targets the file states "
+                                      "(<screwkin:targets>) and the linkage at each", "targets"))
+                data["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
     chain = _attempt(notes, "chain", lambda: kinematic_chain(mech, q, names))
     if chain is not None:
         figures.append(Figure(figure_bytes(draw_chain(chain)), "svg", "kinematic chain: links as nodes, joints as "

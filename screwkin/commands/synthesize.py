@@ -27,10 +27,13 @@ from ..analysis.design.synthesis.path import synthesize_path
 from ..errors import UsageError, quote
 from ..files.description import LIMITS
 from ..files.writer import write_urdf
+from ..model.loader import load
+from ..present.jsonout import to_jsonable
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
 from ._options import count
+from .draw import draw_design
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -39,9 +42,9 @@ KINDS = ("motion", "function", "path", "chains")
 PAIRS_CHECKED = 6
 
 _OPTIONS = {  # which options each kind takes (dest names)
-    "motion": {"poses", "pivots", "moving", "pick", "candidates", "png"},
-    "function": {"function", "x_range", "input_range", "output_range", "points", "spacing", "ground"},
-    "path": {"points", "timing", "starts", "seed", "tolerance"},
+    "motion": {"poses", "pivots", "moving", "pick", "candidates", "png", "draw"},
+    "function": {"function", "x_range", "input_range", "output_range", "points", "spacing", "ground", "draw"},
+    "path": {"points", "timing", "starts", "seed", "tolerance", "draw"},
     "chains": {"links", "dof", "prismatic", "planar"},
 }
 
@@ -56,6 +59,9 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--reject-defects", action="store_true",
                     help="leave out results with a defect (branch, order, limit position, a missed position); "
                          "exit 1 when none is left")
+    sp.add_argument("--draw", metavar="F.png|F.svg",
+                    help="motion, function, path: draw the linkage written with its targets, as 'screwkin draw OUT "
+                         "--png F' does (the linkage at each precision position, a path's coupler curve)")
     m = sp.add_argument_group("motion")
     m.add_argument("--poses", metavar='"x,y,th; ..."',
                    help="3 to 5 poses of the coupler frame (m; th in rad, or with deg)")
@@ -166,6 +172,8 @@ def run(mech, args) -> int:
         return _chains(args)
     if not args.out:
         raise UsageError(f"synthesize {kind} needs -o OUT.urdf (the file to write)")
+    if args.draw and not (args.draw.lower().endswith((".png", ".svg")) and len(args.draw) > 4):
+        raise UsageError(f"--draw expects a file name ending in .png or .svg, got {quote(args.draw)}")
     if kind == "motion":
         result, check, tmp = _motion(args)
     elif kind == "function":
@@ -178,10 +186,21 @@ def run(mech, args) -> int:
                                                    + "; ".join(check.defects))
     _keep(tmp, args.out)
     check = replace(check, file=str(args.out))
+    lines, marks = [], None
+    if args.draw:
+        marks = draw_design(load(args.out), [args.draw], say=lines.append)
     if args.json:
-        print(json.dumps(synthesis_dict(result, check, args.out), indent=2))
+        out = synthesis_dict(result, check, args.out)
+        if args.draw:
+            out["drawing"] = to_jsonable({"file": args.draw, "targets": marks})
+        print(json.dumps(out, indent=2))
     else:
         print(synthesis_text(result, check, args.out))
+        if args.draw:
+            print("\n".join([*lines, f"wrote {args.draw}"]))
+        else:
+            print(f"to see it with its targets: screwkin draw {args.out} --png "
+                  f"{os.path.splitext(str(args.out))[0]}-design.png (or --draw F.png here)")
     return 0
 
 

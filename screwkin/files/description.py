@@ -18,6 +18,9 @@ __all__ = [
     "TREE_JOINT_DOF",
     "CUT_JOINT_DOF",
     "LinkSpec",
+    "TargetSpec",
+    "TARGETS_NS",
+    "TARGET_KINDS",
     "JointSpec",
     "Coupling",
     "CutJointSpec",
@@ -79,6 +82,7 @@ class Limits:
     loop_joints: 200 loop (cut) joints (18 times kangaroo's 11).
     meshes:      2,000 distinct mesh files looked for when loading (PR2 names 26);
                  beyond them a missing mesh is not reported (the view still finds each).
+    targets: 1,000 ``<screwkin:target>`` elements (a synthesized design has 3 to 200).
     coordinates: 500 moving joint coordinates (nv).  Pinocchio's ``Data`` holds
                  nv x nv x nv tensors: about :func:`data_bytes` = 64 nv^3 bytes
                  (measured: 0.14 GB at nv = 100, 0.6 GB at 200, 4.1 GB and 7.6 s
@@ -106,6 +110,7 @@ class Limits:
     loop_joints: int = 200
     meshes: int = 2000
     coordinates: int = 500
+    targets: int = 1000
     length: float = 1e4
     angle: float = 1e4
     mass: float = 1e6
@@ -211,6 +216,30 @@ class CutJointSpec:
         return CUT_JOINT_DOF[self.type]
 
 
+#: The XML namespace of screwkin's own elements in a URDF (``<screwkin:targets>``, docs/format.md):
+#: urdfdom and Pinocchio skip elements they do not know, and a namespace keeps the name ours.
+TARGETS_NS = "urn:screwkin:urdf"
+#: What a <screwkin:target> states: a frame's pose, a point, or an angle about a pivot.
+TARGET_KINDS = ("pose", "point", "angle")
+
+
+@dataclass(frozen=True)
+class TargetSpec:
+    """What a synthesized linkage was designed to do at one precision position, as its file
+    states it (``<screwkin:targets>``): with the joint ``input`` at ``value`` [rad or m, the
+    file's coordinate], the frame of ``link`` must be at ``xyz`` [m, world] turned ``yaw``
+    [rad] about z (``kind`` "pose"), have its origin at ``xyz`` ("point"), or be turned ``yaw``
+    about its pivot ``xyz`` ("angle").  ``label``: how a person reads it (the values as typed)."""
+
+    kind: str  # "pose" | "point" | "angle"
+    link: str
+    input: str
+    value: float
+    xyz: tuple
+    yaw: float | None = None
+    label: str = ""
+
+
 @dataclass
 class MechanismSpec:
     """Everything read from a mechanism file."""
@@ -229,6 +258,7 @@ class MechanismSpec:
     warnings: list = field(default_factory=list)
     package_dirs: list = field(default_factory=list)  # --package-dir folders for package:// meshes
     couplings: list = field(default_factory=list)  # Coupling, from <mimic>
+    targets: tuple = ()  # TargetSpec, from <screwkin:targets> (a synthesized design's precision positions)
 
     @property
     def root(self) -> str:

@@ -2,7 +2,8 @@
 
 The tree part is left to Pinocchio's URDF parser (the file's own text is what it
 reads); this module reads what that parser ignores -- ``<loop_joint>``,
-``<transmission>``, link masses and geometry -- and validates the file first so
+``<transmission>``, ``<screwkin:targets>`` (a synthesized design's precision positions), link
+masses and geometry -- and validates the file first so
 that every problem is reported with the file's name and all at once.
 """
 
@@ -27,6 +28,9 @@ from .description import (
     JointSpec,
     LinkSpec,
     MechanismSpec,
+    TARGET_KINDS,
+    TARGETS_NS,
+    TargetSpec,
     data_bytes,
 )
 from .meshes import check_meshes
@@ -434,6 +438,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
     couplings = _couplings(joints, problems, warnings)
     transmissions = _transmissions(root, joints, {c.name for c in cuts}, warnings,
                                    {c.joint: c.mimics for c in couplings})
+    targets = _targets(root, links, {j.name for j in joints}, problems)
     problems.fail_if_any(path)
     warnings += check_meshes(path, root, package_dirs)
     return MechanismSpec(
@@ -448,6 +453,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
         warnings=warnings,
         package_dirs=[str(d) for d in package_dirs or ()],
         couplings=couplings,
+        targets=targets,
     )
 
 
@@ -528,3 +534,36 @@ def _transmissions(root, joints, loop_names, warnings, mimics=None) -> list:
     return names
 
 
+def _targets(root, links, joint_names, problems) -> tuple:
+    """The TargetSpec of every <screwkin:target> under <screwkin:targets> of the URDF ``root``;
+    a problem recorded (the file refused, as for any element) for an unknown kind, link or
+    joint, a missing or implausible number."""
+    elems = [t for group in root.findall(f"{{{TARGETS_NS}}}targets") for t in group.findall(f"{{{TARGETS_NS}}}target")]
+    if len(elems) > LIMITS.targets:
+        problems.append(f"<screwkin:targets> holds {len(elems)} targets; screwkin reads at most {LIMITS.targets}")
+        return ()
+    out = []
+    for k, e in enumerate(elems, 1):
+        what = f"<screwkin:target> {k}"
+        kind, link, joint = e.get("kind"), e.get("link"), e.get("input")
+        if kind not in TARGET_KINDS:
+            problems.append(f"{what} has kind {quote(kind or '')}; expected {', '.join(TARGET_KINDS)}")
+            continue
+        if link not in links:
+            problems.append(f"{what} names link {quote(link or '')}, which is not a link of the file")
+            continue
+        if joint not in joint_names:
+            problems.append(f"{what} names input {quote(joint or '')}, which is not a joint of the file")
+            continue
+        (value,) = numbers(e.get("value"), 1, f"{what} value", problems, (None,), LIMITS.length)
+        xyz = numbers(e.get("xyz"), 3, f"{what} xyz", problems, (None,) * 3, LIMITS.length)
+        yaw = None
+        if kind != "point":
+            if e.get("yaw") is None:
+                problems.append(f"{what}: a {kind} target needs yaw")
+                continue
+            (yaw,) = numbers(e.get("yaw"), 1, f"{what} yaw", problems, (None,), LIMITS.angle)
+        if value is None or None in xyz or (kind != "point" and yaw is None):
+            continue
+        out.append(TargetSpec(kind, link, joint, value, xyz, yaw, (e.get("label") or "")[:200]))
+    return tuple(out)

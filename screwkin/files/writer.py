@@ -19,8 +19,10 @@ import math
 from dataclasses import dataclass, field
 
 from ..tolerances import DEFAULT
+from .description import TARGETS_NS
 
-__all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf", "number_text", "vector_text"]
+__all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf", "number_text", "vector_text",
+           "targets_text"]
 
 _COLOURS = ((0.35, 0.35, 0.35), (0.85, 0.3, 0.2), (0.2, 0.5, 0.85), (0.2, 0.7, 0.3), (0.85, 0.65, 0.1),
             (0.6, 0.3, 0.75), (0.1, 0.7, 0.7), (0.9, 0.45, 0.6))
@@ -83,6 +85,7 @@ class PlanarLinkage:
     width: float = 0.0  # bar width [m]; 0: 4 % of the mean bar length
     density: float = 1.0  # [kg/m] of bar
     colours: dict = field(default_factory=dict)  # link name -> (r, g, b)
+    targets: tuple = ()  # files.description.TargetSpec: written as <screwkin:targets>
 
 
 def number_text(x) -> str:
@@ -141,7 +144,8 @@ def write_urdf(linkage: PlanarLinkage) -> str:
     if linkage.comment:
         text = linkage.comment.replace("--", "- -")
         out.append("<!--\n" + text.rstrip() + "\n-->")
-    out.append(f'<robot name="{linkage.name}">')
+    space = f' xmlns:screwkin="{TARGETS_NS}"' if linkage.targets else ""
+    out.append(f'<robot name="{linkage.name}"{space}>')
     for k, lk in enumerate(linkage.links):
         r, g, b = linkage.colours.get(lk.name, _COLOURS[k % len(_COLOURS)])
         material = f'<material name="m_{lk.name}"><color rgba="{vector_text(r, g, b, 1)}"/></material>'
@@ -208,5 +212,23 @@ def write_urdf(linkage: PlanarLinkage) -> str:
                    "</hardwareInterface></joint>")
         out.append(f'    <actuator name="m_{name}"><mechanicalReduction>1</mechanicalReduction></actuator>')
         out.append("  </transmission>")
+    out += targets_text(linkage.targets)
     out.append("</robot>")
     return "\n".join(out) + "\n"
+
+
+def _attribute(text: str) -> str:
+    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def targets_text(targets) -> list:
+    """The lines of the <screwkin:targets> element of ``targets`` (TargetSpec); none when empty."""
+    if not targets:
+        return []
+    out = ["  <screwkin:targets>"]
+    for t in targets:
+        yaw = "" if t.yaw is None else f' yaw="{number_text(t.yaw)}"'
+        out.append(f'    <screwkin:target kind="{t.kind}" link="{_attribute(t.link)}" input="{_attribute(t.input)}" '
+                   f'value="{number_text(t.value)}" xyz="{vector_text(*t.xyz)}"{yaw} label="{_attribute(t.label)}"/>')
+    out.append("  </screwkin:targets>")
+    return out

@@ -74,7 +74,7 @@ class Figure:
     data: bytes
     fmt: str  # "svg" | "png"
     caption: str
-    role: str  # "skeleton", "chain", "singular", "sweep", "view": the HTML class and the file name
+    role: str  # "skeleton", "targets", "chain", "singular", "sweep", "view": the HTML class and the file name
 
 
 @dataclass

@@ -20,6 +20,7 @@ import os
 import numpy as np
 
 from ..errors import UsageError
+from .draw_targets import draw_targets
 from .plots import pyplot
 
 __all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label", "number_colours"]
@@ -71,7 +72,7 @@ def _frame(fig, ax, points, r, limits=None):
 
 
 def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitle: str | None = None,
-                   traces: dict | None = None, size: float | None = None, limits=None):
+                   traces: dict | None = None, size: float | None = None, limits=None, marks=None):
     """The skeleton diagram of a :class:`~screwkin.analysis.course.skeleton.Skeleton` as a matplotlib
     Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
     higher pairs as their profiles, binary links as bars, ternary and larger links as filled
@@ -79,7 +80,8 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
     names, the input joints marked with a curved arrow (a straight one for a sliding input),
     and with ``angles`` the absolute link angles (planar mechanisms).  ``size`` [m] (default the
     skeleton's) sets the symbols' scale and ``limits`` ((x0, x1), (y0, y1)) [m] the framing: the
-    frames of an animation share both."""
+    frames of an animation share both.  ``marks``: a synthesized design's targets
+    (present.draw_targets.target_marks), drawn with the linkage ghosted at each."""
     plt = _plt()
     from matplotlib.patches import Arc, Circle, FancyArrowPatch, Polygon, Rectangle
 
@@ -257,11 +259,13 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
         ax.plot(*xy[0], "o", color=f"C{k}", markersize=4, zorder=6, gid=f"tracepoint:{name}")
         ax.annotate(name, xy[0], xytext=(4, 4), textcoords="offset points", fontsize=8, color=f"C{k}")
         points += [tuple(p) for p in xy]
+    if marks:
+        points += draw_targets(ax, marks, r, size or skel.size, col)
     _frame(fig, ax, points, r, limits)
     fig.suptitle(title or os.path.basename(skel.path), fontsize=11, x=0.36, y=0.97)
     if subtitle:
         fig.text(0.36, 0.905, subtitle, ha="center", va="center", fontsize=8.5, color="0.3")
-    _legend(fig, skel.links, skel.joints)
+    _legend(fig, skel.links, skel.joints, marks)
     return fig
 
 
@@ -306,7 +310,7 @@ def _input_arrow(ax, FancyArrowPatch, j, p, r):
                                  label="input"))
 
 
-def _legend(fig, links, joints):
+def _legend(fig, links, joints, marks=None):
     lines = ["links"]
     lines += [f" {lk.number:>2}  {_short(lk.name)}" + ("  (ground)" if lk.ground else "") for lk in links]
     lines.append("")
@@ -318,6 +322,13 @@ def _legend(fig, links, joints):
         if j.cut:
             tags.append("loop")
         lines.append(f" {j.letter:>2}  {_short(j.name)}  {', '.join(tags)}  {j.links[0]}-{j.links[1]}")
+    if marks:
+        listed = [m for m in marks if m.get("numbered", True)]
+        lines += ["", "targets (purple; black: reached)"]
+        if len(listed) < len(marks):
+            lines.append(f" {len(listed)} of the {len(marks)} numbered")
+        width = len(str(len(marks)))
+        lines += [f" {m['number']:>{max(width, 2)}}  {_short(m['label'], 42 - width)}" for m in listed]
     size = 8 if len(lines) <= 40 else max(3.0, 8 * 40 / len(lines))
     fig.text(0.71, 0.88, "\n".join(lines), ha="left", va="top", family="monospace", fontsize=size, gid="legend")
 

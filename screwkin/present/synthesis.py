@@ -5,6 +5,8 @@ name -> dimensions), ``pivots``, ``precision`` (each precision position or point
 ``reached`` and ``residual``), ``grashof``, ``transmission_angle_range`` [deg], ``defects``
 (strings, empty when none) and ``valid``; each kind adds its own keys beside them.  Numbers
 stay SI (m, rad) in the results; keys ending in ``_deg`` and the text give degrees.
+Function generation's precision entries add ``as_typed``: x, phi, psi asked and psi reached in the
+angles of --input-range/--output-range (``target``/``value`` keep the file's rocker-frame angle).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import numpy as np
 
 from ..analysis.design.synthesis.designs import ChainsResult, Check, FunctionResult, MotionResult, PathResult
 from ..analysis.design.synthesis.chains import guides_of
-from ..analysis.design.synthesis.fourbar import tool_local
+from ..analysis.design.synthesis.fourbar import tool_local, wrap
 from .report import table, to_jsonable
 from .tables import shown
 
@@ -113,6 +115,8 @@ def synthesis_dict(result, check: Check, file) -> dict:
             "structural_error_deg": {"max": _deg(result.max_structural_error),
                                      "at_precision_points": [_deg(e) for e in result.error_at_points]},
         })
+        for entry, typed in zip(out["precision"], _typed(result, check)):
+            entry["as_typed"] = typed
     elif isinstance(result, PathResult):
         out.update({
             "points": [list(p) for p in result.points],
@@ -122,6 +126,22 @@ def synthesis_dict(result, check: Check, file) -> dict:
             "tolerance": result.tolerance,
         })
     return to_jsonable(out)
+
+
+def _typed(result: FunctionResult, check: Check) -> list:
+    """Each precision point of function generation in the angles of --input-range and
+    --output-range as typed [deg]: the crank's phi, the rocker's psi asked and the psi the file
+    gives there (None where it does not assemble).  The file's own angles differ: the crank
+    joint counts from the first precision point, the rocker's frame may point from B0 away from B."""
+    out = []
+    for p, phi, psi in zip(check.precision, result.phi, result.psi):
+        got = None
+        if p.value and math.isfinite(p.error):
+            got = math.degrees(psi + float(wrap(p.value[0] - p.target.value[0])))
+        out.append({"x": None, "phi_deg": math.degrees(phi), "psi_deg": math.degrees(psi), "psi_reached_deg": got})
+    for entry, x in zip(out, result.x):
+        entry["x"] = x
+    return out
 
 
 #: Display cut-off of synthesis numbers: below this in magnitude they are written as 0 (the closed
@@ -188,9 +208,13 @@ def synthesis_text(result, check: Check, file) -> str:
     out.append(f"  drawn closed: {'yes' if check.assembled_iterations == 0 else 'no'} (assembly Newton iterations "
                f"{check.assembled_iterations})")
     rows = []
-    for p, travel in zip(check.precision, list(check.travel) + [None] * len(check.precision)):
+    typed = _typed(result, check) if isinstance(result, FunctionResult) else [None] * len(check.precision)
+    for p, travel, as_typed in zip(check.precision, list(check.travel) + [None] * len(check.precision), typed):
         t = p.target
-        if t.kind == "pose":
+        if as_typed is not None:  # function generation: the angles as typed, not the file's
+            want = f"phi {_fmt(as_typed['phi_deg'])} deg -> psi {_fmt(as_typed['psi_deg'])} deg"
+            err = f"{math.degrees(p.error):.2g} deg"
+        elif t.kind == "pose":
             want = f"({_fmt(t.value[0])}, {_fmt(t.value[1])}, {_fmt(math.degrees(t.value[2]))} deg)"
             err = f"{p.error:.2g} m, {math.degrees(p.angle_error):.2g} deg"
         elif t.kind == "point":
@@ -206,6 +230,9 @@ def synthesis_text(result, check: Check, file) -> str:
                      "-" if travel is None else _fmt(math.degrees(travel), 5)])
     out.append("  " + table(["position", "crank [deg]", "target", "reached", "error", "residual",
                              "vs closed form [m]", "travel [deg]"], rows).replace("\n", "\n  "))
+    if isinstance(result, FunctionResult):
+        out.append(f"  targets in the angles typed (--input-range, --output-range); the file's crank_joint "
+                   f"counts from the first precision point: crank = phi - {_fmt(math.degrees(result.phi[0]))} deg")
     if check.defects:
         out.append("DEFECTS:")
         out += [f"  - {x}" for x in check.defects]

@@ -1,6 +1,6 @@
 """Pictures of synthesis results with matplotlib (optional: ``pip install -e '.[plot]'``):
 Burmester's centre-point and circle-point curves with the poses, poles, candidates and the
-four-bar chosen."""
+four-bar chosen, ghosted at the other positions with the guided frame it reaches there."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..analysis.design.synthesis.designs import MotionResult
+from ..analysis.design.synthesis.fourbar import crank_angle, positions
 from .plots import pyplot
 
 __all__ = ["burmester_png"]
@@ -45,6 +46,25 @@ def burmester_png(result: MotionResult, path: str):
     fb = result.design.fourbar
     chain = np.array([fb.A0, fb.A, fb.B, fb.B0])
     ax.plot(chain[:, 0], chain[:, 1], "-o", color="tab:green", lw=2, label=f"four-bar chosen {result.pick}")
+    for k, t in enumerate(result.design.targets[1:], 2):  # the four-bar (closed form) at the other positions
+        best = None
+        for sigma in (1.0, -1.0):
+            p = positions(fb, crank_angle(fb) + t.input, sigma)
+            if p["h2"] < 0:
+                continue
+            miss = math.hypot(float(p["x"]) - t.value[0], float(p["y"]) - t.value[1])
+            if best is None or miss < best[0]:
+                best = (miss, p)
+        if best is None:
+            continue
+        p = best[1]
+        ghost = np.array([fb.A0, p["A"], p["B"], fb.B0])
+        ax.plot(ghost[:, 0], ghost[:, 1], "-", color="tab:green", lw=1, alpha=0.35, gid=f"ghost:{k}",
+                label="the four-bar at the other positions" if k == 2 else None)
+        x, y, th = float(p["x"]), float(p["y"]), float(p["angle"])
+        ax.plot([p["A"][0], x, p["B"][0]], [p["A"][1], y, p["B"][1]], ":", color="0.45", lw=0.8)
+        ax.annotate("", xy=(x + 0.1 * L * math.cos(th), y + 0.1 * L * math.sin(th)), xytext=(x, y),
+                    arrowprops={"arrowstyle": "->", "color": "tab:green", "lw": 0.8}, gid=f"reached:{k}")
     ax.plot([fb.A0[0], fb.B0[0]], [fb.A0[1], fb.B0[1]], "^", color="tab:green", ms=10)
     fixed = np.array([d.fixed for d in result.candidates]).reshape(-1, 2)
     xs = np.concatenate([P[:, 0], chain[:, 0], fixed[:, 0]])

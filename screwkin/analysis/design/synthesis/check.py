@@ -6,7 +6,7 @@ The file is loaded as any mechanism file is (screwkin.model.loader.load), then:
    (the file is drawn closed at the first precision position);
 2. at each precision position the input is set and the loops solved
    (PositionSolver.solve, every assembly mode); the mode closest to the target is
-   polished to a closure residual below 1e-13 and compared with the target (the guided
+   polished to a closure residual below 1e-13 (analysis.design.targets.polished) and compared with the target (the guided
    frame's pose, the coupler point, or the output link's angle) and with the closed-form
    four-bar (screwkin.analysis.design.synthesis.fourbar) at that input;
 3. the Grashof class comes from screwkin.analysis.motion.planar.identify;
@@ -25,7 +25,6 @@ The file is loaded as any mechanism file is (screwkin.model.loader.load), then:
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
@@ -36,6 +35,7 @@ from ...mobility import analyze_mobility
 from ...motion.planar import identify, transmission_angles
 from ...motion.position import PositionSolver
 from ...motion.sweep import sweep
+from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions, wrap
 
@@ -123,7 +123,6 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
     name = design.input_joint
     solver = PositionSolver(mech, [name], output=design.output_link)
     probe = _Probe(mech, design)
-    tight = replace(mech.tolerances, closure=1e-13, max_iterations=60)
     precision, configs, q_first = [], [], None
     for k, target in enumerate(design.targets):
         try:
@@ -135,12 +134,8 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
                            f"{name} = {math.degrees(target.input):.6g} deg")
             continue
         best = min(res.solutions, key=lambda s: sum(probe.error(s.q, target)))
-        q, residual = best.q, best.residual
-        try:
-            polished = mech.closure.solve(q, frozen=solver.frozen, tolerances=tight)
-            q, residual = polished.q, polished.residual
-        except AssemblyError:
-            pass
+        q, residual = polished(mech, solver, best.q)
+        residual = best.residual if residual is None else residual
         if k == 0:
             q_first = q
         configs.append(q)
@@ -205,6 +200,9 @@ def _follow(design: Design, solver, probe, configs, steps):
             covered = max(covered, float(direction * (res.stopped_at - u1)))
         return res, covered
 
+    def typed(x):  # function generation: the crank's angle as typed beside the file's
+        return "" if design.input_offset is None else f" (phi {math.degrees(x + design.input_offset):.6g} deg as typed)"
+
     if design.span is not None:  # the motion is the input range: both ways from the first position
         defects, travel, mus = [], [0.0] + [None] * (n - 1), []
         runs = {}
@@ -216,14 +214,15 @@ def _follow(design: Design, solver, probe, configs, steps):
             mus += probe.mus(res.q)  # the sweep's grid ends at the range's ends
             if res.stopped_at is not None and covered < reach - tol.equal:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
-                               f"{math.degrees(res.stopped_at):.6g} deg: the linkage cannot run through it")
+                               f"{math.degrees(res.stopped_at):.6g} deg{typed(res.stopped_at)}: the linkage cannot "
+                               "run through it")
         for k in range(1, n):
             d = targets[k].input - u1
             direction = 1 if d >= 0 else -1
             res, covered = runs.get(direction, (None, 0.0))
             if res is None or abs(d) > covered + tol.equal:
                 defects.append(f"{label[k]} lies beyond a limit position: the input stops before "
-                               f"{math.degrees(targets[k].input):.6g} deg")
+                               f"{math.degrees(targets[k].input):.6g} deg{typed(targets[k].input)}")
             elif _locate(design, solver, probe, res, targets[k].input, configs[k]):
                 travel[k] = abs(d)
             else:

@@ -89,6 +89,7 @@ class Design:
     span: tuple | None = None  # (low, high) input values the motion must cover; None: a full turn either way
     notes: tuple = ()
     exact: bool = True  # the targets are met exactly (False: least squares; a miss is not a defect)
+    input_offset: float | None = None  # function generation: the crank's phi as typed at crank_joint = 0 [rad]
 
 
 @dataclass(frozen=True)

@@ -15,16 +15,18 @@ The transmission angle mu is the angle at B between the coupler (B -> A) and the
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
+from ....files.description import TargetSpec
 from ....files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
 from ....model.geometry import circle_circle, cross2, vector_angle
 from ....tolerances import DEFAULT
-from .designs import FourBar
+from .designs import Design, FourBar
 
 __all__ = ["angle", "wrap", "rotate", "pose_matrix", "branch", "tool_local", "positions",
-           "transmission", "travel_analysis", "fourbar_linkage", "crank_angle"]
+           "transmission", "travel_analysis", "fourbar_linkage", "crank_angle", "stored"]
 
 TWO_PI = 2 * math.pi
 
@@ -193,3 +195,19 @@ def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None 
     loop = PlanarLoopJoint("coupler_rocker", "revolute", "coupler", (L["coupler"], 0.0), "rocker", (L["rocker"], 0.0),
                            -tab, -tr)
     return PlanarLinkage(name, tuple(links), tuple(joints), (loop,), ("crank_joint",), comment)
+
+
+def stored(design: Design, labels=None) -> Design:
+    """``design`` with its targets in its file (``<screwkin:targets>``, files.description.TargetSpec),
+    so that ``screwkin draw FILE`` shows them later: a pose or point where it was asked, an angle
+    about the output link's fixed pivot B0; ``labels`` (one per target): how each reads as typed
+    (default the target's label)."""
+    specs = []
+    for k, t in enumerate(design.targets):
+        if t.kind == "angle":
+            xyz, yaw = (float(design.fourbar.B0[0]), float(design.fourbar.B0[1]), 0.0), float(t.value[0])
+        else:
+            xyz, yaw = (float(t.value[0]), float(t.value[1]), 0.0), (float(t.value[2]) if t.kind == "pose" else None)
+        specs.append(TargetSpec(t.kind, design.output_link, design.input_joint, float(t.input), xyz, yaw,
+                                labels[k] if labels else t.label))
+    return replace(design, linkage=replace(design.linkage, targets=tuple(specs)))

@@ -31,7 +31,7 @@ from ....errors import UsageError, quote
 from ....model.geometry import circle_circle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
-from .fourbar import branch, fourbar_linkage, wrap
+from .fourbar import branch, fourbar_linkage, stored, wrap
 
 __all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "FUNCTIONS"]
 
@@ -218,8 +218,10 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
                            f"point {k + 1} (x = {x:.6g})")
                     for k, (x, ph, ps) in enumerate(zip(xs, phi, psi)))
     lo, hi = sorted((p0 - phi[0], p1 - phi[0]))
-    design = Design("function", fb, linkage, targets, "crank_joint", "rocker", (float(lo), float(hi)),
-                    exact=points == 3)
+    labels = [f"x = {x:.5g}: phi {math.degrees(ph):.5g} deg, psi {math.degrees(ps):.5g} deg"  # as typed
+              for x, ph, ps in zip(xs, phi, psi)]
+    design = stored(Design("function", fb, linkage, targets, "crank_joint", "rocker", (float(lo), float(hi)),
+                           exact=points == 3, input_offset=float(phi[0])), labels)
     defects = []
     if not np.all(np.isfinite(gen)):
         defects.append("the linkage does not assemble over the whole input range (a limit position inside it)")

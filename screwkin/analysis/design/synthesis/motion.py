@@ -37,7 +37,7 @@ from ....errors import UsageError
 from ....model.geometry import TINY
 from ....tolerances import DEFAULT
 from .designs import Design, Dyad, FourBar, MotionResult, SynthesisError, Target
-from .fourbar import angle, branch, fourbar_linkage, pose_matrix, travel_analysis, wrap
+from .fourbar import angle, branch, fourbar_linkage, pose_matrix, stored, travel_analysis, wrap
 
 __all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "candidates", "burmester_points",
            "rank_pairs", "motion_design", "fourbar_from_dyads", "scale_of"]
@@ -306,7 +306,8 @@ def motion_design(poses, crank: Dyad, rocker: Dyad, name: str = "synthesized_mot
                f"\nlengths [m]: ground {L['ground']:.9g}, crank {L['crank']:.9g}, coupler {L['coupler']:.9g}, "
                f"rocker {L['rocker']:.9g}.\nDrawn closed at the first pose; actuated: crank_joint.")
     linkage = fourbar_linkage(fb, name, comment, tool="coupler_frame")
-    return Design("motion", fb, linkage, targets_of(poses, crank), "crank_joint", "coupler_frame", None, tuple(notes))
+    return stored(Design("motion", fb, linkage, targets_of(poses, crank), "crank_joint", "coupler_frame", None,
+                         tuple(notes)))
 
 
 def _check_poses(poses):

@@ -28,7 +28,7 @@ from ....errors import UsageError
 from ....model.geometry import circle_circle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar, PathResult, SynthesisError, Target
-from .fourbar import fourbar_linkage, travel_analysis, wrap
+from .fourbar import fourbar_linkage, stored, travel_analysis, wrap
 
 __all__ = ["synthesize_path", "coupler_points"]
 
@@ -191,7 +191,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
     linkage = fourbar_linkage(fb, name, comment, tool="coupler_point")
     targets = tuple(Target("point", (float(px), float(py)), float(t), f"point {k + 1}")
                     for k, ((px, py), t) in enumerate(zip(pts, rel)))
-    design = Design("path", fb, linkage, targets, "crank_joint", "coupler_point", None)
+    design = stored(Design("path", fb, linkage, targets, "crank_joint", "coupler_point", None))
     return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
                       tuple(float(wrap(t)) if abs(t) < math.pi else float(t) for t in rel),
                       tuple(map(float, errors)), starts, len(good), tolerance, design)
