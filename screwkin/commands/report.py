@@ -355,7 +355,9 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()
     motion = sweep_motion(mech, res, named_points(mech, args))  # what sweep shows: links, loop joints, points
-    slider_strokes = strokes(res, motion, mech)
+    # each slider's ends located on the mechanism, with the inputs the search held (as figures does)
+    held = list(mech.actuated) if moved in mech.actuated else [moved]
+    slider_strokes = strokes(res, motion, mech, PositionSolver(mech, held))
     fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
                         title=f"{base}: {moved} over its range")
     what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(

@@ -171,7 +171,7 @@ def run(mech, args) -> int:
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 else None
-    slider_strokes = strokes(res, motion, mech)
+    slider_strokes = strokes(res, motion, mech, solver)
     mus = None
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...errors import UsageError
-from ...model.state import loop_coordinate_cuts
+from ...errors import ScrewkinError, UsageError
+from ...model.state import KinematicState, loop_coordinate_cuts
 from .batch_closure import TreeKinematics, Unbatchable
 from .planar import LinkAngles
 
@@ -225,6 +225,9 @@ def _frame_motions(model, data, frames, Q, V, A):
     return R, t, tw, ac
 
 
+LOCATE_XTOL = 1e-12  # a slider's end is located to this in the input [rad or m] (as singular points are)
+
+
 @dataclass(frozen=True)
 class Stroke:
     """A slider's travel along a motion: ``stroke`` = largest - smallest coordinate [m], the input values
@@ -260,28 +263,63 @@ def _extrema(x, p, dp, tol):
     return out
 
 
-def strokes(res, motion, mech) -> list:
+def _refine(solver, res, name, coordinate, x, guess, tol):
+    """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
+    its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
+    from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""
+    from scipy.optimize import brentq
+
+    k = int(np.clip(np.searchsorted(x, guess[0]) - 1, 0, len(x) - 2))
+    mech, q0, cache = solver.mech, res.q[k], {}
+
+    def at(v):
+        a = solver.track({res.input: v}, q0)
+        qd = solver.rates(a.q, mech.closure.jacobian(a.q), {res.input: 1.0})
+        if coordinate is not None:
+            cache[v] = float(a.q[coordinate.idx_q])
+            return float(qd[coordinate.idx_v])
+        state = KinematicState(mech, a.q, qd)
+        cache[v] = float(state.loop_joints[name])
+        return float(state.loop_rates[name])
+
+    try:
+        lo, hi = float(x[k]), float(x[k + 1])
+        if at(lo) * at(hi) > 0:
+            return guess
+        v = brentq(at, lo, hi, xtol=LOCATE_XTOL * max(1.0, abs(hi)), rtol=4 * np.finfo(float).eps)
+        at(v)
+        return float(v), cache[v]
+    except (ScrewkinError, ValueError, RuntimeError):
+        return guess
+
+
+def strokes(res, motion, mech, solver=None) -> list:
     """A Stroke for each slider coordinate (prismatic tree joint or prismatic loop joint) of a sweep
-    ``res`` (analysis.motion.sweep.SweepResult) with its MotionAlong."""
+    ``res`` (analysis.motion.sweep.SweepResult) with its MotionAlong.  With the sweep's ``solver``
+    (analysis.motion.position.PositionSolver) each end is located on the mechanism (Brent's method on
+    the slider's rate); without, on the cubic interpolant of the samples (O(h^4))."""
     series = []
     for k, name in enumerate(res.names):
         c = next((c for c in mech.coordinates if c.joint == name), None)
         if c is not None and c.nv == 1 and mech.translational[c.idx_v]:
-            series.append((name, res.joints[:, k], res.rates[:, k]))
+            series.append((name, res.joints[:, k], res.rates[:, k], c))
     for name, v in motion.loop_joints.items():
         if name not in motion.angular_loop:
-            series.append((name, v, motion.loop_rates[name]))
+            series.append((name, v, motion.loop_rates[name], None))
     x = np.asarray(res.values, float)
     tol = mech.tolerances
     turned = res.unit == "rad" and res.stopped_at is None and abs(x[-1] - x[0]) >= 2 * np.pi * (1 - tol.equal)
     out = []
-    for name, values, rates in series:
+    for name, values, rates, coordinate in series:
         values, slope = np.asarray(values, float), np.asarray(rates, float) / (res.rate or 1.0)
-        ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + _extrema(x, values, slope, tol)
+        inner = _extrema(x, values, slope, tol)
+        if solver is not None and res.q is not None and len(res.q) == len(x):
+            inner = [_refine(solver, res, name, coordinate, x, e, tol) for e in inner]
+        ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + inner
         lo, hi = min(ends, key=lambda e: e[1]), max(ends, key=lambda e: e[1])
         ratio = angles = None
         if turned:
-            z = [a for a, _ in _extrema(x, values, slope, tol) if a < x[0] + 2 * np.pi * (1 - tol.zero)]  # one turn
+            z = [a for a, _ in inner if a < x[0] + 2 * np.pi * (1 - tol.zero)]  # one turn
             if len(z) == 2:
                 d = abs(z[1] - z[0])
                 mid = int(np.clip(np.searchsorted(x, (z[0] + z[1]) / 2), 0, len(x) - 1))
