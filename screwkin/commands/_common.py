@@ -20,7 +20,7 @@ from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line"]
 
 
@@ -247,6 +247,17 @@ def split_inputs(mech, args) -> tuple:
             values[joint] = value
             pivots[link] = link_angles.pivot(link)
     return values, held, pivots
+
+
+def joint_inputs(mech, args, what: str) -> dict:
+    """inputs() for a command that moves its inputs as joints (an animation, a live page): a usage error
+    naming the links that --set-angle would hold by their angle (not pinned to the ground)."""
+    values, held, _ = split_inputs(mech, args)
+    if held:
+        raise UsageError(f"{mech.path}: {what} moves joint inputs; --set-angle {', '.join(held)} is held by its "
+                         "angle (not pinned to the ground): set joints with --set, or use solve, draw --png, "
+                         "statics or singularities at that configuration")
+    return values
 
 
 def input_solver(mech, values: dict, held: dict, output=None) -> PositionSolver:

@@ -1,0 +1,204 @@
+"""--set-angle LINK=ANGLE of a floating link of a planar mechanism (issue 24, item 4): its absolute
+angle held as one more loop equation.  Every value is checked against a closed form written here
+from the files' own numbers (joint origins, loop-joint places): the link's far end from the crank tip
+along its angle, the remaining dyad by circle intersection."""
+
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+from conftest import DATA, ROBOTS, circles
+
+from screwkin.cli import main
+
+FIVE = ROBOTS / "five_bar.urdf"
+FOUR = ROBOTS / "fourbar_crank_rocker.urdf"
+
+
+def run(capsys, argv):
+    code = main(argv)
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def run_json(capsys, argv):
+    code, out, err = run(capsys, [*argv, "--json"])
+    assert code == 0, err
+    return json.loads(out)
+
+
+def u(angle):
+    return np.array([np.cos(angle), np.sin(angle)])
+
+
+def k_cross(w, r):
+    """w (about +z) x r in the plane."""
+    return w * np.array([-r[1], r[0]])
+
+
+def wrap(x):
+    return (x + np.pi) % (2 * np.pi) - np.pi
+
+
+def origins(path):
+    """Joint origins (x, y) and the loop joint's two places (x, y) in their links' frames, as written
+    (every rpy is 0 and every axis +z in these files, so the link frames are the world's at q = 0)."""
+    root = ET.parse(path).getroot()
+    for el in [*(j.find("origin") for j in root.findall("joint")), *root.find("loop_joint")]:
+        assert el is None or [float(v) for v in el.get("rpy", "0 0 0").split()] == [0, 0, 0]
+    for el in root.iter("axis"):
+        assert el.get("xyz").split() == ["0", "0", "1"]
+
+    def xy(el):
+        return np.array([float(v) for v in el.get("xyz").split()][:2])
+
+    joints = {j.get("name"): xy(j.find("origin")) for j in root.findall("joint") if j.find("origin") is not None}
+    loop = root.find("loop_joint")
+    return joints, xy(loop.find("link1")), xy(loop.find("link2"))
+
+
+def five_bar():
+    joints, p1, p2 = origins(FIVE)
+    O1, O2 = joints["motor1"], joints["motor2"]
+    return O1, O2, np.linalg.norm(joints["elbow1"]), np.linalg.norm(joints["elbow2"]), np.linalg.norm(p1), np.linalg.norm(p2)
+
+
+def centres(sol):
+    """The joint centres of a five-bar solution: (O1, A1, O2, A2, P) from the links' frame origins
+    (each link's frame sits on the joint that carries it; tip's on the loop joint P)."""
+    L = sol["links"]
+    return [np.array(L[n]["position"][:2]) for n in ("proximal1", "distal1", "proximal2", "distal2", "tip")]
+
+
+def match(found, expected, atol=1e-9):
+    """Every solution's joint centres equal one closed-form assembly, each assembly met once."""
+    assert len(found) == len(expected)
+    left = list(expected)
+    for pts in found:
+        k = next((i for i, e in enumerate(left) if all(np.allclose(a, b, atol=atol) for a, b in zip(pts, e))), None)
+        assert k is not None, (pts, left)
+        left.pop(k)
+
+
+@pytest.mark.parametrize("theta1,phi", [(110, -60), (95, -100), (130, -80)])
+def test_five_bar_crank_and_the_floating_link_on_it(capsys, theta1, phi):
+    """Crank 1 at theta1 and distal1 (on crank 1's tip) at phi: P = A1 + b1 u(phi); A2 on circles
+    (O2, a2) and (P, b2)."""
+    O1, O2, a1, a2, b1, b2 = five_bar()
+    t1, ph = np.radians(theta1), np.radians(phi)
+    A1 = O1 + a1 * u(t1)
+    P = A1 + b1 * u(ph)
+    expected = [[O1, A1, O2, A2, P] for A2 in circles(O2, a2, P, b2)]
+    d = run_json(capsys, ["solve", str(FIVE), "--set-angle", f"proximal1={theta1}deg", "--set-angle",
+                          f"distal1={phi}deg"])
+    assert d["held_angles"] == {"distal1": pytest.approx(ph, abs=1e-12)}
+    match([centres(s) for s in d["solutions"]], expected)
+    for s in d["solutions"]:
+        assert abs(wrap(s["link_angles"]["distal1"] - ph)) < 1e-9
+        assert abs(wrap(s["link_angles"]["proximal1"] - t1)) < 1e-9
+
+
+def test_five_bar_floating_link_across_the_loop(capsys):
+    """Crank 1 at theta1 and distal2 (on the other crank) at phi: A2 on circles (O2, a2) and
+    (A1 - b2 u(phi), b1), P = A2 + b2 u(phi)."""
+    O1, O2, a1, a2, b1, b2 = five_bar()
+    t1, ph = np.radians(110), np.radians(-120)
+    A1 = O1 + a1 * u(t1)
+    expected = [[O1, A1, O2, A2, A2 + b2 * u(ph)] for A2 in circles(O2, a2, A1 - b2 * u(ph), b1)]
+    d = run_json(capsys, ["solve", str(FIVE), "--set-angle", "proximal1=110deg", "--set-angle", "distal2=-120deg"])
+    match([centres(s) for s in d["solutions"]], expected)
+    for s in d["solutions"]:
+        assert abs(wrap(s["link_angles"]["distal2"] - ph)) < 1e-9
+
+
+def test_five_bar_rates_of_a_floating_input(capsys):
+    """--rate/--accel of the crank and of the floating link: P's velocity and acceleration are the two
+    rotations' (about O1, then about A1), and each link turns at the rate given."""
+    O1, O2, a1, a2, b1, b2 = five_bar()
+    t1, ph = np.radians(110), np.radians(-60)
+    w1, w, al1, al = 1.5, -2.0, 0.7, 3.0
+    r1, r2 = a1 * u(t1), b1 * u(ph)
+    v = k_cross(w1, r1) + k_cross(w, r2)
+    a = k_cross(al1, r1) - w1**2 * r1 + k_cross(al, r2) - w**2 * r2
+    d = run_json(capsys, ["solve", str(FIVE), "--set-angle", "proximal1=110deg", "--set-angle", "distal1=-60deg",
+                          "--rate", f"proximal1={w1},distal1={w}", "--accel", f"proximal1={al1},distal1={al}"])
+    assert len(d["solutions"]) == 2
+    for s in d["solutions"]:
+        L = s["links"]
+        assert L["proximal1"]["omega"] == pytest.approx(w1, abs=1e-12)
+        assert L["distal1"]["omega"] == pytest.approx(w, abs=1e-9)
+        assert L["distal1"]["alpha"] == pytest.approx(al, abs=1e-9)
+        np.testing.assert_allclose(L["tip"]["velocity"][:2], v, atol=1e-9)
+        np.testing.assert_allclose(L["tip"]["acceleration"][:2], a, atol=1e-9)
+        # the crank's rate is its joint's (motor1 turns +z)
+        assert s["rates"]["motor1"] == pytest.approx(w1, abs=1e-12)
+
+
+def test_five_bar_rates_need_no_rate_flag(capsys):
+    """Without --rate or --accel no rates are reported (as for joint inputs)."""
+    d = run_json(capsys, ["solve", str(FIVE), "--set", "motor1=-10deg", "--set-angle", "distal1=-60deg"])
+    assert all("rates" not in s for s in d["solutions"])
+
+
+@pytest.mark.parametrize("path,phis", [(FOUR, (20, 25)), (DATA / "student" / "fourbar_5796.urdf", (120, -150))])
+def test_four_bar_coupler_angle_as_the_only_input(capsys, path, phis):
+    """The coupler's angle phi instead of the crank's: A = O1 + a u(theta2) and |A + b u(phi) - O2| = c,
+    so A lies on circles (O1, a) and (O2 - b u(phi), c): two crank angles.  The student's file turns on
+    continuous joints (a coordinate pair cos, sin each)."""
+    joints, p1, p2 = origins(path)
+    O1, O2 = joints["crank_joint"], joints["rocker_joint"]
+    a, b, c = np.linalg.norm(joints["coupler_joint"]), np.linalg.norm(p1), np.linalg.norm(p2)
+    for phi in phis:
+        ph = np.radians(phi)
+        cranks = sorted(np.arctan2(*(A - O1)[::-1]) for A in circles(O1, a, O2 - b * u(ph), c))
+        d = run_json(capsys, ["solve", str(path), "--set-angle", f"coupler={phi}deg"])
+        got = sorted(s["link_angles"]["crank"] for s in d["solutions"])
+        np.testing.assert_allclose(got, cranks, atol=1e-9)
+        assert d["input_joints"] == [] and d["free_dofs"] == 0
+        for s in d["solutions"]:
+            assert abs(wrap(s["link_angles"]["coupler"] - ph)) < 1e-9
+        # the text says which angle is the input
+        code, out, _ = run(capsys, ["solve", str(path), "--set-angle", f"coupler={phi}deg"])
+        assert code == 0 and f"angle of coupler = {ph:.9g} rad" in out
+
+
+def test_configuration_commands_take_a_floating_angle(capsys, tmp_path):
+    """statics, singularities, export and draw analyse the configuration the angle gives (the same
+    joint values as solve's first mode)."""
+    args = ["--set-angle", "proximal1=110deg", "--set-angle", "distal1=-60deg"]
+    first = run_json(capsys, ["solve", str(FIVE), *args])["solutions"][0]["joints"]
+    sing = run_json(capsys, ["singularities", str(FIVE), *args])
+    assert sing["mode"] == {"index": 1, "of": 2}
+    code, out, err = run(capsys, ["export", str(FIVE), *args, "--urdf", str(tmp_path / "x.urdf")])
+    assert code == 0
+    for name, value in first.items():
+        assert f"{name} = {value:.6g}" in out
+    code, _, err = run(capsys, ["draw", str(FIVE), *args, "--png", str(tmp_path / "x.png")])
+    assert code == 0 and (tmp_path / "x.png").stat().st_size > 0
+    assert run_json(capsys, ["statics", str(FIVE), *args])["mode"] == {"index": 1, "of": 2}
+
+
+@pytest.mark.parametrize("argv,code,words", [
+    ([str(FIVE), "--set-angle", "ground=10deg"], 2, ["'ground' is the ground"]),
+    ([str(FIVE), "--set-angle", "nolink=10deg"], 2, ["no moving link named 'nolink'"]),
+    ([str(FIVE), "--set-angle", "distal1=3mm"], 2, ["unit of length"]),
+    ([str(FOUR), "--set", "crank_joint=30deg", "--set-angle", "coupler=20deg"], 2,
+     ["angle of 'coupler' is fixed by the other inputs (crank_joint)"]),
+    ([str(FIVE), "--set-angle", "proximal1=110deg", "--set-angle", "distal1=10deg", "--set-angle",
+      "distal2=10deg"], 2, ["angle of 'distal2' is fixed by the other inputs (motor1, distal1)"]),
+    ([str(ROBOTS / "rssr.urdf"), "--set-angle", "crank=10deg"], 2, ["planar"]),
+    ([str(FOUR), "--set-angle", "coupler=10deg"], 1, ["the angle of coupler cannot be reached"]),
+])
+def test_errors(capsys, argv, code, words):
+    got, out, err = run(capsys, ["solve", *argv])
+    assert got == code
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    for w in words:
+        assert w in err
+
+
+def test_animation_refuses_a_held_angle(capsys, tmp_path):
+    got, _, err = run(capsys, ["draw", str(FIVE), "--set-angle", "distal1=-60deg", "--animate",
+                               str(tmp_path / "a.gif"), "--from", "0", "--to", "1"])
+    assert got == 2 and "held by its angle" in err
