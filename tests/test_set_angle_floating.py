@@ -198,7 +198,15 @@ def test_errors(capsys, argv, code, words):
         assert w in err
 
 
-def test_animation_refuses_a_held_angle(capsys, tmp_path):
-    got, _, err = run(capsys, ["draw", str(FIVE), "--set-angle", "distal1=-60deg", "--animate",
-                               str(tmp_path / "a.gif"), "--from", "0", "--to", "1"])
-    assert got == 2 and "held by its angle" in err
+@pytest.mark.parametrize("argv", [["draw", "--animate", "a.gif", "--from", "0", "--to", "1"], ["report", "--md", "r.md"]])
+def test_commands_moving_joint_inputs_refuse_a_held_angle(capsys, tmp_path, argv):
+    """draw --animate and report move joint inputs: a held angle is refused in one line, not dropped."""
+    argv = [str(tmp_path / a) if a.endswith((".gif", ".md")) else a for a in argv]
+    got, _, err = run(capsys, [argv[0], str(FIVE), *argv[1:], "--set-angle", "distal1=-60deg"])
+    assert got == 2 and "held by its angle" in err and len(err.strip().splitlines()) == 1
+    assert not any(tmp_path.iterdir())
+
+
+def test_equations_say_the_held_angle_is_an_unknown(capsys):
+    got, out, err = run(capsys, ["equations", str(FOUR), "--set-angle", "coupler=20deg"])
+    assert got == 0 and "the angle of coupler given with --set-angle places the configuration" in err
