@@ -189,6 +189,10 @@ def test_configuration_commands_take_a_floating_angle(capsys, tmp_path):
       "distal2=10deg"], 2, ["angle of 'distal2' is fixed by the other inputs (motor1, distal1)"]),
     ([str(ROBOTS / "rssr.urdf"), "--set-angle", "crank=10deg"], 2, ["planar"]),
     ([str(FOUR), "--set-angle", "coupler=10deg"], 1, ["the angle of coupler cannot be reached"]),
+    ([str(FIVE), "--set-angle", "proximal1=110deg", "--set-angle", "distal1=-60deg", "--rate", "distal2=1"], 2,
+     ["--rate distal2: not an input"]),
+    ([str(FIVE), "--set-angle", "distal1=-60deg", "--set", "motor1=10deg", "--rate", "distal1=3mm/s"], 2,
+     ["'distal1' is a link given by its angle, mm/s is a unit of linear rate"]),
 ])
 def test_errors(capsys, argv, code, words):
     got, out, err = run(capsys, ["solve", *argv])

@@ -158,10 +158,13 @@ _WHAT = {0: "value", 1: "rate", 2: "acceleration"}
 
 
 def _checked(mech, name, value, unit, option, text, order=0, links=()):
-    kind = value_kind(mech, name) or ("angle" if name in links else None)
+    kind = value_kind(mech, name)
+    what = f"{'an' if kind == 'angle' else 'a'} {kind} joint"
+    if kind is None and name in links:
+        kind, what = "angle", "a link given by its angle"
     found = unit_kind(unit)
     if kind and found and found not in _KINDS[kind, order]:
-        raise UsageError(f"{option} {text}: {quote(name)} is {'an' if kind == 'angle' else 'a'} {kind} joint, "
+        raise UsageError(f"{option} {text}: {quote(name)} is {what}, "
                          f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
     if kind == "angle" and not unit and not order and abs(value) > 2 * math.pi:
         print(f"warning: {option} {shorten(name, 60)}={value:g} is read as {value:g} rad = "

@@ -64,6 +64,10 @@ def run(mech, args) -> int:
     rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
     accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None
     rates, accels = link_rates(rates, pivots, "--rate"), link_rates(accels, pivots, "--accel")
+    for given, option in ((rates, "--rate"), (accels, "--accel")):
+        stray = [n for n in (given or {}) if n not in values and n not in held]
+        if stray and (held or pivots):  # a link's rate goes with its --set-angle; a name not an input would be lost
+            raise UsageError(f"{option} {', '.join(stray)}: not an input (inputs: {', '.join([*values, *held])})")
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
