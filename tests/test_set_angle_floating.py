@@ -7,9 +7,13 @@ import json
 import xml.etree.ElementTree as ET
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import DATA, ROBOTS, circles
 
+import screwkin
+from screwkin.analysis.motion.link_inputs import holding_angles
+from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
 
 FIVE = ROBOTS / "five_bar.urdf"
@@ -214,3 +218,46 @@ def test_commands_moving_joint_inputs_refuse_a_held_angle(capsys, tmp_path, argv
 def test_equations_say_the_held_angle_is_an_unknown(capsys):
     got, out, err = run(capsys, ["equations", str(FOUR), "--set-angle", "coupler=20deg"])
     assert got == 0 and "the angle of coupler given with --set-angle places the configuration" in err
+
+
+def test_holding_an_angle_leaves_the_mechanism_as_it_was():
+    """The angle row lives on a copy (Mechanism.with_rows): the mechanism's own closure, rows and solves
+    are the same after."""
+    mech = screwkin.load(str(FIVE))
+    values = {"motor1": np.radians(-10), "motor2": np.radians(20)}
+    before = [s.q for s in PositionSolver(mech, list(values)).solve(values).solutions]
+    rows, closure = mech.closure.nrows, mech.closure
+    held = holding_angles(mech, ["motor1"], {"distal1": np.radians(-60)})
+    assert held.closure.nrows == rows + 1 and held.closure.row_inputs == ("distal1",)
+    PositionSolver(held, ["motor1"]).solve({"motor1": np.radians(-10)})
+    assert mech.closure is closure and mech.closure.nrows == rows and mech.extra_rows == []
+    after = [s.q for s in PositionSolver(mech, list(values)).solve(values).solutions]
+    np.testing.assert_allclose(np.array(after), np.array(before), atol=1e-12)
+
+
+def test_the_angle_row_against_forward_kinematics():
+    """The row's residual is distal1's angle (A1 -> P, from Pinocchio's placements here) minus the value
+    held, modulo a turn, and its Jacobian row is that angle's finite difference (on the manifold)."""
+    mech = screwkin.load(str(FIVE))
+    phi = np.radians(-60)
+    held = holding_angles(mech, ["motor1"], {"distal1": phi})
+    model, data = mech.model, mech.model.createData()
+    elbow, end = model.getJointId("elbow1"), next(c.frame1 for c in mech.cuts if c.name == "end_joint")
+
+    def angle(q):
+        pin.framesForwardKinematics(model, data, q)
+        d = data.oMf[end].translation - data.oMi[elbow].translation
+        return np.arctan2(d[1], d[0])
+
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = rng.uniform(-3, 3, model.nq)
+        r = held.closure.residual(q)[-1]
+        assert r == pytest.approx(wrap(angle(q) - phi), abs=1e-12)
+        turned = pin.integrate(model, q, 2 * np.pi * np.eye(model.nv)[1])  # elbow1 a whole turn on
+        assert held.closure.residual(turned)[-1] == pytest.approx(r, abs=1e-9)
+        J = held.closure.jacobian(q)[-1]
+        h = 1e-6
+        fd = [wrap(angle(pin.integrate(model, q, h * e)) - angle(pin.integrate(model, q, -h * e))) / (2 * h)
+              for e in np.eye(model.nv)]
+        np.testing.assert_allclose(J, fd, atol=1e-7)
