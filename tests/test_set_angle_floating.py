@@ -186,6 +186,7 @@ def test_configuration_commands_take_a_floating_angle(capsys, tmp_path):
 @pytest.mark.parametrize("argv,code,words", [
     ([str(FIVE), "--set-angle", "ground=10deg"], 2, ["'ground' is the ground"]),
     ([str(FIVE), "--set-angle", "nolink=10deg"], 2, ["no moving link named 'nolink'"]),
+    ([str(FIVE), "--set-angle", "tip=10deg"], 2, ["'tip' is fixed to 'distal1'"]),
     ([str(FIVE), "--set-angle", "distal1=3mm"], 2, ["unit of length"]),
     ([str(FOUR), "--set", "crank_joint=30deg", "--set-angle", "coupler=20deg"], 2,
      ["angle of 'coupler' is fixed by the other inputs (crank_joint)"]),

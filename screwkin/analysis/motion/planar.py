@@ -395,6 +395,17 @@ class LinkAngles:
         if link == self.ground:
             raise UsageError(f"{self.mech.path}: '{link}' is the ground: its angle is fixed (links: {', '.join(moving)})")
         if link not in self.links:
+            try:
+                jid = self.mech.model.frames[self.mech.link_frame(link)].parentJoint
+            except UsageError:
+                jid = None
+            if jid == 0:
+                raise UsageError(f"{self.mech.path}: '{link}' is fixed to the ground: its angle is fixed")
+            body = next((k for k, (start, _, _) in self.links.items()
+                         if k != self.ground and start == ("joint", jid)), None)
+            if body is not None:
+                raise UsageError(f"{self.mech.path}: '{link}' is fixed to '{body}' (its angle is that link's plus a "
+                                 f"constant): give '{body}'")
             raise UsageError(f"{self.mech.path}: no moving link named '{link}' (links: {', '.join(moving)})")
 
     def pivoted(self, link: str) -> bool:
