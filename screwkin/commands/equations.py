@@ -22,7 +22,7 @@ from ..present.equations import (
 )
 from ..present.report import position_dict, position_text, to_jsonable
 from ..units import UNITS, parse_typed_assignments
-from ._common import add_configuration_options, configuration, inputs, split_inputs, with_mode
+from ._common import add_configuration_options, configuration, split_inputs, with_mode
 
 NAME = "equations"
 NEEDS_MECHANISM = True
@@ -42,21 +42,19 @@ def add_parser(sub, common, scaled):
 
 
 def _input_names(mech, args):
+    """The input joints: --input, else those set (--set, --set-angle of a link pinned to the ground),
+    else -- unless a floating link's angle is given (it is an input of its own) -- the actuated ones."""
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     if names:
         return names
-    return list(inputs(mech, args)) or list(mech.actuated)
+    values, held, _ = split_inputs(mech, args)
+    return list(values) or ([] if held else list(mech.actuated))
 
 
 def run(mech, args) -> int:
     names = _input_names(mech, args)
     q = configuration(mech, args)
-    held = split_inputs(mech, args)[1]
-    if held:  # the equations' inputs are joints: say that the held angle is written as an unknown
-        print(f"note: the equations take joint inputs ({', '.join(names) or 'none'}); the angle of "
-              f"{', '.join(held)} given with --set-angle places the configuration and is one of their unknowns",
-              file=sys.stderr)
-    res = equations(mech, q, names, output=args.output)
+    res = equations(mech, q, names, output=args.output, links=list(split_inputs(mech, args)[1]))
     if args.json:
         print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
     else:
