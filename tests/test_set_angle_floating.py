@@ -292,3 +292,26 @@ def test_the_angle_row_against_forward_kinematics():
         fd = [wrap(angle(pin.integrate(model, q, h * e)) - angle(pin.integrate(model, q, -h * e))) / (2 * h)
               for e in np.eye(model.nv)]
         np.testing.assert_allclose(J, fd, atol=1e-7)
+
+
+def test_newton_from_estimates_with_the_coupler_angle_known(capsys):
+    """solve --start with the coupler's angle given: one step of Newton on the loop equations
+    F = (-d + a cos t2 + b cos phi - c cos t4, a sin t2 + b sin phi - c sin t4), written here, and the
+    converged crank angle is the closed form's."""
+    joints, p1, p2 = origins(FOUR)
+    O1, O2 = joints["crank_joint"], joints["rocker_joint"]
+    a, b, c, d = (np.linalg.norm(joints["coupler_joint"]), np.linalg.norm(p1), np.linalg.norm(p2),
+                  np.linalg.norm(O2 - O1))
+    ph, t2, t4 = np.radians([20, 40, 60])
+    F = np.array([-d + a * np.cos(t2) + b * np.cos(ph) - c * np.cos(t4), a * np.sin(t2) + b * np.sin(ph) - c * np.sin(t4)])
+    A = np.array([[-a * np.sin(t2), c * np.sin(t4)], [a * np.cos(t2), -c * np.cos(t4)]])
+    step = np.linalg.solve(A, -F)
+    args = ["solve", str(FOUR), "--set-angle", "coupler=20deg", "--start", "theta2=40deg,theta4=60deg"]
+    one = run_json(capsys, [*args, "--iterations", "1"])
+    assert one["inputs"] == {"theta3": pytest.approx(ph, abs=1e-15)}
+    np.testing.assert_allclose([one["values"]["theta2"], one["values"]["theta4"]], [t2, t4] + step, atol=1e-12)
+    done = run_json(capsys, args)
+    crank = done["solutions"][0]["link_angles"]["crank"]
+    closed = [np.arctan2(*(X - O1)[::-1]) for X in circles(O1, a, O2 - b * u(ph), c)]
+    assert min(abs(wrap(crank - x)) for x in closed) < 1e-9
+    assert done["held_angles"] == {"coupler": pytest.approx(ph, abs=1e-12)}

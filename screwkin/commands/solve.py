@@ -71,10 +71,7 @@ def run(mech, args) -> int:
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
-        if held:
-            raise UsageError(f"--start: the textbook Newton takes joint inputs (or links pinned to the ground); "
-                             f"{', '.join(held)} is held by its angle: leave out --start")
-        return equations_command.solve_from_start(mech, args, values)
+        return equations_command.solve_from_start(mech, args, values, held)
     solver = input_solver(mech, values, held, output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
                        points=named_points(mech, args))
