@@ -64,7 +64,6 @@ class ClosureSystem:
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         self._owner = threading.get_ident()
         self._position_rows = None
-        self._unbounded = None  # q indices of continuous joints (cos, sin), for the rows of angles
 
     # ------------------------------------------------------------------ per-thread workspace
     def _workspace(self):
@@ -318,11 +317,7 @@ class ClosureSystem:
         """The rows of the higher pairs (CouplingRow, ContactRow) from row i on."""
         for k, e in enumerate(self.extra, i):
             if isinstance(e, CouplingRow):
-                if e.kind == "angle":  # the joints' angles (a continuous joint's from its cos, sin), modulo a turn
-                    total = sum(c * self._angle(q, iq) for iq, _, c in e.terms) + e.constant
-                    r[k] = np.mod(total + np.pi, 2 * np.pi) - np.pi
-                else:
-                    r[k] = sum(c * q[iq] for iq, _, c in e.terms) + e.constant
+                r[k] = e.value(q)
                 if K is not None:
                     K[k] = 0.0
                     for _, iv, c in e.terms:
@@ -332,14 +327,6 @@ class ClosureSystem:
             r[k] = value
             if K is not None:
                 K[k] = grad
-
-    def _angle(self, q, iq) -> float:
-        """The angle of the one-coordinate revolute joint whose configuration starts at q index iq [rad]:
-        its coordinate, or atan2(sin, cos) of a continuous joint's two."""
-        if self._unbounded is None:
-            m = self.model
-            self._unbounded = {m.idx_qs[j] for j in range(1, m.njoints) if m.nqs[j] == 2 and m.nvs[j] == 1}
-        return float(np.arctan2(q[iq + 1], q[iq])) if iq in self._unbounded else float(q[iq])
 
     def _contact(self, e, jacobian):
         """(value, Jacobian row or None) of a ContactRow at the placements in self.data."""
@@ -501,15 +488,12 @@ class ClosureSystem:
         return labels
 
     def row_rates(self, values: dict) -> np.ndarray:
-        """The time derivative each minimal row is held at: a row held by an input (CouplingRow.input)
-        moves at the rate (or acceleration) ``values`` gives that input, 0 when none is given; every
-        other row is 0.  K q' = row_rates(rates), K q'' + K'q' = row_rates(accelerations)."""
+        """What each minimal row's time derivative is held at: the rate (or acceleration) ``values`` gives
+        the input a row holds (CouplingRow.input; 0 when not given), else 0.  K q' = row_rates(rates)."""
         out = np.zeros(self.nrows)
-        first = self.nrows - len(self.extra)
-        for k, e in enumerate(self.extra, first):
-            name = getattr(e, "input", None)
-            if name is not None:
-                out[k] = float(values.get(name, 0.0))
+        for k, e in enumerate(self.extra, self.nrows - len(self.extra)):
+            if getattr(e, "input", None) is not None:
+                out[k] = float(values.get(e.input, 0.0))
         return out
 
     @property

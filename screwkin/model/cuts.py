@@ -53,6 +53,15 @@ class CouplingRow:
     terms: tuple  # ((q index, v index, coefficient), ...)
     constant: float = 0.0
     input: str | None = None
+    pairs: frozenset = frozenset()  # q indices of continuous joints (cos, sin) in an angle row's terms
+
+    def value(self, q) -> float:
+        """The row's residual at q: sum c_k q_k + c0, or for an angle row the joints' angles (a
+        continuous joint's atan2(sin, cos)) so summed, taken into (-pi, pi]."""
+        if self.kind != "angle":
+            return sum(c * q[iq] for iq, _, c in self.terms) + self.constant
+        total = sum(c * (np.arctan2(q[iq + 1], q[iq]) if iq in self.pairs else q[iq]) for iq, _, c in self.terms)
+        return float(np.mod(total + self.constant + np.pi, 2 * np.pi) - np.pi)
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,8 @@ planar.LinkAngles measures it (the line between joint centres, so that the value
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pinocchio as pin
 
@@ -54,17 +56,15 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
     if not terms:
         raise UsageError(f"{mech.path}: the angle of '{link}' is fixed (no revolute joint between it and the "
                          f"ground: {', '.join(reversed(path)) or 'none'})")
-    theta0 = angles(q0)[link] - sum(c * _angle(model, q0, iq) for iq, _, c in terms)
-    return CouplingRow(f"angle of {link}", "angle", tuple(terms), float(theta0 - angle), input=link)
+    pairs = frozenset(iq for iq, _, _ in terms if model.nqs[_joint_at(model, iq)] == 2)  # continuous joints
+    path_sum = CouplingRow(f"angle of {link}", "angle", tuple(terms), 0.0, input=link, pairs=pairs)
+    theta0 = angles(q0)[link] - path_sum.value(q0)  # the link's angle at q0 less its joints' sum there
+    return replace(path_sum, constant=float(theta0 - angle))
 
 
-def _angle(model, q, iq) -> float:
-    """A one-coordinate revolute joint's angle from its configuration at q index iq (a continuous
-    joint's cos, sin)."""
-    for j in range(1, model.njoints):
-        if model.idx_qs[j] == iq and model.nqs[j] == 2:
-            return float(np.arctan2(q[iq + 1], q[iq]))
-    return float(q[iq])
+def _joint_at(model, iq) -> int:
+    """The joint whose configuration starts at q index iq."""
+    return next(j for j in range(1, model.njoints) if model.idx_qs[j] == iq)
 
 
 def holding_angles(mech, joints, angles: dict):
