@@ -315,3 +315,10 @@ def test_newton_from_estimates_with_the_coupler_angle_known(capsys):
     closed = [np.arctan2(*(X - O1)[::-1]) for X in circles(O1, a, O2 - b * u(ph), c)]
     assert min(abs(wrap(crank - x)) for x in closed) < 1e-9
     assert done["held_angles"] == {"coupler": pytest.approx(ph, abs=1e-12)}
+
+
+def test_a_bare_angle_beyond_a_turn_warns(capsys):
+    """--set-angle distal1=30 is 30 rad: read so (the same row as 30 - 10 pi rad), with a warning."""
+    code, out, err = run(capsys, ["solve", str(FIVE), "--set-angle", "proximal1=110deg", "--set-angle", "distal1=30"])
+    assert "distal1=30 is read as 30 rad = 1718.87 deg" in err
+    assert code == 0 and f"angle of distal1 = {wrap(30.0):.9g} rad" in out

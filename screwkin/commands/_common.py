@@ -236,6 +236,9 @@ def split_inputs(mech, args) -> tuple:
     for name, value, unit in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
         if unit_kind(unit) not in (None, "angle"):
             raise UsageError(f"--set-angle {quote(name)}: {unit} is a unit of {unit_kind(unit)}, --set-angle takes an angle")
+        if not unit and abs(value) > 2 * math.pi:  # as a joint's bare angle (_checked)
+            print(f"warning: --set-angle {shorten(name, 60)}={value:g} is read as {value:g} rad = "
+                  f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
         angles[name] = value
     if angles:
         q = mech.generic_configurations()[1][0]
