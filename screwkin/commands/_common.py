@@ -10,6 +10,7 @@ import sys
 import numpy as np
 import pinocchio as pin
 
+from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.links import Point
 from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
@@ -19,7 +20,7 @@ from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line"]
 
 
@@ -156,11 +157,14 @@ _KINDS = {("angle", 0): ("angle",), ("angle", 1): ("angle", "angular rate"),
 _WHAT = {0: "value", 1: "rate", 2: "acceleration"}
 
 
-def _checked(mech, name, value, unit, option, text, order=0):
+def _checked(mech, name, value, unit, option, text, order=0, links=()):
     kind = value_kind(mech, name)
+    what = f"{'an' if kind == 'angle' else 'a'} {kind} joint"
+    if kind is None and name in links:
+        kind, what = "angle", "a link given by its angle"
     found = unit_kind(unit)
     if kind and found and found not in _KINDS[kind, order]:
-        raise UsageError(f"{option} {text}: {quote(name)} is {'an' if kind == 'angle' else 'a'} {kind} joint, "
+        raise UsageError(f"{option} {text}: {quote(name)} is {what}, "
                          f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
     if kind == "angle" and not unit and not order and abs(value) > 2 * math.pi:
         print(f"warning: {option} {shorten(name, 60)}={value:g} is read as {value:g} rad = "
@@ -168,11 +172,12 @@ def _checked(mech, name, value, unit, option, text, order=0):
     return value
 
 
-def joint_assignments(mech, items, option: str, order: int = 0) -> dict:
+def joint_assignments(mech, items, option: str, order: int = 0, links=()) -> dict:
     """``NAME=VALUE,...`` of joints (order 0), their rates (1) or accelerations (2): SI values; a unit
     of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error, a
-    bare angle of more than a turn is read as radians with a warning."""
-    return {name: _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", order)
+    bare angle of more than a turn is read as radians with a warning.  ``links``: names that are links
+    given by their angle (--set-angle), checked as angles."""
+    return {name: _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", order, links)
             for name, value, unit in parse_typed_assignments(items, option)}
 
 
@@ -186,8 +191,9 @@ def joint_value(mech, joint: str, text: str, option: str, order: int = 0) -> flo
 def add_angle_option(sp):
     """--set-angle: an input as a link's absolute angle (planar mechanisms)."""
     sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE",
-                    help="planar mechanisms: an input given as the absolute angle of a link pinned to the "
-                         "ground, from the ground's x axis (e.g. crank=45deg)")
+                    help="planar mechanisms: an input given as the absolute angle of a link, from the ground's "
+                         "x axis (e.g. crank=45deg): a link pinned to the ground sets its joint, any other "
+                         "link's angle is held by one more loop equation; its rate is --rate LINK=...")
 
 
 def add_length_option(sp):
@@ -208,8 +214,17 @@ def add_configuration_options(sp):
 
 
 def inputs(mech, args) -> dict:
-    """Input values from --set (joint values) and --set-angle (absolute link angles)."""
+    """Input joint values from --set, --set-length and --set-angle of links pinned to the ground
+    (split_inputs; the links held at an angle are left out)."""
+    return split_inputs(mech, args)[0]
 
+
+def split_inputs(mech, args) -> tuple:
+    """(joint values, held angles, pivots) from the options: --set and --set-length as joint values
+    [rad or m]; --set-angle LINK=ANGLE of a link pinned to the ground by a revolute as that joint's
+    value (``pivots``: link -> (joint, sign), its angular velocity sign * the joint's rate), of any
+    other moving link of a planar mechanism as ``held``: link -> angle [rad], held by one more loop
+    equation (analysis.motion.link_inputs; input_solver builds the solver)."""
     values = joint_assignments(mech, getattr(args, "set", None), "--set")
     for name, value, unit in parse_typed_assignments(getattr(args, "set_length", None), "--set-length"):
         if unit_kind(unit) not in (None, "length"):
@@ -217,20 +232,60 @@ def inputs(mech, args) -> dict:
         if name in values:
             raise UsageError(f"joint {quote(name)} is given twice (--set and --set-length)")
         values[name] = value_for_leg_length(mech, name, value)
-    angles = {}
+    angles, held, pivots = {}, {}, {}
     for name, value, unit in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
-        if unit_kind(unit) == "length":
-            raise UsageError(f"--set-angle {quote(name)}: {unit} is a unit of length, --set-angle takes an angle")
+        if unit_kind(unit) not in (None, "angle"):
+            raise UsageError(f"--set-angle {quote(name)}: {unit} is a unit of {unit_kind(unit)}, --set-angle takes an angle")
+        if not unit and abs(value) > 2 * math.pi:  # as a joint's bare angle (_checked)
+            print(f"warning: --set-angle {shorten(name, 60)}={value:g} is read as {value:g} rad = "
+                  f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
         angles[name] = value
     if angles:
         q = mech.generic_configurations()[1][0]
         link_angles = LinkAngles(mech, mech.topology(q))
         for link, angle in angles.items():
+            if not link_angles.pivoted(link):
+                held[link] = angle
+                continue
             joint, value = link_angles.joint_value(link, angle)
             if joint in values:
                 raise UsageError(f"joint '{joint}' is given twice (--set and --set-angle {link})")
             values[joint] = value
+            pivots[link] = link_angles.pivot(link)
+    return values, held, pivots
+
+
+def joint_inputs(mech, args, what: str) -> dict:
+    """inputs() for a command that moves its inputs as joints (an animation, a live page): a usage error
+    naming the links that --set-angle would hold by their angle (not pinned to the ground)."""
+    values, held, _ = split_inputs(mech, args)
+    if held:
+        raise UsageError(f"{mech.path}: {what} moves joint inputs; --set-angle {', '.join(held)} is held by its "
+                         "angle (not pinned to the ground): set joints with --set, or use solve, draw --png, "
+                         "statics or singularities at that configuration")
     return values
+
+
+def input_solver(mech, values: dict, held: dict, output=None) -> PositionSolver:
+    """The PositionSolver of these input joints (split_inputs), with the ``held`` links' angles held by
+    their loop equations (a copy of the mechanism: analysis.motion.link_inputs.holding_angles)."""
+    if held:
+        return PositionSolver(holding_angles(mech, list(values), held), list(values), output=output)
+    return PositionSolver(mech, list(values), output=output)
+
+
+def link_rates(rates: dict | None, pivots: dict, option: str) -> dict | None:
+    """--rate/--accel values with the links pinned to the ground (split_inputs' pivots) given as their
+    joints' (sign * the link's); the held links keep their names (the solver reads them)."""
+    if rates is None:
+        return None
+    out = dict(rates)
+    for link, (joint, sign) in pivots.items():
+        if link in out:
+            if joint in out:
+                raise UsageError(f"{option}: '{joint}' is given twice ({joint} and the link {link} on it)")
+            out[joint] = sign * out.pop(link)
+    return out
 
 
 def configuration(mech, args):
@@ -238,16 +293,16 @@ def configuration(mech, args):
     first: the one nearest the file's or --near's), else the assembled file one.  When there are several
     modes, a line on stderr says which one is analysed and how to get the others, and ``args.mode_chosen``
     holds {"index": K, "of": N} for the JSON (commands add it as "mode")."""
-    values = inputs(mech, args)
+    values, held, _ = split_inputs(mech, args)
     near = joint_assignments(mech, [args.near], "--near") if getattr(args, "near", None) else None
     wanted = getattr(args, "mode", None)
     args.mode_chosen = None
-    if not values:
+    if not values and not held:
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
                              "choose among the modes of those inputs")
         return mech.generic_configurations()[0].q
-    res = PositionSolver(mech, list(values)).solve(values, near=near)
+    res = input_solver(mech, values, held).solve(values, near=near)
     for note in res.notes:  # a --near value the mode found lies far from
         print(f"note: {note}", file=sys.stderr)
     n = len(res.solutions)

@@ -35,6 +35,7 @@ from ._common import (
     configuration,
     inputs,
     joint_assignments,
+    joint_inputs,
     joint_value,
     named_points,
     with_mode,
@@ -312,7 +313,7 @@ def _animate(mech, args) -> int:
     if mech.spec.targets and not args.json:
         print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
               "(draw --png/--svg), not in the animation")
-    given = inputs(mech, args)
+    given = joint_inputs(mech, args, "draw --animate")
     name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
     if name is None:
         raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")

@@ -10,7 +10,6 @@ import sys
 import numpy as np
 
 from ..analysis.course.equations import VectorLoops, equations, newton
-from ..analysis.motion.position import PositionSolver
 from ..errors import AssemblyError, UsageError
 from ..present.equations import (
     Units,
@@ -22,7 +21,7 @@ from ..present.equations import (
 )
 from ..present.report import position_dict, position_text, to_jsonable
 from ..units import UNITS, parse_typed_assignments
-from ._common import add_configuration_options, configuration, inputs, with_mode
+from ._common import add_configuration_options, configuration, input_solver, split_inputs, with_mode
 
 NAME = "equations"
 NEEDS_MECHANISM = True
@@ -42,16 +41,19 @@ def add_parser(sub, common, scaled):
 
 
 def _input_names(mech, args):
+    """The input joints: --input, else those set (--set, --set-angle of a link pinned to the ground),
+    else -- unless a floating link's angle is given (it is an input of its own) -- the actuated ones."""
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     if names:
         return names
-    return list(inputs(mech, args)) or list(mech.actuated)
+    values, held, _ = split_inputs(mech, args)
+    return list(values) or ([] if held else list(mech.actuated))
 
 
 def run(mech, args) -> int:
     names = _input_names(mech, args)
     q = configuration(mech, args)
-    res = equations(mech, q, names, output=args.output)
+    res = equations(mech, q, names, output=args.output, links=list(split_inputs(mech, args)[1]))
     if args.json:
         print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
     else:
@@ -151,21 +153,23 @@ def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
     return pres, got, far
 
 
-def solve_from_start(mech, args, values) -> int:
-    """``solve --start ...``: Newton on the loop equations from the estimates typed."""
+def solve_from_start(mech, args, values, held=None) -> int:
+    """``solve --start ...``: Newton on the loop equations from the estimates typed.  ``held``: links
+    whose absolute angle is given (--set-angle of a floating link) -> angle [rad], known in the equations."""
+    held = dict(held or {})
     if args.iterations is not None and args.iterations < 1:
         raise UsageError("--iterations must be 1 or more")
     if not args.start:
         raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
     q_ref = mech.generic_configurations()[0].q
-    loops = VectorLoops(mech, q_ref, list(values))
-    solver = PositionSolver(mech, list(values))
+    loops = VectorLoops(mech, q_ref, list(values), links=list(held))
+    solver = input_solver(mech, values, held)
     q_in = solver.set_inputs(q_ref, values)
     typed = _typed(args.start, "--start")
-    start, units = start_estimates(mech, loops, solver, q_in, values, typed)
+    start, units = start_estimates(mech, loops, solver, q_in, {**values, **held}, typed)
     input_values = loops.values(q_in)
-    held = {n: input_values[n] for n in loops.input_syms}
-    res = newton(loops, held, start, args.iterations)
+    given = {n: held.get(loops.input_joints[n][0], input_values[n]) for n in loops.input_syms}
+    res = newton(loops, given, start, args.iterations)
 
     typed_units = [u.lower() for _, _, u in typed + _typed(args.set, "--set") + _typed(args.set_angle, "--set-angle")]
     degrees = any(u in _ANGLE_UNITS for u in typed_units)
@@ -184,7 +188,7 @@ def solve_from_start(mech, args, values) -> int:
                                        + (f": {res.stopped}" if res.stopped else ""))
         return 0
     # converged: the configuration it reached, closed and reported as solve reports it
-    q = loops.configuration({**held, **res.values})
+    q = loops.configuration({**given, **res.values})
     pres, got, far = _solved_near(mech, loops, solver, values, q, res, args.starts)
     if far and loops.pairs:  # the solver turns a pair's virtual joints on by the input's whole turns: near without them
         virtual = {n for names in mech.virtual_joints.values() for n in names}

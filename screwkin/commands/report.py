@@ -57,8 +57,8 @@ from ..units import parse_typed_assignments, parse_value, unit_kind
 from ._common import (
     add_configuration_options,
     add_point_option,
-    inputs,
     joint_assignments,
+    joint_inputs,
     named_points,
     rate_units,
     value_kind,
@@ -145,7 +145,7 @@ def run(mech, args) -> int:
         raise UsageError(f"{mech.path}: --steps must be at least 4")
     if args.iterations is not None and args.iterations < 1:
         raise UsageError("--iterations must be 1 or more")
-    given = inputs(mech, args)
+    given = joint_inputs(mech, args, "report (its equations, Newton steps and sweep)")
     names = _input_names(mech, args, given)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
     q0 = mech.generic_configurations()[0].q

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError
 from ..present.report import (
     position_dict,
@@ -17,10 +16,12 @@ from ._common import (
     add_angle_option,
     add_length_option,
     add_point_option,
-    inputs,
+    input_solver,
     joint_assignments,
+    link_rates,
     named_points,
     rate_units,
+    split_inputs,
 )
 from ._options import count
 
@@ -56,17 +57,22 @@ def add_parser(sub, common, scaled):
 
 
 def run(mech, args) -> int:
-    values = inputs(mech, args)
-    if not values:
+    values, held, pivots = split_inputs(mech, args)
+    if not values and not held:
         raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
-    rates = joint_assignments(mech, args.rate, "--rate", order=1) if args.rate or args.accel else None
-    accels = joint_assignments(mech, args.accel, "--accel", order=2) if args.accel else None
+    rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
+    accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None
+    rates, accels = link_rates(rates, pivots, "--rate"), link_rates(accels, pivots, "--accel")
+    for given, option in ((rates, "--rate"), (accels, "--accel")):
+        stray = [n for n in (given or {}) if n not in values and n not in held]
+        if stray and (held or pivots):  # a link's rate goes with its --set-angle; a name not an input would be lost
+            raise UsageError(f"{option} {', '.join(stray)}: not an input (inputs: {', '.join([*values, *held])})")
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
-        return equations_command.solve_from_start(mech, args, values)
-    solver = PositionSolver(mech, list(values), output=args.output)
+        return equations_command.solve_from_start(mech, args, values, held)
+    solver = input_solver(mech, values, held, output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
                        points=named_points(mech, args))
     if args.json:
@@ -76,7 +82,7 @@ def run(mech, args) -> int:
         return 0
     if args.trace:
         names = [mech.coordinate_names[k] for k in solver.passive]
-        print(trace_text(res, mech.closure.row_labels(solver=True), names))
+        print(trace_text(res, solver.mech.closure.row_labels(solver=True), names))
         print()
     print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args)))
     return 0

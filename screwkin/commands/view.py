@@ -24,8 +24,8 @@ from ._common import (
     add_configuration_options,
     add_point_option,
     configuration,
-    inputs,
     joint_assignments,
+    joint_inputs,
     named_points,
     parse_range,
     typed_unit,
@@ -147,7 +147,7 @@ def _interactive(mech, args) -> int:
     if args.sweep or args.html or args.png:
         raise UsageError(f"{mech.path}: --interactive is a live page: leave out --sweep, --html and --png")
     viser_module()  # a clear message before any work when viser is missing
-    given = inputs(mech, args)
+    given = joint_inputs(mech, args, "view --interactive")
     names = list(mech.actuated) or list(given)
     extra = [n for n in given if n not in names]
     if extra:

@@ -317,7 +317,7 @@ class ClosureSystem:
         """The rows of the higher pairs (CouplingRow, ContactRow) from row i on."""
         for k, e in enumerate(self.extra, i):
             if isinstance(e, CouplingRow):
-                r[k] = sum(c * q[iq] for iq, _, c in e.terms) + e.constant
+                r[k] = e.value(q)
                 if K is not None:
                     K[k] = 0.0
                     for _, iv, c in e.terms:
@@ -480,9 +480,26 @@ class ClosureSystem:
                 labels += [f"{cut.name}:align{k}" for k in range(2)]
             elif t == "universal":
                 labels += [f"{cut.name}:perp"]
-        for e in self.extra:  # lengths [m]: position rows for the dimensionless measures
+        for e in self.extra:  # lengths [m]: position rows for the dimensionless measures; an angle is not
+            if isinstance(e, CouplingRow) and e.kind == "angle":
+                labels.append(f"{e.name}:angle")
+                continue
             labels.append(f"{e.name}:pos-{e.kind if isinstance(e, CouplingRow) else 'contact'}")
         return labels
+
+    def row_rates(self, values: dict) -> np.ndarray:
+        """What each minimal row's time derivative is held at: the rate (or acceleration) ``values`` gives
+        the input a row holds (CouplingRow.input; 0 when not given), else 0.  K q' = row_rates(rates)."""
+        out = np.zeros(self.nrows)
+        for k, e in enumerate(self.extra, self.nrows - len(self.extra)):
+            if getattr(e, "input", None) is not None:
+                out[k] = float(values.get(e.input, 0.0))
+        return out
+
+    @property
+    def row_inputs(self) -> tuple:
+        """The inputs that rows hold (CouplingRow.input: links whose absolute angle is given), in row order."""
+        return tuple(e.input for e in self.extra if getattr(e, "input", None) is not None)
 
     def row_wrenches(self, q) -> list:
         """What a unit force in each minimal row exerts, row by row: (frame a, wrench on a's body,

@@ -40,12 +40,28 @@ class CouplingRow:
     """A linear relation of one-coordinate joints, sum c_k q_k + c0 = 0 [m]: the no-slip condition
     of a rolling pair (r1 a1 + r2 a2 = 0) or the lead of a screw pair (advance - lead turn / 2 pi
     = 0), written in the unwrapped coordinates of the pair's virtual joints, so that it holds over
-    any number of turns.  Its Jacobian row is constant and it adds nothing to K'q'."""
+    any number of turns.  Its Jacobian row is constant and it adds nothing to K'q'.
+
+    kind "angle": a link's absolute angle in a planar mechanism held as an input (the signed
+    revolute angles on its path from the ground plus its angle at q = 0, minus the angle given)
+    [rad]; it holds modulo a turn, so its residual is taken in (-pi, pi].  ``input`` names what
+    the row holds (the link): its rate and acceleration are given as that input's
+    (ClosureSystem.row_rates)."""
 
     name: str
-    kind: str  # "roll" | "lead"
+    kind: str  # "roll" | "lead" | "angle"
     terms: tuple  # ((q index, v index, coefficient), ...)
     constant: float = 0.0
+    input: str | None = None
+    pairs: frozenset = frozenset()  # q indices of continuous joints (cos, sin) in an angle row's terms
+
+    def value(self, q) -> float:
+        """The row's residual at q: sum c_k q_k + c0, or for an angle row the joints' angles (a
+        continuous joint's atan2(sin, cos)) so summed, taken into (-pi, pi]."""
+        if self.kind != "angle":
+            return sum(c * q[iq] for iq, _, c in self.terms) + self.constant
+        total = sum(c * (np.arctan2(q[iq + 1], q[iq]) if iq in self.pairs else q[iq]) for iq, _, c in self.terms)
+        return float(np.mod(total + self.constant + np.pi, 2 * np.pi) - np.pi)
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ mobility, and later position, velocity and singularity analysis) work on it.
 
 from __future__ import annotations
 
+import copy
 import threading
 
 from dataclasses import dataclass
@@ -274,6 +275,8 @@ class Mechanism:
         a turn (two turns of a 5 mm lead screw lift 10 mm, not 0)."""
         out = set()
         for row in self.extra_rows:
+            if getattr(row, "kind", None) == "angle":  # a link's angle held as an input: modulo a turn
+                continue
             for iq, _, _ in getattr(row, "terms", ()):
                 jid = next(c.joint_id for c in self.coordinates if c.idx_q == iq)
                 if self.model.joints[jid].shortname().startswith("JointModelR"):
@@ -503,6 +506,22 @@ class Mechanism:
                   f"{max(total - 1 - tol.perturbations, 0)} random configurations within the joint limits"
                   if total > 1 else given)
         raise AssemblyError(self.path, best, best_it, detail=starts, starts=total, reason=self.closure_obstacle())
+
+    def with_rows(self, rows) -> "Mechanism":
+        """This mechanism with more closure rows (model.closure.CouplingRow: a link's absolute angle
+        held as an input), for the solves of one command: a shallow copy that shares the model, the
+        coordinates and the assembly search (made first, on the mechanism's own loops) and has a
+        closure system of its own; the mechanism itself is not changed."""
+        try:
+            self.generic_configurations()  # the reference configurations: the loops' own, not the rows'
+        except AssemblyError:
+            pass  # the copy searches with the rows (its configurations close the loops too)
+        view = copy.copy(self)
+        view.extra_rows = [*self.extra_rows, *rows]
+        view.closure = ClosureSystem(self.model, self.cuts, self.tolerances, self.path, data=self.scratch_data(),
+                                     extra=view.extra_rows)
+        view.cache = {}
+        return view
 
     def closure_obstacle(self) -> str | None:
         """Why a loop of parallel revolutes cannot close, in its links' lengths (model.closability)."""

@@ -80,7 +80,8 @@ def position_dict(res) -> dict:
         sols.append(d)
     return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
             "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols,
-            "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes)}
+            "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes),
+            **({"held_angles": res.held} if res.held else {})}
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:
@@ -151,8 +152,9 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
     accelerations in ``units`` (those typed with --rate/--accel)."""
-    inputs = ", ".join(f"{k} = {value_text(k, v, k in res.angular)}" for k, v in res.inputs.items()
-                       if isinstance(v, float))
+    inputs = ", ".join([f"{k} = {value_text(k, v, k in res.angular)}" for k, v in res.inputs.items()
+                        if isinstance(v, float)] + [f"angle of {k} = {value_text(k, v, True)}"
+                                                    for k, v in (res.held or {}).items()])
     shown = list(res.solutions) if show_all else [s for s in res.solutions if s.physical] or list(res.solutions)
     hidden = len(res.solutions) - len(shown)
     n = len(res.solutions)

@@ -62,12 +62,12 @@ def _spatial(mech, q, inputs, output) -> SpatialEquations:
                             sigma, singular, tuple(conds), float(S.L))
 
 
-def equations(mech, q, inputs=None, output=None):
+def equations(mech, q, inputs=None, output=None, links=()):
     """The equations at the assembled configuration q: :class:`PlanarEquations` for planar
     mechanisms of revolute and prismatic joints, rolling and gear pairs (the no-slip law
     substituted: screwkin.analysis.course.rolling), :class:`SpatialEquations` for spatial and
-    spherical ones."""
+    spherical ones.  ``links``: planar, links whose absolute angle is an input (VectorLoops)."""
     topo = mech.topology(q)
     if topo.motion_space != "planar":
         return _spatial(mech, q, list(inputs) if inputs else list(mech.actuated), output)
-    return VectorLoops(mech, q, inputs).result()
+    return VectorLoops(mech, q, inputs, links).result()

@@ -81,9 +81,10 @@ class VectorLoops:
     joints.  Holds the sympy expressions and their numerical forms; ``result()`` gives the
     plain :class:`PlanarEquations`."""
 
-    def __init__(self, mech, q, inputs=None):
+    def __init__(self, mech, q, inputs=None, links=()):
         """Every command that writes these equations (equations, solve --start, singularities
-        --symbolic, report) builds them here: rolling and gear pairs included."""
+        --symbolic, report) builds them here: rolling and gear pairs included.  ``links``: links
+        whose absolute angle is an input too (--set-angle of a floating link): their theta is known."""
         import sympy as sp
 
         self.sp = sp
@@ -109,8 +110,9 @@ class VectorLoops:
         if topo.loops < 1:
             raise UsageError(f"{path}: the mechanism has no loops: there is no loop equation to write "
                              "(screwkin screws --output LINK gives a chain's structure equations)")
-        self.inputs_joints = list(inputs) if inputs else list(mech.actuated)
-        if not self.inputs_joints:
+        self.input_links = list(links)
+        self.inputs_joints = list(inputs) if inputs or self.input_links else list(mech.actuated)
+        if not self.inputs_joints and not self.input_links:
             raise UsageError(f"{path}: no input joints: declare actuated joints or give --input NAME")
         for n in self.inputs_joints:
             mech.coordinate(n)  # an unknown name is a one-line UsageError
@@ -440,6 +442,20 @@ class VectorLoops:
             info = self.symbol_info[sym]
             self.symbol_info[sym] = Symbol(info.name, info.link, info.kind, info.value, "input",
                                            info.meaning + f"; set by the input joint '{name}'")
+        for link in self.input_links:  # a link's angle given (--set-angle): its theta is the input itself
+            self.angles.check(link)
+            sym = f"theta{self.numbers[self.rep[link]]}"
+            if sym not in self.sym:
+                raise UsageError(f"{mech.path}: link '{link}' is in no loop: its angle is not a quantity of the loop "
+                                 "equations")
+            if sym in self.input_joints:
+                raise UsageError(f"{mech.path}: inputs '{self.input_joints[sym][0]}' and the angle of '{link}' set "
+                                 f"the same quantity {sym}")
+            self.input_syms.append(sym)
+            self.input_joints[sym] = (link, 1.0)
+            info = self.symbol_info[sym]
+            self.symbol_info[sym] = Symbol(info.name, info.link, info.kind, info.value, "input",
+                                           info.meaning + "; given as the link's angle (--set-angle)")
         order = {n: k for k, n in enumerate(self.variables)}
         self.unknowns = sorted((v for v in self.variables if v not in self.input_joints),
                                key=lambda n: (self.numbers[self.symbol_info[n].link], n.startswith("x"), order[n]))

@@ -212,6 +212,8 @@ class BatchClosure:
             raise Unbatchable(f"{mech.path}: joints of more than one coordinate")
         if any(not isinstance(e, CouplingRow) for e in mech.extra_rows):
             raise Unbatchable(f"{mech.path}: sliding contacts (higher pairs)")
+        if any(e.kind == "angle" for e in mech.extra_rows):
+            raise Unbatchable(f"{mech.path}: a link's absolute angle held as an input (a row modulo a turn)")
         if any(model.nvs[j] != 1 for j in range(1, model.njoints)):
             raise Unbatchable(f"{mech.path}: a joint that is not a 1-DOF joint (or a <mimic> joint)")
         cuts = list(mech.cuts)

@@ -135,7 +135,9 @@ class ModeLabels:
                 self.legs.append((c.joint, c.joint_id, fars[0], axis, s_ref))
         configs = solver.generic().configurations
         topo = mech.topology(ref)
-        Vs = [null_space(mech.closure.jacobian(q), mech.tolerances, mech.nv) for q in configs]
+        held = len(mech.closure.row_inputs)  # rows of links held at an angle (the last ones): inputs, not loops
+        Vs = [null_space(mech.closure.jacobian(q)[:mech.closure.nrows - held], mech.tolerances, mech.nv)
+              for q in configs]
         states = [KinematicState(mech, q) for q in configs]
         for link in topo.links:
             if link == topo.ground:

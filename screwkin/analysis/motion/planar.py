@@ -277,6 +277,7 @@ class LinkAngles:
             raise UsageError(f"{mech.path}: absolute link angles are for planar mechanisms; this one is "
                              f"{topo.motion_space}")
         self.mech = mech
+        self.ground = topo.ground
         self.e1, self.e2, self.n = plane_basis(topo.normal)
         model = mech.model
         cut_frames = {}
@@ -388,25 +389,54 @@ class LinkAngles:
             return {link: np.array([r[link] for r in rows]) for link in self.links}
         return out
 
-    def joint_value(self, link: str, angle: float) -> tuple:
-        """(joint name, joint value) that gives ``link`` the absolute angle ``angle`` [rad]: the
-        link must turn about the plane's normal on a joint to the ground."""
-        mech, model = self.mech, self.mech.model
+    def check(self, link: str):
+        """A usage error unless ``link`` is a moving link of the mechanism (the ground's angle is fixed)."""
+        moving = [k for k in self.links if k != self.ground]
+        if link == self.ground:
+            raise UsageError(f"{self.mech.path}: '{link}' is the ground: its angle is fixed (links: {', '.join(moving)})")
         if link not in self.links:
-            raise UsageError(f"{mech.path}: no moving link named '{link}' (links: {', '.join(self.links)})")
-        start = self.links[link][0]
-        jid = start[1]
-        short = model.joints[jid].shortname()
-        name = model.names[jid]
-        if model.parents[jid] != 0 or not short.startswith("JointModelR") or mech.coordinate(name).nv != 1:
+            try:
+                jid = self.mech.model.frames[self.mech.link_frame(link)].parentJoint
+            except UsageError:
+                jid = None
+            if jid == 0:
+                raise UsageError(f"{self.mech.path}: '{link}' is fixed to the ground: its angle is fixed")
+            body = next((k for k, (start, _, _) in self.links.items()
+                         if k != self.ground and start == ("joint", jid)), None)
+            if body is not None:
+                raise UsageError(f"{self.mech.path}: '{link}' is fixed to '{body}' (its angle is that link's plus a "
+                                 f"constant): give '{body}'")
+            raise UsageError(f"{self.mech.path}: no moving link named '{link}' (links: {', '.join(moving)})")
+
+    def pivoted(self, link: str) -> bool:
+        """Whether ``link`` turns on a one-coordinate revolute joint to the ground (its angle is that
+        joint's value plus a constant: joint_value); checked as ``check``."""
+        self.check(link)
+        model = self.mech.model
+        jid = self.links[link][0][1]
+        return (model.parents[jid] == 0 and model.joints[jid].shortname().startswith("JointModelR")
+                and self.mech.coordinate(model.names[jid]).nv == 1)
+
+    def pivot(self, link: str) -> tuple:
+        """(joint name, sign) of the revolute joint that pivots ``link`` on the ground: the link's
+        angle is sign * the joint's value + a constant, its angular velocity sign * the joint's rate."""
+        mech, model = self.mech, self.mech.model
+        if not self.pivoted(link):
             raise UsageError(f"{mech.path}: the absolute angle of '{link}' is not the value of one joint (it does "
                              "not turn on a revolute joint to the ground): set a joint with --set")
-        q = mech.neutral()
+        jid = self.links[link][0][1]
+        name = model.names[jid]
         axis = np.asarray(next(j.axis for j in mech.spec.joints if j.name == name), float)
-        pin.framesForwardKinematics(model, self._data, q)
+        pin.framesForwardKinematics(model, self._data, mech.neutral())
         sign = float(np.sign((self._data.oMi[jid].rotation @ axis) @ self.n))
         if sign == 0:
             raise UsageError(f"{mech.path}: joint '{name}' does not turn about the plane's normal")
-        theta0 = self(q)[link]
+        return name, sign
+
+    def joint_value(self, link: str, angle: float) -> tuple:
+        """(joint name, joint value) that gives ``link`` the absolute angle ``angle`` [rad]: the
+        link must turn about the plane's normal on a joint to the ground."""
+        name, sign = self.pivot(link)
+        theta0 = self(self.mech.neutral())[link]
         value = sign * float(np.mod(angle - theta0 + np.pi, 2 * np.pi) - np.pi)
         return name, value

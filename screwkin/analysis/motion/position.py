@@ -137,6 +137,7 @@ class PositionResult:
     angular_coupled: tuple = ()  # names of the coupled (mimic) joints that are angles
     angular_loop: tuple = ()  # names of the loop (cut) joints with a coordinate that is an angle
     notes: tuple = ()  # what the solver chose that the user should know (a --near value it missed)
+    held: dict | None = None  # links held at an absolute angle (--set-angle of a floating link) -> angle [rad]
 
     @property
     def physical(self) -> tuple:
@@ -187,8 +188,9 @@ class PositionSolver:
             mech.closure.accelerate(compiled)
         self.model = mech.model
         self.data = mech.scratch_data()
-        names = list(input_joints) if input_joints else list(mech.actuated)
-        if not names:
+        held = mech.closure.row_inputs  # links whose angle the closure holds (analysis.motion.link_inputs)
+        names = list(input_joints) if input_joints or (held and input_joints is not None) else list(mech.actuated)
+        if not names and not held:
             raise UsageError(f"{mech.path}: no input joints: declare actuated joints or give --set NAME=VALUE")
         for n in names:
             c = mech.coordinate(n)
@@ -371,7 +373,10 @@ class PositionSolver:
             best = min(best, more)
         if not found:
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
-                                detail=f"the inputs {self._describe(values)} cannot be reached from "
+                                detail="the inputs " + ", ".join(
+                                           [self._describe(values)] * bool(values)
+                                           + [f"the angle of {k}" for k in mech.closure.row_inputs])
+                                       + " cannot be reached from "
                                        f"{len(start_list)} starting configurations")
         if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
             found = engaged(self, found, values)
@@ -389,9 +394,11 @@ class PositionSolver:
         if near_q is not None:
             sols = sols[:1]
             notes = self._missed_near(near, sols[0])
+        held = {link: sols[0].link_angles[link] for link in mech.closure.row_inputs
+                if sols[0].link_angles and link in sols[0].link_angles} or None
         return PositionResult(dict(typed), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
                               tuple(steps), self.output, self._angular, self._angular_coupled(),
-                              angular_loop_joints(self.mech), notes)
+                              angular_loop_joints(self.mech), notes, held)
 
     def _missed_near(self, near: dict, sol) -> tuple:
         """A line for each --near value the mode found lies far from (Tolerances.near_far): the joints
@@ -532,20 +539,23 @@ class PositionSolver:
 
     def rates(self, q, K, values: dict, solve=None):
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
-        the passive joints, so idle spins are zero).  solve: see passive_solver."""
+        the passive joints, so idle spins are zero).  A link held at an angle (link_inputs)
+        turns at the rate ``values`` gives its name (0 when none): its row's K q' is that rate.
+        solve: see passive_solver."""
         qd = np.zeros(self.mech.nv)
         qd[self.frozen] = self._input_vector(values)
         if K.size:
             solve = solve or self.passive_solver(K)[0]
-            qd[self.passive] = -solve(K[:, self.frozen] @ qd[self.frozen])
+            qd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qd[self.frozen])
         return qd
 
     def accelerations(self, q, K, qd, values: dict, solve=None):
-        """Joint accelerations from K q'' = -K' q' with the input accelerations given."""
+        """Joint accelerations from K q'' = -K' q' with the input accelerations given (a held link's
+        angular acceleration as its row's, as in ``rates``)."""
         qdd = np.zeros(self.mech.nv)
         qdd[self.frozen] = self._input_vector(values)
         if K.size:
             bias = self.mech.closure.bias(q, qd)
             solve = solve or self.passive_solver(K)[0]
-            qdd[self.passive] = solve(-(K[:, self.frozen] @ qdd[self.frozen] + bias))
+            qdd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qdd[self.frozen] - bias)
         return qdd
