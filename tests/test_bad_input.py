@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import fourbar, no_hang
+from conftest import ROBOTS, fourbar, no_hang
 from screwkin.cli import main
 
 GOOD = fourbar()
@@ -605,3 +605,17 @@ def test_too_many_elements_or_meshes(tmp_path, capsys):
     text = GOOD.replace('<link name="crank">', '<link name="crank">' + "".join(mesh.format(k=k) for k in range(3000)))
     code, err = run(capsys, ["info", write(tmp_path, text, "meshes.urdf")])
     assert code == 0 and "2000 mesh file(s) not found" in err and "only the first 2000" in err
+
+
+@pytest.mark.parametrize("command", [["solve"], ["report", "--md", "r.md", "--no-view"]])
+def test_a_rate_of_a_joint_that_is_not_an_input_is_refused(command, capsys, tmp_path, monkeypatch):
+    """--rate rocker_joint with the crank as input used to be dropped without a word (rates all 0)."""
+    from screwkin.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    argv = [command[0], str(ROBOTS / "fourbar_crank_rocker.urdf"), "--set", "crank_joint=30deg",
+            "--rate", "rocker_joint=2", *command[1:]]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--rate rocker_joint: not an input (inputs: crank_joint)" in err
+    assert not list(tmp_path.iterdir())

@@ -20,7 +20,7 @@ from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line"]
 
 
@@ -396,3 +396,10 @@ def emit(args, data, text) -> int:
     else:
         print(text() if callable(text) else text)
     return 0
+
+
+def check_rate_names(given: dict | None, inputs, option: str) -> None:
+    """A --rate/--accel name that is not an input would be dropped without a word: exit 2 naming it."""
+    stray = [n for n in (given or {}) if n not in inputs]
+    if stray:
+        raise UsageError(f"{option} {', '.join(stray)}: not an input (inputs: {', '.join(inputs) or 'none'})")

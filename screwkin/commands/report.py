@@ -55,6 +55,7 @@ from ..present.view import (
 )
 from ..units import parse_typed_assignments, parse_value, unit_kind
 from ._common import (
+    check_rate_names,
     add_configuration_options,
     add_point_option,
     joint_assignments,
@@ -154,6 +155,8 @@ def run(mech, args) -> int:
     points = named_points(mech, args)
     rates = joint_assignments(mech, args.rate, "--rate", order=1) or {n: 1.0 for n in names}
     accels = joint_assignments(mech, args.accel, "--accel", order=2) or None
+    check_rate_names(rates, names, "--rate")
+    check_rate_names(accels, names, "--accel")
     notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
 
     # ---- the configuration: solved for the inputs (their file values when none are set)

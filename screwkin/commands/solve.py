@@ -13,6 +13,7 @@ from ..present.report import (
 )
 from . import equations as equations_command
 from ._common import (
+    check_rate_names,
     add_angle_option,
     add_length_option,
     add_point_option,
@@ -64,10 +65,8 @@ def run(mech, args) -> int:
     rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
     accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None
     rates, accels = link_rates(rates, pivots, "--rate"), link_rates(accels, pivots, "--accel")
-    for given, option in ((rates, "--rate"), (accels, "--accel")):
-        stray = [n for n in (given or {}) if n not in values and n not in held]
-        if stray and (held or pivots):  # a link's rate goes with its --set-angle; a name not an input would be lost
-            raise UsageError(f"{option} {', '.join(stray)}: not an input (inputs: {', '.join([*values, *held])})")
+    for given, option in ((rates, "--rate"), (accels, "--accel")):  # a link's rate goes with its --set-angle
+        check_rate_names(given, [*values, *held], option)
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
