@@ -13,6 +13,7 @@ from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep
 from ..errors import UsageError
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
+from ..present.tables import RateUnits
 from ..present.plots import sweep_plot
 from ..present.streamout import SweepWriter
 from ..present.report import (
@@ -52,7 +53,8 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
-    sp.add_argument("--rate", default="1", help="input rate for the joint rates and accelerations (default 1 /s)")
+    sp.add_argument("--rate", help="input rate for the joint rates and accelerations (default 1 rad/s or m/s; "
+                                   "typed with a unit, e.g. 60rpm, the links' omega and alpha are shown in it)")
     sp.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
     sp.add_argument("--parquet", help="write the same columns as --csv to this Parquet file (needs pyarrow)")
     sp.add_argument("--chunk", type=count("chunk"),
@@ -160,7 +162,7 @@ def run(mech, args) -> int:
         raise UsageError("--point needs --output LINK")
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
                                                                                       (args.stop, "--to")))
-    rate = joint_value(mech, args.input, args.rate, "--rate", order=1)
+    rate = joint_value(mech, args.input, args.rate or "1", "--rate", order=1)
     if args.parquet:
         SweepWriter.require_parquet(args.parquet)  # before any work
     others = {k: v for k, v in fixed.items() if k != args.input}
@@ -206,7 +208,9 @@ def run(mech, args) -> int:
             print(line)
         for n in res.notes:
             print(f"note: {n}")
-        table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad")
+        # a --rate typed: the links' omega and alpha beside their angles, in its units (60rpm: rpm)
+        units = RateUnits.typed([parse_typed_value(args.rate)[1]]) if args.rate else None
+        table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad", units)
         if table_text:
             print()
             print(table_text)

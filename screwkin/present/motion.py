@@ -114,17 +114,23 @@ def strokes_text(strokes, angular: bool) -> list:
     return lines
 
 
-def motion_rows_text(res, motion, rows, degrees: bool) -> str:
+def motion_rows_text(res, motion, rows, degrees: bool, units: RateUnits | None = None) -> str:
     """The sweep's absolute quantities at the rows shown: the input (in deg when typed so), each turning
-    link's angle [deg], each slider (loop) coordinate [mm] and each point's position [mm]."""
+    link's angle [deg] (with ``units``, the rate's units typed: its omega and alpha in them too), each
+    slider (loop) coordinate [mm] and each point's position [mm]."""
     cols, head = [], []
     for name, m in motion.links.items():
         if "angle" in m and np.ptp(np.unwrap(m["angle"])) > DEFAULT.equal:  # the link turns
             head.append(f"{name} [deg]")
             cols.append(column_text(np.degrees(np.asarray(m["angle"]))))
+            if units is not None and "omega" in m:
+                w, a = units.angular_rate, units.angular_acceleration
+                head += [f"omega {name} [{w}]", f"alpha {name} [{a}]"]
+                cols += [column_text(RateUnits.of(np.asarray(m["omega"], float), w), absolute=1e-9),
+                         column_text(RateUnits.of(np.asarray(m["alpha"], float), a), absolute=1e-9)]
     for name, v in motion.loop_joints.items():
         angular = name in motion.angular_loop
-        head.append(f"{name} [{'deg' if angular else 'mm'}]")
+        head.append(f"{name} (loop) [{'deg' if angular else 'mm'}]")
         cols.append(column_text(np.degrees(v) if angular else 1000 * np.asarray(v)))
     for name, p in motion.points.items():
         xy = 1000 * np.asarray(p["position"])
