@@ -21,7 +21,7 @@ import numpy as np
 
 from ....files.description import TargetSpec
 from ....files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
-from ....model.geometry import circle_circle, cross2, vector_angle
+from ....model.geometry import circle_circle, cross2, vector_angle, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar
 
@@ -36,8 +36,8 @@ def angle(v) -> float:
 
 
 def wrap(x):
-    """Angles in (-pi, pi]."""
-    return -(np.mod(-np.asarray(x, float) + np.pi, TWO_PI) - np.pi) + 0.0
+    """Angles in (-pi, pi] (model.geometry.wrap_angle's interval turned over, as joint values are)."""
+    return -wrap_angle(-np.asarray(x, float)) + 0.0
 
 
 def rotate(theta):
