@@ -319,3 +319,45 @@ def test_a_grid_too_coarse_to_follow_the_turns_is_left_to_the_tracker():
     assert planar_sweep(solver, "rocker_joint", q0, x0, x0 - 4.15, 3, 1.0, True, 40) is None
     fine = planar_sweep(solver, "rocker_joint", q0, x0, x0 - 4.15, 300, 1.0, True, 400)
     assert fine is not None and len(fine.limits) >= 2
+
+
+def test_closed_form_up_to_a_range_end_next_to_a_limit_position():
+    """A non-Grashof four-bar swept to just inside its limit (as a study's transmission metric does): the
+    slope of the coupler grows without bound there, and the trapezoid predictor of the angle unwrapping
+    overshot by whole turns, so the closed form gave the motion up to the tracker (9x slower in a study).
+    Now it keeps the closed form, and agrees with the tracker (whose passive joints converge only to about
+    the square root of the closure tolerance at the last, nearly singular, value)."""
+    import screwkin
+    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.motion.sweep import sweep
+
+    mech = screwkin.load(ROBOTS / "fourbar.urdf.xacro",
+                         args={"ground": "0.1", "crank": "0.095", "coupler": "0.06", "rocker": "0.075"})
+    solver = PositionSolver(mech, ["crank_joint"])
+    q0 = mech.generic_configurations()[1][0]
+    end = 0.7406765579590034  # 2 % of the crank's range inside its limit position
+    fast = sweep(solver, "crank_joint", 0.0, end, 96, q_start=q0)
+    slow = sweep(solver, "crank_joint", 0.0, end, 96, q_start=q0, closed_form=False, batch=False)
+    assert fast.method == "closed form" and fast.completed and slow.completed
+    np.testing.assert_allclose(fast.values, slow.values, atol=1e-12)
+    np.testing.assert_allclose(fast.joints[:-1], slow.joints[:-1], atol=1e-8)
+    np.testing.assert_allclose(fast.joints[-1], slow.joints[-1], atol=1e-4)
+    assert np.ptp(np.unwrap(fast.joints[:, 1])) < np.pi  # no spurious turn of the coupler joint
+
+
+def test_a_grid_too_coarse_to_unwrap_is_read_from_a_finer_closed_form():
+    """Three steps over a crank's turn (120 deg each: which turn each joint is on cannot be told from the
+    samples) are computed on a grid 8 times finer and read at the three values: still the closed form,
+    and the tracker's answer (which takes steps of at most Tolerances.max_step between the values)."""
+    import screwkin
+    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.motion.sweep import sweep
+
+    mech = screwkin.load(ROBOTS / "fourbar_crank_rocker.urdf")
+    solver = PositionSolver(mech, ["crank_joint"])
+    fast = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 3)
+    slow = sweep(solver, "crank_joint", 0.0, 2 * np.pi, 3, closed_form=False, batch=False)
+    assert fast.method == "closed form" and len(fast.values) == len(slow.values) == 4
+    np.testing.assert_allclose(fast.values, slow.values, atol=1e-12)
+    np.testing.assert_allclose(fast.q, slow.q, atol=1e-8)
+    np.testing.assert_allclose(fast.rates, slow.rates, atol=1e-7)

@@ -332,6 +332,7 @@ class _Unwrap:
     choice could be wrong (a coarse grid; next to a limit, where the slope is infinite)."""
 
     _SAFE = np.pi / 2  # the largest turn between two samples taken as unambiguous [rad]
+    _SLACK = 0.01  # relative slack of the bounds |s| dx on a monotone step
 
     def __init__(self, wrapped):
         self.cols = np.array([iq for iq, _ in wrapped], int)
@@ -351,10 +352,23 @@ class _Unwrap:
         rr = np.vstack([r0, raw])
         ss = np.vstack([s0, slope])
         xx = np.concatenate([[x0], xs])
-        with np.errstate(invalid="ignore"):
-            pred = 0.5 * (ss[1:] + ss[:-1]) * np.diff(xx)[:, None]
+        dx = np.diff(xx)[:, None]
+        with np.errstate(invalid="ignore", over="ignore"):
+            pred = 0.5 * (ss[1:] + ss[:-1]) * dx
         pred = np.where(np.isfinite(pred), pred, 0.0)
-        k = np.round((pred - np.diff(rr, axis=0)) / (2 * np.pi))
+        dr = np.diff(rr, axis=0)
+        k = np.round((pred - dr) / (2 * np.pi))
+        # next to a limit position the slope grows without bound and the trapezoid overshoots by turns:
+        # where both slopes have one sign, the angle moves monotonically by between |s| dx at the
+        # smaller slope and at the larger; the smallest turn that does so is taken instead
+        k_near = np.round(-dr / (2 * np.pi))
+        near = dr + 2 * np.pi * k_near
+        a0, a1 = np.abs(ss[:-1] * dx), np.abs(ss[1:] * dx)
+        with np.errstate(invalid="ignore"):
+            monotone = (np.sign(ss[1:]) == np.sign(ss[:-1])) & (np.sign(near) == np.sign(ss[1:] * dx))
+            fits = monotone & (np.abs(near) >= np.minimum(a0, a1) * (1 - self._SLACK)) & (
+                np.abs(near) <= np.maximum(a0, a1) * (1 + self._SLACK))
+        k = np.where(fits, k_near, k)
         if np.any(np.abs(np.diff(rr, axis=0) + 2 * np.pi * k) > self._SAFE):
             self.ambiguous = True
         turns = k0 + np.cumsum(k, axis=0)
