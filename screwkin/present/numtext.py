@@ -34,8 +34,9 @@ def _scaled(a, k):
     s = a * p
     down = np.flatnonzero(k < 0)
     s[down] = a[down] / p[down]
-    far = k > 22
-    return np.where(far, s * _POW10[np.clip(k - 22, 0, 22)], s) if far.any() else s
+    far = np.flatnonzero(k > 22)
+    s[far] *= _POW10[k[far] - 22]
+    return s
 
 
 def g12_bytes(values, out=None) -> np.ndarray:
@@ -54,16 +55,18 @@ def g12_bytes(values, out=None) -> np.ndarray:
         fast = np.isfinite(x) & (a >= _SMALLEST) & (a < _LARGEST)
         e = np.floor(np.log10(np.where(fast, a, 1.0))).astype(np.int64)
         s = _scaled(a, P - 1 - e)
-        off = (s >= 10.0 ** P).astype(np.int64) - (s < 10.0 ** (P - 1))  # log10 one off near 10^n
-        if off.any():
-            e += off
-            s = np.where(off != 0, _scaled(a, P - 1 - e), s)
+        off = np.flatnonzero(fast & ((s >= 10.0 ** P) | (s < 10.0 ** (P - 1))))  # log10 one off near 10^n
+        e[off] += np.where(s[off] < 10.0 ** (P - 1), -1, 1)
+        s[off] = _scaled(a[off], P - 1 - e[off])
         fast &= (s >= 10.0 ** (P - 1)) & (s < 10.0 ** P)
         fast &= np.abs(s - np.floor(s) - 0.5) >= _BAND
         m = np.where(fast, np.rint(s), 10.0 ** (P - 1))
     carry = m >= 10.0 ** P  # 999999999999.6 -> 10^12: one digit more, the exponent up
     m = np.where(carry, 10.0 ** (P - 1), m)
     e = e + carry
+    zero = a == 0  # "0" (or "-0"): the digits 000000000000 with the exponent 0
+    m[zero] = 0.0
+    fast |= zero
     hi = np.floor(m / 1e8)  # exact: m is an integer below 2^53
     mid = m - hi * 1e8
     lo = np.floor(mid / 1e4)
