@@ -76,3 +76,17 @@ def test_usage_errors_are_the_same():
         with pytest.raises(SystemExit) as whole:
             full.parse_args(argv)
         assert lazy.value.code == whole.value.code == 2
+
+
+
+def test_a_sweep_imports_no_other_analysis():
+    """What `screwkin sweep` costs at start-up: not the analyses of other commands (the public API
+    imports them when first used)."""
+    fourbar = ROBOTS / "fourbar_crank_rocker.urdf"
+    code = ("import sys\nfrom screwkin import cli\ncode = cli.main(['sweep', %r, '--input', 'crank_joint', "
+            "'--from', '0', '--to', '1', '--steps', '3', '--json'])\n"
+            "print(code, sorted(m for m in ('screwkin.analysis.forces.dynamics', 'screwkin.analysis.design.study', "
+            "'screwkin.parallel.study', 'screwkin.analysis.motion.ik') if m in sys.modules))" % str(fourbar))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "0 []"
