@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from itertools import chain
 
 import numpy as np
 
@@ -23,7 +24,7 @@ def to_jsonable(obj, _where: str = ""):
     if isinstance(obj, dict):
         return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        if isinstance(obj, list) and _numbers(obj):  # finite floats only: nothing to convert
+        if isinstance(obj, list) and (_numbers(obj) or _rows(obj)):  # finite floats only: nothing to convert
             return obj
         return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
     if isinstance(obj, np.ndarray):
@@ -61,6 +62,14 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
             return "[]"
         if _numbers(obj):
             return "[\n" + inner + (",\n" + inner).join(map(float.__repr__, obj)) + "\n" + pad + "]"
+        width = _rows(obj)
+        if width:  # rows of numbers of one length (vectors along a sweep): one join over all the numbers
+            deeper = inner + " " * indent
+            parts = [""] * (2 * len(obj) * width - 1)
+            parts[::2] = map(float.__repr__, chain.from_iterable(obj))
+            parts[1::2] = ([",\n" + deeper] * (width - 1) + ["\n" + inner + "],\n" + inner + "[\n" + deeper]) * (
+                len(obj) - 1) + [",\n" + deeper] * (width - 1)
+            return "[\n" + inner + "[\n" + deeper + "".join(parts) + "\n" + inner + "]\n" + pad + "]"
         if all(isinstance(v, list) and v and _numbers(v) for v in obj):  # rows of numbers (vectors along a sweep)
             deeper = inner + " " * indent
             sep = ",\n" + deeper
@@ -73,3 +82,14 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
 def _numbers(values) -> bool:
     """A list of finite floats only (two loops in C)."""
     return set(map(type, values)) == {float} and all(map(math.isfinite, values))
+
+
+def _rows(values) -> int:
+    """The length of every row when ``values`` is a list of lists of finite floats, all of one
+    nonzero length (a sweep's vectors); else 0 (loops in C, no Python call a row)."""
+    if not values or set(map(type, values)) != {list}:
+        return 0
+    widths = set(map(len, values))
+    if len(widths) != 1 or 0 in widths or not _numbers(list(chain.from_iterable(values))):
+        return 0
+    return widths.pop()
