@@ -65,3 +65,13 @@ def test_a_sweeps_csv_is_the_row_format(tmp_path):
     fmt = "%d," + ",".join(["%.12g"] * len(cols)) + "\n"
     rows = "".join(fmt % (12 + k, *row) for k, row in enumerate(np.column_stack(cols).tolist()))
     assert sweep_csv(res, first_step=12, header=False) == rows
+
+
+def test_long_tables_are_written_in_blocks_with_the_same_text():
+    from screwkin.present import numtext
+
+    rng = np.random.default_rng(3)
+    cols = [rng.normal(size=2 * numtext.ROWS + 17) for _ in range(3)]
+    fmt = "%d," + ",".join(["%.12g"] * len(cols)) + "\n"
+    expected = "".join(fmt % (5 + k, *row) for k, row in enumerate(np.column_stack(cols).tolist()))
+    assert csv_rows(cols, 5) == expected

@@ -115,13 +115,19 @@ def g12_bytes(values, out=None) -> np.ndarray:
     return out
 
 
+ROWS = 20_000  #: rows formatted at a time (the byte buffer of a block: about 0.6 kB a row of 22 values)
+
+
 def csv_rows(columns, first: int = 0) -> str:
     """CSV rows ``step,v1,v2,...``: the step numbered from ``first`` (``%d``), then every column
-    (equal-length float arrays) as ``'%.12g'``; the same text as ``"%d,%.12g,...\\n" % row`` a row."""
+    (equal-length float arrays) as ``'%.12g'``; the same text as ``"%d,%.12g,...\\n" % row`` a row.
+    Built ROWS rows at a time, so that the buffers stay small beside the text."""
     cols = [np.asarray(c, dtype=float) for c in columns]
     n = len(cols[0]) if cols else 0
     if n == 0:
         return ""
+    if n > ROWS:
+        return "".join(csv_rows([c[i:i + ROWS] for c in cols], first + i) for i in range(0, n, ROWS))
     m = len(cols)
     buf = np.zeros((n, m + 1, W + 1), dtype=np.uint8)  # the step, then the values: each W bytes and a separator
     steps = np.arange(first, first + n, dtype=np.int64)
