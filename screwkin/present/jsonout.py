@@ -12,7 +12,7 @@ from itertools import chain
 
 import numpy as np
 
-__all__ = ["to_jsonable", "nan_to_none", "json_text"]
+__all__ = ["to_jsonable", "nan_to_none", "json_text", "json_of"]
 
 
 def to_jsonable(obj, _where: str = ""):
@@ -64,12 +64,7 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
             return "[\n" + inner + (",\n" + inner).join(map(float.__repr__, obj)) + "\n" + pad + "]"
         width = _rows(obj)
         if width:  # rows of numbers of one length (vectors along a sweep): one join over all the numbers
-            deeper = inner + " " * indent
-            parts = [""] * (2 * len(obj) * width - 1)
-            parts[::2] = map(float.__repr__, chain.from_iterable(obj))
-            parts[1::2] = ([",\n" + deeper] * (width - 1) + ["\n" + inner + "],\n" + inner + "[\n" + deeper]) * (
-                len(obj) - 1) + [",\n" + deeper] * (width - 1)
-            return "[\n" + inner + "[\n" + deeper + "".join(parts) + "\n" + inner + "]\n" + pad + "]"
+            return _rows_text(map(float.__repr__, chain.from_iterable(obj)), len(obj), width, pad, inner, " " * indent)
         if all(isinstance(v, list) and v and _numbers(v) for v in obj):  # rows of numbers (vectors along a sweep)
             deeper = inner + " " * indent
             sep = ",\n" + deeper
@@ -77,6 +72,33 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
             return "[\n" + inner + (",\n" + inner).join(rows) + "\n" + pad + "]"
         return "[\n" + ",\n".join(inner + json_text(v, indent, _level + 1) for v in obj) + "\n" + pad + "]"
     return json.dumps(obj, indent=indent).replace("\n", "\n" + pad)
+
+
+def json_of(obj, indent: int = 2, _level: int = 0, _where: str = "") -> str:
+    """json_text(to_jsonable(obj)), the same text, with the finite float arrays (a sweep's stacks,
+    (N,) or (N, k)) written from their values: no list a row, no check a number in Python."""
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj) and obj:
+        pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
+        items = (f"{inner}{json.dumps(k)}: {json_of(v, indent, _level + 1, f'{_where}.{k}')}" for k, v in obj.items())
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if (isinstance(obj, np.ndarray) and obj.dtype.kind == "f" and obj.ndim in (1, 2) and obj.size
+            and np.isfinite(obj).all()):
+        pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
+        values = map(float.__repr__, obj.ravel().tolist())
+        if obj.ndim == 1:
+            return "[\n" + inner + (",\n" + inner).join(values) + "\n" + pad + "]"
+        return _rows_text(values, *obj.shape, pad, inner, " " * indent)
+    return json_text(to_jsonable(obj, _where), indent, _level)
+
+
+def _rows_text(values, n: int, width: int, pad: str, inner: str, step: str) -> str:
+    """json.dumps' indented text of n rows of ``width`` numbers, ``values`` their texts row by row."""
+    deeper = inner + step
+    parts = [""] * (2 * n * width - 1)
+    parts[::2] = values
+    parts[1::2] = ([",\n" + deeper] * (width - 1) + ["\n" + inner + "],\n" + inner + "[\n" + deeper]) * (n - 1) + [
+        ",\n" + deeper] * (width - 1)
+    return "[\n" + inner + "[\n" + deeper + "".join(parts) + "\n" + inner + "]\n" + pad + "]"
 
 
 def _numbers(values) -> bool:
