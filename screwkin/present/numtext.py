@@ -5,9 +5,9 @@ values were 4-5 s of one ``%`` a row).
 How: each finite value's 12 significant digits are the integer nearest ``|x| 10^k`` (k = 11 -
 its decimal exponent), computed in floating point with at most two roundings (10^k exact for
 |k| <= 22), i.e. within 3e-4 of the exact scaled value below 10^12.  Where that error could
-change the rounding (the scaled value within 1e-3 of a half), and for zeros, infinities, NaN
-and exponents outside [-33, 33], the value is written by Python's ``%`` itself (once per
-distinct value).  The digits are then laid out as ``%g`` does: fixed notation for exponents -4
+change the rounding (the scaled value within 1e-3 of a half), and for infinities, NaN and
+|x| outside [1e-33, 1e33), the value is written by Python's ``%`` itself (once per distinct
+value); zeros are the digits 000000000000 ("0", "-0").  The digits are then laid out as ``%g`` does: fixed notation for exponents -4
 to 11, exponential otherwise, trailing zeros and a bare point dropped.
 """
 
