@@ -90,3 +90,23 @@ def test_a_sweep_imports_no_other_analysis():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
                          env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
     assert out.stdout.strip().splitlines()[-1] == "0 []"
+
+
+def test_a_urdf_imports_neither_yaml_nor_the_web():
+    """Start-up on a URDF: no yaml (sidecars only), no xml.sax.saxutils with urllib, http, ssl (xacro only)."""
+    fourbar = ROBOTS / "fourbar_crank_rocker.urdf"
+    code = ("import sys\nfrom screwkin import cli\ncode = cli.main(['mobility', %r])\n"
+            "print(code, sorted(m for m in ('yaml', 'xml.sax.saxutils', 'urllib.request', 'ssl', 'defusedxml.minidom') "
+            "if m in sys.modules))" % str(fourbar))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "0 []"
+
+
+@pytest.mark.parametrize("text", ["", "a", 'say "hi"', "it's", "\"'", "a&b<c>d", "x\ny\rz\tw", "&amp;", "é"])
+def test_quoteattr_is_saxutils(text):
+    from xml.sax.saxutils import quoteattr as oracle
+
+    from screwkin.files.writer import quoteattr
+
+    assert quoteattr(text) == oracle(text)

@@ -46,7 +46,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import defusedxml
-import defusedxml.minidom
 
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..units import parse_value
@@ -406,6 +405,8 @@ class XacroInternalError(RuntimeError):
 
 def _dom(text: str, path):
     """A minidom document of checked text (defusedxml: no entities, no external references)."""
+    import defusedxml.minidom  # lazily: only xacro files need it (with xml.sax, urllib, http, ssl: 18 ms)
+
     try:
         return defusedxml.minidom.parseString(text.encode("utf-8"), forbid_dtd=False, forbid_entities=True,
                                               forbid_external=True)
