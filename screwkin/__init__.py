@@ -11,28 +11,51 @@ topology) <- ``analysis`` (results) <- ``present`` (text, JSON, pictures, views)
 ``cli``.  This module is the public API on top of them.
 """
 
-from .analysis.singularities.batch import SerialJacobians
-from .analysis.forces.dynamics import DynamicsResult, Load, dynamics
-from .analysis.motion.ik import inverse_kinematics
-from .analysis.mobility import (
-    IdleMotion,
-    MobilityResult,
-    OutputMotion,
-    analyze_mobility,
-)
-from .analysis.motion.position import PositionResult, PositionSolver, Solution
-from .analysis.singularities.scan import ScanResult, scan
-from .analysis.singularities.singular import SingularityReport, classify
-from .analysis.design.study import StudyResult, pareto_front
-from .parallel.study import run_study as _run_study
-from .analysis.motion.singular_points import locate_singularities
-from .analysis.motion.sweep import SweepResult, SweepSingularity, sweep
+from __future__ import annotations
+
+import importlib
+
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
 from .model import loader as _loader
 from .model import mechanism as _mechanism
-from .model.topology import Joint, Topology
-from .present.report import to_dict
 from .tolerances import Tolerances
+
+#: The rest of the public API, imported when first used (``screwkin.sweep``, ``from screwkin import
+#: scan``): ``import screwkin`` (and the command line, which imports it) loads the model layer
+#: only, not every analysis.
+_LAZY = {
+    "SerialJacobians": ".analysis.singularities.batch",
+    "DynamicsResult": ".analysis.forces.dynamics", "Load": ".analysis.forces.dynamics",
+    "dynamics": ".analysis.forces.dynamics",
+    "inverse_kinematics": ".analysis.motion.ik",
+    "IdleMotion": ".analysis.mobility", "MobilityResult": ".analysis.mobility", "OutputMotion": ".analysis.mobility",
+    "analyze_mobility": ".analysis.mobility",
+    "PositionResult": ".analysis.motion.position", "PositionSolver": ".analysis.motion.position",
+    "Solution": ".analysis.motion.position",
+    "ScanResult": ".analysis.singularities.scan", "scan": ".analysis.singularities.scan",
+    "SingularityReport": ".analysis.singularities.singular", "classify": ".analysis.singularities.singular",
+    "StudyResult": ".analysis.design.study", "pareto_front": ".analysis.design.study",
+    "locate_singularities": ".analysis.motion.singular_points",
+    "SweepResult": ".analysis.motion.sweep", "SweepSingularity": ".analysis.motion.sweep",
+    "sweep": ".analysis.motion.sweep",
+    "Joint": ".model.topology", "Topology": ".model.topology",
+    "to_dict": ".present.report",
+    "run_study": ".parallel.study",  # (screwkin.study below)
+}
+
+
+def __getattr__(name):
+    """The public name ``name`` from its module, imported now (PEP 562)."""
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
     "load",
@@ -80,7 +103,7 @@ class Mechanism(_mechanism.Mechanism):
         joint names overriding the file's; point: the output link's origin as a point."""
         if actuated is not None:
             self.set_actuated(actuated)
-        return analyze_mobility(self, output=output, seed=seed, point=point)
+        return __getattr__("analyze_mobility")(self, output=output, seed=seed, point=point)
 
 
 def load(path, yaml=None, actuated=None, tolerances: Tolerances = _loader.DEFAULT, warn=None,
@@ -98,4 +121,5 @@ def study(spec, scheduler=None, workers=None, progress=None, timeout: float = 10
     processes, or on the dask.distributed cluster at ``scheduler`` (``tcp://host:port``);
     ``workers=0`` in this process.  Returns a StudyResult: ``.rows`` (dicts, SI), ``.table``
     (columns); screwkin.present.study writes CSV, Parquet, text and plots."""
-    return _run_study(spec, scheduler=scheduler, workers=workers, progress=progress, timeout=timeout, base=base)
+    return __getattr__("run_study")(spec, scheduler=scheduler, workers=workers, progress=progress, timeout=timeout,
+                                    base=base)

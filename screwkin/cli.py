@@ -2,14 +2,16 @@
 
 A thin edge over the Python API: it builds the parser from the command modules of
 ``screwkin/commands/`` (one module per command: ``NAME``, ``NEEDS_MECHANISM``,
-``add_parser(sub, common, scaled)``, ``run(mech, args) -> exit code``), loads the mechanism,
-checks what every command shares and dispatches.  Exit codes: 0 success, 1 invalid or
+``add_parser(sub, common, scaled)``, ``run(mech, args) -> exit code``; only the invoked
+command's module is imported, the others are listed from the table COMMANDS), loads the
+mechanism, checks what every command shares and dispatches.  Exit codes: 0 success, 1 invalid or
 unanalysable file, 2 usage error, 3 internal error (a bug).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import re
 import sys
@@ -18,28 +20,6 @@ import warnings
 
 import numpy as np
 
-from .commands import (
-    draw,
-    dynamics,
-    equations,
-    export,
-    grasp,
-    ik,
-    info,
-    map,
-    mobility,
-    report,
-    scan,
-    screws,
-    singularities,
-    solve,
-    statics,
-    study,
-    sweep,
-    synthesize,
-    view,
-    workspace,
-)
 from .commands._common import add_common, add_scaled, names_list
 from .commands._options import check_parsed, screwkin_version
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
@@ -47,12 +27,43 @@ from .files.xacro import parse_args as parse_xacro_args
 from .model.loader import load
 from .units import parse_length
 
-__all__ = ["main", "COMMANDS"]
+__all__ = ["main", "COMMANDS", "command_module"]
 
-#: The commands, in the order `screwkin` lists them.
-COMMANDS = (mobility, info, solve, screws, singularities, map, scan, view, ik, sweep, statics, dynamics, study,
-            synthesize, grasp, workspace, equations, draw, report, export)
-_COMMAND_MODULES = {m.NAME: m for m in COMMANDS}
+#: The commands, in the order `screwkin` lists them, each with its one-line help (the same text as
+#: its module's ``add_parser`` gives: tests/test_cli_lazy.py).  A command's module
+#: (screwkin/commands/NAME.py, with the analysis and presentation it imports) is imported only
+#: when that command runs or shows its own --help: ``screwkin`` and ``screwkin --help`` list them
+#: from this table, and ``screwkin sweep ...`` imports sweep's module alone.
+COMMANDS = (
+    ("mobility", "degrees of freedom: counts and screw-theory mobility"),
+    ("info", "topology table: links, joints, loops (--joint-types: the joint vocabulary)"),
+    ("solve", "position, velocity and acceleration for given input values"),
+    ("screws", "product-of-exponentials structure equations and joint screws"),
+    ("singularities", "classify the singularities of a configuration"),
+    ("map", "map of the smallest singular value over two inputs"),
+    ("scan", "singularity scan of a serial chain over random configurations"),
+    ("view", "show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)"),
+    ("ik", "inverse kinematics: joint values that place an output link at a pose"),
+    ("sweep", "track one assembly mode along an input motion"),
+    ("statics", "actuator efforts and joint reactions holding a load; legs' wrenches"),
+    ("dynamics", "input efforts, joint reactions, shaking forces and flywheel at constant input speed"),
+    ("study", "design-space study of a family of mechanisms (a xacro file) on Dask"),
+    ("synthesize", "synthesize a planar linkage (motion, function, path) or enumerate kinematic chains; "
+                   "writes URDF checked with screwkin"),
+    ("grasp", "grasp analysis: grasp map, form and force closure, internal forces, quality"),
+    ("workspace", "workspace of an output link: volume, singularity-free part, conditioning"),
+    ("equations", "the loop equations in symbols: vector loops, velocity and acceleration matrices, det A and "
+                  "its singular conditions"),
+    ("draw", "skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations"),
+    ("report", "one self-contained document (HTML and/or Markdown): topology, counts, equations, Newton "
+               "iterations, motion, singular configurations with drawings, sweep, view"),
+    ("export", "write the mechanism as MJCF (MuJoCo) or URDF, assembled (loops closed in the file)"),
+)
+
+
+def command_module(name: str):
+    """The module of command ``name`` (screwkin/commands/NAME.py), imported now."""
+    return importlib.import_module(f"{__package__}.commands.{name}")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -74,19 +85,35 @@ class _Parser(argparse.ArgumentParser):
         return ns, rest
 
 
-def _parser():
+def _invoked(argv) -> str | None:
+    """The command named on the command line: its first word that is not an option (the top-level
+    options, --debug, --version and --help, take no value); None when there is none."""
+    names = {name for name, _ in COMMANDS}
+    for word in argv:
+        if isinstance(word, str) and not word.startswith("-"):
+            return word if word in names else None
+    return None
+
+
+def _parser(argv=()):
+    """The parser: every command listed with its help line; the one ``argv`` invokes built in full
+    (its module imported), the others as names only."""
     p = _Parser(prog="screwkin", description="Screw-theory analysis of spatial mechanisms described in URDF.")
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     p.add_argument("--version", action="version", version=f"screwkin {screwkin_version()}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser, title="commands",
                            metavar="COMMAND")
-    for command in COMMANDS:
-        command.add_parser(sub, add_common, add_scaled)
+    wanted = _invoked(argv)
+    for name, help in COMMANDS:
+        if name == wanted:
+            command_module(name).add_parser(sub, add_common, add_scaled)
+        else:
+            sub.add_parser(name, help=help)
     return p
 
 
 def _run(args):
-    command = _COMMAND_MODULES[args.command]
+    command = command_module(args.command)
     if not command.NEEDS_MECHANISM or (command.NEEDS_MECHANISM == "optional" and args.file is None):
         return command.run(None, args)
     if args.file is None:
@@ -118,12 +145,13 @@ def main(argv=None) -> int:
         except (OSError, ValueError):  # stderr closed: nowhere to say it
             pass
 
-    parser = _parser()
-    if not (sys.argv[1:] if argv is None else argv):  # bare `screwkin`: what it can do, a line a command
+    words = sys.argv[1:] if argv is None else list(argv)
+    parser = _parser(words)
+    if not words:  # bare `screwkin`: what it can do, a line a command
         print(parser.format_help())
         return 0
     try:
-        args = parser.parse_args(argv)
+        args = parser.parse_args(words)
     except SystemExit as exc:  # usage errors (2), --help and --version (0): main(argv) returns its code
         return exc.code if isinstance(exc.code, int) else 2
     debug = bool(getattr(args, "debug", False))

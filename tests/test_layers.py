@@ -14,8 +14,9 @@ LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "ana
 # xacro (28 ms, and it replaces minidom's pretty printer when imported) only for .xacro files
 # distributed (0.4-0.9 s) and pyarrow (optional: parquet tables) only for studies
 # PIL (with matplotlib) and imageio_ffmpeg (optional) for draw --animate; viser and trimesh (optional) for view --interactive
+# yaml (7 ms) only for sidecars and study specs; defusedxml.expatbuilder (minidom) only for .xacro files
 LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize", "networkx", "sympy", "xacro",
-        "distributed", "dask", "pyarrow", "PIL", "imageio_ffmpeg", "viser", "trimesh"}
+        "distributed", "dask", "pyarrow", "PIL", "imageio_ffmpeg", "viser", "trimesh", "yaml", "defusedxml.expatbuilder"}
 
 
 def module_name(path: Path) -> str:

@@ -12,18 +12,17 @@ from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep
 from ..errors import UsageError
+from ..present.jsonout import json_of
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.tables import RateUnits
 from ..present.plots import sweep_plot
 from ..present.streamout import SweepWriter
 from ..present.report import (
-    json_text,
     linkage_dict,
     sweep_dict,
     sweep_rows,
     sweep_singularity_dict,
     sweep_text,
-    to_jsonable,
     value_text,
 )
 from ..units import parse_typed_value, unit_kind
@@ -195,7 +194,7 @@ def run(mech, args) -> int:
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
         d["strokes"] = strokes_dict(slider_strokes)
-        print(json_text(to_jsonable(d)))
+        print(json_of(d))
     else:
         rows = sweep_rows(len(res.values), _rows(args.rows))
         typed_deg = any(unit_kind(parse_typed_value(t)[1]) == "angle" and "deg" in t.lower()

@@ -26,14 +26,13 @@ redundant there, as in screwkin's own count.  Visual geometry is not written.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 import pinocchio as pin
 
 from .description import Coupling
 from .mjcf import matrix_quat, quat_matrix
-from .writer import number_text, vector_text
+from .writer import number_text, quoteattr, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
            "TINY_MASS", "coupling_about"]

@@ -22,7 +22,6 @@ Inertias MuJoCo derives from geoms are not computed: a body without ``<inertial>
 from __future__ import annotations
 
 import math
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 import pinocchio as pin
@@ -31,7 +30,7 @@ from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
 from .description import LIMITS, Coupling, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
 from .urdf import Problems, check_sizes, numbers, unit_axis
-from .writer import vector_text
+from .writer import quoteattr, vector_text
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_mjcf", "quat_matrix", "matrix_quat"]

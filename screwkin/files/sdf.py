@@ -14,8 +14,6 @@ with ``use_parent_model_frame`` / ``expressed_in="__model__"``).
 
 from __future__ import annotations
 
-from xml.sax.saxutils import quoteattr
-
 import numpy as np
 import pinocchio as pin
 
@@ -23,6 +21,7 @@ from ..errors import MechanismFileError, quote, shorten
 from .description import LIMITS, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
 from .meshes import check_meshes
 from .urdf import check_sizes, numbers, unit_axis
+from .writer import quoteattr
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_sdf"]

@@ -22,7 +22,7 @@ from ..tolerances import DEFAULT
 from .description import TARGETS_NS
 
 __all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf", "number_text", "vector_text",
-           "targets_text"]
+           "targets_text", "quoteattr"]
 
 _COLOURS = ((0.35, 0.35, 0.35), (0.85, 0.3, 0.2), (0.2, 0.5, 0.85), (0.2, 0.7, 0.3), (0.85, 0.65, 0.1),
             (0.6, 0.3, 0.75), (0.1, 0.7, 0.7), (0.9, 0.45, 0.6))
@@ -86,6 +86,20 @@ class PlanarLinkage:
     density: float = 1.0  # [kg/m] of bar
     colours: dict = field(default_factory=dict)  # link name -> (r, g, b)
     targets: tuple = ()  # files.description.TargetSpec: written as <screwkin:targets>
+
+
+def quoteattr(data: str) -> str:
+    """An XML attribute value with its quotes, xml.sax.saxutils.quoteattr's text (& < > and newlines,
+    carriage returns and tabs escaped; single quotes around a value holding " but no ', else double
+    quotes with " as &quot;), without importing xml.sax.saxutils (it imports urllib.request, http, ssl
+    and email: 15 ms of every command's start-up)."""
+    data = data.replace("&", "&amp;").replace(">", "&gt;").replace("<", "&lt;")
+    data = data.replace("\n", "&#10;").replace("\r", "&#13;").replace("\t", "&#9;")
+    if '"' not in data:
+        return f'"{data}"'
+    if "'" not in data:
+        return f"'{data}'"
+    return '"%s"' % data.replace('"', "&quot;")
 
 
 def number_text(x) -> str:

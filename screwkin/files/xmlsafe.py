@@ -22,7 +22,6 @@ from pathlib import Path
 
 import defusedxml
 import defusedxml.ElementTree as SafeET
-import yaml
 
 from ..errors import MechanismFileError, shorten
 from .description import LIMITS
@@ -136,6 +135,7 @@ def _dashes_in_comment(text: str, line: int, column: int):
 
 
 def _safe_loader():
+    import yaml  # lazily: only sidecars and study specs are YAML (7 ms)
 
     class _NoAliasLoader(yaml.SafeLoader):
         """SafeLoader without aliases (``*a``) and with a bounded nesting depth."""
@@ -161,6 +161,7 @@ def _safe_loader():
 
 def load_yaml_text(text: str, path):
     """The plain data of a YAML document from a user (see the module's notes)."""
+    import yaml  # lazily: only sidecars and study specs are YAML (7 ms)
 
     loader = _safe_loader()(text)
     try:

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import json
 import math
+from itertools import chain
 
 import numpy as np
 
-__all__ = ["to_jsonable", "nan_to_none", "json_text"]
+__all__ = ["to_jsonable", "nan_to_none", "json_text", "json_of"]
 
 
 def to_jsonable(obj, _where: str = ""):
@@ -23,7 +24,7 @@ def to_jsonable(obj, _where: str = ""):
     if isinstance(obj, dict):
         return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        if isinstance(obj, list) and _numbers(obj):  # finite floats only: nothing to convert
+        if isinstance(obj, list) and (_numbers(obj) or _rows(obj)):  # finite floats only: nothing to convert
             return obj
         return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
     if isinstance(obj, np.ndarray):
@@ -61,6 +62,9 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
             return "[]"
         if _numbers(obj):
             return "[\n" + inner + (",\n" + inner).join(map(float.__repr__, obj)) + "\n" + pad + "]"
+        width = _rows(obj)
+        if width:  # rows of numbers of one length (vectors along a sweep): one join over all the numbers
+            return _rows_text(map(float.__repr__, chain.from_iterable(obj)), len(obj), width, pad, inner, " " * indent)
         if all(isinstance(v, list) and v and _numbers(v) for v in obj):  # rows of numbers (vectors along a sweep)
             deeper = inner + " " * indent
             sep = ",\n" + deeper
@@ -70,6 +74,44 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
     return json.dumps(obj, indent=indent).replace("\n", "\n" + pad)
 
 
+def json_of(obj, indent: int = 2, _level: int = 0, _where: str = "") -> str:
+    """json_text(to_jsonable(obj)), the same text, with the finite float arrays (a sweep's stacks,
+    (N,) or (N, k)) written from their values: no list a row, no check a number in Python."""
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj) and obj:
+        pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
+        items = (f"{inner}{json.dumps(k)}: {json_of(v, indent, _level + 1, f'{_where}.{k}')}" for k, v in obj.items())
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if (isinstance(obj, np.ndarray) and obj.dtype.kind == "f" and obj.ndim in (1, 2) and obj.size
+            and np.isfinite(obj).all()):
+        pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
+        values = map(float.__repr__, obj.ravel().tolist())
+        if obj.ndim == 1:
+            return "[\n" + inner + (",\n" + inner).join(values) + "\n" + pad + "]"
+        return _rows_text(values, *obj.shape, pad, inner, " " * indent)
+    return json_text(to_jsonable(obj, _where), indent, _level)
+
+
+def _rows_text(values, n: int, width: int, pad: str, inner: str, step: str) -> str:
+    """json.dumps' indented text of n rows of ``width`` numbers, ``values`` their texts row by row."""
+    deeper = inner + step
+    parts = [""] * (2 * n * width - 1)
+    parts[::2] = values
+    parts[1::2] = ([",\n" + deeper] * (width - 1) + ["\n" + inner + "],\n" + inner + "[\n" + deeper]) * (n - 1) + [
+        ",\n" + deeper] * (width - 1)
+    return "[\n" + inner + "[\n" + deeper + "".join(parts) + "\n" + inner + "]\n" + pad + "]"
+
+
 def _numbers(values) -> bool:
     """A list of finite floats only (two loops in C)."""
     return set(map(type, values)) == {float} and all(map(math.isfinite, values))
+
+
+def _rows(values) -> int:
+    """The length of every row when ``values`` is a list of lists of finite floats, all of one
+    nonzero length (a sweep's vectors); else 0 (loops in C, no Python call a row)."""
+    if not values or set(map(type, values)) != {list}:
+        return 0
+    widths = set(map(len, values))
+    if len(widths) != 1 or 0 in widths or not _numbers(list(chain.from_iterable(values))):
+        return 0
+    return widths.pop()

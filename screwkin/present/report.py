@@ -22,6 +22,7 @@ from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
 from .tables import RateUnits, column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
 from ..tolerances import DEFAULT
+from .numtext import csv_rows
 from .jsonout import json_text, nan_to_none, to_jsonable  # noqa: F401 - json_text exported here as before
 from .mobility import (  # noqa: F401 - exported here as before
     JOINT_COLUMNS,
@@ -408,9 +409,7 @@ def sweep_csv(res: SweepResult, motion=None, first_step: int = 0, header: bool =
     top = csv_text(["step"] + head, []) if header else ""
     if not len(res.values):
         return top
-    fmt = "%d," + ",".join(["%.12g"] * len(cols)) + "\n"
-    M = np.column_stack(cols).tolist()
-    return top + "".join([fmt % (first_step + k, *row) for k, row in enumerate(M)])
+    return top + csv_rows(cols, first_step)  # the text of "%d,%.12g,...\n" % row, built in numpy
 
 
 def scan_dict(res: ScanResult) -> dict:
