@@ -170,7 +170,7 @@ def test_report_lists_the_points_of_its_solutions(four_bar, tmp_path):
     assert len(rows) == 2  # one per assembly mode
 
     def numbers(cell):
-        return np.array([float(x) for x in cell.strip().strip("()").split(",")])
+        return np.array([float(x) for x in cell.strip().strip("()").replace(",", " ").split()])  # solve's "x y z"
 
     # closed form: B on the crank at 100 deg, C where the coupler (0.12) meets the rocker (0.08) about D
     th2, w2 = np.radians(100), 10.0
