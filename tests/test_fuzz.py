@@ -616,8 +616,17 @@ COMMAND_LINES = [
     ["ik", _ARM, "--output", "flange", "--pose", "0.3 0 0.3 0 0 {v}", "--starts", "2", "--json"],
     ["synthesize", "chains", "--links", "{v}", "--dof", "1", "--json"],
     ["mobility", _FIVE, "--output", "{v}", "--json"],
+    # this session's inputs and outputs: a floating link's angle, rates in typed units, branches, drawings
+    ["solve", _FIVE, "--set", "motor1=0.3", "--set-angle", "distal1={v}", "--json"],
+    ["solve", _FOURBAR, "--set-angle", "coupler={v}", "--rate", "coupler=1", "--json"],
+    ["solve", _FOURBAR, "--set", "crank_joint=1", "--rate", "crank_joint={v}"],
+    ["sweep", _FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "360deg", "--steps", "7", "--rate", "{v}"],
+    ["ik", _FIVE, "--output", "distal1", "--position", "{v},0.1,0", "--starts", "2", "--json"],
+    ["synthesize", "path", "--points", "0,0; 0.05,{v}; 0.1,0.05; 0.12,0.1; 0.08,0.12", "--starts", "2",
+     "--draw", "{o}"],
+    ["synthesize", "chains", "--links", "6", "--dof", "1", "-o", "{o}"],
 ]
-CLI_MUTANTS = 80
+CLI_MUTANTS = 110
 
 
 @functools.cache
