@@ -346,3 +346,12 @@ def test_stroke_and_time_ratio_of_an_offset_slider_crank(tmp_path, capsys):
     assert main(argv[:-1] + ["--rows", "all"]) == 0
     out = capsys.readouterr().out
     assert "joint values at 73 of the 73 configurations" in out and "time ratio" in out
+
+
+def test_solve_says_a_leg_length_input_as_typed(capsys):
+    """--set-length leg1=450mm: the inputs line gives the length typed beside the joint's displacement
+    (it gave only the displacement, -0.2026 m, which the user never typed)."""
+    assert main(["solve", str(ROBOTS / "gough_stewart_6ups.urdf"), "--set-length",
+                 "leg1,leg2,leg3,leg4,leg5,leg6=450mm"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("inputs: leg1 = 0.45 m long (joint -0.20258") and first.count("0.45 m long") == 6

@@ -55,9 +55,9 @@ from ..present.view import (
 )
 from ..units import parse_typed_assignments, parse_value, unit_kind
 from ._common import (
-    check_rate_names,
     add_configuration_options,
     add_point_option,
+    check_rate_names,
     joint_assignments,
     joint_inputs,
     named_points,

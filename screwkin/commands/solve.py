@@ -11,12 +11,13 @@ from ..present.report import (
     to_jsonable,
     trace_text,
 )
+from ..units import parse_typed_assignments
 from . import equations as equations_command
 from ._common import (
-    check_rate_names,
     add_angle_option,
     add_length_option,
     add_point_option,
+    check_rate_names,
     input_solver,
     joint_assignments,
     link_rates,
@@ -83,5 +84,6 @@ def run(mech, args) -> int:
         names = [mech.coordinate_names[k] for k in solver.passive]
         print(trace_text(res, solver.mech.closure.row_labels(solver=True), names))
         print()
-    print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args)))
+    legs = {n: v for n, v, _ in parse_typed_assignments(args.set_length, "--set-length")} if args.set_length else None
+    print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args), leg_lengths=legs))
     return 0

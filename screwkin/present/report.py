@@ -149,11 +149,19 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
     return headers, rows
 
 
-def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits()) -> str:
+def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits(),
+                  leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
-    accelerations in ``units`` (those typed with --rate/--accel)."""
-    inputs = ", ".join([f"{k} = {value_text(k, v, k in res.angular)}" for k, v in res.inputs.items()
+    accelerations in ``units`` (those typed with --rate/--accel); ``leg_lengths``: the inputs given
+    as leg lengths (--set-length), said as typed beside the joint's value."""
+    legs = leg_lengths or {}
+
+    def given(k, v):
+        text = value_text(k, v, k in res.angular)
+        return f"{k} = {legs[k]:.9g} m long (joint {text})" if k in legs else f"{k} = {text}"
+
+    inputs = ", ".join([given(k, v) for k, v in res.inputs.items()
                         if isinstance(v, float)] + [f"angle of {k} = {value_text(k, v, True)}"
                                                     for k, v in (res.held or {}).items()])
     shown = list(res.solutions) if show_all else [s for s in res.solutions if s.physical] or list(res.solutions)
