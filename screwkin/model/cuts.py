@@ -1,6 +1,7 @@
 """What a closure system closes: the cut joints bound to a model (frames F1, F2 and axes), the
 linear couplings of rolling and screw pairs, the contacts of profiles in a plane, and the closed
-configuration a solve returns.  Plain frozen data; model.closure evaluates their rows.
+configuration a solve returns.  Plain frozen data; model.closure evaluates their rows.  Also where
+a rolling or gear pair's pitch curves touch (pair_contact: the one place that computes it).
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly"]
+__all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact"]
 
 
 @dataclass(frozen=True)
@@ -105,3 +106,42 @@ class Assembly:
     iterations: int
     start: str = "the given configuration"
     starts: int = 1
+
+#: A unit axis's component off e below this: e lies along the axis, in_plane takes the next one.
+_ALONG_AXIS = 1e-6
+
+
+def in_plane(axis):
+    """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
+    a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1)."""
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    for e in np.eye(3):
+        u = e - (e @ a) * a
+        if np.linalg.norm(u) > _ALONG_AXIS:
+            u /= np.linalg.norm(u)
+            return a, u, np.cross(a, u)
+    raise ValueError("degenerate axis")  # pragma: no cover
+
+
+def pair_contact(pair, M1, M2):
+    """(p, a): the world point where the pitch curves of a rolling or gear pair touch, and the
+    pair's unit axis in the world (the normal of its plane).  ``pair``: the file's loop joint
+    (files.description: axis in F1, radius1 -- inf for a line --, radius2, contact); M1, M2: the
+    world placements (pinocchio.SE3) of its frames F1 (circle 1's centre, or a point of the line,
+    which runs along u of in_plane(axis) in F1) and F2 (circle 2's centre).
+
+    Two circles, outside or inside: r1 from circle 1's centre towards circle 2's (the line of
+    centres); a circle on a line: the foot of circle 2's centre on the line.  Rolling without
+    slip turns one link relative to the other about this point (its instantaneous centre), so a
+    revolute about ``a`` through ``p`` is the pair's instantaneous equivalent."""
+    a, u, _ = in_plane(pair.axis)
+    a = M1.rotation @ a
+    p1, p2 = np.asarray(M1.translation, float), np.asarray(M2.translation, float)
+    d = p2 - p1
+    d = d - (d @ a) * a  # in the pair's plane
+    if np.isinf(pair.radius1):
+        u = M1.rotation @ u
+        return p1 + (d @ u) * u, a
+    dist = float(np.linalg.norm(d))
+    e = d / dist if dist > 0 else M1.rotation @ u  # concentric (inside): F1's line as the contact direction
+    return p1 + float(pair.radius1) * e, a

@@ -29,6 +29,7 @@ from ..files.xacro import is_xacro
 from ..files.xmlsafe import parse_xml_text, read_regular_file
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import FRAME_PREFERENCE, frame_id
+from .cuts import in_plane
 from .mechanism import Mechanism, virtual_joint_name, virtual_roles
 
 __all__ = ["load"]
@@ -196,18 +197,6 @@ def _couple(model, couplings, path):
     return model
 
 
-def _in_plane(axis):
-    """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
-    a, and a x u."""
-    a = np.asarray(axis, float) / np.linalg.norm(axis)
-    for e in np.eye(3):
-        u = e - (e @ a) * a
-        if np.linalg.norm(u) > 1e-6:
-            u /= np.linalg.norm(u)
-            return a, u, np.cross(a, u)
-    raise ValueError("degenerate axis")  # pragma: no cover
-
-
 def _virtual_pairs(model, spec) -> None:
     """Give every rolling, gear and helical loop joint the massless chain of its equivalent
     linkage, from F1 on its first link, whose coordinates are the pair's unwrapped angles (and
@@ -232,7 +221,7 @@ def _virtual_pairs(model, spec) -> None:
             continue  # reported when the cut joint is bound
         parent = model.frames[fid]
         P = parent.placement * placement(c.xyz1, c.rpy1)
-        a, u, n = _in_plane(c.axis)
+        a, u, n = in_plane(c.axis)
         inf, zero = np.array([-np.inf]), np.array([np.inf])
 
         roles = virtual_roles(c)

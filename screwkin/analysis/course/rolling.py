@@ -35,6 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ...model.cuts import in_plane, pair_contact
+
 __all__ = ["HIGHER", "RollingPair", "measure_pairs", "pair_term", "substitute_pairs", "turns_through_pairs",
            "unwrapped", "drop_constant_rows", "virtual_coordinates"]
 
@@ -75,18 +77,18 @@ def measure_pairs(loops, data):
         M1, M2 = data.oMf[f1], data.oMf[f2]
         loops.keep((j.name, la), la, M1.translation)
         loops.keep((j.name, lb), lb, M2.translation)
-        p1, p2 = loops._p2(M1.translation), loops._p2(M2.translation)
-        ux = loops._p2(M1.rotation[:, 0])
+        p1 = loops._p2(M1.translation)
+        d = loops._p2(pair_contact(c, M1, M2)[0]) - p1  # the contact point (model.cuts) from F1's origin
         rack = bool(np.isinf(c.radius1))
         rec = {"name": j.name, "a": la, "b": lb, "r1": None if rack else float(c.radius1), "r2": float(c.radius2),
                "kind": "rack" if rack else ("internal" if c.contact == "internal" else "external")}
         if rack:
-            u = ux / np.linalg.norm(ux)
+            u = loops._p2(M1.rotation @ in_plane(c.axis)[1])
+            u = u / np.linalg.norm(u)
             rec["u_angle"] = float(np.arctan2(u[1], u[0]))  # absolute angle of the line at q
-            rec["x"] = float((p2 - p1) @ u)  # contact point along the line from F1's origin
+            rec["x"] = float(d @ u)  # contact point along the line from F1's origin
         else:
-            d = p2 - p1
-            rec["k_angle"] = float(np.arctan2(d[1], d[0]))  # line of centres at q
+            rec["k_angle"] = float(np.arctan2(d[1], d[0]))  # line of centres at q (towards the contact)
         out[j.name] = rec
     return out
 

@@ -31,12 +31,13 @@ import numpy as np
 import pinocchio as pin
 
 from ...model.linalg import null_space, rank
+from ...model.cuts import pair_contact
 from ...model.state import KinematicState, loop_coordinate_cuts
 from ...tolerances import DEFAULT
 from ..screws import cut_twists, screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
-           "KINDS", "GramLoop", "loop_twists", "gram_cofactors"]
+           "KINDS", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 KINDS = ("serial", "actuator", "constraint")
@@ -229,6 +230,10 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
             scale = L if c.type == "prismatic" else 1.0
             if max(abs(st.loop_rate(c)) for st in states) / scale < tol.stationary:
                 stationary += (c.name,)
+        # a rolling or gear pair too: its rate is that of its Gram column (pair_twist), the links' relative turning
+        for c in mech.cuts:
+            if c.pair in EQUIVALENT_REVOLUTE and max(abs(pair_rate(mech, c, st)) for st in states) < tol.stationary:
+                stationary += (c.name,)
     sigmas = {k: sig.get(k, 1.0) for k in KINDS}
     return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
                              L, tuple(twists), tuple(inputs), output, point, gram_cofactors(mech, q, L))
@@ -276,17 +281,21 @@ def loop_twists(mech, q, cut, length=None):
         sides.append({j for j in model.supports[model.frames[f].parentJoint] if j > 0})
     names, cols, slide = [], [], []
     coord_names = mech.coordinate_names
+    virtual = set(mech.virtual_joints.get(cut.name, ()))
     for c in mech.coordinates:
         on1, on2 = c.joint_id in sides[0], c.joint_id in sides[1]
-        if on1 == on2:
-            continue  # not in the loop, or on the common path from the ground (it cancels)
+        if on1 == on2 or c.joint in virtual:
+            continue  # not in the loop, on the common path from the ground (it cancels), or a pair's virtual joint
         for k in range(c.idx_v, c.idx_v + c.nv):
             names.append(coord_names[k])
             cols.append(J1[:, k] if on1 else -J2[:, k])
             slide.append(bool(mech.translational[k]))
-    extra = cut_twists(mech, cut, state)
+    extra = pair_twist(mech, cut, state) if cut.pair in EQUIVALENT_REVOLUTE else cut_twists(mech, cut, state)
     if extra is None:
-        return names, None, f"the loop closes through the {cut.pair} pair's equivalent linkage: not computed"
+        why = {"contact": "a sliding contact (cam, pin in a slot) has two freedoms, rolling and sliding, and no "
+                          "one-twist equivalent",
+               "helical": "the screw pair's twist is not written here"}.get(cut.pair, "")
+        return names, None, f"the loop closes through the {cut.pair} pair ({why}): not computed"
     for name, t, sl in extra:
         names.append(name)
         cols.append(t)
@@ -295,6 +304,33 @@ def loop_twists(mech, q, cut, length=None):
     S[:3] /= L
     S[:, np.array(slide, bool)] *= L
     return names, S, None
+
+
+#: Higher pairs whose Gram column is a revolute about the contact point (their instantaneous equivalent).
+EQUIVALENT_REVOLUTE = ("rolling", "gear")
+
+
+def _pair_frames(mech, cut):
+    """(the file's loop joint, frame id of F1, of F2) of the rolling or gear pair closed by ``cut``."""
+    spec = next(c for c in mech.spec.cut_joints if c.name == cut.name)
+    return spec, mech.model.getFrameId(f"{cut.name}@F1"), cut.frame2
+
+
+def pair_twist(mech, cut, state):
+    """[(name, twist, False)]: the rolling or gear pair closed by ``cut`` as one revolute about its
+    axis through the contact point (model.cuts.pair_contact), a world twist (v at the world origin,
+    w) at a unit rate of turning of F2's link relative to F1's: pure rolling is that rotation."""
+    spec, f1, f2 = _pair_frames(mech, cut)
+    p, a = pair_contact(spec, state.frame_placement(f1), state.frame_placement(f2))
+    return [(cut.name, np.concatenate([-np.cross(a, p), a]), False)]
+
+
+def pair_rate(mech, cut, state) -> float:
+    """The rate [rad/s] of the pair's column in pair_twist in the motion of ``state`` (with rates):
+    F2's angular velocity relative to F1's about the pair's axis."""
+    spec, f1, f2 = _pair_frames(mech, cut)
+    a = pair_contact(spec, state.frame_placement(f1), state.frame_placement(f2))[1]
+    return float((state.frame_twist(f2)[3:] - state.frame_twist(f1)[3:]) @ a)
 
 
 def gram_cofactors(mech, q, length=None) -> tuple:

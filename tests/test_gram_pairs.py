@@ -1,0 +1,123 @@
+"""The numeric Gram cofactors of loops through rolling and gear pairs (issue 25, points 5 and 6): the
+pair is one column, a revolute about the plane's normal through the contact point (pure rolling turns
+one link about it relative to the other), as singularities --symbolic takes it.  Against formulas the
+test writes itself from the files' dimensions (the symbolic ones of tests/test_course_rolling.py, with
+numbers put in).  The numeric table is dimensionless: twists (y/L, -x/L, 1) of revolutes, a slide's
+(cos b, sin b, 0) (linear part / L, column x L), so each hand formula is written with every length over L."""
+
+import json
+
+import numpy as np
+import pytest
+
+from screwkin import load
+from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.singularities.singular import classify, gram_cofactors
+from screwkin.cli import main
+
+WHEELS, RACK, GEARS = "robots/friction_wheels.urdf", "robots/rack_pinion.urdf", "robots/gear_train_idler.urdf"
+# friction_wheels.urdf: disc 2 (radius 0.02) pinned at the origin, its centre at (0.008, 0.008) at theta2 = 0;
+# disc 3 (radius 0.01) on a slider along x through the origin
+R2, R3 = 0.02, 0.01
+
+
+def solved(path, name, value):
+    mech = load(path)
+    q0 = mech.generic_configurations()[0].q
+    res = PositionSolver(mech, [name]).solve({name: value}, near=mech.joint_values(q0))
+    return mech, res.solutions[0].q
+
+
+def wheels_by_hand(theta2, L):
+    """The friction wheels' cofactors at theta2: C2 = |O2C2| (cos, sin)(theta2 + 45 deg), disc 3's centre at
+    x4 = C2x + sqrt((R2 + R3)^2 - C2y^2) (the branch drawn), t the line of centres' angle; the symbolic formulas
+    C_wheel2 = rho3^2 cos^2 t, C_slide = rho3^2 x4^2 sin^2 t, C_wheel3 = (x4 - rho3 cos t)^2, C_wheels = x4^2
+    (derived in tests/test_course_rolling.py) with lengths over L."""
+    c2 = np.hypot(0.008, 0.008) * np.array([np.cos(theta2 + np.pi / 4), np.sin(theta2 + np.pi / 4)])
+    x4 = c2[0] + np.sqrt((R2 + R3) ** 2 - c2[1] ** 2)
+    t = np.arctan2(-c2[1], x4 - c2[0])
+    rho3, x = R3 / L, x4 / L
+    return x4, {"wheel2_joint": rho3 ** 2 * np.cos(t) ** 2, "slide": rho3 ** 2 * x ** 2 * np.sin(t) ** 2,
+                "wheel3_joint": (x - rho3 * np.cos(t)) ** 2, "wheels": x ** 2}
+
+
+@pytest.mark.parametrize("deg", [0.0, 30.0, 100.0, -160.0])
+def test_friction_wheels_numeric_cofactors_are_the_symbolic_formulas(deg):
+    mech, q = solved(WHEELS, "wheel2_joint", np.radians(deg))
+    (g,) = gram_cofactors(mech, q)
+    x4, hand = wheels_by_hand(np.radians(deg), mech.length)
+    slide = mech.coordinate("slide")
+    assert 0.0369136645896019 + q[slide.idx_q] == pytest.approx(x4, abs=1e-9)  # the configuration meant
+    assert g.nullity == 1 and g.note is None
+    assert sorted(g.joints) == sorted(hand)  # one column for the pair, its virtual joints gone
+    for joint, value in hand.items():
+        assert g.cofactors[joint] == pytest.approx(value, rel=1e-7, abs=1e-12), joint
+    assert g.zero == ()
+    assert classify(mech, q).stationary_joints == ()
+
+
+def test_friction_wheels_stationary_slider_where_its_cofactor_vanishes(capsys):
+    """At theta2 = -45 deg disc 2's centre is on the slider's line: sin t = 0, so C_slide = rho3^2 x4^2 sin^2 t = 0;
+    stationary joints names the slide and only it, as the Gram table does."""
+    mech, q = solved(WHEELS, "wheel2_joint", np.radians(-45.0))
+    (g,) = gram_cofactors(mech, q)
+    _, hand = wheels_by_hand(np.radians(-45.0), mech.length)
+    assert hand["slide"] < 1e-30
+    assert g.zero == ("slide",)
+    assert abs(g.cofactors["slide"]) < 1e-12
+    for joint in ("wheel2_joint", "wheel3_joint", "wheels"):
+        assert g.cofactors[joint] == pytest.approx(hand[joint], rel=1e-7)
+    assert classify(mech, q).stationary_joints == ("slide",)
+    assert main(["singularities", WHEELS, "--set", "wheel2_joint=-45deg", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["stationary_joints"] == ["slide"] and d["gram_zero"] == ["slide"]
+    assert main(["singularities", WHEELS]) == 0
+    out = capsys.readouterr().out
+    assert "not computed" not in out and "wheels" in out
+
+
+@pytest.mark.parametrize("deg", [0.0, 40.0, -170.0])
+def test_gear_loops_numeric_cofactors_are_the_hand_gram_determinants(deg):
+    """gear_train_idler.urdf: input (pitch radius 0.05) at the origin, idler (0.03) 0.08 m and output (0.08) 0.19 m
+    along x.  A loop of two gears on one frame: twists (0, -x/L, 1) of the two centres and of the contact, each
+    2 x 2 Gram determinant |O_b - P|^2 / L^2 (the points on the x axis through the origin): removing one gear
+    leaves the other's centre and the contact, removing the pair leaves the centre distance."""
+    mech, q = solved(GEARS, "input_joint", np.radians(deg))
+    L = mech.length
+    loops = {g.loop: g for g in gram_cofactors(mech, q)}
+    hand = {"mesh1": {"input_joint": 0.03, "idler_joint": 0.05, "mesh1": 0.08},
+            "mesh2": {"idler_joint": 0.08, "output_joint": 0.03, "mesh2": 0.11}}
+    assert set(loops) == set(hand)
+    for name, cof in hand.items():
+        g = loops[name]
+        assert g.nullity == 1 and sorted(g.joints) == sorted(cof)
+        for joint, d in cof.items():
+            assert g.cofactors[joint] == pytest.approx((d / L) ** 2, rel=1e-9), (name, joint)
+        assert g.zero == ()
+    assert classify(mech, q).stationary_joints == ()
+
+
+@pytest.mark.parametrize("deg", [0.0, 50.0, -300.0])
+def test_rack_loop_numeric_cofactors_are_the_hand_formulas(deg):
+    """rack_pinion.urdf: the pinion (pitch radius 0.04) at the origin, the rack's pitch line at y = 0.04: the contact
+    stays at (0, 0.04) however far the rack has moved.  Twists (0, 0, 1), (1, 0, 0), (0.04/L, 0, 1): C_pinion =
+    |(1,0,0) x (0.04/L, 0, 1)|^2 = 1, C_rack = (0.04/L)^2, C_mesh = 1 (the symbolic 1, rho2^2, 1 over L)."""
+    mech, q = solved(RACK, "pinion_joint", np.radians(deg))
+    rack = mech.coordinate("rack_joint")
+    assert abs(q[rack.idx_q]) == pytest.approx(0.04 * abs(np.radians(deg)), abs=1e-9)  # the rack has moved
+    (g,) = gram_cofactors(mech, q)
+    assert g.nullity == 1 and sorted(g.joints) == ["mesh", "pinion_joint", "rack_joint"]
+    hand = {"pinion_joint": 1.0, "rack_joint": (0.04 / mech.length) ** 2, "mesh": 1.0}
+    for joint, value in hand.items():
+        assert g.cofactors[joint] == pytest.approx(value, rel=1e-9), joint
+
+
+def test_a_loop_through_a_sliding_contact_says_why_it_is_not_computed():
+    """A cam or pin-in-slot contact has two freedoms (rolling and sliding): no one-twist equivalent."""
+    from conftest import ROBOTS
+    paths = [p for p in sorted(ROBOTS.glob("*.urdf")) if 'type="contact"' in p.read_text()]
+    assert paths
+    mech = load(str(paths[0]))
+    q = mech.generic_configurations()[0].q
+    notes = [g.note for g in gram_cofactors(mech, q) if g.nullity == -1]
+    assert notes and all("sliding contact" in n and "not computed" in n for n in notes)
