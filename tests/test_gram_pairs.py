@@ -121,3 +121,39 @@ def test_a_loop_through_a_sliding_contact_says_why_it_is_not_computed():
     q = mech.generic_configurations()[0].q
     notes = [g.note for g in gram_cofactors(mech, q) if g.nullity == -1]
     assert notes and all("sliding contact" in n and "not computed" in n for n in notes)
+
+
+@pytest.mark.parametrize("deg", [0.0, 720.0])
+def test_screw_pair_loop_is_one_screw_column(deg):
+    """lead_screw_jack.urdf: screw, lift and the screw pair of lead 0.005 m all on the z axis through the origin.
+    Twists (0, 0, 0, 0, 0, 1), the slide's (0, 0, 1, 0, 0, 0) and the screw's (0, 0, h/L, 0, 0, 1), h = lead / 2 pi:
+    C_screw = Gram(lift, thread) = 1 (h^2/L^2 + 1) - (h/L)^2 = 1, C_lift = Gram(screw, thread) = (h/L)^2,
+    C_thread = Gram(screw, lift) = 1."""
+    mech, q = solved("robots/lead_screw_jack.urdf", "screw_joint", np.radians(deg))
+    (g,) = gram_cofactors(mech, q)
+    h = 0.005 / (2 * np.pi) / mech.length
+    assert g.nullity == 1 and sorted(g.joints) == ["lift", "screw_joint", "thread"]
+    for joint, value in {"screw_joint": 1.0, "lift": h ** 2, "thread": 1.0}.items():
+        assert g.cofactors[joint] == pytest.approx(value, rel=1e-9), joint
+
+
+def test_pair_rate_is_the_relative_turning_and_the_gram_null_vector_agrees():
+    """The pair's column turns at the links' relative rate: for the friction wheels theta3' - theta2' (disc 3 rides a
+    slider that does not turn), the rates here by central differences of solved configurations; the loop's null
+    vector v (adj G = c v v^T) has v_wheels / v_wheel2 = the same rate over theta2'."""
+    import pinocchio as pin
+    from screwkin.analysis.singularities.singular import loop_twists, pair_rate
+    from screwkin.model.state import KinematicState
+    t, dt = np.radians(30.0), 1e-6
+    mech, q = solved(WHEELS, "wheel2_joint", t)
+    _, qa = solved(WHEELS, "wheel2_joint", t - dt)
+    _, qb = solved(WHEELS, "wheel2_joint", t + dt)
+    qd = pin.difference(mech.model, qa, qb) / (2 * dt)
+    w2, w3 = (qd[mech.coordinate(n).idx_v] for n in ("wheel2_joint", "wheel3_joint"))
+    assert w2 == pytest.approx(1.0, abs=1e-6)
+    (cut,) = mech.cuts
+    rate = pair_rate(mech, cut, KinematicState(mech, q, qd))
+    assert rate == pytest.approx(w3 - w2, rel=1e-5)
+    names, S, _ = loop_twists(mech, q, cut)
+    v = np.linalg.svd(S)[2][-1]
+    assert v[names.index("wheels")] / v[names.index("wheel2_joint")] == pytest.approx(rate / w2, rel=1e-5)

@@ -31,7 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...model.linalg import null_space, rank
-from ...model.cuts import pair_contact
+from ...model.cuts import in_plane, pair_contact
 from ...model.state import KinematicState, loop_coordinate_cuts
 from ...tolerances import DEFAULT
 from ..screws import cut_twists, screw_of
@@ -230,9 +230,9 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
             scale = L if c.type == "prismatic" else 1.0
             if max(abs(st.loop_rate(c)) for st in states) / scale < tol.stationary:
                 stationary += (c.name,)
-        # a rolling or gear pair too: its rate is that of its Gram column (pair_twist), the links' relative turning
+        # a rolling, gear or screw pair too: its rate is that of its Gram column (pair_twist), the links' relative turning
         for c in mech.cuts:
-            if c.pair in EQUIVALENT_REVOLUTE and max(abs(pair_rate(mech, c, st)) for st in states) < tol.stationary:
+            if c.pair in ONE_TWIST and max(abs(pair_rate(mech, c, st)) for st in states) < tol.stationary:
                 stationary += (c.name,)
     sigmas = {k: sig.get(k, 1.0) for k in KINDS}
     return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
@@ -290,12 +290,10 @@ def loop_twists(mech, q, cut, length=None):
             names.append(coord_names[k])
             cols.append(J1[:, k] if on1 else -J2[:, k])
             slide.append(bool(mech.translational[k]))
-    extra = pair_twist(mech, cut, state) if cut.pair in EQUIVALENT_REVOLUTE else cut_twists(mech, cut, state)
+    extra = pair_twist(mech, cut, state) if cut.pair in ONE_TWIST else cut_twists(mech, cut, state)
     if extra is None:
-        why = {"contact": "a sliding contact (cam, pin in a slot) has two freedoms, rolling and sliding, and no "
-                          "one-twist equivalent",
-               "helical": "the screw pair's twist is not written here"}.get(cut.pair, "")
-        return names, None, f"the loop closes through the {cut.pair} pair ({why}): not computed"
+        return names, None, ("the loop closes through a sliding contact (cam, pin in a slot): its two freedoms, "
+                             "rolling and sliding, have no one-twist equivalent: not computed")
     for name, t, sl in extra:
         names.append(name)
         cols.append(t)
@@ -306,8 +304,9 @@ def loop_twists(mech, q, cut, length=None):
     return names, S, None
 
 
-#: Higher pairs whose Gram column is a revolute about the contact point (their instantaneous equivalent).
-EQUIVALENT_REVOLUTE = ("rolling", "gear")
+#: Pairs closed through an equivalent linkage whose Gram column is one twist (pair_twist): rolling and gear pairs
+#: a revolute about the contact point (their instantaneous equivalent), a screw pair its screw.
+ONE_TWIST = ("rolling", "gear", "helical")
 
 
 def _pair_frames(mech, cut):
@@ -316,20 +315,29 @@ def _pair_frames(mech, cut):
     return spec, mech.model.getFrameId(f"{cut.name}@F1"), cut.frame2
 
 
-def pair_twist(mech, cut, state):
-    """[(name, twist, False)]: the rolling or gear pair closed by ``cut`` as one revolute about its
-    axis through the contact point (model.cuts.pair_contact), a world twist (v at the world origin,
-    w) at a unit rate of turning of F2's link relative to F1's: pure rolling is that rotation."""
+def _pair_axis(mech, cut, state):
+    """(spec, F1, F2, p, a): a point p of the pair's one-twist axis and its unit direction a, world."""
     spec, f1, f2 = _pair_frames(mech, cut)
-    p, a = pair_contact(spec, state.frame_placement(f1), state.frame_placement(f2))
-    return [(cut.name, np.concatenate([-np.cross(a, p), a]), False)]
+    M1 = state.frame_placement(f1)
+    if cut.pair == "helical":  # the screw's axis through F1's origin
+        return spec, f1, f2, M1.translation, M1.rotation @ in_plane(spec.axis)[0]
+    return (spec, f1, f2, *pair_contact(spec, M1, state.frame_placement(f2)))
+
+
+def pair_twist(mech, cut, state):
+    """[(name, twist, False)]: the pair closed by ``cut`` as one twist (v at the world origin, w) at a
+    unit rate of turning of F2's link relative to F1's.  A rolling or gear pair: a revolute about
+    its axis through the contact point (model.cuts.pair_contact; pure rolling is that rotation);
+    a screw pair: the screw of pitch lead / 2 pi about its axis through F1's origin."""
+    spec, _, _, p, a = _pair_axis(mech, cut, state)
+    v = -np.cross(a, p) + (spec.lead / (2 * np.pi) * a if cut.pair == "helical" else 0.0)
+    return [(cut.name, np.concatenate([v, a]), False)]
 
 
 def pair_rate(mech, cut, state) -> float:
     """The rate [rad/s] of the pair's column in pair_twist in the motion of ``state`` (with rates):
     F2's angular velocity relative to F1's about the pair's axis."""
-    spec, f1, f2 = _pair_frames(mech, cut)
-    a = pair_contact(spec, state.frame_placement(f1), state.frame_placement(f2))[1]
+    _, f1, f2, _, a = _pair_axis(mech, cut, state)
     return float((state.frame_twist(f2)[3:] - state.frame_twist(f1)[3:]) @ a)
 
 
