@@ -123,6 +123,45 @@ def test_a_loop_through_a_sliding_contact_says_why_it_is_not_computed():
     assert notes and all("sliding contact" in n and "not computed" in n for n in notes)
 
 
+PINION_ON_A_SLIDE = """<?xml version="1.0"?>
+<robot name="pinion_on_a_slide">
+  <link name="ground"/><link name="carriage"/><link name="pinion"/>
+  <joint name="carriage_joint" type="prismatic">
+    <parent link="ground"/><child link="carriage"/><origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="-0.2" upper="0.2" effort="10" velocity="5"/>
+  </joint>
+  <joint name="pinion_joint" type="continuous">
+    <parent link="carriage"/><child link="pinion"/><origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/>
+  </joint>
+  <loop_joint name="mesh" type="gear">
+    <link1 link="ground" xyz="0 0.04 0" rpy="0 0 0"/>
+    <link2 link="pinion" xyz="0 0 0" rpy="0 0 1.5707963267949"/>
+    <axis xyz="0 0 1"/>
+    <gear radius1="inf" radius2="0.04"/>
+  </loop_joint>
+  <transmission name="t"><joint name="carriage_joint"/></transmission>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("s", [0.0, 0.07, -0.03])
+def test_pinion_on_a_slide_rolls_on_a_fixed_rack_about_the_moving_contact(tmp_path, s):
+    """A pinion (pitch radius 0.04) on a carriage sliding along x, meshing with a fixed rack whose pitch line is
+    y = 0.04: the contact is (s, 0.04), above the pinion's centre (s, 0), wherever the carriage is.  Twists, lengths
+    over L: slide (1, 0, 0), pinion (0, -s', 1), mesh (h, -s', 1) with s' = s/L, h = 0.04/L:
+    C_slide = |pinion x mesh|^2 = h^2 (1 + s'^2), C_pinion = |slide x mesh|^2 = 1 + s'^2, C_mesh = 1 + s'^2."""
+    path = tmp_path / "pinion_on_a_slide.urdf"
+    path.write_text(PINION_ON_A_SLIDE)
+    mech, q = solved(str(path), "carriage_joint", s)
+    (g,) = gram_cofactors(mech, q)
+    L = mech.length
+    sp, h = s / L, 0.04 / L
+    assert g.nullity == 1 and sorted(g.joints) == ["carriage_joint", "mesh", "pinion_joint"]
+    hand = {"carriage_joint": h ** 2 * (1 + sp ** 2), "pinion_joint": 1 + sp ** 2, "mesh": 1 + sp ** 2}
+    for joint, value in hand.items():
+        assert g.cofactors[joint] == pytest.approx(value, rel=1e-9), joint
+
+
 @pytest.mark.parametrize("deg", [0.0, 720.0])
 def test_screw_pair_loop_is_one_screw_column(deg):
     """lead_screw_jack.urdf: screw, lift and the screw pair of lead 0.005 m all on the z axis through the origin.
