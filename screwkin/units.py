@@ -153,7 +153,10 @@ def parse_typed_assignments(items, option: str) -> list:
             if not name.strip():
                 raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
             typed = parse_typed_value(value)
-            out += [(n, *typed) for n in (*pending, name.strip())]
+            for n in (*pending, name.strip()):
+                if any(n == m for m, _, _ in out):  # the last would win without a word
+                    raise UsageError(f"{option}: {quote(n)} is given twice")
+                out.append((n, *typed))
             pending = []
         if pending:
             raise UsageError(f"{option} expects NAME=VALUE (or NAME,NAME=VALUE), got {quote(item)}: "

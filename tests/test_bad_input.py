@@ -619,3 +619,19 @@ def test_a_rate_of_a_joint_that_is_not_an_input_is_refused(command, capsys, tmp_
     err = capsys.readouterr().err
     assert "--rate rocker_joint: not an input (inputs: crank_joint)" in err
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--set", "crank_joint=0.1", "--set", "crank_joint=0.2"], "--set: 'crank_joint' is given twice"),
+    (["--set", "crank_joint=0.1,crank_joint=0.2"], "--set: 'crank_joint' is given twice"),
+    (["--set-angle", "crank=10deg", "--set-angle", "crank=20deg"], "--set-angle: 'crank' is given twice"),
+    (["--set", "crank_joint=1e308"], "beyond 100000 rad an angle's place in its turn is lost"),
+    (["--set-angle", "coupler=1e9deg"], "beyond 100000 rad an angle's place in its turn is lost"),
+])
+def test_a_value_given_twice_or_beyond_any_turn_is_refused(argv, words, capsys):
+    """The last of two values won without a word; 1e308 rad was solved as if it meant an angle
+    (nothing of its fraction of a turn survives rounding past 1e5 rad at the closure tolerance)."""
+    from screwkin.cli import main
+
+    assert main(["solve", str(ROBOTS / "fourbar_crank_rocker.urdf"), *argv]) == 2
+    assert words in capsys.readouterr().err

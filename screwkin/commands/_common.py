@@ -157,6 +157,11 @@ _KINDS = {("angle", 0): ("angle",), ("angle", 1): ("angle", "angular rate"),
 _WHAT = {0: "value", 1: "rate", 2: "acceleration"}
 
 
+#: The largest angle a joint value may have [rad] (15,915 turns): a double's rounding error there is
+#: 1.5e-11 rad, below the closure tolerance; at 1e308 rad nothing of the fraction of a turn is left.
+MAX_ANGLE = 1e5
+
+
 def _checked(mech, name, value, unit, option, text, order=0, links=()):
     kind = value_kind(mech, name)
     what = f"{'an' if kind == 'angle' else 'a'} {kind} joint"
@@ -166,6 +171,9 @@ def _checked(mech, name, value, unit, option, text, order=0, links=()):
     if kind and found and found not in _KINDS[kind, order]:
         raise UsageError(f"{option} {text}: {quote(name)} is {what}, "
                          f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
+    if kind == "angle" and not order and abs(value) > MAX_ANGLE:
+        raise UsageError(f"{option} {text}: {value:g} rad is {abs(value) / (2 * math.pi):.4g} turns; beyond "
+                         f"{MAX_ANGLE:g} rad an angle's place in its turn is lost to rounding (1e-10 rad)")
     if kind == "angle" and not unit and not order and abs(value) > 2 * math.pi:
         print(f"warning: {option} {shorten(name, 60)}={value:g} is read as {value:g} rad = "
               f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
@@ -236,10 +244,8 @@ def split_inputs(mech, args) -> tuple:
     for name, value, unit in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
         if unit_kind(unit) not in (None, "angle"):
             raise UsageError(f"--set-angle {quote(name)}: {unit} is a unit of {unit_kind(unit)}, --set-angle takes an angle")
-        if not unit and abs(value) > 2 * math.pi:  # as a joint's bare angle (_checked)
-            print(f"warning: --set-angle {shorten(name, 60)}={value:g} is read as {value:g} rad = "
-                  f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
-        angles[name] = value
+        # a bare angle over a turn warned of, one beyond MAX_ANGLE refused, as a joint's
+        angles[name] = _checked(mech, name, value, unit, "--set-angle", f"{quote(name, 60)}=...{unit}", links=(name,))
     if angles:
         q = mech.generic_configurations()[1][0]
         link_angles = LinkAngles(mech, mech.topology(q))
