@@ -267,7 +267,8 @@ def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linea
             dev = np.abs(np.degrees(np.asarray(mus)) - 90)
             k = int(np.argmax(dev))
             lines.append(f"  transmission angle: {np.degrees(min(mus)):.4g} .. {np.degrees(max(mus)):.4g} deg; "
-                         f"worst {np.degrees(mus[k]):.4g} deg at input {res.values[k]:.6g}")
+                         f"worst {np.degrees(mus[k]):.4g} deg at input "
+                         + (f"{np.degrees(res.values[k]):.6g} deg" if degrees else f"{res.values[k]:.6g} {res.unit}"))
     shown = sweep_rows(len(res.values), rows)
     n = len(res.values)
     x = np.degrees(res.values) if degrees else np.asarray(res.values)
