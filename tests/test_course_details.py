@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import DATA
+from conftest import CORPUS, DATA
 from screwkin.cli import main
 
 FLOATING = ('<robot name="f"><link name="base"/><link name="body"/>'
@@ -166,3 +166,19 @@ def test_a_horizontal_guide_has_no_vertical_start(tmp_path, capsys):
     assert main(["solve", str(path), "--set", "O2=60deg", "--start", "rod=20deg,x4h=0.33", "--iterations", "1",
                  "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["start"]["x4"] == pytest.approx(0.33, abs=1e-12)
+
+
+def test_coincident_joint_centres_give_no_vector_and_no_extra_unknown(capsys):
+    """The corpus five-bar closes its loop at a point link ('sphere') whose two loop-joint centres coincide
+    (5e-11 m apart after the closure): that link has no vector and its angle is no unknown, so the loop's
+    two equations have the two unknowns of a five-bar (theta3, theta5) and det A = r3 r5 sin(theta3 - theta5),
+    the five-bar's singularity with the two distal links aligned; before, a vector of length 5.3e-11 m
+    made its angle a third unknown and the report's Newton section refused."""
+    from screwkin.cli import main
+
+    path = str(CORPUS / "5bar_linkage" / "robot.urdf")
+    assert main(["equations", path, "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert len(d["unknowns"]) == 2
+    assert d["det_A"].replace(" ", "") in ("r3*r5*sin(theta3-theta5)", "-r3*r5*sin(theta3-theta5)",
+                                            "r3*r5*sin(θ3-θ5)")

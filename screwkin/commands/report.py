@@ -309,7 +309,9 @@ def _newton(mech, args, loops, q, values, names, notes, data):
                f"length +{100 * START_FRACTION:g} % (of L = {mech.length:.4g} m when 0); give --start NAME=VALUE,... "
                "for other estimates")
     held = {n: solved[n] for n in loops.input_syms}
-    res = newton(loops, held, start, args.iterations)
+    res = _attempt(notes, "newton", lambda: newton(loops, held, start, args.iterations))
+    if res is None:  # the mechanism's own (more unknowns than equations: fewer inputs than DOF), said here
+        return note_section("newton", title, f"not run: {notes['newton']}")
     far = [n for n in loops.unknowns
            if abs(np.angle(np.exp(1j * (res.values[n] - solved[n]))) if loops.symbol_info[n].kind == "angle"
                   else res.values[n] - solved[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]

@@ -258,7 +258,10 @@ class VectorLoops:
         d = self.anchor[kb] - self.anchor[ka]
         length = float(np.linalg.norm(d))
         tol = self.mech.tolerances
-        if length < tol.zero * max(self.mech.length, LENGTH_FLOOR):
+        # centres closer than the geometric tolerance are one point (the loop closes them only to its
+        # tolerance, 5e-11 m on the corpus five-bar's 'sphere'): no vector, and no angle of a link that
+        # has no other vector -- it would be one more unknown than the loop has equations
+        if length < tol.geometry * max(self.mech.length, 1.0):
             return None
         phi = float(np.arctan2(d[1], d[0]))
         k = self.numbers[link]
