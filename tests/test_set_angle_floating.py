@@ -207,9 +207,31 @@ def test_errors(capsys, argv, code, words):
         assert w in err
 
 
-@pytest.mark.parametrize("argv", [["draw", "--animate", "a.gif", "--from", "0", "--to", "1"], ["report", "--md", "r.md"]])
+def test_report_takes_a_held_angle_for_its_positions_equations_and_newton(capsys, tmp_path):
+    """report with a floating link's angle: its positions are solve's (the same numbers), its equations
+    hold that link's theta as an input and Newton converges to the solved values; the singular
+    configurations and the sweep, which move a joint input, say why they are left out."""
+    argv = [str(FIVE), "--set", "motor1=-10deg", "--set-angle", "distal1=-60deg", "--rate", "motor1=1.5,distal1=-2"]
+    sol = run_json(capsys, ["solve", *argv, "--json"])["solutions"][0]
+    md = tmp_path / "r.md"
+    got, _, err = run(capsys, ["report", *argv, "--md", str(md), "--no-view"])
+    assert got == 0, err
+    text = md.read_text()
+    assert "angle of distal1 = -60 deg" in text
+    data = json.loads((tmp_path / "r_files" / "data.json").read_text())
+    rep = data["solve"]["solutions"][0]
+    assert rep["links"].keys() == sol["links"].keys()
+    for link, m in sol["links"].items():
+        for key in ("angle", "omega", "alpha"):
+            assert rep["links"][link].get(key) == pytest.approx(m.get(key), abs=1e-12)
+    assert sol["links"]["distal1"]["angle"] == pytest.approx(np.radians(-60), abs=1e-9)
+    assert data["newton"]["closes"] and "inputs held: θ2 = 110 deg, θ3 = -60 deg" in text
+    assert "not located: the angle of distal1 is an input" in text and "no sweep: the angle of distal1" in text
+
+
+@pytest.mark.parametrize("argv", [["draw", "--animate", "a.gif", "--from", "0", "--to", "1"]])
 def test_commands_moving_joint_inputs_refuse_a_held_angle(capsys, tmp_path, argv):
-    """draw --animate and report move joint inputs: a held angle is refused in one line, not dropped."""
+    """draw --animate moves joint inputs: a held angle is refused in one line, not dropped."""
     argv = [str(tmp_path / a) if a.endswith((".gif", ".md")) else a for a in argv]
     got, _, err = run(capsys, [argv[0], str(FIVE), *argv[1:], "--set-angle", "distal1=-60deg"])
     assert got == 2 and "held by its angle" in err and len(err.strip().splitlines()) == 1

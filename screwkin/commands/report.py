@@ -58,10 +58,12 @@ from ._common import (
     add_configuration_options,
     add_point_option,
     check_rate_names,
+    input_solver,
     joint_assignments,
-    joint_inputs,
+    link_rates,
     named_points,
     rate_units,
+    split_inputs,
     value_kind,
 )
 from ._options import check_writable, count, screwkin_version
@@ -146,33 +148,40 @@ def run(mech, args) -> int:
         raise UsageError(f"{mech.path}: --steps must be at least 4")
     if args.iterations is not None and args.iterations < 1:
         raise UsageError("--iterations must be 1 or more")
-    given = joint_inputs(mech, args, "report (its equations, Newton steps and sweep)")
+    # --set-angle of a link pinned to the ground is its joint's value; of a floating link (held), one more
+    # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
+    given, held, pivots = split_inputs(mech, args)
     names = _input_names(mech, args, given)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
     q0 = mech.generic_configurations()[0].q
     if args.output:
         mech.link_frame(args.output)
     points = named_points(mech, args)
-    rates = joint_assignments(mech, args.rate, "--rate", order=1) or {n: 1.0 for n in names}
-    accels = joint_assignments(mech, args.accel, "--accel", order=2) or None
-    check_rate_names(rates, names, "--rate")
-    check_rate_names(accels, names, "--accel")
+    links = (*held, *pivots)
+    rates = link_rates(joint_assignments(mech, args.rate, "--rate", order=1, links=links), pivots, "--rate") \
+        or {n: 1.0 for n in (*names, *held)}
+    accels = link_rates(joint_assignments(mech, args.accel, "--accel", order=2, links=links), pivots,
+                        "--accel") or None
+    check_rate_names(rates, [*names, *held], "--rate")
+    check_rate_names(accels, [*names, *held], "--accel")
     notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
 
     # ---- the configuration: solved for the inputs (their file values when none are set)
     pres, q = None, q0
     values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
-    if names:
-        solver = PositionSolver(mech, names, output=args.output)
-        pres = solver.solve(values, near=near if (near or given) else mech.joint_values(q0), rates=rates,
+    if names or held:
+        solver = input_solver(mech, values, held, output=args.output)
+        pres = solver.solve(values, near=near if (near or given or held) else mech.joint_values(q0), rates=rates,
                             accels=accels, points=points)
         q = pres.solutions[0].q
         data["solve"] = position_dict(pres)
         data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
     topo = mech.topology(q)
     units = {n: ("rad" if not mech.translational[mech.coordinate_names.index(n)] else "m") for n in names}
-    configuration = (", ".join(value_label(n, v, units[n]) for n, v in values.items())
-                     + ("" if given else " (the file's values)")) if names else "the file's assembled configuration"
+    configuration = (", ".join([value_label(n, v, units[n]) for n, v in values.items()]
+                               + [f"angle of {value_label(k, v, 'rad')}" for k, v in held.items()])
+                     + ("" if given or held else " (the file's values)")) if names or held \
+        else "the file's assembled configuration"
     data["configuration"] = values
 
     # ---- topology, counts, mobility, drawings of the configuration
@@ -203,7 +212,7 @@ def run(mech, args) -> int:
     # ---- equations
     loops = eq = None
     if topo.motion_space == "planar":
-        loops = _attempt(notes, "equations", lambda: VectorLoops(mech, q, names or None))
+        loops = _attempt(notes, "equations", lambda: VectorLoops(mech, q, names or None, links=list(held)))
         eq = loops.result() if loops is not None else None
     else:
         output = args.output or (default_output(mech, names[0], q) if names and not mech.cuts else None)
@@ -215,7 +224,7 @@ def run(mech, args) -> int:
         sections.append(note_section("equations", "Equations", f"no equations: {notes.get('equations')}"))
 
     # ---- Newton from an estimate
-    sections.append(_newton(mech, args, loops, q, values, names, notes, data))
+    sections.append(_newton(mech, args, loops, q, values, names, notes, data, held))
 
     # ---- positions, velocities, accelerations
     if pres is not None:
@@ -228,7 +237,13 @@ def run(mech, args) -> int:
                                      "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
 
     # ---- singular configurations and the sweep
-    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates)
+    if held:  # the sweep moves one joint input with the others held; a link held by its angle is no joint
+        why = (f"the angle of {', '.join(held)} is an input (--set-angle of a link not pinned to the ground); the "
+               "sweep moves a joint input: give the inputs as joints (--set) to locate them along a motion")
+        sections += [note_section("singular", "Singular configurations", f"not located: {why}"),
+                     note_section("sweep", "Sweep of the input", f"no sweep: {why}")]
+    else:
+        sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates)
 
     # ---- the view
     sections.append(_view(mech, args, q, data))
@@ -284,7 +299,7 @@ def _rates_text(mech, args, rates) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech, args, loops, q, values, names, notes, data):
+def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
@@ -293,8 +308,9 @@ def _newton(mech, args, loops, q, values, names, notes, data):
     solved = loops.values(q)
     if args.start:
         typed = _typed(args.start, "--start")
-        solver = PositionSolver(mech, names)
-        start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), values, typed)
+        solver = input_solver(mech, values, held or {})
+        start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), {**values, **(held or {})},
+                                   typed)
         how = "from the estimates given with --start: " + ", ".join(f"{n}={v}" for n, v, _ in typed)
     else:
         start = {}

@@ -186,7 +186,8 @@ def motion_section(pres, rates_text: str, length: float, units: RateUnits = Rate
     the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
     present/motion.links_rows and points_rows), rates in ``units`` (those typed)."""
     s = Section("motion", "Positions, velocities and accelerations")
-    inputs = ", ".join(f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items())
+    inputs = ", ".join([f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items()]
+                       + [f"angle of {k} = {_reading(v, True)}" for k, v in (pres.held or {}).items()])
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
                          "solution 1 is the configuration this report analyses."))
     for k, sol in enumerate(pres.solutions, 1):
