@@ -344,3 +344,27 @@ def test_a_bare_angle_beyond_a_turn_warns(capsys):
     code, out, err = run(capsys, ["solve", str(FIVE), "--set-angle", "proximal1=110deg", "--set-angle", "distal1=30"])
     assert "distal1=30 is read as 30 rad = 1718.87 deg" in err
     assert code == 0 and f"angle of distal1 = {wrap(30.0):.9g} rad" in out
+
+
+def test_sweep_holds_a_floating_link_angle_along_the_motion(capsys):
+    """sweep motor1 with distal1's absolute angle held (--set-angle): at every step distal1 stays at -60 deg
+    and every joint centre is the closed form's (the far end of distal1 from the crank tip along phi, then
+    the dyad to motor2 by circle intersection, on the branch of the first step)."""
+    O1, O2, a1, a2, b1, b2 = five_bar()
+    phi = np.radians(-60)
+    d = run_json(capsys, ["sweep", str(FIVE), "--input", "motor1", "--from", "-10deg", "--to", "10deg",
+                          "--steps", "8", "--set-angle", "distal1=-60deg"])
+    assert d["held_angles"] == {"distal1": pytest.approx(phi)}
+    links = d["links"]
+    assert np.allclose(links["distal1"]["angle"], phi, atol=1e-9)
+    th1 = np.array(links["proximal1"]["angle"])
+    A1 = O1 + a1 * np.stack([np.cos(th1), np.sin(th1)], axis=1)
+    P = A1 + b1 * u(phi)
+    assert np.allclose(np.array(links["tip"]["position"])[:, :2], P, atol=1e-9)
+    A2 = np.array(links["distal2"]["position"])[:, :2]  # the elbow of the second arm
+    assert np.allclose(np.linalg.norm(A2 - O2, axis=1), a2, atol=1e-9)
+    assert np.allclose(np.linalg.norm(P - A2, axis=1), b2, atol=1e-9)
+    k0 = np.argmin([np.linalg.norm(A2[0] - c) for c in circles(O2, a2, P[0], b2)])
+    for k in range(len(P)):  # the branch of the first step, followed
+        expected = circles(O2, a2, P[k], b2)
+        assert np.linalg.norm(A2[k] - expected[k0]) < 1e-9

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 
 from ..analysis.motion.links import motion_along, strokes, sweep_motion
@@ -27,10 +28,13 @@ from ..present.report import (
 )
 from ..units import parse_typed_value, unit_kind
 from ._common import (
+    add_angle_option,
+    input_solver,
     joint_assignments,
     joint_value,
     named_points,
     names_list,
+    split_inputs,
 )
 from ._options import BOUNDS, count
 
@@ -50,6 +54,7 @@ def add_parser(sub, common, scaled):
                     help="number of steps (default 100, at most 100,000; up to 10,000,000 when the sweep only "
                          "writes --csv/--parquet, computed and written in chunks)")
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    add_angle_option(sp)
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
     sp.add_argument("--rate", help="input rate for the joint rates and accelerations (default 1 rad/s or m/s; "
@@ -153,9 +158,12 @@ def _rows(text):
 
 
 def run(mech, args) -> int:
-    fixed = joint_assignments(mech, args.set, "--set")
-    inputs = names_list(args.inputs) or (list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
-    solver = PositionSolver(mech, inputs)
+    # the other inputs: joints (--set, or --set-angle of a link pinned to the ground), or a floating link's
+    # absolute angle held by one more loop equation along the whole motion (--set-angle LINK=ANGLE)
+    fixed, held, _ = split_inputs(mech, args)
+    inputs = names_list(args.inputs) or ([args.input, *(k for k in fixed if k != args.input)] if held else
+                                         list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
+    solver = input_solver(mech, {n: 0.0 for n in inputs}, held) if held else PositionSolver(mech, inputs)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
@@ -171,7 +179,7 @@ def run(mech, args) -> int:
                 turn=args.turn)
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
-    info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 else None
+    info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 and not held else None
     slider_strokes = strokes(res, motion, mech, solver)
     mus = None
     if info is not None:
@@ -194,6 +202,8 @@ def run(mech, args) -> int:
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
         d["strokes"] = strokes_dict(slider_strokes)
+        if held:
+            d["held_angles"] = held  # as solve --json: link -> absolute angle [rad] held along the motion
         print(json_of(d))
     else:
         rows = sweep_rows(len(res.values), _rows(args.rows))
@@ -201,6 +211,8 @@ def run(mech, args) -> int:
                         for t in (args.start, args.stop))
         linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
             else []
+        for link, angle in held.items():
+            print(f"held along the motion: the angle of {link} = {angle:.9g} rad ({math.degrees(angle):.6g} deg)")
         print(sweep_text(res, info, mus, rows=_rows(args.rows), degrees=typed_deg and res.unit == "rad",
                          linear_names=linear_names))
         for line in strokes_text(slider_strokes, res.unit == "rad"):
