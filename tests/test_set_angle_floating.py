@@ -229,9 +229,19 @@ def test_report_takes_a_held_angle_for_its_positions_equations_and_newton(capsys
     assert "not located: the angle of distal1 is an input" in text and "no sweep: the angle of distal1" in text
 
 
-@pytest.mark.parametrize("argv", [["draw", "--animate", "a.gif", "--from", "0", "--to", "1"]])
+def test_draw_animate_holds_a_floating_link_angle(capsys, tmp_path):
+    """draw --animate moves motor1 with distal1's angle held (the motion sweep --set-angle follows): one
+    frame a value, as for joint inputs."""
+    gif = tmp_path / "a.gif"
+    d = run_json(capsys, ["draw", str(FIVE), "--animate", str(gif), "--input", "motor1", "--from", "-10deg",
+                          "--to", "10deg", "--steps", "4", "--set-angle", "distal1=-60deg"])
+    assert d["frames"] == 5 and d["stopped_at"] is None and gif.stat().st_size > 0
+    assert d["values"] == pytest.approx(np.radians([-10, -5, 0, 5, 10]))
+
+
+@pytest.mark.parametrize("argv", [["view", "--interactive"]])
 def test_commands_moving_joint_inputs_refuse_a_held_angle(capsys, tmp_path, argv):
-    """draw --animate moves joint inputs: a held angle is refused in one line, not dropped."""
+    """view --interactive moves joint inputs with sliders: a held angle is refused in one line, not dropped."""
     argv = [str(tmp_path / a) if a.endswith((".gif", ".md")) else a for a in argv]
     got, _, err = run(capsys, [argv[0], str(FIVE), *argv[1:], "--set-angle", "distal1=-60deg"])
     assert got == 2 and "held by its angle" in err and len(err.strip().splitlines()) == 1

@@ -33,11 +33,12 @@ from ._common import (
     add_configuration_options,
     add_point_option,
     configuration,
+    input_solver,
     inputs,
     joint_assignments,
-    joint_inputs,
     joint_value,
     named_points,
+    split_inputs,
     with_mode,
 )
 from ._options import BOUNDS, count
@@ -313,7 +314,7 @@ def _animate(mech, args) -> int:
     if mech.spec.targets and not args.json:
         print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
               "(draw --png/--svg), not in the animation")
-    given = joint_inputs(mech, args, "draw --animate")
+    given, held, _ = split_inputs(mech, args)  # a floating link's angle is held along the motion, as in sweep
     name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
     if name is None:
         raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")
@@ -322,9 +323,10 @@ def _animate(mech, args) -> int:
     stop = joint_value(mech, name, args.stop, "--to")
     unit = unit or parse_typed_value(args.stop)[1]
     fixed = {k: v for k, v in given.items() if k != name}
-    input_names = list(mech.actuated) if name in mech.actuated else [name, *fixed]
+    input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
-    res = sweep(PositionSolver(mech, input_names), name, start, stop, steps, fixed=fixed, near=near)
+    solver = input_solver(mech, dict.fromkeys(input_names, 0.0), held) if held else PositionSolver(mech, input_names)
+    res = sweep(solver, name, start, stop, steps, fixed=fixed, near=near)
     linear = res.unit == "m"
     qs, values = list(res.q), list(res.values)
     limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= mech.tolerances.equal), None)
