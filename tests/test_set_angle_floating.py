@@ -209,8 +209,8 @@ def test_errors(capsys, argv, code, words):
 
 def test_report_takes_a_held_angle_for_its_positions_equations_and_newton(capsys, tmp_path):
     """report with a floating link's angle: its positions are solve's (the same numbers), its equations
-    hold that link's theta as an input and Newton converges to the solved values; the singular
-    configurations and the sweep, which move a joint input, say why they are left out."""
+    hold that link's theta as an input, Newton converges to the solved values, and its sweep moves the
+    joint input with the angle held (the limit positions where the other dyad stretches or folds)."""
     argv = [str(FIVE), "--set", "motor1=-10deg", "--set-angle", "distal1=-60deg", "--rate", "motor1=1.5,distal1=-2"]
     sol = run_json(capsys, ["solve", *argv, "--json"])["solutions"][0]
     md = tmp_path / "r.md"
@@ -226,7 +226,15 @@ def test_report_takes_a_held_angle_for_its_positions_equations_and_newton(capsys
             assert rep["links"][link].get(key) == pytest.approx(m.get(key), abs=1e-12)
     assert sol["links"]["distal1"]["angle"] == pytest.approx(np.radians(-60), abs=1e-9)
     assert data["newton"]["closes"] and "inputs held: θ2 = 110 deg, θ3 = -60 deg" in text
-    assert "not located: the angle of distal1 is an input" in text and "no sweep: the angle of distal1" in text
+    # motor1 moved with distal1 held: its limit positions are where the dyad O2-A2-P stretches or folds,
+    # |O1 + a1 u(theta1) + b1 u(phi) - O2| = a2 + b2 or |a2 - b2| (theta1 = motor1 + the crank's offset)
+    O1, O2, a1, a2, b1, b2 = five_bar()
+    offset = sol["links"]["proximal1"]["angle"] - sol["joints"]["motor1"]
+    limits = [f["input"] for f in data["singular_configurations"]["found"] if f["limit"]]
+    assert limits and "Sweep of the input" in text
+    for x in limits:
+        reach = np.linalg.norm(O1 + a1 * u(x + offset) + b1 * u(np.radians(-60)) - O2)
+        assert min(abs(reach - (a2 + b2)), abs(reach - abs(a2 - b2))) < 1e-9
 
 
 def test_draw_animate_holds_a_floating_link_angle(capsys, tmp_path):

@@ -20,7 +20,6 @@ from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
 from ..analysis.motion.planar import identify, transmission_angles
-from ..analysis.motion.position import PositionSolver
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import ScrewkinError, UsageError
@@ -237,13 +236,7 @@ def run(mech, args) -> int:
                                      "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
 
     # ---- singular configurations and the sweep
-    if held:  # the sweep moves one joint input with the others held; a link held by its angle is no joint
-        why = (f"the angle of {', '.join(held)} is an input (--set-angle of a link not pinned to the ground); the "
-               "sweep moves a joint input: give the inputs as joints (--set) to locate them along a motion")
-        sections += [note_section("singular", "Singular configurations", f"not located: {why}"),
-                     note_section("sweep", "Sweep of the input", f"no sweep: {why}")]
-    else:
-        sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates)
+    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held)
 
     # ---- the view
     sections.append(_view(mech, args, q, data))
@@ -339,7 +332,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
+def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held=None):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -350,7 +343,7 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
     search = _attempt(notes, "singular configurations", lambda: singular_configurations(
         mech, moved, output=args.output, q=q, steps=args.steps,
         fixed={k: v for k, v in given.items() if k != moved}, near=mech.joint_values(q),
-        rate=rates.get(moved) or 1.0))  # the positions section's input rate (a rate 0 gives no strokes: 1)
+        rate=rates.get(moved) or 1.0, held=held))  # the positions section's input rate (a rate 0 gives no strokes: 1)
     if search is None:
         why = notes["singular configurations"]
         return [note_section("singular", "Singular configurations", f"not located: {why}"),
@@ -377,8 +370,9 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates):
         mus = transmission_angles(mech, info, res.q).tolist()
     motion = sweep_motion(mech, res, named_points(mech, args))  # what sweep shows: links, loop joints, points
     # each slider's ends located on the mechanism, with the inputs the search held (as figures does)
-    held = list(mech.actuated) if moved in mech.actuated else [moved]
-    slider_strokes = strokes(res, motion, mech, PositionSolver(mech, held))
+    ins = ([moved, *(k for k in given if k != moved)] if held else
+           list(mech.actuated) if moved in mech.actuated else [moved])
+    slider_strokes = strokes(res, motion, mech, input_solver(mech, dict.fromkeys(ins, 0.0), held or {}))
     fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
                         title=f"{base}: {moved} over its range")
     what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(

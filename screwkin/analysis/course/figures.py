@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError
+from ..motion.link_inputs import holding_angles
 from ..motion.links import motion_along
 from ..motion.position import PositionSolver
 from ..motion.singular_points import locate_singularities
@@ -88,7 +89,7 @@ def input_range(mech, name, q) -> tuple:
 
 
 def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=None, steps: int = 360,
-                            near=None, rate: float = 1.0) -> SingularSearch:
+                            near=None, rate: float = 1.0, held=None) -> SingularSearch:
     """The singular configurations along ``input_joint``'s range (:func:`input_range` from q,
     the assembled configuration by default): one assembly mode followed by screwkin.analysis.
     sweep.sweep through limit positions (``turn``) and located by locate_singularities (the
@@ -96,7 +97,8 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
     :func:`default_output`: a four-bar's rocker, whose limit positions are the crank and
     coupler collinear -- and the constraint ones).  ``fixed``: the other inputs' values
     (default: their values at q); ``rate``: the input's constant rate [rad/s or m/s] the motion's rates
-    and accelerations are for."""
+    and accelerations are for; ``held``: links of a planar mechanism held at absolute angles [rad] along
+    the motion (analysis.motion.link_inputs.holding_angles), the inputs then the joints of ``fixed``."""
     inputs = list(mech.actuated)
     if input_joint is None:
         if not inputs:
@@ -105,6 +107,8 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
     mech.coordinate(input_joint)  # a usage error when unknown
     if input_joint not in inputs:
         inputs = [input_joint]
+    if held:  # the other inputs are the joints given; the held links are no joints
+        inputs = [input_joint, *(k for k in (fixed or {}) if k != input_joint)]
     if q is None:
         q = mech.generic_configurations()[0].q
     values = mech.joint_values(q)
@@ -113,7 +117,7 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
         output = default_output(mech, input_joint, q)
     else:
         mech.link_frame(output)
-    solver = PositionSolver(mech, inputs, output=output)
+    solver = PositionSolver(holding_angles(mech, inputs, held) if held else mech, inputs, output=output)
     start, stop = input_range(mech, input_joint, q)
     if near is None:
         near = values
