@@ -85,24 +85,30 @@ def test_velocity_equations_match_central_differences_of_solutions(wheels):
     assert A @ dz == pytest.approx((B @ [1.0]).tolist(), abs=1e-8)
 
 
-def test_one_newton_step_on_friction_wheels_is_the_hand_computation(capsys):
-    code = main(["solve", WHEELS, "--set", "wheel2_joint=60deg", "--start", "theta3=-100deg,x4=0.035",
-                 "--iterations", "1", "--json"])
-    out, err = capsys.readouterr()
-    assert code == 0, err
-    (it,) = json.loads(out)["trace"]
-    # by hand: theta2 is the angle of O2 -> disc 2's centre (45 deg at joint 0), theta3 disc 3's frame x axis (0 as
-    # drawn); the line of centres theta_k = (rho2 theta2 + rho3 theta3 - c) / (rho2 + rho3), c from the drawing
+def _hand_newton_step():
+    """(F, J, dz, theta3) of one Newton step by hand on friction_wheels from wheel2_joint = 60 deg and the
+    estimates theta3 = -100 deg, x4 = 0.035 m.  theta2 is the angle of O2 -> disc 2's centre (45 deg at
+    joint 0), theta3 disc 3's frame x axis (0 as drawn); the line of centres theta_k = (rho2 theta2 +
+    rho3 theta3 - c) / (rho2 + rho3), c from the drawing; the loop x4 u - R e_k - r2 e2 = 0 (ground ->
+    slider -> disc 3 -> disc 2 -> ground)."""
     t2_0, t3_0 = np.radians(45.0), 0.0
     tk_0 = np.arctan2(-0.008, X0 - 0.008)
     c = R2 * (t2_0 - tk_0) + R3 * (t3_0 - tk_0)
     r2, R = np.hypot(0.008, 0.008), R2 + R3
     t2, t3, x4 = np.radians(60.0 + 45.0), np.radians(-100.0), 0.035
     tk = (R2 * t2 + R3 * t3 - c) / R
-    # loop: x4 u - R e_k - r2 e2 = 0 (ground -> slider -> disc 3 -> disc 2 -> ground)
     F = np.array([x4 - r2 * np.cos(t2) - R * np.cos(tk), -r2 * np.sin(t2) - R * np.sin(tk)])
     J = np.array([[R3 * np.sin(tk), 1.0], [-R3 * np.cos(tk), 0.0]])
-    dz = np.linalg.solve(J, -F)
+    return F, J, np.linalg.solve(J, -F), t3
+
+
+def test_one_newton_step_on_friction_wheels_is_the_hand_computation(capsys):
+    code = main(["solve", WHEELS, "--set", "wheel2_joint=60deg", "--start", "theta3=-100deg,x4=0.035",
+                 "--iterations", "1", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    (it,) = json.loads(out)["trace"]
+    F, J, dz, t3 = _hand_newton_step()
     assert it["residual"] == pytest.approx(F.tolist(), abs=1e-12)
     assert np.array(it["jacobian"]) == pytest.approx(J, abs=1e-12)
     assert it["step"] == pytest.approx(dz.tolist(), abs=1e-10)
@@ -312,16 +318,7 @@ def test_report_writes_the_rolling_pairs_equations_and_a_hand_newton_step(tmp_pa
     det, s = _sympy(data["equations"]["det_A"])
     t = (s["rho2"] * s["theta2"] + s["rho3"] * s["theta3"] - s["c23"]) / (s["rho2"] + s["rho3"])
     assert sp.simplify(det - s["rho3"] * sp.cos(t)) == 0
-    # the hand step (theta2 of the link: 45 deg at joint 0; c from the drawing, as in the test above)
-    t2_0, t3_0 = np.radians(45.0), 0.0
-    tk_0 = np.arctan2(-0.008, X0 - 0.008)
-    c = R2 * (t2_0 - tk_0) + R3 * (t3_0 - tk_0)
-    r2, R = np.hypot(0.008, 0.008), R2 + R3
-    t2, t3, x4 = np.radians(60.0 + 45.0), np.radians(-100.0), 0.035
-    tk = (R2 * t2 + R3 * t3 - c) / R
-    F = np.array([x4 - r2 * np.cos(t2) - R * np.cos(tk), -r2 * np.sin(t2) - R * np.sin(tk)])
-    J = np.array([[R3 * np.sin(tk), 1.0], [-R3 * np.cos(tk), 0.0]])
-    dz = np.linalg.solve(J, -F)
+    F, J, dz, _ = _hand_newton_step()
     (it,) = data["newton"]["trace"]
     # report builds the equations at the solved configuration (closed to the closure tolerance, ~1e-12 m here): c23
     # is measured there, so the residual agrees to that and the step to it over sigma_min(J) ~ 0.01
