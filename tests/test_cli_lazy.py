@@ -47,14 +47,19 @@ def test_help_is_the_full_parsers():
         assert lazy.format_help() == sub.choices[name].format_help(), name
 
 
+
+def _last_line(code: str) -> str:
+    """The last line a fresh Python prints running ``code`` with this checkout first on its path."""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
+    return out.stdout.strip().splitlines()[-1]
+
 @pytest.mark.parametrize("argv", [[], ["--help"], ["--version"], ["nosuch"], ["--debug"]])
 def test_nothing_but_the_top_level_is_imported(argv):
     code = ("import sys\nfrom screwkin import cli\ntry:\n    cli.main(%r)\nexcept SystemExit:\n    pass\n"
             "print(sorted(m for m in sys.modules if m.startswith('screwkin.commands.') and "
             "not m.startswith('screwkin.commands._')))" % (argv,))
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
-    assert out.stdout.strip().splitlines()[-1] == "[]"
+    assert _last_line(code) == "[]"
 
 
 def test_a_command_imports_its_module_alone():
@@ -63,9 +68,7 @@ def test_a_command_imports_its_module_alone():
             "'--from', '0', '--to', '1', '--steps', '3'])\n"
             "print(code, sorted(m for m in sys.modules if m.startswith('screwkin.commands.') and "
             "not m.startswith('screwkin.commands._')))" % str(fourbar))
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
-    assert out.stdout.strip().splitlines()[-1] == "0 ['screwkin.commands.sweep']"
+    assert _last_line(code) == "0 ['screwkin.commands.sweep']"
 
 
 def test_usage_errors_are_the_same():
@@ -87,9 +90,7 @@ def test_a_sweep_imports_no_other_analysis():
             "'--from', '0', '--to', '1', '--steps', '3', '--json'])\n"
             "print(code, sorted(m for m in ('screwkin.analysis.forces.dynamics', 'screwkin.analysis.design.study', "
             "'screwkin.parallel.study', 'screwkin.analysis.motion.ik') if m in sys.modules))" % str(fourbar))
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
-    assert out.stdout.strip().splitlines()[-1] == "0 []"
+    assert _last_line(code) == "0 []"
 
 
 def test_a_urdf_imports_neither_yaml_nor_the_web():
@@ -98,9 +99,7 @@ def test_a_urdf_imports_neither_yaml_nor_the_web():
     code = ("import sys\nfrom screwkin import cli\ncode = cli.main(['mobility', %r])\n"
             "print(code, sorted(m for m in ('yaml', 'xml.sax.saxutils', 'urllib.request', 'ssl', 'defusedxml.minidom') "
             "if m in sys.modules))" % str(fourbar))
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
-                         env={"PYTHONPATH": str(ROOT), "PATH": ""}, check=True)
-    assert out.stdout.strip().splitlines()[-1] == "0 []"
+    assert _last_line(code) == "0 []"
 
 
 @pytest.mark.parametrize("text", ["", "a", 'say "hi"', "it's", "\"'", "a&b<c>d", "x\ny\rz\tw", "&amp;", "é"])
