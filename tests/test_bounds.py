@@ -195,8 +195,6 @@ def test_a_unit_of_the_wrong_kind_is_refused(argv, words, capsys):
 def test_a_bare_angle_beyond_a_turn_warns_and_is_radians(capsys):
     import json
 
-    import numpy as np
-
     assert main(["solve", FOURBAR, "--set", "crank_joint=30", "--json"]) == 0
     captured = capsys.readouterr()
     assert "30 rad = 1718.87 deg" in captured.err and "write 30deg" in captured.err

@@ -2,7 +2,6 @@
 help line): the table must say what each command's own module says, and the parser built
 lazily must be the parser built from every module."""
 
-import argparse
 import subprocess
 import sys
 from pathlib import Path

@@ -75,7 +75,7 @@ def test_a_limit_position_stops_the_animation(tmp_path, capsys, drawn):
     imgs = frames(gif)
     assert len(imgs) == 8 == len(drawn)  # 0, 10, ..., 60 deg and the limit position itself
     assert drawn[-1][0].endswith(f"input_joint = {phi:.5g} deg (limit position)")
-    assert f"8 frames, not the 19 asked" in out
+    assert "8 frames, not the 19 asked" in out
 
 
 def test_an_mp4_through_imageio_ffmpeg(tmp_path, capsys):
