@@ -272,12 +272,14 @@ def joint_inputs(mech, args, what: str) -> dict:
     return values
 
 
-def input_solver(mech, values: dict, held: dict, output=None) -> PositionSolver:
-    """The PositionSolver of these input joints (split_inputs), with the ``held`` links' angles held by
-    their loop equations (a copy of the mechanism: analysis.motion.link_inputs.holding_angles)."""
+def input_solver(mech, inputs, held: dict | None = None, output=None) -> PositionSolver:
+    """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
+    ``held`` links' angles held by their loop equations (a copy of the mechanism:
+    analysis.motion.link_inputs.holding_angles); none held, the plain solver of ``mech``."""
+    inputs = list(inputs)
     if held:
-        return PositionSolver(holding_angles(mech, list(values), held), list(values), output=output)
-    return PositionSolver(mech, list(values), output=output)
+        return PositionSolver(holding_angles(mech, inputs, held), inputs, output=output)
+    return PositionSolver(mech, inputs, output=output)
 
 
 def link_rates(rates: dict | None, pivots: dict, option: str) -> dict | None:

@@ -11,7 +11,6 @@ import os
 import numpy as np
 
 from ..analysis.motion.links import motion_along
-from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.sweep import sweep
 from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
@@ -325,7 +324,7 @@ def _animate(mech, args) -> int:
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
-    solver = input_solver(mech, dict.fromkeys(input_names, 0.0), held) if held else PositionSolver(mech, input_names)
+    solver = input_solver(mech, input_names, held)
     res = sweep(solver, name, start, stop, steps, fixed=fixed, near=near)
     linear = res.unit == "m"
     qs, values = list(res.q), list(res.values)

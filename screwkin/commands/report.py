@@ -301,7 +301,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     solved = loops.values(q)
     if args.start:
         typed = _typed(args.start, "--start")
-        solver = input_solver(mech, values, held or {})
+        solver = input_solver(mech, values, held)
         start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), {**values, **(held or {})},
                                    typed)
         how = "from the estimates given with --start: " + ", ".join(f"{n}={v}" for n, v, _ in typed)
@@ -372,7 +372,7 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, hel
     # each slider's ends located on the mechanism, with the inputs the search held (as figures does)
     ins = ([moved, *(k for k in given if k != moved)] if held else
            list(mech.actuated) if moved in mech.actuated else [moved])
-    slider_strokes = strokes(res, motion, mech, input_solver(mech, dict.fromkeys(ins, 0.0), held or {}))
+    slider_strokes = strokes(res, motion, mech, input_solver(mech, ins, held))
     fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
                         title=f"{base}: {moved} over its range")
     what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(
