@@ -11,6 +11,7 @@ import numpy as np
 
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..errors import AssemblyError, UsageError
+from ..model.geometry import wrap_angle
 from ..present.equations import (
     Units,
     equations_dict,
@@ -147,10 +148,15 @@ def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
     near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}
     pres = solver.solve(values, near=near, starts=starts)
     got = loops.values(pres.solutions[0].q)
-    far = [n for n in loops.unknowns
-           if abs(np.angle(np.exp(1j * (got[n] - res.values[n]))) if loops.symbol_info[n].kind == "angle"
-                  else got[n] - res.values[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
-    return pres, got, far
+    return pres, got, differing(mech, loops, got, res.values)
+
+
+def differing(mech, loops, a: dict, b: dict) -> list:
+    """The unknowns of ``loops`` whose values in ``a`` and ``b`` (symbol -> value) differ: an angle by
+    more than the geometry tolerance modulo a turn, a length by more than it times max(L, 1 m)."""
+    tol = mech.tolerances.geometry * max(mech.length, 1.0)
+    return [n for n in loops.unknowns
+            if abs(wrap_angle(a[n] - b[n]) if loops.symbol_info[n].kind == "angle" else a[n] - b[n]) > tol]
 
 
 def solve_from_start(mech, args, values, held=None) -> int:

@@ -67,7 +67,7 @@ from ._common import (
 )
 from ._options import check_writable, count, screwkin_version
 from .draw import _design, _kind_text, _wrapped
-from .equations import _typed, start_estimates
+from .equations import _typed, differing, start_estimates
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -321,9 +321,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     res = _attempt(notes, "newton", lambda: newton(loops, held, start, args.iterations))
     if res is None:  # the mechanism's own (more unknowns than equations: fewer inputs than DOF), said here
         return note_section("newton", title, f"not run: {notes['newton']}")
-    far = [n for n in loops.unknowns
-           if abs(np.angle(np.exp(1j * (res.values[n] - solved[n]))) if loops.symbol_info[n].kind == "angle"
-                  else res.values[n] - solved[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
+    far = differing(mech, loops, res.values, solved)
     how += (f". {len(res.steps)} iteration(s) to |F| = {res.residual:.3g} m"
             + ("; the values reached are the solved configuration's" if res.closes and not far else
                f"; the values reached differ from the solved configuration's ({', '.join(far)}: another "
