@@ -21,7 +21,8 @@ from ..units import parse_typed_assignments, parse_typed_value, parse_value, uni
 from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
-           "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line"]
+           "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
+           "typed_unit", "rate_units", "MAX_ANGLE"]
 
 
 class PointOption(argparse.Action):
