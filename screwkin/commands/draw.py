@@ -27,7 +27,7 @@ from ..present.draw import (
 )
 from ..present.draw_targets import design_marks
 from ..present.report import to_jsonable
-from ..units import parse_typed_value, parse_value
+from ..units import in_unit, parse_typed_value
 from ._common import (
     add_configuration_options,
     add_point_option,
@@ -295,7 +295,7 @@ def _wrapped(value, unit):
 def _typed(name, value, unit, linear) -> str:
     """'crank = 30 deg' in the unit the person typed (rad or m when bare)."""
     unit = unit or ("m" if linear else "rad")
-    return f"{name} = {value / parse_value('1' + unit):.5g} {unit}"
+    return f"{name} = {in_unit(value, unit):.5g} {unit}"
 
 
 def _animate(mech, args) -> int:

@@ -52,7 +52,7 @@ from ..present.view import (
     screenshot,
     show,
 )
-from ..units import parse_typed_assignments, parse_value, unit_kind
+from ..units import in_unit, parse_typed_assignments, unit_kind
 from ._common import (
     add_configuration_options,
     add_point_option,
@@ -287,7 +287,7 @@ def _rates_text(mech, args, rates) -> str:
         if not unit:
             return f"{n} = {v:.6g} {si[n]}"
         label = unit + "/s" if unit_kind(unit) in ("angle", "length") else unit  # --rate crank=90deg: 90 deg/s
-        return f"{n} = {v / parse_value('1' + unit):.6g} {label} ({v:.6g} {si[n]})"
+        return f"{n} = {in_unit(v, unit):.6g} {label} ({v:.6g} {si[n]})"
 
     return ", ".join(shown(n, v) for n, v in rates.items())
 
