@@ -41,20 +41,21 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--output", help="spatial mechanisms: also the chain to this link")
 
 
-def _input_names(mech, args):
-    """The input joints: --input, else those set (--set, --set-angle of a link pinned to the ground),
-    else -- unless a floating link's angle is given (it is an input of its own) -- the actuated ones."""
+def _input_names(mech, args, values, held):
+    """The input joints: --input, else those set (``values``: --set, --set-angle of a link pinned to the
+    ground), else -- unless a floating link's angle is given (``held``: an input of its own) -- the
+    actuated ones."""
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     if names:
         return names
-    values, held, _ = split_inputs(mech, args)
     return list(values) or ([] if held else list(mech.actuated))
 
 
 def run(mech, args) -> int:
-    names = _input_names(mech, args)
+    values, held, _ = split_inputs(mech, args)
+    names = _input_names(mech, args, values, held)
     q = configuration(mech, args)
-    res = equations(mech, q, names, output=args.output, links=list(split_inputs(mech, args)[1]))
+    res = equations(mech, q, names, output=args.output, links=list(held))
     if args.json:
         print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
     else:
