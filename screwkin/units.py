@@ -32,7 +32,7 @@ import re
 
 from .errors import UsageError, quote
 
-__all__ = ["parse_value", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "UNIT_TABLE",
+__all__ = ["parse_value", "in_unit", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "UNIT_TABLE",
            "unit_kind", "LENGTH_RANGE"]
 
 _DEG = math.pi / 180.0
@@ -119,6 +119,12 @@ def parse_value(text: str, kind: str | None = None, option: str | None = None) -
         raise UsageError(f"{where}{quote(text)}: {m.group(2)} is a unit of {found}, {where.strip() or 'this value'} "
                          f"takes {'an' if kind[0] in 'aeiou' else 'a'} {kind}")
     return value
+
+
+def in_unit(value: float, unit: str) -> float:
+    """An SI value written in ``unit`` as people type it, parse_value's inverse (``in_unit(math.pi, "deg")``
+    is 180.0, ``in_unit(0.03, "mm")`` is 30.0)."""
+    return value / parse_value("1" + unit)
 
 
 def parse_length(text: str, option: str) -> float:

@@ -21,7 +21,8 @@ from ..units import parse_typed_assignments, parse_typed_value, parse_value, uni
 from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
-           "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line"]
+           "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
+           "typed_unit", "rate_units", "MAX_ANGLE"]
 
 
 class PointOption(argparse.Action):
@@ -272,12 +273,14 @@ def joint_inputs(mech, args, what: str) -> dict:
     return values
 
 
-def input_solver(mech, values: dict, held: dict, output=None) -> PositionSolver:
-    """The PositionSolver of these input joints (split_inputs), with the ``held`` links' angles held by
-    their loop equations (a copy of the mechanism: analysis.motion.link_inputs.holding_angles)."""
+def input_solver(mech, inputs, held: dict | None = None, output=None) -> PositionSolver:
+    """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
+    ``held`` links' angles held by their loop equations (a copy of the mechanism:
+    analysis.motion.link_inputs.holding_angles); none held, the plain solver of ``mech``."""
+    inputs = list(inputs)
     if held:
-        return PositionSolver(holding_angles(mech, list(values), held), list(values), output=output)
-    return PositionSolver(mech, list(values), output=output)
+        return PositionSolver(holding_angles(mech, inputs, held), inputs, output=output)
+    return PositionSolver(mech, inputs, output=output)
 
 
 def link_rates(rates: dict | None, pivots: dict, option: str) -> dict | None:

@@ -11,7 +11,6 @@ import os
 import numpy as np
 
 from ..analysis.motion.links import motion_along
-from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.sweep import sweep
 from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
@@ -28,7 +27,7 @@ from ..present.draw import (
 )
 from ..present.draw_targets import design_marks
 from ..present.report import to_jsonable
-from ..units import parse_typed_value, parse_value
+from ..units import in_unit, parse_typed_value
 from ._common import (
     add_configuration_options,
     add_point_option,
@@ -296,7 +295,7 @@ def _wrapped(value, unit):
 def _typed(name, value, unit, linear) -> str:
     """'crank = 30 deg' in the unit the person typed (rad or m when bare)."""
     unit = unit or ("m" if linear else "rad")
-    return f"{name} = {value / parse_value('1' + unit):.5g} {unit}"
+    return f"{name} = {in_unit(value, unit):.5g} {unit}"
 
 
 def _animate(mech, args) -> int:
@@ -325,7 +324,7 @@ def _animate(mech, args) -> int:
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
-    solver = input_solver(mech, dict.fromkeys(input_names, 0.0), held) if held else PositionSolver(mech, input_names)
+    solver = input_solver(mech, input_names, held)
     res = sweep(solver, name, start, stop, steps, fixed=fixed, near=near)
     linear = res.unit == "m"
     qs, values = list(res.q), list(res.values)

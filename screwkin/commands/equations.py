@@ -11,6 +11,7 @@ import numpy as np
 
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..errors import AssemblyError, UsageError
+from ..model.geometry import wrap_angle
 from ..present.equations import (
     Units,
     equations_dict,
@@ -40,20 +41,21 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--output", help="spatial mechanisms: also the chain to this link")
 
 
-def _input_names(mech, args):
-    """The input joints: --input, else those set (--set, --set-angle of a link pinned to the ground),
-    else -- unless a floating link's angle is given (it is an input of its own) -- the actuated ones."""
+def _input_names(mech, args, values, held):
+    """The input joints: --input, else those set (``values``: --set, --set-angle of a link pinned to the
+    ground), else -- unless a floating link's angle is given (``held``: an input of its own) -- the
+    actuated ones."""
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     if names:
         return names
-    values, held, _ = split_inputs(mech, args)
     return list(values) or ([] if held else list(mech.actuated))
 
 
 def run(mech, args) -> int:
-    names = _input_names(mech, args)
+    values, held, _ = split_inputs(mech, args)
+    names = _input_names(mech, args, values, held)
     q = configuration(mech, args)
-    res = equations(mech, q, names, output=args.output, links=list(split_inputs(mech, args)[1]))
+    res = equations(mech, q, names, output=args.output, links=list(held))
     if args.json:
         print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
     else:
@@ -147,10 +149,15 @@ def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
     near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}
     pres = solver.solve(values, near=near, starts=starts)
     got = loops.values(pres.solutions[0].q)
-    far = [n for n in loops.unknowns
-           if abs(np.angle(np.exp(1j * (got[n] - res.values[n]))) if loops.symbol_info[n].kind == "angle"
-                  else got[n] - res.values[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
-    return pres, got, far
+    return pres, got, differing(mech, loops, got, res.values)
+
+
+def differing(mech, loops, a: dict, b: dict) -> list:
+    """The unknowns of ``loops`` whose values in ``a`` and ``b`` (symbol -> value) differ: an angle by
+    more than the geometry tolerance modulo a turn, a length by more than it times max(L, 1 m)."""
+    tol = mech.tolerances.geometry * max(mech.length, 1.0)
+    return [n for n in loops.unknowns
+            if abs(wrap_angle(a[n] - b[n]) if loops.symbol_info[n].kind == "angle" else a[n] - b[n]) > tol]
 
 
 def solve_from_start(mech, args, values, held=None) -> int:

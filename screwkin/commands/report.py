@@ -52,7 +52,7 @@ from ..present.view import (
     screenshot,
     show,
 )
-from ..units import parse_typed_assignments, parse_value, unit_kind
+from ..units import in_unit, parse_typed_assignments, unit_kind
 from ._common import (
     add_configuration_options,
     add_point_option,
@@ -67,7 +67,7 @@ from ._common import (
 )
 from ._options import check_writable, count, screwkin_version
 from .draw import _design, _kind_text, _wrapped
-from .equations import _typed, start_estimates
+from .equations import _typed, differing, start_estimates
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -287,7 +287,7 @@ def _rates_text(mech, args, rates) -> str:
         if not unit:
             return f"{n} = {v:.6g} {si[n]}"
         label = unit + "/s" if unit_kind(unit) in ("angle", "length") else unit  # --rate crank=90deg: 90 deg/s
-        return f"{n} = {v / parse_value('1' + unit):.6g} {label} ({v:.6g} {si[n]})"
+        return f"{n} = {in_unit(v, unit):.6g} {label} ({v:.6g} {si[n]})"
 
     return ", ".join(shown(n, v) for n, v in rates.items())
 
@@ -301,7 +301,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     solved = loops.values(q)
     if args.start:
         typed = _typed(args.start, "--start")
-        solver = input_solver(mech, values, held or {})
+        solver = input_solver(mech, values, held)
         start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), {**values, **(held or {})},
                                    typed)
         how = "from the estimates given with --start: " + ", ".join(f"{n}={v}" for n, v, _ in typed)
@@ -321,9 +321,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     res = _attempt(notes, "newton", lambda: newton(loops, held, start, args.iterations))
     if res is None:  # the mechanism's own (more unknowns than equations: fewer inputs than DOF), said here
         return note_section("newton", title, f"not run: {notes['newton']}")
-    far = [n for n in loops.unknowns
-           if abs(np.angle(np.exp(1j * (res.values[n] - solved[n]))) if loops.symbol_info[n].kind == "angle"
-                  else res.values[n] - solved[n]) > mech.tolerances.geometry * max(mech.length, 1.0)]
+    far = differing(mech, loops, res.values, solved)
     how += (f". {len(res.steps)} iteration(s) to |F| = {res.residual:.3g} m"
             + ("; the values reached are the solved configuration's" if res.closes and not far else
                f"; the values reached differ from the solved configuration's ({', '.join(far)}: another "
@@ -372,7 +370,7 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, hel
     # each slider's ends located on the mechanism, with the inputs the search held (as figures does)
     ins = ([moved, *(k for k in given if k != moved)] if held else
            list(mech.actuated) if moved in mech.actuated else [moved])
-    slider_strokes = strokes(res, motion, mech, input_solver(mech, dict.fromkeys(ins, 0.0), held or {}))
+    slider_strokes = strokes(res, motion, mech, input_solver(mech, ins, held))
     fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
                         title=f"{base}: {moved} over its range")
     what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(

@@ -8,7 +8,6 @@ import os
 
 from ..analysis.motion.links import motion_along, strokes, sweep_motion
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
-from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep
@@ -163,7 +162,7 @@ def run(mech, args) -> int:
     fixed, held, _ = split_inputs(mech, args)
     inputs = names_list(args.inputs) or ([args.input, *(k for k in fixed if k != args.input)] if held else
                                          list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
-    solver = input_solver(mech, {n: 0.0 for n in inputs}, held) if held else PositionSolver(mech, inputs)
+    solver = input_solver(mech, inputs, held)
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")

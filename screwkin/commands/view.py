@@ -18,7 +18,7 @@ from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot,
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player
-from ..units import parse_value
+from ..units import in_unit
 from ..present.viewplanar import colour_links, link_colours, planar_basis
 from ._common import (
     add_configuration_options,
@@ -101,7 +101,7 @@ def run(mech, args) -> int:
         motion = res.q
         q = res.q[0]
         unit = typed_unit(mech, name, args.sweep)
-        frames = [f"{name} = {v / parse_value(f'1{unit}'):.4g} {unit}" for v in res.values]
+        frames = [f"{name} = {in_unit(v, unit):.4g} {unit}" for v in res.values]
         for s in locate_singularities(solver, res, output=args.output):
             rep = classify(mech, s.q, output=args.output)
             twist = next((t for t in rep.singular_twists if t.kind == s.kind), None)
