@@ -6,7 +6,7 @@ import csv
 import io
 from dataclasses import dataclass
 
-from ..units import parse_value, unit_kind
+from ..units import in_unit, unit_kind
 
 __all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits"]
 
@@ -89,8 +89,8 @@ class RateUnits:
 
     @staticmethod
     def of(value: float, unit: str) -> float:
-        """An SI value in ``unit`` (rad/s -> rpm ...)."""
-        return value / parse_value("1" + unit)
+        """An SI value in ``unit`` (rad/s -> rpm ...): units.in_unit."""
+        return in_unit(value, unit)
 
     def is_si(self) -> bool:
         return self == RateUnits()
