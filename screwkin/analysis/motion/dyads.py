@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...model.planar_graph import DyadPlan, plan
-from .batch_closure import BatchClosure, Unbatchable
+from .batch_sweep import batch_closure
 from .planar import plane_basis
 from ..singularities.singular import measures
 
@@ -418,14 +418,11 @@ def _residuals_ok(mech, Q) -> bool:
     tol = mech.tolerances.closure
     if not len(Q) or not mech.cuts:
         return True
-    try:
-        bc = mech.cache.get("dyads.batch")
-        if bc is None:
-            bc = mech.cache["dyads.batch"] = BatchClosure(mech, check=0)
-        r = bc.evaluate(Q, jacobian=False)[0]
-        return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
-    except Unbatchable:
+    bc = batch_closure(mech)
+    if bc is None:
         return all(np.linalg.norm(mech.closure.residual(q)) <= tol for q in Q)
+    r = bc.evaluate(Q, jacobian=False)[0]
+    return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
 
 
 def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
