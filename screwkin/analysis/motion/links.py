@@ -103,7 +103,6 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     loop_acceleration) for every step: one Pinocchio pass a step gives the frames' placements,
     velocities and classical accelerations, and the formulas run on the stacks."""
     model = mech.model
-    data = model.createData()
     cuts = loop_coordinate_cuts(mech)
     links = moving_links(mech)
     link_f = [mech.link_frame(link) for link in links]
@@ -111,7 +110,8 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     frames = list(dict.fromkeys(link_f + point_f + [f for c in cuts for f in (c.frame1, c.frame2)]))
     col = {f: i for i, f in enumerate(frames)}
     tree = _tree(mech) if len(Q) else None
-    R, t, tw, ac = tree.motions(Q, V, A, frames) if tree is not None else _frame_motions(model, data, frames, Q, V, A)
+    R, t, tw, ac = (tree.motions(Q, V, A, frames) if tree is not None
+                    else _frame_motions(model, model.createData(), frames, Q, V, A))
     named = None
     if angles is not None and normal is not None:
         named = angles.batch(Q) if hasattr(angles, "batch") else {
@@ -134,6 +134,10 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
         pts[p.name] = {"link": p.link, "local": list(p.local), "position": t[:, i] + r,
                        "velocity": tw[:, i, :3] + np.cross(w, r),
                        "acceleration": ac[:, i, :3] + np.cross(al, r) + np.cross(w, np.cross(w, r))}
+
+    def dot(x, y):
+        return np.einsum("ij,ij->i", x, y)
+
     loops, loop_rates, loop_accs = {}, {}, {}
     for c in cuts:
         i1, i2 = col[c.frame1], col[c.frame2]
@@ -144,10 +148,6 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
         (a1, al1), (a2, al2) = (ac[:, i1, :3], ac[:, i1, 3:]), (ac[:, i2, :3], ac[:, i2, 3:])
         da = np.cross(w1, axis)  # d axis / dt
         dda = np.cross(al1, axis) + np.cross(w1, da)
-
-        def dot(x, y):
-            return np.einsum("ij,ij->i", x, y)
-
         if c.type == "prismatic":
             r = t[:, i2] - t[:, i1]
             loops[c.name] = dot(r, axis)
