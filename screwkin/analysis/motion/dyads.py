@@ -32,9 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ...model.geometry import plane_basis
 from ...model.planar_graph import DyadPlan, plan
 from .batch_sweep import batch_closure
-from .planar import plane_basis
 from ..singularities.singular import measures
 
 __all__ = ["Jet", "ClosedFormSweep", "planar_sweep", "joint_values"]
