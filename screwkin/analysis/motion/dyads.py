@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...model.geometry import plane_basis
+from ...model.geometry import plane_basis, wrap_angle
 from ...model.planar_graph import DyadPlan, plan
 from .batch_sweep import batch_closure
 from ..singularities.singular import measures
@@ -541,7 +541,7 @@ def joint_values(mech, Q) -> np.ndarray:
     cols = {}
     for (n, i, w) in single:
         v = Q[:, i]
-        cols[n] = np.mod(v + np.pi, 2 * np.pi) - np.pi if w else v
+        cols[n] = wrap_angle(v) if w else v
     for n, i in continuous:
         cols[n] = np.arctan2(Q[:, i + 1], Q[:, i])
     for n, i in multi:
