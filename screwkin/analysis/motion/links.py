@@ -1,7 +1,7 @@
 """Absolute motion in the user's quantities: links, named points and loop-joint coordinates.
 
-Read from :class:`~screwkin.model.state.KinematicState` -- one state per configuration -- for
-one solution (``solve``) or every step of a motion (``sweep``):
+Read from :class:`~screwkin.model.state.KinematicState` for one solution (``solve``); for every
+step of a motion (``sweep``) the same quantities computed on stacks of configurations:
 
 * ``link_motions(state, angles, normal)``: each moving link's frame origin (position, velocity,
   acceleration), its angular velocity and acceleration; planar mechanisms: the vector-loop angle
@@ -9,7 +9,10 @@ one solution (``solve``) or every step of a motion (``sweep``):
 * ``point_motions(state, points)``: the points people name, ``NAME=LINK:x,y,z`` (coordinates in the
   link's frame): position, velocity, acceleration in world axes;
 * ``motion_along(mech, Q, V, A, points, angles, normal)``: the same for every step of a sweep,
-  as arrays, with the loop joints' coordinates.
+  as arrays, with the loop joints' coordinates; ``sweep_motion(mech, res, points)``: that along a
+  SweepResult, with a planar mechanism's angles and plane normal found for it;
+* ``strokes(res, motion, mech, solver)``: each slider's travel along a sweep, its ends, and a
+  whole-turn crank's time ratio.
 
 Units: m, rad, s.
 """
