@@ -32,9 +32,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ...model.geometry import plane_basis, wrap_angle
 from ...model.planar_graph import DyadPlan, plan
-from .batch_closure import BatchClosure, Unbatchable
-from .planar import plane_basis
+from .batch_sweep import batch_closure
 from ..singularities.singular import measures
 
 __all__ = ["Jet", "ClosedFormSweep", "planar_sweep", "joint_values"]
@@ -418,14 +418,11 @@ def _residuals_ok(mech, Q) -> bool:
     tol = mech.tolerances.closure
     if not len(Q) or not mech.cuts:
         return True
-    try:
-        bc = mech.cache.get("dyads.batch")
-        if bc is None:
-            bc = mech.cache["dyads.batch"] = BatchClosure(mech, check=0)
-        r = bc.evaluate(Q, jacobian=False)[0]
-        return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
-    except Unbatchable:
+    bc = batch_closure(mech)
+    if bc is None:
         return all(np.linalg.norm(mech.closure.residual(q)) <= tol for q in Q)
+    r = bc.evaluate(Q, jacobian=False)[0]
+    return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
 
 
 def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
@@ -544,7 +541,7 @@ def joint_values(mech, Q) -> np.ndarray:
     cols = {}
     for (n, i, w) in single:
         v = Q[:, i]
-        cols[n] = np.mod(v + np.pi, 2 * np.pi) - np.pi if w else v
+        cols[n] = wrap_angle(v) if w else v
     for n, i in continuous:
         cols[n] = np.arctan2(Q[:, i + 1], Q[:, i])
     for n, i in multi:

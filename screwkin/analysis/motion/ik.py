@@ -3,12 +3,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
-from dataclasses import dataclass, replace
-
 from ...model.closure import ClosureSystem, CutJoint
 from ...model.geometry import wrap_angle
 from ...model.linalg import rank

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -159,23 +159,21 @@ class Interactive:
         return k + 1 if k >= 0 and d[k] <= self.mech.tolerances.geometry * self.mech.length * math.sqrt(max(len(c), 1)) else 0
 
     # ------------------------------------------------------------------ state
-    def _state(self, q, mode=None, moved=True, message=None) -> LiveState:
+    def _state(self, q, mode=None) -> LiveState:
         mech = self.mech
         modes = self.modes()
-        m = measures(mech, q, self.solver.generic())
         g = self.solver.generic()
+        m = measures(mech, q, g)
         sigma = float(min(m["actuator"], m["constraint"])) if g.rank_K or g.rank_Kp else 1.0
         pose = None
         if self.output is not None:
             pose = KinematicState(mech, q).link_pose(self.output)
         points = self._positions(q) if self.points else {}
         return LiveState(np.array(q, float), dict(self._values), self._mode_of(q, modes) if mode is None else mode,
-                         len(modes), sigma, sigma < mech.tolerances.singular, pose, points, moved, message)
+                         len(modes), sigma, sigma < mech.tolerances.singular, pose, points)
 
     def _refused(self, message) -> LiveState:
-        s = self.state
-        self.state = LiveState(s.q, s.inputs, s.mode, s.modes, s.sigma, s.singular, s.output_pose, s.points, False,
-                               message)
+        self.state = replace(self.state, moved=False, message=message)
         return self.state
 
     def move(self, name: str, value: float) -> LiveState:

@@ -37,7 +37,7 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
     data = mech.scratch_data()
     q0 = mech.neutral()
     pin.forwardKinematics(model, data, q0)
-    terms, path = [], []
+    terms, path, pairs = [], [], set()
     jid = model.frames[mech.link_frame(link)].parentJoint
     while jid != 0:
         joint, name = model.joints[jid], model.names[jid]
@@ -49,6 +49,8 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
                 raise UsageError(f"{mech.path}: joint '{name}' on the path of '{link}' from the ground does not turn "
                                  "about the plane's normal: its angle is not the sum of the joint angles")
             terms.append((int(model.idx_qs[jid]), int(model.idx_vs[jid]), float(np.sign(s))))
+            if model.nqs[jid] == 2:  # a continuous joint: (cos, sin)
+                pairs.add(int(model.idx_qs[jid]))
         elif not (short.startswith("JointModelP") and model.nvs[jid] == 1):
             raise UsageError(f"{mech.path}: joint '{name}' on the path of '{link}' from the ground is not a revolute "
                              "or prismatic joint of one coordinate: --set-angle cannot hold that link's angle")
@@ -56,15 +58,9 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
     if not terms:
         raise UsageError(f"{mech.path}: the angle of '{link}' is fixed (no revolute joint between it and the "
                          f"ground: {', '.join(reversed(path)) or 'none'})")
-    pairs = frozenset(iq for iq, _, _ in terms if model.nqs[_joint_at(model, iq)] == 2)  # continuous joints
-    path_sum = CouplingRow(f"angle of {link}", "angle", tuple(terms), 0.0, input=link, pairs=pairs)
+    path_sum = CouplingRow(f"angle of {link}", "angle", tuple(terms), 0.0, input=link, pairs=frozenset(pairs))
     theta0 = angles(q0)[link] - path_sum.value(q0)  # the link's angle at q0 less its joints' sum there
     return replace(path_sum, constant=float(theta0 - angle))
-
-
-def _joint_at(model, iq) -> int:
-    """The joint whose configuration starts at q index iq."""
-    return next(j for j in range(1, model.njoints) if model.idx_qs[j] == iq)
 
 
 def holding_angles(mech, joints, angles: dict):
@@ -73,10 +69,9 @@ def holding_angles(mech, joints, angles: dict):
     when the mechanism is not planar, or a link's angle is fixed by the other inputs (its row adds no
     rank to the loops' passive columns: e.g. a link on the ground pivot of an input joint, or two
     links of one rigid assembly)."""
-    q = mech.generic_configurations()[1][0]
-    la = LinkAngles(mech, mech.topology(q))
-    rows = [angle_row(la, link, value) for link, value in angles.items()]
     configs = mech.generic_configurations()[1]
+    la = LinkAngles(mech, mech.topology(configs[0]))
+    rows = [angle_row(la, link, value) for link, value in angles.items()]
     before = Generic(mech, list(joints), configurations=configs).rank_Kp
     for k, link in enumerate(angles, 1):
         held = mech.with_rows(rows[:k])

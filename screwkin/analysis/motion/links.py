@@ -1,7 +1,7 @@
 """Absolute motion in the user's quantities: links, named points and loop-joint coordinates.
 
-Read from :class:`~screwkin.model.state.KinematicState` -- one state per configuration -- for
-one solution (``solve``) or every step of a motion (``sweep``):
+Read from :class:`~screwkin.model.state.KinematicState` for one solution (``solve``); for every
+step of a motion (``sweep``) the same quantities computed on stacks of configurations:
 
 * ``link_motions(state, angles, normal)``: each moving link's frame origin (position, velocity,
   acceleration), its angular velocity and acceleration; planar mechanisms: the vector-loop angle
@@ -9,7 +9,10 @@ one solution (``solve``) or every step of a motion (``sweep``):
 * ``point_motions(state, points)``: the points people name, ``NAME=LINK:x,y,z`` (coordinates in the
   link's frame): position, velocity, acceleration in world axes;
 * ``motion_along(mech, Q, V, A, points, angles, normal)``: the same for every step of a sweep,
-  as arrays, with the loop joints' coordinates.
+  as arrays, with the loop joints' coordinates; ``sweep_motion(mech, res, points)``: that along a
+  SweepResult, with a planar mechanism's angles and plane normal found for it;
+* ``strokes(res, motion, mech, solver)``: each slider's travel along a sweep, its ends, and a
+  whole-turn crank's time ratio.
 
 Units: m, rad, s.
 """
@@ -103,7 +106,6 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     loop_acceleration) for every step: one Pinocchio pass a step gives the frames' placements,
     velocities and classical accelerations, and the formulas run on the stacks."""
     model = mech.model
-    data = model.createData()
     cuts = loop_coordinate_cuts(mech)
     links = moving_links(mech)
     link_f = [mech.link_frame(link) for link in links]
@@ -111,7 +113,8 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     frames = list(dict.fromkeys(link_f + point_f + [f for c in cuts for f in (c.frame1, c.frame2)]))
     col = {f: i for i, f in enumerate(frames)}
     tree = _tree(mech) if len(Q) else None
-    R, t, tw, ac = tree.motions(Q, V, A, frames) if tree is not None else _frame_motions(model, data, frames, Q, V, A)
+    R, t, tw, ac = (tree.motions(Q, V, A, frames) if tree is not None
+                    else _frame_motions(model, model.createData(), frames, Q, V, A))
     named = None
     if angles is not None and normal is not None:
         named = angles.batch(Q) if hasattr(angles, "batch") else {
@@ -134,6 +137,10 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
         pts[p.name] = {"link": p.link, "local": list(p.local), "position": t[:, i] + r,
                        "velocity": tw[:, i, :3] + np.cross(w, r),
                        "acceleration": ac[:, i, :3] + np.cross(al, r) + np.cross(w, np.cross(w, r))}
+
+    def dot(x, y):
+        return np.einsum("ij,ij->i", x, y)
+
     loops, loop_rates, loop_accs = {}, {}, {}
     for c in cuts:
         i1, i2 = col[c.frame1], col[c.frame2]
@@ -144,10 +151,6 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
         (a1, al1), (a2, al2) = (ac[:, i1, :3], ac[:, i1, 3:]), (ac[:, i2, :3], ac[:, i2, 3:])
         da = np.cross(w1, axis)  # d axis / dt
         dda = np.cross(al1, axis) + np.cross(w1, da)
-
-        def dot(x, y):
-            return np.einsum("ij,ij->i", x, y)
-
         if c.type == "prismatic":
             r = t[:, i2] - t[:, i1]
             loops[c.name] = dot(r, axis)
@@ -263,7 +266,7 @@ def _extrema(x, p, dp, tol):
     return out
 
 
-def _refine(solver, res, name, coordinate, x, guess, tol):
+def _refine(solver, res, name, coordinate, x, guess):
     """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
     its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
     from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""
@@ -314,7 +317,7 @@ def strokes(res, motion, mech, solver=None) -> list:
         values, slope = np.asarray(values, float), np.asarray(rates, float) / (res.rate or 1.0)
         inner = _extrema(x, values, slope, tol)
         if solver is not None and res.q is not None and len(res.q) == len(x):
-            inner = [_refine(solver, res, name, coordinate, x, e, tol) for e in inner]
+            inner = [_refine(solver, res, name, coordinate, x, e) for e in inner]
         ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + inner
         lo, hi = min(ends, key=lambda e: e[1]), max(ends, key=lambda e: e[1])
         ratio = angles = None
