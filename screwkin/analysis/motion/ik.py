@@ -58,10 +58,11 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     ref_sig = solver.signature(ref if ref is not None else found[0][1])
     needed = mech.nv - solver.idle_dofs
     # what the target leaves free beyond the idle DOFs (a position alone on a planar platform: its turn)
-    free = max(needed - max(rank(system.jacobian(q), mech.tolerances) for _, q, _ in found), 0)
+    jacobians = [system.jacobian(q) for _, q, _ in found]
+    free = max(needed - max(rank(J, mech.tolerances) for J in jacobians), 0)
     sols = []
-    for _, q, a in found:
-        s = np.linalg.svd(system.jacobian(q), compute_uv=False)
+    for (_, q, a), J in zip(found, jacobians):
+        s = np.linalg.svd(J, compute_uv=False)
         k = needed - free  # a continuum left by the target is no singularity: the rank it keeps
         sigma = float(s[k - 1] / s[0]) if 0 < k <= len(s) else 1.0
         # every quantity as solve reports it (loop joints, links, leg lengths), singular by the ik system
