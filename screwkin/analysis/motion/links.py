@@ -228,7 +228,7 @@ def _frame_motions(model, data, frames, Q, V, A):
     return R, t, tw, ac
 
 
-LOCATE_XTOL = 1e-12  # a slider's end is located to this in the input [rad or m] (as singular points are)
+LOCATE_XTOL = 1e-12  # singular points and a slider's ends are located to this in the input [rad or m]
 
 
 @dataclass(frozen=True)

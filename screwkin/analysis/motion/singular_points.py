@@ -12,6 +12,7 @@ import numpy as np
 
 from ...errors import AssemblyError
 from ..singularities.singular import Generic, measures, scaled_jacobians
+from .links import LOCATE_XTOL
 from .sweep import SweepResult, SweepSingularity
 
 __all__ = ["locate_singularities"]
@@ -29,7 +30,7 @@ def _matrix(mech, q, kind, g, V_ref=None):
     return S.J @ V
 
 
-def locate_singularities(solver, res: SweepResult, output=None, xtol: float = 1e-12, point: bool = False):
+def locate_singularities(solver, res: SweepResult, output=None, xtol: float = LOCATE_XTOL, point: bool = False):
     """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
     positions the sweep located, and the other singularities.
 
