@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import plane_basis
+
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact"]
 
 
@@ -107,20 +109,13 @@ class Assembly:
     start: str = "the given configuration"
     starts: int = 1
 
-#: A unit axis's component off e below this: e lies along the axis, in_plane takes the next one.
-_ALONG_AXIS = 1e-6
-
 
 def in_plane(axis):
     """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
-    a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1)."""
-    a = np.asarray(axis, float) / np.linalg.norm(axis)
-    for e in np.eye(3):
-        u = e - (e @ a) * a
-        if np.linalg.norm(u) > _ALONG_AXIS:
-            u /= np.linalg.norm(u)
-            return a, u, np.cross(a, u)
-    raise ValueError("degenerate axis")  # pragma: no cover
+    a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1) --
+    geometry.plane_basis(axis) in the order (normal, e1, e2)."""
+    e1, e2, a = plane_basis(axis)
+    return a, e1, e2
 
 
 def pair_contact(pair, M1, M2):
