@@ -150,14 +150,15 @@ class KinematicState:
                 a.setflags(write=False)
 
     # ------------------------------------------------------------------ Pinocchio, once
-    def _pass(self, data, jacobians: bool):
+    def _pass(self, data):
+        """Pinocchio's pass for this state in ``data``: placements, motions when it has rates, joint Jacobians."""
         model = self.mech.model
         if self.qd is None:
             pin.framesForwardKinematics(model, data, self.q)
         else:
             pin.forwardKinematics(model, data, self.q, self.qd, self.qdd)
             pin.updateFramePlacements(model, data)
-        if jacobians and model.nv:
+        if model.nv:
             pin.computeJointJacobians(model, data, self.q)
             pin.updateFramePlacements(model, data)
         return data
@@ -165,17 +166,13 @@ class KinematicState:
     @cached_property
     def _own(self):
         """This state's Data, with its pass and the joint Jacobians (computed once)."""
-        return self._pass(self.mech.scratch_data(), True)
+        return self._pass(self.mech.scratch_data())
 
     @property
     def _data(self):
         """The Data the state reads: its own; for a model too large for a Data per computation
         (Mechanism.shares_data) the mechanism's shared one, the pass run again at each read."""
-        return self._pass(self.mech.data, True) if self.mech.shares_data else self._own
-
-    @property
-    def _jacobians(self):
-        return self._data
+        return self._pass(self.mech.data) if self.mech.shares_data else self._own
 
     @property
     def has_rates(self) -> bool:
@@ -193,7 +190,7 @@ class KinematicState:
         """(6, nv) Jacobian of a frame in (linear, angular) order, in ``reference``
         (LOCAL_WORLD_ALIGNED by default: the frame origin's velocity and the angular
         velocity, world axes; WORLD: the spatial twist at the world origin) [m/rad, 1]."""
-        return frame_jacobian(self.mech.model, self._jacobians, fid, reference).copy()
+        return frame_jacobian(self.mech.model, self._data, fid, reference).copy()
 
     def link_jacobian(self, link: str, reference=LWA) -> np.ndarray:
         return self.frame_jacobian(self.mech.link_frame(link), reference)
