@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import plane_basis
+from .geometry import plane_basis, wrap_angle
 
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact"]
 
@@ -47,7 +47,7 @@ class CouplingRow:
 
     kind "angle": a link's absolute angle in a planar mechanism held as an input (the signed
     revolute angles on its path from the ground plus its angle at q = 0, minus the angle given)
-    [rad]; it holds modulo a turn, so its residual is taken in (-pi, pi].  ``input`` names what
+    [rad]; it holds modulo a turn, so its residual is taken in [-pi, pi).  ``input`` names what
     the row holds (the link): its rate and acceleration are given as that input's
     (ClosureSystem.row_rates)."""
 
@@ -60,11 +60,11 @@ class CouplingRow:
 
     def value(self, q) -> float:
         """The row's residual at q: sum c_k q_k + c0, or for an angle row the joints' angles (a
-        continuous joint's atan2(sin, cos)) so summed, taken into (-pi, pi]."""
+        continuous joint's atan2(sin, cos)) so summed, taken into [-pi, pi) (geometry.wrap_angle)."""
         if self.kind != "angle":
             return sum(c * q[iq] for iq, _, c in self.terms) + self.constant
         total = sum(c * (np.arctan2(q[iq + 1], q[iq]) if iq in self.pairs else q[iq]) for iq, _, c in self.terms)
-        return float(np.mod(total + self.constant + np.pi, 2 * np.pi) - np.pi)
+        return wrap_angle(total + self.constant)
 
 
 @dataclass(frozen=True)
