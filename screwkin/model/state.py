@@ -75,7 +75,7 @@ def leg_ends(mech) -> dict:
     ("frame", id): the centre of the joint that carries the prismatic joint's parent link, and the
     first centre on its child link (a joint it carries, else a cut joint's frame on it) away from the
     prismatic joint's origin.  A leg length is the distance between the two (a Stewart leg's U to S)."""
-    model, data = mech.model, mech.model.createData()
+    model, data = mech.model, mech.scratch_data()
     pin.framesForwardKinematics(model, data, mech.neutral())
     tiny = mech.tolerances.geometry
     out = {}
@@ -106,7 +106,7 @@ def value_for_leg_length(mech, joint: str, length: float) -> float:
     if ends is None:
         raise UsageError(f"{mech.path}: {quote(joint)} is not a prismatic joint between two joint centres "
                          "(no leg length to set)")
-    model, data = mech.model, mech.model.createData()
+    model, data = mech.model, mech.scratch_data()
     q = mech.neutral()
     pin.framesForwardKinematics(model, data, q)
     c = mech.coordinate(joint)
