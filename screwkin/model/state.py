@@ -3,7 +3,9 @@
 ``KinematicState(mech, q, qd, qdd)`` is an immutable value: forward kinematics (positions,
 and rates and accelerations when ``qd``/``qdd`` are given) run once, lazily, in a ``Data`` that
 belongs to the state, so that nothing depends on what another analysis left in ``mech.data``
-and threads may share a mechanism.  From it every quantity people ask for is read:
+and threads may share a mechanism (a model too large for a Data per computation,
+Mechanism.shares_data, reads the mechanism's one Data, its pass run again at each read: one
+thread at a time).  From it every quantity people ask for is read:
 
 * every link's absolute pose, and the velocity and classical acceleration of its frame origin
   with its angular velocity and acceleration (world axes; twists in (linear, angular) order);
