@@ -47,7 +47,8 @@ class ClosureSystem:
 
     def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>", data=None,
                  extra=()):
-        """data: the pinocchio.Data to compute in (the mechanism's; a new one when None);
+        """data: the pinocchio.Data the building thread computes in (a new one when None; every other
+        thread makes its own: ``_workspace``);
         extra: CouplingRow and ContactRow of higher pairs, after the cut joints' rows."""
         self.model = model
         self._first_data = model.createData() if data is None else data
@@ -59,7 +60,7 @@ class ClosureSystem:
         self.nrows = sum(c.rows for c in self.cuts) + len(self.extra)
         self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
         self._solver_rows = None
-        self._compiled = None  # (kernels, cut kinds, buffers) when accelerate() is on
+        self._compiled = None  # (kernels, cut kinds) when accelerate() is on; each thread's buffers in its workspace
         self._free = {}  # free velocity indices for each set of frozen ones
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         self._owner = threading.get_ident()

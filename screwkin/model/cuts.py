@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import plane_basis, wrap_angle
+
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact"]
 
 
@@ -45,7 +47,7 @@ class CouplingRow:
 
     kind "angle": a link's absolute angle in a planar mechanism held as an input (the signed
     revolute angles on its path from the ground plus its angle at q = 0, minus the angle given)
-    [rad]; it holds modulo a turn, so its residual is taken in (-pi, pi].  ``input`` names what
+    [rad]; it holds modulo a turn, so its residual is taken in [-pi, pi).  ``input`` names what
     the row holds (the link): its rate and acceleration are given as that input's
     (ClosureSystem.row_rates)."""
 
@@ -58,11 +60,11 @@ class CouplingRow:
 
     def value(self, q) -> float:
         """The row's residual at q: sum c_k q_k + c0, or for an angle row the joints' angles (a
-        continuous joint's atan2(sin, cos)) so summed, taken into (-pi, pi]."""
+        continuous joint's atan2(sin, cos)) so summed, taken into [-pi, pi) (geometry.wrap_angle)."""
         if self.kind != "angle":
             return sum(c * q[iq] for iq, _, c in self.terms) + self.constant
         total = sum(c * (np.arctan2(q[iq + 1], q[iq]) if iq in self.pairs else q[iq]) for iq, _, c in self.terms)
-        return float(np.mod(total + self.constant + np.pi, 2 * np.pi) - np.pi)
+        return wrap_angle(total + self.constant)
 
 
 @dataclass(frozen=True)
@@ -107,20 +109,13 @@ class Assembly:
     start: str = "the given configuration"
     starts: int = 1
 
-#: A unit axis's component off e below this: e lies along the axis, in_plane takes the next one.
-_ALONG_AXIS = 1e-6
-
 
 def in_plane(axis):
     """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
-    a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1)."""
-    a = np.asarray(axis, float) / np.linalg.norm(axis)
-    for e in np.eye(3):
-        u = e - (e @ a) * a
-        if np.linalg.norm(u) > _ALONG_AXIS:
-            u /= np.linalg.norm(u)
-            return a, u, np.cross(a, u)
-    raise ValueError("degenerate axis")  # pragma: no cover
+    a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1) --
+    geometry.plane_basis(axis) in the order (normal, e1, e2)."""
+    e1, e2, a = plane_basis(axis)
+    return a, e1, e2
 
 
 def pair_contact(pair, M1, M2):

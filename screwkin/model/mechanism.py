@@ -23,6 +23,7 @@ from ..tolerances import DEFAULT, Tolerances
 from ._pin import frame_id
 from .closability import closure_obstacle
 from .closure import Assembly, ClosureSystem, ContactRow, CouplingRow, CutJoint
+from .geometry import wrap_angle
 from .linalg import null_space, rank
 from .topology import build_topology
 from .lengths import characteristic_length, link_lengths  # noqa: F401 - exported here as before
@@ -291,7 +292,7 @@ class Mechanism:
             p = self.coordinate(c.mimics)
             v = c.multiplier * float(q[p.idx_q]) + c.offset
             if self._revolute_like(c.joint):
-                v = float(np.mod(v + np.pi, 2 * np.pi) - np.pi)
+                v = wrap_angle(v)
             out[c.joint] = v
         return out
 
@@ -300,12 +301,12 @@ class Mechanism:
 
     def difference(self, q0, q1) -> np.ndarray:
         """The velocity-space step from q0 to q1 (pinocchio.difference), with the angles of
-        bounded revolute joints taken the short way round (-pi, pi]."""
+        bounded revolute joints taken the short way round [-pi, pi)."""
         d = pin.difference(self.model, q0, q1)
         _, _, _, _, idx, wrap = self._value_layout()
         if wrap.any():
             v = self._angle_v
-            d[v] = np.mod(d[v] + np.pi, 2 * np.pi) - np.pi
+            d[v] = wrap_angle(d[v])
         return d
 
     def joint_values(self, q) -> dict:
@@ -315,7 +316,7 @@ class Mechanism:
         q = np.asarray(q, float)
         single, continuous, multi, order, idx, wrap = self._value_layout()
         v = q[idx]
-        v[wrap] = np.mod(v[wrap] + np.pi, 2 * np.pi) - np.pi
+        v[wrap] = wrap_angle(v[wrap])
         out = dict(zip((n for n, _, _ in single), v.tolist()))
         for name, i in continuous:
             out[name] = float(np.arctan2(q[i + 1], q[i]))

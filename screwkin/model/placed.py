@@ -40,7 +40,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     Raises MechanismFileError for what ``fmt`` cannot express (a higher pair; for URDF a ball
     or universal joint in the tree)."""
     spec, model = mech.spec, mech.model
-    data = model.createData()
+    data = mech.scratch_data()
     pin.framesForwardKinematics(model, data, q)
     rep = dict(spec.replacements)
     for c in spec.cut_joints:

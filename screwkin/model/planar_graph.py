@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .topology import UnionFind
+
 __all__ = ["DyadPlan", "plan"]
 
 _RJOINTS = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned",
@@ -63,19 +65,12 @@ def plan(mech, inputs, name):
     if isinstance(found, str):
         return found
     nb = mech.model.njoints
-    parent = list(range(nb))
-
-    def root(b):
-        while parent[b] != b:
-            parent[b] = parent[parent[b]]
-            b = parent[b]
-        return b
-
+    bodies = UnionFind(range(nb))
     held = set(inputs) - {name}
     welds = [(b1, b2) for pname, kind, b1, b2, tree in found if kind == "W" or (tree is not None and pname in held)]
     for b1, b2 in welds:
-        parent[root(b1)] = root(b2)
-    groups = tuple(root(b) for b in range(nb))
+        bodies.join(b2, b1)  # b1's group under b2's representative
+    groups = tuple(bodies.find(b) for b in range(nb))
     pairs, swept = [], None
     for pname, kind, b1, b2, tree in found:
         if kind == "W" or (tree is not None and pname in held):

@@ -3,7 +3,9 @@
 ``KinematicState(mech, q, qd, qdd)`` is an immutable value: forward kinematics (positions,
 and rates and accelerations when ``qd``/``qdd`` are given) run once, lazily, in a ``Data`` that
 belongs to the state, so that nothing depends on what another analysis left in ``mech.data``
-and threads may share a mechanism.  From it every quantity people ask for is read:
+and threads may share a mechanism (a model too large for a Data per computation,
+Mechanism.shares_data, reads the mechanism's one Data, its pass run again at each read: one
+thread at a time).  From it every quantity people ask for is read:
 
 * every link's absolute pose, and the velocity and classical acceleration of its frame origin
   with its angular velocity and acceleration (world axes; twists in (linear, angular) order);
@@ -75,7 +77,7 @@ def leg_ends(mech) -> dict:
     ("frame", id): the centre of the joint that carries the prismatic joint's parent link, and the
     first centre on its child link (a joint it carries, else a cut joint's frame on it) away from the
     prismatic joint's origin.  A leg length is the distance between the two (a Stewart leg's U to S)."""
-    model, data = mech.model, mech.model.createData()
+    model, data = mech.model, mech.scratch_data()
     pin.framesForwardKinematics(model, data, mech.neutral())
     tiny = mech.tolerances.geometry
     out = {}
@@ -106,7 +108,7 @@ def value_for_leg_length(mech, joint: str, length: float) -> float:
     if ends is None:
         raise UsageError(f"{mech.path}: {quote(joint)} is not a prismatic joint between two joint centres "
                          "(no leg length to set)")
-    model, data = mech.model, mech.model.createData()
+    model, data = mech.model, mech.scratch_data()
     q = mech.neutral()
     pin.framesForwardKinematics(model, data, q)
     c = mech.coordinate(joint)
@@ -150,14 +152,15 @@ class KinematicState:
                 a.setflags(write=False)
 
     # ------------------------------------------------------------------ Pinocchio, once
-    def _pass(self, data, jacobians: bool):
+    def _pass(self, data):
+        """Pinocchio's pass for this state in ``data``: placements, motions when it has rates, joint Jacobians."""
         model = self.mech.model
         if self.qd is None:
             pin.framesForwardKinematics(model, data, self.q)
         else:
             pin.forwardKinematics(model, data, self.q, self.qd, self.qdd)
             pin.updateFramePlacements(model, data)
-        if jacobians and model.nv:
+        if model.nv:
             pin.computeJointJacobians(model, data, self.q)
             pin.updateFramePlacements(model, data)
         return data
@@ -165,17 +168,13 @@ class KinematicState:
     @cached_property
     def _own(self):
         """This state's Data, with its pass and the joint Jacobians (computed once)."""
-        return self._pass(self.mech.scratch_data(), True)
+        return self._pass(self.mech.scratch_data())
 
     @property
     def _data(self):
         """The Data the state reads: its own; for a model too large for a Data per computation
         (Mechanism.shares_data) the mechanism's shared one, the pass run again at each read."""
-        return self._pass(self.mech.data, True) if self.mech.shares_data else self._own
-
-    @property
-    def _jacobians(self):
-        return self._data
+        return self._pass(self.mech.data) if self.mech.shares_data else self._own
 
     @property
     def has_rates(self) -> bool:
@@ -193,7 +192,7 @@ class KinematicState:
         """(6, nv) Jacobian of a frame in (linear, angular) order, in ``reference``
         (LOCAL_WORLD_ALIGNED by default: the frame origin's velocity and the angular
         velocity, world axes; WORLD: the spatial twist at the world origin) [m/rad, 1]."""
-        return frame_jacobian(self.mech.model, self._jacobians, fid, reference).copy()
+        return frame_jacobian(self.mech.model, self._data, fid, reference).copy()
 
     def link_jacobian(self, link: str, reference=LWA) -> np.ndarray:
         return self.frame_jacobian(self.mech.link_frame(link), reference)

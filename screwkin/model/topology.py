@@ -28,7 +28,7 @@ from ..tolerances import DEFAULT
 from ._pin import frame_id
 from .six_bar import six_bar_inversion
 
-__all__ = ["Joint", "Topology", "build_topology", "frame_link"]
+__all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind"]
 
 MOTION = {
     "revolute": "rotation",
@@ -184,7 +184,10 @@ class Topology:
         return six_bar_inversion([tuple(j.links) for j in self.joints], self.ground)
 
 
-class _Union:
+class UnionFind:
+    """Disjoint sets of ``items`` (union-find with path halving): find(x) its set's representative,
+    join(a, b) puts b's set under a's representative."""
+
     def __init__(self, items):
         self.parent = {i: i for i in items}
 
@@ -368,7 +371,7 @@ def build_topology(mech, q) -> Topology:
     tol = mech.tolerances.geometry
     spec = mech.spec
     edges, welds = _edges(mech, q)
-    uf = _Union(list(spec.links))
+    uf = UnionFind(list(spec.links))
     for a, b, _ in welds:
         uf.join(a, b)
     ground_root = uf.find(spec.root)

@@ -18,10 +18,10 @@ from ...model.linalg import rank
 from .newton import NewtonResult, NewtonStep, newton
 from ..screws import structure
 from ..singularities.singular import Generic, classify, scaled_jacobians
-from .vector_loops import LOWER, SIMPLIFY_OPS, LoopEquation, PlanarEquations, Symbol, Vector, VectorLoops
+from .vector_loops import LoopEquation, PlanarEquations, Symbol, Vector, VectorLoops
 
 __all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations", "SpatialEquations", "NewtonStep",
-           "NewtonResult", "VectorLoops", "equations", "newton", "LOWER", "SIMPLIFY_OPS"]
+           "NewtonResult", "VectorLoops", "equations", "newton"]
 
 
 @dataclass(frozen=True)

@@ -91,8 +91,9 @@ def input_range(mech, name, q) -> tuple:
 def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=None, steps: int = 360,
                             near=None, rate: float = 1.0, held=None) -> SingularSearch:
     """The singular configurations along ``input_joint``'s range (:func:`input_range` from q,
-    the assembled configuration by default): one assembly mode followed by screwkin.analysis.
-    sweep.sweep through limit positions (``turn``) and located by locate_singularities (the
+    the assembled configuration by default): one assembly mode followed by
+    screwkin.analysis.motion.sweep.sweep through limit positions (``turn``) and located by
+    analysis.motion.singular_points.locate_singularities (the
     limit positions, and the serial singularities of ``output`` -- by default
     :func:`default_output`: a four-bar's rocker, whose limit positions are the crank and
     coupler collinear -- and the constraint ones).  ``fixed``: the other inputs' values

@@ -203,6 +203,11 @@ def _axis_sign(loops, data, name):
     return float(np.sign((data.oMf[f1].rotation @ np.asarray(axis, float)) @ loops.n))
 
 
+def _turned_towards(angle, want) -> float:
+    """``angle`` [rad] moved by the whole turns that bring it nearest ``want``."""
+    return float(angle + 2 * np.pi * np.round((want - angle) / (2 * np.pi)))
+
+
 def turns_through_pairs(loops, q, values):
     """``values`` (symbol -> value at q, each link's angle counted in turns along the tree) with
     the angle of a link turned through a rolling pair counted instead by the pair's virtual
@@ -229,11 +234,11 @@ def turns_through_pairs(loops, q, values):
             turned = s * dv2 if rec["kind"] == "rack" else s * (dv1 + dv2)  # theta_b - theta_a (- theta_u)
             if nb in out and nb not in inputs:
                 want = loops.theta_q[loops.rep[rec["b"]]] + da + turned
-                out[nb] = float(out[nb] + 2 * np.pi * np.round((want - out[nb]) / (2 * np.pi)))
+                out[nb] = _turned_towards(out[nb], want)
             elif na in out and na not in inputs and nb in out:
                 db = out[nb] - loops.theta_q[loops.rep[rec["b"]]]
                 want = loops.theta_q[loops.rep[rec["a"]]] + db - turned
-                out[na] = float(out[na] + 2 * np.pi * np.round((want - out[na]) / (2 * np.pi)))
+                out[na] = _turned_towards(out[na], want)
     return out
 
 
@@ -310,7 +315,7 @@ def unwrapped(loops, link, angle, q):
             continue
         turned += float(np.sign(np.asarray(j.direction) @ loops.n)) * (q[c.idx_q] - loops.q[c.idx_q])
     guess = loops.theta_q[link] + turned
-    return float(angle + 2 * np.pi * np.round((guess - angle) / (2 * np.pi)))
+    return _turned_towards(angle, guess)
 
 
 def drop_constant_rows(loops):

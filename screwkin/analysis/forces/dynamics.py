@@ -107,9 +107,10 @@ class DynamicsResult:
 
 
 def check_inertias(mech) -> tuple:
-    """Each moving body needs a mass (and an SDF file's inertias are not read: refused): a moving link without <inertial> on a body none of whose links
-    has one is a MechanismFileError naming it, except a link with no geometry either (the inside of a
-    compound joint), taken as massless and returned, named, in a note."""
+    """Each moving body needs a mass (and an SDF file's inertias are not read: refused): a moving
+    link without <inertial> on a body none of whose links has one is a MechanismFileError naming
+    it, except a link with no geometry either (the inside of a compound joint), taken as massless
+    and returned, named, in a note."""
     if mech.spec.format == "sdf":  # files/sdf.py keeps each link's mass only, at its origin
         raise MechanismFileError(mech.path, "dynamics needs the links' inertias, and screwkin reads only the masses of "
                                             "an SDF file (not their <pose> and <inertia>): write it as URDF")

@@ -88,6 +88,8 @@ def characteristic_length(spec: GraspSpec):
 
 
 def scaled_points(p, L):
+    """The weights of a wrench's p rows (3 planar, 6 spatial) that make it dimensionless: 1 on the
+    forces, 1 / L on the moments (L the characteristic length [m])."""
     d = np.ones(p)
     d[3 if p == 6 else 2:] = 1.0 / L
     return d

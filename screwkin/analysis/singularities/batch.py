@@ -25,13 +25,11 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import compute_frame_jacobian
-from ...model.newton import damped_steps  # noqa: F401 - the batched step, exported here as before
-from ..motion.batch_closure import BatchClosure, TreeKinematics, Unbatchable  # noqa: F401 - their home before the split
+from ..motion.batch_closure import BatchClosure, Unbatchable  # noqa: F401 - tests import them from here
 from ..screws import chains
 
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
-           "singular_value_ratios", "determinants", "BatchClosure", "Unbatchable", "damped_steps",
-           "TreeKinematics"]
+           "singular_value_ratios", "determinants", "BatchClosure", "Unbatchable"]
 
 _REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
 
