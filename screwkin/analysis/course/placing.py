@@ -10,7 +10,7 @@ import numpy as np
 from ...model.geometry import wrap_angle as wrap
 from .rolling import virtual_coordinates
 
-__all__ = ["LOWER", "configuration", "wrap"]
+__all__ = ["LOWER", "configuration"]
 
 #: The joints the vector-loop equations take (besides rolling and gear pairs).
 LOWER = ("revolute", "continuous", "prismatic")

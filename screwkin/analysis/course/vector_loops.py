@@ -47,10 +47,10 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import MechanismFileError, UsageError
+from ...model.geometry import wrap_angle as _wrap
 from .cycles import fundamental_cycles
 from .det_conditions import SIMPLIFY_OPS, determinant
 from .placing import LOWER, configuration
-from .placing import wrap as _wrap
 from .rolling import (HIGHER, drop_constant_rows, measure_pairs, pair_term, substitute_pairs, turns_through_pairs,
                       unwrapped)
 from ..motion.planar import LinkAngles
