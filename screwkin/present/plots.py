@@ -204,7 +204,7 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
     handles = []
     if (~reached).any():
         handles.append(Patch(facecolor="0.92", edgecolor="0.6", hatch="//", label="not reached on this assembly mode"))
-    seams = getattr(res, "seams", None)
+    seams = res.seams
     if seams is not None and len(seams):
         from matplotlib.collections import LineCollection
 
