@@ -92,9 +92,6 @@ class RateUnits:
         """An SI value in ``unit`` (rad/s -> rpm ...)."""
         return value / parse_value("1" + unit)
 
-    def is_si(self) -> bool:
-        return self == RateUnits()
-
 
 #: What a spreadsheet reads as the start of a formula in a text cell (CSV injection).
 _FORMULA = ("=", "+", "-", "@", "\t", "\r")
