@@ -34,12 +34,12 @@ def fmt_vec(v, width=11):
     return " ".join(f"{shown(x):>{width}.6g}" for x in v)
 
 
-def column_text(values, relative: float = 1e-9, absolute: float = 1e-12) -> list:
+def column_text(values, relative: float = 1e-9, absolute: float = SHOWN_ZERO) -> list:
     """A column of numbers with 6 significant digits, each below ``relative`` x the column's largest
     magnitude (or below ``absolute``) written as 0: round-off is not a value (1.6e-15 deg is 0)."""
     big = max((abs(v) for v in values if v == v), default=0.0)
     tiny = max(absolute, relative * big)
-    return [f"{(0.0 if abs(v) < tiny else v) + 0.0:.6g}" for v in values]
+    return [f"{shown(v, tiny):.6g}" for v in values]
 
 
 @dataclass(frozen=True)
