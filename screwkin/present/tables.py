@@ -66,19 +66,19 @@ class RateUnits:
         the kinds typed bare or in SI."""
         out = {}
         for unit in rate_units:
-            shown = cls._RATE.get(unit) or cls._RATE.get(unit.lower())
+            written = cls._RATE.get(unit) or cls._RATE.get(unit.lower())
             kind = unit_kind(unit)
-            if shown is None or kind is None:
+            if written is None or kind is None:
                 continue
             linear = kind in ("length", "linear rate")
-            out.setdefault("linear_rate" if linear else "angular_rate", shown[0])
-            if shown[1]:
-                out.setdefault("linear_acceleration" if linear else "angular_acceleration", shown[1])
+            out.setdefault("linear_rate" if linear else "angular_rate", written[0])
+            if written[1]:
+                out.setdefault("linear_acceleration" if linear else "angular_acceleration", written[1])
         for unit in accel_units:
-            shown, kind = cls._ACCEL.get(unit) or cls._ACCEL.get(unit.lower()), unit_kind(unit)
-            if shown and kind:
+            written, kind = cls._ACCEL.get(unit) or cls._ACCEL.get(unit.lower()), unit_kind(unit)
+            if written and kind:
                 key = "linear_acceleration" if kind in ("length", "linear acceleration") else "angular_acceleration"
-                out[key] = shown  # an acceleration typed wins over one implied by a rate
+                out[key] = written  # an acceleration typed wins over one implied by a rate
         return cls(**out)
 
     def rate(self, linear: bool) -> str:
