@@ -49,16 +49,19 @@ def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], f
     t = 0.5 * (P.min(axis=0) + P.max(axis=0))
     x, y = (P - t) @ right, (P - t) @ cam_up
     t = t + right * 0.5 * (x.max() + x.min()) + cam_up * 0.5 * (y.max() + y.min())  # centred, seen from afar
-    for _ in range(20):  # then centred in perspective: the near side looks bigger
+
+    def distance(t):
+        """(x, y, z) of the points about target t, and the smallest distance that fits them."""
         x, y, z = (P - t) @ right, (P - t) @ cam_up, (P - t) @ u
         D = float(np.max(z + np.maximum(np.abs(x) / (fill * tan_h), np.abs(y) / (fill * tan_v))))
-        D = max(D, 1e-3, 1.05 * float(z.max()))
+        return x, y, z, max(D, 1e-3, 1.05 * float(z.max()))
+
+    for _ in range(20):  # then centred in perspective: the near side looks bigger
+        x, y, z, D = distance(t)
         sx, sy = x / (D - z), y / (D - z)  # tangents of the angles off the axis
         mx, my = 0.5 * (sx.max() + sx.min()), 0.5 * (sy.max() + sy.min())
         if abs(mx) < 1e-4 * tan_h and abs(my) < 1e-4 * tan_v:
             break
         t = t + right * mx * D + cam_up * my * D
-    x, y, z = (P - t) @ right, (P - t) @ cam_up, (P - t) @ u
-    D = float(np.max(z + np.maximum(np.abs(x) / (fill * tan_h), np.abs(y) / (fill * tan_v))))
-    D = max(D, 1e-3, 1.05 * float(z.max()))
+    D = distance(t)[3]
     return t, t + D * u

@@ -37,10 +37,9 @@ def design_marks(mech, q, skel, inputs=None, steps: int = 360):
         if k in shown and t.q is not None and float(np.max(np.abs(mech.difference(q, t.q)))) > mech.tolerances.equal:
             ghosts[k] = skeleton(mech, t.q, inputs, basis=skel.basis)
     marks = target_marks(found, skel.basis, ghosts)
-    for k, m in enumerate(marks):
-        m["numbered"] = k in shown
     welded = {j.child: j.parent for j in mech.spec.joints if j.type == "fixed"}
-    for k, m in enumerate(marks):  # the pins of the link that carries a guided frame or a coupler point
+    for k, m in enumerate(marks):  # numbered or not; the pins of the link that carries a guided frame or a coupler point
+        m["numbered"] = k in shown
         carrier = m["link"]
         while carrier in welded:
             carrier = welded[carrier]

@@ -146,31 +146,29 @@ class InteractiveView:
     def _mode_name(self) -> str:
         return f"mode {max(self.live.state.mode, 1)}"
 
-    def _moved(self, name, unit):
-        def callback(event):
-            with self._lock:
-                if self._busy:
-                    return
-                self._busy = True
-                try:
-                    self.live.move(name, _si(float(self.sliders[name].value), unit))
-                    if not self.live.state.moved:  # refused: the slider goes back to where the mechanism is
-                        self.sliders[name].value = _shown(self.live.state.inputs[name], unit)
-                    self._show()
-                finally:
-                    self._busy = False
-        return callback
-
-    def _switched(self, event):
+    def _act(self, action):
+        """Run ``action`` then redraw, unless a callback is already doing so: setting a control
+        from Python (a slider sent back, the modes' dropdown updated) calls back, and is ignored."""
         with self._lock:
             if self._busy:
                 return
             self._busy = True
             try:
-                self.live.switch(int(str(self.modes.value).split()[-1]))
+                action()
                 self._show()
             finally:
                 self._busy = False
+
+    def _moved(self, name, unit):
+        def move():
+            self.live.move(name, _si(float(self.sliders[name].value), unit))
+            if not self.live.state.moved:  # refused: the slider goes back to where the mechanism is
+                self.sliders[name].value = _shown(self.live.state.inputs[name], unit)
+
+        return lambda event: self._act(move)
+
+    def _switched(self, event):
+        self._act(lambda: self.live.switch(int(str(self.modes.value).split()[-1])))
 
     # ------------------------------------------------------------------ display
     def _show(self):

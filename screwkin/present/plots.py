@@ -188,15 +188,13 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
     (``res.reached`` False) blank and hatched, with a legend entry of their own -- no colour is
     drawn across the jump between two modes."""
     plt = pyplot("--png")
-    from matplotlib.patches import Patch
+    from matplotlib.patches import Patch, Rectangle
 
     fig, ax = plt.subplots(figsize=(7, 5.5))
     xs, ys = _axis(res.xs, x_unit), _axis(res.ys, y_unit)
     X, Y = np.meshgrid(xs, ys)
     reached = np.isfinite(res.log_sigma) if res.reached is None else np.asarray(res.reached, bool)
     shown = np.ma.masked_where(~reached | ~np.isfinite(res.log_sigma), res.log_sigma)
-    from matplotlib.patches import Rectangle
-
     hx0 = abs(xs[1] - xs[0]) / 2 if len(xs) > 1 else 0.5
     hy0 = abs(ys[1] - ys[0]) / 2 if len(ys) > 1 else 0.5
     ax.add_patch(Rectangle((xs.min() - hx0, ys.min() - hy0), np.ptp(xs) + 2 * hx0, np.ptp(ys) + 2 * hy0,
@@ -206,7 +204,7 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
     handles = []
     if (~reached).any():
         handles.append(Patch(facecolor="0.92", edgecolor="0.6", hatch="//", label="not reached on this assembly mode"))
-    seams = getattr(res, "seams", None)
+    seams = res.seams
     if seams is not None and len(seams):
         from matplotlib.collections import LineCollection
 

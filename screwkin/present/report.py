@@ -445,7 +445,7 @@ def map_dict(res: SingularityMap) -> dict:
     ``reached``; ``notes`` says where the continuation stopped; ``seams`` lists the neighbouring
     cells [[j, i, j2, i2], ...] (row j: ys[j], column i: xs[i]) on different sheets of the mode."""
     reached = res.reached if res.reached is not None else np.isfinite(res.log_sigma)
-    seams = res.seams.tolist() if getattr(res, "seams", None) is not None else []
+    seams = res.seams.tolist() if res.seams is not None else []
     return {"x": res.x_name, "y": res.y_name, "xs": res.xs, "ys": res.ys,
             "log10_sigma_min": nan_to_none(res.log_sigma), "kind": res.kind, "reached": reached,
             "off_branch": int(reached.size - reached.sum()), "seams": seams, "notes": list(res.notes)}

@@ -246,7 +246,7 @@ FAILED_COLOR = "crimson"
 def _label(key, result=None):
     """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
     dimension (m^2 or m^3; m^d when they differ)."""
-    label, factor = LABELS.get(key, (_display(key)[0], _display(key)[1]))
+    label, factor = LABELS.get(key, _display(key))
     if "{dim}" in label:
         dims = {r.get("workspace_dimension") for r in (result.succeeded if result is not None else ())} - {None}
         label = label.replace("{dim}", str(dims.pop()) if len(dims) == 1 else "d")
@@ -301,12 +301,12 @@ def metrics_figure(result):
         for j, p in enumerate(params):
             ax = axes[i][j]
             plabel, pf = _parameter_axis(result, p)
-            for cls in dict.fromkeys(c for c, _ in classes.values()):
+            for cls, colour in dict(classes.values()).items():  # class -> its colour, in the rows' order
                 rows = [r for n, r in enumerate(result.rows) if classes[n][0] == cls and r[k] is not None
                         and r["error"] is None]
                 if rows:
                     (h,) = ax.plot([r[p] * pf for r in rows], [r[k] * f for r in rows], "o", ms=4, alpha=0.8,
-                                   color=next(c for n, (c2, c) in classes.items() if c2 == cls), label=cls)
+                                   color=colour, label=cls)
                     handles.setdefault(cls, h)
             failed = [r for r in result.rows if r["error"] is not None]
             if failed:
@@ -347,13 +347,13 @@ def pareto_figure(result, goals=None):
     (la, fa), (lb, fb) = axis[a], axis[b]
     classes = _classes(result)
     fig, ax = plt.subplots(figsize=(6.5, 4.8))
-    for cls in dict.fromkeys(c for c, _ in classes.values()):
+    for cls, colour in dict(classes.values()).items():  # class -> its colour, in the rows' order
         if cls == "failed":
             continue
         rows = [r for n, r in enumerate(result.rows) if classes[n][0] == cls and r[a] is not None and r[b] is not None]
         if rows:
             ax.plot([r[a] * fa for r in rows], [r[b] * fb for r in rows], "o", ms=4, alpha=0.8,
-                    color=next(c for c2, c in classes.values() if c2 == cls),
+                    color=colour,
                     label=cls if cls != "analysed" else "designs")
     fx = [result.rows[k][a] * fa for k in front]
     fy = [result.rows[k][b] * fb for k in front]

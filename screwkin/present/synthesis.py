@@ -134,13 +134,11 @@ def _typed(result: FunctionResult, check: Check) -> list:
     gives there (None where it does not assemble).  The file's own angles differ: the crank
     joint counts from the first precision point, the rocker's frame may point from B0 away from B."""
     out = []
-    for p, phi, psi in zip(check.precision, result.phi, result.psi):
+    for p, x, phi, psi in zip(check.precision, result.x, result.phi, result.psi):
         got = None
         if p.value and math.isfinite(p.error):
             got = math.degrees(psi + float(wrap(p.value[0] - p.target.value[0])))
-        out.append({"x": None, "phi_deg": math.degrees(phi), "psi_deg": math.degrees(psi), "psi_reached_deg": got})
-    for entry, x in zip(out, result.x):
-        entry["x"] = x
+        out.append({"x": x, "phi_deg": math.degrees(phi), "psi_deg": math.degrees(psi), "psi_reached_deg": got})
     return out
 
 

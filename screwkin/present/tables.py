@@ -34,12 +34,12 @@ def fmt_vec(v, width=11):
     return " ".join(f"{shown(x):>{width}.6g}" for x in v)
 
 
-def column_text(values, relative: float = 1e-9, absolute: float = 1e-12) -> list:
+def column_text(values, relative: float = 1e-9, absolute: float = SHOWN_ZERO) -> list:
     """A column of numbers with 6 significant digits, each below ``relative`` x the column's largest
     magnitude (or below ``absolute``) written as 0: round-off is not a value (1.6e-15 deg is 0)."""
     big = max((abs(v) for v in values if v == v), default=0.0)
     tiny = max(absolute, relative * big)
-    return [f"{(0.0 if abs(v) < tiny else v) + 0.0:.6g}" for v in values]
+    return [f"{shown(v, tiny):.6g}" for v in values]
 
 
 @dataclass(frozen=True)
@@ -66,19 +66,19 @@ class RateUnits:
         the kinds typed bare or in SI."""
         out = {}
         for unit in rate_units:
-            shown = cls._RATE.get(unit) or cls._RATE.get(unit.lower())
+            written = cls._RATE.get(unit) or cls._RATE.get(unit.lower())
             kind = unit_kind(unit)
-            if shown is None or kind is None:
+            if written is None or kind is None:
                 continue
             linear = kind in ("length", "linear rate")
-            out.setdefault("linear_rate" if linear else "angular_rate", shown[0])
-            if shown[1]:
-                out.setdefault("linear_acceleration" if linear else "angular_acceleration", shown[1])
+            out.setdefault("linear_rate" if linear else "angular_rate", written[0])
+            if written[1]:
+                out.setdefault("linear_acceleration" if linear else "angular_acceleration", written[1])
         for unit in accel_units:
-            shown, kind = cls._ACCEL.get(unit) or cls._ACCEL.get(unit.lower()), unit_kind(unit)
-            if shown and kind:
+            written, kind = cls._ACCEL.get(unit) or cls._ACCEL.get(unit.lower()), unit_kind(unit)
+            if written and kind:
                 key = "linear_acceleration" if kind in ("length", "linear acceleration") else "angular_acceleration"
-                out[key] = shown  # an acceleration typed wins over one implied by a rate
+                out[key] = written  # an acceleration typed wins over one implied by a rate
         return cls(**out)
 
     def rate(self, linear: bool) -> str:
@@ -91,9 +91,6 @@ class RateUnits:
     def of(value: float, unit: str) -> float:
         """An SI value in ``unit`` (rad/s -> rpm ...): units.in_unit."""
         return in_unit(value, unit)
-
-    def is_si(self) -> bool:
-        return self == RateUnits()
 
 
 #: What a spreadsheet reads as the start of a formula in a text cell (CSV injection).

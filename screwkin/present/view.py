@@ -351,7 +351,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
             cone.meshColor = COLORS["screw"]
             add(cone, "singular:arrow")
     return Scene(geom, roles, scale, center, _corner_points(model, data, geom, q),
-                 declared=getattr(mech, "actuation_source", None) is not None)
+                 declared=mech.actuation_source is not None)
 
 
 class RecordingViewer:
