@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
-from ..units import parse_value
+from ..units import in_unit
 from .plots import pyplot
 from .jsonout import nan_to_none
 from .report import sweep_rows
@@ -23,7 +23,7 @@ def _input_scale(r: DynamicsResult, shown: str | None):
     """(factor from SI, unit) of the input values as shown: in ``shown`` (a unit of the input's
     kind as a person typed it: deg, mm, in), else in SI."""
     if shown:
-        return 1.0 / parse_value(f"1{shown}"), shown
+        return in_unit(1.0, shown), shown
     return 1.0, r.unit
 
 

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
-from ..units import parse_value
+from ..units import in_unit
 
 __all__ = ["sweep_plot", "motion_figure", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
@@ -177,7 +177,7 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
 
 def _axis(values, unit):
     """SI values in ``unit`` (a unit of screwkin.units as typed, any case: 'deg', 'MM'; bare: SI)."""
-    return np.asarray(values, float) / (parse_value(f"1{unit}") if unit else 1.0)
+    return in_unit(np.asarray(values, float), unit) if unit else np.asarray(values, float)
 
 
 def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):

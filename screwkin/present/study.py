@@ -23,7 +23,7 @@ import numpy as np
 from ..analysis.design.study import pareto_front
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
-from ..units import parse_value
+from ..units import in_unit
 from .plots import pyplot
 from .report import to_jsonable
 from .tables import csv_text
@@ -258,7 +258,7 @@ def _parameter_axis(result, name):
     file's ``30mm``), else as given (xacro arguments are SI, the file does not say m or rad)."""
     unit = next((getattr(p, "unit", "") for p in result.spec.parameters if p.name == name), "")
     if unit:
-        return f"{name} [{unit}]", 1.0 / parse_value(f"1{unit}")
+        return f"{name} [{unit}]", in_unit(1.0, unit)
     return f"{name} (as given, SI: no unit typed)", 1.0
 
 
