@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 
 from ..errors import UsageError, quote
-from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, write_mjcf, write_placed_urdf
+from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, mujoco_refuses, write_mjcf, write_placed_urdf
 from ..model.placed import check_closed, placed
 from ..present.report import to_jsonable
 from ._common import add_configuration_options, configuration, emit, with_mode
@@ -72,6 +72,12 @@ def run(mech, args) -> int:
                              f"default density): a rod from the body's origin to its farthest joint, radius "
                              f"{ROD_RATIO:g} of its length (a sphere of radius {ROD_RATIO * pm.length:.3g} m where no "
                              "other joint is on it): MuJoCo needs a mass on every moving body")
+            odd = [b.name for b in pm.bodies if b.joint is not None and b.joint.type != "fixed"
+                   and mujoco_refuses(b.mass, b.inertia)]
+            if odd:
+                notes.append(f"{len(odd)} bodies ({', '.join(quote(n, 30) for n in odd[:3])}{', ...' if len(odd) > 3 else ''})"
+                             " have a mass with an inertia MuJoCo refuses (not positive, or A + B < C): their mass is "
+                             "written with the inertia of the solid above, scaled to it")
         else:
             texts.append((out, write_placed_urdf(pm, mech.spec.root)))
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})

@@ -32,12 +32,13 @@ import pinocchio as pin
 
 from ..tolerances import DEFAULT
 from .description import Coupling
+from .mjcf_inertia import inertia_problem
 from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
            "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid", "helper_names",
-           "joint_points"]
+           "joint_points", "mujoco_refuses"]
 
 #: Mass [kg] (and inertia 1e-3 of it [kg m^2]) of the bodies of written URDF and of nothing else: kept
 #: for the callers that name it; MJCF's moving bodies without mass get DEFAULT_DENSITY solids instead.
@@ -150,11 +151,24 @@ def default_solid(points, length):
     return m, tuple(far / 2), (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
 
 
+def mujoco_refuses(mass, inertia) -> bool:
+    """Whether MuJoCo refuses this mass and inertia (ixx, iyy, izz, ixy, ixz, iyz) of a body with mass:
+    principal moments not all positive, or breaking A + B >= C (a point mass, a URDF's zero inertia)."""
+    xx, yy, zz, xy, xz, yz = inertia
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float)
+    moments = np.linalg.eigvalsh(I)
+    return mass > 0 and (moments[0] <= DEFAULT.zero * max(float(moments[-1]), mass * 1e-6)
+                         or inertia_problem(mass, I) is not None)
+
+
 def _mj_inertial(mass, com, inertia, moving, points=(), length=0.1):
     if mass <= 0:
         if not moving:
             return ""
         mass, com, inertia = default_solid(points, length)
+    elif mujoco_refuses(mass, inertia):  # the body's mass kept, spread as the default solid's
+        m0, _, i0 = default_solid(points, length)
+        inertia = tuple(x * mass / m0 for x in i0)
     return f'<inertial pos="{vector_text(*com)}" mass="{number_text(mass)}" fullinertia="{vector_text(*inertia)}"/>'
 
 

@@ -264,7 +264,10 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
             p.append(f"{what} is defined twice (or is the world)")
             return
         if (elem.get("mocap") or "false") == "true":
-            p.append(f"{what} is a mocap body: not supported")
+            if parent != "world" or elem.find("joint") is not None or elem.find("freejoint") is not None:
+                p.append(f"{what} is a mocap body that is not a jointless child of the world (MuJoCo refuses it too)")
+            r.warnings.append(f"{what} is a mocap body (moved by the simulation's data, not by joints): fixed to "
+                              "the world here, where the file draws it")
         X = T * r.frame(elem.attrib, what)
         world[name] = world[parent] * X
         inertial = None
@@ -431,8 +434,9 @@ def _geom_inertial(r, geoms, what):
             continue
         if kind in ("plane", "hfield"):
             continue
-        if kind not in SOLIDS or a.get("shellinertia", "false") == "true":
-            meshes = True  # a mesh (or sdf, or a shell): MuJoCo integrates it
+        if kind not in SOLIDS or a.get("shellinertia", "false") == "true" or a.get("mesh"):
+            # a mesh, an sdf, a shell, or a primitive MuJoCo fits to a mesh: MuJoCo integrates it
+            meshes = True
             continue
         raw = (a.get("size") or "0").split()
         size = numbers(a.get("size") or "0", len(raw), f"{gw} size", p, (0.0,) * len(raw), LIMITS.length, low=0.0)

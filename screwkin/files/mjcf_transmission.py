@@ -87,6 +87,10 @@ def read_actuators(r, mjoints, tendons, couplings):
     count = 0
     for section in r.root.findall("actuator"):
         for e in section:
+            if e.tag == "plugin":  # an actuator computed by an engine plugin
+                count += 1
+                unused.append(f"{quote(e.get('name') or 'plugin' + str(count))} (a plugin actuator)")
+                continue
             if e.tag not in ACTUATORS:
                 p.append(f"<actuator><{shorten(str(e.tag), 30)}> is not a MuJoCo actuator")
                 continue
