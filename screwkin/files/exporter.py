@@ -157,8 +157,8 @@ def mujoco_refuses(mass, inertia) -> bool:
     xx, yy, zz, xy, xz, yz = inertia
     I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float)
     moments = np.linalg.eigvalsh(I)
-    return mass > 0 and (moments[0] <= DEFAULT.zero * max(float(moments[-1]), mass * 1e-6)
-                         or inertia_problem(mass, I) is not None)
+    scale = max(float(moments[-1]), mass * TINY_MASS)  # a zero tensor: compared with a 1 mm body's
+    return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, I) is not None)
 
 
 def _mj_inertial(mass, com, inertia, moving, points=(), length=0.1):
