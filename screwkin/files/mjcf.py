@@ -171,13 +171,8 @@ class _Reader:
                 return np.eye(3)
             y /= np.linalg.norm(y)
             return np.column_stack([x, y, np.cross(x, y)])
-        z = np.asarray(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
-                                 self.problems, (0.0, 0.0, 1.0)))
-        c = np.cross([0, 0, 1.0], z)
-        s = np.linalg.norm(c)
-        if s < DEFAULT.zero:
-            return np.eye(3) if z[2] > 0 else pin.exp3(np.array([math.pi, 0, 0]))
-        return pin.exp3(c / s * math.atan2(s, z[2]))
+        return _z_to(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
+                               self.problems, (0.0, 0.0, 1.0)))
 
     def content(self, elem, cls):
         """(child, T, class) of every child of a body (or <worldbody>) with its <frame>s opened: T the
