@@ -288,13 +288,6 @@ def test_mujoco_needs_the_input_torque_screwkin_predicts():
     model.opt.disableflags = 0
 
 
-def test_mimic_couplings_are_refused_in_one_line(capsys):
-    """Pinocchio's inverse dynamics has no mimic joints: a file error naming the coupling, not a traceback."""
-    code = main(["dynamics", str(ROBOTS / "gear_train_idler_mimic.urdf"), "--input", "input_joint", "--speed", "1"])
-    err = capsys.readouterr().err
-    assert code == 1 and "<mimic>" in err and len(err.strip().splitlines()) == 1
-
-
 @pytest.mark.parametrize("range_, shown", [((), "deg"), (("--from", "0", "--to", "1"), "rad"),
                                            (("--from", "0", "--to", "1turn"), "turn")])
 def test_the_input_is_shown_in_the_unit_typed(range_, shown, capsys):

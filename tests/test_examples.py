@@ -20,6 +20,21 @@ def test_corpus_survey():
     assert "cassie_like" in out and "not assembled" in out  # kangaroo_like's welds cannot close
 
 
+def test_menagerie_survey(tmp_path):
+    """menagerie_survey.py on a checkout of two of the test's own MJCF forms (Menagerie itself is not
+    shipped): each loads, its mobility is MuJoCo's, its export simulates, and the tally says so."""
+    pytest.importorskip("mujoco")
+    import shutil
+    data = Path(__file__).resolve().parent / "data" / "mjcf"
+    for folder, name in (("gripper", "gripper_4bar_tendon.xml"), ("leg", "leg_ref_loop.xml")):
+        (tmp_path / folder).mkdir()
+        shutil.copy(data / name, tmp_path / folder / name)
+    out = run("menagerie_survey.py", str(tmp_path))
+    assert "gripper/gripper_4bar_tendon.xml" in out and "leg/leg_ref_loop.xml" in out
+    assert ("tally: models 2, mujoco_loads 2, screwkin_loads 2, mobility_equal 2, positions_1e-9 2, "
+            "export_simulates 2") in out
+
+
 def test_overconstrained():
     out = run("overconstrained.py")
     assert "bennett: Kutzbach -2" in out and "screw-theory mobility 1" in out

@@ -83,6 +83,7 @@ class MobilityResult:
     assembly_start: str = "the file's configuration"  # where the assembly search closed the loops
     starts: int = 1  # starting configurations the search tried
     configuration: dict = field(default_factory=dict)  # joint values of the configuration analysed
+    transmissions: tuple = ()  # files.description.Transmission of the inputs driven through a tendon, coupling, gear
 
     @property
     def kutzbach(self) -> int:
@@ -335,6 +336,8 @@ def _analyze(mech, output, seed, point) -> MobilityResult:
     kind, notes = _classify(n, m, eff if eff is not None else 0, overconstraint, topo, M)
     if m and locked:
         notes += (f"With the inputs locked the mechanism can still move ({locked} degree{'s' if locked > 1 else ''} of freedom).",)
+    for t in mech.transmissions():
+        notes += (f"Input {t.text()}: its coordinate is {t.joint}.",)
     first_singular, first_rank, generic_rank = mech.first_assembly_singular
     if first_singular:
         notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on a "
@@ -366,4 +369,5 @@ def _analyze(mech, output, seed, point) -> MobilityResult:
         assembly_start=assembly.start,
         starts=assembly.starts,
         configuration=mech.joint_values(q),
+        transmissions=mech.transmissions(),
     )

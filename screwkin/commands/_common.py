@@ -186,8 +186,19 @@ def joint_assignments(mech, items, option: str, order: int = 0, links=()) -> dic
     of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error, a
     bare angle of more than a turn is read as radians with a warning.  ``links``: names that are links
     given by their angle (--set-angle), checked as angles."""
-    return {name: _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", order, links)
-            for name, value, unit in parse_typed_assignments(items, option)}
+    out = {}
+    for name, value, unit in parse_typed_assignments(items, option):
+        t = mech.input_alias(name)
+        if t is None:
+            out[name] = _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", order, links)
+            continue
+        # an input the file names by a tendon or a coupled joint: scale * joint + offset (files.description.Transmission)
+        v = _checked(mech, t.joint, value, unit, option, f"{quote(name, 60)}=...{unit}", order, links)
+        if t.joint in out:
+            raise UsageError(f"{option}: joint {quote(t.joint)} is given twice ({quote(name)} moves it)")
+        out[t.joint] = (v - (t.offset if order == 0 else 0.0)) / t.scale
+        print(f"note: {option} {shorten(name, 60)} is {t.joint} = {out[t.joint]:.9g} ({t.text()})", file=sys.stderr)
+    return out
 
 
 def joint_value(mech, joint: str, text: str, option: str, order: int = 0) -> float:

@@ -8,7 +8,7 @@ import os
 from pathlib import Path
 
 from ..errors import UsageError, quote
-from ..files.exporter import write_mjcf, write_placed_urdf
+from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, mujoco_refuses, write_mjcf, write_placed_urdf
 from ..model.placed import check_closed, placed
 from ..present.report import to_jsonable
 from ._common import add_configuration_options, configuration, emit, with_mode
@@ -43,28 +43,46 @@ def run(mech, args) -> int:
     comment = (f"Written by screwkin export from {os.path.basename(mech.path)} at an assembled configuration "
                f"(loop residual {residual:.1e}): the file's zero configuration is that one, so each joint's value "
                "here is its value there minus: " + ", ".join(f"{k} {v:.9g}" for k, v in values.items()))
-    written, notes = [], []
-    for fmt, out in (("MJCF", args.mjcf), ("URDF", args.urdf)):
+    written, notes, texts = [], [], []
+    if args.mjcf and args.urdf and os.path.realpath(args.mjcf) == os.path.realpath(args.urdf):
+        raise UsageError(f"--mjcf and --urdf name the same file {quote(args.mjcf)}: give two files")
+    for fmt, out in (("MJCF", args.mjcf), ("URDF", args.urdf)):  # both made before either is written
         if not out:
             continue
         pm = placed(mech, q, fmt, comment=comment)
         notes += [n for n in pm.notes if n not in notes]
         if fmt == "MJCF":
-            _write(out, write_mjcf(pm))
+            texts.append((out, write_mjcf(pm)))
+            names = helper_names(pm)
             for c in pm.cuts:
                 if c.type in ("revolute", "continuous"):
-                    notes.append(f"loop joint {quote(c.name)} (revolute): two <connect>s {pm.length:.3g} m apart on "
-                                 "its axis (MJCF has no hinge equality; one of their 6 rows is redundant)")
+                    notes.append(f"loop joint {quote(c.name)} (revolute): <connect>s {quote(c.name)} and "
+                                 f"{quote(names['axis', c.name])} {pm.length:.3g} m apart on its axis (MJCF has no "
+                                 "hinge equality; one of their 6 rows is redundant; screwkin reads the pair back as "
+                                 "one revolute loop joint)")
                 elif c.type not in ("spherical", "fixed"):
-                    notes.append(f"loop joint {quote(c.name)} ({c.type}): a massless body {quote(c.name + '~F1')} "
+                    notes.append(f"loop joint {quote(c.name)} ({c.type}): a body {quote(names['F1', c.name])} "
                                  "carrying its motion, welded to the second link (MJCF has no such equality)")
             light = [b.name for b in pm.bodies if b.joint is not None and b.joint.type != "fixed" and b.mass <= 0]
+            light += [names["F1", c.name] for c in pm.cuts if ("F1", c.name) in names and c.type not in
+                      ("spherical", "fixed", "revolute", "continuous")]
             if light:
                 notes.append(f"{len(light)} moving bodies without mass ({', '.join(quote(n, 30) for n in light[:3])}"
-                             f"{', ...' if len(light) > 3 else ''}) get 1e-6 kg, which MuJoCo needs")
+                             f"{', ...' if len(light) > 3 else ''}) get a solid of {DEFAULT_DENSITY:g} kg/m^3 (MuJoCo's "
+                             f"default density): a rod from the body's origin to its farthest joint, radius "
+                             f"{ROD_RATIO:g} of its length (a sphere of radius {ROD_RATIO * pm.length:.3g} m where no "
+                             "other joint is on it): MuJoCo needs a mass on every moving body")
+            odd = [b.name for b in pm.bodies if b.joint is not None and b.joint.type != "fixed"
+                   and mujoco_refuses(b.mass, b.inertia)]
+            if odd:
+                notes.append(f"{len(odd)} bodies ({', '.join(quote(n, 30) for n in odd[:3])}{', ...' if len(odd) > 3 else ''})"
+                             " have a mass with an inertia MuJoCo refuses (not positive, or A + B < C): their mass is "
+                             "written with the inertia of the solid above, scaled to it")
         else:
-            _write(out, write_placed_urdf(pm, mech.spec.root))
+            texts.append((out, write_placed_urdf(pm, mech.spec.root)))
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})
+    for out, text in texts:
+        _write(out, text)
 
     def data():
         return to_jsonable(with_mode(args, {"file": mech.path, "written": written, "configuration": values,

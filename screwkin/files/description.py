@@ -23,6 +23,7 @@ __all__ = [
     "TARGET_KINDS",
     "JointSpec",
     "Coupling",
+    "Transmission",
     "CutJointSpec",
     "MechanismSpec",
     "placement",
@@ -181,6 +182,44 @@ class Coupling:
     offset: float
 
 
+@dataclass(frozen=True)
+class Transmission:
+    """How an actuator drives the mechanism, as the file writes it and as screwkin uses it.
+
+    The actuator acts on ``input`` = sum of coef * joint over ``terms`` (one joint with coef 1: a
+    joint actuator; several: an MJCF fixed tendon; a coupled joint: its coupling), which the
+    couplings make ``scale * joint + offset`` of one joint coordinate ``joint`` (None when it stays a
+    combination of several independent coordinates: not an input here).  ``gear``: MuJoCo's gear or
+    a ROS ``<mechanicalReduction>``: the actuator's effort is the input's generalized force / gear.
+    So the actuator's effort is the joint's generalized force / (scale * gear), and the input's
+    value (scale * q + offset) [rad or m, or the tendon's units]."""
+
+    name: str  # what the user calls the input: the tendon's or the (coupled) joint's name
+    actuator: str  # the actuator (MJCF) or <transmission> (URDF) element's name
+    kind: str  # "joint", "coupled joint", "tendon"
+    terms: tuple  # ((joint, coef), ...) as written
+    joint: str | None  # the coordinate it moves
+    scale: float = 1.0
+    offset: float = 0.0
+    gear: float = 1.0
+
+    @property
+    def plain(self) -> bool:
+        """A joint's own value, driven one to one: nothing to say about it."""
+        return self.kind == "joint" and self.scale == 1.0 and self.offset == 0.0 and self.gear == 1.0
+
+    def text(self) -> str:
+        """The transmission in words: ``split = 0.5 right + 0.5 left = 1 left (fixed tendon of actuator 'a')``."""
+        written = " + ".join(f"{c:g} {j}" for j, c in self.terms).replace("+ -", "- ")
+        out = f"{self.name} = {written}" if self.kind == "tendon" else self.name
+        if self.joint is not None and self.kind != "joint":
+            out += f" = {self.scale:g} {self.joint}" + (f" {'+' if self.offset >= 0 else '-'} {abs(self.offset):g}"
+                                                         if self.offset else "")
+        what = {"tendon": "fixed tendon", "coupled joint": "coupled joint", "joint": "joint"}[self.kind]
+        out += f" ({what} of actuator {self.actuator!r}" + (f", gear {self.gear:g}" if self.gear != 1.0 else "") + ")"
+        return out
+
+
 @dataclass
 class CutJointSpec:
     """A cut joint closing a loop.
@@ -259,6 +298,8 @@ class MechanismSpec:
     package_dirs: list = field(default_factory=list)  # --package-dir folders for package:// meshes
     couplings: list = field(default_factory=list)  # Coupling, from <mimic>
     targets: tuple = ()  # TargetSpec, from <screwkin:targets> (a synthesized design's precision positions)
+    inputs: list = field(default_factory=list)  # Transmission of each actuator that is not a plain joint's
+    reference: dict = field(default_factory=dict)  # joint -> value where the file draws it (MJCF ref), when not 0
 
     @property
     def root(self) -> str:

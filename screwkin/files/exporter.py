@@ -30,16 +30,24 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ..tolerances import DEFAULT
 from .description import Coupling
+from .mjcf_inertia import inertia_problem
 from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
-           "TINY_MASS", "coupling_about"]
+           "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid", "helper_names",
+           "joint_points", "mujoco_refuses"]
 
-#: Mass [kg] (and inertia 1e-3 of it [kg m^2]) given to a moving body without one, which MuJoCo
-#: refuses; below Tolerances.dummy_mass, so screwkin still reads such a body as massless.
+#: Mass [kg] (and inertia 1e-3 of it [kg m^2]) of the bodies of written URDF and of nothing else: kept
+#: for the callers that name it; MJCF's moving bodies without mass get DEFAULT_DENSITY solids instead.
 TINY_MASS = 1e-6
+#: Density [kg/m^3] of the solid a moving body without mass gets in MJCF (MuJoCo's own default geom
+#: density, water): a rod from the body's origin to its farthest joint (radius ROD_RATIO of its
+#: length), or, with no other joint on it, a sphere of radius ROD_RATIO of the mechanism's length.
+DEFAULT_DENSITY = 1000.0
+ROD_RATIO = 0.05
 
 
 @dataclass(frozen=True)
@@ -115,15 +123,94 @@ def _children(pm):
 
 
 def _comment(text):
-    return "<!--\n" + text.replace("--", "- -").rstrip() + "\n-->" if text else ""
+    """An XML comment holding ``text``: no "--" inside and no "-" at its end (XML forbids both)."""
+    if not text:
+        return ""
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return "<!--\n" + text.rstrip() + "\n-->"
 
 
-def _mj_inertial(mass, com, inertia, moving):
+def default_solid(points, length):
+    """(mass, centre of mass, (ixx, iyy, izz, ixy, ixz, iyz)) of the solid a moving body without mass
+    gets: a rod of DEFAULT_DENSITY from its origin to the farthest of ``points`` (its joints, in its
+    frame), radius ROD_RATIO of that length; a sphere of radius ROD_RATIO * ``length`` when no point is
+    off its origin."""
+    far = max(points, key=lambda p: float(np.linalg.norm(p)), default=np.zeros(3))
+    far = np.asarray(far, float)
+    L = float(np.linalg.norm(far))
+    if L < DEFAULT.equal * max(length, 1.0):
+        r = ROD_RATIO * length
+        m = DEFAULT_DENSITY * 4.0 / 3.0 * np.pi * r**3
+        i = 0.4 * m * r * r
+        return m, (0.0, 0.0, 0.0), (i, i, i, 0.0, 0.0, 0.0)
+    r = ROD_RATIO * L
+    m = DEFAULT_DENSITY * np.pi * r * r * L
+    d = far / L
+    I = m * (3 * r * r + L * L) / 12.0 * (np.eye(3) - np.outer(d, d)) + m * r * r / 2.0 * np.outer(d, d)
+    return m, tuple(far / 2), (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
+
+
+def mujoco_refuses(mass, inertia) -> bool:
+    """Whether MuJoCo refuses this mass and inertia (ixx, iyy, izz, ixy, ixz, iyz) of a body with mass:
+    principal moments not all positive, or breaking A + B >= C (a point mass, a URDF's zero inertia)."""
+    xx, yy, zz, xy, xz, yz = inertia
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float)
+    moments = np.linalg.eigvalsh(I)
+    scale = max(float(moments[-1]), mass * TINY_MASS)  # a zero tensor: compared with a 1 mm body's
+    return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, I) is not None)
+
+
+def _mj_inertial(mass, com, inertia, moving, points=(), length=0.1):
     if mass <= 0:
         if not moving:
             return ""
-        mass, com, inertia = TINY_MASS, (0, 0, 0), (TINY_MASS * 1e-3,) * 3 + (0.0,) * 3
+        mass, com, inertia = default_solid(points, length)
+    elif mujoco_refuses(mass, inertia):  # the body's mass kept, spread as the default solid's
+        m0, _, i0 = default_solid(points, length)
+        inertia = tuple(x * mass / m0 for x in i0)
     return f'<inertial pos="{vector_text(*com)}" mass="{number_text(mass)}" fullinertia="{vector_text(*inertia)}"/>'
+
+
+def joint_points(pm) -> dict:
+    """Body -> the points in its frame where joints sit: its children's origins and its cut frames."""
+    out = {}
+    for b in pm.bodies:
+        if b.parent is not None:
+            out.setdefault(b.parent, []).append(np.asarray(b.pos, float))
+    for c in pm.cuts:
+        out.setdefault(c.body1, []).append(np.asarray(c.pos1, float))
+        out.setdefault(c.body2, []).append(np.asarray(c.pos2, float))
+    return out
+
+
+def helper_names(pm) -> dict:
+    """Names of what the MJCF writer adds, none equal to a name of the mechanism: (kind, cut or input)
+    -> name, kind one of "F1" (a cut's body), "axis" (a revolute cut's second connect), "weld", "motor"
+    and "aux" (a cut's joints, with its index)."""
+    joints = {b.name for b in pm.bodies} | {b.joint.name for b in pm.bodies if b.joint is not None}
+    taken = joints | {c.name for c in pm.cuts} | {cp.joint for cp in pm.couplings}
+    out = {}
+
+    def fresh(base):
+        name = base
+        k = 1
+        while name in taken:
+            k += 1
+            name = f"{base}~{k}"
+        taken.add(name)
+        return name
+
+    for c in pm.cuts:
+        out["F1", c.name] = fresh(c.name + "~F1")
+        out["axis", c.name] = fresh(c.name + "~axis")
+        out["weld", c.name] = fresh(c.name + "~weld")
+        for k in range(len(_AUX.get(c.type, ()))):
+            single = len(_AUX[c.type]) == 1 and c.name not in joints  # the slide keeps the loop joint's name
+            out["aux", c.name, k] = c.name if single else fresh(f"{c.name}.{k}")
+    for a in pm.actuated:
+        out["motor", a] = fresh(a + "_motor")
+    return out
 
 
 def _mj_joint(j):
@@ -158,16 +245,19 @@ def write_mjcf(pm: PlacedMechanism) -> str:
     for c in pm.cuts:
         if c.type in _AUX:
             aux.setdefault(c.body1, []).append(c)
+    names = helper_names(pm)
+    points = joint_points(pm)
     out = [_comment(pm.comment), f"<mujoco model={quoteattr(pm.name)}>",
            '  <compiler angle="radian" autolimits="true"/>', "  <worldbody>"]
 
     def aux_bodies(name, pad):
         for c in aux.get(name, ()):
-            out.append(f'{pad}<body name={quoteattr(c.name + "~F1")} pos="{vector_text(*c.pos1)}" quat="{vector_text(*c.quat1)}">')
+            out.append(f'{pad}<body name={quoteattr(names["F1", c.name])} pos="{vector_text(*c.pos1)}" '
+                       f'quat="{vector_text(*c.quat1)}">')
             for k, (t, ax) in enumerate(zip(_AUX[c.type], _aux_axes(c))):
-                jn = c.name if len(_AUX[c.type]) == 1 else f"{c.name}.{k}"
-                out.append(f"{pad}  <joint name={quoteattr(jn)} type=\"{t}\" axis=\"{vector_text(*ax)}\"/>")
-            out.append(f"{pad}  {_mj_inertial(0, 0, 0, True)}")
+                out.append(f"{pad}  <joint name={quoteattr(names['aux', c.name, k])} type=\"{t}\" "
+                           f"axis=\"{vector_text(*ax)}\"/>")
+            out.append(f"{pad}  {_mj_inertial(0, 0, 0, True, (), pm.length)}")
             out.append(f"{pad}</body>")
 
     def body(b, depth):
@@ -176,7 +266,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         moving = b.joint is not None and b.joint.type != "fixed"
         if moving:
             out.append(f"{pad}  {_mj_joint(b.joint)}")
-        inertial = _mj_inertial(b.mass, b.com, b.inertia, moving)
+        inertial = _mj_inertial(b.mass, b.com, b.inertia, moving, points.get(b.name, ()), pm.length)
         if inertial:
             out.append(f"{pad}  {inertial}")
         aux_bodies(b.name, pad + "  ")
@@ -196,15 +286,15 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         elif c.type in ("revolute", "continuous"):
             F1 = _se3(c.pos1, c.quat1)
             far = F1.act(pm.length * np.asarray(c.axis, float))
-            for name, p in ((c.name, c.pos1), (f"{c.name}~axis", far)):
+            for name, p in ((c.name, c.pos1), (names["axis", c.name], far)):
                 eq.append(f"<connect name={quoteattr(name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
                           f'anchor="{vector_text(*p)}"/>')
         else:  # fixed: body2 in body1; an aux body: body2 in the aux body, which is at F1 at qpos0
             F1 = pin.SE3.Identity() if c.type in _AUX else _se3(c.pos1, c.quat1)
             F2 = _se3(c.pos2, c.quat2)
             rel = F1 * _se3(*c.rel) * F2.inverse()
-            body1 = c.name + "~F1" if c.type in _AUX else c.body1
-            eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else c.name + '~weld')} "
+            body1 = names["F1", c.name] if c.type in _AUX else c.body1
+            eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else names['weld', c.name])} "
                       f"body1={quoteattr(body1)} body2={quoteattr(c.body2)} anchor=\"{vector_text(*c.pos2)}\" "
                       f'relpose="{vector_text(*rel.translation, *_quat(rel))}"/>')
     for cp in pm.couplings:
@@ -213,7 +303,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
     if eq:
         out += ["  <equality>"] + [f"    {e}" for e in eq] + ["  </equality>"]
     if pm.actuated:
-        out += ["  <actuator>"] + [f"    <motor name={quoteattr(a + '_motor')} joint={quoteattr(a)}/>"
+        out += ["  <actuator>"] + [f"    <motor name={quoteattr(names['motor', a])} joint={quoteattr(a)}/>"
                                    for a in pm.actuated] + ["  </actuator>"]
     out.append("</mujoco>")
     return "\n".join(x for x in out if x) + "\n"

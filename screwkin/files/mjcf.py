@@ -10,13 +10,16 @@ equality that names the world explicitly (``body2="world"``: "Model does not hav
 named world"), which MuJoCo accepts and real files use, and it does not give the plain
 description (cut joints, couplings, inputs) the rest of screwkin reads.
 
-What is read (docs/format.md, section 4b): ``<compiler angle eulerseq>``, ``<default>``
-classes (joint and site attributes; ``childclass``/``class``), every ``<worldbody>``'s bodies
-with ``pos`` and one orientation (``quat``, ``axisangle``, ``euler``, ``xyaxes``, ``zaxis``),
-their joints (``hinge``, ``slide``, ``ball``, ``free``; ``pos``, ``axis``, ``range``),
-``<inertial>``, sites; ``<equality>`` ``connect``, ``weld`` and ``joint`` (linear polycoef);
-actuators on joints.  Anything else that shapes the kinematics is refused in one line.
-Inertias MuJoCo derives from geoms are not computed: a body without ``<inertial>`` has no mass here.
+What is read (docs/format.md, section 4b): ``<include>`` (mjcf_include), ``<compiler angle eulerseq
+autolimits inertiafromgeom inertiagrouprange>``, ``<default>`` classes (``childclass``/``class``), every
+``<worldbody>``'s bodies and ``<frame>``s with ``pos`` and one orientation (``quat``, ``axisangle``,
+``euler``, ``xyaxes``, ``zaxis``), their joints (``hinge``, ``slide``, ``ball``, ``free``; ``pos``,
+``axis``, ``range``, ``limited``, ``ref``: the joint's value where the file draws the body, so a joint's
+value is MuJoCo's qpos), ``<inertial>`` (checked as MuJoCo checks it) or, without one, the mass and
+inertia of the body's geoms as MuJoCo computes them (mjcf_inertia; meshes are not computed, and said),
+sites; ``<equality>`` (mjcf_equality); actuators and fixed tendons (mjcf_transmission).  Anything else
+that shapes the kinematics is refused in one line; what is read and not used (``springref``: screwkin
+has no springs) is said once.
 """
 
 from __future__ import annotations
@@ -28,7 +31,11 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
-from .description import LIMITS, Coupling, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
+from .description import LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
+from .mjcf_equality import matrix_quat, quat_matrix, read_equalities
+from .mjcf_include import expand_includes
+from .mjcf_inertia import DEFAULT_DENSITY, SOLIDS, body_inertia, geom_inertia, geom_volume, inertia_problem
+from .mjcf_transmission import ACTUATORS, read_actuators, read_tendons
 from .urdf import Problems, check_sizes, numbers, unit_axis
 from .writer import quoteattr, vector_text
 from .xmlsafe import parse_xml_text
@@ -37,24 +44,12 @@ __all__ = ["read_mjcf", "quat_matrix", "matrix_quat"]
 
 #: Joint types read, with their URDF stand-in (a ball is a revolute replaced by a spherical joint).
 _JOINTS = {"hinge": "revolute", "slide": "prismatic", "ball": "continuous", "free": "floating"}
-#: Actuator elements whose ``joint`` is an input.
-_ACTUATORS = ("motor", "position", "velocity", "general", "intvelocity", "damper", "cylinder", "muscle")
-#: Elements of a body that do not change its kinematics (geoms are noted as geometry).
+#: Elements of a body that do not change its kinematics (geoms give its mass when it has no <inertial>).
 _BODY_PASSIVE = ("geom", "camera", "light")
+#: MuJoCo's ``limited`` keywords.
+_LIMITED = ("true", "false", "auto")
 #: Top-level sections that do not change the kinematics.
-_PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor", "keyframe", "custom")
-
-
-def quat_matrix(q) -> np.ndarray:
-    """The rotation matrix of MuJoCo's quaternion (w, x, y, z), normalised (Pinocchio's)."""
-    w, x, y, z = (float(v) for v in q)
-    return pin.Quaternion(w, x, y, z).normalized().matrix()
-
-
-def matrix_quat(R) -> tuple:
-    """MuJoCo's quaternion (w, x, y, z) of a rotation matrix."""
-    q = pin.Quaternion(np.asarray(R, float))
-    return (q.w, q.x, q.y, q.z)
+_PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor", "keyframe", "custom", "extension")
 
 
 def _fmt(v):
@@ -84,6 +79,16 @@ class _Reader:
         if comp.get("coordinate", "local") != "local":
             self.problems.append("<compiler coordinate=\"global\"> is not supported (MuJoCo 3 removed it too)")
         self.autolimits = comp.get("autolimits", "true") == "true"
+        self.fromgeom = comp.get("inertiafromgeom", "auto")
+        if self.fromgeom not in ("auto", "true", "false"):
+            self.problems.append(f"<compiler inertiafromgeom={quote(self.fromgeom)}> must be auto, true or false")
+        self.groups = numbers(comp.get("inertiagrouprange"), 2, "<compiler inertiagrouprange>", self.problems,
+                              (0, 5), 1e6, "")
+        unused = [k for k in ("boundmass", "boundinertia", "settotalmass", "balanceinertia") if k in comp
+                  and comp[k] not in ("0", "-1", "false")]
+        if unused:
+            self.warnings.append(f"<compiler {' '.join(unused)}> is not applied: the masses and inertias here are "
+                                 "the file's, before MuJoCo's adjustment")
         self.defaults = {}
         for d in root.findall("default"):
             self._default(d, "main", {})
@@ -109,6 +114,17 @@ class _Reader:
         if cls not in self.defaults and cls != "main":
             self.problems.append(f"<{elem.tag}> names default class {quote(cls)}, which is not defined")
         out = dict(self.defaults.get(cls, {}).get(elem.tag, {}))
+        out.update(elem.attrib)
+        return out
+
+    def actuator_attrs(self, elem):
+        """An actuator's attributes over its class's: MuJoCo's actuator shortcuts share one default."""
+        cls = elem.get("class", "main")
+        if cls not in self.defaults and cls != "main":
+            self.problems.append(f"<{elem.tag}> names default class {quote(cls)}, which is not defined")
+        out = {}
+        for tag in ACTUATORS:
+            out.update(self.defaults.get(cls, {}).get(tag, {}))
         out.update(elem.attrib)
         return out
 
@@ -155,13 +171,25 @@ class _Reader:
                 return np.eye(3)
             y /= np.linalg.norm(y)
             return np.column_stack([x, y, np.cross(x, y)])
-        z = np.asarray(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
-                                 self.problems, (0.0, 0.0, 1.0)))
-        c = np.cross([0, 0, 1.0], z)
-        s = np.linalg.norm(c)
-        if s < DEFAULT.zero:
-            return np.eye(3) if z[2] > 0 else pin.exp3(np.array([math.pi, 0, 0]))
-        return pin.exp3(c / s * math.atan2(s, z[2]))
+        return _z_to(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
+                               self.problems, (0.0, 0.0, 1.0)))
+
+    def content(self, elem, cls):
+        """(child, T, class) of every child of a body (or <worldbody>) with its <frame>s opened: T the
+        frames' placement in the body, class the frames' childclass over ``cls``."""
+        out = []
+
+        def walk(e, T, c, depth):
+            for child in e:
+                if child.tag == "frame":
+                    if depth > LIMITS.elements:  # pragma: no cover - the element count bounds it first
+                        break
+                    walk(child, T * self.frame(child.attrib, "<frame>"), child.get("childclass", c), depth + 1)
+                else:
+                    out.append((child, T, c))
+
+        walk(elem, pin.SE3.Identity(), cls, 0)
+        return out
 
     def frame(self, a, what) -> pin.SE3:
         return pin.SE3(self.rotation(a, what), self.vec(a.get("pos"), 3, f"{what} pos", (0, 0, 0)))
@@ -173,15 +201,14 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
         root = parse_xml_text(text, path)
     if root.tag != "mujoco":
         raise MechanismFileError(path, f"not an MJCF file: the root element is <{shorten(root.tag, 40)}>")
+    expand_includes(root, path)
     r = _Reader(path, root)
     p = r.problems
     for child in root:
-        if child.tag in ("include", "extension", "deformable"):
-            p.append(f"<{child.tag}> is not supported (write the model in one file, without plugins or flexes)")
-        elif child.tag == "tendon" and len(child):
-            r.warnings.append("<tendon> elements are not read (a tendon in an <equality> or an actuator is an error)")
+        if child.tag == "deformable":
+            p.append(f"<{child.tag}> is not supported (flexes and skins are not rigid bodies)")
         elif child.tag not in _PASSIVE + ("compiler", "default", "worldbody", "equality", "actuator", "tendon"):
-            p.append(f"<{shorten(child.tag, 30)}> (under <mujoco>) is not supported")
+            p.append(f"<{shorten(str(child.tag), 30)}> (under <mujoco>) is not supported")
     bodies = root.findall(".//worldbody//body")
     joints_xml = root.findall(".//worldbody//joint") + root.findall(".//worldbody//freejoint")
     check_sizes(path, len(bodies) + 1, len(joints_xml) + len(bodies), len(root.findall("equality/*")))
@@ -193,27 +220,33 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
     mjoints = {}  # MJCF joint name -> (type, body)
     sites = {}  # site name -> (body, placement in the body)
     replacements = []
+    reference = {}  # joint -> ref (its value at qpos0), when not 0
     unnamed = [0]
     out_links = []
+    unread = {"springref": [], "mesh": []}
 
-    def site(elem, body, cls):
+    def site(elem, body, cls, T):
         a = r.attrs(elem, cls)
         name = a.get("name")
         if name:
             if name in sites:
                 p.append(f"site {quote(name)} is defined twice")
-            sites[name] = (body, r.frame(a, f"site {quote(name)}"))
+            sites[name] = (body, T * r.frame(a, f"site {quote(name)}"))
 
     for ws in root.findall("worldbody"):
-        for e in ws:
+        for e, T, cls in r.content(ws, "main"):
             if e.tag == "site":
-                site(e, "world", "main")
-            elif e.tag in ("geom",):
+                site(e, "world", cls, T)
+            elif e.tag == "geom":
                 links["world"].has_geometry = True
             elif e.tag in ("joint", "freejoint"):
                 p.append("a joint directly in <worldbody> (MuJoCo refuses it too)")
+            elif e.tag == "body":
+                pass
+            elif e.tag not in _BODY_PASSIVE:
+                p.append(f"<worldbody> has a <{shorten(str(e.tag), 30)}> element: not supported")
 
-    def body(elem, parent, cls):
+    def body(elem, parent, cls, T):
         cls = elem.get("childclass", cls)
         name = elem.get("name")
         if not name:
@@ -226,27 +259,39 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
             p.append(f"{what} is defined twice (or is the world)")
             return
         if (elem.get("mocap") or "false") == "true":
-            p.append(f"{what} is a mocap body: not supported")
-        X = r.frame(elem.attrib, what)
+            if parent != "world" or elem.find("joint") is not None or elem.find("freejoint") is not None:
+                p.append(f"{what} is a mocap body that is not a jointless child of the world (MuJoCo refuses it too)")
+            r.warnings.append(f"{what} is a mocap body (moved by the simulation's data, not by joints): fixed to "
+                              "the world here, where the file draws it")
+        X = T * r.frame(elem.attrib, what)
         world[name] = world[parent] * X
-        mass, inertial = None, ""
-        jlist = []
-        for e in elem:
+        inertial = None
+        jlist, geoms, kids = [], [], []
+        for e, Te, ecls in r.content(elem, cls):
             if e.tag == "inertial":
-                mass, inertial = _inertial(r, e, what)
+                inertial = e
             elif e.tag in ("joint", "freejoint"):
-                jlist.append(e)
+                jlist.append((e, Te, ecls))
             elif e.tag == "site":
-                site(e, name, cls)
-            elif e.tag in _BODY_PASSIVE or e.tag == "body":
-                pass
-            else:
-                p.append(f"{what} has a <{shorten(e.tag, 30)}> element: not supported")
-        links[name] = LinkSpec(name, mass, elem.find("geom") is not None)
-        out_links.append(f"<link name={quoteattr(name)}>{inertial}</link>")
+                site(e, name, ecls, Te)
+            elif e.tag == "geom":
+                geoms.append((e, Te, ecls))
+            elif e.tag == "body":
+                kids.append((e, Te, ecls))
+            elif e.tag not in _BODY_PASSIVE:
+                p.append(f"{what} has a <{shorten(str(e.tag), 30)}> element: not supported")
+        mass, inertia_xml = None, ""
+        if inertial is not None and r.fromgeom != "true":
+            mass, inertia_xml = _inertial(r, inertial, what)
+        elif r.fromgeom != "false" and geoms:
+            mass, inertia_xml, meshes = _geom_inertial(r, geoms, what)
+            if meshes:
+                unread["mesh"].append(name)
+        links[name] = LinkSpec(name, mass, bool(geoms))
+        out_links.append(f"<link name={quoteattr(name)}>{inertia_xml}</link>")
         prev, prev_pos = parent, None
-        for k, e in enumerate(jlist):
-            a = {"type": "free"} if e.tag == "freejoint" else r.attrs(e, cls)
+        for k, (e, Te, ecls) in enumerate(jlist):
+            a = {"type": "free"} if e.tag == "freejoint" else r.attrs(e, ecls)
             if e.tag == "freejoint" and e.get("name"):
                 a["name"] = e.get("name")
             jt = a.get("type", "hinge")
@@ -260,14 +305,23 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 continue
             if jt == "free" and (parent != "world" or len(jlist) > 1):
                 p.append(f"{jw} is free but not the only joint of a top-level body (MuJoCo refuses it too)")
-            ref = float(numbers(a.get("ref"), 1, f"{jw} ref", p, (0.0,))[0])
-            if ref != 0:
-                p.append(f"{jw} has ref={shorten(a['ref'], 20)}: a reference position other than 0 is not supported")
-            pos = np.zeros(3) if jt == "free" else r.vec(a.get("pos"), 3, f"{jw} pos", (0, 0, 0))
+            pos = np.zeros(3) if jt == "free" else Te.act(r.vec(a.get("pos"), 3, f"{jw} pos", (0, 0, 0)))
             axis = (1.0, 0.0, 0.0) if jt in ("free", "ball") else tuple(unit_axis(
-                r.vec(a.get("axis"), 3, f"{jw} axis", (0, 0, 1), 1e6, ""), jw, p, (0.0, 0.0, 1.0)))
+                Te.rotation @ r.vec(a.get("axis"), 3, f"{jw} axis", (0, 0, 1), 1e6, ""), jw, p, (0.0, 0.0, 1.0)))
+            ref = 0.0
+            if jt in ("hinge", "slide"):
+                ref = float(numbers(a.get("ref"), 1, f"{jw} ref", p, (0.0,), LIMITS.length if jt == "slide"
+                                    else LIMITS.angle, "m" if jt == "slide" else "")[0])
+                ref = r.angle(ref) if jt == "hinge" else ref
+                if ref:
+                    reference[jn] = ref
+                if a.get("springref") not in (None, "0"):
+                    unread["springref"].append(jn)
             mjoints[jn] = (jt, name)
             origin = X * pin.SE3(np.eye(3), pos) if prev_pos is None else pin.SE3(np.eye(3), pos - prev_pos)
+            if ref:  # the body as written is the joint at ref: its zero is -ref from there
+                shift = pin.exp3(np.asarray(axis) * -ref) if jt == "hinge" else np.eye(3)
+                origin = origin * pin.SE3(shift, np.zeros(3) if jt == "hinge" else -ref * np.asarray(axis))
             last = k == len(jlist) - 1
             child = name if last and not np.any(pos) else f"{name}__{jn}"
             if child != name:
@@ -275,9 +329,11 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 out_links.append(f"<link name={quoteattr(child)}/>")
             utype = _JOINTS[jt]
             limit = ""
+            limited = a.get("limited", "auto")
+            if limited not in _LIMITED:
+                p.append(f"{jw} limited={quote(limited)}: MuJoCo's keywords are true, false and auto")
             if jt in ("hinge", "slide"):
                 rng = a.get("range")
-                limited = a.get("limited", "auto")
                 on = limited == "true" or (limited == "auto" and r.autolimits and rng is not None)
                 lo, hi = (-1e9, 1e9)
                 if on and rng is not None:
@@ -292,7 +348,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 limit = f'<limit lower="{lo:.17g}" upper="{hi:.17g}" effort="0" velocity="0"/>'
             elif jt == "ball":
                 replacements.append((jn, "SPHERICAL"))
-                if a.get("range") is not None and a.get("limited", "auto") != "false":
+                if a.get("range") is not None and limited != "false":
                     r.warnings.append(f"{jw} (ball) has a range: its cone of rotation is not read (unlimited here)")
             out.append(f'<joint name={quoteattr(jn)} type="{utype}"><parent link={quoteattr(prev)}/>'
                        f'<child link={quoteattr(child)}/>{_origin(origin)}<axis xyz="{_fmt(axis)}"/>{limit}</joint>')
@@ -306,41 +362,138 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                        f'<child link={quoteattr(name)}/>{_origin(origin)}</joint>')
             joints.append(JointSpec(jn, "fixed", prev, name, tuple(origin.translation),
                                     tuple(pin.rpy.matrixToRpy(origin.rotation))))
-        for e in elem.findall("body"):
-            body(e, name, cls)
+        for e, Te, ecls in kids:
+            body(e, name, ecls, Te)
 
     for ws in root.findall("worldbody"):
-        for e in ws.findall("body"):
-            body(e, "world", "main")
-    for ws in root.findall("worldbody"):
-        for e in ws:
-            if e.tag not in ("body", "site") + _BODY_PASSIVE:
-                p.append(f"<worldbody> has a <{shorten(e.tag, 30)}> element: not supported")
+        for e, T, cls in r.content(ws, "main"):
+            if e.tag == "body":
+                body(e, "world", cls, T)
     p.fail_if_any(path)
-    cuts, couplings = _equalities(r, world, sites, mjoints)
-    transmissions = _actuators(r, mjoints, {c.joint: c.mimics for c in couplings})
+    cuts, couplings = read_equalities(r, world, sites, mjoints, reference, set(mjoints) | set(links))
+    couplings = _chains(couplings)
+    tendons = read_tendons(r, mjoints)
+    transmissions, inputs, unused = read_actuators(r, mjoints, tendons, {c.joint: c for c in couplings})
     p.fail_if_any(path)
-    no_inertia = [n for n, lk in links.items() if n != "world" and lk.has_geometry and lk.mass is None]
-    if no_inertia:
-        r.warnings.append(f"{len(no_inertia)} bodies ({', '.join(quote(n, 30) for n in no_inertia[:3])}"
-                          f"{', ...' if len(no_inertia) > 3 else ''}) have geoms but no <inertial>: MuJoCo derives "
-                          "their inertia from the geoms, screwkin does not (no mass here)")
+    if unused:
+        r.warnings.append(unused)
+    if unread["mesh"]:
+        n = unread["mesh"]
+        r.warnings.append(f"{len(n)} bodies ({', '.join(quote(x, 30) for x in n[:3])}{', ...' if len(n) > 3 else ''}) "
+                          "have mesh geoms and no <inertial>: MuJoCo computes a mesh's mass and inertia, screwkin "
+                          "does not (their mass here is their other geoms')")
+    if unread["springref"]:
+        n = unread["springref"]
+        r.warnings.append(f"springref of {len(n)} joint{'s' if len(n) > 1 else ''} ({', '.join(quote(x, 30) for x in n[:3])}"
+                          f"{', ...' if len(n) > 3 else ''}) is not read: screwkin has no joint springs")
     name = root.get("model") or "mjcf_model"
     urdf = "\n".join([f"<robot name={quoteattr(name)}>", '<link name="world"/>', *out_links, *out, "</robot>"])
     return MechanismSpec(path=str(path), name=name, format="mjcf", urdf_text=urdf, links=links, joints=joints,
                          cut_joints=cuts, transmissions=transmissions, warnings=r.warnings,
                          replacements=replacements, couplings=couplings,
-                         package_dirs=[str(d) for d in package_dirs or ()])
+                         package_dirs=[str(d) for d in package_dirs or ()], inputs=inputs, reference=reference)
+
+
+def _chains(couplings):
+    """Couplings with a chain (a joint coupled to a coupled joint) resolved to its first joint, as
+    <mimic> chains are (files/urdf.py)."""
+    by = {c.joint: c for c in couplings}
+    out = []
+    for c in couplings:
+        target, mult, off, seen = c.mimics, c.multiplier, c.offset, {c.joint}
+        while target in by and target not in seen:
+            seen.add(target)
+            t = by[target]
+            target, mult, off = t.mimics, mult * t.multiplier, mult * t.offset + off
+        out.append(Coupling(c.joint, target, mult, off))
+    return out
+
+
+def _inertia_xml(com, mass, I):
+    return (f"<inertial><origin xyz=\"{_fmt(com)}\" rpy=\"0 0 0\"/><mass value=\"{mass:.17g}\"/><inertia "
+            f"ixx=\"{I[0, 0]:.17g}\" iyy=\"{I[1, 1]:.17g}\" izz=\"{I[2, 2]:.17g}\" ixy=\"{I[0, 1]:.17g}\" "
+            f"ixz=\"{I[0, 2]:.17g}\" iyz=\"{I[1, 2]:.17g}\"/></inertial>")
+
+
+def _geom_inertial(r, geoms, what):
+    """(mass, URDF <inertial>, has meshes) of a body from its geoms, as MuJoCo computes them
+    (screwkin.files.mjcf_inertia)."""
+    p = r.problems
+    parts, meshes = [], False
+    for k, (e, T, cls) in enumerate(geoms):
+        a = r.attrs(e, cls)
+        gw = f"{what} geom {quote(a.get('name') or str(k + 1))}"
+        kind = a.get("type", "sphere")
+        group = numbers(a.get("group"), 1, f"{gw} group", p, (0,), 1e6, "")[0]
+        if not _in_range(group, r.groups):
+            continue
+        if kind in ("plane", "hfield"):
+            continue
+        if kind not in SOLIDS or a.get("shellinertia", "false") == "true" or a.get("mesh"):
+            # a mesh, an sdf, a shell, or a primitive MuJoCo fits to a mesh: MuJoCo integrates it
+            meshes = True
+            continue
+        raw = (a.get("size") or "0").split()
+        size = numbers(a.get("size") or "0", len(raw), f"{gw} size", p, (0.0,) * len(raw), LIMITS.length, low=0.0)
+        size = list(size) + [0.0] * (3 - len(size))
+        M = r.frame(a, gw)
+        if a.get("fromto") is not None:
+            f = r.vec(a["fromto"], 6, f"{gw} fromto", (0,) * 6)
+            d = f[3:] - f[:3]
+            half = float(np.linalg.norm(d)) / 2
+            if kind in ("capsule", "cylinder"):
+                size[1] = half
+            elif kind in ("box", "ellipsoid"):
+                size[1], size[2] = size[0], half
+            M = pin.SE3(_z_to(d), (f[:3] + f[3:]) / 2)
+        need = {"sphere": 1, "capsule": 2, "cylinder": 2, "box": 3, "ellipsoid": 3}[kind]
+        if not all(x > 0 for x in size[:need]):
+            p.append(f"{gw}: a {kind} needs {need} positive size{'s' if need > 1 else ''} (MuJoCo refuses it too)")
+            continue
+        volume = geom_volume(kind, size)
+        if a.get("mass") is not None:
+            m = numbers(a["mass"], 1, f"{gw} mass", p, (0.0,), LIMITS.mass, "kg", low=0.0)[0]
+        else:
+            density = numbers(a.get("density"), 1, f"{gw} density", p, (DEFAULT_DENSITY,), 1e6, "kg/m^3", low=0.0)[0]
+            m = density * volume
+        if m <= 0:
+            continue
+        Tm = T * M
+        parts.append((m, Tm.translation, Tm.rotation, geom_inertia(kind, size, m)))
+    mass, com, I = body_inertia(parts)
+    if mass <= 0:
+        return None, "", meshes
+    return mass, _inertia_xml(com, mass, I), meshes
+
+
+def _in_range(value, bounds) -> bool:
+    """Whether ``value`` lies in the closed range ``bounds`` (lo, hi)."""
+    return bounds[0] <= value <= bounds[1]
+
+
+def _z_to(d) -> np.ndarray:
+    """MuJoCo's rotation taking z onto the direction d (the smallest turn; a half turn about x for -z)."""
+    d = np.asarray(d, float)
+    n = float(np.linalg.norm(d))
+    if not n > 0:
+        return np.eye(3)
+    z = d / n
+    c = np.cross([0, 0, 1.0], z)
+    s = np.linalg.norm(c)
+    if s < DEFAULT.zero:
+        return np.eye(3) if z[2] > 0 else pin.exp3(np.array([math.pi, 0, 0]))
+    return pin.exp3(c / s * math.atan2(s, z[2]))
 
 
 def _inertial(r, e, what):
-    """(mass, URDF <inertial>) of an MJCF ``<inertial pos quat mass diaginertia|fullinertia>``."""
+    """(mass, URDF <inertial>) of an MJCF ``<inertial pos quat mass diaginertia|fullinertia>``, refused
+    where MuJoCo refuses it (a negative mass, a tensor no body has)."""
     p = r.problems
     a = e.attrib
     mass = numbers(a.get("mass"), 1, f"{what} <inertial mass>", p, (0.0,), LIMITS.mass, "kg", low=0.0)[0]
     M = r.frame(a, f"{what} <inertial>")
     if a.get("fullinertia") is not None:
-        if a.get("quat") is not None:
+        if any(a.get(k) is not None for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis")):
             p.append(f"{what} <inertial> gives both fullinertia and an orientation")
         xx, yy, zz, xy, xz, yz = numbers(a["fullinertia"], 6, f"{what} <inertial fullinertia>", p, (0,) * 6,
                                          LIMITS.inertia, "kg m^2")
@@ -348,139 +501,9 @@ def _inertial(r, e, what):
         xx, yy, zz = numbers(a.get("diaginertia") or "?", 3, f"{what} <inertial diaginertia>", p, (0,) * 3,
                              LIMITS.inertia, "kg m^2", low=0.0)
         xy = xz = yz = 0.0
-    return mass, (f"<inertial>{_origin(M)}<mass value=\"{mass:.17g}\"/><inertia ixx=\"{xx:.17g}\" "
-                  f"iyy=\"{yy:.17g}\" izz=\"{zz:.17g}\" ixy=\"{xy:.17g}\" ixz=\"{xz:.17g}\" iyz=\"{yz:.17g}\"/>"
-                  "</inertial>")
-
-
-def _equalities(r, world, sites, mjoints):
-    """Cut joints (connect: spherical, weld: fixed) and couplings (joint) of every <equality>."""
-    p = r.problems
-    cuts, couplings, names = [], [], set()
-    count = {"connect": 0, "weld": 0, "joint": 0}
-    for eq in r.root.findall("equality"):
-        for e in eq:
-            tag = e.tag
-            a = r.attrs(e, "main")
-            if tag not in count:
-                p.append(f"<equality><{shorten(tag, 30)}> is not supported (connect, weld and joint are)")
-                continue
-            count[tag] += 1
-            name = a.get("name") or f"{tag}{count[tag]}"
-            what = f"<equality><{tag}> {quote(name)}"
-            if name in names or name in mjoints:
-                p.append(f"{what}: the name is used twice")
-                continue
-            names.add(name)
-            if a.get("active", "true") == "false":
-                r.warnings.append(f"{what} is inactive (active=\"false\"): not read")
-                continue
-            if tag == "joint":
-                c = _joint_equality(r, a, what, mjoints)
-                if c is not None:
-                    couplings.append(c)
-                continue
-            ends = _ends(r, a, what, world, sites)
-            if ends is None:
-                continue
-            (b1, S1), (b2, S2), by_site = ends
-            if tag == "connect":
-                if by_site:  # the two sites' origins coincide
-                    F1, F2 = pin.SE3(np.eye(3), S1.translation), pin.SE3(np.eye(3), S2.translation)
-                else:  # anchor on body1; the point of body2 there at qpos0
-                    anchor = r.vec(a.get("anchor") or "?", 3, f"{what} anchor", (0, 0, 0))
-                    F1 = pin.SE3(np.eye(3), anchor)
-                    F2 = pin.SE3(np.eye(3), (world[b2].inverse() * world[b1]).act(anchor))
-                ctype = "spherical"
-            else:
-                if by_site:  # the two sites' frames coincide
-                    F1, F2 = S1, S2
-                else:
-                    anchor = r.vec(a.get("anchor"), 3, f"{what} anchor", (0, 0, 0))
-                    F2 = pin.SE3(np.eye(3), anchor)
-                    rel = r.vec(a.get("relpose"), 7, f"{what} relpose", (0, 1, 0, 0, 0, 0, 0))
-                    if np.any(rel[3:]):  # body2's pose in body1
-                        X12 = pin.SE3(quat_matrix(rel[3:]), rel[:3])
-                    else:  # as at qpos0
-                        X12 = world[b1].inverse() * world[b2]
-                    F1 = X12 * F2
-                ctype = "fixed"
-            cuts.append(CutJointSpec(name, ctype, b1, b2, tuple(F1.translation),
-                                     tuple(pin.rpy.matrixToRpy(F1.rotation)), tuple(F2.translation),
-                                     tuple(pin.rpy.matrixToRpy(F2.rotation)), source="mjcf"))
-    return cuts, couplings
-
-
-def _ends(r, a, what, world, sites):
-    """((body1, S1), (body2, S2), by_site) of a connect or weld; body2 omitted or "world" is the world."""
-    p = r.problems
-    if a.get("site1") or a.get("site2"):
-        out = []
-        for k in ("site1", "site2"):
-            s = a.get(k)
-            if s not in sites:
-                p.append(f"{what} {k} {quote(s)} is not a site of the file")
-                return None
-            out.append(sites[s])
-        b1, b2 = out[0][0], out[1][0]
-        res = (out[0], out[1], True)
-    else:
-        b1, b2 = a.get("body1"), a.get("body2") or "world"
-        for k, b in (("body1", b1), ("body2", b2)):
-            if b not in world:  # a body of the file (not one of the links made for its joints)
-                p.append(f"{what} {k} {quote(b)} is not a body of the file")
-                return None
-        res = ((b1, None), (b2, None), False)
-    if b1 == b2:
-        p.append(f"{what} connects body {quote(b1)} to itself")
-        return None
-    return res
-
-
-def _joint_equality(r, a, what, mjoints):
-    p = r.problems
-    j1, j2 = a.get("joint1"), a.get("joint2")
-    if not j2:
-        p.append(f"{what} has no joint2: locking a joint at a value is not supported")
-        return None
-    for k, j in (("joint1", j1), ("joint2", j2)):
-        if j not in mjoints:
-            p.append(f"{what} {k} {quote(j)} is not a joint of the file")
-            return None
-        if mjoints[j][0] not in ("hinge", "slide"):
-            p.append(f"{what} {k} {quote(j)} is a {mjoints[j][0]} joint: only hinge and slide joints can be coupled")
-            return None
-    c = numbers(a.get("polycoef"), 5, f"{what} polycoef", p, (0, 1, 0, 0, 0), 1e9, "")
-    if any(c[2:]):
-        p.append(f"{what} polycoef {quote(a.get('polycoef'))} is not linear: only joint1 = a0 + a1 joint2 "
-                 "is supported")
-        return None
-    if j1 == j2:
-        p.append(f"{what} couples joint {quote(j1)} to itself")
-        return None
-    return Coupling(j1, j2, float(c[1]), float(c[0]))
-
-
-def _actuators(r, mjoints, mimics):
-    """The joints driven by actuators, in file order."""
-    p = r.problems
-    names = []
-    for section in r.root.findall("actuator"):
-        for e in section:
-            a = r.attrs(e, "main")
-            what = f"actuator {quote(a.get('name') or e.tag)}"
-            if e.tag not in _ACTUATORS:
-                p.append(f"{what}: <actuator><{shorten(e.tag, 30)}> is not supported")
-                continue
-            j = a.get("joint") or a.get("jointinparent")
-            if not j:
-                other = next((k for k in ("tendon", "site", "body", "cranksite") if a.get(k)), "nothing")
-                p.append(f"{what} acts on a {other}, not a joint: not supported (screwkin's inputs are joints)")
-                continue
-            if j not in mjoints:
-                p.append(f"{what} names joint {quote(j)}, which is not in the file")
-            elif j in mimics:
-                r.warnings.append(f"{what} drives joint {quote(j)}, which is coupled to {quote(mimics[j])}: ignored")
-            elif j not in names:
-                names.append(j)
-    return names
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    why = inertia_problem(mass, I)
+    if why:
+        p.append(f"{what} <inertial> has {why}")
+    I = M.rotation @ I @ M.rotation.T
+    return mass, _inertia_xml(M.translation, mass, I)

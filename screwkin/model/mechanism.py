@@ -358,8 +358,27 @@ class Mechanism:
         raise UsageError(f"{self.path}: no link named '{link}' (links: {links})")
 
     def neutral(self) -> np.ndarray:
-        """The configuration written in the file (every joint at zero)."""
-        return pin.neutral(self.model)
+        """The configuration written in the file: every joint at zero, or at the value the file
+        draws it at (an MJCF joint's ``ref``: MuJoCo's qpos0)."""
+        q = pin.neutral(self.model)
+        for joint, value in self.spec.reference.items():
+            c = self._coord.get(joint)
+            if c is not None and c.nq == 1:
+                q[c.idx_q] = value
+        return q
+
+    def input_alias(self, name: str):
+        """The Transmission of an input the file names otherwise than by a coordinate's joint (a
+        fixed tendon, a coupled joint an actuator drives), or None."""
+        if name in self._coord:
+            return None
+        return next((t for t in self.spec.inputs if t.name == name and t.joint in self._coord), None)
+
+    def transmissions(self, inputs=None) -> tuple:
+        """The Transmission of each of ``inputs`` (default: the actuated joints) that the file drives
+        through a tendon, a coupling or a gear."""
+        inputs = set(self.actuated if inputs is None else inputs)
+        return tuple(t for t in self.spec.inputs if t.joint in inputs)
 
     # ------------------------------------------------------------------ length
     @property

@@ -54,6 +54,9 @@ def dynamics_dict(r: DynamicsResult) -> dict:
         "loads": [{"link": ld.link, "point": None if ld.point is None else list(ld.point), "name": ld.name,
                    "wrench": list(ld.wrench)} for ld in r.loads],
         "completed": r.completed, "notes": list(r.notes),
+        "actuator_efforts": {k: _list(v) for k, v in r.actuator_efforts.items()},
+        "coupled_efforts": {k: _list(v) for k, v in r.coupled_efforts.items()},
+        "transmissions": [t.text() for t in r.transmissions],
         "units": {"values": r.unit, "speed": rate, "efforts": dict(r.effort_units), "reactions": "N, N m",
                   "shaking": "N, N m", "kinetic_energy": "J", "potential_energy": "J", "input_power": "W",
                   "load_power": "W", "gravity": "m/s^2", "flywheel_energy_fluctuation": "J",
@@ -101,6 +104,14 @@ def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str |
         else:
             lines.append(f"{name}: peak |effort| {r.peak[name]:.6g} {unit}, mean {r.mean[name]:.6g} {unit}, "
                          f"RMS {r.rms[name]:.6g} {unit}")
+    for t in r.transmissions:
+        y = r.actuator_efforts[t.actuator]
+        if np.all(np.isfinite(y)):
+            lines.append(f"actuator {t.actuator!r}: peak |effort| {np.max(np.abs(y)):.6g} (the effort on {t.joint} / "
+                         f"{t.scale * t.gear:g}: {t.text()})")
+    for name, y in r.coupled_efforts.items():
+        lines.append(f"coupled joint {name!r}: peak |effort| {np.max(np.abs(y)):.6g} "
+                     f"{r.effort_units[name].replace(' ', '*')} (what its coupling exerts along it)")
     fly = r.flywheel
     if fly.inertia is not None:
         lines.append(f"flywheel: energy fluctuation {fly.energy_fluctuation:.6g} J over the turn; for Cs = {fly.cs:g} "

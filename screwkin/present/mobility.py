@@ -76,6 +76,9 @@ def mobility_dict(r) -> dict:
         "effective_dofs": r.effective_dofs,
         "actuated": list(r.actuated),
         "actuation_source": r.actuation_source,
+        "transmissions": [{"input": t.name, "actuator": t.actuator, "kind": t.kind, "terms": [list(x) for x in t.terms],
+                           "joint": t.joint, "scale": t.scale, "offset": t.offset, "gear": t.gear}
+                          for t in r.transmissions],
         "free_with_inputs_locked": r.free_with_inputs_locked,
         "classification": r.classification,
         "notes": list(r.notes),

@@ -32,7 +32,9 @@ def statics_dict(r: StaticsResult, legs=None) -> dict:
                        for x in r.reactions],
          "indeterminate": r.indeterminate, "singular": r.singular, "sigma_actuator": r.sigma_actuator,
          "amplification": r.amplification, "characteristic_length": r.length,
-         "constraint_forces": [{"row": k, "value": v} for k, v in r.constraint_forces]}
+         "constraint_forces": [{"row": k, "value": v} for k, v in r.constraint_forces],
+         "actuator_efforts": dict(r.actuator_efforts), "coupled_efforts": dict(r.coupled_efforts),
+         "transmissions": [t.text() for t in r.transmissions]}
     if legs is not None:
         d["legs"] = [leg_dict(leg) for leg in legs]
     return d
@@ -59,6 +61,13 @@ def statics_text(r: StaticsResult, legs=None) -> str:
         lines.append(table(["actuator", "effort"], [
             (n, "indeterminate (redundant actuation)" if r.efforts[n] is None else f"{_num(r.efforts[n])} {r.units[n]}")
             for n in r.inputs]))
+        for t in r.transmissions:
+            e = r.actuator_efforts.get(t.actuator)
+            lines.append(f"actuator {t.actuator!r}: {_num(e)} (the effort on {t.joint} / {t.scale * t.gear:g}: "
+                         f"{t.text()})")
+        for name, e in r.coupled_efforts.items():
+            lines.append(f"coupled joint {name!r}: {_num(e)} {r.units[name]} "
+                         "(what its coupling exerts along it)")
         if r.singular:
             lines.append(f"near an actuator singularity (relative sigma {r.sigma_actuator:.2g}): the efforts grow "
                          f"without bound as the mechanism approaches it; amplification {r.amplification:.3g}")

@@ -31,7 +31,7 @@ I = dE / (Cs omega^2).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
@@ -40,7 +40,7 @@ from ...errors import MechanismFileError, UsageError, quote
 from ...model._pin import frame_jacobian
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
-from .statics import balance, reaction_table
+from .statics import actuator_efforts, balance, coupled_efforts, coupled_units, reaction_table
 from ..motion.sweep import sweep
 
 __all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
@@ -104,6 +104,9 @@ class DynamicsResult:
     loads: tuple  # Load
     completed: bool  # the motion covered the whole range
     notes: tuple  # one line each: what was chosen, what is left open
+    actuator_efforts: dict = field(default_factory=dict)  # actuator -> (n,) through its tendon, coupling, gear
+    coupled_efforts: dict = field(default_factory=dict)  # coupled joint -> (n,) the effort its coupling exerts
+    transmissions: tuple = ()  # files.description.Transmission of those actuators
 
 
 def check_inertias(mech) -> tuple:
@@ -158,6 +161,7 @@ def _ground_sides(mech) -> tuple:
     -1 when its link1 is})."""
     model = mech.model
     tree = {c.joint for c in mech.coordinates if model.parents[c.joint_id] == 0}
+    tree |= {c.joint for c in mech.couplings if model.parents[model.getJointId(c.joint)] == 0}
     cuts = {}
     for cut in mech.cuts:
         on1 = model.frames[cut.frame1].parentJoint == 0
@@ -167,6 +171,20 @@ def _ground_sides(mech) -> tuple:
         elif on1 and not on2:
             cuts[cut.name] = -1.0
     return tree, cuts
+
+
+def _energies(mech, gmodel, data, q, v) -> tuple:
+    """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
+    energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
+    model = mech.model
+    if not mech.couplings:
+        return pin.computeKineticEnergy(model, data, q, v), pin.computePotentialEnergy(gmodel, data, q)
+    M = pin.crba(model, data, q)  # the upper triangle
+    M = np.triu(M) + np.triu(M, 1).T
+    pin.forwardKinematics(model, data, q)
+    g = gmodel.gravity.linear
+    V = -sum(model.inertias[j].mass * float(g @ data.oMi[j].act(model.inertias[j].lever)) for j in range(1, model.njoints))
+    return 0.5 * float(v @ M @ v), float(V)
 
 
 def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
@@ -212,10 +230,6 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     g = np.asarray(gravity, float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
-    if mech.couplings:  # Pinocchio 4.1's RNEA refuses its mimic joints
-        c = mech.couplings[0]
-        raise MechanismFileError(mech.path, f"dynamics does not take <mimic> couplings yet ({quote(c.joint)} mimics "
-                                            f"{quote(c.mimics)}): Pinocchio's inverse dynamics has no mimic joints")
     notes = list(check_inertias(mech))
     fixed = dict(fixed or {})
     if inputs is None:
@@ -232,7 +246,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     m = len(a_idx)
     n = len(res.values)
     efforts = np.full((n, m), np.nan)
-    reactions, kinds, open_ = {}, {}, {}
+    reactions, kinds, open_, coupled = {}, {}, {}, {}
     shaking_f, shaking_m = np.zeros((n, 3)), np.zeros((n, 3))
     T, V, P_in, P_load, unbalanced, scale = (np.zeros(n) for _ in range(6))
     indeterminate = 0
@@ -254,14 +268,16 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
         indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
         table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
+        for name, value in coupled_efforts(mech, q, {k: x[1] for k, x in table.items() if x[0] == "coupled"}).items():
+            coupled.setdefault(name, np.zeros(n))[k] = value
         for name, (kind, wrench, is_open) in table.items():
             reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
             kinds[name] = kind
             open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
         # data holds q's placements (its own Data: reaction_table computes in another)
         for name, (kind, wrench, _) in table.items():
-            if kind == "tree" and name in ground_tree:
-                sign, origin = -1.0, data.oMi[mech.coordinate(name).joint_id].translation
+            if kind in ("tree", "coupled") and name in ground_tree:
+                sign, origin = -1.0, data.oMi[model.getJointId(name)].translation
             elif kind == "cut" and name in ground_cuts:
                 cut = next(c for c in mech.cuts if c.name == name)
                 sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation
@@ -269,10 +285,10 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
                 continue
             shaking_f[k] += sign * wrench[:3]
             shaking_m[k] += sign * (wrench[3:] + np.cross(origin, wrench[:3]))
-        T[k] = pin.computeKineticEnergy(model, data, q, v)
-        V[k] = pin.computePotentialEnergy(gmodel, data, q)
+        T[k], V[k] = _energies(mech, gmodel, data, q, v)
         P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
     units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}
+    units.update(coupled_units(mech))
     eff = {name: efforts[:, j] for j, name in enumerate(inputs)}
     peak = {name: float(np.max(np.abs(y))) if np.all(np.isfinite(y)) else None for name, y in eff.items()}
     rms = {name: float(np.sqrt(_range_mean(res.values, y**2))) if np.all(np.isfinite(y)) else None
@@ -301,4 +317,6 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     return DynamicsResult(input, res.unit, float(speed), res.values, res.q, res.rates, res.accelerations,
                           tuple(inputs), eff, units, reactions, kinds, open_names, indeterminate, shaking_f,
                           shaking_m, T, V, P_in, P_load, unbalanced, peak, mean, rms, fly, tuple(map(float, g)),
-                          tuple(loads), completed, tuple(notes))
+                          tuple(loads), completed, tuple(notes),
+                          {k: np.asarray(v, float) for k, v in actuator_efforts(mech, inputs, eff).items()}, coupled,
+                          mech.transmissions(inputs))

@@ -28,7 +28,7 @@ constraint wrenches together.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
@@ -40,7 +40,7 @@ from ..screws import Screw, cut_twists, screw_of
 from ..singularities.singular import Generic, measures
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
-           "reaction_table"]
+           "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -75,6 +75,9 @@ class StaticsResult:
     amplification: float | None  # |efforts| / |load| with lengths made dimensionless by L (N m both)
     length: float  # the characteristic length L [m]
     constraint_forces: tuple  # (row label, lambda) of the closure rows
+    actuator_efforts: dict = field(default_factory=dict)  # actuator -> effort through its tendon, coupling, gear
+    coupled_efforts: dict = field(default_factory=dict)  # coupled joint -> the effort its coupling exerts
+    transmissions: tuple = ()  # files.description.Transmission of those actuators
 
 
 def _load_norm(w, L) -> float:
@@ -133,6 +136,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     for k, (name, iv) in enumerate(zip(inputs, a_idx)):
         efforts[name] = None if free_tau[k] > tol.indeterminate else float(tau[k])
         units[name] = "N" if mech.translational[iv] else "N m"
+    units.update(coupled_units(mech))
     reactions = _reactions(mech, q, lam, w if output is not None else None, output, gravity, N[m:] if N.size else None)
     L = mech.length
     g = Generic(mech, inputs, None, configurations=mech.generic_configurations()[1])
@@ -141,10 +145,13 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     scaled_tau = [abs(t) * (L if mech.translational[iv] else 1.0) for t, iv in zip(tau, a_idx)]
     amp = float(np.linalg.norm(scaled_tau) / load) if load > 0 and m else None
     labels = mech.closure.row_labels()
+    coupled = coupled_efforts(mech, q, {x.joint: [v or 0.0 for v in x.wrench] for x in reactions
+                                        if x.kind == "coupled"})
     return StaticsResult(tuple(inputs), efforts, units, tuple(w.tolist()), output, gravity,
                          unbalanced <= tol.balanced * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
                          bool(inputs) and sig < tol.singular, float(sig), amp, L,
-                         tuple(zip(labels, map(float, lam))))
+                         tuple(zip(labels, map(float, lam))), actuator_efforts(mech, inputs, efforts), coupled,
+                         mech.transmissions(inputs))
 
 
 def _reactions(mech, q, lam, w, output, gravity, N_lam):
@@ -223,9 +230,49 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dic
         f = data.f[jid]  # transmitted from the parent into joint jid's body, in the joint frame
         M = data.oMi[jid]
         out[c.joint] = ("tree", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
+    for cp in mech.couplings:  # a coupled joint carries its reaction too; its effort: coupled_efforts
+        jid = model.getJointId(cp.joint)
+        f, M = data.f[jid], data.oMi[jid]
+        out[cp.joint] = ("coupled", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
     pin.framesForwardKinematics(model, data, q)
     for name, (frame, wrench) in cut.items():
         out[name] = ("cut", wrench)
+    return out
+
+
+def coupled_efforts(mech, q, reactions: dict) -> dict:
+    """Coupled joint -> the effort [N m or N] its coupling exerts along it: the component along the
+    joint's axis (world axes at q) of its reaction, moment for a revolute, force for a prismatic
+    joint.  ``reactions``: joint -> wrench (force, moment) at the joint's origin, world axes."""
+    if not mech.couplings:
+        return {}
+    data = mech.scratch_data()
+    pin.framesForwardKinematics(mech.model, data, q)
+    spec = {j.name: j for j in mech.spec.joints}
+    out = {}
+    for cp in mech.couplings:
+        j = spec[cp.joint]
+        axis = data.oMi[mech.model.getJointId(cp.joint)].rotation @ (np.asarray(j.axis, float) /
+                                                                      np.linalg.norm(j.axis))
+        w = np.asarray(reactions[cp.joint], float)
+        out[cp.joint] = float(axis @ (w[:3] if j.type == "prismatic" else w[3:]))
+    return out
+
+
+def coupled_units(mech) -> dict:
+    """Coupled joint -> the unit of its effort: "N" for a prismatic joint, "N m" for a revolute one."""
+    kinds = {j.name: j.type for j in mech.spec.joints}
+    return {cp.joint: "N" if kinds.get(cp.joint) == "prismatic" else "N m" for cp in mech.couplings}
+
+
+def actuator_efforts(mech, inputs, efforts: dict) -> dict:
+    """Actuator name -> its effort: the input joint's generalized force / (scale * gear) of each input
+    the file drives through a tendon, a coupled joint or a gear (files.description.Transmission); None
+    where the joint's effort is undetermined."""
+    out = {}
+    for t in mech.transmissions(inputs):
+        e = efforts.get(t.joint)
+        out[t.actuator] = None if e is None else e / (t.scale * t.gear)
     return out
 
 
