@@ -104,7 +104,7 @@ class Tolerances:
     indeterminate: float = 1e-7
     local_order: int = 6
     local_form: float = 1e-6
-    local_step: float = 1e-3
+    local_step: float = 1e-2
     local_starts: int = 64
 
 

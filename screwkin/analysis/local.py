@@ -273,15 +273,14 @@ def _scaled_residual(mech, q, L):
 
 
 def _confirm(mech, q0, system, X, B, h):
-    """Close the loops again at a step h along the branch whose series is X (dimensionless, column
-    space) with tangent space B (tree part, orthonormal): Gauss-Newton with B^T (q - q0) = h B^T x
-    held.  Returns (configuration or None, deviation from the second-order predictor, residual)."""
+    """Close the loops again at a step h along the branch of tangent X[0] (dimensionless, column space)
+    with tangent space B (tree part, orthonormal): Gauss-Newton from q0 + h x with B^T (q - q0) = h B^T x
+    held.  Returns (configuration or None, its distance from q0 + h x -- O(h^2) on a branch --, residual)."""
     tol = mech.tolerances
     nv, L = mech.nv, system.length
     scale = system.scale[:nv]
     x = X[0][:nv]
-    a = X[1][:nv] if len(X) > 1 else np.zeros(nv)
-    predicted = pin.integrate(mech.model, q0, (h * x + h * h / 2 * a) * scale)
+    predicted = pin.integrate(mech.model, q0, h * x * scale)  # the tangent alone: the series is not used
     q = predicted
     target = h * (B.T @ x)
     norm = np.inf
@@ -461,3 +460,48 @@ def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max,
                + f"the series continues along each branch to order {order_max}; not decided beyond")
     return LocalAnalysis(**common, finite_mobility=int(finite), kind=kind, order=order, checked_order=order_max,
                          certain=certain, decided_by=how, branches=tuple(branches), notes=tuple(notes))
+
+
+def _rates_text(rates: dict) -> str:
+    return "(" + ", ".join(f"{n} {v:.4g}" for n, v in rates.items() if abs(v) > 0) + ")"
+
+
+def _order_text(la: LocalAnalysis) -> str:
+    if la.order is None:
+        return "not decided"
+    if la.certain:
+        return f"decided at order {la.order}"
+    return f"to order {la.checked_order} of the series, not decided beyond"
+
+
+def words(la: LocalAnalysis) -> str:
+    """The local analysis in words: the kind, the branches with their tangents, the order."""
+    d, f = la.infinitesimal_mobility, la.finite_mobility
+    n = len(la.branches)
+    if la.kind == "regular":
+        text = f"a regular point: the configuration space is smooth here, mobility {f}"
+    elif la.kind == "bifurcation":
+        b = la.branches[0].mobility
+        text = (f"a change point: {_count(n)} branches of mobility {b} cross here (infinitesimal mobility {d}); "
+                f"tangents " + "; ".join(_rates_text(x.tangent) for x in la.branches))
+    elif la.kind == "kinematotropic":
+        text = (f"branches of different mobility meet here (kinematotropic; infinitesimal mobility {d}): "
+                + "; ".join(f"mobility {x.mobility} along {_rates_text(x.tangent)}" for x in la.branches))
+    elif la.kind == "shaky":
+        text = (f"a shaky point: infinitesimally mobile ({d} instantaneous degree{'s' if d > 1 else ''} of freedom) "
+                "but finitely rigid")
+    elif la.kind == "singular":
+        x = la.branches[0]
+        cone = "" if x.linear else ", its tangent cone a quadric cone"
+        text = (f"a singular point of one branch of mobility {x.mobility} (infinitesimal mobility {d}{cone}); "
+                f"tangent {_rates_text(x.tangent)}")
+    elif la.kind == "rigid":
+        text = "rigid: no motion, not even an infinitesimal one"
+    else:
+        text = f"not decided (infinitesimal mobility {d}): {la.decided_by}"
+        return text
+    return f"{text} ({_order_text(la)})"
+
+
+def _count(n: int) -> str:
+    return {2: "two", 3: "three", 4: "four"}.get(n, str(n))

@@ -23,5 +23,5 @@ def add_parser(sub, common, scaled):
 def run(mech, args) -> int:
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
-    result = analyze_mobility(mech, output=args.output, point=args.point)
+    result = analyze_mobility(mech, output=args.output, point=args.point, suggest=True)
     return emit(args, lambda: to_jsonable(mobility_dict(result)), lambda: mobility_text(result))
