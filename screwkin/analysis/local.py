@@ -159,14 +159,17 @@ def _one_form(Q, zero):
     null = V[:, np.abs(lam) <= zero]
     if not pos.shape[1] or not neg.shape[1]:  # semidefinite: the zeros are Q's kernel, degenerate
         return [] if not null.shape[1] else [_Candidate(null, list(null.T), True, False)]
-    if pos.shape[1] == 1 and neg.shape[1] == 1:  # a pair of hyperplanes
+    if pos.shape[1] == 1 and neg.shape[1] == 1:  # a pair of hyperplanes, meeting in Q's kernel
         out = []
         for sign in (1.0, -1.0):
             normal = np.sqrt(lp[0]) * pos[:, 0] - sign * np.sqrt(-ln[0]) * neg[:, 0]
             P = np.eye(len(Q)) - np.outer(normal, normal) / (normal @ normal)
             T = _orth(P, zero)
             y = np.sqrt(-ln[0]) * pos[:, 0] + sign * np.sqrt(lp[0]) * neg[:, 0]
-            out.append(_Candidate(T, [y / np.linalg.norm(y)] + list(T.T), True, True))
+            y = y / np.linalg.norm(y)
+            # directions of the hyperplane off the kernel (where the zeros are regular): y, y + each kernel vector
+            samples = [y] + [(y + w) / np.linalg.norm(y + w) for w in null.T]
+            out.append(_Candidate(T, samples, True, True))
         return out
     # an irreducible quadric cone: curved, one candidate sampled along it
     samples = []
