@@ -29,8 +29,10 @@ predictor, and the rank of K there gives the branch's own mobility.
 
 Kinds: "regular" (one smooth branch, finite = infinitesimal), "bifurcation" (branches of one
 mobility cross: a change point), "kinematotropic" (branches of different mobilities meet),
-"shaky" (infinitesimally mobile, finitely rigid), "singular" (one branch, with more instantaneous
-than finite mobility: a cone point or a cusp), "rigid" (no motion at all: ker K = 0), "undecided".
+"shaky" (the configuration space smooth here -- an isolated point: infinitesimally mobile, finitely
+rigid; or a branch along which the instantaneous mobility stays above the finite one, Mueller's shaky
+linkage), "singular" (one branch with more instantaneous than finite mobility here only, or a cone
+point), "rigid" (no motion at all: ker K = 0), "undecided" (the series alone cannot tell).
 Ranks are decided as analysis.singularities.singular decides a constraint singularity: singular
 values of the dimensionless K below ``Tolerances.singular`` times the largest are lost.
 """
@@ -65,7 +67,9 @@ class Branch:
     """One branch of the configuration space through the configuration.
 
     tangent: joint -> rate of a tangent of the branch (the first joint moving noticeably at rate 1);
-    mobility: the branch's finite mobility (the rank of K at the configuration reached on it);
+    mobility: the branch's finite mobility, the dimension of its tangent space (the cone's component);
+    nearby: dim ker K at the configuration reached on it a step away: the mobility again at a kinematic
+    singularity, more on a shaky linkage (its instantaneous mobility stays above the finite one);
     tangent_space: a basis of its tangent space when mobility > 1 (dicts as tangent);
     linear: its tangent cone is a linear space (False: a quadric cone, the point singular on it);
     order: the order to which its series was continued;
@@ -74,6 +78,7 @@ class Branch:
 
     tangent: dict
     mobility: int
+    nearby: int | None = None  # the infinitesimal mobility at the configuration reached on it (None: not reached)
     tangent_space: tuple = ()
     linear: bool = True
     order: int = 1
@@ -353,7 +358,7 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
                      "left out")
     if c == 0:
         space = tuple(rates_of(mech, N[:, k], system.scale) for k in range(d)) if d > 1 else ()
-        branch = Branch(rates_of(mech, N[:, 0], system.scale), d, space, True, 1)
+        branch = Branch(rates_of(mech, N[:, 0], system.scale), d, None, space, True, 1)
         return LocalAnalysis(**base, finite_mobility=d, kind="regular", order=1, checked_order=1, certain=True,
                              decided_by="order 1: the loops' Jacobian has full row rank here (no redundant row): "
                                         "a regular point", branches=(branch,), notes=tuple(notes))
@@ -411,13 +416,11 @@ def _branch(mech, q, system, N, cand, X, order) -> Branch:
     T = N @ cand.T
     B = _orth(T[:nv], tol.geometry)
     qh, deviation, residual = _confirm(mech, q, system, X, B, tol.local_step)
-    mobility = cand.T.shape[1]
     confirmed = qh is not None
-    if confirmed:
-        mobility = nv - rank(mech.closure.jacobian(qh), tol)
+    nearby = nv - rank(mech.closure.jacobian(qh), tol) if confirmed else None
     space = tuple(rates_of(mech, T[:, k], system.scale) for k in range(T.shape[1])) if T.shape[1] > 1 else ()
-    return Branch(rates_of(mech, X[0], system.scale), int(mobility), space, cand.linear, order, confirmed,
-                  float(tol.local_step), deviation, residual)
+    return Branch(rates_of(mech, X[0], system.scale), int(cand.T.shape[1]), nearby, space, cand.linear, order,
+                  confirmed, float(tol.local_step), deviation, residual)
 
 
 def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max, notes, d):
@@ -434,15 +437,22 @@ def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max,
                      f"{order_max} was not closed again at a step of {b.step:g} (residual {b.residual:.2g})")
     if not branches:
         at = max((f for _, f in failed), default=2)
-        return LocalAnalysis(**common, finite_mobility=0, kind="shaky", order=at, checked_order=at, certain=False,
-                             decided_by=f"order {at}: every tangent of the quadratic cone fails at order {at} or "
-                                        "before (a cusp's half-branch would not show in a power series: not "
-                                        "certain)", branches=(), notes=tuple(notes))
+        return LocalAnalysis(**common, finite_mobility=None, kind="undecided", order=None, checked_order=at,
+                             certain=False,
+                             decided_by=f"not decided: every tangent of the quadratic cone stops at order {at} or before "
+                                        "in a power series (a cusp's half-branch, a branch of lower dimension inside "
+                                        "the cone, or no motion: the series alone cannot tell)", branches=(),
+                             notes=tuple(notes))
     finite = max(b.mobility for b in branches)
     mobilities = {b.mobility for b in branches}
     if len(branches) == 1:
         b = branches[0]
-        kind = "regular" if b.mobility == d and b.linear else "singular"
+        if b.mobility == d and b.linear:
+            kind = "regular"
+        elif b.linear and b.nearby == d:  # smooth here, and as mobile instantaneously a step away: shaky
+            kind = "shaky"
+        else:
+            kind = "singular"
     else:
         kind = "bifurcation" if len(mobilities) == 1 else "kinematotropic"
     certain = regular_roots and c0 == 0 and not failed and not unconfirmed and all(b.linear for b in branches)
@@ -490,9 +500,12 @@ def words(la: LocalAnalysis) -> str:
     elif la.kind == "kinematotropic":
         text = (f"branches of different mobility meet here (kinematotropic; infinitesimal mobility {d}): "
                 + "; ".join(f"mobility {x.mobility} along {_rates_text(x.tangent)}" for x in la.branches))
-    elif la.kind == "shaky":
+    elif la.kind == "shaky" and not f:
         text = (f"a shaky point: infinitesimally mobile ({d} instantaneous degree{'s' if d > 1 else ''} of freedom) "
                 "but finitely rigid")
+    elif la.kind == "shaky":
+        text = (f"a shaky linkage at a regular point: the configuration space is smooth here with mobility {f}, but "
+                f"the instantaneous mobility is {d} here and a step away along it")
     elif la.kind == "singular":
         x = la.branches[0]
         cone = "" if x.linear else ", its tangent cone a quadric cone"

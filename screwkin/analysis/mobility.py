@@ -349,8 +349,13 @@ def _analyze(mech, output, seed, point, at=None, suggest=False) -> MobilityResul
             best = (None, q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
     _, q, K, rk, M, V, idle, idle_total, I, out, eff = best
     M_generic = M
-    where_q = assembly.q if at is None else np.asarray(at, float)
-    where = assembly.start if at is None else "the configuration given"
+    # where the mobility is decided: the configuration given; else the file's own configuration when it closes
+    # the loops; else (the search closed them from another start, an arbitrary point of any branch) the
+    # configuration of the generic rank the rest of the analysis uses
+    own = assembly.start == "the file's configuration"
+    where_q = np.asarray(at, float) if at is not None else (assembly.q if own else q)
+    where = ("the configuration given" if at is not None else assembly.start if own else
+             "an assembled configuration of the generic rank")
     local_where = where
     local = local_analysis(mech, where_q, generic_rank=rk)
     if local.finite_mobility is not None:
@@ -375,6 +380,11 @@ def _analyze(mech, output, seed, point, at=None, suggest=False) -> MobilityResul
         if local.rank_drop:
             notes += ("The idle motions, the output's motion and the counts use assembled configurations of the "
                       "generic rank.",)
+    first_singular, first_rank, generic_rank = mech.first_assembly_singular
+    if first_singular and at is None and not own:
+        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
+                  f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
+                  f"there); the analysis uses assembled configurations of the generic rank.",)
     found = redundancy(mech, q, suggest_fix=suggest)
     return MobilityResult(
         path=mech.path,

@@ -24,7 +24,7 @@ def local_dict(la: LocalAnalysis, configuration: dict | None = None) -> dict:
         "finite_mobility": la.finite_mobility,
         "kind": la.kind,
         "order": la.order,
-        "branches": [{"tangent": b.tangent, "mobility": b.mobility,
+        "branches": [{"tangent": b.tangent, "mobility": b.mobility, "infinitesimal_mobility_nearby": b.nearby,
                       "tangent_space": list(b.tangent_space), "linear": b.linear, "order": b.order,
                       "confirmed": b.confirmed, "step": b.step, "deviation": b.deviation, "residual": b.residual}
                      for b in la.branches],
@@ -60,7 +60,8 @@ def local_lines(la: LocalAnalysis, where: str) -> list:
     for b in la.branches:
         if b.confirmed:
             lines.append(f"  branch of mobility {b.mobility}: closed again at a step of {b.step:g} along it "
-                         f"(residual {b.residual:.1e}, {b.deviation:.1e} from the tangent's first-order prediction)")
+                         f"(residual {b.residual:.1e}, {b.deviation:.1e} from the tangent's first-order prediction; "
+                         f"infinitesimal mobility there {b.nearby})")
     for n in la.notes:
         lines.append(f"  note: {n}")
     return lines
