@@ -288,17 +288,18 @@ def _classify(n, m, eff, overconstraint, topo, M):
 
 
 def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False, at=None,
-                     suggest: bool = False) -> MobilityResult:
+                     suggest: bool = False, names: bool = False) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
     its origin as a point (3 translations) instead of its full motion.  The mobility reported is the
     finite mobility at the configuration ``at`` (default: where the assembly search first closed the
     loops, the file's configuration when it closes them), decided by analysis.local, with the generic
-    rank as its check (``generic_mobility``); with ``suggest`` the redundant constraints come with the
-    joints that make the model exactly constrained.  Kept in ``mech.cache``."""
+    rank as its check (``generic_mobility``); with ``names`` the redundant constraints by name
+    (analysis.redundancy, ``redundant``), with ``suggest`` also the joints that make the model exactly
+    constrained.  Kept in ``mech.cache``."""
     key = ("mobility", tuple(mech.actuated), output, seed, point,
-           None if at is None else np.asarray(at, float).tobytes(), suggest)
+           None if at is None else np.asarray(at, float).tobytes(), suggest, names)
     if key not in mech.cache:
-        mech.cache[key] = _analyze(mech, output, seed, point, at, suggest)
+        mech.cache[key] = _analyze(mech, output, seed, point, at, suggest, names)
     return mech.cache[key]
 
 
@@ -314,7 +315,7 @@ def _local_notes(local, where, M_generic, generic_rank, samples):
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech, output, seed, point, at=None, suggest=False) -> MobilityResult:
+def _analyze(mech, output, seed, point, at=None, suggest=False, names=False) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)
@@ -385,7 +386,7 @@ def _analyze(mech, output, seed, point, at=None, suggest=False) -> MobilityResul
         notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
                   f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
                   f"there); the analysis uses assembled configurations of the generic rank.",)
-    found = redundancy(mech, q, suggest_fix=suggest)
+    found = redundancy(mech, q, suggest_fix=suggest) if names or suggest else None
     return MobilityResult(
         path=mech.path,
         topology=topo,

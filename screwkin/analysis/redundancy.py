@@ -177,18 +177,23 @@ def _and(items):
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _why(mech, q, W):
+def _algebra(mech, q):
+    """(kind, where, L): the algebra every tree screw lies in ("se(3)", "se(2)" with its normal, "so(3)"
+    with its point; analysis.loop_series.subalgebra) and the characteristic length."""
+    system = loop_system(mech, q, reduce=False)
+    kind, where = subalgebra(system.screws[system.column < mech.nv], mech.tolerances.geometry)
+    return kind, where, system.length
+
+
+def _why(mech, W, algebra):
     """Why a joint's redundant wrenches W (k, 6) are there: "planar" when every one does no work on the
     planar motions the tree's joints make (their screws all lie in one plane's se(2)), "spherical"
     likewise on the rotations about one point, "planar and overconstrained" when only some do, else
     "overconstrained" (the linkage's geometry keeps the rows dependent: Bennett, Sarrus, two frames
     fixing one centre distance)."""
-    system = loop_system(mech, q, reduce=False)
-    tree = system.screws[system.column < mech.nv]
-    kind, where = subalgebra(tree, mech.tolerances.geometry)
+    kind, where, L = algebra
     if kind == "se(3)" or not len(W):
         return "overconstrained"
-    L = system.length
     # a wrench (f, m) pairs with a dimensionless twist (v/L, w) as (f L) . (v/L) + m . w
     algebra = split(kind, where, np.eye(6))[0]
     Ws = np.hstack([W[:, :3] * L, W[:, 3:]])
@@ -244,6 +249,7 @@ def redundancy(mech, q, suggest_fix: bool = False) -> Redundancy:
 
 def _per_joint(mech, q, state, Lam, wrench_rows, owner):
     """JointRedundancy of every joint carrying part of the left null space."""
+    algebra = _algebra(mech, q)
     out = []
     kinds = _names(mech)
     cuts = {c.name: c for c in mech.cuts}
@@ -271,7 +277,7 @@ def _per_joint(mech, q, state, Lam, wrench_rows, owner):
         named, words = _describe(W, p, dirs, L, mech.tolerances)
         if named:  # the canonical wrenches themselves, about the world origin
             W = _canonical(named, dirs, p)
-        why = _why(mech, q, W)
+        why = _why(mech, W, algebra)
         out.append(JointRedundancy(name, kinds.get(name, "loop joint"), len(idx), k,
                                    tuple(tuple(map(float, w)) for w in W), tuple(map(float, p)), named,
                                    f"{k} of its {len(idx)} rows, " + words, why))
@@ -413,18 +419,12 @@ def suggest(mech, q, count=None) -> Suggestion | None:
         return Suggestion((), "none found: no change of joints to spherical, universal or cylindrical ones (a tree "
                               "joint: spherical or universal, as a sidecar replaces it) releases every redundant "
                               "constraint" + (" (forces through the sphere's centre: only sliding joints release them)"
-                                              if system_kind(mech, q) == "so(3)" else ""), None, None, "not built")
+                                              if _algebra(mech, q)[0] == "so(3)" else ""), None, None, "not built")
     words = _change_words(mech, chosen)
     changes = tuple((n, t, w) for (n, _, t, _, _), w in zip(chosen, words))
     text = "make " + _and([w for w in words])
     M, over, checked = _check(mech, q, chosen)
     return Suggestion(changes, text, M, over, checked)
-
-
-def system_kind(mech, q) -> str:
-    """The algebra every tree screw lies in: "se(3)", "se(2)" or "so(3)"."""
-    system = loop_system(mech, q, reduce=False)
-    return subalgebra(system.screws[system.column < mech.nv], mech.tolerances.geometry)[0]
 
 
 def _change_words(mech, chosen):
