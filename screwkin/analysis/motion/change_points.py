@@ -6,8 +6,8 @@ A sweep that meets a change point may go on along either branch (a four-bar fold
 parallelogram onto the anti-parallelogram): the constraint measure (analysis.singularities.singular)
 dips to zero there without changing sign, so it is not among the sign changes that
 analysis.motion.singular_points locates.  Here every local minimum of the constraint measure along the
-recorded sweep (below LOOK_BELOW, lower than both neighbours) is refined by bounded minimization of
-the measure over the input between the neighbours (the loops closed again at each value from the
+recorded sweep (singular_points.dips: below LOOK_BELOW, lower than both neighbours) is refined by
+bounded minimization of the measure over the input between the neighbours (the loops closed again at each value from the
 sweep's configuration), and kept where the measure falls below ``Tolerances.singular``.  At each such
 configuration -- and at the constraint singularities already located -- the local analysis decides
 what the point is; the branch the motion comes in on and the one it continues on are those whose
@@ -23,11 +23,10 @@ import numpy as np
 from ...errors import AssemblyError
 from ..local import LocalAnalysis, local_analysis
 from ..singularities.singular import Generic, measures
+from .singular_points import dips, reclosing
 
-__all__ = ["ChangePoint", "change_points", "LOOK_BELOW"]
+__all__ = ["ChangePoint", "change_points"]
 
-#: A dip of the constraint measure deeper than this is refined (the same screen as singular_points').
-LOOK_BELOW = 0.5
 #: The closure tolerance the refined configurations are solved to when Newton gets there (singular_points' too).
 TIGHT_CLOSURE = 1e-14
 
@@ -83,26 +82,14 @@ def change_points(solver, res, located=(), xtol: float | None = None) -> tuple:
         return ()
     m = np.array([measures(mech, q, g)["constraint"] for q in res.q])
     xs = res.values
-    frozen = solver.frozen
     tight = replace(tol, closure=TIGHT_CLOSURE, max_iterations=60)  # near a crossing Newton is slow: close tighter
     points = [(s.input, s.sigma, s.q, False) for s in located if s.kind == "constraint"]
-    for k in range(len(m)):
-        left = m[k - 1] if k > 0 else np.inf
-        right = m[k + 1] if k + 1 < len(m) else np.inf
-        if not (m[k] <= left and m[k] <= right) or m[k] > LOOK_BELOW:
-            continue
-        lo_k, hi_k = max(k - 1, 0), min(k + 1, len(xs) - 1)
+    for k, lo_k, hi_k in dips(m, xs):
         lo, hi = sorted((xs[lo_k], xs[hi_k]))
         q_k = res.q[k]
+        q_at = reclosing(solver, res, q_k, tight)
 
-        def q_at(x, q_k=q_k):
-            q0 = solver.set_inputs(q_k, {res.input: x})
-            try:
-                return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
-            except AssemblyError:
-                return mech.closure.solve(q0, frozen=frozen).q
-
-        def sigma(x):
+        def sigma(x, q_at=q_at):
             try:
                 return measures(mech, q_at(x), g)["constraint"]
             except AssemblyError:
