@@ -57,6 +57,9 @@ KINDS = ("regular", "bifurcation", "kinematotropic", "shaky", "singular", "rigid
 #: ker K (and two mixes of all of them): a bound on the work for mechanisms with many idle freedoms.
 MAX_DIRECTIONS = 6
 
+#: A branch's tangent space is listed (a basis, joint rates) up to this dimension; beyond, only its tangent.
+SHOWN_SPACE = 12
+
 #: A tangent's joint rates are shown with the first joint whose rate is at least this fraction of the
 #: largest set to 1 (a display normalization, not a decision).
 SHOWN_REFERENCE = 0.1
@@ -70,7 +73,7 @@ class Branch:
     mobility: the branch's finite mobility, the dimension of its tangent space (the cone's component);
     nearby: dim ker K at the configuration reached on it a step away: the mobility again at a kinematic
     singularity, more on a shaky linkage (its instantaneous mobility stays above the finite one);
-    tangent_space: a basis of its tangent space when mobility > 1 (dicts as tangent);
+    tangent_space: a basis of its tangent space when 1 < mobility <= SHOWN_SPACE (dicts as tangent);
     linear: its tangent cone is a linear space (False: a quadric cone, the point singular on it);
     order: the order to which its series was continued;
     confirmed: the step along it closed again (Gauss-Newton), with step, deviation from the
@@ -357,11 +360,12 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
         notes.append(f"every loop lies in {what} ({system.algebra}): its other rows vanish identically and are "
                      "left out")
     if c == 0:
-        space = tuple(rates_of(mech, N[:, k], system.scale) for k in range(d)) if d > 1 else ()
+        space = tuple(rates_of(mech, N[:, k], system.scale) for k in range(d)) if 1 < d <= SHOWN_SPACE else ()
         branch = Branch(rates_of(mech, N[:, 0], system.scale), d, None, space, True, 1)
+        how = ("order 1: the loops' Jacobian has full row rank here (no redundant row): a regular point"
+               if A.shape[0] else "order 1: no loops: every coordinate is free")
         return LocalAnalysis(**base, finite_mobility=d, kind="regular", order=1, checked_order=1, certain=True,
-                             decided_by="order 1: the loops' Jacobian has full row rank here (no redundant row): "
-                                        "a regular point", branches=(branch,), notes=tuple(notes))
+                             decided_by=how, branches=(branch,), notes=tuple(notes))
     if not system.supported:
         notes.append(f"the series beyond order 1 is not available: {system.note}")
         return LocalAnalysis(**base, finite_mobility=None, kind="undecided", order=None, checked_order=1,
@@ -418,7 +422,8 @@ def _branch(mech, q, system, N, cand, X, order) -> Branch:
     qh, deviation, residual = _confirm(mech, q, system, X, B, tol.local_step)
     confirmed = qh is not None
     nearby = nv - rank(mech.closure.jacobian(qh), tol) if confirmed else None
-    space = tuple(rates_of(mech, T[:, k], system.scale) for k in range(T.shape[1])) if T.shape[1] > 1 else ()
+    space = (tuple(rates_of(mech, T[:, k], system.scale) for k in range(T.shape[1]))
+             if 1 < T.shape[1] <= SHOWN_SPACE else ())
     return Branch(rates_of(mech, X[0], system.scale), int(cand.T.shape[1]), nearby, space, cand.linear, order,
                   confirmed, float(tol.local_step), deviation, residual)
 
