@@ -344,3 +344,45 @@ def test_stretched_fourbar_cannot_move_though_the_generic_rank_says_it_can():
     r = analyze_mobility(mech)
     assert (r.mobility, r.generic_mobility, r.local.kind, r.local.infinitesimal_mobility) == (0, 1, "shaky", 2)
     assert any("would give mobility 1" in n and "finite mobility" in n for n in r.notes)
+
+
+def test_the_same_change_point_in_se3_is_said_to_order_six_only(monkeypatch):
+    """Written in se(3) (the planar rows not dropped), the folded four-bar's loop has 4 redundant rows at the
+    change point, 3 of them (F_z, M_x, M_y) vanishing identically at order 2: the quadratic cone still
+    gives the two tangents, but the theorem needs every row, so the answer is said to order 6 -- the same
+    branches, with less certainty, never more."""
+    import screwkin.analysis.local as local_module
+
+    monkeypatch.setattr(local_module, "loop_system", lambda m, q: loop_system(m, q, reduce=False))
+    mech = folded()
+    la = local_module.local_analysis(mech, mech.generic_configurations()[0].q)
+    assert (la.kind, la.finite_mobility, la.redundant_rows, la.identically_zero) == ("bifurcation", 1, 4, 3)
+    assert (la.order, la.certain) == (mech.tolerances.local_order, False)
+    names = mech.coordinate_names
+    found = sorted(tuple(np.round(direction(b.tangent, names) / direction(b.tangent, names)[0], 9)) for b in la.branches)
+    assert found == sorted([(1.0, -1.0, 1.0), (1.0, -3.0, -3.0)])
+
+
+def test_zero_sets_of_quadratic_forms_by_hand():
+    """The cone's zeros on ker K, for forms written by hand: y1^2 - y2^2 in R^3 vanishes on the planes
+    y1 = y2 and y1 = -y2 (two linear candidates of dimension 2); y1^2 + y2^2 - y3^2 on a circular cone (one
+    curved candidate of dimension 2); y1^2 + y2^2 + y3^2 nowhere; {y1 y2, y1 y3} together on the plane
+    y1 = 0 (dimension 2, where the second form's gradient vanishes: degenerate) and the line y2 = y3 = 0
+    (dimension 1, gradients (0, 1, 0) and (0, 0, 1): regular) -- two components of different dimensions."""
+    from screwkin.analysis.local import _cone
+    from screwkin.tolerances import DEFAULT
+
+    def cone(*forms):
+        return _cone(np.array(forms, float), 1e-9, 64, DEFAULT)
+
+    planes = cone(np.diag([1.0, -1.0, 0.0]))
+    assert [(c.T.shape[1], c.linear, c.regular) for c in planes] == [(2, True, True), (2, True, True)]
+    normals = sorted(tuple(np.round(np.abs(np.linalg.svd(c.T.T)[2][-1]) * np.sqrt(2), 9)) for c in planes)
+    assert normals == [(1.0, 1.0, 0.0), (1.0, 1.0, 0.0)]  # |normal| = (1, 1, 0)/sqrt 2 for y1 = +-y2
+    (circular,) = cone(np.diag([1.0, 1.0, -1.0]))
+    assert (circular.T.shape[1], circular.linear) == (2, False)
+    assert cone(np.eye(3)) == []
+    f1 = np.array([[0, 0.5, 0], [0.5, 0, 0], [0, 0, 0]])
+    f2 = np.array([[0, 0, 0.5], [0, 0, 0], [0.5, 0, 0]])
+    parts = sorted((c.T.shape[1], c.regular, c.linear) for c in cone(f1, f2))
+    assert parts == [(1, True, True), (2, False, True)]
