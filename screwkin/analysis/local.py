@@ -57,6 +57,10 @@ KINDS = ("regular", "bifurcation", "kinematotropic", "shaky", "singular", "rigid
 #: ker K (and two mixes of all of them): a bound on the work for mechanisms with many idle freedoms.
 MAX_DIRECTIONS = 6
 
+#: The size below which a term of the series is compared with 1 rather than with itself: the screws are
+#: dimensionless (translations in characteristic lengths), their products of order 1 where the mechanism is.
+UNIT = 1.0
+
 #: A branch's tangent space is listed (a basis, joint rates) up to this dimension; beyond, only its tangent.
 SHOWN_SPACE = 12
 
@@ -246,7 +250,7 @@ def _cone(F, zero, starts, tol):
     return _sampled_zeros(F, zero, starts, tol)
 
 
-def _continue(system, x, Ainv, N, U, order, tol, size, lookahead=True):
+def _continue(system, x, Ainv, N, U, order, tol, lookahead=True):
     """Continue the series from X[0] = x to ``order``: each X[k] = -A^+ R_k + N y, y chosen (least
     squares) so that the next order's residual in coker K is least (0 without ``lookahead``).  Returns (the first order whose
     residual stays -- None when every order to ``order`` holds --, X coefficients, residuals)."""
@@ -256,7 +260,7 @@ def _continue(system, x, Ainv, N, U, order, tol, size, lookahead=True):
         R = s.residual()
         left = U.T @ R
         residuals.append(float(np.linalg.norm(left)))
-        if np.linalg.norm(left) > tol.local_form * size ** (k + 1):
+        if np.linalg.norm(left) > tol.local_form * max(float(np.linalg.norm(R)), UNIT):
             return k + 1, s.X, residuals
         base = -Ainv @ R
         if lookahead and k + 1 < order and N.shape[1] and U.shape[1]:
@@ -353,7 +357,6 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
     Ainv = Vt_A[:rA].T @ np.diag(1.0 / s_A[:rA]) @ U_A[:, :rA].T if rA else np.zeros((cols, A.shape[0]))
     c = U.shape[1]
     base["redundant_rows"] = c
-    size = max(1.0, float(np.max(np.linalg.norm(system.screws, axis=1)))) if len(system.screws) else 1.0
     notes = []
     if system.algebra != "se(3)":
         what = "a plane" if system.algebra == "se(2)" else "a sphere"
@@ -371,7 +374,10 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
         return LocalAnalysis(**base, finite_mobility=None, kind="undecided", order=None, checked_order=1,
                              certain=False, decided_by="not decided: " + system.note, branches=(), notes=tuple(notes))
     F = quadratic_forms(system, N, U)
-    zero = tol.local_form * size ** 2
+    # a form is zero next to the second-order terms themselves (they grow with the mechanism's distance from
+    # the world origin, the projections on coker K of the ones that vanish identically only by round-off)
+    second = max([float(np.linalg.norm(Series(system, N[:, k]).residual())) for k in range(d)] + [UNIT])
+    zero = tol.local_form * second
     Uf, sf, _ = np.linalg.svd(F.reshape(c, d * d), full_matrices=True)
     c2 = int(np.sum(sf > zero))
     F2 = np.einsum("ia,ijk->ajk", Uf[:, :c2], F)
@@ -383,15 +389,16 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
     else:
         candidates = _cone(F2, zero, int(tol.local_starts), tol)
     if c2 and not candidates:
-        how = (f"order 2: the {c2} quadratic form{'s' if c2 > 1 else ''} of the loops on ker K (dimension {d}) "
-               "have no common real zero but 0: no motion leaves this configuration")
+        how = (f"order 2: {_forms(c2)} of the loops on ker K (dimension {d}) "
+               f"{'have no common real zero' if c2 > 1 else 'has no real zero'} but 0: no motion leaves this "
+               "configuration")
         return LocalAnalysis(**base, finite_mobility=0, kind="shaky", order=2, checked_order=2, certain=True,
                              decided_by=how, branches=(), notes=tuple(notes))
     branches, failed = [], []
     for cand in candidates:
         reached, X0 = order_max, None
         for y in cand.samples:
-            fail, X, _ = _continue(system, N @ y, Ainv, N, U, order_max, tol, size, lookahead=c2 > 0)
+            fail, X, _ = _continue(system, N @ y, Ainv, N, U, order_max, tol, lookahead=c2 > 0)
             if X0 is None:
                 X0 = X
             if fail is not None:
@@ -463,9 +470,9 @@ def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max,
     certain = regular_roots and c0 == 0 and not failed and not unconfirmed and all(b.linear for b in branches)
     if certain:
         order = 2
-        how = (f"order 2: the {c2} quadratic form{'s' if c2 > 1 else ''} on ker K (dimension {d}) vanish on "
-               f"{len(branches)} linear space{'s' if len(branches) > 1 else ''} and their Jacobian has full rank "
-               "there: the tangent cone is decided")
+        how = (f"order 2: {_forms(c2)} on ker K (dimension {d}) {'vanish' if c2 > 1 else 'vanishes'} on "
+               f"{len(branches)} linear space{'s' if len(branches) > 1 else ''} and {'their' if c2 > 1 else 'its'} "
+               "Jacobian has full rank there: the tangent cone is decided")
     elif c2 == 0:
         order = order_max
         how = (f"to order {order_max}: every quadratic form on ker K vanishes identically ({c0} redundant "
@@ -522,6 +529,10 @@ def words(la: LocalAnalysis) -> str:
         text = f"not decided (infinitesimal mobility {d}): {la.decided_by}"
         return text
     return f"{text} ({_order_text(la)})"
+
+
+def _forms(c: int) -> str:
+    return "the quadratic form" if c == 1 else f"the {c} quadratic forms"
 
 
 def _count(n: int) -> str:
