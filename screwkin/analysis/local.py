@@ -344,20 +344,26 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
     base = dict(rank=rk, generic_rank=generic_rank, rank_drop=drop, coordinates=nv, infinitesimal_mobility=d,
                 inputs_held=held, sigma=sigma, inputs=inputs)
     system = loop_system(mech, q)
-    base.update(algebra=system.algebra, redundant_rows=max(S.K.shape[0] - rk, 0), identically_zero=0)
-    if d == 0:
-        return LocalAnalysis(**base, finite_mobility=0, kind="rigid", order=1, checked_order=1, certain=True,
-                             decided_by="order 1: K has full column rank, no motion at all", branches=())
     A = system.jacobian
     cols = A.shape[1]
     U_A, s_A, Vt_A = np.linalg.svd(A) if A.size else (np.eye(A.shape[0]), np.zeros(0), np.eye(cols))
     rA = min(cols - d, A.shape[0])
+    notes = []
+    own = int(np.sum(s_A > max(tol.singular * (s_A[0] if s_A.size else 0.0), tol.rank_atol)))
+    if own != rA:  # the loops' Jacobian decides its own kernel (K and A straddle the threshold differently)
+        notes.append(f"the loops written with their cut joints' freedoms have rank {own}, not {rA} as K's rank "
+                     f"says: the analysis follows their kernel, of dimension {cols - own}")
+        rA = own
+        d = cols - own
+    base.update(algebra=system.algebra, redundant_rows=A.shape[0] - rA, identically_zero=0)
+    if d == 0:
+        return LocalAnalysis(**base, finite_mobility=0, kind="rigid", order=1, checked_order=1, certain=True,
+                             decided_by="order 1: K has full column rank, no motion at all", branches=(),
+                             notes=tuple(notes))
     N = Vt_A[rA:].T
     U = U_A[:, rA:]
     Ainv = Vt_A[:rA].T @ np.diag(1.0 / s_A[:rA]) @ U_A[:, :rA].T if rA else np.zeros((cols, A.shape[0]))
     c = U.shape[1]
-    base["redundant_rows"] = c
-    notes = []
     if system.algebra != "se(3)":
         what = "a plane" if system.algebra == "se(2)" else "a sphere"
         notes.append(f"every loop lies in {what} ({system.algebra}): its other rows vanish identically and are "
