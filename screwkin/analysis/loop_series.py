@@ -12,9 +12,9 @@ the sum over the *units*: every one-parameter screw of the tree joints (a revolu
 of a ball joint's three rotations) and of the cut joint's own freedoms (written as a chain of
 one-parameter screws attached to F1: a ball as three rotations), with sigma = +1 for the units
 that carry F2, -1 for those that carry F1 and for the cut joint's freedoms, 0 for the path both
-share.  S_u(t) is the unit's screw (v, w) in the world at time t; y_u = m_u x_col(u) its rate (m_u
-the multiplier of a Pinocchio mimic joint, else 1), x the rates of the columns: the tree's
-velocity coordinates, then the cut joints' freedoms.  Couplings of coordinates (rolling and screw
+share.  S_u(t) is the unit's screw (v, w) in the world at time t; y_u = m_u x_col(u) its rate (m_u = 1:
+a Pinocchio mimic joint is a unit of its primary's column whose motion subspace holds the multiplier),
+x the rates of the columns: the tree's velocity coordinates, then the cut joints' freedoms.  Couplings of coordinates (rolling and screw
 pairs, a link's angle held) add sum c_k x_k = 0.
 
 A screw fixed in a body that moves with the spatial twist W changes as S' = [W, S] (the Lie
