@@ -68,6 +68,14 @@ class Tolerances:
                     this times their size [-].
     indeterminate:  statics: an effort or reaction is indeterminate when the part of it the
                     indeterminate directions change is above this times its size [-].
+    local_order:    the local analysis (analysis/local.py) continues the loops' Taylor series to this
+                    order at most: what it says holds to this order [-].
+    local_form:     a term of that series (a quadratic form on ker K, a higher coefficient) is zero when
+                    it is below this, relative to the size of the screws' products of its order [-].
+    local_step:     the step along a branch's tangent where the local analysis closes the loops again
+                    to confirm the branch (dimensionless: rad, or characteristic lengths) [-].
+    local_starts:   starting directions on the unit sphere of ker K from which the roots of several
+                    quadratic forms in three or more variables are refined [-].
     """
 
     closure: float = 1e-10
@@ -94,6 +102,10 @@ class Tolerances:
     zero: float = 1e-12
     balanced: float = 1e-8
     indeterminate: float = 1e-7
+    local_order: int = 6
+    local_form: float = 1e-6
+    local_step: float = 1e-2
+    local_starts: int = 64
 
 
 DEFAULT = Tolerances()

@@ -19,6 +19,8 @@ import pinocchio as pin
 from ..model.linalg import null_space, rank
 from ..model.state import KinematicState
 from ..model.topology import Topology
+from .local import LocalAnalysis, local_analysis, words as local_words
+from .redundancy import Redundancy, redundancy
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
 
@@ -84,6 +86,10 @@ class MobilityResult:
     starts: int = 1  # starting configurations the search tried
     configuration: dict = field(default_factory=dict)  # joint values of the configuration analysed
     transmissions: tuple = ()  # files.description.Transmission of the inputs driven through a tendon, coupling, gear
+    generic_mobility: int | None = None  # coordinates - the generic rank of K: the check on ``mobility``
+    local: LocalAnalysis | None = None  # the local analysis at the configuration analysed (analysis.local)
+    redundant: Redundancy | None = None  # the redundant constraints by name (analysis.redundancy)
+    local_where: str = "the file's configuration"  # where the local analysis was made, in words
 
     @property
     def kutzbach(self) -> int:
@@ -282,16 +288,35 @@ def _classify(n, m, eff, overconstraint, topo, M):
     return kind, tuple(notes)
 
 
-def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False) -> MobilityResult:
+def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False, at=None,
+                     suggest: bool = False, names: bool = False) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
-    its origin as a point (3 translations) instead of its full motion.  Kept in ``mech.cache``."""
-    key = ("mobility", tuple(mech.actuated), output, seed, point)
+    its origin as a point (3 translations) instead of its full motion.  The mobility reported is the
+    finite mobility at the configuration ``at`` (default: where the assembly search first closed the
+    loops, the file's configuration when it closes them), decided by analysis.local, with the generic
+    rank as its check (``generic_mobility``); with ``names`` the redundant constraints by name
+    (analysis.redundancy, ``redundant``), with ``suggest`` also the joints that make the model exactly
+    constrained.  Kept in ``mech.cache``."""
+    key = ("mobility", tuple(mech.actuated), output, seed, point,
+           None if at is None else np.asarray(at, float).tobytes(), suggest, names)
     if key not in mech.cache:
-        mech.cache[key] = _analyze(mech, output, seed, point)
+        mech.cache[key] = _analyze(mech, output, seed, point, at, suggest, names)
     return mech.cache[key]
 
 
-def _analyze(mech, output, seed, point) -> MobilityResult:
+def _local_notes(local, where, M_generic, generic_rank, samples):
+    """Why the mobility reported (the local analysis' finite mobility at ``where``) is not the generic one."""
+    if local.finite_mobility is None or local.finite_mobility == M_generic:
+        return ()
+    return (f"The generic rank of K ({generic_rank}, the largest over {samples} assembled configurations) would give "
+            f"mobility {M_generic}; the mobility reported is the finite mobility at {where}, {local.finite_mobility}: "
+            f"{local_words(local)}"
+            + (" (the configurations of the larger rank are near solutions the closure tolerance accepts, or "
+               "another branch)" if local.finite_mobility < M_generic else
+               " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
+
+
+def _analyze(mech, output, seed, point, at=None, suggest=False, names=False) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)
@@ -325,6 +350,19 @@ def _analyze(mech, output, seed, point) -> MobilityResult:
         if best is None or idle_total < best[7]:
             best = (None, q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
     _, q, K, rk, M, V, idle, idle_total, I, out, eff = best
+    M_generic = M
+    # where the mobility is decided: the configuration given; else the file's own configuration when it closes
+    # the loops; else (the search closed them from another start, an arbitrary point of any branch) the
+    # configuration of the generic rank the rest of the analysis uses
+    own = assembly.start == "the file's configuration"
+    where_q = np.asarray(at, float) if at is not None else (assembly.q if own else q)
+    where = ("the configuration given" if at is not None else assembly.start if own else
+             "an assembled configuration of the generic rank")
+    local_where = where
+    local = local_analysis(mech, where_q, generic_rank=rk)
+    if local.finite_mobility is not None:
+        M = local.finite_mobility
+        idle_total = min(idle_total, M)
     n = M - idle_total
     m = len(act_idx)
     locked = None
@@ -334,15 +372,24 @@ def _analyze(mech, output, seed, point) -> MobilityResult:
         locked = rank(np.hstack([L, I]), tol) - idle_total if L.shape[1] else 0
     overconstraint = K.shape[0] - rk
     kind, notes = _classify(n, m, eff if eff is not None else 0, overconstraint, topo, M)
+    if local.kind == "shaky":
+        kind = (f"shaky structure: infinitesimally mobile ({local.infinitesimal_mobility} "
+                f"instantaneous degree{'s' if local.infinitesimal_mobility > 1 else ''} of freedom), finitely rigid")
     if m and locked:
         notes += (f"With the inputs locked the mechanism can still move ({locked} degree{'s' if locked > 1 else ''} of freedom).",)
     for t in mech.transmissions():
         notes += (f"Input {t.text()}: its coordinate is {t.joint}.",)
+    if local.kind != "regular" or local.rank_drop or local.finite_mobility != M_generic:
+        notes += _local_notes(local, where, M_generic, rk, len(configs))
+        if local.rank_drop:
+            notes += ("The idle motions, the output's motion and the counts use assembled configurations of the "
+                      "generic rank.",)
     first_singular, first_rank, generic_rank = mech.first_assembly_singular
-    if first_singular:
-        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on a "
-                  f"degenerate branch (rank of K {first_rank} < {generic_rank}: mobility {mech.nv - first_rank} "
+    if first_singular and at is None and not own:
+        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
+                  f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
                   f"there); the analysis uses assembled configurations of the generic rank.",)
+    found = redundancy(mech, q, suggest_fix=suggest) if names or suggest else None
     return MobilityResult(
         path=mech.path,
         topology=topo,
@@ -370,4 +417,8 @@ def _analyze(mech, output, seed, point) -> MobilityResult:
         starts=assembly.starts,
         configuration=mech.joint_values(q),
         transmissions=mech.transmissions(),
+        generic_mobility=M_generic,
+        local=local,
+        redundant=found,
+        local_where=local_where,
     )

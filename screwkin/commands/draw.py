@@ -26,6 +26,7 @@ from ..present.draw import (
     value_label,
 )
 from ..present.draw_targets import design_marks
+from ..present.local import change_point_dict, change_point_lines
 from ..present.report import to_jsonable
 from ..units import in_unit, parse_typed_value
 from ._common import (
@@ -124,6 +125,8 @@ def _title(mech, what) -> str:
 
 
 def _kind_text(s) -> str:
+    if getattr(s, "point", None) is not None:  # a constraint singularity, analysed (analysis.local)
+        return "; ".join(line.strip() for line in change_point_lines(s.point, "it"))[len("at it: "):]
     if s.kind == "actuator" and s.limit:
         return "limit position of the input: actuator singularity (det of the passive Jacobian = 0)"
     if s.kind == "serial":
@@ -251,6 +254,8 @@ def run(mech, args) -> int:
             found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
                           "input_wrapped": _wrapped(s.input, search.unit), "sigma": s.sigma, "files": files,
                           "description": _kind_text(s), "title": title})
+            if getattr(s, "point", None) is not None:
+                found[-1].update({k: v for k, v in change_point_dict(s.point).items() if k not in ("input", "sigma")})
             if not args.json:
                 print(f"{_kind_text(s)} at {at}: wrote {', '.join(files)}")
         report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],

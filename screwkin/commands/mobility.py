@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..analysis.mobility import analyze_mobility
 from ..errors import UsageError
 from ..present.report import mobility_dict, mobility_text, to_jsonable
-from ._common import emit
+from ._common import add_configuration_options, configuration, emit, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -18,10 +18,13 @@ def add_parser(sub, common, scaled):
     common(sp)
     sp.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")
     sp.add_argument("--point", action="store_true", help="the output link's origin as a point (3 translations)")
+    add_configuration_options(sp)  # where the local analysis decides the mobility (default: the file's)
 
 
 def run(mech, args) -> int:
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
-    result = analyze_mobility(mech, output=args.output, point=args.point)
-    return emit(args, lambda: to_jsonable(mobility_dict(result)), lambda: mobility_text(result))
+    given = any(getattr(args, k, None) for k in ("set", "set_angle", "set_length", "near", "mode"))
+    at = configuration(mech, args) if given else None
+    result = analyze_mobility(mech, output=args.output, point=args.point, at=at, suggest=True)
+    return emit(args, lambda: to_jsonable(with_mode(args, mobility_dict(result))), lambda: mobility_text(result))

@@ -6,9 +6,11 @@ import json
 
 from ..analysis.singularities.ellipsoids import ellipsoids
 from ..analysis.singularities.gram_symbolic import symbolic_gram
-from ..analysis.singularities.singular import classify
+from ..analysis.local import local_analysis
+from ..analysis.singularities.singular import classify, named_types
 from ..errors import UsageError
 from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text
+from ..present.local import local_dict, local_lines, types_lines
 from ..present.report import (
     singularity_dict,
     singularity_text,
@@ -54,11 +56,15 @@ def run(mech, args) -> int:
         raise UsageError("--ellipsoids needs --output LINK")
     q = configuration(mech, args)
     rep = classify(mech, q, output=output, point=point)
+    local = local_analysis(mech, q, generic_rank=None)
+    types = named_types(rep, local, mech.tolerances)
     ell = ellipsoids(mech, q, output, point=point) if args.ellipsoids else None
     frame = output_frame_dict(mech, q, jacobian=True, point=point)
     gram = symbolic_gram(mech, q, list(inputs(mech, args)) or None) if args.symbolic else None
     if args.json:
         d = singularity_dict(rep)
+        d["local"] = local_dict(local, mech.joint_values(q))
+        d["types"] = [{"vocabulary": v, "name": n, "meaning": w} for v, n, w in types]
         if frame is not None:  # the named point or tool frame analysed as the output
             d["output_frame"] = frame
         if ell is not None:
@@ -70,6 +76,7 @@ def run(mech, args) -> int:
         if frame is not None:
             print(output_frame_line(frame, point))
         print(singularity_text(rep))
+        print("\n".join(["", *types_lines(types), *local_lines(local, "this configuration")]))
         if ell is not None:
             print()
             print(ellipsoids_text(ell))

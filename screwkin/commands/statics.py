@@ -8,9 +8,11 @@ import json
 import numpy as np
 
 from ..analysis.forces.statics import legs, statics
+from ..analysis.redundancy import redundancy
 from ..errors import UsageError
 from ..model.state import KinematicState
 from ..present.report import to_jsonable
+from ..present.local import redundancy_dict, redundancy_lines
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
 from ._common import (
@@ -54,6 +56,8 @@ def run(mech, args) -> int:
     q = configuration(mech, args)
     result = statics(mech, q, output=output, wrench=wrench, gravity=args.gravity)
     leg_list = legs(mech, q, output) if output is not None and mech.cuts else None
+    # the indeterminate reactions by name: the redundant constraint wrenches (analysis.redundancy)
+    red = redundancy(mech, q) if result.indeterminate else None
     frame = output_frame_dict(mech, q)
     if frame is not None:  # the load at the point (tool origin) is, at the link frame's origin, m_o = m + r x f
         o = KinematicState(mech, q).link_motion(frame["link"])["position"]
@@ -61,6 +65,8 @@ def run(mech, args) -> int:
         frame["wrench_at_link_origin"] = [*f.tolist(), *(m + np.cross(np.asarray(frame["position"]) - o, f)).tolist()]
     if args.json:
         d = statics_dict(result, leg_list)
+        if red is not None:
+            d.update({k: v for k, v in redundancy_dict(red).items() if k != "exactly_constrained_by"})
         if frame is not None:
             d["output_frame"] = frame
         print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
@@ -70,4 +76,6 @@ def run(mech, args) -> int:
             print(output_frame_line(frame, args.tool is None) + f"; the load there is, at {frame['link']}'s "
                   f"origin, (fx fy fz mx my mz) = {moved} (N, N m)")
         print(statics_text(result, leg_list))
+        if red is not None and red.count:
+            print("\n".join(redundancy_lines(red, "the reactions statics cannot give, by joint")))
     return 0

@@ -9,7 +9,9 @@ import os
 from ..analysis.motion.links import motion_along, strokes, sweep_motion
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
 from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
+from ..analysis.motion.change_points import change_points
 from ..analysis.motion.singular_points import locate_singularities
+from ..analysis.motion.sweep import SweepSingularity
 from ..analysis.motion.sweep import sweep
 from ..errors import UsageError
 from ..present.jsonout import json_of
@@ -17,6 +19,7 @@ from ..present.motion import motion_dict, motion_rows_text, strokes_dict, stroke
 from ..present.tables import RateUnits
 from ..present.plots import sweep_plot
 from ..present.streamout import SweepWriter
+from ..present.local import change_point_dict, change_point_lines
 from ..present.report import (
     linkage_dict,
     sweep_dict,
@@ -184,8 +187,13 @@ def run(mech, args) -> int:
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()
     sing = list(res.limits)  # the limit positions met are always listed
+    points = ()
     if args.singularities:
         sing = locate_singularities(solver, res, output=args.output, point=args.point)
+        # the configuration space's own singularities (change points, shaky points): analysis.local
+        points = change_points(solver, res, sing)
+        sing = sorted(sing + [SweepSingularity("constraint", p.input, p.sigma, p.q) for p in points if p.located],
+                      key=lambda x: x.input)
     if args.csv or args.parquet:
         with SweepWriter(args.csv, args.parquet) as out:
             out.write(res, motion)
@@ -198,6 +206,10 @@ def run(mech, args) -> int:
             d["linkage"] = linkage_dict(info)
             d["transmission_angles"] = mus
         d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
+        for entry, x in zip(d["singularities"], sing):  # what the configuration space does there
+            p = next((p for p in points if x.kind == "constraint" and p.input == x.input), None)
+            if p is not None:
+                entry.update({k: v for k, v in change_point_dict(p).items() if k not in ("input", "sigma")})
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
         d["strokes"] = strokes_dict(slider_strokes)
@@ -230,4 +242,7 @@ def run(mech, args) -> int:
             for x in sing:
                 print(f"  {x.kind:<10} at {res.input} = {value_text(res.input, x.input, res.unit == 'rad')}, "
                       f"relative sigma {x.sigma:.2g}" + ("  (limit position)" if x.limit else ""))
+                p = next((p for p in points if x.kind == "constraint" and p.input == x.input), None)
+                if p is not None:
+                    print("\n".join(change_point_lines(p, "this configuration")))
     return 0

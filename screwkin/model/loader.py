@@ -32,7 +32,7 @@ from ._pin import FRAME_PREFERENCE, frame_id
 from .cuts import in_plane
 from .mechanism import Mechanism, virtual_joint_name, virtual_roles
 
-__all__ = ["load"]
+__all__ = ["load", "rebuild"]
 
 
 def _read_text(path: Path) -> str:
@@ -251,6 +251,26 @@ def _virtual_pairs(model, spec) -> None:
         model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
 
 
+def _finish(spec, model):
+    """The tree model of a read file (its sidecar applied) made screwkin's: continuous joints, the joint
+    replacements, mimic couplings, the virtual chains of higher pairs; sizes and cut joints checked."""
+    path = spec.path
+    model = _rebuild(model, spec.replacements, first={c.mimics for c in spec.couplings})
+    model = _couple(model, spec.couplings, path)
+    _virtual_pairs(model, spec)
+    check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
+    _check_cut_bodies(model, spec)
+    return model
+
+
+def rebuild(spec, actuated=None, tolerances: Tolerances = DEFAULT, cls=Mechanism) -> Mechanism:
+    """A Mechanism from a description already read (and changed: other joint replacements, other cut
+    joint types -- analysis.redundancy builds the exactly constrained model it suggests this way)."""
+    with _native_stderr([]):
+        model = pin.buildModelFromXML(spec.urdf_text)
+    return cls(spec, _finish(spec, model), actuated=actuated, tolerances=tolerances)
+
+
 @contextmanager
 def _native_stderr(box: list):
     """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
@@ -348,11 +368,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         yaml = _find_sidecar(path)
     if yaml is not None:
         read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
-    model = _rebuild(model, spec.replacements, first={c.mimics for c in spec.couplings})
-    model = _couple(model, spec.couplings, path)
-    _virtual_pairs(model, spec)
-    check_sizes(spec.yaml_path or path, len(spec.links), len(spec.joints), len(spec.cut_joints), model.nv)
-    _check_cut_bodies(model, spec)
+    model = _finish(spec, model)
     shown = spec.warnings
     if warn is None:  # on the terminal: a bounded number of bounded lines
         warn = _print_warning(path)

@@ -6,6 +6,7 @@ constraint rank, idle and effective DOFs) and the output's motion.
 from __future__ import annotations
 
 from ..model.six_bar import INVERSIONS
+from .local import local_dict, local_lines, redundancy_dict, redundancy_lines
 from .tables import table
 
 __all__ = ["topology_dict", "mobility_dict", "JOINT_COLUMNS", "joint_rows", "topology_text", "count_rows",
@@ -87,7 +88,13 @@ def mobility_dict(r) -> dict:
         "redundant_constraints": r.redundant_constraints,
         "assembly": {"residual": r.residual, "iterations": r.iterations, "configurations_sampled": r.samples,
                      "start": r.assembly_start, "starts": r.starts, "configuration": r.configuration},
+        "generic_mobility": r.generic_mobility,
     })
+    if r.local is not None:
+        d["local"] = local_dict(r.local)
+        d["local"]["where"] = r.local_where
+    if r.redundant is not None:
+        d.update(redundancy_dict(r.redundant))
     return d
 
 
@@ -176,6 +183,10 @@ def mobility_text(r) -> str:
     lines.append(f"classification: {r.classification}")
     for n in r.notes:
         lines.append(f"note: {n}")
+    if r.local is not None:
+        lines += local_lines(r.local, r.local_where)
+    if r.redundant is not None and r.redundant.count:
+        lines += redundancy_lines(r.redundant, f"redundant constraints at a configuration of the generic rank")
     lines.append(f"(assembled from {r.assembly_start}: closure residual {r.residual:.2e} after {r.iterations} "
                  f"iterations; generic rank taken over {r.samples} assembled configurations)")
     return "\n".join(lines)

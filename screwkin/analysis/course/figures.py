@@ -13,6 +13,7 @@ from ...errors import UsageError
 from ..motion.link_inputs import holding_angles
 from ..motion.links import motion_along
 from ..motion.position import PositionSolver
+from ..motion.change_points import change_points
 from ..motion.singular_points import locate_singularities
 from ..motion.sweep import sweep
 from .skeleton import numbering
@@ -33,6 +34,7 @@ class SingularConfiguration:
     q: np.ndarray
     limit: bool
     output: str | None
+    point: object = None  # analysis.motion.change_points.ChangePoint of a constraint singularity: what it is
 
 
 @dataclass(frozen=True)
@@ -124,7 +126,11 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
         near = values
     res = sweep(solver, input_joint, start, stop, steps, fixed=fixed, near=near, turn=True, rate=rate)
     found = locate_singularities(solver, res, output=output)
-    out = tuple(SingularConfiguration(s.kind, s.input, s.sigma, s.q, s.limit, output if s.kind == "serial" else None)
+    points = change_points(solver, res, found)  # change points and shaky points too, each analysed
+    found = found + [SingularConfiguration("constraint", p.input, p.sigma, p.q, False, None) for p in points if p.located]
+    found.sort(key=lambda s: s.input)
+    out = tuple(SingularConfiguration(s.kind, s.input, s.sigma, s.q, s.limit, output if s.kind == "serial" else None,
+                                      next((p for p in points if s.kind == "constraint" and p.input == s.input), None))
                 for s in found)
     return SingularSearch(input_joint, res.unit, float(start), float(stop), output, fixed, out, bool(res.limits),
                           res.circuit_closed, res)

@@ -15,7 +15,35 @@ from ..singularities.singular import Generic, measures, scaled_jacobians
 from .links import LOCATE_XTOL
 from .sweep import SweepResult, SweepSingularity
 
-__all__ = ["locate_singularities"]
+__all__ = ["locate_singularities", "dips", "reclosing", "LOOK_BELOW"]
+
+#: A dip of a relative singular value along a sweep deeper than this is looked at more closely.
+LOOK_BELOW = 0.5
+
+
+def dips(m, xs):
+    """(k, k - 1, k + 1) for each recorded step k where the measure m is lowest among its neighbours and
+    below LOOK_BELOW (the neighbours' indices clipped to the sweep)."""
+    for k in range(len(m)):
+        left = m[k - 1] if k > 0 else np.inf
+        right = m[k + 1] if k + 1 < len(m) else np.inf
+        if m[k] <= left and m[k] <= right and m[k] <= LOOK_BELOW:
+            yield k, max(k - 1, 0), min(k + 1, len(xs) - 1)
+
+
+def reclosing(solver, res, q_k, tight):
+    """x -> the configuration at input value x closed from the sweep's q_k (tolerances ``tight`` when
+    Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
+    mech, frozen = solver.mech, solver.frozen
+
+    def q_at(x):
+        q0 = solver.set_inputs(q_k, {res.input: x})
+        try:
+            return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
+        except AssemblyError:
+            return mech.closure.solve(q0, frozen=frozen).q
+
+    return q_at
 
 
 def _matrix(mech, q, kind, g, V_ref=None):
@@ -49,18 +77,12 @@ def locate_singularities(solver, res: SweepResult, output=None, xtol: float = LO
     rank_of = {"constraint": g.rank_K, "actuator": g.rank_Kp, "serial": g.out_dim or 0}
     found = list(res.limits)
     xs = res.values
-    frozen = solver.frozen
     for kind in (table[0] if table else {}):
         m = np.array([t[kind] for t in table])
         r = rank_of[kind]
         if r == 0:
             continue
-        for k in range(len(m)):
-            left = m[k - 1] if k > 0 else np.inf
-            right = m[k + 1] if k + 1 < len(m) else np.inf
-            if not (m[k] <= left and m[k] <= right) or m[k] > 0.5:
-                continue
-            lo_k, hi_k = max(k - 1, 0), min(k + 1, len(xs) - 1)
+        for k, lo_k, hi_k in dips(m, xs):
             if (xs[k] - xs[lo_k]) * (xs[hi_k] - xs[k]) < 0:  # a turn between: that limit is listed already
                 continue
             q_k = res.q[k]
@@ -69,13 +91,7 @@ def locate_singularities(solver, res: SweepResult, output=None, xtol: float = LO
                 V_ref = scaled_jacobians(mech, q_k, output, point).V
             U, _, Vt = np.linalg.svd(_matrix(mech, q_k, kind, g, V_ref))
             u, v = U[:, r - 1], Vt[r - 1]
-
-            def q_at(x, q_k=q_k):
-                q0 = solver.set_inputs(q_k, {res.input: x})
-                try:
-                    return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
-                except AssemblyError:
-                    return mech.closure.solve(q0, frozen=frozen).q
+            q_at = reclosing(solver, res, q_k, tight)
 
             def signed(x, u=u, v=v, V_ref=V_ref):
                 return float(u @ _matrix(mech, q_at(x), kind, g, V_ref) @ v)

@@ -37,7 +37,7 @@ from ...tolerances import DEFAULT
 from ..screws import cut_twists, screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
-           "KINDS", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
+           "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 KINDS = ("serial", "actuator", "constraint")
@@ -237,6 +237,42 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
     sigmas = {k: sig.get(k, 1.0) for k in KINDS}
     return SingularityReport(serial, actuator, constraint, stationary, min(sigmas.values()), sigmas, cond, manip,
                              L, tuple(twists), tuple(inputs), output, point, gram_cofactors(mech, q, L))
+
+
+def named_types(rep: SingularityReport, local=None, tol=DEFAULT) -> tuple:
+    """The kinds that meet at the configuration in the standard vocabularies: (vocabulary, name, what it
+    means here) for Gosselin and Angeles 1990 (type I: the output loses a direction, type II: it moves with
+    the inputs locked, type III: both) and Zlatanov, Fenton and Benhabib 1995 (redundant input: the inputs
+    move with the output at rest; redundant output: the output moves with the inputs at rest; redundant
+    passive motion: only passive joints move; increased instantaneous mobility: K loses rank), and for a
+    rank drop the configuration-space type from the local analysis (``local``: analysis.local), the
+    constraint singularity of Zlatanov, Bonev and Gosselin 2002 when the configuration space itself is
+    singular there."""
+    out = []
+    if rep.serial and rep.actuator:
+        out.append(("Gosselin-Angeles", "type III", "types I and II at once"))
+    if rep.serial:
+        out.append(("Gosselin-Angeles", "type I", "inverse-kinematic: the output loses a direction of motion"))
+        out.append(("Zlatanov-Fenton-Benhabib", "redundant input", "the inputs can move while the output stays"))
+    if rep.actuator:
+        out.append(("Gosselin-Angeles", "type II", "direct-kinematic: the mechanism moves with its inputs locked"))
+        twist = next((t for t in rep.singular_twists if t.kind == "actuator"), None)
+        moves = twist is not None and twist.twist is not None and np.linalg.norm(twist.twist) > tol.motion
+        if rep.output is None:
+            out.append(("Zlatanov-Fenton-Benhabib", "redundant output or redundant passive motion",
+                        "passive joints move with the inputs at rest (give --output to tell which)"))
+        elif moves:
+            out.append(("Zlatanov-Fenton-Benhabib", "redundant output", "the output moves with the inputs at rest"))
+        else:
+            out.append(("Zlatanov-Fenton-Benhabib", "redundant passive motion",
+                        "passive joints move with the inputs and the output at rest"))
+    if rep.constraint:
+        out.append(("Zlatanov-Fenton-Benhabib", "increased instantaneous mobility",
+                    "K loses rank: more instantaneous freedoms than the mechanism has elsewhere"))
+        if local is not None and local.kind not in ("regular", "undecided"):
+            out.append(("Zlatanov-Bonev-Gosselin", "constraint singularity",
+                        f"the configuration space is singular here: {local.kind}"))
+    return tuple(out)
 
 
 @dataclass(frozen=True)
