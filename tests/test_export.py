@@ -162,3 +162,5 @@ def test_mobility_survives_export(tmp_path, path):
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
     mujoco.mj_forward(m, d)
     assert m.nv - np.linalg.matrix_rank(d.efc_J.reshape(d.nefc, m.nv), tol=1e-9) == M
+    # the loops are closed in the file as MuJoCo's engine reads it (a weld's relpose: the anchor's place)
+    np.testing.assert_allclose(d.efc_pos[:d.ne], 0, rtol=0, atol=1e-12)

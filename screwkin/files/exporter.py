@@ -10,7 +10,8 @@ hold where they should.
 MJCF has only point (``connect``) and frame (``weld``) equalities.  Cut joints become:
 
 - spherical: a ``connect`` at F1;
-- fixed: a ``weld`` with ``relpose`` (body2's pose in body1) written out;
+- fixed: a ``weld`` at F2 with ``relpose`` written out (as MuJoCo's engine reads it: the anchor's
+  place in body1 and body2's turn from body1; files/mjcf_equality.py);
 - revolute, continuous: two ``connect``s, at F1 and one ``length`` further along the axis
   (MJCF has no hinge equality): 6 rows of rank 5 (one redundant, which MuJoCo's soft
   constraints accept);
@@ -292,11 +293,12 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         else:  # fixed: body2 in body1; an aux body: body2 in the aux body, which is at F1 at qpos0
             F1 = pin.SE3.Identity() if c.type in _AUX else _se3(c.pos1, c.quat1)
             F2 = _se3(c.pos2, c.quat2)
-            rel = F1 * _se3(*c.rel) * F2.inverse()
+            at = F1 * _se3(*c.rel)  # F2 in body1 at qpos0: relpose is the anchor's place there, and body2's turn
+            rel = at * F2.inverse()
             body1 = names["F1", c.name] if c.type in _AUX else c.body1
             eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else names['weld', c.name])} "
                       f"body1={quoteattr(body1)} body2={quoteattr(c.body2)} anchor=\"{vector_text(*c.pos2)}\" "
-                      f'relpose="{vector_text(*rel.translation, *_quat(rel))}"/>')
+                      f'relpose="{vector_text(*at.translation, *_quat(rel))}"/>')
     for cp in pm.couplings:
         eq.append(f"<joint joint1={quoteattr(cp.joint)} joint2={quoteattr(cp.mimics)} "
                   f'polycoef="{vector_text(cp.offset, cp.multiplier, 0, 0, 0)}"/>')
