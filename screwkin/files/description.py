@@ -17,6 +17,7 @@ import pinocchio as pin
 __all__ = [
     "TREE_JOINT_DOF",
     "CUT_JOINT_DOF",
+    "JOINT_DYNAMICS",
     "LinkSpec",
     "TargetSpec",
     "TARGETS_NS",
@@ -42,6 +43,9 @@ TREE_JOINT_DOF = {
     "floating": 6,
     "planar": 3,
 }
+
+#: A joint's own dynamics kept from the file and written back (JointSpec): MJCF's names.
+JOINT_DYNAMICS = ("armature", "damping", "frictionloss")
 
 #: Degrees of freedom of the cut (loop) joint types of mechanism-format.md.
 CUT_JOINT_DOF = {
@@ -164,10 +168,21 @@ class JointSpec:
     rpy: tuple = (0.0, 0.0, 0.0)
     axis: tuple = (1.0, 0.0, 0.0)
     mimic: tuple | None = None  # (joint, multiplier, offset) of a URDF <mimic>, as written
+    # the joint's own dynamics, as the file writes them (0: none), per degree of freedom: MJCF armature
+    # (a rotor's reflected inertia [kg m^2 or kg]), damping [N m s/rad or N s/m] and frictionloss
+    # [N m or N]; URDF <dynamics damping friction> (friction is MuJoCo's frictionloss, as its URDF reader has it)
+    armature: float = 0.0
+    damping: float = 0.0
+    frictionloss: float = 0.0
 
     @property
     def dof(self) -> int:
         return TREE_JOINT_DOF[self.type]
+
+    @property
+    def dynamics(self) -> dict:
+        """The joint's armature, damping and frictionloss that are not 0 (name -> value)."""
+        return {k: getattr(self, k) for k in JOINT_DYNAMICS if getattr(self, k)}
 
 
 @dataclass(frozen=True)

@@ -55,12 +55,14 @@ ROD_RATIO = 0.05
 class PlacedJoint:
     """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (the
     joint sits at the body's origin); range [rad or m] about the written configuration, None:
-    unlimited."""
+    unlimited; dynamics: its armature, damping and frictionloss that are not 0 (MJCF's names,
+    description.JOINT_DYNAMICS), as ((name, value), ...)."""
 
     name: str
     type: str
     axis: tuple = (0.0, 0.0, 1.0)
     range: tuple | None = None
+    dynamics: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -215,11 +217,12 @@ def helper_names(pm) -> dict:
 
 
 def _mj_joint(j):
-    if j.type == "free":
+    dyn = "".join(f' {k}="{number_text(v)}"' for k, v in j.dynamics)
+    if j.type == "free" and not dyn:
         return f"<freejoint name={quoteattr(j.name)}/>"
     rng = f' range="{vector_text(*j.range)}"' if j.range is not None else ""
-    axis = "" if j.type == "ball" else f' axis="{vector_text(*j.axis)}"'
-    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{axis}{rng}/>"
+    axis = "" if j.type in ("ball", "free") else f' axis="{vector_text(*j.axis)}"'
+    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{axis}{rng}{dyn}/>"
 
 
 _AUX = {"prismatic": ("slide",), "cylindrical": ("hinge", "slide"), "universal": ("hinge", "hinge"),
@@ -338,6 +341,10 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         if t in ("revolute", "continuous", "prismatic"):
             lo, hi = j.range if j.range is not None else (-1e9, 1e9)
             text += f'<axis xyz="{vector_text(*j.axis)}"/><limit lower="{number_text(lo)}" upper="{number_text(hi)}" effort="0" velocity="0"/>'
+        urdf_dyn = {"damping": "damping", "frictionloss": "friction"}  # armature has no URDF form
+        dyn = " ".join(f'{urdf_dyn[k]}="{number_text(v)}"' for k, v in j.dynamics if k in urdf_dyn)
+        if dyn and t != "fixed":
+            text += f"<dynamics {dyn}/>"
         if j.name in coupled:
             cp = coupled[j.name]
             text += f'<mimic joint={quoteattr(cp.mimics)} multiplier="{number_text(cp.multiplier)}" offset="{number_text(cp.offset)}"/>'

@@ -198,7 +198,10 @@ def _joint(elem, links, problems) -> JointSpec | None:
             mult = numbers(m.get("multiplier"), 1, f"{what} <mimic multiplier>", problems, (1.0,))[0]
             off = numbers(m.get("offset"), 1, f"{what} <mimic offset>", problems, (0.0,))[0]
             mimic = (target, mult, off)
-    return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic)
+    dyn = elem.find("dynamics")  # MuJoCo's URDF reader: damping -> damping, friction -> frictionloss
+    dyn = {} if dyn is None else {key: numbers(dyn.get(attr), 1, f"{what} <dynamics {attr}>", problems, (0.0,), 1e9, "")[0]
+                                  for key, attr in (("damping", "damping"), ("frictionloss", "friction"))}
+    return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic, **dyn)
 
 
 def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:

@@ -85,7 +85,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
                         rng = (float(lo - value), float(hi - value))
                     else:
                         empty.append(j.name)
-            joint = PlacedJoint(j.name, kind, tuple(float(a) for a in j.axis), rng)
+            joint = PlacedJoint(j.name, kind, tuple(float(a) for a in j.axis), rng, tuple(j.dynamics.items()))
             # Pinocchio's inertia of the joint's body, in the joint's frame: the child link's frame
             I = model.frames[mech.link_frame(j.child)].placement.actInv(model.inertias[jid])
             mass, com, inertia = float(I.mass), tuple(I.lever), _inertia(I)
