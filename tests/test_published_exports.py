@@ -13,6 +13,7 @@ import pytest
 import screwkin
 from conftest import DATA
 from screwkin.analysis.forces.dynamics import dynamics
+from screwkin.analysis.forces.statics import statics
 from screwkin.cli import main
 
 mujoco = pytest.importorskip("mujoco")
@@ -108,3 +109,115 @@ def test_urdf_dynamics_are_read_and_exported(tmp_path, capsys):
         for what in ("damping", "frictionloss"):
             assert _dof(ours, name, what) == _dof(theirs, name, what)
     assert (_dof(ours, "shoulder", "damping"), _dof(ours, "shoulder", "frictionloss")) == (0.7, 0.2)
+
+
+# ------------------------------------------------------------------ transmissions with reductions
+ARM_LINK = ('<link name="{n}"><inertial><origin xyz="{c} 0 0"/><mass value="{m}"/><inertia ixx="1e-3" iyy="1e-2" '
+            'izz="1e-2" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+
+
+def geared_arm(tmp_path, shoulder="<actuator name=\"shoulder_motor\"><mechanicalReduction>50</mechanicalReduction>"
+               "</actuator>", extra=""):
+    """A two-link arm in the vertical xz plane (joints about y), drawn horizontal: upper link 0.3 m, 2 kg
+    at 0.15 m; forearm 1 kg at 0.1 m past the elbow.  The shoulder's transmission (ROS 1 form, its
+    reduction under <actuator>) and the elbow's (the older PR2 form: type as an attribute, the
+    reduction directly under <transmission>, -20: the motor turns the other way)."""
+    f = tmp_path / "geared.urdf"
+    f.write_text(
+        '<robot name="geared">' + ARM_LINK.format(n="base", c=0, m=1) + ARM_LINK.format(n="upper", c=0.15, m=2)
+        + ARM_LINK.format(n="fore", c=0.1, m=1)
+        + '<joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 1 0"/>'
+          '<limit lower="-3" upper="3" effort="10" velocity="1"/></joint>'
+          '<joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.3 0 0"/>'
+          '<axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>'
+          '<transmission name="t_shoulder"><type>transmission_interface/SimpleTransmission</type><joint name="shoulder">'
+          f'<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>{shoulder}</transmission>'
+          '<transmission name="t_elbow" type="pr2_mechanism_model/SimpleTransmission"><actuator name="elbow_motor"/>'
+          f'<joint name="elbow"/><mechanicalReduction>-20</mechanicalReduction></transmission>{extra}</robot>')
+    return f
+
+
+def test_reductions_give_the_actuator_efforts(tmp_path, capsys):
+    """Holding the arm horizontal against gravity g = 9.81 m/s^2 (joints about +y: a point at +x drops
+    as the joint turns positive, V = -m g x sin q), the joints need dV/dq:
+    shoulder -g (2 * 0.15 + 1 * (0.3 + 0.1)) = -6.867 N m, elbow -g * 1 * 0.1 = -0.981 N m; through the
+    reductions (ROS SimpleTransmission: actuator effort = joint effort / n) the motors give
+    -6.867 / 50 = -0.13734 N m and -0.981 / -20 = 0.04905 N m.  MuJoCo, on the export: the motors carry
+    gear 50 and -20, and with those controls its actuator_force is them and the arm stays put (qacc 0)."""
+    g = 9.81
+    path = geared_arm(tmp_path)
+    mech = screwkin.load(path)
+    assert {t.actuator: (t.joint, t.gear) for t in mech.transmissions()} == {
+        "shoulder_motor": ("shoulder", 50.0), "elbow_motor": ("elbow", -20.0)}
+    r = statics(mech, mech.neutral(), gravity=True)
+    assert r.efforts["shoulder"] == pytest.approx(-g * 0.7, abs=1e-12)
+    assert r.efforts["elbow"] == pytest.approx(-g * 0.1, abs=1e-12)
+    assert r.actuator_efforts == pytest.approx({"shoulder_motor": -g * 0.7 / 50, "elbow_motor": g * 0.1 / 20}, abs=1e-12)
+    assert main(["statics", str(path), "--gravity"]) == 0
+    assert "(joint of actuator 'shoulder_motor', mechanicalReduction 50)" in capsys.readouterr().out
+    out_x, out_u = tmp_path / "geared.xml", tmp_path / "geared_back.urdf"
+    assert main(["export", str(path), "--mjcf", str(out_x), "--urdf", str(out_u)]) == 0
+    capsys.readouterr()
+    m = mujoco.MjModel.from_xml_path(str(out_x))
+    d = mujoco.MjData(m)
+    ctrl = {"shoulder": r.actuator_efforts["shoulder_motor"], "elbow": r.actuator_efforts["elbow_motor"]}
+    for a in range(m.nu):
+        joint = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, m.actuator_trnid[a][0])
+        assert m.actuator_gear[a][0] == {"shoulder": 50.0, "elbow": -20.0}[joint]
+        d.ctrl[a] = ctrl[joint]
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(d.actuator_force, d.ctrl, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(d.qacc, 0, rtol=0, atol=1e-9)
+    check_urdf(out_u)
+    back = screwkin.load(out_u)
+    assert {t.joint: t.gear for t in back.transmissions()} == {"shoulder": 50.0, "elbow": -20.0}
+
+
+def test_reductions_in_dynamics_against_mujoco_inverse_dynamics(tmp_path, capsys):
+    """dynamics of the geared arm: at every step each motor's effort is MuJoCo's inverse dynamics on the
+    export (qfrc_inverse at the joint, for screwkin's q, rates and accelerations) / the motor's gear."""
+    path = geared_arm(tmp_path)
+    mech = screwkin.load(path)
+    res = dynamics(mech, "shoulder", 2.0, -0.6, 0.6, 5, inputs=["shoulder", "elbow"], fixed={"elbow": 0.4},
+                   gravity=(0, 0, -9.81))
+    out = tmp_path / "geared.xml"
+    assert main(["export", str(path), "--mjcf", str(out)]) == 0
+    capsys.readouterr()
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    for k in range(len(res.values)):
+        for name in ("shoulder", "elbow"):
+            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+            c = mech.coordinate(name)
+            d.qpos[m.jnt_qposadr[j]] = res.q[k][c.idx_q]
+            d.qvel[m.jnt_dofadr[j]] = res.rates[k][c.idx_v]
+            d.qacc[m.jnt_dofadr[j]] = res.accelerations[k][c.idx_v]
+        mujoco.mj_inverse(m, d)
+        for a in range(m.nu):
+            j = m.actuator_trnid[a][0]
+            actuator = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) + "_motor"
+            assert res.actuator_efforts[actuator][k] == pytest.approx(
+                d.qfrc_inverse[m.jnt_dofadr[j]] / m.actuator_gear[a][0], rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("old, new, warning", [
+    ("<mechanicalReduction>50<", "<mechanicalReduction>0<", "has a reduction of 0 (it would exert nothing): not read"),
+    ("<mechanicalReduction>50<", "<mechanicalReduction>x<", "is not 1 number"),
+    ("SimpleTransmission</type><joint name=\"shoulder\"", "DifferentialTransmission</type><joint name=\"shoulder\"",
+     "the reductions of 1 transmission of other types than SimpleTransmission (DifferentialTransmission: 't_shoulder') are not read"),
+    ("<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>",
+     "<offset>0.1</offset></joint>", "the joint <offset> is not read"),
+])
+def test_reductions_that_cannot_be_used_are_said(tmp_path, old, new, warning):
+    """A reduction of 0 or not a number, a reduction of another transmission type: a warning, the
+    joint driven one to one; a joint offset (the actuator's position only): a warning."""
+    path = geared_arm(tmp_path)
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+    seen = []
+    mech = screwkin.load(path, warn=seen.append)
+    gears = {"elbow": -20.0} if "offset" not in new else {"shoulder": 50.0, "elbow": -20.0}
+    assert {t.joint: t.gear for t in mech.transmissions()} == gears
+    assert mech.actuated == ["shoulder", "elbow"]
+    assert any(warning in w for w in seen), seen

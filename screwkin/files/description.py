@@ -207,16 +207,18 @@ class Transmission:
     combination of several independent coordinates: not an input here).  ``gear``: MuJoCo's gear or
     a ROS ``<mechanicalReduction>``: the actuator's effort is the input's generalized force / gear.
     So the actuator's effort is the joint's generalized force / (scale * gear), and the input's
-    value (scale * q + offset) [rad or m, or the tendon's units]."""
+    value (scale * q + offset) [rad or m, or the tendon's units].  ``word``: what the file calls
+    the gear ("gear" in MJCF, "mechanicalReduction" in URDF)."""
 
     name: str  # what the user calls the input: the tendon's or the (coupled) joint's name
-    actuator: str  # the actuator (MJCF) or <transmission> (URDF) element's name
+    actuator: str  # the actuator's name: MJCF's, or URDF's <actuator> (else its <transmission>'s)
     kind: str  # "joint", "coupled joint", "tendon"
     terms: tuple  # ((joint, coef), ...) as written
     joint: str | None  # the coordinate it moves
     scale: float = 1.0
     offset: float = 0.0
     gear: float = 1.0
+    word: str = "gear"
 
     @property
     def plain(self) -> bool:
@@ -231,7 +233,7 @@ class Transmission:
             out += f" = {self.scale:g} {self.joint}" + (f" {'+' if self.offset >= 0 else '-'} {abs(self.offset):g}"
                                                          if self.offset else "")
         what = {"tendon": "fixed tendon", "coupled joint": "coupled joint", "joint": "joint"}[self.kind]
-        out += f" ({what} of actuator {self.actuator!r}" + (f", gear {self.gear:g}" if self.gear != 1.0 else "") + ")"
+        out += f" ({what} of actuator {self.actuator!r}" + (f", {self.word} {self.gear:g}" if self.gear != 1.0 else "") + ")"
         return out
 
 

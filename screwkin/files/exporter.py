@@ -108,6 +108,7 @@ class PlacedMechanism:
     comment: str = ""
     length: float = 0.1  # [m] between a revolute cut's two connects
     notes: tuple = ()  # what the placing changed, one line each (said by the command)
+    gears: tuple = ()  # (input joint, gear) where the actuator's effort is the joint's / gear (not 1)
 
 
 def _se3(pos, quat):
@@ -308,7 +309,9 @@ def write_mjcf(pm: PlacedMechanism) -> str:
     if eq:
         out += ["  <equality>"] + [f"    {e}" for e in eq] + ["  </equality>"]
     if pm.actuated:
-        out += ["  <actuator>"] + [f"    <motor name={quoteattr(names['motor', a])} joint={quoteattr(a)}/>"
+        gears = dict(pm.gears)
+        out += ["  <actuator>"] + [f"    <motor name={quoteattr(names['motor', a])} joint={quoteattr(a)}"
+                                   + (f' gear="{number_text(gears[a])}"' if a in gears else "") + "/>"
                                    for a in pm.actuated] + ["  </actuator>"]
     out.append("</mujoco>")
     return "\n".join(x for x in out if x) + "\n"
@@ -359,10 +362,12 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         if c.axis2 is not None:
             text += f'<axis2 xyz="{vector_text(*c.axis2)}"/>'
         out.append(text + "</loop_joint>")
+    gears = dict(pm.gears)
     for name in pm.actuated:
         out.append(f"  <transmission name={quoteattr('t_' + name)}><type>transmission_interface/SimpleTransmission"
                    f"</type><joint name={quoteattr(name)}><hardwareInterface>hardware_interface/EffortJointInterface"
-                   "</hardwareInterface></joint></transmission>")
+                   f"</hardwareInterface></joint><actuator name={quoteattr(name + '_motor')}><mechanicalReduction>"
+                   f"{number_text(gears.get(name, 1.0))}</mechanicalReduction></actuator></transmission>")
     out.append("</robot>")
     return "\n".join(x for x in out if x) + "\n"
 

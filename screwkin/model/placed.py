@@ -113,8 +113,9 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     if empty:
         notes = (f"{len(empty)} joints with empty limits (lower = upper: {', '.join(quote(n, 30) for n in empty[:3])}"
                  f"{', ...' if len(empty) > 3 else ''}) are written unlimited, as screwkin moves them",)
+    gears = tuple((t.joint, t.scale * t.gear) for t in mech.transmissions() if t.scale * t.gear != 1.0)
     return PlacedMechanism(spec.name, tuple(bodies), tuple(cuts), tuple(couplings), tuple(mech.actuated), comment,
-                           length if length else mech.length, notes)
+                           length if length else mech.length, notes, gears)
 
 
 def check_closed(mech, q, tol: float) -> float:
