@@ -43,7 +43,7 @@ def run(mech, args) -> int:
     comment = (f"Written by screwkin export from {os.path.basename(mech.path)} at an assembled configuration "
                f"(loop residual {residual:.1e}): the file's zero configuration is that one, so each joint's value "
                "here is its value there minus: " + ", ".join(f"{k} {v:.9g}" for k, v in values.items()))
-    written, notes, texts = [], [], []
+    written, notes, texts, compounds = [], [], [], []
     if args.mjcf and args.urdf and os.path.realpath(args.mjcf) == os.path.realpath(args.urdf):
         raise UsageError(f"--mjcf and --urdf name the same file {quote(args.mjcf)}: give two files")
     for fmt, out in (("MJCF", args.mjcf), ("URDF", args.urdf)):  # both made before either is written
@@ -63,6 +63,10 @@ def run(mech, args) -> int:
                 elif c.type not in ("spherical", "fixed"):
                     notes.append(f"loop joint {quote(c.name)} ({c.type}): a body {quote(names['F1', c.name])} "
                                  "carrying its motion, welded to the second link (MJCF has no such equality)")
+            notes += _compound_notes(pm)
+            compounds += [{"type": c.type, "joint": c.name if c.type == "spherical" else None, "members": list(c.members),
+                           "links_left_out": list(c.links), "body": c.body, "axes": [list(a) for a in c.axes],
+                           "values": list(c.values)} for c in pm.compounds]
             light = [b.name for b in pm.bodies if b.joint is not None and b.joint.type != "fixed" and b.mass <= 0]
             light += [names["F1", c.name] for c in pm.cuts if ("F1", c.name) in names and c.type not in
                       ("spherical", "fixed", "revolute", "continuous")]
@@ -91,7 +95,7 @@ def run(mech, args) -> int:
 
     def data():
         return to_jsonable(with_mode(args, {"file": mech.path, "written": written, "configuration": values,
-                                            "residual": residual, "notes": notes}))
+                                            "residual": residual, "notes": notes, "compounds": compounds}))
 
     def text():
         lines = [f"wrote {w['path']} ({w['format']}): {w['bodies']} bodies, {w['loop_joints']} loop joints, at the "
@@ -103,3 +107,27 @@ def run(mech, args) -> int:
         return "\n".join(lines)
 
     return emit(args, data, text)
+
+
+def _names(names, n=3) -> str:
+    return ", ".join(quote(x, 30) for x in names[:n]) + (", ..." if len(names) > n else "")
+
+
+def _compound_notes(pm) -> list:
+    """One line per kind of compound joint the MJCF export wrote as one body's joints."""
+    out = []
+    balls = [c for c in pm.compounds if c.type == "spherical"]
+    if balls:
+        one = len(balls) == 1
+        out.append(f"{len(balls)} compound spherical joint{'' if one else 's'} (three concurrent revolutes through "
+                   f"massless links: {_names([c.name for c in balls])}) {'is' if one else 'are'} one ball joint "
+                   f"{'' if one else 'each, '}of that name, the massless links left out: a ball's quaternion Q = "
+                   "R(a1, d1) R(a2, d2) R(a3, d3) about its members' axes a (--json: compounds) gives the members' "
+                   "values, theirs here + d (screwkin.model.placed.ball_values)")
+    for kind, what in (("universal", "two hinges"), ("cylindrical", "a hinge and a slide")):
+        cs = [c for c in pm.compounds if c.type == kind]
+        if cs:
+            one = len(cs) == 1
+            out.append(f"{len(cs)} compound {kind} joint{'' if one else 's'} ({_names([c.name for c in cs])}) "
+                       f"{'is its' if one else 'are their'} {what} in one body, the massless links left out")
+    return out

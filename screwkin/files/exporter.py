@@ -22,6 +22,10 @@ MJCF has only point (``connect``) and frame (``weld``) equalities.  Cut joints b
 
 A planar loop keeps its out-of-plane rows (MuJoCo has no planar equality): they are
 redundant there, as in screwkin's own count.  Visual geometry is not written.
+
+A compound joint of the tree (model.placed: revolutes and prismatics through massless links) is
+one body's joints -- a ``ball``, or two joints in one body -- with the massless links left out
+(PlacedCompound says which, and how a ball's quaternion gives its members' values).
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ from .mjcf_inertia import inertia_problem
 from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 
-__all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
+__all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
            "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid", "helper_names",
            "joint_points", "mujoco_refuses"]
 
@@ -53,8 +57,9 @@ ROD_RATIO = 0.05
 
 @dataclass(frozen=True)
 class PlacedJoint:
-    """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (the
-    joint sits at the body's origin); range [rad or m] about the written configuration, None:
+    """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (at the
+    written configuration: a body's later joints turn with its earlier ones, as MuJoCo composes them);
+    range [rad or m] about the written configuration, None:
     unlimited; dynamics: its armature, damping and frictionloss that are not 0 (MJCF's names,
     description.JOINT_DYNAMICS), as ((name, value), ...)."""
 
@@ -63,6 +68,7 @@ class PlacedJoint:
     axis: tuple = (0.0, 0.0, 1.0)
     range: tuple | None = None
     dynamics: tuple = ()
+    pos: tuple = (0.0, 0.0, 0.0)  # where it sits in the body's frame (a compound joint's: off the origin)
 
 
 @dataclass(frozen=True)
@@ -78,6 +84,30 @@ class PlacedBody:
     mass: float = 0.0
     com: tuple = (0.0, 0.0, 0.0)
     inertia: tuple = (0.0,) * 6
+    more: tuple = ()  # PlacedJoint: the body's further joints, in order (a compound joint's: MJCF only)
+
+    @property
+    def joints(self) -> tuple:
+        return ((self.joint,) if self.joint is not None else ()) + self.more
+
+
+@dataclass(frozen=True)
+class PlacedCompound:
+    """A compound joint of the tree (revolutes and prismatics through massless links, recognized by
+    model.topology) written as one body's joints: a ``ball`` (spherical) or two joints in one body
+    (universal: two hinges; cylindrical: a hinge and a slide).  members: its URDF joints, parent to
+    child; links: the massless links between them (not written); body: the body that carries it;
+    axes: the members' axes in that body's frame at the written configuration, where the members
+    have ``values``: a ball's quaternion Q is R(axes[0], d0) R(axes[1], d1) R(axes[2], d2), the
+    members at values + d."""
+
+    type: str
+    name: str
+    members: tuple
+    links: tuple
+    body: str
+    axes: tuple
+    values: tuple
 
 
 @dataclass(frozen=True)
@@ -109,6 +139,7 @@ class PlacedMechanism:
     length: float = 0.1  # [m] between a revolute cut's two connects
     notes: tuple = ()  # what the placing changed, one line each (said by the command)
     gears: tuple = ()  # (input joint, gear) where the actuator's effort is the joint's / gear (not 1)
+    compounds: tuple = ()  # PlacedCompound: the tree's compound joints written as one body's joints
 
 
 def _se3(pos, quat):
@@ -192,7 +223,7 @@ def helper_names(pm) -> dict:
     """Names of what the MJCF writer adds, none equal to a name of the mechanism: (kind, cut or input)
     -> name, kind one of "F1" (a cut's body), "axis" (a revolute cut's second connect), "weld", "motor"
     and "aux" (a cut's joints, with its index)."""
-    joints = {b.name for b in pm.bodies} | {b.joint.name for b in pm.bodies if b.joint is not None}
+    joints = {b.name for b in pm.bodies} | {j.name for b in pm.bodies for j in b.joints}
     taken = joints | {c.name for c in pm.cuts} | {cp.joint for cp in pm.couplings}
     out = {}
 
@@ -223,7 +254,8 @@ def _mj_joint(j):
         return f"<freejoint name={quoteattr(j.name)}/>"
     rng = f' range="{vector_text(*j.range)}"' if j.range is not None else ""
     axis = "" if j.type in ("ball", "free") else f' axis="{vector_text(*j.axis)}"'
-    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{axis}{rng}{dyn}/>"
+    pos = f' pos="{vector_text(*j.pos)}"' if any(j.pos) else ""
+    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{pos}{axis}{rng}{dyn}/>"
 
 
 _AUX = {"prismatic": ("slide",), "cylindrical": ("hinge", "slide"), "universal": ("hinge", "hinge"),
@@ -270,7 +302,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         out.append(f'{pad}<body name={quoteattr(b.name)} pos="{vector_text(*b.pos)}" quat="{vector_text(*b.quat)}">')
         moving = b.joint is not None and b.joint.type != "fixed"
         if moving:
-            out.append(f"{pad}  {_mj_joint(b.joint)}")
+            out.extend(f"{pad}  {_mj_joint(j)}" for j in b.joints)
         inertial = _mj_inertial(b.mass, b.com, b.inertia, moving, points.get(b.name, ()), pm.length)
         if inertial:
             out.append(f"{pad}  {inertial}")
@@ -288,7 +320,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         if c.type == "spherical":
             eq.append(f"<connect name={quoteattr(c.name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
                       f'anchor="{vector_text(*c.pos1)}"/>')
-        elif c.type in ("revolute", "continuous"):
+        elif c.type in ("revolute", "continuous") and c.type not in _AUX:
             F1 = _se3(c.pos1, c.quat1)
             far = F1.act(pm.length * np.asarray(c.axis, float))
             for name, p in ((c.name, c.pos1), (names["axis", c.name], far)):
