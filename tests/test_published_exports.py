@@ -316,3 +316,55 @@ def test_ball_values_map_back_to_the_original_joints(tmp_path, capsys):
         M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
         np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
         np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
+
+
+def test_universal_and_cylindrical_pairs_move_as_the_original(tmp_path, capsys):
+    """A body carrying two joints (MuJoCo composes them in order, each about its axis as the earlier
+    ones leave it) moves as the original chain through its massless link: at random joint values of the
+    export (hinge and slide values + their written ones in the original), every body is where the
+    original's Pinocchio forward kinematics puts it -- the Stewart platform's universal joints, and an
+    arm whose cylindrical joint (a revolute and a prismatic on one line, through a massless link, drawn
+    off the base's axes) carries a link."""
+    import pinocchio as pin
+    arm = tmp_path / "cyl.urdf"
+    link = ('<link name="{n}"><inertial><origin xyz="0.05 0.01 0.1"/><mass value="1"/><inertia ixx="1e-3" iyy="1e-3" '
+            'izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial><visual><geometry><box size="0.1 0.1 0.1"/></geometry>'
+            '</visual></link>')
+    arm.write_text('<robot name="cyl">' + link.format(n="base") + '<link name="sleeve"/>' + link.format(n="rod")
+                   + link.format(n="hand") + '<joint name="turn" type="revolute"><parent link="base"/><child link="sleeve"/>'
+                   '<origin xyz="0.1 0.2 0.3" rpy="0.3 -0.2 0.5"/><axis xyz="0 0.6 0.8"/><limit lower="-2" upper="2" '
+                   'effort="1" velocity="1"/></joint><joint name="slide" type="prismatic"><parent link="sleeve"/>'
+                   '<child link="rod"/><origin xyz="0 0 0" rpy="0.1 0.2 0.3"/><axis xyz="0 0 1"/><limit lower="-0.1" '
+                   'upper="0.1" effort="1" velocity="1"/></joint><joint name="wrist" type="revolute"><parent link="rod"/>'
+                   '<child link="hand"/><origin xyz="0 0.1 0.2"/><axis xyz="1 0 0"/><limit lower="-2" upper="2" '
+                   'effort="1" velocity="1"/></joint></robot>')
+    # the prismatic axis in the sleeve's frame, turned by its origin's rpy, must lie on the revolute's line
+    R = pin.rpy.rpyToMatrix(0.1, 0.2, 0.3)
+    arm.write_text(arm.read_text().replace('<axis xyz="0 0 1"/>', '<axis xyz="{} {} {}"/>'.format(
+        *(R.T @ np.array([0, 0.6, 0.8])))))
+    rng = np.random.default_rng(3)
+    for src, kind in ((arm, "cylindrical"), (DATA.parent.parent / "robots" / "gough_stewart_6ups.urdf", "universal")):
+        out, report = _export_mjcf(tmp_path, capsys, src, src.stem + ".xml")
+        assert kind in [c["type"] for c in report["compounds"]]
+        original = screwkin.load(src, warn=lambda w: None)
+        m = mujoco.MjModel.from_xml_path(str(out))
+        d = mujoco.MjData(m)
+        for _ in range(3):
+            q = original.neutral()
+            for j in range(m.njnt):
+                if m.jnt_type[j] in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+                    name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+                    d.qpos[m.jnt_qposadr[j]] = rng.uniform(-0.5, 0.5) * (
+                        0.1 if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE else 1)
+                    q[original.coordinate(name).idx_q] = d.qpos[m.jnt_qposadr[j]] + report["configuration"][name]
+            mujoco.mj_kinematics(m, d)
+            if kind == "universal":  # the Stewart's tree ball joint stays at zero: its members at their values
+                for c in [c for c in report["compounds"] if c["type"] == "spherical"]:
+                    for member, value in zip(c["members"], c["values"]):
+                        q[original.coordinate(member).idx_q] = value
+            data = original.model.createData()
+            pin.framesForwardKinematics(original.model, data, q)
+            for b in range(1, m.nbody):
+                M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
+                np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
+                np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
