@@ -368,3 +368,52 @@ def test_universal_and_cylindrical_pairs_move_as_the_original(tmp_path, capsys):
                 M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
                 np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
                 np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
+
+
+# ------------------------------------------------------------------ the redundant equality rows, named
+def _equality_rank(path):
+    m = mujoco.MjModel.from_xml_path(str(path))
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT) | int(mujoco.mjtDisableBit.mjDSBL_LIMIT)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    J = d.efc_J[:d.nefc * m.nv].reshape(d.nefc, m.nv)[:d.ne]
+    return d.ne, (np.linalg.matrix_rank(J, tol=1e-9) if d.ne else 0)
+
+
+def test_planar_fourbar_redundant_rows_are_named(tmp_path, capsys):
+    """The four-bar, drawn in the xy plane with every axis along z, closed by two connects on the loop
+    joint's axis: no point of it moves along z, so the z rows of both connects do no work; and in a
+    planar motion two points of one body on a line along z move alike, so the second connect's x and
+    y rows repeat the first's.  4 of the 6 rows are redundant: MuJoCo's 6 - rank(efc_J) = 6 - 2."""
+    out, report = _export_mjcf(tmp_path, capsys, DATA.parent.parent / "robots" / "fourbar_crank_rocker.urdf")
+    rows = {r["equality"]: r for r in report["redundant_rows"]}
+    assert rows["coupler_rocker"]["idle"] == ["the force along z"] and rows["coupler_rocker"]["repeated"] == []
+    second = rows["coupler_rocker~axis"]
+    assert (second["idle"], second["repeated"], second["repeats"]) == (
+        ["the force along z"], ["the force along x", "the force along y"], ["connect 'coupler_rocker'"])
+    assert _equality_rank(out) == (6, 2)
+    assert any(n.startswith("4 of MuJoCo's 6 equality rows are redundant") and "connect 'coupler_rocker~axis': "
+               "the forces along x, y (repeating connect 'coupler_rocker'); the force along z (nothing moves along "
+               "it)" in n for n in report["notes"])
+
+
+@pytest.mark.parametrize("name", ["bennett.urdf", "sarrus.urdf", "planar_3rrr.urdf", "spherical_fourbar.urdf",
+                                  "gough_stewart_6ups.urdf", "tsai_3upu.urdf", "strider.urdf"])
+def test_redundant_rows_count_mujocos_left_null_space(tmp_path, capsys, name):
+    """However they are worded, the rows named redundant are as many as MuJoCo's left null space of its
+    equality rows holds, rows - rank(efc_J) at qpos0 (plus the rows MuJoCo writes none of, a zero
+    Jacobian: the spherical four-bar's connect at the sphere's centre, which no joint moves)."""
+    out, report = _export_mjcf(tmp_path, capsys, DATA.parent.parent / "robots" / name)
+    ne, rank = _equality_rank(out)
+    named = report["redundant_rows"]
+    assert sum(r["redundant"] for r in named if not r["dropped"]) == ne - rank
+    if name == "spherical_fourbar.urdf":
+        assert [r["equality"] for r in named if r["dropped"]] == ["coupler_rocker"]
+
+
+def test_without_mujoco_the_rows_are_not_named_and_it_is_said(tmp_path, capsys, monkeypatch):
+    import sys
+    monkeypatch.setitem(sys.modules, "mujoco", None)  # import mujoco raises ImportError
+    out, report = _export_mjcf(tmp_path, capsys, DATA.parent.parent / "robots" / "fourbar_crank_rocker.urdf")
+    assert report["redundant_rows"] is None
+    assert "the redundant equality rows are not named: MuJoCo is not installed (pip install mujoco)" in report["notes"]

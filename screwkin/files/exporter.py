@@ -14,7 +14,10 @@ MJCF has only point (``connect``) and frame (``weld``) equalities.  Cut joints b
   place in body1 and body2's turn from body1; files/mjcf_equality.py);
 - revolute, continuous: two ``connect``s, at F1 and one ``length`` further along the axis
   (MJCF has no hinge equality): 6 rows of rank 5 (one redundant, which MuJoCo's soft
-  constraints accept);
+  constraints accept; files/mjcf_rows names it).  The minimal form, a hinge on a small body
+  welded to link2 (6 rows, none redundant), was measured and drifts more: its small body's
+  unconstrained accelerations leak through MuJoCo's soft weld (1 s with 0.05 N m, the loop
+  joint's axes apart: Sarrus 2.6 rad against 5e-3, the spherical four-bar 3.5e-2 against 9e-4);
 - prismatic, cylindrical, universal, planar: a massless body on link1 at F1 carrying the
   joint's own motions (slide, hinge + slide, two hinges, two slides + hinge), named after
   the cut joint, welded to link2: the loop's rows exactly, with one more body and as many
