@@ -417,3 +417,25 @@ def test_without_mujoco_the_rows_are_not_named_and_it_is_said(tmp_path, capsys, 
     out, report = _export_mjcf(tmp_path, capsys, DATA.parent.parent / "robots" / "fourbar_crank_rocker.urdf")
     assert report["redundant_rows"] is None
     assert "the redundant equality rows are not named: MuJoCo is not installed (pip install mujoco)" in report["notes"]
+
+
+# ------------------------------------------------------------------ the physical-inertia check, any format's
+def test_inertia_problem_takes_any_descriptions_inertial():
+    """screwkin.files.mjcf_inertia.inertia_problem takes the tensor or the six numbers a URDF <inertia>
+    (or MJCF fullinertia) writes, with the same answer: principal moments 1, 1, 3 break A + B >= C
+    (1 + 1 < 3); a thin rod (0, 1, 1) is the limit and passes; a tensor with a negative moment, or a
+    negative mass, is named; MuJoCo refuses the first and accepts the rod's limit alike."""
+    from screwkin.files.mjcf_inertia import inertia_problem
+    bad = (1.0, 1.0, 3.0, 0.0, 0.0, 0.0)
+    assert "break the triangle inequality" in inertia_problem(2.0, bad)
+    assert inertia_problem(2.0, bad) == inertia_problem(2.0, np.diag([1.0, 1.0, 3.0]))
+    R = np.array([[0.0, -0.6, 0.8], [1.0, 0.0, 0.0], [0.0, 0.8, 0.6]])  # the same tensor in other axes
+    I = R @ np.diag([1.0, 1.0, 3.0]) @ R.T
+    assert "break the triangle inequality" in inertia_problem(2.0, (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))
+    assert inertia_problem(1.0, (1e-9, 1e-3, 1e-3, 0, 0, 0)) is None
+    assert "not positive" in inertia_problem(1.0, (1.0, 1.0, 1.0, 2.0, 0.0, 0.0))
+    assert "negative mass" in inertia_problem(-1.0, (1.0, 1.0, 1.0, 0.0, 0.0, 0.0))
+    body = '<mujoco><worldbody><body><joint/><inertial pos="0 0 0" mass="2" fullinertia="{}"/></body></worldbody></mujoco>'
+    with pytest.raises(ValueError):
+        mujoco.MjModel.from_xml_string(body.format("1 1 3 0 0 0"))
+    mujoco.MjModel.from_xml_string(body.format("1e-9 1e-3 1e-3 0 0 0"))

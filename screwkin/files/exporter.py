@@ -193,10 +193,9 @@ def mujoco_refuses(mass, inertia) -> bool:
     """Whether MuJoCo refuses this mass and inertia (ixx, iyy, izz, ixy, ixz, iyz) of a body with mass:
     principal moments not all positive, or breaking A + B >= C (a point mass, a URDF's zero inertia)."""
     xx, yy, zz, xy, xz, yz = inertia
-    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float)
-    moments = np.linalg.eigvalsh(I)
+    moments = np.linalg.eigvalsh(np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float))
     scale = max(float(moments[-1]), mass * TINY_MASS)  # a zero tensor: compared with a 1 mm body's
-    return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, I) is not None)
+    return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, inertia) is not None)
 
 
 def _mj_inertial(mass, com, inertia, moving, points=(), length=0.1):
