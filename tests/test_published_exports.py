@@ -12,6 +12,7 @@ import pytest
 
 import screwkin
 from conftest import DATA
+from test_published import simulate  # 1 s of mj_step with 0.05 N m on the motors: MuJoCo's warnings
 from screwkin.analysis.forces.dynamics import dynamics
 from screwkin.analysis.forces.statics import statics
 from screwkin.cli import main
@@ -27,14 +28,15 @@ def _dof(m, name, what):
     return float(getattr(m, "dof_" + what)[m.jnt_dofadr[j]])
 
 
-def simulate(path, seconds=1.0, effort=0.05):
-    """1 s of mj_step at the file's timestep with ``effort`` on every motor: MuJoCo's warnings."""
-    m = mujoco.MjModel.from_xml_path(str(path))
-    d = mujoco.MjData(m)
-    d.ctrl[:] = effort
-    for _ in range(int(round(seconds / m.opt.timestep))):
-        mujoco.mj_step(m, d)
-    return [mujoco.mjtWarning(k).name for k in range(len(d.warning)) if d.warning[k].number]
+def same_bodies(original, q, m, d):
+    """Every MuJoCo body of (m, d) where the original's Pinocchio forward kinematics at q puts its link."""
+    import pinocchio as pin
+    data = original.model.createData()
+    pin.framesForwardKinematics(original.model, data, q)
+    for b in range(1, m.nbody):
+        M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
+        np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
 
 
 def check_urdf(path):
@@ -309,13 +311,7 @@ def test_ball_values_map_back_to_the_original_joints(tmp_path, capsys):
         else:
             q[original.coordinate(name).idx_q] = d.qpos[adr] + report["configuration"][name]
     assert turned > 0.05  # the balls have turned
-    import pinocchio as pin
-    data = original.model.createData()
-    pin.framesForwardKinematics(original.model, data, q)
-    for b in range(1, m.nbody):
-        M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
-        np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
-        np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
+    same_bodies(original, q, m, d)
 
 
 def test_universal_and_cylindrical_pairs_move_as_the_original(tmp_path, capsys):
@@ -362,12 +358,7 @@ def test_universal_and_cylindrical_pairs_move_as_the_original(tmp_path, capsys):
                 for c in [c for c in report["compounds"] if c["type"] == "spherical"]:
                     for member, value in zip(c["members"], c["values"]):
                         q[original.coordinate(member).idx_q] = value
-            data = original.model.createData()
-            pin.framesForwardKinematics(original.model, data, q)
-            for b in range(1, m.nbody):
-                M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
-                np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
-                np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
+            same_bodies(original, q, m, d)
 
 
 # ------------------------------------------------------------------ the redundant equality rows, named
