@@ -16,9 +16,9 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MechanismFileError, quote
-from ..tolerances import DEFAULT
 from ..files.exporter import PlacedBody, PlacedCompound, PlacedCut, PlacedJoint, PlacedMechanism, coupling_about
 from ..files.mjcf import matrix_quat
+from ..tolerances import DEFAULT
 from .topology import build_topology, frame_link
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS", "ball_values", "davenport"]
@@ -60,7 +60,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     for j in spec.joints:
         if j.name in inner:  # written with the compound's last member
             continue
-        first = spec_joint(spec, last[j.name].members[0]) if j.name in last else j
+        first = _spec_joint(spec, last[j.name].members[0]) if j.name in last else j
         parent = None if first.parent == root else first.parent
         X = world[first.parent].inverse() * world[j.child] if parent is not None else world[j.child]
         t = rep.get(j.name) or j.type
@@ -115,6 +115,11 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     if coned:
         notes += (f"the members' ranges of {len(coned)} ball joints ({', '.join(quote(n, 30) for n in coned[:3])}"
                   f"{', ...' if len(coned) > 3 else ''}) are not written: a ball's range is a cone",)
+    mixed = [c.name for c in compounds if c.type == "spherical" and len({tuple(_spec_joint(spec, m).dynamics.items())
+                                                                        for m in c.members}) > 1]
+    if mixed:
+        notes += (f"the members of {len(mixed)} ball joints ({', '.join(quote(n, 30) for n in mixed[:3])}) have "
+                  "different armature, damping or friction loss: a ball has one of each, none is written",)
     if empty:
         notes += (f"{len(empty)} joints with empty limits (lower = upper: {', '.join(quote(n, 30) for n in empty[:3])}"
                   f"{', ...' if len(empty) > 3 else ''}) are written unlimited, as screwkin moves them",)
@@ -123,7 +128,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
                            length if length else mech.length, notes, gears, tuple(compounds))
 
 
-def spec_joint(spec, name):
+def _spec_joint(spec, name):
     return next(j for j in spec.joints if j.name == name)
 
 
@@ -203,7 +208,7 @@ def _compound_joints(mech, q, c, values, empty) -> list:
     data = mech.scratch_data()
     pin.framesForwardKinematics(mech.model, data, q)
     C = data.oMf[mech.link_frame(c.body)]
-    ms = [spec_joint(mech.spec, m) for m in c.members]
+    ms = [_spec_joint(mech.spec, m) for m in c.members]
     points = [C.actInv(data.oMi[mech.model.getJointId(m.name)].translation) for m in ms]
     if c.type == "spherical":
         for m in ms:
@@ -236,8 +241,9 @@ def davenport(R, axes) -> tuple:
     """(a, b, c) with R = R(n1, a) R(n2, b) R(n3, c) for unit axes n1, n2, n3 (n2 not parallel to
     either other), the solution nearest zero in b.  n1 . R n3 = n1 . R(n2, b) n3 = A cos b + B sin b + C
     with A = n1.n3 - (n1.n2)(n2.n3), B = n1.(n2 x n3), C = (n1.n2)(n2.n3) gives b; a turns R(n2, b) n3
-    onto R n3 about n1, c turns R^T n1 onto R(n2, b)^T n1 about n3 (Shuster and Markley's
-    generalization of Euler angles)."""
+    onto R n3 about n1; c is the turn about n3 that R(n2, b)^T R(n1, a)^T R leaves (Shuster and
+    Markley's generalization of Euler angles).  Axes that span space (a spherical compound's) make
+    A, B not both zero (B is their determinant)."""
     n1, n2, n3 = (a / np.linalg.norm(a) for a in axes)
     A = n1 @ n3 - (n1 @ n2) * (n2 @ n3)
     B = n1 @ np.cross(n2, n3)
