@@ -67,9 +67,9 @@ def run(mech, args) -> int:
             notes += _compound_notes(pm)
             line, redundant = _redundant_note(texts[-1][1])
             notes += [line] if line else []
-            compounds += [{"type": c.type, "joint": c.name if c.type == "spherical" else None, "members": list(c.members),
-                           "links_left_out": list(c.links), "body": c.body, "axes": [list(a) for a in c.axes],
-                           "values": list(c.values)} for c in pm.compounds]
+            compounds += [{"type": c.type, "joint": c.name if c.type == "spherical" else None,
+                           "members": list(c.members), "links_left_out": list(c.links), "body": c.body,
+                           "axes": [list(a) for a in c.axes], "values": list(c.values)} for c in pm.compounds]
             light = [b.name for b in pm.bodies if b.joint is not None and b.joint.type != "fixed" and b.mass <= 0]
             light += [names["F1", c.name] for c in pm.cuts if ("F1", c.name) in names and c.type not in
                       ("spherical", "fixed", "revolute", "continuous")]
@@ -150,5 +150,6 @@ def _redundant_note(text) -> tuple:
         return None, []
     n = sum(r.count for r in rows)
     shown = "; ".join(r.text() for r in rows[:6]) + ("; ... (--json: redundant_rows)" if len(rows) > 6 else "")
-    return (f"{n} of MuJoCo's {written} equality rows {'is' if n == 1 else 'are'} redundant at the written zero (the left "
-            f"null space of its efc_J there; rows taken in the file's order): {shown}", [r.as_dict() for r in rows])
+    return (f"{n} of MuJoCo's {written} equality rows {'is' if n == 1 else 'are'} redundant at the written zero "
+            f"(the left null space of its efc_J there; rows taken in the file's order): {shown}",
+            [r.as_dict() for r in rows])

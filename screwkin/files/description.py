@@ -233,7 +233,8 @@ class Transmission:
             out += f" = {self.scale:g} {self.joint}" + (f" {'+' if self.offset >= 0 else '-'} {abs(self.offset):g}"
                                                          if self.offset else "")
         what = {"tendon": "fixed tendon", "coupled joint": "coupled joint", "joint": "joint"}[self.kind]
-        out += f" ({what} of actuator {self.actuator!r}" + (f", {self.word} {self.gear:g}" if self.gear != 1.0 else "") + ")"
+        out += f" ({what} of actuator {self.actuator!r}" + (f", {self.word} {self.gear:g}" if self.gear != 1.0
+                                                             else "") + ")"
         return out
 
 

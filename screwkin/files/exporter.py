@@ -44,9 +44,9 @@ from .mjcf_inertia import inertia_problem
 from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 
-__all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
-           "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid", "helper_names",
-           "joint_points", "mujoco_refuses"]
+__all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf",
+           "write_placed_urdf", "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid",
+           "helper_names", "joint_points", "mujoco_refuses"]
 
 #: Mass [kg] (and inertia 1e-3 of it [kg m^2]) of the bodies of written URDF and of nothing else: kept
 #: for the callers that name it; MJCF's moving bodies without mass get DEFAULT_DENSITY solids instead.
@@ -61,10 +61,10 @@ ROD_RATIO = 0.05
 @dataclass(frozen=True)
 class PlacedJoint:
     """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (at the
-    written configuration: a body's later joints turn with its earlier ones, as MuJoCo composes them);
-    range [rad or m] about the written configuration, None:
-    unlimited; dynamics: its armature, damping and frictionloss that are not 0 (MJCF's names,
-    description.JOINT_DYNAMICS), as ((name, value), ...)."""
+    written configuration: a body's later joints turn with its earlier ones, as MuJoCo composes
+    them); range [rad or m] about the written configuration, None: unlimited; dynamics: its
+    armature, damping and frictionloss that are not 0 (MJCF's names, description.JOINT_DYNAMICS),
+    as ((name, value), ...)."""
 
     name: str
     type: str
@@ -322,7 +322,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         if c.type == "spherical":
             eq.append(f"<connect name={quoteattr(c.name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
                       f'anchor="{vector_text(*c.pos1)}"/>')
-        elif c.type in ("revolute", "continuous") and c.type not in _AUX:
+        elif c.type in ("revolute", "continuous"):
             F1 = _se3(c.pos1, c.quat1)
             far = F1.act(pm.length * np.asarray(c.axis, float))
             for name, p in ((c.name, c.pos1), (names["axis", c.name], far)):

@@ -16,8 +16,8 @@ autolimits inertiafromgeom inertiagrouprange>``, ``<default>`` classes (``childc
 ``euler``, ``xyaxes``, ``zaxis``), their joints (``hinge``, ``slide``, ``ball``, ``free``; ``pos``,
 ``axis``, ``range``, ``limited``, ``ref``: the joint's value where the file draws the body, so a joint's
 value is MuJoCo's qpos; ``armature``, ``damping``, ``frictionloss``: kept for exports), ``<inertial>``
-(checked as MuJoCo checks it) or, without one, the mass and inertia of the body's geoms as MuJoCo computes them (mjcf_inertia; meshes are not computed, and said),
-sites; ``<equality>`` (mjcf_equality); actuators and fixed tendons (mjcf_transmission).  Anything else
+(checked as MuJoCo checks it) or, without one, the mass and inertia of the body's geoms as MuJoCo
+computes them (mjcf_inertia; meshes are not computed, and said), sites; ``<equality>`` (mjcf_equality); actuators and fixed tendons (mjcf_transmission).  Anything else
 that shapes the kinematics is refused in one line; what is read and not used (``stiffness``,
 ``springref``, ``springdamper``: screwkin has no springs) is said once.
 """
