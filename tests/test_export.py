@@ -26,7 +26,26 @@ def _export(tmp_path, name, setting, capsys):
     out_x, out_u = tmp_path / "out.xml", tmp_path / "out.urdf"
     argv = ["export", str(ROBOTS / name), "--mjcf", str(out_x), "--urdf", str(out_u), "--json"]
     assert main(argv + (["--set", setting] if setting else [])) == 0
-    return out_x, out_u, json.loads(capsys.readouterr().out)["configuration"]
+    report = json.loads(capsys.readouterr().out)
+    return out_x, out_u, report["configuration"], report["compounds"]
+
+
+def _in_export(original, back, q, written_at, compounds):
+    """The original's configuration q in the coordinates of its MJCF export: a hinge or slide minus its
+    written value; a ball (a compound spherical joint) the quaternion R(a1, d1) R(a2, d2) R(a3, d3) of
+    its members' turns d from their written values, about their axes in the ball's body."""
+    qb = pin.neutral(back.model)
+    balls = {c["joint"]: c for c in compounds if c["type"] == "spherical"}
+    for c in back.coordinates:
+        if c.joint in balls:
+            b = balls[c.joint]
+            R = np.eye(3)
+            for member, axis, value in zip(b["members"], b["axes"], b["values"]):
+                R = R @ pin.exp3(np.asarray(axis) * (q[original.coordinate(member).idx_q] - value))
+            qb[c.idx_q:c.idx_q + 4] = pin.Quaternion(R).coeffs()  # (x, y, z, w)
+        else:
+            qb[c.idx_q] = q[original.coordinate(c.joint).idx_q] - written_at[c.joint]
+    return qb
 
 
 def _poses(mech, q, links):
@@ -42,14 +61,23 @@ def _solutions(mech, values):
 @pytest.mark.parametrize("name, inputs, setting", CASES)
 def test_round_trip(tmp_path, capsys, name, inputs, setting):
     original = screwkin.load(ROBOTS / name, warn=lambda w: None)
-    out_x, out_u, written_at = _export(tmp_path, name, setting, capsys)
-    links = list(original.spec.links)
+    out_x, out_u, written_at, compounds = _export(tmp_path, name, setting, capsys)
+    dummies = set(original.topology().dummy_links)  # inside compound joints: the MJCF leaves them out
+    links = [lk for lk in original.spec.links if lk not in dummies]
     shifted = {k: v - written_at[k] for k, v in inputs.items()}  # the written file's zero is written_at
-    expected = [_poses(original, q, links) for q in _solutions(original, inputs)]
+    modes = _solutions(original, inputs)
+    expected = [_poses(original, q, links) for q in modes]
     M = original.mobility().mobility
     for path in (out_x, out_u):
         back = screwkin.load(path, warn=lambda w: None)
         assert back.mobility().mobility == M
+        if path == out_x and compounds:  # ball joints (other coordinates): each mode of the original, in the
+            for q, e in zip(modes, expected):  # export's coordinates, closes its loops and places every link alike
+                qb = _in_export(original, back, q, written_at, compounds)
+                assert np.abs(back.closure.residual(qb)).max() < 1e-9  # the solver's closure tolerance
+                g = _poses(back, qb, links)
+                assert max(np.abs(e[lk] - g[lk]).max() for lk in links) < 1e-12  # the same forward kinematics
+            continue
         got = [_poses(back, q, links) for q in _solutions(back, shifted)]
         assert len(got) == len(expected) >= 1
         for e in expected:  # every assembly mode of the original is one of the file read back
@@ -84,7 +112,12 @@ def test_round_trip(tmp_path, capsys, name, inputs, setting):
     assert solutions and d.ne >= 3
     for q in solutions:
         for j in range(m.njnt):
-            d.qpos[m.jnt_qposadr[j]] = q[back.coordinate(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)).idx_q]
+            c = back.coordinate(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j))
+            if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_BALL:  # Pinocchio's (x, y, z, w), MuJoCo's (w, x, y, z)
+                x, y, z, w = q[c.idx_q:c.idx_q + 4]
+                d.qpos[m.jnt_qposadr[j]:m.jnt_qposadr[j] + 4] = (w, x, y, z)
+            else:
+                d.qpos[m.jnt_qposadr[j]] = q[c.idx_q]
         mujoco.mj_forward(m, d)
         np.testing.assert_allclose(d.efc_pos[:d.ne], 0, atol=1e-9)
         for lk in links:
@@ -95,7 +128,7 @@ def test_round_trip(tmp_path, capsys, name, inputs, setting):
 
 def test_the_loops_are_closed_in_the_mjcf_file(tmp_path, capsys):
     """MuJoCo takes a connect's point on body2 from qpos0: it must be the cut joint's F2."""
-    out_x, _, _ = _export(tmp_path, "slider_crank_offset.urdf", "crank_joint=40deg", capsys)
+    out_x, _, _, _ = _export(tmp_path, "slider_crank_offset.urdf", "crank_joint=40deg", capsys)
     m = mujoco.MjModel.from_xml_path(str(out_x))
     cut = screwkin.load(ROBOTS / "slider_crank_offset.urdf").spec.cut_joints[0]
     e = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, cut.name)
@@ -162,3 +195,5 @@ def test_mobility_survives_export(tmp_path, path):
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
     mujoco.mj_forward(m, d)
     assert m.nv - np.linalg.matrix_rank(d.efc_J.reshape(d.nefc, m.nv), tol=1e-9) == M
+    # the loops are closed in the file as MuJoCo's engine reads it (a weld's relpose: the anchor's place)
+    np.testing.assert_allclose(d.efc_pos[:d.ne], 0, rtol=0, atol=1e-12)

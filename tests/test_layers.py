@@ -15,8 +15,10 @@ LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "ana
 # distributed (0.4-0.9 s) and pyarrow (optional: parquet tables) only for studies
 # PIL (with matplotlib) and imageio_ffmpeg (optional) for draw --animate; viser and trimesh (optional) for view --interactive
 # yaml (7 ms) only for sidecars and study specs; defusedxml.expatbuilder (minidom) only for .xacro files
+# mujoco (optional) only for export --mjcf, to name the redundant rows of what it writes (files/mjcf_rows.py)
 LAZY = {"numba", "matplotlib", "meshcat", "coal", "scipy", "pinocchio.visualize", "networkx", "sympy", "xacro",
-        "distributed", "dask", "pyarrow", "PIL", "imageio_ffmpeg", "viser", "trimesh", "yaml", "defusedxml.expatbuilder"}
+        "distributed", "dask", "pyarrow", "PIL", "imageio_ffmpeg", "viser", "trimesh", "yaml", "defusedxml.expatbuilder",
+        "mujoco"}
 
 
 def module_name(path: Path) -> str:

@@ -236,3 +236,23 @@ def test_euler_sequences_as_mujoco(tmp_path, compiler):
     for name in ("a", "b"):
         b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
         np.testing.assert_allclose(mech.data.oMf[mech.link_frame(name)].rotation, d.xmat[b].reshape(3, 3), atol=1e-12)
+
+
+def test_weld_relpose_is_read_as_mujocos_engine_reads_it(tmp_path):
+    """A weld with both an anchor and a relpose: MuJoCo's engine holds body1's point relpose[:3] on
+    body2's anchor (engine_core_constraint.c), not body2's origin.  Here relpose is written where the
+    bodies are drawn: b at (0.3, 0.1) turned 90 deg about z, anchor (0.2, 0.05) on b is at
+    (0.3, 0.1) + (-0.05, 0.2) = (0.25, 0.3) in a; quaternion (cos 45, 0, 0, sin 45).  MuJoCo's residual
+    at qpos0 is zero, and so is screwkin's closure residual at the configuration the file draws."""
+    f = tmp_path / "weld.xml"
+    h = "0.7071067811865476"
+    f.write_text('<mujoco><worldbody><body name="a"><joint name="ja" axis="0 0 1"/><inertial pos="0.1 0 0" '
+                 'mass="1" diaginertia="1 1 1"/></body><body name="b" pos="0.3 0.1 0" euler="0 0 90"><joint '
+                 'name="jb" axis="0 0 1"/><inertial pos="0.1 0 0" mass="1" diaginertia="1 1 1"/></body></worldbody>'
+                 f'<equality><weld body1="a" body2="b" anchor="0.2 0.05 0" relpose="0.25 0.3 0 {h} 0 0 {h}"/>'
+                 '</equality></mujoco>')
+    m, d = _mj(f)
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(d.efc_pos[:d.ne], 0, rtol=0, atol=1e-12)
+    mech = screwkin.load(f, warn=lambda w: None)
+    np.testing.assert_allclose(mech.closure.residual(mech.neutral()), 0, rtol=0, atol=1e-12)

@@ -204,7 +204,7 @@ def test_mimic_dynamics_is_rnea_of_the_uncoupled_model(path):
 
 # ------------------------------------------------------------------ exports that simulate
 ROUND_TRIPS = [ROBOTS / n for n in ("fourbar_crank_rocker.urdf", "slider_crank_offset.urdf", "delta_parallelogram.urdf",
-                                    "gough_stewart_6ups.urdf", "bennett.urdf")] + [MJCF / n for n in sorted(PUBLISHED)]
+                                    "gough_stewart_6ups.urdf", "bennett.urdf", "tsai_3upu.urdf")] + [MJCF / n for n in sorted(PUBLISHED)]
 
 
 def simulate(path, seconds=1.0, effort=0.05):

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..errors import UsageError, quote
 from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, mujoco_refuses, write_mjcf, write_placed_urdf
+from ..files.mjcf_rows import redundant_rows
 from ..model.placed import check_closed, placed
 from ..present.report import to_jsonable
 from ._common import add_configuration_options, configuration, emit, with_mode
@@ -43,7 +44,7 @@ def run(mech, args) -> int:
     comment = (f"Written by screwkin export from {os.path.basename(mech.path)} at an assembled configuration "
                f"(loop residual {residual:.1e}): the file's zero configuration is that one, so each joint's value "
                "here is its value there minus: " + ", ".join(f"{k} {v:.9g}" for k, v in values.items()))
-    written, notes, texts = [], [], []
+    written, notes, texts, compounds, redundant = [], [], [], [], None
     if args.mjcf and args.urdf and os.path.realpath(args.mjcf) == os.path.realpath(args.urdf):
         raise UsageError(f"--mjcf and --urdf name the same file {quote(args.mjcf)}: give two files")
     for fmt, out in (("MJCF", args.mjcf), ("URDF", args.urdf)):  # both made before either is written
@@ -58,11 +59,17 @@ def run(mech, args) -> int:
                 if c.type in ("revolute", "continuous"):
                     notes.append(f"loop joint {quote(c.name)} (revolute): <connect>s {quote(c.name)} and "
                                  f"{quote(names['axis', c.name])} {pm.length:.3g} m apart on its axis (MJCF has no "
-                                 "hinge equality; one of their 6 rows is redundant; screwkin reads the pair back as "
-                                 "one revolute loop joint)")
+                                 "hinge equality; a hinge on a small body welded to the link drifts more in MuJoCo; "
+                                 "screwkin reads the pair back as one revolute loop joint)")
                 elif c.type not in ("spherical", "fixed"):
                     notes.append(f"loop joint {quote(c.name)} ({c.type}): a body {quote(names['F1', c.name])} "
                                  "carrying its motion, welded to the second link (MJCF has no such equality)")
+            notes += _compound_notes(pm)
+            line, redundant = _redundant_note(texts[-1][1])
+            notes += [line] if line else []
+            compounds += [{"type": c.type, "joint": c.name if c.type == "spherical" else None,
+                           "members": list(c.members), "links_left_out": list(c.links), "body": c.body,
+                           "axes": [list(a) for a in c.axes], "values": list(c.values)} for c in pm.compounds]
             light = [b.name for b in pm.bodies if b.joint is not None and b.joint.type != "fixed" and b.mass <= 0]
             light += [names["F1", c.name] for c in pm.cuts if ("F1", c.name) in names and c.type not in
                       ("spherical", "fixed", "revolute", "continuous")]
@@ -80,13 +87,19 @@ def run(mech, args) -> int:
                              "written with the inertia of the solid above, scaled to it")
         else:
             texts.append((out, write_placed_urdf(pm, mech.spec.root)))
+            rotors = [b.joint.name for b in pm.bodies if b.joint is not None and dict(b.joint.dynamics).get("armature")]
+            if rotors:
+                notes.append(f"the armature of {len(rotors)} joints ({', '.join(quote(n, 30) for n in rotors[:3])}"
+                             f"{', ...' if len(rotors) > 3 else ''}) has no URDF form: not written (damping and "
+                             "frictionloss are, as <dynamics damping friction>)")
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})
     for out, text in texts:
         _write(out, text)
 
     def data():
         return to_jsonable(with_mode(args, {"file": mech.path, "written": written, "configuration": values,
-                                            "residual": residual, "notes": notes}))
+                                            "residual": residual, "notes": notes, "compounds": compounds,
+                                            "redundant_rows": redundant}))
 
     def text():
         lines = [f"wrote {w['path']} ({w['format']}): {w['bodies']} bodies, {w['loop_joints']} loop joints, at the "
@@ -98,3 +111,45 @@ def run(mech, args) -> int:
         return "\n".join(lines)
 
     return emit(args, data, text)
+
+
+def _names(names, n=3) -> str:
+    return ", ".join(quote(x, 30) for x in names[:n]) + (", ..." if len(names) > n else "")
+
+
+def _compound_notes(pm) -> list:
+    """One line per kind of compound joint the MJCF export wrote as one body's joints."""
+    out = []
+    balls = [c for c in pm.compounds if c.type == "spherical"]
+    if balls:
+        one = len(balls) == 1
+        out.append(f"{len(balls)} compound spherical joint{'' if one else 's'} (three concurrent revolutes through "
+                   f"massless links: {_names([c.name for c in balls])}) {'is' if one else 'are'} one ball joint "
+                   f"{'' if one else 'each, '}of that name, the massless links left out: a ball's quaternion Q = "
+                   "R(a1, d1) R(a2, d2) R(a3, d3) about its members' axes a (--json: compounds) gives the members' "
+                   "values, theirs here + d (screwkin.model.placed.ball_values)")
+    for kind, what in (("universal", "two hinges"), ("cylindrical", "a hinge and a slide")):
+        cs = [c for c in pm.compounds if c.type == kind]
+        if cs:
+            one = len(cs) == 1
+            out.append(f"{len(cs)} compound {kind} joint{'' if one else 's'} ({_names([c.name for c in cs])}) "
+                       f"{'is its' if one else 'are their'} {what} in one body, the massless links left out")
+    return out
+
+
+def _redundant_note(text) -> tuple:
+    """(one note naming the redundant equality rows of the MJCF ``text`` from MuJoCo's efc_J at qpos0, or
+    saying why they are not named; the RedundantRows as JSON, None without MuJoCo)."""
+    try:
+        written, rows = redundant_rows(text)
+    except ImportError:
+        return "the redundant equality rows are not named: MuJoCo is not installed (pip install mujoco)", None
+    except Exception as exc:  # noqa: BLE001 - MuJoCo refusing the text is a bug of the writer: said, not hidden
+        return f"the redundant equality rows are not named: MuJoCo refuses the written file ({exc})", None
+    if not rows:
+        return None, []
+    n = sum(r.count for r in rows)
+    shown = "; ".join(r.text() for r in rows[:6]) + ("; ... (--json: redundant_rows)" if len(rows) > 6 else "")
+    return (f"{n} of MuJoCo's {written} equality rows {'is' if n == 1 else 'are'} redundant at the written zero "
+            f"(the left null space of its efc_J there; rows taken in the file's order): {shown}",
+            [r.as_dict() for r in rows])

@@ -17,6 +17,7 @@ import pinocchio as pin
 __all__ = [
     "TREE_JOINT_DOF",
     "CUT_JOINT_DOF",
+    "JOINT_DYNAMICS",
     "LinkSpec",
     "TargetSpec",
     "TARGETS_NS",
@@ -42,6 +43,9 @@ TREE_JOINT_DOF = {
     "floating": 6,
     "planar": 3,
 }
+
+#: A joint's own dynamics kept from the file and written back (JointSpec): MJCF's names.
+JOINT_DYNAMICS = ("armature", "damping", "frictionloss")
 
 #: Degrees of freedom of the cut (loop) joint types of mechanism-format.md.
 CUT_JOINT_DOF = {
@@ -164,10 +168,21 @@ class JointSpec:
     rpy: tuple = (0.0, 0.0, 0.0)
     axis: tuple = (1.0, 0.0, 0.0)
     mimic: tuple | None = None  # (joint, multiplier, offset) of a URDF <mimic>, as written
+    # the joint's own dynamics, as the file writes them (0: none), per degree of freedom: MJCF armature
+    # (a rotor's reflected inertia [kg m^2 or kg]), damping [N m s/rad or N s/m] and frictionloss
+    # [N m or N]; URDF <dynamics damping friction> (friction is MuJoCo's frictionloss, as its URDF reader has it)
+    armature: float = 0.0
+    damping: float = 0.0
+    frictionloss: float = 0.0
 
     @property
     def dof(self) -> int:
         return TREE_JOINT_DOF[self.type]
+
+    @property
+    def dynamics(self) -> dict:
+        """The joint's armature, damping and frictionloss that are not 0 (name -> value)."""
+        return {k: getattr(self, k) for k in JOINT_DYNAMICS if getattr(self, k)}
 
 
 @dataclass(frozen=True)
@@ -192,16 +207,18 @@ class Transmission:
     combination of several independent coordinates: not an input here).  ``gear``: MuJoCo's gear or
     a ROS ``<mechanicalReduction>``: the actuator's effort is the input's generalized force / gear.
     So the actuator's effort is the joint's generalized force / (scale * gear), and the input's
-    value (scale * q + offset) [rad or m, or the tendon's units]."""
+    value (scale * q + offset) [rad or m, or the tendon's units].  ``word``: what the file calls
+    the gear ("gear" in MJCF, "mechanicalReduction" in URDF)."""
 
     name: str  # what the user calls the input: the tendon's or the (coupled) joint's name
-    actuator: str  # the actuator (MJCF) or <transmission> (URDF) element's name
+    actuator: str  # the actuator's name: MJCF's, or URDF's <actuator> (else its <transmission>'s)
     kind: str  # "joint", "coupled joint", "tendon"
     terms: tuple  # ((joint, coef), ...) as written
     joint: str | None  # the coordinate it moves
     scale: float = 1.0
     offset: float = 0.0
     gear: float = 1.0
+    word: str = "gear"
 
     @property
     def plain(self) -> bool:
@@ -216,7 +233,8 @@ class Transmission:
             out += f" = {self.scale:g} {self.joint}" + (f" {'+' if self.offset >= 0 else '-'} {abs(self.offset):g}"
                                                          if self.offset else "")
         what = {"tendon": "fixed tendon", "coupled joint": "coupled joint", "joint": "joint"}[self.kind]
-        out += f" ({what} of actuator {self.actuator!r}" + (f", gear {self.gear:g}" if self.gear != 1.0 else "") + ")"
+        out += f" ({what} of actuator {self.actuator!r}" + (f", {self.word} {self.gear:g}" if self.gear != 1.0
+                                                             else "") + ")"
         return out
 
 

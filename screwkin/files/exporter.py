@@ -10,10 +10,14 @@ hold where they should.
 MJCF has only point (``connect``) and frame (``weld``) equalities.  Cut joints become:
 
 - spherical: a ``connect`` at F1;
-- fixed: a ``weld`` with ``relpose`` (body2's pose in body1) written out;
+- fixed: a ``weld`` at F2 with ``relpose`` written out (as MuJoCo's engine reads it: the anchor's
+  place in body1 and body2's turn from body1; files/mjcf_equality.py);
 - revolute, continuous: two ``connect``s, at F1 and one ``length`` further along the axis
   (MJCF has no hinge equality): 6 rows of rank 5 (one redundant, which MuJoCo's soft
-  constraints accept);
+  constraints accept; files/mjcf_rows names it).  The minimal form, a hinge on a small body
+  welded to link2 (6 rows, none redundant), was measured and drifts more: its small body's
+  unconstrained accelerations leak through MuJoCo's soft weld (1 s with 0.05 N m, the loop
+  joint's axes apart: Sarrus 2.6 rad against 5e-3, the spherical four-bar 3.5e-2 against 9e-4);
 - prismatic, cylindrical, universal, planar: a massless body on link1 at F1 carrying the
   joint's own motions (slide, hinge + slide, two hinges, two slides + hinge), named after
   the cut joint, welded to link2: the loop's rows exactly, with one more body and as many
@@ -21,6 +25,10 @@ MJCF has only point (``connect``) and frame (``weld``) equalities.  Cut joints b
 
 A planar loop keeps its out-of-plane rows (MuJoCo has no planar equality): they are
 redundant there, as in screwkin's own count.  Visual geometry is not written.
+
+A compound joint of the tree (model.placed: revolutes and prismatics through massless links) is
+one body's joints -- a ``ball``, or two joints in one body -- with the massless links left out
+(PlacedCompound says which, and how a ball's quaternion gives its members' values).
 """
 
 from __future__ import annotations
@@ -36,9 +44,9 @@ from .mjcf_inertia import inertia_problem
 from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 
-__all__ = ["PlacedJoint", "PlacedBody", "PlacedCut", "PlacedMechanism", "write_mjcf", "write_placed_urdf",
-           "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid", "helper_names",
-           "joint_points", "mujoco_refuses"]
+__all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf",
+           "write_placed_urdf", "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid",
+           "helper_names", "joint_points", "mujoco_refuses"]
 
 #: Mass [kg] (and inertia 1e-3 of it [kg m^2]) of the bodies of written URDF and of nothing else: kept
 #: for the callers that name it; MJCF's moving bodies without mass get DEFAULT_DENSITY solids instead.
@@ -52,14 +60,18 @@ ROD_RATIO = 0.05
 
 @dataclass(frozen=True)
 class PlacedJoint:
-    """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (the
-    joint sits at the body's origin); range [rad or m] about the written configuration, None:
-    unlimited."""
+    """A body's joint. type: hinge, slide, ball, free or fixed; axis in the body's frame (at the
+    written configuration: a body's later joints turn with its earlier ones, as MuJoCo composes
+    them); range [rad or m] about the written configuration, None: unlimited; dynamics: its
+    armature, damping and frictionloss that are not 0 (MJCF's names, description.JOINT_DYNAMICS),
+    as ((name, value), ...)."""
 
     name: str
     type: str
     axis: tuple = (0.0, 0.0, 1.0)
     range: tuple | None = None
+    dynamics: tuple = ()
+    pos: tuple = (0.0, 0.0, 0.0)  # where it sits in the body's frame (a compound joint's: off the origin)
 
 
 @dataclass(frozen=True)
@@ -75,6 +87,30 @@ class PlacedBody:
     mass: float = 0.0
     com: tuple = (0.0, 0.0, 0.0)
     inertia: tuple = (0.0,) * 6
+    more: tuple = ()  # PlacedJoint: the body's further joints, in order (a compound joint's: MJCF only)
+
+    @property
+    def joints(self) -> tuple:
+        return ((self.joint,) if self.joint is not None else ()) + self.more
+
+
+@dataclass(frozen=True)
+class PlacedCompound:
+    """A compound joint of the tree (revolutes and prismatics through massless links, recognized by
+    model.topology) written as one body's joints: a ``ball`` (spherical) or two joints in one body
+    (universal: two hinges; cylindrical: a hinge and a slide).  members: its URDF joints, parent to
+    child; links: the massless links between them (not written); body: the body that carries it;
+    axes: the members' axes in that body's frame at the written configuration, where the members
+    have ``values``: a ball's quaternion Q is R(axes[0], d0) R(axes[1], d1) R(axes[2], d2), the
+    members at values + d."""
+
+    type: str
+    name: str
+    members: tuple
+    links: tuple
+    body: str
+    axes: tuple
+    values: tuple
 
 
 @dataclass(frozen=True)
@@ -105,6 +141,8 @@ class PlacedMechanism:
     comment: str = ""
     length: float = 0.1  # [m] between a revolute cut's two connects
     notes: tuple = ()  # what the placing changed, one line each (said by the command)
+    gears: tuple = ()  # (input joint, gear) where the actuator's effort is the joint's / gear (not 1)
+    compounds: tuple = ()  # PlacedCompound: the tree's compound joints written as one body's joints
 
 
 def _se3(pos, quat):
@@ -155,10 +193,9 @@ def mujoco_refuses(mass, inertia) -> bool:
     """Whether MuJoCo refuses this mass and inertia (ixx, iyy, izz, ixy, ixz, iyz) of a body with mass:
     principal moments not all positive, or breaking A + B >= C (a point mass, a URDF's zero inertia)."""
     xx, yy, zz, xy, xz, yz = inertia
-    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float)
-    moments = np.linalg.eigvalsh(I)
+    moments = np.linalg.eigvalsh(np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]], float))
     scale = max(float(moments[-1]), mass * TINY_MASS)  # a zero tensor: compared with a 1 mm body's
-    return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, I) is not None)
+    return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, inertia) is not None)
 
 
 def _mj_inertial(mass, com, inertia, moving, points=(), length=0.1):
@@ -188,7 +225,7 @@ def helper_names(pm) -> dict:
     """Names of what the MJCF writer adds, none equal to a name of the mechanism: (kind, cut or input)
     -> name, kind one of "F1" (a cut's body), "axis" (a revolute cut's second connect), "weld", "motor"
     and "aux" (a cut's joints, with its index)."""
-    joints = {b.name for b in pm.bodies} | {b.joint.name for b in pm.bodies if b.joint is not None}
+    joints = {b.name for b in pm.bodies} | {j.name for b in pm.bodies for j in b.joints}
     taken = joints | {c.name for c in pm.cuts} | {cp.joint for cp in pm.couplings}
     out = {}
 
@@ -214,11 +251,13 @@ def helper_names(pm) -> dict:
 
 
 def _mj_joint(j):
-    if j.type == "free":
+    dyn = "".join(f' {k}="{number_text(v)}"' for k, v in j.dynamics)
+    if j.type == "free" and not dyn:
         return f"<freejoint name={quoteattr(j.name)}/>"
     rng = f' range="{vector_text(*j.range)}"' if j.range is not None else ""
-    axis = "" if j.type == "ball" else f' axis="{vector_text(*j.axis)}"'
-    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{axis}{rng}/>"
+    axis = "" if j.type in ("ball", "free") else f' axis="{vector_text(*j.axis)}"'
+    pos = f' pos="{vector_text(*j.pos)}"' if any(j.pos) else ""
+    return f"<joint name={quoteattr(j.name)} type=\"{j.type}\"{pos}{axis}{rng}{dyn}/>"
 
 
 _AUX = {"prismatic": ("slide",), "cylindrical": ("hinge", "slide"), "universal": ("hinge", "hinge"),
@@ -265,7 +304,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         out.append(f'{pad}<body name={quoteattr(b.name)} pos="{vector_text(*b.pos)}" quat="{vector_text(*b.quat)}">')
         moving = b.joint is not None and b.joint.type != "fixed"
         if moving:
-            out.append(f"{pad}  {_mj_joint(b.joint)}")
+            out.extend(f"{pad}  {_mj_joint(j)}" for j in b.joints)
         inertial = _mj_inertial(b.mass, b.com, b.inertia, moving, points.get(b.name, ()), pm.length)
         if inertial:
             out.append(f"{pad}  {inertial}")
@@ -292,18 +331,21 @@ def write_mjcf(pm: PlacedMechanism) -> str:
         else:  # fixed: body2 in body1; an aux body: body2 in the aux body, which is at F1 at qpos0
             F1 = pin.SE3.Identity() if c.type in _AUX else _se3(c.pos1, c.quat1)
             F2 = _se3(c.pos2, c.quat2)
-            rel = F1 * _se3(*c.rel) * F2.inverse()
+            at = F1 * _se3(*c.rel)  # F2 in body1 at qpos0: relpose is the anchor's place there, and body2's turn
+            rel = at * F2.inverse()
             body1 = names["F1", c.name] if c.type in _AUX else c.body1
             eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else names['weld', c.name])} "
                       f"body1={quoteattr(body1)} body2={quoteattr(c.body2)} anchor=\"{vector_text(*c.pos2)}\" "
-                      f'relpose="{vector_text(*rel.translation, *_quat(rel))}"/>')
+                      f'relpose="{vector_text(*at.translation, *_quat(rel))}"/>')
     for cp in pm.couplings:
         eq.append(f"<joint joint1={quoteattr(cp.joint)} joint2={quoteattr(cp.mimics)} "
                   f'polycoef="{vector_text(cp.offset, cp.multiplier, 0, 0, 0)}"/>')
     if eq:
         out += ["  <equality>"] + [f"    {e}" for e in eq] + ["  </equality>"]
     if pm.actuated:
-        out += ["  <actuator>"] + [f"    <motor name={quoteattr(names['motor', a])} joint={quoteattr(a)}/>"
+        gears = dict(pm.gears)
+        out += ["  <actuator>"] + [f"    <motor name={quoteattr(names['motor', a])} joint={quoteattr(a)}"
+                                   + (f' gear="{number_text(gears[a])}"' if a in gears else "") + "/>"
                                    for a in pm.actuated] + ["  </actuator>"]
     out.append("</mujoco>")
     return "\n".join(x for x in out if x) + "\n"
@@ -336,6 +378,10 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         if t in ("revolute", "continuous", "prismatic"):
             lo, hi = j.range if j.range is not None else (-1e9, 1e9)
             text += f'<axis xyz="{vector_text(*j.axis)}"/><limit lower="{number_text(lo)}" upper="{number_text(hi)}" effort="0" velocity="0"/>'
+        urdf_dyn = {"damping": "damping", "frictionloss": "friction"}  # armature has no URDF form
+        dyn = " ".join(f'{urdf_dyn[k]}="{number_text(v)}"' for k, v in j.dynamics if k in urdf_dyn)
+        if dyn and t != "fixed":
+            text += f"<dynamics {dyn}/>"
         if j.name in coupled:
             cp = coupled[j.name]
             text += f'<mimic joint={quoteattr(cp.mimics)} multiplier="{number_text(cp.multiplier)}" offset="{number_text(cp.offset)}"/>'
@@ -350,10 +396,12 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         if c.axis2 is not None:
             text += f'<axis2 xyz="{vector_text(*c.axis2)}"/>'
         out.append(text + "</loop_joint>")
+    gears = dict(pm.gears)
     for name in pm.actuated:
         out.append(f"  <transmission name={quoteattr('t_' + name)}><type>transmission_interface/SimpleTransmission"
                    f"</type><joint name={quoteattr(name)}><hardwareInterface>hardware_interface/EffortJointInterface"
-                   "</hardwareInterface></joint></transmission>")
+                   f"</hardwareInterface></joint><actuator name={quoteattr(name + '_motor')}><mechanicalReduction>"
+                   f"{number_text(gears.get(name, 1.0))}</mechanicalReduction></actuator></transmission>")
     out.append("</robot>")
     return "\n".join(x for x in out if x) + "\n"
 

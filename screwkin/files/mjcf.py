@@ -15,11 +15,11 @@ autolimits inertiafromgeom inertiagrouprange>``, ``<default>`` classes (``childc
 ``<worldbody>``'s bodies and ``<frame>``s with ``pos`` and one orientation (``quat``, ``axisangle``,
 ``euler``, ``xyaxes``, ``zaxis``), their joints (``hinge``, ``slide``, ``ball``, ``free``; ``pos``,
 ``axis``, ``range``, ``limited``, ``ref``: the joint's value where the file draws the body, so a joint's
-value is MuJoCo's qpos), ``<inertial>`` (checked as MuJoCo checks it) or, without one, the mass and
-inertia of the body's geoms as MuJoCo computes them (mjcf_inertia; meshes are not computed, and said),
-sites; ``<equality>`` (mjcf_equality); actuators and fixed tendons (mjcf_transmission).  Anything else
-that shapes the kinematics is refused in one line; what is read and not used (``springref``: screwkin
-has no springs) is said once.
+value is MuJoCo's qpos; ``armature``, ``damping``, ``frictionloss``: kept for exports), ``<inertial>``
+(checked as MuJoCo checks it) or, without one, the mass and inertia of the body's geoms as MuJoCo
+computes them (mjcf_inertia; meshes are not computed, and said), sites; ``<equality>`` (mjcf_equality); actuators and fixed tendons (mjcf_transmission).  Anything else
+that shapes the kinematics is refused in one line; what is read and not used (``stiffness``,
+``springref``, ``springdamper``: screwkin has no springs) is said once.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
-from .description import LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
+from .description import JOINT_DYNAMICS, LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
 from .mjcf_equality import matrix_quat, quat_matrix, read_equalities
 from .mjcf_include import expand_includes
 from .mjcf_inertia import DEFAULT_DENSITY, SOLIDS, body_inertia, geom_inertia, geom_volume, inertia_problem
@@ -223,7 +223,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
     reference = {}  # joint -> ref (its value at qpos0), when not 0
     unnamed = [0]
     out_links = []
-    unread = {"springref": [], "mesh": []}
+    unread = {"springref": [], "mesh": [], "extra numbers": []}
 
     def site(elem, body, cls, T):
         a = r.attrs(elem, cls)
@@ -315,8 +315,14 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 ref = r.angle(ref) if jt == "hinge" else ref
                 if ref:
                     reference[jn] = ref
-                if a.get("springref") not in (None, "0"):
-                    unread["springref"].append(jn)
+            dyn = {}
+            for key in JOINT_DYNAMICS:  # MuJoCo takes the first number (it may be written as several)
+                raw = (a.get(key) or "0").split()
+                dyn[key] = float(numbers(raw[0] if raw else "0", 1, f"{jw} {key}", p, (0.0,), 1e9, "")[0])
+                if len(raw) > 1:
+                    unread["extra numbers"].append(f"{jn} {key}")
+            if any(a.get(k) not in (None, "0", "0 0") for k in ("stiffness", "springref", "springdamper")):
+                unread["springref"].append(jn)
             mjoints[jn] = (jt, name)
             origin = X * pin.SE3(np.eye(3), pos) if prev_pos is None else pin.SE3(np.eye(3), pos - prev_pos)
             if ref:  # the body as written is the joint at ref: its zero is -ref from there
@@ -353,7 +359,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
             out.append(f'<joint name={quoteattr(jn)} type="{utype}"><parent link={quoteattr(prev)}/>'
                        f'<child link={quoteattr(child)}/>{_origin(origin)}<axis xyz="{_fmt(axis)}"/>{limit}</joint>')
             joints.append(JointSpec(jn, utype, prev, child, tuple(origin.translation),
-                                    tuple(pin.rpy.matrixToRpy(origin.rotation)), axis))
+                                    tuple(pin.rpy.matrixToRpy(origin.rotation)), axis, **dyn))
             prev, prev_pos = child, pos
         if prev != name:  # no joint (welded to the parent), or the body's frame is off the last joint's anchor
             jn = f"{name}__fixed"
@@ -384,8 +390,13 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                           "does not (their mass here is their other geoms')")
     if unread["springref"]:
         n = unread["springref"]
-        r.warnings.append(f"springref of {len(n)} joint{'s' if len(n) > 1 else ''} ({', '.join(quote(x, 30) for x in n[:3])}"
-                          f"{', ...' if len(n) > 3 else ''}) is not read: screwkin has no joint springs")
+        r.warnings.append(f"the springs (stiffness, springref, springdamper) of {len(n)} joint{'s' if len(n) > 1 else ''} "
+                          f"({', '.join(quote(x, 30) for x in n[:3])}{', ...' if len(n) > 3 else ''}) are not read: "
+                          "screwkin has no joint springs (nor do its exports)")
+    if unread["extra numbers"]:
+        n = unread["extra numbers"]
+        r.warnings.append(f"{len(n)} joint attributes ({', '.join(quote(x, 40) for x in n[:3])}{', ...' if len(n) > 3 else ''})"
+                          " give several numbers: the first is read, as MuJoCo reads it")
     name = root.get("model") or "mjcf_model"
     urdf = "\n".join([f"<robot name={quoteattr(name)}>", '<link name="world"/>', *out_links, *out, "</robot>"])
     return MechanismSpec(path=str(path), name=name, format="mjcf", urdf_text=urdf, links=links, joints=joints,

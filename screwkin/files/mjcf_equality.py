@@ -4,7 +4,11 @@
 - two ``connect``s between the same two bodies at different points: one revolute cut joint about
   the line through them (what the two hold together: MuJoCo's 6 rows have rank 5), so a planar
   loop closed that way stays planar (screwkin export writes a revolute loop joint so);
-- ``weld``: a fixed cut joint;
+- ``weld``: a fixed cut joint: F2 at ``anchor`` on body2, F1 on body1 where ``relpose`` puts it.
+  MuJoCo's engine (engine_core_constraint.c) holds body1's point ``relpose[:3]`` on body2's anchor
+  and turns body2 by ``relpose[3:]`` from body1: so ``relpose``'s position is the anchor's place
+  in body1, which is body2's origin (as MuJoCo's documentation words it) only for a zero anchor.
+  Without ``relpose`` (a zero quaternion) F1 is where F2 is at qpos0, as MuJoCo's compiler makes it;
 - ``joint``: a coupling joint1 = a0 + a1 joint2 of MuJoCo's values (MuJoCo's polynomial is in the
   displacements from qpos0, y - y0 = a0 + a1 (x - x0), so the offset takes the joints' ``ref``);
   a nonlinear polynomial is refused with the reason.
@@ -100,11 +104,10 @@ def read_equalities(r, world, sites, mjoints, reference, taken):
                 anchor = r.vec(a.get("anchor"), 3, f"{what} anchor", (0, 0, 0))
                 F2 = pin.SE3(np.eye(3), anchor)
                 rel = r.vec(a.get("relpose"), 7, f"{what} relpose", (0, 1, 0, 0, 0, 0, 0))
-                if np.any(rel[3:]):  # body2's pose in body1
-                    X12 = pin.SE3(quat_matrix(rel[3:]), rel[:3])
+                if np.any(rel[3:]):  # as MuJoCo's engine reads it: the anchor's place on body1, body2's turn
+                    F1 = pin.SE3(quat_matrix(rel[3:]), rel[:3])
                 else:  # as at qpos0
-                    X12 = world[b1].inverse() * world[b2]
-                F1 = X12 * F2
+                    F1 = world[b1].inverse() * world[b2] * F2
             cuts.append(CutJointSpec(name, "fixed", b1, b2, tuple(F1.translation), _rpy(F1),
                                      tuple(F2.translation), _rpy(F2), source="mjcf"))
     cuts += _connect_cuts(r, connects, world)

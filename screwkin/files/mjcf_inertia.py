@@ -1,4 +1,5 @@
-"""Mass and inertia of MJCF bodies as MuJoCo's compiler computes them, and the checks it makes.
+"""Mass and inertia of MJCF bodies as MuJoCo's compiler computes them, and the physical-inertia
+check of any format's inertial (inertia_problem).
 
 A body without ``<inertial>`` (or every body, with ``<compiler inertiafromgeom="true">``) gets
 the mass and inertia of its geoms: each geom a solid of uniform ``density`` (the geom's, default
@@ -88,13 +89,21 @@ def body_inertia(parts) -> tuple:
 
 
 def inertia_problem(mass: float, inertia, scale: float = 1.0) -> str | None:
-    """Why a rigid body's mass and inertia tensor [kg, kg m^2] are not physical, or None: a negative
-    mass, an asymmetric or not positive semi-definite tensor, principal moments that break the
-    triangle inequality A + B >= C (no distribution of mass has them; MuJoCo refuses such a file).
-    ``scale`` is the size of the numbers compared (round-off allowance relative to it)."""
+    """Why a rigid body's mass and inertia [kg, kg m^2] are not physical, or None: a negative mass, an
+    asymmetric or not positive semi-definite tensor, principal moments that break the triangle
+    inequality A + B >= C (no distribution of mass has them; MuJoCo refuses such a file).
+
+    Any description's inertial: ``inertia`` is the 3 x 3 tensor (about the centre of mass, in any
+    axes: the checks do not depend on them) or the six numbers a URDF ``<inertia>`` or an MJCF
+    ``fullinertia`` writes, (ixx, iyy, izz, ixy, ixz, iyz).  The message names no file or element
+    (the caller says where: ``link 'x' <inertial> has ...``).  ``scale`` is the size of the numbers
+    compared (round-off allowance relative to it)."""
     if mass < 0:
         return f"a negative mass ({mass:g} kg)"
     inertia = np.asarray(inertia, float)
+    if inertia.shape == (6,):
+        xx, yy, zz, xy, xz, yz = inertia
+        inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     size = max(float(np.abs(inertia).max()), 0.0) * scale
     slack = DEFAULT.zero * size  # round-off of the eigenvalues of a tensor written to ~16 digits
     if np.abs(inertia - inertia.T).max() > slack:

@@ -34,6 +34,7 @@ from .description import (
     data_bytes,
 )
 from .meshes import check_meshes
+from .urdf_transmission import read_transmissions
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_urdf", "numbers", "unit_axis", "check_tree", "check_sizes", "Problems"]
@@ -198,7 +199,10 @@ def _joint(elem, links, problems) -> JointSpec | None:
             mult = numbers(m.get("multiplier"), 1, f"{what} <mimic multiplier>", problems, (1.0,))[0]
             off = numbers(m.get("offset"), 1, f"{what} <mimic offset>", problems, (0.0,))[0]
             mimic = (target, mult, off)
-    return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic)
+    dyn = elem.find("dynamics")  # MuJoCo's URDF reader: damping -> damping, friction -> frictionloss
+    dyn = {} if dyn is None else {key: numbers(dyn.get(attr), 1, f"{what} <dynamics {attr}>", problems, (0.0,), 1e9, "")[0]
+                                  for key, attr in (("damping", "damping"), ("frictionloss", "friction"))}
+    return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic, **dyn)
 
 
 def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
@@ -436,8 +440,8 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
             seen.add(c.name)
             cuts.append(c)
     couplings = _couplings(joints, problems, warnings)
-    transmissions = _transmissions(root, joints, {c.name for c in cuts}, warnings,
-                                   {c.joint: c.mimics for c in couplings})
+    transmissions, inputs = read_transmissions(root, joints, {c.name for c in cuts}, warnings,
+                                               {c.joint: c.mimics for c in couplings}, numbers)
     targets = _targets(root, links, {j.name for j in joints}, problems)
     problems.fail_if_any(path)
     warnings += check_meshes(path, root, package_dirs)
@@ -454,6 +458,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
         package_dirs=[str(d) for d in package_dirs or ()],
         couplings=couplings,
         targets=targets,
+        inputs=inputs,
     )
 
 
@@ -502,36 +507,6 @@ def _couplings(joints, problems, warnings) -> list:
         else:
             out.append(Coupling(name, target, float(mult), float(off)))
     return out
-
-
-def _transmissions(root, joints, loop_names, warnings, mimics=None) -> list:
-    """Joint names of the ``<transmission>`` elements, in order.  A transmission naming a
-    fixed joint, a loop joint, a joint that mimics another (it moves with that one) or a
-    joint not in the file is a warning, and is ignored (ROS files often carry transmissions
-    of fixed or removed joints: PR2, Kinova, TALOS)."""
-    mimics = mimics or {}
-    types = {j.name: j.type for j in joints}
-    names = []
-    for t in root.findall("transmission"):
-        tname = t.get("name")
-        for j in t.findall("joint"):
-            jn = j.get("name")
-            why = None
-            if not jn:
-                why = "a joint without a name"
-            elif jn in loop_names:
-                why = f"joint {quote(jn)}, which is a loop joint (not an input)"
-            elif jn not in types:
-                why = f"joint {quote(jn)}, which is not in the file"
-            elif types[jn] == "fixed":
-                why = f"joint {quote(jn)}, which is fixed"
-            elif jn in mimics:
-                why = f"joint {quote(jn)}, which mimics {quote(mimics[jn])} (it moves with it)"
-            if why:
-                warnings.append(f"transmission {quote(tname)} names {why}: ignored")
-            elif jn not in names:
-                names.append(jn)
-    return names
 
 
 def _targets(root, links, joint_names, problems) -> tuple:

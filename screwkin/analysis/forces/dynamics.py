@@ -231,6 +231,11 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
     notes = list(check_inertias(mech))
+    own = [j.name for j in mech.spec.joints if j.dynamics]
+    if own:
+        notes.append(f"the armature, damping and friction loss the file gives {len(own)} joints ("
+                     f"{', '.join(quote(n, 30) for n in own[:3])}{', ...' if len(own) > 3 else ''}) are not in these "
+                     "efforts (the rigid bodies' dynamics only); export --mjcf writes them for MuJoCo")
     fixed = dict(fixed or {})
     if inputs is None:
         inputs = list(mech.actuated) if input in mech.actuated else [input, *[n for n in fixed if n != input]]
