@@ -16,11 +16,12 @@ from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
 from ..model.state import KinematicState, place_tool, value_for_leg_length
+from ..model.topology import open_joints
 from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "file_configuration_line", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
            "typed_unit", "rate_units", "MAX_ANGLE"]
 
@@ -310,7 +311,9 @@ def configuration(mech, args):
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
                              "choose among the modes of those inputs")
-        return mech.generic_configurations()[0].q
+        q = mech.generic_configurations()[0].q
+        print(f"note: {file_configuration_line(mech, q)}", file=sys.stderr)
+        return q
     res = input_solver(mech, values, held).solve(values, near=near)
     for note in res.notes:  # a --near value the mode found lies far from
         print(f"note: {note}", file=sys.stderr)
@@ -324,6 +327,20 @@ def configuration(mech, args):
         if not getattr(args, "json", False):
             print(f"note: assembly mode {k} of {n} (others: {others}, or --near)", file=sys.stderr)
     return res.solutions[k - 1].q
+
+
+def file_configuration_line(mech, q) -> str:
+    """What a command analyses when no --set is given, in one line: the file's configuration (assembled,
+    when it has loops), with the values it gives the inputs (actuated joints and joints no loop
+    passes through; deg or m)."""
+    names = list(dict.fromkeys([*mech.actuated, *open_joints(mech)]))
+    values = mech.joint_values(q)
+    shown = [f"{n} = " + (f"{values[n]:.6g} m" if mech.translational[mech.coordinate(n).idx_v]
+                          else f"{math.degrees(values[n]) + 0.0:.6g} deg") for n in names[:8] if n in values]
+    more = f", ... ({len(names) - 8} more)" if len(names) > 8 else ""
+    what = "the configuration assembled from the file's" if mech.cuts else "the file's configuration"
+    return (f"no --set given: {what}" + (f" ({', '.join(shown)}{more})" if shown else "")
+            + "; --set NAME=VALUE to choose another")
 
 
 def with_mode(args, d: dict) -> dict:
