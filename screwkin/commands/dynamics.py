@@ -12,7 +12,17 @@ from ..errors import UsageError, quote
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
-from ._common import joint_assignments, joint_value, named_points, names_list, value_kind
+from ..analysis.motion.sweep import sweep_inputs
+from ._common import (
+    add_mode_option,
+    configuration,
+    joint_assignments,
+    joint_value,
+    named_points,
+    names_list,
+    value_kind,
+    with_mode,
+)
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -33,6 +43,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
+    add_mode_option(sp, "the inputs at --from")
     sp.add_argument("--gravity", metavar="GX,GY,GZ",
                     help="gravity [m/s^2] in world axes, e.g. 0,0,-9.81 (default: none)")
     sp.add_argument("--load", action="append", metavar="LINK:FX,FY,FZ,MX,MY,MZ",
@@ -105,16 +116,19 @@ def run(mech, args) -> int:
     units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
     shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
     points = named_points(mech, args)
+    loads, cs, gravity = _loads(mech, args.load, points), _cs(args.cs), _gravity(args.gravity)
+    # the mode (--mode K), chosen and said once dynamics has checked the file and the options
+    mode = lambda: configuration(mech, args, moved={args.input: start},  # noqa: E731
+                                 inputs=inputs or sweep_inputs(mech, args.input, fixed))
     res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
-                   gravity=_gravity(args.gravity), loads=_loads(mech, args.load, points), cs=_cs(args.cs),
-                   progress=True)
+                   gravity=gravity, loads=loads, cs=cs, progress=True, q_start=mode)
     if args.csv:
         with open(args.csv, "w") as f:
             f.write(dynamics_csv(res, shown))
     if args.plot:
         dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:
-        print(json.dumps(to_jsonable(dynamics_dict(res)), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, dynamics_dict(res))), indent=2))
     else:
         print(dynamics_text(res, shown, args.speed))
     return 0

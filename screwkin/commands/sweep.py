@@ -10,7 +10,7 @@ from ..analysis.motion.links import motion_along, strokes, sweep_motion
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
 from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
 from ..analysis.motion.singular_points import locate_singularities
-from ..analysis.motion.sweep import sweep
+from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
@@ -28,12 +28,15 @@ from ..present.report import (
 from ..units import parse_typed_value, unit_kind
 from ._common import (
     add_angle_option,
+    add_mode_option,
+    configuration,
     input_solver,
     joint_assignments,
     joint_value,
     named_points,
     names_list,
     split_inputs,
+    with_mode,
 )
 from ._options import BOUNDS, count
 
@@ -56,6 +59,7 @@ def add_parser(sub, common, scaled):
     add_angle_option(sp)
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
+    add_mode_option(sp, "the inputs at --from")
     sp.add_argument("--rate", help="input rate for the joint rates and accelerations (default 1 rad/s or m/s; "
                                    "typed with a unit, e.g. 60rpm, the links' omega and alpha are shown in it)")
     sp.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
@@ -107,14 +111,14 @@ def _streamed(args) -> bool:
     return True
 
 
-def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
+def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None
     pieces, methods, notes, limits, skipped = 0, [], [], [], 0
     last = None
     with SweepWriter(args.csv, args.parquet) as out:
-        for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, near=near, rate=rate,
+        for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, q_start=q_start, rate=rate,
                                   chunk=chunk):
             if topo is None:
                 topo = mech.topology(piece.q[0])
@@ -161,9 +165,8 @@ def run(mech, args) -> int:
     # absolute angle held by one more loop equation along the whole motion (--set-angle LINK=ANGLE)
     fixed, held, _ = split_inputs(mech, args)
     inputs = names_list(args.inputs) or ([args.input, *(k for k in fixed if k != args.input)] if held else
-                                         list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
+                                         sweep_inputs(mech, args.input, fixed))
     solver = input_solver(mech, inputs, held)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
@@ -172,9 +175,12 @@ def run(mech, args) -> int:
     if args.parquet:
         SweepWriter.require_parquet(args.parquet)  # before any work
     others = {k: v for k, v in fixed.items() if k != args.input}
-    if _streamed(args):
-        return _run_streamed(mech, args, solver, start, stop, others, near, rate)
-    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, near=near, rate=rate, progress=True,
+    streamed = _streamed(args)
+    # the mode followed (--mode K), chosen and said once sweep has checked the inputs
+    q_start = lambda: configuration(mech, args, moved={args.input: start}, inputs=inputs)  # noqa: E731
+    if streamed:
+        return _run_streamed(mech, args, solver, start, stop, others, q_start, rate)
+    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate, progress=True,
                 turn=args.turn)
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
@@ -193,7 +199,7 @@ def run(mech, args) -> int:
         sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
                    title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
     if args.json:
-        d = sweep_dict(res, mech)
+        d = with_mode(args, sweep_dict(res, mech))
         if info is not None:
             d["linkage"] = linkage_dict(info)
             d["transmission_angles"] = mus

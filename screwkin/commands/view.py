@@ -13,7 +13,7 @@ from ..analysis.motion.interactive import Interactive
 from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.singular import classify
 from ..analysis.motion.singular_points import locate_singularities
-from ..analysis.motion.sweep import sweep
+from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
@@ -90,14 +90,17 @@ def run(mech, args) -> int:
         return _interactive(mech, args)
     if getattr(args, "points", None):
         raise UsageError(f"{mech.path}: --point goes with --interactive (its position is read out there)")
-    q = configuration(mech, args)
     motion, singular, frames = None, [], None
-    if args.sweep:
+    if not args.sweep:
+        q = configuration(mech, args)
+    else:
         name, values = parse_range(args.sweep, "--sweep")
         fixed = {k: v for k, v in joint_assignments(mech, args.set, "--set").items() if k != name}
-        inputs = list(mech.actuated) if name in mech.actuated else [name, *fixed]
+        inputs = sweep_inputs(mech, name, fixed)
         solver = PositionSolver(mech, inputs)
-        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed)
+        # the mode followed (--mode K, --near), chosen and said as sweep's
+        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed,
+                    q_start=lambda: configuration(mech, args, moved={name: float(values[0])}, inputs=inputs))
         motion = res.q
         q = res.q[0]
         unit = typed_unit(mech, name, args.sweep)

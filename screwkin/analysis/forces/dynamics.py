@@ -41,7 +41,7 @@ from ...model._pin import frame_jacobian
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
 from .statics import balance, reaction_table
-from ..motion.sweep import sweep
+from ..motion.sweep import sweep, sweep_inputs
 
 __all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
 
@@ -199,14 +199,15 @@ def _range_mean(values, y) -> float:
 
 def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
              fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress: bool = False) -> DynamicsResult:
+             cs: float = 0.05, progress: bool = False, q_start=None) -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 
     inputs: the actuated joints (default: the mechanism's actuated joints when ``input`` is one
     of them, else ``input`` and the joints of ``fixed``); fixed: the other inputs' values;
     gravity: (gx, gy, gz) [m/s^2]; loads: Load; cs: the coefficient of speed fluctuation of the
-    flywheel figure (0 < cs < 2)."""
+    flywheel figure (0 < cs < 2); q_start: a configuration of the assembly mode to follow (as sweep's;
+    without it the mode is solve's first at ``start``, near ``near``)."""
     if not 0 < cs < 2:
         raise UsageError(f"the coefficient of speed fluctuation must lie between 0 and 2, got {cs:g}")
     g = np.asarray(gravity, float)
@@ -218,14 +219,12 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
                                             f"{quote(c.mimics)}): Pinocchio's inverse dynamics has no mimic joints")
     notes = list(check_inertias(mech))
     fixed = dict(fixed or {})
-    if inputs is None:
-        inputs = list(mech.actuated) if input in mech.actuated else [input, *[n for n in fixed if n != input]]
-    inputs = list(inputs)
+    inputs = sweep_inputs(mech, input, fixed) if inputs is None else list(inputs)
     for ld in loads:
         mech.link_frame(ld.link)  # a clear error for an unknown link
     solver = PositionSolver(mech, inputs)
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
-                near=near, rate=speed, progress=progress)
+                near=None if q_start is not None else near, rate=speed, progress=progress, q_start=q_start)
     model = mech.model
     data = mech.scratch_data()
     a_idx = mech.velocity_indices(inputs)
