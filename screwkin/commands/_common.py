@@ -22,7 +22,7 @@ from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "file_configuration_line", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_mode_option", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "file_configuration_line", "check_rate_names", "rate_items", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_mode_option", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
            "typed_unit", "rate_units", "MAX_ANGLE"]
 
@@ -435,6 +435,21 @@ def emit(args, data, text) -> int:
     else:
         print(text() if callable(text) else text)
     return 0
+
+
+def rate_items(items, inputs, option: str) -> list:
+    """--rate, --accel (and dynamics' --speed) as typed, each made NAME=VALUE: the one grammar of every
+    command (``--rate O2=120rpm``, repeatable, ``a,b=1``); a bare VALUE (``--rate 120rpm``) is the input's
+    where there is exactly one input, a usage error naming the inputs otherwise."""
+    out = []
+    for item in [items] if isinstance(items, str) else items or []:
+        if "=" not in item:
+            if len(inputs) != 1:
+                raise UsageError(f"{option} {quote(item, 60)}: give NAME=VALUE (a bare value is the input's where there "
+                                 f"is one input; inputs: {', '.join(inputs) or 'none'})")
+            item = f"{inputs[0]}={item}"
+        out.append(item)
+    return out
 
 
 def check_rate_names(given: dict | None, inputs, option: str) -> None:

@@ -20,6 +20,7 @@ from ._common import (
     joint_value,
     named_points,
     names_list,
+    rate_items,
     value_kind,
     with_mode,
 )
@@ -35,7 +36,8 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="input efforts, joint reactions, shaking forces and flywheel at constant input speed")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint driven at constant speed")
-    sp.add_argument("--speed", required=True, help="its constant speed (60rpm, 90deg/s, 2rad/s, 50mm/s; SI bare)")
+    sp.add_argument("--speed", required=True, metavar="[NAME=]VALUE",
+                    help="its constant speed, as every --rate: 60rpm or NAME=60rpm (90deg/s, 2rad/s, 50mm/s; SI bare)")
     sp.add_argument("--from", dest="start", help="first input value (default 0 for a turning input)")
     sp.add_argument("--to", dest="stop", help="last input value (default 360deg for a turning input)")
     sp.add_argument("--steps", type=count("dynamics_steps"), default=72,
@@ -105,6 +107,10 @@ def run(mech, args) -> int:
     if kind is None:
         mech.coordinate(args.input)  # a clear error for an unknown joint
         raise UsageError(f"--input {quote(args.input)}: dynamics drives a one-coordinate joint (revolute, prismatic)")
+    # the grammar of every --rate: NAME=VALUE, or the bare value of the one input driven
+    name, _, args.speed = rate_items(args.speed, [args.input], "--speed")[0].rpartition("=")
+    if name.strip() != args.input:
+        raise UsageError(f"--speed {quote(name.strip(), 60)}=...: dynamics drives --input {quote(args.input, 60)} only")
     speed = joint_value(mech, args.input, args.speed, "--speed", order=1)
     typed = [t for t in (args.start, args.stop) if t is not None]
     if kind == "length" and len(typed) < 2:

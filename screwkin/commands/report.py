@@ -61,6 +61,7 @@ from ._common import (
     joint_assignments,
     link_rates,
     named_points,
+    rate_items,
     rate_units,
     split_inputs,
     value_kind,
@@ -94,8 +95,9 @@ def add_parser(sub, common, scaled):
                     help="planar: the estimates Newton iterates from (as solve --start; default: the solved "
                          "unknowns, angles +10 deg and lengths +10 %%)")
     sp.add_argument("--iterations", type=count("iterations"), metavar="K", help="exactly K Newton iterations (default: to convergence)")
-    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 rad/s or m/s each; the tables in the unit typed: 10rpm, 90deg/s)")
-    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 rad/s or m/s each; the tables in the unit typed: 10rpm, 90deg/s; a bare value "
+                         "where there is one input)")
+    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0; a bare value where there is one input)")
     sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
     add_point_option(sp)
     sp.add_argument("--steps", type=count("figure_steps"), default=360,
@@ -157,6 +159,7 @@ def run(mech, args) -> int:
         mech.link_frame(args.output)
     points = named_points(mech, args)
     links = (*held, *pivots)
+    args.rate, args.accel = (rate_items(getattr(args, o), [*names, *held], f"--{o}") or None for o in ("rate", "accel"))
     rates = link_rates(joint_assignments(mech, args.rate, "--rate", order=1, links=links), pivots, "--rate") \
         or {n: 1.0 for n in (*names, *held)}
     accels = link_rates(joint_assignments(mech, args.accel, "--accel", order=2, links=links), pivots,

@@ -35,6 +35,7 @@ from .report import (
     joint_rows,
     screw_theory_rows,
     screws_text,
+    slide_note,
     solution_rows,
     to_jsonable,
 )
@@ -196,6 +197,9 @@ def motion_section(pres, rates_text: str, length: float, units: RateUnits = Rate
                              + (" (singular)" if sol.singular else "")))
         # solve's joint table (loop joints too), links and points tables
         s.blocks.append(Table(*solution_rows(pres, sol, units=units), f"solution-{k}"))
+        note = slide_note(pres, sol)
+        if note:
+            s.blocks.append(Text(note))
         if sol.links and any("angle" in m or "omega" in m for m in sol.links.values()):
             title, head, rows = links_rows(sol.links, units)  # the moving links, as solve lists them
             s.blocks += [Text(title), Table(head, rows, f"links-{k}")]

@@ -109,6 +109,7 @@ class Solution:
     linkage: dict | None = None  # a four-bar's diagonal construction (mu, z, alpha, beta) or a slider-crank's mu
     leg_lengths: dict | None = None  # prismatic joint -> distance between the joint centres its leg connects [m]
     guide_angles: dict | None = None  # planar: prismatic joint (tree or loop) -> its slide's angle from the ground's x [rad]
+    guide_positions: dict | None = None  # prismatic joint on the ground -> slider's position along its guide [m] (state.py)
 
     @property
     def physical(self) -> bool:
@@ -543,7 +544,7 @@ class PositionSolver:
                         loop_accelerations=state.loop_accelerations or None,
                         links=link_motions(state, angles, self._plane_normal()),
                         points=point_motions(state, points) or None, linkage=self._linkage(q),
-                        leg_lengths=state.leg_lengths or None,
+                        leg_lengths=state.leg_lengths or None, guide_positions=state.guide_positions or None,
                         guide_angles=(self._angles.guides(state) or None) if self._angles else None)
 
     def _named(self, v) -> dict:
