@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-from ..analysis.forces.statics import legs, statics
+from ..analysis.forces.statics import legs, no_legs_reason, statics
 from ..errors import UsageError
 from ..model.state import KinematicState
 from ..present.report import to_jsonable
@@ -54,6 +54,9 @@ def run(mech, args) -> int:
     q = configuration(mech, args)
     result = statics(mech, q, output=output, wrench=wrench, gravity=args.gravity)
     leg_list = legs(mech, q, output) if output is not None and mech.cuts else None
+    why_not = no_legs_reason(leg_list, output) if leg_list is not None else None
+    if why_not:  # a slider-crank's slider, a four-bar's coupler: no parallel-robot legs to speak of
+        leg_list = None
     frame = output_frame_dict(mech, q)
     if frame is not None:  # the load at the point (tool origin) is, at the link frame's origin, m_o = m + r x f
         o = KinematicState(mech, q).link_motion(frame["link"])["position"]
@@ -61,6 +64,8 @@ def run(mech, args) -> int:
         frame["wrench_at_link_origin"] = [*f.tolist(), *(m + np.cross(np.asarray(frame["position"]) - o, f)).tolist()]
     if args.json:
         d = statics_dict(result, leg_list)
+        if why_not:
+            d["legs"], d["legs_note"] = [], f"no legs: {why_not}"
         if frame is not None:
             d["output_frame"] = frame
         print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
@@ -70,4 +75,6 @@ def run(mech, args) -> int:
             print(output_frame_line(frame, args.tool is None) + f"; the load there is, at {frame['link']}'s "
                   f"origin, (fx fy fz mx my mz) = {moved} (N, N m)")
         print(statics_text(result, leg_list))
+        if why_not:
+            print(f"\nno legs' wrenches: {why_not} (the joint reactions above give what each joint carries)")
     return 0

@@ -549,13 +549,18 @@ def _motion_space(joints, tol, scale):
                         "prismatic axis perpendicular to it", tuple(normal))
     if not pri and not planar_pairs and all(j.type in ("revolute", "continuous", "spherical", "universal") for j in joints):
         lines = [(np.asarray(j.point), np.asarray(j.direction)) for j in rot]
-        if len(lines) >= 2:
+        # a ball or universal joint's axes all pass through its centre: that centre is the common point
+        centres = [np.asarray(j.point, float) for j in joints if j.type in ("spherical", "universal")
+                   and j.point is not None]
+        c = dist = None
+        if centres:
+            c = centres[0]
+            dist = max([0.0] + [np.linalg.norm(np.cross(c - p, _unit(d))) for p, d in lines])
+        elif len(lines) >= 2:
             c, dist = _common_point([p for p, _ in lines], [d for _, d in lines])
-            if c is not None and dist < lt:
-                centres = [np.asarray(j.point) for j in joints if j.type in ("spherical", "universal")]
-                if all(np.linalg.norm(p - c) < lt for p in centres):
-                    cc = np.round(c, 6) + 0.0
-                    return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
+        if c is not None and dist < lt and all(np.linalg.norm(p - c) < lt for p in centres):
+            cc = np.round(c, 6) + 0.0
+            return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
     axial = [j for j in joints if j.direction is not None and j.point is not None]
     if len(axial) == len(joints) and len(axial) >= 2:  # every joint's axis on one line: a screw, a slide along it
         p0, d0 = np.asarray(axial[0].point, float), _unit(np.asarray(axial[0].direction, float))

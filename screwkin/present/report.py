@@ -321,7 +321,16 @@ def singularity_text(rep) -> str:
                  ("constraint (rank of K drops)", yes(rep.constraint), f"{rep.sigmas['constraint']:.3g}"),
              ])]
     lines.append(f"stationary joints (rate forced to zero by the loops): {', '.join(rep.stationary_joints) or 'none'}")
-    for g in getattr(rep, "gram", ()):
+    gram = tuple(getattr(rep, "gram", ()))
+    free = [g for g in gram if not g.cofactors and g.nullity > 1]  # adj(G) = 0: said once, for all such loops
+    if len(free) > 1:
+        lines.append(f"\nloops closed by {', '.join(f'{g.loop} ({len(g.joints)} joint twists, loop mobility {g.nullity})' for g in free)}: "
+                     f"Gram matrix G = S^T S of each loop's joint twists (dimensionless, L = {rep.length:.4g} m)")
+        lines.append("  cofactors: each loop has more than one freedom of its own, so adj(G) = 0 and every cofactor "
+                     "vanishes identically (the cofactors tell the stationary joints of a loop with one freedom)")
+    for g in gram:
+        if len(free) > 1 and g in free:
+            continue
         lines.append(f"\nloop closed by {g.loop}: Gram matrix G = S^T S of its {len(g.joints)} joint twists "
                      f"(dimensionless, L = {rep.length:.4g} m)" + (f", loop mobility {g.nullity}" if g.nullity >= 0 else ""))
         if not g.cofactors:
@@ -338,11 +347,13 @@ def singularity_text(rep) -> str:
         lines.append(f"\n{t.kind} singular direction:")
         if t.joint_rates:
             lines.append("  joints moving: " + ", ".join(f"{n} {v:+.4g}" for n, v in t.joint_rates.items()))
-        if t.screw is not None:
+        if t.screw is not None and np.linalg.norm(t.screw.direction) > 0:
             s = t.screw
             pitch = f"{s.pitch:.4g} m/rad" if np.isfinite(s.pitch) else "inf (a translation)"
             lines.append(f"  screw: axis direction {_fmt_vec(s.direction, 0)}, through "
                          f"{_fmt_vec(s.point, 0) if s.point is not None else '-'}, pitch {pitch}")
+        elif t.twist is not None:  # never a zero twist written as a screw
+            lines.append(f"  the output '{rep.output}' does not move in it (a zero twist: no screw)")
     return "\n".join(lines)
 
 

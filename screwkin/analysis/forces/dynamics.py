@@ -40,7 +40,7 @@ from ...errors import MechanismFileError, UsageError, quote
 from ...model._pin import frame_jacobian
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
-from .statics import balance, reaction_table
+from .statics import balance, compound_joints, reaction_joint_id, reaction_table
 from ..motion.sweep import sweep, sweep_inputs
 
 __all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
@@ -157,7 +157,10 @@ def _ground_sides(mech) -> tuple:
     """(tree joints whose parent is the ground, {cut joint: +1 when its link2 is on the ground,
     -1 when its link1 is})."""
     model = mech.model
-    tree = {c.joint for c in mech.coordinates if model.parents[c.joint_id] == 0}
+    compounds = compound_joints(mech)
+    inside = {m: name for name, members in compounds.items() for m in members}
+    # (a compound joint's row is named as mobility names it; its member next to the parent is the one on the ground)
+    tree = {inside.get(c.joint, c.joint) for c in mech.coordinates if model.parents[c.joint_id] == 0}
     cuts = {}
     for cut in mech.cuts:
         on1 = model.frames[cut.frame1].parentJoint == 0
@@ -260,7 +263,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         # data holds q's placements (its own Data: reaction_table computes in another)
         for name, (kind, wrench, _) in table.items():
             if kind == "tree" and name in ground_tree:
-                sign, origin = -1.0, data.oMi[mech.coordinate(name).joint_id].translation
+                sign, origin = -1.0, data.oMi[reaction_joint_id(mech, name)].translation
             elif kind == "cut" and name in ground_cuts:
                 cut = next(c for c in mech.cuts if c.name == name)
                 sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation
