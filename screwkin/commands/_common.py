@@ -22,7 +22,7 @@ from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "file_configuration_line", "check_rate_names", "rate_items", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_mode_option", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "mode_line", "file_configuration_line", "check_rate_names", "rate_items", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_mode_option", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
            "typed_unit", "rate_units", "MAX_ANGLE"]
 
@@ -335,11 +335,15 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
         print(f"note: {note}", file=sys.stderr)
     if n > 1:
         args.mode_chosen = {"index": k, "of": n}
-        others = ", ".join(f"--mode {j}" for j in range(1, n + 1) if j != k)
         if not getattr(args, "json", False):
-            near_too = ", or --near" if hasattr(args, "near") else ""
-            print(f"note: assembly mode {k} of {n} (others: {others}{near_too})", file=sys.stderr)
+            print(f"note: {mode_line(k, n, hasattr(args, 'near'))}", file=sys.stderr)
     return q
+
+
+def mode_line(k: int, n: int, near: bool = True) -> str:
+    """The words every command says the assembly mode in: ``assembly mode 1 of 2 (others: --mode 2, or --near)``."""
+    others = ", ".join(f"--mode {j}" for j in range(1, n + 1) if j != k)
+    return f"assembly mode {k} of {n} (others: {others}{', or --near' if near else ''})"
 
 
 def file_configuration_line(mech, q) -> str:

@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import os
 import signal
+import sys
 import tempfile
 import time
 
@@ -26,10 +27,12 @@ from ._common import (
     configuration,
     joint_assignments,
     joint_inputs,
+    mode_line,
     named_points,
     parse_range,
     typed_unit,
 )
+from ..model.topology import open_joints
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -151,18 +154,17 @@ def _interactive(mech, args) -> int:
         raise UsageError(f"{mech.path}: --interactive is a live page: leave out --sweep, --html and --png")
     viser_module()  # a clear message before any work when viser is missing
     given = joint_inputs(mech, args, "view --interactive")
-    names = list(mech.actuated) or list(given)
+    # a slider per input: the actuated joints and the joints no loop passes through (a serial arm's)
+    names = list(dict.fromkeys([*mech.actuated, *open_joints(mech)])) or list(given)
     extra = [n for n in given if n not in names]
     if extra:
         raise UsageError(f"{mech.path}: --set {', '.join(extra)}: not an input (inputs: {', '.join(names) or 'none'})")
-    values = None
-    if given:
-        missing = [n for n in names if n not in given]
-        if missing:
-            raise UsageError(f"{mech.path}: give every input a starting value with --set (missing: {', '.join(missing)})")
-        values = given
-    live = Interactive(mech, names, values=values, mode=args.mode or 1, output=args.output,
+    # the inputs not given start at the file's values (the documented default), said in the line below
+    live = Interactive(mech, names, values=given, mode=args.mode or 1, output=args.output,
                        points=named_points(mech, args))
+    print(live.opened, flush=True)
+    if live.mode_index[1] > 1:  # the mode it opened in, said as every command says it
+        print(f"note: {mode_line(*live.mode_index, near=False)}", file=sys.stderr)
     q = live.state.q
     scene = build_scene(mech, q, output=args.output)
     if planar_basis(mech, q) is not None:
