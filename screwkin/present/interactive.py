@@ -73,6 +73,9 @@ PATH_COLORS = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (14
 
 #: The 3-D view's width over its height before a browser says it: a window of 3:2 less the docked panel
 CANVAS_ASPECT = 1.0
+#: A camera within this fraction of its distance from where the view put it is still there (the browser sends
+#: its pose back in single precision); farther, the person moved it and it is no longer framed again
+CAMERA_MOVED = 1e-4
 
 
 def _shown(value, unit) -> float:
@@ -167,7 +170,8 @@ class InteractiveView:
             size = (int(cam.image_width), int(cam.image_height))
             if not size[0] or not size[1] or framed.get("size") == size:
                 return
-            if "eye" in framed and np.linalg.norm(np.asarray(cam.position) - framed["eye"]) > 1e-6 * framed["dist"]:
+            moved = np.linalg.norm(np.asarray(cam.position) - framed["eye"]) if "eye" in framed else 0.0
+            if moved > CAMERA_MOVED * framed["dist"]:
                 return  # moved by the person: theirs to keep
             target, eye = fit_camera(self._points, self._direction, fov_deg=math.degrees(cam.fov),
                                      aspect=size[0] / size[1])
