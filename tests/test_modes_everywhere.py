@@ -10,25 +10,13 @@ import math
 import numpy as np
 import pytest
 
-from conftest import ROBOTS
+from conftest import ROBOTS, readme_fourbar
 from screwkin.cli import main
 
 # The README's first four-bar, every link along +x and the loop open at B: ground O2-O4 d = 0.10 m, crank O2-A
 # a = 0.04, coupler A-B b = 0.12, rocker O4-B c = 0.08.  Written along +x, each joint's value is its link's
 # absolute angle for the crank (theta2) and the rocker (theta4).
-FOURBAR = """<?xml version="1.0"?>
-<robot name="my_fourbar">
-  <link name="ground"/> <link name="crank"/> <link name="coupler"/> <link name="rocker"/>
-  <joint name="O2" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
-  <joint name="A" type="continuous"><parent link="crank"/><child link="coupler"/><origin xyz="0.04 0 0"/>
-    <axis xyz="0 0 1"/></joint>
-  <joint name="O4" type="continuous"><parent link="ground"/><child link="rocker"/><origin xyz="0.10 0 0"/>
-    <axis xyz="0 0 1"/></joint>
-  <loop_joint name="B" type="revolute"><link1 link="coupler" xyz="0.12 0 0"/><link2 link="rocker" xyz="0.08 0 0"/>
-    <axis xyz="0 0 1"/></loop_joint>
-  <transmission name="motor"><joint name="O2"/></transmission>
-</robot>
-"""
+FOURBAR = readme_fourbar()
 
 
 def rocker_angles(theta2, a=0.04, b=0.12, c=0.08, d=0.10):

@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 import screwkin
+from conftest import readme_fourbar
 from screwkin.analysis.motion.interactive import Interactive
 from screwkin.present.view import chromium
 
@@ -32,19 +33,7 @@ pytestmark = [pytest.mark.chromium, pytest.mark.slow,
               pytest.mark.skipif(chromium() is None, reason="Chromium is not installed (.ci/run installs it)")]
 
 # The README's first four-bar: every link along +x, the loop open at B (drawn at O2 = 0, not closed there)
-FOURBAR = """<?xml version="1.0"?>
-<robot name="my_fourbar">
-  <link name="ground"/> <link name="crank"/> <link name="coupler"/> <link name="rocker"/>
-  <joint name="O2" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
-  <joint name="A" type="continuous"><parent link="crank"/><child link="coupler"/><origin xyz="0.04 0 0"/>
-    <axis xyz="0 0 1"/></joint>
-  <joint name="O4" type="continuous"><parent link="ground"/><child link="rocker"/><origin xyz="0.10 0 0"/>
-    <axis xyz="0 0 1"/></joint>
-  <loop_joint name="B" type="revolute"><link1 link="coupler" xyz="0.12 0 0"/><link2 link="rocker" xyz="0.08 0 0"/>
-    <axis xyz="0 0 1"/></loop_joint>
-  <transmission name="motor"><joint name="O2"/></transmission>
-</robot>
-"""
+FOURBAR = readme_fourbar()
 
 LABELS = ("O2", "assembly mode", "relative sigma_min")
 
