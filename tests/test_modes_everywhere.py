@@ -87,15 +87,15 @@ def test_dynamics_torques_differ_between_modes_and_each_balances_the_energy(caps
     torques = {}
     for k in (1, 2):
         out, err = _run(["dynamics", str(ROBOTS / "fourbar_crank_rocker.urdf"), "--input", "crank_joint",
-                         "--speed", "60rpm", "--steps", "720", "--mode", str(k), "--json"], capsys)
+                         "--speed", "60rpm", "--steps", "240", "--mode", str(k), "--json"], capsys)
         d = json.loads(out)
         assert d["mode"] == {"index": k, "of": 2}
         tau = np.array(d["efforts"]["crank_joint"])
         T = np.array(d["kinetic_energy"])
         omega = 2 * np.pi
-        dt = (2 * np.pi / 720) / omega
+        dt = (2 * np.pi / 240) / omega
         dTdt = (T[2:] - T[:-2]) / (2 * dt)
-        assert np.abs(tau[1:-1] * omega - dTdt).max() < 2e-3 * np.abs(dTdt).max()
+        assert np.abs(tau[1:-1] * omega - dTdt).max() < 5e-3 * np.abs(dTdt).max()  # O(h^2), h = 1.5 deg
         torques[k] = tau
     assert np.abs(torques[1] - torques[2]).max() > 0.1 * np.abs(torques[1]).max()
 
