@@ -142,3 +142,21 @@ def test_draw_animate_and_view_sweep_follow_the_mode_asked(tmp_path, capsys):
     _, err = _run(["view", str(path), "--sweep", "O2=0:30deg:3", "--html", str(tmp_path / "v.html"), "--mode", "2"],
                   capsys)
     assert "note: assembly mode 2 of 2 (others: --mode 1, or --near)" in err
+
+
+def test_report_analyses_the_mode_asked(tmp_path, capsys):
+    """report took --mode and analysed solution 1 whatever K was: its document now says which it analyses and
+    its skeleton's rocker is the one of that mode (the data's rocker angle is solve's for that mode)."""
+    path = str(ROBOTS / "fourbar_crank_rocker.urdf")
+    md = tmp_path / "r.md"
+    _, err = _run(["report", path, "--set", "crank_joint=30deg", "--mode", "2", "--md", str(md), "--no-view",
+                   "--steps", "8"], capsys)
+    assert "note: assembly mode 2 of 2 (others: --mode 1, or --near)" in err
+    assert "solution 2 is the configuration this report analyses" in md.read_text()
+    data = json.loads((tmp_path / "r_files" / "data.json").read_text())
+    assert data["mode"] == {"index": 2, "of": 2}
+    solved, _ = _run(["solve", path, "--set", "crank_joint=30deg", "--json"], capsys)
+    rockers = [s["joints"]["rocker_joint"] for s in json.loads(solved)["solutions"]]
+    sweep = data["sweep"]  # the report's sweep starts at the configuration it analyses
+    start = sweep["joints"][0][sweep["coordinates"].index("rocker_joint")]
+    assert abs(_wrapped(start - rockers[1])) < 1e-7 and abs(_wrapped(start - rockers[0])) > 0.1

@@ -330,8 +330,8 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     missing = [n for n in inputs if n not in values]
     if missing:
         raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
-    q, k, n, notes = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
-    for note in notes:  # a --near value the mode found lies far from
+    q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
+    for note in res.notes:  # a --near value the mode found lies far from
         print(f"note: {note}", file=sys.stderr)
     if n > 1:
         args.mode_chosen = {"index": k, "of": n}

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import tempfile
 
 import numpy as np
@@ -19,6 +20,7 @@ import numpy as np
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
+from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
@@ -61,6 +63,7 @@ from ._common import (
     joint_assignments,
     link_rates,
     named_points,
+    mode_line,
     rate_items,
     rate_units,
     split_inputs,
@@ -173,9 +176,12 @@ def run(mech, args) -> int:
     values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
     if names or held:
         solver = input_solver(mech, values, held, output=args.output)
-        pres = solver.solve(values, near=near if (near or given or held) else mech.joint_values(q0), rates=rates,
-                            accels=accels, points=points)
-        q = pres.solutions[0].q
+        # the mode analysed (--mode K), chosen and said as every command chooses and says it
+        q, k, n, pres = choose_mode(solver, values, args.mode, near=near if (near or given or held) else
+                                    mech.joint_values(q0), rates=rates, accels=accels, points=points)
+        if n > 1:
+            data["mode"] = {"index": k, "of": n}
+            print(f"note: {mode_line(k, n)}", file=sys.stderr)
         data["solve"] = position_dict(pres)
         data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
     topo = mech.topology(q)
@@ -232,7 +238,7 @@ def run(mech, args) -> int:
     if pres is not None:
         given_rates = "input rates " + _rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
-        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args)))
+        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args), data.get("mode", {}).get("index", 1)))
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "

@@ -182,7 +182,7 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     return s
 
 
-def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits()) -> Section:
+def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits(), analysed: int = 1) -> Section:
     """The assembly modes for the inputs: every coordinate (loop joints too) with its rate and acceleration,
     the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
     present/motion.links_rows and points_rows), rates in ``units`` (those typed)."""
@@ -190,7 +190,7 @@ def motion_section(pres, rates_text: str, length: float, units: RateUnits = Rate
     inputs = ", ".join([f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items()]
                        + [f"angle of {k} = {_reading(v, True)}" for k, v in (pres.held or {}).items()])
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
-                         "solution 1 is the configuration this report analyses."))
+                         f"solution {analysed} is the configuration this report analyses (--mode K for another)."))
     for k, sol in enumerate(pres.solutions, 1):
         what = "" if sol.physical else f" (not reached by moving: {'; '.join(sol.labels)})"
         s.blocks.append(Text(f"solution {k}{what}: closure residual {sol.residual:.3g}, sigma_min {sol.sigma_min:.3g}"
