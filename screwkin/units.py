@@ -13,7 +13,8 @@ case-insensitive, ``30MM``, ``45Deg``, ``2KN``, except where two differ by case 
 * lengths: ``m``, ``cm``, ``mm``, ``um`` (``µm``, ``μm``), ``nm``, ``in`` (``inch``,
   ``inches``: 25.4 mm), ``ft`` (``foot``, ``feet``: 0.3048 m);
 * rates: ``rad/s``, ``deg/s``, ``rpm`` (``rev/min``), ``rev/s``; ``m/s``, ``mm/s``, ``cm/s``;
-* accelerations: ``rad/s^2``, ``deg/s^2``; ``m/s^2``, ``mm/s^2`` (``s2`` for ``s^2``);
+* accelerations: ``rad/s^2``, ``deg/s^2``, ``rpm/s``, ``rev/s^2``; ``m/s^2``, ``mm/s^2``, ``cm/s^2`` (``s2`` for
+  ``s^2``);
 * forces and moments: ``N``, ``kN``, ``mN``; ``Nm`` (``N*m``, ``N.m``), ``kNm``, ``Nmm``.
 
 Every unit has a kind (:data:`UNIT_TABLE`); where a value's kind is known (a joint's value,
@@ -52,8 +53,11 @@ UNIT_TABLE = {
     "m/s": (1.0, "linear rate"), "mm/s": (1e-3, "linear rate"), "cm/s": (1e-2, "linear rate"),
     "rad/s^2": (1.0, "angular acceleration"), "deg/s^2": (_DEG, "angular acceleration"),
     "rad/s2": (1.0, "angular acceleration"), "deg/s2": (_DEG, "angular acceleration"),
+    "rpm/s": (_TURN / 60.0, "angular acceleration"), "rev/s^2": (_TURN, "angular acceleration"),
+    "rev/s2": (_TURN, "angular acceleration"),
     "m/s^2": (1.0, "linear acceleration"), "mm/s^2": (1e-3, "linear acceleration"),
     "m/s2": (1.0, "linear acceleration"), "mm/s2": (1e-3, "linear acceleration"),
+    "cm/s^2": (1e-2, "linear acceleration"), "cm/s2": (1e-2, "linear acceleration"),
     "N": (1.0, "force"), "kN": (1e3, "force"), "mN": (1e-3, "force"),
     "Nm": (1.0, "moment"), "N*m": (1.0, "moment"), "N.m": (1.0, "moment"), "kNm": (1e3, "moment"),
     "Nmm": (1e-3, "moment"), "N*mm": (1e-3, "moment"),

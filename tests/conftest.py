@@ -14,6 +14,14 @@ DATA = Path(__file__).resolve().parent / "data"
 CORPUS = ROBOTS / "corpus" / "example-parallel-robots"  # vendored, BSD-3-Clause (its LICENSE is beside it)
 
 
+def readme_fourbar() -> str:
+    """The URDF of README.md's "Your first four-bar", as written there: ground O2-O4 0.10 m, crank 0.04, coupler
+    0.12, rocker 0.08, every link along +x and the loop open at B (its joints' values are the crank's and the
+    rocker's absolute angles)."""
+    section = (ROOT / "README.md").read_text().split("## Your first four-bar", 1)[1]
+    return section.split("<<'EOF'\n", 1)[1].split("\nEOF\n", 1)[0]
+
+
 @pytest.fixture
 def quiet():
     """A warn callable that collects warnings instead of printing them."""

@@ -55,7 +55,8 @@ def test_gripper_counts_and_report(capsys):
 
 
 def test_coupled_joints_are_reported_not_set(capsys):
-    res = PositionSolver(screwkin.load(GRIPPER), ["finger_left_joint"]).solve({"finger_left_joint": 0.03})
+    arm = {"shoulder": 0.0, "elbow": 0.0, "wrist": 0.0}  # no loop passes through them: inputs too (issue 33)
+    res = PositionSolver(screwkin.load(GRIPPER), [*arm, "finger_left_joint"]).solve({**arm, "finger_left_joint": 0.03})
     assert res.solutions[0].coupled == {"finger_right_joint": pytest.approx(0.03, abs=1e-15)}
     code = main(["solve", str(GRIPPER), "--set", "finger_right_joint=0.01"])
     err = capsys.readouterr().err

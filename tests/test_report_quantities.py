@@ -90,10 +90,12 @@ def test_markdown_tables_against_the_closed_form(report):
     x, xd, xdd, phi, omega, alpha = closed_form(DRAWN + math.radians(deg), 10.0)
     tables = _md_tables(text, "Positions, velocities and accelerations")
     (jh, joints), (lh, links) = tables[0], tables[1]
-    assert jh[:2] == ["joint", "value [rad or m]"] and jh[3].startswith("rate") and lh[:4] == [
+    assert jh[:3] == ["joint", "value [rad or m*]", "(deg, d*)"] and jh[3].startswith("rate") and lh[:4] == [
         "link", "angle [deg]", "omega [rad/s]", "alpha [rad/s^2]"]
     s = joints["slider_joint"]
-    assert float(s[1]) == pytest.approx(x - X0, abs=1e-9)
+    assert float(s[1]) == pytest.approx(x - X0, abs=1e-9)  # from where the file placed the joint (issue 33)
+    assert s[2].startswith("d = ") and float(s[2].split()[2]) == pytest.approx(x, rel=1e-6)  # from the crank pivot
+    assert "* a slide's value is measured from where the file placed its joint" in text
     assert float(s[3]) == pytest.approx(xd, rel=1e-5, abs=1e-9)
     assert float(s[4]) == pytest.approx(xdd, rel=1e-5, abs=1e-9)
     loop = joints["rod_slider (loop)"]  # the loop joint is a coordinate like the others
@@ -106,7 +108,8 @@ def test_markdown_tables_against_the_closed_form(report):
     assert float(rod[2]) == pytest.approx(omega, rel=1e-5, abs=1e-9)
     assert float(rod[3]) == pytest.approx(alpha, rel=1e-5, abs=1e-9)
     assert float(links["crank"][2]) == pytest.approx(10.0)
-    assert float(links["slider"][4]) == pytest.approx(abs(xd), rel=1e-5)  # |v origin| of the slider: its speed
+    # the slider's velocity, a signed vector in world axes (it was |v origin|, a speed): xd along +x
+    assert [float(c) for c in links["slider"][4].split()] == pytest.approx([xd, 0, 0], rel=1e-5, abs=1e-9)
     assert "input rates crank_joint = 10 rad/s" in text
 
 
@@ -185,7 +188,7 @@ def test_tables_in_the_units_typed(tmp_path, capsys):
     solved = capsys.readouterr().out
     rod = next(ln.split() for ln in solved.splitlines() if ln.startswith("rod "))
     assert [float(c) for c in rod[2:4]] == pytest.approx([math.degrees(omega), math.degrees(alpha)], rel=1e-5)
-    assert "|".join(links["rod"][1:]) == "|".join(rod[1:])  # the one table builder
+    assert " ".join(links["rod"][1:]).split() == rod[1:]  # the one table builder
     capsys.readouterr()
     assert main(["solve", SLIDER_CRANK, "--set", "crank_joint=-30deg", "--rate", "crank_joint=10rpm"]) == 0
     solved = capsys.readouterr().out

@@ -316,3 +316,55 @@ def test_a_value_beyond_the_controls_range_is_refused(fourbar):
     assert not s.moved and "outside its control's range" in s.message
     np.testing.assert_array_equal(s.q, before)
     assert live.move("crank_joint", ctl.start + 0.2).moved  # a value inside still moves
+
+
+# ----------------------------------------------------------------------------- where it opens (issue 33 item 6)
+
+def _open_fourbar(tmp_path, crank=0.04, coupler=0.12, rocker=0.08):
+    """The README's four-bar (links along +x, the loop open at B, ground 0.10 m) with these lengths."""
+    text = f"""<robot name="r"><link name="ground"/><link name="crank"/><link name="coupler"/><link name="rocker"/>
+      <joint name="O2" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
+      <joint name="A" type="continuous"><parent link="crank"/><child link="coupler"/><origin xyz="{crank} 0 0"/>
+        <axis xyz="0 0 1"/></joint>
+      <joint name="O4" type="continuous"><parent link="ground"/><child link="rocker"/><origin xyz="0.10 0 0"/>
+        <axis xyz="0 0 1"/></joint>
+      <loop_joint name="B" type="revolute"><link1 link="coupler" xyz="{coupler} 0 0"/>
+        <link2 link="rocker" xyz="{rocker} 0 0"/><axis xyz="0 0 1"/></loop_joint>
+      <transmission name="m"><joint name="O2"/></transmission></robot>"""
+    p = tmp_path / "fourbar.urdf"
+    p.write_text(text)
+    return screwkin.load(p)
+
+
+def test_it_opens_at_the_files_input_values_and_says_so(tmp_path):
+    """The open drawing first assembles at O2 = 18.4 deg; the file is drawn at O2 = 0, where the loop closes
+    too (A at 0.04, B on the circles of 0.12 about A and 0.08 about O4): it opens there."""
+    mech = _open_fourbar(tmp_path)
+    assert abs(mech.joint_values(mech.assemble().q)["O2"]) > math.radians(10)  # the assembly search moves it
+    live = Interactive(mech)
+    assert live.state.inputs == {"O2": 0.0} and live.opened == "opened at O2 = 0 deg (the file's value)"
+    assert max(cut_gaps(mech, live.state.q)) < 1e-9 and live.mode_index == (1, 2)
+    given = Interactive(mech, values={"O2": math.radians(30)}, mode=2)
+    assert given.opened == "opened at O2 = 30 deg" and given.state.mode == 2
+
+
+def test_where_the_file_does_not_close_at_its_inputs_it_opens_where_it_assembles_and_says_why(tmp_path):
+    """Crank 0.08, coupler 0.09, rocker 0.04: at O2 = 0 the crank tip is 0.02 m from O4, nearer than the
+    coupler and rocker can fold (0.09 - 0.04 = 0.05): no closure there; the first assembled configuration's."""
+    mech = _open_fourbar(tmp_path, crank=0.08, coupler=0.09, rocker=0.04)
+    live = Interactive(mech)
+    assert live.state.inputs["O2"] != 0.0 and max(cut_gaps(mech, live.state.q)) < 1e-9
+    assert "the first assembled configuration's: the file's configuration does not close at its own input " \
+           "values" in live.opened
+
+
+def test_view_interactive_takes_a_serial_arms_joints_as_its_inputs():
+    """A chain without loops and without a transmission: its joints are the inputs (no loop passes through them),
+    starting at the file's values."""
+    mech = screwkin.load(ROBOTS / "arm_6r.urdf")
+    mech.set_actuated([])
+    from screwkin.model.topology import open_joints
+
+    live = Interactive(mech, open_joints(mech), values={"joint2": 0.3})
+    assert live.state.inputs["joint2"] == 0.3 and live.state.inputs["joint1"] == 0.0
+    assert "joint1 = 0 deg (the file's value)" in live.opened and "joint2 = 17.1887 deg," in live.opened

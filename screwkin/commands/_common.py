@@ -12,15 +12,17 @@ import pinocchio as pin
 
 from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.links import Point
+from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
 from ..model.state import KinematicState, place_tool, value_for_leg_length
+from ..model.topology import open_joints
 from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
-__all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
+__all__ = ["with_mode", "mode_line", "file_configuration_line", "check_rate_names", "rate_items", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_mode_option", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
            "typed_unit", "rate_units", "MAX_ANGLE"]
 
@@ -229,8 +231,14 @@ def add_configuration_options(sp):
     add_angle_option(sp)
     add_length_option(sp)
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="assembly mode nearest this configuration")
+    add_mode_option(sp)
+
+
+def add_mode_option(sp, at: str = "the --set inputs"):
+    """--mode K: the K-th assembly mode (configuration() chooses it and says which, of how many)."""
     sp.add_argument("--mode", type=count("mode"), metavar="K",
-                    help="the K-th assembly mode of the --set inputs (as solve lists them; default 1)")
+                    help=f"the K-th assembly mode of {at} (as solve lists them; default 1, the one nearest the "
+                         "file's configuration)")
 
 
 def inputs(mech, args) -> dict:
@@ -308,12 +316,17 @@ def link_rates(rates: dict | None, pivots: dict, option: str) -> dict | None:
     return out
 
 
-def configuration(mech, args):
+def configuration(mech, args, moved: dict | None = None, inputs=None):
     """The configuration a command analyses: solved for --set values (the assembly mode --mode K, else the
     first: the one nearest the file's or --near's), else the assembled file one.  When there are several
     modes, a line on stderr says which one is analysed and how to get the others, and ``args.mode_chosen``
-    holds {"index": K, "of": N} for the JSON (commands add it as "mode")."""
+    holds {"index": K, "of": N} for the JSON (commands add it as "mode": with_mode).
+
+    A command that moves inputs (sweep, dynamics, map, workspace) gives their first values as ``moved``
+    (they take the place of a --set of the same joint) and its solver's ``inputs`` (default: the joints
+    given): the configuration returned is the mode its motion starts from."""
     values, held, _ = split_inputs(mech, args)
+    values.update(moved or {})
     near = joint_assignments(mech, [args.near], "--near") if getattr(args, "near", None) else None
     wanted = getattr(args, "mode", None)
     args.mode_chosen = None
@@ -321,20 +334,41 @@ def configuration(mech, args):
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
                              "choose among the modes of those inputs")
-        return mech.generic_configurations()[0].q
-    res = input_solver(mech, values, held).solve(values, near=near)
+        q = mech.generic_configurations()[0].q
+        print(f"note: {file_configuration_line(mech, q)}", file=sys.stderr)
+        return q
+    inputs = list(values if inputs is None else inputs)
+    missing = [n for n in inputs if n not in values]
+    if missing:
+        raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
+    q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
     for note in res.notes:  # a --near value the mode found lies far from
         print(f"note: {note}", file=sys.stderr)
-    n = len(res.solutions)
-    k = wanted or 1
-    if k > n:
-        raise UsageError(f"--mode {k}: these inputs give {n} assembly mode{'s' if n != 1 else ''}")
     if n > 1:
         args.mode_chosen = {"index": k, "of": n}
-        others = ", ".join(f"--mode {j}" for j in range(1, n + 1) if j != k)
         if not getattr(args, "json", False):
-            print(f"note: assembly mode {k} of {n} (others: {others}, or --near)", file=sys.stderr)
-    return res.solutions[k - 1].q
+            print(f"note: {mode_line(k, n, hasattr(args, 'near'))}", file=sys.stderr)
+    return q
+
+
+def mode_line(k: int, n: int, near: bool = True) -> str:
+    """The words every command says the assembly mode in: ``assembly mode 1 of 2 (others: --mode 2, or --near)``."""
+    others = ", ".join(f"--mode {j}" for j in range(1, n + 1) if j != k)
+    return f"assembly mode {k} of {n} (others: {others}{', or --near' if near else ''})"
+
+
+def file_configuration_line(mech, q) -> str:
+    """What a command analyses when no --set is given, in one line: the file's configuration (assembled,
+    when it has loops), with the values it gives the inputs (actuated joints and joints no loop
+    passes through; deg or m)."""
+    names = list(dict.fromkeys([*mech.actuated, *open_joints(mech)]))
+    values = mech.joint_values(q)
+    shown = [f"{n} = " + (f"{values[n]:.6g} m" if mech.translational[mech.coordinate(n).idx_v]
+                          else f"{math.degrees(values[n]) + 0.0:.6g} deg") for n in names[:8] if n in values]
+    more = f", ... ({len(names) - 8} more)" if len(names) > 8 else ""
+    what = "the configuration assembled from the file's" if mech.cuts else "the file's configuration"
+    return (f"no --set given: {what}" + (f" ({', '.join(shown)}{more})" if shown else "")
+            + "; --set NAME=VALUE to choose another")
 
 
 def with_mode(args, d: dict) -> dict:
@@ -416,6 +450,21 @@ def emit(args, data, text) -> int:
     else:
         print(text() if callable(text) else text)
     return 0
+
+
+def rate_items(items, inputs, option: str) -> list:
+    """--rate, --accel (and dynamics' --speed) as typed, each made NAME=VALUE: the one grammar of every
+    command (``--rate O2=120rpm``, repeatable, ``a,b=1``); a bare VALUE (``--rate 120rpm``) is the input's
+    where there is exactly one input, a usage error naming the inputs otherwise."""
+    out = []
+    for item in [items] if isinstance(items, str) else items or []:
+        if "=" not in item:
+            if len(inputs) != 1:
+                raise UsageError(f"{option} {quote(item, 60)}: give NAME=VALUE (a bare value is the input's where there "
+                                 f"is one input; inputs: {', '.join(inputs) or 'none'})")
+            item = f"{inputs[0]}={item}"
+        out.append(item)
+    return out
 
 
 def check_rate_names(given: dict | None, inputs, option: str) -> None:

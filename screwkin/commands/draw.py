@@ -35,7 +35,6 @@ from ._common import (
     configuration,
     input_solver,
     inputs,
-    joint_assignments,
     joint_value,
     named_points,
     split_inputs,
@@ -328,9 +327,10 @@ def _animate(mech, args) -> int:
     unit = unit or parse_typed_value(args.stop)[1]
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
     solver = input_solver(mech, input_names, held)
-    res = sweep(solver, name, start, stop, steps, fixed=fixed, near=near)
+    # the mode followed (--mode K, --near), chosen and said as sweep's
+    res = sweep(solver, name, start, stop, steps, fixed=fixed,
+                q_start=lambda: configuration(mech, args, moved={name: start}, inputs=input_names))
     linear = res.unit == "m"
     qs, values = list(res.q), list(res.values)
     limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= mech.tolerances.equal), None)

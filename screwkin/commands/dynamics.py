@@ -12,7 +12,18 @@ from ..errors import UsageError, quote
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
-from ._common import joint_assignments, joint_value, named_points, names_list, value_kind
+from ..analysis.motion.sweep import sweep_inputs
+from ._common import (
+    add_mode_option,
+    configuration,
+    joint_assignments,
+    joint_value,
+    named_points,
+    names_list,
+    rate_items,
+    value_kind,
+    with_mode,
+)
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -25,7 +36,8 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="input efforts, joint reactions, shaking forces and flywheel at constant input speed")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint driven at constant speed")
-    sp.add_argument("--speed", required=True, help="its constant speed (60rpm, 90deg/s, 2rad/s, 50mm/s; SI bare)")
+    sp.add_argument("--speed", required=True, metavar="[NAME=]VALUE",
+                    help="its constant speed, as every --rate: 60rpm or NAME=60rpm (90deg/s, 2rad/s, 50mm/s; SI bare)")
     sp.add_argument("--from", dest="start", help="first input value (default 0 for a turning input)")
     sp.add_argument("--to", dest="stop", help="last input value (default 360deg for a turning input)")
     sp.add_argument("--steps", type=count("dynamics_steps"), default=72,
@@ -33,6 +45,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
+    add_mode_option(sp, "the inputs at --from")
     sp.add_argument("--gravity", metavar="GX,GY,GZ",
                     help="gravity [m/s^2] in world axes, e.g. 0,0,-9.81 (default: none)")
     sp.add_argument("--load", action="append", metavar="LINK:FX,FY,FZ,MX,MY,MZ",
@@ -94,6 +107,10 @@ def run(mech, args) -> int:
     if kind is None:
         mech.coordinate(args.input)  # a clear error for an unknown joint
         raise UsageError(f"--input {quote(args.input)}: dynamics drives a one-coordinate joint (revolute, prismatic)")
+    # the grammar of every --rate: NAME=VALUE, or the bare value of the one input driven
+    name, _, args.speed = rate_items(args.speed, [args.input], "--speed")[0].rpartition("=")
+    if name.strip() != args.input:
+        raise UsageError(f"--speed {quote(name.strip(), 60)}=...: dynamics drives --input {quote(args.input, 60)} only")
     speed = joint_value(mech, args.input, args.speed, "--speed", order=1)
     typed = [t for t in (args.start, args.stop) if t is not None]
     if kind == "length" and len(typed) < 2:
@@ -105,16 +122,19 @@ def run(mech, args) -> int:
     units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
     shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
     points = named_points(mech, args)
+    loads, cs, gravity = _loads(mech, args.load, points), _cs(args.cs), _gravity(args.gravity)
+    # the mode (--mode K), chosen and said once dynamics has checked the file and the options
+    mode = lambda: configuration(mech, args, moved={args.input: start},  # noqa: E731
+                                 inputs=inputs or sweep_inputs(mech, args.input, fixed))
     res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
-                   gravity=_gravity(args.gravity), loads=_loads(mech, args.load, points), cs=_cs(args.cs),
-                   progress=True)
+                   gravity=gravity, loads=loads, cs=cs, progress=True, q_start=mode)
     if args.csv:
         with open(args.csv, "w") as f:
             f.write(dynamics_csv(res, shown))
     if args.plot:
         dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:
-        print(json.dumps(to_jsonable(dynamics_dict(res)), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, dynamics_dict(res))), indent=2))
     else:
         print(dynamics_text(res, shown, args.speed))
     return 0

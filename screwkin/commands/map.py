@@ -17,10 +17,13 @@ from ..present.report import (
     to_jsonable,
 )
 from ._common import (
+    add_mode_option,
+    configuration,
     joint_assignments,
     output_frame,
     parse_range,
     typed_unit,
+    with_mode,
 )
 from ._options import BOUNDS
 
@@ -36,6 +39,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--x", required=True, metavar="NAME=A:B:N", help="first input, from A to B in N values")
     sp.add_argument("--y", required=True, metavar="NAME=A:B:N", help="second input")
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    add_mode_option(sp, "the inputs at the map's first corner (the first values of --x and --y)")
     sp.add_argument("--output", help="output link (serial singularities)")
     sp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
     sp.add_argument("--csv", help="the map's data as CSV")
@@ -53,7 +57,9 @@ def run(mech, args) -> int:
     output, point = output_frame(mech, args)  # a named --point is the output
     if point and not output:
         raise UsageError("--point needs --output LINK")
-    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point)
+    # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
+    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
+    res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
     if args.png:
         units = (typed_unit(mech, xn, args.x), typed_unit(mech, yn, args.y))
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
@@ -62,7 +68,8 @@ def run(mech, args) -> int:
         with open(args.csv, "w") as f:
             f.write(map_csv(res))
     if args.json:
-        print(json.dumps(to_jsonable({**map_dict(res), "characteristic_length": mech.length}), indent=2))
+        print(json.dumps(to_jsonable(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})),
+                         indent=2))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} on the mapped assembly mode; "

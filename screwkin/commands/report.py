@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import tempfile
 
 import numpy as np
@@ -19,6 +20,7 @@ import numpy as np
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
+from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
@@ -61,6 +63,8 @@ from ._common import (
     joint_assignments,
     link_rates,
     named_points,
+    mode_line,
+    rate_items,
     rate_units,
     split_inputs,
     value_kind,
@@ -94,8 +98,9 @@ def add_parser(sub, common, scaled):
                     help="planar: the estimates Newton iterates from (as solve --start; default: the solved "
                          "unknowns, angles +10 deg and lengths +10 %%)")
     sp.add_argument("--iterations", type=count("iterations"), metavar="K", help="exactly K Newton iterations (default: to convergence)")
-    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 rad/s or m/s each; the tables in the unit typed: 10rpm, 90deg/s)")
-    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0)")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input rates (default 1 rad/s or m/s each; the tables in the unit typed: 10rpm, 90deg/s; a bare value "
+                         "where there is one input)")
+    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input accelerations (default 0; a bare value where there is one input)")
     sp.add_argument("--output", help="output link (its pose and twist; serial singularities; the chain of a serial arm)")
     add_point_option(sp)
     sp.add_argument("--steps", type=count("figure_steps"), default=360,
@@ -157,6 +162,7 @@ def run(mech, args) -> int:
         mech.link_frame(args.output)
     points = named_points(mech, args)
     links = (*held, *pivots)
+    args.rate, args.accel = (rate_items(getattr(args, o), [*names, *held], f"--{o}") or None for o in ("rate", "accel"))
     rates = link_rates(joint_assignments(mech, args.rate, "--rate", order=1, links=links), pivots, "--rate") \
         or {n: 1.0 for n in (*names, *held)}
     accels = link_rates(joint_assignments(mech, args.accel, "--accel", order=2, links=links), pivots,
@@ -170,9 +176,12 @@ def run(mech, args) -> int:
     values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
     if names or held:
         solver = input_solver(mech, values, held, output=args.output)
-        pres = solver.solve(values, near=near if (near or given or held) else mech.joint_values(q0), rates=rates,
-                            accels=accels, points=points)
-        q = pres.solutions[0].q
+        # the mode analysed (--mode K), chosen and said as every command chooses and says it
+        q, k, n, pres = choose_mode(solver, values, args.mode, near=near if (near or given or held) else
+                                    mech.joint_values(q0), rates=rates, accels=accels, points=points)
+        if n > 1:
+            data["mode"] = {"index": k, "of": n}
+            print(f"note: {mode_line(k, n)}", file=sys.stderr)
         data["solve"] = position_dict(pres)
         data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
     topo = mech.topology(q)
@@ -229,7 +238,7 @@ def run(mech, args) -> int:
     if pres is not None:
         given_rates = "input rates " + _rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
-        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args)))
+        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args), data.get("mode", {}).get("index", 1)))
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "

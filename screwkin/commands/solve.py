@@ -22,6 +22,7 @@ from ._common import (
     joint_assignments,
     link_rates,
     named_points,
+    rate_items,
     rate_units,
     split_inputs,
 )
@@ -45,8 +46,10 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
     sp.add_argument("--output", help="link whose pose (and twist) to report")
     add_point_option(sp)
-    sp.add_argument("--rate", action="append", metavar="NAME=VALUE", help="input joint rate [1/s] (units as --set)")
-    sp.add_argument("--accel", action="append", metavar="NAME=VALUE", help="input joint acceleration [1/s^2]")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE",
+                    help="input joint rate [1/s] (units: 120rpm, 90deg/s, 5mm/s; a bare value where there is one input)")
+    sp.add_argument("--accel", action="append", metavar="NAME=VALUE",
+                    help="input joint acceleration [1/s^2] (units: 10deg/s^2; a bare value where there is one input)")
     sp.add_argument("--trace", action="store_true", help="print the Newton iterations (residual, Jacobian, step)")
     sp.add_argument("--starts", type=count("starts"), default=24, help="random starting configurations (default 24)")
     sp.add_argument("--start", action="append", metavar="NAME=VALUE,...",
@@ -63,6 +66,7 @@ def run(mech, args) -> int:
     if not values and not held:
         raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
     near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    args.rate, args.accel = (rate_items(getattr(args, o), [*values, *held], f"--{o}") or None for o in ("rate", "accel"))
     rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
     accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None
     rates, accels = link_rates(rates, pivots, "--rate"), link_rates(accels, pivots, "--accel")

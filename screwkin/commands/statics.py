@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 
-from ..analysis.forces.statics import legs, statics
+from ..analysis.forces.statics import legs, no_legs_reason, statics
 from ..analysis.redundancy import redundancy
 from ..errors import UsageError
 from ..model.state import KinematicState
@@ -58,6 +58,9 @@ def run(mech, args) -> int:
     leg_list = legs(mech, q, output) if output is not None and mech.cuts else None
     # the indeterminate reactions by name: the redundant constraint wrenches (analysis.redundancy)
     red = redundancy(mech, q) if result.indeterminate else None
+    why_not = no_legs_reason(leg_list, output) if leg_list is not None else None
+    if why_not:  # a slider-crank's slider, a four-bar's coupler: no parallel-robot legs to speak of
+        leg_list = None
     frame = output_frame_dict(mech, q)
     if frame is not None:  # the load at the point (tool origin) is, at the link frame's origin, m_o = m + r x f
         o = KinematicState(mech, q).link_motion(frame["link"])["position"]
@@ -67,6 +70,8 @@ def run(mech, args) -> int:
         d = statics_dict(result, leg_list)
         if red is not None:
             d.update({k: v for k, v in redundancy_dict(red).items() if k != "exactly_constrained_by"})
+        if why_not:
+            d["legs"], d["legs_note"] = [], f"no legs: {why_not}"
         if frame is not None:
             d["output_frame"] = frame
         print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
@@ -76,6 +81,8 @@ def run(mech, args) -> int:
             print(output_frame_line(frame, args.tool is None) + f"; the load there is, at {frame['link']}'s "
                   f"origin, (fx fy fz mx my mz) = {moved} (N, N m)")
         print(statics_text(result, leg_list))
+        if why_not:
+            print(f"\nno legs' wrenches: {why_not} (the joint reactions above give what each joint carries)")
         if red is not None and red.count:
             print("\n".join(redundancy_lines(red, "the reactions statics cannot give, by joint")))
     return 0

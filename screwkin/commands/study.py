@@ -18,6 +18,7 @@ from ..present.study import (
     study_text,
     write_table,
 )
+from ._common import add_mode_option
 from ._options import count, seconds
 
 NAME = "study"
@@ -42,6 +43,8 @@ def add_parser(sub, common, scaled):
                     help="the two columns of the Pareto front and their goals (overrides the spec's pareto)")
     sp.add_argument("--timeout", type=seconds("timeout"), default=10.0,
                     help="seconds to reach the scheduler and a worker (default 10)")
+    add_mode_option(sp, "each design's inputs at their values in its assembled configuration, for the metrics "
+                        "that follow one (transmission_angle, the workspace metrics); overrides the spec's mode")
     sp.add_argument("--design-timeout", type=seconds("design_timeout"), metavar="S",
                     help="seconds one design may take before its row is a failure (overrides the spec's timeout; "
                          "default 120)")
@@ -67,6 +70,8 @@ def run(mech, args) -> int:
     spec = read_study_spec(args.spec)
     if args.pareto:
         spec = replace(spec, pareto=_pareto(args.pareto))
+    if args.mode is not None:
+        spec = replace(spec, mode=args.mode)
     if args.design_timeout is not None:
         if not 0 < args.design_timeout <= 86400:
             raise UsageError(f"--design-timeout must be more than 0 s and at most 86400, got {args.design_timeout:g}")

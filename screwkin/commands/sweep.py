@@ -12,11 +12,11 @@ from ..analysis.motion.stream import DEFAULT_CHUNK, sweep_chunks
 from ..analysis.motion.change_points import change_points
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import SweepSingularity
-from ..analysis.motion.sweep import sweep
+from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
-from ..present.tables import RateUnits
+from ..present.tables import input_rate_words
 from ..present.plots import sweep_plot
 from ..present.streamout import SweepWriter
 from ..present.local import change_point_dict, change_point_lines
@@ -28,15 +28,21 @@ from ..present.report import (
     sweep_text,
     value_text,
 )
-from ..units import parse_typed_value, unit_kind
+from ..units import parse_typed_assignments, parse_typed_value, unit_kind
 from ._common import (
     add_angle_option,
+    add_mode_option,
+    check_rate_names,
+    configuration,
     input_solver,
     joint_assignments,
     joint_value,
     named_points,
     names_list,
+    rate_items,
+    rate_units,
     split_inputs,
+    with_mode,
 )
 from ._options import BOUNDS, count
 
@@ -59,8 +65,11 @@ def add_parser(sub, common, scaled):
     add_angle_option(sp)
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
-    sp.add_argument("--rate", help="input rate for the joint rates and accelerations (default 1 rad/s or m/s; "
-                                   "typed with a unit, e.g. 60rpm, the links' omega and alpha are shown in it)")
+    add_mode_option(sp, "the inputs at --from")
+    sp.add_argument("--rate", action="append", metavar="NAME=VALUE",
+                    help="the swept input's constant rate, NAME=VALUE or a bare value (e.g. crank=60rpm or 60rpm); "
+                         "default 1 rad/s or 1 m/s: the rates and accelerations are then per 1 rad/s (m/s) of the "
+                         "input; typed with a unit, the links' omega and alpha are shown in it")
     sp.add_argument("--csv", help="write the joint values, rates and accelerations per step to this CSV file")
     sp.add_argument("--parquet", help="write the same columns as --csv to this Parquet file (needs pyarrow)")
     sp.add_argument("--chunk", type=count("chunk"),
@@ -110,14 +119,14 @@ def _streamed(args) -> bool:
     return True
 
 
-def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
+def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None
     pieces, methods, notes, limits, skipped = 0, [], [], [], 0
     last = None
     with SweepWriter(args.csv, args.parquet) as out:
-        for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, near=near, rate=rate,
+        for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, q_start=q_start, rate=rate,
                                   chunk=chunk):
             if topo is None:
                 topo = mech.topology(piece.q[0])
@@ -136,6 +145,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
         rows = out.rows
     rad = last.unit == "rad"
     files = " and ".join(f for f in (args.csv, args.parquet) if f)
+    print(_rates_line(args))
     print(f"sweep of {args.input} from {value_text(args.input, start, rad)} to {value_text(args.input, stop, rad)} "
           f"in {args.steps:,} steps, computed and written in {pieces} chunk{'s' if pieces > 1 else ''} of at most "
           f"{chunk:,} steps ({', '.join(methods)}): {rows:,} rows written to {files}")
@@ -148,6 +158,14 @@ def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
     if skipped:
         print(f"{skipped} grid value{'s' if skipped > 1 else ''} passed but not solved (holes in the motion)")
     return 0
+
+
+def _rates_line(args) -> str:
+    """The line that says what the rates and accelerations written are for (the input's rate)."""
+    if args.rate:
+        return f"rates and accelerations {args.rate_words}, held constant"
+    return (f"rates and accelerations {args.rate_words} (the velocity ratios; --rate {args.input}=60rpm for "
+            "another speed), at a constant input rate")
 
 
 def _rows(text):
@@ -164,20 +182,27 @@ def run(mech, args) -> int:
     # absolute angle held by one more loop equation along the whole motion (--set-angle LINK=ANGLE)
     fixed, held, _ = split_inputs(mech, args)
     inputs = names_list(args.inputs) or ([args.input, *(k for k in fixed if k != args.input)] if held else
-                                         list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
+                                         sweep_inputs(mech, args.input, fixed))
     solver = input_solver(mech, inputs, held)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
                                                                                       (args.stop, "--to")))
-    rate = joint_value(mech, args.input, args.rate or "1", "--rate", order=1)
+    args.rate = rate_items(args.rate, [args.input], "--rate") or None  # the one grammar: NAME=VALUE or bare
+    typed = joint_assignments(mech, args.rate, "--rate", order=1)
+    check_rate_names(typed, [args.input], "--rate")  # only the swept input moves
+    rate = typed.get(args.input, 1.0)
+    unit = next((u for _, _, u in parse_typed_assignments(args.rate, "--rate")), None)
+    args.rate_words = input_rate_words(args.input, rate, unit, bool(mech.translational[mech.coordinate(args.input).idx_v]))
     if args.parquet:
         SweepWriter.require_parquet(args.parquet)  # before any work
     others = {k: v for k, v in fixed.items() if k != args.input}
-    if _streamed(args):
-        return _run_streamed(mech, args, solver, start, stop, others, near, rate)
-    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, near=near, rate=rate, progress=True,
+    streamed = _streamed(args)
+    # the mode followed (--mode K), chosen and said once sweep has checked the inputs
+    q_start = lambda: configuration(mech, args, moved={args.input: start}, inputs=inputs)  # noqa: E731
+    if streamed:
+        return _run_streamed(mech, args, solver, start, stop, others, q_start, rate)
+    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate, progress=True,
                 turn=args.turn)
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
@@ -199,9 +224,11 @@ def run(mech, args) -> int:
             out.write(res, motion)
     if args.plot:
         sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
-                   title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}")
+                   title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}, "
+                         f"{args.rate_words}", rate_words=args.rate_words)
     if args.json:
-        d = sweep_dict(res, mech)
+        d = with_mode(args, sweep_dict(res, mech))
+        d["input_rate"], d["rates_are"] = rate, args.rate_words  # SI; "per 1 rad/s of crank" or "at crank 60 rpm"
         if info is not None:
             d["linkage"] = linkage_dict(info)
             d["transmission_angles"] = mus
@@ -226,12 +253,13 @@ def run(mech, args) -> int:
             print(f"held along the motion: the angle of {link} = {angle:.9g} rad ({math.degrees(angle):.6g} deg)")
         print(sweep_text(res, info, mus, rows=_rows(args.rows), degrees=typed_deg and res.unit == "rad",
                          linear_names=linear_names))
+        print(_rates_line(args))
         for line in strokes_text(slider_strokes, res.unit == "rad"):
             print(line)
         for n in res.notes:
             print(f"note: {n}")
         # a --rate typed: the links' omega and alpha beside their angles, in its units (60rpm: rpm)
-        units = RateUnits.typed([parse_typed_value(args.rate)[1]]) if args.rate else None
+        units = rate_units(args) if args.rate else None
         table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad", units)
         if table_text:
             print()

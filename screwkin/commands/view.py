@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import os
 import signal
+import sys
 import tempfile
 import time
 
@@ -13,7 +14,7 @@ from ..analysis.motion.interactive import Interactive
 from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.singular import classify
 from ..analysis.motion.singular_points import locate_singularities
-from ..analysis.motion.sweep import sweep
+from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
@@ -26,10 +27,12 @@ from ._common import (
     configuration,
     joint_assignments,
     joint_inputs,
+    mode_line,
     named_points,
     parse_range,
     typed_unit,
 )
+from ..model.topology import open_joints
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -90,14 +93,17 @@ def run(mech, args) -> int:
         return _interactive(mech, args)
     if getattr(args, "points", None):
         raise UsageError(f"{mech.path}: --point goes with --interactive (its position is read out there)")
-    q = configuration(mech, args)
     motion, singular, frames = None, [], None
-    if args.sweep:
+    if not args.sweep:
+        q = configuration(mech, args)
+    else:
         name, values = parse_range(args.sweep, "--sweep")
         fixed = {k: v for k, v in joint_assignments(mech, args.set, "--set").items() if k != name}
-        inputs = list(mech.actuated) if name in mech.actuated else [name, *fixed]
+        inputs = sweep_inputs(mech, name, fixed)
         solver = PositionSolver(mech, inputs)
-        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed)
+        # the mode followed (--mode K, --near), chosen and said as sweep's
+        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed,
+                    q_start=lambda: configuration(mech, args, moved={name: float(values[0])}, inputs=inputs))
         motion = res.q
         q = res.q[0]
         unit = typed_unit(mech, name, args.sweep)
@@ -148,18 +154,17 @@ def _interactive(mech, args) -> int:
         raise UsageError(f"{mech.path}: --interactive is a live page: leave out --sweep, --html and --png")
     viser_module()  # a clear message before any work when viser is missing
     given = joint_inputs(mech, args, "view --interactive")
-    names = list(mech.actuated) or list(given)
+    # a slider per input: the actuated joints and the joints no loop passes through (a serial arm's)
+    names = list(dict.fromkeys([*mech.actuated, *open_joints(mech)])) or list(given)
     extra = [n for n in given if n not in names]
     if extra:
         raise UsageError(f"{mech.path}: --set {', '.join(extra)}: not an input (inputs: {', '.join(names) or 'none'})")
-    values = None
-    if given:
-        missing = [n for n in names if n not in given]
-        if missing:
-            raise UsageError(f"{mech.path}: give every input a starting value with --set (missing: {', '.join(missing)})")
-        values = given
-    live = Interactive(mech, names, values=values, mode=args.mode or 1, output=args.output,
+    # the inputs not given start at the file's values (the documented default), said in the line below
+    live = Interactive(mech, names, values=given, mode=args.mode or 1, output=args.output,
                        points=named_points(mech, args))
+    print(live.opened, flush=True)
+    if live.mode_index[1] > 1:  # the mode it opened in, said as every command says it
+        print(f"note: {mode_line(*live.mode_index, near=False)}", file=sys.stderr)
     q = live.state.q
     scene = build_scene(mech, q, output=args.output)
     if planar_basis(mech, q) is not None:

@@ -22,7 +22,16 @@ from ..present.workspace import (
     workspace_text,
 )
 from ..units import parse_length, parse_value
-from ._common import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
+from ._common import (
+    add_mode_option,
+    add_point_option,
+    add_tool_option,
+    configuration,
+    output_frame,
+    output_frame_dict,
+    output_frame_line,
+    with_mode,
+)
 from ._options import count, seconds
 
 NAME = "workspace"
@@ -53,6 +62,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--seed", type=count("seed"), default=0, help="random seed of the sampling method (default 0)")
     sp.add_argument("--timeout", type=seconds("timeout"), default=60.0,
                     help="seconds the grid may grow (default 60): past them it stops and the result says it is cut")
+    add_mode_option(sp, "the inputs' values in the file's assembled configuration")
     sp.add_argument("--png", help="slices of the workspace coloured by conditioning, PNG (needs matplotlib)")
     sp.add_argument("--csv", help="every reached point: position, measures, joint values")
     sp.add_argument("--html", help="the mechanism and the workspace as a meshcat point cloud, static HTML page")
@@ -81,6 +91,22 @@ def _orientation(text):
     return pin.rpy.rpyToMatrix(np.array([parse_value(p, "angle", "--orientation") for p in parts]))
 
 
+def _mode(mech, args):
+    """The assembled configuration of the mode whose workspace is asked (--mode K of the actuated joints'
+    values in the file's assembled configuration, said as every command says it); None for a chain
+    without loops, whose joint values are one configuration."""
+    if not (mech.cuts or mech.extra_rows):
+        if args.mode not in (None, 1):
+            raise UsageError(f"--mode {args.mode}: {mech.path} has no loops: its joint values give one configuration")
+        return None
+    q0 = mech.generic_configurations()[0].q
+    inputs = [n for n in mech.actuated if mech.coordinate(n).nv == 1]
+    if not inputs:  # nothing declared: the file's assembly is the one configuration there is to start from
+        return None
+    values = mech.joint_values(q0)
+    return configuration(mech, args, moved={n: values[n] for n in inputs}, inputs=inputs)
+
+
 def run(mech, args) -> int:
     if args.samples < 1:
         raise UsageError(f"--samples must be positive, got {args.samples}")
@@ -92,7 +118,7 @@ def run(mech, args) -> int:
     res = workspace(mech, output, point=point, orientation=_orientation(args.orientation),
                     resolution=parse_length(args.resolution, "--resolution") if args.resolution else None,
                     bounds=_bounds(args.bounds), threshold=args.threshold, length=length, method=args.method,
-                    samples=args.samples, seed=args.seed, timeout=args.timeout)
+                    samples=args.samples, seed=args.seed, timeout=args.timeout, q_start=lambda: _mode(mech, args))
     wrote = []
     if args.csv:
         columns = [(c.joint, c.idx_q) for c in mech.coordinates if c.nq == 1]
@@ -124,7 +150,7 @@ def run(mech, args) -> int:
     if mech.tool is not None:  # the named point or tool frame whose workspace it is, in the assembled configuration
         frame = output_frame_dict(mech, mech.generic_configurations()[0].q)
     if args.json:
-        d = workspace_dict(res)
+        d = with_mode(args, workspace_dict(res))
         d["wrote"] = wrote
         if frame is not None:
             d["output_frame"] = frame

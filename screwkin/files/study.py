@@ -47,7 +47,7 @@ DESIGN_TIMEOUT = 120.0
 #: The metrics computed from screwkin.analysis.design.workspace (they need ``workspace: {resolution: H}``).
 WORKSPACE_METRICS = ("workspace_volume", "singularity_free_volume", "conditioning")
 _KEYS = ("file", "args", "parameters", "sampling", "designs", "seed", "metrics", "input", "output", "point",
-         "workspace", "transmission", "pareto", "chunk", "timeout")
+         "workspace", "transmission", "pareto", "chunk", "timeout", "mode")
 _WORKSPACE_KEYS = ("point", "resolution", "threshold", "length")
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
@@ -91,6 +91,7 @@ class StudySpec:
     pareto: tuple | None = None  # ((metric, "max"|"min"), (metric, "max"|"min"))
     chunk: int | None = None  # designs per task (default: chosen from the number of designs and workers)
     timeout: float = DESIGN_TIMEOUT  # seconds per design: over it, the design is a failed row
+    mode: int | None = None  # the assembly mode every design's motion and workspace follow (None: the first)
 
 
 def _fail(where, message):
@@ -285,9 +286,12 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
     if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 86400:
         _fail(where, f"timeout must be the seconds one design may take, more than 0 and at most 86400, got "
                      f"{quote(timeout)}")
+    mode = data.get("mode")
+    if mode is not None:
+        mode = _count(mode, where, "mode (the K-th assembly mode, as solve lists them)", 1, 1000)
     spec = StudySpec(where, path, tuple(parameters), metrics, sampling, designs, seed, fixed, data.get("input"),
                      data.get("output"), point, workspace, steps, _pareto(data.get("pareto"), where), chunk,
-                     float(timeout))
+                     float(timeout), mode)
     _check_arguments(spec, where)
     return spec
 

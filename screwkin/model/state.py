@@ -303,6 +303,24 @@ class KinematicState:
                 for j, (s, e) in leg_ends(self.mech).items()}
 
     @cached_property
+    def guide_positions(self) -> dict:
+        """Prismatic joint whose guide is the ground (a tree joint on the ground, or a prismatic cut joint whose
+        F1 is on it) -> the slider's position along its guide [m]: the guide direction's component of the
+        slider's frame origin (the joint's frame; a cut joint's F2), i.e. measured from the foot of the
+        perpendicular from the world origin onto the guide line -- a slider-crank's slider distance d when its
+        crank pivots at the origin.  (The joint's value is measured from where the file placed the joint.)"""
+        model, d, out = self.mech.model, self._data, {}
+        for c in self.mech.coordinates:
+            if c.nv == 1 and c.nq == 1 and self.mech.translational[c.idx_v] and model.parents[c.joint_id] == 0:
+                M = d.oMi[c.joint_id]
+                out[c.joint] = float(M.translation @ (M.rotation @ joint_axis(model.joints[c.joint_id])))
+        for cut in self.loop_cuts:
+            if cut.type == "prismatic" and model.frames[cut.frame1].parentJoint == 0:
+                _, M2, axis = self._cut_frames(cut)
+                out[cut.name] = float(M2.translation @ axis)
+        return out
+
+    @cached_property
     def loop_cuts(self) -> tuple:
         """The cut joints whose coordinate is reported (loop_coordinate_cuts)."""
         return loop_coordinate_cuts(self.mech)

@@ -28,7 +28,7 @@ from ..tolerances import DEFAULT
 from ._pin import frame_id
 from .six_bar import six_bar_inversion
 
-__all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind"]
+__all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind", "open_joints"]
 
 MOTION = {
     "revolute": "rotation",
@@ -220,6 +220,26 @@ def frame_link(mech, frame_name: str) -> str:
             return f.name
         fid = f.parentFrame
     return spec.root
+
+
+def open_joints(mech) -> tuple:
+    """The tree joints (with coordinates) that no closure row involves, in tree order: on the tree
+    path between the two frames of no cut joint or contact, and in no linear coupling row (a
+    rolling or screw pair's law, a link held at an angle).  Nothing but its own value decides
+    such a joint -- a serial arm's joints, a gripper hanging off a loop -- so it is an input of
+    every configuration: solved for, it would be any value."""
+    model = mech.model
+    on_loop = set()
+    pairs = [(c.frame1, c.frame2) for c in mech.cuts]
+    pairs += [(r.frame1, r.frame2) for r in mech.extra_rows if hasattr(r, "frame1")]
+    for f1, f2 in pairs:
+        a = set(model.supports[model.frames[f1].parentJoint])
+        b = set(model.supports[model.frames[f2].parentJoint])
+        on_loop |= a ^ b  # the joints between the frames, not their common ancestors
+    by_v = {c.idx_v + k: c.joint_id for c in mech.coordinates for k in range(c.nv)}
+    for r in mech.extra_rows:
+        on_loop |= {by_v[iv] for _, iv, _ in getattr(r, "terms", ())}
+    return tuple(c.joint for c in mech.coordinates if c.joint_id not in on_loop)
 
 
 @dataclass
@@ -529,13 +549,18 @@ def _motion_space(joints, tol, scale):
                         "prismatic axis perpendicular to it", tuple(normal))
     if not pri and not planar_pairs and all(j.type in ("revolute", "continuous", "spherical", "universal") for j in joints):
         lines = [(np.asarray(j.point), np.asarray(j.direction)) for j in rot]
-        if len(lines) >= 2:
+        # a ball or universal joint's axes all pass through its centre: that centre is the common point
+        centres = [np.asarray(j.point, float) for j in joints if j.type in ("spherical", "universal")
+                   and j.point is not None]
+        c = dist = None
+        if centres:
+            c = centres[0]
+            dist = max([0.0] + [np.linalg.norm(np.cross(c - p, _unit(d))) for p, d in lines])
+        elif len(lines) >= 2:
             c, dist = _common_point([p for p, _ in lines], [d for _, d in lines])
-            if c is not None and dist < lt:
-                centres = [np.asarray(j.point) for j in joints if j.type in ("spherical", "universal")]
-                if all(np.linalg.norm(p - c) < lt for p in centres):
-                    cc = np.round(c, 6) + 0.0
-                    return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
+        if c is not None and dist < lt and all(np.linalg.norm(p - c) < lt for p in centres):
+            cc = np.round(c, 6) + 0.0
+            return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
     axial = [j for j in joints if j.direction is not None and j.point is not None]
     if len(axial) == len(joints) and len(axial) >= 2:  # every joint's axis on one line: a screw, a slide along it
         p0, d0 = np.asarray(axial[0].point, float), _unit(np.asarray(axial[0].direction, float))

@@ -35,6 +35,7 @@ from .report import (
     joint_rows,
     screw_theory_rows,
     screws_text,
+    slide_note,
     solution_rows,
     to_jsonable,
 )
@@ -181,7 +182,7 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     return s
 
 
-def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits()) -> Section:
+def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits(), analysed: int = 1) -> Section:
     """The assembly modes for the inputs: every coordinate (loop joints too) with its rate and acceleration,
     the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
     present/motion.links_rows and points_rows), rates in ``units`` (those typed)."""
@@ -189,13 +190,16 @@ def motion_section(pres, rates_text: str, length: float, units: RateUnits = Rate
     inputs = ", ".join([f"{n} = {_reading(v, n in pres.angular)}" for n, v in pres.inputs.items()]
                        + [f"angle of {k} = {_reading(v, True)}" for k, v in (pres.held or {}).items()])
     s.blocks.append(Text(f"inputs: {inputs or 'none'}; {rates_text}. {len(pres.solutions)} assembly mode(s) found; "
-                         "solution 1 is the configuration this report analyses."))
+                         f"solution {analysed} is the configuration this report analyses (--mode K for another)."))
     for k, sol in enumerate(pres.solutions, 1):
         what = "" if sol.physical else f" (not reached by moving: {'; '.join(sol.labels)})"
         s.blocks.append(Text(f"solution {k}{what}: closure residual {sol.residual:.3g}, sigma_min {sol.sigma_min:.3g}"
                              + (" (singular)" if sol.singular else "")))
         # solve's joint table (loop joints too), links and points tables
         s.blocks.append(Table(*solution_rows(pres, sol, units=units), f"solution-{k}"))
+        note = slide_note(pres, sol)
+        if note:
+            s.blocks.append(Text(note))
         if sol.links and any("angle" in m or "omega" in m for m in sol.links.values()):
             title, head, rows = links_rows(sol.links, units)  # the moving links, as solve lists them
             s.blocks += [Text(title), Table(head, rows, f"links-{k}")]

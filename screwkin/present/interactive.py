@@ -71,6 +71,13 @@ PATH_COLORS = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (14
                (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207))
 
 
+#: The 3-D view's width over its height before a browser says it: a window of 3:2 less the docked panel
+CANVAS_ASPECT = 1.0
+#: A camera within this fraction of its distance from where the view put it is still there (the browser sends
+#: its pose back in single precision); farther, the person moved it and it is no longer framed again
+CAMERA_MOVED = 1e-4
+
+
 def _shown(value, unit) -> float:
     return value * 1000.0 if unit == "m" else math.degrees(value)
 
@@ -104,7 +111,9 @@ class InteractiveView:
         self.viz = _visualizer_class()(mech.model, pin.GeometryModel(), scene.geometry)
         self.viz.initViewer(viewer=self.server, open=False)
         self.viz.loadViewerModel(rootNodeName="screwkin")
+        self._dock()
         self._camera(scene, planar_basis(mech, live.state.q))
+        self.server.on_client_connect(self._frame_client)
         self._lock = threading.RLock()
         self._busy = False
         gui = self.server.gui
@@ -126,18 +135,53 @@ class InteractiveView:
         self._dot = 0.025 * float(scene.scale)  # the dot where each point is now [m]
         self._show()
 
+    def _dock(self):
+        """The control panel docked to the window's right edge: the 3-D view is the rest of the window, so the
+        controls never cover the mechanism (viser's floating panel sat over the view's top right corner)."""
+        gui = self.server.gui
+        panel = getattr(gui, "main_panel", None)
+        if panel is not None and hasattr(panel, "dock_right"):
+            panel.dock_right()
+        else:  # viser before 1.1: a fixed sidebar
+            gui.configure_theme(control_layout="fixed")
+
     def _camera(self, scene, basis):
         """The first view: the mechanism framed (fit_camera, as view's pictures), along the plane's
-        normal for a planar mechanism (its drawing's y up), else from view's usual direction."""
-        pts = scene.points if scene.points is not None else scene.center[None]
-        direction = np.asarray(basis[2], float) if basis is not None else view_direction(scene.bounds)
-        target, eye = fit_camera(pts, direction, aspect=1.5)
+        normal for a planar mechanism (its drawing's y up), else from view's usual direction; for the
+        view's shape before a browser says it (then _frame_client frames it for that browser's)."""
+        self._points = scene.points if scene.points is not None else scene.center[None]
+        self._direction = np.asarray(basis[2], float) if basis is not None else view_direction(scene.bounds)
+        self._up = tuple(float(v) for v in (basis[1] if basis is not None else (0.0, 0.0, 1.0)))
+        target, eye = fit_camera(self._points, self._direction, aspect=CANVAS_ASPECT)
         cam = self.server.initial_camera
         cam.look_at = tuple(float(v) for v in target)
         cam.position = tuple(float(v) for v in eye)
-        cam.up = tuple(float(v) for v in (basis[1] if basis is not None else (0.0, 0.0, 1.0)))
+        cam.up = self._up
         dist = float(np.linalg.norm(eye - target))
         cam.near, cam.far = dist / 100, dist * 100
+
+    def _frame_client(self, client):
+        """Frame the mechanism for a browser as it says its view's size and field of view (its camera messages):
+        the view left of the docked panel is narrower than the window, differs by window, and is known only once
+        the panel is laid out; framed again while the size changes, until the person moves the camera."""
+        framed = {}  # the size last framed for and the camera position set for it
+
+        def frame(cam):
+            size = (int(cam.image_width), int(cam.image_height))
+            if not size[0] or not size[1] or framed.get("size") == size:
+                return
+            moved = np.linalg.norm(np.asarray(cam.position) - framed["eye"]) if "eye" in framed else 0.0
+            if moved > CAMERA_MOVED * framed["dist"]:
+                return  # moved by the person: theirs to keep
+            target, eye = fit_camera(self._points, self._direction, fov_deg=math.degrees(cam.fov),
+                                     aspect=size[0] / size[1])
+            framed.update(size=size, eye=np.asarray(eye, float), dist=float(np.linalg.norm(eye - target)))
+            with client.atomic():
+                cam.up_direction = self._up
+                cam.position = tuple(float(v) for v in eye)  # (moves look_at with it: set it after)
+                cam.look_at = tuple(float(v) for v in target)
+
+        client.camera.on_update(frame)
 
     # ------------------------------------------------------------------ callbacks
     def _mode_names(self) -> list:

@@ -14,17 +14,21 @@ __all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "li
 
 def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
     """(title, headers, rows) of absolute link motion -- the moving links only, never the ground: a
-    planar mechanism's angle, omega, alpha about the plane's normal, or a spatial one's |omega|,
-    |alpha|; the frame origin's speed and acceleration magnitude; rates in ``units`` (those typed).
-    The one links table of ``solve``'s text and ``report``'s document."""
+    planar mechanism's angle, omega, alpha about the plane's normal (signed: counterclockwise positive),
+    or a spatial one's omega and alpha vectors (world axes); the frame origin's velocity and acceleration
+    as vectors in world axes (signed components, never magnitudes alone); rates in ``units`` (those typed,
+    each column's unit in its header).  The one links table of ``solve``'s text and ``report``'s document."""
     planar = any(isinstance(m.get("omega", m.get("angle")), float) for m in links.values())
     rated = any("omega" in m for m in links.values())
     names = list(links)
     cols = []
     w, al, v, a = units.rate(False), units.acceleration(False), units.rate(True), units.acceleration(True)
 
-    def column(key, unit, norm=False):
-        return column_text([units.of(np.linalg.norm(links[n][key]) if norm else links[n][key], unit) for n in names])
+    def column(key, unit):
+        return column_text([units.of(links[n][key], unit) for n in names])
+
+    def vectors(key, unit):
+        return [fmt_vec(units.of(np.asarray(links[n][key], float), unit), 0) for n in names]
 
     if planar:
         head = ["link", "angle [deg]"] + ([f"omega [{w}]", f"alpha [{al}]"] if rated else [])
@@ -32,17 +36,18 @@ def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
         if rated:
             cols += [column("omega", w), column("alpha", al)]
     else:
-        head = ["link"] + ([f"|omega| [{w}]", f"|alpha| [{al}]"] if rated else ["position [m]"])
+        head = ["link"] + ([f"omega x y z [{w}]", f"alpha x y z [{al}]"] if rated else ["position [m]"])
         if rated:
-            cols += [column("omega", w, True), column("alpha", al, True)]
+            cols += [vectors("omega", w), vectors("alpha", al)]
         else:
             cols.append([fmt_vec(links[n]["position"], 0) for n in names])
     if rated:
-        head += [f"|v origin| [{v}]", f"|a origin| [{a}]"]
-        cols += [column("velocity", v, True), column("acceleration", a, True)]
+        head += [f"v origin x y z [{v}]", f"a origin x y z [{a}]"]
+        cols += [vectors("velocity", v), vectors("acceleration", a)]
     rows = [[n] + [("" if c[i] == "nan" else c[i]) for c in cols] for i, n in enumerate(names)]
-    title = ("absolute link motion (angles from the ground's x axis, counterclockwise about the plane's normal)"
-             if planar else "absolute link motion (world frame)")
+    title = ("absolute link motion (angles from the ground's x axis; omega and alpha about the plane's normal, "
+             "counterclockwise positive; vectors in world axes)" if planar
+             else "absolute link motion (vectors in world axes)")
     return title, head, rows
 
 

@@ -10,6 +10,7 @@ from ..errors import UsageError
 from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
 from ..units import in_unit
+from .tables import input_rate_words
 
 __all__ = ["sweep_plot", "motion_figure", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
@@ -39,14 +40,17 @@ def _nearest_turn(angle, along):
     return float(cand[np.argmin(np.abs(cand - along))])
 
 
-def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute=False):
+def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute=False,
+                 rate_words=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
     in degrees on the left axis, lengths in mm on a right axis of their own (dashed); every
     curve has a legend entry; each located singularity (``SweepSingularity``: the sweep's limit
     positions and those of ``--singularities``) is a vertical line, with its kind in the legend.
     linear: mask of the coordinates that are lengths (``Mechanism.translational``; default: none).
-    mus: the transmission angle at each step [rad], drawn in degrees with the joint angles."""
+    mus: the transmission angle at each step [rad], drawn in degrees with the joint angles.
+    rate_words: what the rates are for (tables.input_rate_words: "at crank 120 rpm"; default "per 1 rad/s
+    of crank" from the sweep's rate), on the rate and acceleration axes and in the title."""
     plt = pyplot("--plot")
     n = len(res.names)
     linear = np.zeros(n, bool) if linear is None or len(linear) != n else np.asarray(linear, bool)
@@ -60,10 +64,11 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     scale = np.where(linear, 1000.0, 180.0 / np.pi)  # mm, deg
     first = "absolute angle, position" if absolute else "joint value"
     rates_what = "omega, rate" if absolute else "rate"
+    rate_words = rate_words or input_rate_words(res.input, res.rate, None, not x_deg)
     rows = [(first, joints, "deg", "mm"),
-            (f"{rates_what} (input rate {res.rate:g} {'rad' if x_deg else 'm'}/s)", np.asarray(res.rates), "deg/s",
-             "mm/s"),
-            ("alpha, acceleration" if absolute else "acceleration", np.asarray(res.accelerations), "deg/s²", "mm/s²")]
+            (f"{rates_what} ({rate_words})", np.asarray(res.rates), "deg/s", "mm/s"),
+            (f"{'alpha, acceleration' if absolute else 'acceleration'} ({rate_words})", np.asarray(res.accelerations),
+             "deg/s²", "mm/s²")]
     if paths:
         fig = plt.figure(figsize=(8, 13))
         grid = fig.add_gridspec(4, 1, height_ratios=[1, 1, 1, 1.4])
@@ -114,7 +119,7 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
         if r == 0 or len(handles) > 0:
             ax.legend(handles=handles, fontsize=7, loc="best", ncol=2 if len(handles) > 6 else 1)
     axes[2].set_xlabel(f"input {res.input} [{x_unit}]")
-    fig.suptitle(title or f"sweep of {res.input}", fontsize=11)
+    fig.suptitle(title or f"sweep of {res.input}, {rate_words}", fontsize=11)
     fig.tight_layout()
     return fig
 
@@ -151,7 +156,8 @@ def absolute_series(res, motion, linear=None):
                    accelerations=stack(accs)), np.array(lengths, bool)
 
 
-def motion_figure(res, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
+def motion_figure(res, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
+                  rate_words=None):
     """The figure of a sweep (matplotlib, not yet saved; see :func:`sweep_figure` for what is drawn): for
     a planar mechanism with ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle,
     omega and alpha and the sliders' coordinates, else the joint values; the named points' paths in a
@@ -164,13 +170,15 @@ def motion_figure(res, mus=None, singularities=(), title=None, linear=None, moti
         normal = normal if normal is not None else motion.normal
         e1, e2, _ = plane_basis(normal if normal is not None else (0.0, 0.0, 1.0))
         paths = {n: np.asarray(p["position"]) @ np.stack([e1, e2], axis=1) for n, p in motion.points.items()}
-    return sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None)
+    return sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None,
+                        rate_words=rate_words)
 
 
-def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None):
+def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
+               rate_words=None):
     """A sweep into a PNG: :func:`motion_figure`, saved."""
     plt = pyplot("--plot")
-    fig = motion_figure(res, mus, singularities, title, linear, motion, normal)
+    fig = motion_figure(res, mus, singularities, title, linear, motion, normal, rate_words)
     fig.savefig(path, dpi=100)
     plt.close(fig)
 

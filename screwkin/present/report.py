@@ -38,7 +38,7 @@ from .mobility import (  # noqa: F401 - exported here as before
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
-           "screw_theory_rows", "joint_rows", "nan_to_none"]
+           "screw_theory_rows", "joint_rows", "nan_to_none", "slide_note"]
 
 
 def position_dict(res) -> dict:
@@ -66,6 +66,8 @@ def position_dict(res) -> dict:
             d["leg_lengths"] = s.leg_lengths
         if s.guide_angles:
             d["guide_angles"] = s.guide_angles
+        if s.guide_positions:
+            d["guide_positions"] = s.guide_positions
         if s.linkage:
             d["four_bar" if s.linkage["kind"] == "four-bar" else "slider_crank"] = s.linkage
         if s.output_pose is not None:
@@ -120,8 +122,12 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
     guides = {n: a for n, a in (s.guide_angles or {}).items()  # a slide not along the ground's x axis
               if abs(np.sin(a)) > DEFAULT.equal}
 
+    placed = s.guide_positions or {}
+
     def along(name):
-        return f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
+        where = f"d = {placed[name]:.9g} m" if name in placed else ""
+        at = f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
+        return ", ".join(w for w in (where, at) if w)
 
     rates, accs = [], []
     for name, v in s.joints.items():
@@ -143,10 +149,23 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
                         if s.loop_accelerations else float("nan"))
     if s.rates is not None:  # round-off (a loop joint's 4e-16 rad/s) written as 0
         rows = [row + [r, a] for row, r, a in zip(rows, column_text(rates), column_text(accs))]
-    headers = ["joint", "value [rad or m]", "(deg)"] + (
+    slides = any(name not in res.angular for name in s.joints) or any(
+        name not in res.angular_loop for name in (s.loop_joints or {}))
+    headers = ["joint", "value [rad or m" + ("*]" if slides else "]"), "(deg" + (", d*)" if placed else ")")] + (
         [f"rate [{units.rate(False)} or {units.rate(True)}]",
          f"acceleration [{units.acceleration(False)} or {units.acceleration(True)}]"] if s.rates is not None else [])
     return headers, rows
+
+
+def slide_note(res, s) -> str | None:
+    """The footnote of a joint table with slides: what a slide's value is measured from, and its ``d``."""
+    if all(n in res.angular for n in s.joints) and all(n in res.angular_loop for n in (s.loop_joints or {})):
+        return None
+    note = "* a slide's value is measured from where the file placed its joint"
+    if s.guide_positions:
+        note += ("; d is the slider's position along its guide (on the ground) from the foot of the perpendicular "
+                 "from the world origin: the slider distance of a slider-crank whose crank pivots at the origin")
+    return note
 
 
 def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits(),
@@ -193,6 +212,9 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
         for lab in s.labels:
             lines.append(f"  not reached by moving: {lab}")
         lines.append(table(*solution_rows(res, s, degrees, units)))
+        note = slide_note(res, s)
+        if note:
+            lines.append(note)
         if s.coupled:
             lines.append("coupled (mimic) joints: " + ", ".join(
                 f"{n} = {v:.9g}" + (f" ({np.degrees(v):.6g} deg)" if n in res.angular_coupled else "")
@@ -299,7 +321,16 @@ def singularity_text(rep) -> str:
                  ("constraint (rank of K drops)", yes(rep.constraint), f"{rep.sigmas['constraint']:.3g}"),
              ])]
     lines.append(f"stationary joints (rate forced to zero by the loops): {', '.join(rep.stationary_joints) or 'none'}")
-    for g in getattr(rep, "gram", ()):
+    gram = tuple(getattr(rep, "gram", ()))
+    free = [g for g in gram if not g.cofactors and g.nullity > 1]  # adj(G) = 0: said once, for all such loops
+    if len(free) > 1:
+        lines.append(f"\nloops closed by {', '.join(f'{g.loop} ({len(g.joints)} joint twists, loop mobility {g.nullity})' for g in free)}: "
+                     f"Gram matrix G = S^T S of each loop's joint twists (dimensionless, L = {rep.length:.4g} m)")
+        lines.append("  cofactors: each loop has more than one freedom of its own, so adj(G) = 0 and every cofactor "
+                     "vanishes identically (the cofactors tell the stationary joints of a loop with one freedom)")
+    for g in gram:
+        if len(free) > 1 and g in free:
+            continue
         lines.append(f"\nloop closed by {g.loop}: Gram matrix G = S^T S of its {len(g.joints)} joint twists "
                      f"(dimensionless, L = {rep.length:.4g} m)" + (f", loop mobility {g.nullity}" if g.nullity >= 0 else ""))
         if not g.cofactors:
@@ -316,11 +347,13 @@ def singularity_text(rep) -> str:
         lines.append(f"\n{t.kind} singular direction:")
         if t.joint_rates:
             lines.append("  joints moving: " + ", ".join(f"{n} {v:+.4g}" for n, v in t.joint_rates.items()))
-        if t.screw is not None:
+        if t.screw is not None and np.linalg.norm(t.screw.direction) > 0:
             s = t.screw
             pitch = f"{s.pitch:.4g} m/rad" if np.isfinite(s.pitch) else "inf (a translation)"
             lines.append(f"  screw: axis direction {_fmt_vec(s.direction, 0)}, through "
                          f"{_fmt_vec(s.point, 0) if s.point is not None else '-'}, pitch {pitch}")
+        elif t.twist is not None:  # never a zero twist written as a screw
+            lines.append(f"  the output '{rep.output}' does not move in it (a zero twist: no screw)")
     return "\n".join(lines)
 
 

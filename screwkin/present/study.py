@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.design.study import pareto_front
+from ..analysis.design.study import MODE_METRICS, pareto_front
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
@@ -33,6 +33,7 @@ __all__ = [
     "Progress",
     "check_table_path",
     "LABELS",
+    "mode_rule",
     "metrics_figure",
     "metrics_png",
     "pareto_figure",
@@ -124,13 +125,25 @@ def study_dict(result) -> dict:
         "designs": len(result.rows), "analysed": len(result.succeeded), "failed": len(result.failed),
         "seconds": result.seconds, "workers": result.workers, "scheduler": result.scheduler, "chunks": result.chunks,
         "units": "SI (m, rad; workspace volumes in m^workspace_dimension)",
-        "timeout": spec.timeout, "workspace": dict(spec.workspace) if _workspace_metrics(result) else None,
+        "timeout": spec.timeout, "mode": spec.mode or 1, "mode_rule": mode_rule(result), "workspace": dict(spec.workspace) if _workspace_metrics(result) else None,
         "rows": [dict(r) for r in result.rows],
     }
     if spec.pareto and result.succeeded:
         d["pareto"] = {"columns": [{"column": c, "goal": g} for c, g in spec.pareto],
                        "designs": [result.rows[k]["design"] for k in pareto_front(result)]}
     return to_jsonable(d)
+
+
+def mode_rule(result) -> str | None:
+    """The one line that says which assembly mode every design follows (the metrics of MODE_METRICS), or None."""
+    if not any(m in MODE_METRICS for m in result.spec.metrics):
+        return None
+    k = result.spec.mode or 1
+    inputs = (f"its input {result.spec.input!r} at its value" if result.spec.input
+              else "its actuated joints at their values")
+    return (f"assembly mode: each design follows mode {k}{' (the default)' if result.spec.mode is None else ''} of "
+            f"{inputs} in its assembled configuration, as solve lists them (--mode K); the columns mode and "
+            "modes give it and how many each design has")
 
 
 def _workspace_metrics(result) -> bool:
@@ -165,6 +178,9 @@ def study_text(result, table_path=None) -> str:
                      + (" (its origin as a point)" if ws.get("point") else " (at its assembled orientation)")
                      + f" on a grid of step {ws['resolution']:g} m (the spec's workspace resolution), threshold "
                      + f"{ws.get('threshold', 0.01):g}")
+    line = mode_rule(result)
+    if line:
+        lines.append(line)
     if bad:
         reasons = Counter(r["error"] for r in bad)
         lines.append("failed designs:")

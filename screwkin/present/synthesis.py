@@ -17,7 +17,7 @@ import numpy as np
 
 from ..analysis.design.synthesis.designs import ChainsResult, Check, FunctionResult, MotionResult, PathResult
 from ..analysis.design.synthesis.chains import guides_of
-from ..analysis.design.synthesis.fourbar import tool_local, wrap
+from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local, wrap
 from .report import table, to_jsonable
 from .tables import shown
 
@@ -76,6 +76,8 @@ def _core(kind, design, check: Check, file) -> dict:
         "file": str(file),
         "links": links,
         "pivots": {"A0": _pt(fb.A0), "B0": _pt(fb.B0), "A": _pt(fb.A), "B": _pt(fb.B)},
+        # the same pivots by the file's joint and the letter `draw` gives it (one lettering for text and drawing)
+        "pivot_joints": {role: {"joint": joint, "letter": check.letters.get(joint)} for role, joint in PIVOT_JOINTS.items()},
         "precision": precision,
         "grashof": check.grashof,
         "transmission_angle_range": [math.degrees(mu[0]), math.degrees(mu[1])] if mu else None,
@@ -189,14 +191,16 @@ def synthesis_text(result, check: Check, file) -> str:
                    f"{result.converged} reached every point within {_fmt(result.tolerance, 3)} m")
     links = d["links"]
     out.append("links [m]: " + ", ".join(f"{n} {_fmt(v['length'])}" for n, v in links.items()))
+    named = {role: (v["letter"] or role) for role, v in d["pivot_joints"].items()}  # draw's letters
     if "frame" in links["coupler"] or "point" in links["coupler"]:
         t = links["coupler"].get("frame") or links["coupler"].get("point")
         extra = f", {_fmt(t['angle_deg'])} deg" if "angle_deg" in t else ""
-        out.append(f"coupler {'frame' if 'frame' in links['coupler'] else 'point'} in the coupler's frame (origin A, x "
-                   f"along AB): ({_fmt(t['x'])}, {_fmt(t['y'])}) m{extra}")
+        out.append(f"coupler {'frame' if 'frame' in links['coupler'] else 'point'} in the coupler's frame (origin "
+                   f"{named['A']}, x along {named['A']}{named['B']}): ({_fmt(t['x'])}, {_fmt(t['y'])}) m{extra}")
     pv = d["pivots"]
-    out.append("pivots [m] (at the first position): " + ", ".join(f"{k} ({_fmt(v[0])}, {_fmt(v[1])})"
-                                                                   for k, v in pv.items()))
+    order = sorted(pv, key=lambda role: named[role])
+    out.append("joints [m] (at the first position; lettered as draw letters them): " + ", ".join(
+        f"{named[r]} {d['pivot_joints'][r]['joint']} ({_fmt(pv[r][0])}, {_fmt(pv[r][1])})" for r in order))
     out.append(f"Grashof: {d['grashof'] or 'not identified'}")
     mu = d["transmission_angle_range"]
     out.append("transmission angle over the motion: " + (f"{mu[0]:.4g} .. {mu[1]:.4g} deg" if mu else "not measured")

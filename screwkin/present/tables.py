@@ -8,7 +8,8 @@ from dataclasses import dataclass
 
 from ..units import in_unit, unit_kind
 
-__all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits"]
+__all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits",
+           "input_rate_words"]
 
 #: Display cut-off: a number smaller than this in magnitude is written as 0 (round-off is not a value).
 SHOWN_ZERO = 1e-12
@@ -54,11 +55,13 @@ class RateUnits:
 
     #: a unit typed -> (field, display unit): an angle or a length given for a rate keeps its old meaning
     #: (--rate crank=90deg is 90 deg/s); degrees typed for a rate show accelerations in deg/s^2 too
-    _RATE = {"deg": ("deg/s", "deg/s^2"), "deg/s": ("deg/s", "deg/s^2"), "rpm": ("rpm", None),
-             "rev/min": ("rpm", None), "rev/s": ("rev/s", None), "mm": ("mm/s", "mm/s^2"),
-             "mm/s": ("mm/s", "mm/s^2"), "cm": ("cm/s", None), "cm/s": ("cm/s", None)}
+    #: (each rate's acceleration is its unit per second: rpm -> rpm/s, never rpm beside rad/s^2)
+    _RATE = {"deg": ("deg/s", "deg/s^2"), "deg/s": ("deg/s", "deg/s^2"), "rpm": ("rpm", "rpm/s"),
+             "rev/min": ("rpm", "rpm/s"), "rev/s": ("rev/s", "rev/s^2"), "mm": ("mm/s", "mm/s^2"),
+             "mm/s": ("mm/s", "mm/s^2"), "cm": ("cm/s", "cm/s^2"), "cm/s": ("cm/s", "cm/s^2")}
     _ACCEL = {"deg": "deg/s^2", "deg/s^2": "deg/s^2", "deg/s2": "deg/s^2", "mm": "mm/s^2", "mm/s^2": "mm/s^2",
-              "mm/s2": "mm/s^2"}
+              "mm/s2": "mm/s^2", "rpm/s": "rpm/s", "rev/s^2": "rev/s^2", "rev/s2": "rev/s^2", "cm/s^2": "cm/s^2",
+              "cm/s2": "cm/s^2"}
 
     @classmethod
     def typed(cls, rate_units=(), accel_units=()) -> "RateUnits":
@@ -91,6 +94,17 @@ class RateUnits:
     def of(value: float, unit: str) -> float:
         """An SI value in ``unit`` (rad/s -> rpm ...): units.in_unit."""
         return in_unit(value, unit)
+
+
+def input_rate_words(name: str, rate: float, unit: str | None, linear: bool) -> str:
+    """What a sweep's rates and accelerations are for, in words: ``at crank 120 rpm`` for a rate typed
+    (``unit`` as typed; an angle or a length typed for a rate is per second), ``per 1 rad/s of crank`` for
+    the default (the input at 1 rad/s or 1 m/s: the rates are then the velocity ratios)."""
+    si = "m/s" if linear else "rad/s"
+    if not unit:
+        return f"per {rate:g} {si} of {name}" if rate == 1.0 else f"at {name} {rate:g} {si}"
+    written = RateUnits._RATE.get(unit, (None,))[0] or RateUnits._RATE.get(unit.lower(), (None,))[0] or unit
+    return f"at {name} {in_unit(rate, written.replace('^', '')):.6g} {written}"
 
 
 #: What a spreadsheet reads as the start of a formula in a text cell (CSV injection).

@@ -36,12 +36,14 @@ from ...files.xmlsafe import read_regular_file
 from ...model.loader import load
 from ..mobility import analyze_mobility
 from ..motion.planar import identify, transmission_angles
+from ..motion.modes import choose_mode
 from ..motion.position import PositionSolver
 from ..motion.sweep import sweep
 from .workspace import DEFAULT_THRESHOLD, workspace
 
 __all__ = [
     "COLUMNS",
+    "MODE_METRICS",
     "METRICS",
     "DesignTimeout",
     "StudyResult",
@@ -59,11 +61,15 @@ COLUMNS = {
     "mobility": ("mobility", "mobility_count", "motion_space", "overconstraint", "idle_dofs", "effective_mobility",
                  "output_motion"),
     "grashof": ("linkage", "grashof", "grashof_margin"),
-    "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts"),
-    "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated"),
-    "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated"),
-    "conditioning": ("conditioning_min", "conditioning_mean"),
+    "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts", "mode",
+                           "modes"),
+    "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated", "mode", "modes"),
+    "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated", "mode",
+                                "modes"),
+    "conditioning": ("conditioning_min", "conditioning_mean", "mode", "modes"),
 }
+#: The metrics that follow one assembly mode (their rows say which: ``mode`` K of ``modes`` N).
+MODE_METRICS = ("transmission_angle", "workspace_volume", "singularity_free_volume", "conditioning")
 
 #: Short Grashof classes, from the start of analysis.motion.planar's class sentences.
 _GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
@@ -164,6 +170,7 @@ class _Task:
     workspace: dict
     steps: int
     timeout: float = 120.0  # seconds per design
+    mode: int | None = None  # the K-th assembly mode (motion.modes.choose_mode); None: the first
 
 
 class _Design:
@@ -175,6 +182,27 @@ class _Design:
         clock.check()
         self._linkage = None
         self._workspace = None
+        self.mode = None  # (K, N) once the mode is chosen (the metrics that follow one: MODE_METRICS)
+        if any(m in MODE_METRICS for m in task.metrics):
+            self._choose_mode()
+            clock.check()
+
+    def _choose_mode(self):
+        """The assembly mode the design's motion and workspace follow: the task's ``mode`` K (default 1) of the
+        inputs (the study's input, else the actuated joints) at their values in the assembled configuration,
+        as ``solve`` lists them (the one rule of every command's --mode); ``self.q`` becomes its
+        configuration.  Without inputs, the assembled configuration, one mode."""
+        mech = self.mech
+        inputs = [self.task.input] if self.task.input else [n for n in mech.actuated if mech.coordinate(n).nv == 1]
+        if not inputs:
+            self.mode = (1, 1)
+            return
+        values = mech.joint_values(self.q)
+        self.q, k, n, _ = choose_mode(PositionSolver(mech, inputs), {j: values[j] for j in inputs}, self.task.mode)
+        self.mode = (k, n)
+
+    def mode_columns(self) -> dict:
+        return {"mode": self.mode[0], "modes": self.mode[1]}
 
     @property
     def input(self) -> str:
@@ -200,9 +228,11 @@ class _Design:
             ws = self.task.workspace
             # what `screwkin workspace FILE --output LINK [--point] --resolution H [--threshold T] [--length L]`
             # computes for this design (the spec checked that a resolution is given)
+            looped = bool(self.mech.cuts or self.mech.extra_rows)  # (a chain without loops has one mode)
             self._workspace = workspace(self.mech, self.task.output, point=ws.get("point", False),
                                         resolution=ws["resolution"],
-                                        threshold=ws.get("threshold", DEFAULT_THRESHOLD), length=ws.get("length"))
+                                        threshold=ws.get("threshold", DEFAULT_THRESHOLD), length=ws.get("length"),
+                                        q_start=self.q if looped else None)
         return self._workspace
 
 
@@ -272,24 +302,25 @@ def _transmission(d: _Design) -> dict:
                 Q.append(q)
     mus = transmission_angles(mech, info, Q)
     return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max()),
-            "transmission_restarts": restarts}
+            "transmission_restarts": restarts, **d.mode_columns()}
 
 
 def _workspace_volume(d: _Design) -> dict:
     w = d.workspace()
     # truncated: MAX_POINTS cut the grid (a resolution too fine for the workspace): the volumes are lower bounds
-    return {"workspace_dimension": w.dimension, "workspace_volume": w.volume, "workspace_truncated": w.truncated}
+    return {"workspace_dimension": w.dimension, "workspace_volume": w.volume, "workspace_truncated": w.truncated,
+            **d.mode_columns()}
 
 
 def _singularity_free_volume(d: _Design) -> dict:
     w = d.workspace()
     return {"workspace_dimension": w.dimension, "singularity_free_volume": w.free_volume,
-            "workspace_truncated": w.truncated}
+            "workspace_truncated": w.truncated, **d.mode_columns()}
 
 
 def _conditioning(d: _Design) -> dict:
     w = d.workspace()
-    return {"conditioning_min": w.conditioning_min, "conditioning_mean": w.conditioning_mean}
+    return {"conditioning_min": w.conditioning_min, "conditioning_mean": w.conditioning_mean, **d.mode_columns()}
 
 
 #: metric name -> function of a loaded, assembled design returning its columns (COLUMNS).
@@ -391,7 +422,8 @@ def study_task(spec: StudySpec) -> _Task:
     except UnicodeDecodeError:
         raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
     return _Task(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
-                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps, spec.timeout)
+                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps, spec.timeout,
+                 spec.mode)
 
 
 def _resolve(name: str, keys) -> str | None:

@@ -182,7 +182,7 @@ def _translations(mech, q, output, point) -> np.ndarray:
 def workspace(mech, output: str, point: bool = False, orientation=None, resolution: float | None = None,
               bounds=None, threshold: float = DEFAULT_THRESHOLD, length: float | None = None,
               method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None,
-              timeout: float | None = None) -> WorkspaceResult:
+              timeout: float | None = None, q_start=None) -> WorkspaceResult:
     """The workspace of link ``output`` (see the module's text).
 
     point: its origin as a point (orientation free); else at a constant ``orientation`` (a 3x3
@@ -194,6 +194,9 @@ def workspace(mech, output: str, point: bool = False, orientation=None, resoluti
     of the measures (default ``mech.length``).  method: "grid" or "sampling" (default:
     sampling for a serial chain's point, else grid).  samples, seed: of the sampling method.
     inputs: the input joints (default: the actuated ones, or every joint of a serial chain).
+    q_start: an assembled configuration of the mode whose workspace it is (a command's --mode K), or a
+    function giving it, called once the arguments are checked; default: the file's assembled one (or the
+    nearest generic one when that is singular for the output).
     """
     if not (threshold >= 0 and np.isfinite(threshold)):
         raise UsageError(f"the threshold must be a non-negative number, got {threshold!r}")
@@ -222,19 +225,21 @@ def workspace(mech, output: str, point: bool = False, orientation=None, resoluti
     if method == "sampling":
         return _sampling(mech, output, measures, resolution, bounds, threshold, L, samples, seed, inputs)
     deadline = None if timeout is None else time.monotonic() + float(timeout)
-    return _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs, deadline)
+    return _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs, deadline,
+                 q_start)
 
 
-def _seed(mech, output, point, orientation):
-    """The assembled configuration the grid starts from, the output's position and the grid's
-    orientation there (continued from the file's orientation to the one asked)."""
+def _seed(mech, output, point, orientation, q_start=None):
+    """The assembled configuration the grid starts from (``q_start`` when given), the output's position
+    and the grid's orientation there (continued from the file's orientation to the one asked)."""
     assembly, generic = mech.generic_configurations()
+    q_start = q_start() if callable(q_start) else q_start
     fid = mech.link_frame(output)
     bc = BatchClosure(mech, target=(output, "point" if point else "pose"), check=0)
     # the file's assembled configuration may be singular for the output (an arm drawn stretched,
     # a wrist with aligned axes): then the nearest generic one, where the rows' rank is largest
     best = None
-    for q in [assembly.q] + list(generic):
+    for q in [assembly.q] + list(generic) if q_start is None else [np.asarray(q_start, float)]:
         M = KinematicState(mech, q).frame_placement(fid)
         K = bc.evaluate(q[None], (M.translation[None], M.rotation))[1][0]
         k = rank(K, mech.tolerances)
@@ -279,19 +284,19 @@ def _index_bounds(bounds, p_seed, axes, h, dim):
 
 
 def _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs,
-          deadline=None) -> WorkspaceResult:
+          deadline=None, q_start=None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
     except Unbatchable as e:
         raise UsageError(f"{e}: the workspace's batched solver does not take these yet") from None
-    q_seed, p_seed, R = _seed(mech, output, point, orientation)
+    q_seed, p_seed, R = _seed(mech, output, point, orientation, q_start)
     directions = _translations(mech, q_seed, output, point)
     dim = directions.shape[1]
     if dim < 2 and not point and orientation is None and _translations(mech, q_seed, output, True).shape[1] >= 2:
         # the link cannot keep its orientation and move over an area (a five-bar's distal link):
         # what is asked is then where its origin goes
         res = _grid(mech, output, True, None, _Measures(mech, output, True, inputs, L), resolution, bounds,
-                    threshold, L, inputs, deadline)
+                    threshold, L, inputs, deadline, q_start)
         note = (f"'{output}' moves over no area at a constant orientation: the workspace of its origin with "
                 "any orientation (as --point)")
         return dataclasses.replace(res, notes=(note,) + tuple(res.notes))

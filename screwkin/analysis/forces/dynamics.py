@@ -40,8 +40,9 @@ from ...errors import MechanismFileError, UsageError, quote
 from ...model._pin import frame_jacobian
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
-from .statics import actuator_efforts, balance, coupled_efforts, coupled_units, reaction_table
-from ..motion.sweep import sweep
+from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
+                      reaction_joint_id, reaction_table)
+from ..motion.sweep import sweep, sweep_inputs
 
 __all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
 
@@ -160,7 +161,10 @@ def _ground_sides(mech) -> tuple:
     """(tree joints whose parent is the ground, {cut joint: +1 when its link2 is on the ground,
     -1 when its link1 is})."""
     model = mech.model
-    tree = {c.joint for c in mech.coordinates if model.parents[c.joint_id] == 0}
+    compounds = compound_joints(mech)
+    inside = {m: name for name, members in compounds.items() for m in members}
+    # (a compound joint's row is named as mobility names it; its member next to the parent is the one on the ground)
+    tree = {inside.get(c.joint, c.joint) for c in mech.coordinates if model.parents[c.joint_id] == 0}
     tree |= {c.joint for c in mech.couplings if model.parents[model.getJointId(c.joint)] == 0}
     cuts = {}
     for cut in mech.cuts:
@@ -217,14 +221,15 @@ def _range_mean(values, y) -> float:
 
 def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
              fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress: bool = False) -> DynamicsResult:
+             cs: float = 0.05, progress: bool = False, q_start=None) -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 
     inputs: the actuated joints (default: the mechanism's actuated joints when ``input`` is one
     of them, else ``input`` and the joints of ``fixed``); fixed: the other inputs' values;
     gravity: (gx, gy, gz) [m/s^2]; loads: Load; cs: the coefficient of speed fluctuation of the
-    flywheel figure (0 < cs < 2)."""
+    flywheel figure (0 < cs < 2); q_start: a configuration of the assembly mode to follow (as sweep's;
+    without it the mode is solve's first at ``start``, near ``near``)."""
     if not 0 < cs < 2:
         raise UsageError(f"the coefficient of speed fluctuation must lie between 0 and 2, got {cs:g}")
     g = np.asarray(gravity, float)
@@ -237,14 +242,12 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
                      f"{', '.join(quote(n, 30) for n in own[:3])}{', ...' if len(own) > 3 else ''}) are not in these "
                      "efforts (the rigid bodies' dynamics only); export --mjcf writes them for MuJoCo")
     fixed = dict(fixed or {})
-    if inputs is None:
-        inputs = list(mech.actuated) if input in mech.actuated else [input, *[n for n in fixed if n != input]]
-    inputs = list(inputs)
+    inputs = sweep_inputs(mech, input, fixed) if inputs is None else list(inputs)
     for ld in loads:
         mech.link_frame(ld.link)  # a clear error for an unknown link
     solver = PositionSolver(mech, inputs)
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
-                near=near, rate=speed, progress=progress)
+                near=None if q_start is not None else near, rate=speed, progress=progress, q_start=q_start)
     model = mech.model
     data = mech.scratch_data()
     a_idx = mech.velocity_indices(inputs)
@@ -282,7 +285,8 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         # data holds q's placements (its own Data: reaction_table computes in another)
         for name, (kind, wrench, _) in table.items():
             if kind in ("tree", "coupled") and name in ground_tree:
-                sign, origin = -1.0, data.oMi[model.getJointId(name)].translation
+                jid = model.getJointId(name) if kind == "coupled" else reaction_joint_id(mech, name)
+                sign, origin = -1.0, data.oMi[jid].translation
             elif kind == "cut" and name in ground_cuts:
                 cut = next(c for c in mech.cuts if c.name == name)
                 sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation

@@ -40,7 +40,8 @@ from ..screws import Screw, cut_twists, screw_of
 from ..singularities.singular import Generic, measures
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
-           "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts"]
+           "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts", "compound_joints",
+           "reaction_joint_id", "no_legs_reason"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -222,14 +223,18 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dic
     g = model.gravity.linear if gravity is True else np.zeros(3) if gravity is False else np.asarray(gravity, float)
     pin.rnea(mech.model_with_gravity(g), data, q, zero_v if v is None else v, zero_v if a is None else a, fext)
     virtual = {n for names in mech.virtual_joints.values() for n in names}
+    compounds = compound_joints(mech)
+    inside = {m: name for name, members in compounds.items() for m in members}
     out = {}
     for c in mech.coordinates:
-        if c.joint in virtual:
+        if c.joint in virtual or (c.joint in inside and c.joint != compounds[inside[c.joint]][0]):
             continue
         jid = c.joint_id
         f = data.f[jid]  # transmitted from the parent into joint jid's body, in the joint frame
         M = data.oMi[jid]
-        out[c.joint] = ("tree", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
+        # a compound joint (three revolutes through massless links: a ball joint) is one row, named as mobility
+        # names it: the wrench its member next to the parent link transmits
+        out[inside.get(c.joint, c.joint)] = ("tree", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
     for cp in mech.couplings:  # a coupled joint carries its reaction too; its effort: coupled_efforts
         jid = model.getJointId(cp.joint)
         f, M = data.f[jid], data.oMi[jid]
@@ -276,6 +281,26 @@ def actuator_efforts(mech, inputs, efforts: dict) -> dict:
     return out
 
 
+def compound_joints(mech) -> dict:
+    """Compound joint name as mobility names it (``rod1a_top[S]``: model.topology) -> its tree members, the one
+    next to the parent link first (the joint whose origin its reaction is given at); cached on the mechanism.
+    Compounds through a cut joint are left out (their members are reported as they are)."""
+    if "compound_joints" not in mech.cache:
+        model, names = mech.model, set(mech.coordinate_names)
+        found = {}
+        for j in mech.topology().joints:
+            if len(j.members) > 1 and not j.cut and all(m in names for m in j.members):
+                found[j.name] = tuple(sorted(j.members, key=lambda m: len(model.supports[mech.coordinate(m).joint_id])))
+        mech.cache["compound_joints"] = found
+    return mech.cache["compound_joints"]
+
+
+def reaction_joint_id(mech, name: str) -> int:
+    """The tree joint at whose origin a tree reaction row (a joint, or a compound joint) is given."""
+    members = compound_joints(mech).get(name)
+    return mech.coordinate(members[0] if members else name).joint_id
+
+
 # ------------------------------------------------------------------ legs
 @dataclass(frozen=True)
 class Leg:
@@ -291,6 +316,21 @@ class Leg:
     transmission_wrenches: tuple
     constraint_screws: tuple  # Screw
     transmission_screws: tuple
+
+
+def no_legs_reason(leg_list, output: str) -> str | None:
+    """Why the chains that join ``output`` to the ground are not a parallel mechanism's legs (None when they
+    are): legs are two or more chains of two or more joints each from the ground to a platform (a Delta's,
+    a Stewart platform's, a five-bar's).  A slider-crank's slider on its guide or a four-bar's coupler with
+    its rocker is a link joined by a single joint on one side: its chains are no legs."""
+    if len(leg_list) < 2:
+        return f"'{output}' is joined to the ground by one chain"
+    single = [leg.joints for leg in leg_list if len(leg.joints) < 2]  # (none: the loop joint itself)
+    if single:
+        named = ", ".join(j[0] for j in single if j)
+        return (f"'{output}' is joined to the ground by {f'the single joint {named}' if named else 'a single loop joint'}"
+                " on one side: a link of a linkage, not a platform on legs")
+    return None
 
 
 def wrench_screw(wrench, point) -> Screw:
@@ -375,7 +415,8 @@ def legs(mech, q, output, inputs=None) -> tuple:
         P = W_locked - W @ (W.T @ W_locked) if W.size else W_locked
         Ut, st, _ = np.linalg.svd(P, full_matrices=False) if P.size else (np.zeros((6, 0)), np.zeros(0), None)
         trans = Ut[:, st > tol.rank_rtol] if st.size else np.zeros((6, 0))  # rank of P (orthonormal columns)
-        names = tuple(coords[j].joint for j in joints)
+        named = {m: name for name, members in compound_joints(mech).items() for m in members}
+        names = tuple(dict.fromkeys(named.get(coords[j].joint, coords[j].joint) for j in joints))  # as mobility
         out.append(Leg(names, tuple(n for n in names if n in inputs), rank(T, tol),
                        tuple(tuple(map(float, c)) for c in W.T), tuple(tuple(map(float, c)) for c in trans.T),
                        tuple(wrench_screw(c, o) for c in W.T), tuple(wrench_screw(c, o) for c in trans.T)))

@@ -26,6 +26,7 @@ import numpy as np
 from ...errors import AssemblyError, UsageError
 from ...model.state import KinematicState
 from .links import point_motions
+from .modes import choose_mode
 from .position import PositionSolver
 from ..singularities.singular import measures
 from .sweep import sweep
@@ -76,10 +77,11 @@ class LiveState:
 class Interactive:
     """Inputs -> configuration for a GUI, one assembly mode followed as the inputs move.
 
-    inputs: the input joints (default: the actuated ones); values: their starting values
-    (default: the file's assembled configuration's); mode: the starting assembly mode (1-based,
-    as solve lists them); output: the output link whose pose is read out; points:
-    analysis.motion.links.Point objects read out."""
+    inputs: the input joints (default: the actuated ones); values: their starting values, all or some
+    (default, for each input not given: the file's value when the file's configuration assembles with
+    them, else the value in the first configuration the assembly search closes; ``opened`` says which);
+    mode: the starting assembly mode (1-based, as solve lists them: analysis.motion.modes.choose_mode);
+    output: the output link whose pose is read out; points: analysis.motion.links.Point objects read out."""
 
     def __init__(self, mech, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,
                  points=()):
@@ -89,17 +91,33 @@ class Interactive:
         if not self.inputs:
             raise UsageError(f"{mech.path}: no input to move: declare actuated joints or give --inputs")
         self.output, self.points = output, tuple(points)
-        if values is None:
-            q0 = mech.assemble().q
-            joints = mech.joint_values(q0)
-            values = {n: joints[n] for n in self.inputs}
-        self._values = {n: float(values[n]) for n in self.inputs}
-        self.controls = tuple(self._control(n, self._values[n]) for n in self.inputs)
+        given = {n: float(v) for n, v in (values or {}).items()}
+        unknown = [n for n in given if n not in self.inputs]
+        if unknown:
+            raise UsageError(f"{mech.path}: {', '.join(unknown)}: not an input (inputs: {', '.join(self.inputs)})")
+        missing = [n for n in self.inputs if n not in given]
+        drawn = mech.joint_values(mech.neutral())  # the file's own values
+        self._values = {n: given.get(n, drawn.get(n, 0.0)) for n in self.inputs}
+        source = "the file's value" if missing else None
+        try:
+            q, k, n, _ = choose_mode(self.solver, dict(self._values), mode)
+        except AssemblyError:
+            if not missing:
+                raise
+            # the file's drawing does not close at its own input values: the first configuration that closes
+            assembled = mech.joint_values(mech.assemble().q)
+            self._values.update({n: assembled[n] for n in missing})
+            source = ("the first assembled configuration's: the file's configuration does not close at its own "
+                      "input values")
+            q, k, n, _ = choose_mode(self.solver, dict(self._values), mode)
+        self.opened = "opened at " + ", ".join(
+            f"{name} = " + (f"{v * 1000:.6g} mm" if mech.translational[mech.coordinate(name).idx_v]
+                            else f"{math.degrees(v):.6g} deg") + ("" if name in given else f" ({source})")
+            for name, v in self._values.items())
+        self.mode_index = (k, n)
+        self.controls = tuple(self._control(name, self._values[name]) for name in self.inputs)
         self._modes = None
-        modes = self.modes()
-        if not 1 <= mode <= len(modes):
-            raise UsageError(f"--mode {mode}: these inputs give {len(modes)} assembly mode{'s' if len(modes) != 1 else ''}")
-        self.state = self._state(modes[mode - 1], mode)
+        self.state = self._state(q, k)
         self._trace = deque(maxlen=MAX_PATH)  # (inputs, {point: position}) per step
         self._record(self.state.inputs, self.state.points)
 

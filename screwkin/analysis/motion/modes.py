@@ -13,14 +13,28 @@ from dataclasses import replace
 import numpy as np
 import pinocchio as pin
 
-from ...errors import AssemblyError
+from ...errors import AssemblyError, UsageError
 from ...model.linalg import null_space, rank
 from ...model.state import KinematicState
 from ..singularities.singular import scaled_jacobians
 
-__all__ = ["merge", "moves", "connected", "ModeLabels"]
+__all__ = ["merge", "moves", "connected", "ModeLabels", "choose_mode"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+def choose_mode(solver, values: dict, k: int | None = None, near: dict | None = None, starts: int = 24,
+                **options) -> tuple:
+    """The assembly mode a configuration is analysed in, or a motion starts from: the ``k``-th of
+    ``solver.solve(values, near=near, **options)``'s solutions (default 1: the one nearest the reference
+    configuration, or ``near``'s), as (q, k, n, result) with n the modes found and result solve's
+    PositionResult.  A usage error when k is more than n.  The one rule every command's ``--mode K`` (and a
+    study's ``mode``) goes by."""
+    res = solver.solve(values, near=near, starts=starts, **options)
+    n, k = len(res.solutions), k or 1
+    if k > n:
+        raise UsageError(f"--mode {k}: these inputs give {n} assembly mode{'s' if n != 1 else ''}")
+    return res.solutions[k - 1].q, k, n, res
 
 
 def merge(solver, sols):

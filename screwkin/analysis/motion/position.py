@@ -35,6 +35,7 @@ import pinocchio as pin
 from ...errors import AssemblyError, UsageError
 from ...model.closure import Assembly
 from ...model.state import KinematicState, angular_loop_joints
+from ...model.topology import open_joints
 from . import modes
 from ..mobility import analyze_mobility
 from .links import link_motions, point_motions
@@ -108,6 +109,7 @@ class Solution:
     linkage: dict | None = None  # a four-bar's diagonal construction (mu, z, alpha, beta) or a slider-crank's mu
     leg_lengths: dict | None = None  # prismatic joint -> distance between the joint centres its leg connects [m]
     guide_angles: dict | None = None  # planar: prismatic joint (tree or loop) -> its slide's angle from the ground's x [rad]
+    guide_positions: dict | None = None  # prismatic joint on the ground -> slider's position along its guide [m] (state.py)
 
     @property
     def physical(self) -> bool:
@@ -199,6 +201,13 @@ class PositionSolver:
         if len(set(names)) != len(names):
             raise UsageError(f"{mech.path}: an input joint is named twice: {', '.join(names)}")
         self.inputs = names
+        # joints no loop passes through and no input names: nothing decides them but a value
+        loose = [mech.coordinate(j) for j in open_joints(mech) if j not in names]
+        self.unset = tuple(c.joint for c in loose if c.nv == 1)  # solve refuses them unset (unset_error)
+        # a multi-coordinate one (a floating base, a ball joint in the tree) keeps the file's value
+        self.kept = tuple(c.joint for c in loose if c.nv > 1)
+        self._kept_q = np.concatenate([np.arange(c.idx_q, c.idx_q + c.nq) for c in loose if c.nv > 1]).astype(int) \
+            if self.kept else np.zeros(0, int)
         self.frozen = mech.velocity_indices(names)
         self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
         self.output = output
@@ -253,7 +262,8 @@ class PositionSolver:
         """DOFs left free with the inputs held, beyond the idle ones (0 = the inputs determine
         the mechanism)."""
         g = self.generic()
-        return max(len(self.passive) - g.rank_Kp - self.idle_dofs, 0)
+        kept = sum(self.mech.coordinate(j).nv for j in self.kept)  # held at the file's values, not free
+        return max(len(self.passive) - g.rank_Kp - self.idle_dofs - kept, 0)
 
     def _mobility(self):
         self.generic()  # the assembly the mobility analysis starts from
@@ -333,6 +343,20 @@ class PositionSolver:
             raise UsageError(f"{self.mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
                              + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
 
+    def unset_error(self) -> UsageError:
+        """The usage error of a solve whose inputs leave out joints that no loop passes through
+        (``unset``): they are inputs too, named with the file's values as a way to give them."""
+        names = list(self.unset)
+        file_values = self.mech.joint_values(self.mech.neutral())
+        shown = {n: file_values[n] for n in names}
+        if len(set(shown.values())) == 1:
+            hint = f"--set {','.join(names)}={next(iter(shown.values())):g}"
+        else:
+            hint = " ".join(f"--set {n}={v:g}" for n, v in shown.items())
+        return UsageError(f"{self.mech.path}: no loop passes through {', '.join(names)}: "
+                          f"{'each is an input' if len(names) > 1 else 'it is an input'} that only its own value "
+                          f"decides; give {'them' if len(names) > 1 else 'it'} with --set (the file's values: {hint})")
+
     def track(self, values: dict, q) -> Assembly:
         """The configuration that damped Newton reaches from the configuration ``q`` with the
         named inputs moved to ``values`` (inputs not named keep their values in q): the
@@ -352,6 +376,8 @@ class PositionSolver:
         objects whose position (and velocity, acceleration with ``rates``) each solution reports."""
         mech = self.mech
         self._check_inputs(values)
+        if self.unset:
+            raise self.unset_error()
         typed, whole = dict(values), whole_turns(self, values)
         values = {n: v - whole.get(n, 0.0) for n, v in values.items()}  # solved within a turn, then turned on
         steps = []
@@ -366,6 +392,10 @@ class PositionSolver:
             found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
                                         first_trace=recorder if trace else None)
         start_list = [near_q] if found else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
+        if self.kept:  # joints of several coordinates no loop passes through: the file's values, not random ones
+            neutral, start_list = mech.neutral(), [np.array(q0, float) for q0 in start_list]
+            for q0 in start_list:
+                q0[self._kept_q] = neutral[self._kept_q]
         if not found:
             found, more = self.distinct(
                 mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
@@ -390,10 +420,11 @@ class PositionSolver:
             ref_sig = self.signature(ref if ref is not None else sols[0].q)
             sols.sort(key=lambda s: (not s.physical, s.singular,
                                      float(np.linalg.norm(self.signature(s.q) - ref_sig))))
-        notes = ()
+        notes = tuple(f"{j} keeps the file's value: no loop passes through it and its {mech.coordinate(j).nq} "
+                      "coordinates are not inputs" for j in self.kept)
         if near_q is not None:
             sols = sols[:1]
-            notes = self._missed_near(near, sols[0])
+            notes += self._missed_near(near, sols[0])
         held = {link: sols[0].link_angles[link] for link in mech.closure.row_inputs
                 if sols[0].link_angles and link in sols[0].link_angles} or None
         return PositionResult(dict(typed), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
@@ -513,7 +544,7 @@ class PositionSolver:
                         loop_accelerations=state.loop_accelerations or None,
                         links=link_motions(state, angles, self._plane_normal()),
                         points=point_motions(state, points) or None, linkage=self._linkage(q),
-                        leg_lengths=state.leg_lengths or None,
+                        leg_lengths=state.leg_lengths or None, guide_positions=state.guide_positions or None,
                         guide_angles=(self._angles.guides(state) or None) if self._angles else None)
 
     def _named(self, v) -> dict:

@@ -49,10 +49,11 @@ def _keep_turns(mech, res: SweepResult, q_prev) -> SweepResult:
 
 
 def sweep_chunks(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-                 near: dict | None = None, rate: float = 1.0, chunk: int = DEFAULT_CHUNK, **options):
+                 near: dict | None = None, rate: float = 1.0, chunk: int = DEFAULT_CHUNK, q_start=None, **options):
     """Yield ``sweep(solver, name, start, stop, steps, ...)``'s motion as SweepResults of at most
     ``chunk`` (+1 for the first) consecutive steps each, in the order of the motion (see the module
-    docstring).  ``options``: sweep's other keyword arguments (closed_form, batch, ...), not turn.
+    docstring).  ``q_start``: the configuration of the mode to follow (as sweep's).  ``options``: sweep's other
+    keyword arguments (closed_form, batch, ...), not turn.
     Each piece's ``requested`` is its own part of the grid; the last piece's stopped_at and
     stop_reason are the motion's."""
     if options.get("turn"):
@@ -66,7 +67,7 @@ def sweep_chunks(solver, name: str, start: float, stop: float, steps: int, fixed
         a = start + j * h
         b = stop if j1 == steps else start + j1 * h
         res = sweep(solver, name, a, b, max(j1 - j, 1), fixed=fixed, near=near if q is None else None,
-                    rate=rate, q_start=q, **options)
+                    rate=rate, q_start=q_start if q is None else q, **options)
         piece = res if q is None else _drop_first(_keep_turns(solver.mech, res, q))
         yield piece
         if res.stopped_at is not None or j1 >= steps or not len(res.q):

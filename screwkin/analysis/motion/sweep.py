@@ -38,7 +38,7 @@ from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .dyads import planar_sweep
 from ..singularities.singular import measures
 
-__all__ = ["SweepResult", "SweepSingularity", "sweep", "Neighbour", "CONTINUATION_ROUNDS",
+__all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "Neighbour", "CONTINUATION_ROUNDS",
            "drawn_start"]
 
 #: Continuation steps a sweep may take per configuration it records (a bound on its work: a motion that
@@ -255,6 +255,14 @@ class Neighbour:
         return q
 
 
+def sweep_inputs(mech, name: str, fixed) -> list:
+    """The input joints of a motion of ``name`` with the joints ``fixed`` names held (a sweep's, the
+    dynamics'): the actuated ones when ``name`` is one of them, else ``name`` and the held ones."""
+    if name in mech.actuated:
+        return list(mech.actuated)
+    return [name, *(n for n in fixed if n != name)]
+
+
 def drawn_start(solver, values: dict):
     """The configuration the file is drawn in, when it is already at the input ``values`` and is the
     mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
@@ -307,6 +315,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     q_start: a configuration of the assembly mode to follow (a neighbour's, in a map or a
     study): the loops are closed from it at the first input value (raises AssemblyError when
     they cannot be); without it the mode is ``solver.solve``'s first at ``start`` (near ``near``).
+    It may be a function giving that configuration, called once the arguments are checked.
     turn: pass through limit positions onto the other branch (the input then runs back);
     the sweep ends when the mechanism is back at its start, the input reaches ``stop``, or
     after ``max_steps`` recorded configurations (default 20 * steps + 100).
@@ -329,6 +338,8 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     tr = _Tracker(solver, name)
     max_steps = max_steps or 20 * steps + 100
     h = (stop - start) / steps
+    if callable(q_start):  # chosen once the arguments are checked (a command's --mode K, said as it is chosen)
+        q_start = q_start()
     if q_start is not None:
         q0 = solver.track({name: start, **fixed}, q_start).q
     else:

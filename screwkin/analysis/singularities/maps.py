@@ -42,7 +42,8 @@ class SingularityMap:
         return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
 
 
-def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False) -> SingularityMap:
+def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False,
+                    q_start=None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
     if x_name == y_name:
@@ -54,7 +55,10 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
         if n not in solver.inputs:
             raise UsageError(f"{mech.path}: '{n}' is not an input ({', '.join(solver.inputs)})")
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
-    q_first = solver.solve({x_name: xs[0], y_name: ys[0], **fixed}).solutions[0].q
+    first = {x_name: xs[0], y_name: ys[0], **fixed}
+    # the mode mapped: the one of q_start (a command's --mode K), else solve's first at the first corner
+    q_start = q_start() if callable(q_start) else q_start  # (a function: called once the arguments are checked)
+    q_first = solver.solve(first).solutions[0].q if q_start is None else solver.track(first, q_start).q
     g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
     logs = np.full((len(ys), len(xs)), np.nan)
     kinds = np.full((len(ys), len(xs)), "", dtype=object)

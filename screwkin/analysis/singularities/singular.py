@@ -32,11 +32,12 @@ import pinocchio as pin
 
 from ...model.linalg import null_space, rank
 from ...model.cuts import in_plane, pair_contact
+from ...model.geometry import plane_basis
 from ...model.state import KinematicState, loop_coordinate_cuts
 from ...tolerances import DEFAULT
 from ..screws import cut_twists, screw_of
 
-__all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians",
+__all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -207,15 +208,11 @@ def classify(mech, q, inputs=None, output=None, length=None, generic=None, point
         cond = float(kept[0] / kept[-1]) if len(kept) == g.out_dim and kept[-1] > 0 else float("inf")
         manip = float(np.prod(kept))
         if serial:  # the lost direction, as a spatial twist: v at the world origin = v_o - w x o
-            lost = np.zeros(6)
-            lost[:len(U)] = U[:, g.out_dim - 1]
-            lost[:3] *= L
-            lost[:3] -= np.cross(lost[3:], origin)
             topo = mech.topology(q)
             normal = topo.normal if topo.motion_space == "planar" else None
-            if normal is not None:  # a planar mechanism's lost direction lies in its plane: (vx, vy, wz) only
-                n = np.asarray(normal, float) / np.linalg.norm(normal)
-                lost = np.concatenate([lost[:3] - (lost[:3] @ n) * n, (lost[3:] @ n) * n])
+            lost = lost_direction(S.J @ S.V, g.out_dim, normal)
+            lost[:3] *= L
+            lost[:3] -= np.cross(lost[3:], origin)
             twists.append(SingularTwist("serial", {}, tuple(lost), screw_of(lost, L)))
     elif S.K.size and g.rank_Kp:
         s = np.linalg.svd(S.K[:, g.p], compute_uv=False)[:g.rank_Kp]
@@ -401,6 +398,31 @@ def gram_cofactors(mech, q, length=None) -> tuple:
         out.append(GramLoop(cut.name, tuple(names), 1, cof, {nm: float(r) for nm, r in zip(names, rel)},
                             tuple(nm for nm, r in zip(names, rel) if r < tol.stationary ** 2)))
     return tuple(out)
+
+
+def lost_direction(JV, out_dim: int, normal=None) -> np.ndarray:
+    """The output direction lost at a serial singularity, as a unit (6,) twist (v, w) in the rows' scaled
+    coordinates (a point's output: v only, w zero): the left singular vector of the output's motion map
+    JV (rows (v, w) or v, columns the mechanism's motions) for its ``out_dim``-th singular value, the one
+    that vanishes.  For a planar mechanism (``normal``) the map is first restricted to the plane's
+    components (v in the plane, w about the normal): the directions out of the plane are lost everywhere,
+    and round-off there (1e-17) would otherwise tie with the vanishing singular value and could be chosen
+    -- a direction that projects onto the plane as the zero twist."""
+    rows = JV.shape[0]
+    if normal is None:
+        U = np.linalg.svd(JV, full_matrices=True)[0]
+        out = np.zeros(6)
+        out[:rows] = U[:, out_dim - 1]
+        return out
+    e1, e2, n = plane_basis(normal)
+    P = np.zeros((3 if rows == 6 else 2, rows))  # the plane's components of a (v, w) or v row vector
+    P[0, :3], P[1, :3] = e1, e2
+    if rows == 6:
+        P[2, 3:] = n
+    U = np.linalg.svd(P @ JV, full_matrices=True)[0]
+    out = np.zeros(6)
+    out[:rows] = P.T @ U[:, min(out_dim, len(P)) - 1]
+    return out
 
 
 def _motion_twist(kind, x, names, J, tol):

@@ -35,6 +35,7 @@ from ...mobility import analyze_mobility
 from ...motion.planar import identify, transmission_angles
 from ...motion.position import PositionSolver
 from ...motion.sweep import sweep
+from ...course.skeleton import numbering
 from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions, wrap
@@ -161,8 +162,10 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
         direction, travel, mus, found = _follow(design, solver, probe, configs, steps)
         defects += found
     mu_range = (min(mus), max(mus)) if mus else None
+    # the letters `draw` gives the joints (its skeleton numbering from the input): the text names them so
+    letters = numbering(mech.topology(q_first), [name])[1] if q_first is not None else {}
     return Check(str(path), iterations, tuple(precision), grashof, lengths, mu_range, tuple(defects), direction,
-                 tuple(travel), tol)
+                 tuple(travel), tol, letters)
 
 
 def _locate(design, solver, probe, res, x, q_target):

@@ -173,6 +173,7 @@ class Check:
     direction: int  # +1 counterclockwise crank motion, -1 clockwise, 0 undecided
     travel: tuple  # crank travel [rad] from the first position to each position (None: not reached)
     tolerance: float
+    letters: dict = field(default_factory=dict)  # joint name -> its letter in `draw` (course.skeleton.numbering)
 
     @property
     def valid(self) -> bool:

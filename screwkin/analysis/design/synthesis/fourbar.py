@@ -170,6 +170,10 @@ def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
     return best[1]
 
 
+#: The joints fourbar_linkage writes at the four-bar's pivots: the fixed pivots A0, B0 and the moving ones A, B.
+PIVOT_JOINTS = {"A0": "crank_joint", "A": "coupler_joint", "B": "coupler_rocker", "B0": "rocker_joint"}
+
+
 def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None = "coupler_frame") -> PlanarLinkage:
     """The file description of a four-bar drawn at its first position: links ground, crank,
     coupler, rocker (and ``tool``, a frame welded to the coupler at fb.tool), joints
