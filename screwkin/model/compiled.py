@@ -8,7 +8,8 @@ loops compiled by numba (cached on disk after the first use): the same numbers
 as ``ClosureSystem.evaluate(q, solver=True)`` and model.newton.damped_step (tests check
 both), about 2.5 times faster per solve (benchmarks/README.md).  Pinocchio still computes every
 placement and frame Jacobian, and the Newton loop is model.newton.iterate, the numpy solver's own:
-only the rows and the step are compiled.
+the rows, the step and the loop's verdict (model.newton.judge, compiled from its one definition)
+are what is compiled.
 
 The step's linear solve is numba's np.linalg.solve, which raises np.linalg.LinAlgError where
 LAPACK finds the damped system singular in floating point ("Matrix is singular to machine
@@ -18,7 +19,8 @@ back to least squares (and which gives NaN, as numpy does, for a NaN row).
 
 Used only when asked (``PositionSolver(mech, compiled=True)`` or
 ``mech.closure.accelerate()``): importing numba costs about 0.25 s and the first
-use compiles for about 8 s, which a single command would not win back.
+use compiles for about 15 s (8 s of it the rows and the step; loaded from the cache in about
+0.5 s afterwards, on 2 busy cores), which a single command would not win back.
 """
 
 from __future__ import annotations

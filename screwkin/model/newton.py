@@ -126,12 +126,16 @@ def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
     model.compiled compiles this same function."""
     new_norm = np.sqrt((r_new * r_new).sum(axis=1))
     accepted = new_norm < norm
+    count = np.count_nonzero(accepted)
+    if count == 0:  # (every step refused: the same as below, in fewer operations)
+        mu = mu * nu
+        return accepted, new_norm, mu, 2.0 * nu, (norm >= closure) & (mu <= mu_max)
     squared = norm * norm
     predicted = squared - linear_squared
     decrease = predicted > 0.0
     rho = np.where(decrease, squared - new_norm * new_norm, 0.0) / np.where(decrease, predicted, 1.0)
     nielsen = np.maximum(mu * np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), mu_min)
-    if np.count_nonzero(accepted) == len(accepted):  # (the same as below, in fewer operations)
+    if count == len(accepted):  # (every step accepted: the same, in fewer operations)
         return accepted, new_norm, nielsen, np.full(len(accepted), NU), new_norm >= closure
     mu = np.where(accepted, nielsen, mu * nu)
     nu = np.where(accepted, NU, 2.0 * nu)
@@ -179,7 +183,7 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
     bounds = (closure, tol.lm_damping_min, tol.lm_damping_max)
     active = norm >= closure  # a configuration stops once and for all: the active ones are at iteration k
     n = np.count_nonzero(active)
-    limit, k, any_refused = int(tol.max_iterations if iterations is None else iterations), 0, False
+    limit, k = int(tol.max_iterations if iterations is None else iterations), 0
     while n and k < limit:
         k += 1
         whole = n == N  # (then the same operations on the arrays themselves: no copies)
@@ -198,19 +202,22 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
             rn, Kn = evaluate(Qn, idx, True)
         if trace is not None:
             trace(idx, k, Qa, ra, Ka, dQ, ok)
-        if whole and np.count_nonzero(ok) == n:  # every step accepted
-            Q, r, norm, mu, nu, active = Qn, rn, nn, mua, nua, going
-            K = K if Kn is None else Kn  # (without it: every one converged)
-            if any_refused:
-                refused.fill(False)
-                any_refused = False
+        accepted = np.count_nonzero(ok)
+        if whole:  # (new arrays, nothing written into: a trace may hold the old ones)
+            mu, nu, active, refused = mua, nua, going, ~ok
+            if accepted == n:
+                Q, r, norm = Qn, rn, nn
+                K = K if Kn is None else Kn  # (without it: every one converged)
+            elif accepted:
+                Q, r, norm = np.where(ok[:, None], Qn, Q), np.where(ok[:, None], rn, r), np.where(ok, nn, norm)
+                if Kn is not None:
+                    K = np.where(ok[:, None, None], Kn, K)
         else:
             a = idx[ok]
             Q[a], r[a], norm[a] = Qn[ok], rn[ok], nn[ok]
             if Kn is not None:
                 K[a] = Kn[ok]
             mu[idx], nu[idx], refused[idx], active[idx] = mua, nua, ~ok, going
-            any_refused = True
         stopped = n - np.count_nonzero(going)
         n -= stopped
         if stopped:
