@@ -66,7 +66,7 @@ class ClosureSystem:
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         self._owner = threading.get_ident()
         self._position_rows = None
-        self._integrator = None
+        self.integrator = Integrator(model)  # q (+) dq on the model's configuration manifold, for stacks
 
     # ------------------------------------------------------------------ per-thread workspace
     def _workspace(self):
@@ -578,13 +578,6 @@ class ClosureSystem:
         reached when it fails, or when the solution assembles a cut joint upside down."""
         return newton.solve(self, q0, frozen, tolerances or self.tol, trace)
 
-    @property
-    def integrator(self) -> Integrator:
-        """q (+) dq on the model's configuration manifold, for stacks (model.manifold)."""
-        if self._integrator is None:
-            self._integrator = Integrator(self.model)
-        return self._integrator
-
     def free_columns(self, frozen) -> np.ndarray:
         """The velocity indices not in ``frozen`` (a sequence of indices; cached per set of frozen ones)."""
         frozen = np.asarray(frozen, int).ravel()
@@ -600,13 +593,9 @@ class ClosureSystem:
         rows, step, verdict): compiled when accelerate() is on (model.compiled), else numpy
         (newton.damped_step, newton.judge)."""
         if self._compiled:
-            return self._stack_of_one_compiled, compiled.one_step, self._compiled[0].judge
+            return self._stack_of_one, compiled.one_step, self._compiled[0].judge
         return self._stack_of_one, newton.one_step, newton.judge
 
     def _stack_of_one(self, Q, which, jacobian):
-        r, K = self.evaluate(Q[0], jacobian, solver=True)
-        return r[None], (None if K is None else K[None])
-
-    def _stack_of_one_compiled(self, Q, which, jacobian):
-        r, K = self._evaluate_compiled(Q[0], jacobian)
+        r, K = self._evaluate_compiled(Q[0], jacobian) if self._compiled else self.evaluate(Q[0], jacobian, True)
         return r[None], (None if K is None else K[None])
