@@ -133,7 +133,10 @@ def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
     squared = norm * norm
     predicted = squared - linear_squared
     decrease = predicted > 0.0
-    rho = np.where(decrease, squared - new_norm * new_norm, 0.0) / np.where(decrease, predicted, 1.0)
+    if np.count_nonzero(decrease) == len(decrease):  # (the model predicts a decrease: as below, in fewer operations)
+        rho = (squared - new_norm * new_norm) / predicted
+    else:
+        rho = np.where(decrease, squared - new_norm * new_norm, 0.0) / np.where(decrease, predicted, 1.0)
     nielsen = np.maximum(mu * np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), mu_min)
     if count == len(accepted):  # (every step accepted: the same, in fewer operations)
         return accepted, new_norm, nielsen, np.full(len(accepted), NU), new_norm >= closure
