@@ -166,8 +166,8 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
     (model.manifold.Integrator); step(K, r, free, mu): the damped step on the free velocity
     columns (``stacked_steps``, or ``one_at_a_time`` of a one-configuration step); iterations:
     the limit (Tolerances.max_iterations when None); trace: None or callable(which, k, Q, r, K, dQ,
-    accepted) called after the k-th step with the configurations it started from; verdict:
-    ``judge`` (or its compiled form).
+    accepted) called after the k-th step with the configurations it started from (the loop's own
+    arrays: a trace copies what it keeps); verdict: ``judge`` (or its compiled form).
 
     Each configuration has its own damping and its own end (see the module).  When every
     configuration still iterating is about to converge quadratically (residual below
