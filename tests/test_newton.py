@@ -1,7 +1,8 @@
-"""The one damped-Newton step (model/newton.py) of the single, batched and compiled solvers:
-the three give the same step as the damped normal equations written here, the damping follows
-Nielsen's rule, and the batched closure rows equal ClosureSystem's (the program no longer
-compares them at run time: this test does)."""
+"""The one damped-Newton step and verdict (model/newton.py) of the single, batched and compiled
+solvers: the three give the same step as the damped normal equations written here, the verdict
+(numpy and compiled) follows Nielsen's rule as published, and the batched closure rows equal
+ClosureSystem's (the program no longer compares them at run time: this test does).  The loop
+itself: tests/test_newton_loop.py."""
 
 from __future__ import annotations
 
@@ -61,20 +62,50 @@ def test_rank_deficient_rows_still_give_a_finite_step():
     np.testing.assert_allclose(d, -np.linalg.pinv(K) @ r, rtol=0, atol=1e-6)
 
 
-def test_damping_follows_nielsens_rule():
+def nielsen(norm, new_norm, lin2, mu, nu, tol):
+    """Nielsen's rule as written in Madsen, Nielsen and Tingleff, "Methods for non-linear least squares
+    problems" (2004), eq. 2.21, with the gain ratio rho = (F(x) - F(x_new)) / (L(0) - L(h)) of its
+    eq. 2.18, F the squared residual and L the linear model's: an accepted step (the residual went
+    down) takes mu max(1/3, 1 - (2 rho - 1)^3) and nu = 2, a refused one mu nu and 2 nu; never below
+    lm_damping_min; a refused step past lm_damping_max gives up."""
+    predicted = norm**2 - lin2
+    rho = (norm**2 - new_norm**2) / predicted if predicted > 0 else 0.0
+    if new_norm < norm:
+        mu, nu = max(mu * max(1 / 3, 1 - (2 * rho - 1) ** 3), tol.lm_damping_min), 2.0
+        return True, mu, nu, new_norm >= tol.closure
+    mu, nu = mu * nu, 2 * nu
+    return False, mu, nu, norm >= tol.closure and mu <= tol.lm_damping_max
+
+
+def verdicts():
+    yield "numpy", newton.judge
+    if compiled.available():
+        yield "compiled", compiled.kernels().judge
+
+
+@pytest.mark.parametrize("kind, verdict", list(verdicts()))
+def test_the_verdict_follows_nielsens_rule(kind, verdict):
+    """Every case of the rule in one stack (and the stack's entries one at a time): accepted with rho
+    between 0 and 1, above 1, with no predicted decrease, converged; refused, refused past the
+    damping limit; the floor on the damping."""
     tol = DEFAULT
-    for rho in (0.0, 0.25, 0.5, 0.9, 1.0):
-        mu, nu = newton.accept(1e-3, rho, tol)
-        assert mu == pytest.approx(1e-3 * max(1 / 3, 1 - (2 * rho - 1) ** 3), rel=1e-15)
-        assert nu == 2.0
-    assert newton.accept(tol.lm_damping_min, 1.0, tol)[0] == tol.lm_damping_min  # never below the floor
-    assert newton.refuse(1e-3, 4.0) == (4e-3, 8.0)
-    assert newton.given_up(tol.lm_damping_max * 2, tol) and not newton.given_up(1.0, tol)
-    # the gain ratio: actual over predicted decrease of the squared residual
-    assert newton.gain_ratio(2.0, 1.0, 0.0) == pytest.approx(3.0 / 4.0)
-    assert newton.gain_ratio(1.0, 0.5, 1.0) == 0.0  # no decrease predicted
-    np.testing.assert_allclose(newton.gain_ratio(np.array([2.0, 1.0]), np.array([1.0, 0.5]), np.array([0.0, 1.0])),
-                               [0.75, 0.0])
+    cases = [  # norm, new norm, |r + K dq|^2, mu, nu
+        (2.0, 1.0, 0.0, 1e-3, 2.0), (2.0, 1.0, 3.5, 1e-3, 4.0), (1.0, 0.5, 1.0, 1e-3, 2.0),
+        (1.0, 0.9, 0.99, 1e-3, 8.0), (1.0, 0.5, 0.9, tol.lm_damping_min, 2.0), (1e-3, 1e-12, 1e-7, 1e-6, 2.0),
+        (1.0, 1.5, 0.2, 1e-3, 2.0), (1.0, 1.0, 0.2, 1e-3, 16.0), (1.0, 2.0, 0.2, 0.6 * tol.lm_damping_max, 2.0),
+        (1.0, np.nan, 0.2, 1e-3, 2.0)]
+    norm, new, lin2, mu, nu = (np.array(c, float) for c in zip(*cases))
+    for sub in (slice(None), *[slice(k, k + 1) for k in range(len(cases))]):
+        residual_after = np.zeros((len(new[sub]), 3))
+        residual_after[:, 1] = new[sub]  # rows whose norm is the new norm
+        ok, after, mu_n, nu_n, going = verdict(norm[sub], residual_after, lin2[sub], mu[sub], nu[sub], tol.closure,
+                                               tol.lm_damping_min, tol.lm_damping_max)
+        finite = np.isfinite(new[sub])
+        np.testing.assert_array_equal(after[finite], new[sub][finite])
+        for k, c in enumerate(cases[sub]):
+            want = nielsen(*c, tol)
+            assert (bool(ok[k]), bool(going[k])) == (want[0], want[3]), (kind, c)
+            assert mu_n[k] == pytest.approx(want[1], rel=1e-15) and nu_n[k] == want[2], (kind, c)
 
 
 BATCHABLE = ["five_bar.urdf", "fourbar_crank_rocker.urdf", "slider_crank_offset.urdf", "watt_sixbar.urdf",

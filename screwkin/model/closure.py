@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from ..tolerances import DEFAULT, Tolerances
 from . import compiled, newton
+from .manifold import Integrator
 from .cuts import Assembly, ContactRow, CouplingRow, CutJoint  # noqa: F401 - exported here as before
 from .geometry import cross3, perpendicular_basis, skew, skews, skews_batch
 from ._pin import frame_jacobian
@@ -65,6 +66,7 @@ class ClosureSystem:
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         self._owner = threading.get_ident()
         self._position_rows = None
+        self.integrator = Integrator(model)  # q (+) dq on the model's configuration manifold, for stacks
 
     # ------------------------------------------------------------------ per-thread workspace
     def _workspace(self):
@@ -137,8 +139,8 @@ class ClosureSystem:
                           np.empty((n, 6, nv)), np.empty((n, 6, nv)))
         R1, R2, t1, t2, J1, J2 = ws.buffers
         model, data = self.model, ws.data
-        self._kinematics(q, jacobian)
-        for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, self._placements)):
+        self._kinematics(q, jacobian, data)
+        for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, ws.placements)):
             R1[j], R2[j], t1[j], t2[j] = a, b, c, d
             if jacobian:
                 J1[j] = frame_jacobian(model, data, cut.frame1, LWA)
@@ -149,19 +151,14 @@ class ClosureSystem:
         kernels.cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian)
         return r, (K if jacobian else None)
 
-    def _step_compiled(self, K, r, free, mu):
-        try:
-            return self._compiled[0].damped_step(K, r, free, mu)
-        except Exception:  # singular in floating point: the numpy step has the least-squares fallback
-            return newton.damped_step(K, r, free, mu)
-
-    def _kinematics(self, q, jacobian: bool):
-        """Pinocchio's pass for q: frame placements, and the joint Jacobians if asked."""
+    def _kinematics(self, q, jacobian: bool, data):
+        """Pinocchio's pass for q in ``data`` (this thread's): frame placements, and the joint
+        Jacobians if asked."""
         if jacobian:
-            pin.computeJointJacobians(self.model, self.data, q)
-            pin.updateFramePlacements(self.model, self.data)
+            pin.computeJointJacobians(self.model, data, q)
+            pin.updateFramePlacements(self.model, data)
         else:
-            pin.framesForwardKinematics(self.model, self.data, q)
+            pin.framesForwardKinematics(self.model, data, q)
 
     # ------------------------------------------------------------------ residual
     def _rows(self, solver: bool) -> int:
@@ -259,17 +256,18 @@ class ClosureSystem:
         Rows of cut joint j, in order: positions e . d (e fixed in F1, d = o2 - o1),
         then (solver) R2 v - R1 v, or (minimal) log3(R1^T R2) or alignments u . w.
         """
-        model, data = self.model, self.data
-        self._kinematics(q, jacobian)
+        ws = self._workspace()
+        model, data = self.model, ws.data
+        self._kinematics(q, jacobian, data)
         nrows = self._rows(solver)
         r = np.empty(nrows)
         K = np.empty((nrows, model.nv)) if jacobian else None
-        for g in self._groups:
+        for g in ws.groups:
             views = g["views"]
             n = len(views)
             if n <= 2:  # stacking pays from three cut joints of a type on (measured: 1 cut +7 us, 3 cuts -6 us)
                 for j in range(n):
-                    self._evaluate_one(g, j, r, K, solver)
+                    self._evaluate_one(g, j, r, K, solver, data)
                 continue
             R1, R2, t1, t2 = (np.array([v[i] for v in views]) for i in range(4))  # (n, 3, 3), (n, 3)
             d = t2 - t1
@@ -380,10 +378,10 @@ class ClosureSystem:
         d = float(np.sqrt(delta @ delta))
         return (ddd @ delta + dd @ dd) / d - (delta @ dd) ** 2 / d**3
 
-    def _evaluate_one(self, g, j, r, K, solver):
+    def _evaluate_one(self, g, j, r, K, solver, data):
         """The rows of cut joint j of a group (the same rows as the stacked code, with 2-D
-        arrays: a test checks that both give the same numbers)."""
-        model, data = self.model, self.data
+        arrays: a test checks that both give the same numbers), placements in ``data``."""
+        model = self.model
         R1, R2, t1, t2 = g["views"][j]
         i = g["starts"][solver][j]  # the cut joint's rows are r[i:i + k] (positions), then the rest
         d = t2 - t1
@@ -580,16 +578,24 @@ class ClosureSystem:
         reached when it fails, or when the solution assembles a cut joint upside down."""
         return newton.solve(self, q0, frozen, tolerances or self.tol, trace)
 
-    def free_columns(self, frozen: tuple) -> np.ndarray:
-        """The velocity indices not in ``frozen`` (cached per set of frozen ones)."""
-        free = self._free.get(frozen)
+    def free_columns(self, frozen) -> np.ndarray:
+        """The velocity indices not in ``frozen`` (a sequence of indices; cached per set of frozen ones)."""
+        frozen = np.asarray(frozen, int).ravel()
+        key = frozen.tobytes()
+        free = self._free.get(key)
         if free is None:
-            free = self._free[frozen] = np.setdiff1d(np.arange(self.model.nv), np.asarray(frozen, int))
+            free = self._free[key] = np.setdiff1d(np.arange(self.model.nv), frozen)
         return free
 
     def solver_pass(self):
-        """(evaluate(q, jacobian=True) -> (r, K) in the solver's rows, step(K, r, free, mu)):
-        compiled when accelerate() is on, else numpy."""
+        """What model.newton.iterate needs to solve one configuration (a stack of one):
+        (evaluate(Q (1, nq), which, jacobian) -> (r (1, rows), K (1, rows, nv) or None) in the solver's
+        rows, step, verdict): compiled when accelerate() is on (model.compiled), else numpy
+        (newton.damped_step, newton.judge)."""
         if self._compiled:
-            return self._evaluate_compiled, self._step_compiled
-        return (lambda q_, jacobian=True: self.evaluate(q_, jacobian, solver=True)), newton.damped_step
+            return self._stack_of_one, compiled.one_step, self._compiled[0].judge
+        return self._stack_of_one, newton.one_step, newton.judge
+
+    def _stack_of_one(self, Q, which, jacobian):
+        r, K = self._evaluate_compiled(Q[0], jacobian) if self._compiled else self.evaluate(Q[0], jacobian, True)
+        return r[None], (None if K is None else K[None])

@@ -5,22 +5,32 @@ joints -- the 6d and 3d closures of Extended-URDF files -- costs about 38 us in
 numpy for one weld, of which Pinocchio's own calls are 3 us: the rest is the
 overhead of numpy calls on 3-vectors.  Here the rows, their Jacobian and the damped step are
 loops compiled by numba (cached on disk after the first use): the same numbers
-as ``ClosureSystem.evaluate(q, solver=True)`` and the numpy step (tests check
+as ``ClosureSystem.evaluate(q, solver=True)`` and model.newton.damped_step (tests check
 both), about 2.5 times faster per solve (benchmarks/README.md).  Pinocchio still computes every
-placement and frame Jacobian.
+placement and frame Jacobian, and the Newton loop is model.newton.iterate, the numpy solver's own:
+the rows, the step and the loop's verdict (model.newton.judge, compiled from its one definition)
+are what is compiled.
+
+The step's linear solve is numba's np.linalg.solve, which raises np.linalg.LinAlgError where
+LAPACK finds the damped system singular in floating point ("Matrix is singular to machine
+precision") or where K or r holds an inf or a NaN ("Array must not contain infs or NaNs"); nothing
+else in the kernels raises.  ``damped_step`` then takes model.newton.damped_step, whose solve falls
+back to least squares (and which gives NaN, as numpy does, for a NaN row).
 
 Used only when asked (``PositionSolver(mech, compiled=True)`` or
 ``mech.closure.accelerate()``): importing numba costs about 0.25 s and the first
-use compiles for about 8 s, which a single command would not win back.
+use compiles for about 15 s (8 s of it the rows and the step; loaded from the cache in about
+0.5 s afterwards, on 2 busy cores), which a single command would not win back.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from . import newton
 from .newton import TRACE_FLOOR
 
-__all__ = ["available", "kernels", "kinds_of", "SPHERICAL", "FIXED"]
+__all__ = ["available", "kernels", "kinds_of", "damped_step", "one_step", "SPHERICAL", "FIXED"]
 
 SPHERICAL, FIXED = 0, 1  # the cut joint types the kernels know (3 and 12 solver rows)
 _KERNELS = None
@@ -114,7 +124,22 @@ def _build():
 
     k = Kernels()
     k.cut_rows, k.damped_step = cut_rows, damped_step
+    k.judge = nb.njit(cache=True)(newton.judge)  # the loop's verdict, compiled from its one definition
     return k
+
+
+def damped_step(K, r, free, mu):
+    """model.newton.damped_step through the compiled kernel (K C-contiguous, free int64), with
+    the numpy step where numba's solve raises np.linalg.LinAlgError (a singular damped system:
+    the numpy step's least-squares fallback; an inf or NaN in K or r: NaN, as numpy gives)."""
+    try:
+        return kernels().damped_step(K, r, free, mu)
+    except np.linalg.LinAlgError:
+        return newton.damped_step(K, r, free, mu)
+
+
+#: damped_step as the step of model.newton.iterate (the single solve's, compiled).
+one_step = newton.one_at_a_time(damped_step)
 
 
 def kinds_of(cuts):

@@ -1,34 +1,43 @@
-"""The one damped-Newton (Levenberg-Marquardt) step of every closure solver.
+"""The one damped-Newton (Levenberg-Marquardt) loop of every closure solver, and its step.
 
-The single solver (model.closure.ClosureSystem.solve), the batched one
-(analysis.motion.batch_closure.BatchClosure.solve) and the compiled kernel (model.compiled)
-take the same step with the same constants:
+``iterate`` is the loop, written once for a stack of N configurations; the single solve
+(``solve``: model.closure.ClosureSystem.solve) runs it on a stack of one, the batched one
+(analysis.motion.batch_closure.BatchClosure.solve) on many, the compiled path (model.compiled) with
+the rows, the step and the verdict compiled by numba from the same definitions.  Whoever wants to
+change how Newton iterates changes it here:
 
 - the step is the minimum-norm damped step on the free columns of K,
   ``dq_f = -K_f^T (K_f K_f^T + lambda I)^-1 r`` with ``lambda = mu * trace / rows``
   (with more rows than free columns the same step is
-  ``(K_f^T K_f + lambda I)^-1 K_f^T (-r)``, a smaller system);
+  ``(K_f^T K_f + lambda I)^-1 K_f^T (-r)``, a smaller system); where the damped system is singular
+  in floating point, its least-squares solution;
+- the configuration moves by the step on the configuration manifold (pin.integrate, for stacks
+  model.manifold.Integrator), and the step is accepted when the residual norm goes down;
 - the damping ``mu`` starts at ``Tolerances.lm_damping``; an accepted step
   updates it from the gain ratio rho (actual over predicted decrease of the
   squared residual) by Nielsen's rule, never below ``Tolerances.lm_damping_min``;
-  a refused one multiplies it by nu (2, 4, 8, ...); past
-  ``Tolerances.lm_damping_max`` the solver gives up.
+  a refused one multiplies it by nu (2, 4, 8, ...) (``judge``);
+- a configuration stops when its residual norm is below ``Tolerances.closure`` (converged), at
+  ``Tolerances.max_iterations``, or when a refused step takes its damping past
+  ``Tolerances.lm_damping_max`` (given up).
 
 The residual rows may be evaluated one configuration at a time (Pinocchio),
 for a stack (numpy) or compiled (numba); tests compare the three, the program
-does not at run time.  Every function here works on one configuration or, where
-named so, on a stack of them.
+does not at run time.
 """
 
 from __future__ import annotations
 
+import math
+from typing import NamedTuple
+
 import numpy as np
-import pinocchio as pin
 
 from ..errors import AssemblyError
 from .cuts import Assembly
 
-__all__ = ["TRACE_FLOOR", "damped_step", "damped_steps", "gain_ratio", "accept", "refuse", "given_up", "solve", "NU"]
+__all__ = ["TRACE_FLOOR", "NU", "damped_step", "damped_steps", "stacked_steps", "one_at_a_time", "one_step", "judge",
+           "Iterates", "iterate", "solve"]
 
 #: Division guard: the damping is relative to the mean squared row norm, which is never taken
 #: below this (a zero Jacobian) [same units as K^2].
@@ -77,80 +86,173 @@ def damped_steps(Kf, r, mu):
     return dq, np.einsum("ni,ni->n", lin, lin)
 
 
-def gain_ratio(norm, new_norm, linear_squared):
-    """Actual over predicted decrease of the squared residual (scalars or arrays); 0 where
-    the linear model predicts no decrease."""
-    norm, new_norm, linear_squared = np.asarray(norm), np.asarray(new_norm), np.asarray(linear_squared)
-    predicted = norm**2 - linear_squared
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rho = np.where(predicted > 0, (norm**2 - new_norm**2) / predicted, 0.0)
-    return rho if rho.ndim else float(rho)
+def stacked_steps(K, r, free, mu):
+    """damped_steps on the free columns of a stack: K (N, rows, nv), r (N, rows), mu (N,) ->
+    (steps on the free columns (N, free), squared residuals of the linear model (N,)): the step
+    of ``iterate`` for stacks."""
+    return damped_steps(K[:, :, free], r, mu)
 
 
-def accept(mu, rho, tol):
-    """The damping after an accepted step of gain ratio rho (Nielsen), and nu reset:
-    (mu, nu); scalars or arrays."""
-    mu = np.maximum(np.asarray(mu) * np.maximum(1.0 / 3.0, 1.0 - (2.0 * np.asarray(rho) - 1.0) ** 3),
-                    tol.lm_damping_min)
-    return (mu if mu.ndim else float(mu)), NU
+def one_at_a_time(step):
+    """The step of ``iterate`` for stacks from a step of one configuration,
+    ``step(K (rows, nv), r, free, mu) -> (step on the free columns, squared linear residual)``
+    (damped_step, or model.compiled.damped_step): one call per configuration."""
+
+    def steps(K, r, free, mu):
+        if len(K) == 1:  # (the squared residual as a float: it broadcasts)
+            dq, lin = step(K[0], r[0], free, float(mu[0]))
+            return dq[None], lin
+        out = [step(Ki, ri, free, float(mi)) for Ki, ri, mi in zip(K, r, mu)]
+        return np.array([dq for dq, _ in out]).reshape(len(K), len(free)), np.array([lin for _, lin in out])
+
+    return steps
 
 
-def refuse(mu, nu):
-    """The damping after a refused step, and the next factor: (mu * nu, 2 nu)."""
-    return mu * nu, nu * 2.0
+#: damped_step as the step of ``iterate`` (the single solve's).
+one_step = one_at_a_time(damped_step)
 
 
-def given_up(mu, tol):
-    """Whether the damping has grown past the point where the solver stops (scalar or array)."""
-    return mu > tol.lm_damping_max
+def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
+    """The verdict on one step of each configuration of a stack: residual norms before (n,), the
+    residual rows after (n, rows), squared residual of the linear model, damping and Nielsen's
+    factor nu (n,); Tolerances.closure, lm_damping_min, lm_damping_max.
+
+    A step is accepted when it lowers the residual norm.  The damping after an accepted step
+    follows Nielsen's rule from the gain ratio rho (actual over predicted decrease of the squared
+    residual; 0 where the linear model predicts no decrease): mu max(1/3, 1 - (2 rho - 1)^3), never
+    below mu_min, and nu = 2; after a refused one, mu nu and 2 nu.  A configuration goes on while
+    its residual norm is at least ``closure`` and no refused step has taken its damping past
+    mu_max.  Returns (accepted, residual norms after, mu, nu, going on).  Plain numpy on arrays:
+    model.compiled compiles this same function."""
+    new_norm = np.sqrt((r_new * r_new).sum(axis=1))
+    accepted = new_norm < norm
+    count = np.count_nonzero(accepted)
+    if count == 0:  # (every step refused: the same as below, in fewer operations)
+        mu = mu * nu
+        return accepted, new_norm, mu, 2.0 * nu, (norm >= closure) & (mu <= mu_max)
+    squared = norm * norm
+    predicted = squared - linear_squared
+    decrease = predicted > 0.0
+    if np.count_nonzero(decrease) == len(decrease):  # (the model predicts a decrease: as below, in fewer operations)
+        rho = (squared - new_norm * new_norm) / predicted
+    else:
+        rho = np.where(decrease, squared - new_norm * new_norm, 0.0) / np.where(decrease, predicted, 1.0)
+    nielsen = np.maximum(mu * np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3), mu_min)
+    if count == len(accepted):  # (every step accepted: the same, in fewer operations)
+        return accepted, new_norm, nielsen, np.full(len(accepted), NU), new_norm >= closure
+    mu = np.where(accepted, nielsen, mu * nu)
+    nu = np.where(accepted, NU, 2.0 * nu)
+    going_on = (np.where(accepted, new_norm, norm) >= closure) & (accepted | (mu <= mu_max))
+    return accepted, new_norm, mu, nu, going_on
+
+
+class Iterates(NamedTuple):
+    """Where ``iterate`` left each configuration of a stack."""
+
+    q: np.ndarray  #: (N, nq) the last accepted configurations
+    residual: np.ndarray  #: (N,) their residual norms [the rows' units]
+    iterations: np.ndarray  #: (N,) steps tried (accepted or refused)
+    converged: np.ndarray  #: (N,) residual below Tolerances.closure
+    placed: np.ndarray  #: (N,) the last configuration evaluated is q (no step tried, or the last accepted)
+
+
+def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=None, trace=None,
+            verdict=judge) -> Iterates:
+    """The damped-Newton loop, for a stack of N configurations (N = 1: one configuration).
+
+    evaluate(Q (n, nq), which (n,), jacobian) -> (r (n, rows), K (n, rows, nv) or None): the rows
+    at the configurations ``which`` of the stack (indices into Q0: what varies per configuration,
+    a target, is looked up with them); integrate(Q, dQ) -> Q (+) dQ on the configuration manifold
+    (model.manifold.Integrator); step(K, r, free, mu): the damped step on the free velocity
+    columns (``stacked_steps``, or ``one_at_a_time`` of a one-configuration step); iterations:
+    the limit (Tolerances.max_iterations when None); trace: None or callable(which, k, Q, r, K, dQ,
+    accepted) called after the k-th step with the configurations it started from (the loop's own
+    arrays: a trace copies what it keeps); verdict: ``judge`` (or its compiled form).
+
+    Each configuration has its own damping and its own end (see the module).  When every
+    configuration still iterating is about to converge quadratically (residual below
+    0.1 sqrt(closure): the next one near its square) the residual alone is computed first, and the
+    Jacobian only where a step is accepted without converging."""
+    Q = np.array(Q0, float)
+    N = len(Q)
+    every = np.arange(N)
+    r, K = evaluate(Q, every, True)
+    norm = _norms(r)
+    mu, nu = np.empty(N), np.empty(N)
+    mu.fill(tol.lm_damping)
+    nu.fill(NU)
+    its, refused = np.zeros(N, int), np.zeros(N, bool)  # the iteration each one stopped at, its last step refused
+    closure, near, nv = tol.closure, 0.1 * math.sqrt(tol.closure), K.shape[2]
+    bounds = (closure, tol.lm_damping_min, tol.lm_damping_max)
+    active = norm >= closure  # a configuration stops once and for all: the active ones are at iteration k
+    n = np.count_nonzero(active)
+    limit, k = int(tol.max_iterations if iterations is None else iterations), 0
+    while n and k < limit:
+        k += 1
+        whole = n == N  # (then the same operations on the arrays themselves: no copies)
+        if whole:
+            idx, Qa, ra, Ka, na, mua, nua = every, Q, r, K, norm, mu, nu
+        else:
+            idx = active.nonzero()[0]
+            Qa, ra, Ka, na, mua, nua = Q[idx], r[idx], K[idx], norm[idx], mu[idx], nu[idx]
+        dQ = np.zeros((n, nv))
+        dQ[:, free], lin2 = step(Ka, ra, free, mua)
+        Qn = integrate(Qa, dQ)
+        final = np.maximum.reduce(na) < near
+        rn, Kn = evaluate(Qn, idx, not final)
+        ok, nn, mua, nua, going = verdict(na, rn, lin2, mua, nua, *bounds)
+        if final and np.count_nonzero(going & ok):  # accepted, not converged: its Jacobian after all
+            rn, Kn = evaluate(Qn, idx, True)
+        if trace is not None:
+            trace(idx, k, Qa, ra, Ka, dQ, ok)
+        accepted = np.count_nonzero(ok)
+        if whole:  # (new arrays, nothing written into: a trace may hold the old ones)
+            mu, nu, active, refused = mua, nua, going, ~ok
+            if accepted == n:
+                Q, r, norm = Qn, rn, nn
+                K = K if Kn is None else Kn  # (without it: every one converged)
+            elif accepted:
+                Q, r, norm = np.where(ok[:, None], Qn, Q), np.where(ok[:, None], rn, r), np.where(ok, nn, norm)
+                if Kn is not None:
+                    K = np.where(ok[:, None, None], Kn, K)
+        else:
+            a = idx[ok]
+            Q[a], r[a], norm[a] = Qn[ok], rn[ok], nn[ok]
+            if Kn is not None:
+                K[a] = Kn[ok]
+            mu[idx], nu[idx], refused[idx], active[idx] = mua, nua, ~ok, going
+        stopped = n - np.count_nonzero(going)
+        n -= stopped
+        if stopped:
+            its[idx[~going]] = k
+    its[active] = k
+    return Iterates(Q, norm, its, norm < closure, ~refused)
+
+
+def _norms(r):
+    """The residual norm of each row of a stack."""
+    return np.sqrt(np.add.reduce(r * r, axis=1))
 
 
 def solve(system, q0, frozen, tol, trace=None) -> Assembly:
-    """Damped Newton on a model.closure.ClosureSystem from q0 with the velocity indices
-    ``frozen`` held: the step and damping above, Tolerances ``tol`` (closure, max_iterations and
-    the lm_ fields).  When Newton is about to converge quadratically (the next residual near
-    norm^2) the residual alone is computed first, as the Jacobian there is not needed."""
-    model = system.model
+    """``iterate`` on one configuration of a model.closure.ClosureSystem from q0 with the velocity
+    indices ``frozen`` held (Tolerances ``tol``: closure, max_iterations and the lm_ fields);
+    trace: None or callable(iteration, q, r, K, dq, accepted) (ClosureSystem.solve).  Raises
+    AssemblyError with the residual reached when it does not converge, or when the solution
+    assembles a cut joint upside down."""
     q = np.array(q0, float)
     if system.nrows == 0:
         return Assembly(q, 0.0, 0)
-    frozen = tuple(int(f) for f in np.asarray(frozen, int).ravel())
-    free = system.free_columns(frozen)
-    evaluate, step = system.solver_pass()
-    r, K = evaluate(q)
-    last = q  # the configuration whose placements are in the system's Data
-    norm = float(np.sqrt(r @ r))
-    best = norm
-    mu, nu = tol.lm_damping, NU
-    it = 0
-    dq = np.zeros(model.nv)
-    while it < tol.max_iterations:
-        if norm < tol.closure:
-            break
-        it += 1
-        dq[free], lin2 = step(K, r, free, mu)
-        q_new = pin.integrate(model, q, dq)
-        final = norm < 0.1 * np.sqrt(tol.closure)
-        r_new, K_new = evaluate(q_new, jacobian=not final)
-        last = q_new
-        n_new = float(np.sqrt(r_new @ r_new))
-        if final and tol.closure <= n_new < norm:
-            r_new, K_new = evaluate(q_new)
-        accepted = n_new < norm
-        if trace is not None:
-            trace(it, q, r, K, dq.copy(), accepted)
-        if accepted:
-            mu, nu = accept(mu, gain_ratio(norm, n_new, lin2), tol)
-            q, r, K, norm = q_new, r_new, K_new, n_new
-            best = min(best, norm)
-        else:
-            mu, nu = refuse(mu, nu)
-            if given_up(mu, tol):
-                break
-    if norm >= tol.closure:
-        raise AssemblyError(system.path, best, it)
-    bad = system.wrong_branch(q, placed=q is last)
+    evaluate, step, verdict = system.solver_pass()
+    hook = None if trace is None else (
+        lambda which, k, Q, r, K, dQ, ok: trace(k, Q[0], r[0], K[0], dQ[0], bool(ok[0])))
+    out = iterate(evaluate, q[None], system.free_columns(frozen), tol, system.integrator, step, trace=hook,
+                  verdict=verdict)
+    q, norm, it = out.q[0], float(out.residual[0]), int(out.iterations[0])
+    if not out.converged[0]:
+        raise AssemblyError(system.path, norm, it)
+    bad = system.wrong_branch(q, placed=bool(out.placed[0]))
     if bad:
-        raise AssemblyError(system.path, best, it,
+        raise AssemblyError(system.path, norm, it,
                             detail=f"the solution found assembles {', '.join(bad)} with a reversed axis")
     return Assembly(q, norm, it)

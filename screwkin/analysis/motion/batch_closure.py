@@ -2,7 +2,8 @@
 kinematics, batched continuation): ``TreeKinematics`` computes the placements and Jacobians of
 frames of a tree of 1-DOF joints for N configurations in one pass down the tree, and
 ``BatchClosure`` builds on them the same rows, in the same order, as model.closure.ClosureSystem
-and moves every configuration by the one damped-Newton step of model/newton.py.
+and solves them with the one damped-Newton loop of model/newton.py (``iterate``), all configurations
+at once.
 """
 
 from __future__ import annotations
@@ -362,50 +363,27 @@ class BatchClosure:
 
     # ------------------------------------------------------------------ solving
     def solve(self, Q0, targets=None, frozen=(), tolerances=None, iterations: int | None = None):
-        """Damped Newton (Levenberg-Marquardt, minimum-norm steps, the damping of each
-        configuration its own) from every row of Q0 at once, as ClosureSystem.solve does for
-        one.  frozen: velocity indices that do not move (inputs).  Returns (Q, converged (N,),
-        residual norms (N,), iterations (N,)); a configuration that converges with a reversed
-        revolute cut joint counts as not converged."""
+        """Damped Newton from every row of Q0 at once: model.newton.iterate (the loop of
+        ClosureSystem.solve, each configuration with its own damping) on these rows.  frozen:
+        velocity indices that do not move (inputs).  Returns (Q, converged (N,), residual norms
+        (N,), iterations (N,)); a configuration that converges with a reversed revolute cut joint
+        counts as not converged."""
         tol = tolerances or self.mech.tolerances
-        max_it = int(iterations if iterations is not None else tol.max_iterations)
         Q = np.array(np.atleast_2d(Q0), float)
         N, nv = Q.shape[0], self.model.nv
-        free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
-        its = np.zeros(N, int)
         if self.solver_rows == 0 or N == 0:
-            return Q, np.ones(N, bool), np.zeros(N), its
-        tgt = targets
-        r, K = self.evaluate(Q, tgt)
-        norm = np.linalg.norm(r, axis=1)
-        mu, nu = np.full(N, tol.lm_damping), np.full(N, newton.NU)
-        active = norm >= tol.closure
-        for _ in range(max_it):
-            idx = np.flatnonzero(active)
-            if not len(idx):
-                break
-            its[idx] += 1
-            Kf = K[idx][:, :, free]
-            ri = r[idx]
-            dqf, lin2 = newton.damped_steps(Kf, ri, mu[idx])
-            Qn = Q[idx].copy()
-            Qn[:, free] += dqf
-            sub = None if tgt is None else (tgt[0][idx], tgt[1])
-            rn, Kn = self.evaluate(Qn, sub)
-            nn = np.linalg.norm(rn, axis=1)
-            ok = nn < norm[idx]
-            rho = newton.gain_ratio(norm[idx], nn, lin2)
-            a = idx[ok]
-            mu[a], nu[a] = newton.accept(mu[a], rho[ok], tol)
-            Q[a], r[a], K[a], norm[a] = Qn[ok], rn[ok], Kn[ok], nn[ok]
-            b = idx[~ok]
-            mu[b], nu[b] = newton.refuse(mu[b], nu[b])
-            active[idx] = (norm[idx] >= tol.closure) & ~newton.given_up(mu[idx], tol)
-        converged = norm < tol.closure
+            return Q, np.ones(N, bool), np.zeros(N), np.zeros(N, int)
+
+        def evaluate(Q_, which, jacobian):
+            return self.evaluate(Q_, None if targets is None else (targets[0][which], targets[1]), jacobian)
+
+        free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
+        out = newton.iterate(evaluate, Q, free, tol, self.system.integrator, newton.stacked_steps, iterations)
+        converged = out.converged.copy()
         if converged.any():
             c = np.flatnonzero(converged)
-            converged[c] &= ~self.reversed_axes(Q[c])
-        return Q, converged, norm, its
+            converged[c] &= ~self.reversed_axes(out.q[c])
+        return out.q, converged, out.residual, out.iterations
 
     # ------------------------------------------------------------------ self-check
     def _check(self, rng, count):
