@@ -20,10 +20,12 @@ from pathlib import Path
 from ..analysis.design.study import (
     StudyResult,
     StudySpec,
+    apply_requirements,
     check_pareto,
     designs,
     failed_row,
     metric_columns,
+    requirements,
     run_chunk,
     study_task,
 )
@@ -68,6 +70,7 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     elif not isinstance(spec, StudySpec):
         spec = read_study_spec(spec)
     check_pareto(spec)
+    requirements(spec)  # a column the study does not have is a usage error before any design runs
     if scheduler is not None and workers is not None:
         raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
@@ -94,8 +97,14 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
         results, used, where = _on_dask(task, chunks, len(values), scheduler, workers or n_workers, timeout,
                                         progress)
     rows = tuple(r for chunk_rows in results for r in chunk_rows)
-    return StudyResult(spec, task.parameters, metric_columns(spec.metrics), rows, time.perf_counter() - t0, used,
-                       where, len(chunks))
+    rows, column, unmet = apply_requirements(spec, rows)
+    columns = metric_columns(spec.metrics) + ((column,) if column else ())
+    notes = []
+    if spec.transmission_steps is not None and "transmission_angle" in spec.metrics:
+        notes.append(f"transmission: {{steps: {spec.transmission_steps}}} is not used: the transmission angle's "
+                     "extremes over the input's motion are located in closed form, not sampled")
+    return StudyResult(spec, task.parameters, columns, rows, time.perf_counter() - t0, used, where, len(chunks),
+                       {"unmet": unmet, "notes": notes})
 
 
 def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):

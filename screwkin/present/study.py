@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.design.study import pareto_front
+from ..analysis.design.study import REQUIREMENTS_COLUMN, pareto_front, requirements
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
@@ -48,6 +48,7 @@ __all__ = [
 DISPLAY = {
     "transmission_angle_min": ("transmission_angle_min_deg", 180.0 / math.pi),
     "transmission_angle_max": ("transmission_angle_max_deg", 180.0 / math.pi),
+    "transmission_deviation": ("transmission_deviation_deg", 180.0 / math.pi),
     "grashof_margin": ("grashof_margin_m", 1.0),
 }
 
@@ -130,7 +131,32 @@ def study_dict(result) -> dict:
     if spec.pareto and result.succeeded:
         d["pareto"] = {"columns": [{"column": c, "goal": g} for c, g in spec.pareto],
                        "designs": [result.rows[k]["design"] for k in pareto_front(result)]}
+    reqs, default = requirements(spec)
+    if reqs:
+        d["requirements"] = {"rules": [q.text for q in reqs], "default": default,
+                             "unmet": {str(k): v for k, v in result.extra.get("unmet", {}).items()}}
+    d["notes"] = list(result.extra.get("notes", ()))
     return to_jsonable(d)
+
+
+def _requirements_lines(result) -> list:
+    """What the designs had to meet and which did not (left out of the Pareto front)."""
+    reqs, default = requirements(result.spec)
+    if not reqs:
+        return []
+    ok = [r for r in result.succeeded if r.get(REQUIREMENTS_COLUMN)]
+    unmet = result.extra.get("unmet", {})
+    how = (" (the default of " + ", ".join(m for m in result.spec.metrics if m == "transmission_angle")
+           + ": a dead point, mu = 0 or 180 deg, stops the input driving the output; state require: in the spec "
+           "to change it)") if default else ""
+    lines = [f"requirements: {'; '.join(q.text for q in reqs)}{how}: {len(ok)} of {len(result.succeeded)} analysed "
+             "designs meet them"]
+    if unmet:
+        shown = list(unmet.items())[:10]
+        lines.append("  not met (marked in the table, left out of the Pareto front): "
+                     + "; ".join(f"design {k}: {v}" for k, v in shown)
+                     + (f"; ... and {len(unmet) - len(shown)} more" if len(unmet) > len(shown) else ""))
+    return lines
 
 
 def _workspace_metrics(result) -> bool:
@@ -195,10 +221,14 @@ def study_text(result, table_path=None) -> str:
         else:
             counts = Counter(str(v) for _, v in vals)
             lines.append(f"{name}: " + ", ".join(f"{v} {c}" for v, c in counts.most_common()))
+    lines += _requirements_lines(result)
     if spec.pareto and ok:
         front = pareto_front(result)
         names = [f"{g} {_display(c)[0] if c in DISPLAY else c}" for c, g in spec.pareto]
-        lines.append(f"Pareto front ({', '.join(names)}): designs {', '.join(str(result.rows[k]['design']) for k in front)}")
+        among = " among the designs that meet the requirements" if requirements(spec)[0] else ""
+        lines.append(f"Pareto front ({', '.join(names)}){among}: designs "
+                     f"{', '.join(str(result.rows[k]['design']) for k in front) or 'none'}")
+    lines += [f"note: {n}" for n in result.extra.get("notes", ())]
     rows, names = _rows(result)
     if n <= TEXT_ROWS:
         table = [names] + [[_fmt(v) for v in row] for row in rows]
@@ -229,6 +259,8 @@ def _numeric(result):
 LABELS = {
     "transmission_angle_min": ("smallest transmission angle [deg]", 180.0 / math.pi),
     "transmission_angle_max": ("largest transmission angle [deg]", 180.0 / math.pi),
+    "transmission_deviation": ("largest |90 deg - transmission angle| [deg]", 180.0 / math.pi),
+    "dead_points": ("dead points [-]", 1.0),
     "grashof_margin": ("Grashof margin (p+q)-(s+l) [mm]", 1000.0),
     "mobility": ("mobility [DOF]", 1.0),
     "mobility_count": ("mobility by counting [DOF]", 1.0),
@@ -351,10 +383,12 @@ def pareto_figure(result, goals=None):
         if cls == "failed":
             continue
         rows = [r for n, r in enumerate(result.rows) if classes[n][0] == cls and r[a] is not None and r[b] is not None]
-        if rows:
-            ax.plot([r[a] * fa for r in rows], [r[b] * fb for r in rows], "o", ms=4, alpha=0.8,
-                    color=colour,
-                    label=cls if cls != "analysed" else "designs")
+        for meets, style in ((True, {}), (False, {"markerfacecolor": "none"})):
+            some = [r for r in rows if (r.get(REQUIREMENTS_COLUMN) is not False) == meets]
+            if some:
+                ax.plot([r[a] * fa for r in some], [r[b] * fb for r in some], "o", ms=4, alpha=0.8, color=colour,
+                        label=(cls if cls != "analysed" else "designs") + ("" if meets else ", requirements not met"),
+                        **style)
     fx = [result.rows[k][a] * fa for k in front]
     fy = [result.rows[k][b] * fb for k in front]
     ax.plot(fx, fy, "-", color="k", linewidth=1.0, label="Pareto front")
@@ -364,8 +398,10 @@ def pareto_figure(result, goals=None):
     ax.set_xlabel(f"{la} ({ga}imize)" if ga in ("max", "min") else f"{la} ({ga})")
     ax.set_ylabel(f"{lb} ({gb}imize)" if gb in ("max", "min") else f"{lb} ({gb})")
     nfail = len(result.failed)
+    unmet = sum(r.get(REQUIREMENTS_COLUMN) is False for r in result.rows)
     ax.set_title(f"{Path(result.spec.file).name}: {len(result.succeeded)} designs"
-                 + (f", {nfail} failed (not drawn)" if nfail else ""), fontsize=9)
+                 + (f", {nfail} failed (not drawn)" if nfail else "")
+                 + (f"; {unmet} not meeting the requirements (hollow, off the front)" if unmet else ""), fontsize=9)
     ax.legend(fontsize=8, title="Grashof class" if any(r.get("grashof") for r in result.succeeded) else None,
               title_fontsize=8)
     fig.tight_layout()
