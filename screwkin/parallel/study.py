@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from collections import Counter
 import math
 import os
 import time
@@ -26,9 +27,9 @@ from ..analysis.design.study import (
     failed_row,
     metric_columns,
     requirements,
-    run_chunk,
     study_task,
 )
+from ..analysis.design.family import FAMILY_CHUNK, chunk_rows, eligible
 from ..errors import UsageError, one_line, quote
 from ..files.study import read_study_spec, study_spec
 from .scheduler import probe_scheduler, scheduler_address
@@ -81,6 +82,8 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     values = designs(spec)
     n_workers = default_workers() if workers is None and scheduler is None else (workers or 1)
     size = spec.chunk or max(1, min(64, math.ceil(len(values) / (4 * max(n_workers, 1)))))
+    if not spec.chunk and eligible(task) is None:  # the family path: a chunk expanded once pays from tens of designs
+        size = max(1, min(FAMILY_CHUNK, math.ceil(len(values) / (2 * max(n_workers, 1)))))
     chunks = _chunks(list(enumerate(values)), size)
     t0 = time.perf_counter()
     if progress:
@@ -88,7 +91,7 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     if scheduler is None and workers == 0:
         results, failed = [], 0
         for k, chunk in enumerate(chunks):
-            results.append(run_chunk(task, chunk))
+            results.append(chunk_rows(task, chunk))
             failed += sum(r["error"] is not None for r in results[-1])
             if progress:
                 progress(sum(len(c) for c in chunks[:k + 1]), len(values), failed)
@@ -96,15 +99,35 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     else:
         results, used, where = _on_dask(task, chunks, len(values), scheduler, workers or n_workers, timeout,
                                         progress)
-    rows = tuple(r for chunk_rows in results for r in chunk_rows)
+    rows = tuple(r for got in results for r in got)
+    paths, path_notes = Counter(), Counter()
+    for got in results:
+        paths.update(getattr(got, "paths", {"design": len(got)}))
+        path_notes.update(getattr(got, "notes", ()))
     rows, column, unmet = apply_requirements(spec, rows)
     columns = metric_columns(spec.metrics) + ((column,) if column else ())
     notes = []
     if spec.transmission_steps is not None and "transmission_angle" in spec.metrics:
         notes.append(f"transmission: {{steps: {spec.transmission_steps}}} is not used: the transmission angle's "
                      "extremes over the input's motion are located in closed form, not sampled")
+    why = eligible(task)
     return StudyResult(spec, task.parameters, columns, rows, time.perf_counter() - t0, used, where, len(chunks),
-                       {"unmet": unmet, "notes": notes})
+                       {"unmet": unmet, "notes": notes, "paths": dict(paths), "path_notes": _merged(path_notes),
+                        "family": why})
+
+
+def _merged(notes: Counter) -> list:
+    """The chunks' notes, the same reason counted once with its designs added up ("3 designs evaluated
+    alone: why" from several chunks)."""
+    out = Counter()
+    for note, times in notes.items():
+        head, sep, why = note.partition(" evaluated alone: ")
+        count = head.split()[0]
+        if sep and count.isdigit():
+            out[why] += int(count) * times
+        else:
+            out[note] += 0
+    return [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" if c else why for why, c in out.most_common()]
 
 
 def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
@@ -139,7 +162,7 @@ def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
             client = Client(cluster, timeout=timeout)
             used, where = workers, "local cluster"
         token = uuid.uuid4().hex[:12]
-        futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
+        futures = [client.submit(chunk_rows, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
                    for k, chunk in enumerate(chunks)]
         results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
         return results, used, where

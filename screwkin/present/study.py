@@ -131,12 +131,29 @@ def study_dict(result) -> dict:
     if spec.pareto and result.succeeded:
         d["pareto"] = {"columns": [{"column": c, "goal": g} for c, g in spec.pareto],
                        "designs": [result.rows[k]["design"] for k in pareto_front(result)]}
+    d["paths"] = dict(result.extra.get("paths", {}))
+    d["path_notes"] = list(result.extra.get("path_notes", ()))
     reqs, default = requirements(spec)
     if reqs:
         d["requirements"] = {"rules": [q.text for q in reqs], "default": default,
                              "unmet": {str(k): v for k, v in result.extra.get("unmet", {}).items()}}
     d["notes"] = list(result.extra.get("notes", ()))
     return to_jsonable(d)
+
+
+def _paths_line(result) -> list:
+    """How the designs were evaluated: on the family path (expanded once per chunk, closed forms over the
+    designs) or each alone, and why some were alone."""
+    paths = result.extra.get("paths") or {}
+    family, alone = paths.get("family", 0), paths.get("design", 0)
+    if not family:
+        why = result.extra.get("family")
+        return [f"each design evaluated alone (loaded, assembled, analysed){f': {why}' if why else ''}"]
+    lines = [f"{family} designs on the family path (the xacro file expanded once per chunk, each design's file read "
+             "and checked, its four-bar's metrics in closed form over the designs; every chunk checked against "
+             f"designs evaluated alone), {alone} evaluated alone (references and spot checks among them)"]
+    lines += [f"  {n}" for n in result.extra.get("path_notes", ())[:5]]
+    return lines
 
 
 def _requirements_lines(result) -> list:
@@ -185,6 +202,7 @@ def study_text(result, table_path=None) -> str:
     lines = [(f"study of {spec.file} ({what}): {n} designs, {len(ok)} analysed, {len(bad)} failed; "
               f"{result.seconds:.2f} s on {result.workers} worker{'s' if result.workers != 1 else ''} "
               f"({result.scheduler}), timeout {spec.timeout:g} s per design")]
+    lines += _paths_line(result)
     if _workspace_metrics(result):
         ws = spec.workspace
         lines.append(f"workspace metrics of {result.spec.output!r}"

@@ -285,7 +285,9 @@ def design_args(task: _Task, values: tuple) -> dict:
     return args
 
 
-def _evaluate(task: _Task, index: int, values: tuple) -> dict:
+def _evaluate(task: _Task, index: int, values: tuple, keep=None) -> dict:
+    """The row of one design, from its values alone; ``keep`` (a list): the analysed design is appended
+    to it (the family path reads its mechanism)."""
     row = {"design": index, **dict(zip(task.parameters, values))}
     columns = metric_columns(task.metrics)
     row.update(dict.fromkeys(columns))
@@ -301,6 +303,8 @@ def _evaluate(task: _Task, index: int, values: tuple) -> dict:
                 computed.update(METRICS[m](d))
                 clock.check()  # a metric that ran past the deadline (one long workspace grid) fails the row
         row.update(computed)  # all metrics or none: a failed design never shows a number
+        if keep is not None:
+            keep.append(d)
     except ScrewkinError as exc:
         row["error"] = _reason(exc, task.file)
     except Exception as exc:  # noqa: BLE001 - a bug (or a missing module on a worker): the row says it, the run goes on
@@ -309,7 +313,8 @@ def _evaluate(task: _Task, index: int, values: tuple) -> dict:
 
 
 def run_chunk(task: _Task, chunk) -> list:
-    """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes."""
+    """The rows of a chunk of designs [(index, values), ...], each design evaluated alone (what a Dask
+    task computes when the family path does not apply: screwkin.analysis.design.family.chunk_rows)."""
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         return [_evaluate(task, i, v) for i, v in chunk]
