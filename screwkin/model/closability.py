@@ -7,6 +7,7 @@ import numpy as np
 import pinocchio as pin
 
 from ._pin import joint_axis
+from .geometry import cross3
 
 __all__ = ["closure_obstacle", "closure_gap", "planar_loops", "obstacle_of"]
 
@@ -32,15 +33,43 @@ def planar_loops(mech) -> list:
             continue
         axis = data.oMf[c.frame1].rotation @ np.asarray(c.axis, float)
         axes = [data.oMi[j].rotation @ joint_axis(model.joints[j]) for j in joints]
-        if any(np.linalg.norm(np.cross(axis, a)) > mech.tolerances.geometry for a in axes):
+        if any(np.linalg.norm(cross3(axis, a)) > mech.tolerances.geometry for a in axes):
             continue  # not planar: no side-length test
         points = [("frame", c.frame1)] + [("joint", j) for j in joints] + [("frame", c.frame2)]
-        names = [_link_of_joint(mech, j) for j in path1]
-        ground = _link_of_joint(mech, common[-1]) if common and common[-1] > 0 else mech.spec.root
-        names = names + [ground] + [_link_of_joint(mech, j) for j in path2]
-        if len(points) - 1 == len(names):
-            out.append((c.name, tuple(names), tuple(points), (c.frame1, tuple(np.asarray(c.axis, float)))))
+        ground = common[-1] if common and common[-1] > 0 else None
+        out.append((c.name, _Names(mech, path1, ground, path2), tuple(points),
+                    (c.frame1, tuple(np.asarray(c.axis, float)))))
     return out
+
+
+class _Names:
+    """The links of a loop's sides, looked up when first read (a sentence is written only for a loop
+    that cannot close)."""
+
+    def __init__(self, mech, path1, ground, path2):
+        self.mech, self.parts = mech, (path1, ground, path2)
+        self._names = None
+
+    def _all(self):
+        if self._names is None:
+            path1, ground, path2 = self.parts
+            links = {}
+            for f in self.mech.model.frames:  # the link a tree joint carries: its first body frame
+                if f.type == pin.FrameType.BODY:
+                    links.setdefault(f.parentJoint, f.name)
+            name = lambda j: links.get(j, self.mech.model.names[j])  # noqa: E731
+            self._names = tuple([name(j) for j in path1] + [name(ground) if ground is not None else self.mech.spec.root]
+                                + [name(j) for j in path2])
+        return self._names
+
+    def __iter__(self):
+        return iter(self._all())
+
+    def __len__(self):
+        return len(self._all())
+
+    def __getitem__(self, k):
+        return self._all()[k]
 
 
 def obstacle_of(cut: str, names, sides, tol: float):
@@ -85,7 +114,3 @@ def closure_obstacle(mech) -> str | None:
     return found[0] if found else None
 
 
-def _link_of_joint(mech, jid: int) -> str:
-    """The link a tree joint carries (its child body's link)."""
-    return next((f.name for f in mech.model.frames if f.parentJoint == jid and f.type == pin.FrameType.BODY),
-                mech.model.names[jid])

@@ -253,7 +253,8 @@ class PositionSolver:
         """DOFs left free with the inputs held, beyond the idle ones (0 = the inputs determine
         the mechanism)."""
         g = self.generic()
-        return max(len(self.passive) - g.rank_Kp - self.idle_dofs, 0)
+        free = len(self.passive) - g.rank_Kp
+        return max(free - self.idle_dofs, 0) if free > 0 else 0  # (idle DOFs, a mobility analysis: only if any is left)
 
     def _mobility(self):
         self.generic()  # the assembly the mobility analysis starts from
