@@ -9,13 +9,11 @@ limits and a grace is given up, its designs failed rows that say why.
 from __future__ import annotations
 
 import asyncio
-import logging
 from collections import Counter
 import math
 import os
 import time
 import uuid
-import warnings
 from pathlib import Path
 
 from ..analysis.design.study import (
@@ -30,9 +28,9 @@ from ..analysis.design.study import (
     study_task,
 )
 from ..analysis.design.family import FAMILY_CHUNK, chunk_rows, eligible
-from ..errors import UsageError, one_line, quote
+from ..errors import UsageError, one_line
 from ..files.study import read_study_spec, study_spec
-from .scheduler import probe_scheduler, scheduler_address
+from .pool import dask_client
 
 __all__ = ["run_study", "default_workers", "STALL_GRACE"]
 
@@ -133,49 +131,22 @@ def _merged(notes: Counter) -> list:
 def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
     """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
     workers, where)."""
-    from distributed import (  # 0.4-0.9 s to import: only studies need it
-        Client,
-        LocalCluster,
-        as_completed,
-    )
+    from distributed import as_completed  # 0.4-0.9 s to import: only studies need it
 
-    cluster = client = None
-    futures = []
-    try:
-        if scheduler is not None:
-            address = scheduler_address(scheduler)
-            probe_scheduler(address, timeout)
-            try:
-                client = Client(address, timeout=timeout)
-                client.wait_for_workers(1, timeout=timeout)
-            except (OSError, TimeoutError) as exc:
-                what = "has no worker" if client is not None else "cannot be reached"
-                raise UsageError(f"the dask scheduler at {quote(address)} {what} within {timeout:g} s "
-                                 f"({one_line(str(exc) or type(exc).__name__, 160)})") from None
-            used, where = len(client.scheduler_info().get("workers", {})) or 1, address
-        else:
-            with warnings.catch_warnings():  # "Port 8787 is already in use": its HTTP routes then take another
-                warnings.filterwarnings("ignore", message="Port .* is already in use")
-                # processes on 127.0.0.1 only (the scheduler's HTTP routes too: no dashboard address given)
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                       dashboard_address=None, silence_logs=logging.ERROR)
-            client = Client(cluster, timeout=timeout)
-            used, where = workers, "local cluster"
-        token = uuid.uuid4().hex[:12]
-        futures = [client.submit(chunk_rows, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
-                   for k, chunk in enumerate(chunks)]
-        results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
-        return results, used, where
-    finally:
-        if client is not None:
+    with dask_client(scheduler, workers, timeout) as (client, used, where):
+        futures = []
+        try:
+            token = uuid.uuid4().hex[:12]
+            futures = [client.submit(chunk_rows, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
+                       for k, chunk in enumerate(chunks)]
+            results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
+            return results, used, where
+        finally:
             if futures:  # interrupted: take the study's tasks off the cluster
                 try:
                     client.cancel(futures)
                 except Exception:  # noqa: BLE001, S110 - closing anyway
                     pass
-            client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def _collect(client, task, chunks, futures, total, progress, as_completed, grace: float = STALL_GRACE,
