@@ -29,8 +29,7 @@ import numpy as np
 
 from ..errors import MechanismFileError, UsageError
 from .xacro import expand
-from .xacro_eval import _ALLOWED, _COMPARE, FUNCTIONS, XacroEvaluationError, _call, _function_name, _Interpreter, \
-    _parse_expression, _power, _Refused
+from .xacro_eval import _COMPARE, FUNCTIONS, _call, _function_name, _Interpreter, _power, _Refused, evaluate
 from .xmlsafe import parse_xml_text
 
 __all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch"]
@@ -259,21 +258,13 @@ class _BatchInterpreter(_Interpreter):
 
 
 def _evaluator(ctx: _Context):
-    def evaluate(expr, symbols=None):
-        try:
-            tree = _parse_expression(expr)
-            v = _BatchInterpreter({} if symbols is None else symbols, ctx).value(tree)
-        except _Refused as exc:
-            raise XacroEvaluationError(f"refused: {exc} (only {_ALLOWED} are allowed)") from None
-        except RecursionError:
-            raise XacroEvaluationError("properties defined through each other too deeply") from None
-        except OverflowError:
-            raise XacroEvaluationError("a number too large (overflow)") from None
+    def batch_evaluate(expr, symbols=None):
+        v = evaluate(expr, symbols, lambda table: _BatchInterpreter(table, ctx))
         if isinstance(v, Batch):  # where this expression fails design by design, that design fails
             ctx.bad |= v.bad
         return v
 
-    return evaluate
+    return batch_evaluate
 
 
 @dataclass(frozen=True)

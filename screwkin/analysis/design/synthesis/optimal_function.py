@@ -26,7 +26,7 @@ from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, FunctionResult, SynthesisError
 from .fourbar import wrap
-from .function import _generated, function_result, function_task
+from .function import function_result, function_task
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, rank_key
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
 
