@@ -335,23 +335,14 @@ def _family(task, chunk, index, values, alone):
             alone[k] = ("its axes are not parallel" if not planar[m] else
                         "its loop is within the tolerance of closing or not, or a link is nearly zero")
             continue
-        row = {"design": index[k], **dict(zip(task.parameters, chunk[k][1]))}
-        row.update(dict.fromkeys(columns))
-        row["error"] = None
-        if m in proved:
+        if m in proved:  # the failed row of a loop that cannot close: the single commands' sentence
+            row = {"design": index[k], **dict(zip(task.parameters, chunk[k][1]))}
+            row.update(dict.fromkeys(columns))
             reason, gap = proved[m]
             row["error"] = _reason(AssemblyError(task.file, gap, 0, starts=0, reason=reason, proved=True), task.file)
         else:
-            if "mobility" in task.metrics:
-                row.update({col: reference[col] for col in COLUMNS["mobility"]})
-            if "grashof" in task.metrics:
-                row.update({"linkage": "four-bar", "grashof": short[FOUR_BAR_CLASSES[int(codes[m])]],
-                            "grashof_margin": float(margin[m])})
-            if "transmission_angle" in task.metrics:
-                lo, hi = float(mu_lo[m]), float(mu_hi[m])
-                row.update({"transmission_angle_min": lo, "transmission_angle_max": hi, "transmission_restarts": 0,
-                            "transmission_deviation": float(max(math.pi / 2 - lo, hi - math.pi / 2)),
-                            "input_turns": bool(turns[m]), "dead_points": int(dead[m])})
+            row = _row_of(task, index[k], chunk[k][1], columns, reference, codes[m], margin[m], mu_lo[m], mu_hi[m],
+                          turns[m], dead[m], short)
         made[k] = row
     # the family path's rows must be the designs' own: the reference's recomputed, and one drawn at random.
     # Every design the family path covers reports its closed-form row (the reference and the drawn one too),
