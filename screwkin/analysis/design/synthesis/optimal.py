@@ -45,10 +45,11 @@ PREFER = 0.01
 SAMPLES = 180
 #: Members of each run's final population refined (the best, apart from each other).
 REFINED = 3
-#: The refinement's evaluations at most, per unknown (its Jacobian is one batched evaluation); beyond 16
-#: unknowns (crank angles of many points) its trust-region steps are solved by LSMR (no SVD: OpenBLAS's
-#: threads make a dense SVD slow on shared cores).
+#: The refinement's evaluations at most, per unknown (its Jacobian is one batched evaluation); beyond
+#: EXACT_UNKNOWNS unknowns (crank angles of many points) its trust-region steps are solved by LSMR (no SVD:
+#: OpenBLAS's threads made a dense SVD of 240 x 49 take 8-48 ms on the shared cores, 1 ms on one thread).
 REFINE_EVALUATIONS = 30
+EXACT_UNKNOWNS = 40
 #: The refinement's margin inside the constraints (times the path's size; in rad for the transmission angle).
 MARGIN = 1e-6
 #: Most points the global search measures (evenly chosen; the refinement fits them all).
@@ -143,7 +144,7 @@ def refined(residuals, x0, lower, upper, scale, weights=(PENALTY, PENALTY_REFINE
 
         sol = least_squares(fun, x, jac=jac, bounds=(lower, upper), x_scale="jac", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                             max_nfev=(REFINE_EVALUATIONS if k == 0 else REFINE_EVALUATIONS // 3) * max(len(x), 10),
-                            tr_solver="exact" if len(x) <= 16 else "lsmr")
+                            tr_solver="exact" if len(x) <= EXACT_UNKNOWNS else "lsmr")
         x = sol.x
         if not residuals(x[None], 1.0)[0, -1] > 0:  # no constraint missed (the last residual: the penalty)
             break
