@@ -151,6 +151,21 @@ def main(argv=None) -> int:
     rounds(("Strider: pylinkage Linkage.step", lambda: pylinkage_strider(), "positions"),
            ("Strider: screwkin.sweep (API)", lambda: sweep(st_solver, "crank_joint", 0.0, -2 * np.pi, 360),
             "q, rates, accelerations"))
+
+    def fresh_sweep():  # a mechanism loaded anew each time: the first sweep pays every set-up (issue 38)
+        return sweep(PositionSolver(screwkin.load(ROOT / "robots" / "strider.urdf")), "crank_joint", 0.0, -2 * np.pi,
+                     360)
+
+    def fresh_only():
+        m = screwkin.load(ROOT / "robots" / "strider.urdf")
+        t = time.perf_counter()
+        sweep(PositionSolver(m), "crank_joint", 0.0, -2 * np.pi, 360)
+        return time.perf_counter() - t
+
+    rounds(("Strider, fresh: pylinkage builds it and steps it", lambda: pylinkage_strider(), "positions"),
+           ("Strider, fresh: screwkin.load + first sweep", fresh_sweep, "q, rates, accelerations"))
+    rows["Strider, fresh: screwkin's first sweep alone (load not counted)"] = (
+        [fresh_only() for _ in range(args.repeat)], "q, rates, accelerations")
     contest("Strider: screwkin, its start solve(starts=8) alone", lambda: st_solver.solve({"crank_joint": 0.0},
                                                                                             starts=8))
     if not args.quick:
@@ -209,6 +224,11 @@ def main(argv=None) -> int:
     print(f"| four-bar API: screwkin / pylinkage | {ratio('four-bar: screwkin.sweep (API)', 'four-bar: pylinkage fourbar().step')} |")
     print(f"| four-bar API: screwkin / numpy floor | {ratio('four-bar: screwkin.sweep (API)', 'four-bar: numpy closed form (floor)')} |")
     print(f"| Strider API: screwkin / pylinkage | {ratio('Strider: screwkin.sweep (API)', 'Strider: pylinkage Linkage.step')} |")
+    print(f"| Strider, fresh mechanism (load + first sweep): screwkin / pylinkage | "
+          f"{ratio('Strider, fresh: screwkin.load + first sweep', 'Strider, fresh: pylinkage builds it and steps it')} |")
+    alone = "Strider, fresh: screwkin's first sweep alone (load not counted)"
+    print(f"| Strider, fresh mechanism (first sweep alone): screwkin / pylinkage | "
+          f"{ratio(alone, 'Strider, fresh: pylinkage builds it and steps it')} |")
     print(f"| four-bar shell: screwkin / pylinkage script | {ratio('shell: screwkin sweep --steps 10000 --json', 'shell: python script importing pylinkage, 10,000 steps, JSON')} |")
     print(f"| four-bar, 500 angles: mechanism / screwkin | {ratio('four-bar, 500 angles: mechanism (fsolve)', 'four-bar, 500 angles: screwkin.sweep (API)')} |")
     print(f"| Bennett: rational_linkages / screwkin | {ratio('Bennett, 100 angles: rational_linkages direct_kinematics', 'Bennett, 100 angles: screwkin.sweep (tracker)')} |")

@@ -92,11 +92,89 @@ def report(designs: int = 48, repeat: int = 2) -> list:
     return lines
 
 
+def lhs_family(designs: int) -> dict:
+    """Latin-hypercube draws of the four-bar family (crank 10-100 mm, coupler 50-200 mm, rocker 30-200 mm,
+    ground 0.1 m): mobility, grashof, transmission_angle, the family path's kind of study."""
+    return {"file": str(ROOT / "robots" / "fourbar.urdf.xacro"), "args": {"ground": 0.1},
+            "parameters": {"crank": {"min": 0.01, "max": 0.1}, "coupler": {"min": 0.05, "max": 0.2},
+                           "rocker": {"min": 0.03, "max": 0.2}},
+            "sampling": "lhs", "designs": designs, "seed": 1, "metrics": ["mobility", "grashof", "transmission_angle"],
+            "input": "crank_joint", "output": "rocker"}
+
+
+def family_scaling(designs: int = 10_000, workers=(1, 2, 4), repeat: int = 1, alone: int = 200) -> list:
+    """The family path on LocalClusters of each number of workers (started and warmed first, measured from
+    the chunks' submission), in this process, and the per-design path on ``alone`` designs for the ratio;
+    the rows checked against each design evaluated alone (every 50th) in degrees."""
+    import math
+
+    from distributed import Client, LocalCluster
+
+    from screwkin.analysis.design.study import _evaluate, study_task
+    from screwkin.files.study import study_spec
+    from screwkin.parallel.study import run_study
+
+    spec = lhs_family(designs)
+    out = [f"### 6. A family of {designs:,} four-bars (lhs; mobility, grashof, transmission_angle; {os.cpu_count()} "
+           f"cores, load average {os.getloadavg()[0]:.1f} at the start)", "",
+           "| where | designs | family path / alone | failed | time [s] | designs per second |", "|---|---|---|---|---|---|"]
+    t = time.perf_counter()
+    here = run_study(spec, workers=0)
+    t = time.perf_counter() - t
+    paths = here.extra["paths"]
+    out.append(f"| in process | {designs:,} | {paths.get('family', 0)} / {paths.get('design', 0)} | {len(here.failed)} | "
+               f"{t:.2f} | {designs / t:.0f} |")
+    for n in workers:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Port .* is already in use")
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+        client = Client(cluster)
+        try:
+            run_study(dict(spec, designs=40), scheduler=cluster.scheduler_address)  # warm: imports, first chunk
+            client.run(_import)
+            best = math.inf
+            for _ in range(repeat):
+                t = time.perf_counter()
+                res = run_study(spec, scheduler=cluster.scheduler_address)
+                best = min(best, time.perf_counter() - t)
+            assert res.rows == here.rows, "the tables differ"
+            out.append(f"| LocalCluster, {n} worker{'s' if n > 1 else ''} | {designs:,} | "
+                       f"{res.extra['paths'].get('family', 0)} / {res.extra['paths'].get('design', 0)} | "
+                       f"{len(res.failed)} | {best:.2f} | {designs / best:.0f} |")
+        finally:
+            client.close()
+            cluster.close()
+    task = study_task(study_spec(lhs_family(alone)))
+    from screwkin.analysis.design.study import designs as design_values
+
+    vals = design_values(study_spec(lhs_family(alone)))
+    t = time.perf_counter()
+    rows = [_evaluate(task, i, v) for i, v in enumerate(vals)]
+    t = time.perf_counter() - t
+    out.append(f"| each design alone (the per-design path), in process | {alone} | 0 / {alone} | "
+               f"{sum(r['error'] is not None for r in rows)} | {t:.2f} | {alone / t:.0f} |")
+    worst = 0.0
+    for r in here.rows[::50]:
+        own = _evaluate(task, r["design"], tuple(r[p] for p in task.parameters))
+        for c in ("transmission_angle_min", "transmission_angle_max", "transmission_deviation"):
+            if r[c] is not None:
+                worst = max(worst, math.degrees(abs(r[c] - own[c])))
+    out += ["", f"Rows of the family path against each design evaluated alone (every 50th): largest difference "
+                f"{worst:.2g} deg in the transmission columns; the same table, value for value, from every cluster."]
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--designs", type=int, default=48)
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--family", type=int, default=0, help="designs of the family-path benchmark (0: not run)")
+    ap.add_argument("--workers", default="1,2,4", help="the family benchmark's clusters")
     args = ap.parse_args()
+    if args.family:
+        print("\n".join(family_scaling(args.family, tuple(int(w) for w in args.workers.split(",")), args.repeat)))
+        return
     print("\n".join(report(args.designs, args.repeat)))
 
 

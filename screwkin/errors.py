@@ -115,20 +115,26 @@ class AssemblyError(MechanismFileError):
 
     ``residual`` is the smallest closure residual norm reached (m and rad mixed,
     as the constraint rows are), after ``iterations`` Newton iterations (of the
-    best start), from ``starts`` starting configurations when a search was made.
+    best start), from ``starts`` starting configurations when a search was made;
+    ``proved``: no search was made, the lengths prove the loop cannot close and
+    ``residual`` is how far apart its joint stays at least [m].
     """
 
     def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None,
-                 reason: str | None = None):
+                 reason: str | None = None, proved: bool = False):
         self.residual = float(residual)
         self.iterations = int(iterations)
         self.starts = starts
         self.reason = reason
         how = (f"from {starts} starting configurations" if starts and starts > 1
                else f"after {self.iterations} iterations")
-        msg = (f"cannot assemble the mechanism: {reason}; the loop-closure residual got down to "
-               f"{self.residual:.3g} {how}" if reason else
-               f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}")
+        if proved:  # the lengths alone prove it: ``residual`` is the least the loop can stay open, no search made
+            msg = (f"cannot assemble the mechanism: {reason}; the loop-closure residual cannot get below "
+                   f"{self.residual:.3g} (proved from the lengths: no assembly search)")
+        else:
+            msg = (f"cannot assemble the mechanism: {reason}; the loop-closure residual got down to "
+                   f"{self.residual:.3g} {how}" if reason else
+                   f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}")
         if detail:
             msg += f" ({detail})"
         super().__init__(path, msg)

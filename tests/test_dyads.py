@@ -361,3 +361,30 @@ def test_a_grid_too_coarse_to_unwrap_is_read_from_a_finer_closed_form():
     np.testing.assert_allclose(fast.values, slow.values, atol=1e-12)
     np.testing.assert_allclose(fast.q, slow.q, atol=1e-8)
     np.testing.assert_allclose(fast.rates, slow.rates, atol=1e-7)
+
+
+def test_a_regular_drawing_starts_the_sweep_without_the_generic_search():
+    """sweep's start from the file's drawing (sweep._drawn_regular): for mechanisms the dyad plan covers,
+    drawn closed at the start value, it is the configuration solve(values, starts=8) puts first, found
+    without the generic configurations' search; a drawing at a limit position (an actuator
+    singularity: the four-bar's output dyad folded, z = |b - c|) is not taken."""
+    import math
+
+    from screwkin.analysis.motion.sweep import _drawn_regular
+
+    for name in ("strider.urdf", "fourbar_crank_rocker.urdf", "watt_sixbar.urdf", "stephenson_sixbar.urdf",
+                 "slider_crank_offset.urdf", "five_bar.urdf"):
+        mech = screwkin.load(ROBOTS / name)
+        solver = PositionSolver(mech)
+        values = {n: 0.0 for n in solver.inputs}
+        q = _drawn_regular(solver, values)
+        assert q is not None and not mech.generic_known, name
+        first = PositionSolver(screwkin.load(ROBOTS / name)).solve(values, starts=8).solutions[0].q
+        np.testing.assert_allclose(q, first, rtol=0, atol=1e-12, err_msg=name)
+        assert _drawn_regular(solver, {n: 0.3 for n in solver.inputs}) is None  # not drawn there
+    g, a, b, c = 0.1, 0.02, 0.16, 0.075  # a triple rocker drawn at its input's limit position
+    theta = math.acos((a * a + g * g - (b - c) ** 2) / (2 * a * g))
+    mech = screwkin.load(ROBOTS / "fourbar.urdf.xacro", args={"ground": g, "crank": a, "coupler": b, "rocker": c,
+                                                                 "theta": theta})
+    solver = PositionSolver(mech)
+    assert _drawn_regular(solver, {"crank_joint": 0.0}) is None

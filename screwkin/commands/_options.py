@@ -52,7 +52,9 @@ BOUNDS = {
     "dof": (0, 10),                   # synthesize chains --dof
     "seed": (0, 2**32 - 1),           # random seeds (numpy's range)
     "mode": (1, 1_000),               # --mode K: an assembly mode
-    "workers": (0, 64),               # study --workers: processes of the local cluster
+    "workers": (0, 64),               # study / synthesize --workers: processes of the local cluster
+    "best": (1, 50),                  # synthesize --best: designs listed
+    "generations": (1, 10_000),       # synthesize --generations: of each differential-evolution run
     "workspace_samples": (1, 5_000_000),  # workspace --method sampling --samples
 }
 #: The bounds of the durations people type [s], (smallest, largest).

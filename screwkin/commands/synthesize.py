@@ -11,6 +11,7 @@ OUT, so OUT is the checked file and a rejected result leaves no file.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -20,19 +21,25 @@ from pathlib import Path
 
 from ..analysis.design.synthesis.chains import chain_linkage, enumerate_chains
 from ..analysis.design.synthesis.check import check_chain_file, check_design
+from ..analysis.design.synthesis.constraints import GRASHOF_TYPES, Constraints
+from ..analysis.design.synthesis.search import GENERATIONS, Search
 from ..analysis.design.synthesis.designs import SynthesisError
 from ..analysis.design.synthesis.function import synthesize_function
 from ..analysis.design.synthesis.motion import motion_design, synthesize_motion
+from ..analysis.design.synthesis.optimal import optimal_path
+from ..analysis.design.synthesis.optimal_function import optimal_function
+from ..analysis.design.synthesis.optimal_motion import optimal_motion
 from ..analysis.design.synthesis.path import synthesize_path
 from ..errors import UsageError, quote
 from ..files.description import LIMITS
 from ..files.writer import write_urdf
+from ..parallel.pool import dask_client, dask_map
 from ..model.loader import load
 from ..present.jsonout import to_jsonable
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
-from ._options import count
+from ._options import count, seconds
 from .draw import draw_design
 
 NAME = "synthesize"
@@ -41,10 +48,12 @@ KINDS = ("motion", "function", "path", "chains")
 #: Ranked pairs of Burmester dyads checked with screwkin before giving up on a defect-free one.
 PAIRS_CHECKED = 6
 
+#: The options of the constrained global search (motion, function, path).
+SEARCH = {"bounds", "lengths", "grashof", "min_transmission", "best", "generations", "workers", "scheduler", "seed"}
 _OPTIONS = {  # which options each kind takes (dest names)
-    "motion": {"poses", "pivots", "moving", "pick", "candidates", "png", "draw"},
-    "function": {"function", "x_range", "input_range", "output_range", "points", "spacing", "ground", "draw"},
-    "path": {"points", "timing", "starts", "seed", "tolerance", "draw"},
+    "motion": {"poses", "pivots", "moving", "pick", "candidates", "png", "draw"} | SEARCH,
+    "function": {"function", "x_range", "input_range", "output_range", "points", "spacing", "ground", "draw"} | SEARCH,
+    "path": {"points", "timing", "starts", "seed", "tolerance", "draw"} | SEARCH,
     "chains": {"links", "dof", "prismatic", "planar"},
 }
 
@@ -86,9 +95,25 @@ def add_parser(sub, common, scaled):
                                     "(default 3; more: least squares)")
     p.add_argument("--timing", metavar='"a, b, ..."', help="path: the crank angle at each point (from any zero)")
     p.add_argument("--starts", type=count("starts"), default=24, help="path: least-squares starts (default 24)")
-    p.add_argument("--seed", type=count("seed"), default=0, help="path: seed of the starts (default 0)")
+    p.add_argument("--seed", type=count("seed"), default=0,
+                   help="path: seed of the starts; the global search's seed (default 0)")
     p.add_argument("--tolerance", default="1e-6",
                    help="path: a point is reached within this distance (default 1e-6 m)")
+    g = sp.add_argument_group("constraints and the global search (motion, function, path)")
+    g.add_argument("--bounds", metavar='"X0,Y0; X1,Y1"', help="the fixed pivots inside this box (m, or with units)")
+    g.add_argument("--lengths", metavar="MIN..MAX", help="every link, the ground's too, this long (m, or with units)")
+    g.add_argument("--grashof", choices=GRASHOF_TYPES, help="the Grashof type (as study prints it; grashof: any)")
+    g.add_argument("--min-transmission", metavar="ANGLE",
+                   help="the transmission angle within ANGLE .. 180 deg - ANGLE over the motion (rad, or with deg)")
+    g.add_argument("--best", type=count("best"), help="designs listed (default 5)")
+    g.add_argument("--generations", type=count("generations"),
+                   help=f"generations of each differential-evolution run at most (default {GENERATIONS})")
+    g.add_argument("--workers", type=count("workers"), metavar="N",
+                   help="spread the search's runs over a local cluster of N processes (0: in this process, the "
+                        "default)")
+    g.add_argument("--scheduler", metavar="ADDRESS", help="spread them over a running dask cluster, tcp://HOST:PORT")
+    g.add_argument("--timeout", type=seconds("timeout"), default=10.0,
+                   help="seconds to reach the scheduler and a worker (default 10)")
     c = sp.add_argument_group("chains")
     c.add_argument("--links", type=int, help="number of links (the ground included)")
     c.add_argument("--dof", type=int, help="degrees of freedom")
@@ -98,7 +123,7 @@ def add_parser(sub, common, scaled):
 
 def _given(args, dest) -> bool:
     defaults = {"candidates": 24, "spacing": "chebyshev", "ground": "0.1", "starts": 24, "seed": 0,
-                "tolerance": "1e-6", "prismatic": 0, "planar": False}
+                "tolerance": "1e-6", "prismatic": 0, "planar": False, "timeout": 10.0}
     return getattr(args, dest) not in (None, defaults.get(dest))
 
 
@@ -106,8 +131,8 @@ def _option(dest):
     return "--" + dest.replace("_", "-")
 
 
-def _numbers(text, option, count=None):
-    """'x,y; x,y' -> [[x, y], [x, y]] (each number with an optional unit)."""
+def _numbers(text, option, count=None, kind=None):
+    """'x,y; x,y' -> [[x, y], [x, y]] (each number with an optional unit, of ``kind`` when given)."""
     groups = [g for g in text.split(";") if g.strip()]
     if not groups:
         raise UsageError(f"{option}: no values in {quote(text)}")
@@ -117,7 +142,7 @@ def _numbers(text, option, count=None):
         if count is not None and len(parts) != count:
             raise UsageError(f"{option}: {quote(g.strip())} has {len(parts)} numbers, expected {count} "
                              f"(write {'x,y,theta' if count == 3 else 'x,y'}; separated by ;)")
-        out.append([parse_value(x) for x in parts])
+        out.append([parse_value(x, kind, option) if kind else parse_value(x) for x in parts])
     return out
 
 
@@ -189,13 +214,14 @@ def run(mech, args) -> int:
     lines, marks = [], None
     if args.draw:
         marks = draw_design(load(args.out), [args.draw], say=lines.append)
+    constraints = _constraints(args).describe() if getattr(result, "search", None) is not None else ()
     if args.json:
-        out = synthesis_dict(result, check, args.out)
+        out = synthesis_dict(result, check, args.out, constraints)
         if args.draw:
             out["drawing"] = to_jsonable({"file": args.draw, "targets": marks})
         print(json.dumps(out, indent=2))
     else:
-        print(synthesis_text(result, check, args.out))
+        print(synthesis_text(result, check, args.out, constraints))
         if args.draw:
             print("\n".join([*lines, f"wrote {args.draw}"]))
         else:
@@ -204,10 +230,66 @@ def run(mech, args) -> int:
     return 0
 
 
+def _constraints(args) -> Constraints:
+    """--bounds, --lengths, --grashof, --min-transmission, checked."""
+    bounds = lengths = angle = None
+    if args.bounds:
+        corners = _numbers(args.bounds, "--bounds", 2, kind="length")
+        if len(corners) != 2:
+            raise UsageError(f"--bounds expects two corners \"X0,Y0; X1,Y1\", got {len(corners)}")
+        (x0, y0), (x1, y1) = corners
+        if not (x1 > x0 and y1 > y0):
+            raise UsageError("--bounds: the second corner must be above and to the right of the first "
+                             "(X1 > X0, Y1 > Y0)")
+        bounds = ((x0, y0), (x1, y1))
+    if args.lengths:
+        low, sep, high = args.lengths.partition("..")
+        if not sep or not low.strip() or not high.strip():
+            raise UsageError(f"--lengths expects MIN..MAX, got {quote(args.lengths)}")
+        lengths = (parse_value(low, "length", "--lengths"), parse_value(high, "length", "--lengths"))
+        if not 0 < lengths[0] < lengths[1]:
+            raise UsageError(f"--lengths: give 0 < MIN < MAX, got {quote(args.lengths)}")
+    if args.min_transmission:
+        angle = parse_value(args.min_transmission, "angle", "--min-transmission")
+        if not 0 <= angle < math.pi / 2:
+            raise UsageError(f"--min-transmission must lie from 0 to below 90 deg, got {quote(args.min_transmission)}")
+    return Constraints(bounds, lengths, args.grashof, angle)
+
+
+def _searching(args, count: int, beyond: int) -> bool:
+    """Whether the constrained global search runs: a constraint or a search option given, or more
+    precision positions than the classic methods take (``beyond``)."""
+    return count > beyond or any(_given(args, d) for d in SEARCH - {"seed"})
+
+
+@contextlib.contextmanager
+def _search(args):
+    """The Search of the command line: in this process, or spread over a Dask cluster (--workers N, or
+    --scheduler, the grammar of study)."""
+    kw = {"seed": args.seed, "best": args.best or 5, "generations": args.generations or GENERATIONS}
+    if args.scheduler is not None and args.workers is not None:
+        raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
+    if args.scheduler is None and not args.workers:
+        yield Search(**kw)
+        return
+    with dask_client(args.scheduler, args.workers, args.timeout) as (client, used, where):
+        yield Search(**kw, mapper=dask_map(client, "screwkin-synthesis"),
+                     where=f"{where}, {used} worker{'s' if used != 1 else ''}")
+
+
 def _motion(args):
     if not args.poses:
         raise UsageError('synthesize motion needs --poses "x,y,theta; x,y,theta; x,y,theta"')
     poses = _numbers(args.poses, "--poses", 3)
+    if _searching(args, len(poses), 5):
+        for opt, given in (("--pivots", args.pivots), ("--moving", args.moving), ("--pick", args.pick)):
+            if given:
+                raise UsageError(f"{opt} chooses the dyads; the constrained search ({len(poses)} poses or "
+                                 "--bounds, --lengths, --grashof, --min-transmission ...) chooses them itself")
+        with _search(args) as search:
+            result = optimal_motion(poses, _constraints(args), search)
+        check, tmp = _realize(result.design, args.out)
+        return result, check, tmp
     pivots = _numbers(args.pivots, "--pivots", 2) if args.pivots else None
     moving = _numbers(args.moving, "--moving", 2) if args.moving else None
     pick = None
@@ -256,6 +338,14 @@ def _function(args):
                              f"{quote(args.points)}") from None
         if points > 200:
             raise UsageError("--points: at most 200 precision points")
+    if _searching(args, 0, 0):
+        with _search(args) as search:
+            result = optimal_function(args.function, _range(args.x_range, "--x-range"),
+                                      _range(args.input_range, "--input-range"),
+                                      _range(args.output_range, "--output-range"), points, args.spacing,
+                                      parse_value(args.ground, "length", "--ground"), _constraints(args), search)
+        check, tmp = _realize(result.design, args.out)
+        return result, check, tmp
     result = synthesize_function(args.function, _range(args.x_range, "--x-range"),
                                  _range(args.input_range, "--input-range"), _range(args.output_range, "--output-range"),
                                  points, args.spacing, parse_value(args.ground, "length", "--ground"))
@@ -275,7 +365,11 @@ def _path(args):
     tolerance = parse_value(args.tolerance)
     if not tolerance > 0:
         raise UsageError("--tolerance must be a positive length")
-    result = synthesize_path(points, timing, args.starts, args.seed, tolerance)
+    if _searching(args, len(points), 24):
+        with _search(args) as search:
+            result = optimal_path(points, timing, _constraints(args), search, tolerance)
+    else:
+        result = synthesize_path(points, timing, args.starts, args.seed, tolerance)
     check, tmp = _realize(result.design, args.out, tolerance=tolerance)
     return result, check, tmp
 

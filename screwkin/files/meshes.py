@@ -137,10 +137,13 @@ def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
 
 def check_meshes(path, root, package_dirs=()) -> list:
     """Warnings for mesh files that cannot be found (missing meshes do not fail a load)."""
+    meshes = list(root.iter("mesh"))
+    if not meshes:  # (the folders to look in take a scan of sys.path: only when there is a mesh to find)
+        return []
     base = Path(path).resolve().parent
     roots = _roots(base, package_dirs)
     missing, outside, checked = [], [], set()
-    for mesh in root.iter("mesh"):
+    for mesh in meshes:
         uri = mesh.get("filename") or (mesh.findtext("uri") or "").strip()
         if not uri or uri.startswith("model://") or uri in checked:
             continue

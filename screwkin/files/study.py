@@ -10,6 +10,7 @@ file), the parameters to vary and how, and the metrics to compute for each desig
     metrics: [mobility, grashof, transmission_angle]
     input: crank_joint                 # grashof and transmission_angle (default: the actuated joint)
     output: rocker                     # mobility's output motion, workspace metrics
+    require: {dead_points: 0}          # what a design must meet to be on the Pareto front
 
 The spec is untrusted YAML like a sidecar (bounded, no aliases, plain data) and is
 checked whole before any design runs: every problem is a :class:`~screwkin.errors.UsageError`
@@ -47,7 +48,7 @@ DESIGN_TIMEOUT = 120.0
 #: The metrics computed from screwkin.analysis.design.workspace (they need ``workspace: {resolution: H}``).
 WORKSPACE_METRICS = ("workspace_volume", "singularity_free_volume", "conditioning")
 _KEYS = ("file", "args", "parameters", "sampling", "designs", "seed", "metrics", "input", "output", "point",
-         "workspace", "transmission", "pareto", "chunk", "timeout", "mode")
+         "workspace", "transmission", "pareto", "require", "chunk", "timeout", "mode")
 _WORKSPACE_KEYS = ("point", "resolution", "threshold", "length")
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
@@ -87,11 +88,14 @@ class StudySpec:
     output: str | None = None
     point: bool = False  # mobility: the output link's origin as a point
     workspace: dict = field(default_factory=dict)  # point, resolution [m], threshold, length [m]
-    transmission_steps: int = 180  # transmission_angle: input values sampled over the input's range
+    transmission_steps: int | None = None  # accepted from earlier specs, unused: the extremes are located
     pareto: tuple | None = None  # ((metric, "max"|"min"), (metric, "max"|"min"))
     chunk: int | None = None  # designs per task (default: chosen from the number of designs and workers)
     timeout: float = DESIGN_TIMEOUT  # seconds per design: over it, the design is a failed row
     mode: int | None = None  # the assembly mode every design's motion and workspace follow (None: the first)
+    # what a design must meet to be on the Pareto front: ((column, "equal" | "min" | "max", value, unit typed), ...);
+    # None: not given (the default requirement of the metrics applies: screwkin.analysis.design.study)
+    require: tuple | None = None
 
 
 def _fail(where, message):
@@ -186,6 +190,35 @@ def _pareto(value, where):
     return tuple(picked)
 
 
+def _require(value, where):
+    """``{column: value, column: {min: x, max: y}}`` -> ((column, "equal", value, False), (column, "min", x,
+    unit typed), ...); the columns are checked against the study's in screwkin.analysis.design.study."""
+    if value is None:
+        return None
+    if not isinstance(value, dict):
+        _fail(where, "require must be a mapping of column names to a value (dead_points: 0) or bounds "
+                     f"({{min: X, max: Y}}), got {quote(value)}")
+    out = []
+    for name, rule in value.items():
+        if not isinstance(name, str) or not _NAME.match(name):
+            _fail(where, f"require: {quote(name)} is not a column name")
+        if isinstance(rule, dict):
+            if not rule or set(rule) - {"min", "max"}:
+                _fail(where, f"require {quote(name)}: bounds are min and/or max, got {quote(rule)}")
+            for bound in ("min", "max"):
+                if bound in rule:
+                    v = rule[bound]
+                    out.append((name, bound, _value(v, where, f"require {name} {bound}"),
+                                isinstance(v, str) and bool(parse_typed_value(v)[1])))
+        elif isinstance(rule, (bool, int, float, str)):
+            if isinstance(rule, float) and not math.isfinite(rule):
+                _fail(where, f"require {quote(name)} must be finite, got {rule!r}")
+            out.append((name, "equal", rule, False))
+        else:
+            _fail(where, f"require {quote(name)}: give a value or {{min: X, max: Y}}, got {quote(rule)}")
+    return tuple(out)
+
+
 def _workspace(value, where):
     if value is None:
         return {}
@@ -278,7 +311,9 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
     transmission = data.get("transmission") or {}
     if not isinstance(transmission, dict) or set(transmission) - {"steps"}:
         _fail(where, f"transmission must be a mapping with steps, got {quote(transmission)}")
-    steps = _count(transmission.get("steps", 180), where, "transmission steps", 4, 100_000)
+    steps = transmission.get("steps")  # (earlier specs sampled the motion; the extremes are now located)
+    if steps is not None:
+        steps = _count(steps, where, "transmission steps", 4, 100_000)
     chunk = data.get("chunk")
     if chunk is not None:
         chunk = _count(chunk, where, "chunk", 1, 100_000)
@@ -291,7 +326,7 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
         mode = _count(mode, where, "mode (the K-th assembly mode, as solve lists them)", 1, 1000)
     spec = StudySpec(where, path, tuple(parameters), metrics, sampling, designs, seed, fixed, data.get("input"),
                      data.get("output"), point, workspace, steps, _pareto(data.get("pareto"), where), chunk,
-                     float(timeout), mode)
+                     float(timeout), mode, _require(data.get("require"), where))
     _check_arguments(spec, where)
     return spec
 

@@ -277,14 +277,16 @@ def _one_line(exc) -> str:
     return " when evaluating expression ".join(parts[:2]) or type(exc).__name__
 
 
-def _patched(xacro, state: _State, path):
-    """Replace xacro's evaluator, substitutions, includes and macro calls while expanding."""
+def _patched(xacro, state: _State, path, evaluator=None):
+    """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
+    macro calls while expanding."""
     original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",
                                                 "handle_macro_call", "eval_all", "eval_text", "reqd_attrs")}
+    evaluator = evaluator or evaluate
 
     def safe_eval(expr, globals, locals=None):
         try:
-            return evaluate(expr, globals)
+            return evaluator(expr, globals)
         except XacroEvaluationError as exc:  # xacro wraps it with "when evaluating expression ..."
             raise xacro.XacroException(str(exc)) from None
 
@@ -418,12 +420,14 @@ def _dom(text: str, path):
         raise MechanismFileError(path, f"malformed XML: {shorten(_one_line(exc), 100)}") from None
 
 
-def expand(path, text: str, args=None, root=None, warn=None) -> str:
+def expand(path, text: str, args=None, root=None, warn=None, evaluator=None) -> str:
     """The URDF text of xacro file ``path`` (whose text is ``text``) with arguments
     ``args`` ({name: value}; see :func:`normalize_args`).  Raises MechanismFileError (the
     file's problem, one line) or UsageError (an argument the file does not declare).
 
-    warn: callable receiving xacro's own warnings (default: dropped)."""
+    warn: callable receiving xacro's own warnings (default: dropped).
+    evaluator: the interpreter of ``${...}`` (default :func:`evaluate`; files.xacro_batch expands a
+    family for many designs at once with its own)."""
     import xacro  # lazily: only xacro files need it (it also patches minidom's pretty printer on import)
 
     path = Path(path)
@@ -443,7 +447,7 @@ def expand(path, text: str, args=None, root=None, warn=None) -> str:
             elem.setAttribute("default", "")
     output = io.StringIO()
     with _LOCK:
-        original, replaced = _patched(xacro, state, path)
+        original, replaced = _patched(xacro, state, path, evaluator)
         saved_verbosity = xacro.verbosity
         try:
             for k, f in replaced.items():

@@ -249,13 +249,14 @@ class XacroEvaluationError(Exception):
     """An expression xacro asked to evaluate is refused or fails (xacro adds its context)."""
 
 
-def evaluate(expr: str, symbols=None):
+def evaluate(expr: str, symbols=None, interpreter=None):
     """The value of a ``${...}`` expression (its inside) with names from ``symbols`` (a
     mapping; xacro's symbol table while expanding): the subset of :func:`check_expression`,
-    evaluated without ``eval``."""
+    evaluated without ``eval`` (by ``interpreter(symbols)``, default this module's; files.xacro_batch
+    gives one that computes with arrays)."""
     try:
         tree = _parse_expression(expr)
-        return _Interpreter({} if symbols is None else symbols).value(tree)
+        return (interpreter or _Interpreter)({} if symbols is None else symbols).value(tree)
     except _Refused as exc:
         raise XacroEvaluationError(f"refused: {exc} (only {_ALLOWED} are allowed)") from None
     except RecursionError:

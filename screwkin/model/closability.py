@@ -7,17 +7,19 @@ import numpy as np
 import pinocchio as pin
 
 from ._pin import joint_axis
+from .geometry import cross3
 
-__all__ = ["closure_obstacle"]
+__all__ = ["closure_obstacle", "closure_gap", "planar_loops", "obstacle_of"]
 
 
-def closure_obstacle(mech) -> str | None:
-    """Why a loop of revolute joints with parallel axes (a four-bar, a planar n-bar) cannot close,
-    in its links' lengths: its longest side is longer than the others together ("ground 0.2 m >
-    crank + coupler + rocker = 0.18 m"); None when no such loop is found too long.  The sides are
-    the distances between consecutive joint axes on each link, fixed by the file."""
+def planar_loops(mech) -> list:
+    """The loops of revolute joints with parallel axes (at the file's configuration) whose sides
+    closure_obstacle measures, as structure: [(cut joint name, the links of the sides, the points
+    between them)], a point ("frame", id) -- a cut joint's frame F1 first, F2 last -- or ("joint", id),
+    a tree joint's centre; with the loop's normal ("frame", F1's id, axis in F1)."""
     model, data = mech.model, mech.scratch_data()
     pin.framesForwardKinematics(model, data, mech.neutral())
+    out = []
     for c in mech.cuts:
         if c.type not in ("revolute", "continuous") or c.pair:
             continue
@@ -31,31 +33,84 @@ def closure_obstacle(mech) -> str | None:
             continue
         axis = data.oMf[c.frame1].rotation @ np.asarray(c.axis, float)
         axes = [data.oMi[j].rotation @ joint_axis(model.joints[j]) for j in joints]
-        if any(np.linalg.norm(np.cross(axis, a)) > mech.tolerances.geometry for a in axes):
+        if any(np.linalg.norm(cross3(axis, a)) > mech.tolerances.geometry for a in axes):
             continue  # not planar: no side-length test
-        n = axis / np.linalg.norm(axis)
+        points = [("frame", c.frame1)] + [("joint", j) for j in joints] + [("frame", c.frame2)]
+        ground = common[-1] if common and common[-1] > 0 else None
+        out.append((c.name, _Names(mech, path1, ground, path2), tuple(points),
+                    (c.frame1, tuple(np.asarray(c.axis, float)))))
+    return out
 
-        def flat(p):
-            return p - (p @ n) * n
 
-        points = [flat(data.oMf[c.frame1].translation)] + [flat(data.oMi[j].translation) for j in joints]
-        points.append(flat(data.oMf[c.frame2].translation))
-        names = [_link_of_joint(mech, j) for j in path1]
-        ground = _link_of_joint(mech, common[-1]) if common and common[-1] > 0 else mech.spec.root
-        names = names + [ground] + [_link_of_joint(mech, j) for j in path2]
-        sides = [float(np.linalg.norm(points[k + 1] - points[k])) for k in range(len(points) - 1)]
-        if len(sides) != len(names):
-            continue
-        longest = int(np.argmax(sides))
-        others = sum(sides) - sides[longest]
-        if sides[longest] > others + mech.tolerances.geometry:
-            rest = " + ".join(nm for k, nm in enumerate(names) if k != longest)
-            return (f"loop {c.name} cannot close, {names[longest]} {sides[longest]:.6g} m > {rest} = "
-                    f"{others:.6g} m (no side of a closed loop is longer than the others together)")
+class _Names:
+    """The links of a loop's sides, looked up when first read (a sentence is written only for a loop
+    that cannot close)."""
+
+    def __init__(self, mech, path1, ground, path2):
+        self.mech, self.parts = mech, (path1, ground, path2)
+        self._names = None
+
+    def _all(self):
+        if self._names is None:
+            path1, ground, path2 = self.parts
+            links = {}
+            for f in self.mech.model.frames:  # the link a tree joint carries: its first body frame
+                if f.type == pin.FrameType.BODY:
+                    links.setdefault(f.parentJoint, f.name)
+            name = lambda j: links.get(j, self.mech.model.names[j])  # noqa: E731
+            self._names = tuple([name(j) for j in path1] + [name(ground) if ground is not None else self.mech.spec.root]
+                                + [name(j) for j in path2])
+        return self._names
+
+    def __iter__(self):
+        return iter(self._all())
+
+    def __len__(self):
+        return len(self._all())
+
+    def __getitem__(self, k):
+        return self._all()[k]
+
+
+def obstacle_of(cut: str, names, sides, tol: float):
+    """(why the loop ``cut`` cannot close, by how much its longest side is too long [m]) when its longest
+    side (of ``sides``, the lengths of the links ``names``) is longer than the others together (beyond
+    ``tol``); None otherwise."""
+    longest = int(np.argmax(sides))
+    others = sum(sides) - sides[longest]
+    if sides[longest] > others + tol:
+        rest = " + ".join(nm for k, nm in enumerate(names) if k != longest)
+        return (f"loop {cut} cannot close, {names[longest]} {sides[longest]:.6g} m > {rest} = {others:.6g} m (no "
+                "side of a closed loop is longer than the others together)", float(sides[longest] - others))
     return None
 
 
-def _link_of_joint(mech, jid: int) -> str:
-    """The link a tree joint carries (its child body's link)."""
-    return next((f.name for f in mech.model.frames if f.parentJoint == jid and f.type == pin.FrameType.BODY),
-                mech.model.names[jid])
+def closure_gap(mech):
+    """(closure_obstacle's sentence, the longest side's excess over the others [m]), or None."""
+    model, data = mech.model, mech.scratch_data()
+    pin.framesForwardKinematics(model, data, mech.neutral())
+    for cut, names, points, (f1, axis) in planar_loops(mech):
+        n = data.oMf[f1].rotation @ np.asarray(axis, float)
+        n = n / np.linalg.norm(n)
+
+        def flat(ref):
+            p = data.oMf[ref[1]].translation if ref[0] == "frame" else data.oMi[ref[1]].translation
+            return p - (p @ n) * n
+
+        P = [flat(r) for r in points]
+        found = obstacle_of(cut, names, [float(np.linalg.norm(P[k + 1] - P[k])) for k in range(len(P) - 1)],
+                            mech.tolerances.geometry)
+        if found:
+            return found
+    return None
+
+
+def closure_obstacle(mech) -> str | None:
+    """Why a loop of revolute joints with parallel axes (a four-bar, a planar n-bar) cannot close,
+    in its links' lengths: its longest side is longer than the others together ("ground 0.2 m >
+    crank + coupler + rocker = 0.18 m"); None when no such loop is found too long.  The sides are
+    the distances between consecutive joint axes on each link, fixed by the file."""
+    found = closure_gap(mech)
+    return found[0] if found else None
+
+

@@ -21,7 +21,7 @@ from ..errors import AssemblyError, MechanismFileError, UsageError, quote
 from ..files.description import MechanismSpec, placement, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import frame_id
-from .closability import closure_obstacle
+from .closability import closure_gap, closure_obstacle
 from .closure import Assembly, ClosureSystem, ContactRow, CouplingRow, CutJoint
 from .geometry import wrap_angle
 from .linalg import null_space, rank
@@ -492,10 +492,16 @@ class Mechanism:
         it and then random configurations within the joint limits are tried, in a fixed
         order (``seed``), and the first that closes is returned: ``Assembly.start`` says
         which.  ``frozen`` velocity indices (inputs) keep the hint's values in every start.
-        Raises AssemblyError with the smallest residual reached and the number of starts."""
+        Raises AssemblyError with the smallest residual reached and the number of starts, or at once,
+        without a search, when the lengths prove a loop cannot close (model.closability)."""
         cache = q0 is None and not len(frozen)
         if cache and self._assembly is not None:
             return self._assembly
+        if "closure_gap" not in self.cache:  # the lengths may prove it cannot close: then no search
+            self.cache["closure_gap"] = closure_gap(self)
+        if self.cache["closure_gap"] is not None:
+            reason, gap = self.cache["closure_gap"]
+            raise AssemblyError(self.path, gap, 0, starts=0, reason=reason, proved=True)
         tol = self.tolerances
         hint = self.neutral() if q0 is None else np.array(q0, float)
         given = "the file's configuration" if q0 is None else "the given configuration"

@@ -9,27 +9,28 @@ limits and a grace is given up, its designs failed rows that say why.
 from __future__ import annotations
 
 import asyncio
-import logging
+from collections import Counter
 import math
 import os
 import time
 import uuid
-import warnings
 from pathlib import Path
 
 from ..analysis.design.study import (
     StudyResult,
     StudySpec,
+    apply_requirements,
     check_pareto,
     designs,
     failed_row,
     metric_columns,
-    run_chunk,
+    requirements,
     study_task,
 )
-from ..errors import UsageError, one_line, quote
+from ..analysis.design.family import FAMILY_CHUNK, chunk_rows, eligible
+from ..errors import UsageError, one_line
 from ..files.study import read_study_spec, study_spec
-from .scheduler import probe_scheduler, scheduler_address
+from .pool import dask_client
 
 __all__ = ["run_study", "default_workers", "STALL_GRACE"]
 
@@ -68,6 +69,7 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     elif not isinstance(spec, StudySpec):
         spec = read_study_spec(spec)
     check_pareto(spec)
+    requirements(spec)  # a column the study does not have is a usage error before any design runs
     if scheduler is not None and workers is not None:
         raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 0):
@@ -78,6 +80,8 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     values = designs(spec)
     n_workers = default_workers() if workers is None and scheduler is None else (workers or 1)
     size = spec.chunk or max(1, min(64, math.ceil(len(values) / (4 * max(n_workers, 1)))))
+    if not spec.chunk and eligible(task) is None:  # the family path: a chunk expanded once pays from tens of designs
+        size = max(1, min(FAMILY_CHUNK, math.ceil(len(values) / (2 * max(n_workers, 1)))))
     chunks = _chunks(list(enumerate(values)), size)
     t0 = time.perf_counter()
     if progress:
@@ -85,7 +89,7 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     if scheduler is None and workers == 0:
         results, failed = [], 0
         for k, chunk in enumerate(chunks):
-            results.append(run_chunk(task, chunk))
+            results.append(chunk_rows(task, chunk))
             failed += sum(r["error"] is not None for r in results[-1])
             if progress:
                 progress(sum(len(c) for c in chunks[:k + 1]), len(values), failed)
@@ -93,57 +97,56 @@ def run_study(spec, scheduler: str | None = None, workers: int | None = None, pr
     else:
         results, used, where = _on_dask(task, chunks, len(values), scheduler, workers or n_workers, timeout,
                                         progress)
-    rows = tuple(r for chunk_rows in results for r in chunk_rows)
-    return StudyResult(spec, task.parameters, metric_columns(spec.metrics), rows, time.perf_counter() - t0, used,
-                       where, len(chunks))
+    rows = tuple(r for got in results for r in got)
+    paths, path_notes = Counter(), Counter()
+    for got in results:
+        paths.update(getattr(got, "paths", {"design": len(got)}))
+        path_notes.update(getattr(got, "notes", ()))
+    rows, column, unmet = apply_requirements(spec, rows)
+    columns = metric_columns(spec.metrics) + ((column,) if column else ())
+    notes = []
+    if spec.transmission_steps is not None and "transmission_angle" in spec.metrics:
+        notes.append(f"transmission: {{steps: {spec.transmission_steps}}} is not used: the transmission angle's "
+                     "extremes over the input's motion are located in closed form, not sampled")
+    why = eligible(task)
+    return StudyResult(spec, task.parameters, columns, rows, time.perf_counter() - t0, used, where, len(chunks),
+                       {"unmet": unmet, "notes": notes, "paths": dict(paths), "path_notes": _merged(path_notes),
+                        "family": why})
+
+
+def _merged(notes: Counter) -> list:
+    """The chunks' notes, the same reason counted once with its designs added up ("3 designs evaluated
+    alone: why" from several chunks)."""
+    out = Counter()
+    for note, times in notes.items():
+        head, sep, why = note.partition(" evaluated alone: ")
+        count = head.split()[0]
+        if sep and count.isdigit():
+            out[why] += int(count) * times
+        else:
+            out[note] += 0
+    return [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" if c else why for why, c in out.most_common()]
 
 
 def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
     """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
     workers, where)."""
-    from distributed import (  # 0.4-0.9 s to import: only studies need it
-        Client,
-        LocalCluster,
-        as_completed,
-    )
+    from distributed import as_completed  # 0.4-0.9 s to import: only studies need it
 
-    cluster = client = None
-    futures = []
-    try:
-        if scheduler is not None:
-            address = scheduler_address(scheduler)
-            probe_scheduler(address, timeout)
-            try:
-                client = Client(address, timeout=timeout)
-                client.wait_for_workers(1, timeout=timeout)
-            except (OSError, TimeoutError) as exc:
-                what = "has no worker" if client is not None else "cannot be reached"
-                raise UsageError(f"the dask scheduler at {quote(address)} {what} within {timeout:g} s "
-                                 f"({one_line(str(exc) or type(exc).__name__, 160)})") from None
-            used, where = len(client.scheduler_info().get("workers", {})) or 1, address
-        else:
-            with warnings.catch_warnings():  # "Port 8787 is already in use": its HTTP routes then take another
-                warnings.filterwarnings("ignore", message="Port .* is already in use")
-                # processes on 127.0.0.1 only (the scheduler's HTTP routes too: no dashboard address given)
-                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                       dashboard_address=None, silence_logs=logging.ERROR)
-            client = Client(cluster, timeout=timeout)
-            used, where = workers, "local cluster"
-        token = uuid.uuid4().hex[:12]
-        futures = [client.submit(run_chunk, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
-                   for k, chunk in enumerate(chunks)]
-        results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
-        return results, used, where
-    finally:
-        if client is not None:
+    with dask_client(scheduler, workers, timeout) as (client, used, where):
+        futures = []
+        try:
+            token = uuid.uuid4().hex[:12]
+            futures = [client.submit(chunk_rows, task, chunk, key=f"screwkin-study-{token}-{k}", pure=False)
+                       for k, chunk in enumerate(chunks)]
+            results, futures = _collect(client, task, chunks, futures, total, progress, as_completed), []
+            return results, used, where
+        finally:
             if futures:  # interrupted: take the study's tasks off the cluster
                 try:
                     client.cancel(futures)
                 except Exception:  # noqa: BLE001, S110 - closing anyway
                     pass
-            client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def _collect(client, task, chunks, futures, total, progress, as_completed, grace: float = STALL_GRACE,

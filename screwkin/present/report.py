@@ -285,10 +285,18 @@ def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linea
         if info.limit_inputs:
             lines.append("  output limit positions at input = " + ", ".join(
                 f"{x:.6g} rad ({np.degrees(x):.4g} deg)" for x in info.limit_inputs))
+        tr = info.transmission
+        if tr is not None:
+            at = ", ".join(f"{np.degrees(x):.6g} deg" if degrees else f"{x:.6g} rad" for x in tr.low_at + tr.high_at)
+            dead = (f"; {tr.dead_points} dead point{'s' if tr.dead_points != 1 else ''} (mu = 0 or 180 deg)"
+                    if tr.dead_points else "; no dead point")
+            lines.append(f"  transmission angle over the input's whole motion (located in closed form): "
+                         f"{np.degrees(tr.low):.6g} .. {np.degrees(tr.high):.6g} deg (at input {at}); largest "
+                         f"|90 deg - mu| {np.degrees(tr.deviation):.6g} deg{dead}")
         if mus:
             dev = np.abs(np.degrees(np.asarray(mus)) - 90)
             k = int(np.argmax(dev))
-            lines.append(f"  transmission angle: {np.degrees(min(mus)):.4g} .. {np.degrees(max(mus)):.4g} deg; "
+            lines.append(f"  transmission angle along this sweep: {np.degrees(min(mus)):.4g} .. {np.degrees(max(mus)):.4g} deg; "
                          f"worst {np.degrees(mus[k]):.4g} deg at input "
                          + (f"{np.degrees(res.values[k]):.6g} deg" if degrees else f"{res.values[k]:.6g} {res.unit}"))
     shown = sweep_rows(len(res.values), rows)
@@ -385,9 +393,15 @@ def singularity_dict(rep: SingularityReport) -> dict:
 
 
 def linkage_dict(info: LinkageInfo) -> dict:
-    return {"kind": info.kind, "lengths": info.lengths, "grashof": info.grashof, "input_joint": info.input_joint,
-            "input_range": list(info.input_range) if info.input_range else None,
-            "limit_inputs": list(info.limit_inputs), "transmission_angle": info.transmission_angle}
+    d = {"kind": info.kind, "lengths": info.lengths, "grashof": info.grashof, "input_joint": info.input_joint,
+         "input_range": list(info.input_range) if info.input_range else None,
+         "limit_inputs": list(info.limit_inputs), "transmission_angle": info.transmission_angle}
+    tr = info.transmission
+    if tr is not None:  # over the input's whole motion, located in closed form (analysis.motion.transmission)
+        d["transmission_range"] = {"min": tr.low, "max": tr.high, "min_at": list(tr.low_at), "max_at": list(tr.high_at),
+                                   "deviation": tr.deviation, "turns": tr.turns, "dead_points": tr.dead_points,
+                                   "dead_at": list(tr.dead_at), "how": "located in closed form"}
+    return d
 
 
 def sweep_singularity_dict(s: SweepSingularity, mech=None) -> dict:

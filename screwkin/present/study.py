@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.design.study import MODE_METRICS, pareto_front
+from ..analysis.design.study import MODE_METRICS, REQUIREMENTS_COLUMN, pareto_front, requirements
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
@@ -49,6 +49,7 @@ __all__ = [
 DISPLAY = {
     "transmission_angle_min": ("transmission_angle_min_deg", 180.0 / math.pi),
     "transmission_angle_max": ("transmission_angle_max_deg", 180.0 / math.pi),
+    "transmission_deviation": ("transmission_deviation_deg", 180.0 / math.pi),
     "grashof_margin": ("grashof_margin_m", 1.0),
 }
 
@@ -131,6 +132,13 @@ def study_dict(result) -> dict:
     if spec.pareto and result.succeeded:
         d["pareto"] = {"columns": [{"column": c, "goal": g} for c, g in spec.pareto],
                        "designs": [result.rows[k]["design"] for k in pareto_front(result)]}
+    d["paths"] = dict(result.extra.get("paths", {}))
+    d["path_notes"] = list(result.extra.get("path_notes", ()))
+    reqs, default = requirements(spec)
+    if reqs:
+        d["requirements"] = {"rules": [q.text for q in reqs], "default": default,
+                             "unmet": {str(k): v for k, v in result.extra.get("unmet", {}).items()}}
+    d["notes"] = list(result.extra.get("notes", ()))
     return to_jsonable(d)
 
 
@@ -144,6 +152,41 @@ def mode_rule(result) -> str | None:
     return (f"assembly mode: each design follows mode {k}{' (the default)' if result.spec.mode is None else ''} of "
             f"{inputs} in its assembled configuration, as solve lists them (--mode K); the columns mode and "
             "modes give it and how many each design has")
+
+
+def _paths_line(result) -> list:
+    """How the designs were evaluated: on the family path (expanded once per chunk, closed forms over the
+    designs) or each alone, and why some were alone."""
+    paths = result.extra.get("paths") or {}
+    family, alone = paths.get("family", 0), paths.get("design", 0)
+    if not family:
+        why = result.extra.get("family")
+        return [f"each design evaluated alone (loaded, assembled, analysed){f': {why}' if why else ''}"]
+    lines = [f"{family} designs on the family path (the xacro file expanded once per chunk, each design's file read "
+             "and checked, its four-bar's metrics in closed form over the designs; every chunk checked against "
+             f"designs evaluated alone), {alone} evaluated alone (references and spot checks among them)"]
+    lines += [f"  {n}" for n in result.extra.get("path_notes", ())[:5]]
+    return lines
+
+
+def _requirements_lines(result) -> list:
+    """What the designs had to meet and which did not (left out of the Pareto front)."""
+    reqs, default = requirements(result.spec)
+    if not reqs:
+        return []
+    ok = [r for r in result.succeeded if r.get(REQUIREMENTS_COLUMN)]
+    unmet = result.extra.get("unmet", {})
+    how = (" (the default of " + ", ".join(m for m in result.spec.metrics if m == "transmission_angle")
+           + ": a dead point, mu = 0 or 180 deg, stops the input driving the output; state require: in the spec "
+           "to change it)") if default else ""
+    lines = [f"requirements: {'; '.join(q.text for q in reqs)}{how}: {len(ok)} of {len(result.succeeded)} analysed "
+             "designs meet them"]
+    if unmet:
+        shown = list(unmet.items())[:10]
+        lines.append("  not met (marked in the table, left out of the Pareto front): "
+                     + "; ".join(f"design {k}: {v}" for k, v in shown)
+                     + (f"; ... and {len(unmet) - len(shown)} more" if len(unmet) > len(shown) else ""))
+    return lines
 
 
 def _workspace_metrics(result) -> bool:
@@ -172,6 +215,7 @@ def study_text(result, table_path=None) -> str:
     lines = [(f"study of {spec.file} ({what}): {n} designs, {len(ok)} analysed, {len(bad)} failed; "
               f"{result.seconds:.2f} s on {result.workers} worker{'s' if result.workers != 1 else ''} "
               f"({result.scheduler}), timeout {spec.timeout:g} s per design")]
+    lines += _paths_line(result)
     if _workspace_metrics(result):
         ws = spec.workspace
         lines.append(f"workspace metrics of {result.spec.output!r}"
@@ -211,10 +255,14 @@ def study_text(result, table_path=None) -> str:
         else:
             counts = Counter(str(v) for _, v in vals)
             lines.append(f"{name}: " + ", ".join(f"{v} {c}" for v, c in counts.most_common()))
+    lines += _requirements_lines(result)
     if spec.pareto and ok:
         front = pareto_front(result)
         names = [f"{g} {_display(c)[0] if c in DISPLAY else c}" for c, g in spec.pareto]
-        lines.append(f"Pareto front ({', '.join(names)}): designs {', '.join(str(result.rows[k]['design']) for k in front)}")
+        among = " among the designs that meet the requirements" if requirements(spec)[0] else ""
+        lines.append(f"Pareto front ({', '.join(names)}){among}: designs "
+                     f"{', '.join(str(result.rows[k]['design']) for k in front) or 'none'}")
+    lines += [f"note: {n}" for n in result.extra.get("notes", ())]
     rows, names = _rows(result)
     if n <= TEXT_ROWS:
         table = [names] + [[_fmt(v) for v in row] for row in rows]
@@ -245,6 +293,8 @@ def _numeric(result):
 LABELS = {
     "transmission_angle_min": ("smallest transmission angle [deg]", 180.0 / math.pi),
     "transmission_angle_max": ("largest transmission angle [deg]", 180.0 / math.pi),
+    "transmission_deviation": ("largest |90 deg - transmission angle| [deg]", 180.0 / math.pi),
+    "dead_points": ("dead points [-]", 1.0),
     "grashof_margin": ("Grashof margin (p+q)-(s+l) [mm]", 1000.0),
     "mobility": ("mobility [DOF]", 1.0),
     "mobility_count": ("mobility by counting [DOF]", 1.0),
@@ -367,10 +417,12 @@ def pareto_figure(result, goals=None):
         if cls == "failed":
             continue
         rows = [r for n, r in enumerate(result.rows) if classes[n][0] == cls and r[a] is not None and r[b] is not None]
-        if rows:
-            ax.plot([r[a] * fa for r in rows], [r[b] * fb for r in rows], "o", ms=4, alpha=0.8,
-                    color=colour,
-                    label=cls if cls != "analysed" else "designs")
+        for meets, style in ((True, {}), (False, {"markerfacecolor": "none"})):
+            some = [r for r in rows if (r.get(REQUIREMENTS_COLUMN) is not False) == meets]
+            if some:
+                ax.plot([r[a] * fa for r in some], [r[b] * fb for r in some], "o", ms=4, alpha=0.8, color=colour,
+                        label=(cls if cls != "analysed" else "designs") + ("" if meets else ", requirements not met"),
+                        **style)
     fx = [result.rows[k][a] * fa for k in front]
     fy = [result.rows[k][b] * fb for k in front]
     ax.plot(fx, fy, "-", color="k", linewidth=1.0, label="Pareto front")
@@ -380,8 +432,10 @@ def pareto_figure(result, goals=None):
     ax.set_xlabel(f"{la} ({ga}imize)" if ga in ("max", "min") else f"{la} ({ga})")
     ax.set_ylabel(f"{lb} ({gb}imize)" if gb in ("max", "min") else f"{lb} ({gb})")
     nfail = len(result.failed)
+    unmet = sum(r.get(REQUIREMENTS_COLUMN) is False for r in result.rows)
     ax.set_title(f"{Path(result.spec.file).name}: {len(result.succeeded)} designs"
-                 + (f", {nfail} failed (not drawn)" if nfail else ""), fontsize=9)
+                 + (f", {nfail} failed (not drawn)" if nfail else "")
+                 + (f"; {unmet} not meeting the requirements (hollow, off the front)" if unmet else ""), fontsize=9)
     ax.legend(fontsize=8, title="Grashof class" if any(r.get("grashof") for r in result.succeeded) else None,
               title_fontsize=8)
     fig.tight_layout()

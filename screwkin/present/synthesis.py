@@ -71,7 +71,15 @@ def _core(kind, design, check: Check, file) -> dict:
             d["error_deg"] = _deg(p.error)
         precision.append(d)
     mu = check.transmission_range
+    finite = [p.error for p in check.precision if math.isfinite(p.error)]
+    point = None
+    if fb.tool is not None:  # the guided frame's origin, or the tracer, as --point takes it: on the coupler link
+        u, v, _ = tool_local(fb)
+        point = f"{'P' if kind == 'path' else 'F'}={'coupler'}:{u!r},{v!r},0"
     return {
+        "input": design.input_joint,
+        "point": point,
+        "max_error": max(finite) if finite and len(finite) == len(check.precision) else None,
         "kind": kind,
         "file": str(file),
         "links": links,
@@ -89,15 +97,35 @@ def _core(kind, design, check: Check, file) -> dict:
     }
 
 
+def _candidate_dict(k, c) -> dict:
+    fb = c.design.fourbar
+    u, v, _ = tool_local(fb) if fb.tool is not None else (None, None, None)
+    return {"rank": k + 1, "max_error": c.error, "rms_error": c.rms, "error_unit": "rad" if c.design.kind == "function"
+            else "m", "transmission_angle_range": [_deg(c.transmission[0]), _deg(c.transmission[1])]
+            if c.transmission else None, "grashof": c.grashof, "defects": list(c.defects), "unmet": list(c.unmet),
+            "meets_constraints": c.feasible, "lengths": fb.lengths,
+            "pivots": {"A0": _pt(fb.A0), "B0": _pt(fb.B0), "A": _pt(fb.A), "B": _pt(fb.B)},
+            "point": None if u is None else [u, v], "run": c.run}
+
+
+def _search_dict(report, constraints) -> dict:
+    return {"method": report.method, "runs": report.runs, "evaluations": report.evaluations,
+            "seconds": report.seconds, "where": report.where, "seed": report.seed, "constraints": constraints,
+            "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
+
+
 def _dyad_dict(k, d) -> dict:
     return {"index": k, "fixed": _pt(d.fixed), "moving": _pt(d.moving), "moving_local": _pt(d.local),
             "length": d.length}
 
 
-def synthesis_dict(result, check: Check, file) -> dict:
-    """The JSON object of a motion, function or path result and its check."""
+def synthesis_dict(result, check: Check, file, constraints=()) -> dict:
+    """The JSON object of a motion, function or path result and its check (``constraints``: the
+    constrained search's, in words)."""
     design = result.design
     out = _core(design.kind, design, check, file)
+    if getattr(result, "search", None) is not None:
+        out["search"] = _search_dict(result.search, list(constraints))
     if isinstance(result, MotionResult):
         out.update({
             "method": result.method,
@@ -153,9 +181,34 @@ def _fmt(x, digits=6):
     return f"{shown(x, SYNTHESIS_ZERO):.{digits}g}"
 
 
-def synthesis_text(result, check: Check, file) -> str:
+def _search_lines(result, constraints) -> list:
+    """The constrained search: how, what it had to meet, and its best designs (closed form), best first."""
+    report = result.search
+    out = [f"constrained search: {report.method}; {report.runs} run{'s' if report.runs != 1 else ''} "
+           f"({report.where}), seed {report.seed}, {report.seconds:.2f} s"]
+    out += [f"  constraint: {c}" for c in constraints] or ["  constraints: none (the search's box: see docs)"]
+    unit = "deg" if result.design.kind == "function" else "m"
+    rows = []
+    for k, c in enumerate(report.candidates):
+        err = math.degrees(c.error) if unit == "deg" else c.error
+        mu = f"{math.degrees(c.transmission[0]):.4g} .. {math.degrees(c.transmission[1]):.4g}" if c.transmission else "-"
+        L = c.design.fourbar.lengths
+        rows.append([k + 1, f"{err:.3g}", mu, c.grashof, "; ".join(c.defects) or "none",
+                     "yes" if c.feasible else "no: " + "; ".join(c.unmet),
+                     " ".join(f"{L[n]:.4g}" for n in ("ground", "crank", "coupler", "rocker"))])
+    out.append(f"the best {len(rows)} design{'s' if len(rows) != 1 else ''} (judged in closed form, the transmission "
+               "angle over a whole turn where the crank turns fully, else over its travel; the first is written and "
+               "checked below):")
+    out.append("  " + table(["#", f"max error [{unit}]", "transmission [deg]", "Grashof", "defects",
+                             "meets constraints", "ground crank coupler rocker [m]"], rows).replace("\n", "\n  "))
+    if not report.candidates[0].feasible:
+        out.append("NO design found meets every constraint: the nearest is written (see what it misses)")
+    return out
+
+
+def synthesis_text(result, check: Check, file, constraints=()) -> str:
     """A readable report of a motion, function or path result and its check."""
-    d = synthesis_dict(result, check, file)
+    d = synthesis_dict(result, check, file, constraints)
     design = result.design
     out = []
     kind = design.kind
@@ -187,8 +240,14 @@ def synthesis_text(result, check: Check, file) -> str:
                    + " deg")
     elif isinstance(result, PathResult):
         timing = "crank angles prescribed (--timing)" if result.timing is not None else "crank angles free"
-        out.append(f"{len(result.points)} points, {timing}; least squares from {result.starts} starts, "
-                   f"{result.converged} reached every point within {_fmt(result.tolerance, 3)} m")
+        if result.search is None:
+            out.append(f"{len(result.points)} points, {timing}; least squares from {result.starts} starts, "
+                       f"{result.converged} reached every point within {_fmt(result.tolerance, 3)} m")
+        else:
+            out.append(f"{len(result.points)} points, {timing}; {result.converged} of the designs refined reach every "
+                       f"point within {_fmt(result.tolerance, 3)} m")
+    if getattr(result, "search", None) is not None:
+        out += _search_lines(result, constraints)
     links = d["links"]
     out.append("links [m]: " + ", ".join(f"{n} {_fmt(v['length'])}" for n, v in links.items()))
     named = {role: (v["letter"] or role) for role, v in d["pivot_joints"].items()}  # draw's letters
@@ -203,7 +262,8 @@ def synthesis_text(result, check: Check, file) -> str:
         f"{named[r]} {d['pivot_joints'][r]['joint']} ({_fmt(pv[r][0])}, {_fmt(pv[r][1])})" for r in order))
     out.append(f"Grashof: {d['grashof'] or 'not identified'}")
     mu = d["transmission_angle_range"]
-    out.append("transmission angle over the motion: " + (f"{mu[0]:.4g} .. {mu[1]:.4g} deg" if mu else "not measured")
+    out.append("transmission angle from the first position to the farthest (screwkin's sweep): "
+               + (f"{mu[0]:.4g} .. {mu[1]:.4g} deg" if mu else "not measured")
                + (f" (crank turning {d['check']['direction']})" if d["check"]["direction"] else ""))
     out.append("")
     out.append(f"checked with screwkin on {file} (loaded, solved at each precision position, followed by sweep):")

@@ -35,10 +35,9 @@ from ...files.study import StudySpec
 from ...files.xmlsafe import read_regular_file
 from ...model.loader import load
 from ..mobility import analyze_mobility
-from ..motion.planar import identify, transmission_angles
+from ..motion.planar import identify
 from ..motion.modes import choose_mode
 from ..motion.position import PositionSolver
-from ..motion.sweep import sweep
 from .workspace import DEFAULT_THRESHOLD, workspace
 
 __all__ = [
@@ -54,6 +53,11 @@ __all__ = [
     "check_pareto",
     "failed_row",
     "metric_columns",
+    "DEFAULT_REQUIRE",
+    "REQUIREMENTS_COLUMN",
+    "Requirement",
+    "requirements",
+    "apply_requirements",
 ]
 
 #: The columns each metric fills (keys of the rows, SI values).
@@ -61,8 +65,8 @@ COLUMNS = {
     "mobility": ("mobility", "mobility_count", "motion_space", "overconstraint", "idle_dofs", "effective_mobility",
                  "output_motion"),
     "grashof": ("linkage", "grashof", "grashof_margin"),
-    "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts", "mode",
-                           "modes"),
+    "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts",
+                           "transmission_deviation", "input_turns", "dead_points", "mode", "modes"),
     "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated", "mode", "modes"),
     "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated", "mode",
                                 "modes"),
@@ -77,17 +81,12 @@ _GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
             ("Grashof double rocker", "double-rocker"), ("Grashof rocker-crank", "rocker-crank"),
             ("crank turns fully", "crank-turns"), ("crank cannot turn fully", "crank-rocks"))
 
-#: Relative margin at the ends of a limited input range (limit positions) in the transmission sweep.
-RANGE_MARGIN = 1e-9
-
-
 class DesignTimeout(ScrewkinError):
     """A design ran past the study's timeout (its row is failed, its metrics empty)."""
 
 
 class _Clock:
-    """The deadline of one design, checked between its steps (loading, assembly, each metric,
-    each configuration of the transmission sweep)."""
+    """The deadline of one design, checked between its steps (loading, assembly, each metric)."""
 
     def __init__(self, seconds: float):
         self.seconds = seconds
@@ -168,7 +167,6 @@ class _Task:
     output: str | None
     point: bool
     workspace: dict
-    steps: int
     timeout: float = 120.0  # seconds per design
     mode: int | None = None  # the K-th assembly mode (motion.modes.choose_mode); None: the first
 
@@ -258,51 +256,19 @@ def _grashof(d: _Design) -> dict:
 
 
 def _transmission(d: _Design) -> dict:
-    """Smallest and largest transmission angle over the input's motion: the input at
-    ``steps`` + 1 values over a full turn (or over its range, ends taken RANGE_MARGIN of the
-    range inside the limit positions), followed from the design's assembled configuration by the
-    sweep's continuation (analysis.motion.sweep: one assembly mode, one circuit); the angles of all of
-    them at once (analysis.motion.planar.transmission_angles).  Where the continuation stops short, it
-    restarts at the next value from the mode nearest the last configuration reached, and
-    ``transmission_restarts`` counts how often it had to (0: one unbroken motion)."""
-    info = d.linkage()
-    mech, name, steps = d.mech, d.input, d.task.steps
-    coord = mech.coordinate(name)
-    x0 = float(d.q[coord.idx_q]) if coord.nq == 1 else float(np.arctan2(d.q[coord.idx_q + 1], d.q[coord.idx_q]))
-    solver = PositionSolver(mech, [name])
-    if info.input_range is None:
-        paths = [x0 + np.linspace(0.0, 2 * np.pi, steps + 1)]
-    else:
-        lo, hi = info.input_range
-        margin = RANGE_MARGIN * (hi - lo)
-        lo, hi = lo + margin, hi - margin
-        x0 = min(max(x0, lo), hi)
-        up = max(2, round(steps * (hi - x0) / (hi - lo)) + 1)
-        paths = [np.linspace(x0, hi, up), np.linspace(x0, lo, max(2, steps + 2 - up))]
-    Q, restarts = [], 0
-    for path in paths:
-        q, k = d.q, 0
-        while k < len(path) - 1:
-            d.clock.check()
-            res = sweep(solver, name, float(path[k]), float(path[-1]), len(path) - 1 - k, q_start=q)
-            Q += list(res.q)
-            if res.completed:
-                break
-            # stopped short (or holes): restart at the next grid value after the last one reached,
-            # in the mode nearest the last configuration (said in transmission_restarts)
-            h = (path[-1] - path[k]) / (len(path) - 1 - k)
-            reached = int(np.floor((res.values[-1] - path[k]) / h + 1e-9)) if len(res.values) else 0
-            k = k + max(reached, 0) + 1
-            if k >= len(path):
-                break
-            near = solver.joint_values(res.q[-1] if len(res.q) else q)
-            q = solver.solve({name: float(path[k])}, near=near, starts=8).solutions[0].q  # checked, or AssemblyError
-            restarts += 1
-            if k == len(path) - 1:
-                Q.append(q)
-    mus = transmission_angles(mech, info, Q)
-    return {"transmission_angle_min": float(mus.min()), "transmission_angle_max": float(mus.max()),
-            "transmission_restarts": restarts, **d.mode_columns()}
+    """The transmission angle over the input's whole motion (a full turn, or from limit position to
+    limit position on the assembled configuration's circuit), its extremes located in closed form
+    from the identified linkage's lengths (analysis.motion.transmission: the extremes of a
+    four-bar's mu are at the input angles 0 and 180 deg or at its limit positions), as ``sweep
+    --json`` gives them (``linkage.transmission_range``); the largest deviation from 90 deg, whether
+    the input turns fully, and the dead points (mu = 0 or 180 deg).  ``transmission_restarts`` is
+    0: no continuation is followed (the column of earlier, sampled studies).  The transmission angle is
+    the same on both circuits of a four-bar (mu from the law of cosines in the diagonal), so the mode
+    columns only record which mode the design's configuration is."""
+    r = d.linkage().transmission
+    return {"transmission_angle_min": r.low, "transmission_angle_max": r.high, "transmission_restarts": 0,
+            "transmission_deviation": r.deviation, "input_turns": r.turns, "dead_points": r.dead_points,
+            **d.mode_columns()}
 
 
 def _workspace_volume(d: _Design) -> dict:
@@ -353,7 +319,9 @@ def design_args(task: _Task, values: tuple) -> dict:
     return args
 
 
-def _evaluate(task: _Task, index: int, values: tuple) -> dict:
+def _evaluate(task: _Task, index: int, values: tuple, keep=None) -> dict:
+    """The row of one design, from its values alone; ``keep`` (a list): the analysed design is appended
+    to it (the family path reads its mechanism)."""
     row = {"design": index, **dict(zip(task.parameters, values))}
     columns = metric_columns(task.metrics)
     row.update(dict.fromkeys(columns))
@@ -369,6 +337,8 @@ def _evaluate(task: _Task, index: int, values: tuple) -> dict:
                 computed.update(METRICS[m](d))
                 clock.check()  # a metric that ran past the deadline (one long workspace grid) fails the row
         row.update(computed)  # all metrics or none: a failed design never shows a number
+        if keep is not None:
+            keep.append(d)
     except ScrewkinError as exc:
         row["error"] = _reason(exc, task.file)
     except Exception as exc:  # noqa: BLE001 - a bug (or a missing module on a worker): the row says it, the run goes on
@@ -377,7 +347,8 @@ def _evaluate(task: _Task, index: int, values: tuple) -> dict:
 
 
 def run_chunk(task: _Task, chunk) -> list:
-    """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes."""
+    """The rows of a chunk of designs [(index, values), ...], each design evaluated alone (what a Dask
+    task computes when the family path does not apply: screwkin.analysis.design.family.chunk_rows)."""
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         return [_evaluate(task, i, v) for i, v in chunk]
@@ -422,12 +393,12 @@ def study_task(spec: StudySpec) -> _Task:
     except UnicodeDecodeError:
         raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
     return _Task(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
-                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.transmission_steps, spec.timeout,
-                 spec.mode)
+                 spec.input, spec.output, spec.point, dict(spec.workspace), spec.timeout, spec.mode)
 
 
 def _resolve(name: str, keys) -> str | None:
-    for cand in (name, name.removesuffix("_deg")):
+    """The row key of a column named as in the rows or as in the table (``..._deg``, ``..._m``)."""
+    for cand in (name, name.removesuffix("_deg"), name.removesuffix("_m")):
         if cand in keys:
             return cand
     return None
@@ -436,8 +407,8 @@ def _resolve(name: str, keys) -> str | None:
 def pareto_front(result: StudyResult, goals=None) -> list:
     """Indices (into result.rows) of the designs on the Pareto front of two columns:
     ``goals`` ((column, "max" | "min"), (column, "max" | "min")), default the spec's
-    ``pareto``.  Rows without both values are left out; the front is ordered by the first
-    column.  A design is on it when no other is at least as good in both and better in one."""
+    ``pareto``.  Rows without both values, and rows that do not meet the study's requirements
+    (REQUIREMENTS_COLUMN False), are left out; the front is ordered by the first column.  A design is on it when no other is at least as good in both and better in one."""
     goals = goals or result.spec.pareto
     if not goals:
         raise UsageError(f"{result.spec.path}: no pareto columns: give pareto: {{maximize: [...], minimize: [...]}}")
@@ -452,6 +423,8 @@ def pareto_front(result: StudyResult, goals=None) -> list:
     pts = []
     for k, r in enumerate(result.rows):
         vals = [r[c] for c, _ in cols]
+        if r.get(REQUIREMENTS_COLUMN) is False:  # cannot do the job: never recommended
+            continue
         if r["error"] is None and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
                                       for v in vals):
             pts.append((k, vals[0] * cols[0][1], vals[1] * cols[1][1]))
@@ -467,6 +440,84 @@ def check_pareto(spec: StudySpec) -> None:
             if _resolve(name, keys) is None:
                 raise UsageError(f"{spec.path}: pareto column {quote(name)} is not a column of this study "
                                  f"(columns: {', '.join(keys)})")
+
+
+#: What a design must meet when the spec states no ``require``, by metric: a design whose motion has a dead
+#: point (the transmission angle reaching 0 or 180 deg: an input that rocks between limit positions, a
+#: change point folding flat) cannot be driven through its motion by its input.
+DEFAULT_REQUIRE = {"transmission_angle": (("dead_points", "equal", 0, False),)}
+#: The column a study with requirements adds: True (met), False (not met), None (a failed design).
+REQUIREMENTS_COLUMN = "meets_requirements"
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """One requirement on a column: ``kind`` "equal", "min" or "max"; ``value`` SI; ``text`` as stated."""
+
+    column: str
+    kind: str
+    value: object
+    text: str
+
+    def met(self, v) -> bool:
+        if v is None:
+            return False
+        if self.kind == "equal":
+            return v == self.value
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            return False
+        return v >= self.value if self.kind == "min" else v <= self.value
+
+
+def _shown(v) -> str:
+    """A cell as the spec writes it (YAML's true and false)."""
+    return str(v).lower() if isinstance(v, bool) else repr(v) if isinstance(v, str) else f"{v:.6g}" \
+        if isinstance(v, float) else str(v)
+
+
+def requirements(spec: StudySpec) -> tuple:
+    """(requirements, default): the spec's ``require`` resolved against the study's columns (a
+    column written with ``_deg`` takes a bare number in degrees; values with a unit are SI), or,
+    when it states none, DEFAULT_REQUIRE of its metrics (default True).  UsageError for a column the
+    study does not have."""
+    stated = spec.require
+    default = stated is None
+    if default:
+        stated = tuple(r for m in spec.metrics for r in DEFAULT_REQUIRE.get(m, ()))
+    keys = (*(p.name for p in spec.parameters), *metric_columns(spec.metrics))
+    out = []
+    for name, kind, value, unit_typed in stated:
+        key = _resolve(name, keys)
+        if key is None:
+            raise UsageError(f"{spec.path}: require: {quote(name)} is not a column of this study (columns: "
+                             f"{', '.join(keys)})")
+        if kind != "equal" and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            raise UsageError(f"{spec.path}: require {quote(name)} {kind}: a number, got {quote(value)}")
+        si = math.radians(value) if (name.endswith("_deg") and not unit_typed and isinstance(value, (int, float))
+                                     and not isinstance(value, bool)) else value
+        sign = {"equal": "=", "min": ">=", "max": "<="}[kind]
+        out.append(Requirement(key, kind, si, f"{name} {sign} {_shown(value)}"))
+    return tuple(out), default
+
+
+def apply_requirements(spec: StudySpec, rows) -> tuple:
+    """(rows with REQUIREMENTS_COLUMN, the column added or None, {design: what it does not meet}).
+    Nothing is added when there is no requirement."""
+    reqs, _ = requirements(spec)
+    if not reqs:
+        return tuple(rows), None, {}
+    out, unmet = [], {}
+    for r in rows:
+        r = dict(r)
+        if r["error"] is not None:
+            r[REQUIREMENTS_COLUMN] = None
+        else:
+            missed = [f"{q.text} (has {_shown(r[q.column])})" for q in reqs if not q.met(r[q.column])]
+            r[REQUIREMENTS_COLUMN] = not missed
+            if missed:
+                unmet[r["design"]] = "; ".join(missed)
+        out.append(r)
+    return tuple(out), REQUIREMENTS_COLUMN, unmet
 
 
 def failed_row(task, index, values, reason) -> dict:

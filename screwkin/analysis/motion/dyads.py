@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...model.geometry import plane_basis, wrap_angle
+from ...model.geometry import cross3, plane_basis, wrap_angle
 from ...model.planar_graph import DyadPlan, plan
 from .batch_sweep import batch_closure
 from ..singularities.singular import measures
@@ -142,7 +142,7 @@ class _Geometry:
                 col = data.J[:, model.idx_vs[pr.tree]]
                 v, w = col[:3], col[3:]
                 if pr.kind == "R":
-                    x = np.cross(w, v) / (w @ w)
+                    x = cross3(w, v) / (w @ w)
                     axes.append((w, w))
                 else:
                     x = data.oMi[pr.tree].translation.copy()
@@ -161,7 +161,7 @@ class _Geometry:
             self.reason = "no revolute joint: no plane"
             return
         for a, pr in zip((a for both in axes for a in both), (pr for pr in p.pairs for _ in (0, 1))):
-            if (pr.kind == "R" and np.linalg.norm(np.cross(a, n)) > _PARALLEL) or (pr.kind == "P" and abs(a @ n) > _PARALLEL):
+            if (pr.kind == "R" and np.linalg.norm(cross3(a, n)) > _PARALLEL) or (pr.kind == "P" and abs(a @ n) > _PARALLEL):
                 self.ok, self.reason = False, f"joint {pr.name} is out of the plane of the others"
                 return
         e1, e2, n = plane_basis(n)

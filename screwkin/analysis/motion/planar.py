@@ -38,6 +38,7 @@ from ...model.geometry import (
     vector_angle,
 )
 from .batch_closure import TreeKinematics, Unbatchable
+from .transmission import FOUR_BAR_CLASSES, four_bar_classes, transmission_range
 
 __all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
@@ -62,6 +63,14 @@ class LinkageInfo:
     centres: tuple = field(default=(), compare=False, repr=False)
     normal: tuple | None = field(default=None, compare=False, repr=False)
     slide: tuple | None = field(default=None, compare=False, repr=False)
+    # the input's joint value and its angle (four-bar: from the ground line A -> D; slider-crank: from the
+    # slide's direction) at the configuration analysed [rad]; a slider-crank's slide offset with its sign
+    # (the distance of the slide line from the crank's pivot, along the slide's normal) [m]
+    input_value: float | None = None
+    input_angle: float | None = None
+    signed_offset: float | None = None
+    # the transmission angle over the input's whole motion, located in closed form (analysis.motion.transmission)
+    transmission: object = field(default=None, compare=False)
 
     def construction(self) -> dict:
         """JSON-ready: four-bar {transmission_angle, diagonal, alpha, beta}; slider-crank {transmission_angle}."""
@@ -119,7 +128,8 @@ def identify(mech, topo, q, input_joint):
     where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
     if j_d.type in ("revolute", "continuous") and j_c.type in ("revolute", "continuous") \
             and j_b.type in ("revolute", "continuous"):
-        return replace(_four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b, mech.tolerances), **where)
+        info = _four_bar(input_joint, q_in, A, B, C, p2(j_d.point), a, b, mech.tolerances)
+        return replace(info, transmission=transmission_range(info, mech.tolerances.equal), **where)
     if j_d.type == "prismatic" or j_c.type == "prismatic":
         slide = j_d if j_d.type == "prismatic" else j_c
         pin_joint = j_c if slide is j_d else j_d
@@ -127,8 +137,9 @@ def identify(mech, topo, q, input_joint):
             return None
         s = p2(np.asarray(slide.direction) + 0) - p2(np.zeros(3))
         s = s / np.linalg.norm(s)
-        return replace(_slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s, a, b),
-                       slide=tuple(s[0] * e1 + s[1] * e2), **where)
+        info = _slider_crank(input_joint, q_in, A, B, p2(pin_joint.point), s, a, b)
+        return replace(info, slide=tuple(s[0] * e1 + s[1] * e2), transmission=transmission_range(info, mech.tolerances.equal),
+                       **where)
     return None
 
 
@@ -180,18 +191,7 @@ def _transmission(kind, P, n, slide=None):
 def _four_bar(name, q_in, A, B, C, D, a, b, tol):
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
-    s, l = min(lengths.values()), max(lengths.values())
-    p_q = g + a + b + c - s - l
-    if abs(s + l - p_q) < tol.equal * l:
-        cls = "change point (s + l = p + q): the linkage can fold flat"
-    elif s + l > p_q:
-        cls = "non-Grashof (triple rocker): no link turns fully"
-    else:
-        shortest = min((a, 1, "input"), (g, 0, "ground"), (b, 2, "coupler"), (c, 3, "output"))[2]
-        cls = {"input": "Grashof crank-rocker: the input turns fully",
-               "ground": "Grashof double crank (drag link): input and output turn fully",
-               "coupler": "Grashof double rocker: only the coupler turns fully",
-               "output": "Grashof rocker-crank: the output turns fully, the input rocks"}[shortest]
+    cls = FOUR_BAR_CLASSES[int(four_bar_classes(g, a, b, c, tol.equal))]
     u_ad = (D - A) / g
     phi_now = _angle(_rot(B - A, -_angle(u_ad)))  # input angle from AD
     circuit = np.sign(cross2(C - B, D - C)) or 1.0
@@ -221,7 +221,8 @@ def _four_bar(name, q_in, A, B, C, D, a, b, tol):
     # tip sits on the output pivot, the output link or the ground when their two pivots coincide
     alpha = float(vector_angle(B - D, C - D)) if z > 0 and c > 0 else None
     beta = float(vector_angle(B - D, A - D)) if z > 0 and g > 0 else None
-    return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu, z, alpha, beta)
+    return LinkageInfo("four-bar", lengths, cls, name, rng, tuple(sorted(limits)), mu, z, alpha, beta,
+                       input_value=float(q_in), input_angle=float(phi_now))
 
 
 def _slider_crank(name, q_in, A, B, C, s, a, b):
@@ -254,7 +255,8 @@ def _slider_crank(name, q_in, A, B, C, s, a, b):
         Bc = A + (-a if folded and b > a else a) * u
         limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
     mu = float(line_angle(C - B, nrm))
-    return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu)
+    return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu, input_value=float(q_in),
+                       input_angle=float(phi_now), signed_offset=e)
 
 
 class LinkAngles:

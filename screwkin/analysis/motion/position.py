@@ -263,7 +263,8 @@ class PositionSolver:
         the mechanism)."""
         g = self.generic()
         kept = sum(self.mech.coordinate(j).nv for j in self.kept)  # held at the file's values, not free
-        return max(len(self.passive) - g.rank_Kp - self.idle_dofs - kept, 0)
+        free = len(self.passive) - g.rank_Kp - kept
+        return max(free - self.idle_dofs, 0) if free > 0 else 0  # (idle DOFs, a mobility analysis: only if any is left)
 
     def _mobility(self):
         self.generic()  # the assembly the mobility analysis starts from

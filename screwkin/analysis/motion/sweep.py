@@ -35,8 +35,10 @@ import pinocchio as pin
 from ...errors import AssemblyError, UsageError
 from ...model.linalg import null_space
 from .batch_sweep import batch_closure, batched_motion, motion_rates
+from ...model.planar_graph import plan
 from .dyads import planar_sweep
-from ..singularities.singular import measures
+from .position import outside_limits
+from ..singularities.singular import measures, scaled_jacobians
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "Neighbour", "CONTINUATION_ROUNDS",
            "drawn_start"]
@@ -263,11 +265,53 @@ def sweep_inputs(mech, name: str, fixed) -> list:
     return [name, *(n for n in fixed if n != name)]
 
 
+def _drawn_regular(solver, values: dict):
+    """The file's drawn configuration, when it is closed as drawn, at the input ``values``, within the
+    joint limits, and regular by its own ranks for a mechanism the inputs determine by dyads (the plan of
+    analysis.motion.dyads exists: its passive joints follow from the inputs, so the generic ranks of K
+    and of its passive columns are both the number of passive coordinates); then it is, by
+    solve's own order (physical, not singular, nearest the reference: itself, of the largest rank), the
+    mode solve(values) puts first, found without the generic configurations' search.  None otherwise."""
+    mech, tol = solver.mech, solver.mech.tolerances
+    name = next(iter(values), None)
+    if mech.generic_known or name is None or not mech.cuts:
+        return None
+    key = ("dyads.plan", tuple(solver.inputs), name)
+    if key not in mech.cache:
+        mech.cache[key] = plan(mech, solver.inputs, name)
+    if isinstance(mech.cache[key], str):
+        return None
+    try:
+        a = mech.assemble()
+    except AssemblyError:
+        return None
+    if a.iterations or a.starts != 1:  # not closed as drawn
+        return None
+    drawn, angular = solver.joint_values(a.q), set(solver.angular_names())
+    for n, v in values.items():
+        d = drawn.get(n, np.inf) - v
+        if not abs(float(np.angle(np.exp(1j * d))) if n in angular else d) <= tol.equal:
+            return None
+    if outside_limits(mech, a.q):
+        return None
+    K = scaled_jacobians(mech, a.q).K
+    n_p = len(solver.passive)
+    s_K, s_p = (np.linalg.svd(M, compute_uv=False) for M in (K, K[:, solver.passive]))
+    if len(s_p) < n_p or not (s_K[n_p - 1] >= tol.singular * s_K[0] and s_p[n_p - 1] >= tol.singular * s_p[0]):
+        return None
+    if len(s_K) > n_p and s_K[n_p] >= tol.singular * s_K[0]:  # more rank than the plan allows: not this case
+        return None
+    return a.q
+
+
 def drawn_start(solver, values: dict):
     """The configuration the file is drawn in, when it is already at the input ``values`` and is the
     mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
     the drawing of those), found without solve's search from random starts (a sweep from the drawn
     position: 1 ms, not 13 ms, for the Strider); None otherwise."""
+    quick = _drawn_regular(solver, values)
+    if quick is not None:
+        return quick
     ref = solver.reference()
     if ref is None:
         return None

@@ -15,7 +15,7 @@ import numpy as np
 from ....errors import MechanismFileError
 
 __all__ = ["SynthesisError", "FourBar", "Target", "Dyad", "Design", "MotionResult", "FunctionResult",
-           "PathResult", "PrecisionCheck", "Check", "Chain", "ChainFile", "ChainsResult"]
+           "PathResult", "PrecisionCheck", "Check", "Chain", "ChainFile", "ChainsResult", "Candidate"]
 
 
 class SynthesisError(MechanismFileError):
@@ -93,6 +93,28 @@ class Design:
 
 
 @dataclass(frozen=True)
+class Candidate:
+    """One design a constrained global search found (analysis.design.synthesis.optimal), judged in
+    closed form: ``error`` the largest miss of a precision position (m; a function generator's in rad),
+    ``rms`` their root mean square, ``transmission`` (min, max) over the motion [rad] or None,
+    ``grashof`` its type (as study prints it), ``defects`` (branch, order, limit: words) and ``unmet``
+    (the constraints it does not meet: words; empty when it meets them all)."""
+
+    design: Design
+    error: float
+    rms: float
+    transmission: tuple | None
+    grashof: str
+    defects: tuple
+    unmet: tuple
+    run: str  # which run of the search found it (its branch, direction)
+
+    @property
+    def feasible(self) -> bool:
+        return not self.unmet
+
+
+@dataclass(frozen=True)
 class MotionResult:
     """Motion generation: the poses, the dyads offered (candidates) and the pair chosen."""
 
@@ -104,6 +126,7 @@ class MotionResult:
     curves: tuple = ()  # for pictures: ((centre points (n, 2), circle points (n, 2)), ...) per 4-position subset
     poles: tuple = ()  # ((i, j, (x, y)), ...) poles of the displacements between positions
     ranked: tuple = ()  # ((crank, rocker, score), ...) pairs in the order they were tried
+    search: object = None  # search.SearchReport of a constrained global search, or None
 
 
 @dataclass(frozen=True)
@@ -125,6 +148,7 @@ class FunctionResult:
     error_at_points: tuple = ()  # [rad]
     design: Design | None = None
     defects: tuple = ()  # found in closed form (the check finds them again with screwkin)
+    search: object = None  # search.SearchReport of a constrained global search, or None
 
     @property
     def max_structural_error(self) -> float:
@@ -144,6 +168,7 @@ class PathResult:
     converged: int  # polished starts that reached every point within the tolerance
     tolerance: float
     design: Design
+    search: object = None  # search.SearchReport of a constrained global search, or None
 
 
 @dataclass(frozen=True)

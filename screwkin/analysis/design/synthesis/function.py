@@ -33,7 +33,8 @@ from ....tolerances import DEFAULT
 from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
 from .fourbar import branch, fourbar_linkage, stored, wrap
 
-__all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "FUNCTIONS"]
+__all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "function_task",
+           "function_result", "FUNCTIONS"]
 
 WHAT = "synthesize function"
 FUNCTIONS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log, "sqrt": np.sqrt,
@@ -133,12 +134,11 @@ def _generated(K, d, phi, sigma):
     return np.where(h2 >= 0, psi, np.nan), A, B
 
 
-def synthesize_function(text, x_range, input_range, output_range, points: int = 3, spacing: str = "chebyshev",
-                        ground: float = 0.1, samples: int = 721) -> FunctionResult:
-    """A four-bar whose rocker angle psi follows f(x) while the crank turns through the input
-    range: the Freudenstein coefficients through ``points`` precision points, the link lengths
-    for a ground of ``ground`` m, the structural error over the range and the design (drawn at
-    the first precision point)."""
+def function_task(text, x_range, input_range, output_range, points: int = 3, spacing: str = "chebyshev",
+                  ground: float = 0.1, samples: int = 721) -> dict:
+    """The task of function generation, checked: the function, its ranges, the precision points
+    ``xs`` and their crank and rocker angles ``phi``, ``psi`` [rad], a dense ``sample`` of x with the
+    angles there (``phi_sample``, ``psi_sample``)."""
     f = parse_function(text)
     x0, x1 = map(float, x_range)
     if not x1 > x0:
@@ -172,8 +172,29 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     def psi_of(y):
         return s0 + (np.asarray(y) - y_ends[0]) / (y_ends[1] - y_ends[0]) * (s1 - s0)
 
-    phi, psi = phi_of(xs), psi_of(ys)
-    K = freudenstein(phi, psi)
+    return {"text": text, "x0": x0, "x1": x1, "p0": p0, "p1": p1, "s0": s0, "s1": s1, "points": points,
+            "spacing": spacing, "ground": ground, "xs": xs, "phi": phi_of(xs), "psi": psi_of(ys), "sample": sample,
+            "phi_sample": phi_of(sample), "psi_sample": psi_of(y_sample)}
+
+
+def synthesize_function(text, x_range, input_range, output_range, points: int = 3, spacing: str = "chebyshev",
+                        ground: float = 0.1, samples: int = 721) -> FunctionResult:
+    """A four-bar whose rocker angle psi follows f(x) while the crank turns through the input
+    range: the Freudenstein coefficients through ``points`` precision points, the link lengths
+    for a ground of ``ground`` m, the structural error over the range and the design (drawn at
+    the first precision point)."""
+    task = function_task(text, x_range, input_range, output_range, points, spacing, ground, samples)
+    return function_result(task, freudenstein(task["phi"], task["psi"]))
+
+
+def function_result(task, K, d: float | None = None, sigma: float | None = None, offset=(0.0, 0.0),
+                    search=None) -> FunctionResult:
+    """The FunctionResult of the four-bar with Freudenstein coefficients K and ground ``d`` (default the
+    task's), on branch ``sigma`` (default: the branch nearest the first precision point), its rocker's
+    pivot B0 at ``offset`` [m]."""
+    text, x0, x1, p0, p1, s0, s1 = (task[k] for k in ("text", "x0", "x1", "p0", "p1", "s0", "s1"))
+    points, spacing, xs, phi, psi, sample = (task[k] for k in ("points", "spacing", "xs", "phi", "psi", "sample"))
+    ground = task["ground"] if d is None else d
     K1, K2, K3 = K
     if abs(K1) < DEFAULT.equal or abs(K2) < DEFAULT.equal:
         raise SynthesisError(WHAT, f"Freudenstein gives K1 = {K1:.3g}, K2 = {K2:.3g}: a link of infinite length; "
@@ -188,9 +209,9 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
     A0, B0 = np.array([d, 0.0]), np.zeros(2)
     A1 = A0 + a * np.array([math.cos(phi[0]), math.sin(phi[0])])
     B1 = B0 + c * np.array([math.cos(psi[0]), math.sin(psi[0])])
-    if not np.isclose(np.hypot(*(B1 - A1)), b, rtol=1e-9, atol=0):  # least squares: the first point on the circle
+    if sigma is not None or not np.isclose(np.hypot(*(B1 - A1)), b, rtol=1e-9, atol=0):  # the first point on the circle
         sigma1, best = None, 0.0
-        for sg in (1.0, -1.0):
+        for sg in (1.0, -1.0) if sigma is None else (sigma,):
             g, _, _ = _generated(K, d, phi[:1], sg)
             if np.isfinite(g[0]) and (sigma1 is None or abs(wrap(g[0] - psi[0])) < abs(wrap(best - psi[0]))):
                 sigma1, best = sg, g[0]
@@ -199,10 +220,12 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
         _, A, B = _generated(K, d, phi[:1], sigma1)
         A1, B1 = A[0], B[0]
     sigma1 = float(branch(A1, B1, B0))
-    gen, _, _ = _generated(K, d, phi_of(sample), sigma1)
-    err = wrap(gen - psi_of(y_sample))
+    gen, _, _ = _generated(K, d, task["phi_sample"], sigma1)
+    err = wrap(gen - task["psi_sample"])
     err_points = wrap(_generated(K, d, phi, sigma1)[0] - psi)
-    fb = FourBar(tuple(A0), tuple(map(float, A1)), tuple(map(float, B1)), tuple(B0), None)
+    o = np.asarray(offset, float)  # the whole linkage moved: the angles, measured from the x axis, stay
+    fb = FourBar(tuple(map(float, A0 + o)), tuple(map(float, A1 + o)), tuple(map(float, B1 + o)),
+                 tuple(map(float, B0 + o)), None)
     L = fb.lengths
     comment = (f"Four-bar synthesized by screwkin for function generation (Freudenstein): the rocker's angle psi "
                f"follows\ny = {text} for x in [{x0:.9g}, {x1:.9g}] while the crank's angle phi runs through "
@@ -231,4 +254,4 @@ def synthesize_function(text, x_range, input_range, output_range, points: int = 
         defects.append("branch defect: the precision points lie on different assembly modes")
     return FunctionResult(text, (x0, x1), (p0, p1), (s0, s1), spacing, tuple(map(float, xs)), tuple(map(float, phi)),
                           tuple(map(float, psi)), K, points > 3, sample, err, tuple(map(float, err_points)), design,
-                          tuple(defects))
+                          tuple(defects), search)

@@ -30,7 +30,10 @@ from ....tolerances import DEFAULT
 from .designs import Design, FourBar, PathResult, SynthesisError, Target
 from .fourbar import fourbar_linkage, stored, travel_analysis, wrap
 
-__all__ = ["synthesize_path", "coupler_points"]
+__all__ = ["synthesize_path", "coupler_points", "path_points", "path_design", "MAX_POINTS"]
+
+#: Most points a path may have (least squares over them: 12 to 100 points approximate a curve).
+MAX_POINTS = 100
 
 WHAT = "synthesize path"
 TWO_PI = 2 * math.pi
@@ -98,28 +101,8 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
     with the crank angles ``timing`` (relative to the first point [rad]) when given."""
     from scipy.optimize import least_squares
 
-    pts = np.array(points, float)
+    pts, timing, L = path_points(points, timing)
     n = len(pts)
-    if n < 3:
-        raise UsageError(f"--points: path generation needs at least 3 points, got {n}")
-    if n > 24:
-        raise UsageError(f"--points: at most 24 points, got {n}")
-    L = max(float(np.hypot(*(pts[i] - pts[j]))) for i in range(n) for j in range(i))
-    if L <= 0:
-        raise UsageError("--points: the points are all the same")
-    for i in range(n):
-        for j in range(i):
-            if np.hypot(*(pts[i] - pts[j])) < DEFAULT.equal * L:
-                raise UsageError(f"--points: points {j + 1} and {i + 1} are the same")
-    if timing is not None:
-        timing = np.asarray(timing, float)
-        if len(timing) != n:
-            raise UsageError(f"--timing: give one crank angle per point ({n}), got {len(timing)}")
-        timing = timing - timing[0]
-        if np.any(np.abs(np.diff(timing)) < DEFAULT.equal):
-            raise UsageError("--timing: two points have the same crank angle")
-        if not (np.all(np.diff(timing) > 0) or np.all(np.diff(timing) < 0)) or abs(timing[-1]) >= TWO_PI:
-            raise UsageError("--timing: the crank angles must run one way and within one turn")
     if starts < 1:
         raise UsageError("--starts must be at least 1")
     centre = pts.mean(axis=0)
@@ -177,6 +160,44 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
 
     best = min(good, key=quality) if good else min(results, key=lambda r: r[0])
     err, x, sigma, direction, errors, A, B, P, th = best
+    design, rel = path_design(pts, x, sigma, A, B, P, th, errors, name)
+    return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
+                      tuple(float(wrap(t)) if abs(t) < math.pi else float(t) for t in rel),
+                      tuple(map(float, errors)), starts, len(good), tolerance, design)
+
+
+def path_points(points, timing=None):
+    """(points (n, 2), timing relative to the first point or None, the path's size L [m]), checked:
+    3 to MAX_POINTS distinct points; one crank angle per point running one way within a turn."""
+    pts = np.array(points, float)
+    n = len(pts)
+    if n < 3:
+        raise UsageError(f"--points: path generation needs at least 3 points, got {n}")
+    if n > MAX_POINTS:
+        raise UsageError(f"--points: at most {MAX_POINTS} points, got {n}")
+    L = max(float(np.hypot(*(pts[i] - pts[j]))) for i in range(n) for j in range(i))
+    if L <= 0:
+        raise UsageError("--points: the points are all the same")
+    for i in range(n):
+        for j in range(i):
+            if np.hypot(*(pts[i] - pts[j])) < DEFAULT.equal * L:
+                raise UsageError(f"--points: points {j + 1} and {i + 1} are the same")
+    if timing is not None:
+        timing = np.asarray(timing, float)
+        if len(timing) != n:
+            raise UsageError(f"--timing: give one crank angle per point ({n}), got {len(timing)}")
+        timing = timing - timing[0]
+        if np.any(np.abs(np.diff(timing)) < DEFAULT.equal):
+            raise UsageError("--timing: two points have the same crank angle")
+        if not (np.all(np.diff(timing) > 0) or np.all(np.diff(timing) < 0)) or abs(timing[-1]) >= TWO_PI:
+            raise UsageError("--timing: the crank angles must run one way and within one turn")
+    return pts, timing, L
+
+
+def path_design(pts, x, sigma, A, B, P, th, errors, name: str = "synthesized_path", exact: bool = True):
+    """(the Design of the four-bar x (A0, B0, ...: path._unpack's order) drawn at the first point, its
+    crank angles from the first point): A, B, P the moving pivots and coupler point at each point;
+    ``exact`` False: the points are approximated (least squares), a miss is not a defect."""
     A0, B0 = tuple(map(float, x[0:2])), tuple(map(float, x[2:4]))
     phi1 = math.atan2(B[0][1] - A[0][1], B[0][0] - A[0][0])
     fb = FourBar(A0, tuple(map(float, A[0])), tuple(map(float, B[0])), B0, (float(P[0][0]), float(P[0][1]), phi1))
@@ -191,7 +212,4 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
     linkage = fourbar_linkage(fb, name, comment, tool="coupler_point")
     targets = tuple(Target("point", (float(px), float(py)), float(t), f"point {k + 1}")
                     for k, ((px, py), t) in enumerate(zip(pts, rel)))
-    design = stored(Design("path", fb, linkage, targets, "crank_joint", "coupler_point", None))
-    return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
-                      tuple(float(wrap(t)) if abs(t) < math.pi else float(t) for t in rel),
-                      tuple(map(float, errors)), starts, len(good), tolerance, design)
+    return stored(Design("path", fb, linkage, targets, "crank_joint", "coupler_point", None, exact=exact)), rel
