@@ -116,12 +116,24 @@ def test_map_workspace_and_study_say_the_mode(tmp_path, capsys):
     spec.write_text(f"file: {ROBOTS / 'fourbar.urdf.xacro'}\nargs: {{ground: 0.1}}\n"
                     "parameters: {crank: {values: [0.02, 0.03]}, coupler: {values: [0.12]}, rocker: {values: [0.08]}}\n"
                     "metrics: [transmission_angle]\ninput: crank_joint\n")
+    # the transmission angle is the same on both circuits (mu from the law of cosines in the diagonal from the
+    # crank tip to the output pivot, which the crank angle alone sets): --mode is said not to apply, no mode columns
     out, _ = _run(["study", str(spec), "--workers", "0", "--mode", "2"], capsys)
-    assert "each design follows mode 2 of its input 'crank_joint' at its value" in out
+    assert "--mode 2 does not apply: the transmission angle is the same on every assembly mode" in out
     out, _ = _run(["study", str(spec), "--workers", "0", "--json"], capsys)
+    assert all("mode" not in r for r in json.loads(out)["rows"])
+    # a metric that follows one mode: the five-bar's conditioning over its tip's workspace (a family of one
+    # design: the five-bar written as a xacro file with an argument that changes nothing)
+    five = tmp_path / "five_bar.urdf.xacro"
+    five.write_text((ROBOTS / "five_bar.urdf").read_text().replace(
+        '<robot name="five_bar">',
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="five_bar"><xacro:arg name="unused" default="0"/>', 1))
+    spec.write_text(f"file: {five}\nparameters: {{unused: {{values: [0]}}}}\nmetrics: [conditioning]\noutput: tip\n"
+                    "point: true\nworkspace: {resolution: 20mm}\n")
+    out, _ = _run(["study", str(spec), "--workers", "0", "--json", "--mode", "2"], capsys)
     d = json.loads(out)
-    assert d["mode"] == 1 and "mode 1 (the default)" in d["mode_rule"]
-    assert [(r["mode"], r["modes"]) for r in d["rows"]] == [(1, 2), (1, 2)]
+    assert d["mode"] == 2 and "each design follows mode 2 of its actuated joints" in d["mode_rule"]
+    assert [(r["mode"], r["modes"]) for r in d["rows"]] == [(2, 2)]
 
 
 @pytest.mark.parametrize("command", ["sweep", "dynamics", "map", "workspace", "study", "statics", "draw", "export",

@@ -145,6 +145,10 @@ def study_dict(result) -> dict:
 def mode_rule(result) -> str | None:
     """The one line that says which assembly mode every design follows (the metrics of MODE_METRICS), or None."""
     if not any(m in MODE_METRICS for m in result.spec.metrics):
+        if result.spec.mode is not None and "transmission_angle" in result.spec.metrics:
+            return (f"assembly mode: --mode {result.spec.mode} does not apply: the transmission angle is the same on "
+                    "every assembly mode of a four-bar or slider-crank (the law of cosines in the diagonal), and no "
+                    "other metric of this study follows a mode")
         return None
     k = result.spec.mode or 1
     inputs = (f"its input {result.spec.input!r} at its value" if result.spec.input

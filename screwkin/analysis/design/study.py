@@ -66,14 +66,17 @@ COLUMNS = {
                  "output_motion"),
     "grashof": ("linkage", "grashof", "grashof_margin"),
     "transmission_angle": ("transmission_angle_min", "transmission_angle_max", "transmission_restarts",
-                           "transmission_deviation", "input_turns", "dead_points", "mode", "modes"),
+                           "transmission_deviation", "input_turns", "dead_points"),
     "workspace_volume": ("workspace_dimension", "workspace_volume", "workspace_truncated", "mode", "modes"),
     "singularity_free_volume": ("workspace_dimension", "singularity_free_volume", "workspace_truncated", "mode",
                                 "modes"),
     "conditioning": ("conditioning_min", "conditioning_mean", "mode", "modes"),
 }
-#: The metrics that follow one assembly mode (their rows say which: ``mode`` K of ``modes`` N).
-MODE_METRICS = ("transmission_angle", "workspace_volume", "singularity_free_volume", "conditioning")
+#: The metrics that follow one assembly mode (their rows say which: ``mode`` K of ``modes`` N).  Not the
+#: transmission angle: a four-bar's mu comes from the law of cosines in the diagonal from the crank tip to the
+#: output pivot, which depends on the input alone, so it is the same on both circuits (a slider-crank's
+#: likewise, mirrored), and its extremes are located from the lengths (analysis.motion.transmission).
+MODE_METRICS = ("workspace_volume", "singularity_free_volume", "conditioning")
 
 #: Short Grashof classes, from the start of analysis.motion.planar's class sentences.
 _GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
@@ -262,13 +265,11 @@ def _transmission(d: _Design) -> dict:
     four-bar's mu are at the input angles 0 and 180 deg or at its limit positions), as ``sweep
     --json`` gives them (``linkage.transmission_range``); the largest deviation from 90 deg, whether
     the input turns fully, and the dead points (mu = 0 or 180 deg).  ``transmission_restarts`` is
-    0: no continuation is followed (the column of earlier, sampled studies).  The transmission angle is
-    the same on both circuits of a four-bar (mu from the law of cosines in the diagonal), so the mode
-    columns only record which mode the design's configuration is."""
+    0: no continuation is followed (the column of earlier, sampled studies).  No assembly mode is
+    chosen: mu is the same on both circuits (MODE_METRICS says why)."""
     r = d.linkage().transmission
     return {"transmission_angle_min": r.low, "transmission_angle_max": r.high, "transmission_restarts": 0,
-            "transmission_deviation": r.deviation, "input_turns": r.turns, "dead_points": r.dead_points,
-            **d.mode_columns()}
+            "transmission_deviation": r.deviation, "input_turns": r.turns, "dead_points": r.dead_points}
 
 
 def _workspace_volume(d: _Design) -> dict:
