@@ -10,6 +10,7 @@ import os
 from ..analysis.forces.dynamics import Load, dynamics
 from ..errors import UsageError, quote
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
+from ..present.progress import EVERY, Progress
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
 from ._common import joint_assignments, joint_value, named_points, names_list, value_kind
@@ -105,9 +106,11 @@ def run(mech, args) -> int:
     units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
     shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
     points = named_points(mech, args)
+    progress = Progress(label="dynamics", unit="configurations", every=EVERY)  # on a terminal only
     res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
                    gravity=_gravity(args.gravity), loads=_loads(mech, args.load, points), cs=_cs(args.cs),
-                   progress=True)
+                   progress=progress)
+    progress.clear()
     if args.csv:
         with open(args.csv, "w") as f:
             f.write(dynamics_csv(res, shown))

@@ -16,6 +16,7 @@ from ..present.jsonout import json_of
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.tables import RateUnits
 from ..present.plots import sweep_plot
+from ..present.progress import EVERY, Progress
 from ..present.streamout import SweepWriter
 from ..present.report import (
     linkage_dict,
@@ -113,6 +114,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
     topo = None
     pieces, methods, notes, limits, skipped = 0, [], [], [], 0
     last = None
+    progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only
     with SweepWriter(args.csv, args.parquet) as out:
         for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, near=near, rate=rate,
                                   chunk=chunk):
@@ -130,7 +132,9 @@ def _run_streamed(mech, args, solver, start, stop, fixed, near, rate) -> int:
             limits += list(piece.limits)
             skipped += len(piece.skipped)
             last = piece
+            progress(out.rows - 1, args.steps)
         rows = out.rows
+    progress.clear()
     rad = last.unit == "rad"
     files = " and ".join(f for f in (args.csv, args.parquet) if f)
     print(f"sweep of {args.input} from {value_text(args.input, start, rad)} to {value_text(args.input, stop, rad)} "
@@ -174,8 +178,10 @@ def run(mech, args) -> int:
     others = {k: v for k, v in fixed.items() if k != args.input}
     if _streamed(args):
         return _run_streamed(mech, args, solver, start, stop, others, near, rate)
-    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, near=near, rate=rate, progress=True,
+    progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only
+    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, near=near, rate=rate, progress=progress,
                 turn=args.turn)
+    progress.clear()
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 and not held else None

@@ -199,14 +199,15 @@ def _range_mean(values, y) -> float:
 
 def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
              fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress: bool = False) -> DynamicsResult:
+             cs: float = 0.05, progress=None) -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 
     inputs: the actuated joints (default: the mechanism's actuated joints when ``input`` is one
     of them, else ``input`` and the joints of ``fixed``); fixed: the other inputs' values;
     gravity: (gx, gy, gz) [m/s^2]; loads: Load; cs: the coefficient of speed fluctuation of the
-    flywheel figure (0 < cs < 2)."""
+    flywheel figure (0 < cs < 2); progress: a callable ``progress(done, total)`` told of the
+    configurations analysed (None: not told)."""
     if not 0 < cs < 2:
         raise UsageError(f"the coefficient of speed fluctuation must lie between 0 and 2, got {cs:g}")
     g = np.asarray(gravity, float)
@@ -225,7 +226,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         mech.link_frame(ld.link)  # a clear error for an unknown link
     solver = PositionSolver(mech, inputs)
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
-                near=near, rate=speed, progress=progress)
+                near=near, rate=speed)
     model = mech.model
     data = mech.scratch_data()
     a_idx = mech.velocity_indices(inputs)
@@ -239,6 +240,8 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     ground_tree, ground_cuts = _ground_sides(mech)
     gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
     for k in range(n):
+        if progress is not None:
+            progress(k, n)
         q, v, a = res.q[k], res.rates[k], res.accelerations[k]
         b = pin.rnea(gmodel, data, q, v, a).copy()
         pin.computeJointJacobians(model, data, q)

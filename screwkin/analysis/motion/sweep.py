@@ -26,7 +26,6 @@ of the range, or the step budget is spent.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -298,7 +297,7 @@ def _refined(f, start, h, k):
 
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-          near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
+          near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
           max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
@@ -315,6 +314,8 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     batch: without turn, a mechanism the closed form does not cover is corrected a chunk of grid
     values at a time (screwkin.analysis.motion.batch_sweep), the tracker taking the chunks that
     fail (said in ``notes``); False: the per-step tracker.
+    progress: a callable ``progress(done, total)`` told of the grid values reached as the tracker
+    goes (present/progress.Progress draws it on a terminal); None: not told.
     """
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -352,7 +353,6 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     stopped = reason = None
     closed = False
     direction = np.sign(h) or 1.0
-    show = progress and sys.stderr.isatty() and steps >= 200
     try:
         t = tr.tangent(q0)
     except _Stuck as exc:
@@ -363,7 +363,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     # chunk corrected at once cannot take the shorter steps a coarse grid needs across a bend
     if batch and not turn and h != 0 and t is not None and abs(h) / tr.scale[tr.ix] <= mech.tolerances.max_step:
         b = batched_motion(solver, tr, q0, t, start, stop, steps, lambda qa, xa, xb, n: sweep(
-            solver, name, xa, xb, n, fixed=fixed, rate=rate, q_start=qa, closed_form=False, batch=False))
+            solver, name, xa, xb, n, fixed=fixed, rate=rate, q_start=qa, closed_form=False, batch=False), progress)
         if b is not None:
             X, Q, limits, stopped, reason, skipped, notes = b
             return _finish(solver, name, X, Q, rate, stopped, reason, (start, stop, steps), limits, False, False,
@@ -508,12 +508,10 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             if back_at_start():
                 closed = True
                 break
-            if show:
-                sys.stderr.write(f"\rsweep {min(len(X), steps)}/{steps}")
+            if progress is not None:
+                progress(min(len(X), steps), steps)
         else:
             stopped, reason = x, f"the step budget ({max_steps} configurations) is spent"
-    if show:
-        sys.stderr.write("\n")
     if turn and stopped is None and not closed and (stop - x) * np.sign(h) > 1e-9 * max(1.0, abs(stop)):
         stopped, reason = x, "the motion did not reach the end of the range"
     return _finish(solver, name, X, Q, rate, stopped, reason, (start, stop, steps), limits, turn, closed, unit,
