@@ -187,9 +187,13 @@ class _Tracker:
         if np.sign(fa) == np.sign(fb):
             raise _Stuck("the value is not on this arc")
         u = brentq(f, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=100)
-        # polish at the exact input value (the held joint then follows)
-        return self.closure.solve(self.solver.set_inputs(at(u), {self.name: x}), frozen=tuple(
-            sorted(set(self.frozen_other) | {self.ix}))).q
+        # polish at the exact input value (the held joint then follows); where the loops cannot be closed
+        # with the input held there, the value is a hole of the motion (sweep records it), not an error
+        try:
+            return self.closure.solve(self.solver.set_inputs(at(u), {self.name: x}), frozen=tuple(
+                sorted(set(self.frozen_other) | {self.ix}))).q
+        except AssemblyError:
+            raise _Stuck("the loops cannot be closed at this input value") from None
 
     def input_change(self, q0, q1) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
