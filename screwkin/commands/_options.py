@@ -112,6 +112,16 @@ def check_writable(path: str, option: str) -> None:
         raise UsageError(f"{where}: cannot write, the folder {quote(folder, 200)} does not exist")
     if not os.access(folder, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
         raise UsageError(f"{where}: cannot write, permission denied")
+    if not os.path.lexists(path):  # a folder may exist and take no file (/proc, a read-only mount): try one
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        except FileExistsError:  # made meanwhile: it is checked when written
+            return
+        except OSError as exc:
+            why = os.strerror(exc.errno) if exc.errno else str(exc)
+            raise UsageError(f"{where}: cannot write, no file can be made in {quote(folder, 200)} ({why})") from None
+        os.close(fd)
+        os.remove(path)
 
 
 def check_folder_writable(path: str, option: str) -> None:

@@ -9,6 +9,7 @@ import os
 
 from ..analysis.forces.dynamics import Load, dynamics
 from ..errors import UsageError, quote
+from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.progress import EVERY, Progress
 from ..present.report import to_jsonable
@@ -112,8 +113,7 @@ def run(mech, args) -> int:
                    progress=progress)
     progress.clear()
     if args.csv:
-        with open(args.csv, "w") as f:
-            f.write(dynamics_csv(res, shown))
+        write_output(args.csv, dynamics_csv(res, shown))
     if args.plot:
         dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:

@@ -5,12 +5,12 @@ take their second point from qpos0)."""
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 from ..errors import UsageError, quote
 from ..files.exporter import write_mjcf, write_placed_urdf
 from ..model.placed import check_closed, placed
 from ..present.report import to_jsonable
+from ..present.outfile import write_output
 from ._common import add_configuration_options, configuration, emit, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -25,13 +25,6 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--mjcf", metavar="OUT.xml", help="write MJCF here: loops as <equality> connect/weld")
     sp.add_argument("--urdf", metavar="OUT.urdf", help="write URDF here: loops as <loop_joint>")
     add_configuration_options(sp)
-
-
-def _write(path, text):
-    try:
-        Path(path).write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise UsageError(f"cannot write {quote(str(path))}: {exc.strerror or exc}") from None
 
 
 def run(mech, args) -> int:
@@ -50,7 +43,7 @@ def run(mech, args) -> int:
         pm = placed(mech, q, fmt, comment=comment)
         notes += [n for n in pm.notes if n not in notes]
         if fmt == "MJCF":
-            _write(out, write_mjcf(pm))
+            write_output(out, write_mjcf(pm))
             for c in pm.cuts:
                 if c.type in ("revolute", "continuous"):
                     notes.append(f"loop joint {quote(c.name)} (revolute): two <connect>s {pm.length:.3g} m apart on "
@@ -63,7 +56,7 @@ def run(mech, args) -> int:
                 notes.append(f"{len(light)} moving bodies without mass ({', '.join(quote(n, 30) for n in light[:3])}"
                              f"{', ...' if len(light) > 3 else ''}) get 1e-6 kg, which MuJoCo needs")
         else:
-            _write(out, write_placed_urdf(pm, mech.spec.root))
+            write_output(out, write_placed_urdf(pm, mech.spec.root))
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})
 
     def data():

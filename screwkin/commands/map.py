@@ -10,6 +10,7 @@ import numpy as np
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError
+from ..present.outfile import write_output
 from ..present.plots import map_png
 from ..present.report import (
     map_csv,
@@ -59,8 +60,7 @@ def run(mech, args) -> int:
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
         map_png(res, args.png, *units, title=title)
     if args.csv:
-        with open(args.csv, "w") as f:
-            f.write(map_csv(res))
+        write_output(args.csv, map_csv(res))
     if args.json:
         print(json.dumps(to_jsonable({**map_dict(res), "characteristic_length": mech.length}), indent=2))
     else:

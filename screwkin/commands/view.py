@@ -14,6 +14,7 @@ from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.singular import classify
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep
+from ..present.outfile import write_output
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
@@ -130,8 +131,7 @@ def _pictures(mech, args, server, scene, frames=None):
     html = server.viewer.static_html()
     title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
     if args.html:
-        with open(args.html, "w") as f:
-            f.write(with_player(page(html, scene, title), frames, FPS) if frames else page(html, scene, title))
+        write_output(args.html, with_player(page(html, scene, title), frames, FPS) if frames else page(html, scene, title))
         print(f"wrote {args.html}")
     if args.png:
         with tempfile.TemporaryDirectory() as d:

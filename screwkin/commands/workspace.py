@@ -12,6 +12,7 @@ import pinocchio as pin
 
 from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
 from ..errors import UsageError
+from ..present.outfile import write_output
 from ..present.report import to_jsonable
 from ..present.view import ViewerServer, build_scene, screenshot, show
 from ..present.workspace import (
@@ -110,8 +111,7 @@ def run(mech, args) -> int:
             workspace_cloud(res, server.viewer)
             html = server.viewer.static_html()
         if args.html:
-            with open(args.html, "w") as f:
-                f.write(html)
+            write_output(args.html, html)
             wrote.append(args.html)
         if args.cloud_png:
             with tempfile.TemporaryDirectory() as d:

@@ -6,12 +6,15 @@ by frame; written as a GIF with Pillow or an MP4 with imageio-ffmpeg (an optiona
 
 from __future__ import annotations
 
+import io
 import os
+import tempfile
 
 import numpy as np
 
-from ..errors import UsageError, quote
+from ..errors import OutputError, UsageError, quote
 from .draw import draw_mechanism
+from .outfile import write_output
 from .plots import pyplot
 
 __all__ = ["FORMATS", "animation_format", "write_animation"]
@@ -73,29 +76,36 @@ def write_animation(path: str, skeletons, titles, traces: dict | None = None, fp
     plt = pyplot("--animate")
     frames = []
     writer = None
-    try:
-        for k, (skel, title) in enumerate(zip(skeletons, titles)):
-            fig = draw_mechanism(skel, title=title, traces={n: xy[k::-1] for n, xy in traces.items()}, size=size,
-                                 limits=limits, angles=angles, subtitle=subtitle)
-            image = _pixels(fig)
-            plt.close(fig)
-            if ext == ".gif":
-                frames.append(image)
-                continue
-            if writer is None:
-                writer = _ffmpeg().write_frames(str(path), (image.shape[1], image.shape[0]), fps=float(fps),
-                                                macro_block_size=1, quality=7)
-                writer.send(None)
-            writer.send(np.ascontiguousarray(image).tobytes())
+    with tempfile.TemporaryDirectory() as folder:  # ffmpeg's MP4 is made here, then written to ``path``
+        video = os.path.join(folder, "animation.mp4")
+        try:
+            for k, (skel, title) in enumerate(zip(skeletons, titles)):
+                fig = draw_mechanism(skel, title=title, traces={n: xy[k::-1] for n, xy in traces.items()},
+                                     size=size, limits=limits, angles=angles, subtitle=subtitle)
+                image = _pixels(fig)
+                plt.close(fig)
+                if ext == ".gif":
+                    frames.append(image)
+                    continue
+                if writer is None:
+                    writer = _ffmpeg().write_frames(video, (image.shape[1], image.shape[0]), fps=float(fps),
+                                                    macro_block_size=1, quality=7)
+                    writer.send(None)
+                writer.send(np.ascontiguousarray(image).tobytes())
+        except OSError as exc:  # the temporary folder is full: the output itself was not touched
+            raise OutputError(video, f"{exc.strerror or exc} (the video is made there first)") from None
+        finally:
+            if writer is not None:
+                writer.close()
         if ext == ".gif":
             from PIL import Image
 
             images = [Image.fromarray(f) for f in frames]
-            images[0].save(path, save_all=True, append_images=images[1:], duration=int(round(1000 / fps)), loop=0,
-                           optimize=False)
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from None
-    finally:
-        if writer is not None:
-            writer.close()
+            buf = io.BytesIO()
+            images[0].save(buf, format="GIF", save_all=True, append_images=images[1:],
+                           duration=int(round(1000 / fps)), loop=0, optimize=False)
+            write_output(path, buf.getvalue())
+        else:
+            with open(video, "rb") as f:
+                write_output(path, f.read())
     return len(skeletons)

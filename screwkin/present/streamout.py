@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
+from .outfile import OutputFile, output_failed, remove_partial
 from .report import sweep_columns, sweep_csv
 
 __all__ = ["SweepWriter", "parquet_available"]
@@ -34,6 +35,7 @@ class SweepWriter:
         self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
         self._parquet_path, self._pq = parquet, None
         self.rows = 0
+        self._begun = []  # the paths opened (only those are removed when the sweep is abandoned)
 
     @staticmethod
     def require_parquet(path: str) -> None:
@@ -43,12 +45,18 @@ class SweepWriter:
                              "--csv writes the same columns")
 
     def write(self, res, motion=None) -> None:
-        if self._csv_path:
-            if self._csv is None:
-                self._csv = open(self._csv_path, "w")
-            self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
-        if self._parquet_path:
-            self._write_parquet(res, motion)
+        """Append a chunk (OutputError when a file cannot take it: the partial files are removed)."""
+        try:
+            if self._csv_path:
+                if self._csv is None:
+                    self._csv = OutputFile(self._csv_path)
+                    self._begun.append(self._csv_path)
+                self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
+            if self._parquet_path:
+                self._write_parquet(res, motion)
+        except BaseException:
+            self.abandon()
+            raise
         self.rows += len(res.values)
 
     def _write_parquet(self, res, motion):
@@ -60,20 +68,55 @@ class SweepWriter:
         arrays = [pa.array(np.arange(self.rows, self.rows + len(res.values), dtype=np.int64))]
         arrays += [pa.array(np.ascontiguousarray(c, dtype=float)) for c in cols]
         table = pa.Table.from_arrays(arrays, names=names)
-        if self._pq is None:
-            self._pq = pq.ParquetWriter(self._parquet_path, table.schema)
-        self._pq.write_table(table)
+        try:
+            if self._pq is None:
+                self._pq = pq.ParquetWriter(self._parquet_path, table.schema)
+                self._begun.append(self._parquet_path)
+            self._pq.write_table(table)
+        except OSError as exc:
+            self._close_parquet()
+            raise output_failed(self._parquet_path, exc) from None
+
+    def _close_parquet(self) -> None:
+        writer, self._pq = self._pq, None
+        if writer is not None:
+            try:
+                writer.close()
+            except OSError:
+                pass
 
     def close(self) -> None:
+        """Finish both files (OutputError when the last bytes cannot be written: the partial files
+        are removed)."""
+        try:
+            if self._csv is not None:
+                csv, self._csv = self._csv, None
+                csv.close()
+            if self._pq is not None:
+                writer, self._pq = self._pq, None
+                try:
+                    writer.close()
+                except OSError as exc:
+                    raise output_failed(self._parquet_path, exc) from None
+        except BaseException:
+            self.abandon()
+            raise
+
+    def abandon(self) -> None:
+        """Stop writing and remove the files this writer began (the work failed or was interrupted, or a
+        file could not be written): a sweep is never left half written as if whole."""
         if self._csv is not None:
-            self._csv.close()
-            self._csv = None
-        if self._pq is not None:
-            self._pq.close()
-            self._pq = None
+            csv, self._csv = self._csv, None
+            csv.discard()
+        self._close_parquet()
+        for path in self._begun:
+            remove_partial(path)
 
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, kind, exc, tb):
+        if kind is None:
+            self.close()
+        else:
+            self.abandon()

@@ -26,6 +26,7 @@ from .plots import pyplot
 from .progress import Progress  # noqa: F401  (the study's progress bar: present/progress.py)
 from .report import to_jsonable
 from .tables import csv_text
+from .outfile import write_figure, write_output
 
 __all__ = [
     "DISPLAY",
@@ -104,13 +105,15 @@ def write_table(result, path) -> None:
     """The table into ``path``: CSV, or Parquet (``.parquet``, needs pyarrow)."""
     check_table_path(path)
     if Path(path).suffix.lower() == ".csv":
-        Path(path).write_text(study_csv(result))
+        write_output(path, study_csv(result))
         return
     import pyarrow as pa  # optional: only for Parquet
     import pyarrow.parquet as pq
 
     rows, names = _rows(result)
-    pq.write_table(pa.table({n: [row[i] for row in rows] for i, n in enumerate(names)}), str(path))
+    buf = pa.BufferOutputStream()  # made in memory, then written (one way to fail: present/outfile.py)
+    pq.write_table(pa.table({n: [row[i] for row in rows] for i, n in enumerate(names)}), buf)
+    write_output(path, buf.getvalue().to_pybytes())
 
 
 def study_dict(result) -> dict:
@@ -329,8 +332,10 @@ def metrics_png(result, path) -> None:
     """Each numeric metric against each parameter (see :func:`metrics_figure`)."""
     plt = pyplot("--plot")
     fig = metrics_figure(result)
-    fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
+    finally:
+        plt.close(fig)
 
 
 def pareto_figure(result, goals=None):
@@ -375,5 +380,7 @@ def pareto_png(result, path, goals=None) -> None:
     """The designs in the plane of two columns, the Pareto front drawn over them (see :func:`pareto_figure`)."""
     plt = pyplot("--plot")
     fig = pareto_figure(result, goals)
-    fig.savefig(path, dpi=100, metadata={"Title": fig.axes[0].get_title()})
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100, metadata={"Title": fig.axes[0].get_title()})
+    finally:
+        plt.close(fig)
