@@ -6,6 +6,7 @@ outputs that overwrite the model or each other.  Each is refused with one line (
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 
@@ -65,3 +66,47 @@ def test_a_character_reference_is_read_alike_and_kept(tmp_path):
     done = screwkin_cli("info", str(path), "--json")
     assert done.returncode == 0, done.stderr
     assert "coupler\tjoint" in [j["name"] for j in json.loads(done.stdout)["joints"]]
+
+
+# ------------------------------------------------------------------ outputs that overwrite what is read
+@pytest.fixture
+def model(tmp_path):
+    path = tmp_path / "x.urdf"
+    path.write_text(FOURBAR.read_text())
+    return path
+
+
+def _usage(capsys, argv) -> str:
+    code = main([str(a) for a in argv])
+    line = _one_line_error(capsys.readouterr().err)
+    assert code == 2, line
+    return line
+
+
+def test_an_output_that_is_the_model_or_another_output_is_refused_before_the_work(model, tmp_path, capsys):
+    """export --mjcf o.xml --urdf o.xml wrote one over the other; sweep --csv robots/x.urdf overwrote the
+    model it had read.  Compared as resolved paths: through '..', a symbolic link, a hard link."""
+    sweep = ["sweep", model, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "3"]
+    before = model.read_bytes()
+    line = _usage(capsys, ["export", model, "--mjcf", tmp_path / "o.xml", "--urdf", tmp_path / "o.xml"])
+    assert "--urdf" in line and "the same file as --mjcf" in line and not (tmp_path / "o.xml").exists()
+    assert "is the file read" in _usage(capsys, [*sweep, "--csv", model])
+    assert "is the file read" in _usage(capsys, [*sweep, "--csv", tmp_path / ".." / tmp_path.name / "x.urdf"])
+    (tmp_path / "link.csv").symlink_to(model)
+    assert "is the file read" in _usage(capsys, [*sweep, "--csv", tmp_path / "link.csv"])
+    os.link(model, tmp_path / "hard.csv")
+    assert "is the file read" in _usage(capsys, [*sweep, "--plot", tmp_path / "hard.csv"])
+    assert "the same file as --csv" in _usage(capsys, [*sweep, "--csv", tmp_path / "a.csv", "--plot",
+                                                      tmp_path / "a.csv"])
+    assert model.read_bytes() == before
+
+
+def test_the_sidecar_found_beside_the_model_is_not_overwritten_either(model, capsys):
+    side = model.with_suffix(".yaml")
+    side.write_text("actuated: [crank_joint]\n")
+    line = _usage(capsys, ["draw", model, "--png", side])
+    assert "the sidecar read beside it" in line and side.read_text() == "actuated: [crank_joint]\n"
+
+
+def test_devices_take_several_outputs(model, capsys):
+    assert main(["export", str(model), "--mjcf", "/dev/null", "--urdf", "/dev/null"]) == 0

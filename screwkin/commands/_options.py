@@ -9,8 +9,9 @@
   as "not given").
 * **Outputs can be written.** Every file a command will write (``--csv``,
   ``--png``, ``--svg``, ``--plot``, ``--html``, ``--md``, ``-o`` ...) is checked
-  before the work starts: its folder exists and is writable and the path is not
-  a folder.
+  before the work starts: its folder exists and is writable (a new file is
+  tried there), the path is not a folder, and it is neither a file the command
+  reads nor another output's file.
 """
 
 from __future__ import annotations
@@ -136,14 +137,59 @@ def check_folder_writable(path: str, option: str) -> None:
         raise UsageError(f"{where}: cannot write, permission denied")
 
 
+#: Destinations of the files a command reads (the mechanism, its sidecar, a study's or a grasp's spec).
+INPUT_DESTS = ("file", "yaml", "spec")
+
+
+def _same_file(a: str, b: str) -> bool:
+    """Whether paths ``a`` and ``b`` name one file: the same path once links and ``..`` are resolved, or
+    one file under two names (hard links)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist yet: different files
+        return False
+
+
+def _overwritten(args, outputs) -> None:
+    """Refuse an output that would overwrite a file the command reads (the mechanism file, its sidecar
+    given or found beside it, a spec) or another output of the same command line.  A device or a pipe
+    (/dev/null, /dev/stdout) is written, not overwritten: it may take several outputs."""
+    inputs = [(f"the file read ({quote(getattr(args, d), 200)})", getattr(args, d)) for d in INPUT_DESTS
+              if isinstance(getattr(args, d, None), str) and getattr(args, d)]
+    mechanism = getattr(args, "file", None)
+    if isinstance(mechanism, str) and mechanism and getattr(args, "yaml", None) is None:
+        for suffix in (".yaml", ".yml"):  # the sidecar read beside the file (model/loader._find_sidecar)
+            side = os.path.splitext(mechanism)[0] + suffix
+            if os.path.isfile(side):
+                inputs.append((f"the sidecar read beside it ({quote(side, 200)})", side))
+    seen = []
+    for option, path in outputs:
+        if os.path.exists(path) and not os.path.isfile(path):
+            continue
+        for what, other in inputs:
+            if _same_file(path, other):
+                raise UsageError(f"{option} {quote(path, 200)}: is {what}: it would be overwritten; write elsewhere")
+        for first, other in seen:
+            if _same_file(path, other):
+                raise UsageError(f"{option} {quote(path, 200)}: the same file as {first} {quote(other, 200)}: "
+                                 "give each output a file of its own")
+        seen.append((option, path))
+
+
 def check_outputs(parser, args) -> None:
-    """Refuse, before any work, an output file whose folder is missing or not writable, or that is a folder."""
+    """Refuse, before any work, an output file whose folder is missing or not writable, that is a folder,
+    that is a file the command reads, or that another output of the command line names too."""
+    outputs = []
     for action in parser._actions:
         if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
             if getattr(args, "kind", None) == "chains":  # synthesize chains writes into a folder (made if missing)
                 check_folder_writable(getattr(args, action.dest), _option_name(action))
                 continue
             check_writable(getattr(args, action.dest), _option_name(action))
+            outputs.append((_option_name(action), getattr(args, action.dest)))
+    _overwritten(args, outputs)
 
 
 def check_parsed(parser, args) -> None:
