@@ -110,3 +110,75 @@ def test_the_sidecar_found_beside_the_model_is_not_overwritten_either(model, cap
 
 def test_devices_take_several_outputs(model, capsys):
     assert main(["export", str(model), "--mjcf", "/dev/null", "--urdf", "/dev/null"]) == 0
+
+
+# ------------------------------------------------------------------ inertias no body has
+def _with_coupler_inertia(tmp_path, ixx, iyy, izz, ixy=0.0):
+    text = FOURBAR.read_text()
+    start = text.index('<link name="coupler"')
+    a = text.index("<inertia ", start)
+    b = text.index("/>", a) + 2
+    path = tmp_path / "m.urdf"
+    path.write_text(text[:a] + f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="{ixy}" ixz="0" iyz="0"/>'
+                    + text[b:])
+    return path
+
+
+@pytest.mark.parametrize("inertia, says", [((0.0002, 0.0002, -1.0), "a negative principal moment"),
+                                           ((0.0002, 0.0002, 0.0005), "break A + B >= C (0.0004 < 0.0005)"),
+                                           ((0.0002, 0.0002, 0.0002, 0.0003), "a negative principal moment")])
+def test_dynamics_refuses_an_inertia_no_body_has_and_loading_warns(tmp_path, capsys, inertia, says):
+    """izz="-1" gave a kinetic energy of -29.9 J.  Refused by dynamics (exit 1, naming the link), warned
+    of by every command (the file still loads for kinematics: real robots' files break it too)."""
+    path = _with_coupler_inertia(tmp_path, *inertia)
+    code = main(["dynamics", str(path), "--input", "crank_joint", "--speed", "100rpm", "--steps", "4"])
+    line = _one_line_error(capsys.readouterr().err.split("\n", 1)[1])
+    assert code == 1 and "link 'coupler' moves and has" in line and says in line, line
+    assert main(["info", str(path)]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"warning: {path}: link 'coupler' has") and says in err[0]
+
+
+def test_the_check_agrees_with_mujoco():
+    """files/inertia.inertia_problem against MuJoCo's compiler (an independent implementation: it refuses
+    "inertia must have positive eigenvalues" and "A + B >= C"), on random tensors R diag(A, B, C) R^T
+    whose principal moments are each way of the boundaries by at least 1 %."""
+    mujoco = pytest.importorskip("mujoco")
+    import numpy as np
+
+    from screwkin.files.inertia import inertia_problem
+
+    rng = np.random.default_rng(33)
+    agree, seen = 0, set()
+    while agree < 60:
+        moments = rng.uniform(-0.5, 2.0, 3)
+        a, b, c = np.sort(moments)
+        if min(abs(a), abs(a + b - c)) < 0.01 * c:
+            continue
+        q = rng.normal(size=4)
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, q / np.linalg.norm(q))
+        R = R.reshape(3, 3)
+        T = R @ np.diag(moments) @ R.T
+        full = " ".join(f"{x:.17g}" for x in (T[0, 0], T[1, 1], T[2, 2], T[0, 1], T[0, 2], T[1, 2]))
+        xml = (f'<mujoco><worldbody><body><joint type="hinge"/><inertial pos="0 0 0" mass="1" '
+               f'fullinertia="{full}"/></body></worldbody></mujoco>')
+        try:
+            mujoco.MjModel.from_xml_string(xml)
+            refused = False
+        except ValueError:
+            refused = True
+        ours = inertia_problem(1.0, T[0, 0], T[1, 1], T[2, 2], T[0, 1], T[0, 2], T[1, 2])
+        assert refused == (ours is not None), (moments, ours)
+        agree += 1
+        seen.add(ours and ("negative" if "negative" in ours else "A + B"))
+    assert seen == {None, "negative", "A + B"}, seen
+
+
+def test_rounding_in_the_last_digits_is_taken_as_written():
+    """A + B = C to 7 digits (a flat plate written by a CAD export), and zeros written as 1e-35."""
+    from screwkin.files.inertia import inertia_problem
+
+    assert inertia_problem(1.0, 0.1234567, 0.2345678, 0.3580246) is None  # A + B = 0.3580245
+    assert inertia_problem(1.0, -2.4e-35, 0.0, 2.4e-35) is None
+    assert inertia_problem(-1.0, 1, 1, 1) == "a negative mass (-1 kg)"

@@ -107,7 +107,8 @@ class DynamicsResult:
 
 
 def check_inertias(mech) -> tuple:
-    """Each moving body needs a mass (and an SDF file's inertias are not read: refused): a moving
+    """Each moving body needs a mass and an inertia a rigid body can have (files/inertia.py: a link
+    breaking it is a MechanismFileError naming it), and an SDF file's inertias are not read (refused): a moving
     link without <inertial> on a body none of whose links has one is a MechanismFileError naming
     it, except a link with no geometry either (the inside of a compound joint), taken as massless
     and returned, named, in a note."""
@@ -125,7 +126,13 @@ def check_inertias(mech) -> tuple:
     virtual = {n for names in mech.virtual_joints.values() for n in names}
     massless = []
     for joint, links in bodies.items():
-        if joint == 0 or model.names[joint] in virtual or any(x.mass is not None for x in links):
+        if joint == 0 or model.names[joint] in virtual:
+            continue
+        impossible = [x for x in links if x.inertia_problem]
+        if impossible:  # (the file loads for kinematics with a warning; a dynamics computed with it is no body's)
+            raise MechanismFileError(mech.path, f"link {quote(impossible[0].name)} moves and has "
+                                                f"{impossible[0].inertia_problem}, which no rigid body has: dynamics needs a body's")
+        if any(x.mass is not None for x in links):
             continue
         with_geometry = [x.name for x in links if x.has_geometry]
         if with_geometry:
