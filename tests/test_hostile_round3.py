@@ -182,3 +182,26 @@ def test_rounding_in_the_last_digits_is_taken_as_written():
     assert inertia_problem(1.0, 0.1234567, 0.2345678, 0.3580246) is None  # A + B = 0.3580245
     assert inertia_problem(1.0, -2.4e-35, 0.0, 2.4e-35) is None
     assert inertia_problem(-1.0, 1, 1, 1) == "a negative mass (-1 kg)"
+
+
+# ------------------------------------------------------------------ bounded numbers
+@pytest.mark.parametrize("cs", ["1e-320", "0", "0.00009", "0.51", "nan", "inf"])
+def test_the_coefficient_of_speed_fluctuation_is_bounded(capsys, cs):
+    """--cs 1e-320 gave an infinite flywheel (I = dE / (Cs omega^2)): 0.0001 to 0.5, said."""
+    line = _usage(capsys, ["dynamics", FOURBAR, "--input", "crank_joint", "--speed", "100rpm", "--steps", "4",
+                           "--cs", cs])
+    assert "--cs must lie between 0.0001 and 0.5" in line
+
+
+def test_the_bounds_of_the_coefficient_are_taken(capsys):
+    """At both ends the flywheel is dE / (Cs omega^2), omega = 100 rpm = 10.472 rad/s: the two figures are in
+    the ratio of the ends (5,000)."""
+    inertias = []
+    for cs in ("0.0001", "0.5"):
+        assert main(["dynamics", str(FOURBAR), "--input", "crank_joint", "--speed", "100rpm", "--steps", "8",
+                     "--cs", cs, "--json"]) == 0
+        fly = json.loads(capsys.readouterr().out)["flywheel"]
+        omega = 100 * 2 * 3.141592653589793 / 60
+        assert fly["inertia"] == pytest.approx(fly["energy_fluctuation"] / (float(cs) * omega**2), rel=1e-12)
+        inertias.append(fly["inertia"])
+    assert inertias[0] / inertias[1] == pytest.approx(5000, rel=1e-12)

@@ -7,7 +7,7 @@ import json
 import math
 import os
 
-from ..analysis.forces.dynamics import Load, dynamics
+from ..analysis.forces.dynamics import CS_RANGE, Load, dynamics
 from ..errors import UsageError, quote
 from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
@@ -45,7 +45,7 @@ def add_parser(sub, common, scaled):
                     help="a named point on a link, in the link's frame (units allowed: P=coupler:60mm,20mm,0), for "
                          "--load NAME:...; repeatable")
     sp.add_argument("--cs", default="0.05",
-                    help="coefficient of speed fluctuation of the flywheel figure (default 0.05)")
+                    help="coefficient of speed fluctuation of the flywheel figure, 0.0001 to 0.5 (default 0.05)")
     sp.add_argument("--csv", help="write the efforts, energies, shaking wrench and reactions per step to this CSV file")
     sp.add_argument("--plot", help="draw the input effort against the input into this PNG file (needs matplotlib)")
 
@@ -83,8 +83,10 @@ def _cs(text):
         cs = float(text)
     except ValueError:
         raise UsageError(f"--cs expects a number, got {quote(text, 40)}") from None
-    if not 0 < cs < 2:  # nan fails both
-        raise UsageError(f"--cs must lie between 0 and 2 (e.g. 0.05), got {quote(text, 40)}")
+    lo, hi = CS_RANGE
+    if not lo <= cs <= hi:  # nan fails both
+        raise UsageError(f"--cs must lie between {lo:g} and {hi:g} (machines ask for 0.002 to 0.2; default 0.05), "
+                         f"got {quote(text, 40)}")
     return cs
 
 

@@ -43,7 +43,13 @@ from ..motion.position import PositionSolver
 from .statics import balance, reaction_table
 from ..motion.sweep import sweep
 
-__all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
+__all__ = ["CS_RANGE", "Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
+
+#: The coefficients of speed fluctuation Cs = (omega_max - omega_min) / omega_mean the flywheel figure takes.
+#: Machines ask for 0.002 (generators) to 0.2 (crushers, punches); below 1e-4 the flywheel grows past ten
+#: thousand times dE / omega^2 and at --cs 1e-320 it is infinite; above 0.5 the speed swings by half its
+#: mean, and efforts computed at a constant speed no longer describe the motion they would drive.
+CS_RANGE = (1e-4, 0.5)
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -213,10 +219,11 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     inputs: the actuated joints (default: the mechanism's actuated joints when ``input`` is one
     of them, else ``input`` and the joints of ``fixed``); fixed: the other inputs' values;
     gravity: (gx, gy, gz) [m/s^2]; loads: Load; cs: the coefficient of speed fluctuation of the
-    flywheel figure (0 < cs < 2); progress: a callable ``progress(done, total)`` told of the
+    flywheel figure (within CS_RANGE); progress: a callable ``progress(done, total)`` told of the
     configurations analysed (None: not told)."""
-    if not 0 < cs < 2:
-        raise UsageError(f"the coefficient of speed fluctuation must lie between 0 and 2, got {cs:g}")
+    lo, hi = CS_RANGE
+    if not lo <= cs <= hi:  # nan fails both
+        raise UsageError(f"the coefficient of speed fluctuation must lie between {lo:g} and {hi:g}, got {cs:g}")
     g = np.asarray(gravity, float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
