@@ -205,3 +205,36 @@ def test_the_bounds_of_the_coefficient_are_taken(capsys):
         assert fly["inertia"] == pytest.approx(fly["energy_fluctuation"] / (float(cs) * omega**2), rel=1e-12)
         inertias.append(fly["inertia"])
     assert inertias[0] / inertias[1] == pytest.approx(5000, rel=1e-12)
+
+
+@pytest.mark.parametrize("command", [["solve", "--set", "crank_joint=0.5"], ["draw", "--png", "{o}.png"],
+                                     ["dynamics", "--input", "crank_joint", "--speed", "1rpm", "--steps", "3"],
+                                     ["view", "--html", "{o}.html"]])
+@pytest.mark.parametrize("point, says", [("P=coupler:1e308,0,0", "is beyond 10000 m"),
+                                         ("P=coupler:0,-10001,0", "is beyond 10000 m"),
+                                         ("P=nolink:0,0,0", "no link named 'nolink'"),
+                                         ("P=coupler:nan,0,0", "'nan' is not a number"),
+                                         ("P=coupler:0,0", None)])
+def test_every_point_is_checked_by_one_parser(tmp_path, capsys, command, point, says):
+    """--point 1e308 m gave inf and NaN answers (exit 0), and draw did not look at --point at all (an
+    unknown link, NaN).  One parser (commands/_common.named_points, called for every command) bounds the
+    coordinates as a file's positions are (10 km)."""
+    argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
+    code = main([argv[0], str(FOURBAR), *argv[1:], "--point", point])
+    err = capsys.readouterr().err
+    if says is None and argv[0] == "view":  # a checked point, which a static view does not show: said
+        assert code == 2 and "--point goes with --interactive" in _one_line_error(err)
+        return
+    if says is None:
+        assert code == 0, err
+        return
+    line = _one_line_error(err)
+    assert code == 2 and says in line, line
+
+
+def test_draw_says_a_point_it_does_not_draw(tmp_path, capsys):
+    assert main(["draw", str(FOURBAR), "--png", str(tmp_path / "d.png"), "--point", "P=coupler:60mm,0,0"]) == 0
+    assert "note: --point P: a point is drawn as its path, with --trace NAME" in capsys.readouterr().err
+    assert main(["draw", str(FOURBAR), "--png", str(tmp_path / "d.png"), "--point", "P=coupler:60mm,0,0",
+                 "--trace", "P"]) == 0
+    assert "note: --point" not in capsys.readouterr().err

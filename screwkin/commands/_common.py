@@ -15,6 +15,7 @@ from ..analysis.motion.links import Point
 from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
+from ..files.description import LIMITS
 from ..model.state import KinematicState, place_tool, value_for_leg_length
 from ..present.tables import RateUnits
 from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
@@ -22,7 +23,7 @@ from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
-           "typed_unit", "rate_units", "MAX_ANGLE"]
+           "typed_unit", "rate_units", "MAX_ANGLE", "position"]
 
 
 class PointOption(argparse.Action):
@@ -60,9 +61,19 @@ def named_points(mech, args) -> tuple:
             raise UsageError(f"--point: the name {quote(name)} is given twice")
         seen.add(name)
         mech.link_frame(link)  # a clear error for an unknown link
-        local = tuple(parse_value(c, "length", f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
+        local = tuple(position(c, f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
         out.append(Point(name, link, local))
     return tuple(out)
+
+
+def position(text: str, option: str) -> float:
+    """One coordinate of a position typed on the command line [m] (units allowed): finite, and within the
+    LIMITS.length (10 km) a mechanism file's positions are held to (1e308 m gave inf and NaN answers)."""
+    value = parse_value(text, "length", option)
+    if abs(value) > LIMITS.length:
+        raise UsageError(f"{option}: {quote(text, 40)} is beyond {LIMITS.length:g} m, the largest position a mechanism "
+                         "file may hold")
+    return value
 
 
 def add_tool_option(sp):
@@ -77,7 +88,9 @@ def parse_tool(text: str):
     parts = [c for c in text.replace(" ", ",").split(",") if c.strip()]
     if len(parts) not in (3, 6):
         raise UsageError(f"--tool expects x,y,z or x,y,z,roll,pitch,yaw, got {len(parts)} numbers in {quote(text, 80)}")
-    v = [parse_value(c, "length" if k < 3 else "angle", "--tool") for k, c in enumerate(parts)]
+    v = [position(c, "--tool") if k < 3 else parse_value(c, "angle", "--tool") for k, c in enumerate(parts)]
+    if any(abs(x) > MAX_ANGLE for x in v[3:]):
+        raise UsageError(f"--tool {quote(text, 80)}: an angle beyond {MAX_ANGLE:g} rad loses its place in a turn")
     rpy = np.array(v[3:] if len(v) == 6 else [0.0, 0.0, 0.0])
     return pin.SE3(pin.rpy.rpyToMatrix(rpy), np.array(v[:3]))
 

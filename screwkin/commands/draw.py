@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 
 import numpy as np
 
@@ -207,6 +208,10 @@ def run(mech, args) -> int:
         return _animate(mech, args)
     if args.start is not None or args.stop is not None:
         raise UsageError(f"{mech.path}: --from and --to go with --animate OUT.gif")
+    untraced = [p.name for p in named_points(mech, args) if p.name not in (args.trace or ())]
+    if untraced:  # (checked, as every --point is: cli.py)
+        print(f"note: --point {', '.join(untraced)}: a point is drawn as its path, with --trace NAME (or in "
+              "--animate); not drawn here", file=sys.stderr)
     targets = _targets(mech, args)
     if args.chain and args.singular:
         raise UsageError(f"{mech.path}: --chain and --singular are separate drawings; give one of them")
