@@ -23,7 +23,7 @@ from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
-           "typed_unit", "rate_units", "MAX_ANGLE", "position"]
+           "typed_unit", "rate_units", "MAX_ANGLE", "position", "near_values"]
 
 
 class PointOption(argparse.Action):
@@ -316,13 +316,16 @@ def configuration(mech, args):
     modes, a line on stderr says which one is analysed and how to get the others, and ``args.mode_chosen``
     holds {"index": K, "of": N} for the JSON (commands add it as "mode")."""
     values, held, _ = split_inputs(mech, args)
-    near = joint_assignments(mech, [args.near], "--near") if getattr(args, "near", None) else None
+    near = near_values(mech, args)
     wanted = getattr(args, "mode", None)
     args.mode_chosen = None
     if not values and not held:
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
                              "choose among the modes of those inputs")
+        if near:
+            raise UsageError("--near: the file's own configuration is one mode; give --set values to choose the "
+                             "mode of those inputs nearest --near")
         return mech.generic_configurations()[0].q
     res = input_solver(mech, values, held).solve(values, near=near)
     for note in res.notes:  # a --near value the mode found lies far from
@@ -337,6 +340,22 @@ def configuration(mech, args):
         if not getattr(args, "json", False):
             print(f"note: assembly mode {k} of {n} (others: {others}, or --near)", file=sys.stderr)
     return res.solutions[k - 1].q
+
+
+def near_values(mech, args) -> dict | None:
+    """--near NAME=VALUE,...: the configuration whose nearest assembly mode is wanted, as joint values
+    (checked as --set's), every name a moving joint of the mechanism (or a multi-coordinate joint's
+    ``j[qk]``): the one check of every command that takes --near (an unknown name was ignored by draw,
+    export and view).  None when not given."""
+    if not getattr(args, "near", None):
+        return None
+    near = joint_assignments(mech, [args.near], "--near")
+    for name in near:
+        joint, _, k = name[:-1].rpartition("[q") if name.endswith("]") and "[q" in name else (name, "", "")
+        c = mech.coordinate(joint)  # a clear error naming the joints there are
+        if k and not (k.isdigit() and int(k) < c.nq):
+            raise UsageError(f"--near {quote(name, 60)}: joint {quote(joint)} has no coordinate q{k}")
+    return near
 
 
 def with_mode(args, d: dict) -> dict:

@@ -35,9 +35,9 @@ from ._common import (
     configuration,
     input_solver,
     inputs,
-    joint_assignments,
     joint_value,
     named_points,
+    near_values,
     split_inputs,
     with_mode,
 )
@@ -328,7 +328,7 @@ def _animate(mech, args) -> int:
     unit = unit or parse_typed_value(args.stop)[1]
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     solver = input_solver(mech, input_names, held)
     res = sweep(solver, name, start, stop, steps, fixed=fixed, near=near)
     linear = res.unit == "m"

@@ -14,7 +14,7 @@ from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynam
 from ..present.progress import EVERY, Progress
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
-from ._common import joint_assignments, joint_value, named_points, names_list, value_kind
+from ._common import joint_assignments, joint_value, named_points, names_list, near_values, value_kind
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -93,7 +93,7 @@ def _cs(text):
 def run(mech, args) -> int:
     fixed = joint_assignments(mech, args.set, "--set")
     inputs = names_list(args.inputs) or None
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     kind = value_kind(mech, args.input)
     if kind is None:
         mech.coordinate(args.input)  # a clear error for an unknown joint

@@ -62,6 +62,7 @@ from ._common import (
     joint_assignments,
     link_rates,
     named_points,
+    near_values,
     rate_units,
     split_inputs,
     value_kind,
@@ -144,7 +145,7 @@ def run(mech, args) -> int:
     # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
     given, held, pivots = split_inputs(mech, args)
     names = _input_names(mech, args, given)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     q0 = mech.generic_configurations()[0].q
     if args.output:
         mech.link_frame(args.output)

@@ -30,10 +30,10 @@ from ..units import parse_typed_value, unit_kind
 from ._common import (
     add_angle_option,
     input_solver,
-    joint_assignments,
     joint_value,
     named_points,
     names_list,
+    near_values,
     split_inputs,
 )
 from ._options import BOUNDS, count
@@ -167,7 +167,7 @@ def run(mech, args) -> int:
     inputs = names_list(args.inputs) or ([args.input, *(k for k in fixed if k != args.input)] if held else
                                          list(mech.actuated) if args.input in mech.actuated else [args.input, *fixed])
     solver = input_solver(mech, inputs, held)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
