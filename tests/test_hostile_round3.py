@@ -260,3 +260,30 @@ def test_near_without_set_is_refused_as_mode_is(tmp_path, capsys, command):
     argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
     line = _usage(capsys, [argv[0], FOURBAR, *argv[1:], "--near", "crank_joint=1"])
     assert "--near: the file's own configuration is one mode; give --set values" in line
+
+
+@pytest.mark.parametrize("command, says", [
+    (["sweep", "--input", "crank_joint", "--from", "0", "--to", "90deg", "--steps", "3"], "sweep moves it"),
+    (["dynamics", "--input", "crank_joint", "--speed", "10rpm", "--steps", "3"], "dynamics drives it"),
+    (["draw", "--animate", "{o}.gif", "--from", "0", "--to", "1", "--steps", "3"], "--animate moves it"),
+    (["draw", "--animate", "{o}.gif", "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "3"],
+     "--animate moves it"),
+    (["view", "--html", "{o}.html", "--sweep", "crank_joint=0:30deg:5"], "view --sweep moves it"),
+])
+def test_a_set_value_of_the_input_moved_is_a_usage_error(tmp_path, capsys, command, says):
+    """sweep --input X --set X=..., dynamics and draw --animate dropped the value without a word (draw
+    --animate even took the first --set joint as the input to move); view --sweep too."""
+    argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
+    line = _usage(capsys, [argv[0], FOURBAR, *argv[1:], "--set", "crank_joint=0.3"])
+    assert "--set 'crank_joint' (or --set-angle of its link): " + says in line, line
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("command", [["view", "--html", "{o}.html", "--sweep", "crank_joint=0:30mm:5"],
+                                     ["map", "--x", "crank_joint=0:1cm:3", "--y", "rocker_joint=0:1:3"]])
+def test_a_range_in_a_unit_of_the_wrong_kind_is_refused(tmp_path, capsys, command):
+    """view --sweep crank=0:30mm:5 labelled an angle in mm: a range's ends are the joint's values, checked
+    as --set checks them."""
+    argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
+    line = _usage(capsys, [argv[0], FOURBAR, *argv[1:]])
+    assert "'crank_joint' is an angle joint" in line and "is a unit of length" in line, line

@@ -23,7 +23,7 @@ from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
-           "typed_unit", "rate_units", "MAX_ANGLE", "position", "near_values"]
+           "typed_unit", "rate_units", "MAX_ANGLE", "position", "near_values", "moved_not_set"]
 
 
 class PointOption(argparse.Action):
@@ -387,8 +387,10 @@ def rate_units(args) -> RateUnits:
                            [u for _, _, u in parse_typed_assignments(getattr(args, "accel", None), "--accel")])
 
 
-def parse_range(text, option):
-    """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"])."""
+def parse_range(text, option, mech):
+    """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"]), A and B
+    checked as the joint's values (a unit of the other kind, ``crank=0:30mm:5``, is a usage error, as
+    with --set)."""
     name, sep, rest = text.partition("=")
     parts = rest.split(":")
     if not sep or len(parts) != 3:
@@ -397,7 +399,18 @@ def parse_range(text, option):
         n = count("grid")(parts[2])
     except argparse.ArgumentTypeError as exc:
         raise UsageError(f"{option}: N {exc}") from None
-    return name.strip(), np.linspace(parse_value(parts[0]), parse_value(parts[1]), n)
+    name = name.strip()
+    a, b = (joint_value(mech, name, p, f"{option} {quote(name, 60)}") for p in parts[:2])
+    return name, np.linspace(a, b, n)
+
+
+def moved_not_set(values: dict, moved: str, how: str) -> None:
+    """A --set (or --set-angle) value of the input the command moves would be ignored: a usage error
+    naming it (sweep --input X --set X=..., dynamics, draw --animate, view --sweep).  ``how``: what moves
+    it ("sweep moves it from --from to --to")."""
+    if moved in values:
+        raise UsageError(f"--set {quote(moved, 60)} (or --set-angle of its link): {how}, so a value of its own "
+                         "would be ignored; leave it out")
 
 
 def add_common(sp, mechanism: bool = True, optional_file: bool = False):

@@ -36,6 +36,7 @@ from ._common import (
     input_solver,
     inputs,
     joint_value,
+    moved_not_set,
     named_points,
     near_values,
     split_inputs,
@@ -319,13 +320,14 @@ def _animate(mech, args) -> int:
         print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
               "(draw --png/--svg), not in the animation")
     given, held, _ = split_inputs(mech, args)  # a floating link's angle is held along the motion, as in sweep
-    name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
+    name = args.input or (mech.actuated[0] if mech.actuated else None)  # (a --set value is held, never moved)
     if name is None:
         raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")
     unit = parse_typed_value(args.start)[1]
     start = joint_value(mech, name, args.start, "--from")
     stop = joint_value(mech, name, args.stop, "--to")
     unit = unit or parse_typed_value(args.stop)[1]
+    moved_not_set(given, name, "--animate moves it from --from to --to")
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
     near = near_values(mech, args)

@@ -14,7 +14,7 @@ from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynam
 from ..present.progress import EVERY, Progress
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
-from ._common import joint_assignments, joint_value, named_points, names_list, near_values, value_kind
+from ._common import joint_assignments, joint_value, moved_not_set, named_points, names_list, near_values, value_kind
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -92,6 +92,7 @@ def _cs(text):
 
 def run(mech, args) -> int:
     fixed = joint_assignments(mech, args.set, "--set")
+    moved_not_set(fixed, args.input, "dynamics drives it from --from to --to")
     inputs = names_list(args.inputs) or None
     near = near_values(mech, args)
     kind = value_kind(mech, args.input)

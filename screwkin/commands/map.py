@@ -44,8 +44,8 @@ def add_parser(sub, common, scaled):
 
 
 def run(mech, args) -> int:
-    xn, xs = parse_range(args.x, "--x")
-    yn, ys = parse_range(args.y, "--y")
+    xn, xs = parse_range(args.x, "--x", mech)
+    yn, ys = parse_range(args.y, "--y", mech)
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")

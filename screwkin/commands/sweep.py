@@ -31,6 +31,7 @@ from ._common import (
     add_angle_option,
     input_solver,
     joint_value,
+    moved_not_set,
     named_points,
     names_list,
     near_values,
@@ -175,7 +176,8 @@ def run(mech, args) -> int:
     rate = joint_value(mech, args.input, args.rate or "1", "--rate", order=1)
     if args.parquet:
         SweepWriter.require_parquet(args.parquet)  # before any work
-    others = {k: v for k, v in fixed.items() if k != args.input}
+    moved_not_set(fixed, args.input, "sweep moves it from --from to --to")
+    others = dict(fixed)
     if _streamed(args):
         return _run_streamed(mech, args, solver, start, stop, others, near, rate)
     progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only

@@ -27,6 +27,7 @@ from ._common import (
     configuration,
     joint_assignments,
     joint_inputs,
+    moved_not_set,
     named_points,
     parse_range,
     typed_unit,
@@ -91,11 +92,13 @@ def run(mech, args) -> int:
         return _interactive(mech, args)
     if getattr(args, "points", None):
         raise UsageError(f"{mech.path}: --point goes with --interactive (its position is read out there)")
+    if args.sweep:  # (checked before the configuration is solved)
+        name, values = parse_range(args.sweep, "--sweep", mech)
+        fixed = joint_assignments(mech, args.set, "--set")
+        moved_not_set(fixed, name, "view --sweep moves it over its range")
     q = configuration(mech, args)
     motion, singular, frames = None, [], None
     if args.sweep:
-        name, values = parse_range(args.sweep, "--sweep")
-        fixed = {k: v for k, v in joint_assignments(mech, args.set, "--set").items() if k != name}
         inputs = list(mech.actuated) if name in mech.actuated else [name, *fixed]
         solver = PositionSolver(mech, inputs)
         res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed)
