@@ -38,6 +38,7 @@ import pinocchio as pin
 
 from ...errors import MechanismFileError, UsageError, quote
 from ...model._pin import frame_jacobian
+from ...model.geometry import cross3
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
 from .statics import balance, reaction_table
@@ -285,7 +286,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             else:
                 continue
             shaking_f[k] += sign * wrench[:3]
-            shaking_m[k] += sign * (wrench[3:] + np.cross(origin, wrench[:3]))
+            shaking_m[k] += sign * (wrench[3:] + cross3(origin, wrench[:3]))
         T[k] = pin.computeKineticEnergy(model, data, q, v)
         V[k] = pin.computePotentialEnergy(gmodel, data, q)
         P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
