@@ -145,8 +145,8 @@ def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback, progress=No
 def motion_rates(solver, bc, Q, values: dict):
     """Joint rates and accelerations (N, nv) at the closed configurations Q for the input rates
     ``values`` (input accelerations zero): PositionSolver.rates and .accelerations of every row,
-    the constraint Jacobians and the minimum-norm passive solves batched (BatchClosure's rows,
-    the same as ClosureSystem.jacobian's), the bias K' q' Pinocchio's, a configuration at a time."""
+    the constraint Jacobians, the bias K'(q, q') q' and the minimum-norm passive solves batched
+    (BatchClosure's rows, the same as ClosureSystem.jacobian's and .bias's)."""
     mech = solver.mech
     Q = np.atleast_2d(np.asarray(Q, float))
     N, nv = len(Q), mech.nv
@@ -166,6 +166,6 @@ def motion_rates(solver, bc, Q, values: dict):
         return np.einsum("nkp,nk->np", Vt, inv * np.einsum("nmk,nm->nk", U, B))
 
     V[:, pa] = -solve(np.einsum("nmf,nf->nm", K[:, :, fr], V[:, fr]))
-    bias = np.array([mech.closure.bias(q, v) for q, v in zip(Q, V)])
+    bias = bc.bias(Q, V)
     A[:, pa] = solve(-bias)
     return V, A

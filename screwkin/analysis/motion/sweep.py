@@ -544,7 +544,7 @@ def _finish(solver, name, X, Q, rate, stopped, reason, requested, limits, turn, 
     if mech.couplings:
         values = [mech.coupled_values(qq) for qq in Q]
         coupled = {c.joint: np.array([v[c.joint] for v in values]) for c in mech.couplings}
-    return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
+    return SweepResult(name, np.array(X), Qa, mech.joint_value_rows(Qa) if len(Qa) else np.array([]),
                        np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
                        requested, tuple(limits), turn, closed, unit, coupled, tuple(skipped), method, tuple(notes))
 
