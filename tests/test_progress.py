@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import io
 
+import pytest
+
 import screwkin.present.progress as progress_module
 from screwkin.present.progress import Progress
 
@@ -43,3 +45,37 @@ def test_nothing_but_the_final_line_when_not_a_terminal():
     assert plain.getvalue() == ""
     p.finish("done")
     assert plain.getvalue() == "done\n"
+
+
+@pytest.mark.slow  # seconds of work are needed for a line to be drawn
+def test_a_long_streamed_sweep_shows_its_progress_on_a_terminal_only(tmp_path):
+    """A 300,000-step streamed sweep of the MJCF four-bar (batched: several seconds) with stderr a
+    pseudo-terminal draws 'sweep [###...] N/300,000 steps' lines; with stderr a pipe, none."""
+    import os
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    argv = [sys.executable, "-m", "screwkin", "sweep", str(ROOT / "tests" / "data" / "mjcf" / "fourbar.xml"),
+            "--input", "crank_joint", "--from", "0", "--to", "360deg", "--steps", "300000", "--csv",
+            str(tmp_path / "s.csv")]
+    master, slave = os.openpty()
+    p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    seen = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # the terminal's other end closed
+            break
+        if not chunk:
+            break
+        seen += chunk
+    out = p.communicate(timeout=600)[0].decode()
+    os.close(master)
+    assert p.returncode == 0 and "300,001 rows written" in out
+    text = seen.decode()
+    assert "\rsweep [" in text and "/300,000 steps" in text and text.endswith("\r\x1b[K"), text[-300:]
+    plain = subprocess.run(argv, capture_output=True, text=True, timeout=600)
+    assert plain.returncode == 0 and plain.stderr == ""

@@ -36,11 +36,15 @@ def screwkin_version() -> str:
 #: The bounds of the counts people type, (smallest, largest), by what they count.
 BOUNDS = {
     "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest (text, JSON, plots)
-    "streamed_steps": (1, 10_000_000),  # sweep --steps writing --csv/--parquet alone, in chunks (a four-bar: ~10 s a million)
+    # the three below: what finishes in about a minute on the 2 shared cores of the development machine
+    # (measured 2026-11-27, CPU time; wall time about twice under its usual load); long work shows its
+    # progress on a terminal (present/progress.py)
+    "streamed_steps": (1, 2_000_000),  # sweep --steps writing --csv/--parquet alone, in chunks: a million in
+                                       # 6.4 s (a four-bar in closed form), 11.3 s (MJCF four-bar, batched)
     "chunk": (1, 1_000_000),          # sweep --chunk: steps computed and written at a time
-    "dynamics_steps": (1, 20_000),    # dynamics --steps: 1.2 ms a step on a four-bar, 4.5 on a six-bar (90 s at most)
+    "dynamics_steps": (1, 10_000),    # dynamics --steps: 0.85 ms a step on a four-bar, 1.9 on a six-bar
     "figure_steps": (2, 20_000),      # draw --singular / report --steps: a search for singular configurations
-    "animation_steps": (1, 1_000),    # draw --animate --steps: frames drawn (steps + 1), about 0.1 s each
+    "animation_steps": (1, 500),      # draw --animate --steps: frames drawn (steps + 1), 63 ms each
     "starts": (0, 1_000),             # solve / ik / synthesize --starts: random starting configurations
     "iterations": (0, 1_000),         # solve / report --iterations: Newton iterations shown
     "samples": (1, 10_000_000),       # scan --samples (100,000 take about 0.3 s)

@@ -18,6 +18,7 @@ from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
 from ..model.geometry import wrap_angle
 from ..present.animate import animation_format, write_animation
+from ..present.progress import EVERY, Progress
 from ..present.draw import (
     chain_dict,
     draw_chain,
@@ -69,7 +70,7 @@ def add_parser(sub, common, scaled):
                                      "sought (default: a four-bar's rocker, a slider-crank's slider)")
     sp.add_argument("--steps", type=count("figure_steps"), default=None,
                     help="--singular and --trace: steps over the input's range (default 360, at most 20,000); "
-                         "--animate: steps from --from to --to (default 60, at most 1,000)")
+                         "--animate: steps from --from to --to (default 60, at most 500)")
     add_point_option(sp)
     sp.add_argument("--trace", action="append", metavar="NAME",
                     help="draw the path of the --point NAME over a whole turn of the input (or up to its limit "
@@ -358,7 +359,10 @@ def _animate(mech, args) -> int:
     if limit is not None:
         titles[-1] += " (limit position)"
     space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
-    n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space)
+    progress = Progress(label="animate", unit="frame draws (each framed, then drawn)", every=EVERY)  # a terminal
+    n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space,
+                        progress=progress)
+    progress.clear()
     if args.json:
         print(json.dumps(to_jsonable({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
                                       "input": name, "unit": res.unit, "values": values,

@@ -31,7 +31,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--from", dest="start", help="first input value (default 0 for a turning input)")
     sp.add_argument("--to", dest="stop", help="last input value (default 360deg for a turning input)")
     sp.add_argument("--steps", type=count("dynamics_steps"), default=72,
-                    help="number of steps (default 72, at most 20,000)")
+                    help="number of steps (default 72, at most 10,000)")
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
