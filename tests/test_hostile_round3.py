@@ -234,7 +234,7 @@ def test_every_point_is_checked_by_one_parser(tmp_path, capsys, command, point, 
 
 def test_draw_says_a_point_it_does_not_draw(tmp_path, capsys):
     assert main(["draw", str(FOURBAR), "--png", str(tmp_path / "d.png"), "--point", "P=coupler:60mm,0,0"]) == 0
-    assert "note: --point P: a point is drawn as its path, with --trace NAME" in capsys.readouterr().err
+    assert "note: --point 'P': a point is drawn as its path, with --trace NAME" in capsys.readouterr().err
     assert main(["draw", str(FOURBAR), "--png", str(tmp_path / "d.png"), "--point", "P=coupler:60mm,0,0",
                  "--trace", "P"]) == 0
     assert "note: --point" not in capsys.readouterr().err

@@ -456,4 +456,5 @@ def check_rate_names(given: dict | None, inputs, option: str) -> None:
     """A --rate/--accel name that is not an input would be dropped without a word: exit 2 naming it."""
     stray = [n for n in (given or {}) if n not in inputs]
     if stray:
-        raise UsageError(f"{option} {', '.join(stray)}: not an input (inputs: {', '.join(inputs) or 'none'})")
+        raise UsageError(f"{option} {', '.join(shorten(s, 40) for s in stray)}: not an input (inputs: "
+                         f"{', '.join(shorten(i, 40) for i in inputs) or 'none'})")

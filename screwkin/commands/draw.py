@@ -210,10 +210,7 @@ def run(mech, args) -> int:
         return _animate(mech, args)
     if args.start is not None or args.stop is not None:
         raise UsageError(f"{mech.path}: --from and --to go with --animate OUT.gif")
-    untraced = [p.name for p in named_points(mech, args) if p.name not in (args.trace or ())]
-    if untraced:  # (checked, as every --point is: cli.py)
-        print(f"note: --point {', '.join(untraced)}: a point is drawn as its path, with --trace NAME (or in "
-              "--animate); not drawn here", file=sys.stderr)
+    untraced = [p.name for p in named_points(mech, args) if p.name not in (args.trace or ())]  # said at the end
     targets = _targets(mech, args)
     if args.chain and args.singular:
         raise UsageError(f"{mech.path}: --chain and --singular are separate drawings; give one of them")
@@ -292,6 +289,9 @@ def run(mech, args) -> int:
     elif not args.singular:
         for path in written:
             print(f"wrote {path}")
+    if untraced:  # (checked, as every --point is: cli.py)
+        print(f"note: --point {', '.join(quote(n, 40) for n in untraced)}: a point is drawn as its path, with "
+              "--trace NAME (or in --animate); not drawn here", file=sys.stderr)
     return 0
 
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import continuation_steps
 from ..errors import UsageError
 from ..present.outfile import write_output
 from ..present.plots import map_png
@@ -49,6 +50,14 @@ def run(mech, args) -> int:
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")
+    # each grid value is reached from a neighbour by continuation steps of at most Tolerances.max_step: a grid
+    # whose neighbours are far apart (--x motor1=0:1e5rad:3) costs that many steps per point, bounded too
+    per_point = max(continuation_steps(mech, n, v[1] - v[0]) if v.size > 1 and n in {c.joint for c in mech.coordinates}
+                    else 1 for n, v in ((xn, xs), (yn, ys)))
+    if xs.size * ys.size * per_point > BOUNDS["grid_total"][1]:
+        raise UsageError(f"--x and --y: neighbouring values this far apart take {per_point:,} continuation steps each "
+                         f"({xs.size * ys.size * per_point:,} in all, at most {BOUNDS['grid_total'][1]:,}): give a "
+                         "smaller range or more values")
     fixed = joint_assignments(mech, args.set, "--set")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
     output, point = output_frame(mech, args)  # a named --point is the output

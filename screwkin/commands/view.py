@@ -16,7 +16,7 @@ from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep
 from ..present.outfile import write_output
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
-from ..errors import UsageError, quote
+from ..errors import UsageError, quote, shorten
 from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player
 from ..units import in_unit
@@ -159,7 +159,7 @@ def _interactive(mech, args) -> int:
     if given:
         missing = [n for n in names if n not in given]
         if missing:
-            raise UsageError(f"{mech.path}: give every input a starting value with --set (missing: {', '.join(missing)})")
+            raise UsageError(f"{mech.path}: give every input a starting value with --set (missing: {', '.join(shorten(m, 40) for m in missing)})")
         values = given
     live = Interactive(mech, names, values=values, mode=args.mode or 1, output=args.output,
                        points=named_points(mech, args))

@@ -31,13 +31,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from ...errors import AssemblyError, UsageError
+from ...errors import AssemblyError, UsageError, quote, shorten
 from ...model.linalg import null_space
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .dyads import planar_sweep
 from ..singularities.singular import measures
 
-__all__ = ["SweepResult", "SweepSingularity", "sweep", "Neighbour", "CONTINUATION_ROUNDS",
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "Neighbour", "continuation_steps", "CONTINUATION_ROUNDS",
            "drawn_start"]
 
 #: Continuation steps a sweep may take per configuration it records (a bound on its work: a motion that
@@ -224,6 +224,14 @@ class _Tracker:
         return q, self.input_change(qa, q)
 
 
+def continuation_steps(mech, name: str, dx: float) -> int:
+    """How many steps a continuation takes to move input ``name`` by ``dx`` [rad or m]: steps of at most
+    Tolerances.max_step (scaled: characteristic lengths for a sliding input), as the sweep takes them."""
+    c = mech.coordinate(name)
+    scale = mech.length if mech.translational[c.idx_v] else 1.0
+    return int(np.ceil(abs(dx) / (mech.tolerances.max_step * scale)))
+
+
 class Neighbour:
     """One continuation step along input ``name`` of a PositionSolver, from a configuration to
     a nearby input value on the same branch: the sweep's predictor along the curve's tangent,
@@ -239,8 +247,7 @@ class Neighbour:
         direction = np.sign(x_to - x_from)
         if direction == 0:
             return q
-        # in steps of at most Tolerances.max_step (scaled), as the sweep takes them
-        pieces = int(np.ceil(abs(x_to - x_from) / (tr.tol.max_step * tr.scale[tr.ix])))
+        pieces = continuation_steps(tr.mech, tr.name, x_to - x_from)
         try:
             t = tr.tangent(q)
             if t[tr.ix] * direction < 0:
@@ -324,12 +331,12 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
     if name not in solver.inputs:
-        raise UsageError(f"{solver.mech.path}: '{name}' is not one of the inputs ({', '.join(solver.inputs)})")
+        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} is not one of the inputs ({', '.join(shorten(i, 40) for i in solver.inputs)})")
     fixed = dict(fixed or {})
     others = [n for n in solver.inputs if n != name]
     missing = [n for n in others if n not in fixed]
     if missing:
-        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
+        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(shorten(m, 40) for m in missing)}")
     mech = solver.mech
     tr = _Tracker(solver, name)
     max_steps = max_steps or 20 * steps + 100
