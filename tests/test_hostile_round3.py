@@ -249,7 +249,8 @@ def test_near_names_joints_that_exist_for_every_command(tmp_path, capsys, comman
     """--near no_such=1 was refused by solve and ignored by draw, export and view: one check
     (commands/_common.near_values)."""
     argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
-    line = _usage(capsys, [argv[0], FOURBAR, *argv[1:], "--set", "crank_joint=0.5", "--near", "no_such=1"])
+    given = [] if "--input" in argv else ["--set", "crank_joint=0.5"]  # (a moved input takes no --set value)
+    line = _usage(capsys, [argv[0], FOURBAR, *argv[1:], *given, "--near", "no_such=1"])
     assert "no moving joint named 'no_such'" in line, line
     assert not list(tmp_path.iterdir())
 
