@@ -330,3 +330,12 @@ def test_past_a_file_size_limit_the_partial_file_is_removed_and_said(name, tmp_p
                                                           "export-mjcf"}))
 def test_past_a_file_size_limit_every_output(name, tmp_path, study_spec):
     _past_the_size_limit(name, tmp_path, study_spec)
+
+
+def test_a_folder_of_outputs_where_no_folder_can_be_made_is_refused_before_the_work(capsys):
+    """synthesize chains -o /proc/chains was exit 3 (mkdir failed after the enumeration)."""
+    from screwkin.cli import main
+
+    code = main(["synthesize", "chains", "--links", "4", "--dof", "1", "-o", "/proc/screwkin-chains"])
+    line = _single_error(capsys.readouterr().err)
+    assert code == 2 and "cannot write, no folder can be made in '/proc'" in line, line

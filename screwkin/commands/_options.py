@@ -139,6 +139,15 @@ def check_folder_writable(path: str, option: str) -> None:
         raise UsageError(f"{where}: cannot write, the folder {quote(parent, 200)} does not exist")
     if not os.access(path if os.path.isdir(path) else parent, os.W_OK):
         raise UsageError(f"{where}: cannot write, permission denied")
+    if not os.path.lexists(path):  # a folder may exist and take no new folder (/proc): try one
+        try:
+            os.mkdir(path)
+        except FileExistsError:
+            return
+        except OSError as exc:
+            why = os.strerror(exc.errno) if exc.errno else str(exc)
+            raise UsageError(f"{where}: cannot write, no folder can be made in {quote(parent, 200)} ({why})") from None
+        os.rmdir(path)
 
 
 #: Destinations of the files a command reads (the mechanism, its sidecar, a study's or a grasp's spec).

@@ -305,7 +305,10 @@ def _chains(args):
         directory = Path(args.out)
         if directory.exists() and not directory.is_dir():
             raise UsageError(f"-o {quote(str(directory))}: chains are written to a folder, and this is a file")
-        directory.mkdir(parents=True, exist_ok=True)
+        try:
+            directory.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(directory, os_reason(exc)) from None
         files = []
         for c in result.chains:
             for g in c.inversions:
