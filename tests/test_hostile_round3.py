@@ -210,8 +210,8 @@ def test_the_bounds_of_the_coefficient_are_taken(capsys):
 @pytest.mark.parametrize("command", [["solve", "--set", "crank_joint=0.5"], ["draw", "--png", "{o}.png"],
                                      ["dynamics", "--input", "crank_joint", "--speed", "1rpm", "--steps", "3"],
                                      ["view", "--html", "{o}.html"]])
-@pytest.mark.parametrize("point, says", [("P=coupler:1e308,0,0", "is beyond 10000 m"),
-                                         ("P=coupler:0,-10001,0", "is beyond 10000 m"),
+@pytest.mark.parametrize("point, says", [("P=coupler:1e308,0,0", "is beyond the 10000 m a length may have"),
+                                         ("P=coupler:0,-10001,0", "is beyond the 10000 m a length may have"),
                                          ("P=nolink:0,0,0", "no link named 'nolink'"),
                                          ("P=coupler:nan,0,0", "'nan' is not a number"),
                                          ("P=coupler:0,0", None)])
@@ -288,3 +288,35 @@ def test_a_range_in_a_unit_of_the_wrong_kind_is_refused(tmp_path, capsys, comman
     argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
     line = _usage(capsys, [argv[0], FOURBAR, *argv[1:]])
     assert "'crank_joint' is an angle joint" in line and "is a unit of length" in line, line
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["dynamics", FOURBAR, "--input", "crank_joint", "--speed", "1e308rpm"], "beyond the 100000 rad/s an angular rate"),
+    (["dynamics", FOURBAR, "--input", "crank_joint", "--speed", "10rpm", "--gravity", "1e300,0,0"],
+     "beyond the 1e+07 m/s^2 a linear acceleration"),
+    (["dynamics", FOURBAR, "--input", "crank_joint", "--speed", "10rpm", "--load", "coupler:1e308,0,0,0,0,0"],
+     "beyond the 1e+10 N a force"),
+    (["statics", FOURBAR, "--set", "crank_joint=1", "--output", "rocker", "--wrench", "0 0 0 0 0 1e11"],
+     "beyond the 1e+10 N m a moment"),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--rate", "crank_joint=1e300"], "an angular rate"),
+    (["solve", FOURBAR, "--set", "crank_joint=1", "--accel", "crank_joint=1e9"], "an angular acceleration"),
+    (["solve", ROBOTS / "slider_crank_offset.urdf", "--set", "slider_joint=1e308"], "beyond the 10000 m a length"),
+])
+def test_typed_magnitudes_are_bounded_by_their_kind(capsys, argv, says):
+    """--speed 1e308rpm gave NaN efforts, --gravity 1e300 and --load 1e308 inf reactions, and statics
+    --wrench 1e308 an effort of 0, all with exit 0: a value beyond any machine is a usage error naming
+    its kind's bound (units.MAGNITUDES)."""
+    assert says in _usage(capsys, argv)
+
+
+def test_the_length_bound_is_the_files_one():
+    from screwkin.files.description import LIMITS
+    from screwkin.units import MAGNITUDES
+
+    assert MAGNITUDES["length"] == LIMITS.length
+
+
+def test_a_speed_whose_square_underflows_has_no_flywheel(capsys):
+    """--speed 1e-300rpm: omega^2 is 0 in double precision, and dE / (Cs omega^2) was a ZeroDivisionError."""
+    assert main(["dynamics", str(FOURBAR), "--input", "crank_joint", "--speed", "1e-300rpm", "--steps", "8"]) == 0
+    assert "flywheel: not given (at zero speed" in capsys.readouterr().out

@@ -15,10 +15,9 @@ from ..analysis.motion.links import Point
 from ..analysis.motion.planar import LinkAngles
 from ..analysis.motion.position import PositionSolver
 from ..errors import UsageError, quote, shorten
-from ..files.description import LIMITS
 from ..model.state import KinematicState, place_tool, value_for_leg_length
 from ..present.tables import RateUnits
-from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
+from ..units import MAGNITUDES, check_magnitude, parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
@@ -68,12 +67,9 @@ def named_points(mech, args) -> tuple:
 
 def position(text: str, option: str) -> float:
     """One coordinate of a position typed on the command line [m] (units allowed): finite, and within the
-    LIMITS.length (10 km) a mechanism file's positions are held to (1e308 m gave inf and NaN answers)."""
-    value = parse_value(text, "length", option)
-    if abs(value) > LIMITS.length:
-        raise UsageError(f"{option}: {quote(text, 40)} is beyond {LIMITS.length:g} m, the largest position a mechanism "
-                         "file may hold")
-    return value
+    10 km a mechanism file's positions are held to (units.MAGNITUDES, LIMITS.length: 1e308 m gave inf and
+    NaN answers)."""
+    return parse_value(text, "length", option)
 
 
 def add_tool_option(sp):
@@ -173,7 +169,10 @@ _WHAT = {0: "value", 1: "rate", 2: "acceleration"}
 
 #: The largest angle a joint value may have [rad] (15,915 turns): a double's rounding error there is
 #: 1.5e-11 rad, below the closure tolerance; at 1e308 rad nothing of the fraction of a turn is left.
-MAX_ANGLE = 1e5
+MAX_ANGLE = MAGNITUDES["angle"]
+#: The kind (units.MAGNITUDES) of a joint's value (order 0), rate (1) and acceleration (2).
+_MAGNITUDE_KIND = {("angle", 0): "angle", ("angle", 1): "angular rate", ("angle", 2): "angular acceleration",
+                   ("length", 0): "length", ("length", 1): "linear rate", ("length", 2): "linear acceleration"}
 
 
 def _checked(mech, name, value, unit, option, text, order=0, links=()):
@@ -185,6 +184,8 @@ def _checked(mech, name, value, unit, option, text, order=0, links=()):
     if kind and found and found not in _KINDS[kind, order]:
         raise UsageError(f"{option} {text}: {quote(name)} is {what}, "
                          f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
+    if kind and (kind != "angle" or order):  # a length, or a rate or acceleration: bounded by its kind
+        check_magnitude(value, _MAGNITUDE_KIND[kind, order], f"{option} {text}")
     if kind == "angle" and not order and abs(value) > MAX_ANGLE:
         raise UsageError(f"{option} {text}: {value:g} rad is {abs(value) / (2 * math.pi):.4g} turns; beyond "
                          f"{MAX_ANGLE:g} rad an angle's place in its turn is lost to rounding (1e-10 rad)")

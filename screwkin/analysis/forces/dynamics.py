@@ -198,7 +198,7 @@ def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
     mean = work[-1] / x[-1]
     excess = work - mean * x
     de = float(excess.max() - excess.min())
-    if omega == 0:
+    if omega * omega == 0:  # (a speed below 1e-154 rad/s squares to zero in double precision)
         return Flywheel(cs, omega, de, None, "at zero speed no flywheel smooths anything")
     return Flywheel(cs, omega, de, de / (cs * omega**2))
 
