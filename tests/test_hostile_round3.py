@@ -320,3 +320,11 @@ def test_a_speed_whose_square_underflows_has_no_flywheel(capsys):
     """--speed 1e-300rpm: omega^2 is 0 in double precision, and dE / (Cs omega^2) was a ZeroDivisionError."""
     assert main(["dynamics", str(FOURBAR), "--input", "crank_joint", "--speed", "1e-300rpm", "--steps", "8"]) == 0
     assert "flywheel: not given (at zero speed" in capsys.readouterr().out
+
+
+def test_synthesize_draw_is_an_output_checked_like_the_others(tmp_path, capsys):
+    """synthesize -o F --draw F wrote the drawing over the URDF (exit 0): --draw was not among the outputs
+    the up-front check knows."""
+    line = _usage(capsys, ["synthesize", "path", "--points", "0,0; 0.05,0.02; 0.1,0.05; 0.12,0.1; 0.08,0.12",
+                           "--starts", "2", "-o", tmp_path / "d.png", "--draw", tmp_path / "d.png"])
+    assert "--draw" in line and "the same file as --output" in line and not (tmp_path / "d.png").exists()
