@@ -23,7 +23,7 @@ from xml.sax.saxutils import quoteattr
 import pytest
 
 import screwkin
-from conftest import fourbar, planar_3r, screwkin_cli
+from conftest import fourbar, no_hang, planar_3r, screwkin_cli
 
 SCRIPT = "<script>alert(1)</script>"
 IMG = "<img src=x onerror=alert(1)>"
@@ -339,3 +339,49 @@ def test_a_folder_of_outputs_where_no_folder_can_be_made_is_refused_before_the_w
     code = main(["synthesize", "chains", "--links", "4", "--dof", "1", "-o", "/proc/screwkin-chains"])
     line = _single_error(capsys.readouterr().err)
     assert code == 2 and "cannot write, no folder can be made in '/proc'" in line, line
+
+
+def test_a_killed_streamed_sweep_leaves_only_a_file_named_partial(tmp_path):
+    """A process killed on the way (here by a CPU-time limit: SIGXCPU, then SIGKILL) cannot clean up: the
+    streamed CSV is written as out.csv.partial and renamed only once whole, so out.csv never holds half
+    a sweep.  (Found by the directed probes: a killed sweep left a partial out.csv.)"""
+    import resource
+
+    def one_cpu_second():
+        resource.setrlimit(resource.RLIMIT_CPU, (1, 1))
+
+    out = tmp_path / "out.csv"
+    p = subprocess.run([sys.executable, "-m", "screwkin", *_argv(OUTPUTS["sweep-streamed-csv"], tmp_path / "out",
+                                                                 None)[:-4], "--steps", "2000000", "--csv", str(out)],
+                       capture_output=True, text=True, timeout=300, preexec_fn=one_cpu_second)
+    assert p.returncode < 0, (p.returncode, p.stderr[-500:])  # killed by a signal
+    assert not out.exists() and (tmp_path / "out.csv.partial").exists()
+
+
+def test_a_failed_write_leaves_a_file_that_was_there_as_it_was(tmp_path):
+    """The new file is made beside the old one and replaces it once whole: a full disk or a size limit
+    leaves the old output untouched."""
+    out = tmp_path / "out.csv"
+    out.write_text("the old table\n")
+    p = subprocess.run([sys.executable, "-m", "screwkin", *_argv(OUTPUTS["sweep-csv"], tmp_path / "out", None)],
+                       capture_output=True, text=True, timeout=300, preexec_fn=_limited(300))
+    assert p.returncode == 1 and "File too large (the partial file was removed)" in p.stderr
+    assert out.read_text() == "the old table\n" and sorted(q.name for q in tmp_path.iterdir()) == ["out.csv"]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes here")
+def test_a_named_pipe_nothing_reads_is_an_error_not_a_wait(tmp_path, capsys):
+    """Opening a named pipe for writing waits for a reader: with none, screwkin waited for ever.  Opened
+    without waiting, a pipe nothing reads is exit 1 at once; one that is read takes the output."""
+    from screwkin.cli import main
+
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    with no_hang(60):
+        code = main(_argv(OUTPUTS["sweep-csv"], tmp_path / "pipe", None))
+    line = _single_error(capsys.readouterr().err)
+    assert code == 1 and line.endswith("cannot write '" + str(fifo) + "': a named pipe that nothing reads"), line
+    reader = subprocess.Popen(["cat", str(fifo)], stdout=subprocess.PIPE)
+    p = subprocess.run([sys.executable, "-m", "screwkin", *_argv(OUTPUTS["sweep-csv"], tmp_path / "pipe", None)],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0 and reader.communicate(timeout=60)[0].decode().count("\n") == 202  # header + 201 rows

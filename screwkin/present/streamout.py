@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from .outfile import OutputFile, output_failed, remove_partial
+from .outfile import OutputFile
 from .report import sweep_columns, sweep_csv
 
 __all__ = ["SweepWriter", "parquet_available"]
@@ -27,15 +27,15 @@ def parquet_available() -> bool:
 
 
 class SweepWriter:
-    """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written)."""
+    """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written), each through
+    present/outfile.OutputFile: written as PATH.partial and renamed once the sweep is whole."""
 
     def __init__(self, csv: str | None = None, parquet: str | None = None):
         if parquet:
             self.require_parquet(parquet)
         self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
-        self._parquet_path, self._pq = parquet, None
+        self._parquet_path, self._pq, self._pq_file = parquet, None, None
         self.rows = 0
-        self._begun = []  # the paths opened (only those are removed when the sweep is abandoned)
 
     @staticmethod
     def require_parquet(path: str) -> None:
@@ -50,7 +50,6 @@ class SweepWriter:
             if self._csv_path:
                 if self._csv is None:
                     self._csv = OutputFile(self._csv_path)
-                    self._begun.append(self._csv_path)
                 self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
             if self._parquet_path:
                 self._write_parquet(res, motion)
@@ -68,49 +67,39 @@ class SweepWriter:
         arrays = [pa.array(np.arange(self.rows, self.rows + len(res.values), dtype=np.int64))]
         arrays += [pa.array(np.ascontiguousarray(c, dtype=float)) for c in cols]
         table = pa.Table.from_arrays(arrays, names=names)
-        try:
-            if self._pq is None:
-                self._pq = pq.ParquetWriter(self._parquet_path, table.schema)
-                self._begun.append(self._parquet_path)
-            self._pq.write_table(table)
-        except OSError as exc:
-            self._close_parquet()
-            raise output_failed(self._parquet_path, exc) from None
-
-    def _close_parquet(self) -> None:
-        writer, self._pq = self._pq, None
-        if writer is not None:
-            try:
-                writer.close()
-            except OSError:
-                pass
+        if self._pq is None:
+            self._pq_file = OutputFile(self._parquet_path, "wb")
+            self._pq = pq.ParquetWriter(self._pq_file, table.schema)
+        self._pq.write_table(table)  # (a failed write of the file object is its OutputError)
 
     def close(self) -> None:
-        """Finish both files (OutputError when the last bytes cannot be written: the partial files
-        are removed)."""
+        """Finish both files: Parquet's footer written, each renamed to its name (OutputError when the
+        last bytes cannot be written: the partial files are removed)."""
         try:
-            if self._csv is not None:
-                csv, self._csv = self._csv, None
-                csv.close()
             if self._pq is not None:
                 writer, self._pq = self._pq, None
-                try:
-                    writer.close()
-                except OSError as exc:
-                    raise output_failed(self._parquet_path, exc) from None
+                writer.close()
+            for f in (self._pq_file, self._csv):
+                if f is not None:
+                    f.close()
+            self._pq_file = self._csv = None
         except BaseException:
             self.abandon()
             raise
 
     def abandon(self) -> None:
-        """Stop writing and remove the files this writer began (the work failed or was interrupted, or a
-        file could not be written): a sweep is never left half written as if whole."""
-        if self._csv is not None:
-            csv, self._csv = self._csv, None
-            csv.discard()
-        self._close_parquet()
-        for path in self._begun:
-            remove_partial(path)
+        """Stop writing and remove the partial files (the work failed or was interrupted, or a file could
+        not be written): a sweep is never left under its name half written."""
+        writer, self._pq = self._pq, None
+        if writer is not None:
+            try:
+                writer.close()
+            except Exception:  # (its file is discarded below)
+                pass
+        for f in (self._csv, self._pq_file):
+            if f is not None:
+                f.discard()
+        self._csv = self._pq_file = None
 
     def __enter__(self):
         return self
