@@ -12,7 +12,7 @@ import subprocess
 
 import pytest
 
-from conftest import ROBOTS, screwkin_cli
+from conftest import ROBOTS, no_hang, screwkin_cli
 from screwkin.cli import main
 
 FOURBAR = ROBOTS / "fourbar_crank_rocker.urdf"
@@ -328,3 +328,30 @@ def test_synthesize_draw_is_an_output_checked_like_the_others(tmp_path, capsys):
     line = _usage(capsys, ["synthesize", "path", "--points", "0,0; 0.05,0.02; 0.1,0.05; 0.12,0.1; 0.08,0.12",
                            "--starts", "2", "-o", tmp_path / "d.png", "--draw", tmp_path / "d.png"])
     assert "--draw" in line and "the same file as --output" in line and not (tmp_path / "d.png").exists()
+
+
+@pytest.mark.parametrize("argv", [
+    ["view", FOURBAR, "--html", "{o}.html", "--sweep", "crank_joint=0:1e5rad:2000"],
+    ["dynamics", FOURBAR, "--input", "crank_joint", "--speed", "1rpm", "--from", "0", "--to", "1e5rad", "--steps", "10000"],
+    ["sweep", FOURBAR, "--input", "crank_joint", "--from", "-1e5rad", "--to", "1e5rad", "--steps", "3"],
+])
+def test_a_range_the_tracker_would_take_hours_over_is_refused_at_once(tmp_path, capsys, argv):
+    """view --sweep crank=0:1e5rad:2000 and dynamics --to 1e5rad ran past 5 minutes (found by the directed
+    probes): a grid coarser than the tracker's longest step (0.1 rad) makes it walk the whole range,
+    here a million steps.  More than 100,000 (sweep.MAX_TRACKED) is a usage error naming the count:
+    1e5 rad / 0.1 rad = 1,000,000 steps."""
+    with no_hang(30):
+        line = _usage(capsys, [a.replace("{o}", str(tmp_path / "o")) if isinstance(a, str) else a for a in argv])
+    assert "continuation steps" in line and "more than the 100,000 a sweep tracks" in line
+    assert ("1,000,000" in line) or ("2,000,000" in line)
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["workspace", ROBOTS / "five_bar.urdf", "--output", "tip", "--bounds", "0:30deg,-1:1"], "--bounds takes a length"),
+    (["synthesize", "path", "--points", "0,0; 0.05,0.02; 0.1,0.05; 0.12,0.1; 0.08,0.12", "--tolerance", "1e308",
+      "-o", "x.urdf"], "beyond the 10000 m a length"),
+])
+def test_lengths_of_other_options_take_their_kind(tmp_path, monkeypatch, capsys, argv, says):
+    """workspace --bounds 0:30deg and synthesize --tolerance 1e308 were taken as they came (exit 0)."""
+    monkeypatch.chdir(tmp_path)
+    assert says in _usage(capsys, argv)

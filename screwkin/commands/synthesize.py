@@ -288,7 +288,7 @@ def _path(args):
     timing = None
     if args.timing:
         timing = [parse_value(x) for x in args.timing.replace(";", ",").split(",") if x.strip()]
-    tolerance = parse_value(args.tolerance)
+    tolerance = parse_value(args.tolerance, "length", "--tolerance")
     if not tolerance > 0:
         raise UsageError("--tolerance must be a positive length")
     result = synthesize_path(points, timing, args.starts, args.seed, tolerance)

@@ -11,7 +11,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
-from ..errors import UsageError
+from ..errors import UsageError, quote
 from ..present.outfile import write_output
 from ..present.report import to_jsonable
 from ..present.view import ViewerServer, build_scene, screenshot, show
@@ -68,8 +68,8 @@ def _bounds(text):
     for part in text.split(","):
         lo, sep, hi = part.strip().partition(":")
         if not sep:
-            raise UsageError(f"--bounds expects LO:HI ranges separated by commas, got {text!r}")
-        ranges.append((parse_value(lo.strip()), parse_value(hi.strip())))
+            raise UsageError(f"--bounds expects LO:HI ranges separated by commas, got {quote(text, 80)}")
+        ranges.append((parse_value(lo.strip(), "length", "--bounds"), parse_value(hi.strip(), "length", "--bounds")))
     return np.array(ranges)
 
 

@@ -37,12 +37,16 @@ from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .dyads import planar_sweep
 from ..singularities.singular import measures
 
-__all__ = ["SweepResult", "SweepSingularity", "sweep", "Neighbour", "continuation_steps", "CONTINUATION_ROUNDS",
+__all__ = ["SweepResult", "SweepSingularity", "sweep", "Neighbour", "continuation_steps", "CONTINUATION_ROUNDS", "MAX_TRACKED",
            "drawn_start"]
 
 #: Continuation steps a sweep may take per configuration it records (a bound on its work: a motion that
 #: bends too sharply for any step the corrector accepts stops, said so, instead of running on).
 CONTINUATION_ROUNDS = 50
+#: The most continuation steps the per-step tracker is asked for by a grid coarser than its longest step
+#: (Tolerances.max_step): --from 0 --to 1e5rad in 2,000 steps is a million steps of 0.1 rad, hours of
+#: work; 100,000 (what sweep --steps allows) take about half a minute on a four-bar.
+MAX_TRACKED = 100_000
 
 
 @dataclass(frozen=True)
@@ -440,6 +444,11 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         return (turn and forward() and len(X) > 2 and abs(X[-1] - start) < 1e-9 * max(1.0, abs(h))
                 and np.linalg.norm(pin.difference(mech.model, Q[-1], q0) / tr.scale) < 1e-6)
 
+    needed = continuation_steps(mech, name, stop - start)
+    if needed > max(steps, MAX_TRACKED):
+        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} over this range takes {needed:,} continuation steps of at "
+                         f"most {mech.tolerances.max_step:g} (rad or characteristic lengths) between {steps:,} grid "
+                         f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
     if h != 0 and t is not None:
         # the longest step taken (scaled): a grid step, at most Tolerances.max_step -- a coarse grid is
         # followed by shorter steps, so that no step jumps across a bend of the curve to another branch
