@@ -29,7 +29,7 @@ import stat
 
 from ..errors import OutputError
 
-__all__ = ["write_output", "OutputFile", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL"]
+__all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL"]
 
 #: The suffix of a file being written (renamed to its own name once whole).
 PARTIAL = ".partial"
@@ -63,7 +63,21 @@ def output_failed(path, exc: BaseException, partial=None) -> OutputError:
     return OutputError(path, os_reason(exc), remove_partial(str(partial or path)))
 
 
-class OutputFile:
+class WholeOrNothing:
+    """A writer used in a ``with`` block: ``close()`` when the block ends, ``discard()`` (nothing left
+    under the name asked for) when it raises."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if kind is None:
+            self.close()
+        else:
+            self.discard()
+
+
+class OutputFile(WholeOrNothing):
     """A file written piece by piece: ``write(data)`` and ``close()``, as a context manager (see the
     module: a regular file is written as PATH.partial and renamed once whole).  Opening, writing or
     closing it fails with OutputError (the partial file removed); leaving the ``with`` block on any
@@ -147,15 +161,6 @@ class OutputFile:
             self._drop()
             if self._partial:
                 remove_partial(self._partial)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, kind, exc, tb):
-        if kind is None:
-            self.close()
-        else:
-            self.discard()
 
 
 def write_output(path, data) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
-from .outfile import OutputFile
+from .outfile import OutputFile, WholeOrNothing
 from .report import sweep_columns, sweep_csv
 
 __all__ = ["SweepWriter", "parquet_available"]
@@ -26,7 +26,7 @@ def parquet_available() -> bool:
     return True
 
 
-class SweepWriter:
+class SweepWriter(WholeOrNothing):
     """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written), each through
     present/outfile.OutputFile: written as PATH.partial and renamed once the sweep is whole."""
 
@@ -54,7 +54,7 @@ class SweepWriter:
             if self._parquet_path:
                 self._write_parquet(res, motion)
         except BaseException:
-            self.abandon()
+            self.discard()
             raise
         self.rows += len(res.values)
 
@@ -84,10 +84,10 @@ class SweepWriter:
                     f.close()
             self._pq_file = self._csv = None
         except BaseException:
-            self.abandon()
+            self.discard()
             raise
 
-    def abandon(self) -> None:
+    def discard(self) -> None:
         """Stop writing and remove the partial files (the work failed or was interrupted, or a file could
         not be written): a sweep is never left under its name half written."""
         writer, self._pq = self._pq, None
@@ -100,12 +100,3 @@ class SweepWriter:
             if f is not None:
                 f.discard()
         self._csv = self._pq_file = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, kind, exc, tb):
-        if kind is None:
-            self.close()
-        else:
-            self.abandon()
