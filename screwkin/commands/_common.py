@@ -22,7 +22,7 @@ from ._options import count
 
 __all__ = ["with_mode", "check_rate_names", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
-           "typed_unit", "rate_units", "MAX_ANGLE", "position", "near_values", "moved_not_set"]
+           "typed_unit", "rate_units", "MAX_ANGLE", "near_values", "moved_not_set"]
 
 
 class PointOption(argparse.Action):
@@ -60,16 +60,10 @@ def named_points(mech, args) -> tuple:
             raise UsageError(f"--point: the name {quote(name)} is given twice")
         seen.add(name)
         mech.link_frame(link)  # a clear error for an unknown link
-        local = tuple(position(c, f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
+        # each coordinate a length within units.MAGNITUDES (10 km, a file's positions: 1e308 m gave inf answers)
+        local = tuple(parse_value(c, "length", f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
         out.append(Point(name, link, local))
     return tuple(out)
-
-
-def position(text: str, option: str) -> float:
-    """One coordinate of a position typed on the command line [m] (units allowed): finite, and within the
-    10 km a mechanism file's positions are held to (units.MAGNITUDES, LIMITS.length: 1e308 m gave inf and
-    NaN answers)."""
-    return parse_value(text, "length", option)
 
 
 def add_tool_option(sp):
@@ -84,9 +78,7 @@ def parse_tool(text: str):
     parts = [c for c in text.replace(" ", ",").split(",") if c.strip()]
     if len(parts) not in (3, 6):
         raise UsageError(f"--tool expects x,y,z or x,y,z,roll,pitch,yaw, got {len(parts)} numbers in {quote(text, 80)}")
-    v = [position(c, "--tool") if k < 3 else parse_value(c, "angle", "--tool") for k, c in enumerate(parts)]
-    if any(abs(x) > MAX_ANGLE for x in v[3:]):
-        raise UsageError(f"--tool {quote(text, 80)}: an angle beyond {MAX_ANGLE:g} rad loses its place in a turn")
+    v = [parse_value(c, "length" if k < 3 else "angle", "--tool") for k, c in enumerate(parts)]  # (bounded by kind)
     rpy = np.array(v[3:] if len(v) == 6 else [0.0, 0.0, 0.0])
     return pin.SE3(pin.rpy.rpyToMatrix(rpy), np.array(v[:3]))
 
