@@ -199,7 +199,7 @@ def check_outputs(parser, args) -> None:
     outputs = []
     for action in parser._actions:
         if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
-            if getattr(args, "kind", None) == "chains":  # synthesize chains writes into a folder (made if missing)
+            if getattr(args, "kind", None) == "chains" and action.dest == "out":  # synthesize chains -o: a folder
                 check_folder_writable(getattr(args, action.dest), _option_name(action))
                 continue
             check_writable(getattr(args, action.dest), _option_name(action))
