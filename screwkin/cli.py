@@ -20,7 +20,7 @@ import warnings
 
 import numpy as np
 
-from .commands._common import add_common, add_scaled, names_list
+from .commands._common import add_common, add_scaled, named_points, names_list
 from .commands._options import check_parsed, screwkin_version
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
@@ -124,6 +124,8 @@ def _run(args):
         mech.length = parse_length(args.length, "--length")
     if isinstance(getattr(args, "output", None), str):  # every command's output link exists (sweep, draw...)
         mech.link_frame(args.output)
+    if getattr(args, "points", None):  # every --point NAME=LINK:x,y,z checked, whatever the command does with it
+        named_points(mech, args)
     return command.run(mech, args)
 
 

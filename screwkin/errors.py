@@ -19,6 +19,7 @@ __all__ = [
     "UsageError",
     "MechanismFileError",
     "AssemblyError",
+    "OutputError",
     "QUOTE_LIMIT",
     "MESSAGE_LIMIT",
     "quote",
@@ -138,3 +139,15 @@ class AssemblyError(MechanismFileError):
         if detail:
             msg += f" ({detail})"
         super().__init__(path, msg)
+
+
+class OutputError(ScrewkinError):
+    """An output file could not be written after the work was done (a full disk, a file-size limit,
+    a folder where no file can be made): ``path``, the operating system's ``reason``, and what
+    became of a partial file (``partial``: "removed", or None when nothing was left).  Exit 1:
+    the command line was right, the place it named could not take the file."""
+
+    def __init__(self, path, reason: str, partial: str | None = None):
+        self.path, self.reason, self.partial = str(path), str(reason), partial
+        tail = f" (the partial file was {partial})" if partial else ""
+        super().__init__(f"cannot write {quote(self.path, 200)}: {reason}{tail}")

@@ -34,7 +34,7 @@ import re
 from .errors import UsageError, quote
 
 __all__ = ["parse_value", "in_unit", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "UNIT_TABLE",
-           "unit_kind", "LENGTH_RANGE"]
+           "unit_kind", "LENGTH_RANGE", "MAGNITUDES", "check_magnitude"]
 
 _DEG = math.pi / 180.0
 _TURN = 2 * math.pi
@@ -83,6 +83,28 @@ def _canonical(unit: str):
     return u
 
 
+#: The largest magnitude a value of each kind may have [SI]: beyond any machine, and small enough that the
+#: squares and products the analyses form stay finite (--gravity 1e300 gave inf reactions, --speed 1e308rpm
+#: NaN efforts, --wrench 1e308 an effort of 0).  A length is held to a mechanism file's positions
+#: (files/description.LIMITS.length, 10 km); an angle to 1e5 rad (15,915 turns: beyond it a double keeps no
+#: place in a turn); a rate to 1e5 rad/s (955,000 rpm) or 1e4 m/s; an acceleration to 1e8 rad/s^2 or
+#: 1e7 m/s^2 (a million g); a force to 1e10 N and a moment to 1e10 N m (a million tonnes' weight).
+MAGNITUDES = {"length": 1e4, "angle": 1e5, "angular rate": 1e5, "linear rate": 1e4, "angular acceleration": 1e8,
+              "linear acceleration": 1e7, "force": 1e10, "moment": 1e10}
+_SI = {"length": "m", "angle": "rad", "angular rate": "rad/s", "linear rate": "m/s", "angular acceleration": "rad/s^2",
+       "linear acceleration": "m/s^2", "force": "N", "moment": "N m"}
+
+
+def check_magnitude(value: float, kind: str, what: str) -> float:
+    """``value`` [SI] when its magnitude is within MAGNITUDES[kind]; a usage error naming ``what`` otherwise."""
+    bound = MAGNITUDES.get(kind)
+    if bound is not None and abs(value) > bound:
+        article = "an" if kind[0] in "aeiou" else "a"
+        raise UsageError(f"{what}: {value:g} {_SI[kind]} is beyond the {bound:g} {_SI[kind]} {article} {kind} may have "
+                         "here")
+    return value
+
+
 def unit_kind(unit: str):
     """The kind of a unit ('angle', 'length', 'angular rate', ...), or None for a bare number."""
     if not unit:
@@ -105,7 +127,7 @@ def _unit(text: str):
 def parse_value(text: str, kind: str | None = None, option: str | None = None) -> float:
     """A number with an optional unit suffix, in SI units.  With ``kind`` ('angle' or
     'length'), a unit of the other kind is a usage error naming ``option``
-    (``--length 90deg`` is not 1.571 m)."""
+    (``--length 90deg`` is not 1.571 m), and a magnitude beyond MAGNITUDES[kind] another."""
     m = _NUMBER.match(text)
     if not m:
         raise UsageError(f"{quote(text)} is not a number with an optional unit (e.g. 45deg, 30mm, 1in, 0.5)")
@@ -122,6 +144,8 @@ def parse_value(text: str, kind: str | None = None, option: str | None = None) -
         where = f"{option} " if option else ""
         raise UsageError(f"{where}{quote(text)}: {m.group(2)} is a unit of {found}, {where.strip() or 'this value'} "
                          f"takes {'an' if kind[0] in 'aeiou' else 'a'} {kind}")
+    if kind is not None:
+        check_magnitude(value, kind, f"{option} {quote(text, 40)}" if option else quote(text, 40))
     return value
 
 

@@ -100,7 +100,7 @@ def test_an_mp4_without_imageio_ffmpeg_is_a_usage_error(tmp_path, capsys, monkey
 @pytest.mark.parametrize("args, message", [
     (["--animate", "a.png", "--from", "0", "--to", "1"], "ending in .gif or .mp4"),
     (["--animate", "a.gif", "--from", "0"], "--from A and --to B"),
-    (["--animate", "a.gif", "--from", "0", "--to", "1", "--steps", "5000"], "from 1 to 1,000"),
+    (["--animate", "a.gif", "--from", "0", "--to", "1", "--steps", "5000"], "from 1 to 500"),
     (["--animate", "a.gif", "--from", "0", "--to", "1", "--fps", "500"], "from 1 to 60"),
     (["--animate", "a.gif", "--from", "0", "--to", "1", "--png", "a.png"], "one animation"),
     (["--png", "a.png", "--from", "0"], "--from and --to go with --animate"),

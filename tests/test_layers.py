@@ -130,12 +130,35 @@ def test_no_function_imports_a_screwkin_module_or_a_common_library():
 def test_analysis_results_do_not_format_themselves():
     """Results are plain data: the text, JSON and CSV forms live in screwkin/present/."""
     bad = []
-    for path in (PACKAGE / "analysis").glob("*.py"):
+    for path in (PACKAGE / "analysis").rglob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.ClassDef):
                 for item in node.body:
                     if isinstance(item, ast.FunctionDef) and item.name in ("to_dict", "to_json", "csv", "png", "text"):
                         bad.append(f"{path.name}: {node.name}.{item.name}")
     assert not bad, bad
+
+
+def test_analysis_never_prints():
+    """Nothing in screwkin/analysis/ (every subfolder) prints or writes to the terminal: results are
+    returned, and long work reports its progress through a callable the caller gives
+    (present/progress.Progress draws it).  A call of print, or any use of sys.stdout/sys.stderr."""
+    bad = []
+    for path in (PACKAGE / "analysis").rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "print":
+                bad.append(f"{path.relative_to(PACKAGE)}:{node.lineno} print()")
+            if (isinstance(node, ast.Attribute) and node.attr in ("stdout", "stderr")
+                    and isinstance(node.value, ast.Name) and node.value.id == "sys"):
+                bad.append(f"{path.relative_to(PACKAGE)}:{node.lineno} sys.{node.attr}")
+    assert not bad, bad
+
+
+def test_the_walks_reach_every_subfolder():
+    """The checks above walk analysis/'s subfolders (rglob): a glob of the top folder alone saw 3 of its
+    modules.  Every module of analysis/ is in the import graph too."""
+    modules = sorted(p for p in (PACKAGE / "analysis").rglob("*.py") if p.name != "__init__.py")
+    assert len(modules) > len(list((PACKAGE / "analysis").glob("*.py"))) + 20
+    assert all(module_name(p) in GRAPH for p in modules)
 
 

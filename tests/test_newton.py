@@ -135,6 +135,23 @@ def test_batched_rows_equal_the_closure_systems(name):
     del rng
 
 
+@pytest.mark.parametrize("name", BATCHABLE + ["gear_train_idler.urdf", "tsai_3upu.urdf"])
+def test_batched_bias_is_the_second_derivative_of_the_rows(name):
+    """BatchClosure.bias (a sweep's K'(q, v) v, all its configurations at once) against a central finite
+    difference of the closure rows along q(t) = integrate(q, v t) at closed configurations,
+    (r(q + v h) - 2 r(q) + r(q - v h)) / h^2, and against ClosureSystem.bias (Pinocchio's, one at a time)."""
+    mech = screwkin.load(ROBOTS / name)
+    bc = BatchClosure(mech)
+    closed = np.array(mech.generic_configurations()[1])
+    V = np.random.default_rng(7).normal(size=(len(closed), mech.nv))
+    B = bc.bias(closed, V)
+    h = 1e-4
+    for q, v, b in zip(closed, V, B):
+        rows = [mech.closure.evaluate(pin.integrate(mech.model, q, s * h * v), False)[0] for s in (1, 0, -1)]
+        np.testing.assert_allclose(b, (rows[0] - 2 * rows[1] + rows[2]) / h**2, rtol=0, atol=2e-5 * max(1, abs(b).max()))
+        np.testing.assert_allclose(b, mech.closure.bias(q, v), rtol=0, atol=1e-10)
+
+
 @pytest.mark.parametrize("name", ["five_bar.urdf", "gough_stewart_6ups.urdf"])
 def test_batched_solver_reaches_the_single_solvers_configurations(name):
     """From the same perturbed starts, both solvers take the same steps and land on the same

@@ -19,12 +19,12 @@ from ..errors import UsageError, quote, shorten
 from ..model.state import KinematicState, place_tool, value_for_leg_length
 from ..model.topology import open_joints
 from ..present.tables import RateUnits
-from ..units import parse_typed_assignments, parse_typed_value, parse_value, unit_kind
+from ..units import MAGNITUDES, check_magnitude, parse_typed_assignments, parse_typed_value, parse_value, unit_kind
 from ._options import count
 
 __all__ = ["with_mode", "mode_line", "file_configuration_line", "check_rate_names", "rate_items", "names_list", "parse_range", "add_common", "add_scaled", "emit", "add_length_option", "PointOption", "add_point_option", "named_points", "inputs", "split_inputs", "joint_inputs", "input_solver", "link_rates", "configuration", "add_configuration_options", "add_mode_option", "add_angle_option", "joint_assignments",
            "joint_value", "value_kind", "add_tool_option", "parse_tool", "output_frame", "output_frame_dict", "output_frame_line",
-           "typed_unit", "rate_units", "MAX_ANGLE"]
+           "typed_unit", "rate_units", "MAX_ANGLE", "near_values", "moved_not_set"]
 
 
 class PointOption(argparse.Action):
@@ -62,6 +62,7 @@ def named_points(mech, args) -> tuple:
             raise UsageError(f"--point: the name {quote(name)} is given twice")
         seen.add(name)
         mech.link_frame(link)  # a clear error for an unknown link
+        # each coordinate a length within units.MAGNITUDES (10 km, a file's positions: 1e308 m gave inf answers)
         local = tuple(parse_value(c, "length", f"--point {name}") for c in parts) + ((0.0,) if len(parts) == 2 else ())
         out.append(Point(name, link, local))
     return tuple(out)
@@ -79,7 +80,7 @@ def parse_tool(text: str):
     parts = [c for c in text.replace(" ", ",").split(",") if c.strip()]
     if len(parts) not in (3, 6):
         raise UsageError(f"--tool expects x,y,z or x,y,z,roll,pitch,yaw, got {len(parts)} numbers in {quote(text, 80)}")
-    v = [parse_value(c, "length" if k < 3 else "angle", "--tool") for k, c in enumerate(parts)]
+    v = [parse_value(c, "length" if k < 3 else "angle", "--tool") for k, c in enumerate(parts)]  # (bounded by kind)
     rpy = np.array(v[3:] if len(v) == 6 else [0.0, 0.0, 0.0])
     return pin.SE3(pin.rpy.rpyToMatrix(rpy), np.array(v[:3]))
 
@@ -162,7 +163,10 @@ _WHAT = {0: "value", 1: "rate", 2: "acceleration"}
 
 #: The largest angle a joint value may have [rad] (15,915 turns): a double's rounding error there is
 #: 1.5e-11 rad, below the closure tolerance; at 1e308 rad nothing of the fraction of a turn is left.
-MAX_ANGLE = 1e5
+MAX_ANGLE = MAGNITUDES["angle"]
+#: The kind (units.MAGNITUDES) of a joint's value (order 0), rate (1) and acceleration (2).
+_MAGNITUDE_KIND = {("angle", 0): "angle", ("angle", 1): "angular rate", ("angle", 2): "angular acceleration",
+                   ("length", 0): "length", ("length", 1): "linear rate", ("length", 2): "linear acceleration"}
 
 
 def _checked(mech, name, value, unit, option, text, order=0, links=()):
@@ -174,6 +178,8 @@ def _checked(mech, name, value, unit, option, text, order=0, links=()):
     if kind and found and found not in _KINDS[kind, order]:
         raise UsageError(f"{option} {text}: {quote(name)} is {what}, "
                          f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
+    if kind and (kind != "angle" or order):  # a length, or a rate or acceleration: bounded by its kind
+        check_magnitude(value, _MAGNITUDE_KIND[kind, order], f"{option} {text}")
     if kind == "angle" and not order and abs(value) > MAX_ANGLE:
         raise UsageError(f"{option} {text}: {value:g} rad is {abs(value) / (2 * math.pi):.4g} turns; beyond "
                          f"{MAX_ANGLE:g} rad an angle's place in its turn is lost to rounding (1e-10 rad)")
@@ -327,13 +333,16 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     given): the configuration returned is the mode its motion starts from."""
     values, held, _ = split_inputs(mech, args)
     values.update(moved or {})
-    near = joint_assignments(mech, [args.near], "--near") if getattr(args, "near", None) else None
+    near = near_values(mech, args)
     wanted = getattr(args, "mode", None)
     args.mode_chosen = None
     if not values and not held:
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
                              "choose among the modes of those inputs")
+        if near:
+            raise UsageError("--near: the file's own configuration is one mode; give --set values to choose the "
+                             "mode of those inputs nearest --near")
         q = mech.generic_configurations()[0].q
         print(f"note: {file_configuration_line(mech, q)}", file=sys.stderr)
         return q
@@ -371,6 +380,22 @@ def file_configuration_line(mech, q) -> str:
             + "; --set NAME=VALUE to choose another")
 
 
+def near_values(mech, args) -> dict | None:
+    """--near NAME=VALUE,...: the configuration whose nearest assembly mode is wanted, as joint values
+    (checked as --set's), every name a moving joint of the mechanism (or a multi-coordinate joint's
+    ``j[qk]``): the one check of every command that takes --near (an unknown name was ignored by draw,
+    export and view).  None when not given."""
+    if not getattr(args, "near", None):
+        return None
+    near = joint_assignments(mech, [args.near], "--near")
+    for name in near:
+        joint, _, k = name[:-1].rpartition("[q") if name.endswith("]") and "[q" in name else (name, "", "")
+        c = mech.coordinate(joint)  # a clear error naming the joints there are
+        if k and not (k.isdigit() and int(k) < c.nq):
+            raise UsageError(f"--near {quote(name, 60)}: joint {quote(joint)} has no coordinate q{k}")
+    return near
+
+
 def with_mode(args, d: dict) -> dict:
     """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes."""
     if getattr(args, "mode_chosen", None):
@@ -400,8 +425,10 @@ def rate_units(args) -> RateUnits:
                            [u for _, _, u in parse_typed_assignments(getattr(args, "accel", None), "--accel")])
 
 
-def parse_range(text, option):
-    """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"])."""
+def parse_range(text, option, mech):
+    """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"]), A and B
+    checked as the joint's values (a unit of the other kind, ``crank=0:30mm:5``, is a usage error, as
+    with --set)."""
     name, sep, rest = text.partition("=")
     parts = rest.split(":")
     if not sep or len(parts) != 3:
@@ -410,7 +437,18 @@ def parse_range(text, option):
         n = count("grid")(parts[2])
     except argparse.ArgumentTypeError as exc:
         raise UsageError(f"{option}: N {exc}") from None
-    return name.strip(), np.linspace(parse_value(parts[0]), parse_value(parts[1]), n)
+    name = name.strip()
+    a, b = (joint_value(mech, name, p, f"{option} {quote(name, 60)}") for p in parts[:2])
+    return name, np.linspace(a, b, n)
+
+
+def moved_not_set(values: dict, moved: str, how: str) -> None:
+    """A --set (or --set-angle) value of the input the command moves would be ignored: a usage error
+    naming it (sweep --input X --set X=..., dynamics, draw --animate, view --sweep).  ``how``: what moves
+    it ("sweep moves it from --from to --to")."""
+    if moved in values:
+        raise UsageError(f"--set {quote(moved, 60)} (or --set-angle of its link): {how}, so a value of its own "
+                         "would be ignored; leave it out")
 
 
 def add_common(sp, mechanism: bool = True, optional_file: bool = False):
@@ -471,4 +509,5 @@ def check_rate_names(given: dict | None, inputs, option: str) -> None:
     """A --rate/--accel name that is not an input would be dropped without a word: exit 2 naming it."""
     stray = [n for n in (given or {}) if n not in inputs]
     if stray:
-        raise UsageError(f"{option} {', '.join(stray)}: not an input (inputs: {', '.join(inputs) or 'none'})")
+        raise UsageError(f"{option} {', '.join(shorten(s, 40) for s in stray)}: not an input (inputs: "
+                         f"{', '.join(shorten(i, 40) for i in inputs) or 'none'})")

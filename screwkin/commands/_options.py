@@ -9,8 +9,9 @@
   as "not given").
 * **Outputs can be written.** Every file a command will write (``--csv``,
   ``--png``, ``--svg``, ``--plot``, ``--html``, ``--md``, ``-o`` ...) is checked
-  before the work starts: its folder exists and is writable and the path is not
-  a folder.
+  before the work starts: its folder exists and is writable (a new file is
+  tried there), the path is not a folder, and it is neither a file the command
+  reads nor another output's file.
 """
 
 from __future__ import annotations
@@ -35,11 +36,15 @@ def screwkin_version() -> str:
 #: The bounds of the counts people type, (smallest, largest), by what they count.
 BOUNDS = {
     "steps": (1, 100_000),            # sweep --steps: about 30 s of tracking at the largest (text, JSON, plots)
-    "streamed_steps": (1, 10_000_000),  # sweep --steps writing --csv/--parquet alone, in chunks (a four-bar: ~10 s a million)
+    # the three below: what finishes in about a minute on the 2 shared cores of the development machine
+    # (measured 2026-11-27, CPU time; wall time about twice under its usual load); long work shows its
+    # progress on a terminal (present/progress.py)
+    "streamed_steps": (1, 2_000_000),  # sweep --steps writing --csv/--parquet alone, in chunks: a million in
+                                       # 6.4 s (a four-bar in closed form), 11.3 s (MJCF four-bar, batched)
     "chunk": (1, 1_000_000),          # sweep --chunk: steps computed and written at a time
-    "dynamics_steps": (1, 20_000),    # dynamics --steps: 1.2 ms a step on a four-bar, 4.5 on a six-bar (90 s at most)
+    "dynamics_steps": (1, 10_000),    # dynamics --steps: 0.85 ms a step on a four-bar, 1.9 on a six-bar
     "figure_steps": (2, 20_000),      # draw --singular / report --steps: a search for singular configurations
-    "animation_steps": (1, 1_000),    # draw --animate --steps: frames drawn (steps + 1), about 0.1 s each
+    "animation_steps": (1, 500),      # draw --animate --steps: frames drawn (steps + 1), 63 ms each
     "starts": (0, 1_000),             # solve / ik / synthesize --starts: random starting configurations
     "iterations": (0, 1_000),         # solve / report --iterations: Newton iterations shown
     "samples": (1, 10_000_000),       # scan --samples (100,000 take about 0.3 s)
@@ -55,7 +60,8 @@ BOUNDS = {
     "workers": (0, 64),               # study / synthesize --workers: processes of the local cluster
     "best": (1, 50),                  # synthesize --best: designs listed
     "generations": (1, 10_000),       # synthesize --generations: of each differential-evolution run
-    "workspace_samples": (1, 5_000_000),  # workspace --method sampling --samples
+    "workspace_samples": (1, 2_000_000),  # workspace --method sampling --samples: a 6R arm's 5,000,000 took 64 s
+                                          # (CPU) and 870 MB, 2,000,000 about 26 s
 }
 #: The bounds of the durations people type [s], (smallest, largest).
 SECONDS = {"timeout": (0.1, 3600.0), "design_timeout": (0.1, 86400.0)}
@@ -96,7 +102,8 @@ def count(what: str):
 
 
 #: Destinations of options that name a file a command writes (or a prefix of such files).
-OUTPUT_DESTS = ("csv", "parquet", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate", "mjcf", "urdf")
+OUTPUT_DESTS = ("csv", "parquet", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate", "mjcf", "urdf",
+                "draw")
 
 
 def _option_name(action) -> str:
@@ -114,6 +121,16 @@ def check_writable(path: str, option: str) -> None:
         raise UsageError(f"{where}: cannot write, the folder {quote(folder, 200)} does not exist")
     if not os.access(folder, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
         raise UsageError(f"{where}: cannot write, permission denied")
+    if not os.path.lexists(path):  # a folder may exist and take no file (/proc, a read-only mount): try one
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        except FileExistsError:  # made meanwhile: it is checked when written
+            return
+        except OSError as exc:
+            why = os.strerror(exc.errno) if exc.errno else str(exc)
+            raise UsageError(f"{where}: cannot write, no file can be made in {quote(folder, 200)} ({why})") from None
+        os.close(fd)
+        os.remove(path)
 
 
 def check_folder_writable(path: str, option: str) -> None:
@@ -126,16 +143,70 @@ def check_folder_writable(path: str, option: str) -> None:
         raise UsageError(f"{where}: cannot write, the folder {quote(parent, 200)} does not exist")
     if not os.access(path if os.path.isdir(path) else parent, os.W_OK):
         raise UsageError(f"{where}: cannot write, permission denied")
+    if not os.path.lexists(path):  # a folder may exist and take no new folder (/proc): try one
+        try:
+            os.mkdir(path)
+        except FileExistsError:
+            return
+        except OSError as exc:
+            why = os.strerror(exc.errno) if exc.errno else str(exc)
+            raise UsageError(f"{where}: cannot write, no folder can be made in {quote(parent, 200)} ({why})") from None
+        os.rmdir(path)
+
+
+#: Destinations of the files a command reads (the mechanism, its sidecar, a study's or a grasp's spec).
+INPUT_DESTS = ("file", "yaml", "spec")
+
+
+def _same_file(a: str, b: str) -> bool:
+    """Whether paths ``a`` and ``b`` name one file: the same path once links and ``..`` are resolved, or
+    one file under two names (hard links)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist yet: different files
+        return False
+
+
+def _overwritten(args, outputs) -> None:
+    """Refuse an output that would overwrite a file the command reads (the mechanism file, its sidecar
+    given or found beside it, a spec) or another output of the same command line.  A device or a pipe
+    (/dev/null, /dev/stdout) is written, not overwritten: it may take several outputs."""
+    inputs = [(f"the file read ({quote(getattr(args, d), 200)})", getattr(args, d)) for d in INPUT_DESTS
+              if isinstance(getattr(args, d, None), str) and getattr(args, d)]
+    mechanism = getattr(args, "file", None)
+    if isinstance(mechanism, str) and mechanism and getattr(args, "yaml", None) is None:
+        for suffix in (".yaml", ".yml"):  # the sidecar read beside the file (model/loader._find_sidecar)
+            side = os.path.splitext(mechanism)[0] + suffix
+            if os.path.isfile(side):
+                inputs.append((f"the sidecar read beside it ({quote(side, 200)})", side))
+    seen = []
+    for option, path in outputs:
+        if os.path.exists(path) and not os.path.isfile(path):
+            continue
+        for what, other in inputs:
+            if _same_file(path, other):
+                raise UsageError(f"{option} {quote(path, 200)}: is {what}: it would be overwritten; write elsewhere")
+        for first, other in seen:
+            if _same_file(path, other):
+                raise UsageError(f"{option} {quote(path, 200)}: the same file as {first} {quote(other, 200)}: "
+                                 "give each output a file of its own")
+        seen.append((option, path))
 
 
 def check_outputs(parser, args) -> None:
-    """Refuse, before any work, an output file whose folder is missing or not writable, or that is a folder."""
+    """Refuse, before any work, an output file whose folder is missing or not writable, that is a folder,
+    that is a file the command reads, or that another output of the command line names too."""
+    outputs = []
     for action in parser._actions:
         if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
-            if getattr(args, "kind", None) == "chains":  # synthesize chains writes into a folder (made if missing)
+            if getattr(args, "kind", None) == "chains" and action.dest == "out":  # synthesize chains -o: a folder
                 check_folder_writable(getattr(args, action.dest), _option_name(action))
                 continue
             check_writable(getattr(args, action.dest), _option_name(action))
+            outputs.append((_option_name(action), getattr(args, action.dest)))
+    _overwritten(args, outputs)
 
 
 def check_parsed(parser, args) -> None:

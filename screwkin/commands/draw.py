@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
 from ..model.geometry import wrap_angle
 from ..present.animate import animation_format, write_animation
+from ..present.progress import EVERY, Progress
 from ..present.draw import (
     chain_dict,
     draw_chain,
@@ -36,7 +38,9 @@ from ._common import (
     input_solver,
     inputs,
     joint_value,
+    moved_not_set,
     named_points,
+    near_values,
     split_inputs,
     with_mode,
 )
@@ -67,7 +71,7 @@ def add_parser(sub, common, scaled):
                                      "sought (default: a four-bar's rocker, a slider-crank's slider)")
     sp.add_argument("--steps", type=count("figure_steps"), default=None,
                     help="--singular and --trace: steps over the input's range (default 360, at most 20,000); "
-                         "--animate: steps from --from to --to (default 60, at most 1,000)")
+                         "--animate: steps from --from to --to (default 60, at most 500)")
     add_point_option(sp)
     sp.add_argument("--trace", action="append", metavar="NAME",
                     help="draw the path of the --point NAME over a whole turn of the input (or up to its limit "
@@ -209,6 +213,7 @@ def run(mech, args) -> int:
         return _animate(mech, args)
     if args.start is not None or args.stop is not None:
         raise UsageError(f"{mech.path}: --from and --to go with --animate OUT.gif")
+    untraced = [p.name for p in named_points(mech, args) if p.name not in (args.trace or ())]  # said at the end
     targets = _targets(mech, args)
     if args.chain and args.singular:
         raise UsageError(f"{mech.path}: --chain and --singular are separate drawings; give one of them")
@@ -289,6 +294,9 @@ def run(mech, args) -> int:
     elif not args.singular:
         for path in written:
             print(f"wrote {path}")
+    if untraced:  # (checked, as every --point is: cli.py)
+        print(f"note: --point {', '.join(quote(n, 40) for n in untraced)}: a point is drawn as its path, with "
+              "--trace NAME (or in --animate); not drawn here", file=sys.stderr)
     return 0
 
 
@@ -318,15 +326,17 @@ def _animate(mech, args) -> int:
         print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
               "(draw --png/--svg), not in the animation")
     given, held, _ = split_inputs(mech, args)  # a floating link's angle is held along the motion, as in sweep
-    name = args.input or next(iter(given), None) or (mech.actuated[0] if mech.actuated else None)
+    name = args.input or (mech.actuated[0] if mech.actuated else None)  # (a --set value is held, never moved)
     if name is None:
         raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")
     unit = parse_typed_value(args.start)[1]
     start = joint_value(mech, name, args.start, "--from")
     stop = joint_value(mech, name, args.stop, "--to")
     unit = unit or parse_typed_value(args.stop)[1]
+    moved_not_set(given, name, "--animate moves it from --from to --to")
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
+    near_values(mech, args)  # checked before the work (configuration() reads it where the motion starts)
     solver = input_solver(mech, input_names, held)
     # the mode followed (--mode K, --near), chosen and said as sweep's
     res = sweep(solver, name, start, stop, steps, fixed=fixed,
@@ -356,7 +366,10 @@ def _animate(mech, args) -> int:
     if limit is not None:
         titles[-1] += " (limit position)"
     space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
-    n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space)
+    progress = Progress(label="animate", unit="frame draws (each framed, then drawn)", every=EVERY)  # a terminal
+    n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space,
+                        progress=progress)
+    progress.clear()
     if args.json:
         print(json.dumps(to_jsonable({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
                                       "input": name, "unit": res.unit, "values": values,

@@ -7,9 +7,11 @@ import json
 import math
 import os
 
-from ..analysis.forces.dynamics import Load, dynamics
+from ..analysis.forces.dynamics import CS_RANGE, Load, dynamics
 from ..errors import UsageError, quote
+from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
+from ..present.progress import EVERY, Progress
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
 from ..analysis.motion.sweep import sweep_inputs
@@ -18,8 +20,10 @@ from ._common import (
     configuration,
     joint_assignments,
     joint_value,
+    moved_not_set,
     named_points,
     names_list,
+    near_values,
     rate_items,
     value_kind,
     with_mode,
@@ -41,7 +45,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--from", dest="start", help="first input value (default 0 for a turning input)")
     sp.add_argument("--to", dest="stop", help="last input value (default 360deg for a turning input)")
     sp.add_argument("--steps", type=count("dynamics_steps"), default=72,
-                    help="number of steps (default 72, at most 20,000)")
+                    help="number of steps (default 72, at most 10,000)")
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
@@ -56,7 +60,7 @@ def add_parser(sub, common, scaled):
                     help="a named point on a link, in the link's frame (units allowed: P=coupler:60mm,20mm,0), for "
                          "--load NAME:...; repeatable")
     sp.add_argument("--cs", default="0.05",
-                    help="coefficient of speed fluctuation of the flywheel figure (default 0.05)")
+                    help="coefficient of speed fluctuation of the flywheel figure, 0.0001 to 0.5 (default 0.05)")
     sp.add_argument("--csv", help="write the efforts, energies, shaking wrench and reactions per step to this CSV file")
     sp.add_argument("--plot", help="draw the input effort against the input into this PNG file (needs matplotlib)")
 
@@ -94,15 +98,18 @@ def _cs(text):
         cs = float(text)
     except ValueError:
         raise UsageError(f"--cs expects a number, got {quote(text, 40)}") from None
-    if not 0 < cs < 2:  # nan fails both
-        raise UsageError(f"--cs must lie between 0 and 2 (e.g. 0.05), got {quote(text, 40)}")
+    lo, hi = CS_RANGE
+    if not lo <= cs <= hi:  # nan fails both
+        raise UsageError(f"--cs must lie between {lo:g} and {hi:g} (machines ask for 0.002 to 0.2; default 0.05), "
+                         f"got {quote(text, 40)}")
     return cs
 
 
 def run(mech, args) -> int:
     fixed = joint_assignments(mech, args.set, "--set")
+    moved_not_set(fixed, args.input, "dynamics drives it from --from to --to")
     inputs = names_list(args.inputs) or None
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     kind = value_kind(mech, args.input)
     if kind is None:
         mech.coordinate(args.input)  # a clear error for an unknown joint
@@ -126,11 +133,12 @@ def run(mech, args) -> int:
     # the mode (--mode K), chosen and said once dynamics has checked the file and the options
     mode = lambda: configuration(mech, args, moved={args.input: start},  # noqa: E731
                                  inputs=inputs or sweep_inputs(mech, args.input, fixed))
+    progress = Progress(label="dynamics", unit="configurations", every=EVERY)  # on a terminal only
     res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
-                   gravity=gravity, loads=loads, cs=cs, progress=True, q_start=mode)
+                   gravity=gravity, loads=loads, cs=cs, progress=progress, q_start=mode)
+    progress.clear()
     if args.csv:
-        with open(args.csv, "w") as f:
-            f.write(dynamics_csv(res, shown))
+        write_output(args.csv, dynamics_csv(res, shown))
     if args.plot:
         dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:

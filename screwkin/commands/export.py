@@ -5,13 +5,13 @@ take their second point from qpos0)."""
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 from ..errors import UsageError, quote
 from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, mujoco_refuses, write_mjcf, write_placed_urdf
 from ..files.mjcf_rows import redundant_rows
 from ..model.placed import check_closed, placed
 from ..present.report import to_jsonable
+from ..present.outfile import write_output
 from ._common import add_configuration_options, configuration, emit, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -26,13 +26,6 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--mjcf", metavar="OUT.xml", help="write MJCF here: loops as <equality> connect/weld")
     sp.add_argument("--urdf", metavar="OUT.urdf", help="write URDF here: loops as <loop_joint>")
     add_configuration_options(sp)
-
-
-def _write(path, text):
-    try:
-        Path(path).write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise UsageError(f"cannot write {quote(str(path))}: {exc.strerror or exc}") from None
 
 
 def run(mech, args) -> int:
@@ -94,7 +87,7 @@ def run(mech, args) -> int:
                              "frictionloss are, as <dynamics damping friction>)")
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})
     for out, text in texts:
-        _write(out, text)
+        write_output(out, text)
 
     def data():
         return to_jsonable(with_mode(args, {"file": mech.path, "written": written, "configuration": values,

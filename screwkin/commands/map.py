@@ -9,7 +9,9 @@ import numpy as np
 
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import continuation_steps
 from ..errors import UsageError
+from ..present.outfile import write_output
 from ..present.plots import map_png
 from ..present.report import (
     map_csv,
@@ -47,11 +49,19 @@ def add_parser(sub, common, scaled):
 
 
 def run(mech, args) -> int:
-    xn, xs = parse_range(args.x, "--x")
-    yn, ys = parse_range(args.y, "--y")
+    xn, xs = parse_range(args.x, "--x", mech)
+    yn, ys = parse_range(args.y, "--y", mech)
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")
+    # each grid value is reached from a neighbour by continuation steps of at most Tolerances.max_step: a grid
+    # whose neighbours are far apart (--x motor1=0:1e5rad:3) costs that many steps per point, bounded too
+    per_point = max(continuation_steps(mech, n, v[1] - v[0]) if v.size > 1 and n in {c.joint for c in mech.coordinates}
+                    else 1 for n, v in ((xn, xs), (yn, ys)))
+    if xs.size * ys.size * per_point > BOUNDS["grid_total"][1]:
+        raise UsageError(f"--x and --y: neighbouring values this far apart take {per_point:,} continuation steps each "
+                         f"({xs.size * ys.size * per_point:,} in all, at most {BOUNDS['grid_total'][1]:,}): give a "
+                         "smaller range or more values")
     fixed = joint_assignments(mech, args.set, "--set")
     inputs = list(mech.actuated) if {xn, yn} <= set(mech.actuated) else [xn, yn, *fixed]
     output, point = output_frame(mech, args)  # a named --point is the output
@@ -65,8 +75,7 @@ def run(mech, args) -> int:
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
         map_png(res, args.png, *units, title=title)
     if args.csv:
-        with open(args.csv, "w") as f:
-            f.write(map_csv(res))
+        write_output(args.csv, map_csv(res))
     if args.json:
         print(json.dumps(to_jsonable(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})),
                          indent=2))

@@ -24,7 +24,7 @@ from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
-from ..errors import ScrewkinError, UsageError
+from ..errors import OutputError, ScrewkinError, UsageError
 from ..present.document import (
     Document,
     Figure,
@@ -43,6 +43,7 @@ from ..present.document import (
 from ..present.draw import draw_chain, draw_mechanism, value_label
 from ..present.equations import equations_dict, newton_dict
 from ..present.motion import motion_dict, strokes_dict, strokes_text
+from ..present.outfile import os_reason, remove_partial, write_output
 from ..present.plots import absolute_series, motion_figure
 from ..present.report import mobility_dict, position_dict
 from ..present.view import (
@@ -65,6 +66,7 @@ from ._common import (
     named_points,
     mode_line,
     rate_items,
+    near_values,
     rate_units,
     split_inputs,
     value_kind,
@@ -114,14 +116,6 @@ def _writable(path, option):
     check_writable(path, option)
 
 
-def _write(path, data: bytes):
-    try:
-        with open(path, "wb") as f:
-            f.write(data)
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from None
-
-
 def _input_names(mech, args, given):
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     names = names or list(given) or list(mech.actuated)
@@ -156,7 +150,7 @@ def run(mech, args) -> int:
     # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
     given, held, pivots = split_inputs(mech, args)
     names = _input_names(mech, args, given)
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     q0 = mech.generic_configurations()[0].q
     if args.output:
         mech.link_frame(args.output)
@@ -258,20 +252,33 @@ def run(mech, args) -> int:
     doc = Document(f"screwkin report: {os.path.basename(str(mech.path))}", facts, sections, data)
     written = []
     if args.html:
-        _write(args.html, html(doc).encode("utf-8"))
+        write_output(args.html, html(doc).encode("utf-8"))
         written.append(args.html)
     if args.md:
         stem = os.path.splitext(os.path.basename(args.md))[0] or "report"
         folder = f"{stem}_files"
         text, files = markdown(doc, folder)
         where = os.path.join(os.path.dirname(args.md), folder)
+        made = not os.path.isdir(where)
         try:
             os.makedirs(where, exist_ok=True)
         except OSError as exc:
-            raise UsageError(f"cannot write {where}: {exc.strerror or exc}") from None
-        for name, blob in files.items():
-            _write(os.path.join(where, name), blob)
-        _write(args.md, text.encode("utf-8"))
+            raise OutputError(where, os_reason(exc)) from None
+        pictures = []
+        try:
+            for name, blob in files.items():
+                pictures.append(os.path.join(where, name))
+                write_output(pictures[-1], blob)
+            write_output(args.md, text.encode("utf-8"))
+        except OutputError:  # a document is all or nothing: its pictures, and their folder when made here, go too
+            for path in pictures:
+                remove_partial(path)
+            if made:
+                try:
+                    os.rmdir(where)
+                except OSError:
+                    pass
+            raise
         written.append(args.md)
     if args.json:
         print(json.dumps({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],

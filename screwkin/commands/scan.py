@@ -6,6 +6,7 @@ import json
 import time
 
 from ..analysis.singularities.scan import scan
+from ..present.outfile import write_output
 from ..present.report import (
     scan_csv,
     scan_dict,
@@ -39,8 +40,7 @@ def run(mech, args) -> int:
     res = scan(mech, output, args.samples, args.seed, args.measure, None, args.threads, point=point)
     elapsed = time.perf_counter() - t
     if args.csv:
-        with open(args.csv, "w") as f:
-            f.write(scan_csv(res))
+        write_output(args.csv, scan_csv(res))
     d = scan_dict(res)
     if args.json:
         print(json.dumps(to_jsonable({"file": mech.path, **d, "seconds": elapsed}), indent=2))

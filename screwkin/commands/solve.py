@@ -23,6 +23,7 @@ from ._common import (
     link_rates,
     named_points,
     rate_items,
+    near_values,
     rate_units,
     split_inputs,
 )
@@ -65,7 +66,7 @@ def run(mech, args) -> int:
     values, held, pivots = split_inputs(mech, args)
     if not values and not held:
         raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
-    near = joint_assignments(mech, [args.near], "--near") if args.near else None
+    near = near_values(mech, args)
     args.rate, args.accel = (rate_items(getattr(args, o), [*values, *held], f"--{o}") or None for o in ("rate", "accel"))
     rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
     accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None

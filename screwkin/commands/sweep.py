@@ -18,6 +18,7 @@ from ..present.jsonout import json_of
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
 from ..present.tables import input_rate_words
 from ..present.plots import sweep_plot
+from ..present.progress import EVERY, Progress
 from ..present.streamout import SweepWriter
 from ..present.local import change_point_dict, change_point_lines
 from ..present.report import (
@@ -37,8 +38,10 @@ from ._common import (
     input_solver,
     joint_assignments,
     joint_value,
+    moved_not_set,
     named_points,
     names_list,
+    near_values,
     rate_items,
     rate_units,
     split_inputs,
@@ -125,6 +128,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     topo = None
     pieces, methods, notes, limits, skipped = 0, [], [], [], 0
     last = None
+    progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only
     with SweepWriter(args.csv, args.parquet) as out:
         for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, q_start=q_start, rate=rate,
                                   chunk=chunk):
@@ -142,7 +146,9 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
             limits += list(piece.limits)
             skipped += len(piece.skipped)
             last = piece
+            progress(out.rows - 1, args.steps)
         rows = out.rows
+    progress.clear()
     rad = last.unit == "rad"
     files = " and ".join(f for f in (args.csv, args.parquet) if f)
     print(_rates_line(args))
@@ -184,6 +190,7 @@ def run(mech, args) -> int:
     inputs = names_list(args.inputs) or ([args.input, *(k for k in fixed if k != args.input)] if held else
                                          sweep_inputs(mech, args.input, fixed))
     solver = input_solver(mech, inputs, held)
+    near_values(mech, args)  # checked before the work (configuration() reads it where the motion starts)
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
     start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
@@ -196,14 +203,17 @@ def run(mech, args) -> int:
     args.rate_words = input_rate_words(args.input, rate, unit, bool(mech.translational[mech.coordinate(args.input).idx_v]))
     if args.parquet:
         SweepWriter.require_parquet(args.parquet)  # before any work
+    moved_not_set(fixed, args.input, "sweep moves it from --from to --to")
     others = {k: v for k, v in fixed.items() if k != args.input}
     streamed = _streamed(args)
     # the mode followed (--mode K), chosen and said once sweep has checked the inputs
     q_start = lambda: configuration(mech, args, moved={args.input: start}, inputs=inputs)  # noqa: E731
     if streamed:
         return _run_streamed(mech, args, solver, start, stop, others, q_start, rate)
-    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate, progress=True,
+    progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only
+    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate, progress=progress,
                 turn=args.turn)
+    progress.clear()
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 and not held else None

@@ -30,12 +30,13 @@ from ..analysis.design.synthesis.optimal import optimal_path
 from ..analysis.design.synthesis.optimal_function import optimal_function
 from ..analysis.design.synthesis.optimal_motion import optimal_motion
 from ..analysis.design.synthesis.path import synthesize_path
-from ..errors import UsageError, quote
+from ..errors import OutputError, UsageError, quote
 from ..files.description import LIMITS
 from ..files.writer import write_urdf
 from ..parallel.pool import dask_client, dask_map
 from ..model.loader import load
 from ..present.jsonout import to_jsonable
+from ..present.outfile import os_reason, output_failed, remove_partial, write_output
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
@@ -173,18 +174,33 @@ def _realize(design, out, tolerance=None):
     folder = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(folder):
         raise UsageError(f"-o {quote(str(out))}: the folder {quote(folder)} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=".screwkin-", suffix=".urdf", dir=folder)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(write_urdf(design.linkage))
     try:
+        fd, tmp = tempfile.mkstemp(prefix=".screwkin-", suffix=".urdf", dir=folder)
+    except OSError as exc:
+        raise output_failed(out, exc) from None
+    os.close(fd)
+    try:
+        write_output(tmp, write_urdf(design.linkage))  # (a partial file removed when it fails)
         return check_design(design, tmp, tolerance=tolerance), tmp
     except BaseException:
-        os.unlink(tmp)
+        remove_partial(tmp)
         raise
 
 
 def _keep(tmp, out):
-    os.replace(tmp, out)
+    """The checked design at ``out``: the temporary file renamed there, or written through a link, a
+    device or a pipe that ``out`` names (a rename would replace it)."""
+    try:
+        if os.path.islink(out) or (os.path.exists(out) and not os.path.isfile(out)):
+            with open(tmp, encoding="utf-8") as f:
+                write_output(out, f.read())
+            os.remove(tmp)
+            return
+        os.replace(tmp, out)
+    except OSError as exc:
+        raise OutputError(out, os_reason(exc)) from None
+    finally:
+        remove_partial(tmp)
 
 
 def run(mech, args) -> int:
@@ -362,7 +378,7 @@ def _path(args):
     timing = None
     if args.timing:
         timing = [parse_value(x) for x in args.timing.replace(";", ",").split(",") if x.strip()]
-    tolerance = parse_value(args.tolerance)
+    tolerance = parse_value(args.tolerance, "length", "--tolerance")
     if not tolerance > 0:
         raise UsageError("--tolerance must be a positive length")
     if _searching(args, len(points), 24):
@@ -383,14 +399,17 @@ def _chains(args):
         directory = Path(args.out)
         if directory.exists() and not directory.is_dir():
             raise UsageError(f"-o {quote(str(directory))}: chains are written to a folder, and this is a file")
-        directory.mkdir(parents=True, exist_ok=True)
+        try:
+            directory.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(directory, os_reason(exc)) from None
         files = []
         for c in result.chains:
             for g in c.inversions:
                 path = directory / f"chain{c.index:02d}_ground{g}.urdf"
                 checked = None
                 for seed in range(4):  # generic proportions: another seed when the first is special
-                    path.write_text(write_urdf(chain_linkage(c, g, seed=seed, dof=args.dof)))
+                    write_output(path, write_urdf(chain_linkage(c, g, seed=seed, dof=args.dof)))
                     checked = check_chain_file(path, c.index, g, args.dof)
                     if not checked.problem:
                         break

@@ -15,6 +15,7 @@ from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.singular import classify
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep, sweep_inputs
+from ..present.outfile import write_output
 from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
@@ -28,6 +29,7 @@ from ._common import (
     joint_assignments,
     joint_inputs,
     mode_line,
+    moved_not_set,
     named_points,
     parse_range,
     typed_unit,
@@ -96,9 +98,10 @@ def run(mech, args) -> int:
     motion, singular, frames = None, [], None
     if not args.sweep:
         q = configuration(mech, args)
-    else:
-        name, values = parse_range(args.sweep, "--sweep")
-        fixed = {k: v for k, v in joint_assignments(mech, args.set, "--set").items() if k != name}
+    else:  # (the range and the --set values checked before the configuration is solved)
+        name, values = parse_range(args.sweep, "--sweep", mech)
+        fixed = joint_assignments(mech, args.set, "--set")
+        moved_not_set(fixed, name, "view --sweep moves it over its range")
         inputs = sweep_inputs(mech, name, fixed)
         solver = PositionSolver(mech, inputs)
         # the mode followed (--mode K, --near), chosen and said as sweep's
@@ -136,8 +139,7 @@ def _pictures(mech, args, server, scene, frames=None):
     html = server.viewer.static_html()
     title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
     if args.html:
-        with open(args.html, "w") as f:
-            f.write(with_player(page(html, scene, title), frames, FPS) if frames else page(html, scene, title))
+        write_output(args.html, with_player(page(html, scene, title), frames, FPS) if frames else page(html, scene, title))
         print(f"wrote {args.html}")
     if args.png:
         with tempfile.TemporaryDirectory() as d:

@@ -11,7 +11,8 @@ import numpy as np
 import pinocchio as pin
 
 from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
-from ..errors import UsageError
+from ..errors import UsageError, quote
+from ..present.outfile import write_output
 from ..present.report import to_jsonable
 from ..present.view import ViewerServer, build_scene, screenshot, show
 from ..present.workspace import (
@@ -77,8 +78,8 @@ def _bounds(text):
     for part in text.split(","):
         lo, sep, hi = part.strip().partition(":")
         if not sep:
-            raise UsageError(f"--bounds expects LO:HI ranges separated by commas, got {text!r}")
-        ranges.append((parse_value(lo.strip()), parse_value(hi.strip())))
+            raise UsageError(f"--bounds expects LO:HI ranges separated by commas, got {quote(text, 80)}")
+        ranges.append((parse_value(lo.strip(), "length", "--bounds"), parse_value(hi.strip(), "length", "--bounds")))
     return np.array(ranges)
 
 
@@ -136,8 +137,7 @@ def run(mech, args) -> int:
             workspace_cloud(res, server.viewer)
             html = server.viewer.static_html()
         if args.html:
-            with open(args.html, "w") as f:
-                f.write(html)
+            write_output(args.html, html)
             wrote.append(args.html)
         if args.cloud_png:
             with tempfile.TemporaryDirectory() as d:

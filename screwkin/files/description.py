@@ -145,11 +145,13 @@ class LinkSpec:
 
     mass: [kg], None when the file gives no ``<inertial>``.
     has_geometry: the link has a visual or collision element.
+    inertia_problem: why its mass and inertia cannot be a body's (files/inertia.py), or None.
     """
 
     name: str
     mass: float | None = None
     has_geometry: bool = False
+    inertia_problem: str | None = None
 
     def is_massless(self, dummy_mass: float) -> bool:
         """No geometry and (almost) no mass: it can be the inside of a compound joint."""

@@ -33,6 +33,7 @@ from .description import (
     TargetSpec,
     data_bytes,
 )
+from .inertia import inertia_problem, inertia_warnings
 from .meshes import check_meshes
 from .urdf_transmission import read_transmissions
 from .xmlsafe import parse_xml_text
@@ -133,9 +134,13 @@ def _link(elem, problems) -> LinkSpec:
         value = numbers(mass_elem.get("value"), 1, f"{what} <mass value>", problems, (0.0,), LIMITS.mass, "kg",
                         low=0.0)
         mass = value[0]
+    impossible = None
     for inertia in elem.findall("inertial/inertia"):
-        for key, val in inertia.attrib.items():
-            numbers(val, 1, f"{what} <inertia {quote(key, 20)}>", problems, (0.0,), LIMITS.inertia, "kg m^2")
+        before = len(problems)
+        got = {key: numbers(val, 1, f"{what} <inertia {quote(key, 20)}>", problems, (0.0,), LIMITS.inertia,
+                            "kg m^2")[0] for key, val in inertia.attrib.items()}
+        if len(problems) == before:  # (a missing component is urdfdom's to refuse)
+            impossible = inertia_problem(mass, *(got.get(k, 0.0) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")))
     for origin in elem.findall("*/origin"):
         _origin(origin, f"{what} <origin", problems)
     for shape in elem.findall("*/geometry/*"):
@@ -143,7 +148,7 @@ def _link(elem, problems) -> LinkSpec:
             numbers(shape.get(key), count, f"{what} <{shape.tag} {key}>", problems, (0.0,) * count, LIMITS.length,
                     "m", low=None if key == "scale" else 0.0)
     has_geometry = elem.find("visual") is not None or elem.find("collision") is not None
-    return LinkSpec(name=name, mass=mass, has_geometry=has_geometry)
+    return LinkSpec(name=name, mass=mass, has_geometry=has_geometry, inertia_problem=impossible)
 
 
 def _name_and_type(elem, tag, kind, types, problems):
@@ -444,6 +449,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
                                                {c.joint: c.mimics for c in couplings}, numbers)
     targets = _targets(root, links, {j.name for j in joints}, problems)
     problems.fail_if_any(path)
+    warnings += inertia_warnings(links)
     warnings += check_meshes(path, root, package_dirs)
     return MechanismSpec(
         path=str(path),

@@ -271,6 +271,30 @@ def rebuild(spec, actuated=None, tolerances: Tolerances = DEFAULT, cls=Mechanism
     return cls(spec, _finish(spec, model), actuated=actuated, tolerances=tolerances)
 
 
+#: The XML whitespace that attribute-value normalisation turns into a space (XML 1.0, section 3.3.3).
+_NORMALISED = "\t\n\r"
+
+
+def _check_names_read_alike(model, spec, path) -> None:
+    """Refuse a link or joint name that Pinocchio's parser and screwkin's read differently: a literal
+    tab, newline or carriage return inside the quotes of its name.  urdfdom (TinyXML2: Pinocchio's
+    parser, ROS's robot_state_publisher and check_urdf) keeps the character (a carriage return as a
+    newline); the XML standard's attribute-value normalisation, which screwkin's reader, xacro and
+    every conforming parser apply, reads a space.  The same file then names two different joints
+    in two of ROS's own tools, and screwkin's two models would disagree: an error naming the name,
+    exit 1.  Written as a character reference (``&#9;``) the character is kept by every reader
+    (the standard does not normalise references), and the name is accepted."""
+    ours = set(spec.links) | {j.name for j in spec.joints}
+    for frame in list(model.frames)[1:]:
+        name = frame.name
+        if name in ours or not any(c in name for c in _NORMALISED):
+            continue
+        kind = "link" if frame.type == pin.FrameType.BODY else "joint"
+        raise MechanismFileError(path, f"{kind} {quote(name)}: a literal tab or line break in a name is kept by "
+                                       "urdfdom (Pinocchio, ROS) but read as a space by XML-standard readers "
+                                       "(xacro, screwkin): write a space, or &#9; / &#10; to keep the character")
+
+
 @contextmanager
 def _native_stderr(box: list):
     """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
@@ -364,6 +388,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         raise MechanismFileError(path, f"Pinocchio's URDF parser refused the file: {shorten(first, 120)}") from None
     spec.warnings.extend(f"URDF parser: {shorten(m, 120)}" for level, m in _urdfdom_messages(native)
                          if level != "Error")
+    _check_names_read_alike(model, spec, path)
     if yaml is None and spec.format == "urdf":
         yaml = _find_sidecar(path)
     if yaml is not None:

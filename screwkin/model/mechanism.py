@@ -313,16 +313,21 @@ class Mechanism:
         """Every joint coordinate name -> value [rad or m], in the order of the joints:
         revolute angles in [-pi, pi), continuous joints as atan2(sin, cos), the coordinates
         of multi-DOF joints as ``joint[qk]``."""
-        q = np.asarray(q, float)
+        return dict(zip(self._value_layout()[3], self.joint_value_rows(q)[0].tolist()))
+
+    def joint_value_rows(self, Q) -> np.ndarray:
+        """joint_values of each configuration of Q (N, nq), as the rows of an (N, joints) array in the
+        order of joint_values' names: the same numbers, for many configurations at once (a sweep's)."""
+        Q = np.atleast_2d(np.asarray(Q, float))
         single, continuous, multi, order, idx, wrap = self._value_layout()
-        v = q[idx]
-        v[wrap] = wrap_angle(v[wrap])
-        out = dict(zip((n for n, _, _ in single), v.tolist()))
+        V = Q[:, idx]
+        V[:, wrap] = wrap_angle(V[:, wrap])
+        cols = {n: V[:, k] for k, (n, _, _) in enumerate(single)}
         for name, i in continuous:
-            out[name] = float(np.arctan2(q[i + 1], q[i]))
+            cols[name] = np.arctan2(Q[:, i + 1], Q[:, i])
         for name, i in multi:
-            out[name] = float(q[i])
-        return {n: out[n] for n in order}
+            cols[name] = Q[:, i]
+        return np.column_stack([cols[n] for n in order]) if order else np.zeros((len(Q), 0))
 
     @property
     def coordinate_names(self) -> list:

@@ -6,12 +6,15 @@ by frame; written as a GIF with Pillow or an MP4 with imageio-ffmpeg (an optiona
 
 from __future__ import annotations
 
+import io
 import os
+import tempfile
 
 import numpy as np
 
-from ..errors import UsageError, quote
+from ..errors import OutputError, UsageError, quote
 from .draw import draw_mechanism
+from .outfile import write_output
 from .plots import pyplot
 
 __all__ = ["FORMATS", "animation_format", "write_animation"]
@@ -40,12 +43,14 @@ def animation_format(path: str) -> str:
     return ext
 
 
-def _limits(skeletons, titles, traces, size, angles):
+def _limits(skeletons, titles, traces, size, angles, progress=None):
     """The framing of the whole motion: the union of the limits each frame would take alone
     (whole paths drawn), so that every frame is drawn in the same window."""
     plt = pyplot("--animate")
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
-    for skel, title in zip(skeletons, titles):
+    for k, (skel, title) in enumerate(zip(skeletons, titles)):
+        if progress is not None:
+            progress(k, 2 * len(skeletons))
         fig = draw_mechanism(skel, title=title, traces=traces, size=size, angles=angles)
         ax = fig.axes[0]
         (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
@@ -61,41 +66,50 @@ def _pixels(fig) -> np.ndarray:
 
 
 def write_animation(path: str, skeletons, titles, traces: dict | None = None, fps: float = 20.0,
-                    angles: bool = False, subtitle: str | None = None) -> int:
+                    angles: bool = False, subtitle: str | None = None, progress=None) -> int:
     """Write the animation of ``skeletons`` (one per frame, each with its title) to ``path`` (.gif or
     .mp4) at ``fps`` frames per second; ``traces``: name -> (len(skeletons), 2) path of a point in
     the drawing plane [m], drawn up to the current frame (backwards: the point is marked where it is
-    now).  Returns the number of frames written."""
+    now); ``progress(done, total)`` is told of the frames framed, then drawn.  Returns the number of
+    frames written."""
     ext = animation_format(path)
     traces = {n: np.asarray(xy, float) for n, xy in (traces or {}).items()}
     size = max(s.size for s in skeletons)
-    limits = _limits(skeletons, titles, traces, size, angles)
+    limits = _limits(skeletons, titles, traces, size, angles, progress)
     plt = pyplot("--animate")
+    from PIL import Image  # (with matplotlib)
+
     frames = []
     writer = None
-    try:
-        for k, (skel, title) in enumerate(zip(skeletons, titles)):
-            fig = draw_mechanism(skel, title=title, traces={n: xy[k::-1] for n, xy in traces.items()}, size=size,
-                                 limits=limits, angles=angles, subtitle=subtitle)
-            image = _pixels(fig)
-            plt.close(fig)
-            if ext == ".gif":
-                frames.append(image)
-                continue
-            if writer is None:
-                writer = _ffmpeg().write_frames(str(path), (image.shape[1], image.shape[0]), fps=float(fps),
-                                                macro_block_size=1, quality=7)
-                writer.send(None)
-            writer.send(np.ascontiguousarray(image).tobytes())
+    with tempfile.TemporaryDirectory() as folder:  # ffmpeg's MP4 is made here, then written to ``path``
+        video = os.path.join(folder, "animation.mp4")
+        try:
+            for k, (skel, title) in enumerate(zip(skeletons, titles)):
+                if progress is not None:
+                    progress(len(skeletons) + k, 2 * len(skeletons))
+                fig = draw_mechanism(skel, title=title, traces={n: xy[k::-1] for n, xy in traces.items()},
+                                     size=size, limits=limits, angles=angles, subtitle=subtitle)
+                image = _pixels(fig)
+                plt.close(fig)
+                if ext == ".gif":  # a palette of its own (fast octree: a third of the default's time and memory)
+                    frames.append(Image.fromarray(image).quantize(method=Image.Quantize.FASTOCTREE))
+                    continue
+                if writer is None:
+                    writer = _ffmpeg().write_frames(video, (image.shape[1], image.shape[0]), fps=float(fps),
+                                                    macro_block_size=1, quality=7)
+                    writer.send(None)
+                writer.send(np.ascontiguousarray(image).tobytes())
+        except OSError as exc:  # the temporary folder is full: the output itself was not touched
+            raise OutputError(video, f"{exc.strerror or exc} (the video is made there first)") from None
+        finally:
+            if writer is not None:
+                writer.close()
         if ext == ".gif":
-            from PIL import Image
-
-            images = [Image.fromarray(f) for f in frames]
-            images[0].save(path, save_all=True, append_images=images[1:], duration=int(round(1000 / fps)), loop=0,
-                           optimize=False)
-    except OSError as exc:
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from None
-    finally:
-        if writer is not None:
-            writer.close()
+            buf = io.BytesIO()
+            frames[0].save(buf, format="GIF", save_all=True, append_images=frames[1:],
+                           duration=int(round(1000 / fps)), loop=0, optimize=False)
+            write_output(path, buf.getvalue())
+        else:
+            with open(video, "rb") as f:
+                write_output(path, f.read())
     return len(skeletons)

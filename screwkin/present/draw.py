@@ -19,9 +19,9 @@ import os
 
 import numpy as np
 
-from ..errors import UsageError
 from .draw_targets import draw_targets
 from .plots import pyplot
+from .outfile import write_figure
 
 __all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label", "number_colours"]
 
@@ -457,14 +457,14 @@ def _crossings(pos, edges) -> bool:
 
 
 def save_figure(fig, path: str, close: bool = True):
-    """Write a Figure to ``path`` (PNG or SVG by its suffix) and close it (unless ``close`` is
-    False: the same figure written to another file next)."""
+    """Write a Figure to ``path`` (PNG or SVG by its suffix; present/outfile.write_figure) and close it
+    (unless ``close`` is False: the same figure written to another file next)."""
     plt = _plt()
     try:
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
+        write_figure(fig, path, dpi=110)
+    except BaseException:
         plt.close(fig)
-        raise UsageError(f"cannot write {path}: {exc.strerror or exc}") from None
+        raise
     if close:
         plt.close(fig)
 

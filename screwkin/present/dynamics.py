@@ -11,6 +11,7 @@ from .plots import pyplot
 from .jsonout import nan_to_none
 from .report import sweep_rows
 from .tables import column_text, csv_text, table
+from .outfile import write_figure
 
 __all__ = ["dynamics_dict", "dynamics_text", "dynamics_csv", "dynamics_plot", "REACTION_POINT", "SHAKING_POINT"]
 
@@ -176,5 +177,7 @@ def dynamics_plot(r: DynamicsResult, path: str, shown: str | None = None, title:
     rate = "rad/s" if r.unit == "rad" else "m/s"
     ax.set_title(title or f"{r.input} at {r.speed:.6g} {rate}")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100)
+    finally:
+        plt.close(fig)

@@ -11,6 +11,7 @@ from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
 from ..units import in_unit
 from .tables import input_rate_words
+from .outfile import write_figure
 
 __all__ = ["sweep_plot", "motion_figure", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
@@ -179,8 +180,10 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
     """A sweep into a PNG: :func:`motion_figure`, saved."""
     plt = pyplot("--plot")
     fig = motion_figure(res, mus, singularities, title, linear, motion, normal, rate_words)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100)
+    finally:
+        plt.close(fig)
 
 
 def _axis(values, unit):
@@ -242,6 +245,8 @@ def map_png(res, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str
     plt = pyplot("--png")
     fig = map_figure(res, x_unit, y_unit, title)
     ax = fig.axes[0]
-    fig.savefig(path, dpi=100, metadata={"Title": ax.get_title(),
-                                         "Description": f"x: {ax.get_xlabel()}; y: {ax.get_ylabel()}"})
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100, metadata={"Title": ax.get_title(),
+                                                   "Description": f"x: {ax.get_xlabel()}; y: {ax.get_ylabel()}"})
+    finally:
+        plt.close(fig)

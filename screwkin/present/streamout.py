@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import UsageError
+from .outfile import OutputFile, WholeOrNothing
 from .report import sweep_columns, sweep_csv
 
 __all__ = ["SweepWriter", "parquet_available"]
@@ -25,14 +26,15 @@ def parquet_available() -> bool:
     return True
 
 
-class SweepWriter:
-    """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written)."""
+class SweepWriter(WholeOrNothing):
+    """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written), each through
+    present/outfile.OutputFile: written as PATH.partial and renamed once the sweep is whole."""
 
     def __init__(self, csv: str | None = None, parquet: str | None = None):
         if parquet:
             self.require_parquet(parquet)
         self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
-        self._parquet_path, self._pq = parquet, None
+        self._parquet_path, self._pq, self._pq_file = parquet, None, None
         self.rows = 0
 
     @staticmethod
@@ -43,12 +45,17 @@ class SweepWriter:
                              "--csv writes the same columns")
 
     def write(self, res, motion=None) -> None:
-        if self._csv_path:
-            if self._csv is None:
-                self._csv = open(self._csv_path, "w")
-            self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
-        if self._parquet_path:
-            self._write_parquet(res, motion)
+        """Append a chunk (OutputError when a file cannot take it: the partial files are removed)."""
+        try:
+            if self._csv_path:
+                if self._csv is None:
+                    self._csv = OutputFile(self._csv_path)
+                self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
+            if self._parquet_path:
+                self._write_parquet(res, motion)
+        except BaseException:
+            self.discard()
+            raise
         self.rows += len(res.values)
 
     def _write_parquet(self, res, motion):
@@ -61,19 +68,35 @@ class SweepWriter:
         arrays += [pa.array(np.ascontiguousarray(c, dtype=float)) for c in cols]
         table = pa.Table.from_arrays(arrays, names=names)
         if self._pq is None:
-            self._pq = pq.ParquetWriter(self._parquet_path, table.schema)
-        self._pq.write_table(table)
+            self._pq_file = OutputFile(self._parquet_path, "wb")
+            self._pq = pq.ParquetWriter(self._pq_file, table.schema)
+        self._pq.write_table(table)  # (a failed write of the file object is its OutputError)
 
     def close(self) -> None:
-        if self._csv is not None:
-            self._csv.close()
-            self._csv = None
-        if self._pq is not None:
-            self._pq.close()
-            self._pq = None
+        """Finish both files: Parquet's footer written, each renamed to its name (OutputError when the
+        last bytes cannot be written: the partial files are removed)."""
+        try:
+            if self._pq is not None:
+                writer, self._pq = self._pq, None
+                writer.close()
+            for f in (self._pq_file, self._csv):
+                if f is not None:
+                    f.close()
+            self._pq_file = self._csv = None
+        except BaseException:
+            self.discard()
+            raise
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
+    def discard(self) -> None:
+        """Stop writing and remove the partial files (the work failed or was interrupted, or a file could
+        not be written): a sweep is never left under its name half written."""
+        writer, self._pq = self._pq, None
+        if writer is not None:
+            try:
+                writer.close()
+            except Exception:  # (its file is discarded below)
+                pass
+        for f in (self._csv, self._pq_file):
+            if f is not None:
+                f.discard()
+        self._csv = self._pq_file = None

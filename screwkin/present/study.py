@@ -1,6 +1,6 @@
 """A study's results for people: the table (CSV, or Parquet with pyarrow), a text summary,
-JSON, plots (metrics against parameters, the Pareto front of two metrics) and the
-progress bar.
+JSON, plots (metrics against parameters, the Pareto front of two metrics); its progress bar is
+present/progress.py's.
 
 The rows of screwkin.analysis.design.study are SI (angles in rad); the table people read names
 its columns with their units where they are not SI's obvious ones: the transmission
@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import importlib.util
 import math
-import sys
-import time
 from collections import Counter
 from pathlib import Path
 
@@ -25,8 +23,10 @@ from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
 from .plots import pyplot
+from .progress import Progress  # noqa: F401  (the study's progress bar: present/progress.py)
 from .report import to_jsonable
 from .tables import csv_text
+from .outfile import write_figure, write_output
 
 __all__ = [
     "DISPLAY",
@@ -107,13 +107,15 @@ def write_table(result, path) -> None:
     """The table into ``path``: CSV, or Parquet (``.parquet``, needs pyarrow)."""
     check_table_path(path)
     if Path(path).suffix.lower() == ".csv":
-        Path(path).write_text(study_csv(result))
+        write_output(path, study_csv(result))
         return
     import pyarrow as pa  # optional: only for Parquet
     import pyarrow.parquet as pq
 
     rows, names = _rows(result)
-    pq.write_table(pa.table({n: [row[i] for row in rows] for i, n in enumerate(names)}), str(path))
+    buf = pa.BufferOutputStream()  # made in memory, then written (one way to fail: present/outfile.py)
+    pq.write_table(pa.table({n: [row[i] for row in rows] for i, n in enumerate(names)}), buf)
+    write_output(path, buf.getvalue().to_pybytes())
 
 
 def study_dict(result) -> dict:
@@ -400,8 +402,10 @@ def metrics_png(result, path) -> None:
     """Each numeric metric against each parameter (see :func:`metrics_figure`)."""
     plt = pyplot("--plot")
     fig = metrics_figure(result)
-    fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
+    finally:
+        plt.close(fig)
 
 
 def pareto_figure(result, goals=None):
@@ -450,37 +454,7 @@ def pareto_png(result, path, goals=None) -> None:
     """The designs in the plane of two columns, the Pareto front drawn over them (see :func:`pareto_figure`)."""
     plt = pyplot("--plot")
     fig = pareto_figure(result, goals)
-    fig.savefig(path, dpi=100, metadata={"Title": fig.axes[0].get_title()})
-    plt.close(fig)
-
-
-class Progress:
-    """A progress bar on a terminal (``stream``, default stderr), redrawn as chunks finish;
-    nothing when the stream is not a terminal (the caller prints a final line)."""
-
-    def __init__(self, stream=None, width: int = 30):
-        self.stream = stream or sys.stderr
-        try:
-            self.tty = self.stream.isatty()
-        except (AttributeError, ValueError):
-            self.tty = False
-        self.width = width
-        self.t0 = time.perf_counter()
-        self.shown = False
-
-    def __call__(self, done: int, total: int, failed: int) -> None:
-        if not self.tty:
-            return
-        filled = int(self.width * done / max(total, 1))
-        elapsed = time.perf_counter() - self.t0
-        eta = elapsed / done * (total - done) if done else 0.0
-        self.stream.write(f"\rstudy [{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} designs, "
-                          f"{failed} failed, {elapsed:.0f} s, {eta:.0f} s left ")
-        self.stream.flush()
-        self.shown = True
-
-    def finish(self, line: str) -> None:
-        if self.shown:
-            self.stream.write("\r\x1b[K")
-        self.stream.write(line + "\n")
-        self.stream.flush()
+    try:
+        write_figure(fig, path, dpi=100, metadata={"Title": fig.axes[0].get_title()})
+    finally:
+        plt.close(fig)

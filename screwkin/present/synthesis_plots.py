@@ -11,6 +11,7 @@ import numpy as np
 from ..analysis.design.synthesis.designs import MotionResult
 from ..analysis.design.synthesis.fourbar import crank_angle, positions
 from .plots import pyplot
+from .outfile import write_figure
 
 __all__ = ["burmester_png"]
 
@@ -79,5 +80,7 @@ def burmester_png(result: MotionResult, path: str):
     ax.set_title(result.method)
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100)
+    finally:
+        plt.close(fig)

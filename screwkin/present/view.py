@@ -33,6 +33,7 @@ from ..model._pin import frame_id
 from .viewplanar import colour_links, link_colours, planar_basis, top_view
 from .viewserver import ViewerServer
 from .camera import BACKGROUND, FOV, PICTURE, VIEW, fit_camera, view_direction  # noqa: F401 - exported here as before
+from .outfile import write_output
 
 __all__ = ["COLORS", "build_scene", "show", "page", "fit_camera", "legend_entries", "view", "ViewerServer", "RecordingViewer", "screenshot"]
 
@@ -525,14 +526,16 @@ def screenshot(html_path, png_path, size=PICTURE, budget_ms=8000):
         raise UsageError("--png needs Chromium (Debian: apt-get install chromium)")
 
     with tempfile.TemporaryDirectory() as profile:
+        shot = Path(profile) / "screenshot.png"  # Chromium writes here; the PNG is then written to png_path
         cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
                "--enable-unsafe-swiftshader", "--disable-quic", "--no-first-run", "--disable-background-networking",
                "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}",
                f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={budget_ms}",
-               f"--screenshot={Path(png_path).resolve()}", Path(html_path).resolve().as_uri()]
+               f"--screenshot={shot}", Path(html_path).resolve().as_uri()]
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-    if not Path(png_path).is_file():
-        raise UsageError(f"Chromium did not write {png_path}: {p.stderr.strip()[-300:]}")
+        if not shot.is_file():
+            raise UsageError(f"Chromium did not write {png_path}: {p.stderr.strip()[-300:]}")
+        write_output(png_path, shot.read_bytes())
 
 
 _servers = []  # servers started by view(): they live as long as the Python session (a notebook)

@@ -13,6 +13,7 @@ from ..tolerances import DEFAULT
 from .plots import pyplot
 from .report import table
 from .tables import csv_text
+from .outfile import write_figure, write_output
 
 __all__ = ["workspace_dict", "workspace_text", "workspace_csv", "workspace_png", "workspace_figure", "workspace_cloud", "AXIS_NAMES"]
 
@@ -116,8 +117,7 @@ def workspace_csv(r: WorkspaceResult, path, joint_columns=None):
         row += [f"{r.measures[m][k]:.6g}" for m in ("actuator", "serial", "conditioning")] + [int(r.free[k])]
         row += [f"{r.configurations[k, iq]:.9g}" for _, iq in joint_columns]
         rows.append(row)
-    with open(path, "w", newline="") as f:
-        f.write(csv_text(head, rows))
+    write_output(path, csv_text(head, rows))
 
 
 def workspace_figure(r: WorkspaceResult, title: str | None = None):
@@ -201,8 +201,10 @@ def workspace_png(r: WorkspaceResult, path: str):
     """The conditioning over the workspace, in slices (see :func:`workspace_figure`)."""
     plt = pyplot("--png")
     fig = workspace_figure(r)
-    fig.savefig(path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
-    plt.close(fig)
+    try:
+        write_figure(fig, path, dpi=100, metadata={"Title": fig._suptitle.get_text()})
+    finally:
+        plt.close(fig)
 
 
 def workspace_cloud(r: WorkspaceResult, viewer, size=None):

@@ -38,13 +38,20 @@ import pinocchio as pin
 
 from ...errors import MechanismFileError, UsageError, quote
 from ...model._pin import frame_jacobian
+from ...model.geometry import cross3
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
 from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
                       reaction_joint_id, reaction_table)
 from ..motion.sweep import sweep, sweep_inputs
 
-__all__ = ["Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
+__all__ = ["CS_RANGE", "Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
+
+#: The coefficients of speed fluctuation Cs = (omega_max - omega_min) / omega_mean the flywheel figure takes.
+#: Machines ask for 0.002 (generators) to 0.2 (crushers, punches); below 1e-4 the flywheel grows past ten
+#: thousand times dE / omega^2 and at --cs 1e-320 it is infinite; above 0.5 the speed swings by half its
+#: mean, and efforts computed at a constant speed no longer describe the motion they would drive.
+CS_RANGE = (1e-4, 0.5)
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -111,7 +118,8 @@ class DynamicsResult:
 
 
 def check_inertias(mech) -> tuple:
-    """Each moving body needs a mass (and an SDF file's inertias are not read: refused): a moving
+    """Each moving body needs a mass and an inertia a rigid body can have (files/inertia.py: a link
+    breaking it is a MechanismFileError naming it), and an SDF file's inertias are not read (refused): a moving
     link without <inertial> on a body none of whose links has one is a MechanismFileError naming
     it, except a link with no geometry either (the inside of a compound joint), taken as massless
     and returned, named, in a note."""
@@ -129,7 +137,13 @@ def check_inertias(mech) -> tuple:
     virtual = {n for names in mech.virtual_joints.values() for n in names}
     massless = []
     for joint, links in bodies.items():
-        if joint == 0 or model.names[joint] in virtual or any(x.mass is not None for x in links):
+        if joint == 0 or model.names[joint] in virtual:
+            continue
+        impossible = [x for x in links if x.inertia_problem]
+        if impossible:  # (the file loads for kinematics with a warning; a dynamics computed with it is no body's)
+            raise MechanismFileError(mech.path, f"link {quote(impossible[0].name)} moves and has "
+                                                f"{impossible[0].inertia_problem}, which no rigid body has: dynamics needs a body's")
+        if any(x.mass is not None for x in links):
             continue
         with_geometry = [x.name for x in links if x.has_geometry]
         if with_geometry:
@@ -206,7 +220,7 @@ def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
     mean = work[-1] / x[-1]
     excess = work - mean * x
     de = float(excess.max() - excess.min())
-    if omega == 0:
+    if omega * omega == 0:  # (a speed below 1e-154 rad/s squares to zero in double precision)
         return Flywheel(cs, omega, de, None, "at zero speed no flywheel smooths anything")
     return Flywheel(cs, omega, de, de / (cs * omega**2))
 
@@ -221,17 +235,19 @@ def _range_mean(values, y) -> float:
 
 def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
              fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress: bool = False, q_start=None) -> DynamicsResult:
+             cs: float = 0.05, progress=None, q_start=None) -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 
     inputs: the actuated joints (default: the mechanism's actuated joints when ``input`` is one
     of them, else ``input`` and the joints of ``fixed``); fixed: the other inputs' values;
     gravity: (gx, gy, gz) [m/s^2]; loads: Load; cs: the coefficient of speed fluctuation of the
-    flywheel figure (0 < cs < 2); q_start: a configuration of the assembly mode to follow (as sweep's;
+    flywheel figure (within CS_RANGE); progress: a callable ``progress(done, total)`` told of the
+    configurations analysed (None: not told); q_start: a configuration of the assembly mode to follow (as sweep's;
     without it the mode is solve's first at ``start``, near ``near``)."""
-    if not 0 < cs < 2:
-        raise UsageError(f"the coefficient of speed fluctuation must lie between 0 and 2, got {cs:g}")
+    lo, hi = CS_RANGE
+    if not lo <= cs <= hi:  # nan fails both
+        raise UsageError(f"the coefficient of speed fluctuation must lie between {lo:g} and {hi:g}, got {cs:g}")
     g = np.asarray(gravity, float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
@@ -247,7 +263,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         mech.link_frame(ld.link)  # a clear error for an unknown link
     solver = PositionSolver(mech, inputs)
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
-                near=None if q_start is not None else near, rate=speed, progress=progress, q_start=q_start)
+                near=None if q_start is not None else near, rate=speed, q_start=q_start)
     model = mech.model
     data = mech.scratch_data()
     a_idx = mech.velocity_indices(inputs)
@@ -261,6 +277,8 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     ground_tree, ground_cuts = _ground_sides(mech)
     gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
     for k in range(n):
+        if progress is not None:
+            progress(k, n)
         q, v, a = res.q[k], res.rates[k], res.accelerations[k]
         b = pin.rnea(gmodel, data, q, v, a).copy()
         pin.computeJointJacobians(model, data, q)
@@ -293,7 +311,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             else:
                 continue
             shaking_f[k] += sign * wrench[:3]
-            shaking_m[k] += sign * (wrench[3:] + np.cross(origin, wrench[:3]))
+            shaking_m[k] += sign * (wrench[3:] + cross3(origin, wrench[:3]))
         T[k], V[k] = _energies(mech, gmodel, data, q, v)
         P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
     units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}

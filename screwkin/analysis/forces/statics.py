@@ -34,6 +34,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import UsageError
+from ...model.geometry import cross3
 from ...model.linalg import null_space, rank
 from ...model.state import KinematicState
 from ..screws import Screw, cut_twists, screw_of
@@ -170,34 +171,36 @@ def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
     """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
     constraint forces lam, and the mask of its components that change along the null
     directions N_lam of the constraint forces (not determined by the balance)."""
-    base = joint_wrenches(mech, q, lam, loads, gravity, v, a)
+    rows = mech.closure.row_wrenches(q), mech.closure.row_labels()  # the same at q for every call below
+    base = joint_wrenches(mech, q, lam, loads, gravity, v, a, rows=rows)
     free = {name: np.zeros(6) for name in base}
     if N_lam is not None and N_lam.size:
         for k in range(N_lam.shape[1]):
-            for name, value in joint_wrenches(mech, q, N_lam[:, k], (), False).items():
+            for name, value in joint_wrenches(mech, q, N_lam[:, k], (), False, rows=rows).items():
                 free[name] = np.maximum(free[name], np.abs(value[1]))
     size = max([float(np.linalg.norm(x[1])) for x in base.values()] + [1.0])
     # components that change along the indeterminate directions
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dict:
+def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
     forces (Pinocchio's RNEA at (q, v, a)): what the parent side (link1 of a cut joint) exerts
-    on the child side (link2)."""
+    on the child side (link2).  ``rows``: (closure.row_wrenches(q), closure.row_labels()) when the
+    caller has them (reaction_table: the same for every call at q)."""
     model = mech.model
     data = mech.scratch_data()
     pin.framesForwardKinematics(model, data, q)
-    rows = mech.closure.row_wrenches(q)
+    rows, labels = rows if rows is not None else (mech.closure.row_wrenches(q), mech.closure.row_labels())
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
 
     def apply(frame, wrench_at_origin):
         """Add a wrench (force, moment about the frame's origin, world axes) to the frame's body."""
         f = model.frames[frame]
         o = data.oMf[frame].translation
-        force, moment = wrench_at_origin[:3], wrench_at_origin[3:] + np.cross(o, wrench_at_origin[:3])
+        force, moment = wrench_at_origin[:3], wrench_at_origin[3:] + cross3(o, wrench_at_origin[:3])
         fext[f.parentJoint] += data.oMi[f.parentJoint].actInv(pin.Force(force, moment))
 
     cut = {}
@@ -209,7 +212,6 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None) -> dic
     for frame, wrench in loads:  # the loads, each on its link
         apply(frame, np.asarray(wrench, float))
     # each cut joint: the wrench its rows exert on link2, at F2's origin
-    labels = mech.closure.row_labels()
     for (fa, wa, fb, wb), value, label in zip(rows, lam, labels):
         if fa is None:
             continue

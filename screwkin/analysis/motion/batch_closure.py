@@ -347,6 +347,48 @@ class BatchClosure:
             i += 1
         return r, K
 
+    def bias(self, Q, V) -> np.ndarray:
+        """K'(q, v) v of every configuration (N, rows): ClosureSystem.bias's minimal rows (zero joint
+        accelerations) for stacks, from the frames' classical accelerations (TreeKinematics.motions)
+        instead of Pinocchio's a configuration at a time.  A rotation vector's rows take the
+        derivative of log3 at the identity, as constraint_jacobians does (the configurations close
+        the loops: R1^T R2 = I within the closure tolerance); a coupling's row is linear: 0."""
+        if self.target is not None:
+            raise ValueError("bias of a closure with a target is not defined")
+        Q, V = np.atleast_2d(np.asarray(Q, float)), np.atleast_2d(np.asarray(V, float))
+        N = len(Q)
+        ids = self._frame_ids
+        R, t, tw, ac = self.tree.motions(Q, V, np.zeros_like(V), ids)
+        at = {f: k for k, f in enumerate(ids)}
+        out = np.zeros((N, self.nrows))
+        i = 0
+
+        def world(R_, u):  # R u for a stack of rotations and a constant vector
+            return np.einsum("nij,j->ni", R_, np.asarray(u, float))
+
+        for cut, (P, pairs, _, rotation) in zip(self.cuts, self.system.plans):
+            a, b = at[cut.frame1], at[cut.frame2]
+            R1, R2, d = R[:, a], R[:, b], t[:, b] - t[:, a]
+            w1, w2, al1, al2 = tw[:, a, 3:], tw[:, b, 3:], ac[:, a, 3:], ac[:, b, 3:]
+            dd, ddd = tw[:, b, :3] - tw[:, a, :3], ac[:, b, :3] - ac[:, a, :3]
+            # e fixed in F1: d2/dt2 (e . d) = e . (d'' - 2 w1 x d' - al1 x d + w1 x (w1 x d))
+            g = ddd - 2.0 * np.cross(w1, dd) - np.cross(al1, d) + np.cross(w1, np.cross(w1, d))
+            k = len(P)
+            out[:, i:i + k] = np.einsum("kj,nij,ni->nk", P, R1, g)  # P (R1^T g)
+            i += k
+            if rotation:
+                out[:, i:i + 3] = np.einsum("nij,ni->nj", R2, al2 - al1 + np.cross(w2, w1))  # R2^T (...)
+                i += 3
+                continue
+            for u, w in pairs:  # d2/dt2 (u . w), u fixed in F1 and w in F2
+                u, w = world(R1, u), world(R2, w)
+                ud, wd = np.cross(w1, u), np.cross(w2, w)
+                udd, wdd = np.cross(al1, u) + np.cross(w1, ud), np.cross(al2, w) + np.cross(w2, wd)
+                out[:, i] = np.einsum("ni,ni->n", udd, w) + 2.0 * np.einsum("ni,ni->n", ud, wd) + \
+                    np.einsum("ni,ni->n", u, wdd)
+                i += 1
+        return out
+
     def reversed_axes(self, Q) -> np.ndarray:
         """(N,) True where a revolute (cylindrical, planar) cut joint is assembled with its two
         axes opposed: a root of the rows that is not the joint (ClosureSystem.wrong_branch)."""

@@ -65,10 +65,11 @@ def _tangents(bc, tr, Q):
     return out
 
 
-def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback):
+def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback, progress=None):
     """The grid values from start to stop (steps steps) on q0's branch, batched (see the module
     docstring).  tr: sweep's _Tracker; t0: its oriented tangent at q0 (the input's component
-    along the motion); fallback(q, x_from, x_to, n): the tracker's SweepResult of n steps.
+    along the motion); fallback(q, x_from, x_to, n): the tracker's SweepResult of n steps;
+    progress(done, total): called as grid values are reached (None: not).
     Returns (X, Q, limits, stopped, reason, skipped, notes) or None when the mechanism cannot
     be batched."""
     mech = solver.mech
@@ -84,6 +85,8 @@ def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback):
     u = _tangents(bc, tr, q[None])[0]  # unoriented, for the branch test
     k, size = 0, 16
     while k < steps:
+        if progress is not None:
+            progress(k, steps)
         m = min(size, steps - k)
         js = np.arange(k + 1, k + m + 1)
         xs = start + js * h
@@ -142,8 +145,8 @@ def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback):
 def motion_rates(solver, bc, Q, values: dict):
     """Joint rates and accelerations (N, nv) at the closed configurations Q for the input rates
     ``values`` (input accelerations zero): PositionSolver.rates and .accelerations of every row,
-    the constraint Jacobians and the minimum-norm passive solves batched (BatchClosure's rows,
-    the same as ClosureSystem.jacobian's), the bias K' q' Pinocchio's, a configuration at a time."""
+    the constraint Jacobians, the bias K'(q, q') q' and the minimum-norm passive solves batched
+    (BatchClosure's rows, the same as ClosureSystem.jacobian's and .bias's)."""
     mech = solver.mech
     Q = np.atleast_2d(np.asarray(Q, float))
     N, nv = len(Q), mech.nv
@@ -163,6 +166,6 @@ def motion_rates(solver, bc, Q, values: dict):
         return np.einsum("nkp,nk->np", Vt, inv * np.einsum("nmk,nm->nk", U, B))
 
     V[:, pa] = -solve(np.einsum("nmf,nf->nm", K[:, :, fr], V[:, fr]))
-    bias = np.array([mech.closure.bias(q, v) for q, v in zip(Q, V)])
+    bias = bc.bias(Q, V)
     A[:, pa] = solve(-bias)
     return V, A

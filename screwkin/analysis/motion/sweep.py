@@ -26,13 +26,12 @@ of the range, or the step budget is spent.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
 
-from ...errors import AssemblyError, UsageError
+from ...errors import AssemblyError, UsageError, quote, shorten
 from ...model.linalg import null_space
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from ...model.planar_graph import plan
@@ -40,12 +39,16 @@ from .dyads import planar_sweep
 from .position import outside_limits
 from ..singularities.singular import measures, scaled_jacobians
 
-__all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "Neighbour", "CONTINUATION_ROUNDS",
+__all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "Neighbour", "continuation_steps", "CONTINUATION_ROUNDS", "MAX_TRACKED",
            "drawn_start"]
 
 #: Continuation steps a sweep may take per configuration it records (a bound on its work: a motion that
 #: bends too sharply for any step the corrector accepts stops, said so, instead of running on).
 CONTINUATION_ROUNDS = 50
+#: The most continuation steps the per-step tracker is asked for by a grid coarser than its longest step
+#: (Tolerances.max_step): --from 0 --to 1e5rad in 2,000 steps is a million steps of 0.1 rad, hours of
+#: work; 100,000 (what sweep --steps allows) take about half a minute on a four-bar.
+MAX_TRACKED = 100_000
 
 
 @dataclass(frozen=True)
@@ -190,9 +193,13 @@ class _Tracker:
         if np.sign(fa) == np.sign(fb):
             raise _Stuck("the value is not on this arc")
         u = brentq(f, 0.0, 1.0, xtol=1e-14, rtol=4 * np.finfo(float).eps, maxiter=100)
-        # polish at the exact input value (the held joint then follows)
-        return self.closure.solve(self.solver.set_inputs(at(u), {self.name: x}), frozen=tuple(
-            sorted(set(self.frozen_other) | {self.ix}))).q
+        # polish at the exact input value (the held joint then follows); where the loops cannot be closed
+        # with the input held there, the value is a hole of the motion (sweep records it), not an error
+        try:
+            return self.closure.solve(self.solver.set_inputs(at(u), {self.name: x}), frozen=tuple(
+                sorted(set(self.frozen_other) | {self.ix}))).q
+        except AssemblyError:
+            raise _Stuck("the loops cannot be closed at this input value") from None
 
     def input_change(self, q0, q1) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
@@ -223,6 +230,14 @@ class _Tracker:
         return q, self.input_change(qa, q)
 
 
+def continuation_steps(mech, name: str, dx: float) -> int:
+    """How many steps a continuation takes to move input ``name`` by ``dx`` [rad or m]: steps of at most
+    Tolerances.max_step (scaled: characteristic lengths for a sliding input), as the sweep takes them."""
+    c = mech.coordinate(name)
+    scale = mech.length if mech.translational[c.idx_v] else 1.0
+    return int(np.ceil(abs(dx) / (mech.tolerances.max_step * scale)))
+
+
 class Neighbour:
     """One continuation step along input ``name`` of a PositionSolver, from a configuration to
     a nearby input value on the same branch: the sweep's predictor along the curve's tangent,
@@ -238,8 +253,7 @@ class Neighbour:
         direction = np.sign(x_to - x_from)
         if direction == 0:
             return q
-        # in steps of at most Tolerances.max_step (scaled), as the sweep takes them
-        pieces = int(np.ceil(abs(x_to - x_from) / (tr.tol.max_step * tr.scale[tr.ix])))
+        pieces = continuation_steps(tr.mech, tr.name, x_to - x_from)
         try:
             t = tr.tangent(q)
             if t[tr.ix] * direction < 0:
@@ -350,7 +364,7 @@ def _refined(f, start, h, k):
 
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-          near: dict | None = None, rate: float = 1.0, progress: bool = False, turn: bool = False,
+          near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
           max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
@@ -368,16 +382,18 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     batch: without turn, a mechanism the closed form does not cover is corrected a chunk of grid
     values at a time (screwkin.analysis.motion.batch_sweep), the tracker taking the chunks that
     fail (said in ``notes``); False: the per-step tracker.
+    progress: a callable ``progress(done, total)`` told of the grid values reached as the tracker
+    goes (present/progress.Progress draws it on a terminal); None: not told.
     """
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
     if name not in solver.inputs:
-        raise UsageError(f"{solver.mech.path}: '{name}' is not one of the inputs ({', '.join(solver.inputs)})")
+        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} is not one of the inputs ({', '.join(shorten(i, 40) for i in solver.inputs)})")
     fixed = dict(fixed or {})
     others = [n for n in solver.inputs if n != name]
     missing = [n for n in others if n not in fixed]
     if missing:
-        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
+        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(shorten(m, 40) for m in missing)}")
     mech = solver.mech
     tr = _Tracker(solver, name)
     max_steps = max_steps or 20 * steps + 100
@@ -407,7 +423,6 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     stopped = reason = None
     closed = False
     direction = np.sign(h) or 1.0
-    show = progress and sys.stderr.isatty() and steps >= 200
     try:
         t = tr.tangent(q0)
     except _Stuck as exc:
@@ -418,7 +433,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     # chunk corrected at once cannot take the shorter steps a coarse grid needs across a bend
     if batch and not turn and h != 0 and t is not None and abs(h) / tr.scale[tr.ix] <= mech.tolerances.max_step:
         b = batched_motion(solver, tr, q0, t, start, stop, steps, lambda qa, xa, xb, n: sweep(
-            solver, name, xa, xb, n, fixed=fixed, rate=rate, q_start=qa, closed_form=False, batch=False))
+            solver, name, xa, xb, n, fixed=fixed, rate=rate, q_start=qa, closed_form=False, batch=False), progress)
         if b is not None:
             X, Q, limits, stopped, reason, skipped, notes = b
             return _finish(solver, name, X, Q, rate, stopped, reason, (start, stop, steps), limits, False, False,
@@ -484,6 +499,11 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
         return (turn and forward() and len(X) > 2 and abs(X[-1] - start) < 1e-9 * max(1.0, abs(h))
                 and np.linalg.norm(pin.difference(mech.model, Q[-1], q0) / tr.scale) < 1e-6)
 
+    needed = continuation_steps(mech, name, stop - start)
+    if needed > max(steps, MAX_TRACKED):
+        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} over this range takes {needed:,} continuation steps of at "
+                         f"most {mech.tolerances.max_step:g} (rad or characteristic lengths) between {steps:,} grid "
+                         f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
     if h != 0 and t is not None:
         # the longest step taken (scaled): a grid step, at most Tolerances.max_step -- a coarse grid is
         # followed by shorter steps, so that no step jumps across a bend of the curve to another branch
@@ -563,12 +583,10 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
             if back_at_start():
                 closed = True
                 break
-            if show:
-                sys.stderr.write(f"\rsweep {min(len(X), steps)}/{steps}")
+            if progress is not None:
+                progress(min(len(X), steps), steps)
         else:
             stopped, reason = x, f"the step budget ({max_steps} configurations) is spent"
-    if show:
-        sys.stderr.write("\n")
     if turn and stopped is None and not closed and (stop - x) * np.sign(h) > 1e-9 * max(1.0, abs(stop)):
         stopped, reason = x, "the motion did not reach the end of the range"
     return _finish(solver, name, X, Q, rate, stopped, reason, (start, stop, steps), limits, turn, closed, unit,
@@ -597,7 +615,7 @@ def _finish(solver, name, X, Q, rate, stopped, reason, requested, limits, turn, 
     if mech.couplings:
         values = [mech.coupled_values(qq) for qq in Q]
         coupled = {c.joint: np.array([v[c.joint] for v in values]) for c in mech.couplings}
-    return SweepResult(name, np.array(X), Qa, np.array([list(mech.joint_values(qq).values()) for qq in Q]),
+    return SweepResult(name, np.array(X), Qa, mech.joint_value_rows(Qa) if len(Qa) else np.array([]),
                        np.array(V), np.array(A), tuple(mech.coordinate_names), rate, stopped, reason,
                        requested, tuple(limits), turn, closed, unit, coupled, tuple(skipped), method, tuple(notes))
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import UsageError
+from ...errors import UsageError, quote, shorten
 from .singular import Generic, measures
 from ..motion.sweep import Neighbour
 
@@ -53,7 +53,7 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
         raise UsageError(f"{', '.join(twice)} is given by --x/--y and by --set: a map input is not also held")
     for n in (x_name, y_name):
         if n not in solver.inputs:
-            raise UsageError(f"{mech.path}: '{n}' is not an input ({', '.join(solver.inputs)})")
+            raise UsageError(f"{mech.path}: {quote(n, 40)} is not an input ({', '.join(shorten(i, 40) for i in solver.inputs)})")
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     first = {x_name: xs[0], y_name: ys[0], **fixed}
     # the mode mapped: the one of q_start (a command's --mode K), else solve's first at the first corner

@@ -1,0 +1,178 @@
+"""Every file a command writes is written here: one way to write it, one way to fail.
+
+The command line's outputs are checked before the work starts (commands/_options.py); what can
+still fail is the writing itself, once the work is done: a full disk (``/dev/full``), a file-size
+limit (``ulimit -f``: EFBIG), a folder that exists but takes no new file (``/proc``).  Each is
+:class:`~screwkin.errors.OutputError` naming the path and the operating system's reason, exit 1,
+never a traceback.
+
+A regular file is written as ``PATH.partial`` beside it and renamed to ``PATH`` once whole: a file
+under the name asked for is always complete, a write that fails removes the partial one (and says
+so) and leaves a file that was there before as it was, and a process killed on the way (SIGKILL,
+a CPU limit) leaves only ``PATH.partial``, named as what it is.  Links, devices and pipes
+(``/dev/null``, ``/dev/stdout``) are written as they are and never removed; a named pipe nothing
+reads is an error, not a wait.
+
+- :func:`write_output` writes a whole text or blob;
+- :class:`OutputFile` is a file written piece by piece (a sweep streamed in chunks), also a binary
+  file object for writers of their own (pyarrow's);
+- :func:`write_figure` renders a matplotlib figure in memory, then writes it;
+- :func:`output_failed` is what each of them raises, and :func:`remove_partial` what they remove.
+"""
+
+from __future__ import annotations
+
+import errno as errnos
+import io
+import os
+import stat
+
+from ..errors import OutputError
+
+__all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL"]
+
+#: The suffix of a file being written (renamed to its own name once whole).
+PARTIAL = ".partial"
+
+
+def os_reason(exc: BaseException) -> str:
+    """The operating system's words for why ``exc`` happened (strerror of its errno)."""
+    errno = getattr(exc, "errno", None)
+    if errno == errnos.ENXIO:
+        return "a named pipe that nothing reads"
+    if errno:
+        return os.strerror(errno)
+    return getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
+
+
+def remove_partial(path: str) -> str | None:
+    """Remove ``path`` when it is a regular file (not a link, a device or a pipe): "removed"; "left"
+    when it could not be; None when there is no such file to remove."""
+    try:
+        if os.path.islink(path) or not os.path.isfile(path):
+            return None
+        os.remove(path)
+        return "removed"
+    except OSError:
+        return "left"
+
+
+def output_failed(path, exc: BaseException, partial=None) -> OutputError:
+    """The error of a write to ``path`` that failed with ``exc``: the file being written (``partial``,
+    default ``path``) removed, which the message says."""
+    return OutputError(path, os_reason(exc), remove_partial(str(partial or path)))
+
+
+class WholeOrNothing:
+    """A writer used in a ``with`` block: ``close()`` when the block ends, ``discard()`` (nothing left
+    under the name asked for) when it raises."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if kind is None:
+            self.close()
+        else:
+            self.discard()
+
+
+class OutputFile(WholeOrNothing):
+    """A file written piece by piece: ``write(data)`` and ``close()``, as a context manager (see the
+    module: a regular file is written as PATH.partial and renamed once whole).  Opening, writing or
+    closing it fails with OutputError (the partial file removed); leaving the ``with`` block on any
+    other exception (the work failed, or was interrupted) removes the partial file too."""
+
+    def __init__(self, path, mode: str = "w"):
+        self.path = str(path)
+        self._partial = None
+        encoding = None if "b" in mode else "utf-8"
+        try:
+            st = os.stat(self.path) if os.path.exists(self.path) else None
+            if os.path.islink(self.path) or (st is not None and not stat.S_ISREG(st.st_mode)):
+                if st is not None and stat.S_ISFIFO(st.st_mode):  # ENXIO at once when nothing reads it
+                    fd = os.open(self.path, os.O_WRONLY | os.O_NONBLOCK)
+                    os.set_blocking(fd, True)
+                    self._f = os.fdopen(fd, mode, encoding=encoding)
+                else:
+                    self._f = open(self.path, mode, encoding=encoding)
+            else:
+                self._partial = self.path + PARTIAL
+                self._f = open(self._partial, mode, encoding=encoding)
+        except OSError as exc:
+            raise OutputError(self.path, os_reason(exc)) from None
+
+    def write(self, data) -> int:
+        if self._f is None:
+            raise ValueError(f"{self.path} is closed")
+        try:
+            return self._f.write(data)
+        except OSError as exc:
+            self._drop()
+            raise output_failed(self.path, exc, self._partial) from None
+
+    # a writable binary file object for pyarrow's ParquetWriter (PythonFile)
+    def flush(self) -> None:
+        if self._f is not None:
+            try:
+                self._f.flush()
+            except OSError as exc:
+                self._drop()
+                raise output_failed(self.path, exc, self._partial) from None
+
+    def tell(self) -> int:
+        return self._f.tell()
+
+    @property
+    def closed(self) -> bool:
+        return self._f is None
+
+    def writable(self) -> bool:
+        return True
+
+    def readable(self) -> bool:
+        return False
+
+    def seekable(self) -> bool:
+        return False
+
+    def close(self) -> None:
+        f, self._f = self._f, None
+        if f is None:
+            return
+        try:
+            f.close()  # the last buffered bytes: a full disk often shows only here
+            if self._partial:
+                os.replace(self._partial, self.path)
+        except OSError as exc:
+            raise output_failed(self.path, exc, self._partial) from None
+
+    def _drop(self) -> None:
+        f, self._f = self._f, None
+        if f is not None:
+            try:
+                f.close()
+            except OSError:
+                pass
+
+    def discard(self) -> None:
+        """Stop writing and remove the partial file (a regular file; see remove_partial)."""
+        if self._f is not None:
+            self._drop()
+            if self._partial:
+                remove_partial(self._partial)
+
+
+def write_output(path, data) -> None:
+    """Write ``data`` (str, as UTF-8, or bytes) to ``path`` whole (OutputError when it cannot be)."""
+    with OutputFile(path, "wb" if isinstance(data, (bytes, bytearray, memoryview)) else "w") as f:
+        f.write(data)
+
+
+def write_figure(fig, path, **savefig) -> None:
+    """A matplotlib figure into ``path``, in the format of its suffix (PNG without one), rendered in
+    memory first: matplotlib itself does not report every failed write (``/dev/full`` passed)."""
+    fmt = os.path.splitext(str(path))[1][1:].lower() or "png"
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, **savefig)
+    write_output(path, buf.getvalue())
