@@ -124,7 +124,8 @@ def no_hang(seconds):
 # ---- CI must not skip what CI is meant to have (issue 23 item 7, issue 33 item 7)
 #: Modules .ci/run installs (pyproject.toml's test extra) that some tests import or skip without.
 CI_MODULES = ("numba", "matplotlib", "PIL", "mujoco", "viser", "pyarrow", "imageio_ffmpeg", "modern_robotics",
-              "pylinkage", "example_robot_data", "hypothesis")
+              "pylinkage", "example_robot_data", "hypothesis",
+              "websockets")  # (viser's own dependency: the interactive view's Chromium test drives the page with it)
 #: Skip reasons that mean "something .ci/run installs is missing": under CI=true such a skip fails the run.
 #: pytest.importorskip says "could not import 'M...'" (M or a submodule: 'pyarrow.parquet'), an import
 #: "No module named 'M..."; the rest are the reasons the tests give for programs and data.

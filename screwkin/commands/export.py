@@ -38,8 +38,6 @@ def run(mech, args) -> int:
                f"(loop residual {residual:.1e}): the file's zero configuration is that one, so each joint's value "
                "here is its value there minus: " + ", ".join(f"{k} {v:.9g}" for k, v in values.items()))
     written, notes, texts, compounds, redundant = [], [], [], [], None
-    if args.mjcf and args.urdf and os.path.realpath(args.mjcf) == os.path.realpath(args.urdf):
-        raise UsageError(f"--mjcf and --urdf name the same file {quote(args.mjcf)}: give two files")
     for fmt, out in (("MJCF", args.mjcf), ("URDF", args.urdf)):  # both made before either is written
         if not out:
             continue
