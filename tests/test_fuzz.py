@@ -779,13 +779,6 @@ MJCF_MUTANTS = 60 * SCALE
 ROUND3_MUTANTS = 160 * SCALE
 EXPORT_MUTANTS = 40 * SCALE
 
-#: Round-3 mutants that fail in code another issue owns: id -> why (the test is marked xfail, naming it).
-#: Issue 34 (screwkin/files/mjcf.py and exporter.py) owns MJCF inertias breaking A + B >= C, limited="yes",
-#: names with "--" in an export's comments, export helper names (X~F1, X~axis) colliding with the file's,
-#: and export --mjcf --urdf of a model with a ball joint.
-ISSUE_34: dict[str, str] = {}
-
-
 def _op_mjcf_inertia(root, rng):
     """An <inertial> no body has, or one at the edge: negative, zero, A + B < C, a full tensor not positive."""
     elems = list(root.iter("inertial"))
@@ -892,16 +885,10 @@ def mjcf_mutant(i: int):
     return base, data, what
 
 
-def _xfail_if_issue_34(key):
-    if key in ISSUE_34:
-        pytest.xfail(f"issue 34 (screwkin/files/mjcf.py, exporter.py): {ISSUE_34[key]}")
-
-
 @pytest.mark.parametrize("i", range(MJCF_MUTANTS), ids=lambda i: f"mjcf-{i:03d}")
 def test_mjcf_mutant(i, tmp_path, capfd):
     """MJCF files as MuJoCo reads them, mutated (inertias, limited flags, names an export writes, compiler
     settings, equalities): info, mobility, solve and dynamics keep the contract."""
-    _xfail_if_issue_34(f"mjcf-{i:03d}")
     base, data, _ = mjcf_mutant(i)
     path = tmp_path / "m.xml"
     path.write_bytes(data)
@@ -935,7 +922,6 @@ def _export_base(i):
 def test_export_mutant(i, tmp_path, capfd):
     """export --mjcf and --urdf keep the contract, and what they write loads again: screwkin reads back its
     own export (exit 0, the same number of moving coordinates), MuJoCo compiles the MJCF."""
-    _xfail_if_issue_34(f"export-{i:03d}")
     fmt, base, data = _export_base(i)
     path = tmp_path / f"m{base.suffix}"
     if data is None:
@@ -947,8 +933,6 @@ def test_export_mutant(i, tmp_path, capfd):
         code, _, err = check_contract(["export", str(path), "--mjcf", str(out_x), "--urdf", str(out_u), "--json"],
                                       capfd, [path], full=True)
     if code != 0:
-        if (out_x.exists() or out_u.exists()) and "is a ball joint: URDF has none" in err:
-            pytest.xfail("issue 34: export --mjcf --urdf of a model with a ball joint exits 1 after writing the MJCF")
         assert not out_x.exists() and not out_u.exists(), f"a failed export (exit {code}) left a file written"
         return
     for out in (out_x, out_u):
@@ -956,13 +940,7 @@ def test_export_mutant(i, tmp_path, capfd):
             again = check_contract(["mobility", str(out), "--json"], capfd, [out])
         assert again == 0, f"screwkin cannot read back its own export {out.name} of {base.name}"
     mujoco = pytest.importorskip("mujoco")
-    try:
-        mujoco.MjModel.from_xml_path(str(out_x))
-    except ValueError as exc:
-        if "inertia must" in str(exc):  # the reader took an inertia no body has, and wrote it
-            pytest.xfail(f"issue 34: the MJCF reader accepts an inertia MuJoCo refuses ({str(exc).splitlines()[0]}); "
-                         "files/inertia.inertia_problem is the check to call")
-        raise
+    mujoco.MjModel.from_xml_path(str(out_x))  # (an inertia no body has is refused by the reader, never written)
 
 
 #: Values for the round-3 slots: {u} a value with a unit, {p} a --point, {v} a number or count, {o} an output.

@@ -127,7 +127,7 @@ def _with_coupler_inertia(tmp_path, ixx, iyy, izz, ixy=0.0):
 
 
 @pytest.mark.parametrize("inertia, says", [((0.0002, 0.0002, -1.0), "a negative principal moment"),
-                                           ((0.0002, 0.0002, 0.0005), "break A + B >= C (0.0004 < 0.0005)"),
+                                           ((0.0002, 0.0002, 0.0005), "A + B >= C (0.0004 < 0.0005)"),
                                            ((0.0002, 0.0002, 0.0002, 0.0003), "a negative principal moment")])
 def test_dynamics_refuses_an_inertia_no_body_has_and_loading_warns(tmp_path, capsys, inertia, says):
     """izz="-1" gave a kinetic energy of -29.9 J.  Refused by dynamics (exit 1, naming the link), warned

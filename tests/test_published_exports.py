@@ -412,11 +412,11 @@ def test_without_mujoco_the_rows_are_not_named_and_it_is_said(tmp_path, capsys, 
 
 # ------------------------------------------------------------------ the physical-inertia check, any format's
 def test_inertia_problem_takes_any_descriptions_inertial():
-    """screwkin.files.mjcf_inertia.inertia_problem takes the tensor or the six numbers a URDF <inertia>
+    """screwkin.files.inertia.inertia_problem takes the tensor or the six numbers a URDF <inertia>
     (or MJCF fullinertia) writes, with the same answer: principal moments 1, 1, 3 break A + B >= C
     (1 + 1 < 3); a thin rod (0, 1, 1) is the limit and passes; a tensor with a negative moment, or a
     negative mass, is named; MuJoCo refuses the first and accepts the rod's limit alike."""
-    from screwkin.files.mjcf_inertia import inertia_problem
+    from screwkin.files.inertia import inertia_problem
     bad = (1.0, 1.0, 3.0, 0.0, 0.0, 0.0)
     assert "break the triangle inequality" in inertia_problem(2.0, bad)
     assert inertia_problem(2.0, bad) == inertia_problem(2.0, np.diag([1.0, 1.0, 3.0]))

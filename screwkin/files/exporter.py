@@ -40,7 +40,7 @@ import pinocchio as pin
 
 from ..tolerances import DEFAULT
 from .description import Coupling
-from .mjcf_inertia import inertia_problem
+from .inertia import inertia_problem
 from .mjcf import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 

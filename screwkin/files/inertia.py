@@ -31,21 +31,36 @@ ROUNDING = 1e-6
 FLOOR = 1e-12
 
 
-def inertia_problem(mass, ixx, iyy, izz, ixy=0.0, ixz=0.0, iyz=0.0) -> str | None:
+def inertia_problem(mass, *inertia) -> str | None:
     """Why ``mass`` [kg] and the inertia tensor about the centre of mass [kg m^2] cannot be a rigid body's
-    (one phrase, naming the numbers), or None when they can.  A mass of None (not given) is not checked."""
+    (one phrase, naming the numbers), or None when they can.  A mass of None (not given) is not checked.
+
+    Any description's inertial: ``inertia`` is the six numbers a URDF ``<inertia>`` or an MJCF
+    ``fullinertia`` writes, ``ixx, iyy, izz[, ixy, ixz, iyz]`` (products 0 when left out), as arguments or
+    as one sequence, or the 3 x 3 tensor (in any axes: the checks do not depend on them).  The phrase
+    names no file or element (the caller says where: ``link 'x' has ...``)."""
     if mass is not None and mass < 0:
         return f"a negative mass ({mass:g} kg)"
-    tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], float)
+    values = np.asarray(inertia[0] if len(inertia) == 1 else inertia, float)
+    if values.shape == (3, 3):
+        tensor = values
+    elif values.shape in ((3,), (6,)):
+        ixx, iyy, izz, ixy, ixz, iyz = (*values, 0.0, 0.0, 0.0)[:6]
+        tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], float)
+    else:
+        raise ValueError(f"inertia_problem: expected 3 or 6 numbers or a (3, 3) tensor, got shape {values.shape}")
     if not np.all(np.isfinite(tensor)):
         return "an inertia that is not finite"
+    scale = float(np.abs(tensor).max())
+    if np.abs(tensor - tensor.T).max() > ROUNDING * scale + FLOOR:
+        return "an inertia tensor that is not symmetric"
     a, b, c = np.linalg.eigvalsh(tensor)  # ascending
     slack = ROUNDING * max(abs(a), abs(c)) + FLOOR
     moments = f"principal moments {a:.4g}, {b:.4g}, {c:.4g} kg m^2"
     if a < -slack:
-        return f"an inertia with a negative principal moment ({moments})"
+        return f"an inertia tensor that is not positive (a negative principal moment: {moments})"
     if a + b < c - slack:
-        return f"an inertia whose {moments} break A + B >= C ({a + b:.4g} < {c:.4g})"
+        return f"an inertia whose {moments} break the triangle inequality A + B >= C ({a + b:.4g} < {c:.4g})"
     return None
 
 

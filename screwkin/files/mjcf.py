@@ -34,7 +34,8 @@ from ..tolerances import DEFAULT
 from .description import JOINT_DYNAMICS, LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
 from .mjcf_equality import matrix_quat, quat_matrix, read_equalities
 from .mjcf_include import expand_includes
-from .mjcf_inertia import DEFAULT_DENSITY, SOLIDS, body_inertia, geom_inertia, geom_volume, inertia_problem
+from .inertia import inertia_problem
+from .mjcf_inertia import DEFAULT_DENSITY, SOLIDS, body_inertia, geom_inertia, geom_volume
 from .mjcf_transmission import ACTUATORS, read_actuators, read_tendons
 from .urdf import Problems, check_sizes, numbers, unit_axis
 from .writer import quoteattr, vector_text

@@ -1,5 +1,5 @@
-"""Mass and inertia of MJCF bodies as MuJoCo's compiler computes them, and the physical-inertia
-check of any format's inertial (inertia_problem).
+"""Mass and inertia of MJCF bodies as MuJoCo's compiler computes them (the physical-inertia check of
+any format's inertial is files/inertia.inertia_problem).
 
 A body without ``<inertial>`` (or every body, with ``<compiler inertiafromgeom="true">``) gets
 the mass and inertia of its geoms: each geom a solid of uniform ``density`` (the geom's, default
@@ -25,9 +25,7 @@ import math
 
 import numpy as np
 
-from ..tolerances import DEFAULT
-
-__all__ = ["SOLIDS", "DEFAULT_DENSITY", "geom_volume", "geom_inertia", "body_inertia", "inertia_problem"]
+__all__ = ["SOLIDS", "DEFAULT_DENSITY", "geom_volume", "geom_inertia", "body_inertia"]
 
 #: Geom types whose mass MuJoCo computes from their shape and that screwkin computes the same way.
 SOLIDS = ("sphere", "capsule", "cylinder", "box", "ellipsoid")
@@ -86,33 +84,3 @@ def body_inertia(parts) -> tuple:
         d = np.asarray(p, float) - com
         inertia += R @ np.diag(moments) @ R.T + m * (d @ d * np.eye(3) - np.outer(d, d))
     return mass, com, inertia
-
-
-def inertia_problem(mass: float, inertia, scale: float = 1.0) -> str | None:
-    """Why a rigid body's mass and inertia [kg, kg m^2] are not physical, or None: a negative mass, an
-    asymmetric or not positive semi-definite tensor, principal moments that break the triangle
-    inequality A + B >= C (no distribution of mass has them; MuJoCo refuses such a file).
-
-    Any description's inertial: ``inertia`` is the 3 x 3 tensor (about the centre of mass, in any
-    axes: the checks do not depend on them) or the six numbers a URDF ``<inertia>`` or an MJCF
-    ``fullinertia`` writes, (ixx, iyy, izz, ixy, ixz, iyz).  The message names no file or element
-    (the caller says where: ``link 'x' <inertial> has ...``).  ``scale`` is the size of the numbers
-    compared (round-off allowance relative to it)."""
-    if mass < 0:
-        return f"a negative mass ({mass:g} kg)"
-    inertia = np.asarray(inertia, float)
-    if inertia.shape == (6,):
-        xx, yy, zz, xy, xz, yz = inertia
-        inertia = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-    size = max(float(np.abs(inertia).max()), 0.0) * scale
-    slack = DEFAULT.zero * size  # round-off of the eigenvalues of a tensor written to ~16 digits
-    if np.abs(inertia - inertia.T).max() > slack:
-        return "an inertia tensor that is not symmetric"
-    moments = np.linalg.eigvalsh(inertia)
-    if moments[0] < -slack:
-        return f"an inertia tensor that is not positive (principal moments {', '.join(f'{x:.6g}' for x in moments)})"
-    a, b, c = moments
-    if a + b < c - slack:
-        return (f"principal moments {a:.6g}, {b:.6g}, {c:.6g} kg m^2 that break the triangle inequality "
-                "A + B >= C (no body has them)")
-    return None
