@@ -26,7 +26,8 @@ Points stay on the constraint variety (the circles and unit quaternions: a produ
 circles and spheres): a step is taken in its tangent coordinates -- one angle per revolute, applied
 as the complex rotation (c, s) -> (c cos d - s sin d, s cos d + c sin d); one length per prismatic;
 a rotation vector per quaternion, applied as q -> exp(d / 2) q -- which keep c^2 + s^2 and q.q as
-they were (``retract``).  On the variety every rotation is complex orthogonal, and the Jacobian in
+they were (``retract``; it divides them by their square root too, so that round-off, large where
+a path makes a big excursion, cannot make the point drift off the variety).  On the variety every rotation is complex orthogonal, and the Jacobian in
 those coordinates is the geometric one: a revolute's column moves a point p by w x (p - o) and a
 vector v by w x v (w its world axis, o its origin), a prismatic's moves points by its world axis, a
 quaternion's are three revolutes about its frame's axes through its centre.
@@ -39,6 +40,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from . import algebraic_compiled
 from .geometry import skew
 
 __all__ = ["PolynomialClosure", "SquareSystem", "algebraic_obstacle", "quaternion_matrix"]
@@ -112,7 +114,9 @@ class PolynomialClosure:
     length: L [m]; points: frame ids whose origins the signature holds; output: a frame id whose
     pose it holds."""
 
-    def __init__(self, model, cuts, frozen, length: float, points=(), output=None):
+    def __init__(self, model, cuts, frozen, length: float, points=(), output=None, compiled: bool | None = None):
+        """compiled: evaluate the rows with the numba kernel of model.algebraic_compiled (True), with
+        numpy (False), or with the kernel when numba imports (None)."""
         self.model, self.cuts, self.L = model, list(cuts), float(length)
         frozen = set(int(f) for f in np.asarray(frozen, int).ravel())
         data = model.createData()
@@ -188,6 +192,14 @@ class PolynomialClosure:
         self.keep = np.ones(self._nrows_all, bool)
         self.keep = self._nonzero_rows()
         self.m = int(self.keep.sum())
+        self._kernel = None
+        if compiled or (compiled is None and algebraic_compiled.available()):
+            self._kernel, self._packed = algebraic_compiled.kernel(), algebraic_compiled.pack(self)
+
+    @property
+    def compiled(self) -> bool:
+        """Whether the rows are evaluated by the compiled kernel."""
+        return self._kernel is not None
 
     # ------------------------------------------------------------------ layout
     def _ancestors(self, j) -> set:
@@ -337,7 +349,9 @@ class PolynomialClosure:
             d = dT[:, self.rev_t]
             c, s = X[:, self.rev_c], X[:, self.rev_c + 1]
             cd, sd = np.cos(d), np.sin(d)
-            X[:, self.rev_c], X[:, self.rev_c + 1] = c * cd - s * sd, s * cd + c * sd
+            c, s = c * cd - s * sd, s * cd + c * sd
+            rho = np.sqrt(c * c + s * s)  # 1 but for round-off, which big excursions would let drift
+            X[:, self.rev_c], X[:, self.rev_c + 1] = c / rho, s / rho
         if self.pri.size:
             X[:, self.pri_u] += dT[:, self.pri_t]
         for j in self.quat:
@@ -348,7 +362,8 @@ class PolynomialClosure:
             small = np.abs(z) < 1e-8
             sinc = np.where(small, 1 - z / 6, np.sin(np.where(small, 1.0, r)) / np.where(small, 1.0, r))
             u = np.c_[d * sinc[:, None], np.cos(r)]
-            X[:, sl.stop - 4:sl.stop] = _qmul(u, X[:, sl.stop - 4:sl.stop])
+            qn = _qmul(u, X[:, sl.stop - 4:sl.stop])
+            X[:, sl.stop - 4:sl.stop] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
             if self.kind[j] == "F":
                 X[:, sl.start:sl.start + 3] += dT[:, tl][:, :3]
         return X
@@ -498,6 +513,10 @@ class PolynomialClosure:
 
     def rows(self, X, jacobian: bool = True):
         """The closure rows kept (P, m) and their Jacobian in tangent coordinates (P, m, nt)."""
+        if self._kernel is not None:
+            r, J = self._kernel(np.ascontiguousarray(X, complex), np.ascontiguousarray(self.Rc.transpose(2, 0, 1)),
+                                np.ascontiguousarray(self.tc.T), *self._packed, self.nt, jacobian)
+            return r, (J if jacobian else None)
         r, J = self._rows_all(self.kinematics(X, jacobian), jacobian)
         return r[self.keep].T, (J[self.keep].transpose(2, 0, 1) if jacobian else None)
 
@@ -583,6 +602,11 @@ class SquareSystem:
 
     def tangent(self, X):
         return self.closure.tangent(X)
+
+    def on_variety(self, X, tol: float = 1e-10) -> np.ndarray:
+        """(P,) whether X keeps the circles and unit quaternions to round-off (relative to |x|^2)."""
+        g = np.abs(self.closure.constraints(X[:, :self.width])).max(axis=1, initial=0.0)
+        return g <= tol * (1.0 + np.abs(X).max(axis=1)) ** 2
 
     def closes(self, X):
         """(P,) the largest of every closure row (uncombined) and constraint at X."""

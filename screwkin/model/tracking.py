@@ -46,17 +46,19 @@ class TrackerOptions:
     first_step, min_step, max_step: step sizes in t; max_steps: per path;
     max_jump: the most a step may move a point, relative to 1 + |x|;
     diverge: |x| beyond which a path goes to infinity;
-    polish: Newton iterations at t = 1."""
+    polish: Newton iterations at t = 1; root_tol: |H| there (before the last), relative to 1 + |x|,
+    below which a path has arrived at a root."""
 
-    tol: float = 1e-9
-    target: float = 3e-5
-    contraction: float = 0.05
+    tol: float = 1e-7
+    target: float = 1e-4
+    contraction: float = 0.25
     first_step: float = 0.05
     min_step: float = 1e-9
     max_step: float = 0.3
     max_steps: int = 3000
     diverge: float = 1e8
     polish: int = 3
+    root_tol: float = 1e-9
     max_jump: float = 2.0
 
 
@@ -184,7 +186,8 @@ def track(hom, X0, index=None, options: TrackerOptions = DEFAULT_OPTIONS, t0=0.0
         with np.errstate(all="ignore"):
             Xp, _, res = newton(hom, X[ok], T[ok], index[ok], o.polish)
         X[ok], residual[ok] = Xp, res
-        status[ok & ~np.isfinite(residual)] = FAILED
+        # arrived only where Newton settles on a root (a path that strayed is a failure, not a root)
+        status[ok & ~(residual <= o.root_tol * (1.0 + _norm(np.where(np.isfinite(X), X, 0))))] = FAILED
     return Tracked(X, T, status, steps, refused, residual)
 
 

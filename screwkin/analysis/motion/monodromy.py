@@ -43,13 +43,16 @@ class MonodromyOptions:
     """max_rounds: monodromy rounds in all; patience: rounds without a new root before the trace
     test is tried; tries: trace tests before giving up; trace_tol: the trace test's threshold (a
     relative singular value); max_roots: the most roots (orbits) kept, a bound on the work;
+    newton_starts: random starts of damped Newton added to the trace test's witnesses after a test
+    that did not close;
     same: two roots closer than this (relative) are one; tracker: model.tracking.TrackerOptions."""
 
     max_rounds: int = 40
     patience: int = 2
-    tries: int = 4
+    tries: int = 8
     trace_tol: float = 1e-10
     max_roots: int = 4000
+    newton_starts: int = 400
     same: float = 1e-7
     tracker: tracking.TrackerOptions = tracking.DEFAULT_OPTIONS
 
@@ -80,14 +83,32 @@ class _Offsets:
         self.X = np.zeros((0, system.width), complex)
         self.loops = []  # (c1, c2, how many of X have been around it)
         self.paths = self.failed = 0
+        self.last_only = False
         self.add(np.atleast_2d(X))
 
+    def roots(self, X) -> np.ndarray:
+        """Which points of X are roots at the base: the equations there within round-off of c0 and
+        a Newton step from them within round-off of nothing (a path that strayed near infinity
+        and ended on no root is not one)."""
+        X = np.asarray(X, complex)
+        ok = np.isfinite(X).all(axis=1)
+        if not ok.any():
+            return ok
+        with np.errstate(all="ignore"):
+            G, J = self.system.equations(X[ok])
+            H = G - self.c0
+            step = np.abs(tracking._solve(J, H[..., None])[..., 0]).max(axis=1)
+        size = 1.0 + np.abs(X[ok]).max(axis=1)
+        scale = 1.0 + np.abs(self.c0).max()
+        good = (np.abs(H).max(axis=1) <= 1e-10 * scale) & (step <= 1e-9 * size) & self.system.on_variety(X[ok])
+        ok[np.flatnonzero(ok)[~good]] = False
+        return ok
+
     def add(self, X) -> int:
-        """Keep the points of X not yet known (up to the group); returns how many were new."""
+        """Keep the roots of X not yet known (up to the group); returns how many were new."""
         new = 0
-        for x in X:
-            if not np.all(np.isfinite(x)):
-                continue
+        X = np.atleast_2d(X)
+        for x in X[self.roots(X)]:
             Y = self.X
             if self.group.match(x[None], Y, self.o.same)[0] < 0:
                 self.X = np.vstack([Y, x[None]])
@@ -100,8 +121,11 @@ class _Offsets:
         fibre: 24 of 24 found in 3 rounds, against 22 or 23 of 24 after 6 rounds with loops of the
         base's size)."""
         m = len(self.c0)
-        scale = max(float(np.sqrt(np.mean(np.abs(self.c0) ** 2))), 1e-3) * 10.0 * np.exp(self.rng.normal())
-        return scale * (self.rng.normal(size=m) + 1j * self.rng.normal(size=m)) / np.sqrt(2)
+        scale = max(float(np.sqrt(np.mean(np.abs(self.c0) ** 2))), 1e-3) * 10.0 * np.exp(np.clip(self.rng.normal(), -1, 1))
+        out = scale * (self.rng.normal(size=m) + 1j * self.rng.normal(size=m)) / np.sqrt(2)
+        if self.last_only:  # loops in the last offset alone (the trace test's t), the others at the base
+            out[:-1] = self.c0[:-1]
+        return out
 
     def round(self) -> int:
         """One round: a new loop (several while few roots are known) for every root, and the roots
@@ -160,6 +184,9 @@ class _WithLine:
 
     def retract(self, Y, dT):
         return np.c_[self.system.retract(Y[:, :-1], dT[:, :-1]), Y[:, -1] + dT[:, -1]]
+
+    def on_variety(self, Y):
+        return self.system.on_variety(Y[:, :-1])
 
 
 class _Ell:
@@ -239,10 +266,33 @@ class _TraceRun:
         Y0 = np.vstack([np.c_[main.X, np.zeros(len(main.X))], np.c_[seeds, np.ones(len(seeds))]])
         self.run = _Offsets(self.system, _extended(group), Y0, np.r_[c0, 0.0], rng, o)
 
+    def newton(self, starts: int, iterations: int = 40):
+        """Damped Newton on the fibre at t = 0 from ``starts`` random points (x on the variety, l complex
+        normal): a cheap supplement to the loops, whose mixing leaves some witnesses unvisited for
+        long (the roots it reaches are checked like every other)."""
+        closure = self.main.system.closure
+        X = closure.random_points(self.rng, starts)
+        lam = (self.rng.normal(size=starts) + 1j * self.rng.normal(size=starts)) * 2.0
+        Y = np.c_[X, lam]
+        base = np.r_[self.main.c0, 0.0]
+        seg = tracking.Segment(self.system, base[None], base[None])
+        idx = np.zeros(starts, int)
+        with np.errstate(all="ignore"):
+            for _ in range(iterations):
+                H, J = seg.evaluate(Y, np.zeros(len(Y)), idx)
+                d = tracking._solve(J, H[..., None])[..., 0]
+                size = np.abs(d).max(axis=1)
+                d *= np.minimum(1.0, 0.5 / np.where(np.isfinite(size), np.maximum(size, 1e-300), 1.0))[:, None]
+                keep = np.isfinite(d).all(axis=1)
+                Y, idx = self.system.retract(Y[keep], -d[keep]), idx[keep]
+        self.main.paths += starts
+        return self.run.add(Y)
+
     def complete(self):
         """Monodromy rounds until ``patience`` rounds find nothing; main roots found here join the main set."""
         stale = 0
         while stale < self.o.patience and len(self.run.X) < self.o.max_roots:
+            self.run.last_only = not self.run.last_only  # loops in t alone mix the two parts of the fibre
             stale = stale + 1 if self.run.round() == 0 else 0
         self.main.paths += self.run.paths
         self.main.failed += self.run.failed
@@ -309,7 +359,7 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
     main = _Offsets(system, group, x0, c0, rng, o)
     if seeds is not None and len(seeds):
         main.add(seeds)
-    run, trace, complete, why, tries, stale = None, None, False, "", 0, 0
+    run, trace, complete, why, tries, stale, witnesses = None, None, False, "", 0, 0, 0
     for rnd in range(1, o.max_rounds + 1):
         new = main.round()
         stale = stale + 1 if new == 0 else 0
@@ -319,13 +369,23 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
         if stale < 1 and (target_count is None or len(main.X) < target_count):
             continue
         if run is None:
-            run = _TraceRun(main, rng, o)
+            run, before = _TraceRun(main, rng, o), -1
         run.complete()
         trace = run.trace()
+        if trace is not None and trace >= o.trace_tol:  # not complete: Newton from random points adds witnesses
+            if run.newton(o.newton_starts):
+                trace = run.trace()
         tries += 1
         if trace is not None and trace < o.trace_tol:
             complete = True
             break
+        witnesses = run.witnesses
+        if len(run.run.X) == before:
+            # a try that found nothing new: the missing witness may lie near infinity, where neither
+            # loops nor Newton reach it -- the next try draws another line v and slice ell
+            run = None
+        else:
+            before = len(run.run.X)
         if tries >= o.tries:
             why = ("the trace test failed" if trace is None else
                    f"the trace test did not close (relative singular value {trace:.2g})") + f" after {tries} tries"
@@ -334,7 +394,7 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
     else:
         why = why or f"no certificate after {o.max_rounds} monodromy rounds"
     return Roots(main.X, c0, complete, trace, "" if complete else why, rnd, main.paths, main.failed,
-                 0 if run is None else run.witnesses, time.perf_counter() - t0, group)
+                 run.witnesses if run is not None else witnesses, time.perf_counter() - t0, group)
 
 
 @dataclass
@@ -348,9 +408,12 @@ class Endpoints:
     paths: int
 
 
-def to_target(system, roots: Roots, target, options: MonodromyOptions = MonodromyOptions()) -> Endpoints:
-    """Every root at c0 carried to the offset ``target`` (real) by one parameter homotopy, with the
-    Cauchy endgame for the paths that do not arrive regularly."""
+def to_target(system, roots: Roots, target, options: MonodromyOptions = MonodromyOptions(),
+              radius: float = 0.01) -> Endpoints:
+    """Every root at c0 carried to the offset ``target`` by one parameter homotopy.  A path that does
+    not arrive at a regular root (Newton settles, the Jacobian's condition number below 1e10) is
+    tracked again to t = 1 - ``radius`` and finished by the Cauchy endgame: a finite endpoint (the
+    mean of the loop closes the system) is singular, one that does not is at infinity."""
     X0 = roots.X
     P = len(X0)
     a = np.broadcast_to(roots.c0, (P, len(roots.c0)))
@@ -361,29 +424,28 @@ def to_target(system, roots: Roots, target, options: MonodromyOptions = Monodrom
     res = tracking.track(seg, X0, options=options.tracker)
     X = res.X.copy()
     status[res.status == tracking.DIVERGED] = "infinity"
-    # regular: arrived and Newton converges (a nonsingular Jacobian); the others go to the endgame
-    bad = np.flatnonzero(res.status != tracking.DIVERGED)
-    if bad.size:
-        arrived = res.ok[bad]
-        cond = np.full(len(bad), np.inf)
-        if arrived.any():
-            _, J = seg.evaluate(X[bad[arrived]], np.ones(int(arrived.sum())), bad[arrived])
-            s = np.linalg.svd(J, compute_uv=False)
-            cond[arrived] = s[:, 0] / np.maximum(s[:, -1], 1e-300)
-        bad = bad[~arrived | (cond > 1e10) | (res.residual[bad] > 1e-8)]
-    if bad.size:
-        # back to t = 1 - r along the path, then around t = 1
-        r = 0.01
-        back = tracking.track(seg, X0[bad], bad, options.tracker, t1=1.0 - r)
-        good = back.ok
-        status[bad[~good]] = "failed"
+    regular = res.ok.copy()
+    if regular.any():
+        _, J = seg.evaluate(X[regular], np.ones(int(regular.sum())), np.flatnonzero(regular))
+        good = np.isfinite(J).reshape(len(J), -1).all(axis=1)
+        cond = np.full(len(J), np.inf)
         if good.any():
-            ends, cyc, ok = tracking.cauchy(seg, back.X[good], bad[good], r, options=options.tracker)
-            idx = bad[good]
-            X[idx] = ends
-            cycles[idx] = cyc
-            big = np.abs(ends).max(axis=1) > 1e6
-            status[idx[ok & big]] = "infinity"
-            status[idx[ok & ~big]] = "singular"
+            sv = np.linalg.svd(J[good], compute_uv=False)
+            cond[good] = sv[:, 0] / np.maximum(sv[:, -1], 1e-300)
+        regular[np.flatnonzero(regular)[cond > 1e10]] = False
+    bad = np.flatnonzero(~regular & (res.status != tracking.DIVERGED))
+    if bad.size:
+        back = tracking.track(seg, X0[bad], bad, options.tracker, t1=1.0 - radius)
+        status[bad[~back.ok]] = "failed"
+        idx = bad[back.ok]
+        if idx.size:
+            ends, cyc, ok = tracking.cauchy(seg, back.X[back.ok], idx, radius, options=options.tracker)
+            X[idx], cycles[idx] = ends, cyc
+            with np.errstate(all="ignore"):
+                H, _ = seg.evaluate(ends, np.ones(len(idx)), idx, jacobian=False)
+            size = 1.0 + np.abs(np.where(np.isfinite(ends), ends, 0)).max(axis=1)
+            closes = np.abs(H).max(axis=1) <= 1e-6 * size
+            status[idx[ok & closes]] = "singular"
+            status[idx[ok & ~closes]] = "infinity"
             status[idx[~ok]] = "failed"
     return Endpoints(X, status, cycles, P)
