@@ -41,9 +41,10 @@ import numpy as np
 import pinocchio as pin
 
 from . import algebraic_compiled
-from .geometry import skew
+from .geometry import quaternion_matrix, quaternion_product, skew, stack_cross, stack_mm, stack_mv
+from .legs import distance_legs
 
-__all__ = ["PolynomialClosure", "SquareSystem", "algebraic_obstacle", "quaternion_matrix"]
+__all__ = ["PolynomialClosure", "algebraic_obstacle"]
 
 #: Joint models whose motion is polynomial in the unknowns above, by kind.
 _KINDS = {"JointModelRX": "R", "JointModelRY": "R", "JointModelRZ": "R", "JointModelRevoluteUnaligned": "R",
@@ -52,6 +53,10 @@ _KINDS = {"JointModelRX": "R", "JointModelRY": "R", "JointModelRZ": "R", "JointM
           "JointModelPX": "P", "JointModelPY": "P", "JointModelPZ": "P", "JointModelPrismaticUnaligned": "P",
           "JointModelSpherical": "S", "JointModelFreeFlyer": "F"}
 _WIDTH = {"R": 2, "P": 1, "S": 4, "F": 7}
+#: A row this small (relative to the largest) at random points is round-off of a zero polynomial.
+_ZERO_ROW = 1e-10
+#: Below this |d|^2 the quaternion step exp(d) takes sin(r)/r from its series.
+_SERIES = 1e-8
 _TANGENT = {"R": 1, "P": 1, "S": 3, "F": 6}
 
 
@@ -81,31 +86,6 @@ def algebraic_obstacle(model, cuts, extra=(), couplings=()) -> str | None:
     return None
 
 
-def quaternion_matrix(q):
-    """Q(q) for quaternions q (..., 4) in Pinocchio's order (x, y, z, w): the homogeneous quadratic
-    form, (q.q) times the rotation of q / |q|; (..., 3, 3)."""
-    x, y, z, w = (q[..., k] for k in range(4))
-    return np.stack([
-        np.stack([w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z], -1)], -2)
-
-
-def _mm(A, B):
-    """3 x 3 products over the trailing (stack) axes: A (3, 3, ...), B (3, 3, ...)."""
-    return A[:, 0, None] * B[None, 0] + A[:, 1, None] * B[None, 1] + A[:, 2, None] * B[None, 2]
-
-
-def _mv(A, v):
-    """A (3, 3, ...) times v (3, ...)."""
-    return A[:, 0] * v[0] + A[:, 1] * v[1] + A[:, 2] * v[2]
-
-
-def _cross(a, b):
-    """a x b over the leading axis (3, ...)."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
 class PolynomialClosure:
     """The closure rows of a model's cut joints as polynomials in the passive joints' unknowns.
 
@@ -114,11 +94,18 @@ class PolynomialClosure:
     length: L [m]; points: frame ids whose origins the signature holds; output: a frame id whose
     pose it holds."""
 
-    def __init__(self, model, cuts, frozen, length: float, points=(), output=None, compiled: bool | None = None):
+    def __init__(self, model, cuts, frozen, length: float, points=(), output=None, compiled: bool | None = None,
+                 eliminate: bool = True):
         """compiled: evaluate the rows with the numba kernel of model.algebraic_compiled (True), with
-        numpy (False), or with the kernel when numba imports (None)."""
+        numpy (False), or with the kernel when numba imports (None); eliminate: the legs that are
+        distance constraints (model.legs) become one row each, their joints no unknowns."""
         self.model, self.cuts, self.L = model, list(cuts), float(length)
         frozen = set(int(f) for f in np.asarray(frozen, int).ravel())
+        self.legs = distance_legs(model, self.cuts, frozen, self.L, [output] if output is not None else []) \
+            if eliminate else []
+        self.eliminated = {j for leg in self.legs for j in leg.joints}
+        for j in self.eliminated:  # held like inputs: nothing the rows read depends on them any more
+            frozen.update(range(model.joints[j].idx_v, model.joints[j].idx_v + model.joints[j].nv))
         data = model.createData()
         pin.forwardKinematics(model, data, pin.neutral(model))
         nj = self.nj = model.njoints
@@ -174,14 +161,18 @@ class PolynomialClosure:
                 "quat": [(pos[j], j) for j in self.quat if j in pos],
                 "const": np.array([k for k, j in enumerate(js) if not self.passive[j]], int)})
         self._row_plan()
-        self.point_frames = list(points)
+        on_leg = lambda f: model.frames[f].parentJoint in self.eliminated  # noqa: E731
+        self.point_frames = [f for f in points if not on_leg(f)]
         self.output = output
         frames = self.row_frames + self.point_frames + ([output] if output is not None else [])
         self.frames = list(dict.fromkeys(frames))
         self.f_index = {f: k for k, f in enumerate(self.frames)}
-        self.f_joint = np.array([model.frames[f].parentJoint for f in self.frames], int)
-        self.f_R = np.array([model.frames[f].placement.rotation for f in self.frames]).reshape(-1, 3, 3).transpose(1, 2, 0)
-        self.f_t = (np.array([model.frames[f].placement.translation for f in self.frames]).reshape(-1, 3) / self.L).T
+        spec = {f: (model.frames[f].parentJoint, model.frames[f].placement.rotation, model.frames[f].placement.translation)
+                for f in self.frames if not isinstance(f, tuple)}
+        spec.update({("O", k): (leg.parent, np.eye(3), np.array(leg.centre)) for k, leg in enumerate(self.legs)})
+        self.f_joint = np.array([spec[f][0] for f in self.frames], int)
+        self.f_R = np.array([spec[f][1] for f in self.frames]).reshape(-1, 3, 3).transpose(1, 2, 0)
+        self.f_t = (np.array([spec[f][2] for f in self.frames]).reshape(-1, 3) / self.L).T
         ancestors = [self._ancestors(j) for j in range(nj)]
         self.above = np.array([[self.tjoint[v] in ancestors[fj] for v in range(self.nt)] for fj in self.f_joint],
                               bool).reshape(len(self.frames), self.nt)
@@ -213,7 +204,14 @@ class PolynomialClosure:
         """Per cut joint its rows: ("pos", f1, f2), ("vec", f1, u1, f2, u2), ("dotd", f1, u, f2),
         ("dot", f1, u, f2, w), u in F1 and w in F2 (axes of the cut joint's frames)."""
         plan, frames, self.row_cut = [], [], []
+        legs = {leg.cut: k for k, leg in enumerate(self.legs)}
         for cut in self.cuts:
+            if cut.name in legs:  # a leg that is a distance: |p - O|^2 - r^2
+                k = legs[cut.name]
+                plan.append(("dist", ("O", k), self.legs[k].other, k))
+                frames += [("O", k), self.legs[k].other]
+                self.row_cut.append(cut.name)
+                continue
             a = np.asarray(cut.axis, float)
             a = a / np.linalg.norm(a)
             b1, b2 = _perpendicular(a)
@@ -252,7 +250,7 @@ class PolynomialClosure:
                 vq.append((self.f_index[f], np.asarray(u, float)))
             return vq_key[key]
 
-        idx = {k: {"rows": [], "a": [], "b": [], "q1": [], "q2": []} for k in ("pos", "vec", "dotd", "dot")}
+        idx = {k: {"rows": [], "a": [], "b": [], "q1": [], "q2": []} for k in ("pos", "vec", "dotd", "dot", "dist")}
         i = 0
         for row in self.plan:
             kind = row[0]
@@ -260,7 +258,9 @@ class PolynomialClosure:
             width = 3 if kind in ("pos", "vec") else 1
             d["rows"].append(list(range(i, i + width)))
             i += width
-            if kind == "pos":
+            if kind == "dist":
+                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[2]]), d["q1"].append(row[3])
+            elif kind == "pos":
                 d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[2]])
             elif kind == "vec":
                 d["q1"].append(vector(row[1], row[2])), d["q2"].append(vector(row[3], row[4]))
@@ -269,14 +269,22 @@ class PolynomialClosure:
                 d["q1"].append(vector(row[1], row[2]))
             else:
                 d["q1"].append(vector(row[1], row[2])), d["q2"].append(vector(row[3], row[4]))
-        width = {"pos": 3, "vec": 3, "dotd": 1, "dot": 1}
+        width = {"pos": 3, "vec": 3, "dotd": 1, "dot": 1, "dist": 1}
         self.rix = {k: {n: np.array(v, int).reshape(len(v), width[k]) if n == "rows" else np.array(v, int)
                         for n, v in d.items()} for k, d in idx.items()}
         self.vq_f = np.array([f for f, _ in vq], int)
         self.vq_u = np.array([u for _, u in vq]).reshape(-1, 3).T
 
     def set_inputs(self, q):
-        """Take the input joints' (constant) motions from the real configuration q."""
+        """Take the input joints' (constant) motions from the real configuration q, and the eliminated
+        legs' lengths there (their frame's distance from their centre: any leg angles give it)."""
+        if self.legs:
+            data = self.model.createData()
+            pin.framesForwardKinematics(self.model, data, np.asarray(q, float))
+            self.r2 = np.array([np.sum((data.oMf[leg.frame].translation - data.oMi[leg.parent].act(np.array(leg.centre)))
+                                       ** 2) for leg in self.legs]) / self.L ** 2
+        else:
+            self.r2 = np.zeros(0)
         for j in range(1, self.model.njoints):
             if self.passive[j]:
                 continue
@@ -359,10 +367,10 @@ class PolynomialClosure:
             d = dT[:, tl][:, -3:] * 0.5
             z = np.einsum("pi,pi->p", d, d)
             r = np.sqrt(z)
-            small = np.abs(z) < 1e-8
+            small = np.abs(z) < _SERIES
             sinc = np.where(small, 1 - z / 6, np.sin(np.where(small, 1.0, r)) / np.where(small, 1.0, r))
             u = np.c_[d * sinc[:, None], np.cos(r)]
-            qn = _qmul(u, X[:, sl.stop - 4:sl.stop])
+            qn = quaternion_product(u, X[:, sl.stop - 4:sl.stop])
             X[:, sl.stop - 4:sl.stop] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
             if self.kind[j] == "F":
                 X[:, sl.start:sl.start + 3] += dT[:, tl][:, :3]
@@ -383,7 +391,7 @@ class PolynomialClosure:
             for k in range(3):
                 e = np.zeros(4)
                 e[k] = 0.5
-                T[:, sl.stop - 4:sl.stop, tl.stop - 3 + k] = _qmul(np.broadcast_to(e, q.shape), q)
+                T[:, sl.stop - 4:sl.stop, tl.stop - 3 + k] = quaternion_product(np.broadcast_to(e, q.shape), q)
             if self.kind[j] == "F":
                 T[:, sl.start + np.arange(3), tl.start + np.arange(3)] = 1.0
         return T
@@ -420,8 +428,8 @@ class PolynomialClosure:
             js, ps = lv["js"], lv["ps"]
             nl = len(js)
             Rp = oR[:, :, ps]
-            A = _mm(Rp, self.Lr[:, :, js, None])
-            oj = op[:, ps] + _mv(Rp, self.Lt[:, js, None])
+            A = stack_mm(Rp, self.Lr[:, :, js, None])
+            oj = op[:, ps] + stack_mv(Rp, self.Lt[:, js, None])
             R = np.empty((3, 3, nl, P), complex)
             t = np.zeros((3, nl, P), complex)
             k = lv["const"]
@@ -438,12 +446,12 @@ class PolynomialClosure:
             for kq, j in lv["quat"]:
                 Rq, tq = self._motion(j, Xt[self.slices[j]].T)
                 R[:, :, kq], t[:, kq] = Rq.transpose(1, 2, 0), tq.T
-            oR[:, :, js] = _mm(A, R)
-            op[:, js] = oj + _mv(A, t)
+            oR[:, :, js] = stack_mm(A, R)
+            op[:, js] = oj + stack_mv(A, t)
             if jacobian:
                 Aall[:, :, js], oall[:, js], tall[:, js] = A, oj, t
-        fR = _mm(oR[:, :, self.f_joint], self.f_R[..., None])
-        fp = op[:, self.f_joint] + _mv(oR[:, :, self.f_joint], self.f_t[..., None])
+        fR = stack_mm(oR[:, :, self.f_joint], self.f_R[..., None])
+        fp = op[:, self.f_joint] + stack_mv(oR[:, :, self.f_joint], self.f_t[..., None])
         out = {"oR": oR, "op": op, "fR": fR, "fp": fp}
         if jacobian:
             out.update(self._axes(Aall, oall, tall))
@@ -457,15 +465,15 @@ class PolynomialClosure:
         o = np.zeros((3, self.nt, P), complex)
         e = np.zeros((3, self.nt, P), complex)
         if self.rev.size:
-            w[:, self.rev_t] = _mv(A[:, :, self.rev], self.axis[self.rev].T[:, :, None])
+            w[:, self.rev_t] = stack_mv(A[:, :, self.rev], self.axis[self.rev].T[:, :, None])
             o[:, self.rev_t] = oj[:, self.rev]
         if self.pri.size:
-            e[:, self.pri_t] = _mv(A[:, :, self.pri], self.axis[self.pri].T[:, :, None])
+            e[:, self.pri_t] = stack_mv(A[:, :, self.pri], self.axis[self.pri].T[:, :, None])
         for j in self.quat:
             tl = self.tslices[j]
             rot = np.arange(tl.stop - 3, tl.stop)
             w[:, rot] = A[:, :, j]  # the joint frame's axes (columns of A) through the body's origin
-            o[:, rot] = (oj[:, j] + _mv(A[:, :, j], tj[:, j]))[:, None]
+            o[:, rot] = (oj[:, j] + stack_mv(A[:, :, j], tj[:, j]))[:, None]
             if self.kind[j] == "F":
                 e[:, tl.start + np.arange(3)] = A[:, :, j]
         return {"w": w, "o": o, "e": e}
@@ -478,12 +486,12 @@ class PolynomialClosure:
         P, nt = fp.shape[-1], self.nt
         r = np.empty((self._nrows_all, P), complex)
         J = np.empty((self._nrows_all, nt, P), complex) if jacobian else None
-        v = _mv(fR[:, :, self.vq_f], self.vq_u[..., None])  # (3, vectors, P)
+        v = stack_mv(fR[:, :, self.vq_f], self.vq_u[..., None])  # (3, vectors, P)
         if jacobian:
             w, o, e = kin["w"], kin["o"], kin["e"]
             mask_f = self.above[:, :, None]
-            dv = _cross(w[:, None], v[:, :, None]) * self.above[self.vq_f][None, :, :, None]  # (3, vectors, nt, P)
-            dp = (_cross(w[:, None], fp[:, :, None] - o[:, None]) + e[:, None]) * mask_f[None]  # (3, frames, nt, P)
+            dv = stack_cross(w[:, None], v[:, :, None]) * self.above[self.vq_f][None, :, :, None]  # (3, vectors, nt, P)
+            dp = (stack_cross(w[:, None], fp[:, :, None] - o[:, None]) + e[:, None]) * mask_f[None]  # (3, frames, nt, P)
         x = self.rix["pos"]
         if len(x["a"]):
             r[x["rows"]] = (fp[:, x["b"]] - fp[:, x["a"]]).transpose(1, 0, 2)
@@ -502,6 +510,13 @@ class PolynomialClosure:
             r[rows] = (u * d).sum(0)
             if jacobian:
                 J[rows] = (dv[:, x["q1"]] * d[:, :, None]).sum(0) + (u[:, :, None] * (dp[:, x["b"]] - dp[:, x["a"]])).sum(0)
+        x = self.rix["dist"]
+        if len(x["a"]):
+            d = fp[:, x["b"]] - fp[:, x["a"]]
+            rows = x["rows"][:, 0]
+            r[rows] = (d * d).sum(0) - self.r2[x["q1"]][:, None]
+            if jacobian:
+                J[rows] = 2 * (d[:, :, None] * (dp[:, x["b"]] - dp[:, x["a"]])).sum(0)
         x = self.rix["dot"]
         if len(x["q1"]):
             v1, v2 = v[:, x["q1"]], v[:, x["q2"]]
@@ -515,7 +530,8 @@ class PolynomialClosure:
         """The closure rows kept (P, m) and their Jacobian in tangent coordinates (P, m, nt)."""
         if self._kernel is not None:
             r, J = self._kernel(np.ascontiguousarray(X, complex), np.ascontiguousarray(self.Rc.transpose(2, 0, 1)),
-                                np.ascontiguousarray(self.tc.T), *self._packed, self.nt, jacobian)
+                                np.ascontiguousarray(self.tc.T), np.asarray(self.r2, complex), *self._packed, self.nt,
+                                jacobian)
             return r, (J if jacobian else None)
         r, J = self._rows_all(self.kinematics(X, jacobian), jacobian)
         return r[self.keep].T, (J[self.keep].transpose(2, 0, 1) if jacobian else None)
@@ -537,7 +553,7 @@ class PolynomialClosure:
         X = self.random_points(np.random.default_rng(12345), 4)
         r, _ = self._rows_all(self.kinematics(X, jacobian=False), jacobian=False)
         size = np.abs(r).max(axis=1)
-        return size > 1e-10 * max(size.max(initial=0.0), 1.0)  # round-off of rows that are zero as polynomials
+        return size > _ZERO_ROW * max(size.max(initial=0.0), 1.0)
 
     def residual_all(self, X):
         """Every planned row at X (P, rows) (the dropped ones too: they vanish identically)."""
@@ -545,10 +561,12 @@ class PolynomialClosure:
 
     def signature(self, X) -> np.ndarray:
         """What tells assembly modes apart (analysis.motion.position.PositionSolver.signature, in
-        units of L, complex): every joint frame's origin, the points' and the output frame's pose."""
+        units of L, complex): every joint frame's origin (but the eliminated legs', which their ends
+        fix), the points' and the output frame's pose."""
         kin = self.kinematics(X, jacobian=False)
         P = len(X)
-        parts = [kin["op"][:, 1:].transpose(2, 1, 0).reshape(P, -1)]
+        joints = [j for j in range(1, self.nj) if j not in self.eliminated]
+        parts = [kin["op"][:, joints].transpose(2, 1, 0).reshape(P, -1)]
         if self.point_frames:
             idx = [self.f_index[f] for f in self.point_frames]
             parts.append(kin["fp"][:, idx].transpose(2, 1, 0).reshape(P, -1))
@@ -556,13 +574,6 @@ class PolynomialClosure:
             k = self.f_index[self.output]
             parts += [kin["fp"][:, k].T, kin["fR"][:, :, k].transpose(2, 0, 1).reshape(P, 9)]
         return np.concatenate(parts, 1)
-
-
-def _qmul(a, b):
-    """Quaternion products a b of stacks (P, 4) in (x, y, z, w) order."""
-    av, aw, bv, bw = a[:, :3], a[:, 3], b[:, :3], b[:, 3]
-    vec = aw[:, None] * bv + bw[:, None] * av + np.cross(av, bv)
-    return np.c_[vec, aw * bw - np.einsum("pi,pi->p", av, bv)]
 
 
 def _perpendicular(a):
@@ -573,43 +584,3 @@ def _perpendicular(a):
     return b1, np.cross(a, b1)
 
 
-class SquareSystem:
-    """As many equations as tangent coordinates: the m rows of a PolynomialClosure taken down to nt
-    by a random complex combination A (none when m = nt).  Roots of the combination that are not
-    roots of every row (spurious) are told apart by ``closes``.  The equations are offsets in the
-    sense of analysis.motion.monodromy: G(x) = c with c = 0 the closed mechanism."""
-
-    def __init__(self, closure: PolynomialClosure, rng):
-        self.closure = closure
-        self.n, self.width = closure.nt, closure.n
-        need, m = closure.nt, closure.m
-        if m < need:
-            raise ValueError(f"{m} independent closure rows for {need} unknowns")
-        self.A = None if m == need else (rng.normal(size=(need, m)) + 1j * rng.normal(size=(need, m))) / np.sqrt(2 * m)
-
-    def equations(self, X, jacobian: bool = True):
-        r, J = self.closure.rows(X, jacobian)
-        if self.A is None:
-            return r, J
-        return r @ self.A.T, (np.einsum("ij,pjk->pik", self.A, J) if jacobian else None)
-
-    def offsets(self, X):
-        """The offset c for which X solves G(x) = c."""
-        return self.equations(X, jacobian=False)[0]
-
-    def retract(self, X, dT):
-        return self.closure.retract(X, dT)
-
-    def tangent(self, X):
-        return self.closure.tangent(X)
-
-    def on_variety(self, X, tol: float = 1e-10) -> np.ndarray:
-        """(P,) whether X keeps the circles and unit quaternions to round-off (relative to |x|^2)."""
-        g = np.abs(self.closure.constraints(X[:, :self.width])).max(axis=1, initial=0.0)
-        return g <= tol * (1.0 + np.abs(X).max(axis=1)) ** 2
-
-    def closes(self, X):
-        """(P,) the largest of every closure row (uncombined) and constraint at X."""
-        g = self.closure.constraints(X)
-        r = self.closure.residual_all(X)
-        return np.maximum(np.abs(g).max(axis=1, initial=0.0), np.abs(r).max(axis=1, initial=0.0))

@@ -15,7 +15,7 @@ import numpy as np
 __all__ = ["available", "kernel", "pack"]
 
 _KERNEL = None
-POS, VEC, DOTD, DOT = 0, 1, 2, 3
+POS, VEC, DOTD, DOT, DIST = 0, 1, 2, 3, 4
 _KIND = {"": 0, "R": 1, "P": 2, "S": 3, "F": 4}
 
 
@@ -47,6 +47,8 @@ def pack(closure) -> tuple:
                 rows.append((VEC, closure.f_index[row[1]], closure.f_index[row[3]], c, row[2], row[4]))
         elif k == "dotd":
             rows.append((DOTD, closure.f_index[row[1]], closure.f_index[row[3]], 0, row[2], np.zeros(3)))
+        elif k == "dist":
+            rows.append((DIST, closure.f_index[row[1]], closure.f_index[row[2]], row[3], np.zeros(3), np.zeros(3)))
         else:
             rows.append((DOT, closure.f_index[row[1]], closure.f_index[row[3]], 0, row[2], row[4]))
     rows = [r for r, keep in zip(rows, closure.keep) if keep]
@@ -64,7 +66,7 @@ def pack(closure) -> tuple:
 
 
 def kernel():
-    """The compiled function rows(X, Rc, tc, *pack(closure), jacobian) -> (r (P, m), J (P, m, nt))."""
+    """The compiled function rows(X, Rc, tc, r2, *pack(closure), nt, jacobian) -> (r (P, m), J (P, m, nt))."""
     global _KERNEL
     if _KERNEL is None:
         _KERNEL = _build()
@@ -75,7 +77,7 @@ def _build():
     import numba as nb
 
     @nb.njit(cache=True)
-    def one(x, Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
+    def one(x, Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
             nt, jacobian, r, J):
         nj = parent.shape[0]
         oR = np.zeros((nj, 3, 3), np.complex128)
@@ -197,6 +199,8 @@ def _build():
                 r[i] = ua[cc] - ub[cc]
             elif kk == DOTD:
                 r[i] = ua[0] * d[0] + ua[1] * d[1] + ua[2] * d[2]
+            elif kk == DIST:
+                r[i] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - r2[cc]
             else:
                 r[i] = ua[0] * ub[0] + ua[1] * ub[1] + ua[2] * ub[2]
             if not jacobian:
@@ -235,18 +239,20 @@ def _build():
                 elif kk == DOTD:
                     J[i, v] = (da0 * d[0] + da1 * d[1] + da2 * d[2]
                                + ua[0] * (pb0 - pa0) + ua[1] * (pb1 - pa1) + ua[2] * (pb2 - pa2))
+                elif kk == DIST:
+                    J[i, v] = 2.0 * (d[0] * (pb0 - pa0) + d[1] * (pb1 - pa1) + d[2] * (pb2 - pa2))
                 else:
                     J[i, v] = (da0 * ub[0] + da1 * ub[1] + da2 * ub[2]
                                + ua[0] * db0 + ua[1] * db1 + ua[2] * db2)
 
     @nb.njit(cache=True)
-    def rows(X, Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
+    def rows(X, Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
              nt, jacobian):
         P, m = X.shape[0], rk.shape[0]
         r = np.empty((P, m), np.complex128)
         J = np.empty((P, m, nt if jacobian else 0), np.complex128)
         for p in range(P):
-            one(X[p], Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
+            one(X[p], Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
                 nt, jacobian, r[p], J[p])
         return r, J
 

@@ -36,6 +36,8 @@ import numpy as np
 __all__ = ["TrackerOptions", "Tracked", "Segment", "track", "newton", "cauchy", "OK", "FAILED", "DIVERGED"]
 
 OK, FAILED, DIVERGED = 0, 1, 2
+#: A step that ends within this fraction of the segment's length from its end is at the end (round-off).
+_SNAP = 1e-15
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,7 @@ class TrackerOptions:
     contraction: the most the second Newton step may be of the first;
     first_step, min_step, max_step: step sizes in t; max_steps: per path;
     max_jump: the most a step may move a point, relative to 1 + |x|;
+    closed: a Cauchy loop has closed when a path is back within this of its start (relative);
     diverge: |x| beyond which a path goes to infinity;
     polish: Newton iterations at t = 1; root_tol: |H| there (before the last), relative to 1 + |x|,
     below which a path has arrived at a root."""
@@ -60,6 +63,7 @@ class TrackerOptions:
     polish: int = 3
     root_tol: float = 1e-9
     max_jump: float = 2.0
+    closed: float = 1e-6
 
 
 DEFAULT_OPTIONS = TrackerOptions()
@@ -225,7 +229,7 @@ def _loop(hom, X, T, h, K1, known, status, steps, refused, index, active, t1, sp
                 & (_norm(xc - x) <= o.max_jump * scale))
         err = d1 / scale
         acc, rej = active[good], active[~good]
-        X[acc], T[acc] = xc[good], np.where(tn[good] >= t1 - 1e-15 * abs(span), t1, tn[good])
+        X[acc], T[acc] = xc[good], np.where(tn[good] >= t1 - _SNAP * abs(span), t1, tn[good])
         K1[acc] = -np.einsum("pij,pj->pi", Ji[good], hom.dt(xc[good], tn[good], idx[good]))
         known[acc] = True
         steps[acc] += 1
@@ -273,7 +277,7 @@ def cauchy(hom, X, index, radius: float, samples: int = 16, max_loops: int = 8,
                 acc[active[res.ok]] += res.X[res.ok]
                 count[active[res.ok]] += 1
         active = np.flatnonzero(~done & ok)
-        back = _norm(cur[active] - start[active]) <= 1e-6 * (1.0 + _norm(start[active]))
+        back = _norm(cur[active] - start[active]) <= options.closed * (1.0 + _norm(start[active]))
         cycles[active[back]] = loop + 1
         done[active[back]] = True
         if done[ok].all():

@@ -23,17 +23,20 @@ a continuum, idle degrees of freedom, paths that failed, a trace test that did n
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ...errors import AssemblyError
 from ...model import newton
-from ...model.algebraic import PolynomialClosure, SquareSystem, algebraic_obstacle
+from ...model.algebraic import PolynomialClosure, algebraic_obstacle
+from ...model.square import SquareSystem
 from ...model.closure import Assembly
 from ...model.symmetry import find_symmetries
+from .known_counts import known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
 
-__all__ = ["ModeCount", "Certified", "Search", "certified_modes", "search", "join"]
+__all__ = ["ModeCount", "Certified", "Search", "Problem", "certified_modes", "search", "join", "count_after_starts"]
 
 
 @dataclass(frozen=True)
@@ -78,37 +81,75 @@ def obstacle(solver) -> str | None:
         return "no loops"
     if solver.free_dofs:
         return f"these inputs leave {solver.free_dofs} degree(s) of freedom free (a continuum)"
-    if solver.idle_dofs:
-        return (f"the mechanism has {solver.idle_dofs} idle degree(s) of freedom (links that spin without "
-                "moving a joint centre): their positive-dimensional solution sets are not tracked")
     return None
 
 
-def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions()):
+@dataclass
+class Problem:
+    """What the homotopy solves: the model and cut joints (an inverse-kinematics target among them),
+    the Pinocchio closure that polishes and lifts (model.closure.ClosureSystem), the velocity indices
+    held (inputs), the configuration that holds their values and the reference one."""
+
+    model: object
+    cuts: list
+    system: object
+    frozen: np.ndarray
+    q_in: np.ndarray
+    ref: np.ndarray | None
+    target: bool = False
+
+
+def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),
+                    problem: Problem | None = None):
     """The assembly modes for the input ``values`` by homotopy continuation (see the module): a
-    Certified, or the reason (a string) why the method does not apply."""
-    why = obstacle(solver)
-    if why:
-        return why
-    t0 = time.perf_counter()
+    Certified, or the reason (a string) why the method does not apply.  ``problem``: another system
+    to solve (inverse kinematics); by default the solver's loops with its inputs held."""
     mech = solver.mech
-    ref = solver.reference()
-    q_in = solver.set_inputs(mech.neutral() if ref is None else ref, values)
-    closure = PolynomialClosure(mech.model, mech.cuts, solver.frozen, mech.length, points=solver._points,
+    if problem is None:
+        why = obstacle(solver)
+        if why:
+            return why
+        ref = solver.reference()
+        problem = Problem(mech.model, mech.cuts, mech.closure, solver.frozen,
+                          solver.set_inputs(mech.neutral() if ref is None else ref, values), ref)
+    t0 = time.perf_counter()
+    closure = PolynomialClosure(problem.model, problem.cuts, problem.frozen, mech.length, points=solver._points,
                                 output=solver.output_frame)
-    closure.set_inputs(q_in)
-    if closure.m < closure.nt:
-        return (f"the loops give {closure.m} independent equations for {closure.nt} unknowns "
-                "(a continuum for every input)")
+    closure.set_inputs(problem.q_in)
     rng = np.random.default_rng(seed)
+    free = closure.nt - _rank(closure, rng)
+    if free > 0:
+        return (f"the closure leaves {free} unknown(s) free at every configuration"
+                + (f" ({solver.idle_dofs} idle degree(s) of freedom: links that spin without moving a joint "
+                   "centre, not on a leg that is a distance)" if solver.idle_dofs else "")
+                + ": positive-dimensional solution sets are not tracked")
     group = find_symmetries(closure, rng)
     system = SquareSystem(closure, rng)
-    roots = all_roots(system, group, closure.random_points(rng, 1), rng, options)
+    known = known_count(closure, problem.frozen, problem.target)
+    roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
+                      trace_limit=options.trace_limit)
     ends = to_target(system, roots, np.zeros(system.n), options)
-    return _classify(solver, closure, system, group, roots, ends, q_in, ref, time.perf_counter() - t0)
+    got = _classify(solver, problem, closure, system, group, roots, ends, known, time.perf_counter() - t0, options)
+    if known is not None and not got.count.complete and len(roots.X) <= options.trace_limit:
+        # fewer than the class's bound (a special geometry): the trace test decides, within a budget
+        roots = all_roots(system, group, roots.X[:1], rng, replace(options, budget=options.fallback_budget),
+                          seeds=roots.X, trace_test=True)
+        ends = to_target(system, roots, np.zeros(system.n), options)
+        got = _classify(solver, problem, closure, system, group, roots, ends, None, time.perf_counter() - t0,
+                        options, also=got.count.reason)
+    return got
 
 
-def _classify(solver, closure, system, group, roots, ends, q_in, ref, seconds) -> Certified:
+def _rank(closure, rng) -> int:
+    """The generic rank of the closure rows' Jacobian (at random complex points of the variety)."""
+    if closure.nt == 0:
+        return 0
+    _, J = closure.rows(closure.random_points(rng, 2))
+    return int(max(np.linalg.matrix_rank(j, tol=1e-9 * np.abs(j).max()) for j in J))
+
+
+def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: MonodromyOptions,
+              also: str = "") -> Certified:
     """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
     mech, tol = solver.mech, solver.mech.tolerances
     finite = np.isin(ends.status, ("regular", "singular"))
@@ -116,59 +157,103 @@ def _classify(solver, closure, system, group, roots, ends, q_in, ref, seconds) -
     scale = 1.0 + np.abs(np.where(np.isfinite(X), X, 0)).max(axis=1)
     closes = np.zeros(len(X), bool)
     if finite.any():
-        closes[finite] = system.closes(X[finite]) <= 1e-8 * scale[finite] ** 2
-    real = closes & (np.abs(X.imag).max(axis=1) <= 1e-7 * scale)
-    sizes = group.orbit_sizes(np.where(np.isfinite(X), X, 0), 1e-9)
+        closes[finite] = system.closes(X[finite]) <= o.closes * scale[finite] ** 2
+    real = closes & (np.abs(X.imag).max(axis=1) <= o.real * scale)
     modes = []  # [signature, q, assembly, angle sets, simple]
-    elements = group.elements()
+    full = closure if not closure.legs else PolynomialClosure(
+        problem.model, problem.cuts, problem.frozen, mech.length, points=solver._points,
+        output=solver.output_frame, compiled=False, eliminate=False)
+    full_group = group if full is closure else find_symmetries(full, np.random.default_rng(1))
+    elements = full_group.elements()
+    lost = 0
     for i in np.flatnonzero(real):
-        q, a = _best_twin(solver, closure, elements, X[i].real, q_in, ref)
+        q = _lift(solver, problem, closure, X[i].real)
+        if q is None:
+            lost += 1
+            continue
+        xf = full.from_q(q)
+        q, a = _best_twin(solver, problem, full, elements, xf)
         if a.residual > tol.closure:
+            lost += 1
             continue  # not polished onto Pinocchio's closure: left out (counted in the detail)
+        size = int(full_group.orbit_sizes(xf[None], 1e-9)[0])
         sig = solver.signature(q)
         for mode in modes:
             if np.max(np.abs(mode[0] - sig)) < tol.geometry * max(mech.length, 1.0):
-                mode[3] += int(sizes[i])
+                mode[3] += size
                 mode[4] = mode[4] and ends.status[i] == "regular"
                 break
         else:
-            modes.append([sig, q, a, int(sizes[i]), ends.status[i] == "regular" and ends.cycles[i] == 1])
+            modes.append([sig, q, a, size, ends.status[i] == "regular" and ends.cycles[i] == 1])
     # complex modes: distinct complex signatures of the roots that close and are not real
     cplx = np.flatnonzero(closes & ~real)
     sigs = closure.signature(X[cplx]) if cplx.size else np.zeros((0, 0))
     distinct = []
     for s in sigs:
-        if not any(np.max(np.abs(s - d)) < 1e-6 * (1 + np.abs(s).max()) for d in distinct):
+        if not any(np.max(np.abs(s - d)) < o.same * (1 + np.abs(s).max()) for d in distinct):
             distinct.append(s)
     failed = int(np.sum(ends.status == "failed"))
-    complete = roots.complete and failed == 0
-    reason = roots.why if not roots.complete else (
-        f"{failed} path{'s' if failed != 1 else ''} failed on the way to the inputs" if failed else "")
-    detail = {"roots": int(len(roots.X)), "symmetry": int(group.size), "paths": int(roots.paths + ends.paths),
+    sets = int(np.sum(group.orbit_sizes(np.where(np.isfinite(X[closes]), X[closes], 0), 1e-9))) if closes.any() else 0
+    found = len(modes) + len(distinct)
+    certificate, reason = None, roots.why
+    if known is not None:
+        reached = found if known.of == "poses" else sets
+        if reached >= known.bound and failed == 0 and lost == 0:
+            certificate, reason = f"{known.bound} {known.of}, the most for {known.what} ({known.source})", ""
+        else:
+            reason = (f"{reached} {known.of} found of at most {known.bound} for {known.what} ({known.source})"
+                      + (f"; {failed} path(s) failed" if failed else ""))
+    elif roots.complete and failed == 0 and lost == 0:
+        certificate, reason = "trace test", ""
+    elif roots.complete:
+        reason = (f"{failed} path{'s' if failed != 1 else ''} failed on the way to the inputs" if failed else
+                  f"{lost} real root(s) did not polish onto Pinocchio's closure")
+    if reason and also:
+        reason = f"{also}, and {reason}"
+    detail = {"roots": int(len(roots.X)), "symmetry": int(full_group.size), "legs_eliminated": len(closure.legs),
+              "lost_polishing": lost, "paths": int(roots.paths + ends.paths),
               "failed": int(roots.failed + failed), "witnesses": int(roots.witnesses), "trace": roots.trace,
               "at_infinity": int(np.sum(ends.status == "infinity")), "spurious": int(np.sum(finite & ~closes)),
-              "unknowns": int(closure.nt), "seconds": round(float(seconds), 3)}
-    count = ModeCount(len(modes) + len(distinct), complete, "monodromy", len(modes), len(distinct),
-                      "trace test" if complete else None, reason, detail)
-    return Certified([(q, a, sets, simple) for _, q, a, sets, simple in modes], count)
+              "angle_sets": sets, "unknowns": int(closure.nt), "seconds": round(float(seconds), 3)}
+    count = ModeCount(found, certificate is not None, "monodromy", len(modes), len(distinct), certificate, reason,
+                      detail)
+    return Certified([(q, a, n, simple) for _, q, a, n, simple in modes], count)
 
 
-def _best_twin(solver, closure, elements, x, q_in, ref):
+def _lift(solver, problem, closure, x):
+    """The real configuration of a real root x of the closure: its joints, and the eliminated legs'
+    angles (model.legs) solved by damped Newton with every other joint held -- from the inputs'
+    configuration, then from random angles -- or None."""
+    mech = solver.mech
+    q = closure.to_q(x, problem.q_in)
+    if not closure.legs:
+        return q
+    legs = mech.velocity_indices([problem.model.names[j] for j in sorted(closure.eliminated)])
+    held = np.union1d(np.setdiff1d(np.arange(mech.nv), legs), np.asarray(problem.frozen, int))  # inputs stay
+    rng = np.random.default_rng(3)
+    for k in range(8):
+        start = q if k == 0 else mech._keep(mech.random_configuration(rng), q, held)
+        try:
+            return problem.system.solve(start, frozen=held).q
+        except AssemblyError:
+            continue
+    return None
+
+
+def _best_twin(solver, problem, closure, elements, x):
     """(q, Assembly) of the joint-angle set of this root to report: its twins under the symmetry group
     polished on Pinocchio's closure, the one within the joint limits (and without a reversed leg or
     a turned link: analysis.motion.modes) nearest the reference configuration."""
-    from .position import outside_limits
-
-    mech = solver.mech
+    mech, ref = solver.mech, problem.ref
     best = None
     for e in elements:
-        q = closure.to_q(e * x, q_in)
-        bad = (len(outside_limits(mech, q)) > 0,)
+        q = closure.to_q(e * x, problem.q_in)
+        bad = (len(solver.outside(q)) > 0,)
         dist = float(np.linalg.norm(mech.difference(ref, q))) if ref is not None else 0.0
         key = (bad, dist)
         if best is None or key < best[0]:
             best = (key, q)
-    a = newton.polish(mech.closure, best[1], solver.frozen)
+    a = newton.polish(problem.system, best[1], problem.frozen)
     return solver._wrap(a.q), Assembly(solver._wrap(a.q), a.residual, a.iterations, "a homotopy's endpoint")
 
 
@@ -188,9 +273,10 @@ class Search:
         return self.count is not None and self.count.complete
 
 
-def search(solver, values: dict, seed: int = 0) -> Search:
-    """certified_modes for solve: its modes as the (signature, q, Assembly) of PositionSolver.distinct."""
-    got = certified_modes(solver, values, seed=seed)
+def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) -> Search:
+    """certified_modes for solve (and ik, with its ``problem``): its modes as the (signature, q,
+    Assembly) of PositionSolver.distinct."""
+    got = certified_modes(solver, values, seed=seed, problem=problem)
     if isinstance(got, str):
         return Search([], [], None, got)
     found = [(solver.signature(q), q, a) for q, a, _, _ in got.modes]

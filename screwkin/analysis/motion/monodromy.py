@@ -35,6 +35,9 @@ import numpy as np
 from ...model import tracking
 from ...model.symmetry import SignGroup
 
+#: Features of points count as independent above this relative singular value (fitting ell).
+_INDEPENDENT = 1e-8
+
 __all__ = ["MonodromyOptions", "Roots", "all_roots", "to_target", "Endpoints"]
 
 
@@ -44,15 +47,33 @@ class MonodromyOptions:
     test is tried; tries: trace tests before giving up; trace_tol: the trace test's threshold (a
     relative singular value); max_roots: the most roots (orbits) kept, a bound on the work;
     newton_starts: random starts of damped Newton added to the trace test's witnesses after a test
-    that did not close;
+    that did not close; loop_scale: the loops' random offsets, relative to the base offset's size;
+    loops: new loops a round makes at least; budget: paths tracked in all, past which the search stops;
+    fallback_budget: the budget of a trace test run where a published count was not reached;
+    trace_limit: the most roots (orbits) the trace test is tried for (past it the witnesses, several
+    times as many and many of them near infinity, cost more than they are worth);
+    root: |G(x) - c0| below which (relative to 1 + |c0|) a point is a root at the base;
+    closes: every closure row and constraint below this (relative to (1 + |x|)^2) at a target root, or
+    it is a root of the random combination only; real: |Im x| below this (relative to 1 + |x|) is a
+    real root; cauchy: the equations at a Cauchy endgame's estimate below this (relative) make it a
+    finite endpoint;
     same: two roots closer than this (relative) are one; tracker: model.tracking.TrackerOptions."""
 
     max_rounds: int = 40
     patience: int = 2
-    tries: int = 8
+    tries: int = 6
     trace_tol: float = 1e-10
     max_roots: int = 4000
     newton_starts: int = 400
+    loop_scale: float = 10.0
+    loops: int = 1
+    budget: int = 15000
+    fallback_budget: int = 8000
+    trace_limit: int = 24
+    root: float = 1e-10
+    closes: float = 1e-8
+    real: float = 1e-7
+    cauchy: float = 1e-6
     same: float = 1e-7
     tracker: tracking.TrackerOptions = tracking.DEFAULT_OPTIONS
 
@@ -100,7 +121,8 @@ class _Offsets:
             step = np.abs(tracking._solve(J, H[..., None])[..., 0]).max(axis=1)
         size = 1.0 + np.abs(X[ok]).max(axis=1)
         scale = 1.0 + np.abs(self.c0).max()
-        good = (np.abs(H).max(axis=1) <= 1e-10 * scale) & (step <= 1e-9 * size) & self.system.on_variety(X[ok])
+        good = ((np.abs(H).max(axis=1) <= self.o.root * scale) & (step <= self.o.tracker.root_tol * size)
+                & self.system.on_variety(X[ok]))
         ok[np.flatnonzero(ok)[~good]] = False
         return ok
 
@@ -121,7 +143,7 @@ class _Offsets:
         fibre: 24 of 24 found in 3 rounds, against 22 or 23 of 24 after 6 rounds with loops of the
         base's size)."""
         m = len(self.c0)
-        scale = max(float(np.sqrt(np.mean(np.abs(self.c0) ** 2))), 1e-3) * 10.0 * np.exp(np.clip(self.rng.normal(), -1, 1))
+        scale = max(float(np.sqrt(np.mean(np.abs(self.c0) ** 2))), 1e-3) * self.o.loop_scale * np.exp(np.clip(self.rng.normal(), -1, 1))
         out = scale * (self.rng.normal(size=m) + 1j * self.rng.normal(size=m)) / np.sqrt(2)
         if self.last_only:  # loops in the last offset alone (the trace test's t), the others at the base
             out[:-1] = self.c0[:-1]
@@ -130,7 +152,7 @@ class _Offsets:
     def round(self) -> int:
         """One round: a new loop (several while few roots are known) for every root, and the roots
         found in the last round around the older loops.  Returns the number of new roots."""
-        for _ in range(max(1, min(6, 48 // max(len(self.X), 1)))):
+        for _ in range(max(self.o.loops, min(6, 48 // max(len(self.X), 1)))):
             self.loops.append([self._random_offset(), self._random_offset(), 0])
         jobs = [(i, li) for li, (_, _, done) in enumerate(self.loops) for i in range(done, len(self.X))]
         for loop in self.loops:
@@ -227,7 +249,7 @@ class _Ell:
             trial = keep.copy()
             trial[i] = True
             s = np.linalg.svd(F[trial], compute_uv=False)
-            if s[-1] > 1e-8 * s[0] and trial.sum() <= max(len(self.alpha) - 1, 1):
+            if s[-1] > _INDEPENDENT * s[0] and trial.sum() <= max(len(self.alpha) - 1, 1):
                 keep = trial
         Fk = F[keep]
         pinv = np.linalg.pinv(Fk)
@@ -349,9 +371,11 @@ def _duplicates(Y, tol) -> bool:
 
 
 def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = MonodromyOptions(),
-              seeds=None, target_count: int | None = None) -> Roots:
-    """Every root (one per orbit of ``group``) of system.equations(x) = [0; c0] with c0 = r(x0), by
-    monodromy, certified by the trace test (see the module).  ``seeds``: more roots at c0."""
+              seeds=None, trace_test: bool = True, trace_limit: int | None = None) -> Roots:
+    """Every root (one per orbit of ``group``) of system.equations(x) = c0 with c0 = G(x0), by
+    monodromy, certified by the trace test (see the module) -- or, with ``trace_test`` False, until a
+    round finds no new root (a known root count then decides).  ``seeds``: more roots at c0.  The
+    work is bounded by ``options.budget`` paths."""
     t0 = time.perf_counter()
     o = options
     x0 = np.atleast_2d(np.asarray(x0, complex))
@@ -366,8 +390,19 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
         if len(main.X) >= o.max_roots:
             why = f"more than {o.max_roots} roots: the search stopped there"
             break
-        if stale < 1 and (target_count is None or len(main.X) < target_count):
+        if main.paths > o.budget:
+            why = f"the search stopped at its budget of {o.budget} paths"
+            break
+        small = trace_test and (trace_limit is None or len(main.X) <= trace_limit)
+        if stale < (1 if small else o.patience):  # no trace test to settle it: one more empty round
             continue
+        if not trace_test:
+            why = f"the monodromy found no new root in {stale} rounds (no trace test asked)"
+            break
+        if trace_limit is not None and len(main.X) > trace_limit:
+            why = (f"the trace test is not tried past {trace_limit} roots, its extra witnesses too many to "
+                   f"collect ({len(main.X)} roots here)")
+            break
         if run is None:
             run, before = _TraceRun(main, rng, o), -1
         run.complete()
@@ -386,9 +421,10 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
             run = None
         else:
             before = len(run.run.X)
-        if tries >= o.tries:
+        if tries >= o.tries or main.paths > o.budget:
             why = ("the trace test failed" if trace is None else
-                   f"the trace test did not close (relative singular value {trace:.2g})") + f" after {tries} tries"
+                   f"the trace test did not close (relative singular value {trace:.2g})") + \
+                f" after {tries} tries and {main.paths} paths"
             break
         stale = 0
     else:
@@ -444,7 +480,7 @@ def to_target(system, roots: Roots, target, options: MonodromyOptions = Monodrom
             with np.errstate(all="ignore"):
                 H, _ = seg.evaluate(ends, np.ones(len(idx)), idx, jacobian=False)
             size = 1.0 + np.abs(np.where(np.isfinite(ends), ends, 0)).max(axis=1)
-            closes = np.abs(H).max(axis=1) <= 1e-6 * size
+            closes = np.abs(H).max(axis=1) <= options.cauchy * size
             status[idx[ok & closes]] = "singular"
             status[idx[ok & ~closes]] = "infinity"
             status[idx[~ok]] = "failed"

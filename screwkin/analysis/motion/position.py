@@ -299,6 +299,10 @@ class PositionSolver:
                                  f"{name}[q0] ... {name}[q{c.nq - 1}]")
         return pin.normalize(self.model, q) if multi else q
 
+    def outside(self, q) -> tuple:
+        """The joints of q outside the file's limits (outside_limits)."""
+        return outside_limits(self.mech, q)
+
     def joint_values(self, q) -> dict:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
