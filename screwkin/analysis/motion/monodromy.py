@@ -67,7 +67,7 @@ class MonodromyOptions:
     newton_starts: int = 400
     loop_scale: float = 10.0
     loops: int = 1
-    budget: int = 15000
+    budget: int = 8000
     fallback_budget: int = 8000
     trace_limit: int = 24
     root: float = 1e-10
@@ -308,14 +308,12 @@ class _TraceRun:
                 keep = np.isfinite(d).all(axis=1)
                 Y, idx = self.system.retract(Y[keep], -d[keep]), idx[keep]
         self.main.paths += starts
-        return self.run.add(Y)
+        added = self.run.add(Y)
+        self.settle()
+        return added
 
-    def complete(self):
-        """Monodromy rounds until ``patience`` rounds find nothing; main roots found here join the main set."""
-        stale = 0
-        while stale < self.o.patience and len(self.run.X) < self.o.max_roots:
-            self.run.last_only = not self.run.last_only  # loops in t alone mix the two parts of the fibre
-            stale = stale + 1 if self.run.round() == 0 else 0
+    def settle(self):
+        """Count this run's paths in the main run's, and let the main roots it found (l = 0) join them."""
         self.main.paths += self.run.paths
         self.main.failed += self.run.failed
         self.run.paths = self.run.failed = 0
@@ -373,9 +371,13 @@ def _duplicates(Y, tol) -> bool:
 def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = MonodromyOptions(),
               seeds=None, trace_test: bool = True, trace_limit: int | None = None) -> Roots:
     """Every root (one per orbit of ``group``) of system.equations(x) = c0 with c0 = G(x0), by
-    monodromy, certified by the trace test (see the module) -- or, with ``trace_test`` False, until a
-    round finds no new root (a known root count then decides).  ``seeds``: more roots at c0.  The
-    work is bounded by ``options.budget`` paths."""
+    monodromy, certified by the trace test (see the module) -- or, with ``trace_test`` False, until
+    ``patience`` rounds find no new root (a known root count then decides).  ``seeds``: more roots at
+    c0.  The work is bounded by ``options.budget`` paths.
+
+    With the trace test, the main loops stop at the first round that finds nothing; the test's own
+    loops (over its fibre, the main roots among it) go on a round at a time, the test tried after
+    each, until it closes: a small system is certified after a round or two."""
     t0 = time.perf_counter()
     o = options
     x0 = np.atleast_2d(np.asarray(x0, complex))
@@ -383,54 +385,53 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
     main = _Offsets(system, group, x0, c0, rng, o)
     if seeds is not None and len(seeds):
         main.add(seeds)
-    run, trace, complete, why, tries, stale, witnesses = None, None, False, "", 0, 0, 0
-    for rnd in range(1, o.max_rounds + 1):
-        new = main.round()
-        stale = stale + 1 if new == 0 else 0
-        if len(main.X) >= o.max_roots:
-            why = f"more than {o.max_roots} roots: the search stopped there"
+    why, rnd, stale = "", 0, 0
+    limit = trace_limit if trace_test and trace_limit is not None else None
+    for rnd in range(1, o.max_rounds + 1):  # the main loops
+        stale = stale + 1 if main.round() == 0 else 0
+        if len(main.X) >= o.max_roots or main.paths > o.budget:
+            why = (f"more than {o.max_roots} roots" if len(main.X) >= o.max_roots else
+                   f"the budget of {o.budget} paths") + ": the search stopped there"
             break
-        if main.paths > o.budget:
-            why = f"the search stopped at its budget of {o.budget} paths"
+        if stale >= (1 if trace_test and (limit is None or len(main.X) <= limit) else o.patience):
             break
-        small = trace_test and (trace_limit is None or len(main.X) <= trace_limit)
-        if stale < (1 if small else o.patience):  # no trace test to settle it: one more empty round
-            continue
-        if not trace_test:
-            why = f"the monodromy found no new root in {stale} rounds (no trace test asked)"
-            break
-        if trace_limit is not None and len(main.X) > trace_limit:
-            why = (f"the trace test is not tried past {trace_limit} roots, its extra witnesses too many to "
-                   f"collect ({len(main.X)} roots here)")
-            break
+    else:
+        why = f"no round without a new root in {o.max_rounds} monodromy rounds"
+    if why or not trace_test:
+        why = why or f"the monodromy found no new root in {stale} rounds (no trace test asked)"
+        return Roots(main.X, c0, False, None, why, rnd, main.paths, main.failed, 0, time.perf_counter() - t0, group)
+    if limit is not None and len(main.X) > limit:
+        why = (f"the trace test is not tried past {limit} roots, its extra witnesses too many to collect "
+               f"({len(main.X)} roots here)")
+        return Roots(main.X, c0, False, None, why, rnd, main.paths, main.failed, 0, time.perf_counter() - t0, group)
+    run, trace, complete, tries, stale, newton_done = None, None, False, 0, 0, False
+    while True:
         if run is None:
-            run, before = _TraceRun(main, rng, o), -1
-        run.complete()
+            run, stale, newton_done = _TraceRun(main, rng, o), 0, False
+        run.run.last_only = not run.run.last_only  # loops in t alone mix the two parts of the fibre
+        new = run.run.round()
+        run.settle()
         trace = run.trace()
-        if trace is not None and trace >= o.trace_tol:  # not complete: Newton from random points adds witnesses
-            if run.newton(o.newton_starts):
-                trace = run.trace()
         tries += 1
         if trace is not None and trace < o.trace_tol:
             complete = True
             break
-        witnesses = run.witnesses
-        if len(run.run.X) == before:
-            # a try that found nothing new: the missing witness may lie near infinity, where neither
-            # loops nor Newton reach it -- the next try draws another line v and slice ell
-            run = None
-        else:
-            before = len(run.run.X)
-        if tries >= o.tries or main.paths > o.budget:
+        stale = stale + 1 if new == 0 else 0
+        if stale >= o.patience:
+            if not newton_done:  # Newton from random points adds witnesses the loops leave unvisited
+                newton_done, stale = True, 0
+                run.newton(o.newton_starts)
+            else:
+                # nothing new: the missing witness may lie near infinity, where neither loops nor Newton
+                # reach it -- the next try draws another line v and slice ell
+                run = None
+        if tries >= o.tries * (o.patience + 2) or main.paths > o.budget:
             why = ("the trace test failed" if trace is None else
                    f"the trace test did not close (relative singular value {trace:.2g})") + \
-                f" after {tries} tries and {main.paths} paths"
+                f" after {main.paths} paths"
             break
-        stale = 0
-    else:
-        why = why or f"no certificate after {o.max_rounds} monodromy rounds"
     return Roots(main.X, c0, complete, trace, "" if complete else why, rnd, main.paths, main.failed,
-                 run.witnesses if run is not None else witnesses, time.perf_counter() - t0, group)
+                 0 if run is None else run.witnesses, time.perf_counter() - t0, group)
 
 
 @dataclass

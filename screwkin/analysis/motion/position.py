@@ -381,7 +381,7 @@ class PositionSolver:
         if not found and near_q is None and not trace and method != "starts":
             done = certified.search(self, values, seed)  # homotopy continuation: every mode, certified
             found = list(done.found)
-        if not by_near and not (done is not None and done.complete):
+        if not by_near and not (done is not None and done.complete and found):
             more_found, more = self.distinct(
                 mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
                 first_trace=recorder if trace and near_q is None else None)
@@ -389,15 +389,14 @@ class PositionSolver:
         count = (done.count if done is not None and done.complete else
                  None if by_near else certified.count_after_starts(done, found, len(start_list)))
         if not found:
-            if done is not None and done.complete:
-                raise AssemblyError(mech.path, best, 0, detail=f"none of the {done.count.complex} complex solutions "
-                                    "for the inputs " + self._describe(values) + " is real (certified: trace test)")
+            certain = (f"; none of the {done.count.complex} complex solutions is real (certified: "
+                       f"{done.count.certificate})") if done is not None and done.complete else ""
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
                                 detail="the inputs " + ", ".join(
                                            [self._describe(values)] * bool(values)
                                            + [f"the angle of {k}" for k in mech.closure.row_inputs])
                                        + " cannot be reached from "
-                                       f"{len(start_list)} starting configurations")
+                                       f"{len(start_list)} starting configurations" + certain)
         if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
             found = engaged(self, found, values)
         if whole:
