@@ -546,7 +546,7 @@ class PolynomialClosure:
             elif self.kind[j] in "SF":
                 q = X[:, sl.stop - 4:sl.stop]
                 out.append(np.einsum("pi,pi->p", q, q) - 1.0)
-        return np.array(out).T.reshape(len(X), -1)
+        return np.array(out).T.reshape(len(X), len(out))
 
     def _nonzero_rows(self) -> np.ndarray:
         """Rows that do not vanish identically on the constraint variety (tried at random complex points)."""

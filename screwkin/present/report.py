@@ -110,8 +110,8 @@ def modes_line(res, n: int) -> str:
                 if c.complex else "")
         return f"all {n} assembly mode{s} (certified: {c.certificate}){more}{each}"
     how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
-           f"by homotopy continuation and {res.starts} random starts")
-    return f"{n} found {how}; completeness not certified because {c.reason}{each}"
+           f"by homotopy continuation and from {res.starts} starting configurations")
+    return f"{n} assembly mode{s} found {how}; completeness not certified because {c.reason}{each}"
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:

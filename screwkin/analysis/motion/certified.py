@@ -166,6 +166,7 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
     full_group = group if full is closure else find_symmetries(full, np.random.default_rng(1))
     elements = full_group.elements()
     lost = 0
+    multiple = _coinciding(X, real, group, o.same)  # paths that met: a multiple root
     for i in np.flatnonzero(real):
         q = _lift(solver, problem, closure, X[i].real)
         if q is None:
@@ -181,10 +182,10 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
         for mode in modes:
             if np.max(np.abs(mode[0] - sig)) < tol.geometry * max(mech.length, 1.0):
                 mode[3] += size
-                mode[4] = mode[4] and ends.status[i] == "regular"
+                mode[4] = mode[4] and not multiple[i] and ends.status[i] == "regular"
                 break
         else:
-            modes.append([sig, q, a, size, ends.status[i] == "regular" and ends.cycles[i] == 1])
+            modes.append([sig, q, a, size, ends.status[i] == "regular" and ends.cycles[i] == 1 and not multiple[i]])
     # complex modes: distinct complex signatures of the roots that close and are not real
     cplx = np.flatnonzero(closes & ~real)
     sigs = closure.signature(X[cplx]) if cplx.size else np.zeros((0, 0))
@@ -217,7 +218,20 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
               "angle_sets": sets, "unknowns": int(closure.nt), "seconds": round(float(seconds), 3)}
     count = ModeCount(found, certificate is not None, "monodromy", len(modes), len(distinct), certificate, reason,
                       detail)
-    return Certified([(q, a, n, simple) for _, q, a, n, simple in modes], count)
+    # a regular endpoint leaves the verdict to the measures (and, where they are small, to Newton's
+    # convergence: modes.simple_root); two paths that met, or a singular endpoint, are a multiple root
+    return Certified([(q, a, n, None if simple else False) for _, q, a, n, simple in modes], count)
+
+
+def _coinciding(X, mask, group, tol) -> np.ndarray:
+    """(P,) where an endpoint of ``mask`` lies on another's orbit (two paths ended together)."""
+    out = np.zeros(len(X), bool)
+    idx = np.flatnonzero(mask)
+    for k, i in enumerate(idx[1:], 1):
+        j = group.match(X[i][None], X[idx[:k]], tol)[0]
+        if j >= 0:
+            out[i] = out[idx[j]] = True
+    return out
 
 
 def _lift(solver, problem, closure, x):
