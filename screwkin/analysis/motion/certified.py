@@ -36,6 +36,9 @@ from ...model.symmetry import find_symmetries
 from .known_counts import known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
 
+#: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
+_RANK = 1e-9
+
 __all__ = ["ModeCount", "Certified", "Search", "Problem", "certified_modes", "search", "join", "count_after_starts"]
 
 
@@ -142,10 +145,10 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
 
 def _rank(closure, rng) -> int:
     """The generic rank of the closure rows' Jacobian (at random complex points of the variety)."""
-    if closure.nt == 0:
+    if closure.nt == 0 or closure.m == 0:
         return 0
     _, J = closure.rows(closure.random_points(rng, 2))
-    return int(max(np.linalg.matrix_rank(j, tol=1e-9 * np.abs(j).max()) for j in J))
+    return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
 
 
 def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: MonodromyOptions,

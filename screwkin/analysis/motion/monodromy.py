@@ -49,7 +49,11 @@ class MonodromyOptions:
     newton_starts: random starts of damped Newton added to the trace test's witnesses after a test
     that did not close; loop_scale: the loops' random offsets, relative to the base offset's size;
     loops: new loops a round makes at least; budget: paths tracked in all, past which the search stops;
+    count_budget: the budget of a search a published count settles (no trace test: its paths are only
+    the main loops');
     fallback_budget: the budget of a trace test run where a published count was not reached;
+    redraws: how many times the trace test may start again with another line and slice when its
+    witnesses stop growing;
     trace_limit: the most roots (orbits) the trace test is tried for (past it the witnesses, several
     times as many and many of them near infinity, cost more than they are worth);
     root: |G(x) - c0| below which (relative to 1 + |c0|) a point is a root at the base;
@@ -67,9 +71,11 @@ class MonodromyOptions:
     newton_starts: int = 400
     loop_scale: float = 10.0
     loops: int = 1
-    budget: int = 8000
+    budget: int = 4000
+    count_budget: int = 30000
     fallback_budget: int = 8000
     trace_limit: int = 24
+    redraws: int = 1
     root: float = 1e-10
     closes: float = 1e-8
     real: float = 1e-7
@@ -387,13 +393,16 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
         main.add(seeds)
     why, rnd, stale = "", 0, 0
     limit = trace_limit if trace_test and trace_limit is not None else None
+    budget = o.budget if trace_test else o.count_budget
     for rnd in range(1, o.max_rounds + 1):  # the main loops
         stale = stale + 1 if main.round() == 0 else 0
-        if len(main.X) >= o.max_roots or main.paths > o.budget:
+        if len(main.X) >= o.max_roots or main.paths > budget:
             why = (f"more than {o.max_roots} roots" if len(main.X) >= o.max_roots else
-                   f"the budget of {o.budget} paths") + ": the search stopped there"
+                   f"the budget of {budget} paths") + ": the search stopped there"
             break
-        if stale >= (1 if trace_test and (limit is None or len(main.X) <= limit) else o.patience):
+        if limit is not None and len(main.X) > limit:
+            break  # no certificate can come of it: the roots found so far are all the search gives
+        if stale >= (1 if trace_test else o.patience):
             break
     else:
         why = f"no round without a new root in {o.max_rounds} monodromy rounds"
@@ -404,7 +413,7 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
         why = (f"the trace test is not tried past {limit} roots, its extra witnesses too many to collect "
                f"({len(main.X)} roots here)")
         return Roots(main.X, c0, False, None, why, rnd, main.paths, main.failed, 0, time.perf_counter() - t0, group)
-    run, trace, complete, tries, stale, newton_done = None, None, False, 0, 0, False
+    run, trace, complete, tries, stale, newton_done, redrawn = None, None, False, 0, 0, False, 0
     while True:
         if run is None:
             run, stale, newton_done = _TraceRun(main, rng, o), 0, False
@@ -421,10 +430,15 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
             if not newton_done:  # Newton from random points adds witnesses the loops leave unvisited
                 newton_done, stale = True, 0
                 run.newton(o.newton_starts)
-            else:
+            elif redrawn < o.redraws:
                 # nothing new: the missing witness may lie near infinity, where neither loops nor Newton
                 # reach it -- the next try draws another line v and slice ell
-                run = None
+                run, redrawn = None, redrawn + 1
+            else:
+                why = (f"the trace test did not close (relative singular value {trace:.2g}) and its witnesses "
+                       f"stopped growing, after {main.paths} paths" if trace is not None else
+                       f"the trace test failed after {main.paths} paths")
+                break
         if tries >= o.tries * (o.patience + 2) or main.paths > o.budget:
             why = ("the trace test failed" if trace is None else
                    f"the trace test did not close (relative singular value {trace:.2g})") + \
