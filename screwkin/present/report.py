@@ -108,7 +108,8 @@ def modes_line(res, n: int) -> str:
     if c.complete:
         more = (f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex (no real assembly)"
                 if c.complex else "")
-        return f"all {n} assembly mode{s} (certified: {c.certificate}){more}{each}"
+        head = f"all {n} assembly modes" if n != 1 else "1 assembly mode, the only one"
+        return f"{head} (certified: {c.certificate}){more}{each}"
     how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
            f"by homotopy continuation and from {res.starts} starting configurations")
     return f"{n} assembly mode{s} found {how}; completeness not certified because {c.reason}{each}"

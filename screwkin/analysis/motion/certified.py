@@ -36,6 +36,7 @@ from ...model.symmetry import find_symmetries
 from .known_counts import known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
 
+NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
 _RANK = 1e-9
 
@@ -80,10 +81,10 @@ def obstacle(solver) -> str | None:
     why = algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings)
     if why:
         return f"the loop closure is not polynomial: {why}"
-    if not mech.cuts:
-        return "no loops"
     if solver.free_dofs:
         return f"these inputs leave {solver.free_dofs} degree(s) of freedom free (a continuum)"
+    if not mech.cuts:
+        return NO_LOOPS
     return None
 
 
@@ -314,6 +315,8 @@ def join(solver, found, more) -> list:
 def count_after_starts(done: Search | None, found: list, starts: int) -> ModeCount:
     """The ModeCount of a result found (also) by damped Newton from ``starts`` starting configurations:
     never complete; the reason says why the homotopy did not settle it."""
+    if done is not None and done.why == NO_LOOPS and len(found) == 1:  # the inputs set every joint
+        return ModeCount(1, True, "no loops", 1, 0, "no loops: the inputs set every joint", "", {"starts": starts})
     why = ("" if done is None else done.why or (done.count.reason if done.count else "")) or \
         "the random-start search does not know how many modes there are"
     if done is not None and done.count is not None:
