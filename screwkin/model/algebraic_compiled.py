@@ -12,20 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from .compiled import available
+
 __all__ = ["available", "kernel", "pack"]
 
 _KERNEL = None
 POS, VEC, DOTD, DOT, DIST = 0, 1, 2, 3, 4
 _KIND = {"": 0, "R": 1, "P": 2, "S": 3, "F": 4}
-
-
-def available() -> bool:
-    """Whether numba can be imported."""
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 def pack(closure) -> tuple:

@@ -131,13 +131,7 @@ def _constant_distance(model, q0, f, chain, revs, centre, length, tol) -> bool:
                 q[jm.idx_q] = 0.1 * trial * length
         dists = []
         for _ in range(4):
-            for k in revs:
-                jm = model.joints[k]
-                a = rng.uniform(-np.pi, np.pi)
-                if jm.nq == 1:
-                    q[jm.idx_q] = a
-                else:
-                    q[jm.idx_q:jm.idx_q + 2] = (np.cos(a), np.sin(a))
+            _turn(model, q, revs, rng)
             pin.framesForwardKinematics(model, data, q)
             dists.append(np.linalg.norm(data.oMf[f].translation - centre))
         if max(dists) - min(dists) > tol * length:
@@ -178,13 +172,7 @@ def chain_distance(model, frozen, joint: int, length: float, tol: float = DEFAUL
     dists = []
     for _ in range(4):
         q = pin.neutral(model)
-        for k in chain[:head] + chain[tail:]:
-            jm = model.joints[k]
-            angle = rng.uniform(-np.pi, np.pi)
-            if jm.nq == 1:
-                q[jm.idx_q] = angle
-            else:
-                q[jm.idx_q:jm.idx_q + 2] = (np.cos(angle), np.sin(angle))
+        _turn(model, q, chain[:head] + chain[tail:], rng)
         pin.forwardKinematics(model, data, q)
         dists.append(np.linalg.norm(data.oMi[joint].act(b_local) - a))
     if max(dists) - min(dists) > tol * length:
@@ -195,3 +183,14 @@ def chain_distance(model, frozen, joint: int, length: float, tol: float = DEFAUL
 def _passive(model, j, frozen) -> bool:
     jm = model.joints[j]
     return not any(jm.idx_v + k in frozen for k in range(jm.nv))
+
+
+def _turn(model, q, joints, rng):
+    """q with the revolutes ``joints`` turned to random angles (in place)."""
+    for k in joints:
+        jm = model.joints[k]
+        angle = rng.uniform(-np.pi, np.pi)
+        if jm.nq == 1:
+            q[jm.idx_q] = angle
+        else:
+            q[jm.idx_q:jm.idx_q + 2] = (np.cos(angle), np.sin(angle))
