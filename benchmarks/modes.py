@@ -3,7 +3,7 @@ screwkin's random-start search at equal coverage.
 
     python benchmarks/modes.py
 
-The platform is tests/test_certified.py's of random geometry (seed 3: 40 complex assembly modes).
+The platform is tests/test_certified.py's of random geometry, seed 5 (40 complex assembly modes, 6 real).
 Measured in one run, on the same machine, one after the other:
 - ``solve`` by homotopy continuation (the default): time to every mode and its certificate (the
   published count of 40 reached), with the numba kernel and with numpy alone;
@@ -30,6 +30,9 @@ from screwkin.model import algebraic  # noqa: E402
 from test_certified import stewart_urdf  # noqa: E402
 
 
+SEED = 5  # of seeds 0..11 (all 40 complex modes), one with the most real modes: 6
+
+
 def best(f, rounds=3):
     out, t = None, np.inf
     for _ in range(rounds):
@@ -40,7 +43,7 @@ def best(f, rounds=3):
 
 
 def main():
-    text, _, _ = stewart_urdf()
+    text, _, _ = stewart_urdf(SEED)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "stewart.urdf"
         path.write_text(text)
@@ -74,7 +77,8 @@ def main():
     print("|---|---|---|---|---|")
     for name, secs, found, real, note in rows:
         print(f"| {name} | {secs:.2f} | {'-' if found is None else found} | {real} | {note} |")
-    print(f"\nratio, random starts to equal coverage / homotopy: {rows[-1][1] / t:.1f}x")
+    print(f"\nhomotopy (numba) / random starts to equal coverage of the real modes: {t / rows[-1][1]:.1f}x "
+          "(the random starts cannot know they have them all, nor count the complex ones)")
 
 
 if __name__ == "__main__":
