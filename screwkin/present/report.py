@@ -112,7 +112,8 @@ def modes_line(res, n: int) -> str:
         return f"{head} (certified: {c.certificate}){more}{each}"
     how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
            f"by homotopy continuation and from {res.starts} starting configurations")
-    return f"{n} assembly mode{s} found {how}; completeness not certified because {c.reason}{each}"
+    more = f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex" if c.complex else ""
+    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}"
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:
