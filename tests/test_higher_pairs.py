@@ -79,6 +79,21 @@ def test_friction_wheels_at_45_deg_against_the_closed_form():
     assert np.linalg.norm(d) == pytest.approx(r2 + r3, abs=1e-10)  # the closure tolerance
 
 
+
+def test_friction_wheels_at_45_deg_has_both_assemblies(capsys):
+    """The rolling-contact course problem at theta2 = 45 deg: disc 2's centre at (0, 8 sqrt 2) mm, disc 3's
+    centre on the x axis 30 mm from it, so at x = +-sqrt(30^2 - 2 * 8^2) mm: the upper assembly (the
+    drawing's side) and the lower one.  A release that kept only the solutions whose rolling angles
+    continue the drawing's (as a thread or a tooth would) dropped the lower assembly; it is another
+    mode, not another turn, and is reported (labelled: its slider lies outside the slide's limits)."""
+    assert main(["solve", str(ROBOTS / "friction_wheels.urdf"), "--set", "wheel2_joint=45deg", "--all", "--json"]) == 0
+    sols = json.loads(capsys.readouterr().out)["solutions"]
+    x_drawn = 0.008 + np.sqrt(0.03 ** 2 - 0.008 ** 2)  # disc 3's centre at theta2 = 0 (the file's comment)
+    x3 = np.sqrt(0.03 ** 2 - 2 * 0.008 ** 2)
+    got = sorted(s["joints"]["slide"] + x_drawn for s in sols)
+    np.testing.assert_allclose(got, [-x3, x3], rtol=0, atol=1e-9)
+    assert [s["physical"] for s in sorted(sols, key=lambda s: -s["joints"]["slide"])] == [True, False]
+
 @pytest.mark.parametrize("name", ["gear_train_idler", "gear_train_idler_mimic"])
 def test_gear_train_output_speed_ratio(name):
     mech = load(name)

@@ -74,9 +74,17 @@ def run(mech, args) -> int:
             print(f"note: the target leaves {res.free_dofs} degree{'s' if res.free_dofs != 1 else ''} of freedom free"
                   + (" (a position alone: the output may turn)" if n == 3 else "")
                   + f": the solutions form a continuum; the {len(res.solutions)} below are samples of it")
-        print(f"search: damped Newton on the loops and the pose from {res.starts} starting configurations (the "
-              f"assembled and the file's configurations, and random ones within the joint limits): "
-              + _found_text(count, res.free_dofs))
+        c = res.modes
+        if c is not None and c.complete:
+            print(f"search: homotopy continuation on the loops and the pose, every solution (certified: "
+                  f"{c.certificate}): " + _found_text(count, res.free_dofs, certified=True)
+                  + (f"; {c.complex} more complex" if c.complex else ""))
+        else:
+            print(f"search: {'homotopy continuation and ' if c is not None and c.method != 'random starts' else ''}"
+                  f"damped Newton on the loops and the pose from {res.starts} starting configurations (the "
+                  f"assembled and the file's configurations, and random ones within the joint limits): "
+                  + _found_text(count, res.free_dofs)
+                  + (f"; completeness not certified because {c.reason}" if c is not None and c.reason else ""))
         shown = list(res.solutions) if args.all else list(res.physical) or list(res.solutions)
         if mech.actuated:
             for k, s in enumerate(shown, 1):
@@ -86,12 +94,13 @@ def run(mech, args) -> int:
     return 0
 
 
-def _found_text(count, free: int) -> str:
-    """'8 distinct branches found (legs: 2 x 2 x 2) of at most 8 (why): all of them', or how far from it."""
+def _found_text(count, free: int, certified: bool = False) -> str:
+    """'8 distinct branches found (legs: 2 x 2 x 2) of at most 8 (why): all of them', or how far from it
+    (``certified``: the homotopy has them all, whatever the legs' bound)."""
     n = count.found
     what = ("solution" if n == 1 else "solutions") if free else ("branch" if n == 1 else "branches")
     text = f"{n} distinct {what} found"
     if count.legs and count.at_most is not None:
         text += " (legs: " + " x ".join(str(k) for _, k, _ in count.legs) + f") of at most {count.at_most} ({count.why})"
-        return text + (": all of them" if count.complete else "; --starts N tries more")
-    return text + "; not exhaustive, --starts N tries more"
+        return text + (": all of them" if count.complete or certified else "; --starts N tries more")
+    return text + (": all of them" if certified else "; not exhaustive, --starts N tries more")

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
-           "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle"]
+           "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle",
+           "quaternion_matrix", "quaternion_product", "stack_mm", "stack_mv", "stack_cross"]
 
 #: Division guard: the distance between two circles' centres is taken at least this [m].
 TINY = 1e-300  # division guard
@@ -203,3 +204,37 @@ def skews_batch(U, m=None):
     n, _, k = U.shape
     index, sign = _skew_table(k, m)
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
+
+
+# -- stacks of small complex matrices, the stack's axes last (model.algebraic) --------------------------
+
+def quaternion_matrix(q):
+    """Q(q) for quaternions q (..., 4) in Pinocchio's order (x, y, z, w): the homogeneous quadratic
+    form, (q.q) times the rotation of q / |q|; (..., 3, 3)."""
+    x, y, z, w = (q[..., k] for k in range(4))
+    return np.stack([
+        np.stack([w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z], -1)], -2)
+
+
+def stack_mm(A, B):
+    """3 x 3 products over the trailing (stack) axes: A (3, 3, ...), B (3, 3, ...)."""
+    return A[:, 0, None] * B[None, 0] + A[:, 1, None] * B[None, 1] + A[:, 2, None] * B[None, 2]
+
+
+def stack_mv(A, v):
+    """A (3, 3, ...) times v (3, ...)."""
+    return A[:, 0] * v[0] + A[:, 1] * v[1] + A[:, 2] * v[2]
+
+
+def stack_cross(a, b):
+    """a x b over the leading axis (3, ...)."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def quaternion_product(a, b):
+    """Quaternion products a b of stacks (P, 4) in (x, y, z, w) order."""
+    av, aw, bv, bw = a[:, :3], a[:, 3], b[:, :3], b[:, 3]
+    vec = aw[:, None] * bv + bw[:, None] * av + np.cross(av, bv)
+    return np.c_[vec, aw * bw - np.einsum("pi,pi->p", av, bv)]

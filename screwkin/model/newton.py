@@ -21,6 +21,10 @@ change how Newton iterates changes it here:
   ``Tolerances.max_iterations``, or when a refused step takes its damping past
   ``Tolerances.lm_damping_max`` (given up).
 
+``polish`` is the undamped step at the end: from a configuration near a root (a damped solve's, a
+homotopy's real endpoint), Newton's own step until the residual stops falling -- round-off for a
+simple root, where damped steps stop at the closure tolerance.
+
 The residual rows may be evaluated one configuration at a time (Pinocchio),
 for a stack (numpy) or compiled (numba); tests compare the three, the program
 does not at run time.
@@ -37,7 +41,7 @@ from ..errors import AssemblyError
 from .cuts import Assembly
 
 __all__ = ["TRACE_FLOOR", "NU", "damped_step", "damped_steps", "stacked_steps", "one_at_a_time", "one_step", "judge",
-           "Iterates", "iterate", "solve"]
+           "Iterates", "iterate", "solve", "polish"]
 
 #: Division guard: the damping is relative to the mean squared row norm, which is never taken
 #: below this (a zero Jacobian) [same units as K^2].
@@ -256,3 +260,26 @@ def solve(system, q0, frozen, tol, trace=None) -> Assembly:
         raise AssemblyError(system.path, norm, it,
                             detail=f"the solution found assembles {', '.join(bad)} with a reversed axis")
     return Assembly(q, norm, it)
+
+
+def polish(system, q0, frozen=(), iterations: int = 8) -> Assembly:
+    """Undamped Newton from q0, which is already near a root of ``system`` (a model.closure.ClosureSystem),
+    with the velocity indices ``frozen`` held: the minimum-norm step on the free columns of the
+    solver's rows (least squares: the rows are redundant), while the residual keeps falling.  A simple
+    root is reached to round-off in two or three steps.  Returns the configuration with the smallest
+    residual seen (its norm, the steps taken)."""
+    model = system.model
+    free = system.free_columns(tuple(int(f) for f in np.asarray(frozen, int).ravel()))
+    q = np.array(q0, float)
+    r, K = system.evaluate(q, jacobian=True, solver=True)
+    best_q, best, it = q, float(np.linalg.norm(r)), 0
+    for it in range(1, iterations + 1):
+        dq = np.zeros(model.nv)
+        dq[free] = -np.linalg.lstsq(K[:, free], r, rcond=None)[0]
+        q_new = pin.integrate(model, q, dq)
+        r, K = system.evaluate(q_new, jacobian=True, solver=True)
+        norm = float(np.linalg.norm(r))
+        if not norm < best:
+            break
+        best_q, best, q = q_new, norm, q_new
+    return Assembly(best_q, best, it)

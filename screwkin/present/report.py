@@ -36,6 +36,7 @@ from .mobility import (  # noqa: F401 - exported here as before
 )
 
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
+           "modes_dict", "modes_line",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
            "screw_theory_rows", "joint_rows", "nan_to_none", "slide_note"]
@@ -47,7 +48,8 @@ def position_dict(res) -> dict:
         # every coordinate under its name, loop joints too (also kept apart under "loop_joints")
         d = {"joints": _with_loop(s.joints, s.loop_joints), "residual": s.residual, "iterations": s.iterations, "singular": s.singular,
              "sigma_min": s.sigma_min, "outside_limits": list(s.outside_limits),
-             "physical": s.physical, "labels": list(s.labels), "continuum": s.continuum, "merged": s.merged}
+             "physical": s.physical, "labels": list(s.labels), "continuum": s.continuum, "merged": s.merged,
+             "simple": s.simple, "angle_sets": s.angle_sets}
         if s.sigmas is not None:
             d["sigmas"] = s.sigmas
         if s.link_angles is not None:
@@ -84,7 +86,36 @@ def position_dict(res) -> dict:
     return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
             "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols,
             "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes),
-            **({"held_angles": res.held} if res.held else {})}
+            **({"held_angles": res.held} if res.held else {}), **({"modes": modes_dict(res.modes)} if res.modes else {})}
+
+
+def modes_dict(c) -> dict:
+    """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
+    reason (null when certified) and what the search did."""
+    return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
+            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail)}
+
+
+def modes_line(res, n: int) -> str:
+    """How many assembly modes, and how that is known: "all 4 assembly modes (certified: trace test);
+    36 more solutions are complex", or "3 found ...; completeness not certified because ..."."""
+    c = res.modes
+    s = "s" if n != 1 else ""
+    if c is None:
+        return f"{n} assembly mode{s} found from {res.starts} starting configurations"
+    sets = {x.angle_sets for x in res.solutions}
+    each = (f"; each reached by {sets.pop()} joint-angle sets (universal and spherical joints written as "
+            "revolutes, wrists flipped: one placement of the links)" if len(sets) == 1 and None not in sets
+            and max(sets) > 1 else "")
+    if c.complete:
+        more = (f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex (no real assembly)"
+                if c.complex else "")
+        head = f"all {n} assembly modes" if n != 1 else "1 assembly mode, the only one"
+        return f"{head} (certified: {c.certificate}){more}{each}"
+    how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
+           f"by homotopy continuation and from {res.starts} starting configurations")
+    more = f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex" if c.complex else ""
+    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}"
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:
@@ -187,8 +218,7 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
     hidden = len(res.solutions) - len(shown)
     n = len(res.solutions)
     lines = [f"inputs: {inputs}" if inputs else "inputs: -",
-             f"{n} assembly mode{'s' if n != 1 else ''} found from {res.starts} starting configurations"
-             + (f"; measures dimensionless with L = {length:.4g} m" if length else "")]
+             modes_line(res, n) + (f"; measures dimensionless with L = {length:.4g} m" if length else "")]
     if hidden:
         why = sorted({lab.split(":")[0].split(" (")[0] for s in res.solutions if not s.physical for lab in s.labels})
         lines.append(f"of the {n}, {n - hidden} reachable by moving from the drawn configuration and shown; "
@@ -205,10 +235,14 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
         elif s.singular:
             flag = "  SINGULAR (passive joints not determined: limit position or singularity" + (
                 f"; a double root, reached {s.merged} ways)" if s.merged > 1 else ")")
+        elif s.simple and s.sigma_min < DEFAULT.singular:
+            flag = (f"  ill-conditioned (condition number {1.0 / max(s.sigma_min, 1e-300):.3g}): a simple root, "
+                    "the passive joints are determined")
         else:
             flag = ""
+        sets = f", {s.angle_sets} joint-angle sets" if s.angle_sets and len({x.angle_sets for x in res.solutions}) > 1 else ""
         lines.append(f"\nsolution {k}: residual {s.residual:.2e}, {s.iterations} iterations, "
-                     f"sigma_min {s.sigma_min:.3g}{flag}")
+                     f"sigma_min {s.sigma_min:.3g}{sets}{flag}")
         for lab in s.labels:
             lines.append(f"  not reached by moving: {lab}")
         lines.append(table(*solution_rows(res, s, degrees, units)))

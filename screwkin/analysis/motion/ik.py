@@ -9,18 +9,20 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
+from ...model.algebraic import algebraic_obstacle
 from ...model.closure import ClosureSystem, CutJoint
 from ...model.geometry import wrap_angle
 from ...model.linalg import rank
 from ...model.state import KinematicState, angular_loop_joints
 from ...model.topology import frame_link
+from . import certified
 from .position import PositionResult, PositionSolver
 
 __all__ = ["inverse_kinematics", "Branches", "branches"]
 
 
 def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
-                       position_only: bool = False) -> PositionResult:
+                       position_only: bool = False, method: str = "auto") -> PositionResult:
     """Joint values (actuated and passive) that place link ``output`` at ``pose``
     (a pinocchio.SE3 in the world), for every distinct assembly found; with ``position_only``
     only its frame's origin at the pose's translation (any orientation).  ``output`` may name
@@ -29,7 +31,10 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     The target is one more cut joint, a weld (a ball joint for ``position_only``) between a
     ground frame at ``pose`` and the output frame, solved together with the loop closures.  Raises
     AssemblyError (saying how close it got) when the pose is unreachable.
-    Solutions are labelled and ordered as those of PositionSolver.solve.
+    Solutions are labelled and ordered as those of PositionSolver.solve.  ``method`` "auto": every
+    solution by homotopy continuation where the closure is polynomial (analysis.motion.certified:
+    certified by the trace test or a published count), random starts added where it is not
+    certified; "starts": damped Newton from random starts only.
     """
     out_frame = mech.link_frame(output)
     # the target frame (made with the model: adding frames later would outgrow existing Data) placed at
@@ -47,7 +52,21 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
         raise UsageError(f"{mech.path}: the mechanism has no moving joint: nothing to solve for")
     solver = PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output)
     start_list = solver._starts(starts, seed)
-    found, best = solver.distinct(system, start_list)
+    done, found, best = None, [], np.inf
+    why = algebraic_obstacle(model, system.cuts, mech.extra_rows, mech.couplings)
+    if method != "starts":
+        ref = solver.reference()
+        problem = certified.Problem(model, system.cuts, system, np.zeros(0, int),
+                                    mech.neutral() if ref is None else ref, ref, target=not position_only)
+        done = certified.Search([], [], None, f"the closure is not polynomial: {why}") if why else \
+            certified.search(solver, {}, seed, problem)
+        found = list(done.found)
+    if not done or not done.complete:
+        more, best = solver.distinct(system, start_list)
+        found = certified.join(solver, found, more)
+    else:
+        start_list = []
+    count = done.count if done is not None and done.complete else certified.count_after_starts(done, found, len(start_list))
     if not found:
         xyz = ", ".join(f"{x:.6g}" for x in pose.translation)
         raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
@@ -61,17 +80,20 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     jacobians = [system.jacobian(q) for _, q, _ in found]
     free = max(needed - max(rank(J, mech.tolerances) for J in jacobians), 0)
     sols = []
-    for (_, q, a), J in zip(found, jacobians):
+    info = dict(enumerate(done.info)) if done is not None else {}
+    for k_found, ((_, q, a), J) in enumerate(zip(found, jacobians)):
         s = np.linalg.svd(J, compute_uv=False)
         k = needed - free  # a continuum left by the target is no singularity: the rank it keeps
         sigma = float(s[k - 1] / s[0]) if 0 < k <= len(s) else 1.0
+        sets, simple = info.get(k_found, (None, None))
         # every quantity as solve reports it (loop joints, links, leg lengths), singular by the ik system
-        sols.append(replace(solver.solution(q, a), singular=sigma < mech.tolerances.singular, sigma_min=sigma,
-                            output_pose=KinematicState(mech, q).frame_pose(out_frame), sigmas=None))
+        sol = solver.solution(q, a, sets=sets, simple=True)
+        sols.append(replace(sol, singular=sigma < mech.tolerances.singular and not simple, sigma_min=sigma,
+                            output_pose=KinematicState(mech, q).frame_pose(out_frame), sigmas=None, simple=simple))
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
     return PositionResult({"position": pose.translation.tolist()} if position_only else {"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), len(start_list),
                           free, (), output, solver.angular_names(), solver._angular_coupled(),
-                          angular_loop_joints(mech))
+                          angular_loop_joints(mech), modes=count)
 
 
 @dataclass(frozen=True)

@@ -211,6 +211,13 @@ class Interactive:
         fixed = {n: v for n, v in self._values.items() if n != name}
         try:  # continued from the current configuration: its assembly mode is kept
             res = sweep(self.solver, name, start, value, steps, fixed=fixed, q_start=self.state.q)
+            if self.state.singular and res.stopped_at is not None and res.values.size <= 1:
+                # at a limit position itself (a double root, where no tangent leads off): from the mode a
+                # millionth of the way along, nearest this one
+                nudge = start + 1e-6 * (value - start)
+                near = min((s.q for s in self.solver.solve({**fixed, name: nudge}).solutions),
+                           key=lambda q: float(np.linalg.norm(self.solver.signature(q) - self.solver.signature(self.state.q))))
+                res = sweep(self.solver, name, nudge, value, steps, fixed=fixed, q_start=near)
         except AssemblyError as exc:
             return self._refused(f"{name} cannot move from here: {exc}")
         if res.stopped_at is not None or res.skipped:

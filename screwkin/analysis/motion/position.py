@@ -33,10 +33,11 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
+from ...model import newton
 from ...model.closure import Assembly
 from ...model.state import KinematicState, angular_loop_joints
 from ...model.topology import open_joints
-from . import modes
+from . import certified, modes
 from ..mobility import analyze_mobility
 from .links import link_motions, point_motions
 from .turns import engaged, turn_on, whole_turns
@@ -110,6 +111,8 @@ class Solution:
     leg_lengths: dict | None = None  # prismatic joint -> distance between the joint centres its leg connects [m]
     guide_angles: dict | None = None  # planar: prismatic joint (tree or loop) -> its slide's angle from the ground's x [rad]
     guide_positions: dict | None = None  # prismatic joint on the ground -> slider's position along its guide [m] (state.py)
+    angle_sets: int | None = None  # joint-angle sets that reach this mode (certified search; None: not counted)
+    simple: bool | None = None  # a simple root: isolated, its Jacobian of full rank (however ill-conditioned)
 
     @property
     def physical(self) -> bool:
@@ -140,6 +143,7 @@ class PositionResult:
     angular_loop: tuple = ()  # names of the loop (cut) joints with a coordinate that is an angle
     notes: tuple = ()  # what the solver chose that the user should know (a --near value it missed)
     held: dict | None = None  # links held at an absolute angle (--set-angle of a floating link) -> angle [rad]
+    modes: object | None = None  # analysis.motion.certified.ModeCount: how many modes and how that is known
 
     @property
     def physical(self) -> tuple:
@@ -306,6 +310,10 @@ class PositionSolver:
                                  f"{name}[q0] ... {name}[q{c.nq - 1}]")
         return pin.normalize(self.model, q) if multi else q
 
+    def outside(self, q) -> tuple:
+        """The joints of q outside the file's limits (outside_limits)."""
+        return outside_limits(self.mech, q)
+
     def joint_values(self, q) -> dict:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
@@ -372,9 +380,12 @@ class PositionSolver:
 
     def solve(self, values: dict, near: dict | None = None, rates: dict | None = None,
               accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False,
-              points=()) -> PositionResult:
+              points=(), method: str = "auto") -> PositionResult:
         """Every assembly mode for the input ``values`` (see the class).  ``points``: motion.Point
-        objects whose position (and velocity, acceleration with ``rates``) each solution reports."""
+        objects whose position (and velocity, acceleration with ``rates``) each solution reports.
+        ``method``: "auto" -- homotopy continuation, certified, where the closure is polynomial
+        (analysis.motion.certified), with ``starts`` random starts added where it is not certified
+        --, or "starts" (damped Newton from random starts only, as with --trace or --near)."""
         mech = self.mech
         self._check_inputs(values)
         if self.unset:
@@ -397,24 +408,34 @@ class PositionSolver:
             neutral, start_list = mech.neutral(), [np.array(q0, float) for q0 in start_list]
             for q0 in start_list:
                 q0[self._kept_q] = neutral[self._kept_q]
-        if not found:
-            found, more = self.distinct(
+        by_near, done = bool(found), None
+        if not found and near_q is None and not trace and method != "starts":
+            done = certified.search(self, values, seed)  # homotopy continuation: every mode, certified
+            found = list(done.found)
+        if not by_near and not (done is not None and done.complete and found):
+            more_found, more = self.distinct(
                 mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
                 first_trace=recorder if trace and near_q is None else None)
-            best = min(best, more)
+            found, best = certified.join(self, found, more_found), min(best, more)
+        count = (done.count if done is not None and done.complete else
+                 None if by_near else certified.count_after_starts(done, found, len(start_list)))
         if not found:
+            certain = (f"; none of the {done.count.complex} complex solutions is real (certified: "
+                       f"{done.count.certificate})") if done is not None and done.complete else ""
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
                                 detail="the inputs " + ", ".join(
                                            [self._describe(values)] * bool(values)
                                            + [f"the angle of {k}" for k in mech.closure.row_inputs])
                                        + " cannot be reached from "
-                                       f"{len(start_list)} starting configurations")
+                                       f"{len(start_list)} starting configurations" + certain)
         if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
             found = engaged(self, found, values)
         if whole:
             found = [(k, *turn_on(self, q, whole, typed)) for k, q, _ in found]
         self.generic(hint=found[0][1])  # generic ranks (from the solution when nothing else assembles)
-        sols = [self.solution(q, a, rates, accels, points, typed=typed) for _, q, a in found]
+        info = dict(enumerate(done.info)) if done is not None else {}
+        sols = [self.solution(q, a, rates, accels, points, typed=typed, sets=info.get(k, (None, None))[0],
+                              simple=info.get(k, (None, None))[1]) for k, (_, q, a) in enumerate(found)]
         sols = self._merge(sols)
         ref = near_q if near_q is not None else self.reference()
         if len(sols) > 1:
@@ -428,9 +449,10 @@ class PositionSolver:
             notes += self._missed_near(near, sols[0])
         held = {link: sols[0].link_angles[link] for link in mech.closure.row_inputs
                 if sols[0].link_angles and link in sols[0].link_angles} or None
-        return PositionResult(dict(typed), tuple(self.inputs), tuple(sols), len(start_list), self.free_dofs,
+        return PositionResult(dict(typed), tuple(self.inputs), tuple(sols),
+                              0 if done is not None and done.complete else len(start_list), self.free_dofs,
                               tuple(steps), self.output, self._angular, self._angular_coupled(),
-                              angular_loop_joints(self.mech), notes, held)
+                              angular_loop_joints(self.mech), notes, held, count)
 
     def _missed_near(self, near: dict, sol) -> tuple:
         """A line for each --near value the mode found lies far from (Tolerances.near_far): the joints
@@ -459,6 +481,8 @@ class PositionSolver:
             except AssemblyError as exc:
                 best = min(best, exc.residual)
                 continue
+            p = newton.polish(system, a.q, frozen)  # undamped at the end: round-off, not the damped tolerance
+            a = Assembly(p.q, p.residual, a.iterations + p.iterations, a.start, a.starts)
             q = self._wrap(a.q)
             if len(starts) == 1:  # nothing to tell apart
                 found.append((None, q, a))
@@ -511,13 +535,17 @@ class PositionSolver:
         return self._angles(q) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q, a, rates=None, accels=None, points=(), typed=None) -> Solution:
+    def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.closure.Assembly), every quantity
-        read from one KinematicState; rates and accelerations when input rates are given."""
+        read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
+        the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here
+        when its measure is below the singular tolerance, modes.simple_root)."""
         mech, tol = self.mech, self.mech.tolerances
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
-        singular = sigma < tol.singular
+        if sigma < tol.singular and simple is None:
+            simple = modes.simple_root(self, q)
+        singular = sigma < tol.singular and not simple  # an ill-conditioned simple root is determined
         K = mech.closure.jacobian(q)
         pose = twist = acc = qd = qdd = None
         rate_d = acc_d = None
@@ -546,7 +574,8 @@ class PositionSolver:
                         links=link_motions(state, angles, self._plane_normal()),
                         points=point_motions(state, points) or None, linkage=self._linkage(q),
                         leg_lengths=state.leg_lengths or None, guide_positions=state.guide_positions or None,
-                        guide_angles=(self._angles.guides(state) or None) if self._angles else None)
+                        guide_angles=(self._angles.guides(state) or None) if self._angles else None,
+                        angle_sets=sets, simple=simple)
 
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))

@@ -49,6 +49,11 @@ def engaged(solver, found, values):
     off = [float(np.max(np.abs(np.array([q[t] for t in counted]) - pred))) for _, q, _ in found]
     kept = [f for f, d in zip(found, off) if d < np.pi]
     if kept:
+        # the others are other turns of the same engagement (dropped) or other assembly modes (kept: a
+        # friction wheel's lower assembly has counted angles of its own, not the upper one's turned)
+        for f, d in zip(found, off):
+            if d >= np.pi and not any(_turned(solver, f[1], k[1], counted) for k in kept):
+                kept.append(f)
         return kept
     # no start reached the counted angles the motion from the file's configuration gives (a start lies
     # within a turn of each, the motion may not: an idler's two meshes count its turn each on its own):
@@ -61,6 +66,23 @@ def engaged(solver, found, values):
     if float(np.max(np.abs(np.array([a.q[t] for t in counted]) - pred))) < np.pi:
         return [(solver.signature(a.q), a.q, a)]
     return [found[int(np.argmin(off))]]
+
+
+def _turned(solver, q, other, counted) -> bool:
+    """Whether q is ``other`` with some of its pairs turned on by whole turns: for each higher pair's
+    coupling row, one of its counted angles differs from other's by a whole number of turns (a
+    thread, a tooth), at least one by a nonzero number."""
+    shift = False
+    for row in solver.mech.extra_rows:
+        members = [iq for iq, _, _ in getattr(row, "terms", ()) if iq in counted]
+        if not members:
+            continue
+        turns = [(q[iq] - other[iq]) / (2 * np.pi) for iq in members]
+        whole = [abs(k - round(k)) < solver.mech.tolerances.geometry for k in turns]
+        if not any(whole):
+            return False
+        shift |= any(w and round(k) != 0 for w, k in zip(whole, turns))
+    return shift
 
 
 def turn_on(solver, q, whole: dict, typed: dict):

@@ -1,0 +1,326 @@
+"""Every assembly mode of a mechanism with polynomial loop closure, and how complete the set is.
+
+For the inputs given, the closure of the passive joints (model.algebraic: cosines and sines of
+revolute angles, prismatic lengths, quaternions) is solved over the complex numbers by monodromy,
+certified by the trace test (analysis.motion.monodromy), then carried to the inputs by one parameter
+homotopy.  Of the roots reached:
+- a root that does not make every closure row vanish is a root of the random combination of rows
+  only (spurious) and is dropped;
+- a real root is an assembly mode: its configuration is polished by undamped Newton on Pinocchio's
+  closure (model.newton.polish, the reference), then reported as solve reports every mode;
+- the others are complex: no real assembly, counted.
+Roots that differ only by the closure's sign symmetries (model.symmetry: a universal joint
+flipped, the other Euler set of a spherical joint) are one placement of the links, so one mode;
+roots with the same joint centres and output pose (PositionSolver.signature) are one mode too.  Of
+each mode's joint-angle sets the one within the joint limits and nearest the reference
+configuration is reported, and how many sets reach it.
+
+``ModeCount`` says what was found and how completeness is known: certified (the trace test), or
+why not -- closure not polynomial (rolling, gears, screws, cams, --set-angle rows, mimic joints),
+a continuum, idle degrees of freedom, paths that failed, a trace test that did not close.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ...errors import AssemblyError
+from ...model import newton
+from ...model.algebraic import PolynomialClosure, algebraic_obstacle
+from ...model.square import SquareSystem
+from ...model.closure import Assembly
+from ...model.symmetry import find_symmetries
+from .known_counts import known_count
+from .monodromy import MonodromyOptions, all_roots, to_target
+
+NO_LOOPS = "no loops"
+#: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
+_RANK = 1e-9
+
+__all__ = ["ModeCount", "Certified", "Search", "Problem", "certified_modes", "search", "join", "count_after_starts"]
+
+
+@dataclass(frozen=True)
+class ModeCount:
+    """How many assembly modes there are for the inputs, and how that is known.
+
+    found:       modes found, real and complex (distinct placements of the links);
+    complete:    every mode is found (certified: ``certificate`` says how);
+    method:      "monodromy" (homotopy continuation) or "random starts" (damped Newton);
+    real:        modes with real joint values: the mechanism's assembly modes, reported;
+    complex:     modes with complex joint values (no real assembly), None when not known;
+    certificate: how completeness is known ("trace test"), None when it is not;
+    reason:      why completeness is not certified ("" when it is);
+    detail:      what the search did: paths tracked and failed, the trace test's value, the
+                 symmetry group's size, roots at infinity and spurious ones, seconds."""
+
+    found: int
+    complete: bool
+    method: str
+    real: int
+    complex: int | None
+    certificate: str | None
+    reason: str = ""
+    detail: dict = field(default_factory=dict)
+
+
+@dataclass
+class Certified:
+    """Real modes found (each (q, model.closure.Assembly, angle sets, simple)) and the count."""
+
+    modes: list
+    count: ModeCount
+
+
+def obstacle(solver) -> str | None:
+    """Why the certified search does not apply to this solver's mechanism and inputs, or None."""
+    mech = solver.mech
+    why = algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings)
+    if why:
+        return f"the loop closure is not polynomial: {why}"
+    if solver.free_dofs:
+        return f"these inputs leave {solver.free_dofs} degree(s) of freedom free (a continuum)"
+    if not mech.cuts:
+        return NO_LOOPS
+    return None
+
+
+@dataclass
+class Problem:
+    """What the homotopy solves: the model and cut joints (an inverse-kinematics target among them),
+    the Pinocchio closure that polishes and lifts (model.closure.ClosureSystem), the velocity indices
+    held (inputs), the configuration that holds their values and the reference one."""
+
+    model: object
+    cuts: list
+    system: object
+    frozen: np.ndarray
+    q_in: np.ndarray
+    ref: np.ndarray | None
+    target: bool = False
+
+
+def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),
+                    problem: Problem | None = None):
+    """The assembly modes for the input ``values`` by homotopy continuation (see the module): a
+    Certified, or the reason (a string) why the method does not apply.  ``problem``: another system
+    to solve (inverse kinematics); by default the solver's loops with its inputs held."""
+    mech = solver.mech
+    if problem is None:
+        why = obstacle(solver)
+        if why:
+            return why
+        ref = solver.reference()
+        problem = Problem(mech.model, mech.cuts, mech.closure, solver.frozen,
+                          solver.set_inputs(mech.neutral() if ref is None else ref, values), ref)
+    t0 = time.perf_counter()
+    closure = PolynomialClosure(problem.model, problem.cuts, problem.frozen, mech.length, points=solver._points,
+                                output=solver.output_frame)
+    closure.set_inputs(problem.q_in)
+    rng = np.random.default_rng(seed)
+    free = closure.nt - _rank(closure, rng)
+    if free > 0:
+        return (f"the closure leaves {free} unknown(s) free at every configuration"
+                + (f" ({solver.idle_dofs} idle degree(s) of freedom: links that spin without moving a joint "
+                   "centre, not on a leg that is a distance)" if solver.idle_dofs else "")
+                + ": positive-dimensional solution sets are not tracked")
+    group = find_symmetries(closure, rng)
+    system = SquareSystem(closure, rng)
+    known = known_count(closure, problem.frozen, problem.target)
+    roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
+                      trace_limit=options.trace_limit)
+    ends = to_target(system, roots, np.zeros(system.n), options)
+    got = _classify(solver, problem, closure, system, group, roots, ends, known, time.perf_counter() - t0, options)
+    if known is not None and not got.count.complete and len(roots.X) <= options.trace_limit:
+        # fewer than the class's bound (a special geometry): the trace test decides, within a budget
+        roots = all_roots(system, group, roots.X[:1], rng, replace(options, budget=options.fallback_budget),
+                          seeds=roots.X, trace_test=True)
+        ends = to_target(system, roots, np.zeros(system.n), options)
+        got = _classify(solver, problem, closure, system, group, roots, ends, None, time.perf_counter() - t0,
+                        options, also=got.count.reason)
+    return got
+
+
+def _rank(closure, rng) -> int:
+    """The generic rank of the closure rows' Jacobian (at random complex points of the variety)."""
+    if closure.nt == 0 or closure.m == 0:
+        return 0
+    _, J = closure.rows(closure.random_points(rng, 2))
+    return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
+
+
+def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: MonodromyOptions,
+              also: str = "") -> Certified:
+    """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
+    mech, tol = solver.mech, solver.mech.tolerances
+    finite = np.isin(ends.status, ("regular", "singular"))
+    X = ends.X
+    scale = 1.0 + np.abs(np.where(np.isfinite(X), X, 0)).max(axis=1)
+    closes = np.zeros(len(X), bool)
+    if finite.any():
+        closes[finite] = system.closes(X[finite]) <= o.closes * scale[finite] ** 2
+    real = closes & (np.abs(X.imag).max(axis=1) <= o.real * scale)
+    modes = []  # [signature, q, assembly, angle sets, simple]
+    full = closure if not closure.legs else PolynomialClosure(
+        problem.model, problem.cuts, problem.frozen, mech.length, points=solver._points,
+        output=solver.output_frame, compiled=False, eliminate=False)
+    full_group = group if full is closure else find_symmetries(full, np.random.default_rng(1))
+    elements = full_group.elements()
+    lost = 0
+    multiple = _coinciding(X, real, group, o.same)  # paths that met: a multiple root
+    for i in np.flatnonzero(real):
+        q = _lift(solver, problem, closure, X[i].real)
+        if q is None:
+            lost += 1
+            continue
+        xf = full.from_q(q)
+        q, a = _best_twin(solver, problem, full, elements, xf)
+        if a.residual > tol.closure:
+            lost += 1
+            continue  # not polished onto Pinocchio's closure: left out (counted in the detail)
+        size = int(full_group.orbit_sizes(xf[None], 1e-9)[0])
+        sig = solver.signature(q)
+        for mode in modes:
+            if np.max(np.abs(mode[0] - sig)) < tol.geometry * max(mech.length, 1.0):
+                mode[3] += size
+                mode[4] = mode[4] and not multiple[i] and ends.status[i] == "regular"
+                break
+        else:
+            modes.append([sig, q, a, size, ends.status[i] == "regular" and ends.cycles[i] == 1 and not multiple[i]])
+    # complex modes: distinct complex signatures of the roots that close and are not real
+    cplx = np.flatnonzero(closes & ~real)
+    sigs = closure.signature(X[cplx]) if cplx.size else np.zeros((0, 0))
+    distinct = []
+    for s in sigs:
+        if not any(np.max(np.abs(s - d)) < o.same * (1 + np.abs(s).max()) for d in distinct):
+            distinct.append(s)
+    failed = int(np.sum(ends.status == "failed"))
+    sets = int(np.sum(group.orbit_sizes(np.where(np.isfinite(X[closes]), X[closes], 0), 1e-9))) if closes.any() else 0
+    found = len(modes) + len(distinct)
+    certificate, reason = None, roots.why
+    if known is not None:
+        reached = found if known.of == "poses" else sets
+        if reached >= known.bound and failed == 0 and lost == 0:
+            certificate, reason = f"{known.bound} {known.of}, the most for {known.what} ({known.source})", ""
+        else:
+            reason = (f"{reached} {known.of} found of at most {known.bound} for {known.what} ({known.source})"
+                      + (f"; {failed} path(s) failed" if failed else ""))
+    elif roots.complete and failed == 0 and lost == 0:
+        certificate, reason = "trace test", ""
+    elif roots.complete:
+        reason = (f"{failed} path{'s' if failed != 1 else ''} failed on the way to the inputs" if failed else
+                  f"{lost} real root(s) did not polish onto Pinocchio's closure")
+    if reason and also:
+        reason = f"{also}, and {reason}"
+    detail = {"roots": int(len(roots.X)), "symmetry": int(full_group.size), "legs_eliminated": len(closure.legs),
+              "lost_polishing": lost, "paths": int(roots.paths + ends.paths),
+              "failed": int(roots.failed + failed), "witnesses": int(roots.witnesses), "trace": roots.trace,
+              "at_infinity": int(np.sum(ends.status == "infinity")), "spurious": int(np.sum(finite & ~closes)),
+              "angle_sets": sets, "unknowns": int(closure.nt), "seconds": round(float(seconds), 3)}
+    count = ModeCount(found, certificate is not None, "monodromy", len(modes), len(distinct), certificate, reason,
+                      detail)
+    # a regular endpoint leaves the verdict to the measures (and, where they are small, to Newton's
+    # convergence: modes.simple_root); two paths that met, or a singular endpoint, are a multiple root
+    return Certified([(q, a, n, None if simple else False) for _, q, a, n, simple in modes], count)
+
+
+def _coinciding(X, mask, group, tol) -> np.ndarray:
+    """(P,) where an endpoint of ``mask`` lies on another's orbit (two paths ended together)."""
+    out = np.zeros(len(X), bool)
+    idx = np.flatnonzero(mask)
+    for k, i in enumerate(idx[1:], 1):
+        j = group.match(X[i][None], X[idx[:k]], tol)[0]
+        if j >= 0:
+            out[i] = out[idx[j]] = True
+    return out
+
+
+def _lift(solver, problem, closure, x):
+    """The real configuration of a real root x of the closure: its joints, and the eliminated legs'
+    angles (model.legs) solved by damped Newton with every other joint held -- from the inputs'
+    configuration, then from random angles -- or None."""
+    mech = solver.mech
+    q = closure.to_q(x, problem.q_in)
+    if not closure.legs:
+        return q
+    legs = mech.velocity_indices([problem.model.names[j] for j in sorted(closure.eliminated)])
+    held = np.union1d(np.setdiff1d(np.arange(mech.nv), legs), np.asarray(problem.frozen, int))  # inputs stay
+    rng = np.random.default_rng(3)
+    for k in range(8):
+        start = q if k == 0 else mech._keep(mech.random_configuration(rng), q, held)
+        try:
+            return problem.system.solve(start, frozen=held).q
+        except AssemblyError:
+            continue
+    return None
+
+
+def _best_twin(solver, problem, closure, elements, x):
+    """(q, Assembly) of the joint-angle set of this root to report: its twins under the symmetry group
+    polished on Pinocchio's closure, the one within the joint limits (and without a reversed leg or
+    a turned link: analysis.motion.modes) nearest the reference configuration."""
+    mech, ref = solver.mech, problem.ref
+    best = None
+    for e in elements:
+        q = closure.to_q(e * x, problem.q_in)
+        bad = (len(solver.outside(q)) > 0,)
+        dist = float(np.linalg.norm(mech.difference(ref, q))) if ref is not None else 0.0
+        key = (bad, dist)
+        if best is None or key < best[0]:
+            best = (key, q)
+    a = newton.polish(problem.system, best[1], problem.frozen)
+    return solver._wrap(a.q), Assembly(solver._wrap(a.q), a.residual, a.iterations, "a homotopy's endpoint")
+
+
+@dataclass
+class Search:
+    """What solve's search found: ``found`` [(signature, q, Assembly)] of the real modes, ``info`` per
+    mode (angle sets, certified simple) by position in ``found``, ``count`` (a ModeCount, or None when
+    the homotopy did not apply) and ``why`` (the reason it did not)."""
+
+    found: list
+    info: list
+    count: ModeCount | None
+    why: str = ""
+
+    @property
+    def complete(self) -> bool:
+        return self.count is not None and self.count.complete
+
+
+def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) -> Search:
+    """certified_modes for solve (and ik, with its ``problem``): its modes as the (signature, q,
+    Assembly) of PositionSolver.distinct."""
+    got = certified_modes(solver, values, seed=seed, problem=problem)
+    if isinstance(got, str):
+        return Search([], [], None, got)
+    found = [(solver.signature(q), q, a) for q, a, _, _ in got.modes]
+    return Search(found, [(sets, simple) for _, _, sets, simple in got.modes], got.count)
+
+
+def join(solver, found, more) -> list:
+    """``found`` with the modes of ``more`` that are not already in it (by signature)."""
+    out = list(found)
+    tol = solver.mech.tolerances.geometry
+    for sig, q, a in more:
+        sig = solver.signature(q) if sig is None else sig
+        if not any(np.max(np.abs(sig - (s if s is not None else solver.signature(p)))) < tol for s, p, _ in out):
+            out.append((sig, q, a))
+    return out
+
+
+def count_after_starts(done: Search | None, found: list, starts: int) -> ModeCount:
+    """The ModeCount of a result found (also) by damped Newton from ``starts`` starting configurations:
+    never complete; the reason says why the homotopy did not settle it."""
+    if done is not None and done.why == NO_LOOPS and len(found) == 1:  # the inputs set every joint
+        return ModeCount(1, True, "no loops", 1, 0, "no loops: the inputs set every joint", "", {"starts": starts})
+    why = ("" if done is None else done.why or (done.count.reason if done.count else "")) or \
+        "the random-start search does not know how many modes there are"
+    if done is not None and done.count is not None:
+        base = done.count
+        return ModeCount(len(found) + (base.complex or 0), False, "monodromy and random starts", len(found),
+                         base.complex, None, why, {**base.detail, "starts": starts})
+    return ModeCount(len(found), False, "random starts", len(found), None, None, why, {"starts": starts})
