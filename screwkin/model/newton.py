@@ -276,7 +276,7 @@ def polish(system, q0, frozen=(), iterations: int = 8) -> Assembly:
     for it in range(1, iterations + 1):
         dq = np.zeros(model.nv)
         dq[free] = -np.linalg.lstsq(K[:, free], r, rcond=None)[0]
-        q_new = pin.integrate(model, q, dq)
+        q_new = system.integrator(q[None], dq[None])[0]  # q (+) dq on the manifold, as the loop moves
         r, K = system.evaluate(q_new, jacobian=True, solver=True)
         norm = float(np.linalg.norm(r))
         if not norm < best:
