@@ -13,7 +13,6 @@ from conftest import ROBOTS
 from screwkin.analysis.motion.ik import inverse_kinematics
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
-from screwkin.model import algebraic_compiled, tracking
 from screwkin.model.algebraic import PolynomialClosure
 from screwkin.model.symmetry import find_symmetries
 
@@ -69,9 +68,9 @@ def test_jacobian_is_the_derivative_along_the_variety(name):
         np.testing.assert_allclose(J[:, :, v], fd, rtol=0, atol=1e-7 * (1 + np.abs(J).max()))
 
 
-@pytest.mark.skipif(not algebraic_compiled.available(), reason="numba is not installed")
 @pytest.mark.parametrize("name", FILES)
 def test_the_compiled_kernel_gives_the_numpy_numbers(name):
+    pytest.importorskip("numba")  # (CI installs it: conftest.CI_MODULES)
     _, _, a, q = closure_of(name)
     mech, _, b, _ = closure_of(name, compiled=True)
     X = a.random_points(np.random.default_rng(1), 7)
