@@ -13,6 +13,7 @@ from conftest import ROBOTS
 from screwkin.analysis.motion.ik import inverse_kinematics
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
+from screwkin.model import tracking
 from screwkin.model.algebraic import PolynomialClosure
 from screwkin.model.symmetry import find_symmetries
 
