@@ -399,13 +399,6 @@ class Mechanism:
         self._length = None if value is None else float(value)
         self.cache.clear()
 
-    @property
-    def length_rule(self) -> str:
-        """How :attr:`length` was chosen, in words."""
-        if self._length is not None:
-            return "given"
-        return "mean link length" if link_lengths(self.model, self.cuts) else "no link has a length: 1 m"
-
     def _translational_coordinates(self) -> np.ndarray:
         """Mask of the velocity coordinates that are lengths (prismatic joints, the translations
         of planar, translation and free-flyer joints)."""

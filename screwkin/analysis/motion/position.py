@@ -245,11 +245,6 @@ class PositionSolver:
             return None
 
     @property
-    def expected_rank(self) -> int:
-        """Generic rank of the passive columns of the constraint Jacobian."""
-        return self.generic().rank_Kp
-
-    @property
     def idle_dofs(self) -> int:
         return self._mobility().idle_dofs
 

@@ -212,13 +212,6 @@ class SerialJacobians:
         return (np.concatenate([p[1] for p in parts]), np.concatenate([p[2] for p in parts]),
                 np.concatenate([p[0] for p in parts]))
 
-    def chain_jacobians(self, Q) -> np.ndarray:
-        """(N, 6, n) the same Jacobians restricted to the n chain joints' columns."""
-        Q = np.atleast_2d(np.asarray(Q, float))
-        th = self._theta(Q)
-        return np.concatenate([self._block(np.ascontiguousarray(th[:, s:s + self.block]))
-                               for s in range(0, len(Q), self.block)]) if len(Q) else np.empty((0, 6, len(th)))
-
     def measures(self, Q, measure: str = "sigma_min", scale_translation: float | None = None, workers: int = 1,
                  method: str = "svd", point: bool = False) -> np.ndarray:
         """(N,) a singularity measure of the chain Jacobian at each configuration of Q (N, nq),
