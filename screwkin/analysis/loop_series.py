@@ -42,7 +42,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from ..model.closure import ContactRow
+from ..model.cuts import ContactRow
 from ..model.geometry import perpendicular_basis
 from ..model.state import KinematicState
 from .screws import cut_twists

@@ -22,7 +22,7 @@ from ..model.topology import Topology
 from .local import LocalAnalysis, local_analysis, words as local_words
 from .redundancy import Redundancy, redundancy
 
-__all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
+__all__ = ["MobilityResult", "OutputMotion", "analyze_mobility"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _FEW_COORDINATES = 60  # above this many joint coordinates, idle motions are analysed at one configuration

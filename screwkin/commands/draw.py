@@ -29,7 +29,7 @@ from ..present.draw import (
 )
 from ..present.draw_targets import design_marks
 from ..present.local import change_point_dict, change_point_lines
-from ..present.report import to_jsonable
+from ..present.jsonout import to_jsonable
 from ..units import in_unit, parse_typed_value
 from ._common import (
     add_configuration_options,

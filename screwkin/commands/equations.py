@@ -9,7 +9,9 @@ import sys
 
 import numpy as np
 
-from ..analysis.course.equations import VectorLoops, equations, newton
+from ..analysis.course.equations import equations
+from ..analysis.course.newton import newton
+from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..model.geometry import wrap_angle
 from ..present.equations import (
@@ -20,7 +22,8 @@ from ..present.equations import (
     newton_dict,
     newton_text,
 )
-from ..present.report import position_dict, position_text, to_jsonable
+from ..present.report import position_dict, position_text
+from ..present.jsonout import to_jsonable
 from ..units import UNITS, parse_typed_assignments
 from ._common import add_configuration_options, configuration, input_solver, split_inputs, with_mode
 

@@ -17,7 +17,9 @@ import tempfile
 
 import numpy as np
 
-from ..analysis.course.equations import VectorLoops, equations, newton
+from ..analysis.course.equations import equations
+from ..analysis.course.newton import newton
+from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
 from ..analysis.motion.modes import choose_mode
@@ -45,16 +47,17 @@ from ..present.equations import equations_dict, newton_dict
 from ..present.motion import motion_dict, strokes_dict, strokes_text
 from ..present.outfile import os_reason, remove_partial, write_output
 from ..present.plots import absolute_series, motion_figure
-from ..present.report import mobility_dict, position_dict
+from ..present.report import position_dict
+from ..present.mobility import mobility_dict
 from ..present.view import (
-    PICTURE,
-    ViewerServer,
     build_scene,
     chromium,
     page,
     screenshot,
     show,
 )
+from ..present.camera import PICTURE
+from ..present.viewserver import ViewerServer
 from ..units import in_unit, parse_typed_assignments, unit_kind
 from ._common import (
     add_configuration_options,

@@ -8,9 +8,9 @@ from ..errors import UsageError
 from ..present.report import (
     position_dict,
     position_text,
-    to_jsonable,
     trace_text,
 )
+from ..present.jsonout import to_jsonable
 from ..units import parse_typed_assignments
 from . import equations as equations_command
 from ._common import (

@@ -41,7 +41,7 @@ import pinocchio as pin
 from ..tolerances import DEFAULT
 from .description import Coupling
 from .inertia import inertia_problem
-from .mjcf import matrix_quat, quat_matrix
+from .mjcf_equality import matrix_quat, quat_matrix
 from .writer import number_text, quoteattr, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf",

@@ -32,7 +32,7 @@ import pinocchio as pin
 from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
 from .description import JOINT_DYNAMICS, LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
-from .mjcf_equality import matrix_quat, quat_matrix, read_equalities
+from .mjcf_equality import quat_matrix, read_equalities
 from .mjcf_include import expand_includes
 from .inertia import inertia_problem
 from .mjcf_inertia import DEFAULT_DENSITY, SOLIDS, body_inertia, geom_inertia, geom_volume
@@ -41,7 +41,7 @@ from .urdf import Problems, check_sizes, numbers, unit_axis
 from .writer import quoteattr, vector_text
 from .xmlsafe import parse_xml_text
 
-__all__ = ["read_mjcf", "quat_matrix", "matrix_quat"]
+__all__ = ["read_mjcf"]
 
 #: Joint types read, with their URDF stand-in (a ball is a revolute replaced by a spherical joint).
 _JOINTS = {"hinge": "revolute", "slide": "prismatic", "ball": "continuous", "free": "floating"}

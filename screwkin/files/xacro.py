@@ -11,7 +11,7 @@ size, no entities, bounded nesting):
 * before xacro sees the file, every attribute and text is checked: each ``${...}`` must
   parse (Python's ``ast``) as numbers, strings, names not starting with ``_``,
   arithmetic, comparisons, ``and``/``or``/``not``, ``a if c else b`` and calls of the
-  math functions of :data:`FUNCTIONS` (also as ``math.NAME``); the only substitution is
+  math functions of :data:`xacro_eval.FUNCTIONS` (also as ``math.NAME``); the only substitution is
   ``$(arg NAME)``; ``load_yaml`` and includes of files outside the file's folder are
   refused;
 * while xacro runs, its evaluator is replaced by an interpreter of that same subset
@@ -50,17 +50,10 @@ import defusedxml
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..units import parse_value
 from .description import LIMITS
-from .xacro_eval import (
-    FUNCTIONS,
-    MAX_STRING,
-    XacroEvaluationError,
-    check_expression,
-    evaluate,
-)
+from .xacro_eval import MAX_STRING, XacroEvaluationError, check_expression, evaluate
 from .xmlsafe import parse_xml_text, read_regular_file
 
-__all__ = ["FUNCTIONS", "MAX_INCLUDES", "MAX_STRING", "XacroEvaluationError", "XacroInternalError", "check_expression", "declared_args",
-           "evaluate", "expand", "is_xacro", "normalize_args", "parse_args"]
+__all__ = ["MAX_INCLUDES", "XacroInternalError", "declared_args", "expand", "is_xacro", "normalize_args", "parse_args"]
 
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro")
 #: Most files one expansion reads (the first one and its includes).

@@ -201,7 +201,7 @@ def _virtual_pairs(model, spec) -> None:
     """Give every rolling, gear and helical loop joint the massless chain of its equivalent
     linkage, from F1 on its first link, whose coordinates are the pair's unwrapped angles (and
     advance); the loop closes with a weld from the chain's end frame ``NAME@end`` to F2, and a
-    coupling row (model.closure.CouplingRow) relates the coordinates:
+    coupling row (model.cuts.CouplingRow) relates the coordinates:
 
     - two circles (radii r1, r2; R = r1 + r2 outside, r1 - r2 inside): a revolute at F1's
       origin (coordinate a1: the contact direction in F1, from its x axis), then, at distance R

@@ -17,7 +17,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote
 from ..files.exporter import PlacedBody, PlacedCompound, PlacedCut, PlacedJoint, PlacedMechanism, coupling_about
-from ..files.mjcf import matrix_quat
+from ..files.mjcf_equality import matrix_quat
 from ..tolerances import DEFAULT
 from .topology import build_topology, frame_link
 

@@ -24,21 +24,20 @@ from html import escape
 
 import numpy as np
 
-from ..analysis.course.vector_loops import PlanarEquations
+from ..analysis.course.symbols import PlanarEquations
 from ..model.geometry import wrap_angle as _wrap
 from .equations import Units, equations_text, greek, newton_text
 from .tables import RateUnits, shown
 from .motion import linkage_construction_text, links_rows, points_rows
-from .report import (
+from .report import slide_note, solution_rows
+from .jsonout import to_jsonable
+from .mobility import (
     JOINT_COLUMNS,
     count_rows,
     joint_rows,
     screw_theory_rows,
-    screws_text,
-    slide_note,
-    solution_rows,
-    to_jsonable,
 )
+from .screws import screws_text
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",

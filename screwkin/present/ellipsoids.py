@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.singularities.ellipsoids import Ellipsoids
-from .report import table
+from .tables import table
 
 __all__ = ["ellipsoids_dict", "ellipsoids_text"]
 

@@ -8,8 +8,9 @@ import re
 
 import numpy as np
 
-from ..analysis.course.vector_loops import PlanarEquations
-from .report import screws_dict, screws_text, table
+from ..analysis.course.symbols import PlanarEquations
+from .screws import screws_dict, screws_text
+from .tables import table
 from .tables import shown
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]

@@ -10,7 +10,8 @@ from ..analysis.forces.grasp import GraspResult
 from ..analysis.screws import screw_of
 from ..model.geometry import TINY
 from ..tolerances import DEFAULT
-from .report import table, to_jsonable
+from .jsonout import to_jsonable
+from .tables import table
 from .tables import SHOWN_ZERO, shown
 
 __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.forces.statics import Leg, StaticsResult
-from .report import screw_dict, table
+from .screws import screw_dict
+from .tables import table
 from .tables import shown
 
 __all__ = ["statics_dict", "statics_text"]

@@ -23,14 +23,12 @@ from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
 from .plots import pyplot
-from .progress import Progress  # noqa: F401  (the study's progress bar: present/progress.py)
-from .report import to_jsonable
+from .jsonout import to_jsonable
 from .tables import csv_text
 from .outfile import write_figure, write_output
 
 __all__ = [
     "DISPLAY",
-    "Progress",
     "check_table_path",
     "LABELS",
     "mode_rule",

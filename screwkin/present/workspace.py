@@ -11,7 +11,7 @@ import pinocchio as pin
 from ..analysis.design.workspace import WorkspaceResult
 from ..tolerances import DEFAULT
 from .plots import pyplot
-from .report import table
+from .tables import table
 from .tables import csv_text
 from .outfile import write_figure, write_output
 

@@ -20,7 +20,7 @@ circle a's centre to circle b's):
 
 c_ab (an arc length [m]) is measured at the configuration the equations are built at, and is
 0 where the marks on both pitch circles touch there.  These are the coupling rows
-r1 a1 +- r2 a2 = 0 (x + r2 a2 = 0) of model.closure.CouplingRow written in the links' angles.
+r1 a1 +- r2 a2 = 0 (x + r2 a2 = 0) of model.cuts.CouplingRow written in the links' angles.
 
 When the rest of a pair's loop fixes the line of centres -- it is constant (two gears pinned to
 one frame), or one link's vector (a planet pinned to an arm: theta_ab is the arm's angle) --

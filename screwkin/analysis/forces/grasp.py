@@ -43,19 +43,18 @@ import numpy as np
 
 from ...files.grasp import GraspSpec
 from ...tolerances import DEFAULT
-from .grasp_map import (  # noqa: F401 - the grasp map's functions, exported here as before
+from .grasp_map import (
     exact_cones,
     generator_matrix,
     scaled_points,
     characteristic_length,
     cone_error,
-    contact_frame,
     generators,
     grasp_map,
 )
 
 __all__ = ["GraspTolerances", "GRASP_TOLERANCES", "ContactForce", "Certificate", "GraspQuality", "GraspResult",
-           "contact_frame", "grasp_map", "characteristic_length", "generators", "cone_error", "analyze_grasp"]
+           "analyze_grasp"]
 
 
 @dataclass(frozen=True)

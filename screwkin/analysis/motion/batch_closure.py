@@ -12,7 +12,8 @@ import numpy as np
 import pinocchio as pin
 
 from ...model import newton
-from ...model.closure import ClosureSystem, CouplingRow, CutJoint
+from ...model.closure import ClosureSystem
+from ...model.cuts import CouplingRow, CutJoint
 
 __all__ = ["TreeKinematics", "BatchClosure", "Unbatchable"]
 

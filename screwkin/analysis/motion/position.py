@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
-from ...model.closure import Assembly
+from ...model.cuts import Assembly
 from ...model.state import KinematicState, angular_loop_joints
 from ...model.topology import open_joints
 from . import modes
@@ -507,7 +507,7 @@ class PositionSolver:
 
     # --------------------------------------------------------------- one solution
     def solution(self, q, a, rates=None, accels=None, points=(), typed=None) -> Solution:
-        """One assembly mode at the closed configuration q (a: its model.closure.Assembly), every quantity
+        """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given."""
         mech, tol = self.mech, self.mech.tolerances
         m = measures(mech, q, self.generic())

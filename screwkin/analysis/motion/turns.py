@@ -12,7 +12,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError
-from ...model.closure import Assembly
+from ...model.cuts import Assembly
 
 __all__ = ["whole_turns", "engaged", "turn_on"]
 

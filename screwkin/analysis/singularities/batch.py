@@ -25,11 +25,10 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import compute_frame_jacobian
-from ..motion.batch_closure import BatchClosure, Unbatchable  # noqa: F401 - tests import them from here
 from ..screws import chains
 
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
-           "singular_value_ratios", "determinants", "BatchClosure", "Unbatchable"]
+           "singular_value_ratios", "determinants"]
 
 _REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
 
