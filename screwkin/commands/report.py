@@ -18,7 +18,7 @@ import tempfile
 import numpy as np
 
 from ..analysis.course.equations import equations
-from ..analysis.course.newton import newton
+from ..analysis.course.newton import differing, newton, start_estimates
 from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
@@ -42,8 +42,10 @@ from ..present.document import (
     topology_section,
     view_section,
 )
-from ..present.draw import draw_chain, draw_mechanism, value_label
+from ..present.draw import draw_chain, draw_mechanism, value_label, wrapped_value
+from ..present.draw_targets import design_drawing
 from ..present.equations import equations_dict, newton_dict
+from ..present.local import singularity_kind_text
 from ..present.motion import motion_dict, strokes_dict, strokes_text
 from ..present.outfile import os_reason, remove_partial, write_output
 from ..present.plots import absolute_series, motion_figure
@@ -75,8 +77,6 @@ from ._common import (
     value_kind,
 )
 from ._options import check_writable, count, screwkin_version
-from .draw import _design, _kind_text, _wrapped
-from .equations import _typed, differing, start_estimates
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -200,7 +200,7 @@ def run(mech, args) -> int:
                              subtitle=None if skel.planar else f"schematic projection of a {skel.motion_space} mechanism")
         figures.append(Figure(figure_bytes(fig), "svg", "skeleton diagram at the configuration analysed", "skeleton"))
         if mech.spec.targets:  # a synthesized design: what it was asked to do, as `draw FILE` shows it
-            design = _attempt(notes, "targets", lambda: _design(mech, q, names, skel, 360))
+            design = _attempt(notes, "targets", lambda: design_drawing(mech, q, names, skel, 360))
             if design is not None:
                 marks, curve = design
                 fig = draw_mechanism(skel, title=f"{os.path.basename(str(mech.path))}: the design's targets",
@@ -319,7 +319,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
         return note_section("newton", title, why)
     solved = loops.values(q)
     if args.start:
-        typed = _typed(args.start, "--start")
+        typed = parse_typed_assignments(args.start, "--start")
         solver = input_solver(mech, values, held)
         start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), {**values, **(held or {})},
                                    typed)
@@ -368,8 +368,8 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, hel
     figures, descriptions, found = [], [], []
     base = os.path.basename(str(mech.path))
     for k, s in enumerate(search.found, 1):
-        at = value_label(search.input, _wrapped(s.input, search.unit), search.unit)
-        what = _kind_text(s)
+        at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
+        what = singularity_kind_text(s)
         skel = skeleton(mech, s.q, [search.input, *search.fixed])
         fig = draw_mechanism(skel, title=f"{base}: singular configuration {k} of {len(search.found)} at {at}",
                              subtitle=what)

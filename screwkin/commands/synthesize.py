@@ -35,13 +35,13 @@ from ..files.description import LIMITS
 from ..files.writer import write_urdf
 from ..parallel.pool import dask_client, dask_map
 from ..model.loader import load
+from ..present.draw import draw_design
 from ..present.jsonout import to_jsonable
 from ..present.outfile import os_reason, output_failed, remove_partial, write_output
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
 from ._options import count, seconds
-from .draw import draw_design
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False

@@ -19,11 +19,14 @@ import os
 
 import numpy as np
 
-from .draw_targets import draw_targets
+from ..analysis.course.skeleton import skeleton
+from ..model.geometry import wrap_angle
+from .draw_targets import design_drawing, draw_targets
 from .plots import pyplot
 from .outfile import write_figure
 
-__all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label", "number_colours"]
+__all__ = ["chain_dict", "draw_chain", "draw_mechanism", "draw_design", "save_figure", "skeleton_dict", "value_label",
+           "wrapped_value", "configuration_text", "drawing_title", "number_colours"]
 
 _TYPE_WORD = {"revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical": "C", "universal": "U",
               "spherical": "S", "planar": "E", "helical": "H", "rolling": "rolling", "gear": "gear",
@@ -39,6 +42,23 @@ def value_label(name, value, unit) -> str:
     if unit == "m":
         return f"{name} = {value * 1000:.4g} mm"
     return f"{name} = {np.degrees(value):.5g} deg"
+
+
+def wrapped_value(value, unit):
+    """A coordinate's value as a drawing names it: a length [m] as it is, an angle in [-pi, pi)."""
+    return value if unit == "m" else wrap_angle(value)
+
+
+def configuration_text(skel) -> str:
+    """The inputs a skeleton is drawn at ('crank = 30 deg, ...'), or 'assembled configuration'."""
+    if not skel.inputs:
+        return "assembled configuration"
+    return ", ".join(value_label(k, v, skel.units[k]) for k, v in skel.inputs.items())
+
+
+def drawing_title(mech, what) -> str:
+    """A drawing's title: the file's name, then ``what``."""
+    return f"{os.path.basename(str(mech.path))}: {what}"
 
 
 def _short(name, n=26):
@@ -467,6 +487,20 @@ def save_figure(fig, path: str, close: bool = True):
         raise
     if close:
         plt.close(fig)
+
+
+def draw_design(mech, paths, steps: int = 360, say=None) -> list:
+    """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
+    ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
+    q = mech.assemble().q
+    input_names = list(mech.actuated)
+    skel = skeleton(mech, q, input_names)
+    marks, curve = (None, None) if not mech.spec.targets else design_drawing(mech, q, input_names, skel, steps, say)
+    traces = {} if curve is None else {curve[0]: curve[1]}
+    for path in paths:
+        fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), traces=traces, marks=marks)
+        save_figure(fig, path)
+    return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
 def skeleton_dict(skel) -> dict:
