@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
-           "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle"]
+           "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle",
+           "nearest_turn"]
 
 #: Division guard: the distance between two circles' centres is taken at least this [m].
 TINY = 1e-300  # division guard
@@ -126,13 +127,27 @@ def _cross_norm(u, w):
     return np.linalg.norm(np.cross(u, w), axis=-1)
 
 
-def wrap_angle(a):
-    """An angle [rad] brought into [-pi, pi) (a float for a number, an array for an array).
+def wrap_angle(a, upper: bool = False):
+    """An angle [rad] brought into [-pi, pi), or into (-pi, pi] with ``upper`` (where atan2 and
+    Pinocchio's continuous joints put it); a float for a number, an array for an array.
 
-    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2
+    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2, wrap_angle(np.pi), wrap_angle(-np.pi, upper=True)
+    (True, -3.141592653589793, 3.141592653589793)
+    """
+    a = np.asarray(a, float)
+    w = np.pi - np.mod(np.pi - a, 2 * np.pi) if upper else np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return float(w) if w.ndim == 0 else w
+
+
+def nearest_turn(angle, ref):
+    """``angle`` [rad] moved by the whole turns that bring it nearest ``ref`` (within half a turn;
+    exactly half a turn away, the even number of turns), broadcast; a float for numbers.
+
+    >>> nearest_turn(0.5, 13.0) == 0.5 + 4 * np.pi
     True
     """
-    w = np.mod(np.asarray(a, float) + np.pi, 2 * np.pi) - np.pi
+    a = np.asarray(angle, float)
+    w = a - 2 * np.pi * np.round((a - np.asarray(ref, float)) / (2 * np.pi))
     return float(w) if w.ndim == 0 else w
 
 

@@ -26,6 +26,7 @@ from .closure import ClosureSystem
 from .cuts import Assembly, ContactRow, CouplingRow, CutJoint
 from .geometry import wrap_angle
 from .linalg import null_space, rank
+from .manifold import continuous_angle, set_continuous_angle
 from .topology import build_topology
 from .lengths import characteristic_length
 
@@ -325,7 +326,7 @@ class Mechanism:
         V[:, wrap] = wrap_angle(V[:, wrap])
         cols = {n: V[:, k] for k, (n, _, _) in enumerate(single)}
         for name, i in continuous:
-            cols[name] = np.arctan2(Q[:, i + 1], Q[:, i])
+            cols[name] = continuous_angle(Q, i)
         for name, i in multi:
             cols[name] = Q[:, i]
         return np.column_stack([cols[n] for n in order]) if order else np.zeros((len(Q), 0))
@@ -451,7 +452,7 @@ class Mechanism:
                     q[i] = rng.uniform(-np.pi, np.pi)
             elif c.nq == 2 and c.nv == 1:  # continuous: (cos, sin)
                 a = rng.uniform(-np.pi, np.pi)
-                q[i:i + 2] = (np.cos(a), np.sin(a))
+                set_continuous_angle(q, i, a)
             elif short == "JointModelSpherical":
                 v = rng.normal(size=4)
                 q[i:i + 4] = v / np.linalg.norm(v)

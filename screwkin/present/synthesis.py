@@ -17,7 +17,8 @@ import numpy as np
 
 from ..analysis.design.synthesis.designs import ChainsResult, Check, FunctionResult, MotionResult, PathResult
 from ..analysis.design.synthesis.chains import guides_of
-from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local, wrap
+from ..model.geometry import wrap_angle
+from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local
 from .jsonout import to_jsonable
 from .tables import table
 from .tables import shown
@@ -168,7 +169,7 @@ def _typed(result: FunctionResult, check: Check) -> list:
     for p, x, phi, psi in zip(check.precision, result.x, result.phi, result.psi):
         got = None
         if p.value and math.isfinite(p.error):
-            got = math.degrees(psi + float(wrap(p.value[0] - p.target.value[0])))
+            got = math.degrees(psi + float(wrap_angle(p.value[0] - p.target.value[0], upper=True)))
         out.append({"x": x, "phi_deg": math.degrees(phi), "psi_deg": math.degrees(psi), "psi_reached_deg": got})
     return out
 

@@ -28,6 +28,7 @@ import pinocchio as pin
 from ...errors import UsageError
 from ...model._pin import joint_axis
 from ...model.geometry import wrap_angle as _wrap
+from ...model.manifold import continuous_angle
 from ...model.geometry import (
     circle_intersections,
     cross2,
@@ -122,7 +123,7 @@ def identify(mech, topo, q, input_joint):
     j_c = other(coupler, j_b)
     j_d = other(ground, inp)
     coord = mech.coordinate(input_joint)
-    q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
+    q_in = float(continuous_angle(q, coord.idx_q)) if coord.nq == 2 else float(q[coord.idx_q])
     A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
     a, b = np.linalg.norm(B - A), np.linalg.norm(C - B)
     where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
@@ -440,5 +441,5 @@ class LinkAngles:
         link must turn about the plane's normal on a joint to the ground."""
         name, sign = self.pivot(link)
         theta0 = self(self.mech.neutral())[link]
-        value = sign * float(np.mod(angle - theta0 + np.pi, 2 * np.pi) - np.pi)
+        value = sign * _wrap(angle - theta0)
         return name, value

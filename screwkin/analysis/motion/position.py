@@ -34,6 +34,8 @@ import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model.cuts import Assembly
+from ...model.geometry import wrap_angle
+from ...model.manifold import set_continuous_angle
 from ...model.state import KinematicState, angular_loop_joints
 from ...model.topology import open_joints
 from . import modes
@@ -293,7 +295,7 @@ class PositionSolver:
                 continue
             c = self.mech.coordinate(name)
             if c.nq == 2 and c.nv == 1:
-                q[c.idx_q:c.idx_q + 2] = (np.cos(v), np.sin(v))
+                set_continuous_angle(q, c.idx_q, v)
             elif c.nq == 1:
                 q[c.idx_q] = v
             else:
@@ -310,7 +312,7 @@ class PositionSolver:
         _, _, _, _, idx, wrap = self.mech._value_layout()
         w = idx[wrap]
         if len(w):
-            q[w] = np.mod(q[w] + np.pi, 2 * np.pi) - np.pi
+            q[w] = wrap_angle(q[w])
         return q
 
     def signature(self, q):
@@ -436,7 +438,7 @@ class PositionSolver:
             if got is None:
                 continue
             angle = name in self._angular
-            miss = abs(float(np.angle(np.exp(1j * (got - want))))) if angle else abs(got - want)
+            miss = abs(wrap_angle(got - want)) if angle else abs(got - want)
             if miss > tol.near_far * (1.0 if angle else self.mech.length):
                 shown = (lambda v: f"{np.degrees(v):.4g} deg") if angle else (lambda v: f"{v:.4g} m")
                 out.append(f"--near {name}={shown(want)}: the assembly mode found has {name} = {shown(got)} "
@@ -531,7 +533,7 @@ class PositionSolver:
         angles = self._link_angles(q)
         joints = self.joint_values(q)
         for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
-            if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < tol.equal:
+            if name in joints and abs(wrap_angle(joints[name] - v)) < tol.equal:
                 joints[name] = float(v)
         return Solution(q, joints, a.residual, a.iterations, bool(singular), float(sigma), pose,
                         rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...model.geometry import nearest_turn
+
 __all__ = ["FOUR_BAR_CLASSES", "four_bar_classes", "four_bar_transmission", "slider_crank_transmission",
            "TransmissionRange", "transmission_range"]
 
@@ -159,7 +161,7 @@ def transmission_range(info, equal: float) -> TransmissionRange:
     offset = info.input_value - info.input_angle  # joint value = phi + offset
     if info.input_range is None or turns:  # (a change point's range is a turn less round-off)
         xs = [offset + phi for phi in phis]
-        xs = [info.input_value + math.remainder(x - info.input_value, 2 * math.pi) for x in xs]
+        xs = [nearest_turn(x, info.input_value) for x in xs]
         ends = []
     else:
         lo_x, hi_x = info.input_range

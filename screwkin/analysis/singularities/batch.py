@@ -25,6 +25,7 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import compute_frame_jacobian
+from ...model.manifold import continuous_angle
 from ..screws import chains
 
 __all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
@@ -112,7 +113,7 @@ class SerialJacobians:
         """(n, N) joint displacements of the chain joints."""
         th = np.empty((len(self._reads), len(Q)))
         for k, (kind, iq, zero) in enumerate(self._reads):
-            th[k] = Q[:, iq] - zero if kind == "linear" else np.arctan2(Q[:, iq + 1], Q[:, iq])
+            th[k] = Q[:, iq] - zero if kind == "linear" else continuous_angle(Q, iq)
         return th
 
     def _block(self, th, pose: bool = False):

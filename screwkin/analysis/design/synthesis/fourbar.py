@@ -25,7 +25,7 @@ from ....model.geometry import circle_circle, cross2, vector_angle, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar
 
-__all__ = ["angle", "wrap", "rotate", "pose_matrix", "branch", "tool_local", "positions",
+__all__ = ["angle", "rotate", "pose_matrix", "branch", "tool_local", "positions",
            "transmission", "travel_analysis", "fourbar_linkage", "crank_angle", "stored"]
 
 TWO_PI = 2 * math.pi
@@ -33,11 +33,6 @@ TWO_PI = 2 * math.pi
 
 def angle(v) -> float:
     return float(math.atan2(v[1], v[0]))
-
-
-def wrap(x):
-    """Angles in (-pi, pi] (model.geometry.wrap_angle's interval turned over, as joint values are)."""
-    return -wrap_angle(-np.asarray(x, float)) + 0.0
 
 
 def rotate(theta):
@@ -191,7 +186,8 @@ def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None 
              PlanarLink("coupler", tuple(coupler_points)),
              PlanarLink("rocker", ((0.0, 0.0), (L["rocker"], 0.0)))]
     joints = [PlanarJoint("crank_joint", "revolute", "ground", "crank", tuple(A0), tc),
-              PlanarJoint("coupler_joint", "revolute", "crank", "coupler", (L["crank"], 0.0), wrap(tab - tc)),
+              PlanarJoint("coupler_joint", "revolute", "crank", "coupler", (L["crank"], 0.0),
+                          wrap_angle(tab - tc, upper=True)),
               PlanarJoint("rocker_joint", "revolute", "ground", "rocker", tuple(B0), tr)]
     if tool and fb.tool is not None:
         links.append(PlanarLink(tool, ((0.0, 0.0),), frame_only=True))

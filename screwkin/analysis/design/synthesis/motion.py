@@ -34,10 +34,10 @@ import math
 import numpy as np
 
 from ....errors import UsageError
-from ....model.geometry import TINY
+from ....model.geometry import TINY, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, Dyad, FourBar, MotionResult, SynthesisError, Target
-from .fourbar import angle, branch, fourbar_linkage, pose_matrix, stored, travel_analysis, wrap
+from .fourbar import angle, branch, fourbar_linkage, pose_matrix, stored, travel_analysis
 
 __all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "candidates", "burmester_points",
            "rank_pairs", "motion_design", "fourbar_from_dyads", "scale_of"]
@@ -110,7 +110,7 @@ def _base_pole(poses):
     of the largest turn."""
     best = None
     for k in range(1, len(poses)):
-        turn = abs(float(wrap(poses[k][2] - poses[0][2])))
+        turn = abs(float(wrap_angle(poses[k][2] - poses[0][2], upper=True)))
         if turn > DEFAULT.equal and (best is None or turn > best[0]):
             best = (turn, k)
     if best is None:
@@ -268,7 +268,8 @@ def targets_of(poses, crank: Dyad) -> tuple:
     for pose in poses:
         R, p = pose_matrix(pose)
         thetas.append(angle(R @ np.array(crank.local) + p - np.array(crank.fixed)))
-    return tuple(Target("pose", tuple(float(x) for x in pose), float(wrap(t - thetas[0])), f"position {k + 1}")
+    return tuple(Target("pose", tuple(float(x) for x in pose), float(wrap_angle(t - thetas[0], upper=True)),
+                        f"position {k + 1}")
                  for k, (pose, t) in enumerate(zip(poses, thetas)))
 
 
@@ -314,7 +315,8 @@ def _check_poses(poses):
     L = scale_of(poses)
     for i, j in itertools.combinations(range(len(poses)), 2):
         a, b = poses[i], poses[j]
-        if math.hypot(a[0] - b[0], a[1] - b[1]) < DEFAULT.equal * L and abs(float(wrap(a[2] - b[2]))) < DEFAULT.equal:
+        if math.hypot(a[0] - b[0], a[1] - b[1]) < DEFAULT.equal * L \
+                and abs(float(wrap_angle(a[2] - b[2], upper=True))) < DEFAULT.equal:
             raise UsageError(f"--poses: positions {i + 1} and {j + 1} are the same pose: give distinct poses")
 
 

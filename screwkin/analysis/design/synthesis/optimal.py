@@ -29,7 +29,8 @@ import numpy as np
 from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, PathResult, SynthesisError
-from .fourbar import travel_analysis, wrap
+from ....model.geometry import wrap_angle
+from .fourbar import travel_analysis
 from .path import _residuals, _unpack, coupler_points, path_design, path_points
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
 
@@ -279,6 +280,7 @@ def optimal_path(points, timing, constraints, search, tolerance: float = 1e-6, e
                           f"{REFINED} distinct members of each run", len(runs), evaluations, seconds, search.where,
                           search.seed, listed)
     return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
-                      tuple(float(wrap(t)) if abs(t) < math.pi else float(t) for t in rel), tuple(map(float, errors)),
+                      tuple(float(wrap_angle(t, upper=True)) if abs(t) < math.pi else float(t) for t in rel),
+                      tuple(map(float, errors)),
                       len(runs), sum(c[0][0].error <= tolerance for c in cands), tolerance, best.design, report)
 

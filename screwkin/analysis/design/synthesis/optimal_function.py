@@ -23,9 +23,9 @@ from dataclasses import replace
 import numpy as np
 
 from ....errors import UsageError
+from ....model.geometry import wrap_angle
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, FunctionResult, SynthesisError
-from .fourbar import wrap
 from .function import function_result, function_task
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, rank_key
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
@@ -71,7 +71,7 @@ def _errors(X, names, task, signs, constraints, equal, phi, psi):
     e = -A / dist[..., None]  # from A towards B0 (the origin)
     n = np.stack([-e[..., 1], e[..., 0]], -1)
     B = A + along[..., None] * e + (sigma * np.sqrt(np.maximum(h2, 0)))[..., None] * n
-    err = wrap(np.arctan2(B[..., 1], B[..., 0]) + (math.pi if sc < 0 else 0.0) - psi[None])
+    err = wrap_angle(np.arctan2(B[..., 1], B[..., 0]) + (math.pi if sc < 0 else 0.0) - psi[None], upper=True)
     apart = np.maximum(-h2, 0).sum(axis=1) / d ** 2
     g = d
     mu_lo, mu_hi = motion_mu(g, a, b, c, task["p0"] - math.pi, task["p1"] - task["p0"], equal)

@@ -30,7 +30,8 @@ import numpy as np
 from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, Dyad, MotionResult, SynthesisError
-from .fourbar import pose_matrix, travel_analysis, wrap
+from ....model.geometry import wrap_angle
+from .fourbar import pose_matrix, travel_analysis
 from .motion import _base_pole, _check_poses, _positions_of, _rows, burmester_points, motion_design, poles, scale_of
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, _defect_words, rank_key
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
@@ -86,7 +87,7 @@ def _driven(A0, a, B0, b, poses, direction, constraints, L, equal):
     c, s = np.cos(turn), np.sin(turn)
     origin = A - np.stack([c * a[:, None, 0] - s * a[:, None, 1], s * a[:, None, 0] + c * a[:, None, 1]], -1)
     miss = np.hypot(*np.moveaxis(origin - P[None], -1, 0)) / L
-    angle = np.abs(wrap(turn - TH[None]))
+    angle = np.abs(wrap_angle(turn - TH[None], upper=True))
     res = np.concatenate([miss, angle], axis=1)
     # every configuration between two poses must assemble (no limit position on the way)
     steps = (np.arange(1, BETWEEN + 1) / (BETWEEN + 1))
