@@ -119,7 +119,7 @@ def _writable(path, option):
     check_writable(path, option)
 
 
-def _input_names(mech, args, given):
+def _report_inputs(mech, args, given):
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     names = names or list(given) or list(mech.actuated)
     for n in names:
@@ -152,7 +152,7 @@ def run(mech, args) -> int:
     # --set-angle of a link pinned to the ground is its joint's value; of a floating link (held), one more
     # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
     given, held, pivots = split_inputs(mech, args)
-    names = _input_names(mech, args, given)
+    names = _report_inputs(mech, args, given)
     near = near_values(mech, args)
     q0 = mech.generic_configurations()[0].q
     if args.output:
@@ -233,7 +233,7 @@ def run(mech, args) -> int:
 
     # ---- positions, velocities, accelerations
     if pres is not None:
-        given_rates = "input rates " + _rates_text(mech, args, rates) + \
+        given_rates = "input rates " + _input_rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
         sections.append(motion_section(pres, given_rates, mech.length, rate_units(args), data.get("mode", {}).get("index", 1)))
     else:
@@ -294,7 +294,7 @@ def run(mech, args) -> int:
     return 0
 
 
-def _rates_text(mech, args, rates) -> str:
+def _input_rates_text(mech, args, rates) -> str:
     """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
     if not args.rate:

@@ -25,7 +25,7 @@ import pinocchio as pin
 from ..tolerances import DEFAULT, Tolerances
 from . import compiled, newton
 from .manifold import Integrator
-from .cuts import Assembly, ContactRow, CouplingRow
+from .cuts import Assembly, CouplingRow
 from .geometry import cross3, perpendicular_basis, skew, skews, skews_batch
 from ._pin import frame_jacobian
 

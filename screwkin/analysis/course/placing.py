@@ -11,13 +11,13 @@ from ...model.geometry import wrap_angle as wrap
 from ...model.manifold import continuous_angle, set_continuous_angle
 from .rolling import virtual_coordinates
 
-__all__ = ["LOWER", "configuration"]
+__all__ = ["LOWER", "joint_configuration"]
 
 #: The joints the vector-loop equations take (besides rolling and gear pairs).
 LOWER = ("revolute", "continuous", "prismatic")
 
 
-def configuration(loops, values: dict) -> np.ndarray:
+def joint_configuration(loops, values: dict) -> np.ndarray:
     """A joint configuration whose link angles and slider coordinates are ``values``: each
     tree joint's value from the relative angle (revolute) or the slider coordinate
     (prismatic) it carries, calibrated at the configuration the equations were built at.

@@ -47,7 +47,7 @@ from .grasp_map import (
     exact_cones,
     generator_matrix,
     scaled_points,
-    characteristic_length,
+    grasp_characteristic_length,
     cone_error,
     generators,
     grasp_map,
@@ -330,7 +330,7 @@ def _closure(spec, G, Gs, blocks, W, parts, cones, tol, L):
     return False, _wrench_certificate(spec, Gs, blocks, u, both, L, cones)
 
 
-def _decide(spec, G, Gs, blocks, facets, tol, L):
+def _decide_closure(spec, G, Gs, blocks, facets, tol, L):
     """(force_closure, certificate, how, facets used, notes)."""
     notes = []
     if all(exact_cones(c, spec.planar) for c in spec.contacts):
@@ -367,7 +367,7 @@ def _decide(spec, G, Gs, blocks, facets, tol, L):
 
 
 # ------------------------------------------------------------------ quality
-def _hull(X):
+def _qhull(X):
     """Qhull's hull of the points X (rows); joggled ("QJ") when the exact hull fails on nearly
     coplanar points (fine pyramids): its facets then move by about 1e-11 (relative)."""
     from scipy.spatial import ConvexHull, QhullError
@@ -415,7 +415,7 @@ def _epsilon(W, tol):
     upper = math.inf
     while True:
         try:
-            hull = _hull(W[:, S].T)
+            hull = _qhull(W[:, S].T)
         except (QhullError, ValueError) as exc:
             first = (str(exc).strip().splitlines() or ["?"])[0]
             return None, None, f"Qhull failed: {first[:120]}"
@@ -466,14 +466,14 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
     G, labels, blocks = grasp_map(spec)
     p = G.shape[0]
     if length is None:
-        L, source = characteristic_length(spec)
+        L, source = grasp_characteristic_length(spec)
     else:
         L, source = float(length), "given"
     Gs = G * scaled_points(p, L)[:, None]
     rank = _rank(Gs, tol.rank_rtol)
     Wf, parts_f = generator_matrix(spec, Gs, blocks, facets, frictionless=True)
     form, _ = _closure_form(Wf, tol)
-    closed, cert, how, n, notes = _decide(spec, G, Gs, blocks, facets, tol, L)
+    closed, cert, how, n, notes = _decide_closure(spec, G, Gs, blocks, facets, tol, L)
     exact = all(exact_cones(c, spec.planar) for c in spec.contacts)
     quality = _quality(spec, Gs, blocks, n, exact, closed, tol, L)
     if rank < p:

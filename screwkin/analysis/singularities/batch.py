@@ -28,7 +28,7 @@ from ...model._pin import compute_frame_jacobian
 from ...model.manifold import continuous_angle
 from ..screws import chains
 
-__all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
+__all__ = ["frame_jacobians", "SerialJacobians", "stack_singular_values", "smallest_singular_values",
            "singular_value_ratios", "determinants"]
 
 _REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
@@ -287,7 +287,7 @@ def _apply(R, x) -> np.ndarray:
     return out if out is not None else np.zeros(R.shape[1:])
 
 
-def singular_values(J) -> np.ndarray:
+def stack_singular_values(J) -> np.ndarray:
     """(N, min(m, n)) singular values of a stack of matrices (N, m, n), largest first."""
     return np.linalg.svd(np.asarray(J), compute_uv=False)
 
@@ -321,7 +321,7 @@ def _extreme_singular_values(J, scale_translation, method, slide=None):
     if slide is not None:
         J[:, :, slide] *= scale_translation
     if method == "svd":
-        s = singular_values(J)
+        s = stack_singular_values(J)
         return s[:, -1], s[:, 0]
     if method != "gram":
         raise UsageError(f"unknown method '{method}': svd or gram")
@@ -331,7 +331,7 @@ def _extreme_singular_values(J, scale_translation, method, slide=None):
     low, high = np.sqrt(np.maximum(lam[:, 0], 0.0)), np.sqrt(np.maximum(lam[:, -1], 0.0))
     near = lam[:, 0] < _GRAM_KAPPA**2 * lam[:, -1]
     if near.any():
-        s = singular_values(J[near])
+        s = stack_singular_values(J[near])
         low[near], high[near] = s[:, -1], s[:, 0]
     return low, high
 

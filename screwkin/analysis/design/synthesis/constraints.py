@@ -97,6 +97,14 @@ class Constraints:
         t = None if self.min_transmission is None else self.min_transmission + angle
         return Constraints(bounds, lengths, self.grashof, t)
 
+    def pivot_box(self, centre, size: float) -> tuple:
+        """(low, high) corners [m] of where a search puts the fixed pivots: the bounds, else ``centre``
+        +- 2 ``size`` (the task's own size: its points' or poses')."""
+        if self.bounds is not None:
+            (x0, y0), (x1, y1) = self.bounds
+            return np.array([x0, y0]), np.array([x1, y1])
+        return centre - 2 * size, centre + 2 * size
+
     @property
     def any(self) -> bool:
         return any(v is not None for v in (self.bounds, self.lengths, self.grashof, self.min_transmission))

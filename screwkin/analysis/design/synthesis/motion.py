@@ -52,7 +52,7 @@ def scale_of(poses) -> float:
     return d if d > 0 else 1.0
 
 
-def _rows(poses, A0):
+def _burmester_rows(poses, A0):
     """The rows [2 g_i, rhs_i] (i = 2..n) at fixed pivots A0 (..., 2): shape (..., n-1, 3)."""
     A0 = np.asarray(A0, float)
     R1, p1 = pose_matrix(poses[0])
@@ -67,7 +67,7 @@ def _rows(poses, A0):
 
 def moving_pivot(poses, A0, what=WHAT):
     """The moving pivot (coupler frame) of the dyad with fixed pivot A0 through three poses."""
-    M = _rows(poses[:3], A0)
+    M = _burmester_rows(poses[:3], A0)
     G, r = M[:, :2], M[:, 2]
     scale = scale_of(poses)
     if abs(np.linalg.det(G)) < DEFAULT.zero * max(np.abs(G).max(), TINY) ** 2 or np.abs(G).max() < DEFAULT.zero * scale:
@@ -136,7 +136,7 @@ def centre_point_curve(poses, directions: int = 360, bound: float | None = None)
     e = np.stack([np.cos(alphas), np.sin(alphas)], axis=-1)  # (m, 2)
     ts = np.array([-1.0, 1.0, 2.0]) * L
     pts = P + ts[None, :, None] * e[:, None, :]  # (m, 3, 2)
-    f = np.linalg.det(_rows(poses, pts))  # (m, 3): f(t) = c1 t + c2 t^2 + c3 t^3
+    f = np.linalg.det(_burmester_rows(poses, pts))  # (m, 3): f(t) = c1 t + c2 t^2 + c3 t^3
     V = np.stack([ts, ts**2, ts**3], axis=-1)
     coef = np.linalg.solve(V, f.T).T  # (m, 3)
     out_c, out_idx = [], []
@@ -160,7 +160,7 @@ def _circle_points(poses, C):
     (least squares of the linear equations; exact on the curve)."""
     if len(C) == 0:
         return np.zeros((0, 2)), np.zeros((0, 2))
-    M = _rows(poses, C)
+    M = _burmester_rows(poses, C)
     G, r = M[..., :2], M[..., 2]
     local = np.full((len(C), 2), np.nan)
     for k in range(len(C)):
@@ -185,7 +185,7 @@ def candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
 
 
 def _D(poses4, X):
-    return np.linalg.det(_rows(poses4, X))
+    return np.linalg.det(_burmester_rows(poses4, X))
 
 
 def burmester_points(poses, seeds: int = 360) -> tuple:
@@ -223,7 +223,7 @@ def burmester_points(poses, seeds: int = 360) -> tuple:
             continue
         if any(np.hypot(*(x - y)) < 1e-7 * L for y in found):
             continue
-        M = _rows(poses, x)
+        M = _burmester_rows(poses, x)
         G, r = M[:, :2], M[:, 2]
         a, *_ = np.linalg.lstsq(G, r, rcond=None)
         if np.linalg.matrix_rank(G, tol=DEFAULT.equal * max(np.abs(G).max(), TINY)) < 2:
@@ -238,7 +238,7 @@ def burmester_points(poses, seeds: int = 360) -> tuple:
         found.append(x)
     out = []
     for x in found:
-        M = _rows(poses, x)
+        M = _burmester_rows(poses, x)
         a, *_ = np.linalg.lstsq(M[:, :2], M[:, 2], rcond=None)
         R1, p1 = pose_matrix(poses[0])
         out.append(Dyad(tuple(map(float, x)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))))

@@ -58,15 +58,10 @@ SEARCHED = 24
 TWO_PI = 2 * math.pi
 
 
-def _box(pts, constraints, L):
+def _path_box(pts, constraints, L):
     """The search's box: the pivots inside the bounds (else 2 path sizes around the points), the links
     within the length range (else 2 % of the path's size to 4 times it), the coupler point within 3 sizes."""
-    centre = pts.mean(axis=0)
-    if constraints.bounds is not None:
-        (x0, y0), (x1, y1) = constraints.bounds
-        plo, phi = np.array([x0, y0]), np.array([x1, y1])
-    else:
-        plo, phi = centre - 2 * L, centre + 2 * L
+    plo, phi = constraints.pivot_box(pts.mean(axis=0), L)
     llo, lhi = constraints.lengths if constraints.lengths is not None else (0.02 * L, 4 * L)
     lower = [*plo, *plo, llo, llo, llo, -3 * L, -3 * L]
     upper = [*phi, *phi, lhi, lhi, lhi, 3 * L, 3 * L]
@@ -178,7 +173,7 @@ def _path_run(task):
     at most SEARCHED points, evenly chosen, when there are more), then the refinement of its best
     distinct members on all the points.  Returns ([(x, sigma, direction)], generations)."""
     pts, timing, sigma, direction, constraints, L, seed, generations, popsize, equal = task
-    lower, upper = _box(pts, constraints, L)
+    lower, upper = _path_box(pts, constraints, L)
     few = np.unique(np.linspace(0, len(pts) - 1, min(len(pts), SEARCHED)).round().astype(int))
     if timing is None:
         def cost(X):

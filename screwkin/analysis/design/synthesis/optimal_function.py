@@ -33,7 +33,7 @@ from .search import SearchReport, distinct_best, evolve, run_all, task_seed
 __all__ = ["optimal_function"]
 
 
-def _layout(task, constraints):
+def _unknowns(task, constraints):
     """(names of the unknowns, lower, upper): a, b, c (and d with --lengths, B0's x, y with --bounds)."""
     d = task["ground"]
     lo, hi = constraints.lengths if constraints.lengths is not None else (0.05 * d, 10 * d)
@@ -84,7 +84,7 @@ def _function_run(job):
     """One run (picklable: what a Dask worker computes): differential evolution on the precision points,
     then least squares from its best distinct members.  Returns ([(x, signs)], generations)."""
     task, names, constraints, signs, seed, generations, popsize, equal = job
-    _, lower, upper = _layout(task, constraints)
+    _, lower, upper = _unknowns(task, constraints)
     phi, psi = task["phi"], task["psi"]
 
     def cost(X):
@@ -112,7 +112,7 @@ def optimal_function(text, x_range, input_range, output_range, points, spacing, 
     task = function_task(text, x_range, input_range, output_range, points, spacing, ground)
     if constraints.lengths is not None and not 0 < constraints.lengths[0] < constraints.lengths[1]:
         raise UsageError("--lengths: give MIN..MAX with 0 < MIN < MAX")
-    names, _, _ = _layout(task, constraints)
+    names, _, _ = _unknowns(task, constraints)
     runs = [(s, sa, sc) for s in (1.0, -1.0) for sa in (1.0, -1.0) for sc in (1.0, -1.0)]
     jobs = [(task, names, constraints, r, task_seed(search.seed, k), search.generations, search.popsize, equal)
             for k, r in enumerate(runs)]
