@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from screwkin.model.geometry import (circle_circle, circle_intersections, cross2, line_angle, line_circle, line_foot,
-                                     nearest_turn, perpendicular_basis, plane_basis, vector_angle, wrap_angle)
+                                     lines_point, nearest_turn, perpendicular_basis, plane_basis, vector_angle,
+                                     wrap_angle)
 
 
 @pytest.mark.parametrize("a", [(0, 0, 1), (1, 0, 0), (0, 1, 0), (1, 1, 1), (0.95, -0.1, 0.3)])
@@ -106,3 +107,14 @@ def test_nearest_turn_hand_values():
     np.testing.assert_allclose(nearest_turn(np.array([0.0, 3.0]), np.array([7.0, -3.0])), [2 * np.pi, 3.0 - 2 * np.pi],
                                rtol=0, atol=1e-14)
 
+
+def test_lines_point_hand_values():
+    # three axes through (1, 2, 3) along x, y and z meet there
+    c, d = lines_point([[0, 2, 3], [1, 0, 3], [1, 2, 0]], [[1, 0, 0], [0, 2, 0], [0, 0, -5]], 1e-12)
+    np.testing.assert_allclose(c, [1, 2, 3], rtol=0, atol=1e-14)
+    assert d == pytest.approx(0.0, abs=1e-14)
+    # the x axis and the line through (0, 0, 1) along y: the midpoint of their common normal, 0.5 from each
+    c, d = lines_point([[0, 0, 0], [0, 0, 1]], [[1, 0, 0], [0, 1, 0]], 1e-12)
+    np.testing.assert_allclose(c, [0, 0, 0.5], rtol=0, atol=1e-14)
+    assert d == pytest.approx(0.5, abs=1e-14)
+    assert lines_point([[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [-2, 0, 0]], 1e-12) == (None, np.inf)  # parallel

@@ -18,7 +18,7 @@ import tempfile
 import numpy as np
 
 from ..analysis.course.equations import equations
-from ..analysis.course.newton import differing, newton, start_estimates
+from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
@@ -337,7 +337,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
                f"length +{100 * START_FRACTION:g} % (of L = {mech.length:.4g} m when 0); give --start NAME=VALUE,... "
                "for other estimates")
     held = {n: solved[n] for n in loops.input_syms}
-    res = _attempt(notes, "newton", lambda: newton(loops, held, start, args.iterations))
+    res = _attempt(notes, "newton", lambda: textbook_newton(loops, held, start, args.iterations))
     if res is None:  # the mechanism's own (more unknowns than equations: fewer inputs than DOF), said here
         return note_section("newton", title, f"not run: {notes['newton']}")
     far = differing(mech, loops, res.values, solved)

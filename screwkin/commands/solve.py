@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import sys
 
-from ..analysis.course.newton import differing, newton, start_estimates
+from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..present.equations import Units, greek, newton_dict, newton_text
@@ -128,7 +128,7 @@ def _solve_from_start(mech, args, values, held=None) -> int:
     start, units = start_estimates(mech, loops, solver, q_in, {**values, **held}, typed)
     input_values = loops.values(q_in)
     given = {n: held.get(loops.input_joints[n][0], input_values[n]) for n in loops.input_syms}
-    res = newton(loops, given, start, args.iterations)
+    res = textbook_newton(loops, given, start, args.iterations)
 
     typed_units = [u.lower() for _, _, u in typed + parse_typed_assignments(args.set, "--set")
                    + parse_typed_assignments(args.set_angle, "--set-angle")]

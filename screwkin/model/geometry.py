@@ -12,7 +12,7 @@ import numpy as np
 
 __all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
            "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle",
-           "nearest_turn"]
+           "nearest_turn", "lines_point"]
 
 #: Division guard: the distance between two circles' centres is taken at least this [m].
 TINY = 1e-300  # division guard
@@ -119,6 +119,29 @@ def line_circle(point, direction, centre, radius) -> list:
         return []
     h = np.sqrt(h2)
     return [foot - h * direction, foot + h * direction]
+
+
+def lines_point(points, directions, tol: float):
+    """(c, d): the point c nearest, in least squares, the 3-D lines through ``points`` along
+    ``directions`` (sum (I - u u^T) (c - p) = 0, u the unit directions), and the largest distance d
+    of a line from it; (None, inf) where the lines are parallel (that system's rank, by ``tol``,
+    below 3).
+
+    >>> c, d = lines_point([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]], 1e-12)
+    >>> [round(float(x), 12) + 0.0 for x in c], round(float(d), 12)
+    ([1.0, 0.0, 0.0], 0.0)
+    """
+    A, b, projections = np.zeros((3, 3)), np.zeros(3), []
+    for p, d in zip(points, directions):
+        u = np.asarray(d, float) / np.linalg.norm(d)
+        P = np.eye(3) - np.outer(u, u)
+        projections.append((P, np.asarray(p, float)))
+        A += P
+        b += P @ np.asarray(p, float)
+    if np.linalg.matrix_rank(A, tol=tol) < 3:  # the lines are parallel: no common point
+        return None, np.inf
+    c = np.linalg.solve(A, b)
+    return c, max(np.linalg.norm(P @ (c - p)) for P, p in projections)
 
 
 def _cross_norm(u, w):

@@ -26,6 +26,7 @@ from ..files.description import CUT_JOINT_DOF
 from ..files.sidecar import axis_letters
 from ..tolerances import DEFAULT
 from ._pin import frame_id
+from .geometry import lines_point
 from .six_bar import six_bar_inversion
 
 __all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind", "open_joints"]
@@ -328,21 +329,6 @@ def _line_distance(p1, d1, p2, d2, tol):
     return abs((p2 - p1) @ _unit_vector(n))
 
 
-def _common_point(points, directions):
-    """Least-squares point closest to all lines; returns (point, largest distance)."""
-    A = np.zeros((3, 3))
-    b = np.zeros(3)
-    for p, d in zip(points, directions):
-        P = np.eye(3) - np.outer(_unit_vector(d), _unit_vector(d))
-        A += P
-        b += P @ p
-    if np.linalg.matrix_rank(A, tol=DEFAULT.equal) < 3:  # the lines are parallel: no common point
-        return None, np.inf
-    c = np.linalg.solve(A, b)
-    dist = max(np.linalg.norm((np.eye(3) - np.outer(_unit_vector(d), _unit_vector(d))) @ (c - p)) for p, d in zip(points, directions))
-    return c, dist
-
-
 def _compound_name(members, kind) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
 
@@ -379,7 +365,7 @@ def _classify_chain(chain, tol, scale, coupled=frozenset()):
     if len(chain) == 3 and len(rev) == 3:
         dirs = np.array([_unit_vector(e.direction) for e in rev])
         if np.linalg.matrix_rank(dirs, tol=tol) == 3:
-            _, dist = _common_point([e.point for e in rev], dirs)
+            _, dist = lines_point([e.point for e in rev], dirs, DEFAULT.equal)
             if dist < lt:
                 return "spherical"
     del kinds
@@ -467,7 +453,7 @@ def build_topology(mech, q) -> Topology:
         if kind == "cylindrical":
             direction = next(e.direction for e in chain if e.type != "prismatic")
         elif kind == "spherical":
-            point, _ = _common_point([e.point for e in chain], [e.direction for e in chain])
+            point, _ = lines_point([e.point for e in chain], [e.direction for e in chain], DEFAULT.equal)
         elif kind == "universal":
             a, b = chain
             n = np.cross(_unit_vector(a.direction), _unit_vector(b.direction))
@@ -557,7 +543,7 @@ def _motion_space(joints, tol, scale):
             c = centres[0]
             dist = max([0.0] + [np.linalg.norm(np.cross(c - p, _unit_vector(d))) for p, d in lines])
         elif len(lines) >= 2:
-            c, dist = _common_point([p for p, _ in lines], [d for _, d in lines])
+            c, dist = lines_point([p for p, _ in lines], [d for _, d in lines], DEFAULT.equal)
         if c is not None and dist < lt and all(np.linalg.norm(p - c) < lt for p in centres):
             cc = np.round(c, 6) + 0.0
             return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None

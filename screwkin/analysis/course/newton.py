@@ -12,7 +12,7 @@ import numpy as np
 from ...errors import UsageError
 from ...model.geometry import TINY, wrap_angle
 
-__all__ = ["NewtonStep", "NewtonResult", "newton", "start_estimates", "differing"]
+__all__ = ["NewtonStep", "NewtonResult", "textbook_newton", "start_estimates", "differing"]
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class NewtonResult:
     stopped: str | None  # why Newton stopped early (a singular Jacobian), else None
 
 
-def newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> NewtonResult:
+def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> NewtonResult:
     """Plain (undamped) Newton on the loop equations, as a textbook does it: from the
     estimates ``start`` (every unknown symbol -> value), with the inputs (input symbol ->
     value) held.  ``iterations``: exactly that many steps (fewer only when the Jacobian is

@@ -182,7 +182,7 @@ def _linprog(c, tol, **kw):
     return res.x if res.status == 0 and res.x is not None else None
 
 
-def _rank(A, rtol):
+def _relative_rank(A, rtol):
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
     return int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
@@ -320,7 +320,7 @@ def _wrench_certificate(spec, Gs, blocks, u, both, L, cones):
 def _closure(spec, G, Gs, blocks, W, parts, cones, tol, L):
     """(closed, certificate) for one set of polyhedral cones (exact or a pyramid)."""
     p = W.shape[0]
-    if _rank(W, tol.rank_rtol) == p:
+    if _relative_rank(W, tol.rank_rtol) == p:
         lam, _ = _positive_null_vector(W, tol)
         if lam is not None:
             return True, _internal_certificate(spec, G, Gs, blocks, W, parts, lam, cones, tol)
@@ -395,10 +395,10 @@ def _epsilon(W, tol):
 
     p = W.shape[0]
     W = np.unique(W.T, axis=0).T
-    r = _rank(W, tol.rank_rtol)
+    r = _relative_rank(W, tol.rank_rtol)
     if r < p:
         return 0.0, 0.0, f"the primitive wrenches span {r} of {p} dimensions (the hull is flat: epsilon 0)"
-    if _rank(W - W[:, :1], tol.rank_rtol) < p:
+    if _relative_rank(W - W[:, :1], tol.rank_rtol) < p:
         return 0.0, 0.0, "the primitive wrenches lie on a hyperplane that misses the origin (epsilon 0)"
     scale = float(np.abs(W).max())
     _, _, Vt = np.linalg.svd(W @ W.T)
@@ -470,7 +470,7 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
     else:
         L, source = float(length), "given"
     Gs = G * scaled_points(p, L)[:, None]
-    rank = _rank(Gs, tol.rank_rtol)
+    rank = _relative_rank(Gs, tol.rank_rtol)
     Wf, parts_f = generator_matrix(spec, Gs, blocks, facets, frictionless=True)
     form, _ = _closure_form(Wf, tol)
     closed, cert, how, n, notes = _decide_closure(spec, G, Gs, blocks, facets, tol, L)
@@ -484,7 +484,7 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
 
 def _closure_form(Wf, tol):
     """Form closure: the normals' wrenches positively span wrench space (an exact test)."""
-    if _rank(Wf, tol.rank_rtol) < Wf.shape[0]:
+    if _relative_rank(Wf, tol.rank_rtol) < Wf.shape[0]:
         return False, None
     lam, margin = _positive_null_vector(Wf, tol)
     return lam is not None, lam

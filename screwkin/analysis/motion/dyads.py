@@ -124,7 +124,7 @@ class _Pose:
         return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
 
 
-def _turn(u0, u):
+def _turn_from(u0, u):
     """The angle from the constant vector u0 to the jet vector u, in (-pi, pi]."""
     return Jet.atan2(u[1] * u0[0] - u[0] * u0[1], u[0] * u0[0] + u[1] * u0[1])
 
@@ -216,8 +216,8 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clam
         disc = d2.inverse() * r1s - a * a
         h = _root(disc, clamp) * sigma
         B = (A[0] + a * w[0] - h * w[1], A[1] + a * w[1] + h * w[0])
-        th1 = _turn(B1 - A1, (B[0] - A[0], B[1] - A[1]))
-        th2 = _turn(B2 - C2, (B[0] - C[0], B[1] - C[1]))
+        th1 = _turn_from(B1 - A1, (B[0] - A[0], B[1] - A[1]))
+        th2 = _turn_from(B2 - C2, (B[0] - C[0], B[1] - C[1]))
         return (_Pose.through(th1, A, A1), _Pose.through(th2, C, C2)), disc.v * d2.v / r1s
     if kinds == "RRP":  # B on g2 slides along a line of C's other link
         A, P = pa(AK), pc(B2)
@@ -228,7 +228,7 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clam
         disc = b * b - (e[0] * e[0] + e[1] * e[1] - r1s)
         s = _root(disc, clamp) * sigma - b
         B = (P[0] + s * dd[0], P[1] + s * dd[1])
-        th1 = _turn(B1 - A1, (B[0] - A[0], B[1] - A[1]))
+        th1 = _turn_from(B1 - A1, (B[0] - A[0], B[1] - A[1]))
         return (_Pose.through(th1, A, A1), _Pose.through(pc.th, B, B2)), disc.v / r1s
     # RPR: both links turn by the same angle; C - A = R(th) (C2 - A1 + s d)
     A, C = pa(AK), pc(CK)

@@ -39,7 +39,7 @@ from ....tolerances import DEFAULT
 from .designs import Design, Dyad, FourBar, MotionResult, SynthesisError, Target
 from .fourbar import angle, branch, fourbar_linkage, pose_matrix, stored, travel_analysis
 
-__all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "candidates", "burmester_points",
+__all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "dyad_candidates", "burmester_points",
            "rank_pairs", "motion_design", "fourbar_from_dyads", "scale_of"]
 
 WHAT = "synthesize motion"
@@ -170,7 +170,7 @@ def _circle_points(poses, C):
     return local, local @ R1.T + p1
 
 
-def candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
+def dyad_candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
     """Dyads of four positions for a list to choose from: the curve traced with ``count``
     lines through the base pole, points within ``bound`` (default 3 times the size of the
     task) of the poses' centroid, neither link shorter than 2 % of the task's size."""
@@ -359,7 +359,7 @@ def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 2
             raise UsageError("--pivots and --moving apply to three positions; four and five positions are solved by "
                              "Burmester theory (choose a pair with --pick)")
         if n == 4:
-            dyads = list(candidates(poses, count))
+            dyads = list(dyad_candidates(poses, count))
             C, W, _, _ = centre_point_curve(poses, 720, 3 * scale_of(poses))
             curves = ((C, W),)
             method = "Burmester, four positions (centre-point and circle-point curves)"
