@@ -110,7 +110,7 @@ def family_scaling(designs: int = 10_000, workers=(1, 2, 4), repeat: int = 1, al
 
     from distributed import Client, LocalCluster
 
-    from screwkin.analysis.design.study import _evaluate, study_task
+    from screwkin.analysis.design.study import evaluate_design, study_task
     from screwkin.files.study import study_spec
     from screwkin.parallel.study import run_study
 
@@ -150,13 +150,13 @@ def family_scaling(designs: int = 10_000, workers=(1, 2, 4), repeat: int = 1, al
 
     vals = design_values(study_spec(lhs_family(alone)))
     t = time.perf_counter()
-    rows = [_evaluate(task, i, v) for i, v in enumerate(vals)]
+    rows = [evaluate_design(task, i, v) for i, v in enumerate(vals)]
     t = time.perf_counter() - t
     out.append(f"| each design alone (the per-design path), in process | {alone} | 0 / {alone} | "
                f"{sum(r['error'] is not None for r in rows)} | {t:.2f} | {alone / t:.0f} |")
     worst = 0.0
     for r in here.rows[::50]:
-        own = _evaluate(task, r["design"], tuple(r[p] for p in task.parameters))
+        own = evaluate_design(task, r["design"], tuple(r[p] for p in task.parameters))
         for c in ("transmission_angle_min", "transmission_angle_max", "transmission_deviation"):
             if r[c] is not None:
                 worst = max(worst, math.degrees(abs(r[c] - own[c])))

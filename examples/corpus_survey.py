@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 import screwkin
-from screwkin.present.report import table
+from screwkin.present.tables import table
 
 default = Path(__file__).resolve().parents[1] / "robots" / "corpus" / "example-parallel-robots"
 folder = Path(sys.argv[1]) if len(sys.argv) > 1 else default

@@ -33,7 +33,7 @@ import re
 
 from .errors import UsageError, quote
 
-__all__ = ["parse_value", "in_unit", "parse_typed_value", "parse_length", "parse_assignments", "UNITS", "UNIT_TABLE",
+__all__ = ["parse_value", "in_unit", "parse_typed_value", "parse_length", "UNITS", "UNIT_TABLE",
            "unit_kind", "LENGTH_RANGE", "MAGNITUDES", "check_magnitude"]
 
 _DEG = math.pi / 180.0
@@ -196,8 +196,3 @@ def parse_typed_assignments(items, option: str) -> list:
             raise UsageError(f"{option} expects NAME=VALUE (or NAME,NAME=VALUE), got {quote(item)}: "
                              f"no value for {quote(', '.join(pending))}")
     return out
-
-
-def parse_assignments(items, option: str) -> dict:
-    """``["a=45deg", "b=0.1,c=2mm"]`` -> ``{"a": 0.785..., "b": 0.1, "c": 0.002}``."""
-    return {name: value for name, value, _ in parse_typed_assignments(items, option)}

@@ -318,3 +318,23 @@ def test_singular_figures_at_one_input_say_which_mode(tmp_path, capsys, monkeypa
     assert "assembly mode 1 of the 2 at this input" in found[0]["title"]
     assert "assembly mode 2 of the 2 at this input" in found[1]["title"]
     assert "assembly mode" not in found[2]["title"]
+
+
+@pytest.mark.parametrize("name", ["friction_wheels", "rack_pinion"])
+def test_a_rolling_pair_is_drawn_where_its_pitch_curves_touch(name):
+    """The pair's joint in the drawing is the contact point, by hand from the drawn profiles: two
+    circles touching outside (radii 20 mm and 10 mm) meet r1 from circle 1's centre along the line of
+    centres, 30 mm apart; a pinion on a rack line (gear radius1 inf) meets it at the foot of its
+    centre on the line, 40 mm from it."""
+    mech, q = assembled(ROBOTS / f"{name}.urdf")
+    skel = skeleton(mech, q)
+    joint = next(j for j in skel.joints if j.type in ("rolling", "gear"))
+    first, second = (p for p in skel.profiles if p.joint == joint.letter)
+    c1, c2, point = np.array(first.centre), np.array(second.centre), np.array(joint.point)
+    if first.shape == "circle":
+        assert np.linalg.norm(c2 - c1) == pytest.approx(first.radius + second.radius, abs=1e-9)
+        np.testing.assert_allclose(point, c1 + first.radius * (c2 - c1) / np.linalg.norm(c2 - c1), rtol=0, atol=1e-12)
+    else:
+        u = np.array(first.direction)
+        np.testing.assert_allclose(point, c1 + ((c2 - c1) @ u) * u, rtol=0, atol=1e-12)
+        assert np.linalg.norm(c2 - point) == pytest.approx(second.radius, abs=1e-9)

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 import sympy
 
-from screwkin.analysis.course.equations import VectorLoops, equations
+from screwkin.analysis.course.equations import equations
+from screwkin.analysis.course.vector_loops import VectorLoops
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main

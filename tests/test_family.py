@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from conftest import ROBOTS
 
-from screwkin.analysis.design.study import _GRASHOF, _evaluate, design_args, metric_columns, study_task
+from screwkin.analysis.design.study import _GRASHOF, evaluate_design, design_args, metric_columns, study_task
 from screwkin.cli import main
 from screwkin.files.study import study_spec
 from screwkin.files.xacro import expand
@@ -47,7 +47,7 @@ def test_rows_are_the_designs_own(lhs):
     columns = metric_columns(task.metrics)
     failed = 0
     for r in [r for r in lhs.rows if r["design"] % 5 == 0 or r["error"] is not None]:
-        own = _evaluate(task, r["design"], tuple(r[p] for p in task.parameters))
+        own = evaluate_design(task, r["design"], tuple(r[p] for p in task.parameters))
         for c in ("error", *columns):
             assert _close(r[c], own[c]), (r["design"], c, r[c], own[c])
         failed += r["error"] is not None
@@ -114,7 +114,7 @@ def test_a_refused_file_and_a_failing_expansion_are_evaluated_alone():
     assert bad and all("below 0" in r["error"] or "cannot" in r["error"] for r in bad), [r["error"] for r in bad]
     task = study_task(study_spec(spec))
     for r in bad:
-        assert r["error"] == _evaluate(task, r["design"], (r["crank"], r["coupler"], r["rocker"]))["error"]
+        assert r["error"] == evaluate_design(task, r["design"], (r["crank"], r["coupler"], r["rocker"]))["error"]
     assert res.extra["paths"]["family"] == 8 and res.extra["paths"]["design"] == 4
     assert any("refused" in n for n in res.extra["path_notes"])
 
@@ -138,7 +138,7 @@ def test_a_closed_form_that_disagrees_sends_the_chunk_design_by_design(monkeypat
     task = study_task(study_spec(spec))
     r = dict(res.rows[3])
     r.pop("meets_requirements")
-    assert r == _evaluate(task, r["design"], (r["crank"], r["coupler"], r["rocker"]))
+    assert r == evaluate_design(task, r["design"], (r["crank"], r["coupler"], r["rocker"]))
 
 
 # ------------------------------------------------------------------ the expansion for many designs at once

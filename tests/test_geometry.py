@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from screwkin.model.geometry import (circle_circle, circle_intersections, cross2, line_angle, line_circle, line_foot,
-                                     perpendicular_basis, plane_basis, vector_angle)
+                                     lines_point, nearest_turn, perpendicular_basis, plane_basis, vector_angle,
+                                     wrap_angle)
 
 
 @pytest.mark.parametrize("a", [(0, 0, 1), (1, 0, 0), (0, 1, 0), (1, 1, 1), (0.95, -0.1, 0.3)])
@@ -80,3 +81,40 @@ def test_vector_and_line_angles(u, w, angle):
     # (3, 4) and (4, 3): |u x w| = 7, u . w = 24
     assert abs(float(vector_angle(u, w)) - angle) < 1e-15
     assert abs(float(line_angle(u, w)) - min(angle, np.pi - angle)) < 1e-15
+
+
+def test_wrap_angle_hand_values():
+    # 270 deg is -90 deg; a half turn is -180 deg in [-pi, pi) and +180 deg in (-pi, pi] (atan2's interval)
+    assert wrap_angle(3 * np.pi / 2) == pytest.approx(-np.pi / 2, abs=1e-15)
+    assert wrap_angle(np.pi) == -np.pi and wrap_angle(-np.pi) == -np.pi
+    assert wrap_angle(np.pi, upper=True) == np.pi and wrap_angle(-np.pi, upper=True) == np.pi
+    assert wrap_angle(-7 * np.pi / 2, upper=True) == pytest.approx(np.pi / 2, abs=1e-15)  # -630 deg is 90 deg
+    v = np.array([0.0, 2 * np.pi, -2 * np.pi, 5.0])
+    np.testing.assert_allclose(wrap_angle(v), [0, 0, 0, 5 - 2 * np.pi], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(wrap_angle(v, upper=True), [0, 0, 0, 5 - 2 * np.pi], rtol=0, atol=1e-15)
+    assert not np.signbit(wrap_angle(-0.0, upper=True))  # no negative zero
+    # the two intervals agree away from the half turn, as atan2 of (cos, sin) does
+    x = np.linspace(-20, 20, 4001)
+    np.testing.assert_allclose(wrap_angle(x, upper=True), np.arctan2(np.sin(x), np.cos(x)), rtol=0, atol=1e-13)
+
+
+def test_nearest_turn_hand_values():
+    assert nearest_turn(0.5, 13.0) == pytest.approx(0.5 + 4 * np.pi, abs=1e-14)  # 13 rad is about 2.07 turns
+    assert nearest_turn(-0.5, -6.0) == pytest.approx(-0.5 - 2 * np.pi, abs=1e-14)
+    assert nearest_turn(0.0, np.pi) == 0.0 and nearest_turn(0.0, -np.pi) == 0.0  # exactly half a turn: 0 turns (even)
+    # 1.5 turns above -pi: 0 and -2 pi are both half a turn from it; the even count of turns (2) gives -2 pi
+    assert nearest_turn(2 * np.pi, -np.pi) == pytest.approx(-2 * np.pi, abs=1e-15)
+    np.testing.assert_allclose(nearest_turn(np.array([0.0, 3.0]), np.array([7.0, -3.0])), [2 * np.pi, 3.0 - 2 * np.pi],
+                               rtol=0, atol=1e-14)
+
+
+def test_lines_point_hand_values():
+    # three axes through (1, 2, 3) along x, y and z meet there
+    c, d = lines_point([[0, 2, 3], [1, 0, 3], [1, 2, 0]], [[1, 0, 0], [0, 2, 0], [0, 0, -5]], 1e-12)
+    np.testing.assert_allclose(c, [1, 2, 3], rtol=0, atol=1e-14)
+    assert d == pytest.approx(0.0, abs=1e-14)
+    # the x axis and the line through (0, 0, 1) along y: the midpoint of their common normal, 0.5 from each
+    c, d = lines_point([[0, 0, 0], [0, 0, 1]], [[1, 0, 0], [0, 1, 0]], 1e-12)
+    np.testing.assert_allclose(c, [0, 0, 0.5], rtol=0, atol=1e-14)
+    assert d == pytest.approx(0.5, abs=1e-14)
+    assert lines_point([[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [-2, 0, 0]], 1e-12) == (None, np.inf)  # parallel

@@ -12,7 +12,7 @@ import sympy as sp
 
 from conftest import DATA, ROBOTS
 from screwkin import load
-from screwkin.analysis.course.equations import VectorLoops
+from screwkin.analysis.course.vector_loops import VectorLoops
 from screwkin.analysis.singularities.gram_symbolic import symbolic_gram
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.analysis.singularities.singular import gram_cofactors

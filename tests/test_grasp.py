@@ -22,9 +22,8 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull
 
 from conftest import ROOT
-from screwkin.analysis.forces.grasp import (
-    GraspTolerances,
-    analyze_grasp,
+from screwkin.analysis.forces.grasp import GraspTolerances, analyze_grasp
+from screwkin.analysis.forces.grasp_map import (
     contact_frame,
     cone_error,
     grasp_map,

@@ -9,7 +9,8 @@ from screwkin.cli import main
 from screwkin.errors import MechanismFileError
 from screwkin.files import xacro as xacro_module
 from screwkin.files.description import LIMITS
-from screwkin.files.xacro import MAX_STRING, XacroInternalError, expand
+from screwkin.files.xacro import XacroInternalError, expand
+from screwkin.files.xacro_eval import MAX_STRING
 
 HEAD = '<?xml version="1.0"?>\n<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
 

@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from screwkin.model.manifold import Integrator
+from screwkin.model.manifold import Integrator, continuous_angle, set_continuous_angle
 
 
 def every_joint_type():
@@ -86,3 +86,24 @@ def test_a_joint_the_numpy_forms_do_not_cover_integrates_one_configuration_at_a_
     Q = np.array([pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq)) for _ in range(6)])
     V = rng.normal(size=(6, model.nv))
     np.testing.assert_array_equal(integrator(Q, V), reference(model, Q, V))
+
+
+def test_continuous_joint_coordinates_as_pinocchio_writes_them():
+    """A continuous joint's (cos, sin): the angle written is pin.integrate's from the neutral (1, 0), and
+    the angle read back is the one integrated, in (-pi, pi] (a half turn reads as +pi)."""
+    model = pin.Model()
+    model.addJoint(0, pin.JointModelPX(), pin.SE3.Identity(), "slide")
+    model.addJoint(1, pin.JointModelRUBZ(), pin.SE3.Identity(), "wheel")
+    i = model.idx_qs[2]
+    angles = np.array([0.3, -2.5, np.pi, 7.0])
+    Q = np.array([pin.integrate(model, pin.neutral(model), np.array([0.1, a])) for a in angles])
+    np.testing.assert_allclose(continuous_angle(Q, i), [0.3, -2.5, np.pi, 7.0 - 2 * np.pi], rtol=0, atol=1e-14)
+    assert continuous_angle(Q[2], i) == pytest.approx(np.pi, abs=1e-15)
+    mine = np.tile(pin.neutral(model), (len(angles), 1))
+    mine[:, 0] = 0.1
+    set_continuous_angle(mine, i, angles)  # a stack, one angle per row
+    np.testing.assert_allclose(mine, Q, rtol=0, atol=1e-15)
+    q = pin.neutral(model)
+    set_continuous_angle(q, i, -2.5)  # one configuration
+    np.testing.assert_allclose(q, pin.integrate(model, pin.neutral(model), np.array([0.0, -2.5])), rtol=0, atol=1e-15)
+

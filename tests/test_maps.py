@@ -87,7 +87,7 @@ def test_the_map_command_says_what_it_left_out(wide_five_bar):
 
 
 def test_json_writes_infinity_as_a_string_and_refuses_nan():
-    from screwkin.present.report import to_jsonable
+    from screwkin.present.jsonout import to_jsonable
     assert to_jsonable({"a": [1.0, float("inf"), -np.inf]}) == {"a": [1.0, "inf", "-inf"]}
     with pytest.raises(RuntimeError, match=r"NaN in the JSON output at b\[1\]"):
         to_jsonable({"b": np.array([0.0, np.nan])})

@@ -13,7 +13,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from screwkin.analysis.singularities.batch import BatchClosure, Unbatchable
+from screwkin.analysis.motion.batch_closure import BatchClosure, Unbatchable
 from screwkin.model import compiled, newton
 from screwkin.tolerances import DEFAULT
 

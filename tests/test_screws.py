@@ -43,6 +43,12 @@ def test_revolute_twist_and_planar_form(tmp_path):
     xi = ch.xi0[:, 0]
     np.testing.assert_allclose(xi, [0, -0.1, 0, 0, 0, 1], atol=1e-15)
     np.testing.assert_allclose(planar_form(xi, [0, 0, 1]), [0, -0.1, 1], atol=1e-15)
+    # in the x-z plane (normal +y) the plane's axes are those of every planar output (geometry.plane_basis):
+    # e1 = x, e2 = y x x = -z; a revolute about y through (0.1, 0, 0.2): v = -w x p = (-0.2, 0, 0.1),
+    # so (v.e1, v.e2, w.n) = (-0.2, -0.1, 1)
+    p_y = np.array([0.1, 0.0, 0.2])
+    xi_y = np.r_[-np.cross([0.0, 1.0, 0.0], p_y), 0.0, 1.0, 0.0]
+    np.testing.assert_allclose(planar_form(xi_y, [0, 1, 0]), [-0.2, -0.1, 1], atol=1e-15)
     s = screw_of(xi)
     assert s.pitch == 0 and np.allclose(s.point, [0.1, 0, 0])
     assert screw_of([1, 0, 0, 0, 0, 0]).pitch == np.inf

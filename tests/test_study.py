@@ -36,7 +36,8 @@ from screwkin.cli import main
 from screwkin.parallel.study import _collect, run_study
 from screwkin.files.study import study_spec
 from screwkin.files.xacro import expand
-from screwkin.present.study import Progress, study_csv, study_text
+from screwkin.present.study import study_csv, study_text
+from screwkin.present.progress import Progress
 
 ROOT = Path(__file__).resolve().parents[1]
 GROUND = 0.1

@@ -202,3 +202,21 @@ def test_vectorised_forms_equal_the_scalar_ones():
     assert FOUR_BAR_CLASSES[codes[0]].startswith("change point")
     sc = slider_crank_transmission(np.array([0.05, 0.2]), 0.15, 0.02, 1e-9)
     assert list(sc[2]) == [True, False] and list(sc[3]) == [0, 2] and sc[0][1] == 0.0
+
+
+def test_the_one_transmission_angle_from_points_and_from_lengths():
+    """The point forms and the length form of mu, by hand: a four-bar with C at the origin, B on +y and D
+    on +x has mu = 90 deg; with B at (-1, 1) 135 deg.  The same four-bar from its lengths: ground
+    g = 3 (A = (0, 0), D = (3, 0)), input a = 4 straight up (phi = 90 deg, B = (0, 4)): z = |BD| = 5,
+    and with coupler b = 4, output c = 3 the triangle BCD is 3-4-5, right-angled at C (cos mu = 0).
+    A slider-crank's rod at 30 deg from the slide's normal has mu = 30 deg."""
+    from screwkin.analysis.motion.transmission import four_bar_cos_mu, slide_transmission_angle, transmission_angle
+
+    assert np.degrees(transmission_angle([0, 1], [0, 0], [1, 0])) == pytest.approx(90.0, abs=1e-12)
+    assert np.degrees(transmission_angle([-1, 1, 0], [0, 0, 0], [2, 0, 0])) == pytest.approx(135.0, abs=1e-12)
+    assert four_bar_cos_mu(3.0, 4.0, 4.0, 3.0, np.pi / 2) == pytest.approx(0.0, abs=1e-15)
+    assert four_bar_cos_mu(3.0, 4.0, 4.0, 3.0, 0.0) == pytest.approx((16 + 9 - 1) / 24, abs=1e-15)  # z = 1
+    normal = np.array([0.0, 1.0])
+    rod = np.array([np.sin(np.radians(30)), np.cos(np.radians(30))])
+    assert np.degrees(slide_transmission_angle([1.0, 2.0], np.array([1.0, 2.0]) + 0.3 * rod, normal)) == \
+        pytest.approx(30.0, abs=1e-12)

@@ -7,7 +7,8 @@ import pytest
 import screwkin
 from conftest import CORPUS, ROBOTS
 from screwkin.cli import main
-from screwkin.present.view import COLORS, RecordingViewer, ViewerServer, build_scene, chromium, show
+from screwkin.present.view import COLORS, RecordingViewer, build_scene, chromium, show
+from screwkin.present.viewserver import ViewerServer
 
 
 @pytest.fixture(scope="module")

@@ -8,15 +8,17 @@ import screwkin
 from conftest import ROBOTS
 from screwkin.cli import main
 from screwkin.present.view import (
-    BACKGROUND,
-    FOV,
     RecordingViewer,
     build_scene,
     chromium,
-    fit_camera,
     legend_entries,
     page,
     show,
+)
+from screwkin.present.camera import (
+    BACKGROUND,
+    FOV,
+    fit_camera,
     view_direction,
 )
 

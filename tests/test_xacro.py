@@ -15,13 +15,13 @@ from hypothesis import strategies as st
 import screwkin
 from screwkin.analysis.motion.planar import identify
 from screwkin.cli import main
-from screwkin.files.xacro import (
+from screwkin.files.xacro import parse_args
+from screwkin.files.xacro_eval import (
     XacroEvaluationError,
     check_expression,
     evaluate,
-    parse_args,
 )
-from screwkin.model.mechanism import link_lengths
+from screwkin.model.lengths import link_lengths
 
 FOURBAR = ROBOTS / "fourbar.urdf.xacro"
 DELTA = ROBOTS / "delta.urdf.xacro"

@@ -513,7 +513,7 @@ def words(la: LocalAnalysis) -> str:
         text = f"a regular point: the configuration space is smooth here, mobility {f}"
     elif la.kind == "bifurcation":
         b = la.branches[0].mobility
-        text = (f"a change point: {_count(n)} branches of mobility {b} cross here (infinitesimal mobility {d}); "
+        text = (f"a change point: {_number_word(n)} branches of mobility {b} cross here (infinitesimal mobility {d}); "
                 f"tangents " + "; ".join(_rates_text(x.tangent) for x in la.branches))
     elif la.kind == "kinematotropic":
         text = (f"branches of different mobility meet here (kinematotropic; infinitesimal mobility {d}): "
@@ -541,5 +541,5 @@ def _forms(c: int) -> str:
     return "the quadratic form" if c == 1 else f"the {c} quadratic forms"
 
 
-def _count(n: int) -> str:
+def _number_word(n: int) -> str:
     return {2: "two", 3: "three", 4: "four"}.get(n, str(n))

@@ -42,7 +42,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pinocchio as pin
 
-from ..model.closure import ContactRow
+from ..model.cuts import ContactRow
 from ..model.geometry import perpendicular_basis
 from ..model.state import KinematicState
 from .screws import cut_twists
@@ -238,8 +238,7 @@ def coordinates(kind, where) -> np.ndarray:
     """The (rows, 6) map from a twist of the algebra to its coordinates: se(2) (v.e1, v.e2, w.n), so(3) w."""
     if kind == "se(2)":
         n = where
-        e1 = perpendicular_basis(n)[0]
-        e2 = np.cross(n, e1)
+        e1, e2 = perpendicular_basis(n)
         Z = np.zeros(3)
         return np.array([np.r_[e1, Z], np.r_[e2, Z], np.r_[Z, n]])
     if kind == "so(3)":
@@ -255,8 +254,7 @@ def _cut_units(mech, cut, state, kind, where, L):
     free = cut_twists(mech, replace(cut, pair=None), state) or []
     if cut.type == "spherical" and kind == "se(2)":
         p = state.frame_placement(cut.frame1).translation
-        e1 = perpendicular_basis(where)[0]
-        axes = (e1, np.cross(where, e1), where)
+        axes = (*perpendicular_basis(where), where)
         free = [(f"{cut.name}[{k}]", np.concatenate([np.cross(p, u), u]), False) for k, u in enumerate(axes)]
     return free
 

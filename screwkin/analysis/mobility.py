@@ -22,7 +22,7 @@ from ..model.topology import Topology
 from .local import LocalAnalysis, local_analysis, words as local_words
 from .redundancy import Redundancy, redundancy
 
-__all__ = ["MobilityResult", "OutputMotion", "analyze_mobility", "rank", "null_space"]
+__all__ = ["MobilityResult", "OutputMotion", "analyze_mobility"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _FEW_COORDINATES = 60  # above this many joint coordinates, idle motions are analysed at one configuration
@@ -241,7 +241,7 @@ def _output_motion(link, T, tol, origin) -> OutputMotion:
     return OutputMotion(link, dim, t, r, label, center, tuple(tuple(col) for col in basis.T))
 
 
-def _classify(n, m, eff, overconstraint, topo, M):
+def _classification(n, m, eff, overconstraint, topo, M):
     """The classification and notes; a structure (no effective DOF) is statically determinate
     or not in its detected motion space: a planar triangle is determinate in the plane
     (Gruebler 0 = M), although 3 of its 5 spatial constraint rows are redundant."""
@@ -371,7 +371,7 @@ def _analyze(mech, output, seed, point, at=None, suggest=False, names=False) -> 
         L = null_space(V[act_idx], tol, M)
         locked = rank(np.hstack([L, I]), tol) - idle_total if L.shape[1] else 0
     overconstraint = K.shape[0] - rk
-    kind, notes = _classify(n, m, eff if eff is not None else 0, overconstraint, topo, M)
+    kind, notes = _classification(n, m, eff if eff is not None else 0, overconstraint, topo, M)
     if local.kind == "shaky":
         kind = (f"shaky structure: infinitesimally mobile ({local.infinitesimal_mobility} "
                 f"instantaneous degree{'s' if local.infinitesimal_mobility > 1 else ''} of freedom), finitely rigid")

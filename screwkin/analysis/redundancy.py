@@ -106,7 +106,7 @@ def _left_null(mech, q):
     return Ks, Lam, mech.closure.row_labels()
 
 
-def _names(mech):
+def _cut_words(mech):
     """cut joint or coupling name -> (what it is in the file's words)."""
     out = {}
     for c in mech.spec.cut_joints:
@@ -136,7 +136,7 @@ def _directions(cut, state, tol):
     return e1, e2, a, ("a direction across the axis", "the other direction across it", "the axis")
 
 
-def _describe(W, at, dirs, L, tol):
+def _describe_span(W, at, dirs, L, tol):
     """(named canonical wrenches, words) of the span of wrenches W (k, 6) at point ``at`` (moment
     about the world origin): canonical when the span is that of some of the joint's six canonical
     wrenches, else each basis wrench as a screw."""
@@ -251,7 +251,7 @@ def _per_joint(mech, q, state, Lam, wrench_rows, owner):
     """JointRedundancy of every joint carrying part of the left null space."""
     algebra = _algebra(mech, q)
     out = []
-    kinds = _names(mech)
+    kinds = _cut_words(mech)
     cuts = {c.name: c for c in mech.cuts}
     L = mech.length
     for name in dict.fromkeys(owner):
@@ -274,9 +274,9 @@ def _per_joint(mech, q, state, Lam, wrench_rows, owner):
             W.append(np.r_[w[:3], w[3:] + np.cross(p, w[:3])])
         W = np.array(W)
         dirs = _directions(cut, state, mech.tolerances)
-        named, words = _describe(W, p, dirs, L, mech.tolerances)
+        named, words = _describe_span(W, p, dirs, L, mech.tolerances)
         if named:  # the canonical wrenches themselves, about the world origin
-            W = _canonical(named, dirs, p)
+            W = _canonical_wrenches(named, dirs, p)
         why = _why(mech, W, algebra)
         out.append(JointRedundancy(name, kinds.get(name, "loop joint"), len(idx), k,
                                    tuple(tuple(map(float, w)) for w in W), tuple(map(float, p)), named,
@@ -284,7 +284,7 @@ def _per_joint(mech, q, state, Lam, wrench_rows, owner):
     return tuple(out)
 
 
-def _canonical(named, dirs, p):
+def _canonical_wrenches(named, dirs, p):
     e1, e2, e3, labels = dirs
     out = []
     for n in named:
@@ -294,7 +294,7 @@ def _canonical(named, dirs, p):
     return np.array(out)
 
 
-def _rot(u, p):
+def _rotation_twist(u, p):
     return np.r_[np.cross(p, u), u]
 
 
@@ -304,14 +304,14 @@ def _options(mech, state, name, kind, axis, point, axes):
     opts = []
     if kind == "revolute":
         e1, e2 = perpendicular_basis(axis)
-        opts.append(("spherical", [_rot(e1, point), _rot(e2, point)], None))
+        opts.append(("spherical", [_rotation_twist(e1, point), _rotation_twist(e2, point)], None))
         for u, letter in axes:
-            opts.append(("universal", [_rot(u, point)], letter))
+            opts.append(("universal", [_rotation_twist(u, point)], letter))
         opts.append(("cylindrical", [np.r_[axis, np.zeros(3)]], None))
     elif kind == "prismatic":
-        opts.append(("cylindrical", [_rot(axis, point)], None))
+        opts.append(("cylindrical", [_rotation_twist(axis, point)], None))
     elif kind == "universal":
-        opts.append(("spherical", [_rot(np.cross(axis[0], axis[1]), point)], None))
+        opts.append(("spherical", [_rotation_twist(np.cross(axis[0], axis[1]), point)], None))
     return opts
 
 
@@ -428,7 +428,7 @@ def suggest(mech, q, count=None) -> Suggestion | None:
 
 
 def _change_words(mech, chosen):
-    kinds = _names(mech)
+    kinds = _cut_words(mech)
     out = []
     for name, is_cut, new_type, twists, letter in chosen:
         who = f"{kinds[name]} '{name}'" if is_cut and kinds.get(name) in ("connect", "weld") else name

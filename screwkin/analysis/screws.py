@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UsageError
-from ..model.geometry import perpendicular_basis
+from ..model.geometry import perpendicular_basis, plane_basis
 from ..model.linalg import null_space
 from ..model.state import KinematicState
 from ..tolerances import DEFAULT
@@ -226,12 +226,9 @@ def loop_product(loop: LoopScrews, theta) -> np.ndarray:
 
 
 def planar_form(xi, normal):
-    """(v_x, v_y, w) of a planar twist in a right-handed basis (e1, e2) of the plane with normal n."""
-    n = np.asarray(normal, float) / np.linalg.norm(normal)
-    e1 = perpendicular_basis(n)[0]
-    if abs(n @ np.array([0, 0, 1.0])) > 1 - DEFAULT.zero:  # the usual x-y plane: keep x, y
-        e1 = np.array([1.0, 0, 0]) * np.sign(n[2])
-    e2 = np.cross(n, e1)
+    """(v_x, v_y, w) of a planar twist in the plane's axes (e1, e2, n) (geometry.plane_basis: the axes
+    the drawing, the vector loops and the link angles use)."""
+    e1, e2, n = plane_basis(normal)
     xi = np.asarray(xi)
     return np.array([xi[:3] @ e1, xi[:3] @ e2, xi[3:] @ n])
 

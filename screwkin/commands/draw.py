@@ -16,20 +16,22 @@ from ..analysis.motion.sweep import sweep
 from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
-from ..model.geometry import wrap_angle
 from ..present.animate import animation_format, write_animation
 from ..present.progress import EVERY, Progress
 from ..present.draw import (
     chain_dict,
+    configuration_text,
     draw_chain,
     draw_mechanism,
+    drawing_title,
     save_figure,
     skeleton_dict,
     value_label,
+    wrapped_value,
 )
-from ..present.draw_targets import design_marks
-from ..present.local import change_point_dict, change_point_lines
-from ..present.report import to_jsonable
+from ..present.draw_targets import design_drawing
+from ..present.local import change_point_dict, singularity_kind_text
+from ..present.jsonout import to_jsonable
 from ..units import in_unit, parse_typed_value
 from ._common import (
     add_configuration_options,
@@ -48,13 +50,6 @@ from ._options import BOUNDS, count
 
 NAME = "draw"
 NEEDS_MECHANISM = True
-
-_KIND = {
-    "actuator": "actuator singularity (det of the passive Jacobian = 0)",
-    "serial": "serial singularity",
-    "constraint": "constraint singularity (the loops lose a constraint)",
-}
-
 
 def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
@@ -117,27 +112,6 @@ def _suffixed(path, k) -> str:
     return f"{stem}-singular-{k}{ext}"
 
 
-def _configuration_text(skel) -> str:
-    if not skel.inputs:
-        return "assembled configuration"
-    return ", ".join(value_label(k, v, skel.units[k]) for k, v in skel.inputs.items())
-
-
-def _title(mech, what) -> str:
-    return f"{os.path.basename(str(mech.path))}: {what}"
-
-
-def _kind_text(s) -> str:
-    if getattr(s, "point", None) is not None:  # a constraint singularity, analysed (analysis.local)
-        return "; ".join(line.strip() for line in change_point_lines(s.point, "it"))[len("at it: "):]
-    if s.kind == "actuator" and s.limit:
-        return "limit position of the input: actuator singularity (det of the passive Jacobian = 0)"
-    if s.kind == "serial":
-        return (f"serial singularity of '{s.output}': its limit position (a dead centre when driven from it)"
-                if s.output else "serial singularity")
-    return _KIND.get(s.kind, s.kind)
-
-
 def _traces(mech, args, q, input_names, given, skel) -> dict:
     """--trace NAME: name -> (the point's path in the drawing's plane (N, 2) [m], where the input stopped)."""
     if not args.trace:
@@ -158,54 +132,6 @@ def _traces(mech, args, q, input_names, given, skel) -> dict:
         if res.stopped_at is not None and not args.json:
             print(f"path of {name}: {input_names[0]} stopped at {res.stopped_at:.6g} ({res.stop_reason})")
     return out
-
-
-def _design(mech, q, input_names, skel, steps, say=None, hint=""):
-    """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
-    precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
-    ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
-    say = say or (lambda _line: None)
-    found, marks = design_marks(mech, q, skel, input_names, steps=steps)
-    ghosts = sum(m["ghost"] is not None for m in marks)
-    kinds = sorted({m["kind"] for m in marks})
-    numbered = sum(m["numbered"] for m in marks)
-    which = f"; {numbered} of them numbered, evenly chosen" if numbered < len(marks) else ""
-    say(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>{hint}{which}), "
-        f"the linkage ghosted at {ghosts} precision position(s)")
-    for m in marks:
-        if m["reached"] is None:
-            say(f"target {m['number']} ({m['label']}): the linkage does not assemble at {m['input']} = "
-                f"{m['value']:.6g}: nothing reached drawn")
-    curve = None
-    if found.curve is not None:
-        e1, e2, _ = (np.asarray(v, float) for v in skel.basis)
-        name = f"curve of {next(m['link'] for m in marks if m['kind'] == 'point')}"
-        stops = [x for x, _ in found.stops if x is not None]
-        curve = (name, np.stack([found.curve @ e1, found.curve @ e2], axis=1), stops or None)
-        for m, i in zip(marks, found.on_curve):  # where the curve passes each target, for --json
-            m["curve_index"] = i
-            m["curve_input"] = None if i is None else float(found.curve_inputs[i])
-        off = [m["number"] for m, i in zip(marks, found.on_curve) if m["kind"] == "point" and i is None]
-        for x, why in found.stops:
-            if x is not None:
-                say(f"{name}: the input stops at {x:.6g} ({why}): the curve runs between its limit positions")
-        if off:
-            say(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
-    return marks, curve
-
-
-def draw_design(mech, paths, steps: int = 360, say=None) -> list:
-    """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
-    ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
-    q = mech.assemble().q
-    input_names = list(mech.actuated)
-    skel = skeleton(mech, q, input_names)
-    marks, curve = (None, None) if not mech.spec.targets else _design(mech, q, input_names, skel, steps, say)
-    traces = {} if curve is None else {curve[0]: curve[1]}
-    for path in paths:
-        fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), traces=traces, marks=marks)
-        save_figure(fig, path)
-    return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
 def run(mech, args) -> int:
@@ -243,12 +169,13 @@ def run(mech, args) -> int:
             same.setdefault(round(float(s.input), 9), []).append(s)
         for k, s in enumerate(search.found, 1):
             skel = skeleton(mech, s.q, [search.input, *search.fixed])
-            at = value_label(search.input, _wrapped(s.input, search.unit), search.unit)
+            at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
             key = round(float(s.input), 9)
             seen[key] = seen.get(key, 0) + 1
             mode = f", assembly mode {seen[key]} of the {len(same[key])} at this input" if len(same[key]) > 1 else ""
             title = f"singular configuration {k} of {len(search.found)} at {at}{mode}"
-            fig = draw_mechanism(skel, title=_title(mech, title), angles=args.angles, subtitle=_kind_text(s))
+            fig = draw_mechanism(skel, title=drawing_title(mech, title), angles=args.angles,
+                                 subtitle=singularity_kind_text(s))
             files = []
             for path in targets:
                 out = _suffixed(path, k)
@@ -256,12 +183,12 @@ def run(mech, args) -> int:
                 files.append(out)
             written += files
             found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
-                          "input_wrapped": _wrapped(s.input, search.unit), "sigma": s.sigma, "files": files,
-                          "description": _kind_text(s), "title": title})
+                          "input_wrapped": wrapped_value(s.input, search.unit), "sigma": s.sigma, "files": files,
+                          "description": singularity_kind_text(s), "title": title})
             if getattr(s, "point", None) is not None:
                 found[-1].update({k: v for k, v in change_point_dict(s.point).items() if k not in ("input", "sigma")})
             if not args.json:
-                print(f"{_kind_text(s)} at {at}: wrote {', '.join(files)}")
+                print(f"{singularity_kind_text(s)} at {at}: wrote {', '.join(files)}")
         report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
                   "output": search.output, "singular_configurations": found}
         if not args.json and not found:
@@ -273,12 +200,12 @@ def run(mech, args) -> int:
         traces = _traces(mech, args, q, input_names, given, skel)
         marks, curve = (None, None)
         if mech.spec.targets and args.targets:
-            marks, curve = _design(mech, q, input_names, skel, args.steps, None if args.json else print,
+            marks, curve = design_drawing(mech, q, input_names, skel, args.steps, None if args.json else print,
                                    "; --no-targets leaves them out")
         if curve is not None:
             traces[curve[0]] = curve[1:]
         for path in targets:
-            fig = draw_mechanism(skel, title=_title(mech, _configuration_text(skel)), angles=args.angles,
+            fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), angles=args.angles,
                                  subtitle=("" if skel.planar else space.strip(" ()")) or None,
                                  traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
             save_figure(fig, path)
@@ -298,10 +225,6 @@ def run(mech, args) -> int:
         print(f"note: --point {', '.join(quote(n, 40) for n in untraced)}: a point is drawn as its path, with "
               "--trace NAME (or in --animate); not drawn here", file=sys.stderr)
     return 0
-
-
-def _wrapped(value, unit):
-    return value if unit == "m" else wrap_angle(value)
 
 
 def _typed(name, value, unit, linear) -> str:
@@ -362,7 +285,7 @@ def _animate(mech, args) -> int:
         for p in points:
             P = np.asarray(motion.points[p.name]["position"])
             traces[p.name] = np.stack([P @ e1, P @ e2], axis=1)
-    titles = [_title(mech, _typed(name, x, unit, linear)) for x in values]
+    titles = [drawing_title(mech, _typed(name, x, unit, linear)) for x in values]
     if limit is not None:
         titles[-1] += " (limit position)"
     space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"

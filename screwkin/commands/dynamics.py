@@ -12,7 +12,7 @@ from ..errors import UsageError, quote
 from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.progress import EVERY, Progress
-from ..present.report import to_jsonable
+from ..present.jsonout import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
 from ..analysis.motion.sweep import sweep_inputs
 from ._common import (

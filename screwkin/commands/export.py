@@ -10,7 +10,7 @@ from ..errors import UsageError, quote
 from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, mujoco_refuses, write_mjcf, write_placed_urdf
 from ..files.mjcf_rows import redundant_rows
 from ..model.placed import check_closed, placed
-from ..present.report import to_jsonable
+from ..present.jsonout import to_jsonable
 from ..present.outfile import write_output
 from ._common import add_configuration_options, configuration, emit, with_mode
 

@@ -10,11 +10,8 @@ import pinocchio as pin
 
 from ..analysis.motion.ik import branches, inverse_kinematics
 from ..errors import UsageError, quote
-from ..present.report import (
-    position_dict,
-    position_text,
-    to_jsonable,
-)
+from ..present.report import position_dict, position_text
+from ..present.jsonout import to_jsonable
 from ..units import parse_value
 from ._common import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count

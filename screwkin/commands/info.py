@@ -4,13 +4,9 @@ from __future__ import annotations
 
 from ..errors import ScrewkinError, UsageError
 from ..model.joint_types import JOINT_TYPES
-from ..present.report import (
-    joint_types_dict,
-    joint_types_text,
-    to_jsonable,
-    topology_dict,
-    topology_text,
-)
+from ..present.report import joint_types_dict, joint_types_text
+from ..present.jsonout import to_jsonable
+from ..present.mobility import topology_dict, topology_text
 from ._common import emit
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

@@ -13,11 +13,8 @@ from ..analysis.motion.sweep import continuation_steps
 from ..errors import UsageError
 from ..present.outfile import write_output
 from ..present.plots import map_png
-from ..present.report import (
-    map_csv,
-    map_dict,
-    to_jsonable,
-)
+from ..present.report import map_csv, map_dict
+from ..present.jsonout import to_jsonable
 from ._common import (
     add_mode_option,
     configuration,

@@ -17,7 +17,9 @@ import tempfile
 
 import numpy as np
 
-from ..analysis.course.equations import VectorLoops, equations, newton
+from ..analysis.course.equations import equations
+from ..analysis.course.newton import differing, start_estimates, textbook_newton
+from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
 from ..analysis.motion.modes import choose_mode
@@ -40,21 +42,24 @@ from ..present.document import (
     topology_section,
     view_section,
 )
-from ..present.draw import draw_chain, draw_mechanism, value_label
+from ..present.draw import draw_chain, draw_mechanism, value_label, wrapped_value
+from ..present.draw_targets import design_drawing
 from ..present.equations import equations_dict, newton_dict
+from ..present.local import singularity_kind_text
 from ..present.motion import motion_dict, strokes_dict, strokes_text
 from ..present.outfile import os_reason, remove_partial, write_output
 from ..present.plots import absolute_series, motion_figure
-from ..present.report import mobility_dict, position_dict
+from ..present.report import position_dict
+from ..present.mobility import mobility_dict
 from ..present.view import (
-    PICTURE,
-    ViewerServer,
     build_scene,
     chromium,
     page,
     screenshot,
     show,
 )
+from ..present.camera import PICTURE
+from ..present.viewserver import ViewerServer
 from ..units import in_unit, parse_typed_assignments, unit_kind
 from ._common import (
     add_configuration_options,
@@ -72,8 +77,6 @@ from ._common import (
     value_kind,
 )
 from ._options import check_writable, count, screwkin_version
-from .draw import _design, _kind_text, _wrapped
-from .equations import _typed, differing, start_estimates
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -116,7 +119,7 @@ def _writable(path, option):
     check_writable(path, option)
 
 
-def _input_names(mech, args, given):
+def _report_inputs(mech, args, given):
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     names = names or list(given) or list(mech.actuated)
     for n in names:
@@ -149,7 +152,7 @@ def run(mech, args) -> int:
     # --set-angle of a link pinned to the ground is its joint's value; of a floating link (held), one more
     # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
     given, held, pivots = split_inputs(mech, args)
-    names = _input_names(mech, args, given)
+    names = _report_inputs(mech, args, given)
     near = near_values(mech, args)
     q0 = mech.generic_configurations()[0].q
     if args.output:
@@ -197,7 +200,7 @@ def run(mech, args) -> int:
                              subtitle=None if skel.planar else f"schematic projection of a {skel.motion_space} mechanism")
         figures.append(Figure(figure_bytes(fig), "svg", "skeleton diagram at the configuration analysed", "skeleton"))
         if mech.spec.targets:  # a synthesized design: what it was asked to do, as `draw FILE` shows it
-            design = _attempt(notes, "targets", lambda: _design(mech, q, names, skel, 360))
+            design = _attempt(notes, "targets", lambda: design_drawing(mech, q, names, skel, 360))
             if design is not None:
                 marks, curve = design
                 fig = draw_mechanism(skel, title=f"{os.path.basename(str(mech.path))}: the design's targets",
@@ -230,7 +233,7 @@ def run(mech, args) -> int:
 
     # ---- positions, velocities, accelerations
     if pres is not None:
-        given_rates = "input rates " + _rates_text(mech, args, rates) + \
+        given_rates = "input rates " + _input_rates_text(mech, args, rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
         sections.append(motion_section(pres, given_rates, mech.length, rate_units(args), data.get("mode", {}).get("index", 1)))
     else:
@@ -291,7 +294,7 @@ def run(mech, args) -> int:
     return 0
 
 
-def _rates_text(mech, args, rates) -> str:
+def _input_rates_text(mech, args, rates) -> str:
     """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
     if not args.rate:
@@ -316,7 +319,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
         return note_section("newton", title, why)
     solved = loops.values(q)
     if args.start:
-        typed = _typed(args.start, "--start")
+        typed = parse_typed_assignments(args.start, "--start")
         solver = input_solver(mech, values, held)
         start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), {**values, **(held or {})},
                                    typed)
@@ -334,7 +337,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
                f"length +{100 * START_FRACTION:g} % (of L = {mech.length:.4g} m when 0); give --start NAME=VALUE,... "
                "for other estimates")
     held = {n: solved[n] for n in loops.input_syms}
-    res = _attempt(notes, "newton", lambda: newton(loops, held, start, args.iterations))
+    res = _attempt(notes, "newton", lambda: textbook_newton(loops, held, start, args.iterations))
     if res is None:  # the mechanism's own (more unknowns than equations: fewer inputs than DOF), said here
         return note_section("newton", title, f"not run: {notes['newton']}")
     far = differing(mech, loops, res.values, solved)
@@ -365,8 +368,8 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, hel
     figures, descriptions, found = [], [], []
     base = os.path.basename(str(mech.path))
     for k, s in enumerate(search.found, 1):
-        at = value_label(search.input, _wrapped(s.input, search.unit), search.unit)
-        what = _kind_text(s)
+        at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
+        what = singularity_kind_text(s)
         skel = skeleton(mech, s.q, [search.input, *search.fixed])
         fig = draw_mechanism(skel, title=f"{base}: singular configuration {k} of {len(search.found)} at {at}",
                              subtitle=what)

@@ -7,11 +7,8 @@ import time
 
 from ..analysis.singularities.scan import scan
 from ..present.outfile import write_output
-from ..present.report import (
-    scan_csv,
-    scan_dict,
-    to_jsonable,
-)
+from ..present.report import scan_csv, scan_dict
+from ..present.jsonout import to_jsonable
 from ._common import output_frame
 from ._options import count
 

@@ -6,12 +6,12 @@ import json
 
 from ..analysis.screws import loop_screws, structure
 from ..errors import UsageError
-from ..present.report import (
+from ..present.jsonout import to_jsonable
+from ..present.screws import (
     loops_dict,
     loops_text,
     screws_dict,
     screws_text,
-    to_jsonable,
 )
 from ._common import (
     add_configuration_options,

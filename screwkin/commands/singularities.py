@@ -11,11 +11,8 @@ from ..analysis.singularities.singular import classify, named_types
 from ..errors import UsageError
 from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text
 from ..present.local import local_dict, local_lines, types_lines
-from ..present.report import (
-    singularity_dict,
-    singularity_text,
-    to_jsonable,
-)
+from ..present.report import singularity_dict, singularity_text
+from ..present.jsonout import to_jsonable
 from ..present.screws import gram_symbolic_dict, gram_symbolic_text
 from ._common import (
     add_configuration_options,

@@ -1,18 +1,23 @@
-"""screwkin solve: position, velocity and acceleration for given input values."""
+"""``screwkin solve``: position, velocity and acceleration for given input values; with ``--start``,
+Newton on the vector-loop equations (screwkin equations) from a person's estimates, iteration by
+iteration."""
 
 from __future__ import annotations
 
 import json
+import sys
 
-from ..errors import UsageError
+from ..analysis.course.newton import differing, start_estimates, textbook_newton
+from ..analysis.course.vector_loops import VectorLoops
+from ..errors import AssemblyError, UsageError
+from ..present.equations import Units, greek, newton_dict, newton_text
 from ..present.report import (
     position_dict,
     position_text,
-    to_jsonable,
     trace_text,
 )
-from ..units import parse_typed_assignments
-from . import equations as equations_command
+from ..present.jsonout import to_jsonable
+from ..units import UNITS, parse_typed_assignments
 from ._common import (
     add_angle_option,
     add_length_option,
@@ -33,6 +38,9 @@ __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
 NAME = "solve"
 NEEDS_MECHANISM = True
+
+_ANGLE_UNITS = {"deg", "degree", "degrees", "°"}
+_LENGTH_UNITS = {"m", "cm", "mm", "um", "µm", "μm", "in", "inch", "inches", "ft", "foot", "feet"}
 
 
 def add_parser(sub, common, scaled):
@@ -76,7 +84,7 @@ def run(mech, args) -> int:
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
     if args.start or args.iterations is not None:
-        return equations_command.solve_from_start(mech, args, values, held)
+        return _solve_from_start(mech, args, values, held)
     solver = input_solver(mech, values, held, output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
                        points=named_points(mech, args))
@@ -91,4 +99,85 @@ def run(mech, args) -> int:
         print()
     legs = {n: v for n, v, _ in parse_typed_assignments(args.set_length, "--set-length")} if args.set_length else None
     print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args), leg_lengths=legs))
+    return 0
+
+
+# ------------------------------------------------------------------ solve --start
+def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
+    """solve's configuration near q (Newton's root), the loop symbols there, and the unknowns
+    in which it differs from Newton's root."""
+    near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}
+    pres = solver.solve(values, near=near, starts=starts)
+    got = loops.values(pres.solutions[0].q)
+    return pres, got, differing(mech, loops, got, res.values)
+
+
+def _solve_from_start(mech, args, values, held=None) -> int:
+    """``solve --start ...``: Newton on the loop equations from the estimates typed.  ``held``: links
+    whose absolute angle is given (--set-angle of a floating link) -> angle [rad], known in the equations."""
+    held = dict(held or {})
+    if args.iterations is not None and args.iterations < 1:
+        raise UsageError("--iterations must be 1 or more")
+    if not args.start:
+        raise UsageError("--iterations needs --start NAME=VALUE,... (the estimates to iterate from)")
+    q_ref = mech.generic_configurations()[0].q
+    loops = VectorLoops(mech, q_ref, list(values), links=list(held))
+    solver = input_solver(mech, values, held)
+    q_in = solver.set_inputs(q_ref, values)
+    typed = parse_typed_assignments(args.start, "--start")
+    start, units = start_estimates(mech, loops, solver, q_in, {**values, **held}, typed)
+    input_values = loops.values(q_in)
+    given = {n: held.get(loops.input_joints[n][0], input_values[n]) for n in loops.input_syms}
+    res = textbook_newton(loops, given, start, args.iterations)
+
+    typed_units = [u.lower() for _, _, u in typed + parse_typed_assignments(args.set, "--set")
+                   + parse_typed_assignments(args.set_angle, "--set-angle")]
+    degrees = any(u in _ANGLE_UNITS for u in typed_units)
+    lengths = {n: (u, UNITS[u]) for n, u in units.items()
+               if u and u in _LENGTH_UNITS and loops.symbol_info[n].kind != "angle"}
+    show = Units(degrees, lengths)
+    trace_wanted = args.trace or args.iterations is not None
+    if args.iterations is not None or not res.closes:
+        if args.json:
+            print(json.dumps(to_jsonable({"file": mech.path, **newton_dict(res)}), indent=2))
+        else:
+            print(newton_text(res, loops.symbol_info, show, mech.path))
+        if args.iterations is None:  # asked to converge and it did not: an error, not a result
+            raise AssemblyError(mech.path, res.residual, len(res.steps),
+                                detail="Newton from the given estimates did not converge"
+                                       + (f": {res.stopped}" if res.stopped else ""))
+        return 0
+    # converged: the configuration it reached, closed and reported as solve reports it
+    q = loops.configuration({**given, **res.values})
+    pres, got, far = _solved_near(mech, loops, solver, values, q, res, args.starts)
+    if far and loops.pairs:  # the solver turns a pair's virtual joints on by the input's whole turns: near without them
+        virtual = {n for names in mech.virtual_joints.values() for n in names}
+        print(f"note: solve's configuration near Newton's root differs in {', '.join(far)}; solved again near it "
+              "without the rolling pairs' virtual joints", file=sys.stderr)
+        pres, got, far = _solved_near(mech, loops, solver, values, q, res, args.starts, skip=virtual)
+    if far and loops.pairs:  # solve placed the gears otherwise (its count of a pair's turns): say so, no table
+        raise AssemblyError(mech.path, res.residual, len(res.steps),
+                            detail="Newton's root closes the loop equations (" + ", ".join(
+                                f"{n} = {res.values[n]:.6g}" for n in far) + ") but solve's configuration at these "
+                            "inputs has " + ", ".join(f"{n} = {got[n]:.6g}" for n in far) + ": it counts a rolling "
+                            "pair's turns otherwise (give --iterations K to see Newton's steps alone)")
+    if far:  # pragma: no cover - the polished configuration left Newton's root
+        raise AssemblyError(mech.path, res.residual, len(res.steps),
+                            detail=f"the configuration of Newton's root does not close as solved ({', '.join(far)})")
+    if args.json:
+        d = position_dict(pres)
+        d["characteristic_length"] = mech.length
+        d["newton"] = newton_dict(res)
+        d["trace"] = d["newton"]["trace"]
+        print(json.dumps(to_jsonable(d), indent=2))
+        return 0
+    if trace_wanted:
+        print(newton_text(res, loops.symbol_info, show, mech.path))
+        print()
+    else:
+        print(f"Newton on the vector-loop equations from the estimates given: {len(res.steps)} iterations to "
+              f"|F| = {res.residual:.3g} m: " + ", ".join(
+                  f"{greek(n)} = {show.value(n, loops.symbol_info[n].kind, v)}" for n, v in res.values.items()))
+        print()
+    print(position_text(pres, show_all=True, length=mech.length))
     return 0

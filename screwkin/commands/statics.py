@@ -11,7 +11,7 @@ from ..analysis.forces.statics import legs, no_legs_reason, statics
 from ..analysis.redundancy import redundancy
 from ..errors import UsageError
 from ..model.state import KinematicState
-from ..present.report import to_jsonable
+from ..present.jsonout import to_jsonable
 from ..present.local import redundancy_dict, redundancy_lines
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value

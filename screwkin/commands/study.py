@@ -10,7 +10,6 @@ from ..parallel.study import run_study
 from ..errors import UsageError, quote
 from ..files.study import read_study_spec
 from ..present.study import (
-    Progress,
     check_table_path,
     metrics_png,
     pareto_png,
@@ -18,6 +17,7 @@ from ..present.study import (
     study_text,
     write_table,
 )
+from ..present.progress import Progress
 from ._common import add_mode_option
 from ._options import count, seconds
 

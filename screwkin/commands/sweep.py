@@ -174,7 +174,7 @@ def _rates_line(args) -> str:
             "another speed), at a constant input rate")
 
 
-def _rows(text):
+def _rows_option(text):
     if text is None or text.strip().lower() == "all":
         return None if text is None else "all"
     try:
@@ -254,14 +254,14 @@ def run(mech, args) -> int:
             d["held_angles"] = held  # as solve --json: link -> absolute angle [rad] held along the motion
         print(json_of(d))
     else:
-        rows = sweep_rows(len(res.values), _rows(args.rows))
+        rows = sweep_rows(len(res.values), _rows_option(args.rows))
         typed_deg = any(unit_kind(parse_typed_value(t)[1]) == "angle" and "deg" in t.lower()
                         for t in (args.start, args.stop))
         linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
             else []
         for link, angle in held.items():
             print(f"held along the motion: the angle of {link} = {angle:.9g} rad ({math.degrees(angle):.6g} deg)")
-        print(sweep_text(res, info, mus, rows=_rows(args.rows), degrees=typed_deg and res.unit == "rad",
+        print(sweep_text(res, info, mus, rows=_rows_option(args.rows), degrees=typed_deg and res.unit == "rad",
                          linear_names=linear_names))
         print(_rates_line(args))
         for line in strokes_text(slider_strokes, res.unit == "rad"):

@@ -35,13 +35,13 @@ from ..files.description import LIMITS
 from ..files.writer import write_urdf
 from ..parallel.pool import dask_client, dask_map
 from ..model.loader import load
+from ..present.draw import draw_design
 from ..present.jsonout import to_jsonable
 from ..present.outfile import os_reason, output_failed, remove_partial, write_output
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
 from ._options import count, seconds
-from .draw import draw_design
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -132,7 +132,7 @@ def _option(dest):
     return "--" + dest.replace("_", "-")
 
 
-def _numbers(text, option, count=None, kind=None):
+def _number_groups(text, option, count=None, kind=None):
     """'x,y; x,y' -> [[x, y], [x, y]] (each number with an optional unit, of ``kind`` when given)."""
     groups = [g for g in text.split(";") if g.strip()]
     if not groups:
@@ -250,7 +250,7 @@ def _constraints(args) -> Constraints:
     """--bounds, --lengths, --grashof, --min-transmission, checked."""
     bounds = lengths = angle = None
     if args.bounds:
-        corners = _numbers(args.bounds, "--bounds", 2, kind="length")
+        corners = _number_groups(args.bounds, "--bounds", 2, kind="length")
         if len(corners) != 2:
             raise UsageError(f"--bounds expects two corners \"X0,Y0; X1,Y1\", got {len(corners)}")
         (x0, y0), (x1, y1) = corners
@@ -296,7 +296,7 @@ def _search(args):
 def _motion(args):
     if not args.poses:
         raise UsageError('synthesize motion needs --poses "x,y,theta; x,y,theta; x,y,theta"')
-    poses = _numbers(args.poses, "--poses", 3)
+    poses = _number_groups(args.poses, "--poses", 3)
     if _searching(args, len(poses), 5):
         for opt, given in (("--pivots", args.pivots), ("--moving", args.moving), ("--pick", args.pick)):
             if given:
@@ -306,8 +306,8 @@ def _motion(args):
             result = optimal_motion(poses, _constraints(args), search)
         check, tmp = _realize(result.design, args.out)
         return result, check, tmp
-    pivots = _numbers(args.pivots, "--pivots", 2) if args.pivots else None
-    moving = _numbers(args.moving, "--moving", 2) if args.moving else None
+    pivots = _number_groups(args.pivots, "--pivots", 2) if args.pivots else None
+    moving = _number_groups(args.moving, "--moving", 2) if args.moving else None
     pick = None
     if args.pick:
         try:
@@ -374,7 +374,7 @@ def _function(args):
 def _path(args):
     if not args.points:
         raise UsageError('synthesize path needs --points "x,y; x,y; x,y; ..."')
-    points = _numbers(args.points, "--points", 2)
+    points = _number_groups(args.points, "--points", 2)
     timing = None
     if args.timing:
         timing = [parse_value(x) for x in args.timing.replace(";", ",").split(",") if x.strip()]

@@ -16,7 +16,9 @@ from ..analysis.singularities.singular import classify
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..present.outfile import write_output
-from ..present.view import PICTURE, ViewerServer, build_scene, page, screenshot, show
+from ..present.view import build_scene, page, screenshot, show
+from ..present.camera import PICTURE
+from ..present.viewserver import ViewerServer
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player

@@ -13,8 +13,9 @@ import pinocchio as pin
 from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
 from ..errors import UsageError, quote
 from ..present.outfile import write_output
-from ..present.report import to_jsonable
-from ..present.view import ViewerServer, build_scene, screenshot, show
+from ..present.jsonout import to_jsonable
+from ..present.view import build_scene, screenshot, show
+from ..present.viewserver import ViewerServer
 from ..present.workspace import (
     workspace_cloud,
     workspace_csv,

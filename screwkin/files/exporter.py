@@ -41,8 +41,8 @@ import pinocchio as pin
 from ..tolerances import DEFAULT
 from .description import Coupling
 from .inertia import inertia_problem
-from .mjcf import matrix_quat, quat_matrix
-from .writer import number_text, quoteattr, vector_text
+from .mjcf_equality import matrix_quat, quat_matrix
+from .writer import number_text, origin_text, quoteattr, vector_text
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf",
            "write_placed_urdf", "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid",
@@ -145,7 +145,7 @@ class PlacedMechanism:
     compounds: tuple = ()  # PlacedCompound: the tree's compound joints written as one body's joints
 
 
-def _se3(pos, quat):
+def _placement(pos, quat):
     return pin.SE3(quat_matrix(quat), np.asarray(pos, float))
 
 
@@ -272,7 +272,7 @@ def _aux_axes(c):
         u /= np.linalg.norm(u)
         return (tuple(u), tuple(np.cross(a, u)), tuple(a))
     if c.type == "universal":  # axis2 is fixed in F2: in F1's axes at the written configuration
-        R = _se3(c.rel[0], c.rel[1]).rotation
+        R = _placement(c.rel[0], c.rel[1]).rotation
         return (tuple(a), tuple(R @ np.asarray(c.axis2, float)))
     return (tuple(a),) * len(_AUX[c.type])
 
@@ -323,15 +323,15 @@ def write_mjcf(pm: PlacedMechanism) -> str:
             eq.append(f"<connect name={quoteattr(c.name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
                       f'anchor="{vector_text(*c.pos1)}"/>')
         elif c.type in ("revolute", "continuous"):
-            F1 = _se3(c.pos1, c.quat1)
+            F1 = _placement(c.pos1, c.quat1)
             far = F1.act(pm.length * np.asarray(c.axis, float))
             for name, p in ((c.name, c.pos1), (names["axis", c.name], far)):
                 eq.append(f"<connect name={quoteattr(name)} body1={quoteattr(c.body1)} body2={quoteattr(c.body2)} "
                           f'anchor="{vector_text(*p)}"/>')
         else:  # fixed: body2 in body1; an aux body: body2 in the aux body, which is at F1 at qpos0
-            F1 = pin.SE3.Identity() if c.type in _AUX else _se3(c.pos1, c.quat1)
-            F2 = _se3(c.pos2, c.quat2)
-            at = F1 * _se3(*c.rel)  # F2 in body1 at qpos0: relpose is the anchor's place there, and body2's turn
+            F1 = pin.SE3.Identity() if c.type in _AUX else _placement(c.pos1, c.quat1)
+            F2 = _placement(c.pos2, c.quat2)
+            at = F1 * _placement(*c.rel)  # F2 in body1 at qpos0: relpose is the anchor's place there, and body2's turn
             rel = at * F2.inverse()
             body1 = names["F1", c.name] if c.type in _AUX else c.body1
             eq.append(f"<weld name={quoteattr(c.name if c.type == 'fixed' else names['weld', c.name])} "
@@ -372,9 +372,8 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         out.append(f"  <link name={quoteattr(b.name)}>{inertial}</link>")
         j = b.joint or PlacedJoint(f"{b.name}__fixed", "fixed")
         t = _URDF_TYPE.get(j.type) or ("revolute" if j.range is not None else "continuous")
-        rpy = pin.rpy.matrixToRpy(_se3(b.pos, b.quat).rotation)
         text = (f"  <joint name={quoteattr(j.name)} type=\"{t}\"><parent link={quoteattr(b.parent or root)}/>"
-                f"<child link={quoteattr(b.name)}/><origin xyz=\"{vector_text(*b.pos)}\" rpy=\"{vector_text(*rpy)}\"/>")
+                f"<child link={quoteattr(b.name)}/>{origin_text(_placement(b.pos, b.quat))}")
         if t in ("revolute", "continuous", "prismatic"):
             lo, hi = j.range if j.range is not None else (-1e9, 1e9)
             text += f'<axis xyz="{vector_text(*j.axis)}"/><limit lower="{number_text(lo)}" upper="{number_text(hi)}" effort="0" velocity="0"/>'
@@ -388,7 +387,7 @@ def write_placed_urdf(pm: PlacedMechanism, root: str) -> str:
         joints.append(text + "</joint>")
     out += joints
     for c in pm.cuts:
-        r1, r2 = (pin.rpy.matrixToRpy(_se3(c.pos1 if k == 1 else c.pos2, c.quat1 if k == 1 else c.quat2).rotation)
+        r1, r2 = (pin.rpy.matrixToRpy(_placement(c.pos1 if k == 1 else c.pos2, c.quat1 if k == 1 else c.quat2).rotation)
                   for k in (1, 2))
         text = (f"  <loop_joint name={quoteattr(c.name)} type=\"{c.type}\"><link1 link={quoteattr(c.body1)} "
                 f'xyz="{vector_text(*c.pos1)}" rpy="{vector_text(*r1)}"/><link2 link={quoteattr(c.body2)} xyz="{vector_text(*c.pos2)}" '

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from ..errors import quote, shorten
 from .description import LIMITS
+from .xmlsafe import inside_folder
 
 __all__ = ["resolve_uri", "find_mesh", "locate_mesh", "check_meshes"]
 
@@ -89,11 +90,6 @@ def _real(p: Path):
         return None
 
 
-def _inside(p: Path, folder) -> bool:
-    folder = _real(Path(folder))
-    return folder is not None and p.is_relative_to(folder)
-
-
 def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool:
     """Whether the mesh candidate ``cand`` (``real`` once resolved) may be read: inside the file's folder,
     a --package-dir or ROS_PACKAGE_PATH folder, or the package the file is in; a ``package://NAME/``
@@ -109,11 +105,11 @@ def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool
         pkg_root = cand
         for _ in range(depth):
             pkg_root = pkg_root.parent
-        if not _inside(real, pkg_root):
+        if not inside_folder(real, pkg_root):
             return False
         own = [a for a in [base, *list(base.parents)[:2]] if package and a.name == package]
         folders += own
-    return any(_inside(real, f) for f in folders)
+    return any(inside_folder(real, f) for f in folders)
 
 
 def locate_mesh(uri: str, base: Path, package_dirs=(), roots=None):

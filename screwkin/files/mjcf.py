@@ -32,16 +32,16 @@ import pinocchio as pin
 from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
 from .description import JOINT_DYNAMICS, LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
-from .mjcf_equality import matrix_quat, quat_matrix, read_equalities
+from .mjcf_equality import quat_matrix, read_equalities
 from .mjcf_include import expand_includes
 from .inertia import inertia_problem
 from .mjcf_inertia import DEFAULT_DENSITY, SOLIDS, body_inertia, geom_inertia, geom_volume
 from .mjcf_transmission import ACTUATORS, read_actuators, read_tendons
 from .urdf import Problems, check_sizes, numbers, unit_axis
-from .writer import quoteattr, vector_text
+from .writer import origin_text, quoteattr, vector_text
 from .xmlsafe import parse_xml_text
 
-__all__ = ["read_mjcf", "quat_matrix", "matrix_quat"]
+__all__ = ["read_mjcf"]
 
 #: Joint types read, with their URDF stand-in (a ball is a revolute replaced by a spherical joint).
 _JOINTS = {"hinge": "revolute", "slide": "prismatic", "ball": "continuous", "free": "floating"}
@@ -51,14 +51,6 @@ _BODY_PASSIVE = ("geom", "camera", "light")
 _LIMITED = ("true", "false", "auto")
 #: Top-level sections that do not change the kinematics.
 _PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor", "keyframe", "custom", "extension")
-
-
-def _fmt(v):
-    return vector_text(*v)
-
-
-def _origin(M):
-    return f'<origin xyz="{_fmt(M.translation)}" rpy="{_fmt(pin.rpy.matrixToRpy(M.rotation))}"/>'
 
 
 class _Reader:
@@ -358,7 +350,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 if a.get("range") is not None and limited != "false":
                     r.warnings.append(f"{jw} (ball) has a range: its cone of rotation is not read (unlimited here)")
             out.append(f'<joint name={quoteattr(jn)} type="{utype}"><parent link={quoteattr(prev)}/>'
-                       f'<child link={quoteattr(child)}/>{_origin(origin)}<axis xyz="{_fmt(axis)}"/>{limit}</joint>')
+                       f'<child link={quoteattr(child)}/>{origin_text(origin)}<axis xyz="{vector_text(*axis)}"/>{limit}</joint>')
             joints.append(JointSpec(jn, utype, prev, child, tuple(origin.translation),
                                     tuple(pin.rpy.matrixToRpy(origin.rotation)), axis, **dyn))
             prev, prev_pos = child, pos
@@ -366,7 +358,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
             jn = f"{name}__fixed"
             origin = X if prev_pos is None else pin.SE3(np.eye(3), -prev_pos)
             out.append(f'<joint name={quoteattr(jn)} type="fixed"><parent link={quoteattr(prev)}/>'
-                       f'<child link={quoteattr(name)}/>{_origin(origin)}</joint>')
+                       f'<child link={quoteattr(name)}/>{origin_text(origin)}</joint>')
             joints.append(JointSpec(jn, "fixed", prev, name, tuple(origin.translation),
                                     tuple(pin.rpy.matrixToRpy(origin.rotation))))
         for e, Te, ecls in kids:
@@ -378,7 +370,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 body(e, "world", cls, T)
     p.fail_if_any(path)
     cuts, couplings = read_equalities(r, world, sites, mjoints, reference, set(mjoints) | set(links))
-    couplings = _chains(couplings)
+    couplings = _resolve_chains(couplings)
     tendons = read_tendons(r, mjoints)
     transmissions, inputs, unused = read_actuators(r, mjoints, tendons, {c.joint: c for c in couplings})
     p.fail_if_any(path)
@@ -406,7 +398,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                          package_dirs=[str(d) for d in package_dirs or ()], inputs=inputs, reference=reference)
 
 
-def _chains(couplings):
+def _resolve_chains(couplings):
     """Couplings with a chain (a joint coupled to a coupled joint) resolved to its first joint, as
     <mimic> chains are (files/urdf.py)."""
     by = {c.joint: c for c in couplings}
@@ -422,7 +414,7 @@ def _chains(couplings):
 
 
 def _inertia_xml(com, mass, I):
-    return (f"<inertial><origin xyz=\"{_fmt(com)}\" rpy=\"0 0 0\"/><mass value=\"{mass:.17g}\"/><inertia "
+    return (f"<inertial><origin xyz=\"{vector_text(*com)}\" rpy=\"0 0 0\"/><mass value=\"{mass:.17g}\"/><inertia "
             f"ixx=\"{I[0, 0]:.17g}\" iyy=\"{I[1, 1]:.17g}\" izz=\"{I[2, 2]:.17g}\" ixy=\"{I[0, 1]:.17g}\" "
             f"ixz=\"{I[0, 2]:.17g}\" iyz=\"{I[1, 2]:.17g}\"/></inertial>")
 

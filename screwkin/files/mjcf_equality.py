@@ -26,7 +26,7 @@ import pinocchio as pin
 from ..errors import quote, shorten
 from ..tolerances import DEFAULT
 from .description import Coupling, CutJointSpec
-from .urdf import numbers, unit_axis  # noqa: F401 - unit_axis re-exported for the reader
+from .urdf import numbers
 
 __all__ = ["read_equalities", "quat_matrix", "matrix_quat"]
 

@@ -128,7 +128,7 @@ def _row_word(label: str, i: int) -> str:
     return "the coupling"
 
 
-def _orth(A: np.ndarray, tol: float) -> np.ndarray:
+def _column_basis(A: np.ndarray, tol: float) -> np.ndarray:
     """An orthonormal basis (columns) of the column space of A."""
     if A.size == 0:
         return np.zeros((A.shape[0], 0))
@@ -172,12 +172,12 @@ def redundant_rows(text: str, tol: Tolerances = DEFAULT) -> tuple:
             continue
         Je = J[rows]
         before = J[: rows[0]]
-        Q = _orth(before.T, cut)  # the row space of the rows before, as columns in R^nv
+        Q = _column_basis(before.T, cut)  # the row space of the rows before, as columns in R^nv
         free = _null_left(Je - (Je @ Q) @ Q.T, cut)  # f: J_e^T f in that row space
         if free.shape[1] == 0:
             continue
         idle = _null_left(Je, cut)  # J_e^T f = 0: inside ``free`` already
-        rest = _orth(free - idle @ (idle.T @ free), cut)  # the rest of free: what earlier rows give
+        rest = _column_basis(free - idle @ (idle.T @ free), cut)  # the rest of free: what earlier rows give
         repeats = []
         if rest.shape[1]:
             g = np.linalg.lstsq(before.T, Je.T @ rest, rcond=None)[0]

@@ -21,7 +21,7 @@ from ..errors import MechanismFileError, quote, shorten
 from .description import LIMITS, CutJointSpec, JointSpec, LinkSpec, MechanismSpec
 from .meshes import check_meshes
 from .urdf import check_sizes, numbers, unit_axis
-from .writer import quoteattr
+from .writer import origin_text, quoteattr, vector_text
 from .xmlsafe import parse_xml_text
 
 __all__ = ["read_sdf"]
@@ -57,7 +57,7 @@ def _vec(text, what, problems):
     return np.array(unit_axis(v, what, problems))
 
 
-def _axis(joint, tag, name, X_joint, problems):
+def _axis_element(joint, tag, name, X_joint, problems):
     a = joint.find(tag)
     if a is None:
         return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])
@@ -66,14 +66,6 @@ def _axis(joint, tag, name, X_joint, problems):
     model_frame = (a.findtext("use_parent_model_frame") or "").strip() == "true" or (
         xyz is not None and xyz.get("expressed_in") == "__model__")
     return X_joint.rotation.T @ v if model_frame else v
-
-
-def _fmt(v):
-    return " ".join(f"{x:.17g}" for x in v)
-
-
-def _origin(M):
-    return f'<origin xyz="{_fmt(M.translation)}" rpy="{_fmt(pin.rpy.matrixToRpy(M.rotation))}"/>'
 
 
 def _spanning_tree(links, edges, ground) -> dict:
@@ -155,7 +147,7 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
         raise MechanismFileError(path, "the model has no links")
     # world pose of every joint frame (SDF: joint pose relative to the child link)
     joint_pose = {n: poses[c] * _pose(e.find("pose"), f"joint {quote(n)}", problems) for n, _, _, c, e in raw}
-    axes = {n: (_axis(e, "axis", n, joint_pose[n], problems), _axis(e, "axis2", n, joint_pose[n], problems))
+    axes = {n: (_axis_element(e, "axis", n, joint_pose[n], problems), _axis_element(e, "axis2", n, joint_pose[n], problems))
             for n, _, _, _, e in raw}
     if problems:
         raise MechanismFileError(path, problems)
@@ -194,10 +186,10 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 if nxt != child:
                     spec_links[nxt] = LinkSpec(nxt, None, False)
                     out.append(f"<link name={quoteattr(nxt)}/>")
-                o = _origin(origin) if i == 0 else '<origin xyz="0 0 0" rpy="0 0 0"/>'
+                o = origin_text(origin) if i == 0 else '<origin xyz="0 0 0" rpy="0 0 0"/>'
                 jn = f"{n}__{i}"
                 out.append(f'<joint name={quoteattr(jn)} type="revolute"><parent link={quoteattr(prev)}/>'
-                           f'<child link={quoteattr(nxt)}/>{o}<axis xyz="{_fmt(ax)}"/>'
+                           f'<child link={quoteattr(nxt)}/>{o}<axis xyz="{vector_text(*ax)}"/>'
                            f'<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/></joint>')
                 joints.append(JointSpec(jn, "revolute", prev, nxt, tuple(origin.translation) if i == 0 else (0, 0, 0),
                                         tuple(pin.rpy.matrixToRpy(origin.rotation)) if i == 0 else (0, 0, 0), tuple(ax)))
@@ -206,7 +198,7 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
         urdf_type = "revolute" if jt == "continuous" else jt
         limit = '<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/>' if jt != "fixed" else ""
         out.append(f'<joint name={quoteattr(n)} type="{urdf_type}"><parent link={quoteattr(parent)}/>'
-                   f'<child link={quoteattr(child)}/>{_origin(origin)}<axis xyz="{_fmt(a1)}"/>{limit}</joint>')
+                   f'<child link={quoteattr(child)}/>{origin_text(origin)}<axis xyz="{vector_text(*a1)}"/>{limit}</joint>')
         joints.append(JointSpec(n, urdf_type, parent, child, tuple(origin.translation),
                                 tuple(pin.rpy.matrixToRpy(origin.rotation)), tuple(a1)))
     for k, (n, jt, p, c, _) in enumerate(raw):

@@ -171,7 +171,7 @@ def _metrics(value, where):
     return tuple(out)
 
 
-def _pareto(value, where):
+def _spec_pareto(value, where):
     """``{maximize: [a], minimize: [b]}`` (two metrics in all) -> ((a, "max"), (b, "min"))."""
     if value is None:
         return None
@@ -325,7 +325,7 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
     if mode is not None:
         mode = _count(mode, where, "mode (the K-th assembly mode, as solve lists them)", 1, 1000)
     spec = StudySpec(where, path, tuple(parameters), metrics, sampling, designs, seed, fixed, data.get("input"),
-                     data.get("output"), point, workspace, steps, _pareto(data.get("pareto"), where), chunk,
+                     data.get("output"), point, workspace, steps, _spec_pareto(data.get("pareto"), where), chunk,
                      float(timeout), mode, _require(data.get("require"), where))
     _check_arguments(spec, where)
     return spec

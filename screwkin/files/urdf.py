@@ -259,7 +259,7 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
     if l1 == l2:
         problems.append(f"{what} connects link {quote(l1)} to itself")
         return None
-    extra = _higher_pair(elem, jtype, what, axis, problems) if jtype in HIGHER_PAIRS else {}
+    extra = _pair_parameters(elem, jtype, what, axis, problems) if jtype in HIGHER_PAIRS else {}
     if extra is None:
         return None
     return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint", **extra)
@@ -279,7 +279,7 @@ def _radius(text, what, problems, allow_inf=False):
     return value
 
 
-def _higher_pair(elem, jtype, what, axis, problems) -> dict | None:
+def _pair_parameters(elem, jtype, what, axis, problems) -> dict | None:
     """The parameters of a rolling, gear, contact or helical loop joint, checked."""
     n0 = len(problems)
     out = {}
@@ -447,7 +447,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
     couplings = _couplings(joints, problems, warnings)
     transmissions, inputs = read_transmissions(root, joints, {c.name for c in cuts}, warnings,
                                                {c.joint: c.mimics for c in couplings}, numbers)
-    targets = _targets(root, links, {j.name for j in joints}, problems)
+    targets = _read_targets(root, links, {j.name for j in joints}, problems)
     problems.fail_if_any(path)
     warnings += inertia_warnings(links)
     warnings += check_meshes(path, root, package_dirs)
@@ -515,7 +515,7 @@ def _couplings(joints, problems, warnings) -> list:
     return out
 
 
-def _targets(root, links, joint_names, problems) -> tuple:
+def _read_targets(root, links, joint_names, problems) -> tuple:
     """The TargetSpec of every <screwkin:target> under <screwkin:targets> of the URDF ``root``;
     a problem recorded (the file refused, as for any element) for an unknown kind, link or
     joint, a missing or implausible number."""

@@ -18,11 +18,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import pinocchio as pin
+
 from ..tolerances import DEFAULT
 from .description import TARGETS_NS
 
 __all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf", "number_text", "vector_text",
-           "targets_text", "quoteattr"]
+           "origin_text", "targets_text", "quoteattr"]
 
 _COLOURS = ((0.35, 0.35, 0.35), (0.85, 0.3, 0.2), (0.2, 0.5, 0.85), (0.2, 0.7, 0.3), (0.85, 0.65, 0.1),
             (0.6, 0.3, 0.75), (0.1, 0.7, 0.7), (0.9, 0.45, 0.6))
@@ -111,6 +113,11 @@ def vector_text(*xs) -> str:
     return " ".join(number_text(x) for x in xs)
 
 
+def origin_text(M) -> str:
+    """The URDF ``<origin>`` of a placement M (pinocchio.SE3): its translation and its rotation as rpy."""
+    return f'<origin xyz="{vector_text(*M.translation)}" rpy="{vector_text(*pin.rpy.matrixToRpy(M.rotation))}"/>'
+
+
 def _bars(points):
     """Pairs of points drawn as bars: the one segment of two points, the closed polygon of
     more (points in order of angle about their centroid)."""
@@ -125,7 +132,7 @@ def _bars(points):
     return [(ring[k], ring[(k + 1) % len(ring)]) for k in range(len(ring))]
 
 
-def _check(linkage):
+def _check_linkage(linkage):
     names = [lk.name for lk in linkage.links]
     if len(set(names)) != len(names):
         raise ValueError("link names repeat")
@@ -149,7 +156,7 @@ def _check(linkage):
 
 def write_urdf(linkage: PlanarLinkage) -> str:
     """The URDF text of ``linkage`` (see the module docstring)."""
-    _check(linkage)
+    _check_linkage(linkage)
     lengths = [math.dist(p, q) for lk in linkage.links if not lk.frame_only for p, q in _bars(lk.points)]
     lengths = [x for x in lengths if x > 0]
     mean = sum(lengths) / len(lengths) if lengths else 0.1

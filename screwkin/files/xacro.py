@@ -11,7 +11,7 @@ size, no entities, bounded nesting):
 * before xacro sees the file, every attribute and text is checked: each ``${...}`` must
   parse (Python's ``ast``) as numbers, strings, names not starting with ``_``,
   arithmetic, comparisons, ``and``/``or``/``not``, ``a if c else b`` and calls of the
-  math functions of :data:`FUNCTIONS` (also as ``math.NAME``); the only substitution is
+  math functions of :data:`xacro_eval.FUNCTIONS` (also as ``math.NAME``); the only substitution is
   ``$(arg NAME)``; ``load_yaml`` and includes of files outside the file's folder are
   refused;
 * while xacro runs, its evaluator is replaced by an interpreter of that same subset
@@ -50,17 +50,10 @@ import defusedxml
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..units import parse_value
 from .description import LIMITS
-from .xacro_eval import (
-    FUNCTIONS,
-    MAX_STRING,
-    XacroEvaluationError,
-    check_expression,
-    evaluate,
-)
-from .xmlsafe import parse_xml_text, read_regular_file
+from .xacro_eval import MAX_STRING, XacroEvaluationError, check_expression, evaluate
+from .xmlsafe import inside_folder, parse_xml_text, read_regular_file
 
-__all__ = ["FUNCTIONS", "MAX_INCLUDES", "MAX_STRING", "XacroEvaluationError", "XacroInternalError", "check_expression", "declared_args",
-           "evaluate", "expand", "is_xacro", "normalize_args", "parse_args"]
+__all__ = ["MAX_INCLUDES", "XacroInternalError", "declared_args", "expand", "is_xacro", "normalize_args", "parse_args"]
 
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro")
 #: Most files one expansion reads (the first one and its includes).
@@ -185,18 +178,11 @@ def _check_extension(token: str, path) -> None:
                                    f"({quote(word, 20)} would read the environment, other files or run code)")
 
 
-def _inside(state: _State, target: Path) -> bool:
-    try:
-        return Path(os.path.realpath(target)).is_relative_to(state.folder)
-    except (OSError, ValueError):
-        return False
-
-
 def _include_path(spec: str, current: Path, path, state: _State) -> Path:
     if _GLOB.search(spec):
         raise MechanismFileError(path, f"xacro:include {quote(spec, 60)}: wildcards are refused")
     target = Path(spec) if os.path.isabs(spec) else current.parent / spec
-    if not _inside(state, target):
+    if not inside_folder(target, state.folder):
         raise MechanismFileError(path, f"xacro:include {quote(spec, 60)} is outside the folder of "
                                        f"{quote(state.top.name)} (refused: a mechanism file reads only files beside it "
                                        "or below)")
@@ -311,7 +297,7 @@ def _patched(xacro, state: _State, path, evaluator=None):
         if inp is not None:
             return original["parse"](inp, filename)
         target = Path(filename)
-        if not _inside(state, target):  # pragma: no cover - get_include_files checked it
+        if not inside_folder(target, state.folder):  # pragma: no cover - get_include_files checked it
             raise MechanismFileError(path, f"xacro:include {quote(str(filename), 60)} is outside the file's folder")
         text, root = _read_file(target, path, state)
         _check_tree(root, target, state, follow=False)

@@ -26,10 +26,20 @@ import defusedxml.ElementTree as SafeET
 from ..errors import MechanismFileError, shorten
 from .description import LIMITS
 
-__all__ = ["parse_xml_text", "read_regular_file", "load_yaml_text", "MAX_DEPTH"]
+__all__ = ["parse_xml_text", "read_regular_file", "load_yaml_text", "inside_folder", "MAX_DEPTH"]
 
 #: Deepest element nesting accepted in XML and YAML (URDF and SDF need about 6, sidecars 3).
 MAX_DEPTH = 100
+
+
+def inside_folder(path, folder) -> bool:
+    """Whether ``path`` lies in ``folder`` once both have their symbolic links and ``..`` resolved;
+    False where the system refuses to resolve either (the one containment check of the readers:
+    meshes, xacro includes)."""
+    try:
+        return Path(os.path.realpath(path)).is_relative_to(Path(os.path.realpath(folder)))
+    except (OSError, ValueError):
+        return False
 
 
 def read_regular_file(path, max_bytes: int, what: str = "file") -> bytes:

@@ -25,11 +25,11 @@ import pinocchio as pin
 from ..tolerances import DEFAULT, Tolerances
 from . import compiled, newton
 from .manifold import Integrator
-from .cuts import Assembly, ContactRow, CouplingRow, CutJoint  # noqa: F401 - exported here as before
+from .cuts import Assembly, CouplingRow
 from .geometry import cross3, perpendicular_basis, skew, skews, skews_batch
 from ._pin import frame_jacobian
 
-__all__ = ["CutJoint", "CouplingRow", "ContactRow", "ClosureSystem", "Assembly", "perpendicular_basis"]
+__all__ = ["ClosureSystem"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 

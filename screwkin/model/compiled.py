@@ -49,11 +49,11 @@ def kernels():
     """The compiled functions (compiled or loaded from the cache at the first call)."""
     global _KERNELS
     if _KERNELS is None:
-        _KERNELS = _build()
+        _KERNELS = _compile_kernels()
     return _KERNELS
 
 
-def _build():
+def _compile_kernels():
     import numba as nb
 
     @nb.njit(cache=True)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .geometry import plane_basis, wrap_angle
+from .manifold import continuous_angle
 
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact"]
 
@@ -63,7 +64,7 @@ class CouplingRow:
         continuous joint's atan2(sin, cos)) so summed, taken into [-pi, pi) (geometry.wrap_angle)."""
         if self.kind != "angle":
             return sum(c * q[iq] for iq, _, c in self.terms) + self.constant
-        total = sum(c * (np.arctan2(q[iq + 1], q[iq]) if iq in self.pairs else q[iq]) for iq, _, c in self.terms)
+        total = sum(c * (continuous_angle(q, iq) if iq in self.pairs else q[iq]) for iq, _, c in self.terms)
         return wrap_angle(total + self.constant)
 
 

@@ -12,7 +12,8 @@ import numpy as np
 
 __all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
            "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle",
-           "quaternion_matrix", "quaternion_product", "stack_mm", "stack_mv", "stack_cross"]
+           "quaternion_matrix", "quaternion_product", "stack_mm", "stack_mv", "stack_cross",
+           "nearest_turn", "lines_point"]
 
 #: Division guard: the distance between two circles' centres is taken at least this [m].
 TINY = 1e-300  # division guard
@@ -121,19 +122,56 @@ def line_circle(point, direction, centre, radius) -> list:
     return [foot - h * direction, foot + h * direction]
 
 
+def lines_point(points, directions, tol: float):
+    """(c, d): the point c nearest, in least squares, the 3-D lines through ``points`` along
+    ``directions`` (sum (I - u u^T) (c - p) = 0, u the unit directions), and the largest distance d
+    of a line from it; (None, inf) where the lines are parallel (that system's rank, by ``tol``,
+    below 3).
+
+    >>> c, d = lines_point([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]], 1e-12)
+    >>> [round(float(x), 12) + 0.0 for x in c], round(float(d), 12)
+    ([1.0, 0.0, 0.0], 0.0)
+    """
+    A, b, projections = np.zeros((3, 3)), np.zeros(3), []
+    for p, d in zip(points, directions):
+        u = np.asarray(d, float) / np.linalg.norm(d)
+        P = np.eye(3) - np.outer(u, u)
+        projections.append((P, np.asarray(p, float)))
+        A += P
+        b += P @ np.asarray(p, float)
+    if np.linalg.matrix_rank(A, tol=tol) < 3:  # the lines are parallel: no common point
+        return None, np.inf
+    c = np.linalg.solve(A, b)
+    return c, max(np.linalg.norm(P @ (c - p)) for P, p in projections)
+
+
 def _cross_norm(u, w):
     if u.shape[-1] == 2:
         return np.abs(cross2(u, w))
     return np.linalg.norm(np.cross(u, w), axis=-1)
 
 
-def wrap_angle(a):
-    """An angle [rad] brought into [-pi, pi) (a float for a number, an array for an array).
+def wrap_angle(a, upper: bool = False):
+    """An angle [rad] brought into [-pi, pi), or into (-pi, pi] with ``upper`` (where atan2 and
+    Pinocchio's continuous joints put it); a float for a number, an array for an array.
 
-    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2
+    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2, wrap_angle(np.pi), wrap_angle(-np.pi, upper=True)
+    (True, -3.141592653589793, 3.141592653589793)
+    """
+    a = np.asarray(a, float)
+    w = np.pi - np.mod(np.pi - a, 2 * np.pi) if upper else np.mod(a + np.pi, 2 * np.pi) - np.pi
+    return float(w) if w.ndim == 0 else w
+
+
+def nearest_turn(angle, ref):
+    """``angle`` [rad] moved by the whole turns that bring it nearest ``ref`` (within half a turn;
+    exactly half a turn away, the even number of turns), broadcast; a float for numbers.
+
+    >>> nearest_turn(0.5, 13.0) == 0.5 + 4 * np.pi
     True
     """
-    w = np.mod(np.asarray(a, float) + np.pi, 2 * np.pi) - np.pi
+    a = np.asarray(angle, float)
+    w = a - 2 * np.pi * np.round((a - np.asarray(ref, float)) / (2 * np.pi))
     return float(w) if w.ndim == 0 else w
 
 

@@ -201,7 +201,7 @@ def _virtual_pairs(model, spec) -> None:
     """Give every rolling, gear and helical loop joint the massless chain of its equivalent
     linkage, from F1 on its first link, whose coordinates are the pair's unwrapped angles (and
     advance); the loop closes with a weld from the chain's end frame ``NAME@end`` to F2, and a
-    coupling row (model.closure.CouplingRow) relates the coordinates:
+    coupling row (model.cuts.CouplingRow) relates the coordinates:
 
     - two circles (radii r1, r2; R = r1 + r2 outside, r1 - r2 inside): a revolute at F1's
       origin (coordinate a1: the contact direction in F1, from its x axis), then, at distance R
@@ -251,7 +251,7 @@ def _virtual_pairs(model, spec) -> None:
         model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
 
 
-def _finish(spec, model):
+def _finish_model(spec, model):
     """The tree model of a read file (its sidecar applied) made screwkin's: continuous joints, the joint
     replacements, mimic couplings, the virtual chains of higher pairs; sizes and cut joints checked."""
     path = spec.path
@@ -268,7 +268,7 @@ def rebuild(spec, actuated=None, tolerances: Tolerances = DEFAULT, cls=Mechanism
     joint types -- analysis.redundancy builds the exactly constrained model it suggests this way)."""
     with _native_stderr([]):
         model = pin.buildModelFromXML(spec.urdf_text)
-    return cls(spec, _finish(spec, model), actuated=actuated, tolerances=tolerances)
+    return cls(spec, _finish_model(spec, model), actuated=actuated, tolerances=tolerances)
 
 
 #: The XML whitespace that attribute-value normalisation turns into a space (XML 1.0, section 3.3.3).
@@ -393,7 +393,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         yaml = _find_sidecar(path)
     if yaml is not None:
         read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
-    model = _finish(spec, model)
+    model = _finish_model(spec, model)
     shown = spec.warnings
     if warn is None:  # on the terminal: a bounded number of bounded lines
         warn = _print_warning(path)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["Integrator"]
+__all__ = ["Integrator", "continuous_angle", "set_continuous_angle"]
 
 _VECTOR = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned", "JointModelPX",
            "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned", "JointModelHX", "JointModelHY",
@@ -33,6 +33,23 @@ _TAYLOR = _EPS ** 0.25  # Pinocchio's TaylorSeriesExpansion<double>::precision<3
 #: Below this turn rate [rad] a planar joint's exponential is the straight-line one (Pinocchio's
 #: SE(2) exp, written as a literal there too).
 SE2_STRAIGHT = 1e-14
+
+
+def continuous_angle(q, i):
+    """The angle [rad] of the continuous joint whose (cos, sin) stand at q[..., i], q[..., i + 1]:
+    atan2(sin, cos), in (-pi, pi]; for a stack of configurations (N, nq), one per row.
+
+    >>> float(continuous_angle(np.array([0.5, 0.0, 1.0]), 1))
+    1.5707963267948966
+    """
+    return np.arctan2(q[..., i + 1], q[..., i])
+
+
+def set_continuous_angle(q, i, angle) -> None:
+    """Write ``angle`` [rad] (a number, or one per row of a stack q (N, nq)) as the (cos, sin) of the
+    continuous joint at q[..., i], q[..., i + 1], in place."""
+    q[..., i] = np.cos(angle)
+    q[..., i + 1] = np.sin(angle)
 
 
 class Integrator:

@@ -22,13 +22,15 @@ from ..files.description import MechanismSpec, placement, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import frame_id
 from .closability import closure_gap, closure_obstacle
-from .closure import Assembly, ClosureSystem, ContactRow, CouplingRow, CutJoint
+from .closure import ClosureSystem
+from .cuts import Assembly, ContactRow, CouplingRow, CutJoint
 from .geometry import wrap_angle
 from .linalg import null_space, rank
+from .manifold import continuous_angle, set_continuous_angle
 from .topology import build_topology
-from .lengths import characteristic_length, link_lengths  # noqa: F401 - exported here as before
+from .lengths import characteristic_length
 
-__all__ = ["Mechanism", "Coordinate", "characteristic_length", "link_lengths"]
+__all__ = ["Mechanism", "Coordinate"]
 
 
 def virtual_roles(c) -> tuple:
@@ -69,7 +71,7 @@ class Mechanism:
     path:       the file it was read from.
     spec:       the :class:`~screwkin.files.description.MechanismSpec` read from the file.
     model:      ``pinocchio.Model`` of the spanning tree (with frames F1, F2 of every cut joint).
-    cuts:       list of :class:`~screwkin.model.closure.CutJoint`.
+    cuts:       list of :class:`~screwkin.model.cuts.CutJoint`.
     closure:    the :class:`~screwkin.model.closure.ClosureSystem` r(q) = 0.
     coordinates: list of :class:`Coordinate`, one per tree joint with coordinates.
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
@@ -88,7 +90,7 @@ class Mechanism:
         self._coord = {c.joint: c for c in self.coordinates}
         self.couplings = tuple(spec.couplings)  # <mimic> joints: no coordinate of their own
         self._coupled = {c.joint: c for c in self.couplings}
-        self.extra_rows = []  # rows of higher pairs (model.closure.CouplingRow / ContactRow)
+        self.extra_rows = []  # rows of higher pairs (model.cuts.CouplingRow / ContactRow)
         self.virtual_joints = {}  # higher pair -> the coordinates of its virtual chain
         self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
         # a ground frame for targets (inverse kinematics); every frame must exist
@@ -324,7 +326,7 @@ class Mechanism:
         V[:, wrap] = wrap_angle(V[:, wrap])
         cols = {n: V[:, k] for k, (n, _, _) in enumerate(single)}
         for name, i in continuous:
-            cols[name] = np.arctan2(Q[:, i + 1], Q[:, i])
+            cols[name] = continuous_angle(Q, i)
         for name, i in multi:
             cols[name] = Q[:, i]
         return np.column_stack([cols[n] for n in order]) if order else np.zeros((len(Q), 0))
@@ -399,13 +401,6 @@ class Mechanism:
         self._length = None if value is None else float(value)
         self.cache.clear()
 
-    @property
-    def length_rule(self) -> str:
-        """How :attr:`length` was chosen, in words."""
-        if self._length is not None:
-            return "given"
-        return "mean link length" if link_lengths(self.model, self.cuts) else "no link has a length: 1 m"
-
     def _translational_coordinates(self) -> np.ndarray:
         """Mask of the velocity coordinates that are lengths (prismatic joints, the translations
         of planar, translation and free-flyer joints)."""
@@ -457,7 +452,7 @@ class Mechanism:
                     q[i] = rng.uniform(-np.pi, np.pi)
             elif c.nq == 2 and c.nv == 1:  # continuous: (cos, sin)
                 a = rng.uniform(-np.pi, np.pi)
-                q[i:i + 2] = (np.cos(a), np.sin(a))
+                set_continuous_angle(q, i, a)
             elif short == "JointModelSpherical":
                 v = rng.normal(size=4)
                 q[i:i + 4] = v / np.linalg.norm(v)
@@ -539,7 +534,7 @@ class Mechanism:
         raise AssemblyError(self.path, best, best_it, detail=starts, starts=total, reason=self.closure_obstacle())
 
     def with_rows(self, rows) -> "Mechanism":
-        """This mechanism with more closure rows (model.closure.CouplingRow: a link's absolute angle
+        """This mechanism with more closure rows (model.cuts.CouplingRow: a link's absolute angle
         held as an input), for the solves of one command: a shallow copy that shares the model, the
         coordinates and the assembly search (made first, on the mechanism's own loops) and has a
         closure system of its own; the mechanism itself is not changed."""

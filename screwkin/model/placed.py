@@ -17,8 +17,9 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote
 from ..files.exporter import PlacedBody, PlacedCompound, PlacedCut, PlacedJoint, PlacedMechanism, coupling_about
-from ..files.mjcf import matrix_quat
+from ..files.mjcf_equality import matrix_quat
 from ..tolerances import DEFAULT
+from .geometry import perpendicular_basis, wrap_angle
 from .topology import build_topology, frame_link
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS", "ball_values", "davenport"]
@@ -250,19 +251,14 @@ def davenport(R, axes) -> tuple:
     C = (n1 @ n2) * (n2 @ n3)
     rho, phi = float(np.hypot(A, B)), float(np.arctan2(B, A))
     delta = float(np.arccos(np.clip((n1 @ R @ n3 - C) / rho, -1.0, 1.0)))
-    b = min((phi + delta, phi - delta), key=lambda x: abs((x + np.pi) % (2 * np.pi) - np.pi))
-    b = float((b + np.pi) % (2 * np.pi) - np.pi)
+    b = wrap_angle(min((phi + delta, phi - delta), key=lambda x: abs(wrap_angle(x))))
     R2 = pin.exp3(n2 * b)
     v = R2 @ n3
     lock = np.linalg.norm(v - (n1 @ v) * n1) < DEFAULT.geometry  # gimbal lock: a and c turn about one line
     a = 0.0 if lock else _angle_about(n1, v, R @ n3)
-    e = np.cross(n3, _any_normal(n3))  # c: the turn about n3 that R(n1, a) R(n2, b) leaves, of a normal to n3
+    e = perpendicular_basis(n3)[0]  # c: the turn about n3 that R(n1, a) R(n2, b) leaves, of a normal to n3
     c = _angle_about(n3, e, R2.T @ pin.exp3(-n1 * a) @ R @ e)
     return a, b, c
-
-
-def _any_normal(n) -> np.ndarray:
-    return np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
 
 
 def check_closed(mech, q, tol: float) -> float:

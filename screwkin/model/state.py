@@ -208,13 +208,6 @@ class KinematicState:
         (model.closure, computed in the closure's own Data and copied here)."""
         return np.array(self.mech.closure.jacobian(self.q), float)
 
-    @cached_property
-    def constraint_bias(self) -> np.ndarray:
-        """K' q' (needs rates): the loops' accelerations satisfy K q'' = -K' q'."""
-        if not self.has_rates:
-            raise ValueError("the state has no rates: K' q' needs them")
-        return np.array(self.mech.closure.bias(self.q, self.qd), float)
-
     def frame_pose(self, fid: int) -> np.ndarray:
         """4x4 world pose of a frame."""
         return self._data.oMf[fid].homogeneous.copy()

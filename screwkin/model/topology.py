@@ -26,6 +26,7 @@ from ..files.description import CUT_JOINT_DOF
 from ..files.sidecar import axis_letters
 from ..tolerances import DEFAULT
 from ._pin import frame_id
+from .geometry import lines_point
 from .six_bar import six_bar_inversion
 
 __all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind", "open_joints"]
@@ -312,35 +313,20 @@ def _edges(mech, q):
     return edges, welds
 
 
-def _unit(v):
+def _unit_vector(v):
     return v / np.linalg.norm(v)
 
 
 def _parallel(d1, d2, tol):
-    return np.linalg.norm(np.cross(_unit(d1), _unit(d2))) < tol
+    return np.linalg.norm(np.cross(_unit_vector(d1), _unit_vector(d2))) < tol
 
 
 def _line_distance(p1, d1, p2, d2, tol):
-    n = np.cross(_unit(d1), _unit(d2))
+    n = np.cross(_unit_vector(d1), _unit_vector(d2))
     if np.linalg.norm(n) < tol:  # parallel: distance between the lines
         w = p2 - p1
-        return np.linalg.norm(w - (w @ _unit(d1)) * _unit(d1))
-    return abs((p2 - p1) @ _unit(n))
-
-
-def _common_point(points, directions):
-    """Least-squares point closest to all lines; returns (point, largest distance)."""
-    A = np.zeros((3, 3))
-    b = np.zeros(3)
-    for p, d in zip(points, directions):
-        P = np.eye(3) - np.outer(_unit(d), _unit(d))
-        A += P
-        b += P @ p
-    if np.linalg.matrix_rank(A, tol=DEFAULT.equal) < 3:  # the lines are parallel: no common point
-        return None, np.inf
-    c = np.linalg.solve(A, b)
-    dist = max(np.linalg.norm((np.eye(3) - np.outer(_unit(d), _unit(d))) @ (c - p)) for p, d in zip(points, directions))
-    return c, dist
+        return np.linalg.norm(w - (w @ _unit_vector(d1)) * _unit_vector(d1))
+    return abs((p2 - p1) @ _unit_vector(n))
 
 
 def _compound_name(members, kind) -> str:
@@ -377,9 +363,9 @@ def _classify_chain(chain, tol, scale, coupled=frozenset()):
                 return "helical"
             return "cylindrical"
     if len(chain) == 3 and len(rev) == 3:
-        dirs = np.array([_unit(e.direction) for e in rev])
+        dirs = np.array([_unit_vector(e.direction) for e in rev])
         if np.linalg.matrix_rank(dirs, tol=tol) == 3:
-            _, dist = _common_point([e.point for e in rev], dirs)
+            _, dist = lines_point([e.point for e in rev], dirs, DEFAULT.equal)
             if dist < lt:
                 return "spherical"
     del kinds
@@ -467,14 +453,14 @@ def build_topology(mech, q) -> Topology:
         if kind == "cylindrical":
             direction = next(e.direction for e in chain if e.type != "prismatic")
         elif kind == "spherical":
-            point, _ = _common_point([e.point for e in chain], [e.direction for e in chain])
+            point, _ = lines_point([e.point for e in chain], [e.direction for e in chain], DEFAULT.equal)
         elif kind == "universal":
             a, b = chain
-            n = np.cross(_unit(a.direction), _unit(b.direction))
+            n = np.cross(_unit_vector(a.direction), _unit_vector(b.direction))
             # intersection point of the two axes
-            A = np.stack([_unit(a.direction), -_unit(b.direction), n], axis=1)
+            A = np.stack([_unit_vector(a.direction), -_unit_vector(b.direction), n], axis=1)
             s = np.linalg.lstsq(A, b.point - a.point, rcond=None)[0]
-            point = a.point + s[0] * _unit(a.direction)
+            point = a.point + s[0] * _unit_vector(a.direction)
             # the first axis turns with the link at the start of the chain, the second with the end
             direction, direction2 = a.direction, b.direction
         if kind == "helical":  # its coupling is the screw's lead: counted in the pair, not again
@@ -526,19 +512,19 @@ def _motion_space(joints, tol, scale):
     if not other:
         normal = None
         if rot:
-            normal = _unit(np.asarray(rot[0].direction))
+            normal = _unit_vector(np.asarray(rot[0].direction))
         elif planar_pairs:
-            normal = _unit(np.asarray(planar_pairs[0].direction))
+            normal = _unit_vector(np.asarray(planar_pairs[0].direction))
         elif len(pri) >= 1:
-            dirs = np.array([_unit(np.asarray(j.direction)) for j in pri])
+            dirs = np.array([_unit_vector(np.asarray(j.direction)) for j in pri])
             u, s, vt = np.linalg.svd(dirs)
             if len(s) < 3 or s[-1] < tol:
                 normal = vt[-1]
         if normal is not None:
             ok = all(_parallel(normal, np.asarray(j.direction), tol) for j in rot + planar_pairs)
-            ok = ok and all(abs(normal @ _unit(np.asarray(j.direction))) < tol for j in pri)
+            ok = ok and all(abs(normal @ _unit_vector(np.asarray(j.direction))) < tol for j in pri)
             if ok:
-                normal = _unit(normal)
+                normal = _unit_vector(normal)
                 # one of the two normals, the same whatever the axes' signs: +z, else +y, else +x side
                 for k in (2, 1, 0):
                     if abs(normal[k]) > DEFAULT.equal:
@@ -555,15 +541,15 @@ def _motion_space(joints, tol, scale):
         c = dist = None
         if centres:
             c = centres[0]
-            dist = max([0.0] + [np.linalg.norm(np.cross(c - p, _unit(d))) for p, d in lines])
+            dist = max([0.0] + [np.linalg.norm(np.cross(c - p, _unit_vector(d))) for p, d in lines])
         elif len(lines) >= 2:
-            c, dist = _common_point([p for p, _ in lines], [d for _, d in lines])
+            c, dist = lines_point([p for p, _ in lines], [d for _, d in lines], DEFAULT.equal)
         if c is not None and dist < lt and all(np.linalg.norm(p - c) < lt for p in centres):
             cc = np.round(c, 6) + 0.0
             return "spherical", f"every joint axis passes through ({cc[0]:g}, {cc[1]:g}, {cc[2]:g})", None
     axial = [j for j in joints if j.direction is not None and j.point is not None]
     if len(axial) == len(joints) and len(axial) >= 2:  # every joint's axis on one line: a screw, a slide along it
-        p0, d0 = np.asarray(axial[0].point, float), _unit(np.asarray(axial[0].direction, float))
+        p0, d0 = np.asarray(axial[0].point, float), _unit_vector(np.asarray(axial[0].direction, float))
         on_line = all(_parallel(d0, np.asarray(j.direction), tol)
                       and np.linalg.norm(np.cross(np.asarray(j.point, float) - p0, d0)) < lt for j in axial)
         if on_line:
@@ -571,7 +557,7 @@ def _motion_space(joints, tol, scale):
             return ("spatial", f"every joint axis lies on one line ({', '.join(types)}): the motion is a rotation "
                                "about and a translation along it, which neither the planar nor the spherical count "
                                "describes", None)
-    parallel = all(_parallel(_unit(np.asarray(rot[0].direction)), np.asarray(j.direction), tol) for j in rot) \
+    parallel = all(_parallel(_unit_vector(np.asarray(rot[0].direction)), np.asarray(j.direction), tol) for j in rot) \
         if rot else False
     if parallel and pri:
         return ("spatial", "the revolute axes are parallel but a prismatic axis is not perpendicular to them (not "

@@ -18,7 +18,6 @@ from pathlib import Path
 
 from ..analysis.design.study import (
     StudyResult,
-    StudySpec,
     apply_requirements,
     check_pareto,
     designs,
@@ -27,6 +26,7 @@ from ..analysis.design.study import (
     requirements,
     study_task,
 )
+from ..files.study import StudySpec
 from ..analysis.design.family import FAMILY_CHUNK, chunk_rows, eligible
 from ..errors import UsageError, one_line
 from ..files.study import read_study_spec, study_spec

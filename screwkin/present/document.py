@@ -24,21 +24,20 @@ from html import escape
 
 import numpy as np
 
-from ..analysis.course.vector_loops import PlanarEquations
-from ..model.geometry import wrap_angle as _wrap
+from ..analysis.course.symbols import PlanarEquations
+from .draw import wrapped_value
 from .equations import Units, equations_text, greek, newton_text
 from .tables import RateUnits, shown
 from .motion import linkage_construction_text, links_rows, points_rows
-from .report import (
+from .report import slide_note, solution_rows
+from .jsonout import to_jsonable
+from .mobility import (
     JOINT_COLUMNS,
     count_rows,
     joint_rows,
     screw_theory_rows,
-    screws_text,
-    slide_note,
-    solution_rows,
-    to_jsonable,
 )
+from .screws import screws_text
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",
@@ -231,7 +230,7 @@ def singular_section(search, figures, descriptions, conditions=()) -> Section:
                          + (" (the motion passes limit positions onto the other branch)" if search.turned else "")))
     if search.found:
         s.blocks.append(Table(["#", "kind", f"{search.input}", "relative sigma"],
-                              [[k, kind, _reading(f.input if unit == "m" else _wrap(f.input), unit != "m"), f"{f.sigma:.2g}"]
+                              [[k, kind, _reading(wrapped_value(f.input, unit), unit != "m"), f"{f.sigma:.2g}"]
                                for k, (f, kind) in enumerate(zip(search.found, descriptions), 1)],
                               "singular"))
     s.blocks += list(figures)

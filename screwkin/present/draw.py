@@ -19,11 +19,14 @@ import os
 
 import numpy as np
 
-from .draw_targets import draw_targets
+from ..analysis.course.skeleton import skeleton
+from ..model.geometry import wrap_angle
+from .draw_targets import design_drawing, draw_targets
 from .plots import pyplot
 from .outfile import write_figure
 
-__all__ = ["chain_dict", "draw_chain", "draw_mechanism", "save_figure", "skeleton_dict", "value_label", "number_colours"]
+__all__ = ["chain_dict", "draw_chain", "draw_mechanism", "draw_design", "save_figure", "skeleton_dict", "value_label",
+           "wrapped_value", "configuration_text", "drawing_title", "number_colours"]
 
 _TYPE_WORD = {"revolute": "R", "continuous": "R", "prismatic": "P", "cylindrical": "C", "universal": "U",
               "spherical": "S", "planar": "E", "helical": "H", "rolling": "rolling", "gear": "gear",
@@ -41,6 +44,23 @@ def value_label(name, value, unit) -> str:
     return f"{name} = {np.degrees(value):.5g} deg"
 
 
+def wrapped_value(value, unit):
+    """A coordinate's value as a drawing names it: a length [m] as it is, an angle in [-pi, pi)."""
+    return value if unit == "m" else wrap_angle(value)
+
+
+def configuration_text(skel) -> str:
+    """The inputs a skeleton is drawn at ('crank = 30 deg, ...'), or 'assembled configuration'."""
+    if not skel.inputs:
+        return "assembled configuration"
+    return ", ".join(value_label(k, v, skel.units[k]) for k, v in skel.inputs.items())
+
+
+def drawing_title(mech, what) -> str:
+    """A drawing's title: the file's name, then ``what``."""
+    return f"{os.path.basename(str(mech.path))}: {what}"
+
+
 def _short(name, n=26):
     return name if len(name) <= n else name[: n - 1] + "~"
 
@@ -52,13 +72,13 @@ def number_colours(n):
     return {k: cycle[(k - 2) % len(cycle)] for k in range(2, n + 2)}
 
 
-def _unit(v):
+def _direction_2d(v):
     v = np.asarray(v, float)
     n = np.linalg.norm(v)
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _frame(fig, ax, points, r, limits=None):
+def _fit_axes(fig, ax, points, r, limits=None):
     """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
     ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
@@ -141,7 +161,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
             P = np.array(pts)
             c = P.mean(axis=0)
             if lk.shape in ("bar", "stub"):
-                d = _unit(P[-1] - P[0])
+                d = _direction_2d(P[-1] - P[0])
                 c = c + 2.0 * r * np.array([-d[1], d[0]])
             elif lk.shape == "block":
                 d = _block_direction(skel, lk)
@@ -157,7 +177,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
         points.append(tuple(p))
         kind = j.type
         if kind == "prismatic":
-            d = _unit(j.direction if j.direction is not None else (1.0, 0.0))
+            d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
             guide_link = j.links[0]
             length = 9 * r if guide_link == 1 else 4.5 * r
             a, b = p - length * d, p + length * d
@@ -183,7 +203,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
             elif kind not in ("revolute", "continuous"):
                 ax.text(*p, j.symbol, ha="center", va="center", fontsize=6, zorder=6, label="symbol")
             if j.direction is not None and kind != "prismatic":  # a tilted axis, projected (spatial)
-                d = _unit(j.direction) * 2.6 * r * np.sin(j.tilt)
+                d = _direction_2d(j.direction) * 2.6 * r * np.sin(j.tilt)
                 ax.plot(*zip(p - d, p + d), color="0.35", lw=1.0, ls="--", zorder=4.5, label="axis")
             if j.ground and kind in ("revolute", "continuous", "spherical", "universal", "cylindrical", "helical"):
                 ground_at(j.letter, p)
@@ -223,7 +243,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
                                     label="profile edge"))
             points.extend([tuple(c + pr.radius), tuple(c - pr.radius)])
         elif pr.shape == "line":
-            d = _unit(pr.direction)
+            d = _direction_2d(pr.direction)
             contact = np.asarray(skel.joint(pr.joint).point, float)
             s = (contact - c) @ d
             lo, hi = min(0.0, s) - 6 * r, max(0.0, s) + 6 * r
@@ -261,7 +281,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
         points += [tuple(p) for p in xy]
     if marks:
         points += draw_targets(ax, marks, r, size or skel.size, col)
-    _frame(fig, ax, points, r, limits)
+    _fit_axes(fig, ax, points, r, limits)
     fig.suptitle(title or os.path.basename(skel.path), fontsize=11, x=0.36, y=0.97)
     if subtitle:
         fig.text(0.36, 0.905, subtitle, ha="center", va="center", fontsize=8.5, color="0.3")
@@ -272,7 +292,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
 def _block_direction(skel, lk):
     for j in skel.joints:
         if lk.number in j.links and j.type in ("prismatic", "cylindrical") and j.direction is not None:
-            return _unit(j.direction)
+            return _direction_2d(j.direction)
     return np.array([1.0, 0.0])
 
 
@@ -287,7 +307,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid, alpha=0.85):
 
 def _input_arrow(ax, FancyArrowPatch, j, p, r):
     if j.type == "prismatic":
-        d = _unit(j.direction if j.direction is not None else (1.0, 0.0))
+        d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
         a = p + 3.2 * r * n - 2.5 * r * d
         b = p + 3.2 * r * n + 2.5 * r * d
@@ -467,6 +487,20 @@ def save_figure(fig, path: str, close: bool = True):
         raise
     if close:
         plt.close(fig)
+
+
+def draw_design(mech, paths, steps: int = 360, say=None) -> list:
+    """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
+    ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
+    q = mech.assemble().q
+    input_names = list(mech.actuated)
+    skel = skeleton(mech, q, input_names)
+    marks, curve = (None, None) if not mech.spec.targets else design_drawing(mech, q, input_names, skel, steps, say)
+    traces = {} if curve is None else {curve[0]: curve[1]}
+    for path in paths:
+        fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), traces=traces, marks=marks)
+        save_figure(fig, path)
+    return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
 def skeleton_dict(skel) -> dict:

@@ -17,7 +17,7 @@ import numpy as np
 from ..analysis.course.skeleton import skeleton
 from ..analysis.design.targets import design_targets
 
-__all__ = ["design_marks", "target_marks", "draw_targets", "NUMBERED"]
+__all__ = ["design_marks", "design_drawing", "target_marks", "draw_targets", "NUMBERED"]
 
 TARGET_COLOUR = "#6a3d9a"
 #: At most this many targets are numbered, listed and ghosted (evenly chosen, the first and the last
@@ -47,6 +47,40 @@ def design_marks(mech, q, skel, inputs=None, steps: int = 360):
         outline = next((lk.outline for lk in at.links if lk.name == carrier), ()) if at is not None else ()
         m["carrier"] = [list(map(float, p)) for p in outline] if m["kind"] != "angle" and carrier != m["link"] else []
     return found, marks
+
+
+def design_drawing(mech, q, input_names, skel, steps, say=None, hint=""):
+    """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
+    precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
+    ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
+    say = say or (lambda _line: None)
+    found, marks = design_marks(mech, q, skel, input_names, steps=steps)
+    ghosts = sum(m["ghost"] is not None for m in marks)
+    kinds = sorted({m["kind"] for m in marks})
+    numbered = sum(m["numbered"] for m in marks)
+    which = f"; {numbered} of them numbered, evenly chosen" if numbered < len(marks) else ""
+    say(f"drawn with the {len(marks)} target {'/'.join(kinds)}s the file states (<screwkin:targets>{hint}{which}), "
+        f"the linkage ghosted at {ghosts} precision position(s)")
+    for m in marks:
+        if m["reached"] is None:
+            say(f"target {m['number']} ({m['label']}): the linkage does not assemble at {m['input']} = "
+                f"{m['value']:.6g}: nothing reached drawn")
+    curve = None
+    if found.curve is not None:
+        e1, e2, _ = (np.asarray(v, float) for v in skel.basis)
+        name = f"curve of {next(m['link'] for m in marks if m['kind'] == 'point')}"
+        stops = [x for x, _ in found.stops if x is not None]
+        curve = (name, np.stack([found.curve @ e1, found.curve @ e2], axis=1), stops or None)
+        for m, i in zip(marks, found.on_curve):  # where the curve passes each target, for --json
+            m["curve_index"] = i
+            m["curve_input"] = None if i is None else float(found.curve_inputs[i])
+        off = [m["number"] for m, i in zip(marks, found.on_curve) if m["kind"] == "point" and i is None]
+        for x, why in found.stops:
+            if x is not None:
+                say(f"{name}: the input stops at {x:.6g} ({why}): the curve runs between its limit positions")
+        if off:
+            say(f"{name}: target(s) {', '.join(map(str, off))} are not met along the traced motion")
+    return marks, curve
 
 
 def target_marks(design, basis, skeletons=None) -> list:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.singularities.ellipsoids import Ellipsoids
-from .report import table
+from .tables import table
 
 __all__ = ["ellipsoids_dict", "ellipsoids_text"]
 
@@ -14,7 +14,7 @@ __all__ = ["ellipsoids_dict", "ellipsoids_text"]
 SHOWN_COMPONENT = 5e-4
 
 
-def _axis(v, rows) -> str:
+def _axis_words(v, rows) -> str:
     parts = [f"{x:+.3f} {name}" for x, name in zip(v, rows) if abs(x) >= SHOWN_COMPONENT]
     return ", ".join(parts) or "0"
 
@@ -45,7 +45,7 @@ def ellipsoids_text(e: Ellipsoids) -> str:
     rows = []
     for k, (s, f) in enumerate(zip(e.velocity.semi_axes, e.force.semi_axes)):
         rows.append([str(k + 1), f"{s:.6g}", "inf" if not np.isfinite(f) else f"{f:.6g}",
-                     _axis(e.velocity.axes[:, k], e.rows)])
+                     _axis_words(e.velocity.axes[:, k], e.rows)])
     lines.append(table(["axis", "velocity semi-axis", "force semi-axis", "direction"], rows))
     lines.append(f"rank {e.rank} of {len(e.rows)}; isotropy (smallest / largest velocity semi-axis) "
                  f"{_ratio(e.velocity.semi_axes):.4g}; a unit input rate vector moves the output along the "

@@ -8,9 +8,10 @@ import re
 
 import numpy as np
 
-from ..analysis.course.vector_loops import PlanarEquations
-from .report import screws_dict, screws_text, table
-from .tables import shown
+from ..analysis.course.symbols import PlanarEquations
+from .screws import screws_dict, screws_text
+from .tables import table
+from .tables import shown_text
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
 
@@ -23,10 +24,6 @@ def greek(text: str) -> str:
         text = re.sub(rf"\b{word}(?=\d)", letter, text)
     text = re.sub(r"\bpi\b", "π", text)
     return text.replace("**", "^")
-
-
-def _fmt(x):
-    return f"{shown(x):.6g}"
 
 
 def _matrix_text(name, rows, indent="  "):
@@ -43,7 +40,7 @@ def _numbers_text(name, M, indent="    "):
     lines = []
     for i, row in enumerate(M):
         head = f"{name} = " if i == 0 else " " * (len(name) + 3)
-        lines.append(indent + head + "[" + " ".join(f"{_fmt(x):>12}" for x in row) + " ]")
+        lines.append(indent + head + "[" + " ".join(f"{shown_text(x):>12}" for x in row) + " ]")
     return lines
 
 
@@ -131,9 +128,9 @@ def equations_text(res) -> str:
         lines += [f"  {c}" for c in res.singular_conditions]
         return "\n".join(lines)
     num = ", ".join(f"{k} {name}" for name, k in sorted(res.numbers.items(), key=lambda t: t[1]))
-    lines = [f"Vector-loop equations of {res.path} (planar, normal ({', '.join(_fmt(x) for x in res.normal)}))",
+    lines = [f"Vector-loop equations of {res.path} (planar, normal ({', '.join(shown_text(x) for x in res.normal)}))",
              f"links: {num}", ""]
-    rows = [[greek(n), s.link, s.kind, _fmt(s.value) + (" rad" if s.kind == "angle" else " m"), s.role, greek(s.meaning)]
+    rows = [[greek(n), s.link, s.kind, shown_text(s.value) + (" rad" if s.kind == "angle" else " m"), s.role, greek(s.meaning)]
             for n, s in res.symbols.items()]
     lines.append(table(["symbol", "link", "kind", "value", "role", "meaning"], rows))
     lines.append("vectors: " + "; ".join(f"{v.name} = {greek(v.length)} at {greek(v.angle)}" for v in res.vectors))
@@ -168,11 +165,11 @@ def equations_text(res) -> str:
     lines += _numbers_text("A", res.A_value)
     lines += _numbers_text("B", res.B_value)
     if res.det_A_value is not None:
-        lines.append(f"    det A = {_fmt(res.det_A_value)}")
+        lines.append(f"    det A = {shown_text(res.det_A_value)}")
     if res.rates is not None:
         lines.append("    unknown rates per unit input rate, A^-1 B:")
         for n, row in zip(res.unknowns, res.rates):
-            lines.append(f"      {greek(n)}' = " + " + ".join(f"({_fmt(x)}) {greek(m)}'" for x, m in zip(row, res.inputs)))
+            lines.append(f"      {greek(n)}' = " + " + ".join(f"({shown_text(x)}) {greek(m)}'" for x, m in zip(row, res.inputs)))
     if res.det_A is not None:
         lines.append(f"\ndet A = {greek(res.det_A)}")
     lines.append("singular (det A = 0) where:" if res.singular_conditions else "")
@@ -216,7 +213,7 @@ def newton_text(res, symbols, units: Units, path: str) -> str:
     for st in res.steps:
         lines.append(f"\niteration {st.iteration}: at " + ", ".join(
             f"{greek(n)} = {units.value(n, kinds[n], st.before[n])}" for n in res.unknowns))
-        lines.append("  F  = [" + " ".join(f"{_fmt(x):>12}" for x in st.residual) + " ]  m")
+        lines.append("  F  = [" + " ".join(f"{shown_text(x):>12}" for x in st.residual) + " ]  m")
         lines += _numbers_text("A ", st.jacobian, indent="  ")
         lines.append("  dz = " + ", ".join(f"d{greek(n)} = {units.step(n, kinds[n], d)}"
                                          for n, d in zip(res.unknowns, st.step)))

@@ -10,8 +10,9 @@ from ..analysis.forces.grasp import GraspResult
 from ..analysis.screws import screw_of
 from ..model.geometry import TINY
 from ..tolerances import DEFAULT
-from .report import table, to_jsonable
-from .tables import SHOWN_ZERO, shown
+from .jsonout import to_jsonable
+from .tables import table
+from .tables import SHOWN_ZERO, shown, shown_text
 
 __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]
 
@@ -19,16 +20,11 @@ __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]
 TEXT_COLUMNS = 16
 
 
-def _num(x) -> str:
-    """6 significant digits, round-off (below tables.SHOWN_ZERO) as 0."""
-    return f"{shown(x):.6g}"
+def _vector_text(v) -> str:
+    return "(" + ", ".join(shown_text(x) for x in v) + ")"
 
 
-def _vec(v) -> str:
-    return "(" + ", ".join(_num(x) for x in v) + ")"
-
-
-def _rows(planar):
+def _wrench_labels(planar):
     return ["fx", "fy", "mz"] if planar else ["fx", "fy", "fz", "mx", "my", "mz"]
 
 
@@ -81,7 +77,7 @@ def grasp_dict(r: GraspResult) -> dict:
         "file": r.spec.path,
         "planar": r.spec.planar,
         "contacts": [_contact_dict(c) for c in r.spec.contacts],
-        "wrench_components": _rows(r.spec.planar),
+        "wrench_components": _wrench_labels(r.spec.planar),
         "grasp_map": r.grasp_map,
         "grasp_map_columns": list(r.columns),
         "rank": r.rank,
@@ -113,17 +109,17 @@ def _percent(x) -> str:
 def grasp_text(r: GraspResult) -> str:
     """The analysis as text: contacts, G, rank, closure with the certificate, quality, cones."""
     spec = r.spec
-    rows = _rows(spec.planar)
+    rows = _wrench_labels(spec.planar)
     n = len(spec.contacts)
     lines = [f"grasp: {spec.path} -- {n} contact{'s' if n != 1 else ''}, "
              f"{'planar' if spec.planar else 'spatial'}; wrenches ({', '.join(rows)}) on the object, about the "
              "origin of its frame"]
     shown = spec.contacts[:50]
     lines.append(table(["contact", "model", "point [m]", "normal (into the object)", "mu", "mu_torsion [m]"], [
-        (k, c.model, " ".join(_num(x) for x in (c.point[:2] if spec.planar else c.point)),
-         " ".join(_num(x) for x in (c.normal[:2] if spec.planar else c.normal)),
-         _num(c.mu) if c.model != "frictionless" else "-",
-         _num(c.mu_torsion) if c.model == "soft_finger" else "-") for k, c in enumerate(shown, 1)]))
+        (k, c.model, " ".join(shown_text(x) for x in (c.point[:2] if spec.planar else c.point)),
+         " ".join(shown_text(x) for x in (c.normal[:2] if spec.planar else c.normal)),
+         shown_text(c.mu) if c.model != "frictionless" else "-",
+         shown_text(c.mu_torsion) if c.model == "soft_finger" else "-") for k, c in enumerate(shown, 1)]))
     if n > len(shown):
         lines.append(f"... and {n - len(shown)} more contacts (all in --json)")
     p, m = r.grasp_map.shape
@@ -131,7 +127,7 @@ def grasp_text(r: GraspResult) -> str:
     if m <= TEXT_COLUMNS:
         lines.append(f"grasp map G ({p} x {m}; force rows in N, moment rows in N m, per unit contact force [N] "
                      "or torsion [N m]):")
-        body = [[lab] + [_num(x) for x in row] for lab, row in zip(rows, r.grasp_map)]
+        body = [[lab] + [shown_text(x) for x in row] for lab, row in zip(rows, r.grasp_map)]
         lines += ["  " + x for x in table(["", *r.columns], body).splitlines()]
     else:
         lines.append(f"grasp map G: {p} x {m} (columns {r.columns[0]} ... {r.columns[-1]}; printed by --json)")
@@ -169,8 +165,8 @@ def _certificate_lines(r: GraspResult):
         shown = c.contact_forces[:50]
         body = []
         for cf in shown:
-            body.append((cf.contact, _num(cf.normal), " ".join(_num(x) for x in cf.tangential) or "-",
-                         _num(cf.torsion) if cf.torsion is not None else "-", _percent(cf.friction_ratio),
+            body.append((cf.contact, shown_text(cf.normal), " ".join(shown_text(x) for x in cf.tangential) or "-",
+                         shown_text(cf.torsion) if cf.torsion is not None else "-", _percent(cf.friction_ratio),
                          _percent(cf.torsion_ratio)))
         heads = ["contact", "normal [N]", "tangential [N]" + (" (t1 t2)" if spatial else " (t)"),
                  "torsion [N m]", "friction used", "torsion used"]
@@ -181,12 +177,12 @@ def _certificate_lines(r: GraspResult):
     w = pure_moment(c.unresisted_wrench, r.spec.planar)
     k = 2 if r.spec.planar else 3
     ax = wrench_axis(w, r.spec.planar)
-    where = (f"a pure moment about {_vec(ax['direction'])}" if ax["point"] is None else
-             f"line of action along {_vec(ax['direction'])} through {_vec(ax['point'])}, pitch "
-             f"{_num(ax['pitch'])} m")
+    where = (f"a pure moment about {_vector_text(ax['direction'])}" if ax["point"] is None else
+             f"line of action along {_vector_text(ax['direction'])} through {_vector_text(ax['point'])}, pitch "
+             f"{shown_text(ax['pitch'])} m")
     return [f"  certificate: a wrench on the object that no contact forces inside the cones balance "
             f"(found with the {c.cones} cones):",
-            f"    force {_vec(w[:k])} N, moment {_vec(w[k:])} N m ({where})",
+            f"    force {_vector_text(w[:k])} N, moment {_vector_text(w[k:])} N m ({where})",
             "    " + ("nor its opposite: it lies outside the span of G" if c.both_signs else
                       "every contact wrench has a component along it, none against it")]
 

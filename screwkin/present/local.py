@@ -5,7 +5,14 @@ from __future__ import annotations
 
 from ..analysis.local import LocalAnalysis, words
 
-__all__ = ["change_point_dict", "change_point_lines", "local_dict", "local_lines", "redundancy_dict", "redundancy_lines", "redundant_wrenches", "types_lines"]
+__all__ = ["change_point_dict", "change_point_lines", "local_dict", "local_lines", "redundancy_dict", "redundancy_lines",
+           "redundant_wrenches", "singularity_kind_text", "types_lines"]
+
+_KIND = {
+    "actuator": "actuator singularity (det of the passive Jacobian = 0)",
+    "serial": "serial singularity",
+    "constraint": "constraint singularity (the loops lose a constraint)",
+}
 
 
 def types_lines(types) -> list:
@@ -144,3 +151,16 @@ def change_point_lines(cp, where: str) -> list:
         lines.append(f"    the motion comes in on {_branch_text(cp.local, cp.came)} and continues on "
                      f"{_branch_text(cp.local, cp.goes)}")
     return lines
+
+
+def singularity_kind_text(s) -> str:
+    """What a singular configuration met along the input is, in words (a drawing's subtitle, a
+    report's table): its kind, a limit position, the change point analysed (analysis.local)."""
+    if getattr(s, "point", None) is not None:  # a constraint singularity, analysed (analysis.local)
+        return "; ".join(line.strip() for line in change_point_lines(s.point, "it"))[len("at it: "):]
+    if s.kind == "actuator" and s.limit:
+        return "limit position of the input: actuator singularity (det of the passive Jacobian = 0)"
+    if s.kind == "serial":
+        return (f"serial singularity of '{s.output}': its limit position (a dead centre when driven from it)"
+                if s.output else "serial singularity")
+    return _KIND.get(s.kind, s.kind)

@@ -186,7 +186,7 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
         plt.close(fig)
 
 
-def _axis(values, unit):
+def _axis_values(values, unit):
     """SI values in ``unit`` (a unit of screwkin.units as typed, any case: 'deg', 'MM'; bare: SI)."""
     return in_unit(np.asarray(values, float), unit) if unit else np.asarray(values, float)
 
@@ -202,7 +202,7 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
     from matplotlib.patches import Patch, Rectangle
 
     fig, ax = plt.subplots(figsize=(7, 5.5))
-    xs, ys = _axis(res.xs, x_unit), _axis(res.ys, y_unit)
+    xs, ys = _axis_values(res.xs, x_unit), _axis_values(res.ys, y_unit)
     X, Y = np.meshgrid(xs, ys)
     reached = np.isfinite(res.log_sigma) if res.reached is None else np.asarray(res.reached, bool)
     shown = np.ma.masked_where(~reached | ~np.isfinite(res.log_sigma), res.log_sigma)

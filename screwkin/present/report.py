@@ -18,28 +18,17 @@ from ..analysis.singularities.singular import SingularityReport
 from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from .motion import linkage_construction_text, links_table, points_table
-from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
+from .screws import screw_dict
 from .tables import RateUnits, column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
 from ..tolerances import DEFAULT
 from .numtext import csv_rows
-from .jsonout import json_text, nan_to_none, to_jsonable  # noqa: F401 - json_text exported here as before
-from .mobility import (  # noqa: F401 - exported here as before
-    JOINT_COLUMNS,
-    count_rows,
-    joint_rows,
-    mobility_dict,
-    mobility_text,
-    screw_theory_rows,
-    topology_dict,
-    topology_text,
-)
+from .jsonout import nan_to_none, to_jsonable
+from .mobility import mobility_dict, topology_dict
 
-__all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
-           "modes_dict", "modes_line",
-           "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
-           "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
-           "screw_theory_rows", "joint_rows", "nan_to_none", "slide_note"]
+__all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "singularity_dict",
+           "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
+           "scan_dict", "scan_csv", "map_csv", "slide_note"]
 
 
 def position_dict(res) -> dict:

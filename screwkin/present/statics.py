@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..analysis.forces.statics import Leg, StaticsResult
-from .report import screw_dict, table
-from .tables import shown
+from .screws import screw_dict
+from .tables import table
+from .tables import shown_text
 
 __all__ = ["statics_dict", "statics_text"]
 
@@ -40,16 +41,12 @@ def statics_dict(r: StaticsResult, legs=None) -> dict:
     return d
 
 
-def _num(x, fmt=".6g"):
-    return "?" if x is None else f"{shown(x):{fmt}}"
-
-
 def statics_text(r: StaticsResult, legs=None) -> str:
     load = []
     if r.output is not None and any(r.wrench):
         f, m = r.wrench[:3], r.wrench[3:]
-        load.append(f"wrench on '{r.output}' at its frame's origin: force ({', '.join(_num(x) for x in f)}) N, "
-                    f"moment ({', '.join(_num(x) for x in m)}) N m (world axes)")
+        load.append(f"wrench on '{r.output}' at its frame's origin: force ({', '.join(shown_text(x) for x in f)}) N, "
+                    f"moment ({', '.join(shown_text(x) for x in m)}) N m (world axes)")
     if r.gravity:
         load.append("the links' weights (Pinocchio's gravity, from the inertials)")
     lines = ["load: " + ("; ".join(load) if load else "none")]
@@ -59,14 +56,14 @@ def statics_text(r: StaticsResult, legs=None) -> str:
     if r.inputs:
         lines.append("")
         lines.append(table(["actuator", "effort"], [
-            (n, "indeterminate (redundant actuation)" if r.efforts[n] is None else f"{_num(r.efforts[n])} {r.units[n]}")
+            (n, "indeterminate (redundant actuation)" if r.efforts[n] is None else f"{shown_text(r.efforts[n])} {r.units[n]}")
             for n in r.inputs]))
         for t in r.transmissions:
             e = r.actuator_efforts.get(t.actuator)
-            lines.append(f"actuator {t.actuator!r}: {_num(e)} (the effort on {t.joint} / {t.scale * t.gear:g}: "
+            lines.append(f"actuator {t.actuator!r}: {shown_text(e)} (the effort on {t.joint} / {t.scale * t.gear:g}: "
                          f"{t.text()})")
         for name, e in r.coupled_efforts.items():
-            lines.append(f"coupled joint {name!r}: {_num(e)} {r.units[name]} "
+            lines.append(f"coupled joint {name!r}: {shown_text(e)} {r.units[name]} "
                          "(what its coupling exerts along it)")
         if r.singular:
             lines.append(f"near an actuator singularity (relative sigma {r.sigma_actuator:.2g}): the efforts grow "
@@ -74,7 +71,7 @@ def statics_text(r: StaticsResult, legs=None) -> str:
         elif r.amplification is not None:
             lines.append(f"amplification |efforts| / |load| = {r.amplification:.3g} (lengths made dimensionless by "
                          f"L = {r.length:.4g} m; actuator sigma {r.sigma_actuator:.3g})")
-    rows = [(x.joint, x.kind, *(_num(v, ".5g") for v in x.wrench)) for x in r.reactions]
+    rows = [(x.joint, x.kind, *(shown_text(v, 5) for v in x.wrench)) for x in r.reactions]
     lines.append("")
     lines.append("joint reactions: what the parent side exerts on the child side, at each joint's origin, world axes")
     lines.append(table(["joint", "kind", "fx [N]", "fy", "fz", "mx [N m]", "my", "mz"], rows))

@@ -23,14 +23,12 @@ from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
 from .plots import pyplot
-from .progress import Progress  # noqa: F401  (the study's progress bar: present/progress.py)
-from .report import to_jsonable
+from .jsonout import to_jsonable
 from .tables import csv_text
 from .outfile import write_figure, write_output
 
 __all__ = [
     "DISPLAY",
-    "Progress",
     "check_table_path",
     "LABELS",
     "mode_rule",
@@ -77,7 +75,7 @@ def _cell(v, factor):
     return v
 
 
-def _rows(result):
+def _table_rows(result):
     cols = table_columns(result)
     return [[_cell(r[k], f) for k, _, f in cols] for r in result.rows], [name for _, name, _ in cols]
 
@@ -85,7 +83,7 @@ def _rows(result):
 def study_csv(result) -> str:
     """The table as CSV: one row per design, in design order; empty cells for missing values;
     floats written exactly (shortest round-trip form)."""
-    rows, names = _rows(result)
+    rows, names = _table_rows(result)
     return csv_text(names, (["" if v is None else ("true" if v is True else "false" if v is False else
                                                    repr(v) if isinstance(v, float) else v) for v in row]
                             for row in rows))
@@ -112,7 +110,7 @@ def write_table(result, path) -> None:
     import pyarrow as pa  # optional: only for Parquet
     import pyarrow.parquet as pq
 
-    rows, names = _rows(result)
+    rows, names = _table_rows(result)
     buf = pa.BufferOutputStream()  # made in memory, then written (one way to fail: present/outfile.py)
     pq.write_table(pa.table({n: [row[i] for row in rows] for i, n in enumerate(names)}), buf)
     write_output(path, buf.getvalue().to_pybytes())
@@ -199,7 +197,7 @@ def _workspace_metrics(result) -> bool:
     return any(m in WORKSPACE_METRICS for m in result.spec.metrics)
 
 
-def _fmt(v):
+def _cell_text(v):
     if v is None:
         return "-"
     if isinstance(v, float):
@@ -251,13 +249,13 @@ def study_text(result, table_path=None) -> str:
             hi = max(vals, key=lambda t: t[1])
 
             def at(r):
-                return ", ".join(f"{p}={_fmt(r[pk])}" for pk, p, _ in params)
+                return ", ".join(f"{p}={_cell_text(r[pk])}" for pk, p, _ in params)
 
             if lo[1] == hi[1]:
-                lines.append(f"{name}: {_fmt(lo[1])} in all {len(vals)}")
+                lines.append(f"{name}: {_cell_text(lo[1])} in all {len(vals)}")
             else:
-                lines.append(f"{name}: {_fmt(lo[1])} (design {lo[0]['design']}: {at(lo[0])}) .. "
-                             f"{_fmt(hi[1])} (design {hi[0]['design']}: {at(hi[0])})")
+                lines.append(f"{name}: {_cell_text(lo[1])} (design {lo[0]['design']}: {at(lo[0])}) .. "
+                             f"{_cell_text(hi[1])} (design {hi[0]['design']}: {at(hi[0])})")
         else:
             counts = Counter(str(v) for _, v in vals)
             lines.append(f"{name}: " + ", ".join(f"{v} {c}" for v, c in counts.most_common()))
@@ -269,9 +267,9 @@ def study_text(result, table_path=None) -> str:
         lines.append(f"Pareto front ({', '.join(names)}){among}: designs "
                      f"{', '.join(str(result.rows[k]['design']) for k in front) or 'none'}")
     lines += [f"note: {n}" for n in result.extra.get("notes", ())]
-    rows, names = _rows(result)
+    rows, names = _table_rows(result)
     if n <= TEXT_ROWS:
-        table = [names] + [[_fmt(v) for v in row] for row in rows]
+        table = [names] + [[_cell_text(v) for v in row] for row in rows]
         widths = [max(len(row[i]) for row in table) for i in range(len(names) - 1)]
         lines.append("")
         for row in table:
@@ -362,7 +360,7 @@ def metrics_figure(result):
     # a metric with one value for every design (a four-bar family's mobility) gets no panel, only a mention
     constant = [(k, name, f) for k, name, f in numeric if len({r[k] for r in ok if r[k] is not None}) == 1]
     metrics = [m for m in numeric if m not in constant] or numeric
-    same = ", ".join(f"{name} = {_fmt(_cell(next(r[k] for r in ok if r[k] is not None), f))}"
+    same = ", ".join(f"{name} = {_cell_text(_cell(next(r[k] for r in ok if r[k] is not None), f))}"
                      for k, name, f in constant if (k, name, f) not in metrics)
     classes = _classes(result)
     fig, axes = plt.subplots(len(metrics), len(params), squeeze=False,

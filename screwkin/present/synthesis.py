@@ -17,9 +17,11 @@ import numpy as np
 
 from ..analysis.design.synthesis.designs import ChainsResult, Check, FunctionResult, MotionResult, PathResult
 from ..analysis.design.synthesis.chains import guides_of
-from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local, wrap
-from .report import table, to_jsonable
-from .tables import shown
+from ..model.geometry import wrap_angle
+from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local
+from .jsonout import to_jsonable
+from .tables import table
+from .tables import shown_text
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
@@ -145,7 +147,7 @@ def synthesis_dict(result, check: Check, file, constraints=()) -> dict:
             "structural_error_deg": {"max": _deg(result.max_structural_error),
                                      "at_precision_points": [_deg(e) for e in result.error_at_points]},
         })
-        for entry, typed in zip(out["precision"], _typed(result, check)):
+        for entry, typed in zip(out["precision"], _as_typed(result, check)):
             entry["as_typed"] = typed
     elif isinstance(result, PathResult):
         out.update({
@@ -158,7 +160,7 @@ def synthesis_dict(result, check: Check, file, constraints=()) -> dict:
     return to_jsonable(out)
 
 
-def _typed(result: FunctionResult, check: Check) -> list:
+def _as_typed(result: FunctionResult, check: Check) -> list:
     """Each precision point of function generation in the angles of --input-range and
     --output-range as typed [deg]: the crank's phi, the rocker's psi asked and the psi the file
     gives there (None where it does not assemble).  The file's own angles differ: the crank
@@ -167,7 +169,7 @@ def _typed(result: FunctionResult, check: Check) -> list:
     for p, x, phi, psi in zip(check.precision, result.x, result.phi, result.psi):
         got = None
         if p.value and math.isfinite(p.error):
-            got = math.degrees(psi + float(wrap(p.value[0] - p.target.value[0])))
+            got = math.degrees(psi + float(wrap_angle(p.value[0] - p.target.value[0], upper=True)))
         out.append({"x": x, "phi_deg": math.degrees(phi), "psi_deg": math.degrees(psi), "psi_reached_deg": got})
     return out
 
@@ -177,8 +179,9 @@ def _typed(result: FunctionResult, check: Check) -> list:
 SYNTHESIS_ZERO = 1e-15
 
 
-def _fmt(x, digits=6):
-    return f"{shown(x, SYNTHESIS_ZERO):.{digits}g}"
+def _shown_number(x, digits=6):
+    """tables.shown_text with synthesis' own round-off (SYNTHESIS_ZERO)."""
+    return shown_text(x, digits, SYNTHESIS_ZERO)
 
 
 def _search_lines(result, constraints) -> list:
@@ -218,23 +221,23 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
     if isinstance(result, MotionResult):
         out.append(f"method: {result.method}")
         if len(result.candidates) > 2 or result.ranked:
-            rows = [[k, f"({_fmt(c.fixed[0])}, {_fmt(c.fixed[1])})", f"({_fmt(c.moving[0])}, {_fmt(c.moving[1])})",
-                     _fmt(c.length)] for k, c in enumerate(result.candidates)]
+            rows = [[k, f"({_shown_number(c.fixed[0])}, {_shown_number(c.fixed[1])})", f"({_shown_number(c.moving[0])}, {_shown_number(c.moving[1])})",
+                     _shown_number(c.length)] for k, c in enumerate(result.candidates)]
             out.append(f"candidate dyads ({len(rows)}; --pick CRANK,ROCKER chooses two):")
             out.append("  " + table(["#", "fixed pivot (centre point) [m]", "moving pivot (circle point) [m]",
                                      "length [m]"], rows).replace("\n", "\n  "))
         out.append(f"chosen: crank = candidate {result.pick[0]}, rocker = candidate {result.pick[1]}")
     elif isinstance(result, FunctionResult):
-        out.append(f"y = {result.function} on x in [{_fmt(result.x_range[0])}, {_fmt(result.x_range[1])}]; crank "
-                   f"phi {_fmt(math.degrees(result.input_range[0]))} .. {_fmt(math.degrees(result.input_range[1]))} "
-                   f"deg, rocker psi {_fmt(math.degrees(result.output_range[0]))} .. "
-                   f"{_fmt(math.degrees(result.output_range[1]))} deg")
+        out.append(f"y = {result.function} on x in [{_shown_number(result.x_range[0])}, {_shown_number(result.x_range[1])}]; crank "
+                   f"phi {_shown_number(math.degrees(result.input_range[0]))} .. {_shown_number(math.degrees(result.input_range[1]))} "
+                   f"deg, rocker psi {_shown_number(math.degrees(result.output_range[0]))} .. "
+                   f"{_shown_number(math.degrees(result.output_range[1]))} deg")
         how = "least squares" if result.least_squares else "exact (3 x 3 linear solve)"
         out.append(f"{len(result.x)} precision points ({result.spacing} spacing), {how}: "
                    f"K1 = {result.K[0]:.9g}, K2 = {result.K[1]:.9g}, K3 = {result.K[2]:.9g}")
         where = "over the range" if np.all(np.isfinite(result.structural_error)) else \
             "where the linkage assembles"
-        out.append(f"structural error: largest {_fmt(math.degrees(result.max_structural_error), 4)} deg {where}; "
+        out.append(f"structural error: largest {_shown_number(math.degrees(result.max_structural_error), 4)} deg {where}; "
                    "at the precision points " + ", ".join(f"{math.degrees(e):.2g}" if math.isfinite(e) else "(none)"
                                                           for e in result.error_at_points)
                    + " deg")
@@ -242,24 +245,24 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
         timing = "crank angles prescribed (--timing)" if result.timing is not None else "crank angles free"
         if result.search is None:
             out.append(f"{len(result.points)} points, {timing}; least squares from {result.starts} starts, "
-                       f"{result.converged} reached every point within {_fmt(result.tolerance, 3)} m")
+                       f"{result.converged} reached every point within {_shown_number(result.tolerance, 3)} m")
         else:
             out.append(f"{len(result.points)} points, {timing}; {result.converged} of the designs refined reach every "
-                       f"point within {_fmt(result.tolerance, 3)} m")
+                       f"point within {_shown_number(result.tolerance, 3)} m")
     if getattr(result, "search", None) is not None:
         out += _search_lines(result, constraints)
     links = d["links"]
-    out.append("links [m]: " + ", ".join(f"{n} {_fmt(v['length'])}" for n, v in links.items()))
+    out.append("links [m]: " + ", ".join(f"{n} {_shown_number(v['length'])}" for n, v in links.items()))
     named = {role: (v["letter"] or role) for role, v in d["pivot_joints"].items()}  # draw's letters
     if "frame" in links["coupler"] or "point" in links["coupler"]:
         t = links["coupler"].get("frame") or links["coupler"].get("point")
-        extra = f", {_fmt(t['angle_deg'])} deg" if "angle_deg" in t else ""
+        extra = f", {_shown_number(t['angle_deg'])} deg" if "angle_deg" in t else ""
         out.append(f"coupler {'frame' if 'frame' in links['coupler'] else 'point'} in the coupler's frame (origin "
-                   f"{named['A']}, x along {named['A']}{named['B']}): ({_fmt(t['x'])}, {_fmt(t['y'])}) m{extra}")
+                   f"{named['A']}, x along {named['A']}{named['B']}): ({_shown_number(t['x'])}, {_shown_number(t['y'])}) m{extra}")
     pv = d["pivots"]
     order = sorted(pv, key=lambda role: named[role])
     out.append("joints [m] (at the first position; lettered as draw letters them): " + ", ".join(
-        f"{named[r]} {d['pivot_joints'][r]['joint']} ({_fmt(pv[r][0])}, {_fmt(pv[r][1])})" for r in order))
+        f"{named[r]} {d['pivot_joints'][r]['joint']} ({_shown_number(pv[r][0])}, {_shown_number(pv[r][1])})" for r in order))
     out.append(f"Grashof: {d['grashof'] or 'not identified'}")
     mu = d["transmission_angle_range"]
     out.append("transmission angle from the first position to the farthest (screwkin's sweep): "
@@ -270,31 +273,31 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
     out.append(f"  drawn closed: {'yes' if check.assembled_iterations == 0 else 'no'} (assembly Newton iterations "
                f"{check.assembled_iterations})")
     rows = []
-    typed = _typed(result, check) if isinstance(result, FunctionResult) else [None] * len(check.precision)
+    typed = _as_typed(result, check) if isinstance(result, FunctionResult) else [None] * len(check.precision)
     for p, travel, as_typed in zip(check.precision, list(check.travel) + [None] * len(check.precision), typed):
         t = p.target
         if as_typed is not None:  # function generation: the angles as typed, not the file's
-            want = f"phi {_fmt(as_typed['phi_deg'])} deg -> psi {_fmt(as_typed['psi_deg'])} deg"
+            want = f"phi {_shown_number(as_typed['phi_deg'])} deg -> psi {_shown_number(as_typed['psi_deg'])} deg"
             err = f"{math.degrees(p.error):.2g} deg"
         elif t.kind == "pose":
-            want = f"({_fmt(t.value[0])}, {_fmt(t.value[1])}, {_fmt(math.degrees(t.value[2]))} deg)"
+            want = f"({_shown_number(t.value[0])}, {_shown_number(t.value[1])}, {_shown_number(math.degrees(t.value[2]))} deg)"
             err = f"{p.error:.2g} m, {math.degrees(p.angle_error):.2g} deg"
         elif t.kind == "point":
-            want = f"({_fmt(t.value[0])}, {_fmt(t.value[1])})"
+            want = f"({_shown_number(t.value[0])}, {_shown_number(t.value[1])})"
             err = f"{p.error:.2g} m"
         else:
-            want = f"psi {_fmt(math.degrees(t.value[0]))} deg"
+            want = f"psi {_shown_number(math.degrees(t.value[0]))} deg"
             err = f"{math.degrees(p.error):.2g} deg"
         if not math.isfinite(p.error):
             err = "not assembled"
-        rows.append([t.label, f"{_fmt(math.degrees(t.input))}", want, "yes" if p.reached else "NO", err,
+        rows.append([t.label, f"{_shown_number(math.degrees(t.input))}", want, "yes" if p.reached else "NO", err,
                      f"{p.residual:.2g}", f"{p.closed_form_error:.2g}" if math.isfinite(p.closed_form_error) else "-",
-                     "-" if travel is None else _fmt(math.degrees(travel), 5)])
+                     "-" if travel is None else _shown_number(math.degrees(travel), 5)])
     out.append("  " + table(["position", "crank [deg]", "target", "reached", "error", "residual",
                              "vs closed form [m]", "travel [deg]"], rows).replace("\n", "\n  "))
     if isinstance(result, FunctionResult):
         out.append(f"  targets in the angles typed (--input-range, --output-range); the file's crank_joint "
-                   f"counts from the first precision point: crank = phi - {_fmt(math.degrees(result.phi[0]))} deg")
+                   f"counts from the first precision point: crank = phi - {_shown_number(math.degrees(result.phi[0]))} deg")
     if check.defects:
         out.append("DEFECTS:")
         out += [f"  - {x}" for x in check.defects]

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 from ..units import in_unit, unit_kind
 
-__all__ = ["table", "shown", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits",
+__all__ = ["table", "shown", "shown_text", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits",
            "input_rate_words"]
 
 #: Display cut-off: a number smaller than this in magnitude is written as 0 (round-off is not a value).
@@ -28,6 +28,12 @@ def table(headers, rows) -> str:
 def shown(x, below: float = SHOWN_ZERO) -> float:
     """x as written: 0.0 where its magnitude is below ``below``, and never -0.0."""
     return (0.0 if abs(x) < below else x) + 0.0
+
+
+def shown_text(x, digits: int = 6, below: float = SHOWN_ZERO, missing: str = "?") -> str:
+    """A number as every text table writes it: ``digits`` significant digits, round-off below ``below``
+    as 0 (``shown``); ``missing`` for None."""
+    return missing if x is None else f"{shown(x, below):.{digits}g}"
 
 
 def fmt_vec(v, width=11):

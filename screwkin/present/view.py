@@ -32,10 +32,10 @@ from ..model.geometry import perpendicular_basis
 from ..model._pin import frame_id
 from .viewplanar import colour_links, link_colours, planar_basis, top_view
 from .viewserver import ViewerServer
-from .camera import BACKGROUND, FOV, PICTURE, VIEW, fit_camera, view_direction  # noqa: F401 - exported here as before
+from .camera import BACKGROUND, PICTURE, fit_camera, view_direction
 from .outfile import write_output
 
-__all__ = ["COLORS", "build_scene", "show", "page", "fit_camera", "legend_entries", "view", "ViewerServer", "RecordingViewer", "screenshot"]
+__all__ = ["COLORS", "build_scene", "show", "page", "legend_entries", "view", "RecordingViewer", "screenshot"]
 
 COLORS = {
     "actuated": np.array([1.0, 0.55, 0.0, 1.0]),

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..analysis.motion.planar import plane_basis
+from ..model.geometry import plane_basis
 from ..analysis.course.skeleton import numbering
 from .draw import number_colours
 

@@ -11,7 +11,7 @@ import pinocchio as pin
 from ..analysis.design.workspace import WorkspaceResult
 from ..tolerances import DEFAULT
 from .plots import pyplot
-from .report import table
+from .tables import table
 from .tables import csv_text
 from .outfile import write_figure, write_output
 
@@ -20,7 +20,7 @@ __all__ = ["workspace_dict", "workspace_text", "workspace_csv", "workspace_png",
 AXIS_NAMES = ("x", "y", "z")
 
 
-def _unit(dim: int) -> str:
+def _measure_unit(dim: int) -> str:
     return "m^3" if dim == 3 else "m^2"
 
 
@@ -36,7 +36,7 @@ def axis_labels(r: WorkspaceResult) -> list:
 def workspace_dict(r: WorkspaceResult) -> dict:
     d = {
         "file": r.path, "output": r.output, "point": r.point, "method": r.method, "dimension": r.dimension,
-        "volume": r.volume, "volume_unit": _unit(r.dimension), "volume_cells": r.volume_cells,
+        "volume": r.volume, "volume_unit": _measure_unit(r.dimension), "volume_cells": r.volume_cells,
         "free_volume": r.free_volume, "free_fraction": r.free_volume / r.volume if r.volume > 0 else None,
         "conditioning_min": r.conditioning_min, "conditioning_mean": r.conditioning_mean,
         "threshold": r.threshold, "characteristic_length": r.length, "inputs": list(r.inputs),
@@ -54,7 +54,7 @@ def workspace_dict(r: WorkspaceResult) -> dict:
 
 
 def workspace_text(r: WorkspaceResult) -> str:
-    dim, unit = r.dimension, _unit(r.dimension)
+    dim, unit = r.dimension, _measure_unit(r.dimension)
     names = axis_labels(r)
     if r.method == "grid":
         what = (f"origin of '{r.output}' (any orientation)" if r.point else
@@ -84,8 +84,8 @@ def workspace_text(r: WorkspaceResult) -> str:
         [f"{size}, grid cells [{unit}]", f"{r.volume_cells:.6g}", "points reached x cell size"],
         [f"singularity-free {size} [{unit}]", f"{r.free_volume:.6g}",
          f"{100 * frac:.1f} % of the {size}: measures >= {r.threshold:g}"],
-        ["conditioning, worst (free part)", _num(r.conditioning_min), "1/condition number of the input -> output map"],
-        ["conditioning, mean (free part)", _num(r.conditioning_mean), f"lengths divided by L = {r.length:.6g} m"],
+        ["conditioning, worst (free part)", _value_text(r.conditioning_min), "1/condition number of the input -> output map"],
+        ["conditioning, mean (free part)", _value_text(r.conditioning_mean), f"lengths divided by L = {r.length:.6g} m"],
     ]
     lines += [table(["quantity", "value", "how"], rows), "", f"  singular measures: {measure}",
               f"  inputs: {', '.join(r.inputs)}"]
@@ -101,7 +101,7 @@ def workspace_text(r: WorkspaceResult) -> str:
     return "\n".join(lines)
 
 
-def _num(x):
+def _value_text(x):
     return "-" if x is None else f"{x:.4g}"
 
 
@@ -192,7 +192,7 @@ def workspace_figure(r: WorkspaceResult, title: str | None = None):
     what = ("a point, orientation free" if r.point else "position at fixed orientation"
             if r.dimension == 3 and r.orientation is not None else "pose")
     fig.suptitle(title or (f"{Path(str(r.path)).stem}: workspace of '{r.output}' ({what})\n{r.volume:.4g} "
-                           f"{_unit(r.dimension)}, singularity-free {r.free_volume:.4g} {_unit(r.dimension)}, "
+                           f"{_measure_unit(r.dimension)}, singularity-free {r.free_volume:.4g} {_measure_unit(r.dimension)}, "
                            f"grid step {mm * h:.3g} mm"), fontsize=12)
     return fig
 

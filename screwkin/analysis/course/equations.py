@@ -15,13 +15,11 @@ from dataclasses import dataclass
 
 from ...errors import UsageError
 from ...model.linalg import rank
-from .newton import NewtonResult, NewtonStep, newton
 from ..screws import structure
 from ..singularities.singular import Generic, classify, scaled_jacobians
-from .vector_loops import LoopEquation, PlanarEquations, Symbol, Vector, VectorLoops
+from .vector_loops import VectorLoops
 
-__all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations", "SpatialEquations", "NewtonStep",
-           "NewtonResult", "VectorLoops", "equations", "newton"]
+__all__ = ["SpatialEquations", "equations"]
 
 
 @dataclass(frozen=True)

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError
-from ...model.geometry import TINY
+from ...model.geometry import TINY, wrap_angle
 
-__all__ = ["NewtonStep", "NewtonResult", "newton"]
+__all__ = ["NewtonStep", "NewtonResult", "textbook_newton", "start_estimates", "differing"]
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class NewtonResult:
     stopped: str | None  # why Newton stopped early (a singular Jacobian), else None
 
 
-def newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> NewtonResult:
+def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> NewtonResult:
     """Plain (undamped) Newton on the loop equations, as a textbook does it: from the
     estimates ``start`` (every unknown symbol -> value), with the inputs (input symbol ->
     value) held.  ``iterations``: exactly that many steps (fewer only when the Jacobian is
@@ -84,3 +84,85 @@ def newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> N
     return NewtonResult(tuple(loops.unknowns), dict(inputs), {n: float(start[n]) for n in loops.unknowns},
                         tuple(steps), {n: values[n] for n in loops.unknowns}, res, closes,
                         closes and iterations is None, stopped)
+
+
+def start_estimates(mech, loops, solver, q_in, values, typed):
+    """The estimates of every unknown of the loop equations from ``--start`` items (units.parse_typed_assignments):
+    symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
+    returns (symbol -> estimate, symbol -> unit typed)."""
+    by_link = {}
+    for n in loops.variables:
+        info = loops.symbol_info[n]
+        if info.kind == "angle":
+            by_link[info.link] = n
+    symbols, joints, units = {}, {}, {}
+    joint_names = set(mech.coordinate_names)
+    for name, v, unit in typed:
+        if name in loops.input_joints or name in values:
+            raise UsageError(f"{mech.path}: '{name}' is an input: give its value with --set")
+        if name in loops.unknowns:
+            symbols[name] = v
+        elif name[-1:] in ("h", "v") and name[:-1] in loops.unknowns and loops.symbol_info[name[:-1]].kind == "slider":
+            # the textbook's horizontal (h) or vertical (v) coordinate of the slider's centre, measured
+            # from the same joint centre, for a guide on the ground: from + x u + e n, read along x or y
+            guide = loops.ground_guide(name[:-1])
+            if guide is None:
+                raise UsageError(f"{mech.path}: --start {name}: the guide of {name[:-1]} turns with a link; give "
+                                 f"{name[:-1]}, the distance along the guide")
+            beta, e = guide
+            c, s_ = (np.cos(beta), -np.sin(beta)) if name[-1] == "h" else (np.sin(beta), np.cos(beta))
+            if abs(c) < mech.tolerances.geometry:
+                other = "v" if name[-1] == "h" else "h"
+                raise UsageError(f"{mech.path}: --start {name}: the guide of {name[:-1]} is "
+                                 f"{'vertical' if name[-1] == 'h' else 'horizontal'}; give {name[:-1]}{other} or "
+                                 f"{name[:-1]}")
+            name = name[:-1]
+            symbols[name] = (v - e * s_) / c
+        elif name in by_link:
+            symbols[by_link[name]] = v
+            name = by_link[name]
+        elif name in joint_names:
+            joints[name] = v
+            continue
+        else:
+            valid = ", ".join(list(loops.unknowns) + [lk for lk, n in by_link.items() if n in loops.unknowns])
+            raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{name[:80]}' "
+                             f"(unknowns of the loop equations: {valid}; or passive joint names)")
+        units[name] = unit
+    start = loops.values(solver.set_inputs(q_in, joints)) if joints else {}
+    covered = set(symbols)
+    if joints:
+        given = set(joints) | set(values)
+        covered |= {n for n in loops.unknowns if _needed_joints(loops, n) <= given}
+    missing = [n for n in loops.unknowns if n not in covered]
+    if missing:
+        raise UsageError(f"{mech.path}: --start gives no estimate of {', '.join(missing)} "
+                         f"(links {', '.join(loops.symbol_info[n].link for n in missing)})")
+    start = {n: symbols.get(n, start.get(n)) for n in loops.unknowns}
+    return start, units
+
+
+def _needed_joints(loops, name):
+    """The tree joints whose values place the quantity ``name`` (the joints from the ground to the
+    links it is measured on)."""
+    mech = loops.mech
+    model = mech.model
+    info = loops.symbol_info[name]
+    if info.kind == "angle":
+        links = [info.link]
+    else:
+        joint = next(j for j, t in loops.slide_terms.items() if t["x"].name == name)
+        links = [loops.slides[joint]["guide"], loops.slides[joint]["slider"]]
+    out = set()
+    for lk in links:
+        jid = model.frames[mech.link_frame(lk)].parentJoint
+        out |= {model.names[j] for j in model.supports[jid] if j > 0}
+    return out
+
+
+def differing(mech, loops, a: dict, b: dict) -> list:
+    """The unknowns of ``loops`` whose values in ``a`` and ``b`` (symbol -> value) differ: an angle by
+    more than the geometry tolerance modulo a turn, a length by more than it times max(L, 1 m)."""
+    tol = mech.tolerances.geometry * max(mech.length, 1.0)
+    return [n for n in loops.unknowns
+            if abs(wrap_angle(a[n] - b[n]) if loops.symbol_info[n].kind == "angle" else a[n] - b[n]) > tol]

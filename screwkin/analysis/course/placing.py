@@ -8,15 +8,16 @@ from __future__ import annotations
 import numpy as np
 
 from ...model.geometry import wrap_angle as wrap
+from ...model.manifold import continuous_angle, set_continuous_angle
 from .rolling import virtual_coordinates
 
-__all__ = ["LOWER", "configuration"]
+__all__ = ["LOWER", "joint_configuration"]
 
 #: The joints the vector-loop equations take (besides rolling and gear pairs).
 LOWER = ("revolute", "continuous", "prismatic")
 
 
-def configuration(loops, values: dict) -> np.ndarray:
+def joint_configuration(loops, values: dict) -> np.ndarray:
     """A joint configuration whose link angles and slider coordinates are ``values``: each
     tree joint's value from the relative angle (revolute) or the slider coordinate
     (prismatic) it carries, calibrated at the configuration the equations were built at.
@@ -52,8 +53,7 @@ def configuration(loops, values: dict) -> np.ndarray:
         rel = angle(child, values, theta0) - angle(parent, values, theta0)
         delta = sign * (wrap(rel - rel0) if not loops.pairs else rel - rel0)  # a rolling pair counts turns
         if c.nq == 2:
-            a = float(np.arctan2(q0[c.idx_q + 1], q0[c.idx_q])) + delta
-            q[c.idx_q:c.idx_q + 2] = (np.cos(a), np.sin(a))
+            set_continuous_angle(q, c.idx_q, float(continuous_angle(q0, c.idx_q)) + delta)
         else:
             q[c.idx_q] = q0[c.idx_q] + delta
     if loops.pairs:  # the virtual joints of the rolling pairs' equivalent linkages

@@ -20,7 +20,7 @@ circle a's centre to circle b's):
 
 c_ab (an arc length [m]) is measured at the configuration the equations are built at, and is
 0 where the marks on both pitch circles touch there.  These are the coupling rows
-r1 a1 +- r2 a2 = 0 (x + r2 a2 = 0) of model.closure.CouplingRow written in the links' angles.
+r1 a1 +- r2 a2 = 0 (x + r2 a2 = 0) of model.cuts.CouplingRow written in the links' angles.
 
 When the rest of a pair's loop fixes the line of centres -- it is constant (two gears pinned to
 one frame), or one link's vector (a planet pinned to an arm: theta_ab is the arm's angle) --
@@ -36,6 +36,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...model.cuts import in_plane, pair_contact
+from ...model.geometry import nearest_turn
 
 __all__ = ["HIGHER", "RollingPair", "measure_pairs", "pair_term", "substitute_pairs", "turns_through_pairs",
            "unwrapped", "drop_constant_rows", "virtual_coordinates"]
@@ -203,11 +204,6 @@ def _axis_sign(loops, data, name):
     return float(np.sign((data.oMf[f1].rotation @ np.asarray(axis, float)) @ loops.n))
 
 
-def _turned_towards(angle, want) -> float:
-    """``angle`` [rad] moved by the whole turns that bring it nearest ``want``."""
-    return float(angle + 2 * np.pi * np.round((want - angle) / (2 * np.pi)))
-
-
 def turns_through_pairs(loops, q, values):
     """``values`` (symbol -> value at q, each link's angle counted in turns along the tree) with
     the angle of a link turned through a rolling pair counted instead by the pair's virtual
@@ -234,11 +230,11 @@ def turns_through_pairs(loops, q, values):
             turned = s * dv2 if rec["kind"] == "rack" else s * (dv1 + dv2)  # theta_b - theta_a (- theta_u)
             if nb in out and nb not in inputs:
                 want = loops.theta_q[loops.rep[rec["b"]]] + da + turned
-                out[nb] = _turned_towards(out[nb], want)
+                out[nb] = nearest_turn(out[nb], want)
             elif na in out and na not in inputs and nb in out:
                 db = out[nb] - loops.theta_q[loops.rep[rec["b"]]]
                 want = loops.theta_q[loops.rep[rec["a"]]] + db - turned
-                out[na] = _turned_towards(out[na], want)
+                out[na] = nearest_turn(out[na], want)
     return out
 
 
@@ -315,7 +311,7 @@ def unwrapped(loops, link, angle, q):
             continue
         turned += float(np.sign(np.asarray(j.direction) @ loops.n)) * (q[c.idx_q] - loops.q[c.idx_q])
     guess = loops.theta_q[link] + turned
-    return _turned_towards(angle, guess)
+    return nearest_turn(angle, guess)
 
 
 def drop_constant_rows(loops):

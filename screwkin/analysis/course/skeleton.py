@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError
+from ...model.cuts import pair_contact
 from ...model.geometry import TINY, line_foot, plane_basis
 from ...model.state import KinematicState
 from ..motion.planar import LinkAngles
@@ -442,11 +443,14 @@ def _higher_pair(state, spec, letter, nums, p2, e1, e2):
     for (shape, r), c, M, num in zip(shapes, (c1, c2), (F1, F2), nums):
         d = tuple(float(x) for x in along_x(M)) if shape == "line" else None
         out.append(Profile(letter, num, shape, (float(c[0]), float(c[1])), float(r) if shape == "circle" else None, d))
-    contact = _contact_point(out[0], out[1], spec.contact == "internal")
+    if spec.type in ("rolling", "gear"):  # where the pitch curves touch: model.cuts.pair_contact, the one place
+        return p2(pair_contact(spec, F1, F2)[0]), out
+    contact = _contact_point(out[0], out[1])
     return (float(contact[0]), float(contact[1])), out
 
 
-def _contact_point(a, b, internal):
+def _contact_point(a, b):
+    """Where two profiles of a sliding contact (point, line, circle) touch, in the plane."""
     ca, cb = np.array(a.centre), np.array(b.centre)
     if a.shape == "point":
         return ca

@@ -49,15 +49,15 @@ import pinocchio as pin
 from ...errors import MechanismFileError, UsageError
 from ...model.geometry import wrap_angle as _wrap
 from .cycles import fundamental_cycles
-from .det_conditions import SIMPLIFY_OPS, determinant
-from .placing import LOWER, configuration
+from .det_conditions import determinant
+from .placing import LOWER, joint_configuration
 from .rolling import (HIGHER, drop_constant_rows, measure_pairs, pair_term, substitute_pairs, turns_through_pairs,
                       unwrapped)
 from ..motion.planar import LinkAngles
 from .skeleton import numbering
-from .symbols import LoopEquation, PlanarEquations, Symbol, Vector  # noqa: F401 - exported here as before
+from .symbols import LoopEquation, PlanarEquations, Symbol, Vector
 
-__all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations", "VectorLoops", "LOWER", "SIMPLIFY_OPS"]
+__all__ = ["VectorLoops"]
 
 _SUFFIX = "abcdefghijklmnopqrstuvwxyz"
 
@@ -575,4 +575,4 @@ class VectorLoops:
     def configuration(self, values: dict) -> np.ndarray:
         """A joint configuration whose link angles and slider coordinates are ``values``
         (screwkin.analysis.course.placing)."""
-        return configuration(self, values)
+        return joint_configuration(self, values)

@@ -45,7 +45,7 @@ from ...files.xacro import is_xacro
 from ...files.xacro_batch import Unbatchable, expand_batch
 from ...model.closability import obstacle_of, planar_loops
 from ..motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_transmission
-from .study import _GRASHOF, COLUMNS, _evaluate, _reason, metric_columns, run_chunk
+from .study import _GRASHOF, COLUMNS, evaluate_design, _reason, metric_columns, run_chunk
 
 __all__ = ["ChunkRows", "FAMILY_CHUNK", "FAMILY_METRICS", "chunk_rows", "eligible", "family_rows"]
 
@@ -92,7 +92,7 @@ def chunk_rows(task, chunk) -> ChunkRows:
     return ChunkRows(run_chunk(task, chunk), {"design": len(chunk)})
 
 
-def _rpy(rpy):
+def _rpy_matrices(rpy):
     """Rotation matrices (n, 3, 3) of URDF rpy angles (n, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy[:, 0], rpy[:, 1], rpy[:, 2]
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
@@ -131,7 +131,7 @@ class _Placed:
                 xyz = np.array([s.joints[k].xyz for s in specs], float)
                 rpy = np.array([s.joints[k].rpy for s in specs], float)
                 axis = np.array([s.joints[k].axis for s in specs], float)
-                R = R0 @ _rpy(rpy)
+                R = R0 @ _rpy_matrices(rpy)
                 p = p0 + np.einsum("nij,nj->ni", R0, xyz)
                 links[j.child] = (R, p)
                 self.joints[j.name] = (R, p)
@@ -148,7 +148,7 @@ class _Placed:
                 R0, p0 = links[link]
                 xyz = np.array([getattr(s.cut_joints[k], xyz_of) for s in specs], float)
                 rpy = np.array([getattr(s.cut_joints[k], rpy_of) for s in specs], float)
-                frames.append((R0 @ _rpy(rpy), p0 + np.einsum("nij,nj->ni", R0, xyz)))
+                frames.append((R0 @ _rpy_matrices(rpy), p0 + np.einsum("nij,nj->ni", R0, xyz)))
             self.cuts[c.name] = frames
             axis = np.array([s.cut_joints[k].axis for s in specs], float)
             self.axes[c.name] = np.einsum("nij,nj->ni", frames[0][0], axis / np.linalg.norm(axis, axis=1)[:, None])
@@ -243,7 +243,7 @@ def family_rows(task, chunk):
     try:
         return _family(task, chunk, index, values, alone)
     except Unbatchable as exc:
-        rows = [_evaluate(task, i, v) for i, v in chunk]
+        rows = [evaluate_design(task, i, v) for i, v in chunk]
         return ChunkRows(rows, {"design": len(chunk)}, [f"designs {index[0]}-{index[-1]} evaluated one by one: "
                                                         f"{exc}"])
 
@@ -267,7 +267,7 @@ def _family(task, chunk, index, values, alone):
         if specs[k] is None:
             continue
         kept = []
-        rows[k] = _evaluate(task, index[k], chunk[k][1], keep=kept)
+        rows[k] = evaluate_design(task, index[k], chunk[k][1], keep=kept)
         if kept:
             ref = k
             d = kept[0]
@@ -359,7 +359,7 @@ def _family(task, chunk, index, values, alone):
     if candidates:
         rng = np.random.default_rng(index[0])
         k = candidates[int(rng.integers(len(candidates)))]
-        own = _evaluate(task, index[k], chunk[k][1])
+        own = evaluate_design(task, index[k], chunk[k][1])
         col = _differs(made[k], own, columns)
         if col is not None:
             raise Unbatchable(f"the family path's {col} of design {index[k]} ({made[k][col]!r}) is not its own "
@@ -370,7 +370,7 @@ def _family(task, chunk, index, values, alone):
             out.append(made[k])
             continue
         if rows[k] is None:
-            rows[k] = _evaluate(task, index[k], chunk[k][1])
+            rows[k] = evaluate_design(task, index[k], chunk[k][1])
         out.append(rows[k])
         reasons[alone.get(k, "the reference")] += 1
     notes = [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" for why, c in reasons.most_common()]

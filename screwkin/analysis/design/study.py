@@ -48,6 +48,7 @@ __all__ = [
     "StudyResult",
     "designs",
     "pareto_front",
+    "evaluate_design",
     "run_chunk",
     "study_task",
     "check_pareto",
@@ -126,7 +127,7 @@ def _alarm(seconds: float):
 
 
 # ------------------------------------------------------------------ the designs
-def _steps(low: float, high: float, n: int) -> tuple:
+def _exact_steps(low: float, high: float, n: int) -> tuple:
     """n values from low to high, both ends exact (low (1 - t) + high t: 0.02..0.06 in 3 gives 0.04,
     where numpy's linspace gives 0.039999999999999994)."""
     if n == 1:
@@ -138,7 +139,7 @@ def designs(spec: StudySpec) -> list:
     """The parameter values of every design (tuples in the order of ``spec.parameters``, SI)."""
     params = spec.parameters
     if spec.sampling == "grid":
-        axes = [p.values if p.values is not None else _steps(p.low, p.high, p.samples) for p in params]
+        axes = [p.values if p.values is not None else _exact_steps(p.low, p.high, p.samples) for p in params]
         return [tuple(float(v) for v in combo) for combo in itertools.product(*axes)]
     n = spec.designs
     rng = np.random.default_rng(spec.seed)
@@ -258,7 +259,7 @@ def _grashof(d: _Design) -> dict:
     return {"linkage": info.kind, "grashof": short, "grashof_margin": float(margin)}
 
 
-def _transmission(d: _Design) -> dict:
+def _transmission_angle(d: _Design) -> dict:
     """The transmission angle over the input's whole motion (a full turn, or from limit position to
     limit position on the assembled configuration's circuit), its extremes located in closed form
     from the identified linkage's lengths (analysis.motion.transmission: the extremes of a
@@ -291,7 +292,7 @@ def _conditioning(d: _Design) -> dict:
 
 
 #: metric name -> function of a loaded, assembled design returning its columns (COLUMNS).
-METRICS = {"mobility": _mobility, "grashof": _grashof, "transmission_angle": _transmission,
+METRICS = {"mobility": _mobility, "grashof": _grashof, "transmission_angle": _transmission_angle,
            "workspace_volume": _workspace_volume, "singularity_free_volume": _singularity_free_volume,
            "conditioning": _conditioning}
 
@@ -320,7 +321,7 @@ def design_args(task: _Task, values: tuple) -> dict:
     return args
 
 
-def _evaluate(task: _Task, index: int, values: tuple, keep=None) -> dict:
+def evaluate_design(task: _Task, index: int, values: tuple, keep=None) -> dict:
     """The row of one design, from its values alone; ``keep`` (a list): the analysed design is appended
     to it (the family path reads its mechanism)."""
     row = {"design": index, **dict(zip(task.parameters, values))}
@@ -352,7 +353,7 @@ def run_chunk(task: _Task, chunk) -> list:
     task computes when the family path does not apply: screwkin.analysis.design.family.chunk_rows)."""
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        return [_evaluate(task, i, v) for i, v in chunk]
+        return [evaluate_design(task, i, v) for i, v in chunk]
 
 
 # ------------------------------------------------------------------ the study
@@ -397,7 +398,7 @@ def study_task(spec: StudySpec) -> _Task:
                  spec.input, spec.output, spec.point, dict(spec.workspace), spec.timeout, spec.mode)
 
 
-def _resolve(name: str, keys) -> str | None:
+def _row_key(name: str, keys) -> str | None:
     """The row key of a column named as in the rows or as in the table (``..._deg``, ``..._m``)."""
     for cand in (name, name.removesuffix("_deg"), name.removesuffix("_m")):
         if cand in keys:
@@ -416,7 +417,7 @@ def pareto_front(result: StudyResult, goals=None) -> list:
     keys = (*result.parameters, *result.columns)
     cols = []
     for name, goal in goals:
-        key = _resolve(name, keys)
+        key = _row_key(name, keys)
         if key is None or goal not in ("max", "min"):
             raise UsageError(f"{result.spec.path}: pareto column {quote(name)} is not a column of this study "
                              f"(columns: {', '.join(keys)})")
@@ -438,7 +439,7 @@ def check_pareto(spec: StudySpec) -> None:
     if spec.pareto:
         keys = (*(p.name for p in spec.parameters), *metric_columns(spec.metrics))
         for name, _ in spec.pareto:
-            if _resolve(name, keys) is None:
+            if _row_key(name, keys) is None:
                 raise UsageError(f"{spec.path}: pareto column {quote(name)} is not a column of this study "
                                  f"(columns: {', '.join(keys)})")
 
@@ -470,7 +471,7 @@ class Requirement:
         return v >= self.value if self.kind == "min" else v <= self.value
 
 
-def _shown(v) -> str:
+def _spec_text(v) -> str:
     """A cell as the spec writes it (YAML's true and false)."""
     return str(v).lower() if isinstance(v, bool) else repr(v) if isinstance(v, str) else f"{v:.6g}" \
         if isinstance(v, float) else str(v)
@@ -488,7 +489,7 @@ def requirements(spec: StudySpec) -> tuple:
     keys = (*(p.name for p in spec.parameters), *metric_columns(spec.metrics))
     out = []
     for name, kind, value, unit_typed in stated:
-        key = _resolve(name, keys)
+        key = _row_key(name, keys)
         if key is None:
             raise UsageError(f"{spec.path}: require: {quote(name)} is not a column of this study (columns: "
                              f"{', '.join(keys)})")
@@ -497,7 +498,7 @@ def requirements(spec: StudySpec) -> tuple:
         si = math.radians(value) if (name.endswith("_deg") and not unit_typed and isinstance(value, (int, float))
                                      and not isinstance(value, bool)) else value
         sign = {"equal": "=", "min": ">=", "max": "<="}[kind]
-        out.append(Requirement(key, kind, si, f"{name} {sign} {_shown(value)}"))
+        out.append(Requirement(key, kind, si, f"{name} {sign} {_spec_text(value)}"))
     return tuple(out), default
 
 
@@ -513,7 +514,7 @@ def apply_requirements(spec: StudySpec, rows) -> tuple:
         if r["error"] is not None:
             r[REQUIREMENTS_COLUMN] = None
         else:
-            missed = [f"{q.text} (has {_shown(r[q.column])})" for q in reqs if not q.met(r[q.column])]
+            missed = [f"{q.text} (has {_spec_text(r[q.column])})" for q in reqs if not q.met(r[q.column])]
             r[REQUIREMENTS_COLUMN] = not missed
             if missed:
                 unmet[r["design"]] = "; ".join(missed)

@@ -49,7 +49,7 @@ from ..motion.position import within_limits
 from ..singularities.singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions
 
-__all__ = ["WorkspaceResult", "workspace", "DEFAULT_THRESHOLD", "MAX_POINTS", "MAX_ESTIMATE"]
+__all__ = ["WorkspaceResult", "workspace", "DEFAULT_THRESHOLD", "MAX_ESTIMATE"]
 
 DEFAULT_THRESHOLD = 0.01
 #: Most grid points a --resolution may ask for, estimated from a first coarse pass before the work starts

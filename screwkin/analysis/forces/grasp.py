@@ -43,19 +43,18 @@ import numpy as np
 
 from ...files.grasp import GraspSpec
 from ...tolerances import DEFAULT
-from .grasp_map import (  # noqa: F401 - the grasp map's functions, exported here as before
+from .grasp_map import (
     exact_cones,
     generator_matrix,
     scaled_points,
-    characteristic_length,
+    grasp_characteristic_length,
     cone_error,
-    contact_frame,
     generators,
     grasp_map,
 )
 
 __all__ = ["GraspTolerances", "GRASP_TOLERANCES", "ContactForce", "Certificate", "GraspQuality", "GraspResult",
-           "contact_frame", "grasp_map", "characteristic_length", "generators", "cone_error", "analyze_grasp"]
+           "analyze_grasp"]
 
 
 @dataclass(frozen=True)
@@ -183,7 +182,7 @@ def _linprog(c, tol, **kw):
     return res.x if res.status == 0 and res.x is not None else None
 
 
-def _rank(A, rtol):
+def _relative_rank(A, rtol):
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
     return int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
@@ -321,7 +320,7 @@ def _wrench_certificate(spec, Gs, blocks, u, both, L, cones):
 def _closure(spec, G, Gs, blocks, W, parts, cones, tol, L):
     """(closed, certificate) for one set of polyhedral cones (exact or a pyramid)."""
     p = W.shape[0]
-    if _rank(W, tol.rank_rtol) == p:
+    if _relative_rank(W, tol.rank_rtol) == p:
         lam, _ = _positive_null_vector(W, tol)
         if lam is not None:
             return True, _internal_certificate(spec, G, Gs, blocks, W, parts, lam, cones, tol)
@@ -331,7 +330,7 @@ def _closure(spec, G, Gs, blocks, W, parts, cones, tol, L):
     return False, _wrench_certificate(spec, Gs, blocks, u, both, L, cones)
 
 
-def _decide(spec, G, Gs, blocks, facets, tol, L):
+def _decide_closure(spec, G, Gs, blocks, facets, tol, L):
     """(force_closure, certificate, how, facets used, notes)."""
     notes = []
     if all(exact_cones(c, spec.planar) for c in spec.contacts):
@@ -368,7 +367,7 @@ def _decide(spec, G, Gs, blocks, facets, tol, L):
 
 
 # ------------------------------------------------------------------ quality
-def _hull(X):
+def _qhull(X):
     """Qhull's hull of the points X (rows); joggled ("QJ") when the exact hull fails on nearly
     coplanar points (fine pyramids): its facets then move by about 1e-11 (relative)."""
     from scipy.spatial import ConvexHull, QhullError
@@ -396,10 +395,10 @@ def _epsilon(W, tol):
 
     p = W.shape[0]
     W = np.unique(W.T, axis=0).T
-    r = _rank(W, tol.rank_rtol)
+    r = _relative_rank(W, tol.rank_rtol)
     if r < p:
         return 0.0, 0.0, f"the primitive wrenches span {r} of {p} dimensions (the hull is flat: epsilon 0)"
-    if _rank(W - W[:, :1], tol.rank_rtol) < p:
+    if _relative_rank(W - W[:, :1], tol.rank_rtol) < p:
         return 0.0, 0.0, "the primitive wrenches lie on a hyperplane that misses the origin (epsilon 0)"
     scale = float(np.abs(W).max())
     _, _, Vt = np.linalg.svd(W @ W.T)
@@ -416,7 +415,7 @@ def _epsilon(W, tol):
     upper = math.inf
     while True:
         try:
-            hull = _hull(W[:, S].T)
+            hull = _qhull(W[:, S].T)
         except (QhullError, ValueError) as exc:
             first = (str(exc).strip().splitlines() or ["?"])[0]
             return None, None, f"Qhull failed: {first[:120]}"
@@ -467,14 +466,14 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
     G, labels, blocks = grasp_map(spec)
     p = G.shape[0]
     if length is None:
-        L, source = characteristic_length(spec)
+        L, source = grasp_characteristic_length(spec)
     else:
         L, source = float(length), "given"
     Gs = G * scaled_points(p, L)[:, None]
-    rank = _rank(Gs, tol.rank_rtol)
+    rank = _relative_rank(Gs, tol.rank_rtol)
     Wf, parts_f = generator_matrix(spec, Gs, blocks, facets, frictionless=True)
     form, _ = _closure_form(Wf, tol)
-    closed, cert, how, n, notes = _decide(spec, G, Gs, blocks, facets, tol, L)
+    closed, cert, how, n, notes = _decide_closure(spec, G, Gs, blocks, facets, tol, L)
     exact = all(exact_cones(c, spec.planar) for c in spec.contacts)
     quality = _quality(spec, Gs, blocks, n, exact, closed, tol, L)
     if rank < p:
@@ -485,7 +484,7 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
 
 def _closure_form(Wf, tol):
     """Form closure: the normals' wrenches positively span wrench space (an exact test)."""
-    if _rank(Wf, tol.rank_rtol) < Wf.shape[0]:
+    if _relative_rank(Wf, tol.rank_rtol) < Wf.shape[0]:
         return False, None
     lam, margin = _positive_null_vector(Wf, tol)
     return lam is not None, lam

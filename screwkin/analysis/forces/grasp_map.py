@@ -14,8 +14,8 @@ import numpy as np
 from ...files.grasp import GraspSpec
 from ...tolerances import DEFAULT
 
-__all__ = ["contact_frame", "contact_columns", "grasp_map", "characteristic_length", "scaled_points", "cone_error",
-           "exact_cones", "generators", "generator_matrix"]
+__all__ = ["contact_frame", "contact_columns", "grasp_map", "grasp_characteristic_length", "scaled_points",
+           "cone_error", "exact_cones", "generators", "generator_matrix"]
 
 
 # ------------------------------------------------------------------ the grasp map
@@ -76,7 +76,7 @@ def grasp_map(spec: GraspSpec):
     return np.hstack(cols), tuple(labels), tuple(blocks)
 
 
-def characteristic_length(spec: GraspSpec):
+def grasp_characteristic_length(spec: GraspSpec):
     """(L, source): the mean distance of the contact points from their centroid [m], or 1 m
     when they all coincide."""
     P = np.array([c.point for c in spec.contacts], float)

@@ -12,7 +12,8 @@ import numpy as np
 import pinocchio as pin
 
 from ...model import newton
-from ...model.closure import ClosureSystem, CouplingRow, CutJoint
+from ...model.closure import ClosureSystem
+from ...model.cuts import CouplingRow, CutJoint
 
 __all__ = ["TreeKinematics", "BatchClosure", "Unbatchable"]
 
@@ -304,9 +305,9 @@ class BatchClosure:
             rows = slice(i, i + k)
             if jacobian:  # e . (v2 - v1) + (e x d) . w1 = e . (v2 - v1 + d x w1)
                 if J2 is not None:
-                    add(rows, c2, _times(E, J2[:, :3]))
+                    add(rows, c2, _stacked_products(E, J2[:, :3]))
                 if J1 is not None:
-                    add(rows, c1, _times(E, _cross_columns(d, J1[:, 3:]) - J1[:, :3]))
+                    add(rows, c1, _stacked_products(E, _cross_columns(d, J1[:, 3:]) - J1[:, :3]))
             i += k
             if solver and vectors is not None:
                 for v in np.asarray(vectors, float):  # R2 v - R1 v; derivative (R1 v) x w1 - (R2 v) x w2
@@ -324,9 +325,9 @@ class BatchClosure:
                 if jacobian:
                     R2t = R2.transpose(0, 2, 1)
                     if J2 is not None:
-                        add(slice(i, i + 3), c2, _times(R2t, J2[:, 3:]))
+                        add(slice(i, i + 3), c2, _stacked_products(R2t, J2[:, 3:]))
                     if J1 is not None:
-                        add(slice(i, i + 3), c1, -_times(R2t, J1[:, 3:]))
+                        add(slice(i, i + 3), c1, -_stacked_products(R2t, J1[:, 3:]))
                 i += 3
                 continue
             for u0, w0 in pairs:  # alignments u . w; derivative (w x u) . (w2 - w1)
@@ -335,9 +336,9 @@ class BatchClosure:
                 if jacobian:
                     wu = np.cross(w, u)[:, None, :]
                     if J2 is not None:
-                        add(slice(i, i + 1), c2, _times(wu, J2[:, 3:]))
+                        add(slice(i, i + 1), c2, _stacked_products(wu, J2[:, 3:]))
                     if J1 is not None:
-                        add(slice(i, i + 1), c1, -_times(wu, J1[:, 3:]))
+                        add(slice(i, i + 1), c1, -_stacked_products(wu, J1[:, 3:]))
                 i += 1
         for iq, iv, coef, const in self.couplings:
             r[:, i] = Q[:, iq] @ coef + const
@@ -478,7 +479,7 @@ def _thin(C, RT, block: int = 4096) -> np.ndarray:
     return out
 
 
-def _times(A, B) -> np.ndarray:
+def _stacked_products(A, B) -> np.ndarray:
     """A @ B for stacks A (N, k, 3), B (N, 3, n): three broadcast products (numpy's stacked
     matmul on 3-long inner products costs several times more)."""
     return A[:, :, 0, None] * B[:, None, 0] + A[:, :, 1, None] * B[:, None, 1] + A[:, :, 2, None] * B[:, None, 2]

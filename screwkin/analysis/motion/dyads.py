@@ -32,12 +32,13 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...model.geometry import cross3, plane_basis, wrap_angle
+from ...model.geometry import cross3, plane_basis
+from ...model.manifold import continuous_angle, set_continuous_angle
 from ...model.planar_graph import DyadPlan, plan
 from .batch_sweep import batch_closure
 from ..singularities.singular import measures
 
-__all__ = ["Jet", "ClosedFormSweep", "planar_sweep", "joint_values"]
+__all__ = ["Jet", "ClosedFormSweep", "planar_sweep"]
 
 _PARALLEL = 1e-9  # |axis x n| (or |axis . n| of a slide) accepted as parallel (normal) [-]
 _NEAR_LIMIT = 1e-8  # a relative discriminant at q0 below this: q0 is (nearly) a limit position; not handled [-]
@@ -123,7 +124,7 @@ class _Pose:
         return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
 
 
-def _turn(u0, u):
+def _turn_from(u0, u):
     """The angle from the constant vector u0 to the jet vector u, in (-pi, pi]."""
     return Jet.atan2(u[1] * u0[0] - u[0] * u0[1], u[0] * u0[0] + u[1] * u0[1])
 
@@ -215,8 +216,8 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clam
         disc = d2.inverse() * r1s - a * a
         h = _root(disc, clamp) * sigma
         B = (A[0] + a * w[0] - h * w[1], A[1] + a * w[1] + h * w[0])
-        th1 = _turn(B1 - A1, (B[0] - A[0], B[1] - A[1]))
-        th2 = _turn(B2 - C2, (B[0] - C[0], B[1] - C[1]))
+        th1 = _turn_from(B1 - A1, (B[0] - A[0], B[1] - A[1]))
+        th2 = _turn_from(B2 - C2, (B[0] - C[0], B[1] - C[1]))
         return (_Pose.through(th1, A, A1), _Pose.through(th2, C, C2)), disc.v * d2.v / r1s
     if kinds == "RRP":  # B on g2 slides along a line of C's other link
         A, P = pa(AK), pc(B2)
@@ -227,7 +228,7 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clam
         disc = b * b - (e[0] * e[0] + e[1] * e[1] - r1s)
         s = _root(disc, clamp) * sigma - b
         B = (P[0] + s * dd[0], P[1] + s * dd[1])
-        th1 = _turn(B1 - A1, (B[0] - A[0], B[1] - A[1]))
+        th1 = _turn_from(B1 - A1, (B[0] - A[0], B[1] - A[1]))
         return (_Pose.through(th1, A, A1), _Pose.through(pc.th, B, B2)), disc.v / r1s
     # RPR: both links turn by the same angle; C - A = R(th) (C2 - A1 + s d)
     A, C = pa(AK), pc(CK)
@@ -309,8 +310,7 @@ class _Layout:
             if kind == "R":
                 rel = (pc.th - pp.th) * geo.signs[i]
                 if nq == 2:
-                    ang = np.arctan2(q0[iq + 1], q0[iq]) + rel.v
-                    Q[:, iq], Q[:, iq + 1] = np.cos(ang), np.sin(ang)
+                    set_continuous_angle(Q, iq, continuous_angle(q0, iq) + rel.v)
                 else:
                     Q[:, iq] = q0[iq] + rel.v
             else:
@@ -528,22 +528,8 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
     if turn and stopped is None and not closed and (stop - last_x) * np.sign(h) > mech.tolerances.equal * max(1.0, abs(stop)):
         stopped, reason = last_x, "the motion did not reach the end of the range"
     unit = "m" if p.pairs[p.swept].kind == "P" else "rad"
-    return ClosedFormSweep(X, Q, joint_values(mech, Q), V, A, stopped, reason, tuple(limits), closed, unit)
+    return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 
 def _take(j, n):
     return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))
-
-
-def joint_values(mech, Q) -> np.ndarray:
-    """Mechanism.joint_values of every row of Q, as an array (N, names) in its order."""
-    single, continuous, multi, order, idx, wrap = mech._value_layout()
-    cols = {}
-    for (n, i, w) in single:
-        v = Q[:, i]
-        cols[n] = wrap_angle(v) if w else v
-    for n, i in continuous:
-        cols[n] = np.arctan2(Q[:, i + 1], Q[:, i])
-    for n, i in multi:
-        cols[n] = Q[:, i]
-    return np.column_stack([cols[n] for n in order]) if order else np.zeros((len(Q), 0))

@@ -10,7 +10,8 @@ import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model.algebraic import algebraic_obstacle
-from ...model.closure import ClosureSystem, CutJoint
+from ...model.closure import ClosureSystem
+from ...model.cuts import CutJoint
 from ...model.geometry import wrap_angle
 from ...model.linalg import rank
 from ...model.state import KinematicState, angular_loop_joints

@@ -266,7 +266,7 @@ def _extrema(x, p, dp, tol):
     return out
 
 
-def _refine(solver, res, name, coordinate, x, guess):
+def _stroke_end(solver, res, name, coordinate, x, guess):
     """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
     its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
     from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""
@@ -317,7 +317,7 @@ def strokes(res, motion, mech, solver=None) -> list:
         values, slope = np.asarray(values, float), np.asarray(rates, float) / (res.rate or 1.0)
         inner = _extrema(x, values, slope, tol)
         if solver is not None and res.q is not None and len(res.q) == len(x):
-            inner = [_refine(solver, res, name, coordinate, x, e) for e in inner]
+            inner = [_stroke_end(solver, res, name, coordinate, x, e) for e in inner]
         ends = [(float(x[0]), float(values[0])), (float(x[-1]), float(values[-1]))] + inner
         lo, hi = min(ends, key=lambda e: e[1]), max(ends, key=lambda e: e[1])
         ratio = angles = None

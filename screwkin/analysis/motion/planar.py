@@ -28,17 +28,18 @@ import pinocchio as pin
 from ...errors import UsageError
 from ...model._pin import joint_axis
 from ...model.geometry import wrap_angle as _wrap
+from ...model.manifold import continuous_angle
 from ...model.geometry import (
     circle_intersections,
     cross2,
-    line_angle,
     line_circle,
     perpendicular_basis,
     plane_basis,
     vector_angle,
 )
 from .batch_closure import TreeKinematics, Unbatchable
-from .transmission import FOUR_BAR_CLASSES, four_bar_classes, transmission_range
+from .transmission import (FOUR_BAR_CLASSES, four_bar_classes, slide_transmission_angle, transmission_angle,
+                           transmission_range)
 
 __all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
@@ -122,7 +123,7 @@ def identify(mech, topo, q, input_joint):
     j_c = other(coupler, j_b)
     j_d = other(ground, inp)
     coord = mech.coordinate(input_joint)
-    q_in = float(np.arctan2(q[coord.idx_q + 1], q[coord.idx_q])) if coord.nq == 2 else float(q[coord.idx_q])
+    q_in = float(continuous_angle(q, coord.idx_q)) if coord.nq == 2 else float(q[coord.idx_q])
     A, B, C = p2(inp.point), p2(j_b.point), p2(j_c.point)
     a, b = np.linalg.norm(B - A), np.linalg.norm(C - B)
     where = {"centres": tuple(_locator(mech, j) for j in (inp, j_b, j_c, j_d)), "normal": tuple(n)}
@@ -184,8 +185,8 @@ def _transmission(kind, P, n, slide=None):
     P = P - (P @ n)[..., None] * n
     B, C, D = P[..., 1, :], P[..., 2, :], P[..., 3, :]
     if kind == "four-bar":
-        return vector_angle(B - C, D - C)
-    return line_angle(C - B, np.cross(n, slide))
+        return transmission_angle(B, C, D)
+    return slide_transmission_angle(B, C, np.cross(n, slide))
 
 
 def _four_bar(name, q_in, A, B, C, D, a, b, tol):
@@ -215,7 +216,7 @@ def _four_bar(name, q_in, A, B, C, D, a, b, tol):
             if (np.sign(cross2(Cc - Bc, D - Cc)) or circuit) != circuit:
                 continue
             limits.append(q_in + _wrap(_angle(_rot(Bc - A, -_angle(u_ad))) - phi_now))
-    mu = float(vector_angle(B - C, D - C))
+    mu = float(transmission_angle(B, C, D))
     z = float(np.linalg.norm(B - D))
     # an angle with a vanishing side has no value (None, not NaN): the diagonal vanishes when the crank
     # tip sits on the output pivot, the output link or the ground when their two pivots coincide
@@ -254,7 +255,7 @@ def _slider_crank(name, q_in, A, B, C, s, a, b):
         u = (Cc - A) / np.linalg.norm(Cc - A)
         Bc = A + (-a if folded and b > a else a) * u
         limits.append(q_in + _wrap(_angle(np.array([(Bc - A) @ s, (Bc - A) @ nrm])) - phi_now))
-    mu = float(line_angle(C - B, nrm))
+    mu = float(slide_transmission_angle(B, C, nrm))
     return LinkageInfo("slider-crank", lengths, cls, name, rng, tuple(sorted(limits)), mu, input_value=float(q_in),
                        input_angle=float(phi_now), signed_offset=e)
 
@@ -440,5 +441,5 @@ class LinkAngles:
         link must turn about the plane's normal on a joint to the ground."""
         name, sign = self.pivot(link)
         theta0 = self(self.mech.neutral())[link]
-        value = sign * float(np.mod(angle - theta0 + np.pi, 2 * np.pi) - np.pi)
+        value = sign * _wrap(angle - theta0)
         return name, value

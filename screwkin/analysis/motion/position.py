@@ -34,7 +34,9 @@ import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model import newton
-from ...model.closure import Assembly
+from ...model.cuts import Assembly
+from ...model.geometry import wrap_angle
+from ...model.manifold import set_continuous_angle
 from ...model.state import KinematicState, angular_loop_joints
 from ...model.topology import open_joints
 from . import certified, modes
@@ -249,11 +251,6 @@ class PositionSolver:
             return None
 
     @property
-    def expected_rank(self) -> int:
-        """Generic rank of the passive columns of the constraint Jacobian."""
-        return self.generic().rank_Kp
-
-    @property
     def idle_dofs(self) -> int:
         return self._mobility().idle_dofs
 
@@ -302,7 +299,7 @@ class PositionSolver:
                 continue
             c = self.mech.coordinate(name)
             if c.nq == 2 and c.nv == 1:
-                q[c.idx_q:c.idx_q + 2] = (np.cos(v), np.sin(v))
+                set_continuous_angle(q, c.idx_q, v)
             elif c.nq == 1:
                 q[c.idx_q] = v
             else:
@@ -323,7 +320,7 @@ class PositionSolver:
         _, _, _, _, idx, wrap = self.mech._value_layout()
         w = idx[wrap]
         if len(w):
-            q[w] = np.mod(q[w] + np.pi, 2 * np.pi) - np.pi
+            q[w] = wrap_angle(q[w])
         return q
 
     def signature(self, q):
@@ -463,7 +460,7 @@ class PositionSolver:
             if got is None:
                 continue
             angle = name in self._angular
-            miss = abs(float(np.angle(np.exp(1j * (got - want))))) if angle else abs(got - want)
+            miss = abs(wrap_angle(got - want)) if angle else abs(got - want)
             if miss > tol.near_far * (1.0 if angle else self.mech.length):
                 shown = (lambda v: f"{np.degrees(v):.4g} deg") if angle else (lambda v: f"{v:.4g} m")
                 out.append(f"--near {name}={shown(want)}: the assembly mode found has {name} = {shown(got)} "
@@ -536,7 +533,7 @@ class PositionSolver:
 
     # --------------------------------------------------------------- one solution
     def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None) -> Solution:
-        """One assembly mode at the closed configuration q (a: its model.closure.Assembly), every quantity
+        """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here
         when its measure is below the singular tolerance, modes.simple_root)."""
@@ -564,7 +561,7 @@ class PositionSolver:
         angles = self._link_angles(q)
         joints = self.joint_values(q)
         for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
-            if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < tol.equal:
+            if name in joints and abs(wrap_angle(joints[name] - v)) < tol.equal:
                 joints[name] = float(v)
         return Solution(q, joints, a.residual, a.iterations, bool(singular), float(sigma), pose,
                         rate_d, acc_d, twist, acc, qd, qdd, outside, self._labels(q, outside),

@@ -32,6 +32,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError, quote, shorten
+from ...model.geometry import wrap_angle
 from ...model.linalg import null_space
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from ...model.planar_graph import plan
@@ -304,7 +305,7 @@ def _drawn_regular(solver, values: dict):
     drawn, angular = solver.joint_values(a.q), set(solver.angular_names())
     for n, v in values.items():
         d = drawn.get(n, np.inf) - v
-        if not abs(float(np.angle(np.exp(1j * d))) if n in angular else d) <= tol.equal:
+        if not abs(wrap_angle(d) if n in angular else d) <= tol.equal:
             return None
     if outside_limits(mech, a.q):
         return None
@@ -335,7 +336,7 @@ def drawn_start(solver, values: dict):
         if n not in drawn:
             return None
         d = drawn[n] - v
-        if abs(float(np.angle(np.exp(1j * d))) if n in angular else d) > tol.equal:
+        if abs(wrap_angle(d) if n in angular else d) > tol.equal:
             return None
     sol = solver.solve(values, near=drawn, starts=0).solutions[0]
     far = np.linalg.norm(solver.signature(sol.q) - solver.signature(ref))

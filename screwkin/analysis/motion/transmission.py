@@ -33,8 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...model.geometry import line_angle, nearest_turn, vector_angle
+
 __all__ = ["FOUR_BAR_CLASSES", "four_bar_classes", "four_bar_transmission", "slider_crank_transmission",
-           "TransmissionRange", "transmission_range"]
+           "TransmissionRange", "transmission_range", "transmission_angle", "slide_transmission_angle",
+           "four_bar_cos_mu"]
 
 #: The Grashof classes of a four-bar as screwkin words them, by the codes four_bar_classes returns.
 FOUR_BAR_CLASSES = (
@@ -63,6 +66,31 @@ def four_bar_classes(g, a, b, c, equal: float):
 
 def _acos(x):
     return np.arccos(np.clip(x, -1.0, 1.0))
+
+
+def transmission_angle(B, C, D):
+    """mu [rad] of four-bars from their joint centres: the angle at the coupler-output joint C between
+    C -> B (the coupler) and C -> D (the output link), in [0, pi]; points (..., 2) or (..., 3).
+
+    >>> round(float(np.degrees(transmission_angle([0.0, 1.0], [0.0, 0.0], [1.0, 0.0]))), 9)
+    90.0
+    """
+    B, C, D = (np.asarray(v, float) for v in (B, C, D))
+    return vector_angle(B - C, D - C)
+
+
+def slide_transmission_angle(B, C, normal):
+    """mu [rad] of slider-cranks from the rod's ends B (on the crank) and C (the slider's pin): the angle
+    between the rod B -> C and the slide's normal ``normal``, in [0, pi/2]."""
+    return line_angle(np.asarray(C, float) - np.asarray(B, float), normal)
+
+
+def four_bar_cos_mu(g, a, b, c, phi):
+    """cos(mu) of four-bars (ground g, input a, coupler b, output c) at the input angle phi [rad] from the
+    ground line, from the lengths (module docstring): (b^2 + c^2 - z^2) / (2 b c) with the diagonal
+    z^2 = a^2 + g^2 - 2 a g cos(phi); beyond [-1, 1] where the linkage does not assemble at phi."""
+    z2 = a * a + g * g - 2 * a * g * np.cos(phi)
+    return (b * b + c * c - z2) / (2 * b * c)
 
 
 def four_bar_transmission(g, a, b, c, equal: float):
@@ -132,9 +160,7 @@ def _mu_at(info, phi, equal):
     """mu [rad] at input angles phi (from the ground line, or the slide's direction)."""
     L = info.lengths
     if info.kind == "four-bar":
-        g, a, b, c = L["ground"], L["input"], L["coupler"], L["output"]
-        z2 = a * a + g * g - 2 * a * g * np.cos(phi)
-        return _acos((b * b + c * c - z2) / (2 * b * c))
+        return _acos(four_bar_cos_mu(L["ground"], L["input"], L["coupler"], L["output"], phi))
     s = info.signed_offset - L["crank"] * np.sin(phi)
     return _acos(np.abs(s) / L["rod"])
 
@@ -159,7 +185,7 @@ def transmission_range(info, equal: float) -> TransmissionRange:
     offset = info.input_value - info.input_angle  # joint value = phi + offset
     if info.input_range is None or turns:  # (a change point's range is a turn less round-off)
         xs = [offset + phi for phi in phis]
-        xs = [info.input_value + math.remainder(x - info.input_value, 2 * math.pi) for x in xs]
+        xs = [nearest_turn(x, info.input_value) for x in xs]
         ends = []
     else:
         lo_x, hi_x = info.input_range

@@ -12,7 +12,8 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError
-from ...model.closure import Assembly
+from ...model.cuts import Assembly
+from ...model.geometry import wrap_angle
 
 __all__ = ["whole_turns", "engaged", "turn_on"]
 
@@ -26,7 +27,7 @@ def whole_turns(solver, values) -> dict:
     for name, v in values.items():
         c = next((c for c in solver.mech.coordinates if c.joint == name and c.nq == 1), None)
         if c is not None and solver.model.joints[c.joint_id].shortname().startswith("JointModelR"):
-            w = float(v - (np.mod(v + np.pi, 2 * np.pi) - np.pi))
+            w = float(v - wrap_angle(v))
             if abs(w) > 0:
                 out[name] = w
     return out

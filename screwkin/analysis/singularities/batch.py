@@ -25,11 +25,11 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import compute_frame_jacobian
-from ..motion.batch_closure import BatchClosure, Unbatchable  # noqa: F401 - tests import them from here
+from ...model.manifold import continuous_angle
 from ..screws import chains
 
-__all__ = ["frame_jacobians", "SerialJacobians", "singular_values", "smallest_singular_values",
-           "singular_value_ratios", "determinants", "BatchClosure", "Unbatchable"]
+__all__ = ["frame_jacobians", "SerialJacobians", "stack_singular_values", "smallest_singular_values",
+           "singular_value_ratios", "determinants"]
 
 _REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
 
@@ -113,7 +113,7 @@ class SerialJacobians:
         """(n, N) joint displacements of the chain joints."""
         th = np.empty((len(self._reads), len(Q)))
         for k, (kind, iq, zero) in enumerate(self._reads):
-            th[k] = Q[:, iq] - zero if kind == "linear" else np.arctan2(Q[:, iq + 1], Q[:, iq])
+            th[k] = Q[:, iq] - zero if kind == "linear" else continuous_angle(Q, iq)
         return th
 
     def _block(self, th, pose: bool = False):
@@ -212,13 +212,6 @@ class SerialJacobians:
         return (np.concatenate([p[1] for p in parts]), np.concatenate([p[2] for p in parts]),
                 np.concatenate([p[0] for p in parts]))
 
-    def chain_jacobians(self, Q) -> np.ndarray:
-        """(N, 6, n) the same Jacobians restricted to the n chain joints' columns."""
-        Q = np.atleast_2d(np.asarray(Q, float))
-        th = self._theta(Q)
-        return np.concatenate([self._block(np.ascontiguousarray(th[:, s:s + self.block]))
-                               for s in range(0, len(Q), self.block)]) if len(Q) else np.empty((0, 6, len(th)))
-
     def measures(self, Q, measure: str = "sigma_min", scale_translation: float | None = None, workers: int = 1,
                  method: str = "svd", point: bool = False) -> np.ndarray:
         """(N,) a singularity measure of the chain Jacobian at each configuration of Q (N, nq),
@@ -294,7 +287,7 @@ def _apply(R, x) -> np.ndarray:
     return out if out is not None else np.zeros(R.shape[1:])
 
 
-def singular_values(J) -> np.ndarray:
+def stack_singular_values(J) -> np.ndarray:
     """(N, min(m, n)) singular values of a stack of matrices (N, m, n), largest first."""
     return np.linalg.svd(np.asarray(J), compute_uv=False)
 
@@ -328,7 +321,7 @@ def _extreme_singular_values(J, scale_translation, method, slide=None):
     if slide is not None:
         J[:, :, slide] *= scale_translation
     if method == "svd":
-        s = singular_values(J)
+        s = stack_singular_values(J)
         return s[:, -1], s[:, 0]
     if method != "gram":
         raise UsageError(f"unknown method '{method}': svd or gram")
@@ -338,7 +331,7 @@ def _extreme_singular_values(J, scale_translation, method, slide=None):
     low, high = np.sqrt(np.maximum(lam[:, 0], 0.0)), np.sqrt(np.maximum(lam[:, -1], 0.0))
     near = lam[:, 0] < _GRAM_KAPPA**2 * lam[:, -1]
     if near.any():
-        s = singular_values(J[near])
+        s = stack_singular_values(J[near])
         low[near], high[near] = s[:, -1], s[:, 0]
     return low, high
 

@@ -55,7 +55,7 @@ class Ellipsoids:
     point: bool = False
 
 
-def _rows(d: int, linear: int):
+def _axis_labels(d: int, linear: int):
     lin = ("vx/L", "vy/L", "vz/L")[:linear]
     ang = ("wx", "wy", "wz")[: d - linear]
     flin = ("L fx", "L fy", "L fz")[:linear]
@@ -72,7 +72,7 @@ def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point=Fa
     vel[~keep] = 0.0
     force = np.full(d, np.inf)
     force[keep] = 1.0 / vel[keep]
-    rows, frows = _rows(d, linear)
+    rows, frows = _axis_labels(d, linear)
     return Ellipsoids(Ellipsoid(U.copy(), vel), Ellipsoid(U.copy(), force), M, rows, frows, tuple(inputs), float(L),
                       int(keep.sum()), output, point)
 

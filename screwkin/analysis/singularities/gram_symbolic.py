@@ -47,7 +47,7 @@ def _simplified(sp, expr):
     return coeff * sp.Mul(*[g ** m for g, m in parts]), [g for g, _ in parts]
 
 
-def _rank(mech, S, here) -> int:
+def _loop_rank(mech, S, here) -> int:
     """The rank of the loop's twists at the configuration measured (lengths over the characteristic
     length: a row scaling, the rank unchanged)."""
     M = np.array(S.subs(here).evalf(), dtype=float)
@@ -71,7 +71,7 @@ def symbolic_gram(mech, q, inputs=None) -> tuple:
         names = tuple(n for n, _ in twists)
         n = len(twists)
         S = sp.Matrix([[sp.sympify(t[r]) for _, t in twists] for r in range(3)])
-        free = n - _rank(mech, S, here)
+        free = n - _loop_rank(mech, S, here)
         if free != 1:
             out.append(SymbolicGramLoop(names, {}, {}, f"the loop has {n} joints and {free} freedoms on its own in "
                                                           "the plane, so every cofactor is 0 identically or none is"))

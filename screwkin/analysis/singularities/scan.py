@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import UsageError
+from ...model.manifold import set_continuous_angle
 from .batch import SerialJacobians
 
 __all__ = ["ScanResult", "scan"]
@@ -98,7 +99,7 @@ def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str =
         x = rng.uniform(lo, hi, samples)
         theta[:, k] = x
         if c.nq == 2:
-            Q[:, c.idx_q], Q[:, c.idx_q + 1] = np.cos(x), np.sin(x)
+            set_continuous_angle(Q, c.idx_q, x)
         else:
             Q[:, c.idx_q] = x
     L = float(length) if length else mech.length

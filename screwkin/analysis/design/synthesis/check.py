@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from ....errors import AssemblyError, ScrewkinError
+from ....model.geometry import wrap_angle
 from ....model.loader import load
 from ...mobility import analyze_mobility
 from ...motion.planar import identify, transmission_angles
@@ -38,7 +39,7 @@ from ...motion.sweep import sweep
 from ...course.skeleton import numbering
 from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
-from .fourbar import positions, wrap
+from .fourbar import positions
 
 __all__ = ["check_design", "check_chain_file", "TOLERANCE"]
 
@@ -73,10 +74,10 @@ class _Probe:
         v = self.value(q)
         t = target.value
         if target.kind == "pose":
-            return math.hypot(v[0] - t[0], v[1] - t[1]), abs(float(wrap(v[2] - t[2])))
+            return math.hypot(v[0] - t[0], v[1] - t[1]), abs(float(wrap_angle(v[2] - t[2], upper=True)))
         if target.kind == "point":
             return math.hypot(v[0] - t[0], v[1] - t[1]), 0.0
-        return abs(float(wrap(v[0] - t[0]))), 0.0
+        return abs(float(wrap_angle(v[0] - t[0], upper=True))), 0.0
 
     def mus(self, Q) -> list:
         """Transmission angles [rad] at the configurations Q (analysis.motion.planar.transmission_angles

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_transmission
+from ...motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_cos_mu, four_bar_transmission
 
 __all__ = ["Constraints", "GRASHOF_TYPES", "mu_over", "motion_mu", "grashof_type"]
 
@@ -46,9 +46,8 @@ def mu_over(g, a, b, c, phi0, travel):
     g, a, b, c, phi0, travel = np.broadcast_arrays(*(np.asarray(v, float) for v in (g, a, b, c, phi0, travel)))
 
     def mu(phi):
-        z2 = a * a + g * g - 2 * a * g * np.cos(phi)
         with np.errstate(invalid="ignore", divide="ignore"):
-            cos = (b * b + c * c - z2) / (2 * b * c)
+            cos = four_bar_cos_mu(g, a, b, c, phi)
         return np.where(np.abs(cos) <= 1, np.arccos(np.clip(cos, -1, 1)), np.nan)
 
     lo, hi = np.minimum(phi0, phi0 + travel), np.maximum(phi0, phi0 + travel)
@@ -97,6 +96,14 @@ class Constraints:
             lengths = (self.lengths[0] + length, self.lengths[1] - length)
         t = None if self.min_transmission is None else self.min_transmission + angle
         return Constraints(bounds, lengths, self.grashof, t)
+
+    def pivot_box(self, centre, size: float) -> tuple:
+        """(low, high) corners [m] of where a search puts the fixed pivots: the bounds, else ``centre``
+        +- 2 ``size`` (the task's own size: its points' or poses')."""
+        if self.bounds is not None:
+            (x0, y0), (x1, y1) = self.bounds
+            return np.array([x0, y0]), np.array([x1, y1])
+        return centre - 2 * size, centre + 2 * size
 
     @property
     def any(self) -> bool:

@@ -21,23 +21,19 @@ import numpy as np
 
 from ....files.description import TargetSpec
 from ....files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
-from ....model.geometry import circle_circle, cross2, vector_angle, wrap_angle
+from ....model.geometry import circle_circle, cross2, wrap_angle
+from ...motion.transmission import transmission_angle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar
 
-__all__ = ["angle", "wrap", "rotate", "pose_matrix", "branch", "tool_local", "positions",
-           "transmission", "travel_analysis", "fourbar_linkage", "crank_angle", "stored"]
+__all__ = ["angle", "rotate", "pose_matrix", "branch", "tool_local", "positions",
+           "travel_analysis", "fourbar_linkage", "crank_angle", "stored"]
 
 TWO_PI = 2 * math.pi
 
 
 def angle(v) -> float:
     return float(math.atan2(v[1], v[0]))
-
-
-def wrap(x):
-    """Angles in (-pi, pi] (model.geometry.wrap_angle's interval turned over, as joint values are)."""
-    return -wrap_angle(-np.asarray(x, float)) + 0.0
 
 
 def rotate(theta):
@@ -83,13 +79,7 @@ def positions(fb: FourBar, theta, sigma):
     u, v, gamma = tool_local(fb)
     x = A[..., 0] + u * np.cos(phi) - v * np.sin(phi)
     y = A[..., 1] + u * np.sin(phi) + v * np.cos(phi)
-    return {"A": A, "B": B, "x": x, "y": y, "angle": phi + gamma, "h2": h2, "mu": transmission(A, B, fb.B0)}
-
-
-def transmission(A, B, B0):
-    """mu [rad]: the angle at B between B -> A and B -> B0."""
-    A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
-    return vector_angle(A - B, B0 - B)
+    return {"A": A, "B": B, "x": x, "y": y, "angle": phi + gamma, "h2": h2, "mu": transmission_angle(A, B, fb.B0)}
 
 
 def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
@@ -191,7 +181,8 @@ def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None 
              PlanarLink("coupler", tuple(coupler_points)),
              PlanarLink("rocker", ((0.0, 0.0), (L["rocker"], 0.0)))]
     joints = [PlanarJoint("crank_joint", "revolute", "ground", "crank", tuple(A0), tc),
-              PlanarJoint("coupler_joint", "revolute", "crank", "coupler", (L["crank"], 0.0), wrap(tab - tc)),
+              PlanarJoint("coupler_joint", "revolute", "crank", "coupler", (L["crank"], 0.0),
+                          wrap_angle(tab - tc, upper=True)),
               PlanarJoint("rocker_joint", "revolute", "ground", "rocker", tuple(B0), tr)]
     if tool and fb.tool is not None:
         links.append(PlanarLink(tool, ((0.0, 0.0),), frame_only=True))

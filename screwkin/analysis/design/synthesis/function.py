@@ -28,10 +28,10 @@ import math
 import numpy as np
 
 from ....errors import UsageError, quote
-from ....model.geometry import circle_circle
+from ....model.geometry import circle_circle, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar, FunctionResult, SynthesisError, Target
-from .fourbar import branch, fourbar_linkage, stored, wrap
+from .fourbar import branch, fourbar_linkage, stored
 
 __all__ = ["parse_function", "precision_points", "freudenstein", "synthesize_function", "function_task",
            "function_result", "FUNCTIONS"]
@@ -213,7 +213,8 @@ def function_result(task, K, d: float | None = None, sigma: float | None = None,
         sigma1, best = None, 0.0
         for sg in (1.0, -1.0) if sigma is None else (sigma,):
             g, _, _ = _generated(K, d, phi[:1], sg)
-            if np.isfinite(g[0]) and (sigma1 is None or abs(wrap(g[0] - psi[0])) < abs(wrap(best - psi[0]))):
+            if np.isfinite(g[0]) and (sigma1 is None or abs(wrap_angle(g[0] - psi[0], upper=True))
+                                      < abs(wrap_angle(best - psi[0], upper=True))):
                 sigma1, best = sg, g[0]
         if sigma1 is None:
             raise SynthesisError(WHAT, "the least-squares four-bar does not assemble at the first precision point")
@@ -221,8 +222,8 @@ def function_result(task, K, d: float | None = None, sigma: float | None = None,
         A1, B1 = A[0], B[0]
     sigma1 = float(branch(A1, B1, B0))
     gen, _, _ = _generated(K, d, task["phi_sample"], sigma1)
-    err = wrap(gen - task["psi_sample"])
-    err_points = wrap(_generated(K, d, phi, sigma1)[0] - psi)
+    err = wrap_angle(gen - task["psi_sample"], upper=True)
+    err_points = wrap_angle(_generated(K, d, phi, sigma1)[0] - psi, upper=True)
     o = np.asarray(offset, float)  # the whole linkage moved: the angles, measured from the x axis, stay
     fb = FourBar(tuple(map(float, A0 + o)), tuple(map(float, A1 + o)), tuple(map(float, B1 + o)),
                  tuple(map(float, B0 + o)), None)
@@ -237,7 +238,7 @@ def function_result(task, K, d: float | None = None, sigma: float | None = None,
                "Drawn closed at the first precision point; actuated: crank_joint (input), output: rocker.")
     linkage = fourbar_linkage(fb, "synthesized_function", comment, tool=None)
     rocker_offset = math.pi if c < 0 else 0.0
-    targets = tuple(Target("angle", (float(wrap(ps + rocker_offset)),), float(ph - phi[0]),
+    targets = tuple(Target("angle", (float(wrap_angle(ps + rocker_offset, upper=True)),), float(ph - phi[0]),
                            f"point {k + 1} (x = {x:.6g})")
                     for k, (x, ph, ps) in enumerate(zip(xs, phi, psi)))
     lo, hi = sorted((p0 - phi[0], p1 - phi[0]))

@@ -34,12 +34,12 @@ import math
 import numpy as np
 
 from ....errors import UsageError
-from ....model.geometry import TINY
+from ....model.geometry import TINY, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, Dyad, FourBar, MotionResult, SynthesisError, Target
-from .fourbar import angle, branch, fourbar_linkage, pose_matrix, stored, travel_analysis, wrap
+from .fourbar import angle, branch, fourbar_linkage, pose_matrix, stored, travel_analysis
 
-__all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "candidates", "burmester_points",
+__all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "dyad_candidates", "burmester_points",
            "rank_pairs", "motion_design", "fourbar_from_dyads", "scale_of"]
 
 WHAT = "synthesize motion"
@@ -52,7 +52,7 @@ def scale_of(poses) -> float:
     return d if d > 0 else 1.0
 
 
-def _rows(poses, A0):
+def _burmester_rows(poses, A0):
     """The rows [2 g_i, rhs_i] (i = 2..n) at fixed pivots A0 (..., 2): shape (..., n-1, 3)."""
     A0 = np.asarray(A0, float)
     R1, p1 = pose_matrix(poses[0])
@@ -67,7 +67,7 @@ def _rows(poses, A0):
 
 def moving_pivot(poses, A0, what=WHAT):
     """The moving pivot (coupler frame) of the dyad with fixed pivot A0 through three poses."""
-    M = _rows(poses[:3], A0)
+    M = _burmester_rows(poses[:3], A0)
     G, r = M[:, :2], M[:, 2]
     scale = scale_of(poses)
     if abs(np.linalg.det(G)) < DEFAULT.zero * max(np.abs(G).max(), TINY) ** 2 or np.abs(G).max() < DEFAULT.zero * scale:
@@ -110,7 +110,7 @@ def _base_pole(poses):
     of the largest turn."""
     best = None
     for k in range(1, len(poses)):
-        turn = abs(float(wrap(poses[k][2] - poses[0][2])))
+        turn = abs(float(wrap_angle(poses[k][2] - poses[0][2], upper=True)))
         if turn > DEFAULT.equal and (best is None or turn > best[0]):
             best = (turn, k)
     if best is None:
@@ -136,7 +136,7 @@ def centre_point_curve(poses, directions: int = 360, bound: float | None = None)
     e = np.stack([np.cos(alphas), np.sin(alphas)], axis=-1)  # (m, 2)
     ts = np.array([-1.0, 1.0, 2.0]) * L
     pts = P + ts[None, :, None] * e[:, None, :]  # (m, 3, 2)
-    f = np.linalg.det(_rows(poses, pts))  # (m, 3): f(t) = c1 t + c2 t^2 + c3 t^3
+    f = np.linalg.det(_burmester_rows(poses, pts))  # (m, 3): f(t) = c1 t + c2 t^2 + c3 t^3
     V = np.stack([ts, ts**2, ts**3], axis=-1)
     coef = np.linalg.solve(V, f.T).T  # (m, 3)
     out_c, out_idx = [], []
@@ -160,7 +160,7 @@ def _circle_points(poses, C):
     (least squares of the linear equations; exact on the curve)."""
     if len(C) == 0:
         return np.zeros((0, 2)), np.zeros((0, 2))
-    M = _rows(poses, C)
+    M = _burmester_rows(poses, C)
     G, r = M[..., :2], M[..., 2]
     local = np.full((len(C), 2), np.nan)
     for k in range(len(C)):
@@ -170,7 +170,7 @@ def _circle_points(poses, C):
     return local, local @ R1.T + p1
 
 
-def candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
+def dyad_candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
     """Dyads of four positions for a list to choose from: the curve traced with ``count``
     lines through the base pole, points within ``bound`` (default 3 times the size of the
     task) of the poses' centroid, neither link shorter than 2 % of the task's size."""
@@ -185,7 +185,7 @@ def candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
 
 
 def _D(poses4, X):
-    return np.linalg.det(_rows(poses4, X))
+    return np.linalg.det(_burmester_rows(poses4, X))
 
 
 def burmester_points(poses, seeds: int = 360) -> tuple:
@@ -223,7 +223,7 @@ def burmester_points(poses, seeds: int = 360) -> tuple:
             continue
         if any(np.hypot(*(x - y)) < 1e-7 * L for y in found):
             continue
-        M = _rows(poses, x)
+        M = _burmester_rows(poses, x)
         G, r = M[:, :2], M[:, 2]
         a, *_ = np.linalg.lstsq(G, r, rcond=None)
         if np.linalg.matrix_rank(G, tol=DEFAULT.equal * max(np.abs(G).max(), TINY)) < 2:
@@ -238,7 +238,7 @@ def burmester_points(poses, seeds: int = 360) -> tuple:
         found.append(x)
     out = []
     for x in found:
-        M = _rows(poses, x)
+        M = _burmester_rows(poses, x)
         a, *_ = np.linalg.lstsq(M[:, :2], M[:, 2], rcond=None)
         R1, p1 = pose_matrix(poses[0])
         out.append(Dyad(tuple(map(float, x)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))))
@@ -268,7 +268,8 @@ def targets_of(poses, crank: Dyad) -> tuple:
     for pose in poses:
         R, p = pose_matrix(pose)
         thetas.append(angle(R @ np.array(crank.local) + p - np.array(crank.fixed)))
-    return tuple(Target("pose", tuple(float(x) for x in pose), float(wrap(t - thetas[0])), f"position {k + 1}")
+    return tuple(Target("pose", tuple(float(x) for x in pose), float(wrap_angle(t - thetas[0], upper=True)),
+                        f"position {k + 1}")
                  for k, (pose, t) in enumerate(zip(poses, thetas)))
 
 
@@ -314,7 +315,8 @@ def _check_poses(poses):
     L = scale_of(poses)
     for i, j in itertools.combinations(range(len(poses)), 2):
         a, b = poses[i], poses[j]
-        if math.hypot(a[0] - b[0], a[1] - b[1]) < DEFAULT.equal * L and abs(float(wrap(a[2] - b[2]))) < DEFAULT.equal:
+        if math.hypot(a[0] - b[0], a[1] - b[1]) < DEFAULT.equal * L \
+                and abs(float(wrap_angle(a[2] - b[2], upper=True))) < DEFAULT.equal:
             raise UsageError(f"--poses: positions {i + 1} and {j + 1} are the same pose: give distinct poses")
 
 
@@ -357,7 +359,7 @@ def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 2
             raise UsageError("--pivots and --moving apply to three positions; four and five positions are solved by "
                              "Burmester theory (choose a pair with --pick)")
         if n == 4:
-            dyads = list(candidates(poses, count))
+            dyads = list(dyad_candidates(poses, count))
             C, W, _, _ = centre_point_curve(poses, 720, 3 * scale_of(poses))
             curves = ((C, W),)
             method = "Burmester, four positions (centre-point and circle-point curves)"

@@ -29,7 +29,8 @@ import numpy as np
 from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, PathResult, SynthesisError
-from .fourbar import travel_analysis, wrap
+from ....model.geometry import wrap_angle
+from .fourbar import travel_analysis
 from .path import _residuals, _unpack, coupler_points, path_design, path_points
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
 
@@ -57,15 +58,10 @@ SEARCHED = 24
 TWO_PI = 2 * math.pi
 
 
-def _box(pts, constraints, L):
+def _path_box(pts, constraints, L):
     """The search's box: the pivots inside the bounds (else 2 path sizes around the points), the links
     within the length range (else 2 % of the path's size to 4 times it), the coupler point within 3 sizes."""
-    centre = pts.mean(axis=0)
-    if constraints.bounds is not None:
-        (x0, y0), (x1, y1) = constraints.bounds
-        plo, phi = np.array([x0, y0]), np.array([x1, y1])
-    else:
-        plo, phi = centre - 2 * L, centre + 2 * L
+    plo, phi = constraints.pivot_box(pts.mean(axis=0), L)
     llo, lhi = constraints.lengths if constraints.lengths is not None else (0.02 * L, 4 * L)
     lower = [*plo, *plo, llo, llo, llo, -3 * L, -3 * L]
     upper = [*phi, *phi, lhi, lhi, lhi, 3 * L, 3 * L]
@@ -177,7 +173,7 @@ def _path_run(task):
     at most SEARCHED points, evenly chosen, when there are more), then the refinement of its best
     distinct members on all the points.  Returns ([(x, sigma, direction)], generations)."""
     pts, timing, sigma, direction, constraints, L, seed, generations, popsize, equal = task
-    lower, upper = _box(pts, constraints, L)
+    lower, upper = _path_box(pts, constraints, L)
     few = np.unique(np.linspace(0, len(pts) - 1, min(len(pts), SEARCHED)).round().astype(int))
     if timing is None:
         def cost(X):
@@ -279,6 +275,7 @@ def optimal_path(points, timing, constraints, search, tolerance: float = 1e-6, e
                           f"{REFINED} distinct members of each run", len(runs), evaluations, seconds, search.where,
                           search.seed, listed)
     return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
-                      tuple(float(wrap(t)) if abs(t) < math.pi else float(t) for t in rel), tuple(map(float, errors)),
+                      tuple(float(wrap_angle(t, upper=True)) if abs(t) < math.pi else float(t) for t in rel),
+                      tuple(map(float, errors)),
                       len(runs), sum(c[0][0].error <= tolerance for c in cands), tolerance, best.design, report)
 

@@ -23,9 +23,9 @@ from dataclasses import replace
 import numpy as np
 
 from ....errors import UsageError
+from ....model.geometry import wrap_angle
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, FunctionResult, SynthesisError
-from .fourbar import wrap
 from .function import function_result, function_task
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, rank_key
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
@@ -33,7 +33,7 @@ from .search import SearchReport, distinct_best, evolve, run_all, task_seed
 __all__ = ["optimal_function"]
 
 
-def _layout(task, constraints):
+def _unknowns(task, constraints):
     """(names of the unknowns, lower, upper): a, b, c (and d with --lengths, B0's x, y with --bounds)."""
     d = task["ground"]
     lo, hi = constraints.lengths if constraints.lengths is not None else (0.05 * d, 10 * d)
@@ -71,7 +71,7 @@ def _errors(X, names, task, signs, constraints, equal, phi, psi):
     e = -A / dist[..., None]  # from A towards B0 (the origin)
     n = np.stack([-e[..., 1], e[..., 0]], -1)
     B = A + along[..., None] * e + (sigma * np.sqrt(np.maximum(h2, 0)))[..., None] * n
-    err = wrap(np.arctan2(B[..., 1], B[..., 0]) + (math.pi if sc < 0 else 0.0) - psi[None])
+    err = wrap_angle(np.arctan2(B[..., 1], B[..., 0]) + (math.pi if sc < 0 else 0.0) - psi[None], upper=True)
     apart = np.maximum(-h2, 0).sum(axis=1) / d ** 2
     g = d
     mu_lo, mu_hi = motion_mu(g, a, b, c, task["p0"] - math.pi, task["p1"] - task["p0"], equal)
@@ -84,7 +84,7 @@ def _function_run(job):
     """One run (picklable: what a Dask worker computes): differential evolution on the precision points,
     then least squares from its best distinct members.  Returns ([(x, signs)], generations)."""
     task, names, constraints, signs, seed, generations, popsize, equal = job
-    _, lower, upper = _layout(task, constraints)
+    _, lower, upper = _unknowns(task, constraints)
     phi, psi = task["phi"], task["psi"]
 
     def cost(X):
@@ -112,7 +112,7 @@ def optimal_function(text, x_range, input_range, output_range, points, spacing, 
     task = function_task(text, x_range, input_range, output_range, points, spacing, ground)
     if constraints.lengths is not None and not 0 < constraints.lengths[0] < constraints.lengths[1]:
         raise UsageError("--lengths: give MIN..MAX with 0 < MIN < MAX")
-    names, _, _ = _layout(task, constraints)
+    names, _, _ = _unknowns(task, constraints)
     runs = [(s, sa, sc) for s in (1.0, -1.0) for sa in (1.0, -1.0) for sc in (1.0, -1.0)]
     jobs = [(task, names, constraints, r, task_seed(search.seed, k), search.generations, search.popsize, equal)
             for k, r in enumerate(runs)]

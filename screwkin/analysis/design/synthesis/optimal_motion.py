@@ -30,8 +30,9 @@ import numpy as np
 from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, Dyad, MotionResult, SynthesisError
-from .fourbar import pose_matrix, travel_analysis, wrap
-from .motion import _base_pole, _check_poses, _positions_of, _rows, burmester_points, motion_design, poles, scale_of
+from ....model.geometry import wrap_angle
+from .fourbar import pose_matrix, travel_analysis
+from .motion import _base_pole, _burmester_rows, _check_poses, _positions_of, burmester_points, motion_design, poles, scale_of
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, _defect_words, rank_key
 from .search import SearchReport, distinct_best, evolve, run_all, task_seed
 
@@ -86,7 +87,7 @@ def _driven(A0, a, B0, b, poses, direction, constraints, L, equal):
     c, s = np.cos(turn), np.sin(turn)
     origin = A - np.stack([c * a[:, None, 0] - s * a[:, None, 1], s * a[:, None, 0] + c * a[:, None, 1]], -1)
     miss = np.hypot(*np.moveaxis(origin - P[None], -1, 0)) / L
-    angle = np.abs(wrap(turn - TH[None]))
+    angle = np.abs(wrap_angle(turn - TH[None], upper=True))
     res = np.concatenate([miss, angle], axis=1)
     # every configuration between two poses must assemble (no limit position on the way)
     steps = (np.arange(1, BETWEEN + 1) / (BETWEEN + 1))
@@ -122,7 +123,7 @@ def _solve2(G, r):
 def _moving(poses, A0):
     """The moving pivots (m, 2) of the dyads with fixed pivots A0 (m, 2) through the poses (3: exactly;
     4: on the centre-point curve, exactly)."""
-    M = _rows(poses, A0)
+    M = _burmester_rows(poses, A0)
     return _solve2(M[..., :2], M[..., 2])
 
 
@@ -133,7 +134,7 @@ def _curve_points(poses, alpha, root, L):
     e = np.stack([np.cos(alpha), np.sin(alpha)], -1)
     ts = np.array([-1.0, 1.0, 2.0]) * L
     pts = P + ts[None, :, None] * e[:, None, :]
-    f = np.linalg.det(_rows(poses, pts))
+    f = np.linalg.det(_burmester_rows(poses, pts))
     V = np.stack([ts, ts ** 2, ts ** 3], -1)
     c1, c2, c3 = np.linalg.solve(V, f.T)
     disc = c2 * c2 - 4 * c3 * c1
@@ -143,7 +144,7 @@ def _curve_points(poses, alpha, root, L):
     return P + t[:, None] * e
 
 
-def _unpack(kind, X, poses, L, root=None):
+def _dyads_of(kind, X, poses, L, root=None):
     """(A0, a, B0, b) of designs X for a kind of run: "pivots" (3 poses), "curve" (4), "free" (6+)."""
     if kind == "pivots":
         A0, B0 = X[:, 0:2], X[:, 2:4]
@@ -155,13 +156,10 @@ def _unpack(kind, X, poses, L, root=None):
     return X[:, 0:2], X[:, 2:4], X[:, 4:6], X[:, 6:8]
 
 
-def _box(kind, poses, constraints, L):
-    centre = np.mean([p[:2] for p in poses], axis=0)
-    if constraints.bounds is not None:
-        (x0, y0), (x1, y1) = constraints.bounds
-        plo, phi = np.array([x0, y0]), np.array([x1, y1])
-    else:
-        plo, phi = centre - 2 * L, centre + 2 * L
+def _motion_box(kind, poses, constraints, L):
+    """The search's box of a kind of run: the pivots inside the bounds (else 2 sizes around the poses),
+    the curve parameters in [0, pi], the moving pivots within 3 sizes."""
+    plo, phi = constraints.pivot_box(np.mean([p[:2] for p in poses], axis=0), L)
     if kind == "pivots":
         return np.array([*plo, *plo]), np.array([*phi, *phi])
     if kind == "curve":
@@ -176,10 +174,10 @@ def _motion_run(task):
     from scipy.optimize import minimize
 
     kind, poses, root, direction, constraints, L, seed, generations, popsize, equal = task
-    lower, upper = _box(kind, poses, constraints, L)
+    lower, upper = _motion_box(kind, poses, constraints, L)
 
     def cost(X):
-        return _cost(*_unpack(kind, X, poses, L, root), poses, direction, constraints, L, equal)
+        return _cost(*_dyads_of(kind, X, poses, L, root), poses, direction, constraints, L, equal)
 
     pop, costs, nfev = evolve(cost, lower, upper, seed, generations, popsize)
     tight = constraints.tightened(MARGIN * L, MARGIN)
@@ -188,21 +186,21 @@ def _motion_run(task):
         x = pop[k]
         if kind == "free":
             def residuals(X, weight):
-                res, pen, _, _ = _driven(*_unpack(kind, X, poses, L), poses, direction, tight, L, equal)
+                res, pen, _, _ = _driven(*_dyads_of(kind, X, poses, L), poses, direction, tight, L, equal)
                 return np.concatenate([res, weight * pen[:, None]], axis=1)
             x = refined(residuals, x, lower, upper, L)
         else:
-            sol = minimize(lambda x_: float(_cost(*_unpack(kind, x_[None], poses, L, root), poses, direction, tight, L,
+            sol = minimize(lambda x_: float(_cost(*_dyads_of(kind, x_[None], poses, L, root), poses, direction, tight, L,
                                                   equal)[0]), x, method="Nelder-Mead", bounds=list(zip(lower, upper)),
                            options={"xatol": 1e-10 * L, "fatol": 1e-12, "maxiter": 2000})
             x = sol.x if sol.fun <= costs[k] else x
-        A0, a, B0, b = (v[0] for v in _unpack(kind, x[None], poses, L, root))
+        A0, a, B0, b = (v[0] for v in _dyads_of(kind, x[None], poses, L, root))
         if np.all(np.isfinite([*A0, *a, *B0, *b])):
             out.append((A0, a, B0, b, direction))
     return out, nfev
 
 
-def _judge(poses, A0, a, B0, b, direction, constraints, L, tol, equal, run, exact):
+def _judge_motion(poses, A0, a, B0, b, direction, constraints, L, tol, equal, run, exact):
     R1, p1 = pose_matrix(poses[0])
     crank, rocker = Dyad(tuple(map(float, A0)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))), \
         Dyad(tuple(map(float, B0)), tuple(map(float, R1 @ b + p1)), tuple(map(float, b)))
@@ -264,7 +262,7 @@ def optimal_motion(poses, constraints, search, tolerance: float = 1e-9, equal: f
     found += [(x, f"crank {'counterclockwise' if x[4] > 0 else 'clockwise'}") for x in fixed]
     cands = []
     for (A0, a, B0, b, d), run in found:
-        judged = _judge(poses, A0, a, B0, b, d, constraints, L, tol, equal, run, exact=n <= 5)
+        judged = _judge_motion(poses, A0, a, B0, b, d, constraints, L, tol, equal, run, exact=n <= 5)
         if judged is not None:
             cands.append(judged)
     if not cands:

@@ -25,10 +25,10 @@ import math
 import numpy as np
 
 from ....errors import UsageError
-from ....model.geometry import circle_circle
+from ....model.geometry import circle_circle, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar, PathResult, SynthesisError, Target
-from .fourbar import fourbar_linkage, stored, travel_analysis, wrap
+from .fourbar import fourbar_linkage, stored, travel_analysis
 
 __all__ = ["synthesize_path", "coupler_points", "path_points", "path_design", "MAX_POINTS"]
 
@@ -162,7 +162,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
     err, x, sigma, direction, errors, A, B, P, th = best
     design, rel = path_design(pts, x, sigma, A, B, P, th, errors, name)
     return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
-                      tuple(float(wrap(t)) if abs(t) < math.pi else float(t) for t in rel),
+                      tuple(float(wrap_angle(t, upper=True)) if abs(t) < math.pi else float(t) for t in rel),
                       tuple(map(float, errors)), starts, len(good), tolerance, design)
 
 
