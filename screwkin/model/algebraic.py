@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from . import algebraic_compiled
+from . import algebraic_compiled, compiled as numba_kernels
 from .geometry import quaternion_matrix, quaternion_product, skew, stack_cross, stack_mm, stack_mv
 from .legs import distance_legs
 
@@ -184,7 +184,7 @@ class PolynomialClosure:
         self.keep = self._nonzero_rows()
         self.m = int(self.keep.sum())
         self._kernel = None
-        if compiled or (compiled is None and algebraic_compiled.available()):
+        if compiled or (compiled is None and numba_kernels.available()):
             self._kernel, self._packed = algebraic_compiled.kernel(), algebraic_compiled.pack(self)
 
     @property

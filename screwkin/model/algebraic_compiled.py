@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import available
 
-__all__ = ["available", "kernel", "pack"]
+__all__ = ["kernel", "pack"]
 
 _KERNEL = None
 POS, VEC, DOTD, DOT, DIST = 0, 1, 2, 3, 4

@@ -31,7 +31,7 @@ from ...errors import AssemblyError
 from ...model import newton
 from ...model.algebraic import PolynomialClosure, algebraic_obstacle
 from ...model.square import SquareSystem
-from ...model.closure import Assembly
+from ...model.cuts import Assembly
 from ...model.symmetry import find_symmetries
 from .known_counts import known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
