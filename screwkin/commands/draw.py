@@ -31,19 +31,16 @@ from ..present.draw_targets import design_marks
 from ..present.local import change_point_dict, change_point_lines
 from ..present.report import to_jsonable
 from ..units import in_unit, parse_typed_value
-from ._common import (
+from ._configuration import (
     add_configuration_options,
-    add_point_option,
     configuration,
     input_solver,
-    inputs,
-    joint_value,
     moved_not_set,
-    named_points,
     near_values,
-    split_inputs,
     with_mode,
 )
+from ._output_frame import add_point_option, named_points
+from ._values import inputs, joint_value, split_inputs
 from ._options import BOUNDS, count
 
 NAME = "draw"

@@ -15,19 +15,9 @@ from ..present.progress import EVERY, Progress
 from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
 from ..analysis.motion.sweep import sweep_inputs
-from ._common import (
-    add_mode_option,
-    configuration,
-    joint_assignments,
-    joint_value,
-    moved_not_set,
-    named_points,
-    names_list,
-    near_values,
-    rate_items,
-    value_kind,
-    with_mode,
-)
+from ._configuration import add_mode_option, configuration, moved_not_set, near_values, with_mode
+from ._output_frame import named_points
+from ._values import joint_assignments, joint_value, names_list, rate_items, value_kind
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

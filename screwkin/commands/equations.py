@@ -22,7 +22,8 @@ from ..present.equations import (
 )
 from ..present.report import position_dict, position_text, to_jsonable
 from ..units import UNITS, parse_typed_assignments
-from ._common import add_configuration_options, configuration, input_solver, split_inputs, with_mode
+from ._configuration import add_configuration_options, configuration, input_solver, with_mode
+from ._values import split_inputs
 
 NAME = "equations"
 NEEDS_MECHANISM = True

@@ -12,7 +12,8 @@ from ..files.mjcf_rows import redundant_rows
 from ..model.placed import check_closed, placed
 from ..present.report import to_jsonable
 from ..present.outfile import write_output
-from ._common import add_configuration_options, configuration, emit, with_mode
+from ._common import emit
+from ._configuration import add_configuration_options, configuration, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 

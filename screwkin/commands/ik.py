@@ -16,7 +16,7 @@ from ..present.report import (
     to_jsonable,
 )
 from ..units import parse_value
-from ._common import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
+from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

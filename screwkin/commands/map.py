@@ -18,15 +18,9 @@ from ..present.report import (
     map_dict,
     to_jsonable,
 )
-from ._common import (
-    add_mode_option,
-    configuration,
-    joint_assignments,
-    output_frame,
-    parse_range,
-    typed_unit,
-    with_mode,
-)
+from ._configuration import add_mode_option, configuration, with_mode
+from ._output_frame import output_frame
+from ._values import joint_assignments, parse_range, typed_unit
 from ._options import BOUNDS
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

@@ -5,7 +5,8 @@ from __future__ import annotations
 from ..analysis.mobility import analyze_mobility
 from ..errors import UsageError
 from ..present.report import mobility_dict, mobility_text, to_jsonable
-from ._common import add_configuration_options, configuration, emit, with_mode
+from ._common import emit
+from ._configuration import add_configuration_options, configuration, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 

@@ -56,21 +56,9 @@ from ..present.view import (
     show,
 )
 from ..units import in_unit, parse_typed_assignments, unit_kind
-from ._common import (
-    add_configuration_options,
-    add_point_option,
-    check_rate_names,
-    input_solver,
-    joint_assignments,
-    link_rates,
-    named_points,
-    mode_line,
-    rate_items,
-    near_values,
-    rate_units,
-    split_inputs,
-    value_kind,
-)
+from ._configuration import add_configuration_options, input_solver, mode_line, near_values
+from ._output_frame import add_point_option, named_points
+from ._values import check_rate_names, joint_assignments, link_rates, rate_items, rate_units, split_inputs, value_kind
 from ._options import check_writable, count, screwkin_version
 from .draw import _design, _kind_text, _wrapped
 from .equations import _typed, differing, start_estimates

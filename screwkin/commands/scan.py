@@ -12,7 +12,7 @@ from ..present.report import (
     scan_dict,
     to_jsonable,
 )
-from ._common import output_frame
+from ._output_frame import output_frame
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

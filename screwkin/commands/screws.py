@@ -13,11 +13,7 @@ from ..present.report import (
     screws_text,
     to_jsonable,
 )
-from ._common import (
-    add_configuration_options,
-    configuration,
-    with_mode,
-)
+from ._configuration import add_configuration_options, configuration, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 

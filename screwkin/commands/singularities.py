@@ -17,16 +17,9 @@ from ..present.report import (
     to_jsonable,
 )
 from ..present.screws import gram_symbolic_dict, gram_symbolic_text
-from ._common import (
-    add_configuration_options,
-    add_tool_option,
-    configuration,
-    inputs,
-    output_frame,
-    output_frame_dict,
-    output_frame_line,
-    with_mode,
-)
+from ._configuration import add_configuration_options, configuration, with_mode
+from ._output_frame import add_tool_option, output_frame, output_frame_dict, output_frame_line
+from ._values import inputs
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 

@@ -13,20 +13,9 @@ from ..present.report import (
 )
 from ..units import parse_typed_assignments
 from . import equations as equations_command
-from ._common import (
-    add_angle_option,
-    add_length_option,
-    add_point_option,
-    check_rate_names,
-    input_solver,
-    joint_assignments,
-    link_rates,
-    named_points,
-    rate_items,
-    near_values,
-    rate_units,
-    split_inputs,
-)
+from ._configuration import add_angle_option, add_length_option, input_solver, near_values
+from ._output_frame import add_point_option, named_points
+from ._values import check_rate_names, joint_assignments, link_rates, rate_items, rate_units, split_inputs
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

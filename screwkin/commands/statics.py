@@ -15,16 +15,8 @@ from ..present.report import to_jsonable
 from ..present.local import redundancy_dict, redundancy_lines
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
-from ._common import (
-    add_configuration_options,
-    add_point_option,
-    add_tool_option,
-    configuration,
-    output_frame,
-    output_frame_dict,
-    output_frame_line,
-    with_mode,
-)
+from ._configuration import add_configuration_options, configuration, with_mode
+from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 
 NAME = "statics"
 NEEDS_MECHANISM = True

@@ -18,7 +18,7 @@ from ..present.study import (
     study_text,
     write_table,
 )
-from ._common import add_mode_option
+from ._configuration import add_mode_option
 from ._options import count, seconds
 
 NAME = "study"

@@ -30,23 +30,17 @@ from ..present.report import (
     value_text,
 )
 from ..units import parse_typed_assignments, parse_typed_value, unit_kind
-from ._common import (
+from ._configuration import (
     add_angle_option,
     add_mode_option,
-    check_rate_names,
     configuration,
     input_solver,
-    joint_assignments,
-    joint_value,
     moved_not_set,
-    named_points,
-    names_list,
     near_values,
-    rate_items,
-    rate_units,
-    split_inputs,
     with_mode,
 )
+from ._output_frame import named_points
+from ._values import check_rate_names, joint_assignments, joint_value, names_list, rate_items, rate_units, split_inputs
 from ._options import BOUNDS, count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

@@ -22,18 +22,9 @@ from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player
 from ..units import in_unit
 from ..present.viewplanar import colour_links, link_colours, planar_basis
-from ._common import (
-    add_configuration_options,
-    add_point_option,
-    configuration,
-    joint_assignments,
-    joint_inputs,
-    mode_line,
-    moved_not_set,
-    named_points,
-    parse_range,
-    typed_unit,
-)
+from ._configuration import add_configuration_options, configuration, mode_line, moved_not_set
+from ._output_frame import add_point_option, named_points
+from ._values import joint_assignments, joint_inputs, parse_range, typed_unit
 from ..model.topology import open_joints
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]

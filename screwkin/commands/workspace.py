@@ -23,16 +23,8 @@ from ..present.workspace import (
     workspace_text,
 )
 from ..units import parse_length, parse_value
-from ._common import (
-    add_mode_option,
-    add_point_option,
-    add_tool_option,
-    configuration,
-    output_frame,
-    output_frame_dict,
-    output_frame_line,
-    with_mode,
-)
+from ._configuration import add_mode_option, configuration, with_mode
+from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count, seconds
 
 NAME = "workspace"
