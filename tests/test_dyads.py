@@ -295,7 +295,7 @@ def test_json_text_is_json_dumps_with_indent():
     """The sweep's JSON writer gives json.dumps(..., indent=2) character for character."""
     import json
 
-    from screwkin.present.report import json_text, to_jsonable
+    from screwkin.present.jsonout import json_text, to_jsonable
 
     mech = load("slider_crank_offset.urdf")
     res = sweep(PositionSolver(mech), "crank_joint", 0.0, 2 * np.pi, 12)

@@ -4,8 +4,8 @@ its one way to print JSON or text."""
 from __future__ import annotations
 
 import argparse
-import json
 
+from ..present.jsonout import json_of
 from ._output_frame import add_point_option
 
 __all__ = ["add_common", "add_scaled", "emit"]
@@ -41,10 +41,10 @@ def add_scaled(sp, point=True):
 
 
 def emit(args, data, text) -> int:
-    """Print ``data`` as one JSON object (--json; to_jsonable applied by the caller's data) or ``text``
-    (a string, or a callable making it, so that text-only work is skipped for --json); exit code 0."""
+    """Print ``data`` as one JSON object (--json; written by present/jsonout.json_of, the one writer) or
+    ``text`` (a string, or a callable making it, so that text-only work is skipped for --json); exit code 0."""
     if getattr(args, "json", False):
-        print(json.dumps(data() if callable(data) else data, indent=2))
+        print(json_of(data() if callable(data) else data))
     else:
         print(text() if callable(text) else text)
     return 0

@@ -5,7 +5,6 @@ the input's range (``--singular``)."""
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 
@@ -17,6 +16,7 @@ from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
 from ..model.geometry import wrap_angle
+from ..present.jsonout import json_of
 from ..present.animate import animation_format, write_animation
 from ..present.progress import EVERY, Progress
 from ..present.draw import (
@@ -29,7 +29,6 @@ from ..present.draw import (
 )
 from ..present.draw_targets import design_marks
 from ..present.local import change_point_dict, change_point_lines
-from ..present.report import to_jsonable
 from ..units import in_unit, parse_typed_value
 from ._configuration import (
     add_configuration_options,
@@ -287,7 +286,7 @@ def run(mech, args) -> int:
             report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
     if args.json:
         report["files"] = written
-        print(json.dumps(to_jsonable(report), indent=2))
+        print(json_of(report))
     elif not args.singular:
         for path in written:
             print(f"wrote {path}")
@@ -368,10 +367,10 @@ def _animate(mech, args) -> int:
                         progress=progress)
     progress.clear()
     if args.json:
-        print(json.dumps(to_jsonable({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
-                                      "input": name, "unit": res.unit, "values": values,
-                                      "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
-                                      "traces": {k: xy.tolist() for k, xy in traces.items()}}), indent=2))
+        print(json_of({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
+                       "input": name, "unit": res.unit, "values": values,
+                       "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
+                       "traces": {k: xy.tolist() for k, xy in traces.items()}}))
     else:
         print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit, linear)} "
               f"to {_typed(name, values[-1], unit, linear).split(' = ')[1]}")

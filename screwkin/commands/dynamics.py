@@ -3,16 +3,15 @@ a mechanism driven at constant input speed (inverse dynamics of the closed chain
 
 from __future__ import annotations
 
-import json
 import math
 import os
 
 from ..analysis.forces.dynamics import CS_RANGE, Load, dynamics
 from ..errors import UsageError, quote
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.progress import EVERY, Progress
-from ..present.report import to_jsonable
 from ..units import parse_typed_value, parse_value, unit_kind
 from ..analysis.motion.sweep import sweep_inputs
 from ._configuration import add_mode_option, configuration, moved_not_set, near_values, with_mode
@@ -132,7 +131,7 @@ def run(mech, args) -> int:
     if args.plot:
         dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, dynamics_dict(res))), indent=2))
+        print(json_of(with_mode(args, dynamics_dict(res))))
     else:
         print(dynamics_text(res, shown, args.speed))
     return 0

@@ -4,7 +4,6 @@ equations from a person's estimates, iteration by iteration."""
 
 from __future__ import annotations
 
-import json
 import sys
 
 import numpy as np
@@ -12,6 +11,7 @@ import numpy as np
 from ..analysis.course.equations import VectorLoops, equations, newton
 from ..errors import AssemblyError, UsageError
 from ..model.geometry import wrap_angle
+from ..present.jsonout import json_of
 from ..present.equations import (
     Units,
     equations_dict,
@@ -20,7 +20,7 @@ from ..present.equations import (
     newton_dict,
     newton_text,
 )
-from ..present.report import position_dict, position_text, to_jsonable
+from ..present.report import position_dict, position_text
 from ..units import UNITS, parse_typed_assignments
 from ._configuration import add_configuration_options, configuration, input_solver, with_mode
 from ._values import split_inputs
@@ -58,7 +58,7 @@ def run(mech, args) -> int:
     q = configuration(mech, args)
     res = equations(mech, q, names, output=args.output, links=list(held))
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
+        print(json_of(with_mode(args, equations_dict(res))))
     else:
         print(equations_text(res))
     return 0
@@ -187,7 +187,7 @@ def solve_from_start(mech, args, values, held=None) -> int:
     trace_wanted = args.trace or args.iterations is not None
     if args.iterations is not None or not res.closes:
         if args.json:
-            print(json.dumps(to_jsonable({"file": mech.path, **newton_dict(res)}), indent=2))
+            print(json_of({"file": mech.path, **newton_dict(res)}))
         else:
             print(newton_text(res, loops.symbol_info, show, mech.path))
         if args.iterations is None:  # asked to converge and it did not: an error, not a result
@@ -217,7 +217,7 @@ def solve_from_start(mech, args, values, held=None) -> int:
         d["characteristic_length"] = mech.length
         d["newton"] = newton_dict(res)
         d["trace"] = d["newton"]["trace"]
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
         return 0
     if trace_wanted:
         print(newton_text(res, loops.symbol_info, show, mech.path))

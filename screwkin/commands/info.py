@@ -7,7 +7,6 @@ from ..model.joint_types import JOINT_TYPES
 from ..present.report import (
     joint_types_dict,
     joint_types_text,
-    to_jsonable,
     topology_dict,
     topology_text,
 )
@@ -43,7 +42,7 @@ def run(mech, args) -> int:
         d = topology_dict(topo)
         d.update({"file": mech.path, "actuated": mech.actuated, "cut_joints": [c.name for c in mech.cuts],
                   "coordinates": mech.nv, "assembled": note is None})
-        return to_jsonable(d)
+        return d
 
     def text():
         lines = [topology_text(topo, f"Topology of {mech.path}"), f"actuated: {', '.join(mech.actuated) or 'none declared'}"]

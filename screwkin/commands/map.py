@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -11,12 +10,12 @@ from ..analysis.singularities.maps import singularity_map
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.sweep import continuation_steps
 from ..errors import UsageError
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.plots import map_png
 from ..present.report import (
     map_csv,
     map_dict,
-    to_jsonable,
 )
 from ._configuration import add_mode_option, configuration, with_mode
 from ._output_frame import output_frame
@@ -71,8 +70,7 @@ def run(mech, args) -> int:
     if args.csv:
         write_output(args.csv, map_csv(res))
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})),
-                         indent=2))
+        print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} on the mapped assembly mode; "

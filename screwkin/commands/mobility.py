@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..analysis.mobility import analyze_mobility
 from ..errors import UsageError
-from ..present.report import mobility_dict, mobility_text, to_jsonable
+from ..present.report import mobility_dict, mobility_text
 from ._common import emit
 from ._configuration import add_configuration_options, configuration, with_mode
 
@@ -28,4 +28,4 @@ def run(mech, args) -> int:
     given = any(getattr(args, k, None) for k in ("set", "set_angle", "set_length", "near", "mode"))
     at = configuration(mech, args) if given else None
     result = analyze_mobility(mech, output=args.output, point=args.point, at=at, suggest=True)
-    return emit(args, lambda: to_jsonable(with_mode(args, mobility_dict(result))), lambda: mobility_text(result))
+    return emit(args, lambda: with_mode(args, mobility_dict(result)), lambda: mobility_text(result))

@@ -10,7 +10,6 @@ instead, and the rest is still written."""
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import tempfile
@@ -25,6 +24,7 @@ from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import OutputError, ScrewkinError, UsageError
+from ..present.jsonout import json_of
 from ..present.document import (
     Document,
     Figure,
@@ -269,8 +269,8 @@ def run(mech, args) -> int:
             raise
         written.append(args.md)
     if args.json:
-        print(json.dumps({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],
-                          "omitted": notes}, indent=2))
+        print(json_of({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],
+                       "omitted": notes}))
     else:
         for path in written:
             print(f"wrote {path}")

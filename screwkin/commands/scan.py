@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import json
 import time
 
 from ..analysis.singularities.scan import scan
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.report import (
     scan_csv,
     scan_dict,
-    to_jsonable,
 )
 from ._output_frame import output_frame
 from ._options import count
@@ -43,7 +42,7 @@ def run(mech, args) -> int:
         write_output(args.csv, scan_csv(res))
     d = scan_dict(res)
     if args.json:
-        print(json.dumps(to_jsonable({"file": mech.path, **d, "seconds": elapsed}), indent=2))
+        print(json_of({"file": mech.path, **d, "seconds": elapsed}))
         return 0
     what = (("smallest / largest singular value of the output origin's velocity Jacobian (a point)"
              if res.point else "smallest / largest singular value of the output Jacobian (v / L, w)")

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import json
 
 from ..errors import UsageError
+from ..present.jsonout import json_of
 from ..present.report import (
     position_dict,
     position_text,
-    to_jsonable,
     trace_text,
 )
 from ..units import parse_typed_assignments
@@ -72,7 +71,7 @@ def run(mech, args) -> int:
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
         return 0
     if args.trace:
         names = [mech.coordinate_names[k] for k in solver.passive]

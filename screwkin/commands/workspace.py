@@ -3,7 +3,6 @@ with any), the part free of singularities, and the conditioning over it."""
 
 from __future__ import annotations
 
-import json
 import os
 import tempfile
 
@@ -12,8 +11,8 @@ import pinocchio as pin
 
 from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
 from ..errors import UsageError, quote
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
-from ..present.report import to_jsonable
 from ..present.view import ViewerServer, build_scene, screenshot, show
 from ..present.workspace import (
     workspace_cloud,
@@ -146,7 +145,7 @@ def run(mech, args) -> int:
         d["wrote"] = wrote
         if frame is not None:
             d["output_frame"] = frame
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
     else:
         if frame is not None:
             print(output_frame_line(frame, bool(args.points)))

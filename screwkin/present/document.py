@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import base64
 import io
-import json
 import re
 from dataclasses import dataclass, field
 from html import escape
@@ -37,8 +36,8 @@ from .report import (
     screws_text,
     slide_note,
     solution_rows,
-    to_jsonable,
 )
+from .jsonout import json_of
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",
@@ -317,7 +316,7 @@ def html(doc: Document) -> str:
         parts += [_html_block(b) for b in s.blocks]
         parts.append("</section>")
     # < > & as JSON escapes: no name can close the script element or open a comment in it
-    data = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True)
+    data = (json_of(doc.data, indent=1, sort_keys=True)
             .replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026"))
     parts.append(f'<script type="application/json" id="screwkin-data">{data}</script>')
     parts.append("</body></html>")
@@ -369,6 +368,6 @@ def markdown(doc: Document, folder: str) -> tuple:
                 lines.append("")
                 lines.append(f"*{_md_cell(b.caption)}*")
             lines.append("")
-    files["data.json"] = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True) + "\n").encode()
+    files["data.json"] = (json_of(doc.data, indent=1, sort_keys=True) + "\n").encode()
     lines.append(f"The results as JSON: [{folder}/data.json]({folder}/data.json)")
     return "\n".join(lines) + "\n", files

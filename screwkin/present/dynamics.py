@@ -8,7 +8,6 @@ import numpy as np
 from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
 from ..units import in_unit
 from .plots import pyplot
-from .jsonout import nan_to_none
 from .report import sweep_rows
 from .tables import column_text, csv_text, table
 from .outfile import write_figure
@@ -29,9 +28,9 @@ def _input_scale(r: DynamicsResult, shown: str | None):
 
 
 def _list(a):
-    """A flat list of numbers, None where the analysis leaves a value undetermined (NaN: an effort
-    of redundant actuation) -- present.jsonout.nan_to_none on the flattened array."""
-    return nan_to_none(np.asarray(a, float).ravel())
+    """A flat list of numbers, NaN where the analysis leaves a value undetermined (an effort of
+    redundant actuation: null in the JSON, by present/jsonout.py's rule)."""
+    return np.asarray(a, float).ravel().tolist()
 
 
 def dynamics_dict(r: DynamicsResult) -> dict:

@@ -23,7 +23,7 @@ from .tables import RateUnits, column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
 from ..tolerances import DEFAULT
 from .numtext import csv_rows
-from .jsonout import json_text, nan_to_none, to_jsonable  # noqa: F401 - json_text exported here as before
+from .jsonout import to_jsonable
 from .mobility import (  # noqa: F401 - exported here as before
     JOINT_COLUMNS,
     count_rows,
@@ -37,8 +37,8 @@ from .mobility import (  # noqa: F401 - exported here as before
 
 __all__ = ["loops_dict", "loops_text", "to_dict", "mobility_dict", "mobility_text", "topology_dict", "topology_text", "position_dict",
            "position_text", "singularity_dict", "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
-           "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "to_jsonable", "count_rows",
-           "screw_theory_rows", "joint_rows", "nan_to_none", "slide_note"]
+           "scan_dict", "scan_csv", "map_csv", "screws_dict", "screws_text", "table", "count_rows",
+           "screw_theory_rows", "joint_rows", "slide_note"]
 
 
 def position_dict(res) -> dict:
@@ -494,7 +494,7 @@ def map_dict(res: SingularityMap) -> dict:
     reached = res.reached if res.reached is not None else np.isfinite(res.log_sigma)
     seams = res.seams.tolist() if res.seams is not None else []
     return {"x": res.x_name, "y": res.y_name, "xs": res.xs, "ys": res.ys,
-            "log10_sigma_min": nan_to_none(res.log_sigma), "kind": res.kind, "reached": reached,
+            "log10_sigma_min": res.log_sigma, "kind": res.kind, "reached": reached,
             "off_branch": int(reached.size - reached.sum()), "seams": seams, "notes": list(res.notes)}
 
 
@@ -510,8 +510,9 @@ _DICTS = {MobilityResult: mobility_dict, PositionResult: position_dict, Singular
 
 
 def to_dict(result) -> dict:
-    """What ``--json`` prints for a result of screwkin's analyses, as plain Python (numbers,
-    strings, lists, dictionaries; None for numbers that are not finite)."""
+    """What ``--json`` prints for a result of screwkin's analyses, as plain Python (numbers, strings,
+    lists, dictionaries) by the one rule of present/jsonout.py: an infinite number as "inf" or "-inf",
+    a value that does not exist (NaN) as None."""
     for cls, fn in _DICTS.items():
         if isinstance(result, cls):
             return to_jsonable(fn(result))

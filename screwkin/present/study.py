@@ -24,7 +24,7 @@ from ..files.study import WORKSPACE_METRICS
 from ..units import in_unit
 from .plots import pyplot
 from .progress import Progress  # noqa: F401  (the study's progress bar: present/progress.py)
-from .report import to_jsonable
+from .jsonout import to_jsonable
 from .tables import csv_text
 from .outfile import write_figure, write_output
 
@@ -73,7 +73,7 @@ def _cell(v, factor):
         return int(v)
     if isinstance(v, (float, np.floating)):
         v = float(v) * factor if factor != 1.0 else float(v)
-        return v if math.isfinite(v) else None
+        return None if math.isnan(v) else v  # no value: an empty cell (an infinite one is inf, as in JSON)
     return v
 
 

@@ -18,7 +18,8 @@ import numpy as np
 from ..analysis.design.synthesis.designs import ChainsResult, Check, FunctionResult, MotionResult, PathResult
 from ..analysis.design.synthesis.chains import guides_of
 from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local, wrap
-from .report import table, to_jsonable
+from .jsonout import to_jsonable
+from .report import table
 from .tables import shown
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]

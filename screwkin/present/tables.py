@@ -112,8 +112,11 @@ _FORMULA = ("=", "+", "-", "@", "\t", "\r")
 
 
 def csv_cell(value):
-    """A cell for a CSV written from untrusted names: numbers as they are; a text that a spreadsheet
-    would run as a formula (=, +, -, @, tab, CR first) gets a leading apostrophe."""
+    """A cell for a CSV written from untrusted names: numbers as they are, but a value that does not
+    exist (NaN: an effort redundant actuation leaves undetermined) empty, as a missing one (None); a
+    text that a spreadsheet would run as a formula (=, +, -, @, tab, CR first) gets a leading apostrophe."""
+    if isinstance(value, float) and value != value:
+        return ""
     if isinstance(value, str) and value.startswith(_FORMULA):
         try:
             float(value)
