@@ -1,23 +1,25 @@
 """Joint values as people type them (--set, --set-length, --set-angle, --rate, --accel, NAME=A:B:N):
-each checked against its joint's kind (an angle or a length) and the kinds of unit it takes."""
+each parsed once into a units.Quantity (SI value, kind, the unit typed) and checked against its joint's
+kind (an angle or a length) and the kinds of unit it takes; the Quantity goes on to the table that
+answers in the unit typed."""
 
 from __future__ import annotations
 
 import argparse
 import math
 import sys
+from dataclasses import replace
 
 import numpy as np
 
 from ..analysis.motion.planar import LinkAngles
 from ..errors import UsageError, quote, shorten
 from ..model.state import value_for_leg_length
-from ..present.tables import RateUnits
-from ..units import MAGNITUDES, check_magnitude, parse_typed_assignments, parse_typed_value, unit_kind
+from ..units import MAGNITUDES, Quantity, check_magnitude, parse_quantity, parse_typed_assignments
 from ._options import count
 
-__all__ = ["value_kind", "MAX_ANGLE", "joint_assignments", "joint_value", "inputs", "split_inputs", "joint_inputs",
-           "link_rates", "names_list", "typed_unit", "rate_units", "parse_range", "rate_items", "check_rate_names"]
+__all__ = ["value_kind", "MAX_ANGLE", "joint_quantities", "joint_assignments", "joint_value", "inputs", "split_inputs",
+           "joint_inputs", "link_rates", "names_list", "parse_range", "rate_items", "check_rate_names"]
 
 
 def value_kind(mech, joint: str):
@@ -45,12 +47,14 @@ _MAGNITUDE_KIND = {("angle", 0): "angle", ("angle", 1): "angular rate", ("angle"
                    ("length", 0): "length", ("length", 1): "linear rate", ("length", 2): "linear acceleration"}
 
 
-def _checked(mech, name, value, unit, option, text, order=0, links=()):
+def _checked(mech, name, typed: Quantity, option, text, order=0, links=()) -> Quantity:
+    """``typed`` (parsed without a kind: its unit's) as the value (order 0), rate (1) or acceleration (2)
+    of joint ``name``: the Quantity of that kind, or a usage error."""
+    value, unit, found = typed.value, typed.unit, typed.kind
     kind = value_kind(mech, name)
     what = f"{'an' if kind == 'angle' else 'a'} {kind} joint"
     if kind is None and name in links:
         kind, what = "angle", "a link given by its angle"
-    found = unit_kind(unit)
     if kind and found and found not in _KINDS[kind, order]:
         raise UsageError(f"{option} {text}: {quote(name)} is {what}, "
                          f"{unit} is a unit of {found} (its {_WHAT[order]} takes {' or '.join(_KINDS[kind, order])})")
@@ -62,34 +66,40 @@ def _checked(mech, name, value, unit, option, text, order=0, links=()):
     if kind == "angle" and not unit and not order and abs(value) > 2 * math.pi:
         print(f"warning: {option} {shorten(name, 60)}={value:g} is read as {value:g} rad = "
               f"{math.degrees(value):.6g} deg (more than a turn); write {value:g}deg for degrees", file=sys.stderr)
-    return value
+    return replace(typed, kind=_MAGNITUDE_KIND[kind, order]) if kind else typed
 
 
-def joint_assignments(mech, items, option: str, order: int = 0, links=()) -> dict:
-    """``NAME=VALUE,...`` of joints (order 0), their rates (1) or accelerations (2): SI values; a unit
-    of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error, a
-    bare angle of more than a turn is read as radians with a warning.  ``links``: names that are links
+def joint_quantities(mech, items, option: str, order: int = 0, links=()) -> dict:
+    """``NAME=VALUE,...`` of joints (order 0), their rates (1) or accelerations (2): joint -> units.Quantity
+    (the SI value, the kind -- 'angle', 'angular rate', 'linear acceleration' ... -- and the unit typed);
+    a unit of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error,
+    a bare angle of more than a turn is read as radians with a warning.  ``links``: names that are links
     given by their angle (--set-angle), checked as angles."""
     out = {}
-    for name, value, unit in parse_typed_assignments(items, option):
+    for name, typed in parse_typed_assignments(items, option):
         t = mech.input_alias(name)
         if t is None:
-            out[name] = _checked(mech, name, value, unit, option, f"{quote(name, 60)}=...{unit}", order, links)
+            out[name] = _checked(mech, name, typed, option, f"{quote(name, 60)}=...{typed.unit}", order, links)
             continue
         # an input the file names by a tendon or a coupled joint: scale * joint + offset (files.description.Transmission)
-        v = _checked(mech, t.joint, value, unit, option, f"{quote(name, 60)}=...{unit}", order, links)
+        v = _checked(mech, t.joint, typed, option, f"{quote(name, 60)}=...{typed.unit}", order, links)
         if t.joint in out:
             raise UsageError(f"{option}: joint {quote(t.joint)} is given twice ({quote(name)} moves it)")
-        out[t.joint] = (v - (t.offset if order == 0 else 0.0)) / t.scale
-        print(f"note: {option} {shorten(name, 60)} is {t.joint} = {out[t.joint]:.9g} ({t.text()})", file=sys.stderr)
+        out[t.joint] = replace(v, value=(v.value - (t.offset if order == 0 else 0.0)) / t.scale)
+        print(f"note: {option} {shorten(name, 60)} is {t.joint} = {out[t.joint].value:.9g} ({t.text()})",
+              file=sys.stderr)
     return out
 
 
-def joint_value(mech, joint: str, text: str, option: str, order: int = 0) -> float:
+def joint_assignments(mech, items, option: str, order: int = 0, links=()) -> dict:
+    """joint_quantities' SI values: joint -> value [rad, m, rad/s ...]."""
+    return {name: q.value for name, q in joint_quantities(mech, items, option, order, links).items()}
+
+
+def joint_value(mech, joint: str, text: str, option: str, order: int = 0) -> Quantity:
     """One value (rate: order 1) of ``joint`` typed after ``option`` (``--from -90deg``), checked like
-    joint_assignments."""
-    value, unit = parse_typed_value(text)
-    return _checked(mech, joint, value, unit, option, quote(text, 60), order)
+    joint_quantities: its units.Quantity."""
+    return _checked(mech, joint, parse_quantity(text), option, quote(text, 60), order)
 
 
 def inputs(mech, args) -> dict:
@@ -105,18 +115,20 @@ def split_inputs(mech, args) -> tuple:
     other moving link of a planar mechanism as ``held``: link -> angle [rad], held by one more loop
     equation (analysis.motion.link_inputs; input_solver builds the solver)."""
     values = joint_assignments(mech, getattr(args, "set", None), "--set")
-    for name, value, unit in parse_typed_assignments(getattr(args, "set_length", None), "--set-length"):
-        if unit_kind(unit) not in (None, "length"):
-            raise UsageError(f"--set-length {quote(name)}: {unit} is a unit of {unit_kind(unit)}, a leg length is a length")
+    for name, typed in parse_typed_assignments(getattr(args, "set_length", None), "--set-length"):
+        if typed.kind not in (None, "length"):
+            raise UsageError(f"--set-length {quote(name)}: {typed.unit} is a unit of {typed.kind}, a leg length is a length")
         if name in values:
             raise UsageError(f"joint {quote(name)} is given twice (--set and --set-length)")
-        values[name] = value_for_leg_length(mech, name, value)
+        values[name] = value_for_leg_length(mech, name, typed.value)
     angles, held, pivots = {}, {}, {}
-    for name, value, unit in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
-        if unit_kind(unit) not in (None, "angle"):
-            raise UsageError(f"--set-angle {quote(name)}: {unit} is a unit of {unit_kind(unit)}, --set-angle takes an angle")
+    for name, typed in parse_typed_assignments(getattr(args, "set_angle", None), "--set-angle"):
+        if typed.kind not in (None, "angle"):
+            raise UsageError(f"--set-angle {quote(name)}: {typed.unit} is a unit of {typed.kind}, --set-angle takes an "
+                             "angle")
         # a bare angle over a turn warned of, one beyond MAX_ANGLE refused, as a joint's
-        angles[name] = _checked(mech, name, value, unit, "--set-angle", f"{quote(name, 60)}=...{unit}", links=(name,))
+        angles[name] = _checked(mech, name, typed, "--set-angle", f"{quote(name, 60)}=...{typed.unit}",
+                                links=(name,)).value
     if angles:
         q = mech.generic_configurations()[1][0]
         link_angles = LinkAngles(mech, mech.topology(q))
@@ -162,27 +174,11 @@ def names_list(text):
     return [n.strip() for n in text.split(",") if n.strip()] if text else None
 
 
-def typed_unit(mech, name: str, text: str) -> str:
-    """The unit to answer a ``NAME=A:B:N`` range in: the one typed with A (``crank=0deg:360deg:61`` ->
-    'deg'), else with B, else the SI unit of the joint's kind (rad or m)."""
-    for part in text.partition("=")[2].split(":")[:2]:
-        unit = parse_typed_value(part)[1]
-        if unit:
-            return unit
-    return "m" if value_kind(mech, name) == "length" else "rad"
-
-
-def rate_units(args) -> RateUnits:
-    """The units solve's and report's tables write rates and accelerations in: those typed with --rate
-    and --accel (``10rpm``: omega in rpm; ``90deg``: deg/s and deg/s^2; ``5mm/s``: mm/s), SI otherwise."""
-    return RateUnits.typed([u for _, _, u in parse_typed_assignments(getattr(args, "rate", None), "--rate")],
-                           [u for _, _, u in parse_typed_assignments(getattr(args, "accel", None), "--accel")])
-
-
 def parse_range(text, option, mech):
-    """``NAME=A:B:N`` -> (name, N values from A to B), N bounded (commands/_options.BOUNDS["grid"]), A and B
-    checked as the joint's values (a unit of the other kind, ``crank=0:30mm:5``, is a usage error, as
-    with --set)."""
+    """``NAME=A:B:N`` -> (name, N values from A to B, the unit to answer in), N bounded
+    (commands/_options.BOUNDS["grid"]), A and B checked as the joint's values (a unit of the other kind,
+    ``crank=0:30mm:5``, is a usage error, as with --set); the unit the one typed with A
+    (``crank=0deg:360deg:61`` -> 'deg'), else with B, else the SI unit of the joint's kind (rad or m)."""
     name, sep, rest = text.partition("=")
     parts = rest.split(":")
     if not sep or len(parts) != 3:
@@ -193,7 +189,7 @@ def parse_range(text, option, mech):
         raise UsageError(f"{option}: N {exc}") from None
     name = name.strip()
     a, b = (joint_value(mech, name, p, f"{option} {quote(name, 60)}") for p in parts[:2])
-    return name, np.linspace(a, b, n)
+    return name, np.linspace(a.value, b.value, n), (a if a.unit else b).shown_unit or "rad"
 
 
 def rate_items(items, inputs, option: str) -> list:

@@ -29,7 +29,7 @@ from ..present.draw import (
 )
 from ..present.draw_targets import design_marks
 from ..present.local import change_point_dict, change_point_lines
-from ..units import in_unit, parse_typed_value
+from ..units import unit_text
 from ._configuration import (
     add_configuration_options,
     configuration,
@@ -300,10 +300,9 @@ def _wrapped(value, unit):
     return value if unit == "m" else wrap_angle(value)
 
 
-def _typed(name, value, unit, linear) -> str:
-    """'crank = 30 deg' in the unit the person typed (rad or m when bare)."""
-    unit = unit or ("m" if linear else "rad")
-    return f"{name} = {in_unit(value, unit):.5g} {unit}"
+def _typed(name, value, unit) -> str:
+    """'crank = 30 deg' in the unit the person typed (``unit``: rad or m when bare)."""
+    return f"{name} = {unit_text(value, unit, 5)}"
 
 
 def _animate(mech, args) -> int:
@@ -325,10 +324,8 @@ def _animate(mech, args) -> int:
     name = args.input or (mech.actuated[0] if mech.actuated else None)  # (a --set value is held, never moved)
     if name is None:
         raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")
-    unit = parse_typed_value(args.start)[1]
-    start = joint_value(mech, name, args.start, "--from")
-    stop = joint_value(mech, name, args.stop, "--to")
-    unit = unit or parse_typed_value(args.stop)[1]
+    typed = [joint_value(mech, name, args.start, "--from"), joint_value(mech, name, args.stop, "--to")]
+    start, stop = (q.value for q in typed)
     moved_not_set(given, name, "--animate moves it from --from to --to")
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
@@ -337,14 +334,14 @@ def _animate(mech, args) -> int:
     # the mode followed (--mode K, --near), chosen and said as sweep's
     res = sweep(solver, name, start, stop, steps, fixed=fixed,
                 q_start=lambda: configuration(mech, args, moved={name: start}, inputs=input_names))
-    linear = res.unit == "m"
+    unit = next((q.shown_unit for q in typed if q.unit), None) or ("m" if res.unit == "m" else "rad")
     qs, values = list(res.q), list(res.values)
     limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= mech.tolerances.equal), None)
     if limit is not None:  # the last frame: the mechanism at the limit position itself
         qs.append(limit.q)
         values.append(limit.input)
     if res.stopped_at is not None and not args.json:
-        print(f"{name} stopped at {_typed(name, res.stopped_at, unit, linear).split(' = ')[1]} ({res.stop_reason}): "
+        print(f"{name} stopped at {_typed(name, res.stopped_at, unit).split(' = ')[1]} ({res.stop_reason}): "
               f"{len(qs)} frames, not the {steps + 1} asked")
     if res.skipped and not args.json:
         print(f"{len(res.skipped)} input value(s) on the way could not be solved: no frame for them")
@@ -358,7 +355,7 @@ def _animate(mech, args) -> int:
         for p in points:
             P = np.asarray(motion.points[p.name]["position"])
             traces[p.name] = np.stack([P @ e1, P @ e2], axis=1)
-    titles = [_title(mech, _typed(name, x, unit, linear)) for x in values]
+    titles = [_title(mech, _typed(name, x, unit)) for x in values]
     if limit is not None:
         titles[-1] += " (limit position)"
     space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
@@ -372,6 +369,6 @@ def _animate(mech, args) -> int:
                        "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
                        "traces": {k: xy.tolist() for k, xy in traces.items()}}))
     else:
-        print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit, linear)} "
-              f"to {_typed(name, values[-1], unit, linear).split(' = ')[1]}")
+        print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit)} "
+              f"to {_typed(name, values[-1], unit).split(' = ')[1]}")
     return 0

@@ -12,7 +12,7 @@ from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.progress import EVERY, Progress
-from ..units import parse_typed_value, parse_value, unit_kind
+from ..units import parse_value
 from ..analysis.motion.sweep import sweep_inputs
 from ._configuration import add_mode_option, configuration, moved_not_set, near_values, with_mode
 from ._output_frame import named_points
@@ -107,15 +107,16 @@ def run(mech, args) -> int:
     name, _, args.speed = rate_items(args.speed, [args.input], "--speed")[0].rpartition("=")
     if name.strip() != args.input:
         raise UsageError(f"--speed {quote(name.strip(), 60)}=...: dynamics drives --input {quote(args.input, 60)} only")
-    speed = joint_value(mech, args.input, args.speed, "--speed", order=1)
-    typed = [t for t in (args.start, args.stop) if t is not None]
+    speed = joint_value(mech, args.input, args.speed, "--speed", order=1).value
+    typed = [joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
+                                                                              (args.stop, "--to")) if text is not None]
     if kind == "length" and len(typed) < 2:
         raise UsageError(f"--input {quote(args.input)} slides: give its range with --from and --to")
-    start = 0.0 if args.start is None else joint_value(mech, args.input, args.start, "--from")
-    stop = start + 2 * math.pi if args.stop is None else joint_value(mech, args.input, args.stop, "--to")
-    # the input shown in the unit typed (the first --from/--to with a unit of its kind; SI when typed bare),
-    # degrees when no range is typed
-    units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
+    start = 0.0 if args.start is None else typed[0].value
+    stop = start + 2 * math.pi if args.stop is None else typed[-1].value
+    # the input shown in the unit typed (the first --from/--to with a unit; SI when typed bare), degrees when
+    # no range is typed
+    units = [q.shown_unit for q in typed if q.unit]
     shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
     points = named_points(mech, args)
     loads, cs, gravity = _loads(mech, args.load, points), _cs(args.cs), _gravity(args.gravity)

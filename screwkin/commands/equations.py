@@ -21,7 +21,7 @@ from ..present.equations import (
     newton_text,
 )
 from ..present.report import position_dict, position_text
-from ..units import UNITS, parse_typed_assignments
+from ..units import parse_typed_assignments
 from ._configuration import add_configuration_options, configuration, input_solver, with_mode
 from ._values import split_inputs
 
@@ -29,7 +29,6 @@ NAME = "equations"
 NEEDS_MECHANISM = True
 
 _ANGLE_UNITS = {"deg", "degree", "degrees", "°"}
-_LENGTH_UNITS = {"m", "cm", "mm", "um", "µm", "μm", "in", "inch", "inches", "ft", "foot", "feet"}
 
 
 def add_parser(sub, common, scaled):
@@ -66,7 +65,7 @@ def run(mech, args) -> int:
 
 # ------------------------------------------------------------------ solve --start
 def _typed(items, option):
-    """[(name, value in SI, unit typed)] from NAME=VALUE items."""
+    """[(name, units.Quantity)] from NAME=VALUE items."""
     return parse_typed_assignments(items, option)
 
 
@@ -91,7 +90,7 @@ def _needed_joints(loops, name):
 def start_estimates(mech, loops, solver, q_in, values, typed):
     """The estimates of every unknown of the loop equations from ``--start`` items (``_typed``):
     symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
-    returns (symbol -> estimate, symbol -> unit typed)."""
+    returns (symbol -> estimate, symbol -> the units.Quantity typed)."""
     by_link = {}
     for n in loops.variables:
         info = loops.symbol_info[n]
@@ -99,7 +98,8 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             by_link[info.link] = n
     symbols, joints, units = {}, {}, {}
     joint_names = set(mech.coordinate_names)
-    for name, v, unit in typed:
+    for name, typed_value in typed:
+        v = typed_value.value
         if name in loops.input_joints or name in values:
             raise UsageError(f"{mech.path}: '{name}' is an input: give its value with --set")
         if name in loops.unknowns:
@@ -130,7 +130,7 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             valid = ", ".join(list(loops.unknowns) + [lk for lk, n in by_link.items() if n in loops.unknowns])
             raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{name[:80]}' "
                              f"(unknowns of the loop equations: {valid}; or passive joint names)")
-        units[name] = unit
+        units[name] = typed_value
     start = loops.values(solver.set_inputs(q_in, joints)) if joints else {}
     covered = set(symbols)
     if joints:
@@ -179,10 +179,10 @@ def solve_from_start(mech, args, values, held=None) -> int:
     given = {n: held.get(loops.input_joints[n][0], input_values[n]) for n in loops.input_syms}
     res = newton(loops, given, start, args.iterations)
 
-    typed_units = [u.lower() for _, _, u in typed + _typed(args.set, "--set") + _typed(args.set_angle, "--set-angle")]
-    degrees = any(u in _ANGLE_UNITS for u in typed_units)
-    lengths = {n: (u, UNITS[u]) for n, u in units.items()
-               if u and u in _LENGTH_UNITS and loops.symbol_info[n].kind != "angle"}
+    # (--set and --set-angle read again: solve's split_inputs keeps their values, not their units)
+    degrees = any(q.unit in _ANGLE_UNITS
+                  for _, q in typed + _typed(args.set, "--set") + _typed(args.set_angle, "--set-angle"))
+    lengths = {n: q.shown_unit for n, q in units.items() if q.kind == "length" and loops.symbol_info[n].kind != "angle"}
     show = Units(degrees, lengths)
     trace_wanted = args.trace or args.iterations is not None
     if args.iterations is not None or not res.closes:

@@ -19,7 +19,7 @@ from ..present.report import (
 )
 from ._configuration import add_mode_option, configuration, with_mode
 from ._output_frame import output_frame
-from ._values import joint_assignments, parse_range, typed_unit
+from ._values import joint_assignments, parse_range
 from ._options import BOUNDS
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -42,8 +42,8 @@ def add_parser(sub, common, scaled):
 
 
 def run(mech, args) -> int:
-    xn, xs = parse_range(args.x, "--x", mech)
-    yn, ys = parse_range(args.y, "--y", mech)
+    xn, xs, x_unit = parse_range(args.x, "--x", mech)
+    yn, ys, y_unit = parse_range(args.y, "--y", mech)
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")
@@ -64,9 +64,8 @@ def run(mech, args) -> int:
     mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
     if args.png:
-        units = (typed_unit(mech, xn, args.x), typed_unit(mech, yn, args.y))
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
-        map_png(res, args.png, *units, title=title)
+        map_png(res, args.png, x_unit, y_unit, title=title)
     if args.csv:
         write_output(args.csv, map_csv(res))
     if args.json:

@@ -10,11 +10,12 @@ from ..present.report import (
     position_text,
     trace_text,
 )
+from ..present.tables import RateUnits
 from ..units import parse_typed_assignments
 from . import equations as equations_command
 from ._configuration import add_angle_option, add_length_option, input_solver, near_values
 from ._output_frame import add_point_option, named_points
-from ._values import check_rate_names, joint_assignments, link_rates, rate_items, rate_units, split_inputs
+from ._values import check_rate_names, joint_quantities, link_rates, rate_items, split_inputs
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -56,8 +57,10 @@ def run(mech, args) -> int:
         raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
     near = near_values(mech, args)
     args.rate, args.accel = (rate_items(getattr(args, o), [*values, *held], f"--{o}") or None for o in ("rate", "accel"))
-    rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
-    accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None
+    typed = {o: joint_quantities(mech, getattr(args, o), f"--{o}", order=k, links=(*held, *pivots))
+             for k, o in ((1, "rate"), (2, "accel"))}  # the tables answer in the units typed
+    rates = {n: q.value for n, q in typed["rate"].items()} if args.rate or args.accel else None
+    accels = {n: q.value for n, q in typed["accel"].items()} if args.accel else None
     rates, accels = link_rates(rates, pivots, "--rate"), link_rates(accels, pivots, "--accel")
     for given, option in ((rates, "--rate"), (accels, "--accel")):  # a link's rate goes with its --set-angle
         check_rate_names(given, [*values, *held], option)
@@ -77,6 +80,8 @@ def run(mech, args) -> int:
         names = [mech.coordinate_names[k] for k in solver.passive]
         print(trace_text(res, solver.mech.closure.row_labels(solver=True), names))
         print()
-    legs = {n: v for n, v, _ in parse_typed_assignments(args.set_length, "--set-length")} if args.set_length else None
-    print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args), leg_lengths=legs))
+    legs = {n: q.value for n, q in parse_typed_assignments(args.set_length, "--set-length")} if args.set_length \
+        else None
+    units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())
+    print(position_text(res, show_all=args.all, length=mech.length, units=units, leg_lengths=legs))
     return 0

@@ -170,7 +170,7 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     """Newton's iterations on the loop equations from the estimates ``how`` describes."""
     s = Section("newton", "Newton iterations")
     s.blocks.append(Text(how))
-    show = Units(True, {n: ("mm", 1e-3) for n in res.unknowns if symbols[n].kind != "angle"})  # deg and mm
+    show = Units(True, {n: "mm" for n in res.unknowns if symbols[n].kind != "angle"})  # deg and mm
     rows = [[st.iteration, ", ".join(f"{greek(n)} = {show.value(n, symbols[n].kind, st.before[n])}"
                                      for n in res.unknowns),
              f"{np.linalg.norm(st.residual):.3e}",

@@ -17,6 +17,7 @@ from ..analysis.screws import Screw
 from ..analysis.singularities.singular import SingularityReport
 from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
+from ..units import in_unit
 from .motion import linkage_construction_text, links_table, points_table
 from .screws import loops_dict, loops_text, screw_dict, screws_dict, screws_text
 from .tables import RateUnits, column_text, csv_text, table
@@ -136,16 +137,16 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
         rows.append(row)
         if s.rates is not None:
             linear = name not in res.angular
-            rates.append(units.of(s.rates.get(name, float("nan")), units.rate(linear)))
-            accs.append(units.of(s.accelerations.get(name, float("nan")), units.acceleration(linear)))
+            rates.append(in_unit(s.rates.get(name, float("nan")), units.rate(linear)))
+            accs.append(in_unit(s.accelerations.get(name, float("nan")), units.acceleration(linear)))
     for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
         row = [f"{name} (loop)", f"{v:.9g}"]
         row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
         rows.append(row)
         if s.rates is not None:
             linear = name not in res.angular_loop
-            rates.append(units.of(s.loop_rates[name], units.rate(linear)) if s.loop_rates else float("nan"))
-            accs.append(units.of(s.loop_accelerations[name], units.acceleration(linear))
+            rates.append(in_unit(s.loop_rates[name], units.rate(linear)) if s.loop_rates else float("nan"))
+            accs.append(in_unit(s.loop_accelerations[name], units.acceleration(linear))
                         if s.loop_accelerations else float("nan"))
     if s.rates is not None:  # round-off (a loop joint's 4e-16 rad/s) written as 0
         rows = [row + [r, a] for row, r, a in zip(rows, column_text(rates), column_text(accs))]
