@@ -20,20 +20,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import ROBOTS
+from test_ellipsoids_cli import ARM  # the planar 2R arm of the ellipsoid's closed form
 
 from screwkin.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 SLIDER = str(ROBOTS / "slider_crank_offset.urdf")
-
-ARM = """<robot name="arm2r">
-  <link name="base"/><link name="upper"/><link name="fore"/><link name="hand"/>
-  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
-    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.4 0 0"/>
-    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-  <joint name="wrist" type="fixed"><parent link="fore"/><child link="hand"/><origin xyz="0.25 0 0"/></joint>
-</robot>"""
 
 
 def _strict(text: str):
