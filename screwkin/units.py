@@ -43,7 +43,7 @@ from dataclasses import dataclass
 from .errors import UsageError, quote
 
 __all__ = ["Quantity", "parse_quantity", "parse_value", "in_unit", "unit_text", "shown_unit", "parse_length",
-           "parse_typed_assignments", "UNITS", "UNIT_TABLE", "unit_kind", "RATE_OF", "LENGTH_RANGE", "MAGNITUDES",
+           "parse_typed_assignments", "UNITS", "UNIT_TABLE", "unit_kind", "LENGTH_RANGE", "MAGNITUDES",
            "check_magnitude"]
 
 _DEG = math.pi / 180.0
@@ -197,7 +197,7 @@ def unit_text(value: float, unit: str, digits: int = 6) -> str:
 
 
 #: The kind a value's rate has (the rate of an angle is an angular rate), and an acceleration's.
-RATE_OF = {"angle": "angular rate", "length": "linear rate", "angular rate": "angular acceleration",
+_RATE_OF = {"angle": "angular rate", "length": "linear rate", "angular rate": "angular acceleration",
            "linear rate": "linear acceleration"}
 
 
@@ -218,10 +218,10 @@ def shown_unit(typed: str, kind: str | None) -> str:
     si = _SI.get(kind, "") if kind else ""
     if found is None or kind is None or found == kind:
         return _written(unit) if unit else si
-    if RATE_OF.get(found) == kind:  # deg for a rate: deg/s; rpm for an acceleration: rpm/s
+    if _RATE_OF.get(found) == kind:  # deg for a rate: deg/s; rpm for an acceleration: rpm/s
         base = _written(unit)
         made = base[:-2] + "/s^2" if base.endswith("/s") else base + "/s"
-    elif RATE_OF.get(RATE_OF.get(found)) == kind:  # deg for an acceleration: deg/s^2
+    elif _RATE_OF.get(_RATE_OF.get(found)) == kind:  # deg for an acceleration: deg/s^2
         made = unit + "/s^2"
     else:
         return si

@@ -221,8 +221,8 @@ def run(mech, args) -> int:
     if pres is not None:
         given_rates = "input rates " + _rates_text(mech, typed["rate"], rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
-        sections.append(motion_section(pres, given_rates, mech.length,
-                                       RateUnits.typed(typed["rate"].values(), typed["accel"].values()), data.get("mode", {}).get("index", 1)))
+        rate_units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())  # the units typed
+        sections.append(motion_section(pres, given_rates, mech.length, rate_units, data.get("mode", {}).get("index", 1)))
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "

@@ -25,9 +25,9 @@ def _ratio(s) -> float:
 
 
 def ellipsoids_dict(e: Ellipsoids) -> dict:
-    """JSON: each principal axis (unit vector over ``rows``) with its velocity and force
-    semi-axes (dimensionless; a force semi-axis is infinite, "inf", along a wrench that loads no input), the rank, and the
-    isotropy (smallest over largest velocity semi-axis)."""
+    """JSON: each principal axis (unit vector over ``rows``) with its velocity and force semi-axes
+    (dimensionless; a force semi-axis is infinite, "inf" in JSON, along a wrench that loads no input), the
+    rank, and the isotropy (smallest over largest velocity semi-axis)."""
     return {
         "output": e.output, "point": e.point, "inputs": list(e.inputs), "characteristic_length": e.length,
         "rows": list(e.rows), "force_rows": list(e.force_rows), "rank": e.rank,
