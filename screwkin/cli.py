@@ -20,7 +20,9 @@ import warnings
 
 import numpy as np
 
-from .commands._common import add_common, add_scaled, named_points, names_list
+from .commands._common import add_common, add_scaled
+from .commands._output_frame import named_points
+from .commands._values import names_list
 from .commands._options import check_parsed, screwkin_version
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args

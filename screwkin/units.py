@@ -21,6 +21,14 @@ Every unit has a kind (:data:`UNIT_TABLE`); where a value's kind is known (a joi
 a length, a rate) a unit of another kind is a usage error.  An angle or length given for a
 rate keeps its old meaning (``--rate crank=90deg`` is 90 deg/s).
 
+A value is parsed once, into a :class:`Quantity`: its value in SI, its kind and the unit typed,
+carried to the table that shows it.  How a value is shown is decided here and nowhere else:
+:func:`shown_unit` (the unit a value of a kind is shown in, from the unit a person typed:
+``deg`` typed for a rate shows rates in deg/s and accelerations in deg/s^2, ``rpm`` shows
+accelerations in rpm/s) and :func:`in_unit` (an SI value in a unit).  pint was considered and
+not taken: importing it and building its registry take about 0.35 s, more than the whole start-up
+of the command line (0.2 s), and it knows neither the kinds an option takes nor the refusals above.
+
 Kilometres are not accepted on purpose (no mechanism is that big: ``1km`` is
 more likely a typo than a value).  Numbers are plain decimal ASCII (``1e-3``,
 ``.5``); ``nan``, ``inf`` and ``1_000`` are refused.
@@ -30,11 +38,13 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass
 
 from .errors import UsageError, quote
 
-__all__ = ["parse_value", "in_unit", "parse_typed_value", "parse_length", "UNITS", "UNIT_TABLE",
-           "unit_kind", "LENGTH_RANGE", "MAGNITUDES", "check_magnitude"]
+__all__ = ["Quantity", "parse_quantity", "parse_value", "in_unit", "unit_text", "shown_unit", "parse_length",
+           "parse_typed_assignments", "UNITS", "UNIT_TABLE", "unit_kind", "LENGTH_RANGE", "MAGNITUDES",
+           "check_magnitude"]
 
 _DEG = math.pi / 180.0
 _TURN = 2 * math.pi
@@ -124,9 +134,29 @@ def _unit(text: str):
     return UNIT_TABLE[u][0] if u else None
 
 
-def parse_value(text: str, kind: str | None = None, option: str | None = None) -> float:
-    """A number with an optional unit suffix, in SI units.  With ``kind`` ('angle' or
-    'length'), a unit of the other kind is a usage error naming ``option``
+@dataclass(frozen=True)
+class Quantity:
+    """A value as a person typed it, parsed once: ``value`` in SI, ``kind`` what it is ('angle',
+    'length', 'angular rate', ...: the kind its place gives it, else its unit's; None for a bare
+    number of no known kind), ``unit`` the unit typed ('' when bare; 'DEG' is 'deg')."""
+
+    value: float
+    kind: str | None = None
+    unit: str = ""
+
+    @property
+    def shown_unit(self) -> str:
+        """The unit this value, and others of its kind, are shown in (:func:`shown_unit`)."""
+        return shown_unit(self.unit, self.kind)
+
+    def text(self, value: float | None = None, digits: int = 6) -> str:
+        """This value (or ``value`` [SI], of the same kind) in :attr:`shown_unit`: ``30 deg``, ``60 rpm``."""
+        return unit_text(self.value if value is None else value, self.shown_unit, digits)
+
+
+def parse_quantity(text: str, kind: str | None = None, option: str | None = None) -> Quantity:
+    """A number with an optional unit suffix: its value in SI, its kind and the unit typed.  With
+    ``kind`` ('angle', 'length', ...), a unit of another kind is a usage error naming ``option``
     (``--length 90deg`` is not 1.571 m), and a magnitude beyond MAGNITUDES[kind] another."""
     m = _NUMBER.match(text)
     if not m:
@@ -146,13 +176,56 @@ def parse_value(text: str, kind: str | None = None, option: str | None = None) -
                          f"takes {'an' if kind[0] in 'aeiou' else 'a'} {kind}")
     if kind is not None:
         check_magnitude(value, kind, f"{option} {quote(text, 40)}" if option else quote(text, 40))
-    return value
+    return Quantity(value, kind or found, _canonical(m.group(2)) if m.group(2) else "")
 
 
-def in_unit(value: float, unit: str) -> float:
-    """An SI value written in ``unit`` as people type it, parse_value's inverse (``in_unit(math.pi, "deg")``
-    is 180.0, ``in_unit(0.03, "mm")`` is 30.0)."""
-    return value / parse_value("1" + unit)
+def parse_value(text: str, kind: str | None = None, option: str | None = None) -> float:
+    """The SI value of a number with an optional unit suffix (:func:`parse_quantity`)."""
+    return parse_quantity(text, kind, option).value
+
+
+def in_unit(value, unit: str):
+    """An SI value (or an array of them) written in ``unit`` as people type it, parse_value's inverse
+    (``in_unit(math.pi, "deg")`` is 180.0, ``in_unit(0.03, "mm")`` is 30.0; SI for '')."""
+    return value / parse_value("1" + unit.replace(" ", ""))
+
+
+def unit_text(value: float, unit: str, digits: int = 6) -> str:
+    """``value`` [SI] written in ``unit``: ``unit_text(math.pi / 6, "deg")`` is '30 deg' (the bare
+    number for no unit)."""
+    return f"{in_unit(value, unit):.{digits}g} {unit}" if unit else f"{value:.{digits}g}"
+
+
+#: The kind a value's rate has (the rate of an angle is an angular rate), and an acceleration's.
+_RATE_OF = {"angle": "angular rate", "length": "linear rate", "angular rate": "angular acceleration",
+           "linear rate": "linear acceleration"}
+
+
+def _written(unit: str) -> str:
+    """A unit as the tables write it: rev/min as rpm, s2 as s^2."""
+    return "rpm" if unit == "rev/min" else unit[:-2] + "s^2" if unit.endswith("/s2") else unit
+
+
+def shown_unit(typed: str, kind: str | None) -> str:
+    """The unit a value of ``kind`` is shown in when a person typed ``typed`` for it, or for the value
+    it is the rate or acceleration of: the unit typed when it is of that kind; an angle's or a
+    length's unit made a rate or an acceleration (``deg``: deg/s, deg/s^2; ``mm``: mm/s, mm/s^2); a
+    rate's unit made an acceleration (``rpm``: rpm/s; ``deg/s``: deg/s^2); the SI unit of the kind
+    otherwise (``turn`` typed for a rate: rad/s, there being no turn/s), '' for a bare number of no
+    known kind."""
+    unit = _canonical(typed) if typed else None
+    found = UNIT_TABLE[unit][1] if unit else None
+    si = _SI.get(kind, "") if kind else ""
+    if found is None or kind is None or found == kind:
+        return _written(unit) if unit else si
+    if _RATE_OF.get(found) == kind:  # deg for a rate: deg/s; rpm for an acceleration: rpm/s
+        base = _written(unit)
+        made = base[:-2] + "/s^2" if base.endswith("/s") else base + "/s"
+    elif _RATE_OF.get(_RATE_OF.get(found)) == kind:  # deg for an acceleration: deg/s^2
+        made = unit + "/s^2"
+    else:
+        return si
+    return made if made in UNIT_TABLE else si
 
 
 def parse_length(text: str, option: str) -> float:
@@ -164,16 +237,11 @@ def parse_length(text: str, option: str) -> float:
     return value
 
 
-def parse_typed_value(text: str) -> tuple:
-    """``"-90deg"`` -> ``(-1.5707..., "deg")``: the value in SI and the unit as typed ("" when bare)."""
-    value = parse_value(text)
-    return value, _NUMBER.match(text).group(2)
-
-
 def parse_typed_assignments(items, option: str) -> list:
-    """``["a=45deg", "b=0.1,c=2mm"]`` -> ``[("a", 0.785..., "deg"), ("b", 0.1, ""), ("c", 0.002, "mm")]``:
-    each value in SI with the unit as typed (to answer in the units a person used).  Several names
-    may share one value: ``"leg1,leg2,leg3=0.41"`` gives each of the three 0.41."""
+    """``["a=45deg", "b=0.1,c=2mm"]`` -> ``[("a", Quantity(0.785..., "angle", "deg")), ("b", Quantity(0.1)),
+    ("c", Quantity(0.002, "length", "mm"))]``: each value parsed once, with the unit as typed (to answer
+    in the units a person used).  Several names may share one value: ``"leg1,leg2,leg3=0.41"`` gives
+    each of the three 0.41."""
     out = []
     for item in items or []:
         pending = []  # names before a comma, waiting for the value of the next NAME=VALUE
@@ -186,11 +254,11 @@ def parse_typed_assignments(items, option: str) -> list:
                 continue
             if not name.strip():
                 raise UsageError(f"{option} expects NAME=VALUE, got {quote(part)}")
-            typed = parse_typed_value(value)
+            typed = parse_quantity(value)
             for n in (*pending, name.strip()):
-                if any(n == m for m, _, _ in out):  # the last would win without a word
+                if any(n == m for m, _ in out):  # the last would win without a word
                     raise UsageError(f"{option}: {quote(n)} is given twice")
-                out.append((n, *typed))
+                out.append((n, typed))
             pending = []
         if pending:
             raise UsageError(f"{option} expects NAME=VALUE (or NAME,NAME=VALUE), got {quote(item)}: "

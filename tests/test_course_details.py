@@ -43,7 +43,7 @@ def test_a_certificate_below_the_force_tolerance_is_a_pure_moment():
     from screwkin.present.grasp import wrench_axis
 
     ax = wrench_axis([0.0, -3.46e-7, 1.0], planar=True)
-    assert ax["point"] is None and ax["pitch"] == "inf" and list(ax["direction"]) == [0.0, 0.0, 1.0]
+    assert ax["point"] is None and ax["pitch"] == math.inf and list(ax["direction"]) == [0.0, 0.0, 1.0]  # JSON: "inf"
     ax = wrench_axis([0.2, 0.0, 1.0], planar=True)  # a real force: its line is y = -m / fx = -5 m
     assert ax["point"][1] == -5.0 or abs(ax["point"][1] + 5.0) < 1e-12
 

@@ -219,7 +219,7 @@ def test_the_bounds_of_the_coefficient_are_taken(capsys):
                                          ("P=coupler:0,0", None)])
 def test_every_point_is_checked_by_one_parser(tmp_path, capsys, command, point, says):
     """--point 1e308 m gave inf and NaN answers (exit 0), and draw did not look at --point at all (an
-    unknown link, NaN).  One parser (commands/_common.named_points, called for every command) bounds the
+    unknown link, NaN).  One parser (commands/_output_frame.named_points, called for every command) bounds the
     coordinates as a file's positions are (10 km)."""
     argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
     code = main([argv[0], str(FOURBAR), *argv[1:], "--point", point])
@@ -249,7 +249,7 @@ def test_draw_says_a_point_it_does_not_draw(tmp_path, capsys):
                                      ["dynamics", "--input", "crank_joint", "--speed", "1rpm", "--steps", "3"]])
 def test_near_names_joints_that_exist_for_every_command(tmp_path, capsys, command):
     """--near no_such=1 was refused by solve and ignored by draw, export and view: one check
-    (commands/_common.near_values)."""
+    (commands/_configuration.near_values)."""
     argv = [a.replace("{o}", str(tmp_path / "out")) for a in command]
     given = [] if "--input" in argv else ["--set", "crank_joint=0.5"]  # (a moved input takes no --set value)
     line = _usage(capsys, [argv[0], FOURBAR, *argv[1:], *given, "--near", "no_such=1"])

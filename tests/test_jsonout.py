@@ -29,6 +29,13 @@ def test_json_of_is_json_dumps_of_to_jsonable(indent):
         assert json_text(to_jsonable(obj), indent) == expected
 
 
-def test_nan_is_still_refused():
-    with pytest.raises(RuntimeError, match="NaN in the JSON output at a.b"):
-        json_of({"a": {"b": np.array([1.0, np.nan])}})
+def test_nan_is_null_and_infinity_a_string():
+    """The one rule (README, "Command line"): a value that does not exist (NaN) is null, an infinite
+    one "inf" or "-inf" -- in arrays, lists, scalars and numpy scalars alike; sorted keys and one line
+    as json.dumps writes them."""
+    obj = {"b": {"a": np.array([1.0, np.nan, np.inf]), "c": [float("-inf"), float("nan")], "d": np.float64("nan")},
+           "a": np.array([[np.nan, 1.0], [2.0, -np.inf]])}
+    expected = {"b": {"a": [1.0, None, "inf"], "c": ["-inf", None], "d": None}, "a": [[None, 1.0], [2.0, "-inf"]]}
+    assert json.loads(json_of(obj)) == expected
+    assert json_of(obj, indent=1, sort_keys=True) == json.dumps(expected, indent=1, sort_keys=True)
+    assert json_of(obj, indent=None) == json.dumps(expected)

@@ -139,11 +139,11 @@ def test_solve_tables_units_and_signs_against_the_closed_form(deg, capsys):
 
 def test_accelerations_are_in_the_rate_unit_per_second():
     from screwkin.present.tables import RateUnits
-    from screwkin.units import parse_value
+    from screwkin.units import parse_quantity, parse_value
 
     for typed, rate, accel in (("rpm", "rpm", "rpm/s"), ("rev/s", "rev/s", "rev/s^2"), ("deg", "deg/s", "deg/s^2"),
                                ("cm/s", "cm/s", "cm/s^2"), ("mm/s", "mm/s", "mm/s^2")):
-        u = RateUnits.typed([typed])
+        u = RateUnits.typed([parse_quantity("1" + typed)])  # the units.Quantity of --rate NAME=1<typed>
         linear = typed.startswith(("cm", "mm"))
         assert (u.rate(linear), u.acceleration(linear)) == (rate, accel)
         assert parse_value("1" + accel) == pytest.approx(parse_value("1" + rate))  # per second

@@ -5,7 +5,6 @@ the input's range (``--singular``)."""
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 
@@ -16,6 +15,7 @@ from ..analysis.motion.sweep import sweep
 from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
+from ..present.jsonout import json_of
 from ..present.animate import animation_format, write_animation
 from ..present.progress import EVERY, Progress
 from ..present.draw import (
@@ -31,21 +31,17 @@ from ..present.draw import (
 )
 from ..present.draw_targets import design_drawing
 from ..present.local import change_point_dict, singularity_kind_text
-from ..present.jsonout import to_jsonable
-from ..units import in_unit, parse_typed_value
-from ._common import (
+from ..units import unit_text
+from ._configuration import (
     add_configuration_options,
-    add_point_option,
     configuration,
     input_solver,
-    inputs,
-    joint_value,
     moved_not_set,
-    named_points,
     near_values,
-    split_inputs,
     with_mode,
 )
+from ._output_frame import add_point_option, named_points
+from ._values import inputs, joint_value, split_inputs
 from ._options import BOUNDS, count
 
 NAME = "draw"
@@ -217,7 +213,7 @@ def run(mech, args) -> int:
             report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
     if args.json:
         report["files"] = written
-        print(json.dumps(to_jsonable(report), indent=2))
+        print(json_of(report))
     elif not args.singular:
         for path in written:
             print(f"wrote {path}")
@@ -227,10 +223,9 @@ def run(mech, args) -> int:
     return 0
 
 
-def _typed(name, value, unit, linear) -> str:
-    """'crank = 30 deg' in the unit the person typed (rad or m when bare)."""
-    unit = unit or ("m" if linear else "rad")
-    return f"{name} = {in_unit(value, unit):.5g} {unit}"
+def _typed(name, value, unit) -> str:
+    """'crank = 30 deg' in the unit the person typed (``unit``: rad or m when bare)."""
+    return f"{name} = {unit_text(value, unit, 5)}"
 
 
 def _animate(mech, args) -> int:
@@ -252,10 +247,8 @@ def _animate(mech, args) -> int:
     name = args.input or (mech.actuated[0] if mech.actuated else None)  # (a --set value is held, never moved)
     if name is None:
         raise UsageError(f"{mech.path}: --animate needs --input NAME (the file declares no actuated joint)")
-    unit = parse_typed_value(args.start)[1]
-    start = joint_value(mech, name, args.start, "--from")
-    stop = joint_value(mech, name, args.stop, "--to")
-    unit = unit or parse_typed_value(args.stop)[1]
+    typed = [joint_value(mech, name, args.start, "--from"), joint_value(mech, name, args.stop, "--to")]
+    start, stop = (q.value for q in typed)
     moved_not_set(given, name, "--animate moves it from --from to --to")
     fixed = {k: v for k, v in given.items() if k != name}
     input_names = [name, *fixed] if held or name not in mech.actuated else list(mech.actuated)
@@ -264,14 +257,14 @@ def _animate(mech, args) -> int:
     # the mode followed (--mode K, --near), chosen and said as sweep's
     res = sweep(solver, name, start, stop, steps, fixed=fixed,
                 q_start=lambda: configuration(mech, args, moved={name: start}, inputs=input_names))
-    linear = res.unit == "m"
+    unit = next((q.shown_unit for q in typed if q.unit), None) or ("m" if res.unit == "m" else "rad")
     qs, values = list(res.q), list(res.values)
     limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= mech.tolerances.equal), None)
     if limit is not None:  # the last frame: the mechanism at the limit position itself
         qs.append(limit.q)
         values.append(limit.input)
     if res.stopped_at is not None and not args.json:
-        print(f"{name} stopped at {_typed(name, res.stopped_at, unit, linear).split(' = ')[1]} ({res.stop_reason}): "
+        print(f"{name} stopped at {_typed(name, res.stopped_at, unit).split(' = ')[1]} ({res.stop_reason}): "
               f"{len(qs)} frames, not the {steps + 1} asked")
     if res.skipped and not args.json:
         print(f"{len(res.skipped)} input value(s) on the way could not be solved: no frame for them")
@@ -285,7 +278,7 @@ def _animate(mech, args) -> int:
         for p in points:
             P = np.asarray(motion.points[p.name]["position"])
             traces[p.name] = np.stack([P @ e1, P @ e2], axis=1)
-    titles = [drawing_title(mech, _typed(name, x, unit, linear)) for x in values]
+    titles = [drawing_title(mech, _typed(name, x, unit)) for x in values]
     if limit is not None:
         titles[-1] += " (limit position)"
     space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
@@ -294,11 +287,11 @@ def _animate(mech, args) -> int:
                         progress=progress)
     progress.clear()
     if args.json:
-        print(json.dumps(to_jsonable({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
-                                      "input": name, "unit": res.unit, "values": values,
-                                      "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
-                                      "traces": {k: xy.tolist() for k, xy in traces.items()}}), indent=2))
+        print(json_of({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
+                       "input": name, "unit": res.unit, "values": values,
+                       "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
+                       "traces": {k: xy.tolist() for k, xy in traces.items()}}))
     else:
-        print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit, linear)} "
-              f"to {_typed(name, values[-1], unit, linear).split(' = ')[1]}")
+        print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit)} "
+              f"to {_typed(name, values[-1], unit).split(' = ')[1]}")
     return 0

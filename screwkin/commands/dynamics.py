@@ -3,31 +3,20 @@ a mechanism driven at constant input speed (inverse dynamics of the closed chain
 
 from __future__ import annotations
 
-import json
 import math
 import os
 
 from ..analysis.forces.dynamics import CS_RANGE, Load, dynamics
 from ..errors import UsageError, quote
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynamics_text
 from ..present.progress import EVERY, Progress
-from ..present.jsonout import to_jsonable
-from ..units import parse_typed_value, parse_value, unit_kind
+from ..units import parse_value
 from ..analysis.motion.sweep import sweep_inputs
-from ._common import (
-    add_mode_option,
-    configuration,
-    joint_assignments,
-    joint_value,
-    moved_not_set,
-    named_points,
-    names_list,
-    near_values,
-    rate_items,
-    value_kind,
-    with_mode,
-)
+from ._configuration import add_mode_option, configuration, moved_not_set, near_values, with_mode
+from ._output_frame import named_points
+from ._values import joint_assignments, joint_value, names_list, rate_items, value_kind
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -118,15 +107,16 @@ def run(mech, args) -> int:
     name, _, args.speed = rate_items(args.speed, [args.input], "--speed")[0].rpartition("=")
     if name.strip() != args.input:
         raise UsageError(f"--speed {quote(name.strip(), 60)}=...: dynamics drives --input {quote(args.input, 60)} only")
-    speed = joint_value(mech, args.input, args.speed, "--speed", order=1)
-    typed = [t for t in (args.start, args.stop) if t is not None]
+    speed = joint_value(mech, args.input, args.speed, "--speed", order=1).value
+    typed = [joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
+                                                                              (args.stop, "--to")) if text is not None]
     if kind == "length" and len(typed) < 2:
         raise UsageError(f"--input {quote(args.input)} slides: give its range with --from and --to")
-    start = 0.0 if args.start is None else joint_value(mech, args.input, args.start, "--from")
-    stop = start + 2 * math.pi if args.stop is None else joint_value(mech, args.input, args.stop, "--to")
-    # the input shown in the unit typed (the first --from/--to with a unit of its kind; SI when typed bare),
-    # degrees when no range is typed
-    units = [u for u in (parse_typed_value(t)[1] for t in typed) if unit_kind(u) == kind]
+    start = 0.0 if args.start is None else typed[0].value
+    stop = start + 2 * math.pi if args.stop is None else typed[-1].value
+    # the input shown in the unit typed (the first --from/--to with a unit; SI when typed bare), degrees when
+    # no range is typed
+    units = [q.shown_unit for q in typed if q.unit]
     shown = units[0] if units else ("deg" if kind == "angle" and not typed else None)
     points = named_points(mech, args)
     loads, cs, gravity = _loads(mech, args.load, points), _cs(args.cs), _gravity(args.gravity)
@@ -142,7 +132,7 @@ def run(mech, args) -> int:
     if args.plot:
         dynamics_plot(res, args.plot, shown, title=f"{os.path.basename(mech.path)}: {args.input} at {args.speed}")
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, dynamics_dict(res))), indent=2))
+        print(json_of(with_mode(args, dynamics_dict(res))))
     else:
         print(dynamics_text(res, shown, args.speed))
     return 0

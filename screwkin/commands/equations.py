@@ -4,12 +4,11 @@ estimates is ``solve --start`` (commands/solve.py)."""
 
 from __future__ import annotations
 
-import json
-
 from ..analysis.course.equations import equations
 from ..present.equations import equations_dict, equations_text
-from ..present.jsonout import to_jsonable
-from ._common import add_configuration_options, configuration, split_inputs, with_mode
+from ..present.jsonout import json_of
+from ._configuration import add_configuration_options, configuration, with_mode
+from ._values import split_inputs
 
 NAME = "equations"
 NEEDS_MECHANISM = True
@@ -41,7 +40,7 @@ def run(mech, args) -> int:
     q = configuration(mech, args)
     res = equations(mech, q, names, output=args.output, links=list(held))
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, equations_dict(res))), indent=2))
+        print(json_of(with_mode(args, equations_dict(res))))
     else:
         print(equations_text(res))
     return 0

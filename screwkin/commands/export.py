@@ -10,9 +10,9 @@ from ..errors import UsageError, quote
 from ..files.exporter import DEFAULT_DENSITY, ROD_RATIO, helper_names, mujoco_refuses, write_mjcf, write_placed_urdf
 from ..files.mjcf_rows import redundant_rows
 from ..model.placed import check_closed, placed
-from ..present.jsonout import to_jsonable
 from ..present.outfile import write_output
-from ._common import add_configuration_options, configuration, emit, with_mode
+from ._common import emit
+from ._configuration import add_configuration_options, configuration, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -88,9 +88,9 @@ def run(mech, args) -> int:
         write_output(out, text)
 
     def data():
-        return to_jsonable(with_mode(args, {"file": mech.path, "written": written, "configuration": values,
-                                            "residual": residual, "notes": notes, "compounds": compounds,
-                                            "redundant_rows": redundant}))
+        return with_mode(args, {"file": mech.path, "written": written, "configuration": values,
+                                "residual": residual, "notes": notes, "compounds": compounds,
+                                "redundant_rows": redundant})
 
     def text():
         lines = [f"wrote {w['path']} ({w['format']}): {w['bodies']} bodies, {w['loop_joints']} loop joints, at the "

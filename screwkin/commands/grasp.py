@@ -3,11 +3,11 @@ internal forces and the Ferrari-Canny quality of contacts on one object."""
 
 from __future__ import annotations
 
-import json
 
 from ..analysis.forces.grasp import GRASP_TOLERANCES, analyze_grasp
 from ..errors import UsageError
 from ..files.grasp import read_grasp
+from ..present.jsonout import json_of
 from ..present.grasp import grasp_dict, grasp_text
 from ..units import parse_length
 
@@ -35,7 +35,7 @@ def run(mech, args) -> int:
     spec = read_grasp(args.file)
     result = analyze_grasp(spec, facets=args.facets, length=length)
     if args.json:
-        print(json.dumps(grasp_dict(result), indent=2))
+        print(json_of(grasp_dict(result)))
     else:
         print(grasp_text(result))
     return 0

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 
 import numpy as np
@@ -10,10 +9,10 @@ import pinocchio as pin
 
 from ..analysis.motion.ik import branches, inverse_kinematics
 from ..errors import UsageError, quote
+from ..present.jsonout import json_of
 from ..present.report import position_dict, position_text
-from ..present.jsonout import to_jsonable
 from ..units import parse_value
-from ._common import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
+from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -61,7 +60,7 @@ def run(mech, args) -> int:
                          "legs": [{"joints": list(j), "found": k, "at_most": m} for j, k, m in count.legs]}
         if frame is not None:
             d["output_frame"] = {k: frame[k] for k in ("name", "link", "local")}
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
     else:
         if frame is not None:
             print(output_frame_line(frame, args.tool is None).split(", in the world")[0])

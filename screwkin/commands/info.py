@@ -5,7 +5,6 @@ from __future__ import annotations
 from ..errors import ScrewkinError, UsageError
 from ..model.joint_types import JOINT_TYPES
 from ..present.report import joint_types_dict, joint_types_text
-from ..present.jsonout import to_jsonable
 from ..present.mobility import topology_dict, topology_text
 from ._common import emit
 
@@ -39,7 +38,7 @@ def run(mech, args) -> int:
         d = topology_dict(topo)
         d.update({"file": mech.path, "actuated": mech.actuated, "cut_joints": [c.name for c in mech.cuts],
                   "coordinates": mech.nv, "assembled": note is None})
-        return to_jsonable(d)
+        return d
 
     def text():
         lines = [topology_text(topo, f"Topology of {mech.path}"), f"actuated: {', '.join(mech.actuated) or 'none declared'}"]

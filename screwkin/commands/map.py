@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -11,19 +10,13 @@ from ..analysis.singularities.maps import singularity_map
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.sweep import continuation_steps
 from ..errors import UsageError
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.plots import map_png
 from ..present.report import map_csv, map_dict
-from ..present.jsonout import to_jsonable
-from ._common import (
-    add_mode_option,
-    configuration,
-    joint_assignments,
-    output_frame,
-    parse_range,
-    typed_unit,
-    with_mode,
-)
+from ._configuration import add_mode_option, configuration, with_mode
+from ._output_frame import output_frame
+from ._values import joint_assignments, parse_range
 from ._options import BOUNDS
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -46,8 +39,8 @@ def add_parser(sub, common, scaled):
 
 
 def run(mech, args) -> int:
-    xn, xs = parse_range(args.x, "--x", mech)
-    yn, ys = parse_range(args.y, "--y", mech)
+    xn, xs, x_unit = parse_range(args.x, "--x", mech)
+    yn, ys, y_unit = parse_range(args.y, "--y", mech)
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
         raise UsageError(f"--x and --y: {xs.size:,} x {ys.size:,} = {xs.size * ys.size:,} configurations, "
                          f"at most {BOUNDS['grid_total'][1]:,}")
@@ -68,14 +61,12 @@ def run(mech, args) -> int:
     mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
     if args.png:
-        units = (typed_unit(mech, xn, args.x), typed_unit(mech, yn, args.y))
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
-        map_png(res, args.png, *units, title=title)
+        map_png(res, args.png, x_unit, y_unit, title=title)
     if args.csv:
         write_output(args.csv, map_csv(res))
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})),
-                         indent=2))
+        print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} on the mapped assembly mode; "

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from ..analysis.mobility import analyze_mobility
 from ..errors import UsageError
-from ..present.jsonout import to_jsonable
 from ..present.mobility import mobility_dict, mobility_text
-from ._common import add_configuration_options, configuration, emit, with_mode
+from ._common import emit
+from ._configuration import add_configuration_options, configuration, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -28,4 +28,4 @@ def run(mech, args) -> int:
     given = any(getattr(args, k, None) for k in ("set", "set_angle", "set_length", "near", "mode"))
     at = configuration(mech, args) if given else None
     result = analyze_mobility(mech, output=args.output, point=args.point, at=at, suggest=True)
-    return emit(args, lambda: to_jsonable(with_mode(args, mobility_dict(result))), lambda: mobility_text(result))
+    return emit(args, lambda: with_mode(args, mobility_dict(result)), lambda: mobility_text(result))

@@ -10,7 +10,6 @@ instead, and the rest is still written."""
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import tempfile
@@ -27,6 +26,7 @@ from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import OutputError, ScrewkinError, UsageError
+from ..present.jsonout import json_of
 from ..present.document import (
     Document,
     Figure,
@@ -59,23 +59,12 @@ from ..present.view import (
     show,
 )
 from ..present.camera import PICTURE
+from ..present.tables import RateUnits
 from ..present.viewserver import ViewerServer
-from ..units import in_unit, parse_typed_assignments, unit_kind
-from ._common import (
-    add_configuration_options,
-    add_point_option,
-    check_rate_names,
-    input_solver,
-    joint_assignments,
-    link_rates,
-    named_points,
-    mode_line,
-    rate_items,
-    near_values,
-    rate_units,
-    split_inputs,
-    value_kind,
-)
+from ..units import parse_typed_assignments
+from ._configuration import add_configuration_options, input_solver, mode_line, near_values
+from ._output_frame import add_point_option, named_points
+from ._values import check_rate_names, joint_quantities, link_rates, rate_items, split_inputs, value_kind
 from ._options import check_writable, count, screwkin_version
 
 NAME = "report"
@@ -160,10 +149,11 @@ def run(mech, args) -> int:
     points = named_points(mech, args)
     links = (*held, *pivots)
     args.rate, args.accel = (rate_items(getattr(args, o), [*names, *held], f"--{o}") or None for o in ("rate", "accel"))
-    rates = link_rates(joint_assignments(mech, args.rate, "--rate", order=1, links=links), pivots, "--rate") \
+    typed = {o: joint_quantities(mech, getattr(args, o), f"--{o}", order=k, links=links)
+             for k, o in ((1, "rate"), (2, "accel"))}  # the tables answer in the units typed
+    rates = link_rates({n: q.value for n, q in typed["rate"].items()}, pivots, "--rate") \
         or {n: 1.0 for n in (*names, *held)}
-    accels = link_rates(joint_assignments(mech, args.accel, "--accel", order=2, links=links), pivots,
-                        "--accel") or None
+    accels = link_rates({n: q.value for n, q in typed["accel"].items()}, pivots, "--accel") or None
     check_rate_names(rates, [*names, *held], "--rate")
     check_rate_names(accels, [*names, *held], "--accel")
     notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
@@ -233,9 +223,10 @@ def run(mech, args) -> int:
 
     # ---- positions, velocities, accelerations
     if pres is not None:
-        given_rates = "input rates " + _input_rates_text(mech, args, rates) + \
+        given_rates = "input rates " + _rates_text(mech, typed["rate"], rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
-        sections.append(motion_section(pres, given_rates, mech.length, rate_units(args), data.get("mode", {}).get("index", 1)))
+        rate_units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())  # the units typed
+        sections.append(motion_section(pres, given_rates, mech.length, rate_units, data.get("mode", {}).get("index", 1)))
     else:
         sections.append(note_section("motion", "Positions, velocities and accelerations",
                                      "no input joint (none declared actuated, none given with --input or --set): "
@@ -284,8 +275,8 @@ def run(mech, args) -> int:
             raise
         written.append(args.md)
     if args.json:
-        print(json.dumps({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],
-                          "omitted": notes}, indent=2))
+        print(json_of({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],
+                       "omitted": notes}))
     else:
         for path in written:
             print(f"wrote {path}")
@@ -294,19 +285,18 @@ def run(mech, args) -> int:
     return 0
 
 
-def _input_rates_text(mech, args, rates) -> str:
-    """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``), or the default 1 in SI."""
+def _rates_text(mech, typed: dict, rates) -> str:
+    """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``; ``typed``: joint_quantities of
+    --rate), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
-    if not args.rate:
+    if not typed:
         return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
-    typed = {n: unit for n, _, unit in parse_typed_assignments(args.rate, "--rate")}
 
     def shown(n, v):
-        unit = typed.get(n)
-        if not unit:
+        q = typed.get(n)
+        if q is None or q.shown_unit in ("", si[n]):
             return f"{n} = {v:.6g} {si[n]}"
-        label = unit + "/s" if unit_kind(unit) in ("angle", "length") else unit  # --rate crank=90deg: 90 deg/s
-        return f"{n} = {in_unit(v, unit):.6g} {label} ({v:.6g} {si[n]})"
+        return f"{n} = {q.text(v)} ({v:.6g} {si[n]})"  # --rate crank=90deg: 90 deg/s
 
     return ", ".join(shown(n, v) for n, v in rates.items())
 
@@ -323,7 +313,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
         solver = input_solver(mech, values, held)
         start, _ = start_estimates(mech, loops, solver, solver.set_inputs(q, values), {**values, **(held or {})},
                                    typed)
-        how = "from the estimates given with --start: " + ", ".join(f"{n}={v}" for n, v, _ in typed)
+        how = "from the estimates given with --start: " + ", ".join(f"{n}={q.value}" for n, q in typed)
     else:
         start = {}
         for n in loops.unknowns:

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import time
 
 from ..analysis.singularities.scan import scan
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.report import scan_csv, scan_dict
-from ..present.jsonout import to_jsonable
-from ._common import output_frame
+from ._output_frame import output_frame
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -40,7 +39,7 @@ def run(mech, args) -> int:
         write_output(args.csv, scan_csv(res))
     d = scan_dict(res)
     if args.json:
-        print(json.dumps(to_jsonable({"file": mech.path, **d, "seconds": elapsed}), indent=2))
+        print(json_of({"file": mech.path, **d, "seconds": elapsed}))
         return 0
     what = (("smallest / largest singular value of the output origin's velocity Jacobian (a point)"
              if res.point else "smallest / largest singular value of the output Jacobian (v / L, w)")

@@ -2,22 +2,17 @@
 
 from __future__ import annotations
 
-import json
 
 from ..analysis.screws import loop_screws, structure
 from ..errors import UsageError
-from ..present.jsonout import to_jsonable
+from ..present.jsonout import json_of
 from ..present.screws import (
     loops_dict,
     loops_text,
     screws_dict,
     screws_text,
 )
-from ._common import (
-    add_configuration_options,
-    configuration,
-    with_mode,
-)
+from ._configuration import add_configuration_options, configuration, with_mode
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -43,8 +38,8 @@ def run(mech, args) -> int:
         normal = topo.normal
     loops = loop_screws(mech)
     if args.json:
-        print(json.dumps(to_jsonable(with_mode(args, {"motion_space": topo.motion_space, "chains": screws_dict(st, normal),
-                                      "loops": loops_dict(loops, normal)})), indent=2))
+        print(json_of(with_mode(args, {"motion_space": topo.motion_space, "chains": screws_dict(st, normal),
+                                       "loops": loops_dict(loops, normal)})))
     else:
         print(screws_text(st, normal))
         if loops:

@@ -2,28 +2,20 @@
 
 from __future__ import annotations
 
-import json
 
 from ..analysis.singularities.ellipsoids import ellipsoids
 from ..analysis.singularities.gram_symbolic import symbolic_gram
 from ..analysis.local import local_analysis
 from ..analysis.singularities.singular import classify, named_types
 from ..errors import UsageError
+from ..present.jsonout import json_of
 from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text
 from ..present.local import local_dict, local_lines, types_lines
 from ..present.report import singularity_dict, singularity_text
-from ..present.jsonout import to_jsonable
 from ..present.screws import gram_symbolic_dict, gram_symbolic_text
-from ._common import (
-    add_configuration_options,
-    add_tool_option,
-    configuration,
-    inputs,
-    output_frame,
-    output_frame_dict,
-    output_frame_line,
-    with_mode,
-)
+from ._configuration import add_configuration_options, configuration, with_mode
+from ._output_frame import add_tool_option, output_frame, output_frame_dict, output_frame_line
+from ._values import inputs
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -68,7 +60,7 @@ def run(mech, args) -> int:
             d["ellipsoids"] = ellipsoids_dict(ell)
         if gram is not None:
             d["gram_symbolic"] = gram_symbolic_dict(gram)
-        print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
+        print(json_of(with_mode(args, d)))
     else:
         if frame is not None:
             print(output_frame_line(frame, point))

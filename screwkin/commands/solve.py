@@ -4,34 +4,23 @@ iteration."""
 
 from __future__ import annotations
 
-import json
 import sys
 
 from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..present.equations import Units, greek, newton_dict, newton_text
+from ..present.jsonout import json_of
 from ..present.report import (
     position_dict,
     position_text,
     trace_text,
 )
-from ..present.jsonout import to_jsonable
-from ..units import UNITS, parse_typed_assignments
-from ._common import (
-    add_angle_option,
-    add_length_option,
-    add_point_option,
-    check_rate_names,
-    input_solver,
-    joint_assignments,
-    link_rates,
-    named_points,
-    rate_items,
-    near_values,
-    rate_units,
-    split_inputs,
-)
+from ..present.tables import RateUnits
+from ..units import parse_typed_assignments
+from ._configuration import add_angle_option, add_length_option, input_solver, near_values
+from ._output_frame import add_point_option, named_points
+from ._values import check_rate_names, joint_quantities, link_rates, rate_items, split_inputs
 from ._options import count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -40,7 +29,6 @@ NAME = "solve"
 NEEDS_MECHANISM = True
 
 _ANGLE_UNITS = {"deg", "degree", "degrees", "°"}
-_LENGTH_UNITS = {"m", "cm", "mm", "um", "µm", "μm", "in", "inch", "inches", "ft", "foot", "feet"}
 
 
 def add_parser(sub, common, scaled):
@@ -76,8 +64,10 @@ def run(mech, args) -> int:
         raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
     near = near_values(mech, args)
     args.rate, args.accel = (rate_items(getattr(args, o), [*values, *held], f"--{o}") or None for o in ("rate", "accel"))
-    rates = joint_assignments(mech, args.rate, "--rate", order=1, links=(*held, *pivots)) if args.rate or args.accel else None
-    accels = joint_assignments(mech, args.accel, "--accel", order=2, links=(*held, *pivots)) if args.accel else None
+    typed = {o: joint_quantities(mech, getattr(args, o), f"--{o}", order=k, links=(*held, *pivots))
+             for k, o in ((1, "rate"), (2, "accel"))}  # the tables answer in the units typed
+    rates = {n: q.value for n, q in typed["rate"].items()} if args.rate or args.accel else None
+    accels = {n: q.value for n, q in typed["accel"].items()} if args.accel else None
     rates, accels = link_rates(rates, pivots, "--rate"), link_rates(accels, pivots, "--accel")
     for given, option in ((rates, "--rate"), (accels, "--accel")):  # a link's rate goes with its --set-angle
         check_rate_names(given, [*values, *held], option)
@@ -91,14 +81,16 @@ def run(mech, args) -> int:
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
         return 0
     if args.trace:
         names = [mech.coordinate_names[k] for k in solver.passive]
         print(trace_text(res, solver.mech.closure.row_labels(solver=True), names))
         print()
-    legs = {n: v for n, v, _ in parse_typed_assignments(args.set_length, "--set-length")} if args.set_length else None
-    print(position_text(res, show_all=args.all, length=mech.length, units=rate_units(args), leg_lengths=legs))
+    legs = {n: q.value for n, q in parse_typed_assignments(args.set_length, "--set-length")} if args.set_length \
+        else None
+    units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())
+    print(position_text(res, show_all=args.all, length=mech.length, units=units, leg_lengths=legs))
     return 0
 
 
@@ -130,16 +122,15 @@ def _solve_from_start(mech, args, values, held=None) -> int:
     given = {n: held.get(loops.input_joints[n][0], input_values[n]) for n in loops.input_syms}
     res = textbook_newton(loops, given, start, args.iterations)
 
-    typed_units = [u.lower() for _, _, u in typed + parse_typed_assignments(args.set, "--set")
-                   + parse_typed_assignments(args.set_angle, "--set-angle")]
-    degrees = any(u in _ANGLE_UNITS for u in typed_units)
-    lengths = {n: (u, UNITS[u]) for n, u in units.items()
-               if u and u in _LENGTH_UNITS and loops.symbol_info[n].kind != "angle"}
+    # (--set and --set-angle read again: solve's split_inputs keeps their values, not their units)
+    degrees = any(q.unit in _ANGLE_UNITS for _, q in typed + parse_typed_assignments(args.set, "--set")
+                  + parse_typed_assignments(args.set_angle, "--set-angle"))
+    lengths = {n: q.shown_unit for n, q in units.items() if q.kind == "length" and loops.symbol_info[n].kind != "angle"}
     show = Units(degrees, lengths)
     trace_wanted = args.trace or args.iterations is not None
     if args.iterations is not None or not res.closes:
         if args.json:
-            print(json.dumps(to_jsonable({"file": mech.path, **newton_dict(res)}), indent=2))
+            print(json_of({"file": mech.path, **newton_dict(res)}))
         else:
             print(newton_text(res, loops.symbol_info, show, mech.path))
         if args.iterations is None:  # asked to converge and it did not: an error, not a result
@@ -169,7 +160,7 @@ def _solve_from_start(mech, args, values, held=None) -> int:
         d["characteristic_length"] = mech.length
         d["newton"] = newton_dict(res)
         d["trace"] = d["newton"]["trace"]
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
         return 0
     if trace_wanted:
         print(newton_text(res, loops.symbol_info, show, mech.path))

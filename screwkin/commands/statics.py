@@ -3,7 +3,6 @@ and transmission wrenches of a parallel mechanism's legs."""
 
 from __future__ import annotations
 
-import json
 
 import numpy as np
 
@@ -11,20 +10,12 @@ from ..analysis.forces.statics import legs, no_legs_reason, statics
 from ..analysis.redundancy import redundancy
 from ..errors import UsageError
 from ..model.state import KinematicState
-from ..present.jsonout import to_jsonable
+from ..present.jsonout import json_of
 from ..present.local import redundancy_dict, redundancy_lines
 from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
-from ._common import (
-    add_configuration_options,
-    add_point_option,
-    add_tool_option,
-    configuration,
-    output_frame,
-    output_frame_dict,
-    output_frame_line,
-    with_mode,
-)
+from ._configuration import add_configuration_options, configuration, with_mode
+from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 
 NAME = "statics"
 NEEDS_MECHANISM = True
@@ -74,7 +65,7 @@ def run(mech, args) -> int:
             d["legs"], d["legs_note"] = [], f"no legs: {why_not}"
         if frame is not None:
             d["output_frame"] = frame
-        print(json.dumps(to_jsonable(with_mode(args, d)), indent=2))
+        print(json_of(with_mode(args, d)))
     else:
         if frame is not None:
             moved = " ".join(f"{v:.6g}" for v in frame["wrench_at_link_origin"])

@@ -3,12 +3,12 @@ the metrics of every design, on Dask (a local cluster, or ``--scheduler tcp://..
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 
 from ..parallel.study import run_study
 from ..errors import UsageError, quote
 from ..files.study import read_study_spec
+from ..present.jsonout import json_of
 from ..present.study import (
     check_table_path,
     metrics_png,
@@ -18,7 +18,7 @@ from ..present.study import (
     write_table,
 )
 from ..present.progress import Progress
-from ._common import add_mode_option
+from ._configuration import add_mode_option
 from ._options import count, seconds
 
 NAME = "study"
@@ -90,7 +90,7 @@ def run(mech, args) -> int:
         if spec.pareto and result.succeeded:
             pareto_png(result, f"{args.plot}-pareto.png")
     if args.json:
-        print(json.dumps(study_dict(result), indent=2))
+        print(json_of(study_dict(result)))
     else:
         print(study_text(result, args.table))
     return 0 if ok or not n else 1

@@ -16,7 +16,7 @@ from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.motion import motion_dict, motion_rows_text, strokes_dict, strokes_text
-from ..present.tables import input_rate_words
+from ..present.tables import RateUnits, input_rate_words
 from ..present.plots import sweep_plot
 from ..present.progress import EVERY, Progress
 from ..present.streamout import SweepWriter
@@ -29,24 +29,17 @@ from ..present.report import (
     sweep_text,
     value_text,
 )
-from ..units import parse_typed_assignments, parse_typed_value, unit_kind
-from ._common import (
+from ._configuration import (
     add_angle_option,
     add_mode_option,
-    check_rate_names,
     configuration,
     input_solver,
-    joint_assignments,
-    joint_value,
     moved_not_set,
-    named_points,
-    names_list,
     near_values,
-    rate_items,
-    rate_units,
-    split_inputs,
     with_mode,
 )
+from ._output_frame import named_points
+from ._values import check_rate_names, joint_quantities, joint_value, names_list, rate_items, split_inputs
 from ._options import BOUNDS, count
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -193,14 +186,15 @@ def run(mech, args) -> int:
     near_values(mech, args)  # checked before the work (configuration() reads it where the motion starts)
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
-    start, stop = (joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
-                                                                                      (args.stop, "--to")))
+    typed_range = [joint_value(mech, args.input, text, option) for text, option in ((args.start, "--from"),
+                                                                                    (args.stop, "--to"))]
+    start, stop = (q.value for q in typed_range)
     args.rate = rate_items(args.rate, [args.input], "--rate") or None  # the one grammar: NAME=VALUE or bare
-    typed = joint_assignments(mech, args.rate, "--rate", order=1)
+    typed = joint_quantities(mech, args.rate, "--rate", order=1)
     check_rate_names(typed, [args.input], "--rate")  # only the swept input moves
-    rate = typed.get(args.input, 1.0)
-    unit = next((u for _, _, u in parse_typed_assignments(args.rate, "--rate")), None)
-    args.rate_words = input_rate_words(args.input, rate, unit, bool(mech.translational[mech.coordinate(args.input).idx_v]))
+    rate = typed[args.input].value if args.input in typed else 1.0
+    args.rate_words = input_rate_words(args.input, typed.get(args.input),
+                                       bool(mech.translational[mech.coordinate(args.input).idx_v]))
     if args.parquet:
         SweepWriter.require_parquet(args.parquet)  # before any work
     moved_not_set(fixed, args.input, "sweep moves it from --from to --to")
@@ -255,8 +249,7 @@ def run(mech, args) -> int:
         print(json_of(d))
     else:
         rows = sweep_rows(len(res.values), _rows_option(args.rows))
-        typed_deg = any(unit_kind(parse_typed_value(t)[1]) == "angle" and "deg" in t.lower()
-                        for t in (args.start, args.stop))
+        typed_deg = any(q.kind == "angle" and "deg" in q.unit for q in typed_range)
         linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
             else []
         for link, angle in held.items():
@@ -269,7 +262,7 @@ def run(mech, args) -> int:
         for n in res.notes:
             print(f"note: {n}")
         # a --rate typed: the links' omega and alpha beside their angles, in its units (60rpm: rpm)
-        units = rate_units(args) if args.rate else None
+        units = RateUnits.typed(typed.values()) if args.rate else None
         table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad", units)
         if table_text:
             print()

@@ -12,7 +12,6 @@ OUT, so OUT is the checked file and a rejected result leaves no file.
 from __future__ import annotations
 
 import contextlib
-import json
 import math
 import os
 import tempfile
@@ -36,7 +35,7 @@ from ..files.writer import write_urdf
 from ..parallel.pool import dask_client, dask_map
 from ..model.loader import load
 from ..present.draw import draw_design
-from ..present.jsonout import to_jsonable
+from ..present.jsonout import json_of
 from ..present.outfile import os_reason, output_failed, remove_partial, write_output
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
@@ -234,8 +233,8 @@ def run(mech, args) -> int:
     if args.json:
         out = synthesis_dict(result, check, args.out, constraints)
         if args.draw:
-            out["drawing"] = to_jsonable({"file": args.draw, "targets": marks})
-        print(json.dumps(out, indent=2))
+            out["drawing"] = {"file": args.draw, "targets": marks}
+        print(json_of(out))
     else:
         print(synthesis_text(result, check, args.out, constraints))
         if args.draw:
@@ -425,7 +424,7 @@ def _chains(args):
                                                   f"with {args.prismatic} prismatic joints (every candidate has a "
                                                   "separable part, a degenerate sub-chain or a locked loop)")
     if args.json:
-        print(json.dumps(chains_dict(result, directory), indent=2))
+        print(json_of(chains_dict(result, directory)))
     else:
         print(chains_text(result, directory))
     return 0

@@ -22,20 +22,11 @@ from ..present.viewserver import ViewerServer
 from ..errors import UsageError, quote
 from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player
-from ..units import in_unit
+from ..units import unit_text
 from ..present.viewplanar import colour_links, link_colours, planar_basis
-from ._common import (
-    add_configuration_options,
-    add_point_option,
-    configuration,
-    joint_assignments,
-    joint_inputs,
-    mode_line,
-    moved_not_set,
-    named_points,
-    parse_range,
-    typed_unit,
-)
+from ._configuration import add_configuration_options, configuration, mode_line, moved_not_set
+from ._output_frame import add_point_option, named_points
+from ._values import joint_assignments, joint_inputs, parse_range
 from ..model.topology import open_joints
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
@@ -101,7 +92,7 @@ def run(mech, args) -> int:
     if not args.sweep:
         q = configuration(mech, args)
     else:  # (the range and the --set values checked before the configuration is solved)
-        name, values = parse_range(args.sweep, "--sweep", mech)
+        name, values, unit = parse_range(args.sweep, "--sweep", mech)
         fixed = joint_assignments(mech, args.set, "--set")
         moved_not_set(fixed, name, "view --sweep moves it over its range")
         inputs = sweep_inputs(mech, name, fixed)
@@ -111,8 +102,7 @@ def run(mech, args) -> int:
                     q_start=lambda: configuration(mech, args, moved={name: float(values[0])}, inputs=inputs))
         motion = res.q
         q = res.q[0]
-        unit = typed_unit(mech, name, args.sweep)
-        frames = [f"{name} = {in_unit(v, unit):.4g} {unit}" for v in res.values]
+        frames = [f"{name} = {unit_text(v, unit, 4)}" for v in res.values]
         for s in locate_singularities(solver, res, output=args.output):
             rep = classify(mech, s.q, output=args.output)
             twist = next((t for t in rep.singular_twists if t.kind == s.kind), None)

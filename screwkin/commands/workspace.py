@@ -3,7 +3,6 @@ with any), the part free of singularities, and the conditioning over it."""
 
 from __future__ import annotations
 
-import json
 import os
 import tempfile
 
@@ -12,8 +11,8 @@ import pinocchio as pin
 
 from ..analysis.design.workspace import DEFAULT_THRESHOLD, workspace
 from ..errors import UsageError, quote
+from ..present.jsonout import json_of
 from ..present.outfile import write_output
-from ..present.jsonout import to_jsonable
 from ..present.view import build_scene, screenshot, show
 from ..present.viewserver import ViewerServer
 from ..present.workspace import (
@@ -24,16 +23,8 @@ from ..present.workspace import (
     workspace_text,
 )
 from ..units import parse_length, parse_value
-from ._common import (
-    add_mode_option,
-    add_point_option,
-    add_tool_option,
-    configuration,
-    output_frame,
-    output_frame_dict,
-    output_frame_line,
-    with_mode,
-)
+from ._configuration import add_mode_option, configuration, with_mode
+from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count, seconds
 
 NAME = "workspace"
@@ -155,7 +146,7 @@ def run(mech, args) -> int:
         d["wrote"] = wrote
         if frame is not None:
             d["output_frame"] = frame
-        print(json.dumps(to_jsonable(d), indent=2))
+        print(json_of(d))
     else:
         if frame is not None:
             print(output_frame_line(frame, bool(args.points)))

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import MechanismFileError, UsageError, quote
-from ..units import parse_typed_value, parse_value
+from ..units import Quantity, parse_quantity
 from .description import LIMITS
 from .xacro import declared_args, normalize_args
 from .xmlsafe import load_yaml_text, read_regular_file
@@ -66,10 +66,9 @@ class Parameter:
     unit: str = ""  # the unit its values were typed in (the first one typed: "mm", "deg"), "" when bare
 
 
-def _typed_unit(items) -> str:
+def _first_unit(quantities) -> str:
     """The first unit typed among a parameter's values ("" when every value is a bare number)."""
-    units = (parse_typed_value(v)[1] for v in items if isinstance(v, str))  # checked by _value already
-    return next((u for u in units if u), "")
+    return next((q.unit for q in quantities if q.unit), "")
 
 
 @dataclass(frozen=True)
@@ -102,18 +101,23 @@ def _fail(where, message):
     raise UsageError(f"{where}: {message}")
 
 
-def _value(v, where, what):
-    """A number, or a number with a unit (text), in SI."""
+def _quantity(v, where, what) -> Quantity:
+    """A number, or a number with a unit (text): its units.Quantity (SI value, the unit typed)."""
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
         _fail(where, f"{what} must be a number (units allowed, e.g. 30mm), got {quote(v)}")
     if isinstance(v, str):
         try:
-            return parse_value(v)
+            return parse_quantity(v)
         except UsageError as exc:
             _fail(where, f"{what}: {exc}")
     if not math.isfinite(v):
         _fail(where, f"{what} must be finite, got {v!r}")
-    return float(v)
+    return Quantity(float(v))
+
+
+def _value(v, where, what) -> float:
+    """A number, or a number with a unit (text), in SI."""
+    return _quantity(v, where, what).value
 
 
 def _count(v, where, what, low=1, high=MAX_DESIGNS):
@@ -125,7 +129,8 @@ def _count(v, where, what, low=1, high=MAX_DESIGNS):
 def _parameter(name, item, where, sampling) -> Parameter:
     what = f"parameter {quote(name)}"
     if not isinstance(item, dict):
-        return Parameter(name, values=(_value(item, where, what),), unit=_typed_unit((item,)))
+        q = _quantity(item, where, what)
+        return Parameter(name, values=(q.value,), unit=q.unit)
     unknown = [k for k in item if k not in ("min", "max", "samples", "values")]
     if unknown:
         _fail(where, f"{what}: unknown key {quote(unknown[0])} (a range is min, max, samples; a list is values)")
@@ -137,11 +142,12 @@ def _parameter(name, item, where, sampling) -> Parameter:
             _fail(where, f"{what}: values must be a non-empty list, got {quote(values)}")
         if len(values) > MAX_VALUES:
             _fail(where, f"{what}: more than {MAX_VALUES} values")
-        return Parameter(name, values=tuple(_value(v, where, f"{what} value") for v in values),
-                         unit=_typed_unit(values))
+        typed = [_quantity(v, where, f"{what} value") for v in values]
+        return Parameter(name, values=tuple(q.value for q in typed), unit=_first_unit(typed))
     if "min" not in item or "max" not in item:
         _fail(where, f"{what}: a range needs min and max (or give values: [...])")
-    low, high = _value(item["min"], where, f"{what} min"), _value(item["max"], where, f"{what} max")
+    typed = _quantity(item["min"], where, f"{what} min"), _quantity(item["max"], where, f"{what} max")
+    low, high = (q.value for q in typed)
     if low > high:
         _fail(where, f"{what}: bad range, min {low:g} is above max {high:g}")
     samples = item.get("samples")
@@ -153,7 +159,7 @@ def _parameter(name, item, where, sampling) -> Parameter:
             _fail(where, f"{what}: 1 sample cannot span min {low:g} to max {high:g} (give 2 or more, or one value)")
     elif samples is not None:
         _count(samples, where, f"{what} samples", 1, MAX_VALUES)  # accepted, unused: designs says how many
-    return Parameter(name, low=low, high=high, samples=samples, unit=_typed_unit((item["min"], item["max"])))
+    return Parameter(name, low=low, high=high, samples=samples, unit=_first_unit(typed))
 
 
 def _metrics(value, where):
@@ -208,8 +214,8 @@ def _require(value, where):
             for bound in ("min", "max"):
                 if bound in rule:
                     v = rule[bound]
-                    out.append((name, bound, _value(v, where, f"require {name} {bound}"),
-                                isinstance(v, str) and bool(parse_typed_value(v)[1])))
+                    q = _quantity(v, where, f"require {name} {bound}")
+                    out.append((name, bound, q.value, bool(q.unit)))
         elif isinstance(rule, (bool, int, float, str)):
             if isinstance(rule, float) and not math.isfinite(rule):
                 _fail(where, f"require {quote(name)} must be finite, got {rule!r}")

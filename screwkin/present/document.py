@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import base64
 import io
-import json
 import re
 from dataclasses import dataclass, field
 from html import escape
@@ -30,7 +29,6 @@ from .equations import Units, equations_text, greek, newton_text
 from .tables import RateUnits, shown
 from .motion import linkage_construction_text, links_rows, points_rows
 from .report import slide_note, solution_rows
-from .jsonout import to_jsonable
 from .mobility import (
     JOINT_COLUMNS,
     count_rows,
@@ -38,6 +36,7 @@ from .mobility import (
     screw_theory_rows,
 )
 from .screws import screws_text
+from .jsonout import json_of
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",
@@ -170,7 +169,7 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     """Newton's iterations on the loop equations from the estimates ``how`` describes."""
     s = Section("newton", "Newton iterations")
     s.blocks.append(Text(how))
-    show = Units(True, {n: ("mm", 1e-3) for n in res.unknowns if symbols[n].kind != "angle"})  # deg and mm
+    show = Units(True, {n: "mm" for n in res.unknowns if symbols[n].kind != "angle"})  # deg and mm
     rows = [[st.iteration, ", ".join(f"{greek(n)} = {show.value(n, symbols[n].kind, st.before[n])}"
                                      for n in res.unknowns),
              f"{np.linalg.norm(st.residual):.3e}",
@@ -316,7 +315,7 @@ def html(doc: Document) -> str:
         parts += [_html_block(b) for b in s.blocks]
         parts.append("</section>")
     # < > & as JSON escapes: no name can close the script element or open a comment in it
-    data = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True)
+    data = (json_of(doc.data, indent=1, sort_keys=True)
             .replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026"))
     parts.append(f'<script type="application/json" id="screwkin-data">{data}</script>')
     parts.append("</body></html>")
@@ -368,6 +367,6 @@ def markdown(doc: Document, folder: str) -> tuple:
                 lines.append("")
                 lines.append(f"*{_md_cell(b.caption)}*")
             lines.append("")
-    files["data.json"] = (json.dumps(to_jsonable(doc.data), indent=1, sort_keys=True) + "\n").encode()
+    files["data.json"] = (json_of(doc.data, indent=1, sort_keys=True) + "\n").encode()
     lines.append(f"The results as JSON: [{folder}/data.json]({folder}/data.json)")
     return "\n".join(lines) + "\n", files

@@ -8,7 +8,6 @@ import numpy as np
 from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
 from ..units import in_unit
 from .plots import pyplot
-from .jsonout import nan_to_none
 from .report import sweep_rows
 from .tables import column_text, csv_text, table
 from .outfile import write_figure
@@ -20,18 +19,18 @@ REACTION_POINT = ("what the parent side (link1 of a cut joint) exerts on the chi
 SHAKING_POINT = "what the moving links exert on the ground: force, and moment about the world origin, world axes"
 
 
-def _input_scale(r: DynamicsResult, shown: str | None):
-    """(factor from SI, unit) of the input values as shown: in ``shown`` (a unit of the input's
-    kind as a person typed it: deg, mm, in), else in SI."""
+def _input_values(r: DynamicsResult, shown: str | None):
+    """(the input's values, their unit) as shown: in ``shown`` (a unit of the input's kind as a person
+    typed it: deg, mm, in; units.in_unit converts), else in SI."""
     if shown:
-        return in_unit(1.0, shown), shown
-    return 1.0, r.unit
+        return in_unit(r.values, shown), shown
+    return r.values, r.unit
 
 
 def _list(a):
-    """A flat list of numbers, None where the analysis leaves a value undetermined (NaN: an effort
-    of redundant actuation) -- present.jsonout.nan_to_none on the flattened array."""
-    return nan_to_none(np.asarray(a, float).ravel())
+    """A flat list of numbers, NaN where the analysis leaves a value undetermined (an effort of
+    redundant actuation: null in the JSON, by present/jsonout.py's rule)."""
+    return np.asarray(a, float).ravel().tolist()
 
 
 def dynamics_dict(r: DynamicsResult) -> dict:
@@ -70,7 +69,7 @@ def _effort_header(r, name):
 
 
 def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str | None = None) -> str:
-    f, u = _input_scale(r, shown)
+    x, u = _input_values(r, shown)
     rate = "rad/s" if r.unit == "rad" else "m/s"
     speed = f"{speed_text} ({r.speed:.6g} {rate})" if speed_text else f"{r.speed:.6g} {rate}"
     lines = [f"{r.input} driven at the constant speed {speed}, {len(r.values)} configurations"]
@@ -82,7 +81,7 @@ def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str |
         lines.append(f"load on '{ld.link}' at {at}: force ({', '.join(f'{x:.6g}' for x in ld.wrench[:3])}) N, "
                      f"moment ({', '.join(f'{x:.6g}' for x in ld.wrench[3:])}) N*m, world axes")
     rows = sweep_rows(len(r.values))
-    cols = [column_text(r.values[rows] * f)]
+    cols = [column_text(x[rows])]
     headers = [f"{r.input} [{u}]"]
     for name in r.inputs:
         cols.append([("nan" if not np.isfinite(x) else c) for x, c in zip(r.efforts[name][rows],
@@ -139,7 +138,7 @@ def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str |
 
 
 def dynamics_csv(r: DynamicsResult, shown: str | None = None) -> str:
-    f, u = _input_scale(r, shown)
+    x, u = _input_values(r, shown)
     header = [f"{r.input} [{u}]"] + [_effort_header(r, n) for n in r.inputs] + [
         "kinetic energy [J]", "potential energy [J]", "input power [W]"]
     header += [f"shaking {c} [{'N' if c[0] == 'f' else 'N*m'}]" for c in COMPONENTS]
@@ -147,7 +146,7 @@ def dynamics_csv(r: DynamicsResult, shown: str | None = None) -> str:
         header += [f"{name} {c} [{'N' if c[0] == 'f' else 'N*m'}]" for c in COMPONENTS]
     rows = []
     for k in range(len(r.values)):
-        row = [r.values[k] * f] + [r.efforts[n][k] for n in r.inputs]
+        row = [x[k]] + [r.efforts[n][k] for n in r.inputs]
         row += [r.kinetic_energy[k], r.potential_energy[k], r.input_power[k]]
         row += list(r.shaking_force[k]) + list(r.shaking_moment[k])
         for w in r.reactions.values():
@@ -159,9 +158,8 @@ def dynamics_csv(r: DynamicsResult, shown: str | None = None) -> str:
 def dynamics_plot(r: DynamicsResult, path: str, shown: str | None = None, title: str | None = None) -> None:
     """The input efforts against the input (one curve per actuator, the mean dashed) into a PNG."""
     plt = pyplot("--plot")
-    f, u = _input_scale(r, shown)
+    x, u = _input_values(r, shown)
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    x = r.values * f
     for name in r.inputs:
         y = r.efforts[name]
         ax.plot(x, y, label=f"{name}")

@@ -25,14 +25,14 @@ def _ratio(s) -> float:
 
 
 def ellipsoids_dict(e: Ellipsoids) -> dict:
-    """JSON: each principal axis (unit vector over ``rows``) with its velocity and force
-    semi-axes (dimensionless; force semi-axes ``null`` where infinite), the rank, and the
-    isotropy (smallest over largest velocity semi-axis)."""
+    """JSON: each principal axis (unit vector over ``rows``) with its velocity and force semi-axes
+    (dimensionless; a force semi-axis is infinite, "inf" in JSON, along a wrench that loads no input), the
+    rank, and the isotropy (smallest over largest velocity semi-axis)."""
     return {
         "output": e.output, "point": e.point, "inputs": list(e.inputs), "characteristic_length": e.length,
         "rows": list(e.rows), "force_rows": list(e.force_rows), "rank": e.rank,
         "velocity_semi_axes": [float(x) for x in e.velocity.semi_axes],
-        "force_semi_axes": [float(x) if np.isfinite(x) else None for x in e.force.semi_axes],
+        "force_semi_axes": [float(x) for x in e.force.semi_axes],
         "axes": e.velocity.axes.T.tolist(),
         "isotropy": _ratio(e.velocity.semi_axes),
     }

@@ -9,9 +9,9 @@ import re
 import numpy as np
 
 from ..analysis.course.symbols import PlanarEquations
+from ..units import unit_text
 from .screws import screws_dict, screws_text
-from .tables import table
-from .tables import shown_text
+from .tables import shown_text, table
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
 
@@ -183,23 +183,22 @@ def equations_text(res) -> str:
 
 
 class Units:
-    """How a person typed each quantity: angles in deg or rad, lengths in a unit of length."""
+    """How a person typed each quantity: angles in deg or rad, lengths in a unit of length (written by
+    units.unit_text)."""
 
     def __init__(self, degrees: bool, lengths: dict | None = None):
         self.degrees = degrees
-        self.lengths = lengths or {}  # symbol -> (unit name, factor)
+        self.lengths = lengths or {}  # symbol -> unit ("mm"); m when not given
 
     def value(self, name, kind, v):
         if kind == "angle":
-            return f"{np.degrees(v):.6g} deg" if self.degrees else f"{v:.6g} rad"
-        unit, f = self.lengths.get(name, ("m", 1.0))
-        return f"{v / f:.6g} {unit}"
+            return unit_text(v, "deg" if self.degrees else "rad")
+        return unit_text(v, self.lengths.get(name, "m"))
 
     def step(self, name, kind, v):
         if kind == "angle":
-            return f"{v:.6g} rad" + (f" = {np.degrees(v):.6g} deg" if self.degrees else "")
-        unit, f = self.lengths.get(name, ("m", 1.0))
-        return f"{v / f:.6g} {unit}"
+            return unit_text(v, "rad") + (f" = {unit_text(v, 'deg')}" if self.degrees else "")
+        return unit_text(v, self.lengths.get(name, "m"))
 
 
 def newton_text(res, symbols, units: Units, path: str) -> str:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -11,8 +10,7 @@ from ..analysis.screws import screw_of
 from ..model.geometry import TINY
 from ..tolerances import DEFAULT
 from .jsonout import to_jsonable
-from .tables import table
-from .tables import SHOWN_ZERO, shown, shown_text
+from .tables import SHOWN_ZERO, shown_text, table
 
 __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]
 
@@ -47,7 +45,7 @@ def wrench_axis(w, planar: bool) -> dict:
     f, m = (np.array([w[0], w[1], 0.0]), np.array([0.0, 0.0, w[2]])) if planar else (w[:3], w[3:])
     s = screw_of(np.concatenate([m, f]))  # a twist's (v, w) is a wrench's (m, f): the same axis
     return {"direction": list(s.direction), "point": list(s.point) if s.point is not None else None,
-            "pitch": s.pitch if math.isfinite(s.pitch) else "inf"}
+            "pitch": s.pitch}  # infinite for a couple: "inf" (present/jsonout.py)
 
 
 def _contact_dict(c) -> dict:
@@ -71,7 +69,8 @@ def _certificate_dict(r: GraspResult):
 
 
 def grasp_dict(r: GraspResult) -> dict:
-    """What ``screwkin grasp --json`` prints (plain Python, None for non-finite numbers)."""
+    """What ``screwkin grasp --json`` prints, as plain Python (present/jsonout.py's rule: "inf" for an
+    infinite number, None for a value that does not exist)."""
     q = r.quality
     return to_jsonable({
         "file": r.spec.path,

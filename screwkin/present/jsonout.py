@@ -1,7 +1,12 @@
-"""JSON as screwkin writes it: numpy values as plain numbers and lists; an infinite number as the
-string "inf" or "-inf" (JSON has no Infinity); a NaN refused as the bug it is (a value that does not
-exist is None, written so by the analysis that knows why); and the indented text of json.dumps
-written fast for the long lists of numbers a sweep holds.
+"""JSON as screwkin writes it: the one writer of every ``--json``, of ``report``'s data.json and of
+the Python API's ``to_dict``.
+
+The rule (README, "Command line"): numbers in SI; numpy values as plain numbers and lists; an
+infinite number as the string ``"inf"`` or ``"-inf"`` (JSON has no Infinity: a force ellipsoid's
+semi-axis along a wrench that loads no input, a pure translation's pitch); a value that does not
+exist -- NaN inside screwkin: a map cell off the branch, an effort redundant actuation leaves
+undetermined -- as ``null``, as None is.  The indented text of json.dumps is written fast for the
+long lists of numbers a sweep holds.
 """
 
 from __future__ import annotations
@@ -12,50 +17,70 @@ from itertools import chain
 
 import numpy as np
 
-__all__ = ["to_jsonable", "nan_to_none", "json_text", "json_of"]
+__all__ = ["to_jsonable", "json_of", "json_text"]
 
 
-def to_jsonable(obj, _where: str = ""):
-    """Plain Python for json.dumps: numpy values as numbers and lists; an infinite number (the
-    condition number of a singular matrix, an unbounded effort) as the string "inf" or "-inf",
-    since JSON has no Infinity.  A NaN is a bug, never an answer: RuntimeError naming where it
-    sits (a value that does not exist -- a map cell off the branch -- is None, written so by
-    the analysis that knows why)."""
+def to_jsonable(obj):
+    """Plain Python for json.dumps by the rule above: numpy values as numbers and lists, an infinite
+    number as "inf" or "-inf", a NaN as None."""
     if isinstance(obj, dict):
-        return {k: to_jsonable(v, f"{_where}.{k}") for k, v in obj.items()}
+        return {k: to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         if isinstance(obj, list) and (_numbers(obj) or _rows(obj)):  # finite floats only: nothing to convert
             return obj
-        return [to_jsonable(v, f"{_where}[{i}]") for i, v in enumerate(obj)]
+        return [to_jsonable(v) for v in obj]
     if isinstance(obj, np.ndarray):
         if obj.dtype.kind == "f" and np.isfinite(obj).all():  # (a sweep's arrays: one C call, not a call a number)
             return obj.tolist()
-        return to_jsonable(obj.tolist(), _where)
+        return to_jsonable(obj.tolist())
     if isinstance(obj, np.generic):
         obj = obj.item()
-    if isinstance(obj, float) and not np.isfinite(obj):
-        if np.isnan(obj):
-            raise RuntimeError(f"internal error: NaN in the JSON output at {_where.lstrip('.') or 'the top'}")
+    if isinstance(obj, float) and not math.isfinite(obj):
+        if math.isnan(obj):
+            return None
         return "inf" if obj > 0 else "-inf"
     return obj
 
 
-def nan_to_none(a) -> list:
-    """An array whose NaN entries mean 'no value here' (said so by its analysis) as nested lists
-    with None there, for to_jsonable."""
-    a = np.asarray(a, float)
-    return np.where(np.isnan(a), None, a.astype(object)).tolist()
+def json_of(obj, indent: int | None = 2, sort_keys: bool = False) -> str:
+    """The JSON text of ``obj`` by the rule of this module: json.dumps(to_jsonable(obj), indent=indent,
+    sort_keys=sort_keys), character for character (``indent=None``: on one line), with the finite float
+    arrays (a sweep's stacks, (N,) or (N, k)) written from their values: no list a row, no check a
+    number in Python."""
+    if indent is None:
+        return json.dumps(to_jsonable(obj), sort_keys=sort_keys, allow_nan=False)
+    return _of(obj, indent, sort_keys, 0)
 
 
-def json_text(obj, indent: int = 2, _level: int = 0) -> str:
-    """json.dumps(obj, indent=indent) of to_jsonable's output, character for character, with the
-    lists of numbers (a sweep's tens of thousands of values) written in one join each instead of
-    json's pure-Python encoder (the one it uses with indent), which takes seconds on them."""
+def _of(obj, indent: int, sort_keys: bool, level: int) -> str:
+    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj) and obj:
+        pad, inner = " " * (indent * level), " " * (indent * (level + 1))
+        items = (f"{inner}{json.dumps(k)}: {_of(v, indent, sort_keys, level + 1)}" for k, v in _items(obj, sort_keys))
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if (isinstance(obj, np.ndarray) and obj.dtype.kind == "f" and obj.ndim in (1, 2) and obj.size
+            and np.isfinite(obj).all()):
+        pad, inner = " " * (indent * level), " " * (indent * (level + 1))
+        values = map(float.__repr__, obj.ravel().tolist())
+        if obj.ndim == 1:
+            return "[\n" + inner + (",\n" + inner).join(values) + "\n" + pad + "]"
+        return _rows_text(values, *obj.shape, pad, inner, " " * indent)
+    return json_text(to_jsonable(obj), indent, sort_keys, level)
+
+
+def _items(d: dict, sort_keys: bool):
+    return sorted(d.items(), key=lambda kv: kv[0]) if sort_keys else d.items()
+
+
+def json_text(obj, indent: int = 2, sort_keys: bool = False, _level: int = 0) -> str:
+    """json.dumps(obj, indent=indent, sort_keys=sort_keys) of to_jsonable's output, character for
+    character, with the lists of numbers (a sweep's tens of thousands of values) written in one join
+    each instead of json's pure-Python encoder (the one it uses with indent), which takes seconds on them."""
     pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
     if isinstance(obj, dict) and all(isinstance(k, str) for k in obj):
         if not obj:
             return "{}"
-        items = (f"{inner}{json.dumps(k)}: {json_text(v, indent, _level + 1)}" for k, v in obj.items())
+        items = (f"{inner}{json.dumps(k)}: {json_text(v, indent, sort_keys, _level + 1)}"
+                 for k, v in _items(obj, sort_keys))
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
     if isinstance(obj, (list, tuple)):
         if not obj:
@@ -70,25 +95,9 @@ def json_text(obj, indent: int = 2, _level: int = 0) -> str:
             sep = ",\n" + deeper
             rows = ("[\n" + deeper + sep.join(map(float.__repr__, v)) + "\n" + inner + "]" for v in obj)
             return "[\n" + inner + (",\n" + inner).join(rows) + "\n" + pad + "]"
-        return "[\n" + ",\n".join(inner + json_text(v, indent, _level + 1) for v in obj) + "\n" + pad + "]"
-    return json.dumps(obj, indent=indent).replace("\n", "\n" + pad)
-
-
-def json_of(obj, indent: int = 2, _level: int = 0, _where: str = "") -> str:
-    """json_text(to_jsonable(obj)), the same text, with the finite float arrays (a sweep's stacks,
-    (N,) or (N, k)) written from their values: no list a row, no check a number in Python."""
-    if isinstance(obj, dict) and all(isinstance(k, str) for k in obj) and obj:
-        pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
-        items = (f"{inner}{json.dumps(k)}: {json_of(v, indent, _level + 1, f'{_where}.{k}')}" for k, v in obj.items())
-        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
-    if (isinstance(obj, np.ndarray) and obj.dtype.kind == "f" and obj.ndim in (1, 2) and obj.size
-            and np.isfinite(obj).all()):
-        pad, inner = " " * (indent * _level), " " * (indent * (_level + 1))
-        values = map(float.__repr__, obj.ravel().tolist())
-        if obj.ndim == 1:
-            return "[\n" + inner + (",\n" + inner).join(values) + "\n" + pad + "]"
-        return _rows_text(values, *obj.shape, pad, inner, " " * indent)
-    return json_text(to_jsonable(obj, _where), indent, _level)
+        return "[\n" + ",\n".join(inner + json_text(v, indent, sort_keys, _level + 1) for v in obj) + "\n" + pad + "]"
+    # (allow_nan=False: to_jsonable left no NaN or infinity; one would be a bug in this module)
+    return json.dumps(obj, indent=indent, sort_keys=sort_keys, allow_nan=False).replace("\n", "\n" + pad)
 
 
 def _rows_text(values, n: int, width: int, pad: str, inner: str, step: str) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..tolerances import DEFAULT
+from ..units import in_unit
 from .tables import RateUnits, column_text, fmt_vec, table
 
 __all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "links_table", "points_rows",
@@ -25,10 +26,10 @@ def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
     w, al, v, a = units.rate(False), units.acceleration(False), units.rate(True), units.acceleration(True)
 
     def column(key, unit):
-        return column_text([units.of(links[n][key], unit) for n in names])
+        return column_text([in_unit(links[n][key], unit) for n in names])
 
     def vectors(key, unit):
-        return [fmt_vec(units.of(np.asarray(links[n][key], float), unit), 0) for n in names]
+        return [fmt_vec(in_unit(np.asarray(links[n][key], float), unit), 0) for n in names]
 
     if planar:
         head = ["link", "angle [deg]"] + ([f"omega [{w}]", f"alpha [{al}]"] if rated else [])
@@ -65,8 +66,8 @@ def points_rows(points: dict, units: RateUnits = RateUnits()) -> tuple:
     for name, m in points.items():
         row = [name, m["link"], fmt_vec(m["position"], 0)]
         if "velocity" in m:
-            row += [fmt_vec(units.of(np.asarray(m["velocity"], float), v), 0),
-                    fmt_vec(units.of(np.asarray(m["acceleration"], float), a), 0)]
+            row += [fmt_vec(in_unit(np.asarray(m["velocity"], float), v), 0),
+                    fmt_vec(in_unit(np.asarray(m["acceleration"], float), a), 0)]
         rows.append(row)
     head = ["point", "link", "position [m]"] + ([f"velocity [{v}]", f"acceleration [{a}]"]
                                                  if any("velocity" in m for m in points.values()) else [])
@@ -131,8 +132,8 @@ def motion_rows_text(res, motion, rows, degrees: bool, units: RateUnits | None =
             if units is not None and "omega" in m:
                 w, a = units.angular_rate, units.angular_acceleration
                 head += [f"omega {name} [{w}]", f"alpha {name} [{a}]"]
-                cols += [column_text(RateUnits.of(np.asarray(m["omega"], float), w), absolute=1e-9),
-                         column_text(RateUnits.of(np.asarray(m["alpha"], float), a), absolute=1e-9)]
+                cols += [column_text(in_unit(np.asarray(m["omega"], float), w), absolute=1e-9),
+                         column_text(in_unit(np.asarray(m["alpha"], float), a), absolute=1e-9)]
     for name, v in motion.loop_joints.items():
         angular = name in motion.angular_loop
         head.append(f"{name} (loop) [{'deg' if angular else 'mm'}]")

@@ -10,8 +10,9 @@ fetched: the page stays offline.
 
 from __future__ import annotations
 
-import json
 from html import escape
+
+from .jsonout import json_of
 
 __all__ = ["player_html", "with_player", "PLAYER_ID"]
 
@@ -38,7 +39,7 @@ def player_html(labels, fps: float) -> str:
               f'<span class="sk-readout">frame 1 / {n}: {escape(labels[0]) if labels else ""}</span></div>')
     script = f"""<script>
 (function () {{
-  var labels = {json.dumps(labels)}, fps = {float(fps)!r}, n = labels.length;
+  var labels = {json_of(labels, indent=None)}, fps = {float(fps)!r}, n = labels.length;
   var bar = document.getElementById("{PLAYER_ID}");
   var button = bar.querySelector(".sk-play"), scrub = bar.querySelector(".sk-scrub");
   var readout = bar.querySelector(".sk-readout");

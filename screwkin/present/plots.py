@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
-from ..units import in_unit
+from ..units import Quantity, in_unit
 from .tables import input_rate_words
 from .outfile import write_figure
 
@@ -65,7 +65,7 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     scale = np.where(linear, 1000.0, 180.0 / np.pi)  # mm, deg
     first = "absolute angle, position" if absolute else "joint value"
     rates_what = "omega, rate" if absolute else "rate"
-    rate_words = rate_words or input_rate_words(res.input, res.rate, None, not x_deg)
+    rate_words = rate_words or input_rate_words(res.input, Quantity(res.rate), not x_deg)
     rows = [(first, joints, "deg", "mm"),
             (f"{rates_what} ({rate_words})", np.asarray(res.rates), "deg/s", "mm/s"),
             (f"{'alpha, acceleration' if absolute else 'acceleration'} ({rate_words})", np.asarray(res.accelerations),

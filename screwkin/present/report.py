@@ -17,13 +17,14 @@ from ..analysis.screws import Screw
 from ..analysis.singularities.singular import SingularityReport
 from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
+from ..units import in_unit
 from .motion import linkage_construction_text, links_table, points_table
 from .screws import screw_dict
 from .tables import RateUnits, column_text, csv_text, table
 from .tables import fmt_vec as _fmt_vec
 from ..tolerances import DEFAULT
 from .numtext import csv_rows
-from .jsonout import nan_to_none, to_jsonable
+from .jsonout import to_jsonable
 from .mobility import mobility_dict, topology_dict
 
 __all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "singularity_dict",
@@ -156,16 +157,16 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
         rows.append(row)
         if s.rates is not None:
             linear = name not in res.angular
-            rates.append(units.of(s.rates.get(name, float("nan")), units.rate(linear)))
-            accs.append(units.of(s.accelerations.get(name, float("nan")), units.acceleration(linear)))
+            rates.append(in_unit(s.rates.get(name, float("nan")), units.rate(linear)))
+            accs.append(in_unit(s.accelerations.get(name, float("nan")), units.acceleration(linear)))
     for name, v in (s.loop_joints or {}).items():  # the loop (cut) joints' coordinates, as the tree's
         row = [f"{name} (loop)", f"{v:.9g}"]
         row.append(f"{np.degrees(v):.6g} deg" if degrees and name in res.angular_loop else along(name))
         rows.append(row)
         if s.rates is not None:
             linear = name not in res.angular_loop
-            rates.append(units.of(s.loop_rates[name], units.rate(linear)) if s.loop_rates else float("nan"))
-            accs.append(units.of(s.loop_accelerations[name], units.acceleration(linear))
+            rates.append(in_unit(s.loop_rates[name], units.rate(linear)) if s.loop_rates else float("nan"))
+            accs.append(in_unit(s.loop_accelerations[name], units.acceleration(linear))
                         if s.loop_accelerations else float("nan"))
     if s.rates is not None:  # round-off (a loop joint's 4e-16 rad/s) written as 0
         rows = [row + [r, a] for row, r, a in zip(rows, column_text(rates), column_text(accs))]
@@ -517,7 +518,7 @@ def map_dict(res: SingularityMap) -> dict:
     reached = res.reached if res.reached is not None else np.isfinite(res.log_sigma)
     seams = res.seams.tolist() if res.seams is not None else []
     return {"x": res.x_name, "y": res.y_name, "xs": res.xs, "ys": res.ys,
-            "log10_sigma_min": nan_to_none(res.log_sigma), "kind": res.kind, "reached": reached,
+            "log10_sigma_min": res.log_sigma, "kind": res.kind, "reached": reached,
             "off_branch": int(reached.size - reached.sum()), "seams": seams, "notes": list(res.notes)}
 
 
@@ -533,8 +534,9 @@ _DICTS = {MobilityResult: mobility_dict, PositionResult: position_dict, Singular
 
 
 def to_dict(result) -> dict:
-    """What ``--json`` prints for a result of screwkin's analyses, as plain Python (numbers,
-    strings, lists, dictionaries; None for numbers that are not finite)."""
+    """What ``--json`` prints for a result of screwkin's analyses, as plain Python (numbers, strings,
+    lists, dictionaries) by the one rule of present/jsonout.py: an infinite number as "inf" or "-inf",
+    a value that does not exist (NaN) as None."""
     for cls, fn in _DICTS.items():
         if isinstance(result, cls):
             return to_jsonable(fn(result))

@@ -15,7 +15,7 @@ __all__ = ["gram_symbolic_dict", "gram_symbolic_text", "screw_dict", "screws_dic
 def screw_dict(s: Screw) -> dict:
     return {"twist": list(s.twist), "direction": list(s.direction),
             "point": list(s.point) if s.point is not None else None,
-            "pitch": s.pitch if np.isfinite(s.pitch) else "inf"}
+            "pitch": s.pitch}  # infinite for a translation: "inf" (present/jsonout.py)
 
 
 def screws_dict(structure, normal=None) -> list:

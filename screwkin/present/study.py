@@ -43,17 +43,24 @@ __all__ = [
     "write_table",
 ]
 
-#: Row key -> (column name in the table, factor from SI).
+#: Row key -> (column name in the table, the unit it is written in: units.in_unit converts).
 DISPLAY = {
-    "transmission_angle_min": ("transmission_angle_min_deg", 180.0 / math.pi),
-    "transmission_angle_max": ("transmission_angle_max_deg", 180.0 / math.pi),
-    "transmission_deviation": ("transmission_deviation_deg", 180.0 / math.pi),
-    "grashof_margin": ("grashof_margin_m", 1.0),
+    "transmission_angle_min": ("transmission_angle_min_deg", "deg"),
+    "transmission_angle_max": ("transmission_angle_max_deg", "deg"),
+    "transmission_deviation": ("transmission_deviation_deg", "deg"),
+    "grashof_margin": ("grashof_margin_m", "m"),
 }
 
 
+def _factor(unit: str) -> float:
+    """The factor from SI of a value shown in ``unit`` (units.in_unit's; 1 for a number without one)."""
+    return in_unit(1.0, unit) if unit else 1.0
+
+
 def _display(key):
-    return DISPLAY.get(key, (key, 1.0))
+    """(column name, factor from SI) of a row key."""
+    name, unit = DISPLAY.get(key, (key, ""))
+    return name, _factor(unit)
 
 
 def table_columns(result) -> list:
@@ -71,7 +78,7 @@ def _cell(v, factor):
         return int(v)
     if isinstance(v, (float, np.floating)):
         v = float(v) * factor if factor != 1.0 else float(v)
-        return v if math.isfinite(v) else None
+        return None if math.isnan(v) else v  # no value: an empty cell (an infinite one is inf, as in JSON)
     return v
 
 
@@ -293,22 +300,23 @@ def _numeric(result):
     return out
 
 
-#: Metric key -> (axis label with its unit, factor from SI) on the study's plots
+#: Metric key -> (axis label, the unit it is shown in: units.in_unit converts; "" for none) on the
+#: study's plots; the label says the unit (in brackets after the name when it is one of units.py's).
 LABELS = {
-    "transmission_angle_min": ("smallest transmission angle [deg]", 180.0 / math.pi),
-    "transmission_angle_max": ("largest transmission angle [deg]", 180.0 / math.pi),
-    "transmission_deviation": ("largest |90 deg - transmission angle| [deg]", 180.0 / math.pi),
-    "dead_points": ("dead points [-]", 1.0),
-    "grashof_margin": ("Grashof margin (p+q)-(s+l) [mm]", 1000.0),
-    "mobility": ("mobility [DOF]", 1.0),
-    "mobility_count": ("mobility by counting [DOF]", 1.0),
-    "overconstraint": ("overconstraint [constraints]", 1.0),
-    "idle_dofs": ("idle DOFs [DOF]", 1.0),
-    "effective_mobility": ("effective mobility [DOF]", 1.0),
-    "workspace_volume": ("workspace volume [m^{dim}]", 1.0),
-    "singularity_free_volume": ("singularity-free volume [m^{dim}]", 1.0),
-    "conditioning_min": ("smallest conditioning [-]", 1.0),
-    "conditioning_mean": ("mean conditioning [-]", 1.0),
+    "transmission_angle_min": ("smallest transmission angle", "deg"),
+    "transmission_angle_max": ("largest transmission angle", "deg"),
+    "transmission_deviation": ("largest |90 deg - transmission angle|", "deg"),
+    "dead_points": ("dead points [-]", ""),
+    "grashof_margin": ("Grashof margin (p+q)-(s+l)", "mm"),
+    "mobility": ("mobility [DOF]", ""),
+    "mobility_count": ("mobility by counting [DOF]", ""),
+    "overconstraint": ("overconstraint [constraints]", ""),
+    "idle_dofs": ("idle DOFs [DOF]", ""),
+    "effective_mobility": ("effective mobility [DOF]", ""),
+    "workspace_volume": ("workspace volume [m^{dim}]", ""),
+    "singularity_free_volume": ("singularity-free volume [m^{dim}]", ""),
+    "conditioning_min": ("smallest conditioning [-]", ""),
+    "conditioning_mean": ("mean conditioning [-]", ""),
 }
 FAILED_COLOR = "crimson"
 
@@ -316,7 +324,11 @@ FAILED_COLOR = "crimson"
 def _label(key, result=None):
     """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
     dimension (m^2 or m^3; m^d when they differ)."""
-    label, factor = LABELS.get(key, _display(key))
+    if key in LABELS:
+        label, unit = LABELS[key]
+        label, factor = (f"{label} [{unit}]" if unit else label), _factor(unit)
+    else:
+        label, factor = _display(key)
     if "{dim}" in label:
         dims = {r.get("workspace_dimension") for r in (result.succeeded if result is not None else ())} - {None}
         label = label.replace("{dim}", str(dims.pop()) if len(dims) == 1 else "d")
@@ -328,7 +340,7 @@ def _parameter_axis(result, name):
     file's ``30mm``), else as given (xacro arguments are SI, the file does not say m or rad)."""
     unit = next((getattr(p, "unit", "") for p in result.spec.parameters if p.name == name), "")
     if unit:
-        return f"{name} [{unit}]", in_unit(1.0, unit)
+        return f"{name} [{unit}]", _factor(unit)
     return f"{name} (as given, SI: no unit typed)", 1.0
 
 

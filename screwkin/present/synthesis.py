@@ -20,8 +20,7 @@ from ..analysis.design.synthesis.chains import guides_of
 from ..model.geometry import wrap_angle
 from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local
 from .jsonout import to_jsonable
-from .tables import table
-from .tables import shown_text
+from .tables import shown_text, table
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 

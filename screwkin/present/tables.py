@@ -6,7 +6,7 @@ import csv
 import io
 from dataclasses import dataclass
 
-from ..units import in_unit, unit_kind
+from ..units import Quantity, shown_unit, unit_text
 
 __all__ = ["table", "shown", "shown_text", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits",
            "input_rate_words"]
@@ -52,43 +52,30 @@ def column_text(values, relative: float = 1e-9, absolute: float = SHOWN_ZERO) ->
 @dataclass(frozen=True)
 class RateUnits:
     """The units a table writes rates and accelerations in: SI unless a person typed others with
-    ``--rate``/``--accel`` (:meth:`typed`).  Values stay SI everywhere else (JSON, analysis)."""
+    ``--rate``/``--accel`` (:meth:`typed`).  Values stay SI everywhere else (JSON, analysis); which
+    unit a typed one makes is units.shown_unit's rule, the conversion units.in_unit."""
 
     angular_rate: str = "rad/s"
     angular_acceleration: str = "rad/s^2"
     linear_rate: str = "m/s"
     linear_acceleration: str = "m/s^2"
 
-    #: a unit typed -> (field, display unit): an angle or a length given for a rate keeps its old meaning
-    #: (--rate crank=90deg is 90 deg/s); degrees typed for a rate show accelerations in deg/s^2 too
-    #: (each rate's acceleration is its unit per second: rpm -> rpm/s, never rpm beside rad/s^2)
-    _RATE = {"deg": ("deg/s", "deg/s^2"), "deg/s": ("deg/s", "deg/s^2"), "rpm": ("rpm", "rpm/s"),
-             "rev/min": ("rpm", "rpm/s"), "rev/s": ("rev/s", "rev/s^2"), "mm": ("mm/s", "mm/s^2"),
-             "mm/s": ("mm/s", "mm/s^2"), "cm": ("cm/s", "cm/s^2"), "cm/s": ("cm/s", "cm/s^2")}
-    _ACCEL = {"deg": "deg/s^2", "deg/s^2": "deg/s^2", "deg/s2": "deg/s^2", "mm": "mm/s^2", "mm/s^2": "mm/s^2",
-              "mm/s2": "mm/s^2", "rpm/s": "rpm/s", "rev/s^2": "rev/s^2", "rev/s2": "rev/s^2", "cm/s^2": "cm/s^2",
-              "cm/s2": "cm/s^2"}
-
     @classmethod
-    def typed(cls, rate_units=(), accel_units=()) -> "RateUnits":
-        """The units of the first rate and acceleration typed of each kind (angular, linear); SI for
-        the kinds typed bare or in SI."""
-        out = {}
-        for unit in rate_units:
-            written = cls._RATE.get(unit) or cls._RATE.get(unit.lower())
-            kind = unit_kind(unit)
-            if written is None or kind is None:
-                continue
-            linear = kind in ("length", "linear rate")
-            out.setdefault("linear_rate" if linear else "angular_rate", written[0])
-            if written[1]:
-                out.setdefault("linear_acceleration" if linear else "angular_acceleration", written[1])
-        for unit in accel_units:
-            written, kind = cls._ACCEL.get(unit) or cls._ACCEL.get(unit.lower()), unit_kind(unit)
-            if written and kind:
-                key = "linear_acceleration" if kind in ("length", "linear acceleration") else "angular_acceleration"
-                out[key] = written  # an acceleration typed wins over one implied by a rate
-        return cls(**out)
+    def typed(cls, rates=(), accels=()) -> "RateUnits":
+        """The units of the first rate and acceleration typed of each kind (angular, linear), from the
+        units.Quantity values of --rate and --accel: a rate's unit per second for the accelerations
+        too (rpm: rpm/s), an acceleration typed winning over it; SI for the kinds typed bare or in SI."""
+        out = [{}, {}]  # implied by a rate, typed as an acceleration
+        for quantities, fields, into in ((rates, ("rate", "acceleration"), out[0]),
+                                         (accels, ("acceleration",), out[1])):
+            for q in quantities:
+                side = "linear" if q.kind in ("length", "linear rate", "linear acceleration") else "angular"
+                for field in fields:
+                    kind = f"{side} {field}"
+                    unit = shown_unit(q.unit, kind)
+                    if q.unit and unit != shown_unit("", kind):
+                        into.setdefault(kind.replace(" ", "_"), unit)
+        return cls(**{**out[0], **out[1]})
 
     def rate(self, linear: bool) -> str:
         return self.linear_rate if linear else self.angular_rate
@@ -96,21 +83,16 @@ class RateUnits:
     def acceleration(self, linear: bool) -> str:
         return self.linear_acceleration if linear else self.angular_acceleration
 
-    @staticmethod
-    def of(value: float, unit: str) -> float:
-        """An SI value in ``unit`` (rad/s -> rpm ...): units.in_unit."""
-        return in_unit(value, unit)
 
-
-def input_rate_words(name: str, rate: float, unit: str | None, linear: bool) -> str:
+def input_rate_words(name: str, rate: Quantity | None, linear: bool) -> str:
     """What a sweep's rates and accelerations are for, in words: ``at crank 120 rpm`` for a rate typed
-    (``unit`` as typed; an angle or a length typed for a rate is per second), ``per 1 rad/s of crank`` for
-    the default (the input at 1 rad/s or 1 m/s: the rates are then the velocity ratios)."""
+    (shown in its unit; an angle or a length typed for a rate is per second), ``per 1 rad/s of crank``
+    for the default (the input at 1 rad/s or 1 m/s: the rates are then the velocity ratios)."""
     si = "m/s" if linear else "rad/s"
-    if not unit:
-        return f"per {rate:g} {si} of {name}" if rate == 1.0 else f"at {name} {rate:g} {si}"
-    written = RateUnits._RATE.get(unit, (None,))[0] or RateUnits._RATE.get(unit.lower(), (None,))[0] or unit
-    return f"at {name} {in_unit(rate, written.replace('^', '')):.6g} {written}"
+    value = 1.0 if rate is None else rate.value
+    if rate is None or not rate.unit:
+        return f"per {value:g} {si} of {name}" if value == 1.0 else f"at {name} {value:g} {si}"
+    return f"at {name} {unit_text(value, shown_unit(rate.unit, 'linear rate' if linear else 'angular rate'))}"
 
 
 #: What a spreadsheet reads as the start of a formula in a text cell (CSV injection).
@@ -118,8 +100,11 @@ _FORMULA = ("=", "+", "-", "@", "\t", "\r")
 
 
 def csv_cell(value):
-    """A cell for a CSV written from untrusted names: numbers as they are; a text that a spreadsheet
-    would run as a formula (=, +, -, @, tab, CR first) gets a leading apostrophe."""
+    """A cell for a CSV written from untrusted names: numbers as they are, but a value that does not
+    exist (NaN: an effort redundant actuation leaves undetermined) empty, as a missing one (None); a
+    text that a spreadsheet would run as a formula (=, +, -, @, tab, CR first) gets a leading apostrophe."""
+    if isinstance(value, float) and value != value:
+        return ""
     if isinstance(value, str) and value.startswith(_FORMULA):
         try:
             float(value)

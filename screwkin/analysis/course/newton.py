@@ -89,7 +89,7 @@ def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = N
 def start_estimates(mech, loops, solver, q_in, values, typed):
     """The estimates of every unknown of the loop equations from ``--start`` items (units.parse_typed_assignments):
     symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
-    returns (symbol -> estimate, symbol -> unit typed)."""
+    returns (symbol -> estimate, symbol -> the units.Quantity typed)."""
     by_link = {}
     for n in loops.variables:
         info = loops.symbol_info[n]
@@ -97,7 +97,8 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             by_link[info.link] = n
     symbols, joints, units = {}, {}, {}
     joint_names = set(mech.coordinate_names)
-    for name, v, unit in typed:
+    for name, typed_value in typed:
+        v = typed_value.value
         if name in loops.input_joints or name in values:
             raise UsageError(f"{mech.path}: '{name}' is an input: give its value with --set")
         if name in loops.unknowns:
@@ -128,7 +129,7 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             valid = ", ".join(list(loops.unknowns) + [lk for lk, n in by_link.items() if n in loops.unknowns])
             raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{name[:80]}' "
                              f"(unknowns of the loop equations: {valid}; or passive joint names)")
-        units[name] = unit
+        units[name] = typed_value
     start = loops.values(solver.set_inputs(q_in, joints)) if joints else {}
     covered = set(symbols)
     if joints:
