@@ -223,7 +223,7 @@ def run(mech, args) -> int:
 
     # ---- positions, velocities, accelerations
     if pres is not None:
-        given_rates = "input rates " + _rates_text(mech, typed["rate"], rates) + \
+        given_rates = "input rates " + _input_rates_text(mech, typed["rate"], rates) + \
                       (", input accelerations as given" if accels else ", input accelerations 0")
         rate_units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())  # the units typed
         sections.append(motion_section(pres, given_rates, mech.length, rate_units, data.get("mode", {}).get("index", 1)))
@@ -285,7 +285,7 @@ def run(mech, args) -> int:
     return 0
 
 
-def _rates_text(mech, typed: dict, rates) -> str:
+def _input_rates_text(mech, typed: dict, rates) -> str:
     """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``; ``typed``: joint_quantities of
     --rate), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
