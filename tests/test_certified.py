@@ -10,6 +10,7 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
+from screwkin.analysis.motion import certified
 from screwkin.analysis.motion.ik import inverse_kinematics
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
@@ -98,16 +99,13 @@ def test_sign_symmetries_of_the_six_ups():
 
 
 # ------------------------------------------------------------------ counts
-def test_four_bar_has_two_modes_certified(capsys):
-    """The README's four-bar at 30 deg: two modes, the rocker at 55.27 deg or -89.30 deg (law of
-    cosines), certified by the trace test."""
-    path = str(ROBOTS / "fourbar_crank_rocker.urdf")
-    assert main(["solve", path, "--set", "crank_joint=30deg", "--json"]) == 0
-    d = json.loads(capsys.readouterr().out)
-    assert d["modes"]["complete"] and d["modes"]["certificate"] == "trace test"
-    assert (d["modes"]["real"], d["modes"]["complex"], d["modes"]["found"]) == (2, 0, 2)
-    assert main(["solve", path, "--set", "crank_joint=30deg"]) == 0
-    assert "all 2 assembly modes (certified: trace test)" in capsys.readouterr().out
+def test_four_bar_has_two_modes_certified():
+    """A crank-rocker four-bar at 30 deg: two modes, certified by the trace test (the homotopy itself:
+    solve places a mechanism made of dyads in closed form, tests/test_dyad_modes.py compares the two)."""
+    solver = PositionSolver(screwkin.load(ROBOTS / "fourbar_crank_rocker.urdf"))
+    c = certified.certified_modes(solver, {"crank_joint": np.radians(30)}).count
+    assert c.complete and c.certificate == "trace test" and c.method == "monodromy"
+    assert (c.real, c.complex, c.found) == (2, 0, 2)
 
 
 def _total_degree_roots(pc):
@@ -153,9 +151,9 @@ def test_monodromy_agrees_with_a_total_degree_homotopy():
     mech, solver, pc, q = closure_of("fourbar_crank_rocker", eliminate=False)
     td = _total_degree_roots(pc)
     td = td[np.abs(pc.residual_all(td)).max(axis=1) < 1e-8]
-    res = solver.solve({"crank_joint": float(q[mech.coordinate("crank_joint").idx_q])})
-    assert res.modes.complete and res.modes.found == len(td) == 2
-    got = sorted(s.joints["rocker_joint"] for s in res.solutions)
+    got = certified.certified_modes(solver, {"crank_joint": float(q[mech.coordinate("crank_joint").idx_q])})
+    assert got.count.complete and got.count.found == len(td) == 2 and got.count.method == "monodromy"
+    got = sorted(float(q[mech.coordinate("rocker_joint").idx_q]) for q, _, _, _ in got.modes)
     want = sorted(float(pc.to_q(x, q)[mech.coordinate("rocker_joint").idx_q]) for x in td)
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
 

@@ -33,6 +33,7 @@ from ...model.algebraic import PolynomialClosure, algebraic_obstacle
 from ...model.square import SquareSystem
 from ...model.cuts import Assembly
 from ...model.symmetry import find_symmetries
+from .dyad_modes import dyad_modes
 from .known_counts import known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
 
@@ -49,10 +50,12 @@ class ModeCount:
 
     found:       modes found, real and complex (distinct placements of the links);
     complete:    every mode is found (certified: ``certificate`` says how);
-    method:      "monodromy" (homotopy continuation) or "random starts" (damped Newton);
+    method:      "closed form (dyads)" (a planar mechanism made of dyads: analysis.motion.dyad_modes),
+                 "monodromy" (homotopy continuation) or "random starts" (damped Newton);
     real:        modes with real joint values: the mechanism's assembly modes, reported;
     complex:     modes with complex joint values (no real assembly), None when not known;
-    certificate: how completeness is known ("trace test"), None when it is not;
+    certificate: how completeness is known ("closed form, 2 dyads, 4 branch vectors", "trace test", a
+                 published count), None when it is not;
     reason:      why completeness is not certified ("" when it is);
     detail:      what the search did: paths tracked and failed, the trace test's value, the
                  symmetry group's size, roots at infinity and spurious ones, seconds."""
@@ -291,10 +294,37 @@ class Search:
         return self.count is not None and self.count.complete
 
 
+def closed_form(solver, values: dict):
+    """The modes of a planar mechanism made of dyads (analysis.motion.dyad_modes) as a Certified, or
+    why the closed form does not apply (a string)."""
+    got = dyad_modes(solver, values)
+    if isinstance(got, str):
+        return got
+    k, s = got.dyads, "s" if got.dyads != 1 else ""
+    double = sum(n > 1 for _, _, n, _ in got.modes)
+    certificate = (f"closed form, {k} dyad{s} ({', '.join(got.kinds)}), {got.choices} branch vectors"
+                   + (f", {got.complex} with a negative discriminant" if got.complex else "")
+                   + (f", {2 * double} meeting at a limit position" if double else ""))
+    detail = {"dyads": k, "kinds": list(got.kinds), "branch_vectors": got.choices, "real_branch_vectors":
+              got.real_choices, "swept_from": got.swept, "seconds": round(float(got.seconds), 3)}
+    count = ModeCount(len(got.modes) + got.complex, True, "closed form (dyads)", len(got.modes), got.complex,
+                      certificate, "", detail)
+    return Certified(got.modes, count)
+
+
 def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) -> Search:
-    """certified_modes for solve (and ik, with its ``problem``): its modes as the (signature, q,
-    Assembly) of PositionSolver.distinct."""
-    got = certified_modes(solver, values, seed=seed, problem=problem)
+    """Every mode for solve (and ik, with its ``problem``): in closed form where the mechanism is made
+    of dyads (``closed_form``), else by certified_modes; its modes as the (signature, q, Assembly) of
+    PositionSolver.distinct."""
+    got, dyads = None, ""
+    if problem is None and not obstacle(solver):
+        got = closed_form(solver, values)
+        if isinstance(got, str):
+            got, dyads = None, got
+    if got is None:
+        got = certified_modes(solver, values, seed=seed, problem=problem)
+        if dyads and not isinstance(got, str):
+            got.count = replace(got.count, detail={**got.count.detail, "closed_form": dyads})
     if isinstance(got, str):
         return Search([], [], None, got)
     found = [(solver.signature(q), q, a) for q, a, _, _ in got.modes]

@@ -131,9 +131,10 @@ def _turn_from(u0, u):
 
 class _Geometry:
     """The plan's joints read at q0: plane basis, points and slide directions in plane
-    coordinates, axis signs, the branch of each dyad."""
+    coordinates, axis signs, the branch of each dyad (``probe``; without it ``branch`` is None:
+    the caller chooses the branches, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech, p: DyadPlan, q0):
+    def __init__(self, mech, p: DyadPlan, q0, probe: bool = True):
         model, data = mech.model, mech.scratch_data()
         pin.computeJointJacobians(model, data, q0)
         pin.updateFramePlacements(model, data)
@@ -170,7 +171,9 @@ class _Geometry:
         self._points = [tuple(np.array([e1 @ x, e2 @ x]) for x in both) for both in points]
         self._dirs = [tuple(np.array([e1 @ a, e2 @ a]) for a in both) for both in axes]
         self.signs = [float(np.sign(a[0] @ n)) for a in axes]
-        self.branch = []
+        self.branch = [] if probe else None
+        if not probe:
+            return
         for (kinds, ia, ib, ic), (g1, g2) in zip(p.dyads, p.order[1:]):
             d = _solve_dyad(self, kinds, ia, ib, ic, g1, g2, None, None, None, probe=True)
             if not (abs(d) > _NEAR_LIMIT):
@@ -398,13 +401,20 @@ _LIMIT_REASON = ("limit position: the passive joints become undetermined (an act
                  "the input cannot go further on this branch")
 
 
-def _ready(solver, name, q0):
-    """(plan, geometry, layout) for sweeping ``name`` from q0, or None when the closed form does not apply."""
+def cached_plan(solver, name):
+    """model.planar_graph.plan of the solver's mechanism swept along ``name`` with its other inputs
+    held (a DyadPlan, or why not), kept in the mechanism's cache."""
     mech = solver.mech
     key = ("dyads.plan", tuple(solver.inputs), name)
     if key not in mech.cache:
         mech.cache[key] = plan(mech, solver.inputs, name)
-    p = mech.cache[key]
+    return mech.cache[key]
+
+
+def _ready(solver, name, q0):
+    """(plan, geometry, layout) for sweeping ``name`` from q0, or None when the closed form does not apply."""
+    mech = solver.mech
+    p = cached_plan(solver, name)
     if isinstance(p, str):
         return None
     geo = _Geometry(mech, p, q0)

@@ -417,14 +417,16 @@ class PositionSolver:
         count = (done.count if done is not None and done.complete else
                  None if by_near else certified.count_after_starts(done, found, len(start_list)))
         if not found:
-            certain = (f"; none of the {done.count.complex} complex solutions is real (certified: "
-                       f"{done.count.certificate})") if done is not None and done.complete else ""
+            # certified: said first (a long message is cut at its end)
+            certain = ((f"none of the {done.count.complex} complex solutions is real" if done.count.complex != 1 else
+                        "its one solution is complex") + f" (certified: {done.count.certificate})") \
+                if done is not None and done.complete else None
             raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
                                 detail="the inputs " + ", ".join(
                                            [self._describe(values)] * bool(values)
                                            + [f"the angle of {k}" for k in mech.closure.row_inputs])
                                        + " cannot be reached from "
-                                       f"{len(start_list)} starting configurations" + certain)
+                                       f"{len(start_list)} starting configurations", reason=certain)
         if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
             found = engaged(self, found, values)
         if whole:
