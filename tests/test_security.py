@@ -113,7 +113,7 @@ def test_no_output_holds_the_canary_or_raw_html_names(hostile):
         "solve": ["solve", path, "--set", "crank_joint=1.5", "--json"],
         "info": ["info", path, "--json"],
         "mobility": ["mobility", path, "--json"],
-        "map": ["map", arm, f"--x={MINUS}=0:1:3", f"--y={AT}=0.5:1:3", "--csv", out / "map.csv"],
+        "map": ["map", arm, f"--x={MINUS}=0:1:3", f"--y={AT}=0.5:1:3", "--set", "j3=0", "--csv", out / "map.csv"],
         "workspace": ["workspace", arm, "--output", IMG, "--resolution", "50mm", "--csv", out / "ws.csv"],
         "scan": ["scan", arm, "--output", IMG, "--samples", "20", "--csv", out / "scan.csv"],
     }
@@ -162,7 +162,7 @@ def test_csv_quotes_names_and_neutralises_formulas(hostile):
     assert not any(c.startswith(("=", "+", "@")) for c in head)
     assert len(body) == 5 and all(isinstance(float(c), float) for r in body for c in r)  # numbers stay numbers
     assert any(c.startswith("-") for r in body for c in r)  # a negative number is written as it is
-    assert screwkin_cli("map", str(arm), f"--x={MINUS}=0:1:3", f"--y={AT}=0.5:1:3",
+    assert screwkin_cli("map", str(arm), f"--x={MINUS}=0:1:3", f"--y={AT}=0.5:1:3", "--set", "j3=0",
                         "--csv", str(out / "map.csv")).returncode == 0
     head, *body = _rows(out / "map.csv")
     assert head == ["'" + MINUS, "'" + AT, "log10_sigma_min", "kind"] and len(body) == 9
@@ -330,6 +330,20 @@ def test_past_a_file_size_limit_the_partial_file_is_removed_and_said(name, tmp_p
                                                           "export-mjcf"}))
 def test_past_a_file_size_limit_every_output(name, tmp_path, study_spec):
     _past_the_size_limit(name, tmp_path, study_spec)
+
+
+def test_under_a_file_size_limit_the_compiled_kernels_stay_in_memory(tmp_path):
+    """The RSSR's modes come from the homotopy, whose kernels numba compiles and caches on disk: under
+    ``ulimit -f`` the cache file's write failed with EFBIG, exit 3 ("internal error ... File too
+    large") on a solve that writes no file.  Now the kernels stay in memory there (an empty cache
+    folder forces the write)."""
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    p = subprocess.run([sys.executable, "-m", "screwkin", "solve", str(root / "robots" / "rssr.urdf"),
+                        "--set", "crank_joint=0.3"], capture_output=True, text=True, timeout=300,
+                       preexec_fn=_limited(300), env=env)
+    assert p.returncode == 0 and "rocker_joint" in p.stdout, p.stderr
+    assert not (tmp_path / "numba").exists()
 
 
 def test_a_folder_of_outputs_where_no_folder_can_be_made_is_refused_before_the_work(capsys):

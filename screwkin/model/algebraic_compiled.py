@@ -68,7 +68,10 @@ def kernel():
 def _build():
     import numba as nb
 
-    @nb.njit(cache=True)
+    from .compiled import cache_on_disk
+    cache = cache_on_disk()
+
+    @nb.njit(cache=cache)
     def one(x, Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
             nt, jacobian, r, J):
         nj = parent.shape[0]
@@ -237,7 +240,7 @@ def _build():
                     J[i, v] = (da0 * ub[0] + da1 * ub[1] + da2 * ub[2]
                                + ua[0] * db0 + ua[1] * db1 + ua[2] * db2)
 
-    @nb.njit(cache=True)
+    @nb.njit(cache=cache)
     def rows(X, Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
              nt, jacobian):
         P, m = X.shape[0], rk.shape[0]

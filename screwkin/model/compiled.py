@@ -45,6 +45,17 @@ def available() -> bool:
     return True
 
 
+def cache_on_disk() -> bool:
+    """Whether numba may keep its compiled kernels on disk: not under a limit on the size of the files
+    this process writes (ulimit -f), which numba's cache files (several MB) would pass -- the write
+    fails with EFBIG, and the kernels are then compiled in memory for this run only."""
+    try:
+        import resource
+    except ImportError:  # not a POSIX system
+        return True
+    return resource.getrlimit(resource.RLIMIT_FSIZE)[0] == resource.RLIM_INFINITY
+
+
 def kernels():
     """The compiled functions (compiled or loaded from the cache at the first call)."""
     global _KERNELS
@@ -56,7 +67,9 @@ def kernels():
 def _compile_kernels():
     import numba as nb
 
-    @nb.njit(cache=True)
+    cache = cache_on_disk()
+
+    @nb.njit(cache=cache)
     def cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian):
         """Solver rows of each cut joint c, in order: F2's origin along F1's axes
         (e . d, e fixed in F1), then for welds R2 e - R1 e for the three axes e.
@@ -95,7 +108,7 @@ def _compile_kernels():
                     i += 3
         return i
 
-    @nb.njit(cache=True)
+    @nb.njit(cache=cache)
     def damped_step(K, r, free, mu):
         """model.newton.damped_step, compiled: the minimum-norm damped step on the free columns
         (the smaller of the two normal systems) and |r + K_f dq_f|^2 (the linear model's residual)."""
@@ -124,7 +137,7 @@ def _compile_kernels():
 
     k = Kernels()
     k.cut_rows, k.damped_step = cut_rows, damped_step
-    k.judge = nb.njit(cache=True)(newton.judge)  # the loop's verdict, compiled from its one definition
+    k.judge = nb.njit(cache=cache)(newton.judge)  # the loop's verdict, compiled from its one definition
     return k
 
 
