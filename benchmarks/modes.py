@@ -55,12 +55,12 @@ def main():
     res, t = best(lambda: solver.solve(values))
     c = res.modes
     rows.append(("homotopy continuation, numba kernel", t, c.found, c.real, c.certificate or c.reason))
-    original = algebraic.algebraic_compiled.available
-    algebraic.algebraic_compiled.available = lambda: False
+    original = algebraic.numba_kernels.available
+    algebraic.numba_kernels.available = lambda: False
     try:
         res_np, t_np = best(lambda: solver.solve(values), rounds=1)
     finally:
-        algebraic.algebraic_compiled.available = original
+        algebraic.numba_kernels.available = original
     rows.append(("homotopy continuation, numpy only", t_np, res_np.modes.found, res_np.modes.real,
                  res_np.modes.certificate or res_np.modes.reason))
     want = [s.q for s in res.solutions]

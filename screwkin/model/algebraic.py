@@ -31,8 +31,9 @@ a path makes a big excursion, cannot make the point drift off the variety).  On 
 those coordinates is the geometric one: a revolute's column moves a point p by w x (p - o) and a
 vector v by w x v (w its world axis, o its origin), a prismatic's moves points by its world axis, a
 quaternion's are three revolutes about its frame's axes through its centre.
-Everything is evaluated for a stack of points at once in complex arithmetic, the stack's index
-last inside (3 x 3 products as sums of broadcast products: four times numpy's stacked matmul).
+Everything is evaluated for a stack of points at once in complex arithmetic: in numpy by
+model.algebraic_numpy (the stack's index last inside; 3 x 3 products as sums of broadcast products,
+four times numpy's stacked matmul), or by the compiled kernel of model.algebraic_compiled.
 """
 
 from __future__ import annotations
@@ -41,7 +42,8 @@ import numpy as np
 import pinocchio as pin
 
 from . import algebraic_compiled, compiled as numba_kernels
-from .geometry import quaternion_matrix, quaternion_product, skew, stack_cross, stack_mm, stack_mv
+from .algebraic_numpy import Placed, rows_all
+from .geometry import quaternion_matrix, quaternion_product, skew
 from .legs import distance_legs
 
 __all__ = ["PolynomialClosure", "algebraic_obstacle"]
@@ -145,21 +147,6 @@ class PolynomialClosure:
         self.tjoint = np.zeros(self.nt, int)
         for j, sl in self.tslices.items():
             self.tjoint[sl] = j
-        depth = np.zeros(nj, int)
-        for j in range(1, nj):
-            depth[j] = depth[self.parent[j]] + 1
-        self.levels = []
-        for d in range(1, depth.max(initial=0) + 1):
-            js = np.flatnonzero(depth == d)
-            pos = {int(j): k for k, j in enumerate(js)}
-            rev = [j for j in self.rev if j in pos]
-            pri = [j for j in self.pri if j in pos]
-            self.levels.append({
-                "js": js, "ps": self.parent[js],
-                "rev": np.array([pos[j] for j in rev], int), "rev_c": np.array([self.slices[j].start for j in rev], int),
-                "pri": np.array([pos[j] for j in pri], int), "pri_u": np.array([self.slices[j].start for j in pri], int),
-                "quat": [(pos[j], j) for j in self.quat if j in pos],
-                "const": np.array([k for k, j in enumerate(js) if not self.passive[j]], int)})
         self._row_plan()
         on_leg = lambda f: model.frames[f].parentJoint in self.eliminated  # noqa: E731
         self.point_frames = [f for f in points if not on_leg(f)]
@@ -179,6 +166,7 @@ class PolynomialClosure:
         self._row_index()
         self.Rc = np.broadcast_to(np.eye(3, dtype=complex)[:, :, None], (3, 3, nj)).copy()
         self.tc = np.zeros((3, nj), complex)
+        self._placed = {}  # frames placed (None: all, "rows": the rows') -> algebraic_numpy.Placed
         self.set_inputs(pin.neutral(model))
         self.keep = np.ones(self._nrows_all, bool)
         self.keep = self._nonzero_rows()
@@ -292,6 +280,8 @@ class PolynomialClosure:
             x = self._from_joint(j, np.asarray(q, float)[jm.idx_q:jm.idx_q + jm.nq])
             R, t = self._motion(j, x[None].astype(complex))
             self.Rc[:, :, j], self.tc[:, j] = R[0], t[0]
+        for placed in self._placed.values():
+            placed.refresh()
 
     def _from_joint(self, j, qj):
         kind = self.kind[j]
@@ -412,120 +402,19 @@ class PolynomialClosure:
             R, t = quaternion_matrix(xj[:, 3:]), xj[:, :3].copy()
         return R, t
 
+    def placed(self, which=None) -> Placed:
+        """How the numpy evaluation places the frames: every joint and frame (None) or the rows' ("rows")."""
+        if which not in self._placed:
+            self._placed[which] = Placed(self, None if which is None else np.arange(len(self.row_frames)))
+        return self._placed[which]
+
     def kinematics(self, X, jacobian: bool = True):
         """World placements (stack axis last) of every joint frame (oR (3, 3, nj, P), op (3, nj, P))
         and of the frames the rows and points read (fR, fp); with ``jacobian`` each tangent
         coordinate's world axis w (3, nt, P), origin o and translation direction e (the module)."""
-        Xt = np.asarray(X, complex).T  # (n, P)
-        P, nj = Xt.shape[1], self.nj
-        oR = np.empty((3, 3, nj, P), complex)
-        op = np.empty((3, nj, P), complex)
-        oR[:, :, 0], op[:, 0] = np.eye(3)[:, :, None], 0.0
-        if jacobian:
-            Aall, oall = np.empty_like(oR), np.empty_like(op)
-            tall = np.zeros_like(op)
-        for lv in self.levels:
-            js, ps = lv["js"], lv["ps"]
-            nl = len(js)
-            Rp = oR[:, :, ps]
-            A = stack_mm(Rp, self.Lr[:, :, js, None])
-            oj = op[:, ps] + stack_mv(Rp, self.Lt[:, js, None])
-            R = np.empty((3, 3, nl, P), complex)
-            t = np.zeros((3, nl, P), complex)
-            k = lv["const"]
-            if k.size:
-                R[:, :, k], t[:, k] = self.Rc[:, :, js[k], None], self.tc[:, js[k], None]
-            k = lv["rev"]
-            if k.size:
-                jr, cols = js[k], lv["rev_c"]
-                R[:, :, k] = self.ww[:, :, jr, None] + Xt[cols] * self.Pm[:, :, jr, None] + Xt[cols + 1] * self.W[:, :, jr, None]
-            k = lv["pri"]
-            if k.size:
-                R[:, :, k] = np.eye(3)[:, :, None, None]
-                t[:, k] = Xt[lv["pri_u"]] * self.axis[js[k]].T[:, :, None]
-            for kq, j in lv["quat"]:
-                Rq, tq = self._motion(j, Xt[self.slices[j]].T)
-                R[:, :, kq], t[:, kq] = Rq.transpose(1, 2, 0), tq.T
-            oR[:, :, js] = stack_mm(A, R)
-            op[:, js] = oj + stack_mv(A, t)
-            if jacobian:
-                Aall[:, :, js], oall[:, js], tall[:, js] = A, oj, t
-        fR = stack_mm(oR[:, :, self.f_joint], self.f_R[..., None])
-        fp = op[:, self.f_joint] + stack_mv(oR[:, :, self.f_joint], self.f_t[..., None])
-        out = {"oR": oR, "op": op, "fR": fR, "fp": fp}
-        if jacobian:
-            out.update(self._axes(Aall, oall, tall))
-        return out
-
-    def _axes(self, A, oj, tj):
-        """Per tangent coordinate: w (3, nt, P) its world rotation axis (0 for a slide), o its
-        centre, e (3, nt, P) its world translation direction (0 for a rotation)."""
-        P = A.shape[-1]
-        w = np.zeros((3, self.nt, P), complex)
-        o = np.zeros((3, self.nt, P), complex)
-        e = np.zeros((3, self.nt, P), complex)
-        if self.rev.size:
-            w[:, self.rev_t] = stack_mv(A[:, :, self.rev], self.axis[self.rev].T[:, :, None])
-            o[:, self.rev_t] = oj[:, self.rev]
-        if self.pri.size:
-            e[:, self.pri_t] = stack_mv(A[:, :, self.pri], self.axis[self.pri].T[:, :, None])
-        for j in self.quat:
-            tl = self.tslices[j]
-            rot = np.arange(tl.stop - 3, tl.stop)
-            w[:, rot] = A[:, :, j]  # the joint frame's axes (columns of A) through the body's origin
-            o[:, rot] = (oj[:, j] + stack_mv(A[:, :, j], tj[:, j]))[:, None]
-            if self.kind[j] == "F":
-                e[:, tl.start + np.arange(3)] = A[:, :, j]
-        return {"w": w, "o": o, "e": e}
+        return self.placed()(X, jacobian)
 
     # ------------------------------------------------------------------ equations
-    def _rows_all(self, kin, jacobian: bool):
-        """Every planned row (before dropping the identically zero ones), (rows, P), and its
-        Jacobian in tangent coordinates (rows, nt, P)."""
-        fR, fp = kin["fR"], kin["fp"]
-        P, nt = fp.shape[-1], self.nt
-        r = np.empty((self._nrows_all, P), complex)
-        J = np.empty((self._nrows_all, nt, P), complex) if jacobian else None
-        v = stack_mv(fR[:, :, self.vq_f], self.vq_u[..., None])  # (3, vectors, P)
-        if jacobian:
-            w, o, e = kin["w"], kin["o"], kin["e"]
-            mask_f = self.above[:, :, None]
-            dv = stack_cross(w[:, None], v[:, :, None]) * self.above[self.vq_f][None, :, :, None]  # (3, vectors, nt, P)
-            dp = (stack_cross(w[:, None], fp[:, :, None] - o[:, None]) + e[:, None]) * mask_f[None]  # (3, frames, nt, P)
-        x = self.rix["pos"]
-        if len(x["a"]):
-            r[x["rows"]] = (fp[:, x["b"]] - fp[:, x["a"]]).transpose(1, 0, 2)
-            if jacobian:
-                J[x["rows"]] = (dp[:, x["b"]] - dp[:, x["a"]]).transpose(1, 0, 2, 3)
-        x = self.rix["vec"]
-        if len(x["q1"]):
-            r[x["rows"]] = (v[:, x["q1"]] - v[:, x["q2"]]).transpose(1, 0, 2)
-            if jacobian:
-                J[x["rows"]] = (dv[:, x["q1"]] - dv[:, x["q2"]]).transpose(1, 0, 2, 3)
-        x = self.rix["dotd"]
-        if len(x["q1"]):
-            d = fp[:, x["b"]] - fp[:, x["a"]]
-            u = v[:, x["q1"]]
-            rows = x["rows"][:, 0]
-            r[rows] = (u * d).sum(0)
-            if jacobian:
-                J[rows] = (dv[:, x["q1"]] * d[:, :, None]).sum(0) + (u[:, :, None] * (dp[:, x["b"]] - dp[:, x["a"]])).sum(0)
-        x = self.rix["dist"]
-        if len(x["a"]):
-            d = fp[:, x["b"]] - fp[:, x["a"]]
-            rows = x["rows"][:, 0]
-            r[rows] = (d * d).sum(0) - self.r2[x["q1"]][:, None]
-            if jacobian:
-                J[rows] = 2 * (d[:, :, None] * (dp[:, x["b"]] - dp[:, x["a"]])).sum(0)
-        x = self.rix["dot"]
-        if len(x["q1"]):
-            v1, v2 = v[:, x["q1"]], v[:, x["q2"]]
-            rows = x["rows"][:, 0]
-            r[rows] = (v1 * v2).sum(0)
-            if jacobian:
-                J[rows] = (dv[:, x["q1"]] * v2[:, :, None]).sum(0) + (v1[:, :, None] * dv[:, x["q2"]]).sum(0)
-        return r, J
-
     def rows(self, X, jacobian: bool = True):
         """The closure rows kept (P, m) and their Jacobian in tangent coordinates (P, m, nt)."""
         if self._kernel is not None:
@@ -533,7 +422,7 @@ class PolynomialClosure:
                                 np.ascontiguousarray(self.tc.T), np.asarray(self.r2, complex), *self._packed, self.nt,
                                 jacobian)
             return r, (J if jacobian else None)
-        r, J = self._rows_all(self.kinematics(X, jacobian), jacobian)
+        r, J = rows_all(self, self.placed("rows")(X, jacobian), jacobian)
         return r[self.keep].T, (J[self.keep].transpose(2, 0, 1) if jacobian else None)
 
     def constraints(self, X):
@@ -551,13 +440,13 @@ class PolynomialClosure:
     def _nonzero_rows(self) -> np.ndarray:
         """Rows that do not vanish identically on the constraint variety (tried at random complex points)."""
         X = self.random_points(np.random.default_rng(12345), 4)
-        r, _ = self._rows_all(self.kinematics(X, jacobian=False), jacobian=False)
+        r, _ = rows_all(self, self.placed("rows")(X, jacobian=False), jacobian=False)
         size = np.abs(r).max(axis=1)
         return size > _ZERO_ROW * max(size.max(initial=0.0), 1.0)
 
     def residual_all(self, X):
         """Every planned row at X (P, rows) (the dropped ones too: they vanish identically)."""
-        return self._rows_all(self.kinematics(X, jacobian=False), jacobian=False)[0].T
+        return rows_all(self, self.placed("rows")(X, jacobian=False), jacobian=False)[0].T
 
     def signature(self, X) -> np.ndarray:
         """What tells assembly modes apart (analysis.motion.position.PositionSolver.signature, in

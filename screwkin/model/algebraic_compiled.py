@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .compiled import cache_on_disk
 
 __all__ = ["kernel", "pack"]
 
@@ -68,7 +69,6 @@ def kernel():
 def _build():
     import numba as nb
 
-    from .compiled import cache_on_disk
     cache = cache_on_disk()
 
     @nb.njit(cache=cache)

@@ -27,6 +27,11 @@ from __future__ import annotations
 
 import numpy as np
 
+try:
+    import resource
+except ImportError:  # not a POSIX system
+    resource = None
+
 from . import newton
 from .newton import TRACE_FLOOR
 
@@ -49,9 +54,7 @@ def cache_on_disk() -> bool:
     """Whether numba may keep its compiled kernels on disk: not under a limit on the size of the files
     this process writes (ulimit -f), which numba's cache files (several MB) would pass -- the write
     fails with EFBIG, and the kernels are then compiled in memory for this run only."""
-    try:
-        import resource
-    except ImportError:  # not a POSIX system
+    if resource is None:  # not a POSIX system
         return True
     return resource.getrlimit(resource.RLIMIT_FSIZE)[0] == resource.RLIM_INFINITY
 
