@@ -204,10 +204,12 @@ class UnionFind:
 
 
 def frame_link(mech, frame_name: str) -> str:
-    """The URDF link a Pinocchio frame is attached to."""
+    """The URDF link a Pinocchio frame is attached to (the output frame's: the link place_tool put it on)."""
     spec = mech.spec
     if frame_name in spec.links:
         return frame_name
+    if mech.tool is not None and frame_name == mech.tool.name:
+        return mech.tool.link
     for j in spec.joints:
         if j.name == frame_name:
             return j.child

@@ -13,6 +13,7 @@ import pinocchio as pin
 
 from ...model import newton
 from ...model.closure import ClosureSystem, CouplingRow, CutJoint
+from ...model.state import frame_parent, model_with_output
 
 __all__ = ["TreeKinematics", "BatchClosure", "Unbatchable"]
 
@@ -37,7 +38,7 @@ class TreeKinematics:
 
     def __init__(self, mech):
         model = mech.model
-        self.model = model
+        self.mech, self.model = mech, model
         if model.nq != model.nv:
             raise Unbatchable(f"{mech.path}: joints of more than one coordinate")
         data = mech.scratch_data()
@@ -73,11 +74,11 @@ class TreeKinematics:
         return self.supports[jid]
 
     def _frame(self, f):
-        """(parent joint, [R | t]^T of the frame's placement) of frame f."""
+        """(parent joint, [R | t]^T of the frame's placement) of frame f (model.state.frame_parent: the output
+        frame where place_tool put it)."""
         if f not in self._frames:
-            frame = self.model.frames[f]
-            self._frames[f] = (frame.parentJoint,
-                               np.hstack([frame.placement.rotation, frame.placement.translation[:, None]]).T.copy())
+            joint, placement = frame_parent(self.mech, f)
+            self._frames[f] = (joint, np.hstack([placement.rotation, placement.translation[:, None]]).T.copy())
         return self._frames[f]
 
     def _pass(self, Q):
@@ -207,7 +208,9 @@ class BatchClosure:
     """
 
     def __init__(self, mech, target=None, check: int = 0):
-        model = mech.model
+        # with a target, a copy of the model with the output frame placed (model.state.model_with_output): the
+        # target's cut joint is a frame of it, and the self-check moves the target frame in it, not in the mechanism's
+        model = mech.model if target is None else model_with_output(mech)
         self.mech, self.model = mech, model
         if model.nq != model.nv:
             raise Unbatchable(f"{mech.path}: joints of more than one coordinate")

@@ -34,7 +34,7 @@ import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model.closure import Assembly
-from ...model.state import KinematicState, angular_loop_joints
+from ...model.state import KinematicState, angular_loop_joints, frame_parent
 from ...model.topology import open_joints
 from . import modes
 from ..mobility import analyze_mobility
@@ -212,6 +212,8 @@ class PositionSolver:
         self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
         self.output = output
         self.output_frame = mech.link_frame(output) if output else None
+        # (joint, placement in it) of the output frame: a tool or named point is no frame of the model
+        self._output_at = frame_parent(mech, self.output_frame) if output else None
         self._generic = None
         self._labelling = None
         self._angles = False  # LinkAngles, None when not planar, False before the first look
@@ -324,7 +326,8 @@ class PositionSolver:
         pin.framesForwardKinematics(self.model, self.data, q)
         parts = [self.data.oMf[f].translation for f in self._points]
         if self.output_frame is not None:
-            parts.append(self.data.oMf[self.output_frame].homogeneous[:3].ravel() * 0.1)
+            joint, placement = self._output_at
+            parts.append((self.data.oMi[joint] * placement).homogeneous[:3].ravel() * 0.1)
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def _starts(self, count, seed):
