@@ -15,13 +15,25 @@ from ...model import newton
 from ...model.closure import ClosureSystem, CouplingRow, CutJoint
 from ...model.state import frame_parent, model_with_output
 
-__all__ = ["TreeKinematics", "BatchClosure", "Unbatchable"]
+__all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 
 
 class Unbatchable(Exception):
     """The mechanism holds something the batched closure does not represent (joints of more
     than one coordinate, <mimic> joints, helical joints, sliding contacts): the caller solves
     one configuration at a time with model.closure.ClosureSystem instead."""
+
+
+def tree_kinematics(mech):
+    """The mechanism's TreeKinematics, made once (mech.cache), None when its joints are not all 1-DOF
+    revolute or prismatic (its users then run Pinocchio a configuration at a time)."""
+    key = "links.tree"
+    if key not in mech.cache:
+        try:
+            mech.cache[key] = TreeKinematics(mech)
+        except Unbatchable:
+            mech.cache[key] = None
+    return mech.cache[key]
 
 
 class TreeKinematics:
@@ -147,6 +159,26 @@ class TreeKinematics:
             ac[:, i, :3] = acc[jid] + np.cross(al[jid], r) + np.cross(om[jid], wr)
             ac[:, i, 3:] = al[jid]
         return R, t, tw, ac
+
+    def centres(self, Q, refs) -> dict:
+        """{ref: (N, 3)} the world positions [m] KinematicState.centre reads -- ("joint", i) joint i's
+        centre, ("mount", i) where joint i sits on its parent, ("frame", f) frame f's origin -- at every
+        row of Q: its stacked form, from one pass down the tree."""
+        Q = np.atleast_2d(np.asarray(Q, float))
+        N = len(Q)
+        RTs, ps, _ = self._pass(Q)
+        out = {}
+        for kind, i in refs:
+            if kind == "joint":
+                out[(kind, i)] = ps[i]
+                continue
+            if kind == "mount":
+                jid, t = self.model.parents[i], np.asarray(self.model.jointPlacements[i].translation, float)[None]
+            else:
+                jid, CfT = self._frame(i)
+                t = CfT[3:4]
+            out[(kind, i)] = ps[jid] + _thin(t, RTs[jid])[0].reshape(N, 3)
+        return out
 
     def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the

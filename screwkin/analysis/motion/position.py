@@ -503,7 +503,7 @@ class PositionSolver:
             self._link_angles(self.mech.neutral())
         return None if self._angles is None else self._angles.n
 
-    def _link_angles(self, q):
+    def _link_angles(self, q, state=None):
         if self._angles is False:
             self._angles = None
             ref = self.reference()
@@ -511,7 +511,7 @@ class PositionSolver:
                 topo = self.mech.topology(ref)
                 if topo.motion_space == "planar":
                     self._angles = LinkAngles(self.mech, topo)
-        return self._angles(q) if self._angles is not None else None
+        return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
     def solution(self, q, a, rates=None, accels=None, points=(), typed=None) -> Solution:
@@ -536,7 +536,7 @@ class PositionSolver:
             if rates is not None:
                 twist, acc = state.frame_twist(self.output_frame), state.frame_acceleration(self.output_frame)
         outside = outside_limits(mech, q)
-        angles = self._link_angles(q)
+        angles = self._link_angles(q, state)
         joints = self.joint_values(q)
         for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
             if name in joints and abs(np.mod(joints[name] - v + np.pi, 2 * np.pi) - np.pi) < tol.equal:
