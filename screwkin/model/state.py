@@ -335,7 +335,7 @@ class KinematicState:
     def link_motion(self, link: str) -> dict:
         """position, velocity, acceleration of the link frame's origin; omega, alpha (vectors)."""
         fid = self.mech.link_frame(link)
-        out = {"position": self.frame_placement(fid).translation}
+        out = {"position": self.frame_placement(fid).translation.copy()}
         if self.has_rates:
             v, w = np.split(self.frame_twist(fid), 2)
             a, alpha = np.split(self.frame_acceleration(fid), 2)
