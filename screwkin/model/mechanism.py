@@ -57,7 +57,8 @@ class Coordinate:
     nv: int
 
 
-#: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data).
+#: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data, and every
+#: KinematicState of them: model.state).
 SHARED_DATA_NV = 120
 
 

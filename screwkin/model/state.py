@@ -22,12 +22,13 @@ SHARED_DATA_NV coordinates) reads the mechanism's one Data, its pass run again a
   of F2 about the axis (revolute, continuous) or the displacement of F2's origin along the axis
   (prismatic), both measured in F1 -- with its rate and acceleration.
 
-Who else calls Pinocchio's kinematics: code that runs them for many configurations at once or in
-an algorithm's inner loop, on a Data it keeps -- the closure's residual and Jacobian and the
-Newton loops on them (model.closure, model.newton, analysis.motion.position's mode signature),
-stacked passes (analysis.motion.links, batch_closure, singularities.batch), dynamics algorithms
-(RNEA, CRBA, energies: analysis.forces) -- and a view's geometry placement.  Whatever reads
-one configuration's quantities reads them here.
+The rule: whatever reads the kinematic quantities of one configuration reads them from a
+KinematicState.  Pinocchio's kinematics are called directly only (1) inside an algorithm's inner
+loop, on a Data it keeps: the closure's residual and Jacobian and the Newton loops on them
+(model.closure, model.newton, the position solver's mode signature); (2) for a stack of
+configurations at once (analysis.motion.links, batch_closure's TreeKinematics and BatchClosure,
+singularities.batch); (3) by a dynamics algorithm that runs its own pass (RNEA, CRBA, the energies
+in analysis.forces) or a viewer that places the geometry (present).
 
 Units: m, rad, s.
 """
