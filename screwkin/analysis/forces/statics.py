@@ -195,12 +195,16 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=N
     rows, labels = rows if rows is not None else (mech.closure.row_wrenches(q), mech.closure.row_labels())
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
 
+    placed = {}  # frame -> (its body's joint, that joint's placement, the frame's origin): read once
+
     def apply(frame, wrench_at_origin):
         """Add a wrench (force, moment about the frame's origin, world axes) to the frame's body."""
-        joint = frame_parent(mech, frame)[0]
-        o = state.frame_placement(frame).translation
+        if frame not in placed:
+            joint = frame_parent(mech, frame)[0]
+            placed[frame] = (joint, state.joint_placement(joint), state.frame_placement(frame).translation.copy())
+        joint, M, o = placed[frame]
         force, moment = wrench_at_origin[:3], wrench_at_origin[3:] + cross3(o, wrench_at_origin[:3])
-        fext[joint] += state.joint_placement(joint).actInv(pin.Force(force, moment))
+        fext[joint] += M.actInv(pin.Force(force, moment))
 
     cut = {}
     for (fa, wa, fb, wb), value in zip(rows, lam):
