@@ -19,6 +19,7 @@ import screwkin
 import screwkin.model.mechanism as mechanism
 from conftest import ROBOTS
 from screwkin.analysis.forces.statics import statics
+from screwkin.analysis.motion.batch_closure import TreeKinematics
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.model.state import KinematicState, model_with_output, place_tool
 
@@ -194,6 +195,16 @@ def test_place_tool_leaves_the_model_as_it_was():
     pin.framesForwardKinematics(placed, pdata, q)
     np.testing.assert_allclose(pdata.oMf[mech.tool_frame].homogeneous, data.oMf[ref_id].homogeneous, rtol=0,
                                atol=1e-12)
+    # placed again, elsewhere: every reader takes the new frame (the state, a batched pass made before)
+    tree = TreeKinematics(mech)
+    _, p, _, _ = tree.frames(q[None], [mech.tool_frame], jacobian=False)[mech.tool_frame]
+    np.testing.assert_allclose(p[0], data.oMf[ref_id].translation, rtol=0, atol=1e-12)
+    moved = pin.SE3(np.eye(3), np.array([-0.01, 0.04, 0.0]))
+    other = place_tool(mech, "tip2", "rocker", moved)
+    there = KinematicState(mech, q).link_pose("rocker") @ moved.homogeneous
+    np.testing.assert_allclose(KinematicState(mech, q).link_pose(other), there, rtol=0, atol=1e-12)
+    _, p, _, _ = tree.frames(q[None], [mech.tool_frame], jacobian=False)[mech.tool_frame]
+    np.testing.assert_allclose(p[0], there[:3, 3], rtol=0, atol=1e-12)
 
 
 #: The modules that may call Pinocchio's kinematics themselves, by the rule of model/state.py's docstring:

@@ -88,10 +88,13 @@ class TreeKinematics:
     def _frame(self, f):
         """(parent joint, [R | t]^T of the frame's placement) of frame f (model.state.frame_parent: the output
         frame where place_tool put it)."""
-        if f not in self._frames:
-            joint, placement = frame_parent(self.mech, f)
-            self._frames[f] = (joint, np.hstack([placement.rotation, placement.translation[:, None]]).T.copy())
-        return self._frames[f]
+        if f in self._frames:
+            return self._frames[f]
+        joint, placement = frame_parent(self.mech, f)
+        out = (joint, np.hstack([placement.rotation, placement.translation[:, None]]).T.copy())
+        if f != self.mech.tool_frame:  # (the output frame is wherever place_tool last put it)
+            self._frames[f] = out
+        return out
 
     def _pass(self, Q):
         """(RTs, ps, ws) of every joint (index 0 the ground) for the configurations Q (N, nq):
