@@ -31,7 +31,7 @@ def folded(theta=0.0):
 
 def unit_screws(mech, q, system):
     """Every tree unit's dimensionless screw at q, straight from Pinocchio (joint placements, motion subspaces)."""
-    units = _units(mech, KinematicState(mech, q)._data)[0]
+    units = _units(mech, KinematicState(mech, q))[0]
     S = np.array([u[0] for u in units])
     S[:, :3] /= system.length
     return S * system.scale[np.array([u[1] for u in units])][:, None]

@@ -174,7 +174,7 @@ class Series:
         return other
 
 
-def _units(mech, data):
+def _units(mech, state):
     """Every unit of the tree: (screw (v, w) at the world origin, column, multiplier), the carriers
     of each (a set of unit indices), the units of each joint, and a note when a joint has no closed
     form here.  A Pinocchio mimic joint is a unit of its primary's column (its motion subspace holds
@@ -185,7 +185,7 @@ def _units(mech, data):
     for j in range(1, model.njoints):
         short = model.joints[j].shortname()
         parent_units = sorted({u for a in model.supports[j][1:-1] for u in by_joint.get(a, ())})
-        S_local = np.asarray(data.joints[j].S, float).reshape(6, -1)
+        S = state.joint_twists(j)
         if short == "JointModelMimic":
             cols = [model.idx_vs[j]]
         else:
@@ -194,7 +194,7 @@ def _units(mech, data):
                 note = note or f"joint '{model.names[j]}' ({short}) has no closed-form screw derivatives here"
         first = len(units)
         for k, col in enumerate(cols):
-            units.append((data.oMi[j].act(pin.Motion(S_local[:, k])).vector.copy(), col, 1.0))
+            units.append((S[:, k], col, 1.0))
             own = range(first, first + len(cols)) if short in BODY_JOINTS else range(first, first + k)
             carriers.append(set(parent_units) | set(own))
         by_joint[j] = list(range(first, len(units)))
@@ -272,7 +272,7 @@ def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> Lo
     L = float(length or mech.length)
     tol = mech.tolerances
     state = KinematicState(mech, q)
-    units, carriers, by_joint, note = _units(mech, state._data)
+    units, carriers, by_joint, note = _units(mech, state)
     nv = mech.nv
     tree_units = len(units)
     tree_screws = np.array([u[0] for u in units], float).reshape(tree_units, 6)

@@ -23,7 +23,7 @@ import pinocchio as pin
 from ..errors import UsageError
 from ..model.geometry import perpendicular_basis, plane_basis
 from ..model.linalg import null_space
-from ..model.state import KinematicState
+from ..model.state import KinematicState, frame_parent
 from ..tolerances import DEFAULT
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
@@ -89,7 +89,7 @@ def chains_to(mech, targets) -> list:
     state = KinematicState(mech, mech.neutral())
     out = []
     for name, fid in targets:
-        jid = model.frames[fid].parentJoint
+        jid = frame_parent(mech, fid)[0]
         support = [j for j in model.supports[jid] if j > 0]
         joints, cols = [], []
         for j in support:

@@ -10,13 +10,15 @@ import numpy as np
 import pinocchio as pin
 
 
-def frame_jacobian(model, data, frame: int, reference):
-    """pinocchio.getFrameJacobian as a (6, nv) matrix (after computeJointJacobians).
+def frame_jacobian(model, data, frame: int, reference, placement=None):
+    """pinocchio.getFrameJacobian as a (6, nv) matrix (after computeJointJacobians); with ``placement``
+    (a pinocchio.SE3) ``frame`` is a joint id and the frame the one at ``placement`` in that joint.
     Pinocchio 4.1's getFrameJacobian crashes the process (signal 11) for a model without
     joint coordinates (nv = 0): its Jacobian is then the empty 6 x 0 matrix."""
     if model.nv == 0:
         return np.zeros((6, 0))
-    return pin.getFrameJacobian(model, data, frame, reference).reshape(6, model.nv)
+    where = (frame,) if placement is None else (frame, placement)
+    return pin.getFrameJacobian(model, data, *where, reference).reshape(6, model.nv)
 
 
 def compute_frame_jacobian(model, data, q, frame: int, reference):

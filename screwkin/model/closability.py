@@ -8,6 +8,7 @@ import pinocchio as pin
 
 from ._pin import joint_axis
 from .geometry import cross3
+from .state import KinematicState
 
 __all__ = ["closure_obstacle", "closure_gap", "planar_loops", "obstacle_of"]
 
@@ -17,8 +18,7 @@ def planar_loops(mech) -> list:
     closure_obstacle measures, as structure: [(cut joint name, the links of the sides, the points
     between them)], a point ("frame", id) -- a cut joint's frame F1 first, F2 last -- or ("joint", id),
     a tree joint's centre; with the loop's normal ("frame", F1's id, axis in F1)."""
-    model, data = mech.model, mech.scratch_data()
-    pin.framesForwardKinematics(model, data, mech.neutral())
+    model, state = mech.model, KinematicState(mech, mech.neutral())
     out = []
     for c in mech.cuts:
         if c.type not in ("revolute", "continuous") or c.pair:
@@ -31,8 +31,8 @@ def planar_loops(mech) -> list:
         joints = path1 + path2
         if not joints or any(not model.joints[j].shortname().startswith("JointModelR") for j in joints):
             continue
-        axis = data.oMf[c.frame1].rotation @ np.asarray(c.axis, float)
-        axes = [data.oMi[j].rotation @ joint_axis(model.joints[j]) for j in joints]
+        axis = state.frame_placement(c.frame1).rotation @ np.asarray(c.axis, float)
+        axes = [state.joint_placement(j).rotation @ joint_axis(model.joints[j]) for j in joints]
         if any(np.linalg.norm(cross3(axis, a)) > mech.tolerances.geometry for a in axes):
             continue  # not planar: no side-length test
         points = [("frame", c.frame1)] + [("joint", j) for j in joints] + [("frame", c.frame2)]
@@ -87,14 +87,13 @@ def obstacle_of(cut: str, names, sides, tol: float):
 
 def closure_gap(mech):
     """(closure_obstacle's sentence, the longest side's excess over the others [m]), or None."""
-    model, data = mech.model, mech.scratch_data()
-    pin.framesForwardKinematics(model, data, mech.neutral())
+    state = KinematicState(mech, mech.neutral())
     for cut, names, points, (f1, axis) in planar_loops(mech):
-        n = data.oMf[f1].rotation @ np.asarray(axis, float)
+        n = state.frame_placement(f1).rotation @ np.asarray(axis, float)
         n = n / np.linalg.norm(n)
 
         def flat(ref):
-            p = data.oMf[ref[1]].translation if ref[0] == "frame" else data.oMi[ref[1]].translation
+            p = state.centre(ref)
             return p - (p @ n) * n
 
         P = [flat(r) for r in points]

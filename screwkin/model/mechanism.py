@@ -59,7 +59,8 @@ class Coordinate:
     nv: int
 
 
-#: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data).
+#: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data, and every
+#: KinematicState of them: model.state).
 SHARED_DATA_NV = 120
 
 
@@ -97,15 +98,18 @@ class Mechanism:
         # before the pinocchio.Data is made from the model
         self.target_frame = model.addFrame(
             pin.Frame("screwkin@target", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
-        # the output frame a command may move onto a link (--tool, a named --point): model.state.place_tool
+        # the id of the output frame a command may put on a link (--tool, a named --point): its placement is
+        # mech.tool's (model.state.place_tool), read by KinematicState and model.state.frame_parent; in this
+        # model the frame stays where it is made, a reserved slot a copy may place (model.state.model_with_output)
         self.tool_frame = model.addFrame(
             pin.Frame("screwkin@tool", 0, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
-        self.tool = None  # (name, link, placement on the link) once placed
+        self.tool = None  # model.state.OutputFrame (name, link, placement on the link) once placed
         # The mechanism's own Data: Pinocchio 4.1 allocates nv^3-sized tensors in one (a Data of a
         # 500-joint chain: 17 s and 7.9 GB here, 0.2 s at 200 joints, 1 ms at 30).  Computations
         # take a Data of their own from scratch_data(); only models past SHARED_DATA_NV
         # coordinates hand this one out (each user then runs Pinocchio's pass first).
         self.data = model.createData()
+        self.state_data = threading.local()  # each thread's Data for KinematicState (model.state)
         self._gravity_models = {}  # (gx, gy, gz) -> a copy of the model with that gravity
         self._models_lock = threading.Lock()
         self.closure = ClosureSystem(model, self.cuts, tolerances, self.path, data=self.scratch_data(),
@@ -355,7 +359,8 @@ class Mechanism:
         return self._limits
 
     def link_frame(self, link: str) -> int:
-        """Frame id of a link (its body frame), or of the tool placed under its name (model.state.place_tool)."""
+        """Frame id of a link (its body frame), or of the output frame placed under its name (model.state.place_tool:
+        read it through KinematicState or model.state.frame_parent, not from this model's frames)."""
         if self.tool is not None and link == self.tool[0]:
             return self.tool_frame
         for fid, f in enumerate(self.model.frames):

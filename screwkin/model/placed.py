@@ -20,6 +20,7 @@ from ..files.exporter import PlacedBody, PlacedCompound, PlacedCut, PlacedJoint,
 from ..files.mjcf_equality import matrix_quat
 from ..tolerances import DEFAULT
 from .geometry import perpendicular_basis, wrap_angle
+from .state import KinematicState
 from .topology import build_topology, frame_link
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS", "ball_values", "davenport"]
@@ -42,20 +43,19 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
     Raises MechanismFileError for what ``fmt`` cannot express (a higher pair; for URDF a ball
     or universal joint in the tree)."""
     spec, model = mech.spec, mech.model
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(model, data, q)
+    state = KinematicState(mech, q)
     rep = dict(spec.replacements)
     for c in spec.cut_joints:
         if c.type not in WRITABLE_CUTS:
             raise MechanismFileError(mech.path, f"loop joint {quote(c.name)} is a {c.type} pair: {fmt} cannot "
                                                 "express it (lower pairs only)")
-    world = {name: data.oMf[mech.link_frame(name)] for name in spec.links}
+    world = {name: state.frame_placement(mech.link_frame(name)) for name in spec.links}
     root = spec.root
     bodies = []
     if root != "world":
         bodies.append(PlacedBody(root, None, tuple(world[root].translation), matrix_quat(world[root].rotation)))
     values, empty = {}, []
-    compounds = _compounds(mech, q, data, world) if fmt == "MJCF" else ()
+    compounds = _compounds(mech, q, state, world) if fmt == "MJCF" else ()
     inner = {m: c for c in compounds for m in c.members[:-1]}
     last = {c.members[-1]: c for c in compounds}
     for j in spec.joints:
@@ -83,7 +83,7 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
                 raise MechanismFileError(mech.path, f"joint {quote(j.name)} is floating but not on a link of the "
                                                     f"ground: {fmt} allows free joints only there")
             if j.name in last:
-                joint, *more = _compound_joints(mech, q, last[j.name], values, empty)
+                joint, *more = _compound_joints(mech, q, state, last[j.name], values, empty)
                 more = tuple(more)
             else:
                 joint = _placed_joint(mech, q, j, kind, values, empty)
@@ -99,9 +99,9 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
         F = []
         for fid, frame in ((c.frame1, c.link1), (c.frame2, c.link2)):
             link = frame_link(mech, frame)
-            F.append((link, world[link].inverse() * data.oMf[fid]))
+            F.append((link, world[link].inverse() * state.frame_placement(fid)))
         (b1, F1), (b2, F2) = F
-        rel = data.oMf[c.frame1].inverse() * data.oMf[c.frame2]
+        rel = state.frame_placement(c.frame1).inverse() * state.frame_placement(c.frame2)
         cuts.append(PlacedCut(s.name, s.type, b1, tuple(F1.translation), matrix_quat(F1.rotation), b2,
                               tuple(F2.translation), matrix_quat(F2.rotation), tuple(s.axis),
                               tuple(s.axis2) if s.axis2 is not None else None,
@@ -152,7 +152,7 @@ def _placed_joint(mech, q, j, kind, values, empty, axis=None, pos=(0.0, 0.0, 0.0
     return PlacedJoint(j.name, kind, axis, rng, tuple(j.dynamics.items()), tuple(float(x) for x in pos))
 
 
-def _compounds(mech, q, data, world) -> list:
+def _compounds(mech, q, state, world) -> list:
     """The tree's compound joints (model.topology: revolutes and prismatics through massless links)
     that MJCF writes as one body's joints: spherical (a ball), universal, cylindrical; only where the
     massless links carry nothing else and no member is coupled, nor, for a ball, an input."""
@@ -186,7 +186,7 @@ def _compounds(mech, q, data, world) -> list:
         C = world[chain[-1].child]
         axes = []
         for m in chain:
-            M = data.oMi[mech.model.getJointId(m.name)]
+            M = state.joint_placement(mech.model.getJointId(m.name))
             axes.append(tuple(C.rotation.T @ M.rotation @ np.asarray(m.axis, float)))
         vals = tuple(float(q[mech.coordinate(m.name).idx_q]) for m in chain)
         out.append(PlacedCompound(J.type, J.name, tuple(m.name for m in chain), inside, chain[-1].child,
@@ -203,14 +203,12 @@ def _compounds(mech, q, data, world) -> list:
     return out
 
 
-def _compound_joints(mech, q, c, values, empty) -> list:
-    """The PlacedJoints of compound ``c`` in its body: one ball at the members' common point, or the
-    members' own joints with their axes and points in the body's frame."""
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(mech.model, data, q)
-    C = data.oMf[mech.link_frame(c.body)]
+def _compound_joints(mech, q, state, c, values, empty) -> list:
+    """The PlacedJoints of compound ``c`` in its body (``state``: the KinematicState at q): one ball at
+    the members' common point, or the members' own joints with their axes and points in the body's frame."""
+    C = state.frame_placement(mech.link_frame(c.body))
     ms = [_spec_joint(mech.spec, m) for m in c.members]
-    points = [C.actInv(data.oMi[mech.model.getJointId(m.name)].translation) for m in ms]
+    points = [C.actInv(state.centre(("joint", mech.model.getJointId(m.name)))) for m in ms]
     if c.type == "spherical":
         for m in ms:
             values[m.name] = float(q[mech.coordinate(m.name).idx_q])

@@ -1,28 +1,45 @@
-"""One configuration's kinematic quantities, computed once in a Pinocchio ``Data`` of its own.
+"""One configuration's kinematic quantities: the one place they are computed.
 
 ``KinematicState(mech, q, qd, qdd)`` is an immutable value: forward kinematics (positions,
-and rates and accelerations when ``qd``/``qdd`` are given) run once, lazily, in a ``Data`` that
-belongs to the state, so that nothing depends on what another analysis left in ``mech.data``
-and threads may share a mechanism (a model too large for a Data per computation,
-Mechanism.shares_data, reads the mechanism's one Data, its pass run again at each read: one
-thread at a time).  From it every quantity people ask for is read:
+and rates and accelerations when ``qd``/``qdd`` are given) run lazily, the joint Jacobians only
+when one is read, and every read returns a copy, so that nothing depends on what another
+analysis left in a Pinocchio ``Data`` and threads may share a mechanism.  The pass runs in a
+Data the thread's states share (Mechanism.state_data), again only when another state ran
+there since; a model too large for a Data per thread (Mechanism.shares_data, past
+SHARED_DATA_NV coordinates) reads the mechanism's one Data, its pass run again at each read
+(one thread at a time).  From it every quantity people ask for is read:
 
 * every link's absolute pose, and the velocity and classical acceleration of its frame origin
   with its angular velocity and acceleration (world axes; twists in (linear, angular) order);
 * any point fixed on a link (coordinates in the link's frame): position, velocity, acceleration;
-* frame and joint placements, frame Jacobians (joint Jacobians computed once), the tree
+* frame and joint placements, joint centres, frame Jacobians, each joint's twists, the tree
   joints' values by name, the constraint Jacobian K of the loops and K'q';
+* the output frame a command places on a link (``place_tool``: a tool, a named point), under
+  its name like a link, its placement composed with its link's (Pinocchio's frame functions
+  of a joint and a placement): it is no frame of the model;
 * the coordinates of the loop (cut) joints: the value of a one-coordinate ``<loop_joint>`` as a
   tree joint's value is read -- zero where its frames F1 and F2 coincide as written, the angle
   of F2 about the axis (revolute, continuous) or the displacement of F2's origin along the axis
   (prismatic), both measured in F1 -- with its rate and acceleration.
+
+The rule: whatever reads the kinematic quantities of one configuration reads them from a
+KinematicState.  Pinocchio's kinematics are called directly only (1) inside an algorithm's inner
+loop, on a Data it keeps: the closure's residual and Jacobian and the Newton loops on them
+(model.closure, model.newton, the position solver's mode signature); (2) for a stack of
+configurations at once (analysis.motion.links, batch_closure's TreeKinematics and BatchClosure,
+singularities.batch); (3) by a dynamics algorithm that runs its own pass (RNEA, CRBA, the energies
+in analysis.forces) or a viewer that places the geometry (present); (4) on a bare Pinocchio model
+that has no mechanism yet (model.legs probing which legs are distances, model.algebraic's
+reference placements for the homotopy).
 
 Units: m, rad, s.
 """
 
 from __future__ import annotations
 
+import itertools
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -30,31 +47,63 @@ import pinocchio as pin
 from ..errors import UsageError, quote
 from ._pin import frame_jacobian, joint_axis
 
-__all__ = ["KinematicState", "PointMotion", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts", "angular_loop_joints",
-           "leg_ends", "value_for_leg_length", "place_tool"]
+__all__ = ["KinematicState", "PointMotion", "OutputFrame", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts",
+           "angular_loop_joints", "leg_ends", "value_for_leg_length", "place_tool", "frame_parent",
+           "model_with_output"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 #: The loop-joint types whose coordinate a state reports (one coordinate along or about the axis).
 LOOP_COORDINATE_TYPES = ("revolute", "continuous", "prismatic")
+_KEYS = itertools.count(1)  # one per state: which state's pass a thread's Data holds
+
+
+class OutputFrame(NamedTuple):
+    """The output frame a command analyses (``place_tool``): a tool, or a named point with its link's
+    orientation, at ``placement`` (pinocchio.SE3) in ``link``'s frame, called ``name``."""
+
+    name: str
+    link: str
+    placement: object
 
 
 def place_tool(mech, name: str, link: str, placement) -> str:
-    """Move the mechanism's output frame (``mech.tool_frame``) onto ``link`` at ``placement`` (a
-    pinocchio.SE3 in the link's frame: a tool, or a named point with the link's orientation), under
-    ``name``: from then on ``mech.link_frame(name)`` is that frame, and every analysis that takes an
-    output link (its pose, twist, frame Jacobian) takes it.  Called once by a command, before the
-    analysis (the frame exists from the start, so every Data made from the model has it)."""
+    """Make the frame at ``placement`` (a pinocchio.SE3 in ``link``'s frame: a tool, or a named point
+    with the link's orientation) the mechanism's output frame, under ``name``: from then on every
+    analysis that takes an output link (its pose, twist, frame Jacobian) takes ``name`` too
+    (``mech.link_frame(name)`` is the output frame's id, mech.tool_frame).  The model is not changed:
+    this records the frame as ``mech.tool`` (an OutputFrame), which KinematicState and frame_parent
+    read; closure systems that need it as a model frame place it in a copy (model_with_output)."""
     if name in mech.spec.links:
         raise UsageError(f"{mech.path}: the output frame's name {quote(name)} is a link's name; choose another")
-    body = mech.link_frame(link)
-    frame = mech.model.frames[mech.tool_frame]
-    frame.name = name
-    frame.parentJoint = mech.model.frames[body].parentJoint
-    frame.parentFrame = body
-    frame.placement = mech.model.frames[body].placement * placement
-    mech.model.frames[mech.tool_frame] = frame
-    mech.tool = (name, link, placement)
+    mech.link_frame(link)  # a clear error for an unknown link
+    mech.tool = OutputFrame(name, link, pin.SE3(placement))
     return name
+
+
+def frame_parent(mech, fid: int) -> tuple:
+    """(joint id, pinocchio.SE3 in that joint's frame) of frame ``fid``: as the model holds it, except the
+    output frame (mech.tool_frame), on its link where place_tool put it.  A frame's world placement is
+    ``data.oMi[joint] * placement`` after any forward-kinematics pass in ``data``."""
+    model = mech.model
+    if fid == mech.tool_frame and mech.tool is not None:
+        body = model.frames[mech.link_frame(mech.tool.link)]
+        return body.parentJoint, body.placement * mech.tool.placement
+    f = model.frames[fid]
+    return f.parentJoint, f.placement
+
+
+def model_with_output(mech, model=None):
+    """A copy of the mechanism's model (or ``model``, itself a copy, changed in place) with the output
+    frame placed where place_tool put it, for a closure system that holds it as a cut joint's frame
+    (inverse kinematics, a workspace's targets); the mechanism's own model is never changed."""
+    model = pin.Model(mech.model) if model is None else model
+    if mech.tool is not None:
+        joint, placement = frame_parent(mech, mech.tool_frame)
+        frame = model.frames[mech.tool_frame]
+        frame.name, frame.parentJoint, frame.placement = mech.tool.name, joint, placement
+        frame.parentFrame = mech.link_frame(mech.tool.link)
+        model.frames[mech.tool_frame] = frame
+    return model
 
 
 def loop_coordinate_cuts(mech) -> tuple:
@@ -67,18 +116,15 @@ def angular_loop_joints(mech) -> tuple:
     return tuple(c.name for c in loop_coordinate_cuts(mech) if c.type != "prismatic")
 
 
-def _point_ref(data, ref):
-    kind, i = ref
-    return data.oMi[i].translation if kind == "joint" else data.oMf[i].translation
-
-
 def leg_ends(mech) -> dict:
     """Prismatic tree joint -> (start, end): the joint centres the leg connects, as ("joint", id) or
-    ("frame", id): the centre of the joint that carries the prismatic joint's parent link, and the
-    first centre on its child link (a joint it carries, else a cut joint's frame on it) away from the
-    prismatic joint's origin.  A leg length is the distance between the two (a Stewart leg's U to S)."""
-    model, data = mech.model, mech.scratch_data()
-    pin.framesForwardKinematics(model, data, mech.neutral())
+    ("frame", id) (KinematicState.centre): the centre of the joint that carries the prismatic joint's
+    parent link, and the first centre on its child link (a joint it carries, else a cut joint's frame
+    on it) away from the prismatic joint's origin.  A leg length is the distance between the two (a
+    Stewart leg's U to S).  Read once per mechanism, at its file's configuration."""
+    if "leg_ends" in mech.cache:
+        return mech.cache["leg_ends"]
+    model, state = mech.model, KinematicState(mech, mech.neutral())
     tiny = mech.tolerances.geometry
     out = {}
     for c in mech.coordinates:
@@ -90,13 +136,14 @@ def leg_ends(mech) -> dict:
         start = ("joint", parent) if parent > 0 else None
         if start is None:
             continue
-        origin = data.oMi[jid].translation
+        origin = state.centre(("joint", jid))
         candidates = [("joint", k) for k in model.children[jid]]
         candidates += [("frame", f) for cut in mech.cuts for f in (cut.frame1, cut.frame2)
                        if model.frames[f].parentJoint == jid]
-        end = next((r for r in candidates if np.linalg.norm(_point_ref(data, r) - origin) > tiny), None)
+        end = next((r for r in candidates if np.linalg.norm(state.centre(r) - origin) > tiny), None)
         if end is not None:
             out[c.joint] = (start, end)
+    mech.cache["leg_ends"] = out
     return out
 
 
@@ -108,15 +155,12 @@ def value_for_leg_length(mech, joint: str, length: float) -> float:
     if ends is None:
         raise UsageError(f"{mech.path}: {quote(joint)} is not a prismatic joint between two joint centres "
                          "(no leg length to set)")
-    model, data = mech.model, mech.scratch_data()
-    q = mech.neutral()
-    pin.framesForwardKinematics(model, data, q)
+    model, state = mech.model, KinematicState(mech, mech.neutral())
     c = mech.coordinate(joint)
-    parent = model.parents[c.joint_id]
-    R = data.oMi[parent].rotation
-    start, end = (_point_ref(data, r) for r in ends)
+    R = state.joint_placement(model.parents[c.joint_id]).rotation
+    start, end = (state.centre(r) for r in ends)
     d0 = R.T @ (end - start)
-    u = R.T @ (data.oMi[c.joint_id].rotation @ joint_axis(model.joints[c.joint_id]))
+    u = R.T @ (state.joint_placement(c.joint_id).rotation @ joint_axis(model.joints[c.joint_id]))
     b = float(d0 @ u)
     disc = b * b - float(d0 @ d0) + length * length
     if disc < 0:
@@ -140,7 +184,8 @@ class PointMotion:
 
 class KinematicState:
     """The kinematics of ``mech`` at ``q`` (and rates ``qd``, accelerations ``qdd``: tangent
-    vectors of the model, (nv,)).  Read-only; every quantity is computed on first use."""
+    vectors of the model, (nv,)).  Read-only; every quantity is computed on first use and
+    returned as a copy."""
 
     def __init__(self, mech, q, qd=None, qdd=None):
         self.mech = mech
@@ -150,49 +195,92 @@ class KinematicState:
         for a in (self.q, self.qd, self.qdd):
             if a is not None:
                 a.setflags(write=False)
+        self._key = next(_KEYS)
 
     # ------------------------------------------------------------------ Pinocchio, once
-    def _pass(self, data):
-        """Pinocchio's pass for this state in ``data``: placements, motions when it has rates, joint Jacobians."""
+    def _pass(self, data, jacobians: bool, placed: bool = False):
+        """Pinocchio's pass for this state in ``data``: placements, and motions when it has rates
+        (unless ``placed``: done already); with ``jacobians`` the joint Jacobians too."""
         model = self.mech.model
-        if self.qd is None:
-            pin.framesForwardKinematics(model, data, self.q)
-        else:
-            pin.forwardKinematics(model, data, self.q, self.qd, self.qdd)
-            pin.updateFramePlacements(model, data)
-        if model.nv:
+        if not placed:
+            if self.qd is None:
+                pin.framesForwardKinematics(model, data, self.q)
+            else:
+                pin.forwardKinematics(model, data, self.q, self.qd, self.qdd)
+                pin.updateFramePlacements(model, data)
+        if jacobians and model.nv:
             pin.computeJointJacobians(model, data, self.q)
             pin.updateFramePlacements(model, data)
         return data
 
-    @cached_property
-    def _own(self):
-        """This state's Data, with its pass and the joint Jacobians (computed once)."""
-        return self._pass(self.mech.scratch_data())
-
-    @property
-    def _data(self):
-        """The Data the state reads: its own; for a model too large for a Data per computation
-        (Mechanism.shares_data) the mechanism's shared one, the pass run again at each read."""
-        return self._pass(self.mech.data) if self.mech.shares_data else self._own
+    def _data(self, jacobians: bool = False):
+        """A Data holding this state's pass (with the joint Jacobians when asked), to read at once:
+        the thread's Data for states (Mechanism.state_data), the pass run again only when another
+        state ran there since; for a model too large for a Data per thread (Mechanism.shares_data)
+        the mechanism's shared one, the pass run again at each read."""
+        mech = self.mech
+        if mech.shares_data:
+            return self._pass(mech.data, jacobians)
+        slot = mech.state_data
+        data = getattr(slot, "data", None)
+        if data is None:
+            data = slot.data = mech.model.createData()
+            slot.key = slot.jacobians = None
+        if slot.key != self._key:
+            self._pass(data, jacobians)
+            slot.key, slot.jacobians = self._key, jacobians
+        elif jacobians and not slot.jacobians:
+            self._pass(data, True, placed=True)
+            slot.jacobians = True
+        return data
 
     @property
     def has_rates(self) -> bool:
         return self.qd is not None
 
+    def _output(self, fid: int):
+        """(joint, placement in it) of the output frame place_tool placed, when ``fid`` is it; else None."""
+        mech = self.mech
+        return frame_parent(mech, fid) if fid == mech.tool_frame and mech.tool is not None else None
+
     def frame_placement(self, fid: int):
         """World placement of a frame (pinocchio.SE3, a copy)."""
-        return pin.SE3(self._data.oMf[fid])
+        out = self._output(fid)
+        d = self._data()
+        return d.oMi[out[0]] * out[1] if out else pin.SE3(d.oMf[fid])
 
     def joint_placement(self, jid: int):
         """World placement of a joint's frame (pinocchio.SE3, a copy)."""
-        return pin.SE3(self._data.oMi[jid])
+        return pin.SE3(self._data().oMi[jid])
+
+    def centre(self, ref) -> np.ndarray:
+        """World position [m] of a point named by reference: ("joint", i) the centre of joint i (its
+        frame's origin, moving with it), ("mount", i) where joint i sits on its parent link (fixed
+        there whatever joint i's value), ("frame", f) frame f's origin."""
+        kind, i = ref
+        d = self._data()
+        if kind == "mount":
+            return d.oMi[self.mech.model.parents[i]].act(self.mech.model.jointPlacements[i].translation)
+        return (d.oMi[i] if kind == "joint" else d.oMf[i]).translation.copy()
+
+    def joint_twists(self, jid: int) -> np.ndarray:
+        """(6, k) the unit twists of joint jid's k coordinates (its motion subspace S moved to the
+        world: spatial, (v at the world origin, w), world axes) [m/rad, 1]."""
+        d = self._data()
+        S = np.asarray(d.joints[jid].S, float).reshape(6, -1)
+        M = d.oMi[jid]
+        return np.column_stack([M.act(pin.Motion(S[:, k])).vector for k in range(S.shape[1])]) if S.size \
+            else np.zeros((6, 0))
 
     def frame_jacobian(self, fid: int, reference=LWA) -> np.ndarray:
         """(6, nv) Jacobian of a frame in (linear, angular) order, in ``reference``
         (LOCAL_WORLD_ALIGNED by default: the frame origin's velocity and the angular
         velocity, world axes; WORLD: the spatial twist at the world origin) [m/rad, 1]."""
-        return frame_jacobian(self.mech.model, self._data, fid, reference).copy()
+        out = self._output(fid)
+        d = self._data(jacobians=True)
+        if out:
+            return frame_jacobian(self.mech.model, d, out[0], reference, placement=out[1])
+        return frame_jacobian(self.mech.model, d, fid, reference).copy()
 
     def link_jacobian(self, link: str, reference=LWA) -> np.ndarray:
         return self.frame_jacobian(self.mech.link_frame(link), reference)
@@ -210,15 +298,19 @@ class KinematicState:
 
     def frame_pose(self, fid: int) -> np.ndarray:
         """4x4 world pose of a frame."""
-        return self._data.oMf[fid].homogeneous.copy()
+        return self.frame_placement(fid).homogeneous
 
     def frame_twist(self, fid: int) -> np.ndarray:
         """(v, w) of the frame's origin, world axes [m/s, rad/s]."""
-        return pin.getFrameVelocity(self.mech.model, self._data, fid, LWA).vector.copy()
+        out = self._output(fid)
+        where = out if out else (fid,)
+        return pin.getFrameVelocity(self.mech.model, self._data(), *where, LWA).vector.copy()
 
     def frame_acceleration(self, fid: int) -> np.ndarray:
         """Classical acceleration (a, alpha) of the frame's origin, world axes [m/s^2, rad/s^2]."""
-        return pin.getFrameClassicalAcceleration(self.mech.model, self._data, fid, LWA).vector.copy()
+        out = self._output(fid)
+        where = out if out else (fid,)
+        return pin.getFrameClassicalAcceleration(self.mech.model, self._data(), *where, LWA).vector.copy()
 
     # ------------------------------------------------------------------ links and points
     def link_pose(self, link: str) -> np.ndarray:
@@ -227,7 +319,7 @@ class KinematicState:
     def point(self, link: str, local=(0.0, 0.0, 0.0)) -> PointMotion:
         """Motion of the point with coordinates ``local`` [m] in ``link``'s frame."""
         fid = self.mech.link_frame(link)
-        M = self._data.oMf[fid]
+        M = self.frame_placement(fid)
         r = M.rotation @ np.asarray(local, float)  # from the frame origin to the point, world axes
         p = M.translation + r
         if not self.has_rates:
@@ -239,7 +331,7 @@ class KinematicState:
     def link_motion(self, link: str) -> dict:
         """position, velocity, acceleration of the link frame's origin; omega, alpha (vectors)."""
         fid = self.mech.link_frame(link)
-        out = {"position": self._data.oMf[fid].translation.copy()}
+        out = {"position": self.frame_placement(fid).translation.copy()}
         if self.has_rates:
             v, w = np.split(self.frame_twist(fid), 2)
             a, alpha = np.split(self.frame_acceleration(fid), 2)
@@ -248,8 +340,7 @@ class KinematicState:
 
     # ------------------------------------------------------------------ loop-joint coordinates
     def _cut_frames(self, cut):
-        d = self._data
-        M1, M2 = d.oMf[cut.frame1], d.oMf[cut.frame2]
+        M1, M2 = self.frame_placement(cut.frame1), self.frame_placement(cut.frame2)
         axis = M1.rotation @ np.asarray(cut.axis, float)
         return M1, M2, axis / np.linalg.norm(axis)
 
@@ -292,8 +383,8 @@ class KinematicState:
     @cached_property
     def leg_lengths(self) -> dict:
         """Prismatic joint -> the distance between the joint centres its leg connects [m] (leg_ends)."""
-        return {j: float(np.linalg.norm(_point_ref(self._data, e) - _point_ref(self._data, s)))
-                for j, (s, e) in leg_ends(self.mech).items()}
+        ends = leg_ends(self.mech)
+        return {j: float(np.linalg.norm(self.centre(e) - self.centre(s))) for j, (s, e) in ends.items()}
 
     @cached_property
     def guide_positions(self) -> dict:
@@ -302,10 +393,10 @@ class KinematicState:
         slider's frame origin (the joint's frame; a cut joint's F2), i.e. measured from the foot of the
         perpendicular from the world origin onto the guide line -- a slider-crank's slider distance d when its
         crank pivots at the origin.  (The joint's value is measured from where the file placed the joint.)"""
-        model, d, out = self.mech.model, self._data, {}
+        model, out = self.mech.model, {}
         for c in self.mech.coordinates:
             if c.nv == 1 and c.nq == 1 and self.mech.translational[c.idx_v] and model.parents[c.joint_id] == 0:
-                M = d.oMi[c.joint_id]
+                M = self.joint_placement(c.joint_id)
                 out[c.joint] = float(M.translation @ (M.rotation @ joint_axis(model.joints[c.joint_id])))
         for cut in self.loop_cuts:
             if cut.type == "prismatic" and model.frames[cut.frame1].parentJoint == 0:

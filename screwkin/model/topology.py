@@ -28,6 +28,7 @@ from ..tolerances import DEFAULT
 from ._pin import frame_id
 from .geometry import lines_point
 from .six_bar import six_bar_inversion
+from .state import KinematicState
 
 __all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind", "open_joints"]
 
@@ -205,10 +206,12 @@ class UnionFind:
 
 
 def frame_link(mech, frame_name: str) -> str:
-    """The URDF link a Pinocchio frame is attached to."""
+    """The URDF link a Pinocchio frame is attached to (the output frame's: the link place_tool put it on)."""
     spec = mech.spec
     if frame_name in spec.links:
         return frame_name
+    if mech.tool is not None and frame_name == mech.tool.name:
+        return mech.tool.link
     for j in spec.joints:
         if j.name == frame_name:
             return j.child
@@ -260,8 +263,7 @@ class _Edge:
 def _edges(mech, q):
     """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
     model = mech.model
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(model, data, q)
+    state = KinematicState(mech, q)
     replaced = dict(mech.spec.replacements)
     edges, welds = [], []
     for j in mech.spec.joints:
@@ -279,13 +281,13 @@ def _edges(mech, q):
         point = direction = direction2 = None
         if model.existJointName(j.name):
             jid = model.getJointId(j.name)
-            M = data.oMi[jid]
+            M = state.joint_placement(jid)
             point = M.translation.copy()
             if t in ("revolute", "continuous", "prismatic", "planar"):
                 direction = M.rotation @ np.asarray(j.axis)
             elif t == "universal":  # a native universal joint from a sidecar replacement
                 a1, a2 = axis_letters(rep)
-                base = data.oMi[model.parents[jid]] * model.jointPlacements[jid]
+                base = state.joint_placement(model.parents[jid]) * model.jointPlacements[jid]
                 direction, direction2 = base.rotation @ a1, M.rotation @ a2
         dof = {"spherical": 3, "universal": 2}.get(t, j.dof)
         edges.append(_Edge(j.name, t, dof, j.parent, j.child, False, point, direction, direction2))
@@ -294,7 +296,7 @@ def _edges(mech, q):
         a = frame_link(mech, c.link1)
         b = frame_link(mech, c.link2)
         if c.pair is not None:  # one higher (or screw) pair between the two links, at F1
-            M1 = data.oMf[model.getFrameId(f"{c.name}@F1")]
+            M1 = state.frame_placement(model.getFrameId(f"{c.name}@F1"))
             s = specs.get(c.name)
             profile = f"{s.profile1[0]}-{s.profile2[0]}" if s is not None and s.profile1 else None
             edges.append(_Edge(c.name, c.pair, CUT_JOINT_DOF[c.pair], a, b, True, M1.translation.copy(),
@@ -303,12 +305,12 @@ def _edges(mech, q):
         if c.type == "fixed":
             welds.append((a, b, c.name))
             continue
-        M1 = data.oMf[c.frame1]
+        M1 = state.frame_placement(c.frame1)
         direction = direction2 = None
         if c.type in ("revolute", "continuous", "prismatic", "cylindrical", "planar", "universal"):
             direction = M1.rotation @ np.asarray(c.axis)
         if c.type == "universal":
-            direction2 = data.oMf[c.frame2].rotation @ np.asarray(c.axis2)
+            direction2 = state.frame_placement(c.frame2).rotation @ np.asarray(c.axis2)
         edges.append(_Edge(c.name, c.type, c.dof, a, b, True, M1.translation.copy(), direction, direction2))
     return edges, welds
 

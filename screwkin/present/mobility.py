@@ -186,7 +186,7 @@ def mobility_text(r) -> str:
     if r.local is not None:
         lines += local_lines(r.local, r.local_where)
     if r.redundant is not None and r.redundant.count:
-        lines += redundancy_lines(r.redundant, f"redundant constraints at a configuration of the generic rank")
+        lines += redundancy_lines(r.redundant, "redundant constraints at a configuration of the generic rank")
     lines.append(f"(assembled from {r.assembly_start}: closure residual {r.residual:.2e} after {r.iterations} "
                  f"iterations; generic rank taken over {r.samples} assembled configurations)")
     return "\n".join(lines)

@@ -30,6 +30,7 @@ from ..files.meshes import find_mesh
 from ..files.xmlsafe import parse_xml_text
 from ..model.geometry import perpendicular_basis
 from ..model._pin import frame_id
+from ..model.state import KinematicState
 from .viewplanar import colour_links, link_colours, planar_basis, top_view
 from .viewserver import ViewerServer
 from .camera import BACKGROUND, PICTURE, fit_camera, view_direction
@@ -210,11 +211,12 @@ class Scene:
         return np.array([pts.min(axis=0), pts.max(axis=0)])
 
 
-def _corner_points(model, data, geom, q) -> np.ndarray:
-    """Points that bound the drawn geometry at q: the joint centres and the corners of each
-    object's own bounding box placed where its joint puts it (meshes as loaded, scale included)."""
-    pin.forwardKinematics(model, data, q)
-    pts = [data.oMi[j].translation for j in range(model.njoints)]
+def _corner_points(state, geom) -> np.ndarray:
+    """Points that bound the drawn geometry at the configuration of ``state`` (a KinematicState): the
+    joint centres and the corners of each object's own bounding box placed where its joint puts it
+    (meshes as loaded, scale included)."""
+    placed = [state.joint_placement(j) for j in range(state.mech.model.njoints)]
+    pts = [M.translation for M in placed]
     signs = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
     for obj in geom.geometryObjects:
         g = obj.geometry
@@ -225,7 +227,7 @@ def _corner_points(model, data, geom, q) -> np.ndarray:
             lo = hi = np.zeros(3)
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
             lo = hi = np.zeros(3)
-        M = data.oMi[obj.parentJoint] * obj.placement
+        M = placed[obj.parentJoint] * obj.placement
         corners = lo + signs * (hi - lo)
         pts.extend(corners @ M.rotation.T + M.translation)
     return np.asarray(pts)
@@ -261,9 +263,8 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
     model = mech.model
     geom = _visual_geometry(mech, warn)
     roles = {o.name: "link" for o in geom.geometryObjects}
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(model, data, q)
-    pts = np.array([data.oMi[j].translation for j in range(model.njoints)])
+    state = KinematicState(mech, q)
+    pts = np.array([state.centre(("joint", j)) for j in range(model.njoints)])
     scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
     center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     r_axis, L_axis = 0.004 * scale, 0.08 * scale
@@ -336,10 +337,9 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
             add(_segment(f"screwkin/output/{axis}", fr.parentJoint, fid, fr.placement.translation, end, r_axis,
                          COLORS[axis]), f"output:{axis}")
     for k, (qs, twist) in enumerate(singular):
-        d = mech.scratch_data()
-        pin.framesForwardKinematics(model, d, qs)
         if output is not None:
-            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, d.oMf[mech.link_frame(output)].translation, 4 * r_axis,
+            at = KinematicState(mech, qs).frame_placement(mech.link_frame(output)).translation
+            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, at, 4 * r_axis,
                       COLORS["marker"]), "singular:marker")
         if twist is not None and twist.screw is not None and twist.screw.point is not None:
             s = twist.screw
@@ -351,7 +351,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
                 _coal().Cone(3 * r_axis, 6 * r_axis))
             cone.meshColor = COLORS["screw"]
             add(cone, "singular:arrow")
-    return Scene(geom, roles, scale, center, _corner_points(model, data, geom, q),
+    return Scene(geom, roles, scale, center, _corner_points(state, geom),
                  declared=mech.actuation_source is not None)
 
 

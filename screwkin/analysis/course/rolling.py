@@ -33,7 +33,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from ...model.cuts import in_plane, pair_contact
 from ...model.geometry import nearest_turn
@@ -60,9 +59,9 @@ class RollingPair:
     in_system: bool  # the law is one of the equations F (theta_ab constant)
 
 
-def measure_pairs(loops, data):
-    """Per rolling/gear loop joint of ``loops`` (a VectorLoops being built, its forward
-    kinematics in ``data`` at loops.q): the anchors of its two centres on its two links
+def measure_pairs(loops, state):
+    """Per rolling/gear loop joint of ``loops`` (a VectorLoops being built; ``state``: its
+    model.state.KinematicState at loops.q): the anchors of its two centres on its two links
     (loops.keep) and a dict of what the loop terms need."""
     mech = loops.mech
     model = mech.model
@@ -75,7 +74,7 @@ def measure_pairs(loops, data):
         la, lb = j.links
         f1 = model.getFrameId(f"{j.name}@F1")
         f2 = model.getFrameId(f"{j.name}@F2")
-        M1, M2 = data.oMf[f1], data.oMf[f2]
+        M1, M2 = state.frame_placement(f1), state.frame_placement(f2)
         loops.keep((j.name, la), la, M1.translation)
         loops.keep((j.name, lb), lb, M2.translation)
         p1 = loops._p2(M1.translation)
@@ -177,13 +176,11 @@ def virtual_coordinates(loops, q, values, before):
     def delta(e):
         return float(loops.sp.sympify(e).subs(known)) - float(loops.sp.sympify(e).subs(known0))
 
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(mech.model, data, loops.q)
     for name, rec in loops.pair_geometry.items():
         if "ta" not in rec:
             continue  # in no loop
         j1, j2 = (mech.coordinate(n) for n in mech.virtual_joints[name])
-        s = _axis_sign(loops, data, name)
+        s = _axis_sign(loops, name)
         d_a, d_b = delta(rec["ta"]), delta(rec["tb"])
         if rec["kind"] == "rack":
             d_u = delta(rec["tu"])
@@ -196,12 +193,12 @@ def virtual_coordinates(loops, q, values, before):
     return q
 
 
-def _axis_sign(loops, data, name):
-    """+1 when the pair's axis (in F1) points along the plane's normal, else -1."""
+def _axis_sign(loops, name):
+    """+1 when the pair's axis (in F1) points along the plane's normal at loops.q, else -1."""
     mech = loops.mech
     f1 = mech.model.getFrameId(f"{name}@F1")
     axis = next(c.axis for c in mech.spec.cut_joints if c.name == name)
-    return float(np.sign((data.oMf[f1].rotation @ np.asarray(axis, float)) @ loops.n))
+    return float(np.sign((loops.state.frame_placement(f1).rotation @ np.asarray(axis, float)) @ loops.n))
 
 
 def turns_through_pairs(loops, q, values):
@@ -212,8 +209,6 @@ def turns_through_pairs(loops, q, values):
     plus what the pair turned.  Inputs keep their values."""
     mech = loops.mech
     out = dict(values)
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(mech.model, data, loops.q)
     inputs = set(getattr(loops, "input_joints", {}) or {})
 
     def name_of(link):
@@ -224,7 +219,7 @@ def turns_through_pairs(loops, q, values):
         for pname, rec in loops.pair_geometry.items():
             na, nb = name_of(rec["a"]), name_of(rec["b"])
             j1, j2 = (mech.coordinate(n) for n in mech.virtual_joints[pname])
-            s = _axis_sign(loops, data, pname)
+            s = _axis_sign(loops, pname)
             dv1, dv2 = q[j1.idx_q] - loops.q[j1.idx_q], q[j2.idx_q] - loops.q[j2.idx_q]
             da = (out[na] - loops.theta_q[loops.rep[rec["a"]]]) if na in out else 0.0
             turned = s * dv2 if rec["kind"] == "rack" else s * (dv1 + dv2)  # theta_b - theta_a (- theta_u)

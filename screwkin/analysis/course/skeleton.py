@@ -383,13 +383,13 @@ def skeleton(mech, q, inputs=None, basis=None) -> Skeleton:
         except UsageError:
             la = None
         if la is not None:
-            th = la(q)
+            th = la(q, state)
             angles = {number[k]: v for k, v in th.items() if k in number}
             origins = {}
             for k in th:
                 if k in number:
                     start = la.links[k][0]
-                    origins[number[k]] = p2(la._point(start))
+                    origins[number[k]] = p2(state.centre(start))
     units = {k: ("m" if mech.translational[mech.coordinate(k).idx_v] else "rad") for k in inputs}
     return Skeleton(str(mech.path), topo.motion_space, planar, (tuple(e1), tuple(e2), tuple(n)), tuple(links),
                     tuple(joints), tuple(profiles), {k: values[k] for k in inputs}, units, size, angles, origins)

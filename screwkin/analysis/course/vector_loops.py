@@ -44,10 +44,10 @@ from __future__ import annotations
 
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import MechanismFileError, UsageError
 from ...model.geometry import wrap_angle as _wrap
+from ...model.state import KinematicState
 from .cycles import fundamental_cycles
 from .det_conditions import determinant
 from .placing import LOWER, joint_configuration
@@ -171,9 +171,8 @@ class VectorLoops:
         """World positions of the joint centres at q; the anchors (points fixed in a link) of
         each joint on each of its links, as (frame id, local point) for forward kinematics."""
         mech, topo = self.mech, self.topo
-        model, data = mech.model, mech.scratch_data()
-        pin.framesForwardKinematics(model, data, self.q)
-        self.theta_q = self.angles(self.q)
+        self.state = state = KinematicState(mech, self.q)  # the configuration the equations are built at
+        self.theta_q = self.angles(self.q, state)
         self.frames = {lk: mech.link_frame(lk) for lk in topo.links}
         self.anchor = {}  # (joint, link) -> 2D point at q
         self.local = {}  # (joint, link) -> (frame id, local 3D point)
@@ -188,7 +187,7 @@ class VectorLoops:
         def keep(key, link, point):
             fid = self.frames[link]
             self.anchor[key] = self._p2(point)
-            self.local[key] = (fid, data.oMf[fid].actInv(np.asarray(point, float)))
+            self.local[key] = (fid, state.frame_placement(fid).actInv(np.asarray(point, float)))
 
         self.keep = keep
 
@@ -213,11 +212,11 @@ class VectorLoops:
             u = flip * u
             nrm = np.array([-u[1], u[0]])
             fid = self.frames[g]
-            u_local = data.oMf[fid].rotation.T @ (flip * u3 / np.linalg.norm(self._p2(u3)))
+            u_local = state.frame_placement(fid).rotation.T @ (flip * u3 / np.linalg.norm(self._p2(u3)))
             self.slides[j.name] = {"guide": g, "slider": s, "u": u, "x": float(d @ u), "e": float(d @ nrm),
                                    "u_local": u_local, "from": ja.name if ja is not None else j.name,
                                    "to": jb.name if jb is not None else j.name}
-        self.pair_geometry = measure_pairs(self, data)  # rolling and gear pairs: their centres, radii
+        self.pair_geometry = measure_pairs(self, state)  # rolling and gear pairs: their centres, radii
 
     # ------------------------------------------------------------------ symbols
     def _new_symbol(self, name, link, kind, value, role, meaning):
@@ -497,9 +496,8 @@ class VectorLoops:
         """The variable symbols (angles, slider coordinates) at configuration q, by forward
         kinematics of the anchors (the loops need not close at q)."""
         mech = self.mech
-        th = self.angles(q)
-        data = mech.scratch_data()
-        pin.framesForwardKinematics(mech.model, data, q)
+        state = KinematicState(mech, q)
+        th = self.angles(q, state)
         out = {}
         for n in self.variables:
             info = self.symbol_info[n]
@@ -512,9 +510,9 @@ class VectorLoops:
             g, s = sl["guide"], sl["slider"]
             fa, pa = self.local[(joint, g)]
             fb, pb = self.local[(joint, s)]
-            A = data.oMf[fa].act(pa)
-            B = data.oMf[fb].act(pb)
-            u3 = data.oMf[self.frames[g]].rotation @ sl["u_local"]
+            A = state.frame_placement(fa).act(pa)
+            B = state.frame_placement(fb).act(pb)
+            u3 = state.frame_placement(self.frames[g]).rotation @ sl["u_local"]
             u = self._p2(u3)
             out[t["x"].name] = float(self._p2(B - A) @ (u / np.linalg.norm(u)))
         return out

@@ -37,13 +37,13 @@ import warnings
 from collections import Counter
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import AssemblyError, MechanismFileError, UsageError
 from ...files.urdf import read_urdf
 from ...files.xacro import is_xacro
 from ...files.xacro_batch import Unbatchable, expand_batch
 from ...model.closability import obstacle_of, planar_loops
+from ...model.state import KinematicState
 from ..motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_transmission
 from .study import _GRASHOF, COLUMNS, evaluate_design, _reason, metric_columns, run_chunk
 
@@ -398,17 +398,17 @@ def _check_reference(d, fb, placed, spec) -> None:
     """The composed placements of the reference design (the first of ``placed``) are Pinocchio's at the
     file's configuration, to 1e-9 of the mechanism's size: the template and its reading are right."""
     mech = d.mech
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(mech.model, data, mech.neutral())
+    state = KinematicState(mech, mech.neutral())
     equal = mech.tolerances.equal
     scale = equal * max(mech.length, 1.0)
     for k in range(1, mech.model.njoints):
         name = mech.model.names[k]
         if name in placed.joints:
             R, p = placed.joints[name]
-            if np.abs(p[0] - data.oMi[k].translation).max() > scale or np.abs(R[0] - data.oMi[k].rotation).max() > equal:
+            M = state.joint_placement(k)
+            if np.abs(p[0] - M.translation).max() > scale or np.abs(R[0] - M.rotation).max() > equal:
                 raise Unbatchable(f"the family's template does not place joint {name} where its file does")
     for c in mech.cuts:
         for fid, (R, p) in zip((c.frame1, c.frame2), placed.cuts[c.name]):
-            if np.abs(p[0] - data.oMf[fid].translation).max() > scale:
+            if np.abs(p[0] - state.frame_placement(fid).translation).max() > scale:
                 raise Unbatchable(f"the family's template does not place loop joint {c.name} where its file does")

@@ -10,10 +10,10 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import AssemblyError
 from ...model.geometry import wrap_angle
+from ...model.state import KinematicState
 from ..course.figures import trace_points
 from ..motion.links import Point, motion_along
 from ..motion.position import PositionSolver
@@ -69,9 +69,8 @@ class DesignTargets:
     stops: tuple = ()  # ((input value, reason) or (None, None)) where the motion stopped: back, then forward
 
 
-def _frame(mech, data, fid, q):
-    pin.framesForwardKinematics(mech.model, data, q)
-    M = data.oMf[fid]
+def _frame(mech, fid, q):
+    M = KinematicState(mech, q).frame_placement(fid)
     return tuple(float(v) for v in M.translation), float(math.atan2(M.rotation[1, 0], M.rotation[0, 0]))
 
 
@@ -88,7 +87,6 @@ def design_targets(mech, q, steps: int = 360) -> DesignTargets:
     target kept, as ``screwkin synthesize`` checks it; with point targets, the curve of their
     link's origin (analysis.course.figures.trace_points, ``steps`` over a turn of the input)."""
     specs = tuple(mech.spec.targets)
-    data = mech.scratch_data()
     reached = []
     for spec in specs:
         fid = mech.link_frame(spec.link)
@@ -100,11 +98,11 @@ def design_targets(mech, q, steps: int = 360) -> DesignTargets:
             continue
         best = None
         for s in res.solutions:
-            err, aerr = _error(spec, *_frame(mech, data, fid, s.q))
+            err, aerr = _error(spec, *_frame(mech, fid, s.q))
             if best is None or err + aerr < best[0]:
                 best = (err + aerr, s.q)
         q_k = np.asarray(polished(mech, solver, best[1])[0], float).copy()
-        position, yaw = _frame(mech, data, fid, q_k)
+        position, yaw = _frame(mech, fid, q_k)
         reached.append(TargetReached(spec, q_k, position, yaw, *_error(spec, position, yaw)))
     points = [s for s in specs if s.kind == "point"]
     if not points:
@@ -146,7 +144,7 @@ def design_targets(mech, q, steps: int = 360) -> DesignTargets:
             q_u = polished(mech, solver, solver.track({name: u}, Q[j]).q)[0]
         except AssemblyError:
             continue
-        extra.append((u, _frame(mech, data, fid, q_u)[0], k))
+        extra.append((u, _frame(mech, fid, q_u)[0], k))
     inputs = np.concatenate([values, [u for u, _, _ in extra]])
     xyz = np.concatenate([curve, np.array([p for _, p, _ in extra]).reshape(-1, 3)])
     order = np.argsort(inputs, kind="stable")

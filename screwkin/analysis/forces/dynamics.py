@@ -37,8 +37,8 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import MechanismFileError, UsageError, quote
-from ...model._pin import frame_jacobian
 from ...model.geometry import cross3
+from ...model.state import KinematicState
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
 from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
@@ -156,16 +156,15 @@ def check_inertias(mech) -> tuple:
     return ()
 
 
-def _load_wrenches(mech, loads, data) -> list:
-    """(frame id, wrench at the frame's origin, world axes) of each load at the placements in
-    ``data`` (the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
+def _load_wrenches(mech, loads, state) -> list:
+    """(frame id, wrench at the frame's origin, world axes) of each load at the configuration of
+    ``state`` (a KinematicState; the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []
     for ld in loads:
         fid = mech.link_frame(ld.link)
         w = np.asarray(ld.wrench, float)
         if ld.point is not None:
-            M = data.oMf[fid]
-            arm = M.rotation @ np.asarray(ld.point, float)
+            arm = state.frame_placement(fid).rotation @ np.asarray(ld.point, float)
             w = np.r_[w[:3], w[3:] + np.cross(arm, w[:3])]
         out.append((fid, w))
     return out
@@ -281,11 +280,10 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             progress(k, n)
         q, v, a = res.q[k], res.rates[k], res.accelerations[k]
         b = pin.rnea(gmodel, data, q, v, a).copy()
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        frames = _load_wrenches(mech, loads, data)
+        state = KinematicState(mech, q)
+        frames = _load_wrenches(mech, loads, state)
         for fid, w in frames:
-            J = frame_jacobian(model, data, fid, LWA)
+            J = state.frame_jacobian(fid, LWA)
             b -= J.T @ w
             P_load[k] += float(w @ (J @ v))
         K = mech.closure.jacobian(q)
@@ -300,14 +298,13 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
             kinds[name] = kind
             open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
-        # data holds q's placements (its own Data: reaction_table computes in another)
         for name, (kind, wrench, _) in table.items():
             if kind in ("tree", "coupled") and name in ground_tree:
                 jid = model.getJointId(name) if kind == "coupled" else reaction_joint_id(mech, name)
-                sign, origin = -1.0, data.oMi[jid].translation
+                sign, origin = -1.0, state.centre(("joint", jid))
             elif kind == "cut" and name in ground_cuts:
                 cut = next(c for c in mech.cuts if c.name == name)
-                sign, origin = ground_cuts[name], data.oMf[cut.frame2].translation
+                sign, origin = ground_cuts[name], state.centre(("frame", cut.frame2))
             else:
                 continue
             shaking_f[k] += sign * wrench[:3]

@@ -36,7 +36,7 @@ import pinocchio as pin
 from ...errors import UsageError
 from ...model.geometry import cross3
 from ...model.linalg import null_space, rank
-from ...model.state import KinematicState
+from ...model.state import KinematicState, frame_parent
 from ..screws import Screw, cut_twists, screw_of
 from ..singularities.singular import Generic, measures
 
@@ -191,17 +191,20 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=N
     on the child side (link2).  ``rows``: (closure.row_wrenches(q), closure.row_labels()) when the
     caller has them (reaction_table: the same for every call at q)."""
     model = mech.model
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(model, data, q)
+    state = KinematicState(mech, q)
     rows, labels = rows if rows is not None else (mech.closure.row_wrenches(q), mech.closure.row_labels())
     fext = [pin.Force.Zero() for _ in range(model.njoints)]
 
+    placed = {}  # frame -> (its body's joint, that joint's placement, the frame's origin): read once
+
     def apply(frame, wrench_at_origin):
         """Add a wrench (force, moment about the frame's origin, world axes) to the frame's body."""
-        f = model.frames[frame]
-        o = data.oMf[frame].translation
+        if frame not in placed:
+            joint = frame_parent(mech, frame)[0]
+            placed[frame] = (joint, state.joint_placement(joint), state.frame_placement(frame).translation.copy())
+        joint, M, o = placed[frame]
         force, moment = wrench_at_origin[:3], wrench_at_origin[3:] + cross3(o, wrench_at_origin[:3])
-        fext[f.parentJoint] += data.oMi[f.parentJoint].actInv(pin.Force(force, moment))
+        fext[joint] += M.actInv(pin.Force(force, moment))
 
     cut = {}
     for (fa, wa, fb, wb), value in zip(rows, lam):
@@ -223,6 +226,7 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=N
             total[1] = total[1] + wa * value
     zero_v = np.zeros(model.nv)
     g = model.gravity.linear if gravity is True else np.zeros(3) if gravity is False else np.asarray(gravity, float)
+    data = mech.scratch_data()  # RNEA's own Data: the forces each joint transmits, read below
     pin.rnea(mech.model_with_gravity(g), data, q, zero_v if v is None else v, zero_v if a is None else a, fext)
     virtual = {n for names in mech.virtual_joints.values() for n in names}
     compounds = compound_joints(mech)
@@ -233,15 +237,14 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=N
             continue
         jid = c.joint_id
         f = data.f[jid]  # transmitted from the parent into joint jid's body, in the joint frame
-        M = data.oMi[jid]
+        M = state.joint_placement(jid)
         # a compound joint (three revolutes through massless links: a ball joint) is one row, named as mobility
         # names it: the wrench its member next to the parent link transmits
         out[inside.get(c.joint, c.joint)] = ("tree", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
     for cp in mech.couplings:  # a coupled joint carries its reaction too; its effort: coupled_efforts
         jid = model.getJointId(cp.joint)
-        f, M = data.f[jid], data.oMi[jid]
+        f, M = data.f[jid], state.joint_placement(jid)
         out[cp.joint] = ("coupled", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
-    pin.framesForwardKinematics(model, data, q)
     for name, (frame, wrench) in cut.items():
         out[name] = ("cut", wrench)
     return out
@@ -253,13 +256,12 @@ def coupled_efforts(mech, q, reactions: dict) -> dict:
     joint.  ``reactions``: joint -> wrench (force, moment) at the joint's origin, world axes."""
     if not mech.couplings:
         return {}
-    data = mech.scratch_data()
-    pin.framesForwardKinematics(mech.model, data, q)
+    state = KinematicState(mech, q)
     spec = {j.name: j for j in mech.spec.joints}
     out = {}
     for cp in mech.couplings:
         j = spec[cp.joint]
-        axis = data.oMi[mech.model.getJointId(cp.joint)].rotation @ (np.asarray(j.axis, float) /
+        axis = state.joint_placement(mech.model.getJointId(cp.joint)).rotation @ (np.asarray(j.axis, float) /
                                                                       np.linalg.norm(j.axis))
         w = np.asarray(reactions[cp.joint], float)
         out[cp.joint] = float(axis @ (w[:3] if j.type == "prismatic" else w[3:]))
@@ -356,7 +358,7 @@ def legs(mech, q, output, inputs=None) -> tuple:
     state = KinematicState(mech, q)
     inputs = set(mech.actuated if inputs is None else inputs)
     fid = mech.link_frame(output)
-    body = model.frames[fid].parentJoint
+    body = frame_parent(mech, fid)[0]
     o = state.frame_placement(fid).translation
     coords = {c.joint_id: c for c in mech.coordinates}
 

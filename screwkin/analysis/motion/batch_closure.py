@@ -14,14 +14,27 @@ import pinocchio as pin
 from ...model import newton
 from ...model.closure import ClosureSystem
 from ...model.cuts import CouplingRow, CutJoint
+from ...model.state import frame_parent, model_with_output
 
-__all__ = ["TreeKinematics", "BatchClosure", "Unbatchable"]
+__all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 
 
 class Unbatchable(Exception):
     """The mechanism holds something the batched closure does not represent (joints of more
     than one coordinate, <mimic> joints, helical joints, sliding contacts): the caller solves
     one configuration at a time with model.closure.ClosureSystem instead."""
+
+
+def tree_kinematics(mech):
+    """The mechanism's TreeKinematics, made once (mech.cache), None when its joints are not all 1-DOF
+    revolute or prismatic (its users then run Pinocchio a configuration at a time)."""
+    key = "links.tree"
+    if key not in mech.cache:
+        try:
+            mech.cache[key] = TreeKinematics(mech)
+        except Unbatchable:
+            mech.cache[key] = None
+    return mech.cache[key]
 
 
 class TreeKinematics:
@@ -38,7 +51,7 @@ class TreeKinematics:
 
     def __init__(self, mech):
         model = mech.model
-        self.model = model
+        self.mech, self.model = mech, model
         if model.nq != model.nv:
             raise Unbatchable(f"{mech.path}: joints of more than one coordinate")
         data = mech.scratch_data()
@@ -74,12 +87,15 @@ class TreeKinematics:
         return self.supports[jid]
 
     def _frame(self, f):
-        """(parent joint, [R | t]^T of the frame's placement) of frame f."""
-        if f not in self._frames:
-            frame = self.model.frames[f]
-            self._frames[f] = (frame.parentJoint,
-                               np.hstack([frame.placement.rotation, frame.placement.translation[:, None]]).T.copy())
-        return self._frames[f]
+        """(parent joint, [R | t]^T of the frame's placement) of frame f (model.state.frame_parent: the output
+        frame where place_tool put it)."""
+        if f in self._frames:
+            return self._frames[f]
+        joint, placement = frame_parent(self.mech, f)
+        out = (joint, np.hstack([placement.rotation, placement.translation[:, None]]).T.copy())
+        if f != self.mech.tool_frame:  # (the output frame is wherever place_tool last put it)
+            self._frames[f] = out
+        return out
 
     def _pass(self, Q):
         """(RTs, ps, ws) of every joint (index 0 the ground) for the configurations Q (N, nq):
@@ -148,6 +164,26 @@ class TreeKinematics:
             ac[:, i, 3:] = al[jid]
         return R, t, tw, ac
 
+    def centres(self, Q, refs) -> dict:
+        """{ref: (N, 3)} the world positions [m] KinematicState.centre reads -- ("joint", i) joint i's
+        centre, ("mount", i) where joint i sits on its parent, ("frame", f) frame f's origin -- at every
+        row of Q: its stacked form, from one pass down the tree."""
+        Q = np.atleast_2d(np.asarray(Q, float))
+        N = len(Q)
+        RTs, ps, _ = self._pass(Q)
+        out = {}
+        for kind, i in refs:
+            if kind == "joint":
+                out[(kind, i)] = ps[i]
+                continue
+            if kind == "mount":
+                jid, t = self.model.parents[i], np.asarray(self.model.jointPlacements[i].translation, float)[None]
+            else:
+                jid, CfT = self._frame(i)
+                t = CfT[3:4]
+            out[(kind, i)] = ps[jid] + _thin(t, RTs[jid])[0].reshape(N, 3)
+        return out
+
     def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
         frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
@@ -208,7 +244,9 @@ class BatchClosure:
     """
 
     def __init__(self, mech, target=None, check: int = 0):
-        model = mech.model
+        # with a target, a copy of the model with the output frame placed (model.state.model_with_output): the
+        # target's cut joint is a frame of it, and the self-check moves the target frame in it, not in the mechanism's
+        model = mech.model if target is None else model_with_output(mech)
         self.mech, self.model = mech, model
         if model.nq != model.nv:
             raise Unbatchable(f"{mech.path}: joints of more than one coordinate")

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...model import newton
-from ...model.closure import Assembly
+from ...model.cuts import Assembly
 from .dyads import _evaluate, _Geometry, _Layout, cached_plan
 
 __all__ = ["DyadModes", "dyad_modes", "MAX_DYADS"]
@@ -37,7 +37,7 @@ MAX_DYADS = 12
 
 @dataclass(frozen=True)
 class DyadModes:
-    """The real modes [(q, model.closure.Assembly, branch vectors that reach it, simple)] -- simple:
+    """The real modes [(q, model.cuts.Assembly, branch vectors that reach it, simple)] -- simple:
     None for a regular root (solve's measures decide), False for a double root (a dyad at a limit
     position) -- and the counts: ``dyads`` k, ``choices`` 2^k branch vectors (every complex
     solution, with multiplicity), ``real_choices`` those that are real, ``kinds`` the dyads' kinds

@@ -35,6 +35,7 @@ import pinocchio as pin
 from ...model.geometry import cross3, plane_basis
 from ...model.manifold import continuous_angle, set_continuous_angle
 from ...model.planar_graph import DyadPlan, plan
+from ...model.state import KinematicState
 from .batch_sweep import batch_closure
 from ..singularities.singular import measures
 
@@ -135,24 +136,22 @@ class _Geometry:
     the caller chooses the branches, as dyad_modes does for every one of them)."""
 
     def __init__(self, mech, p: DyadPlan, q0, probe: bool = True):
-        model, data = mech.model, mech.scratch_data()
-        pin.computeJointJacobians(model, data, q0)
-        pin.updateFramePlacements(model, data)
+        state = KinematicState(mech, q0)
         axes, points = [], []  # per pair: (on the side of its first group, of its second)
         for pr in p.pairs:
             if pr.tree is not None:
-                col = data.J[:, model.idx_vs[pr.tree]]
+                col = state.joint_twists(pr.tree)[:, 0]  # its unit twist (v at the world origin, w)
                 v, w = col[:3], col[3:]
                 if pr.kind == "R":
                     x = cross3(w, v) / (w @ w)
                     axes.append((w, w))
                 else:
-                    x = data.oMi[pr.tree].translation.copy()
+                    x = state.centre(("joint", pr.tree))
                     axes.append((v, v))
                 points.append((x, x))
             else:  # each side from its own frame: exact on its link, whatever q0's closure residual
                 cut = next(c for c in mech.cuts if c.name == pr.name)
-                M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
+                M1, M2 = state.frame_placement(cut.frame1), state.frame_placement(cut.frame2)
                 a = np.asarray(cut.axis, float)
                 axes.append((M1.rotation @ a, M2.rotation @ a))
                 points.append((M1.translation.copy(), M2.translation.copy()))

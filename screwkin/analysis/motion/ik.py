@@ -6,7 +6,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
 from ...model.algebraic import algebraic_obstacle
@@ -14,7 +13,7 @@ from ...model.closure import ClosureSystem
 from ...model.cuts import CutJoint
 from ...model.geometry import wrap_angle
 from ...model.linalg import rank
-from ...model.state import KinematicState, angular_loop_joints
+from ...model.state import KinematicState, angular_loop_joints, model_with_output
 from ...model.topology import frame_link
 from . import certified
 from .position import PositionResult, PositionSolver
@@ -39,8 +38,9 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     """
     out_frame = mech.link_frame(output)
     # the target frame (made with the model: adding frames later would outgrow existing Data) placed at
-    # the pose in a copy of the model: the mechanism's own model is not changed (threads may share it)
-    model = pin.Model(mech.model)
+    # the pose in a copy of the model, with the output frame where place_tool put it: the mechanism's own
+    # model is not changed (threads may share it)
+    model = model_with_output(mech)
     fid = mech.target_frame
     frame = model.frames[fid]
     frame.placement = pose

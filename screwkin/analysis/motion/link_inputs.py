@@ -15,11 +15,11 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import joint_axis
 from ...model.cuts import CouplingRow
+from ...model.state import KinematicState
 from ..singularities.singular import Generic
 from .planar import LinkAngles
 
@@ -34,9 +34,8 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
     angles.check(link)
     mech = angles.mech
     model = mech.model
-    data = mech.scratch_data()
     q0 = mech.neutral()
-    pin.forwardKinematics(model, data, q0)
+    state = KinematicState(mech, q0)
     terms, path, pairs = [], [], set()
     jid = model.frames[mech.link_frame(link)].parentJoint
     while jid != 0:
@@ -44,7 +43,7 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
         short = joint.shortname()
         path.append(name)
         if short.startswith("JointModelR") and model.nvs[jid] == 1:
-            s = float((data.oMi[jid].rotation @ joint_axis(joint)) @ angles.n)
+            s = float((state.joint_placement(jid).rotation @ joint_axis(joint)) @ angles.n)
             if abs(abs(s) - 1.0) > mech.tolerances.equal:
                 raise UsageError(f"{mech.path}: joint '{name}' on the path of '{link}' from the ground does not turn "
                                  "about the plane's normal: its angle is not the sum of the joint angles")
@@ -59,7 +58,7 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
         raise UsageError(f"{mech.path}: the angle of '{link}' is fixed (no revolute joint between it and the "
                          f"ground: {', '.join(reversed(path)) or 'none'})")
     path_sum = CouplingRow(f"angle of {link}", "angle", tuple(terms), 0.0, input=link, pairs=frozenset(pairs))
-    theta0 = angles(q0)[link] - path_sum.value(q0)  # the link's angle at q0 less its joints' sum there
+    theta0 = angles(q0, state)[link] - path_sum.value(q0)  # the link's angle at q0 less its joints' sum there
     return replace(path_sum, constant=float(theta0 - angle))
 
 

@@ -26,7 +26,7 @@ import pinocchio as pin
 
 from ...errors import ScrewkinError, UsageError
 from ...model.state import KinematicState, loop_coordinate_cuts
-from .batch_closure import TreeKinematics, Unbatchable
+from .batch_closure import tree_kinematics
 from .planar import LinkAngles
 
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "sweep_motion", "moving_links",
@@ -112,9 +112,9 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
     point_f = [mech.link_frame(p.link) for p in points]
     frames = list(dict.fromkeys(link_f + point_f + [f for c in cuts for f in (c.frame1, c.frame2)]))
     col = {f: i for i, f in enumerate(frames)}
-    tree = _tree(mech) if len(Q) else None
+    tree = tree_kinematics(mech) if len(Q) else None
     R, t, tw, ac = (tree.motions(Q, V, A, frames) if tree is not None
-                    else _frame_motions(model, model.createData(), frames, Q, V, A))
+                    else _frame_motions(model, mech.scratch_data(), frames, Q, V, A))
     named = None
     if angles is not None and normal is not None:
         named = angles.batch(Q) if hasattr(angles, "batch") else {
@@ -181,16 +181,6 @@ def sweep_motion(mech, res, points=()) -> MotionAlong:
                         None if angles is None else angles.n)
 
 
-def _tree(mech):
-    """The mechanism's TreeKinematics (cached: the frames' motions on stacks), None when its joints
-    are not all 1-DOF revolute or prismatic (then Pinocchio a step: _frame_motions)."""
-    key = "links.tree"
-    if key not in mech.cache:
-        try:
-            mech.cache[key] = TreeKinematics(mech)
-        except Unbatchable:
-            mech.cache[key] = None
-    return mech.cache[key]
 
 
 def _frame_motions(model, data, frames, Q, V, A):

@@ -23,10 +23,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import UsageError
 from ...model._pin import joint_axis
+from ...model.state import KinematicState
 from ...model.geometry import wrap_angle as _wrap
 from ...model.manifold import continuous_angle
 from ...model.geometry import (
@@ -37,7 +37,7 @@ from ...model.geometry import (
     plane_basis,
     vector_angle,
 )
-from .batch_closure import TreeKinematics, Unbatchable
+from .batch_closure import tree_kinematics
 from .transmission import (FOUR_BAR_CLASSES, four_bar_classes, slide_transmission_angle, transmission_angle,
                            transmission_range)
 
@@ -163,18 +163,19 @@ def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
     B -> C and the normal of the slide; both in the plane of motion."""
     Q = np.atleast_2d(np.asarray(Q, float))
     P = np.empty((len(Q), 4, 3))
-    model, data = mech.model, mech.scratch_data()
-    for k, q in enumerate(Q):
-        pin.framesForwardKinematics(model, data, q)
-        topo = None
+    tree = tree_kinematics(mech) if all(kind != "topology" for kind, _ in info.centres) else None
+    if tree is not None:  # the centres' stacked form: one pass down the tree for the whole stack
+        at = tree.centres(Q, info.centres)
+        for i, ref in enumerate(info.centres):
+            P[:, i] = at[ref]
+    for k, q in enumerate(Q if tree is None else ()):
+        state, topo = KinematicState(mech, q), None
         for i, (kind, ident) in enumerate(info.centres):
-            if kind == "frame":
-                P[k, i] = data.oMf[ident].translation
-            elif kind == "joint":
-                P[k, i] = data.oMi[ident].translation
-            else:
+            if kind == "topology":
                 topo = topo or mech.topology(q)
                 P[k, i] = next(j.point for j in topo.joints if j.name == ident)
+            else:
+                P[k, i] = state.centre((kind, ident))
     return _transmission(info.kind, P, np.asarray(info.normal, float),
                          None if info.slide is None else np.asarray(info.slide, float))
 
@@ -301,38 +302,29 @@ class LinkAngles:
                 candidates = [("mount", k) for k in model.children[jid]]
             candidates += [("frame", f) for f in cut_frames.get(jid, [])]
             self.links[link] = (start, candidates, fid)
-        self._data = mech.scratch_data()
-        ends = self._ends(mech.neutral())
+        ends = self._ends(KinematicState(mech, mech.neutral()))
         self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
 
-    def _point(self, ref):
-        """("joint", i): joint i's centre, moved with it; ("mount", i): where joint i sits on its
-        parent (fixed in the parent whatever joint i's value); ("frame", f): frame f's origin."""
-        kind, i = ref
-        d = self._data
-        if kind == "mount":
-            return d.oMi[self.mech.model.parents[i]].act(self.mech.model.jointPlacements[i].translation)
-        return d.oMi[i].translation if kind == "joint" else d.oMf[i].translation
-
-    def _ends(self, q):
-        """Choose each link's second point: the first candidate away from its first point."""
-        pin.framesForwardKinematics(self.mech.model, self._data, q)
+    def _ends(self, state):
+        """Choose each link's second point (KinematicState.centre's references, or ("axis", its frame)): the
+        first candidate away from its first point at the configuration of ``state``."""
         out = {}
         tiny = 1e-9 * self.mech.length
         for link, (start, candidates, fid) in self.links.items():
-            p0 = self._point(start)
-            out[link] = next((c for c in candidates if np.linalg.norm(self._point(c) - p0) > tiny), ("axis", fid))
+            p0 = state.centre(start)
+            out[link] = next((c for c in candidates if np.linalg.norm(state.centre(c) - p0) > tiny), ("axis", fid))
         return out
 
-    def __call__(self, q) -> dict:
-        """link name -> absolute angle [rad] in (-pi, pi]."""
-        pin.framesForwardKinematics(self.mech.model, self._data, q)
+    def __call__(self, q, state=None) -> dict:
+        """link name -> absolute angle [rad] in (-pi, pi] at q (read from ``state``, a KinematicState at q,
+        when the caller has one)."""
+        state = state or KinematicState(self.mech, q)
         out = {}
         for link, (start, end, fid) in self.links.items():
             if end[0] == "axis":
-                v = self._data.oMf[fid].rotation[:, 0]
+                v = state.frame_placement(fid).rotation[:, 0]
             else:
-                v = self._point(end) - self._point(start)
+                v = state.centre(end) - state.centre(start)
             out[link] = float(np.arctan2(v @ self.e2, v @ self.e1))
         return out
 
@@ -356,35 +348,16 @@ class LinkAngles:
         """link name -> (N,) absolute angles [rad] at every row of Q: __call__ on the stack, from one
         batched forward-kinematics pass (a loop over Q where the tree has joints of two coordinates)."""
         Q = np.atleast_2d(Q)
-        refs = {r for start, end, fid in self.links.values() for r in (start, end if end[0] != "axis" else ("frame", fid))}
-        model = self.mech.model
-
-        def joint_of(r):  # the joint whose placement carries the point: a mount sits on the parent's
-            return model.parents[r[1]] if r[0] == "mount" else r[1]
-
-        fids = {r: (r[1] if r[0] == "frame" else model.getFrameId(model.names[joint_of(r)], pin.FrameType.JOINT))
-                for r in refs if r[0] == "frame" or joint_of(r) != 0}
-        try:
-            placed = TreeKinematics(self.mech).frames(Q, sorted(set(fids.values())), jacobian=False)
-        except Unbatchable:
+        tree = tree_kinematics(self.mech)
+        if tree is None:
             rows = [self(q) for q in Q]
             return {link: np.array([r[link] for r in rows]) for link in self.links}
-
-        def point(r):
-            if r[0] != "mount":
-                return placed[fids[r]][1]
-            t = np.asarray(model.jointPlacements[r[1]].translation, float)
-            if r not in fids:  # mounted on the ground
-                return np.broadcast_to(t, (len(Q), 3))
-            R, p = placed[fids[r]][:2]
-            return p + R @ t
-
+        at = tree.centres(Q, {r for start, end, _ in self.links.values() for r in (start, end) if r[0] != "axis"})
+        by_axis = sorted({fid for _, end, fid in self.links.values() if end[0] == "axis"})
+        axes = tree.frames(Q, by_axis, jacobian=False) if by_axis else {}
         out = {}
         for link, (start, end, fid) in self.links.items():
-            if end[0] == "axis":
-                v = placed[fids[("frame", fid)]][0][:, :, 0]
-            else:
-                v = point(end) - point(start)
+            v = axes[fid][0][:, :, 0] if end[0] == "axis" else at[end] - at[start]
             out[link] = np.arctan2(v @ self.e2, v @ self.e1)
         first = self(Q[0])  # a link along -e1 (+-pi) could come out with the other sign: then the loop
         if any(abs(out[link][0] - first[link]) > self.mech.tolerances.equal for link in out):
@@ -430,8 +403,7 @@ class LinkAngles:
         jid = self.links[link][0][1]
         name = model.names[jid]
         axis = np.asarray(next(j.axis for j in mech.spec.joints if j.name == name), float)
-        pin.framesForwardKinematics(model, self._data, mech.neutral())
-        sign = float(np.sign((self._data.oMi[jid].rotation @ axis) @ self.n))
+        sign = float(np.sign((KinematicState(mech, mech.neutral()).joint_placement(jid).rotation @ axis) @ self.n))
         if sign == 0:
             raise UsageError(f"{mech.path}: joint '{name}' does not turn about the plane's normal")
         return name, sign

@@ -37,7 +37,7 @@ from ...model import newton
 from ...model.cuts import Assembly
 from ...model.geometry import wrap_angle
 from ...model.manifold import set_continuous_angle
-from ...model.state import KinematicState, angular_loop_joints
+from ...model.state import KinematicState, angular_loop_joints, frame_parent
 from ...model.topology import open_joints
 from . import certified, modes
 from ..mobility import analyze_mobility
@@ -218,6 +218,8 @@ class PositionSolver:
         self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
         self.output = output
         self.output_frame = mech.link_frame(output) if output else None
+        # (joint, placement in it) of the output frame: a tool or named point is no frame of the model
+        self._output_at = frame_parent(mech, self.output_frame) if output else None
         self._generic = None
         self._labelling = None
         self._angles = False  # LinkAngles, None when not planar, False before the first look
@@ -329,7 +331,8 @@ class PositionSolver:
         pin.framesForwardKinematics(self.model, self.data, q)
         parts = [self.data.oMf[f].translation for f in self._points]
         if self.output_frame is not None:
-            parts.append(self.data.oMf[self.output_frame].homogeneous[:3].ravel() * 0.1)
+            joint, placement = self._output_at
+            parts.append((self.data.oMi[joint] * placement).homogeneous[:3].ravel() * 0.1)
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def _starts(self, count, seed):
@@ -523,7 +526,7 @@ class PositionSolver:
             self._link_angles(self.mech.neutral())
         return None if self._angles is None else self._angles.n
 
-    def _link_angles(self, q):
+    def _link_angles(self, q, state=None):
         if self._angles is False:
             self._angles = None
             ref = self.reference()
@@ -531,7 +534,7 @@ class PositionSolver:
                 topo = self.mech.topology(ref)
                 if topo.motion_space == "planar":
                     self._angles = LinkAngles(self.mech, topo)
-        return self._angles(q) if self._angles is not None else None
+        return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
     def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None) -> Solution:
@@ -560,7 +563,7 @@ class PositionSolver:
             if rates is not None:
                 twist, acc = state.frame_twist(self.output_frame), state.frame_acceleration(self.output_frame)
         outside = outside_limits(mech, q)
-        angles = self._link_angles(q)
+        angles = self._link_angles(q, state)
         joints = self.joint_values(q)
         for name, v in (typed or {}).items():  # an input is reported as typed: 720deg stays 720 deg, not 0
             if name in joints and abs(wrap_angle(joints[name] - v)) < tol.equal:

@@ -69,7 +69,7 @@ class SerialJacobians:
         self.frame = chain.frame
         if not chain.joints:
             raise UsageError(f"{mech.path}: no moving joint lies between the ground and "
-                             f"'{self.model.frames[chain.frame].name}'")
+                             f"'{chain.name.removeprefix('output ')}'")
         self.chain = chain
         model = self.model
         self._cols = list(chain.columns)

@@ -27,11 +27,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pinocchio as pin
 
 from ....errors import AssemblyError, ScrewkinError
 from ....model.geometry import wrap_angle
 from ....model.loader import load
+from ....model.state import KinematicState
 from ...mobility import analyze_mobility
 from ...motion.planar import identify, transmission_angles
 from ...motion.position import PositionSolver
@@ -52,7 +52,7 @@ class _Probe:
     """What the check reads off a configuration of the written four-bar."""
 
     def __init__(self, mech, design: Design):
-        self.mech, self.model, self.data = mech, mech.model, mech.scratch_data()
+        self.mech = mech
         self.design = design
         self.out = mech.link_frame(design.output_link)
         jid = {mech.model.names[k]: k for k in range(1, mech.model.njoints)}
@@ -61,8 +61,7 @@ class _Probe:
         self.linkage = None  # analysis.motion.planar.identify's LinkageInfo, set at the first position
 
     def value(self, q):
-        pin.framesForwardKinematics(self.model, self.data, q)
-        M = self.data.oMf[self.out]
+        M = KinematicState(self.mech, q).frame_placement(self.out)
         kind = self.design.targets[0].kind
         if kind == "pose":
             return (float(M.translation[0]), float(M.translation[1]), float(math.atan2(M.rotation[1, 0], M.rotation[0, 0])))
@@ -88,8 +87,8 @@ class _Probe:
         return transmission_angles(self.mech, self.linkage, Q).tolist()
 
     def pins(self, q):
-        pin.framesForwardKinematics(self.model, self.data, q)
-        return self.data.oMi[self.jA].translation[:2].copy(), self.data.oMf[self.fB].translation[:2].copy()
+        state = KinematicState(self.mech, q)
+        return state.centre(("joint", self.jA))[:2], state.centre(("frame", self.fB))[:2]
 
 
 def _closed_form_error(design: Design, probe: _Probe, q, target) -> float:
