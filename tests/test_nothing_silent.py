@@ -163,3 +163,19 @@ QUICK_FOURBAR = """<?xml version="1.0"?>
   <transmission name="motor"><joint name="O2"/></transmission>
 </robot>
 """
+
+
+def test_solve_without_inputs_names_them_with_a_command_that_works(capsys):
+    """solve with no input value said only "solve needs input values"; a newcomer then had to read the
+    file for the names.  The error names the inputs (the actuated joints leg1..leg6 of the Stewart
+    platform, motor1 and motor2 of the five-bar: as the files' <transmission> elements say) in a --set
+    at the file's values, and that option, typed as printed, solves."""
+    from screwkin.cli import main
+
+    for name, want in (("gough_stewart_6ups.urdf", "--set leg1,leg2,leg3,leg4,leg5,leg6=0"),
+                       ("five_bar.urdf", "--set motor1,motor2=0")):
+        assert main(["solve", str(ROBOTS / name)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith(f"screwkin: error: {ROBOTS / name}: solve needs input values") and want in err, err
+    assert main(["solve", str(ROBOTS / "five_bar.urdf"), *"--set motor1,motor2=0".split()]) == 0
+    assert "all 2 assembly modes (certified" in capsys.readouterr().out

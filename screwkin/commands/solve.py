@@ -61,7 +61,9 @@ def add_parser(sub, common, scaled):
 def run(mech, args) -> int:
     values, held, pivots = split_inputs(mech, args)
     if not values and not held:
-        raise UsageError("solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or --set-length LEG=LENGTH")
+        solver = input_solver(mech, [], output=args.output)
+        raise UsageError(f"{mech.path}: solve needs input values: --set NAME=VALUE, --set-angle LINK=ANGLE or "
+                         f"--set-length LEG=LENGTH (its inputs, at the file's values: {solver.file_values_hint()})")
     near = near_values(mech, args)
     args.rate, args.accel = (rate_items(getattr(args, o), [*values, *held], f"--{o}") or None for o in ("rate", "accel"))
     typed = {o: joint_quantities(mech, getattr(args, o), f"--{o}", order=k, links=(*held, *pivots))

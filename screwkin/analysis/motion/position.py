@@ -352,16 +352,21 @@ class PositionSolver:
             raise UsageError(f"{self.mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
                              + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
 
+    def file_values_hint(self, names=None) -> str:
+        """--set options that give the joints ``names`` (default: the inputs) the file's values (SI:
+        rad, m), as a way to name them in an error: one option where the values are equal."""
+        names = list(self.inputs if names is None else names)
+        file_values = self.mech.joint_values(self.mech.neutral())
+        shown = {n: file_values[n] for n in names}
+        if len(set(shown.values())) == 1:
+            return f"--set {','.join(names)}={next(iter(shown.values())):g}"
+        return " ".join(f"--set {n}={v:g}" for n, v in shown.items())
+
     def unset_error(self) -> UsageError:
         """The usage error of a solve whose inputs leave out joints that no loop passes through
         (``unset``): they are inputs too, named with the file's values as a way to give them."""
         names = list(self.unset)
-        file_values = self.mech.joint_values(self.mech.neutral())
-        shown = {n: file_values[n] for n in names}
-        if len(set(shown.values())) == 1:
-            hint = f"--set {','.join(names)}={next(iter(shown.values())):g}"
-        else:
-            hint = " ".join(f"--set {n}={v:g}" for n, v in shown.items())
+        hint = self.file_values_hint(names)
         return UsageError(f"{self.mech.path}: no loop passes through {', '.join(names)}: "
                           f"{'each is an input' if len(names) > 1 else 'it is an input'} that only its own value "
                           f"decides; give {'them' if len(names) > 1 else 'it'} with --set (the file's values: {hint})")
