@@ -188,6 +188,7 @@ def test_a_singular_input_with_a_continuum_is_one_solution():
 
 
 # ------------------------------------------------------------------ spatial overconstrained loops
+@pytest.mark.slow  # about 1.4 s on 2 shared cores: out of the fast subset
 def test_bennett_written_at_its_dh_zero():
     alpha, beta = np.radians(30), np.radians(50)
     k = np.sin((beta + alpha) / 2) / np.sin((beta - alpha) / 2)
@@ -202,6 +203,7 @@ def test_bennett_written_at_its_dh_zero():
         assert abs(wrap(s.joints["joint3"] + t1)) < 1e-9  # theta3 = -theta1 in this DH convention
 
 
+@pytest.mark.slow  # about 4.6 s on 2 shared cores: out of the fast subset
 def test_sarrus_written_flat_moves_in_a_straight_line():
     """Top height 2 l sin(e) for limb A's elevation e, orientation unchanged (Sarrus 1853)."""
     mech = load("sarrus")
@@ -365,6 +367,7 @@ def test_delta_modes_that_keep_the_platform_orientation_come_first(capsys):
     assert text.count("\nsolution ") == len(phys)
 
 
+@pytest.mark.slow  # about 2.9 s on 2 shared cores: out of the fast subset
 def test_3rpr_inverse_kinematics_labels_reversed_legs():
     mech = screwkin.load(DATA.parent.parent / "robots" / "planar_3rpr.urdf")
     home = mech.model.createData()

@@ -147,6 +147,7 @@ def _total_degree_roots(pc):
     return res.X[res.ok]
 
 
+@pytest.mark.slow  # about 11.7 s on 2 shared cores: out of the fast subset
 def test_monodromy_agrees_with_a_total_degree_homotopy():
     mech, solver, pc, q = closure_of("fourbar_crank_rocker", eliminate=False)
     td = _total_degree_roots(pc)
@@ -158,6 +159,7 @@ def test_monodromy_agrees_with_a_total_degree_homotopy():
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow  # about 2.0 s on 2 shared cores: out of the fast subset
 def test_bundled_gough_stewart_planar_hexagons():
     """The bundled 6-UPS has its base and platform points in planes (semi-regular hexagons): at its
     drawn leg lengths 28 complex poses, 8 of them real, below the 40 of a general geometry
@@ -286,6 +288,7 @@ def test_general_6r_inverse_kinematics_has_16(tmp_path):
         np.testing.assert_allclose(data.oMf[mech.link_frame("l6")].homogeneous, pose.homogeneous, rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow  # about 3.3 s on 2 shared cores: out of the fast subset
 def test_planar_3rpr_counts():
     """The bundled 3-RPR at its drawn leg lengths: at most 6 complex solutions (Hunt 1983; Gosselin
     and Sefrioui 1991: a sextic); here 2 real and 2 complex, the other 2 of a general geometry at

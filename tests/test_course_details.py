@@ -86,6 +86,7 @@ def test_stationary_joints_and_the_gram_table_agree(capsys):
     assert zero == {"A", "slide"} and zero <= set(d["stationary_joints"])
 
 
+@pytest.mark.slow  # about 1.5 s on 2 shared cores: out of the fast subset
 def test_a_planar_mechanisms_lost_direction_lies_in_its_plane(capsys):
     """item 11: the planar 3-RPR with leg 1 at zero length (its U and the wrist coincide) loses a platform
     translation in the plane (along the line the zero leg can no longer push: perpendicular to nothing out of

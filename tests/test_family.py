@@ -86,6 +86,7 @@ def test_rows_are_the_single_commands(lhs, capsys):
     assert checked >= 8 and failed >= 1
 
 
+@pytest.mark.slow  # about 2.7 s on 2 shared cores: out of the fast subset
 def test_the_same_rows_whatever_the_chunks(lhs):
     """Every design the family path covers reports its closed-form row, whichever chunk it falls in (the
     reference and the spot-checked design too): the table is the same, to the last bit."""

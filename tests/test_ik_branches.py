@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 import pinocchio as pin
+import pytest
 
 import screwkin
 from screwkin.analysis.motion.ik import branches, inverse_kinematics
@@ -24,6 +25,7 @@ def _centre(m, q, joint):
     return data.oMi[model.getJointId(joint)].translation.copy()
 
 
+@pytest.mark.slow  # about 3.3 s on 2 shared cores: out of the fast subset
 def test_3rrr_pose_has_all_eight_branches_by_circle_intersections():
     m = screwkin.load(ROBOTS / "planar_3rrr.urdf")
     res = inverse_kinematics(m, "platform", pin.SE3.Identity())
@@ -45,6 +47,7 @@ def test_3rrr_pose_has_all_eight_branches_by_circle_intersections():
         assert abs(np.dot(e1 - e2, mid - motor)) < 1e-9 * max(1.0, np.linalg.norm(mid - motor))
 
 
+@pytest.mark.slow  # about 2.9 s on 2 shared cores: out of the fast subset
 def test_position_alone_on_a_planar_platform_is_a_continuum_said_first():
     out = subprocess.run([sys.executable, "-m", "screwkin", "ik", str(ROBOTS / "planar_3rrr.urdf"), "--output",
                           "platform", "--position", "0,0,0"], capture_output=True, text=True, timeout=120)
@@ -58,6 +61,7 @@ def test_position_alone_on_a_planar_platform_is_a_continuum_said_first():
     assert d["free_dofs"] == 1 and d["branches"]["at_most"] is None
 
 
+@pytest.mark.slow  # about 8.2 s on 2 shared cores: out of the fast subset
 def test_pose_text_and_json_say_all_of_them():
     args = [sys.executable, "-m", "screwkin", "ik", str(ROBOTS / "planar_3rpr.urdf"), "--output", "platform",
             "--pose", "0,0,0,0,0,0"]
@@ -68,6 +72,7 @@ def test_pose_text_and_json_say_all_of_them():
     assert [leg["at_most"] for leg in d["branches"]["legs"]] == [2, 2, 2]
 
 
+@pytest.mark.slow  # about 1.4 s on 2 shared cores: out of the fast subset
 def test_serial_arm_has_no_bound_and_says_not_exhaustive():
     m = screwkin.load(ROBOTS / "arm_6r.urdf")
     res = inverse_kinematics(m, "flange", pin.SE3(np.eye(3), np.array([0.3, 0.0, 0.3])))

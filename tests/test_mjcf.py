@@ -121,6 +121,7 @@ def test_what_is_read():
     assert delta.model.joints[delta.coordinate("elbow0").joint_id].shortname() == "JointModelSpherical"
 
 
+@pytest.mark.slow  # about 2.0 s on 2 shared cores: out of the fast subset
 def test_cli_mobility_and_solve(capsys):
     assert main(["mobility", str(MJCF / "fourbar.xml"), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["mobility"] == 1

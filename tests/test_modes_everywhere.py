@@ -100,6 +100,7 @@ def test_dynamics_torques_differ_between_modes_and_each_balances_the_energy(caps
     assert np.abs(torques[1] - torques[2]).max() > 0.1 * np.abs(torques[1]).max()
 
 
+@pytest.mark.slow  # about 1.7 s on 2 shared cores: out of the fast subset
 def test_map_workspace_and_study_say_the_mode(tmp_path, capsys):
     _, err = _run(["map", str(ROBOTS / "five_bar.urdf"), "--x", "motor1=0:90deg:3", "--y", "motor2=0:90deg:3",
                    "--mode", "2"], capsys)

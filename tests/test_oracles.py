@@ -242,6 +242,7 @@ def _virtual_work_torque(mech, theta, output="link3", wrench=BENNETT_LOAD, h=1e-
     return q0, -twist @ wrench
 
 
+@pytest.mark.slow  # about 4.4 s on 2 shared cores: out of the fast subset
 @pytest.mark.parametrize("theta", [0.3, 1.1, -0.8])
 def test_bennett_input_torque_by_virtual_work(theta):
     from screwkin.analysis.forces.statics import statics
@@ -255,6 +256,7 @@ def test_bennett_input_torque_by_virtual_work(theta):
     assert r.efforts["joint1"] == pytest.approx(expected, rel=1e-6)
 
 
+@pytest.mark.slow  # about 2.9 s on 2 shared cores: out of the fast subset
 def test_bennett_statics_command_gives_the_virtual_work_torque(capsys):
     from screwkin.cli import main
 

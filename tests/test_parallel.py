@@ -80,6 +80,7 @@ def test_stewart_file_matches_its_design():
         np.testing.assert_allclose(b, BASE[k], atol=1e-12)
 
 
+@pytest.mark.slow  # about 4.6 s on 2 shared cores: out of the fast subset
 @pytest.mark.parametrize("c, rpy", [((0.03, 0.02, 0.65), (0.1, 0.05, -0.1)), ((-0.05, 0.04, 0.55), (-0.08, 0.1, 0.3))])
 def test_stewart_inverse_kinematics_is_leg_lengths(c, rpy):
     mech = load("gough_stewart_6ups")
@@ -113,6 +114,7 @@ def test_stewart_inverse_jacobian_rows_are_pluecker_lines():
         np.testing.assert_allclose(J[k], np.r_[u, np.cross(p - o, u)], atol=1e-9)
 
 
+@pytest.mark.slow  # about 2.0 s on 2 shared cores: out of the fast subset
 def test_stewart_forward_kinematics_finds_several_assembly_modes():
     mech = load("gough_stewart_6ups")
     res = PositionSolver(mech).solve({f"leg{k + 1}": 0.0 for k in range(6)}, starts=40)
@@ -140,6 +142,7 @@ def plucker_det(psi, h=0.6):
     return np.linalg.det(np.array(rows))
 
 
+@pytest.mark.slow  # about 4.5 s on 2 shared cores: out of the fast subset
 def test_fichter_singularity():
     """Centred platform turned about the vertical: the closed-form Pluecker determinant vanishes
     at +-90 deg (Fichter 1986); screwkin finds an actuator singularity there and not 0.1 rad away."""
@@ -155,6 +158,7 @@ def test_fichter_singularity():
 
 
 # ------------------------------------------------------------------ 3-RPR
+@pytest.mark.slow  # about 5.3 s on 2 shared cores: out of the fast subset
 def test_3rpr_concurrent_legs_are_an_actuator_singularity():
     mech = load("planar_3rpr")
     data = mech.model.createData()
@@ -220,6 +224,7 @@ def test_6r_wrist_elbow_shoulder_singularities():
 
 
 # ------------------------------------------------------------------ Tsai 3-UPU
+@pytest.mark.slow  # about 1.5 s on 2 shared cores: out of the fast subset
 def test_tsai_3upu_constraint_singularity_in_the_base_plane():
     mech = load("tsai_3upu")
     frame0 = mech.model.createData()

@@ -52,6 +52,7 @@ def four_bar(tmp_path):
     return str(path)
 
 
+@pytest.mark.slow  # about 1.6 s on 2 shared cores: out of the fast subset
 def test_ik_places_the_tool_at_the_target_pose(arm):
     # a reachable target: the tool of joint values (0.3, 1.1), placed at (0.25, 0.05) turned 30 deg on 'fore'
     target, heading = arm_tool(0.3, 1.1, 0.25, 0.05, np.radians(30))
@@ -72,6 +73,7 @@ def test_ik_places_the_tool_at_the_target_pose(arm):
     assert link.translation[:2] == pytest.approx(elbow, abs=1e-8)
 
 
+@pytest.mark.slow  # about 1.5 s on 2 shared cores: out of the fast subset
 def test_ik_places_a_named_point_at_a_position(arm):
     d = run_json("ik", arm, "--point", "P=fore:0.25,0.05,0", "--position", "0.3,0.4,0")
     assert len(d["solutions"]) == 2  # elbow up and down

@@ -332,6 +332,7 @@ def test_past_a_file_size_limit_every_output(name, tmp_path, study_spec):
     _past_the_size_limit(name, tmp_path, study_spec)
 
 
+@pytest.mark.slow  # about 3.8 s on 2 shared cores: out of the fast subset
 def test_under_a_file_size_limit_the_compiled_kernels_stay_in_memory(tmp_path):
     """The RSSR's modes come from the homotopy, whose kernels numba compiles and caches on disk: under
     ``ulimit -f`` the cache file's write failed with EFBIG, exit 3 ("internal error ... File too

@@ -207,6 +207,7 @@ def test_errors(capsys, argv, code, words):
         assert w in err
 
 
+@pytest.mark.slow  # about 1.5 s on 2 shared cores: out of the fast subset
 def test_report_takes_a_held_angle_for_its_positions_equations_and_newton(capsys, tmp_path):
     """report with a floating link's angle: its positions are solve's (the same numbers), its equations
     hold that link's theta as an input, Newton converges to the solved values, and its sweep moves the

@@ -295,6 +295,7 @@ def test_slider_crank_transmission_angle_per_solution(tmp_path, capsys):
         assert sol["slider_crank"]["transmission_angle"] == pytest.approx(expected, abs=1e-9)
 
 
+@pytest.mark.slow  # about 2.2 s on 2 shared cores: out of the fast subset
 def test_stewart_leg_lengths_set_and_reported_between_u_and_s_centres(capsys):
     """issue 24 item 4: --set-length leg1,...,leg6=0.7; each leg k >= 2 ends at its base U centre (joint basek_a's
     origin) and its platform S centre (ballk's link2 point in the platform frame), read from the file here: the
@@ -348,6 +349,7 @@ def test_stroke_and_time_ratio_of_an_offset_slider_crank(tmp_path, capsys):
     assert "joint values at 73 of the 73 configurations" in out and "time ratio" in out
 
 
+@pytest.mark.slow  # about 1.9 s on 2 shared cores: out of the fast subset
 def test_solve_says_a_leg_length_input_as_typed(capsys):
     """--set-length leg1=450mm: the inputs line gives the length typed beside the joint's displacement
     (it gave only the displacement, -0.2026 m, which the user never typed)."""

@@ -82,6 +82,7 @@ def test_a_five_bar_moves_each_input_on_its_own():
     np.testing.assert_allclose(s.output_pose, data.oMf[mech.link_frame("tip")].homogeneous, atol=1e-12)
 
 
+@pytest.mark.slow  # about 3.9 s on 2 shared cores: out of the fast subset
 @pytest.mark.parametrize("path", [FOURBAR, ROBOTS / "five_bar.urdf", ROBOTS / "gough_stewart_6ups.urdf"])
 def test_switching_modes_keeps_the_loops_closed(path):
     mech = screwkin.load(path)
@@ -129,6 +130,7 @@ def test_points_are_read_out_where_the_link_puts_them(fourbar):
                                atol=1e-12)
 
 
+@pytest.mark.slow  # about 3.9 s on 2 shared cores: out of the fast subset
 def test_controls_span_the_limits_or_a_turn(fourbar):
     (c,) = Interactive(fourbar).controls
     assert c.name == "crank_joint" and c.unit == "rad"
