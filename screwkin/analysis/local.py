@@ -371,7 +371,8 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
     if c == 0:
         space = tuple(rates_of(mech, N[:, k], system.scale) for k in range(d)) if 1 < d <= SHOWN_SPACE else ()
         branch = Branch(rates_of(mech, N[:, 0], system.scale), d, None, space, True, 1)
-        how = ("order 1: the loops' Jacobian has full row rank here (no redundant row): a regular point"
+        among = {"se(2)": " among the rows in the plane", "so(3)": " among the rows on the sphere"}.get(system.algebra, "")
+        how = (f"order 1: the loops' Jacobian has full row rank here (no redundant row{among}): a regular point"
                if A.shape[0] else "order 1: no loops: every coordinate is free")
         return LocalAnalysis(**base, finite_mobility=d, kind="regular", order=1, checked_order=1, certain=True,
                              decided_by=how, branches=(branch,), notes=tuple(notes))
