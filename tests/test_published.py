@@ -128,9 +128,10 @@ def test_tendon_input_is_named_and_used(capsys):
 
 def test_coupled_joint_actuator_and_mujoco_inverse_dynamics():
     """The WidowX form: the gripper actuator on the coupled finger (left = -right) is an input on the
-    right finger with scale -1; dynamics' efforts are MuJoCo's qfrc_inverse (constraints off) projected
-    on screwkin's coordinates, G^T qfrc_inverse, at every step; the coupled finger's effort is MuJoCo's
-    own at that joint."""
+    right finger with scale -1; dynamics' efforts are MuJoCo's qfrc_inverse (constraints off; it holds
+    the joints' armature and damping) plus the joints' dry friction, projected on screwkin's
+    coordinates, G^T qfrc_inverse, at every step; the coupled finger's effort is MuJoCo's own at that
+    joint."""
     path = MJCF / "gripper_coupled_slides.xml"
     mech = screwkin.load(path, warn=lambda w: None)
     assert mech.actuated == ["waist", "shoulder", "elbow", "wrist", "right_finger"]
@@ -138,7 +139,7 @@ def test_coupled_joint_actuator_and_mujoco_inverse_dynamics():
     assert (t.name, t.joint, t.scale, t.kind) == ("left_finger", "right_finger", -1.0, "coupled joint")
     fixed = {"waist": 0.2, "elbow": 0.4, "wrist": -0.3, "right_finger": -0.02}
     res = dynamics(mech, "shoulder", 2.0, -0.5, 0.5, 5, inputs=mech.actuated, fixed=fixed, gravity=(0, 0, -9.81))
-    m, d = _mj(path, bare=True)
+    m, d = _mj(path)  # with the file's armature (0.1) and friction loss (0.1), as MuJoCo reads them
     m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     G = _coupling_map(mech, m)
     for k in range(len(res.values)):
@@ -150,12 +151,13 @@ def test_coupled_joint_actuator_and_mujoco_inverse_dynamics():
         d.qvel[:] = G @ res.rates[k]
         d.qacc[:] = G @ res.accelerations[k]
         mujoco.mj_inverse(m, d)
-        tau = G.T @ d.qfrc_inverse
+        # the joints' dry friction is a constraint in MuJoCo, off here: frictionloss x sign(qvel), added
+        full = d.qfrc_inverse + m.dof_frictionloss * np.sign(d.qvel)
+        tau = G.T @ full
         for name in mech.actuated:
             assert res.efforts[name][k] == pytest.approx(tau[mech.coordinate(name).idx_v], rel=1e-9, abs=1e-12)
         left = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "left_finger")
-        assert res.coupled_efforts["left_finger"][k] == pytest.approx(d.qfrc_inverse[m.jnt_dofadr[left]],
-                                                                      rel=1e-9, abs=1e-12)
+        assert res.coupled_efforts["left_finger"][k] == pytest.approx(full[m.jnt_dofadr[left]], rel=1e-9, abs=1e-12)
         assert res.actuator_efforts["gripper"][k] == pytest.approx(-res.efforts["right_finger"][k])
 
 
@@ -193,7 +195,9 @@ def test_mimic_dynamics_is_rnea_of_the_uncoupled_model(path):
                 p = mech.coordinate(name)
                 G[full.idx_vs[j]:full.idx_vs[j] + full.nvs[j], p.idx_v:p.idx_v + p.nv] = np.eye(p.nv)
                 qf[full.idx_qs[j]:full.idx_qs[j] + full.nqs[j]] = q[p.idx_q:p.idx_q + p.nq]
-        tau = pin.rnea(full, fdata, qf, G @ v, G @ a)
+        vf = G @ v
+        # the <dynamics damping friction> of the file (Pinocchio reads them), as ROS and MuJoCo apply them
+        tau = pin.rnea(full, fdata, qf, vf, G @ a) + full.damping * vf + full.friction * np.sign(vf)
         scale = max(1.0, float(np.abs(tau).max()))
         for name in inputs:
             assert res.efforts[name][k] == pytest.approx((G.T @ tau)[mech.coordinate(name).idx_v], abs=1e-9 * scale)

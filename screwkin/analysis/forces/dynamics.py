@@ -8,7 +8,11 @@ acceleration is zero).  At each step, with q, v = q' and a = q'':
     E tau_a + K^T lambda = RNEA(q, v, a) - sum_k J_k^T w_k
 
 the tree's inverse dynamics by Pinocchio's RNEA (gravity in model.gravity, the links' inertias
-from the file's <inertial>), the loads w_k (force, moment at their link frame's origin, world
+from the file's <inertial>) plus each joint's own dynamics as MuJoCo defines them (an MJCF joint's
+armature, damping and frictionloss, per degree of freedom: armature * a, the reflected inertia of a
+motor added to the mass matrix's diagonal; damping * v, the force that overcomes the viscous
+passive force; frictionloss * sign(v), the dry friction overcome while the joint moves -- at rest
+it lies anywhere in +-frictionloss, which the notes say), the loads w_k (force, moment at their link frame's origin, world
 axes; J_k that origin's frame Jacobian, LOCAL_WORLD_ALIGNED), the loop constraint forces lambda
 of the closure rows K (model/closure.py) and the actuator efforts tau_a (torques of revolute,
 forces of prismatic inputs).  It is solved as statics solves it (analysis.forces.statics.balance):
@@ -190,6 +194,70 @@ def _ground_sides(mech) -> tuple:
     return tree, cuts
 
 
+class JointDynamics(dict):
+    """The joints' own dynamics a file gives (MJCF armature, damping, frictionloss), as MuJoCo applies
+    them to each degree of freedom; name -> the joint's velocity indices.  Arrays over the model's
+    velocity coordinates: ``armature``, ``damping``, ``frictionloss``."""
+
+    def __init__(self, mech, joints, coupled):
+        super().__init__()
+        nv = mech.model.nv
+        self.armature, self.damping, self.frictionloss = np.zeros(nv), np.zeros(nv), np.zeros(nv)
+        for j in joints:
+            idx = mech.velocity_indices([j.name])
+            self[j.name] = idx
+            self.armature[idx], self.damping[idx], self.frictionloss[idx] = j.armature, j.damping, j.frictionloss
+        # a mimic joint moves at multiplier x its leader's rate: its own terms reach the leader through it
+        self.coupled = {c.joint: (c.multiplier, int(mech.coordinate(c.mimics).idx_v), j) for c, j in coupled}
+        for name, (_, iv, _) in self.coupled.items():
+            self[name] = np.array([iv])
+        self._zero = mech.tolerances.equal
+
+    def _terms(self, arm, damp, fl, v, a):
+        return arm * a + damp * v + fl * np.where(np.abs(v) > self._zero, np.sign(v), 0.0)
+
+    def coupled_forces(self, v, a) -> dict:
+        """Each mimic joint's own force at (v, a) (its rate and acceleration: multiplier x its leader's)."""
+        return {name: float(self._terms(j.armature, j.damping, j.frictionloss, m * v[iv], m * a[iv]))
+                for name, (m, iv, j) in self.coupled.items()}
+
+    def force(self, v, a) -> np.ndarray:
+        """The generalized force that drives them at (v, a): armature a + damping v + frictionloss sign(v),
+        sign(v) 0 where the joint stands still (|v| within the tolerance ``equal``); a mimic joint's, times
+        its multiplier, on its leader's coordinate."""
+        out = self._terms(self.armature, self.damping, self.frictionloss, v, a)
+        for name, f in self.coupled_forces(v, a).items():
+            m, iv, _ = self.coupled[name]
+            out[iv] += m * f
+        return out
+
+    def friction_at_rest(self, v) -> set:
+        """The joints with friction loss that stand still at v (their dry friction not determined)."""
+        fl = {n: self.coupled[n][2].frictionloss if n in self.coupled else self.frictionloss[idx].max()
+              for n, idx in self.items()}
+        return {n for n, idx in self.items() if fl[n] > 0 and np.any(np.abs(v[idx]) <= self._zero)}
+
+    def kinetic(self, v) -> float:
+        """The armature's kinetic energy 1/2 sum armature v^2 [J] (MuJoCo's mass matrix holds it)."""
+        return 0.5 * (float(self.armature @ (v * v))
+                      + sum(j.armature * (m * v[iv]) ** 2 for m, iv, j in self.coupled.values()))
+
+
+def joint_dynamics(mech) -> tuple:
+    """(JointDynamics of the tree and mimic joints with armature, damping or friction loss; names of
+    those it cannot hold: loop joints, which have no coordinate of their own in the tree)."""
+    given = [j for j in mech.spec.joints if j.dynamics]
+    names = {c.joint for c in mech.coordinates}
+    couplings = {c.joint: c for c in mech.couplings}
+    coupled = [(couplings[j.name], j) for j in given if j.name in couplings]
+    return (JointDynamics(mech, [j for j in given if j.name in names], coupled),
+            [j.name for j in given if j.name not in names and j.name not in couplings])
+
+
+def _names(names) -> str:
+    return f"{', '.join(quote(n, 30) for n in names[:3])}{', ...' if len(names) > 3 else ''}"
+
+
 def _energies(mech, gmodel, data, q, v) -> tuple:
     """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
     energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
@@ -251,11 +319,14 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
     notes = list(check_inertias(mech))
-    own = [j.name for j in mech.spec.joints if j.dynamics]
+    own, left = joint_dynamics(mech)
     if own:
         notes.append(f"the armature, damping and friction loss the file gives {len(own)} joints ("
-                     f"{', '.join(quote(n, 30) for n in own[:3])}{', ...' if len(own) > 3 else ''}) are not in these "
-                     "efforts (the rigid bodies' dynamics only); export --mjcf writes them for MuJoCo")
+                     f"{_names(list(own))}) are in these efforts, as MuJoCo applies them (per degree of freedom: "
+                     "armature * a + damping * v + frictionloss * sign(v))")
+    if left:
+        notes.append(f"the armature, damping and friction loss of {len(left)} loop joints ({_names(left)}) are not "
+                     "in these efforts: they have no coordinate of their own in the tree")
     fixed = dict(fixed or {})
     inputs = sweep_inputs(mech, input, fixed) if inputs is None else list(inputs)
     for ld in loads:
@@ -273,6 +344,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     shaking_f, shaking_m = np.zeros((n, 3)), np.zeros((n, 3))
     T, V, P_in, P_load, unbalanced, scale = (np.zeros(n) for _ in range(6))
     indeterminate = 0
+    friction_at_rest = set()
     ground_tree, ground_cuts = _ground_sides(mech)
     gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
     for k in range(n):
@@ -280,6 +352,9 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             progress(k, n)
         q, v, a = res.q[k], res.rates[k], res.accelerations[k]
         b = pin.rnea(gmodel, data, q, v, a).copy()
+        if own:
+            b += own.force(v, a)
+            friction_at_rest |= own.friction_at_rest(v)
         state = KinematicState(mech, q)
         frames = _load_wrenches(mech, loads, state)
         for fid, w in frames:
@@ -292,8 +367,9 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
         indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
         table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
+        own_coupled = own.coupled_forces(v, a) if own else {}
         for name, value in coupled_efforts(mech, q, {k: x[1] for k, x in table.items() if x[0] == "coupled"}).items():
-            coupled.setdefault(name, np.zeros(n))[k] = value
+            coupled.setdefault(name, np.zeros(n))[k] = value + own_coupled.get(name, 0.0)
         for name, (kind, wrench, is_open) in table.items():
             reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
             kinds[name] = kind
@@ -310,6 +386,8 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             shaking_f[k] += sign * wrench[:3]
             shaking_m[k] += sign * (wrench[3:] + cross3(origin, wrench[:3]))
         T[k], V[k] = _energies(mech, gmodel, data, q, v)
+        if own:
+            T[k] += own.kinetic(v)
         P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
     units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}
     units.update(coupled_units(mech))
@@ -320,6 +398,9 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     mean = {name: _range_mean(res.values, y) if np.all(np.isfinite(y)) else None for name, y in eff.items()}
     completed = res.completed
     fly = _flywheel(res.values, eff.get(input), speed, res.unit, cs, completed)
+    if friction_at_rest:
+        notes.append(f"where {_names(sorted(friction_at_rest))} stand still the dry friction lies anywhere in "
+                     "+-frictionloss: the efforts there take it as 0")
     if not np.any(g):
         notes.append("gravity: none (give --gravity 0,0,-9.81 for the links' weights)")
     open_names = {name: tuple(c for c, o in zip(COMPONENTS, mask) if o) for name, mask in open_.items()}
