@@ -94,8 +94,9 @@ def test_published_forms_read_as_mujoco_reads_them(name):
 def test_tendon_input_is_named_and_used(capsys):
     """The 2F-85 form: the actuator's fixed tendon split = 0.5 right + 0.5 left driver, the right
     coupled to the left, is the left driver's angle; mobility says so, solve --set split= takes it,
-    statics gives the tendon's force: MuJoCo's by virtual work along the one motion N its equality
-    rows allow, F = dV / dL from its own potential energy V and tendon length L (central difference)."""
+    statics gives the tendon's force holding gravity and the joints' springs: MuJoCo's by virtual work
+    along the one motion N its equality rows allow, F = dV / dL from its own potential energy V (gravity
+    and springs) and tendon length L (central difference)."""
     path = MJCF / "gripper_4bar_tendon.xml"
     mech = screwkin.load(path, warn=lambda w: None)
     (t,) = mech.transmissions()
@@ -108,14 +109,15 @@ def test_tendon_input_is_named_and_used(capsys):
     assert "--set split is left_driver_joint = 0.3" in out.err and '"left_driver_joint": 0.3' in out.out
     q = mech.neutral()
     r = statics(mech, q, gravity=True)
-    m, d = _mj(path, bare=True)
+    assert any("the springs of" in n for n in r.notes)  # the links' springs (stiffness, springref) are read
+    m, d = _mj(path)
     d.qpos[:] = m.qpos0
     mujoco.mj_forward(m, d)
     J = d.efc_J.reshape(d.nefc, m.nv)[:d.ne]
     N = np.linalg.svd(J)[2][-1]  # the one motion the equalities allow
     m.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
 
-    def energy_and_length(x):  # MuJoCo's potential energy (gravity: no springs here) and tendon length
+    def energy_and_length(x):  # MuJoCo's potential energy (gravity and the joints' springs), tendon length
         d.qpos[:] = m.qpos0 + x * N
         mujoco.mj_forward(m, d)
         return d.energy[0], d.ten_length[0]

@@ -476,3 +476,67 @@ def test_inertia_problem_takes_any_descriptions_inertial():
     with pytest.raises(ValueError):
         mujoco.MjModel.from_xml_string(body.format("1 1 3 0 0 0"))
     mujoco.MjModel.from_xml_string(body.format("1e-9 1e-3 1e-3 0 0 0"))
+
+
+def _finger_with_springs(tmp_path):
+    """The finger with MuJoCo joint springs: mid pulled towards 17.19 deg (0.3 rad written in degrees:
+    the compiler's unit) with 0.05 N m/rad, tip towards -0.2 rad with 0.02 N m/rad."""
+    text = FINGER.read_text().replace('<compiler angle="radian"/>', '<compiler angle="degree"/>')
+    text = text.replace('range="-1.6 1.6"', 'range="-91.67 91.67"')
+    text = text.replace('<joint name="mid" ', f'<joint name="mid" stiffness="0.05" springref="{float(np.degrees(0.3))!r}" ')
+    text = text.replace('<joint name="tip" ', f'<joint name="tip" stiffness="0.02" springref="{float(np.degrees(-0.2))!r}" ')
+    path = tmp_path / "finger_springs.xml"
+    path.write_text(text)
+    return path
+
+
+def test_joint_springs_are_mujocos_inverse_dynamics(tmp_path):
+    """A hinge's stiffness and springref (MuJoCo's qpos_spring, the compiler's angle unit converted): the
+    efforts of dynamics, the finger's base turning at 2 rad/s with mid and tip held away from their
+    springs' rest angles under gravity, are MuJoCo's qfrc_inverse (constraints off: it holds armature,
+    damping and the springs) plus the dry friction MuJoCo applies as a constraint, at every step; the
+    potential energy holds the springs' 1/2 k (x - springref)^2."""
+    path = _finger_with_springs(tmp_path)
+    mech = screwkin.load(path, warn=lambda w: None)
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    spec = {j.name: j for j in mech.spec.joints}
+    for name in ("mid", "tip"):
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+        assert spec[name].stiffness == m.jnt_stiffness[j]
+        assert spec[name].springref == pytest.approx(m.qpos_spring[m.jnt_qposadr[j]], abs=1e-15)
+    fixed = {"mid": 0.7, "tip": -0.6}
+    res = dynamics(mech, "base", 2.0, -0.5, 0.5, 6, inputs=["base", "mid", "tip"], fixed=fixed, gravity=(0, 0, -9.81))
+    assert any("the springs of 'mid', 'tip'" in n for n in res.notes)
+    for k in range(len(res.values)):
+        for name in ("base", "mid", "tip"):
+            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+            c = mech.coordinate(name)
+            d.qpos[m.jnt_qposadr[j]] = res.q[k][c.idx_q]
+            d.qvel[m.jnt_dofadr[j]] = res.rates[k][c.idx_v]
+            d.qacc[m.jnt_dofadr[j]] = res.accelerations[k][c.idx_v]
+        mujoco.mj_inverse(m, d)
+        full = d.qfrc_inverse + m.dof_frictionloss * np.sign(d.qvel)
+        for name in ("base", "mid", "tip"):
+            dof = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]
+            assert res.efforts[name][k] == pytest.approx(full[dof], rel=1e-9, abs=1e-12), (name, k)
+    mujoco.mj_energyPos(m, d)  # gravity and springs (0.5 0.05 0.4^2 + 0.5 0.02 0.4^2 = 0.0056 J), MuJoCo's own
+    assert res.potential_energy[-1] == pytest.approx(d.energy[0], abs=1e-12)
+
+
+def test_joint_springs_are_exported_about_the_written_configuration(tmp_path, capsys):
+    """export --mjcf writes each spring with its rest angle moved with the joint's zero (the export draws
+    the configuration given, qpos0 = 0 there): MuJoCo's qpos_spring of the export is springref - value;
+    the URDF export says the spring has no URDF form."""
+    path = _finger_with_springs(tmp_path)
+    out_x, out_u = tmp_path / "out.xml", tmp_path / "out.urdf"
+    assert main(["export", str(path), "--set", "base=0.1,mid=0.5,tip=-0.1", "--mjcf", str(out_x),
+                 "--urdf", str(out_u)]) == 0
+    assert "the spring of 2 joints ('mid', 'tip') has no URDF form" in capsys.readouterr().out
+    m = mujoco.MjModel.from_xml_path(str(out_x))
+    for name, k, rest in (("mid", 0.05, 0.3 - 0.5), ("tip", 0.02, -0.2 + 0.1)):
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+        assert m.jnt_stiffness[j] == k
+        assert m.qpos_spring[m.jnt_qposadr[j]] == pytest.approx(rest, abs=1e-12)
+        assert m.qpos0[m.jnt_qposadr[j]] == 0.0

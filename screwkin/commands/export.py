@@ -78,11 +78,12 @@ def run(mech, args) -> int:
                              "written with the inertia of the solid above, scaled to it")
         else:
             texts.append((out, write_placed_urdf(pm, mech.spec.root)))
-            rotors = [b.joint.name for b in pm.bodies if b.joint is not None and dict(b.joint.dynamics).get("armature")]
-            if rotors:
-                notes.append(f"the armature of {len(rotors)} joints ({', '.join(quote(n, 30) for n in rotors[:3])}"
-                             f"{', ...' if len(rotors) > 3 else ''}) has no URDF form: not written (damping and "
-                             "frictionloss are, as <dynamics damping friction>)")
+            for what, key in (("armature", "armature"), ("spring", "stiffness")):
+                rotors = [b.joint.name for b in pm.bodies if b.joint is not None and dict(b.joint.dynamics).get(key)]
+                if rotors:
+                    notes.append(f"the {what} of {len(rotors)} joints ({', '.join(quote(n, 30) for n in rotors[:3])}"
+                                 f"{', ...' if len(rotors) > 3 else ''}) has no URDF form: not written (damping and "
+                                 "frictionloss are, as <dynamics damping friction>)")
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})
     for out, text in texts:
         write_output(out, text)

@@ -176,6 +176,10 @@ class JointSpec:
     armature: float = 0.0
     damping: float = 0.0
     frictionloss: float = 0.0
+    # an MJCF hinge's or slide's spring: stiffness [N m/rad or N/m] pulling the joint's value (MuJoCo's
+    # qpos) towards springref [rad or m] (0: no spring)
+    stiffness: float = 0.0
+    springref: float = 0.0
 
     @property
     def dof(self) -> int:
@@ -183,8 +187,12 @@ class JointSpec:
 
     @property
     def dynamics(self) -> dict:
-        """The joint's armature, damping and frictionloss that are not 0 (name -> value)."""
-        return {k: getattr(self, k) for k in JOINT_DYNAMICS if getattr(self, k)}
+        """The joint's armature, damping and frictionloss that are not 0, and its spring (stiffness and
+        springref) where it has one (name -> value, MJCF's names)."""
+        out = {k: getattr(self, k) for k in JOINT_DYNAMICS if getattr(self, k)}
+        if self.stiffness:
+            out.update(stiffness=self.stiffness, springref=self.springref)
+        return out
 
 
 @dataclass(frozen=True)

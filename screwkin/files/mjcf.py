@@ -15,11 +15,12 @@ autolimits inertiafromgeom inertiagrouprange>``, ``<default>`` classes (``childc
 ``<worldbody>``'s bodies and ``<frame>``s with ``pos`` and one orientation (``quat``, ``axisangle``,
 ``euler``, ``xyaxes``, ``zaxis``), their joints (``hinge``, ``slide``, ``ball``, ``free``; ``pos``,
 ``axis``, ``range``, ``limited``, ``ref``: the joint's value where the file draws the body, so a joint's
-value is MuJoCo's qpos; ``armature``, ``damping``, ``frictionloss``: kept for exports), ``<inertial>``
+value is MuJoCo's qpos; ``armature``, ``damping``, ``frictionloss``, a hinge's or slide's
+``stiffness`` and ``springref``: kept for dynamics and exports), ``<inertial>``
 (checked as MuJoCo checks it) or, without one, the mass and inertia of the body's geoms as MuJoCo
 computes them (mjcf_inertia; meshes are not computed, and said), sites; ``<equality>`` (mjcf_equality); actuators and fixed tendons (mjcf_transmission).  Anything else
-that shapes the kinematics is refused in one line; what is read and not used (``stiffness``,
-``springref``, ``springdamper``: screwkin has no springs) is said once.
+that shapes the kinematics is refused in one line; what is read and not used (``springdamper``, a
+ball's or free joint's spring) is said once.
 """
 
 from __future__ import annotations
@@ -314,7 +315,15 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 dyn[key] = float(numbers(raw[0] if raw else "0", 1, f"{jw} {key}", p, (0.0,), 1e9, "")[0])
                 if len(raw) > 1:
                     unread["extra numbers"].append(f"{jn} {key}")
-            if any(a.get(k) not in (None, "0", "0 0") for k in ("stiffness", "springref", "springdamper")):
+            if jt in ("hinge", "slide"):  # a spring towards springref (qpos; a hinge's in the compiler's angle unit)
+                raw = (a.get("stiffness") or "0").split()
+                dyn["stiffness"] = float(numbers(raw[0] if raw else "0", 1, f"{jw} stiffness", p, (0.0,), 1e9, "")[0])
+                ref_at = float(numbers(a.get("springref"), 1, f"{jw} springref", p, (0.0,), LIMITS.length
+                                       if jt == "slide" else LIMITS.angle, "m" if jt == "slide" else "")[0])
+                dyn["springref"] = r.angle(ref_at) if jt == "hinge" else ref_at
+                if a.get("springdamper") not in (None, "0", "0 0"):
+                    unread["springref"].append(jn)
+            elif any(a.get(k) not in (None, "0", "0 0") for k in ("stiffness", "springref", "springdamper")):
                 unread["springref"].append(jn)
             mjoints[jn] = (jt, name)
             origin = X * pin.SE3(np.eye(3), pos) if prev_pos is None else pin.SE3(np.eye(3), pos - prev_pos)
@@ -383,9 +392,10 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                           "does not (their mass here is their other geoms')")
     if unread["springref"]:
         n = unread["springref"]
-        r.warnings.append(f"the springs (stiffness, springref, springdamper) of {len(n)} joint{'s' if len(n) > 1 else ''} "
+        r.warnings.append(f"the springs of {len(n)} joint{'s' if len(n) > 1 else ''} "
                           f"({', '.join(quote(x, 30) for x in n[:3])}{', ...' if len(n) > 3 else ''}) are not read: "
-                          "screwkin has no joint springs (nor do its exports)")
+                          "screwkin reads a hinge's or slide's stiffness and springref, not a ball's or free joint's "
+                          "spring nor springdamper")
     if unread["extra numbers"]:
         n = unread["extra numbers"]
         r.warnings.append(f"{len(n)} joint attributes ({', '.join(quote(x, 40) for x in n[:3])}{', ...' if len(n) > 3 else ''})"

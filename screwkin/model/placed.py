@@ -149,7 +149,10 @@ def _placed_joint(mech, q, j, kind, values, empty, axis=None, pos=(0.0, 0.0, 0.0
             else:
                 empty.append(j.name)
     axis = tuple(float(a) for a in j.axis) if axis is None else axis
-    return PlacedJoint(j.name, kind, axis, rng, tuple(j.dynamics.items()), tuple(float(x) for x in pos))
+    dyn = dict(j.dynamics)
+    if "springref" in dyn and coord is not None:  # the joint's zero moves to its value at q, as its range does
+        dyn["springref"] -= mech.joint_values(q)[j.name]
+    return PlacedJoint(j.name, kind, axis, rng, tuple(dyn.items()), tuple(float(x) for x in pos))
 
 
 def _compounds(mech, q, state, world) -> list:

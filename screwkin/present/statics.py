@@ -35,7 +35,7 @@ def statics_dict(r: StaticsResult, legs=None) -> dict:
          "amplification": r.amplification, "characteristic_length": r.length,
          "constraint_forces": [{"row": k, "value": v} for k, v in r.constraint_forces],
          "actuator_efforts": dict(r.actuator_efforts), "coupled_efforts": dict(r.coupled_efforts),
-         "transmissions": [t.text() for t in r.transmissions]}
+         "transmissions": [t.text() for t in r.transmissions], "springs": dict(r.springs), "notes": list(r.notes)}
     if legs is not None:
         d["legs"] = [leg_dict(leg) for leg in legs]
     return d
@@ -78,6 +78,8 @@ def statics_text(r: StaticsResult, legs=None) -> str:
     if r.indeterminate:
         lines.append(f"'?': not determined by statics ({r.indeterminate} redundant constraint or actuator "
                      "direction(s): an overconstrained linkage, or a planar one's out-of-plane components)")
+    for name, f in r.springs.items():
+        lines.append(f"spring of {name!r}: {shown_text(f)} {r.units[name]} along the joint (-stiffness (x - springref))")
     for k, leg in enumerate(legs or (), 1):
         lines.append("")
         lines.append(f"leg {k}: joints {', '.join(leg.joints)}; actuated {', '.join(leg.actuated) or 'none'}; "
@@ -86,4 +88,5 @@ def statics_text(r: StaticsResult, legs=None) -> str:
             lines.append(f"  constraint wrench: {_screw_text(s)}")
         for s in leg.transmission_screws:
             lines.append(f"  transmission wrench: {_screw_text(s)}")
+    lines += [f"note: {n}" for n in r.notes]
     return "\n".join(lines)

@@ -45,6 +45,7 @@ from ...model.geometry import cross3
 from ...model.state import KinematicState
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
+from .joint_dynamics import joint_dynamics, names_text as _names
 from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
                       reaction_joint_id, reaction_table)
 from ..motion.sweep import sweep, sweep_inputs
@@ -104,7 +105,7 @@ class DynamicsResult:
     shaking_force: np.ndarray  # (n, 3) what the moving links exert on the ground [N]
     shaking_moment: np.ndarray  # (n, 3) its moment about the world origin [N m]
     kinetic_energy: np.ndarray  # (n,) [J]
-    potential_energy: np.ndarray  # (n,) of gravity [J] (zero reference at the world origin)
+    potential_energy: np.ndarray  # (n,) of gravity (zero reference at the world origin) and of the joints' springs [J]
     input_power: np.ndarray  # (n,) sum of actuator effort x rate [W]
     load_power: np.ndarray  # (n,) power of the loads [W]
     unbalanced: np.ndarray  # (n,) |E tau + K^T lambda - b|: what the inputs cannot drive
@@ -194,70 +195,6 @@ def _ground_sides(mech) -> tuple:
     return tree, cuts
 
 
-class JointDynamics(dict):
-    """The joints' own dynamics a file gives (MJCF armature, damping, frictionloss), as MuJoCo applies
-    them to each degree of freedom; name -> the joint's velocity indices.  Arrays over the model's
-    velocity coordinates: ``armature``, ``damping``, ``frictionloss``."""
-
-    def __init__(self, mech, joints, coupled):
-        super().__init__()
-        nv = mech.model.nv
-        self.armature, self.damping, self.frictionloss = np.zeros(nv), np.zeros(nv), np.zeros(nv)
-        for j in joints:
-            idx = mech.velocity_indices([j.name])
-            self[j.name] = idx
-            self.armature[idx], self.damping[idx], self.frictionloss[idx] = j.armature, j.damping, j.frictionloss
-        # a mimic joint moves at multiplier x its leader's rate: its own terms reach the leader through it
-        self.coupled = {c.joint: (c.multiplier, int(mech.coordinate(c.mimics).idx_v), j) for c, j in coupled}
-        for name, (_, iv, _) in self.coupled.items():
-            self[name] = np.array([iv])
-        self._zero = mech.tolerances.equal
-
-    def _terms(self, arm, damp, fl, v, a):
-        return arm * a + damp * v + fl * np.where(np.abs(v) > self._zero, np.sign(v), 0.0)
-
-    def coupled_forces(self, v, a) -> dict:
-        """Each mimic joint's own force at (v, a) (its rate and acceleration: multiplier x its leader's)."""
-        return {name: float(self._terms(j.armature, j.damping, j.frictionloss, m * v[iv], m * a[iv]))
-                for name, (m, iv, j) in self.coupled.items()}
-
-    def force(self, v, a) -> np.ndarray:
-        """The generalized force that drives them at (v, a): armature a + damping v + frictionloss sign(v),
-        sign(v) 0 where the joint stands still (|v| within the tolerance ``equal``); a mimic joint's, times
-        its multiplier, on its leader's coordinate."""
-        out = self._terms(self.armature, self.damping, self.frictionloss, v, a)
-        for name, f in self.coupled_forces(v, a).items():
-            m, iv, _ = self.coupled[name]
-            out[iv] += m * f
-        return out
-
-    def friction_at_rest(self, v) -> set:
-        """The joints with friction loss that stand still at v (their dry friction not determined)."""
-        fl = {n: self.coupled[n][2].frictionloss if n in self.coupled else self.frictionloss[idx].max()
-              for n, idx in self.items()}
-        return {n for n, idx in self.items() if fl[n] > 0 and np.any(np.abs(v[idx]) <= self._zero)}
-
-    def kinetic(self, v) -> float:
-        """The armature's kinetic energy 1/2 sum armature v^2 [J] (MuJoCo's mass matrix holds it)."""
-        return 0.5 * (float(self.armature @ (v * v))
-                      + sum(j.armature * (m * v[iv]) ** 2 for m, iv, j in self.coupled.values()))
-
-
-def joint_dynamics(mech) -> tuple:
-    """(JointDynamics of the tree and mimic joints with armature, damping or friction loss; names of
-    those it cannot hold: loop joints, which have no coordinate of their own in the tree)."""
-    given = [j for j in mech.spec.joints if j.dynamics]
-    names = {c.joint for c in mech.coordinates}
-    couplings = {c.joint: c for c in mech.couplings}
-    coupled = [(couplings[j.name], j) for j in given if j.name in couplings]
-    return (JointDynamics(mech, [j for j in given if j.name in names], coupled),
-            [j.name for j in given if j.name not in names and j.name not in couplings])
-
-
-def _names(names) -> str:
-    return f"{', '.join(quote(n, 30) for n in names[:3])}{', ...' if len(names) > 3 else ''}"
-
-
 def _energies(mech, gmodel, data, q, v) -> tuple:
     """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
     energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
@@ -323,7 +260,9 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
     if own:
         notes.append(f"the armature, damping and friction loss the file gives {len(own)} joints ("
                      f"{_names(list(own))}) are in these efforts, as MuJoCo applies them (per degree of freedom: "
-                     "armature * a + damping * v + frictionloss * sign(v))")
+                     "armature * a + damping * v + frictionloss * sign(v)"
+                     + (f"; the springs of {_names(list(own.springs))}: stiffness * (x - springref), their energy in "
+                        "the potential energy" if own.springs else "") + ")")
     if left:
         notes.append(f"the armature, damping and friction loss of {len(left)} loop joints ({_names(left)}) are not "
                      "in these efforts: they have no coordinate of their own in the tree")
@@ -353,7 +292,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         q, v, a = res.q[k], res.rates[k], res.accelerations[k]
         b = pin.rnea(gmodel, data, q, v, a).copy()
         if own:
-            b += own.force(v, a)
+            b += own.force(q, v, a)
             friction_at_rest |= own.friction_at_rest(v)
         state = KinematicState(mech, q)
         frames = _load_wrenches(mech, loads, state)
@@ -388,6 +327,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         T[k], V[k] = _energies(mech, gmodel, data, q, v)
         if own:
             T[k] += own.kinetic(v)
+            V[k] += own.potential(q)
         P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
     units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}
     units.update(coupled_units(mech))

@@ -39,6 +39,7 @@ from ...model.linalg import null_space, rank
 from ...model.state import KinematicState, frame_parent
 from ..screws import Screw, cut_twists, screw_of
 from ..singularities.singular import Generic, measures
+from .joint_dynamics import joint_dynamics, names_text
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
            "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts", "compound_joints",
@@ -80,6 +81,8 @@ class StaticsResult:
     actuator_efforts: dict = field(default_factory=dict)  # actuator -> effort through its tendon, coupling, gear
     coupled_efforts: dict = field(default_factory=dict)  # coupled joint -> the effort its coupling exerts
     transmissions: tuple = ()  # files.description.Transmission of those actuators
+    springs: dict = field(default_factory=dict)  # spring joint -> the force it exerts at q [N m or N] (-k (x - ref))
+    notes: tuple = ()  # one line each: what the balance holds and what it takes as 0
 
 
 def _load_norm(w, L) -> float:
@@ -127,6 +130,15 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     b = np.zeros(nv)
     if gravity:
         b += pin.computeGeneralizedGravity(model, data, q)
+    own, notes = joint_dynamics(mech)[0], []
+    springs = {}
+    if own.springs:  # at rest: only the springs of the joints' own dynamics act (v = a = 0)
+        b += own.force(q, np.zeros(nv), np.zeros(nv))
+        springs = {n: -own.springs[n][1] * x for n, x in own.spring_stretch(q).items()}
+        notes.append(f"the springs of {names_text(list(springs))} (the file's stiffness and springref) are in the balance")
+    if any(own.frictionloss) or any(j.frictionloss for _, _, j in own.coupled.values()):
+        notes.append("the joints' dry friction (frictionloss) is taken as 0: at rest it lies anywhere within "
+                     "+-frictionloss, so these efforts hold the load with no help from friction")
     J_o = None
     if output is not None:
         J_o = KinematicState(mech, q).link_jacobian(output, LWA)
@@ -139,6 +151,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
         efforts[name] = None if free_tau[k] > tol.indeterminate else float(tau[k])
         units[name] = "N" if mech.translational[iv] else "N m"
     units.update(coupled_units(mech))
+    units.update({n: "N" if mech.translational[own.springs[n][0]] else "N m" for n in springs})
     reactions = _reactions(mech, q, lam, w if output is not None else None, output, gravity, N[m:] if N.size else None)
     L = mech.length
     g = Generic(mech, inputs, None, configurations=mech.generic_configurations()[1])
@@ -153,7 +166,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
                          unbalanced <= tol.balanced * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
                          bool(inputs) and sig < tol.singular, float(sig), amp, L,
                          tuple(zip(labels, map(float, lam))), actuator_efforts(mech, inputs, efforts), coupled,
-                         mech.transmissions(inputs))
+                         mech.transmissions(inputs), springs, tuple(notes))
 
 
 def _reactions(mech, q, lam, w, output, gravity, N_lam):
