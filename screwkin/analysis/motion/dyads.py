@@ -30,13 +30,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from ...model.geometry import cross3, plane_basis
 from ...model.manifold import continuous_angle, set_continuous_angle
 from ...model.planar_graph import DyadPlan, plan
 from ...model.state import KinematicState
 from .batch_sweep import batch_closure
+from .continuation import LIMIT_REASON, locate, returned
 from ..singularities.singular import measures
 
 __all__ = ["Jet", "ClosedFormSweep", "planar_sweep"]
@@ -396,10 +396,6 @@ class ClosedFormSweep:
     unit: str
 
 
-_LIMIT_REASON = ("limit position: the passive joints become undetermined (an actuator singularity); "
-                 "the input cannot go further on this branch")
-
-
 def cached_plan(solver, name):
     """model.planar_graph.plan of the solver's mechanism swept along ``name`` with its other inputs
     held (a DyadPlan, or why not), kept in the mechanism's cache."""
@@ -485,9 +481,9 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
             Q, V, A = unwrap(Q, D, xs[:n_ok]), D * rate, DD * rate * rate
             xs_ok = xs[:n_ok]
             if turn and forward and not first:  # back at the start: the circuit is closed
-                at = np.flatnonzero(np.abs(xs_ok - start) < mech.tolerances.equal * max(1.0, abs(h)))
-                for i in at:
-                    if count + i + 1 > 2 and np.linalg.norm(pin.difference(mech.model, Q[i], q0) / scale) < mech.tolerances.geometry:
+                near = np.flatnonzero(np.abs(xs_ok - start) < mech.tolerances.equal * max(1.0, abs(h)))  # (cheap first)
+                for i in near:
+                    if count + i + 1 > 2 and returned(mech, xs_ok[i], start, h, Q[i], q0, scale):
                         n_ok, closed = int(i) + 1, True
                         Q, V, A, xs_ok = Q[:n_ok], V[:n_ok], A[:n_ok], xs_ok[:n_ok]
                         break
@@ -509,9 +505,7 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
 
         if not worst(lo) > 0:
             return None  # two limit positions within one step of the grid
-        from scipy.optimize import brentq  # (here: importing scipy.optimize takes 0.3 s, a sweep 20 ms)
-
-        x_lim = brentq(worst, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+        x_lim = locate(worst, lo, hi, xtol=1e-15, maxiter=200)
         d_lim = _evaluate(geo, p, [x_lim], start, branch)[1][:, 0]
         which = int(np.argmin(np.abs(np.where(np.isnan(d_lim), np.inf, d_lim))))
         poses = _evaluate(geo, p, [x_lim], start, branch, clamp=which)[0]
@@ -522,7 +516,7 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
         sig = measures(mech, q_lim, solver.generic())["actuator"]
         limits.append((float(x_lim), float(sig), q_lim))
         if not turn:
-            stopped, reason = float(x_lim), _LIMIT_REASON
+            stopped, reason = float(x_lim), LIMIT_REASON
             break
         branch[which] = -branch[which]
         forward = not forward
