@@ -35,7 +35,7 @@ import pinocchio as pin
 from ...errors import AssemblyError
 from ...model.geometry import TINY
 
-__all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "jumped",
+__all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
            "LIMIT_REASON"]
 
@@ -128,6 +128,18 @@ def passes_limit(ta, tb, ix):
     """A limit position between two configurations (oriented tangents ta, tb: ``orient``): the
     input's share of the tangent does not keep its sign (rows of stacks compared pairwise)."""
     return np.asarray(ta)[..., ix] * np.asarray(tb)[..., ix] <= 0
+
+
+def keeps_orientation(Ks_from, Ks_new, r):
+    """The branch rule of a continuation in several parameters (a workspace's grid growth): each new
+    Jacobian (N, m, n; dimensionless) restricted to the old one's range and row space (rank r) keeps the
+    sign of its determinant -- a jump across a fold to another working mode flips it.  With one
+    parameter it is ``passes_limit``'s rule.  The old row space C: the top r eigenvectors of
+    Ks^T Ks (half the cost of an SVD); the old range is Ks C / s, so det(B^T K_new C) has the sign
+    of det(C^T Ks^T K_new C).  (N,) bool."""
+    C = np.linalg.eigh(Ks_from.transpose(0, 2, 1) @ Ks_from)[1][:, :, -r:]
+    KC = Ks_from @ C
+    return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
 def jumped(miss, sigma, tol):
