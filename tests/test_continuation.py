@@ -198,7 +198,7 @@ def test_the_tangent_and_the_jump_test_are_defined_in_one_place():
     _start_tangent (Curve.tangent, oriented along the grid)."""
     allowed = {("model/square.py", "tangent"), ("model/algebraic.py", "tangent"),
                ("analysis/motion/batch_sweep.py", "tangents"), ("analysis/motion/sweep.py", "_start_tangent")}
-    words = ("tangent", "jump", "orient", "passes_limit", "locate_limit", "on_arc", "brentq")
+    words = ("tangent", "jump", "orient", "passes_limit", "on_arc", "brentq")
     found = []
     package = ROOT / "screwkin"
     for path in sorted(package.rglob("*.py")):
@@ -214,5 +214,16 @@ def test_the_tangent_and_the_jump_test_are_defined_in_one_place():
     for rel in ("analysis/motion/sweep.py", "analysis/motion/tracker.py", "analysis/motion/dyads.py",
                 "analysis/motion/batch_sweep.py"):
         assert "brentq" not in (package / rel).read_text(), rel
-    # the private tracker is gone; nothing imports a continuation piece from sweep
+    # the private tracker is gone
     assert "_Tracker" not in (package / "analysis/motion/sweep.py").read_text()
+
+
+def test_every_engine_has_the_interface():
+    """The engines -- per step, batched, closed form -- each answer the five questions of the interface."""
+    from screwkin.analysis.motion.continuation import Engine
+    from screwkin.analysis.motion.dyads import ClosedFormCurve
+
+    questions = [n for n in vars(Engine) if not n.startswith("_")]
+    assert sorted(questions) == ["accept", "choose_branch", "correct", "locate_limit", "predict"]
+    for engine in (Curve, BatchedCurve, ClosedFormCurve):
+        assert all(callable(getattr(engine, n, None)) for n in questions), engine

@@ -66,23 +66,30 @@ class Motion:
 
 
 class Engine(Protocol):
-    """The interface of a continuation engine (see the module docstring).  q: a configuration (or,
-    for a batched engine, a stack of them, one per row); t: the oriented unit tangent(s) (nv)."""
+    """The interface of a continuation engine (see the module docstring): five questions, each engine
+    answering them on its own state.  ``Curve``: q one configuration, t its oriented unit tangent (nv),
+    sigma a dimensionless step, ``held`` a velocity index; ``BatchedCurve``: the same on a stack of
+    configurations (one per row, sigma one per row); ``ClosedFormCurve`` (analysis.motion.dyads): input
+    values instead of steps (its prediction is exact), a sign per dyad for the branch."""
 
-    def predict(self, q, t, sigma):
-        """The configuration(s) a dimensionless step sigma along t from q."""
+    def predict(self, *args):
+        """Where the next configuration(s) should be: a step along the tangent (the closed form: its
+        placement at the input values)."""
 
-    def correct(self, predicted, held):
-        """The configuration(s) closing the loops from ``predicted`` with joint ``held`` kept."""
+    def correct(self, *args):
+        """The configuration(s) closing the loops from the prediction, with one joint held (the closed
+        form: the joint coordinates of its placement)."""
 
-    def accept(self, predicted, corrected, sigma):
-        """Whether the correction stayed on the curve (``jumped``, and for a batch the branch rule)."""
+    def accept(self, *args):
+        """Which corrections stayed on the curve: ``jumped`` and, for a stack, ``passes_limit`` (the
+        closed form: every discriminant non-negative)."""
 
-    def choose_branch(self, t, previous):
-        """t oriented to continue ``previous`` (``orient``)."""
+    def choose_branch(self, *args):
+        """The branch that continues the motion: ``orient`` (the closed form: past a dyad's limit
+        position, its other sign)."""
 
-    def locate_limit(self, qa, ta, qb, held):
-        """(configuration, input offset from qa) of the limit position between qa and qb."""
+    def locate_limit(self, *args):
+        """The limit position bracketed between two configurations (input values), by ``locate``."""
 
 
 def projections(K, V, scale, free, tol) -> np.ndarray:

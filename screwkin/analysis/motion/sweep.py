@@ -22,8 +22,7 @@ from ...errors import AssemblyError, UsageError, quote, shorten
 from ...model.geometry import wrap_angle
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .continuation import Curve, Motion, Stuck, continuation_steps
-from ...model.planar_graph import plan
-from .dyads import planar_sweep
+from .dyads import cached_plan, planar_sweep
 from .position import outside_limits
 from .tracker import Tracker
 from ..singularities.singular import scaled_jacobians
@@ -92,10 +91,7 @@ def _drawn_regular(solver, values: dict):
     name = next(iter(values), None)
     if mech.generic_known or name is None or not mech.cuts:
         return None
-    key = ("dyads.plan", tuple(solver.inputs), name)
-    if key not in mech.cache:
-        mech.cache[key] = plan(mech, solver.inputs, name)
-    if isinstance(mech.cache[key], str):
+    if isinstance(cached_plan(solver, name), str):
         return None
     try:
         a = mech.assemble()
