@@ -227,3 +227,7 @@ def test_every_engine_has_the_interface():
     assert sorted(questions) == ["accept", "choose_branch", "correct", "locate_limit", "predict"]
     for engine in (Curve, BatchedCurve, ClosedFormCurve):
         assert all(callable(getattr(engine, n, None)) for n in questions), engine
+    # the certified mode search's homotopy paths: predict, correct, accept (no branch nor limit in C^n)
+    from screwkin.model.tracking import Paths
+
+    assert all(callable(getattr(Paths, n, None)) for n in ("predict", "correct", "accept"))

@@ -20,8 +20,12 @@ stacked so that one configuration and a batch of them are the same computation. 
 ``Curve`` here (one configuration at a time: the per-step tracker of analysis.motion.tracker walks
 with it, and ``Neighbour`` takes a map's steps with it), ``BatchedCurve`` (analysis.motion.batch_sweep:
 a chunk of grid values at once), the closed form of analysis.motion.dyads (every value at once; its
-limit positions located by ``locate``, its return to the start by ``returned``), and the workspace's
-grid growth (analysis.design.workspace_grid: the jump test).  analysis.motion.sweep chooses among them.
+limit positions located by ``locate``, its return to the start by ``returned``), the workspace's grid
+growth (analysis.design.workspace_grid: the jump test, and ``keeps_orientation``, the branch rule in
+several parameters), and the certified mode search's homotopy paths (model.tracking.Paths: predict,
+correct, accept -- in complex space there is no branch to choose nor limit to locate; the layers keep
+that engine below this module, which it matches by its methods).  analysis.motion.sweep chooses among
+the first three.
 """
 
 from __future__ import annotations
