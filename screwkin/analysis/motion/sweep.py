@@ -183,64 +183,94 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     progress: a callable ``progress(done, total)`` told of the grid values reached as the tracker
     goes (present/progress.Progress draws it on a terminal); None: not told.
     """
-    if steps < 1:
-        raise UsageError("a sweep needs at least 1 step")
-    if name not in solver.inputs:
-        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} is not one of the inputs ({', '.join(shorten(i, 40) for i in solver.inputs)})")
-    fixed = dict(fixed or {})
-    others = [n for n in solver.inputs if n != name]
-    missing = [n for n in others if n not in fixed]
-    if missing:
-        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(shorten(m, 40) for m in missing)}")
-    mech = solver.mech
-    curve = Curve(solver, name)
+    fixed = _other_inputs(solver, name, steps, fixed)
+    curve, requested = Curve(solver, name), (start, stop, steps)
     max_steps = max_steps or 20 * steps + 100
-    h = (stop - start) / steps
-    if callable(q_start):  # chosen once the arguments are checked (a command's --mode K, said as it is chosen)
-        q_start = q_start()
-    if q_start is not None:
-        q0 = solver.track({name: start, **fixed}, q_start).q
-    else:
-        q0 = drawn_start(solver, {name: start, **fixed}) if near is None else None
-        if q0 is None:
-            first = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0)
-            q0 = first.solutions[0].q
-    requested = (start, stop, steps)
+    q0 = _start(solver, name, start, fixed, near, q_start)
     if closed_form:
-        f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
-        if f is None and not turn and steps * REFINE <= max_steps:
-            f = _refined(planar_sweep(solver, name, q0, start, stop, steps * REFINE, rate, turn, max_steps * REFINE),
-                         start, (stop - start) / steps, REFINE)
+        f = _closed_form(solver, name, q0, start, stop, steps, rate, turn, max_steps)
         if f is not None:
-            limits = tuple(SweepSingularity("actuator", x, s, q, limit=True) for x, s, q in f.limits)
-            return SweepResult(name, f.values, f.q, f.joints, f.rates, f.accelerations, tuple(mech.coordinate_names),
-                               rate, f.stopped_at, f.stop_reason, requested, limits, turn,
-                               f.circuit_closed, f.unit, method="closed form")
+            return f
+    h = (stop - start) / steps
     t, why = _start_tangent(curve, q0, h)
     # batched only on grids no coarser than the longest step the tracker takes (Tolerances.max_step): a
     # chunk corrected at once cannot take the shorter steps a coarse grid needs across a bend
-    if batch and not turn and h != 0 and t is not None and abs(h) / curve.scale[curve.ix] <= mech.tolerances.max_step:
-
-        def fallback(qa, xa, xb, n):  # the tracker from qa (closed again at xa, as a sweep from it would be)
-            qa = solver.track({name: xa, **fixed}, qa).q
-            ta, why_a = _start_tangent(curve, qa, (xb - xa) / n)
-            if ta is None:
-                return Motion([xa], [qa], stopped=xa, reason=why_a)
-            return Tracker(curve, qa, ta, xa, xb, n).run()
-
-        b = batched_motion(solver, curve, q0, t, start, stop, steps, fallback, progress)
+    if batch and not turn and h != 0 and t is not None and abs(h) / curve.scale[curve.ix] <= solver.mech.tolerances.max_step:
+        b = batched_motion(solver, curve, q0, t, start, stop, steps, _fallback(solver, curve, fixed), progress)
         if b is not None:
             return _finish(solver, name, b, rate, requested, False, curve.unit, "batched")
-    needed = continuation_steps(mech, name, stop - start)
-    if needed > max(steps, MAX_TRACKED):
-        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} over this range takes {needed:,} continuation steps of at "
-                         f"most {mech.tolerances.max_step:g} (rad or characteristic lengths) between {steps:,} grid "
-                         f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
+    _trackable(solver.mech, name, start, stop, steps)
     if t is None:
         motion = Motion([start], [q0], stopped=start, reason=why)
     else:
         motion = Tracker(curve, q0, t, start, stop, steps, turn, max_steps, progress).run()
     return _finish(solver, name, motion, rate, requested, turn, curve.unit)
+
+
+def _other_inputs(solver, name, steps, fixed) -> dict:
+    """The other inputs' values (a copy of ``fixed``), once the arguments are checked."""
+    if steps < 1:
+        raise UsageError("a sweep needs at least 1 step")
+    if name not in solver.inputs:
+        raise UsageError(f"{solver.mech.path}: {quote(name, 40)} is not one of the inputs ({', '.join(shorten(i, 40) for i in solver.inputs)})")
+    fixed = dict(fixed or {})
+    missing = [n for n in solver.inputs if n != name and n not in fixed]
+    if missing:
+        raise UsageError(f"{solver.mech.path}: give values for the other inputs with --set: {', '.join(shorten(m, 40) for m in missing)}")
+    return fixed
+
+
+def _start(solver, name, start, fixed, near, q_start):
+    """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
+    may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
+    drawing when it is solve's first mode there, else solve's first (near ``near``)."""
+    if callable(q_start):
+        q_start = q_start()
+    if q_start is not None:
+        return solver.track({name: start, **fixed}, q_start).q
+    q0 = drawn_start(solver, {name: start, **fixed}) if near is None else None
+    if q0 is None:
+        q0 = solver.solve({name: start, **fixed}, near=near, starts=8 if near is None else 0).solutions[0].q
+    return q0
+
+
+def _closed_form(solver, name, q0, start, stop, steps, rate, turn, max_steps):
+    """The SweepResult of the closed-form engine (analysis.motion.dyads; on a finer grid read at this
+    one's values where this one is too coarse for it), or None where it does not apply."""
+    f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
+    if f is None and not turn and steps * REFINE <= max_steps:
+        f = _refined(planar_sweep(solver, name, q0, start, stop, steps * REFINE, rate, turn, max_steps * REFINE),
+                     start, (stop - start) / steps, REFINE)
+    if f is None:
+        return None
+    limits = tuple(SweepSingularity("actuator", x, s, q, limit=True) for x, s, q in f.limits)
+    return SweepResult(name, f.values, f.q, f.joints, f.rates, f.accelerations, tuple(solver.mech.coordinate_names),
+                       rate, f.stopped_at, f.stop_reason, (start, stop, steps), limits, turn, f.circuit_closed, f.unit,
+                       method="closed form")
+
+
+def _fallback(solver, curve, fixed):
+    """The batched engine's fallback: the per-step tracker's Motion of n steps from qa (input xa) to xb,
+    qa closed again at xa first (as a sweep started from it)."""
+
+    def fallback(qa, xa, xb, n):
+        qa = solver.track({curve.name: xa, **fixed}, qa).q
+        ta, why = _start_tangent(curve, qa, (xb - xa) / n)
+        if ta is None:
+            return Motion([xa], [qa], stopped=xa, reason=why)
+        return Tracker(curve, qa, ta, xa, xb, n).run()
+
+    return fallback
+
+
+def _trackable(mech, name, start, stop, steps):
+    """A range the per-step tracker takes more than MAX_TRACKED steps over (and more than its grid
+    values) is a usage error naming the count."""
+    needed = continuation_steps(mech, name, stop - start)
+    if needed > max(steps, MAX_TRACKED):
+        raise UsageError(f"{mech.path}: {quote(name, 40)} over this range takes {needed:,} continuation steps of at "
+                         f"most {mech.tolerances.max_step:g} (rad or characteristic lengths) between {steps:,} grid "
+                         f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
 
 
 def _start_tangent(curve, q0, h):
