@@ -19,7 +19,7 @@ constraint Jacobian, in dimensionless coordinates (lengths divided by the charac
 stacked so that one configuration and a batch of them are the same computation.  The engines:
 ``Curve`` here (one configuration at a time: the per-step tracker of analysis.motion.tracker walks
 with it, and ``Neighbour`` takes a map's steps with it), ``BatchedCurve`` (analysis.motion.batch_sweep:
-a chunk of grid values at once), the closed form of analysis.motion.dyads (every value at once; its
+a chunk of grid values at once), ``ClosedFormCurve`` (analysis.motion.dyads: every value at once, its
 limit positions located by ``locate``, its return to the start by ``returned``), the workspace's grid
 growth (analysis.design.workspace_grid: the jump test, and ``keeps_orientation``, the branch rule in
 several parameters), and the certified mode search's homotopy paths (model.tracking.Paths: predict,
