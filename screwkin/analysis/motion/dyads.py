@@ -20,7 +20,8 @@ accelerations are the exact derivatives of the closed form: q' rate and q'' rate
 (input acceleration zero, other inputs held), what PositionSolver.rates and
 .accelerations give for a mechanism the inputs determine.
 
-``plan`` says why a mechanism does not decompose (then ``sweep`` runs its tracker);
+``ClosedFormCurve`` is the continuation engine (analysis.motion.continuation's interface) that does
+this; ``plan`` says why a mechanism does not decompose (then ``sweep`` runs another engine);
 ``planar_sweep`` reproduces ``sweep``'s result (limits, turns, circuit, budget) from
 the closed form, every configuration checked by its closure residual first.
 """
@@ -443,9 +444,9 @@ class ClosedFormCurve:
         self.branch[which] = -self.branch[which]
 
     def locate_limit(self, lo, hi):
-        """(input value, configuration (not unwrapped), dyad) of the limit position between the input
-        values lo (placed) and hi (not): Brent's method on the smallest discriminant; None when lo's
-        is not positive (two limit positions within one step)."""
+        """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
+        position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
+        on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
 
         def worst(x):
             d = self.predict([x])[1][:, 0]
