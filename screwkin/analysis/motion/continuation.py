@@ -110,6 +110,12 @@ def projections(K, V, scale, free, tol) -> np.ndarray:
         return out
     Ks = (K * scale)[:, :, free]
     m, f = Ks.shape[1:]
+    if N == 1:  # one configuration (the per-step engines): plain matrix products, no stacked einsum
+        _, s, vt = np.linalg.svd(Ks[0], full_matrices=m < f)
+        r = int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol))) if s.size and s[0] > tol.rank_atol else 0
+        null = vt[r:]
+        out[0, free] = null.T @ (null @ V[0, free])
+        return out
     # a tall matrix's thin SVD has every right singular vector (as model.linalg.null_space)
     _, s, vt = np.linalg.svd(Ks, full_matrices=m < f)
     sp = np.zeros((N, f))
