@@ -238,6 +238,12 @@ class Curve:
     def choose_branch(self, t, previous):
         return orient(t, previous)
 
+    def along(self, q, direction):
+        """The unit tangent at q oriented so that the input moves the way of ``direction`` (its sign;
+        zero: increasing) -- where a motion starts."""
+        t = self.tangent(q)
+        return -t if t[self.ix] * (np.sign(direction) or 1.0) < 0 else t
+
     def hold(self, t):
         """The velocity index of the joint to hold for a step along t: the input when it has a
         large share of the tangent, else the one-DOF joint with the largest share."""
@@ -359,9 +365,7 @@ class Neighbour:
             return q
         pieces = continuation_steps(c.mech, c.name, x_to - x_from)
         try:
-            t = c.tangent(q)
-            if t[c.ix] * direction < 0:
-                t = -t
+            t = c.along(q, direction)
             x = x_from
             for k in range(1, pieces + 1):
                 x_next = x_to if k == pieces else x_from + (x_to - x_from) * k / pieces

@@ -276,10 +276,9 @@ def _trackable(mech, name, start, stop, steps):
 def _start_tangent(curve, q0, h):
     """(the tangent at q0 oriented along the grid step h, None) or (None, why the input cannot move)."""
     try:
-        t = curve.tangent(q0)
+        return curve.along(q0, h), None
     except Stuck as exc:
         return None, str(exc)
-    return (-t if t[curve.ix] * (np.sign(h) or 1.0) < 0 else t), None
 
 
 def _finish(solver, name, motion, rate, requested, turn, unit, method="tracker"):
