@@ -52,6 +52,15 @@ class Tolerances:
     sample_step:    size of the random step to a nearby configuration [rad or m].
     max_step:       the longest continuation step a sweep takes [rad, or characteristic lengths]: a
                     coarser grid is followed by shorter steps between its values [-].
+    min_step:       the shortest continuation step: a motion no shorter step can continue past a
+                    configuration stops there, said so [rad, or characteristic lengths].
+    jump:           a continuation step's correction (the closure solve after the tangent's
+                    prediction) may move the configuration by at most this fraction of the
+                    step; a larger one jumped away from the curve, to another branch [-].
+    jump_floor:     a correction this small (dimensionless) is accepted whatever the step [-].
+    limit_share:    the input's direction projected on the curve's tangent shorter than this:
+                    the configuration is a limit position itself, and the tangent there is the
+                    previous one's projected instead [-].
     near_far:       a --near value the chosen mode misses by more than this is said to be missed
                     [rad for angles, times the characteristic length for lengths].
     moves:          a joint moves (in the generic configurations) where its row of the
@@ -95,6 +104,10 @@ class Tolerances:
     samples: int = 3
     sample_step: float = 0.05
     max_step: float = 0.1
+    min_step: float = 1e-10
+    jump: float = 0.5
+    jump_floor: float = 1e-7
+    limit_share: float = 1e-7
     near_far: float = 0.5
     moves: float = 1e-6
     stationary: float = 1e-7

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.motion.position import PositionSolver
-from ..analysis.motion.sweep import continuation_steps
+from ..analysis.motion.continuation import continuation_steps
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.outfile import write_output

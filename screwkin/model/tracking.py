@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["TrackerOptions", "Tracked", "Segment", "track", "newton", "cauchy", "OK", "FAILED", "DIVERGED"]
+__all__ = ["TrackerOptions", "Tracked", "Segment", "Paths", "track", "newton", "cauchy", "OK", "FAILED", "DIVERGED"]
 
 OK, FAILED, DIVERGED = 0, 1, 2
 #: A step that ends within this fraction of the segment's length from its end is at the end (round-off).
@@ -195,38 +195,67 @@ def track(hom, X0, index=None, options: TrackerOptions = DEFAULT_OPTIONS, t0=0.0
     return Tracked(X, T, status, steps, refused, residual)
 
 
-def _loop(hom, X, T, h, K1, known, status, steps, refused, index, active, t1, span, o):
-    """The predictor-corrector iterations of ``track`` on the arrays it passes (changed in place)."""
+class Paths:
+    """The homotopy's continuation engine: the questions of analysis.motion.continuation's ``Engine``
+    asked of a stack of paths in complex space (``predict``, ``correct``, ``accept``).  A path there
+    has no branch to choose and no limit position to locate on its way -- between generic complex
+    parameters it meets the singular set with probability zero -- so those two questions are not
+    asked: a singular endpoint is the Cauchy endgame's (``cauchy``)."""
 
-    def field(x, t, idx):
-        _, J = hom.evaluate(x, t, idx)
-        return -_solve(J, hom.dt(x, t, idx)[..., None])[..., 0]
+    def __init__(self, hom, options: TrackerOptions = DEFAULT_OPTIONS):
+        self.hom, self.o = hom, options
 
-    while active.size:
-        x, t, idx = X[active], T[active], index[active]
-        hh = np.minimum(h[active], t1 - t)
-        k1 = K1[active]
-        fresh = ~known[active]
-        if fresh.any():
-            k1[fresh] = field(x[fresh], t[fresh], idx[fresh])
+    def field(self, x, t, idx):
+        """dx/dt = -H_x^-1 H_t at the points x (parameter t)."""
+        _, J = self.hom.evaluate(x, t, idx)
+        return -_solve(J, self.hom.dt(x, t, idx)[..., None])[..., 0]
+
+    def predict(self, x, t, hh, k1, idx):
+        """Fourth-order Runge-Kutta from x at t by steps hh (k1: the first stage): the points at t + hh."""
+        hom, field = self.hom, self.field
         half = 0.5 * hh
         k2 = field(hom.retract(x, half[:, None] * k1), t + half, idx)
         k3 = field(hom.retract(x, half[:, None] * k2), t + half, idx)
         k4 = field(hom.retract(x, hh[:, None] * k3), t + hh, idx)
-        tn = t + hh
-        xp = hom.retract(x, (hh / 6.0)[:, None] * (k1 + 2 * k2 + 2 * k3 + k4))
-        # corrector: a Newton step, then a simplified one with the same Jacobian
+        return hom.retract(x, (hh / 6.0)[:, None] * (k1 + 2 * k2 + 2 * k3 + k4))
+
+    def correct(self, xp, tn, idx):
+        """A Newton step, then a simplified one with the same Jacobian: (points, first and second step
+        norms, the inverse Jacobian at the prediction)."""
+        hom = self.hom
         H, J = hom.evaluate(xp, tn, idx)
         Ji = _inverse(J)
         dx1 = np.einsum("pij,pj->pi", Ji, H)
         x1 = hom.retract(xp, -dx1)
         H1, _ = hom.evaluate(x1, tn, idx, jacobian=False)
         dx2 = np.einsum("pij,pj->pi", Ji, H1)
-        xc = hom.retract(x1, -dx2)
-        d1, d2 = _norm(dx1), _norm(dx2)
+        return hom.retract(x1, -dx2), _norm(dx1), _norm(dx2), Ji
+
+    def accept(self, x, xc, d1, d2):
+        """The corrector converged (its last step under tol relative to 1 + |x|) and contracted (the
+        second step at most ``contraction`` times the first), and the step moved the point by at most
+        max_jump (relative): a step that lands near another path is refused (no path jumping)."""
+        o = self.o
         scale = 1.0 + _norm(x)  # the last accepted point's size: a step to a huge point is no step
-        good = (np.isfinite(d2) & (d2 <= o.tol * scale) & ((d2 <= o.contraction * d1) | (d1 <= o.tol * scale))
+        return (np.isfinite(d2) & (d2 <= o.tol * scale) & ((d2 <= o.contraction * d1) | (d1 <= o.tol * scale))
                 & (_norm(xc - x) <= o.max_jump * scale))
+
+
+def _loop(hom, X, T, h, K1, known, status, steps, refused, index, active, t1, span, o):
+    """The predictor-corrector iterations of ``track`` on the arrays it passes (changed in place)."""
+    paths = Paths(hom, o)
+    while active.size:
+        x, t, idx = X[active], T[active], index[active]
+        hh = np.minimum(h[active], t1 - t)
+        k1 = K1[active]
+        fresh = ~known[active]
+        if fresh.any():
+            k1[fresh] = paths.field(x[fresh], t[fresh], idx[fresh])
+        tn = t + hh
+        xp = paths.predict(x, t, hh, k1, idx)
+        xc, d1, d2, Ji = paths.correct(xp, tn, idx)
+        good = paths.accept(x, xc, d1, d2)
+        scale = 1.0 + _norm(x)
         err = d1 / scale
         acc, rej = active[good], active[~good]
         X[acc], T[acc] = xc[good], np.where(tn[good] >= t1 - _SNAP * abs(span), t1, tn[good])

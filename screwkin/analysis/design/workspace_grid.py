@@ -2,7 +2,8 @@
 output on axes spanning its translations, filled outwards wave by wave from the assembled
 configuration by batched inverse kinematics (analysis.motion.batch_closure.BatchClosure), each point
 from a neighbour's solution along a first-order predictor, kept only when it continues that
-neighbour's branch (the sign of the rows' Jacobian determinant on the parent's row space), with
+neighbour's branch (the one continuation's jump test and branch rule, analysis.motion.continuation:
+the sign of the rows' Jacobian determinant on the parent's row space), with
 substeps near folds and runs extended to the boundary by bisection.
 """
 
@@ -15,6 +16,7 @@ import numpy as np
 from ...model.linalg import rank
 from ...model.newton import damped_steps
 from ..motion.batch_closure import BatchClosure
+from ..motion.continuation import jumped, keeps_orientation
 from ..motion.position import within_limits
 
 __all__ = ["Grid", "grid_axes", "null_motions", "MAX_POINTS"]
@@ -116,18 +118,12 @@ class Grid:
         sigma: the new Jacobian's r-th singular value relative to its largest (dimensionless),
         how far it is from a fold (``substeps``)."""
         step = np.linalg.norm(Q_pred - Q_from, axis=1)
-        miss = np.linalg.norm(Q_new - Q_pred, axis=1)
-        ok = miss <= 0.5 * step + 1e-6
+        ok = ~jumped(np.linalg.norm(Q_new - Q_pred, axis=1), step, self.mech.tolerances)
         K_new = self._scaled(self.closure.evaluate(Q_new, (P_new, self.R))[1])
         r = self.rank
         if not r:
             return ok, np.ones(len(ok))
-        # the old row space C: the top r eigenvectors of Ks^T Ks (half the cost of an SVD); the
-        # old range is Ks C / s, so det(B^T K_new C) has the sign of det(C^T Ks^T K_new C)
-        Ks = self._scaled(K_from)
-        C = np.linalg.eigh(Ks.transpose(0, 2, 1) @ Ks)[1][:, :, -r:]
-        KC = Ks @ C
-        ok &= np.linalg.det(KC.transpose(0, 2, 1) @ K_new @ C) > 0
+        ok &= keeps_orientation(self._scaled(K_from), K_new, r)
         ev = np.sqrt(np.maximum(np.linalg.eigvalsh(K_new.transpose(0, 2, 1) @ K_new), 0.0))[:, ::-1]
         return ok, np.where(ev[:, 0] > 0, ev[:, r - 1] / np.where(ev[:, 0] > 0, ev[:, 0], 1.0), 0.0)
 

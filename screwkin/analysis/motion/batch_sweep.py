@@ -2,21 +2,21 @@
 
 For mechanisms the closed form (dyads.py) does not cover -- spatial loops, triads -- but whose
 closure BatchClosure represents (1-DOF revolute and prismatic joints), the grid values of the
-input are taken a chunk at a time:
+input are taken a chunk at a time by ``BatchedCurve``, the batched engine of the one continuation
+(analysis.motion.continuation: its tangent, jump test and branch rule, on stacks):
 
 - predict every value of the chunk from the last configuration reached, along its tangent
-  (sweep's predictor, the input held at each grid value);
+  (the input held at each grid value);
 - correct them all at once with BatchClosure.solve (the one damped-Newton step of
   model/newton.py, each configuration its own damping);
-- check each is on the branch, as sweep's tracker does: it converged, the correction is small
-  next to the predicted step (at most half of it), and no limit position lies between it and
-  the previous one (the tangent's input component keeps its sign: the unoriented tangents
-  P e, P the projector onto the null space of the scaled constraint Jacobian, of neighbours
-  have a positive dot product).
+- accept each that is on the branch, as the per-step tracker does: it converged, the correction
+  passes the jump test, and no limit position lies between it and the previous one (the input's
+  share of the tangent, oriented along the chunk, keeps its sign).
 
 The configurations before the first that fails are kept; the chunk is halved and tried again
 from there; a chunk of the smallest size that still fails is handed to the per-step tracker
-(``fallback``: sweep itself, which locates limit positions), and that is said in the notes.
+(``fallback``, which locates limit positions: BatchedCurve's ``locate_limit`` is the Curve's),
+and that is said in the notes.
 """
 
 from __future__ import annotations
@@ -24,11 +24,12 @@ from __future__ import annotations
 import numpy as np
 
 from .batch_closure import BatchClosure, Unbatchable
+from ...model.geometry import TINY
+from .continuation import Curve, Motion, jumped, passes_limit
 
-__all__ = ["batch_closure", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
+__all__ = ["batch_closure", "BatchedCurve", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
 
 SMALLEST, LARGEST = 4, 256  # grid values a chunk: it starts at 16 and doubles while it goes well
-_JUMP_FLOOR = 1e-7  # the smallest correction always accepted (scaled), as sweep._Tracker.step's [-]
 
 
 def batch_closure(mech):
@@ -42,104 +43,95 @@ def batch_closure(mech):
     return mech.cache[key]
 
 
-def _tangents(bc, tr, Q):
-    """Unoriented tangents P e (N, nv) at the configurations Q: the input's direction projected
-    onto the null space of the scaled constraint Jacobian (sweep._Tracker.tangent, batched)."""
-    K = bc.constraint_jacobians(Q)
-    N, nv = len(Q), tr.mech.nv
-    free = tr.free
-    e_col = int(np.searchsorted(free, tr.ix))
-    out = np.zeros((N, nv))
-    if K.shape[1] == 0:
-        out[:, tr.ix] = 1.0
-        return out
-    Ks = (K * tr.scale)[:, :, free]
-    _, s, vt = np.linalg.svd(Ks, full_matrices=True)
-    sp = np.zeros((N, len(free)))
-    sp[:, :s.shape[1]] = s
-    tol = tr.tol
-    ranked = sp > np.maximum(tol.rank_rtol * sp[:, :1], tol.rank_atol)
-    ranked &= (sp[:, :1] > tol.rank_atol)  # a zero matrix: everything is null space
-    coef = vt[:, :, e_col] * ~ranked
-    out[:, free] = np.einsum("nk,nkj->nj", coef, vt)
-    return out
+class BatchedCurve(Curve):
+    """The Curve's engine on stacks of configurations (one per row), its closure batched."""
+
+    def __init__(self, solver, name, bc):
+        super().__init__(solver, name)
+        self.bc = bc
+
+    def tangents(self, Q, previous):
+        """Unit tangents at the configurations Q, each oriented like the row before it, the first
+        like ``previous`` (``choose_branch``); a zero row where the input cannot move."""
+        U = self.input_directions(self.bc.constraint_jacobians(Q))
+        n = np.linalg.norm(U, axis=1)
+        return self.choose_branch(U / np.where(n > TINY, n, 1.0)[:, None], previous)
+
+    def predict(self, q, t, sigma):
+        return q[None] + (self.scale * t)[None] * sigma[:, None]  # (nq == nv: integrate is a sum)
+
+    def correct(self, predicted, held):
+        Qc, ok, _, _ = self.bc.solve(predicted, frozen=self.frozen(held))
+        ok &= np.all(np.isfinite(Qc), axis=1)
+        Qc[~ok] = predicted[~ok]  # (refused by accept; finite for the tangents)
+        return Qc, ok
+
+    def accept(self, predicted, corrected, sigma, t=None, T=None):
+        """Rows that pass the jump test and, given the tangent t before the stack and the stack's T,
+        have no limit position between them and the row before."""
+        ok = ~jumped(np.linalg.norm((corrected - predicted) / self.scale, axis=1), sigma, self.tol)
+        if T is not None:
+            ok &= ~passes_limit(np.vstack([t[None], T[:-1]]), T, self.ix)
+        return ok
 
 
-def batched_motion(solver, tr, q0, t0, start, stop, steps, fallback, progress=None):
+def batched_motion(solver, curve, q0, t0, start, stop, steps, fallback, progress=None):
     """The grid values from start to stop (steps steps) on q0's branch, batched (see the module
-    docstring).  tr: sweep's _Tracker; t0: its oriented tangent at q0 (the input's component
-    along the motion); fallback(q, x_from, x_to, n): the tracker's SweepResult of n steps;
+    docstring).  curve: the sweep's Curve; t0: its oriented tangent at q0 (the input's component
+    along the motion); fallback(q, x_from, x_to, n): the tracker's Motion of n steps;
     progress(done, total): called as grid values are reached (None: not).
-    Returns (X, Q, limits, stopped, reason, skipped, notes) or None when the mechanism cannot
-    be batched."""
+    Returns a Motion, or None when the mechanism cannot be batched."""
     mech = solver.mech
     bc = batch_closure(mech)
     if bc is None or mech.model.nq != mech.model.nv or bc.target is not None:
         return None
+    c = BatchedCurve(solver, curve.name, bc)
     h = (stop - start) / steps
-    frozen = tuple(sorted(set(tr.frozen_other) | {tr.ix}))
-    X, Q = [float(start)], [np.array(q0, float)]
-    limits, skipped, notes = [], [], []
-    stopped = reason = None
-    q, x, t = Q[0], float(start), np.array(t0, float)
-    u = _tangents(bc, tr, q[None])[0]  # unoriented, for the branch test
+    m = Motion([float(start)], [np.array(q0, float)])
+    q, x, t = m.Q[0], float(start), np.array(t0, float)
     k, size = 0, 16
     while k < steps:
         if progress is not None:
             progress(k, steps)
-        m = min(size, steps - k)
-        js = np.arange(k + 1, k + m + 1)
+        n = min(size, steps - k)
+        js = np.arange(k + 1, k + n + 1)
         xs = start + js * h
         if js[-1] == steps and (xs[-1] - stop) * np.sign(h) > 0:
             xs[-1] = stop
-        sig = (xs - x) / tr.scale[tr.ix] / t[tr.ix]  # predicted steps along the tangent (scaled)
-        pred = q[None] + (tr.scale * t)[None] * sig[:, None]  # (nq == nv: integrate is a sum)
-        Qc, ok, _, _ = bc.solve(pred, frozen=frozen)
-        ok &= np.all(np.isfinite(Qc), axis=1)
-        Qc[~ok] = pred[~ok]  # (refused below; finite for the tangents)
-        jump = np.linalg.norm((Qc - pred) / tr.scale, axis=1)
-        ok &= jump <= np.maximum(0.5 * np.abs(sig), _JUMP_FLOOR)
-        U = _tangents(bc, tr, Qc)
-        prev = np.vstack([u[None], U[:-1]])
-        ok &= np.einsum("ij,ij->i", U, prev) > 0
+        sig = (xs - x) / c.scale[c.ix] / t[c.ix]  # predicted steps along the tangent (scaled)
+        pred = c.predict(q, t, sig)
+        Qc, ok = c.correct(pred, c.ix)
+        T = c.tangents(Qc, t)
+        ok &= c.accept(pred, Qc, sig, t, T)
         bad = np.flatnonzero(~ok)
-        n_ok = int(bad[0]) if len(bad) else m
+        n_ok = int(bad[0]) if len(bad) else n
         if n_ok:
-            X += [float(v) for v in xs[:n_ok]]
-            Q += list(Qc[:n_ok])
-            # the oriented tangent at the last kept configuration
-            w = U[n_ok - 1]
-            nw = np.linalg.norm(w)
-            t_new = w / nw if nw > 0 else t
-            if t_new @ t < 0:
-                t_new = -t_new
-            q, x, t, u, k = Qc[n_ok - 1], float(xs[n_ok - 1]), t_new, U[n_ok - 1], k + n_ok
-        if n_ok == m:
+            m.X += [float(v) for v in xs[:n_ok]]
+            m.Q += list(Qc[:n_ok])
+            q, x, t, k = Qc[n_ok - 1], float(xs[n_ok - 1]), T[n_ok - 1], k + n_ok
+        if n_ok == n:
             size = min(2 * size, LARGEST)
             continue
-        if n_ok == 0 and m <= SMALLEST:  # the smallest chunk fails at once: the tracker takes it
-            res = fallback(q, x, float(xs[-1]), m)
-            notes.append(f"the batched corrector failed at {tr.name} = {x:.9g} (a limit position or a sharp bend "
-                         f"near): the per-step tracker took {m} step{'s' if m > 1 else ''} from there")
-            X += [float(v) for v in res.values[1:]]
-            Q += [np.array(v, float) for v in res.q[1:]]
-            limits += list(res.limits)
-            skipped += list(res.skipped)
-            if res.stopped_at is not None:
-                stopped, reason = res.stopped_at, res.stop_reason
+        if n_ok == 0 and n <= SMALLEST:  # the smallest chunk fails at once: the tracker takes it
+            res = fallback(q, x, float(xs[-1]), n)
+            m.notes.append(f"the batched corrector failed at {c.name} = {x:.9g} (a limit position or a sharp bend "
+                           f"near): the per-step tracker took {n} step{'s' if n > 1 else ''} from there")
+            m.X += [float(v) for v in res.X[1:]]
+            m.Q += [np.array(v, float) for v in res.Q[1:]]
+            m.limits += list(res.limits)
+            m.skipped += list(res.skipped)
+            if res.stopped is not None:
+                m.stopped, m.reason = res.stopped, res.reason
                 break
-            q, x = Q[-1], X[-1]
-            u = _tangents(bc, tr, q[None])[0]
-            nu = np.linalg.norm(u)
-            if not nu > 0:
-                stopped, reason = x, "the mechanism cannot move along this input here"
+            q, x = m.Q[-1], m.X[-1]
+            t_new = c.tangents(q[None], t)[0]
+            if not np.linalg.norm(t_new) > 0:
+                m.stopped, m.reason = x, "the mechanism cannot move along this input here"
                 break
-            t = u / nu if u @ t >= 0 else -u / nu
-            k += m
-            size = 16
+            t, k, size = t_new, k + n, 16
             continue
         size = max(SMALLEST, size // 2)
-    return X, Q, limits, stopped, reason, skipped, notes
+    return m
 
 
 def motion_rates(solver, bc, Q, values: dict):

@@ -12,7 +12,7 @@ system of k quadratics; a dyad's two circles are never concentric where the plan
 - a discriminant that is zero (to round-off: below Tolerances.zero, relative) is a limit
   position: that dyad's two branches are one double root, one mode, not a simple root.
 The real set is therefore complete by construction -- no search, no trace test.  The placing is
-analysis.motion.dyads' own (``_evaluate`` on its ``_Geometry`` and ``_Layout``, every branch
+analysis.motion.dyads' own (its continuation engine, ``ClosedFormCurve``, predicting every branch
 vector at once); each configuration is checked by its closure residual on Pinocchio's closure
 (model.closure) after the same undamped Newton polish as the homotopy's modes.  Where the plan does
 not apply, or a check fails, the caller (analysis.motion.certified) takes the homotopy.
@@ -27,7 +27,7 @@ import numpy as np
 
 from ...model import newton
 from ...model.cuts import Assembly
-from .dyads import _evaluate, _Geometry, _Layout, cached_plan
+from .dyads import ClosedFormCurve, cached_plan
 
 __all__ = ["DyadModes", "dyad_modes", "MAX_DYADS"]
 
@@ -78,14 +78,14 @@ def dyad_modes(solver, values: dict) -> DyadModes | str:
     # configuration placed is checked on Pinocchio's closure below.
     ref = solver.reference()
     q0 = solver.set_inputs(mech.neutral() if ref is None else ref, {n: v for n, v in values.items() if n != name})
-    geo = _Geometry(mech, p, q0, probe=False)
-    if not geo.ok:
-        return geo.reason
     c = mech.coordinate(name)
     start = float(q0[c.idx_q]) if c.nq == 1 else float(np.arctan2(q0[c.idx_q + 1], q0[c.idx_q]))
+    curve = ClosedFormCurve(mech, p, q0, start, probe=False)
+    if not curve.ok:
+        return curve.reason
     x = float(values[name])
     B = 1.0 - 2.0 * ((np.arange(2 ** k)[:, None] >> np.arange(k)[None]) & 1)  # (2^k, k) every branch vector
-    _, discs = _evaluate(geo, p, np.full(len(B), x), start, list(B.T))
+    _, discs = curve.predict(np.full(len(B), x), list(B.T))
     zero = mech.tolerances.zero
     negative = discs < -zero
     # a dyad placed on real links whose discriminant is not a number: its circles are concentric
@@ -98,14 +98,13 @@ def dyad_modes(solver, values: dict) -> DyadModes | str:
     if np.any(near[:, real].sum(axis=0) > 1):
         return "two dyads at a limit position at once"
     clamp = np.where(near.any(axis=0), near.argmax(axis=0), -1)
-    layout = _Layout(mech, p, geo, q0)
     found = []  # [signature, q, Assembly, branch vectors, simple]
     for i in np.unique(clamp[real]):
         cols = np.flatnonzero(real & (clamp == i))
-        poses, d = _evaluate(geo, p, np.full(len(cols), x), start, list(B[cols].T), None if i < 0 else int(i))
+        poses, d = curve.predict(np.full(len(cols), x), list(B[cols].T), None if i < 0 else int(i))
         if np.any(d[np.arange(k) != i] < -zero):
             return "a dyad's discriminant changed sign when another's limit position was placed exactly"
-        Q = layout(poses, len(cols))[0]
+        Q = curve.correct(poses, len(cols))[0]
         for q in Q:
             a = newton.polish(mech.closure, solver._wrap(q), solver.frozen)
             if not a.residual <= mech.tolerances.closure:

@@ -20,7 +20,8 @@ accelerations are the exact derivatives of the closed form: q' rate and q'' rate
 (input acceleration zero, other inputs held), what PositionSolver.rates and
 .accelerations give for a mechanism the inputs determine.
 
-``plan`` says why a mechanism does not decompose (then ``sweep`` runs its tracker);
+``ClosedFormCurve`` is the continuation engine (analysis.motion.continuation's interface) that does
+this; ``plan`` says why a mechanism does not decompose (then ``sweep`` runs another engine);
 ``planar_sweep`` reproduces ``sweep``'s result (limits, turns, circuit, budget) from
 the closed form, every configuration checked by its closure residual first.
 """
@@ -30,16 +31,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pinocchio as pin
 
 from ...model.geometry import cross3, plane_basis
 from ...model.manifold import continuous_angle, set_continuous_angle
 from ...model.planar_graph import DyadPlan, plan
 from ...model.state import KinematicState
 from .batch_sweep import batch_closure
+from .continuation import LIMIT_REASON, locate, returned
 from ..singularities.singular import measures
 
-__all__ = ["Jet", "ClosedFormSweep", "planar_sweep"]
+__all__ = ["Jet", "ClosedFormSweep", "ClosedFormCurve", "planar_sweep", "cached_plan"]
 
 _PARALLEL = 1e-9  # |axis x n| (or |axis . n| of a slide) accepted as parallel (normal) [-]
 _NEAR_LIMIT = 1e-8  # a relative discriminant at q0 below this: q0 is (nearly) a limit position; not handled [-]
@@ -396,10 +397,6 @@ class ClosedFormSweep:
     unit: str
 
 
-_LIMIT_REASON = ("limit position: the passive joints become undetermined (an actuator singularity); "
-                 "the input cannot go further on this branch")
-
-
 def cached_plan(solver, name):
     """model.planar_graph.plan of the solver's mechanism swept along ``name`` with its other inputs
     held (a DyadPlan, or why not), kept in the mechanism's cache."""
@@ -410,16 +407,67 @@ def cached_plan(solver, name):
     return mech.cache[key]
 
 
-def _ready(solver, name, q0):
-    """(plan, geometry, layout) for sweeping ``name`` from q0, or None when the closed form does not apply."""
-    mech = solver.mech
+class ClosedFormCurve:
+    """The closed form's continuation engine (analysis.motion.continuation's interface, every input value
+    at once): the plan ``p``'s dyads read at q0 (input ``start``) and placed at input values.  ``ok`` is
+    False (``reason`` why) when the geometry does not apply; probe=False: no branch is read off q0 (the
+    caller passes its branch vectors, as dyad_modes does for every one of them)."""
+
+    def __init__(self, mech, p: DyadPlan, q0, start, probe: bool = True):
+        self.mech, self.p, self.start = mech, p, start
+        self.geo = _Geometry(mech, p, q0, probe)
+        self.ok, self.reason = self.geo.ok, getattr(self.geo, "reason", None)
+        if self.ok:
+            self.layout = _Layout(mech, p, self.geo, q0)
+            self.branch = None if self.geo.branch is None else list(self.geo.branch)
+
+    def predict(self, xs, branch=None, clamp=None):
+        """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
+        sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
+        at its limit (its discriminant taken as max(disc, 0))."""
+        return _evaluate(self.geo, self.p, xs, self.start, self.branch if branch is None else branch, clamp)
+
+    @staticmethod
+    def accept(discs) -> int:
+        """How many leading values are placed: every discriminant non-negative (past a limit the branch
+        does not exist; its values are NaN)."""
+        bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(discs) else np.zeros(0, int)
+        return int(bad[0]) if len(bad) else discs.shape[1]
+
+    def correct(self, poses, n):
+        """The closed form is exact: the poses of the first n values as joint coordinates
+        (Q with its one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2)."""
+        return self.layout({g: _Pose(_take(q.th, n), _take(q.tx, n), _take(q.ty, n)) for g, q in poses.items()}, n)
+
+    def choose_branch(self, which):
+        """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
+        self.branch[which] = -self.branch[which]
+
+    def locate_limit(self, lo, hi):
+        """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
+        position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
+        on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
+
+        def worst(x):
+            d = self.predict([x])[1][:, 0]
+            return float(np.min(np.where(np.isnan(d), -1.0, d)))
+
+        if not worst(lo) > 0:
+            return None
+        x_lim = locate(worst, lo, hi, xtol=1e-15, maxiter=200)
+        d_lim = self.predict([x_lim])[1][:, 0]
+        which = int(np.argmin(np.abs(np.where(np.isnan(d_lim), np.inf, d_lim))))
+        Q, D, _ = self.correct(self.predict([x_lim], clamp=which)[0], 1)
+        return x_lim, Q, D, which
+
+
+def _ready(solver, name, q0, start):
+    """The ClosedFormCurve for sweeping ``name`` from q0, or None when the closed form does not apply."""
     p = cached_plan(solver, name)
     if isinstance(p, str):
         return None
-    geo = _Geometry(mech, p, q0)
-    if not geo.ok:
-        return None
-    return p, geo, _Layout(mech, p, geo, q0)
+    curve = ClosedFormCurve(solver.mech, p, q0, start)
+    return curve if curve.ok else None
 
 
 def _residuals_ok(mech, Q) -> bool:
@@ -438,16 +486,14 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
     (two limits between grid values, a configuration not closing the loops)."""
-    ready = _ready(solver, name, q0)
-    if ready is None:
+    curve = _ready(solver, name, q0, start)
+    if curve is None:
         return None
-    p, geo, layout = ready
     mech = solver.mech
     max_steps = max_steps or 20 * steps + 100
     h = (stop - start) / steps
     scale = np.where(mech.translational, mech.length, 1.0)
-    branch = list(geo.branch)
-    unwrap = _Unwrap(layout.wrapped)
+    unwrap = _Unwrap(curve.layout.wrapped)
     Xs, Qs, Vs, As, limits = [], [], [], [], []
     count, k_pos, forward = 0, 0.0, True
     stopped = reason = None
@@ -474,20 +520,18 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
             xs[-1] = stop
         if h == 0:
             xs = xs[:1]
-        poses, discs = _evaluate(geo, p, xs, start, branch)
-        bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(p.dyads) else np.zeros(0, int)
-        n_ok = int(bad[0]) if len(bad) else len(xs)
+        poses, discs = curve.predict(xs)
+        n_ok = curve.accept(discs)
         if first and n_ok == 0:
             return None
         if n_ok:
-            sub = {g: _Pose(_take(q.th, n_ok), _take(q.tx, n_ok), _take(q.ty, n_ok)) for g, q in poses.items()}
-            Q, D, DD = layout(sub, n_ok)
+            Q, D, DD = curve.correct(poses, n_ok)
             Q, V, A = unwrap(Q, D, xs[:n_ok]), D * rate, DD * rate * rate
             xs_ok = xs[:n_ok]
             if turn and forward and not first:  # back at the start: the circuit is closed
-                at = np.flatnonzero(np.abs(xs_ok - start) < mech.tolerances.equal * max(1.0, abs(h)))
-                for i in at:
-                    if count + i + 1 > 2 and np.linalg.norm(pin.difference(mech.model, Q[i], q0) / scale) < mech.tolerances.geometry:
+                near = np.flatnonzero(np.abs(xs_ok - start) < mech.tolerances.equal * max(1.0, abs(h)))  # (cheap first)
+                for i in near:
+                    if count + i + 1 > 2 and returned(mech, xs_ok[i], start, h, Q[i], q0, scale):
                         n_ok, closed = int(i) + 1, True
                         Q, V, A, xs_ok = Q[:n_ok], V[:n_ok], A[:n_ok], xs_ok[:n_ok]
                         break
@@ -501,30 +545,19 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
         if n_ok == len(xs):
             continue  # the end of the range (forward), or the budget (back): said at the top
         # a limit position between last_x and xs[n_ok]
-        lo, hi = last_x, float(xs[n_ok])
-
-        def worst(x):
-            d = _evaluate(geo, p, [x], start, branch)[1][:, 0]
-            return float(np.min(np.where(np.isnan(d), -1.0, d)))
-
-        if not worst(lo) > 0:
+        found = curve.locate_limit(last_x, float(xs[n_ok]))
+        if found is None:
             return None  # two limit positions within one step of the grid
-        from scipy.optimize import brentq  # (here: importing scipy.optimize takes 0.3 s, a sweep 20 ms)
-
-        x_lim = brentq(worst, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
-        d_lim = _evaluate(geo, p, [x_lim], start, branch)[1][:, 0]
-        which = int(np.argmin(np.abs(np.where(np.isnan(d_lim), np.inf, d_lim))))
-        poses = _evaluate(geo, p, [x_lim], start, branch, clamp=which)[0]
-        Q, D, _ = layout(poses, 1)
+        x_lim, Q, D, which = found
         q_lim = unwrap(Q, D, np.array([x_lim]))[0]
         if not _residuals_ok(mech, q_lim[None]):
             return None
         sig = measures(mech, q_lim, solver.generic())["actuator"]
         limits.append((float(x_lim), float(sig), q_lim))
         if not turn:
-            stopped, reason = float(x_lim), _LIMIT_REASON
+            stopped, reason = float(x_lim), LIMIT_REASON
             break
-        branch[which] = -branch[which]
+        curve.choose_branch(which)
         forward = not forward
         k_pos = (x_lim - start) / h
         last_x = float(x_lim)
@@ -536,7 +569,7 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
         return None
     if turn and stopped is None and not closed and (stop - last_x) * np.sign(h) > mech.tolerances.equal * max(1.0, abs(stop)):
         stopped, reason = last_x, "the motion did not reach the end of the range"
-    unit = "m" if p.pairs[p.swept].kind == "P" else "rad"
+    unit = "m" if curve.p.pairs[curve.p.swept].kind == "P" else "rad"
     return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 

@@ -2,7 +2,7 @@
 
 One assembly mode is mapped: the first solution at the grid's first corner, and
 from it every cell that continuation reaches, each from a neighbour already
-reached (one input changes), by the sweep's step (analysis.motion.sweep.Neighbour:
+reached (one input changes), by the sweep's step (analysis.motion.continuation.Neighbour:
 tangent predictor, corrector, branch tests).  A step that would jump to another
 branch or cross a limit position is refused, so a cell is either on the mapped
 branch or marked off it (``reached`` False, NaN, no kind): near a fold no cell
@@ -18,7 +18,7 @@ import numpy as np
 
 from ...errors import UsageError, quote, shorten
 from .singular import Generic, measures
-from ..motion.sweep import Neighbour
+from ..motion.continuation import Neighbour
 
 __all__ = ["SingularityMap", "singularity_map", "seams"]
 
@@ -104,7 +104,7 @@ def _apart(mech, q1, q2) -> float:
 def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
-    characteristic length) and -- when the steps (analysis.motion.sweep.Neighbour along x and y) and
+    characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and
     grids are given -- continuation from one does not arrive at the other (a steep but continuous
     stretch near a singular point is no seam).  Continuation round a singular point can come back on
     another sheet: the map's mode is one sheet only up to these seams.  (k, 4) int rows j, i, j2, i2."""
