@@ -163,6 +163,48 @@ def test_coupled_joint_actuator_and_mujoco_inverse_dynamics():
         assert res.actuator_efforts["gripper"][k] == pytest.approx(-res.efforts["right_finger"][k])
 
 
+def test_a_coupled_joints_spring_reaches_its_leader(tmp_path):
+    """The WidowX-form gripper with a spring on the coupled finger (left = -right: stiffness 40 N/m towards
+    left = 0.03 m) and the right finger moving: the right finger's effort holds the left's spring through
+    the coupling, G^T (MuJoCo's qfrc_inverse with the spring, constraints off, plus its dry friction) at
+    every step, and the coupled finger's effort is MuJoCo's own there."""
+    text = (MJCF / "gripper_coupled_slides.xml").read_text().replace(
+        '<joint name="left_finger" ', '<joint name="left_finger" stiffness="40" springref="0.03" ')
+    path = tmp_path / "gripper_spring.xml"
+    path.write_text(text)
+    mech = screwkin.load(path, warn=lambda w: None)
+    fixed = {"waist": 0.2, "shoulder": 0.1, "elbow": 0.4, "wrist": -0.3}
+    res = dynamics(mech, "right_finger", 0.05, -0.035, -0.017, 4, inputs=mech.actuated, fixed=fixed,
+                   gravity=(0, 0, -9.81))
+    assert any("the springs of 'left_finger'" in n for n in res.notes)
+    m, d = _mj(path)
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    G = _coupling_map(mech, m)
+    left = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "left_finger")]
+    for k in range(len(res.values)):
+        for j in range(m.njnt):
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
+            d.qpos[m.jnt_qposadr[j]] = (mech.coupled_values(res.q[k])[name] if name == "left_finger"
+                                        else res.q[k][mech.coordinate(name).idx_q])
+        d.qvel[:] = G @ res.rates[k]
+        d.qacc[:] = G @ res.accelerations[k]
+        mujoco.mj_inverse(m, d)
+        full = d.qfrc_inverse + m.dof_frictionloss * np.sign(d.qvel)
+        tau = G.T @ full
+        for name in mech.actuated:
+            assert res.efforts[name][k] == pytest.approx(tau[mech.coordinate(name).idx_v], rel=1e-9, abs=1e-12)
+        assert res.coupled_efforts["left_finger"][k] == pytest.approx(full[left], rel=1e-9, abs=1e-12)
+    assert abs(40 * (mech.coupled_values(res.q[0])["left_finger"] - 0.03)) > 0.1  # the spring matters here
+    st = statics(mech, res.q[-1], gravity=True)  # at rest: MuJoCo's qfrc_inverse with v = a = 0 (no friction)
+    d.qvel[:] = 0
+    d.qacc[:] = 0
+    mujoco.mj_inverse(m, d)
+    tau = G.T @ d.qfrc_inverse
+    for name in mech.actuated:
+        assert st.efforts[name] == pytest.approx(tau[mech.coordinate(name).idx_v], rel=1e-9, abs=1e-12)
+    assert st.coupled_efforts["left_finger"] == pytest.approx(d.qfrc_inverse[left], rel=1e-9, abs=1e-12)
+
+
 @pytest.mark.skipif(ROBOT_DATA is None, reason="example-robot-data is not installed (pip install example-robot-data)")
 @pytest.mark.parametrize("path", ["panda_description/urdf/panda.urdf", None])
 def test_mimic_dynamics_is_rnea_of_the_uncoupled_model(path):

@@ -306,7 +306,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
         indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
         table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
-        own_coupled = own.coupled_forces(v, a) if own else {}
+        own_coupled = own.coupled_forces(q, v, a) if own else {}
         for name, value in coupled_efforts(mech, q, {k: x[1] for k, x in table.items() if x[0] == "coupled"}).items():
             coupled.setdefault(name, np.zeros(n))[k] = value + own_coupled.get(name, 0.0)
         for name, (kind, wrench, is_open) in table.items():

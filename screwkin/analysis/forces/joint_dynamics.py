@@ -25,9 +25,10 @@ __all__ = ["JointDynamics", "joint_dynamics", "names_text"]
 
 
 class JointDynamics(dict):
-    """The joints' own dynamics a file gives (MJCF armature, damping, frictionloss), as MuJoCo applies
-    them to each degree of freedom; name -> the joint's velocity indices.  Arrays over the model's
-    velocity coordinates: ``armature``, ``damping``, ``frictionloss``."""
+    """The joints' own dynamics a file gives (MJCF armature, damping, frictionloss, a hinge's or slide's
+    spring), as MuJoCo applies them to each degree of freedom; name -> the joint's velocity indices (a
+    mimic joint's: its leader's).  Arrays over the model's velocity coordinates: ``armature``,
+    ``damping``, ``frictionloss``; ``springs`` and ``coupled`` (the mimic joints') by name."""
 
     def __init__(self, mech, joints, coupled):
         super().__init__()
@@ -40,25 +41,32 @@ class JointDynamics(dict):
             self.armature[idx], self.damping[idx], self.frictionloss[idx] = j.armature, j.damping, j.frictionloss
             if j.stiffness:
                 self.springs[j.name] = (int(idx[0]), j.stiffness, j.springref)
-        self._values = mech.joint_values
+        self._values = lambda q: {**mech.joint_values(q), **(mech.coupled_values(q) if coupled else {})}
         # a mimic joint moves at multiplier x its leader's rate: its own terms reach the leader through it
         self.coupled = {c.joint: (c.multiplier, int(mech.coordinate(c.mimics).idx_v), j) for c, j in coupled}
-        for name, (_, iv, _) in self.coupled.items():
+        for name, (_, iv, j) in self.coupled.items():
             self[name] = np.array([iv])
+            if j.stiffness:
+                self.springs[name] = (iv, j.stiffness, j.springref)
         self._zero = mech.tolerances.equal
-        self._continuous = lambda name: mech.coordinate(name).nq == 2
+        # an angle with no whole turns in its value: a continuous joint's, and a mimic hinge's (wrapped)
+        self._continuous = lambda name: (self.coupled[name][2].type in ("revolute", "continuous") if name in self.coupled
+                                         else mech.coordinate(name).nq == 2)
 
     def _terms(self, arm, damp, fl, v, a):
         return arm * a + damp * v + fl * np.where(np.abs(v) > self._zero, np.sign(v), 0.0)
 
-    def coupled_forces(self, v, a) -> dict:
-        """Each mimic joint's own force at (v, a) (its rate and acceleration: multiplier x its leader's)."""
-        return {name: float(self._terms(j.armature, j.damping, j.frictionloss, m * v[iv], m * a[iv]))
+    def coupled_forces(self, q, v, a) -> dict:
+        """Each mimic joint's own force at (q, v, a) (its rate and acceleration: multiplier x its leader's),
+        its spring's with it."""
+        stretch = self.spring_stretch(q) if any(n in self.springs for n in self.coupled) else {}
+        return {name: float(self._terms(j.armature, j.damping, j.frictionloss, m * v[iv], m * a[iv])
+                            + j.stiffness * stretch.get(name, 0.0))
                 for name, (m, iv, j) in self.coupled.items()}
 
     def spring_stretch(self, q) -> dict:
-        """Each spring's stretch x - springref [rad or m] at q (a continuous joint's angle taken within a
-        half turn of springref: its value has no whole turns)."""
+        """Each spring's stretch x - springref [rad or m] at q (a continuous joint's or a mimic hinge's
+        angle taken within a half turn of springref: its value has no whole turns)."""
         values = self._values(q)
         return {n: (wrap_angle(values[n] - ref) if self._continuous(n) else values[n] - ref)
                 for n, (_, _, ref) in self.springs.items()}
@@ -69,9 +77,10 @@ class JointDynamics(dict):
         ``equal``); a mimic joint's, times its multiplier, on its leader's coordinate."""
         out = self._terms(self.armature, self.damping, self.frictionloss, v, a)
         for name, x in self.spring_stretch(q).items():
-            iv, k, _ = self.springs[name]
-            out[iv] += k * x
-        for name, f in self.coupled_forces(v, a).items():
+            if name not in self.coupled:  # a mimic joint's spring is among its coupled forces, below
+                iv, k, _ = self.springs[name]
+                out[iv] += k * x
+        for name, f in self.coupled_forces(q, v, a).items():
             m, iv, _ = self.coupled[name]
             out[iv] += m * f
         return out

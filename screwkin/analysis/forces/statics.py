@@ -162,6 +162,8 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     labels = mech.closure.row_labels()
     coupled = coupled_efforts(mech, q, {x.joint: [v or 0.0 for v in x.wrench] for x in reactions
                                         if x.kind == "coupled"})
+    for name, f in own.coupled_forces(q, np.zeros(nv), np.zeros(nv)).items():  # a coupled joint's spring
+        coupled[name] = coupled.get(name, 0.0) + f
     return StaticsResult(tuple(inputs), efforts, units, tuple(w.tolist()), output, gravity,
                          unbalanced <= tol.balanced * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
                          bool(inputs) and sig < tol.singular, float(sig), amp, L,
