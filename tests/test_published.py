@@ -144,8 +144,18 @@ def test_coupled_joint_actuator_and_mujoco_inverse_dynamics():
     m, d = _mj(path)  # with the file's armature (0.1) and friction loss (0.1), as MuJoCo reads them
     m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     G = _coupling_map(mech, m)
+    _gripper_efforts_are_mujocos(mech, res, m, d, G)
     for k in range(len(res.values)):
-        d.qpos[:] = m.qpos0
+        assert res.actuator_efforts["gripper"][k] == pytest.approx(-res.efforts["right_finger"][k])
+
+
+def _gripper_efforts_are_mujocos(mech, res, m, d, G):
+    """At every step of ``res`` (dynamics of the WidowX-form gripper): each input's effort is G^T of
+    MuJoCo's qfrc_inverse (constraints off) plus the dry friction MuJoCo applies as a constraint
+    (frictionloss x sign(qvel), added), and the coupled finger's effort is that force at its own dof.
+    Returns the coupled finger's dof (d is left at the last step's configuration)."""
+    left = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "left_finger")]
+    for k in range(len(res.values)):
         for j in range(m.njnt):
             name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
             d.qpos[m.jnt_qposadr[j]] = (mech.coupled_values(res.q[k])[name] if name == "left_finger"
@@ -153,14 +163,12 @@ def test_coupled_joint_actuator_and_mujoco_inverse_dynamics():
         d.qvel[:] = G @ res.rates[k]
         d.qacc[:] = G @ res.accelerations[k]
         mujoco.mj_inverse(m, d)
-        # the joints' dry friction is a constraint in MuJoCo, off here: frictionloss x sign(qvel), added
         full = d.qfrc_inverse + m.dof_frictionloss * np.sign(d.qvel)
         tau = G.T @ full
         for name in mech.actuated:
             assert res.efforts[name][k] == pytest.approx(tau[mech.coordinate(name).idx_v], rel=1e-9, abs=1e-12)
-        left = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "left_finger")
-        assert res.coupled_efforts["left_finger"][k] == pytest.approx(full[m.jnt_dofadr[left]], rel=1e-9, abs=1e-12)
-        assert res.actuator_efforts["gripper"][k] == pytest.approx(-res.efforts["right_finger"][k])
+        assert res.coupled_efforts["left_finger"][k] == pytest.approx(full[left], rel=1e-9, abs=1e-12)
+    return left
 
 
 def test_a_coupled_joints_spring_reaches_its_leader(tmp_path):
@@ -180,20 +188,7 @@ def test_a_coupled_joints_spring_reaches_its_leader(tmp_path):
     m, d = _mj(path)
     m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
     G = _coupling_map(mech, m)
-    left = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "left_finger")]
-    for k in range(len(res.values)):
-        for j in range(m.njnt):
-            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)
-            d.qpos[m.jnt_qposadr[j]] = (mech.coupled_values(res.q[k])[name] if name == "left_finger"
-                                        else res.q[k][mech.coordinate(name).idx_q])
-        d.qvel[:] = G @ res.rates[k]
-        d.qacc[:] = G @ res.accelerations[k]
-        mujoco.mj_inverse(m, d)
-        full = d.qfrc_inverse + m.dof_frictionloss * np.sign(d.qvel)
-        tau = G.T @ full
-        for name in mech.actuated:
-            assert res.efforts[name][k] == pytest.approx(tau[mech.coordinate(name).idx_v], rel=1e-9, abs=1e-12)
-        assert res.coupled_efforts["left_finger"][k] == pytest.approx(full[left], rel=1e-9, abs=1e-12)
+    left = _gripper_efforts_are_mujocos(mech, res, m, d, G)  # its qpos is res.q[-1]'s after it
     assert abs(40 * (mech.coupled_values(res.q[0])["left_finger"] - 0.03)) > 0.1  # the spring matters here
     st = statics(mech, res.q[-1], gravity=True)  # at rest: MuJoCo's qfrc_inverse with v = a = 0 (no friction)
     d.qvel[:] = 0

@@ -221,6 +221,18 @@ def test_reductions_give_the_actuator_efforts(tmp_path, capsys):
     assert {t.joint: t.gear for t in back.transmissions()} == {"shoulder": 50.0, "elbow": -20.0}
 
 
+def _inverse_at(mech, res, k, m, d, joints):
+    """MuJoCo's inverse dynamics (mj_inverse on m, d) at step k of the dynamics result ``res``: the named
+    one-coordinate joints at screwkin's q, rates and accelerations there."""
+    for name in joints:
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+        c = mech.coordinate(name)
+        d.qpos[m.jnt_qposadr[j]] = res.q[k][c.idx_q]
+        d.qvel[m.jnt_dofadr[j]] = res.rates[k][c.idx_v]
+        d.qacc[m.jnt_dofadr[j]] = res.accelerations[k][c.idx_v]
+    mujoco.mj_inverse(m, d)
+
+
 def test_reductions_in_dynamics_against_mujoco_inverse_dynamics(tmp_path, capsys):
     """dynamics of the geared arm: at every step each motor's effort is MuJoCo's inverse dynamics on the
     export (qfrc_inverse at the joint, for screwkin's q, rates and accelerations) / the motor's gear."""
@@ -234,13 +246,7 @@ def test_reductions_in_dynamics_against_mujoco_inverse_dynamics(tmp_path, capsys
     m = mujoco.MjModel.from_xml_path(str(out))
     d = mujoco.MjData(m)
     for k in range(len(res.values)):
-        for name in ("shoulder", "elbow"):
-            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
-            c = mech.coordinate(name)
-            d.qpos[m.jnt_qposadr[j]] = res.q[k][c.idx_q]
-            d.qvel[m.jnt_dofadr[j]] = res.rates[k][c.idx_v]
-            d.qacc[m.jnt_dofadr[j]] = res.accelerations[k][c.idx_v]
-        mujoco.mj_inverse(m, d)
+        _inverse_at(mech, res, k, m, d, ("shoulder", "elbow"))
         for a in range(m.nu):
             j = m.actuator_trnid[a][0]
             actuator = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) + "_motor"
@@ -510,13 +516,7 @@ def test_joint_springs_are_mujocos_inverse_dynamics(tmp_path):
     res = dynamics(mech, "base", 2.0, -0.5, 0.5, 6, inputs=["base", "mid", "tip"], fixed=fixed, gravity=(0, 0, -9.81))
     assert any("the springs of 'mid', 'tip'" in n for n in res.notes)
     for k in range(len(res.values)):
-        for name in ("base", "mid", "tip"):
-            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
-            c = mech.coordinate(name)
-            d.qpos[m.jnt_qposadr[j]] = res.q[k][c.idx_q]
-            d.qvel[m.jnt_dofadr[j]] = res.rates[k][c.idx_v]
-            d.qacc[m.jnt_dofadr[j]] = res.accelerations[k][c.idx_v]
-        mujoco.mj_inverse(m, d)
+        _inverse_at(mech, res, k, m, d, ("base", "mid", "tip"))
         full = d.qfrc_inverse + m.dof_frictionloss * np.sign(d.qvel)
         for name in ("base", "mid", "tip"):
             dof = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]
