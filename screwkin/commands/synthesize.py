@@ -181,7 +181,7 @@ def _realize(design, out, tolerance=None):
     try:
         write_output(tmp, write_urdf(design.linkage))  # (a partial file removed when it fails)
         return check_design(design, tmp, tolerance=tolerance), tmp
-    except BaseException:
+    except BaseException:  # a failed check or Ctrl-C: the temporary file removed, the error goes on
         remove_partial(tmp)
         raise
 

@@ -482,7 +482,7 @@ def save_figure(fig, path: str, close: bool = True):
     plt = _plt()
     try:
         write_figure(fig, path, dpi=110)
-    except BaseException:
+    except BaseException:  # any failure, Ctrl-C too: the figure is closed, the error goes on
         plt.close(fig)
         raise
     if close:

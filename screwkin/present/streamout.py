@@ -53,7 +53,7 @@ class SweepWriter(WholeOrNothing):
                 self._csv.write(sweep_csv(res, motion, first_step=self.rows, header=self.rows == 0))
             if self._parquet_path:
                 self._write_parquet(res, motion)
-        except BaseException:
+        except BaseException:  # a failed write or Ctrl-C: the partial files removed, the error goes on
             self.discard()
             raise
         self.rows += len(res.values)
@@ -83,7 +83,7 @@ class SweepWriter(WholeOrNothing):
                 if f is not None:
                     f.close()
             self._pq_file = self._csv = None
-        except BaseException:
+        except BaseException:  # a failed close or Ctrl-C: the partial files removed, the error goes on
             self.discard()
             raise
 
