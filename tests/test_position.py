@@ -188,7 +188,7 @@ def test_track_refuses_what_it_cannot_reach(tmp_path):
 
 def test_outside_limits_compares_angles_modulo_a_turn(tmp_path):
     from conftest import LINK
-    from screwkin.analysis.motion.position import outside_limits
+    from screwkin.model.limits import outside_limits
 
     body = "".join(LINK.format(n=n) for n in ("a", "b", "c"))
     body += ('<joint name="r" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'

@@ -1,6 +1,7 @@
 """What a closure system closes: the cut joints bound to a model (frames F1, F2 and axes), the
 linear couplings of rolling and screw pairs, the contacts of profiles in a plane, and the closed
-configuration a solve returns.  Plain frozen data; model.closure evaluates their rows.  Also where
+configuration a solve returns.  Plain frozen data (bind_cut makes it from a description's loop joint);
+model.closure evaluates their rows.  Also where
 a rolling or gear pair's pitch curves touch (pair_contact: the one place that computes it).
 """
 
@@ -9,11 +10,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
+from ..errors import MechanismFileError, quote
+from ..files.description import placement
+from ._pin import frame_id
 from .geometry import plane_basis, wrap_angle
 from .manifold import continuous_angle
 
-__all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact"]
+__all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact", "bind_cut",
+           "virtual_roles", "virtual_joint_name"]
 
 
 @dataclass(frozen=True)
@@ -141,3 +147,63 @@ def pair_contact(pair, M1, M2):
     dist = float(np.linalg.norm(d))
     e = d / dist if dist > 0 else M1.rotation @ u  # concentric (inside): F1's line as the contact direction
     return p1 + float(pair.radius1) * e, a
+
+
+def virtual_roles(c) -> tuple:
+    """The roles of the virtual joints of a rolling, gear or helical loop joint ``c``, in chain order."""
+    if c.type == "helical":
+        return ("turn", "advance")
+    if np.isinf(c.radius1):
+        return ("x", "a2")
+    return ("a1", "a2")
+
+
+def virtual_joint_name(loop_joint: str, role: str) -> str:
+    """The model's name of the virtual joint of ``loop_joint`` in ``role`` (``mesh.a1``)."""
+    return f"{loop_joint}.{role}"
+
+
+def bind_cut(model, c, coordinates: dict, path: str) -> tuple:
+    """(CutJoint, its extra row or None, the names of its virtual chain's joints or ()) of the
+    description's loop joint ``c`` on ``model`` (its frames F1, F2 are added to the model): what closes
+    the loop there -- the cut joint itself; for a rolling, gear or helical pair a weld from its virtual
+    chain's end (model.loader._virtual_pairs) to F2 and a coupling row; for a sliding contact a planar
+    joint and a contact row.  ``coordinates``: joint name -> Mechanism's Coordinate."""
+    ids = []
+    for k, (frame, xyz, rpy) in enumerate(((c.frame1, c.xyz1, c.rpy1), (c.frame2, c.xyz2, c.rpy2)), 1):
+        fid = frame_id(model, frame)
+        if fid is None:
+            raise MechanismFileError(path, f"loop joint {quote(c.name)} names frame {quote(frame)}, which is not "
+                                           "in the model")
+        parent = model.frames[fid]
+        new = pin.Frame(f"{c.name}@F{k}", parent.parentJoint, fid, parent.placement * placement(xyz, rpy),
+                        pin.FrameType.OP_FRAME)
+        ids.append(model.addFrame(new, False))
+    axis, axis2 = tuple(c.axis), tuple(c.axis2) if c.axis2 is not None else None
+    if c.type in ("rolling", "gear", "helical"):
+        # the joints loader._virtual_pairs named, by role: names are built, never parsed (a loop
+        # joint's name may hold dots, and "a" and "a.x" may both be loop joints)
+        roles = virtual_roles(c)
+        names = tuple(virtual_joint_name(c.name, role) for role in roles)
+        coord = {role: coordinates[name] for role, name in zip(roles, names)}
+        if c.type == "helical":  # advance - lead turn / 2 pi = 0
+            terms = ((coord["advance"], 1.0), (coord["turn"], -c.lead / (2 * np.pi)))
+            kind = "lead"
+        elif np.isinf(c.radius1):  # x + r2 a2 = 0 with a2 = -q
+            terms = ((coord["x"], 1.0), (coord["a2"], -c.radius2))
+            kind = "roll"
+        else:  # r1 a1 + r2 a2 = 0 outside, r1 a1 - r2 a2 = 0 inside, with a2 = -q
+            sign = -1.0 if c.contact != "internal" else 1.0
+            terms = ((coord["a1"], c.radius1), (coord["a2"], sign * c.radius2))
+            kind = "roll"
+        row = CouplingRow(c.name, kind, tuple((k.idx_q, k.idx_v, v) for k, v in terms))
+        end = model.getFrameId(f"{c.name}@end")
+        return CutJoint(c.name, "fixed", 0, end, ids[1], c.frame1, c.frame2, axis, None, pair=c.type), row, names
+    if c.type == "contact":
+        a = np.asarray(c.axis, float)
+        normal = np.cross(a / np.linalg.norm(a), [1.0, 0.0, 0.0])
+        normal = normal / max(np.linalg.norm(normal), 1e-300)
+        (s1, r1), (s2, r2) = c.profile1, c.profile2
+        row = ContactRow(c.name, ids[0], ids[1], s1, r1, s2, r2, c.contact == "internal", tuple(normal))
+        return CutJoint(c.name, "planar", 3, ids[0], ids[1], c.frame1, c.frame2, axis, None, pair="contact"), row, ()
+    return CutJoint(c.name, c.type, c.dof, ids[0], ids[1], c.frame1, c.frame2, axis, axis2), None, ()

@@ -30,7 +30,8 @@ from ..files.xmlsafe import parse_xml_text, read_regular_file
 from ..tolerances import DEFAULT, Tolerances
 from ._pin import FRAME_PREFERENCE, frame_id
 from .cuts import in_plane
-from .mechanism import Mechanism, virtual_joint_name, virtual_roles
+from .cuts import virtual_joint_name, virtual_roles
+from .mechanism import Mechanism
 
 __all__ = ["load", "rebuild"]
 

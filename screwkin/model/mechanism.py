@@ -18,12 +18,11 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import AssemblyError, MechanismFileError, UsageError, quote
-from ..files.description import MechanismSpec, placement, resolve_actuation
+from ..files.description import MechanismSpec, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
-from ._pin import frame_id
 from .closability import closure_gap, closure_obstacle
 from .closure import ClosureSystem
-from .cuts import Assembly, ContactRow, CouplingRow, CutJoint
+from .cuts import Assembly, bind_cut
 from .geometry import wrap_angle
 from .linalg import null_space, rank
 from .manifold import continuous_angle, set_continuous_angle
@@ -31,20 +30,6 @@ from .topology import build_topology
 from .lengths import characteristic_length
 
 __all__ = ["Mechanism", "Coordinate"]
-
-
-def virtual_roles(c) -> tuple:
-    """The roles of the virtual joints of a rolling, gear or helical loop joint ``c``, in chain order."""
-    if c.type == "helical":
-        return ("turn", "advance")
-    if np.isinf(c.radius1):
-        return ("x", "a2")
-    return ("a1", "a2")
-
-
-def virtual_joint_name(loop_joint: str, role: str) -> str:
-    """The model's name of the virtual joint of ``loop_joint`` in ``role`` (``mesh.a1``)."""
-    return f"{loop_joint}.{role}"
 
 
 @dataclass(frozen=True)
@@ -93,7 +78,14 @@ class Mechanism:
         self._coupled = {c.joint: c for c in self.couplings}
         self.extra_rows = []  # rows of higher pairs (model.cuts.CouplingRow / ContactRow)
         self.virtual_joints = {}  # higher pair -> the coordinates of its virtual chain
-        self.cuts = [self._bind_cut(c) for c in spec.cut_joints]
+        self.cuts = []
+        for c in spec.cut_joints:
+            cut, row, virtual = bind_cut(model, c, self._coord, self.path)
+            self.cuts.append(cut)
+            if row is not None:
+                self.extra_rows.append(row)
+            if virtual:
+                self.virtual_joints[c.name] = virtual
         # a ground frame for targets (inverse kinematics); every frame must exist
         # before the pinocchio.Data is made from the model
         self.target_frame = model.addFrame(
@@ -149,55 +141,6 @@ class Mechanism:
                 model.gravity = pin.Motion(np.array(key), np.zeros(3))
                 self._gravity_models[key] = model
         return model
-
-    def _frame_id(self, name: str, what: str) -> int:
-        fid = frame_id(self.model, name)
-        if fid is None:
-            raise MechanismFileError(self.path, f"{what} names frame {quote(name)}, which is not in the model")
-        return fid
-
-    def _bind_cut(self, c) -> CutJoint:
-        """The cut joint's frames F1, F2 on the model, and what closes the loop there: the cut
-        joint itself; for a rolling, gear or helical pair a weld from its virtual chain's end
-        (screwkin.model.loader._virtual_pairs) to F2 and a coupling row; for a sliding contact a
-        planar joint and a contact row."""
-        ids = []
-        for k, (frame, xyz, rpy) in enumerate(((c.frame1, c.xyz1, c.rpy1), (c.frame2, c.xyz2, c.rpy2)), 1):
-            fid = self._frame_id(frame, f"loop joint {quote(c.name)}")
-            parent = self.model.frames[fid]
-            frame_placement = parent.placement * placement(xyz, rpy)
-            new = pin.Frame(f"{c.name}@F{k}", parent.parentJoint, fid, frame_placement, pin.FrameType.OP_FRAME)
-            ids.append(self.model.addFrame(new, False))
-        axis, axis2 = tuple(c.axis), tuple(c.axis2) if c.axis2 is not None else None
-        if c.type in ("rolling", "gear", "helical"):
-            # the joints loader._virtual_pairs named, by role: names are built, never parsed (a loop
-            # joint's name may hold dots, and "a" and "a.x" may both be loop joints)
-            roles = virtual_roles(c)
-            names = [virtual_joint_name(c.name, role) for role in roles]
-            coord = {role: self._coord[name] for role, name in zip(roles, names)}
-            self.virtual_joints[c.name] = tuple(names)
-            if c.type == "helical":  # advance - lead turn / 2 pi = 0
-                terms = ((coord["advance"], 1.0), (coord["turn"], -c.lead / (2 * np.pi)))
-                kind = "lead"
-            elif np.isinf(c.radius1):  # x + r2 a2 = 0 with a2 = -q
-                terms = ((coord["x"], 1.0), (coord["a2"], -c.radius2))
-                kind = "roll"
-            else:  # r1 a1 + r2 a2 = 0 outside, r1 a1 - r2 a2 = 0 inside, with a2 = -q
-                sign = -1.0 if c.contact != "internal" else 1.0
-                terms = ((coord["a1"], c.radius1), (coord["a2"], sign * c.radius2))
-                kind = "roll"
-            self.extra_rows.append(CouplingRow(c.name, kind, tuple((k.idx_q, k.idx_v, v) for k, v in terms)))
-            end = self.model.getFrameId(f"{c.name}@end")
-            return CutJoint(c.name, "fixed", 0, end, ids[1], c.frame1, c.frame2, axis, None, pair=c.type)
-        if c.type == "contact":
-            a = np.asarray(c.axis, float)
-            normal = np.cross(a / np.linalg.norm(a), [1.0, 0.0, 0.0])
-            normal = normal / max(np.linalg.norm(normal), 1e-300)
-            (s1, r1), (s2, r2) = c.profile1, c.profile2
-            self.extra_rows.append(ContactRow(c.name, ids[0], ids[1], s1, r1, s2, r2, c.contact == "internal",
-                                              tuple(normal)))
-            return CutJoint(c.name, "planar", 3, ids[0], ids[1], c.frame1, c.frame2, axis, None, pair="contact")
-        return CutJoint(c.name, c.type, c.dof, ids[0], ids[1], c.frame1, c.frame2, axis, axis2)
 
     def set_actuated(self, actuated=None):
         """Choose the actuated joints (None: the file's declaration)."""

@@ -11,7 +11,7 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
-from ..analysis.motion.position import PositionResult
+from ..analysis.motion.solution import PositionResult
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
 from ..analysis.singularities.singular import SingularityReport

@@ -45,7 +45,7 @@ from ...model.linalg import rank
 from ...model.state import KinematicState
 from ..singularities.batch import SerialJacobians
 from ..motion.batch_closure import BatchClosure, Unbatchable
-from ..motion.position import within_limits
+from ...model.limits import within_limits
 from ..singularities.singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions
 

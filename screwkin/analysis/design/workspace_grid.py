@@ -17,7 +17,7 @@ from ...model.linalg import rank
 from ...model.newton import damped_steps
 from ..motion.batch_closure import BatchClosure
 from ..motion.continuation import jumped, keeps_orientation
-from ..motion.position import within_limits
+from ...model.limits import within_limits
 
 __all__ = ["Grid", "grid_axes", "null_motions", "MAX_POINTS"]
 

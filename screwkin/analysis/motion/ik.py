@@ -16,7 +16,8 @@ from ...model.linalg import rank
 from ...model.state import KinematicState, angular_loop_joints, model_with_output
 from ...model.topology import frame_link
 from . import certified
-from .position import PositionResult, PositionSolver
+from .position import PositionSolver
+from .solution import PositionResult
 
 __all__ = ["inverse_kinematics", "Branches", "branches"]
 

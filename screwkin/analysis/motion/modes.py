@@ -116,7 +116,7 @@ def connected(solver, q1, q2, pieces: int = 12) -> bool:
 
 
 class ModeLabels:
-    """The labels of analysis.motion.position.Solution.labels for one solver: built once (the prismatic
+    """The labels of analysis.motion.solution.Solution.labels for one solver: built once (the prismatic
     legs between a pivot and a far joint, with their signed length at the reference configuration,
     and the links that only translate, with their reference orientation), then read at each
     solution.  Nothing is labelled for mechanisms without loops or without a reference."""

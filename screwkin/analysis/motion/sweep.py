@@ -23,7 +23,7 @@ from ...model.geometry import wrap_angle
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .continuation import Curve, Motion, Stuck, continuation_steps
 from .dyads import cached_plan, planar_sweep
-from .position import outside_limits
+from ...model.limits import outside_limits
 from .tracker import Tracker
 from ..singularities.singular import scaled_jacobians
 
