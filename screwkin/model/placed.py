@@ -20,6 +20,7 @@ from ..files.exporter import PlacedBody, PlacedCompound, PlacedCut, PlacedJoint,
 from ..files.mjcf_equality import matrix_quat
 from ..tolerances import DEFAULT
 from .geometry import perpendicular_basis, wrap_angle
+from .manifold import continuous_angle
 from .state import KinematicState
 from .topology import build_topology, frame_link
 
@@ -140,7 +141,7 @@ def _placed_joint(mech, q, j, kind, values, empty, axis=None, pos=(0.0, 0.0, 0.0
     rng = None
     coord = next((c for c in mech.coordinates if c.joint == j.name), None)
     if kind in ("hinge", "slide") and coord is not None:
-        value = float(q[coord.idx_q])
+        value = float(q[coord.idx_q]) if coord.nq == 1 else continuous_angle(q, coord.idx_q)  # a turn's (cos, sin)
         values[j.name] = value
         lo, hi = model.lowerPositionLimit[coord.idx_q], model.upperPositionLimit[coord.idx_q]
         if abs(lo) < _NO_LIMIT and abs(hi) < _NO_LIMIT:
@@ -150,8 +151,9 @@ def _placed_joint(mech, q, j, kind, values, empty, axis=None, pos=(0.0, 0.0, 0.0
                 empty.append(j.name)
     axis = tuple(float(a) for a in j.axis) if axis is None else axis
     dyn = dict(j.dynamics)
-    if "springref" in dyn and coord is not None:  # the joint's zero moves to its value at q, as its range does
-        dyn["springref"] -= mech.joint_values(q)[j.name]
+    if "springref" in dyn and j.name in values:  # the joint's zero moves to its value at q, as its range does
+        rest = dyn["springref"] - values[j.name]  # a hinge's within half a turn (analysis/forces/joint_dynamics)
+        dyn["springref"] = wrap_angle(rest) if kind == "hinge" else rest
     return PlacedJoint(j.name, kind, axis, rng, tuple(dyn.items()), tuple(float(x) for x in pos))
 
 

@@ -49,9 +49,9 @@ class JointDynamics(dict):
             if j.stiffness:
                 self.springs[name] = (iv, j.stiffness, j.springref)
         self._zero = mech.tolerances.equal
-        # an angle with no whole turns in its value: a continuous joint's, and a mimic hinge's (wrapped)
-        self._continuous = lambda name: (self.coupled[name][2].type in ("revolute", "continuous") if name in self.coupled
-                                         else mech.coordinate(name).nq == 2)
+        # a hinge's angle is known modulo a turn (a solve gives it in (-pi, pi]): its spring's stretch too
+        self._angular = lambda name: (self.coupled[name][2].type in ("revolute", "continuous") if name in self.coupled
+                                      else not mech.translational[mech.coordinate(name).idx_v])
 
     def _terms(self, arm, damp, fl, v, a):
         return arm * a + damp * v + fl * np.where(np.abs(v) > self._zero, np.sign(v), 0.0)
@@ -65,10 +65,10 @@ class JointDynamics(dict):
                 for name, (m, iv, j) in self.coupled.items()}
 
     def spring_stretch(self, q) -> dict:
-        """Each spring's stretch x - springref [rad or m] at q (a continuous joint's or a mimic hinge's
-        angle taken within a half turn of springref: its value has no whole turns)."""
+        """Each spring's stretch x - springref [rad or m] at q; a hinge's within half a turn of springref
+        (its angle is known modulo a turn: a spring wound further than half a turn is not represented)."""
         values = self._values(q)
-        return {n: (wrap_angle(values[n] - ref) if self._continuous(n) else values[n] - ref)
+        return {n: (wrap_angle(values[n] - ref) if self._angular(n) else values[n] - ref)
                 for n, (_, _, ref) in self.springs.items()}
 
     def force(self, q, v, a) -> np.ndarray:
