@@ -158,3 +158,32 @@ def test_dask_workers_give_the_same_designs(tmp_path, capsys):
     there = run_json(capsys, [*argv, "--workers", "2", "-o", str(tmp_path / "b.urdf")])
     assert there["search"]["where"] == "local cluster, 2 workers"
     assert here["search"]["designs"] == there["search"]["designs"]
+
+
+def test_function_generations_transmission_angle_for_either_crank_sign():
+    """Optimal function generation with the crank pointing against its angle (Freudenstein's negative a)
+    took the crank's angle from the ground line as phi - pi for both signs, so the transmission angle of
+    an input that does not turn fully was taken at the wrong crank position.  A triple rocker (d, a, b,
+    c = 1, 0.7, 0.6, 0.5: s + l > p + q) held at one crank angle: mu is measured on the construction
+    itself, A = A0 + sa a (cos phi, sin phi) with A0 = (d, 0), B the circles' intersection on the
+    branch, mu the angle between B - A and B - B0 (B0 at the origin)."""
+    import math
+
+    from screwkin.analysis.design.synthesis.constraints import Constraints
+    from screwkin.analysis.design.synthesis.optimal_function import _errors
+
+    d, a, b, c = 1.0, 0.7, 0.6, 0.5
+    X = np.array([[a, b, c]])
+    for sa, phi in ((1.0, 2.8), (-1.0, 0.3)):  # a crank position where the loop closes, for each sign
+        task = {"ground": d, "p0": phi, "p1": phi}
+        for sigma in (1.0, -1.0):
+            A = np.array([d + sa * a * math.cos(phi), sa * a * math.sin(phi)])
+            z = np.hypot(*A)
+            along = (b * b - c * c + z * z) / (2 * z)
+            e = -A / z
+            B = A + along * e + sigma * math.sqrt(b * b - along ** 2) * np.array([-e[1], e[0]])
+            u, v = B - A, B
+            mu = math.acos(u @ v / np.linalg.norm(u) / np.linalg.norm(v))
+            _, _, (lo, hi) = _errors(X, ["a", "b", "c"], task, (sigma, sa, 1.0), Constraints(), 1e-9,
+                                     np.array([phi]), np.array([0.0]))
+            assert float(lo[0]) == pytest.approx(mu, abs=1e-12) and float(hi[0]) == pytest.approx(mu, abs=1e-12)

@@ -74,7 +74,8 @@ def _errors(X, names, task, signs, constraints, equal, phi, psi):
     err = wrap_angle(np.arctan2(B[..., 1], B[..., 0]) + (math.pi if sc < 0 else 0.0) - psi[None], upper=True)
     apart = np.maximum(-h2, 0).sum(axis=1) / d ** 2
     g = d
-    mu_lo, mu_hi = motion_mu(g, a, b, c, task["p0"] - math.pi, task["p1"] - task["p0"], equal)
+    phi0 = task["p0"] - (math.pi if sa > 0 else 0.0)  # the crank from the ground line A0 -> B0 (along -x)
+    mu_lo, mu_hi = motion_mu(g, a, b, c, phi0, task["p1"] - task["p0"], equal)
     A0 = B0 + np.stack([d, np.zeros_like(d)], -1)
     pen = constraints.penalty(A0, B0, g, a, b, c, mu_lo, mu_hi, task["ground"]) + apart
     return err, pen, (mu_lo, mu_hi)
