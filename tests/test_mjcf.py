@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import DATA
+from conftest import DATA, screwkin_cli
 from screwkin.cli import main
 
 mujoco = pytest.importorskip("mujoco")
@@ -257,3 +257,20 @@ def test_weld_relpose_is_read_as_mujocos_engine_reads_it(tmp_path):
     np.testing.assert_allclose(d.efc_pos[:d.ne], 0, rtol=0, atol=1e-12)
     mech = screwkin.load(f, warn=lambda w: None)
     np.testing.assert_allclose(mech.closure.residual(mech.neutral()), 0, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("second, words", [
+    ('joint1="j2" joint2="j1" polycoef="0 0.5 0 0 0"', "go round in a circle"),
+    ('joint1="j1" joint2="j2" polycoef="0 3 0 0 0"', "is coupled by two <equality><joint> elements"),
+])
+def test_equality_joint_cycles_and_doubles_are_refused(tmp_path, second, words):
+    """Two <equality><joint> that go round (j1 = 2 j2, j2 = 0.5 j1) were resolved into j1 mimicking
+    j1 and Pinocchio's own error; one joint coupled twice kept the last silently.  Both are a one-line
+    error naming the joint, exit 1."""
+    path = tmp_path / "cycle.xml"
+    path.write_text('<mujoco><worldbody><body><joint name="j1" type="hinge"/><geom size=".1" mass="1"/><body>'
+                    '<joint name="j2" type="hinge"/><geom size=".1" mass="1"/></body></body></worldbody><equality>'
+                    f'<joint joint1="j1" joint2="j2" polycoef="0 2 0 0 0"/><joint {second}/></equality></mujoco>')
+    done = screwkin_cli("mobility", str(path))
+    assert done.returncode == 1 and words in done.stderr and "'j1'" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr

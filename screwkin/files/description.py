@@ -29,6 +29,7 @@ __all__ = [
     "MechanismSpec",
     "placement",
     "resolve_actuation",
+    "resolve_chains",
     "Limits",
     "LIMITS",
     "data_bytes",
@@ -205,6 +206,27 @@ class Coupling:
     mimics: str
     multiplier: float
     offset: float
+
+
+def resolve_chains(links: dict, circle) -> list:
+    """The Couplings of ``links`` (joint -> (joint it follows, multiplier, offset)), each resolved to the
+    first joint of its chain: j = m k + o with k = m' p + o' gives j = (m m') p + (m o' + o).  A chain
+    that goes round in a circle gives no coupling: ``circle(joint)`` is told (a reader's warning or
+    problem)."""
+    out = []
+    for name in links:
+        target, mult, off = links[name]
+        seen = {name}
+        while target in links:
+            if target in seen:
+                circle(name)
+                break
+            seen.add(target)
+            t2, m2, o2 = links[target]
+            target, mult, off = t2, mult * m2, mult * o2 + off
+        else:
+            out.append(Coupling(name, target, float(mult), float(off)))
+    return out
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ import pinocchio as pin
 
 from ..errors import MechanismFileError, quote, shorten
 from ..tolerances import DEFAULT
-from .description import JOINT_DYNAMICS, LIMITS, Coupling, JointSpec, LinkSpec, MechanismSpec
+from .description import JOINT_DYNAMICS, LIMITS, JointSpec, LinkSpec, MechanismSpec, resolve_chains
 from .mjcf_equality import quat_matrix, read_equalities
 from .mjcf_include import expand_includes
 from .inertia import inertia_problem
@@ -379,7 +379,16 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                 body(e, "world", cls, T)
     p.fail_if_any(path)
     cuts, couplings = read_equalities(r, world, sites, mjoints, reference, set(mjoints) | set(links))
-    couplings = _resolve_chains(couplings)
+    chains = {}
+    for c in couplings:
+        if c.joint in chains:
+            p.append(f"joint {quote(c.joint)} is coupled by two <equality><joint> elements: screwkin holds one "
+                     "coupling per joint")
+        chains[c.joint] = (c.mimics, c.multiplier, c.offset)
+    couplings = resolve_chains(chains, lambda name: p.append(
+        f"the <equality><joint> couplings of joint {quote(name)} go round in a circle: screwkin holds a coupling "
+        "only to a joint that moves on its own"))
+    p.fail_if_any(path)
     tendons = read_tendons(r, mjoints)
     transmissions, inputs, unused = read_actuators(r, mjoints, tendons, {c.joint: c for c in couplings})
     p.fail_if_any(path)
@@ -406,21 +415,6 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                          cut_joints=cuts, transmissions=transmissions, warnings=r.warnings,
                          replacements=replacements, couplings=couplings,
                          package_dirs=[str(d) for d in package_dirs or ()], inputs=inputs, reference=reference)
-
-
-def _resolve_chains(couplings):
-    """Couplings with a chain (a joint coupled to a coupled joint) resolved to its first joint, as
-    <mimic> chains are (files/urdf.py)."""
-    by = {c.joint: c for c in couplings}
-    out = []
-    for c in couplings:
-        target, mult, off, seen = c.mimics, c.multiplier, c.offset, {c.joint}
-        while target in by and target not in seen:
-            seen.add(target)
-            t = by[target]
-            target, mult, off = t.mimics, mult * t.multiplier, mult * t.offset + off
-        out.append(Coupling(c.joint, target, mult, off))
-    return out
 
 
 def _inertia_xml(com, mass, I):

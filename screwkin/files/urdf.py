@@ -23,11 +23,11 @@ from .description import (
     LIMITS,
     PROFILE_SHAPES,
     TREE_JOINT_DOF,
-    Coupling,
     CutJointSpec,
     JointSpec,
     LinkSpec,
     MechanismSpec,
+    resolve_chains,
     TARGET_KINDS,
     TARGETS_NS,
     TargetSpec,
@@ -499,20 +499,8 @@ def _couplings(joints, problems, warnings) -> list:
             warnings.append(why)
         else:
             raw[j.name] = (target, mult, off)
-    out = []
-    for name in raw:
-        target, mult, off = raw[name]
-        seen = {name}
-        while target in raw:
-            if target in seen:
-                warnings.append(f"the <mimic> couplings of joint {quote(name)} go round in a circle: ignored")
-                break
-            seen.add(target)
-            t2, m2, o2 = raw[target]
-            target, mult, off = t2, mult * m2, mult * o2 + off
-        else:
-            out.append(Coupling(name, target, float(mult), float(off)))
-    return out
+    return resolve_chains(raw, lambda name: warnings.append(
+        f"the <mimic> couplings of joint {quote(name)} go round in a circle: ignored"))
 
 
 def _read_targets(root, links, joint_names, problems) -> tuple:
