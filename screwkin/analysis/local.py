@@ -395,12 +395,20 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
         candidates = [_Candidate(np.eye(d), list(np.eye(d))[:MAX_DIRECTIONS] + _mixes(d), True, False)]
     else:
         candidates = _cone(F2, zero, int(tol.local_starts), tol)
+    # two or more forms on a kernel of dimension 3 or more: their common zeros are searched from starting
+    # directions (_sampled_zeros), which finds them but cannot prove there are no others
+    sampled = d + int(tol.local_starts) if c2 > 1 and d > 2 else 0
     if c2 and not candidates:
-        how = (f"order 2: {_forms(c2)} of the loops on ker K (dimension {d}) "
-               f"{'have no common real zero' if c2 > 1 else 'has no real zero'} but 0: no motion leaves this "
-               "configuration")
-        return LocalAnalysis(**base, finite_mobility=0, kind="shaky", order=2, checked_order=2, certain=True,
-                             decided_by=how, branches=(), notes=tuple(notes))
+        if sampled:
+            how = (f"order 2: {_forms(c2)} of the loops on ker K (dimension {d}): no common real zero but 0 found "
+                   f"from {sampled} starting directions (sampled, not proved): no motion found leaving this "
+                   "configuration")
+        else:
+            how = (f"order 2: {_forms(c2)} of the loops on ker K (dimension {d}) "
+                   f"{'have no common real zero' if c2 > 1 else 'has no real zero'} but 0: no motion leaves this "
+                   "configuration")
+        return LocalAnalysis(**base, finite_mobility=0, kind="shaky", order=2, checked_order=2,
+                             certain=not sampled, decided_by=how, branches=(), notes=tuple(notes))
     branches, failed = [], []
     for cand in candidates:
         reached, X0 = order_max, None
@@ -417,7 +425,7 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
             continue
         branch = _branch(mech, q, system, N, cand, X0, order_max)
         branches.append(branch)
-    return _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max, notes, d)
+    return _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled)
 
 
 def _mixes(d, count=2, seed=0):
@@ -442,8 +450,9 @@ def _branch(mech, q, system, N, cand, X, order) -> Branch:
                   confirmed, float(tol.local_step), deviation, residual)
 
 
-def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max, notes, d):
-    """The kind, finite mobility, order and words from the surviving branches."""
+def _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled):
+    """The kind, finite mobility, order and words from the surviving branches (``sampled``: the number of
+    starting directions the quadratic cone's zeros were searched from, 0 where they are found exactly)."""
     notes = list(notes)
     common = {k: v for k, v in base.items()}
     regular_roots = all(c.regular for c in candidates) and c2 > 0
@@ -474,7 +483,8 @@ def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max,
             kind = "singular"
     else:
         kind = "bifurcation" if len(mobilities) == 1 else "kinematotropic"
-    certain = regular_roots and c0 == 0 and not failed and not unconfirmed and all(b.linear for b in branches)
+    certain = (regular_roots and c0 == 0 and not failed and not unconfirmed and all(b.linear for b in branches)
+               and not sampled)
     if certain:
         order = 2
         how = (f"order 2: {_forms(c2)} on ker K (dimension {d}) {'vanish' if c2 > 1 else 'vanishes'} on "
@@ -487,7 +497,9 @@ def _decide(mech, base, system, branches, failed, c2, c0, candidates, order_max,
                f"checked to order {order_max}; not decided beyond")
     else:
         order = order_max
-        how = (f"to order {order_max}: the quadratic cone gives the tangents; "
+        how = (f"to order {order_max}: the quadratic cone gives the tangents"
+               + (f" (its zeros found from {sampled} starting directions: sampled, others not excluded)"
+                  if sampled else "") + "; "
                + (f"{c0} row{'s' if c0 > 1 else ''} vanish identically at order 2 and " if c0 else "")
                + f"the series continues along each branch to order {order_max}; not decided beyond")
     return LocalAnalysis(**common, finite_mobility=int(finite), kind=kind, order=order, checked_order=order_max,
