@@ -55,8 +55,9 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--from", dest="start", required=True, help="first input value (SI or with a unit)")
     sp.add_argument("--to", dest="stop", required=True, help="last input value")
     sp.add_argument("--steps", type=_steps, default=100,
-                    help="number of steps (default 100, at most 100,000; up to 10,000,000 when the sweep only "
-                         "writes --csv/--parquet, computed and written in chunks)")
+                    help=f"number of steps (default 100, at most {BOUNDS['steps'][1]:,}; up to "
+                         f"{BOUNDS['streamed_steps'][1]:,} when the sweep only writes --csv/--parquet, computed and "
+                         "written in chunks)")
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
     add_angle_option(sp)
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
@@ -83,7 +84,7 @@ def add_parser(sub, common, scaled):
 
 
 def _steps(text):
-    """--steps: 1 to 100,000, or to 10,000,000 for a streamed sweep (checked again in run)."""
+    """--steps: within BOUNDS["steps"], or BOUNDS["streamed_steps"] for a streamed sweep (checked again in run)."""
     lo, hi = BOUNDS["steps"]
     try:
         return count("streamed_steps")(text)

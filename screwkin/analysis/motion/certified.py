@@ -210,12 +210,13 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
             certificate, reason = f"{known.bound} {known.of}, the most for {known.what} ({known.source})", ""
         else:
             reason = (f"{reached} {known.of} found of at most {known.bound} for {known.what} ({known.source})"
-                      + (f"; {failed} path(s) failed" if failed else ""))
+                      + (f"; {failed} path(s) failed" if failed else "")
+                      + (f"; {lost} real root(s) did not polish onto Pinocchio's closure" if lost else ""))
     elif roots.complete and failed == 0 and lost == 0:
         certificate, reason = "trace test", ""
     elif roots.complete:
-        reason = (f"{failed} path{'s' if failed != 1 else ''} failed on the way to the inputs" if failed else
-                  f"{lost} real root(s) did not polish onto Pinocchio's closure")
+        reason = "; ".join(([f"{failed} path{'s' if failed != 1 else ''} failed on the way to the inputs"] if failed
+                            else []) + ([f"{lost} real root(s) did not polish onto Pinocchio's closure"] if lost else []))
     if reason and also:
         reason = f"{also}, and {reason}"
     detail = {"roots": int(len(roots.X)), "symmetry": int(full_group.size), "legs_eliminated": len(closure.legs),
@@ -262,9 +263,9 @@ def _lift(solver, problem, closure, x):
 
 
 def _best_twin(solver, problem, closure, elements, x):
-    """(q, Assembly) of the joint-angle set of this root to report: its twins under the symmetry group
-    polished on Pinocchio's closure, the one within the joint limits (and without a reversed leg or
-    a turned link: analysis.motion.modes) nearest the reference configuration."""
+    """(q, Assembly) of the joint-angle set of this root to report: of its twins under the symmetry group
+    (which place the links alike), the one within the joint limits nearest the reference configuration,
+    polished on Pinocchio's closure."""
     mech, ref = solver.mech, problem.ref
     best = None
     for e in elements:

@@ -139,6 +139,8 @@ class Tracker:
                     if self.back_at_start():
                         m.closed = True
                         break
+                    if self.progress is not None:
+                        self.progress(min(len(m.X), self.steps), self.steps)
                     continue
                 if held is False:
                     break
