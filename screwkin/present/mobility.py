@@ -156,8 +156,12 @@ def screw_theory_rows(r) -> list:
         ("joint coordinates", r.coordinates),
         ("constraint rows (cut joints)", r.constraint_rows),
         ("rank of constraint Jacobian K", r.rank),
-        ("mobility M = coordinates - rank K", r.mobility),
-        ("overconstraint, spatial (rows - rank = M - Kutzbach)", r.overconstraint),
+        *([("mobility M = coordinates - rank K", r.mobility),
+           ("overconstraint, spatial (rows - rank = M - Kutzbach)", r.overconstraint)]
+          if r.generic_mobility in (None, r.mobility) else
+          [(f"mobility M (finite, at {r.local_where}: the local analysis)", r.mobility),
+           ("generic mobility = coordinates - rank K", r.generic_mobility),
+           ("overconstraint, spatial (rows - rank = generic mobility - Kutzbach)", r.overconstraint)]),
         *([(f"redundant constraints {'in the plane (M - Gruebler)' if t.motion_space == 'planar' else 'on the sphere (M - spherical count)'}",
             r.redundant_constraints)] if t.motion_space != "spatial" else []),
         ("idle DOFs", r.idle_dofs),
