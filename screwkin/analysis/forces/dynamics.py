@@ -45,7 +45,7 @@ from ...model.geometry import cross3
 from ...model.state import KinematicState
 from ...tolerances import DEFAULT
 from ..motion.position import PositionSolver
-from .joint_dynamics import joint_dynamics, names_text as _names
+from .joint_dynamics import joint_dynamics, left_out_note, names_text as _names
 from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
                       reaction_joint_id, reaction_table)
 from ..motion.sweep import sweep, sweep_inputs
@@ -264,8 +264,7 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
                      + (f"; the springs of {_names(list(own.springs))}: stiffness * (x - springref), their energy in "
                         "the potential energy" if own.springs else "") + ")")
     if left:
-        notes.append(f"the armature, damping and friction loss of {len(left)} loop joints ({_names(left)}) are not "
-                     "in these efforts: they have no coordinate of their own in the tree")
+        notes.append(left_out_note(left))
     fixed = dict(fixed or {})
     inputs = sweep_inputs(mech, input, fixed) if inputs is None else list(inputs)
     for ld in loads:
@@ -291,8 +290,10 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
             progress(k, n)
         q, v, a = res.q[k], res.rates[k], res.accelerations[k]
         b = pin.rnea(gmodel, data, q, v, a).copy()
+        own_coupled = {}
         if own:
-            b += own.force(q, v, a)
+            joint_force, own_coupled = own.forces(q, v, a)
+            b += joint_force
             friction_at_rest |= own.friction_at_rest(v)
         state = KinematicState(mech, q)
         frames = _load_wrenches(mech, loads, state)
@@ -306,7 +307,6 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
         indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
         table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
-        own_coupled = own.coupled_forces(q, v, a) if own else {}
         for name, value in coupled_efforts(mech, q, {k: x[1] for k, x in table.items() if x[0] == "coupled"}).items():
             coupled.setdefault(name, np.zeros(n))[k] = value + own_coupled.get(name, 0.0)
         for name, (kind, wrench, is_open) in table.items():

@@ -21,7 +21,7 @@ import numpy as np
 from ...errors import quote
 from ...model.geometry import wrap_angle
 
-__all__ = ["JointDynamics", "joint_dynamics", "names_text"]
+__all__ = ["JointDynamics", "joint_dynamics", "left_out_note", "names_text"]
 
 
 class JointDynamics(dict):
@@ -71,19 +71,21 @@ class JointDynamics(dict):
         return {n: (wrap_angle(values[n] - ref) if self._angular(n) else values[n] - ref)
                 for n, (_, _, ref) in self.springs.items()}
 
-    def force(self, q, v, a) -> np.ndarray:
-        """The generalized force that drives them at (q, v, a): armature a + damping v + frictionloss sign(v)
-        + stiffness (x - springref), sign(v) 0 where the joint stands still (|v| within the tolerance
-        ``equal``); a mimic joint's, times its multiplier, on its leader's coordinate."""
+    def forces(self, q, v, a) -> tuple:
+        """(the generalized force that drives them at (q, v, a), each mimic joint's own force): armature a +
+        damping v + frictionloss sign(v) + stiffness (x - springref), sign(v) 0 where the joint stands
+        still (|v| within the tolerance ``equal``); a mimic joint's, times its multiplier, on its leader's
+        coordinate."""
         out = self._terms(self.armature, self.damping, self.frictionloss, v, a)
         for name, x in self.spring_stretch(q).items():
             if name not in self.coupled:  # a mimic joint's spring is among its coupled forces, below
                 iv, k, _ = self.springs[name]
                 out[iv] += k * x
-        for name, f in self.coupled_forces(q, v, a).items():
+        coupled = self.coupled_forces(q, v, a)
+        for name, f in coupled.items():
             m, iv, _ = self.coupled[name]
             out[iv] += m * f
-        return out
+        return out, coupled
 
     def friction_at_rest(self, v) -> set:
         """The joints with friction loss that stand still at v (their dry friction not determined)."""
@@ -115,3 +117,11 @@ def joint_dynamics(mech) -> tuple:
 def names_text(names) -> str:
     """Up to three names, quoted, and ', ...' for more."""
     return f"{', '.join(quote(n, 30) for n in names[:3])}{', ...' if len(names) > 3 else ''}"
+
+
+def left_out_note(left) -> str | None:
+    """The note naming the loop joints whose own dynamics no balance holds (joint_dynamics' second part)."""
+    if not left:
+        return None
+    return (f"the armature, damping, friction loss and springs of {len(left)} loop joints ({names_text(left)}) are "
+            "not in these efforts: they have no coordinate of their own in the tree")

@@ -39,7 +39,7 @@ from ...model.linalg import null_space, rank
 from ...model.state import KinematicState, frame_parent
 from ..screws import Screw, cut_twists, screw_of
 from ..singularities.singular import Generic, measures
-from .joint_dynamics import joint_dynamics, names_text
+from .joint_dynamics import joint_dynamics, left_out_note, names_text
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
            "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts", "compound_joints",
@@ -130,10 +130,12 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     b = np.zeros(nv)
     if gravity:
         b += pin.computeGeneralizedGravity(model, data, q)
-    own, notes = joint_dynamics(mech)[0], []
-    springs = {}
+    own, left = joint_dynamics(mech)
+    notes = [left_out_note(left)] if left else []
+    springs, own_coupled = {}, {}
     if own.springs:  # at rest: only the springs of the joints' own dynamics act (v = a = 0)
-        b += own.force(q, np.zeros(nv), np.zeros(nv))
+        joint_force, own_coupled = own.forces(q, np.zeros(nv), np.zeros(nv))
+        b += joint_force
         springs = {n: -own.springs[n][1] * x for n, x in own.spring_stretch(q).items()}
         notes.append(f"the springs of {names_text(list(springs))} (the file's stiffness and springref) are in the balance")
     if any(own.frictionloss) or any(j.frictionloss for _, _, j in own.coupled.values()):
@@ -162,7 +164,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
     labels = mech.closure.row_labels()
     coupled = coupled_efforts(mech, q, {x.joint: [v or 0.0 for v in x.wrench] for x in reactions
                                         if x.kind == "coupled"})
-    for name, f in own.coupled_forces(q, np.zeros(nv), np.zeros(nv)).items():  # a coupled joint's spring
+    for name, f in own_coupled.items():  # a coupled joint's spring
         coupled[name] = coupled.get(name, 0.0) + f
     return StaticsResult(tuple(inputs), efforts, units, tuple(w.tolist()), output, gravity,
                          unbalanced <= tol.balanced * scale, unbalanced, reactions, int(N.shape[1]) if N.size else 0,
