@@ -17,7 +17,7 @@ from pathlib import Path
 from ..errors import MechanismFileError, quote, shorten
 from .description import LIMITS
 from .xacro import MAX_INCLUDES
-from .xmlsafe import parse_xml_text, read_regular_file
+from .xmlsafe import inside_folder, parse_xml_text, read_regular_file
 
 __all__ = ["expand_includes"]
 
@@ -34,7 +34,7 @@ def expand_includes(root, path) -> int:
             raise MechanismFileError(path, "<include> has no file")
         target = Path(spec) if os.path.isabs(spec) else folder / spec
         real = Path(os.path.realpath(target))
-        if not real.is_relative_to(folder):
+        if not inside_folder(real, folder):
             raise MechanismFileError(path, f"<include file={quote(spec, 60)}> is outside the folder of "
                                            f"{quote(path.name)} (refused: a model reads only files beside it or below)")
         if real in chain:

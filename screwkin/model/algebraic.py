@@ -43,7 +43,7 @@ import pinocchio as pin
 
 from . import algebraic_compiled, compiled as numba_kernels
 from .algebraic_numpy import Placed, rows_all
-from .geometry import quaternion_matrix, quaternion_product, skew
+from .geometry import perpendicular_basis, quaternion_matrix, quaternion_product, skew
 from .legs import distance_legs
 
 __all__ = ["PolynomialClosure", "algebraic_obstacle"]
@@ -202,7 +202,7 @@ class PolynomialClosure:
                 continue
             a = np.asarray(cut.axis, float)
             a = a / np.linalg.norm(a)
-            b1, b2 = _perpendicular(a)
+            b1, b2 = perpendicular_basis(a)
             f1, f2 = cut.frame1, cut.frame2
             frames += [f1, f2]
             t = cut.type
@@ -463,13 +463,5 @@ class PolynomialClosure:
             k = self.f_index[self.output]
             parts += [kin["fp"][:, k].T, kin["fR"][:, :, k].transpose(2, 0, 1).reshape(P, 9)]
         return np.concatenate(parts, 1)
-
-
-def _perpendicular(a):
-    """Two unit vectors completing the unit axis a to an orthonormal basis."""
-    t = np.eye(3)[int(np.argmin(np.abs(a)))]
-    b1 = np.cross(a, t)
-    b1 /= np.linalg.norm(b1)
-    return b1, np.cross(a, b1)
 
 

@@ -272,7 +272,8 @@ def stack_cross(a, b):
 
 
 def quaternion_product(a, b):
-    """Quaternion products a b of stacks (P, 4) in (x, y, z, w) order."""
-    av, aw, bv, bw = a[:, :3], a[:, 3], b[:, :3], b[:, 3]
-    vec = aw[:, None] * bv + bw[:, None] * av + np.cross(av, bv)
-    return np.c_[vec, aw * bw - np.einsum("pi,pi->p", av, bv)]
+    """Hamilton products a b of stacks (P, 4) of quaternions in (x, y, z, w) order (real or complex)."""
+    ax, ay, az, aw = a.T
+    bx, by, bz, bw = b.T
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by + ay * bw + az * bx - ax * bz,
+                     aw * bz + az * bw + ax * by - ay * bx, aw * bw - ax * bx - ay * by - az * bz], axis=1)

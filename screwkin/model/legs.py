@@ -22,6 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..tolerances import DEFAULT
+from .geometry import lines_point
 
 __all__ = ["Leg", "distance_legs", "chain_distance"]
 
@@ -110,11 +111,8 @@ def _common_point(model, data, revs, length, tol):
         points.append(M.translation)
     if np.linalg.matrix_rank(np.array(dirs), tol=tol) < 2:
         return None
-    A = sum(np.eye(3) - np.outer(d, d) for d in dirs)
-    b = sum((np.eye(3) - np.outer(d, d)) @ p for d, p in zip(dirs, points))
-    o = np.linalg.solve(A, b)
-    off = max(np.linalg.norm((np.eye(3) - np.outer(d, d)) @ (o - p)) for d, p in zip(dirs, points))
-    return o if off <= tol * length else None
+    o, off = lines_point(points, dirs, tol)
+    return o if o is not None and off <= tol * length else None
 
 
 def _constant_distance(model, q0, f, chain, revs, centre, length, tol) -> bool:

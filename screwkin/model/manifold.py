@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from .geometry import quaternion_product
+
 __all__ = ["Integrator", "continuous_angle", "set_continuous_angle"]
 
 _VECTOR = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned", "JointModelPX",
@@ -113,14 +115,6 @@ def _exp3(w):
     return np.where((t2 > _TAYLOR)[:, None], far, near)
 
 
-def _product(a, b):
-    """Hamilton products a b of quaternions stored (x, y, z, w)."""
-    ax, ay, az, aw = a.T
-    bx, by, bz, bw = b.T
-    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by + ay * bw + az * bx - ax * bz,
-                     aw * bz + az * bw + ax * by - ay * bx, aw * bw - ax * bx - ay * by - az * bz], axis=1)
-
-
 def _normalize(quat):
     """Pinocchio's quaternion::firstOrderNormalize: times (3 - |q|^2) / 2."""
     return quat * ((3.0 - np.einsum("ni,ni->n", quat, quat)) / 2.0)[:, None]
@@ -134,7 +128,7 @@ def _rotate(quat, x):
 
 
 def _so3(q, v):
-    return _normalize(_product(q, _exp3(v)))
+    return _normalize(quaternion_product(q, _exp3(v)))
 
 
 def _se3(q, v):
@@ -149,7 +143,7 @@ def _se3(q, v):
     wv = np.cross(w, lin)
     trans = lin + a * wv + b * np.cross(w, wv)
     quat = q[:, 3:]
-    turned = _product(quat, _exp3(w))
+    turned = quaternion_product(quat, _exp3(w))
     turned = np.where((np.einsum("ni,ni->n", turned, quat) < 0.0)[:, None], -turned, turned)
     return np.concatenate([_rotate(quat, trans) + q[:, :3], _normalize(turned)], axis=1)
 

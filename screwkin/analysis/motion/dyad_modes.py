@@ -27,6 +27,7 @@ import numpy as np
 
 from ...model import newton
 from ...model.cuts import Assembly
+from ...model.manifold import continuous_angle
 from .dyads import ClosedFormCurve, cached_plan
 
 __all__ = ["DyadModes", "dyad_modes", "MAX_DYADS"]
@@ -79,7 +80,7 @@ def dyad_modes(solver, values: dict) -> DyadModes | str:
     ref = solver.reference()
     q0 = solver.set_inputs(mech.neutral() if ref is None else ref, {n: v for n, v in values.items() if n != name})
     c = mech.coordinate(name)
-    start = float(q0[c.idx_q]) if c.nq == 1 else float(np.arctan2(q0[c.idx_q + 1], q0[c.idx_q]))
+    start = float(q0[c.idx_q]) if c.nq == 1 else float(continuous_angle(q0, c.idx_q))
     curve = ClosedFormCurve(mech, p, q0, start, probe=False)
     if not curve.ok:
         return curve.reason
