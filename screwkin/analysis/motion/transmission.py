@@ -156,7 +156,7 @@ class TransmissionRange:
         return float(max(math.pi / 2 - self.low, self.high - math.pi / 2))
 
 
-def _mu_at(info, phi, equal):
+def _mu_at(info, phi):
     """mu [rad] at input angles phi (from the ground line, or the slide's direction)."""
     L = info.lengths
     if info.kind == "four-bar":
@@ -194,7 +194,7 @@ def transmission_range(info, equal: float) -> TransmissionRange:
             k0 = math.ceil((lo_x - offset - phi) / (2 * math.pi))
             xs += [offset + phi + 2 * math.pi * k for k in range(k0, k0 + 2) if lo_x <= offset + phi + 2 * math.pi * k <= hi_x]
         ends = [lo_x, hi_x]
-    mus = _mu_at(info, np.array(xs + ends) - offset, equal)
+    mus = _mu_at(info, np.array(xs + ends) - offset)
     if ends:  # the limit positions: mu exactly 0 or 180 deg
         mus[len(xs):] = np.where(mus[len(xs):] < math.pi / 2, 0.0, math.pi)
     cand = xs + ends

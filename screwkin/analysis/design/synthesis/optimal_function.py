@@ -23,7 +23,7 @@ from dataclasses import replace
 import numpy as np
 
 from ....errors import UsageError
-from ....model.geometry import wrap_angle
+from ....model.geometry import circle_circle, wrap_angle
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, FunctionResult, SynthesisError
 from .function import function_result, function_task
@@ -64,13 +64,7 @@ def _errors(X, names, task, signs, constraints, equal, phi, psi):
     sigma, sa, sc = signs
     a, b, c, d, B0 = _parts(X, names, task, constraints.bounds)
     A = np.stack([d[:, None] + sa * a[:, None] * np.cos(phi)[None], sa * a[:, None] * np.sin(phi)[None]], -1)
-    dist = np.hypot(A[..., 0], A[..., 1])
-    dist = np.where(dist > 0, dist, 1e-300)
-    along = (b[:, None] ** 2 - c[:, None] ** 2 + dist ** 2) / (2 * dist)
-    h2 = b[:, None] ** 2 - along ** 2
-    e = -A / dist[..., None]  # from A towards B0 (the origin)
-    n = np.stack([-e[..., 1], e[..., 0]], -1)
-    B = A + along[..., None] * e + (sigma * np.sqrt(np.maximum(h2, 0)))[..., None] * n
+    B, h2 = circle_circle(A, b[:, None], np.zeros(2), c[:, None], sigma)  # B0 at the origin
     err = wrap_angle(np.arctan2(B[..., 1], B[..., 0]) + (math.pi if sc < 0 else 0.0) - psi[None], upper=True)
     apart = np.maximum(-h2, 0).sum(axis=1) / d ** 2
     g = d

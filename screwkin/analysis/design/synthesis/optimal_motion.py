@@ -30,7 +30,7 @@ import numpy as np
 from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, Dyad, MotionResult, SynthesisError
-from ....model.geometry import wrap_angle
+from ....model.geometry import circle_circle, wrap_angle
 from .fourbar import pose_matrix, travel_analysis
 from .motion import _base_pole, _burmester_rows, _check_poses, _positions_of, burmester_points, motion_design, poles, scale_of
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, _defect_words, rank_key
@@ -70,14 +70,7 @@ def _driven(A0, a, B0, b, poses, direction, constraints, L, equal):
 
     def at(theta):
         A = A0[:, None, :] + crank[:, None, None] * np.stack([np.cos(theta), np.sin(theta)], -1)
-        d = B0[:, None, :] - A
-        dist = np.hypot(d[..., 0], d[..., 1])
-        dist = np.where(dist > 0, dist, 1e-300)
-        along = (coupler[:, None] ** 2 - rocker[:, None] ** 2 + dist ** 2) / (2 * dist)
-        h2 = coupler[:, None] ** 2 - along ** 2
-        e = d / dist[..., None]
-        n = np.stack([-e[..., 1], e[..., 0]], -1)
-        B = A + along[..., None] * e + (sigma[:, None] * np.sqrt(np.maximum(h2, 0)))[..., None] * n
+        B, h2 = circle_circle(A, coupler[:, None], B0[:, None, :], rocker[:, None], sigma[:, None])
         return A, B, h2
 
     A, B, h2 = at(th)
