@@ -112,7 +112,7 @@ def _candidate_dict(k, c) -> dict:
 def _search_dict(report, constraints) -> dict:
     return {"method": report.method, "runs": report.runs, "evaluations": report.evaluations,
             "seconds": report.seconds, "where": report.where, "seed": report.seed, "constraints": constraints,
-            "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
+            "searched_within": report.box, "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
 
 
 def _dyad_dict(k, d) -> dict:
@@ -188,7 +188,9 @@ def _search_lines(result, constraints) -> list:
     report = result.search
     out = [f"constrained search: {report.method}; {report.runs} run{'s' if report.runs != 1 else ''} "
            f"({report.where}), seed {report.seed}, {report.seconds:.2f} s"]
-    out += [f"  constraint: {c}" for c in constraints] or ["  constraints: none (the search's box: see docs)"]
+    out += [f"  constraint: {c}" for c in constraints] or ["  constraints: none"]
+    if report.box:
+        out.append(f"  searched within: {report.box}")
     unit = "deg" if result.design.kind == "function" else "m"
     rows = []
     for k, c in enumerate(report.candidates):

@@ -32,7 +32,7 @@ from .designs import Candidate, PathResult, SynthesisError
 from ....model.geometry import wrap_angle
 from .fourbar import travel_analysis
 from .path import _residuals, _unpack, coupler_points, path_design, path_points
-from .search import SearchReport, distinct_best, evolve, run_all, task_seed
+from .search import SearchReport, box_text, distinct_best, evolve, run_all, task_seed
 
 __all__ = ["optimal_path", "PENALTY", "SAMPLES"]
 
@@ -66,6 +66,12 @@ def _path_box(pts, constraints, L):
     lower = [*plo, *plo, llo, llo, llo, -3 * L, -3 * L]
     upper = [*phi, *phi, lhi, lhi, lhi, 3 * L, 3 * L]
     return np.array(lower, float), np.array(upper, float)
+
+
+def _box(pts, constraints, L) -> str:
+    """_path_box in words."""
+    lower, upper = _path_box(pts, constraints, L)
+    return box_text(constraints, (lower[0:2], upper[0:2]), (lower[4], upper[4])) + f"; coupler point within {3 * L:.4g} m"
 
 
 def _free_cost(X, pts, sigma, direction, constraints, L, equal):
@@ -273,7 +279,7 @@ def optimal_path(points, timing, constraints, search, tolerance: float = 1e-6, e
     report = SearchReport(f"differential evolution (scipy, best1bin, population {search.popsize} x dimensions, at most "
                           f"{search.generations} generations), then least squares from the best "
                           f"{REFINED} distinct members of each run", len(runs), evaluations, seconds, search.where,
-                          search.seed, listed)
+                          search.seed, listed, _box(pts, constraints, L))
     return PathResult(tuple(map(tuple, pts.tolist())), None if timing is None else tuple(map(float, timing)),
                       tuple(float(wrap_angle(t, upper=True)) if abs(t) < math.pi else float(t) for t in rel),
                       tuple(map(float, errors)),

@@ -28,7 +28,7 @@ from .constraints import grashof_type, motion_mu
 from .designs import Candidate, FunctionResult, SynthesisError
 from .function import function_result, function_task
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, rank_key
-from .search import SearchReport, distinct_best, evolve, run_all, task_seed
+from .search import SearchReport, box_text, distinct_best, evolve, run_all, task_seed
 
 __all__ = ["optimal_function"]
 
@@ -107,7 +107,7 @@ def optimal_function(text, x_range, input_range, output_range, points, spacing, 
     task = function_task(text, x_range, input_range, output_range, points, spacing, ground)
     if constraints.lengths is not None and not 0 < constraints.lengths[0] < constraints.lengths[1]:
         raise UsageError("--lengths: give MIN..MAX with 0 < MIN < MAX")
-    names, _, _ = _unknowns(task, constraints)
+    names, lower, upper = _unknowns(task, constraints)
     runs = [(s, sa, sc) for s in (1.0, -1.0) for sa in (1.0, -1.0) for sc in (1.0, -1.0)]
     jobs = [(task, names, constraints, r, task_seed(search.seed, k), search.generations, search.popsize, equal)
             for k, r in enumerate(runs)]
@@ -141,5 +141,5 @@ def optimal_function(text, x_range, input_range, output_range, points, spacing, 
                           f"{' (the ground line centred in the bounds)' if constraints.bounds else ''} searched: differential "
                           f"evolution (scipy, best1bin), then least squares from the best {REFINED} distinct members "
                           "of each run", len(runs), evaluations, seconds, search.where, search.seed,
-                          tuple(c[0] for c in cands[:search.best]))
+                          tuple(c[0] for c in cands[:search.best]), box_text(constraints, lengths=(lower[0], upper[0])))
     return replace(cands[0][1], search=report)

@@ -34,7 +34,7 @@ from ....model.geometry import circle_circle, wrap_angle
 from .fourbar import pose_matrix, travel_analysis
 from .motion import _base_pole, _burmester_rows, _check_poses, _positions_of, burmester_points, motion_design, poles, scale_of
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, _defect_words, rank_key
-from .search import SearchReport, distinct_best, evolve, run_all, task_seed
+from .search import SearchReport, box_text, distinct_best, evolve, run_all, task_seed
 
 __all__ = ["optimal_motion", "MAX_POSES"]
 
@@ -265,7 +265,8 @@ def optimal_motion(poses, constraints, search, tolerance: float = 1e-9, equal: f
     report = SearchReport(method + ("" if not tasks else "; differential evolution (scipy, best1bin), then the "
                                                          f"refinement of the best {REFINED} distinct members of each "
                                                          "run"), max(len(tasks), 1), evaluations, seconds, search.where,
-                          search.seed, tuple(c[0] for c in cands[:search.best]))
+                          search.seed, tuple(c[0] for c in cands[:search.best]),
+                          box_text(constraints, constraints.pivot_box(np.mean([p[:2] for p in poses], axis=0), L)) if tasks else "")
     pole_list = tuple((i, j, tuple(map(float, P))) for i, j, P in poles(poses))
     return MotionResult(tuple(poses), "constrained search: " + method, (crank, rocker), (0, 1), best.design, (),
                         pole_list, (), report)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Search", "SearchReport", "evolve", "distinct_best", "task_seed"]
+__all__ = ["box_text", "Search", "SearchReport", "evolve", "distinct_best", "task_seed"]
 
 #: Differential evolution's settings: population (times the dimensions: 15, scipy's default, missed the
 #: exact path through 12 points of a coupler curve that 25 to 30 finds), generations, tolerance.
@@ -55,6 +55,22 @@ class SearchReport:
     where: str
     seed: int
     candidates: tuple = ()  # the designs listed (analysis.design.synthesis.designs.Candidate), best first
+    box: str = ""  # where the search looked, as chosen (box_text): what the constraints left to the search
+
+
+def box_text(constraints, pivots=None, lengths=None) -> str:
+    """Where a search looks, in words: the fixed pivots' box ((low, high) corners [m]) and the links'
+    lengths ((low, high) [m]), each said to be the search's own choice where ``constraints`` (a
+    Constraints) does not give it (--bounds, --lengths)."""
+    parts = []
+    if pivots is not None:
+        (x0, y0), (x1, y1) = pivots
+        parts.append(f"fixed pivots in x {x0:.4g} .. {x1:.4g} m, y {y0:.4g} .. {y1:.4g} m"
+                     + ("" if constraints.bounds is not None else " (chosen around the task: --bounds sets it)"))
+    if lengths is not None:
+        parts.append(f"links {lengths[0]:.4g} .. {lengths[1]:.4g} m"
+                     + ("" if constraints.lengths is not None else " (chosen from the task's size: --lengths sets it)"))
+    return "; ".join(parts)
 
 
 def task_seed(seed: int, index: int) -> int:
