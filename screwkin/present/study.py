@@ -174,8 +174,9 @@ def _paths_line(result) -> list:
         why = result.extra.get("family")
         return [f"each design evaluated alone (loaded, assembled, analysed){f': {why}' if why else ''}"]
     lines = [f"{family} designs on the family path (the xacro file expanded once per chunk, each design's file read "
-             "and checked, its four-bar's metrics in closed form over the designs; every chunk checked against "
-             f"designs evaluated alone), {alone} evaluated alone (references and spot checks among them)"]
+             "and checked, its four-bar's Grashof class and transmission angles in closed form over the designs, its "
+             "mobility the chunk's reference design's -- assumed, the structure being the same; each chunk's "
+             f"reference and one design drawn at random also evaluated alone and compared), {alone} evaluated alone"]
     lines += [f"  {n}" for n in result.extra.get("path_notes", ())[:5]]
     return lines
 

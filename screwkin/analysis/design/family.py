@@ -21,7 +21,7 @@ For a chunk of designs (chunk_rows, what a Dask task runs):
    lengths of one order, all axes parallel: M = 1 and the same counts);
 4. a loop whose lengths cannot close is the failed row the single commands give (the same sentence,
    proved from the lengths: model.closability); a loop within the tolerance of closing or not, a
-   link two orders shorter than the longest, axes that are not parallel: evaluated alone;
+   link three orders shorter than the longest, axes that are not parallel: evaluated alone;
 5. one more design, drawn at random (seeded by the chunk), is evaluated alone and must give the
    family path's row to 1e-9; if not, the whole chunk is evaluated design by design (said in the
    notes).
