@@ -109,6 +109,8 @@ def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str |
         if np.all(np.isfinite(y)):
             lines.append(f"actuator {t.actuator!r}: peak |effort| {np.max(np.abs(y)):.6g} (the effort on {t.joint} / "
                          f"{t.scale * t.gear:g}: {t.text()})")
+        else:
+            lines.append(f"actuator {t.actuator!r}: effort not determined (redundant actuation)")
     for name, y in r.coupled_efforts.items():
         lines.append(f"coupled joint {name!r}: peak |effort| {np.max(np.abs(y)):.6g} "
                      f"{r.effort_units[name].replace(' ', '*')} (what its coupling exerts along it)")
