@@ -1,5 +1,6 @@
 import contextlib
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -92,6 +93,17 @@ def circles(p, r, c, s):
     u = (c - p) / d
     n = np.array([-u[1], u[0]])
     return [p + along * u + h * n, p + along * u - h * n]
+
+
+def check_urdf(path) -> str:
+    """urdfdom's check_urdf (an independent URDF parser) run on ``path``: its stdout, the run asserted
+    to succeed; a skip naming it where it is not installed (under CI=true that skip fails the run)."""
+    tool = shutil.which("check_urdf")
+    if tool is None:
+        pytest.skip("urdfdom's check_urdf is not installed")
+    done = subprocess.run([tool, str(path)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout
 
 
 def screwkin_cli(*args, timeout=300):

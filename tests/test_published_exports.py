@@ -4,14 +4,12 @@ universal joints in the tree, the minimal equality rows and the redundant ones n
 against MuJoCo (its own readers, its constraint rows, its simulation), hand formulas and urdfdom's
 check_urdf."""
 
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
 import screwkin
-from conftest import DATA
+from conftest import DATA, check_urdf
 from test_published import simulate  # 1 s of mj_step with 0.05 N m on the motors: MuJoCo's warnings
 from screwkin.analysis.forces.dynamics import dynamics
 from screwkin.analysis.forces.statics import statics
@@ -37,13 +35,6 @@ def same_bodies(original, q, m, d):
         M = data.oMf[original.link_frame(mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b))]
         np.testing.assert_allclose(M.translation, d.xpos[b], rtol=0, atol=1e-12)
         np.testing.assert_allclose(M.rotation, d.xmat[b].reshape(3, 3), rtol=0, atol=1e-12)
-
-
-def check_urdf(path):
-    tool = shutil.which("check_urdf")
-    if tool:
-        done = subprocess.run([tool, str(path)], capture_output=True, text=True, timeout=60)
-        assert done.returncode == 0, done.stdout + done.stderr
 
 
 # ------------------------------------------------------------------ armature, damping, friction loss
