@@ -201,9 +201,16 @@ _RATE_OF = {"angle": "angular rate", "length": "linear rate", "angular rate": "a
            "linear rate": "linear acceleration"}
 
 
+#: Spellings of one unit, written as the tables write it.
+_SPELLED = {"degree": "deg", "degrees": "deg", "°": "deg", "radian": "rad", "radians": "rad", "turns": "turn",
+            "µm": "um", "μm": "um", "inch": "in", "inches": "in", "foot": "ft", "feet": "ft",
+            "rev/min": "rpm", "N*m": "Nm", "N.m": "Nm", "N*mm": "Nmm"}
+
+
 def _written(unit: str) -> str:
-    """A unit as the tables write it: rev/min as rpm, s2 as s^2."""
-    return "rpm" if unit == "rev/min" else unit[:-2] + "s^2" if unit.endswith("/s2") else unit
+    """A unit as the tables write it: one spelling of each (degrees and ° as deg, rev/min as rpm), s2 as s^2."""
+    unit = _SPELLED.get(unit, unit)
+    return unit[:-2] + "s^2" if unit.endswith("/s2") else unit
 
 
 def shown_unit(typed: str, kind: str | None) -> str:
@@ -222,7 +229,7 @@ def shown_unit(typed: str, kind: str | None) -> str:
         base = _written(unit)
         made = base[:-2] + "/s^2" if base.endswith("/s") else base + "/s"
     elif _RATE_OF.get(_RATE_OF.get(found)) == kind:  # deg for an acceleration: deg/s^2
-        made = unit + "/s^2"
+        made = _written(unit) + "/s^2"
     else:
         return si
     return made if made in UNIT_TABLE else si

@@ -28,8 +28,6 @@ __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 NAME = "solve"
 NEEDS_MECHANISM = True
 
-_ANGLE_UNITS = {"deg", "degree", "degrees", "°"}
-
 
 def add_parser(sub, common, scaled):
     sp = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
@@ -125,7 +123,7 @@ def _solve_from_start(mech, args, values, held=None) -> int:
     res = textbook_newton(loops, given, start, args.iterations)
 
     # (--set and --set-angle read again: solve's split_inputs keeps their values, not their units)
-    degrees = any(q.unit in _ANGLE_UNITS for _, q in typed + parse_typed_assignments(args.set, "--set")
+    degrees = any(q.kind == "angle" and q.shown_unit == "deg" for _, q in typed + parse_typed_assignments(args.set, "--set")
                   + parse_typed_assignments(args.set_angle, "--set-angle"))
     lengths = {n: q.shown_unit for n, q in units.items() if q.kind == "length" and loops.symbol_info[n].kind != "angle"}
     show = Units(degrees, lengths)

@@ -250,7 +250,7 @@ def run(mech, args) -> int:
         print(json_of(d))
     else:
         rows = sweep_rows(len(res.values), _rows_option(args.rows))
-        typed_deg = any(q.kind == "angle" and "deg" in q.unit for q in typed_range)
+        typed_deg = any(q.kind == "angle" and q.shown_unit == "deg" for q in typed_range)
         linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
             else []
         for link, angle in held.items():
