@@ -187,7 +187,7 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
         size = int(full_group.orbit_sizes(xf[None], 1e-9)[0])
         sig = solver.signature(q)
         for mode in modes:
-            if np.max(np.abs(mode[0] - sig)) < tol.geometry * max(mech.length, 1.0):
+            if solver.same_mode(mode[0], sig):
                 mode[3] += size
                 mode[4] = mode[4] and not multiple[i] and ends.status[i] == "regular"
                 break
@@ -335,10 +335,9 @@ def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) 
 def join(solver, found, more) -> list:
     """``found`` with the modes of ``more`` that are not already in it (by signature)."""
     out = list(found)
-    tol = solver.mech.tolerances.geometry
     for sig, q, a in more:
         sig = solver.signature(q) if sig is None else sig
-        if not any(np.max(np.abs(sig - (s if s is not None else solver.signature(p)))) < tol for s, p, _ in out):
+        if not any(solver.same_mode(sig, s if s is not None else solver.signature(p)) for s, p, _ in out):
             out.append((sig, q, a))
     return out
 

@@ -113,7 +113,7 @@ def dyad_modes(solver, values: dict) -> DyadModes | str:
                         "the dyads' geometry was not read as Pinocchio places the links")
             q = solver._wrap(a.q)
             sig = solver.signature(q)
-            same = next((m for m in found if np.max(np.abs(m[0] - sig)) < mech.tolerances.geometry * max(mech.length, 1.0)),
+            same = next((m for m in found if solver.same_mode(m[0], sig)),
                         None)
             if same is not None:  # two branch vectors, one placement: a double root
                 same[3] += 1

@@ -203,6 +203,13 @@ class PositionSolver:
             parts.append((self.data.oMi[joint] * placement).homogeneous[:3].ravel() * 0.1)
         return np.concatenate(parts) if parts else np.zeros(0)
 
+    def same_mode(self, sig_a, sig_b) -> bool:
+        """Whether two signatures are one assembly mode: every joint centre (and the output pose) within
+        the geometry tolerance, scaled by the mechanism's size where it is over a metre (the one rule of
+        the random-start search, the homotopy and the closed form)."""
+        return bool(np.max(np.abs(sig_a - sig_b), initial=0.0)
+                    < self.mech.tolerances.geometry * max(self.mech.length, 1.0))
+
     def _starts(self, count, seed):
         """The reference configuration (when there is one), the file's configuration, and
         ``count`` random configurations within the joint limits."""
@@ -363,7 +370,7 @@ class PositionSolver:
                 found.append((None, q, a))
                 continue
             sig = self.signature(q)
-            if any(np.max(np.abs(sig - s)) < self.mech.tolerances.geometry for s, *_ in found):
+            if any(self.same_mode(sig, s) for s, *_ in found):
                 continue
             found.append((sig, q, a))
         return found, best
