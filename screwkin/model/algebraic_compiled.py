@@ -1,7 +1,7 @@
 """The rows of model.algebraic.PolynomialClosure and their Jacobian, compiled (numba; optional).
 
 The same numbers as the numpy evaluation (tests compare the two at random complex points), one
-path at a time in compiled loops, the paths spread over the cores (numba's prange): a homotopy
+path at a time in compiled loops (one core): a homotopy
 tracks tens to thousands of paths, each step evaluating the rows a few times, and numpy's
 overhead per call (about a hundred calls per evaluation) dominates for small stacks.  Used by
 PolynomialClosure when numba imports (``compiled=None``), or when asked (``compiled=True``).

@@ -434,7 +434,8 @@ class Mechanism:
     def assemble(self, q0=None, frozen=(), seed: int = 0) -> Assembly:
         """Close the loops: a seeded search, not a single descent.
 
-        The hint ``q0`` (default: the file's configuration, every joint at zero) is tried
+        The hint ``q0`` (default: the file's configuration, ``neutral()``: every joint at zero, an MJCF
+        joint at its ``ref``) is tried
         first; when damped Newton does not close the loops from it (a file drawn with every
         link along one line has a residual whose gradient vanishes there), perturbations of
         it and then random configurations within the joint limits are tried, in a fixed
@@ -479,7 +480,7 @@ class Mechanism:
         starts = (f"{given}, {min(tol.perturbations, total - 1)} perturbations of it and "
                   f"{max(total - 1 - tol.perturbations, 0)} random configurations within the joint limits"
                   if total > 1 else given)
-        raise AssemblyError(self.path, best, best_it, detail=starts, starts=total, reason=self.closure_obstacle())
+        raise AssemblyError(self.path, best, best_it, detail=starts, starts=total)  # (a proved gap raised above)
 
     def with_rows(self, rows) -> "Mechanism":
         """This mechanism with more closure rows (model.cuts.CouplingRow: a link's absolute angle

@@ -13,7 +13,7 @@ SHARED_DATA_NV coordinates) reads the mechanism's one Data, its pass run again a
   with its angular velocity and acceleration (world axes; twists in (linear, angular) order);
 * any point fixed on a link (coordinates in the link's frame): position, velocity, acceleration;
 * frame and joint placements, joint centres, frame Jacobians, each joint's twists, the tree
-  joints' values by name, the constraint Jacobian K of the loops and K'q';
+  joints' values by name, the constraint Jacobian K of the loops;
 * the output frame a command places on a link (``place_tool``: a tool, a named point), under
   its name like a link, its placement composed with its link's (Pinocchio's frame functions
   of a joint and a placement): it is no frame of the model;
@@ -184,8 +184,8 @@ class PointMotion:
 
 class KinematicState:
     """The kinematics of ``mech`` at ``q`` (and rates ``qd``, accelerations ``qdd``: tangent
-    vectors of the model, (nv,)).  Read-only; every quantity is computed on first use and
-    returned as a copy."""
+    vectors of the model, (nv,)).  Read-only; every quantity is computed when first asked (Pinocchio's
+    pass run again where another state has used the thread's Data since) and returned as a copy."""
 
     def __init__(self, mech, q, qd=None, qdd=None):
         self.mech = mech
@@ -197,7 +197,7 @@ class KinematicState:
                 a.setflags(write=False)
         self._key = next(_KEYS)
 
-    # ------------------------------------------------------------------ Pinocchio, once
+    # ------------------------------------------------------------------ Pinocchio's pass
     def _pass(self, data, jacobians: bool, placed: bool = False):
         """Pinocchio's pass for this state in ``data``: placements, and motions when it has rates
         (unless ``placed``: done already); with ``jacobians`` the joint Jacobians too."""
