@@ -282,10 +282,9 @@ def _animate(mech, args) -> int:
     if limit is not None:
         titles[-1] += " (limit position)"
     space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
-    progress = Progress(label="animate", unit="frame draws (each framed, then drawn)", every=EVERY)  # a terminal
-    n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space,
-                        progress=progress)
-    progress.clear()
+    with Progress(label="animate", unit="frame draws (each framed, then drawn)", every=EVERY) as progress:  # a terminal
+        n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space,
+                            progress=progress)
     if args.json:
         print(json_of({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
                        "input": name, "unit": res.unit, "values": values,

@@ -123,10 +123,9 @@ def run(mech, args) -> int:
     # the mode (--mode K), chosen and said once dynamics has checked the file and the options
     mode = lambda: configuration(mech, args, moved={args.input: start},  # noqa: E731
                                  inputs=inputs or sweep_inputs(mech, args.input, fixed))
-    progress = Progress(label="dynamics", unit="configurations", every=EVERY)  # on a terminal only
-    res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
-                   gravity=gravity, loads=loads, cs=cs, progress=progress, q_start=mode)
-    progress.clear()
+    with Progress(label="dynamics", unit="configurations", every=EVERY) as progress:  # on a terminal only
+        res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
+                       gravity=gravity, loads=loads, cs=cs, progress=progress, q_start=mode)
     if args.csv:
         write_output(args.csv, dynamics_csv(res, shown))
     if args.plot:

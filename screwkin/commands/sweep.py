@@ -122,8 +122,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     topo = None
     pieces, methods, notes, limits, skipped = 0, [], [], [], 0
     last = None
-    progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only
-    with SweepWriter(args.csv, args.parquet) as out:
+    with Progress(label="sweep", unit="steps", every=EVERY) as progress, SweepWriter(args.csv, args.parquet) as out:
         for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, q_start=q_start, rate=rate,
                                   chunk=chunk):
             if topo is None:
@@ -142,7 +141,6 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
             last = piece
             progress(out.rows - 1, args.steps)
         rows = out.rows
-    progress.clear()
     rad = last.unit == "rad"
     files = " and ".join(f for f in (args.csv, args.parquet) if f)
     print(_rates_line(args))
@@ -205,10 +203,9 @@ def run(mech, args) -> int:
     q_start = lambda: configuration(mech, args, moved={args.input: start}, inputs=inputs)  # noqa: E731
     if streamed:
         return _run_streamed(mech, args, solver, start, stop, others, q_start, rate)
-    progress = Progress(label="sweep", unit="steps", every=EVERY)  # on a terminal only
-    res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate, progress=progress,
-                turn=args.turn)
-    progress.clear()
+    with Progress(label="sweep", unit="steps", every=EVERY) as progress:  # on a terminal only
+        res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate,
+                    progress=progress, turn=args.turn)
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 and not held else None

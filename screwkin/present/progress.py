@@ -21,7 +21,8 @@ class Progress:
     """``progress(done, total[, failed])`` of work counted in ``unit``, drawn as
     ``LABEL [####....] done/total UNIT, elapsed, left`` on ``stream`` (default stderr) when it is a
     terminal, at most every ``every`` seconds (0: at every call); ``finish(line)`` clears it and
-    prints the line that stays (always, terminal or not), ``clear()`` only clears it."""
+    prints the line that stays (always, terminal or not), ``clear()`` only clears it (as leaving a
+    ``with`` block does, however the work ended)."""
 
     def __init__(self, stream=None, width: int = 30, label: str = "study", unit: str = "designs",
                  every: float = 0.0):
@@ -50,6 +51,14 @@ class Progress:
                           f"{self.unit}{bad}, {elapsed:.0f} s, {eta:.0f} s left ")
         self.stream.flush()
         self.shown = True
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        """Leaving a ``with`` block, on success or failure (an error, Ctrl-C), removes the line drawn:
+        what is printed next (the result, or the one-line error) starts on a clean line."""
+        self.clear()
 
     def clear(self) -> None:
         """Remove the line drawn (if any), so that what follows starts on a clean line."""
