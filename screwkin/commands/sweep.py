@@ -214,13 +214,11 @@ def run(mech, args) -> int:
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()
     sing = list(res.limits)  # the limit positions met are always listed
-    points = ()
     if args.singularities:
         sing = locate_singularities(solver, res, output=args.output, point=args.point)
         # the configuration space's own singularities (change points, shaky points): analysis.local
-        points = change_points(solver, res, sing)
-        sing = sorted(sing + [SweepSingularity("constraint", p.input, p.sigma, p.q) for p in points if p.located],
-                      key=lambda x: x.input)
+        sing = sorted(sing + [SweepSingularity("constraint", p.input, p.sigma, p.q, point=p)
+                              for p in change_points(solver, res, sing) if p.located], key=lambda x: x.input)
     if args.csv or args.parquet:
         with SweepWriter(args.csv, args.parquet) as out:
             out.write(res, motion)
@@ -236,9 +234,8 @@ def run(mech, args) -> int:
             d["transmission_angles"] = mus
         d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
         for entry, x in zip(d["singularities"], sing):  # what the configuration space does there
-            p = next((p for p in points if x.kind == "constraint" and p.input == x.input), None)
-            if p is not None:
-                entry.update({k: v for k, v in change_point_dict(p).items() if k not in ("input", "sigma")})
+            if x.point is not None:
+                entry.update({k: v for k, v in change_point_dict(x.point).items() if k not in ("input", "sigma")})
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
         d["strokes"] = strokes_dict(slider_strokes)
@@ -271,7 +268,6 @@ def run(mech, args) -> int:
             for x in sing:
                 print(f"  {x.kind:<10} at {res.input} = {value_text(res.input, x.input, res.unit == 'rad')}, "
                       f"relative sigma {x.sigma:.2g}" + ("  (limit position)" if x.limit else ""))
-                p = next((p for p in points if x.kind == "constraint" and p.input == x.input), None)
-                if p is not None:
-                    print("\n".join(change_point_lines(p, "this configuration")))
+                if x.point is not None:
+                    print("\n".join(change_point_lines(x.point, "this configuration")))
     return 0

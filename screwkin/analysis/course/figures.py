@@ -15,7 +15,7 @@ from ..motion.links import motion_along
 from ..motion.position import PositionSolver
 from ..motion.change_points import change_points
 from ..motion.singular_points import locate_singularities
-from ..motion.sweep import sweep
+from ..motion.sweep import SweepSingularity, sweep
 from .skeleton import numbering
 
 __all__ = ["SingularConfiguration", "SingularSearch", "default_output", "input_range", "singular_configurations",
@@ -127,11 +127,10 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
     res = sweep(solver, input_joint, start, stop, steps, fixed=fixed, near=near, turn=True, rate=rate)
     found = locate_singularities(solver, res, output=output)
     points = change_points(solver, res, found)  # change points and shaky points too, each analysed
-    found = found + [SingularConfiguration("constraint", p.input, p.sigma, p.q, False, None) for p in points if p.located]
+    found = found + [SweepSingularity("constraint", p.input, p.sigma, p.q, point=p) for p in points if p.located]
     found.sort(key=lambda s: s.input)
     out = tuple(SingularConfiguration(s.kind, s.input, s.sigma, s.q, s.limit, output if s.kind == "serial" else None,
-                                      next((p for p in points if s.kind == "constraint" and p.input == s.input), None))
-                for s in found)
+                                      s.point) for s in found)
     return SingularSearch(input_joint, res.unit, float(start), float(stop), output, fixed, out, bool(res.limits),
                           res.circuit_closed, res)
 

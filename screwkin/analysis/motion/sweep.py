@@ -42,6 +42,7 @@ class SweepSingularity:
     sigma: float  # relative smallest singular value there
     q: np.ndarray
     limit: bool = False  # a limit position: the motion along the input cannot go on past it
+    point: object = None  # analysis.motion.change_points.ChangePoint of a constraint singularity: what it is
 
 
 @dataclass(frozen=True)
