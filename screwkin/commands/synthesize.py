@@ -253,22 +253,17 @@ def _constraints(args) -> Constraints:
         if len(corners) != 2:
             raise UsageError(f"--bounds expects two corners \"X0,Y0; X1,Y1\", got {len(corners)}")
         (x0, y0), (x1, y1) = corners
-        if not (x1 > x0 and y1 > y0):
-            raise UsageError("--bounds: the second corner must be above and to the right of the first "
-                             "(X1 > X0, Y1 > Y0)")
         bounds = ((x0, y0), (x1, y1))
     if args.lengths:
         low, sep, high = args.lengths.partition("..")
         if not sep or not low.strip() or not high.strip():
             raise UsageError(f"--lengths expects MIN..MAX, got {quote(args.lengths)}")
         lengths = (parse_value(low, "length", "--lengths"), parse_value(high, "length", "--lengths"))
-        if not 0 < lengths[0] < lengths[1]:
-            raise UsageError(f"--lengths: give 0 < MIN < MAX, got {quote(args.lengths)}")
     if args.min_transmission:
         angle = parse_value(args.min_transmission, "angle", "--min-transmission")
         if not 0 <= angle < math.pi / 2:
             raise UsageError(f"--min-transmission must lie from 0 to below 90 deg, got {quote(args.min_transmission)}")
-    return Constraints(bounds, lengths, args.grashof, angle)
+    return Constraints(bounds, lengths, args.grashof, angle).check()
 
 
 def _searching(args, count: int, beyond: int) -> bool:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ....errors import UsageError
 from ...motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_cos_mu, four_bar_transmission
 
 __all__ = ["Constraints", "GRASHOF_TYPES", "mu_over", "motion_mu", "grashof_type"]
@@ -83,6 +84,18 @@ class Constraints:
     lengths: tuple | None = None
     grashof: str | None = None
     min_transmission: float | None = None
+
+    def check(self) -> "Constraints":
+        """These constraints, refused (UsageError, in the options' words) where the box's corners are out
+        of order or the length range is not 0 < MIN < MAX: the one check of the command and the API."""
+        if self.bounds is not None:
+            (x0, y0), (x1, y1) = self.bounds
+            if not (x1 > x0 and y1 > y0):
+                raise UsageError("--bounds: the second corner must be above and to the right of the first "
+                                 "(X1 > X0, Y1 > Y0)")
+        if self.lengths is not None and not 0 < self.lengths[0] < self.lengths[1]:
+            raise UsageError(f"--lengths: give 0 < MIN < MAX, got {self.lengths[0]:g} m .. {self.lengths[1]:g} m")
+        return self
 
     def tightened(self, length: float, angle: float) -> "Constraints":
         """These constraints with a margin (``length`` [m] inside the bounds and the length range,

@@ -26,7 +26,6 @@ import math
 
 import numpy as np
 
-from ....errors import UsageError
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, PathResult, SynthesisError
 from ....model.geometry import wrap_angle
@@ -250,12 +249,7 @@ def optimal_path(points, timing, constraints, search, tolerance: float = 1e-6, e
     ``timing`` when given) that meet ``constraints``, found by ``search`` (module docstring); the
     PathResult of the best, its ``search`` report listing the best few (Candidates)."""
     pts, timing, L = path_points(points, timing)
-    if constraints.bounds is not None:
-        (x0, y0), (x1, y1) = constraints.bounds
-        if not (x1 > x0 and y1 > y0):
-            raise UsageError("--bounds: the box's second corner must be above and to the right of the first")
-    if constraints.lengths is not None and not 0 < constraints.lengths[0] < constraints.lengths[1]:
-        raise UsageError("--lengths: give MIN..MAX with 0 < MIN < MAX")
+    constraints.check()
     directions = (1.0, -1.0) if timing is None else (1.0,)
     runs = [(s, d) for s in (1.0, -1.0) for d in directions]
     tasks = [(pts, timing, s, d, constraints, L, task_seed(search.seed, k), search.generations, search.popsize, equal)

@@ -22,7 +22,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ....errors import UsageError
 from ....model.geometry import circle_circle, wrap_angle
 from .constraints import grashof_type, motion_mu
 from .designs import Candidate, FunctionResult, SynthesisError
@@ -105,8 +104,7 @@ def optimal_function(text, x_range, input_range, output_range, points, spacing, 
     """The best function generators that meet ``constraints`` (module docstring): the FunctionResult of
     the best, its ``search`` report listing the best few."""
     task = function_task(text, x_range, input_range, output_range, points, spacing, ground)
-    if constraints.lengths is not None and not 0 < constraints.lengths[0] < constraints.lengths[1]:
-        raise UsageError("--lengths: give MIN..MAX with 0 < MIN < MAX")
+    constraints.check()
     names, lower, upper = _unknowns(task, constraints)
     runs = [(s, sa, sc) for s in (1.0, -1.0) for sa in (1.0, -1.0) for sc in (1.0, -1.0)]
     jobs = [(task, names, constraints, r, task_seed(search.seed, k), search.generations, search.popsize, equal)

@@ -227,6 +227,7 @@ def optimal_motion(poses, constraints, search, tolerance: float = 1e-9, equal: f
     if n < 3 or n > MAX_POSES:
         raise UsageError(f"--poses: motion generation takes 3 to {MAX_POSES} poses, got {n}")
     _check_poses(poses)
+    constraints.check()
     L = scale_of(poses)
     tol = max(tolerance, 1e-9 * L)
     runs, tasks, fixed = [], [], []
