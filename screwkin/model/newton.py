@@ -176,7 +176,8 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
     Each configuration has its own damping and its own end (see the module).  When every
     configuration still iterating is about to converge quadratically (residual below
     0.1 sqrt(closure): the next one near its square) the residual alone is computed first, and the
-    Jacobian only where a step is accepted without converging."""
+    residual and Jacobian again, for the active stack, only when some step there is accepted without
+    converging."""
     Q = np.array(Q0, float)
     N = len(Q)
     every = np.arange(N)
