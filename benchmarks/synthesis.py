@@ -17,7 +17,7 @@ crank's end, in the coupler's frame), at crank angles spread over 300 deg: an ex
   the written design's own, by its closed form (the command also checks it with screwkin's solve).
 
 Both errors are measured here by the same function of the result's geometry: the largest distance
-from a target to its nearest point of the coupler curve (3,600 crank angles).
+from a target to its nearest point of the coupler curve (36,000 crank angles).
 """
 
 from __future__ import annotations

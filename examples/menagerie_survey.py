@@ -224,13 +224,13 @@ def survey(path: Path, work: Path) -> dict:
     row["loads"] = True
     try:
         row["M"] = mech.mobility().mobility
-    except Exception as exc:  # noqa: BLE001
+    except Exception as exc:  # noqa: BLE001 - a survey row, not a crash
         row["error"] = f"mobility: {str(exc)[:140]}"
         return row
     if m is not None:
         try:
             row["pos"] = position_error(mech, m, d)
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:  # noqa: BLE001 - a survey row, not a crash
             row["pos_error"] = str(exc)[:120]
     out = work / (path.stem + ".export.xml")
     err = io.StringIO()
@@ -243,7 +243,7 @@ def survey(path: Path, work: Path) -> dict:
             row["simulates"], why = simulates(out)
             if why:
                 row["export_error"] = why
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:  # noqa: BLE001 - a survey row, not a crash
             row["export_error"] = f"MuJoCo: {str(exc).splitlines()[0][:120]}"
     return row
 
