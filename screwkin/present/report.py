@@ -97,6 +97,13 @@ def modes_line(res, n: int) -> str:
     each = (f"; each reached by {sets.pop()} joint-angle sets (universal and spherical joints written as "
             "revolutes, wrists flipped: one placement of the links)" if len(sets) == 1 and None not in sets
             and max(sets) > 1 else "")
+    if c.method == "closed form (Pieper)":  # a serial arm: every joint solution is an answer
+        more = f"; {c.complex} more {'are' if c.complex != 1 else 'is'} complex (no real solution)" if c.complex else ""
+        return f"all {n} joint solution{s} ({c.certificate}){more}"
+    if c.method == "closed form (legs)":
+        return (f"{n} solution{s} of {c.found} listed ({c.certificate}): the physical one first (every leg extended, "
+                "each leg's angle set within the joint limits where one exists), then "
+                + ("every other combination of the legs' branches" if c.found == n else "each leg's other branch"))
     if c.complete:
         more = (f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex (no real assembly)"
                 if c.complex else "")
