@@ -318,8 +318,8 @@ def respell(mech, q):
     names, idx, lo, hi, angle = mech.limited_coordinates()
     bad = {int(i) for i in idx[_outside_rows(q, idx, lo, hi, angle)]}
     for leg in platform.legs:
-        if not any(model.joints[j].idx_q in bad for j in leg.joints if model.joints[j].nq == 1):
-            continue
+        if not any(model.joints[j].idx_q in bad for j in leg.joints if model.joints[j].nq == 1 and j != leg.slide):
+            continue  # its angles are within their limits (a slide outside them no spelling moves)
         poses = leg_poses(platform, leg, P)[0]
         if not poses:
             continue

@@ -78,8 +78,9 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
         poses, why, gap = leg_poses(platform, leg, P)
         if not poses:
             xyz = ", ".join(f"{v:.6g}" for v in pose.translation)
-            raise AssemblyError(mech.path, gap, 0, proved=True,
-                                reason=f"the pose of '{output}' at ({xyz}) is unreachable (closed form): {why}")
+            raise AssemblyError(mech.path, gap, 0, proved=True, reason=why,
+                                message=f"the pose of '{output}' at ({xyz}) is unreachable: {why} (closed form: "
+                                        "each leg's length follows from the pose; no search)")
         legs.append(poses)
     ref = mech.neutral()
     q = set_free(platform, model, np.array(ref, float), P)
@@ -148,8 +149,8 @@ def _arm(solver, output, out_frame, arm, pose, start):
     if not qs:
         xyz = ", ".join(f"{v:.6g}" for v in pose.translation)
         raise AssemblyError(mech.path, np.inf, 0, starts=0,
-                            detail=f"the pose of '{output}' at ({xyz}) is unreachable: all {BOUND} solutions of "
-                                   "the closed form (Pieper) are complex")
+                            message=f"the pose of '{output}' at ({xyz}) is unreachable: all {BOUND} joint solutions "
+                                    "of the closed form (Pieper: the last three axes meet) are complex; no search")
     sols = [_solution(solver, q, out_frame, _residual(mech, q, out_frame, pose)) for q in qs]
     ref_sig = solver.signature(mech.neutral())
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))

@@ -134,8 +134,6 @@ def branches(mech, res: PositionResult) -> Branches:
     joints are solved on their own, so the branches are the combinations of the legs' settings.
     A planar leg of three one-DOF joints (a dyad: two unknowns) has at most two closures (one when
     two of its joints slide)."""
-    import networkx as nx
-
     n = len(res.solutions)
     c = res.modes
     if c is not None and c.method == "closed form (legs)":  # every combination of the legs' branches exists
@@ -143,6 +141,8 @@ def branches(mech, res: PositionResult) -> Branches:
         return Branches(c.found, legs, c.found, "closed form: each leg extended or reversed through its pivot")
     if c is not None and c.method == "closed form (Pieper)":
         return Branches(n, (), n, "closed form (Pieper): every real joint solution")
+    import networkx as nx
+
     if res.free_dofs or not res.output or not res.solutions:
         return Branches(n, (), None, "")
     topo = mech.topology(res.solutions[0].q)
