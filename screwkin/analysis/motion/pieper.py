@@ -178,12 +178,15 @@ def _trig_roots(F, degree: int, scale: float):
     for z in roots:
         if abs(abs(z) - 1.0) < 1e-5:
             t = float(np.angle(z))
-            for _ in range(6):  # Newton on F itself
-                h = 1e-7
-                d = (F(t + h) - F(t - h)) / (2 * h)
+            ks = np.arange(-degree, degree + 1)
+            for _ in range(3):  # Newton on F itself, its derivative from the coefficients
+                d = float(np.real(np.sum(1j * ks * coeffs * np.exp(1j * ks * t))))
                 if d == 0:
                     break
-                t -= F(t) / d
+                step = F(t) / d
+                t -= step
+                if abs(step) < 1e-15:
+                    break
             if not any(abs(np.angle(np.exp(1j * (t - u)))) < 1e-9 for u in real):
                 real.append(float(np.angle(np.exp(1j * t))))
         else:
