@@ -262,3 +262,21 @@ def test_bundled_6ups_file_configuration_is_a_physical_mode():
     mine = [s for s in res.solutions if np.max(np.abs(solver.signature(s.q) - ref)) < 1e-9]
     assert len(mine) == 1 and mine[0].physical and not mine[0].outside_limits
     assert res.solutions[0] is mine[0]
+
+
+def test_arm_6r_at_its_drawn_pose_has_the_stretched_wrist_as_one_continuum():
+    """At the file's configuration joint 5 is 0: joints 4 and 6 turn about one line (only their sum is
+    fixed), so that solution is a continuum, said so, and the other position solutions keep their two
+    wrist sets."""
+    mech = screwkin.load(ROBOTS / "arm_6r.urdf")
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, mech.neutral())
+    pose = pin.SE3(data.oMf[mech.link_frame("flange")])
+    res = inverse_kinematics(mech, "flange", pose)
+    assert res.modes.method == "closed form (Pieper)" and res.modes.detail["stretched"] == 1
+    cont = [s for s in res.solutions if s.continuum]
+    assert len(cont) == 1 and np.allclose(cont[0].q, 0, atol=1e-12)
+    assert all(fk_error(mech, s.q, "flange", pose) < 1e-10 for s in res.solutions)
+    q = cont[0].q.copy()
+    q[3], q[5] = 0.7, -0.7  # along the continuum: the flange stays
+    assert fk_error(mech, q, "flange", pose) < 1e-12

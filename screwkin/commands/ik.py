@@ -98,8 +98,8 @@ def _closed_text(mech, res, count) -> str:
     c = res.modes
     ms = f" ({c.detail.get('seconds', 0) * 1e3:.3g} ms)"
     if c.method == "closed form (Pieper)":
-        return (f"search: {c.certificate}: {c.real} real joint solution{'s' if c.real != 1 else ''}, every one"
-                + (f"; {c.complex} more complex" if c.complex else "") + ms)
+        return (f"search: {c.certificate}: {c.real} real joint solution{'s' if c.real != 1 else ''}"
+                + ", every one" + (f"; {c.complex} more complex" if c.complex else "") + ms)
     text = f"search: {c.certificate}: " + _found_text(count, res.free_dofs, certified=True) + ms
     if c.found > len(res.solutions):
         first = res.solutions[0]

@@ -127,9 +127,9 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
 
 def _arm(solver, output, out_frame, arm, pose, start):
     mech, model = solver.mech, solver.mech.model
-    sets, _, why = pieper(arm, pose)
+    sets, _, why, stretched = pieper(arm, pose)
     if why:
-        return None  # a continuum: the general method
+        return None  # the wrist centre on the first or second axis (a continuum): the general method
     lo, hi = model.lowerPositionLimit, model.upperPositionLimit
     qs = []
     for s in sets:
@@ -152,12 +152,18 @@ def _arm(solver, output, out_frame, arm, pose, start):
                             message=f"the pose of '{output}' at ({xyz}) is unreachable: all {BOUND} joint solutions "
                                     "of the closed form (Pieper: the last three axes meet) are complex; no search")
     sols = [_solution(solver, q, out_frame, _residual(mech, q, out_frame, pose)) for q in qs]
+    sols = [replace(s, continuum=True, singular=True) if st else s for s, st in zip(sols, stretched)]
     ref_sig = solver.signature(mech.neutral())
     sols.sort(key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
     c = ", ".join(f"{v:.6g}" for v in arm.centre)
-    count = ModeCount(BOUND, True, "closed form (Pieper)", len(sols), BOUND - len(sols),
+    names = [model.names[j] for j in arm.joints]
+    n_cont = sum(stretched)
+    count = ModeCount(BOUND, True, "closed form (Pieper)", len(sols), BOUND - len(sols) - n_cont,
                       f"closed form (Pieper: last three axes meet at ({c}) m at the file's configuration; "
-                      f"at most {BOUND} solutions)",
-                      detail={"wrist_centre": arm.centre.tolist(), "seconds": round(time.perf_counter() - start, 4)})
-    return _result(solver, output, pose, sols, count)
+                      f"at most {BOUND} solutions)"
+                      + (f"; {n_cont} of them a continuum: the wrist stretched ({names[3]} and {names[5]} about "
+                         f"one line, only their sum fixed), shown with {names[3]} = 0" if n_cont else ""),
+                      detail={"wrist_centre": arm.centre.tolist(), "stretched": n_cont,
+                              "seconds": round(time.perf_counter() - start, 4)})
+    return replace(_result(solver, output, pose, sols, count), free_dofs=int(bool(sols) and all(stretched)))
 

@@ -74,10 +74,12 @@ def wrist_arm(mech, out_frame: int, placement):
 
 
 def pieper(arm: Wrist, T, tol: float = 1e-9):
-    """(sets, complex, why): every real joint solution (t1, ..., t6) placing the output frame at T (a
-    pinocchio.SE3), how many of the 8 are complex, and why the closed form does not answer ("" when it
-    does: a continuum -- the wrist centre on axis 1 or 2, the wrist stretched -- or a degenerate first
-    pair of axes leave it to the general method)."""
+    """(sets, complex, why, stretched): every real joint solution (t1, ..., t6) placing the output frame at
+    T (a pinocchio.SE3), how many of the 8 are complex, why the closed form does not answer ("" when it
+    does: the wrist centre on axis 1 or 2 -- a continuum -- or a degenerate first pair of axes leave it
+    to the general method), and for each set whether the wrist is stretched there (its first and last axes
+    in line: joints 4 and 6 free with their sum fixed, a continuum, given with joint 4 at 0; it stands for
+    two of the 8)."""
     w, r = arm.axes, arm.points
     g = T * arm.M0.inverse()
     c = g.act(arm.centre)
@@ -148,15 +150,36 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
             if np.linalg.norm(rotation(w[0], t1) @ (p - r1) - (c - r1)) > 1e-7 * scale:
                 continue
             positions.append((t1, t2, t3))
-    sets = []
+    sets, stretched = [], []
     for t1, t2, t3 in positions:
         R3 = rotation(w[0], t1) @ rotation(w[1], t2) @ rotation(w[2], t3)
-        wrist = run_angles(list(w[3:]), R3.T @ g.rotation)
+        wrist = run_angles(list(w[3:]), R3.T @ g.rotation) or _stretched(w[3:], R3.T @ g.rotation)
+        for ts in wrist:
+            sets.append(tuple(float(np.angle(np.exp(1j * t))) for t in (t1, t2, t3) + tuple(0.0 if t is None else t
+                                                                                           for t in ts)))
+            stretched.append(ts[0] is None)
         if not wrist:
-            why = "the wrist is stretched: its first and last axes in line (a continuum)"
+            why = "the wrist cannot take the orientation (numerically degenerate)"
+    return sets, n_complex * 2, ("" if sets else why), stretched
+
+
+def _stretched(axes, R):
+    """A stretched wrist (its last axis turned onto its first: joints 4 and 6 turn about one line, only their
+    sum is fixed): [(None, t5, t6)] for each t5 that turns w6 onto +-w4, t6 with joint 4 at 0, else []."""
+    w4, w5, w6 = axes
+    if np.linalg.norm(np.cross(R @ w6, w4)) > 1e-7:
+        return []
+    out = []
+    for sign in (1.0, -1.0):
+        if abs(w5 @ w6 - sign * (w5 @ w4)) > 1e-9:
             continue
-        sets += [(t1, t2, t3) + tuple(ts) for ts in wrist]
-    return sets, n_complex * 2, why
+        t5 = rotation_to(w5, w6, sign * w4)
+        if t5 is None or np.linalg.norm(rotation(w5, t5) @ w6 - sign * w4) > 1e-9:
+            continue
+        t6 = run_angles([w6], rotation(w5, t5).T @ R)
+        if t6:
+            out.append((None, t5, t6[0][0]))
+    return out
 
 
 def _trig_roots(F, degree: int, scale: float):
