@@ -327,8 +327,30 @@ def respell(mech, q):
         pose = min(poses, key=lambda p: abs(p.x - x))
         if abs(pose.x - x) > 1e-6 * max(mech.length, 1e-3):
             continue
-        set_leg(model, out, pose, best_set(mech, q, pose, near=pin.neutral(model)))
+        best = best_set(mech, q, pose, near=pin.neutral(model))
+        now = {j: _angle(model, q, j) for j in best}
+        if _bad(mech, best) < _bad(mech, now):  # only where the leg gets within its limits
+            set_leg(model, out, pose, best)
     return out
+
+
+def _angle(model, q, j) -> float:
+    jm = model.joints[j]
+    return float(np.arctan2(q[jm.idx_q + 1], q[jm.idx_q])) if jm.nq == 2 else float(q[jm.idx_q])
+
+
+def _bad(mech, angles: dict) -> int:
+    """How many of the revolutes {joint id: angle} lie outside the file's limits (modulo a turn)."""
+    _, idx, lo, hi, angle = mech.limited_coordinates()
+    where = {int(i): k for k, i in enumerate(idx)}
+    rows = [(where[mech.model.joints[j].idx_q], t) for j, t in angles.items()
+            if mech.model.joints[j].nq == 1 and mech.model.joints[j].idx_q in where]
+    if not rows:
+        return 0
+    k = np.array([r[0] for r in rows])
+    q = np.zeros(int(idx.max()) + 1)
+    q[idx[k]] = [r[1] for r in rows]
+    return int(_outside_rows(q, idx[k], lo[k], hi[k], angle[k]).sum())
 
 
 def _outside_rows(q, idx, lo, hi, angle):
