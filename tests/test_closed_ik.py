@@ -280,3 +280,49 @@ def test_arm_6r_at_its_drawn_pose_has_the_stretched_wrist_as_one_continuum():
     q = cont[0].q.copy()
     q[3], q[5] = 0.7, -0.7  # along the continuum: the flange stays
     assert fk_error(mech, q, "flange", pose) < 1e-12
+
+
+def ups_floating_urdf():
+    """The bundled platform's geometry with the platform on a floating joint: six U-P legs, each closed by
+    a spherical loop joint (the same anchors: BASE, PLAT at C_HOME turned by R_HOME)."""
+    rpy = " ".join(f"{v:.15g}" for v in pin.rpy.matrixToRpy(R_HOME))
+    parts = ['<link name="base"/><link name="platform"/>',
+             f'<joint name="free" type="floating"><parent link="base"/><child link="platform"/>'
+             f'<origin xyz="{C_HOME[0]} {C_HOME[1]} {C_HOME[2]}" rpy="{rpy}"/></joint>']
+    for k in range(6):
+        d = C_HOME + R_HOME @ PLAT[k] - BASE[k]
+        u = d / np.linalg.norm(d)
+        a = np.cross(u, [0, 0, 1.0])
+        a /= np.linalg.norm(a)
+        b = np.cross(u, a)
+        v = lambda x: " ".join(f"{c:.15g}" for c in x)  # noqa: E731
+        lim = '<limit lower="-1.2" upper="1.2" effort="1" velocity="1"/>'
+        parts += [f'<link name="u{k}"/><link name="c{k}"/><link name="p{k}"/>',
+                  f'<joint name="base{k + 1}_a" type="revolute"><parent link="base"/><child link="u{k}"/>'
+                  f'<origin xyz="{v(BASE[k])}"/><axis xyz="{v(a)}"/>{lim}</joint>',
+                  f'<joint name="base{k + 1}_b" type="revolute"><parent link="u{k}"/><child link="c{k}"/>'
+                  f'<axis xyz="{v(b)}"/>{lim}</joint>',
+                  f'<joint name="leg{k + 1}" type="prismatic"><parent link="c{k}"/><child link="p{k}"/>'
+                  f'<axis xyz="{v(u)}"/><limit lower="-0.3" upper="0.3" effort="1" velocity="1"/></joint>',
+                  f'<loop_joint name="ball{k + 1}" type="spherical"><link1 link="p{k}" xyz="{v(d)}"/>'
+                  f'<link2 link="platform" xyz="{v(PLAT[k])}"/></loop_joint>']
+    return f'<?xml version="1.0"?><robot name="ups_floating">{"".join(parts)}</robot>'
+
+
+def test_tree_and_floating_forms_of_one_platform_agree(tmp_path):
+    path = tmp_path / "ups_floating.urdf"
+    path.write_text(ups_floating_urdf())
+    floating = screwkin.load(path, actuated=[f"leg{k}" for k in range(1, 7)])
+    tree = stewart()
+    for c, R in random_poses(3, 17):
+        target = pin.SE3(R, c)  # the floating platform's frame: at the centre, its points PLAT turned by R
+        res_f = inverse_kinematics(floating, "platform", target)
+        res_t = inverse_kinematics(tree, "platform", platform_pose(c, R))
+        assert res_f.modes.method == res_t.modes.method == "closed form (legs)"
+        assert "floating joint" in res_f.modes.certificate
+        first = res_f.solutions[0]
+        assert first.physical and loops_closed(floating, first.q) < 1e-12
+        for k in range(1, 7):
+            assert abs(first.joints[f"leg{k}"] - res_t.solutions[0].joints[f"leg{k}"]) < 1e-12
+            home = np.linalg.norm(C_HOME + R_HOME @ PLAT[k - 1] - BASE[k - 1])
+            assert abs(first.joints[f"leg{k}"] - (np.linalg.norm(c + R @ PLAT[k - 1] - BASE[k - 1]) - home)) < 1e-12
