@@ -122,10 +122,12 @@ def rps_urdf():
         u = d / np.linalg.norm(d)
         links += [f'<link name="cyl{k}"/>', f'<link name="pis{k}"/>']
         xyz = " ".join(f"{v:.15g}" for v in a)
-        joints += [f'<joint name="rev{k}" type="revolute"><parent link="base"/><child link="cyl{k}"/><origin xyz="{xyz}"/>'
-                   f'<axis xyz="{tangent[0]:.15g} {tangent[1]:.15g} 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>',
-                   f'<joint name="leg{k}" type="prismatic"><parent link="cyl{k}"/><child link="pis{k}"/><origin xyz="0 0 0"/>'
-                   f'<axis xyz="{u[0]:.15g} {u[1]:.15g} {u[2]:.15g}"/><limit lower="-0.2" upper="0.2" effort="1" velocity="1"/></joint>']
+        lim = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+        joints += [f'<joint name="rev{k}" type="revolute"><parent link="base"/><child link="cyl{k}"/>'
+                   f'<origin xyz="{xyz}"/><axis xyz="{tangent[0]:.15g} {tangent[1]:.15g} 0"/>{lim}</joint>',
+                   f'<joint name="leg{k}" type="prismatic"><parent link="cyl{k}"/><child link="pis{k}"/>'
+                   f'<origin xyz="0 0 0"/><axis xyz="{u[0]:.15g} {u[1]:.15g} {u[2]:.15g}"/>'
+                   '<limit lower="-0.2" upper="0.2" effort="1" velocity="1"/></joint>']
         dxyz = " ".join(f"{v:.15g}" for v in d)
         if k == 1:
             links += ['<link name="s1"/>', '<link name="s2"/>']

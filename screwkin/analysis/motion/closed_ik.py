@@ -6,8 +6,8 @@ analysis.motion.pieper).  None where neither applies: analysis.motion.ik then se
 A platform's answer is the physical solution first (every leg extended, each leg's angle set within the
 joint limits where one exists), then each leg's other branch beside it (that leg reversed through its
 pivot, the others as in the first): every combination of the legs' branches is a solution too
-(2 per leg), listed where there are at most LISTED (a 3-RPR's 8), else counted.  An arm's answer is every distinct joint solution (up to 8, the
-others complex, counted).
+(2 per leg), listed where there are at most LISTED (a 3-RPR's 8), else counted.  An arm's answer is
+every distinct joint solution (up to 8, the others complex, counted).
 """
 
 from __future__ import annotations
@@ -112,7 +112,8 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
     sols = [_solution(solver, qq, out_frame, _residual(mech, qq, out_frame, pose)) for qq in qs]
     ref_sig = solver.signature(ref)
     if combos <= LISTED:  # all of them: nearest the reference first (each leg's other branch: in leg order)
-        sols[1:] = sorted(sols[1:], key=lambda s: (not s.physical, float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
+        sols[1:] = sorted(sols[1:], key=lambda s: (not s.physical,
+                                                   float(np.linalg.norm(solver.signature(s.q) - ref_sig))))
     sets = int(np.prod([len(p[0].sets) for p in legs]))
     where = "a floating joint holds the platform" if platform.free is not None else \
         f"{platform.legs[0].name} holds the platform in the tree"
