@@ -328,3 +328,41 @@ def test_tree_and_floating_forms_of_one_platform_agree(tmp_path):
             assert abs(first.joints[f"leg{k}"] - res_t.solutions[0].joints[f"leg{k}"]) < 1e-12
             home = np.linalg.norm(C_HOME + R_HOME @ PLAT[k - 1] - BASE[k - 1])
             assert abs(first.joints[f"leg{k}"] - (np.linalg.norm(c + R @ PLAT[k - 1] - BASE[k - 1]) - home)) < 1e-12
+
+
+def random_wrist_arm_urdf(rng):
+    """A 6R arm of random geometry (joints 1-3: random axes and offsets) with a wrist of three random axes
+    through one point."""
+    parts = ['<link name="l0"/>']
+    for i in range(1, 7):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        xyz = rng.uniform(-0.3, 0.3, 3) if i <= 4 else np.zeros(3)
+        rpy = rng.uniform(-np.pi, np.pi, 3)
+        v = lambda x: " ".join(f"{c:.15g}" for c in x)  # noqa: E731
+        parts.append(f'<link name="l{i}"/><joint name="j{i}" type="revolute"><parent link="l{i - 1}"/>'
+                     f'<child link="l{i}"/><origin xyz="{v(xyz)}" rpy="{v(rpy)}"/><axis xyz="{v(axis)}"/>'
+                     '<limit lower="-3.2" upper="3.2" effort="1" velocity="1"/></joint>')
+    parts.append('<link name="tool"/><joint name="t" type="fixed"><parent link="l6"/><child link="tool"/>'
+                 '<origin xyz="0.1 0.02 0.05"/></joint>')
+    return f'<?xml version="1.0"?><robot name="wrist6r">{"".join(parts)}</robot>'
+
+
+def test_pieper_on_random_arms_with_a_spherical_wrist(tmp_path):
+    """Any 6R whose last three axes meet: every solution places the tool (Pinocchio), the configuration the
+    pose came from is among them, and the real and complex ones make 8."""
+    rng = np.random.default_rng(3)
+    for k in range(4):
+        path = tmp_path / f"w{k}.urdf"
+        path.write_text(random_wrist_arm_urdf(rng))
+        mech = screwkin.load(path, actuated=[f"j{i}" for i in range(1, 7)])
+        q0 = rng.uniform(-3, 3, 6)
+        data = mech.model.createData()
+        pin.framesForwardKinematics(mech.model, data, q0)
+        pose = pin.SE3(data.oMf[mech.link_frame("tool")])
+        res = inverse_kinematics(mech, "tool", pose)
+        c = res.modes
+        assert c.method == "closed form (Pieper)" and c.real + c.complex == 8 and c.real == len(res.solutions)
+        assert all(fk_error(mech, s.q, "tool", pose) < 1e-10 for s in res.solutions)
+        assert min(np.abs(np.angle(np.exp(1j * (s.q - q0)))).max() for s in res.solutions) < 1e-8
+        assert distinct([s.q for s in res.solutions])

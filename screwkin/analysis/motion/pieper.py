@@ -94,7 +94,7 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
 
     def parts(t3):
         q3 = r[2] + rotation(w[2], t3) @ (arm.centre - r[2])
-        v = q3 - r[1]
+        v = q3 - r2  # from the point of axis 2 that delta reaches
         vpar = w[1] * (w[1] @ v)
         xy = np.array([(v - vpar) @ e1, (v - vpar) @ e2])
         b = np.array([h1 - w[0] @ delta - w[0] @ vpar, (h2 - delta @ delta - v @ v - 2 * delta @ vpar) / 2])
@@ -142,7 +142,7 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
             zs = [foot + across, foot - across]
         for z in zs:
             t2 = float(np.arctan2(z[1], z[0]) - np.arctan2(xy[1], xy[0]))
-            p = r[1] + rotation(w[1], t2) @ (q3 - r[1])
+            p = r2 + rotation(w[1], t2) @ (q3 - r2)
             t1 = rotation_to(w[0], p - r1, c - r1)
             if t1 is None:
                 why = "the wrist centre lies on the first axis (a continuum)"
