@@ -284,9 +284,11 @@ def test_arm_6r_at_its_drawn_pose_has_the_stretched_wrist_as_one_continuum():
     assert fk_error(mech, q, "flange", pose) < 1e-12
 
 
-def ups_floating_urdf():
+def ups_floating_urdf(base=BASE, plat=PLAT, rng=None):
     """The bundled platform's geometry with the platform on a floating joint: six U-P legs, each closed by
-    a spherical loop joint (the same anchors: BASE, PLAT at C_HOME turned by R_HOME)."""
+    a spherical loop joint (the same anchors: BASE, PLAT at C_HOME turned by R_HOME); with ``rng`` the
+    universal joints' axes at random angles (not perpendicular)."""
+    BASE, PLAT = base, plat  # noqa: N806
     rpy = " ".join(f"{v:.15g}" for v in pin.rpy.matrixToRpy(R_HOME))
     parts = ['<link name="base"/><link name="platform"/>',
              f'<joint name="free" type="floating"><parent link="base"/><child link="platform"/>'
@@ -294,9 +296,10 @@ def ups_floating_urdf():
     for k in range(6):
         d = C_HOME + R_HOME @ PLAT[k] - BASE[k]
         u = d / np.linalg.norm(d)
-        a = np.cross(u, [0, 0, 1.0])
+        a = np.cross(u, [0, 0, 1.0]) if rng is None else rng.normal(size=3)  # random: skew to the leg
         a /= np.linalg.norm(a)
-        b = np.cross(u, a)
+        b = np.cross(u, a)  # across the leg: the universal joint turns it toward any direction
+        b /= np.linalg.norm(b)
         v = lambda x: " ".join(f"{c:.15g}" for c in x)  # noqa: E731
         lim = '<limit lower="-1.2" upper="1.2" effort="1" velocity="1"/>'
         parts += [f'<link name="u{k}"/><link name="c{k}"/><link name="p{k}"/>',
@@ -366,3 +369,23 @@ def test_pieper_on_random_arms_with_a_spherical_wrist(tmp_path):
         assert all(fk_error(mech, s.q, "tool", pose) < 1e-10 for s in res.solutions)
         assert min(np.abs(np.angle(np.exp(1j * (s.q - q0)))).max() for s in res.solutions) < 1e-8
         assert distinct([s.q for s in res.solutions])
+
+
+def test_random_platforms_in_closed_form(tmp_path):
+    """Random anchors and universal joints whose first axis is skew to the leg: the first solution has every leg at the
+    hand distance between its anchors, the loops closed in Pinocchio's placements."""
+    rng = np.random.default_rng(23)
+    for k in range(3):
+        base = [np.array([*rng.uniform(-0.6, 0.6, 2), 0.0]) for _ in range(6)]
+        plat = [np.array([*rng.uniform(-0.3, 0.3, 2), 0.0]) for _ in range(6)]
+        path = tmp_path / f"p{k}.urdf"
+        path.write_text(ups_floating_urdf(base, plat, rng))
+        mech = screwkin.load(path, actuated=[f"leg{i}" for i in range(1, 7)])
+        for c, R in random_poses(2, k):
+            res = inverse_kinematics(mech, "platform", pin.SE3(R, c))
+            assert res.modes.method == "closed form (legs)"
+            first = res.solutions[0]
+            assert loops_closed(mech, first.q) < 1e-12
+            for i in range(6):
+                home = np.linalg.norm(C_HOME + R_HOME @ plat[i] - base[i])
+                assert abs(first.joints[f"leg{i + 1}"] - (np.linalg.norm(c + R @ plat[i] - base[i]) - home)) < 1e-12
