@@ -9,6 +9,7 @@ import sys
 from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import BRANCHES
 from ..errors import UsageError, quote
 from ..model.topology import open_joints
 from ._options import count
@@ -52,8 +53,6 @@ def add_mode_option(sp, at: str = "the --set inputs"):
 
 def add_branch_option(sp, what: str = "the motion"):
     """--branch continue|other: what a motion does at a change point (analysis.motion.sweep's branch)."""
-    from ..analysis.motion.sweep import BRANCHES
-
     sp.add_argument("--branch", choices=BRANCHES, default=BRANCHES[0],
                     help=f"at a change point of {what} (branches of the motion cross: a parallelogram four-bar "
                          "folding flat), go on along the branch whose tangent continues the motion (continue, the "

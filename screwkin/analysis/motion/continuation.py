@@ -38,6 +38,7 @@ import pinocchio as pin
 
 from ...errors import AssemblyError
 from ...model.geometry import TINY
+from ..singularities.singular import measures
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -190,8 +191,6 @@ def at_change_point(solver, q) -> dict:
     """The singularity measures at a located limit position q (analysis.singularities.singular.measures),
     with "change": whether K itself loses rank there (a change point, not a limit position: the input
     passes it on a branch that goes on)."""
-    from ..singularities.singular import measures
-
     m = measures(solver.mech, q, solver.generic())
     return {**m, "change": solver.generic().rank_K > 0 and m["constraint"] < solver.mech.tolerances.singular}
 

@@ -23,6 +23,7 @@ from ...errors import AssemblyError, UsageError, quote, shorten
 from ...model.geometry import wrap_angle
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .continuation import Curve, Motion, Stuck, continuation_steps
+from .crossing import START, crossing, follow, passed
 from .dyads import cached_plan, planar_sweep
 from ...model.limits import outside_limits
 from .tracker import Tracker
@@ -347,8 +348,6 @@ def _through_change_points(solver, res, fixed, progress, max_steps, closed_form,
     slipped onto the other, or stopped or turned back there as at a limit position) the motion is cut
     there and the sweep goes on from the branch's configuration at the next grid value.  Each change
     point is named in ``change_points`` and in ``notes``."""
-    from .change_points import crossing, follow, passed
-
     name = res.input
     start, stop, steps = res.requested
     h = (stop - start) / steps if steps else 0.0
@@ -439,8 +438,6 @@ def _change_point_note(solver, name, unit, cp, why, branch) -> str:
     at = f"{cp.input:.9g} m" if unit == "m" else f"{cp.input:.9g} rad ({np.degrees(cp.input):.6g} deg)"
     n = len(cp.local.branches)
     what = f"{_WORDS.get(n, str(n))} branches cross" if n > 1 else "the configuration space is singular"
-    from .change_points import START
-
     if cp.goes is not None and why and why.startswith(START):
         how = why.split("; ")[0] + ("; taking the other one instead, as --branch other asks" if cp.switched else "")
         why = "; ".join(why.split("; ")[1:]) or None
