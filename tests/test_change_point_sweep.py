@@ -188,7 +188,7 @@ def test_sweep_names_the_change_point_and_takes_the_other_branch_on_request(file
     args = ["sweep", str(files["kite"]), "--input", "crank_joint", "--from", "0", "--to", "180deg", "--steps", "36"]
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert ("note: change point at crank_joint = 1.5707963 rad (90 deg): two branches cross; continuing on the "
+    assert ("note: change point at crank_joint = 1.570796 rad (90 deg): two branches cross; continuing on the "
             "branch whose tangent continues the motion (the other: --branch other)") in out
     assert "limit position at" not in out and "stopped" not in out and ": 37 configurations" in out
     assert main([*args, "--turn"]) == 0
@@ -208,7 +208,7 @@ def test_dynamics_shares_the_sweep(files, capsys):
     assert main(["dynamics", str(files["kite"]), "--input", "crank_joint", "--from", "0", "--to", "180deg",
                  "--steps", "36", "--speed", "60rpm", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert d["completed"] and any(n.startswith("change point at crank_joint = 1.5707963 rad (90 deg)") for n in d["notes"])
+    assert d["completed"] and any(n.startswith("change point at crank_joint = 1.570796 rad (90 deg)") for n in d["notes"])
     assert not any("limit position" in n for n in d["notes"])
 
 
@@ -222,3 +222,28 @@ def test_draw_animate_shares_the_sweep(files, capsys, tmp_path):
     d = json.loads(capsys.readouterr().out)
     assert d["frames"] == 13 and d["stopped_at"] is None
     assert len(d["change_points"]) == 1 and "as --branch other asks" in d["change_points"][0]
+
+
+@pytest.mark.parametrize("chunk", [18, 5])
+def test_a_sweep_in_chunks_passes_the_change_point_as_the_whole_sweep(solvers, chunk):
+    """sweep --chunk: a chunk that starts on the change point (18: the fold at the 18th of 36 steps) goes on
+    along the branch the motion came in on, as the sweep in one piece does."""
+    from screwkin.analysis.motion.stream import sweep_chunks
+
+    pieces = list(sweep_chunks(solvers["kite"], "crank_joint", 0.0, math.pi, 36, chunk=chunk))
+    t = DRAWN["kite"][0] + np.concatenate([p.joints[:, 0] for p in pieces])
+    p = DRAWN["kite"][1] + np.concatenate([p.joints[:, 2] for p in pieces])
+    assert len(t) == 37 and np.max(off(p, [kite(v) for v in t])) < ANGLE
+    assert sum(len(p.change_points) for p in pieces) == 1
+
+
+def test_a_chunk_that_starts_on_the_change_point_continues_the_motion_before_it(solvers):
+    """The parallelogram drawn folded flat, a whole turn in chunks of 18 of 36 steps: the second chunk starts
+    on the fold at 180 deg, where the drawing (on the other fold, on both branches) cannot choose; the
+    motion before it (the chunk's prior configuration) does: the parallelogram."""
+    from screwkin.analysis.motion.stream import sweep_chunks
+
+    pieces = list(sweep_chunks(solvers["flat"], "crank_joint", 0.0, 2 * math.pi, 36, chunk=18))
+    t = np.concatenate([p.joints[:, 0] for p in pieces])
+    p = np.concatenate([p.joints[:, 2] for p in pieces])
+    assert len(t) == 37 and np.max(off(p, t)) < ANGLE

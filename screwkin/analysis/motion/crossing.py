@@ -21,7 +21,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import AssemblyError
 from ...model.geometry import wrap_angle
@@ -119,6 +118,7 @@ class Crossing:
     before: int
     at: int | None = None
     limit: bool = False
+    rank: int = 0  # the generic rank of K the measure was taken at
 
 
 def constraint_profile(mech, Q, rank: int | None = None) -> tuple:
@@ -202,7 +202,7 @@ def passed(solver, res) -> list:
             before = k
         else:
             continue  # outside the recorded motion
-        out.append(Crossing(x, np.asarray(q, float), s, before, at))
+        out.append(Crossing(x, np.asarray(q, float), s, before, at, rank=r))
     for lim in res.limits:  # a "limit position" where K loses rank is a change point
         s = _measure(mech, lim.q, g)
         if not s < tol.singular:
@@ -225,7 +225,7 @@ def passed(solver, res) -> list:
                 x, q, s = float(found.x), q_at(float(found.x)), float(found.fun)
             except AssemblyError:
                 pass
-        out.append(Crossing(x, q, s, before, None, True))
+        out.append(Crossing(x, q, s, before, None, True, rank=r))
     seen, unique = [], []
     for c in sorted(out, key=lambda c: c.before):
         if any(abs(c.x - d.x) <= tol.geometry * max(1.0, abs(c.x)) and abs(c.before - d.before) <= 1 for d in seen):
@@ -311,11 +311,14 @@ def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None):
     nearest the input's direction projected on ker K -- unless ``prior`` (input value, configuration)
     gives where the motion came from before it (a chunk of a longer sweep)."""
     mech = solver.mech
-    local = local_analysis(mech, c.q, inputs=solver.inputs)
+    local = local_analysis(mech, c.q, inputs=solver.inputs, generic_rank=c.rank or None)
     branches = [_branch_rates(mech, b) for b in local.branches]
     xs = np.asarray(res.values, float)
     direction = _arriving(xs, c, res.requested)
-    moving = [k for k, v in enumerate(branches) if abs(v[curve.ix]) > curve.tol.limit_share * np.linalg.norm(v)]
+    # the branches the motion can take: the input moves along them, the other inputs stay held
+    held = list(curve.frozen_other)
+    moving = [k for k, v in enumerate(branches) if abs(v[curve.ix]) > curve.tol.limit_share * np.linalg.norm(v)
+              and not np.any(np.abs(v[held]) > curve.tol.limit_share * np.linalg.norm(v))]
     came = None
     if (c.before >= 0 or prior is not None) and len(branches) > 1:
         b = c.before  # a recorded configuration the branches' lines tell apart (not next to c)
@@ -324,10 +327,11 @@ def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None):
             b -= 1
         xa, qa = (float(xs[b]), res.q[b]) if b >= 0 else (float(prior[0]), np.asarray(prior[1], float))
         miss = [np.inf] * len(branches)
+        seen = solver.signature(qa)  # (joint centres: the same whatever turn an angle is written on)
         for k, v in enumerate(branches):
             back = follow(curve, c.q, c.x, v, xa)
             if back is not None:
-                miss[k] = float(np.linalg.norm(pin.difference(mech.model, back, qa) / curve.scale))
+                miss[k] = float(np.linalg.norm(solver.signature(back) - seen))
         came = int(np.argmin(miss)) if np.isfinite(min(miss)) else nearest_branch(mech, local, res.rates[max(b, 0)])
     elif branches:
         came = 0 if c.before >= 0 or prior is not None else None
@@ -343,7 +347,7 @@ def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None):
             why = (why + "; " if why else "") + "the other branch does not move the input: the motion continues on this one"
     incoming = None if c.before < 0 and prior is None else came  # (at the start: none; came is the default there)
     if goes is None or goes not in moving:
-        return ChangePoint(c.x, c.sigma, c.q, local, incoming, None, True), None, "no branch through it moves the input"
+        return ChangePoint(c.x, c.sigma, c.q, local, incoming, None, True), None, None
     v = branches[goes]
     if v[curve.ix] * direction < 0:
         v = -v
@@ -367,10 +371,9 @@ def _starting(solver, curve, local, branches, moving, c: Crossing, direction):
             x_ref = c.x + float(wrap_angle(x_ref - c.x))
         if abs(x_ref - c.x) > curve.tol.local_step * curve.scale[curve.ix]:
             drawn = solver.signature(ref)
-            for k in moving:
-                q1 = follow(curve, c.q, c.x, branches[k], x_ref)
-                if q1 is not None and np.linalg.norm(solver.signature(q1) - drawn) <= mech.tolerances.geometry * mech.length:
-                    return k, f"{START}: taking the branch the file's configuration lies on"
+            on = [k for k in moving if _reaches(solver, curve, c, branches[k], x_ref, drawn)]
+            if len(on) == 1:  # (the drawing on another change point lies on both branches: no answer)
+                return on[0], f"{START}: taking the branch the file's configuration lies on"
     K = mech.closure.jacobian(c.q) * curve.scale  # ker K of the rank the local analysis found
     null = np.linalg.svd(K[:, curve.free])[2][local.rank:] if K.size else np.eye(len(curve.free))
     e = np.zeros(mech.nv)
@@ -379,6 +382,14 @@ def _starting(solver, curve, local, branches, moving, c: Crossing, direction):
     if came not in moving and moving:
         came = moving[0]
     return came, f"{START}: taking the branch nearest the input's own direction (projected on ker K)"
+
+
+def _reaches(solver, curve, c: Crossing, rates, x, drawn) -> bool:
+    """Whether the branch of tangent ``rates`` at the change point c, followed to input value x, reaches the
+    configuration whose signature (PositionSolver.signature) is ``drawn``."""
+    q = follow(curve, c.q, c.x, rates, x)
+    return q is not None and bool(np.linalg.norm(solver.signature(q) - drawn) <= solver.mech.tolerances.geometry
+                                  * solver.mech.length)
 
 
 #: How a change point at the start of a motion is said (analysis.motion.sweep's notes read it).

@@ -371,6 +371,10 @@ def _through_change_points(solver, res, fixed, progress, max_steps, closed_form,
         cp, v, why = crossing(solver, curve, res, c, branch == "other", prior if c.before < 0 else None)
         named.append(cp)
         notes.append(_change_point_note(solver, name, res.unit, cp, why, branch))
+        if len(cp.local.branches) < 2 and not c.limit:  # not a crossing of branches: the engine went on along its one
+            named.pop()
+            notes.pop()
+            continue
         if v is None or v[ix] * np.sign(h) < 0:  # not drivable through, or met running back (turn)
             if v is not None:
                 notes[-1] += "; met with the input running back: the motion is the engine's"
@@ -425,8 +429,9 @@ def _engine_took(solver, curve, res, k0, after, h) -> bool:
             return False
         if k > 0 and (res.values[k] - res.values[k - 1]) * h <= 0:
             return False
-        if np.linalg.norm(pin.difference(solver.mech.model, res.q[k], q) / curve.scale) > tol.geometry:
-            return False
+        if np.linalg.norm(pin.difference(solver.mech.model, res.q[k], q) / curve.scale) > tol.geometry and \
+                np.linalg.norm(solver.signature(res.q[k]) - solver.signature(q)) > tol.geometry * solver.mech.length:
+            return False  # (the joint centres apart: not an angle written a turn away)
     return True
 
 
@@ -435,14 +440,18 @@ GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index cou
 
 def _change_point_note(solver, name, unit, cp, why, branch) -> str:
     """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
-    at = f"{cp.input:.9g} m" if unit == "m" else f"{cp.input:.9g} rad ({np.degrees(cp.input):.6g} deg)"
+    # (located where the constraint measure is least: to about the square root of the closure's round-off)
+    at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
     n = len(cp.local.branches)
-    what = f"{_WORDS.get(n, str(n))} branches cross" if n > 1 else "the configuration space is singular"
+    what = f"{_WORDS.get(n, str(n))} branches cross" if n > 1 else \
+        f"the loops' Jacobian loses rank (local analysis: {cp.local.kind})"
     if cp.goes is not None and why and why.startswith(START):
         how = why.split("; ")[0] + ("; taking the other one instead, as --branch other asks" if cp.switched else "")
         why = "; ".join(why.split("; ")[1:]) or None
     elif cp.goes is None:
-        how = "no branch through it moves the input"
+        how = ("no branch through it moves the input with the other inputs held" if n else
+               "the local analysis finds no branch through it")
+        how += ": the motion is the engine's"
     elif cp.switched:
         how = "continuing on the other branch, as --branch other asks (the default continues the motion's tangent)"
     else:
