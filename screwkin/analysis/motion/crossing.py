@@ -63,7 +63,6 @@ def reclosing(solver, res, q_k, tight):
     return q_at
 
 
-
 @dataclass(frozen=True)
 class ChangePoint:
     """A constraint singularity met along a sweep: ``input`` [rad or m], the measure there, the
@@ -77,7 +76,7 @@ class ChangePoint:
     came: int | None
     goes: int | None
     located: bool  # found here (a dip without a sign change), not by singular_points
-    switched: bool = False  # a motion passing it took the other branch, as asked (Crossing.switched)
+    switched: bool = False  # a motion passing it took the other branch, as asked (sweep's branch="other")
 
 
 def _direction(mech, rates):
@@ -104,7 +103,6 @@ def nearest_branch(mech, local, rates):
     return best
 
 
-
 @dataclass(frozen=True)
 class Crossing:
     """A change point a motion meets (``passed``): its input value x, configuration q, relative sigma,
@@ -123,9 +121,9 @@ class Crossing:
 
 def constraint_profile(mech, Q, rank: int | None = None) -> tuple:
     """(the relative smallest singular value of the scaled K at each configuration of Q (N,), the rank
-    it is taken at): as analysis.singularities.singular.measures' "constraint" with ``rank`` (default
-    the largest rank met along Q) for the generic one (a motion's configurations are generic but for isolated ones);
-    the Jacobians batched where the closure is (analysis.motion.batch_sweep.batch_closure)."""
+    it is taken at): analysis.singularities.singular.measures' "constraint", with ``rank`` (default the
+    largest rank met along Q: a motion's configurations are generic but for isolated ones) for the
+    generic one; the Jacobians batched where the closure is (analysis.motion.batch_sweep.batch_closure)."""
     Q = np.atleast_2d(np.asarray(Q, float))
     if not mech.cuts or not len(Q):
         return np.ones(len(Q)), 0
@@ -154,8 +152,6 @@ def passed(solver, res) -> list:
     Tolerances.singular -- at the start, at a dip between two recorded configurations (refined by
     bounded minimization over the input, the loops closed again from the recorded one), or at a limit
     position an engine located (an actuator singularity where K itself loses rank: a change point)."""
-    from scipy.optimize import minimize_scalar
-
     mech, tol = solver.mech, solver.mech.tolerances
     xs = np.asarray(res.values, float)
     if not len(xs):
@@ -165,30 +161,18 @@ def passed(solver, res) -> list:
     if r == 0:
         return out
     tight = replace(tol, closure=TIGHT_CLOSURE, max_iterations=60)
-    g = _Rank(r)
     for k, lo_k, hi_k in dips(m, xs):
         if 0 < k < len(xs) - 1 and (xs[k] - xs[lo_k]) * (xs[hi_k] - xs[k]) < 0:
             continue  # the input turns back here: a limit position (listed by the engine)
-        if not (m[k] < tol.singular or _may_reach_zero(m, xs, k)):
-            continue
         if m[k] < tol.singular:
             x, q, s = float(xs[k]), res.q[k], float(m[k])
-        else:
-            q_at = reclosing(solver, res, res.q[k], tight)
-
-            def sigma(x, q_at=q_at):
-                try:
-                    return _measure(mech, q_at(x), g)
-                except AssemblyError:
-                    return np.inf
-
-            lo, hi = sorted((xs[lo_k], xs[hi_k]))
-            x = float(minimize_scalar(sigma, bounds=(lo, hi), method="bounded", options={"xatol": tol.closure}).x)
-            try:
-                q = q_at(x)
-            except AssemblyError:
+        elif _may_reach_zero(m, xs, k):
+            found = _least(solver, res, res.q[k], sorted((xs[lo_k], xs[hi_k])), r, tight)
+            if found is None:
                 continue
-            s = _measure(mech, q, g)
+            x, q, s = found
+        else:
+            continue
         if not s < tol.singular:
             continue
         at = next((j for j in (k, lo_k, hi_k) if abs(xs[j] - x) <= tol.equal * max(1.0, abs(x))), None)
@@ -204,28 +188,17 @@ def passed(solver, res) -> list:
             continue  # outside the recorded motion
         out.append(Crossing(x, np.asarray(q, float), s, before, at, rank=r))
     for lim in res.limits:  # a "limit position" where K loses rank is a change point
-        s = _measure(mech, lim.q, g)
+        s = _measure(mech, lim.q, r)
         if not s < tol.singular:
             continue
         before = _limit_index(xs, lim.input)
         x, q = float(lim.input), np.asarray(lim.q, float)
-        # located as a limit (a double root, to about the square root of round-off): refined as the dips
-        half = 0.5 * abs(xs[before] - x) if abs(xs[before] - x) > 0 else tol.geometry
-        q_at = reclosing(solver, res, q, tight)
-
-        def sigma(x, q_at=q_at):
-            try:
-                return _measure(mech, q_at(x), g)
-            except AssemblyError:
-                return np.inf
-
-        found = minimize_scalar(sigma, bounds=(x - half, x + half), method="bounded", options={"xatol": tol.closure})
-        if found.fun < s:
-            try:
-                x, q, s = float(found.x), q_at(float(found.x)), float(found.fun)
-            except AssemblyError:
-                pass
-        out.append(Crossing(x, q, s, before, None, True, rank=r))
+        # located as a limit (a double root: to about the square root of round-off), refined as a dip is
+        half = max(0.5 * abs(xs[before] - x), tol.geometry)
+        found = _least(solver, res, q, (x - half, x + half), r, tight)
+        if found is not None and found[2] < s:
+            x, q, s = found
+        out.append(Crossing(x, np.asarray(q, float), s, before, None, True, rank=r))
     seen, unique = [], []
     for c in sorted(out, key=lambda c: c.before):
         if any(abs(c.x - d.x) <= tol.geometry * max(1.0, abs(c.x)) and abs(c.before - d.before) <= 1 for d in seen):
@@ -247,14 +220,31 @@ def _may_reach_zero(m, xs, k) -> bool:
     return bool(slopes) and m[k] <= 2 * max(slopes) * step
 
 
-class _Rank:
-    def __init__(self, r):
-        self.rank_K = r
+def _measure(mech, q, rank: int) -> float:
+    return float(constraint_profile(mech, [q], rank)[0][0])
 
 
-def _measure(mech, q, g) -> float:
-    m, _ = constraint_profile(mech, [q], g.rank_K)
-    return float(m[0]) if g.rank_K else 1.0
+def _least(solver, res, q, bounds, rank, tight):
+    """(x, configuration, measure) where the constraint measure is least for the input within bounds, the
+    loops closed again from q at each value (bounded minimization, to the closure tolerance); None
+    where they cannot be closed there."""
+    from scipy.optimize import minimize_scalar
+
+    mech = solver.mech
+    q_at = reclosing(solver, res, q, tight)
+
+    def sigma(x):
+        try:
+            return _measure(mech, q_at(x), rank)
+        except AssemblyError:
+            return np.inf
+
+    x = float(minimize_scalar(sigma, bounds=tuple(bounds), method="bounded", options={"xatol": mech.tolerances.closure}).x)
+    try:
+        q = q_at(x)
+    except AssemblyError:
+        return None
+    return x, q, _measure(mech, q, rank)
 
 
 def _limit_index(xs, x) -> int:
@@ -264,7 +254,7 @@ def _limit_index(xs, x) -> int:
     d = np.diff(xs)
     for k in range(len(d)):
         turns = d[k] == 0 or (k > 0 and d[k] * d[k - 1] < 0)
-        if turns and abs(xs[k] - x) <= 2 * max(np.max(np.abs(d[max(k - 1, 0):k + 2])), 0.0):
+        if turns and abs(xs[k] - x) <= 2 * np.max(np.abs(d[max(k - 1, 0):k + 2])):
             return k
     return len(xs) - 1
 

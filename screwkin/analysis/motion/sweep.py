@@ -342,12 +342,14 @@ def _finish(solver, name, motion, rate, requested, turn, unit, method="tracker")
 
 
 def _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior=None):
-    """The motion res carried through the change points it meets (analysis.motion.change_points: passed,
+    """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it
     slipped onto the other, or stopped or turned back there as at a limit position) the motion is cut
-    there and the sweep goes on from the branch's configuration at the next grid value.  Each change
-    point is named in ``change_points`` and in ``notes``."""
+    there and the sweep goes on from the branch's configuration at the next grid value (with ``turn``,
+    until it is back there: the whole circuit from the change point on).  A change point met with the
+    input running back (after a limit position, with ``turn``) is named, the engine's motion kept.
+    Each change point is named in ``change_points`` and in ``notes``."""
     name = res.input
     start, stop, steps = res.requested
     h = (stop - start) / steps if steps else 0.0
