@@ -167,7 +167,8 @@ def passed(solver, res) -> list:
         if m[k] < tol.singular:
             x, q, s = float(xs[k]), res.q[k], float(m[k])
         elif _may_reach_zero(m, xs, k):
-            found = _least(solver, res, res.q[k], sorted((xs[lo_k], xs[hi_k])), r, tight)
+            bounds = sorted((xs[lo_k], xs[hi_k]))
+            found = _again(solver, out, res, k, lo_k, hi_k, bounds) or _least(solver, res, res.q[k], bounds, r, tight)
             if found is None:
                 continue
             x, q, s = found
@@ -222,6 +223,18 @@ def _may_reach_zero(m, xs, k) -> bool:
 
 def _measure(mech, q, rank: int) -> float:
     return float(constraint_profile(mech, [q], rank)[0][0])
+
+
+def _again(solver, out, res, k, lo_k, hi_k, bounds):
+    """(x, configuration, measure) of a change point already found (in ``out``) that this dip is another
+    pass of (a motion through limit positions passes one point again and again): its input within the
+    dip's bounds, its joint centres nearer the recorded configuration k than the neighbours are; else None."""
+    sig = solver.signature
+    reach = max(np.linalg.norm(sig(res.q[lo_k]) - sig(res.q[k])), np.linalg.norm(sig(res.q[hi_k]) - sig(res.q[k])))
+    for c in out:
+        if bounds[0] <= c.x <= bounds[1] and np.linalg.norm(sig(c.q) - sig(res.q[k])) <= reach:
+            return c.x, c.q, c.sigma
+    return None
 
 
 def _least(solver, res, q, bounds, rank, tight):
@@ -301,7 +314,7 @@ def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None):
     nearest the input's direction projected on ker K -- unless ``prior`` (input value, configuration)
     gives where the motion came from before it (a chunk of a longer sweep)."""
     mech = solver.mech
-    local = local_analysis(mech, c.q, inputs=solver.inputs, generic_rank=c.rank or None)
+    local = _local(solver, c)
     branches = [_branch_rates(mech, b) for b in local.branches]
     xs = np.asarray(res.values, float)
     direction = _arriving(xs, c, res.requested)
@@ -384,6 +397,17 @@ def _reaches(solver, curve, c: Crossing, rates, x, drawn) -> bool:
 
 #: How a change point at the start of a motion is said (analysis.motion.sweep's notes read it).
 START = "the motion starts on it"
+
+
+def _local(solver, c: Crossing) -> LocalAnalysis:
+    """The local analysis at the change point c, kept in the mechanism's cache by its configuration (to
+    Tolerances.geometry): a motion through limit positions (``turn``) passes the same point again and again."""
+    mech = solver.mech
+    key = ("crossing.local", tuple(solver.inputs), c.rank,
+           tuple(np.round(np.asarray(c.q) / mech.tolerances.geometry).astype(np.int64)))
+    if key not in mech.cache:
+        mech.cache[key] = local_analysis(mech, c.q, inputs=solver.inputs, generic_rank=c.rank or None)
+    return mech.cache[key]
 
 
 def _arriving(xs, c: Crossing, requested) -> float:

@@ -369,7 +369,7 @@ def _through_change_points(solver, res, fixed, progress, max_steps, closed_form,
                 q_end = c.q
             end = _finish(solver, name, Motion([stop], [q_end]), res.rate, res.requested, res.turn, res.unit)
             return replace(_joined(solver, res, _slice(res, c.before + 1), end, None, (), (), c),
-                           change_points=res.change_points + tuple(named), notes=res.notes + tuple(notes))
+                           change_points=res.change_points + tuple(named), notes=_once(res.notes + tuple(notes)))
         cp, v, why = crossing(solver, curve, res, c, branch == "other", prior if c.before < 0 else None)
         named.append(cp)
         notes.append(_change_point_note(solver, name, res.unit, cp, why, branch))
@@ -418,7 +418,12 @@ def _through_change_points(solver, res, fixed, progress, max_steps, closed_form,
         return _joined(solver, res, head, middle, tail, named, notes, c)
     if not named:
         return res
-    return replace(res, change_points=res.change_points + tuple(named), notes=res.notes + tuple(notes))
+    return replace(res, change_points=res.change_points + tuple(named), notes=_once(res.notes + tuple(notes)))
+
+
+def _once(notes) -> tuple:
+    """The notes, each said once (a motion through limit positions passes one change point again and again)."""
+    return tuple(dict.fromkeys(notes))
 
 
 def _engine_took(solver, curve, res, k0, after, h) -> bool:
@@ -499,5 +504,5 @@ def _joined(solver, res, head, middle, tail, named, notes, c):
                    limits=head.limits + (tail.limits if tail is not None else ()),
                    circuit_closed=bool(tail is not None and tail.circuit_closed), coupled=coupled,
                    skipped=head.skipped + (tail.skipped if tail is not None else ()),
-                   notes=head.notes + tuple(methods) + tuple(notes) + (tail.notes if tail is not None else ()),
+                   notes=_once(head.notes + tuple(methods) + tuple(notes) + (tail.notes if tail is not None else ())),
                    change_points=head.change_points + tuple(named) + (tail.change_points if tail is not None else ()))
