@@ -492,8 +492,8 @@ def _joined(solver, res, head, middle, tail, named, notes, c):
     coupled = None
     if res.coupled is not None:
         coupled = {k: np.concatenate([p.coupled[k] for p in parts if p.coupled is not None]) for k in res.coupled}
-    methods = [] if tail is None or tail.method == head.method else [f"after the change point the motion is "
-                                                                       f"computed by: {tail.method}"]
+    methods = [] if tail is None or tail.method == head.method else [
+        f"from {res.input} = {tail.values[0]:.9g} on (after the change point) the motion is computed by: {tail.method}"]
     stopped, reason = (last.stopped_at, last.stop_reason) if tail is not None else (None, None)
     if tail is None and middle is not None and len(middle.values) and \
             abs(middle.values[-1] - res.requested[1]) > solver.mech.tolerances.equal * max(1.0, abs(res.requested[1])):
