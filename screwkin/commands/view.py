@@ -24,7 +24,7 @@ from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player
 from ..units import unit_text
 from ..present.viewplanar import colour_links, link_colours, planar_basis
-from ._configuration import add_configuration_options, configuration, mode_line, moved_not_set
+from ._configuration import add_branch_option, add_configuration_options, configuration, mode_line, moved_not_set
 from ._output_frame import add_point_option, named_points
 from ._values import joint_assignments, joint_inputs, parse_range
 from ..model.topology import open_joints
@@ -39,6 +39,7 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
     common(sp)
     add_configuration_options(sp)
+    add_branch_option(sp, "--sweep's motion")
     sp.add_argument("--output", help="output link: its frame is drawn, singularities are marked on it")
     sp.add_argument("--sweep", metavar="NAME=A:B:N", help="animate the motion of one input (other inputs from --set)")
     sp.add_argument("--html", help="write a self-contained static HTML page of the scene and exit")
@@ -127,8 +128,10 @@ def run(mech, args) -> int:
         inputs = sweep_inputs(mech, name, fixed)
         solver = PositionSolver(mech, inputs)
         # the mode followed (--mode K, --near), chosen and said as sweep's
-        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed,
+        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed, branch=args.branch,
                     q_start=lambda: configuration(mech, args, moved={name: float(values[0])}, inputs=inputs))
+        for line in res.change_point_notes:  # the change points passed, and the branch taken at each
+            print(f"note: {line}")
         motion = res.q
         q = res.q[0]
         frames = [f"{name} = {unit_text(v, unit, 4)}" for v in res.values]
