@@ -78,10 +78,10 @@ def numbers(text, count, what, problems, default, bound=None, unit="m", low=None
         problems.append(f"{what}: {quote(text)} contains NaN or infinite numbers")
         return tuple(default)
     if bound is not None and any(abs(v) > bound for v in values):
-        problems.append(f"{what}: {quote(text)} is not a plausible value (beyond {bound:g} {unit})")
+        problems.append(f"{what}: {quote(text)} is not a plausible value (beyond {bound:g}{' ' + unit if unit else ''})")
         return tuple(default)
     if low is not None and any(v < low for v in values):
-        problems.append(f"{what}: {quote(text)} is not a plausible value (below {low:g} {unit})")
+        problems.append(f"{what}: {quote(text)} is not a plausible value (below {low:g}{' ' + unit if unit else ''})")
         return tuple(default)
     return values
 
