@@ -450,8 +450,10 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
     targets = _read_targets(root, links, {j.name for j in joints}, problems)
     problems.fail_if_any(path)
     warnings += inertia_warnings(links)
-    warnings += check_meshes(path, root, package_dirs)
+    meshes = []
+    warnings += check_meshes(path, root, package_dirs, meshes)
     return MechanismSpec(
+        files_read=meshes,
         path=str(path),
         name=root.get("name") or Path(path).stem,
         format="urdf",
