@@ -11,6 +11,7 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
+from ..analysis.motion.modes import continuum_words
 from ..analysis.motion.solution import PositionResult
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
@@ -216,8 +217,8 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
     for note in res.notes:
         lines.append(f"note: {note}")
     if res.free_dofs:
-        lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
-                     "the solutions form a continuum and only some are shown")
+        lines.append(f"note: {continuum_words(res.free_dofs)}: the solutions shown are samples of it, not "
+                     "assembly modes")
     for k, s in enumerate(shown, 1):
         if s.continuum:
             flag = ("  SINGULAR: these inputs leave a finite motion (a continuum of configurations"
