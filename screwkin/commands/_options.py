@@ -50,6 +50,7 @@ BOUNDS = {
     "samples": (1, 10_000_000),       # scan --samples (100,000 take about 0.3 s)
     "threads": (1, 256),              # scan --threads
     "grid": (2, 2_000),               # map / view --sweep N: values along one input
+    "local_samples": (1, 100_000),    # mobility --local-samples: tangent directions continued at a singular point
     "grid_total": (4, 100_000),       # map: both inputs together (about 25 s on the five-bar)
     "facets": (3, 1_000),             # grasp --facets: edges of a friction cone's pyramid
     "candidates": (1, 10_000),        # synthesize --candidates
