@@ -27,8 +27,10 @@ from __future__ import annotations
 
 import errno as errnos
 import io
+import logging
 import os
 import stat
+import sys
 
 from ..errors import OutputError
 
@@ -200,6 +202,29 @@ def write_figure(fig, path, **savefig) -> None:
     fmt = os.path.splitext(str(path))[1][1:].lower() or "png"
     if fmt not in _METADATA:  # matplotlib refuses metadata (a title) for the others: "not supported for format"
         savefig.pop("metadata", None)
+    elif fmt == "pdf" and "Description" in savefig.get("metadata", {}):  # PDF's word for it (else a UserWarning)
+        savefig["metadata"] = {("Subject" if k == "Description" else k): v for k, v in savefig["metadata"].items()}
     buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, **savefig)
+    said = _Said()  # what matplotlib logs as it writes (PostScript: "does not support transparency")
+    logger = logging.getLogger("matplotlib")
+    logger.addHandler(said)
+    propagate, logger.propagate = logger.propagate, False
+    try:
+        fig.savefig(buf, format=fmt, **savefig)
+    finally:
+        logger.removeHandler(said)
+        logger.propagate = propagate
     write_output(path, buf.getvalue())
+    for message in dict.fromkeys(said.messages):  # as every warning is said: one line, naming the file
+        print(f"warning: {path}: matplotlib: {message}", file=sys.stderr)
+
+
+class _Said(logging.Handler):
+    """The warnings a logger gives while a figure is written, kept to be said as screwkin says warnings."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages = []
+
+    def emit(self, record):
+        self.messages.append(" ".join(record.getMessage().split()))
