@@ -107,6 +107,9 @@ def test_the_output_file_keeps_the_permissions_a_new_file_gets(tmp_path):
     finally:
         os.umask(old)
     assert (tmp_path / "o.txt").stat().st_mode & 0o777 == 0o644
+    os.chmod(tmp_path / "o.txt", 0o600)  # a private output replaced stays private
+    write_output(tmp_path / "o.txt", "y")
+    assert (tmp_path / "o.txt").stat().st_mode & 0o777 == 0o600 and (tmp_path / "o.txt").read_text() == "y"
 
 
 # ------------------------------------------------------------------ outputs onto files the model was read from

@@ -120,6 +120,8 @@ class OutputFile(WholeOrNothing):
                     self._f = open(self.path, mode, encoding=encoding)
             else:
                 fd, self._partial = open_partial(self.path)
+                if st is not None:  # a file replaced keeps its permissions (a private one stays private)
+                    os.fchmod(fd, stat.S_IMODE(st.st_mode))
                 self._f = os.fdopen(fd, mode, encoding=encoding)
         except OSError as exc:
             raise OutputError(self.path, os_reason(exc)) from None
