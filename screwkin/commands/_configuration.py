@@ -82,7 +82,7 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     values.update(moved or {})
     near = near_values(mech, args)
     wanted = getattr(args, "mode", None)
-    args.mode_chosen = None
+    args.mode_chosen = args.continuum = None
     if not values and not held:
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
@@ -98,8 +98,10 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     if missing:
         raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
     q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
-    for note in res.notes:  # a --near value the mode found lies far from
+    for note in res.notes:  # a --near value the mode found lies far from; a continuum's sample
         print(f"note: {note}", file=sys.stderr)
+    if res.free_dofs:
+        args.continuum = {"free_dofs": res.free_dofs}
     if n > 1:
         args.mode_chosen = {"index": k, "of": n}
         if not getattr(args, "json", False):
@@ -144,9 +146,12 @@ def near_values(mech, args) -> dict | None:
 
 
 def with_mode(args, d: dict) -> dict:
-    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes."""
+    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes, with
+    "continuum": {"free_dofs"} when it was a sample of a continuum the inputs leave (no modes then)."""
     if getattr(args, "mode_chosen", None):
         d["mode"] = args.mode_chosen
+    if getattr(args, "continuum", None):
+        d["continuum"] = args.continuum
     return d
 
 

@@ -196,6 +196,8 @@ def _interactive(mech, args) -> int:
     print(live.opened, flush=True)
     if live.mode_index[1] > 1:  # the mode it opened in, said as every command says it
         print(f"note: {mode_line(*live.mode_index, near=False)}", file=sys.stderr)
+    for note in live.notes:
+        print(f"note: {note}", file=sys.stderr)
     q = live.state.q
     scene = build_scene(mech, q, output=args.output)
     if planar_basis(mech, q) is not None:

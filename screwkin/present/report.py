@@ -11,6 +11,7 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
+from ..analysis.motion.modes import continuum_words
 from ..analysis.motion.solution import PositionResult
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
@@ -91,6 +92,9 @@ def modes_line(res, n: int) -> str:
     36 more solutions are complex", or "3 found ...; completeness not certified because ..."."""
     c = res.modes
     s = "s" if n != 1 else ""
+    if res.free_dofs:  # a continuum: what was found are samples of it, not modes to count
+        return (f"{n} configuration{s} found from {res.starts} starting configurations: "
+                f"{continuum_words(res.free_dofs)}: they are samples of it, not assembly modes")
     if c is None:
         return f"{n} assembly mode{s} found from {res.starts} starting configurations"
     sets = {x.angle_sets for x in res.solutions}
@@ -222,9 +226,6 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
                      f"{hidden} not ({'; '.join(why)}): --all shows them")
     for note in res.notes:
         lines.append(f"note: {note}")
-    if res.free_dofs:
-        lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
-                     "the solutions form a continuum and only some are shown")
     for k, s in enumerate(shown, 1):
         if s.continuum:
             flag = ("  SINGULAR: these inputs leave a finite motion (a continuum of configurations"

@@ -34,6 +34,7 @@ from ...model.square import SquareSystem
 from ...model.cuts import Assembly
 from ...model.symmetry import find_symmetries
 from .dyad_modes import dyad_modes
+from .modes import continuum_words
 from .known_counts import known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
 
@@ -85,7 +86,7 @@ def obstacle(solver) -> str | None:
     if why:
         return f"the loop closure is not polynomial: {why}"
     if solver.free_dofs:
-        return f"these inputs leave {solver.free_dofs} degree(s) of freedom free (a continuum)"
+        return continuum_words(solver.free_dofs)
     if not mech.cuts:
         return NO_LOOPS
     return None
