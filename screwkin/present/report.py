@@ -83,7 +83,8 @@ def modes_dict(c) -> dict:
     """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
-            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail)}
+            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail),
+            "certificate_check": dict(c.check) or None}
 
 
 def modes_line(res, n: int) -> str:

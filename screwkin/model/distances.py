@@ -1,0 +1,145 @@
+"""Two rigid bodies joined by six distances (a Stewart-Gough platform), in the platform's own pose:
+the system a coefficient-parameter homotopy tracks (analysis.motion.generic_modes), the same whether
+the file writes the platform on a floating joint or carried by one leg in the tree.
+
+Unknowns x = (t / L, q): the translation of the platform's frame and its quaternion (Pinocchio's
+order x, y, z, w) on q.q = 1 (q and -q are one pose: a sign symmetry).  Rows, one per leg:
+
+    G_k(x) = |t + Q(q) B_k - A_k|^2 / L^2            (A_k on the ground, B_k on the platform)
+
+and the family G(x) = c: c_k = r_k^2 / L^2 the legs' squared lengths.  These are exactly the linear
+offsets of analysis.motion.monodromy, so the family's generic solution set (monodromy at a random
+complex c0, certified by the trace test or the published count) is carried to any leg lengths by
+one straight segment in c (Morgan and Sommese 1989).  A step moves the platform in tangent
+coordinates: a translation and a rotation vector d in the world (q -> exp(d / 2) q), as
+model.algebraic moves a free flyer.
+
+``chain_angles``: the joint angles of a leg that carries the platform (two revolutes meeting at the
+ground point, inputs, three revolutes meeting at the platform point) that put the platform at a
+given pose -- Paden-Kahan subproblems, every real solution (up to four).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .geometry import quaternion_matrix, quaternion_product
+
+__all__ = ["SixDistances", "chain_angles"]
+
+_SERIES = 1e-8
+
+
+class SixDistances:
+    """The six distance rows in (t / L, q) (see the module); A (6, 3) ground points in the world,
+    B (6, 3) platform points in the platform's frame, both already divided by L."""
+
+    n, width = 6, 7
+
+    def __init__(self, A, B):
+        self.A = np.asarray(A, float)
+        self.B = np.asarray(B, float)
+        self.closure = self  # the trace test draws its random points from ``closure``
+
+    def _v(self, X):
+        R = quaternion_matrix(X[:, 3:])
+        RB = np.einsum("pij,kj->pki", R, self.B)
+        return X[:, None, :3] + RB - self.A[None], RB
+
+    def equations(self, X, jacobian: bool = True):
+        X = np.asarray(X, complex)
+        v, RB = self._v(X)
+        G = np.einsum("pki,pki->pk", v, v)
+        if not jacobian:
+            return G, None
+        return G, np.concatenate([2 * v, 2 * np.cross(RB, v)], axis=2)
+
+    def offsets(self, X):
+        return self.equations(X, jacobian=False)[0]
+
+    def residual(self, X, c):
+        """(P,) the largest |G(x) - c|."""
+        return np.abs(self.offsets(X) - np.asarray(c)).max(axis=1)
+
+    def retract(self, X, dT):
+        X = np.array(X, complex)
+        X[:, :3] += dT[:, :3]
+        d = dT[:, 3:] * 0.5
+        z = np.einsum("pi,pi->p", d, d)
+        r = np.sqrt(z)
+        small = np.abs(z) < _SERIES
+        sinc = np.where(small, 1 - z / 6, np.sin(np.where(small, 1.0, r)) / np.where(small, 1.0, r))
+        qn = quaternion_product(np.c_[d * sinc[:, None], np.cos(r)], X[:, 3:])
+        X[:, 3:] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
+        return X
+
+    def tangent(self, X):
+        P = len(X)
+        T = np.zeros((P, 7, 6), complex)
+        T[:, np.arange(3), np.arange(3)] = 1.0
+        q = X[:, 3:]
+        for k in range(3):
+            e = np.zeros(4)
+            e[k] = 0.5
+            T[:, 3:, 3 + k] = quaternion_product(np.broadcast_to(e, q.shape), q)
+        return T
+
+    def constraints(self, X):
+        q = np.asarray(X)[:, 3:]
+        return (np.einsum("pi,pi->p", q, q) - 1.0)[:, None]
+
+    def on_variety(self, X, tol: float = 1e-10) -> np.ndarray:
+        return np.abs(self.constraints(X)[:, 0]) <= tol * (1.0 + np.abs(X).max(axis=1)) ** 2
+
+    def random_points(self, rng, P: int) -> np.ndarray:
+        q = rng.normal(size=(P, 4)) + 1j * rng.normal(size=(P, 4)) * 0.5
+        q = q / np.sqrt(np.einsum("pi,pi->p", q, q))[:, None]
+        t = (rng.normal(size=(P, 3)) + 1j * rng.normal(size=(P, 3))) * 0.5
+        return np.c_[t, q]
+
+
+def _rotation(w, theta):
+    K = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    return np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K
+
+
+def _sub1(w, p, q) -> float:
+    """theta with exp(w theta) p = q (their components across w)."""
+    pp, qq = p - w * (w @ p), q - w * (w @ q)
+    return float(np.arctan2(w @ np.cross(pp, qq), pp @ qq))
+
+
+def _sub2(w1, w2, p, q, tol: float = 1e-9) -> list:
+    """Every real (theta1, theta2) with exp(w1 theta1) exp(w2 theta2) p = q (Paden-Kahan)."""
+    c = float(w1 @ w2)
+    if abs(abs(c) - 1.0) < 1e-12:
+        return []
+    a = (c * (w2 @ p) - w1 @ q) / (c * c - 1.0)
+    b = (c * (w1 @ q) - w2 @ p) / (c * c - 1.0)
+    n = np.cross(w1, w2)
+    g2 = (p @ p - a * a - b * b - 2 * a * b * c) / (n @ n)
+    if g2 < -tol * max(p @ p, 1e-300):
+        return []
+    out = []
+    for g in {np.sqrt(max(g2, 0.0)), -np.sqrt(max(g2, 0.0))}:
+        z = a * w1 + b * w2 + g * n
+        out.append((_sub1(w1, z, q), _sub1(w2, p, z)))
+    return out
+
+
+def chain_angles(head_axes, tail_axes, A, p0, R0, p, R) -> list:
+    """Every real (theta_head (2,), theta_tail (3,)) of a leg (see the module): world axes at the
+    angles' zero (head through the ground point A, tail through the platform point, which is at p0
+    with the platform at rotation R0), the platform point wanted at p and the platform's rotation R."""
+    w1, w2 = head_axes
+    w3, w4, w5 = tail_axes
+    out = []
+    for t1, t2 in _sub2(w1, w2, p0 - A, p - A):
+        H = _rotation(w1, t1) @ _rotation(w2, t2)
+        N = H.T @ R @ R0.T
+        for t3, t4 in _sub2(w3, w4, w5, N @ w5):
+            S = _rotation(w3, t3) @ _rotation(w4, t4)
+            v = np.cross(w5, [1.0, 0, 0] if abs(w5[0]) < 0.9 else [0, 1.0, 0])
+            t5 = _sub1(w5, v, S.T @ N @ v)
+            out.append((np.array([t1, t2]), np.array([t3, t4, t5])))
+    return out
