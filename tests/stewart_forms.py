@@ -70,19 +70,13 @@ def urdf(base, plat, R, t, form: str = "tree", name: str = "stewart") -> str:
     return "\n".join(out)
 
 
-def frame_pose(R, t, plat):
-    """(R0, t0) of the URDF's platform frame in the geometry's platform frame: the frame sits at
-    B_1 with the axes the platform had when drawn (R)."""
-    return np.asarray(R, float), np.asarray(plat[0], float)
-
-
 def pose_of(mech, q, R_drawn, plat):
     """The platform's pose (R, t) as the geometry's: P_k = R B_k + t for every k."""
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, np.asarray(q, float))
     M = data.oMf[mech.model.getFrameId("platform")]
-    # world = M (R_drawn^T (B - B_1))  =>  R = M.R R_drawn^T, t = M.t - R B_1
-    Rg = M.rotation @ np.asarray(R_drawn).T
+    # the frame holds P_k - P_1 = R_drawn (B_k - B_1): world = M.R R_drawn (B - B_1) + M.t
+    Rg = M.rotation @ np.asarray(R_drawn)
     return Rg, M.translation - Rg @ plat[0]
 
 

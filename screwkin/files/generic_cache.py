@@ -23,6 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+try:
+    import resource
+except ImportError:  # no such module on Windows: no limit to read, nothing written
+    resource = None
+
 __all__ = ["folder", "key", "read", "write", "VERSION"]
 
 #: Bumped when the stored formulation changes: older files are ignored.
@@ -81,11 +86,12 @@ def read(name: str, width: int, n: int):
 
 
 def _may_write() -> bool:
+    if resource is None:
+        return False
     try:
-        import resource
         soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
         return soft == resource.RLIM_INFINITY
-    except (ImportError, OSError, ValueError, AttributeError):
+    except (OSError, ValueError, AttributeError):
         return False
 
 

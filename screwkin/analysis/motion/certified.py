@@ -140,7 +140,11 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
     if known is STEWART:  # a parameter homotopy from the architecture's generic solution set
         arch = generic_modes.architecture(problem, closure, mech.length)
         if arch is not None:
-            return generic_modes.platform_modes(solver, problem, closure, arch, seed, options)
+            modes, *counts = generic_modes.platform_modes(solver, problem, closure, arch, seed, options,
+                                                          lambda x: _lift(solver, problem, closure, x))
+            found, real, cplx, certificate, reason, detail, check = counts
+            return Certified(modes, ModeCount(found, certificate is not None, "parameter homotopy", real, cplx,
+                                              certificate, reason, detail, check))
     roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
                       trace_limit=options.trace_limit)
     ends = to_target(system, roots, np.zeros(system.n), options)

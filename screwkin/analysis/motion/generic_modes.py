@@ -47,11 +47,14 @@ _MOVED = 1e-6
 
 class Architecture:
     """A platform as six distances: ``A``, ``B`` (6, 3) [m] (A in the world, B in the frame of the
-    platform's joint ``joint``), ``r2`` the squared lengths at the inputs [m^2], ``L`` the scale;
+    platform's joint ``joint``), ``r2`` the squared lengths at the inputs [m^2], ``L`` the scale (the
+    largest coordinate of A and B);
     ``carrier`` the leg in the tree as (head joints, tail joints, A, B) or None (a floating joint)."""
 
-    def __init__(self, A, B, r2, L, joint, carrier):
-        self.A, self.B, self.r2, self.L = np.asarray(A, float), np.asarray(B, float), np.asarray(r2, float), L
+    def __init__(self, A, B, r2, joint, carrier):
+        self.A, self.B, self.r2 = np.asarray(A, float), np.asarray(B, float), np.asarray(r2, float)
+        # the scale from the geometry alone: the same platform written either way shares its generic set
+        L = self.L = float(max(np.abs(self.A).max(), np.abs(self.B).max(), 1e-9))
         self.joint, self.carrier = joint, carrier
         self.system = SixDistances(self.A / L, self.B / L)
         self.key = generic_cache.key("six distances", [self.A / L, self.B / L])
@@ -97,7 +100,7 @@ def architecture(problem, closure, L: float):
         carrier = (head, tail)
     else:
         return None
-    return Architecture(A, B, r2, L, joint, carrier)
+    return Architecture(A, B, r2, joint, carrier)
 
 
 def _group() -> SignGroup:
@@ -117,7 +120,7 @@ def generic_set(arch: Architecture, rng, options: MonodromyOptions):
             roots = Roots(X, c0, True, None, "", 0, 0, 0, 0, 0.0, group)
             return roots, how, where / f"{arch.key}.json", True
     x0 = system.random_points(rng, 1)
-    roots = all_roots(system, group, x0, rng, options, trace_test=False)
+    roots = all_roots(system, group, x0, rng, options, trace_test=False, stop_at=BOUND)
     how = None
     if len(roots.X) == BOUND:
         how = f"{BOUND} poses, the published bound ({SOURCE})"
@@ -130,9 +133,11 @@ def generic_set(arch: Architecture, rng, options: MonodromyOptions):
     return roots, how, path, False
 
 
-def platform_modes(solver, problem, closure, arch: Architecture, seed: int, options: MonodromyOptions):
-    """The modes of a platform (see the module) as analysis.motion.certified.Certified."""
-    from . import certified  # (it calls this module)
+def platform_modes(solver, problem, closure, arch: Architecture, seed: int, options: MonodromyOptions, lift_legs):
+    """The modes of a platform (see the module): (modes [(q, Assembly, angle sets, simple)], found, real,
+    complex, certificate or None, reason, detail, check) -- analysis.motion.certified makes them a
+    Certified.  ``lift_legs(x)``: the configuration with the eliminated legs' angles solved from the
+    closure's unknowns x, or None."""
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
     roots, how, path, reused = generic_set(arch, rng, options)
@@ -157,7 +162,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, opti
     for i in distinct:
         if not real[i]:
             continue
-        got = _lift(solver, problem, closure, arch, X[i].real)
+        got = _onto_joints(solver, problem, closure, arch, X[i].real, lift_legs)
         if got is None:
             lost += 1
             continue
@@ -194,15 +199,12 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, opti
               "at_infinity": check["at_infinity"], "generic_set": str(path) if path else None,
               "generic_set_reused": reused, "generic_seconds": round(t1 - t0, 3),
               "seconds": round(time.perf_counter() - t0, 3), "lost_polishing": lost}
-    count = certified.ModeCount(len(distinct), certificate is not None, "parameter homotopy", len(modes),
-                                n_complex, certificate, "; ".join(why), detail, check)
-    return certified.Certified(modes, count)
+    return modes, len(distinct), len(modes), n_complex, certificate, "; ".join(why), detail, check
 
 
-def _lift(solver, problem, closure, arch: Architecture, x):
+def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
     """(q, Assembly) of the real pose x = (t / L, q) on the file's joints -- of its angle sets the one
     within the joint limits nearest the reference configuration -- or None."""
-    from . import certified
     model, L = problem.model, arch.L
     R = _wxyz(x[3:7]).toRotationMatrix()
     t = x[:3] * L
@@ -226,7 +228,7 @@ def _lift(solver, problem, closure, arch: Architecture, x):
         return (outside, dist)
 
     for q in sorted(candidates, key=rank):
-        full = certified._lift(solver, problem, closure, closure.from_q(q))
+        full = lift_legs(closure.from_q(q))
         if full is None:
             continue
         a = newton.polish(problem.system, full, problem.frozen)
