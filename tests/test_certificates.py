@@ -117,7 +117,7 @@ def test_a_malformed_cache_file_is_not_read(tmp_path, shipped_cache):
     (name,) = list(shipped_cache.glob("*.json"))
     key, data = name.stem, json.loads(name.read_text())
     c0, X, how = generic_cache.read(key, 7, 6)
-    assert X.shape == (40, 7) and c0.shape == (6,) and "40 poses" in how
+    assert X.shape == (40, 7) and c0.shape == (6,) and "published bound" in how
     for bad in ({"version": 99}, {"key": "b" * 64}, {"roots": "x"}, {"roots": [[[1, 2, 3]]]},
                 {"c0": [[float("nan"), 0]] * 6}, {"certified_by": 3}):
         name.write_text(json.dumps({**data, **bad}))

@@ -98,15 +98,18 @@ def modes_line(res, n: int) -> str:
     each = (f"; each reached by {sets.pop()} joint-angle sets (universal and spherical joints written as "
             "revolutes, wrists flipped: one placement of the links)" if len(sets) == 1 and None not in sets
             and max(sets) > 1 else "")
+    kept = c.detail.get("generic_set")
+    kept = (f"; generic solution set {'reused from' if c.detail.get('generic_set_reused') else 'kept in'} {kept}"
+            if kept else "")
     if c.complete:
         more = (f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex (no real assembly)"
                 if c.complex else "")
         head = f"all {n} assembly modes" if n != 1 else "1 assembly mode, the only one"
-        return f"{head} (certified: {c.certificate}){more}{each}"
+        return f"{head} (certified: {c.certificate}){more}{each}{kept}"
     how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
            f"by homotopy continuation and from {res.starts} starting configurations")
     more = f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex" if c.complex else ""
-    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}"
+    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}{kept}"
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:

@@ -134,8 +134,6 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
                 + (f" ({solver.idle_dofs} idle degree(s) of freedom: links that spin without moving a joint "
                    "centre, not on a leg that is a distance)" if solver.idle_dofs else "")
                 + ": positive-dimensional solution sets are not tracked")
-    group = find_symmetries(closure, rng)
-    system = SquareSystem(closure, rng)
     known = known_count(closure, problem.frozen, problem.target)
     if known is STEWART:  # a parameter homotopy from the architecture's generic solution set
         arch = generic_modes.architecture(problem, closure, mech.length)
@@ -145,6 +143,8 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
             found, real, cplx, certificate, reason, detail, check = counts
             return Certified(modes, ModeCount(found, certificate is not None, "parameter homotopy", real, cplx,
                                               certificate, reason, detail, check))
+    group = find_symmetries(closure, rng)
+    system = SquareSystem(closure, rng)
     roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
                       trace_limit=options.trace_limit)
     ends = to_target(system, roots, np.zeros(system.n), options)

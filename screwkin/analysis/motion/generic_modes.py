@@ -123,12 +123,12 @@ def generic_set(arch: Architecture, rng, options: MonodromyOptions):
     roots = all_roots(system, group, x0, rng, options, trace_test=False, stop_at=BOUND)
     how = None
     if len(roots.X) == BOUND:
-        how = f"{BOUND} poses, the published bound ({SOURCE})"
+        how = f"the published bound ({SOURCE})"
     elif len(roots.X) < BOUND:
         roots = all_roots(system, group, roots.X[:1], rng, replace(options, budget=options.fallback_budget),
                           seeds=roots.X, trace_test=True, trace_limit=None)
         if roots.complete and len(roots.X) <= BOUND:
-            how = f"trace test (relative singular value {roots.trace:.1g})"
+            how = f"the trace test (relative singular value {roots.trace:.1g})"
     path = generic_cache.write(arch.key, roots.c0, roots.X, how) if how else None
     return roots, how, path, False
 
@@ -192,9 +192,9 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, opti
     check["checked"] = not why
     certificate = None
     if not why:
-        certificate = (f"{len(distinct)} poses by a parameter homotopy from the generic solution set of this "
-                       f"architecture ({len(roots.X)} poses, complete by the {how}): {len(roots.X)} paths, none "
-                       f"failed, {len(distinct)} distinct simple poses, at most {BOUND} ({SOURCE})")
+        certificate = (f"{len(distinct)} poses, a parameter homotopy from this architecture's generic solution set "
+                       f"({len(roots.X)} poses, complete by {how}): {len(roots.X)} paths, none failed, "
+                       f"{len(distinct)} distinct simple poses, at most {BOUND}")
     detail = {"roots": int(len(roots.X)), "paths": int(roots.paths + ends.paths), "failed": int(roots.failed + failed),
               "at_infinity": check["at_infinity"], "generic_set": str(path) if path else None,
               "generic_set_reused": reused, "generic_seconds": round(t1 - t0, 3),
