@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import quaternion_matrix, quaternion_product
+from .geometry import quaternion_product
 
 __all__ = ["SixDistances", "chain_angles"]
 
@@ -42,17 +42,28 @@ class SixDistances:
         self.closure = self  # the trace test draws its random points from ``closure``
 
     def _v(self, X):
-        R = quaternion_matrix(X[:, 3:])
-        RB = np.einsum("pij,kj->pki", R, self.B)
-        return X[:, None, :3] + RB - self.A[None], RB
+        """(v, RB): per leg the vector from A_k to the platform point, and R B_k; each a list of three
+        (P, 6) arrays (component-wise arithmetic: these stacks are small, numpy's calls dominate)."""
+        x, y, z, w = X[:, 3], X[:, 4], X[:, 5], X[:, 6]
+        xx, yy, zz, ww = x * x, y * y, z * z, w * w
+        xy, xz, xw, yz, yw, zw = x * y, x * z, x * w, y * z, y * w, z * w
+        R = ((ww + xx - yy - zz, 2 * (xy - zw), 2 * (xz + yw)),
+             (2 * (xy + zw), ww - xx + yy - zz, 2 * (yz - xw)),
+             (2 * (xz - yw), 2 * (yz + xw), ww - xx - yy + zz))
+        B, A = self.B, self.A
+        RB = [R[i][0][:, None] * B[:, 0] + R[i][1][:, None] * B[:, 1] + R[i][2][:, None] * B[:, 2] for i in range(3)]
+        v = [X[:, i, None] + RB[i] - A[:, i] for i in range(3)]
+        return v, RB
 
     def equations(self, X, jacobian: bool = True):
         X = np.asarray(X, complex)
         v, RB = self._v(X)
-        G = np.einsum("pki,pki->pk", v, v)
+        G = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
         if not jacobian:
             return G, None
-        return G, np.concatenate([2 * v, 2 * np.cross(RB, v)], axis=2)
+        J = np.stack([2 * v[0], 2 * v[1], 2 * v[2], 2 * (RB[1] * v[2] - RB[2] * v[1]),
+                      2 * (RB[2] * v[0] - RB[0] * v[2]), 2 * (RB[0] * v[1] - RB[1] * v[0])], axis=2)
+        return G, J
 
     def offsets(self, X):
         return self.equations(X, jacobian=False)[0]
@@ -77,11 +88,11 @@ class SixDistances:
         P = len(X)
         T = np.zeros((P, 7, 6), complex)
         T[:, np.arange(3), np.arange(3)] = 1.0
-        q = X[:, 3:]
-        for k in range(3):
-            e = np.zeros(4)
-            e[k] = 0.5
-            T[:, 3:, 3 + k] = quaternion_product(np.broadcast_to(e, q.shape), q)
+        x, y, z, w = (0.5 * X[:, 3 + k] for k in range(4))
+        # d/dd_k of exp(d / 2) q at d = 0: the Hamilton product (e_k / 2) q, (x, y, z, w) order
+        T[:, 3:, 3] = np.stack([w, -z, y, -x], 1)
+        T[:, 3:, 4] = np.stack([z, w, -x, -y], 1)
+        T[:, 3:, 5] = np.stack([-y, x, w, -z], 1)
         return T
 
     def constraints(self, X):
