@@ -113,13 +113,15 @@ def test_new_leg_lengths_reuse_the_generic_set(tmp_path, shipped_cache):
 
 def test_a_malformed_cache_file_is_not_read(tmp_path, shipped_cache):
     """The cache is read as untrusted input: another version, fields of another type or shape, numbers
-    not finite, a file that is no JSON, a huge file, a name that is no hash -- each is ignored."""
+    not finite, a set cut short (its digest), a file that is no JSON, a huge file, a name that is no
+    hash -- each is ignored."""
     (name,) = list(shipped_cache.glob("*.json"))
     key, data = name.stem, json.loads(name.read_text())
     c0, X, how = generic_cache.read(key, 7, 6)
     assert X.shape == (40, 7) and c0.shape == (6,) and "published bound" in how
     for bad in ({"version": 99}, {"key": "b" * 64}, {"roots": "x"}, {"roots": [[[1, 2, 3]]]},
-                {"c0": [[float("nan"), 0]] * 6}, {"certified_by": 3}):
+                {"c0": [[float("nan"), 0]] * 6}, {"certified_by": 3}, {"roots": data["roots"][:39]},
+                {"digest": "0" * 64}):
         name.write_text(json.dumps({**data, **bad}))
         assert generic_cache.read(key, 7, 6) is None
     name.write_text("[" * 10)
@@ -135,7 +137,9 @@ def test_the_solver_refuses_a_cached_root_that_is_no_root(tmp_path, shipped_cach
     (name,) = list(shipped_cache.glob("*.json"))
     data = json.loads(name.read_text())
     data["roots"][3][0][0] += 1e-3
+    data["digest"] = generic_cache._digest(data["c0"], data["roots"], data["certified_by"])  # passes the reader
     name.write_text(json.dumps(data))
+    assert generic_cache.read(name.stem, 7, 6) is not None
     base, plat, lengths, phc = sf.dietmaier()
     R, t = phc[0]
     mech, res = _solve(tmp_path, base, plat, R, t, "floating", {f"leg{k + 1}": float(lengths[k] - d) for k, d in

@@ -7,8 +7,8 @@ architecture's description (``key``).  Clearing it: delete the folder (``rm -rf 
 ``SCREWKIN_CACHE=off`` neither reads nor writes one.
 
 The files are ours but are read as untrusted input: at most 1 MiB, JSON only (no pickle), every field
-checked for its type and shape, numbers finite; a file that fails any check is ignored (and the set
-computed again).  The caller checks the roots themselves against its own system before using them.
+checked for its type and shape, numbers finite, the SHA-256 of its numbers and claim as written
+(a file cut short or edited); a file that fails any check is ignored (and the set computed again).  The caller checks the roots themselves against its own system before using them.
 Nothing is written when the process has a file-size limit (RLIMIT_FSIZE), the folder cannot be made
 or written, or the write fails in any way: the answer never depends on the cache, only its time.
 """
@@ -76,6 +76,8 @@ def read(name: str, width: int, n: int):
         how = data.get("certified_by")
         if not isinstance(how, str) or len(how) > 200:
             return None
+        if data.get("digest") != _digest(data["c0"], data["roots"], how):  # a file cut short or edited
+            return None
         c0 = _complex([data["c0"]], n)
         X = _complex(data["roots"], width)
         if c0 is None or X is None or not 1 <= len(X) <= 4096:
@@ -83,6 +85,11 @@ def read(name: str, width: int, n: int):
         return c0[0], X, how
     except (OSError, ValueError, TypeError, KeyError, IndexError):
         return None
+
+
+def _digest(c0, roots, how) -> str:
+    """SHA-256 of the stored numbers and the claim: a set cut short or edited is not read."""
+    return hashlib.sha256(json.dumps([c0, roots, how]).encode()).hexdigest()
 
 
 def _may_write() -> bool:
@@ -101,8 +108,9 @@ def write(name: str, c0, X, how: str) -> Path | None:
     if where is None or not _may_write():
         return None
     pair = lambda a: [[float(v.real), float(v.imag)] for v in a]  # noqa: E731
-    text = json.dumps({"version": VERSION, "key": name, "certified_by": how, "c0": pair(np.ravel(c0)),
-                       "roots": [pair(x) for x in np.asarray(X)]})
+    c0, roots = pair(np.ravel(c0)), [pair(x) for x in np.asarray(X)]
+    text = json.dumps({"version": VERSION, "key": name, "certified_by": how, "c0": c0, "roots": roots,
+                       "digest": _digest(c0, roots, how)})
     try:
         where.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=where, prefix=".tmp-", suffix=".json")

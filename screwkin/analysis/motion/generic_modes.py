@@ -74,7 +74,7 @@ def architecture(problem, closure, L: float):
     r2 = list(np.asarray(closure.r2, float) * L ** 2)
     carrier = None
     if len(closure.legs) == 6:
-        if closure.kind[joint] != "F" or model.parents[joint] != 0:
+        if closure.kind[joint] != "F" or model.parents[joint] != 0 or set(closure.slices) != {joint}:
             return None
     elif len(closure.legs) == 5:
         got = chain_distance(model, problem.frozen, joint, L)
@@ -90,7 +90,7 @@ def architecture(problem, closure, L: float):
         head, tail = chain[:2], chain[-3:]
         if any(closure.kind[j] != "R" or j not in closure.slices for j in head + tail):
             return None
-        if any(j in closure.slices for j in chain[2:-3]):
+        if set(closure.slices) != set(head + tail):  # nothing else unknown: the pose sets every joint
             return None
         data = model.createData()
         pin.forwardKinematics(model, data, np.asarray(problem.q_in, float))
@@ -116,7 +116,8 @@ def generic_set(arch: Architecture, rng, options: MonodromyOptions):
         c0, X, how = got
         ok = (system.residual(X, c0) <= _CACHED_ROOT * (1 + np.abs(c0).max())) & system.on_variety(X, 1e-8)
         distinct = all(group.match(X[i][None], X[:i], options.same)[0] < 0 for i in range(len(X)))
-        if ok.all() and distinct and len(X) <= BOUND:
+        whole = len(X) == BOUND if how.startswith("the published bound") else len(X) <= BOUND
+        if ok.all() and distinct and whole:
             roots = Roots(X, c0, True, None, "", 0, 0, 0, 0, 0.0, group)
             return roots, how, where / f"{arch.key}.json", True
     x0 = system.random_points(rng, 1)
