@@ -16,6 +16,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import screwkin
@@ -26,6 +27,14 @@ from screwkin.files import generic_cache
 
 ZERO = {f"leg{k}": 0.0 for k in range(1, 7)}
 SHIPPED = sf.DATA / "generic"
+#: Bertini 2's answers for these geometries, and how they were produced (tests/oracles/bertini_stewart.py).
+BERTINI = json.loads((sf.DATA / "bertini_stewart.json").read_text())["geometries"]
+
+
+def _bertini(name):
+    """(poses, real, real poses (R, t)) of Bertini 2's total-degree solve of a geometry."""
+    b = BERTINI[name]
+    return b["poses"], b["real"], [(np.array(p["R"]), np.array(p["t"])) for p in b["real_poses"]]
 
 
 def _solve(tmp_path, base, plat, R, t, form, values=ZERO):
@@ -91,6 +100,9 @@ def test_dietmaier_has_40_real_poses_in_both_forms(tmp_path, shipped_cache, form
     poses = _poses(mech, res, R, plat)
     _check_poses(poses, base, plat, lengths)
     _same_sets(poses, phc, 1e-4)  # PHC: coefficients rounded to 10 digits, some poses ill-conditioned
+    found, real, bertini = _bertini("dietmaier")
+    assert (found, real) == (res.modes.found, res.modes.real)
+    _same_sets(poses, bertini, 1e-7)
 
 
 def test_new_leg_lengths_reuse_the_generic_set(tmp_path, shipped_cache):
@@ -203,6 +215,9 @@ def test_tree_and_floating_forms_agree_from_scratch(tmp_path, monkeypatch, seed,
         got[form] = _poses(mech, res, R, plat)
         _check_poses(got[form], base, plat, lengths)
     _same_sets(got["tree"], got["floating"], 1e-8)
+    found, real, bertini = _bertini("planar" if planar else "general")
+    assert (res.modes.found, res.modes.real) == (found, real)
+    _same_sets(got["tree"], bertini, 1e-7)
     if planar:  # base and platform planar: a pose's mirror through the base plane is one too
         for Rg, tg in got["tree"]:
             M = np.diag([1.0, 1.0, -1.0])
@@ -232,3 +247,23 @@ def test_bundled_six_ups_has_28_certified_by_the_trace_test(tmp_path, monkeypatc
     _certified(res.modes, 28, 8)
     assert "trace test" in res.modes.certificate
     assert all(s.residual < 1e-12 for s in res.solutions)
+    found, real, bertini = _bertini("six_ups")
+    assert (found, real) == (28, 8)
+    data = mech.model.createData()
+    poses = []
+    for s in res.solutions:  # the pose of the platform's joint frame, as Bertini's geometry has it
+        pin.forwardKinematics(mech.model, data, s.q)
+        M = data.oMi[mech.model.getJointId("ball1_z")]
+        poses.append((M.rotation, M.translation))
+    _same_sets(poses, bertini, 1e-7)
+
+
+@pytest.mark.slow  # Bertini 2's 128 paths: about 90 s
+def test_bertini_counts_the_bundled_six_ups_too():
+    """The oracle itself, where bertini2 is installed (it is not in the test extra: it conflicts with
+    the bertini and pybertini packages, which write the same module): 28 poses, 8 real."""
+    pytest.importorskip("bertini")
+    from oracles import bertini_stewart
+    g = BERTINI["six_ups"]["geometry"]
+    got = bertini_stewart.solve_geometry(np.array(g["base"]), np.array(g["platform"]), np.array(g["lengths"]))
+    assert (got["poses"], got["real"]) == (28, 8)
