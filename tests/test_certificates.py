@@ -129,7 +129,7 @@ def test_a_malformed_cache_file_is_not_read(tmp_path, shipped_cache):
     hash -- each is ignored."""
     (name,) = list(shipped_cache.glob("*.json"))
     key, data = name.stem, json.loads(name.read_text())
-    c0, X, how = generic_cache.read(key, 7, 6)
+    c0, X, how, _ = generic_cache.read(key, 7, 6)
     assert X.shape == (40, 7) and c0.shape == (6,) and "published bound" in how
     for bad in ({"version": 99}, {"key": "b" * 64}, {"roots": "x"}, {"roots": [[[1, 2, 3]]]},
                 {"c0": [[float("nan"), 0]] * 6}, {"certified_by": 3}, {"roots": data["roots"][:39]},
@@ -242,8 +242,10 @@ def test_bundled_six_ups_has_28_certified_by_the_trace_test(tmp_path, monkeypatc
     """The bundled 6-UPS (semi-regular hexagons): 28 poses, 8 real -- Bertini 2's count for this
     geometry -- now certified: its generic set has 28 poses, complete by the trace test."""
     monkeypatch.setenv("SCREWKIN_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(generic_cache, "SHIPPED", tmp_path / "none")  # computed here, not the shipped set
     mech = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
     res = PositionSolver(mech).solve(ZERO)
+    assert not res.modes.detail["generic_set_reused"]
     _certified(res.modes, 28, 8)
     assert "trace test" in res.modes.certificate
     assert all(s.residual < 1e-12 for s in res.solutions)
@@ -256,6 +258,16 @@ def test_bundled_six_ups_has_28_certified_by_the_trace_test(tmp_path, monkeypatc
         M = data.oMi[mech.model.getJointId("ball1_z")]
         poses.append((M.rotation, M.translation))
     _same_sets(poses, bertini, 1e-7)
+
+
+def test_bundled_six_ups_from_its_shipped_generic_set():
+    """The bundled 6-UPS's generic set ships with screwkin (screwkin/files/generic_sets): 28 poses, 8
+    real, certified, in a second -- Bertini 2's 28 and 8 for this geometry."""
+    mech = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
+    res = PositionSolver(mech).solve(ZERO)
+    _certified(res.modes, 28, 8)
+    assert res.modes.detail["generic_set_reused"] and "generic_sets" in res.modes.detail["generic_set"]
+    assert (BERTINI["six_ups"]["poses"], BERTINI["six_ups"]["real"]) == (28, 8)
 
 
 @pytest.mark.slow  # Bertini 2's 128 paths: about 90 s

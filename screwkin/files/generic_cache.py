@@ -4,7 +4,8 @@ analysis.motion.generic_modes' parameter homotopy), and how they are read back.
 The folder: ``$SCREWKIN_CACHE`` if set, else ``$XDG_CACHE_HOME/screwkin/generic`` (``~/.cache/screwkin/
 generic`` when XDG_CACHE_HOME is not set).  One JSON file per architecture, named by the SHA-256 of the
 architecture's description (``key``).  Clearing it: delete the folder (``rm -rf ~/.cache/screwkin``);
-``SCREWKIN_CACHE=off`` neither reads nor writes one.
+``SCREWKIN_CACHE=off`` neither reads nor writes one.  The bundled robots' sets ship in
+``screwkin/files/generic_sets/`` and are read (and checked) the same way.
 
 The files are ours but are read as untrusted input: at most 1 MiB, JSON only (no pickle), every field
 checked for its type and shape, numbers finite, the SHA-256 of its numbers and claim as written
@@ -32,6 +33,8 @@ __all__ = ["folder", "key", "read", "write", "VERSION"]
 
 #: Bumped when the stored formulation changes: older files are ignored.
 VERSION = 1
+#: Sets shipped with screwkin (the bundled robots'), read like the cache's, never written.
+SHIPPED = Path(__file__).parent / "generic_sets"
 _MAX_BYTES = 1 << 20
 
 
@@ -62,11 +65,19 @@ def _complex(rows, width: int):
 
 
 def read(name: str, width: int, n: int):
-    """(c0 (n,), X (N, width), how) stored under ``name``, or None (absent, unreadable or malformed)."""
-    where = folder()
-    if where is None or len(name) != 64 or not all(ch in "0123456789abcdef" for ch in name):
+    """(c0 (n,), X (N, width), how, path) stored under ``name`` -- in the cache folder, else among the
+    sets shipped with screwkin (``SHIPPED``) --, or None (absent, unreadable or malformed)."""
+    if len(name) != 64 or not all(ch in "0123456789abcdef" for ch in name):
         return None
-    path = where / f"{name}.json"
+    where = folder()
+    for path in ([where / f"{name}.json"] if where is not None else []) + [SHIPPED / f"{name}.json"]:
+        got = _read(path, name, width, n)
+        if got is not None:
+            return (*got, path)
+    return None
+
+
+def _read(path: Path, name: str, width: int, n: int):
     try:
         if not path.is_file() or path.stat().st_size > _MAX_BYTES:
             return None

@@ -111,15 +111,14 @@ def generic_set(arch: Architecture, rng, options: MonodromyOptions):
     """(Roots at generic c0, how its completeness is known or None, where it is kept or None, reused)."""
     system, group = arch.system, _group()
     got = generic_cache.read(arch.key, 7, 6)
-    where = generic_cache.folder()
     if got is not None:
-        c0, X, how = got
+        c0, X, how, kept = got
         ok = (system.residual(X, c0) <= _CACHED_ROOT * (1 + np.abs(c0).max())) & system.on_variety(X, 1e-8)
         distinct = all(group.match(X[i][None], X[:i], options.same)[0] < 0 for i in range(len(X)))
         whole = len(X) == BOUND if how.startswith("the published bound") else len(X) <= BOUND
         if ok.all() and distinct and whole:
             roots = Roots(X, c0, True, None, "", 0, 0, 0, 0, 0.0, group)
-            return roots, how, where / f"{arch.key}.json", True
+            return roots, how, kept, True
     x0 = system.random_points(rng, 1)
     roots = all_roots(system, group, x0, rng, options, trace_test=False, stop_at=BOUND)
     how = None
