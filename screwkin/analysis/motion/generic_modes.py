@@ -13,10 +13,10 @@ coefficient-parameter homotopy every isolated pose of the query is the end of on
 joints (the carrying leg's angles by Paden-Kahan subproblems, the other legs by model.legs' lift)
 and polished on Pinocchio's closure.
 
-The certificate is checked before it is given (``_check``): the generic set was complete, no path
-failed, every real pose lifted and polished, the poses are distinct (q and -q are one), their number
-is at most 40 and each is a simple root; otherwise the result says which check failed and is not
-called certified.
+The certificate is checked before it is given: the generic set was complete, no path failed, every
+real pose lifted and polished, the poses are distinct (q and -q are one), the complex ones come in
+conjugate pairs, their number is at most 40 and each is a simple root; otherwise the result says
+which check failed and is not called certified.
 """
 
 from __future__ import annotations
@@ -171,13 +171,19 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, opti
         modes.append((q, a, None, None if simple else False))
     n_real = len(modes) + lost
     n_complex = len(distinct) - n_real
+    # the leg lengths are real: a complex pose's conjugate is a pose too (a lone one is a real pose
+    # misjudged, or a path that went astray)
+    cplx = [i for i in distinct if not real[i]]
+    lone = sum(group.match(np.conj(X[i])[None], X[[k for k in cplx if k != i]], 1e-6)[0] < 0 for i in cplx) \
+        if len(cplx) > 1 else len(cplx)
     failed = int(np.sum(status == "failed"))
     singular = int(np.sum(closes & (status == "singular")))
     check = {"method": "coefficient-parameter homotopy", "generic_set": len(roots.X),
              "generic_set_certified_by": how, "paths": int(len(roots.X)), "failed_paths": failed,
              "at_infinity": int(np.sum(status == "infinity")), "singular_endpoints": singular,
              "paths_meeting": int(meets.sum()), "bound": BOUND, "distinct_poses": len(distinct),
-             "real_not_polished": lost, "counts": "platform poses (q and -q one pose)"}
+             "real_not_polished": lost, "complex_without_conjugate": int(lone),
+             "counts": "platform poses (q and -q one pose)"}
     why = []
     if how is None:
         why.append(f"the generic solution set is not known to be complete ({roots.why or 'monodromy found ' + str(len(roots.X))})")
@@ -185,6 +191,8 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, opti
         why.append(f"{failed} of {len(roots.X)} paths failed")
     if lost:
         why.append(f"{lost} real pose(s) did not lift onto the file's joints")
+    if lone:
+        why.append(f"{lone} complex pose(s) without their conjugate")
     if len(distinct) > BOUND:
         why.append(f"{len(distinct)} distinct poses, more than the bound of {BOUND}")
     if singular or meets.any():
