@@ -9,12 +9,14 @@ import sys
 from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import BRANCHES
 from ..errors import UsageError, quote
 from ..model.topology import open_joints
 from ._options import count
 from ._values import joint_assignments, split_inputs
 
-__all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "input_solver",
+__all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "add_branch_option",
+           "input_solver",
            "configuration", "mode_line", "file_configuration_line", "near_values", "with_mode", "moved_not_set"]
 
 
@@ -47,6 +49,14 @@ def add_mode_option(sp, at: str = "the --set inputs"):
     sp.add_argument("--mode", type=count("mode"), metavar="K",
                     help=f"the K-th assembly mode of {at} (as solve lists them; default 1, the one nearest the "
                          "file's configuration)")
+
+
+def add_branch_option(sp, what: str = "the motion"):
+    """--branch continue|other: what a motion does at a change point (analysis.motion.sweep's branch)."""
+    sp.add_argument("--branch", choices=BRANCHES, default=BRANCHES[0],
+                    help=f"at a change point of {what} (branches of the motion cross: a parallelogram four-bar "
+                         "folding flat), go on along the branch whose tangent continues the motion (continue, the "
+                         "default: the parallelogram stays a parallelogram) or along the other one (other)")
 
 
 def input_solver(mech, inputs, held: dict | None = None, output=None) -> PositionSolver:

@@ -16,7 +16,7 @@ model.algebraic moves a free flyer.
 
 ``chain_angles``: the joint angles of a leg that carries the platform (two revolutes meeting at the
 ground point, inputs, three revolutes meeting at the platform point) that put the platform at a
-given pose -- Paden-Kahan subproblems, every real solution (up to four).
+given pose -- Paden-Kahan subproblems (model.subproblems), every real solution (up to four).
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from .geometry import quaternion_product
+from .subproblems import rotation, run_angles, two_rotations
 
 __all__ = ["SixDistances", "chain_angles"]
 
@@ -109,48 +110,15 @@ class SixDistances:
         return np.c_[t, q]
 
 
-def _rotation(w, theta):
-    K = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-    return np.eye(3) + np.sin(theta) * K + (1 - np.cos(theta)) * K @ K
-
-
-def _sub1(w, p, q) -> float:
-    """theta with exp(w theta) p = q (their components across w)."""
-    pp, qq = p - w * (w @ p), q - w * (w @ q)
-    return float(np.arctan2(w @ np.cross(pp, qq), pp @ qq))
-
-
-def _sub2(w1, w2, p, q, tol: float = 1e-9) -> list:
-    """Every real (theta1, theta2) with exp(w1 theta1) exp(w2 theta2) p = q (Paden-Kahan)."""
-    c = float(w1 @ w2)
-    if abs(abs(c) - 1.0) < 1e-12:
-        return []
-    a = (c * (w2 @ p) - w1 @ q) / (c * c - 1.0)
-    b = (c * (w1 @ q) - w2 @ p) / (c * c - 1.0)
-    n = np.cross(w1, w2)
-    g2 = (p @ p - a * a - b * b - 2 * a * b * c) / (n @ n)
-    if g2 < -tol * max(p @ p, 1e-300):
-        return []
-    out = []
-    for g in {np.sqrt(max(g2, 0.0)), -np.sqrt(max(g2, 0.0))}:
-        z = a * w1 + b * w2 + g * n
-        out.append((_sub1(w1, z, q), _sub1(w2, p, z)))
-    return out
-
-
 def chain_angles(head_axes, tail_axes, A, p0, R0, p, R) -> list:
     """Every real (theta_head (2,), theta_tail (3,)) of a leg (see the module): world axes at the
     angles' zero (head through the ground point A, tail through the platform point, which is at p0
-    with the platform at rotation R0), the platform point wanted at p and the platform's rotation R."""
+    with the platform at rotation R0), the platform point wanted at p and the platform's rotation R
+    (model.subproblems: subproblem 2 for the head, the tail's rotation written about its three axes)."""
     w1, w2 = head_axes
-    w3, w4, w5 = tail_axes
     out = []
-    for t1, t2 in _sub2(w1, w2, p0 - A, p - A):
-        H = _rotation(w1, t1) @ _rotation(w2, t2)
-        N = H.T @ R @ R0.T
-        for t3, t4 in _sub2(w3, w4, w5, N @ w5):
-            S = _rotation(w3, t3) @ _rotation(w4, t4)
-            v = np.cross(w5, [1.0, 0, 0] if abs(w5[0]) < 0.9 else [0, 1.0, 0])
-            t5 = _sub1(w5, v, S.T @ N @ v)
-            out.append((np.array([t1, t2]), np.array([t3, t4, t5])))
+    for t1, t2 in two_rotations(w1, w2, p0 - A, p - A)[0]:
+        H = rotation(w1, t1) @ rotation(w2, t2)
+        for ts in run_angles(tail_axes, H.T @ R @ R0.T):
+            out.append((np.array([t1, t2]), np.array(ts)))
     return out

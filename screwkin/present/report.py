@@ -98,6 +98,13 @@ def modes_line(res, n: int) -> str:
     each = (f"; each reached by {sets.pop()} joint-angle sets (universal and spherical joints written as "
             "revolutes, wrists flipped: one placement of the links)" if len(sets) == 1 and None not in sets
             and max(sets) > 1 else "")
+    if c.method == "closed form (Pieper)":  # a serial arm: every joint solution is an answer
+        more = f"; {c.complex} more {'are' if c.complex != 1 else 'is'} complex (no real solution)" if c.complex else ""
+        return f"all {n} joint solution{s} ({c.certificate}){more}"
+    if c.method == "closed form (legs)":
+        return (f"{n} solution{s} of {c.found} listed ({c.certificate}): the physical one first (every leg extended, "
+                "each leg's angle set within the joint limits where one exists), then "
+                + ("every other combination of the legs' branches" if c.found == n else "each leg's other branch"))
     kept = c.detail.get("generic_set")
     kept = (f"; generic solution set {'reused from' if c.detail.get('generic_set_reused') else 'kept in'} {kept}"
             if kept else "")
@@ -375,10 +382,7 @@ def singularity_text(rep) -> str:
         lines.append(table(["joint", "cofactor C_ii", "C_ii / sum C_jj (= v_i^2)", "stationary"],
                            [(n, f"{g.cofactors[n]:.6g}", f"{g.relative[n]:.6g}", "YES (C_ii = 0)" if n in g.zero else
                              "no") for n in g.joints]))
-    if rep.condition is not None:
-        lines.append(f"condition number {rep.condition:.4g}" + (
-            f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
-            + f" (L = {rep.length:.4g} m)")
+    lines += _condition_lines(rep)
     for t in rep.singular_twists:
         lines.append(f"\n{t.kind} singular direction:")
         if t.joint_rates:
@@ -391,6 +395,36 @@ def singularity_text(rep) -> str:
         elif t.twist is not None:  # never a zero twist written as a screw
             lines.append(f"  the output '{rep.output}' does not move in it (a zero twist: no screw)")
     return "\n".join(lines)
+
+
+def _condition_meaning(rep) -> str | None:
+    """What ``rep.condition`` is the condition number of (it is not the input -> output map's)."""
+    if rep.condition is None:
+        return None
+    if rep.manipulability is not None:
+        return ("J_o V: the output's twist over an orthonormal basis of the mechanism's joint-rate motions "
+                "(not over the input rates)")
+    return "K_p: the loops' Jacobian in the passive joints (how well the inputs fix them)"
+
+
+def _condition_lines(rep) -> list:
+    """The two condition numbers, each saying what it is of: the input -> output map's first (Merlet's, what a
+    parallel robot's user means), then the one of J_o V or K_p."""
+    io = getattr(rep, "condition_input_output", None)
+    note = getattr(rep, "input_output_note", None)
+    value = f"{io:.4g}" if io is not None else "-"
+    if io is None:
+        lines = [f"condition number of the input -> output map (Merlet's): - ({note})"]
+    else:
+        lines = [f"condition number of the input -> output map (Merlet's): {value}"
+                 + (f" ({note})" if note else "")
+                 + f"  (of J: the input rates -> {rep.output}'s twist (v/L, w) at its origin, = of J^-1; "
+                   f"L = {rep.length:.4g} m)"]
+    if rep.condition is not None:
+        lines.append(f"condition number {rep.condition:.4g}" + (
+            f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
+            + f" (L = {rep.length:.4g} m) of {_condition_meaning(rep)}")
+    return lines
 
 
 # ------------------------------------------------------------------ results as dictionaries
@@ -410,6 +444,9 @@ def singularity_dict(rep: SingularityReport) -> dict:
         "serial": rep.serial, "actuator": rep.actuator, "constraint": rep.constraint,
         "stationary_joints": list(rep.stationary_joints), "sigma_min": rep.sigma_min,
         "sigmas": rep.sigmas, "condition": rep.condition, "manipulability": rep.manipulability,
+        "condition_of": _condition_meaning(rep),
+        "condition_input_output": getattr(rep, "condition_input_output", None),
+        "condition_input_output_note": getattr(rep, "input_output_note", None),
         "characteristic_length": rep.length, "inputs": list(rep.inputs), "output": rep.output,
         "point": rep.point,
         **_gram_dict(getattr(rep, "gram", ())),
