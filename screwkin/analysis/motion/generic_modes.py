@@ -43,6 +43,8 @@ SOURCE = "Raghavan 1993; Wampler 1996: at most 40"
 _CACHED_ROOT = 1e-8
 #: A polished real pose that moved by more than this (relative to L) from its endpoint is another pose.
 _MOVED = 1e-6
+#: A complex pose and its conjugate's endpoint agree to this (relative): both are tracked separately.
+_CONJUGATE = 1e-6
 
 
 class Architecture:
@@ -174,7 +176,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, opti
     # the leg lengths are real: a complex pose's conjugate is a pose too (a lone one is a real pose
     # misjudged, or a path that went astray)
     cplx = [i for i in distinct if not real[i]]
-    lone = sum(group.match(np.conj(X[i])[None], X[[k for k in cplx if k != i]], 1e-6)[0] < 0 for i in cplx) \
+    lone = sum(group.match(np.conj(X[i])[None], X[[k for k in cplx if k != i]], _CONJUGATE)[0] < 0 for i in cplx) \
         if len(cplx) > 1 else len(cplx)
     failed = int(np.sum(status == "failed"))
     singular = int(np.sum(closes & (status == "singular")))
