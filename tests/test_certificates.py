@@ -22,6 +22,7 @@ import pytest
 import screwkin
 import stewart_forms as sf
 from conftest import ROBOTS
+from screwkin.analysis.motion import certified
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.files import generic_cache
 
@@ -37,17 +38,24 @@ def _bertini(name):
     return b["poses"], b["real"], [(np.array(p["R"]), np.array(p["t"])) for p in b["real_poses"]]
 
 
+class _Every:
+    """What the tests read of the search for every mode (certified.search, as solve --all runs it):
+    ``modes`` the ModeCount, ``solutions`` the real modes' (q, Assembly)."""
+
+    def __init__(self, mech, values):
+        found = certified.search(PositionSolver(mech), values)
+        self.modes, self.solutions = found.count, [(q, a) for _, q, a in found.found]
+
+
 def _solve(tmp_path, base, plat, R, t, form, values=ZERO):
     path = tmp_path / f"stewart_{form}.urdf"
     path.write_text(sf.urdf(base, plat, R, t, form))
     mech = screwkin.load(path)
-    solver = PositionSolver(mech)
-    res = solver.solve(values)
-    return mech, res
+    return mech, _Every(mech, values)
 
 
 def _poses(mech, res, R_drawn, plat):
-    return [sf.pose_of(mech, s.q, R_drawn, plat) for s in res.solutions]
+    return [sf.pose_of(mech, q, R_drawn, plat) for q, _ in res.solutions]
 
 
 def _check_poses(poses, base, plat, lengths):
@@ -192,7 +200,7 @@ def test_modes_json_has_the_certificate_check(tmp_path, shipped_cache, capsys):
     path.write_text(sf.urdf(base, plat, R, t, "floating"))
     sets = ",".join(f"leg{k + 1}={lengths[k] - d:.17g}" for k, d in enumerate(sf.leg_lengths(base, plat, R, t)))
     from screwkin.cli import main
-    assert main(["solve", str(path), "--set", sets, "--json"]) == 0
+    assert main(["solve", str(path), "--set", sets, "--all", "--json"]) == 0
     m = json.loads(capsys.readouterr().out)["modes"]
     assert {"found", "complete", "method", "real", "complex", "certificate", "reason", "search"} <= set(m)
     check = m["certificate_check"]
@@ -244,17 +252,17 @@ def test_bundled_six_ups_has_28_certified_by_the_trace_test(tmp_path, monkeypatc
     monkeypatch.setenv("SCREWKIN_CACHE", str(tmp_path / "cache"))
     monkeypatch.setattr(generic_cache, "SHIPPED", tmp_path / "none")  # computed here, not the shipped set
     mech = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
-    res = PositionSolver(mech).solve(ZERO)
+    res = _Every(mech, ZERO)
     assert not res.modes.detail["generic_set_reused"]
     _certified(res.modes, 28, 8)
     assert "trace test" in res.modes.certificate
-    assert all(s.residual < 1e-12 for s in res.solutions)
+    assert all(a.residual < 1e-12 for _, a in res.solutions)
     found, real, bertini = _bertini("six_ups")
     assert (found, real) == (28, 8)
     data = mech.model.createData()
     poses = []
-    for s in res.solutions:  # the pose of the platform's joint frame, as Bertini's geometry has it
-        pin.forwardKinematics(mech.model, data, s.q)
+    for q, _ in res.solutions:  # the pose of the platform's joint frame, as Bertini's geometry has it
+        pin.forwardKinematics(mech.model, data, q)
         M = data.oMi[mech.model.getJointId("ball1_z")]
         poses.append((M.rotation, M.translation))
     _same_sets(poses, bertini, 1e-7)
@@ -264,7 +272,7 @@ def test_bundled_six_ups_from_its_shipped_generic_set():
     """The bundled 6-UPS's generic set ships with screwkin (screwkin/files/generic_sets): 28 poses, 8
     real, certified, in a second -- Bertini 2's 28 and 8 for this geometry."""
     mech = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
-    res = PositionSolver(mech).solve(ZERO)
+    res = _Every(mech, ZERO)
     _certified(res.modes, 28, 8)
     assert res.modes.detail["generic_set_reused"] and "generic_sets" in res.modes.detail["generic_set"]
     assert (BERTINI["six_ups"]["poses"], BERTINI["six_ups"]["real"]) == (28, 8)

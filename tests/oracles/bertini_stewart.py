@@ -3,7 +3,7 @@ forward kinematics of a Stewart-Gough platform: Wampler's (1996) formulation in 
 coordinates (e, g) in P^7 -- six leg quadrics and the Study quadric Re(g e') = 0, on a random real
 affine patch -- solved by a total-degree homotopy (2^7 = 128 paths).  Usage:
 
-    python bertini_stewart.py GEOMETRY.json   # {"base": [[x,y,z]]*6, "platform": [...], "lengths": [...]}
+    python bertini_stewart.py GEOMETRY.json [SEED]   # {"base": [[x,y,z]]*6, "platform": [...], "lengths": [...]}
 
 prints one JSON line: the poses (R, t) with e e' away from 0 (the solutions on e e' = 0 are no poses),
 distinct, and how many are real.  Derivation: with n = e e', R v = e v e' / n, t = g e' / n (Re(g e') = 0),
@@ -62,13 +62,13 @@ def _leg_form(a, b, l):
     return _form(f)
 
 
-def main(path):
+def main(path, seed=7):
     g_ = json.load(open(path))
     print(json.dumps(solve_geometry(np.array(g_["base"], float), np.array(g_["platform"], float),
-                                    np.array(g_["lengths"], float))))
+                                    np.array(g_["lengths"], float), int(seed))))
 
 
-def solve_geometry(A, B, L) -> dict:
+def solve_geometry(A, B, L, seed: int = 7) -> dict:
     """Bertini's poses of the platform with ground points A, platform points B, leg lengths L."""
     names = [f"e{k}" for k in range(4)] + [f"g{k}" for k in range(4)]
     v = bertini.variables(names)
@@ -91,7 +91,7 @@ def solve_geometry(A, B, L) -> dict:
         f = term if f is None else f + term
     sysm.add_function(f - bertini.coefficient("1"))
     t0 = time.time()
-    res = bertini.solve(sysm, seed=7, show_progress=False)
+    res = bertini.solve(sysm, seed=seed, show_progress=False)
     seconds = time.time() - t0
     poses = []
     for s in res.solutions:
@@ -117,4 +117,4 @@ def solve_geometry(A, B, L) -> dict:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    main(*sys.argv[1:3])
