@@ -5,9 +5,11 @@ geometry alone, poses distinct).
 
 Outside references: Dietmaier's platform with 40 real poses and PHCpack's 40 solutions of it
 (tests/data/stewgou40.json, from PHCpack's src/Demo/stewgou40); 40, the most for any geometry
-(Raghavan 1993; Wampler 1996); the bundled 6-UPS's 28 poses (Bertini 2, a total-degree solve run by
-the issue's author: 28 isolated solutions).  The platforms are built in the tests from their
-geometry (tests/stewart_forms.py).
+(Raghavan 1993; Wampler 1996); Bertini 2's total-degree solves (tests/oracles/bertini_stewart.py, run
+in a virtual environment of its own; its counts and real poses recorded in
+tests/data/bertini_stewart.json with how they were produced): Dietmaier 40 / 40 real, the planar
+geometry 40 / 4, the bundled 6-UPS 28 / 8.  The platforms are built in the tests from their geometry
+(tests/stewart_forms.py).
 """
 
 import json
@@ -223,9 +225,11 @@ def test_tree_and_floating_forms_agree_from_scratch(tmp_path, monkeypatch, seed,
         got[form] = _poses(mech, res, R, plat)
         _check_poses(got[form], base, plat, lengths)
     _same_sets(got["tree"], got["floating"], 1e-8)
-    found, real, bertini = _bertini("planar" if planar else "general")
-    assert (res.modes.found, res.modes.real) == (found, real)
-    _same_sets(got["tree"], bertini, 1e-7)
+    name = "planar" if planar else "general"
+    if name in BERTINI:  # (Bertini's run on the general one did not end within 15 minutes with seed 7)
+        found, real, bertini = _bertini(name)
+        assert (res.modes.found, res.modes.real) == (found, real)
+        _same_sets(got["tree"], bertini, 1e-7)
     if planar:  # base and platform planar: a pose's mirror through the base plane is one too
         for Rg, tg in got["tree"]:
             M = np.diag([1.0, 1.0, -1.0])
