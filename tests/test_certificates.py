@@ -7,8 +7,8 @@ Outside references: Dietmaier's platform with 40 real poses and PHCpack's 40 sol
 (tests/data/stewgou40.json, from PHCpack's src/Demo/stewgou40); 40, the most for any geometry
 (Raghavan 1993; Wampler 1996); Bertini 2's total-degree solves (tests/oracles/bertini_stewart.py, run
 in a virtual environment of its own; its counts and real poses recorded in
-tests/data/bertini_stewart.json with how they were produced): Dietmaier 40 / 40 real, the planar
-geometry 40 / 4, the bundled 6-UPS 28 / 8.  The platforms are built in the tests from their geometry
+tests/data/bertini_stewart.json with how they were produced): Dietmaier 40 / 40 real, the general
+geometry 40 / 2, the planar one 40 / 4, the bundled 6-UPS 28 / 8.  The platforms are built in the tests from their geometry
 (tests/stewart_forms.py).
 """
 
@@ -226,10 +226,9 @@ def test_tree_and_floating_forms_agree_from_scratch(tmp_path, monkeypatch, seed,
         _check_poses(got[form], base, plat, lengths)
     _same_sets(got["tree"], got["floating"], 1e-8)
     name = "planar" if planar else "general"
-    if name in BERTINI:  # (Bertini's run on the general one did not end within 15 minutes with seed 7)
-        found, real, bertini = _bertini(name)
-        assert (res.modes.found, res.modes.real) == (found, real)
-        _same_sets(got["tree"], bertini, 1e-7)
+    found, real, bertini = _bertini(name)
+    assert (res.modes.found, res.modes.real) == (found, real)
+    _same_sets(got["tree"], bertini, 1e-7)
     if planar:  # base and platform planar: a pose's mirror through the base plane is one too
         for Rg, tg in got["tree"]:
             M = np.diag([1.0, 1.0, -1.0])
