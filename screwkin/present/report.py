@@ -84,7 +84,8 @@ def modes_dict(c) -> dict:
     """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
-            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail)}
+            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail),
+            "certificate_check": dict(c.check) or None}
 
 
 def modes_line(res, n: int) -> str:
@@ -108,15 +109,18 @@ def modes_line(res, n: int) -> str:
         return (f"{n} solution{s} of {c.found} listed ({c.certificate}): the physical one first (every leg extended, "
                 "each leg's angle set within the joint limits where one exists), then "
                 + ("every other combination of the legs' branches" if c.found == n else "each leg's other branch"))
+    kept = c.detail.get("generic_set")
+    kept = (f"; generic solution set {'reused from' if c.detail.get('generic_set_reused') else 'kept in'} {kept}"
+            if kept else "")
     if c.complete:
         more = (f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex (no real assembly)"
                 if c.complex else "")
         head = f"all {n} assembly modes" if n != 1 else "1 assembly mode, the only one"
-        return f"{head} (certified: {c.certificate}){more}{each}"
+        return f"{head} (certified: {c.certificate}){more}{each}{kept}"
     how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
            f"by homotopy continuation and from {res.starts} starting configurations")
     more = f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex" if c.complex else ""
-    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}"
+    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}{kept}"
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:
