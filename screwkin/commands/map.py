@@ -6,13 +6,16 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.singularities.loci import trace_loci
 from ..analysis.singularities.maps import singularity_map
+from ..analysis.singularities.regions import regions
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.continuation import continuation_steps
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.outfile import write_output
 from ..present.plots import map_png
+from ..present.loci import loci_dict, loci_lines, loci_png
 from ..present.report import map_csv, map_dict
 from ._configuration import add_mode_option, configuration, with_mode
 from ._output_frame import output_frame
@@ -35,6 +38,12 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--output", help="output link (serial singularities)")
     sp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
     sp.add_argument("--csv", help="the map's data as CSV")
+    sp.add_argument("--loci", action="store_true",
+                    help="trace the singular curves over every assembly mode (actuator; serial with --output), "
+                         "their cusps and crossings, and the regions they cut the box into with their numbers "
+                         "of assembly modes (with --png: their picture instead of the heat map)")
+    sp.add_argument("--no-regions", dest="regions", action="store_false",
+                    help="with --loci: leave out the regions and their mode counts (an all-modes solve each)")
     scaled(sp)
 
 
@@ -60,13 +69,18 @@ def run(mech, args) -> int:
     # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
     mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
-    if args.png:
+    traced = _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point) if args.loci else None
+    if traced is not None and args.png:
+        title = f"{mech.spec.name or Path(mech.path).stem}: singular loci over {xn} and {yn}"
+        loci_png(*traced, args.png, xs, ys, xn, yn, x_unit, y_unit, title=title)
+    elif args.png:
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
         map_png(res, args.png, x_unit, y_unit, title=title)
     if args.csv:
         write_output(args.csv, map_csv(res))
     if args.json:
-        print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})))
+        extra = loci_dict(*traced, x_unit, y_unit) if traced is not None else {}
+        print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length, **extra})))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} on the mapped assembly mode; "
@@ -74,5 +88,22 @@ def run(mech, args) -> int:
               if finite.size else "no point assembled")
         for note in res.notes:
             print(note)
+        if traced is not None:
+            for line in loci_lines(*traced, xn, yn, x_unit, y_unit):
+                print(line)
     return 0
+
+
+def _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point):
+    """(Loci, Regions or None) of map --loci: every input other than --x and --y held by --set."""
+    held = [n for n in inputs if n not in (xn, yn)]
+    missing = [n for n in held if n not in fixed]
+    if missing:
+        raise UsageError(f"--loci: give the other inputs with --set ({', '.join(missing)}): the loci lie in the "
+                         "plane of --x and --y with the others held")
+    solver = PositionSolver(mech, inputs)
+    held_values = {n: fixed[n] for n in held}
+    traced = trace_loci(solver, xn, xs, yn, ys, held_values, output, point)
+    cut = regions(solver, traced, xn, xs, yn, ys, held_values) if args.regions else None
+    return traced, cut
 

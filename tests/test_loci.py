@@ -1,0 +1,175 @@
+"""Singular loci traced in the plane of two inputs, their cusps, nodes and regions (issue 44), against closed
+forms: the five-bar's actuator and serial sets, and the 3-RPR's cusps as triple roots of its forward-kinematics
+polynomial (built independently with numpy in tests/loci_robots.py)."""
+
+import json
+
+import numpy as np
+import pytest
+from numpy.polynomial import Polynomial
+
+import screwkin
+from screwkin.analysis.singularities.loci import trace_loci
+from screwkin.analysis.singularities.regions import regions
+from conftest import screwkin_cli
+from loci_robots import FIVE_BAR, five_bar, rpr3, rpr3_cusp, rpr3_polynomial, RPR_BASE
+
+REL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def five(tmp_path_factory):
+    text, elbows = five_bar(**FIVE_BAR)
+    path = tmp_path_factory.mktemp("loci") / "five_bar_loci.urdf"
+    path.write_text(text)
+    return path, elbows
+
+
+def _five_bar_conditions(elbows, m1, m2):
+    """The closed forms, relative: actuator -- the distal links collinear, |B1 B2| = b1 + b2 or |b1 - b2|;
+    serial -- a leg stretched or folded, the tip on proximal i's line at a_i +- b_i from A_i and at b_j from
+    B_j."""
+    D, a1, a2, b1, b2 = (FIVE_BAR[k] for k in ("D", "a1", "a2", "b1", "b2"))
+    A1, A2, B1, B2 = elbows(m1, m2)
+    d = np.linalg.norm(B2 - B1)
+    actuator = [(d - (b1 + b2)) / (b1 + b2), (d - abs(b1 - b2)) / (b1 + b2)]
+    u1, u2 = (B1 - A1) / a1, (B2 - A2) / a2
+    serial = [(np.linalg.norm(A1 + c * u1 - B2) - b2) / b2 for c in (a1 + b1, a1 - b1)]
+    serial += [(np.linalg.norm(A2 + c * u2 - B1) - b1) / b1 for c in (a2 + b2, a2 - b2)]
+    return actuator, serial
+
+
+def _dense(P, k=10):
+    """The polyline P with k points on each segment (the traces' points are continuation steps apart)."""
+    if len(P) < 2:
+        return P
+    w = np.arange(k) / k
+    return np.vstack([P[i] + np.outer(w, P[i + 1] - P[i]) for i in range(len(P) - 1)] + [P[-1:]])
+
+
+def _trace_five(five, n=41, regions_too=False):
+    path, elbows = five
+    mech = screwkin.load(path)
+    solver = screwkin.PositionSolver(mech)
+    xs = ys = np.radians(np.linspace(-90, 90, n))
+    traced = trace_loci(solver, "motor1", xs, "motor2", ys, {}, output="tip", point=True)
+    cut = regions(solver, traced, "motor1", xs, "motor2", ys, {}) if regions_too else None
+    return traced, cut, xs, ys
+
+
+def test_five_bar_loci_points_satisfy_the_closed_forms_and_every_component_is_found(five):
+    traced, _, xs, ys = _trace_five(five)
+    _, elbows = five
+    kinds = {lc.kind for lc in traced.loci}
+    assert kinds == {"actuator", "serial"}
+    for lc in traced.loci:
+        assert len(lc.points) > 10
+        for m1, m2 in lc.points:
+            actuator, serial = _five_bar_conditions(elbows, m1, m2)
+            assert min(abs(c) for c in (actuator if lc.kind == "actuator" else serial)) < REL, (lc.kind, m1, m2)
+            assert xs[0] - 1e-12 <= m1 <= xs[-1] + 1e-12 and ys[0] - 1e-12 <= m2 <= ys[-1] + 1e-12
+    # completeness against the closed forms: every sign change of a closed-form condition between neighbouring
+    # nodes of a fine grid has a traced point of that kind within a cell
+    fine = np.radians(np.linspace(-90, 90, 121))
+    cell = fine[1] - fine[0]
+    G = np.array([[np.concatenate(_five_bar_conditions(elbows, a, b)) for a in fine] for b in fine])
+    for k in range(G.shape[2]):
+        kind = "actuator" if k < 2 else "serial"
+        pts = np.concatenate([_dense(lc.points) for lc in traced.loci if lc.kind == kind])
+        g = G[:, :, k]
+        for j, i, j2, i2 in [(j, i, j, i + 1) for j in range(121) for i in range(120)] + \
+                            [(j, i, j + 1, i) for j in range(120) for i in range(121)]:
+            if g[j, i] * g[j2, i2] < 0:
+                mid = np.array([fine[i] + fine[i2], fine[j] + fine[j2]]) / 2
+                assert np.abs(pts - mid).max(axis=1).min() < cell, (kind, k, np.degrees(mid))
+
+
+def test_five_bar_regions_count_the_closed_form_modes(five):
+    traced, cut, xs, ys = _trace_five(five, n=41, regions_too=True)
+    _, elbows = five
+    b1, b2 = FIVE_BAR["b1"], FIVE_BAR["b2"]
+    assert len(cut.regions) >= 4
+    for r in cut.regions:
+        _, _, B1, B2 = elbows(*r.sample)
+        d = np.linalg.norm(B2 - B1)
+        expected = 2 if abs(b1 - b2) < d < b1 + b2 else 0
+        assert r.modes == expected, r
+    # every node of a region on one side of the curves: the same number of modes as its sample (closed form)
+    for k, r in enumerate(cut.regions):
+        J, I = np.nonzero(cut.labels == k + 1)
+        for j, i in list(zip(J, I))[:: max(1, len(J) // 25)]:
+            _, _, B1, B2 = elbows(xs[i], ys[j])
+            d = np.linalg.norm(B2 - B1)
+            assert (2 if abs(b1 - b2) < d < b1 + b2 else 0) == r.modes
+
+
+def test_map_loci_json_keeps_the_map_keys_and_answers_in_the_typed_units(five, tmp_path):
+    path, elbows = five
+    png = tmp_path / "loci.png"
+    p = screwkin_cli("map", str(path), "--x", "motor1=-90deg:90deg:31", "--y", "motor2=-90deg:90deg:31",
+                     "--loci", "--output", "tip", "--point", "--json", "--png", str(png))
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    for key in ("xs", "ys", "log10_sigma_min", "kind", "reached", "seams", "notes"):  # the map's own keys stay
+        assert key in d
+    assert d["complete"] is False and "seeds" in d["how"]
+    assert {lc["kind"] for lc in d["loci"]} == {"actuator", "serial"}
+    for lc in d["loci"]:
+        for x, y in lc["points"]:  # degrees, as typed
+            assert -90 - 1e-9 <= x <= 90 + 1e-9 and -90 - 1e-9 <= y <= 90 + 1e-9
+            actuator, serial = _five_bar_conditions(elbows, np.radians(x), np.radians(y))
+            assert min(abs(c) for c in (actuator if lc["kind"] == "actuator" else serial)) < 1e-8
+    assert all(r["modes"] in (0, 2) for r in d["regions"])
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_map_loci_needs_the_other_inputs_held(tmp_path):
+    text, _ = rpr3()
+    path = tmp_path / "rpr3.urdf"
+    path.write_text(text)
+    p = screwkin_cli("map", str(path), "--x", "leg2=0:0.1:5", "--y", "leg3=0:0.1:5", "--set", "leg1=0", "--loci",
+                     "--no-regions")
+    assert p.returncode == 0, p.stderr
+    p = screwkin_cli("map", str(path), "--x", "leg2=0:0.1:5", "--y", "leg3=0:0.1:5", "--loci")
+    assert p.returncode == 2 and "leg1" in p.stderr and "Traceback" not in p.stderr
+
+
+@pytest.mark.slow
+def test_3rpr_cusps_are_triple_roots_of_the_forward_kinematics_polynomial(tmp_path):
+    """The 3-RPR of Innocenti & Parenti-Castelli (Zein, Wenger & Chablat 2008) in the section rho1 = 0.17 m
+    (17 in the published units): its actuator loci in (rho2, rho3), each point with the three leg lines
+    concurrent, and its cusps, where three of the polynomial's roots coincide."""
+    text, rho0 = rpr3()
+    path = tmp_path / "rpr3.urdf"
+    path.write_text(text)
+    mech = screwkin.load(path)
+    solver = screwkin.PositionSolver(mech)
+    rho1 = 0.17
+    xs, ys = np.linspace(0.02, 0.40, 41) - rho0[1], np.linspace(0.02, 0.40, 41) - rho0[2]
+    traced = trace_loci(solver, "leg2", xs, "leg3", ys, {"leg1": rho1 - rho0[0]})
+    assert traced.loci and {lc.kind for lc in traced.loci} == {"actuator"}
+    base = [mech.coordinate(f"base{i}").idx_q for i in (1, 2, 3)]
+    u0 = [np.array([float(v) for v in
+                    text.split(f'name="leg{i}"')[1].split('axis xyz="')[1].split('"')[0].split()[:2]])
+          for i in (1, 2, 3)]
+    for lc in traced.loci:
+        for q in lc.q[:: 5]:
+            rows = []
+            for i in range(3):  # the leg's line: through A_i along its base joint's turn of the drawn direction
+                c, s = np.cos(q[base[i]]), np.sin(q[base[i]])
+                d = np.array([c * u0[i][0] - s * u0[i][1], s * u0[i][0] + c * u0[i][1]])
+                n = np.array([-d[1], d[0]])
+                rows.append([n[0], n[1], n @ RPR_BASE[i] / 0.2])
+            assert abs(np.linalg.det(np.array(rows))) < REL
+    assert len(traced.cusps) >= 2
+    for (x, y), kind in traced.cusps:
+        rho = (rho1, x + rho0[1], y + rho0[2])
+        roots = rpr3_polynomial(rho).roots()
+        t = min(roots, key=lambda z: np.sort(np.abs(roots - z))[2]).real  # the middle of the tightest three
+        r2, r3, tc = rpr3_cusp(rho1, rho[1], rho[2], t)
+        assert abs(r2 - rho[1]) < 1e-8 and abs(r3 - rho[2]) < 1e-8, (rho, r2, r3)
+        P = rpr3_polynomial((rho1, r2, r3))
+        # each derivative relative to the sum of its terms' sizes at tc: round-off is 1e-16 of that
+        rel = [abs(D(tc)) / Polynomial(np.abs(D.coef))(abs(tc)) for D in (P, P.deriv(1), P.deriv(2), P.deriv(3))]
+        assert max(rel[:3]) < 1e-9, rel  # a triple root
+        assert rel[3] > 1e-4, rel  # and not a quadruple one
