@@ -90,6 +90,9 @@ class LocusSystem:
         self.pos = mech.closure.position_rows if mech.closure.nrows else None
         self.nv = mech.nv
         self.ncols = len(self.p) if kind == "actuator" else mech.nv
+        names = list(mech.joint_values(mech.neutral()))  # the columns of joint_value_rows: which are angles
+        self.angular = np.array([n in mech.coordinate_names and not mech.translational[mech.coordinate_names.index(n)]
+                                 for n in names], bool)
 
     # ----------------------------------------------------------------- pieces
     def value(self, q, c) -> float:
@@ -170,11 +173,11 @@ class LocusSystem:
         return np.linalg.svd(self.A(q))[2][-1]
 
     # ------------------------------------------------------------ Newton, tangent
-    def newton(self, q, v, extra=None, iterations: int = 30, max_step: float = 0.3):
+    def newton(self, q, v, extra=None, iterations: int = 30, max_step: float = 0.3, J=None):
         """Newton (least squares, steps capped at max_step; the Jacobian kept while the residual falls
         fast: a chord step) on F, with ``extra`` rows (function (q, v) -> (rows, rhs), linear in the
         step): (q, v) converged (|F| < RESIDUAL), or None."""
-        J, last = None, np.inf
+        last = np.inf  # J: a Jacobian from nearby to start the chord steps with
         for k in range(iterations):
             A = self.A(q)
             F = self.residual(q, v, A)
@@ -199,9 +202,9 @@ class LocusSystem:
         F = self.residual(q, v)
         return (q, v) if float(np.linalg.norm(F)) < RESIDUAL else None
 
-    def tangent(self, q, v, previous=None) -> np.ndarray:
-        """Unit null vector of dF in (u, v), oriented along ``previous``."""
-        t = np.linalg.svd(self.jacobian(q, v))[2][-1]
+    def tangent(self, q, v, previous=None, J=None) -> np.ndarray:
+        """Unit null vector of dF in (u, v) (J: dF at (q, v) when already computed), oriented along ``previous``."""
+        t = np.linalg.svd(self.jacobian(q, v) if J is None else J)[2][-1]
         if previous is not None and t @ previous < 0:
             t = -t
         return t
@@ -215,7 +218,7 @@ class LocusSystem:
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q, v, t, h):
+    def along(self, q, v, t, h, J=None):
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q
@@ -224,7 +227,7 @@ class LocusSystem:
             d = np.concatenate([self.mech.difference(q0, qc) / self.scale, vc - v])
             return t[None], np.array([h - t @ d])
 
-        return self.newton(qp, vp, plane, iterations=8, max_step=max(h, 1e-3))
+        return self.newton(qp, vp, plane, iterations=8, max_step=max(h, 1e-3), J=J)
 
 
 def _in_box(p, box, margin=0.0):
@@ -236,23 +239,25 @@ def _in_box(p, box, margin=0.0):
 def _follow(sys, q, v, box, direction):
     """Points from (q, v) along +-tangent until the box's edge, the start again, or MAX_POINTS.
     Returns (qs, vs, closed, truncated)."""
-    t = direction * sys.tangent(q, v)
+    J = sys.jacobian(q, v)
+    t = direction * sys.tangent(q, v, None, J)
     qs, vs, ts = [q], [v], [t]
     h, travelled, start = STEP, 0.0, q
     while len(qs) < MAX_POINTS:
-        res = sys.along(q, v, t, h)
+        res = sys.along(q, v, t, h, J)
         if res is None:
             h /= 2
             if h < STEP_MIN:
                 return qs, vs, ts, False, True
             continue
         qn, vn = res
-        tn = sys.tangent(qn, vn, t)
+        Jn = sys.jacobian(qn, vn)
+        tn = sys.tangent(qn, vn, t, Jn)
         if tn @ t < 0.96 and h > STEP_MIN * 4:  # turned too fast: smaller steps
             h /= 2
             continue
         travelled += h
-        q, v, t = qn, vn, tn
+        q, v, t, J = qn, vn, tn, Jn
         p = sys.xy(q)
         qs.append(q), vs.append(v), ts.append(t)
         if not _in_box(p, box):
@@ -341,7 +346,7 @@ def _cusps(sys, qs, vs, ts):
     return out
 
 
-def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, kinds=None, grid: int = 13,
+def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, kinds=None, grid: int = 9,
                starts=None) -> Loci:
     """The singular loci of each kind in the box xs[0]..xs[-1] x ys[0]..ys[-1] (see the module).
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""
@@ -429,7 +434,12 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
 
 
 def _near(sys, q, Q) -> float:
-    D = np.array([sys.mech.difference(q, qk) for qk in Q[:: max(1, len(Q) // 400)]]) / sys.scale
+    """The distance (dimensionless: lengths over L) from q to the nearest of the configurations Q, by
+    their joint values (angles the short way round)."""
+    rows = sys.mech.joint_value_rows(np.vstack([q[None], Q]))
+    D = rows[1:] - rows[0]
+    D[:, sys.angular] = np.arctan2(np.sin(D[:, sys.angular]), np.cos(D[:, sys.angular]))
+    D[:, ~sys.angular] /= sys.L
     return float(np.sqrt((D * D).sum(axis=1)).min())
 
 
