@@ -9,6 +9,7 @@ import pytest
 from numpy.polynomial import Polynomial
 
 import screwkin
+from screwkin.analysis.motion.connect import loop, wedge_direction
 from screwkin.analysis.singularities.loci import trace_loci
 from screwkin.analysis.singularities.regions import regions
 from conftest import screwkin_cli
@@ -134,19 +135,34 @@ def test_map_loci_needs_the_other_inputs_held(tmp_path):
     assert p.returncode == 2 and "leg1" in p.stderr and "Traceback" not in p.stderr
 
 
-@pytest.mark.slow
-def test_3rpr_cusps_are_triple_roots_of_the_forward_kinematics_polynomial(tmp_path):
+@pytest.fixture(scope="module")
+def rpr(tmp_path_factory):
     """The 3-RPR of Innocenti & Parenti-Castelli (Zein, Wenger & Chablat 2008) in the section rho1 = 0.17 m
-    (17 in the published units): its actuator loci in (rho2, rho3), each point with the three leg lines
-    concurrent, and its cusps, where three of the polynomial's roots coincide."""
+    (17 in the published units): (mech, solver, text, rho0, rho1, traced actuator loci in (rho2, rho3))."""
     text, rho0 = rpr3()
-    path = tmp_path / "rpr3.urdf"
+    path = tmp_path_factory.mktemp("rpr") / "rpr3.urdf"
     path.write_text(text)
     mech = screwkin.load(path)
     solver = screwkin.PositionSolver(mech)
     rho1 = 0.17
     xs, ys = np.linspace(0.02, 0.40, 41) - rho0[1], np.linspace(0.02, 0.40, 41) - rho0[2]
     traced = trace_loci(solver, "leg2", xs, "leg3", ys, {"leg1": rho1 - rho0[0]})
+    return mech, solver, text, rho0, rho1, traced
+
+
+def _platform_t(mech, q):
+    """tan(phi / 2) of the platform's turn phi from its frame in RPR_PLATFORM: drawn at 30 deg, then turned
+    by the planar revolutes base1 and wrist1 of the tree."""
+    phi = np.radians(30.0) + q[mech.coordinate("base1").idx_q] + q[mech.coordinate("wrist1").idx_q]
+    return np.tan(0.5 * phi)
+
+
+@pytest.mark.slow
+def test_3rpr_loci_have_concurrent_legs_and_cusps_that_are_triple_roots(rpr):
+    """Each locus point with the three leg lines concurrent (the actuator singularity in closed form); each
+    cusp where three of the polynomial's roots coincide, located to 1e-8 m by an independent Newton on
+    P = P' = P'' = 0."""
+    mech, _, text, rho0, rho1, traced = rpr
     assert traced.loci and {lc.kind for lc in traced.loci} == {"actuator"}
     base = [mech.coordinate(f"base{i}").idx_q for i in (1, 2, 3)]
     u0 = [np.array([float(v) for v in
@@ -173,3 +189,38 @@ def test_3rpr_cusps_are_triple_roots_of_the_forward_kinematics_polynomial(tmp_pa
         rel = [abs(D(tc)) / Polynomial(np.abs(D.coef))(abs(tc)) for D in (P, P.deriv(1), P.deriv(2), P.deriv(3))]
         assert max(rel[:3]) < 1e-9, rel  # a triple root
         assert rel[3] > 1e-4, rel  # and not a quadruple one
+
+
+@pytest.mark.slow
+def test_a_loop_round_a_cusp_changes_the_3rpr_mode_without_a_singularity(rpr):
+    """McAree & Daniel 1999, Zein, Wenger & Chablat 2008: from inside a cusp's wedge (three of the modes
+    there are the cusp's), each outer one of the three, followed once round the cusp in one sense, comes
+    back on another mode with the actuator measure away from zero all along; a loop of the same size round
+    no cusp brings every mode back to itself.  Both ends are real roots of the independent polynomial."""
+    mech, solver, _, rho0, rho1, traced = rpr
+    fixed = {"leg1": rho1 - rho0[0]}
+    (cx, cy), _ = traced.cusps[0]
+    r = 0.004
+    pts = np.concatenate([lc.points for lc in traced.loci])
+    th = wedge_direction(pts, (cx, cy), r)
+    start = (cx + r * np.cos(th), cy + r * np.sin(th))
+    sols = solver.solve({"leg2": start[0], "leg3": start[1], **fixed}).solutions
+    P = rpr3_polynomial((rho1, start[0] + rho0[1], start[1] + rho0[2]))
+    changed = 0
+    for sol in sols:
+        for turn in (1, -1):
+            L = loop(solver, "leg2", "leg3", fixed, (cx, cy), (r, r), sol.q, start=th, turn=turn)
+            if L.regular and L.joined:
+                changed += 1
+                t0, t1 = _platform_t(mech, L.q[0]), _platform_t(mech, L.q[-1])
+                scale = Polynomial(np.abs(P.coef))
+                assert abs(P(t0)) < 1e-8 * scale(abs(t0)) and abs(P(t1)) < 1e-8 * scale(abs(t1))
+                assert abs(t0 - t1) > 1e-3  # another root: another assembly mode
+                assert L.sigma_min > mech.tolerances.singular
+    assert changed >= 2  # the two outer modes of the cusp, each in one sense
+    # a loop round no cusp: every mode comes back
+    far = (cx + 3 * r * np.cos(th + np.pi), cy + 3 * r * np.sin(th + np.pi))
+    assert all(np.hypot(far[0] - p[0], far[1] - p[1]) > 2 * r for p, _ in traced.cusps)
+    for sol in solver.solve({"leg2": far[0] + r, "leg3": far[1], **fixed}).solutions:
+        L = loop(solver, "leg2", "leg3", fixed, far, (r, r), sol.q)
+        assert not L.joined

@@ -415,6 +415,7 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
                     cusps.append((tuple(p), kind))
                     cusp_q.append(qc)
         span = max(box[0][1] - box[0][0], box[1][1] - box[1][0], 1e-300)
+        mine = []
         for Q, V, closed in traced:
             pts = np.array([sys.xy(q) for q in Q])
             worst = max(sys.relative(q, v) for q, v in zip(Q, V))
@@ -423,7 +424,12 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
                              "held (a self-motion through the singular configurations): a point of the locus")
                 pts, Q, closed = pts[:1], Q[:1], False
             loci.append(Locus(kind, pts, Q, bool(closed), worst))
-        nodes += [(p, kind) for p in _crossings([lc.points for lc in loci if lc.kind == kind], box)]
+            mine.append((pts, Q, V))
+        for c, k, c2, k2, f1, f2, p in _crossings([m[0] for m in mine], box):
+            refined = _refine_node(sys, mine[c], k, f1, mine[c2], k2, f2, span)
+            p = refined if refined is not None else p
+            if not any(np.allclose(p, o[0], rtol=0, atol=1e-9 * span) for o in nodes):
+                nodes.append((tuple(float(a) for a in p), kind))
     notes = list(dict.fromkeys(notes))
     how = (f"seeds: Newton on [closure; A v = 0; |v| = 1] from the configurations of {mode_how}, each continued "
            f"over a {grid} x {grid} grid of the box, at the nodes next to a fold and where the kind's relative "
@@ -555,7 +561,37 @@ def _crossings(curves, box):
             s = (w[0] * d2[1] - w[1] * d2[0]) / den
             t = (w[0] * d1[1] - w[1] * d1[0]) / den
             if 0 <= s < 1 and 0 <= t < 1:
-                p = (a + s * d1) * span
-                if not any(np.allclose(p, o, rtol=0, atol=1e-9 * span.max()) for o in out):
-                    out.append(tuple(p))
+                out.append((c, k, c2, k2, s, t, (a + s * d1) * span))
     return out
+
+
+def _refine_node(sys, one, k1, f1, other, k2, f2, span):
+    """The crossing of two traces near their segments k1 and k2 (at fractions f1, f2 of them): Newton on
+    the two arclengths s1, s2 from the segments' first points, xy(curve1(s1)) = xy(curve2(s2)), each
+    point converged on F (LocusSystem.along).  None when it does not converge."""
+    starts = []
+    for (P, Q, V), k, f in ((one, k1, f1), (other, k2, f2)):
+        q, v = Q[k], V[k]
+        t = sys.tangent(q, v)
+        dz = np.concatenate([sys.mech.difference(q, Q[k + 1]) / sys.scale, V[k + 1] - v])
+        if t @ dz < 0:
+            t = -t
+        starts.append((q, v, t, f * float(t @ dz)))
+    s = np.array([starts[0][3], starts[1][3]])
+    for _ in range(12):
+        pts, vel = [], []
+        for (q, v, t, _), si in zip(starts, s):
+            res = sys.along(q, v, t, si) if si != 0 else (q, v)
+            if res is None:
+                return None
+            pts.append(sys.xy(res[0]))
+            vel.append(sys.projected(res[0], sys.tangent(*res, t)))
+        gap = pts[1] - pts[0]
+        if np.abs(gap).max() < 1e-12 * span:
+            return 0.5 * (pts[0] + pts[1])
+        M = np.column_stack([vel[0], -vel[1]])
+        try:
+            s = s + np.linalg.solve(M, gap)
+        except np.linalg.LinAlgError:
+            return None
+    return None
