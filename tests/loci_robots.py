@@ -28,14 +28,14 @@ def _loop(name, l1, p1, l2, p2):
 
 
 #: five-bar: ground pivots (0, 0), (D, 0); proximal links A1, A2; distal B1, B2; drawn with the motors at HOME
-FIVE_BAR = dict(D=0.1, a1=0.1, a2=0.1, b1=0.15, b2=0.12, home=(np.radians(120), np.radians(60)))
+FIVE_BAR = {"D": 0.1, "a1": 0.1, "a2": 0.1, "b1": 0.15, "b2": 0.12, "home": (np.radians(120), np.radians(60))}
 
 
 def five_bar(D, a1, a2, b1, b2, home):
     """(URDF text, function (motor1, motor2) -> (A1, A2, B1, B2) in the plane).  A motor's joint value is
     its proximal link's angle minus the drawn one."""
     A1, A2 = np.zeros(2), np.array([D, 0.0])
-    u = lambda t: np.array([np.cos(t), np.sin(t)])  # noqa: E731
+    u = lambda t: np.array([np.cos(t), np.sin(t)])
     B1, B2 = A1 + a1 * u(home[0]), A2 + a2 * u(home[1])
     d = np.linalg.norm(B2 - B1)
     e = (B2 - B1) / d

@@ -6,14 +6,14 @@ import json
 
 import numpy as np
 import pytest
+from conftest import screwkin_cli
+from loci_robots import FIVE_BAR, RPR_BASE, five_bar, rpr3, rpr3_cusp, rpr3_polynomial
 from numpy.polynomial import Polynomial
 
 import screwkin
 from screwkin.analysis.motion.connect import loop, wedge_direction
 from screwkin.analysis.singularities.loci import trace_loci
 from screwkin.analysis.singularities.regions import regions
-from conftest import screwkin_cli
-from loci_robots import FIVE_BAR, five_bar, rpr3, rpr3_cusp, rpr3_polynomial, RPR_BASE
 
 REL = 1e-9
 
@@ -30,7 +30,7 @@ def _five_bar_conditions(elbows, m1, m2):
     """The closed forms, relative: actuator -- the distal links collinear, |B1 B2| = b1 + b2 or |b1 - b2|;
     serial -- a leg stretched or folded, the tip on proximal i's line at a_i +- b_i from A_i and at b_j from
     B_j."""
-    D, a1, a2, b1, b2 = (FIVE_BAR[k] for k in ("D", "a1", "a2", "b1", "b2"))
+    a1, a2, b1, b2 = (FIVE_BAR[k] for k in ("a1", "a2", "b1", "b2"))
     A1, A2, B1, B2 = elbows(m1, m2)
     d = np.linalg.norm(B2 - B1)
     actuator = [(d - (b1 + b2)) / (b1 + b2), (d - abs(b1 - b2)) / (b1 + b2)]
@@ -49,7 +49,7 @@ def _dense(P, k=10):
 
 
 def _trace_five(five, n=41, regions_too=False):
-    path, elbows = five
+    path, _ = five
     mech = screwkin.load(path)
     solver = screwkin.PositionSolver(mech)
     xs = ys = np.radians(np.linspace(-90, 90, n))
@@ -86,7 +86,7 @@ def test_five_bar_loci_points_satisfy_the_closed_forms_and_every_component_is_fo
 
 
 def test_five_bar_regions_count_the_closed_form_modes(five):
-    traced, cut, xs, ys = _trace_five(five, n=41, regions_too=True)
+    _, cut, xs, ys = _trace_five(five, n=41, regions_too=True)
     _, elbows = five
     b1, b2 = FIVE_BAR["b1"], FIVE_BAR["b2"]
     assert len(cut.regions) >= 4

@@ -6,21 +6,21 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.motion.continuation import continuation_steps
+from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.loci import trace_loci
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.singularities.regions import regions
-from ..analysis.motion.position import PositionSolver
-from ..analysis.motion.continuation import continuation_steps
 from ..errors import UsageError
 from ..present.jsonout import json_of
+from ..present.loci import loci_dict, loci_lines, loci_png
 from ..present.outfile import write_output
 from ..present.plots import map_png
-from ..present.loci import loci_dict, loci_lines, loci_png
 from ..present.report import map_csv, map_dict
 from ._configuration import add_mode_option, configuration, with_mode
+from ._options import BOUNDS
 from ._output_frame import output_frame
 from ._values import joint_assignments, parse_range
-from ._options import BOUNDS
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -67,7 +67,7 @@ def run(mech, args) -> int:
     if point and not output:
         raise UsageError("--point needs --output LINK")
     # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
-    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
+    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
     traced = _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point) if args.loci else None
     if traced is not None and args.png:

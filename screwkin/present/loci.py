@@ -98,7 +98,7 @@ def loci_png(loci, regions, path, xs, ys, x_name, y_name, x_unit, y_unit, title=
             P = np.array([_xy(p, x_unit, y_unit) for p in lc.points])
             label = None if lc.kind in shown else f"{lc.kind} singularity"
             shown.add(lc.kind)
-            style = dict(color=_COLOURS.get(lc.kind, "k"), label=label)
+            style = {"color": _COLOURS.get(lc.kind, "k"), "label": label}
             if len(P) == 1:
                 ax.plot(P[:, 0], P[:, 1], "o", ms=4, **style)
             else:

@@ -53,8 +53,8 @@ def _blocked(curves, xs, ys) -> np.ndarray:
                                + [F[-1:]])
         lo_i, hi_i = np.ceil(F[:, 0] - 0.75).astype(int), np.floor(F[:, 0] + 0.75).astype(int)
         lo_j, hi_j = np.ceil(F[:, 1] - 0.75).astype(int), np.floor(F[:, 1] + 0.75).astype(int)
-        for a in range(0, 2):
-            for b in range(0, 2):
+        for a in range(2):
+            for b in range(2):
                 i, j = lo_i + a, lo_j + b
                 ok = (i <= hi_i) & (j <= hi_j) & (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
                 mask[j[ok], i[ok]] = True
