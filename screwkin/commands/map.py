@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.motion.connect import cusp_loops
 from ..analysis.motion.continuation import continuation_steps
 from ..analysis.motion.position import PositionSolver
 from ..analysis.singularities.loci import trace_loci
@@ -42,6 +43,9 @@ def add_parser(sub, common, scaled):
                     help="trace the singular curves over every assembly mode (actuator; serial with --output), "
                          "their cusps and crossings, and the regions they cut the box into with their numbers "
                          "of assembly modes (with --png: their picture instead of the heat map)")
+    sp.add_argument("--connect", action="store_true",
+                    help="with --loci: follow every mode at a point inside each cusp's wedge once round the cusp, "
+                         "each way, and list the loops that end on another mode without meeting a singularity")
     sp.add_argument("--no-regions", dest="regions", action="store_false",
                     help="with --loci: leave out the regions and their mode counts (an all-modes solve each)")
     scaled(sp)
@@ -69,17 +73,19 @@ def run(mech, args) -> int:
     # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
     mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
+    if args.connect and not args.loci:
+        raise UsageError("--connect needs --loci: the loops go round the cusps of the traced loci")
     traced = _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point) if args.loci else None
     if traced is not None and args.png:
         title = f"{mech.spec.name or Path(mech.path).stem}: singular loci over {xn} and {yn}"
-        loci_png(*traced, args.png, xs, ys, xn, yn, x_unit, y_unit, title=title)
+        loci_png(*traced[:2], args.png, xs, ys, xn, yn, x_unit, y_unit, title=title)
     elif args.png:
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
         map_png(res, args.png, x_unit, y_unit, title=title)
     if args.csv:
         write_output(args.csv, map_csv(res))
     if args.json:
-        extra = loci_dict(*traced, x_unit, y_unit) if traced is not None else {}
+        extra = loci_dict(*traced[:2], x_unit, y_unit, traced[2], mech) if traced is not None else {}
         print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length, **extra})))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
@@ -89,13 +95,14 @@ def run(mech, args) -> int:
         for note in res.notes:
             print(note)
         if traced is not None:
-            for line in loci_lines(*traced, xn, yn, x_unit, y_unit):
+            for line in loci_lines(*traced[:2], xn, yn, x_unit, y_unit, traced[2]):
                 print(line)
     return 0
 
 
 def _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point):
-    """(Loci, Regions or None) of map --loci: every input other than --x and --y held by --set."""
+    """(Loci, Regions or None, (cusp loops, tried) or None) of map --loci: every input other than --x and
+    --y held by --set."""
     held = [n for n in inputs if n not in (xn, yn)]
     missing = [n for n in held if n not in fixed]
     if missing:
@@ -105,5 +112,7 @@ def _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point):
     held_values = {n: fixed[n] for n in held}
     traced = trace_loci(solver, xn, xs, yn, ys, held_values, output, point)
     cut = regions(solver, traced, xn, xs, yn, ys, held_values) if args.regions else None
-    return traced, cut
+    box = ((float(min(xs[0], xs[-1])), float(max(xs[0], xs[-1]))), (float(min(ys[0], ys[-1])), float(max(ys[0], ys[-1]))))
+    loops = cusp_loops(solver, traced, xn, yn, held_values, box) if args.connect else None
+    return traced, cut, loops
 

@@ -19,9 +19,11 @@ def _xy(p, xu, yu):
     return [float(in_unit(p[0], xu)), float(in_unit(p[1], yu))]
 
 
-def loci_dict(loci, regions, x_unit: str, y_unit: str) -> dict:
+def loci_dict(loci, regions, x_unit: str, y_unit: str, loops=None, mech=None) -> dict:
     """The keys ``map --loci --json`` adds: loci [{kind, points, closed, sigma_max}], cusps, nodes,
-    regions [{sample, modes, certain, how}], complete, how, loci_notes."""
+    regions [{sample, modes, certain, how}], complete, how, loci_notes; with --connect, connections
+    [{cusp, start, radius, modes, joined, turn, sigma_min, path: [{inputs, joints}]}] (modes: the indices
+    of the start's solutions, 0-based) and connections_tried."""
     out = {
         "loci": [{"kind": lc.kind, "points": [_xy(p, x_unit, y_unit) for p in lc.points], "closed": lc.closed,
                   "sigma_max": lc.residual} for lc in loci.loci],
@@ -38,10 +40,20 @@ def loci_dict(loci, regions, x_unit: str, y_unit: str) -> dict:
                            "how": r.how, "nodes": r.nodes} for r in regions.regions]
         out["regions_how"] = regions.resolution
         out["loci_notes"] += list(regions.notes)
+    if loops is not None:
+        found, tried = loops
+        out["connections"] = [
+            {"cusp": _xy(c.cusp, x_unit, y_unit), "start": _xy(c.start, x_unit, y_unit),
+             "radius": _xy(c.radius, x_unit, y_unit), "modes": list(c.modes), "joined": c.loop.joined,
+             "turn": "counter-clockwise" if c.turn > 0 else "clockwise", "sigma_min": c.loop.sigma_min,
+             "path": [{"inputs": _xy(p, x_unit, y_unit), "joints": mech.joint_values(q)}
+                      for p, q in zip(c.loop.inputs[::20], c.loop.q[::20])]}
+            for c in found]
+        out["connections_tried"] = tried
     return out
 
 
-def loci_lines(loci, regions, x_name, y_name, x_unit: str, y_unit: str) -> list:
+def loci_lines(loci, regions, x_name, y_name, x_unit: str, y_unit: str, loops=None) -> list:
     """Text lines: each curve, the cusps, nodes and regions, and how they were found."""
     def pt(p):
         a, b = _xy(p, x_unit, y_unit)
@@ -69,6 +81,14 @@ def loci_lines(loci, regions, x_name, y_name, x_unit: str, y_unit: str) -> list:
             lines.append(f"region of {r.nodes} grid points, sample {pt(r.sample)}: {modes}")
         lines.append(regions.resolution)
         lines += list(regions.notes)
+    if loops is not None:
+        found, tried = loops
+        for c in found:
+            lines.append(f"mode {c.modes[0] + 1} -> mode {c.modes[1] + 1 if c.modes[1] is not None else '?'} without a "
+                         f"singularity: once round the cusp at {pt(c.cusp)}, "
+                         f"{'counter-clockwise' if c.turn > 0 else 'clockwise'} from {pt(c.start)} "
+                         f"(smallest actuator measure {c.loop.sigma_min:.2g})")
+        lines.append(f"{len(found)} of {tried} loops round the cusps change the assembly mode without a singularity")
     lines.append(f"complete: {'yes' if loci.complete else 'not claimed'}; {loci.how}")
     lines += list(loci.notes)
     return lines

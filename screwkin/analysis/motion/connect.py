@@ -18,10 +18,13 @@ import numpy as np
 from ...errors import AssemblyError
 from ..singularities.singular import Generic, measures
 
-__all__ = ["Loop", "loop", "wedge_direction"]
+__all__ = ["CuspLoop", "Loop", "cusp_loops", "loop", "wedge_direction"]
 
 #: A step of the loop that moves the configuration further than this (dimensionless) jumped branches.
 JUMP = 0.05
+#: A loop's end this near its start (dimensionless) is its start again: the steps close the loops to
+#: Tolerances.closure (1e-10), and modes near a cusp differ by about the square root of the loop's size.
+SAME = 1e-6
 
 
 @dataclass(frozen=True)
@@ -63,7 +66,7 @@ def loop(solver, x_name, y_name, fixed, centre, radius, q0, steps: int = 720, st
         sig.append(measures(mech, q, g)["actuator"])
     smallest = float(min(sig))
     regular = smallest > tol.singular
-    joined = _apart(mech, Q[0], Q[-1]) > tol.near_far
+    joined = _apart(mech, Q[0], Q[-1]) > SAME
     why = ("the loop ends on another assembly mode, no singularity met" if regular and joined else
            "the loop returns to its start" if regular else "the loop meets a singularity")
     return Loop(xy, np.array(Q), smallest, regular, joined, why)
@@ -80,3 +83,47 @@ def wedge_direction(points, cusp, radius) -> float:
         near = r > 0
     u = (d[near] / r[near, None]).mean(axis=0)
     return float(np.arctan2(u[1], u[0]))
+
+
+@dataclass(frozen=True)
+class CuspLoop:
+    cusp: tuple  # (x, y) [SI]
+    start: tuple  # the loop's first inputs, inside the cusp's wedge
+    radius: tuple  # semi-axes [SI]
+    modes: tuple  # (i, j): the start's solutions (0-based, as listed) it leaves and reaches
+    turn: int  # 1 counter-clockwise, -1 clockwise
+    loop: Loop
+
+
+def cusp_loops(solver, loci, x_name, y_name, fixed, box, size: float = 0.02, steps: int = 720) -> tuple:
+    """For each cusp of the actuator loci (analysis.singularities.loci.Loci): every mode at a point inside
+    its wedge, followed once round the cusp each way on an ellipse of semi-axes ``size`` times the box's
+    sides (``loop``).  Returns (CuspLoop of every regular loop that ends on another mode, loops tried)."""
+    mech = solver.mech
+    span = np.array([box[0][1] - box[0][0], box[1][1] - box[1][0]], float)
+    span[span == 0] = 1.0
+    pts = [lc.points for lc in loci.loci if lc.kind == "actuator"]
+    if not pts:
+        return (), 0
+    P = np.concatenate(pts) / span
+    out, tried = [], 0
+    for (cx, cy), kind in loci.cusps:
+        if kind != "actuator":
+            continue
+        th = wedge_direction(P, (cx / span[0], cy / span[1]), size)
+        r = size * span
+        start = (cx + r[0] * np.cos(th), cy + r[1] * np.sin(th))
+        try:
+            sols = [s.q for s in solver.solve({x_name: start[0], y_name: start[1], **fixed}).solutions]
+        except AssemblyError:
+            continue
+        for i, q in enumerate(sols):
+            for turn in (1, -1):
+                tried += 1
+                lp = loop(solver, x_name, y_name, fixed, (cx, cy), tuple(r), q, steps, start=th, turn=turn)
+                if not (lp.regular and lp.joined):
+                    continue
+                gaps = [_apart(mech, qk, lp.q[-1]) for qk in sols]
+                j = int(np.argmin(gaps)) if min(gaps) < SAME else None  # the start's solution it ends on
+                out.append(CuspLoop((cx, cy), start, tuple(r), (i, j), turn, lp))
+    return tuple(out), tried
