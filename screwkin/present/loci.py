@@ -32,6 +32,7 @@ def loci_dict(loci, regions, x_unit: str, y_unit: str, loops=None, mech=None) ->
         "nodes": [_xy(p, x_unit, y_unit) for p, _ in loci.nodes],
         "node_kinds": [k for _, k in loci.nodes],
         "complete": loci.complete,
+        "loci_kinds": list(loci.traced),
         "how": loci.how,
         "loci_notes": list(loci.notes),
     }
@@ -70,7 +71,8 @@ def loci_lines(loci, regions, x_name, y_name, x_unit: str, y_unit: str, loops=No
             lines.append(f"  {'closed curve' if c.closed else 'curve'} of {len(c.points)} points from "
                          f"{pt(c.points[0])} to {pt(c.points[-1])}")
     if not loci.loci:
-        lines.append("no singular locus found in the box")
+        lines.append(f"no {' or '.join(loci.traced)} singular locus found in the box" if loci.traced else
+                     "no singular locus traced (see below)")
     for p, kind in loci.cusps:
         lines.append(f"cusp ({kind}: three assembly modes meet) at {pt(p)}")
     for p, kind in loci.nodes:

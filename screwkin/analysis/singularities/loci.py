@@ -75,6 +75,7 @@ class Loci:
     how: str
     notes: tuple = ()
     cusp_q: tuple = field(default=(), repr=False)
+    traced: tuple = ()  # the kinds traced (the others: a note says why not)
 
 
 class LocusSystem:
@@ -390,13 +391,14 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
         mode_how = f"{len(starts)} given configurations"
     grown = sheets(solver, x_name, y_name, box, starts, grid)
     wanted = kinds or ("actuator", "serial")
-    loci, cusps, cusp_q, nodes = [], [], [], []
+    loci, cusps, cusp_q, nodes, traced_kinds = [], [], [], [], []
     for kind in wanted:
         why = _untraceable(mech, g, kind, output, solver.inputs)
         if why:
-            if kinds:
+            if kinds or kind == "actuator" or output is not None:
                 notes.append(f"{kind} loci not traced: {why}")
             continue
+        traced_kinds.append(kind)
         sys = LocusSystem(mech, solver.inputs, x_name, y_name, fixed, kind, output, point, g)
         traced = []
         for q0, sigma in candidates(sys, grown):
@@ -454,9 +456,10 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
             p = refined if refined is not None else p
             if not any(np.allclose(p, o[0], rtol=0, atol=1e-9 * span) for o in nodes):
                 nodes.append((tuple(float(a) for a in p), kind))
-    unexplained = unexplained_folds(grown, loci, box, grid) if "actuator" in wanted else []
+    unexplained = unexplained_folds(grown, loci, box, grid) if "actuator" in traced_kinds else []
     notes += unexplained
-    checked = ("Not every grid step refused by a fold has an actuator curve near it (see the notes)" if unexplained
+    checked = ("No fold check (no actuator loci traced)" if "actuator" not in traced_kinds else
+               "Not every grid step refused by a fold has an actuator curve near it (see the notes)" if unexplained
                else "Checked: every grid step refused by a fold has an actuator curve within a cell and a half")
     notes = list(dict.fromkeys(notes))
     how = (f"seeds: Newton on [closure; A v = 0; |v| = 1] from the configurations of {mode_how}, each continued "
@@ -465,7 +468,7 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
            "continuation to the box's edges or round to its start; cusps located by Brent's method where the trace "
            f"reverses, nodes by Newton on the two arclengths. {checked}. A component no mode at the centre "
            "reaches near a grid node is missed, so completeness is not claimed")
-    return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q))
+    return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
 
 
 def _near(sys, q, Q) -> float:
