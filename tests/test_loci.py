@@ -252,3 +252,19 @@ def test_map_connect_lists_the_mode_changes_round_a_3rpr_cusp(tmp_path):
             t = np.tan(0.5 * (np.radians(30.0) + point["joints"]["base1"] + point["joints"]["wrist1"]))
             P = rpr3_polynomial((rho1, rho2, rho3))
             assert abs(P(t)) < 1e-10 * np.linalg.norm(P.coef) * max(1.0, abs(t)) ** P.degree()
+
+
+def test_map_loci_of_a_box_over_a_whole_turn(five):
+    """A box over 0..360 deg (the solver's angles are in [-180, 180)): the seeds are taken the whole turn into
+    it; the five-bar's inner curve |B1 B2| = b1 - b2 lies near motor1 = -60 deg, here 300 deg."""
+    path, elbows = five
+    p = screwkin_cli("map", str(path), "--x", "motor1=0deg:360deg:37", "--y", "motor2=90deg:-90deg:19", "--loci",
+                     "--no-regions", "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    closed = [lc for lc in d["loci"] if lc["closed"]]
+    assert len(closed) == 1 and closed[0]["kind"] == "actuator"
+    for x, y in closed[0]["points"]:
+        assert 270 < x < 330
+        actuator, _ = _five_bar_conditions(elbows, np.radians(x), np.radians(y))
+        assert abs(actuator[1]) < 1e-8

@@ -375,18 +375,10 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""
     mech = solver.mech
     box = ((min(xs[0], xs[-1]), max(xs[0], xs[-1])), (min(ys[0], ys[-1]), max(ys[0], ys[-1])))
-    centre = {x_name: 0.5 * sum(box[0]), y_name: 0.5 * sum(box[1]), **fixed}
     notes = []
     g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
     if starts is None:
-        try:
-            found = solver.solve(centre)
-            starts = [s.q for s in found.solutions]
-            mode_how = (f"{len(starts)} assembly modes at the box's centre"
-                        + (f" ({found.modes.method}{', complete' if found.modes.complete else ', maybe not all'})"
-                           if found.modes is not None else ""))
-        except AssemblyError:
-            starts, mode_how = [], "no assembly mode at the box's centre"
+        starts, mode_how = _modes_in_box(solver, x_name, y_name, box, fixed)
     else:
         mode_how = f"{len(starts)} given configurations"
     grown = sheets(solver, x_name, y_name, box, starts, grid)
@@ -469,6 +461,25 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
            f"reverses, nodes by Newton on the two arclengths. {checked}. A component no mode at the centre "
            "reaches near a grid node is missed, so completeness is not claimed")
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
+
+
+def _modes_in_box(solver, x_name, y_name, box, fixed):
+    """(configurations, in words): every mode the solver finds at the box's centre; where none assembles
+    there, at the first of the other nodes of a 3 x 3 grid of the box that assembles."""
+    (x0, x1), (y0, y1) = box
+    points = [(0.5 * (x0 + x1), 0.5 * (y0 + y1))] + [(x, y) for y in (y0, 0.5 * (y0 + y1), y1)
+                                                      for x in (x0, 0.5 * (x0 + x1), x1)
+                                                      if (x, y) != (0.5 * (x0 + x1), 0.5 * (y0 + y1))]
+    for k, (x, y) in enumerate(points):
+        try:
+            found = solver.solve({x_name: x, y_name: y, **fixed})
+        except AssemblyError:
+            continue
+        where = "the box's centre" if k == 0 else f"({x:.6g}, {y:.6g}) (none at the box's centre)"
+        how = f" ({found.modes.method}{', complete' if found.modes.complete else ', maybe not all'})" \
+            if found.modes is not None else ""
+        return [sol.q for sol in found.solutions], f"{len(found.solutions)} assembly modes at {where}{how}"
+    return [], "no assembly mode at the centre, corners or edge midpoints of the box"
 
 
 def _near(sys, q, Q) -> float:

@@ -42,11 +42,21 @@ def sheets(solver, x_name, y_name, box, starts, n):
     for q0 in starts:
         qs = np.full((n, n, mech.nq), np.nan)
         refused = np.zeros((n, n), bool)
-        # the start is at the centre; the node nearest it, reached by two steps
-        j0 = i0 = n // 2
-        vals = mech.joint_values(q0)
-        q = steps[x_name](q0, vals[x_name], float(gx[i0])) if abs(vals[x_name] - gx[i0]) > 0 else q0
-        q = steps[y_name](q, vals[y_name], float(gy[j0])) if q is not None else None
+        # the node nearest the start, reached by two steps (an angle taken the whole turns into the box)
+        q0 = np.array(q0, float)
+        vals = {}
+        for name, grid in ((x_name, gx), (y_name, gy)):
+            c = mech.coordinate(name)
+            v = float(q0[c.idx_q]) if c.nq == 1 else float(np.arctan2(q0[c.idx_q + 1], q0[c.idx_q]))
+            if c.nq == 1 and not mech.translational[c.idx_v]:
+                turns = np.round((0.5 * (grid[0] + grid[-1]) - v) / (2 * np.pi))
+                if grid.min() <= v + 2 * np.pi * turns <= grid.max():
+                    q0[c.idx_q] += 2 * np.pi * turns
+                    v += 2 * np.pi * turns
+            vals[name] = v
+        i0, j0 = int(np.abs(gx - vals[x_name]).argmin()), int(np.abs(gy - vals[y_name]).argmin())
+        q = steps[x_name](q0, vals[x_name], float(gx[i0])) if vals[x_name] != gx[i0] else q0
+        q = steps[y_name](q, vals[y_name], float(gy[j0])) if q is not None and vals[y_name] != gy[j0] else q
         if q is None:
             continue
         qs[j0, i0] = q
