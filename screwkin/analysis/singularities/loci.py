@@ -174,6 +174,17 @@ class LocusSystem:
     def kernel(self, q) -> np.ndarray:
         return np.linalg.svd(self.A(q))[2][-1]
 
+    def edge(self, axis: int, bound: float):
+        """The extra row of ``newton`` that holds the plane's coordinate ``axis`` (0: x, 1: y) at ``bound``."""
+        c = (self.cx, self.cy)[axis]
+
+        def row(qc, vc):
+            r = np.zeros(self.nv + len(vc))
+            r[c.idx_v] = 1.0
+            return r[None], np.array([(bound - self.value(qc, c)) / self.scale[c.idx_v]])
+
+        return row
+
     # ------------------------------------------------------------ Newton, tangent
     def newton(self, q, v, extra=None, iterations: int = 30, max_step: float = 0.3, J=None):
         """Newton (least squares, steps capped at max_step; the Jacobian kept while the residual falls
@@ -286,23 +297,17 @@ def _clip(sys, qs, vs, box):
         inner_v = out_v[end - 1] if end == -1 else out_v[1]
         p_in, p_out = sys.xy(inner), sys.xy(out_q[end])
         best = None
-        for axis, c in ((0, sys.cx), (1, sys.cy)):
+        for axis in (0, 1):
             for bound in box[axis]:
                 if (p_in[axis] - bound) * (p_out[axis] - bound) < 0:
                     frac = (bound - p_in[axis]) / (p_out[axis] - p_in[axis])
                     if best is None or frac < best[0]:
-                        best = (frac, axis, c, bound)
+                        best = (frac, axis, bound)
         if best is None:
             out_q.pop(end), out_v.pop(end)
             continue
-        _, axis, c, bound = best
-        scale = sys.scale[c.idx_v]
-
-        def edge(qc, vc, c=c, bound=bound, scale=scale):
-            row = np.zeros(sys.nv + len(vc))
-            row[c.idx_v] = 1.0
-            return row[None], np.array([(bound - sys.value(qc, c)) / scale])
-
+        _, axis, bound = best
+        edge = sys.edge(axis, bound)
         res = sys.newton(inner, inner_v, edge, iterations=12, max_step=0.1)
         if res is not None and _in_box(sys.xy(res[0]), box, 1e-9):
             out_q[end], out_v[end] = res
@@ -314,18 +319,12 @@ def _clip(sys, qs, vs, box):
 def _onto_edge(sys, q, v, box):
     """A locus point outside the box moved along the curve onto the box's edge: Newton on F with the
     coordinate outside held at the nearer bound (x, then y).  None when the curve does not reach it."""
-    for axis, c in ((0, sys.cx), (1, sys.cy)):
+    for axis in (0, 1):
         value = sys.xy(q)[axis]
         lo, hi = box[axis]
         if lo <= value <= hi:
             continue
-        bound = lo if value < lo else hi
-
-        def edge(qc, vc, c=c, bound=bound):
-            row = np.zeros(sys.nv + len(vc))
-            row[c.idx_v] = 1.0
-            return row[None], np.array([(bound - sys.value(qc, c)) / sys.scale[c.idx_v]])
-
+        edge = sys.edge(axis, lo if value < lo else hi)
         res = sys.newton(q, v, edge, iterations=20, max_step=0.1)
         if res is not None and _in_box(sys.xy(res[0]), box, 1e-9):
             return res
@@ -392,62 +391,11 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
             continue
         traced_kinds.append(kind)
         sys = LocusSystem(mech, solver.inputs, x_name, y_name, fixed, kind, output, point, g)
-        traced = []
-        for q0, sigma in candidates(sys, grown):
-            if len(traced) >= MAX_CURVES:
-                notes.append(f"{kind}: stopped after {MAX_CURVES} curves")
-                break
-            if traced and min(_near(sys, q0, c[0]) for c in traced) < STEP_MAX * 1.5:
-                continue  # a grid configuration next to a curve already traced
-            res = sys.newton(q0, sys.kernel(q0))
-            if res is not None and not _in_box(sys.xy(res[0]), box, 1e-9):
-                res = _onto_edge(sys, *res, box)  # the curve nearest the grid point crosses the box elsewhere
-            if res is None:
-                continue
-            q, v = res
-            if traced and min(_near(sys, q, c[0]) for c in traced) < STEP_MAX * 1.5:
-                continue
-            if not sys.nullity_ok(q, v):
-                notes.append(f"{kind}: seeds where the locus is not a curve (the augmented system drops rank: "
-                             "several singularities meet, or a self-motion) were left")
-                continue
-            fwd = _follow(sys, q, v, box, +1)
-            if fwd[3]:
-                qs, vs, ts, closed = fwd[0], fwd[1], fwd[2], True
-            else:
-                bwd = _follow(sys, q, v, box, -1)
-                qs = bwd[0][::-1] + fwd[0][1:]
-                vs = bwd[1][::-1] + fwd[1][1:]
-                ts = [-t for t in bwd[2][::-1]] + fwd[2][1:]
-                closed = False
-                if fwd[4] or bwd[4]:
-                    notes.append(f"{kind}: a curve was left unfinished (steps below {STEP_MIN:g} or "
-                                 f"{MAX_POINTS} points)")
-            cq = _cusps(sys, qs, vs, ts)
-            if not closed:
-                qs, vs = _clip(sys, qs, vs, box)
-            traced.append((np.array(qs), np.array(vs), closed))
-            for qc, vc in cq:
-                p = sys.xy(qc)
-                if _in_box(p, box) and not any(np.allclose(p, c[0], atol=1e-7) for c in cusps):
-                    cusps.append((tuple(p), kind))
-                    cusp_q.append(qc)
-        span = max(box[0][1] - box[0][0], box[1][1] - box[1][0], 1e-300)
-        mine = []
-        for Q, V, closed in traced:
-            pts = np.array([sys.xy(q) for q in Q])
-            worst = max(sys.relative(q, v) for q, v in zip(Q, V))
-            if np.ptp(pts, axis=0).max() < 1e-9 * span:  # the inputs stand still along the whole curve
-                notes.append(f"{kind}: at ({pts[0][0]:.9g}, {pts[0][1]:.9g}) the mechanism moves with the inputs "
-                             "held (a self-motion through the singular configurations): a point of the locus")
-                pts, Q, closed = pts[:1], Q[:1], False
-            loci.append(Locus(kind, pts, Q, bool(closed), worst))
-            mine.append((pts, Q, V))
-        for c, k, c2, k2, f1, f2, p in crossings([m[0] for m in mine], box):
-            refined = refine_node(sys, mine[c], k, f1, mine[c2], k2, f2, span)
-            p = refined if refined is not None else p
-            if not any(np.allclose(p, o[0], rtol=0, atol=1e-9 * span) for o in nodes):
-                nodes.append((tuple(float(a) for a in p), kind))
+        found = trace_kind(sys, kind, (q0 for q0, _ in candidates(sys, grown)), box, notes)
+        loci += found[0]
+        cusps += found[1]
+        cusp_q += found[2]
+        nodes += found[3]
     unexplained = unexplained_folds(grown, loci, box, grid) if "actuator" in traced_kinds else []
     notes += unexplained
     checked = ("No fold check (no actuator loci traced)" if "actuator" not in traced_kinds else
@@ -461,6 +409,70 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
            f"reverses, nodes by Newton on the two arclengths. {checked}. A component no mode at the centre "
            "reaches near a grid node is missed, so completeness is not claimed")
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
+
+
+def trace_kind(sys, kind, seeds, box, notes):
+    """The curves of one kind (sys: a LocusSystem or one like it) from the configurations ``seeds``, each
+    brought onto the locus by Newton (onto the box's edge when outside) unless near a curve already traced:
+    (loci, cusps ((x, y), kind), their configurations, nodes ((x, y), kind)); notes gets what it left."""
+    loci, cusps, cusp_q, nodes = [], [], [], []
+    traced = []
+    for q0 in seeds:
+        if len(traced) >= MAX_CURVES:
+            notes.append(f"{kind}: stopped after {MAX_CURVES} curves")
+            break
+        if traced and min(_near(sys, q0, c[0]) for c in traced) < STEP_MAX * 1.5:
+            continue  # a grid configuration next to a curve already traced
+        res = sys.newton(q0, sys.kernel(q0))
+        if res is not None and not _in_box(sys.xy(res[0]), box, 1e-9):
+            res = _onto_edge(sys, *res, box)  # the curve nearest the grid point crosses the box elsewhere
+        if res is None:
+            continue
+        q, v = res
+        if traced and min(_near(sys, q, c[0]) for c in traced) < STEP_MAX * 1.5:
+            continue
+        if not sys.nullity_ok(q, v):
+            notes.append(f"{kind}: seeds where the locus is not a curve (the augmented system drops rank: "
+                         "several singularities meet, or a self-motion) were left")
+            continue
+        fwd = _follow(sys, q, v, box, +1)
+        if fwd[3]:
+            qs, vs, ts, closed = fwd[0], fwd[1], fwd[2], True
+        else:
+            bwd = _follow(sys, q, v, box, -1)
+            qs = bwd[0][::-1] + fwd[0][1:]
+            vs = bwd[1][::-1] + fwd[1][1:]
+            ts = [-t for t in bwd[2][::-1]] + fwd[2][1:]
+            closed = False
+            if fwd[4] or bwd[4]:
+                notes.append(f"{kind}: a curve was left unfinished (steps below {STEP_MIN:g} or "
+                             f"{MAX_POINTS} points)")
+        cq = _cusps(sys, qs, vs, ts)
+        if not closed:
+            qs, vs = _clip(sys, qs, vs, box)
+        traced.append((np.array(qs), np.array(vs), closed))
+        for qc, vc in cq:
+            p = sys.xy(qc)
+            if _in_box(p, box) and not any(np.allclose(p, c[0], atol=1e-7) for c in cusps):
+                cusps.append((tuple(p), kind))
+                cusp_q.append(qc)
+    span = max(box[0][1] - box[0][0], box[1][1] - box[1][0], 1e-300)
+    mine = []
+    for Q, V, closed in traced:
+        pts = np.array([sys.xy(q) for q in Q])
+        worst = max(sys.relative(q, v) for q, v in zip(Q, V))
+        if np.ptp(pts, axis=0).max() < 1e-9 * span:  # the inputs stand still along the whole curve
+            notes.append(f"{kind}: at ({pts[0][0]:.9g}, {pts[0][1]:.9g}) the mechanism moves with the inputs "
+                         "held (a self-motion through the singular configurations): a point of the locus")
+            pts, Q, closed = pts[:1], Q[:1], False
+        loci.append(Locus(kind, pts, Q, bool(closed), worst))
+        mine.append((pts, Q, V))
+    for c, k, c2, k2, f1, f2, p in crossings([m[0] for m in mine], box):
+        refined = refine_node(sys, mine[c], k, f1, mine[c2], k2, f2, span)
+        p = refined if refined is not None else p
+        if not any(np.allclose(p, o[0], rtol=0, atol=1e-9 * span) for o in nodes):
+            nodes.append((tuple(float(a) for a in p), kind))
+    return loci, cusps, cusp_q, nodes
 
 
 def _modes_in_box(solver, x_name, y_name, box, fixed):
