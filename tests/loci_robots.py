@@ -140,3 +140,35 @@ def rpr3_cusp(rho1, rho2, rho3, t):
         if np.abs(dz).max() < 1e-15:
             break
     return z[1], z[2], z[0]
+
+
+def orthogonal_3r(d2, d3, d4, r2, r3):
+    """An orthogonal 3R in the modified Denavit-Hartenberg parameters of Baili, Wenger & Chablat (2004):
+    alpha = (0, -90, 90) deg, a = (0, d2, d3), r = (0, r2, r3), the tool point at d4 along x3; its output
+    link is `tool`."""
+    links = "".join(_LINK.format(n=n) for n in ("base", "link1", "link2", "link3")) + '<link name="tool"/>'
+
+    def joint(name, parent, child, xyz, roll):
+        return (f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+                f'<origin xyz="{float(xyz[0])!r} {float(xyz[1])!r} {float(xyz[2])!r}" rpy="{float(roll)!r} 0 0"/>'
+                '<axis xyz="0 0 1"/><limit lower="-3.1416" upper="3.1416" effort="1" velocity="1"/></joint>')
+
+    body = links + joint("theta1", "base", "link1", (0, 0, 0), 0.0)
+    body += joint("theta2", "link1", "link2", (d2, 0, 0), -np.pi / 2)
+    body += joint("theta3", "link2", "link3", (d3, 0, r2), np.pi / 2)
+    body += f'<joint name="tool_joint" type="fixed"><parent link="link3"/><child link="tool"/>' \
+            f'<origin xyz="{float(d4)!r} 0 {float(r3)!r}"/></joint>'
+    return f'<?xml version="1.0"?><robot name="orthogonal_3r">{body}</robot>'
+
+
+def orthogonal_3r_quartic(d2, d3, d4, r2, r3, x, z):
+    """The inverse kinematics of orthogonal_3r at the point (x, 0, z), as a polynomial in t = tan(theta3 / 2)
+    (numpy, independent of screwkin): with R^2 = x^2 + z^2, the tool point's distance from the base and its
+    height give (K - 2 d3 d4 c3 - 2 r2 d4 s3)^2 + 4 d2^2 (z^2 - (d3 + d4 c3)^2 - r3^2) = 0,
+    K = R^2 - d2^2 - d3^2 - d4^2 - r2^2 - r3^2; each real root is one solution (theta2 and theta1 follow)."""
+    from numpy.polynomial import Polynomial as P
+    one, c, s = P([1, 0, 1]), P([1, 0, -1]), P([0, 2])
+    K = x * x + z * z - d2**2 - d3**2 - d4**2 - r2**2 - r3**2
+    first = K * one - 2 * d3 * d4 * c - 2 * r2 * d4 * s
+    ux = d3 * one + d4 * c
+    return first**2 + 4 * d2**2 * ((z * z - r3**2) * one**2 - ux**2)

@@ -5,6 +5,7 @@ polynomial (built independently with numpy in tests/loci_robots.py)."""
 import json
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from conftest import screwkin_cli
 from loci_robots import FIVE_BAR, RPR_BASE, five_bar, rpr3, rpr3_cusp, rpr3_polynomial
@@ -268,3 +269,36 @@ def test_map_loci_of_a_box_over_a_whole_turn(five):
         assert 270 < x < 330
         actuator, _ = _five_bar_conditions(elbows, np.radians(x), np.radians(y))
         assert abs(actuator[1]) < 1e-8
+
+
+@pytest.mark.slow
+def test_a_cuspidal_orthogonal_3r_has_cusps_where_three_ik_solutions_meet(tmp_path):
+    """The orthogonal 3R d2 = 1, d3 = 2, d4 = 1.5, r2 = 1, r3 = 0 (Baili, Wenger & Chablat's family; Wenger's
+    cuspidal example): in the section y = 0 its serial singular curve has four cusps on each side of the
+    first axis, each a triple root of the independent inverse-kinematics quartic; the robot is cuspidal."""
+    from loci_robots import orthogonal_3r, orthogonal_3r_quartic
+
+    from screwkin.analysis.singularities.section import trace_section
+
+    params = (1.0, 2.0, 1.5, 1.0, 0.0)
+    path = tmp_path / "o3r.urdf"
+    path.write_text(orthogonal_3r(*params))
+    mech = screwkin.load(path)
+    grid = np.linspace(-5, 5, 41)
+    sec = trace_section(mech, "tool", "x", grid, "z", grid, 0.0, samples=200)
+    assert sec.cuspidal
+    assert len(sec.loci.cusps) == 8
+    assert sum(p[0] > 0 for p, _ in sec.loci.cusps) == 4
+    for (x, z), _ in sec.loci.cusps:
+        P = orthogonal_3r_quartic(*params, x, z)
+        roots = P.roots()
+        spread = min(max(abs(a - b) for a in g for b in g)
+                     for g in [[roots[i], roots[j], roots[k]] for i in range(4) for j in range(i + 1, 4)
+                               for k in range(j + 1, 4)])
+        assert spread < 1e-3 * max(1.0, abs(roots).max())  # three roots together (a triple root, perturbed)
+    for lc in sec.loci.loci:  # every point on the serial condition: J_p over the three joints singular
+        for q in lc.q[:: 10]:
+            Jp = pin.computeFrameJacobian(mech.model, mech.model.createData(), q, mech.model.getFrameId("tool"),
+                                          pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[:3]
+            s = np.linalg.svd(Jp, compute_uv=False)
+            assert s[-1] / s[0] < 1e-9

@@ -364,6 +364,13 @@ def _cusps(sys, qs, vs, ts):
             qc, vc = cache.get(s) or sys.along(q0, v0, t0, s)
         except (ValueError, TypeError):
             continue
+        # a cusp: the plane's velocity itself vanishes there (a sharp turn, where it only passes at right
+        # angles to the bracket's first one, is none)
+        if np.linalg.norm(sys.projected(qc, sys.tangent(qc, vc, t0))) > 1e-6 * max(na, nb):
+            continue
+        if not sys.nullity_ok(qc, vc):
+            continue  # two singular curves cross there (the system drops rank): no cusp of one
+
         out.append((qc, vc))
     return out
 
@@ -447,7 +454,9 @@ def trace_kind(sys, kind, seeds, box, notes):
             if fwd[4] or bwd[4]:
                 notes.append(f"{kind}: a curve was left unfinished (steps below {STEP_MIN:g} or "
                              f"{MAX_POINTS} points)")
-        cq = _cusps(sys, qs, vs, ts)
+        span = max(box[0][1] - box[0][0], box[1][1] - box[1][0], 1e-300)
+        still = np.ptp(np.array([sys.xy(qk) for qk in qs[:: max(1, len(qs) // 50)]]), axis=0).max() < 1e-9 * span
+        cq = [] if still else _cusps(sys, qs, vs, ts)  # (a self-motion's curve stands still in the plane)
         if not closed:
             qs, vs = _clip(sys, qs, vs, box)
         traced.append((np.array(qs), np.array(vs), closed))
