@@ -148,19 +148,21 @@ class LocusSystem:
             K = np.array(mech.closure.jacobian(q), float)
             K[self.pos] /= self.L
             blocks.append(np.hstack([K * self.scale, np.zeros((len(K), len(v)))]))
+        return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
+
+    def _held_kind_norm_rows(self, q, v, A) -> list:
+        """The Jacobian's rows after the loops' (a section's too): the held inputs, d(A v)/d(u, v) (d/du by
+        forward differences of step FD) and |v| = 1."""
         H = np.zeros((len(self.held), self.nv + len(v)))
         for k, (c, _, _) in enumerate(self.held):
             H[k, c.idx_v] = 1.0
-        blocks.append(H)
         Av = A @ v
         D = np.empty((len(A), self.nv))
         for k in range(self.nv):
             e = np.zeros(self.nv)
             e[k] = FD
             D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / FD
-        blocks.append(np.hstack([D, A]))
-        blocks.append(np.concatenate([np.zeros(self.nv), v])[None])
-        return np.vstack(blocks)
+        return [H, np.hstack([D, A]), np.concatenate([np.zeros(self.nv), v])[None]]
 
     def relative(self, q, v=None) -> float:
         """|A v| / |A| (v: A's smallest right singular vector when None): the point's distance from the
