@@ -89,6 +89,21 @@ class Tolerances:
                     on one tangent space (an irreducible quadric cone on a kernel of dimension d has
                     about d^2 / 4: 361 for a 40-joint loop folded flat, all continued); beyond, an even
                     spread of them, and the answer says so (mobility --local-samples N) [-].
+    closed_form:    closed forms (model/subproblems.py, model/leg_chains.py, analysis/motion/pieper.py): lines
+                    meet at a point, a pivot lies on its axis, a discriminant is not negative, a rotation
+                    matrix is not singular, two axes are not parallel, when within this, relative to the
+                    scale (the characteristic length for lengths, 1 for directions) [-].
+    closed_check:   a closed form's solution is kept when it reproduces its target (a point turned onto
+                    another, a leg's direction, a leg's plane) to within this, relative to the scale [-].
+    unit_circle:    a root z of a closed form's polynomial in e^{it} is a real angle when |z| is within this
+                    of 1; the others are complex solutions [-].
+    newton_step:    Newton's refinement of a closed form's root stops when its step is below this [rad].
+    stalled:        a Newton solve whose residual (dimensionless) is still above this after six steps and
+                    fell by less than half in the last one does not converge (singular loci) [-].
+    crossing_rank:  two singular curves cross where the loci's system drops rank: its second smallest
+                    singular value below this relative to the largest [-].
+    cusp:           a point of a singular curve is a cusp where the plane's velocity along the curve is
+                    below this relative to its size on either side [-].
     """
 
     closure: float = 1e-10
@@ -124,6 +139,13 @@ class Tolerances:
     local_step: float = 1e-2
     local_starts: int = 64
     local_samples: int = 400
+    closed_form: float = 1e-9
+    closed_check: float = 1e-7
+    unit_circle: float = 1e-5
+    newton_step: float = 1e-15
+    stalled: float = 1e-6
+    crossing_rank: float = 1e-6
+    cusp: float = 1e-6
 
 
 DEFAULT = Tolerances()

@@ -104,7 +104,7 @@ def _closed_text(mech, res, count) -> str:
     if c.found > len(res.solutions):
         first = res.solutions[0]
         others = [f"{n} = {s.joints[n]:.6g} m" for s in res.solutions[1:] for n in mech.actuated
-                  if abs(s.joints[n] - first.joints[n]) > 1e-12]
+                  if abs(s.joints[n] - first.joints[n]) > mech.tolerances.zero]
         text += (f"\nlisted: the physical solution and each leg's other branch, reversed through its pivot "
                  f"(solutions 2 to {len(res.solutions)}; --all shows them in full): " + ", ".join(others))
     sets = c.detail.get("angle_sets", 1)

@@ -26,13 +26,17 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ..tolerances import DEFAULT
 from ._pin import joint_axis
 from .geometry import lines_point
-from .manifold import set_continuous_angle
+from .manifold import continuous_angle, set_continuous_angle
+from .state import KinematicState
 from .subproblems import rotation, rotation_to, run_angles, two_rotations
 
 __all__ = ["LegChain", "Platform", "platform_of", "LegPose", "leg_poses", "set_leg", "set_free", "best_set",
            "respell"]
+
+TINY = 1e-12  # guard: the square of a leg's length (m^2) and lines_point's parallel test, never zero
 
 
 @dataclass(frozen=True)
@@ -82,7 +86,8 @@ class LegPose:
     sets: tuple
 
 
-def _kind(model, j) -> str:
+def _joint_letter(model, j) -> str:
+    """R (one-axis revolute), P (prismatic), F (floating) or ? for joint j of the model."""
     short = model.joints[j].shortname()
     if model.joints[j].nv == 1 and short.startswith("JointModelR"):
         return "R"
@@ -93,29 +98,27 @@ def _kind(model, j) -> str:
     return "?"
 
 
-def platform_of(mech, out_joint: int, tol: float = 1e-9):
+def platform_of(mech, out_joint: int, tol: float = DEFAULT.closed_form):
     """The Platform whose output link is carried by ``out_joint``, or None when the mechanism is not one
     (see the module).  Read once per mechanism and output joint."""
     key = ("platform", out_joint)
     if key not in mech.cache:
-        mech.cache[key] = _platform(mech, out_joint, tol)
+        mech.cache[key] = _find_platform(mech, out_joint, tol)
     return mech.cache[key]
 
 
-def _platform(mech, out_joint, tol):
+def _find_platform(mech, out_joint, tol):
     model = mech.model
     if not mech.cuts or mech.couplings or getattr(mech, "extra_rows", None) or out_joint <= 0:
         return None
-    data = model.createData()
-    q0 = pin.neutral(model)
-    pin.framesForwardKinematics(model, data, q0)
+    state = KinematicState(mech, pin.neutral(model))
     scale = max(mech.length, 1e-3)
     legs, free = [], None
-    path = _path(model, out_joint)
-    if len(path) == 1 and _kind(model, path[0]) == "F":
+    path = _joints_from_ground(model, out_joint)
+    if len(path) == 1 and _joint_letter(model, path[0]) == "F":
         free = path[0]
     else:
-        leg = _leg(model, data, path, None, None, scale)
+        leg = _leg_chain(model, state, path, None, None, scale, tol)
         if leg is None or leg.b_joints[-1:] != (out_joint,) or not leg.b_joints:
             return None
         legs.append(leg)
@@ -130,10 +133,10 @@ def _platform(mech, out_joint, tol):
         else:
             return None
         jl = model.frames[f_leg].parentJoint
-        if jl <= 0 or _kind(model, jl) != "P":
+        if jl <= 0 or _joint_letter(model, jl) != "P":
             return None
         b_local = np.array(model.frames[f_out].placement.translation)
-        leg = _leg(model, data, _path(model, jl), c.name, (f_leg, b_local), scale)
+        leg = _leg_chain(model, state, _joints_from_ground(model, jl), c.name, (f_leg, b_local), scale, tol)
         if leg is None:
             return None
         legs.append(leg)
@@ -141,10 +144,11 @@ def _platform(mech, out_joint, tol):
     moving = [j for j in range(1, model.njoints) if model.joints[j].nv > 0]
     if len(set(used)) != len(used) or sorted(used) != moving:
         return None
-    return Platform(out_joint, pin.SE3(data.oMi[out_joint]), free, tuple(legs))
+    return Platform(out_joint, state.joint_placement(out_joint), free, tuple(legs))
 
 
-def _path(model, j) -> list:
+def _joints_from_ground(model, j) -> list:
+    """The joint ids from the ground to joint j (j last)."""
     out = []
     while j > 0:
         out.append(j)
@@ -152,8 +156,9 @@ def _path(model, j) -> list:
     return out[::-1]
 
 
-def _leg(model, data, path, cut, end, scale):
-    kinds = [_kind(model, j) for j in path]
+def _leg_chain(model, state, path, cut, end, scale, tol):
+    """The LegChain of the joints ``path`` (see the module), read in ``state``, or None when they are no leg."""
+    kinds = [_joint_letter(model, j) for j in path]
     if kinds.count("P") != 1:
         return None
     p = kinds.index("P")
@@ -164,13 +169,13 @@ def _leg(model, data, path, cut, end, scale):
         return None
 
     def axis(j):
-        return data.oMi[j].rotation @ joint_axis(model.joints[j])
+        return state.joint_placement(j).rotation @ joint_axis(model.joints[j])
 
     def centre(js):
         if len(js) == 1:
-            return np.array(data.oMi[js[0]].translation)
-        o, off = lines_point([data.oMi[j].translation for j in js], [axis(j) for j in js], 1e-12)
-        if o is None or off > 1e-9 * scale:
+            return np.array(state.joint_placement(js[0]).translation)
+        o, off = lines_point([state.joint_placement(j).translation for j in js], [axis(j) for j in js], TINY)
+        if o is None or off > tol * scale:
             return None
         return o
 
@@ -181,11 +186,11 @@ def _leg(model, data, path, cut, end, scale):
         f0 = centre(b)
         if f0 is None:
             return None
-        b_local = data.oMi[path[-1]].actInv(f0)
+        b_local = state.joint_placement(path[-1]).actInv(f0)
     else:
-        f0 = np.array(data.oMf[end[0]].translation)
+        f0 = np.array(state.frame_placement(end[0]).translation)
         b_local = end[1]
-    if len(b) == 1 and np.linalg.norm(np.cross(axis(b[0]), f0 - data.oMi[b[0]].translation)) > 1e-9 * scale:
+    if len(b) == 1 and np.linalg.norm(np.cross(axis(b[0]), f0 - state.joint_placement(b[0]).translation)) > tol * scale:
         return None
     name = model.names[path[p]]
     return LegChain(name, tuple(a), path[p], tuple(b), tuple(tuple(axis(j)) for j in a),
@@ -193,7 +198,7 @@ def _leg(model, data, path, cut, end, scale):
                     tuple(float(v) for v in b_local), cut)
 
 
-def leg_poses(platform: Platform, leg: LegChain, P, tol: float = 1e-9):
+def leg_poses(platform: Platform, leg: LegChain, P, tol: float = DEFAULT.closed_form):
     """(poses, why, gap): the leg's LegPoses (extended root first) for the output joint at world
     placement P (a pinocchio.SE3); when it has none, why (else "") and how far it stays from the pose
     [m]."""
@@ -204,7 +209,7 @@ def leg_poses(platform: Platform, leg: LegChain, P, tol: float = 1e-9):
     L = float(np.linalg.norm(target))
     bb = float(d0 @ u0)
     disc = bb * bb - float(d0 @ d0) + L * L
-    if disc < -tol * max(L * L, 1e-12):
+    if disc < -tol * max(L * L, TINY):
         across = np.sqrt(max(float(d0 @ d0) - bb * bb, 0.0))
         return [], (f"leg {leg.name} cannot be {L:.6g} m long: its ends stay {across:.6g} m apart across its "
                     "axis"), across - L
@@ -217,8 +222,8 @@ def leg_poses(platform: Platform, leg: LegChain, P, tol: float = 1e-9):
             w = a_axes[0]
             off = abs(float(w @ v - w @ target))
             t = rotation_to(w, v, target)
-            a_sets = [] if t is None or off > 1e-7 * max(L, 1e-3) else [(t,)]
-            if off > 1e-7 * max(L, 1e-3):
+            a_sets = [] if t is None or off > DEFAULT.closed_check * max(L, 1e-3) else [(t,)]
+            if off > DEFAULT.closed_check * max(L, 1e-3):
                 why, gap = f"leg {leg.name} would leave the plane its pivot turns in by {off:.3g} m", off
         else:
             a_sets, _ = two_rotations(a_axes[0], a_axes[1], v, target, tol)
@@ -229,7 +234,7 @@ def leg_poses(platform: Platform, leg: LegChain, P, tol: float = 1e-9):
             RA = np.eye(3)
             for w, t in zip(a_axes, ta):
                 RA = RA @ rotation(w, t)
-            if np.linalg.norm(RA @ v - target) > 1e-7 * max(L, 1e-3):
+            if np.linalg.norm(RA @ v - target) > DEFAULT.closed_check * max(L, 1e-3):
                 continue
             vals = dict(zip(leg.a_joints, ta))
             if leg.b_joints:
@@ -311,9 +316,7 @@ def respell(mech, q):
     if platform is None:
         return q
     model = mech.model
-    data = model.createData()
-    pin.forwardKinematics(model, data, q)
-    P = pin.SE3(data.oMi[platform.out_joint])
+    P = KinematicState(mech, q).joint_placement(platform.out_joint)
     out = np.array(q, float)
     names, idx, lo, hi, angle = mech.limited_coordinates()
     bad = {int(i) for i in idx[_outside_rows(q, idx, lo, hi, angle)]}
@@ -325,18 +328,19 @@ def respell(mech, q):
             continue
         x = q[model.joints[leg.slide].idx_q]
         pose = min(poses, key=lambda p: abs(p.x - x))
-        if abs(pose.x - x) > 1e-6 * max(mech.length, 1e-3):
+        if abs(pose.x - x) > mech.tolerances.geometry * max(mech.length, 1e-3):
             continue
         best = best_set(mech, q, pose, near=pin.neutral(model))
-        now = {j: _angle(model, q, j) for j in best}
+        now = {j: _joint_angle(model, q, j) for j in best}
         if _bad(mech, best) < _bad(mech, now):  # only where the leg gets within its limits
             set_leg(model, out, pose, best)
     return out
 
 
-def _angle(model, q, j) -> float:
+def _joint_angle(model, q, j) -> float:
+    """Joint j's value in q (a continuous joint's angle from its (cos, sin))."""
     jm = model.joints[j]
-    return float(np.arctan2(q[jm.idx_q + 1], q[jm.idx_q])) if jm.nq == 2 else float(q[jm.idx_q])
+    return float(continuous_angle(q, jm.idx_q)) if jm.nq == 2 else float(q[jm.idx_q])
 
 
 def _bad(mech, angles: dict) -> int:

@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from ..tolerances import DEFAULT
+
 __all__ = ["rotation", "rotation_to", "two_rotations", "run_angles"]
 
 
@@ -27,7 +29,7 @@ def rotation(w, t):
     return pin.exp3(np.asarray(w, float) * float(t))
 
 
-def rotation_to(w, p, q, tol: float = 1e-9):
+def rotation_to(w, p, q, tol: float = DEFAULT.closed_form):
     """The angle t in (-pi, pi] with R(w, t) p = q (subproblem 1), None when p lies on the axis
     (any angle: a continuum)."""
     w = np.asarray(w, float)
@@ -38,7 +40,7 @@ def rotation_to(w, p, q, tol: float = 1e-9):
     return float(np.arctan2(w @ _cross(pp, qq), pp @ qq))
 
 
-def two_rotations(w1, w2, p, q, tol: float = 1e-9):
+def two_rotations(w1, w2, p, q, tol: float = DEFAULT.closed_form):
     """(solutions, complex): every real (t1, t2) with R(w1, t1) R(w2, t2) p = q (subproblem 2:
     z = R(w2, t2) p = R(w1, -t1) q lies on both circles), and whether the pair is complex (the
     circles miss).  A solution whose intermediate point lies on an axis (a continuum) is left out."""
@@ -65,7 +67,7 @@ def two_rotations(w1, w2, p, q, tol: float = 1e-9):
     return out, False
 
 
-def run_angles(axes, R, tol: float = 1e-9) -> list:
+def run_angles(axes, R, tol: float = DEFAULT.closed_form) -> list:
     """Every real (t1, ..., tk) with R(w1, t1) ... R(wk, tk) = R for k = 1, 2, 3 unit axes (see the
     module); each set checked against R (a rotation not of that form gives []).  A continuum (a
     spherical wrist with its outer axes aligned) gives []: the caller says so."""
@@ -98,7 +100,7 @@ def run_angles(axes, R, tol: float = 1e-9) -> list:
         M = np.eye(3)
         for w, t in zip(axes, ts):
             M = M @ rotation(w, t)
-        if np.max(np.abs(M - R)) <= 1e3 * tol + 1e-7:
+        if np.max(np.abs(M - R)) <= 1e3 * tol + DEFAULT.closed_check:
             out.append(tuple(float(t) for t in ts))
     return out
 

@@ -34,7 +34,7 @@ class SingularConfiguration:
     q: np.ndarray
     limit: bool
     output: str | None
-    point: object = None  # analysis.motion.change_points.ChangePoint of a constraint singularity: what it is
+    point: object = None  # analysis.motion.crossing.ChangePoint of a constraint singularity: what it is
 
 
 @dataclass(frozen=True)

@@ -137,7 +137,7 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
                 + ": positive-dimensional solution sets are not tracked")
     known = known_count(closure, problem.frozen, problem.target)
     if known is STEWART:  # a parameter homotopy from the architecture's generic solution set
-        arch = generic_modes.architecture(problem, closure, mech.length)
+        arch = generic_modes.architecture(problem, closure, mech)
         if arch is not None:
             modes, *counts = generic_modes.platform_modes(solver, problem, closure, arch, seed, options,
                                                           lambda x: _lift(solver, problem, closure, x))

@@ -6,7 +6,7 @@ A sweep that meets a change point may go on along either branch (a four-bar fold
 parallelogram onto the anti-parallelogram): the constraint measure (analysis.singularities.singular)
 dips to zero there without changing sign, so it is not among the sign changes that
 analysis.motion.singular_points locates.  Here every local minimum of the constraint measure along the
-recorded sweep (singular_points.dips: below LOOK_BELOW, lower than both neighbours) is refined by
+recorded sweep (crossing.dips: below LOOK_BELOW, lower than both neighbours) is refined by
 bounded minimization of the measure over the input between the neighbours (the loops closed again at each value from the
 sweep's configuration), and kept where the measure falls below ``Tolerances.singular``.  At each such
 configuration -- and at the constraint singularities already located -- the local analysis decides
@@ -26,7 +26,7 @@ from ..local import local_analysis
 from ..singularities.singular import Generic, measures
 from .crossing import TIGHT_CLOSURE, ChangePoint, dips, nearest_branch, reclosing
 
-__all__ = ["ChangePoint", "change_points"]
+__all__ = ["change_points"]
 
 
 

@@ -92,7 +92,7 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
         chosen.append((first, s))
     tol = mech.tolerances
     res = _residual(mech, q, out_frame, pose)
-    if res > tol.closure * 100 + 1e-9:
+    if res > tol.closure * 100 + tol.closed_form:
         return None  # a loop joint the legs do not close (a universal joint's angle): the general method
     combos = int(np.prod([len(p) for p in legs]))
     if combos <= LISTED:  # every combination of the legs' branches
@@ -106,7 +106,7 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
         for i, poses in zip(pick, legs):
             if i:
                 set_leg(model, q2, poses[i], best_set(mech, ref, poses[i]))
-        if _residual(mech, q2, out_frame, pose) <= tol.closure * 100 + 1e-9:
+        if _residual(mech, q2, out_frame, pose) <= tol.closure * 100 + tol.closed_form:
             qs.append(q2)
     solver.generic(hint=q)  # the reference configuration's search starts from the physical solution
     sols = [_solution(solver, qq, out_frame, _residual(mech, qq, out_frame, pose)) for qq in qs]
@@ -128,7 +128,7 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
 
 def _arm(solver, output, out_frame, arm, pose, start):
     mech, model = solver.mech, solver.mech.model
-    sets, _, why, stretched = pieper(arm, pose)
+    sets, _, why, stretched = pieper(arm, pose, mech.tolerances)
     if why:
         return None  # the wrist centre on the first or second axis (a continuum): the general method
     lo, hi = model.lowerPositionLimit, model.upperPositionLimit

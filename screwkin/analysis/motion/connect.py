@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import AssemblyError
+from ..singularities.maps import apart
 from ..singularities.singular import Generic, measures
 
 __all__ = ["CuspLoop", "Loop", "cusp_loops", "loop", "wedge_direction"]
@@ -37,12 +38,6 @@ class Loop:
     why: str  # in words
 
 
-def _apart(mech, q1, q2) -> float:
-    d = mech.difference(q1, q2)
-    d[mech.translational] /= mech.length
-    return float(np.linalg.norm(d))
-
-
 def loop(solver, x_name, y_name, fixed, centre, radius, q0, steps: int = 720, start: float = 0.0,
          turn: int = 1) -> Loop:
     """Follow q0 (at the angle ``start`` of the ellipse) once round the ellipse of the inputs with ``centre``
@@ -59,14 +54,14 @@ def loop(solver, x_name, y_name, fixed, centre, radius, q0, steps: int = 720, st
             q = solver.track({x_name: float(xy[k, 0]), y_name: float(xy[k, 1]), **fixed}, Q[-1]).q
         except AssemblyError:
             return Loop(xy[:k], np.array(Q), min(sig), False, False, f"the closure failed at step {k}")
-        if _apart(mech, Q[-1], q) > JUMP:
+        if apart(mech, Q[-1], q) > JUMP:
             return Loop(xy[:k + 1], np.array(Q + [q]), min(sig), False, False,
                         f"step {k} jumped (another branch): the loop passes too near a singularity for its steps")
         Q.append(q)
         sig.append(measures(mech, q, g)["actuator"])
     smallest = float(min(sig))
     regular = smallest > tol.singular
-    joined = _apart(mech, Q[0], Q[-1]) > SAME
+    joined = apart(mech, Q[0], Q[-1]) > SAME
     why = ("the loop ends on another assembly mode, no singularity met" if regular and joined else
            "the loop returns to its start" if regular else "the loop meets a singularity")
     return Loop(xy, np.array(Q), smallest, regular, joined, why)
@@ -123,7 +118,7 @@ def cusp_loops(solver, loci, x_name, y_name, fixed, box, size: float = 0.02, ste
                 lp = loop(solver, x_name, y_name, fixed, (cx, cy), tuple(r), q, steps, start=th, turn=turn)
                 if not (lp.regular and lp.joined):
                     continue
-                gaps = [_apart(mech, qk, lp.q[-1]) for qk in sols]
+                gaps = [apart(mech, qk, lp.q[-1]) for qk in sols]
                 j = int(np.argmin(gaps)) if min(gaps) < SAME else None  # the start's solution it ends on
                 out.append(CuspLoop((cx, cy), start, tuple(r), (i, j), turn, lp))
     return tuple(out), tried

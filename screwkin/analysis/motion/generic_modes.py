@@ -32,6 +32,7 @@ from ...model import newton
 from ...model.cuts import Assembly
 from ...model.distances import SixDistances, chain_angles
 from ...model.legs import chain_distance
+from ...model.state import KinematicState
 from ...model.symmetry import SignGroup
 from .monodromy import MonodromyOptions, Roots, all_roots, to_target
 
@@ -62,8 +63,10 @@ class Architecture:
         self.key = generic_cache.key("six distances", [self.A / L, self.B / L])
 
 
-def architecture(problem, closure, L: float):
-    """The platform of a closure that known_counts recognized as a Stewart-Gough platform, or None."""
+def architecture(problem, closure, mech):
+    """The platform of a closure that known_counts recognized as a Stewart-Gough platform (of ``mech``),
+    or None."""
+    L = mech.length
     model = problem.model
     if problem.target or any(leg.parent != 0 for leg in closure.legs):
         return None
@@ -94,11 +97,10 @@ def architecture(problem, closure, L: float):
             return None
         if set(closure.slices) != set(head + tail):  # nothing else unknown: the pose sets every joint
             return None
-        data = model.createData()
-        pin.forwardKinematics(model, data, np.asarray(problem.q_in, float))
+        placement = KinematicState(mech, problem.q_in).joint_placement(joint)
         A.insert(0, np.asarray(a, float))
         B.insert(0, np.asarray(b, float))
-        r2.insert(0, float(np.sum((data.oMi[joint].act(np.asarray(b)) - a) ** 2)))
+        r2.insert(0, float(np.sum((placement.act(np.asarray(b)) - a) ** 2)))
         carrier = (head, tail)
     else:
         return None
@@ -226,7 +228,7 @@ def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
         q[jm.idx_q:jm.idx_q + 7] = pin.SE3ToXYZQUAT(M)
         candidates.append(q)
     else:
-        candidates = _carried(problem, arch, R, t)
+        candidates = _carried(solver.mech, problem, arch, R, t)
     # the carrier's angle sets ranked as reported (within the limits, then nearest the reference); the
     # other legs' angles do not depend on which: the first that lifts and polishes is the one
     names = {model.names[j] for j in (arch.carrier[0] + arch.carrier[1] if arch.carrier else ())}
@@ -242,7 +244,7 @@ def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
         if full is None:
             continue
         a = newton.polish(problem.system, full, problem.frozen)
-        if a.residual > solver.mech.tolerances.closure or not _same_pose(model, a.q, arch, R, t):
+        if a.residual > solver.mech.tolerances.closure or not _same_pose(solver.mech, a.q, arch, R, t):
             continue
         q = solver._wrap(a.q)
         return q, Assembly(q, a.residual, a.iterations, "a homotopy's endpoint")
@@ -255,28 +257,24 @@ def _wxyz(q):
     return pin.Quaternion(q[3], q[0], q[1], q[2])
 
 
-def _same_pose(model, q, arch, R, t) -> bool:
-    data = model.createData()
-    pin.forwardKinematics(model, data, np.asarray(q, float))
-    M = data.oMi[arch.joint]
+def _same_pose(mech, q, arch, R, t) -> bool:
+    M = KinematicState(mech, q).joint_placement(arch.joint)
     return (np.abs(M.translation - t).max() <= _MOVED * arch.L and np.abs(M.rotation - R).max() <= _MOVED)
 
 
-def _carried(problem, arch: Architecture, R, t) -> list:
+def _carried(mech, problem, arch: Architecture, R, t) -> list:
     """Configurations with the carrying leg's angles putting the platform's joint frame at (R, t)."""
     model = problem.model
     head, tail = arch.carrier
     q0 = np.array(problem.q_in, float)
     for j in head + tail:
         _set_angle(model, q0, j, 0.0)
-    data = model.createData()
-    pin.forwardKinematics(model, data, q0)
+    state = KinematicState(mech, q0)
     axes = {}
     for j in head + tail:
-        S = np.asarray(data.joints[j].S).reshape(6, -1)[:, 0]
-        w = data.oMi[j].rotation @ S[3:]
+        w = state.joint_twists(j)[3:, 0]
         axes[j] = w / np.linalg.norm(w)
-    M0 = data.oMi[arch.joint]
+    M0 = state.joint_placement(arch.joint)
     p0 = M0.act(arch.B[0])
     p = R @ arch.B[0] + t
     out = []

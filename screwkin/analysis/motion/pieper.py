@@ -26,11 +26,14 @@ import pinocchio as pin
 
 from ...model._pin import joint_axis
 from ...model.geometry import lines_point
+from ...model.state import KinematicState
 from ...model.subproblems import rotation, rotation_to, run_angles
+from ...tolerances import DEFAULT, Tolerances
 
 __all__ = ["Wrist", "wrist_arm", "pieper"]
 
 BOUND = 8  # real and complex solutions of a 6R arm with a spherical wrist (Pieper 1968)
+TINY = 1e-12  # scale guard: the size of a matrix's rows, never zero
 
 
 @dataclass(frozen=True)
@@ -62,28 +65,28 @@ def wrist_arm(mech, out_frame: int, placement):
         return None
     if any(model.joints[j].nv != 1 or not model.joints[j].shortname().startswith("JointModelR") for j in path):
         return None
-    data = model.createData()
-    pin.forwardKinematics(model, data, pin.neutral(model))
-    axes = np.array([data.oMi[j].rotation @ joint_axis(model.joints[j]) for j in path])
-    points = np.array([data.oMi[j].translation for j in path])
+    state = KinematicState(mech, pin.neutral(model))
+    placements = [state.joint_placement(j) for j in path]
+    axes = np.array([M.rotation @ joint_axis(model.joints[j]) for M, j in zip(placements, path)])
+    points = np.array([M.translation for M in placements])
     scale = max(mech.length, 1e-3)
-    c0, off = lines_point(points[3:], axes[3:], 1e-12)
-    if c0 is None or off > 1e-9 * scale:
+    c0, off = lines_point(points[3:], axes[3:], TINY)
+    if c0 is None or off > mech.tolerances.closed_form * scale:
         return None
-    return Wrist(tuple(path), axes, points, c0, pin.SE3(data.oMi[path[-1]]) * placement)
+    return Wrist(tuple(path), axes, points, c0, placements[-1] * placement)
 
 
-def pieper(arm: Wrist, T, tol: float = 1e-9):
+def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT):
     """(sets, complex, why, stretched): every real joint solution (t1, ..., t6) placing the output frame at
     T (a pinocchio.SE3), how many of the 8 are complex, why the closed form does not answer ("" when it
     does: the wrist centre on axis 1 or 2 -- a continuum -- or a degenerate first pair of axes leave it
     to the general method), and for each set whether the wrist is stretched there (its first and last axes
     in line: joints 4 and 6 free with their sum fixed, a continuum, given with joint 4 at 0; it stands for
-    two of the 8)."""
+    two of the 8).  ``tol``: closed_form, closed_check, unit_circle, newton_step, equal and zero decide."""
     w, r = arm.axes, arm.points
     g = T * arm.M0.inverse()
     c = g.act(arm.centre)
-    r1, r2 = _closest(r[0], w[0], r[1], w[1])
+    r1, r2 = _closest(r[0], w[0], r[1], w[1], tol.closed_form)
     delta = r2 - r1
     e1 = np.cross(w[1], _perp(w[1]))
     e1 /= np.linalg.norm(e1)
@@ -102,7 +105,7 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
 
     det = float(np.linalg.det(M))
     norms = np.linalg.norm(M, axis=1)
-    if abs(det) > 1e-9 * max(norms.max(), 1e-12) * scale:
+    if abs(det) > tol.closed_form * max(norms.max(), TINY) * scale:
         Minv = np.linalg.inv(M)
 
         def F(t3):
@@ -110,7 +113,7 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
             z = Minv @ b
             return z @ z - xy @ xy
         degree = 2
-    elif norms.max() > 1e-9 * scale:  # one row a multiple of the other: one equation in t3 alone
+    elif norms.max() > tol.closed_form * scale:  # one row a multiple of the other: one equation in t3 alone
         k = int(np.argmax(norms))
         lam = float(M[1 - k] @ M[k] / (M[k] @ M[k]))
 
@@ -120,13 +123,13 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
         degree = 1
     else:
         return [], 0, "the first two axes are one line"
-    t3s, n_complex = _trig_roots(F, degree, scale)
+    t3s, n_complex = _trig_roots(F, degree, tol)
     positions = []  # (t1, t2, t3)
     why = ""
     for t3 in t3s:
         q3, xy, b = parts(t3)
         rho2 = float(xy @ xy)
-        if rho2 < (tol * scale) ** 2:
+        if rho2 < (tol.closed_form * scale) ** 2:
             why = "the wrist centre lies on the second axis (a continuum)"
             continue
         if degree == 2:
@@ -135,7 +138,7 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
             m = M[k]
             foot = b[k] / (m @ m) * m
             s2 = rho2 - foot @ foot
-            if s2 < -tol * scale * scale:
+            if s2 < -tol.closed_form * scale * scale:
                 n_complex += 2
                 continue
             across = np.array([-m[1], m[0]]) / np.linalg.norm(m) * np.sqrt(max(s2, 0.0))
@@ -147,13 +150,13 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
             if t1 is None:
                 why = "the wrist centre lies on the first axis (a continuum)"
                 continue
-            if np.linalg.norm(rotation(w[0], t1) @ (p - r1) - (c - r1)) > 1e-7 * scale:
+            if np.linalg.norm(rotation(w[0], t1) @ (p - r1) - (c - r1)) > tol.closed_check * scale:
                 continue
             positions.append((t1, t2, t3))
     sets, stretched = [], []
     for t1, t2, t3 in positions:
         R3 = rotation(w[0], t1) @ rotation(w[1], t2) @ rotation(w[2], t3)
-        wrist = run_angles(list(w[3:]), R3.T @ g.rotation) or _stretched(w[3:], R3.T @ g.rotation)
+        wrist = run_angles(list(w[3:]), R3.T @ g.rotation) or _stretched(w[3:], R3.T @ g.rotation, tol)
         for ts in wrist:
             sets.append(tuple(float(np.angle(np.exp(1j * t))) for t in (t1, t2, t3) + tuple(0.0 if t is None else t
                                                                                            for t in ts)))
@@ -163,18 +166,18 @@ def pieper(arm: Wrist, T, tol: float = 1e-9):
     return sets, n_complex * 2, ("" if sets else why), stretched
 
 
-def _stretched(axes, R):
+def _stretched(axes, R, tol: Tolerances):
     """A stretched wrist (its last axis turned onto its first: joints 4 and 6 turn about one line, only their
     sum is fixed): [(None, t5, t6)] for each t5 that turns w6 onto +-w4, t6 with joint 4 at 0, else []."""
     w4, w5, w6 = axes
-    if np.linalg.norm(np.cross(R @ w6, w4)) > 1e-7:
+    if np.linalg.norm(np.cross(R @ w6, w4)) > tol.closed_check:
         return []
     out = []
     for sign in (1.0, -1.0):
-        if abs(w5 @ w6 - sign * (w5 @ w4)) > 1e-9:
+        if abs(w5 @ w6 - sign * (w5 @ w4)) > tol.closed_form:
             continue
         t5 = rotation_to(w5, w6, sign * w4)
-        if t5 is None or np.linalg.norm(rotation(w5, t5) @ w6 - sign * w4) > 1e-9:
+        if t5 is None or np.linalg.norm(rotation(w5, t5) @ w6 - sign * w4) > tol.closed_form:
             continue
         t6 = run_angles([w6], rotation(w5, t5).T @ R)
         if t6:
@@ -182,7 +185,7 @@ def _stretched(axes, R):
     return out
 
 
-def _trig_roots(F, degree: int, scale: float):
+def _trig_roots(F, degree: int, tol: Tolerances):
     """The real roots in (-pi, pi] of the trigonometric polynomial F of the given degree (from 8
     samples: the polynomial in e^{it} of degree 2 * degree, its roots on the unit circle, refined by
     Newton) and how many roots are complex."""
@@ -194,12 +197,12 @@ def _trig_roots(F, degree: int, scale: float):
     if big == 0:
         return [], 0
     poly = coeffs[::-1]  # numpy: highest power first; z^d F(z) = sum_k c_k z^{k + d}
-    while len(poly) > 1 and abs(poly[0]) < 1e-12 * big:
+    while len(poly) > 1 and abs(poly[0]) < tol.zero * big:
         poly = poly[1:]
     roots = np.roots(poly) if len(poly) > 1 else np.zeros(0)
     real, n_complex = [], 0
     for z in roots:
-        if abs(abs(z) - 1.0) < 1e-5:
+        if abs(abs(z) - 1.0) < tol.unit_circle:
             t = float(np.angle(z))
             ks = np.arange(-degree, degree + 1)
             for _ in range(3):  # Newton on F itself, its derivative from the coefficients
@@ -208,19 +211,20 @@ def _trig_roots(F, degree: int, scale: float):
                     break
                 step = F(t) / d
                 t -= step
-                if abs(step) < 1e-15:
+                if abs(step) < tol.newton_step:
                     break
-            if not any(abs(np.angle(np.exp(1j * (t - u)))) < 1e-9 for u in real):
+            if not any(abs(np.angle(np.exp(1j * (t - u)))) < tol.equal for u in real):
                 real.append(float(np.angle(np.exp(1j * t))))
         else:
             n_complex += 1
     return real, n_complex
 
 
-def _closest(p1, w1, p2, w2):
-    """Points of the two lines nearest each other (the foot of p2 on line 1 where they are parallel)."""
+def _closest(p1, w1, p2, w2, parallel: float):
+    """Points of the two lines nearest each other (the foot of p2 on line 1 where they are parallel: the
+    sine of their angle below ``parallel``)."""
     n = np.cross(w1, w2)
-    if n @ n < 1e-18:
+    if n @ n < parallel ** 2:
         return p1 + w1 * (w1 @ (p2 - p1)), p2
     A = np.array([[w1 @ w1, -(w1 @ w2)], [w1 @ w2, -(w2 @ w2)]])
     s, t = np.linalg.solve(A, [w1 @ (p2 - p1), w2 @ (p2 - p1)])

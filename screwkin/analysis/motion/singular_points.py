@@ -13,10 +13,10 @@ import numpy as np
 from ...errors import AssemblyError
 from ..singularities.singular import Generic, measures, scaled_jacobians
 from .links import LOCATE_XTOL
-from .crossing import LOOK_BELOW, dips, reclosing
+from .crossing import dips, reclosing
 from .sweep import SweepResult, SweepSingularity
 
-__all__ = ["locate_singularities", "dips", "reclosing", "LOOK_BELOW"]
+__all__ = ["locate_singularities"]
 
 def _matrix(mech, q, kind, g, V_ref=None):
     """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""

@@ -50,7 +50,7 @@ class SweepSingularity:
     sigma: float  # relative smallest singular value there
     q: np.ndarray
     limit: bool = False  # a limit position: the motion along the input cannot go on past it
-    point: object = None  # analysis.motion.change_points.ChangePoint of a constraint singularity: what it is
+    point: object = None  # analysis.motion.crossing.ChangePoint of a constraint singularity: what it is
 
 
 @dataclass(frozen=True)
@@ -74,7 +74,7 @@ class SweepResult:
     skipped: tuple = ()  # input values on the grid the motion passed but could not solve at (holes)
     method: str = "tracker"  # how it was computed: "closed form" (dyads), "tracker", "batched" (see notes)
     notes: tuple = ()  # one line each: what the computation chose or fell back to
-    change_points: tuple = ()  # analysis.motion.change_points.ChangePoint of each change point passed
+    change_points: tuple = ()  # analysis.motion.crossing.ChangePoint of each change point passed
 
     @property
     def change_point_notes(self) -> tuple:

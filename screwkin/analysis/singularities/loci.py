@@ -42,7 +42,7 @@ from ...errors import AssemblyError
 from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
 from ..motion.continuation import locate
-from .loci_seeds import candidates, crossings, refine_node, sheets, unexplained_folds
+from .loci_seeds import crossings, refine_node, seed_configurations, sheets, unexplained_folds
 from .singular import LWA, Generic
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
@@ -148,19 +148,21 @@ class LocusSystem:
             K = np.array(mech.closure.jacobian(q), float)
             K[self.pos] /= self.L
             blocks.append(np.hstack([K * self.scale, np.zeros((len(K), len(v)))]))
+        return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
+
+    def _held_kind_norm_rows(self, q, v, A) -> list:
+        """The Jacobian's rows after the loops' (a section's too): the held inputs, d(A v)/d(u, v) (d/du by
+        forward differences of step FD) and |v| = 1."""
         H = np.zeros((len(self.held), self.nv + len(v)))
         for k, (c, _, _) in enumerate(self.held):
             H[k, c.idx_v] = 1.0
-        blocks.append(H)
         Av = A @ v
         D = np.empty((len(A), self.nv))
         for k in range(self.nv):
             e = np.zeros(self.nv)
             e[k] = FD
             D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / FD
-        blocks.append(np.hstack([D, A]))
-        blocks.append(np.concatenate([np.zeros(self.nv), v])[None])
-        return np.vstack(blocks)
+        return [H, np.hstack([D, A]), np.concatenate([np.zeros(self.nv), v])[None]]
 
     def relative(self, q, v=None) -> float:
         """|A v| / |A| (v: A's smallest right singular vector when None): the point's distance from the
@@ -196,9 +198,9 @@ class LocusSystem:
             F = self.residual(q, v, A)
             norm = float(np.linalg.norm(F))
             er, eb = extra(q, v) if extra is not None else (None, np.zeros(0))
-            if norm < RESIDUAL and float(np.abs(eb).max(initial=0.0)) < 1e-12:
+            if norm < RESIDUAL and float(np.abs(eb).max(initial=0.0)) < self.mech.tolerances.zero:
                 return q, v
-            if k >= 6 and norm > 0.5 * last and norm > 1e-6:
+            if k >= 6 and norm > 0.5 * last and norm > self.mech.tolerances.stalled:
                 return None  # not converging
             if J is None or norm > 0.25 * last:
                 J = self.jacobian(q, v, A)
@@ -224,7 +226,7 @@ class LocusSystem:
 
     def nullity_ok(self, q, v) -> bool:
         s = np.linalg.svd(self.jacobian(q, v), compute_uv=False)
-        return len(s) >= self.nv + len(v) - 1 and s[self.nv + len(v) - 2] > 1e-6 * s[0]
+        return len(s) >= self.nv + len(v) - 1 and s[self.nv + len(v) - 2] > self.mech.tolerances.crossing_rank * s[0]
 
     def projected(self, q, t) -> np.ndarray:
         """The plane's velocity (dx, dy) [SI] along the tangent t of the curve."""
@@ -249,7 +251,7 @@ def _in_box(p, box, margin=0.0):
     return x0 - mx <= p[0] <= x1 + mx and y0 - my <= p[1] <= y1 + my
 
 
-def _follow(sys, q, v, box, direction):
+def _trace_one_way(sys, q, v, box, direction):
     """Points from (q, v) along +-tangent until the box's edge, the start again, or MAX_POINTS.
     Returns (qs, vs, closed, truncated)."""
     J = sys.jacobian(q, v)
@@ -366,7 +368,7 @@ def _cusps(sys, qs, vs, ts):
             continue
         # a cusp: the plane's velocity itself vanishes there (a sharp turn, where it only passes at right
         # angles to the bracket's first one, is none)
-        if np.linalg.norm(sys.projected(qc, sys.tangent(qc, vc, t0))) > 1e-6 * max(na, nb):
+        if np.linalg.norm(sys.projected(qc, sys.tangent(qc, vc, t0))) > sys.mech.tolerances.cusp * max(na, nb):
             continue
         if not sys.nullity_ok(qc, vc):
             continue  # two singular curves cross there (the system drops rank): no cusp of one
@@ -398,7 +400,7 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
             continue
         traced_kinds.append(kind)
         sys = LocusSystem(mech, solver.inputs, x_name, y_name, fixed, kind, output, point, g)
-        found = trace_kind(sys, kind, (q0 for q0, _ in candidates(sys, grown)), box, notes)
+        found = trace_kind(sys, kind, (q0 for q0, _ in seed_configurations(sys, grown)), box, notes)
         loci += found[0]
         cusps += found[1]
         cusp_q += found[2]
@@ -442,11 +444,11 @@ def trace_kind(sys, kind, seeds, box, notes):
             notes.append(f"{kind}: seeds where the locus is not a curve (the augmented system drops rank: "
                          "several singularities meet, or a self-motion) were left")
             continue
-        fwd = _follow(sys, q, v, box, +1)
+        fwd = _trace_one_way(sys, q, v, box, +1)
         if fwd[3]:
             qs, vs, ts, closed = fwd[0], fwd[1], fwd[2], True
         else:
-            bwd = _follow(sys, q, v, box, -1)
+            bwd = _trace_one_way(sys, q, v, box, -1)
             qs = bwd[0][::-1] + fwd[0][1:]
             vs = bwd[1][::-1] + fwd[1][1:]
             ts = [-t for t in bwd[2][::-1]] + fwd[2][1:]
@@ -455,7 +457,7 @@ def trace_kind(sys, kind, seeds, box, notes):
                 notes.append(f"{kind}: a curve was left unfinished (steps below {STEP_MIN:g} or "
                              f"{MAX_POINTS} points)")
         span = max(box[0][1] - box[0][0], box[1][1] - box[1][0], 1e-300)
-        still = np.ptp(np.array([sys.xy(qk) for qk in qs[:: max(1, len(qs) // 50)]]), axis=0).max() < 1e-9 * span
+        still = np.ptp(np.array([sys.xy(qk) for qk in qs[:: max(1, len(qs) // 50)]]), axis=0).max() < sys.mech.tolerances.equal * span
         cq = [] if still else _cusps(sys, qs, vs, ts)  # (a self-motion's curve stands still in the plane)
         if not closed:
             qs, vs = _clip(sys, qs, vs, box)
@@ -470,7 +472,7 @@ def trace_kind(sys, kind, seeds, box, notes):
     for Q, V, closed in traced:
         pts = np.array([sys.xy(q) for q in Q])
         worst = max(sys.relative(q, v) for q, v in zip(Q, V))
-        if np.ptp(pts, axis=0).max() < 1e-9 * span:  # the inputs stand still along the whole curve
+        if np.ptp(pts, axis=0).max() < sys.mech.tolerances.equal * span:  # the inputs stand still along the whole curve
             notes.append(f"{kind}: at ({pts[0][0]:.9g}, {pts[0][1]:.9g}) the mechanism moves with the inputs "
                          "held (a self-motion through the singular configurations): a point of the locus")
             pts, Q, closed = pts[:1], Q[:1], False

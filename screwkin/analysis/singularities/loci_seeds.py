@@ -9,7 +9,9 @@ import numpy as np
 
 from ..motion.continuation import Neighbour
 
-__all__ = ["candidates", "crossings", "refine_node", "sheets", "unexplained_folds"]
+__all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexplained_folds"]
+
+TINY = 1e-300  # division guard: two segments parallel
 
 
 def unexplained_folds(sheets, loci, box, n):
@@ -78,7 +80,7 @@ def sheets(solver, x_name, y_name, box, starts, n):
     return out
 
 
-def candidates(sys, sheets):
+def seed_configurations(sys, sheets):
     """Grid configurations to seed Newton from, most singular first: next to a refused step, or a local
     minimum of the kind's relative singular value along a grid line."""
     cands = []
@@ -132,7 +134,7 @@ def crossings(curves, box):
                 continue
             d1, d2 = b - a, b2 - a2
             den = d1[0] * d2[1] - d1[1] * d2[0]
-            if abs(den) < 1e-300:
+            if abs(den) < TINY:
                 continue
             w = a2 - a
             s = (w[0] * d2[1] - w[1] * d2[0]) / den
@@ -164,7 +166,7 @@ def refine_node(sys, one, k1, f1, other, k2, f2, span):
             pts.append(sys.xy(res[0]))
             vel.append(sys.projected(res[0], sys.tangent(*res, t)))
         gap = pts[1] - pts[0]
-        if np.abs(gap).max() < 1e-12 * span:
+        if np.abs(gap).max() < sys.mech.tolerances.zero * span:
             return 0.5 * (pts[0] + pts[1])
         M = np.column_stack([vel[0], -vel[1]])
         try:

@@ -20,7 +20,7 @@ from ...errors import UsageError, quote, shorten
 from .singular import Generic, measures
 from ..motion.continuation import Neighbour
 
-__all__ = ["SingularityMap", "singularity_map", "seams"]
+__all__ = ["SingularityMap", "singularity_map", "seams", "apart"]
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,9 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
 
 
-def _apart(mech, q1, q2) -> float:
+def apart(mech, q1, q2) -> float:
+    """How far apart two configurations are: the norm of their difference, lengths over the
+    characteristic length (rad and characteristic lengths) [-]."""
     d = mech.difference(q1, q2)
     d[mech.translational] /= mech.length
     return float(np.linalg.norm(d))
@@ -115,12 +117,12 @@ def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.n
             jn, in_ = j + dj, i + di
             if jn >= reached.shape[0] or in_ >= reached.shape[1] or not reached[jn, in_]:
                 continue
-            if _apart(mech, qs[j, i], qs[jn, in_]) <= tol:
+            if apart(mech, qs[j, i], qs[jn, in_]) <= tol:
                 continue
             if step is not None:
                 a, b = (i, in_) if di else (j, jn)
                 q = step(qs[j, i], float(grid[a]), float(grid[b]))
-                if q is not None and _apart(mech, q, qs[jn, in_]) <= tol:
+                if q is not None and apart(mech, q, qs[jn, in_]) <= tol:
                     continue
             out.append((j, i, jn, in_))
     return np.array(out, int).reshape(-1, 4)

@@ -74,19 +74,7 @@ class SectionSystem(LocusSystem):
         _, J = self._pose(q)
         A = J[:, self.free] if A is None else A
         rows = [np.concatenate([J[self.h], np.zeros(len(v))])[None]]
-        H = np.zeros((len(self.held), self.nv + len(v)))
-        for k, (c, _, _) in enumerate(self.held):
-            H[k, c.idx_v] = 1.0
-        rows.append(H)
-        Av = A @ v
-        D = np.empty((len(A), self.nv))
-        for k in range(self.nv):
-            e = np.zeros(self.nv)
-            e[k] = 1e-7
-            D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / 1e-7
-        rows.append(np.hstack([D, A]))
-        rows.append(np.concatenate([np.zeros(self.nv), v])[None])
-        return np.vstack(rows)
+        return np.vstack(rows + self._held_kind_norm_rows(q, v, A))
 
     def projected(self, q, t) -> np.ndarray:
         _, J = self._pose(q)
