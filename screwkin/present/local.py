@@ -134,7 +134,7 @@ def _branch_text(la, k) -> str:
 
 
 def change_point_dict(cp, mech=None) -> dict:
-    """A constraint singularity met along a motion (analysis.motion.change_points.ChangePoint)."""
+    """A constraint singularity met along a motion (analysis.motion.crossing.ChangePoint)."""
     d = {"input": cp.input, "sigma": cp.sigma, "local": local_dict(cp.local),
          "came_on_branch": None if cp.came is None else cp.came + 1,
          "continues_on_branch": None if cp.goes is None else cp.goes + 1,
