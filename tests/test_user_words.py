@@ -86,3 +86,83 @@ def test_report_sweeps_in_the_rpm_typed(tmp_path, monkeypatch, capsys):
     (fig,) = figures
     _, crank = _curve(fig, "omega", "crank")
     assert list(crank.get_ydata()) == pytest.approx([120.0] * len(crank.get_ydata()))
+
+
+# ------------------------------------------------------------------ item 6: words and conventions
+WATT = str(ROBOTS / "watt_sixbar.urdf")
+
+
+def test_a_ternary_links_angle_names_the_line_it_is_measured_along(capsys):
+    """The Watt rocker (pivot rocker_joint at (0.12, 0), carrying joint_F at (0.0454, 0.0392) and the loop
+    joint B at (-0.0012, 0.0900) in its frame, robots/watt_sixbar.urdf): its angle, 40.76 deg, is that of
+    rocker_joint to joint_F, not of rocker_joint to B (90.76 deg); the text and JSON now say so."""
+    import json
+
+    out, _ = _out(["solve", WATT, "--set", "crank_joint=0", "--json"], capsys)
+    links = json.loads(out)["solutions"][0]["links"]
+    rocker = links["rocker"]
+    assert rocker["angle_along"] == ["rocker_joint", "joint_F"]
+    assert math.degrees(rocker["angle"]) == pytest.approx(math.degrees(math.atan2(0.03917235122948064,
+                                                                                  0.04544806815645969)), abs=1e-9)
+    assert abs(math.degrees(rocker["angle"]) - math.degrees(math.atan2(0.08999211311152194, -0.001191460332130287))) > 45
+    assert links["coupler"]["angle_along"] == ["coupler_joint", "joint_E"]
+    out, _ = _out(["solve", WATT, "--set", "crank_joint=0"], capsys)
+    row = next(line for line in out.splitlines() if line.startswith("rocker "))
+    assert row.split()[1] == "40.7585" and row.endswith("rocker_joint to joint_F")
+    out, _ = _out(["sweep", WATT, "--input", "crank_joint", "--from", "0", "--to", "90deg", "--steps", "3"], capsys)
+    assert "rocker: rocker_joint to joint_F" in out
+    out, _ = _out(["equations", WATT, "--set", "crank_joint=0"], capsys)
+    assert "the line rocker_joint to joint_F" in out
+
+
+def test_start_takes_the_symbol_as_equations_writes_it(capsys):
+    out, _ = _out(["equations", FOURBAR, "--set", "crank_joint=30deg"], capsys)
+    assert "θ3" in out and "θ4" in out
+    greek, _ = _out(["solve", FOURBAR, "--set", "crank_joint=30deg", "--start", "θ3=30deg,θ4=80deg"], capsys)
+    latin, _ = _out(["solve", FOURBAR, "--set", "crank_joint=30deg", "--start", "theta3=30deg,theta4=80deg"], capsys)
+    assert greek == latin and "θ3 = 18.8879 deg" in greek
+    assert main(["solve", FOURBAR, "--set", "crank_joint=30deg", "--start", "θ7=30deg"]) == 2
+    assert "'θ7'" in capsys.readouterr().err
+
+
+def test_a_synthesized_file_letters_its_pivots_one_way_and_reached_says_within_what(tmp_path, capsys):
+    """The file's comment named the pivots A0 and B0, the text A and D (draw's letters): the comment now names
+    the joints themselves.  "reached: yes" beside a structural error: "reached" says its tolerance, and the
+    structural error says it is between the precision points."""
+    out_file = tmp_path / "f.urdf"
+    out, _ = _out(["synthesize", "function", "--function", "log(x)", "--x-range", "1:2", "--input-range",
+                   "30deg:120deg", "--output-range", "240deg:330deg", "-o", str(out_file)], capsys)
+    comment = out_file.read_text().split("-->")[0]
+    assert "A0" not in comment and "B0" not in comment
+    assert "rocker's pivot rocker_joint to the crank's crank_joint" in comment
+    assert "A crank_joint (0.1, 0)" in out and "D rocker_joint (0, 0)" in out
+    assert "reached (within 1e-09 rad)" in out
+    assert "structural error (the output's miss between the precision points)" in out
+    assert "between them the output is off by up to 0.4203 deg (the structural error)" in out
+
+
+@pytest.mark.slow
+def test_the_two_transmission_ranges_have_their_own_names(tmp_path, capsys):
+    """The written design's range (between its precision positions, screwkin's sweep) and each searched design's
+    (over the whole motion) were both `transmission_angle_range`: the keys stay, each gets a name of its own."""
+    import json
+
+    out, _ = _out(["synthesize", "function", "--function", "log(x)", "--x-range", "1:2", "--input-range",
+                   "30deg:120deg", "--output-range", "240deg:330deg", "--points", "5", "--generations", "3",
+                   "--min-transmission", "20deg", "-o", str(tmp_path / "f.urdf"), "--json"], capsys)
+    d = json.loads(out)
+    assert d["transmission_angle_range_between_positions"] == d["transmission_angle_range"]
+    for design in d["search"]["designs"]:
+        assert design["transmission_angle_range_over_motion"] == design["transmission_angle_range"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["mobility", FOURBAR, "--set", "crank_joint=30deg", "--mode", "2_0"],
+    ["mobility", FOURBAR, "--set", "crank_joint=30deg", "--mode", "٢"],
+    ["sweep", FOURBAR, "--input", "crank_joint", "--from", "0", "--to", "1", "--steps", "1_0"],
+    ["synthesize", "chains", "--links", "4_0", "--dof", "1"],
+])
+def test_a_count_with_an_underscore_is_refused(argv, capsys):
+    """Python's int() reads "2_0" as 20: --mode 2_0 chose mode 20 ("these inputs give 2 assembly modes")."""
+    assert main(argv) == 2
+    assert "expected a whole number" in capsys.readouterr().err

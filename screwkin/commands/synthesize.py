@@ -11,6 +11,7 @@ OUT, so OUT is the checked file and a rejected result leaves no file.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import math
 import os
@@ -40,7 +41,7 @@ from ..present.outfile import os_reason, output_failed, remove_partial, write_ou
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
-from ._options import count, seconds
+from ._options import count, seconds, whole
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -89,7 +90,7 @@ def add_parser(sub, common, scaled):
     f.add_argument("--output-range", metavar="C:D", help="the rocker's angle range (rad, or with deg)")
     f.add_argument("--spacing", choices=("chebyshev", "even"), default="chebyshev",
                    help="precision points (default chebyshev)")
-    f.add_argument("--ground", default="0.1", help="ground length A0B0 (default 0.1 m)")
+    f.add_argument("--ground", default="0.1", help="ground length, crank_joint to rocker_joint (default 0.1 m)")
     p = sp.add_argument_group("path (and function)")
     p.add_argument("--points", help='path: the points "x,y; x,y; ..."; function: the number of precision points '
                                     "(default 3; more: least squares)")
@@ -115,9 +116,9 @@ def add_parser(sub, common, scaled):
     g.add_argument("--timeout", type=seconds("timeout"), default=10.0,
                    help="seconds to reach the scheduler and a worker (default 10)")
     c = sp.add_argument_group("chains")
-    c.add_argument("--links", type=int, help="number of links (the ground included)")
-    c.add_argument("--dof", type=int, help="degrees of freedom")
-    c.add_argument("--prismatic", type=int, default=0, help="how many joints are prismatic (default 0)")
+    c.add_argument("--links", type=whole, help="number of links (the ground included)")
+    c.add_argument("--dof", type=whole, help="degrees of freedom")
+    c.add_argument("--prismatic", type=whole, default=0, help="how many joints are prismatic (default 0)")
     c.add_argument("--planar", action="store_true", help="planar chains (the only kind enumerated)")
 
 
@@ -305,8 +306,8 @@ def _motion(args):
     pick = None
     if args.pick:
         try:
-            pick = tuple(int(x) for x in args.pick.split(","))
-        except ValueError:
+            pick = tuple(whole(x) for x in args.pick.split(","))
+        except argparse.ArgumentTypeError:
             raise UsageError(f"--pick expects I,J (two candidate numbers), got {quote(args.pick)}") from None
         if len(pick) != 2:
             raise UsageError(f"--pick expects I,J (two candidate numbers), got {quote(args.pick)}")
@@ -342,8 +343,8 @@ def _function(args):
     points = 3
     if args.points:
         try:
-            points = int(args.points)
-        except ValueError:
+            points = whole(args.points)
+        except argparse.ArgumentTypeError:
             raise UsageError(f"--points: for function generation, the number of precision points, got "
                              f"{quote(args.points)}") from None
         if points > 200:

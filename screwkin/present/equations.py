@@ -8,15 +8,12 @@ import re
 
 import numpy as np
 
-from ..analysis.course.symbols import PlanarEquations
+from ..analysis.course.symbols import GREEK as _GREEK, PlanarEquations
 from ..units import unit_text
 from .screws import screws_dict, screws_text
 from .tables import shown_text, table
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
-
-_GREEK = (("theta", "θ"), ("alpha", "α"), ("beta", "β"), ("rho", "ρ"))
-
 
 def greek(text: str) -> str:
     """theta3 -> θ3, alpha3b -> α3b, pi -> π, ** -> ^ (for reading; JSON keeps sympy syntax)."""
