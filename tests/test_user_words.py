@@ -166,3 +166,61 @@ def test_a_count_with_an_underscore_is_refused(argv, capsys):
     """Python's int() reads "2_0" as 20: --mode 2_0 chose mode 20 ("these inputs give 2 assembly modes")."""
     assert main(argv) == 2
     assert "expected a whole number" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ item 7: an answer that fits a screen
+SCREEN = 40  # lines: a terminal's screen
+# each command on the bundled four-bar as a new user runs it (the ones that take the file; files go to tmp)
+COMMANDS = {
+    "mobility": [],
+    "info": [],
+    "solve": ["--set", "crank_joint=30deg", "--rate", "60rpm"],
+    "screws": [],
+    "singularities": [],
+    "statics": ["--gravity"],
+    "equations": [],
+    "sweep": ["--input", "crank_joint", "--from", "0", "--to", "360deg"],
+    "dynamics": ["--input", "crank_joint", "--speed", "60rpm"],
+    "draw": ["--svg", "{tmp}/d.svg"],
+    "export": ["--mjcf", "{tmp}/e.xml"],
+    "map": ["--x", "crank_joint=0:360deg:8", "--y", "rocker_joint=0:1:8"],
+}
+# what --explain brings back, by command (it was all printed before)
+EXPLAINED = {
+    "mobility": ["  how: order 1", "exactly constrained if you make coupler_rocker spherical",
+                 "as Chrono removes them", "rank of K 2 (generic 2, drop 0)"],
+    "singularities": ["  how: order 1"],
+    "statics": ["coupler_rocker: 3 of its 5 rows", "as Chrono removes them"],
+    "equations": ["    A = [", "    B = [", "unknown rates per unit input rate, A^-1 B:"],
+}
+
+
+def _argv(name, tmp_path, *extra):
+    return [name, FOURBAR, *(a.replace("{tmp}", str(tmp_path)) for a in COMMANDS[name]), *extra]
+
+
+@pytest.mark.parametrize("name", sorted(COMMANDS))
+def test_the_default_text_of_each_command_fits_a_screen(name, tmp_path, capsys):
+    out, _ = _out(_argv(name, tmp_path), capsys)
+    lines = out.rstrip("\n").splitlines()
+    assert 0 < len(lines) <= SCREEN, f"{name}: {len(lines)} lines\n{out}"
+    for words in EXPLAINED.get(name, ()):
+        assert words not in out, f"{name} explains by default: {words!r}"
+
+
+@pytest.mark.parametrize("name", sorted(EXPLAINED))
+def test_explain_brings_the_explanations_back(name, tmp_path, capsys):
+    out, _ = _out(_argv(name, tmp_path, "--explain"), capsys)
+    for words in EXPLAINED[name]:
+        assert words in out, f"{name} --explain lacks {words!r}"
+
+
+def test_mobility_answers_first_and_json_keeps_everything(capsys):
+    import json
+
+    out, _ = _out(["mobility", FOURBAR], capsys)
+    assert out.splitlines()[0] == "M = 1, actuated by crank_joint: constrained mechanism (properly actuated)"
+    assert "redundant constraints: 3, 3 at coupler_rocker (the loop is planar) (--explain names them" in out
+    d = json.loads(_out(["mobility", FOURBAR, "--json"], capsys)[0])
+    assert d["exactly_constrained_by"]["overconstraint"] == 0 and len(d["redundant_wrenches"]) == 3
+    assert d["local"]["decided_by"].startswith("order 1")

@@ -28,4 +28,4 @@ def run(mech, args) -> int:
     given = any(getattr(args, k, None) for k in ("set", "set_angle", "set_length", "near", "mode"))
     at = configuration(mech, args) if given else None
     result = analyze_mobility(mech, output=args.output, point=args.point, at=at, suggest=True)
-    return emit(args, lambda: with_mode(args, mobility_dict(result)), lambda: mobility_text(result))
+    return emit(args, lambda: with_mode(args, mobility_dict(result)), lambda: mobility_text(result, args.explain))

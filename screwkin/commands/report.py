@@ -180,7 +180,7 @@ def run(mech, args) -> int:
     data["configuration"] = values
 
     # ---- topology, counts, mobility, drawings of the configuration
-    mob = _attempt(notes, "mobility", lambda: analyze_mobility(mech, output=args.output))
+    mob = _attempt(notes, "mobility", lambda: analyze_mobility(mech, output=args.output, suggest=True))
     if mob is not None:
         data["mobility"] = mobility_dict(mob)
     figures = []

@@ -36,6 +36,7 @@ from .mobility import (
     screw_theory_rows,
 )
 from .screws import screws_text
+from .local import local_lines, redundancy_lines
 from .jsonout import json_of
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
@@ -136,6 +137,13 @@ def topology_section(topo, mobility, figures=()) -> Section:
         s.blocks.append(Table(["screw theory", "value"], screw_theory_rows(mobility), "mobility"))
         s.blocks.append(Text(f"classification: {mobility.classification}"))
         s.blocks += [Text(f"note: {n}") for n in mobility.notes]
+        # the explanations the command's default text leaves to --explain: how the local analysis decided, the
+        # redundant constraints by name and the exactly constrained alternative
+        explained = (local_lines(mobility.local, mobility.local_where) if mobility.local is not None else []) + (
+            redundancy_lines(mobility.redundant, "redundant constraints at a configuration of the generic rank")
+            if mobility.redundant is not None else [])
+        if explained:
+            s.blocks.append(Code("\n".join(explained)))
     s.blocks += list(figures)
     return s
 
