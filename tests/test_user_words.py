@@ -224,3 +224,30 @@ def test_mobility_answers_first_and_json_keeps_everything(capsys):
     d = json.loads(_out(["mobility", FOURBAR, "--json"], capsys)[0])
     assert d["exactly_constrained_by"]["overconstraint"] == 0 and len(d["redundant_wrenches"]) == 3
     assert d["local"]["decided_by"].startswith("order 1")
+
+
+# ------------------------------------------------------------------ item 8: --workers
+def _square_after(x):
+    import time
+
+    time.sleep(0.05 * (3 - x % 3))  # uneven tasks: the next free process takes the next one
+    return x * x
+
+
+def test_the_local_process_pool_maps_in_order_and_leaves_no_server():
+    """synthesize --workers N: N local processes forked from a fork server (a Dask LocalCluster took 3 to 9 s to
+    start and made the README's search 2.6 times slower on 2 loaded cores); the results in the tasks' order."""
+    from multiprocessing import forkserver
+
+    from screwkin.parallel.pool import process_pool
+
+    with process_pool(2, ["math"]) as (mapper, how):
+        assert mapper(_square_after, range(7)) == [x * x for x in range(7)]
+    assert how in ("local processes (forkserver)", "local processes (spawn)")
+    assert getattr(forkserver._forkserver, "_forkserver_pid", None) is None  # stopped and waited for
+
+
+def test_synthesize_workers_says_when_it_helps(capsys):
+    assert main(["synthesize", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "it helps only with N idle cores" in text

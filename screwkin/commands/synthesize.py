@@ -33,7 +33,7 @@ from ..analysis.design.synthesis.path import synthesize_path
 from ..errors import OutputError, UsageError, quote
 from ..files.description import LIMITS
 from ..files.writer import write_urdf
-from ..parallel.pool import dask_client, dask_map
+from ..parallel.pool import dask_client, dask_map, process_pool
 from ..model.loader import load
 from ..present.draw import draw_design
 from ..present.jsonout import json_of
@@ -50,6 +50,9 @@ KINDS = ("motion", "function", "path", "chains")
 PAIRS_CHECKED = 6
 
 #: The options of the constrained global search (motion, function, path).
+#: What the processes of --workers import once, before they fork (the search's runs are in them).
+SEARCH_MODULES = ("screwkin.analysis.design.synthesis.optimal", "screwkin.analysis.design.synthesis.optimal_motion",
+                  "screwkin.analysis.design.synthesis.optimal_function")
 SEARCH = {"bounds", "lengths", "grashof", "min_transmission", "best", "generations", "workers", "scheduler", "seed"}
 _OPTIONS = {  # which options each kind takes (dest names)
     "motion": {"poses", "pivots", "moving", "pick", "candidates", "png", "draw"} | SEARCH,
@@ -110,8 +113,9 @@ def add_parser(sub, common, scaled):
     g.add_argument("--generations", type=count("generations"),
                    help=f"generations of each differential-evolution run at most (default {GENERATIONS})")
     g.add_argument("--workers", type=count("workers"), metavar="N",
-                   help="spread the search's runs over a local cluster of N processes (0: in this process, the "
-                        "default)")
+                   help="spread the search's runs over N local processes (0: in this process, the default); "
+                        "it helps only with N idle cores: the search is 4 to 8 runs of seconds each, so at best "
+                        "about 1.8x on 2 idle cores, and nothing on cores busy with other work (README, synthesize)")
     g.add_argument("--scheduler", metavar="ADDRESS", help="spread them over a running dask cluster, tcp://HOST:PORT")
     g.add_argument("--timeout", type=seconds("timeout"), default=10.0,
                    help="seconds to reach the scheduler and a worker (default 10)")
@@ -275,13 +279,17 @@ def _searching(args, count: int, beyond: int) -> bool:
 
 @contextlib.contextmanager
 def _search(args):
-    """The Search of the command line: in this process, or spread over a Dask cluster (--workers N, or
-    --scheduler, the grammar of study)."""
+    """The Search of the command line: in this process, over N local processes (--workers N: forked from a
+    fork server, parallel.pool.process_pool), or over a running Dask cluster (--scheduler, study's grammar)."""
     kw = {"seed": args.seed, "best": args.best or 5, "generations": args.generations or GENERATIONS}
     if args.scheduler is not None and args.workers is not None:
         raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
     if args.scheduler is None and not args.workers:
         yield Search(**kw)
+        return
+    if args.scheduler is None:  # a few runs of seconds each: local processes, not a Dask LocalCluster
+        with process_pool(args.workers, SEARCH_MODULES) as (mapper, how):
+            yield Search(**kw, mapper=mapper, where=f"{how}, {args.workers} worker{'s' if args.workers != 1 else ''}")
         return
     with dask_client(args.scheduler, args.workers, args.timeout) as (client, used, where):
         yield Search(**kw, mapper=dask_map(client, "screwkin-synthesis"),
