@@ -164,4 +164,4 @@ def motion_rows_text(res, motion, rows, degrees: bool, units: RateUnits | None =
     unit = "deg" if degrees else res.unit
     body = [[f"{x[k]:.6g}"] + [c[k] for c in cols] for k in rows]
     along = along_line(turning)
-    return "absolute motion" + (f" ({along})" if along else "") + "\n" + table([f"input [{unit}]"] + head, body)
+    return (f"{along}\n" if along else "") + "absolute motion\n" + table([f"input [{unit}]"] + head, body)
