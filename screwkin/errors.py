@@ -122,7 +122,8 @@ class AssemblyError(MechanismFileError):
     """
 
     def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None,
-                 reason: str | None = None, proved: bool = False):
+                 reason: str | None = None, proved: bool = False, message: str | None = None):
+        """``message``: the whole message where no search was made at all (a closed form's answer)."""
         self.residual = float(residual)
         self.iterations = int(iterations)
         self.starts = starts
@@ -138,7 +139,7 @@ class AssemblyError(MechanismFileError):
                    f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}")
         if detail:
             msg += f" ({detail})"
-        super().__init__(path, msg)
+        super().__init__(path, message or msg)
 
 
 class OutputError(ScrewkinError):

@@ -9,12 +9,14 @@ import sys
 from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.sweep import BRANCHES
 from ..errors import UsageError, quote
 from ..model.topology import open_joints
 from ._options import count
 from ._values import joint_assignments, split_inputs
 
-__all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "input_solver",
+__all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "add_branch_option",
+           "input_solver",
            "configuration", "mode_line", "file_configuration_line", "near_values", "with_mode", "moved_not_set"]
 
 
@@ -49,6 +51,14 @@ def add_mode_option(sp, at: str = "the --set inputs"):
                          "file's configuration)")
 
 
+def add_branch_option(sp, what: str = "the motion"):
+    """--branch continue|other: what a motion does at a change point (analysis.motion.sweep's branch)."""
+    sp.add_argument("--branch", choices=BRANCHES, default=BRANCHES[0],
+                    help=f"at a change point of {what} (branches of the motion cross: a parallelogram four-bar "
+                         "folding flat), go on along the branch whose tangent continues the motion (continue, the "
+                         "default: the parallelogram stays a parallelogram) or along the other one (other)")
+
+
 def input_solver(mech, inputs, held: dict | None = None, output=None) -> PositionSolver:
     """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
     ``held`` links' angles held by their loop equations (a copy of the mechanism:
@@ -72,7 +82,7 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     values.update(moved or {})
     near = near_values(mech, args)
     wanted = getattr(args, "mode", None)
-    args.mode_chosen = None
+    args.mode_chosen = args.continuum = None
     if not values and not held:
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
@@ -88,8 +98,10 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     if missing:
         raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
     q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
-    for note in res.notes:  # a --near value the mode found lies far from
+    for note in res.notes:  # a --near value the mode found lies far from; a continuum's sample
         print(f"note: {note}", file=sys.stderr)
+    if res.free_dofs:
+        args.continuum = {"free_dofs": res.free_dofs}
     if n > 1:
         args.mode_chosen = {"index": k, "of": n}
         if not getattr(args, "json", False):
@@ -134,9 +146,12 @@ def near_values(mech, args) -> dict | None:
 
 
 def with_mode(args, d: dict) -> dict:
-    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes."""
+    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes, with
+    "continuum": {"free_dofs"} when it was a sample of a continuum the inputs leave (no modes then)."""
     if getattr(args, "mode_chosen", None):
         d["mode"] = args.mode_chosen
+    if getattr(args, "continuum", None):
+        d["continuum"] = args.continuum
     return d
 
 
