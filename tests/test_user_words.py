@@ -251,3 +251,10 @@ def test_synthesize_workers_says_when_it_helps(capsys):
     assert main(["synthesize", "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())
     assert "it helps only with N idle cores" in text
+
+
+def test_dynamics_flywheel_speaks_the_rpm_typed(capsys):
+    """dynamics --speed 120rpm said the flywheel's speed as 12.5664 rad/s only."""
+    out, _ = _out(["dynamics", FOURBAR, "--input", "crank_joint", "--speed", "120rpm"], capsys)
+    line = next(ln for ln in out.splitlines() if ln.startswith("flywheel:"))
+    assert f"at 120rpm ({4 * math.pi:.6g} rad/s)" in line
