@@ -128,7 +128,7 @@ def test_mobility_and_statics_name_the_redundant_wrenches(capsys):
     d = json.loads(capsys.readouterr().out)
     assert len(d["redundant_wrenches"]) == 3 and all(len(w["wrench"]) == 6 for w in d["redundant_wrenches"])
     assert d["exactly_constrained_by"]["overconstraint"] == 0
-    assert main(["statics", str(MJCF), "--gravity"]) == 0
+    assert main(["statics", str(MJCF), "--gravity", "--explain"]) == 0  # the reactions named: an explanation
     out = capsys.readouterr().out
     assert "connect 'ground_pivot': 1 of its 3 rows, the force along z -- the loop is planar" in out
     assert main(["statics", str(MJCF), "--gravity", "--json"]) == 0

@@ -140,7 +140,9 @@ def test_solve_json_and_text_report_loop_joints_and_links(tmp_path, capsys):
     sol = d["solutions"][0]
     assert set(sol["loop_joints"]) == {"guide"} and set(sol["loop_rates"]) == {"guide"}
     assert set(sol["links"]) == {"crank", "rod", "slider"}
-    assert set(sol["links"]["rod"]) == {"position", "velocity", "acceleration", "omega", "alpha", "angle"}
+    assert set(sol["links"]["rod"]) == {"position", "velocity", "acceleration", "omega", "alpha", "angle",
+                                        "angle_along"}
+    assert sol["links"]["rod"]["angle_along"] == ["pin_A", "pin_B"]  # the line its angle is measured along
     assert main(["solve", str(path), "--set", "crank_joint=30deg", "--rate", "crank_joint=10"]) == 0
     out = capsys.readouterr().out
     assert "guide (loop)" in out and "absolute link motion" in out and "omega [rad/s]" in out

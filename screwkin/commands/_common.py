@@ -8,11 +8,17 @@ import argparse
 from ..present.jsonout import json_of
 from ._output_frame import add_point_option
 
-__all__ = ["add_common", "add_scaled", "emit"]
+__all__ = ["add_common", "add_scaled", "emit", "EXPLAIN_HELP"]
+
+#: --explain, the one option every command shares for the explanations its text leaves out by default.
+EXPLAIN_HELP = ("also print the explanations: how each answer was decided, the redundant constraints by name and "
+                "how to remove them, the worked numbers (the default text gives the answers, about a screen for a "
+                "four-bar; --json and report always have everything)")
 
 
 def add_common(sp, mechanism: bool = True, optional_file: bool = False):
     """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
+    sp.add_argument("--explain", action="store_true", help=EXPLAIN_HELP)
     if not mechanism:
         sp.add_argument("--json", action="store_true", help="print one JSON object")
         sp.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show tracebacks of errors")

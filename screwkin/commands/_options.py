@@ -18,11 +18,12 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 from importlib import metadata
 
 from ..errors import UsageError, quote
 
-__all__ = ["screwkin_version", "check_writable", "check_folder_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "check_not_read", "check_picture", "PICTURES", "BOUNDS"]
+__all__ = ["screwkin_version", "check_writable", "check_folder_writable", "count", "whole", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "check_not_read", "check_picture", "PICTURES", "BOUNDS"]
 
 
 def screwkin_version() -> str:
@@ -85,15 +86,24 @@ def seconds(what: str):
     return parse
 
 
+_WHOLE = re.compile(r"[+-]?[0-9]+")
+
+
+def whole(text: str) -> int:
+    """A whole number as a person types it: ASCII digits with an optional sign, nothing else.  Python's int()
+    also reads ``2_0`` as 20 and other scripts' digits (``٣``): a typo taken for a count.  The one parse of every
+    count on the command line (count() below, --links, --port, --facets, --pick, --points)."""
+    if not isinstance(text, str) or not _WHOLE.fullmatch(text.strip()):
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {quote(str(text), 40)}")
+    return int(text.strip())
+
+
 def count(what: str):
-    """argparse type of a count bounded by ``BOUNDS[what]`` (whole numbers only)."""
+    """argparse type of a count bounded by ``BOUNDS[what]`` (whole numbers only: :func:`whole`)."""
     lo, hi = BOUNDS[what]
 
     def parse(text: str) -> int:
-        try:
-            n = int(text.strip())
-        except (ValueError, AttributeError):
-            raise argparse.ArgumentTypeError(f"expected a whole number, got {quote(text, 40)}") from None
+        n = whole(text)
         if not lo <= n <= hi:
             raise argparse.ArgumentTypeError(f"must be between {lo:,} and {hi:,}, got {n:,}")
         return n

@@ -42,5 +42,5 @@ def run(mech, args) -> int:
     if args.json:
         print(json_of(with_mode(args, equations_dict(res))))
     else:
-        print(equations_text(res))
+        print(equations_text(res, args.explain))
     return 0

@@ -10,6 +10,7 @@ from ..files.grasp import read_grasp
 from ..present.jsonout import json_of
 from ..present.grasp import grasp_dict, grasp_text
 from ..units import parse_length
+from ._options import whole
 
 NAME = "grasp"
 NEEDS_MECHANISM = False
@@ -19,7 +20,7 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="grasp analysis: grasp map, form and force closure, internal forces, quality")
     sp.add_argument("file", metavar="GRASP.yaml", help="contacts on one object (docs/format.md, 'Grasps')")
     common(sp, mechanism=False)
-    sp.add_argument("--facets", type=int, default=8,
+    sp.add_argument("--facets", type=whole, default=8,
                     help="facets of the pyramids that stand for circular friction cones (default 8; refined up to "
                          f"{GRASP_TOLERANCES.max_facets} when the answer is ambiguous)")
     sp.add_argument("--length", help="characteristic length L dividing the moments (default: the mean distance "

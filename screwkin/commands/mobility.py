@@ -38,4 +38,4 @@ def run(mech, args) -> int:
     at = configuration(mech, args) if given else None
     with Progress(label="mobility", unit="tangent directions continued", every=EVERY) as progress:  # a terminal only
         result = analyze_mobility(mech, output=args.output, point=args.point, at=at, suggest=True, progress=progress)
-    return emit(args, lambda: with_mode(args, mobility_dict(result)), lambda: mobility_text(result))
+    return emit(args, lambda: with_mode(args, mobility_dict(result)), lambda: mobility_text(result, args.explain))

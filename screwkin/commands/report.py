@@ -59,7 +59,7 @@ from ..present.view import (
     show,
 )
 from ..present.camera import PICTURE
-from ..present.tables import RateUnits
+from ..present.tables import RateUnits, input_rate_words
 from ..present.viewserver import ViewerServer
 from ..units import parse_typed_assignments
 from ._configuration import add_configuration_options, input_solver, mode_line, near_values
@@ -183,7 +183,7 @@ def run(mech, args) -> int:
     data["configuration"] = values
 
     # ---- topology, counts, mobility, drawings of the configuration
-    mob = _attempt(notes, "mobility", lambda: analyze_mobility(mech, output=args.output))
+    mob = _attempt(notes, "mobility", lambda: analyze_mobility(mech, output=args.output, suggest=True))
     if mob is not None:
         data["mobility"] = mobility_dict(mob)
     figures = []
@@ -236,7 +236,9 @@ def run(mech, args) -> int:
                                      "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
 
     # ---- singular configurations and the sweep
-    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held)
+    sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held,
+                                    typed_rates={pivots[k][0] if k in pivots else k: v
+                                                 for k, v in typed["rate"].items()})
 
     # ---- the view
     sections.append(_view(mech, args, q, data))
@@ -342,7 +344,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held=None):
+def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held=None, typed_rates=None):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -383,12 +385,18 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, hel
     ins = ([moved, *(k for k in given if k != moved)] if held else
            list(mech.actuated) if moved in mech.actuated else [moved])
     slider_strokes = strokes(res, motion, mech, input_solver(mech, ins, held))
+    # the rates as typed (--rate crank=120rpm: "at crank 120 rpm", omega in rpm and alpha in rpm/s), as the
+    # positions section shows them; the default 1 rad/s (or a rate 0, moved at 1): per 1 rad/s of the input
+    typed_rates = typed_rates or {}
+    typed_moved = typed_rates.get(moved) if rates.get(moved) else None
+    rate_words = input_rate_words(moved, typed_moved, bool(mech.translational[mech.coordinate(moved).idx_v]))
+    units = RateUnits.typed(typed_rates.values()) if typed_rates else None
     fig = motion_figure(res, mus, singularities=search.found, linear=mech.translational, motion=motion,
-                        title=f"{base}: {moved} over its range")
+                        title=f"{base}: {moved} over its range, {rate_words}", rate_words=rate_words, units=units)
     what = ("the links' absolute angle, omega and alpha and the slider coordinates" if absolute_series(
         res, motion, mech.translational) is not None else "joint values, rates and accelerations")
     out.append(sweep_section(search, Figure(figure_bytes(fig), "svg", f"{what} against {moved}", "sweep"),
-                             strokes_text(slider_strokes, res.unit == "rad")))
+                             strokes_text(slider_strokes, res.unit == "rad"), rate_words))
     data["sweep"] = {"input": moved, "steps": len(res.values) - 1, "values": res.values, "names": list(res.names),
                      "coordinates": list(res.names), "joints": res.joints, "rates": res.rates,
                      "accelerations": res.accelerations,

@@ -65,7 +65,7 @@ def run(mech, args) -> int:
         if frame is not None:
             print(output_frame_line(frame, point))
         print(singularity_text(rep))
-        print("\n".join(["", *types_lines(types), *local_lines(local, "this configuration")]))
+        print("\n".join(["", *types_lines(types), *local_lines(local, "this configuration", args.explain)]))
         if ell is not None:
             print()
             print(ellipsoids_text(ell))

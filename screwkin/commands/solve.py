@@ -49,7 +49,8 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--starts", type=count("starts"), default=24, help="random starting configurations (default 24)")
     sp.add_argument("--start", action="append", metavar="NAME=VALUE,...",
                    help="planar: Newton on the vector-loop equations (screwkin equations) from these estimates of "
-                        "the unknowns: symbols (theta3, x4), link names (their angles) or passive joint values")
+                        "the unknowns: symbols (theta3 or θ3 as equations writes it, x4), link names (their angles) or "
+                        "passive joint values")
     sp.add_argument("--iterations", type=count("iterations"), metavar="K",
                    help="with --start: exactly K Newton iterations, each printed (residual, Jacobian, step, "
                         "estimates); without it Newton goes on to convergence")

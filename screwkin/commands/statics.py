@@ -75,5 +75,5 @@ def run(mech, args) -> int:
         if why_not:
             print(f"\nno legs' wrenches: {why_not} (the joint reactions above give what each joint carries)")
         if red is not None and red.count:
-            print("\n".join(redundancy_lines(red, "the reactions statics cannot give, by joint")))
+            print("\n".join(redundancy_lines(red, "the reactions statics cannot give, by joint", args.explain)))
     return 0

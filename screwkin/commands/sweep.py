@@ -224,10 +224,12 @@ def run(mech, args) -> int:
     if args.csv or args.parquet:
         with SweepWriter(args.csv, args.parquet) as out:
             out.write(res, motion)
+    # a --rate typed: the links' omega and alpha in its units (60rpm: rpm, rpm/s), in the tables and the plot
+    units = RateUnits.typed(typed.values()) if args.rate else None
     if args.plot:
         sweep_plot(res, args.plot, mus, singularities=sing, linear=mech.translational, motion=motion,
                    title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}, "
-                         f"{args.rate_words}", rate_words=args.rate_words)
+                         f"{args.rate_words}", rate_words=args.rate_words, units=units)
     if args.json:
         d = with_mode(args, sweep_dict(res, mech))
         d["input_rate"], d["rates_are"] = rate, args.rate_words  # SI; "per 1 rad/s of crank" or "at crank 60 rpm"
@@ -261,8 +263,6 @@ def run(mech, args) -> int:
             print(line)
         for n in res.notes:
             print(f"note: {n}")
-        # a --rate typed: the links' omega and alpha beside their angles, in its units (60rpm: rpm)
-        units = RateUnits.typed(typed.values()) if args.rate else None
         table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad", units)
         if table_text:
             print()

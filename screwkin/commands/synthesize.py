@@ -11,6 +11,7 @@ OUT, so OUT is the checked file and a rejected result leaves no file.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import math
 import os
@@ -32,7 +33,7 @@ from ..analysis.design.synthesis.path import synthesize_path
 from ..errors import OutputError, UsageError, quote
 from ..files.description import LIMITS
 from ..files.writer import write_urdf
-from ..parallel.pool import dask_client, dask_map
+from ..parallel.pool import dask_client, dask_map, process_pool
 from ..model.loader import load
 from ..present.draw import draw_design
 from ..present.jsonout import json_of
@@ -40,7 +41,7 @@ from ..present.outfile import os_reason, output_failed, remove_partial, write_ou
 from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthesis_text
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
-from ._options import count, seconds
+from ._options import count, seconds, whole
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -49,6 +50,9 @@ KINDS = ("motion", "function", "path", "chains")
 PAIRS_CHECKED = 6
 
 #: The options of the constrained global search (motion, function, path).
+#: What the processes of --workers import once, before they fork (the search's runs are in them).
+SEARCH_MODULES = ("screwkin.analysis.design.synthesis.optimal", "screwkin.analysis.design.synthesis.optimal_motion",
+                  "screwkin.analysis.design.synthesis.optimal_function")
 SEARCH = {"bounds", "lengths", "grashof", "min_transmission", "best", "generations", "workers", "scheduler", "seed"}
 _OPTIONS = {  # which options each kind takes (dest names)
     "motion": {"poses", "pivots", "moving", "pick", "candidates", "png", "draw"} | SEARCH,
@@ -89,7 +93,7 @@ def add_parser(sub, common, scaled):
     f.add_argument("--output-range", metavar="C:D", help="the rocker's angle range (rad, or with deg)")
     f.add_argument("--spacing", choices=("chebyshev", "even"), default="chebyshev",
                    help="precision points (default chebyshev)")
-    f.add_argument("--ground", default="0.1", help="ground length A0B0 (default 0.1 m)")
+    f.add_argument("--ground", default="0.1", help="ground length, crank_joint to rocker_joint (default 0.1 m)")
     p = sp.add_argument_group("path (and function)")
     p.add_argument("--points", help='path: the points "x,y; x,y; ..."; function: the number of precision points '
                                     "(default 3; more: least squares)")
@@ -109,15 +113,16 @@ def add_parser(sub, common, scaled):
     g.add_argument("--generations", type=count("generations"),
                    help=f"generations of each differential-evolution run at most (default {GENERATIONS})")
     g.add_argument("--workers", type=count("workers"), metavar="N",
-                   help="spread the search's runs over a local cluster of N processes (0: in this process, the "
-                        "default)")
+                   help="spread the search's runs over N local processes (0: in this process, the default); "
+                        "it helps only with N idle cores: the search is 4 to 8 runs of seconds each, so at best "
+                        "about 1.8x on 2 idle cores, and nothing on cores busy with other work (README, synthesize)")
     g.add_argument("--scheduler", metavar="ADDRESS", help="spread them over a running dask cluster, tcp://HOST:PORT")
     g.add_argument("--timeout", type=seconds("timeout"), default=10.0,
                    help="seconds to reach the scheduler and a worker (default 10)")
     c = sp.add_argument_group("chains")
-    c.add_argument("--links", type=int, help="number of links (the ground included)")
-    c.add_argument("--dof", type=int, help="degrees of freedom")
-    c.add_argument("--prismatic", type=int, default=0, help="how many joints are prismatic (default 0)")
+    c.add_argument("--links", type=whole, help="number of links (the ground included)")
+    c.add_argument("--dof", type=whole, help="degrees of freedom")
+    c.add_argument("--prismatic", type=whole, default=0, help="how many joints are prismatic (default 0)")
     c.add_argument("--planar", action="store_true", help="planar chains (the only kind enumerated)")
 
 
@@ -274,13 +279,17 @@ def _searching(args, count: int, beyond: int) -> bool:
 
 @contextlib.contextmanager
 def _search(args):
-    """The Search of the command line: in this process, or spread over a Dask cluster (--workers N, or
-    --scheduler, the grammar of study)."""
+    """The Search of the command line: in this process, over N local processes (--workers N: forked from a
+    fork server, parallel.pool.process_pool), or over a running Dask cluster (--scheduler, study's grammar)."""
     kw = {"seed": args.seed, "best": args.best or 5, "generations": args.generations or GENERATIONS}
     if args.scheduler is not None and args.workers is not None:
         raise UsageError("--workers is for the local cluster; a scheduler's cluster has its own workers")
     if args.scheduler is None and not args.workers:
         yield Search(**kw)
+        return
+    if args.scheduler is None:  # a few runs of seconds each: local processes, not a Dask LocalCluster
+        with process_pool(args.workers, SEARCH_MODULES) as (mapper, how):
+            yield Search(**kw, mapper=mapper, where=f"{how}, {args.workers} worker{'s' if args.workers != 1 else ''}")
         return
     with dask_client(args.scheduler, args.workers, args.timeout) as (client, used, where):
         yield Search(**kw, mapper=dask_map(client, "screwkin-synthesis"),
@@ -305,8 +314,8 @@ def _motion(args):
     pick = None
     if args.pick:
         try:
-            pick = tuple(int(x) for x in args.pick.split(","))
-        except ValueError:
+            pick = tuple(whole(x) for x in args.pick.split(","))
+        except argparse.ArgumentTypeError:
             raise UsageError(f"--pick expects I,J (two candidate numbers), got {quote(args.pick)}") from None
         if len(pick) != 2:
             raise UsageError(f"--pick expects I,J (two candidate numbers), got {quote(args.pick)}")
@@ -342,8 +351,8 @@ def _function(args):
     points = 3
     if args.points:
         try:
-            points = int(args.points)
-        except ValueError:
+            points = whole(args.points)
+        except argparse.ArgumentTypeError:
             raise UsageError(f"--points: for function generation, the number of precision points, got "
                              f"{quote(args.points)}") from None
         if points > 200:

@@ -36,6 +36,7 @@ from .mobility import (
     screw_theory_rows,
 )
 from .screws import screws_text
+from .local import local_lines, redundancy_lines
 from .jsonout import json_of
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
@@ -136,6 +137,13 @@ def topology_section(topo, mobility, figures=()) -> Section:
         s.blocks.append(Table(["screw theory", "value"], screw_theory_rows(mobility), "mobility"))
         s.blocks.append(Text(f"classification: {mobility.classification}"))
         s.blocks += [Text(f"note: {n}") for n in mobility.notes]
+        # the explanations the command's default text leaves to --explain: how the local analysis decided, the
+        # redundant constraints by name and the exactly constrained alternative
+        explained = (local_lines(mobility.local, mobility.local_where) if mobility.local is not None else []) + (
+            redundancy_lines(mobility.redundant, "redundant constraints at a configuration of the generic rank")
+            if mobility.redundant is not None else [])
+        if explained:
+            s.blocks.append(Code("\n".join(explained)))
     s.blocks += list(figures)
     return s
 
@@ -236,14 +244,17 @@ def singular_section(search, figures, descriptions, conditions=()) -> Section:
     return s
 
 
-def sweep_section(search, figure, lines=()) -> Section:
+def sweep_section(search, figure, lines=(), rate_words=None) -> Section:
     """The input moved over its range: the figure, and ``lines`` (each slider's stroke and time ratio,
-    present/motion.strokes_text, as sweep prints them)."""
+    present/motion.strokes_text, as sweep prints them); ``rate_words``: the input's rate as typed
+    (tables.input_rate_words, "at crank 120 rpm"; default: the sweep's rate in SI)."""
     s = Section("sweep", "Sweep of the input")
     res = search.motion
     x = _reading(res.values[-1], res.unit != "m") if len(res.values) else "-"
-    s.blocks.append(Text(f"{search.input} moved in {len(res.values) - 1} steps at {res.rate:g} "
-                         f"{'rad/s' if res.unit != 'm' else 'm/s'} (one assembly mode followed"
+    first = _reading(res.values[0], res.unit != "m") if len(res.values) else "-"
+    rate_words = rate_words or f"at {res.rate:g} {'rad/s' if res.unit != 'm' else 'm/s'}"
+    s.blocks.append(Text(f"{search.input} moved from {first} in {len(res.values) - 1} steps {rate_words} "
+                         f"(one assembly mode followed"
                          + (", through limit positions" if res.limits else "") + f"; last value {x})"
                          + (f"; stopped: {res.stop_reason}" if res.stopped_at is not None else "")))
     s.blocks += [Text(line) for line in lines]

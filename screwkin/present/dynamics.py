@@ -116,8 +116,10 @@ def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str |
                      f"{r.effort_units[name].replace(' ', '*')} (what its coupling exerts along it)")
     fly = r.flywheel
     if fly.inertia is not None:
+        at = f"{fly.omega:.6g} rad/s"  # the speed as typed first (120rpm), as the first line says it
+        at = f"{speed_text} ({at})" if speed_text and abs(fly.omega - r.speed) <= 1e-12 * max(1.0, abs(r.speed)) else at
         lines.append(f"flywheel: energy fluctuation {fly.energy_fluctuation:.6g} J over the turn; for Cs = {fly.cs:g} "
-                     f"at {fly.omega:.6g} rad/s it takes I = dE / (Cs omega^2) = {fly.inertia:.6g} kg*m^2")
+                     f"at {at} it takes I = dE / (Cs omega^2) = {fly.inertia:.6g} kg*m^2")
     else:
         lines.append(f"flywheel: not given ({fly.reason})")
     lines += ["", "joint reactions: " + REACTION_POINT, "largest magnitude over the motion:"]

@@ -8,15 +8,12 @@ import re
 
 import numpy as np
 
-from ..analysis.course.symbols import PlanarEquations
+from ..analysis.course.symbols import GREEK as _GREEK, PlanarEquations
 from ..units import unit_text
 from .screws import screws_dict, screws_text
 from .tables import shown_text, table
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
-
-_GREEK = (("theta", "θ"), ("alpha", "α"), ("beta", "β"), ("rho", "ρ"))
-
 
 def greek(text: str) -> str:
     """theta3 -> θ3, alpha3b -> α3b, pi -> π, ** -> ^ (for reading; JSON keeps sympy syntax)."""
@@ -118,7 +115,9 @@ def equations_dict(res) -> dict:
     }
 
 
-def equations_text(res) -> str:
+def equations_text(res, explain: bool = True) -> str:
+    """The equations as text; without ``explain`` (the command's default, --explain for all) the values at the
+    configuration are det A and the rates A^-1 B on one line, without the matrices A and B in numbers."""
     if not isinstance(res, PlanarEquations):
         lines = [f"{res.motion_space} mechanism {res.path}: the product-of-exponentials structure equations of each "
                  "chain (the loops close where the chains to both sides of each cut joint meet)", ""]
@@ -161,12 +160,19 @@ def equations_text(res) -> str:
     ww = ", ".join(greek(n) + "''" for n in res.inputs)
     lines.append(f"acceleration: A [{zz}] = B [{ww}] + c      (rates written NAME_d)")
     lines += _matrix_text("c", [[e] for e in res.acceleration_terms])
-    lines.append("\nat this configuration:")
-    lines += _numbers_text("A", res.A_value)
-    lines += _numbers_text("B", res.B_value)
-    if res.det_A_value is not None:
+    if not explain:
+        here = ([f"det A = {shown_text(res.det_A_value)}"] if res.det_A_value is not None else []) + (
+            ["unknown rates per unit input rate (A^-1 B): " + ", ".join(
+                f"{greek(n)}' = " + " + ".join(f"({shown_text(x)}) {greek(m)}'" for x, m in zip(row, res.inputs))
+                for n, row in zip(res.unknowns, res.rates))] if res.rates is not None else [])
+        lines.append("\nat this configuration: " + "; ".join(here or ["-"]) + " (--explain: A and B in numbers)")
+    else:
+        lines.append("\nat this configuration:")
+        lines += _numbers_text("A", res.A_value)
+        lines += _numbers_text("B", res.B_value)
+    if explain and res.det_A_value is not None:
         lines.append(f"    det A = {shown_text(res.det_A_value)}")
-    if res.rates is not None:
+    if explain and res.rates is not None:
         lines.append("    unknown rates per unit input rate, A^-1 B:")
         for n, row in zip(res.unknowns, res.rates):
             lines.append(f"      {greek(n)}' = " + " + ".join(f"({shown_text(x)}) {greek(m)}'" for x, m in zip(row, res.inputs)))

@@ -55,21 +55,23 @@ def local_dict(la: LocalAnalysis, configuration: dict | None = None) -> dict:
     return d
 
 
-def local_lines(la: LocalAnalysis, where: str) -> list:
-    """Text lines: what the mechanism can do at ``where``, the ranks and how it was decided."""
+def local_lines(la: LocalAnalysis, where: str, explain: bool = True) -> list:
+    """Text lines: what the mechanism can do at ``where``; with ``explain`` (--explain, report) the ranks, how
+    it was decided and the notes too (the branches met are always listed: they are part of the answer)."""
     held = "" if la.inputs_held is None else f", {la.inputs_held} with the inputs held"
-    lines = [f"at {where}: {words(la)}",
-             f"  rank of K {la.rank}" + (f" (generic {la.generic_rank}, drop {la.rank_drop})" if la.generic_rank is not None
-                                         else "")
-             + f"; infinitesimal mobility {la.infinitesimal_mobility}{held}; finite mobility "
-             + ("undecided" if la.finite_mobility is None else str(la.finite_mobility)),
-             f"  how: {la.decided_by}"]
+    lines = [f"at {where}: {words(la)}"]
+    if explain:
+        lines += [f"  rank of K {la.rank}" + (f" (generic {la.generic_rank}, drop {la.rank_drop})"
+                                              if la.generic_rank is not None else "")
+                  + f"; infinitesimal mobility {la.infinitesimal_mobility}{held}; finite mobility "
+                  + ("undecided" if la.finite_mobility is None else str(la.finite_mobility)),
+                  f"  how: {la.decided_by}"]
     for b in la.branches:
         if b.confirmed:
             lines.append(f"  branch of mobility {b.mobility}: closed again at a step of {b.step:g} along it "
                          f"(residual {b.residual:.1e}, {b.deviation:.1e} from the tangent's first-order prediction; "
                          f"infinitesimal mobility there {b.nearby})")
-    for n in la.notes:
+    for n in la.notes if explain else ():
         lines.append(f"  note: {n}")
     return lines
 
@@ -106,14 +108,21 @@ _WHY = {"planar": "the loop is planar", "spherical": "the loop is spherical",
         "overconstrained": "the linkage is overconstrained"}
 
 
-def redundancy_lines(r, title: str = "redundant constraints") -> list:
-    """Text lines naming each joint's redundant wrenches, the rows a QR names, and the suggestion."""
+def redundancy_lines(r, title: str = "redundant constraints", explain: bool = True) -> list:
+    """Text lines naming each joint's redundant wrenches, the rows a QR names, and the suggestion; without
+    ``explain`` one line: how many, at which joints and why (--explain names them and the way out)."""
     if not r.count:
         return []
+    def who(j):
+        return f"{j.what} '{j.joint}'" if j.what in ("connect", "weld", "coupling") else j.joint
+
+    if not explain:
+        where = "; ".join(f"{j.count} at {who(j)} ({_WHY.get(j.why, j.why)})" for j in r.joints)
+        return [f"{title}: {r.count}" + (f", {where}" if where else "") + " (--explain names them"
+                + (" and how to remove them)" if r.suggestion is not None else ")")]
     lines = [f"{title} ({r.count}, the statically indeterminate wrenches):"]
     for j in r.joints:
-        who = f"{j.what} '{j.joint}'" if j.what in ("connect", "weld", "coupling") else j.joint
-        lines.append(f"  {who}: {j.words} -- {_WHY.get(j.why, j.why)}")
+        lines.append(f"  {who(j)}: {j.words} -- {_WHY.get(j.why, j.why)}")
     if r.qr_redundant_rows:
         lines.append("  rows a pivoted QR of K^T puts last (as Chrono removes them): " + ", ".join(r.qr_redundant_rows))
     s = r.suggestion

@@ -174,9 +174,23 @@ def screw_theory_rows(r) -> list:
     return rows
 
 
-def mobility_text(r) -> str:
+def answer_line(r) -> str:
+    """The answer first: M (the effective mobility beside it when links idle), the actuated joints, what the
+    output link can do, the classification."""
+    idle = r.mobility - r.effective_mobility
+    acts = ", ".join(r.actuated)
+    return (f"M = {r.mobility}" + (f" ({r.effective_mobility} effective, {idle} idle)" if idle else "")
+            + (f", actuated by {acts}" if acts else "")
+            + (f"; output link '{r.output.link}' can do {r.output.label}" if r.output is not None else "")
+            + f": {r.classification}")
+
+
+def mobility_text(r, explain: bool = True) -> str:
+    """The text of ``mobility``: the answer first, then the topology, the counts and the screw-theory table;
+    ``explain`` (--explain) adds how the local analysis decided, and names the redundant constraints with the
+    exactly constrained alternative (one line says how many without it)."""
     t = r.topology
-    lines = [topology_text(t, f"Mobility of {r.path}"), ""]
+    lines = [answer_line(r), "", topology_text(t, f"Mobility of {r.path}"), ""]
     lines.append(table(["count", "formula", "value"], count_rows(t)))
     lines.append("")
     rows = screw_theory_rows(r)
@@ -188,9 +202,10 @@ def mobility_text(r) -> str:
     for n in r.notes:
         lines.append(f"note: {n}")
     if r.local is not None:
-        lines += local_lines(r.local, r.local_where)
+        lines += local_lines(r.local, r.local_where, explain)
     if r.redundant is not None and r.redundant.count:
-        lines += redundancy_lines(r.redundant, "redundant constraints at a configuration of the generic rank")
+        lines += redundancy_lines(r.redundant, "redundant constraints at a configuration of the generic rank"
+                                  if explain else "redundant constraints", explain)
     lines.append(f"(assembled from {r.assembly_start}: closure residual {r.residual:.2e} after {r.iterations} "
                  f"iterations; generic rank taken over {r.samples} assembled configurations)")
     return "\n".join(lines)

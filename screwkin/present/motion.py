@@ -9,7 +9,7 @@ from ..tolerances import DEFAULT
 from ..units import in_unit
 from .tables import RateUnits, column_text, fmt_vec, table
 
-__all__ = ["strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "links_table", "points_rows",
+__all__ = ["along_text", "along_line", "strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "links_table", "points_rows",
            "points_table", "motion_dict", "linkage_construction_text"]
 
 
@@ -45,11 +45,26 @@ def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
     if rated:
         head += [f"v origin x y z [{v}]", f"a origin x y z [{a}]"]
         cols += [vectors("velocity", v), vectors("acceleration", a)]
+    along = planar and any("angle_along" in m for m in links.values())
+    if along:  # which side of a ternary link its angle is (the Watt rocker's O4 -> C, not O4 -> B)
+        head.append("angle of the line")
+        cols.append([along_text(links[n].get("angle_along")) for n in names])
     rows = [[n] + [("" if c[i] == "nan" else c[i]) for c in cols] for i, n in enumerate(names)]
-    title = ("absolute link motion (angles from the ground's x axis; omega and alpha about the plane's normal, "
-             "counterclockwise positive; vectors in world axes)" if planar
+    title = (f"absolute link motion (angles from the ground's x axis{' to the line named' * along}; "
+             "omega and alpha about the plane's normal, counterclockwise positive; vectors in world axes)" if planar
              else "absolute link motion (vectors in world axes)")
     return title, head, rows
+
+
+def along_text(along) -> str:
+    """The two points a link's angle is measured along (LinkAngles.along): ``rocker_joint to joint_F``."""
+    return "" if not along else f"{along[0]} to {along[1]}" if along[1] != "x axis" else "its frame's x axis"
+
+
+def along_line(links: dict) -> str:
+    """One line naming the points each turning link's angle is measured along (a sweep's table), '' for none."""
+    parts = [f"{n}: {along_text(m['angle_along'])}" for n, m in links.items() if m.get("angle_along")]
+    return "each link's angle is that of the line " + "; ".join(parts) if parts else ""
 
 
 def links_table(links: dict, units: RateUnits = RateUnits()) -> str:
@@ -124,9 +139,10 @@ def motion_rows_text(res, motion, rows, degrees: bool, units: RateUnits | None =
     """The sweep's absolute quantities at the rows shown: the input (in deg when typed so), each turning
     link's angle [deg] (with ``units``, the rate's units typed: its omega and alpha in them too), each
     slider (loop) coordinate [mm] and each point's position [mm]."""
-    cols, head = [], []
+    cols, head, turning = [], [], {}
     for name, m in motion.links.items():
         if "angle" in m and np.ptp(np.unwrap(m["angle"])) > DEFAULT.equal:  # the link turns
+            turning[name] = m
             head.append(f"{name} [deg]")
             cols.append(column_text(np.degrees(np.asarray(m["angle"]))))
             if units is not None and "omega" in m:
@@ -147,4 +163,5 @@ def motion_rows_text(res, motion, rows, degrees: bool, units: RateUnits | None =
     x = np.degrees(res.values) if degrees else np.asarray(res.values)
     unit = "deg" if degrees else res.unit
     body = [[f"{x[k]:.6g}"] + [c[k] for c in cols] for k in rows]
-    return "absolute motion\n" + table([f"input [{unit}]"] + head, body)
+    along = along_line(turning)
+    return (f"{along}\n" if along else "") + "absolute motion\n" + table([f"input [{unit}]"] + head, body)

@@ -41,8 +41,23 @@ def _nearest_turn(angle, along):
     return float(cand[np.argmin(np.abs(cand - along))])
 
 
+def _rate_scales(units):
+    """The rows' units and factors (SI value x factor = value shown) of a sweep figure: angles in deg and
+    lengths in mm; rates and accelerations in ``units`` (tables.RateUnits: those typed with --rate, as the
+    tables show them), or deg/s and mm/s (per s^2) when None."""
+    if units is None:
+        return [("deg", "mm"), ("deg/s", "mm/s"), ("deg/s²", "mm/s²")]
+    return [("deg", "mm"), (units.rate(False), units.rate(True)),
+            (units.acceleration(False), units.acceleration(True))]
+
+
+def _factor(unit):
+    """The number 1 SI (1 rad/s, 1 m) is written as in ``unit`` ('deg/s²' as 'deg/s^2')."""
+    return in_unit(1.0, unit.replace("²", "^2"))
+
+
 def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute=False,
-                 rate_words=None):
+                 rate_words=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
     in degrees on the left axis, lengths in mm on a right axis of their own (dashed); every
@@ -51,7 +66,9 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     linear: mask of the coordinates that are lengths (``Mechanism.translational``; default: none).
     mus: the transmission angle at each step [rad], drawn in degrees with the joint angles.
     rate_words: what the rates are for (tables.input_rate_words: "at crank 120 rpm"; default "per 1 rad/s
-    of crank" from the sweep's rate), on the rate and acceleration axes and in the title."""
+    of crank" from the sweep's rate), on the rate and acceleration axes and in the title.
+    units: the units of the rates and accelerations (tables.RateUnits, those typed: --rate 120rpm draws rpm
+    and rpm/s, as the tables show them); None: deg/s and mm/s, per s for the accelerations."""
     plt = pyplot("--plot")
     n = len(res.names)
     linear = np.zeros(n, bool) if linear is None or len(linear) != n else np.asarray(linear, bool)
@@ -62,14 +79,14 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     joints = np.array(res.joints, float)
     if joints.ndim == 2 and joints.shape[1] == n and len(joints):
         joints[:, ~linear] = np.unwrap(joints[:, ~linear], axis=0)
-    scale = np.where(linear, 1000.0, 180.0 / np.pi)  # mm, deg
     first = "absolute angle, position" if absolute else "joint value"
     rates_what = "omega, rate" if absolute else "rate"
     rate_words = rate_words or input_rate_words(res.input, Quantity(res.rate), not x_deg)
-    rows = [(first, joints, "deg", "mm"),
-            (f"{rates_what} ({rate_words})", np.asarray(res.rates), "deg/s", "mm/s"),
+    shown = [(a.replace("^2", "²"), b.replace("^2", "²")) for a, b in _rate_scales(units)]
+    rows = [(first, joints, *shown[0]),
+            (f"{rates_what} ({rate_words})", np.asarray(res.rates), *shown[1]),
             (f"{'alpha, acceleration' if absolute else 'acceleration'} ({rate_words})", np.asarray(res.accelerations),
-             "deg/s²", "mm/s²")]
+             *shown[2])]
     if paths:
         fig = plt.figure(figsize=(8, 13))
         grid = fig.add_gridspec(4, 1, height_ratios=[1, 1, 1, 1.4])
@@ -89,6 +106,7 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for r, (what, data, a_unit, l_unit) in enumerate(rows):
         ax = axes[r]
+        scale = np.where(linear, _factor(l_unit), _factor(a_unit))
         handles = []
         twin = ax.twinx() if linear.any() else None
         for k, name in enumerate(res.names):
@@ -158,7 +176,7 @@ def absolute_series(res, motion, linear=None):
 
 
 def motion_figure(res, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
-                  rate_words=None):
+                  rate_words=None, units=None):
     """The figure of a sweep (matplotlib, not yet saved; see :func:`sweep_figure` for what is drawn): for
     a planar mechanism with ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle,
     omega and alpha and the sliders' coordinates, else the joint values; the named points' paths in a
@@ -172,14 +190,14 @@ def motion_figure(res, mus=None, singularities=(), title=None, linear=None, moti
         e1, e2, _ = plane_basis(normal if normal is not None else (0.0, 0.0, 1.0))
         paths = {n: np.asarray(p["position"]) @ np.stack([e1, e2], axis=1) for n, p in motion.points.items()}
     return sweep_figure(res, mus, singularities, title, linear, paths=paths, absolute=absolute is not None,
-                        rate_words=rate_words)
+                        rate_words=rate_words, units=units)
 
 
 def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
-               rate_words=None):
+               rate_words=None, units=None):
     """A sweep into a PNG: :func:`motion_figure`, saved."""
     plt = pyplot("--plot")
-    fig = motion_figure(res, mus, singularities, title, linear, motion, normal, rate_words)
+    fig = motion_figure(res, mus, singularities, title, linear, motion, normal, rate_words, units)
     try:
         write_figure(fig, path, dpi=100)
     finally:

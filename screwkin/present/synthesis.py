@@ -90,6 +90,9 @@ def _core(kind, design, check: Check, file) -> dict:
         "precision": precision,
         "grashof": check.grashof,
         "transmission_angle_range": [math.degrees(mu[0]), math.degrees(mu[1])] if mu else None,
+        # the same range by a name that says what it is over (a design of search.designs has its own, over the
+        # whole motion: transmission_angle_range_over_motion)
+        "transmission_angle_range_between_positions": [math.degrees(mu[0]), math.degrees(mu[1])] if mu else None,
         "defects": list(check.defects),
         "valid": check.valid,
         "check": {"assembled_iterations": check.assembled_iterations, "tolerance": check.tolerance,
@@ -101,9 +104,11 @@ def _core(kind, design, check: Check, file) -> dict:
 def _candidate_dict(k, c) -> dict:
     fb = c.design.fourbar
     u, v, _ = tool_local(fb) if fb.tool is not None else (None, None, None)
+    mu = [_deg(c.transmission[0]), _deg(c.transmission[1])] if c.transmission else None
+    # transmission_angle_range as it always was here, and by the name that tells it from the written design's
+    # (the top level's, between the precision positions): over a whole turn where the crank turns, else its travel
     return {"rank": k + 1, "max_error": c.error, "rms_error": c.rms, "error_unit": "rad" if c.design.kind == "function"
-            else "m", "transmission_angle_range": [_deg(c.transmission[0]), _deg(c.transmission[1])]
-            if c.transmission else None, "grashof": c.grashof, "defects": list(c.defects), "unmet": list(c.unmet),
+            else "m", "transmission_angle_range": mu, "transmission_angle_range_over_motion": mu, "grashof": c.grashof, "defects": list(c.defects), "unmet": list(c.unmet),
             "meets_constraints": c.feasible, "lengths": fb.lengths,
             "pivots": {"A0": _pt(fb.A0), "B0": _pt(fb.B0), "A": _pt(fb.A), "B": _pt(fb.B)},
             "point": None if u is None else [u, v], "run": c.run}
@@ -238,8 +243,8 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
                    f"K1 = {result.K[0]:.9g}, K2 = {result.K[1]:.9g}, K3 = {result.K[2]:.9g}")
         where = "over the range" if np.all(np.isfinite(result.structural_error)) else \
             "where the linkage assembles"
-        out.append(f"structural error: largest {_shown_number(math.degrees(result.max_structural_error), 4)} deg {where}; "
-                   "at the precision points " + ", ".join(f"{math.degrees(e):.2g}" if math.isfinite(e) else "(none)"
+        out.append(f"structural error (the output's miss between the precision points): largest "
+                   f"{_shown_number(math.degrees(result.max_structural_error), 4)} deg {where}; at the precision points " + ", ".join(f"{math.degrees(e):.2g}" if math.isfinite(e) else "(none)"
                                                           for e in result.error_at_points)
                    + " deg")
     elif isinstance(result, PathResult):
@@ -294,7 +299,11 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
         rows.append([t.label, f"{_shown_number(math.degrees(t.input))}", want, "yes" if p.reached else "NO", err,
                      f"{p.residual:.2g}", f"{p.closed_form_error:.2g}" if math.isfinite(p.closed_form_error) else "-",
                      "-" if travel is None else _shown_number(math.degrees(travel), 5)])
-    out.append("  " + table(["position", "crank [deg]", "target", "reached", "error", "residual",
+    # "reached" is at the position itself, within the check's tolerance (the header says it): a function
+    # generator's structural error between the positions is another number, on its own line above
+    within = f"{check.tolerance:.0e} rad" if isinstance(result, FunctionResult) else (
+        f"{check.tolerance:.0e} m" + (" and rad" if any(p.target.kind == "pose" for p in check.precision) else ""))
+    out.append("  " + table(["position", "crank [deg]", "target", f"reached (within {within})", "error", "residual",
                              "vs closed form [m]", "travel [deg]"], rows).replace("\n", "\n  "))
     if isinstance(result, FunctionResult):
         out.append(f"  targets in the angles typed (--input-range, --output-range); the file's crank_joint "
@@ -304,7 +313,11 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
         out += [f"  - {x}" for x in check.defects]
         out.append("not valid: the linkage does not do what was asked as written (see the defects)")
     elif all(p.reached for p in check.precision):
-        out.append("no defect: every precision position is reached, on one branch, in the order given")
+        between = (f"; between them the output is off by up to "
+                   f"{_shown_number(math.degrees(result.max_structural_error), 4)} deg (the structural error)"
+                   if isinstance(result, FunctionResult) else "")
+        out.append(f"no defect: every precision position is reached (within {within}), on one branch, in the order "
+                   f"given{between}")
     else:
         out.append("no defect: the positions are approximated (least squares), on one branch, in the order given")
     return "\n".join(out)
@@ -330,7 +343,8 @@ def chains_dict(result: ChainsResult, directory=None) -> dict:
     defects = [f"chain {f.chain}, chain link {f.ground} grounded: {f.problem}" for f in result.files if f.problem]
     return to_jsonable({
         "kind": "chains", "file": None if directory is None else str(directory), "links": {}, "pivots": {},
-        "precision": [], "grashof": None, "transmission_angle_range": None, "defects": defects,
+        "precision": [], "grashof": None, "transmission_angle_range": None,
+        "transmission_angle_range_between_positions": None, "defects": defects,
         "valid": not defects,
         "chain_links": result.links, "dof": result.dof, "prismatic": result.prismatic, "joints": result.joints,
         "gruebler": f"3({result.links} - 1) - 2 x {result.joints} = {result.dof}",

@@ -11,6 +11,7 @@ import numpy as np
 
 from ...errors import UsageError
 from ...model.geometry import TINY, wrap_angle
+from .symbols import GREEK, spelled
 
 __all__ = ["NewtonStep", "NewtonResult", "textbook_newton", "start_estimates", "differing"]
 
@@ -99,6 +100,9 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
     joint_names = set(mech.coordinate_names)
     for name, typed_value in typed:
         v = typed_value.value
+        as_typed = name
+        if name not in by_link and name not in joint_names:  # θ3 as the text writes it, theta3 as JSON does
+            name = spelled(name)
         if name in loops.input_joints or name in values:
             raise UsageError(f"{mech.path}: '{name}' is an input: give its value with --set")
         if name in loops.unknowns:
@@ -126,8 +130,9 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             joints[name] = v
             continue
         else:
-            valid = ", ".join(list(loops.unknowns) + [lk for lk, n in by_link.items() if n in loops.unknowns])
-            raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{name[:80]}' "
+            valid = ", ".join([f"{n} ({w})" if w != n else n for n, w in ((n, _written(n)) for n in loops.unknowns)]
+                              + [lk for lk, n in by_link.items() if n in loops.unknowns])
+            raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{as_typed[:80]}' "
                              f"(unknowns of the loop equations: {valid}; or passive joint names)")
         units[name] = typed_value
     start = loops.values(solver.set_inputs(q_in, joints)) if joints else {}
@@ -141,6 +146,14 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
                          f"(links {', '.join(loops.symbol_info[n].link for n in missing)})")
     start = {n: symbols.get(n, start.get(n)) for n in loops.unknowns}
     return start, units
+
+
+def _written(name: str) -> str:
+    """A symbol as the text writes it (theta3 -> θ3), the other spelling --start takes."""
+    for word, letter in GREEK:
+        if name.startswith(word) and name[len(word):][:1].isdigit():
+            return letter + name[len(word):]
+    return name
 
 
 def _needed_joints(loops, name):

@@ -9,7 +9,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations"]
+__all__ = ["Symbol", "Vector", "LoopEquation", "PlanarEquations", "GREEK", "spelled"]
+
+#: The symbols' Greek words and the letters the text writes them with (theta3 is written θ3).
+GREEK = (("theta", "θ"), ("alpha", "α"), ("beta", "β"), ("rho", "ρ"))
+
+
+def spelled(name: str) -> str:
+    """A symbol as the equations name it, from either spelling a person may type: ``θ3`` (as the text
+    writes it) -> ``theta3``; ``theta3`` stays."""
+    for word, letter in GREEK:
+        if name.startswith(letter):
+            return word + name[len(letter):]
+    return name
 
 
 @dataclass(frozen=True)

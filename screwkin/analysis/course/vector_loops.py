@@ -230,7 +230,10 @@ class VectorLoops:
         r = self.rep[link]
         name = f"theta{self.numbers[r]}"
         if name not in self.sym:
+            a, b = self.angles.along().get(r, ("", ""))
+            line = f"the line {a} to {b} on it" if b != "x axis" else "its frame's x axis"
             self._new_symbol(name, r, "angle", self.theta_q[r], "unknown",
+                             f"absolute angle of link '{r}' (its link_angles value: {line})" if a else
                              f"absolute angle of link '{r}' (its link_angles value)")
             self.variables.append(name)
         return self.sym[name]

@@ -55,17 +55,20 @@ def moving_links(mech) -> tuple:
     return tuple(out)
 
 
-def link_motions(state, angles=None, normal=None) -> dict:
+def link_motions(state, angles=None, normal=None, along=None) -> dict:
     """Every moving link's absolute motion at a state: ``position`` (and, with rates, ``velocity``,
     ``acceleration``) of its frame origin [m, m/s, m/s^2], ``omega`` and ``alpha`` [rad/s, rad/s^2];
     planar mechanisms (``normal`` given): ``angle`` [rad] from ``angles`` (the vector-loop angles of
-    LinkAngles) and omega, alpha as numbers about the plane's normal, else 3-vectors (world axes)."""
+    LinkAngles) with ``angle_along``, the two points it is measured along (``along``: LinkAngles.along),
+    and omega, alpha as numbers about the plane's normal, else 3-vectors (world axes)."""
     out = {}
     for link in moving_links(state.mech):
         d = state.link_motion(link)
         if normal is not None:
             if angles is not None and link in angles:
                 d["angle"] = angles[link]
+                if along and link in along:
+                    d["angle_along"] = list(along[link])
             if "omega" in d:
                 d["omega"], d["alpha"] = float(d["omega"] @ normal), float(d["alpha"] @ normal)
         out[link] = d
@@ -120,6 +123,7 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
         named = angles.batch(Q) if hasattr(angles, "batch") else {
             link: np.array([a[link] for a in map(angles, Q)]) for link in (angles(Q[0]) if len(Q) else ())}
     out_links = {}
+    along = angles.along() if named is not None and hasattr(angles, "along") else {}
     for link, f in zip(links, link_f):
         i = col[f]
         d = {"position": t[:, i].copy(), "velocity": tw[:, i, :3].copy(), "acceleration": ac[:, i, :3].copy(),
@@ -127,6 +131,8 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
         if normal is not None:
             if named is not None and link in named:
                 d["angle"] = np.asarray(named[link], float)
+                if link in along:
+                    d["angle_along"] = list(along[link])
             d["omega"], d["alpha"] = d["omega"] @ normal, d["alpha"] @ normal
         out_links[link] = d
     pts = {}

@@ -344,6 +344,19 @@ class LinkAngles:
                 out[cut.name] = float(np.arctan2(u @ self.e2, u @ self.e1))
         return out
 
+    def along(self) -> dict:
+        """link name -> (from, to): the two points its angle is measured along, by name -- the joint that
+        carries it (the ground: its first joint), and the joint or loop joint its vector points to, or
+        "x axis" where it is measured by its frame's x axis (no second joint centre on it).  A ternary
+        link's angle is that of one of its sides: the Watt rocker's is along O4 -> the joint it carries in
+        the file, not along O4 -> the loop joint; this names which."""
+        names = self.mech.model.names
+        loops = {f: c.name for c in self.mech.cuts for f in (c.frame1, c.frame2)}
+        def named(ref):
+            kind, i = ref
+            return "x axis" if kind == "axis" else loops.get(i, str(i)) if kind == "frame" else str(names[i])
+        return {link: (named(start), named(end)) for link, (start, end, _) in self.links.items()}
+
     def batch(self, Q) -> dict:
         """link name -> (N,) absolute angles [rad] at every row of Q: __call__ on the stack, from one
         batched forward-kinematics pass (a loop over Q where the tree has joints of two coordinates)."""

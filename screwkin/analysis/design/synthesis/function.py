@@ -231,7 +231,7 @@ def function_result(task, K, d: float | None = None, sigma: float | None = None,
     comment = (f"Four-bar synthesized by screwkin for function generation (Freudenstein): the rocker's angle psi "
                f"follows\ny = {text} for x in [{x0:.9g}, {x1:.9g}] while the crank's angle phi runs through "
                f"[{math.degrees(p0):.9g}, {math.degrees(p1):.9g}] deg,\npsi through [{math.degrees(s0):.9g}, "
-               f"{math.degrees(s1):.9g}] deg (both from the x axis: from the rocker's pivot B0 to the crank's A0).\n"
+               f"{math.degrees(s1):.9g}] deg (both from the x axis: from the rocker's pivot rocker_joint to the crank's crank_joint).\n"
                f"{points} precision points ({spacing} spacing): x = " + ", ".join(f"{x:.9g}" for x in xs)
                + f".\nK1 = {K1:.12g}, K2 = {K2:.12g}, K3 = {K3:.12g}; lengths [m]: ground {L['ground']:.9g}, "
                f"crank {L['crank']:.9g}, coupler {L['coupler']:.9g}, rocker {L['rocker']:.9g}.\n"

@@ -303,7 +303,8 @@ def motion_design(poses, crank: Dyad, rocker: Dyad, name: str = "synthesized_mot
     comment = ("Four-bar synthesized by screwkin for motion generation (rigid-body guidance):\n"
                f"the frame 'coupler_frame' passes through {len(poses)} poses (x y theta, m and deg):\n"
                + "\n".join(f"  {p[0]:.9g} {p[1]:.9g} {math.degrees(p[2]):.9g}" for p in poses)
-               + f"\nFixed pivots A0 = ({fb.A0[0]:.9g}, {fb.A0[1]:.9g}), B0 = ({fb.B0[0]:.9g}, {fb.B0[1]:.9g});"
+               + f"\nFixed pivots: crank_joint at ({fb.A0[0]:.9g}, {fb.A0[1]:.9g}), rocker_joint at ({fb.B0[0]:.9g}, "
+               f"{fb.B0[1]:.9g});"
                f"\nlengths [m]: ground {L['ground']:.9g}, crank {L['crank']:.9g}, coupler {L['coupler']:.9g}, "
                f"rocker {L['rocker']:.9g}.\nDrawn closed at the first pose; actuated: crank_joint.")
     linkage = fourbar_linkage(fb, name, comment, tool="coupler_frame")

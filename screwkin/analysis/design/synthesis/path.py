@@ -206,7 +206,8 @@ def path_design(pts, x, sigma, A, B, P, th, errors, name: str = "synthesized_pat
     comment = ("Four-bar synthesized by screwkin for path generation: the point 'coupler_point' passes through\n"
                + "\n".join(f"  {x_:.9g} {y_:.9g} (crank {math.degrees(t):+.6g} deg, off by {e:.3g} m)"
                            for (x_, y_), t, e in zip(pts, rel, errors))
-               + f"\nFixed pivots A0 = ({A0[0]:.9g}, {A0[1]:.9g}), B0 = ({B0[0]:.9g}, {B0[1]:.9g}); lengths [m]: "
+               + f"\nFixed pivots: crank_joint at ({A0[0]:.9g}, {A0[1]:.9g}), rocker_joint at ({B0[0]:.9g}, {B0[1]:.9g}); "
+               "lengths [m]: "
                f"ground {lengths['ground']:.9g}, crank {lengths['crank']:.9g}, coupler {lengths['coupler']:.9g}, "
                f"rocker {lengths['rocker']:.9g}.\nDrawn closed at the first point; actuated: crank_joint.")
     linkage = fourbar_linkage(fb, name, comment, tool="coupler_point")
