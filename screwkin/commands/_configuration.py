@@ -7,8 +7,10 @@ import math
 import sys
 
 from ..analysis.motion.link_inputs import holding_angles
+from ..analysis.motion.given import unknowns
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.solution import NEWTON_FROM_FILE
 from ..errors import UsageError, quote
 from ..model.topology import open_joints
 from ._options import count
@@ -87,10 +89,23 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     missing = [n for n in inputs if n not in values]
     if missing:
         raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
-    q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
-    for note in res.notes:  # a --near value the mode found lies far from
+    solver = input_solver(mech, inputs, held)
+    if wanted is not None and wanted > 1:
+        if near:
+            raise UsageError(f"--near and --mode {wanted}: give one of them (--near picks the mode nearest a "
+                             "configuration, --mode K the K-th of the list of every mode)")
+        if solver.newton_first() and unknowns(solver).size:
+            print(f"note: --mode {wanted} needs the list of every assembly mode: searching them (homotopy "
+                  "continuation)", file=sys.stderr)
+    q, k, n, res = choose_mode(solver, values, wanted, near, method="nearest")
+    for note in res.notes:  # a --near value the mode found lies far from; every joint given
         print(f"note: {note}", file=sys.stderr)
-    if n > 1:
+    if res.method == NEWTON_FROM_FILE:  # one mode, at once: how many others there are is not known
+        args.mode_chosen = {"index": 1, "of": None, "method": res.method}
+        if not getattr(args, "json", False):
+            print("note: the assembly mode Newton reaches from the file's configuration (no search: --mode K "
+                  "lists every mode and takes the K-th)", file=sys.stderr)
+    elif n > 1:
         args.mode_chosen = {"index": k, "of": n}
         if not getattr(args, "json", False):
             print(f"note: {mode_line(k, n, hasattr(args, 'near'))}", file=sys.stderr)

@@ -29,7 +29,11 @@ def choose_mode(solver, values: dict, k: int | None = None, near: dict | None = 
     ``solver.solve(values, near=near, **options)``'s solutions (default 1: the one nearest the reference
     configuration, or ``near``'s), as (q, k, n, result) with n the modes found and result solve's
     PositionResult.  A usage error when k is more than n.  The one rule every command's ``--mode K`` (and a
-    study's ``mode``) goes by."""
+    study's ``mode``) goes by.  A k over 1 needs the list of every mode: solve searches them (method
+    "auto", whatever ``options`` say), listed from the reference configuration (``near`` is not used: it
+    picks one mode, not a list)."""
+    if k is not None and k > 1:
+        near, options = None, {**options, "method": "auto"}
     res = solver.solve(values, near=near, starts=starts, **options)
     n, k = len(res.solutions), k or 1
     if k > n:
