@@ -137,6 +137,49 @@ def test_default_solve_at_the_file_inputs(name, capsys):
         assert len(d["solutions"]) == 1 and not d["complete"] and "--all" in d["modes"]["reason"]
 
 
+@pytest.mark.parametrize("name", ["gough_stewart_6ups.urdf", "planar_3rpr.urdf", "planar_3rrr.urdf", "tsai_3upu.urdf"])
+def test_default_solve_of_a_platform_is_the_drawn_mode_at_once(name, capsys):
+    """At the file's own input values the mode nearest the drawn configuration is the drawn one: every file's
+    zero configuration closes its loops (robots/README.md), so Newton from it answers every joint 0 -- the
+    whole homotopy is not run (it is --all's), and the answer says so."""
+    inputs, every, _, _ = facts(name)
+    assert all(abs(v) < 1e-12 for v in every.values())  # (the file's assembled configuration is its zero one)
+    code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(inputs), "--json"])
+    d = json.loads(out)
+    assert d["method"] == "newton from the file's configuration" and not d["complete"]
+    assert d["modes"]["found"] == 1 and d["modes"]["certificate"] is None and "--all" in d["modes"]["reason"]
+    (s,) = d["solutions"]
+    assert max(abs(v) for v in s["joints"].values()) < 1e-9 and s["residual"] < 1e-10
+    code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(inputs)])
+    assert "1 assembly mode: the one Newton reaches from the file's configuration (no search; --all" in out
+
+
+def test_default_solve_falls_back_to_the_search_where_newton_fails(monkeypatch):
+    """Newton from the file's configuration made to fail (rssr: a polynomial closure, no dyads): solve says
+    so in a note and searches every mode, as --all does."""
+    import screwkin
+    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.errors import AssemblyError
+
+    mech = screwkin.load(ROBOTS / "rssr.urdf")
+    solver = PositionSolver(mech)
+    drawn = solver.set_inputs(solver.reference(), {"crank_joint": 0.3})
+    real = mech.closure.solve
+
+    def fails_from_the_drawn(q0, frozen=(), tolerances=None, trace=None):
+        if np.array_equal(q0, drawn):
+            raise AssemblyError(mech.path, 1e-3, mech.tolerances.max_iterations)
+        return real(q0, frozen, tolerances, trace)
+
+    monkeypatch.setattr(mech.closure, "solve", fails_from_the_drawn)
+    res = solver.solve({"crank_joint": 0.3}, method="nearest")
+    every = PositionSolver(mech).solve({"crank_joint": 0.3})
+    assert any("Newton from the file's configuration did not converge" in n and "every mode searched" in n
+               for n in res.notes)
+    assert res.method != "newton from the file's configuration" and res.method == every.method
+    assert len(res.solutions) == len(every.solutions) >= 1
+
+
 def test_every_joint_given_that_does_not_close_names_the_gap(capsys):
     """planar_3rpr with leg 1 given 0.01 m longer than the file's closed configuration: the platform rides on
     leg 1 (its wrist is in the tree), so the loops through legs 2 and 3 open at their wrists."""

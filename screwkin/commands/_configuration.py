@@ -7,7 +7,6 @@ import math
 import sys
 
 from ..analysis.motion.link_inputs import holding_angles
-from ..analysis.motion.given import unknowns
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.solution import NEWTON_FROM_FILE
@@ -89,17 +88,16 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     missing = [n for n in inputs if n not in values]
     if missing:
         raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
-    solver = input_solver(mech, inputs, held)
-    if wanted is not None and wanted > 1:
-        if near:
-            raise UsageError(f"--near and --mode {wanted}: give one of them (--near picks the mode nearest a "
-                             "configuration, --mode K the K-th of the list of every mode)")
-        if solver.newton_first() and unknowns(solver).size:
-            print(f"note: --mode {wanted} needs the list of every assembly mode: searching them (homotopy "
-                  "continuation)", file=sys.stderr)
-    q, k, n, res = choose_mode(solver, values, wanted, near, method="nearest")
+    if wanted is not None and wanted > 1 and near:
+        raise UsageError(f"--near and --mode {wanted}: give one of them (--near picks the mode nearest a "
+                         "configuration, --mode K the K-th of the list of every mode)")
+    q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near, method="nearest")
     for note in res.notes:  # a --near value the mode found lies far from; every joint given
         print(f"note: {note}", file=sys.stderr)
+    if wanted is not None and wanted > 1 and res.method == "homotopy search":
+        print(f"note: --mode {wanted} needs the list of every assembly mode: it was searched (homotopy "
+              "continuation; without --mode, Newton answers the mode nearest the file's configuration at once)",
+              file=sys.stderr)
     if res.method == NEWTON_FROM_FILE:  # one mode, at once: how many others there are is not known
         args.mode_chosen = {"index": 1, "of": None, "method": res.method}
         if not getattr(args, "json", False):

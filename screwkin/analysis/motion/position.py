@@ -296,7 +296,7 @@ class PositionSolver:
                                         first_trace=recorder if trace else None)
             first = "newton from --near's configuration" if found else None
         elif method == "nearest" and not trace:  # the mode asked for, at once, where listing every one is not
-            done = self._closed_form(values)
+            done = self._at_once(values)
             if done is None:
                 found, best = self.distinct(mech.closure, [self.set_inputs(self._drawn(), values)], frozen=self.frozen)
                 first = NEWTON_FROM_FILE if found else None
@@ -364,20 +364,13 @@ class PositionSolver:
         ref = self.reference()
         return self.mech.neutral() if ref is None else ref
 
-    def newton_first(self) -> bool:
-        """Whether solve's default (method "nearest") may answer one mode by Newton from the file's
-        configuration: where the search for every mode could be the homotopy -- a polynomial closure.  A
-        closure that is not polynomial keeps its random starts (no homotopy to spare); a mechanism of dyads
-        lists every mode in closed form (``_closed_form``)."""
+    def _at_once(self, values):
+        """solve's default (method "nearest"): every mode where they come at once, as a certified.Search --
+        a closure that is not polynomial (an empty Search: solve's random starts find them, no homotopy to
+        spare), a mechanism of dyads (their closed form, analysis.motion.certified.closed_form) -- or None
+        where only the homotopy would list them (Newton then answers the mode asked for)."""
         mech = self.mech
-        return not algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings)
-
-    def _closed_form(self, values):
-        """Every mode for solve's default where they come at once -- a closure that is not polynomial (its
-        random starts, which solve makes after this empty Search) or a mechanism of dyads (their
-        closed form, analysis.motion.certified.closed_form) -- as a certified.Search; None where only the
-        homotopy would list them (Newton then answers the mode asked for)."""
-        if not self.newton_first():
+        if algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings):
             return certified.Search([], [], None, certified.obstacle(self))
         got = certified.closed_form(self, values) if any(
             not isinstance(cached_plan(self, name), str) for name in self.inputs) else "no dyads"
