@@ -11,7 +11,7 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
-from ..analysis.motion.solution import NEWTON_FROM_FILE, PositionResult
+from ..analysis.motion.solution import NEWTON_FROM_FILE, PositionResult, search_method
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
 from ..analysis.singularities.singular import SingularityReport
@@ -78,7 +78,8 @@ def position_dict(res) -> dict:
             "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes),
             **({"held_angles": res.held} if res.held else {}), **({"modes": modes_dict(res.modes)} if res.modes else {}),
             # how the solutions were found, and whether they are every mode there is
-            "method": res.method, "complete": bool(res.modes is not None and res.modes.complete)}
+            "method": res.method or search_method(res.modes),
+            "complete": bool(res.modes is not None and res.modes.complete)}
 
 
 def modes_dict(c) -> dict:

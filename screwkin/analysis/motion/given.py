@@ -10,8 +10,7 @@ evaluated there (the solver's rows, as model.newton judges convergence):
   metres, its misalignment in radians), and how to let the loops solve for a joint instead.
 
 Where something is unknown and solve's default answers only the mode asked for (Newton from the file's
-configuration, analysis.motion.position), ``first_count`` says so in the counts every solve carries,
-and ``search_method`` names how a search found its modes.
+configuration, analysis.motion.position), ``first_count`` says so in the counts every solve carries.
 """
 
 from __future__ import annotations
@@ -23,7 +22,7 @@ from ...model.cuts import Assembly
 from .certified import ModeCount
 from .solution import NEWTON_FROM_FILE
 
-__all__ = ["unknowns", "given_configuration", "gaps", "first_count", "search_method"]
+__all__ = ["unknowns", "given_configuration", "gaps", "first_count"]
 
 
 def unknowns(solver) -> np.ndarray:
@@ -87,10 +86,3 @@ def first_count(first: str, assembly):
     return ModeCount(1, False, first, 1, None, None, "only the mode asked for was solved, by Newton from the file's "
                      "configuration (no search); --all searches every mode", {"iterations": int(assembly.iterations)})
 
-
-def search_method(count) -> str:
-    """How solve's modes were found, in the words of its JSON "method": "closed form (dyads)", "homotopy
-    search" (with random starts where it did not settle every mode), "random starts" or "no loops"."""
-    if count is None:
-        return "random starts"
-    return "homotopy search" if count.method.startswith("monodromy") else count.method

@@ -45,7 +45,7 @@ from ..mobility import analyze_mobility
 from .links import link_motions, point_motions
 from .turns import engaged, turn_on, whole_turns
 from .planar import LinkAngles, identify
-from .solution import NEWTON_FROM_FILE, PositionResult, Solution, TraceStep
+from .solution import NEWTON_FROM_FILE, PositionResult, Solution, TraceStep, search_method
 from ..singularities.singular import Generic, measures
 
 __all__ = ["PositionSolver"]
@@ -356,7 +356,7 @@ class PositionSolver:
                               0 if done is not None and done.complete else len(start_list), self.free_dofs,
                               tuple(steps), self.output, self._angular, self._angular_coupled(),
                               angular_loop_joints(self.mech), notes, held, count,
-                              first or given.search_method(count))
+                              first or search_method(count))
 
     def _drawn(self):
         """The configuration the values are set on where nothing is searched: the reference (the file's,
