@@ -12,13 +12,19 @@ synthesis task, a grasp) and are not part of the matrix."""
 from __future__ import annotations
 
 import functools
+import itertools
 import json
 import re
 
+from dataclasses import dataclass
+
 import numpy as np
+import pinocchio as pin
 import pytest
 
+import screwkin
 from conftest import ROBOTS
+from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
 from test_robots import TABLE
 
@@ -29,30 +35,32 @@ OUTPUT = {**{name: row["out"] for name, row in TABLE.items()}, "fourbar.urdf.xac
 MECHANISMS = sorted(OUTPUT)
 
 
-@functools.lru_cache(maxsize=None)
-def facts(name):
+@dataclass(frozen=True)
+class Facts:
     """What the matrix needs of a mechanism: its inputs (solve's: the actuated joints, and the joints no loop
-    passes through) at the file's assembled values, every one-coordinate joint's value there, and the output
-    link's position there (a target ik reaches)."""
-    import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    passes through) at the file's assembled values, ``slides`` those that are lengths, every one-coordinate
+    joint's value there, the output link's position there (a target ik reaches: Pinocchio's forward
+    kinematics) and the characteristic length."""
 
+    inputs: dict
+    slides: set
+    every: dict
+    position: np.ndarray
+    length: float
+
+
+@functools.cache
+def facts(name) -> Facts:
     mech = screwkin.load(ROBOTS / name)
     q = mech.generic_configurations()[0].q
     values = mech.joint_values(q)
     solver = PositionSolver(mech)
-    inputs = {n: values[n] for n in (*solver.inputs, *solver.unset)}
-    every = {c.joint: values[c.joint] for c in mech.coordinates if c.nv == 1}
-    import pinocchio as pin
-
+    inputs = {n: float(values[n]) for n in (*solver.inputs, *solver.unset)}
     data = mech.model.createData()
     pin.framesForwardKinematics(mech.model, data, q)
-    position = data.oMf[mech.link_frame(OUTPUT[name])].translation.copy()
-    facts.slides[name] = {n for n in inputs if mech.translational[mech.coordinate(n).idx_v]}
-    return inputs, every, position, mech.length
-
-
-facts.slides = {}  # name -> the inputs that are lengths (a step of 0.01 L, not 0.1 rad)
+    return Facts(inputs, {n for n in inputs if mech.translational[mech.coordinate(n).idx_v]},
+                 {c.joint: float(values[c.joint]) for c in mech.coordinates if c.nv == 1},
+                 data.oMf[mech.link_frame(OUTPUT[name])].translation.copy(), mech.length)
 
 
 def sets(values: dict) -> list:
@@ -105,7 +113,7 @@ def certificates(d, where):
 # ------------------------------------------------------------------ fast: the two regressions of issue 41
 @pytest.mark.parametrize("name", MECHANISMS)
 def test_singularities_with_every_joint_given_answer_there_without_a_search(name, capsys):
-    _, every, _, _ = facts(name)
+    every = facts(name).every
     code, out, err = run(capsys, ["singularities", ROBOTS / name, *sets(every), "--json"])
     assert code == 0, err
     # the values are the file's assembled configuration's: the loops close there, and nothing is searched
@@ -116,7 +124,7 @@ def test_singularities_with_every_joint_given_answer_there_without_a_search(name
 
 @pytest.mark.parametrize("name", MECHANISMS)
 def test_solve_with_every_joint_given_is_that_configuration(name, capsys):
-    _, every, _, _ = facts(name)
+    every = facts(name).every
     code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(every), "--json"])
     assert code == 0, err
     d = json.loads(out)
@@ -128,7 +136,7 @@ def test_solve_with_every_joint_given_is_that_configuration(name, capsys):
 
 @pytest.mark.parametrize("name", MECHANISMS)
 def test_default_solve_at_the_file_inputs(name, capsys):
-    inputs, _, _, _ = facts(name)
+    inputs = facts(name).inputs
     if not inputs:
         pytest.skip("no inputs")
     code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(inputs), "--json"])
@@ -146,15 +154,15 @@ def test_default_solve_of_a_platform_is_the_drawn_mode_at_once(name, capsys):
     """At the file's own input values the mode nearest the drawn configuration is the drawn one: every file's
     zero configuration closes its loops (robots/README.md), so Newton from it answers every joint 0 -- the
     whole homotopy is not run (it is --all's), and the answer says so."""
-    inputs, every, _, _ = facts(name)
+    inputs, every = facts(name).inputs, facts(name).every
     assert all(abs(v) < 1e-12 for v in every.values())  # (the file's assembled configuration is its zero one)
-    code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(inputs), "--json"])
+    _, out, _ = run(capsys, ["solve", ROBOTS / name, *sets(inputs), "--json"])
     d = json.loads(out)
     assert d["method"] == "newton from the file's configuration" and not d["complete"]
     assert d["modes"]["found"] == 1 and d["modes"]["certificate"] is None and "--all" in d["modes"]["reason"]
     (s,) = d["solutions"]
     assert max(abs(v) for v in s["joints"].values()) < 1e-9 and s["residual"] < 1e-10
-    code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(inputs)])
+    _, out, _ = run(capsys, ["solve", ROBOTS / name, *sets(inputs)])
     assert "1 assembly mode: the one Newton reaches from the file's configuration (no search; --all" in out
 
 
@@ -187,7 +195,7 @@ def test_default_solve_falls_back_to_the_search_where_newton_fails(monkeypatch):
 def test_every_joint_given_that_does_not_close_names_the_gap(capsys):
     """planar_3rpr with leg 1 given 0.01 m longer than the file's closed configuration: the platform rides on
     leg 1 (its wrist is in the tree), so the loops through legs 2 and 3 open at their wrists."""
-    _, every, _, _ = facts("planar_3rpr.urdf")
+    every = facts("planar_3rpr.urdf").every
     code, _, err = run(capsys, ["singularities", ROBOTS / "planar_3rpr.urdf", *sets({**every, "leg1": every["leg1"]
                                                                                       + 0.01})])
     assert code == 1
@@ -199,10 +207,11 @@ def commands(name, tmp_path):
     """(command, its arguments after the file) for every command that takes a mechanism file, with the least
     each needs: inputs at the file's values where a command needs them, a load for statics, a target for ik,
     coarse grids for the maps, sweeps and workspaces, files written under tmp_path."""
-    inputs, _, position, length = facts(name)
+    f = facts(name)
+    inputs, position, length = f.inputs, f.position, f.length
     out = OUTPUT[name]
     first = next(iter(inputs), None)
-    step = {n: 0.01 * length if n in facts.slides[name] else 0.1 for n in inputs}
+    step = {n: 0.01 * length if n in f.slides else 0.1 for n in inputs}
     rest = {n: v for n, v in inputs.items() if n != first}
     second = next(iter(rest), None)
     table = [("mobility", []), ("info", []), ("screws", []), ("singularities", []), ("equations", []),
@@ -218,7 +227,7 @@ def commands(name, tmp_path):
         span = ["--from", f"{v!r}", "--to", f"{v + step[first]!r}"]
         table += [("sweep", ["--input", first, *span, "--steps", "3", *sets(rest)]),
                   ("dynamics", ["--input", first, "--speed", "1", "--steps", "4",
-                                *(span if first in facts.slides[name] else []), *sets(rest)])]
+                                *(span if first in f.slides else []), *sets(rest)])]
     if second is not None:
         a, b = inputs[first], inputs[second]
         table.append(("map", ["--x", f"{first}={a!r}:{a + step[first]!r}:3", "--y", f"{second}={b!r}:{b + step[second]!r}:3",
@@ -234,7 +243,7 @@ def commands(name, tmp_path):
 def test_ik_reaches_the_output_where_the_file_puts_it(name, capsys):
     """The output link's position in the file's assembled configuration is reachable: that configuration
     reaches it (a position computed by Pinocchio's forward kinematics, not by the ik under test)."""
-    _, _, position, _ = facts(name)
+    position = facts(name).position
     code, out, err = run(capsys, ["ik", ROBOTS / name, "--output", OUTPUT[name], "--position",
                                   ",".join(f"{float(x)!r}" for x in position), "--json"])
     assert code == 0, err
@@ -259,12 +268,12 @@ def test_every_command_at_the_file_configuration(name, tmp_path, capsys):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", MECHANISMS)
 def test_every_command_with_every_joint_given(name, tmp_path, capsys):
-    _, every, _, _ = facts(name)
+    every = facts(name).every
     for command, args in commands(name, tmp_path):
         if command not in CONFIGURED:
             continue
         # every joint's value in place of the command's own --set values; a swept or mapped input is left out
-        moved = {str(b).split("=")[0] for a, b in zip(args, args[1:]) if a in ("--input", "--x", "--y")}
+        moved = {str(b).split("=")[0] for a, b in itertools.pairwise(args) if a in ("--input", "--x", "--y")}
         run(capsys, [command, ROBOTS / name, *own(args), *sets({n: v for n, v in every.items() if n not in moved})])
 
 
@@ -285,7 +294,7 @@ def own(args):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", MECHANISMS)
 def test_every_command_at_mode_2(name, tmp_path, capsys):
-    inputs, _, _, _ = facts(name)
+    inputs = facts(name).inputs
     if not inputs:
         pytest.skip("no inputs: one configuration")
     code, out, err = run(capsys, ["solve", ROBOTS / name, *sets(inputs), "--all", "--json"])

@@ -80,9 +80,10 @@ def first_count(first: str, assembly):
     """The certified.ModeCount of an answer reached without a search: ``first`` says how -- "every joint
     given" (the one configuration: complete) or Newton from the file's configuration (the mode asked
     for; how many others there are is not known: ``--all`` searches)."""
-    if first == "every joint given":
-        return ModeCount(1, True, first, 1, 0, f"every joint given: the loops close (residual {assembly.residual:.2g}), "
-                         "no search", "", {"residual": float(assembly.residual)})
-    return ModeCount(1, False, first, 1, None, None, "only the mode asked for was solved, by Newton from the file's "
-                     "configuration (no search); --all searches every mode", {"iterations": int(assembly.iterations)})
+    if first == NEWTON_FROM_FILE:
+        return ModeCount(1, False, first, 1, None, None, "only the mode asked for was solved, by Newton from the "
+                         "file's configuration (no search); --all searches every mode",
+                         {"iterations": int(assembly.iterations)})
+    return ModeCount(1, True, first, 1, 0, f"every joint given: the loops close (residual {assembly.residual:.2g}), "
+                     "no search", "", {"residual": float(assembly.residual)})
 

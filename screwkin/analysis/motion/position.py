@@ -300,8 +300,8 @@ class PositionSolver:
             if done is None:
                 found, best = self.distinct(mech.closure, [self.set_inputs(self._drawn(), values)], frozen=self.frozen)
                 first = NEWTON_FROM_FILE if found else None
-                lead = () if found else (f"Newton from the file's configuration did not converge (residual "
-                                         f"{best:.2g}): every mode searched",)
+                lead = () if found else ((f"Newton from the file's configuration did not converge (residual "
+                                          f"{best:.2g}): every mode searched"),)
             else:
                 found = list(done.found)
         start_list = [found[0][1]] if first else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
