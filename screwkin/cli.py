@@ -23,7 +23,7 @@ import numpy as np
 from .commands._common import add_common, add_scaled
 from .commands._output_frame import named_points
 from .commands._values import names_list
-from .commands._options import check_parsed, screwkin_version
+from .commands._options import check_not_read, check_parsed, screwkin_version
 from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
 from .model.loader import load
@@ -122,6 +122,7 @@ def _run(args):
         raise UsageError(f"{args.command} needs a FILE")
     mech = load(args.file, yaml=args.yaml, actuated=names_list(getattr(args, "actuated", None)),
                 package_dirs=args.package_dirs, args=parse_xacro_args(args.xacro_args))
+    check_not_read(args, mech.spec.files_read)  # an output onto an included file, a mesh: only reading finds them
     if getattr(args, "length", None):
         mech.length = parse_length(args.length, "--length")
     if isinstance(getattr(args, "output", None), str):  # every command's output link exists (sweep, draw...)

@@ -118,21 +118,19 @@ class AssemblyError(MechanismFileError):
     as the constraint rows are), after ``iterations`` Newton iterations (of the
     best start), from ``starts`` starting configurations when a search was made;
     ``proved``: no search was made, the lengths prove the loop cannot close and
-    ``residual`` is how far apart its joint stays at least [m]; ``given``: every joint was given,
-    nothing was solved, and ``residual`` is the closure's where the values put it.
+    ``residual`` is how far apart its joint stays at least [m].
     """
 
     def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None,
-                 reason: str | None = None, proved: bool = False, given: bool = False):
+                 reason: str | None = None, proved: bool = False, message: str | None = None):
+        """``message``: the whole message where no search was made at all (a closed form's answer)."""
         self.residual = float(residual)
         self.iterations = int(iterations)
         self.starts = starts
         self.reason = reason
         how = (f"from {starts} starting configurations" if starts and starts > 1
                else f"after {self.iterations} iterations")
-        if given:  # every joint given: nothing was solved, ``residual`` is the closure's where the values put it
-            msg = f"cannot assemble the mechanism: {reason}; the loop-closure residual there is {self.residual:.3g}"
-        elif proved:  # the lengths alone prove it: ``residual`` is the least the loop can stay open, no search made
+        if proved:  # the lengths alone prove it: ``residual`` is the least the loop can stay open, no search made
             msg = (f"cannot assemble the mechanism: {reason}; the loop-closure residual cannot get below "
                    f"{self.residual:.3g} (proved from the lengths: no assembly search)")
         else:
@@ -141,7 +139,7 @@ class AssemblyError(MechanismFileError):
                    f"cannot assemble the mechanism: the loop-closure residual got down to {self.residual:.3g} {how}")
         if detail:
             msg += f" ({detail})"
-        super().__init__(path, msg)
+        super().__init__(path, message or msg)
 
 
 class OutputError(ScrewkinError):

@@ -85,6 +85,10 @@ class Tolerances:
                     to confirm the branch (dimensionless: rad, or characteristic lengths) [-].
     local_starts:   starting directions on the unit sphere of ker K from which the roots of several
                     quadratic forms in three or more variables are refined [-].
+    local_samples:  the local analysis continues the series along at most this many directions sampled
+                    on one tangent space (an irreducible quadric cone on a kernel of dimension d has
+                    about d^2 / 4: 361 for a 40-joint loop folded flat, all continued); beyond, an even
+                    spread of them, and the answer says so (mobility --local-samples N) [-].
     """
 
     closure: float = 1e-10
@@ -119,6 +123,7 @@ class Tolerances:
     local_form: float = 1e-6
     local_step: float = 1e-2
     local_starts: int = 64
+    local_samples: int = 400
 
 
 DEFAULT = Tolerances()

@@ -23,6 +23,13 @@ def readme_fourbar() -> str:
     return section.split("<<'EOF'\n", 1)[1].split("\nEOF\n", 1)[0]
 
 
+@pytest.fixture(autouse=True)
+def _cache_of_the_session(tmp_path_factory, monkeypatch):
+    """The generic solution sets (files/generic_cache.py) go to one folder of the test session, never to
+    the user's cache."""
+    monkeypatch.setenv("SCREWKIN_CACHE", str(tmp_path_factory.getbasetemp() / "screwkin-cache"))
+
+
 @pytest.fixture
 def quiet():
     """A warn callable that collects warnings instead of printing them."""

@@ -163,17 +163,18 @@ def test_monodromy_agrees_with_a_total_degree_homotopy():
 def test_bundled_gough_stewart_planar_hexagons():
     """The bundled 6-UPS has its base and platform points in planes (semi-regular hexagons): at its
     drawn leg lengths 28 complex poses, 8 of them real, below the 40 of a general geometry
-    (Raghavan 1993, Wampler 1996); with base and platform planar the poses come in mirror pairs
-    through the base plane (the reflection keeps every leg length), so the count is even and a
-    real pose's mirror is one too.  Every pose polished to round-off, each reached by 128
-    joint-angle sets; not certified (the count is below the published bound)."""
+    (Raghavan 1993, Wampler 1996) -- and Bertini 2's 28 for this geometry; with base and platform
+    planar the poses come in mirror pairs through the base plane (the reflection keeps every leg
+    length), so the count is even and a real pose's mirror is one too.  Every pose polished to
+    round-off; certified since the architecture's generic solution set has 28 poses, complete by the
+    trace test (issue 41: the count says what it rests on)."""
     mech = screwkin.load(ROBOTS / "gough_stewart_6ups.urdf")
     solver = PositionSolver(mech)
     res = solver.solve({n: 0.0 for n in solver.inputs})
     c = res.modes
-    assert (c.real, c.complex, c.complete) == (8, 20, False)
-    assert "28 poses found of at most 40" in c.reason
-    assert all(s.residual < 1e-12 and s.angle_sets == 128 and not s.singular for s in res.solutions)
+    assert (c.real, c.complex, c.complete) == (8, 20, True)
+    assert "trace test" in c.certificate and c.check["distinct_poses"] == 28
+    assert all(s.residual < 1e-12 and not s.singular for s in res.solutions)
     # the mirror pairs: reflect each real pose's platform through z = 0
     poses = []
     for s in res.solutions:

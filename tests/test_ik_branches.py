@@ -72,9 +72,16 @@ def test_pose_text_and_json_say_all_of_them():
     assert [leg["at_most"] for leg in d["branches"]["legs"]] == [2, 2, 2]
 
 
-@pytest.mark.slow  # about 1.4 s on 2 shared cores: out of the fast subset
-def test_serial_arm_has_no_bound_and_says_not_exhaustive():
+def test_serial_arm_with_a_spherical_wrist_is_answered_in_closed_form_every_solution():
+    """arm_6r's last three axes meet: Pieper's closed form lists every real joint solution, the rest
+    counted complex (8 in all), each placing the flange at the pose by Pinocchio's forward kinematics."""
     m = screwkin.load(ROBOTS / "arm_6r.urdf")
-    res = inverse_kinematics(m, "flange", pin.SE3(np.eye(3), np.array([0.3, 0.0, 0.3])))
+    pose = pin.SE3(np.eye(3), np.array([0.3, 0.0, 0.3]))
+    res = inverse_kinematics(m, "flange", pose)
     count = branches(m, res)
-    assert count.at_most is None and not count.complete
+    assert res.modes.method == "closed form (Pieper)" and count.complete
+    assert res.modes.real == len(res.solutions) and res.modes.real + res.modes.complex == 8
+    data = m.model.createData()
+    for s in res.solutions:
+        pin.framesForwardKinematics(m.model, data, s.q)
+        assert np.linalg.norm(pin.log6(data.oMf[m.link_frame("flange")].inverse() * pose).vector) < 1e-10

@@ -305,12 +305,14 @@ def test_mobility_and_singularities_at_a_given_configuration(capsys):
     assert "Zlatanov-Bonev-Gosselin: constraint singularity" in out and "a change point" in out
 
 
-def test_sweep_names_the_change_point_and_the_branch_it_takes(capsys):
+@pytest.mark.parametrize("branch", ["continue", "other"])
+def test_sweep_names_the_change_point_and_the_branch_it_takes(capsys, branch):
     """The four-bar drawn as a parallelogram at 0.5 rad, swept to -1 (the crank through 0, the folded pose
     at input -0.5): the constraint measure dips to 0 there without a sign change; the sweep lists it as a
-    change point and says it comes in on the parallelogram (1, -1, 1) and goes on along the other branch."""
+    change point and says it comes in on the parallelogram (1, -1, 1) and goes on along it (issue 41: the
+    branch whose tangent continues the motion), or, with --branch other, along the other one (1, -3, -3)."""
     assert main(["sweep", str(FOURBAR), *FOLDED_ARGS, "--arg", "theta=0.5", "--input", "crank_joint", "--from", "0",
-                 "--to", "-1", "--steps", "21", "--singularities", "--json"]) == 0
+                 "--to", "-1", "--steps", "21", "--singularities", "--branch", branch, "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     points = [s for s in d["singularities"] if s.get("local")]
     assert len(points) == 1
@@ -319,7 +321,9 @@ def test_sweep_names_the_change_point_and_the_branch_it_takes(capsys):
     came = p["local"]["branches"][p["came_on_branch"] - 1]["tangent"]
     goes = p["local"]["branches"][p["continues_on_branch"] - 1]["tangent"]
     assert np.allclose(list(came.values()), [1, -1, 1], atol=1e-6)
-    assert np.allclose(list(goes.values()), [1, -3, -3], atol=1e-6)
+    assert np.allclose(list(goes.values()), [1, -1, 1] if branch == "continue" else [1, -3, -3], atol=1e-6)
+    (named,) = d["change_points"]
+    assert abs(named["input"] + 0.5) < 1e-6 and named["branch"] == branch
 
 
 def test_a_sliding_contact_is_said_undecided_beyond_order_one_not_guessed():

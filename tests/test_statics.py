@@ -165,3 +165,48 @@ def test_statics_command(capsys):
     assert "fx fy fz mx my mz" in capsys.readouterr().err
     assert main(["statics", str(ROBOTS / "bennett.urdf"), "--output", "link3", "--wrench", "1 2 3 0 0 0"]) == 0
     assert "not determined by statics" in capsys.readouterr().out
+
+
+ARM_SHOULDER_ONLY = """<robot name="arm2r">
+  <link name="base"/><link name="upper"/><link name="fore"/><link name="hand"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.4 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="wrist" type="fixed"><parent link="fore"/><child link="hand"/><origin xyz="0.25 0 0"/></joint>
+  <transmission name="t"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="shoulder"><hardwareInterface>EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m"><mechanicalReduction>1</mechanicalReduction></actuator></transmission>
+</robot>"""
+
+
+def test_no_equilibrium_shows_no_reactions_as_a_solution(tmp_path, capsys):
+    """Issue 43 item 4: a moment about z on the hand of a 2R arm whose elbow is passive: the elbow's generalized
+    force (J^T w)_elbow = m_z = 2 N m has nothing to balance it, so there is no equilibrium, and the
+    least-squares fit's reaction table (a 2 N m torque about the passive elbow's own axis) was printed as one."""
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM_SHOULDER_ONLY)
+    args = ["statics", str(path), "--set", "shoulder=0.3", "--set", "elbow=1.1", "--output", "hand",
+            "--wrench", "0 0 0 0 0 2"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "NO EQUILIBRIUM" in out and "unbalanced generalized force 2" in out
+    assert "joint reactions:" not in out and "fx [N]" not in out  # no reaction table
+    assert "actuator  effort" not in out and "-2 N m" not in out  # nor the fit's efforts
+    assert main(args + ["--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["equilibrium"] is False and d["least_squares_residual"] == pytest.approx(2.0, abs=1e-12)
+    assert d["solution"].startswith("none") and "least-squares fit" in d["solution"]
+    assert d["reactions"] and d["efforts"]  # kept, flagged by "solution"
+    # the elbow actuated too: an equilibrium (efforts 2 and 2 N m, J^T w), its tables shown
+    elbow = ('<transmission name="t2"><type>transmission_interface/SimpleTransmission</type><joint name="elbow">'
+             '<hardwareInterface>EffortJointInterface</hardwareInterface></joint><actuator name="m2">'
+             '<mechanicalReduction>1</mechanicalReduction></actuator></transmission>\n</robot>')
+    path.write_text(ARM_SHOULDER_ONLY.replace("</robot>", elbow))
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "NO EQUILIBRIUM" not in out and "joint reactions:" in out and "actuator  effort" in out
+    assert main(args + ["--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["equilibrium"] is True and d["least_squares_residual"] is None and d["solution"] == "equilibrium"
+    assert [abs(d["efforts"][n]) for n in ("shoulder", "elbow")] == pytest.approx([2.0, 2.0], abs=1e-12)

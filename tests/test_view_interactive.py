@@ -370,3 +370,54 @@ def test_view_interactive_takes_a_serial_arms_joints_as_its_inputs():
     live = Interactive(mech, open_joints(mech), values={"joint2": 0.3})
     assert live.state.inputs["joint2"] == 0.3 and live.state.inputs["joint1"] == 0.0
     assert "joint1 = 0 deg (the file's value)" in live.opened and "joint2 = 17.1887 deg," in live.opened
+
+
+class _Camera:
+    """A browser's camera as viser's handle reports it, recording what the view sets."""
+
+    def __init__(self, size, position, fov=math.radians(75.0)):
+        self.image_width, self.image_height = size
+        self.position, self.fov, self.set = np.asarray(position, float), fov, []
+        self.look_at = self.up_direction = None
+
+    def __setattr__(self, name, value):
+        if name == "position" and hasattr(self, "set"):
+            self.set.append(np.asarray(value, float))
+        object.__setattr__(self, name, value)
+
+    def browser(self, width, position):
+        """The browser's next report: its view's width and where its camera is."""
+        object.__setattr__(self, "image_width", width)
+        object.__setattr__(self, "position", np.asarray(position, float))
+
+
+class _Client:
+    def __init__(self, camera):
+        import contextlib
+
+        self.camera, self.atomic = camera, contextlib.nullcontext
+        camera.on_update = lambda callback: setattr(self, "report", callback)
+
+
+def test_the_view_is_framed_for_each_browser_report_until_the_person_moves_it(page):
+    """Issue 43 item 2: the first camera report raised KeyError: 'dist' and nothing was framed.  The reports are
+    those Chromium sent (tests/test_view_interactive_chromium.py): the whole window at viser's default camera, then
+    the view beside the docked panel at the first view's position (the browser applied it after the first framing):
+    each is framed with fit_camera for its aspect; a camera elsewhere was moved by the person and is kept."""
+    from screwkin.present.camera import fit_camera
+
+    cam = _Camera((1400, 417), (3.0, 3.0, 3.0))
+    client = _Client(cam)
+    page._frame_client(client)
+    client.report(cam)
+    expected = fit_camera(page._points, page._direction, fov_deg=75.0, aspect=1400 / 417)[1]
+    assert len(cam.set) == 1 and np.allclose(cam.set[-1], expected)
+    cam.browser(1076, page._first[0])  # the first view, reported with the width of the view beside the panel
+    client.report(cam)
+    expected = fit_camera(page._points, page._direction, fov_deg=75.0, aspect=1076 / 417)[1]
+    assert len(cam.set) == 2 and np.allclose(cam.set[-1], expected)
+    client.report(cam)  # there, and the same size: nothing to do
+    assert len(cam.set) == 2
+    cam.browser(900, np.asarray(cam.position) + 0.2 * page._first[1])  # moved by the person, and the window resized
+    client.report(cam)
+    assert len(cam.set) == 2

@@ -197,3 +197,106 @@ def test_the_interactive_page_as_a_person_sees_it(tmp_path):
         margin = 0.05 * width
         assert uv[:, 0].min() - margin <= xs.min() and xs.max() <= uv[:, 0].max() + margin, link
         assert uv[:, 1].min() - margin <= ys.min() and ys.max() <= uv[:, 1].max() + margin, link
+
+
+NOTICES = """JSON.stringify(Array.from(document.querySelectorAll('[class*="Notification-root"]'))
+  .map(e => e.getBoundingClientRect()).map(r => [r.left, r.top, r.right, r.bottom]))"""
+
+
+def _painted_box(image, rects, scale, colours, notices=()):
+    """The box (x0, y0, x1, y1; the 3-D view's pixels) of the pixels painted in the links' colours, outside
+    ``notices`` (the page's rectangles over the view: viser's "Software WebGL" card has an orange edge)."""
+    image = image.copy()
+    for r in notices:
+        x0, y0, x1, y1 = (int(round(v * scale)) for v in r)
+        image[max(y0, 0):y1 + 1, max(x0, 0):x1 + 1] = 255
+    left, top, right, bottom = (int(round(v * scale)) for v in rects["canvas"])
+    view_pixels = image[top:bottom, left:right]
+    near = np.zeros(view_pixels.shape[:2], bool)
+    for rgba in colours:
+        rgb = np.array(rgba[:3], float) * (255 if max(rgba[:3]) <= 1 else 1)
+        near |= np.abs(view_pixels - rgb).sum(axis=2) < 60
+    corner = int(90 * scale)  # viser's orientation gizmo in the view's lower left corner
+    near[-corner:, :corner] = False
+    ys, xs = np.nonzero(near)
+    assert len(xs) > 100, "no link painted"
+    return np.array([xs.min(), ys.min(), xs.max(), ys.max()], float)
+
+
+def test_the_command_frames_the_mechanism_for_the_browser_without_a_traceback(tmp_path):
+    """Issue 43 item 2: `view --interactive` raised KeyError: 'dist' at each camera report of the browser (a
+    traceback on the command's stderr), and the re-framing for the browser's view never ran: the mechanism stayed
+    framed for a square view.  The command is run as a user runs it, its page opened in a wide window (the view
+    twice as wide as high, where the two framings differ), photographed, and the command stopped: its stderr holds
+    no traceback, and the links are painted where the framing for the browser's view puts them."""
+    pytest.importorskip("viser")
+    pytest.importorskip("websockets.sync.client")
+    import os
+    import select
+    import signal
+    import sys
+    from types import SimpleNamespace
+
+    from PIL import Image
+
+    from screwkin.present.camera import fit_camera
+    from screwkin.present.interactive import CANVAS_ASPECT
+    from screwkin.present.view import build_scene
+    from screwkin.present.viewplanar import link_colours, planar_basis
+
+    path = tmp_path / "fourbar.urdf"
+    path.write_text(FOURBAR)
+    port = _free_port()
+    err_file = open(tmp_path / "stderr.txt", "w+")
+    proc = subprocess.Popen([sys.executable, "-m", "screwkin", "view", str(path), "--interactive", "--port", str(port)],
+                            stdout=subprocess.PIPE, stderr=err_file, text=True, start_new_session=True)
+    browser = None
+    try:
+        for _ in range(300):  # its line (at most 300 waits of a second)
+            assert proc.poll() is None, (tmp_path / "stderr.txt").read_text()
+            if select.select([proc.stdout], [], [], 1.0)[0] and proc.stdout.readline().startswith("interactive view:"):
+                break
+        browser = DevTools(tmp_path / "profile", size=(1400, 560))
+        browser.call("Page.enable")
+        browser.call("Page.navigate", url=f"http://127.0.0.1:{port}")
+        deadline = time.monotonic() + 90
+        rects = {}
+        while time.monotonic() < deadline and not (rects.get("canvas") and all(rects.get(w) for w in LABELS)):
+            time.sleep(0.5)
+            rects = json.loads(browser.evaluate(RECTS % json.dumps(LABELS)) or "{}")
+        assert rects.get("canvas") and all(rects.get(w) for w in LABELS), rects
+        time.sleep(4.0)  # the camera reports sent, the view framed for them, and a few frames drawn
+        rects = json.loads(browser.evaluate(RECTS % json.dumps(LABELS)))
+        notices = json.loads(browser.evaluate(NOTICES))
+        png = base64.b64decode(browser.call("Page.captureScreenshot", format="png")["data"])
+    finally:
+        if browser is not None:
+            browser.close()
+        os.killpg(proc.pid, signal.SIGTERM)
+        out, _ = proc.communicate(timeout=60)
+    err_file.seek(0)
+    err = err_file.read()
+    err_file.close()
+    assert proc.returncode == 0 and "stopped by SIGTERM" in out, (out, err)
+    assert "Traceback" not in err and "Error" not in err, err
+
+    (tmp_path / "interactive.png").write_bytes(png)
+    image = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    scale = rects["size"][2]
+    width, height = (int(round((rects["canvas"][k + 2] - rects["canvas"][k]) * scale)) for k in (0, 1))
+    mech = screwkin.load(path)
+    q = Interactive(mech).state.q
+    scene = build_scene(mech, q)
+    basis = planar_basis(mech, q)
+    painted = _painted_box(image, rects, scale, link_colours(mech, q).values(), notices)
+
+    def predicted(aspect):  # where the mechanism is drawn with a camera framed for a view of this aspect
+        target, eye = fit_camera(scene.points, basis[2], fov_deg=75.0, aspect=aspect)  # (viser's field of view)
+        cam = SimpleNamespace(position=eye, look_at=target, up_direction=basis[1], fov=math.radians(75.0))
+        uv = _project(scene.points, cam, width, height)
+        return np.array([*uv.min(axis=0), *uv.max(axis=0)])
+
+    framed, square = predicted(width / height), predicted(CANVAS_ASPECT)
+    assert width / height > 1.8  # a wide view ...
+    assert np.abs(framed - square).max() > 0.1 * width  # ... where the two framings differ
+    assert np.abs(painted - framed).max() < 0.04 * width, (painted, framed, square)  # framed for the browser

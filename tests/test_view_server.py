@@ -156,3 +156,80 @@ def test_a_bad_port_number_is_a_usage_error(text, capsys):
 
     assert main(["view", FILE, "--port", text]) == 2
     assert "--port" in capsys.readouterr().err
+
+
+class _SignalAfterLine:
+    """sys.stdout that sends ``sig`` to this process as soon as the serving line (``ready``) has been
+    written: the signal arrives between saying where the page is and waiting, every time (issue 43 item 1:
+    under load it exited 130 without its "stopped by" line)."""
+
+    def __init__(self, sig, ready):
+        self.sig, self.ready, self.text = sig, ready, ""
+
+    def write(self, text):
+        self.text += text
+        if text.startswith(self.ready):
+            os.kill(os.getpid(), self.sig)
+        return len(text)
+
+    def flush(self):
+        pass
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
+def test_a_signal_right_after_the_serving_line_stops_cleanly(sig, monkeypatch):
+    from screwkin.cli import main
+
+    previous = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
+    port = free_port()
+    out = _SignalAfterLine(sig, "meshcat: ")
+    monkeypatch.setattr(sys, "stdout", out)
+    assert main(["view", FILE, "--port", str(port)]) == 0
+    assert f"stopped by {sig.name}: the meshcat server on port {port} is closed" in out.text
+    assert port_is_free(port)
+    assert {s: signal.getsignal(s) for s in previous} == previous  # the handlers given back
+    assert signal.set_wakeup_fd(-1) == -1  # and no wakeup descriptor left behind
+
+
+def test_a_signal_right_after_the_interactive_line_stops_cleanly(monkeypatch):
+    pytest.importorskip("viser")
+    from screwkin.cli import main
+
+    port = free_port()
+    out = _SignalAfterLine(signal.SIGTERM, "interactive view: ")
+    monkeypatch.setattr(sys, "stdout", out)
+    assert main(["view", FILE, "--interactive", "--port", str(port)]) == 0
+    assert f"stopped by SIGTERM: the server on port {port} is closed" in out.text
+    assert port_is_free(port)
+
+
+@pytest.mark.slow
+def test_signals_right_after_the_line_under_load_stop_cleanly():
+    """The README's test command on a loaded machine: `screwkin view` in a session of its own, signalled the
+    moment its line is read, six times (each signal twice) beside a process that keeps a CPU busy."""
+    hog = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        for sig in [signal.SIGTERM, signal.SIGHUP, signal.SIGINT] * 2:
+            port = free_port()
+            proc = subprocess.Popen([sys.executable, "-m", "screwkin", "view", FILE, "--port", str(port)],
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                    start_new_session=True)
+            out = ""
+            for line in proc.stdout:  # (bounded: the command ends, or is killed below after 120 s)
+                out += line
+                if line.startswith("meshcat: "):
+                    proc.send_signal(sig)
+                    break
+            try:
+                rest, err = proc.communicate(timeout=120)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                pytest.fail(f"screwkin view did not end after {sig.name}")
+            assert proc.returncode == 0, (sig.name, out + rest, err)
+            assert f"stopped by {sig.name}: the meshcat server on port {port} is closed" in out + rest
+            assert "Traceback" not in err
+            wait_free(port, proc.pid)
+            assert not group_alive(proc.pid)
+    finally:
+        hog.kill()
+        hog.wait()

@@ -267,11 +267,7 @@ def _continue(system, x, Ainv, N, U, order, tol, lookahead=True):
             t0 = s.copy()
             t0.push(base)
             r0 = U.T @ t0.residual()
-            M = np.zeros((U.shape[1], N.shape[1]))
-            for j in range(N.shape[1]):
-                tj = s.copy()
-                tj.push(base + N[:, j])
-                M[:, j] = U.T @ tj.residual() - r0
+            M = U.T @ t0.residual_change(N)  # (the next residual is affine in X[k]: exact, one pass for all of N)
             base = base + N @ np.linalg.lstsq(M, -r0, rcond=None)[0]
         s.push(base)
     return None, s.X, residuals
@@ -315,10 +311,12 @@ def _confirm(mech, q0, system, X, B, h):
     return q, deviation, norm
 
 
-def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
+def local_analysis(mech, q, inputs=None, generic_rank=None, progress=None) -> LocalAnalysis:
     """The local analysis of ``mech`` at the assembled configuration q (see the module docstring);
     inputs: the joints held for ``inputs_held`` (default the actuated ones); generic_rank: the rank of
-    K at generic configurations (default: the largest over mech.generic_configurations())."""
+    K at generic configurations (default: the largest over mech.generic_configurations()); progress: a
+    callable progress(done, total) told of each tangent direction whose series is continued (the long part
+    of a long loop at a singular point; at most Tolerances.local_samples a tangent space)."""
     tol = mech.tolerances
     inputs = tuple(mech.actuated if inputs is None else inputs)
     nv = mech.nv
@@ -409,16 +407,23 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
                    "configuration")
         return LocalAnalysis(**base, finite_mobility=0, kind="shaky", order=2, checked_order=2,
                              certain=not sampled, decided_by=how, branches=(), notes=tuple(notes))
+    candidates, thinned = _at_most_samples(candidates, max(int(tol.local_samples), 1))
+    if thinned:
+        notes.append(thinned)
     branches, failed = [], []
+    total, done = sum(len(c.samples) for c in candidates), 0
     for cand in candidates:
         reached, X0 = order_max, None
         for y in cand.samples:
             fail, X, _ = _continue(system, N @ y, Ainv, N, U, order_max, tol, lookahead=c2 > 0)
+            done += 1
+            if progress is not None:
+                progress(done, total)
             if X0 is None:
                 X0 = X
             if fail is not None:
                 reached = min(reached, fail - 1)
-                if y is cand.samples[0]:
+                if y is cand.samples[0] or reached <= 1:  # (no later sample can stop it earlier than order 2)
                     break
         if reached < order_max and cand.samples:
             failed.append((cand, reached + 1))
@@ -426,6 +431,26 @@ def local_analysis(mech, q, inputs=None, generic_rank=None) -> LocalAnalysis:
         branch = _branch(mech, q, system, N, cand, X0, order_max)
         branches.append(branch)
     return _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled)
+
+
+def _at_most_samples(candidates, cap):
+    """The candidates with at most ``cap`` samples each (an irreducible quadric cone on a kernel of dimension d
+    has up to d^2 / 4 sampled generators, each continued at a cost growing with d: a 40-joint loop folded flat
+    has 361), spread evenly over the list and always its first; and the note that says so (None when
+    nothing was left out)."""
+    out, left = [], []
+    for c in candidates:
+        if len(c.samples) <= cap:
+            out.append(c)
+            continue
+        keep = sorted(set(np.linspace(0, len(c.samples) - 1, cap).round().astype(int).tolist()))
+        out.append(_Candidate(c.T, [c.samples[k] for k in keep], c.linear, c.regular))
+        left.append((len(keep), len(c.samples)))
+    if not left:
+        return out, None
+    kept, of = sum(k for k, _ in left), sum(n for _, n in left)
+    return out, (f"the series was continued along {kept} of the {of} directions sampled on the tangent cone (sampled, "
+                 f"at most {cap} a tangent space: Tolerances.local_samples, mobility --local-samples N raises it)")
 
 
 def _mixes(d, count=2, seed=0):

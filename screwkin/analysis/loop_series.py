@@ -43,7 +43,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..model.cuts import ContactRow
-from ..model.geometry import perpendicular_basis
+from ..model.geometry import cross_last, perpendicular_basis
 from ..model.state import KinematicState
 from .screws import cut_twists
 
@@ -58,7 +58,7 @@ SEQUENTIAL_JOINTS = ("JointModelUniversal", "JointModelSphericalZYX")
 def ad(W, S):
     """ad_W S for twists (v, w) in the last axis of W and S (arrays (..., 6))."""
     vW, wW, vS, wS = W[..., :3], W[..., 3:], S[..., :3], S[..., 3:]
-    return np.concatenate([np.cross(wW, vS) + np.cross(vW, wS), np.cross(wW, wS)], axis=-1)
+    return np.concatenate([cross_last(wW, vS) + cross_last(vW, wS), cross_last(wW, wS)], axis=-1)
 
 
 @dataclass(frozen=True)
@@ -161,6 +161,22 @@ class Series:
             self.S.append(self._next_screws())
         P = sum(self.S[l] * self._y(k - l)[:, None] for l in range(1, k + 1))
         return self.sys.coupled(self.sys.stack(P), np.zeros(self.sys.columns))
+
+    def residual_change(self, V) -> np.ndarray:
+        """(rows, m): how residual() changes when the last X pushed, X[j] (j = len(X) - 1 >= 1), changes
+        by each column of V (columns, m).  R_{j+1} is affine in X[j]: X[j] enters it only through
+        S[1] y[j] and through S[j+1] y[0], whose term ad(W[j], S[0]) / (j + 1) holds W[j]'s
+        carriers @ (S[0] y[j]); so this is exact, the difference of two residuals without computing them."""
+        j = len(self.X) - 1
+        if j < 1:
+            raise ValueError("residual_change needs X[1] or later pushed")
+        sys_ = self.sys
+        Y = (sys_.multiplier[:, None] * np.asarray(V, float)[sys_.column]).T  # (m, units)
+        S0, S1 = self.S[0], self.S[1]
+        W = np.einsum("uw,mwi->mui", sys_.carriers, S0[None] * Y[:, :, None])
+        D = S1[None] * Y[:, :, None] + ad(W, S0[None]) * (self._y(0)[None, :, None] / (j + 1))
+        zero = np.zeros(sys_.columns)
+        return np.stack([sys_.coupled(sys_.stack(d), zero) for d in D], axis=1)
 
     def push(self, xk) -> None:
         """Take X[k] = xk for the next order k."""

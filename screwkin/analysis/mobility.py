@@ -289,18 +289,18 @@ def _classification(n, m, eff, overconstraint, topo, M):
 
 
 def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False, at=None,
-                     suggest: bool = False, names: bool = False) -> MobilityResult:
+                     suggest: bool = False, names: bool = False, progress=None) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
     its origin as a point (3 translations) instead of its full motion.  The mobility reported is the
     finite mobility at the configuration ``at`` (default: where the assembly search first closed the
     loops, the file's configuration when it closes them), decided by analysis.local, with the generic
     rank as its check (``generic_mobility``); with ``names`` the redundant constraints by name
     (analysis.redundancy, ``redundant``), with ``suggest`` also the joints that make the model exactly
-    constrained.  Kept in ``mech.cache``."""
+    constrained.  Kept in ``mech.cache``.  progress: told of the local analysis' work (analysis.local)."""
     key = ("mobility", tuple(mech.actuated), output, seed, point,
            None if at is None else np.asarray(at, float).tobytes(), suggest, names)
     if key not in mech.cache:
-        mech.cache[key] = _analyze(mech, output, seed, point, at, suggest, names)
+        mech.cache[key] = _analyze(mech, output, seed, point, at, suggest, names, progress)
     return mech.cache[key]
 
 
@@ -316,7 +316,7 @@ def _local_notes(local, where, M_generic, generic_rank, samples):
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech, output, seed, point, at=None, suggest=False, names=False) -> MobilityResult:
+def _analyze(mech, output, seed, point, at=None, suggest=False, names=False, progress=None) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)
@@ -359,7 +359,7 @@ def _analyze(mech, output, seed, point, at=None, suggest=False, names=False) -> 
     where = ("the configuration given" if at is not None else assembly.start if own else
              "an assembled configuration of the generic rank")
     local_where = where
-    local = local_analysis(mech, where_q, generic_rank=rk)
+    local = local_analysis(mech, where_q, generic_rank=rk, progress=progress)
     if local.finite_mobility is not None:
         M = local.finite_mobility
         idle_total = min(idle_total, M)

@@ -10,12 +10,14 @@ from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
 from ..analysis.motion.solution import NEWTON_FROM_FILE
+from ..analysis.motion.sweep import BRANCHES
 from ..errors import UsageError, quote
 from ..model.topology import open_joints
 from ._options import count
 from ._values import joint_assignments, split_inputs
 
-__all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "input_solver",
+__all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "add_branch_option",
+           "input_solver",
            "configuration", "mode_line", "file_configuration_line", "near_values", "with_mode", "moved_not_set"]
 
 
@@ -50,6 +52,14 @@ def add_mode_option(sp, at: str = "the --set inputs"):
                          "file's configuration)")
 
 
+def add_branch_option(sp, what: str = "the motion"):
+    """--branch continue|other: what a motion does at a change point (analysis.motion.sweep's branch)."""
+    sp.add_argument("--branch", choices=BRANCHES, default=BRANCHES[0],
+                    help=f"at a change point of {what} (branches of the motion cross: a parallelogram four-bar "
+                         "folding flat), go on along the branch whose tangent continues the motion (continue, the "
+                         "default: the parallelogram stays a parallelogram) or along the other one (other)")
+
+
 def input_solver(mech, inputs, held: dict | None = None, output=None) -> PositionSolver:
     """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
     ``held`` links' angles held by their loop equations (a copy of the mechanism:
@@ -73,7 +83,7 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     values.update(moved or {})
     near = near_values(mech, args)
     wanted = getattr(args, "mode", None)
-    args.mode_chosen = None
+    args.mode_chosen = args.continuum = None
     if not values and not held:
         if wanted not in (None, 1):
             raise UsageError(f"--mode {wanted}: the file's own configuration is one mode; give --set values to "
@@ -92,8 +102,10 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
         raise UsageError(f"--near and --mode {wanted}: give one of them (--near picks the mode nearest a "
                          "configuration, --mode K the K-th of the list of every mode)")
     q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near, method="nearest")
-    for note in res.notes:  # a --near value the mode found lies far from; every joint given
+    for note in res.notes:  # a --near value the mode found lies far from; a continuum's sample; every joint given
         print(f"note: {note}", file=sys.stderr)
+    if res.free_dofs:
+        args.continuum = {"free_dofs": res.free_dofs}
     if wanted is not None and wanted > 1 and res.method == "homotopy search":
         print(f"note: --mode {wanted} needs the list of every assembly mode: it was searched (homotopy "
               "continuation; without --mode, Newton answers the mode nearest the file's configuration at once)",
@@ -147,9 +159,12 @@ def near_values(mech, args) -> dict | None:
 
 
 def with_mode(args, d: dict) -> dict:
-    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes."""
+    """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes, with
+    "continuum": {"free_dofs"} when it was a sample of a continuum the inputs leave (no modes then)."""
     if getattr(args, "mode_chosen", None):
         d["mode"] = args.mode_chosen
+    if getattr(args, "continuum", None):
+        d["continuum"] = args.continuum
     return d
 
 

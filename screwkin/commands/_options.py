@@ -22,7 +22,7 @@ from importlib import metadata
 
 from ..errors import UsageError, quote
 
-__all__ = ["screwkin_version", "check_writable", "check_folder_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "BOUNDS"]
+__all__ = ["screwkin_version", "check_writable", "check_folder_writable", "count", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "check_not_read", "check_picture", "PICTURES", "BOUNDS"]
 
 
 def screwkin_version() -> str:
@@ -50,6 +50,7 @@ BOUNDS = {
     "samples": (1, 10_000_000),       # scan --samples (100,000 take about 0.3 s)
     "threads": (1, 256),              # scan --threads
     "grid": (2, 2_000),               # map / view --sweep N: values along one input
+    "local_samples": (1, 100_000),    # mobility --local-samples: tangent directions continued at a singular point
     "grid_total": (4, 100_000),       # map: both inputs together (about 25 s on the five-bar)
     "facets": (3, 1_000),             # grasp --facets: edges of a friction cone's pyramid
     "candidates": (1, 10_000),        # synthesize --candidates
@@ -104,6 +105,45 @@ def count(what: str):
 #: Destinations of options that name a file a command writes (or a prefix of such files).
 OUTPUT_DESTS = ("csv", "parquet", "plot", "png", "svg", "html", "md", "cloud_png", "table", "out", "animate", "mjcf", "urdf",
                 "draw")
+
+
+#: Options whose file is a picture: dest -> the suffixes it takes, or MATPLOTLIB (a figure matplotlib writes in the
+#: format its suffix names, PNG without one); (command, dest) where a command's option takes others.  A file that
+#: is not a picture (study --plot is a prefix) is not listed.
+MATPLOTLIB = "matplotlib"
+PICTURES = {"plot": MATPLOTLIB, "png": MATPLOTLIB, "svg": (".svg",), "cloud_png": (".png",), "draw": (".png", ".svg"),
+            "animate": (".gif", ".mp4"), ("draw", "png"): (".png",), ("view", "png"): (".png",), ("study", "plot"): None}
+
+#: Formats matplotlib lists but cannot write here without more: PGF needs a TeX system (xelatex).
+_NOT_MATPLOTLIB = {".pgf"}
+
+
+def _matplotlib_formats() -> tuple:
+    """The suffixes matplotlib writes (its own list, less _NOT_MATPLOTLIB); () without matplotlib (the
+    command says it needs it)."""
+    try:
+        from matplotlib.backend_bases import FigureCanvasBase
+    except ImportError:
+        return ()
+    return tuple(sorted("." + k for k in FigureCanvasBase.get_supported_filetypes() if "." + k not in _NOT_MATPLOTLIB))
+
+
+def check_picture(path: str, option: str, formats) -> None:
+    """Refuse a picture file whose suffix names a format its writer does not write (sweep --plot o.xml),
+    naming the formats it does.  A device or a pipe (/dev/stdout) takes the writer's first format;
+    a matplotlib figure without a suffix is a PNG."""
+    if os.path.exists(path) and not os.path.isfile(path):
+        return
+    base = os.path.basename(path)
+    ext = os.path.splitext(base)[1].lower()
+    if formats == MATPLOTLIB:
+        formats = _matplotlib_formats()
+        if not formats or not ext:
+            return
+    if ext not in formats or len(base) <= len(ext):
+        names = " or ".join(formats) if len(formats) < 3 else ", ".join(formats[:-1]) + " or " + formats[-1]
+        raise UsageError(f"{option} expects a file name ending in {names}"
+                         f"{' (a picture format matplotlib writes)' if len(formats) > 2 else ''}, got {quote(path, 200)}")
 
 
 def _option_name(action) -> str:
@@ -198,7 +238,7 @@ def _overwritten(args, outputs) -> None:
 def check_outputs(parser, args) -> None:
     """Refuse, before any work, an output file whose folder is missing or not writable, that is a folder,
     that is a file the command reads, or that another output of the command line names too."""
-    outputs = []
+    outputs, pictures = [], []
     for action in parser._actions:
         if action.dest in OUTPUT_DESTS and action.option_strings and isinstance(getattr(args, action.dest), str):
             if getattr(args, "kind", None) == "chains" and action.dest == "out":  # synthesize chains -o: a folder
@@ -206,7 +246,29 @@ def check_outputs(parser, args) -> None:
                 continue
             check_writable(getattr(args, action.dest), _option_name(action))
             outputs.append((_option_name(action), getattr(args, action.dest)))
+            pictures.append((action, getattr(args, action.dest)))
     _overwritten(args, outputs)
+    words = parser.prog.split()
+    for action, path in pictures:  # a file name no picture format has (sweep --plot o.xml)
+        picture = next((PICTURES[w, action.dest] for w in words if (w, action.dest) in PICTURES),
+                       PICTURES.get(action.dest))
+        if picture is not None:
+            check_picture(path, _option_name(action), picture)
+    if outputs:  # (the (sub)parser that has them: kept for check_not_read, once the model is read)
+        args.output_files = outputs
+
+
+def check_not_read(args, files) -> None:
+    """Refuse, once the model is read and before the work, an output that is one of ``files``: every file
+    the model was read from (MechanismSpec.files_read: its MJCF or xacro includes, its meshes, its sidecar),
+    which only reading the model finds."""
+    for option, path in getattr(args, "output_files", ()):
+        if os.path.exists(path) and not os.path.isfile(path):  # a device or a pipe: written, not overwritten
+            continue
+        for other in files:
+            if _same_file(path, other):
+                raise UsageError(f"{option} {quote(path, 200)}: is {quote(str(other), 200)}, a file the model was read "
+                                 "from: it would be overwritten; write elsewhere")
 
 
 def check_parsed(parser, args) -> None:

@@ -33,6 +33,7 @@ from ..present.draw_targets import design_drawing
 from ..present.local import change_point_dict, singularity_kind_text
 from ..units import unit_text
 from ._configuration import (
+    add_branch_option,
     add_configuration_options,
     configuration,
     input_solver,
@@ -51,6 +52,7 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
     common(sp)
     add_configuration_options(sp)
+    add_branch_option(sp, "--animate's motion")
     sp.add_argument("--png", metavar="F.png", help="write the drawing as PNG")
     sp.add_argument("--svg", metavar="F.svg", help="write the drawing as SVG")
     sp.add_argument("--angles", action="store_true", help="annotate the absolute link angles (planar mechanisms)")
@@ -255,8 +257,11 @@ def _animate(mech, args) -> int:
     near_values(mech, args)  # checked before the work (configuration() reads it where the motion starts)
     solver = input_solver(mech, input_names, held)
     # the mode followed (--mode K, --near), chosen and said as sweep's
-    res = sweep(solver, name, start, stop, steps, fixed=fixed,
+    res = sweep(solver, name, start, stop, steps, fixed=fixed, branch=args.branch,
                 q_start=lambda: configuration(mech, args, moved={name: start}, inputs=input_names))
+    if not args.json:
+        for line in res.change_point_notes:  # the change points passed, and the branch taken at each
+            print(f"note: {line}")
     unit = next((q.shown_unit for q in typed if q.unit), None) or ("m" if res.unit == "m" else "rad")
     qs, values = list(res.q), list(res.values)
     limit = next((s for s in res.limits if res.stopped_at is not None and abs(s.input - res.stopped_at) <= mech.tolerances.equal), None)
@@ -289,6 +294,7 @@ def _animate(mech, args) -> int:
         print(json_of({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
                        "input": name, "unit": res.unit, "values": values,
                        "stopped_at": res.stopped_at, "stop_reason": res.stop_reason,
+                       "change_points": list(res.change_point_notes),
                        "traces": {k: xy.tolist() for k, xy in traces.items()}}))
     else:
         print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit)} "

@@ -14,7 +14,7 @@ from ..present.dynamics import dynamics_csv, dynamics_dict, dynamics_plot, dynam
 from ..present.progress import EVERY, Progress
 from ..units import parse_value
 from ..analysis.motion.sweep import sweep_inputs
-from ._configuration import add_mode_option, configuration, moved_not_set, near_values, with_mode
+from ._configuration import add_branch_option, add_mode_option, configuration, moved_not_set, near_values, with_mode
 from ._output_frame import named_points
 from ._values import joint_assignments, joint_value, names_list, rate_items, value_kind
 from ._options import count
@@ -39,6 +39,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--inputs", help="input joints, comma separated (default: the actuated joints)")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="start on the assembly mode nearest this configuration")
     add_mode_option(sp, "the inputs at --from")
+    add_branch_option(sp)
     sp.add_argument("--gravity", metavar="GX,GY,GZ",
                     help="gravity [m/s^2] in world axes, e.g. 0,0,-9.81 (default: none)")
     sp.add_argument("--load", action="append", metavar="LINK:FX,FY,FZ,MX,MY,MZ",
@@ -125,7 +126,7 @@ def run(mech, args) -> int:
                                  inputs=inputs or sweep_inputs(mech, args.input, fixed))
     with Progress(label="dynamics", unit="configurations", every=EVERY) as progress:  # on a terminal only
         res = dynamics(mech, args.input, speed, start, stop, args.steps, inputs=inputs, fixed=fixed, near=near,
-                       gravity=gravity, loads=loads, cs=cs, progress=progress, q_start=mode)
+                       gravity=gravity, loads=loads, cs=cs, progress=progress, q_start=mode, branch=args.branch)
     if args.csv:
         write_output(args.csv, dynamics_csv(res, shown))
     if args.plot:

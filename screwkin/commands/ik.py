@@ -71,7 +71,9 @@ def run(mech, args) -> int:
                   + (" (a position alone: the output may turn)" if n == 3 else "")
                   + f": the solutions form a continuum; the {len(res.solutions)} below are samples of it")
         c = res.modes
-        if c is not None and c.complete:
+        if c is not None and c.method.startswith("closed form"):
+            print(_closed_text(mech, res, count))
+        elif c is not None and c.complete:
             print(f"search: homotopy continuation on the loops and the pose, every solution (certified: "
                   f"{c.certificate}): " + _found_text(count, res.free_dofs, certified=True)
                   + (f"; {c.complex} more complex" if c.complex else ""))
@@ -88,6 +90,29 @@ def run(mech, args) -> int:
         # the continuum was said first: not again in the table's header
         print(position_text(replace(res, free_dofs=0), show_all=args.all).split("\n", 1)[1])
     return 0
+
+
+def _closed_text(mech, res, count) -> str:
+    """The search line of a closed-form answer (analysis.motion.closed_ik), and for a platform whose
+    combinations are not all listed each leg's other branch beside the first solution."""
+    c = res.modes
+    ms = f" ({c.detail.get('seconds', 0) * 1e3:.3g} ms)"
+    if c.method == "closed form (Pieper)":
+        return (f"search: {c.certificate}: {c.real} real joint solution{'s' if c.real != 1 else ''}"
+                + ", every one" + (f"; {c.complex} more complex" if c.complex else "") + ms)
+    text = f"search: {c.certificate}: " + _found_text(count, res.free_dofs, certified=True) + ms
+    if c.found > len(res.solutions):
+        first = res.solutions[0]
+        others = [f"{n} = {s.joints[n]:.6g} m" for s in res.solutions[1:] for n in mech.actuated
+                  if abs(s.joints[n] - first.joints[n]) > 1e-12]
+        text += (f"\nlisted: the physical solution and each leg's other branch, reversed through its pivot "
+                 f"(solutions 2 to {len(res.solutions)}; --all shows them in full): " + ", ".join(others))
+    sets = c.detail.get("angle_sets", 1)
+    if sets > 1:
+        text += (f"\neach solution is reached by {sets} joint-angle sets (a universal joint's (a, b) and "
+                 "(a + pi, pi - b) with its leg spun about its line, a spherical joint's two Euler sets): one pose; "
+                 "shown in the set within the joint limits where one exists")
+    return text
 
 
 def _found_text(count, free: int, certified: bool = False) -> str:

@@ -6,18 +6,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.singularities.maps import singularity_map
-from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.connect import cusp_loops
 from ..analysis.motion.continuation import continuation_steps
+from ..analysis.motion.position import PositionSolver
+from ..analysis.singularities.loci import trace_loci
+from ..analysis.singularities.maps import singularity_map
+from ..analysis.singularities.regions import regions
 from ..errors import UsageError
 from ..present.jsonout import json_of
+from ..present.loci import loci_dict, loci_lines, loci_png
 from ..present.outfile import write_output
 from ..present.plots import map_png
 from ..present.report import map_csv, map_dict
 from ._configuration import add_mode_option, configuration, with_mode
+from ._options import BOUNDS
 from ._output_frame import output_frame
 from ._values import joint_assignments, parse_range
-from ._options import BOUNDS
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -35,6 +39,15 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--output", help="output link (serial singularities)")
     sp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
     sp.add_argument("--csv", help="the map's data as CSV")
+    sp.add_argument("--loci", action="store_true",
+                    help="trace the singular curves over every assembly mode (actuator; serial with --output), "
+                         "their cusps and crossings, and the regions they cut the box into with their numbers "
+                         "of assembly modes (with --png: their picture instead of the heat map)")
+    sp.add_argument("--connect", action="store_true",
+                    help="with --loci: follow every mode at a point inside each cusp's wedge once round the cusp, "
+                         "each way, and list the loops that end on another mode without meeting a singularity")
+    sp.add_argument("--no-regions", dest="regions", action="store_false",
+                    help="with --loci: leave out the regions and their mode counts (an all-modes solve each)")
     scaled(sp)
 
 
@@ -58,15 +71,22 @@ def run(mech, args) -> int:
     if point and not output:
         raise UsageError("--point needs --output LINK")
     # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
-    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
+    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
-    if args.png:
+    if args.connect and not args.loci:
+        raise UsageError("--connect needs --loci: the loops go round the cusps of the traced loci")
+    traced = _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point) if args.loci else None
+    if traced is not None and args.png:
+        title = f"{mech.spec.name or Path(mech.path).stem}: singular loci over {xn} and {yn}"
+        loci_png(*traced[:2], args.png, xs, ys, xn, yn, x_unit, y_unit, title=title)
+    elif args.png:
         title = f"{mech.spec.name or Path(mech.path).stem}: singularity map over {xn} and {yn}"
         map_png(res, args.png, x_unit, y_unit, title=title)
     if args.csv:
         write_output(args.csv, map_csv(res))
     if args.json:
-        print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length})))
+        extra = loci_dict(*traced[:2], x_unit, y_unit, traced[2], mech) if traced is not None else {}
+        print(json_of(with_mode(args, {**map_dict(res), "characteristic_length": mech.length, **extra})))
     else:
         finite = res.log_sigma[np.isfinite(res.log_sigma)]
         print(f"map of {xn} x {yn}: {res.log_sigma.size} points, {finite.size} on the mapped assembly mode; "
@@ -74,5 +94,25 @@ def run(mech, args) -> int:
               if finite.size else "no point assembled")
         for note in res.notes:
             print(note)
+        if traced is not None:
+            for line in loci_lines(*traced[:2], xn, yn, x_unit, y_unit, traced[2]):
+                print(line)
     return 0
+
+
+def _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point):
+    """(Loci, Regions or None, (cusp loops, tried) or None) of map --loci: every input other than --x and
+    --y held by --set."""
+    held = [n for n in inputs if n not in (xn, yn)]
+    missing = [n for n in held if n not in fixed]
+    if missing:
+        raise UsageError(f"--loci: give the other inputs with --set ({', '.join(missing)}): the loci lie in the "
+                         "plane of --x and --y with the others held")
+    solver = PositionSolver(mech, inputs)
+    held_values = {n: fixed[n] for n in held}
+    traced = trace_loci(solver, xn, xs, yn, ys, held_values, output, point)
+    cut = regions(solver, traced, xn, xs, yn, ys, held_values) if args.regions else None
+    box = ((float(min(xs[0], xs[-1])), float(max(xs[0], xs[-1]))), (float(min(ys[0], ys[-1])), float(max(ys[0], ys[-1]))))
+    loops = cusp_loops(solver, traced, xn, yn, held_values, box) if args.connect else None
+    return traced, cut, loops
 

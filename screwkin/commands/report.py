@@ -169,6 +169,9 @@ def run(mech, args) -> int:
         if n > 1:
             data["mode"] = {"index": k, "of": n}
             print(f"note: {mode_line(k, n)}", file=sys.stderr)
+        if pres.free_dofs:  # a continuum: a sample of it, said as choose_mode says it
+            data["continuum"] = {"free_dofs": pres.free_dofs}
+            print(f"note: {pres.notes[-1]}", file=sys.stderr)
         data["solve"] = position_dict(pres)
         data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
     topo = mech.topology(q)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 
-from ..analysis.singularities.ellipsoids import ellipsoids
+from ..analysis.singularities.ellipsoids import ellipsoids, with_input_output_condition
 from ..analysis.singularities.gram_symbolic import symbolic_gram
 from ..analysis.local import local_analysis
 from ..analysis.singularities.singular import classify, named_types
@@ -44,7 +44,7 @@ def run(mech, args) -> int:
     if args.ellipsoids and not output:
         raise UsageError("--ellipsoids needs --output LINK")
     q = configuration(mech, args)
-    rep = classify(mech, q, output=output, point=point)
+    rep = with_input_output_condition(mech, q, classify(mech, q, output=output, point=point))
     local = local_analysis(mech, q, generic_rank=None)
     types = named_types(rep, local, mech.tolerances)
     ell = ellipsoids(mech, q, output, point=point) if args.ellipsoids else None

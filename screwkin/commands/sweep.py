@@ -31,6 +31,7 @@ from ..present.report import (
 )
 from ._configuration import (
     add_angle_option,
+    add_branch_option,
     add_mode_option,
     configuration,
     input_solver,
@@ -80,6 +81,7 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--turn", action="store_true",
                    help="pass through limit positions onto the other branch (the input runs back) until the "
                         "mechanism returns to its start or the input reaches --to")
+    add_branch_option(sp)
     scaled(sp)
 
 
@@ -124,7 +126,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     last = None
     with Progress(label="sweep", unit="steps", every=EVERY) as progress, SweepWriter(args.csv, args.parquet) as out:
         for piece in sweep_chunks(solver, args.input, start, stop, args.steps, fixed=fixed, q_start=q_start, rate=rate,
-                                  chunk=chunk):
+                                  chunk=chunk, branch=args.branch):
             if topo is None:
                 topo = mech.topology(piece.q[0])
                 if topo.motion_space == "planar" and topo.normal is not None:
@@ -205,7 +207,7 @@ def run(mech, args) -> int:
         return _run_streamed(mech, args, solver, start, stop, others, q_start, rate)
     with Progress(label="sweep", unit="steps", every=EVERY) as progress:  # on a terminal only
         res = sweep(solver, args.input, start, stop, args.steps, fixed=others, q_start=q_start, rate=rate,
-                    progress=progress, turn=args.turn)
+                    progress=progress, turn=args.turn, branch=args.branch)
     topo = mech.topology(res.q[0])
     motion = sweep_motion(mech, res, named_points(mech, args))
     info = identify(mech, topo, res.q[0], args.input) if len(inputs) == 1 and not held else None
@@ -236,6 +238,9 @@ def run(mech, args) -> int:
         for entry, x in zip(d["singularities"], sing):  # what the configuration space does there
             if x.point is not None:
                 entry.update({k: v for k, v in change_point_dict(x.point).items() if k not in ("input", "sigma")})
+        # the change points passed: where, what the configuration space does there, the branch taken
+        d["change_points"] = [{**change_point_dict(cp), "branch": "other" if cp.switched else "continue", "note": line}
+                              for cp, line in zip(res.change_points, res.change_point_notes)]
         d["characteristic_length"] = mech.length
         d.update(motion_dict(motion))
         d["strokes"] = strokes_dict(slider_strokes)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import select
 import signal
 import sys
 import tempfile
-import time
 
 from ..analysis.motion.interactive import Interactive
 from ..analysis.motion.position import PositionSolver
@@ -24,7 +24,7 @@ from ..present.interactive import InteractiveView, viser_module
 from ..present.player import with_player
 from ..units import unit_text
 from ..present.viewplanar import colour_links, link_colours, planar_basis
-from ._configuration import add_configuration_options, configuration, mode_line, moved_not_set
+from ._configuration import add_branch_option, add_configuration_options, configuration, mode_line, moved_not_set
 from ._output_frame import add_point_option, named_points
 from ._values import joint_assignments, joint_inputs, parse_range
 from ..model.topology import open_joints
@@ -39,6 +39,7 @@ def add_parser(sub, common, scaled):
     sp = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
     common(sp)
     add_configuration_options(sp)
+    add_branch_option(sp, "--sweep's motion")
     sp.add_argument("--output", help="output link: its frame is drawn, singularities are marked on it")
     sp.add_argument("--sweep", metavar="NAME=A:B:N", help="animate the motion of one input (other inputs from --set)")
     sp.add_argument("--html", help="write a self-contained static HTML page of the scene and exit")
@@ -63,24 +64,53 @@ def port_number(text: str) -> int:
     return port
 
 
-@contextlib.contextmanager
-def _stopped_by_signals():
-    """SIGTERM and SIGHUP end the command as Ctrl-C (SIGINT) does: a KeyboardInterrupt raised in the
-    main thread, so that every ``with`` (the meshcat server among them) closes what it opened.  A
-    second signal while closing is ignored; the previous handlers come back afterwards."""
-    stopping = []
+class _Stop:
+    """SIGTERM, SIGHUP and SIGINT (Ctrl-C) stop ``view`` cleanly whenever they arrive: its handler
+    records the first signal (``signum``; a second while stopping is ignored).  While the command
+    gets ready (the server starting, pictures written) the handler also raises KeyboardInterrupt, so
+    that a long start can be stopped (``run`` catches it as a stop); from ``_serve_until_stopped``
+    on (before its line is printed) it only records, and the wait checks the record: a signal that
+    arrives between saying where the page is and waiting is not lost (it exited 130 without its
+    "stopped by" line), and ``signal.set_wakeup_fd`` wakes the wait at once.  The handlers and the
+    wakeup descriptor are installed before the server starts; the previous ones come back after."""
 
-    def stop(signum, frame):
-        if not stopping:
-            stopping.append(signum)
-            raise KeyboardInterrupt
+    def __init__(self):
+        self.signum = None
+        self.interrupting = True
+        self.wake = None
 
-    previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
-    try:
-        yield stopping
-    finally:
-        for s, handler in previous.items():
+    def _handle(self, signum, frame):
+        if self.signum is None:
+            self.signum = signum
+            if self.interrupting:
+                raise KeyboardInterrupt
+
+    def __enter__(self):
+        self.wake, self._wake_w = os.pipe()
+        for fd in (self.wake, self._wake_w):
+            os.set_blocking(fd, False)
+        self._previous_fd = signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
+        self._previous = {s: signal.signal(s, self._handle) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
+        return self
+
+    def __exit__(self, *exc):
+        for s, handler in self._previous.items():
             signal.signal(s, handler)
+        signal.set_wakeup_fd(self._previous_fd)
+        os.close(self.wake)
+        os.close(self._wake_w)
+
+    def wait(self) -> None:
+        """Until a signal has been recorded (the handler only records from now on)."""
+        self.interrupting = False
+        while self.signum is None:
+            select.select([self.wake], [], [], 60.0)  # the wakeup byte: at once, even if it came before
+            with contextlib.suppress(BlockingIOError):
+                while os.read(self.wake, 64):
+                    pass
+
+    def said(self, where: str) -> str:
+        return f"stopped by {signal.Signals(self.signum).name}: {where}"
 
 
 def run(mech, args) -> int:
@@ -98,8 +128,10 @@ def run(mech, args) -> int:
         inputs = sweep_inputs(mech, name, fixed)
         solver = PositionSolver(mech, inputs)
         # the mode followed (--mode K, --near), chosen and said as sweep's
-        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed,
+        res = sweep(solver, name, values[0], values[-1], len(values) - 1, fixed=fixed, branch=args.branch,
                     q_start=lambda: configuration(mech, args, moved={name: float(values[0])}, inputs=inputs))
+        for line in res.change_point_notes:  # the change points passed, and the branch taken at each
+            print(f"note: {line}")
         motion = res.q
         q = res.q[0]
         frames = [f"{name} = {unit_text(v, unit, 4)}" for v in res.values]
@@ -109,16 +141,21 @@ def run(mech, args) -> int:
             singular.append((s.q, twist))
             print(f"singular ({s.kind}) at {name} = {s.input:.9g}")
     scene = build_scene(mech, q, output=args.output, singular=singular)
-    with _stopped_by_signals() as stopping:
-        with ViewerServer(port=args.port) as server:
-            show(mech, scene, server.viewer, q, motion=motion, fps=FPS)
-            if args.html or args.png:
-                _pictures(mech, args, server, scene, frames)
-                return 0
-            _serve_until_stopped(f"meshcat: {server.web_url}")
-    if stopping:
-        print(f"stopped by {signal.Signals(stopping[0]).name}: the meshcat server on port {server.port} is closed",
-              flush=True)
+    server = None
+    with _Stop() as stop:
+        try:
+            with ViewerServer(port=args.port) as server:
+                show(mech, scene, server.viewer, q, motion=motion, fps=FPS)
+                if args.html or args.png:
+                    _pictures(mech, args, server, scene, frames)
+                    stop.interrupting = False
+                    return 0
+                _serve_until_stopped(f"meshcat: {server.web_url}", stop)
+        except KeyboardInterrupt:  # a signal while getting ready (the handler raised it): a stop as any other
+            if stop.signum is None:
+                raise
+    closed = f"the meshcat server on port {server.port} is closed" if server else "before the meshcat server served"
+    print(stop.said(closed), flush=True)
     return 0
 
 
@@ -159,28 +196,32 @@ def _interactive(mech, args) -> int:
     print(live.opened, flush=True)
     if live.mode_index[1] > 1:  # the mode it opened in, said as every command says it
         print(f"note: {mode_line(*live.mode_index, near=False)}", file=sys.stderr)
+    for note in live.notes:
+        print(f"note: {note}", file=sys.stderr)
     q = live.state.q
     scene = build_scene(mech, q, output=args.output)
     if planar_basis(mech, q) is not None:
         colour_links(scene, link_colours(mech, q))
-    with _stopped_by_signals() as stopping:
-        view = InteractiveView(mech, live, scene, port=args.port, title=os.path.basename(mech.path))
+    view = None
+    with _Stop() as stop:
         try:
-            _serve_until_stopped(f"interactive view: {view.url}")
-        finally:
-            view.close()
-    if stopping:
-        print(f"stopped by {signal.Signals(stopping[0]).name}: the server on port {view.port} is closed", flush=True)
+            view = InteractiveView(mech, live, scene, port=args.port, title=os.path.basename(mech.path))
+            try:
+                _serve_until_stopped(f"interactive view: {view.url}", stop)
+            finally:
+                stop.interrupting = False
+                view.close()
+        except KeyboardInterrupt:  # a signal while getting ready: a stop as any other
+            if stop.signum is None:
+                raise
+    print(stop.said(f"the server on port {view.port} is closed" if view else "before the server served"), flush=True)
     return 0
 
 
-def _serve_until_stopped(where: str) -> None:
-    """Say where the page is served and wait until Ctrl-C (or SIGTERM/SIGHUP, which
-    _stopped_by_signals turns into the same interrupt) ends the serving; an interrupt before
-    the page is served propagates from the caller."""
+def _serve_until_stopped(where: str, stop: _Stop) -> None:
+    """Say where the page is served and wait until SIGINT (Ctrl-C), SIGTERM or SIGHUP: from here on the
+    handler only records the signal (it raises nothing), so one that arrives while or just after the line
+    is printed ends the wait as one that arrives later does."""
+    stop.interrupting = False
     print(f"{where}  (Ctrl-C to stop)", flush=True)
-    try:
-        while True:
-            time.sleep(1)
-    except KeyboardInterrupt:
-        return
+    stop.wait()

@@ -350,6 +350,9 @@ class MechanismSpec:
     targets: tuple = ()  # TargetSpec, from <screwkin:targets> (a synthesized design's precision positions)
     inputs: list = field(default_factory=list)  # Transmission of each actuator that is not a plain joint's
     reference: dict = field(default_factory=dict)  # joint -> value where the file draws it (MJCF ref), when not 0
+    # every file the model was read from: the file, its MJCF or xacro includes, the meshes found, the YAML sidecar
+    # (an output that is one of them is refused: commands/_options.check_not_read)
+    files_read: list = field(default_factory=list)
 
     @property
     def root(self) -> str:

@@ -131,8 +131,9 @@ def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
     return locate_mesh(uri, base, package_dirs, roots)[0]
 
 
-def check_meshes(path, root, package_dirs=()) -> list:
-    """Warnings for mesh files that cannot be found (missing meshes do not fail a load)."""
+def check_meshes(path, root, package_dirs=(), found_list=None) -> list:
+    """Warnings for mesh files that cannot be found (missing meshes do not fail a load); ``found_list``
+    (a list), when given, gets the path of each mesh file found."""
     meshes = list(root.iter("mesh"))
     if not meshes:  # (the folders to look in take a scan of sys.path: only when there is a mesh to find)
         return []
@@ -151,6 +152,8 @@ def check_meshes(path, root, package_dirs=()) -> list:
             outside.append(uri)
         elif found is None:
             missing.append(uri)
+        elif found_list is not None:
+            found_list.append(str(found))
     warnings = [f"mesh {quote(m, 120)} is outside the robot's folder and the package folders "
                 f"(--package-dir, ROS_PACKAGE_PATH): not read, views draw a stand-in" for m in outside[:3]]
     if len(outside) > 3:

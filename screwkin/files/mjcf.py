@@ -195,7 +195,8 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
         root = parse_xml_text(text, path)
     if root.tag != "mujoco":
         raise MechanismFileError(path, f"not an MJCF file: the root element is <{shorten(root.tag, 40)}>")
-    expand_includes(root, path)
+    included = []
+    expand_includes(root, path, included)
     r = _Reader(path, root)
     p = r.problems
     for child in root:
@@ -411,7 +412,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                           " give several numbers: the first is read, as MuJoCo reads it")
     name = root.get("model") or "mjcf_model"
     urdf = "\n".join([f"<robot name={quoteattr(name)}>", '<link name="world"/>', *out_links, *out, "</robot>"])
-    return MechanismSpec(path=str(path), name=name, format="mjcf", urdf_text=urdf, links=links, joints=joints,
+    return MechanismSpec(path=str(path), name=name, format="mjcf", files_read=included, urdf_text=urdf, links=links, joints=joints,
                          cut_joints=cuts, transmissions=transmissions, warnings=r.warnings,
                          replacements=replacements, couplings=couplings,
                          package_dirs=[str(d) for d in package_dirs or ()], inputs=inputs, reference=reference)

@@ -4,7 +4,9 @@ MuJoCo replaces an ``<include>`` by the children of the included file's ``<mujoc
 the element stands; the file's path is relative to the folder of the main model file (nested
 includes too).  Here an included file must lie in that folder or below it (a model reads only
 files beside it), be a regular file, and the files together stay within the limits of one file
-(:class:`~screwkin.files.description.Limits`: bytes and XML elements); at most
+(:class:`~screwkin.files.description.Limits`: bytes and XML elements, and the nesting depth of
+:data:`~screwkin.files.xmlsafe.MAX_DEPTH` over the whole model, an included file's elements as deep
+as they stand once included, not as deep as in their own file); at most
 :data:`~screwkin.files.xacro.MAX_INCLUDES` files; a file that includes itself, directly or not, is
 refused as MuJoCo refuses it.
 """
@@ -17,19 +19,20 @@ from pathlib import Path
 from ..errors import MechanismFileError, quote, shorten
 from .description import LIMITS
 from .xacro import MAX_INCLUDES
-from .xmlsafe import inside_folder, parse_xml_text, read_regular_file
+from .xmlsafe import MAX_DEPTH, inside_folder, parse_xml_text, read_regular_file
 
 __all__ = ["expand_includes"]
 
 
-def expand_includes(root, path) -> int:
+def expand_includes(root, path, read=None) -> int:
     """Replace every ``<include>`` under ``root`` (the main file's ``<mujoco>``, read from ``path``)
-    by the included file's content, in place.  Returns the number of files included."""
+    by the included file's content, in place.  Returns the number of files included; ``read`` (a list),
+    when given, gets the path of each file included."""
     path = Path(path)
     folder = Path(os.path.realpath(path.parent if str(path.parent) else "."))
     state = {"files": 0, "bytes": 0, "elements": sum(1 for _ in root.iter())}
 
-    def included(spec: str, chain: tuple):
+    def included(spec: str, chain: tuple, depth: int):
         if not spec:
             raise MechanismFileError(path, "<include> has no file")
         target = Path(spec) if os.path.isabs(spec) else folder / spec
@@ -61,22 +64,27 @@ def expand_includes(root, path) -> int:
         state["elements"] += sum(1 for _ in sub.iter())
         if state["elements"] > LIMITS.elements:
             raise MechanismFileError(path, f"the file and its includes hold more than {LIMITS.elements:,} XML elements")
-        expand(sub, chain + (real,))
+        if read is not None:
+            read.append(str(real))
+        expand(sub, chain + (real,), depth)  # its root's children take the place of the <include>
         return list(sub)
 
-    def expand(elem, chain):
+    def expand(elem, chain, depth):  # depth: elem's, in the whole model (the main file's root: 1)
         k = 0
         while k < len(elem):
             child = elem[k]
             if child.tag == "include":
-                content = included(child.get("file"), chain)
+                content = included(child.get("file"), chain, depth)
                 elem.remove(child)
                 for j, c in enumerate(content):
                     elem.insert(k + j, c)
                 k += len(content)
             else:
-                expand(child, chain)
+                if depth + 1 > MAX_DEPTH:
+                    raise MechanismFileError(path, f"XML nested deeper than {MAX_DEPTH} elements once its includes "
+                                                   "are in place (refused: no mechanism file needs it)")
+                expand(child, chain, depth + 1)
                 k += 1
 
-    expand(root, (Path(os.path.realpath(path)),))
+    expand(root, (Path(os.path.realpath(path)),), 1)
     return state["files"]

@@ -56,8 +56,9 @@ def read_tendons(r, mjoints) -> dict:
                     p.append(f"{what} is a {mjoints[jn][0]} joint: a fixed tendon takes hinge and slide joints")
                     continue
                 (coef,) = numbers(j.get("coef"), 1, f"{what} coef", p, (None,), 1e9, "")
-                if coef is None and j.get("coef") is None:
-                    p.append(f"{what} has no coef (MuJoCo requires it)")
+                if coef is None:  # missing, or invalid (numbers() said why)
+                    if j.get("coef") is None:
+                        p.append(f"{what} has no coef (MuJoCo requires it)")
                     continue
                 terms.append((jn, float(coef)))
             out[name] = tuple(terms)

@@ -211,7 +211,9 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                                  tuple(P2.translation), tuple(pin.rpy.matrixToRpy(P2.rotation)), tuple(a1),
                                  tuple(a2) if _CUT[jt] == "universal" else None, source="sdf"))
     out.append("</robot>")
-    return MechanismSpec(path=str(path), name=model.get("name") or "sdf_model", format="sdf",
+    meshes = []
+    warnings = check_meshes(path, model, package_dirs, meshes)
+    return MechanismSpec(path=str(path), name=model.get("name") or "sdf_model", format="sdf", files_read=meshes,
                          urdf_text="\n".join(out), links=spec_links, joints=joints, cut_joints=cuts,
-                         warnings=check_meshes(path, model, package_dirs),
+                         warnings=warnings,
                          package_dirs=[str(d) for d in package_dirs or ()])

@@ -78,10 +78,10 @@ def numbers(text, count, what, problems, default, bound=None, unit="m", low=None
         problems.append(f"{what}: {quote(text)} contains NaN or infinite numbers")
         return tuple(default)
     if bound is not None and any(abs(v) > bound for v in values):
-        problems.append(f"{what}: {quote(text)} is not a plausible value (beyond {bound:g} {unit})")
+        problems.append(f"{what}: {quote(text)} is not a plausible value (beyond {bound:g}{' ' + unit if unit else ''})")
         return tuple(default)
     if low is not None and any(v < low for v in values):
-        problems.append(f"{what}: {quote(text)} is not a plausible value (below {low:g} {unit})")
+        problems.append(f"{what}: {quote(text)} is not a plausible value (below {low:g}{' ' + unit if unit else ''})")
         return tuple(default)
     return values
 
@@ -450,8 +450,10 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
     targets = _read_targets(root, links, {j.name for j in joints}, problems)
     problems.fail_if_any(path)
     warnings += inertia_warnings(links)
-    warnings += check_meshes(path, root, package_dirs)
+    meshes = []
+    warnings += check_meshes(path, root, package_dirs, meshes)
     return MechanismSpec(
+        files_read=meshes,
         path=str(path),
         name=root.get("name") or Path(path).stem,
         format="urdf",

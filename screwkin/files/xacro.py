@@ -406,14 +406,15 @@ def _dom(text: str, path):
         raise MechanismFileError(path, f"malformed XML: {shorten(_one_line(exc), 100)}") from None
 
 
-def expand(path, text: str, args=None, root=None, warn=None, evaluator=None) -> str:
+def expand(path, text: str, args=None, root=None, warn=None, evaluator=None, read=None) -> str:
     """The URDF text of xacro file ``path`` (whose text is ``text``) with arguments
     ``args`` ({name: value}; see :func:`normalize_args`).  Raises MechanismFileError (the
     file's problem, one line) or UsageError (an argument the file does not declare).
 
     warn: callable receiving xacro's own warnings (default: dropped).
     evaluator: the interpreter of ``${...}`` (default :func:`evaluate`; files.xacro_batch expands a
-    family for many designs at once with its own)."""
+    family for many designs at once with its own).
+    read: a list, when given, that gets the path of each file the expansion read (the file's first)."""
     import xacro  # lazily: only xacro files need it (it also patches minidom's pretty printer on import)
 
     path = Path(path)
@@ -463,6 +464,8 @@ def expand(path, text: str, args=None, root=None, warn=None, evaluator=None) -> 
             if line and not line.startswith(("when processing file", "in file", "included from", "when instantiating",
                                              "instantiated from")):
                 warn(f"xacro: {line.removeprefix('warning: ')}")
+    if read is not None:
+        read.extend(str(f) for f in state.files)
     if len(result) > LIMITS.file_bytes:
         raise MechanismFileError(path, f"the expanded URDF is over {LIMITS.file_bytes / 1e6:g} MB")
     return result

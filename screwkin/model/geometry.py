@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["perpendicular_basis", "plane_basis", "cross2", "circle_circle", "circle_intersections", "line_foot",
+__all__ = ["perpendicular_basis", "plane_basis", "cross2", "cross_last", "circle_circle", "circle_intersections", "line_foot",
            "line_circle", "vector_angle", "line_angle", "cross3", "skew", "skews", "skews_batch", "wrap_angle",
            "quaternion_matrix", "quaternion_product", "stack_mm", "stack_mv", "stack_cross",
            "nearest_turn", "lines_point"]
@@ -201,6 +201,15 @@ def cross3(a, b):
     """Cross product of two 3-vectors (numpy.cross costs about 35 us a call here: it was
     70% of a sweep step in a profile; this costs about 1 us)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def cross_last(a, b):
+    """a x b over the last axis (of length 3) of arrays broadcast together: numpy.cross's value without its
+    axis moves (numpy.cross's overhead on small arrays was most of the time of a long loop's local
+    analysis: analysis/loop_series.ad); stack_cross is the same over the leading axis."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def skew(a):

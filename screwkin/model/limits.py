@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["outside_limits", "within_limits"]
+from .leg_chains import respell
+
+__all__ = ["outside_limits", "within_limits", "spelled_within_limits"]
 
 
 def outside_limits(mech, q) -> tuple:
@@ -37,3 +39,15 @@ def _outside(mech, Q) -> np.ndarray:
         shifted = v + 2 * np.pi * np.ceil((lo - v) / (2 * np.pi))
         out &= ~(angle & (lo <= shifted) & (shifted <= hi))
     return out
+
+
+def spelled_within_limits(mech, q):
+    """q, or where joints of q lie outside the file's limits, the angle set of the same pose within them
+    where one exists: a universal joint's flipped set (a, b) -> (a + pi, pi - b) with its leg spun about
+    its own line, a spherical joint's other Euler set (model.leg_chains.respell: the legs of a
+    platform).  Every joint centre stays where it was; "within the limits" is a property of the pose,
+    not of one of its spellings.  The one place solutions are written in their angle sets."""
+    if not outside_limits(mech, q):
+        return q
+    q2 = respell(mech, q)
+    return q2 if len(outside_limits(mech, q2)) < len(outside_limits(mech, q)) else q

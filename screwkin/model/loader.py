@@ -355,9 +355,9 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
     path = Path(path)
     text = _read_text(path) if text is None else text
     root = parse_xml_text(text, path)  # the root element decides the format, not the suffix
-    expansion_warnings = []
+    expansion_warnings, read = [], []
     if is_xacro(path, text):
-        text = expand_xacro(path, text, args, root=root, warn=expansion_warnings.append)
+        text = expand_xacro(path, text, args, root=root, warn=expansion_warnings.append, read=read)
         root = parse_xml_text(text, path)
     elif args:
         raise UsageError(f"{path}: xacro arguments (--arg) are given but the file is not a xacro file (its name "
@@ -377,6 +377,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
                                        "expected <sdf>")
     spec.package_dirs = package_dirs
     spec.warnings[:0] = expansion_warnings
+    spec.files_read[:0] = read or [str(path)]  # (the reader's own: includes, meshes)
     native = []  # what urdfdom (inside Pinocchio) prints on the process's stderr: kept out of the output
     try:
         with _native_stderr(native):
@@ -394,6 +395,7 @@ def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=
         yaml = _find_sidecar(path)
     if yaml is not None:
         read_yaml_sidecar(spec, Path(yaml), [f.name for f in model.frames], _frame_bodies(model))
+        spec.files_read.append(str(yaml))
     model = _finish_model(spec, model)
     shown = spec.warnings
     if warn is None:  # on the terminal: a bounded number of bounded lines

@@ -306,8 +306,12 @@ class Mechanism:
         read it through KinematicState or model.state.frame_parent, not from this model's frames)."""
         if self.tool is not None and link == self.tool[0]:
             return self.tool_frame
+        ids = self.__dict__.setdefault("_body_frames", {})  # read once: a scan of Pinocchio's frames is slow
+        if link in ids:
+            return ids[link]
         for fid, f in enumerate(self.model.frames):
             if f.name == link and f.type == pin.FrameType.BODY:
+                ids[link] = fid
                 return fid
         links = ", ".join(self.spec.links)
         raise UsageError(f"{self.path}: no link named '{link}' (links: {links})")

@@ -78,6 +78,12 @@ CANVAS_ASPECT = 1.0
 CAMERA_MOVED = 1e-4
 
 
+def _moved(position, eye, dist) -> bool:
+    """Whether a camera reported at ``position`` is no longer where the view put it (``eye``, at ``dist`` from its
+    target): farther than CAMERA_MOVED of that distance."""
+    return float(np.linalg.norm(np.asarray(position, float) - eye)) > CAMERA_MOVED * dist
+
+
 def _shown(value, unit) -> float:
     return value * 1000.0 if unit == "m" else math.degrees(value)
 
@@ -159,23 +165,29 @@ class InteractiveView:
         cam.up = self._up
         dist = float(np.linalg.norm(eye - target))
         cam.near, cam.far = dist / 100, dist * 100
+        self._first = (np.asarray(eye, float), dist)
 
     def _frame_client(self, client):
         """Frame the mechanism for a browser as it says its view's size and field of view (its camera messages):
         the view left of the docked panel is narrower than the window, differs by window, and is known only once
-        the panel is laid out; framed again while the size changes, until the person moves the camera."""
+        the panel is laid out; framed again while the size changes, until the person moves the camera.  A camera
+        reported where this view put it (the first view, or any framing: the browser may apply the first view
+        after a framing, and its reports may lag one) was not moved by the person; elsewhere it was."""
         framed = {}  # the size last framed for and the camera position set for it
+        placed = [self._first]  # every (eye, distance to its target) this view gave the camera
 
         def frame(cam):
             size = (int(cam.image_width), int(cam.image_height))
-            if not size[0] or not size[1] or framed.get("size") == size:
+            if not size[0] or not size[1]:
                 return
-            moved = np.linalg.norm(np.asarray(cam.position) - framed["eye"]) if "eye" in framed else 0.0
-            if moved > CAMERA_MOVED * framed["dist"]:
-                return  # moved by the person: theirs to keep
+            if framed.get("size") == size and not _moved(cam.position, framed["eye"], framed["dist"]):
+                return  # framed for this view, and there
+            if framed and all(_moved(cam.position, eye, dist) for eye, dist in placed):
+                return  # moved by the person: theirs to keep (the first report has nothing to compare with)
             target, eye = fit_camera(self._points, self._direction, fov_deg=math.degrees(cam.fov),
                                      aspect=size[0] / size[1])
             framed.update(size=size, eye=np.asarray(eye, float), dist=float(np.linalg.norm(eye - target)))
+            placed.append((framed["eye"], framed["dist"]))
             with client.atomic():
                 cam.up_direction = self._up
                 cam.position = tuple(float(v) for v in eye)  # (moves look_at with it: set it after)

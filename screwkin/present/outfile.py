@@ -6,10 +6,13 @@ limit (``ulimit -f``: EFBIG), a folder that exists but takes no new file (``/pro
 :class:`~screwkin.errors.OutputError` naming the path and the operating system's reason, exit 1,
 never a traceback.
 
-A regular file is written as ``PATH.partial`` beside it and renamed to ``PATH`` once whole: a file
-under the name asked for is always complete, a write that fails removes the partial one (and says
-so) and leaves a file that was there before as it was, and a process killed on the way (SIGKILL,
-a CPU limit) leaves only ``PATH.partial``, named as what it is.  Links, devices and pipes
+A regular file is written under a fresh name beside it, ``PATH.<random>.partial``, and renamed to
+``PATH`` once whole: a file under the name asked for is always complete, a write that fails removes
+the partial one (and says so) and leaves a file that was there before as it was, and a process
+killed on the way (SIGKILL, a CPU limit) leaves only the partial file, named as what it is.  The
+partial file is made new (``O_CREAT | O_EXCL | O_NOFOLLOW``): a link or a file planted under a
+name it could have (``PATH.partial -> victim``) is neither followed nor reused, and a file of the
+user's own named ``PATH.partial`` is left as it is.  Links, devices and pipes
 (``/dev/null``, ``/dev/stdout``) are written as they are and never removed; a named pipe nothing
 reads is an error, not a wait.
 
@@ -24,15 +27,34 @@ from __future__ import annotations
 
 import errno as errnos
 import io
+import logging
 import os
 import stat
+import sys
 
 from ..errors import OutputError
 
-__all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL"]
+__all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL", "open_partial"]
 
 #: The suffix of a file being written (renamed to its own name once whole).
 PARTIAL = ".partial"
+
+#: The flags of a partial file: made new, never through a link, not inherited by a child process.
+_FRESH = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+def open_partial(path: str) -> tuple:
+    """A new file beside ``path`` to write it under: ``(fd, name)``, the name ``PATH.<16 hex>.partial``
+    (the file name cut to fit the system's limit of a name), made new with the umask's permissions, as
+    ``open(..., "w")`` makes a file.  Never a link or a file that exists: a name taken is tried again."""
+    folder, base = os.path.split(os.path.abspath(path))
+    for _ in range(100):
+        name = os.path.join(folder, f"{base[:200]}.{os.urandom(8).hex()}{PARTIAL}")
+        try:
+            return os.open(name, _FRESH, 0o666), name
+        except FileExistsError:  # taken (one in 2**64): another name
+            continue
+    raise FileExistsError(errnos.EEXIST, "no fresh name for a partial file", path)
 
 
 def os_reason(exc: BaseException) -> str:
@@ -79,7 +101,7 @@ class WholeOrNothing:
 
 class OutputFile(WholeOrNothing):
     """A file written piece by piece: ``write(data)`` and ``close()``, as a context manager (see the
-    module: a regular file is written as PATH.partial and renamed once whole).  Opening, writing or
+    module: a regular file is written as PATH.<random>.partial and renamed once whole).  Opening, writing or
     closing it fails with OutputError (the partial file removed); leaving the ``with`` block on any
     other exception (the work failed, or was interrupted) removes the partial file too."""
 
@@ -97,8 +119,10 @@ class OutputFile(WholeOrNothing):
                 else:
                     self._f = open(self.path, mode, encoding=encoding)
             else:
-                self._partial = self.path + PARTIAL
-                self._f = open(self._partial, mode, encoding=encoding)
+                fd, self._partial = open_partial(self.path)
+                if st is not None:  # a file replaced keeps its permissions (a private one stays private)
+                    os.fchmod(fd, stat.S_IMODE(st.st_mode))
+                self._f = os.fdopen(fd, mode, encoding=encoding)
         except OSError as exc:
             raise OutputError(self.path, os_reason(exc)) from None
 
@@ -169,10 +193,40 @@ def write_output(path, data) -> None:
         f.write(data)
 
 
+#: The formats whose files matplotlib writes a ``metadata`` title into (it refuses one for JPEG, GIF, TIFF...).
+_METADATA = ("png", "pdf", "svg", "svgz", "ps", "eps")
+
+
 def write_figure(fig, path, **savefig) -> None:
     """A matplotlib figure into ``path``, in the format of its suffix (PNG without one), rendered in
-    memory first: matplotlib itself does not report every failed write (``/dev/full`` passed)."""
+    memory first: matplotlib itself does not report every failed write (``/dev/full`` passed).  A title
+    in ``metadata`` is written where the format has room for one, left out elsewhere."""
     fmt = os.path.splitext(str(path))[1][1:].lower() or "png"
+    if fmt not in _METADATA:  # matplotlib refuses metadata (a title) for the others: "not supported for format"
+        savefig.pop("metadata", None)
+    elif fmt == "pdf" and "Description" in savefig.get("metadata", {}):  # PDF's word for it (else a UserWarning)
+        savefig["metadata"] = {("Subject" if k == "Description" else k): v for k, v in savefig["metadata"].items()}
     buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, **savefig)
+    said = _Said()  # what matplotlib logs as it writes (PostScript: "does not support transparency")
+    logger = logging.getLogger("matplotlib")
+    logger.addHandler(said)
+    propagate, logger.propagate = logger.propagate, False
+    try:
+        fig.savefig(buf, format=fmt, **savefig)
+    finally:
+        logger.removeHandler(said)
+        logger.propagate = propagate
     write_output(path, buf.getvalue())
+    for message in dict.fromkeys(said.messages):  # as every warning is said: one line, naming the file
+        print(f"warning: {path}: matplotlib: {message}", file=sys.stderr)
+
+
+class _Said(logging.Handler):
+    """The warnings a logger gives while a figure is written, kept to be said as screwkin says warnings."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages = []
+
+    def emit(self, record):
+        self.messages.append(" ".join(record.getMessage().split()))

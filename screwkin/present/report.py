@@ -11,6 +11,7 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
+from ..analysis.motion.modes import continuum_words
 from ..analysis.motion.solution import NEWTON_FROM_FILE, PositionResult, search_method
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
@@ -86,7 +87,8 @@ def modes_dict(c) -> dict:
     """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
-            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail)}
+            "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail),
+            "certificate_check": dict(c.check) or None}
 
 
 def modes_line(res, n: int) -> str:
@@ -94,6 +96,9 @@ def modes_line(res, n: int) -> str:
     36 more solutions are complex", or "3 found ...; completeness not certified because ..."."""
     c = res.modes
     s = "s" if n != 1 else ""
+    if res.free_dofs:  # a continuum: what was found are samples of it, not modes to count
+        return (f"{n} configuration{s} found from {res.starts} starting configurations: "
+                f"{continuum_words(res.free_dofs)}: they are samples of it, not assembly modes")
     if c is None:
         return f"{n} assembly mode{s} found from {res.starts} starting configurations"
     if c.method == "every joint given":
@@ -105,15 +110,25 @@ def modes_line(res, n: int) -> str:
     each = (f"; each reached by {sets.pop()} joint-angle sets (universal and spherical joints written as "
             "revolutes, wrists flipped: one placement of the links)" if len(sets) == 1 and None not in sets
             and max(sets) > 1 else "")
+    if c.method == "closed form (Pieper)":  # a serial arm: every joint solution is an answer
+        more = f"; {c.complex} more {'are' if c.complex != 1 else 'is'} complex (no real solution)" if c.complex else ""
+        return f"all {n} joint solution{s} ({c.certificate}){more}"
+    if c.method == "closed form (legs)":
+        return (f"{n} solution{s} of {c.found} listed ({c.certificate}): the physical one first (every leg extended, "
+                "each leg's angle set within the joint limits where one exists), then "
+                + ("every other combination of the legs' branches" if c.found == n else "each leg's other branch"))
+    kept = c.detail.get("generic_set")
+    kept = (f"; generic solution set {'reused from' if c.detail.get('generic_set_reused') else 'kept in'} {kept}"
+            if kept else "")
     if c.complete:
         more = (f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex (no real assembly)"
                 if c.complex else "")
         head = f"all {n} assembly modes" if n != 1 else "1 assembly mode, the only one"
-        return f"{head} (certified: {c.certificate}){more}{each}"
+        return f"{head} (certified: {c.certificate}){more}{each}{kept}"
     how = (f"from {res.starts} starting configurations" if c.method == "random starts" else
            f"by homotopy continuation and from {res.starts} starting configurations")
     more = f"; {c.complex} more solution{'s are' if c.complex != 1 else ' is'} complex" if c.complex else ""
-    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}"
+    return f"{n} assembly mode{s} found {how}{more}; completeness not certified because {c.reason}{each}{kept}"
 
 
 def _with_loop(tree: dict, loop: dict | None) -> dict:
@@ -223,9 +238,6 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
                      f"{hidden} not ({'; '.join(why)}): --all shows them")
     for note in res.notes:
         lines.append(f"note: {note}")
-    if res.free_dofs:
-        lines.append(f"note: these inputs leave {res.free_dofs} degree(s) of freedom free: "
-                     "the solutions form a continuum and only some are shown")
     for k, s in enumerate(shown, 1):
         if s.continuum:
             flag = ("  SINGULAR: these inputs leave a finite motion (a continuum of configurations"
@@ -379,10 +391,7 @@ def singularity_text(rep) -> str:
         lines.append(table(["joint", "cofactor C_ii", "C_ii / sum C_jj (= v_i^2)", "stationary"],
                            [(n, f"{g.cofactors[n]:.6g}", f"{g.relative[n]:.6g}", "YES (C_ii = 0)" if n in g.zero else
                              "no") for n in g.joints]))
-    if rep.condition is not None:
-        lines.append(f"condition number {rep.condition:.4g}" + (
-            f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
-            + f" (L = {rep.length:.4g} m)")
+    lines += _condition_lines(rep)
     for t in rep.singular_twists:
         lines.append(f"\n{t.kind} singular direction:")
         if t.joint_rates:
@@ -395,6 +404,36 @@ def singularity_text(rep) -> str:
         elif t.twist is not None:  # never a zero twist written as a screw
             lines.append(f"  the output '{rep.output}' does not move in it (a zero twist: no screw)")
     return "\n".join(lines)
+
+
+def _condition_meaning(rep) -> str | None:
+    """What ``rep.condition`` is the condition number of (it is not the input -> output map's)."""
+    if rep.condition is None:
+        return None
+    if rep.manipulability is not None:
+        return ("J_o V: the output's twist over an orthonormal basis of the mechanism's joint-rate motions "
+                "(not over the input rates)")
+    return "K_p: the loops' Jacobian in the passive joints (how well the inputs fix them)"
+
+
+def _condition_lines(rep) -> list:
+    """The two condition numbers, each saying what it is of: the input -> output map's first (Merlet's, what a
+    parallel robot's user means), then the one of J_o V or K_p."""
+    io = getattr(rep, "condition_input_output", None)
+    note = getattr(rep, "input_output_note", None)
+    value = f"{io:.4g}" if io is not None else "-"
+    if io is None:
+        lines = [f"condition number of the input -> output map (Merlet's): - ({note})"]
+    else:
+        lines = [f"condition number of the input -> output map (Merlet's): {value}"
+                 + (f" ({note})" if note else "")
+                 + f"  (of J: the input rates -> {rep.output}'s twist (v/L, w) at its origin, = of J^-1; "
+                   f"L = {rep.length:.4g} m)"]
+    if rep.condition is not None:
+        lines.append(f"condition number {rep.condition:.4g}" + (
+            f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
+            + f" (L = {rep.length:.4g} m) of {_condition_meaning(rep)}")
+    return lines
 
 
 # ------------------------------------------------------------------ results as dictionaries
@@ -414,6 +453,9 @@ def singularity_dict(rep: SingularityReport) -> dict:
         "serial": rep.serial, "actuator": rep.actuator, "constraint": rep.constraint,
         "stationary_joints": list(rep.stationary_joints), "sigma_min": rep.sigma_min,
         "sigmas": rep.sigmas, "condition": rep.condition, "manipulability": rep.manipulability,
+        "condition_of": _condition_meaning(rep),
+        "condition_input_output": getattr(rep, "condition_input_output", None),
+        "condition_input_output_note": getattr(rep, "input_output_note", None),
         "characteristic_length": rep.length, "inputs": list(rep.inputs), "output": rep.output,
         "point": rep.point,
         **_gram_dict(getattr(rep, "gram", ())),

@@ -9,7 +9,11 @@ from .screws import screw_dict
 from .tables import table
 from .tables import shown_text
 
-__all__ = ["statics_dict", "statics_text"]
+__all__ = ["statics_dict", "statics_text", "NO_SOLUTION"]
+
+#: JSON "solution" where the inputs cannot hold the load
+NO_SOLUTION = ("none: no equilibrium; efforts, reactions, constraint_forces and amplification are a least-squares "
+               "fit that leaves least_squares_residual unbalanced, not a solution")
 
 
 def _screw_text(s) -> str:
@@ -35,7 +39,10 @@ def statics_dict(r: StaticsResult, legs=None) -> dict:
          "amplification": r.amplification, "characteristic_length": r.length,
          "constraint_forces": [{"row": k, "value": v} for k, v in r.constraint_forces],
          "actuator_efforts": dict(r.actuator_efforts), "coupled_efforts": dict(r.coupled_efforts),
-         "transmissions": [t.text() for t in r.transmissions], "springs": dict(r.springs), "notes": list(r.notes)}
+         "transmissions": [t.text() for t in r.transmissions], "springs": dict(r.springs), "notes": list(r.notes),
+         # no equilibrium: efforts, reactions, constraint_forces and amplification are a least-squares fit, no solution
+         "least_squares_residual": None if r.equilibrium else r.unbalanced,
+         "solution": "equilibrium" if r.equilibrium else NO_SOLUTION}
     if legs is not None:
         d["legs"] = [leg_dict(leg) for leg in legs]
     return d
@@ -53,7 +60,9 @@ def statics_text(r: StaticsResult, legs=None) -> str:
     if not r.equilibrium:
         lines.append(f"NO EQUILIBRIUM: the inputs ({', '.join(r.inputs) or 'none'}) cannot hold this load "
                      f"(unbalanced generalized force {r.unbalanced:.3g})")
-    if r.inputs:
+        lines.append("no actuator efforts and no joint reactions hold it: those of a least-squares fit are not shown "
+                     "(--json has them, with \"solution\" and \"least_squares_residual\" saying they are a fit)")
+    if r.inputs and r.equilibrium:
         lines.append("")
         lines.append(table(["actuator", "effort"], [
             (n, "indeterminate (redundant actuation)" if r.efforts[n] is None else f"{shown_text(r.efforts[n])} {r.units[n]}")
@@ -72,10 +81,11 @@ def statics_text(r: StaticsResult, legs=None) -> str:
             lines.append(f"amplification |efforts| / |load| = {r.amplification:.3g} (lengths made dimensionless by "
                          f"L = {r.length:.4g} m; actuator sigma {r.sigma_actuator:.3g})")
     rows = [(x.joint, x.kind, *(shown_text(v, 5) for v in x.wrench)) for x in r.reactions]
-    lines.append("")
-    lines.append("joint reactions: what the parent side exerts on the child side, at each joint's origin, world axes")
-    lines.append(table(["joint", "kind", "fx [N]", "fy", "fz", "mx [N m]", "my", "mz"], rows))
-    if r.indeterminate:
+    if r.equilibrium:
+        lines.append("")
+        lines.append("joint reactions: what the parent side exerts on the child side, at each joint's origin, world axes")
+        lines.append(table(["joint", "kind", "fx [N]", "fy", "fz", "mx [N m]", "my", "mz"], rows))
+    if r.indeterminate and r.equilibrium:
         lines.append(f"'?': not determined by statics ({r.indeterminate} redundant constraint or actuator "
                      "direction(s): an overconstrained linkage, or a planar one's out-of-plane components)")
     for name, f in r.springs.items():

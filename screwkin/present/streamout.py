@@ -28,7 +28,7 @@ def parquet_available() -> bool:
 
 class SweepWriter(WholeOrNothing):
     """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written), each through
-    present/outfile.OutputFile: written as PATH.partial and renamed once the sweep is whole."""
+    present/outfile.OutputFile: written as PATH.<random>.partial and renamed once the sweep is whole."""
 
     def __init__(self, csv: str | None = None, parquet: str | None = None):
         if parquet:

@@ -239,7 +239,7 @@ def _range_mean(values, y) -> float:
 
 def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
              fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress=None, q_start=None) -> DynamicsResult:
+             cs: float = 0.05, progress=None, q_start=None, branch: str = "continue") -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 
@@ -271,7 +271,8 @@ def dynamics(mech, input: str, speed: float, start: float, stop: float, steps: i
         mech.link_frame(ld.link)  # a clear error for an unknown link
     solver = PositionSolver(mech, inputs)
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
-                near=None if q_start is not None else near, rate=speed, q_start=q_start)
+                near=None if q_start is not None else near, rate=speed, q_start=q_start, branch=branch)
+    notes += res.change_point_notes  # the change points passed, and the branch taken at each
     model = mech.model
     data = mech.scratch_data()
     a_idx = mech.velocity_indices(inputs)

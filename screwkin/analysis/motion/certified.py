@@ -34,7 +34,9 @@ from ...model.square import SquareSystem
 from ...model.cuts import Assembly
 from ...model.symmetry import find_symmetries
 from .dyad_modes import dyad_modes
-from .known_counts import known_count
+from . import generic_modes
+from .modes import continuum_words
+from .known_counts import STEWART, known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
 
 NO_LOOPS = "no loops"
@@ -58,7 +60,9 @@ class ModeCount:
                  published count), None when it is not;
     reason:      why completeness is not certified ("" when it is);
     detail:      what the search did: paths tracked and failed, the trace test's value, the
-                 symmetry group's size, roots at infinity and spurious ones, seconds."""
+                 symmetry group's size, roots at infinity and spurious ones, seconds;
+    check:       the certificate's own counts, checked before it is given (``checked``: every check
+                 held): what is counted, paths and failed paths, the bound, distinct solutions."""
 
     found: int
     complete: bool
@@ -68,6 +72,7 @@ class ModeCount:
     certificate: str | None
     reason: str = ""
     detail: dict = field(default_factory=dict)
+    check: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -85,7 +90,7 @@ def obstacle(solver) -> str | None:
     if why:
         return f"the loop closure is not polynomial: {why}"
     if solver.free_dofs:
-        return f"these inputs leave {solver.free_dofs} degree(s) of freedom free (a continuum)"
+        return continuum_words(solver.free_dofs)
     if not mech.cuts:
         return NO_LOOPS
     return None
@@ -130,9 +135,17 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
                 + (f" ({solver.idle_dofs} idle degree(s) of freedom: links that spin without moving a joint "
                    "centre, not on a leg that is a distance)" if solver.idle_dofs else "")
                 + ": positive-dimensional solution sets are not tracked")
+    known = known_count(closure, problem.frozen, problem.target)
+    if known is STEWART:  # a parameter homotopy from the architecture's generic solution set
+        arch = generic_modes.architecture(problem, closure, mech.length)
+        if arch is not None:
+            modes, *counts = generic_modes.platform_modes(solver, problem, closure, arch, seed, options,
+                                                          lambda x: _lift(solver, problem, closure, x))
+            found, real, cplx, certificate, reason, detail, check = counts
+            return Certified(modes, ModeCount(found, certificate is not None, "parameter homotopy", real, cplx,
+                                              certificate, reason, detail, check))
     group = find_symmetries(closure, rng)
     system = SquareSystem(closure, rng)
-    known = known_count(closure, problem.frozen, problem.target)
     roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
                       trace_limit=options.trace_limit)
     ends = to_target(system, roots, np.zeros(system.n), options)
@@ -206,8 +219,11 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
     certificate, reason = None, roots.why
     if known is not None:
         reached = found if known.of == "poses" else sets
-        if reached >= known.bound and failed == 0 and lost == 0:
+        if reached == known.bound and failed == 0 and lost == 0:
             certificate, reason = f"{known.bound} {known.of}, the most for {known.what} ({known.source})", ""
+        elif reached > known.bound:  # a count past the bound: solutions counted twice, or not solutions
+            reason = (f"{reached} {known.of} found, more than the {known.bound} at most for {known.what} "
+                      f"({known.source}): some are counted twice, so the count is no certificate")
         else:
             reason = (f"{reached} {known.of} found of at most {known.bound} for {known.what} ({known.source})"
                       + (f"; {failed} path(s) failed" if failed else "")
@@ -224,8 +240,13 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
               "failed": int(roots.failed + failed), "witnesses": int(roots.witnesses), "trace": roots.trace,
               "at_infinity": int(np.sum(ends.status == "infinity")), "spurious": int(np.sum(finite & ~closes)),
               "angle_sets": sets, "unknowns": int(closure.nt), "seconds": round(float(seconds), 3)}
+    check = {"method": "monodromy" + (", published count" if known is not None else ", trace test"),
+             "paths": int(roots.paths + ends.paths), "failed_paths": int(roots.failed + failed),
+             "bound": known.bound if known is not None else None, "counts": known.of if known is not None else
+             "distinct placements of the links", "distinct": found, "real_not_polished": lost,
+             "checked": certificate is not None}
     count = ModeCount(found, certificate is not None, "monodromy", len(modes), len(distinct), certificate, reason,
-                      detail)
+                      detail, check)
     # a regular endpoint leaves the verdict to the measures (and, where they are small, to Newton's
     # convergence: modes.simple_root); two paths that met, or a singular endpoint, are a multiple root
     return Certified([(q, a, n, None if simple else False) for _, q, a, n, simple in modes], count)

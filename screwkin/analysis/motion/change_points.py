@@ -12,62 +12,22 @@ sweep's configuration), and kept where the measure falls below ``Tolerances.sing
 configuration -- and at the constraint singularities already located -- the local analysis decides
 what the point is; the branch the motion comes in on and the one it continues on are those whose
 tangents are nearest (largest |cos|) the sweep's joint rates on either side.
+
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 from ...errors import AssemblyError
-from ..local import LocalAnalysis, local_analysis
+from ..local import local_analysis
 from ..singularities.singular import Generic, measures
-from .singular_points import dips, reclosing
+from .crossing import TIGHT_CLOSURE, ChangePoint, dips, nearest_branch, reclosing
 
 __all__ = ["ChangePoint", "change_points"]
 
-#: The closure tolerance the refined configurations are solved to when Newton gets there (singular_points' too).
-TIGHT_CLOSURE = 1e-14
-
-
-@dataclass(frozen=True)
-class ChangePoint:
-    """A constraint singularity met along a sweep: ``input`` [rad or m], the measure there, the
-    configuration, its local analysis, and the branches (indices into local.branches) the motion comes
-    in on and continues on (None when the motion does not run on either side, or no branch is near)."""
-
-    input: float
-    sigma: float
-    q: np.ndarray
-    local: LocalAnalysis
-    came: int | None
-    goes: int | None
-    located: bool  # found here (a dip without a sign change), not by singular_points
-
-
-def _direction(mech, rates):
-    v = np.asarray(rates, float).copy()
-    v[mech.translational] /= mech.length
-    n = np.linalg.norm(v)
-    return v / n if n > 0 else None
-
-
-def _nearest(mech, local, rates):
-    """The branch whose tangent is nearest the direction of ``rates`` (joint rates), or None."""
-    u = _direction(mech, rates)
-    if u is None or not local.branches:
-        return None
-    names = mech.coordinate_names
-    best, score = None, 0.0
-    for k, b in enumerate(local.branches):
-        t = _direction(mech, [b.tangent.get(n, 0.0) for n in names])
-        if t is None:
-            continue
-        c = abs(float(u @ t))
-        if c > score:
-            best, score = k, c
-    return best
 
 
 def change_points(solver, res, located=(), xtol: float | None = None) -> tuple:
@@ -119,7 +79,7 @@ def change_points(solver, res, located=(), xtol: float | None = None) -> tuple:
             a, b = j - 1, j
         else:
             a, b = j, j + 1
-        came = _nearest(mech, local, res.rates[a]) if 0 <= a < n else None
-        goes = _nearest(mech, local, res.rates[b]) if 0 <= b < n else None
+        came = nearest_branch(mech, local, res.rates[a]) if 0 <= a < n else None
+        goes = nearest_branch(mech, local, res.rates[b]) if 0 <= b < n else None
         out.append(ChangePoint(float(x), float(s), q, local, came, goes, new))
     return tuple(out)

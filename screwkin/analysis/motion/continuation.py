@@ -38,13 +38,17 @@ import pinocchio as pin
 
 from ...errors import AssemblyError
 from ...model.geometry import TINY
+from ..singularities.singular import measures
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
-           "LIMIT_REASON"]
+           "LIMIT_REASON", "CHANGE_REASON", "at_change_point"]
 
 LIMIT_REASON = ("limit position: the passive joints become undetermined (an actuator singularity); "
                 "the input cannot go further on this branch")
+#: Where an engine stops at a "limit position" where the loops' Jacobian K itself loses rank: a change point,
+#: which the input passes (analysis.motion.sweep carries the motion on through it; the engine does not turn back).
+CHANGE_REASON = "change point: branches of the motion cross here (the loops' Jacobian loses rank)"
 
 
 class Stuck(Exception):
@@ -181,6 +185,14 @@ def returned(mech, x, start, h, q, q0, scale) -> bool:
     tol = mech.tolerances
     return bool(abs(x - start) < tol.equal * max(1.0, abs(h))
                 and np.linalg.norm(pin.difference(mech.model, q, q0) / scale) < tol.geometry)
+
+
+def at_change_point(solver, q) -> dict:
+    """The singularity measures at a located limit position q (analysis.singularities.singular.measures),
+    with "change": whether K itself loses rank there (a change point, not a limit position: the input
+    passes it on a branch that goes on)."""
+    m = measures(solver.mech, q, solver.generic())
+    return {**m, "change": solver.generic().rank_K > 0 and m["constraint"] < solver.mech.tolerances.singular}
 
 
 def continuation_steps(mech, name: str, dx: float) -> int:

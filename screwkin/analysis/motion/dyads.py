@@ -37,8 +37,7 @@ from ...model.manifold import continuous_angle, set_continuous_angle
 from ...model.planar_graph import DyadPlan, plan
 from ...model.state import KinematicState
 from .batch_sweep import batch_closure
-from .continuation import LIMIT_REASON, locate, returned
-from ..singularities.singular import measures
+from .continuation import CHANGE_REASON, LIMIT_REASON, at_change_point, locate, returned
 
 __all__ = ["Jet", "ClosedFormSweep", "ClosedFormCurve", "planar_sweep", "cached_plan"]
 
@@ -552,8 +551,11 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
         q_lim = unwrap(Q, D, np.array([x_lim]))[0]
         if not _residuals_ok(mech, q_lim[None]):
             return None
-        sig = measures(mech, q_lim, solver.generic())["actuator"]
-        limits.append((float(x_lim), float(sig), q_lim))
+        m = at_change_point(solver, q_lim)
+        limits.append((float(x_lim), float(m["actuator"]), q_lim))
+        if m["change"]:  # not a limit: a change point, which sweep carries the motion through
+            stopped, reason = float(x_lim), CHANGE_REASON
+            break
         if not turn:
             stopped, reason = float(x_lim), LIMIT_REASON
             break

@@ -69,11 +69,10 @@ def given_configuration(solver, q) -> tuple:
     flipped = mech.closure.wrong_branch(q)
     if flipped:
         shown.append(f"{', '.join(flipped)} assembled with a reversed axis")
-    raise AssemblyError(mech.path, norm, 0, given=True,
-                        reason="every joint is given, so nothing is solved, and the loops do not close there: "
-                               + ("; ".join(shown) or f"residual {norm:.3g}"),
-                        detail="leave out the --set of a joint the loops should solve for, or give the values "
-                               "of a closed configuration")
+    raise AssemblyError(mech.path, norm, 0, message=(
+        "cannot assemble the mechanism: every joint is given, so nothing is solved, and the loops do not close "
+        f"there: {'; '.join(shown) or f'residual {norm:.3g}'}; the loop-closure residual there is {norm:.3g} "
+        "(leave out the --set of a joint the loops should solve for, or give the values of a closed configuration)"))
 
 
 def first_count(first: str, assembly):

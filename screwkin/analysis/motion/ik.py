@@ -16,6 +16,7 @@ from ...model.linalg import rank
 from ...model.state import KinematicState, angular_loop_joints, model_with_output
 from ...model.topology import frame_link
 from . import certified
+from .closed_ik import closed_form_ik
 from .position import PositionSolver
 from .solution import PositionResult
 
@@ -32,12 +33,19 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     The target is one more cut joint, a weld (a ball joint for ``position_only``) between a
     ground frame at ``pose`` and the output frame, solved together with the loop closures.  Raises
     AssemblyError (saying how close it got) when the pose is unreachable.
-    Solutions are labelled and ordered as those of PositionSolver.solve.  ``method`` "auto": every
-    solution by homotopy continuation where the closure is polynomial (analysis.motion.certified:
-    certified by the trace test or a published count), random starts added where it is not
+    Solutions are labelled and ordered as those of PositionSolver.solve.  ``method`` "auto": in closed
+    form where the mechanism gives one (a full pose of a platform whose legs' lengths follow from it, a
+    6R arm whose last three axes meet: analysis.motion.closed_ik; its ``modes.method`` starts with
+    "closed form"), else every solution by homotopy continuation where the closure is polynomial
+    (analysis.motion.certified: certified by the trace test or a published count), random starts added where it is not
     certified; "starts": damped Newton from random starts only.
     """
     out_frame = mech.link_frame(output)
+    if method == "auto" and not position_only and mech.coordinates:
+        closed = closed_form_ik(PositionSolver(mech, mech.actuated or [mech.coordinates[0].joint], output=output),
+                                output, pose)
+        if closed is not None:
+            return closed
     # the target frame (made with the model: adding frames later would outgrow existing Data) placed at
     # the pose in a copy of the model, with the output frame where place_tool put it: the mechanism's own
     # model is not changed (threads may share it)
@@ -126,9 +134,15 @@ def branches(mech, res: PositionResult) -> Branches:
     joints are solved on their own, so the branches are the combinations of the legs' settings.
     A planar leg of three one-DOF joints (a dyad: two unknowns) has at most two closures (one when
     two of its joints slide)."""
+    n = len(res.solutions)
+    c = res.modes
+    if c is not None and c.method == "closed form (legs)":  # every combination of the legs' branches exists
+        legs = tuple((tuple(j), k, k) for j, k in zip(c.detail["leg_joints"], c.detail["branches_per_leg"]))
+        return Branches(c.found, legs, c.found, "closed form: each leg extended or reversed through its pivot")
+    if c is not None and c.method == "closed form (Pieper)":
+        return Branches(n, (), n, "closed form (Pieper): every real joint solution")
     import networkx as nx
 
-    n = len(res.solutions)
     if res.free_dofs or not res.output or not res.solutions:
         return Branches(n, (), None, "")
     topo = mech.topology(res.solutions[0].q)

@@ -100,7 +100,7 @@ class Interactive:
         self._values = {n: given.get(n, drawn.get(n, 0.0)) for n in self.inputs}
         source = "the file's value" if missing else None
         try:
-            q, k, n, _ = choose_mode(self.solver, dict(self._values), mode)
+            q, k, n, res = choose_mode(self.solver, dict(self._values), mode)
         except AssemblyError:
             if not missing:
                 raise
@@ -109,7 +109,8 @@ class Interactive:
             self._values.update({n: assembled[n] for n in missing})
             source = ("the first assembled configuration's: the file's configuration does not close at its own "
                       "input values")
-            q, k, n, _ = choose_mode(self.solver, dict(self._values), mode)
+            q, k, n, res = choose_mode(self.solver, dict(self._values), mode)
+        self.notes = res.notes  # (a continuum's sample: said, as choose_mode says it)
         self.opened = "opened at " + ", ".join(
             f"{name} = " + (f"{v * 1000:.6g} mm" if mech.translational[mech.coordinate(name).idx_v]
                             else f"{math.degrees(v):.6g} deg") + ("" if name in given else f" ({source})")

@@ -18,7 +18,7 @@ from ...model.linalg import null_space, rank
 from ...model.state import KinematicState
 from ..singularities.singular import scaled_jacobians
 
-__all__ = ["merge", "moves", "connected", "ModeLabels", "choose_mode", "simple_root"]
+__all__ = ["merge", "moves", "connected", "ModeLabels", "choose_mode", "simple_root", "continuum_words"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -28,17 +28,31 @@ def choose_mode(solver, values: dict, k: int | None = None, near: dict | None = 
     """The assembly mode a configuration is analysed in, or a motion starts from: the ``k``-th of
     ``solver.solve(values, near=near, **options)``'s solutions (default 1: the one nearest the reference
     configuration, or ``near``'s), as (q, k, n, result) with n the modes found and result solve's
-    PositionResult.  A usage error when k is more than n.  The one rule every command's ``--mode K`` (and a
-    study's ``mode``) goes by.  A k over 1 needs the list of every mode: solve searches them (method
-    "auto", whatever ``options`` say), listed from the reference configuration (``near`` is not used: it
-    picks one mode, not a list)."""
+    PositionResult.  A usage error when k is more than n.  Where the inputs leave a continuum (free degrees of
+    freedom), the solutions are samples of it, not modes: n is 1, the first sample is used, a k over 1 is a
+    usage error, and the result's notes say so (continuum_words).  The one rule every command's ``--mode K`` (and a
+    study's ``mode``) goes by.  A k over 1 needs the list of every mode: solve searches them (method "auto",
+    whatever ``options`` say), listed from the reference configuration (``near`` is not used: it picks one
+    mode, not a list)."""
     if k is not None and k > 1:
         near, options = None, {**options, "method": "auto"}
     res = solver.solve(values, near=near, starts=starts, **options)
     n, k = len(res.solutions), k or 1
+    if res.free_dofs:  # a continuum: its configurations found are samples of it, not modes to number
+        if k > 1:
+            raise UsageError(f"--mode {k}: {continuum_words(res.free_dofs)}: the configurations found are samples of "
+                             "it, not assembly modes to choose among; --set more inputs (or --near) to choose one")
+        note = (f"{continuum_words(res.free_dofs)}: the configuration used is one sample of it, the one nearest "
+                "the starting configuration (--near's, else the file's), not an assembly mode")
+        return res.solutions[0].q, 1, 1, replace(res, notes=res.notes + (note,))
     if k > n:
         raise UsageError(f"--mode {k}: these inputs give {n} assembly mode{'s' if n != 1 else ''}")
     return res.solutions[k - 1].q, k, n, res
+
+
+def continuum_words(free: int) -> str:
+    """The words every command says a continuum in: the inputs leave ``free`` degrees of freedom free."""
+    return f"these inputs leave {free} degree{'s' if free != 1 else ''} of freedom free (a continuum)"
 
 
 def merge(solver, sols):

@@ -375,11 +375,12 @@ def _duplicates(Y, tol) -> bool:
 
 
 def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = MonodromyOptions(),
-              seeds=None, trace_test: bool = True, trace_limit: int | None = None) -> Roots:
+              seeds=None, trace_test: bool = True, trace_limit: int | None = None, stop_at: int | None = None) -> Roots:
     """Every root (one per orbit of ``group``) of system.equations(x) = c0 with c0 = G(x0), by
     monodromy, certified by the trace test (see the module) -- or, with ``trace_test`` False, until
     ``patience`` rounds find no new root (a known root count then decides).  ``seeds``: more roots at
-    c0.  The work is bounded by ``options.budget`` paths.
+    c0.  The work is bounded by ``options.budget`` paths.  ``stop_at``: a known bound on the number of
+    roots (orbits): the loops stop as soon as it is reached (no trace test is needed then).
 
     With the trace test, the main loops stop at the first round that finds nothing; the test's own
     loops (over its fibre, the main roots among it) go on a round at a time, the test tried after
@@ -396,6 +397,8 @@ def all_roots(system, group: SignGroup, x0, rng, options: MonodromyOptions = Mon
     budget = o.budget if trace_test else o.count_budget
     for rnd in range(1, o.max_rounds + 1):  # the main loops
         stale = stale + 1 if main.round() == 0 else 0
+        if stop_at is not None and len(main.X) >= stop_at:
+            break
         if len(main.X) >= o.max_roots or main.paths > budget:
             why = (f"more than {o.max_roots} roots" if len(main.X) >= o.max_roots else
                    f"the budget of {budget} paths") + ": the search stopped there"

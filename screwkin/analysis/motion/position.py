@@ -36,7 +36,7 @@ from ...model.cuts import Assembly
 from ...model.geometry import wrap_angle
 from ...model.manifold import set_continuous_angle
 from ...model.state import KinematicState, angular_loop_joints, frame_parent
-from ...model.limits import outside_limits
+from ...model.limits import outside_limits, spelled_within_limits
 from ...model.topology import open_joints
 from ...model.algebraic import algebraic_obstacle
 from . import certified, given, modes
@@ -466,6 +466,7 @@ class PositionSolver:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here
         when its measure is below the singular tolerance, modes.simple_root)."""
         mech, tol = self.mech, self.mech.tolerances
+        q = spelled_within_limits(mech, q)  # the pose's angle set within the limits, where one exists
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
         if sigma < tol.singular and simple is None:

@@ -13,38 +13,10 @@ import numpy as np
 from ...errors import AssemblyError
 from ..singularities.singular import Generic, measures, scaled_jacobians
 from .links import LOCATE_XTOL
+from .crossing import LOOK_BELOW, dips, reclosing
 from .sweep import SweepResult, SweepSingularity
 
 __all__ = ["locate_singularities", "dips", "reclosing", "LOOK_BELOW"]
-
-#: A dip of a relative singular value along a sweep deeper than this is looked at more closely.
-LOOK_BELOW = 0.5
-
-
-def dips(m, xs):
-    """(k, k - 1, k + 1) for each recorded step k where the measure m is lowest among its neighbours and
-    below LOOK_BELOW (the neighbours' indices clipped to the sweep)."""
-    for k in range(len(m)):
-        left = m[k - 1] if k > 0 else np.inf
-        right = m[k + 1] if k + 1 < len(m) else np.inf
-        if m[k] <= left and m[k] <= right and m[k] <= LOOK_BELOW:
-            yield k, max(k - 1, 0), min(k + 1, len(xs) - 1)
-
-
-def reclosing(solver, res, q_k, tight):
-    """x -> the configuration at input value x closed from the sweep's q_k (tolerances ``tight`` when
-    Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
-    mech, frozen = solver.mech, solver.frozen
-
-    def q_at(x):
-        q0 = solver.set_inputs(q_k, {res.input: x})
-        try:
-            return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
-        except AssemblyError:
-            return mech.closure.solve(q0, frozen=frozen).q
-
-    return q_at
-
 
 def _matrix(mech, q, kind, g, V_ref=None):
     """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""

@@ -61,15 +61,16 @@ def sweep_chunks(solver, name: str, start: float, stop: float, steps: int, fixed
     if chunk < 1:
         raise UsageError("a chunk needs at least 1 step")
     h = (stop - start) / steps if steps else 0.0
-    j, q = 0, None
+    j, q, prior = 0, None, None
     while True:
         j1 = min(steps, j + chunk)
         a = start + j * h
         b = stop if j1 == steps else start + j1 * h
         res = sweep(solver, name, a, b, max(j1 - j, 1), fixed=fixed, near=near if q is None else None,
-                    rate=rate, q_start=q_start if q is None else q, **options)
+                    rate=rate, q_start=q_start if q is None else q, prior=prior, **options)
         piece = res if q is None else _drop_first(_keep_turns(solver.mech, res, q))
         yield piece
         if res.stopped_at is not None or j1 >= steps or not len(res.q):
             return
         q, j = np.array(piece.q[-1] if len(piece.q) else res.q[-1]), j1
+        prior = (float(res.values[-2]), np.array(res.q[-2])) if len(res.values) > 1 else None

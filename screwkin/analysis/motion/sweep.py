@@ -17,17 +17,25 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError, quote, shorten
 from ...model.geometry import wrap_angle
 from .batch_sweep import batch_closure, batched_motion, motion_rates
 from .continuation import Curve, Motion, Stuck, continuation_steps
+from .crossing import START, crossing, follow, passed
 from .dyads import cached_plan, planar_sweep
 from ...model.limits import outside_limits
 from .tracker import Tracker
 from ..singularities.singular import scaled_jacobians
 
-__all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start"]
+__all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
+
+CHANGE_NOTE = "change point at "  # how the note naming a change point passed begins
+
+#: What a motion does at a change point: go on along the branch whose tangent continues the incoming one,
+#: or along the other one (sweep's ``branch``; the commands' --branch).
+BRANCHES = ("continue", "other")
 
 #: The most continuation steps the per-step tracker is asked for by a grid coarser than its longest step
 #: (Tolerances.max_step): --from 0 --to 1e5rad in 2,000 steps is a million steps of 0.1 rad, hours of
@@ -66,6 +74,12 @@ class SweepResult:
     skipped: tuple = ()  # input values on the grid the motion passed but could not solve at (holes)
     method: str = "tracker"  # how it was computed: "closed form" (dyads), "tracker", "batched" (see notes)
     notes: tuple = ()  # one line each: what the computation chose or fell back to
+    change_points: tuple = ()  # analysis.motion.change_points.ChangePoint of each change point passed
+
+    @property
+    def change_point_notes(self) -> tuple:
+        """The notes that name the change points passed and the branch taken at each (one line each)."""
+        return tuple(n for n in self.notes if n.startswith(CHANGE_NOTE))
 
     @property
     def completed(self) -> bool:
@@ -164,7 +178,8 @@ def _refined(f, start, h, k):
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
-          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True) -> SweepResult:
+          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True,
+          branch: str = "continue", prior=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
 
@@ -183,11 +198,24 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     fail (said in ``notes``); False: the per-step tracker.
     progress: a callable ``progress(done, total)`` told of the grid values reached as the tracker
     goes (present/progress.Progress draws it on a terminal); None: not told.
+    branch: at a change point (branches of the configuration space cross) the motion goes on along
+    the branch whose tangent continues the incoming one ("continue"), or along the other ("other");
+    each is named in ``change_points`` and said in ``notes`` (``_through_change_points``).
+    prior: (input value, configuration) the motion came from before ``start`` (a chunk of a longer
+    sweep): a change point on ``start`` is passed as inside a motion, not chosen as at its start.
     """
+    if branch not in BRANCHES:
+        raise UsageError(f"branch: one of {', '.join(BRANCHES)}, got {quote(str(branch), 40)}")
     fixed = _other_inputs(solver, name, steps, fixed)
-    curve, requested = Curve(solver, name), (start, stop, steps)
     max_steps = max_steps or 20 * steps + 100
     q0 = _start(solver, name, start, fixed, near, q_start)
+    res = _engine(solver, name, q0, start, stop, steps, fixed, rate, progress, turn, max_steps, closed_form, batch)
+    return _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior)
+
+
+def _engine(solver, name, q0, start, stop, steps, fixed, rate, progress, turn, max_steps, closed_form, batch):
+    """The SweepResult of the engine that applies (see ``sweep``), started from q0."""
+    curve, requested = Curve(solver, name), (start, stop, steps)
     if closed_form:
         f = _closed_form(solver, name, q0, start, stop, steps, rate, turn, max_steps)
         if f is not None:
@@ -311,3 +339,170 @@ def _finish(solver, name, motion, rate, requested, turn, unit, method="tracker")
                        tuple(motion.notes))
 
 
+
+
+def _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior=None):
+    """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
+    crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
+    change point to the grid values after it; where the engine's own result is not that branch (it
+    slipped onto the other, or stopped or turned back there as at a limit position) the motion is cut
+    there and the sweep goes on from the branch's configuration at the next grid value (with ``turn``,
+    until it is back there: the whole circuit from the change point on).  A change point met with the
+    input running back (after a limit position, with ``turn``) is named, the engine's motion kept.
+    Each change point is named in ``change_points`` and in ``notes``."""
+    name = res.input
+    start, stop, steps = res.requested
+    h = (stop - start) / steps if steps else 0.0
+    if not solver.mech.cuts or h == 0 or len(res.values) < 1:
+        return res
+    curve = Curve(solver, name)
+    tol, ix = solver.mech.tolerances, curve.ix
+    named, notes = [], []
+    for c in passed(solver, res):
+        if abs(c.x - stop) <= tol.geometry * max(1.0, abs(h)):  # the motion ends on it
+            if not c.limit:
+                continue
+            # an engine stopped on it as at a limit position: the range's last value is the change point
+            try:
+                q_end = solver.mech.closure.solve(solver.set_inputs(c.q, {name: stop}), frozen=curve.frozen(ix)).q
+            except AssemblyError:
+                q_end = c.q
+            end = _finish(solver, name, Motion([stop], [q_end]), res.rate, res.requested, res.turn, res.unit)
+            return replace(_joined(solver, res, _slice(res, c.before + 1), end, None, (), (), c),
+                           change_points=res.change_points + tuple(named), notes=_once(res.notes + tuple(notes)))
+        cp, v, why = crossing(solver, curve, res, c, branch == "other", prior if c.before < 0 else None)
+        named.append(cp)
+        notes.append(_change_point_note(solver, name, res.unit, cp, why, branch))
+        if len(cp.local.branches) < 2 and not c.limit:  # not a crossing of branches: the engine went on along its one
+            named.pop()
+            notes.pop()
+            continue
+        if v is None or v[ix] * np.sign(h) < 0:  # not drivable through, or met running back (turn)
+            if v is not None:
+                notes[-1] += "; met with the input running back: the motion is the engine's"
+            continue
+        # the grid values on and after the change point, in the direction of the motion, on the branch followed
+        j = int(np.floor((c.x - start) / h + GRID_ON))
+        on = abs(start + j * h - c.x) <= tol.geometry * max(1.0, abs(h))
+        j = j if on else j + 1
+        X, Q, q_next = [], [], None
+        while j <= steps:
+            x = start + j * h
+            q = follow(curve, c.q, c.x, v, x)
+            if q is None:
+                break
+            if abs(x - c.x) >= tol.local_step * curve.scale[ix]:
+                q_next = (j, x, q)
+                break
+            X.append(x)
+            Q.append(q)
+            j += 1
+        if q_next is None and j <= steps:  # the branch cannot be followed: the engine's motion stands
+            notes[-1] += "; the branch could not be followed from it: the motion is the engine's"
+            continue
+        # where the engine's own result is that branch, it stands
+        k0 = c.before + 1
+        after = list(zip(X, Q)) + ([q_next[1:]] if q_next is not None else [])
+        if not c.limit and _engine_took(solver, curve, res, k0, after, h):
+            continue
+        head = _slice(res, k0)
+        middle = _finish(solver, name, Motion(X, Q), res.rate, res.requested, res.turn, res.unit) if X else None
+        if middle is not None and on:
+            middle.rates[0] = v / v[ix] * res.rate  # at the change point: the followed branch's tangent
+        tail = None
+        if q_next is not None:
+            j_n, x_n, q_n = q_next
+            tail = sweep(solver, name, x_n, stop, steps - j_n, fixed=fixed, rate=res.rate, progress=progress,
+                         turn=res.turn, max_steps=max(max_steps - len(head.values) - len(X), 1), q_start=q_n,
+                         closed_form=closed_form, batch=batch, branch=branch)
+        return _joined(solver, res, head, middle, tail, named, notes, c)
+    if not named:
+        return res
+    return replace(res, change_points=res.change_points + tuple(named), notes=_once(res.notes + tuple(notes)))
+
+
+def _once(notes) -> tuple:
+    """The notes, each said once (a motion through limit positions passes one change point again and again)."""
+    return tuple(dict.fromkeys(notes))
+
+
+def _engine_took(solver, curve, res, k0, after, h) -> bool:
+    """Whether the engine's recorded configurations from index k0 are ``after`` ((input value,
+    configuration) each, the branch followed), the input running the way of h."""
+    tol = solver.mech.tolerances
+    for i, (x, q) in enumerate(after):
+        k = k0 + i
+        if k >= len(res.values) or abs(res.values[k] - x) > tol.equal * max(1.0, abs(h)):
+            return False
+        if k > 0 and (res.values[k] - res.values[k - 1]) * h <= 0:
+            return False
+        if np.linalg.norm(pin.difference(solver.mech.model, res.q[k], q) / curve.scale) > tol.geometry and \
+                np.linalg.norm(solver.signature(res.q[k]) - solver.signature(q)) > tol.geometry * solver.mech.length:
+            return False  # (the joint centres apart: not an angle written a turn away)
+    return True
+
+
+GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index counts as on it
+
+
+def _change_point_note(solver, name, unit, cp, why, branch) -> str:
+    """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
+    # (located where the constraint measure is least: to about the square root of the closure's round-off)
+    at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
+    n = len(cp.local.branches)
+    what = f"{_WORDS.get(n, str(n))} branches cross" if n > 1 else \
+        f"the loops' Jacobian loses rank (local analysis: {cp.local.kind})"
+    if cp.goes is not None and why and why.startswith(START):
+        how = why.split("; ")[0] + ("; taking the other one instead, as --branch other asks" if cp.switched else "")
+        why = "; ".join(why.split("; ")[1:]) or None
+    elif cp.goes is None:
+        how = ("no branch through it moves the input with the other inputs held" if n else
+               "the local analysis finds no branch through it")
+        how += ": the motion is the engine's"
+    elif cp.switched:
+        how = "continuing on the other branch, as --branch other asks (the default continues the motion's tangent)"
+    else:
+        how = "continuing on the branch whose tangent continues the motion"
+    other = " (the other: --branch other)" if branch == "continue" and n > 1 and cp.goes is not None else ""
+    return f"{CHANGE_NOTE}{name} = {at}: {what}; {how}{other}" + (f"; {why}" if why else "")
+
+
+_WORDS = {2: "two", 3: "three", 4: "four"}
+
+
+def _slice(res, n):
+    """The first n configurations of res (n >= 0), its limits before them."""
+    xs = res.values[:n]
+    lim = tuple(s for s in res.limits if n and _between(s.input, res.values[0], res.values[n - 1]))
+    coupled = None if res.coupled is None else {k: v[:n] for k, v in res.coupled.items()}
+    return replace(res, values=xs, q=res.q[:n], joints=res.joints[:n], rates=res.rates[:n],
+                   accelerations=res.accelerations[:n], limits=lim, coupled=coupled,
+                   skipped=tuple(x for x in res.skipped if n and _between(x, res.values[0], res.values[n - 1])))
+
+
+def _between(x, a, b) -> bool:
+    return min(a, b) <= x <= max(a, b)
+
+
+def _joined(solver, res, head, middle, tail, named, notes, c):
+    """head + middle + tail (SweepResults; middle or tail may be None): one motion."""
+    parts = [p for p in (head, middle, tail) if p is not None and len(p.values)]
+    cat = (lambda f: np.concatenate([getattr(p, f) for p in parts])) if parts else (lambda f: getattr(head, f))
+    last = tail if tail is not None else (middle or head)
+    coupled = None
+    if res.coupled is not None:
+        coupled = {k: np.concatenate([p.coupled[k] for p in parts if p.coupled is not None]) for k in res.coupled}
+    methods = [] if tail is None or tail.method == head.method else [
+        f"from {res.input} = {tail.values[0]:.9g} on (after the change point) the motion is computed by: {tail.method}"]
+    stopped, reason = (last.stopped_at, last.stop_reason) if tail is not None else (None, None)
+    if tail is None and middle is not None and len(middle.values) and \
+            abs(middle.values[-1] - res.requested[1]) > solver.mech.tolerances.equal * max(1.0, abs(res.requested[1])):
+        stopped, reason = float(middle.values[-1]), "the branch could not be followed further"
+    return replace(res, values=cat("values"), q=np.vstack([p.q for p in parts]), joints=np.vstack([p.joints for p in parts]),
+                   rates=np.vstack([p.rates for p in parts]), accelerations=np.vstack([p.accelerations for p in parts]),
+                   stopped_at=stopped, stop_reason=reason,
+                   limits=head.limits + (tail.limits if tail is not None else ()),
+                   circuit_closed=bool(tail is not None and tail.circuit_closed), coupled=coupled,
+                   skipped=head.skipped + (tail.skipped if tail is not None else ()),
+                   notes=_once(head.notes + tuple(methods) + tuple(notes) + (tail.notes if tail is not None else ())),
+                   change_points=head.change_points + tuple(named) + (tail.change_points if tail is not None else ()))

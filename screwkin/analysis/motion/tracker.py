@@ -22,8 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..singularities.singular import measures
-from .continuation import LIMIT_REASON, Motion, Stuck, passes_limit, returned
+from .continuation import CHANGE_REASON, LIMIT_REASON, Motion, Stuck, at_change_point, passes_limit, returned
 
 __all__ = ["Tracker", "CONTINUATION_ROUNDS"]
 
@@ -215,8 +214,12 @@ class Tracker:
             q_lim, dx = c.locate_limit(q, t, q_new, held)
             x_lim = x + dx
             self.record(q, x, t, q_lim, x_lim, held=held)
-            sig = measures(c.mech, q_lim, c.solver.generic())["actuator"]
-            m.limits.append((float(x_lim), float(sig), q_lim))
+            ms = at_change_point(c.solver, q_lim)
+            m.limits.append((float(x_lim), float(ms["actuator"]), q_lim))
+            if ms["change"]:  # not a limit: a change point, which sweep carries the motion through
+                if not (self.forward() and (x_lim - self.stop) * self.direction >= 0):
+                    m.stopped, m.reason = float(x_lim), CHANGE_REASON
+                return True
             if not self.turn:
                 if self.forward() and (x_lim - self.stop) * self.direction >= 0:
                     return True  # the limit lies at or past the end of the range: every value was reached

@@ -16,16 +16,17 @@ of sliding inputs taken per L):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...errors import UsageError
 from ...tolerances import DEFAULT, Tolerances
 from ..motion.position import PositionSolver
-from .singular import scaled_jacobians
+from ...model.linalg import null_space, rank
+from .singular import SingularityReport, scaled_jacobians
 
-__all__ = ["Ellipsoid", "Ellipsoids", "ellipsoids_of", "ellipsoids"]
+__all__ = ["Ellipsoid", "Ellipsoids", "ellipsoids_of", "ellipsoids", "with_input_output_condition"]
 
 
 @dataclass(frozen=True)
@@ -127,3 +128,39 @@ def ellipsoids(mech, q, output: str, inputs=None, point: bool = False, length: f
         cols.append(S.J @ x * (L if slide[idx] else 1.0))  # a sliding input's unit is L
     M = np.column_stack(cols) if cols else np.zeros((S.J.shape[0], 0))
     return _of_scaled(M, L, names, tol, 3, output, point)
+
+
+def with_input_output_condition(mech, q, rep: SingularityReport) -> SingularityReport:
+    """``rep`` (singular.classify at q) with the condition number of the map from the input rates to the output's
+    twist: Merlet's for a parallel robot, of its Jacobian J (input rates -> twist), = that of J^-1 (twist -> leg
+    rates), dimensionless as every measure here -- the twist (v/L, w) at the output frame's origin, a sliding
+    input's rate per L, L = ``rep.length``.  It is the largest over the smallest nonzero singular value of the map
+    whose ellipsoids :func:`ellipsoids` gives.  inf where the output moves with the inputs held (an actuator
+    singularity) or loses a direction (a serial one); None, with ``input_output_note`` saying why, without an
+    output or where the inputs do not fix the output (fewer than it needs)."""
+    io, note = _input_output_condition(mech, q, rep)
+    return replace(rep, condition_input_output=io, input_output_note=note)
+
+
+def _input_output_condition(mech, q, rep) -> tuple:
+    tol = mech.tolerances
+    if rep.output is None:
+        return None, "give --output LINK, the moving platform"
+    moving = next((t for t in rep.singular_twists if t.kind == "actuator"), None)
+    if moving is not None and moving.twist is not None and np.linalg.norm(moving.twist) > tol.motion:
+        return float("inf"), "the output moves with the inputs held: an actuator singularity"
+    if rep.serial:
+        return float("inf"), "the output loses a direction: a serial singularity"
+    S = scaled_jacobians(mech, q, rep.output, rep.point, rep.length)
+    inputs = list(rep.inputs)
+    if inputs or mech.cuts:  # (a chain without loops or inputs: every joint is an input, as in ellipsoids)
+        passive = np.setdiff1d(np.arange(mech.nv), mech.velocity_indices(inputs))
+        held = null_space(S.K[:, passive] if S.K.size else np.zeros((0, len(passive))), tol, len(passive))
+        if held.shape[1] and np.linalg.norm(S.J[:, passive] @ held, 2) > tol.motion * np.linalg.norm(S.J, 2):
+            return None, "the inputs do not fix the output: it moves with them held (fewer inputs than it needs)"
+    try:
+        M = ellipsoids(mech, q, rep.output, inputs=inputs or None, point=rep.point, length=rep.length).jacobian
+    except UsageError as exc:  # an input that is not a joint of one freedom, loops not closed
+        return None, str(exc)
+    s = np.linalg.svd(M, compute_uv=False)[:rank(M, tol)]
+    return (float(s[0] / s[-1]), None) if len(s) else (None, "the inputs do not move the output")

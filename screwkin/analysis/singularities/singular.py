@@ -68,6 +68,10 @@ class SingularityReport:
     output: str | None
     point: bool = False  # the output link's origin analysed as a point
     gram: tuple = ()  # GramLoop: the Gram-matrix cofactors of each loop's joint twists
+    # the condition number of the map from the input rates to the output's twist (Merlet's), and why it is None or
+    # inf: analysis.singularities.ellipsoids.with_input_output_condition (classify leaves them None)
+    condition_input_output: float | None = None
+    input_output_note: str | None = None
 
 
 def _rel(s, k):

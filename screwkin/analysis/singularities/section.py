@@ -1,0 +1,141 @@
+"""The serial singular curves of a chain's output point in a section of its workspace, and whether the
+robot is cuspidal (issue 44).
+
+For a chain without loops whose output point is moved by three joints (the others held), the section is
+the plane of two of the point's coordinates with the third held (for a 3R whose first axis is z: y = 0, the
+plane through that axis).  Its serial singular curve is traced like the loci in the plane of two inputs
+(analysis.singularities.loci: the augmented system [held coordinate; held joints; J_p v = 0; |v| = 1],
+J_p the point's Jacobian over the three free joints, dimensionless), seeded by Newton from random joint
+configurations.  A cusp of that curve, where three inverse-kinematic solutions meet, makes a generic 3R
+robot cuspidal -- it can change solution without a singularity -- and its absence makes it not
+(Salunkhe, Spartalis, Capco, Chablat & Wenger 2022; for orthogonal robots Baili, Wenger & Chablat 2004).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import UsageError
+from ...model.state import KinematicState
+from .loci import Loci, LocusSystem, trace_kind
+from .singular import LWA
+
+__all__ = ["Section", "SectionSystem", "trace_section"]
+
+AXES = {"x": 0, "y": 1, "z": 2}
+
+
+class SectionSystem(LocusSystem):
+    """The augmented system of the serial singularity of ``output``'s origin in a workspace section."""
+
+    def __init__(self, mech, output, x_axis, y_axis, level, fixed):  # (LocusSystem's own set-up is for inputs)
+        self.mech, self.kind, self.output, self.point = mech, "serial", output, True
+        self.L = mech.length
+        self.scale = np.where(mech.translational, self.L, 1.0)
+        self.held = [(mech.coordinate(n), float(v), n) for n, v in fixed.items()]
+        self.nv = mech.nv
+        self.axes = (x_axis, y_axis)
+        self.h = ({0, 1, 2} - {x_axis, y_axis}).pop()
+        self.level = float(level)
+        self.fid = mech.link_frame(output)
+        held_v = {c.idx_v for c, _, _ in self.held}
+        self.free = np.array([k for k in range(mech.nv) if k not in held_v], int)
+        if len(self.free) != 3:
+            raise UsageError(f"{mech.path}: a workspace section needs the point moved by three joints: "
+                             f"{len(self.free)} are free (hold the others with --set)")
+        names = list(mech.joint_values(mech.neutral()))
+        self.angular = np.array([n in mech.coordinate_names and not mech.translational[mech.coordinate_names.index(n)]
+                                 for n in names], bool)
+
+    def _pose(self, q):
+        st = KinematicState(self.mech, q)
+        J = st.frame_jacobian(self.fid, LWA)[:3] * self.scale / self.L  # d(p / L)/du
+        return st.frame_placement(self.fid).translation.copy(), J
+
+    def xy(self, q) -> np.ndarray:
+        p, _ = self._pose(q)
+        return np.array([p[self.axes[0]], p[self.axes[1]]])
+
+    def A(self, q) -> np.ndarray:
+        return self._pose(q)[1][:, self.free]
+
+    def residual(self, q, v, A=None) -> np.ndarray:
+        p, J = self._pose(q)
+        A = J[:, self.free] if A is None else A
+        held = []
+        for c, target, _ in self.held:
+            d = self.value(q, c) - target
+            held.append(np.arctan2(np.sin(d), np.cos(d)) if not self.mech.translational[c.idx_v] else d / self.L)
+        return np.concatenate([[(p[self.h] - self.level) / self.L], held, A @ v, [0.5 * (v @ v - 1.0)]])
+
+    def jacobian(self, q, v, A=None) -> np.ndarray:
+        _, J = self._pose(q)
+        A = J[:, self.free] if A is None else A
+        rows = [np.concatenate([J[self.h], np.zeros(len(v))])[None]]
+        H = np.zeros((len(self.held), self.nv + len(v)))
+        for k, (c, _, _) in enumerate(self.held):
+            H[k, c.idx_v] = 1.0
+        rows.append(H)
+        Av = A @ v
+        D = np.empty((len(A), self.nv))
+        for k in range(self.nv):
+            e = np.zeros(self.nv)
+            e[k] = 1e-7
+            D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / 1e-7
+        rows.append(np.hstack([D, A]))
+        rows.append(np.concatenate([np.zeros(self.nv), v])[None])
+        return np.vstack(rows)
+
+    def projected(self, q, t) -> np.ndarray:
+        _, J = self._pose(q)
+        return self.L * (J[list(self.axes)] @ t[:self.nv])
+
+    def edge(self, axis: int, bound: float):
+        def row(qc, vc):
+            p, J = self._pose(qc)
+            return (np.concatenate([J[self.axes[axis]], np.zeros(len(vc))])[None],
+                    np.array([(bound - p[self.axes[axis]]) / self.L]))
+
+        return row
+
+
+@dataclass(frozen=True)
+class Section:
+    loci: Loci
+    cuspidal: bool
+    why: str
+
+
+def trace_section(mech, output, x_axis: str, xs, y_axis: str, ys, level: float = 0.0, fixed=None,
+                  samples: int = 400, seed: int = 0) -> Section:
+    """The serial singular curves of ``output``'s origin in the section (x_axis, y_axis) of its workspace, the
+    third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes and
+    whether the robot is cuspidal (see the module)."""
+    fixed = dict(fixed or {})
+    sys = SectionSystem(mech, output, AXES[x_axis], AXES[y_axis], level, fixed)
+    box = ((min(xs[0], xs[-1]), max(xs[0], xs[-1])), (min(ys[0], ys[-1]), max(ys[0], ys[-1])))
+    rng = np.random.default_rng(seed)
+    starts = []
+    for _ in range(samples):
+        q = mech.random_configuration(rng)
+        for c, v, _ in sys.held:
+            q[c.idx_q] = v
+        starts.append((sys.relative(q), q))
+    starts.sort(key=lambda s: s[0])
+    notes = []
+    loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", (q for _, q in starts), box, notes)
+    how = (f"seeds: Newton on [held coordinate; J_p v = 0; |v| = 1] from {samples} random joint configurations "
+           "(seed {seed}), most singular first; every curve followed by pseudo-arclength continuation to the "
+           "box's edges or round to its start; cusps located by Brent's method where the trace reverses. A "
+           "component no random configuration converges to is missed, so completeness is not claimed")
+    result = Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how.replace("{seed}", str(seed)),
+                  tuple(dict.fromkeys(notes)), tuple(cusp_q), ("serial",))
+    if cusps:
+        why = (f"{len(cusps)} cusps of the serial singular curve in the section: three inverse-kinematic "
+               "solutions meet there, and a generic 3R with a cusp is cuspidal (Salunkhe et al. 2022)")
+    else:
+        why = ("no cusp on the traced curves: a generic 3R without one is not cuspidal (Salunkhe et al. 2022); "
+               "the curves were seeded from random configurations, so a missed component is possible")
+    return Section(result, bool(cusps), why)
