@@ -110,7 +110,7 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
         print(f"note: --mode {wanted} needs the list of every assembly mode: it was searched (homotopy "
               "continuation; without --mode, Newton answers the mode nearest the file's configuration at once)",
               file=sys.stderr)
-    if res.method == NEWTON_FROM_FILE:  # one mode, at once: how many others there are is not known
+    if res.method == NEWTON_FROM_FILE and not res.free_dofs:  # one mode, at once: how many others is not known
         args.mode_chosen = {"index": 1, "of": None, "method": res.method}
         if not getattr(args, "json", False):
             print("note: the assembly mode Newton reaches from the file's configuration (no search: --mode K "

@@ -366,12 +366,12 @@ class PositionSolver:
 
     def _at_once(self, values):
         """solve's default (method "nearest"): every mode where they come at once, as a certified.Search --
-        a closure that is not polynomial (an empty Search: solve's random starts find them, no homotopy to
-        spare), a mechanism of dyads (their closed form, analysis.motion.certified.closed_form) -- or None
+        a closure that is not polynomial or inputs that leave a continuum (an empty Search: solve's random
+        starts find them, or samples of the continuum; no homotopy to spare), a mechanism of dyads (their closed form, analysis.motion.certified.closed_form) -- or None
         where only the homotopy would list them (Newton then answers the mode asked for)."""
         mech = self.mech
-        if algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings):
-            return certified.Search([], [], None, certified.obstacle(self))
+        if algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings) or self.free_dofs:
+            return certified.Search([], [], None, certified.obstacle(self))  # (a continuum: its samples, as before)
         got = certified.closed_form(self, values) if any(
             not isinstance(cached_plan(self, name), str) for name in self.inputs) else "no dyads"
         if isinstance(got, str):
