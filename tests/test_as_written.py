@@ -351,20 +351,26 @@ def test_one_characteristic_length_everywhere(capsys):
 # ------------------------------------------------------------------ modes a user can read
 def test_delta_modes_that_keep_the_platform_orientation_come_first(capsys):
     path = str(DATA.parent.parent / "robots" / "delta_parallelogram.urdf")
-    d = run_json(capsys, ["solve", path, "--set", "arm1=0.1,arm2=0,arm3=-0.1", "--output", "platform"])
+    # every mode: --all (issue 41: the default answers the mode asked for, at once)
+    d = run_json(capsys, ["solve", path, "--set", "arm1=0.1,arm2=0,arm3=-0.1", "--output", "platform", "--all"])
     phys = [s for s in d["solutions"] if s["physical"]]
     assert phys and d["solutions"][:len(phys)] == phys
     for s in phys:
         np.testing.assert_allclose(np.array(s["output_pose"])[:3, :3], np.eye(3), atol=1e-9)
     for s in d["solutions"][len(phys):]:
         assert s["labels"]
-    assert main(["solve", path, "--set", "arm1=0.1,arm2=0,arm3=-0.1", "--output", "platform"]) == 0
+    assert main(["solve", path, "--set", "arm1=0.1,arm2=0,arm3=-0.1", "--output", "platform", "--all"]) == 0
     text = capsys.readouterr().out
-    n = len(d["solutions"])  # the count reads as the total: "of the 7, 1 reachable ...; 6 not"
+    n = len(d["solutions"])  # the count reads as the total; --all shows every mode, each one's label with it
     assert f"{n} assembly modes found" in text
-    assert f"of the {n}, {len(phys)} reachable by moving" in text and f"{n - len(phys)} not (" in text
-    assert "--all" in text
-    assert text.count("\nsolution ") == len(phys)
+    assert text.count("\nsolution ") == n
+    assert all(text.split("\nsolution ")[k + 1].count("\n  not reached by moving: ") == len(s["labels"])
+               for k, s in enumerate(d["solutions"]))
+    # the default: the mode Newton reaches from the drawn configuration, the platform level, and how to get every one
+    d1 = run_json(capsys, ["solve", path, "--set", "arm1=0.1,arm2=0,arm3=-0.1", "--output", "platform"])
+    assert len(d1["solutions"]) == 1 and d1["solutions"][0]["physical"] and not d1["complete"]
+    assert d1["method"] == "newton from the file's configuration" and "--all" in d1["modes"]["reason"]
+    np.testing.assert_allclose(d1["solutions"][0]["output_pose"], phys[0]["output_pose"], atol=1e-9)
 
 
 @pytest.mark.slow  # about 2.9 s on 2 shared cores: out of the fast subset

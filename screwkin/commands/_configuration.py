@@ -9,6 +9,7 @@ import sys
 from ..analysis.motion.link_inputs import holding_angles
 from ..analysis.motion.modes import choose_mode
 from ..analysis.motion.position import PositionSolver
+from ..analysis.motion.solution import NEWTON_FROM_FILE
 from ..analysis.motion.sweep import BRANCHES
 from ..errors import UsageError, quote
 from ..model.topology import open_joints
@@ -97,12 +98,24 @@ def configuration(mech, args, moved: dict | None = None, inputs=None):
     missing = [n for n in inputs if n not in values]
     if missing:
         raise UsageError(f"{mech.path}: give values for the other inputs with --set: {', '.join(missing)}")
-    q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near)
-    for note in res.notes:  # a --near value the mode found lies far from; a continuum's sample
+    if wanted is not None and wanted > 1 and near:
+        raise UsageError(f"--near and --mode {wanted}: give one of them (--near picks the mode nearest a "
+                         "configuration, --mode K the K-th of the list of every mode)")
+    q, k, n, res = choose_mode(input_solver(mech, inputs, held), values, wanted, near, method="nearest")
+    for note in res.notes:  # a --near value the mode found lies far from; a continuum's sample; every joint given
         print(f"note: {note}", file=sys.stderr)
     if res.free_dofs:
         args.continuum = {"free_dofs": res.free_dofs}
-    if n > 1:
+    if wanted is not None and wanted > 1 and res.method == "homotopy search":
+        print(f"note: --mode {wanted} needs the list of every assembly mode: it was searched (homotopy "
+              "continuation; without --mode, Newton answers the mode nearest the file's configuration at once)",
+              file=sys.stderr)
+    if res.method == NEWTON_FROM_FILE and not res.free_dofs:  # one mode, at once: how many others is not known
+        args.mode_chosen = {"index": 1, "of": None, "method": res.method}
+        if not getattr(args, "json", False):
+            print("note: the assembly mode Newton reaches from the file's configuration (no search: --mode K "
+                  "lists every mode and takes the K-th)", file=sys.stderr)
+    elif n > 1:
         args.mode_chosen = {"index": k, "of": n}
         if not getattr(args, "json", False):
             print(f"note: {mode_line(k, n, hasattr(args, 'near'))}", file=sys.stderr)

@@ -37,7 +37,10 @@ def add_parser(sub, common, scaled):
     add_angle_option(sp)
     add_length_option(sp)
     sp.add_argument("--all", action="store_true",
-                   help="show every assembly mode, also those the mechanism cannot reach by moving")
+                   help="search every assembly mode (homotopy continuation, certified where it can be, where no "
+                        "closed form lists them) and show them all, also those the mechanism cannot reach by "
+                        "moving; without it, such a mechanism answers at once the mode Newton reaches from the "
+                        "file's configuration")
     sp.add_argument("--near", metavar="NAME=VALUE,...", help="report only the assembly mode nearest this configuration")
     sp.add_argument("--output", help="link whose pose (and twist) to report")
     add_point_option(sp)
@@ -78,7 +81,7 @@ def run(mech, args) -> int:
         return _solve_from_start(mech, args, values, held)
     solver = input_solver(mech, values, held, output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
-                       points=named_points(mech, args))
+                       points=named_points(mech, args), method="auto" if args.all else "nearest")
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length

@@ -12,7 +12,7 @@ from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
 from ..analysis.motion.modes import continuum_words
-from ..analysis.motion.solution import PositionResult
+from ..analysis.motion.solution import NEWTON_FROM_FILE, PositionResult, search_method
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
 from ..analysis.singularities.singular import SingularityReport
@@ -77,7 +77,10 @@ def position_dict(res) -> dict:
     return {"inputs": res.inputs, "input_joints": list(res.input_joints), "output": res.output,
             "free_dofs": res.free_dofs, "starts": res.starts, "solutions": sols,
             "physical_solutions": sum(s.physical for s in res.solutions), "notes": list(res.notes),
-            **({"held_angles": res.held} if res.held else {}), **({"modes": modes_dict(res.modes)} if res.modes else {})}
+            **({"held_angles": res.held} if res.held else {}), **({"modes": modes_dict(res.modes)} if res.modes else {}),
+            # how the solutions were found, and whether they are every mode there is
+            "method": res.method or search_method(res.modes),
+            "complete": bool(res.modes is not None and res.modes.complete)}
 
 
 def modes_dict(c) -> dict:
@@ -98,6 +101,11 @@ def modes_line(res, n: int) -> str:
                 f"{continuum_words(res.free_dofs)}: they are samples of it, not assembly modes")
     if c is None:
         return f"{n} assembly mode{s} found from {res.starts} starting configurations"
+    if c.method == "every joint given":
+        return "1 configuration, the one the values give: every joint given, nothing solved or searched"
+    if c.method == NEWTON_FROM_FILE:
+        return ("1 assembly mode: the one Newton reaches from the file's configuration (no search; --all lists "
+                "every mode, with how complete the list is)")
     sets = {x.angle_sets for x in res.solutions}
     each = (f"; each reached by {sets.pop()} joint-angle sets (universal and spherical joints written as "
             "revolutes, wrists flipped: one placement of the links)" if len(sets) == 1 and None not in sets

@@ -31,7 +31,11 @@ def choose_mode(solver, values: dict, k: int | None = None, near: dict | None = 
     PositionResult.  A usage error when k is more than n.  Where the inputs leave a continuum (free degrees of
     freedom), the solutions are samples of it, not modes: n is 1, the first sample is used, a k over 1 is a
     usage error, and the result's notes say so (continuum_words).  The one rule every command's ``--mode K`` (and a
-    study's ``mode``) goes by."""
+    study's ``mode``) goes by.  A k over 1 needs the list of every mode: solve searches them (method "auto",
+    whatever ``options`` say), listed from the reference configuration (``near`` is not used: it picks one
+    mode, not a list)."""
+    if k is not None and k > 1:
+        near, options = None, {**options, "method": "auto"}
     res = solver.solve(values, near=near, starts=starts, **options)
     n, k = len(res.solutions), k or 1
     if res.free_dofs:  # a continuum: its configurations found are samples of it, not modes to number

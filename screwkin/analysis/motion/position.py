@@ -38,12 +38,14 @@ from ...model.manifold import set_continuous_angle
 from ...model.state import KinematicState, angular_loop_joints, frame_parent
 from ...model.limits import outside_limits, spelled_within_limits
 from ...model.topology import open_joints
-from . import certified, modes
+from ...model.algebraic import algebraic_obstacle
+from . import certified, given, modes
+from .dyads import cached_plan
 from ..mobility import analyze_mobility
 from .links import link_motions, point_motions
 from .turns import engaged, turn_on, whole_turns
 from .planar import LinkAngles, identify
-from .solution import PositionResult, Solution, TraceStep
+from .solution import NEWTON_FROM_FILE, PositionResult, Solution, TraceStep, search_method
 from ..singularities.singular import Generic, measures
 
 __all__ = ["PositionSolver"]
@@ -265,7 +267,13 @@ class PositionSolver:
         objects whose position (and velocity, acceleration with ``rates``) each solution reports.
         ``method``: "auto" -- homotopy continuation, certified, where the closure is polynomial
         (analysis.motion.certified), with ``starts`` random starts added where it is not certified
-        --, or "starts" (damped Newton from random starts only, as with --trace or --near)."""
+        --, "starts" (damped Newton from random starts only, as with --trace or --near), or "nearest"
+        (solve's default on the command line): every mode where they come at once (a mechanism of dyads,
+        in closed form; random starts where the closure is not polynomial), else only the mode damped
+        Newton reaches from the file's configuration, nothing searched -- "auto" when Newton fails there,
+        said in the notes.  Every joint given (nothing unknown): that configuration, the closure
+        evaluated there and nothing solved (analysis.motion.given), whatever the method.
+        ``PositionResult.method`` says which way the solutions came."""
         mech = self.mech
         self._check_inputs(values)
         if self.unset:
@@ -279,26 +287,39 @@ class PositionSolver:
         if near:
             ref = self.reference()
             near_q = self.set_inputs(mech.neutral() if ref is None else ref, near)
-        found, best = [], np.inf
-        if near_q is not None:  # the mode reached from the given configuration, when Newton gets there
+        found, best, first, lead, done = [], np.inf, None, (), None  # first: how one answer came without a search
+        if not given.unknowns(self).size:  # every joint given: the closure evaluated there, nothing solved
+            q, a, line = given.given_configuration(self, self.set_inputs(self._drawn(), values))
+            found, first, lead = [(None, q, a)], "every joint given", (line,)
+        elif near_q is not None:  # the mode reached from the given configuration, when Newton gets there
             found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
                                         first_trace=recorder if trace else None)
-        start_list = [near_q] if found else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
+            first = "newton from --near's configuration" if found else None
+        elif method == "nearest" and not trace:  # the mode asked for, at once, where listing every one is not
+            done = self._at_once(values)
+            if done is None:
+                found, best = self.distinct(mech.closure, [self.set_inputs(self._drawn(), values)], frozen=self.frozen)
+                first = NEWTON_FROM_FILE if found else None
+                lead = () if found else ((f"Newton from the file's configuration did not converge (residual "
+                                          f"{best:.2g}): every mode searched"),)
+            else:
+                found = list(done.found)
+        start_list = [found[0][1]] if first else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
         if self.kept:  # joints of several coordinates no loop passes through: the file's values, not random ones
             neutral, start_list = mech.neutral(), [np.array(q0, float) for q0 in start_list]
             for q0 in start_list:
                 q0[self._kept_q] = neutral[self._kept_q]
-        by_near, done = bool(found), None
-        if not found and near_q is None and not trace and method != "starts":
+        if not found and done is None and near_q is None and not trace and method != "starts":
             done = certified.search(self, values, seed)  # homotopy continuation: every mode, certified
             found = list(done.found)
-        if not by_near and not (done is not None and done.complete and found):
+        if not first and not (done is not None and done.complete and found):
             more_found, more = self.distinct(
                 mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
                 first_trace=recorder if trace and near_q is None else None)
             found, best = certified.join(self, found, more_found), min(best, more)
-        count = (done.count if done is not None and done.complete else
-                 None if by_near else certified.count_after_starts(done, found, len(start_list)))
+        count = (done.count if done is not None and done.complete else given.first_count(first, found[0][2])
+                 if first and first != "newton from --near's configuration" else None if first else
+                 certified.count_after_starts(done, found, len(start_list)))
         if not found:
             # certified: said first (a long message is cut at its end)
             certain = ((f"none of the {done.count.complex} complex solutions is real" if done.count.complex != 1 else
@@ -324,8 +345,8 @@ class PositionSolver:
             ref_sig = self.signature(ref if ref is not None else sols[0].q)
             sols.sort(key=lambda s: (not s.physical, s.singular,
                                      float(np.linalg.norm(self.signature(s.q) - ref_sig))))
-        notes = tuple(f"{j} keeps the file's value: no loop passes through it and its {mech.coordinate(j).nq} "
-                      "coordinates are not inputs" for j in self.kept)
+        notes = lead + tuple(f"{j} keeps the file's value: no loop passes through it and its "
+                             f"{mech.coordinate(j).nq} coordinates are not inputs" for j in self.kept)
         if near_q is not None:
             sols = sols[:1]
             notes += self._missed_near(near, sols[0])
@@ -334,7 +355,29 @@ class PositionSolver:
         return PositionResult(dict(typed), tuple(self.inputs), tuple(sols),
                               0 if done is not None and done.complete else len(start_list), self.free_dofs,
                               tuple(steps), self.output, self._angular, self._angular_coupled(),
-                              angular_loop_joints(self.mech), notes, held, count)
+                              angular_loop_joints(self.mech), notes, held, count,
+                              first or search_method(count))
+
+    def _drawn(self):
+        """The configuration the values are set on where nothing is searched: the reference (the file's,
+        assembled), else the file's own."""
+        ref = self.reference()
+        return self.mech.neutral() if ref is None else ref
+
+    def _at_once(self, values):
+        """solve's default (method "nearest"): every mode where they come at once, as a certified.Search --
+        a closure that is not polynomial or inputs that leave a continuum (an empty Search: solve's random
+        starts find them, or samples of the continuum; no homotopy to spare), a mechanism of dyads (their closed form, analysis.motion.certified.closed_form) -- or None
+        where only the homotopy would list them (Newton then answers the mode asked for)."""
+        mech = self.mech
+        if algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings) or self.free_dofs:
+            return certified.Search([], [], None, certified.obstacle(self))  # (a continuum: its samples, as before)
+        got = certified.closed_form(self, values) if any(
+            not isinstance(cached_plan(self, name), str) for name in self.inputs) else "no dyads"
+        if isinstance(got, str):
+            return None
+        return certified.Search([(self.signature(q), q, a) for q, a, _, _ in got.modes],
+                                [(sets, simple) for _, _, sets, simple in got.modes], got.count)
 
     def _missed_near(self, near: dict, sol) -> tuple:
         """A line for each --near value the mode found lies far from (Tolerances.near_far): the joints

@@ -14,7 +14,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["Solution", "PositionResult", "TraceStep"]
+__all__ = ["Solution", "PositionResult", "TraceStep", "NEWTON_FROM_FILE", "search_method"]
+
+#: PositionResult.method where solve's default answered the mode Newton reaches from the file's
+#: configuration, and searched nothing (analysis.motion.position).
+NEWTON_FROM_FILE = "newton from the file's configuration"
+
+
+def search_method(count) -> str:
+    """How a search found its modes, from its certified.ModeCount (None: damped Newton from random starts),
+    in the words of PositionResult.method: "closed form (dyads)", "homotopy search" (with random starts
+    where it did not settle every mode), "random starts" or "no loops"."""
+    if count is None:
+        return "random starts"
+    return "homotopy search" if count.method.startswith("monodromy") else count.method
 
 
 @dataclass(frozen=True)
@@ -113,6 +126,9 @@ class PositionResult:
     notes: tuple = ()  # what the solver chose that the user should know (a --near value it missed)
     held: dict | None = None  # links held at an absolute angle (--set-angle of a floating link) -> angle [rad]
     modes: object | None = None  # analysis.motion.certified.ModeCount: how many modes and how that is known
+    #: how the solutions were found: "every joint given", "newton from the file's configuration", "newton from
+    #: --near's configuration", "closed form (dyads)", "homotopy search", "random starts", "no loops"
+    method: str = ""
 
     @property
     def physical(self) -> tuple:
