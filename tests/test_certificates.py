@@ -308,3 +308,23 @@ def test_a_failed_path_is_no_certificate(tmp_path, shipped_cache):
     c = got.count
     assert not c.complete and c.certificate is None and not c.check["checked"]
     assert c.check["failed_paths"] > 0 and f"{c.check['failed_paths']} of 40 paths failed" in c.reason
+
+
+def test_a_certificate_that_misses_the_drawn_root_is_taken_back(capsys):
+    """The spherical four-bar's rocker frame sits at the sphere's centre, where every joint axis meets
+    (robots/spherical_fourbar.urdf), so every configuration of its one-degree-of-freedom motion puts it
+    there: ik of that point is a whole circle of real solutions.  The homotopy's trace test closed on two
+    complex roots of its square system and was printed as a certificate beside an 'unreachable' error;
+    the drawn configuration, a root it did not hold, now takes the certificate back and the continuum is
+    said."""
+    from screwkin.cli import main
+    code = main(["ik", str(ROBOTS / "spherical_fourbar.urdf"), "--output", "rocker", "--position", "0,0,0",
+                 "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    d = json.loads(out)
+    modes = d["modes"]
+    assert modes["complete"] is False and modes["certificate"] is None
+    assert "not among them" in modes["reason"] and "positive-dimensional" in modes["reason"]
+    assert d["free_dofs"] == 1  # the crank turns the whole mechanism about the centre
+    assert len(d["solutions"]) >= 1

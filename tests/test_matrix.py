@@ -236,10 +236,7 @@ def commands(name, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(
-    strict=True, reason="issue 41 s.1 (cert): the rocker's origin is the sphere's centre, so every configuration "
-                        "reaches it, yet the homotopy certifies 'trace test: 2 found, 0 real' and ik exits 1"))
-    if n == "spherical_fourbar.urdf" else n for n in MECHANISMS])
+@pytest.mark.parametrize("name", MECHANISMS)
 def test_ik_reaches_the_output_where_the_file_puts_it(name, capsys):
     """The output link's position in the file's assembled configuration is reachable: that configuration
     reaches it (a position computed by Pinocchio's forward kinematics, not by the ik under test)."""

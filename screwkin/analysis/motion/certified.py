@@ -32,6 +32,7 @@ from ...model import newton
 from ...model.algebraic import PolynomialClosure, algebraic_obstacle
 from ...model.square import SquareSystem
 from ...model.cuts import Assembly
+from ...model.linalg import rank
 from ...model.symmetry import find_symmetries
 from .dyad_modes import dyad_modes
 from . import generic_modes
@@ -142,8 +143,8 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
             modes, *counts = generic_modes.platform_modes(solver, problem, closure, arch, seed, options,
                                                           lambda x: _lift(solver, problem, closure, x))
             found, real, cplx, certificate, reason, detail, check = counts
-            return Certified(modes, ModeCount(found, certificate is not None, "parameter homotopy", real, cplx,
-                                              certificate, reason, detail, check))
+            return _reference_check(solver, problem, Certified(modes, ModeCount(
+                found, certificate is not None, "parameter homotopy", real, cplx, certificate, reason, detail, check)))
     group = find_symmetries(closure, rng)
     system = SquareSystem(closure, rng)
     roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
@@ -157,7 +158,39 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
         ends = to_target(system, roots, np.zeros(system.n), options)
         got = _classify(solver, problem, closure, system, group, roots, ends, None, time.perf_counter() - t0,
                         options, also=got.count.reason)
-    return got
+    return _reference_check(solver, problem, got)
+
+
+def _reference_check(solver, problem, got: Certified) -> Certified:
+    """A certificate held against one root found another way before it is given: damped Newton from the
+    reference configuration (the file's drawing, the inputs set) on Pinocchio's closure.  A real root there
+    that the certified set does not hold, or one where the closure's Jacobian in the unknowns loses rank (a
+    positive-dimensional solution set, which no path of the square system reaches, or a multiple root),
+    takes the certificate back, with the reason (an ik target at a point every configuration reaches: the
+    homotopy's 'trace test' closed on 2 complex roots beside a whole circle of real ones)."""
+    if not got.count.complete or got.count.method == "closed form (dyads)":
+        return got
+    mech, tol = solver.mech, solver.mech.tolerances
+    try:
+        a = problem.system.solve(problem.q_in, frozen=problem.frozen)
+    except AssemblyError:
+        return got  # Newton did not converge from there: nothing to hold the set against
+    q = solver._wrap(a.q)
+    unknown = np.setdiff1d(np.arange(mech.nv), np.asarray(problem.frozen, int))
+    free = unknown.size - solver.idle_dofs - rank(problem.system.jacobian(q)[:, unknown], tol)
+    sig = solver.signature(q)
+    held = any(solver.same_mode(sig, solver.signature(m[0])) for m in got.modes)
+    if held and free <= 0:
+        return got
+    why = ("the root Newton reaches from the file's configuration is not among them" if not held else
+           "the root Newton reaches from the file's configuration is not simple")
+    if free > 0:
+        why += (f" (the closure's Jacobian there leaves {free} unknown(s) free: a positive-dimensional solution "
+                "set or a multiple root, which the homotopy's paths do not count)")
+    c = got.count
+    count = replace(c, complete=False, certificate=None, reason=f"{c.certificate} does not hold: {why}",
+                    check={**c.check, "checked": False, "reference_root": {"held": held, "free": int(max(free, 0))}})
+    return Certified(got.modes, count)
 
 
 def _rank(closure, rng) -> int:
