@@ -190,6 +190,12 @@ def in_unit(value, unit: str):
     return value / parse_value("1" + unit.replace(" ", ""))
 
 
+def si_factor(unit: str) -> float:
+    """The number 1 SI (1 rad/s, 1 m) written in ``unit`` ('deg/s²' read as 'deg/s^2'); 1 for a number
+    without a unit."""
+    return in_unit(1.0, unit.replace("²", "^2")) if unit else 1.0
+
+
 def unit_text(value: float, unit: str, digits: int = 6) -> str:
     """``value`` [SI] written in ``unit``: ``unit_text(math.pi / 6, "deg")`` is '30 deg' (the bare
     number for no unit)."""

@@ -281,16 +281,6 @@ def test_bundled_six_ups_from_its_shipped_generic_set():
     assert (BERTINI["six_ups"]["poses"], BERTINI["six_ups"]["real"]) == (28, 8)
 
 
-@pytest.mark.slow  # Bertini 2's 128 paths: about 90 s
-def test_bertini_counts_the_bundled_six_ups_too():
-    """The oracle itself, where bertini2 is installed (it is not in the test extra: it conflicts with
-    the bertini and pybertini packages, which write the same module): 28 poses, 8 real."""
-    pytest.importorskip("bertini")
-    from oracles import bertini_stewart
-    g = BERTINI["six_ups"]["geometry"]
-    got = bertini_stewart.solve_geometry(np.array(g["base"]), np.array(g["platform"]), np.array(g["lengths"]))
-    assert (got["poses"], got["real"]) == (28, 8)
-
 
 def test_a_failed_path_is_no_certificate(tmp_path, shipped_cache):
     """Paths cut short (a tracker allowed 10 steps): the count is not called certified, and the reason

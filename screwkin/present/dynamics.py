@@ -3,6 +3,8 @@ of the effort against the input."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..analysis.forces.dynamics import COMPONENTS, DynamicsResult
@@ -117,7 +119,7 @@ def dynamics_text(r: DynamicsResult, shown: str | None = None, speed_text: str |
     fly = r.flywheel
     if fly.inertia is not None:
         at = f"{fly.omega:.6g} rad/s"  # the speed as typed first (120rpm), as the first line says it
-        at = f"{speed_text} ({at})" if speed_text and abs(fly.omega - r.speed) <= 1e-12 * max(1.0, abs(r.speed)) else at
+        at = f"{speed_text} ({at})" if speed_text and math.isclose(fly.omega, r.speed) else at
         lines.append(f"flywheel: energy fluctuation {fly.energy_fluctuation:.6g} J over the turn; for Cs = {fly.cs:g} "
                      f"at {at} it takes I = dE / (Cs omega^2) = {fly.inertia:.6g} kg*m^2")
     else:

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model.geometry import plane_basis
 from ..tolerances import DEFAULT
-from ..units import Quantity, in_unit
+from ..units import Quantity, in_unit, si_factor
 from .tables import input_rate_words
 from .outfile import write_figure
 
@@ -49,11 +49,6 @@ def _rate_scales(units):
         return [("deg", "mm"), ("deg/s", "mm/s"), ("deg/s²", "mm/s²")]
     return [("deg", "mm"), (units.rate(False), units.rate(True)),
             (units.acceleration(False), units.acceleration(True))]
-
-
-def _factor(unit):
-    """The number 1 SI (1 rad/s, 1 m) is written as in ``unit`` ('deg/s²' as 'deg/s^2')."""
-    return in_unit(1.0, unit.replace("²", "^2"))
 
 
 def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute=False,
@@ -106,7 +101,7 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for r, (what, data, a_unit, l_unit) in enumerate(rows):
         ax = axes[r]
-        scale = np.where(linear, _factor(l_unit), _factor(a_unit))
+        scale = np.where(linear, si_factor(l_unit), si_factor(a_unit))
         handles = []
         twin = ax.twinx() if linear.any() else None
         for k, name in enumerate(res.names):

@@ -21,7 +21,7 @@ import numpy as np
 from ..analysis.design.study import MODE_METRICS, REQUIREMENTS_COLUMN, pareto_front, requirements
 from ..errors import UsageError, quote
 from ..files.study import WORKSPACE_METRICS
-from ..units import in_unit
+from ..units import si_factor
 from .plots import pyplot
 from .jsonout import to_jsonable
 from .tables import csv_text
@@ -52,15 +52,10 @@ DISPLAY = {
 }
 
 
-def _factor(unit: str) -> float:
-    """The factor from SI of a value shown in ``unit`` (units.in_unit's; 1 for a number without one)."""
-    return in_unit(1.0, unit) if unit else 1.0
-
-
 def _display(key):
     """(column name, factor from SI) of a row key."""
     name, unit = DISPLAY.get(key, (key, ""))
-    return name, _factor(unit)
+    return name, si_factor(unit)
 
 
 def table_columns(result) -> list:
@@ -327,7 +322,7 @@ def _label(key, result=None):
     dimension (m^2 or m^3; m^d when they differ)."""
     if key in LABELS:
         label, unit = LABELS[key]
-        label, factor = (f"{label} [{unit}]" if unit else label), _factor(unit)
+        label, factor = (f"{label} [{unit}]" if unit else label), si_factor(unit)
     else:
         label, factor = _display(key)
     if "{dim}" in label:
@@ -341,7 +336,7 @@ def _parameter_axis(result, name):
     file's ``30mm``), else as given (xacro arguments are SI, the file does not say m or rad)."""
     unit = next((getattr(p, "unit", "") for p in result.spec.parameters if p.name == name), "")
     if unit:
-        return f"{name} [{unit}]", _factor(unit)
+        return f"{name} [{unit}]", si_factor(unit)
     return f"{name} (as given, SI: no unit typed)", 1.0
 
 

@@ -130,7 +130,7 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
             joints[name] = v
             continue
         else:
-            valid = ", ".join([f"{n} ({w})" if w != n else n for n, w in ((n, _written(n)) for n in loops.unknowns)]
+            valid = ", ".join([f"{n} ({w})" if w != n else n for n, w in ((n, _as_symbol(n)) for n in loops.unknowns)]
                               + [lk for lk, n in by_link.items() if n in loops.unknowns])
             raise UsageError(f"{mech.path}: --start: no unknown, link or joint named '{as_typed[:80]}' "
                              f"(unknowns of the loop equations: {valid}; or passive joint names)")
@@ -148,7 +148,7 @@ def start_estimates(mech, loops, solver, q_in, values, typed):
     return start, units
 
 
-def _written(name: str) -> str:
+def _as_symbol(name: str) -> str:
     """A symbol as the text writes it (theta3 -> θ3), the other spelling --start takes."""
     for word, letter in GREEK:
         if name.startswith(word) and name[len(word):][:1].isdigit():

@@ -41,7 +41,7 @@ import numpy as np
 from ...errors import AssemblyError
 from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
-from ..motion.continuation import locate
+from ..motion.continuation import locate, orient
 from .loci_seeds import crossings, refine_node, seed_configurations, sheets, unexplained_folds
 from .singular import LWA, Generic
 
@@ -220,9 +220,7 @@ class LocusSystem:
     def tangent(self, q, v, previous=None, J=None) -> np.ndarray:
         """Unit null vector of dF in (u, v) (J: dF at (q, v) when already computed), oriented along ``previous``."""
         t = np.linalg.svd(self.jacobian(q, v) if J is None else J)[2][-1]
-        if previous is not None and t @ previous < 0:
-            t = -t
-        return t
+        return orient(t, previous)  # the continuation's one branch rule
 
     def nullity_ok(self, q, v) -> bool:
         s = np.linalg.svd(self.jacobian(q, v), compute_uv=False)
