@@ -79,4 +79,5 @@ def test_a_long_streamed_sweep_shows_its_progress_on_a_terminal_only(tmp_path):
     assert "\rsweep [" in text and "/300,000 steps" in text and text.endswith("\r\x1b[K"), text[-300:]
     plain = subprocess.run(argv, capture_output=True, text=True, timeout=600)
     # the one line naming the assembly mode taken is said on a pipe too; no progress is
-    assert plain.returncode == 0 and plain.stderr == "note: assembly mode 1 of 2 (others: --mode 2, or --near)\n"
+    assert plain.returncode == 0 and plain.stderr == ("note: the assembly mode Newton reaches from the file's configuration "
+                                                "(no search: --mode K lists every mode and takes the K-th)\n")
