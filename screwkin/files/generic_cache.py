@@ -129,7 +129,7 @@ def write(name: str, c0, X, how: str) -> Path | None:
             with os.fdopen(fd, "w", encoding="utf-8") as f:
                 f.write(text)
             os.replace(tmp, where / f"{name}.json")
-        except BaseException:
+        except BaseException:  # any failure or Ctrl-C: the temporary file goes, and the error goes on (raise)
             try:
                 os.unlink(tmp)
             except OSError:
