@@ -69,12 +69,12 @@ def command_module(name: str):
 
 
 class _Parser(argparse.ArgumentParser):
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         # a value that starts with a minus and a digit is a value, units and all: --to -90deg, --from -1e-3
         self._negative_number_matcher = re.compile(r"^-\.?[0-9]")
 
-    def error(self, message):  # one line (the arguments quoted in it are bounded and escaped), exit code 2
+    def error(self, message) -> None:  # one line (the arguments quoted in it are bounded and escaped), exit code 2
         self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
 
     def parse_known_args(self, args=None, namespace=None):
@@ -144,7 +144,7 @@ def main(argv=None) -> int:
     (before or after the command) prints the traceback first, with the same exit code.
     """
 
-    def say(line):
+    def say(line) -> None:
         try:
             print(line, file=sys.stderr)
         except (OSError, ValueError):  # stderr closed: nowhere to say it

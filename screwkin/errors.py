@@ -92,7 +92,7 @@ class MechanismFileError(ScrewkinError):
     :data:`MESSAGE_LIMIT` characters after the path.
     """
 
-    def __init__(self, path, problems):
+    def __init__(self, path, problems) -> None:
         if isinstance(problems, str):
             problems = [problems]
         self.path = str(path)
@@ -122,7 +122,7 @@ class AssemblyError(MechanismFileError):
     """
 
     def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None,
-                 reason: str | None = None, proved: bool = False, message: str | None = None):
+                 reason: str | None = None, proved: bool = False, message: str | None = None) -> None:
         """``message``: the whole message where no search was made at all (a closed form's answer)."""
         self.residual = float(residual)
         self.iterations = int(iterations)
@@ -148,7 +148,7 @@ class OutputError(ScrewkinError):
     became of a partial file (``partial``: "removed", or None when nothing was left).  Exit 1:
     the command line was right, the place it named could not take the file."""
 
-    def __init__(self, path, reason: str, partial: str | None = None):
+    def __init__(self, path, reason: str, partial: str | None = None) -> None:
         self.path, self.reason, self.partial = str(path), str(reason), partial
         tail = f" (the partial file was {partial})" if partial else ""
         super().__init__(f"cannot write {quote(self.path, 200)}: {reason}{tail}")

@@ -133,7 +133,7 @@ class Series:
     """The Taylor coefficients of a motion's column rates X[0], X[1], ... and of the units' screws
     along it; ``residual()`` is R_k for the next order k (Phi[k] with X[k] = 0)."""
 
-    def __init__(self, system: LoopSystem, x0):
+    def __init__(self, system: LoopSystem, x0) -> None:
         self.sys = system
         self.X = [np.asarray(x0, float)]
         self.S = [system.screws]
@@ -142,7 +142,7 @@ class Series:
     def _y(self, k):
         return self.sys.multiplier * self.X[k][self.sys.column]
 
-    def _p(self, m, with_last=True):
+    def _p(self, m, with_last: bool=True):
         terms = [self.S[l] * self._y(m - l)[:, None] for l in range(m + 1) if with_last or l > 0]
         return np.sum(terms, axis=0) if terms else np.zeros_like(self.sys.screws)
 

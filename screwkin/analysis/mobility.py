@@ -316,7 +316,7 @@ def _local_notes(local, where, M_generic, generic_rank, samples):
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech, output, seed, point, at=None, suggest=False, names=False, progress=None) -> MobilityResult:
+def _analyze(mech, output, seed, point, at=None, suggest: bool=False, names: bool=False, progress=None) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)

@@ -22,14 +22,14 @@ class PointOption(argparse.Action):
     """``--point`` alone: the output link's origin analysed as a point (``args.point = True``, as
     before); ``--point NAME=LINK:x,y,z``: a named point on a link (``args.points``), repeatable."""
 
-    def __call__(self, parser, namespace, value, option_string=None):
+    def __call__(self, parser, namespace, value, option_string=None) -> None:
         if value is None:
             namespace.point = True
         else:
             namespace.points = [*(getattr(namespace, "points", None) or []), value]
 
 
-def add_point_option(sp, origin_help: str | None = None):
+def add_point_option(sp, origin_help: str | None = None) -> None:
     """--point: named points NAME=LINK:x,y,z (and, with ``origin_help``, --point alone as before)."""
     sp.set_defaults(point=False, points=None)
     help = ("a point on a link, NAME=LINK:x,y,z in the link's frame (units allowed: P=coupler:60mm,20mm,0); "
@@ -59,7 +59,7 @@ def named_points(mech, args) -> tuple:
     return tuple(out)
 
 
-def add_tool_option(sp):
+def add_tool_option(sp) -> None:
     """--tool x,y,z[,roll,pitch,yaw]: the output frame moved on the output link."""
     sp.add_argument("--tool", metavar="x,y,z[,roll,pitch,yaw]",
                     help="a tool frame on the --output link, placed in the link's frame (units allowed: "

@@ -47,7 +47,7 @@ _MAGNITUDE_KIND = {("angle", 0): "angle", ("angle", 1): "angular rate", ("angle"
                    ("length", 0): "length", ("length", 1): "linear rate", ("length", 2): "linear acceleration"}
 
 
-def _checked(mech, name, typed: Quantity, option, text, order=0, links=()) -> Quantity:
+def _checked(mech, name, typed: Quantity, option, text, order: int=0, links=()) -> Quantity:
     """``typed`` (parsed without a kind: its unit's) as the value (order 0), rate (1) or acceleration (2)
     of joint ``name``: the Quantity of that kind, or a usage error."""
     value, unit, found = typed.value, typed.unit, typed.kind

@@ -48,7 +48,7 @@ from ._options import BOUNDS, count
 NAME = "draw"
 NEEDS_MECHANISM = True
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
     common(sp)
     add_configuration_options(sp)

@@ -25,7 +25,7 @@ NAME = "dynamics"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="input efforts, joint reactions, shaking forces and flywheel at constant input speed")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint driven at constant speed")

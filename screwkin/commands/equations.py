@@ -14,7 +14,7 @@ NAME = "equations"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="the loop equations in symbols: vector loops, velocity and acceleration "
                                    "matrices, det A and its singular conditions")
     common(sp)

@@ -20,7 +20,7 @@ NAME = "export"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="write the mechanism as MJCF (MuJoCo) or URDF, assembled (loops closed in the file)")
     common(sp)
     sp.add_argument("--mjcf", metavar="OUT.xml", help="write MJCF here: loops as <equality> connect/weld")
@@ -105,7 +105,7 @@ def run(mech, args) -> int:
     return emit(args, data, text)
 
 
-def _names(names, n=3) -> str:
+def _names(names, n: int=3) -> str:
     return ", ".join(quote(x, 30) for x in names[:n]) + (", ..." if len(names) > n else "")
 
 

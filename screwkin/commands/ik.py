@@ -21,7 +21,7 @@ NAME = "ik"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(sp)
     sp.add_argument("--output", help="the link to place (or its --tool; or give a named --point)")

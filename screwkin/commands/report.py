@@ -76,7 +76,7 @@ START_ANGLE = np.radians(10.0)
 START_FRACTION = 0.10
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="one self-contained document (HTML and/or Markdown): topology, counts, equations, "
                                    "Newton iterations, motion, singular configurations with drawings, sweep, view")
     common(sp)
@@ -297,7 +297,7 @@ def _input_rates_text(mech, typed: dict, rates) -> str:
     if not typed:
         return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
 
-    def shown(n, v):
+    def shown(n, v) -> str:
         q = typed.get(n)
         if q is None or q.shown_unit in ("", si[n]):
             return f"{n} = {v:.6g} {si[n]}"

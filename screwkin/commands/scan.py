@@ -17,7 +17,7 @@ NAME = "scan"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("scan", help="singularity scan of a serial chain over random configurations")
     common(sp)
     sp.add_argument("--output", help="the chain's last link (e.g. the flange; or give a named --point)")

@@ -20,7 +20,7 @@ NAME = "screws"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
     common(sp)
     add_configuration_options(sp)

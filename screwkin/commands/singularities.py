@@ -23,7 +23,7 @@ NAME = "singularities"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("singularities", help="classify the singularities of a configuration")
     common(sp)
     add_configuration_options(sp)

@@ -29,7 +29,7 @@ NAME = "solve"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(sp)
     sp.add_argument("--set", action="append", metavar="NAME=VALUE",

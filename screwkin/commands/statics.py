@@ -21,7 +21,7 @@ NAME = "statics"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="actuator efforts and joint reactions holding a load; legs' wrenches")
     common(sp)
     add_configuration_options(sp)

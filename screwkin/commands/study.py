@@ -25,7 +25,7 @@ NAME = "study"
 NEEDS_MECHANISM = False
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="design-space study of a family of mechanisms (a xacro file) on Dask")
     sp.add_argument("spec", metavar="SPEC.yaml", help="the study: file, parameters, sampling, metrics (docs/format.md)")
     common(sp, mechanism=False)

@@ -62,7 +62,7 @@ _OPTIONS = {  # which options each kind takes (dest names)
 }
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("synthesize", help="synthesize a planar linkage (motion, function, path) or enumerate "
                                            "kinematic chains; writes URDF checked with screwkin")
     sp.add_argument("kind", choices=KINDS, help="what to synthesize")
@@ -393,7 +393,7 @@ def _path(args):
     return result, check, tmp
 
 
-def _chains(args):
+def _chains(args) -> int:
     if args.links is None or args.dof is None:
         raise UsageError("synthesize chains needs --links N and --dof F")
     result = enumerate_chains(args.links, args.dof, args.prismatic)

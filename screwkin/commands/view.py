@@ -35,7 +35,7 @@ NAME = "view"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
     common(sp)
     add_configuration_options(sp)
@@ -74,7 +74,7 @@ class _Stop:
     "stopped by" line), and ``signal.set_wakeup_fd`` wakes the wait at once.  The handlers and the
     wakeup descriptor are installed before the server starts; the previous ones come back after."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.signum = None
         self.interrupting = True
         self.wake = None
@@ -93,7 +93,7 @@ class _Stop:
         self._previous = {s: signal.signal(s, self._handle) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc) -> None:
         for s, handler in self._previous.items():
             signal.signal(s, handler)
         signal.set_wakeup_fd(self._previous_fd)
@@ -163,7 +163,7 @@ def run(mech, args) -> int:
 FPS = 30
 
 
-def _pictures(mech, args, server, scene, frames=None):
+def _pictures(mech, args, server, scene, frames=None) -> None:
     """--html (with a play/scrub bar when ``frames``, the text of each animation frame) and --png."""
     html = server.viewer.static_html()
     title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")

@@ -31,7 +31,7 @@ NAME = "workspace"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="workspace of an output link: volume, singularity-free part, conditioning")
     common(sp)
     sp.add_argument("--output", help="the link whose workspace to find (e.g. the platform; or its --tool frame's)")

@@ -198,7 +198,7 @@ def mujoco_refuses(mass, inertia) -> bool:
     return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, inertia) is not None)
 
 
-def _mj_inertial(mass, com, inertia, moving, points=(), length=0.1):
+def _mj_inertial(mass, com, inertia, moving, points=(), length: float=0.1) -> str:
     if mass <= 0:
         if not moving:
             return ""
@@ -250,7 +250,7 @@ def helper_names(pm) -> dict:
     return out
 
 
-def _mj_joint(j):
+def _mj_joint(j) -> str:
     dyn = "".join(f' {k}="{number_text(v)}"' for k, v in j.dynamics)
     if j.type == "free" and not dyn:
         return f"<freejoint name={quoteattr(j.name)}/>"
@@ -289,7 +289,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
     out = [_comment(pm.comment), f"<mujoco model={quoteattr(pm.name)}>",
            '  <compiler angle="radian" autolimits="true"/>', "  <worldbody>"]
 
-    def aux_bodies(name, pad):
+    def aux_bodies(name, pad) -> None:
         for c in aux.get(name, ()):
             out.append(f'{pad}<body name={quoteattr(names["F1", c.name])} pos="{vector_text(*c.pos1)}" '
                        f'quat="{vector_text(*c.quat1)}">')
@@ -299,7 +299,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
             out.append(f"{pad}  {_mj_inertial(0, 0, 0, True, (), pm.length)}")
             out.append(f"{pad}</body>")
 
-    def body(b, depth):
+    def body(b, depth) -> None:
         pad = "  " * depth
         out.append(f'{pad}<body name={quoteattr(b.name)} pos="{vector_text(*b.pos)}" quat="{vector_text(*b.quat)}">')
         moving = b.joint is not None and b.joint.type != "fixed"

@@ -96,7 +96,7 @@ def _vector(value, what, planar, problems):
     return tuple(v)
 
 
-def _coefficient(c, key, k, problems, bound, unit=""):
+def _coefficient(c, key, k, problems, bound, unit: str=""):
     value = c.get(key)
     if not _is_number(value):
         problems.append(f"contact {k}: {key} must be a number, got {quote(value)}")
@@ -179,7 +179,7 @@ def _contact(c, k, planar, problems):
     return Contact(point, normal, model, mu, mu_t)
 
 
-def parse_grasp(content, path="<grasp>") -> GraspSpec:
+def parse_grasp(content, path: str="<grasp>") -> GraspSpec:
     """A GraspSpec from the plain data of a grasp file (what the YAML loads to), every
     problem collected and raised at once as a MechanismFileError naming ``path``."""
     if content is None:

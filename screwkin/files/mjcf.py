@@ -55,7 +55,7 @@ _PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor
 
 
 class _Reader:
-    def __init__(self, path, root):
+    def __init__(self, path, root) -> None:
         self.path, self.root = path, root
         self.problems = Problems()
         self.warnings = []
@@ -88,7 +88,7 @@ class _Reader:
             self._default(d, "main", {})
 
     # ---- defaults -------------------------------------------------------------------------
-    def _default(self, elem, name, inherited):
+    def _default(self, elem, name, inherited) -> None:
         own = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in elem:
             if child.tag == "default":
@@ -123,7 +123,7 @@ class _Reader:
         return out
 
     # ---- numbers and frames ---------------------------------------------------------------
-    def vec(self, text, n, what, default, bound=LIMITS.length, unit="m"):
+    def vec(self, text, n, what, default, bound=LIMITS.length, unit: str="m"):
         return np.array(numbers(text, n, what, self.problems, default, bound, unit), float)
 
     def angle(self, value):
@@ -173,7 +173,7 @@ class _Reader:
         frames' placement in the body, class the frames' childclass over ``cls``."""
         out = []
 
-        def walk(e, T, c, depth):
+        def walk(e, T, c, depth) -> None:
             for child in e:
                 if child.tag == "frame":
                     if depth > LIMITS.elements:  # pragma: no cover - the element count bounds it first
@@ -220,7 +220,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
     out_links = []
     unread = {"springref": [], "mesh": [], "extra numbers": []}
 
-    def site(elem, body, cls, T):
+    def site(elem, body, cls, T) -> None:
         a = r.attrs(elem, cls)
         name = a.get("name")
         if name:
@@ -241,7 +241,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
             elif e.tag not in _BODY_PASSIVE:
                 p.append(f"<worldbody> has a <{shorten(str(e.tag), 30)}> element: not supported")
 
-    def body(elem, parent, cls, T):
+    def body(elem, parent, cls, T) -> None:
         cls = elem.get("childclass", cls)
         name = elem.get("name")
         if not name:
@@ -418,7 +418,7 @@ def read_mjcf(path, text, root=None, package_dirs=()) -> MechanismSpec:
                          package_dirs=[str(d) for d in package_dirs or ()], inputs=inputs, reference=reference)
 
 
-def _inertia_xml(com, mass, I):
+def _inertia_xml(com, mass, I) -> str:
     return (f"<inertial><origin xyz=\"{vector_text(*com)}\" rpy=\"0 0 0\"/><mass value=\"{mass:.17g}\"/><inertia "
             f"ixx=\"{I[0, 0]:.17g}\" iyy=\"{I[1, 1]:.17g}\" izz=\"{I[2, 2]:.17g}\" ixy=\"{I[0, 1]:.17g}\" "
             f"ixz=\"{I[0, 2]:.17g}\" iyz=\"{I[1, 2]:.17g}\"/></inertial>")

@@ -165,7 +165,7 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
     spec_links = dict(links)
     joints, cuts = [], []
 
-    def link_xml(name):
+    def link_xml(name) -> str:
         mass = spec_links[name].mass
         inertial = (f'<inertial><mass value="{mass:.17g}"/><inertia ixx="1e-9" iyy="1e-9" izz="1e-9" '
                     f'ixy="0" ixz="0" iyz="0"/></inertial>') if mass else ""

@@ -120,7 +120,7 @@ def _value(v, where, what) -> float:
     return _quantity(v, where, what).value
 
 
-def _count(v, where, what, low=1, high=MAX_DESIGNS):
+def _count(v, where, what, low: int=1, high=MAX_DESIGNS):
     if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
         _fail(where, f"{what} must be a whole number from {low} to {high}, got {quote(v)}")
     return v

@@ -54,7 +54,7 @@ _NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\Z")
 _NONFINITE = re.compile(r"[-+]?(?:nan|inf|infinity)\Z", re.IGNORECASE)
 
 
-def numbers(text, count, what, problems, default, bound=None, unit="m", low=None):
+def numbers(text, count, what, problems, default, bound=None, unit: str="m", low=None):
     """Parse ``count`` floats from an attribute; record a problem when invalid.
 
     bound: largest magnitude accepted (see :class:`~screwkin.files.description.Limits`);
@@ -265,7 +265,7 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
     return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint", **extra)
 
 
-def _radius(text, what, problems, allow_inf=False):
+def _radius(text, what, problems, allow_inf: bool=False):
     """A radius [m]: a positive number, or (a straight line) 'inf' where allowed."""
     if text is None:
         problems.append(f"{what} is missing")
@@ -358,7 +358,7 @@ def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: in
                   f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
-def check_tree(path, links, joints, problems):
+def check_tree(path, links, joints, problems) -> None:
     """Record problems that keep the joints from forming one tree over the links."""
     parent_of = {}
     for j in joints:

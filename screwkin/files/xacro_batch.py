@@ -53,7 +53,7 @@ class Unbatchable(Exception):
 class _Context:
     """The Batch values of one expansion, each written into the text as its token."""
 
-    def __init__(self, n: int):
+    def __init__(self, n: int) -> None:
         self.n = n
         self.batches = []
         self._ids = {}
@@ -88,7 +88,7 @@ class Batch:
 
     __slots__ = ("v", "bad", "ctx")
 
-    def __init__(self, v, bad, ctx: _Context):
+    def __init__(self, v, bad, ctx: _Context) -> None:
         self.v, self.bad, self.ctx = np.asarray(v), bad, ctx
 
     def _other(self, o):
@@ -98,7 +98,7 @@ class Batch:
             return o, False
         self.ctx.refuse("a parameter combined with text")
 
-    def _bin(self, o, f, reverse=False):
+    def _bin(self, o, f, reverse: bool=False):
         ov, ob = self._other(o)
         with np.errstate(all="ignore"):
             r = np.asarray(f(ov, self.v) if reverse else f(self.v, ov))
@@ -130,7 +130,7 @@ class Batch:
     def __pos__(self):
         return self
 
-    def __bool__(self):
+    def __bool__(self) -> bool:
         good = np.asarray(self.v, bool)[~self.bad]
         if good.all():
             return True
@@ -139,12 +139,12 @@ class Batch:
         self.ctx.refuse("a condition on a parameter that some designs meet and others do not (the file's "
                         "structure depends on it)")
 
-    def __str__(self):  # written into the file: a token, replaced by each design's value
+    def __str__(self) -> str:  # written into the file: a token, replaced by each design's value
         return self.ctx.token(self)
 
     __repr__ = __str__
 
-    def _refuse_number(self, *_):
+    def _refuse_number(self, *_) -> None:
         self.ctx.refuse("a parameter used where xacro needs one number")
 
     __int__ = __float__ = __index__ = _refuse_number
@@ -158,7 +158,7 @@ class _BatchInterpreter(_Interpreter):
     """xacro_eval's interpreter with Batch values: what it does with a number, it does with each
     design's number."""
 
-    def __init__(self, symbols, ctx: _Context):
+    def __init__(self, symbols, ctx: _Context) -> None:
         super().__init__(symbols)
         self.ctx = ctx
 

@@ -188,7 +188,7 @@ def _call(name, args):
 class _Interpreter:
     """Evaluates a checked tree with names looked up in xacro's symbol table."""
 
-    def __init__(self, symbols):
+    def __init__(self, symbols) -> None:
         self.symbols = symbols
 
     def value(self, node):

@@ -46,7 +46,7 @@ class _Names:
     """The links of a loop's sides, looked up when first read (a sentence is written only for a loop
     that cannot close)."""
 
-    def __init__(self, mech, path1, ground, path2):
+    def __init__(self, mech, path1, ground, path2) -> None:
         self.mech, self.parts = mech, (path1, ground, path2)
         self._names = None
 
@@ -65,7 +65,7 @@ class _Names:
     def __iter__(self):
         return iter(self._all())
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self._all())
 
     def __getitem__(self, k):

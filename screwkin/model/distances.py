@@ -37,7 +37,7 @@ class SixDistances:
 
     n, width = 6, 7
 
-    def __init__(self, A, B):
+    def __init__(self, A, B) -> None:
         self.A = np.asarray(A, float)
         self.B = np.asarray(B, float)
         self.closure = self  # the trace test draws its random points from ``closure``

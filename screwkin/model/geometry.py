@@ -80,7 +80,7 @@ def circle_circle(p, r, c, s, side):
     return p + along[..., None] * u + (side * h)[..., None] * n, h2
 
 
-def circle_intersections(p, r, c, s, slack=0.0, concentric=0.0) -> list:
+def circle_intersections(p, r, c, s, slack: float=0.0, concentric: float=0.0) -> list:
     """The points where the circles (p, r) and (c, s) in the plane meet: [left of p -> c,
     right], the same point twice where they touch, [] where they do not meet (the centres
     closer than ``concentric``, or farther than r + s + slack, or nearer than |r - s| - slack).

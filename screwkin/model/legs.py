@@ -183,7 +183,7 @@ def _passive(model, j, frozen) -> bool:
     return not any(jm.idx_v + k in frozen for k in range(jm.nv))
 
 
-def _turn(model, q, joints, rng):
+def _turn(model, q, joints, rng) -> None:
     """q with the revolutes ``joints`` turned to random angles (in place)."""
     for k in joints:
         jm = model.joints[k]

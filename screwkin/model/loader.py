@@ -328,7 +328,7 @@ def _urdfdom_messages(box: list) -> list:
 
 
 def _print_warning(path):
-    def warn(m):
+    def warn(m) -> None:
         print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
 
     return warn

@@ -57,7 +57,7 @@ def set_continuous_angle(q, i, angle) -> None:
 class Integrator:
     """q (+) v for stacks: ``Integrator(model)(Q (N, nq), V (N, nv)) -> (N, nq)``."""
 
-    def __init__(self, model):
+    def __init__(self, model) -> None:
         self.model = model
         vector_q, vector_v = [], []
         groups = {"so2": ([], []), "so3": ([], []), "se3": ([], []), "se2": ([], [])}

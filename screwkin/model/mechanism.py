@@ -63,7 +63,7 @@ class Mechanism:
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """
 
-    def __init__(self, spec: MechanismSpec, model, actuated=None, tolerances: Tolerances = DEFAULT):
+    def __init__(self, spec: MechanismSpec, model, actuated=None, tolerances: Tolerances = DEFAULT) -> None:
         self.spec = spec
         self.path = spec.path
         self.tolerances = tolerances
@@ -567,7 +567,7 @@ class Mechanism:
         at q (default: a generic assembled configuration)."""
         return build_topology(self, self.generic_configurations()[1][0] if q is None else q)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "
                 f"{len(self.coordinates)} moving tree joints, {len(self.cuts)} cut joints)")
 

@@ -175,10 +175,10 @@ class PointMotion:
 
     __slots__ = ("position", "velocity", "acceleration")
 
-    def __init__(self, position, velocity=None, acceleration=None):
+    def __init__(self, position, velocity=None, acceleration=None) -> None:
         self.position, self.velocity, self.acceleration = position, velocity, acceleration
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"PointMotion(position={self.position}, velocity={self.velocity}, acceleration={self.acceleration})"
 
 
@@ -187,7 +187,7 @@ class KinematicState:
     vectors of the model, (nv,)).  Read-only; every quantity is computed when first asked (Pinocchio's
     pass run again where another state has used the thread's Data since) and returned as a copy."""
 
-    def __init__(self, mech, q, qd=None, qdd=None):
+    def __init__(self, mech, q, qd=None, qdd=None) -> None:
         self.mech = mech
         self.q = np.array(q, float)
         self.qd = None if qd is None else np.array(qd, float)

@@ -190,7 +190,7 @@ class UnionFind:
     """Disjoint sets of ``items`` (union-find with path halving): find(x) its set's representative,
     join(a, b) puts b's set under a's representative."""
 
-    def __init__(self, items):
+    def __init__(self, items) -> None:
         self.parent = {i: i for i in items}
 
     def find(self, x):
@@ -199,7 +199,7 @@ class UnionFind:
             x = self.parent[x]
         return x
 
-    def join(self, a, b):
+    def join(self, a, b) -> None:
         ra, rb = self.find(a), self.find(b)
         if ra != rb:
             self.parent[rb] = ra
@@ -402,7 +402,7 @@ def build_topology(mech, q) -> Topology:
     def massless(r):
         return r != ground_root and all(spec.links[m].is_massless(dm) for m in groups[r])
 
-    def one_dof(k):
+    def one_dof(k) -> bool:
         return edges[k].type in ("revolute", "continuous", "prismatic")
 
     candidates = {r for r in groups if massless(r) and len(incident[r]) == 2 and all(one_dof(k) for k in incident[r])}

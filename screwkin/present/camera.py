@@ -31,7 +31,7 @@ def view_direction(bounds) -> np.ndarray:
     return d / np.linalg.norm(d)
 
 
-def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], fill=0.7):
+def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], fill: float=0.7):
     """Target and position (world) of a perspective camera looking along -direction, z up, at
     which the points fill the fraction ``fill`` of the frame along its tighter dimension: the
     target is moved (a few fixed-point steps) until the points' projected extent is centred, and

@@ -111,7 +111,7 @@ def figure_bytes(fig, fmt: str = "svg") -> bytes:
 
 
 # ------------------------------------------------------------------ numbers as people read them
-def _g(x, digits=6) -> str:
+def _g(x, digits: int=6) -> str:
     return f"{shown(x):.{digits}g}"
 
 

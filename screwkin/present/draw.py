@@ -61,7 +61,7 @@ def drawing_title(mech, what) -> str:
     return f"{os.path.basename(str(mech.path))}: {what}"
 
 
-def _short(name, n=26):
+def _short(name, n: int=26):
     return name if len(name) <= n else name[: n - 1] + "~"
 
 
@@ -78,7 +78,7 @@ def _direction_2d(v):
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _fit_axes(fig, ax, points, r, limits=None):
+def _fit_axes(fig, ax, points, r, limits=None) -> None:
     """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
     ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
@@ -116,7 +116,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
         return "0.25" if n == 1 else colour[n]
 
     # ground symbol under a point (a pivot) or along a guide
-    def ground_at(letter, p, down=None, along=None):
+    def ground_at(letter, p, down=None, along=None) -> None:
         p = np.asarray(p, float)
         down = np.array([0.0, -1.0]) if down is None else down
         side = np.array([-down[1], down[0]]) if along is None else np.asarray(along, float)
@@ -296,7 +296,7 @@ def _block_direction(skel, lk):
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid, alpha=0.85):
+def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float=0.85) -> None:
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -305,7 +305,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid, alpha=0.85):
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j, p, r):
+def _input_arrow(ax, FancyArrowPatch, j, p, r) -> None:
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
@@ -330,7 +330,7 @@ def _input_arrow(ax, FancyArrowPatch, j, p, r):
                                  label="input"))
 
 
-def _legend(fig, links, joints, marks=None):
+def _legend(fig, links, joints, marks=None) -> None:
     lines = ["links"]
     lines += [f" {lk.number:>2}  {_short(lk.name)}" + ("  (ground)" if lk.ground else "") for lk in links]
     lines.append("")

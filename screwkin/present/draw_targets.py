@@ -49,7 +49,7 @@ def design_marks(mech, q, skel, inputs=None, steps: int = 360):
     return found, marks
 
 
-def design_drawing(mech, q, input_names, skel, steps, say=None, hint=""):
+def design_drawing(mech, q, input_names, skel, steps, say=None, hint: str=""):
     """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
     precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
     ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""

@@ -23,7 +23,7 @@ def greek(text: str) -> str:
     return text.replace("**", "^")
 
 
-def _matrix_text(name, rows, indent="  "):
+def _matrix_text(name, rows, indent: str="  "):
     """A matrix of expressions, one row a line."""
     lines = []
     for i, row in enumerate(rows):
@@ -32,7 +32,7 @@ def _matrix_text(name, rows, indent="  "):
     return lines
 
 
-def _numbers_text(name, M, indent="    "):
+def _numbers_text(name, M, indent: str="    "):
     M = np.atleast_2d(np.asarray(M, float))
     lines = []
     for i, row in enumerate(M):
@@ -192,7 +192,7 @@ class Units:
     """How a person typed each quantity: angles in deg or rad, lengths in a unit of length (written by
     units.unit_text)."""
 
-    def __init__(self, degrees: bool, lengths: dict | None = None):
+    def __init__(self, degrees: bool, lengths: dict | None = None) -> None:
         self.degrees = degrees
         self.lengths = lengths or {}  # symbol -> unit ("mm"); m when not given
 

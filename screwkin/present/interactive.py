@@ -51,7 +51,7 @@ def _visualizer_class():
     class Visualizer(ViserVisualizer):
         """Pinocchio's ViserVisualizer, which also draws cones (screwkin's arrow heads)."""
 
-        def loadViewerGeometryObject(self, geometry_object, prefix="", color=None):
+        def loadViewerGeometryObject(self, geometry_object, prefix: str="", color=None):
             geom = geometry_object.geometry
             if not isinstance(geom, coal.Cone):
                 return super().loadViewerGeometryObject(geometry_object, prefix, color)
@@ -97,7 +97,7 @@ class InteractiveView:
     a scene (screwkin.present.view.build_scene); ``port``: default 8080.  The controls are
     ``sliders`` (input name -> slider), ``modes`` (the dropdown), ``status`` and ``readout``."""
 
-    def __init__(self, mech, live, scene, port: int | None = None, title: str = "screwkin"):
+    def __init__(self, mech, live, scene, port: int | None = None, title: str = "screwkin") -> None:
         viser = viser_module()
         self.mech, self.live = mech, live
         if port is not None:  # viser takes the next free port when the one asked is in use: check it first
@@ -141,7 +141,7 @@ class InteractiveView:
         self._dot = 0.025 * float(scene.scale)  # the dot where each point is now [m]
         self._show()
 
-    def _dock(self):
+    def _dock(self) -> None:
         """The control panel docked to the window's right edge: the 3-D view is the rest of the window, so the
         controls never cover the mechanism (viser's floating panel sat over the view's top right corner)."""
         gui = self.server.gui
@@ -151,7 +151,7 @@ class InteractiveView:
         else:  # viser before 1.1: a fixed sidebar
             gui.configure_theme(control_layout="fixed")
 
-    def _camera(self, scene, basis):
+    def _camera(self, scene, basis) -> None:
         """The first view: the mechanism framed (fit_camera, as view's pictures), along the plane's
         normal for a planar mechanism (its drawing's y up), else from view's usual direction; for the
         view's shape before a browser says it (then _frame_client frames it for that browser's)."""
@@ -167,7 +167,7 @@ class InteractiveView:
         cam.near, cam.far = dist / 100, dist * 100
         self._first = (np.asarray(eye, float), dist)
 
-    def _frame_client(self, client):
+    def _frame_client(self, client) -> None:
         """Frame the mechanism for a browser as it says its view's size and field of view (its camera messages):
         the view left of the docked panel is narrower than the window, differs by window, and is known only once
         the panel is laid out; framed again while the size changes, until the person moves the camera.  A camera
@@ -176,7 +176,7 @@ class InteractiveView:
         framed = {}  # the size last framed for and the camera position set for it
         placed = [self._first]  # every (eye, distance to its target) this view gave the camera
 
-        def frame(cam):
+        def frame(cam) -> None:
             size = (int(cam.image_width), int(cam.image_height))
             if not size[0] or not size[1]:
                 return
@@ -202,7 +202,7 @@ class InteractiveView:
     def _mode_name(self) -> str:
         return f"mode {max(self.live.state.mode, 1)}"
 
-    def _act(self, action):
+    def _act(self, action) -> None:
         """Run ``action`` then redraw, unless a callback is already doing so: setting a control
         from Python (a slider sent back, the modes' dropdown updated) calls back, and is ignored."""
         with self._lock:
@@ -216,18 +216,18 @@ class InteractiveView:
                 self._busy = False
 
     def _moved(self, name, unit):
-        def move():
+        def move() -> None:
             self.live.move(name, _si(float(self.sliders[name].value), unit))
             if not self.live.state.moved:  # refused: the slider goes back to where the mechanism is
                 self.sliders[name].value = _shown(self.live.state.inputs[name], unit)
 
         return lambda event: self._act(move)
 
-    def _switched(self, event):
+    def _switched(self, event) -> None:
         self._act(lambda: self.live.switch(int(str(self.modes.value).split()[-1])))
 
     # ------------------------------------------------------------------ display
-    def _show(self):
+    def _show(self) -> None:
         s = self.live.state
         self.viz.display(s.q)
         names = self._mode_names()
@@ -256,7 +256,7 @@ class InteractiveView:
         self.readout.content = "  \n".join(out)
         self._trace(s)
 
-    def _trace(self, s):
+    def _trace(self, s) -> None:
         """Each named point's traced path as line segments between its successive positions."""
         scene = self.server.scene
         for k, name in enumerate(s.points):
@@ -271,6 +271,6 @@ class InteractiveView:
             elif name in self.paths:  # a mode switch started the path again
                 self.paths.pop(name).remove()
 
-    def close(self):
+    def close(self) -> None:
         with contextlib.redirect_stdout(io.StringIO()):
             self.server.stop()

@@ -56,7 +56,7 @@ def loci_dict(loci, regions, x_unit: str, y_unit: str, loops=None, mech=None) ->
 
 def loci_lines(loci, regions, x_name, y_name, x_unit: str, y_unit: str, loops=None) -> list:
     """Text lines: each curve, the cusps, nodes and regions, and how they were found."""
-    def pt(p):
+    def pt(p) -> str:
         a, b = _xy(p, x_unit, y_unit)
         return f"({x_name} = {a:.9g} {x_unit}, {y_name} = {b:.9g} {y_unit})"
 
@@ -96,7 +96,7 @@ def loci_lines(loci, regions, x_name, y_name, x_unit: str, y_unit: str, loops=No
     return lines
 
 
-def loci_png(loci, regions, path, xs, ys, x_name, y_name, x_unit, y_unit, title=None):
+def loci_png(loci, regions, path, xs, ys, x_name, y_name, x_unit, y_unit, title=None) -> None:
     """Loci by kind, cusps and nodes, regions shaded by their number of assembly modes."""
     plt = pyplot("--png")
     fig, ax = plt.subplots(figsize=(7, 6))

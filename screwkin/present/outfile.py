@@ -33,6 +33,8 @@ import stat
 import sys
 
 from ..errors import OutputError
+from types import TracebackType
+from typing import Optional, Type
 
 __all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL", "open_partial"]
 
@@ -92,7 +94,7 @@ class WholeOrNothing:
     def __enter__(self):
         return self
 
-    def __exit__(self, kind, exc, tb):
+    def __exit__(self, kind: Optional[Type[BaseException]], exc: Optional[BaseException], tb: Optional[TracebackType]) -> None:
         if kind is None:
             self.close()
         else:
@@ -105,7 +107,7 @@ class OutputFile(WholeOrNothing):
     closing it fails with OutputError (the partial file removed); leaving the ``with`` block on any
     other exception (the work failed, or was interrupted) removes the partial file too."""
 
-    def __init__(self, path, mode: str = "w"):
+    def __init__(self, path, mode: str = "w") -> None:
         self.path = str(path)
         self._partial = None
         encoding = None if "b" in mode else "utf-8"
@@ -224,9 +226,9 @@ def write_figure(fig, path, **savefig) -> None:
 class _Said(logging.Handler):
     """The warnings a logger gives while a figure is written, kept to be said as screwkin says warnings."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         super().__init__(logging.WARNING)
         self.messages = []
 
-    def emit(self, record):
+    def emit(self, record) -> None:
         self.messages.append(" ".join(record.getMessage().split()))

@@ -51,7 +51,7 @@ def _rate_scales(units):
             (units.acceleration(False), units.acceleration(True))]
 
 
-def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute=False,
+def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute: bool=False,
                  rate_words=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
@@ -189,7 +189,7 @@ def motion_figure(res, mus=None, singularities=(), title=None, linear=None, moti
 
 
 def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
-               rate_words=None, units=None):
+               rate_words=None, units=None) -> None:
     """A sweep into a PNG: :func:`motion_figure`, saved."""
     plt = pyplot("--plot")
     fig = motion_figure(res, mus, singularities, title, linear, motion, normal, rate_words, units)
@@ -253,7 +253,7 @@ def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None 
     return fig
 
 
-def map_png(res, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):
+def map_png(res, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None) -> None:
     """A singularity map (SingularityMap) as a heat map with the singular curves (see :func:`map_figure`)."""
     plt = pyplot("--png")
     fig = map_figure(res, x_unit, y_unit, title)

@@ -25,7 +25,7 @@ class Progress:
     ``with`` block does, however the work ended)."""
 
     def __init__(self, stream=None, width: int = 30, label: str = "study", unit: str = "designs",
-                 every: float = 0.0):
+                 every: float = 0.0) -> None:
         self.stream = stream or sys.stderr
         try:
             self.tty = self.stream.isatty()

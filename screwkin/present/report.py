@@ -212,7 +212,7 @@ def slide_note(res, s) -> str | None:
     return note
 
 
-def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits(),
+def position_text(res, degrees: bool=True, show_all: bool=False, length=None, units: RateUnits = RateUnits(),
                   leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and

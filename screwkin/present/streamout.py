@@ -30,7 +30,7 @@ class SweepWriter(WholeOrNothing):
     """Appends chunks of a sweep to ``csv`` and/or ``parquet`` (paths; None: not written), each through
     present/outfile.OutputFile: written as PATH.<random>.partial and renamed once the sweep is whole."""
 
-    def __init__(self, csv: str | None = None, parquet: str | None = None):
+    def __init__(self, csv: str | None = None, parquet: str | None = None) -> None:
         if parquet:
             self.require_parquet(parquet)
         self._csv_path, self._csv = csv, None  # (opened at the first chunk: a sweep refused writes nothing)
@@ -58,7 +58,7 @@ class SweepWriter(WholeOrNothing):
             raise
         self.rows += len(res.values)
 
-    def _write_parquet(self, res, motion):
+    def _write_parquet(self, res, motion) -> None:
         import pyarrow as pa
         import pyarrow.parquet as pq
 

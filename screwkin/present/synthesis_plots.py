@@ -16,7 +16,7 @@ from .outfile import write_figure
 __all__ = ["burmester_png"]
 
 
-def burmester_png(result: MotionResult, path: str):
+def burmester_png(result: MotionResult, path: str) -> None:
     """The curves of a four- or five-position MotionResult (three positions: the poses and
     the four-bar only) into a PNG."""
     plt = pyplot("--png")

@@ -136,7 +136,7 @@ def _ball(name, joint, frame, p, radius, color):
     return obj
 
 
-def _disc(name, joint, frame, M, radius, color, alpha=0.35):
+def _disc(name, joint, frame, M, radius, color, alpha: float=0.35):
     """A thin disc of ``radius`` whose normal is the z axis of the placement M (a pitch circle or
     a circular profile), see-through so the links stay visible."""
     obj = pin.GeometryObject(name, joint, frame, M, _coal().Cylinder(radius, 0.05 * radius))
@@ -269,7 +269,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
     center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     r_axis, L_axis = 0.004 * scale, 0.08 * scale
 
-    def add(obj, role):
+    def add(obj, role) -> None:
         if obj is not None:
             geom.addGeometryObject(obj)
             roles[obj.name] = role
@@ -358,7 +358,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
 class RecordingViewer:
     """A stand-in for meshcat.Visualizer that records what is sent to it."""
 
-    def __init__(self, root=None, path=""):
+    def __init__(self, root=None, path: str="") -> None:
         import meshcat.path
 
         self._root = root or self
@@ -371,19 +371,19 @@ class RecordingViewer:
         path = path if path.startswith("/") else f"{self._path}/{path}"
         return RecordingViewer(self._root, path)
 
-    def set_object(self, geometry, material=None):
+    def set_object(self, geometry, material=None) -> None:
         self._root.objects[self._path] = (geometry, material)
 
-    def set_transform(self, matrix=np.eye(4)):
+    def set_transform(self, matrix=np.eye(4)) -> None:
         self._root.transforms[self._path] = np.asarray(matrix)
 
-    def set_property(self, key, value):
+    def set_property(self, key, value) -> None:
         self._root.properties[(self._path, key)] = value
 
-    def delete(self):
+    def delete(self) -> None:
         self._root.objects.pop(self._path, None)
 
-    def set_animation(self, animation, play=True, repetitions=1):
+    def set_animation(self, animation, play: bool=True, repetitions: int=1) -> None:
         self._root.animation = animation
 
     def get_image(self, *args):  # pragma: no cover - present so Pinocchio does not warn
@@ -396,7 +396,7 @@ def _translation(p):
     return T
 
 
-def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
+def show(mech, scene: Scene, viewer, q, motion=None, fps: int=30):
     """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
     with ``motion`` (a sequence of configurations) also set a meshcat animation.  A planar
     mechanism is seen along its plane's normal, orthographic, a colour per link (viewplanar)."""
@@ -519,7 +519,7 @@ def chromium():
     return None
 
 
-def screenshot(html_path, png_path, size=PICTURE, budget_ms=8000):
+def screenshot(html_path, png_path, size=PICTURE, budget_ms: int=8000):
     """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
     exe = chromium()
     if exe is None:

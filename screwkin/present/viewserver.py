@@ -44,7 +44,7 @@ def _bridge_class():
     return LoopbackBridge
 
 
-def _exit_when_stdin_closes():
+def _exit_when_stdin_closes() -> None:
     """End this process (at once, sockets closed by the kernel) when the parent's end of stdin closes."""
     try:
         while sys.stdin.buffer.read(4096):
@@ -54,7 +54,7 @@ def _exit_when_stdin_closes():
     os._exit(0)
 
 
-def main(argv=None):
+def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     port = int(argv[argv.index("--port") + 1]) if "--port" in argv else None
     # the parent stops this server: Ctrl-C in a terminal reaches the whole process group, and the
@@ -77,7 +77,7 @@ class ViewerServer:
     process group; ``port``: the web server's port (default: the first free one from 7000).
     The server ends when :meth:`close` is called, or when this process ends in any way."""
 
-    def __init__(self, port: int | None = None):
+    def __init__(self, port: int | None = None) -> None:
         cmd = [sys.executable, "-u", "-m", "screwkin.present.viewserver"]
         if port is not None:
             cmd += ["--port", str(int(port))]
@@ -102,7 +102,7 @@ class ViewerServer:
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; the CLI says it itself
             self.viewer = meshcat.Visualizer(zmq_url=self.zmq_url)
 
-    def close(self):
+    def close(self) -> None:
         """Stop the server and wait for it (killed if it has not ended after 5 s)."""
         if self.proc.poll() is None:
             self.proc.terminate()
@@ -118,7 +118,7 @@ class ViewerServer:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc) -> None:
         self.close()
 
 

@@ -105,7 +105,7 @@ def _value_text(x):
     return "-" if x is None else f"{x:.4g}"
 
 
-def workspace_csv(r: WorkspaceResult, path, joint_columns=None):
+def workspace_csv(r: WorkspaceResult, path, joint_columns=None) -> None:
     """One row per reached point (cell): world position, grid index, measures, free; with
     ``joint_columns`` ((name, q index) pairs) the joint values of the grid's solutions."""
     joint_columns = list(joint_columns or []) if r.configurations is not None else []
@@ -197,7 +197,7 @@ def workspace_figure(r: WorkspaceResult, title: str | None = None):
     return fig
 
 
-def workspace_png(r: WorkspaceResult, path: str):
+def workspace_png(r: WorkspaceResult, path: str) -> None:
     """The conditioning over the workspace, in slices (see :func:`workspace_figure`)."""
     plt = pyplot("--png")
     fig = workspace_figure(r)
@@ -207,7 +207,7 @@ def workspace_png(r: WorkspaceResult, path: str):
         plt.close(fig)
 
 
-def workspace_cloud(r: WorkspaceResult, viewer, size=None):
+def workspace_cloud(r: WorkspaceResult, viewer, size=None) -> None:
     """The reached points as a meshcat point cloud, coloured by conditioning (viridis-like
     ramp from dark blue to yellow), points below the threshold grey."""
     import meshcat.geometry as g

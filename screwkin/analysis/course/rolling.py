@@ -309,7 +309,7 @@ def unwrapped(loops, link, angle, q):
     return nearest_turn(angle, guess)
 
 
-def drop_constant_rows(loops):
+def drop_constant_rows(loops) -> None:
     """Leave out of loops.F a row of constants only (a rack's centre distance, fixed by the guides
     too): an identity of the configuration measured; said in a note."""
     variables = {loops.sym[n] for n in loops.variables}

@@ -206,7 +206,7 @@ def numbering(topo, inputs=()) -> tuple:
     own = {j.name for j in joints if re.fullmatch(rf"[A-Z][A-Za-z0-9]{{0,{SHORT_NAME - 1}}}", j.name)}
     taken, next_letter = set(own), [0]
 
-    def mark(j):
+    def mark(j) -> None:
         if j.name not in letter:
             if j.name in own:
                 letter[j.name] = j.name
@@ -217,7 +217,7 @@ def numbering(topo, inputs=()) -> tuple:
                 taken.add(letter[j.name])
             lettered.append(j)
 
-    def visit(link):
+    def visit(link) -> None:
         for j in joints:
             if link not in j.links:
                 continue

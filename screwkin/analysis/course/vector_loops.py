@@ -81,7 +81,7 @@ class VectorLoops:
     joints.  Holds the sympy expressions and their numerical forms; ``result()`` gives the
     plain :class:`PlanarEquations`."""
 
-    def __init__(self, mech, q, inputs=None, links=()):
+    def __init__(self, mech, q, inputs=None, links=()) -> None:
         """Every command that writes these equations (equations, solve --start, singularities
         --symbolic, report) builds them here: rolling and gear pairs included.  ``links``: links
         whose absolute angle is an input too (--set-angle of a floating link): their theta is known."""
@@ -143,7 +143,7 @@ class VectorLoops:
         v = np.asarray(v, float)
         return np.array([v @ self.e1, v @ self.e2])
 
-    def _build_classes(self):
+    def _build_classes(self) -> None:
         """Links joined by prismatic joints turn together: one angle per class."""
         topo = self.topo
         parent = {lk: lk for lk in topo.links}
@@ -167,7 +167,7 @@ class VectorLoops:
             for m in members:
                 self.rep[m] = r
 
-    def _measure(self):
+    def _measure(self) -> None:
         """World positions of the joint centres at q; the anchors (points fixed in a link) of
         each joint on each of its links, as (frame id, local point) for forward kinematics."""
         mech, topo = self.mech, self.topo
@@ -184,7 +184,7 @@ class VectorLoops:
                     return j
             return None
 
-        def keep(key, link, point):
+        def keep(key, link, point) -> None:
             fid = self.frames[link]
             self.anchor[key] = self._p2(point)
             self.local[key] = (fid, state.frame_placement(fid).actInv(np.asarray(point, float)))
@@ -349,7 +349,7 @@ class VectorLoops:
         return None
 
     # ------------------------------------------------------------------ loops
-    def _build_loops(self):
+    def _build_loops(self) -> None:
         sp = self.sp
         self.symbol_info, self.sym, self.variables = {}, {}, []
         self.vec, self.slide_terms, self.used_r, self.used_x, self.used_rho = {}, {}, {}, {}, {}
@@ -465,7 +465,7 @@ class VectorLoops:
         self.unknowns = sorted((v for v in self.variables if v not in self.input_joints),
                                key=lambda n: (self.numbers[self.symbol_info[n].link], n.startswith("x"), order[n]))
 
-    def _build_matrices(self):
+    def _build_matrices(self) -> None:
         sp = self.sp
         if self.pairs:
             drop_constant_rows(self)

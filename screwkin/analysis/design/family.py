@@ -63,7 +63,7 @@ class ChunkRows(list):
     """A chunk's rows, with ``paths`` ({"family": n, "design": m}) and ``notes`` (why designs were
     evaluated alone), sent back with them from the worker."""
 
-    def __init__(self, rows=(), paths=None, notes=()):
+    def __init__(self, rows=(), paths=None, notes=()) -> None:
         super().__init__(rows)
         self.paths = dict(paths or {})
         self.notes = list(notes)
@@ -114,7 +114,7 @@ class _Placed:
     """Every design's tree joint frames and loop-joint frames at the file's configuration (all joints
     at zero), composed from their files' origins: world (R (n, 3, 3), p (n, 3))."""
 
-    def __init__(self, specs):
+    def __init__(self, specs) -> None:
         first = specs[0]
         n = len(specs)
         links = {first.root: (np.broadcast_to(np.eye(3), (n, 3, 3)), np.zeros((n, 3)))}
@@ -171,7 +171,7 @@ class _Fourbar:
     """The reference design's four-bar: which joint centres and loop frames each link's length joins,
     and the sides of its loop (model.closability.planar_loops)."""
 
-    def __init__(self, d, spec):
+    def __init__(self, d, spec) -> None:
         mech, info = d.mech, d.linkage()
         if info.kind != "four-bar":
             raise Unbatchable("the family path analyses four-bars (this one is a slider-crank)")

@@ -92,7 +92,7 @@ class DesignTimeout(ScrewkinError):
 class _Clock:
     """The deadline of one design, checked between its steps (loading, assembly, each metric)."""
 
-    def __init__(self, seconds: float):
+    def __init__(self, seconds: float) -> None:
         self.seconds = seconds
         self.end = time.perf_counter() + seconds
 
@@ -178,7 +178,7 @@ class _Task:
 class _Design:
     """One loaded design and what its metrics share (assembly, linkage, workspace)."""
 
-    def __init__(self, task: _Task, mech, clock: _Clock):
+    def __init__(self, task: _Task, mech, clock: _Clock) -> None:
         self.task, self.mech, self.clock = task, mech, clock
         self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
         clock.check()
@@ -189,7 +189,7 @@ class _Design:
             self._choose_mode()
             clock.check()
 
-    def _choose_mode(self):
+    def _choose_mode(self) -> None:
         """The assembly mode the design's motion and workspace follow: the task's ``mode`` K (default 1) of the
         inputs (the study's input, else the actuated joints) at their values in the assembled configuration,
         as ``solve`` lists them (the one rule of every command's --mode); ``self.q`` becomes its

@@ -102,7 +102,7 @@ class WorkspaceResult:
 class _Measures:
     """The workspace measures for stacks of assembled configurations."""
 
-    def __init__(self, mech, output, point, inputs, length):
+    def __init__(self, mech, output, point, inputs, length) -> None:
         self.mech, self.point, self.L = mech, point, float(length or mech.length)
         self.closure = BatchClosure(mech, check=0) if (mech.cuts or mech.extra_rows) else None
         self.out = SerialJacobians(mech, output, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, check=0)

@@ -59,7 +59,7 @@ def grid_axes(directions) -> np.ndarray:
 class Grid:
     """Batched inverse kinematics on a grid (see the module's text)."""
 
-    def __init__(self, mech, output, point, orientation, q_seed, p_seed, axes, h, lo, hi, frozen=()):
+    def __init__(self, mech, output, point, orientation, q_seed, p_seed, axes, h, lo, hi, frozen=()) -> None:
         self.mech, self.axes, self.h = mech, axes, float(h)
         self.deadline = None  # time.monotonic() past which the growth stops (the result marked truncated)
         self.timed_out = False
@@ -162,7 +162,7 @@ class Grid:
             Qc[sel[good]], Pc[sel[good]], sigma[sel] = Qn[good], Pk[good], sig
         return Qc, ok, sigma, jumped
 
-    def advance_all(self, Q, P_from, P_to, n, retry=True):
+    def advance_all(self, Q, P_from, P_to, n, retry: bool=True):
         """advance for points with each their number of substeps n (> 0), in blocks; with
         ``retry``, a step refused as a jump to another branch is tried again in twice as many
         substeps, up to _SUBSTEPS (a step that does not converge -- past the boundary -- is not)."""

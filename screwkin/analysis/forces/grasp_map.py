@@ -133,7 +133,7 @@ def generators(c, planar, facets: int = 8, circumscribed: bool = False) -> np.nd
     return C
 
 
-def generator_matrix(spec, Gs, blocks, facets, circumscribed=False, frictionless=False):
+def generator_matrix(spec, Gs, blocks, facets, circumscribed: bool=False, frictionless: bool=False):
     """W = G_s C (scaled primitive wrenches, columns) and, per contact, its columns' slice and C_i."""
     cols, parts, start = [], [], 0
     for c, b in zip(spec.contacts, blocks):

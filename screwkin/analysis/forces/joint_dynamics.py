@@ -30,7 +30,7 @@ class JointDynamics(dict):
     mimic joint's: its leader's).  Arrays over the model's velocity coordinates: ``armature``,
     ``damping``, ``frictionloss``; ``springs`` and ``coupled`` (the mimic joints') by name."""
 
-    def __init__(self, mech, joints, coupled):
+    def __init__(self, mech, joints, coupled) -> None:
         super().__init__()
         nv = mech.model.nv
         self.armature, self.damping, self.frictionloss = np.zeros(nv), np.zeros(nv), np.zeros(nv)

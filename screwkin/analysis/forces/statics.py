@@ -200,7 +200,7 @@ def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=None) -> dict:
+def joint_wrenches(mech, q, lam, loads=(), gravity: bool=False, v=None, a=None, rows=None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
@@ -214,7 +214,7 @@ def joint_wrenches(mech, q, lam, loads=(), gravity=False, v=None, a=None, rows=N
 
     placed = {}  # frame -> (its body's joint, that joint's placement, the frame's origin): read once
 
-    def apply(frame, wrench_at_origin):
+    def apply(frame, wrench_at_origin) -> None:
         """Add a wrench (force, moment about the frame's origin, world axes) to the frame's body."""
         if frame not in placed:
             joint = frame_parent(mech, frame)[0]

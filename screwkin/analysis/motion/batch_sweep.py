@@ -46,7 +46,7 @@ def batch_closure(mech):
 class BatchedCurve(Curve):
     """The Curve's engine on stacks of configurations (one per row), its closure batched."""
 
-    def __init__(self, solver, name, bc):
+    def __init__(self, solver, name, bc) -> None:
         super().__init__(solver, name)
         self.bc = bc
 

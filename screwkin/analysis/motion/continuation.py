@@ -80,23 +80,23 @@ class Engine(Protocol):
     configurations (one per row, sigma one per row); ``ClosedFormCurve`` (analysis.motion.dyads): input
     values instead of steps (its prediction is exact), a sign per dyad for the branch."""
 
-    def predict(self, *args):
+    def predict(self, *args) -> None:
         """Where the next configuration(s) should be: a step along the tangent (the closed form: its
         placement at the input values)."""
 
-    def correct(self, *args):
+    def correct(self, *args) -> None:
         """The configuration(s) closing the loops from the prediction, with one joint held (the closed
         form: the joint coordinates of its placement)."""
 
-    def accept(self, *args):
+    def accept(self, *args) -> None:
         """Which corrections stayed on the curve: ``jumped`` and, for a stack, ``passes_limit`` (the
         closed form: every discriminant non-negative)."""
 
-    def choose_branch(self, *args):
+    def choose_branch(self, *args) -> None:
         """The branch that continues the motion: ``orient`` (the closed form: past a dyad's limit
         position, its other sign)."""
 
-    def locate_limit(self, *args):
+    def locate_limit(self, *args) -> None:
         """The limit position bracketed between two configurations (input values), by ``locate``."""
 
 
@@ -170,7 +170,7 @@ def jumped(miss, sigma, tol):
     return ~(np.asarray(miss) <= np.maximum(tol.jump * np.abs(sigma), tol.jump_floor))
 
 
-def locate(f, lo, hi, xtol=1e-14, maxiter=100) -> float:
+def locate(f, lo, hi, xtol: float=1e-14, maxiter: int=100) -> float:
     """The root of f bracketed in [lo, hi] (f changes sign there) by Brent's method, to xtol and
     four units of round-off: where every engine locates its limit positions (the tangent's input
     share, a closed form's discriminant) and the input values on an arc near them."""
@@ -206,7 +206,7 @@ def continuation_steps(mech, name: str, dx: float) -> int:
 class Curve:
     """The curve along input ``name`` of a PositionSolver, one configuration at a time: an ``Engine``."""
 
-    def __init__(self, solver, name):
+    def __init__(self, solver, name) -> None:
         mech = self.mech = solver.mech
         self.solver, self.model, self.closure = solver, solver.model, mech.closure
         self.name = name
@@ -275,7 +275,7 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed") from None
 
-    def accept(self, predicted, corrected, sigma):
+    def accept(self, predicted, corrected, sigma) -> bool:
         miss = np.linalg.norm(pin.difference(self.model, predicted, corrected) / self.scale)
         return not jumped(miss, sigma, self.tol)
 
@@ -366,7 +366,7 @@ class Neighbour:
     its corrector and its branch tests (a correction that jumps away from the curve, or a
     limit position between the two values, refuses the step).  Maps walk their grids with it."""
 
-    def __init__(self, solver, name: str):
+    def __init__(self, solver, name: str) -> None:
         self.curve = Curve(solver, name)
 
     def __call__(self, q, x_from: float, x_to: float):

@@ -50,7 +50,7 @@ class Jet:
 
     __slots__ = ("v", "d", "dd")
 
-    def __init__(self, v, d=0.0, dd=0.0):
+    def __init__(self, v, d: float=0.0, dd: float=0.0) -> None:
         self.v, self.d, self.dd = v, d, dd
 
     def __add__(self, o):
@@ -108,7 +108,7 @@ class _Pose:
 
     __slots__ = ("th", "c", "s", "tx", "ty")
 
-    def __init__(self, th, tx, ty):
+    def __init__(self, th, tx, ty) -> None:
         self.th, self.c, self.s, self.tx, self.ty = th, th.cos(), th.sin(), tx, ty
 
     def rotate(self, u):
@@ -135,7 +135,7 @@ class _Geometry:
     coordinates, axis signs, the branch of each dyad (``probe``; without it ``branch`` is None:
     the caller chooses the branches, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech, p: DyadPlan, q0, probe: bool = True):
+    def __init__(self, mech, p: DyadPlan, q0, probe: bool = True) -> None:
         state = KinematicState(mech, q0)
         axes, points = [], []  # per pair: (on the side of its first group, of its second)
         for pr in p.pairs:
@@ -193,7 +193,7 @@ class _Geometry:
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clamp=False):
+def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe: bool=False, clamp: bool=False):
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -289,7 +289,7 @@ def _evaluate_all(geo, p, xs, start, branch, clamp):
 class _Layout:
     """Where each tree joint's coordinate comes from: the groups of its two links, its kind."""
 
-    def __init__(self, mech, p: DyadPlan, geo, q0):
+    def __init__(self, mech, p: DyadPlan, geo, q0) -> None:
         model = mech.model
         self.rows = []  # (idx_q, nq, idx_v, kind, parent group, child group, pair index or None)
         by_tree = {pr.tree: i for i, pr in enumerate(p.pairs) if pr.tree is not None}
@@ -336,7 +336,7 @@ class _Unwrap:
     _SAFE = np.pi / 2  # the largest turn between two samples taken as unambiguous [rad]
     _SLACK = 0.01  # relative slack of the bounds |s| dx on a monotone step
 
-    def __init__(self, wrapped):
+    def __init__(self, wrapped) -> None:
         self.cols = np.array([iq for iq, _ in wrapped], int)
         self._iv = np.array([iv for _, iv in wrapped], int)
         self.last = None  # (raw, slope, x, turns) of the last sample
@@ -412,7 +412,7 @@ class ClosedFormCurve:
     False (``reason`` why) when the geometry does not apply; probe=False: no branch is read off q0 (the
     caller passes its branch vectors, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech, p: DyadPlan, q0, start, probe: bool = True):
+    def __init__(self, mech, p: DyadPlan, q0, start, probe: bool = True) -> None:
         self.mech, self.p, self.start = mech, p, start
         self.geo = _Geometry(mech, p, q0, probe)
         self.ok, self.reason = self.geo.ok, getattr(self.geo, "reason", None)
@@ -438,7 +438,7 @@ class ClosedFormCurve:
         (Q with its one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2)."""
         return self.layout({g: _Pose(_take(q.th, n), _take(q.tx, n), _take(q.ty, n)) for g, q in poses.items()}, n)
 
-    def choose_branch(self, which):
+    def choose_branch(self, which) -> None:
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
@@ -481,7 +481,7 @@ def _residuals_ok(mech, Q) -> bool:
     return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
 
 
-def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
+def planar_sweep(solver, name, q0, start, stop, steps, rate: float=1.0, turn: bool=False, max_steps=None):
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
     (two limits between grid values, a configuration not closing the loops)."""

@@ -84,7 +84,7 @@ class Interactive:
     output: the output link whose pose is read out; points: analysis.motion.links.Point objects read out."""
 
     def __init__(self, mech, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,
-                 points=()):
+                 points=()) -> None:
         self.mech = mech
         self.solver = PositionSolver(mech, list(inputs) if inputs else None, output=output)
         self.inputs = tuple(self.solver.inputs)
@@ -123,7 +123,7 @@ class Interactive:
         self._record(self.state.inputs, self.state.points)
 
     # ------------------------------------------------------------------ traced paths
-    def _record(self, inputs, points):
+    def _record(self, inputs, points) -> None:
         if self.points:
             self._trace.append((dict(inputs), {n: np.array(p, float) for n, p in points.items()}))
 

@@ -139,7 +139,7 @@ class ModeLabels:
     and the links that only translate, with their reference orientation), then read at each
     solution.  Nothing is labelled for mechanisms without loops or without a reference."""
 
-    def __init__(self, solver):
+    def __init__(self, solver) -> None:
         mech, model = solver.mech, solver.model
         self.mech, self.model = mech, model
         self.legs, self.turned = [], []

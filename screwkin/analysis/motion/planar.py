@@ -276,7 +276,7 @@ class LinkAngles:
     child's slide does not turn its parent (the ground of a slider-crank kept a constant
     angle only while the slider stood still)."""
 
-    def __init__(self, mech, topo):
+    def __init__(self, mech, topo) -> None:
         if topo.motion_space != "planar" or topo.normal is None:
             raise UsageError(f"{mech.path}: absolute link angles are for planar mechanisms; this one is "
                              f"{topo.motion_space}")

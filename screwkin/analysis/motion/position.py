@@ -56,7 +56,7 @@ class PositionSolver:
     """Solves a mechanism for given input joints; reuses the model and data
     between calls (build once, solve many times)."""
 
-    def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None):
+    def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None) -> None:
         """compiled: True to solve the closure equations with the compiled kernels of
         screwkin.model.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
         joints are all fixed or spherical, False for numpy, None to leave the mechanism's

@@ -310,7 +310,7 @@ def _start_tangent(curve, q0, h):
         return None, str(exc)
 
 
-def _finish(solver, name, motion, rate, requested, turn, unit, method="tracker"):
+def _finish(solver, name, motion, rate, requested, turn, unit, method: str="tracker"):
     """The SweepResult of an engine's Motion: rates and accelerations at each configuration."""
     X, Q = motion.X, motion.Q
     mech = solver.mech

@@ -36,7 +36,7 @@ class Tracker:
     """One motion of ``curve`` from q0 (input ``start``, oriented tangent t) over the grid of ``steps``
     steps to ``stop``; ``run`` returns the Motion.  The state of the walk is its attributes."""
 
-    def __init__(self, curve, q0, t, start, stop, steps, turn=False, max_steps=None, progress=None):
+    def __init__(self, curve, q0, t, start, stop, steps, turn: bool=False, max_steps=None, progress=None) -> None:
         self.c, self.q0, self.start, self.stop, self.steps = curve, q0, float(start), float(stop), steps
         self.turn, self.progress = turn, progress
         self.max_steps = max_steps or 20 * steps + 100
@@ -79,7 +79,7 @@ class Tracker:
                 pass
         return None
 
-    def keep(self, g, qg):
+    def keep(self, g, qg) -> None:
         if qg is None:
             self.m.skipped.append(float(g))  # said in the result: never a hole in a motion marked complete
         else:
@@ -89,7 +89,7 @@ class Tracker:
     def arc(self, qa, xa, qb, held):
         return (qa, xa, qb, held) if held is not None and held != self.c.ix else None
 
-    def record(self, qa, xa, ta, qb, xb, tb=None, held=None):
+    def record(self, qa, xa, ta, qb, xb, tb=None, held=None) -> None:
         """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
         position between them, each predicted from the nearer end (not from a limit position:
         there the input does not move, pass tb=None for such an end); where the predictor fails
@@ -102,7 +102,7 @@ class Tracker:
             self.keep(g, self.solved(g, (lambda g=g: c.at_input(qb, xb, g, tb)) if near_b else
                                      (lambda g=g: c.at_input(qa, xa, g, ta)), arc))
 
-    def record_back(self, q_lim, x_lim, qb, xb, tb, held=None):
+    def record_back(self, q_lim, x_lim, qb, xb, tb, held=None) -> None:
         """After a limit position: the grid values between it and qb, predicted from qb."""
         arc = self.arc(q_lim, x_lim, qb, held)
         for g in self.grid_between(x_lim, xb):

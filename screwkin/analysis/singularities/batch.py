@@ -58,7 +58,7 @@ class SerialJacobians:
     """
 
     def __init__(self, mech, link: str | None, reference=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
-                 check: int = 0, chain=None):
+                 check: int = 0, chain=None) -> None:
         """chain: a screws.Chain to any frame instead of the one to ``link``'s body frame."""
 
         if reference not in _REFERENCES:
@@ -241,7 +241,7 @@ class SerialJacobians:
         th = self._theta(Q)
         out = np.empty(len(Q))
 
-        def run(start):
+        def run(start) -> None:
             stop = min(start + self.block, len(Q))
             J = self._block(np.ascontiguousarray(th[:, start:stop]))
             if point:

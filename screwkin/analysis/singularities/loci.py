@@ -81,7 +81,7 @@ class Loci:
 class LocusSystem:
     """The augmented system F of one kind on S (see the module)."""
 
-    def __init__(self, mech, inputs, x_name, y_name, fixed, kind, output=None, point=False, generic=None):
+    def __init__(self, mech, inputs, x_name, y_name, fixed, kind, output=None, point: bool=False, generic=None) -> None:
         self.mech, self.kind, self.output, self.point = mech, kind, output, point
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)  # dq = scale * u: u dimensionless
@@ -243,7 +243,7 @@ class LocusSystem:
         return self.newton(qp, vp, plane, iterations=8, max_step=max(h, 1e-3), J=J)
 
 
-def _in_box(p, box, margin=0.0):
+def _in_box(p, box, margin: float=0.0):
     (x0, x1), (y0, y1) = box
     mx, my = margin * (x1 - x0), margin * (y1 - y0)
     return x0 - mx <= p[0] <= x1 + mx and y0 - my <= p[1] <= y1 + my
@@ -375,7 +375,7 @@ def _cusps(sys, qs, vs, ts):
     return out
 
 
-def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, kinds=None, grid: int = 9,
+def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point: bool=False, kinds=None, grid: int = 9,
                starts=None) -> Loci:
     """The singular loci of each kind in the box xs[0]..xs[-1] x ys[0]..ys[-1] (see the module).
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""

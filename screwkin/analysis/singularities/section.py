@@ -30,7 +30,7 @@ AXES = {"x": 0, "y": 1, "z": 2}
 class SectionSystem(LocusSystem):
     """The augmented system of the serial singularity of ``output``'s origin in a workspace section."""
 
-    def __init__(self, mech, output, x_axis, y_axis, level, fixed):  # (LocusSystem's own set-up is for inputs)
+    def __init__(self, mech, output, x_axis, y_axis, level, fixed) -> None:  # (LocusSystem's own set-up is for inputs)
         self.mech, self.kind, self.output, self.point = mech, "serial", output, True
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)

@@ -124,7 +124,7 @@ class Generic:
     joints that move there (a joint whose rate the loops force to zero everywhere is not
     "stationary" at any one configuration)."""
 
-    def __init__(self, mech, inputs, output=None, point: bool = False, configurations=None):
+    def __init__(self, mech, inputs, output=None, point: bool = False, configurations=None) -> None:
         tol = mech.tolerances
         configs = configurations if configurations is not None else mech.generic_configurations()[1]
         self.inputs = list(inputs)

@@ -178,7 +178,7 @@ def _orbits(n, autos):
     return tuple(orbits)
 
 
-def _name(links, degrees, edges, kinds):
+def _name(links, degrees, edges, kinds) -> str:
     prismatic = sum(1 for k in kinds.values() if k == "P")
     counts = {}
     for d in degrees:
@@ -247,7 +247,7 @@ def _drawing_numbers(ground: int, joints) -> dict:
     then tree joints, then loop joints)."""
     number = {ground: 1}
 
-    def visit(link):
+    def visit(link) -> None:
         for u, v in joints:
             if link in (u, v):
                 other = v if link == u else u

@@ -51,7 +51,7 @@ TWO_PI = 2 * math.pi
 class _Probe:
     """What the check reads off a configuration of the written four-bar."""
 
-    def __init__(self, mech, design: Design):
+    def __init__(self, mech, design: Design) -> None:
         self.mech = mech
         self.design = design
         self.out = mech.link_frame(design.output_link)

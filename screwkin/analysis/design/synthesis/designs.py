@@ -22,7 +22,7 @@ class SynthesisError(MechanismFileError):
     """No linkage (or no acceptable one) for the request: exit code 1, one line naming what
     was asked (``synthesize motion``) and why."""
 
-    def __init__(self, what: str, problem: str):
+    def __init__(self, what: str, problem: str) -> None:
         super().__init__(what, problem)
 
 
