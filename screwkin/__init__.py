@@ -44,7 +44,7 @@ _LAZY = {
 }
 
 
-def __getattr__(name):
+def __getattr__(name: str):
     """The public name ``name`` from its module, imported now (PEP 562)."""
     if name not in _LAZY:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -53,7 +53,7 @@ def __getattr__(name):
     return value
 
 
-def __dir__():
+def __dir__() -> list:
     return sorted(set(globals()) | set(_LAZY))
 
 

@@ -28,6 +28,10 @@ from .errors import MESSAGE_LIMIT, ScrewkinError, UsageError, one_line
 from .files.xacro import parse_args as parse_xacro_args
 from .model.loader import load
 from .units import parse_length
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["main", "COMMANDS", "command_module"]
 
@@ -69,15 +73,15 @@ def command_module(name: str):
 
 
 class _Parser(argparse.ArgumentParser):
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         # a value that starts with a minus and a digit is a value, units and all: --to -90deg, --from -1e-3
         self._negative_number_matcher = re.compile(r"^-\.?[0-9]")
 
-    def error(self, message) -> None:  # one line (the arguments quoted in it are bounded and escaped), exit code 2
+    def error(self, message: str) -> None:  # one line (the arguments quoted in it are bounded and escaped), exit code 2
         self.exit(2, f"screwkin: error: {one_line(message, MESSAGE_LIMIT)}\n")
 
-    def parse_known_args(self, args=None, namespace=None):
+    def parse_known_args(self, args: argparse.Namespace | None = None, namespace=None) -> tuple:
         # every (sub)parser checks its own options: no empty values, outputs writable (commands/_options.py)
         ns, rest = super().parse_known_args(args, namespace)
         try:
@@ -114,7 +118,7 @@ def _parser(argv=()):
     return p
 
 
-def _run(args):
+def _run(args: argparse.Namespace):
     command = command_module(args.command)
     if not command.NEEDS_MECHANISM or (command.NEEDS_MECHANISM == "optional" and args.file is None):
         return command.run(None, args)

@@ -37,6 +37,10 @@ from ..model.loader import rebuild
 from ..model.state import KinematicState
 from .loop_series import loop_system, split, subalgebra
 from .screws import screw_of
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["JointRedundancy", "Suggestion", "Redundancy", "redundancy", "suggest", "CANONICAL"]
 
@@ -92,7 +96,7 @@ class Redundancy:
     suggestion: Suggestion | None
 
 
-def _left_null(mech, q):
+def _left_null(mech: Mechanism, q: np.ndarray) -> tuple:
     """(K scaled (positions / L), lambda basis in K's own units (columns), labels)."""
     K = mech.closure.jacobian(q)
     L = mech.length
@@ -106,7 +110,7 @@ def _left_null(mech, q):
     return Ks, Lam, mech.closure.row_labels()
 
 
-def _cut_words(mech):
+def _cut_words(mech: Mechanism):
     """cut joint or coupling name -> (what it is in the file's words)."""
     out = {}
     for c in mech.spec.cut_joints:
@@ -117,7 +121,7 @@ def _cut_words(mech):
     return out
 
 
-def _directions(cut, state, tol):
+def _directions(cut, state, tol) -> tuple:
     """(e1, e2, e3, names): a joint's directions: e3 its axis when it has one ("the axis" and, when it is
     a world axis, its letter), e1 e2 across it (world axes when they are); else the world axes."""
     letters = {0: "x", 1: "y", 2: "z"}
@@ -136,7 +140,7 @@ def _directions(cut, state, tol):
     return e1, e2, a, ("a direction across the axis", "the other direction across it", "the axis")
 
 
-def _describe_span(W, at, dirs, L, tol):
+def _describe_span(W, at, dirs, L, tol) -> tuple[tuple, str]:
     """(named canonical wrenches, words) of the span of wrenches W (k, 6) at point ``at`` (moment
     about the world origin): canonical when the span is that of some of the joint's six canonical
     wrenches, else each basis wrench as a screw."""
@@ -177,7 +181,7 @@ def _and(items):
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _algebra(mech, q):
+def _algebra(mech: Mechanism, q: np.ndarray) -> tuple:
     """(kind, where, L): the algebra every tree screw lies in ("se(3)", "se(2)" with its normal, "so(3)"
     with its point; analysis.loop_series.subalgebra) and the characteristic length."""
     system = loop_system(mech, q, reduce=False)
@@ -185,7 +189,7 @@ def _algebra(mech, q):
     return kind, where, system.length
 
 
-def _why(mech, W, algebra):
+def _why(mech: Mechanism, W, algebra):
     """Why a joint's redundant wrenches W (k, 6) are there: "planar" when every one does no work on the
     planar motions the tree's joints make (their screws all lie in one plane's se(2)), "spherical"
     likewise on the rotations about one point, "planar and overconstrained" when only some do, else
@@ -206,7 +210,7 @@ def _why(mech, W, algebra):
     return f"{name} and overconstrained" if working < len(W) else "overconstrained"
 
 
-def redundancy(mech, q, suggest_fix: bool = False) -> Redundancy:
+def redundancy(mech: Mechanism, q: np.ndarray, suggest_fix: bool = False) -> Redundancy:
     """The redundant constraints of ``mech`` at the assembled configuration q; with ``suggest_fix`` the
     joints that make it exactly constrained, checked (see the module docstring)."""
     from scipy.linalg import qr
@@ -247,7 +251,7 @@ def redundancy(mech, q, suggest_fix: bool = False) -> Redundancy:
                       qr_rank, found)
 
 
-def _per_joint(mech, q, state, Lam, wrench_rows, owner):
+def _per_joint(mech: Mechanism, q: np.ndarray, state, Lam, wrench_rows, owner) -> tuple:
     """JointRedundancy of every joint carrying part of the left null space."""
     algebra = _algebra(mech, q)
     out = []
@@ -284,7 +288,7 @@ def _per_joint(mech, q, state, Lam, wrench_rows, owner):
     return tuple(out)
 
 
-def _canonical_wrenches(named, dirs, p):
+def _canonical_wrenches(named, dirs, p) -> np.ndarray:
     e1, e2, e3, labels = dirs
     out = []
     for n in named:
@@ -298,7 +302,7 @@ def _rotation_twist(u, p):
     return np.r_[np.cross(p, u), u]
 
 
-def _options(mech, state, name, kind, axis, point, axes):
+def _options(mech: Mechanism, state, name: str, kind: str, axis, point, axes):
     """(new type, [(world twist, words)], replacement) for each way to free more at one joint; ``axes``:
     the directions a universal joint's second axis may take ((world vector, letter or None))."""
     opts = []
@@ -315,7 +319,7 @@ def _options(mech, state, name, kind, axis, point, axes):
     return opts
 
 
-def _candidates(mech, state):
+def _candidates(mech: Mechanism, state):
     """The joints a suggestion may change, in the order it tries them: cut joints, then unactuated tree
     joints on the ground, then the other unactuated ones, then the actuated ones; each (name, is a cut,
     options)."""
@@ -361,7 +365,7 @@ def _candidates(mech, state):
                   for _, (n, _, opts) in tree]
 
 
-def _column(system, mech, name, is_cut, twist):
+def _column(system, mech: Mechanism, name: str, is_cut, twist) -> np.ndarray:
     """The column of A (unreduced loop system) that a new freedom ``twist`` (world) at joint ``name`` adds."""
     t = np.asarray(twist, float).copy()
     t[:3] /= system.length
@@ -376,7 +380,7 @@ def _column(system, mech, name, is_cut, twist):
     return np.concatenate([col, np.zeros(system.rows - len(col))])
 
 
-def suggest(mech, q, count=None) -> Suggestion | None:
+def suggest(mech: Mechanism, q: np.ndarray, count: int | None = None) -> Suggestion | None:
     """Joints that make the model exactly constrained (see the module docstring), checked by building it."""
     tol = mech.tolerances
     system = loop_system(mech, q, reduce=False)
@@ -393,7 +397,7 @@ def suggest(mech, q, count=None) -> Suggestion | None:
     state = KinematicState(mech, q)
     chosen, cols = [], []
 
-    def effective(columns):
+    def effective(columns) -> int:
         if not columns:
             return 0
         s = np.linalg.svd(U.T @ np.array(columns).T, compute_uv=False)
@@ -427,7 +431,7 @@ def suggest(mech, q, count=None) -> Suggestion | None:
     return Suggestion(changes, text, M, over, checked)
 
 
-def _change_words(mech, chosen):
+def _change_words(mech: Mechanism, chosen):
     kinds = _cut_words(mech)
     out = []
     for name, is_cut, new_type, twists, letter in chosen:
@@ -441,7 +445,7 @@ def _change_words(mech, chosen):
     return out
 
 
-def _check(mech, q, chosen):
+def _check(mech: Mechanism, q: np.ndarray, chosen) -> tuple:
     """(mobility, overconstraint, words) of the mechanism with the chosen joints, built and analysed:
     the largest rank of K over its generic configurations."""
     spec = copy.deepcopy(mech.spec)

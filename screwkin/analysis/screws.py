@@ -25,6 +25,10 @@ from ..model.geometry import perpendicular_basis, plane_basis
 from ..model.linalg import null_space
 from ..model.state import KinematicState, frame_parent
 from ..tolerances import DEFAULT
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
            "loop_product", "split_jacobians", "cut_twists"]
@@ -72,7 +76,7 @@ class Chain:
     g0: np.ndarray  # 4x4 tool frame at the reference configuration
 
 
-def chains(mech, output=None):
+def chains(mech: Mechanism, output=None):
     """One chain per cut-joint side and one to the output link."""
     targets = []
     for c in mech.cuts:
@@ -82,7 +86,7 @@ def chains(mech, output=None):
     return chains_to(mech, targets)
 
 
-def chains_to(mech, targets) -> list:
+def chains_to(mech: Mechanism, targets) -> list:
     """The chain from the ground to each frame of ``targets`` ((name, frame id) pairs), read
     at the reference configuration (every joint at zero)."""
     model = mech.model
@@ -103,7 +107,7 @@ def chains_to(mech, targets) -> list:
     return out
 
 
-def joint_angles(mech, q, chain):
+def joint_angles(mech: Mechanism, q: np.ndarray, chain):
     """theta_i: each chain joint's displacement from the reference configuration."""
     dq = pin.difference(mech.model, mech.neutral(), q)
     return dq[list(chain.columns)]
@@ -117,7 +121,7 @@ def poe(chain, theta) -> np.ndarray:
     return M.homogeneous @ chain.g0
 
 
-def structure(mech, q, output=None):
+def structure(mech: Mechanism, q: np.ndarray, output=None):
     """Per chain: reference twists, g(0), current twists (space Jacobian columns at q)."""
     state = KinematicState(mech, q)
     result = []
@@ -147,7 +151,7 @@ class LoopScrews:
     closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
 
 
-def cut_twists(mech, cut, state):
+def cut_twists(mech: Mechanism, cut, state):
     """The cut joint's freedoms at the configuration of ``state`` (a model.state.KinematicState) as
     world twists (v at the world origin, w): [(name, twist, sliding)], or None for a higher pair (its
     loop closes through an equivalent linkage and coupling rows)."""
@@ -157,10 +161,10 @@ def cut_twists(mech, cut, state):
     a = M1.rotation @ (np.asarray(cut.axis, float) / np.linalg.norm(cut.axis))
     p = M1.translation
 
-    def rot(u):
+    def rot(u) -> tuple[np.ndarray, bool]:
         return np.concatenate([-np.cross(u, p), u]), False
 
-    def slide(u):
+    def slide(u) -> tuple[np.ndarray, bool]:
         return np.concatenate([u, np.zeros(3)]), True
 
     if cut.type in ("revolute", "continuous"):
@@ -186,7 +190,7 @@ def cut_twists(mech, cut, state):
     return [(f"{cut.name}[{k}]", *t) for k, t in enumerate(out)]
 
 
-def loop_screws(mech) -> list:
+def loop_screws(mech: Mechanism) -> list:
     """A LoopScrews for each one-coordinate cut joint (revolute, continuous, prismatic; no higher pair)."""
     model = mech.model
     state = KinematicState(mech, mech.neutral())
@@ -225,7 +229,7 @@ def loop_product(loop: LoopScrews, theta) -> np.ndarray:
     return M.homogeneous
 
 
-def planar_form(xi, normal):
+def planar_form(xi, normal) -> np.ndarray:
     """(v_x, v_y, w) of a planar twist in the plane's axes (e1, e2, n) (geometry.plane_basis: the axes
     the drawing, the vector loops and the link angles use)."""
     e1, e2, n = plane_basis(normal)
@@ -233,7 +237,7 @@ def planar_form(xi, normal):
     return np.array([xi[:3] @ e1, xi[:3] @ e2, xi[3:] @ n])
 
 
-def split_jacobians(mech, q, output, inputs=None):
+def split_jacobians(mech: Mechanism, q: np.ndarray, output, inputs=None) -> dict:
     """Constraint Jacobian split into input and passive columns, and the forward
     (output twist from input rates) and inverse (input rates from output twist)
     Jacobians at q.  Output twists are (v, w) of the output frame origin in

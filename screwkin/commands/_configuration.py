@@ -15,6 +15,12 @@ from ..errors import UsageError, quote
 from ..model.topology import open_joints
 from ._options import count
 from ._values import joint_assignments, split_inputs
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
+    import numpy as np
 
 __all__ = ["add_angle_option", "add_length_option", "add_configuration_options", "add_mode_option", "add_branch_option",
            "input_solver",
@@ -60,7 +66,7 @@ def add_branch_option(sp, what: str = "the motion") -> None:
                          "default: the parallelogram stays a parallelogram) or along the other one (other)")
 
 
-def input_solver(mech, inputs, held: dict | None = None, output=None) -> PositionSolver:
+def input_solver(mech: Mechanism, inputs, held: dict | None = None, output=None) -> PositionSolver:
     """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
     ``held`` links' angles held by their loop equations (a copy of the mechanism:
     analysis.motion.link_inputs.holding_angles); none held, the plain solver of ``mech``."""
@@ -70,7 +76,7 @@ def input_solver(mech, inputs, held: dict | None = None, output=None) -> Positio
     return PositionSolver(mech, inputs, output=output)
 
 
-def configuration(mech, args, moved: dict | None = None, inputs=None):
+def configuration(mech: Mechanism, args: argparse.Namespace, moved: dict | None = None, inputs=None):
     """The configuration a command analyses: solved for --set values (the assembly mode --mode K, else the
     first: the one nearest the file's or --near's), else the assembled file one.  When there are several
     modes, a line on stderr says which one is analysed and how to get the others, and ``args.mode_chosen``
@@ -128,7 +134,7 @@ def mode_line(k: int, n: int, near: bool = True) -> str:
     return f"assembly mode {k} of {n} (others: {others}{', or --near' if near else ''})"
 
 
-def file_configuration_line(mech, q) -> str:
+def file_configuration_line(mech: Mechanism, q: np.ndarray) -> str:
     """What a command analyses when no --set is given, in one line: the file's configuration (assembled,
     when it has loops), with the values it gives the inputs (actuated joints and joints no loop
     passes through; deg or m)."""
@@ -142,7 +148,7 @@ def file_configuration_line(mech, q) -> str:
             + "; --set NAME=VALUE to choose another")
 
 
-def near_values(mech, args) -> dict | None:
+def near_values(mech: Mechanism, args: argparse.Namespace) -> dict | None:
     """--near NAME=VALUE,...: the configuration whose nearest assembly mode is wanted, as joint values
     (checked as --set's), every name a moving joint of the mechanism (or a multi-coordinate joint's
     ``j[qk]``): the one check of every command that takes --near (an unknown name was ignored by draw,
@@ -158,7 +164,7 @@ def near_values(mech, args) -> dict | None:
     return near
 
 
-def with_mode(args, d: dict) -> dict:
+def with_mode(args: argparse.Namespace, d: dict) -> dict:
     """``d`` with "mode": {"index", "of"} when the configuration was one of several assembly modes, with
     "continuum": {"free_dofs"} when it was a sample of a continuum the inputs leave (no modes then)."""
     if getattr(args, "mode_chosen", None):

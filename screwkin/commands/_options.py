@@ -219,7 +219,7 @@ def _same_file(a: str, b: str) -> bool:
         return False
 
 
-def _overwritten(args, outputs) -> None:
+def _overwritten(args: argparse.Namespace, outputs) -> None:
     """Refuse an output that would overwrite a file the command reads (the mechanism file, its sidecar
     given or found beside it, a spec) or another output of the same command line.  A device or a pipe
     (/dev/null, /dev/stdout) is written, not overwritten: it may take several outputs."""
@@ -245,7 +245,7 @@ def _overwritten(args, outputs) -> None:
         seen.append((option, path))
 
 
-def check_outputs(parser, args) -> None:
+def check_outputs(parser, args: argparse.Namespace) -> None:
     """Refuse, before any work, an output file whose folder is missing or not writable, that is a folder,
     that is a file the command reads, or that another output of the command line names too."""
     outputs, pictures = [], []
@@ -268,7 +268,7 @@ def check_outputs(parser, args) -> None:
         args.output_files = outputs
 
 
-def check_not_read(args, files) -> None:
+def check_not_read(args: argparse.Namespace, files) -> None:
     """Refuse, once the model is read and before the work, an output that is one of ``files``: every file
     the model was read from (MechanismSpec.files_read: its MJCF or xacro includes, its meshes, its sidecar),
     which only reading the model finds."""
@@ -281,7 +281,7 @@ def check_not_read(args, files) -> None:
                                  "from: it would be overwritten; write elsewhere")
 
 
-def check_parsed(parser, args) -> None:
+def check_parsed(parser, args: argparse.Namespace) -> None:
     """Refuse empty option values, then unwritable outputs (see the module's docstring)."""
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):

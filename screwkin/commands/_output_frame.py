@@ -13,6 +13,10 @@ from ..analysis.motion.links import Point
 from ..errors import UsageError, quote
 from ..model.state import KinematicState, place_tool
 from ..units import parse_value
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["PointOption", "add_point_option", "named_points", "add_tool_option", "parse_tool", "output_frame",
            "output_frame_dict", "output_frame_line"]
@@ -39,7 +43,7 @@ def add_point_option(sp, origin_help: str | None = None) -> None:
     sp.add_argument("--point", nargs="?", action=PointOption, metavar="NAME=LINK:x,y,z", help=help)
 
 
-def named_points(mech, args) -> tuple:
+def named_points(mech: Mechanism, args: argparse.Namespace) -> tuple:
     """The analysis.motion.links.Point objects of --point NAME=LINK:x,y,z (links checked, names unique)."""
     out, seen = [], set()
     for text in getattr(args, "points", None) or []:
@@ -76,7 +80,7 @@ def parse_tool(text: str):
     return pin.SE3(pin.rpy.rpyToMatrix(rpy), np.array(v[:3]))
 
 
-def output_frame(mech, args, required: bool = False):
+def output_frame(mech: Mechanism, args: argparse.Namespace, required: bool = False) -> tuple:
     """The output a command analyses, from --output, --tool and a named --point: ``(name, point)``.
 
     ``--tool`` moves the output frame onto the --output link (named ``LINK@tool``); a named
@@ -105,7 +109,7 @@ def output_frame(mech, args, required: bool = False):
     return output, bool(getattr(args, "point", False))
 
 
-def output_frame_dict(mech, q, jacobian: bool = False, point: bool = False) -> dict | None:
+def output_frame_dict(mech: Mechanism, q: np.ndarray, jacobian: bool = False, point: bool = False) -> dict | None:
     """JSON of the placed output frame (model.state.place_tool) at q: its name, link, placement on the
     link (x, y, z, roll, pitch, yaw) and world pose (position, rotation); with ``jacobian`` its frame
     Jacobian (world axes, rows (v, w) of its origin; only v for a ``point``: J_p = J_v - [r]x J_w, one

@@ -17,12 +17,16 @@ from ..errors import UsageError, quote, shorten
 from ..model.state import value_for_leg_length
 from ..units import MAGNITUDES, Quantity, check_magnitude, parse_quantity, parse_typed_assignments
 from ._options import count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["value_kind", "MAX_ANGLE", "joint_quantities", "joint_assignments", "joint_value", "inputs", "split_inputs",
            "joint_inputs", "link_rates", "names_list", "parse_range", "rate_items", "check_rate_names"]
 
 
-def value_kind(mech, joint: str):
+def value_kind(mech: Mechanism, joint: str) -> str | None:
     """'angle' or 'length': what a value of this one-coordinate joint is; None when it is no such
     joint (a multi-coordinate joint's ``j[q0]``, an unknown name: the analysis names the problem)."""
     c = next((c for c in mech.coordinates if c.joint == joint), None)
@@ -47,7 +51,7 @@ _MAGNITUDE_KIND = {("angle", 0): "angle", ("angle", 1): "angular rate", ("angle"
                    ("length", 0): "length", ("length", 1): "linear rate", ("length", 2): "linear acceleration"}
 
 
-def _checked(mech, name, typed: Quantity, option, text, order: int=0, links=()) -> Quantity:
+def _checked(mech: Mechanism, name: str, typed: Quantity, option: str, text: str, order: int = 0, links=()) -> Quantity:
     """``typed`` (parsed without a kind: its unit's) as the value (order 0), rate (1) or acceleration (2)
     of joint ``name``: the Quantity of that kind, or a usage error."""
     value, unit, found = typed.value, typed.unit, typed.kind
@@ -69,7 +73,7 @@ def _checked(mech, name, typed: Quantity, option, text, order: int=0, links=()) 
     return replace(typed, kind=_MAGNITUDE_KIND[kind, order]) if kind else typed
 
 
-def joint_quantities(mech, items, option: str, order: int = 0, links=()) -> dict:
+def joint_quantities(mech: Mechanism, items, option: str, order: int = 0, links=()) -> dict:
     """``NAME=VALUE,...`` of joints (order 0), their rates (1) or accelerations (2): joint -> units.Quantity
     (the SI value, the kind -- 'angle', 'angular rate', 'linear acceleration' ... -- and the unit typed);
     a unit of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error,
@@ -91,24 +95,24 @@ def joint_quantities(mech, items, option: str, order: int = 0, links=()) -> dict
     return out
 
 
-def joint_assignments(mech, items, option: str, order: int = 0, links=()) -> dict:
+def joint_assignments(mech: Mechanism, items, option: str, order: int = 0, links=()) -> dict:
     """joint_quantities' SI values: joint -> value [rad, m, rad/s ...]."""
     return {name: q.value for name, q in joint_quantities(mech, items, option, order, links).items()}
 
 
-def joint_value(mech, joint: str, text: str, option: str, order: int = 0) -> Quantity:
+def joint_value(mech: Mechanism, joint: str, text: str, option: str, order: int = 0) -> Quantity:
     """One value (rate: order 1) of ``joint`` typed after ``option`` (``--from -90deg``), checked like
     joint_quantities: its units.Quantity."""
     return _checked(mech, joint, parse_quantity(text), option, quote(text, 60), order)
 
 
-def inputs(mech, args) -> dict:
+def inputs(mech: Mechanism, args: argparse.Namespace) -> dict:
     """Input joint values from --set, --set-length and --set-angle of links pinned to the ground
     (split_inputs; the links held at an angle are left out)."""
     return split_inputs(mech, args)[0]
 
 
-def split_inputs(mech, args) -> tuple:
+def split_inputs(mech: Mechanism, args: argparse.Namespace) -> tuple:
     """(joint values, held angles, pivots) from the options: --set and --set-length as joint values
     [rad or m]; --set-angle LINK=ANGLE of a link pinned to the ground by a revolute as that joint's
     value (``pivots``: link -> (joint, sign), its angular velocity sign * the joint's rate), of any
@@ -144,7 +148,7 @@ def split_inputs(mech, args) -> tuple:
     return values, held, pivots
 
 
-def joint_inputs(mech, args, what: str) -> dict:
+def joint_inputs(mech: Mechanism, args: argparse.Namespace, what: str) -> dict:
     """inputs() for a command that moves its inputs as joints (an animation, a live page): a usage error
     naming the links that --set-angle would hold by their angle (not pinned to the ground)."""
     values, held, _ = split_inputs(mech, args)
@@ -169,12 +173,12 @@ def link_rates(rates: dict | None, pivots: dict, option: str) -> dict | None:
     return out
 
 
-def names_list(text):
+def names_list(text: str) -> list | None:
     """``"a, b,c"`` -> ``["a", "b", "c"]``; None for no text."""
     return [n.strip() for n in text.split(",") if n.strip()] if text else None
 
 
-def parse_range(text, option, mech):
+def parse_range(text: str, option: str, mech: Mechanism) -> tuple:
     """``NAME=A:B:N`` -> (name, N values from A to B, the unit to answer in), N bounded
     (commands/_options.BOUNDS["grid"]), A and B checked as the joint's values (a unit of the other kind,
     ``crank=0:30mm:5``, is a usage error, as with --set); the unit the one typed with A

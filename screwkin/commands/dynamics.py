@@ -18,6 +18,11 @@ from ._configuration import add_branch_option, add_mode_option, configuration, m
 from ._output_frame import named_points
 from ._values import joint_assignments, joint_value, names_list, rate_items, value_kind
 from ._options import count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -55,7 +60,7 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--plot", help="draw the input effort against the input into this PNG file (needs matplotlib)")
 
 
-def _gravity(text):
+def _gravity(text: str) -> tuple:
     if text is None:
         return (0.0, 0.0, 0.0)
     parts = [p for p in text.replace(" ", ",").split(",") if p.strip()]
@@ -64,7 +69,7 @@ def _gravity(text):
     return tuple(parse_value(p, "linear acceleration", "--gravity") for p in parts)
 
 
-def _loads(mech, items, points) -> tuple:
+def _loads(mech: Mechanism, items, points) -> tuple:
     by_name = {p.name: p for p in points}
     out = []
     for text in items or []:
@@ -83,7 +88,7 @@ def _loads(mech, items, points) -> tuple:
     return tuple(out)
 
 
-def _cs(text):
+def _cs(text: str):
     try:
         cs = float(text)
     except ValueError:
@@ -95,7 +100,7 @@ def _cs(text):
     return cs
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     fixed = joint_assignments(mech, args.set, "--set")
     moved_not_set(fixed, args.input, "dynamics drives it from --from to --to")
     inputs = names_list(args.inputs) or None

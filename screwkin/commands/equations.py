@@ -9,6 +9,11 @@ from ..present.equations import equations_dict, equations_text
 from ..present.jsonout import json_of
 from ._configuration import add_configuration_options, configuration, with_mode
 from ._values import split_inputs
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 NAME = "equations"
 NEEDS_MECHANISM = True
@@ -24,7 +29,7 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--output", help="spatial mechanisms: also the chain to this link")
 
 
-def _input_names(mech, args, values, held):
+def _input_names(mech: Mechanism, args: argparse.Namespace, values, held):
     """The input joints: --input, else those set (``values``: --set, --set-angle of a link pinned to the
     ground), else -- unless a floating link's angle is given (``held``: an input of its own) -- the
     actuated ones."""
@@ -34,7 +39,7 @@ def _input_names(mech, args, values, held):
     return list(values) or ([] if held else list(mech.actuated))
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     values, held, _ = split_inputs(mech, args)
     names = _input_names(mech, args, values, held)
     q = configuration(mech, args)

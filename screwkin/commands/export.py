@@ -13,6 +13,11 @@ from ..model.placed import check_closed, placed
 from ..present.outfile import write_output
 from ._common import emit
 from ._configuration import add_configuration_options, configuration, with_mode
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -28,7 +33,7 @@ def add_parser(sub, common, scaled) -> None:
     add_configuration_options(sp)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if not args.mjcf and not args.urdf:
         raise UsageError("export needs --mjcf OUT.xml or --urdf OUT.urdf (or both)")
     q = configuration(mech, args)
@@ -93,7 +98,7 @@ def run(mech, args) -> int:
                                 "residual": residual, "notes": notes, "compounds": compounds,
                                 "redundant_rows": redundant})
 
-    def text():
+    def text() -> str:
         lines = [f"wrote {w['path']} ({w['format']}): {w['bodies']} bodies, {w['loop_joints']} loop joints, at the "
                  f"assembled configuration (residual {residual:.1e})" for w in written]
         lines.append("joint values there (the written file's zero): "
@@ -105,7 +110,7 @@ def run(mech, args) -> int:
     return emit(args, data, text)
 
 
-def _names(names, n: int=3) -> str:
+def _names(names, n: int = 3) -> str:
     return ", ".join(quote(x, 30) for x in names[:n]) + (", ..." if len(names) > n else "")
 
 
@@ -129,7 +134,7 @@ def _compound_notes(pm) -> list:
     return out
 
 
-def _redundant_note(text) -> tuple:
+def _redundant_note(text: str) -> tuple:
     """(one note naming the redundant equality rows of the MJCF ``text`` from MuJoCo's efc_J at qpos0, or
     saying why they are not named; the RedundantRows as JSON, None without MuJoCo)."""
     try:

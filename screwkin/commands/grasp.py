@@ -11,6 +11,11 @@ from ..present.jsonout import json_of
 from ..present.grasp import grasp_dict, grasp_text
 from ..units import parse_length
 from ._options import whole
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 NAME = "grasp"
 NEEDS_MECHANISM = False
@@ -27,7 +32,7 @@ def add_parser(sub, common, scaled) -> None:
                                      "of the contacts from their centroid; printed with the quality)")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if not 3 <= args.facets <= GRASP_TOLERANCES.max_facets:
         raise UsageError(f"--facets {args.facets}: give 3 to {GRASP_TOLERANCES.max_facets}")
     length = None

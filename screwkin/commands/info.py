@@ -7,6 +7,11 @@ from ..model.joint_types import JOINT_TYPES
 from ..present.report import joint_types_dict, joint_types_text
 from ..present.mobility import topology_dict, topology_text
 from ._common import emit
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -21,7 +26,7 @@ def add_parser(sub, common, scaled) -> None:
                     help="list every joint type screwkin knows (DOF, motion, pair, contact); needs no FILE")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.joint_types:
         return emit(args, lambda: {"joint_types": joint_types_dict(JOINT_TYPES)}, lambda: joint_types_text(JOINT_TYPES))
     if mech is None:
@@ -40,7 +45,7 @@ def run(mech, args) -> int:
                   "coordinates": mech.nv, "assembled": note is None})
         return d
 
-    def text():
+    def text() -> str:
         lines = [topology_text(topo, f"Topology of {mech.path}"), f"actuated: {', '.join(mech.actuated) or 'none declared'}"]
         return "\n".join(lines + ([f"note: {note}"] if note else []))
 

@@ -22,6 +22,11 @@ from ._configuration import add_mode_option, configuration, with_mode
 from ._options import BOUNDS
 from ._output_frame import output_frame
 from ._values import joint_assignments, parse_range
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -51,7 +56,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     xn, xs, x_unit = parse_range(args.x, "--x", mech)
     yn, ys, y_unit = parse_range(args.y, "--y", mech)
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
@@ -100,7 +105,7 @@ def run(mech, args) -> int:
     return 0
 
 
-def _loci(mech, args, inputs, xn, xs, yn, ys, fixed, output, point):
+def _loci(mech: Mechanism, args: argparse.Namespace, inputs, xn, xs: np.ndarray, yn, ys: np.ndarray, fixed, output, point) -> tuple:
     """(Loci, Regions or None, (cusp loops, tried) or None) of map --loci: every input other than --x and
     --y held by --set."""
     held = [n for n in inputs if n not in (xn, yn)]

@@ -11,6 +11,11 @@ from ..present.progress import EVERY, Progress
 from ._common import emit
 from ._configuration import add_configuration_options, configuration, with_mode
 from ._options import count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -29,7 +34,7 @@ def add_parser(sub, common, scaled) -> None:
                          "one tangent space (default 400; the answer says when some were left out)")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.point and not args.output:
         raise UsageError("--point needs --output LINK")
     given = any(getattr(args, k, None) for k in ("set", "set_angle", "set_length", "near", "mode"))

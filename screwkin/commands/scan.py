@@ -10,6 +10,11 @@ from ..present.outfile import write_output
 from ..present.report import scan_csv, scan_dict
 from ._output_frame import output_frame
 from ._options import count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -30,7 +35,7 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--csv", help="write every sample (joint values and the measure) to this CSV file")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     t = time.perf_counter()
     output, point = output_frame(mech, args, required=True)  # a named --point is the output
     res = scan(mech, output, args.samples, args.seed, args.measure, None, args.threads, point=point)

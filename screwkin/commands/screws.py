@@ -13,6 +13,11 @@ from ..present.screws import (
     screws_text,
 )
 from ._configuration import add_configuration_options, configuration, with_mode
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -27,7 +32,7 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--output", help="also the chain to this link")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if not mech.cuts and not args.output:
         raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
     q = configuration(mech, args)

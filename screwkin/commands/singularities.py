@@ -16,6 +16,11 @@ from ..present.screws import gram_symbolic_dict, gram_symbolic_text
 from ._configuration import add_configuration_options, configuration, with_mode
 from ._output_frame import add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._values import inputs
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -37,7 +42,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     output, point = output_frame(mech, args)
     if point and not output:
         raise UsageError("--point needs --output LINK")

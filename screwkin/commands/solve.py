@@ -22,6 +22,12 @@ from ._configuration import add_angle_option, add_length_option, input_solver, n
 from ._output_frame import add_point_option, named_points
 from ._values import check_rate_names, joint_quantities, link_rates, rate_items, split_inputs
 from ._options import count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
+    import numpy as np
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -60,7 +66,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp, point=False)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     values, held, pivots = split_inputs(mech, args)
     if not values and not held:
         solver = input_solver(mech, [], output=args.output)
@@ -99,7 +105,7 @@ def run(mech, args) -> int:
 
 
 # ------------------------------------------------------------------ solve --start
-def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
+def _solved_near(mech: Mechanism, loops, solver, values, q: np.ndarray, res, starts: int, skip=()) -> tuple:
     """solve's configuration near q (Newton's root), the loop symbols there, and the unknowns
     in which it differs from Newton's root."""
     near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}
@@ -108,7 +114,7 @@ def _solved_near(mech, loops, solver, values, q, res, starts, skip=()):
     return pres, got, differing(mech, loops, got, res.values)
 
 
-def _solve_from_start(mech, args, values, held=None) -> int:
+def _solve_from_start(mech: Mechanism, args: argparse.Namespace, values, held=None) -> int:
     """``solve --start ...``: Newton on the loop equations from the estimates typed.  ``held``: links
     whose absolute angle is given (--set-angle of a floating link) -> angle [rad], known in the equations."""
     held = dict(held or {})

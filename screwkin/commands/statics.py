@@ -16,6 +16,11 @@ from ..present.statics import statics_dict, statics_text
 from ..units import parse_value
 from ._configuration import add_configuration_options, configuration, with_mode
 from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 NAME = "statics"
 NEEDS_MECHANISM = True
@@ -34,7 +39,7 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--length", help="characteristic length for the amplification (default: mean link length)")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     wrench = None
     if args.wrench is not None:
         parts = args.wrench.replace(",", " ").split()

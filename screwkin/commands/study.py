@@ -20,6 +20,11 @@ from ..present.study import (
 from ..present.progress import Progress
 from ._configuration import add_mode_option
 from ._options import count, seconds
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 NAME = "study"
 NEEDS_MECHANISM = False
@@ -50,7 +55,7 @@ def add_parser(sub, common, scaled) -> None:
                          "default 120)")
 
 
-def _pareto(text):
+def _pareto(text: str) -> tuple:
     goals = []
     for part in text.split(","):
         goal, sep, column = part.strip().partition(":")
@@ -62,7 +67,7 @@ def _pareto(text):
     return tuple(goals)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 0:
         raise UsageError("--workers must be 0 or more (0: in this process)")
     if args.table:

@@ -42,6 +42,11 @@ from ._configuration import (
 from ._output_frame import named_points
 from ._values import check_rate_names, joint_quantities, joint_value, names_list, rate_items, split_inputs
 from ._options import BOUNDS, count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import numpy as np
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -85,7 +90,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp)
 
 
-def _steps(text):
+def _steps(text: str):
     """--steps: within BOUNDS["steps"], or BOUNDS["streamed_steps"] for a streamed sweep (checked again in run)."""
     lo, hi = BOUNDS["steps"]
     try:
@@ -102,7 +107,7 @@ _NOT_STREAMED = (("json", "--json"), ("plot", "--plot"), ("singularities", "--si
                  ("rows", "--rows"))
 
 
-def _streamed(args) -> bool:
+def _streamed(args: argparse.Namespace) -> bool:
     """Whether this sweep is computed and written in chunks; refuses what a streamed sweep cannot do."""
     lo, hi = BOUNDS["steps"]
     if args.chunk is None and args.steps <= hi:
@@ -118,7 +123,7 @@ def _streamed(args) -> bool:
     return True
 
 
-def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
+def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop, fixed, q_start: np.ndarray, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None
@@ -160,7 +165,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     return 0
 
 
-def _rates_line(args) -> str:
+def _rates_line(args: argparse.Namespace) -> str:
     """The line that says what the rates and accelerations written are for (the input's rate)."""
     if args.rate:
         return f"rates and accelerations {args.rate_words}, held constant"
@@ -168,7 +173,7 @@ def _rates_line(args) -> str:
             "another speed), at a constant input rate")
 
 
-def _rows_option(text):
+def _rows_option(text: str):
     if text is None or text.strip().lower() == "all":
         return None if text is None else "all"
     try:
@@ -177,7 +182,7 @@ def _rows_option(text):
         raise UsageError(f"--rows: {exc} (or all)") from None
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     # the other inputs: joints (--set, or --set-angle of a link pinned to the ground), or a floating link's
     # absolute angle held by one more loop equation along the whole motion (--set-angle LINK=ANGLE)
     fixed, held, _ = split_inputs(mech, args)

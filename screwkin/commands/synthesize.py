@@ -42,6 +42,10 @@ from ..present.synthesis import chains_dict, chains_text, synthesis_dict, synthe
 from ..present.synthesis_plots import burmester_png
 from ..units import parse_value
 from ._options import count, seconds, whole
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -126,7 +130,7 @@ def add_parser(sub, common, scaled) -> None:
     c.add_argument("--planar", action="store_true", help="planar chains (the only kind enumerated)")
 
 
-def _given(args, dest) -> bool:
+def _given(args: argparse.Namespace, dest) -> bool:
     defaults = {"candidates": 24, "spacing": "chebyshev", "ground": "0.1", "starts": 24, "seed": 0,
                 "tolerance": "1e-6", "prismatic": 0, "planar": False, "timeout": 10.0}
     return getattr(args, dest) not in (None, defaults.get(dest))
@@ -136,7 +140,7 @@ def _option(dest):
     return "--" + dest.replace("_", "-")
 
 
-def _number_groups(text, option, count=None, kind=None):
+def _number_groups(text: str, option: str, count: int | None = None, kind: str | None = None):
     """'x,y; x,y' -> [[x, y], [x, y]] (each number with an optional unit, of ``kind`` when given)."""
     groups = [g for g in text.split(";") if g.strip()]
     if not groups:
@@ -151,14 +155,14 @@ def _number_groups(text, option, count=None, kind=None):
     return out
 
 
-def _range(text, option):
+def _range(text: str, option: str) -> tuple:
     parts = text.split(":") if text else []
     if len(parts) != 2:
         raise UsageError(f"{option} expects A:B, got {quote(text or '')}")
     return parse_value(parts[0]), parse_value(parts[1])
 
 
-def _plausible(design, kind):
+def _plausible(design, kind: str):
     """A linkage whose numbers a file can hold: finite, and within the 10 km the reader accepts."""
     fb = design.fourbar
     values = [*fb.A0, *fb.A, *fb.B, *fb.B0, *(fb.tool or ())]
@@ -171,7 +175,7 @@ def _plausible(design, kind):
                                                    f"the {LIMITS.length:g} m a mechanism file may hold")
 
 
-def _realize(design, out, tolerance=None):
+def _realize(design, out, tolerance=None) -> tuple:
     """Write design's URDF under a temporary name beside ``out``, check it there; returns
     (check, temporary path)."""
     _plausible(design, design.kind)
@@ -207,7 +211,7 @@ def _keep(tmp, out):
         remove_partial(tmp)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     kind = args.kind
     for dest in sorted(set().union(*_OPTIONS.values()) - _OPTIONS[kind]):
         if _given(args, dest):
@@ -250,7 +254,7 @@ def run(mech, args) -> int:
     return 0
 
 
-def _constraints(args) -> Constraints:
+def _constraints(args: argparse.Namespace) -> Constraints:
     """--bounds, --lengths, --grashof, --min-transmission, checked."""
     bounds = lengths = angle = None
     if args.bounds:
@@ -271,14 +275,14 @@ def _constraints(args) -> Constraints:
     return Constraints(bounds, lengths, args.grashof, angle).check()
 
 
-def _searching(args, count: int, beyond: int) -> bool:
+def _searching(args: argparse.Namespace, count: int, beyond: int) -> bool:
     """Whether the constrained global search runs: a constraint or a search option given, or more
     precision positions than the classic methods take (``beyond``)."""
     return count > beyond or any(_given(args, d) for d in SEARCH - {"seed"})
 
 
 @contextlib.contextmanager
-def _search(args):
+def _search(args: argparse.Namespace):
     """The Search of the command line: in this process, over N local processes (--workers N: forked from a
     fork server, parallel.pool.process_pool), or over a running Dask cluster (--scheduler, study's grammar)."""
     kw = {"seed": args.seed, "best": args.best or 5, "generations": args.generations or GENERATIONS}
@@ -296,7 +300,7 @@ def _search(args):
                      where=f"{where}, {used} worker{'s' if used != 1 else ''}")
 
 
-def _motion(args):
+def _motion(args: argparse.Namespace):
     if not args.poses:
         raise UsageError('synthesize motion needs --poses "x,y,theta; x,y,theta; x,y,theta"')
     poses = _number_groups(args.poses, "--poses", 3)
@@ -343,7 +347,7 @@ def _motion(args):
     return first
 
 
-def _function(args):
+def _function(args: argparse.Namespace) -> tuple:
     missing = [o for o, v in (("--function", args.function), ("--x-range", args.x_range),
                               ("--input-range", args.input_range), ("--output-range", args.output_range)) if not v]
     if missing:
@@ -374,7 +378,7 @@ def _function(args):
     return result, check, tmp
 
 
-def _path(args):
+def _path(args: argparse.Namespace) -> tuple:
     if not args.points:
         raise UsageError('synthesize path needs --points "x,y; x,y; x,y; ..."')
     points = _number_groups(args.points, "--points", 2)
@@ -393,7 +397,7 @@ def _path(args):
     return result, check, tmp
 
 
-def _chains(args) -> int:
+def _chains(args: argparse.Namespace) -> int:
     if args.links is None or args.dof is None:
         raise UsageError("synthesize chains needs --links N and --dof F")
     result = enumerate_chains(args.links, args.dof, args.prismatic)

@@ -28,6 +28,11 @@ from ._configuration import add_branch_option, add_configuration_options, config
 from ._output_frame import add_point_option, named_points
 from ._values import joint_assignments, joint_inputs, parse_range
 from ..model.topology import open_joints
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -93,7 +98,7 @@ class _Stop:
         self._previous = {s: signal.signal(s, self._handle) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: Any) -> None:
         for s, handler in self._previous.items():
             signal.signal(s, handler)
         signal.set_wakeup_fd(self._previous_fd)
@@ -113,7 +118,7 @@ class _Stop:
         return f"stopped by {signal.Signals(self.signum).name}: {where}"
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.interactive:
         return _interactive(mech, args)
     if getattr(args, "points", None):
@@ -163,7 +168,7 @@ def run(mech, args) -> int:
 FPS = 30
 
 
-def _pictures(mech, args, server, scene, frames=None) -> None:
+def _pictures(mech: Mechanism, args: argparse.Namespace, server, scene, frames=None) -> None:
     """--html (with a play/scrub bar when ``frames``, the text of each animation frame) and --png."""
     html = server.viewer.static_html()
     title = os.path.basename(mech.path) + (f", {args.sweep.split('=')[0].strip()} swept" if args.sweep else "")
@@ -179,7 +184,7 @@ def _pictures(mech, args, server, scene, frames=None) -> None:
         print(f"wrote {args.png}")
 
 
-def _interactive(mech, args) -> int:
+def _interactive(mech: Mechanism, args: argparse.Namespace) -> int:
     """view --interactive: the viser page, served until a signal stops it."""
     if args.sweep or args.html or args.png:
         raise UsageError(f"{mech.path}: --interactive is a live page: leave out --sweep, --html and --png")

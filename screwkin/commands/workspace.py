@@ -26,6 +26,11 @@ from ..units import parse_length, parse_value
 from ._configuration import add_mode_option, configuration, with_mode
 from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count, seconds
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 NAME = "workspace"
 NEEDS_MECHANISM = True
@@ -63,7 +68,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp, point=False)
 
 
-def _bounds(text):
+def _bounds(text: str) -> np.ndarray | None:
     if text is None:
         return None
     ranges = []
@@ -75,7 +80,7 @@ def _bounds(text):
     return np.array(ranges)
 
 
-def _orientation(text):
+def _orientation(text: str):
     if text is None:
         return None
     parts = text.replace(",", " ").split()
@@ -84,7 +89,7 @@ def _orientation(text):
     return pin.rpy.rpyToMatrix(np.array([parse_value(p, "angle", "--orientation") for p in parts]))
 
 
-def _mode(mech, args):
+def _mode(mech: Mechanism, args: argparse.Namespace):
     """The assembled configuration of the mode whose workspace is asked (--mode K of the actuated joints'
     values in the file's assembled configuration, said as every command says it); None for a chain
     without loops, whose joint values are one configuration."""
@@ -100,7 +105,7 @@ def _mode(mech, args):
     return configuration(mech, args, moved={n: values[n] for n in inputs}, inputs=inputs)
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.samples < 1:
         raise UsageError(f"--samples must be positive, got {args.samples}")
     length = parse_length(args.length, "--length") if args.length else None

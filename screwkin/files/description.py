@@ -361,7 +361,7 @@ class MechanismSpec:
         return roots[0]
 
 
-def resolve_actuation(spec: MechanismSpec, actuated=None):
+def resolve_actuation(spec: MechanismSpec, actuated=None) -> tuple:
     """The actuated joint names and where they were declared.
 
     Precedence: the caller's list (the command line), the YAML ``name_mot``,

@@ -160,7 +160,7 @@ def _children(pm):
     return kids
 
 
-def _comment(text):
+def _comment(text: str):
     """An XML comment holding ``text``: no "--" inside and no "-" at its end (XML forbids both)."""
     if not text:
         return ""
@@ -169,7 +169,7 @@ def _comment(text):
     return "<!--\n" + text.rstrip() + "\n-->"
 
 
-def default_solid(points, length):
+def default_solid(points, length) -> tuple:
     """(mass, centre of mass, (ixx, iyy, izz, ixy, ixz, iyz)) of the solid a moving body without mass
     gets: a rod of DEFAULT_DENSITY from its origin to the farthest of ``points`` (its joints, in its
     frame), radius ROD_RATIO of that length; a sphere of radius ROD_RATIO * ``length`` when no point is
@@ -198,7 +198,7 @@ def mujoco_refuses(mass, inertia) -> bool:
     return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, inertia) is not None)
 
 
-def _mj_inertial(mass, com, inertia, moving, points=(), length: float=0.1) -> str:
+def _mj_inertial(mass, com, inertia, moving, points=(), length: float = 0.1) -> str:
     if mass <= 0:
         if not moving:
             return ""
@@ -250,7 +250,7 @@ def helper_names(pm) -> dict:
     return out
 
 
-def _mj_joint(j) -> str:
+def _mj_joint(j: int) -> str:
     dyn = "".join(f' {k}="{number_text(v)}"' for k, v in j.dynamics)
     if j.type == "free" and not dyn:
         return f"<freejoint name={quoteattr(j.name)}/>"
@@ -289,7 +289,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
     out = [_comment(pm.comment), f"<mujoco model={quoteattr(pm.name)}>",
            '  <compiler angle="radian" autolimits="true"/>', "  <worldbody>"]
 
-    def aux_bodies(name, pad) -> None:
+    def aux_bodies(name: str, pad) -> None:
         for c in aux.get(name, ()):
             out.append(f'{pad}<body name={quoteattr(names["F1", c.name])} pos="{vector_text(*c.pos1)}" '
                        f'quat="{vector_text(*c.quat1)}">')

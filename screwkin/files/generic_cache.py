@@ -64,7 +64,7 @@ def _complex(rows, width: int):
     return a[..., 0] + 1j * a[..., 1]
 
 
-def read(name: str, width: int, n: int):
+def read(name: str, width: int, n: int) -> tuple | None:
     """(c0 (n,), X (N, width), how, path) stored under ``name`` -- in the cache folder, else among the
     sets shipped with screwkin (``SHIPPED``) --, or None (absent, unreadable or malformed)."""
     if len(name) != 64 or not all(ch in "0123456789abcdef" for ch in name):
@@ -77,7 +77,7 @@ def read(name: str, width: int, n: int):
     return None
 
 
-def _read(path: Path, name: str, width: int, n: int):
+def _read(path: Path, name: str, width: int, n: int) -> tuple | None:
     try:
         if not path.is_file() or path.stat().st_size > _MAX_BYTES:
             return None
@@ -113,7 +113,7 @@ def _may_write() -> bool:
         return False
 
 
-def write(name: str, c0, X, how: str) -> Path | None:
+def write(name: str, c0, X: np.ndarray, how: str) -> Path | None:
     """Store a generic solution set (atomically); its path, or None when nothing was written."""
     where = folder()
     if where is None or not _may_write():

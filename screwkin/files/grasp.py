@@ -64,7 +64,7 @@ def _is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
-def _vector(value, what, planar, problems):
+def _vector(value, what: str, planar, problems) -> tuple | None:
     """A 3-tuple of floats from a YAML list (planar: 2 numbers, or 3 with z = 0), or None."""
     sizes = "2 or 3" if planar else "3"
     if not isinstance(value, list):
@@ -96,7 +96,7 @@ def _vector(value, what, planar, problems):
     return tuple(v)
 
 
-def _coefficient(c, key, k, problems, bound, unit: str=""):
+def _coefficient(c, key, k: int, problems, bound, unit: str = ""):
     value = c.get(key)
     if not _is_number(value):
         problems.append(f"contact {k}: {key} must be a number, got {quote(value)}")
@@ -118,7 +118,7 @@ def _coefficient(c, key, k, problems, bound, unit: str=""):
     return x
 
 
-def _contact(c, k, planar, problems):
+def _contact(c, k: int, planar, problems) -> Contact | None:
     if not isinstance(c, dict):
         problems.append(f"contact {k} must be a mapping with point, normal, model, got {quote(c)}")
         return None
@@ -179,7 +179,7 @@ def _contact(c, k, planar, problems):
     return Contact(point, normal, model, mu, mu_t)
 
 
-def parse_grasp(content, path: str="<grasp>") -> GraspSpec:
+def parse_grasp(content, path: str = "<grasp>") -> GraspSpec:
     """A GraspSpec from the plain data of a grasp file (what the YAML loads to), every
     problem collected and raised at once as a MechanismFileError naming ``path``."""
     if content is None:

@@ -22,6 +22,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import quote
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["inertia_problem", "inertia_warnings", "ROUNDING", "FLOOR"]
 
@@ -31,7 +35,7 @@ ROUNDING = 1e-6
 FLOOR = 1e-12
 
 
-def inertia_problem(mass, *inertia) -> str | None:
+def inertia_problem(mass, *inertia: Any) -> str | None:
     """Why ``mass`` [kg] and the inertia tensor about the centre of mass [kg m^2] cannot be a rigid body's
     (one phrase, naming the numbers), or None when they can.  A mass of None (not given) is not checked.
 

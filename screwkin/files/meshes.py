@@ -82,7 +82,7 @@ def resolve_uri(uri: str, base: Path, package_dirs=(), roots=None):
     return [p if p.is_absolute() else base / p]
 
 
-def _real(p: Path):
+def _real(p: Path) -> Path | None:
     """p with symbolic links and ``..`` resolved, or None when the system refuses it."""
     try:
         return Path(os.path.realpath(p))
@@ -112,7 +112,7 @@ def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool
     return any(inside_folder(real, f) for f in folders)
 
 
-def locate_mesh(uri: str, base: Path, package_dirs=(), roots=None):
+def locate_mesh(uri: str, base: Path, package_dirs=(), roots=None) -> tuple:
     """(the first existing, allowed file among the candidates of ``uri`` or None, the resolved path
     of an existing candidate that was refused because it lies outside the allowed folders, or None)."""
     refused = None

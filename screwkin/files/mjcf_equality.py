@@ -31,7 +31,7 @@ from .urdf import numbers
 __all__ = ["read_equalities", "quat_matrix", "matrix_quat"]
 
 
-def quat_matrix(q) -> np.ndarray:
+def quat_matrix(q: np.ndarray) -> np.ndarray:
     """The rotation matrix of MuJoCo's quaternion (w, x, y, z), normalised (Pinocchio's)."""
     w, x, y, z = (float(v) for v in q)
     return pin.Quaternion(w, x, y, z).normalized().matrix()
@@ -43,11 +43,11 @@ def matrix_quat(R) -> tuple:
     return (q.w, q.x, q.y, q.z)
 
 
-def _rpy(M):
+def _rpy(M) -> tuple:
     return tuple(pin.rpy.matrixToRpy(M.rotation))
 
 
-def read_equalities(r, world, sites, mjoints, reference, taken):
+def read_equalities(r, world, sites, mjoints, reference, taken) -> tuple:
     """(cut joints, couplings) of every <equality>.  world: body -> pose at qpos0; sites: name ->
     (body, placement); mjoints: joint -> (type, body); reference: joint -> ref; taken: the names of
     joints and bodies."""
@@ -142,7 +142,7 @@ def _connect_cuts(r, connects, world):
     return out
 
 
-def _ends(r, a, what, world, sites):
+def _ends(r, a, what: str, world, sites):
     """((body1, S1), (body2, S2), by_site) of a connect or weld; body2 omitted or "world" is the world."""
     p = r.problems
     if a.get("site1") or a.get("site2"):
@@ -168,7 +168,7 @@ def _ends(r, a, what, world, sites):
     return res
 
 
-def _joint_equality(r, a, what, mjoints, reference):
+def _joint_equality(r, a, what: str, mjoints, reference) -> Coupling | None:
     p = r.problems
     j1, j2 = a.get("joint1"), a.get("joint2")
     if not j2:

@@ -32,7 +32,7 @@ def expand_includes(root, path, read=None) -> int:
     folder = Path(os.path.realpath(path.parent if str(path.parent) else "."))
     state = {"files": 0, "bytes": 0, "elements": sum(1 for _ in root.iter())}
 
-    def included(spec: str, chain: tuple, depth: int):
+    def included(spec: str, chain: tuple, depth: int) -> list:
         if not spec:
             raise MechanismFileError(path, "<include> has no file")
         target = Path(spec) if os.path.isabs(spec) else folder / spec

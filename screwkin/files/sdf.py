@@ -31,7 +31,7 @@ _CUT = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismati
         "ball": "spherical", "universal": "universal", "revolute2": "universal"}
 
 
-def _pose(elem, what, problems):
+def _pose(elem, what: str, problems):
     if elem is None or not (elem.text or "").strip():
         return pin.SE3.Identity()
     rel = elem.get("relative_to")
@@ -49,7 +49,7 @@ def _pose(elem, what, problems):
     return pin.SE3(pin.rpy.rpyToMatrix(np.array(rpy)), np.array(xyz))
 
 
-def _vec(text, what, problems):
+def _vec(text: str, what: str, problems) -> np.ndarray:
     before = len(problems)
     v = numbers((text or "").strip() or "?", 3, what, problems, (1.0, 0, 0))
     if len(problems) > before:
@@ -57,7 +57,7 @@ def _vec(text, what, problems):
     return np.array(unit_axis(v, what, problems))
 
 
-def _axis_element(joint, tag, name, X_joint, problems):
+def _axis_element(joint, tag, name: str, X_joint, problems):
     a = joint.find(tag)
     if a is None:
         return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])
@@ -82,7 +82,7 @@ def _spanning_tree(links, edges, ground) -> dict:
     return {min(graph[link][other]): (link, other) for link, other in nx.bfs_edges(graph, ground)}
 
 
-def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
+def read_sdf(path, text: str, root=None, package_dirs=()) -> MechanismSpec:
     """Read an SDF file (already loaded as ``text``, parsed as ``root`` when given)."""
     if root is None:
         root = parse_xml_text(text, path)
@@ -165,7 +165,7 @@ def read_sdf(path, text, root=None, package_dirs=()) -> MechanismSpec:
     spec_links = dict(links)
     joints, cuts = [], []
 
-    def link_xml(name) -> str:
+    def link_xml(name: str) -> str:
         mass = spec_links[name].mass
         inertial = (f'<inertial><mass value="{mass:.17g}"/><inertia ixx="1e-9" iyy="1e-9" izz="1e-9" '
                     f'ixy="0" ixz="0" iyz="0"/></inertial>') if mass else ""

@@ -97,11 +97,11 @@ class StudySpec:
     require: tuple | None = None
 
 
-def _fail(where, message):
+def _fail(where: str, message: str):
     raise UsageError(f"{where}: {message}")
 
 
-def _quantity(v, where, what) -> Quantity:
+def _quantity(v, where: str, what: str) -> Quantity:
     """A number, or a number with a unit (text): its units.Quantity (SI value, the unit typed)."""
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
         _fail(where, f"{what} must be a number (units allowed, e.g. 30mm), got {quote(v)}")
@@ -115,18 +115,18 @@ def _quantity(v, where, what) -> Quantity:
     return Quantity(float(v))
 
 
-def _value(v, where, what) -> float:
+def _value(v, where: str, what: str) -> float:
     """A number, or a number with a unit (text), in SI."""
     return _quantity(v, where, what).value
 
 
-def _count(v, where, what, low: int=1, high=MAX_DESIGNS):
+def _count(v, where: str, what: str, low: int = 1, high=MAX_DESIGNS):
     if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
         _fail(where, f"{what} must be a whole number from {low} to {high}, got {quote(v)}")
     return v
 
 
-def _parameter(name, item, where, sampling) -> Parameter:
+def _parameter(name: str, item, where: str, sampling) -> Parameter:
     what = f"parameter {quote(name)}"
     if not isinstance(item, dict):
         q = _quantity(item, where, what)
@@ -162,7 +162,7 @@ def _parameter(name, item, where, sampling) -> Parameter:
     return Parameter(name, low=low, high=high, samples=samples, unit=_first_unit(typed))
 
 
-def _metrics(value, where):
+def _metrics(value, where: str) -> tuple:
     if isinstance(value, str):
         value = [value]
     if not isinstance(value, list) or not value:
@@ -177,7 +177,7 @@ def _metrics(value, where):
     return tuple(out)
 
 
-def _spec_pareto(value, where):
+def _spec_pareto(value, where: str) -> tuple | None:
     """``{maximize: [a], minimize: [b]}`` (two metrics in all) -> ((a, "max"), (b, "min"))."""
     if value is None:
         return None
@@ -196,7 +196,7 @@ def _spec_pareto(value, where):
     return tuple(picked)
 
 
-def _require(value, where):
+def _require(value, where: str) -> tuple | None:
     """``{column: value, column: {min: x, max: y}}`` -> ((column, "equal", value, False), (column, "min", x,
     unit typed), ...); the columns are checked against the study's in screwkin.analysis.design.study."""
     if value is None:
@@ -225,7 +225,7 @@ def _require(value, where):
     return tuple(out)
 
 
-def _workspace(value, where):
+def _workspace(value, where: str):
     if value is None:
         return {}
     if not isinstance(value, dict):
@@ -337,7 +337,7 @@ def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySp
     return spec
 
 
-def _check_arguments(spec: StudySpec, where) -> None:
+def _check_arguments(spec: StudySpec, where: str) -> None:
     """The parameters and fixed arguments must be arguments the xacro file declares, and
     every argument without a default must be given."""
     text = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")

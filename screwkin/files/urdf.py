@@ -54,7 +54,7 @@ _NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\Z")
 _NONFINITE = re.compile(r"[-+]?(?:nan|inf|infinity)\Z", re.IGNORECASE)
 
 
-def numbers(text, count, what, problems, default, bound=None, unit: str="m", low=None):
+def numbers(text: str, count: int, what: str, problems, default, bound=None, unit: str = "m", low=None):
     """Parse ``count`` floats from an attribute; record a problem when invalid.
 
     bound: largest magnitude accepted (see :class:`~screwkin.files.description.Limits`);
@@ -86,7 +86,7 @@ def numbers(text, count, what, problems, default, bound=None, unit: str="m", low
     return values
 
 
-def unit_axis(values, what, problems, default=(1.0, 0.0, 0.0)):
+def unit_axis(values, what: str, problems, default=(1.0, 0.0, 0.0)) -> tuple:
     """``values`` scaled to length 1 (safely: divided by the largest magnitude first);
     records a problem for a zero axis or one whose length Pinocchio cannot normalize."""
     v = np.asarray(values, float)
@@ -103,7 +103,7 @@ def unit_axis(values, what, problems, default=(1.0, 0.0, 0.0)):
     return tuple(u / np.linalg.norm(u))
 
 
-def _axis(elem, what, problems, default=(1.0, 0.0, 0.0)):
+def _axis(elem, what: str, problems, default=(1.0, 0.0, 0.0)):
     if elem is None or elem.get("xyz") is None:  # urdfdom's default: the x axis
         return tuple(default)
     before = len(problems)
@@ -113,7 +113,7 @@ def _axis(elem, what, problems, default=(1.0, 0.0, 0.0)):
     return unit_axis(values, what, problems, default)
 
 
-def _origin(elem, what, problems):
+def _origin(elem, what: str, problems) -> tuple:
     """xyz and rpy of an ``<origin>`` (or of any element carrying them), checked."""
     get = (lambda k: elem.get(k)) if elem is not None else (lambda k: None)
     xyz = numbers(get("xyz"), 3, f"{what} xyz>", problems, (0.0, 0.0, 0.0), LIMITS.length, "m")
@@ -151,7 +151,7 @@ def _link(elem, problems) -> LinkSpec:
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry, inertia_problem=impossible)
 
 
-def _name_and_type(elem, tag, kind, types, problems):
+def _name_and_type(elem, tag, kind: str, types, problems) -> tuple | None:
     """(name, type, 'kind NAME') of a <joint> or <loop_joint>, or None after recording why."""
     name = elem.get("name")
     if not name:
@@ -265,7 +265,7 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
     return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint", **extra)
 
 
-def _radius(text, what, problems, allow_inf: bool=False):
+def _radius(text: str, what: str, problems, allow_inf: bool=False):
     """A radius [m]: a positive number, or (a straight line) 'inf' where allowed."""
     if text is None:
         problems.append(f"{what} is missing")
@@ -279,7 +279,7 @@ def _radius(text, what, problems, allow_inf: bool=False):
     return value
 
 
-def _pair_parameters(elem, jtype, what, axis, problems) -> dict | None:
+def _pair_parameters(elem, jtype, what: str, axis, problems) -> dict | None:
     """The parameters of a rolling, gear, contact or helical loop joint, checked."""
     n0 = len(problems)
     out = {}

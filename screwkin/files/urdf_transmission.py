@@ -76,7 +76,7 @@ def read_transmissions(root, joints, loop_names, warnings, mimics, numbers) -> t
     return names, inputs
 
 
-def _reduction(t, what, warnings, numbers, others) -> float:
+def _reduction(t, what: str, warnings, numbers, others) -> float:
     """The SimpleTransmission's reduction (1 when none is written or it cannot be used, said)."""
     found = [(path, e) for path in _REDUCTION for e in t.findall(path)]
     for e in t.findall("joint/offset"):

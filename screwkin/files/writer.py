@@ -22,6 +22,10 @@ import pinocchio as pin
 
 from ..tolerances import DEFAULT
 from .description import TARGETS_NS
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["PlanarLink", "PlanarJoint", "PlanarLoopJoint", "PlanarLinkage", "write_urdf", "number_text", "vector_text",
            "origin_text", "targets_text", "quoteattr"]
@@ -109,7 +113,7 @@ def number_text(x) -> str:
     return repr(0.0 if x == 0 else x)
 
 
-def vector_text(*xs) -> str:
+def vector_text(*xs: Any) -> str:
     return " ".join(number_text(x) for x in xs)
 
 
@@ -118,7 +122,7 @@ def origin_text(M) -> str:
     return f'<origin xyz="{vector_text(*M.translation)}" rpy="{vector_text(*pin.rpy.matrixToRpy(M.rotation))}"/>'
 
 
-def _bars(points):
+def _bars(points) -> list:
     """Pairs of points drawn as bars: the one segment of two points, the closed polygon of
     more (points in order of angle about their centroid)."""
     pts = [tuple(map(float, p)) for p in points]

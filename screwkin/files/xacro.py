@@ -189,7 +189,7 @@ def _include_path(spec: str, current: Path, path, state: _State) -> Path:
     return target
 
 
-def _read_file(target: Path, path, state: _State):
+def _read_file(target: Path, path, state: _State) -> tuple:
     """(text, ElementTree root) of an included file: bounded, checked, counted."""
     if len(state.files) >= MAX_INCLUDES:
         raise MechanismFileError(path, f"more than {MAX_INCLUDES} files included (refused)")
@@ -231,7 +231,7 @@ def _check_tree(root, path: Path, state: _State, follow: bool = True) -> None:
             _check_tree(sub, target, state)
 
 
-def _prepare(path, text, root=None) -> _State:
+def _prepare(path, text: str, root=None) -> _State:
     path = Path(path)
     state = _State(path, Path(os.path.realpath(path.parent if str(path.parent) else ".")))
     state.files.append(path)
@@ -303,7 +303,7 @@ def _patched(xacro, state: _State, path, evaluator=None):
         _check_tree(root, target, state, follow=False)
         return _dom(text, target)
 
-    def block_named(name, symbols):
+    def block_named(name: str, symbols):
         """The block ``xacro:insert_block name=...`` inserts (a property block or a macro's block
         parameter), or None."""
         for key in ("**" + name, "*" + name):
@@ -343,7 +343,7 @@ def _patched(xacro, state: _State, path, evaluator=None):
             child = child.nextSibling
         return original["eval_all"](node, macros, symbols)
 
-    def eval_text(text, symbols):
+    def eval_text(text: str, symbols):
         # xacro joins the values of a text's ${...} and $(...) outside the evaluator: bound them here
         # (a property "${s}${s}" of a property "${s}${s}" of ... doubles at each level)
         result = original["eval_text"](text, symbols)

@@ -31,6 +31,10 @@ from ..errors import MechanismFileError, UsageError
 from .xacro import expand
 from .xacro_eval import _COMPARE, FUNCTIONS, _call, _function_name, _Interpreter, _power, _Refused, evaluate
 from .xmlsafe import parse_xml_text
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch"]
 
@@ -71,7 +75,7 @@ class _Context:
             self.batches.append(b)
         return f"skwbatch{k}x"
 
-    def lookup(self, name):
+    def lookup(self, name: str):
         m = TOKEN.fullmatch(name.strip()) if isinstance(name, str) else None
         return self.batches[int(m.group(1))] if m and int(m.group(1)) < len(self.batches) else None
 
@@ -91,14 +95,14 @@ class Batch:
     def __init__(self, v, bad, ctx: _Context) -> None:
         self.v, self.bad, self.ctx = np.asarray(v), bad, ctx
 
-    def _other(self, o):
+    def _other(self, o) -> tuple:
         if isinstance(o, Batch):
             return o.v, o.bad
         if isinstance(o, (bool, int, float)):
             return o, False
         self.ctx.refuse("a parameter combined with text")
 
-    def _bin(self, o, f, reverse: bool=False):
+    def _bin(self, o, f, reverse: bool=False) -> Batch:
         ov, ob = self._other(o)
         with np.errstate(all="ignore"):
             r = np.asarray(f(ov, self.v) if reverse else f(self.v, ov))
@@ -124,7 +128,7 @@ class Batch:
     def __ne__(self, o): return self._bin(o, np.not_equal)  # noqa: E704
     __hash__ = object.__hash__
 
-    def __neg__(self):
+    def __neg__(self) -> Batch:
         return Batch(-self.v, self.bad, self.ctx)
 
     def __pos__(self):
@@ -144,7 +148,7 @@ class Batch:
 
     __repr__ = __str__
 
-    def _refuse_number(self, *_) -> None:
+    def _refuse_number(self, *_: Any) -> None:
         self.ctx.refuse("a parameter used where xacro needs one number")
 
     __int__ = __float__ = __index__ = _refuse_number
@@ -162,7 +166,7 @@ class _BatchInterpreter(_Interpreter):
         super().__init__(symbols)
         self.ctx = ctx
 
-    def _where(self, test, a, b):
+    def _where(self, test, a, b) -> Batch:
         """``a if test else b``, design by design (each design's failures from its own branch and the test)."""
         ctx = self.ctx
         t = np.asarray(test.v, bool) if isinstance(test, Batch) else np.full(ctx.n, bool(test))

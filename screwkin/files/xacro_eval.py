@@ -145,7 +145,7 @@ def check_expression(expr: str) -> None:
         raise ValueError(f"xacro expression {quote(expr, 60)} uses {exc}: only {_ALLOWED} are allowed") from None
 
 
-def _number(x):
+def _number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, complex)
 
 
@@ -167,7 +167,7 @@ def _power(a, b):
     return float(a) ** float(b)  # OverflowError when too large
 
 
-def _call(name, args):
+def _call(name: str, args):
     if not all(_number(a) for a in args):
         raise _Refused(f"{name}() of text")
     if name == "abs":

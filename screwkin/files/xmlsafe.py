@@ -128,7 +128,7 @@ def parse_xml_text(text: str, path) -> ET.Element:
     return root
 
 
-def _dashes_in_comment(text: str, line: int, column: int):
+def _dashes_in_comment(text: str, line: int, column: int) -> tuple | None:
     """(line of the ``--``, line of its ``<!--``) when the parse error at (line, column) is a
     ``--`` inside a comment (XML forbids it; expat says only "invalid token"), else None."""
     if line < 1:
@@ -152,7 +152,7 @@ def _safe_loader():
 
         _depth = 0
 
-        def compose_node(self, parent, index):
+        def compose_node(self, parent, index: int):
             if self.check_event(yaml.AliasEvent):
                 event = self.peek_event()
                 raise yaml.composer.ComposerError(None, None, "YAML aliases (*name) are not allowed (refused for "

@@ -68,7 +68,7 @@ class _Names:
     def __len__(self) -> int:
         return len(self._all())
 
-    def __getitem__(self, k):
+    def __getitem__(self, k: int):
         return self._all()[k]
 
 

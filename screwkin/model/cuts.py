@@ -65,7 +65,7 @@ class CouplingRow:
     input: str | None = None
     pairs: frozenset = frozenset()  # q indices of continuous joints (cos, sin) in an angle row's terms
 
-    def value(self, q) -> float:
+    def value(self, q: np.ndarray) -> float:
         """The row's residual at q: sum c_k q_k + c0, or for an angle row the joints' angles (a
         continuous joint's atan2(sin, cos)) so summed, taken into [-pi, pi) (geometry.wrap_angle)."""
         if self.kind != "angle":
@@ -117,7 +117,7 @@ class Assembly:
     starts: int = 1
 
 
-def in_plane(axis):
+def in_plane(axis) -> tuple:
     """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
     a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1) --
     geometry.plane_basis(axis) in the order (normal, e1, e2)."""
@@ -125,7 +125,7 @@ def in_plane(axis):
     return a, e1, e2
 
 
-def pair_contact(pair, M1, M2):
+def pair_contact(pair, M1, M2) -> tuple:
     """(p, a): the world point where the pitch curves of a rolling or gear pair touch, and the
     pair's unit axis in the world (the normal of its plane).  ``pair``: the file's loop joint
     (files.description: axis in F1, radius1 -- inf for a line --, radius2, contact); M1, M2: the
@@ -163,7 +163,7 @@ def virtual_joint_name(loop_joint: str, role: str) -> str:
     return f"{loop_joint}.{role}"
 
 
-def bind_cut(model, c, coordinates: dict, path: str) -> tuple:
+def bind_cut(model: pin.Model, c, coordinates: dict, path: str) -> tuple:
     """(CutJoint, its extra row or None, the names of its virtual chain's joints or ()) of the
     description's loop joint ``c`` on ``model`` (its frames F1, F2 are added to the model): what closes
     the loop there -- the cut joint itself; for a rolling, gear or helical pair a weld from its virtual

@@ -21,7 +21,7 @@ TINY = 1e-300  # division guard
 AXIS_IN_PLANE = 1e-6
 
 
-def perpendicular_basis(a):
+def perpendicular_basis(a) -> tuple:
     """Two unit vectors (b1, b2) completing the unit vector ``a`` to a right-handed basis
     (b1, b2, a): b1 = a x h / |a x h| with h the world x axis (y when a is near x), b2 = a x b1.
 
@@ -36,7 +36,7 @@ def perpendicular_basis(a):
     return b1, b2
 
 
-def plane_basis(normal):
+def plane_basis(normal) -> tuple:
     """(e1, e2, n): e1 the world x axis projected into the plane (the world y axis when x is
     normal to it), e2 = n x e1, so angles from e1 are counterclockwise seen from +n.
 
@@ -58,7 +58,7 @@ def cross2(u, w):
     return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 
 
-def circle_circle(p, r, c, s, side):
+def circle_circle(p, r, c, s, side) -> tuple:
     """The intersection of the circle (centre p, radius r) and the circle (c, s) in the plane
     on the ``side`` (+1: left of the line p -> c, -1: right), broadcast over points (..., 2):
     (X, h2), h2 the squared distance of X from the line p -> c; h2 < 0 where the circles do
@@ -80,7 +80,7 @@ def circle_circle(p, r, c, s, side):
     return p + along[..., None] * u + (side * h)[..., None] * n, h2
 
 
-def circle_intersections(p, r, c, s, slack: float=0.0, concentric: float=0.0) -> list:
+def circle_intersections(p, r, c, s, slack: float = 0.0, concentric: float = 0.0) -> list:
     """The points where the circles (p, r) and (c, s) in the plane meet: [left of p -> c,
     right], the same point twice where they touch, [] where they do not meet (the centres
     closer than ``concentric``, or farther than r + s + slack, or nearer than |r - s| - slack).
@@ -122,7 +122,7 @@ def line_circle(point, direction, centre, radius) -> list:
     return [foot - h * direction, foot + h * direction]
 
 
-def lines_point(points, directions, tol: float):
+def lines_point(points, directions, tol: float) -> tuple:
     """(c, d): the point c nearest, in least squares, the 3-D lines through ``points`` along
     ``directions`` (sum (I - u u^T) (c - p) = 0, u the unit directions), and the largest distance d
     of a line from it; (None, inf) where the lines are parallel (that system's rank, by ``tol``,
@@ -197,13 +197,13 @@ def line_angle(u, w):
 
 
 # ------------------------------------------------------------------ cross products, fast
-def cross3(a, b):
+def cross3(a, b) -> np.ndarray:
     """Cross product of two 3-vectors (numpy.cross costs about 35 us a call here: it was
     70% of a sweep step in a profile; this costs about 1 us)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def cross_last(a, b):
+def cross_last(a, b) -> np.ndarray:
     """a x b over the last axis (of length 3) of arrays broadcast together: numpy.cross's value without its
     axis moves (numpy.cross's overhead on small arrays was most of the time of a long loop's local
     analysis: analysis/loop_series.ad); stack_cross is the same over the leading axis."""
@@ -221,7 +221,7 @@ _SKEW_INDEX = np.array([[0, 2, 1], [2, 0, 0], [1, 0, 0]])
 _SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
 
 
-def _skew_table(k, m=None):
+def _skew_table(k: int, m=None):
     """Index and sign tables that turn the columns of a 3 x k matrix, flattened column by
     column, into their stacked cross-product matrices (3k x 3); with m, columns j and m + j
     side by side (3m x 6)."""
@@ -255,7 +255,7 @@ def skews_batch(U, m=None):
 
 # -- stacks of small complex matrices, the stack's axes last (model.algebraic) --------------------------
 
-def quaternion_matrix(q):
+def quaternion_matrix(q: np.ndarray) -> np.ndarray:
     """Q(q) for quaternions q (..., 4) in Pinocchio's order (x, y, z, w): the homogeneous quadratic
     form, (q.q) times the rotation of q / |q|; (..., 3, 3)."""
     x, y, z, w = (q[..., k] for k in range(4))
@@ -275,12 +275,12 @@ def stack_mv(A, v):
     return A[:, 0] * v[0] + A[:, 1] * v[1] + A[:, 2] * v[2]
 
 
-def stack_cross(a, b):
+def stack_cross(a, b) -> np.ndarray:
     """a x b over the leading axis (3, ...)."""
     return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def quaternion_product(a, b):
+def quaternion_product(a, b) -> np.ndarray:
     """Hamilton products a b of stacks (P, 4) of quaternions in (x, y, z, w) order (real or complex)."""
     ax, ay, az, aw = a.T
     bx, by, bz, bw = b.T

@@ -32,6 +32,10 @@ from .geometry import lines_point
 from .manifold import continuous_angle, set_continuous_angle
 from .state import KinematicState
 from .subproblems import rotation, rotation_to, run_angles, two_rotations
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["LegChain", "Platform", "platform_of", "LegPose", "leg_poses", "set_leg", "set_free", "best_set",
            "respell"]
@@ -86,7 +90,7 @@ class LegPose:
     sets: tuple
 
 
-def _joint_letter(model, j) -> str:
+def _joint_letter(model: pin.Model, j: int) -> str:
     """R (one-axis revolute), P (prismatic), F (floating) or ? for joint j of the model."""
     short = model.joints[j].shortname()
     if model.joints[j].nv == 1 and short.startswith("JointModelR"):
@@ -98,7 +102,7 @@ def _joint_letter(model, j) -> str:
     return "?"
 
 
-def platform_of(mech, out_joint: int, tol: float = DEFAULT.closed_form):
+def platform_of(mech: Mechanism, out_joint: int, tol: float = DEFAULT.closed_form):
     """The Platform whose output link is carried by ``out_joint``, or None when the mechanism is not one
     (see the module).  Read once per mechanism and output joint."""
     key = ("platform", out_joint)
@@ -107,7 +111,7 @@ def platform_of(mech, out_joint: int, tol: float = DEFAULT.closed_form):
     return mech.cache[key]
 
 
-def _find_platform(mech, out_joint, tol):
+def _find_platform(mech: Mechanism, out_joint, tol) -> Platform | None:
     model = mech.model
     if not mech.cuts or mech.couplings or getattr(mech, "extra_rows", None) or out_joint <= 0:
         return None
@@ -147,7 +151,7 @@ def _find_platform(mech, out_joint, tol):
     return Platform(out_joint, state.joint_placement(out_joint), free, tuple(legs))
 
 
-def _joints_from_ground(model, j) -> list:
+def _joints_from_ground(model: pin.Model, j: int) -> list:
     """The joint ids from the ground to joint j (j last)."""
     out = []
     while j > 0:
@@ -156,7 +160,7 @@ def _joints_from_ground(model, j) -> list:
     return out[::-1]
 
 
-def _leg_chain(model, state, path, cut, end, scale, tol):
+def _leg_chain(model: pin.Model, state, path, cut, end, scale, tol):
     """The LegChain of the joints ``path`` (see the module), read in ``state``, or None when they are no leg."""
     kinds = [_joint_letter(model, j) for j in path]
     if kinds.count("P") != 1:
@@ -168,7 +172,7 @@ def _leg_chain(model, state, path, cut, end, scale, tol):
     if (cut is None) == (not b):
         return None
 
-    def axis(j):
+    def axis(j: int):
         return state.joint_placement(j).rotation @ joint_axis(model.joints[j])
 
     def centre(js):
@@ -198,7 +202,7 @@ def _leg_chain(model, state, path, cut, end, scale, tol):
                     tuple(float(v) for v in b_local), cut)
 
 
-def leg_poses(platform: Platform, leg: LegChain, P, tol: float = DEFAULT.closed_form):
+def leg_poses(platform: Platform, leg: LegChain, P, tol: float = DEFAULT.closed_form) -> tuple:
     """(poses, why, gap): the leg's LegPoses (extended root first) for the output joint at world
     placement P (a pinocchio.SE3); when it has none, why (else "") and how far it stays from the pose
     [m]."""
@@ -250,7 +254,7 @@ def leg_poses(platform: Platform, leg: LegChain, P, tol: float = DEFAULT.closed_
     return out, ("" if out else why or f"leg {leg.name} cannot reach the pose"), gap
 
 
-def set_leg(model, q, pose: LegPose, angles: dict):
+def set_leg(model: pin.Model, q: np.ndarray, pose: LegPose, angles: dict):
     """q with the leg's slide at pose.x and its revolutes at ``angles`` (in place; returned)."""
     q[model.joints[pose.leg.slide].idx_q] = pose.x
     for j, t in angles.items():
@@ -262,7 +266,7 @@ def set_leg(model, q, pose: LegPose, angles: dict):
     return q
 
 
-def set_free(platform: Platform, model, q, P):
+def set_free(platform: Platform, model: pin.Model, q: np.ndarray, P):
     """q with the floating joint holding the platform at the output joint's world placement P."""
     if platform.free is not None:
         jm = model.joints[platform.free]
@@ -270,7 +274,7 @@ def set_free(platform: Platform, model, q, P):
     return q
 
 
-def best_set(mech, q, pose: LegPose, near=None):
+def best_set(mech: Mechanism, q: np.ndarray, pose: LegPose, near=None):
     """The angle set of ``pose`` to report: the fewest of its joints outside the file's limits, then
     the nearest ``near`` (a configuration; default the file's), angles compared modulo a turn."""
     model = mech.model
@@ -278,7 +282,7 @@ def best_set(mech, q, pose: LegPose, near=None):
     names, idx, lo, hi, angle = mech.limited_coordinates()
     limits = {int(i): (a, b, ang) for i, a, b, ang in zip(idx, lo, hi, angle)}
 
-    def key(s):
+    def key(s) -> tuple:
         bad, far = 0, 0.0
         for j, t in s.items():
             jm = model.joints[j]
@@ -292,7 +296,7 @@ def best_set(mech, q, pose: LegPose, near=None):
     return min(pose.sets, key=key)
 
 
-def _common_output(mech):
+def _common_output(mech: Mechanism):
     """The joint carrying the link every loop joint closes on (a platform's), or None."""
     model = mech.model
     common = None
@@ -302,7 +306,7 @@ def _common_output(mech):
     return next(iter(common)) if common and len(common) == 1 else None
 
 
-def respell(mech, q):
+def respell(mech: Mechanism, q: np.ndarray):
     """q with each platform leg (see the module) whose joints lie outside the file's limits written in
     an angle set of the same pose within them, where one exists (the leg's slide kept); q itself when
     the mechanism is no such platform or nothing changes.  A pose, not its spelling, is within the
@@ -337,13 +341,13 @@ def respell(mech, q):
     return out
 
 
-def _joint_angle(model, q, j) -> float:
+def _joint_angle(model: pin.Model, q: np.ndarray, j: int) -> float:
     """Joint j's value in q (a continuous joint's angle from its (cos, sin))."""
     jm = model.joints[j]
     return float(continuous_angle(q, jm.idx_q)) if jm.nq == 2 else float(q[jm.idx_q])
 
 
-def _bad(mech, angles: dict) -> int:
+def _bad(mech: Mechanism, angles: dict) -> int:
     """How many of the revolutes {joint id: angle} lie outside the file's limits (modulo a turn)."""
     _, idx, lo, hi, angle = mech.limited_coordinates()
     where = {int(i): k for k, i in enumerate(idx)}
@@ -357,7 +361,7 @@ def _bad(mech, angles: dict) -> int:
     return int(_outside_rows(q, idx[k], lo[k], hi[k], angle[k]).sum())
 
 
-def _outside_rows(q, idx, lo, hi, angle):
+def _outside_rows(q: np.ndarray, idx, lo, hi, angle):
     """Which limited coordinates of q lie outside their range (angles modulo a turn)."""
     v = np.asarray(q)[idx]
     out = (v < lo) | (v > hi)

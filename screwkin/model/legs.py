@@ -41,7 +41,7 @@ class Leg:
     centre: tuple
 
 
-def distance_legs(model, cuts, frozen, length: float, keep_frames=(), tol: float = DEFAULT.geometry) -> list:
+def distance_legs(model: pin.Model, cuts, frozen, length: float, keep_frames=(), tol: float = DEFAULT.geometry) -> list:
     """The legs of ``cuts`` that are distance constraints (see the module), with the inputs at the
     velocity indices ``frozen`` held; ``keep_frames``: frames that must not lie on a leg (an output);
     ``tol``: the geometric tolerance (axes meeting, a distance constant), relative to the length."""
@@ -69,13 +69,13 @@ def distance_legs(model, cuts, frozen, length: float, keep_frames=(), tol: float
     return legs
 
 
-def _passive_revolute(model, j, frozen) -> bool:
+def _passive_revolute(model: pin.Model, j: int, frozen) -> bool:
     jm = model.joints[j]
     passive = not any(jm.idx_v + k in frozen for k in range(jm.nv))
     return passive and jm.nv == 1 and jm.shortname().startswith("JointModelR")
 
 
-def _leg(model, data, q0, name, f, other, used, frozen, length, taken, tol):
+def _leg(model: pin.Model, data, q0: np.ndarray, name: str, f, other, used, frozen, length, taken, tol) -> Leg | None:
     """The leg ending at frame f, or None."""
     chain = []
     j = model.frames[f].parentJoint
@@ -98,7 +98,7 @@ def _leg(model, data, q0, name, f, other, used, frozen, length, taken, tol):
     return None
 
 
-def _common_point(model, data, revs, length, tol):
+def _common_point(model: pin.Model, data, revs, length, tol):
     """The point where the revolutes' axes meet (at the neutral configuration), or None when there are
     fewer than two independent axes or they do not meet."""
     if len(revs) < 2:
@@ -115,7 +115,7 @@ def _common_point(model, data, revs, length, tol):
     return o if o is not None and off <= tol * length else None
 
 
-def _constant_distance(model, q0, f, chain, revs, centre, length, tol) -> bool:
+def _constant_distance(model: pin.Model, q0: np.ndarray, f, chain, revs, centre, length, tol) -> bool:
     """Whether the frame's origin stays at one distance from the centre as the leg's passive revolutes
     turn (tried at random angles, with its inputs at two values)."""
     rng = np.random.default_rng(7)
@@ -137,7 +137,7 @@ def _constant_distance(model, q0, f, chain, revs, centre, length, tol) -> bool:
     return True
 
 
-def chain_distance(model, frozen, joint: int, length: float, tol: float = DEFAULT.geometry):
+def chain_distance(model: pin.Model, frozen, joint: int, length: float, tol: float = DEFAULT.geometry) -> tuple | None:
     """(A, B) when the tree's chain from the ground to ``joint`` is itself a distance between the ground
     and joint's link: passive revolutes meeting at a point A of the ground first, passive revolutes
     meeting at a point B of the link last (three: it turns freely about B), inputs between, |B - A|
@@ -178,12 +178,12 @@ def chain_distance(model, frozen, joint: int, length: float, tol: float = DEFAUL
     return a, b_local
 
 
-def _passive(model, j, frozen) -> bool:
+def _passive(model: pin.Model, j: int, frozen) -> bool:
     jm = model.joints[j]
     return not any(jm.idx_v + k in frozen for k in range(jm.nv))
 
 
-def _turn(model, q, joints, rng) -> None:
+def _turn(model: pin.Model, q: np.ndarray, joints, rng: np.random.Generator) -> None:
     """q with the revolutes ``joints`` turned to random angles (in place)."""
     for k in joints:
         jm = model.joints[k]

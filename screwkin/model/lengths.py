@@ -8,11 +8,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..tolerances import DEFAULT
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 __all__ = ["link_lengths", "characteristic_length"]
 
 
-def link_lengths(model, cuts) -> list:
+def link_lengths(model: pin.Model, cuts) -> list:
     """The length of each rigid body of the model that has one: the largest distance between
     two joint centres on it (the origin of the joint that carries it, the origins of the
     joints it carries, and the frames of the cut joints on it), as written in the file --
@@ -37,7 +41,7 @@ def link_lengths(model, cuts) -> list:
     return lengths
 
 
-def characteristic_length(model, cuts) -> float:
+def characteristic_length(model: pin.Model, cuts) -> float:
     """The characteristic length L of a mechanism [m]: the mean length of its links
     (:func:`link_lengths`), 1 m when no link has a length.  Every measure that mixes
     translations and rotations divides translations by L (and multiplies the rates of

@@ -8,11 +8,15 @@ from __future__ import annotations
 import numpy as np
 
 from .leg_chains import respell
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["outside_limits", "within_limits", "spelled_within_limits"]
 
 
-def outside_limits(mech, q) -> tuple:
+def outside_limits(mech: Mechanism, q: np.ndarray) -> tuple:
     """Joints whose value lies outside the position limits of the file."""
     names = mech.limited_coordinates()[0]
     if not names:
@@ -21,7 +25,7 @@ def outside_limits(mech, q) -> tuple:
     return tuple(n for n, o in zip(names, out) if o)
 
 
-def within_limits(mech, Q) -> np.ndarray:
+def within_limits(mech: Mechanism, Q: np.ndarray) -> np.ndarray:
     """(N,) True where every joint of the configurations Q (N, nq) is within its limits (an
     angle may sit in its range modulo a turn): outside_limits for a stack."""
     Q = np.atleast_2d(np.asarray(Q, float))
@@ -30,7 +34,7 @@ def within_limits(mech, Q) -> np.ndarray:
     return ~_outside(mech, Q).any(axis=1)
 
 
-def _outside(mech, Q) -> np.ndarray:
+def _outside(mech: Mechanism, Q: np.ndarray) -> np.ndarray:
     """(N, limited joints) True where a joint lies outside its limits."""
     _, idx, lo, hi, angle = mech.limited_coordinates()
     v = Q[:, idx]
@@ -41,7 +45,7 @@ def _outside(mech, Q) -> np.ndarray:
     return out
 
 
-def spelled_within_limits(mech, q):
+def spelled_within_limits(mech: Mechanism, q: np.ndarray):
     """q, or where joints of q lie outside the file's limits, the angle set of the same pose within them
     where one exists: a universal joint's flipped set (a, b) -> (a + pi, pi - b) with its leg spun about
     its own line, a spherical joint's other Euler set (model.leg_chains.respell: the legs of a

@@ -33,7 +33,7 @@ def rank(A, tol) -> int:
     return int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
 
 
-def null_space(A, tol, n=None) -> np.ndarray:
+def null_space(A, tol, n: int | None = None) -> np.ndarray:
     """Orthonormal basis (columns) of the null space of A (A has n columns)."""
     A = np.asarray(A, float)
     n = A.shape[1] if n is None else n

@@ -60,7 +60,7 @@ def _find_sidecar(path: Path):
     return None
 
 
-def _frame_bodies(model) -> dict:
+def _frame_bodies(model: pin.Model) -> dict:
     """Frame name -> the Pinocchio joint carrying it (of the preferred frame when several share the name)."""
     rank = {t: k for k, t in enumerate(FRAME_PREFERENCE)}
     best = {}
@@ -75,7 +75,7 @@ def _frame_bodies(model) -> dict:
 MAX_WARNINGS = 20
 
 
-def _check_cut_bodies(model, spec) -> None:
+def _check_cut_bodies(model: pin.Model, spec) -> None:
     """Refuse a cut joint whose two frames are on the same rigid body (fixed together):
     it closes no loop."""
     for c in spec.cut_joints:
@@ -107,7 +107,7 @@ def _revolute_for(jm):
     return None
 
 
-def _order(model, first=()):
+def _order(model: pin.Model, first=()):
     """The model's joints in a depth-first order with, among siblings, the subtrees that hold a
     joint of ``first`` before the others: Pinocchio needs a mimicked joint before its mimics."""
     children = {j: [] for j in range(model.njoints)}
@@ -128,7 +128,7 @@ def _order(model, first=()):
     return order
 
 
-def _rebuild(model, replacements=(), first=()):
+def _rebuild(model: pin.Model, replacements=(), first=()):
     """The model with continuous joints as revolute joints without limits (one coordinate, the
     angle, which counts turns: Pinocchio's (cos, sin) pair cannot, and a gear train or a lead
     screw turned twice must move twice as far), the sidecar's joint replacements (SPHERICAL,
@@ -176,7 +176,7 @@ def _rebuild(model, replacements=(), first=()):
     return new
 
 
-def _couple(model, couplings, path):
+def _couple(model: pin.Model, couplings, path):
     """The model with each coupled joint turned into a Pinocchio mimic joint (no coordinate of
     its own; its motion is m times its primary's plus o)."""
     for c in couplings:
@@ -198,7 +198,7 @@ def _couple(model, couplings, path):
     return model
 
 
-def _virtual_pairs(model, spec) -> None:
+def _virtual_pairs(model: pin.Model, spec) -> None:
     """Give every rolling, gear and helical loop joint the massless chain of its equivalent
     linkage, from F1 on its first link, whose coordinates are the pair's unwrapped angles (and
     advance); the loop closes with a weld from the chain's end frame ``NAME@end`` to F2, and a
@@ -227,7 +227,7 @@ def _virtual_pairs(model, spec) -> None:
 
         roles = virtual_roles(c)
 
-        def add(joint_parent, jm, M, role, c=c):  # called at once, in this iteration
+        def add(joint_parent, jm, M, role: str, c=c):  # called at once, in this iteration
             name = virtual_joint_name(c.name, role)
             if model.existJointName(name):
                 raise MechanismFileError(spec.path, f"joint {quote(name)} is also the name of a coordinate of loop "
@@ -252,7 +252,7 @@ def _virtual_pairs(model, spec) -> None:
         model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
 
 
-def _finish_model(spec, model):
+def _finish_model(spec, model: pin.Model):
     """The tree model of a read file (its sidecar applied) made screwkin's: continuous joints, the joint
     replacements, mimic couplings, the virtual chains of higher pairs; sizes and cut joints checked."""
     path = spec.path
@@ -276,7 +276,7 @@ def rebuild(spec, actuated=None, tolerances: Tolerances = DEFAULT, cls=Mechanism
 _NORMALISED = "\t\n\r"
 
 
-def _check_names_read_alike(model, spec, path) -> None:
+def _check_names_read_alike(model: pin.Model, spec, path) -> None:
     """Refuse a link or joint name that Pinocchio's parser and screwkin's read differently: a literal
     tab, newline or carriage return inside the quotes of its name.  urdfdom (TinyXML2: Pinocchio's
     parser, ROS's robot_state_publisher and check_urdf) keeps the character (a carriage return as a
@@ -335,7 +335,7 @@ def _print_warning(path):
 
 
 def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None,
-         cls=Mechanism, args=None, text=None) -> Mechanism:
+         cls=Mechanism, args=None, text: str | None = None) -> Mechanism:
     """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, SDF, MJCF, or a
     xacro file that expands to such a URDF).
 

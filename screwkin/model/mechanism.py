@@ -63,7 +63,7 @@ class Mechanism:
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """
 
-    def __init__(self, spec: MechanismSpec, model, actuated=None, tolerances: Tolerances = DEFAULT) -> None:
+    def __init__(self, spec: MechanismSpec, model: pin.Model, actuated=None, tolerances: Tolerances = DEFAULT) -> None:
         self.spec = spec
         self.path = spec.path
         self.tolerances = tolerances
@@ -233,7 +233,7 @@ class Mechanism:
                     out.add(iq)
         return frozenset(out)
 
-    def coupled_values(self, q) -> dict:
+    def coupled_values(self, q: np.ndarray) -> dict:
         """The value of every coupled (<mimic>) joint: multiplier * its primary's + offset
         [rad or m]; angles in [-pi, pi)."""
         out = {}
@@ -248,7 +248,7 @@ class Mechanism:
     def _revolute_like(self, joint: str) -> bool:
         return next((j.type for j in self.spec.joints if j.name == joint), "") in ("revolute", "continuous")
 
-    def difference(self, q0, q1) -> np.ndarray:
+    def difference(self, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
         """The velocity-space step from q0 to q1 (pinocchio.difference), with the angles of
         bounded revolute joints taken the short way round [-pi, pi)."""
         d = pin.difference(self.model, q0, q1)
@@ -258,13 +258,13 @@ class Mechanism:
             d[v] = wrap_angle(d[v])
         return d
 
-    def joint_values(self, q) -> dict:
+    def joint_values(self, q: np.ndarray) -> dict:
         """Every joint coordinate name -> value [rad or m], in the order of the joints:
         revolute angles in [-pi, pi), continuous joints as atan2(sin, cos), the coordinates
         of multi-DOF joints as ``joint[qk]``."""
         return dict(zip(self._value_layout()[3], self.joint_value_rows(q)[0].tolist()))
 
-    def joint_value_rows(self, Q) -> np.ndarray:
+    def joint_value_rows(self, Q: np.ndarray) -> np.ndarray:
         """joint_values of each configuration of Q (N, nq), as the rows of an (N, joints) array in the
         order of joint_values' names: the same numbers, for many configurations at once (a sweep's)."""
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -373,7 +373,7 @@ class Mechanism:
         return self._translational
 
     # ------------------------------------------------------------------ configurations
-    def random_configuration(self, rng, around=None, spread: float = 0.3) -> np.ndarray:
+    def random_configuration(self, rng: np.random.Generator, around=None, spread: float = 0.3) -> np.ndarray:
         """A random configuration.
 
         Without ``around``: every joint uniform within its limits -- angles over their
@@ -423,7 +423,7 @@ class Mechanism:
                 q[i:i + c.nq] = pin.integrate(model, pin.neutral(model), dq)[i:i + c.nq]
         return q
 
-    def _keep(self, q, hint, frozen):
+    def _keep(self, q: np.ndarray, hint, frozen):
         """q with the coordinates of the joints whose velocity indices are frozen taken from hint."""
         if not len(frozen):
             return q
@@ -435,7 +435,7 @@ class Mechanism:
         return q
 
     # ------------------------------------------------------------------ analyses
-    def assemble(self, q0=None, frozen=(), seed: int = 0) -> Assembly:
+    def assemble(self, q0: np.ndarray | None = None, frozen=(), seed: int = 0) -> Assembly:
         """Close the loops: a seeded search, not a single descent.
 
         The hint ``q0`` (default: the file's configuration, ``neutral()``: every joint at zero, an MJCF
@@ -562,7 +562,7 @@ class Mechanism:
             self.generic_configurations()
         return self._generic[2:]
 
-    def topology(self, q=None):
+    def topology(self, q: np.ndarray | None = None):
         """The :class:`~screwkin.model.topology.Topology` (links, joints, compound joints, loops)
         at q (default: a generic assembled configuration)."""
         return build_topology(self, self.generic_configurations()[1][0] if q is None else q)

@@ -23,6 +23,10 @@ from .geometry import perpendicular_basis, wrap_angle
 from .manifold import continuous_angle
 from .state import KinematicState
 from .topology import build_topology, frame_link
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS", "ball_values", "davenport"]
 
@@ -33,12 +37,12 @@ WRITABLE_CUTS = ("fixed", "revolute", "continuous", "prismatic", "cylindrical", 
 _NO_LIMIT = 1e6
 
 
-def _inertia(I):
+def _inertia(I) -> tuple:
     m = I.inertia
     return (m[0, 0], m[1, 1], m[2, 2], m[0, 1], m[0, 2], m[1, 2])
 
 
-def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str = "") -> PlacedMechanism:
+def placed(mech: Mechanism, q: np.ndarray, fmt: str = "MJCF", length: float | None = None, comment: str = "") -> PlacedMechanism:
     """``mech`` at configuration ``q`` (an assembled one, for loops closed in the file).
 
     Raises MechanismFileError for what ``fmt`` cannot express (a higher pair; for URDF a ball
@@ -130,11 +134,11 @@ def placed(mech, q, fmt: str = "MJCF", length: float | None = None, comment: str
                            length if length else mech.length, notes, gears, tuple(compounds))
 
 
-def _spec_joint(spec, name):
+def _spec_joint(spec, name: str):
     return next(j for j in spec.joints if j.name == name)
 
 
-def _placed_joint(mech, q, j, kind, values, empty, axis=None, pos=(0.0, 0.0, 0.0)) -> PlacedJoint:
+def _placed_joint(mech: Mechanism, q: np.ndarray, j: int, kind: str, values, empty, axis=None, pos=(0.0, 0.0, 0.0)) -> PlacedJoint:
     """The PlacedJoint of tree joint ``j`` (a hinge or slide keeps its range about q; ``values``
     and ``empty`` collect its value and an empty range)."""
     model = mech.model
@@ -157,7 +161,7 @@ def _placed_joint(mech, q, j, kind, values, empty, axis=None, pos=(0.0, 0.0, 0.0
     return PlacedJoint(j.name, kind, axis, rng, tuple(dyn.items()), tuple(float(x) for x in pos))
 
 
-def _compounds(mech, q, state, world) -> list:
+def _compounds(mech: Mechanism, q: np.ndarray, state, world) -> list:
     """The tree's compound joints (model.topology: revolutes and prismatics through massless links)
     that MJCF writes as one body's joints: spherical (a ball), universal, cylindrical; only where the
     massless links carry nothing else and no member is coupled, nor, for a ball, an input."""
@@ -208,7 +212,7 @@ def _compounds(mech, q, state, world) -> list:
     return out
 
 
-def _compound_joints(mech, q, state, c, values, empty) -> list:
+def _compound_joints(mech: Mechanism, q: np.ndarray, state, c, values, empty) -> list:
     """The PlacedJoints of compound ``c`` in its body (``state``: the KinematicState at q): one ball at
     the members' common point, or the members' own joints with their axes and points in the body's frame."""
     C = state.frame_placement(mech.link_frame(c.body))
@@ -234,7 +238,7 @@ def ball_values(c: PlacedCompound, quat) -> dict:
     return {m: v + dv for m, v, dv in zip(c.members, c.values, d)}
 
 
-def _angle_about(n, v, w) -> float:
+def _angle_about(n: int, v, w) -> float:
     """The angle [rad] about unit axis n taking v's projection on n's plane to w's."""
     v = v - (n @ v) * n
     w = w - (n @ w) * n
@@ -264,7 +268,7 @@ def davenport(R, axes) -> tuple:
     return a, b, c
 
 
-def check_closed(mech, q, tol: float) -> float:
+def check_closed(mech: Mechanism, q: np.ndarray, tol: float) -> float:
     """The largest loop-closure residual at q [m or rad]; MechanismFileError when over tol."""
     r = float(np.max(np.abs(mech.closure.residual(q)))) if mech.closure.nrows else 0.0
     if r > tol:

@@ -92,7 +92,7 @@ def frame_parent(mech, fid: int) -> tuple:
     return f.parentJoint, f.placement
 
 
-def model_with_output(mech, model=None):
+def model_with_output(mech, model: pin.Model | None = None):
     """A copy of the mechanism's model (or ``model``, itself a copy, changed in place) with the output
     frame placed where place_tool put it, for a closure system that holds it as a cut joint's frame
     (inverse kinematics, a workspace's targets); the mechanism's own model is never changed."""
@@ -187,7 +187,7 @@ class KinematicState:
     vectors of the model, (nv,)).  Read-only; every quantity is computed when first asked (Pinocchio's
     pass run again where another state has used the thread's Data since) and returned as a copy."""
 
-    def __init__(self, mech, q, qd=None, qdd=None) -> None:
+    def __init__(self, mech, q: np.ndarray, qd=None, qdd=None) -> None:
         self.mech = mech
         self.q = np.array(q, float)
         self.qd = None if qd is None else np.array(qd, float)
@@ -339,7 +339,7 @@ class KinematicState:
         return out
 
     # ------------------------------------------------------------------ loop-joint coordinates
-    def _cut_frames(self, cut):
+    def _cut_frames(self, cut) -> tuple:
         M1, M2 = self.frame_placement(cut.frame1), self.frame_placement(cut.frame2)
         axis = M1.rotation @ np.asarray(cut.axis, float)
         return M1, M2, axis / np.linalg.norm(axis)

@@ -260,7 +260,7 @@ class _Edge:
     profile: str | None = None
 
 
-def _edges(mech, q):
+def _edges(mech, q: np.ndarray) -> tuple:
     """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
     model = mech.model
     state = KinematicState(mech, q)
@@ -319,7 +319,7 @@ def _unit_vector(v):
     return v / np.linalg.norm(v)
 
 
-def _parallel(d1, d2, tol):
+def _parallel(d1, d2, tol) -> bool:
     return np.linalg.norm(np.cross(_unit_vector(d1), _unit_vector(d2))) < tol
 
 
@@ -331,7 +331,7 @@ def _line_distance(p1, d1, p2, d2, tol):
     return abs((p2 - p1) @ _unit_vector(n))
 
 
-def _compound_name(members, kind) -> str:
+def _compound_name(members, kind: str) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
 
     prefix = os.path.commonprefix(members)
@@ -343,7 +343,7 @@ def _compound_name(members, kind) -> str:
     return "+".join(members)
 
 
-def _classify_chain(chain, tol, scale, coupled=frozenset()):
+def _classify_chain(chain, tol, scale, coupled=frozenset()) -> str | None:
     """The compound type of a chain of 1-DOF edges through massless links, or None.
     coupled: the pairs of joint names one of which mimics the other."""
     kinds = [e.type for e in chain]
@@ -374,7 +374,7 @@ def _classify_chain(chain, tol, scale, coupled=frozenset()):
     return None
 
 
-def build_topology(mech, q) -> Topology:
+def build_topology(mech, q: np.ndarray) -> Topology:
     """Links, joints (with compound joints recognized) and motion space at configuration q."""
     tol = mech.tolerances.geometry
     spec = mech.spec
@@ -399,10 +399,10 @@ def build_topology(mech, q) -> Topology:
         incident[e.b].append(k)
     dm = mech.tolerances.dummy_mass
 
-    def massless(r):
+    def massless(r) -> bool:
         return r != ground_root and all(spec.links[m].is_massless(dm) for m in groups[r])
 
-    def one_dof(k) -> bool:
+    def one_dof(k: int) -> bool:
         return edges[k].type in ("revolute", "continuous", "prismatic")
 
     candidates = {r for r in groups if massless(r) and len(incident[r]) == 2 and all(one_dof(k) for k in incident[r])}
@@ -500,7 +500,7 @@ def build_topology(mech, q) -> Topology:
                     normal, tuple(c for c in mech.couplings if c not in consumed))
 
 
-def _motion_space(joints, tol, scale):
+def _motion_space(joints, tol, scale) -> tuple:
     """'planar' when every revolute axis is parallel to one normal and every
     prismatic axis perpendicular to it; 'spherical' when every joint is a
     rotation about one common point; 'spatial' otherwise."""

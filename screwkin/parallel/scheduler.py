@@ -18,7 +18,7 @@ __all__ = ["MAX_HANDSHAKE", "scheduler_address", "probe_scheduler"]
 MAX_HANDSHAKE = 1 << 20
 
 
-def _host_port(address: str):
+def _host_port(address: str) -> tuple:
     """(host, port) of tcp://HOST:PORT or tls://HOST:PORT ([IPv6]:PORT too), or a UsageError."""
     scheme, sep, rest = address.partition("://") if isinstance(address, str) else ("", "", "")
     if not sep or scheme not in ("tcp", "tls"):

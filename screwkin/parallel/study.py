@@ -128,7 +128,7 @@ def _merged(notes: Counter) -> list:
     return [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" if c else why for why, c in out.most_common()]
 
 
-def _on_dask(task, chunks, total, scheduler, workers, timeout, progress):
+def _on_dask(task, chunks, total, scheduler, workers, timeout, progress) -> tuple:
     """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
     workers, where)."""
     from distributed import as_completed  # 0.4-0.9 s to import: only studies need it

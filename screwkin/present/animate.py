@@ -43,7 +43,7 @@ def animation_format(path: str) -> str:
     return ext
 
 
-def _limits(skeletons, titles, traces, size, angles, progress=None):
+def _limits(skeletons, titles, traces, size, angles, progress=None) -> tuple[tuple, tuple]:
     """The framing of the whole motion: the union of the limits each frame would take alone
     (whole paths drawn), so that every frame is drawn in the same window."""
     plt = pyplot("--animate")

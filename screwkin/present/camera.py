@@ -31,7 +31,7 @@ def view_direction(bounds) -> np.ndarray:
     return d / np.linalg.norm(d)
 
 
-def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], fill: float=0.7):
+def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], fill: float = 0.7) -> tuple:
     """Target and position (world) of a perspective camera looking along -direction, z up, at
     which the points fill the fraction ``fill`` of the frame along its tighter dimension: the
     target is moved (a few fixed-point steps) until the points' projected extent is centred, and
@@ -50,7 +50,7 @@ def fit_camera(points, direction, fov_deg=FOV, aspect=PICTURE[0] / PICTURE[1], f
     x, y = (P - t) @ right, (P - t) @ cam_up
     t = t + right * 0.5 * (x.max() + x.min()) + cam_up * 0.5 * (y.max() + y.min())  # centred, seen from afar
 
-    def distance(t):
+    def distance(t) -> tuple:
         """(x, y, z) of the points about target t, and the smallest distance that fits them."""
         x, y, z = (P - t) @ right, (P - t) @ cam_up, (P - t) @ u
         D = float(np.max(z + np.maximum(np.abs(x) / (fill * tan_h), np.abs(y) / (fill * tan_v))))

@@ -111,7 +111,7 @@ def figure_bytes(fig, fmt: str = "svg") -> bytes:
 
 
 # ------------------------------------------------------------------ numbers as people read them
-def _g(x, digits: int=6) -> str:
+def _g(x, digits: int = 6) -> str:
     return f"{shown(x):.{digits}g}"
 
 
@@ -272,7 +272,7 @@ def view_section(png, note=None) -> Section:
     return s
 
 
-def note_section(id, title, text) -> Section:
+def note_section(id, title: str, text: str) -> Section:
     return Section(id, title, [Note(text)])
 
 
@@ -344,7 +344,7 @@ def _md_cell(c) -> str:
     return _md_text(c).replace("|", "\\|").replace("\r", " ").replace("\n", " ")
 
 
-def _fence(text) -> str:
+def _fence(text: str) -> str:
     """A code fence longer than any run of backticks in ``text``."""
     return "`" * max(3, 1 + max((len(r) for r in re.findall(r"`+", text)), default=0))
 

@@ -24,6 +24,10 @@ from ..model.geometry import wrap_angle
 from .draw_targets import design_drawing, draw_targets
 from .plots import pyplot
 from .outfile import write_figure
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["chain_dict", "draw_chain", "draw_mechanism", "draw_design", "save_figure", "skeleton_dict", "value_label",
            "wrapped_value", "configuration_text", "drawing_title", "number_colours"]
@@ -37,14 +41,14 @@ def _plt():
     return pyplot("drawing")
 
 
-def value_label(name, value, unit) -> str:
+def value_label(name: str, value, unit: str) -> str:
     """'crank = 30 deg' or 'slide = 12.5 mm': a value as a person reads it."""
     if unit == "m":
         return f"{name} = {value * 1000:.4g} mm"
     return f"{name} = {np.degrees(value):.5g} deg"
 
 
-def wrapped_value(value, unit):
+def wrapped_value(value, unit: str):
     """A coordinate's value as a drawing names it: a length [m] as it is, an angle in [-pi, pi)."""
     return value if unit == "m" else wrap_angle(value)
 
@@ -56,16 +60,16 @@ def configuration_text(skel) -> str:
     return ", ".join(value_label(k, v, skel.units[k]) for k, v in skel.inputs.items())
 
 
-def drawing_title(mech, what) -> str:
+def drawing_title(mech: Mechanism, what: str) -> str:
     """A drawing's title: the file's name, then ``what``."""
     return f"{os.path.basename(str(mech.path))}: {what}"
 
 
-def _short(name, n: int=26):
+def _short(name: str, n: int = 26):
     return name if len(name) <= n else name[: n - 1] + "~"
 
 
-def number_colours(n):
+def number_colours(n: int) -> dict:
     """Link number -> colour (2 .. n + 1; the ground, 1, is drawn grey): the colours drawings and the
     planar view share."""
     cycle = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
@@ -112,7 +116,7 @@ def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitl
     links = {lk.number: lk for lk in skel.links}
     points = []
 
-    def col(n):
+    def col(n: int):
         return "0.25" if n == 1 else colour[n]
 
     # ground symbol under a point (a pivot) or along a guide
@@ -296,7 +300,7 @@ def _block_direction(skel, lk):
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float=0.85) -> None:
+def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float = 0.85) -> None:
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -305,7 +309,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float=0.85) -> None:
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j, p, r) -> None:
+def _input_arrow(ax, FancyArrowPatch, j: int, p, r) -> None:
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
@@ -419,7 +423,7 @@ def draw_chain(chain, title: str | None = None):
     return fig
 
 
-def _layout(chain):
+def _layout(chain) -> dict:
     """Node positions in a unit box: networkx's Kamada-Kawai layout, else a circle; the ground
     at the bottom."""
     numbers = [nd.number for nd in chain.nodes]
@@ -489,7 +493,7 @@ def save_figure(fig, path: str, close: bool = True):
         plt.close(fig)
 
 
-def draw_design(mech, paths, steps: int = 360, say=None) -> list:
+def draw_design(mech: Mechanism, paths, steps: int = 360, say=None) -> list:
     """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
     ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
     q = mech.assemble().q

@@ -16,6 +16,10 @@ import numpy as np
 
 from ..analysis.course.skeleton import skeleton
 from ..analysis.design.targets import design_targets
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["design_marks", "design_drawing", "target_marks", "draw_targets", "NUMBERED"]
 
@@ -25,7 +29,7 @@ TARGET_COLOUR = "#6a3d9a"
 NUMBERED = 12
 
 
-def design_marks(mech, q, skel, inputs=None, steps: int = 360):
+def design_marks(mech: Mechanism, q: np.ndarray, skel, inputs=None, steps: int = 360) -> tuple:
     """(analysis.design.targets.DesignTargets, marks) of ``mech``'s file drawn at ``q`` as ``skel``:
     the marks (target_marks) with the linkage's skeleton at each precision position other than the
     one drawn (in skel's plane, ``inputs`` marked)."""
@@ -49,7 +53,7 @@ def design_marks(mech, q, skel, inputs=None, steps: int = 360):
     return found, marks
 
 
-def design_drawing(mech, q, input_names, skel, steps, say=None, hint: str=""):
+def design_drawing(mech: Mechanism, q: np.ndarray, input_names, skel, steps: int, say=None, hint: str = "") -> tuple:
     """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
     precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
     ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
@@ -90,7 +94,7 @@ def target_marks(design, basis, skeletons=None) -> list:
     assemble), and ``ghost`` (the Skeleton at that position, from ``skeletons``, or None)."""
     e1, e2 = (np.asarray(v, float) for v in basis[:2])
 
-    def plane(v):
+    def plane(v) -> list:
         v = np.asarray(v, float)
         return [float(v @ e1), float(v @ e2)]
 

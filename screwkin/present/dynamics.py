@@ -21,7 +21,7 @@ REACTION_POINT = ("what the parent side (link1 of a cut joint) exerts on the chi
 SHAKING_POINT = "what the moving links exert on the ground: force, and moment about the world origin, world axes"
 
 
-def _input_values(r: DynamicsResult, shown: str | None):
+def _input_values(r: DynamicsResult, shown: str | None) -> tuple:
     """(the input's values, their unit) as shown: in ``shown`` (a unit of the input's kind as a person
     typed it: deg, mm, in; units.in_unit converts), else in SI."""
     if shown:
@@ -66,7 +66,7 @@ def dynamics_dict(r: DynamicsResult) -> dict:
     }
 
 
-def _effort_header(r, name) -> str:
+def _effort_header(r, name: str) -> str:
     return f"{name} [{r.effort_units[name].replace(' ', '*')}]"
 
 

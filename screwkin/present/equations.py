@@ -23,7 +23,7 @@ def greek(text: str) -> str:
     return text.replace("**", "^")
 
 
-def _matrix_text(name, rows, indent: str="  "):
+def _matrix_text(name: str, rows, indent: str = "  "):
     """A matrix of expressions, one row a line."""
     lines = []
     for i, row in enumerate(rows):
@@ -32,7 +32,7 @@ def _matrix_text(name, rows, indent: str="  "):
     return lines
 
 
-def _numbers_text(name, M, indent: str="    "):
+def _numbers_text(name: str, M, indent: str = "    "):
     M = np.atleast_2d(np.asarray(M, float))
     lines = []
     for i, row in enumerate(M):
@@ -196,12 +196,12 @@ class Units:
         self.degrees = degrees
         self.lengths = lengths or {}  # symbol -> unit ("mm"); m when not given
 
-    def value(self, name, kind, v):
+    def value(self, name: str, kind: str, v):
         if kind == "angle":
             return unit_text(v, "deg" if self.degrees else "rad")
         return unit_text(v, self.lengths.get(name, "m"))
 
-    def step(self, name, kind, v):
+    def step(self, name: str, kind: str, v):
         if kind == "angle":
             return unit_text(v, "rad") + (f" = {unit_text(v, 'deg')}" if self.degrees else "")
         return unit_text(v, self.lengths.get(name, "m"))

@@ -22,7 +22,7 @@ def _vector_text(v) -> str:
     return "(" + ", ".join(shown_text(x) for x in v) + ")"
 
 
-def _wrench_labels(planar):
+def _wrench_labels(planar) -> list:
     return ["fx", "fy", "mz"] if planar else ["fx", "fy", "fz", "mx", "my", "mz"]
 
 
@@ -55,7 +55,7 @@ def _contact_dict(c) -> dict:
     return d
 
 
-def _certificate_dict(r: GraspResult):
+def _certificate_dict(r: GraspResult) -> dict | None:
     c = r.certificate
     if c is None:
         return None

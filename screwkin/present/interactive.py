@@ -30,6 +30,10 @@ import pinocchio as pin
 from ..errors import UsageError
 from .camera import fit_camera, view_direction
 from .viewplanar import planar_basis
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["InteractiveView", "viser_module"]
 
@@ -51,7 +55,7 @@ def _visualizer_class():
     class Visualizer(ViserVisualizer):
         """Pinocchio's ViserVisualizer, which also draws cones (screwkin's arrow heads)."""
 
-        def loadViewerGeometryObject(self, geometry_object, prefix: str="", color=None):
+        def loadViewerGeometryObject(self, geometry_object, prefix: str = "", color=None):
             geom = geometry_object.geometry
             if not isinstance(geom, coal.Cone):
                 return super().loadViewerGeometryObject(geometry_object, prefix, color)
@@ -84,11 +88,11 @@ def _moved(position, eye, dist) -> bool:
     return float(np.linalg.norm(np.asarray(position, float) - eye)) > CAMERA_MOVED * dist
 
 
-def _shown(value, unit) -> float:
+def _shown(value, unit: str) -> float:
     return value * 1000.0 if unit == "m" else math.degrees(value)
 
 
-def _si(shown, unit) -> float:
+def _si(shown, unit: str) -> float:
     return shown / 1000.0 if unit == "m" else math.radians(shown)
 
 
@@ -97,7 +101,7 @@ class InteractiveView:
     a scene (screwkin.present.view.build_scene); ``port``: default 8080.  The controls are
     ``sliders`` (input name -> slider), ``modes`` (the dropdown), ``status`` and ``readout``."""
 
-    def __init__(self, mech, live, scene, port: int | None = None, title: str = "screwkin") -> None:
+    def __init__(self, mech: Mechanism, live, scene, port: int | None = None, title: str = "screwkin") -> None:
         viser = viser_module()
         self.mech, self.live = mech, live
         if port is not None:  # viser takes the next free port when the one asked is in use: check it first
@@ -215,7 +219,7 @@ class InteractiveView:
             finally:
                 self._busy = False
 
-    def _moved(self, name, unit):
+    def _moved(self, name: str, unit: str):
         def move() -> None:
             self.live.move(name, _si(float(self.sliders[name].value), unit))
             if not self.live.state.moved:  # refused: the slider goes back to where the mechanism is

@@ -4,6 +4,10 @@ dictionaries and text lines, for mobility, singularities, statics, sweep and dra
 from __future__ import annotations
 
 from ..analysis.local import LocalAnalysis, words
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["change_point_dict", "change_point_lines", "local_dict", "local_lines", "redundancy_dict", "redundancy_lines",
            "redundant_wrenches", "singularity_kind_text", "types_lines"]
@@ -113,7 +117,7 @@ def redundancy_lines(r, title: str = "redundant constraints", explain: bool = Tr
     ``explain`` one line: how many, at which joints and why (--explain names them and the way out)."""
     if not r.count:
         return []
-    def who(j):
+    def who(j: int):
         return f"{j.what} '{j.joint}'" if j.what in ("connect", "weld", "coupling") else j.joint
 
     if not explain:
@@ -135,14 +139,14 @@ def redundancy_lines(r, title: str = "redundant constraints", explain: bool = Tr
     return lines
 
 
-def _branch_text(la, k) -> str:
+def _branch_text(la, k: int) -> str:
     if k is None:
         return "no branch found"
     b = la.branches[k]
     return f"branch {k + 1} (" + ", ".join(f"{n} {v:.4g}" for n, v in b.tangent.items() if v) + ")"
 
 
-def change_point_dict(cp, mech=None) -> dict:
+def change_point_dict(cp, mech: Mechanism | None = None) -> dict:
     """A constraint singularity met along a motion (analysis.motion.crossing.ChangePoint)."""
     d = {"input": cp.input, "sigma": cp.sigma, "local": local_dict(cp.local),
          "came_on_branch": None if cp.came is None else cp.came + 1,

@@ -13,7 +13,7 @@ __all__ = ["topology_dict", "mobility_dict", "JOINT_COLUMNS", "joint_rows", "top
            "screw_theory_rows", "mobility_text"]
 
 
-def _joint_dict(j) -> dict:
+def _joint_dict(j: int) -> dict:
     return {
         "name": j.name,
         "type": j.type,

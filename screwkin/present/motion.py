@@ -25,10 +25,10 @@ def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
     cols = []
     w, al, v, a = units.rate(False), units.acceleration(False), units.rate(True), units.acceleration(True)
 
-    def column(key, unit):
+    def column(key, unit: str):
         return column_text([in_unit(links[n][key], unit) for n in names])
 
-    def vectors(key, unit):
+    def vectors(key, unit: str) -> list:
         return [fmt_vec(in_unit(np.asarray(links[n][key], float), unit), 0) for n in names]
 
     if planar:
@@ -121,7 +121,7 @@ def strokes_dict(strokes) -> list:
 
 def strokes_text(strokes, angular: bool) -> list:
     """A line per slider: its stroke, where its ends are reached, and the time ratio."""
-    def at(x):
+    def at(x) -> str:
         return f"{np.degrees(x):.6g} deg" if angular else f"{1000 * x:.6g} mm"
 
     lines = []

@@ -35,6 +35,10 @@ import sys
 from ..errors import OutputError
 from types import TracebackType
 from typing import Optional, Type
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL", "open_partial"]
 
@@ -199,7 +203,7 @@ def write_output(path, data) -> None:
 _METADATA = ("png", "pdf", "svg", "svgz", "ps", "eps")
 
 
-def write_figure(fig, path, **savefig) -> None:
+def write_figure(fig, path, **savefig: Any) -> None:
     """A matplotlib figure into ``path``, in the format of its suffix (PNG without one), rendered in
     memory first: matplotlib itself does not report every failed write (``/dev/full`` passed).  A title
     in ``metadata`` is written where the format has room for one, left out elsewhere."""

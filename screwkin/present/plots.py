@@ -16,7 +16,7 @@ from .outfile import write_figure
 __all__ = ["sweep_plot", "motion_figure", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
 
-def pyplot(option):
+def pyplot(option: str):
     try:
         import matplotlib
 
@@ -41,7 +41,7 @@ def _nearest_turn(angle, along):
     return float(cand[np.argmin(np.abs(cand - along))])
 
 
-def _rate_scales(units):
+def _rate_scales(units) -> list:
     """The rows' units and factors (SI value x factor = value shown) of a sweep figure: angles in deg and
     lengths in mm; rates and accelerations in ``units`` (tables.RateUnits: those typed with --rate, as the
     tables show them), or deg/s and mm/s (per s^2) when None."""
@@ -51,7 +51,7 @@ def _rate_scales(units):
             (units.acceleration(False), units.acceleration(True))]
 
 
-def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths=None, absolute: bool=False,
+def sweep_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, paths=None, absolute: bool=False,
                  rate_words=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
@@ -138,7 +138,7 @@ def sweep_figure(res, mus=None, singularities=(), title=None, linear=None, paths
     return fig
 
 
-def absolute_series(res, motion, linear=None):
+def absolute_series(res, motion, linear=None) -> tuple | None:
     """The sweep's curves in absolute quantities (issue 24): for a planar mechanism each link that
     turns (its vector-loop angle, omega, alpha about the plane's normal) and each slider coordinate
     (prismatic tree or loop joint: position, rate, acceleration); ``res`` with those as its
@@ -170,7 +170,7 @@ def absolute_series(res, motion, linear=None):
                    accelerations=stack(accs)), np.array(lengths, bool)
 
 
-def motion_figure(res, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
+def motion_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, motion=None, normal=None,
                   rate_words=None, units=None):
     """The figure of a sweep (matplotlib, not yet saved; see :func:`sweep_figure` for what is drawn): for
     a planar mechanism with ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle,
@@ -188,7 +188,7 @@ def motion_figure(res, mus=None, singularities=(), title=None, linear=None, moti
                         rate_words=rate_words, units=units)
 
 
-def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, motion=None, normal=None,
+def sweep_plot(res, path, mus=None, singularities=(), title: str | None = None, linear=None, motion=None, normal=None,
                rate_words=None, units=None) -> None:
     """A sweep into a PNG: :func:`motion_figure`, saved."""
     plt = pyplot("--plot")
@@ -199,7 +199,7 @@ def sweep_plot(res, path, mus=None, singularities=(), title=None, linear=None, m
         plt.close(fig)
 
 
-def _axis_values(values, unit):
+def _axis_values(values, unit: str):
     """SI values in ``unit`` (a unit of screwkin.units as typed, any case: 'deg', 'MM'; bare: SI)."""
     return in_unit(np.asarray(values, float), unit) if unit else np.asarray(values, float)
 

@@ -10,6 +10,10 @@ from __future__ import annotations
 
 import sys
 import time
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["Progress", "EVERY"]
 
@@ -55,7 +59,7 @@ class Progress:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: Any) -> None:
         """Leaving a ``with`` block, on success or failure (an error, Ctrl-C), removes the line drawn:
         what is printed next (the result, or the one-line error) starts on a clean line."""
         self.clear()

@@ -52,7 +52,7 @@ DISPLAY = {
 }
 
 
-def _display(key):
+def _display(key) -> tuple:
     """(column name, factor from SI) of a row key."""
     name, unit = DISPLAY.get(key, (key, ""))
     return name, si_factor(unit)
@@ -77,7 +77,7 @@ def _cell(v, factor):
     return v
 
 
-def _table_rows(result):
+def _table_rows(result) -> tuple[list, list]:
     cols = table_columns(result)
     return [[_cell(r[k], f) for k, _, f in cols] for r in result.rows], [name for _, name, _ in cols]
 
@@ -200,7 +200,7 @@ def _workspace_metrics(result) -> bool:
     return any(m in WORKSPACE_METRICS for m in result.spec.metrics)
 
 
-def _cell_text(v):
+def _cell_text(v) -> str:
     if v is None:
         return "-"
     if isinstance(v, float):
@@ -251,7 +251,7 @@ def study_text(result, table_path=None) -> str:
             lo = min(vals, key=lambda t: t[1])
             hi = max(vals, key=lambda t: t[1])
 
-            def at(r):
+            def at(r) -> str:
                 return ", ".join(f"{p}={_cell_text(r[pk])}" for pk, p, _ in params)
 
             if lo[1] == hi[1]:
@@ -317,7 +317,7 @@ LABELS = {
 FAILED_COLOR = "crimson"
 
 
-def _label(key, result=None):
+def _label(key, result=None) -> tuple:
     """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
     dimension (m^2 or m^3; m^d when they differ)."""
     if key in LABELS:
@@ -331,7 +331,7 @@ def _label(key, result=None):
     return label, factor
 
 
-def _parameter_axis(result, name):
+def _parameter_axis(result, name: str) -> tuple:
     """(axis label, factor from SI) of a parameter: in the unit its values were typed in (the study
     file's ``30mm``), else as given (xacro arguments are SI, the file does not say m or rad)."""
     unit = next((getattr(p, "unit", "") for p in result.spec.parameters if p.name == name), "")

@@ -30,7 +30,7 @@ def _deg(x):
     return None if x is None or x != x else math.degrees(x)
 
 
-def _pt(p):
+def _pt(p) -> list:
     return [float(p[0]), float(p[1])]
 
 
@@ -42,7 +42,7 @@ def _target_dict(t) -> dict:
     return {"psi_deg": _deg(t.value[0])}
 
 
-def _value_dict(kind, v) -> dict | None:
+def _value_dict(kind: str, v) -> dict | None:
     if not v:
         return None
     if kind == "pose":
@@ -52,7 +52,7 @@ def _value_dict(kind, v) -> dict | None:
     return {"psi_deg": _deg(v[0])}
 
 
-def _core(kind, design, check: Check, file) -> dict:
+def _core(kind: str, design, check: Check, file) -> dict:
     fb = design.fourbar
     L = fb.lengths
     links = {"ground": {"length": L["ground"]}, "crank": {"length": L["crank"]},
@@ -101,7 +101,7 @@ def _core(kind, design, check: Check, file) -> dict:
     }
 
 
-def _candidate_dict(k, c) -> dict:
+def _candidate_dict(k: int, c) -> dict:
     fb = c.design.fourbar
     u, v, _ = tool_local(fb) if fb.tool is not None else (None, None, None)
     mu = [_deg(c.transmission[0]), _deg(c.transmission[1])] if c.transmission else None
@@ -120,7 +120,7 @@ def _search_dict(report, constraints) -> dict:
             "searched_within": report.box, "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
 
 
-def _dyad_dict(k, d) -> dict:
+def _dyad_dict(k: int, d) -> dict:
     return {"index": k, "fixed": _pt(d.fixed), "moving": _pt(d.moving), "moving_local": _pt(d.local),
             "length": d.length}
 
@@ -183,7 +183,7 @@ def _as_typed(result: FunctionResult, check: Check) -> list:
 SYNTHESIS_ZERO = 1e-15
 
 
-def _shown_number(x, digits: int=6):
+def _shown_number(x, digits: int = 6):
     """tables.shown_text with synthesis' own round-off (SYNTHESIS_ZERO)."""
     return shown_text(x, digits, SYNTHESIS_ZERO)
 

@@ -36,7 +36,7 @@ def shown_text(x, digits: int = 6, below: float = SHOWN_ZERO, missing: str = "?"
     return missing if x is None else f"{shown(x, below):.{digits}g}"
 
 
-def fmt_vec(v, width: int=11):
+def fmt_vec(v, width: int = 11) -> str:
     """Numbers with 6 significant digits; round-off below SHOWN_ZERO shows as 0."""
     return " ".join(f"{shown(x):>{width}.6g}" for x in v)
 

@@ -10,13 +10,17 @@ import numpy as np
 from ..model.geometry import plane_basis
 from ..analysis.course.skeleton import numbering
 from .draw import number_colours
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["GROUND", "planar_basis", "link_colours", "colour_links", "top_view"]
 
 GROUND = np.array([0.3, 0.3, 0.3, 1.0])  # the ground's links: darker than the passive joints' grey
 
 
-def planar_basis(mech, q):
+def planar_basis(mech: Mechanism, q: np.ndarray):
     """(e1, e2, n) of the plane of motion of a planar mechanism at q; None for a spatial or spherical one."""
     topo = mech.topology(q)
     if topo.motion_space != "planar" or topo.normal is None:
@@ -29,7 +33,7 @@ def _rgba(hex_colour) -> np.ndarray:
     return np.array([int(h[k:k + 2], 16) / 255 for k in (0, 2, 4)] + [1.0])
 
 
-def link_colours(mech, q) -> dict:
+def link_colours(mech: Mechanism, q: np.ndarray) -> dict:
     """Pinocchio joint id of each rigid body -> RGBA: the colour ``screwkin draw`` gives its link
     (links numbered from the ground along the chain, the actuated joints first); the ground (joint 0) grey."""
     topo = mech.topology(q)

@@ -22,6 +22,10 @@ import tempfile
 import threading
 
 from ..errors import UsageError
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["ViewerServer", "main"]
 
@@ -34,7 +38,7 @@ def _bridge_class():
             app = super().make_app()
             listen = app.listen
 
-            def loopback_listen(port, **kwargs):
+            def loopback_listen(port, **kwargs: Any):
                 kwargs["address"] = "127.0.0.1"
                 return listen(port, **kwargs)
 
@@ -118,7 +122,7 @@ class ViewerServer:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: Any) -> None:
         self.close()
 
 

@@ -101,7 +101,7 @@ def workspace_text(r: WorkspaceResult) -> str:
     return "\n".join(lines)
 
 
-def _value_text(x):
+def _value_text(x) -> str:
     return "-" if x is None else f"{x:.4g}"
 
 

@@ -12,7 +12,7 @@ __all__ = ["determinant", "condition", "SIMPLIFY_OPS"]
 SIMPLIFY_OPS = 80
 
 
-def determinant(loops):
+def determinant(loops) -> tuple:
     """(det A simplified, its singular conditions as strings, the same in words) of the
     vector loops ``loops`` (screwkin.analysis.course.vector_loops.VectorLoops)."""
     sp = loops.sp
@@ -47,7 +47,7 @@ def determinant(loops):
     return d, tuple(conds), tuple(words)
 
 
-def condition(loops, f, present):
+def condition(loops, f, present) -> tuple:
     """(the condition that factor f of det A vanishes, in symbols; the same in words): f a
     sine or cosine of one argument is solved for its first symbol in ``present``."""
     sp = loops.sp

@@ -18,6 +18,11 @@ from ...model.linalg import rank
 from ..screws import structure
 from ..singularities.singular import Generic, classify, scaled_jacobians
 from .vector_loops import VectorLoops
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import numpy as np
 
 __all__ = ["SpatialEquations", "equations"]
 
@@ -37,7 +42,7 @@ class SpatialEquations:
     length: float
 
 
-def _spatial(mech, q, inputs, output) -> SpatialEquations:
+def _spatial(mech: Mechanism, q: np.ndarray, inputs, output) -> SpatialEquations:
     topo = mech.topology(q)
     if not mech.cuts and not output:
         raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
@@ -60,7 +65,7 @@ def _spatial(mech, q, inputs, output) -> SpatialEquations:
                             sigma, singular, tuple(conds), float(S.L))
 
 
-def equations(mech, q, inputs=None, output=None, links=()):
+def equations(mech: Mechanism, q: np.ndarray, inputs=None, output=None, links=()):
     """The equations at the assembled configuration q: :class:`PlanarEquations` for planar
     mechanisms of revolute and prismatic joints, rolling and gear pairs (the no-slip law
     substituted: screwkin.analysis.course.rolling), :class:`SpatialEquations` for spatial and

@@ -17,6 +17,10 @@ from ..motion.change_points import change_points
 from ..motion.singular_points import locate_singularities
 from ..motion.sweep import SweepSingularity, sweep
 from .skeleton import numbering
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["SingularConfiguration", "SingularSearch", "default_output", "input_range", "singular_configurations",
            "trace_points"]
@@ -51,7 +55,7 @@ class SingularSearch:
     motion: object = None  # the SweepResult followed (joint values, rates, accelerations along the range)
 
 
-def default_output(mech, input_joint, q=None):
+def default_output(mech: Mechanism, input_joint, q: np.ndarray | None = None):
     """The link a textbook calls the output when none is given: the link of the last joint to
     the ground (in lettering order) that does not carry the input joint's link -- a four-bar's
     rocker, a slider-crank's slider; None when there is none (a serial arm: its last link)."""
@@ -69,7 +73,7 @@ def default_output(mech, input_joint, q=None):
     return None
 
 
-def input_range(mech, name, q) -> tuple:
+def input_range(mech: Mechanism, name: str, q: np.ndarray) -> tuple:
     """(start, stop) of an input's range, from its value at q: a full turn for a revolute joint
     whose limits span a turn or more (or have none), else its limits; a sliding joint's limits
     when finite and within 100 L, else 2 L either side."""
@@ -90,7 +94,7 @@ def input_range(mech, name, q) -> tuple:
     return x - 2 * L, x + 2 * L
 
 
-def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=None, steps: int = 360,
+def singular_configurations(mech: Mechanism, input_joint=None, output=None, fixed=None, q: np.ndarray | None = None, steps: int = 360,
                             near=None, rate: float = 1.0, held=None) -> SingularSearch:
     """The singular configurations along ``input_joint``'s range (:func:`input_range` from q,
     the assembled configuration by default): one assembly mode followed by
@@ -135,7 +139,7 @@ def singular_configurations(mech, input_joint=None, output=None, fixed=None, q=N
                           res.circuit_closed, res)
 
 
-def trace_points(mech, q, input_name: str, points, steps: int = 360, fixed=None):
+def trace_points(mech: Mechanism, q: np.ndarray, input_name: str, points, steps: int = 360, fixed=None) -> tuple:
     """The paths of ``points`` while ``input_name`` turns a whole turn (or, for a slider or an input
     that cannot turn, runs to its limit position) from its value at ``q``, on the assembly mode of
     ``q``: (SweepResult, MotionAlong).  The sweep is analysis.motion.sweep's, so its limits are reported."""

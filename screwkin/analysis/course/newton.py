@@ -12,6 +12,10 @@ import numpy as np
 from ...errors import UsageError
 from ...model.geometry import TINY, wrap_angle
 from .symbols import GREEK, spelled
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["NewtonStep", "NewtonResult", "textbook_newton", "start_estimates", "differing"]
 
@@ -87,7 +91,7 @@ def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = N
                         closes and iterations is None, stopped)
 
 
-def start_estimates(mech, loops, solver, q_in, values, typed):
+def start_estimates(mech: Mechanism, loops, solver, q_in: np.ndarray, values, typed) -> tuple:
     """The estimates of every unknown of the loop equations from ``--start`` items (units.parse_typed_assignments):
     symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
     returns (symbol -> estimate, symbol -> the units.Quantity typed)."""
@@ -156,7 +160,7 @@ def _as_symbol(name: str) -> str:
     return name
 
 
-def _needed_joints(loops, name):
+def _needed_joints(loops, name: str):
     """The tree joints whose values place the quantity ``name`` (the joints from the ground to the
     links it is measured on)."""
     mech = loops.mech
@@ -174,7 +178,7 @@ def _needed_joints(loops, name):
     return out
 
 
-def differing(mech, loops, a: dict, b: dict) -> list:
+def differing(mech: Mechanism, loops, a: dict, b: dict) -> list:
     """The unknowns of ``loops`` whose values in ``a`` and ``b`` (symbol -> value) differ: an angle by
     more than the geometry tolerance modulo a turn, a length by more than it times max(L, 1 m)."""
     tol = mech.tolerances.geometry * max(mech.length, 1.0)

@@ -28,7 +28,7 @@ def joint_configuration(loops, values: dict) -> np.ndarray:
     q = np.array(q0, float)
     slide_of = {j: t["x"].name for j, t in loops.slide_terms.items()}
 
-    def angle(link, vals, th):
+    def angle(link: str, vals, th):
         r = loops.rep[link]
         name = f"theta{loops.numbers[r]}"
         if r == loops.topo.ground or name not in vals:

@@ -93,7 +93,7 @@ def measure_pairs(loops, state):
     return out
 
 
-def _times(radius, angle, line):
+def _times(radius, angle, line) -> str:
     """rho*(theta - theta_ab) as a textbook writes it (the ground's angle 0: -rho*theta_ab)."""
     return f"-{radius}*{line}" if angle == 0 else f"{radius}*({angle} - {line})"
 
@@ -110,13 +110,13 @@ def pair_term(loops, rec, placeholder=None):
     na, nb = loops.numbers[a], loops.numbers[b]
     tol = loops.mech.tolerances
 
-    def theta(link):
+    def theta(link: str):
         return sp.Integer(0) if loops.rep[link] == loops.topo.ground else loops._theta(link)
 
-    def theta_q(link):
+    def theta_q(link: str) -> float:
         return 0.0 if loops.rep[link] == loops.topo.ground else float(loops.theta_q[loops.rep[link]])
 
-    def radius(link, value):
+    def radius(link: str, value):
         k = loops.numbers[link]
         return loops._new_symbol(f"rho{k}{loops._suffix(k, loops.used_rho)}", link, "length", value, "constant",
                                  f"pitch radius on link '{link}' of the pair '{rec['name']}'")
@@ -164,7 +164,7 @@ def pair_term(loops, rec, placeholder=None):
         rec["name"], rec["kind"], (a, b), law, f"{name} = {expr}", False)
 
 
-def virtual_coordinates(loops, q, values, before):
+def virtual_coordinates(loops, q: np.ndarray, values, before):
     """Set in q (in place) the coordinates of each pair's virtual joints (model.loader's
     equivalent linkage: a1 and -a2, or x and -a2) for the link angles ``values`` (symbol ->
     value; the others as ``before``, their values at loops.q), moved from their values at
@@ -193,7 +193,7 @@ def virtual_coordinates(loops, q, values, before):
     return q
 
 
-def _axis_sign(loops, name):
+def _axis_sign(loops, name: str) -> float:
     """+1 when the pair's axis (in F1) points along the plane's normal at loops.q, else -1."""
     mech = loops.mech
     f1 = mech.model.getFrameId(f"{name}@F1")
@@ -201,7 +201,7 @@ def _axis_sign(loops, name):
     return float(np.sign((loops.state.frame_placement(f1).rotation @ np.asarray(axis, float)) @ loops.n))
 
 
-def turns_through_pairs(loops, q, values):
+def turns_through_pairs(loops, q: np.ndarray, values):
     """``values`` (symbol -> value at q, each link's angle counted in turns along the tree) with
     the angle of a link turned through a rolling pair counted instead by the pair's virtual
     joints, which count turns as the no-slip law does (the tree may hold a gear's joint a whole
@@ -211,7 +211,7 @@ def turns_through_pairs(loops, q, values):
     out = dict(values)
     inputs = set(getattr(loops, "input_joints", {}) or {})
 
-    def name_of(link):
+    def name_of(link: str) -> str | None:
         r = loops.rep[link]
         return None if r == loops.topo.ground else f"theta{loops.numbers[r]}"
 
@@ -260,7 +260,7 @@ def _line_of_centres(loops, rows, hold, rec):
     return phi + flip + 2 * sp.pi * int(np.round((rec["tk_q"] - here) / (2 * np.pi)))
 
 
-def substitute_pairs(loops, number, rows, crossed, twists=()):
+def substitute_pairs(loops, number, rows, crossed, twists=()) -> tuple:
     """The loop's rows with each rolling pair's line-of-centres angle replaced: by its no-slip
     expression in the links' angles; or, where the rest of the loop fixes the line of centres
     (two gears pinned to one link, a planet on an arm: screwkin.analysis.course.rolling), by
@@ -291,7 +291,7 @@ def substitute_pairs(loops, number, rows, crossed, twists=()):
     return (out if tk is not None else rows), twists
 
 
-def unwrapped(loops, link, angle, q):
+def unwrapped(loops, link: str, angle, q: np.ndarray):
     """A link's angle at q counted in turns from the configuration the equations were built at
     (the no-slip law of a rolling pair is not periodic in one link's angle): its value there
     plus the turns of the revolute joints from the ground to it, ``angle`` (its value at q)

@@ -30,6 +30,10 @@ from ...model.cuts import pair_contact
 from ...model.geometry import TINY, line_foot, plane_basis
 from ...model.state import KinematicState
 from ..motion.planar import LinkAngles
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = [
     "ChainEdge",
@@ -206,7 +210,7 @@ def numbering(topo, inputs=()) -> tuple:
     own = {j.name for j in joints if re.fullmatch(rf"[A-Z][A-Za-z0-9]{{0,{SHORT_NAME - 1}}}", j.name)}
     taken, next_letter = set(own), [0]
 
-    def mark(j) -> None:
+    def mark(j: int) -> None:
         if j.name not in letter:
             if j.name in own:
                 letter[j.name] = j.name
@@ -217,7 +221,7 @@ def numbering(topo, inputs=()) -> tuple:
                 taken.add(letter[j.name])
             lettered.append(j)
 
-    def visit(link) -> None:
+    def visit(link: str) -> None:
         for j in joints:
             if link not in j.links:
                 continue
@@ -237,11 +241,11 @@ def numbering(topo, inputs=()) -> tuple:
     return number, letter, tuple(lettered)
 
 
-def _frame_point(state, name):
+def _frame_point(state, name: str):
     return state.frame_placement(state.mech.model.getFrameId(name))
 
 
-def _joint_ends(state, j):
+def _joint_ends(state, j: int) -> tuple:
     """(point on links[0], point on links[1], axis or None) of a topology joint, in the world, at
     the configuration of ``state`` (a model.state.KinematicState)."""
     model = state.mech.model
@@ -289,7 +293,7 @@ def _distinct(points, tol):
     return out
 
 
-def _basis(mech, topo, centres):
+def _basis(mech: Mechanism, topo, centres) -> tuple:
     if topo.motion_space == "planar" and topo.normal is not None:
         return plane_basis(topo.normal), True
     P = np.array(centres) if centres else np.zeros((1, 3))
@@ -306,7 +310,7 @@ def _basis(mech, topo, centres):
     return (e1, e2, n), False
 
 
-def skeleton(mech, q, inputs=None, basis=None) -> Skeleton:
+def skeleton(mech: Mechanism, q: np.ndarray, inputs=None, basis=None) -> Skeleton:
     """The :class:`Skeleton` of ``mech`` at configuration ``q``; ``inputs``: the input joints
     (default: the actuated ones), marked and listed with their values; ``basis``: the drawing
     plane (e1, e2, n) of another skeleton (the frames of an animation: a spatial mechanism's
@@ -322,7 +326,7 @@ def skeleton(mech, q, inputs=None, basis=None) -> Skeleton:
     if basis is not None:
         e1, e2, n = (np.asarray(v, float) for v in basis)
 
-    def p2(v):
+    def p2(v) -> tuple[float, float]:
         return (float(np.asarray(v) @ e1), float(np.asarray(v) @ e2))
 
     values = mech.joint_values(q)
@@ -401,7 +405,7 @@ def _area(hull):
     return 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))
 
 
-def _extremes(pts):
+def _extremes(pts: np.ndarray) -> tuple[tuple, tuple]:
     P = np.array(pts)
     c = P.mean(axis=0)
     _, _, vt = np.linalg.svd(P - c)
@@ -409,7 +413,7 @@ def _extremes(pts):
     return (tuple(P[int(np.argmin(s))]), tuple(P[int(np.argmax(s))]))
 
 
-def _stub(state, name, pts, p2, tol):
+def _stub(state, name: str, pts: np.ndarray, p2, tol) -> tuple[str, tuple]:
     """A link with one joint centre: drawn to its frame's origin, else its centre of mass,
     else a short stub along its frame's x axis."""
     mech = state.mech
@@ -468,7 +472,7 @@ def _contact_point(a, b):
     return ca + a.radius * u  # on circle 1 towards circle 2's centre (outside, or inside it: internal)
 
 
-def kinematic_chain(mech, q=None, inputs=None) -> KinematicChain:
+def kinematic_chain(mech: Mechanism, q: np.ndarray | None = None, inputs=None) -> KinematicChain:
     """The kinematic chain of ``mech`` (numbered as :func:`skeleton` numbers it)."""
     inputs = list(inputs) if inputs else list(mech.actuated)
     topo = mech.topology(q)

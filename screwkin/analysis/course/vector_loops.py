@@ -56,6 +56,10 @@ from .rolling import (HIGHER, drop_constant_rows, measure_pairs, pair_term, subs
 from ..motion.planar import LinkAngles
 from .skeleton import numbering
 from .symbols import LoopEquation, PlanarEquations, Symbol, Vector
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["VectorLoops"]
 
@@ -81,7 +85,7 @@ class VectorLoops:
     joints.  Holds the sympy expressions and their numerical forms; ``result()`` gives the
     plain :class:`PlanarEquations`."""
 
-    def __init__(self, mech, q, inputs=None, links=()) -> None:
+    def __init__(self, mech: Mechanism, q: np.ndarray, inputs=None, links=()) -> None:
         """Every command that writes these equations (equations, solve --start, singularities
         --symbolic, report) builds them here: rolling and gear pairs included.  ``links``: links
         whose absolute angle is an input too (--set-angle of a floating link): their theta is known."""
@@ -139,7 +143,7 @@ class VectorLoops:
         """The constant symbols made so far -> their values (the loops are still being built)."""
         return {self.sym[n]: s.value for n, s in self.symbol_info.items() if s.role == "constant"}
 
-    def _p2(self, v):
+    def _p2(self, v) -> np.ndarray:
         v = np.asarray(v, float)
         return np.array([v @ self.e1, v @ self.e2])
 
@@ -178,13 +182,13 @@ class VectorLoops:
         self.local = {}  # (joint, link) -> (frame id, local 3D point)
         self.slides = {}  # prismatic joint name -> dict
 
-        def first_revolute(link, skip):
+        def first_revolute(link: str, skip):
             for j in topo.joints:
                 if j is not skip and link in j.links and j.type in ("revolute", "continuous"):
                     return j
             return None
 
-        def keep(key, link, point) -> None:
+        def keep(key, link: str, point) -> None:
             fid = self.frames[link]
             self.anchor[key] = self._p2(point)
             self.local[key] = (fid, state.frame_placement(fid).actInv(np.asarray(point, float)))
@@ -219,13 +223,13 @@ class VectorLoops:
         self.pair_geometry = measure_pairs(self, state)  # rolling and gear pairs: their centres, radii
 
     # ------------------------------------------------------------------ symbols
-    def _new_symbol(self, name, link, kind, value, role, meaning):
+    def _new_symbol(self, name: str, link: str, kind: str, value, role: str, meaning):
         sym = self.sp.Symbol(name, real=True)
         self.symbol_info[name] = Symbol(name, link, kind, float(value), role, meaning)
         self.sym[name] = sym
         return sym
 
-    def _theta(self, link):
+    def _theta(self, link: str):
         """The angle symbol of a moving class (created on first use)."""
         r = self.rep[link]
         name = f"theta{self.numbers[r]}"
@@ -238,18 +242,18 @@ class VectorLoops:
             self.variables.append(name)
         return self.sym[name]
 
-    def _suffix(self, k, used):
+    def _suffix(self, k: int, used):
         n = used.get(k, 0)
         used[k] = n + 1
         return "" if n == 0 else _SUFFIX[n]
 
-    def _constant_angle(self, name, link, value, meaning):
+    def _constant_angle(self, name: str, link: str, value, meaning):
         exact = _exact_angle(self.sp, value, self.mech.tolerances.closure)
         if exact is not None:
             return exact
         return self._new_symbol(name, link, "angle", value, "constant", meaning)
 
-    def _vector(self, link, ka, kb):
+    def _vector(self, link: str, ka, kb) -> tuple | None:
         """(vector record, sign) for the vector on ``link`` from anchor ka to anchor kb, or None
         when the two centres coincide."""
         sp = self.sp
@@ -332,7 +336,7 @@ class VectorLoops:
         self.slide_terms[joint] = term
         return term
 
-    def ground_guide(self, x_name: str):
+    def ground_guide(self, x_name: str) -> tuple | None:
         """(beta, e) of the slider coordinate ``x_name`` when its guide is on the ground: the
         guide's constant angle from the ground's x axis [rad] and the offset of the slider's
         centre from the guide line [m] (the slider's centre is at from + x u + e n); None for a
@@ -495,7 +499,7 @@ class VectorLoops:
         self._c = sp.lambdify([z, w, zd, wd], self.cm.subs(self.constants), "numpy")
 
     # ------------------------------------------------------------------ numbers
-    def values(self, q) -> dict:
+    def values(self, q: np.ndarray) -> dict:
         """The variable symbols (angles, slider coordinates) at configuration q, by forward
         kinematics of the anchors (the loops need not close at q)."""
         mech = self.mech
@@ -520,7 +524,7 @@ class VectorLoops:
             out[t["x"].name] = float(self._p2(B - A) @ (u / np.linalg.norm(u)))
         return out
 
-    def _vectors(self, values):
+    def _vectors(self, values) -> tuple:
         z = np.array([values[n] for n in self.unknowns], float)
         w = np.array([values[n] for n in self.input_syms], float)
         return z, w
@@ -528,7 +532,7 @@ class VectorLoops:
     def residual(self, values) -> np.ndarray:
         return np.asarray(self._F(*self._vectors(values)), float).reshape(-1)
 
-    def matrices(self, values):
+    def matrices(self, values) -> tuple:
         """A and B evaluated at ``values`` (symbol name -> value)."""
         z, w = self._vectors(values)
         A = np.asarray(self._A(z, w), float).reshape(len(self.F), len(self.unknowns))

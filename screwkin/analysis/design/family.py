@@ -79,7 +79,7 @@ def eligible(task) -> str | None:
     return None
 
 
-def chunk_rows(task, chunk) -> ChunkRows:
+def chunk_rows(task, chunk: int) -> ChunkRows:
     """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes.  A family
     whose structure does not change with its parameters takes the family path (family_rows); other
     studies, and the designs the family path cannot vouch for, are evaluated one by one
@@ -92,7 +92,7 @@ def chunk_rows(task, chunk) -> ChunkRows:
     return ChunkRows(run_chunk(task, chunk), {"design": len(chunk)})
 
 
-def _rpy_matrices(rpy):
+def _rpy_matrices(rpy) -> np.ndarray:
     """Rotation matrices (n, 3, 3) of URDF rpy angles (n, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy[:, 0], rpy[:, 1], rpy[:, 2]
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
@@ -181,10 +181,10 @@ class _Fourbar:
         inp = joints[info.input_joint]
         ground = topo.ground
 
-        def other(link, joint):
+        def other(link: str, joint):
             return next(j for j in topo.joints if j is not joint and link in j.links)
 
-        def far(joint, link):
+        def far(joint, link: str):
             return joint.links[1] if joint.links[0] == link else joint.links[0]
 
         moving = far(inp, ground)
@@ -210,7 +210,7 @@ class _Fourbar:
             self.frames[c.frame2] = (c.name, 1)
         self.lengths = info.lengths
 
-    def point(self, placed, joint, link):
+    def point(self, placed, joint, link: str):
         """The joint's centre (a loop joint: its frame on ``link``) at every design: (n, 3)."""
         if joint in self.cut_names:
             c = self.cut_names[joint]
@@ -228,11 +228,11 @@ class _Fourbar:
         return placed.joints[self.names[ident]][1]
 
 
-def _flat(P, n):
+def _flat(P, n: int):
     return P - np.einsum("ni,ni->n", P, n)[:, None] * n
 
 
-def family_rows(task, chunk):
+def family_rows(task, chunk: int):
     """The rows of ``chunk`` ([(index, values), ...]) by the family path (module docstring), a
     ChunkRows; None when the study is not one it applies to (its metrics, a plain file)."""
     if eligible(task) is not None:
@@ -248,7 +248,7 @@ def family_rows(task, chunk):
                                                         f"{exc}"])
 
 
-def _family(task, chunk, index, values, alone):
+def _family(task, chunk: int, index: int, values, alone) -> ChunkRows:
     n = len(chunk)
     be = expand_batch(task.file, task.text, task.args, {p: values[:, k] for k, p in enumerate(task.parameters)})
     specs = [None] * n
@@ -377,7 +377,7 @@ def _family(task, chunk, index, values, alone):
     return ChunkRows(out, {"family": len(made), "design": n - len(made)}, notes)
 
 
-def _row_of(task, i, values, columns, reference, code, margin, lo, hi, turns, dead, short):
+def _row_of(task, i: int, values, columns, reference, code, margin, lo, hi, turns, dead, short):
     """The family path's row of one design from its closed-form numbers (the reference's recomputed)."""
     row = {"design": i, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(columns))

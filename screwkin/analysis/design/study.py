@@ -39,6 +39,10 @@ from ..motion.planar import identify
 from ..motion.modes import choose_mode
 from ..motion.position import PositionSolver
 from .workspace import DEFAULT_THRESHOLD, workspace
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = [
     "COLUMNS",
@@ -178,7 +182,7 @@ class _Task:
 class _Design:
     """One loaded design and what its metrics share (assembly, linkage, workspace)."""
 
-    def __init__(self, task: _Task, mech, clock: _Clock) -> None:
+    def __init__(self, task: _Task, mech: Mechanism, clock: _Clock) -> None:
         self.task, self.mech, self.clock = task, mech, clock
         self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
         clock.check()
@@ -348,7 +352,7 @@ def evaluate_design(task: _Task, index: int, values: tuple, keep=None) -> dict:
     return row
 
 
-def run_chunk(task: _Task, chunk) -> list:
+def run_chunk(task: _Task, chunk: int) -> list:
     """The rows of a chunk of designs [(index, values), ...], each design evaluated alone (what a Dask
     task computes when the family path does not apply: screwkin.analysis.design.family.chunk_rows)."""
     with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -522,7 +526,7 @@ def apply_requirements(spec: StudySpec, rows) -> tuple:
     return tuple(out), REQUIREMENTS_COLUMN, unmet
 
 
-def failed_row(task, index, values, reason) -> dict:
+def failed_row(task, index: int, values, reason) -> dict:
     row = {"design": index, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(metric_columns(task.metrics)))
     row["error"] = reason

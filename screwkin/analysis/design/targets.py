@@ -18,6 +18,10 @@ from ..course.figures import trace_points
 from ..motion.links import Point, motion_along
 from ..motion.position import PositionSolver
 from ..motion.sweep import sweep
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["TargetReached", "DesignTargets", "design_targets", "polished", "POLISH_CLOSURE"]
 
@@ -27,7 +31,7 @@ TWO_PI = 2 * math.pi
 POLISH_CLOSURE = 1e-13
 
 
-def polished(mech, solver, q):
+def polished(mech: Mechanism, solver, q: np.ndarray) -> tuple:
     """(q, residual): ``q`` closed by damped Newton to a residual below POLISH_CLOSURE with the
     solver's inputs held (unchanged, residual None, when that does not converge)."""
     tight = replace(mech.tolerances, closure=POLISH_CLOSURE, max_iterations=60)
@@ -69,19 +73,19 @@ class DesignTargets:
     stops: tuple = ()  # ((input value, reason) or (None, None)) where the motion stopped: back, then forward
 
 
-def _frame(mech, fid, q):
+def _frame(mech: Mechanism, fid, q: np.ndarray) -> tuple[tuple, float]:
     M = KinematicState(mech, q).frame_placement(fid)
     return tuple(float(v) for v in M.translation), float(math.atan2(M.rotation[1, 0], M.rotation[0, 0]))
 
 
-def _error(spec, position, yaw):
+def _error(spec, position, yaw) -> tuple:
     if spec.kind == "angle":
         return abs(wrap_angle(yaw - spec.yaw)), 0.0
     err = math.dist(position, spec.xyz)
     return err, (abs(wrap_angle(yaw - spec.yaw)) if spec.kind == "pose" else 0.0)
 
 
-def design_targets(mech, q, steps: int = 360) -> DesignTargets:
+def design_targets(mech: Mechanism, q: np.ndarray, steps: int = 360) -> DesignTargets:
     """The targets of ``mech``'s file (mech.spec.targets) reached by its linkage: at each one's
     input value every assembly mode is solved (PositionSolver.solve) and the one nearest the
     target kept, as ``screwkin synthesize`` checks it; with point targets, the curve of their

@@ -52,6 +52,10 @@ from .grasp_map import (
     generators,
     grasp_map,
 )
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["GraspTolerances", "GRASP_TOLERANCES", "ContactForce", "Certificate", "GraspQuality", "GraspResult",
            "analyze_grasp"]
@@ -173,7 +177,7 @@ class GraspResult:
     notes: tuple = ()
 
 
-def _linprog(c, tol, **kw):
+def _linprog(c, tol, **kw: Any):
     """scipy's HiGHS; the solution x, or None when infeasible or when the solver gives up."""
     from scipy.optimize import linprog
 
@@ -182,12 +186,12 @@ def _linprog(c, tol, **kw):
     return res.x if res.status == 0 and res.x is not None else None
 
 
-def _relative_rank(A, rtol):
+def _relative_rank(A, rtol) -> int:
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
     return int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
 
-def _positive_null_vector(W, tol):
+def _positive_null_vector(W, tol) -> tuple:
     """lambda > 0 (summing to 1) with W lambda = 0, maximizing its smallest entry t, and k t
     (1 when all are equal); (None, margin) when there is none: LP  max t  s.t.
     W (mu + t 1) = 0, 1.mu + k t = 1, mu >= 0, t >= 0; then projected exactly onto null(W)."""
@@ -214,7 +218,7 @@ def _positive_null_vector(W, tol):
     return (lam, margin) if margin > tol.margin else (None, margin)
 
 
-def _separator(W, tol):
+def _separator(W, tol) -> tuple:
     """(u, both): a unit u with u . w >= 0 for every column w of W (up to the LP's tolerance),
     or (None, False) when there is none (the columns positively span).  both: u is orthogonal
     to every column (W lacks rank): -u is one too."""
@@ -237,7 +241,7 @@ def _separator(W, tol):
 
 
 # ------------------------------------------------------------------ exact cone checks
-def _contact_forces(spec, G, blocks, f):
+def _contact_forces(spec, G, blocks, f) -> tuple:
     out = []
     for k, (c, b) in enumerate(zip(spec.contacts, blocks), 1):
         fi = f[b]
@@ -275,7 +279,7 @@ def _force_margin(spec, forces, tol):
     return worst
 
 
-def _dual_margin(spec, Gs, blocks, u):
+def _dual_margin(spec, Gs: np.ndarray, blocks, u):
     """min over contacts of the smallest u . (G_s f) over the circular cone's section f_n = 1:
     u_n - mu |u_t| - mu_torsion |u_torsion| (>= 0: u separates the cone)."""
     worst = math.inf
@@ -294,7 +298,7 @@ def _dual_margin(spec, Gs, blocks, u):
 
 
 # ------------------------------------------------------------------ closure
-def _internal_certificate(spec, G, Gs, blocks, W, parts, lam, cones, tol):
+def _internal_certificate(spec, G, Gs: np.ndarray, blocks, W, parts, lam, cones, tol) -> Certificate:
     f = np.zeros(G.shape[1])
     for (sl, C), b in zip(parts, blocks):
         f[b] = C @ lam[sl]
@@ -309,7 +313,7 @@ def _internal_certificate(spec, G, Gs, blocks, W, parts, lam, cones, tol):
                        residual=float(np.linalg.norm(G @ f)), margin=margin, cones=cones)
 
 
-def _wrench_certificate(spec, Gs, blocks, u, both, L, cones):
+def _wrench_certificate(spec, Gs: np.ndarray, blocks, u, both, L, cones) -> Certificate:
     p = Gs.shape[0]
     w = u.copy()  # the scaled wrench (f, m / L) = u as (f, m)
     w[3 if p == 6 else 2:] *= L
@@ -317,7 +321,7 @@ def _wrench_certificate(spec, Gs, blocks, u, both, L, cones):
                        margin=_dual_margin(spec, Gs, blocks, u), cones=cones)
 
 
-def _closure(spec, G, Gs, blocks, W, parts, cones, tol, L):
+def _closure(spec, G, Gs: np.ndarray, blocks, W, parts, cones, tol, L) -> tuple:
     """(closed, certificate) for one set of polyhedral cones (exact or a pyramid)."""
     p = W.shape[0]
     if _relative_rank(W, tol.rank_rtol) == p:
@@ -330,7 +334,7 @@ def _closure(spec, G, Gs, blocks, W, parts, cones, tol, L):
     return False, _wrench_certificate(spec, Gs, blocks, u, both, L, cones)
 
 
-def _decide_closure(spec, G, Gs, blocks, facets, tol, L):
+def _decide_closure(spec, G, Gs: np.ndarray, blocks, facets, tol, L) -> tuple:
     """(force_closure, certificate, how, facets used, notes)."""
     notes = []
     if all(exact_cones(c, spec.planar) for c in spec.contacts):
@@ -367,7 +371,7 @@ def _decide_closure(spec, G, Gs, blocks, facets, tol, L):
 
 
 # ------------------------------------------------------------------ quality
-def _qhull(X):
+def _qhull(X: np.ndarray):
     """Qhull's hull of the points X (rows); joggled ("QJ") when the exact hull fails on nearly
     coplanar points (fine pyramids): its facets then move by about 1e-11 (relative)."""
     from scipy.spatial import ConvexHull, QhullError
@@ -378,7 +382,7 @@ def _qhull(X):
         return ConvexHull(X, qhull_options="QJ")
 
 
-def _epsilon(W, tol):
+def _epsilon(W, tol) -> tuple:
     """(lower, upper, reason): bounds on the distance epsilon from the origin to the boundary of
     the hull of W's columns (0 when the origin is not strictly inside); equal unless the work
     bound stopped the search (reason says so).
@@ -442,7 +446,7 @@ def _epsilon(W, tol):
         S += added
 
 
-def _quality(spec, Gs, blocks, facets, exact, closed, tol, L):
+def _quality(spec, Gs: np.ndarray, blocks, facets, exact, closed, tol, L) -> GraspQuality:
     W_in, _ = generator_matrix(spec, Gs, blocks, facets)
     eps, upper, reason = _epsilon(W_in, tol)
     if not exact:
@@ -482,7 +486,7 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
                        0.0 if exact else cone_error(n), exact, quality, L, source, tol.margin, tuple(notes))
 
 
-def _closure_form(Wf, tol):
+def _closure_form(Wf, tol) -> tuple:
     """Form closure: the normals' wrenches positively span wrench space (an exact test)."""
     if _relative_rank(Wf, tol.rank_rtol) < Wf.shape[0]:
         return False, None

@@ -31,7 +31,7 @@ def contact_frame(normal) -> np.ndarray:
     return np.column_stack([t1, np.cross(n, t1), n])
 
 
-def _hat(p):
+def _hat(p) -> np.ndarray:
     x, y, z = p
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
@@ -47,7 +47,7 @@ def contact_columns(c, planar):
     if planar:
         t = np.array([-n[1], n[0]])
 
-        def col(d):
+        def col(d) -> np.ndarray:
             return np.array([d[0], d[1], p[0] * d[1] - p[1] * d[0]])
 
         if c.model == "frictionless":
@@ -62,7 +62,7 @@ def contact_columns(c, planar):
     return Ad[:, idx], labels
 
 
-def grasp_map(spec: GraspSpec):
+def grasp_map(spec: GraspSpec) -> tuple[np.ndarray, tuple, tuple]:
     """(G, labels, blocks): the grasp map (wrenches (f, m) about the object frame's origin;
     planar: (fx, fy, mz)), its column labels "contact:coordinate" and each contact's column
     slice."""
@@ -76,7 +76,7 @@ def grasp_map(spec: GraspSpec):
     return np.hstack(cols), tuple(labels), tuple(blocks)
 
 
-def grasp_characteristic_length(spec: GraspSpec):
+def grasp_characteristic_length(spec: GraspSpec) -> tuple:
     """(L, source): the mean distance of the contact points from their centroid [m], or 1 m
     when they all coincide."""
     P = np.array([c.point for c in spec.contacts], float)
@@ -133,7 +133,7 @@ def generators(c, planar, facets: int = 8, circumscribed: bool = False) -> np.nd
     return C
 
 
-def generator_matrix(spec, Gs, blocks, facets, circumscribed: bool=False, frictionless: bool=False):
+def generator_matrix(spec, Gs: np.ndarray, blocks, facets, circumscribed: bool=False, frictionless: bool=False) -> tuple:
     """W = G_s C (scaled primitive wrenches, columns) and, per contact, its columns' slice and C_i."""
     cols, parts, start = [], [], 0
     for c, b in zip(spec.contacts, blocks):

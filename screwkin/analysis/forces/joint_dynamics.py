@@ -20,6 +20,10 @@ import numpy as np
 
 from ...errors import quote
 from ...model.geometry import wrap_angle
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["JointDynamics", "joint_dynamics", "left_out_note", "names_text"]
 
@@ -30,7 +34,7 @@ class JointDynamics(dict):
     mimic joint's: its leader's).  Arrays over the model's velocity coordinates: ``armature``,
     ``damping``, ``frictionloss``; ``springs`` and ``coupled`` (the mimic joints') by name."""
 
-    def __init__(self, mech, joints, coupled) -> None:
+    def __init__(self, mech: Mechanism, joints, coupled) -> None:
         super().__init__()
         nv = mech.model.nv
         self.armature, self.damping, self.frictionloss = np.zeros(nv), np.zeros(nv), np.zeros(nv)
@@ -56,7 +60,7 @@ class JointDynamics(dict):
     def _terms(self, arm, damp, fl, v, a):
         return arm * a + damp * v + fl * np.where(np.abs(v) > self._zero, np.sign(v), 0.0)
 
-    def coupled_forces(self, q, v, a) -> dict:
+    def coupled_forces(self, q: np.ndarray, v, a) -> dict:
         """Each mimic joint's own force at (q, v, a) (its rate and acceleration: multiplier x its leader's),
         its spring's with it."""
         stretch = self.spring_stretch(q) if any(n in self.springs for n in self.coupled) else {}
@@ -64,14 +68,14 @@ class JointDynamics(dict):
                             + j.stiffness * stretch.get(name, 0.0))
                 for name, (m, iv, j) in self.coupled.items()}
 
-    def spring_stretch(self, q) -> dict:
+    def spring_stretch(self, q: np.ndarray) -> dict:
         """Each spring's stretch x - springref [rad or m] at q; a hinge's within half a turn of springref
         (its angle is known modulo a turn: a spring wound further than half a turn is not represented)."""
         values = self._values(q)
         return {n: (wrap_angle(values[n] - ref) if self._angular(n) else values[n] - ref)
                 for n, (_, _, ref) in self.springs.items()}
 
-    def forces(self, q, v, a) -> tuple:
+    def forces(self, q: np.ndarray, v, a) -> tuple:
         """(the generalized force that drives them at (q, v, a), each mimic joint's own force): armature a +
         damping v + frictionloss sign(v) + stiffness (x - springref), sign(v) 0 where the joint stands
         still (|v| within the tolerance ``equal``); a mimic joint's, times its multiplier, on its leader's
@@ -93,7 +97,7 @@ class JointDynamics(dict):
               for n, idx in self.items()}
         return {n for n, idx in self.items() if fl[n] > 0 and np.any(np.abs(v[idx]) <= self._zero)}
 
-    def potential(self, q) -> float:
+    def potential(self, q: np.ndarray) -> float:
         """The springs' energy 1/2 sum stiffness (x - springref)^2 [J]."""
         return 0.5 * sum(self.springs[n][1] * x * x for n, x in self.spring_stretch(q).items())
 
@@ -103,7 +107,7 @@ class JointDynamics(dict):
                       + sum(j.armature * (m * v[iv]) ** 2 for m, iv, j in self.coupled.values()))
 
 
-def joint_dynamics(mech) -> tuple:
+def joint_dynamics(mech: Mechanism) -> tuple:
     """(JointDynamics of the tree and mimic joints with armature, damping or friction loss; names of
     those it cannot hold: loop joints, which have no coordinate of their own in the tree)."""
     given = [j for j in mech.spec.joints if j.dynamics]

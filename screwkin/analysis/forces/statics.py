@@ -40,6 +40,10 @@ from ...model.state import KinematicState, frame_parent
 from ..screws import Screw, cut_twists, screw_of
 from ..singularities.singular import Generic, measures
 from .joint_dynamics import joint_dynamics, left_out_note, names_text
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
            "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts", "compound_joints",
@@ -89,7 +93,7 @@ def _load_norm(w, L) -> float:
     return float(np.linalg.norm(np.r_[np.asarray(w[:3]) * L, w[3:]]))
 
 
-def balance(mech, K, a_idx, b) -> tuple:
+def balance(mech: Mechanism, K: np.ndarray, a_idx, b) -> tuple:
     """The balance of generalized forces E tau + K^T lambda = b (E: the columns of the actuated
     velocity indices ``a_idx``; K: the closure Jacobian, rows as ClosureSystem writes them; b:
     the generalized force the tree needs [N, N m]), solved in the least-squares, minimum-norm
@@ -112,7 +116,7 @@ def balance(mech, K, a_idx, b) -> tuple:
     return x[:m], x[m:], N, unbalanced, scale
 
 
-def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = False) -> StaticsResult:
+def statics(mech: Mechanism, q: np.ndarray, inputs=None, output=None, wrench=None, gravity: bool = False) -> StaticsResult:
     """Actuator efforts and joint reactions holding ``wrench`` (force, moment) [N, N m] applied to
     ``output`` at its frame's origin (world axes) and, with ``gravity``, the links' weights,
     at the assembled configuration q.  See the module docstring."""
@@ -173,7 +177,7 @@ def statics(mech, q, inputs=None, output=None, wrench=None, gravity: bool = Fals
                          mech.transmissions(inputs), springs, tuple(notes))
 
 
-def _reactions(mech, q, lam, w, output, gravity, N_lam):
+def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity, N_lam) -> tuple:
     """Reactions of every joint for constraint forces lam (and the load), and whether each is
     determined: it must not change along the null directions N_lam of the constraint forces."""
     loads = [(mech.link_frame(output), np.asarray(w, float))] if w is not None else []
@@ -184,7 +188,7 @@ def _reactions(mech, q, lam, w, output, gravity, N_lam):
     return tuple(out)
 
 
-def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
+def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
     """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
     constraint forces lam, and the mask of its components that change along the null
     directions N_lam of the constraint forces (not determined by the balance)."""
@@ -200,7 +204,7 @@ def reaction_table(mech, q, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech, q, lam, loads=(), gravity: bool=False, v=None, a=None, rows=None) -> dict:
+def joint_wrenches(mech: Mechanism, q: np.ndarray, lam, loads=(), gravity: bool=False, v=None, a=None, rows=None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
@@ -267,7 +271,7 @@ def joint_wrenches(mech, q, lam, loads=(), gravity: bool=False, v=None, a=None, 
     return out
 
 
-def coupled_efforts(mech, q, reactions: dict) -> dict:
+def coupled_efforts(mech: Mechanism, q: np.ndarray, reactions: dict) -> dict:
     """Coupled joint -> the effort [N m or N] its coupling exerts along it: the component along the
     joint's axis (world axes at q) of its reaction, moment for a revolute, force for a prismatic
     joint.  ``reactions``: joint -> wrench (force, moment) at the joint's origin, world axes."""
@@ -285,13 +289,13 @@ def coupled_efforts(mech, q, reactions: dict) -> dict:
     return out
 
 
-def coupled_units(mech) -> dict:
+def coupled_units(mech: Mechanism) -> dict:
     """Coupled joint -> the unit of its effort: "N" for a prismatic joint, "N m" for a revolute one."""
     kinds = {j.name: j.type for j in mech.spec.joints}
     return {cp.joint: "N" if kinds.get(cp.joint) == "prismatic" else "N m" for cp in mech.couplings}
 
 
-def actuator_efforts(mech, inputs, efforts: dict) -> dict:
+def actuator_efforts(mech: Mechanism, inputs, efforts: dict) -> dict:
     """Actuator name -> its effort: the input joint's generalized force / (scale * gear) of each input
     the file drives through a tendon, a coupled joint or a gear (files.description.Transmission); None
     where the joint's effort is undetermined."""
@@ -302,7 +306,7 @@ def actuator_efforts(mech, inputs, efforts: dict) -> dict:
     return out
 
 
-def compound_joints(mech) -> dict:
+def compound_joints(mech: Mechanism) -> dict:
     """Compound joint name as mobility names it (``rod1a_top[S]``: model.topology) -> its tree members, the one
     next to the parent link first (the joint whose origin its reaction is given at); cached on the mechanism.
     Compounds through a cut joint are left out (their members are reported as they are)."""
@@ -316,7 +320,7 @@ def compound_joints(mech) -> dict:
     return mech.cache["compound_joints"]
 
 
-def reaction_joint_id(mech, name: str) -> int:
+def reaction_joint_id(mech: Mechanism, name: str) -> int:
     """The tree joint at whose origin a tree reaction row (a joint, or a compound joint) is given."""
     members = compound_joints(mech).get(name)
     return mech.coordinate(members[0] if members else name).joint_id
@@ -362,7 +366,7 @@ def wrench_screw(wrench, point) -> Screw:
     return screw_of(np.r_[m0, f])
 
 
-def legs(mech, q, output, inputs=None) -> tuple:
+def legs(mech: Mechanism, q: np.ndarray, output, inputs=None) -> tuple:
     """The legs between the ground and the ``output`` link (see Leg), at the assembled q.
 
     A leg is the set of tree joints on the branches that reach the platform -- the platform's
@@ -379,7 +383,7 @@ def legs(mech, q, output, inputs=None) -> tuple:
     o = state.frame_placement(fid).translation
     coords = {c.joint_id: c for c in mech.coordinates}
 
-    def support(joint):
+    def support(joint) -> list:
         return [j for j in model.supports[joint] if j in coords]
 
     def at_platform(frame):  # frame Jacobian as the twist of the frame's body at the platform origin
@@ -444,7 +448,7 @@ def legs(mech, q, output, inputs=None) -> tuple:
     return tuple(out)
 
 
-def _cut_twists(mech, cut, o, state) -> np.ndarray:
+def _cut_twists(mech: Mechanism, cut, o, state) -> np.ndarray:
     """The relative twists a cut joint allows (analysis.screws.cut_twists), moved to the platform
     origin o, world axes (6 x k); none for a higher pair (its equivalent linkage's joints belong
     to the leg)."""

@@ -26,13 +26,17 @@ import numpy as np
 from .batch_closure import BatchClosure, Unbatchable
 from ...model.geometry import TINY
 from .continuation import Curve, Motion, jumped, passes_limit
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["batch_closure", "BatchedCurve", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
 
 SMALLEST, LARGEST = 4, 256  # grid values a chunk: it starts at 16 and doubles while it goes well
 
 
-def batch_closure(mech):
+def batch_closure(mech: Mechanism):
     """The mechanism's BatchClosure (cached), or None when it cannot be batched."""
     key = "dyads.batch"  # (the one dyads.py checks its residuals with)
     if key not in mech.cache:
@@ -46,27 +50,27 @@ def batch_closure(mech):
 class BatchedCurve(Curve):
     """The Curve's engine on stacks of configurations (one per row), its closure batched."""
 
-    def __init__(self, solver, name, bc) -> None:
+    def __init__(self, solver, name: str, bc) -> None:
         super().__init__(solver, name)
         self.bc = bc
 
-    def tangents(self, Q, previous):
+    def tangents(self, Q: np.ndarray, previous):
         """Unit tangents at the configurations Q, each oriented like the row before it, the first
         like ``previous`` (``choose_branch``); a zero row where the input cannot move."""
         U = self.input_directions(self.bc.constraint_jacobians(Q))
         n = np.linalg.norm(U, axis=1)
         return self.choose_branch(U / np.where(n > TINY, n, 1.0)[:, None], previous)
 
-    def predict(self, q, t, sigma):
+    def predict(self, q: np.ndarray, t, sigma: float):
         return q[None] + (self.scale * t)[None] * sigma[:, None]  # (nq == nv: integrate is a sum)
 
-    def correct(self, predicted, held):
+    def correct(self, predicted, held) -> tuple:
         Qc, ok, _, _ = self.bc.solve(predicted, frozen=self.frozen(held))
         ok &= np.all(np.isfinite(Qc), axis=1)
         Qc[~ok] = predicted[~ok]  # (refused by accept; finite for the tangents)
         return Qc, ok
 
-    def accept(self, predicted, corrected, sigma, t=None, T=None):
+    def accept(self, predicted, corrected, sigma: float, t=None, T=None):
         """Rows that pass the jump test and, given the tangent t before the stack and the stack's T,
         have no limit position between them and the row before."""
         ok = ~jumped(np.linalg.norm((corrected - predicted) / self.scale, axis=1), sigma, self.tol)
@@ -75,7 +79,7 @@ class BatchedCurve(Curve):
         return ok
 
 
-def batched_motion(solver, curve, q0, t0, start, stop, steps, fallback, progress=None):
+def batched_motion(solver, curve, q0: np.ndarray, t0, start, stop, steps: int, fallback, progress=None):
     """The grid values from start to stop (steps steps) on q0's branch, batched (see the module
     docstring).  curve: the sweep's Curve; t0: its oriented tangent at q0 (the input's component
     along the motion); fallback(q, x_from, x_to, n): the tracker's Motion of n steps;
@@ -134,7 +138,7 @@ def batched_motion(solver, curve, q0, t0, start, stop, steps, fallback, progress
     return m
 
 
-def motion_rates(solver, bc, Q, values: dict):
+def motion_rates(solver, bc, Q: np.ndarray, values: dict):
     """Joint rates and accelerations (N, nv) at the closed configurations Q for the input rates
     ``values`` (input accelerations zero): PositionSolver.rates and .accelerations of every row,
     the constraint Jacobians, the bias K'(q, q') q' and the minimum-norm passive solves batched

@@ -27,6 +27,10 @@ from ...model.geometry import wrap_angle
 from ..local import LocalAnalysis, local_analysis
 from .batch_sweep import batch_closure
 from .continuation import Neighbour, Stuck
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["ChangePoint", "Crossing", "passed", "crossing", "follow", "constraint_profile", "dips", "reclosing",
            "LOOK_BELOW", "TIGHT_CLOSURE", "START", "nearest_branch"]
@@ -38,7 +42,7 @@ TIGHT_CLOSURE = 1e-14
 LOOK_BELOW = 0.5
 
 
-def dips(m, xs):
+def dips(m, xs: np.ndarray):
     """(k, k - 1, k + 1) for each recorded step k where the measure m is lowest among its neighbours and
     below LOOK_BELOW (the neighbours' indices clipped to the sweep)."""
     for k in range(len(m)):
@@ -48,7 +52,7 @@ def dips(m, xs):
             yield k, max(k - 1, 0), min(k + 1, len(xs) - 1)
 
 
-def reclosing(solver, res, q_k, tight):
+def reclosing(solver, res, q_k: np.ndarray, tight):
     """x -> the configuration at input value x closed from the sweep's q_k (tolerances ``tight`` when
     Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
     mech, frozen = solver.mech, solver.frozen
@@ -79,14 +83,14 @@ class ChangePoint:
     switched: bool = False  # a motion passing it took the other branch, as asked (sweep's branch="other")
 
 
-def _direction(mech, rates):
+def _direction(mech: Mechanism, rates):
     v = np.asarray(rates, float).copy()
     v[mech.translational] /= mech.length
     n = np.linalg.norm(v)
     return v / n if n > 0 else None
 
 
-def nearest_branch(mech, local, rates):
+def nearest_branch(mech: Mechanism, local, rates):
     """The branch whose tangent is nearest the direction of ``rates`` (joint rates), or None."""
     u = _direction(mech, rates)
     if u is None or not local.branches:
@@ -119,7 +123,7 @@ class Crossing:
     rank: int = 0  # the generic rank of K the measure was taken at
 
 
-def constraint_profile(mech, Q, rank: int | None = None) -> tuple:
+def constraint_profile(mech: Mechanism, Q: np.ndarray, rank: int | None = None) -> tuple:
     """(the relative smallest singular value of the scaled K at each configuration of Q (N,), the rank
     it is taken at): analysis.singularities.singular.measures' "constraint", with ``rank`` (default the
     largest rank met along Q: a motion's configurations are generic but for isolated ones) for the
@@ -209,7 +213,7 @@ def passed(solver, res) -> list:
     return unique
 
 
-def _may_reach_zero(m, xs, k) -> bool:
+def _may_reach_zero(m, xs: np.ndarray, k: int) -> bool:
     """Whether the dip of the measure m at the recorded configuration k (not at an end) may reach zero
     between its neighbours: near a change point the smallest singular value is |linear| in the input
     (a V), so it is at most the steeper side's slope times the step there (twice that, for the
@@ -221,11 +225,11 @@ def _may_reach_zero(m, xs, k) -> bool:
     return bool(slopes) and m[k] <= 2 * max(slopes) * step
 
 
-def _measure(mech, q, rank: int) -> float:
+def _measure(mech: Mechanism, q: np.ndarray, rank: int) -> float:
     return float(constraint_profile(mech, [q], rank)[0][0])
 
 
-def _again(solver, out, res, k, lo_k, hi_k, bounds):
+def _again(solver, out, res, k: int, lo_k, hi_k, bounds) -> tuple | None:
     """(x, configuration, measure) of a change point already found (in ``out``) that this dip is another
     pass of (a motion through limit positions passes one point again and again): its input within the
     dip's bounds, its joint centres nearer the recorded configuration k than the neighbours are; else None."""
@@ -237,7 +241,7 @@ def _again(solver, out, res, k, lo_k, hi_k, bounds):
     return None
 
 
-def _least(solver, res, q, bounds, rank, tight):
+def _least(solver, res, q: np.ndarray, bounds, rank, tight):
     """(x, configuration, measure) where the constraint measure is least for the input within bounds, the
     loops closed again from q at each value (bounded minimization, to the closure tolerance); None
     where they cannot be closed there."""
@@ -260,7 +264,7 @@ def _least(solver, res, q, bounds, rank, tight):
     return x, q, _measure(mech, q, rank)
 
 
-def _limit_index(xs, x) -> int:
+def _limit_index(xs: np.ndarray, x) -> int:
     """The index of the recorded configuration a located limit position comes after: the first place
     near it where the input turns back (or repeats a value: the grid value before a limit, recorded
     going and coming back), else the last configuration (a motion that stopped there)."""
@@ -272,12 +276,12 @@ def _limit_index(xs, x) -> int:
     return len(xs) - 1
 
 
-def _branch_rates(mech, branch) -> np.ndarray:
+def _branch_rates(mech: Mechanism, branch: str) -> np.ndarray:
     """A branch's tangent as joint rates (nv), in the order of the coordinates."""
     return np.array([branch.tangent.get(n, 0.0) for n in mech.coordinate_names], float)
 
 
-def follow(curve, q, x, rates, x_to):
+def follow(curve, q: np.ndarray, x, rates, x_to):
     """The configuration at input value x_to reached from the configuration q (input x) along the
     branch of tangent ``rates`` (joint rates): a first step of Tolerances.local_step along it (where
     the local analysis confirms its branches), then the continuation's steps (Neighbour) to x_to.
@@ -306,7 +310,7 @@ def follow(curve, q, x, rates, x_to):
     return Neighbour(curve.solver, curve.name)(q1, x1, x_to)
 
 
-def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None):
+def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
     """At the change point c of the motion res: (ChangePoint, the followed branch's tangent as joint
     rates oriented along the motion or None, why-not text or None).  The incoming branch is the one
     whose line, followed back from c (``follow``), reaches nearest the configuration recorded before
@@ -357,7 +361,7 @@ def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None):
     return ChangePoint(c.x, c.sigma, c.q, local, incoming, goes, True, switched=goes != came), v, why
 
 
-def _starting(solver, curve, local, branches, moving, c: Crossing, direction):
+def _starting(solver, curve, local, branches, moving, c: Crossing, direction) -> tuple:
     """(the branch a motion starting on the change point c takes, the rule in words): of the branches
     that move the input, the one the file's configuration lies on (followed from c to its input value,
     it reaches the drawing: solve's first mode is the one nearest the drawing); where none does (the
@@ -410,7 +414,7 @@ def _local(solver, c: Crossing) -> LocalAnalysis:
     return mech.cache[key]
 
 
-def _arriving(xs, c: Crossing, requested) -> float:
+def _arriving(xs: np.ndarray, c: Crossing, requested) -> float:
     """The sign of the input's motion at the change point c (+1 or -1)."""
     if c.before >= 0:
         d = c.x - xs[c.before]

@@ -21,6 +21,10 @@ from ...errors import AssemblyError
 from ...model.cuts import Assembly
 from .certified import ModeCount
 from .solution import NEWTON_FROM_FILE
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["unknowns", "given_configuration", "gaps", "first_count"]
 
@@ -33,7 +37,7 @@ def unknowns(solver) -> np.ndarray:
     return np.setdiff1d(solver.passive, np.concatenate(kept).astype(int) if kept else np.zeros(0, int))
 
 
-def gaps(mech, q) -> list:
+def gaps(mech: Mechanism, q: np.ndarray) -> list:
     """[(loop joint or higher pair, position gap [m], misalignment [rad])] of the rows of q's closure that
     are open, the largest first: the minimal rows grouped by the joint they close (model.closure's
     row labels: ``pos`` rows are distances, the others angles)."""
@@ -50,7 +54,7 @@ def gaps(mech, q) -> list:
     return sorted(((n, p, a) for n, (p, a) in out.items()), key=lambda g: -max(g[1] / mech.length, g[2]))
 
 
-def given_configuration(solver, q) -> tuple:
+def given_configuration(solver, q: np.ndarray) -> tuple:
     """(q wrapped, model.cuts.Assembly, note) of a configuration whose every unknown is given (``q``: the
     values set on the reference configuration): the loops close there; AssemblyError naming the gap
     when they do not."""
@@ -75,7 +79,7 @@ def given_configuration(solver, q) -> tuple:
         "(leave out the --set of a joint the loops should solve for, or give the values of a closed configuration)"))
 
 
-def first_count(first: str, assembly):
+def first_count(first: str, assembly) -> ModeCount:
     """The certified.ModeCount of an answer reached without a search: ``first`` says how -- "every joint
     given" (the one configuration: complete) or Newton from the file's configuration (the mode asked
     for; how many others there are is not known: ``--all`` searches)."""

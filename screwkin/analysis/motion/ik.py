@@ -19,11 +19,15 @@ from . import certified
 from .closed_ik import closed_form_ik
 from .position import PositionSolver
 from .solution import PositionResult
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["inverse_kinematics", "Branches", "branches"]
 
 
-def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
+def inverse_kinematics(mech: Mechanism, output: str, pose, starts: int = 16, seed: int = 0,
                        position_only: bool = False, method: str = "auto") -> PositionResult:
     """Joint values (actuated and passive) that place link ``output`` at ``pose``
     (a pinocchio.SE3 in the world), for every distinct assembly found; with ``position_only``
@@ -128,7 +132,7 @@ class Branches:
         return self.at_most is not None and self.found >= self.at_most
 
 
-def branches(mech, res: PositionResult) -> Branches:
+def branches(mech: Mechanism, res: PositionResult) -> Branches:
     """Count the branches of an inverse-kinematics result leg by leg.  A leg is a connected set of
     links once the ground and the output link are taken away; with the output placed, each leg's
     joints are solved on their own, so the branches are the combinations of the legs' settings.

@@ -28,6 +28,10 @@ from ...errors import ScrewkinError, UsageError
 from ...model.state import KinematicState, loop_coordinate_cuts
 from .batch_closure import tree_kinematics
 from .planar import LinkAngles
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "sweep_motion", "moving_links",
            "Stroke", "strokes"]
@@ -42,7 +46,7 @@ class Point:
     local: tuple
 
 
-def moving_links(mech) -> tuple:
+def moving_links(mech: Mechanism) -> tuple:
     """The links that move (those with a frame of their own not welded to the ground), in file order."""
     out = []
     for link in mech.spec.links:
@@ -101,7 +105,7 @@ class MotionAlong:
     normal: tuple | None = None  # planar mechanisms: the plane's normal omega and alpha are about
 
 
-def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAlong:
+def motion_along(mech: Mechanism, Q: np.ndarray, V, A, points=(), angles=None, normal=None) -> MotionAlong:
     """The absolute motion at each configuration Q[k] with rates V[k] and accelerations A[k];
     ``angles``: a callable q -> link angles (LinkAngles) for planar mechanisms, with ``normal``.
 
@@ -174,7 +178,7 @@ def motion_along(mech, Q, V, A, points=(), angles=None, normal=None) -> MotionAl
                        None if normal is None else tuple(float(x) for x in normal))
 
 
-def sweep_motion(mech, res, points=()) -> MotionAlong:
+def sweep_motion(mech: Mechanism, res, points=()) -> MotionAlong:
     """The absolute motion along a sweep ``res`` (analysis.motion.sweep.SweepResult): a planar
     mechanism's (its topology at the first step) with the vector-loop angles of LinkAngles, omega and
     alpha about the plane's normal; a spatial one's as vectors.  What ``sweep`` and ``report`` show."""
@@ -189,7 +193,7 @@ def sweep_motion(mech, res, points=()) -> MotionAlong:
 
 
 
-def _frame_motions(model, data, frames, Q, V, A):
+def _frame_motions(model: pin.Model, data, frames, Q: np.ndarray, V, A) -> tuple:
     """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
     (a, alpha) of the frames' origins in world axes (N, F, 6) -- what pin.getFrameVelocity and
     pin.getFrameClassicalAcceleration give in LOCAL_WORLD_ALIGNED -- from one forwardKinematics a
@@ -262,7 +266,7 @@ def _extrema(x, p, dp, tol):
     return out
 
 
-def _stroke_end(solver, res, name, coordinate, x, guess):
+def _stroke_end(solver, res, name: str, coordinate, x, guess):
     """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
     its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
     from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""
@@ -271,7 +275,7 @@ def _stroke_end(solver, res, name, coordinate, x, guess):
     k = int(np.clip(np.searchsorted(x, guess[0]) - 1, 0, len(x) - 2))
     mech, q0, cache = solver.mech, res.q[k], {}
 
-    def at(v):
+    def at(v) -> float:
         a = solver.track({res.input: v}, q0)
         qd = solver.rates(a.q, mech.closure.jacobian(a.q), {res.input: 1.0})
         if coordinate is not None:
@@ -292,7 +296,7 @@ def _stroke_end(solver, res, name, coordinate, x, guess):
         return guess
 
 
-def strokes(res, motion, mech, solver=None) -> list:
+def strokes(res, motion, mech: Mechanism, solver=None) -> list:
     """A Stroke for each slider coordinate (prismatic tree joint or prismatic loop joint) of a sweep
     ``res`` (analysis.motion.sweep.SweepResult) with its MotionAlong.  With the sweep's ``solver``
     (analysis.motion.position.PositionSolver) each end is located on the mechanism (Brent's method on

@@ -29,6 +29,10 @@ from ...model.geometry import lines_point
 from ...model.state import KinematicState
 from ...model.subproblems import rotation, rotation_to, run_angles
 from ...tolerances import DEFAULT, Tolerances
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Wrist", "wrist_arm", "pieper"]
 
@@ -48,7 +52,7 @@ class Wrist:
     M0: object
 
 
-def wrist_arm(mech, out_frame: int, placement):
+def wrist_arm(mech: Mechanism, out_frame: int, placement) -> Wrist | None:
     """The Wrist of the arm whose output frame is on the joint ``out_frame``'s parent chain at
     ``placement`` (pinocchio.SE3 in the last joint's frame), or None when the mechanism is not a serial
     6R arm whose last three axes meet (the model's joint screws at the file's configuration)."""
@@ -95,7 +99,7 @@ def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT):
     h1, h2 = float(w[0] @ (c - r1)), float((c - r1) @ (c - r1))
     scale = max(float(np.abs(r).max()), float(np.abs(c).max()), 1e-3)
 
-    def parts(t3):
+    def parts(t3) -> tuple:
         q3 = r[2] + rotation(w[2], t3) @ (arm.centre - r[2])
         v = q3 - r2  # from the point of axis 2 that delta reaches
         vpar = w[1] * (w[1] @ v)
@@ -185,7 +189,7 @@ def _stretched(axes, R, tol: Tolerances):
     return out
 
 
-def _trig_roots(F, degree: int, tol: Tolerances):
+def _trig_roots(F, degree: int, tol: Tolerances) -> tuple:
     """The real roots in (-pi, pi] of the trigonometric polynomial F of the given degree (from 8
     samples: the polynomial in e^{it} of degree 2 * degree, its roots on the unit circle, refined by
     Newton) and how many roots are complex."""
@@ -220,7 +224,7 @@ def _trig_roots(F, degree: int, tol: Tolerances):
     return real, n_complex
 
 
-def _closest(p1, w1, p2, w2, parallel: float):
+def _closest(p1, w1, p2, w2, parallel: float) -> tuple:
     """Points of the two lines nearest each other (the foot of p2 on line 1 where they are parallel: the
     sine of their angle below ``parallel``)."""
     n = np.cross(w1, w2)

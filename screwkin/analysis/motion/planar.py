@@ -40,6 +40,10 @@ from ...model.geometry import (
 from .batch_closure import tree_kinematics
 from .transmission import (FOUR_BAR_CLASSES, four_bar_classes, slide_transmission_angle, transmission_angle,
                            transmission_range)
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
@@ -81,23 +85,23 @@ class LinkageInfo:
         return d
 
 
-def _rot(v, ang):
+def _rot(v, ang) -> np.ndarray:
     c, s = np.cos(ang), np.sin(ang)
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
 
 
-def _angle(v):
+def _angle(v) -> float:
     return float(np.arctan2(v[1], v[0]))
 
 
-def _interval(start, end, phi_now, q_in):
+def _interval(start, end, phi_now, q_in: np.ndarray) -> tuple:
     """Joint values of the angle interval [start, end] (end > start) that contains phi_now."""
     k = np.floor((phi_now - start) / (2 * np.pi))
     start, end = start + 2 * np.pi * k, end + 2 * np.pi * k
     return (q_in + start - phi_now, q_in + end - phi_now)
 
 
-def identify(mech, topo, q, input_joint):
+def identify(mech: Mechanism, topo, q: np.ndarray, input_joint):
     """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
     joint is a ground joint, at the configuration ``topo`` was built at (q)."""
     if topo.motion_space != "planar" or (topo.n_links, topo.n_joints, topo.loops) != (4, 4, 1):
@@ -110,11 +114,11 @@ def identify(mech, topo, q, input_joint):
     n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
     e1, e2 = perpendicular_basis(n)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
 
-    def p2(v):
+    def p2(v) -> np.ndarray:
         v = np.asarray(v)
         return np.array([v @ e1, v @ e2])
 
-    def other(link, joint):
+    def other(link: str, joint):
         return next(j for j in topo.joints if j is not joint and link in j.links)
 
     moving = inp.links[1] if inp.links[0] == ground else inp.links[0]
@@ -144,7 +148,7 @@ def identify(mech, topo, q, input_joint):
     return None
 
 
-def _locator(mech, joint):
+def _locator(mech: Mechanism, joint) -> tuple:
     """How to find ``joint``'s centre at any configuration: ("frame", id) of a cut joint's F1,
     ("joint", id) of a simple tree joint, or ("topology", name) for a compound joint (its
     centre is the topology's, rebuilt at each configuration)."""
@@ -156,7 +160,7 @@ def _locator(mech, joint):
     return ("topology", joint.name)
 
 
-def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
+def transmission_angles(mech: Mechanism, info: LinkageInfo, Q: np.ndarray) -> np.ndarray:
     """Transmission angles mu [rad] of the linkage ``info`` (from :func:`identify`, computed
     once) at the configurations Q (N, nq): shape (N,).  Four-bar: the angle at the
     coupler-output joint C between C -> B and C -> D; slider-crank: the angle between the rod
@@ -180,7 +184,7 @@ def transmission_angles(mech, info: LinkageInfo, Q) -> np.ndarray:
                          None if info.slide is None else np.asarray(info.slide, float))
 
 
-def _transmission(kind, P, n, slide=None):
+def _transmission(kind: str, P, n: int, slide=None):
     """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
     unit normal n (slide: the slide's unit direction, slider-crank)."""
     P = P - (P @ n)[..., None] * n
@@ -190,7 +194,7 @@ def _transmission(kind, P, n, slide=None):
     return slide_transmission_angle(B, C, np.cross(n, slide))
 
 
-def _four_bar(name, q_in, A, B, C, D, a, b, tol):
+def _four_bar(name: str, q_in: np.ndarray, A, B, C, D, a, b, tol) -> LinkageInfo:
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     cls = FOUR_BAR_CLASSES[int(four_bar_classes(g, a, b, c, tol.equal))]
@@ -227,7 +231,7 @@ def _four_bar(name, q_in, A, B, C, D, a, b, tol):
                        input_value=float(q_in), input_angle=float(phi_now))
 
 
-def _slider_crank(name, q_in, A, B, C, s, a, b):
+def _slider_crank(name: str, q_in: np.ndarray, A, B, C, s, a, b) -> LinkageInfo:
     nrm = np.array([-s[1], s[0]])
     e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
     lengths = {"crank": a, "rod": b, "offset": abs(e)}
@@ -276,7 +280,7 @@ class LinkAngles:
     child's slide does not turn its parent (the ground of a slider-crank kept a constant
     angle only while the slider stood still)."""
 
-    def __init__(self, mech, topo) -> None:
+    def __init__(self, mech: Mechanism, topo) -> None:
         if topo.motion_space != "planar" or topo.normal is None:
             raise UsageError(f"{mech.path}: absolute link angles are for planar mechanisms; this one is "
                              f"{topo.motion_space}")
@@ -315,7 +319,7 @@ class LinkAngles:
             out[link] = next((c for c in candidates if np.linalg.norm(state.centre(c) - p0) > tiny), ("axis", fid))
         return out
 
-    def __call__(self, q, state=None) -> dict:
+    def __call__(self, q: np.ndarray, state=None) -> dict:
         """link name -> absolute angle [rad] in (-pi, pi] at q (read from ``state``, a KinematicState at q,
         when the caller has one)."""
         state = state or KinematicState(self.mech, q)
@@ -357,7 +361,7 @@ class LinkAngles:
             return "x axis" if kind == "axis" else loops.get(i, str(i)) if kind == "frame" else str(names[i])
         return {link: (named(start), named(end)) for link, (start, end, _) in self.links.items()}
 
-    def batch(self, Q) -> dict:
+    def batch(self, Q: np.ndarray) -> dict:
         """link name -> (N,) absolute angles [rad] at every row of Q: __call__ on the stack, from one
         batched forward-kinematics pass (a loop over Q where the tree has joints of two coordinates)."""
         Q = np.atleast_2d(Q)

@@ -15,10 +15,14 @@ from ..singularities.singular import Generic, measures, scaled_jacobians
 from .links import LOCATE_XTOL
 from .crossing import dips, reclosing
 from .sweep import SweepResult, SweepSingularity
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["locate_singularities"]
 
-def _matrix(mech, q, kind, g, V_ref=None):
+def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g, V_ref=None):
     """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""
     S = scaled_jacobians(mech, q, g.output, g.point)
     if kind == "constraint":
@@ -65,7 +69,7 @@ def locate_singularities(solver, res: SweepResult, output=None, xtol: float = LO
             u, v = U[:, r - 1], Vt[r - 1]
             q_at = reclosing(solver, res, q_k, tight)
 
-            def signed(x, u=u, v=v, V_ref=V_ref):
+            def signed(x, u=u, v=v, V_ref=V_ref) -> float:
                 return float(u @ _matrix(mech, q_at(x), kind, g, V_ref) @ v)
 
             lo, hi = sorted((xs[lo_k], xs[hi_k]))

@@ -21,6 +21,11 @@ import numpy as np
 
 from ...errors import UsageError
 from .sweep import SweepResult, sweep
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["sweep_chunks", "DEFAULT_CHUNK"]
 
@@ -33,7 +38,7 @@ def _drop_first(res: SweepResult) -> SweepResult:
                    accelerations=res.accelerations[1:], coupled=coupled)
 
 
-def _keep_turns(mech, res: SweepResult, q_prev) -> SweepResult:
+def _keep_turns(mech: Mechanism, res: SweepResult, q_prev: np.ndarray) -> SweepResult:
     """The piece's one-coordinate angles moved by the whole turns its start was wrapped by (sweep
     starts from an angle in (-pi, pi]), so that q runs on continuously from the previous piece."""
     single, *_ = mech._value_layout()
@@ -49,7 +54,7 @@ def _keep_turns(mech, res: SweepResult, q_prev) -> SweepResult:
 
 
 def sweep_chunks(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-                 near: dict | None = None, rate: float = 1.0, chunk: int = DEFAULT_CHUNK, q_start=None, **options):
+                 near: dict | None = None, rate: float = 1.0, chunk: int = DEFAULT_CHUNK, q_start: np.ndarray | None = None, **options: Any):
     """Yield ``sweep(solver, name, start, stop, steps, ...)``'s motion as SweepResults of at most
     ``chunk`` (+1 for the first) consecutive steps each, in the order of the motion (see the module
     docstring).  ``q_start``: the configuration of the mode to follow (as sweep's).  ``options``: sweep's other

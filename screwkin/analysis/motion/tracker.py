@@ -36,7 +36,7 @@ class Tracker:
     """One motion of ``curve`` from q0 (input ``start``, oriented tangent t) over the grid of ``steps``
     steps to ``stop``; ``run`` returns the Motion.  The state of the walk is its attributes."""
 
-    def __init__(self, curve, q0, t, start, stop, steps, turn: bool=False, max_steps=None, progress=None) -> None:
+    def __init__(self, curve, q0: np.ndarray, t, start, stop, steps: int, turn: bool=False, max_steps: int | None = None, progress=None) -> None:
         self.c, self.q0, self.start, self.stop, self.steps = curve, q0, float(start), float(stop), steps
         self.turn, self.progress = turn, progress
         self.max_steps = max_steps or 20 * steps + 100
@@ -50,7 +50,7 @@ class Tracker:
         """The input runs the way of the range (not back after a limit position)."""
         return self.direction * np.sign(self.h) > 0
 
-    def grid_between(self, xa, xb):
+    def grid_between(self, xa, xb) -> list:
         """Grid values strictly after xa up to xb (inclusive) in the direction of motion, within the range."""
         h, start = self.h, self.start
         if h == 0:
@@ -86,10 +86,10 @@ class Tracker:
             self.m.X.append(g)
             self.m.Q.append(qg)
 
-    def arc(self, qa, xa, qb, held):
+    def arc(self, qa: np.ndarray, xa, qb: np.ndarray, held) -> tuple | None:
         return (qa, xa, qb, held) if held is not None and held != self.c.ix else None
 
-    def record(self, qa, xa, ta, qb, xb, tb=None, held=None) -> None:
+    def record(self, qa: np.ndarray, xa, ta, qb: np.ndarray, xb, tb=None, held=None) -> None:
         """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
         position between them, each predicted from the nearer end (not from a limit position:
         there the input does not move, pass tb=None for such an end); where the predictor fails
@@ -102,7 +102,7 @@ class Tracker:
             self.keep(g, self.solved(g, (lambda g=g: c.at_input(qb, xb, g, tb)) if near_b else
                                      (lambda g=g: c.at_input(qa, xa, g, ta)), arc))
 
-    def record_back(self, q_lim, x_lim, qb, xb, tb, held=None) -> None:
+    def record_back(self, q_lim, x_lim, qb: np.ndarray, xb, tb, held=None) -> None:
         """After a limit position: the grid values between it and qb, predicted from qb."""
         arc = self.arc(q_lim, x_lim, qb, held)
         for g in self.grid_between(x_lim, xb):
@@ -194,7 +194,7 @@ class Tracker:
         self.sigma = min(self.sigma * 1.5, self.longest)
         return None
 
-    def arc_step(self, held):
+    def arc_step(self, held) -> bool | None:
         """A step with the passive joint ``held`` held (a limit position located and passed on the way):
         True when the motion ends here, False when it goes on, None when the step was refused (the
         next one shorter)."""

@@ -51,7 +51,7 @@ FOUR_BAR_CLASSES = (
 _BY_SHORTEST = np.array([3, 2, 4, 5])  # shortest link ground, input, coupler, output -> class code
 
 
-def four_bar_classes(g, a, b, c, equal: float):
+def four_bar_classes(g, a, b, c, equal: float) -> np.ndarray:
     """Grashof class codes (indices into FOUR_BAR_CLASSES) of four-bars with ground g, input a,
     coupler b and output c: s + l against p + q (a change point within ``equal`` times the longest
     link), and, for a Grashof linkage, which link is the shortest (the first of ground, input,
@@ -93,7 +93,7 @@ def four_bar_cos_mu(g, a, b, c, phi):
     return (b * b + c * c - z2) / (2 * b * c)
 
 
-def four_bar_transmission(g, a, b, c, equal: float):
+def four_bar_transmission(g, a, b, c, equal: float) -> tuple:
     """(mu_min, mu_max [rad], turns, dead points) of four-bars over their input's motion (module
     docstring): ``turns`` where the input turns fully; ``dead`` the number of positions of the
     motion where mu is 0 or 180 deg (the two limit positions of an input that rocks, and a
@@ -119,7 +119,7 @@ def four_bar_transmission(g, a, b, c, equal: float):
     return mu_min, mu_max, turns, dead
 
 
-def slider_crank_transmission(a, b, e, equal: float):
+def slider_crank_transmission(a, b, e, equal: float) -> tuple:
     """(mu_min, mu_max [rad], turns, dead points) of slider-cranks (crank a, rod b, offset e) over
     the crank's motion (module docstring)."""
     a, b, e = np.broadcast_arrays(*(np.asarray(v, float) for v in (a, b, e)))

@@ -69,7 +69,7 @@ def engaged(solver, found, values):
     return [found[int(np.argmin(off))]]
 
 
-def _turned(solver, q, other, counted) -> bool:
+def _turned(solver, q: np.ndarray, other, counted) -> bool:
     """Whether q is ``other`` with some of its pairs turned on by whole turns: for each higher pair's
     coupling row, one of its counted angles differs from other's by a whole number of turns (a
     thread, a tooth), at least one by a nonzero number."""
@@ -86,7 +86,7 @@ def _turned(solver, q, other, counted) -> bool:
     return shift
 
 
-def turn_on(solver, q, whole: dict, typed: dict):
+def turn_on(solver, q: np.ndarray, whole: dict, typed: dict) -> tuple:
     """(q, assembly) of the solution ``q`` found within a turn, turned on by the inputs' whole turns:
     the loops' rates per unit input move every joint and every counted angle linearly (exactly, for
     gears and screws), then Newton closes at the typed inputs."""

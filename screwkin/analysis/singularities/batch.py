@@ -27,6 +27,10 @@ from ...errors import UsageError
 from ...model._pin import compute_frame_jacobian
 from ...model.manifold import continuous_angle
 from ..screws import chains
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["frame_jacobians", "SerialJacobians", "stack_singular_values", "smallest_singular_values",
            "singular_value_ratios", "determinants"]
@@ -34,7 +38,7 @@ __all__ = ["frame_jacobians", "SerialJacobians", "stack_singular_values", "small
 _REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
 
 
-def frame_jacobians(model, frame_id: int, Q, reference=pin.ReferenceFrame.WORLD, data=None) -> np.ndarray:
+def frame_jacobians(model: pin.Model, frame_id: int, Q: np.ndarray, reference=pin.ReferenceFrame.WORLD, data=None) -> np.ndarray:
     """(N, 6, nv) frame Jacobians for the configurations in the rows of Q (N, nq)."""
     Q = np.atleast_2d(np.asarray(Q, float))
     if Q.shape[1] != model.nq:
@@ -57,7 +61,7 @@ class SerialJacobians:
     >>> J = sj(Q)            # (N, 6, nv), Q: (N, nq) Pinocchio configurations
     """
 
-    def __init__(self, mech, link: str | None, reference=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
+    def __init__(self, mech: Mechanism, link: str | None, reference=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
                  check: int = 0, chain=None) -> None:
         """chain: a screws.Chain to any frame instead of the one to ``link``'s body frame."""
 
@@ -109,7 +113,7 @@ class SerialJacobians:
             self._check(np.random.default_rng(0), check)
 
     # ------------------------------------------------------------ structure equations
-    def _theta(self, Q) -> np.ndarray:
+    def _theta(self, Q: np.ndarray) -> np.ndarray:
         """(n, N) joint displacements of the chain joints."""
         th = np.empty((len(self._reads), len(Q)))
         for k, (kind, iq, zero) in enumerate(self._reads):
@@ -187,7 +191,7 @@ class SerialJacobians:
             return J.transpose(2, 0, 1), np.stack(Re, axis=1).transpose(2, 0, 1), pe.T
         return J.transpose(2, 0, 1)
 
-    def __call__(self, Q) -> np.ndarray:
+    def __call__(self, Q: np.ndarray) -> np.ndarray:
         """(N, 6, nv) Jacobians for the configurations in the rows of Q (N, nq)."""
         Q = np.atleast_2d(np.asarray(Q, float))
         if Q.ndim != 2 or Q.shape[1] != self.model.nq:
@@ -199,7 +203,7 @@ class SerialJacobians:
             out[start:stop, :, self._cols] = self._block(np.ascontiguousarray(th[:, start:stop]))
         return out
 
-    def poses(self, Q):
+    def poses(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The frame's placements and chain Jacobians for Q (N, nq): rotations (N, 3, 3),
         origins (N, 3) and (N, 6, n) Jacobians restricted to the chain's n columns."""
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -212,7 +216,7 @@ class SerialJacobians:
         return (np.concatenate([p[1] for p in parts]), np.concatenate([p[2] for p in parts]),
                 np.concatenate([p[0] for p in parts]))
 
-    def measures(self, Q, measure: str = "sigma_min", scale_translation: float | None = None, workers: int = 1,
+    def measures(self, Q: np.ndarray, measure: str = "sigma_min", scale_translation: float | None = None, workers: int = 1,
                  method: str = "svd", point: bool = False) -> np.ndarray:
         """(N,) a singularity measure of the chain Jacobian at each configuration of Q (N, nq),
         block by block (the Jacobians of all N are never held at once).
@@ -262,7 +266,7 @@ class SerialJacobians:
                 run(start)
         return out
 
-    def _check(self, rng, count):
+    def _check(self, rng: np.random.Generator, count: int):
         model = self.model
         data = self.mech.scratch_data()
         lo = np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi)
@@ -287,12 +291,12 @@ def _apply(R, x) -> np.ndarray:
     return out if out is not None else np.zeros(R.shape[1:])
 
 
-def stack_singular_values(J) -> np.ndarray:
+def stack_singular_values(J: np.ndarray) -> np.ndarray:
     """(N, min(m, n)) singular values of a stack of matrices (N, m, n), largest first."""
     return np.linalg.svd(np.asarray(J), compute_uv=False)
 
 
-def smallest_singular_values(J, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
+def smallest_singular_values(J: np.ndarray, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
     """(N,) smallest singular value of each Jacobian in the stack, translations divided by a
     characteristic length ``scale_translation`` [m] (and the columns of sliding joints, the
     mask ``slide``, multiplied by it) so that the values are dimensionless.
@@ -305,7 +309,7 @@ def smallest_singular_values(J, scale_translation: float = 1.0, method: str = "s
     return _extreme_singular_values(J, scale_translation, method, slide)[0]
 
 
-def singular_value_ratios(J, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
+def singular_value_ratios(J: np.ndarray, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
     """(N,) smallest over largest singular value of each Jacobian (translations divided by
     ``scale_translation``, see ``smallest_singular_values``); methods as there."""
     low, high = _extreme_singular_values(J, scale_translation, method, slide)
@@ -313,7 +317,7 @@ def singular_value_ratios(J, scale_translation: float = 1.0, method: str = "svd"
         return np.where(high > 0, low / high, 0.0)
 
 
-def _extreme_singular_values(J, scale_translation, method, slide=None):
+def _extreme_singular_values(J: np.ndarray, scale_translation, method, slide=None) -> tuple:
     J = np.array(J, float)
     if J.ndim != 3:
         raise ValueError(f"expected a stack of matrices (N, m, n), got shape {J.shape}")
@@ -339,7 +343,7 @@ def _extreme_singular_values(J, scale_translation, method, slide=None):
 _GRAM_KAPPA = 1e-3  # below this sigma_min / sigma_max the Gram eigenvalue loses digits: use the SVD
 
 
-def determinants(J) -> np.ndarray:
+def determinants(J: np.ndarray) -> np.ndarray:
     """(N,) determinants of a stack of square matrices (N, n, n) (LU with partial pivoting)."""
     return np.linalg.det(np.asarray(J))
 

@@ -24,6 +24,10 @@ from ...errors import UsageError
 from ..course.det_conditions import SIMPLIFY_OPS, condition
 from ...model.linalg import rank
 from ..course.vector_loops import LENGTH_FLOOR, VectorLoops
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["SymbolicGramLoop", "symbolic_gram"]
 
@@ -36,7 +40,7 @@ class SymbolicGramLoop:
     note: str | None = None
 
 
-def _simplified(sp, expr):
+def _simplified(sp, expr) -> tuple:
     expr = sp.factor(sp.expand(expr))
     coeff, factors = sp.factor_list(expr)
     parts = []
@@ -47,7 +51,7 @@ def _simplified(sp, expr):
     return coeff * sp.Mul(*[g ** m for g, m in parts]), [g for g, _ in parts]
 
 
-def _loop_rank(mech, S, here) -> int:
+def _loop_rank(mech: Mechanism, S, here) -> int:
     """The rank of the loop's twists at the configuration measured (lengths over the characteristic
     length: a row scaling, the rank unchanged)."""
     M = np.array(S.subs(here).evalf(), dtype=float)
@@ -55,7 +59,7 @@ def _loop_rank(mech, S, here) -> int:
     return rank(M, mech.tolerances)
 
 
-def symbolic_gram(mech, q, inputs=None) -> tuple:
+def symbolic_gram(mech: Mechanism, q: np.ndarray, inputs=None) -> tuple:
     """A SymbolicGramLoop for each independent loop of a planar mechanism of revolute and
     prismatic joints, rolling and gear pairs (the loops of screwkin equations), at the assembled
     configuration q."""

@@ -14,7 +14,7 @@ __all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexpla
 TINY = 1e-300  # division guard: two segments parallel
 
 
-def unexplained_folds(sheets, loci, box, n):
+def unexplained_folds(sheets, loci, box, n: int) -> list:
     """Notes for the grid nodes a continuation step was refused from (a fold lies within a cell) with no
     traced actuator curve within a cell and a half: a component the seeds missed."""
     span = np.array([box[0][1] - box[0][0], box[1][1] - box[1][0]], float)
@@ -34,7 +34,7 @@ def unexplained_folds(sheets, loci, box, n):
     return []
 
 
-def sheets(solver, x_name, y_name, box, starts, n):
+def sheets(solver, x_name: str, y_name: str, box, starts: int, n: int):
     """Each start continued over an n x n grid of the box from its nearest node: a list of
     (qs (n, n, nq) with NaN where not reached, refused (n, n) bool: a step from there refused)."""
     mech = solver.mech
@@ -80,7 +80,7 @@ def sheets(solver, x_name, y_name, box, starts, n):
     return out
 
 
-def seed_configurations(sys, sheets):
+def seed_configurations(sys, sheets) -> list:
     """Grid configurations to seed Newton from, most singular first: next to a refused step, or a local
     minimum of the kind's relative singular value along a grid line."""
     cands = []

@@ -19,6 +19,10 @@ import numpy as np
 from ...errors import UsageError, quote, shorten
 from .singular import Generic, measures
 from ..motion.continuation import Neighbour
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["SingularityMap", "singularity_map", "seams", "apart"]
 
@@ -42,8 +46,8 @@ class SingularityMap:
         return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
 
 
-def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False,
-                    q_start=None) -> SingularityMap:
+def singularity_map(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed=None, output=None, point: bool = False,
+                    q_start: np.ndarray | None = None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
     if x_name == y_name:
@@ -95,7 +99,7 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
 
 
-def apart(mech, q1, q2) -> float:
+def apart(mech: Mechanism, q1: np.ndarray, q2: np.ndarray) -> float:
     """How far apart two configurations are: the norm of their difference, lengths over the
     characteristic length (rad and characteristic lengths) [-]."""
     d = mech.difference(q1, q2)
@@ -103,7 +107,7 @@ def apart(mech, q1, q2) -> float:
     return float(np.linalg.norm(d))
 
 
-def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.ndarray:
+def seams(mech: Mechanism, qs, reached, step_x=None, step_y=None, xs: np.ndarray | None = None, ys: np.ndarray | None = None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
     characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and

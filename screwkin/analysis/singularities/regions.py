@@ -39,7 +39,7 @@ class Regions:
     notes: tuple = ()
 
 
-def _blocked(curves, xs, ys) -> np.ndarray:
+def _blocked(curves, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     nx, ny = len(xs), len(ys)
     mask = np.zeros((ny, nx), bool)
     dx = (xs[-1] - xs[0]) / (nx - 1) if nx > 1 else 1.0
@@ -61,7 +61,7 @@ def _blocked(curves, xs, ys) -> np.ndarray:
     return mask
 
 
-def regions(solver, loci, x_name, xs, y_name, ys, fixed, count: bool = True, max_counted: int = 24) -> Regions:
+def regions(solver, loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed, count: bool = True, max_counted: int = 24) -> Regions:
     """The regions of the grid xs x ys cut by ``loci`` (analysis.singularities.loci.Loci), each with its sample
     and (count) its number of real assembly modes there."""
     from scipy import ndimage

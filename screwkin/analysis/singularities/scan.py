@@ -22,6 +22,10 @@ import pinocchio as pin
 from ...errors import UsageError
 from ...model.manifold import set_continuous_angle
 from .batch import SerialJacobians
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["ScanResult", "scan"]
 
@@ -56,7 +60,7 @@ class ScanResult:
         return float(np.mean(self.values < self.threshold))
 
 
-def scan(mech, output: str, samples: int = 100000, seed: int = 0, measure: str = "sigma_ratio",
+def scan(mech: Mechanism, output: str, samples: int = 100000, seed: int = 0, measure: str = "sigma_ratio",
          length: float | None = None, workers: int | None = None, method: str = "svd",
          point: bool = False) -> ScanResult:
     """Sample ``samples`` configurations of the chain from the ground to ``output``,

@@ -69,7 +69,7 @@ def _joints_for(links: int, dof: int) -> int:
     return twice // 2
 
 
-def _graph(n, edges):
+def _graph(n: int, edges):
     import networkx as nx
 
     g = nx.Graph()
@@ -78,7 +78,7 @@ def _graph(n, edges):
     return g
 
 
-def _revolute_graphs(links: int, joints: int):
+def _revolute_graphs(links: int, joints: int) -> tuple:
     """Edge lists of the non-isomorphic chains (see the module docstring); and how many
     graphs were looked at."""
     import networkx as nx
@@ -122,13 +122,13 @@ def _revolute_graphs(links: int, joints: int):
     return chains, looked
 
 
-def _invariant(g):
+def _invariant(g) -> tuple:
     """Equal for isomorphic graphs: each link's joints and its neighbours' joints, sorted."""
     deg = dict(g.degree())
     return tuple(sorted((deg[v], tuple(sorted(deg[u] for u in g[v]))) for v in g.nodes))
 
 
-def _automorphisms(g, kinds=None, guides=None):
+def _automorphisms(g, kinds=None, guides=None) -> list:
     """Every automorphism of chain g (node permutations as dicts), keeping joint kinds and, with
     ``guides`` (prismatic joint -> its guide link), which element of each prismatic joint is the
     guide and which the block."""
@@ -167,7 +167,7 @@ def guides_of(links: int, joints) -> dict:
     return {(u, v): max((u, v), key=lambda x: (slides[x], degree[x], -x)) for u, v, k in joints if k == "P"}
 
 
-def _orbits(n, autos):
+def _orbits(n: int, autos) -> tuple:
     seen, orbits = set(), []
     for v in range(n):
         if v in seen:
@@ -247,7 +247,7 @@ def _drawing_numbers(ground: int, joints) -> dict:
     then tree joints, then loop joints)."""
     number = {ground: 1}
 
-    def visit(link) -> None:
+    def visit(link: str) -> None:
         for u, v in joints:
             if link in (u, v):
                 other = v if link == u else u

@@ -40,6 +40,10 @@ from ...course.skeleton import numbering
 from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["check_design", "check_chain_file", "TOLERANCE"]
 
@@ -51,7 +55,7 @@ TWO_PI = 2 * math.pi
 class _Probe:
     """What the check reads off a configuration of the written four-bar."""
 
-    def __init__(self, mech, design: Design) -> None:
+    def __init__(self, mech: Mechanism, design: Design) -> None:
         self.mech = mech
         self.design = design
         self.out = mech.link_frame(design.output_link)
@@ -60,7 +64,7 @@ class _Probe:
         self.fB = mech.cuts[0].frame1 if mech.cuts else None
         self.linkage = None  # analysis.motion.planar.identify's LinkageInfo, set at the first position
 
-    def value(self, q):
+    def value(self, q: np.ndarray) -> tuple:
         M = KinematicState(self.mech, q).frame_placement(self.out)
         kind = self.design.targets[0].kind
         if kind == "pose":
@@ -69,7 +73,7 @@ class _Probe:
             return (float(M.translation[0]), float(M.translation[1]))
         return (float(math.atan2(M.rotation[1, 0], M.rotation[0, 0])),)
 
-    def error(self, q, target):
+    def error(self, q: np.ndarray, target) -> tuple:
         v = self.value(q)
         t = target.value
         if target.kind == "pose":
@@ -78,7 +82,7 @@ class _Probe:
             return math.hypot(v[0] - t[0], v[1] - t[1]), 0.0
         return abs(float(wrap_angle(v[0] - t[0], upper=True))), 0.0
 
-    def mus(self, Q) -> list:
+    def mus(self, Q: np.ndarray) -> list:
         """Transmission angles [rad] at the configurations Q (analysis.motion.planar.transmission_angles
         of the file's four-bar as identified at the first position); none when it was not
         identified (the check then says the angle was not measured)."""
@@ -86,12 +90,12 @@ class _Probe:
             return []
         return transmission_angles(self.mech, self.linkage, Q).tolist()
 
-    def pins(self, q):
+    def pins(self, q: np.ndarray) -> tuple:
         state = KinematicState(self.mech, q)
         return state.centre(("joint", self.jA))[:2], state.centre(("frame", self.fB))[:2]
 
 
-def _closed_form_error(design: Design, probe: _Probe, q, target) -> float:
+def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target) -> float:
     """Distance between the file's moving pivots (and guided frame) at q and the closed-form
     four-bar at the same crank angle, on the branch that is nearer."""
     fb = design.fourbar
@@ -168,7 +172,7 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
                  tuple(travel), tol, letters)
 
 
-def _locate(design, solver, probe, res, x, q_target):
+def _locate(design, solver, probe, res, x, q_target: np.ndarray) -> bool:
     """Whether the branch followed by sweep ``res`` is, at input value x, in the configuration
     q_target (the solution found for that precision position): same moving pivots."""
     if q_target is None:
@@ -185,7 +189,7 @@ def _locate(design, solver, probe, res, x, q_target):
     return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
-def _follow(design: Design, solver, probe, configs, steps):
+def _follow(design: Design, solver, probe, configs, steps: int):
     """(direction, travel per position, transmission angles along the motion, defects)."""
     name = design.input_joint
     tol = probe.mech.tolerances
@@ -195,7 +199,7 @@ def _follow(design: Design, solver, probe, configs, steps):
     near = {name: targets[0].input}
     u1 = targets[0].input
 
-    def follow(direction, reach):
+    def follow(direction, reach) -> tuple:
         count = max(int(round(steps * reach / TWO_PI)), 4)
         res = sweep(solver, name, u1, u1 + direction * reach, count, near=near)
         covered = float(np.max(direction * (res.values - u1))) if len(res.values) else 0.0
@@ -203,7 +207,7 @@ def _follow(design: Design, solver, probe, configs, steps):
             covered = max(covered, float(direction * (res.stopped_at - u1)))
         return res, covered
 
-    def typed(x):  # function generation: the crank's angle as typed beside the file's
+    def typed(x) -> str:  # function generation: the crank's angle as typed beside the file's
         return "" if design.input_offset is None else f" (phi {math.degrees(x + design.input_offset):.6g} deg as typed)"
 
     if design.span is not None:  # the motion is the input range: both ways from the first position

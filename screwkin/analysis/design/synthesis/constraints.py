@@ -31,7 +31,7 @@ _CODES = {"change-point": 0, "non-Grashof": 1, "crank-rocker": 2, "double-crank"
 _SHORTEST = {"double-crank": 0, "crank-rocker": 1, "double-rocker": 2, "rocker-crank": 3}  # ground, crank, coupler, rocker
 
 
-def grashof_type(g, a, b, c, equal: float):
+def grashof_type(g, a, b, c, equal: float) -> list:
     """The short Grashof type names (as GRASHOF_TYPES) of four-bars with ground g, crank a, coupler b,
     rocker c (arrays broadcast)."""
     names = {v: k for k, v in _CODES.items()}
@@ -46,7 +46,7 @@ def mu_over(g, a, b, c, phi0, travel):
     (the linkage does not assemble there)."""
     g, a, b, c, phi0, travel = np.broadcast_arrays(*(np.asarray(v, float) for v in (g, a, b, c, phi0, travel)))
 
-    def mu(phi):
+    def mu(phi) -> np.ndarray:
         with np.errstate(invalid="ignore", divide="ignore"):
             cos = four_bar_cos_mu(g, a, b, c, phi)
         return np.where(np.abs(cos) <= 1, np.arccos(np.clip(cos, -1, 1)), np.nan)
@@ -65,7 +65,7 @@ def mu_over(g, a, b, c, phi0, travel):
     return np.where(bad, np.nan, low), np.where(bad, np.nan, high)
 
 
-def motion_mu(g, a, b, c, phi0, travel, equal: float):
+def motion_mu(g, a, b, c, phi0, travel, equal: float) -> tuple[np.ndarray, np.ndarray]:
     """(mu_min, mu_max) [rad] over the motion a design runs: the whole turn when its input turns fully
     (a motor keeps turning it: four_bar_transmission's located extremes), else the crank's travel from
     phi0 (mu_over).  Arrays broadcast."""
@@ -138,7 +138,7 @@ class Constraints:
             out.append(f"transmission angle {t:.6g} .. {180 - t:.6g} deg over the motion")
         return out
 
-    def penalty(self, A0, B0, g, a, b, c, mu_lo, mu_hi, scale: float):
+    def penalty(self, A0: np.ndarray, B0: np.ndarray, g, a, b, c, mu_lo, mu_hi, scale: float):
         """How far each design is from meeting the constraints (0 where it meets them): lengths over
         ``scale`` plus angles in rad, summed; arrays of designs (A0, B0 (n, 2), the rest (n,))."""
         g, a, b, c = (np.asarray(v, float) for v in (g, a, b, c))
@@ -173,7 +173,7 @@ class Constraints:
             out += np.maximum(t - lo, 0) + np.maximum(hi - (math.pi - t), 0)
         return out
 
-    def unmet(self, A0, B0, g, a, b, c, mu, equal: float, tol: float) -> list:
+    def unmet(self, A0: np.ndarray, B0: np.ndarray, g, a, b, c, mu, equal: float, tol: float) -> list:
         """What one finished design does not meet (words; empty when it meets them all): ``mu`` its
         (min, max) transmission angle over the motion [rad] or None, ``tol`` [m] the slack on
         positions and lengths."""

@@ -36,17 +36,17 @@ def angle(v) -> float:
     return float(math.atan2(v[1], v[0]))
 
 
-def rotate(theta):
+def rotate(theta) -> np.ndarray:
     c, s = math.cos(theta), math.sin(theta)
     return np.array([[c, -s], [s, c]])
 
 
-def pose_matrix(pose):
+def pose_matrix(pose) -> tuple:
     """(R, p) of a pose (x, y, theta)."""
     return rotate(pose[2]), np.array(pose[:2], float)
 
 
-def branch(A, B, B0):
+def branch(A, B, B0: np.ndarray):
     """sigma: +1 when B lies left of the line A -> B0, -1 right (arrays broadcast)."""
     A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
     return np.sign(cross2(B0 - A, B - A))
@@ -56,7 +56,7 @@ def crank_angle(fb: FourBar) -> float:
     return angle(np.subtract(fb.A, fb.A0))
 
 
-def tool_local(fb: FourBar):
+def tool_local(fb: FourBar) -> tuple[float, float, float]:
     """The tool (guided frame or coupler point) in the coupler's frame: origin A, x axis along
     A -> B: (u, v, gamma)."""
     A, B = np.array(fb.A, float), np.array(fb.B, float)
@@ -66,7 +66,7 @@ def tool_local(fb: FourBar):
     return float(u), float(v), float(t[2] - phi)
 
 
-def positions(fb: FourBar, theta, sigma):
+def positions(fb: FourBar, theta, sigma: float) -> dict:
     """Closed-form positions at crank angles theta (absolute, array): dict with A, B, the tool
     pose (x, y, angle) arrays, h2 (< 0: not assembled) and mu."""
     theta = np.asarray(theta, float)
@@ -96,7 +96,7 @@ def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
     sigmas = np.asarray(sigmas, float)
     s1 = sigmas[0]
 
-    def along(direction, reach):
+    def along(direction, reach) -> tuple:
         t = np.linspace(0.0, reach, max(int(steps * reach / TWO_PI), 2) + 1)
         pos = positions(fb, thetas[0] + direction * t, s1)
         bad = np.nonzero(pos["h2"] < 0)[0]

@@ -52,7 +52,7 @@ def scale_of(poses) -> float:
     return d if d > 0 else 1.0
 
 
-def _burmester_rows(poses, A0):
+def _burmester_rows(poses, A0: np.ndarray) -> np.ndarray:
     """The rows [2 g_i, rhs_i] (i = 2..n) at fixed pivots A0 (..., 2): shape (..., n-1, 3)."""
     A0 = np.asarray(A0, float)
     R1, p1 = pose_matrix(poses[0])
@@ -65,7 +65,7 @@ def _burmester_rows(poses, A0):
     return np.stack(rows, axis=-2)
 
 
-def moving_pivot(poses, A0, what=WHAT):
+def moving_pivot(poses, A0: np.ndarray, what: str = WHAT) -> np.ndarray:
     """The moving pivot (coupler frame) of the dyad with fixed pivot A0 through three poses."""
     M = _burmester_rows(poses[:3], A0)
     G, r = M[:, :2], M[:, 2]
@@ -76,7 +76,7 @@ def moving_pivot(poses, A0, what=WHAT):
     return np.linalg.solve(G, r)
 
 
-def fixed_pivot(poses, local, what=WHAT):
+def fixed_pivot(poses, local, what: str = WHAT) -> np.ndarray:
     """The fixed pivot of a dyad whose moving pivot is ``local`` in the coupler frame: the centre
     of the circle through its three positions."""
     W = [pose_matrix(p)[0] @ np.asarray(local, float) + pose_matrix(p)[1] for p in poses[:3]]
@@ -105,7 +105,7 @@ def poles(poses) -> list:
     return out
 
 
-def _base_pole(poses):
+def _base_pole(poses) -> np.ndarray:
     """A pole P_1k (on the centre-point curve of these positions: its row vanishes), the one
     of the largest turn."""
     best = None
@@ -122,7 +122,7 @@ def _base_pole(poses):
     return np.linalg.solve(np.eye(2) - R, pk - R @ p1)
 
 
-def centre_point_curve(poses, directions: int = 360, bound: float | None = None):
+def centre_point_curve(poses, directions: int = 360, bound: float | None = None) -> tuple:
     """Points of the centre-point curve of four poses and their circle points (world, first
     position): (centre points (m, 2), circle points (m, 2), local moving pivots (m, 2),
     direction index (m,)), ordered by the direction of the line through the base pole and,
@@ -155,7 +155,7 @@ def centre_point_curve(poses, directions: int = 360, bound: float | None = None)
     return C[keep], circle[keep], local[keep], np.array(out_idx, int)[keep]
 
 
-def _circle_points(poses, C):
+def _circle_points(poses, C) -> tuple:
     """Moving pivots (local, and world at the first position) of the dyads with fixed pivots C
     (least squares of the linear equations; exact on the curve)."""
     if len(C) == 0:
@@ -184,7 +184,7 @@ def dyad_candidates(poses, count: int = 24, bound: float | None = None) -> tuple
     return tuple(out)
 
 
-def _D(poses4, X):
+def _D(poses4, X: np.ndarray):
     return np.linalg.det(_burmester_rows(poses4, X))
 
 
@@ -251,7 +251,7 @@ def fourbar_from_dyads(poses, crank: Dyad, rocker: Dyad) -> FourBar:
                    tuple(float(x) for x in poses[0]))
 
 
-def _positions_of(poses, crank: Dyad, rocker: Dyad):
+def _positions_of(poses, crank: Dyad, rocker: Dyad) -> tuple[np.ndarray, np.ndarray]:
     """Crank angles and branches of the four-bar at each pose (from the dyads themselves)."""
     thetas, sigmas = [], []
     for pose in poses:
@@ -273,7 +273,7 @@ def targets_of(poses, crank: Dyad) -> tuple:
                  for k, (pose, t) in enumerate(zip(poses, thetas)))
 
 
-def rank_pairs(poses, dyads, limit: int | None = None):
+def rank_pairs(poses, dyads, limit: int | None = None) -> list:
     """Every ordered pair (crank i, rocker j) of dyads, best first, in closed form
     (fourbar.travel_analysis): pairs without defects first, then by the worst transmission
     angle over the motion (the largest |90 deg - mu|).  Pairs whose ground is shorter than

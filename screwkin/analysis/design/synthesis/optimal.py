@@ -57,7 +57,7 @@ SEARCHED = 24
 TWO_PI = 2 * math.pi
 
 
-def _path_box(pts, constraints, L):
+def _path_box(pts: np.ndarray, constraints, L) -> tuple[np.ndarray, np.ndarray]:
     """The search's box: the pivots inside the bounds (else 2 path sizes around the points), the links
     within the length range (else 2 % of the path's size to 4 times it), the coupler point within 3 sizes."""
     plo, phi = constraints.pivot_box(pts.mean(axis=0), L)
@@ -67,13 +67,13 @@ def _path_box(pts, constraints, L):
     return np.array(lower, float), np.array(upper, float)
 
 
-def _box(pts, constraints, L) -> str:
+def _box(pts: np.ndarray, constraints, L) -> str:
     """_path_box in words."""
     lower, upper = _path_box(pts, constraints, L)
     return box_text(constraints, (lower[0:2], upper[0:2]), (lower[4], upper[4])) + f"; coupler point within {3 * L:.4g} m"
 
 
-def _free_cost(X, pts, sigma, direction, constraints, L, equal):
+def _free_cost(X: np.ndarray, pts: np.ndarray, sigma: float, direction, constraints, L, equal) -> tuple:
     """The search's cost of designs X (m, 9) without timing (module docstring), and each point's
     nearest sample (m, n)."""
     A0, B0 = X[:, 0:2], X[:, 2:4]
@@ -109,7 +109,7 @@ def _free_cost(X, pts, sigma, direction, constraints, L, equal):
     return np.where(np.isfinite(cost), cost, 1e3), j
 
 
-def _timed_cost(X, pts, timing, sigma, constraints, L, equal):
+def _timed_cost(X: np.ndarray, pts: np.ndarray, timing, sigma: float, constraints, L, equal) -> np.ndarray:
     """The search's cost of designs X (m, 10) with the crank angles prescribed."""
     A0, B0, a, b, c, p, q, th = _unpack(X, timing, 1.0)
     R = _residuals(X, pts, timing, 1.0, sigma, L)
@@ -152,13 +152,13 @@ def refined(residuals, x0, lower, upper, scale, weights=(PENALTY, PENALTY_REFINE
     return x
 
 
-def _refine(x0, pts, timing, direction, sigma, constraints, L, lower, upper, equal):
+def _refine(x0, pts: np.ndarray, timing, direction, sigma: float, constraints, L, lower, upper, equal):
     """path.py's least squares from x0 (its parameter order), with the constraints' penalty as one more
     residual; the pivots and links kept in the search's box."""
     n = len(pts)
     constraints = constraints.tightened(MARGIN * L, MARGIN)  # on the right side of a constraint it settles on
 
-    def residuals(X, weight):
+    def residuals(X: np.ndarray, weight) -> np.ndarray:
         R = _residuals(X, pts, timing, direction, sigma, L)
         A0, B0, a, b, c, _, _, th = _unpack(X, timing, direction)
         g = np.hypot(*(B0 - A0).T)
@@ -181,11 +181,11 @@ def _path_run(task):
     lower, upper = _path_box(pts, constraints, L)
     few = np.unique(np.linspace(0, len(pts) - 1, min(len(pts), SEARCHED)).round().astype(int))
     if timing is None:
-        def cost(X):
+        def cost(X: np.ndarray):
             return _free_cost(X, pts[few], sigma, direction, constraints, L, equal)[0]
         lo, hi = lower, upper
     else:
-        def cost(X):
+        def cost(X: np.ndarray):
             return _timed_cost(X, pts[few], timing[few] - timing[few[0]], sigma, constraints, L, equal)
         lo, hi = np.append(lower, -math.pi), np.append(upper, math.pi)
     pop, costs, nfev = evolve(cost, lo, hi, seed, generations, popsize)
@@ -203,7 +203,7 @@ def _path_run(task):
     return out, nfev
 
 
-def _judge(pts, x, sigma, direction, timing, constraints, L, tol, equal, run):
+def _judge(pts: np.ndarray, x, sigma: float, direction, timing, constraints, L, tol, equal, run) -> tuple | None:
     """A refined design as a Candidate (closed form: errors, motion, defects, constraints)."""
     A0, B0, a, b, c, p, q, th = _unpack(x, timing, direction)
     P, h2, A, B = (v[0] for v in coupler_points(A0, B0, a, b, c, p, q, th, sigma))
@@ -236,7 +236,7 @@ def _defect_words(d) -> str:
     return "order: the points are not met in the order given"
 
 
-def rank_key(cand: Candidate, tol: float):
+def rank_key(cand: Candidate, tol: float) -> tuple:
     """Feasible first, then without defects, then the miss (within ``tol`` counted as none), then the
     transmission angle's worst deviation from 90 deg."""
     mu = cand.transmission

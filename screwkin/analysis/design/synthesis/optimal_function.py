@@ -32,7 +32,7 @@ from .search import SearchReport, box_text, distinct_best, evolve, run_all, task
 __all__ = ["optimal_function"]
 
 
-def _unknowns(task, constraints):
+def _unknowns(task, constraints) -> tuple:
     """(names of the unknowns, lower, upper): a, b, c (and d with --lengths, B0's x, y with --bounds)."""
     d = task["ground"]
     lo, hi = constraints.lengths if constraints.lengths is not None else (0.05 * d, 10 * d)
@@ -44,7 +44,7 @@ def _unknowns(task, constraints):
     return names, np.array(lower, float), np.array(upper, float)
 
 
-def _parts(X, names, task, bounds=None):
+def _parts(X: np.ndarray, names, task, bounds=None) -> tuple:
     """a, b, c, d (m,) and B0 (m, 2): at the origin, or, with ``bounds``, the ground line centred in the box."""
     get = {n: X[:, k] for k, n in enumerate(names)}
     d = get.get("d", np.full(len(X), task["ground"]))
@@ -56,7 +56,7 @@ def _parts(X, names, task, bounds=None):
     return get["a"], get["b"], get["c"], d, B0
 
 
-def _errors(X, names, task, signs, constraints, equal, phi, psi):
+def _errors(X: np.ndarray, names, task, signs, constraints, equal, phi, psi) -> tuple:
     """(structural errors (m, n) [rad], penalties (m,), mu (lo, hi)) of designs X at the angles phi, psi;
     ``signs`` (branch, crank's, rocker's): Freudenstein's signed crank and rocker (a link pointing the
     other way from its angle, as function.py's negative a or c)."""
@@ -81,7 +81,7 @@ def _function_run(job):
     _, lower, upper = _unknowns(task, constraints)
     phi, psi = task["phi"], task["psi"]
 
-    def cost(X):
+    def cost(X: np.ndarray) -> np.ndarray:
         err, pen, (lo, hi) = _errors(X, names, task, signs, constraints, equal, phi, psi)
         dev = np.where(np.isnan(lo), math.pi / 2, np.maximum(math.pi / 2 - lo, hi - math.pi / 2))
         c = np.sqrt((err ** 2).mean(axis=1)) + PENALTY * pen + PREFER * dev / (math.pi / 2)
@@ -90,7 +90,7 @@ def _function_run(job):
     pop, costs, nfev = evolve(cost, lower, upper, seed, generations, popsize)
     tight = constraints.tightened(MARGIN * task["ground"], MARGIN)
     out = []
-    def residuals(X, weight):
+    def residuals(X: np.ndarray, weight) -> np.ndarray:
         err, pen, _ = _errors(X, names, task, signs, tight, equal, phi, psi)
         return np.concatenate([err, weight * pen[:, None]], axis=1)
 
@@ -99,7 +99,7 @@ def _function_run(job):
     return out, nfev
 
 
-def optimal_function(text, x_range, input_range, output_range, points, spacing, ground, constraints, search,
+def optimal_function(text: str, x_range, input_range, output_range, points, spacing, ground, constraints, search,
                      equal: float = 1e-9) -> FunctionResult:
     """The best function generators that meet ``constraints`` (module docstring): the FunctionResult of
     the best, its ``search`` report listing the best few."""

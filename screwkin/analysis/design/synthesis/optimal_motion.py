@@ -45,14 +45,14 @@ BETWEEN = 8
 TWO_PI = 2 * math.pi
 
 
-def _frames(poses):
+def _frames(poses) -> tuple:
     R = np.array([pose_matrix(p)[0] for p in poses])
     p = np.array([p[:2] for p in poses], float)
     th = np.array([p[2] for p in poses], float)
     return R, p, th
 
 
-def _driven(A0, a, B0, b, poses, direction, constraints, L, equal):
+def _driven(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints, L, equal) -> tuple:
     """(miss residuals (m, 2n): origin's miss over L and angle's miss per pose, penalties (m,), mu (lo, hi),
     the crank angles (m, n)) of designs A0, a, B0, b (m, 2) driven through the poses."""
     R, P, TH = _frames(poses)
@@ -68,7 +68,7 @@ def _driven(A0, a, B0, b, poses, direction, constraints, L, equal):
     rel = np.mod(direction * (th - th[:, :1]), TWO_PI)  # travel from the first pose, the crank turning one way
     order = np.maximum(-np.diff(rel, axis=1), 0).sum(axis=1) / TWO_PI  # the poses met in another order
 
-    def at(theta):
+    def at(theta) -> tuple:
         A = A0[:, None, :] + crank[:, None, None] * np.stack([np.cos(theta), np.sin(theta)], -1)
         B, h2 = circle_circle(A, coupler[:, None], B0[:, None, :], rocker[:, None], sigma[:, None])
         return A, B, h2
@@ -94,7 +94,7 @@ def _driven(A0, a, B0, b, poses, direction, constraints, L, equal):
     return res, pen, (mu_lo, mu_hi), th
 
 
-def _cost(A0, a, B0, b, poses, direction, constraints, L, equal):
+def _cost(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints, L, equal) -> np.ndarray:
     res, pen, (lo, hi), _ = _driven(A0, a, B0, b, poses, direction, constraints, L, equal)
     err = np.sqrt((res ** 2).mean(axis=1))
     deviation = np.where(np.isnan(lo), math.pi / 2, np.maximum(math.pi / 2 - lo, hi - math.pi / 2))
@@ -102,7 +102,7 @@ def _cost(A0, a, B0, b, poses, direction, constraints, L, equal):
     return np.where(np.isfinite(cost), cost, 1e3)
 
 
-def _solve2(G, r):
+def _solve2(G, r) -> np.ndarray:
     """Batched 2 x 2 (or least-squares) solves, NaN where singular."""
     if G.shape[-2] != 2:
         G, r = np.einsum("mki,mkj->mij", G, G), np.einsum("mki,mk->mi", G, r)
@@ -113,7 +113,7 @@ def _solve2(G, r):
     return np.where(np.isfinite(x), x, np.nan)
 
 
-def _moving(poses, A0):
+def _moving(poses, A0: np.ndarray):
     """The moving pivots (m, 2) of the dyads with fixed pivots A0 (m, 2) through the poses (3: exactly;
     4: on the centre-point curve, exactly)."""
     M = _burmester_rows(poses, A0)
@@ -137,7 +137,7 @@ def _curve_points(poses, alpha, root, L):
     return P + t[:, None] * e
 
 
-def _dyads_of(kind, X, poses, L, root=None):
+def _dyads_of(kind: str, X: np.ndarray, poses, L, root=None) -> tuple:
     """(A0, a, B0, b) of designs X for a kind of run: "pivots" (3 poses), "curve" (4), "free" (6+)."""
     if kind == "pivots":
         A0, B0 = X[:, 0:2], X[:, 2:4]
@@ -149,7 +149,7 @@ def _dyads_of(kind, X, poses, L, root=None):
     return X[:, 0:2], X[:, 2:4], X[:, 4:6], X[:, 6:8]
 
 
-def _motion_box(kind, poses, constraints, L):
+def _motion_box(kind: str, poses, constraints, L) -> tuple[np.ndarray, np.ndarray]:
     """The search's box of a kind of run: the pivots inside the bounds (else 2 sizes around the poses),
     the curve parameters in [0, pi], the moving pivots within 3 sizes."""
     plo, phi = constraints.pivot_box(np.mean([p[:2] for p in poses], axis=0), L)
@@ -169,7 +169,7 @@ def _motion_run(task):
     kind, poses, root, direction, constraints, L, seed, generations, popsize, equal = task
     lower, upper = _motion_box(kind, poses, constraints, L)
 
-    def cost(X):
+    def cost(X: np.ndarray):
         return _cost(*_dyads_of(kind, X, poses, L, root), poses, direction, constraints, L, equal)
 
     pop, costs, nfev = evolve(cost, lower, upper, seed, generations, popsize)
@@ -178,7 +178,7 @@ def _motion_run(task):
     for k in distinct_best(pop, costs, lower, upper, REFINED):
         x = pop[k]
         if kind == "free":
-            def residuals(X, weight):
+            def residuals(X: np.ndarray, weight) -> np.ndarray:
                 res, pen, _, _ = _driven(*_dyads_of(kind, X, poses, L), poses, direction, tight, L, equal)
                 return np.concatenate([res, weight * pen[:, None]], axis=1)
             x = refined(residuals, x, lower, upper, L)
@@ -193,7 +193,7 @@ def _motion_run(task):
     return out, nfev
 
 
-def _judge_motion(poses, A0, a, B0, b, direction, constraints, L, tol, equal, run, exact):
+def _judge_motion(poses, A0: np.ndarray, a, B0: np.ndarray, b, direction, constraints, L, tol, equal, run, exact):
     R1, p1 = pose_matrix(poses[0])
     crank, rocker = Dyad(tuple(map(float, A0)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))), \
         Dyad(tuple(map(float, B0)), tuple(map(float, R1 @ b + p1)), tuple(map(float, b)))

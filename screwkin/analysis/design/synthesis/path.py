@@ -40,7 +40,7 @@ TWO_PI = 2 * math.pi
 _BETWEEN = np.array([0.25, 0.5, 0.75])
 
 
-def _unpack(x, timing, direction):
+def _unpack(x, timing, direction) -> tuple:
     """The parameters of one design (x: (n,)) or of many (x: (m, n)), as arrays with the design
     index first: A0, B0 (m, 2), a, b, c, p, q (m,), crank angles th (m, N)."""
     X = np.atleast_2d(x)
@@ -54,7 +54,7 @@ def _unpack(x, timing, direction):
     return A0, B0, a, b, c, p, q, th
 
 
-def coupler_points(A0, B0, a, b, c, p, q, th, sigma):
+def coupler_points(A0: np.ndarray, B0: np.ndarray, a, b, c, p, q: np.ndarray, th, sigma: float) -> tuple:
     """Coupler point at crank angles th (..., N) of designs whose parameters (A0, B0 (..., 2); a,
     b, c, p, q scalars or (...,)) broadcast against them: (P (..., N, 2), h2 (..., N): < 0 where
     the linkage does not assemble, A, B)."""
@@ -66,7 +66,7 @@ def coupler_points(A0, B0, a, b, c, p, q, th, sigma):
     return A + p[..., None] * u + q[..., None] * n, h2, A, B
 
 
-def _residuals(X, pts, timing, direction, sigma, L):
+def _residuals(X: np.ndarray, pts: np.ndarray, timing, direction, sigma: float, L) -> np.ndarray:
     """Residuals of designs X (m, n) -> (m, residuals): the distances to the points (over L),
     how far apart the circles are at and between the points (weighted), a turn exceeded."""
     A0, B0, a, b, c, p, q, th = _unpack(X, timing, direction)
@@ -81,7 +81,7 @@ def _residuals(X, pts, timing, direction, sigma, L):
     return np.concatenate([r, 10 * apart / L, np.maximum(travel - 0.98 * TWO_PI, 0.0)[:, None]], axis=1)
 
 
-def _problem(pts, timing, direction, sigma, L):
+def _problem(pts: np.ndarray, timing, direction, sigma: float, L):
     """(fun, jac) for scipy: the Jacobian by central differences, all 2n designs in one call."""
     def fun(x):
         return _residuals(x[None], pts, timing, direction, sigma, L)[0]
@@ -150,7 +150,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
         raise SynthesisError(WHAT, f"no start out of {starts} gave a four-bar that assembles at every point")
     good = [r for r in results if r[0] <= tolerance]
 
-    def quality(r):
+    def quality(r) -> tuple:
         _, x, sigma, direction, errors, A, B, P, th = r
         fb = FourBar(tuple(x[0:2]), tuple(A[0]), tuple(B[0]), tuple(x[2:4]), (*P[0], 0.0))
         res = travel_analysis(fb, th, np.full(len(th), sigma))
@@ -166,7 +166,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
                       tuple(map(float, errors)), starts, len(good), tolerance, design)
 
 
-def path_points(points, timing=None):
+def path_points(points, timing=None) -> tuple:
     """(points (n, 2), timing relative to the first point or None, the path's size L [m]), checked:
     3 to MAX_POINTS distinct points; one crank angle per point running one way within a turn."""
     pts = np.array(points, float)
@@ -194,7 +194,7 @@ def path_points(points, timing=None):
     return pts, timing, L
 
 
-def path_design(pts, x, sigma, A, B, P, th, errors, name: str = "synthesized_path", exact: bool = True):
+def path_design(pts: np.ndarray, x, sigma: float, A, B, P, th, errors, name: str = "synthesized_path", exact: bool = True) -> tuple:
     """(the Design of the four-bar x (A0, B0, ...: path._unpack's order) drawn at the first point, its
     crank angles from the first point): A, B, P the moving pivots and coupler point at each point;
     ``exact`` False: the points are approximated (least squares), a miss is not a defect."""
