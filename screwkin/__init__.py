@@ -14,11 +14,16 @@ topology) <- ``analysis`` (results) <- ``present`` (text, JSON, pictures, views)
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING
 
 from .errors import AssemblyError, MechanismFileError, ScrewkinError, UsageError
 from .model import loader as _loader
 from .model import mechanism as _mechanism
 from .tolerances import Tolerances
+
+if TYPE_CHECKING:  # the return types of the methods below, imported lazily at run time
+    from .analysis.design.study import StudyResult
+    from .analysis.mobility import MobilityResult
 
 #: The rest of the public API, imported when first used (``screwkin.sweep``, ``from screwkin import
 #: scan``): ``import screwkin`` (and the command line, which imports it) loads the model layer

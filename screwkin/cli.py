@@ -189,7 +189,7 @@ def main(argv=None) -> int:
         return exc.exit_code
     except KeyboardInterrupt:  # pragma: no cover
         return 130
-    except Exception as exc:  # a bug in screwkin, not a problem of the input: still one line, exit 3
+    except Exception as exc:  # noqa: BLE001 - a bug in screwkin, not a problem of the input: still one line, exit 3
         if debug:
             traceback.print_exc()
         where = f" on {one_line(paths[0], 200)}" if paths else ""

@@ -188,7 +188,7 @@ class Series:
             self.S.append(self._next_screws())
         self.X.append(np.asarray(xk, float))
 
-    def copy(self) -> "Series":
+    def copy(self) -> Series:
         other = Series.__new__(Series)
         other.sys, other.X, other.S, other.P = self.sys, list(self.X), list(self.S), list(self.P)
         return other

@@ -232,7 +232,7 @@ def redundancy(mech: Mechanism, q: np.ndarray, suggest_fix: bool = False) -> Red
     for k in range(count):
         lam = Lam[:, k]
         per = {}
-        for i, (fa, wa, fb, wb) in enumerate(wrench_rows):
+        for i, (fa, _wa, fb, wb) in enumerate(wrench_rows):
             if abs(lam[i]) <= mech.tolerances.zero * np.abs(lam).max():
                 continue
             if fa is None:  # a coupling row: its multiplier is what it carries

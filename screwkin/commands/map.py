@@ -76,7 +76,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if point and not output:
         raise UsageError("--point needs --output LINK")
     # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
-    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)
+    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
     if args.connect and not args.loci:
         raise UsageError("--connect needs --loci: the loops go round the cusps of the traced loci")

@@ -147,7 +147,7 @@ def redundant_rows(text: str, tol: Tolerances = DEFAULT) -> tuple:
     """(the number of equality rows MuJoCo writes at qpos0, RedundantRows of each equality of the
     MJCF ``text`` that has redundant ones, in the file's order), from MuJoCo's efc_J at qpos0 (dense;
     contacts and limits off).  Raises ImportError without MuJoCo."""
-    import mujoco  # noqa: PLC0415 - MuJoCo is optional: imported only when asked
+    import mujoco  # MuJoCo is optional: imported only when asked
 
     m = mujoco.MjModel.from_xml_string(text)
     m.opt.jacobian = mujoco.mjtJacobian.mjJAC_DENSE

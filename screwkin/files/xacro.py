@@ -45,8 +45,6 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import defusedxml
-
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..units import parse_value
 from .description import LIMITS

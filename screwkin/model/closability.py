@@ -94,7 +94,7 @@ def closure_gap(mech):
 
         def flat(ref):
             p = state.centre(ref)
-            return p - (p @ n) * n
+            return p - (p @ n) * n  # noqa: B023 - called within this iteration
 
         P = [flat(r) for r in points]
         found = obstacle_of(cut, names, [float(np.linalg.norm(P[k + 1] - P[k])) for k in range(len(P) - 1)],

@@ -232,7 +232,7 @@ def _virtual_pairs(model: pin.Model, spec) -> None:
             if model.existJointName(name):
                 raise MechanismFileError(spec.path, f"joint {quote(name)} is also the name of a coordinate of loop "
                                                     f"joint {quote(c.name)} ({c.type}): rename one of them")
-            jid = model.addJoint(joint_parent, jm, M, name, np.zeros(1), np.zeros(1), inf, zero)
+            jid = model.addJoint(joint_parent, jm, M, name, np.zeros(1), np.zeros(1), inf, zero)  # noqa: B023 - add is called at once
             model.appendBodyToJoint(jid, pin.Inertia.Zero(), pin.SE3.Identity())
             return jid
 

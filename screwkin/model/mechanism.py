@@ -486,7 +486,7 @@ class Mechanism:
                   if total > 1 else given)
         raise AssemblyError(self.path, best, best_it, detail=starts, starts=total)  # (a proved gap raised above)
 
-    def with_rows(self, rows) -> "Mechanism":
+    def with_rows(self, rows) -> Mechanism:
         """This mechanism with more closure rows (model.cuts.CouplingRow: a link's absolute angle
         held as an input), for the solves of one command: a shallow copy that shares the model, the
         coordinates and the assembly search (made first, on the mechanism's own loops) and has a

@@ -58,7 +58,7 @@ def probe_scheduler(address: str, timeout: float) -> None:
             if not 0 < n <= MAX_HANDSHAKE:
                 raise UsageError(f"not a Dask scheduler at {where}: its first message announces {n} bytes")
             body = _recv_exactly(sock, n)
-    except (TimeoutError, socket.timeout):
+    except TimeoutError:
         raise UsageError(f"not a Dask scheduler at {where}: no handshake within {timeout:g} s") from None
     except ConnectionError as exc:
         raise UsageError(f"the dask scheduler at {where} cannot be reached ({exc.strerror or exc})") from None

@@ -34,7 +34,6 @@ import sys
 
 from ..errors import OutputError
 from types import TracebackType
-from typing import Optional, Type
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -98,7 +97,7 @@ class WholeOrNothing:
     def __enter__(self):
         return self
 
-    def __exit__(self, kind: Optional[Type[BaseException]], exc: Optional[BaseException], tb: Optional[TracebackType]) -> None:
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None) -> None:
         if kind is None:
             self.close()
         else:

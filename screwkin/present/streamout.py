@@ -19,7 +19,7 @@ __all__ = ["SweepWriter", "parquet_available"]
 
 def parquet_available() -> bool:
     try:
-        import pyarrow  # noqa: F401
+        import pyarrow
         import pyarrow.parquet  # noqa: F401
     except ImportError:
         return False
@@ -94,7 +94,7 @@ class SweepWriter(WholeOrNothing):
         if writer is not None:
             try:
                 writer.close()
-            except Exception:  # (its file is discarded below)
+            except Exception:  # noqa: BLE001, S110 - its file is discarded below
                 pass
         for f in (self._csv, self._pq_file):
             if f is not None:

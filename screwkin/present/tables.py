@@ -61,7 +61,7 @@ class RateUnits:
     linear_acceleration: str = "m/s^2"
 
     @classmethod
-    def typed(cls, rates=(), accels=()) -> "RateUnits":
+    def typed(cls, rates=(), accels=()) -> RateUnits:
         """The units of the first rate and acceleration typed of each kind (angular, linear), from the
         units.Quantity values of --rate and --accel: a rate's unit per second for the accelerations
         too (rpm: rpm/s), an acceleration typed winning over it; SI for the kinds typed bare or in SI."""

@@ -409,6 +409,6 @@ def _check_reference(d, fb, placed, spec) -> None:
             if np.abs(p[0] - M.translation).max() > scale or np.abs(R[0] - M.rotation).max() > equal:
                 raise Unbatchable(f"the family's template does not place joint {name} where its file does")
     for c in mech.cuts:
-        for fid, (R, p) in zip((c.frame1, c.frame2), placed.cuts[c.name]):
+        for fid, (_R, p) in zip((c.frame1, c.frame2), placed.cuts[c.name]):
             if np.abs(p[0] - state.frame_placement(fid).translation).max() > scale:
                 raise Unbatchable(f"the family's template does not place loop joint {c.name} where its file does")

@@ -266,7 +266,7 @@ def _force_margin(spec, forces, tol):
     torsion component where the coefficient is 0)."""
     worst = 1.0
     total = sum(cf.normal for cf in forces)
-    for c, cf in zip(spec.contacts, forces):
+    for _c, cf in zip(spec.contacts, forces):
         if not cf.normal > tol.margin * total:
             return -1.0
         for ratio, comp in ((cf.friction_ratio, math.hypot(*cf.tangential) if cf.tangential else 0.0),

@@ -266,7 +266,7 @@ def joint_wrenches(mech: Mechanism, q: np.ndarray, lam, loads=(), gravity: bool=
         jid = model.getJointId(cp.joint)
         f, M = data.f[jid], state.joint_placement(jid)
         out[cp.joint] = ("coupled", np.r_[M.rotation @ f.linear, M.rotation @ f.angular])
-    for name, (frame, wrench) in cut.items():
+    for name, (_frame, wrench) in cut.items():
         out[name] = ("cut", wrench)
     return out
 
@@ -413,11 +413,11 @@ def legs(mech: Mechanism, q: np.ndarray, output, inputs=None) -> tuple:
 
         def allowed(locked):
             blocks, n_extra = [], []
-            for frame, cut in leg["ends"]:
+            for frame, cut in leg["ends"]:  # noqa: B023 - called within this iteration
                 A = _cut_twists(mech, cut, o, state) if cut is not None else np.zeros((6, 0))
                 blocks.append((at_platform(frame), A))
                 n_extra.append(A.shape[1])
-            free_cols = [c for c in cols if c not in (act if locked else [])]
+            free_cols = [c for c in cols if c not in (act if locked else [])]  # noqa: B023 - called within this iteration
             # unknowns: t (6), the leg's free joint rates, each connection's a_c
             n = 6 + len(free_cols) + sum(n_extra)
             rows, start = [], 6 + len(free_cols)

@@ -112,7 +112,7 @@ class Problem:
     target: bool = False
 
 
-def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),
+def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),  # noqa: B008 - frozen
                     problem: Problem | None = None):
     """The assembly modes for the input ``values`` by homotopy continuation (see the module): a
     Certified, or the reason (a string) why the method does not apply.  ``problem``: another system

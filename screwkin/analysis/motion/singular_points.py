@@ -70,7 +70,7 @@ def locate_singularities(solver, res: SweepResult, output=None, xtol: float = LO
             q_at = reclosing(solver, res, q_k, tight)
 
             def signed(x, u=u, v=v, V_ref=V_ref) -> float:
-                return float(u @ _matrix(mech, q_at(x), kind, g, V_ref) @ v)
+                return float(u @ _matrix(mech, q_at(x), kind, g, V_ref) @ v)  # noqa: B023 - used within this iteration
 
             lo, hi = sorted((xs[lo_k], xs[hi_k]))
             try:

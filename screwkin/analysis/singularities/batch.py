@@ -80,7 +80,7 @@ class SerialJacobians:
         # how each chain joint's displacement theta is read from q (relative to the neutral configuration)
         self._reads = []
         neutral = mech.neutral()
-        for name, col in zip(chain.joints, chain.columns):
+        for name, _col in zip(chain.joints, chain.columns):
             jid = model.getJointId(name)
             iq, nq = model.idx_qs[jid], model.nqs[jid]
             if nq == 1:

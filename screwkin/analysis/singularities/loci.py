@@ -464,7 +464,7 @@ def trace_kind(sys, kind: str, seeds, box, notes) -> tuple:
         if not closed:
             qs, vs = _clip(sys, qs, vs, box)
         traced.append((np.array(qs), np.array(vs), closed))
-        for qc, vc in cq:
+        for qc, _vc in cq:
             p = sys.xy(qc)
             if _in_box(p, box) and not any(np.allclose(p, c[0], atol=1e-7) for c in cusps):
                 cusps.append((tuple(p), kind))

@@ -149,7 +149,7 @@ def refine_node(sys, one, k1, f1, other, k2, f2, span):
     the two arclengths s1, s2 from the segments' first points, xy(curve1(s1)) = xy(curve2(s2)), each
     point converged on F (LocusSystem.along).  None when it does not converge."""
     starts = []
-    for (P, Q, V), k, f in ((one, k1, f1), (other, k2, f2)):
+    for (_P, Q, V), k, f in ((one, k1, f1), (other, k2, f2)):
         q, v = Q[k], V[k]
         t = sys.tangent(q, v)
         dz = np.concatenate([sys.mech.difference(q, Q[k + 1]) / sys.scale, V[k + 1] - v])

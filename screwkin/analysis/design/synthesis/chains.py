@@ -274,7 +274,7 @@ def chain_linkage(chain: Chain, ground: int, size: float = 0.1, seed: int = 0, d
     layout = nx.spring_layout(g, seed=seed + 1, iterations=200)
     centres = {v: np.asarray(layout[v], float) * size for v in g.nodes}
     points, axes = {}, {}
-    for u, v, k in chain.joints:
+    for u, v, _k in chain.joints:
         mid = (centres[u] + centres[v]) / 2
         span = float(np.hypot(*(centres[u] - centres[v]))) or size
         points[(u, v)] = mid + rng.normal(scale=0.2 * span, size=2)

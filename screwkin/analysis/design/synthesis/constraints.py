@@ -85,7 +85,7 @@ class Constraints:
     grashof: str | None = None
     min_transmission: float | None = None
 
-    def check(self) -> "Constraints":
+    def check(self) -> Constraints:
         """These constraints, refused (UsageError, in the options' words) where the box's corners are out
         of order or the length range is not 0 < MIN < MAX: the one check of the command and the API."""
         if self.bounds is not None:
@@ -97,7 +97,7 @@ class Constraints:
             raise UsageError(f"--lengths: give 0 < MIN < MAX, got {self.lengths[0]:g} m .. {self.lengths[1]:g} m")
         return self
 
-    def tightened(self, length: float, angle: float) -> "Constraints":
+    def tightened(self, length: float, angle: float) -> Constraints:
         """These constraints with a margin (``length`` [m] inside the bounds and the length range,
         ``angle`` [rad] on the transmission angle): a refinement that settles on a constraint's edge then
         stays on its right side of it."""
