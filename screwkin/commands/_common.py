@@ -46,7 +46,7 @@ def add_scaled(sp, point: bool=True) -> None:
                              "instead of its full motion")
 
 
-def emit(args: argparse.Namespace, data, text: str) -> int:
+def emit(args: argparse.Namespace, data, text) -> int:
     """Print ``data`` as one JSON object (--json; written by present/jsonout.json_of, the one writer) or
     ``text`` (a string, or a callable making it, so that text-only work is skipped for --json); exit code 0."""
     if getattr(args, "json", False):

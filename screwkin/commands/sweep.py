@@ -123,7 +123,7 @@ def _streamed(args: argparse.Namespace) -> bool:
     return True
 
 
-def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop, fixed, q_start: np.ndarray, rate) -> int:
+def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop, fixed, q_start, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None

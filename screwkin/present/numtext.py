@@ -28,7 +28,7 @@ _FOUR = np.frombuffer("".join(f"{i:04d}" for i in range(10000)).encode(), dtype=
 _SLOT = np.arange(P + 1, dtype=np.int8)
 
 
-def _scaled(a, k: int):
+def _scaled(a, k):
     """|x| 10^k for k in [-22, 44] with at most two roundings."""
     p = _POW10[np.minimum(np.abs(k), 22)]
     s = a * p

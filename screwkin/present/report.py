@@ -140,7 +140,7 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name: str, value, angular) -> str:
+def value_text(name, value, angular) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"

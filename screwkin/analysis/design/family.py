@@ -232,7 +232,7 @@ def _flat(P, n: int):
     return P - np.einsum("ni,ni->n", P, n)[:, None] * n
 
 
-def family_rows(task, chunk: int):
+def family_rows(task, chunk):
     """The rows of ``chunk`` ([(index, values), ...]) by the family path (module docstring), a
     ChunkRows; None when the study is not one it applies to (its metrics, a plain file)."""
     if eligible(task) is not None:
@@ -248,7 +248,7 @@ def family_rows(task, chunk: int):
                                                         f"{exc}"])
 
 
-def _family(task, chunk: int, index: int, values, alone) -> ChunkRows:
+def _family(task, chunk, index: int, values, alone) -> ChunkRows:
     n = len(chunk)
     be = expand_batch(task.file, task.text, task.args, {p: values[:, k] for k, p in enumerate(task.parameters)})
     specs = [None] * n

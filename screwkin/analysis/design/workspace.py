@@ -186,7 +186,7 @@ def _translations(mech: Mechanism, q: np.ndarray, output, point) -> np.ndarray:
 def workspace(mech: Mechanism, output: str, point: bool = False, orientation=None, resolution: float | None = None,
               bounds=None, threshold: float = DEFAULT_THRESHOLD, length: float | None = None,
               method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None,
-              timeout: float | None = None, q_start: np.ndarray | None = None) -> WorkspaceResult:
+              timeout: float | None = None, q_start=None) -> WorkspaceResult:
     """The workspace of link ``output`` (see the module's text).
 
     point: its origin as a point (orientation free); else at a constant ``orientation`` (a 3x3
@@ -233,7 +233,7 @@ def workspace(mech: Mechanism, output: str, point: bool = False, orientation=Non
                  q_start)
 
 
-def _seed(mech: Mechanism, output, point, orientation, q_start: np.ndarray | None = None) -> tuple:
+def _seed(mech: Mechanism, output, point, orientation, q_start=None) -> tuple:
     """The assembled configuration the grid starts from (``q_start`` when given), the output's position
     and the grid's orientation there (continued from the file's orientation to the one asked)."""
     assembly, generic = mech.generic_configurations()
@@ -288,7 +288,7 @@ def _index_bounds(bounds, p_seed, axes, h, dim) -> tuple:
 
 
 def _grid(mech: Mechanism, output, point, orientation, measures, resolution, bounds, threshold, L, inputs,
-          deadline=None, q_start: np.ndarray | None = None) -> WorkspaceResult:
+          deadline=None, q_start=None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
     except Unbatchable as e:

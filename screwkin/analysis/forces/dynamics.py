@@ -243,7 +243,7 @@ def _range_mean(values, y) -> float:
 
 def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
              fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress=None, q_start: np.ndarray | None = None, branch: str = "continue") -> DynamicsResult:
+             cs: float = 0.05, progress=None, q_start=None, branch: str = "continue") -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 

@@ -424,7 +424,7 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs: np.ndarray, branch: str | None = None, clamp=None):
+    def predict(self, xs, branch=None, clamp=None):
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""

@@ -184,7 +184,7 @@ def transmission_angles(mech: Mechanism, info: LinkageInfo, Q: np.ndarray) -> np
                          None if info.slide is None else np.asarray(info.slide, float))
 
 
-def _transmission(kind: str, P, n: int, slide=None):
+def _transmission(kind: str, P, n, slide=None):
     """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
     unit normal n (slide: the slide's unit direction, slider-crank)."""
     P = P - (P @ n)[..., None] * n

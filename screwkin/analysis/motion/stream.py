@@ -54,7 +54,7 @@ def _keep_turns(mech: Mechanism, res: SweepResult, q_prev: np.ndarray) -> SweepR
 
 
 def sweep_chunks(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-                 near: dict | None = None, rate: float = 1.0, chunk: int = DEFAULT_CHUNK, q_start: np.ndarray | None = None, **options: Any):
+                 near: dict | None = None, rate: float = 1.0, chunk: int = DEFAULT_CHUNK, q_start=None, **options: Any):
     """Yield ``sweep(solver, name, start, stop, steps, ...)``'s motion as SweepResults of at most
     ``chunk`` (+1 for the first) consecutive steps each, in the order of the motion (see the module
     docstring).  ``q_start``: the configuration of the mode to follow (as sweep's).  ``options``: sweep's other

@@ -182,7 +182,7 @@ def _refined(f, start, h, k: int):
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
-          max_steps: int | None = None, q_start: np.ndarray | None = None, closed_form: bool = True, batch: bool = True,
+          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True,
           branch: str = "continue", prior=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
@@ -253,7 +253,7 @@ def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
     return fixed
 
 
-def _start(solver, name: str, start, fixed, near, q_start: np.ndarray):
+def _start(solver, name: str, start, fixed, near, q_start):
     """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
     may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
     drawing when it is solve's first mode there, else solve's first (near ``near``)."""

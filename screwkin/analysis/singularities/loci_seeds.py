@@ -34,7 +34,7 @@ def unexplained_folds(sheets, loci, box, n: int) -> list:
     return []
 
 
-def sheets(solver, x_name: str, y_name: str, box, starts: int, n: int):
+def sheets(solver, x_name: str, y_name: str, box, starts, n: int):
     """Each start continued over an n x n grid of the box from its nearest node: a list of
     (qs (n, n, nq) with NaN where not reached, refused (n, n) bool: a step from there refused)."""
     mech = solver.mech

@@ -47,7 +47,7 @@ class SingularityMap:
 
 
 def singularity_map(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed=None, output=None, point: bool = False,
-                    q_start: np.ndarray | None = None) -> SingularityMap:
+                    q_start=None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
     if x_name == y_name:
