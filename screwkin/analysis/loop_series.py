@@ -146,7 +146,7 @@ class Series:
     def _y(self, k: int):
         return self.sys.multiplier * self.X[k][self.sys.column]
 
-    def _p(self, m, with_last: bool=True):
+    def _p(self, m: int, with_last: bool=True):
         terms = [self.S[l] * self._y(m - l)[:, None] for l in range(m + 1) if with_last or l > 0]
         return np.sum(terms, axis=0) if terms else np.zeros_like(self.sys.screws)
 
@@ -194,7 +194,7 @@ class Series:
         return other
 
 
-def _units(mech: Mechanism, state) -> tuple:
+def _units(mech: Mechanism, state: KinematicState) -> tuple:
     """Every unit of the tree: (screw (v, w) at the world origin, column, multiplier), the carriers
     of each (a set of unit indices), the units of each joint, and a note when a joint has no closed
     form here.  A Pinocchio mimic joint is a unit of its primary's column (its motion subspace holds
@@ -266,7 +266,7 @@ def coordinates(kind: str, where: str) -> np.ndarray:
     return np.eye(6)
 
 
-def _cut_units(mech: Mechanism, cut, state, kind: str, where: str, L):
+def _cut_units(mech: Mechanism, cut, state: KinematicState, kind: str, where: str, L: float):
     """The cut joint's freedoms as world twists [(name, twist, sliding)] (screws.cut_twists); a ball's
     three rotations about axes that put the algebra's own rotation last (e1, e2, n in a plane)."""
     # a sliding contact closes through a planar cut joint (its contact row apart); a rolling, gear or screw

@@ -118,7 +118,7 @@ def _body_frames(mech: Mechanism, topo):
     return frames
 
 
-def _joint_geometry_rows(mech: Mechanism, topo, frames, jac, state):
+def _joint_geometry_rows(mech: Mechanism, topo, frames, jac: dict, state: KinematicState):
     """Rows whose null space is the set of motions keeping every joint's geometry still.
 
     For each joint and each of its two links: the velocity (seen from that link)
@@ -308,7 +308,7 @@ def analyze_mobility(mech: Mechanism, output=None, seed: int = 0, point: bool = 
     return mech.cache[key]
 
 
-def _local_notes(local, where: str, M_generic, generic_rank, samples) -> tuple:
+def _local_notes(local, where: str, M_generic, generic_rank, samples: int) -> tuple:
     """Why the mobility reported (the local analysis' finite mobility at ``where``) is not the generic one."""
     if local.finite_mobility is None or local.finite_mobility == M_generic:
         return ()
@@ -320,7 +320,7 @@ def _local_notes(local, where: str, M_generic, generic_rank, samples) -> tuple:
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech: Mechanism, output, seed: int, point, at=None, suggest: bool=False, names: bool=False, progress=None) -> MobilityResult:
+def _analyze(mech: Mechanism, output, seed: int, point: bool, at=None, suggest: bool=False, names: bool=False, progress=None) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)

@@ -121,7 +121,7 @@ def _cut_words(mech: Mechanism):
     return out
 
 
-def _directions(cut, state, tol) -> tuple:
+def _directions(cut, state: KinematicState, tol) -> tuple:
     """(e1, e2, e3, names): a joint's directions: e3 its axis when it has one ("the axis" and, when it is
     a world axis, its letter), e1 e2 across it (world axes when they are); else the world axes."""
     letters = {0: "x", 1: "y", 2: "z"}
@@ -177,7 +177,7 @@ def _describe_span(W, at, dirs, L, tol) -> tuple[tuple, str]:
     return (), "; ".join(words)
 
 
-def _and(items):
+def _and(items: list):
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
@@ -251,7 +251,7 @@ def redundancy(mech: Mechanism, q: np.ndarray, suggest_fix: bool = False) -> Red
                       qr_rank, found)
 
 
-def _per_joint(mech: Mechanism, q: np.ndarray, state, Lam, wrench_rows, owner) -> tuple:
+def _per_joint(mech: Mechanism, q: np.ndarray, state: KinematicState, Lam, wrench_rows, owner: list) -> tuple:
     """JointRedundancy of every joint carrying part of the left null space."""
     algebra = _algebra(mech, q)
     out = []
@@ -302,7 +302,7 @@ def _rotation_twist(u, p):
     return np.r_[np.cross(p, u), u]
 
 
-def _options(mech: Mechanism, state, name: str, kind: str, axis, point, axes):
+def _options(mech: Mechanism, state: KinematicState, name: str, kind: str, axis, point, axes: list):
     """(new type, [(world twist, words)], replacement) for each way to free more at one joint; ``axes``:
     the directions a universal joint's second axis may take ((world vector, letter or None))."""
     opts = []
@@ -319,7 +319,7 @@ def _options(mech: Mechanism, state, name: str, kind: str, axis, point, axes):
     return opts
 
 
-def _candidates(mech: Mechanism, state):
+def _candidates(mech: Mechanism, state: KinematicState):
     """The joints a suggestion may change, in the order it tries them: cut joints, then unactuated tree
     joints on the ground, then the other unactuated ones, then the actuated ones; each (name, is a cut,
     options)."""

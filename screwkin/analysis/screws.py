@@ -151,7 +151,7 @@ class LoopScrews:
     closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
 
 
-def cut_twists(mech: Mechanism, cut, state):
+def cut_twists(mech: Mechanism, cut, state: KinematicState):
     """The cut joint's freedoms at the configuration of ``state`` (a model.state.KinematicState) as
     world twists (v at the world origin, w): [(name, twist, sliding)], or None for a higher pair (its
     loop closes through an equivalent linkage and coupling rows)."""

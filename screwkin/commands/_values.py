@@ -196,7 +196,7 @@ def parse_range(text: str, option: str, mech: Mechanism) -> tuple:
     return name, np.linspace(a.value, b.value, n), (a if a.unit else b).shown_unit or "rad"
 
 
-def rate_items(items, inputs, option: str) -> list:
+def rate_items(items, inputs: list, option: str) -> list:
     """--rate, --accel (and dynamics' --speed) as typed, each made NAME=VALUE: the one grammar of every
     command (``--rate O2=120rpm``, repeatable, ``a,b=1``); a bare VALUE (``--rate 120rpm``) is the input's
     where there is exactly one input, a usage error naming the inputs otherwise."""
@@ -211,7 +211,7 @@ def rate_items(items, inputs, option: str) -> list:
     return out
 
 
-def check_rate_names(given: dict | None, inputs, option: str) -> None:
+def check_rate_names(given: dict | None, inputs: list, option: str) -> None:
     """A --rate/--accel name that is not an input would be dropped without a word: exit 2 naming it."""
     stray = [n for n in (given or {}) if n not in inputs]
     if stray:

@@ -110,7 +110,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return emit(args, data, text)
 
 
-def _names(names, n: int = 3) -> str:
+def _names(names: list, n: int = 3) -> str:
     return ", ".join(quote(x, 30) for x in names[:n]) + (", ..." if len(names) > n else "")
 
 

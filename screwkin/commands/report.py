@@ -311,7 +311,7 @@ def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, values, names, notes, data, held=None):
+def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, values: dict, names, notes, data, held=None):
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
@@ -349,7 +349,7 @@ def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, val
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates=None):
+def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates: dict | None = None):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:

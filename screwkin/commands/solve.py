@@ -105,7 +105,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------ solve --start
-def _solved_near(mech: Mechanism, loops, solver, values, q: np.ndarray, res, starts: int, skip=()) -> tuple:
+def _solved_near(mech: Mechanism, loops: VectorLoops, solver, values, q: np.ndarray, res, starts: int, skip: set | tuple = ()) -> tuple:
     """solve's configuration near q (Newton's root), the loop symbols there, and the unknowns
     in which it differs from Newton's root."""
     near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}

@@ -153,7 +153,7 @@ def _quat(M):
     return matrix_quat(M.rotation)
 
 
-def _children(pm):
+def _children(pm: PlacedMechanism):
     kids = {}
     for b in pm.bodies:
         kids.setdefault(b.parent, []).append(b)
@@ -169,7 +169,7 @@ def _comment(text: str):
     return "<!--\n" + text.rstrip() + "\n-->"
 
 
-def default_solid(points, length) -> tuple:
+def default_solid(points, length: float) -> tuple:
     """(mass, centre of mass, (ixx, iyy, izz, ixy, ixz, iyz)) of the solid a moving body without mass
     gets: a rod of DEFAULT_DENSITY from its origin to the farthest of ``points`` (its joints, in its
     frame), radius ROD_RATIO of that length; a sphere of radius ROD_RATIO * ``length`` when no point is
@@ -209,7 +209,7 @@ def _mj_inertial(mass, com, inertia, moving, points=(), length: float = 0.1) -> 
     return f'<inertial pos="{vector_text(*com)}" mass="{number_text(mass)}" fullinertia="{vector_text(*inertia)}"/>'
 
 
-def joint_points(pm) -> dict:
+def joint_points(pm: PlacedMechanism) -> dict:
     """Body -> the points in its frame where joints sit: its children's origins and its cut frames."""
     out = {}
     for b in pm.bodies:

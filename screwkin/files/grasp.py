@@ -64,7 +64,7 @@ def _is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
-def _vector(value, what: str, planar, problems) -> tuple | None:
+def _vector(value, what: str, planar, problems: Problems) -> tuple | None:
     """A 3-tuple of floats from a YAML list (planar: 2 numbers, or 3 with z = 0), or None."""
     sizes = "2 or 3" if planar else "3"
     if not isinstance(value, list):
@@ -96,7 +96,7 @@ def _vector(value, what: str, planar, problems) -> tuple | None:
     return tuple(v)
 
 
-def _coefficient(c, key, k: int, problems, bound, unit: str = ""):
+def _coefficient(c, key: str, k: int, problems: Problems, bound, unit: str = ""):
     value = c.get(key)
     if not _is_number(value):
         problems.append(f"contact {k}: {key} must be a number, got {quote(value)}")
@@ -118,7 +118,7 @@ def _coefficient(c, key, k: int, problems, bound, unit: str = ""):
     return x
 
 
-def _contact(c, k: int, planar, problems) -> Contact | None:
+def _contact(c, k: int, planar, problems: Problems) -> Contact | None:
     if not isinstance(c, dict):
         problems.append(f"contact {k} must be a mapping with point, normal, model, got {quote(c)}")
         return None

@@ -88,7 +88,7 @@ class _Reader:
             self._default(d, "main", {})
 
     # ---- defaults -------------------------------------------------------------------------
-    def _default(self, elem, name: str, inherited) -> None:
+    def _default(self, elem, name: str, inherited: dict) -> None:
         own = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in elem:
             if child.tag == "default":
@@ -123,7 +123,7 @@ class _Reader:
         return out
 
     # ---- numbers and frames ---------------------------------------------------------------
-    def vec(self, text: str, n: int, what: str, default, bound=LIMITS.length, unit: str = "m") -> np.ndarray:
+    def vec(self, text: str, n: int, what: str, default: tuple, bound=LIMITS.length, unit: str = "m") -> np.ndarray:
         return np.array(numbers(text, n, what, self.problems, default, bound, unit), float)
 
     def angle(self, value):
@@ -189,7 +189,7 @@ class _Reader:
         return pin.SE3(self.rotation(a, what), self.vec(a.get("pos"), 3, f"{what} pos", (0, 0, 0)))
 
 
-def read_mjcf(path, text: str, root=None, package_dirs=()) -> MechanismSpec:
+def read_mjcf(path, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
     """Read an MJCF file (already loaded as ``text``, parsed as ``root`` when given)."""
     if root is None:
         root = parse_xml_text(text, path)
@@ -424,7 +424,7 @@ def _inertia_xml(com, mass, I) -> str:
             f"ixz=\"{I[0, 2]:.17g}\" iyz=\"{I[1, 2]:.17g}\"/></inertial>")
 
 
-def _geom_inertial(r, geoms, what: str) -> tuple:
+def _geom_inertial(r: _Reader, geoms, what: str) -> tuple:
     """(mass, URDF <inertial>, has meshes) of a body from its geoms, as MuJoCo computes them
     (screwkin.files.mjcf_inertia)."""
     p = r.problems
@@ -494,7 +494,7 @@ def _z_to(d) -> np.ndarray:
     return pin.exp3(c / s * math.atan2(s, z[2]))
 
 
-def _inertial(r, e, what: str) -> tuple:
+def _inertial(r: _Reader, e, what: str) -> tuple:
     """(mass, URDF <inertial>) of an MJCF ``<inertial pos quat mass diaginertia|fullinertia>``, refused
     where MuJoCo refuses it (a negative mass, a tensor no body has)."""
     p = r.problems

@@ -47,7 +47,7 @@ def _rpy(M) -> tuple:
     return tuple(pin.rpy.matrixToRpy(M.rotation))
 
 
-def read_equalities(r, world, sites, mjoints, reference, taken) -> tuple:
+def read_equalities(r, world: dict, sites: dict, mjoints: dict, reference: dict, taken) -> tuple:
     """(cut joints, couplings) of every <equality>.  world: body -> pose at qpos0; sites: name ->
     (body, placement); mjoints: joint -> (type, body); reference: joint -> ref; taken: the names of
     joints and bodies."""
@@ -114,7 +114,7 @@ def read_equalities(r, world, sites, mjoints, reference, taken) -> tuple:
     return cuts, couplings
 
 
-def _connect_cuts(r, connects, world):
+def _connect_cuts(r, connects: list, world: dict):
     """Spherical cut joints of the connects; two between the same bodies: one revolute."""
     pairs = {}
     for c in connects:
@@ -142,7 +142,7 @@ def _connect_cuts(r, connects, world):
     return out
 
 
-def _ends(r, a, what: str, world, sites):
+def _ends(r, a, what: str, world: dict, sites: dict):
     """((body1, S1), (body2, S2), by_site) of a connect or weld; body2 omitted or "world" is the world."""
     p = r.problems
     if a.get("site1") or a.get("site2"):
@@ -168,7 +168,7 @@ def _ends(r, a, what: str, world, sites):
     return res
 
 
-def _joint_equality(r, a, what: str, mjoints, reference) -> Coupling | None:
+def _joint_equality(r, a, what: str, mjoints: dict, reference: dict) -> Coupling | None:
     p = r.problems
     j1, j2 = a.get("joint1"), a.get("joint2")
     if not j2:

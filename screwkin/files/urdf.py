@@ -103,7 +103,7 @@ def unit_axis(values, what: str, problems, default=(1.0, 0.0, 0.0)) -> tuple:
     return tuple(u / np.linalg.norm(u))
 
 
-def _axis(elem, what: str, problems, default=(1.0, 0.0, 0.0)):
+def _axis(elem, what: str, problems: Problems, default=(1.0, 0.0, 0.0)):
     if elem is None or elem.get("xyz") is None:  # urdfdom's default: the x axis
         return tuple(default)
     before = len(problems)
@@ -113,7 +113,7 @@ def _axis(elem, what: str, problems, default=(1.0, 0.0, 0.0)):
     return unit_axis(values, what, problems, default)
 
 
-def _origin(elem, what: str, problems) -> tuple:
+def _origin(elem, what: str, problems: Problems) -> tuple:
     """xyz and rpy of an ``<origin>`` (or of any element carrying them), checked."""
     get = (lambda k: elem.get(k)) if elem is not None else (lambda k: None)
     xyz = numbers(get("xyz"), 3, f"{what} xyz>", problems, (0.0, 0.0, 0.0), LIMITS.length, "m")
@@ -125,7 +125,7 @@ _GEOMETRY = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), 
              "capsule": (("radius", 1), ("length", 1)), "mesh": (("scale", 3),)}
 
 
-def _link(elem, problems) -> LinkSpec:
+def _link(elem, problems: Problems) -> LinkSpec:
     name = elem.get("name")
     what = f"link {quote(name)}"
     mass = None
@@ -151,7 +151,7 @@ def _link(elem, problems) -> LinkSpec:
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry, inertia_problem=impossible)
 
 
-def _name_and_type(elem, tag, kind: str, types, problems) -> tuple | None:
+def _name_and_type(elem, tag: str, kind: str, types, problems: Problems) -> tuple | None:
     """(name, type, 'kind NAME') of a <joint> or <loop_joint>, or None after recording why."""
     name = elem.get("name")
     if not name:
@@ -165,7 +165,7 @@ def _name_and_type(elem, tag, kind: str, types, problems) -> tuple | None:
     return name, jtype, what
 
 
-def _joint(elem, links, problems) -> JointSpec | None:
+def _joint(elem, links: dict, problems: Problems) -> JointSpec | None:
     head = _name_and_type(elem, "joint", "joint", TREE_JOINT_DOF, problems)
     if head is None:
         return None
@@ -210,7 +210,7 @@ def _joint(elem, links, problems) -> JointSpec | None:
     return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic, **dyn)
 
 
-def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
+def _loop_joint(elem, links: dict, problems: Problems, warnings) -> CutJointSpec | None:
     head = _name_and_type(elem, "loop_joint", "loop joint", CUT_JOINT_DOF, problems)
     if head is None:
         return None
@@ -265,7 +265,7 @@ def _loop_joint(elem, links, problems, warnings) -> CutJointSpec | None:
     return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint", **extra)
 
 
-def _radius(text: str, what: str, problems, allow_inf: bool=False):
+def _radius(text: str, what: str, problems: Problems, allow_inf: bool=False):
     """A radius [m]: a positive number, or (a straight line) 'inf' where allowed."""
     if text is None:
         problems.append(f"{what} is missing")
@@ -279,7 +279,7 @@ def _radius(text: str, what: str, problems, allow_inf: bool=False):
     return value
 
 
-def _pair_parameters(elem, jtype, what: str, axis, problems) -> dict | None:
+def _pair_parameters(elem, jtype, what: str, axis, problems: Problems) -> dict | None:
     """The parameters of a rolling, gear, contact or helical loop joint, checked."""
     n0 = len(problems)
     out = {}
@@ -358,7 +358,7 @@ def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: in
                   f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
-def check_tree(path, links, joints, problems) -> None:
+def check_tree(path, links: dict, joints: list, problems: Problems) -> None:
     """Record problems that keep the joints from forming one tree over the links."""
     parent_of = {}
     for j in joints:
@@ -396,11 +396,11 @@ def check_tree(path, links, joints, problems) -> None:
             reaches |= on_path
 
 
-def _coordinates(joints) -> int:
+def _coordinates(joints: list) -> int:
     return sum(TREE_JOINT_DOF[j.type] for j in joints)
 
 
-def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpec:
+def read_urdf(path: Path, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
     """Read a URDF file (already loaded as ``text``, and parsed as ``root`` when given)
     into a :class:`MechanismSpec`.  package_dirs: folders searched for ``package://`` meshes."""
     if root is None:
@@ -473,7 +473,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs=()) -> MechanismSpe
 _MOVING_1DOF = ("revolute", "continuous", "prismatic")
 
 
-def _couplings(joints, problems, warnings) -> list:
+def _couplings(joints: list, problems: Problems, warnings) -> list:
     """The ``<mimic>`` couplings, each resolved to the first joint of its chain (a gear train
     written 'idler mimics input, output mimics idler' couples the output to the input):
     j = m * k + o with k = m' * p + o' gives j = (m m') p + (m o' + o).  A <mimic> that cannot
@@ -505,7 +505,7 @@ def _couplings(joints, problems, warnings) -> list:
         f"the <mimic> couplings of joint {quote(name)} go round in a circle: ignored"))
 
 
-def _read_targets(root, links, joint_names, problems) -> tuple:
+def _read_targets(root, links: dict, joint_names: set, problems: Problems) -> tuple:
     """The TargetSpec of every <screwkin:target> under <screwkin:targets> of the URDF ``root``;
     a problem recorded (the file refused, as for any element) for an unknown kind, link or
     joint, a missing or implausible number."""

@@ -33,7 +33,7 @@ def _kind(t) -> str:
     return t.get("type") or ""
 
 
-def read_transmissions(root, joints, loop_names, warnings, mimics, numbers) -> tuple:
+def read_transmissions(root, joints: list, loop_names: set, warnings, mimics: dict, numbers) -> tuple:
     """(joint names of the ``<transmission>`` elements in order, Transmission of each with a
     reduction other than 1).  ``numbers``: files.urdf's reader of numbers (passed in: that module
     calls this one).  A transmission naming a fixed joint, a loop joint, a joint that

@@ -136,7 +136,7 @@ def _bars(points) -> list:
     return [(ring[k], ring[(k + 1) % len(ring)]) for k in range(len(ring))]
 
 
-def _check_linkage(linkage):
+def _check_linkage(linkage: PlanarLinkage):
     names = [lk.name for lk in linkage.links]
     if len(set(names)) != len(names):
         raise ValueError("link names repeat")

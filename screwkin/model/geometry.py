@@ -186,7 +186,7 @@ def vector_angle(u, w):
     return np.arctan2(_cross_norm(u, w), np.sum(u * w, axis=-1))
 
 
-def line_angle(u, w):
+def line_angle(u, w: np.ndarray):
     """The angle between the lines along u and w, in [0, pi/2] [rad].
 
     >>> float(line_angle([1.0, 0.0], [-1.0, 1.0]))  # doctest: +ELLIPSIS
@@ -239,7 +239,7 @@ def _skew_table(k: int, m=None):
 _SKEW_TABLES = {}
 
 
-def skews(U, m=None):
+def skews(U: np.ndarray, m=None):
     """The cross-product matrices of the columns of U (3 x k), stacked (3k x 3); with m,
     columns j and m + j side by side ((3m x 6): [[u_j]x, [u_m+j]x])."""
     index, sign = _skew_table(U.shape[1], m)

@@ -111,7 +111,7 @@ def platform_of(mech: Mechanism, out_joint: int, tol: float = DEFAULT.closed_for
     return mech.cache[key]
 
 
-def _find_platform(mech: Mechanism, out_joint, tol) -> Platform | None:
+def _find_platform(mech: Mechanism, out_joint: int, tol: float) -> Platform | None:
     model = mech.model
     if not mech.cuts or mech.couplings or getattr(mech, "extra_rows", None) or out_joint <= 0:
         return None
@@ -160,7 +160,7 @@ def _joints_from_ground(model: pin.Model, j: int) -> list:
     return out[::-1]
 
 
-def _leg_chain(model: pin.Model, state, path, cut, end, scale, tol):
+def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | None, scale, tol: float):
     """The LegChain of the joints ``path`` (see the module), read in ``state``, or None when they are no leg."""
     kinds = [_joint_letter(model, j) for j in path]
     if kinds.count("P") != 1:

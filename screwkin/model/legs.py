@@ -41,7 +41,7 @@ class Leg:
     centre: tuple
 
 
-def distance_legs(model: pin.Model, cuts, frozen, length: float, keep_frames=(), tol: float = DEFAULT.geometry) -> list:
+def distance_legs(model: pin.Model, cuts, frozen: set, length: float, keep_frames=(), tol: float = DEFAULT.geometry) -> list:
     """The legs of ``cuts`` that are distance constraints (see the module), with the inputs at the
     velocity indices ``frozen`` held; ``keep_frames``: frames that must not lie on a leg (an output);
     ``tol``: the geometric tolerance (axes meeting, a distance constant), relative to the length."""
@@ -69,13 +69,13 @@ def distance_legs(model: pin.Model, cuts, frozen, length: float, keep_frames=(),
     return legs
 
 
-def _passive_revolute(model: pin.Model, j: int, frozen) -> bool:
+def _passive_revolute(model: pin.Model, j: int, frozen: set) -> bool:
     jm = model.joints[j]
     passive = not any(jm.idx_v + k in frozen for k in range(jm.nv))
     return passive and jm.nv == 1 and jm.shortname().startswith("JointModelR")
 
 
-def _leg(model: pin.Model, data, q0: np.ndarray, name: str, f, other, used, frozen, length, taken, tol) -> Leg | None:
+def _leg(model: pin.Model, data, q0: np.ndarray, name: str, f, other, used: dict, frozen: set, length: float, taken, tol: float) -> Leg | None:
     """The leg ending at frame f, or None."""
     chain = []
     j = model.frames[f].parentJoint
@@ -98,7 +98,7 @@ def _leg(model: pin.Model, data, q0: np.ndarray, name: str, f, other, used, froz
     return None
 
 
-def _common_point(model: pin.Model, data, revs, length, tol):
+def _common_point(model: pin.Model, data, revs, length: float, tol: float):
     """The point where the revolutes' axes meet (at the neutral configuration), or None when there are
     fewer than two independent axes or they do not meet."""
     if len(revs) < 2:
@@ -115,7 +115,7 @@ def _common_point(model: pin.Model, data, revs, length, tol):
     return o if o is not None and off <= tol * length else None
 
 
-def _constant_distance(model: pin.Model, q0: np.ndarray, f, chain, revs, centre, length, tol) -> bool:
+def _constant_distance(model: pin.Model, q0: np.ndarray, f, chain, revs: list, centre, length: float, tol: float) -> bool:
     """Whether the frame's origin stays at one distance from the centre as the leg's passive revolutes
     turn (tried at random angles, with its inputs at two values)."""
     rng = np.random.default_rng(7)
@@ -178,7 +178,7 @@ def chain_distance(model: pin.Model, frozen, joint: int, length: float, tol: flo
     return a, b_local
 
 
-def _passive(model: pin.Model, j: int, frozen) -> bool:
+def _passive(model: pin.Model, j: int, frozen: set) -> bool:
     jm = model.joints[j]
     return not any(jm.idx_v + k in frozen for k in range(jm.nv))
 

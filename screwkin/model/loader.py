@@ -107,7 +107,7 @@ def _revolute_for(jm):
     return None
 
 
-def _order(model: pin.Model, first=()):
+def _order(model: pin.Model, first: set | tuple = ()):
     """The model's joints in a depth-first order with, among siblings, the subtrees that hold a
     joint of ``first`` before the others: Pinocchio needs a mimicked joint before its mimics."""
     children = {j: [] for j in range(model.njoints)}
@@ -128,7 +128,7 @@ def _order(model: pin.Model, first=()):
     return order
 
 
-def _rebuild(model: pin.Model, replacements=(), first=()):
+def _rebuild(model: pin.Model, replacements=(), first: set | tuple = ()):
     """The model with continuous joints as revolute joints without limits (one coordinate, the
     angle, which counts turns: Pinocchio's (cos, sin) pair cannot, and a gear train or a lead
     screw turned twice must move twice as far), the sidecar's joint replacements (SPHERICAL,
@@ -264,7 +264,7 @@ def _finish_model(spec, model: pin.Model):
     return model
 
 
-def rebuild(spec, actuated=None, tolerances: Tolerances = DEFAULT, cls=Mechanism) -> Mechanism:
+def rebuild(spec, actuated: list | None = None, tolerances: Tolerances = DEFAULT, cls=Mechanism) -> Mechanism:
     """A Mechanism from a description already read (and changed: other joint replacements, other cut
     joint types -- analysis.redundancy builds the exactly constrained model it suggests this way)."""
     with _native_stderr([]):

@@ -67,7 +67,7 @@ def two_rotations(w1, w2, p, q: np.ndarray, tol: float = DEFAULT.closed_form) ->
     return out, False
 
 
-def run_angles(axes, R, tol: float = DEFAULT.closed_form) -> list:
+def run_angles(axes: list, R, tol: float = DEFAULT.closed_form) -> list:
     """Every real (t1, ..., tk) with R(w1, t1) ... R(wk, tk) = R for k = 1, 2, 3 unit axes (see the
     module); each set checked against R (a rotation not of that form gives []).  A continuum (a
     spherical wrist with its outer axes aligned) gives []: the caller says so."""

@@ -331,7 +331,7 @@ def _line_distance(p1, d1, p2, d2, tol):
     return abs((p2 - p1) @ _unit_vector(n))
 
 
-def _compound_name(members, kind: str) -> str:
+def _compound_name(members: list, kind: str) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
 
     prefix = os.path.commonprefix(members)

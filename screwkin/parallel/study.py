@@ -31,6 +31,10 @@ from ..analysis.design.family import FAMILY_CHUNK, chunk_rows, eligible
 from ..errors import UsageError, one_line
 from ..files.study import read_study_spec, study_spec
 from .pool import dask_client
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.present.progress import Progress
 
 __all__ = ["run_study", "default_workers", "STALL_GRACE"]
 
@@ -53,7 +57,7 @@ def _chunks(items: list, size: int) -> list:
     return [items[i:i + size] for i in range(0, len(items), size)]
 
 
-def run_study(spec, scheduler: str | None = None, workers: int | None = None, progress=None,
+def run_study(spec, scheduler: str | None = None, workers: int | None = None, progress: Progress | None = None,
               timeout: float = 10.0, base=None) -> StudyResult:
     """Run a study: ``spec`` a StudySpec, a spec file's path, or a dict (its ``file``
     relative to ``base``, default the current folder).
@@ -128,7 +132,7 @@ def _merged(notes: Counter) -> list:
     return [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" if c else why for why, c in out.most_common()]
 
 
-def _on_dask(task, chunks, total, scheduler, workers, timeout, progress) -> tuple:
+def _on_dask(task, chunks, total: int, scheduler: str | None, workers, timeout: float, progress: Progress | None) -> tuple:
     """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
     workers, where)."""
     from distributed import as_completed  # 0.4-0.9 s to import: only studies need it

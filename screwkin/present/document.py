@@ -120,7 +120,7 @@ def _reading(value, angular: bool) -> str:
 
 
 # ------------------------------------------------------------------ sections
-def topology_section(topo, mobility, figures=()) -> Section:
+def topology_section(topo, mobility, figures: list | tuple = ()) -> Section:
     """Joint table, the counts with their formulas, the screw-theory mobility."""
     s = Section("topology", "Topology and mobility")
     s.blocks.append(Text(f"links N = {topo.n_links} (ground: {topo.ground}), joints J = {topo.n_joints}, "
@@ -244,7 +244,7 @@ def singular_section(search, figures, descriptions, conditions=()) -> Section:
     return s
 
 
-def sweep_section(search, figure, lines=(), rate_words=None) -> Section:
+def sweep_section(search, figure: Figure, lines=(), rate_words=None) -> Section:
     """The input moved over its range: the figure, and ``lines`` (each slider's stroke and time ratio,
     present/motion.strokes_text, as sweep prints them); ``rate_words``: the input's rate as typed
     (tables.input_rate_words, "at crank 120 rpm"; default: the sweep's rate in SI)."""
@@ -262,7 +262,7 @@ def sweep_section(search, figure, lines=(), rate_words=None) -> Section:
     return s
 
 
-def view_section(png, note=None) -> Section:
+def view_section(png, note: str | None = None) -> Section:
     s = Section("view", "View")
     if png is not None:
         s.blocks.append(Figure(png, "png", "the mechanism at the configuration analysed (screwkin view, headless "
@@ -272,7 +272,7 @@ def view_section(png, note=None) -> Section:
     return s
 
 
-def note_section(id, title: str, text: str) -> Section:
+def note_section(id: str, title: str, text: str) -> Section:
     return Section(id, title, [Note(text)])
 
 

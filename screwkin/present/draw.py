@@ -300,7 +300,7 @@ def _block_direction(skel, lk):
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float = 0.85) -> None:
+def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float = 0.85) -> None:
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -493,7 +493,7 @@ def save_figure(fig, path: str, close: bool = True):
         plt.close(fig)
 
 
-def draw_design(mech: Mechanism, paths, steps: int = 360, say=None) -> list:
+def draw_design(mech: Mechanism, paths: list, steps: int = 360, say=None) -> list:
     """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
     ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
     q = mech.assemble().q

@@ -87,7 +87,7 @@ def design_drawing(mech: Mechanism, q: np.ndarray, input_names, skel, steps: int
     return marks, curve
 
 
-def target_marks(design, basis, skeletons=None) -> list:
+def target_marks(design, basis, skeletons: dict | None = None) -> list:
     """The drawing's data of an analysis.design.targets.DesignTargets in the plane (e1, e2, n) of
     the skeleton: one dict per target with number, kind, label, target (x, y), direction (a unit
     vector or None), reached (x, y) and reached_direction (None where the file does not

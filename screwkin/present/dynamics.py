@@ -66,7 +66,7 @@ def dynamics_dict(r: DynamicsResult) -> dict:
     }
 
 
-def _effort_header(r, name: str) -> str:
+def _effort_header(r: DynamicsResult, name: str) -> str:
     return f"{name} [{r.effort_units[name].replace(' ', '*')}]"
 
 

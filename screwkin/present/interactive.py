@@ -92,7 +92,7 @@ def _shown(value, unit: str) -> float:
     return value * 1000.0 if unit == "m" else math.degrees(value)
 
 
-def _si(shown, unit: str) -> float:
+def _si(shown: float, unit: str) -> float:
     return shown / 1000.0 if unit == "m" else math.radians(shown)
 
 

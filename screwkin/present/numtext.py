@@ -39,7 +39,7 @@ def _scaled(a, k):
     return s
 
 
-def g12_bytes(values, out=None) -> np.ndarray:
+def g12_bytes(values: np.ndarray, out=None) -> np.ndarray:
     """Values (shape S) -> uint8 array (S..., W): the ASCII of ``'%.12g' % value`` of each, with zero
     bytes between and around its characters (drop them when joining); ``out``: an array of zeros of
     that shape (a view) to write into.

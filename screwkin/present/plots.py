@@ -51,7 +51,7 @@ def _rate_scales(units) -> list:
             (units.acceleration(False), units.acceleration(True))]
 
 
-def sweep_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, paths=None, absolute: bool=False,
+def sweep_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, paths: dict | None = None, absolute: bool=False,
                  rate_words=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn

@@ -140,14 +140,14 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name, value, angular) -> str:
+def value_text(name, value, angular: bool) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
     return f"{value:.9g} m"
 
 
-def trace_text(res, row_labels, passive_names) -> str:
+def trace_text(res, row_labels, passive_names: list) -> str:
     lines = ["Newton iterations from the first start (rows: closure residual; columns: passive joints)"]
     for st in res.trace:
         lines.append(f"\niteration {st.iteration}: |r| = {np.linalg.norm(st.residual):.3e}"

@@ -404,7 +404,7 @@ def metrics_figure(result):
     return fig
 
 
-def metrics_png(result, path) -> None:
+def metrics_png(result, path: str) -> None:
     """Each numeric metric against each parameter (see :func:`metrics_figure`)."""
     plt = pyplot("--plot")
     fig = metrics_figure(result)
@@ -456,7 +456,7 @@ def pareto_figure(result, goals=None):
     return fig
 
 
-def pareto_png(result, path, goals=None) -> None:
+def pareto_png(result, path: str, goals=None) -> None:
     """The designs in the plane of two columns, the Pareto front drawn over them (see :func:`pareto_figure`)."""
     plt = pyplot("--plot")
     fig = pareto_figure(result, goals)

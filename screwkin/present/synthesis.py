@@ -114,7 +114,7 @@ def _candidate_dict(k: int, c) -> dict:
             "point": None if u is None else [u, v], "run": c.run}
 
 
-def _search_dict(report, constraints) -> dict:
+def _search_dict(report, constraints: list) -> dict:
     return {"method": report.method, "runs": report.runs, "evaluations": report.evaluations,
             "seconds": report.seconds, "where": report.where, "seed": report.seed, "constraints": constraints,
             "searched_within": report.box, "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}

@@ -63,7 +63,7 @@ def _coal():
     return coal
 
 
-def _visual_urdf(mech: Mechanism, unreadable=()) -> str:
+def _visual_urdf(mech: Mechanism, unreadable: set | tuple = ()) -> str:
     """The URDF text with every mesh resolved to an absolute path, and visuals
     whose mesh cannot be found (or is in ``unreadable``) dropped (their links get stand-ins)."""
     root = parse_xml_text(mech.spec.urdf_text, mech.path)
@@ -216,7 +216,7 @@ class Scene:
         return np.array([pts.min(axis=0), pts.max(axis=0)])
 
 
-def _corner_points(state, geom) -> np.ndarray:
+def _corner_points(state: KinematicState, geom) -> np.ndarray:
     """Points that bound the drawn geometry at the configuration of ``state`` (a KinematicState): the
     joint centres and the corners of each object's own bounding box placed where its joint puts it
     (meshes as loaded, scale included)."""

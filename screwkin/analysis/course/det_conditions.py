@@ -47,7 +47,7 @@ def determinant(loops) -> tuple:
     return d, tuple(conds), tuple(words)
 
 
-def condition(loops, f, present) -> tuple:
+def condition(loops, f, present: list) -> tuple:
     """(the condition that factor f of det A vanishes, in symbols; the same in words): f a
     sine or cosine of one argument is solved for its first symbol in ``present``."""
     sp = loops.sp

@@ -65,7 +65,7 @@ def _spatial(mech: Mechanism, q: np.ndarray, inputs, output) -> SpatialEquations
                             sigma, singular, tuple(conds), float(S.L))
 
 
-def equations(mech: Mechanism, q: np.ndarray, inputs=None, output=None, links=()):
+def equations(mech: Mechanism, q: np.ndarray, inputs=None, output=None, links: list | tuple = ()):
     """The equations at the assembled configuration q: :class:`PlanarEquations` for planar
     mechanisms of revolute and prismatic joints, rolling and gear pairs (the no-slip law
     substituted: screwkin.analysis.course.rolling), :class:`SpatialEquations` for spatial and

@@ -94,7 +94,7 @@ def input_range(mech: Mechanism, name: str, q: np.ndarray) -> tuple:
     return x - 2 * L, x + 2 * L
 
 
-def singular_configurations(mech: Mechanism, input_joint=None, output=None, fixed=None, q: np.ndarray | None = None, steps: int = 360,
+def singular_configurations(mech: Mechanism, input_joint=None, output=None, fixed: dict | None = None, q: np.ndarray | None = None, steps: int = 360,
                             near=None, rate: float = 1.0, held=None) -> SingularSearch:
     """The singular configurations along ``input_joint``'s range (:func:`input_range` from q,
     the assembled configuration by default): one assembly mode followed by
@@ -139,7 +139,7 @@ def singular_configurations(mech: Mechanism, input_joint=None, output=None, fixe
                           res.circuit_closed, res)
 
 
-def trace_points(mech: Mechanism, q: np.ndarray, input_name: str, points, steps: int = 360, fixed=None) -> tuple:
+def trace_points(mech: Mechanism, q: np.ndarray, input_name: str, points: list, steps: int = 360, fixed: dict | None = None) -> tuple:
     """The paths of ``points`` while ``input_name`` turns a whole turn (or, for a slider or an input
     that cannot turn, runs to its limit position) from its value at ``q``, on the assembly mode of
     ``q``: (SweepResult, MotionAlong).  The sweep is analysis.motion.sweep's, so its limits are reported."""

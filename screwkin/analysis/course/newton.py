@@ -91,7 +91,7 @@ def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = N
                         closes and iterations is None, stopped)
 
 
-def start_estimates(mech: Mechanism, loops, solver, q_in: np.ndarray, values, typed) -> tuple:
+def start_estimates(mech: Mechanism, loops, solver, q_in: np.ndarray, values: dict, typed) -> tuple:
     """The estimates of every unknown of the loop equations from ``--start`` items (units.parse_typed_assignments):
     symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
     returns (symbol -> estimate, symbol -> the units.Quantity typed)."""

@@ -164,7 +164,7 @@ def pair_term(loops, rec, placeholder=None):
         rec["name"], rec["kind"], (a, b), law, f"{name} = {expr}", False)
 
 
-def virtual_coordinates(loops, q: np.ndarray, values, before):
+def virtual_coordinates(loops, q: np.ndarray, values: dict, before):
     """Set in q (in place) the coordinates of each pair's virtual joints (model.loader's
     equivalent linkage: a1 and -a2, or x and -a2) for the link angles ``values`` (symbol ->
     value; the others as ``before``, their values at loops.q), moved from their values at
@@ -233,7 +233,7 @@ def turns_through_pairs(loops, q: np.ndarray, values):
     return out
 
 
-def _line_of_centres(loops, rows, hold, rec):
+def _line_of_centres(loops, rows: list, hold, rec):
     """The angle of the pair's line of centres as the rest of its loop fixes it, or None: where
     the rest is constant (two gears pinned to one link) or one link's vector (a planet's arm),
     the loop fixes the centre distance as the pair does and theta_ab follows the rest alone."""
@@ -260,7 +260,7 @@ def _line_of_centres(loops, rows, hold, rec):
     return phi + flip + 2 * sp.pi * int(np.round((rec["tk_q"] - here) / (2 * np.pi)))
 
 
-def substitute_pairs(loops, number, rows, crossed, twists=()) -> tuple:
+def substitute_pairs(loops, number, rows: list, crossed: list, twists=()) -> tuple:
     """The loop's rows with each rolling pair's line-of-centres angle replaced: by its no-slip
     expression in the links' angles; or, where the rest of the loop fixes the line of centres
     (two gears pinned to one link, a planet on an arm: screwkin.analysis.course.rolling), by

@@ -241,11 +241,11 @@ def numbering(topo, inputs=()) -> tuple:
     return number, letter, tuple(lettered)
 
 
-def _frame_point(state, name: str):
+def _frame_point(state: KinematicState, name: str):
     return state.frame_placement(state.mech.model.getFrameId(name))
 
 
-def _joint_ends(state, j: int) -> tuple:
+def _joint_ends(state: KinematicState, j: int) -> tuple:
     """(point on links[0], point on links[1], axis or None) of a topology joint, in the world, at
     the configuration of ``state`` (a model.state.KinematicState)."""
     model = state.mech.model
@@ -264,7 +264,7 @@ def _joint_ends(state, j: int) -> tuple:
     return p, p, axis
 
 
-def _hull(points):
+def _hull(points: list):
     """Convex hull corners of 2-D points, counterclockwise (monotone chain)."""
     pts = sorted(set(points))
     if len(pts) <= 2:
@@ -293,7 +293,7 @@ def _distinct(points, tol):
     return out
 
 
-def _basis(mech: Mechanism, topo, centres) -> tuple:
+def _basis(mech: Mechanism, topo, centres: list) -> tuple:
     if topo.motion_space == "planar" and topo.normal is not None:
         return plane_basis(topo.normal), True
     P = np.array(centres) if centres else np.zeros((1, 3))
@@ -413,7 +413,7 @@ def _extremes(pts: np.ndarray) -> tuple[tuple, tuple]:
     return (tuple(P[int(np.argmin(s))]), tuple(P[int(np.argmax(s))]))
 
 
-def _stub(state, name: str, pts: np.ndarray, p2, tol) -> tuple[str, tuple]:
+def _stub(state: KinematicState, name: str, pts: np.ndarray, p2, tol) -> tuple[str, tuple]:
     """A link with one joint centre: drawn to its frame's origin, else its centre of mass,
     else a short stub along its frame's x axis."""
     mech = state.mech
@@ -430,7 +430,7 @@ def _stub(state, name: str, pts: np.ndarray, p2, tol) -> tuple[str, tuple]:
     return "stub", (pts[0], end)
 
 
-def _higher_pair(state, spec, letter, nums, p2, e1, e2):
+def _higher_pair(state: KinematicState, spec, letter, nums: tuple, p2, e1, e2):
     """(contact point, profiles) of a rolling, gear or contact pair in the plane."""
     F1, F2 = _frame_point(state, f"{spec.name}@F1"), _frame_point(state, f"{spec.name}@F2")
     c1, c2 = np.array(p2(F1.translation)), np.array(p2(F2.translation))

@@ -247,13 +247,13 @@ class VectorLoops:
         used[k] = n + 1
         return "" if n == 0 else _SUFFIX[n]
 
-    def _constant_angle(self, name: str, link: str, value, meaning):
+    def _constant_angle(self, name: str, link: str, value: float, meaning: str):
         exact = _exact_angle(self.sp, value, self.mech.tolerances.closure)
         if exact is not None:
             return exact
         return self._new_symbol(name, link, "angle", value, "constant", meaning)
 
-    def _vector(self, link: str, ka, kb) -> tuple | None:
+    def _vector(self, link: str, ka: tuple, kb: tuple) -> tuple | None:
         """(vector record, sign) for the vector on ``link`` from anchor ka to anchor kb, or None
         when the two centres coincide."""
         sp = self.sp

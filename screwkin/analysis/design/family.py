@@ -92,7 +92,7 @@ def chunk_rows(task, chunk: int) -> ChunkRows:
     return ChunkRows(run_chunk(task, chunk), {"design": len(chunk)})
 
 
-def _rpy_matrices(rpy) -> np.ndarray:
+def _rpy_matrices(rpy: np.ndarray) -> np.ndarray:
     """Rotation matrices (n, 3, 3) of URDF rpy angles (n, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy[:, 0], rpy[:, 1], rpy[:, 2]
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
@@ -248,7 +248,7 @@ def family_rows(task, chunk):
                                                         f"{exc}"])
 
 
-def _family(task, chunk, index: int, values, alone) -> ChunkRows:
+def _family(task, chunk, index: int, values: np.ndarray, alone: dict) -> ChunkRows:
     n = len(chunk)
     be = expand_batch(task.file, task.text, task.args, {p: values[:, k] for k, p in enumerate(task.parameters)})
     specs = [None] * n
@@ -377,7 +377,7 @@ def _family(task, chunk, index: int, values, alone) -> ChunkRows:
     return ChunkRows(out, {"family": len(made), "design": n - len(made)}, notes)
 
 
-def _row_of(task, i: int, values, columns, reference, code, margin, lo, hi, turns, dead, short):
+def _row_of(task, i: int, values, columns, reference, code, margin, lo, hi, turns, dead, short: dict):
     """The family path's row of one design from its closed-form numbers (the reference's recomputed)."""
     row = {"design": i, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(columns))
@@ -394,7 +394,7 @@ def _row_of(task, i: int, values, columns, reference, code, margin, lo, hi, turn
     return row
 
 
-def _check_reference(d, fb, placed, spec) -> None:
+def _check_reference(d, fb: _Fourbar, placed: _Placed, spec) -> None:
     """The composed placements of the reference design (the first of ``placed``) are Pinocchio's at the
     file's configuration, to 1e-9 of the mechanism's size: the template and its reading are right."""
     mech = d.mech

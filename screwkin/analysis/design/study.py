@@ -325,7 +325,7 @@ def design_args(task: _Task, values: tuple) -> dict:
     return args
 
 
-def evaluate_design(task: _Task, index: int, values: tuple, keep=None) -> dict:
+def evaluate_design(task: _Task, index: int, values: tuple, keep: list | None = None) -> dict:
     """The row of one design, from its values alone; ``keep`` (a list): the analysed design is appended
     to it (the family path reads its mechanism)."""
     row = {"design": index, **dict(zip(task.parameters, values))}
@@ -402,7 +402,7 @@ def study_task(spec: StudySpec) -> _Task:
                  spec.input, spec.output, spec.point, dict(spec.workspace), spec.timeout, spec.mode)
 
 
-def _row_key(name: str, keys) -> str | None:
+def _row_key(name: str, keys: tuple) -> str | None:
     """The row key of a column named as in the rows or as in the table (``..._deg``, ``..._m``)."""
     for cand in (name, name.removesuffix("_deg"), name.removesuffix("_m")):
         if cand in keys:
@@ -506,7 +506,7 @@ def requirements(spec: StudySpec) -> tuple:
     return tuple(out), default
 
 
-def apply_requirements(spec: StudySpec, rows) -> tuple:
+def apply_requirements(spec: StudySpec, rows: tuple) -> tuple:
     """(rows with REQUIREMENTS_COLUMN, the column added or None, {design: what it does not meet}).
     Nothing is added when there is no requirement."""
     reqs, _ = requirements(spec)

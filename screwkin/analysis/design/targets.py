@@ -31,7 +31,7 @@ TWO_PI = 2 * math.pi
 POLISH_CLOSURE = 1e-13
 
 
-def polished(mech: Mechanism, solver, q: np.ndarray) -> tuple:
+def polished(mech: Mechanism, solver: PositionSolver, q: np.ndarray) -> tuple:
     """(q, residual): ``q`` closed by damped Newton to a residual below POLISH_CLOSURE with the
     solver's inputs held (unchanged, residual None, when that does not converge)."""
     tight = replace(mech.tolerances, closure=POLISH_CLOSURE, max_iterations=60)

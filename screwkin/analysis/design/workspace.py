@@ -163,7 +163,7 @@ class _Measures:
         return {"actuator": actuator, "serial": serial, "conditioning": conditioning}
 
 
-def _translations(mech: Mechanism, q: np.ndarray, output, point) -> np.ndarray:
+def _translations(mech: Mechanism, q: np.ndarray, output, point: bool) -> np.ndarray:
     """(3, k) directions the output (its origin for a point) can translate in at q, at a
     constant orientation unless ``point``: the linear part of the output twists that the loops
     allow with no rotation."""
@@ -233,7 +233,7 @@ def workspace(mech: Mechanism, output: str, point: bool = False, orientation=Non
                  q_start)
 
 
-def _seed(mech: Mechanism, output, point, orientation, q_start=None) -> tuple:
+def _seed(mech: Mechanism, output, point: bool, orientation, q_start=None) -> tuple:
     """The assembled configuration the grid starts from (``q_start`` when given), the output's position
     and the grid's orientation there (continued from the file's orientation to the one asked)."""
     assembly, generic = mech.generic_configurations()
@@ -287,7 +287,7 @@ def _index_bounds(bounds, p_seed, axes, h, dim) -> tuple:
     return list(lo), list(hi)
 
 
-def _grid(mech: Mechanism, output, point, orientation, measures, resolution, bounds, threshold, L, inputs,
+def _grid(mech: Mechanism, output, point: bool, orientation, measures: _Measures, resolution, bounds, threshold, L, inputs,
           deadline=None, q_start=None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
@@ -405,7 +405,7 @@ def _grid(mech: Mechanism, output, point, orientation, measures, resolution, bou
         tuple(inputs), rng, bool(truncated), grid.solves, 0, tuple(notes))
 
 
-def _free_part(m0, m1, length, threshold, p0, direction, crossings) -> float:
+def _free_part(m0, m1, length, threshold, p0, direction, crossings: list) -> float:
     """The free length of a segment from a point of measure m0 to one of m1 (linear between),
     recording a crossing of the threshold."""
     a, b = m0 >= threshold, m1 >= threshold
@@ -419,7 +419,7 @@ def _free_part(m0, m1, length, threshold, p0, direction, crossings) -> float:
 
 
 # ----------------------------------------------------------------------------------- sampling
-def _sampling(mech: Mechanism, output, measures, resolution, bounds, threshold, L, samples, seed: int, inputs) -> WorkspaceResult:
+def _sampling(mech: Mechanism, output: str, measures: _Measures, resolution: float | None, bounds, threshold: float, L: float, samples: int, seed: int, inputs: list) -> WorkspaceResult:
     samples = int(samples)
     if samples < 1:
         raise UsageError(f"the number of samples must be positive, got {samples}")

@@ -166,7 +166,7 @@ class Grid:
             Qc[sel[good]], Pc[sel[good]], sigma[sel] = Qn[good], Pk[good], sig
         return Qc, ok, sigma, jumped
 
-    def advance_all(self, Q: np.ndarray, P_from, P_to, n: np.ndarray, retry: bool=True) -> tuple:
+    def advance_all(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: np.ndarray, retry: bool=True) -> tuple:
         """advance for points with each their number of substeps n (> 0), in blocks; with
         ``retry``, a step refused as a jump to another branch is tried again in twice as many
         substeps, up to _SUBSTEPS (a step that does not converge -- past the boundary -- is not)."""
@@ -283,7 +283,7 @@ class Grid:
             current = following
         return ends
 
-    def extend(self, starts: np.ndarray, Q: np.ndarray, direction) -> tuple:
+    def extend(self, starts: np.ndarray, Q: np.ndarray, direction: np.ndarray) -> tuple:
         """Bisection from the reached points ``starts`` (m, d) (configurations Q) towards their
         unreached neighbours along ``direction`` (a unit index vector): the reached fraction of
         the step (0..1) and the configurations there."""

@@ -165,7 +165,7 @@ def check_inertias(mech: Mechanism) -> tuple:
     return ()
 
 
-def _load_wrenches(mech: Mechanism, loads, state) -> list:
+def _load_wrenches(mech: Mechanism, loads, state: KinematicState) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the configuration of
     ``state`` (a KinematicState; the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []
@@ -213,7 +213,7 @@ def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v) -> tuple:
     return 0.5 * float(v @ M @ v), float(V)
 
 
-def _flywheel(values, tau, speed, unit: str, cs, completed) -> Flywheel:
+def _flywheel(values, tau, speed: float, unit: str, cs: float, completed) -> Flywheel:
     """The flywheel figure from the input effort tau over the input values (see the module)."""
     omega = abs(speed)
     span = abs(values[-1] - values[0]) if len(values) > 1 else 0.0

@@ -177,7 +177,7 @@ class GraspResult:
     notes: tuple = ()
 
 
-def _linprog(c, tol, **kw: Any):
+def _linprog(c, tol: GraspTolerances, **kw: Any):
     """scipy's HiGHS; the solution x, or None when infeasible or when the solver gives up."""
     from scipy.optimize import linprog
 
@@ -191,7 +191,7 @@ def _relative_rank(A, rtol) -> int:
     return int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
 
-def _positive_null_vector(W, tol) -> tuple:
+def _positive_null_vector(W, tol: GraspTolerances) -> tuple:
     """lambda > 0 (summing to 1) with W lambda = 0, maximizing its smallest entry t, and k t
     (1 when all are equal); (None, margin) when there is none: LP  max t  s.t.
     W (mu + t 1) = 0, 1.mu + k t = 1, mu >= 0, t >= 0; then projected exactly onto null(W)."""
@@ -218,7 +218,7 @@ def _positive_null_vector(W, tol) -> tuple:
     return (lam, margin) if margin > tol.margin else (None, margin)
 
 
-def _separator(W, tol) -> tuple:
+def _separator(W, tol: GraspTolerances) -> tuple:
     """(u, both): a unit u with u . w >= 0 for every column w of W (up to the LP's tolerance),
     or (None, False) when there is none (the columns positively span).  both: u is orthogonal
     to every column (W lacks rank): -u is one too."""
@@ -241,7 +241,7 @@ def _separator(W, tol) -> tuple:
 
 
 # ------------------------------------------------------------------ exact cone checks
-def _contact_forces(spec, G, blocks, f) -> tuple:
+def _contact_forces(spec: GraspSpec, G, blocks, f) -> tuple:
     out = []
     for k, (c, b) in enumerate(zip(spec.contacts, blocks), 1):
         fi = f[b]
@@ -260,7 +260,7 @@ def _contact_forces(spec, G, blocks, f) -> tuple:
     return tuple(out)
 
 
-def _force_margin(spec, forces, tol):
+def _force_margin(spec: GraspSpec, forces, tol: GraspTolerances):
     """How far inside the circular cones the contact forces are (1 - the largest ratio), or a
     negative number when one is not strictly inside (a normal force <= 0, or a tangential or
     torsion component where the coefficient is 0)."""
@@ -279,7 +279,7 @@ def _force_margin(spec, forces, tol):
     return worst
 
 
-def _dual_margin(spec, Gs: np.ndarray, blocks, u):
+def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks, u):
     """min over contacts of the smallest u . (G_s f) over the circular cone's section f_n = 1:
     u_n - mu |u_t| - mu_torsion |u_torsion| (>= 0: u separates the cone)."""
     worst = math.inf
@@ -298,7 +298,7 @@ def _dual_margin(spec, Gs: np.ndarray, blocks, u):
 
 
 # ------------------------------------------------------------------ closure
-def _internal_certificate(spec, G, Gs: np.ndarray, blocks, W, parts, lam, cones, tol) -> Certificate:
+def _internal_certificate(spec: GraspSpec, G, Gs: np.ndarray, blocks, W, parts, lam, cones: str, tol: GraspTolerances) -> Certificate:
     f = np.zeros(G.shape[1])
     for (sl, C), b in zip(parts, blocks):
         f[b] = C @ lam[sl]
@@ -313,7 +313,7 @@ def _internal_certificate(spec, G, Gs: np.ndarray, blocks, W, parts, lam, cones,
                        residual=float(np.linalg.norm(G @ f)), margin=margin, cones=cones)
 
 
-def _wrench_certificate(spec, Gs: np.ndarray, blocks, u, both, L, cones) -> Certificate:
+def _wrench_certificate(spec: GraspSpec, Gs: np.ndarray, blocks, u, both, L, cones: str) -> Certificate:
     p = Gs.shape[0]
     w = u.copy()  # the scaled wrench (f, m / L) = u as (f, m)
     w[3 if p == 6 else 2:] *= L
@@ -321,7 +321,7 @@ def _wrench_certificate(spec, Gs: np.ndarray, blocks, u, both, L, cones) -> Cert
                        margin=_dual_margin(spec, Gs, blocks, u), cones=cones)
 
 
-def _closure(spec, G, Gs: np.ndarray, blocks, W, parts, cones, tol, L) -> tuple:
+def _closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, W, parts, cones: str, tol: GraspTolerances, L) -> tuple:
     """(closed, certificate) for one set of polyhedral cones (exact or a pyramid)."""
     p = W.shape[0]
     if _relative_rank(W, tol.rank_rtol) == p:
@@ -334,7 +334,7 @@ def _closure(spec, G, Gs: np.ndarray, blocks, W, parts, cones, tol, L) -> tuple:
     return False, _wrench_certificate(spec, Gs, blocks, u, both, L, cones)
 
 
-def _decide_closure(spec, G, Gs: np.ndarray, blocks, facets, tol, L) -> tuple:
+def _decide_closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, facets: int, tol: GraspTolerances, L) -> tuple:
     """(force_closure, certificate, how, facets used, notes)."""
     notes = []
     if all(exact_cones(c, spec.planar) for c in spec.contacts):
@@ -382,7 +382,7 @@ def _qhull(X: np.ndarray):
         return ConvexHull(X, qhull_options="QJ")
 
 
-def _epsilon(W, tol) -> tuple:
+def _epsilon(W, tol: GraspTolerances) -> tuple:
     """(lower, upper, reason): bounds on the distance epsilon from the origin to the boundary of
     the hull of W's columns (0 when the origin is not strictly inside); equal unless the work
     bound stopped the search (reason says so).
@@ -446,7 +446,7 @@ def _epsilon(W, tol) -> tuple:
         S += added
 
 
-def _quality(spec, Gs: np.ndarray, blocks, facets, exact, closed, tol, L) -> GraspQuality:
+def _quality(spec: GraspSpec, Gs: np.ndarray, blocks, facets, exact, closed, tol: GraspTolerances, L) -> GraspQuality:
     W_in, _ = generator_matrix(spec, Gs, blocks, facets)
     eps, upper, reason = _epsilon(W_in, tol)
     if not exact:
@@ -486,7 +486,7 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
                        0.0 if exact else cone_error(n), exact, quality, L, source, tol.margin, tuple(notes))
 
 
-def _closure_form(Wf, tol) -> tuple:
+def _closure_form(Wf, tol: GraspTolerances) -> tuple:
     """Form closure: the normals' wrenches positively span wrench space (an exact test)."""
     if _relative_rank(Wf, tol.rank_rtol) < Wf.shape[0]:
         return False, None

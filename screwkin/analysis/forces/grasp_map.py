@@ -19,7 +19,7 @@ __all__ = ["contact_frame", "contact_columns", "grasp_map", "grasp_characteristi
 
 
 # ------------------------------------------------------------------ the grasp map
-def contact_frame(normal) -> np.ndarray:
+def contact_frame(normal: np.ndarray) -> np.ndarray:
     """R = [t1 t2 n] (columns), right-handed, n the unit normal; t1 is the unit vector
     orthogonal to n nearest the coordinate axis least aligned with n."""
     n = np.asarray(normal, float)
@@ -31,7 +31,7 @@ def contact_frame(normal) -> np.ndarray:
     return np.column_stack([t1, np.cross(n, t1), n])
 
 
-def _hat(p) -> np.ndarray:
+def _hat(p: np.ndarray) -> np.ndarray:
     x, y, z = p
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
@@ -133,7 +133,7 @@ def generators(c, planar, facets: int = 8, circumscribed: bool = False) -> np.nd
     return C
 
 
-def generator_matrix(spec, Gs: np.ndarray, blocks, facets, circumscribed: bool=False, frictionless: bool=False) -> tuple:
+def generator_matrix(spec: GraspSpec, Gs: np.ndarray, blocks, facets, circumscribed: bool=False, frictionless: bool=False) -> tuple:
     """W = G_s C (scaled primitive wrenches, columns) and, per contact, its columns' slice and C_i."""
     cols, parts, start = [], [], 0
     for c, b in zip(spec.contacts, blocks):

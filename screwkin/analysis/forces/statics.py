@@ -177,7 +177,7 @@ def statics(mech: Mechanism, q: np.ndarray, inputs=None, output=None, wrench=Non
                          mech.transmissions(inputs), springs, tuple(notes))
 
 
-def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity, N_lam) -> tuple:
+def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity: bool, N_lam) -> tuple:
     """Reactions of every joint for constraint forces lam (and the load), and whether each is
     determined: it must not change along the null directions N_lam of the constraint forces."""
     loads = [(mech.link_frame(output), np.asarray(w, float))] if w is not None else []
@@ -188,7 +188,7 @@ def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity, N_lam) -
     return tuple(out)
 
 
-def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity, N_lam, v=None, a=None) -> dict:
+def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity: bool | np.ndarray, N_lam, v=None, a=None) -> dict:
     """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
     constraint forces lam, and the mask of its components that change along the null
     directions N_lam of the constraint forces (not determined by the balance)."""
@@ -204,7 +204,7 @@ def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity, N_lam, v
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech: Mechanism, q: np.ndarray, lam, loads=(), gravity: bool=False, v=None, a=None, rows=None) -> dict:
+def joint_wrenches(mech: Mechanism, q: np.ndarray, lam, loads=(), gravity: bool=False, v=None, a=None, rows: tuple | None = None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
@@ -448,7 +448,7 @@ def legs(mech: Mechanism, q: np.ndarray, output, inputs=None) -> tuple:
     return tuple(out)
 
 
-def _cut_twists(mech: Mechanism, cut, o, state) -> np.ndarray:
+def _cut_twists(mech: Mechanism, cut, o, state: KinematicState) -> np.ndarray:
     """The relative twists a cut joint allows (analysis.screws.cut_twists), moved to the platform
     origin o, world axes (6 x k); none for a higher pair (its equivalent linkage's joints belong
     to the leg)."""

@@ -79,7 +79,7 @@ class BatchedCurve(Curve):
         return ok
 
 
-def batched_motion(solver, curve, q0: np.ndarray, t0, start, stop, steps: int, fallback, progress=None):
+def batched_motion(solver, curve, q0: np.ndarray, t0, start: float, stop: float, steps: int, fallback, progress=None):
     """The grid values from start to stop (steps steps) on q0's branch, batched (see the module
     docstring).  curve: the sweep's Curve; t0: its oriented tangent at q0 (the input's component
     along the motion); fallback(q, x_from, x_to, n): the tracker's Motion of n steps;

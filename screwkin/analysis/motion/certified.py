@@ -193,7 +193,7 @@ def _reference_check(solver, problem, got: Certified) -> Certified:
     return Certified(got.modes, count)
 
 
-def _rank(closure, rng: np.random.Generator) -> int:
+def _rank(closure: PolynomialClosure, rng: np.random.Generator) -> int:
     """The generic rank of the closure rows' Jacobian (at random complex points of the variety)."""
     if closure.nt == 0 or closure.m == 0:
         return 0
@@ -201,7 +201,7 @@ def _rank(closure, rng: np.random.Generator) -> int:
     return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
 
 
-def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: MonodromyOptions,
+def _classify(solver, problem, closure: PolynomialClosure, system: SquareSystem, group, roots, ends, known, seconds, o: MonodromyOptions,
               also: str = "") -> Certified:
     """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
     mech, tol = solver.mech, solver.mech.tolerances
@@ -296,7 +296,7 @@ def _coinciding(X: np.ndarray, mask, group, tol) -> np.ndarray:
     return out
 
 
-def _lift(solver, problem, closure, x):
+def _lift(solver, problem, closure: PolynomialClosure, x):
     """The real configuration of a real root x of the closure: its joints, and the eliminated legs'
     angles (model.legs) solved by damped Newton with every other joint held -- from the inputs'
     configuration, then from random angles -- or None."""

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.continuation import Curve
 
 __all__ = ["ChangePoint", "Crossing", "passed", "crossing", "follow", "constraint_profile", "dips", "reclosing",
            "LOOK_BELOW", "TIGHT_CLOSURE", "START", "nearest_branch"]
@@ -229,7 +230,7 @@ def _measure(mech: Mechanism, q: np.ndarray, rank: int) -> float:
     return float(constraint_profile(mech, [q], rank)[0][0])
 
 
-def _again(solver, out, res, k: int, lo_k, hi_k, bounds) -> tuple | None:
+def _again(solver, out: list, res, k: int, lo_k, hi_k, bounds: list) -> tuple | None:
     """(x, configuration, measure) of a change point already found (in ``out``) that this dip is another
     pass of (a motion through limit positions passes one point again and again): its input within the
     dip's bounds, its joint centres nearer the recorded configuration k than the neighbours are; else None."""
@@ -241,7 +242,7 @@ def _again(solver, out, res, k: int, lo_k, hi_k, bounds) -> tuple | None:
     return None
 
 
-def _least(solver, res, q: np.ndarray, bounds, rank, tight):
+def _least(solver, res, q: np.ndarray, bounds: list | tuple, rank, tight):
     """(x, configuration, measure) where the constraint measure is least for the input within bounds, the
     loops closed again from q at each value (bounded minimization, to the closure tolerance); None
     where they cannot be closed there."""
@@ -281,7 +282,7 @@ def _branch_rates(mech: Mechanism, branch: str) -> np.ndarray:
     return np.array([branch.tangent.get(n, 0.0) for n in mech.coordinate_names], float)
 
 
-def follow(curve, q: np.ndarray, x, rates, x_to):
+def follow(curve: Curve, q: np.ndarray, x, rates, x_to):
     """The configuration at input value x_to reached from the configuration q (input x) along the
     branch of tangent ``rates`` (joint rates): a first step of Tolerances.local_step along it (where
     the local analysis confirms its branches), then the continuation's steps (Neighbour) to x_to.
@@ -310,7 +311,7 @@ def follow(curve, q: np.ndarray, x, rates, x_to):
     return Neighbour(curve.solver, curve.name)(q1, x1, x_to)
 
 
-def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
+def crossing(solver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
     """At the change point c of the motion res: (ChangePoint, the followed branch's tangent as joint
     rates oriented along the motion or None, why-not text or None).  The incoming branch is the one
     whose line, followed back from c (``follow``), reaches nearest the configuration recorded before
@@ -361,7 +362,7 @@ def crossing(solver, curve, res, c: Crossing, switch: bool, prior=None) -> tuple
     return ChangePoint(c.x, c.sigma, c.q, local, incoming, goes, True, switched=goes != came), v, why
 
 
-def _starting(solver, curve, local, branches, moving, c: Crossing, direction) -> tuple:
+def _starting(solver, curve: Curve, local, branches: list, moving: list, c: Crossing, direction) -> tuple:
     """(the branch a motion starting on the change point c takes, the rule in words): of the branches
     that move the input, the one the file's configuration lies on (followed from c to its input value,
     it reaches the drawing: solve's first mode is the one nearest the drawing); where none does (the
@@ -391,7 +392,7 @@ def _starting(solver, curve, local, branches, moving, c: Crossing, direction) ->
     return came, f"{START}: taking the branch nearest the input's own direction (projected on ker K)"
 
 
-def _reaches(solver, curve, c: Crossing, rates, x, drawn) -> bool:
+def _reaches(solver, curve: Curve, c: Crossing, rates, x, drawn) -> bool:
     """Whether the branch of tangent ``rates`` at the change point c, followed to input value x, reaches the
     configuration whose signature (PositionSolver.signature) is ``drawn``."""
     q = follow(curve, c.q, c.x, rates, x)

@@ -129,7 +129,7 @@ class _Pose:
         return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
 
 
-def _turn_from(u0, u):
+def _turn_from(u0, u: tuple):
     """The angle from the constant vector u0 to the jet vector u, in (-pi, pi]."""
     return Jet.atan2(u[1] * u0[0] - u[0] * u0[1], u[0] * u0[0] + u[1] * u0[1])
 
@@ -249,14 +249,14 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma: float, probe: boo
     return (_Pose.through(th, A, A1), _Pose.through(th, C, C2)), disc.v / v0s
 
 
-def _root(disc, clamp):
+def _root(disc, clamp: bool):
     """The square root of a discriminant (NaN where it is negative); clamp: of max(disc, 0),
     values only (at a limit position, where the derivatives are infinite)."""
     with np.errstate(invalid="ignore", divide="ignore"):
         return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
 
 
-def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp=None):
+def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp: int | None = None):
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
     clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
     Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
@@ -424,7 +424,7 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs, branch=None, clamp=None):
+    def predict(self, xs: list, branch=None, clamp: int | None = None):
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
@@ -464,7 +464,7 @@ class ClosedFormCurve:
         return x_lim, Q, D, which
 
 
-def _ready(solver, name: str, q0: np.ndarray, start):
+def _ready(solver, name: str, q0: np.ndarray, start: float):
     """The ClosedFormCurve for sweeping ``name`` from q0, or None when the closed form does not apply."""
     p = cached_plan(solver, name)
     if isinstance(p, str):
@@ -485,7 +485,7 @@ def _residuals_ok(mech: Mechanism, Q: np.ndarray) -> bool:
     return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
 
 
-def planar_sweep(solver, name: str, q0: np.ndarray, start, stop, steps: int, rate: float = 1.0, turn: bool=False, max_steps: int | None = None) -> ClosedFormSweep | None:
+def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float = 1.0, turn: bool=False, max_steps: int | None = None) -> ClosedFormSweep | None:
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
     (two limits between grid values, a configuration not closing the loops)."""

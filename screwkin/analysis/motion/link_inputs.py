@@ -66,7 +66,7 @@ def angle_row(angles: LinkAngles, link: str, angle: float) -> CouplingRow:
     return replace(path_sum, constant=float(theta0 - angle))
 
 
-def holding_angles(mech: Mechanism, joints, angles: dict):
+def holding_angles(mech: Mechanism, joints: list, angles: dict):
     """``mech`` with the links of ``angles`` (link -> absolute angle [rad]) held at those angles, for a
     solve whose input joints are ``joints``: Mechanism.with_rows of their angle rows.  A usage error
     when the mechanism is not planar, or a link's angle is fixed by the other inputs (its row adds no

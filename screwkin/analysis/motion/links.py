@@ -59,7 +59,7 @@ def moving_links(mech: Mechanism) -> tuple:
     return tuple(out)
 
 
-def link_motions(state, angles=None, normal=None, along=None) -> dict:
+def link_motions(state: KinematicState, angles=None, normal=None, along=None) -> dict:
     """Every moving link's absolute motion at a state: ``position`` (and, with rates, ``velocity``,
     ``acceleration``) of its frame origin [m, m/s, m/s^2], ``omega`` and ``alpha`` [rad/s, rad/s^2];
     planar mechanisms (``normal`` given): ``angle`` [rad] from ``angles`` (the vector-loop angles of
@@ -79,7 +79,7 @@ def link_motions(state, angles=None, normal=None, along=None) -> dict:
     return out
 
 
-def point_motions(state, points) -> dict:
+def point_motions(state: KinematicState, points) -> dict:
     """name -> {link, position, velocity, acceleration} of each Point (velocity and acceleration
     only when the state has rates)."""
     out = {}
@@ -193,7 +193,7 @@ def sweep_motion(mech: Mechanism, res, points=()) -> MotionAlong:
 
 
 
-def _frame_motions(model: pin.Model, data, frames, Q: np.ndarray, V, A) -> tuple:
+def _frame_motions(model: pin.Model, data, frames: list, Q: np.ndarray, V, A) -> tuple:
     """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
     (a, alpha) of the frames' origins in world axes (N, F, 6) -- what pin.getFrameVelocity and
     pin.getFrameClassicalAcceleration give in LOCAL_WORLD_ALIGNED -- from one forwardKinematics a
@@ -245,7 +245,7 @@ class Stroke:
     crank_angles: tuple | None  # (forward, return) crank angles [rad] when time_ratio is known
 
 
-def _extrema(x, p, dp, tol):
+def _extrema(x: np.ndarray, p, dp, tol):
     """(input value, coordinate) at each zero of dp/dx along the samples: the cubic Hermite
     interpolant of p on each bracket whose slope changes sign (accurate to O(h^4)), its vertex."""
     out = []
@@ -266,7 +266,7 @@ def _extrema(x, p, dp, tol):
     return out
 
 
-def _stroke_end(solver, res, name: str, coordinate, x, guess):
+def _stroke_end(solver, res, name: str, coordinate, x: np.ndarray, guess):
     """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
     its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
     from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""

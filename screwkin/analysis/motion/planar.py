@@ -184,7 +184,7 @@ def transmission_angles(mech: Mechanism, info: LinkageInfo, Q: np.ndarray) -> np
                          None if info.slide is None else np.asarray(info.slide, float))
 
 
-def _transmission(kind: str, P, n, slide=None):
+def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide=None):
     """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
     unit normal n (slide: the slide's unit direction, slider-crank)."""
     P = P - (P @ n)[..., None] * n
@@ -309,7 +309,7 @@ class LinkAngles:
         ends = self._ends(KinematicState(mech, mech.neutral()))
         self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
 
-    def _ends(self, state):
+    def _ends(self, state: KinematicState):
         """Choose each link's second point (KinematicState.centre's references, or ("axis", its frame)): the
         first candidate away from its first point at the configuration of ``state``."""
         out = {}

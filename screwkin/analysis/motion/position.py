@@ -233,7 +233,7 @@ class PositionSolver:
             raise UsageError(f"{self.mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
                              + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
 
-    def file_values_hint(self, names=None) -> str:
+    def file_values_hint(self, names: list | None = None) -> str:
         """--set options that give the joints ``names`` (default: the inputs) the file's values (SI:
         rad, m), as a way to name them in an error: one option where the values are equal."""
         names = list(self.inputs if names is None else names)
@@ -368,7 +368,7 @@ class PositionSolver:
         ref = self.reference()
         return self.mech.neutral() if ref is None else ref
 
-    def _at_once(self, values):
+    def _at_once(self, values: dict):
         """solve's default (method "nearest"): every mode where they come at once, as a certified.Search --
         a closure that is not polynomial or inputs that leave a continuum (an empty Search: solve's random
         starts find them, or samples of the continuum; no homotopy to spare), a mechanism of dyads (their closed form, analysis.motion.certified.closed_form) -- or None
@@ -399,7 +399,7 @@ class PositionSolver:
                            f"(the nearest these inputs allow; the joints --near does not name were free)")
         return tuple(out)
 
-    def distinct(self, system, starts, frozen=(), first_trace=None) -> tuple:
+    def distinct(self, system, starts: list, frozen=(), first_trace=None) -> tuple:
         """Solve ``system`` from every start; keep one solution per assembly mode.
 
         Returns ([(signature, q, Assembly)], smallest residual of the failures)."""
@@ -423,7 +423,7 @@ class PositionSolver:
         return found, best
 
     @staticmethod
-    def _describe(values) -> str:
+    def _describe(values: dict) -> str:
         return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
 
     # --------------------------------------------------------------- one answer per mode
@@ -453,7 +453,7 @@ class PositionSolver:
             self._link_angles(self.mech.neutral())
         return None if self._angles is None else self._angles.n
 
-    def _link_angles(self, q: np.ndarray, state=None):
+    def _link_angles(self, q: np.ndarray, state: KinematicState | None = None):
         if self._angles is False:
             self._angles = None
             ref = self.reference()
@@ -464,7 +464,7 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q: np.ndarray, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None) -> Solution:
+    def solution(self, q: np.ndarray, a, rates: dict | None = None, accels: dict | None = None, points=(), typed=None, sets=None, simple=None) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here

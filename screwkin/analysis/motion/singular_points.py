@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
 __all__ = ["locate_singularities"]
 
-def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g, V_ref=None):
+def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref=None):
     """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""
     S = scaled_jacobians(mech, q, g.output, g.point)
     if kind == "constraint":

@@ -168,7 +168,7 @@ REFINE = 8
 ON_GRID = 1e-6  # a value within this fraction of a fine step of a fine grid value is on that grid
 
 
-def _refined(f, start, h, k: int):
+def _refined(f, start: float, h, k: int):
     """The closed-form sweep ``f`` of a grid k times finer (step h / k) at the values of the grid of step h
     (and its located limit position, off both grids); None for None."""
     if f is None:
@@ -217,7 +217,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     return _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior)
 
 
-def _engine(solver, name: str, q0: np.ndarray, start, stop, steps: int, fixed, rate, progress, turn, max_steps: int, closed_form, batch):
+def _engine(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, fixed, rate: float, progress, turn: bool, max_steps: int, closed_form: bool, batch: bool):
     """The SweepResult of the engine that applies (see ``sweep``), started from q0."""
     curve, requested = Curve(solver, name), (start, stop, steps)
     if closed_form:
@@ -253,7 +253,7 @@ def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
     return fixed
 
 
-def _start(solver, name: str, start, fixed, near, q_start):
+def _start(solver, name: str, start: float, fixed, near: dict | None, q_start):
     """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
     may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
     drawing when it is solve's first mode there, else solve's first (near ``near``)."""
@@ -267,7 +267,7 @@ def _start(solver, name: str, start, fixed, near, q_start):
     return q0
 
 
-def _closed_form(solver, name: str, q0: np.ndarray, start, stop, steps: int, rate, turn, max_steps: int) -> SweepResult | None:
+def _closed_form(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float, turn: bool, max_steps: int) -> SweepResult | None:
     """The SweepResult of the closed-form engine (analysis.motion.dyads; on a finer grid read at this
     one's values where this one is too coarse for it), or None where it does not apply."""
     f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
@@ -296,7 +296,7 @@ def _fallback(solver, curve, fixed):
     return fallback
 
 
-def _trackable(mech: Mechanism, name: str, start, stop, steps: int):
+def _trackable(mech: Mechanism, name: str, start: float, stop: float, steps: int):
     """A range the per-step tracker takes more than MAX_TRACKED steps over (and more than its grid
     values) is a usage error naming the count."""
     needed = continuation_steps(mech, name, stop - start)
@@ -345,7 +345,7 @@ def _finish(solver, name: str, motion, rate, requested, turn, unit: str, method:
 
 
 
-def _through_change_points(solver, res, fixed, progress, max_steps: int, closed_form, batch, branch: str, prior=None):
+def _through_change_points(solver, res, fixed, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None):
     """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it
@@ -430,7 +430,7 @@ def _once(notes) -> tuple:
     return tuple(dict.fromkeys(notes))
 
 
-def _engine_took(solver, curve, res, k0, after, h) -> bool:
+def _engine_took(solver, curve: Curve, res, k0, after, h) -> bool:
     """Whether the engine's recorded configurations from index k0 are ``after`` ((input value,
     configuration) each, the branch followed), the input running the way of h."""
     tol = solver.mech.tolerances

@@ -79,7 +79,7 @@ def transmission_angle(B, C, D):
     return vector_angle(B - C, D - C)
 
 
-def slide_transmission_angle(B, C, normal):
+def slide_transmission_angle(B, C, normal: np.ndarray):
     """mu [rad] of slider-cranks from the rod's ends B (on the crank) and C (the slider's pin): the angle
     between the rod B -> C and the slide's normal ``normal``, in [0, pi/2]."""
     return line_angle(np.asarray(C, float) - np.asarray(B, float), normal)

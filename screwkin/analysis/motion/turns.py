@@ -18,7 +18,7 @@ from ...model.geometry import wrap_angle
 __all__ = ["whole_turns", "engaged", "turn_on"]
 
 
-def whole_turns(solver, values) -> dict:
+def whole_turns(solver, values: dict) -> dict:
     """Input name -> the whole turns [rad] of a revolute input's typed value, when the mechanism has
     higher pairs whose coupling rows count turns (screws, gears): 720deg is not 0 there."""
     if not solver.mech.counted_turns:
@@ -33,7 +33,7 @@ def whole_turns(solver, values) -> dict:
     return out
 
 
-def engaged(solver, found, values):
+def engaged(solver, found, values: dict):
     """The solutions whose counted angles (a screw's turn, a gear's roll) continue the assembled
     configuration's: each predicted from there by the loops' rates (linear for screws and gears) and
     kept when within half a turn of it; the others differ by whole turns of a thread or a tooth
@@ -69,7 +69,7 @@ def engaged(solver, found, values):
     return [found[int(np.argmin(off))]]
 
 
-def _turned(solver, q: np.ndarray, other, counted) -> bool:
+def _turned(solver, q: np.ndarray, other, counted: list) -> bool:
     """Whether q is ``other`` with some of its pairs turned on by whole turns: for each higher pair's
     coupling row, one of its counted angles differs from other's by a whole number of turns (a
     thread, a tooth), at least one by a nonzero number."""

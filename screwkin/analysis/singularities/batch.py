@@ -281,7 +281,7 @@ class SerialJacobians:
                 raise RuntimeError(f"batched Jacobian differs from Pinocchio's by {err:.1e}")
 
 
-def _apply(R, x) -> np.ndarray:
+def _apply(R: np.ndarray, x) -> np.ndarray:
     """R x for a stack of rotations stored by columns (R[b]: (3, N)) and a constant 3-vector x."""
     out = None
     for b in range(3):
@@ -317,7 +317,7 @@ def singular_value_ratios(J: np.ndarray, scale_translation: float = 1.0, method:
         return np.where(high > 0, low / high, 0.0)
 
 
-def _extreme_singular_values(J: np.ndarray, scale_translation, method, slide=None) -> tuple:
+def _extreme_singular_values(J: np.ndarray, scale_translation: float, method: str, slide=None) -> tuple:
     J = np.array(J, float)
     if J.ndim != 3:
         raise ValueError(f"expected a stack of matrices (N, m, n), got shape {J.shape}")

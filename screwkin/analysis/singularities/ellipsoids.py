@@ -68,7 +68,7 @@ def _axis_labels(d: int, linear: int) -> tuple:
     return lin + ang, flin + fang
 
 
-def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point: bool=False) -> Ellipsoids:
+def _of_scaled(M, L: float, inputs, tol: Tolerances, linear: int, output: str | None = None, point: bool=False) -> Ellipsoids:
     d = M.shape[0]
     U, s, _ = np.linalg.svd(M, full_matrices=True) if M.size else (np.eye(d), np.zeros(0), None)
     vel = np.zeros(d)
@@ -146,7 +146,7 @@ def with_input_output_condition(mech: Mechanism, q: np.ndarray, rep: Singularity
     return replace(rep, condition_input_output=io, input_output_note=note)
 
 
-def _input_output_condition(mech: Mechanism, q: np.ndarray, rep) -> tuple:
+def _input_output_condition(mech: Mechanism, q: np.ndarray, rep: SingularityReport) -> tuple:
     tol = mech.tolerances
     if rep.output is None:
         return None, "give --output LINK, the moving platform"

@@ -51,7 +51,7 @@ def _simplified(sp, expr) -> tuple:
     return coeff * sp.Mul(*[g ** m for g, m in parts]), [g for g, _ in parts]
 
 
-def _loop_rank(mech: Mechanism, S, here) -> int:
+def _loop_rank(mech: Mechanism, S, here: dict) -> int:
     """The rank of the loop's twists at the configuration measured (lengths over the characteristic
     length: a row scaling, the rank unchanged)."""
     M = np.array(S.subs(here).evalf(), dtype=float)

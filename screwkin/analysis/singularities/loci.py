@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
 
@@ -253,7 +254,7 @@ def _in_box(p, box, margin: float = 0.0) -> bool:
     return x0 - mx <= p[0] <= x1 + mx and y0 - my <= p[1] <= y1 + my
 
 
-def _trace_one_way(sys, q: np.ndarray, v, box, direction) -> tuple:
+def _trace_one_way(sys, q: np.ndarray, v, box: tuple, direction) -> tuple:
     """Points from (q, v) along +-tangent until the box's edge, the start again, or MAX_POINTS.
     Returns (qs, vs, closed, truncated)."""
     J = sys.jacobian(q, v)
@@ -290,7 +291,7 @@ def _dist(sys, q1: np.ndarray, q2: np.ndarray) -> float:
     return float(np.linalg.norm(sys.mech.difference(q1, q2) / sys.scale))
 
 
-def _clip(sys, qs, vs, box) -> tuple:
+def _clip(sys, qs, vs, box: tuple) -> tuple:
     """The points in the box; an end outside is replaced by the curve's crossing of the box's edge
     (Newton with the coordinate held at the edge)."""
     out_q, out_v = list(qs), list(vs)
@@ -379,7 +380,7 @@ def _cusps(sys, qs, vs, ts):
     return out
 
 
-def trace_loci(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed, output=None, point: bool=False, kinds=None, grid: int = 9,
+def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, output=None, point: bool=False, kinds=None, grid: int = 9,
                starts: int | None = None) -> Loci:
     """The singular loci of each kind in the box xs[0]..xs[-1] x ys[0]..ys[-1] (see the module).
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""
@@ -422,7 +423,7 @@ def trace_loci(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray,
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
 
 
-def trace_kind(sys, kind: str, seeds, box, notes) -> tuple:
+def trace_kind(sys, kind: str, seeds, box: tuple, notes) -> tuple:
     """The curves of one kind (sys: a LocusSystem or one like it) from the configurations ``seeds``, each
     brought onto the locus by Newton (onto the box's edge when outside) unless near a curve already traced:
     (loci, cusps ((x, y), kind), their configurations, nodes ((x, y), kind)); notes gets what it left."""
@@ -488,7 +489,7 @@ def trace_kind(sys, kind: str, seeds, box, notes) -> tuple:
     return loci, cusps, cusp_q, nodes
 
 
-def _modes_in_box(solver, x_name: str, y_name: str, box, fixed) -> tuple[list, str]:
+def _modes_in_box(solver: PositionSolver, x_name: str, y_name: str, box: tuple, fixed: dict) -> tuple[list, str]:
     """(configurations, in words): every mode the solver finds at the box's centre; where none assembles
     there, at the first of the other nodes of a 3 x 3 grid of the box that assembles."""
     (x0, x1), (y0, y1) = box
@@ -517,7 +518,7 @@ def _near(sys, q: np.ndarray, Q: np.ndarray) -> float:
     return float(np.sqrt((D * D).sum(axis=1)).min())
 
 
-def _untraceable(mech: Mechanism, g, kind: str, output, inputs) -> str | None:
+def _untraceable(mech: Mechanism, g: Generic, kind: str, output, inputs) -> str | None:
     if kind == "actuator":
         if not mech.closure.nrows or not len(g.p):
             return "no loop, no passive joint"

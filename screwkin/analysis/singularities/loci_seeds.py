@@ -8,13 +8,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..motion.continuation import Neighbour
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexplained_folds"]
 
 TINY = 1e-300  # division guard: two segments parallel
 
 
-def unexplained_folds(sheets, loci, box, n: int) -> list:
+def unexplained_folds(sheets, loci, box: tuple, n: int) -> list:
     """Notes for the grid nodes a continuation step was refused from (a fold lies within a cell) with no
     traced actuator curve within a cell and a half: a component the seeds missed."""
     span = np.array([box[0][1] - box[0][0], box[1][1] - box[1][0]], float)
@@ -34,7 +38,7 @@ def unexplained_folds(sheets, loci, box, n: int) -> list:
     return []
 
 
-def sheets(solver, x_name: str, y_name: str, box, starts, n: int):
+def sheets(solver: PositionSolver, x_name: str, y_name: str, box: tuple, starts: int | None, n: int):
     """Each start continued over an n x n grid of the box from its nearest node: a list of
     (qs (n, n, nq) with NaN where not reached, refused (n, n) bool: a step from there refused)."""
     mech = solver.mech
@@ -109,7 +113,7 @@ def seed_configurations(sys, sheets) -> list:
     return [(q, s) for s, q in cands]
 
 
-def crossings(curves, box):
+def crossings(curves: list, box: tuple):
     """Points where two traces (or one with itself, away from its neighbours) cross: segment
     intersections of the polylines (the traces are dense: each segment is one continuation step)."""
     out = []

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["SingularityMap", "singularity_map", "seams", "apart"]
 
@@ -46,7 +47,7 @@ class SingularityMap:
         return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
 
 
-def singularity_map(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed=None, output=None, point: bool = False,
+def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed=None, output=None, point: bool = False,
                     q_start=None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
@@ -107,7 +108,7 @@ def apart(mech: Mechanism, q1: np.ndarray, q2: np.ndarray) -> float:
     return float(np.linalg.norm(d))
 
 
-def seams(mech: Mechanism, qs, reached, step_x=None, step_y=None, xs: np.ndarray | None = None, ys: np.ndarray | None = None) -> np.ndarray:
+def seams(mech: Mechanism, qs: np.ndarray, reached: np.ndarray, step_x=None, step_y=None, xs: np.ndarray | None = None, ys: np.ndarray | None = None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
     characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and

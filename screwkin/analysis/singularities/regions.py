@@ -18,6 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import AssemblyError
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["Region", "Regions", "regions"]
 
@@ -39,7 +43,7 @@ class Regions:
     notes: tuple = ()
 
 
-def _blocked(curves, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+def _blocked(curves: list, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     nx, ny = len(xs), len(ys)
     mask = np.zeros((ny, nx), bool)
     dx = (xs[-1] - xs[0]) / (nx - 1) if nx > 1 else 1.0
@@ -61,7 +65,7 @@ def _blocked(curves, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return mask
 
 
-def regions(solver, loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed, count: bool = True, max_counted: int = 24) -> Regions:
+def regions(solver: PositionSolver, loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, count: bool = True, max_counted: int = 24) -> Regions:
     """The regions of the grid xs x ys cut by ``loci`` (analysis.singularities.loci.Loci), each with its sample
     and (count) its number of real assembly modes there."""
     from scipy import ndimage

@@ -172,7 +172,7 @@ def _measures(S: Scaled, g: Generic) -> dict:
     return out
 
 
-def classify(mech: Mechanism, q: np.ndarray, inputs=None, output=None, length=None, generic=None, point: bool = False) -> SingularityReport:
+def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=None, length=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:
     """Classify the configuration q (assembled) for the given inputs and output link.
     length: the characteristic length [m] (default ``mech.length``); point: the output
     link's origin as a point (its 3 translations) instead of its full motion."""
@@ -365,7 +365,7 @@ def _pair_axis(mech: Mechanism, cut, state) -> tuple:
     return (spec, f1, f2, *pair_contact(spec, M1, state.frame_placement(f2)))
 
 
-def pair_twist(mech: Mechanism, cut, state) -> list:
+def pair_twist(mech: Mechanism, cut, state: KinematicState) -> list:
     """[(name, twist, False)]: the pair closed by ``cut`` as one twist (v at the world origin, w) at a
     unit rate of turning of F2's link relative to F1's.  A rolling or gear pair: a revolute about
     its axis through the contact point (model.cuts.pair_contact; pure rolling is that rotation);

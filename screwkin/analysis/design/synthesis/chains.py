@@ -178,7 +178,7 @@ def _orbits(n: int, autos) -> tuple:
     return tuple(orbits)
 
 
-def _name(links, degrees, edges, kinds) -> str:
+def _name(links: int, degrees: tuple, edges, kinds) -> str:
     prismatic = sum(1 for k in kinds.values() if k == "P")
     counts = {}
     for d in degrees:

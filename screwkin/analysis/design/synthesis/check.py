@@ -172,7 +172,7 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
                  tuple(travel), tol, letters)
 
 
-def _locate(design, solver, probe, res, x, q_target: np.ndarray) -> bool:
+def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x, q_target: np.ndarray) -> bool:
     """Whether the branch followed by sweep ``res`` is, at input value x, in the configuration
     q_target (the solution found for that precision position): same moving pivots."""
     if q_target is None:
@@ -189,7 +189,7 @@ def _locate(design, solver, probe, res, x, q_target: np.ndarray) -> bool:
     return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
-def _follow(design: Design, solver, probe, configs, steps: int):
+def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs, steps: int):
     """(direction, travel per position, transmission angles along the motion, defects)."""
     name = design.input_joint
     tol = probe.mech.tolerances

@@ -192,7 +192,7 @@ def fourbar_linkage(fb: FourBar, name: str, comment: str = "", tool: str | None 
     return PlanarLinkage(name, tuple(links), tuple(joints), (loop,), ("crank_joint",), comment)
 
 
-def stored(design: Design, labels=None) -> Design:
+def stored(design: Design, labels: list | None = None) -> Design:
     """``design`` with its targets in its file (``<screwkin:targets>``, files.description.TargetSpec),
     so that ``screwkin draw FILE`` shows them later: a pose or point where it was asked, an angle
     about the output link's fixed pivot B0; ``labels`` (one per target): how each reads as typed

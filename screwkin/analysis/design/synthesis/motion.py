@@ -65,7 +65,7 @@ def _burmester_rows(poses, A0: np.ndarray) -> np.ndarray:
     return np.stack(rows, axis=-2)
 
 
-def moving_pivot(poses, A0: np.ndarray, what: str = WHAT) -> np.ndarray:
+def moving_pivot(poses: list, A0: np.ndarray, what: str = WHAT) -> np.ndarray:
     """The moving pivot (coupler frame) of the dyad with fixed pivot A0 through three poses."""
     M = _burmester_rows(poses[:3], A0)
     G, r = M[:, :2], M[:, 2]
@@ -76,7 +76,7 @@ def moving_pivot(poses, A0: np.ndarray, what: str = WHAT) -> np.ndarray:
     return np.linalg.solve(G, r)
 
 
-def fixed_pivot(poses, local, what: str = WHAT) -> np.ndarray:
+def fixed_pivot(poses: list, local, what: str = WHAT) -> np.ndarray:
     """The fixed pivot of a dyad whose moving pivot is ``local`` in the coupler frame: the centre
     of the circle through its three positions."""
     W = [pose_matrix(p)[0] @ np.asarray(local, float) + pose_matrix(p)[1] for p in poses[:3]]
@@ -170,7 +170,7 @@ def _circle_points(poses, C) -> tuple:
     return local, local @ R1.T + p1
 
 
-def dyad_candidates(poses, count: int = 24, bound: float | None = None) -> tuple:
+def dyad_candidates(poses: list, count: int = 24, bound: float | None = None) -> tuple:
     """Dyads of four positions for a list to choose from: the curve traced with ``count``
     lines through the base pole, points within ``bound`` (default 3 times the size of the
     task) of the poses' centroid, neither link shorter than 2 % of the task's size."""
@@ -188,7 +188,7 @@ def _D(poses4, X: np.ndarray):
     return np.linalg.det(_burmester_rows(poses4, X))
 
 
-def burmester_points(poses, seeds: int = 360) -> tuple:
+def burmester_points(poses: list, seeds: int = 360) -> tuple:
     """The Burmester points of five poses as dyads (at most four)."""
     poses = list(poses)[:5]
     L = scale_of(poses)
@@ -251,7 +251,7 @@ def fourbar_from_dyads(poses, crank: Dyad, rocker: Dyad) -> FourBar:
                    tuple(float(x) for x in poses[0]))
 
 
-def _positions_of(poses, crank: Dyad, rocker: Dyad) -> tuple[np.ndarray, np.ndarray]:
+def _positions_of(poses: list, crank: Dyad, rocker: Dyad) -> tuple[np.ndarray, np.ndarray]:
     """Crank angles and branches of the four-bar at each pose (from the dyads themselves)."""
     thetas, sigmas = [], []
     for pose in poses:
@@ -273,7 +273,7 @@ def targets_of(poses, crank: Dyad) -> tuple:
                  for k, (pose, t) in enumerate(zip(poses, thetas)))
 
 
-def rank_pairs(poses, dyads, limit: int | None = None) -> list:
+def rank_pairs(poses: list, dyads: list, limit: int | None = None) -> list:
     """Every ordered pair (crank i, rocker j) of dyads, best first, in closed form
     (fourbar.travel_analysis): pairs without defects first, then by the worst transmission
     angle over the motion (the largest |90 deg - mu|).  Pairs whose ground is shorter than
@@ -312,7 +312,7 @@ def motion_design(poses, crank: Dyad, rocker: Dyad, name: str = "synthesized_mot
                          tuple(notes)))
 
 
-def _check_poses(poses):
+def _check_poses(poses: list):
     L = scale_of(poses)
     for i, j in itertools.combinations(range(len(poses)), 2):
         a, b = poses[i], poses[j]

@@ -203,7 +203,7 @@ def _path_run(task):
     return out, nfev
 
 
-def _judge(pts: np.ndarray, x, sigma: float, direction, timing, constraints, L, tol, equal, run) -> tuple | None:
+def _judge(pts: np.ndarray, x, sigma: float, direction, timing, constraints, L, tol: float, equal: float, run) -> tuple | None:
     """A refined design as a Candidate (closed form: errors, motion, defects, constraints)."""
     A0, B0, a, b, c, p, q, th = _unpack(x, timing, direction)
     P, h2, A, B = (v[0] for v in coupler_points(A0, B0, a, b, c, p, q, th, sigma))

@@ -193,7 +193,7 @@ def _motion_run(task):
     return out, nfev
 
 
-def _judge_motion(poses, A0: np.ndarray, a, B0: np.ndarray, b, direction, constraints, L, tol, equal, run, exact):
+def _judge_motion(poses: list, A0: np.ndarray, a, B0: np.ndarray, b, direction, constraints, L, tol, equal: float, run, exact: bool):
     R1, p1 = pose_matrix(poses[0])
     crank, rocker = Dyad(tuple(map(float, A0)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))), \
         Dyad(tuple(map(float, B0)), tuple(map(float, R1 @ b + p1)), tuple(map(float, b)))
