@@ -111,7 +111,7 @@ class LoopSystem:
     def columns(self) -> int:
         return len(self.names)
 
-    def stack(self, P) -> np.ndarray:
+    def stack(self, P: np.ndarray) -> np.ndarray:
         """The constraint rows of P (units, 6): each cut's sum of sigma P in its algebra."""
         blocks = [E @ (s @ P) for E, s in zip(self.basis, self.sigma)]
         return np.concatenate(blocks) if blocks else np.zeros(0)
@@ -126,7 +126,7 @@ class LoopSystem:
             A[:, k] = self.coupled(self.stack(self.screws * y[:, None]), np.eye(n)[k])
         return A
 
-    def coupled(self, loops, x) -> np.ndarray:
+    def coupled(self, loops, x: np.ndarray) -> np.ndarray:
         """The loop rows followed by the coupling rows of the column rates x (and, for A only, the
         contacts' first-order rows)."""
         out = np.concatenate([loops, self.couplings @ x]) if len(self.couplings) else loops

@@ -169,7 +169,7 @@ def _joint_geometry_rows(mech: Mechanism, topo, frames, jac: dict, state: Kinema
     return rows
 
 
-def _idle(mech: Mechanism, topo, frames, q: np.ndarray, V, output_link, tol) -> tuple:
+def _idle(mech: Mechanism, topo, frames, q: np.ndarray, V: np.ndarray, output_link, tol) -> tuple:
     """Idle motions: motions that change no joint's geometry.
 
     Links joined to the rest by a single joint (free tips such as a serial
@@ -245,7 +245,7 @@ def _output_motion(link: str, T, tol, origin) -> OutputMotion:
     return OutputMotion(link, dim, t, r, label, center, tuple(tuple(col) for col in basis.T))
 
 
-def _classification(n: int, m, eff, overconstraint, topo, M) -> tuple:
+def _classification(n: int, m, eff, overconstraint, topo: Topology, M) -> tuple:
     """The classification and notes; a structure (no effective DOF) is statically determinate
     or not in its detected motion space: a planar triangle is determinate in the plane
     (Gruebler 0 = M), although 3 of its 5 spatial constraint rows are redundant."""

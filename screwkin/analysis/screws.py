@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
 
 __all__ = ["Screw", "Chain", "LoopScrews", "screw_of", "chains", "chains_to", "poe", "structure", "loop_screws",
            "loop_product", "split_jacobians", "cut_twists"]
@@ -113,7 +114,7 @@ def joint_angles(mech: Mechanism, q: np.ndarray, chain):
     return dq[list(chain.columns)]
 
 
-def poe(chain, theta) -> np.ndarray:
+def poe(chain: Chain, theta) -> np.ndarray:
     """g(theta) = prod exp([xi_i] theta_i) g(0), as a 4x4 matrix."""
     M = pin.SE3.Identity()
     for k in range(len(chain.joints)):
@@ -151,7 +152,7 @@ class LoopScrews:
     closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
 
 
-def cut_twists(mech: Mechanism, cut, state: KinematicState):
+def cut_twists(mech: Mechanism, cut: CutJoint, state: KinematicState):
     """The cut joint's freedoms at the configuration of ``state`` (a model.state.KinematicState) as
     world twists (v at the world origin, w): [(name, twist, sliding)], or None for a higher pair (its
     loop closes through an equivalent linkage and coupling rows)."""

@@ -19,6 +19,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from screwkin.analysis.motion.ik import Branches
+    from screwkin.analysis.motion.solution import PositionResult
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -97,7 +99,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _closed_text(mech: Mechanism, res, count) -> str:
+def _closed_text(mech: Mechanism, res: PositionResult, count) -> str:
     """The search line of a closed-form answer (analysis.motion.closed_ik), and for a platform whose
     combinations are not all listed each leg's other branch beside the first solution."""
     c = res.modes
@@ -120,7 +122,7 @@ def _closed_text(mech: Mechanism, res, count) -> str:
     return text
 
 
-def _found_text(count, free: int, certified: bool = False) -> str:
+def _found_text(count: Branches, free: int, certified: bool = False) -> str:
     """'8 distinct branches found (legs: 2 x 2 x 2) of at most 8 (why): all of them', or how far from it
     (``certified``: the homotopy has them all, whatever the legs' bound)."""
     n = count.found

@@ -311,7 +311,7 @@ def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, values: dict, names, notes, data, held=None):
+def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np.ndarray, values: dict, names, notes, data, held=None):
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \

@@ -46,6 +46,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.design.synthesis.designs import Design
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -175,7 +176,7 @@ def _plausible(design, kind: str):
                                                    f"the {LIMITS.length:g} m a mechanism file may hold")
 
 
-def _realize(design, out, tolerance=None) -> tuple:
+def _realize(design: Design, out, tolerance=None) -> tuple:
     """Write design's URDF under a temporary name beside ``out``, check it there; returns
     (check, temporary path)."""
     _plausible(design, design.kind)

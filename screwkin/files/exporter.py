@@ -221,7 +221,7 @@ def joint_points(pm: PlacedMechanism) -> dict:
     return out
 
 
-def helper_names(pm) -> dict:
+def helper_names(pm: PlacedMechanism) -> dict:
     """Names of what the MJCF writer adds, none equal to a name of the mechanism: (kind, cut or input)
     -> name, kind one of "F1" (a cut's body), "axis" (a revolute cut's second connect), "weld", "motor"
     and "aux" (a cut's joints, with its index)."""
@@ -264,7 +264,7 @@ _AUX = {"prismatic": ("slide",), "cylindrical": ("hinge", "slide"), "universal":
         "planar": ("slide", "slide", "hinge")}
 
 
-def _aux_axes(c):
+def _aux_axes(c: PlacedCut):
     """The axes (in F1) of the aux body's joints for a cut joint of type in _AUX."""
     a = np.asarray(c.axis, float)
     if c.type == "planar":

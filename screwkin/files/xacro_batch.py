@@ -80,7 +80,7 @@ class _Context:
         return self.batches[int(m.group(1))] if m and int(m.group(1)) < len(self.batches) else None
 
 
-def _finite_bad(values, bad):
+def _finite_bad(values: np.ndarray, bad):
     if values.dtype == bool:
         return bad
     return bad | ~np.isfinite(values)
@@ -95,7 +95,7 @@ class Batch:
     def __init__(self, v, bad, ctx: _Context) -> None:
         self.v, self.bad, self.ctx = np.asarray(v), bad, ctx
 
-    def _other(self, o) -> tuple:
+    def _other(self, o: Batch) -> tuple:
         if isinstance(o, Batch):
             return o.v, o.bad
         if isinstance(o, (bool, int, float)):
@@ -166,7 +166,7 @@ class _BatchInterpreter(_Interpreter):
         super().__init__(symbols)
         self.ctx = ctx
 
-    def _where(self, test, a, b) -> Batch:
+    def _where(self, test: Batch, a, b) -> Batch:
         """``a if test else b``, design by design (each design's failures from its own branch and the test)."""
         ctx = self.ctx
         t = np.asarray(test.v, bool) if isinstance(test, Batch) else np.full(ctx.n, bool(test))

@@ -17,6 +17,10 @@ from ..files.description import placement
 from ._pin import frame_id
 from .geometry import plane_basis, wrap_angle
 from .manifold import continuous_angle
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.files.description import CutJointSpec
 
 __all__ = ["CutJoint", "CouplingRow", "ContactRow", "Assembly", "in_plane", "pair_contact", "bind_cut",
            "virtual_roles", "virtual_joint_name"]
@@ -125,7 +129,7 @@ def in_plane(axis) -> tuple:
     return a, e1, e2
 
 
-def pair_contact(pair, M1, M2) -> tuple:
+def pair_contact(pair: CutJointSpec, M1, M2) -> tuple:
     """(p, a): the world point where the pitch curves of a rolling or gear pair touch, and the
     pair's unit axis in the world (the normal of its plane).  ``pair``: the file's loop joint
     (files.description: axis in F1, radius1 -- inf for a line --, radius2, contact); M1, M2: the
@@ -149,7 +153,7 @@ def pair_contact(pair, M1, M2) -> tuple:
     return p1 + float(pair.radius1) * e, a
 
 
-def virtual_roles(c) -> tuple:
+def virtual_roles(c: CutJointSpec) -> tuple:
     """The roles of the virtual joints of a rolling, gear or helical loop joint ``c``, in chain order."""
     if c.type == "helical":
         return ("turn", "advance")
@@ -163,7 +167,7 @@ def virtual_joint_name(loop_joint: str, role: str) -> str:
     return f"{loop_joint}.{role}"
 
 
-def bind_cut(model: pin.Model, c, coordinates: dict, path: str) -> tuple:
+def bind_cut(model: pin.Model, c: CutJointSpec, coordinates: dict, path: str) -> tuple:
     """(CutJoint, its extra row or None, the names of its virtual chain's joints or ()) of the
     description's loop joint ``c`` on ``model`` (its frames F1, F2 are added to the model): what closes
     the loop there -- the cut joint itself; for a rolling, gear or helical pair a weld from its virtual

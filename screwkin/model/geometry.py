@@ -145,7 +145,7 @@ def lines_point(points, directions, tol: float) -> tuple:
     return c, max(np.linalg.norm(P @ (c - p)) for P, p in projections)
 
 
-def _cross_norm(u, w):
+def _cross_norm(u: np.ndarray, w):
     if u.shape[-1] == 2:
         return np.abs(cross2(u, w))
     return np.linalg.norm(np.cross(u, w), axis=-1)
@@ -280,7 +280,7 @@ def stack_cross(a, b) -> np.ndarray:
     return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def quaternion_product(a, b) -> np.ndarray:
+def quaternion_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton products a b of stacks (P, 4) of quaternions in (x, y, z, w) order (real or complex)."""
     ax, ay, az, aw = a.T
     bx, by, bz, bw = b.T

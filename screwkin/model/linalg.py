@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["rank", "null_space", "singular_values"]
 
 
-def _square(A):
+def _square(A: np.ndarray):
     """A matrix with the singular values and right singular vectors of A: A itself, or for a
     tall A (m > 2n rows) the triangular factor R of its QR factorization (A^T A = R^T R),
     several times cheaper to decompose than A (the idle-motion rows of a 500-joint chain:
@@ -25,7 +29,7 @@ def singular_values(A) -> np.ndarray:
     return np.linalg.svd(_square(A), compute_uv=False)
 
 
-def rank(A, tol) -> int:
+def rank(A, tol: Tolerances) -> int:
     """Numerical rank: singular values above ``tol.rank_rtol * sigma_max`` and ``tol.rank_atol``."""
     s = singular_values(A)
     if s.size == 0 or s[0] <= tol.rank_atol:
@@ -33,7 +37,7 @@ def rank(A, tol) -> int:
     return int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
 
 
-def null_space(A, tol, n: int | None = None) -> np.ndarray:
+def null_space(A, tol: Tolerances, n: int | None = None) -> np.ndarray:
     """Orthonormal basis (columns) of the null space of A (A has n columns)."""
     A = np.asarray(A, float)
     n = A.shape[1] if n is None else n

@@ -32,6 +32,10 @@ from ._pin import FRAME_PREFERENCE, frame_id
 from .cuts import in_plane
 from .cuts import virtual_joint_name, virtual_roles
 from .mechanism import Mechanism
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.files.description import MechanismSpec
 
 __all__ = ["load", "rebuild"]
 
@@ -75,7 +79,7 @@ def _frame_bodies(model: pin.Model) -> dict:
 MAX_WARNINGS = 20
 
 
-def _check_cut_bodies(model: pin.Model, spec) -> None:
+def _check_cut_bodies(model: pin.Model, spec: MechanismSpec) -> None:
     """Refuse a cut joint whose two frames are on the same rigid body (fixed together):
     it closes no loop."""
     for c in spec.cut_joints:
@@ -252,7 +256,7 @@ def _virtual_pairs(model: pin.Model, spec) -> None:
         model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
 
 
-def _finish_model(spec, model: pin.Model):
+def _finish_model(spec: MechanismSpec, model: pin.Model):
     """The tree model of a read file (its sidecar applied) made screwkin's: continuous joints, the joint
     replacements, mimic couplings, the virtual chains of higher pairs; sizes and cut joints checked."""
     path = spec.path

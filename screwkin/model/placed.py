@@ -212,7 +212,7 @@ def _compounds(mech: Mechanism, q: np.ndarray, state: KinematicState, world: dic
     return out
 
 
-def _compound_joints(mech: Mechanism, q: np.ndarray, state: KinematicState, c, values, empty) -> list:
+def _compound_joints(mech: Mechanism, q: np.ndarray, state: KinematicState, c: PlacedCompound, values, empty) -> list:
     """The PlacedJoints of compound ``c`` in its body (``state``: the KinematicState at q): one ball at
     the members' common point, or the members' own joints with their axes and points in the body's frame."""
     C = state.frame_placement(mech.link_frame(c.body))
@@ -245,7 +245,7 @@ def _angle_about(n: int, v, w) -> float:
     return float(np.arctan2(n @ np.cross(v, w), v @ w))
 
 
-def davenport(R, axes: list) -> tuple:
+def davenport(R: np.ndarray, axes: list) -> tuple:
     """(a, b, c) with R = R(n1, a) R(n2, b) R(n3, c) for unit axes n1, n2, n3 (n2 not parallel to
     either other), the solution nearest zero in b.  n1 . R n3 = n1 . R(n2, b) n3 = A cos b + B sin b + C
     with A = n1.n3 - (n1.n2)(n2.n3), B = n1.(n2 x n3), C = (n1.n2)(n2.n3) gives b; a turns R(n2, b) n3

@@ -29,7 +29,7 @@ def rotation(w, t):
     return pin.exp3(np.asarray(w, float) * float(t))
 
 
-def rotation_to(w, p, q: np.ndarray, tol: float = DEFAULT.closed_form) -> float | None:
+def rotation_to(w, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_form) -> float | None:
     """The angle t in (-pi, pi] with R(w, t) p = q (subproblem 1), None when p lies on the axis
     (any angle: a continuum)."""
     w = np.asarray(w, float)
@@ -40,7 +40,7 @@ def rotation_to(w, p, q: np.ndarray, tol: float = DEFAULT.closed_form) -> float 
     return float(np.arctan2(w @ _cross(pp, qq), pp @ qq))
 
 
-def two_rotations(w1, w2, p, q: np.ndarray, tol: float = DEFAULT.closed_form) -> tuple:
+def two_rotations(w1, w2, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_form) -> tuple:
     """(solutions, complex): every real (t1, t2) with R(w1, t1) R(w2, t2) p = q (subproblem 2:
     z = R(w2, t2) p = R(w1, -t1) q lies on both circles), and whether the pair is complex (the
     circles miss).  A solution whose intermediate point lies on an axis (a continuum) is left out."""

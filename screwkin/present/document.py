@@ -38,6 +38,14 @@ from .mobility import (
 from .screws import screws_text
 from .local import local_lines, redundancy_lines
 from .jsonout import json_of
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.course.figures import SingularSearch
+    from screwkin.analysis.course.newton import NewtonResult
+    from screwkin.analysis.mobility import MobilityResult
+    from screwkin.analysis.motion.solution import PositionResult
+    from screwkin.model.topology import Topology
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",
@@ -120,7 +128,7 @@ def _reading(value, angular: bool) -> str:
 
 
 # ------------------------------------------------------------------ sections
-def topology_section(topo, mobility, figures: list | tuple = ()) -> Section:
+def topology_section(topo: Topology, mobility: MobilityResult, figures: list | tuple = ()) -> Section:
     """Joint table, the counts with their formulas, the screw-theory mobility."""
     s = Section("topology", "Topology and mobility")
     s.blocks.append(Text(f"links N = {topo.n_links} (ground: {topo.ground}), joints J = {topo.n_joints}, "
@@ -173,7 +181,7 @@ def equations_section(res) -> Section:
     return s
 
 
-def newton_section(res, symbols, how: str, path: str) -> Section:
+def newton_section(res: NewtonResult, symbols, how: str, path: str) -> Section:
     """Newton's iterations on the loop equations from the estimates ``how`` describes."""
     s = Section("newton", "Newton iterations")
     s.blocks.append(Text(how))
@@ -188,7 +196,7 @@ def newton_section(res, symbols, how: str, path: str) -> Section:
     return s
 
 
-def motion_section(pres, rates_text: str, length: float, units: RateUnits = RateUnits(), analysed: int = 1) -> Section:
+def motion_section(pres: PositionResult, rates_text: str, length: float, units: RateUnits = RateUnits(), analysed: int = 1) -> Section:
     """The assembly modes for the inputs: every coordinate (loop joints too) with its rate and acceleration,
     the moving links' absolute motion, named points -- the tables of ``solve`` (present/report.solution_rows,
     present/motion.links_rows and points_rows), rates in ``units`` (those typed)."""
@@ -223,7 +231,7 @@ def motion_section(pres, rates_text: str, length: float, units: RateUnits = Rate
     return s
 
 
-def singular_section(search, figures, descriptions, conditions=()) -> Section:
+def singular_section(search: SingularSearch, figures, descriptions, conditions=()) -> Section:
     """The singular configurations located along the input's range, each with its drawing."""
     s = Section("singular", "Singular configurations")
     if conditions:
@@ -244,7 +252,7 @@ def singular_section(search, figures, descriptions, conditions=()) -> Section:
     return s
 
 
-def sweep_section(search, figure: Figure, lines=(), rate_words=None) -> Section:
+def sweep_section(search: SingularSearch, figure: Figure, lines=(), rate_words=None) -> Section:
     """The input moved over its range: the figure, and ``lines`` (each slider's stroke and time ratio,
     present/motion.strokes_text, as sweep prints them); ``rate_words``: the input's rate as typed
     (tables.input_rate_words, "at crank 120 rpm"; default: the sweep's rate in SI)."""

@@ -28,6 +28,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.course.skeleton import KinematicChain
+    from screwkin.analysis.course.skeleton import Skeleton
 
 __all__ = ["chain_dict", "draw_chain", "draw_mechanism", "draw_design", "save_figure", "skeleton_dict", "value_label",
            "wrapped_value", "configuration_text", "drawing_title", "number_colours"]
@@ -95,7 +97,7 @@ def _fit_axes(fig, ax, points, r, limits=None) -> None:
     ax.set_axis_off()
 
 
-def draw_mechanism(skel, title: str | None = None, angles: bool = False, subtitle: str | None = None,
+def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = False, subtitle: str | None = None,
                    traces: dict | None = None, size: float | None = None, limits=None, marks=None):
     """The skeleton diagram of a :class:`~screwkin.analysis.course.skeleton.Skeleton` as a matplotlib
     Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
@@ -357,7 +359,7 @@ def _legend(fig, links, joints, marks=None) -> None:
     fig.text(0.71, 0.88, "\n".join(lines), ha="left", va="top", family="monospace", fontsize=size, gid="legend")
 
 
-def draw_chain(chain, title: str | None = None):
+def draw_chain(chain: KinematicChain, title: str | None = None):
     """The kinematic chain (:class:`~screwkin.analysis.course.skeleton.KinematicChain`) as a Figure: a
     node per link (a circle for a link with at most two joints, a triangle for a ternary link,
     a square for a quaternary one ...; the ground hatched), an edge per joint labelled with its
@@ -423,7 +425,7 @@ def draw_chain(chain, title: str | None = None):
     return fig
 
 
-def _layout(chain) -> dict:
+def _layout(chain: KinematicChain) -> dict:
     """Node positions in a unit box: networkx's Kamada-Kawai layout, else a circle; the ground
     at the bottom."""
     numbers = [nd.number for nd in chain.nodes]
@@ -507,7 +509,7 @@ def draw_design(mech: Mechanism, paths: list, steps: int = 360, say=None) -> lis
     return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
-def skeleton_dict(skel) -> dict:
+def skeleton_dict(skel: Skeleton) -> dict:
     """The numbering and symbols of a drawing, for --json."""
     return {
         "planar": skel.planar,
@@ -521,7 +523,7 @@ def skeleton_dict(skel) -> dict:
     }
 
 
-def chain_dict(chain) -> dict:
+def chain_dict(chain: KinematicChain) -> dict:
     return {
         "nodes": [{"number": nd.number, "name": nd.name, "degree": nd.degree, "ground": nd.ground}
                   for nd in chain.nodes],

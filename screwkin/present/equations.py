@@ -12,6 +12,10 @@ from ..analysis.course.symbols import GREEK as _GREEK, PlanarEquations
 from ..units import unit_text
 from .screws import screws_dict, screws_text
 from .tables import shown_text, table
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.course.newton import NewtonResult
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
 
@@ -207,7 +211,7 @@ class Units:
         return unit_text(v, self.lengths.get(name, "m"))
 
 
-def newton_text(res, symbols, units: Units, path: str) -> str:
+def newton_text(res: NewtonResult, symbols, units: Units, path: str) -> str:
     kinds = {n: symbols[n].kind for n in symbols}
     z = ", ".join(greek(n) for n in res.unknowns)
     ins = ", ".join(f"{greek(n)} = {units.value(n, kinds[n], v)}" for n, v in res.inputs.items())
@@ -236,7 +240,7 @@ def newton_text(res, symbols, units: Units, path: str) -> str:
     return "\n".join(lines)
 
 
-def newton_dict(res) -> dict:
+def newton_dict(res: NewtonResult) -> dict:
     return {"unknowns": list(res.unknowns), "inputs": dict(res.inputs), "start": dict(res.start),
             "trace": [{"iteration": st.iteration, "estimates": dict(st.before), "residual": st.residual.tolist(),
                        "jacobian": st.jacobian.tolist(), "step": st.step.tolist(), "values": dict(st.values)}

@@ -11,6 +11,10 @@ from ..model.geometry import TINY
 from ..tolerances import DEFAULT
 from .jsonout import to_jsonable
 from .tables import SHOWN_ZERO, shown_text, table
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.files.grasp import Contact
 
 __all__ = ["grasp_dict", "grasp_text", "wrench_axis"]
 
@@ -48,7 +52,7 @@ def wrench_axis(w, planar: bool) -> dict:
             "pitch": s.pitch}  # infinite for a couple: "inf" (present/jsonout.py)
 
 
-def _contact_dict(c) -> dict:
+def _contact_dict(c: Contact) -> dict:
     d = {"point": list(c.point), "normal": list(c.normal), "model": c.model, "mu": c.mu}
     if c.model == "soft_finger":
         d["mu_torsion"] = c.mu_torsion

@@ -34,6 +34,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.interactive import Interactive
+    from screwkin.present.view import Scene
 
 __all__ = ["InteractiveView", "viser_module"]
 
@@ -101,7 +103,7 @@ class InteractiveView:
     a scene (screwkin.present.view.build_scene); ``port``: default 8080.  The controls are
     ``sliders`` (input name -> slider), ``modes`` (the dropdown), ``status`` and ``readout``."""
 
-    def __init__(self, mech: Mechanism, live, scene, port: int | None = None, title: str = "screwkin") -> None:
+    def __init__(self, mech: Mechanism, live: Interactive, scene: Scene, port: int | None = None, title: str = "screwkin") -> None:
         viser = viser_module()
         self.mech, self.live = mech, live
         if port is not None:  # viser takes the next free port when the one asked is in use: check it first
@@ -155,7 +157,7 @@ class InteractiveView:
         else:  # viser before 1.1: a fixed sidebar
             gui.configure_theme(control_layout="fixed")
 
-    def _camera(self, scene, basis) -> None:
+    def _camera(self, scene: Scene, basis) -> None:
         """The first view: the mechanism framed (fit_camera, as view's pictures), along the plane's
         normal for a planar mechanism (its drawing's y up), else from view's usual direction; for the
         view's shape before a browser says it (then _frame_client frames it for that browser's)."""

@@ -52,7 +52,7 @@ def json_of(obj, indent: int | None = 2, sort_keys: bool = False) -> str:
     return _of(obj, indent, sort_keys, 0)
 
 
-def _of(obj, indent: int, sort_keys: bool, level: int) -> str:
+def _of(obj: np.ndarray, indent: int, sort_keys: bool, level: int) -> str:
     if isinstance(obj, dict) and all(isinstance(k, str) for k in obj) and obj:
         pad, inner = " " * (indent * level), " " * (indent * (level + 1))
         items = (f"{inner}{json.dumps(k)}: {_of(v, indent, sort_keys, level + 1)}" for k, v in _items(obj, sort_keys))

@@ -8,6 +8,9 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.course.figures import SingularConfiguration
+    from screwkin.analysis.motion.crossing import ChangePoint
+    from screwkin.analysis.redundancy import Redundancy
 
 __all__ = ["change_point_dict", "change_point_lines", "local_dict", "local_lines", "redundancy_dict", "redundancy_lines",
            "redundant_wrenches", "singularity_kind_text", "types_lines"]
@@ -80,7 +83,7 @@ def local_lines(la: LocalAnalysis, where: str, explain: bool = True) -> list:
     return lines
 
 
-def redundant_wrenches(r) -> list:
+def redundant_wrenches(r: Redundancy) -> list:
     """``redundant_wrenches``: a basis of the statically indeterminate wrenches, each {joint: (fx, fy, fz, mx,
     my, mz)} about the world origin in the ground frame, with the rows of K it combines.  When every
     vector of the left null space lies in one joint's rows, the joints' own (canonical) bases are used."""
@@ -92,7 +95,7 @@ def redundant_wrenches(r) -> list:
             for b, rows in zip(r.basis, r.rows)]
 
 
-def redundancy_dict(r) -> dict:
+def redundancy_dict(r: Redundancy) -> dict:
     d = {"redundant_wrenches": redundant_wrenches(r),
          "redundant_joints": [{"joint": j.joint, "what": j.what, "rows": j.rows, "redundant_rows": j.count,
                                "wrenches": [list(w) for w in j.wrenches], "at": list(j.at), "named": list(j.named),
@@ -112,7 +115,7 @@ _WHY = {"planar": "the loop is planar", "spherical": "the loop is spherical",
         "overconstrained": "the linkage is overconstrained"}
 
 
-def redundancy_lines(r, title: str = "redundant constraints", explain: bool = True) -> list:
+def redundancy_lines(r: Redundancy, title: str = "redundant constraints", explain: bool = True) -> list:
     """Text lines naming each joint's redundant wrenches, the rows a QR names, and the suggestion; without
     ``explain`` one line: how many, at which joints and why (--explain names them and the way out)."""
     if not r.count:
@@ -146,7 +149,7 @@ def _branch_text(la, k: int) -> str:
     return f"branch {k + 1} (" + ", ".join(f"{n} {v:.4g}" for n, v in b.tangent.items() if v) + ")"
 
 
-def change_point_dict(cp, mech: Mechanism | None = None) -> dict:
+def change_point_dict(cp: ChangePoint, mech: Mechanism | None = None) -> dict:
     """A constraint singularity met along a motion (analysis.motion.crossing.ChangePoint)."""
     d = {"input": cp.input, "sigma": cp.sigma, "local": local_dict(cp.local),
          "came_on_branch": None if cp.came is None else cp.came + 1,
@@ -157,7 +160,7 @@ def change_point_dict(cp, mech: Mechanism | None = None) -> dict:
     return d
 
 
-def change_point_lines(cp, where: str) -> list:
+def change_point_lines(cp: ChangePoint, where: str) -> list:
     """What a constraint singularity met along a motion is, and which branch the motion takes there."""
     lines = [f"  at {where}: {words(cp.local)}"]
     if cp.local.branches and (cp.came is not None or cp.goes is not None):
@@ -166,7 +169,7 @@ def change_point_lines(cp, where: str) -> list:
     return lines
 
 
-def singularity_kind_text(s) -> str:
+def singularity_kind_text(s: SingularConfiguration) -> str:
     """What a singular configuration met along the input is, in words (a drawing's subtitle, a
     report's table): its kind, a limit position, the change point analysed (analysis.local)."""
     if getattr(s, "point", None) is not None:  # a constraint singularity, analysed (analysis.local)

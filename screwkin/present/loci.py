@@ -13,6 +13,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.singularities.loci import Loci
+    from screwkin.analysis.singularities.regions import Regions
 
 __all__ = ["loci_dict", "loci_lines", "loci_png"]
 
@@ -23,7 +25,7 @@ def _xy(p, xu, yu) -> list:
     return [float(in_unit(p[0], xu)), float(in_unit(p[1], yu))]
 
 
-def loci_dict(loci, regions, x_unit: str, y_unit: str, loops=None, mech: Mechanism | None = None) -> dict:
+def loci_dict(loci: Loci, regions: Regions, x_unit: str, y_unit: str, loops=None, mech: Mechanism | None = None) -> dict:
     """The keys ``map --loci --json`` adds: loci [{kind, points, closed, sigma_max}], cusps, nodes,
     regions [{sample, modes, certain, how}], complete, how, loci_notes; with --connect, connections
     [{cusp, start, radius, modes, joined, turn, sigma_min, path: [{inputs, joints}]}] (modes: the indices
@@ -58,7 +60,7 @@ def loci_dict(loci, regions, x_unit: str, y_unit: str, loops=None, mech: Mechani
     return out
 
 
-def loci_lines(loci, regions, x_name: str, y_name: str, x_unit: str, y_unit: str, loops=None) -> list:
+def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: str, y_unit: str, loops=None) -> list:
     """Text lines: each curve, the cusps, nodes and regions, and how they were found."""
     def pt(p) -> str:
         a, b = _xy(p, x_unit, y_unit)
@@ -100,7 +102,7 @@ def loci_lines(loci, regions, x_name: str, y_name: str, x_unit: str, y_unit: str
     return lines
 
 
-def loci_png(loci, regions, path, xs: np.ndarray, ys: np.ndarray, x_name: str, y_name: str, x_unit, y_unit, title: str | None = None) -> None:
+def loci_png(loci: Loci, regions, path, xs: np.ndarray, ys: np.ndarray, x_name: str, y_name: str, x_unit, y_unit, title: str | None = None) -> None:
     """Loci by kind, cusps and nodes, regions shaded by their number of assembly modes."""
     plt = pyplot("--png")
     fig, ax = plt.subplots(figsize=(7, 6))

@@ -8,6 +8,11 @@ from __future__ import annotations
 from ..model.six_bar import INVERSIONS
 from .local import local_dict, local_lines, redundancy_dict, redundancy_lines
 from .tables import table
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.mobility import MobilityResult
+    from screwkin.model.topology import Topology
 
 __all__ = ["topology_dict", "mobility_dict", "JOINT_COLUMNS", "joint_rows", "topology_text", "count_rows",
            "screw_theory_rows", "mobility_text"]
@@ -27,7 +32,7 @@ def _joint_dict(j: int) -> dict:
     }
 
 
-def topology_dict(topo) -> dict:
+def topology_dict(topo: Topology) -> dict:
     return {
         "links": topo.n_links,
         "link_names": list(topo.links),
@@ -44,7 +49,7 @@ def topology_dict(topo) -> dict:
     }
 
 
-def mobility_dict(r) -> dict:
+def mobility_dict(r: MobilityResult) -> dict:
     t = r.topology
     out = None
     if r.output is not None:
@@ -108,7 +113,7 @@ def joint_rows(topo, limit: int = 48) -> list:
              f"{j.pair} ({j.contact})", f"{j.links[0]} - {j.links[1]}", "cut" if j.cut else "") for j in topo.joints]
 
 
-def topology_text(topo, title: str) -> str:
+def topology_text(topo: Topology, title: str) -> str:
     lines = [title, "", table(list(JOINT_COLUMNS), joint_rows(topo)), ""]
     lines.append(f"links N = {topo.n_links} (ground: {topo.ground})   joints J = {topo.n_joints}   "
                  f"loops L = J - N + 1 = {topo.loops}   sum f = {topo.sum_dof}"
@@ -130,7 +135,7 @@ def topology_text(topo, title: str) -> str:
     return "\n".join(lines)
 
 
-def count_rows(t) -> list:
+def count_rows(t: Topology) -> list:
     """(count, formula with the numbers put in, value) for a Topology: Kutzbach, and Gruebler (both
     ways the textbooks write it) or the spherical count where they apply."""
     c, cv = (" - C", f" - {len(t.couplings)}") if t.couplings else ("", "")
@@ -149,7 +154,7 @@ def count_rows(t) -> list:
     return counts
 
 
-def screw_theory_rows(r) -> list:
+def screw_theory_rows(r: MobilityResult) -> list:
     """(quantity, value) rows of the screw-theory mobility of a MobilityResult."""
     t = r.topology
     rows = [
@@ -174,7 +179,7 @@ def screw_theory_rows(r) -> list:
     return rows
 
 
-def answer_line(r) -> str:
+def answer_line(r: MobilityResult) -> str:
     """The answer first: M (the effective mobility beside it when links idle), the actuated joints, what the
     output link can do, the classification."""
     idle = r.mobility - r.effective_mobility
@@ -185,7 +190,7 @@ def answer_line(r) -> str:
             + f": {r.classification}")
 
 
-def mobility_text(r, explain: bool = True) -> str:
+def mobility_text(r: MobilityResult, explain: bool = True) -> str:
     """The text of ``mobility``: the answer first, then the topology, the counts and the screw-theory table;
     ``explain`` (--explain) adds how the local analysis decided, and names the redundant constraints with the
     exactly constrained alternative (one line says how many without it)."""

@@ -12,6 +12,13 @@ from ..tolerances import DEFAULT
 from ..units import Quantity, in_unit, si_factor
 from .tables import input_rate_words
 from .outfile import write_figure
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.motion.links import MotionAlong
+    from screwkin.analysis.motion.sweep import SweepResult
+    from screwkin.analysis.singularities.maps import SingularityMap
+    from screwkin.present.tables import RateUnits
 
 __all__ = ["sweep_plot", "motion_figure", "sweep_figure", "map_png", "map_figure", "pyplot"]
 
@@ -41,7 +48,7 @@ def _nearest_turn(angle, along):
     return float(cand[np.argmin(np.abs(cand - along))])
 
 
-def _rate_scales(units) -> list:
+def _rate_scales(units: RateUnits) -> list:
     """The rows' units and factors (SI value x factor = value shown) of a sweep figure: angles in deg and
     lengths in mm; rates and accelerations in ``units`` (tables.RateUnits: those typed with --rate, as the
     tables show them), or deg/s and mm/s (per s^2) when None."""
@@ -51,7 +58,7 @@ def _rate_scales(units) -> list:
             (units.acceleration(False), units.acceleration(True))]
 
 
-def sweep_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, paths: dict | None = None, absolute: bool=False,
+def sweep_figure(res: SweepResult, mus=None, singularities=(), title: str | None = None, linear=None, paths: dict | None = None, absolute: bool=False,
                  rate_words=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
@@ -138,7 +145,7 @@ def sweep_figure(res, mus=None, singularities=(), title: str | None = None, line
     return fig
 
 
-def absolute_series(res, motion, linear=None) -> tuple | None:
+def absolute_series(res: SweepResult, motion: MotionAlong, linear=None) -> tuple | None:
     """The sweep's curves in absolute quantities (issue 24): for a planar mechanism each link that
     turns (its vector-loop angle, omega, alpha about the plane's normal) and each slider coordinate
     (prismatic tree or loop joint: position, rate, acceleration); ``res`` with those as its
@@ -170,7 +177,7 @@ def absolute_series(res, motion, linear=None) -> tuple | None:
                    accelerations=stack(accs)), np.array(lengths, bool)
 
 
-def motion_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, motion=None, normal=None,
+def motion_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, motion: MotionAlong | None = None, normal=None,
                   rate_words=None, units=None):
     """The figure of a sweep (matplotlib, not yet saved; see :func:`sweep_figure` for what is drawn): for
     a planar mechanism with ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle,
@@ -204,7 +211,7 @@ def _axis_values(values, unit: str):
     return in_unit(np.asarray(values, float), unit) if unit else np.asarray(values, float)
 
 
-def map_figure(res, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):
+def map_figure(res: SingularityMap, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None):
     """The figure of :func:`map_png` (matplotlib, not yet saved): log10 of the smallest relative
     singular value over the two inputs, with the axes in ``x_unit`` and ``y_unit`` (the units the
     user typed: 'deg', 'mm', ...; SI values are divided by the unit's factor), the curve

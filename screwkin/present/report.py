@@ -31,13 +31,15 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.certified import ModeCount
+    from screwkin.analysis.motion.solution import Solution
 
 __all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "singularity_dict",
            "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "slide_note"]
 
 
-def position_dict(res) -> dict:
+def position_dict(res: PositionResult) -> dict:
     sols = []
     for s in res.solutions:
         # every coordinate under its name, loop joints too (also kept apart under "loop_joints")
@@ -87,7 +89,7 @@ def position_dict(res) -> dict:
             "complete": bool(res.modes is not None and res.modes.complete)}
 
 
-def modes_dict(c) -> dict:
+def modes_dict(c: ModeCount) -> dict:
     """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
@@ -95,7 +97,7 @@ def modes_dict(c) -> dict:
             "certificate_check": dict(c.check) or None}
 
 
-def modes_line(res, n: int) -> str:
+def modes_line(res: PositionResult, n: int) -> str:
     """How many assembly modes, and how that is known: "all 4 assembly modes (certified: trace test);
     36 more solutions are complex", or "3 found ...; completeness not certified because ..."."""
     c = res.modes
@@ -160,7 +162,7 @@ def trace_text(res, row_labels, passive_names: list) -> str:
     return "\n".join(lines)
 
 
-def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
+def solution_rows(res: PositionResult, s: Solution, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
     """(headers, rows) of one solution's coordinates -- every tree joint, then every loop (cut) joint
     as ``NAME (loop)`` -- with value [rad or m], the angle in deg (a slide not along the ground's x
     axis: its guide's angle), rate and acceleration when solved with rates, in ``units`` (those typed
@@ -205,7 +207,7 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
     return headers, rows
 
 
-def slide_note(res, s) -> str | None:
+def slide_note(res: PositionResult, s: Solution) -> str | None:
     """The footnote of a joint table with slides: what a slide's value is measured from, and its ``d``."""
     if all(n in res.angular for n in s.joints) and all(n in res.angular_loop for n in (s.loop_joints or {})):
         return None
@@ -216,7 +218,7 @@ def slide_note(res, s) -> str | None:
     return note
 
 
-def position_text(res, degrees: bool=True, show_all: bool=False, length=None, units: RateUnits = RateUnits(),
+def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False, length=None, units: RateUnits = RateUnits(),
                   leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
@@ -302,7 +304,7 @@ def sweep_rows(n: int, rows=None) -> list:
     return idx
 
 
-def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linear_names=()) -> str:
+def sweep_text(res: SweepResult, info: LinkageInfo | None = None, mus=None, rows=None, degrees: bool = False, linear_names=()) -> str:
     """The sweep's summary and a table of joint values (``rows``: see sweep_rows; ``degrees``: the
     input and the angles in deg, the coordinates in ``linear_names`` staying in m)."""
     angular = res.unit == "rad"
@@ -361,7 +363,7 @@ def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linea
     return "\n".join(lines)
 
 
-def singularity_text(rep) -> str:
+def singularity_text(rep: SingularityReport) -> str:
     def yes(b) -> str:
         return "YES" if b else "no"
 
@@ -410,7 +412,7 @@ def singularity_text(rep) -> str:
     return "\n".join(lines)
 
 
-def _condition_meaning(rep) -> str | None:
+def _condition_meaning(rep: SingularityReport) -> str | None:
     """What ``rep.condition`` is the condition number of (it is not the input -> output map's)."""
     if rep.condition is None:
         return None
@@ -420,7 +422,7 @@ def _condition_meaning(rep) -> str | None:
     return "K_p: the loops' Jacobian in the passive joints (how well the inputs fix them)"
 
 
-def _condition_lines(rep) -> list:
+def _condition_lines(rep: SingularityReport) -> list:
     """The two condition numbers, each saying what it is of: the input -> output map's first (Merlet's, what a
     parallel robot's user means), then the one of J_o V or K_p."""
     io = getattr(rep, "condition_input_output", None)

@@ -8,6 +8,10 @@ from ..analysis.forces.statics import Leg, StaticsResult
 from .screws import screw_dict
 from .tables import table
 from .tables import shown_text
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.screws import Screw
 
 __all__ = ["statics_dict", "statics_text", "NO_SOLUTION"]
 
@@ -16,7 +20,7 @@ NO_SOLUTION = ("none: no equilibrium; efforts, reactions, constraint_forces and 
                "fit that leaves least_squares_residual unbalanced, not a solution")
 
 
-def _screw_text(s) -> str:
+def _screw_text(s: Screw) -> str:
     pitch = f"pitch {s.pitch:.4g} m" if np.isfinite(s.pitch) else "pitch inf (a couple)"
     point = "" if s.point is None else " through (" + ", ".join(f"{x:.4g}" for x in s.point) + ")"
     return "axis (" + ", ".join(f"{x:.4g}" for x in s.direction) + ")" + point + ", " + pitch

@@ -26,6 +26,10 @@ from .plots import pyplot
 from .jsonout import to_jsonable
 from .tables import csv_text
 from .outfile import write_figure, write_output
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.study import StudyResult
 
 __all__ = [
     "DISPLAY",
@@ -58,7 +62,7 @@ def _display(key) -> tuple:
     return name, si_factor(unit)
 
 
-def table_columns(result) -> list:
+def table_columns(result: StudyResult) -> list:
     """[(row key, table column name, factor)] in the table's order."""
     keys = ("design", *result.parameters, *result.columns, "error")
     return [(k, *_display(k)) for k in keys]
@@ -118,7 +122,7 @@ def write_table(result, path) -> None:
     write_output(path, buf.getvalue().to_pybytes())
 
 
-def study_dict(result) -> dict:
+def study_dict(result: StudyResult) -> dict:
     """What ``--json`` prints: the study, the rows (SI, as the Python API gives them) and,
     when the spec names two columns, the designs on the Pareto front."""
     spec = result.spec
@@ -176,7 +180,7 @@ def _paths_line(result) -> list:
     return lines
 
 
-def _requirements_lines(result) -> list:
+def _requirements_lines(result: StudyResult) -> list:
     """What the designs had to meet and which did not (left out of the Pareto front)."""
     reqs, default = requirements(result.spec)
     if not reqs:
@@ -212,7 +216,7 @@ def _cell_text(v) -> str:
 TEXT_ROWS = 40
 
 
-def study_text(result, table_path=None) -> str:
+def study_text(result: StudyResult, table_path=None) -> str:
     """A summary: counts, the failures' reasons, each metric's range and the design reaching
     each end; the rows themselves when there are few."""
     spec = result.spec
@@ -285,7 +289,7 @@ def study_text(result, table_path=None) -> str:
     return "\n".join(line.rstrip() for line in lines)
 
 
-def _numeric(result):
+def _numeric(result: StudyResult):
     """[(row key, label, factor)] of the metric columns with numbers."""
     out = []
     for k, name, f in table_columns(result):
@@ -340,7 +344,7 @@ def _parameter_axis(result, name: str) -> tuple:
     return f"{name} (as given, SI: no unit typed)", 1.0
 
 
-def _classes(result):
+def _classes(result: StudyResult):
     """The colour of each design (row index -> (class, colour)): its Grashof class when the study
     has one, failed designs in FAILED_COLOR."""
     out = {}
@@ -355,7 +359,7 @@ def _classes(result):
     return out
 
 
-def metrics_figure(result):
+def metrics_figure(result: StudyResult):
     """The figure of :func:`metrics_png` (not yet saved): each numeric metric against each parameter,
     one panel per pair, axes with their units, points coloured by Grashof class (when the study has
     it), failed designs as crosses along the bottom of each panel at their parameter values."""
@@ -414,7 +418,7 @@ def metrics_png(result, path: str) -> None:
         plt.close(fig)
 
 
-def pareto_figure(result, goals=None):
+def pareto_figure(result: StudyResult, goals=None):
     """The figure of :func:`pareto_png` (not yet saved): the designs in the plane of two columns with
     their units, coloured by Grashof class (when the study has it), the Pareto front drawn over them;
     the failed designs, which have no place in this plane, counted in the title."""

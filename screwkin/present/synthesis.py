@@ -21,6 +21,13 @@ from ..model.geometry import wrap_angle
 from ..analysis.design.synthesis.fourbar import PIVOT_JOINTS, tool_local
 from .jsonout import to_jsonable
 from .tables import shown_text, table
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.synthesis.designs import Candidate
+    from screwkin.analysis.design.synthesis.designs import Design
+    from screwkin.analysis.design.synthesis.designs import Dyad
+    from screwkin.analysis.design.synthesis.search import SearchReport
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
@@ -52,7 +59,7 @@ def _value_dict(kind: str, v) -> dict | None:
     return {"psi_deg": _deg(v[0])}
 
 
-def _core(kind: str, design, check: Check, file) -> dict:
+def _core(kind: str, design: Design, check: Check, file) -> dict:
     fb = design.fourbar
     L = fb.lengths
     links = {"ground": {"length": L["ground"]}, "crank": {"length": L["crank"]},
@@ -101,7 +108,7 @@ def _core(kind: str, design, check: Check, file) -> dict:
     }
 
 
-def _candidate_dict(k: int, c) -> dict:
+def _candidate_dict(k: int, c: Candidate) -> dict:
     fb = c.design.fourbar
     u, v, _ = tool_local(fb) if fb.tool is not None else (None, None, None)
     mu = [_deg(c.transmission[0]), _deg(c.transmission[1])] if c.transmission else None
@@ -114,13 +121,13 @@ def _candidate_dict(k: int, c) -> dict:
             "point": None if u is None else [u, v], "run": c.run}
 
 
-def _search_dict(report, constraints: list) -> dict:
+def _search_dict(report: SearchReport, constraints: list) -> dict:
     return {"method": report.method, "runs": report.runs, "evaluations": report.evaluations,
             "seconds": report.seconds, "where": report.where, "seed": report.seed, "constraints": constraints,
             "searched_within": report.box, "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
 
 
-def _dyad_dict(k: int, d) -> dict:
+def _dyad_dict(k: int, d: Dyad) -> dict:
     return {"index": k, "fixed": _pt(d.fixed), "moving": _pt(d.moving), "moving_local": _pt(d.local),
             "length": d.length}
 

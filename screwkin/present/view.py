@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from typing import Any
     from screwkin.model.mechanism import Mechanism
+    from screwkin.files.description import CutJointSpec
 
 __all__ = ["COLORS", "build_scene", "show", "page", "legend_entries", "view", "RecordingViewer", "screenshot"]
 
@@ -149,7 +150,7 @@ def _disc(name: str, joint, frame, M, radius, color, alpha: float = 0.35):
     return obj
 
 
-def _pair_geometry(mech: Mechanism, cut, spec, r_axis, L_axis):
+def _pair_geometry(mech: Mechanism, cut, spec: CutJointSpec, r_axis, L_axis):
     """What a higher pair looks like: pitch circles (rolling, gears; a pitch line for a rack),
     profiles (circles as discs, lines as slots, points as pins) and a screw's helix of its lead."""
     model = mech.model

@@ -4,11 +4,15 @@ outside the tree closes one loop, L = J - N + 1 of them (for a connected mechani
 """
 
 from __future__ import annotations
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.topology import Topology
 
 __all__ = ["fundamental_cycles"]
 
 
-def fundamental_cycles(topo) -> list:
+def fundamental_cycles(topo: Topology) -> list:
     """The fundamental cycles of ``topo`` (screwkin.model.topology.Topology): a list of
     (links, joints), one per joint outside the breadth-first spanning tree from the ground
     (in the topology's joint order), with joints[i] between links[i] and links[i + 1]

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.course.vector_loops import VectorLoops
 
 __all__ = ["NewtonStep", "NewtonResult", "textbook_newton", "start_estimates", "differing"]
 
@@ -46,7 +47,7 @@ class NewtonResult:
     stopped: str | None  # why Newton stopped early (a singular Jacobian), else None
 
 
-def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = None) -> NewtonResult:
+def textbook_newton(loops: VectorLoops, inputs: dict, start: dict, iterations: int | None = None) -> NewtonResult:
     """Plain (undamped) Newton on the loop equations, as a textbook does it: from the
     estimates ``start`` (every unknown symbol -> value), with the inputs (input symbol ->
     value) held.  ``iterations``: exactly that many steps (fewer only when the Jacobian is
@@ -91,7 +92,7 @@ def textbook_newton(loops, inputs: dict, start: dict, iterations: int | None = N
                         closes and iterations is None, stopped)
 
 
-def start_estimates(mech: Mechanism, loops, solver, q_in: np.ndarray, values: dict, typed) -> tuple:
+def start_estimates(mech: Mechanism, loops: VectorLoops, solver, q_in: np.ndarray, values: dict, typed) -> tuple:
     """The estimates of every unknown of the loop equations from ``--start`` items (units.parse_typed_assignments):
     symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
     returns (symbol -> estimate, symbol -> the units.Quantity typed)."""
@@ -160,7 +161,7 @@ def _as_symbol(name: str) -> str:
     return name
 
 
-def _needed_joints(loops, name: str):
+def _needed_joints(loops: VectorLoops, name: str):
     """The tree joints whose values place the quantity ``name`` (the joints from the ground to the
     links it is measured on)."""
     mech = loops.mech
@@ -178,7 +179,7 @@ def _needed_joints(loops, name: str):
     return out
 
 
-def differing(mech: Mechanism, loops, a: dict, b: dict) -> list:
+def differing(mech: Mechanism, loops: VectorLoops, a: dict, b: dict) -> list:
     """The unknowns of ``loops`` whose values in ``a`` and ``b`` (symbol -> value) differ: an angle by
     more than the geometry tolerance modulo a turn, a length by more than it times max(L, 1 m)."""
     tol = mech.tolerances.geometry * max(mech.length, 1.0)

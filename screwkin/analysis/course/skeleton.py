@@ -34,6 +34,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.files.description import CutJointSpec
+    from screwkin.model.topology import Topology
 
 __all__ = [
     "ChainEdge",
@@ -195,7 +197,7 @@ def _is_input(joint, inputs) -> bool:
     return any(m in inputs for m in joint.members)
 
 
-def numbering(topo, inputs=()) -> tuple:
+def numbering(topo: Topology, inputs=()) -> tuple:
     """(link name -> number, joint name -> letter, joints in letter order) for a topology:
     ground 1 and a depth-first walk from it (see the module docstring).  A joint whose name is at
     most SHORT_NAME letters and digits, the first a capital (A, B, O2), keeps it as its letter; the others are lettered
@@ -293,7 +295,7 @@ def _distinct(points, tol):
     return out
 
 
-def _basis(mech: Mechanism, topo, centres: list) -> tuple:
+def _basis(mech: Mechanism, topo: Topology, centres: list) -> tuple:
     if topo.motion_space == "planar" and topo.normal is not None:
         return plane_basis(topo.normal), True
     P = np.array(centres) if centres else np.zeros((1, 3))
@@ -430,7 +432,7 @@ def _stub(state: KinematicState, name: str, pts: np.ndarray, p2, tol) -> tuple[s
     return "stub", (pts[0], end)
 
 
-def _higher_pair(state: KinematicState, spec, letter, nums: tuple, p2, e1, e2):
+def _higher_pair(state: KinematicState, spec: CutJointSpec, letter, nums: tuple, p2, e1: np.ndarray, e2: np.ndarray):
     """(contact point, profiles) of a rolling, gear or contact pair in the plane."""
     F1, F2 = _frame_point(state, f"{spec.name}@F1"), _frame_point(state, f"{spec.name}@F2")
     c1, c2 = np.array(p2(F1.translation)), np.array(p2(F2.translation))
@@ -453,7 +455,7 @@ def _higher_pair(state: KinematicState, spec, letter, nums: tuple, p2, e1, e2):
     return (float(contact[0]), float(contact[1])), out
 
 
-def _contact_point(a, b):
+def _contact_point(a: Profile, b: Profile):
     """Where two profiles of a sliding contact (point, line, circle) touch, in the plane."""
     ca, cb = np.array(a.centre), np.array(b.centre)
     if a.shape == "point":

@@ -46,6 +46,12 @@ from ...model.closability import obstacle_of, planar_loops
 from ...model.state import KinematicState
 from ..motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_transmission
 from .study import _GRASHOF, COLUMNS, evaluate_design, _reason, metric_columns, run_chunk
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.study import _Design
+    from screwkin.analysis.design.study import _Task
+    from screwkin.files.description import MechanismSpec
 
 __all__ = ["ChunkRows", "FAMILY_CHUNK", "FAMILY_METRICS", "chunk_rows", "eligible", "family_rows"]
 
@@ -69,7 +75,7 @@ class ChunkRows(list):
         self.notes = list(notes)
 
 
-def eligible(task) -> str | None:
+def eligible(task: _Task) -> str | None:
     """Why the family path does not apply to a study (None: it may)."""
     other = [m for m in task.metrics if m not in FAMILY_METRICS]
     if other:
@@ -101,7 +107,7 @@ def _rpy_matrices(rpy: np.ndarray) -> np.ndarray:
                      np.stack([-sp, cp * sr, cp * cr], -1)], -2)
 
 
-def _signature(spec, dummy_mass) -> tuple:
+def _signature(spec: MechanismSpec, dummy_mass) -> tuple:
     """What must be the same for two designs to share a structure."""
     return (tuple((k, v.is_massless(dummy_mass), v.has_geometry) for k, v in spec.links.items()),
             tuple((j.name, j.type, j.parent, j.child, j.mimic) for j in spec.joints),
@@ -171,7 +177,7 @@ class _Fourbar:
     """The reference design's four-bar: which joint centres and loop frames each link's length joins,
     and the sides of its loop (model.closability.planar_loops)."""
 
-    def __init__(self, d, spec) -> None:
+    def __init__(self, d: _Design, spec) -> None:
         mech, info = d.mech, d.linkage()
         if info.kind != "four-bar":
             raise Unbatchable("the family path analyses four-bars (this one is a slider-crank)")
@@ -210,7 +216,7 @@ class _Fourbar:
             self.frames[c.frame2] = (c.name, 1)
         self.lengths = info.lengths
 
-    def point(self, placed, joint, link: str):
+    def point(self, placed: _Placed, joint, link: str):
         """The joint's centre (a loop joint: its frame on ``link``) at every design: (n, 3)."""
         if joint in self.cut_names:
             c = self.cut_names[joint]
@@ -220,7 +226,7 @@ class _Fourbar:
             return placed.cuts[joint][side][1]
         return placed.joints[joint][1]
 
-    def ref_point(self, placed, ref):
+    def ref_point(self, placed: _Placed, ref):
         kind, ident = ref
         if kind == "frame":
             name, side = self.frames[ident]
@@ -248,7 +254,7 @@ def family_rows(task, chunk):
                                                         f"{exc}"])
 
 
-def _family(task, chunk, index: int, values: np.ndarray, alone: dict) -> ChunkRows:
+def _family(task: _Task, chunk, index: int, values: np.ndarray, alone: dict) -> ChunkRows:
     n = len(chunk)
     be = expand_batch(task.file, task.text, task.args, {p: values[:, k] for k, p in enumerate(task.parameters)})
     specs = [None] * n

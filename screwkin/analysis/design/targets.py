@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.files.description import TargetSpec
 
 __all__ = ["TargetReached", "DesignTargets", "design_targets", "polished", "POLISH_CLOSURE"]
 
@@ -78,7 +79,7 @@ def _frame(mech: Mechanism, fid, q: np.ndarray) -> tuple[tuple, float]:
     return tuple(float(v) for v in M.translation), float(math.atan2(M.rotation[1, 0], M.rotation[0, 0]))
 
 
-def _error(spec, position, yaw) -> tuple:
+def _error(spec: TargetSpec, position, yaw) -> tuple:
     if spec.kind == "angle":
         return abs(wrap_angle(yaw - spec.yaw)), 0.0
     err = math.dist(position, spec.xyz)

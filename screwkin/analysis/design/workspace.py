@@ -271,7 +271,7 @@ def _seed(mech: Mechanism, output, point: bool, orientation, q_start=None) -> tu
     return q, p, R
 
 
-def _index_bounds(bounds, p_seed, axes, h, dim) -> tuple:
+def _index_bounds(bounds, p_seed: np.ndarray, axes: np.ndarray, h, dim) -> tuple:
     """Index ranges (lo, hi) per axis for world-coordinate bounds (dimension, 2), or None."""
     if bounds is None:
         return [-(10**9)] * dim, [10**9] * dim

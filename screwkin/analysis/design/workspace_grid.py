@@ -36,7 +36,7 @@ _ITERATIONS = 8  # Newton from a neighbour's solution and the predictor converge
 #                   takes more lies beyond the boundary (or across a singularity) from that neighbour
 
 
-def null_motions(A, mech: Mechanism):
+def null_motions(A: np.ndarray, mech: Mechanism):
     if not A.size:
         return np.eye(A.shape[1])
     _, s, vt = np.linalg.svd(A)
@@ -44,7 +44,7 @@ def null_motions(A, mech: Mechanism):
     return vt[k:].T
 
 
-def grid_axes(directions) -> np.ndarray:
+def grid_axes(directions: np.ndarray) -> np.ndarray:
     """Grid axes spanning the translation directions: the world axes in 3-D; in a plane the two
     world axes of a coordinate plane, else an orthonormal basis of the plane."""
     k = directions.shape[1]

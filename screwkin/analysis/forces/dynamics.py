@@ -199,7 +199,7 @@ def _ground_sides(mech: Mechanism) -> tuple:
     return tree, cuts
 
 
-def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v) -> tuple:
+def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v: np.ndarray) -> tuple:
     """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
     energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
     model = mech.model

@@ -186,12 +186,12 @@ def _linprog(c, tol: GraspTolerances, **kw: Any):
     return res.x if res.status == 0 and res.x is not None else None
 
 
-def _relative_rank(A, rtol) -> int:
+def _relative_rank(A: np.ndarray, rtol) -> int:
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
     return int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
 
-def _positive_null_vector(W, tol: GraspTolerances) -> tuple:
+def _positive_null_vector(W: np.ndarray, tol: GraspTolerances) -> tuple:
     """lambda > 0 (summing to 1) with W lambda = 0, maximizing its smallest entry t, and k t
     (1 when all are equal); (None, margin) when there is none: LP  max t  s.t.
     W (mu + t 1) = 0, 1.mu + k t = 1, mu >= 0, t >= 0; then projected exactly onto null(W)."""
@@ -218,7 +218,7 @@ def _positive_null_vector(W, tol: GraspTolerances) -> tuple:
     return (lam, margin) if margin > tol.margin else (None, margin)
 
 
-def _separator(W, tol: GraspTolerances) -> tuple:
+def _separator(W: np.ndarray, tol: GraspTolerances) -> tuple:
     """(u, both): a unit u with u . w >= 0 for every column w of W (up to the LP's tolerance),
     or (None, False) when there is none (the columns positively span).  both: u is orthogonal
     to every column (W lacks rank): -u is one too."""
@@ -279,7 +279,7 @@ def _force_margin(spec: GraspSpec, forces, tol: GraspTolerances):
     return worst
 
 
-def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks, u):
+def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks, u: np.ndarray):
     """min over contacts of the smallest u . (G_s f) over the circular cone's section f_n = 1:
     u_n - mu |u_t| - mu_torsion |u_torsion| (>= 0: u separates the cone)."""
     worst = math.inf
@@ -298,7 +298,7 @@ def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks, u):
 
 
 # ------------------------------------------------------------------ closure
-def _internal_certificate(spec: GraspSpec, G, Gs: np.ndarray, blocks, W, parts, lam, cones: str, tol: GraspTolerances) -> Certificate:
+def _internal_certificate(spec: GraspSpec, G: np.ndarray, Gs: np.ndarray, blocks, W: np.ndarray, parts, lam, cones: str, tol: GraspTolerances) -> Certificate:
     f = np.zeros(G.shape[1])
     for (sl, C), b in zip(parts, blocks):
         f[b] = C @ lam[sl]
@@ -321,7 +321,7 @@ def _wrench_certificate(spec: GraspSpec, Gs: np.ndarray, blocks, u, both, L, con
                        margin=_dual_margin(spec, Gs, blocks, u), cones=cones)
 
 
-def _closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, W, parts, cones: str, tol: GraspTolerances, L) -> tuple:
+def _closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, W: np.ndarray, parts, cones: str, tol: GraspTolerances, L) -> tuple:
     """(closed, certificate) for one set of polyhedral cones (exact or a pyramid)."""
     p = W.shape[0]
     if _relative_rank(W, tol.rank_rtol) == p:
@@ -486,7 +486,7 @@ def analyze_grasp(spec: GraspSpec, facets: int = 8, length: float | None = None,
                        0.0 if exact else cone_error(n), exact, quality, L, source, tol.margin, tuple(notes))
 
 
-def _closure_form(Wf, tol: GraspTolerances) -> tuple:
+def _closure_form(Wf: np.ndarray, tol: GraspTolerances) -> tuple:
     """Form closure: the normals' wrenches positively span wrench space (an exact test)."""
     if _relative_rank(Wf, tol.rank_rtol) < Wf.shape[0]:
         return False, None

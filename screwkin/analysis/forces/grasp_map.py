@@ -13,6 +13,10 @@ import numpy as np
 
 from ...files.grasp import GraspSpec
 from ...tolerances import DEFAULT
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.files.grasp import Contact
 
 __all__ = ["contact_frame", "contact_columns", "grasp_map", "grasp_characteristic_length", "scaled_points",
            "cone_error", "exact_cones", "generators", "generator_matrix"]
@@ -40,7 +44,7 @@ _SPATIAL_BASIS = {"frictionless": ([2], ["n"]), "point_friction": ([0, 1, 2], ["
                   "soft_finger": ([0, 1, 2, 5], ["t1", "t2", "n", "torsion"])}
 
 
-def contact_columns(c, planar):
+def contact_columns(c: Contact, planar):
     """(G_i, labels) of one contact."""
     p = np.asarray(c.point, float)
     n = np.asarray(c.normal, float)
@@ -102,12 +106,12 @@ def cone_error(facets: int) -> float:
     return 1.0 - math.cos(math.pi / facets)
 
 
-def exact_cones(c, planar) -> bool:
+def exact_cones(c: Contact, planar) -> bool:
     """Whether the contact's cone is polyhedral (then its generators are exact)."""
     return planar or c.model == "frictionless" or c.mu == 0.0
 
 
-def generators(c, planar, facets: int = 8, circumscribed: bool = False) -> np.ndarray:
+def generators(c: Contact, planar, facets: int = 8, circumscribed: bool = False) -> np.ndarray:
     """The generators of the contact's cone (or of the N-facet pyramid inscribed in it, or
     circumscribed about it) in the contact's coordinates (columns of G_i), each with unit
     normal force: frictionless (1); planar (t, n): (+-mu, 1); point contact (t1, t2, n):

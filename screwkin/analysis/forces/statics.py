@@ -93,7 +93,7 @@ def _load_norm(w, L) -> float:
     return float(np.linalg.norm(np.r_[np.asarray(w[:3]) * L, w[3:]]))
 
 
-def balance(mech: Mechanism, K: np.ndarray, a_idx, b) -> tuple:
+def balance(mech: Mechanism, K: np.ndarray, a_idx, b: np.ndarray) -> tuple:
     """The balance of generalized forces E tau + K^T lambda = b (E: the columns of the actuated
     velocity indices ``a_idx``; K: the closure Jacobian, rows as ClosureSystem writes them; b:
     the generalized force the tree needs [N, N m]), solved in the least-squares, minimum-norm
@@ -188,7 +188,7 @@ def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity: bool, N_
     return tuple(out)
 
 
-def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity: bool | np.ndarray, N_lam, v=None, a=None) -> dict:
+def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity: bool | np.ndarray, N_lam: np.ndarray, v=None, a=None) -> dict:
     """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
     constraint forces lam, and the mask of its components that change along the null
     directions N_lam of the constraint forces (not determined by the balance)."""

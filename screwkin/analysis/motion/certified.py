@@ -39,6 +39,12 @@ from . import generic_modes
 from .modes import continuum_words
 from .known_counts import STEWART, known_count
 from .monodromy import MonodromyOptions, all_roots, to_target
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.motion.known_counts import KnownCount
+    from screwkin.analysis.motion.monodromy import Endpoints
+    from screwkin.analysis.motion.monodromy import Roots
 
 NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
@@ -161,7 +167,7 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
     return _reference_check(solver, problem, got)
 
 
-def _reference_check(solver, problem, got: Certified) -> Certified:
+def _reference_check(solver, problem: Problem, got: Certified) -> Certified:
     """A certificate held against one root found another way before it is given: damped Newton from the
     reference configuration (the file's drawing, the inputs set) on Pinocchio's closure.  A real root there
     that the certified set does not hold, or one where the closure's Jacobian in the unknowns loses rank (a
@@ -201,7 +207,7 @@ def _rank(closure: PolynomialClosure, rng: np.random.Generator) -> int:
     return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
 
 
-def _classify(solver, problem, closure: PolynomialClosure, system: SquareSystem, group, roots, ends, known, seconds, o: MonodromyOptions,
+def _classify(solver, problem: Problem, closure: PolynomialClosure, system: SquareSystem, group, roots: Roots, ends: Endpoints, known: KnownCount, seconds, o: MonodromyOptions,
               also: str = "") -> Certified:
     """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
     mech, tol = solver.mech, solver.mech.tolerances
@@ -296,7 +302,7 @@ def _coinciding(X: np.ndarray, mask, group, tol) -> np.ndarray:
     return out
 
 
-def _lift(solver, problem, closure: PolynomialClosure, x):
+def _lift(solver, problem: Problem, closure: PolynomialClosure, x):
     """The real configuration of a real root x of the closure: its joints, and the eliminated legs'
     angles (model.legs) solved by damped Newton with every other joint held -- from the inputs'
     configuration, then from random angles -- or None."""
@@ -316,7 +322,7 @@ def _lift(solver, problem, closure: PolynomialClosure, x):
     return None
 
 
-def _best_twin(solver, problem, closure, elements, x) -> tuple:
+def _best_twin(solver, problem: Problem, closure, elements, x) -> tuple:
     """(q, Assembly) of the joint-angle set of this root to report: of its twins under the symmetry group
     (which place the links alike), the one within the joint limits nearest the reference configuration,
     polished on Pinocchio's closure."""

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.model.leg_chains import Platform
 
 __all__ = ["closed_form_ik", "LISTED"]
 
@@ -76,7 +77,7 @@ def _residual(mech: Mechanism, q: np.ndarray, out_frame, pose) -> float:
     return max(loops, float(np.linalg.norm(err)))
 
 
-def _platform(solver: PositionSolver, output: str, out_frame, platform, P, pose, start):
+def _platform(solver: PositionSolver, output: str, out_frame, platform: Platform, P, pose, start):
     mech, model = solver.mech, solver.mech.model
     legs = []
     for leg in platform.legs:

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.singularities.loci import Loci
 
 __all__ = ["CuspLoop", "Loop", "cusp_loops", "loop", "wedge_direction"]
 
@@ -94,7 +95,7 @@ class CuspLoop:
     loop: Loop
 
 
-def cusp_loops(solver: PositionSolver, loci, x_name: str, y_name: str, fixed: dict, box: tuple, size: float = 0.02, steps: int = 720) -> tuple:
+def cusp_loops(solver: PositionSolver, loci: Loci, x_name: str, y_name: str, fixed: dict, box: tuple, size: float = 0.02, steps: int = 720) -> tuple:
     """For each cusp of the actuator loci (analysis.singularities.loci.Loci): every mode at a point inside
     its wedge, followed once round the cusp each way on an ellipse of semi-axes ``size`` times the box's
     sides (``loop``).  Returns (CuspLoop of every regular loop that ends on another mode, loops tried)."""

@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from typing import Any
     from screwkin.model.mechanism import Mechanism
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -105,7 +106,7 @@ class Engine(Protocol):
         """The limit position bracketed between two configurations (input values), by ``locate``."""
 
 
-def projections(K: np.ndarray, V, scale, free, tol) -> np.ndarray:
+def projections(K: np.ndarray, V, scale, free, tol: Tolerances) -> np.ndarray:
     """The vectors V (N, nv) projected onto the null space of the scaled constraint Jacobians K
     (N, m, nv) -- columns times ``scale`` (characteristic lengths for sliding joints), restricted to
     the ``free`` columns (the held inputs have no part) -- with the rank rule of model.linalg (singular
@@ -135,7 +136,7 @@ def projections(K: np.ndarray, V, scale, free, tol) -> np.ndarray:
     return out
 
 
-def orient(t, previous):
+def orient(t, previous: np.ndarray):
     """The branch rule: t, or -t, whichever continues ``previous`` (a non-negative dot product);
     t itself without a previous one.  Rows of a stack are oriented each like the row before it,
     the first like ``previous``."""
@@ -156,7 +157,7 @@ def passes_limit(ta, tb, ix) -> bool:
     return np.asarray(ta)[..., ix] * np.asarray(tb)[..., ix] <= 0
 
 
-def keeps_orientation(Ks_from, Ks_new, r) -> bool:
+def keeps_orientation(Ks_from, Ks_new: np.ndarray, r) -> bool:
     """The branch rule of a continuation in several parameters (a workspace's grid growth): each new
     Jacobian (N, m, n; dimensionless) restricted to the old one's range and row space (rank r) keeps the
     sign of its determinant -- a jump across a fold to another working mode flips it.  With one
@@ -168,7 +169,7 @@ def keeps_orientation(Ks_from, Ks_new, r) -> bool:
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss, sigma: float, tol):
+def jumped(miss, sigma: float, tol: Tolerances):
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""

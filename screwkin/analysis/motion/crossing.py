@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.continuation import Curve
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["ChangePoint", "Crossing", "passed", "crossing", "follow", "constraint_profile", "dips", "reclosing",
            "LOOK_BELOW", "TIGHT_CLOSURE", "START", "nearest_branch"]
@@ -53,7 +54,7 @@ def dips(m, xs: np.ndarray):
             yield k, max(k - 1, 0), min(k + 1, len(xs) - 1)
 
 
-def reclosing(solver, res, q_k: np.ndarray, tight):
+def reclosing(solver: PositionSolver, res, q_k: np.ndarray, tight):
     """x -> the configuration at input value x closed from the sweep's q_k (tolerances ``tight`` when
     Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
     mech, frozen = solver.mech, solver.frozen
@@ -311,7 +312,7 @@ def follow(curve: Curve, q: np.ndarray, x, rates, x_to):
     return Neighbour(curve.solver, curve.name)(q1, x1, x_to)
 
 
-def crossing(solver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
+def crossing(solver: PositionSolver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
     """At the change point c of the motion res: (ChangePoint, the followed branch's tangent as joint
     rates oriented along the motion or None, why-not text or None).  The incoming branch is the one
     whose line, followed back from c (``follow``), reaches nearest the configuration recorded before
@@ -362,7 +363,7 @@ def crossing(solver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -
     return ChangePoint(c.x, c.sigma, c.q, local, incoming, goes, True, switched=goes != came), v, why
 
 
-def _starting(solver, curve: Curve, local, branches: list, moving: list, c: Crossing, direction) -> tuple:
+def _starting(solver: PositionSolver, curve: Curve, local, branches: list, moving: list, c: Crossing, direction) -> tuple:
     """(the branch a motion starting on the change point c takes, the rule in words): of the branches
     that move the input, the one the file's configuration lies on (followed from c to its input value,
     it reaches the drawing: solve's first mode is the one nearest the drawing); where none does (the
@@ -392,7 +393,7 @@ def _starting(solver, curve: Curve, local, branches: list, moving: list, c: Cros
     return came, f"{START}: taking the branch nearest the input's own direction (projected on ker K)"
 
 
-def _reaches(solver, curve: Curve, c: Crossing, rates, x, drawn) -> bool:
+def _reaches(solver: PositionSolver, curve: Curve, c: Crossing, rates, x, drawn) -> bool:
     """Whether the branch of tangent ``rates`` at the change point c, followed to input value x, reaches the
     configuration whose signature (PositionSolver.signature) is ``drawn``."""
     q = follow(curve, c.q, c.x, rates, x)
@@ -426,6 +427,6 @@ def _arriving(xs: np.ndarray, c: Crossing, requested) -> float:
     return float(np.sign(d) or 1.0)
 
 
-def _cos(a, b) -> float:
+def _cos(a: np.ndarray, b: np.ndarray) -> float:
     na, nb = np.linalg.norm(a), np.linalg.norm(b)
     return float(a @ b / (na * nb)) if na > 0 and nb > 0 else 0.0

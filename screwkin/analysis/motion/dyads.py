@@ -57,7 +57,7 @@ class Jet:
     def __init__(self, v, d: float = 0.0, dd: float = 0.0) -> None:
         self.v, self.d, self.dd = v, d, dd
 
-    def __add__(self, o) -> Jet:
+    def __add__(self, o: Jet) -> Jet:
         if isinstance(o, Jet):
             return Jet(self.v + o.v, self.d + o.d, self.dd + o.dd)
         return Jet(self.v + o, self.d, self.dd)
@@ -73,7 +73,7 @@ class Jet:
     def __rsub__(self, o):
         return (-self) + o
 
-    def __mul__(self, o) -> Jet:
+    def __mul__(self, o: Jet) -> Jet:
         if isinstance(o, Jet):
             return Jet(self.v * o.v, self.d * o.v + self.v * o.d, self.dd * o.v + 2 * self.d * o.d + self.v * o.dd)
         return Jet(self.v * o, self.d * o, self.dd * o)
@@ -100,7 +100,7 @@ class Jet:
         return Jet(s, c * self.d, -s * self.d * self.d + c * self.dd)
 
     @staticmethod
-    def atan2(y, x) -> Jet:
+    def atan2(y: Jet, x: Jet) -> Jet:
         r2 = x.v * x.v + y.v * y.v
         num = x.v * y.d - y.v * x.d
         dr2 = 2 * (x.v * x.d + y.v * y.d)
@@ -112,7 +112,7 @@ class _Pose:
 
     __slots__ = ("th", "c", "s", "tx", "ty")
 
-    def __init__(self, th, tx, ty) -> None:
+    def __init__(self, th: Jet, tx, ty) -> None:
         self.th, self.c, self.s, self.tx, self.ty = th, th.cos(), th.sin(), tx, ty
 
     def rotate(self, u) -> tuple:
@@ -123,7 +123,7 @@ class _Pose:
         return x + self.tx, y + self.ty
 
     @classmethod
-    def through(cls, th, point, p0):
+    def through(cls, th: Jet, point, p0):
         """The displacement turning by th that takes the q0 point p0 to ``point``."""
         c, s = th.cos(), th.sin()
         return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
@@ -197,7 +197,7 @@ class _Geometry:
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma: float, probe: bool=False, clamp: bool=False):
+def _solve_dyad(geo: _Geometry, kinds, ia, ib, ic, g1, g2, pa, pc: _Pose, sigma: float, probe: bool=False, clamp: bool=False):
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -249,7 +249,7 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma: float, probe: boo
     return (_Pose.through(th, A, A1), _Pose.through(th, C, C2)), disc.v / v0s
 
 
-def _root(disc, clamp: bool):
+def _root(disc: Jet, clamp: bool):
     """The square root of a discriminant (NaN where it is negative); clamp: of max(disc, 0),
     values only (at a limit position, where the derivatives are infinite)."""
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -264,7 +264,7 @@ def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp: int |
         return _evaluate_all(geo, p, xs, start, branch, clamp)
 
 
-def _evaluate_all(geo, p, xs: np.ndarray, start, branch: str, clamp) -> tuple:
+def _evaluate_all(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp) -> tuple:
     xs = np.asarray(xs, float)
     zero = Jet(np.zeros(len(xs)))
     poses = {p.groups[0]: _Pose(zero, zero, zero)}
@@ -431,7 +431,7 @@ class ClosedFormCurve:
         return _evaluate(self.geo, self.p, xs, self.start, self.branch if branch is None else branch, clamp)
 
     @staticmethod
-    def accept(discs) -> int:
+    def accept(discs: np.ndarray) -> int:
         """How many leading values are placed: every discriminant non-negative (past a limit the branch
         does not exist; its values are NaN)."""
         bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(discs) else np.zeros(0, int)

@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.mechanism import Coordinate
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "sweep_motion", "moving_links",
            "Stroke", "strokes"]
@@ -59,7 +61,7 @@ def moving_links(mech: Mechanism) -> tuple:
     return tuple(out)
 
 
-def link_motions(state: KinematicState, angles=None, normal=None, along=None) -> dict:
+def link_motions(state: KinematicState, angles=None, normal: np.ndarray | None = None, along=None) -> dict:
     """Every moving link's absolute motion at a state: ``position`` (and, with rates, ``velocity``,
     ``acceleration``) of its frame origin [m, m/s, m/s^2], ``omega`` and ``alpha`` [rad/s, rad/s^2];
     planar mechanisms (``normal`` given): ``angle`` [rad] from ``angles`` (the vector-loop angles of
@@ -105,7 +107,7 @@ class MotionAlong:
     normal: tuple | None = None  # planar mechanisms: the plane's normal omega and alpha are about
 
 
-def motion_along(mech: Mechanism, Q: np.ndarray, V, A, points=(), angles=None, normal=None) -> MotionAlong:
+def motion_along(mech: Mechanism, Q: np.ndarray, V, A, points=(), angles: LinkAngles | None = None, normal: np.ndarray | None = None) -> MotionAlong:
     """The absolute motion at each configuration Q[k] with rates V[k] and accelerations A[k];
     ``angles``: a callable q -> link angles (LinkAngles) for planar mechanisms, with ``normal``.
 
@@ -245,7 +247,7 @@ class Stroke:
     crank_angles: tuple | None  # (forward, return) crank angles [rad] when time_ratio is known
 
 
-def _extrema(x: np.ndarray, p, dp, tol):
+def _extrema(x: np.ndarray, p, dp, tol: Tolerances):
     """(input value, coordinate) at each zero of dp/dx along the samples: the cubic Hermite
     interpolant of p on each bracket whose slope changes sign (accurate to O(h^4)), its vertex."""
     out = []
@@ -266,7 +268,7 @@ def _extrema(x: np.ndarray, p, dp, tol):
     return out
 
 
-def _stroke_end(solver, res, name: str, coordinate, x: np.ndarray, guess):
+def _stroke_end(solver, res, name: str, coordinate: Coordinate, x: np.ndarray, guess):
     """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
     its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
     from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""
@@ -296,7 +298,7 @@ def _stroke_end(solver, res, name: str, coordinate, x: np.ndarray, guess):
         return guess
 
 
-def strokes(res, motion, mech: Mechanism, solver=None) -> list:
+def strokes(res, motion: MotionAlong, mech: Mechanism, solver=None) -> list:
     """A Stroke for each slider coordinate (prismatic tree joint or prismatic loop joint) of a sweep
     ``res`` (analysis.motion.sweep.SweepResult) with its MotionAlong.  With the sweep's ``solver``
     (analysis.motion.position.PositionSolver) each end is located on the mechanism (Brent's method on

@@ -170,7 +170,7 @@ def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT):
     return sets, n_complex * 2, ("" if sets else why), stretched
 
 
-def _stretched(axes, R, tol: Tolerances):
+def _stretched(axes, R: np.ndarray, tol: Tolerances):
     """A stretched wrist (its last axis turned onto its first: joints 4 and 6 turn about one line, only their
     sum is fixed): [(None, t5, t6)] for each t5 that turns w6 onto +-w4, t6 with joint 4 at 0, else []."""
     w4, w5, w6 = axes
@@ -224,7 +224,7 @@ def _trig_roots(F, degree: int, tol: Tolerances) -> tuple:
     return real, n_complex
 
 
-def _closest(p1, w1, p2, w2, parallel: float) -> tuple:
+def _closest(p1, w1: np.ndarray, p2, w2: np.ndarray, parallel: float) -> tuple:
     """Points of the two lines nearest each other (the foot of p2 on line 1 where they are parallel: the
     sine of their angle below ``parallel``)."""
     n = np.cross(w1, w2)
@@ -235,6 +235,6 @@ def _closest(p1, w1, p2, w2, parallel: float) -> tuple:
     return p1 + s * w1, p2 + t * w2
 
 
-def _perp(w):
+def _perp(w: np.ndarray):
     e = np.eye(3)[int(np.argmin(np.abs(w)))]
     return e - w * (w @ e)

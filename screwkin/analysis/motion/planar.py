@@ -44,6 +44,9 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.topology import Joint
+    from screwkin.model.topology import Topology
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["LinkageInfo", "identify", "transmission_angles", "LinkAngles"]
 
@@ -101,7 +104,7 @@ def _interval(start, end, phi_now, q_in: np.ndarray) -> tuple:
     return (q_in + start - phi_now, q_in + end - phi_now)
 
 
-def identify(mech: Mechanism, topo, q: np.ndarray, input_joint):
+def identify(mech: Mechanism, topo: Topology, q: np.ndarray, input_joint):
     """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
     joint is a ground joint, at the configuration ``topo`` was built at (q)."""
     if topo.motion_space != "planar" or (topo.n_links, topo.n_joints, topo.loops) != (4, 4, 1):
@@ -148,7 +151,7 @@ def identify(mech: Mechanism, topo, q: np.ndarray, input_joint):
     return None
 
 
-def _locator(mech: Mechanism, joint) -> tuple:
+def _locator(mech: Mechanism, joint: Joint) -> tuple:
     """How to find ``joint``'s centre at any configuration: ("frame", id) of a cut joint's F1,
     ("joint", id) of a simple tree joint, or ("topology", name) for a compound joint (its
     centre is the topology's, rebuilt at each configuration)."""
@@ -194,7 +197,7 @@ def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide=None):
     return slide_transmission_angle(B, C, np.cross(n, slide))
 
 
-def _four_bar(name: str, q_in: np.ndarray, A, B, C, D, a, b, tol) -> LinkageInfo:
+def _four_bar(name: str, q_in: np.ndarray, A, B, C, D, a, b, tol: Tolerances) -> LinkageInfo:
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     cls = FOUR_BAR_CLASSES[int(four_bar_classes(g, a, b, c, tol.equal))]
@@ -231,7 +234,7 @@ def _four_bar(name: str, q_in: np.ndarray, A, B, C, D, a, b, tol) -> LinkageInfo
                        input_value=float(q_in), input_angle=float(phi_now))
 
 
-def _slider_crank(name: str, q_in: np.ndarray, A, B, C, s, a, b) -> LinkageInfo:
+def _slider_crank(name: str, q_in: np.ndarray, A, B, C, s: np.ndarray, a, b) -> LinkageInfo:
     nrm = np.array([-s[1], s[0]])
     e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
     lengths = {"crank": a, "rod": b, "offset": abs(e)}
@@ -280,7 +283,7 @@ class LinkAngles:
     child's slide does not turn its parent (the ground of a slider-crank kept a constant
     angle only while the slider stood still)."""
 
-    def __init__(self, mech: Mechanism, topo) -> None:
+    def __init__(self, mech: Mechanism, topo: Topology) -> None:
         if topo.motion_space != "planar" or topo.normal is None:
             raise UsageError(f"{mech.path}: absolute link angles are for planar mechanisms; this one is "
                              f"{topo.motion_space}")
@@ -332,7 +335,7 @@ class LinkAngles:
             out[link] = float(np.arctan2(v @ self.e2, v @ self.e1))
         return out
 
-    def guides(self, state) -> dict:
+    def guides(self, state: KinematicState) -> dict:
         """Prismatic joint (tree or loop) -> the angle of its slide in the plane [rad], from the
         ground's x axis, counterclockwise about the plane's normal, at the configuration of
         ``state`` (a model.state.KinematicState): a slider coordinate is a distance along it."""

@@ -19,10 +19,11 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["locate_singularities"]
 
-def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref=None):
+def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref: np.ndarray | None = None):
     """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""
     S = scaled_jacobians(mech, q, g.output, g.point)
     if kind == "constraint":
@@ -34,7 +35,7 @@ def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref=None):
     return S.J @ V
 
 
-def locate_singularities(solver, res: SweepResult, output=None, xtol: float = LOCATE_XTOL, point: bool = False):
+def locate_singularities(solver: PositionSolver, res: SweepResult, output=None, xtol: float = LOCATE_XTOL, point: bool = False):
     """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
     positions the sweep located, and the other singularities.
 

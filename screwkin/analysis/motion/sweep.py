@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.crossing import ChangePoint
+    from screwkin.analysis.motion.position import PositionSolver
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
 
@@ -99,7 +101,7 @@ def sweep_inputs(mech: Mechanism, name: str, fixed) -> list:
     return [name, *(n for n in fixed if n != name)]
 
 
-def _drawn_regular(solver, values: dict):
+def _drawn_regular(solver: PositionSolver, values: dict):
     """The file's drawn configuration, when it is closed as drawn, at the input ``values``, within the
     joint limits, and regular by its own ranks for a mechanism the inputs determine by dyads (the plan of
     analysis.motion.dyads exists: its passive joints follow from the inputs, so the generic ranks of K
@@ -135,7 +137,7 @@ def _drawn_regular(solver, values: dict):
     return a.q
 
 
-def drawn_start(solver, values: dict):
+def drawn_start(solver: PositionSolver, values: dict):
     """The configuration the file is drawn in, when it is already at the input ``values`` and is the
     mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
     the drawing of those), found without solve's search from random starts (a sweep from the drawn
@@ -253,7 +255,7 @@ def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
     return fixed
 
 
-def _start(solver, name: str, start: float, fixed, near: dict | None, q_start):
+def _start(solver: PositionSolver, name: str, start: float, fixed, near: dict | None, q_start):
     """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
     may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
     drawing when it is solve's first mode there, else solve's first (near ``near``)."""
@@ -314,7 +316,7 @@ def _start_tangent(curve, q0: np.ndarray, h) -> tuple:
         return None, str(exc)
 
 
-def _finish(solver, name: str, motion, rate, requested, turn, unit: str, method: str = "tracker") -> SweepResult:
+def _finish(solver: PositionSolver, name: str, motion: Motion, rate, requested, turn, unit: str, method: str = "tracker") -> SweepResult:
     """The SweepResult of an engine's Motion: rates and accelerations at each configuration."""
     X, Q = motion.X, motion.Q
     mech = solver.mech
@@ -345,7 +347,7 @@ def _finish(solver, name: str, motion, rate, requested, turn, unit: str, method:
 
 
 
-def _through_change_points(solver, res, fixed, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None):
+def _through_change_points(solver: PositionSolver, res: SweepResult, fixed, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None):
     """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it
@@ -430,7 +432,7 @@ def _once(notes) -> tuple:
     return tuple(dict.fromkeys(notes))
 
 
-def _engine_took(solver, curve: Curve, res, k0, after, h) -> bool:
+def _engine_took(solver: PositionSolver, curve: Curve, res, k0, after, h) -> bool:
     """Whether the engine's recorded configurations from index k0 are ``after`` ((input value,
     configuration) each, the branch followed), the input running the way of h."""
     tol = solver.mech.tolerances
@@ -449,7 +451,7 @@ def _engine_took(solver, curve: Curve, res, k0, after, h) -> bool:
 GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index counts as on it
 
 
-def _change_point_note(solver, name: str, unit: str, cp, why, branch: str) -> str:
+def _change_point_note(solver, name: str, unit: str, cp: ChangePoint, why, branch: str) -> str:
     """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
     # (located where the constraint measure is least: to about the square root of the closure's round-off)
     at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
@@ -474,7 +476,7 @@ def _change_point_note(solver, name: str, unit: str, cp, why, branch: str) -> st
 _WORDS = {2: "two", 3: "three", 4: "four"}
 
 
-def _slice(res, n: int):
+def _slice(res: SweepResult, n: int):
     """The first n configurations of res (n >= 0), its limits before them."""
     xs = res.values[:n]
     lim = tuple(s for s in res.limits if n and _between(s.input, res.values[0], res.values[n - 1]))
@@ -488,7 +490,7 @@ def _between(x, a, b) -> bool:
     return min(a, b) <= x <= max(a, b)
 
 
-def _joined(solver, res, head, middle, tail, named, notes, c):
+def _joined(solver, res: SweepResult, head: SweepResult, middle, tail: SweepResult, named, notes, c):
     """head + middle + tail (SweepResults; middle or tail may be None): one motion."""
     parts = [p for p in (head, middle, tail) if p is not None and len(p.values)]
     cat = (lambda f: np.concatenate([getattr(p, f) for p in parts])) if parts else (lambda f: getattr(head, f))

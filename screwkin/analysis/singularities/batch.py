@@ -120,7 +120,7 @@ class SerialJacobians:
             th[k] = Q[:, iq] - zero if kind == "linear" else continuous_angle(Q, iq)
         return th
 
-    def _block(self, th, pose: bool = False):
+    def _block(self, th: np.ndarray, pose: bool = False):
         """(N, 6, n) Jacobians of a block of configurations; arrays are laid out with the
         configurations last so that every operation is one numpy call on N numbers.
         pose: also the frame's rotations (N, 3, 3) and origins (N, 3)."""

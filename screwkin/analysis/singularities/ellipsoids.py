@@ -68,7 +68,7 @@ def _axis_labels(d: int, linear: int) -> tuple:
     return lin + ang, flin + fang
 
 
-def _of_scaled(M, L: float, inputs, tol: Tolerances, linear: int, output: str | None = None, point: bool=False) -> Ellipsoids:
+def _of_scaled(M: np.ndarray, L: float, inputs, tol: Tolerances, linear: int, output: str | None = None, point: bool=False) -> Ellipsoids:
     d = M.shape[0]
     U, s, _ = np.linalg.svd(M, full_matrices=True) if M.size else (np.eye(d), np.zeros(0), None)
     vel = np.zeros(d)

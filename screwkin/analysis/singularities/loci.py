@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.model.mechanism import Coordinate
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
 
@@ -102,7 +103,7 @@ class LocusSystem:
                                  for n in names], bool)
 
     # ----------------------------------------------------------------- pieces
-    def value(self, q: np.ndarray, c) -> float:
+    def value(self, q: np.ndarray, c: Coordinate) -> float:
         """The coordinate's value [rad or m] (continuous joints: their unwrapped angle's atan2)."""
         return float(continuous_angle(q[None], c.idx_q)[0]) if c.nq == 2 else float(q[c.idx_q])
 
@@ -128,7 +129,7 @@ class LocusSystem:
     def integrate(self, q: np.ndarray, u) -> np.ndarray:
         return self.mech.closure.integrator(q[None], (self.scale * u)[None])[0]
 
-    def residual(self, q: np.ndarray, v, A=None) -> np.ndarray:
+    def residual(self, q: np.ndarray, v: np.ndarray, A=None) -> np.ndarray:
         mech = self.mech
         parts = []
         if mech.closure.nrows:
@@ -155,7 +156,7 @@ class LocusSystem:
             blocks.append(np.hstack([K * self.scale, np.zeros((len(K), len(v)))]))
         return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
 
-    def _held_kind_norm_rows(self, q: np.ndarray, v, A) -> list:
+    def _held_kind_norm_rows(self, q: np.ndarray, v: np.ndarray, A: np.ndarray) -> list:
         """The Jacobian's rows after the loops' (a section's too): the held inputs, d(A v)/d(u, v) (d/du by
         forward differences of step FD) and |v| = 1."""
         H = np.zeros((len(self.held), self.nv + len(v)))
@@ -169,7 +170,7 @@ class LocusSystem:
             D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / FD
         return [H, np.hstack([D, A]), np.concatenate([np.zeros(self.nv), v])[None]]
 
-    def relative(self, q: np.ndarray, v=None) -> float:
+    def relative(self, q: np.ndarray, v: np.ndarray | None = None) -> float:
         """|A v| / |A| (v: A's smallest right singular vector when None): the point's distance from the
         kind's singular condition, relative."""
         A = self.A(q)
@@ -236,7 +237,7 @@ class LocusSystem:
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q: np.ndarray, v, t, h, J: np.ndarray | None = None):
+    def along(self, q: np.ndarray, v, t: np.ndarray, h, J: np.ndarray | None = None):
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q

@@ -40,6 +40,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
@@ -308,7 +310,7 @@ class GramLoop:
 STATIONARY = DEFAULT.stationary
 
 
-def loop_twists(mech: Mechanism, q: np.ndarray, cut, length=None) -> tuple:
+def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length=None) -> tuple:
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
     says why) when the loop has a higher pair or a joint without one twist per coordinate."""
@@ -408,7 +410,7 @@ def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
     return tuple(out)
 
 
-def lost_direction(JV, out_dim: int, normal=None) -> np.ndarray:
+def lost_direction(JV: np.ndarray, out_dim: int, normal=None) -> np.ndarray:
     """The output direction lost at a serial singularity, as a unit (6,) twist (v, w) in the rows' scaled
     coordinates (a point's output: v only, w zero): the left singular vector of the output's motion map
     JV (rows (v, w) or v, columns the mechanism's motions) for its ``out_dim``-th singular value, the one
@@ -433,7 +435,7 @@ def lost_direction(JV, out_dim: int, normal=None) -> np.ndarray:
     return out
 
 
-def _motion_twist(kind: str, x, names, J: np.ndarray, tol) -> SingularTwist:
+def _motion_twist(kind: str, x, names, J: np.ndarray, tol: Tolerances) -> SingularTwist:
     """The motion x (any length) as a SingularTwist: its rates (those not zero next to the unit
     vector: above Tolerances.equal), its twist and screw (none for a zero twist)."""
     x = x / np.linalg.norm(x)

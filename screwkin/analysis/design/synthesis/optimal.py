@@ -32,6 +32,11 @@ from ....model.geometry import wrap_angle
 from .fourbar import travel_analysis
 from .path import _residuals, _unpack, coupler_points, path_design, path_points
 from .search import SearchReport, box_text, distinct_best, evolve, run_all, task_seed
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.synthesis.constraints import Constraints
+    from screwkin.analysis.design.synthesis.search import Search
 
 __all__ = ["optimal_path", "PENALTY", "SAMPLES"]
 
@@ -57,7 +62,7 @@ SEARCHED = 24
 TWO_PI = 2 * math.pi
 
 
-def _path_box(pts: np.ndarray, constraints, L) -> tuple[np.ndarray, np.ndarray]:
+def _path_box(pts: np.ndarray, constraints: Constraints, L) -> tuple[np.ndarray, np.ndarray]:
     """The search's box: the pivots inside the bounds (else 2 path sizes around the points), the links
     within the length range (else 2 % of the path's size to 4 times it), the coupler point within 3 sizes."""
     plo, phi = constraints.pivot_box(pts.mean(axis=0), L)
@@ -244,7 +249,7 @@ def rank_key(cand: Candidate, tol: float) -> tuple:
     return (not cand.feasible, len(cand.defects), max(cand.error - tol, 0.0), deviation, cand.error)
 
 
-def optimal_path(points, timing, constraints, search, tolerance: float = 1e-6, equal: float = 1e-9) -> PathResult:
+def optimal_path(points, timing, constraints, search: Search, tolerance: float = 1e-6, equal: float = 1e-9) -> PathResult:
     """The best four-bars whose coupler point passes through ``points`` (with the crank angles
     ``timing`` when given) that meet ``constraints``, found by ``search`` (module docstring); the
     PathResult of the best, its ``search`` report listing the best few (Candidates)."""

@@ -28,6 +28,11 @@ from .designs import Candidate, FunctionResult, SynthesisError
 from .function import function_result, function_task
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, rank_key
 from .search import SearchReport, box_text, distinct_best, evolve, run_all, task_seed
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.synthesis.constraints import Constraints
+    from screwkin.analysis.design.synthesis.search import Search
 
 __all__ = ["optimal_function"]
 
@@ -56,7 +61,7 @@ def _parts(X: np.ndarray, names, task, bounds=None) -> tuple:
     return get["a"], get["b"], get["c"], d, B0
 
 
-def _errors(X: np.ndarray, names, task, signs, constraints, equal, phi, psi) -> tuple:
+def _errors(X: np.ndarray, names, task, signs, constraints: Constraints, equal, phi, psi) -> tuple:
     """(structural errors (m, n) [rad], penalties (m,), mu (lo, hi)) of designs X at the angles phi, psi;
     ``signs`` (branch, crank's, rocker's): Freudenstein's signed crank and rocker (a link pointing the
     other way from its angle, as function.py's negative a or c)."""
@@ -99,7 +104,7 @@ def _function_run(job):
     return out, nfev
 
 
-def optimal_function(text: str, x_range, input_range, output_range, points, spacing, ground, constraints, search,
+def optimal_function(text: str, x_range, input_range, output_range, points, spacing, ground, constraints: Constraints, search: Search,
                      equal: float = 1e-9) -> FunctionResult:
     """The best function generators that meet ``constraints`` (module docstring): the FunctionResult of
     the best, its ``search`` report listing the best few."""

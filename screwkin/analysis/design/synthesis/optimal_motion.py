@@ -35,6 +35,11 @@ from .fourbar import pose_matrix, travel_analysis
 from .motion import _base_pole, _burmester_rows, _check_poses, _positions_of, burmester_points, motion_design, poles, scale_of
 from .optimal import MARGIN, PENALTY, PREFER, REFINED, refined, _defect_words, rank_key
 from .search import SearchReport, box_text, distinct_best, evolve, run_all, task_seed
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.synthesis.constraints import Constraints
+    from screwkin.analysis.design.synthesis.search import Search
 
 __all__ = ["optimal_motion", "MAX_POSES"]
 
@@ -193,7 +198,7 @@ def _motion_run(task):
     return out, nfev
 
 
-def _judge_motion(poses: list, A0: np.ndarray, a, B0: np.ndarray, b, direction, constraints, L, tol, equal: float, run, exact: bool):
+def _judge_motion(poses: list, A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, direction, constraints, L, tol, equal: float, run, exact: bool):
     R1, p1 = pose_matrix(poses[0])
     crank, rocker = Dyad(tuple(map(float, A0)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))), \
         Dyad(tuple(map(float, B0)), tuple(map(float, R1 @ b + p1)), tuple(map(float, b)))
@@ -219,7 +224,7 @@ def _judge_motion(poses: list, A0: np.ndarray, a, B0: np.ndarray, b, direction, 
     return Candidate(design, err, float(np.sqrt(np.mean(miss ** 2))), mu, kind, defects, unmet, run), (crank, rocker)
 
 
-def optimal_motion(poses, constraints, search, tolerance: float = 1e-9, equal: float = 1e-9) -> MotionResult:
+def optimal_motion(poses, constraints: Constraints, search: Search, tolerance: float = 1e-9, equal: float = 1e-9) -> MotionResult:
     """The best four-bars guiding the coupler frame through ``poses`` that meet ``constraints`` (module
     docstring): the MotionResult of the best, its ``search`` report listing the best few."""
     poses = [tuple(float(x) for x in p) for p in poses]

@@ -20,6 +20,10 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.analysis.design.synthesis.constraints import Constraints
 
 __all__ = ["box_text", "Search", "SearchReport", "evolve", "distinct_best", "task_seed"]
 
@@ -58,7 +62,7 @@ class SearchReport:
     box: str = ""  # where the search looked, as chosen (box_text): what the constraints left to the search
 
 
-def box_text(constraints, pivots=None, lengths: tuple | None = None) -> str:
+def box_text(constraints: Constraints, pivots=None, lengths: tuple | None = None) -> str:
     """Where a search looks, in words: the fixed pivots' box ((low, high) corners [m]) and the links'
     lengths ((low, high) [m]), each said to be the search's own choice where ``constraints`` (a
     Constraints) does not give it (--bounds, --lengths)."""
