@@ -101,7 +101,7 @@ def _invoked(argv) -> str | None:
     return None
 
 
-def _parser(argv=()):
+def _parser(argv=()) -> _Parser:
     """The parser: every command listed with its help line; the one ``argv`` invokes built in full
     (its module imported), the others as names only."""
     p = _Parser(prog="screwkin", description="Screw-theory analysis of spatial mechanisms described in URDF.")

@@ -108,7 +108,7 @@ class MobilityResult:
         return self.topology.motion_space
 
 
-def _body_frames(mech: Mechanism, topo):
+def _body_frames(mech: Mechanism, topo) -> dict:
     """One body frame per link of the topology (not the ground)."""
     frames = {}
     for link in topo.links:
@@ -118,7 +118,7 @@ def _body_frames(mech: Mechanism, topo):
     return frames
 
 
-def _joint_geometry_rows(mech: Mechanism, topo, frames, jac: dict, state: KinematicState):
+def _joint_geometry_rows(mech: Mechanism, topo, frames, jac: dict, state: KinematicState) -> list:
     """Rows whose null space is the set of motions keeping every joint's geometry still.
 
     For each joint and each of its two links: the velocity (seen from that link)

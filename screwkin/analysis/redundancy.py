@@ -110,7 +110,7 @@ def _left_null(mech: Mechanism, q: np.ndarray) -> tuple:
     return Ks, Lam, mech.closure.row_labels()
 
 
-def _cut_words(mech: Mechanism):
+def _cut_words(mech: Mechanism) -> dict:
     """cut joint or coupling name -> (what it is in the file's words)."""
     out = {}
     for c in mech.spec.cut_joints:
@@ -302,7 +302,7 @@ def _rotation_twist(u, p):
     return np.r_[np.cross(p, u), u]
 
 
-def _options(mech: Mechanism, state: KinematicState, name: str, kind: str, axis, point, axes: list):
+def _options(mech: Mechanism, state: KinematicState, name: str, kind: str, axis, point, axes: list) -> list:
     """(new type, [(world twist, words)], replacement) for each way to free more at one joint; ``axes``:
     the directions a universal joint's second axis may take ((world vector, letter or None))."""
     opts = []
@@ -431,7 +431,7 @@ def suggest(mech: Mechanism, q: np.ndarray, count: int | None = None) -> Suggest
     return Suggestion(changes, text, M, over, checked)
 
 
-def _change_words(mech: Mechanism, chosen):
+def _change_words(mech: Mechanism, chosen) -> list:
     kinds = _cut_words(mech)
     out = []
     for name, is_cut, new_type, twists, letter in chosen:

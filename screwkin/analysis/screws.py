@@ -77,7 +77,7 @@ class Chain:
     g0: np.ndarray  # 4x4 tool frame at the reference configuration
 
 
-def chains(mech: Mechanism, output=None):
+def chains(mech: Mechanism, output=None) -> list:
     """One chain per cut-joint side and one to the output link."""
     targets = []
     for c in mech.cuts:
@@ -122,7 +122,7 @@ def poe(chain: Chain, theta) -> np.ndarray:
     return M.homogeneous @ chain.g0
 
 
-def structure(mech: Mechanism, q: np.ndarray, output=None):
+def structure(mech: Mechanism, q: np.ndarray, output=None) -> list:
     """Per chain: reference twists, g(0), current twists (space Jacobian columns at q)."""
     state = KinematicState(mech, q)
     result = []
@@ -152,7 +152,7 @@ class LoopScrews:
     closed_at_reference: bool  # F1 and F2 coincide in the file's configuration
 
 
-def cut_twists(mech: Mechanism, cut: CutJoint, state: KinematicState):
+def cut_twists(mech: Mechanism, cut: CutJoint, state: KinematicState) -> list | None:
     """The cut joint's freedoms at the configuration of ``state`` (a model.state.KinematicState) as
     world twists (v at the world origin, w): [(name, twist, sliding)], or None for a higher pair (its
     loop closes through an equivalent linkage and coupling rows)."""

@@ -88,7 +88,7 @@ def _loads(mech: Mechanism, items, points) -> tuple:
     return tuple(out)
 
 
-def _cs(text: str):
+def _cs(text: str) -> float:
     try:
         cs = float(text)
     except ValueError:

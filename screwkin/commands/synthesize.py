@@ -141,7 +141,7 @@ def _option(dest):
     return "--" + dest.replace("_", "-")
 
 
-def _number_groups(text: str, option: str, count: int | None = None, kind: str | None = None):
+def _number_groups(text: str, option: str, count: int | None = None, kind: str | None = None) -> list:
     """'x,y; x,y' -> [[x, y], [x, y]] (each number with an optional unit, of ``kind`` when given)."""
     groups = [g for g in text.split(";") if g.strip()]
     if not groups:
@@ -163,7 +163,7 @@ def _range(text: str, option: str) -> tuple:
     return parse_value(parts[0]), parse_value(parts[1])
 
 
-def _plausible(design, kind: str):
+def _plausible(design: Design, kind: str):
     """A linkage whose numbers a file can hold: finite, and within the 10 km the reader accepts."""
     fb = design.fourbar
     values = [*fb.A0, *fb.A, *fb.B, *fb.B0, *(fb.tool or ())]

@@ -149,11 +149,11 @@ def _placement(pos, quat):
     return pin.SE3(quat_matrix(quat), np.asarray(pos, float))
 
 
-def _quat(M):
+def _quat(M) -> tuple:
     return matrix_quat(M.rotation)
 
 
-def _children(pm: PlacedMechanism):
+def _children(pm: PlacedMechanism) -> dict:
     kids = {}
     for b in pm.bodies:
         kids.setdefault(b.parent, []).append(b)

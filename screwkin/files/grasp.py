@@ -96,7 +96,7 @@ def _vector(value, what: str, planar, problems: Problems) -> tuple | None:
     return tuple(v)
 
 
-def _coefficient(c, key: str, k: int, problems: Problems, bound, unit: str = ""):
+def _coefficient(c, key: str, k: int, problems: Problems, bound, unit: str = "") -> float | None:
     value = c.get(key)
     if not _is_number(value):
         problems.append(f"contact {k}: {key} must be a number, got {quote(value)}")

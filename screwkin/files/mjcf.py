@@ -102,7 +102,7 @@ class _Reader:
                 continue
             self._default(child, child.get("class"), own)
 
-    def attrs(self, elem, cls):
+    def attrs(self, elem, cls) -> dict:
         """The element's attributes over those of its default class."""
         cls = elem.get("class", cls)
         if cls not in self.defaults and cls != "main":
@@ -111,7 +111,7 @@ class _Reader:
         out.update(elem.attrib)
         return out
 
-    def actuator_attrs(self, elem):
+    def actuator_attrs(self, elem) -> dict:
         """An actuator's attributes over its class's: MuJoCo's actuator shortcuts share one default."""
         cls = elem.get("class", "main")
         if cls not in self.defaults and cls != "main":
@@ -168,7 +168,7 @@ class _Reader:
         return _z_to(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
                                self.problems, (0.0, 0.0, 1.0)))
 
-    def content(self, elem, cls):
+    def content(self, elem, cls) -> list:
         """(child, T, class) of every child of a body (or <worldbody>) with its <frame>s opened: T the
         frames' placement in the body, class the frames' childclass over ``cls``."""
         out = []

@@ -114,7 +114,7 @@ def read_equalities(r, world: dict, sites: dict, mjoints: dict, reference: dict,
     return cuts, couplings
 
 
-def _connect_cuts(r, connects: list, world: dict):
+def _connect_cuts(r, connects: list, world: dict) -> list:
     """Spherical cut joints of the connects; two between the same bodies: one revolute."""
     pairs = {}
     for c in connects:
@@ -142,7 +142,7 @@ def _connect_cuts(r, connects: list, world: dict):
     return out
 
 
-def _ends(r, a, what: str, world: dict, sites: dict):
+def _ends(r, a, what: str, world: dict, sites: dict) -> tuple | None:
     """((body1, S1), (body2, S2), by_site) of a connect or weld; body2 omitted or "world" is the world."""
     p = r.problems
     if a.get("site1") or a.get("site2"):

@@ -225,7 +225,7 @@ def _require(value, where: str) -> tuple | None:
     return tuple(out)
 
 
-def _workspace(value, where: str):
+def _workspace(value, where: str) -> dict:
     if value is None:
         return {}
     if not isinstance(value, dict):

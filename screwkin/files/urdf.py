@@ -54,7 +54,7 @@ _NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\Z")
 _NONFINITE = re.compile(r"[-+]?(?:nan|inf|infinity)\Z", re.IGNORECASE)
 
 
-def numbers(text: str, count: int, what: str, problems, default, bound=None, unit: str = "m", low=None):
+def numbers(text: str, count: int, what: str, problems, default, bound=None, unit: str = "m", low=None) -> tuple:
     """Parse ``count`` floats from an attribute; record a problem when invalid.
 
     bound: largest magnitude accepted (see :class:`~screwkin.files.description.Limits`);
@@ -103,7 +103,7 @@ def unit_axis(values, what: str, problems, default=(1.0, 0.0, 0.0)) -> tuple:
     return tuple(u / np.linalg.norm(u))
 
 
-def _axis(elem, what: str, problems: Problems, default=(1.0, 0.0, 0.0)):
+def _axis(elem, what: str, problems: Problems, default=(1.0, 0.0, 0.0)) -> tuple:
     if elem is None or elem.get("xyz") is None:  # urdfdom's default: the x axis
         return tuple(default)
     before = len(problems)

@@ -261,7 +261,7 @@ def _one_line(exc) -> str:
     return " when evaluating expression ".join(parts[:2]) or type(exc).__name__
 
 
-def _patched(xacro, state: _State, path, evaluator=None):
+def _patched(xacro, state: _State, path, evaluator=None) -> tuple:
     """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
     macro calls while expanding."""
     original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",

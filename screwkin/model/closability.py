@@ -72,7 +72,7 @@ class _Names:
         return self._all()[k]
 
 
-def obstacle_of(cut: str, names, sides: list, tol: float):
+def obstacle_of(cut: str, names, sides: list, tol: float) -> tuple | None:
     """(why the loop ``cut`` cannot close, by how much its longest side is too long [m]) when its longest
     side (of ``sides``, the lengths of the links ``names``) is longer than the others together (beyond
     ``tol``); None otherwise."""

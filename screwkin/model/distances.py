@@ -85,7 +85,7 @@ class SixDistances:
         X[:, 3:] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
         return X
 
-    def tangent(self, X: np.ndarray):
+    def tangent(self, X: np.ndarray) -> np.ndarray:
         P = len(X)
         T = np.zeros((P, 7, 6), complex)
         T[:, np.arange(3), np.arange(3)] = 1.0

@@ -105,7 +105,7 @@ def line_foot(x, point, direction):
     return point + ((x - point) @ direction) * direction
 
 
-def line_circle(point, direction, centre, radius) -> list:
+def line_circle(point, direction: np.ndarray, centre, radius) -> list:
     """The points where the line through ``point`` along the unit vector ``direction`` meets the
     circle (sphere) (centre, radius): [behind, ahead] along ``direction`` (the foot twice where it
     touches), [] where it passes farther than the radius.

@@ -160,7 +160,7 @@ def _joints_from_ground(model: pin.Model, j: int) -> list:
     return out[::-1]
 
 
-def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | None, scale, tol: float):
+def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | None, scale, tol: float) -> LegChain | None:
     """The LegChain of the joints ``path`` (see the module), read in ``state``, or None when they are no leg."""
     kinds = [_joint_letter(model, j) for j in path]
     if kinds.count("P") != 1:
@@ -254,7 +254,7 @@ def leg_poses(platform: Platform, leg: LegChain, P, tol: float = DEFAULT.closed_
     return out, ("" if out else why or f"leg {leg.name} cannot reach the pose"), gap
 
 
-def set_leg(model: pin.Model, q: np.ndarray, pose: LegPose, angles: dict):
+def set_leg(model: pin.Model, q: np.ndarray, pose: LegPose, angles: dict) -> np.ndarray:
     """q with the leg's slide at pose.x and its revolutes at ``angles`` (in place; returned)."""
     q[model.joints[pose.leg.slide].idx_q] = pose.x
     for j, t in angles.items():
@@ -266,7 +266,7 @@ def set_leg(model: pin.Model, q: np.ndarray, pose: LegPose, angles: dict):
     return q
 
 
-def set_free(platform: Platform, model: pin.Model, q: np.ndarray, P):
+def set_free(platform: Platform, model: pin.Model, q: np.ndarray, P) -> np.ndarray:
     """q with the floating joint holding the platform at the output joint's world placement P."""
     if platform.free is not None:
         jm = model.joints[platform.free]
@@ -306,7 +306,7 @@ def _common_output(mech: Mechanism):
     return next(iter(common)) if common and len(common) == 1 else None
 
 
-def respell(mech: Mechanism, q: np.ndarray):
+def respell(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     """q with each platform leg (see the module) whose joints lie outside the file's limits written in
     an angle set of the same pose within them, where one exists (the leg's slide kept); q itself when
     the mechanism is no such platform or nothing changes.  A pose, not its spelling, is within the

@@ -202,7 +202,7 @@ def _couple(model: pin.Model, couplings, path):
     return model
 
 
-def _virtual_pairs(model: pin.Model, spec) -> None:
+def _virtual_pairs(model: pin.Model, spec: MechanismSpec) -> None:
     """Give every rolling, gear and helical loop joint the massless chain of its equivalent
     linkage, from F1 on its first link, whose coordinates are the pair's unwrapped angles (and
     advance); the loop closes with a weld from the chain's end frame ``NAME@end`` to F2, and a

@@ -28,6 +28,10 @@ from .linalg import null_space, rank
 from .manifold import continuous_angle, set_continuous_angle
 from .topology import build_topology
 from .lengths import characteristic_length
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.topology import Topology
 
 __all__ = ["Mechanism", "Coordinate"]
 
@@ -423,7 +427,7 @@ class Mechanism:
                 q[i:i + c.nq] = pin.integrate(model, pin.neutral(model), dq)[i:i + c.nq]
         return q
 
-    def _keep(self, q: np.ndarray, hint, frozen):
+    def _keep(self, q: np.ndarray, hint, frozen) -> np.ndarray:
         """q with the coordinates of the joints whose velocity indices are frozen taken from hint."""
         if not len(frozen):
             return q
@@ -562,7 +566,7 @@ class Mechanism:
             self.generic_configurations()
         return self._generic[2:]
 
-    def topology(self, q: np.ndarray | None = None):
+    def topology(self, q: np.ndarray | None = None) -> Topology:
         """The :class:`~screwkin.model.topology.Topology` (links, joints, compound joints, loops)
         at q (default: a generic assembled configuration)."""
         return build_topology(self, self.generic_configurations()[1][0] if q is None else q)

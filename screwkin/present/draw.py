@@ -295,7 +295,7 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
     return fig
 
 
-def _block_direction(skel, lk):
+def _block_direction(skel: Skeleton, lk):
     for j in skel.joints:
         if lk.number in j.links and j.type in ("prismatic", "cylindrical") and j.direction is not None:
             return _direction_2d(j.direction)

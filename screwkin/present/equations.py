@@ -27,7 +27,7 @@ def greek(text: str) -> str:
     return text.replace("**", "^")
 
 
-def _matrix_text(name: str, rows, indent: str = "  "):
+def _matrix_text(name: str, rows, indent: str = "  ") -> list:
     """A matrix of expressions, one row a line."""
     lines = []
     for i, row in enumerate(rows):
@@ -36,7 +36,7 @@ def _matrix_text(name: str, rows, indent: str = "  "):
     return lines
 
 
-def _numbers_text(name: str, M, indent: str = "    "):
+def _numbers_text(name: str, M, indent: str = "    ") -> list:
     M = np.atleast_2d(np.asarray(M, float))
     lines = []
     for i, row in enumerate(M):
@@ -200,7 +200,7 @@ class Units:
         self.degrees = degrees
         self.lengths = lengths or {}  # symbol -> unit ("mm"); m when not given
 
-    def value(self, name: str, kind: str, v):
+    def value(self, name: str, kind: str, v) -> str:
         if kind == "angle":
             return unit_text(v, "deg" if self.degrees else "rad")
         return unit_text(v, self.lengths.get(name, "m"))

@@ -190,7 +190,7 @@ def _certificate_lines(r: GraspResult):
                       "every contact wrench has a component along it, none against it")]
 
 
-def _quality_lines(r: GraspResult):
+def _quality_lines(r: GraspResult) -> list:
     q = r.quality
     scale = f"moments divided by L = {q.torque_scale:.4g} m ({r.length_source})"
     what = ("Ferrari-Canny, L1: the hull of the primitive wrenches of unit normal force, i.e. sum of normal "

@@ -107,7 +107,7 @@ def mobility_dict(r: MobilityResult) -> dict:
 JOINT_COLUMNS = ("joint", "type", "dof", "motion", "pair (contact)", "links", "loop")
 
 
-def joint_rows(topo, limit: int = 48) -> list:
+def joint_rows(topo: Topology, limit: int = 48) -> list:
     """One row per joint of a Topology (columns JOINT_COLUMNS); names longer than ``limit`` shortened."""
     return [(j.name if len(j.name) <= limit else j.name[:limit - 3] + "...", j.type, j.dof, j.motion,
              f"{j.pair} ({j.contact})", f"{j.links[0]} - {j.links[1]}", "cut" if j.cut else "") for j in topo.joints]

@@ -148,7 +148,7 @@ def study_dict(result: StudyResult) -> dict:
     return to_jsonable(d)
 
 
-def mode_rule(result) -> str | None:
+def mode_rule(result: StudyResult) -> str | None:
     """The one line that says which assembly mode every design follows (the metrics of MODE_METRICS), or None."""
     if not any(m in MODE_METRICS for m in result.spec.metrics):
         if result.spec.mode is not None and "transmission_angle" in result.spec.metrics:
@@ -164,7 +164,7 @@ def mode_rule(result) -> str | None:
             "modes give it and how many each design has")
 
 
-def _paths_line(result) -> list:
+def _paths_line(result: StudyResult) -> list:
     """How the designs were evaluated: on the family path (expanded once per chunk, closed forms over the
     designs) or each alone, and why some were alone."""
     paths = result.extra.get("paths") or {}
@@ -200,7 +200,7 @@ def _requirements_lines(result: StudyResult) -> list:
     return lines
 
 
-def _workspace_metrics(result) -> bool:
+def _workspace_metrics(result: StudyResult) -> bool:
     return any(m in WORKSPACE_METRICS for m in result.spec.metrics)
 
 
@@ -289,7 +289,7 @@ def study_text(result: StudyResult, table_path=None) -> str:
     return "\n".join(line.rstrip() for line in lines)
 
 
-def _numeric(result: StudyResult):
+def _numeric(result: StudyResult) -> list:
     """[(row key, label, factor)] of the metric columns with numbers."""
     out = []
     for k, name, f in table_columns(result):
@@ -321,7 +321,7 @@ LABELS = {
 FAILED_COLOR = "crimson"
 
 
-def _label(key, result=None) -> tuple:
+def _label(key, result: StudyResult | None = None) -> tuple:
     """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
     dimension (m^2 or m^3; m^d when they differ)."""
     if key in LABELS:
@@ -335,7 +335,7 @@ def _label(key, result=None) -> tuple:
     return label, factor
 
 
-def _parameter_axis(result, name: str) -> tuple:
+def _parameter_axis(result: StudyResult, name: str) -> tuple:
     """(axis label, factor from SI) of a parameter: in the unit its values were typed in (the study
     file's ``30mm``), else as given (xacro arguments are SI, the file does not say m or rad)."""
     unit = next((getattr(p, "unit", "") for p in result.spec.parameters if p.name == name), "")
@@ -344,7 +344,7 @@ def _parameter_axis(result, name: str) -> tuple:
     return f"{name} (as given, SI: no unit typed)", 1.0
 
 
-def _classes(result: StudyResult):
+def _classes(result: StudyResult) -> dict:
     """The colour of each design (row index -> (class, colour)): its Grashof class when the study
     has one, failed designs in FAILED_COLOR."""
     out = {}

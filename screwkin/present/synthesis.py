@@ -190,7 +190,7 @@ def _as_typed(result: FunctionResult, check: Check) -> list:
 SYNTHESIS_ZERO = 1e-15
 
 
-def _shown_number(x, digits: int = 6):
+def _shown_number(x, digits: int = 6) -> str:
     """tables.shown_text with synthesis' own round-off (SYNTHESIS_ZERO)."""
     return shown_text(x, digits, SYNTHESIS_ZERO)
 

@@ -150,7 +150,7 @@ def _disc(name: str, joint, frame, M, radius, color, alpha: float = 0.35):
     return obj
 
 
-def _pair_geometry(mech: Mechanism, cut, spec: CutJointSpec, r_axis, L_axis):
+def _pair_geometry(mech: Mechanism, cut, spec: CutJointSpec, r_axis, L_axis) -> list:
     """What a higher pair looks like: pitch circles (rolling, gears; a pitch line for a rack),
     profiles (circles as discs, lines as slots, points as pins) and a screw's helix of its lead."""
     model = mech.model
@@ -396,7 +396,7 @@ class RecordingViewer:
         raise NotImplementedError
 
 
-def _translation(p):
+def _translation(p) -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = p
     return T

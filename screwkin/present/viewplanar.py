@@ -20,7 +20,7 @@ __all__ = ["GROUND", "planar_basis", "link_colours", "colour_links", "top_view"]
 GROUND = np.array([0.3, 0.3, 0.3, 1.0])  # the ground's links: darker than the passive joints' grey
 
 
-def planar_basis(mech: Mechanism, q: np.ndarray):
+def planar_basis(mech: Mechanism, q: np.ndarray) -> tuple | None:
     """(e1, e2, n) of the plane of motion of a planar mechanism at q; None for a spatial or spherical one."""
     topo = mech.topology(q)
     if topo.motion_space != "planar" or topo.normal is None:

@@ -59,7 +59,7 @@ class RollingPair:
     in_system: bool  # the law is one of the equations F (theta_ab constant)
 
 
-def measure_pairs(loops, state):
+def measure_pairs(loops, state) -> dict:
     """Per rolling/gear loop joint of ``loops`` (a VectorLoops being built; ``state``: its
     model.state.KinematicState at loops.q): the anchors of its two centres on its two links
     (loops.keep) and a dict of what the loop terms need."""
@@ -98,7 +98,7 @@ def _times(radius, angle, line) -> str:
     return f"-{radius}*{line}" if angle == 0 else f"{radius}*({angle} - {line})"
 
 
-def pair_term(loops, rec, placeholder=None):
+def pair_term(loops, rec, placeholder=None) -> tuple:
     """(fx, fy, term names) of crossing the pair from link a to link b, and the RollingPair
     record; ``placeholder``: a sympy symbol to stand for theta_ab (replaced later).  Sets
     rec["contact"]: the contact point from link a's anchor (circle a's centre: rho_a along the
@@ -164,7 +164,7 @@ def pair_term(loops, rec, placeholder=None):
         rec["name"], rec["kind"], (a, b), law, f"{name} = {expr}", False)
 
 
-def virtual_coordinates(loops, q: np.ndarray, values: dict, before):
+def virtual_coordinates(loops, q: np.ndarray, values: dict, before) -> np.ndarray:
     """Set in q (in place) the coordinates of each pair's virtual joints (model.loader's
     equivalent linkage: a1 and -a2, or x and -a2) for the link angles ``values`` (symbol ->
     value; the others as ``before``, their values at loops.q), moved from their values at
@@ -201,7 +201,7 @@ def _axis_sign(loops, name: str) -> float:
     return float(np.sign((loops.state.frame_placement(f1).rotation @ np.asarray(axis, float)) @ loops.n))
 
 
-def turns_through_pairs(loops, q: np.ndarray, values):
+def turns_through_pairs(loops, q: np.ndarray, values) -> dict:
     """``values`` (symbol -> value at q, each link's angle counted in turns along the tree) with
     the angle of a link turned through a rolling pair counted instead by the pair's virtual
     joints, which count turns as the no-slip law does (the tree may hold a gear's joint a whole

@@ -287,7 +287,7 @@ def _hull(points: list):
     return lower[:-1] + upper[:-1]
 
 
-def _distinct(points, tol):
+def _distinct(points, tol) -> list:
     out = []
     for p in points:
         if all(np.hypot(p[0] - r[0], p[1] - r[1]) > tol for r in out):
@@ -432,7 +432,7 @@ def _stub(state: KinematicState, name: str, pts: np.ndarray, p2, tol) -> tuple[s
     return "stub", (pts[0], end)
 
 
-def _higher_pair(state: KinematicState, spec: CutJointSpec, letter, nums: tuple, p2, e1: np.ndarray, e2: np.ndarray):
+def _higher_pair(state: KinematicState, spec: CutJointSpec, letter, nums: tuple, p2, e1: np.ndarray, e2: np.ndarray) -> tuple:
     """(contact point, profiles) of a rolling, gear or contact pair in the plane."""
     F1, F2 = _frame_point(state, f"{spec.name}@F1"), _frame_point(state, f"{spec.name}@F2")
     c1, c2 = np.array(p2(F1.translation)), np.array(p2(F2.translation))

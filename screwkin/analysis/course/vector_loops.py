@@ -545,7 +545,7 @@ class VectorLoops:
                           float).reshape(-1)
 
     # ------------------------------------------------------------------ determinant
-    def determinant(self):
+    def determinant(self) -> tuple:
         """(det A simplified, its singular conditions as strings, the same in words):
         screwkin.analysis.course.det_conditions."""
         return determinant(self)

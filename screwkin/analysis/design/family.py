@@ -238,7 +238,7 @@ def _flat(P, n: int):
     return P - np.einsum("ni,ni->n", P, n)[:, None] * n
 
 
-def family_rows(task, chunk):
+def family_rows(task, chunk) -> ChunkRows | None:
     """The rows of ``chunk`` ([(index, values), ...]) by the family path (module docstring), a
     ChunkRows; None when the study is not one it applies to (its metrics, a plain file)."""
     if eligible(task) is not None:
@@ -383,7 +383,7 @@ def _family(task: _Task, chunk, index: int, values: np.ndarray, alone: dict) -> 
     return ChunkRows(out, {"family": len(made), "design": n - len(made)}, notes)
 
 
-def _row_of(task, i: int, values, columns, reference, code, margin, lo, hi, turns, dead, short: dict):
+def _row_of(task: _Task, i: int, values, columns, reference, code, margin, lo, hi, turns, dead, short: dict) -> dict:
     """The family path's row of one design from its closed-form numbers (the reference's recomputed)."""
     row = {"design": i, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(columns))

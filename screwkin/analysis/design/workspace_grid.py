@@ -188,7 +188,7 @@ class Grid:
             self.truncated = self.timed_out = True
         return self.timed_out
 
-    def fill(self):
+    def fill(self) -> dict:
         """{grid index: configuration} of the points reached, filled wave by wave (also
         ``self.sigma``: index -> relative singular value of the rows' Jacobian there)."""
         d = len(self.axes)

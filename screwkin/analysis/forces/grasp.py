@@ -241,7 +241,7 @@ def _separator(W: np.ndarray, tol: GraspTolerances) -> tuple:
 
 
 # ------------------------------------------------------------------ exact cone checks
-def _contact_forces(spec: GraspSpec, G, blocks, f) -> tuple:
+def _contact_forces(spec: GraspSpec, G: np.ndarray, blocks, f) -> tuple:
     out = []
     for k, (c, b) in enumerate(zip(spec.contacts, blocks), 1):
         fi = f[b]

@@ -44,7 +44,7 @@ _SPATIAL_BASIS = {"frictionless": ([2], ["n"]), "point_friction": ([0, 1, 2], ["
                   "soft_finger": ([0, 1, 2, 5], ["t1", "t2", "n", "torsion"])}
 
 
-def contact_columns(c: Contact, planar):
+def contact_columns(c: Contact, planar) -> tuple:
     """(G_i, labels) of one contact."""
     p = np.asarray(c.point, float)
     n = np.asarray(c.normal, float)
@@ -91,7 +91,7 @@ def grasp_characteristic_length(spec: GraspSpec) -> tuple:
     return L, "the mean distance of the contacts from their centroid"
 
 
-def scaled_points(p, L):
+def scaled_points(p, L) -> np.ndarray:
     """The weights of a wrench's p rows (3 planar, 6 spatial) that make it dimensionless: 1 on the
     forces, 1 / L on the moments (L the characteristic length [m])."""
     d = np.ones(p)

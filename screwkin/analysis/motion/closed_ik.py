@@ -77,7 +77,7 @@ def _residual(mech: Mechanism, q: np.ndarray, out_frame, pose) -> float:
     return max(loops, float(np.linalg.norm(err)))
 
 
-def _platform(solver: PositionSolver, output: str, out_frame, platform: Platform, P, pose, start):
+def _platform(solver: PositionSolver, output: str, out_frame, platform: Platform, P, pose, start) -> PositionResult | None:
     mech, model = solver.mech, solver.mech.model
     legs = []
     for leg in platform.legs:

@@ -235,7 +235,7 @@ class Curve:
     def unit(self) -> str:
         return "m" if self.mech.translational[self.ix] else "rad"
 
-    def input_directions(self, K: np.ndarray):
+    def input_directions(self, K: np.ndarray) -> np.ndarray:
         """The unnormalized tangents P e at configurations of constraint Jacobians K (N, m, nv)."""
         return projections(K, self.e[None].repeat(len(K), 0), self.scale, self.free, self.tol)
 
@@ -349,7 +349,7 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed at this input value") from None
 
-    def locate_limit(self, qa: np.ndarray, ta, qb: np.ndarray, held):
+    def locate_limit(self, qa: np.ndarray, ta, qb: np.ndarray, held) -> tuple:
         """The limit position between qa and qb (the input's tangent component changes sign),
         with joint ``held`` as the parameter: (configuration, input offset from qa)."""
         at = self._arc(qa, qb, held, None)

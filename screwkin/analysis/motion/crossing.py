@@ -152,7 +152,7 @@ def constraint_profile(mech: Mechanism, Q: np.ndarray, rank: int | None = None) 
     return np.where(top[:, 0] > 0, s[:, r - 1] / np.where(top[:, 0] > 0, top[:, 0], 1.0), 0.0), r
 
 
-def passed(solver, res) -> list:
+def passed(solver: PositionSolver, res) -> list:
     """The change points the recorded motion ``res`` (a SweepResult) meets, in the order of the motion
     (Crossing each): a configuration where the constraint measure (``constraint_profile``) is below
     Tolerances.singular -- at the start, at a dip between two recorded configurations (refined by
@@ -231,7 +231,7 @@ def _measure(mech: Mechanism, q: np.ndarray, rank: int) -> float:
     return float(constraint_profile(mech, [q], rank)[0][0])
 
 
-def _again(solver, out: list, res, k: int, lo_k, hi_k, bounds: list) -> tuple | None:
+def _again(solver: PositionSolver, out: list, res, k: int, lo_k, hi_k, bounds: list) -> tuple | None:
     """(x, configuration, measure) of a change point already found (in ``out``) that this dip is another
     pass of (a motion through limit positions passes one point again and again): its input within the
     dip's bounds, its joint centres nearer the recorded configuration k than the neighbours are; else None."""
@@ -243,7 +243,7 @@ def _again(solver, out: list, res, k: int, lo_k, hi_k, bounds: list) -> tuple | 
     return None
 
 
-def _least(solver, res, q: np.ndarray, bounds: list | tuple, rank, tight):
+def _least(solver: PositionSolver, res, q: np.ndarray, bounds: list | tuple, rank, tight) -> tuple | None:
     """(x, configuration, measure) where the constraint measure is least for the input within bounds, the
     loops closed again from q at each value (bounded minimization, to the closure tolerance); None
     where they cannot be closed there."""
@@ -405,7 +405,7 @@ def _reaches(solver: PositionSolver, curve: Curve, c: Crossing, rates, x, drawn)
 START = "the motion starts on it"
 
 
-def _local(solver, c: Crossing) -> LocalAnalysis:
+def _local(solver: PositionSolver, c: Crossing) -> LocalAnalysis:
     """The local analysis at the change point c, kept in the mechanism's cache by its configuration (to
     Tolerances.geometry): a motion through limit positions (``turn``) passes the same point again and again."""
     mech = solver.mech

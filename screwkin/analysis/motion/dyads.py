@@ -256,7 +256,7 @@ def _root(disc: Jet, clamp: bool):
         return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
 
 
-def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp: int | None = None):
+def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp: int | None = None) -> tuple:
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
     clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
     Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
@@ -424,7 +424,7 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs: list, branch=None, clamp: int | None = None):
+    def predict(self, xs: list, branch=None, clamp: int | None = None) -> tuple:
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
@@ -446,7 +446,7 @@ class ClosedFormCurve:
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
-    def locate_limit(self, lo, hi):
+    def locate_limit(self, lo, hi) -> tuple | None:
         """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
         position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
         on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
@@ -464,7 +464,7 @@ class ClosedFormCurve:
         return x_lim, Q, D, which
 
 
-def _ready(solver, name: str, q0: np.ndarray, start: float):
+def _ready(solver, name: str, q0: np.ndarray, start: float) -> ClosedFormCurve | None:
     """The ClosedFormCurve for sweeping ``name`` from q0, or None when the closed form does not apply."""
     p = cached_plan(solver, name)
     if isinstance(p, str):

@@ -247,7 +247,7 @@ class Stroke:
     crank_angles: tuple | None  # (forward, return) crank angles [rad] when time_ratio is known
 
 
-def _extrema(x: np.ndarray, p, dp, tol: Tolerances):
+def _extrema(x: np.ndarray, p, dp, tol: Tolerances) -> list:
     """(input value, coordinate) at each zero of dp/dx along the samples: the cubic Hermite
     interpolant of p on each bracket whose slope changes sign (accurate to O(h^4)), its vertex."""
     out = []

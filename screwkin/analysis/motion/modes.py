@@ -59,7 +59,7 @@ def continuum_words(free: int) -> str:
     return f"these inputs leave {free} degree{'s' if free != 1 else ''} of freedom free (a continuum)"
 
 
-def merge(solver, sols):
+def merge(solver, sols) -> list:
     """Solutions that are one root: a singular solution and others within the accuracy a
     double root can be computed to (about the square root of the closure tolerance), or
     joined to it by a motion with the inputs held (a continuum)."""

@@ -80,7 +80,7 @@ def wrist_arm(mech: Mechanism, out_frame: int, placement) -> Wrist | None:
     return Wrist(tuple(path), axes, points, c0, placements[-1] * placement)
 
 
-def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT):
+def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT) -> tuple:
     """(sets, complex, why, stretched): every real joint solution (t1, ..., t6) placing the output frame at
     T (a pinocchio.SE3), how many of the 8 are complex, why the closed form does not answer ("" when it
     does: the wrist centre on axis 1 or 2 -- a continuum -- or a degenerate first pair of axes leave it
@@ -170,7 +170,7 @@ def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT):
     return sets, n_complex * 2, ("" if sets else why), stretched
 
 
-def _stretched(axes, R: np.ndarray, tol: Tolerances):
+def _stretched(axes, R: np.ndarray, tol: Tolerances) -> list:
     """A stretched wrist (its last axis turned onto its first: joints 4 and 6 turn about one line, only their
     sum is fixed): [(None, t5, t6)] for each t5 that turns w6 onto +-w4, t6 with joint 4 at 0, else []."""
     w4, w5, w6 = axes

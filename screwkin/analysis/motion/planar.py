@@ -312,7 +312,7 @@ class LinkAngles:
         ends = self._ends(KinematicState(mech, mech.neutral()))
         self.links = {k: (start, ends[k], fid) for k, (start, _, fid) in self.links.items()}
 
-    def _ends(self, state: KinematicState):
+    def _ends(self, state: KinematicState) -> dict:
         """Choose each link's second point (KinematicState.centre's references, or ("axis", its frame)): the
         first candidate away from its first point at the configuration of ``state``."""
         out = {}

@@ -51,6 +51,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.mobility import MobilityResult
 
 __all__ = ["PositionSolver"]
 
@@ -143,7 +144,7 @@ class PositionSolver:
         free = len(self.passive) - g.rank_Kp - kept
         return max(free - self.idle_dofs, 0) if free > 0 else 0  # (idle DOFs, a mobility analysis: only if any is left)
 
-    def _mobility(self):
+    def _mobility(self) -> MobilityResult:
         self.generic()  # the assembly the mobility analysis starts from
         return analyze_mobility(self.mech)
 
@@ -191,7 +192,7 @@ class PositionSolver:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
 
-    def _wrap(self, q: np.ndarray):
+    def _wrap(self, q: np.ndarray) -> np.ndarray:
         q = np.array(q, float)
         _, _, _, _, idx, wrap = self.mech._value_layout()
         w = idx[wrap]
@@ -511,7 +512,7 @@ class PositionSolver:
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
 
-    def _input_vector(self, values: dict):
+    def _input_vector(self, values: dict) -> np.ndarray:
         x = np.zeros(len(self.frozen))
         for k, name in enumerate(self.inputs):
             x[k] = values.get(name, 0.0)
@@ -529,7 +530,7 @@ class PositionSolver:
         U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
         return (lambda b: Vt.T @ (inv * (U.T @ b))), s
 
-    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None):
+    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None) -> np.ndarray:
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
         the passive joints, so idle spins are zero).  A link held at an angle (link_inputs)
         turns at the rate ``values`` gives its name (0 when none): its row's K q' is that rate.
@@ -541,7 +542,7 @@ class PositionSolver:
             qd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qd[self.frozen])
         return qd
 
-    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None):
+    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None) -> np.ndarray:
         """Joint accelerations from K q'' = -K' q' with the input accelerations given (a held link's
         angular acceleration as its row's, as in ``rates``)."""
         qdd = np.zeros(self.mech.nv)

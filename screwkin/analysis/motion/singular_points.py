@@ -35,7 +35,7 @@ def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref: np.nda
     return S.J @ V
 
 
-def locate_singularities(solver: PositionSolver, res: SweepResult, output=None, xtol: float = LOCATE_XTOL, point: bool = False):
+def locate_singularities(solver: PositionSolver, res: SweepResult, output=None, xtol: float = LOCATE_XTOL, point: bool = False) -> list:
     """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
     positions the sweep located, and the other singularities.
 

@@ -432,7 +432,7 @@ def _once(notes) -> tuple:
     return tuple(dict.fromkeys(notes))
 
 
-def _engine_took(solver: PositionSolver, curve: Curve, res, k0, after, h) -> bool:
+def _engine_took(solver: PositionSolver, curve: Curve, res: SweepResult, k0, after, h) -> bool:
     """Whether the engine's recorded configurations from index k0 are ``after`` ((input value,
     configuration) each, the branch followed), the input running the way of h."""
     tol = solver.mech.tolerances
@@ -451,7 +451,7 @@ def _engine_took(solver: PositionSolver, curve: Curve, res, k0, after, h) -> boo
 GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index counts as on it
 
 
-def _change_point_note(solver, name: str, unit: str, cp: ChangePoint, why, branch: str) -> str:
+def _change_point_note(solver: PositionSolver, name: str, unit: str, cp: ChangePoint, why, branch: str) -> str:
     """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
     # (located where the constraint measure is least: to about the square root of the closure's round-off)
     at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
@@ -490,7 +490,7 @@ def _between(x, a, b) -> bool:
     return min(a, b) <= x <= max(a, b)
 
 
-def _joined(solver, res: SweepResult, head: SweepResult, middle, tail: SweepResult, named, notes, c):
+def _joined(solver: PositionSolver, res: SweepResult, head: SweepResult, middle, tail: SweepResult, named, notes, c):
     """head + middle + tail (SweepResults; middle or tail may be None): one motion."""
     parts = [p for p in (head, middle, tail) if p is not None and len(p.values)]
     cat = (lambda f: np.concatenate([getattr(p, f) for p in parts])) if parts else (lambda f: getattr(head, f))

@@ -161,7 +161,7 @@ class Tracker:
             m.stopped, m.reason = self.x, "the motion did not reach the end of the range"
         return m
 
-    def input_step(self):
+    def input_step(self) -> bool | int | None:
         """A step with the input held, to its next grid value or toward it: None when taken; else the
         joint to hold for an arc step instead (a limit position lies in this step, or the step was
         refused), or False when none can be held (the motion stops, said so)."""

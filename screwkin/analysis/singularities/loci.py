@@ -237,7 +237,7 @@ class LocusSystem:
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q: np.ndarray, v, t: np.ndarray, h, J: np.ndarray | None = None):
+    def along(self, q: np.ndarray, v, t: np.ndarray, h, J: np.ndarray | None = None) -> tuple | None:
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q
@@ -337,7 +337,7 @@ def _onto_edge(sys, q: np.ndarray, v, box):
     return None
 
 
-def _cusps(sys, qs, vs, ts):
+def _cusps(sys, qs, vs, ts) -> list:
     """Cusps on one traced curve: reversals of the plane's velocity between neighbouring points,
     each located by Brent's method on the arclength from the first point of the bracket."""
     out = []

@@ -38,7 +38,7 @@ def unexplained_folds(sheets, loci, box: tuple, n: int) -> list:
     return []
 
 
-def sheets(solver: PositionSolver, x_name: str, y_name: str, box: tuple, starts: int | None, n: int):
+def sheets(solver: PositionSolver, x_name: str, y_name: str, box: tuple, starts: int | None, n: int) -> list:
     """Each start continued over an n x n grid of the box from its nearest node: a list of
     (qs (n, n, nq) with NaN where not reached, refused (n, n) bool: a step from there refused)."""
     mech = solver.mech
@@ -113,7 +113,7 @@ def seed_configurations(sys, sheets) -> list:
     return [(q, s) for s, q in cands]
 
 
-def crossings(curves: list, box: tuple):
+def crossings(curves: list, box: tuple) -> list:
     """Points where two traces (or one with itself, away from its neighbours) cross: segment
     intersections of the polylines (the traces are dense: each segment is one continuation step)."""
     out = []

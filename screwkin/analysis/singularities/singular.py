@@ -367,7 +367,7 @@ def _pair_axis(mech: Mechanism, cut, state) -> tuple:
     return (spec, f1, f2, *pair_contact(spec, M1, state.frame_placement(f2)))
 
 
-def pair_twist(mech: Mechanism, cut, state: KinematicState) -> list:
+def pair_twist(mech: Mechanism, cut: CutJoint, state: KinematicState) -> list:
     """[(name, twist, False)]: the pair closed by ``cut`` as one twist (v at the world origin, w) at a
     unit rate of turning of F2's link relative to F1's.  A rolling or gear pair: a revolute about
     its axis through the contact point (model.cuts.pair_contact; pure rolling is that rotation);

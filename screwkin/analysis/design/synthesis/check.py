@@ -189,7 +189,7 @@ def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x, q_tar
     return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
-def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs, steps: int):
+def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs, steps: int) -> tuple:
     """(direction, travel per position, transmission angles along the motion, defects)."""
     name = design.input_joint
     tol = probe.mech.tolerances

@@ -39,7 +39,7 @@ def grashof_type(g, a, b, c, equal: float) -> list:
     return [names[int(k)] for k in codes]
 
 
-def mu_over(g, a, b, c, phi0, travel):
+def mu_over(g, a, b, c, phi0, travel) -> tuple:
     """(mu_min, mu_max) [rad] of four-bars over the crank's motion from phi0 (its angle from the ground
     line A0 -> B0) through ``travel`` (signed, [rad]; |travel| >= 2 pi: a full turn): at the two ends and
     at phi = 0 and pi when the motion passes them.  Arrays broadcast; NaN where z leaves [|b - c|, b + c]

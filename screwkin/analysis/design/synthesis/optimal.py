@@ -178,7 +178,7 @@ def _refine(x0, pts: np.ndarray, timing, direction, sigma: float, constraints, L
     return refined(residuals, x0, lo, hi, L)
 
 
-def _path_run(task):
+def _path_run(task) -> tuple:
     """One run of the path search (picklable: what a Dask worker computes): differential evolution (on
     at most SEARCHED points, evenly chosen, when there are more), then the refinement of its best
     distinct members on all the points.  Returns ([(x, sigma, direction)], generations)."""

@@ -79,7 +79,7 @@ def _errors(X: np.ndarray, names, task, signs, constraints: Constraints, equal, 
     return err, pen, (mu_lo, mu_hi)
 
 
-def _function_run(job):
+def _function_run(job) -> tuple:
     """One run (picklable: what a Dask worker computes): differential evolution on the precision points,
     then least squares from its best distinct members.  Returns ([(x, signs)], generations)."""
     task, names, constraints, signs, seed, generations, popsize, equal = job

@@ -118,7 +118,7 @@ def _solve2(G, r) -> np.ndarray:
     return np.where(np.isfinite(x), x, np.nan)
 
 
-def _moving(poses, A0: np.ndarray):
+def _moving(poses, A0: np.ndarray) -> np.ndarray:
     """The moving pivots (m, 2) of the dyads with fixed pivots A0 (m, 2) through the poses (3: exactly;
     4: on the centre-point curve, exactly)."""
     M = _burmester_rows(poses, A0)
@@ -165,7 +165,7 @@ def _motion_box(kind: str, poses, constraints, L) -> tuple[np.ndarray, np.ndarra
     return np.array([*plo, -3 * L, -3 * L, *plo, -3 * L, -3 * L]), np.array([*phi, 3 * L, 3 * L, *phi, 3 * L, 3 * L])
 
 
-def _motion_run(task):
+def _motion_run(task) -> tuple:
     """One run (picklable: what a Dask worker computes): differential evolution, then the refinement of
     its best distinct members (Nelder-Mead on the cost for exact kinds, least squares on the misses
     for free pivots).  Returns ([(A0, a, B0, b, direction)], generations)."""
@@ -198,7 +198,7 @@ def _motion_run(task):
     return out, nfev
 
 
-def _judge_motion(poses: list, A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, direction, constraints, L, tol, equal: float, run, exact: bool):
+def _judge_motion(poses: list, A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, direction, constraints: Constraints, L, tol, equal: float, run, exact: bool) -> tuple | None:
     R1, p1 = pose_matrix(poses[0])
     crank, rocker = Dyad(tuple(map(float, A0)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))), \
         Dyad(tuple(map(float, B0)), tuple(map(float, R1 @ b + p1)), tuple(map(float, b)))

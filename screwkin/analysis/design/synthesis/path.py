@@ -81,7 +81,7 @@ def _residuals(X: np.ndarray, pts: np.ndarray, timing, direction, sigma: float, 
     return np.concatenate([r, 10 * apart / L, np.maximum(travel - 0.98 * TWO_PI, 0.0)[:, None]], axis=1)
 
 
-def _problem(pts: np.ndarray, timing, direction, sigma: float, L):
+def _problem(pts: np.ndarray, timing, direction, sigma: float, L) -> tuple:
     """(fun, jac) for scipy: the Jacobian by central differences, all 2n designs in one call."""
     def fun(x):
         return _residuals(x[None], pts, timing, direction, sigma, L)[0]

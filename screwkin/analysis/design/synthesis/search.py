@@ -82,7 +82,7 @@ def task_seed(seed: int, index: int) -> int:
     return int(np.random.SeedSequence([int(seed), int(index)]).generate_state(1)[0])
 
 
-def evolve(cost, lower, upper, seed: int, generations: int = GENERATIONS, popsize: int = POPSIZE):
+def evolve(cost, lower, upper, seed: int, generations: int = GENERATIONS, popsize: int = POPSIZE) -> tuple:
     """Differential evolution (scipy, best1bin, Latin-hypercube start, deferred updating) of the
     vectorized ``cost`` (X (n, d) -> (n,)) over the box [lower, upper]: (population (m, d), costs (m,),
     evaluations)."""
