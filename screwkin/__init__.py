@@ -24,6 +24,8 @@ from .tolerances import Tolerances
 if TYPE_CHECKING:  # the return types of the methods below, imported lazily at run time
     from .analysis.design.study import StudyResult
     from .analysis.mobility import MobilityResult
+    from collections.abc import Callable
+    from pathlib import Path
 
 #: The rest of the public API, imported when first used (``screwkin.sweep``, ``from screwkin import
 #: scan``): ``import screwkin`` (and the command line, which imports it) loads the model layer
@@ -49,7 +51,7 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Callable:
     """The public name ``name`` from its module, imported now (PEP 562)."""
     if name not in _LAZY:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -103,7 +105,7 @@ class Mechanism(_mechanism.Mechanism):
     """A mechanism (screwkin.model.mechanism.Mechanism) with the analysis asked most often
     as a method: ``mech.mobility()``."""
 
-    def mobility(self, actuated=None, output=None, seed: int = 0, point: bool = False) -> MobilityResult:
+    def mobility(self, actuated=None, output: str | None=None, seed: int = 0, point: bool = False) -> MobilityResult:
         """Mobility analysis (screwkin.analysis.mobility.analyze_mobility); actuated: actuated
         joint names overriding the file's; point: the output link's origin as a point."""
         if actuated is not None:
@@ -111,7 +113,7 @@ class Mechanism(_mechanism.Mechanism):
         return __getattr__("analyze_mobility")(self, output=output, seed=seed, point=point)
 
 
-def load(path, yaml=None, actuated=None, tolerances: Tolerances = _loader.DEFAULT, warn=None,
+def load(path: str | Path, yaml=None, actuated: list | None=None, tolerances: Tolerances = _loader.DEFAULT, warn: Callable | None=None,
          package_dirs=None, args=None) -> Mechanism:
     """Read a mechanism file (URDF with <loop_joint> or a YAML sidecar, SDF, or a xacro file
     with its arguments ``args``, e.g. ``{"crank": "30mm"}``) into a :class:`Mechanism`; see

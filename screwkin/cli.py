@@ -91,7 +91,7 @@ class _Parser(argparse.ArgumentParser):
         return ns, rest
 
 
-def _invoked(argv) -> str | None:
+def _invoked(argv: list) -> str | None:
     """The command named on the command line: its first word that is not an option (the top-level
     options, --debug, --version and --help, take no value); None when there is none."""
     names = {name for name, _ in COMMANDS}
@@ -101,7 +101,7 @@ def _invoked(argv) -> str | None:
     return None
 
 
-def _parser(argv=()) -> _Parser:
+def _parser(argv: list=()) -> _Parser:
     """The parser: every command listed with its help line; the one ``argv`` invokes built in full
     (its module imported), the others as names only."""
     p = _Parser(prog="screwkin", description="Screw-theory analysis of spatial mechanisms described in URDF.")
@@ -118,7 +118,7 @@ def _parser(argv=()) -> _Parser:
     return p
 
 
-def _run(args: argparse.Namespace):
+def _run(args: argparse.Namespace) -> int:
     command = command_module(args.command)
     if not command.NEEDS_MECHANISM or (command.NEEDS_MECHANISM == "optional" and args.file is None):
         return command.run(None, args)
@@ -136,7 +136,7 @@ def _run(args: argparse.Namespace):
     return command.run(mech, args)
 
 
-def main(argv=None) -> int:
+def main(argv: list | None=None) -> int:
     """The command line.  Exit codes: 0 success, 1 invalid or unanalysable file, 2 usage
     error, 3 internal error (a bug: never caused by input), 141 when the reader of the
     output went away (``screwkin info F | head -1``): the shell's code for a process ended

@@ -45,7 +45,7 @@ def _escape(text: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
-def shorten(value, limit: int = QUOTE_LIMIT) -> str:
+def shorten(value: str, limit: int = QUOTE_LIMIT) -> str:
     """``value`` (a string, or any object by its bounded repr) as at most ``limit``
     characters plus "...", control characters escaped (the limit counts the escapes:
     ``\U0001d246`` is ten characters); never contains a newline."""
@@ -60,7 +60,7 @@ def shorten(value, limit: int = QUOTE_LIMIT) -> str:
     return "".join(out) + ("..." if len(text) > limit + 1 else "")
 
 
-def quote(value, limit: int = QUOTE_LIMIT) -> str:
+def quote(value: str, limit: int = QUOTE_LIMIT) -> str:
     """``'value'`` for a message: :func:`shorten` between single quotes; a value that is
     not a string (a YAML list, None) as its bounded repr, without quotes."""
     return f"'{shorten(value, limit)}'" if isinstance(value, str) else shorten(value, limit)
@@ -92,7 +92,7 @@ class MechanismFileError(ScrewkinError):
     :data:`MESSAGE_LIMIT` characters after the path.
     """
 
-    def __init__(self, path, problems) -> None:
+    def __init__(self, path: str, problems: str) -> None:
         if isinstance(problems, str):
             problems = [problems]
         self.path = str(path)
@@ -121,7 +121,7 @@ class AssemblyError(MechanismFileError):
     ``residual`` is how far apart its joint stays at least [m].
     """
 
-    def __init__(self, path, residual: float, iterations: int, detail: str = "", starts: int | None = None,
+    def __init__(self, path: str, residual: float, iterations: int, detail: str = "", starts: int | None = None,
                  reason: str | None = None, proved: bool = False, message: str | None = None) -> None:
         """``message``: the whole message where no search was made at all (a closed form's answer)."""
         self.residual = float(residual)

@@ -41,6 +41,10 @@ import re
 from dataclasses import dataclass
 
 from .errors import UsageError, quote
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["Quantity", "parse_quantity", "parse_value", "in_unit", "unit_text", "shown_unit", "parse_length",
            "parse_typed_assignments", "UNITS", "UNIT_TABLE", "unit_kind", "LENGTH_RANGE", "MAGNITUDES",
@@ -83,7 +87,7 @@ _CASE = {k: v[0] if len(v) == 1 else tuple(v) for k, v in _CASE.items()}
 LENGTH_RANGE = (1e-9, 1e4)
 
 
-def _canonical(unit: str):
+def _canonical(unit: str) -> str:
     if unit in UNIT_TABLE:
         return unit
     u = _CASE.get(unit.lower()) if unit.isascii() else None
@@ -115,7 +119,7 @@ def check_magnitude(value: float, kind: str, what: str) -> float:
     return value
 
 
-def unit_kind(unit: str):
+def unit_kind(unit: str) -> str | None:
     """The kind of a unit ('angle', 'length', 'angular rate', ...), or None for a bare number."""
     if not unit:
         return None
@@ -126,7 +130,7 @@ def unit_kind(unit: str):
 _NUMBER = re.compile(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*\Z")
 
 
-def _unit(text: str):
+def _unit(text: str) -> float:
     """The factor of a unit as typed (case-insensitive for ASCII units), or None."""
     if not text:
         return 1.0
@@ -184,7 +188,7 @@ def parse_value(text: str, kind: str | None = None, option: str | None = None) -
     return parse_quantity(text, kind, option).value
 
 
-def in_unit(value, unit: str):
+def in_unit(value: np.ndarray | float, unit: str) -> np.ndarray | float:
     """An SI value (or an array of them) written in ``unit`` as people type it, parse_value's inverse
     (``in_unit(math.pi, "deg")`` is 180.0, ``in_unit(0.03, "mm")`` is 30.0; SI for '')."""
     return value / parse_value("1" + unit.replace(" ", ""))
@@ -250,7 +254,7 @@ def parse_length(text: str, option: str) -> float:
     return value
 
 
-def parse_typed_assignments(items, option: str) -> list:
+def parse_typed_assignments(items: list | None, option: str) -> list:
     """``["a=45deg", "b=0.1,c=2mm"]`` -> ``[("a", Quantity(0.785..., "angle", "deg")), ("b", Quantity(0.1)),
     ("c", Quantity(0.002, "length", "mm"))]``: each value parsed once, with the unit as typed (to answer
     in the units a person used).  Several names may share one value: ``"leg1,leg2,leg3=0.41"`` gives

@@ -50,6 +50,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
 
 __all__ = ["LoopSystem", "Series", "loop_system", "ad", "split", "subalgebra", "BODY_JOINTS", "SEQUENTIAL_JOINTS"]
 
@@ -126,7 +127,7 @@ class LoopSystem:
             A[:, k] = self.coupled(self.stack(self.screws * y[:, None]), np.eye(n)[k])
         return A
 
-    def coupled(self, loops, x: np.ndarray) -> np.ndarray:
+    def coupled(self, loops: np.ndarray, x: np.ndarray) -> np.ndarray:
         """The loop rows followed by the coupling rows of the column rates x (and, for A only, the
         contacts' first-order rows)."""
         out = np.concatenate([loops, self.couplings @ x]) if len(self.couplings) else loops
@@ -221,7 +222,7 @@ def _units(mech: Mechanism, state: KinematicState) -> tuple:
     return units, carriers, by_joint, note
 
 
-def subalgebra(screws, tol) -> tuple:
+def subalgebra(screws: np.ndarray, tol: float) -> tuple:
     """("se(2)", normal) when every screw (v, w) lies in the planar motions normal to one direction,
     ("so(3)", point) when every one is a rotation about one point, else ("se(3)", None)."""
     rot = [s for s in screws if np.linalg.norm(s[3:]) > tol]
@@ -240,7 +241,7 @@ def subalgebra(screws, tol) -> tuple:
     return "se(3)", None
 
 
-def split(kind: str, where: str, S) -> tuple:
+def split(kind: str, where: str, S: np.ndarray) -> tuple:
     """(the part of twists S (..., 6) in the algebra, the part in its complement m): se(2) normal to
     n: (v - (v.n) n, (w.n) n) and ((v.n) n, w - (w.n) n); so(3) about p: (p x w, w) and (v - p x w, 0).
     m is invariant under the algebra's brackets, so motions of units in the algebra stay in it."""
@@ -266,7 +267,7 @@ def coordinates(kind: str, where: str) -> np.ndarray:
     return np.eye(6)
 
 
-def _cut_units(mech: Mechanism, cut, state: KinematicState, kind: str, where: str, L: float):
+def _cut_units(mech: Mechanism, cut: CutJoint, state: KinematicState, kind: str, where: str, L: float) -> list:
     """The cut joint's freedoms as world twists [(name, twist, sliding)] (screws.cut_twists); a ball's
     three rotations about axes that put the algebra's own rotation last (e1, e2, n in a plane)."""
     # a sliding contact closes through a planar cut joint (its contact row apart); a rolling, gear or screw

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility"]
 
@@ -108,7 +109,7 @@ class MobilityResult:
         return self.topology.motion_space
 
 
-def _body_frames(mech: Mechanism, topo) -> dict:
+def _body_frames(mech: Mechanism, topo: Topology) -> dict:
     """One body frame per link of the topology (not the ground)."""
     frames = {}
     for link in topo.links:
@@ -118,7 +119,7 @@ def _body_frames(mech: Mechanism, topo) -> dict:
     return frames
 
 
-def _joint_geometry_rows(mech: Mechanism, topo, frames, jac: dict, state: KinematicState) -> list:
+def _joint_geometry_rows(mech: Mechanism, topo: Topology, frames: dict, jac: dict, state: KinematicState) -> list:
     """Rows whose null space is the set of motions keeping every joint's geometry still.
 
     For each joint and each of its two links: the velocity (seen from that link)
@@ -169,7 +170,7 @@ def _joint_geometry_rows(mech: Mechanism, topo, frames, jac: dict, state: Kinema
     return rows
 
 
-def _idle(mech: Mechanism, topo, frames, q: np.ndarray, V: np.ndarray, output_link, tol) -> tuple:
+def _idle(mech: Mechanism, topo: Topology, frames: dict, q: np.ndarray, V: np.ndarray, output_link: str | None, tol: Tolerances) -> tuple:
     """Idle motions: motions that change no joint's geometry.
 
     Links joined to the rest by a single joint (free tips such as a serial
@@ -214,7 +215,7 @@ def _point_motion(link: str, T, tol) -> OutputMotion:
     return OutputMotion(link, dim, dim, 0, f"{dim}T", None, tuple(tuple(c) for c in U[:, :dim].T), True)
 
 
-def _output_motion(link: str, T, tol, origin) -> OutputMotion:
+def _output_motion(link: str, T: np.ndarray, tol: Tolerances, origin: np.ndarray) -> OutputMotion:
     dim = rank(T, tol)
     if dim == 0:
         return OutputMotion(link, 0, 0, 0, "0 (immobile)", None, ())
@@ -245,7 +246,7 @@ def _output_motion(link: str, T, tol, origin) -> OutputMotion:
     return OutputMotion(link, dim, t, r, label, center, tuple(tuple(col) for col in basis.T))
 
 
-def _classification(n: int, m, eff, overconstraint, topo: Topology, M) -> tuple:
+def _classification(n: int, m: int, eff: int, overconstraint: int, topo: Topology, M: int) -> tuple:
     """The classification and notes; a structure (no effective DOF) is statically determinate
     or not in its detected motion space: a planar triangle is determinate in the plane
     (Gruebler 0 = M), although 3 of its 5 spatial constraint rows are redundant."""
@@ -292,7 +293,7 @@ def _classification(n: int, m, eff, overconstraint, topo: Topology, M) -> tuple:
     return kind, tuple(notes)
 
 
-def analyze_mobility(mech: Mechanism, output=None, seed: int = 0, point: bool = False, at=None,
+def analyze_mobility(mech: Mechanism, output: str | None=None, seed: int = 0, point: bool = False, at=None,
                      suggest: bool = False, names: bool = False, progress=None) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
     its origin as a point (3 translations) instead of its full motion.  The mobility reported is the
@@ -320,7 +321,7 @@ def _local_notes(local, where: str, M_generic, generic_rank, samples: int) -> tu
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech: Mechanism, output, seed: int, point: bool, at=None, suggest: bool=False, names: bool=False, progress=None) -> MobilityResult:
+def _analyze(mech: Mechanism, output: str | None, seed: int, point: bool, at=None, suggest: bool=False, names: bool=False, progress=None) -> MobilityResult:
     tol = mech.tolerances
     if output is not None:
         out_frame = mech.link_frame(output)

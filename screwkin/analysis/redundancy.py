@@ -41,6 +41,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["JointRedundancy", "Suggestion", "Redundancy", "redundancy", "suggest", "CANONICAL"]
 
@@ -121,7 +123,7 @@ def _cut_words(mech: Mechanism) -> dict:
     return out
 
 
-def _directions(cut, state: KinematicState, tol) -> tuple:
+def _directions(cut: CutJoint, state: KinematicState, tol: Tolerances) -> tuple:
     """(e1, e2, e3, names): a joint's directions: e3 its axis when it has one ("the axis" and, when it is
     a world axis, its letter), e1 e2 across it (world axes when they are); else the world axes."""
     letters = {0: "x", 1: "y", 2: "z"}
@@ -140,7 +142,7 @@ def _directions(cut, state: KinematicState, tol) -> tuple:
     return e1, e2, a, ("a direction across the axis", "the other direction across it", "the axis")
 
 
-def _describe_span(W, at, dirs, L, tol) -> tuple[tuple, str]:
+def _describe_span(W: np.ndarray, at: np.ndarray, dirs: tuple, L: float, tol: Tolerances) -> tuple[tuple, str]:
     """(named canonical wrenches, words) of the span of wrenches W (k, 6) at point ``at`` (moment
     about the world origin): canonical when the span is that of some of the joint's six canonical
     wrenches, else each basis wrench as a screw."""
@@ -189,7 +191,7 @@ def _algebra(mech: Mechanism, q: np.ndarray) -> tuple:
     return kind, where, system.length
 
 
-def _why(mech: Mechanism, W, algebra):
+def _why(mech: Mechanism, W: np.ndarray, algebra: tuple) -> str:
     """Why a joint's redundant wrenches W (k, 6) are there: "planar" when every one does no work on the
     planar motions the tree's joints make (their screws all lie in one plane's se(2)), "spherical"
     likewise on the rotations about one point, "planar and overconstrained" when only some do, else
@@ -251,7 +253,7 @@ def redundancy(mech: Mechanism, q: np.ndarray, suggest_fix: bool = False) -> Red
                       qr_rank, found)
 
 
-def _per_joint(mech: Mechanism, q: np.ndarray, state: KinematicState, Lam, wrench_rows, owner: list) -> tuple:
+def _per_joint(mech: Mechanism, q: np.ndarray, state: KinematicState, Lam: np.ndarray, wrench_rows: list, owner: list) -> tuple:
     """JointRedundancy of every joint carrying part of the left null space."""
     algebra = _algebra(mech, q)
     out = []

@@ -51,7 +51,7 @@ class Screw:
 TRANSLATION_RATIO = 1e-6
 
 
-def screw_of(xi, length: float | None = None) -> Screw:
+def screw_of(xi: np.ndarray | list, length: float | None = None) -> Screw:
     """The screw of a twist (v, w); with ``length`` [m] a rotation about an axis farther than
     length / TRANSLATION_RATIO is read as the translation it is (round-off near a singularity)."""
     xi = np.asarray(xi, float)
@@ -77,7 +77,7 @@ class Chain:
     g0: np.ndarray  # 4x4 tool frame at the reference configuration
 
 
-def chains(mech: Mechanism, output=None) -> list:
+def chains(mech: Mechanism, output: str | None=None) -> list:
     """One chain per cut-joint side and one to the output link."""
     targets = []
     for c in mech.cuts:
@@ -87,7 +87,7 @@ def chains(mech: Mechanism, output=None) -> list:
     return chains_to(mech, targets)
 
 
-def chains_to(mech: Mechanism, targets) -> list:
+def chains_to(mech: Mechanism, targets: list) -> list:
     """The chain from the ground to each frame of ``targets`` ((name, frame id) pairs), read
     at the reference configuration (every joint at zero)."""
     model = mech.model
@@ -108,13 +108,13 @@ def chains_to(mech: Mechanism, targets) -> list:
     return out
 
 
-def joint_angles(mech: Mechanism, q: np.ndarray, chain):
+def joint_angles(mech: Mechanism, q: np.ndarray, chain: Chain) -> np.ndarray:
     """theta_i: each chain joint's displacement from the reference configuration."""
     dq = pin.difference(mech.model, mech.neutral(), q)
     return dq[list(chain.columns)]
 
 
-def poe(chain: Chain, theta) -> np.ndarray:
+def poe(chain: Chain, theta: np.ndarray) -> np.ndarray:
     """g(theta) = prod exp([xi_i] theta_i) g(0), as a 4x4 matrix."""
     M = pin.SE3.Identity()
     for k in range(len(chain.joints)):
@@ -122,7 +122,7 @@ def poe(chain: Chain, theta) -> np.ndarray:
     return M.homogeneous @ chain.g0
 
 
-def structure(mech: Mechanism, q: np.ndarray, output=None) -> list:
+def structure(mech: Mechanism, q: np.ndarray, output: str | None=None) -> list:
     """Per chain: reference twists, g(0), current twists (space Jacobian columns at q)."""
     state = KinematicState(mech, q)
     result = []
@@ -221,7 +221,7 @@ def loop_screws(mech: Mechanism) -> list:
     return out
 
 
-def loop_product(loop: LoopScrews, theta) -> np.ndarray:
+def loop_product(loop: LoopScrews, theta: list) -> np.ndarray:
     """The left side of the loop's equation, a 4x4 matrix, for joint displacements ``theta`` in loop
     order (the cut joint's as model.state.KinematicState.loop_value); the identity when the loop closes."""
     M = pin.SE3.Identity()
@@ -230,7 +230,7 @@ def loop_product(loop: LoopScrews, theta) -> np.ndarray:
     return M.homogeneous
 
 
-def planar_form(xi, normal) -> np.ndarray:
+def planar_form(xi: np.ndarray, normal: list | tuple) -> np.ndarray:
     """(v_x, v_y, w) of a planar twist in the plane's axes (e1, e2, n) (geometry.plane_basis: the axes
     the drawing, the vector loops and the link angles use)."""
     e1, e2, n = plane_basis(normal)
@@ -238,7 +238,7 @@ def planar_form(xi, normal) -> np.ndarray:
     return np.array([xi[:3] @ e1, xi[:3] @ e2, xi[3:] @ n])
 
 
-def split_jacobians(mech: Mechanism, q: np.ndarray, output, inputs=None) -> dict:
+def split_jacobians(mech: Mechanism, q: np.ndarray, output: str, inputs=None) -> dict:
     """Constraint Jacobian split into input and passive columns, and the forward
     (output twist from input rates) and inverse (input rates from output twist)
     Jacobians at q.  Output twists are (v, w) of the output frame origin in

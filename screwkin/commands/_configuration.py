@@ -27,7 +27,7 @@ __all__ = ["add_angle_option", "add_length_option", "add_configuration_options",
            "configuration", "mode_line", "file_configuration_line", "near_values", "with_mode", "moved_not_set"]
 
 
-def add_angle_option(sp) -> None:
+def add_angle_option(sp: argparse.ArgumentParser) -> None:
     """--set-angle: an input as a link's absolute angle (planar mechanisms)."""
     sp.add_argument("--set-angle", action="append", metavar="LINK=ANGLE",
                     help="planar mechanisms: an input given as the absolute angle of a link, from the ground's "
@@ -35,14 +35,14 @@ def add_angle_option(sp) -> None:
                          "link's angle is held by one more loop equation; its rate is --rate LINK=...")
 
 
-def add_length_option(sp) -> None:
+def add_length_option(sp: argparse.ArgumentParser) -> None:
     """--set-length: an input given as the length of a prismatic leg."""
     sp.add_argument("--set-length", action="append", metavar="JOINT=LENGTH",
                     help="a prismatic input given as its leg's length, the distance between the joint centres it "
                          "connects (e.g. leg1=0.418 or 418mm)")
 
 
-def add_configuration_options(sp) -> None:
+def add_configuration_options(sp: argparse.ArgumentParser) -> None:
     """--set, --set-angle, --set-length and --near: the configuration a command analyses (see configuration)."""
     sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="input values of the configuration")
     add_angle_option(sp)
@@ -51,14 +51,14 @@ def add_configuration_options(sp) -> None:
     add_mode_option(sp)
 
 
-def add_mode_option(sp, at: str = "the --set inputs") -> None:
+def add_mode_option(sp: argparse.ArgumentParser, at: str = "the --set inputs") -> None:
     """--mode K: the K-th assembly mode (configuration() chooses it and says which, of how many)."""
     sp.add_argument("--mode", type=count("mode"), metavar="K",
                     help=f"the K-th assembly mode of {at} (as solve lists them; default 1, the one nearest the "
                          "file's configuration)")
 
 
-def add_branch_option(sp, what: str = "the motion") -> None:
+def add_branch_option(sp: argparse.ArgumentParser, what: str = "the motion") -> None:
     """--branch continue|other: what a motion does at a change point (analysis.motion.sweep's branch)."""
     sp.add_argument("--branch", choices=BRANCHES, default=BRANCHES[0],
                     help=f"at a change point of {what} (branches of the motion cross: a parallelogram four-bar "
@@ -66,7 +66,7 @@ def add_branch_option(sp, what: str = "the motion") -> None:
                          "default: the parallelogram stays a parallelogram) or along the other one (other)")
 
 
-def input_solver(mech: Mechanism, inputs, held: dict | None = None, output=None) -> PositionSolver:
+def input_solver(mech: Mechanism, inputs: dict | list, held: dict | None = None, output=None) -> PositionSolver:
     """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
     ``held`` links' angles held by their loop equations (a copy of the mechanism:
     analysis.motion.link_inputs.holding_angles); none held, the plain solver of ``mech``."""
@@ -76,7 +76,7 @@ def input_solver(mech: Mechanism, inputs, held: dict | None = None, output=None)
     return PositionSolver(mech, inputs, output=output)
 
 
-def configuration(mech: Mechanism, args: argparse.Namespace, moved: dict | None = None, inputs=None):
+def configuration(mech: Mechanism, args: argparse.Namespace, moved: dict | None = None, inputs: list | None=None) -> np.ndarray:
     """The configuration a command analyses: solved for --set values (the assembly mode --mode K, else the
     first: the one nearest the file's or --near's), else the assembled file one.  When there are several
     modes, a line on stderr says which one is analysed and how to get the others, and ``args.mode_chosen``

@@ -22,6 +22,10 @@ import re
 from importlib import metadata
 
 from ..errors import UsageError, quote
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["screwkin_version", "check_writable", "check_folder_writable", "count", "whole", "seconds", "SECONDS", "check_parsed", "OUTPUT_DESTS", "check_outputs", "check_not_read", "check_picture", "PICTURES", "BOUNDS"]
 
@@ -98,7 +102,7 @@ def whole(text: str) -> int:
     return int(text.strip())
 
 
-def count(what: str):
+def count(what: str) -> Callable:
     """argparse type of a count bounded by ``BOUNDS[what]`` (whole numbers only: :func:`whole`)."""
     lo, hi = BOUNDS[what]
 
@@ -219,7 +223,7 @@ def _same_file(a: str, b: str) -> bool:
         return False
 
 
-def _overwritten(args: argparse.Namespace, outputs) -> None:
+def _overwritten(args: argparse.Namespace, outputs: list) -> None:
     """Refuse an output that would overwrite a file the command reads (the mechanism file, its sidecar
     given or found beside it, a spec) or another output of the same command line.  A device or a pipe
     (/dev/null, /dev/stdout) is written, not overwritten: it may take several outputs."""
@@ -268,7 +272,7 @@ def check_outputs(parser, args: argparse.Namespace) -> None:
         args.output_files = outputs
 
 
-def check_not_read(args: argparse.Namespace, files) -> None:
+def check_not_read(args: argparse.Namespace, files: list) -> None:
     """Refuse, once the model is read and before the work, an output that is one of ``files``: every file
     the model was read from (MechanismSpec.files_read: its MJCF or xacro includes, its meshes, its sidecar),
     which only reading the model finds."""

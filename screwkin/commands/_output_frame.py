@@ -26,7 +26,7 @@ class PointOption(argparse.Action):
     """``--point`` alone: the output link's origin analysed as a point (``args.point = True``, as
     before); ``--point NAME=LINK:x,y,z``: a named point on a link (``args.points``), repeatable."""
 
-    def __call__(self, parser, namespace, value, option_string=None) -> None:
+    def __call__(self, parser, namespace: argparse.Namespace, value: str | None, option_string: str | None=None) -> None:
         if value is None:
             namespace.point = True
         else:

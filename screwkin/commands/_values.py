@@ -51,7 +51,7 @@ _MAGNITUDE_KIND = {("angle", 0): "angle", ("angle", 1): "angular rate", ("angle"
                    ("length", 0): "length", ("length", 1): "linear rate", ("length", 2): "linear acceleration"}
 
 
-def _checked(mech: Mechanism, name: str, typed: Quantity, option: str, text: str, order: int = 0, links=()) -> Quantity:
+def _checked(mech: Mechanism, name: str, typed: Quantity, option: str, text: str, order: int = 0, links: tuple=()) -> Quantity:
     """``typed`` (parsed without a kind: its unit's) as the value (order 0), rate (1) or acceleration (2)
     of joint ``name``: the Quantity of that kind, or a usage error."""
     value, unit, found = typed.value, typed.unit, typed.kind
@@ -73,7 +73,7 @@ def _checked(mech: Mechanism, name: str, typed: Quantity, option: str, text: str
     return replace(typed, kind=_MAGNITUDE_KIND[kind, order]) if kind else typed
 
 
-def joint_quantities(mech: Mechanism, items, option: str, order: int = 0, links=()) -> dict:
+def joint_quantities(mech: Mechanism, items: list | None, option: str, order: int = 0, links: tuple=()) -> dict:
     """``NAME=VALUE,...`` of joints (order 0), their rates (1) or accelerations (2): joint -> units.Quantity
     (the SI value, the kind -- 'angle', 'angular rate', 'linear acceleration' ... -- and the unit typed);
     a unit of a kind the joint does not take (``crank=30mm``, ``crank=10rpm`` as a value) is a usage error,
@@ -95,7 +95,7 @@ def joint_quantities(mech: Mechanism, items, option: str, order: int = 0, links=
     return out
 
 
-def joint_assignments(mech: Mechanism, items, option: str, order: int = 0, links=()) -> dict:
+def joint_assignments(mech: Mechanism, items: list | None, option: str, order: int = 0, links: tuple=()) -> dict:
     """joint_quantities' SI values: joint -> value [rad, m, rad/s ...]."""
     return {name: q.value for name, q in joint_quantities(mech, items, option, order, links).items()}
 
@@ -196,7 +196,7 @@ def parse_range(text: str, option: str, mech: Mechanism) -> tuple:
     return name, np.linspace(a.value, b.value, n), (a if a.unit else b).shown_unit or "rad"
 
 
-def rate_items(items, inputs: list, option: str) -> list:
+def rate_items(items: list | None, inputs: list, option: str) -> list:
     """--rate, --accel (and dynamics' --speed) as typed, each made NAME=VALUE: the one grammar of every
     command (``--rate O2=120rpm``, repeatable, ``a,b=1``); a bare VALUE (``--rate 120rpm``) is the input's
     where there is exactly one input, a usage error naming the inputs otherwise."""

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -25,7 +26,7 @@ NAME = "screws"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
     common(sp)
     add_configuration_options(sp)

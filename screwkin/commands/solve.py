@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
     import numpy as np
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -35,7 +36,7 @@ NAME = "solve"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(sp)
     sp.add_argument("--set", action="append", metavar="NAME=VALUE",

@@ -46,7 +46,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
-    import numpy as np
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -54,7 +54,7 @@ NAME = "sweep"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint to move")
@@ -90,7 +90,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp)
 
 
-def _steps(text: str):
+def _steps(text: str) -> int:
     """--steps: within BOUNDS["steps"], or BOUNDS["streamed_steps"] for a streamed sweep (checked again in run)."""
     lo, hi = BOUNDS["steps"]
     try:
@@ -173,7 +173,7 @@ def _rates_line(args: argparse.Namespace) -> str:
             "another speed), at a constant input rate")
 
 
-def _rows_option(text: str):
+def _rows_option(text: str) -> str:
     if text is None or text.strip().lower() == "all":
         return None if text is None else "all"
     try:

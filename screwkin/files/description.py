@@ -13,6 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = [
     "TREE_JOINT_DOF",
@@ -134,7 +138,7 @@ def data_bytes(nv: int) -> float:
     return 64.0 * nv**3
 
 
-def placement(xyz, rpy):
+def placement(xyz: tuple, rpy: tuple) -> pin.SE3:
     """The pinocchio.SE3 of a URDF ``<origin xyz rpy>``."""
 
     return pin.SE3(pin.rpy.rpyToMatrix(np.asarray(rpy, float)), np.asarray(xyz, float))
@@ -208,7 +212,7 @@ class Coupling:
     offset: float
 
 
-def resolve_chains(links: dict, circle) -> list:
+def resolve_chains(links: dict, circle: Callable) -> list:
     """The Couplings of ``links`` (joint -> (joint it follows, multiplier, offset)), each resolved to the
     first joint of its chain: j = m k + o with k = m' p + o' gives j = (m m') p + (m o' + o).  A chain
     that goes round in a circle gives no coupling: ``circle(joint)`` is told (a reader's warning or
@@ -361,7 +365,7 @@ class MechanismSpec:
         return roots[0]
 
 
-def resolve_actuation(spec: MechanismSpec, actuated=None) -> tuple:
+def resolve_actuation(spec: MechanismSpec, actuated: list | None=None) -> tuple:
     """The actuated joint names and where they were declared.
 
     Precedence: the caller's list (the command line), the YAML ``name_mot``,

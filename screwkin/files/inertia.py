@@ -35,7 +35,7 @@ ROUNDING = 1e-6
 FLOOR = 1e-12
 
 
-def inertia_problem(mass, *inertia: Any) -> str | None:
+def inertia_problem(mass: float, *inertia: Any) -> str | None:
     """Why ``mass`` [kg] and the inertia tensor about the centre of mass [kg m^2] cannot be a rigid body's
     (one phrase, naming the numbers), or None when they can.  A mass of None (not given) is not checked.
 

@@ -48,7 +48,7 @@ def installed_package_roots() -> list:
     return out
 
 
-def _roots(base: Path, package_dirs=()) -> list:
+def _roots(base: Path, package_dirs: list=()) -> list:
     roots = [Path(d) for d in package_dirs or ()]
     roots += [base, *list(base.parents)[:2]]
     roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
@@ -60,7 +60,7 @@ def _roots(base: Path, package_dirs=()) -> list:
     return out
 
 
-def resolve_uri(uri: str, base: Path, package_dirs=(), roots=None):
+def resolve_uri(uri: str, base: Path, package_dirs: list=(), roots: list | None=None) -> list:
     """Candidate paths of a mesh URI: ``package://`` against ``package_dirs`` (the
     ``--package-dir`` folders), the file's folder and the two above it, and
     ``ROS_PACKAGE_PATH`` (``roots``: those folders, when already known); ``file://``
@@ -112,7 +112,7 @@ def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool
     return any(inside_folder(real, f) for f in folders)
 
 
-def locate_mesh(uri: str, base: Path, package_dirs=(), roots=None) -> tuple:
+def locate_mesh(uri: str, base: Path, package_dirs: list=(), roots: list | None=None) -> tuple:
     """(the first existing, allowed file among the candidates of ``uri`` or None, the resolved path
     of an existing candidate that was refused because it lies outside the allowed folders, or None)."""
     refused = None
@@ -131,7 +131,7 @@ def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
     return locate_mesh(uri, base, package_dirs, roots)[0]
 
 
-def check_meshes(path, root, package_dirs: list | tuple = (), found_list: list | None = None) -> list:
+def check_meshes(path: Path, root, package_dirs: list | tuple = (), found_list: list | None = None) -> list:
     """Warnings for mesh files that cannot be found (missing meshes do not fail a load); ``found_list``
     (a list), when given, gets the path of each mesh file found."""
     meshes = list(root.iter("mesh"))

@@ -39,7 +39,7 @@ def _replacement_type(t) -> str | None:
     return None
 
 
-def _string_list(content, key: str, problems: Problems, what: str = "joint names") -> list | None:
+def _string_list(content: dict, key: str, problems: Problems, what: str = "joint names") -> list | None:
     """content[key] as a list of strings (None when absent), with a problem for anything else."""
     value = content.get(key)
     if value is None:
@@ -56,7 +56,7 @@ def _string_list(content, key: str, problems: Problems, what: str = "joint names
     return out
 
 
-def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, frame_body=None) -> None:
+def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, frame_body: dict | None=None) -> None:
     """Add the loops, actuation and joint replacements of an Extended-URDF sidecar.
 
     ``frame_names`` are the frames of the Pinocchio model of the tree: the YAML

@@ -44,7 +44,7 @@ __all__ = ["read_urdf", "numbers", "unit_axis", "check_tree", "check_sizes", "Pr
 class Problems(list):
     """Collects every problem of a file before failing."""
 
-    def fail_if_any(self, path):
+    def fail_if_any(self, path: Path) -> None:
         if self:
             raise MechanismFileError(path, list(self))
 
@@ -54,7 +54,7 @@ _NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\Z")
 _NONFINITE = re.compile(r"[-+]?(?:nan|inf|infinity)\Z", re.IGNORECASE)
 
 
-def numbers(text: str, count: int, what: str, problems, default, bound=None, unit: str = "m", low=None) -> tuple:
+def numbers(text: str, count: int, what: str, problems: list | Problems, default: tuple, bound: float | None=None, unit: str = "m", low: float | None=None) -> tuple:
     """Parse ``count`` floats from an attribute; record a problem when invalid.
 
     bound: largest magnitude accepted (see :class:`~screwkin.files.description.Limits`);
@@ -86,7 +86,7 @@ def numbers(text: str, count: int, what: str, problems, default, bound=None, uni
     return values
 
 
-def unit_axis(values, what: str, problems, default=(1.0, 0.0, 0.0)) -> tuple:
+def unit_axis(values: tuple, what: str, problems: Problems, default: tuple=(1.0, 0.0, 0.0)) -> tuple:
     """``values`` scaled to length 1 (safely: divided by the largest magnitude first);
     records a problem for a zero axis or one whose length Pinocchio cannot normalize."""
     v = np.asarray(values, float)
@@ -103,7 +103,7 @@ def unit_axis(values, what: str, problems, default=(1.0, 0.0, 0.0)) -> tuple:
     return tuple(u / np.linalg.norm(u))
 
 
-def _axis(elem, what: str, problems: Problems, default=(1.0, 0.0, 0.0)) -> tuple:
+def _axis(elem, what: str, problems: Problems, default: tuple=(1.0, 0.0, 0.0)) -> tuple:
     if elem is None or elem.get("xyz") is None:  # urdfdom's default: the x axis
         return tuple(default)
     before = len(problems)
@@ -151,7 +151,7 @@ def _link(elem, problems: Problems) -> LinkSpec:
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry, inertia_problem=impossible)
 
 
-def _name_and_type(elem, tag: str, kind: str, types, problems: Problems) -> tuple | None:
+def _name_and_type(elem, tag: str, kind: str, types: dict, problems: Problems) -> tuple | None:
     """(name, type, 'kind NAME') of a <joint> or <loop_joint>, or None after recording why."""
     name = elem.get("name")
     if not name:
@@ -210,7 +210,7 @@ def _joint(elem, links: dict, problems: Problems) -> JointSpec | None:
     return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic, **dyn)
 
 
-def _loop_joint(elem, links: dict, problems: Problems, warnings) -> CutJointSpec | None:
+def _loop_joint(elem, links: dict, problems: Problems, warnings: list) -> CutJointSpec | None:
     head = _name_and_type(elem, "loop_joint", "loop joint", CUT_JOINT_DOF, problems)
     if head is None:
         return None
@@ -344,7 +344,7 @@ def _pair_parameters(elem, jtype, what: str, axis, problems: Problems) -> dict |
     return None if len(problems) > n0 else out
 
 
-def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: int | None = None):
+def check_sizes(path: str | Path, links: int, joints: int, loop_joints: int, coordinates: int | None = None) -> None:
     """Refuse a file beyond :data:`~screwkin.files.description.LIMITS` (before Pinocchio builds anything)."""
     for count, limit, what in ((links, LIMITS.links, "links"), (joints, LIMITS.joints, "joints"),
                                (loop_joints, LIMITS.loop_joints, "loop joints")):
@@ -358,7 +358,7 @@ def check_sizes(path, links: int, joints: int, loop_joints: int, coordinates: in
                   f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
-def check_tree(path, links: dict, joints: list, problems: Problems) -> None:
+def check_tree(path: Path, links: dict, joints: list, problems: Problems) -> None:
     """Record problems that keep the joints from forming one tree over the links."""
     parent_of = {}
     for j in joints:
@@ -473,7 +473,7 @@ def read_urdf(path: Path, text: str, root=None, package_dirs: list | tuple = ())
 _MOVING_1DOF = ("revolute", "continuous", "prismatic")
 
 
-def _couplings(joints: list, problems: Problems, warnings) -> list:
+def _couplings(joints: list, problems: Problems, warnings: list) -> list:
     """The ``<mimic>`` couplings, each resolved to the first joint of its chain (a gear train
     written 'idler mimics input, output mimics idler' couples the output to the input):
     j = m * k + o with k = m' * p + o' gives j = (m m') p + (m o' + o).  A <mimic> that cannot

@@ -16,6 +16,10 @@ from __future__ import annotations
 
 from ..errors import quote
 from .description import Transmission
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["read_transmissions"]
 
@@ -33,7 +37,7 @@ def _kind(t) -> str:
     return t.get("type") or ""
 
 
-def read_transmissions(root, joints: list, loop_names: set, warnings, mimics: dict, numbers) -> tuple:
+def read_transmissions(root, joints: list, loop_names: set, warnings: list, mimics: dict, numbers: Callable) -> tuple:
     """(joint names of the ``<transmission>`` elements in order, Transmission of each with a
     reduction other than 1).  ``numbers``: files.urdf's reader of numbers (passed in: that module
     calls this one).  A transmission naming a fixed joint, a loop joint, a joint that
@@ -76,7 +80,7 @@ def read_transmissions(root, joints: list, loop_names: set, warnings, mimics: di
     return names, inputs
 
 
-def _reduction(t, what: str, warnings, numbers, others) -> float:
+def _reduction(t, what: str, warnings: list, numbers: Callable, others: list) -> float:
     """The SimpleTransmission's reduction (1 when none is written or it cannot be used, said)."""
     found = [(path, e) for path in _REDUCTION for e in t.findall(path)]
     for e in t.findall("joint/offset"):

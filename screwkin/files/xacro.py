@@ -80,7 +80,7 @@ def _xacro_tag(tag: str):
     return None
 
 
-def is_xacro(path, text: str) -> bool:
+def is_xacro(path: Path, text: str) -> bool:
     """A xacro file: its name ends in ``.xacro`` or it declares the ``xacro`` namespace."""
     return str(path).lower().endswith(".xacro") or re.search(r"xmlns:xacro\s*=", text) is not None
 
@@ -110,7 +110,7 @@ def _arg_value(name: str, value, where: str) -> str:
     return repr(number)
 
 
-def normalize_args(args, where: str = "arguments") -> dict:
+def normalize_args(args: dict, where: str = "arguments") -> dict:
     """{name: value} (numbers, text with units) -> {name: text for xacro}, names checked."""
     out = {}
     for name, value in dict(args or {}).items():

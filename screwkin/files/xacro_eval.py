@@ -74,7 +74,7 @@ def _describe(node) -> str:
     return type(node).__name__
 
 
-def _check_node(node) -> None:
+def _check_node(node):
     if isinstance(node, ast.Expression):
         return _check_node(node.body)
     if isinstance(node, ast.Constant):

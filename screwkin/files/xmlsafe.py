@@ -42,7 +42,7 @@ def inside_folder(path, folder) -> bool:
         return False
 
 
-def read_regular_file(path, max_bytes: int, what: str = "file") -> bytes:
+def read_regular_file(path: Path, max_bytes: int, what: str = "file") -> bytes:
     """The bytes of ``path``, refusing what is not a regular file and files over ``max_bytes``.
 
     The file is opened without blocking and checked with fstat, so a named pipe is
@@ -85,7 +85,7 @@ def read_regular_file(path, max_bytes: int, what: str = "file") -> bytes:
         os.close(fd)
 
 
-def parse_xml_text(text: str, path) -> ET.Element:
+def parse_xml_text(text: str, path: Path) -> ET.Element:
     """Parse ``text`` (the contents of ``path``) and return the root element.
 
     The elements are counted and their nesting measured while parsing, so a file of a
@@ -144,7 +144,7 @@ def _dashes_in_comment(text: str, line: int, column: int) -> tuple | None:
     return text.count("\n", 0, dashes) + 1, text.count("\n", 0, start) + 1
 
 
-def _safe_loader():
+def _safe_loader() -> type:
     import yaml  # lazily: only sidecars and study specs are YAML (7 ms)
 
     class _NoAliasLoader(yaml.SafeLoader):
@@ -169,7 +169,7 @@ def _safe_loader():
     return _NoAliasLoader
 
 
-def load_yaml_text(text: str, path):
+def load_yaml_text(text: str, path: Path) -> dict:
     """The plain data of a YAML document from a user (see the module's notes)."""
     import yaml  # lazily: only sidecars and study specs are YAML (7 ms)
 

@@ -10,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 
 
-def frame_jacobian(model: pin.Model, data, frame: int, reference, placement=None):
+def frame_jacobian(model: pin.Model, data: pin.Data, frame: int, reference: pin.ReferenceFrame, placement=None) -> np.ndarray:
     """pinocchio.getFrameJacobian as a (6, nv) matrix (after computeJointJacobians); with ``placement``
     (a pinocchio.SE3) ``frame`` is a joint id and the frame the one at ``placement`` in that joint.
     Pinocchio 4.1's getFrameJacobian crashes the process (signal 11) for a model without
@@ -21,7 +21,7 @@ def frame_jacobian(model: pin.Model, data, frame: int, reference, placement=None
     return pin.getFrameJacobian(model, data, *where, reference).reshape(6, model.nv)
 
 
-def compute_frame_jacobian(model: pin.Model, data, q: np.ndarray, frame: int, reference):
+def compute_frame_jacobian(model: pin.Model, data: pin.Data, q: np.ndarray, frame: int, reference: pin.ReferenceFrame) -> np.ndarray:
     """pinocchio.computeFrameJacobian as a (6, nv) matrix."""
     return pin.computeFrameJacobian(model, data, q, frame, reference).reshape(6, model.nv)
 
@@ -32,7 +32,7 @@ FRAME_PREFERENCE = (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED
                     pin.FrameType.SENSOR)
 
 
-def frame_id(model: pin.Model, name: str, prefer=FRAME_PREFERENCE):
+def frame_id(model: pin.Model, name: str, prefer: tuple=FRAME_PREFERENCE) -> int:
     """Id of the frame named ``name`` (None when there is none).  When several frames
     share the name, the first of the types in ``prefer`` wins -- by default the BODY
     frame (the link), where ``model.getFrameId(name)`` raises "Several frames match"."""
@@ -47,7 +47,7 @@ def frame_id(model: pin.Model, name: str, prefer=FRAME_PREFERENCE):
     return matches[0]
 
 
-def joint_axis(joint) -> np.ndarray:
+def joint_axis(joint: pin.JointModel) -> np.ndarray:
     """The axis of a one-coordinate revolute or prismatic joint model in its own frame: x, y or z for
     the aligned models (RX, RUBZ, PY ...), the model's own axis for the unaligned ones."""
     short = joint.shortname()

@@ -46,7 +46,7 @@ class _Names:
     """The links of a loop's sides, looked up when first read (a sentence is written only for a loop
     that cannot close)."""
 
-    def __init__(self, mech, path1, ground, path2) -> None:
+    def __init__(self, mech, path1: list, ground, path2: list) -> None:
         self.mech, self.parts = mech, (path1, ground, path2)
         self._names = None
 
@@ -72,7 +72,7 @@ class _Names:
         return self._all()[k]
 
 
-def obstacle_of(cut: str, names, sides: list, tol: float) -> tuple | None:
+def obstacle_of(cut: str, names: _Names, sides: list, tol: float) -> tuple | None:
     """(why the loop ``cut`` cannot close, by how much its longest side is too long [m]) when its longest
     side (of ``sides``, the lengths of the links ``names``) is longer than the others together (beyond
     ``tol``); None otherwise."""

@@ -21,7 +21,7 @@ TINY = 1e-300  # division guard
 AXIS_IN_PLANE = 1e-6
 
 
-def perpendicular_basis(a) -> tuple:
+def perpendicular_basis(a: np.ndarray | list | tuple) -> tuple:
     """Two unit vectors (b1, b2) completing the unit vector ``a`` to a right-handed basis
     (b1, b2, a): b1 = a x h / |a x h| with h the world x axis (y when a is near x), b2 = a x b1.
 
@@ -36,7 +36,7 @@ def perpendicular_basis(a) -> tuple:
     return b1, b2
 
 
-def plane_basis(normal) -> tuple:
+def plane_basis(normal: np.ndarray | list | tuple) -> tuple:
     """(e1, e2, n): e1 the world x axis projected into the plane (the world y axis when x is
     normal to it), e2 = n x e1, so angles from e1 are counterclockwise seen from +n.
 
@@ -52,13 +52,13 @@ def plane_basis(normal) -> tuple:
     raise ValueError("degenerate normal")  # pragma: no cover
 
 
-def cross2(u, w):
+def cross2(u: np.ndarray | list, w: np.ndarray | list) -> float:
     """The z component of u x w for plane vectors (..., 2): > 0 when w turns counterclockwise from u."""
     u, w = np.asarray(u, float), np.asarray(w, float)
     return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 
 
-def circle_circle(p, r, c, s, side) -> tuple:
+def circle_circle(p: np.ndarray | list, r: float, c: np.ndarray | list, s: float, side: np.ndarray | float) -> tuple:
     """The intersection of the circle (centre p, radius r) and the circle (c, s) in the plane
     on the ``side`` (+1: left of the line p -> c, -1: right), broadcast over points (..., 2):
     (X, h2), h2 the squared distance of X from the line p -> c; h2 < 0 where the circles do
@@ -80,7 +80,7 @@ def circle_circle(p, r, c, s, side) -> tuple:
     return p + along[..., None] * u + (side * h)[..., None] * n, h2
 
 
-def circle_intersections(p, r, c, s, slack: float = 0.0, concentric: float = 0.0) -> list:
+def circle_intersections(p: np.ndarray | list, r: float, c: np.ndarray | list, s: float, slack: float = 0.0, concentric: float = 0.0) -> list:
     """The points where the circles (p, r) and (c, s) in the plane meet: [left of p -> c,
     right], the same point twice where they touch, [] where they do not meet (the centres
     closer than ``concentric``, or farther than r + s + slack, or nearer than |r - s| - slack).
@@ -95,7 +95,7 @@ def circle_intersections(p, r, c, s, slack: float = 0.0, concentric: float = 0.0
     return [circle_circle(p, r, c, s, side)[0] for side in (1.0, -1.0)]
 
 
-def line_foot(x, point, direction):
+def line_foot(x: np.ndarray | list, point: np.ndarray | list, direction: np.ndarray | list) -> np.ndarray:
     """The point of the line through ``point`` along the unit vector ``direction`` nearest x.
 
     >>> line_foot([3.0, 4.0], [0.0, 1.0], [1.0, 0.0]).tolist()
@@ -105,7 +105,7 @@ def line_foot(x, point, direction):
     return point + ((x - point) @ direction) * direction
 
 
-def line_circle(point, direction: np.ndarray, centre, radius) -> list:
+def line_circle(point: np.ndarray | list, direction: np.ndarray, centre: np.ndarray | list, radius: float) -> list:
     """The points where the line through ``point`` along the unit vector ``direction`` meets the
     circle (sphere) (centre, radius): [behind, ahead] along ``direction`` (the foot twice where it
     touches), [] where it passes farther than the radius.
@@ -122,7 +122,7 @@ def line_circle(point, direction: np.ndarray, centre, radius) -> list:
     return [foot - h * direction, foot + h * direction]
 
 
-def lines_point(points, directions, tol: float) -> tuple:
+def lines_point(points: list, directions: np.ndarray | list, tol: float) -> tuple:
     """(c, d): the point c nearest, in least squares, the 3-D lines through ``points`` along
     ``directions`` (sum (I - u u^T) (c - p) = 0, u the unit directions), and the largest distance d
     of a line from it; (None, inf) where the lines are parallel (that system's rank, by ``tol``,
@@ -145,13 +145,13 @@ def lines_point(points, directions, tol: float) -> tuple:
     return c, max(np.linalg.norm(P @ (c - p)) for P, p in projections)
 
 
-def _cross_norm(u: np.ndarray, w):
+def _cross_norm(u: np.ndarray, w: np.ndarray) -> np.ndarray | float:
     if u.shape[-1] == 2:
         return np.abs(cross2(u, w))
     return np.linalg.norm(np.cross(u, w), axis=-1)
 
 
-def wrap_angle(a, upper: bool = False):
+def wrap_angle(a: np.ndarray | float, upper: bool = False) -> np.ndarray | float:
     """An angle [rad] brought into [-pi, pi), or into (-pi, pi] with ``upper`` (where atan2 and
     Pinocchio's continuous joints put it); a float for a number, an array for an array.
 
@@ -163,7 +163,7 @@ def wrap_angle(a, upper: bool = False):
     return float(w) if w.ndim == 0 else w
 
 
-def nearest_turn(angle, ref):
+def nearest_turn(angle: np.ndarray | float, ref: np.ndarray | float) -> np.ndarray | float:
     """``angle`` [rad] moved by the whole turns that bring it nearest ``ref`` (within half a turn;
     exactly half a turn away, the even number of turns), broadcast; a float for numbers.
 
@@ -175,7 +175,7 @@ def nearest_turn(angle, ref):
     return float(w) if w.ndim == 0 else w
 
 
-def vector_angle(u, w):
+def vector_angle(u: np.ndarray | tuple, w: np.ndarray | tuple) -> float:
     """The angle between vectors u and w, in [0, pi] [rad] (atan2 of |u x w| and u . w: exact
     near 0 and pi, where arccos of the cosine is not).
 
@@ -186,7 +186,7 @@ def vector_angle(u, w):
     return np.arctan2(_cross_norm(u, w), np.sum(u * w, axis=-1))
 
 
-def line_angle(u, w: np.ndarray):
+def line_angle(u: np.ndarray | tuple, w: np.ndarray) -> np.ndarray | float:
     """The angle between the lines along u and w, in [0, pi/2] [rad].
 
     >>> float(line_angle([1.0, 0.0], [-1.0, 1.0]))  # doctest: +ELLIPSIS
@@ -197,7 +197,7 @@ def line_angle(u, w: np.ndarray):
 
 
 # ------------------------------------------------------------------ cross products, fast
-def cross3(a, b) -> np.ndarray:
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product of two 3-vectors (numpy.cross costs about 35 us a call here: it was
     70% of a sweep step in a profile; this costs about 1 us)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
@@ -212,7 +212,7 @@ def cross_last(a, b) -> np.ndarray:
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
-def skew(a):
+def skew(a: np.ndarray) -> np.ndarray:
     """The cross-product matrix [a]x of a 3-vector (a x b = [a]x b)."""
     return a[_SKEW_INDEX] * _SKEW_SIGN
 
@@ -221,7 +221,7 @@ _SKEW_INDEX = np.array([[0, 2, 1], [2, 0, 0], [1, 0, 0]])
 _SKEW_SIGN = np.array([[0.0, -1.0, 1.0], [1.0, 0.0, -1.0], [-1.0, 1.0, 0.0]])
 
 
-def _skew_table(k: int, m=None):
+def _skew_table(k: int, m: int | None=None) -> tuple:
     """Index and sign tables that turn the columns of a 3 x k matrix, flattened column by
     column, into their stacked cross-product matrices (3k x 3); with m, columns j and m + j
     side by side (3m x 6)."""
@@ -239,14 +239,14 @@ def _skew_table(k: int, m=None):
 _SKEW_TABLES = {}
 
 
-def skews(U: np.ndarray, m=None):
+def skews(U: np.ndarray, m: int | None=None) -> np.ndarray:
     """The cross-product matrices of the columns of U (3 x k), stacked (3k x 3); with m,
     columns j and m + j side by side ((3m x 6): [[u_j]x, [u_m+j]x])."""
     index, sign = _skew_table(U.shape[1], m)
     return U.T.ravel()[index] * sign
 
 
-def skews_batch(U, m=None):
+def skews_batch(U: np.ndarray, m=None) -> np.ndarray:
     """skews for a stack: U (n, 3, k) -> (n, 3k, 3), or (n, 3m, 6) with m."""
     n, _, k = U.shape
     index, sign = _skew_table(k, m)
@@ -265,12 +265,12 @@ def quaternion_matrix(q: np.ndarray) -> np.ndarray:
         np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z], -1)], -2)
 
 
-def stack_mm(A, B):
+def stack_mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """3 x 3 products over the trailing (stack) axes: A (3, 3, ...), B (3, 3, ...)."""
     return A[:, 0, None] * B[None, 0] + A[:, 1, None] * B[None, 1] + A[:, 2, None] * B[None, 2]
 
 
-def stack_mv(A, v):
+def stack_mv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     """A (3, 3, ...) times v (3, ...)."""
     return A[:, 0] * v[0] + A[:, 1] * v[1] + A[:, 2] * v[2]
 

@@ -41,7 +41,7 @@ class Leg:
     centre: tuple
 
 
-def distance_legs(model: pin.Model, cuts, frozen: set, length: float, keep_frames=(), tol: float = DEFAULT.geometry) -> list:
+def distance_legs(model: pin.Model, cuts: list, frozen: set, length: float, keep_frames: list=(), tol: float = DEFAULT.geometry) -> list:
     """The legs of ``cuts`` that are distance constraints (see the module), with the inputs at the
     velocity indices ``frozen`` held; ``keep_frames``: frames that must not lie on a leg (an output);
     ``tol``: the geometric tolerance (axes meeting, a distance constant), relative to the length."""

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 __all__ = ["link_lengths", "characteristic_length"]
 
 
-def link_lengths(model: pin.Model, cuts) -> list:
+def link_lengths(model: pin.Model, cuts: list) -> list:
     """The length of each rigid body of the model that has one: the largest distance between
     two joint centres on it (the origin of the joint that carries it, the origins of the
     joints it carries, and the frames of the cut joints on it), as written in the file --
@@ -41,7 +41,7 @@ def link_lengths(model: pin.Model, cuts) -> list:
     return lengths
 
 
-def characteristic_length(model: pin.Model, cuts) -> float:
+def characteristic_length(model: pin.Model, cuts: list) -> float:
     """The characteristic length L of a mechanism [m]: the mean length of its links
     (:func:`link_lengths`), 1 m when no link has a length.  Every measure that mixes
     translations and rotations divides translations by L (and multiplies the rates of

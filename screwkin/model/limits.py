@@ -45,7 +45,7 @@ def _outside(mech: Mechanism, Q: np.ndarray) -> np.ndarray:
     return out
 
 
-def spelled_within_limits(mech: Mechanism, q: np.ndarray):
+def spelled_within_limits(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     """q, or where joints of q lie outside the file's limits, the angle set of the same pose within them
     where one exists: a universal joint's flipped set (a, b) -> (a + pi, pi - b) with its leg spun about
     its own line, a spherical joint's other Euler set (model.leg_chains.respell: the legs of a

@@ -11,7 +11,7 @@ if TYPE_CHECKING:
 __all__ = ["rank", "null_space", "singular_values"]
 
 
-def _square(A: np.ndarray):
+def _square(A: np.ndarray) -> np.ndarray:
     """A matrix with the singular values and right singular vectors of A: A itself, or for a
     tall A (m > 2n rows) the triangular factor R of its QR factorization (A^T A = R^T R),
     several times cheaper to decompose than A (the idle-motion rows of a 500-joint chain:
@@ -21,7 +21,7 @@ def _square(A: np.ndarray):
     return A
 
 
-def singular_values(A) -> np.ndarray:
+def singular_values(A: np.ndarray) -> np.ndarray:
     """Singular values of A, largest first (none for an empty matrix)."""
     A = np.asarray(A, float)
     if A.size == 0:
@@ -29,7 +29,7 @@ def singular_values(A) -> np.ndarray:
     return np.linalg.svd(_square(A), compute_uv=False)
 
 
-def rank(A, tol: Tolerances) -> int:
+def rank(A: np.ndarray, tol: Tolerances) -> int:
     """Numerical rank: singular values above ``tol.rank_rtol * sigma_max`` and ``tol.rank_atol``."""
     s = singular_values(A)
     if s.size == 0 or s[0] <= tol.rank_atol:
@@ -37,7 +37,7 @@ def rank(A, tol: Tolerances) -> int:
     return int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
 
 
-def null_space(A, tol: Tolerances, n: int | None = None) -> np.ndarray:
+def null_space(A: np.ndarray, tol: Tolerances, n: int | None = None) -> np.ndarray:
     """Orthonormal basis (columns) of the null space of A (A has n columns)."""
     A = np.asarray(A, float)
     n = A.shape[1] if n is None else n

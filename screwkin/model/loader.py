@@ -36,6 +36,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.files.description import MechanismSpec
+    from collections.abc import Callable
+    from collections.abc import Iterator
 
 __all__ = ["load", "rebuild"]
 
@@ -51,7 +53,7 @@ def _read_text(path: Path) -> str:
         raise MechanismFileError(path, "not a text file (not UTF-8)") from None
 
 
-def _find_sidecar(path: Path):
+def _find_sidecar(path: Path) -> Path | None:
     """``FILE.yaml`` or ``FILE.yml`` beside the file, if there is one (whatever it is:
     a pipe or a directory of that name is then refused when read, not skipped)."""
     for suffix in (".yaml", ".yml"):
@@ -98,7 +100,7 @@ _UNBOUNDED = {"JointModelRUBX": pin.JointModelRX, "JointModelRUBY": pin.JointMod
               "JointModelRUBZ": pin.JointModelRZ}
 
 
-def _revolute_for(jm):
+def _revolute_for(jm: pin.JointModel) -> pin.JointModelRY | pin.JointModelRZ | None:
     """The one-coordinate revolute joint model about the axis of an unbounded (continuous)
     revolute joint model, or None for other joint models."""
     short = jm.shortname()
@@ -111,7 +113,7 @@ def _revolute_for(jm):
     return None
 
 
-def _order(model: pin.Model, first: set | tuple = ()):
+def _order(model: pin.Model, first: set | tuple = ()) -> list:
     """The model's joints in a depth-first order with, among siblings, the subtrees that hold a
     joint of ``first`` before the others: Pinocchio needs a mimicked joint before its mimics."""
     children = {j: [] for j in range(model.njoints)}
@@ -132,7 +134,7 @@ def _order(model: pin.Model, first: set | tuple = ()):
     return order
 
 
-def _rebuild(model: pin.Model, replacements=(), first: set | tuple = ()):
+def _rebuild(model: pin.Model, replacements: list=(), first: set | tuple = ()) -> pin.Model:
     """The model with continuous joints as revolute joints without limits (one coordinate, the
     angle, which counts turns: Pinocchio's (cos, sin) pair cannot, and a gear train or a lead
     screw turned twice must move twice as far), the sidecar's joint replacements (SPHERICAL,
@@ -180,7 +182,7 @@ def _rebuild(model: pin.Model, replacements=(), first: set | tuple = ()):
     return new
 
 
-def _couple(model: pin.Model, couplings, path):
+def _couple(model: pin.Model, couplings: list, path: str) -> pin.Model:
     """The model with each coupled joint turned into a Pinocchio mimic joint (no coordinate of
     its own; its motion is m times its primary's plus o)."""
     for c in couplings:
@@ -256,7 +258,7 @@ def _virtual_pairs(model: pin.Model, spec: MechanismSpec) -> None:
         model.addFrame(pin.Frame(f"{c.name}@end", v2, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME), False)
 
 
-def _finish_model(spec: MechanismSpec, model: pin.Model):
+def _finish_model(spec: MechanismSpec, model: pin.Model) -> pin.Model:
     """The tree model of a read file (its sidecar applied) made screwkin's: continuous joints, the joint
     replacements, mimic couplings, the virtual chains of higher pairs; sizes and cut joints checked."""
     path = spec.path
@@ -280,7 +282,7 @@ def rebuild(spec, actuated: list | None = None, tolerances: Tolerances = DEFAULT
 _NORMALISED = "\t\n\r"
 
 
-def _check_names_read_alike(model: pin.Model, spec, path) -> None:
+def _check_names_read_alike(model: pin.Model, spec: MechanismSpec, path: Path) -> None:
     """Refuse a link or joint name that Pinocchio's parser and screwkin's read differently: a literal
     tab, newline or carriage return inside the quotes of its name.  urdfdom (TinyXML2: Pinocchio's
     parser, ROS's robot_state_publisher and check_urdf) keeps the character (a carriage return as a
@@ -301,7 +303,7 @@ def _check_names_read_alike(model: pin.Model, spec, path) -> None:
 
 
 @contextmanager
-def _native_stderr(box: list):
+def _native_stderr(box: list) -> Iterator:
     """Collect into ``box`` what native code writes to file descriptor 2 while inside."""
     try:
         sys.stderr.flush()
@@ -331,15 +333,15 @@ def _urdfdom_messages(box: list) -> list:
     return out
 
 
-def _print_warning(path):
+def _print_warning(path: Path) -> Callable:
     def warn(m) -> None:
         print(f"warning: {shorten(str(path), 200)}: {shorten(m, 400)}", file=sys.stderr)
 
     return warn
 
 
-def load(path, yaml=None, actuated=None, tolerances: Tolerances = DEFAULT, warn=None, package_dirs=None,
-         cls=Mechanism, args=None, text: str | None = None) -> Mechanism:
+def load(path: str | Path, yaml=None, actuated: list | None=None, tolerances: Tolerances = DEFAULT, warn: Callable | None=None, package_dirs=None,
+         cls=Mechanism, args: dict | None=None, text: str | None = None) -> Mechanism:
     """Read a mechanism file (URDF with ``<loop_joint>`` or a YAML sidecar, SDF, MJCF, or a
     xacro file that expands to such a URDF).
 

@@ -37,7 +37,7 @@ _TAYLOR = _EPS ** 0.25  # Pinocchio's TaylorSeriesExpansion<double>::precision<3
 SE2_STRAIGHT = 1e-14
 
 
-def continuous_angle(q: np.ndarray, i: int):
+def continuous_angle(q: np.ndarray, i: int) -> np.ndarray | float:
     """The angle [rad] of the continuous joint whose (cos, sin) stand at q[..., i], q[..., i + 1]:
     atan2(sin, cos), in (-pi, pi]; for a stack of configurations (N, nq), one per row.
 
@@ -47,7 +47,7 @@ def continuous_angle(q: np.ndarray, i: int):
     return np.arctan2(q[..., i + 1], q[..., i])
 
 
-def set_continuous_angle(q: np.ndarray, i: int, angle) -> None:
+def set_continuous_angle(q: np.ndarray, i: int, angle: np.ndarray | float) -> None:
     """Write ``angle`` [rad] (a number, or one per row of a stack q (N, nq)) as the (cos, sin) of the
     continuous joint at q[..., i], q[..., i + 1], in place."""
     q[..., i] = np.cos(angle)
@@ -80,7 +80,7 @@ class Integrator:
         self.plain = not self.groups and not self.per_configuration and model.nq == model.nv and (
             np.array_equal(self.vector[0], np.arange(model.nq)) and np.array_equal(self.vector[1], np.arange(model.nv)))
 
-    def __call__(self, Q: np.ndarray, V) -> np.ndarray:
+    def __call__(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
         if self.plain:
             return Q + V
         Q, V = np.asarray(Q, float), np.asarray(V, float)
@@ -96,14 +96,14 @@ class Integrator:
         return out
 
 
-def _so2(q: np.ndarray, v):
+def _so2(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(cos, sin) turned by the angle v, renormalized to first order."""
     c, s = np.cos(v[:, 0]), np.sin(v[:, 0])
     out = np.stack([c * q[:, 0] - s * q[:, 1], s * q[:, 0] + c * q[:, 1]], axis=1)
     return out * ((3.0 - np.einsum("ni,ni->n", out, out)) / 2.0)[:, None]
 
 
-def _exp3(w) -> np.ndarray:
+def _exp3(w: np.ndarray) -> np.ndarray:
     """Unit quaternions (x, y, z, w) of the rotations exp([w]x) (Pinocchio's quaternion::exp3)."""
     t2 = np.einsum("ni,ni->n", w, w)
     t = np.sqrt(t2 + _EPS * _EPS)
@@ -115,23 +115,23 @@ def _exp3(w) -> np.ndarray:
     return np.where((t2 > _TAYLOR)[:, None], far, near)
 
 
-def _normalize(quat):
+def _normalize(quat: np.ndarray) -> np.ndarray:
     """Pinocchio's quaternion::firstOrderNormalize: times (3 - |q|^2) / 2."""
     return quat * ((3.0 - np.einsum("ni,ni->n", quat, quat)) / 2.0)[:, None]
 
 
-def _rotate(quat, x):
+def _rotate(quat: np.ndarray, x: np.ndarray) -> np.ndarray:
     """The vectors x turned by the unit quaternions quat (Eigen's q * v: v + 2 w (u x v) + 2 u x (u x v))."""
     u, w = quat[:, :3], quat[:, 3:]
     uv = 2.0 * np.cross(u, x)
     return x + w * uv + np.cross(u, uv)
 
 
-def _so3(q: np.ndarray, v):
+def _so3(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return _normalize(quaternion_product(q, _exp3(v)))
 
 
-def _se3(q: np.ndarray, v) -> np.ndarray:
+def _se3(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Free flyer (x, y, z, quaternion) moved by exp6 of the twist v = (linear, angular) in its own axes."""
     lin, w = v[:, :3], v[:, 3:]
     t2 = np.einsum("ni,ni->n", w, w) + _EPS * _EPS
@@ -148,7 +148,7 @@ def _se3(q: np.ndarray, v) -> np.ndarray:
     return np.concatenate([_rotate(quat, trans) + q[:, :3], _normalize(turned)], axis=1)
 
 
-def _se2(q: np.ndarray, v) -> np.ndarray:
+def _se2(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Planar joint (x, y, cos, sin) moved by the planar exponential of v = (vx, vy, omega)."""
     omega = v[:, 2]
     cv, sv = np.cos(omega), np.sin(omega)

@@ -67,7 +67,7 @@ class Mechanism:
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """
 
-    def __init__(self, spec: MechanismSpec, model: pin.Model, actuated=None, tolerances: Tolerances = DEFAULT) -> None:
+    def __init__(self, spec: MechanismSpec, model: pin.Model, actuated: list | None=None, tolerances: Tolerances = DEFAULT) -> None:
         self.spec = spec
         self.path = spec.path
         self.tolerances = tolerances
@@ -127,13 +127,13 @@ class Mechanism:
         """Whether the model is too large for a Data per computation (see scratch_data)."""
         return self.model.nv > SHARED_DATA_NV
 
-    def scratch_data(self):
+    def scratch_data(self) -> pin.Data:
         """A pinocchio.Data for one computation, so that no result depends on what another left
         in a Data it shares: a new one, except past SHARED_DATA_NV coordinates, where a Data costs
         seconds and gigabytes and the mechanism's own is handed out (its user runs its pass first)."""
         return self.data if self.shares_data else self.model.createData()
 
-    def model_with_gravity(self, g):
+    def model_with_gravity(self, g: np.ndarray) -> pin.Model:
         """The Pinocchio model with gravity ``g`` (gx, gy, gz) [m/s^2] (RNEA, gravity terms and
         potential energy read model.gravity): a copy made once per g, so that no computation
         changes the model another is reading (threads may share a mechanism)."""
@@ -146,7 +146,7 @@ class Mechanism:
                 self._gravity_models[key] = model
         return model
 
-    def set_actuated(self, actuated=None):
+    def set_actuated(self, actuated: list | None=None) -> None:
         """Choose the actuated joints (None: the file's declaration)."""
         names, source = resolve_actuation(self.spec, actuated)
         unknown = [n for n in names if n not in self._coord]
@@ -189,7 +189,7 @@ class Mechanism:
             known = ", ".join(c.joint for c in self.coordinates)
             raise UsageError(f"{self.path}: no moving joint named '{joint}' (joints: {known})") from None
 
-    def velocity_indices(self, joints) -> np.ndarray:
+    def velocity_indices(self, joints: tuple | list) -> np.ndarray:
         """Velocity (tangent) indices of the named joints, in order."""
         idx = []
         for j in joints:
@@ -197,7 +197,7 @@ class Mechanism:
             idx.extend(range(c.idx_v, c.idx_v + c.nv))
         return np.asarray(idx, int)
 
-    def _value_layout(self):
+    def _value_layout(self) -> tuple:
         """(1-coordinate joints (name, q index, wrap), continuous joints (name, q index), the
         coordinates of multi-DOF joints (name, q index), order of the names)."""
         if self._layout is None:
@@ -289,7 +289,7 @@ class Mechanism:
             names += [c.joint] if c.nv == 1 else [f"{c.joint}[{k}]" for k in range(c.nv)]
         return names
 
-    def limited_coordinates(self):
+    def limited_coordinates(self) -> tuple:
         """(names, q indices, lower, upper, is an angle) of the one-coordinate joints with a
         finite <limit> range, as arrays (for checking many configurations quickly)."""
         if self._limits is None:
@@ -337,7 +337,7 @@ class Mechanism:
             return None
         return next((t for t in self.spec.inputs if t.name == name and t.joint in self._coord), None)
 
-    def transmissions(self, inputs=None) -> tuple:
+    def transmissions(self, inputs: list | None=None) -> tuple:
         """The Transmission of each of ``inputs`` (default: the actuated joints) that the file drives
         through a tendon, a coupling or a gear."""
         inputs = set(self.actuated if inputs is None else inputs)
@@ -377,7 +377,7 @@ class Mechanism:
         return self._translational
 
     # ------------------------------------------------------------------ configurations
-    def random_configuration(self, rng: np.random.Generator, around=None, spread: float = 0.3) -> np.ndarray:
+    def random_configuration(self, rng: np.random.Generator, around: np.ndarray | None=None, spread: float = 0.3) -> np.ndarray:
         """A random configuration.
 
         Without ``around``: every joint uniform within its limits -- angles over their
@@ -427,7 +427,7 @@ class Mechanism:
                 q[i:i + c.nq] = pin.integrate(model, pin.neutral(model), dq)[i:i + c.nq]
         return q
 
-    def _keep(self, q: np.ndarray, hint, frozen) -> np.ndarray:
+    def _keep(self, q: np.ndarray, hint: np.ndarray, frozen: tuple) -> np.ndarray:
         """q with the coordinates of the joints whose velocity indices are frozen taken from hint."""
         if not len(frozen):
             return q
@@ -439,7 +439,7 @@ class Mechanism:
         return q
 
     # ------------------------------------------------------------------ analyses
-    def assemble(self, q0: np.ndarray | None = None, frozen=(), seed: int = 0) -> Assembly:
+    def assemble(self, q0: np.ndarray | None = None, frozen: tuple=(), seed: int = 0) -> Assembly:
         """Close the loops: a seeded search, not a single descent.
 
         The hint ``q0`` (default: the file's configuration, ``neutral()``: every joint at zero, an MJCF
@@ -558,7 +558,7 @@ class Mechanism:
         return found[:2]
 
     @property
-    def first_assembly_singular(self):
+    def first_assembly_singular(self) -> tuple:
         """(True, its rank, the generic rank) when the first configuration the assembly search
         closed is less constrained than the generic ones (singular or on a degenerate branch);
         (False, r, r) otherwise.  Needs generic_configurations() first."""

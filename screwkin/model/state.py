@@ -46,6 +46,10 @@ import pinocchio as pin
 
 from ..errors import UsageError, quote
 from ._pin import frame_jacobian, joint_axis
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.cuts import CutJoint
 
 __all__ = ["KinematicState", "PointMotion", "OutputFrame", "LOOP_COORDINATE_TYPES", "loop_coordinate_cuts",
            "angular_loop_joints", "leg_ends", "value_for_leg_length", "place_tool", "frame_parent",
@@ -175,7 +179,7 @@ class PointMotion:
 
     __slots__ = ("position", "velocity", "acceleration")
 
-    def __init__(self, position, velocity=None, acceleration=None) -> None:
+    def __init__(self, position: np.ndarray, velocity: np.ndarray | None=None, acceleration: np.ndarray | None=None) -> None:
         self.position, self.velocity, self.acceleration = position, velocity, acceleration
 
     def __repr__(self) -> str:
@@ -187,7 +191,7 @@ class KinematicState:
     vectors of the model, (nv,)).  Read-only; every quantity is computed when first asked (Pinocchio's
     pass run again where another state has used the thread's Data since) and returned as a copy."""
 
-    def __init__(self, mech, q: np.ndarray, qd=None, qdd=None) -> None:
+    def __init__(self, mech, q: np.ndarray, qd: np.ndarray | None=None, qdd: np.ndarray | None=None) -> None:
         self.mech = mech
         self.q = np.array(q, float)
         self.qd = None if qd is None else np.array(qd, float)
@@ -198,7 +202,7 @@ class KinematicState:
         self._key = next(_KEYS)
 
     # ------------------------------------------------------------------ Pinocchio's pass
-    def _pass(self, data, jacobians: bool, placed: bool = False):
+    def _pass(self, data: pin.Data, jacobians: bool, placed: bool = False) -> pin.Data:
         """Pinocchio's pass for this state in ``data``: placements, and motions when it has rates
         (unless ``placed``: done already); with ``jacobians`` the joint Jacobians too."""
         model = self.mech.model
@@ -213,7 +217,7 @@ class KinematicState:
             pin.updateFramePlacements(model, data)
         return data
 
-    def _data(self, jacobians: bool = False):
+    def _data(self, jacobians: bool = False) -> pin.Data:
         """A Data holding this state's pass (with the joint Jacobians when asked), to read at once:
         the thread's Data for states (Mechanism.state_data), the pass run again only when another
         state ran there since; for a model too large for a Data per thread (Mechanism.shares_data)
@@ -243,17 +247,17 @@ class KinematicState:
         mech = self.mech
         return frame_parent(mech, fid) if fid == mech.tool_frame and mech.tool is not None else None
 
-    def frame_placement(self, fid: int):
+    def frame_placement(self, fid: int) -> pin.SE3:
         """World placement of a frame (pinocchio.SE3, a copy)."""
         out = self._output(fid)
         d = self._data()
         return d.oMi[out[0]] * out[1] if out else pin.SE3(d.oMf[fid])
 
-    def joint_placement(self, jid: int):
+    def joint_placement(self, jid: int) -> pin.SE3:
         """World placement of a joint's frame (pinocchio.SE3, a copy)."""
         return pin.SE3(self._data().oMi[jid])
 
-    def centre(self, ref) -> np.ndarray:
+    def centre(self, ref: tuple) -> np.ndarray:
         """World position [m] of a point named by reference: ("joint", i) the centre of joint i (its
         frame's origin, moving with it), ("mount", i) where joint i sits on its parent link (fixed
         there whatever joint i's value), ("frame", f) frame f's origin."""
@@ -272,7 +276,7 @@ class KinematicState:
         return np.column_stack([M.act(pin.Motion(S[:, k])).vector for k in range(S.shape[1])]) if S.size \
             else np.zeros((6, 0))
 
-    def frame_jacobian(self, fid: int, reference=LWA) -> np.ndarray:
+    def frame_jacobian(self, fid: int, reference: pin.ReferenceFrame=LWA) -> np.ndarray:
         """(6, nv) Jacobian of a frame in (linear, angular) order, in ``reference``
         (LOCAL_WORLD_ALIGNED by default: the frame origin's velocity and the angular
         velocity, world axes; WORLD: the spatial twist at the world origin) [m/rad, 1]."""
@@ -282,7 +286,7 @@ class KinematicState:
             return frame_jacobian(self.mech.model, d, out[0], reference, placement=out[1])
         return frame_jacobian(self.mech.model, d, fid, reference).copy()
 
-    def link_jacobian(self, link: str, reference=LWA) -> np.ndarray:
+    def link_jacobian(self, link: str, reference: pin.ReferenceFrame=LWA) -> np.ndarray:
         return self.frame_jacobian(self.mech.link_frame(link), reference)
 
     @cached_property
@@ -316,7 +320,7 @@ class KinematicState:
     def link_pose(self, link: str) -> np.ndarray:
         return self.frame_pose(self.mech.link_frame(link))
 
-    def point(self, link: str, local=(0.0, 0.0, 0.0)) -> PointMotion:
+    def point(self, link: str, local: tuple=(0.0, 0.0, 0.0)) -> PointMotion:
         """Motion of the point with coordinates ``local`` [m] in ``link``'s frame."""
         fid = self.mech.link_frame(link)
         M = self.frame_placement(fid)
@@ -339,12 +343,12 @@ class KinematicState:
         return out
 
     # ------------------------------------------------------------------ loop-joint coordinates
-    def _cut_frames(self, cut) -> tuple:
+    def _cut_frames(self, cut: CutJoint) -> tuple:
         M1, M2 = self.frame_placement(cut.frame1), self.frame_placement(cut.frame2)
         axis = M1.rotation @ np.asarray(cut.axis, float)
         return M1, M2, axis / np.linalg.norm(axis)
 
-    def loop_value(self, cut) -> float:
+    def loop_value(self, cut: CutJoint) -> float:
         """The coordinate of a one-coordinate cut joint [rad or m] (see the module's docstring)."""
         M1, M2, axis = self._cut_frames(cut)
         if cut.type == "prismatic":
@@ -357,7 +361,7 @@ class KinematicState:
         c = 0.5 * (np.trace(R) - a @ R @ a)
         return float(np.arctan2(s, c))
 
-    def loop_rate(self, cut) -> float:
+    def loop_rate(self, cut: CutJoint) -> float:
         """d/dt of loop_value [rad/s or m/s] (needs rates)."""
         M1, M2, axis = self._cut_frames(cut)
         v1, w1 = np.split(self.frame_twist(cut.frame1), 2)
@@ -366,7 +370,7 @@ class KinematicState:
             return float((v2 - v1) @ axis + (M2.translation - M1.translation) @ np.cross(w1, axis))
         return float((w2 - w1) @ axis)
 
-    def loop_acceleration(self, cut) -> float:
+    def loop_acceleration(self, cut: CutJoint) -> float:
         """d^2/dt^2 of loop_value [rad/s^2 or m/s^2] (needs rates)."""
         M1, M2, axis = self._cut_frames(cut)
         v1, w1 = np.split(self.frame_twist(cut.frame1), 2)

@@ -110,12 +110,12 @@ def _rows_text(values, n: int, width: int, pad: str, inner: str, step: str) -> s
     return "[\n" + inner + "[\n" + deeper + "".join(parts) + "\n" + inner + "]\n" + pad + "]"
 
 
-def _numbers(values) -> bool:
+def _numbers(values: list) -> bool:
     """A list of finite floats only (two loops in C)."""
     return set(map(type, values)) == {float} and all(map(math.isfinite, values))
 
 
-def _rows(values) -> int:
+def _rows(values: list) -> int:
     """The length of every row when ``values`` is a list of lists of finite floats, all of one
     nonzero length (a sweep's vectors); else 0 (loops in C, no Python call a row)."""
     if not values or set(map(type, values)) != {list}:

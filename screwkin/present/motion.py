@@ -60,7 +60,7 @@ def links_rows(links: dict, units: RateUnits = RateUnits()) -> tuple:
     return title, head, rows
 
 
-def along_text(along) -> str:
+def along_text(along: list) -> str:
     """The two points a link's angle is measured along (LinkAngles.along): ``rocker_joint to joint_F``."""
     return "" if not along else f"{along[0]} to {along[1]}" if along[1] != "x axis" else "its frame's x axis"
 
@@ -111,19 +111,19 @@ def linkage_construction_text(d: dict) -> str:
     return f"four-bar: {mu}, diagonal z (crank tip to output pivot) = {d['diagonal']:.6g} m{angles}"
 
 
-def motion_dict(m) -> dict:
+def motion_dict(m: MotionAlong) -> dict:
     """A sweep's analysis.motion.links.MotionAlong as JSON-ready lists, one entry per step."""
     return {"loop_joints": m.loop_joints, "loop_rates": m.loop_rates, "loop_accelerations": m.loop_accelerations,
             "links": m.links, "points": m.points}
 
 
-def strokes_dict(strokes) -> list:
+def strokes_dict(strokes: list) -> list:
     return [{"coordinate": st.coordinate, "stroke": st.stroke, "low_at": st.low_at, "high_at": st.high_at,
              "time_ratio": st.time_ratio, "crank_angles": list(st.crank_angles) if st.crank_angles else None}
             for st in strokes]
 
 
-def strokes_text(strokes, angular: bool) -> list:
+def strokes_text(strokes: list, angular: bool) -> list:
     """A line per slider: its stroke, where its ends are reached, and the time ratio."""
     def at(x) -> str:
         return f"{np.degrees(x):.6g} deg" if angular else f"{1000 * x:.6g} mm"
@@ -139,7 +139,7 @@ def strokes_text(strokes, angular: bool) -> list:
     return lines
 
 
-def motion_rows_text(res, motion: MotionAlong, rows, degrees: bool, units: RateUnits | None = None) -> str:
+def motion_rows_text(res, motion: MotionAlong, rows: list, degrees: bool, units: RateUnits | None = None) -> str:
     """The sweep's absolute quantities at the rows shown: the input (in deg when typed so), each turning
     link's angle [deg] (with ``units``, the rate's units typed: its omega and alpha in them too), each
     slider (loop) coordinate [mm] and each point's position [mm]."""

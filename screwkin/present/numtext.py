@@ -28,7 +28,7 @@ _FOUR = np.frombuffer("".join(f"{i:04d}" for i in range(10000)).encode(), dtype=
 _SLOT = np.arange(P + 1, dtype=np.int8)
 
 
-def _scaled(a, k):
+def _scaled(a: np.ndarray, k: np.ndarray) -> np.ndarray:
     """|x| 10^k for k in [-22, 44] with at most two roundings."""
     p = _POW10[np.minimum(np.abs(k), 22)]
     s = a * p
@@ -39,7 +39,7 @@ def _scaled(a, k):
     return s
 
 
-def g12_bytes(values: np.ndarray, out=None) -> np.ndarray:
+def g12_bytes(values: np.ndarray, out: np.ndarray | None=None) -> np.ndarray:
     """Values (shape S) -> uint8 array (S..., W): the ASCII of ``'%.12g' % value`` of each, with zero
     bytes between and around its characters (drop them when joining); ``out``: an array of zeros of
     that shape (a view) to write into.
@@ -120,7 +120,7 @@ def g12_bytes(values: np.ndarray, out=None) -> np.ndarray:
 ROWS = 2_000
 
 
-def csv_rows(columns, first: int = 0) -> str:
+def csv_rows(columns: list, first: int = 0) -> str:
     """CSV rows ``step,v1,v2,...``: the step numbered from ``first`` (``%d``), then every column
     (equal-length float arrays) as ``'%.12g'``; the same text as ``"%d,%.12g,...\\n" % row`` a row.
     Built ROWS rows at a time, so that the buffers stay small beside the text."""

@@ -58,7 +58,7 @@ def _rate_scales(units: RateUnits) -> list:
             (units.acceleration(False), units.acceleration(True))]
 
 
-def sweep_figure(res: SweepResult, mus=None, singularities=(), title: str | None = None, linear=None, paths: dict | None = None, absolute: bool=False,
+def sweep_figure(res: SweepResult, mus=None, singularities: tuple=(), title: str | None = None, linear: np.ndarray | None=None, paths: dict | None = None, absolute: bool=False,
                  rate_words=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
@@ -145,7 +145,7 @@ def sweep_figure(res: SweepResult, mus=None, singularities=(), title: str | None
     return fig
 
 
-def absolute_series(res: SweepResult, motion: MotionAlong, linear=None) -> tuple | None:
+def absolute_series(res: SweepResult, motion: MotionAlong, linear: np.ndarray | None=None) -> tuple | None:
     """The sweep's curves in absolute quantities (issue 24): for a planar mechanism each link that
     turns (its vector-loop angle, omega, alpha about the plane's normal) and each slider coordinate
     (prismatic tree or loop joint: position, rate, acceleration); ``res`` with those as its

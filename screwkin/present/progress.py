@@ -56,7 +56,7 @@ class Progress:
         self.stream.flush()
         self.shown = True
 
-    def __enter__(self):
+    def __enter__(self) -> Progress:
         return self
 
     def __exit__(self, *exc: Any) -> None:

@@ -142,7 +142,7 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name, value, angular: bool) -> str:
+def value_text(name: str, value: float, angular: bool) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
@@ -218,7 +218,7 @@ def slide_note(res: PositionResult, s: Solution) -> str | None:
     return note
 
 
-def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False, length=None, units: RateUnits = RateUnits(),
+def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False, length: float | None=None, units: RateUnits = RateUnits(),
                   leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
@@ -292,7 +292,7 @@ def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False,
     return "\n".join(lines)
 
 
-def sweep_rows(n: int, rows=None) -> list:
+def sweep_rows(n: int, rows: str | None=None) -> list:
     """The steps a sweep's tables show: ``rows`` None -> about 11 evenly spaced (the last included),
     "all" -> every step, a number -> about that many."""
     if rows == "all":
@@ -304,7 +304,7 @@ def sweep_rows(n: int, rows=None) -> list:
     return idx
 
 
-def sweep_text(res: SweepResult, info: LinkageInfo | None = None, mus=None, rows=None, degrees: bool = False, linear_names=()) -> str:
+def sweep_text(res: SweepResult, info: LinkageInfo | None = None, mus: list | None=None, rows: str | None=None, degrees: bool = False, linear_names: list=()) -> str:
     """The sweep's summary and a table of joint values (``rows``: see sweep_rows; ``degrees``: the
     input and the angles in deg, the coordinates in ``linear_names`` staying in m)."""
     angular = res.unit == "rad"

@@ -18,7 +18,7 @@ def screw_dict(s: Screw) -> dict:
             "pitch": s.pitch}  # infinite for a translation: "inf" (present/jsonout.py)
 
 
-def screws_dict(structure, normal=None) -> list:
+def screws_dict(structure: list, normal: tuple | None=None) -> list:
     out = []
     for st in structure:
         ch = st["chain"]
@@ -35,7 +35,7 @@ def screws_dict(structure, normal=None) -> list:
     return out
 
 
-def loops_dict(loops, normal=None) -> list:
+def loops_dict(loops: list, normal: tuple | None=None) -> list:
     """analysis.screws.LoopScrews as JSON: each loop's joints in order with sign and twist."""
     out = []
     for lp in loops:
@@ -49,7 +49,7 @@ def loops_dict(loops, normal=None) -> list:
     return out
 
 
-def loops_text(loops, normal=None) -> str:
+def loops_text(loops: list, normal: tuple | None=None) -> str:
     """Each loop as the product of exponentials of all its joints, the cut joint included, = I."""
     lines = []
     for lp in loops:
@@ -71,7 +71,7 @@ def loops_text(loops, normal=None) -> str:
     return "\n".join(lines)
 
 
-def screws_text(structure, normal=None) -> str:
+def screws_text(structure: list, normal: tuple | None=None) -> str:
     lines = []
     for st in structure:
         ch = st["chain"]

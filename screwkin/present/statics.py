@@ -34,7 +34,7 @@ def leg_dict(leg: Leg) -> dict:
                                       for w, s in zip(leg.transmission_wrenches, leg.transmission_screws)]}
 
 
-def statics_dict(r: StaticsResult, legs=None) -> dict:
+def statics_dict(r: StaticsResult, legs: tuple | None=None) -> dict:
     d = {"inputs": list(r.inputs), "efforts": r.efforts, "units": r.units, "wrench": list(r.wrench),
          "output": r.output, "gravity": r.gravity, "equilibrium": r.equilibrium, "unbalanced": r.unbalanced,
          "reactions": [{"joint": x.joint, "kind": x.kind, "wrench": list(x.wrench), "determinate": x.determinate}

@@ -7,6 +7,10 @@ import io
 from dataclasses import dataclass
 
 from ..units import Quantity, shown_unit, unit_text
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["table", "shown", "shown_text", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits",
            "input_rate_words"]
@@ -15,7 +19,7 @@ __all__ = ["table", "shown", "shown_text", "fmt_vec", "column_text", "csv_cell",
 SHOWN_ZERO = 1e-12
 
 
-def table(headers, rows) -> str:
+def table(headers: list, rows: list) -> str:
     """A plain-text table with aligned columns."""
     rows = [[str(c) for c in r] for r in rows]
     widths = [max(len(str(h)), *(len(r[i]) for r in rows)) if rows else len(str(h)) for i, h in enumerate(headers)]
@@ -25,23 +29,23 @@ def table(headers, rows) -> str:
     return "\n".join(out)
 
 
-def shown(x, below: float = SHOWN_ZERO) -> float:
+def shown(x: float, below: float = SHOWN_ZERO) -> float:
     """x as written: 0.0 where its magnitude is below ``below``, and never -0.0."""
     return (0.0 if abs(x) < below else x) + 0.0
 
 
-def shown_text(x, digits: int = 6, below: float = SHOWN_ZERO, missing: str = "?") -> str:
+def shown_text(x: float | None, digits: int = 6, below: float = SHOWN_ZERO, missing: str = "?") -> str:
     """A number as every text table writes it: ``digits`` significant digits, round-off below ``below``
     as 0 (``shown``); ``missing`` for None."""
     return missing if x is None else f"{shown(x, below):.{digits}g}"
 
 
-def fmt_vec(v, width: int = 11) -> str:
+def fmt_vec(v: np.ndarray | tuple, width: int = 11) -> str:
     """Numbers with 6 significant digits; round-off below SHOWN_ZERO shows as 0."""
     return " ".join(f"{shown(x):>{width}.6g}" for x in v)
 
 
-def column_text(values, relative: float = 1e-9, absolute: float = SHOWN_ZERO) -> list:
+def column_text(values: np.ndarray | list, relative: float = 1e-9, absolute: float = SHOWN_ZERO) -> list:
     """A column of numbers with 6 significant digits, each below ``relative`` x the column's largest
     magnitude (or below ``absolute``) written as 0: round-off is not a value (1.6e-15 deg is 0)."""
     big = max((abs(v) for v in values if v == v), default=0.0)

@@ -34,7 +34,7 @@ class JointDynamics(dict):
     mimic joint's: its leader's).  Arrays over the model's velocity coordinates: ``armature``,
     ``damping``, ``frictionloss``; ``springs`` and ``coupled`` (the mimic joints') by name."""
 
-    def __init__(self, mech: Mechanism, joints, coupled) -> None:
+    def __init__(self, mech: Mechanism, joints: list, coupled: list) -> None:
         super().__init__()
         nv = mech.model.nv
         self.armature, self.damping, self.frictionloss = np.zeros(nv), np.zeros(nv), np.zeros(nv)

@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
 
 __all__ = ["Reaction", "StaticsResult", "Leg", "statics", "legs", "wrench_screw", "balance", "joint_wrenches",
            "reaction_table", "coupled_efforts", "coupled_units", "actuator_efforts", "compound_joints",
@@ -89,11 +90,11 @@ class StaticsResult:
     notes: tuple = ()  # one line each: what the balance holds and what it takes as 0
 
 
-def _load_norm(w, L) -> float:
+def _load_norm(w: np.ndarray, L: float) -> float:
     return float(np.linalg.norm(np.r_[np.asarray(w[:3]) * L, w[3:]]))
 
 
-def balance(mech: Mechanism, K: np.ndarray, a_idx, b: np.ndarray) -> tuple:
+def balance(mech: Mechanism, K: np.ndarray, a_idx: np.ndarray, b: np.ndarray) -> tuple:
     """The balance of generalized forces E tau + K^T lambda = b (E: the columns of the actuated
     velocity indices ``a_idx``; K: the closure Jacobian, rows as ClosureSystem writes them; b:
     the generalized force the tree needs [N, N m]), solved in the least-squares, minimum-norm
@@ -116,7 +117,7 @@ def balance(mech: Mechanism, K: np.ndarray, a_idx, b: np.ndarray) -> tuple:
     return x[:m], x[m:], N, unbalanced, scale
 
 
-def statics(mech: Mechanism, q: np.ndarray, inputs=None, output=None, wrench=None, gravity: bool = False) -> StaticsResult:
+def statics(mech: Mechanism, q: np.ndarray, inputs: list | None=None, output: str | None=None, wrench: list | np.ndarray | None=None, gravity: bool = False) -> StaticsResult:
     """Actuator efforts and joint reactions holding ``wrench`` (force, moment) [N, N m] applied to
     ``output`` at its frame's origin (world axes) and, with ``gravity``, the links' weights,
     at the assembled configuration q.  See the module docstring."""
@@ -177,7 +178,7 @@ def statics(mech: Mechanism, q: np.ndarray, inputs=None, output=None, wrench=Non
                          mech.transmissions(inputs), springs, tuple(notes))
 
 
-def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity: bool, N_lam) -> tuple:
+def _reactions(mech: Mechanism, q: np.ndarray, lam: np.ndarray, w: np.ndarray | None, output: str | None, gravity: bool, N_lam: np.ndarray | None) -> tuple:
     """Reactions of every joint for constraint forces lam (and the load), and whether each is
     determined: it must not change along the null directions N_lam of the constraint forces."""
     loads = [(mech.link_frame(output), np.asarray(w, float))] if w is not None else []
@@ -188,7 +189,7 @@ def _reactions(mech: Mechanism, q: np.ndarray, lam, w, output, gravity: bool, N_
     return tuple(out)
 
 
-def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity: bool | np.ndarray, N_lam: np.ndarray, v=None, a=None) -> dict:
+def reaction_table(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list, gravity: bool | np.ndarray, N_lam: np.ndarray, v=None, a=None) -> dict:
     """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
     constraint forces lam, and the mask of its components that change along the null
     directions N_lam of the constraint forces (not determined by the balance)."""
@@ -204,7 +205,7 @@ def reaction_table(mech: Mechanism, q: np.ndarray, lam, loads, gravity: bool | n
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech: Mechanism, q: np.ndarray, lam, loads=(), gravity: bool=False, v=None, a=None, rows: tuple | None = None) -> dict:
+def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity: bool=False, v=None, a=None, rows: tuple | None = None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
@@ -295,7 +296,7 @@ def coupled_units(mech: Mechanism) -> dict:
     return {cp.joint: "N" if kinds.get(cp.joint) == "prismatic" else "N m" for cp in mech.couplings}
 
 
-def actuator_efforts(mech: Mechanism, inputs, efforts: dict) -> dict:
+def actuator_efforts(mech: Mechanism, inputs: list, efforts: dict) -> dict:
     """Actuator name -> its effort: the input joint's generalized force / (scale * gear) of each input
     the file drives through a tendon, a coupled joint or a gear (files.description.Transmission); None
     where the joint's effort is undetermined."""
@@ -343,7 +344,7 @@ class Leg:
     transmission_screws: tuple
 
 
-def no_legs_reason(leg_list, output: str) -> str | None:
+def no_legs_reason(leg_list: tuple, output: str) -> str | None:
     """Why the chains that join ``output`` to the ground are not a parallel mechanism's legs (None when they
     are): legs are two or more chains of two or more joints each from the ground to a platform (a Delta's,
     a Stewart platform's, a five-bar's).  A slider-crank's slider on its guide or a four-bar's coupler with
@@ -358,7 +359,7 @@ def no_legs_reason(leg_list, output: str) -> str | None:
     return None
 
 
-def wrench_screw(wrench, point) -> Screw:
+def wrench_screw(wrench: np.ndarray, point: np.ndarray) -> Screw:
     """The screw of a wrench (force, moment about ``point``): axis along the force through the
     line of action, pitch m . f / |f|^2 (inf for a pure moment)."""
     w = np.asarray(wrench, float)
@@ -366,7 +367,7 @@ def wrench_screw(wrench, point) -> Screw:
     return screw_of(np.r_[m0, f])
 
 
-def legs(mech: Mechanism, q: np.ndarray, output, inputs=None) -> tuple:
+def legs(mech: Mechanism, q: np.ndarray, output: str, inputs=None) -> tuple:
     """The legs between the ground and the ``output`` link (see Leg), at the assembled q.
 
     A leg is the set of tree joints on the branches that reach the platform -- the platform's
@@ -448,7 +449,7 @@ def legs(mech: Mechanism, q: np.ndarray, output, inputs=None) -> tuple:
     return tuple(out)
 
 
-def _cut_twists(mech: Mechanism, cut, o, state: KinematicState) -> np.ndarray:
+def _cut_twists(mech: Mechanism, cut: CutJoint, o: np.ndarray, state: KinematicState) -> np.ndarray:
     """The relative twists a cut joint allows (analysis.screws.cut_twists), moved to the platform
     origin o, world axes (6 x k); none for a higher pair (its equivalent linkage's joints belong
     to the leg)."""

@@ -36,7 +36,7 @@ __all__ = ["batch_closure", "BatchedCurve", "batched_motion", "motion_rates", "S
 SMALLEST, LARGEST = 4, 256  # grid values a chunk: it starts at 16 and doubles while it goes well
 
 
-def batch_closure(mech: Mechanism):
+def batch_closure(mech: Mechanism) -> BatchClosure:
     """The mechanism's BatchClosure (cached), or None when it cannot be batched."""
     key = "dyads.batch"  # (the one dyads.py checks its residuals with)
     if key not in mech.cache:

@@ -119,7 +119,7 @@ class Problem:
 
 
 def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),  # noqa: B008 - frozen
-                    problem: Problem | None = None):
+                    problem: Problem | None = None) -> Certified:
     """The assembly modes for the input ``values`` by homotopy continuation (see the module): a
     Certified, or the reason (a string) why the method does not apply.  ``problem``: another system
     to solve (inverse kinematics); by default the solver's loops with its inputs held."""
@@ -207,7 +207,7 @@ def _rank(closure: PolynomialClosure, rng: np.random.Generator) -> int:
     return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
 
 
-def _classify(solver, problem: Problem, closure: PolynomialClosure, system: SquareSystem, group, roots: Roots, ends: Endpoints, known: KnownCount, seconds, o: MonodromyOptions,
+def _classify(solver, problem: Problem, closure: PolynomialClosure, system: SquareSystem, group, roots: Roots, ends: Endpoints, known: KnownCount, seconds: float, o: MonodromyOptions,
               also: str = "") -> Certified:
     """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
     mech, tol = solver.mech, solver.mech.tolerances
@@ -291,7 +291,7 @@ def _classify(solver, problem: Problem, closure: PolynomialClosure, system: Squa
     return Certified([(q, a, n, None if simple else False) for _, q, a, n, simple in modes], count)
 
 
-def _coinciding(X: np.ndarray, mask, group, tol) -> np.ndarray:
+def _coinciding(X: np.ndarray, mask: np.ndarray, group, tol: float) -> np.ndarray:
     """(P,) where an endpoint of ``mask`` lies on another's orbit (two paths ended together)."""
     out = np.zeros(len(X), bool)
     idx = np.flatnonzero(mask)
@@ -355,7 +355,7 @@ class Search:
         return self.count is not None and self.count.complete
 
 
-def closed_form(solver, values: dict):
+def closed_form(solver, values: dict) -> str | Certified:
     """The modes of a planar mechanism made of dyads (analysis.motion.dyad_modes) as a Certified, or
     why the closed form does not apply (a string)."""
     got = dyad_modes(solver, values)
@@ -392,7 +392,7 @@ def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) 
     return Search(found, [(sets, simple) for _, _, sets, simple in got.modes], got.count)
 
 
-def join(solver, found, more) -> list:
+def join(solver, found: list, more: list) -> list:
     """``found`` with the modes of ``more`` that are not already in it (by signature)."""
     out = list(found)
     for sig, q, a in more:

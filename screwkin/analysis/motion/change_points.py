@@ -34,7 +34,7 @@ __all__ = ["change_points"]
 
 
 
-def change_points(solver: PositionSolver, res, located=(), xtol: float | None = None) -> tuple:
+def change_points(solver: PositionSolver, res, located: list=(), xtol: float | None = None) -> tuple:
     """ChangePoint for each constraint singularity along the sweep ``res`` of ``solver``: those of
     ``located`` (SweepSingularity of kind "constraint" from singular_points) and the dips found here."""
     from scipy.optimize import minimize_scalar

@@ -33,6 +33,9 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.continuation import Curve
     from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.tolerances import Tolerances
+    from collections.abc import Callable
+    from collections.abc import Iterator
 
 __all__ = ["ChangePoint", "Crossing", "passed", "crossing", "follow", "constraint_profile", "dips", "reclosing",
            "LOOK_BELOW", "TIGHT_CLOSURE", "START", "nearest_branch"]
@@ -44,7 +47,7 @@ TIGHT_CLOSURE = 1e-14
 LOOK_BELOW = 0.5
 
 
-def dips(m, xs: np.ndarray):
+def dips(m: np.ndarray, xs: np.ndarray) -> Iterator:
     """(k, k - 1, k + 1) for each recorded step k where the measure m is lowest among its neighbours and
     below LOOK_BELOW (the neighbours' indices clipped to the sweep)."""
     for k in range(len(m)):
@@ -54,7 +57,7 @@ def dips(m, xs: np.ndarray):
             yield k, max(k - 1, 0), min(k + 1, len(xs) - 1)
 
 
-def reclosing(solver: PositionSolver, res, q_k: np.ndarray, tight):
+def reclosing(solver: PositionSolver, res, q_k: np.ndarray, tight: Tolerances) -> Callable:
     """x -> the configuration at input value x closed from the sweep's q_k (tolerances ``tight`` when
     Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
     mech, frozen = solver.mech, solver.frozen
@@ -215,7 +218,7 @@ def passed(solver: PositionSolver, res) -> list:
     return unique
 
 
-def _may_reach_zero(m, xs: np.ndarray, k: int) -> bool:
+def _may_reach_zero(m: np.ndarray, xs: np.ndarray, k: int) -> bool:
     """Whether the dip of the measure m at the recorded configuration k (not at an end) may reach zero
     between its neighbours: near a change point the smallest singular value is |linear| in the input
     (a V), so it is at most the steeper side's slope times the step there (twice that, for the

@@ -79,7 +79,7 @@ def given_configuration(solver, q: np.ndarray) -> tuple:
         "(leave out the --set of a joint the loops should solve for, or give the values of a closed configuration)"))
 
 
-def first_count(first: str, assembly) -> ModeCount:
+def first_count(first: str, assembly: Assembly) -> ModeCount:
     """The certified.ModeCount of an answer reached without a search: ``first`` says how -- "every joint
     given" (the one configuration: complete) or Newton from the file's configuration (the mode asked
     for; how many others there are is not known: ``--all`` searches)."""

@@ -61,7 +61,7 @@ def moving_links(mech: Mechanism) -> tuple:
     return tuple(out)
 
 
-def link_motions(state: KinematicState, angles=None, normal: np.ndarray | None = None, along=None) -> dict:
+def link_motions(state: KinematicState, angles: dict | None=None, normal: np.ndarray | None = None, along: dict | None=None) -> dict:
     """Every moving link's absolute motion at a state: ``position`` (and, with rates, ``velocity``,
     ``acceleration``) of its frame origin [m, m/s, m/s^2], ``omega`` and ``alpha`` [rad/s, rad/s^2];
     planar mechanisms (``normal`` given): ``angle`` [rad] from ``angles`` (the vector-loop angles of
@@ -81,7 +81,7 @@ def link_motions(state: KinematicState, angles=None, normal: np.ndarray | None =
     return out
 
 
-def point_motions(state: KinematicState, points) -> dict:
+def point_motions(state: KinematicState, points: tuple) -> dict:
     """name -> {link, position, velocity, acceleration} of each Point (velocity and acceleration
     only when the state has rates)."""
     out = {}
@@ -107,7 +107,7 @@ class MotionAlong:
     normal: tuple | None = None  # planar mechanisms: the plane's normal omega and alpha are about
 
 
-def motion_along(mech: Mechanism, Q: np.ndarray, V, A, points=(), angles: LinkAngles | None = None, normal: np.ndarray | None = None) -> MotionAlong:
+def motion_along(mech: Mechanism, Q: np.ndarray, V: np.ndarray, A: np.ndarray, points: tuple=(), angles: LinkAngles | None = None, normal: np.ndarray | None = None) -> MotionAlong:
     """The absolute motion at each configuration Q[k] with rates V[k] and accelerations A[k];
     ``angles``: a callable q -> link angles (LinkAngles) for planar mechanisms, with ``normal``.
 
@@ -180,7 +180,7 @@ def motion_along(mech: Mechanism, Q: np.ndarray, V, A, points=(), angles: LinkAn
                        None if normal is None else tuple(float(x) for x in normal))
 
 
-def sweep_motion(mech: Mechanism, res, points=()) -> MotionAlong:
+def sweep_motion(mech: Mechanism, res, points: tuple=()) -> MotionAlong:
     """The absolute motion along a sweep ``res`` (analysis.motion.sweep.SweepResult): a planar
     mechanism's (its topology at the first step) with the vector-loop angles of LinkAngles, omega and
     alpha about the plane's normal; a spatial one's as vectors.  What ``sweep`` and ``report`` show."""
@@ -247,7 +247,7 @@ class Stroke:
     crank_angles: tuple | None  # (forward, return) crank angles [rad] when time_ratio is known
 
 
-def _extrema(x: np.ndarray, p, dp, tol: Tolerances) -> list:
+def _extrema(x: np.ndarray, p: np.ndarray, dp: np.ndarray, tol: Tolerances) -> list:
     """(input value, coordinate) at each zero of dp/dx along the samples: the cubic Hermite
     interpolant of p on each bracket whose slope changes sign (accurate to O(h^4)), its vertex."""
     out = []
@@ -268,7 +268,7 @@ def _extrema(x: np.ndarray, p, dp, tol: Tolerances) -> list:
     return out
 
 
-def _stroke_end(solver, res, name: str, coordinate: Coordinate, x: np.ndarray, guess):
+def _stroke_end(solver, res, name: str, coordinate: Coordinate, x: np.ndarray, guess: tuple) -> tuple:
     """(input, coordinate) at a slider's end between the samples x[k], x[k + 1] of a sweep: the zero of
     its rate located by Brent's method on the mechanism itself (each trial closed by damped Newton
     from the sample before it), not on an interpolant; ``guess`` (the interpolant's) when that fails."""

@@ -59,7 +59,7 @@ def continuum_words(free: int) -> str:
     return f"these inputs leave {free} degree{'s' if free != 1 else ''} of freedom free (a continuum)"
 
 
-def merge(solver, sols) -> list:
+def merge(solver, sols: list) -> list:
     """Solutions that are one root: a singular solution and others within the accuracy a
     double root can be computed to (about the square root of the closure tolerance), or
     joined to it by a motion with the inputs held (a continuum)."""
@@ -188,7 +188,7 @@ class ModeLabels:
         return float((p - state.joint_placement(self.model.parents[jid]).translation)
                      @ (state.joint_placement(jid).rotation @ axis))
 
-    def __call__(self, q: np.ndarray, outside) -> tuple:
+    def __call__(self, q: np.ndarray, outside: tuple) -> tuple:
         """Why the solution at q is not reached by moving from the reference configuration."""
         labels = [f"outside the joint limits: {', '.join(outside)}"] if outside else []
         if not self.active:

@@ -88,23 +88,23 @@ class LinkageInfo:
         return d
 
 
-def _rot(v, ang) -> np.ndarray:
+def _rot(v: np.ndarray, ang: float) -> np.ndarray:
     c, s = np.cos(ang), np.sin(ang)
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
 
 
-def _angle(v) -> float:
+def _angle(v: np.ndarray) -> float:
     return float(np.arctan2(v[1], v[0]))
 
 
-def _interval(start, end, phi_now, q_in: np.ndarray) -> tuple:
+def _interval(start: float, end: float, phi_now: float, q_in: np.ndarray) -> tuple:
     """Joint values of the angle interval [start, end] (end > start) that contains phi_now."""
     k = np.floor((phi_now - start) / (2 * np.pi))
     start, end = start + 2 * np.pi * k, end + 2 * np.pi * k
     return (q_in + start - phi_now, q_in + end - phi_now)
 
 
-def identify(mech: Mechanism, topo: Topology, q: np.ndarray, input_joint):
+def identify(mech: Mechanism, topo: Topology, q: np.ndarray, input_joint: str) -> LinkageInfo | None:
     """A :class:`LinkageInfo` for a planar four-bar or slider-crank whose input
     joint is a ground joint, at the configuration ``topo`` was built at (q)."""
     if topo.motion_space != "planar" or (topo.n_links, topo.n_joints, topo.loops) != (4, 4, 1):
@@ -187,7 +187,7 @@ def transmission_angles(mech: Mechanism, info: LinkageInfo, Q: np.ndarray) -> np
                          None if info.slide is None else np.asarray(info.slide, float))
 
 
-def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide=None):
+def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide: np.ndarray | None=None) -> np.ndarray:
     """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
     unit normal n (slide: the slide's unit direction, slider-crank)."""
     P = P - (P @ n)[..., None] * n
@@ -197,7 +197,7 @@ def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide=None):
     return slide_transmission_angle(B, C, np.cross(n, slide))
 
 
-def _four_bar(name: str, q_in: np.ndarray, A, B, C, D, a, b, tol: Tolerances) -> LinkageInfo:
+def _four_bar(name: str, q_in: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, a: float, b: float, tol: Tolerances) -> LinkageInfo:
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     cls = FOUR_BAR_CLASSES[int(four_bar_classes(g, a, b, c, tol.equal))]
@@ -234,7 +234,7 @@ def _four_bar(name: str, q_in: np.ndarray, A, B, C, D, a, b, tol: Tolerances) ->
                        input_value=float(q_in), input_angle=float(phi_now))
 
 
-def _slider_crank(name: str, q_in: np.ndarray, A, B, C, s: np.ndarray, a, b) -> LinkageInfo:
+def _slider_crank(name: str, q_in: np.ndarray, A: np.ndarray, B: np.ndarray, C: np.ndarray, s: np.ndarray, a: float, b: float) -> LinkageInfo:
     nrm = np.array([-s[1], s[0]])
     e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
     lengths = {"crank": a, "rod": b, "offset": abs(e)}
@@ -322,7 +322,7 @@ class LinkAngles:
             out[link] = next((c for c in candidates if np.linalg.norm(state.centre(c) - p0) > tiny), ("axis", fid))
         return out
 
-    def __call__(self, q: np.ndarray, state=None) -> dict:
+    def __call__(self, q: np.ndarray, state: KinematicState | None=None) -> dict:
         """link name -> absolute angle [rad] in (-pi, pi] at q (read from ``state``, a KinematicState at q,
         when the caller has one)."""
         state = state or KinematicState(self.mech, q)

@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.mobility import MobilityResult
+    from collections.abc import Callable
 
 __all__ = ["PositionSolver"]
 
@@ -61,7 +62,7 @@ class PositionSolver:
     """Solves a mechanism for given input joints; reuses the model and data
     between calls (build once, solve many times)."""
 
-    def __init__(self, mech: Mechanism, input_joints=None, output=None, compiled: bool | None = None) -> None:
+    def __init__(self, mech: Mechanism, input_joints: list | None=None, output: str | None=None, compiled: bool | None = None) -> None:
         """compiled: True to solve the closure equations with the compiled kernels of
         screwkin.model.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
         joints are all fixed or spherical, False for numpy, None to leave the mechanism's
@@ -109,7 +110,7 @@ class PositionSolver:
         return self.mech.closure.accelerated
 
     # --------------------------------------------------------------- generic data
-    def generic(self, hint=None) -> Generic:
+    def generic(self, hint: np.ndarray | None=None) -> Generic:
         """Generic ranks for these inputs and output (screwkin.analysis.singularities.singular.Generic) over the
         mechanism's generic configurations; ``hint``: an assembled configuration to start
         from when the mechanism's own assembly search has not been made."""
@@ -119,7 +120,7 @@ class PositionSolver:
             self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
         return self._generic
 
-    def reference(self):
+    def reference(self) -> np.ndarray:
         """The reference configuration (the mechanism's assembled one), or None when the
         assembly search finds none (the solutions for the inputs then stand in)."""
         try:
@@ -160,7 +161,7 @@ class PositionSolver:
     def _angular_coupled(self) -> tuple:
         return tuple(c.joint for c in self.mech.couplings if self.mech._revolute_like(c.joint))
 
-    def set_inputs(self, q: np.ndarray, values: dict):
+    def set_inputs(self, q: np.ndarray, values: dict) -> np.ndarray:
         """q with the named coordinates set: joint names of 1-DOF joints [rad or m], and the
         'joint[qk]' names that joint_values gives to the coordinates of multi-DOF joints."""
         q = np.array(q, float)
@@ -210,14 +211,14 @@ class PositionSolver:
             parts.append((self.data.oMi[joint] * placement).homogeneous[:3].ravel() * 0.1)
         return np.concatenate(parts) if parts else np.zeros(0)
 
-    def same_mode(self, sig_a, sig_b) -> bool:
+    def same_mode(self, sig_a: np.ndarray, sig_b: np.ndarray) -> bool:
         """Whether two signatures are one assembly mode: every joint centre (and the output pose) within
         the geometry tolerance, scaled by the mechanism's size where it is over a metre (the one rule of
         the random-start search, the homotopy and the closed form)."""
         return bool(np.max(np.abs(sig_a - sig_b), initial=0.0)
                     < self.mech.tolerances.geometry * max(self.mech.length, 1.0))
 
-    def _starts(self, count: int, seed: int):
+    def _starts(self, count: int, seed: int) -> list:
         """The reference configuration (when there is one), the file's configuration, and
         ``count`` random configurations within the joint limits."""
         rng = np.random.default_rng(seed)
@@ -227,7 +228,7 @@ class PositionSolver:
         return starts
 
     # --------------------------------------------------------------- solving
-    def _check_inputs(self, values: dict, every: bool = True):
+    def _check_inputs(self, values: dict, every: bool = True) -> None:
         unknown = [n for n in values if n not in self.inputs]
         missing = [n for n in self.inputs if n not in values] if every else []
         if unknown or missing:
@@ -267,7 +268,7 @@ class PositionSolver:
 
     def solve(self, values: dict, near: dict | None = None, rates: dict | None = None,
               accels: dict | None = None, starts: int = 24, seed: int = 0, trace: bool = False,
-              points=(), method: str = "auto") -> PositionResult:
+              points: tuple=(), method: str = "auto") -> PositionResult:
         """Every assembly mode for the input ``values`` (see the class).  ``points``: motion.Point
         objects whose position (and velocity, acceleration with ``rates``) each solution reports.
         ``method``: "auto" -- homotopy continuation, certified, where the closure is polynomial
@@ -363,7 +364,7 @@ class PositionSolver:
                               angular_loop_joints(self.mech), notes, held, count,
                               first or search_method(count))
 
-    def _drawn(self):
+    def _drawn(self) -> np.ndarray:
         """The configuration the values are set on where nothing is searched: the reference (the file's,
         assembled), else the file's own."""
         ref = self.reference()
@@ -384,7 +385,7 @@ class PositionSolver:
         return certified.Search([(self.signature(q), q, a) for q, a, _, _ in got.modes],
                                 [(sets, simple) for _, _, sets, simple in got.modes], got.count)
 
-    def _missed_near(self, near: dict, sol) -> tuple:
+    def _missed_near(self, near: dict, sol: Solution) -> tuple:
         """A line for each --near value the mode found lies far from (Tolerances.near_far): the joints
         --near does not name are free, so the mode nearest the given ones may not be near them."""
         tol, out = self.mech.tolerances, []
@@ -400,7 +401,7 @@ class PositionSolver:
                            f"(the nearest these inputs allow; the joints --near does not name were free)")
         return tuple(out)
 
-    def distinct(self, system, starts: list, frozen=(), first_trace=None) -> tuple:
+    def distinct(self, system, starts: list, frozen: np.ndarray=(), first_trace=None) -> tuple:
         """Solve ``system`` from every start; keep one solution per assembly mode.
 
         Returns ([(signature, q, Assembly)], smallest residual of the failures)."""
@@ -428,33 +429,33 @@ class PositionSolver:
         return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
 
     # --------------------------------------------------------------- one answer per mode
-    def _merge(self, sols):
+    def _merge(self, sols: list) -> list:
         """Solutions that are one root merged (analysis.motion.modes.merge)."""
         return modes.merge(self, sols)
 
     def _distance(self, q1: np.ndarray, q2: np.ndarray) -> float:
         return float(np.linalg.norm(self.signature(q1) - self.signature(q2)))
 
-    def _labels(self, q: np.ndarray, outside) -> tuple:
+    def _labels(self, q: np.ndarray, outside: tuple) -> tuple:
         """Why a solution is not reached by moving from the reference configuration
         (analysis.motion.modes.ModeLabels)."""
         if self._labelling is None:
             self._labelling = modes.ModeLabels(self)
         return self._labelling(q, outside)
 
-    def _linkage(self, q: np.ndarray):
+    def _linkage(self, q: np.ndarray) -> dict | None:
         """A four-bar's or slider-crank's textbook construction at q (planar.identify), or None."""
         if len(self.inputs) != 1 or self._plane_normal() is None or len(self.mech.cuts) != 1:
             return None
         info = identify(self.mech, self.mech.topology(q), q, self.inputs[0])
         return None if info is None else info.construction()
 
-    def _plane_normal(self):
+    def _plane_normal(self) -> np.ndarray:
         if self._angles is False:
             self._link_angles(self.mech.neutral())
         return None if self._angles is None else self._angles.n
 
-    def _link_angles(self, q: np.ndarray, state: KinematicState | None = None):
+    def _link_angles(self, q: np.ndarray, state: KinematicState | None = None) -> dict:
         if self._angles is False:
             self._angles = None
             ref = self.reference()
@@ -465,7 +466,7 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q: np.ndarray, a, rates: dict | None = None, accels: dict | None = None, points=(), typed=None, sets=None, simple=None) -> Solution:
+    def solution(self, q: np.ndarray, a: Assembly, rates: dict | None = None, accels: dict | None = None, points: tuple=(), typed: dict | None=None, sets: int | None=None, simple=None) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here
@@ -509,7 +510,7 @@ class PositionSolver:
                         guide_angles=(self._angles.guides(state) or None) if self._angles else None,
                         angle_sets=sets, simple=simple)
 
-    def _named(self, v) -> dict:
+    def _named(self, v: np.ndarray) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
 
     def _input_vector(self, values: dict) -> np.ndarray:
@@ -530,7 +531,7 @@ class PositionSolver:
         U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
         return (lambda b: Vt.T @ (inv * (U.T @ b))), s
 
-    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None) -> np.ndarray:
+    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve: Callable | None=None) -> np.ndarray:
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
         the passive joints, so idle spins are zero).  A link held at an angle (link_inputs)
         turns at the rate ``values`` gives its name (0 when none): its row's K q' is that rate.
@@ -542,7 +543,7 @@ class PositionSolver:
             qd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qd[self.frozen])
         return qd
 
-    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None) -> np.ndarray:
+    def accelerations(self, q: np.ndarray, K: np.ndarray, qd: np.ndarray, values: dict, solve: Callable | None=None) -> np.ndarray:
         """Joint accelerations from K q'' = -K' q' with the input accelerations given (a held link's
         angular acceleration as its row's, as in ``rates``)."""
         qdd = np.zeros(self.mech.nv)

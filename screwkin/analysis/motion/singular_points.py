@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 __all__ = ["locate_singularities"]
 
-def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref: np.ndarray | None = None):
+def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref: np.ndarray | None = None) -> np.ndarray:
     """The (scaled) matrix whose rank loss defines a singularity of this kind at q."""
     S = scaled_jacobians(mech, q, g.output, g.point)
     if kind == "constraint":
@@ -35,7 +35,7 @@ def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref: np.nda
     return S.J @ V
 
 
-def locate_singularities(solver: PositionSolver, res: SweepResult, output=None, xtol: float = LOCATE_XTOL, point: bool = False) -> list:
+def locate_singularities(solver: PositionSolver, res: SweepResult, output: str | None=None, xtol: float = LOCATE_XTOL, point: bool = False) -> list:
     """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
     positions the sweep located, and the other singularities.
 

@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.crossing import ChangePoint
     from screwkin.analysis.motion.position import PositionSolver
+    from collections.abc import Callable
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
 
@@ -93,7 +94,7 @@ class SweepResult:
         return self.stopped_at is None and not self.skipped
 
 
-def sweep_inputs(mech: Mechanism, name: str, fixed) -> list:
+def sweep_inputs(mech: Mechanism, name: str, fixed: dict) -> list:
     """The input joints of a motion of ``name`` with the joints ``fixed`` names held (a sweep's, the
     dynamics'): the actuated ones when ``name`` is one of them, else ``name`` and the held ones."""
     if name in mech.actuated:
@@ -101,7 +102,7 @@ def sweep_inputs(mech: Mechanism, name: str, fixed) -> list:
     return [name, *(n for n in fixed if n != name)]
 
 
-def _drawn_regular(solver: PositionSolver, values: dict):
+def _drawn_regular(solver: PositionSolver, values: dict) -> np.ndarray | None:
     """The file's drawn configuration, when it is closed as drawn, at the input ``values``, within the
     joint limits, and regular by its own ranks for a mechanism the inputs determine by dyads (the plan of
     analysis.motion.dyads exists: its passive joints follow from the inputs, so the generic ranks of K
@@ -137,7 +138,7 @@ def _drawn_regular(solver: PositionSolver, values: dict):
     return a.q
 
 
-def drawn_start(solver: PositionSolver, values: dict):
+def drawn_start(solver: PositionSolver, values: dict) -> np.ndarray | None:
     """The configuration the file is drawn in, when it is already at the input ``values`` and is the
     mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
     the drawing of those), found without solve's search from random starts (a sweep from the drawn
@@ -182,9 +183,9 @@ def _refined(f, start: float, h, k: int):
                    accelerations=f.accelerations[keep])
 
 
-def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
+def sweep(solver: PositionSolver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
-          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True,
+          max_steps: int | None = None, q_start: Callable | None=None, closed_form: bool = True, batch: bool = True,
           branch: str = "continue", prior=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
@@ -219,7 +220,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     return _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior)
 
 
-def _engine(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, fixed, rate: float, progress, turn: bool, max_steps: int, closed_form: bool, batch: bool):
+def _engine(solver: PositionSolver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, fixed: dict, rate: float, progress, turn: bool, max_steps: int, closed_form: bool, batch: bool) -> SweepResult:
     """The SweepResult of the engine that applies (see ``sweep``), started from q0."""
     curve, requested = Curve(solver, name), (start, stop, steps)
     if closed_form:
@@ -242,7 +243,7 @@ def _engine(solver, name: str, q0: np.ndarray, start: float, stop: float, steps:
     return _finish(solver, name, motion, rate, requested, turn, curve.unit)
 
 
-def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
+def _other_inputs(solver: PositionSolver, name: str, steps: int, fixed: dict | None) -> dict:
     """The other inputs' values (a copy of ``fixed``), once the arguments are checked."""
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -255,7 +256,7 @@ def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
     return fixed
 
 
-def _start(solver: PositionSolver, name: str, start: float, fixed, near: dict | None, q_start):
+def _start(solver: PositionSolver, name: str, start: float, fixed: dict, near: dict | None, q_start: Callable | None) -> np.ndarray:
     """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
     may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
     drawing when it is solve's first mode there, else solve's first (near ``near``)."""
@@ -269,7 +270,7 @@ def _start(solver: PositionSolver, name: str, start: float, fixed, near: dict | 
     return q0
 
 
-def _closed_form(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float, turn: bool, max_steps: int) -> SweepResult | None:
+def _closed_form(solver: PositionSolver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float, turn: bool, max_steps: int) -> SweepResult | None:
     """The SweepResult of the closed-form engine (analysis.motion.dyads; on a finer grid read at this
     one's values where this one is too coarse for it), or None where it does not apply."""
     f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
@@ -347,7 +348,7 @@ def _finish(solver: PositionSolver, name: str, motion: Motion, rate, requested, 
 
 
 
-def _through_change_points(solver: PositionSolver, res: SweepResult, fixed, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None):
+def _through_change_points(solver: PositionSolver, res: SweepResult, fixed: dict, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None) -> SweepResult:
     """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it

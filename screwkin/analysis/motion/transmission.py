@@ -51,7 +51,7 @@ FOUR_BAR_CLASSES = (
 _BY_SHORTEST = np.array([3, 2, 4, 5])  # shortest link ground, input, coupler, output -> class code
 
 
-def four_bar_classes(g, a, b, c, equal: float) -> np.ndarray:
+def four_bar_classes(g: float, a: float, b: float, c: float, equal: float) -> np.ndarray:
     """Grashof class codes (indices into FOUR_BAR_CLASSES) of four-bars with ground g, input a,
     coupler b and output c: s + l against p + q (a change point within ``equal`` times the longest
     link), and, for a Grashof linkage, which link is the shortest (the first of ground, input,
@@ -64,11 +64,11 @@ def four_bar_classes(g, a, b, c, equal: float) -> np.ndarray:
     return np.where(np.abs(s + l - p_q) < equal * l, 0, code)
 
 
-def _acos(x):
+def _acos(x: np.ndarray | float) -> np.ndarray | float:
     return np.arccos(np.clip(x, -1.0, 1.0))
 
 
-def transmission_angle(B, C, D):
+def transmission_angle(B: np.ndarray, C: np.ndarray, D: np.ndarray) -> float:
     """mu [rad] of four-bars from their joint centres: the angle at the coupler-output joint C between
     C -> B (the coupler) and C -> D (the output link), in [0, pi]; points (..., 2) or (..., 3).
 
@@ -79,13 +79,13 @@ def transmission_angle(B, C, D):
     return vector_angle(B - C, D - C)
 
 
-def slide_transmission_angle(B, C, normal: np.ndarray):
+def slide_transmission_angle(B: np.ndarray, C: np.ndarray, normal: np.ndarray) -> np.ndarray | float:
     """mu [rad] of slider-cranks from the rod's ends B (on the crank) and C (the slider's pin): the angle
     between the rod B -> C and the slide's normal ``normal``, in [0, pi/2]."""
     return line_angle(np.asarray(C, float) - np.asarray(B, float), normal)
 
 
-def four_bar_cos_mu(g, a, b, c, phi):
+def four_bar_cos_mu(g: float, a: float, b: float, c: float, phi: np.ndarray) -> np.ndarray:
     """cos(mu) of four-bars (ground g, input a, coupler b, output c) at the input angle phi [rad] from the
     ground line, from the lengths (module docstring): (b^2 + c^2 - z^2) / (2 b c) with the diagonal
     z^2 = a^2 + g^2 - 2 a g cos(phi); beyond [-1, 1] where the linkage does not assemble at phi."""
@@ -93,7 +93,7 @@ def four_bar_cos_mu(g, a, b, c, phi):
     return (b * b + c * c - z2) / (2 * b * c)
 
 
-def four_bar_transmission(g, a, b, c, equal: float) -> tuple:
+def four_bar_transmission(g: float, a: float, b: float, c: float, equal: float) -> tuple:
     """(mu_min, mu_max [rad], turns, dead points) of four-bars over their input's motion (module
     docstring): ``turns`` where the input turns fully; ``dead`` the number of positions of the
     motion where mu is 0 or 180 deg (the two limit positions of an input that rocks, and a
@@ -119,7 +119,7 @@ def four_bar_transmission(g, a, b, c, equal: float) -> tuple:
     return mu_min, mu_max, turns, dead
 
 
-def slider_crank_transmission(a, b, e, equal: float) -> tuple:
+def slider_crank_transmission(a: float, b: float, e: float, equal: float) -> tuple:
     """(mu_min, mu_max [rad], turns, dead points) of slider-cranks (crank a, rod b, offset e) over
     the crank's motion (module docstring)."""
     a, b, e = np.broadcast_arrays(*(np.asarray(v, float) for v in (a, b, e)))
@@ -156,7 +156,7 @@ class TransmissionRange:
         return float(max(math.pi / 2 - self.low, self.high - math.pi / 2))
 
 
-def _mu_at(info, phi):
+def _mu_at(info, phi: np.ndarray) -> np.ndarray:
     """mu [rad] at input angles phi (from the ground line, or the slide's direction)."""
     L = info.lengths
     if info.kind == "four-bar":

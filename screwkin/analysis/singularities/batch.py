@@ -38,7 +38,7 @@ __all__ = ["frame_jacobians", "SerialJacobians", "stack_singular_values", "small
 _REFERENCES = (pin.ReferenceFrame.WORLD, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, pin.ReferenceFrame.LOCAL)
 
 
-def frame_jacobians(model: pin.Model, frame_id: int, Q: np.ndarray, reference=pin.ReferenceFrame.WORLD, data=None) -> np.ndarray:
+def frame_jacobians(model: pin.Model, frame_id: int, Q: np.ndarray, reference: pin.ReferenceFrame=pin.ReferenceFrame.WORLD, data=None) -> np.ndarray:
     """(N, 6, nv) frame Jacobians for the configurations in the rows of Q (N, nq)."""
     Q = np.atleast_2d(np.asarray(Q, float))
     if Q.shape[1] != model.nq:

@@ -80,7 +80,7 @@ class SingularityReport:
     input_output_note: str | None = None
 
 
-def _rel(s, k: int) -> float:
+def _rel(s: np.ndarray, k: int) -> float:
     """k-th singular value (1-based) relative to the largest; 0 when missing."""
     if k <= 0:
         return 1.0
@@ -102,7 +102,7 @@ class Scaled:
     L: float
 
 
-def scaled_jacobians(mech: Mechanism, q: np.ndarray, output=None, point: bool = False, length: float | None = None) -> Scaled:
+def scaled_jacobians(mech: Mechanism, q: np.ndarray, output: str | None=None, point: bool = False, length: float | None = None) -> Scaled:
     """The matrices of :class:`Scaled` at q (assembled)."""
     L = float(length or mech.length)
     slide = mech.translational
@@ -130,7 +130,7 @@ class Generic:
     joints that move there (a joint whose rate the loops force to zero everywhere is not
     "stationary" at any one configuration)."""
 
-    def __init__(self, mech: Mechanism, inputs, output=None, point: bool = False, configurations=None) -> None:
+    def __init__(self, mech: Mechanism, inputs: list, output: str | None=None, point: bool = False, configurations: tuple | None=None) -> None:
         tol = mech.tolerances
         configs = configurations if configurations is not None else mech.generic_configurations()[1]
         self.inputs = list(inputs)
