@@ -90,8 +90,8 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
                                  f"{', ...' if len(rotors) > 3 else ''}) has no URDF form: not written (damping and "
                                  "frictionloss are, as <dynamics damping friction>)")
         written.append({"format": fmt, "path": str(out), "bodies": len(pm.bodies), "loop_joints": len(pm.cuts)})
-    for out, text in texts:
-        write_output(out, text)
+    for out, body in texts:
+        write_output(out, body)
 
     def data():
         return with_mode(args, {"file": mech.path, "written": written, "configuration": values,

@@ -31,7 +31,7 @@ from ..errors import MechanismFileError, UsageError
 from .xacro import expand
 from .xacro_eval import _COMPARE, FUNCTIONS, _call, _function_name, _Interpreter, _power, _Refused, evaluate
 from .xmlsafe import parse_xml_text
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 if TYPE_CHECKING:
     from typing import Any
@@ -64,7 +64,7 @@ class _Context:
         self.bad = np.zeros(n, bool)
         self.reason = None
 
-    def refuse(self, why: str):
+    def refuse(self, why: str) -> NoReturn:
         self.reason = self.reason or why
         raise Unbatchable(why)
 
