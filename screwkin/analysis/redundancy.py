@@ -142,7 +142,7 @@ def _directions(cut: CutJoint, state: KinematicState, tol: Tolerances) -> tuple:
     return e1, e2, a, ("a direction across the axis", "the other direction across it", "the axis")
 
 
-def _describe_span(W: np.ndarray, at: np.ndarray, dirs: tuple, L: float, tol: Tolerances) -> tuple[tuple, str]:
+def _describe_span(W: np.ndarray | list, at: np.ndarray, dirs: tuple, L: float, tol: Tolerances) -> tuple[tuple, str]:
     """(named canonical wrenches, words) of the span of wrenches W (k, 6) at point ``at`` (moment
     about the world origin): canonical when the span is that of some of the joint's six canonical
     wrenches, else each basis wrench as a screw."""
@@ -191,7 +191,7 @@ def _algebra(mech: Mechanism, q: np.ndarray) -> tuple:
     return kind, where, system.length
 
 
-def _why(mech: Mechanism, W: np.ndarray, algebra: tuple) -> str:
+def _why(mech: Mechanism, W: np.ndarray | list, algebra: tuple) -> str:
     """Why a joint's redundant wrenches W (k, 6) are there: "planar" when every one does no work on the
     planar motions the tree's joints make (their screws all lie in one plane's se(2)), "spherical"
     likewise on the rotations about one point, "planar and overconstrained" when only some do, else

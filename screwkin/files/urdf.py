@@ -44,7 +44,7 @@ __all__ = ["read_urdf", "numbers", "unit_axis", "check_tree", "check_sizes", "Pr
 class Problems(list):
     """Collects every problem of a file before failing."""
 
-    def fail_if_any(self, path: Path) -> None:
+    def fail_if_any(self, path: Path | str) -> None:
         if self:
             raise MechanismFileError(path, list(self))
 
@@ -86,7 +86,7 @@ def numbers(text: str, count: int, what: str, problems: list | Problems, default
     return values
 
 
-def unit_axis(values: tuple, what: str, problems: Problems, default: tuple=(1.0, 0.0, 0.0)) -> tuple:
+def unit_axis(values: tuple | np.ndarray, what: str, problems: Problems | list, default: tuple=(1.0, 0.0, 0.0)) -> tuple:
     """``values`` scaled to length 1 (safely: divided by the largest magnitude first);
     records a problem for a zero axis or one whose length Pinocchio cannot normalize."""
     v = np.asarray(values, float)
@@ -358,7 +358,7 @@ def check_sizes(path: str | Path, links: int, joints: int, loop_joints: int, coo
                   f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
-def check_tree(path: Path, links: dict, joints: list, problems: Problems) -> None:
+def check_tree(path, links: dict, joints: list, problems: Problems) -> None:
     """Record problems that keep the joints from forming one tree over the links."""
     parent_of = {}
     for j in joints:
@@ -400,7 +400,7 @@ def _coordinates(joints: list) -> int:
     return sum(TREE_JOINT_DOF[j.type] for j in joints)
 
 
-def read_urdf(path: Path, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
+def read_urdf(path: Path | str, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
     """Read a URDF file (already loaded as ``text``, and parsed as ``root`` when given)
     into a :class:`MechanismSpec`.  package_dirs: folders searched for ``package://`` meshes."""
     if root is None:

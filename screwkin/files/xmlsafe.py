@@ -85,7 +85,7 @@ def read_regular_file(path: Path, max_bytes: int, what: str = "file") -> bytes:
         os.close(fd)
 
 
-def parse_xml_text(text: str, path: Path) -> ET.Element:
+def parse_xml_text(text: str, path: Path | str) -> ET.Element:
     """Parse ``text`` (the contents of ``path``) and return the root element.
 
     The elements are counted and their nesting measured while parsing, so a file of a

@@ -21,7 +21,7 @@ TINY = 1e-300  # division guard
 AXIS_IN_PLANE = 1e-6
 
 
-def perpendicular_basis(a: np.ndarray | list | tuple) -> tuple:
+def perpendicular_basis(a) -> tuple:
     """Two unit vectors (b1, b2) completing the unit vector ``a`` to a right-handed basis
     (b1, b2, a): b1 = a x h / |a x h| with h the world x axis (y when a is near x), b2 = a x b1.
 
@@ -58,7 +58,7 @@ def cross2(u: np.ndarray | list, w: np.ndarray | list) -> float:
     return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 
 
-def circle_circle(p: np.ndarray | list, r: float, c: np.ndarray | list, s: float, side: np.ndarray | float) -> tuple:
+def circle_circle(p: np.ndarray | list, r: float, c: np.ndarray | list | tuple, s: float, side: np.ndarray | float) -> tuple:
     """The intersection of the circle (centre p, radius r) and the circle (c, s) in the plane
     on the ``side`` (+1: left of the line p -> c, -1: right), broadcast over points (..., 2):
     (X, h2), h2 the squared distance of X from the line p -> c; h2 < 0 where the circles do
@@ -80,7 +80,7 @@ def circle_circle(p: np.ndarray | list, r: float, c: np.ndarray | list, s: float
     return p + along[..., None] * u + (side * h)[..., None] * n, h2
 
 
-def circle_intersections(p: np.ndarray | list, r: float, c: np.ndarray | list, s: float, slack: float = 0.0, concentric: float = 0.0) -> list:
+def circle_intersections(p: np.ndarray | list, r: float, c: np.ndarray | list, s, slack: float = 0.0, concentric: float = 0.0) -> list:
     """The points where the circles (p, r) and (c, s) in the plane meet: [left of p -> c,
     right], the same point twice where they touch, [] where they do not meet (the centres
     closer than ``concentric``, or farther than r + s + slack, or nearer than |r - s| - slack).
@@ -122,7 +122,7 @@ def line_circle(point: np.ndarray | list, direction: np.ndarray, centre: np.ndar
     return [foot - h * direction, foot + h * direction]
 
 
-def lines_point(points: list, directions: np.ndarray | list, tol: float) -> tuple:
+def lines_point(points: list | np.ndarray, directions: np.ndarray | list, tol: float) -> tuple:
     """(c, d): the point c nearest, in least squares, the 3-D lines through ``points`` along
     ``directions`` (sum (I - u u^T) (c - p) = 0, u the unit directions), and the largest distance d
     of a line from it; (None, inf) where the lines are parallel (that system's rank, by ``tol``,

@@ -80,7 +80,7 @@ class Integrator:
         self.plain = not self.groups and not self.per_configuration and model.nq == model.nv and (
             np.array_equal(self.vector[0], np.arange(model.nq)) and np.array_equal(self.vector[1], np.arange(model.nv)))
 
-    def __call__(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+    def __call__(self, Q: np.ndarray | tuple, V: np.ndarray) -> np.ndarray:
         if self.plain:
             return Q + V
         Q, V = np.asarray(Q, float), np.asarray(V, float)

@@ -43,7 +43,7 @@ class DyadPlan:
     order: tuple  # per op: the groups it places: (known, placed) for the input, (g1, g2) for a dyad
 
 
-def _pairs(mech: Mechanism) -> list:
+def _pairs(mech: Mechanism):
     """The tree and cut joints as (name, kind, body1, body2, tree index), or a reason they are not R/P."""
     model, out = mech.model, []
     for j in range(1, model.njoints):
@@ -60,7 +60,7 @@ def _pairs(mech: Mechanism) -> list:
     return out
 
 
-def plan(mech: Mechanism, inputs: list, name: str) -> DyadPlan:
+def plan(mech: Mechanism, inputs: list, name: str):
     """The DyadPlan of ``mech`` swept along input ``name`` with the other ``inputs`` held, or a
     string saying why it does not decompose into the input and RRR/RRP/PRR/RPR dyads."""
     if mech.couplings or mech.extra_rows:

@@ -257,7 +257,7 @@ class KinematicState:
         """World placement of a joint's frame (pinocchio.SE3, a copy)."""
         return pin.SE3(self._data().oMi[jid])
 
-    def centre(self, ref: tuple) -> np.ndarray:
+    def centre(self, ref: tuple | list) -> np.ndarray:
         """World position [m] of a point named by reference: ("joint", i) the centre of joint i (its
         frame's origin, moving with it), ("mount", i) where joint i sits on its parent link (fixed
         there whatever joint i's value), ("frame", f) frame f's origin."""

@@ -18,7 +18,7 @@ __all__ = ["topology_dict", "mobility_dict", "JOINT_COLUMNS", "joint_rows", "top
            "screw_theory_rows", "mobility_text"]
 
 
-def _joint_dict(j: int) -> dict:
+def _joint_dict(j) -> dict:
     return {
         "name": j.name,
         "type": j.type,

@@ -31,7 +31,6 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.motion.certified import ModeCount
     from screwkin.analysis.motion.solution import Solution
 
 __all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "singularity_dict",
@@ -89,7 +88,7 @@ def position_dict(res: PositionResult) -> dict:
             "complete": bool(res.modes is not None and res.modes.complete)}
 
 
-def modes_dict(c: ModeCount) -> dict:
+def modes_dict(c) -> dict:
     """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
@@ -142,7 +141,7 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name: str, value: float, angular: bool) -> str:
+def value_text(name: str | int, value: float, angular: bool) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
@@ -174,7 +173,7 @@ def solution_rows(res: PositionResult, s: Solution, degrees: bool = True, units:
 
     placed = s.guide_positions or {}
 
-    def along(name: str) -> str:
+    def along(name: str | np.ndarray) -> str:
         where = f"d = {placed[name]:.9g} m" if name in placed else ""
         at = f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
         return ", ".join(w for w in (where, at) if w)

@@ -212,7 +212,7 @@ def numbering(topo: Topology, inputs=()) -> tuple:
     own = {j.name for j in joints if re.fullmatch(rf"[A-Z][A-Za-z0-9]{{0,{SHORT_NAME - 1}}}", j.name)}
     taken, next_letter = set(own), [0]
 
-    def mark(j: int) -> None:
+    def mark(j) -> None:
         if j.name not in letter:
             if j.name in own:
                 letter[j.name] = j.name
@@ -247,7 +247,7 @@ def _frame_point(state: KinematicState, name: str):
     return state.frame_placement(state.mech.model.getFrameId(name))
 
 
-def _joint_ends(state: KinematicState, j: int) -> tuple:
+def _joint_ends(state: KinematicState, j) -> tuple:
     """(point on links[0], point on links[1], axis or None) of a topology joint, in the world, at
     the configuration of ``state`` (a model.state.KinematicState)."""
     model = state.mech.model
@@ -407,7 +407,7 @@ def _area(hull):
     return 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))
 
 
-def _extremes(pts: np.ndarray) -> tuple[tuple, tuple]:
+def _extremes(pts: np.ndarray | list) -> tuple[tuple, tuple]:
     P = np.array(pts)
     c = P.mean(axis=0)
     _, _, vt = np.linalg.svd(P - c)
@@ -415,7 +415,7 @@ def _extremes(pts: np.ndarray) -> tuple[tuple, tuple]:
     return (tuple(P[int(np.argmin(s))]), tuple(P[int(np.argmax(s))]))
 
 
-def _stub(state: KinematicState, name: str, pts: np.ndarray, p2, tol) -> tuple[str, tuple]:
+def _stub(state: KinematicState, name: str, pts: np.ndarray | list, p2, tol) -> tuple[str, tuple]:
     """A link with one joint centre: drawn to its frame's origin, else its centre of mass,
     else a short stub along its frame's x axis."""
     mech = state.mech

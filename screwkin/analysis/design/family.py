@@ -254,7 +254,7 @@ def family_rows(task, chunk) -> ChunkRows | None:
                                                         f"{exc}"])
 
 
-def _family(task: _Task, chunk, index: int, values: np.ndarray, alone: dict) -> ChunkRows:
+def _family(task: _Task, chunk, index: int | list, values: np.ndarray, alone: dict) -> ChunkRows:
     n = len(chunk)
     be = expand_batch(task.file, task.text, task.args, {p: values[:, k] for k, p in enumerate(task.parameters)})
     specs = [None] * n

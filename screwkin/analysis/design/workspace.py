@@ -116,7 +116,7 @@ class _Measures:
         self.slide = mech.translational
         self.position_rows = mech.closure.position_rows
 
-    def __call__(self, Q: np.ndarray) -> dict:
+    def __call__(self, Q: np.ndarray | tuple) -> dict:
         out = {"actuator": np.empty(len(Q)), "serial": np.empty(len(Q)), "conditioning": np.empty(len(Q))}
         for s in range(0, len(Q), _BLOCK):
             part = self._block(Q[s:s + _BLOCK])

@@ -82,7 +82,7 @@ class Grid:
         self.solves = 0
         self.truncated = False
 
-    def position(self, index: np.ndarray) -> np.ndarray:
+    def position(self, index) -> np.ndarray:
         return self.p_seed + (np.asarray(index, float) * self.h) @ self.axes
 
     def solve(self, Q0: np.ndarray, P) -> tuple:
@@ -131,7 +131,7 @@ class Grid:
         ev = np.sqrt(np.maximum(np.linalg.eigvalsh(K_new.transpose(0, 2, 1) @ K_new), 0.0))[:, ::-1]
         return ok, np.where(ev[:, 0] > 0, ev[:, r - 1] / np.where(ev[:, 0] > 0, ev[:, 0], 1.0), 0.0)
 
-    def substeps(self, sigma: float) -> np.ndarray:
+    def substeps(self, sigma: float | np.ndarray) -> np.ndarray:
         """Substeps for a grid step from points of relative singular value sigma: two branches
         of a fold a distance d inside it differ by about sqrt(d / L) in the joints, and so does
         sigma there, so a step of h may land on either below about sqrt(h / L): the step is cut
@@ -143,7 +143,7 @@ class Grid:
         n = np.minimum(2 ** np.ceil(np.log2(np.clip(need, 1.0, _SUBSTEPS))), _SUBSTEPS)
         return np.where(sigma >= _SINGULAR, n, 0).astype(int)
 
-    def advance(self, Q: np.ndarray, P_from, P_to, n: int) -> tuple:
+    def advance(self, Q: np.ndarray, P_from, P_to, n) -> tuple:
         """Solve from Q at P_from to P_to in n equal substeps (n: an int, or one per point,
         all advanced together): (Q, ok, sigma, jumped) -- jumped: a substep converged within
         the limits but ``kept`` refused it (another branch, or far from the prediction)."""

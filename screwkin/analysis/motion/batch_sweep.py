@@ -138,7 +138,7 @@ def batched_motion(solver, curve, q0: np.ndarray, t0, start: float, stop: float,
     return m
 
 
-def motion_rates(solver, bc: BatchClosure, Q: np.ndarray, values: dict) -> tuple:
+def motion_rates(solver, bc: BatchClosure, Q: np.ndarray | list, values: dict) -> tuple:
     """Joint rates and accelerations (N, nv) at the closed configurations Q for the input rates
     ``values`` (input accelerations zero): PositionSolver.rates and .accelerations of every row,
     the constraint Jacobians, the bias K'(q, q') q' and the minimum-norm passive solves batched

@@ -119,7 +119,7 @@ class Problem:
 
 
 def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),  # noqa: B008 - frozen
-                    problem: Problem | None = None) -> Certified:
+                    problem: Problem | None = None):
     """The assembly modes for the input ``values`` by homotopy continuation (see the module): a
     Certified, or the reason (a string) why the method does not apply.  ``problem``: another system
     to solve (inverse kinematics); by default the solver's loops with its inputs held."""

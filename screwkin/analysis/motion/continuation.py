@@ -375,7 +375,7 @@ class Neighbour:
     def __init__(self, solver, name: str) -> None:
         self.curve = Curve(solver, name)
 
-    def __call__(self, q: np.ndarray, x_from: float, x_to: float):
+    def __call__(self, q: np.ndarray | tuple, x_from: float, x_to: float):
         """The configuration at input value x_to on q's branch (q at x_from), or None."""
         c = self.curve
         direction = np.sign(x_to - x_from)

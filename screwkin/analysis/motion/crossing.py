@@ -128,7 +128,7 @@ class Crossing:
     rank: int = 0  # the generic rank of K the measure was taken at
 
 
-def constraint_profile(mech: Mechanism, Q: np.ndarray, rank: int | None = None) -> tuple:
+def constraint_profile(mech: Mechanism, Q: np.ndarray | list, rank: int | None = None) -> tuple:
     """(the relative smallest singular value of the scaled K at each configuration of Q (N,), the rank
     it is taken at): analysis.singularities.singular.measures' "constraint", with ``rank`` (default the
     largest rank met along Q: a motion's configurations are generic but for isolated ones) for the
@@ -281,7 +281,7 @@ def _limit_index(xs: np.ndarray, x) -> int:
     return len(xs) - 1
 
 
-def _branch_rates(mech: Mechanism, branch: str) -> np.ndarray:
+def _branch_rates(mech: Mechanism, branch) -> np.ndarray:
     """A branch's tangent as joint rates (nv), in the order of the coordinates."""
     return np.array([branch.tangent.get(n, 0.0) for n in mech.coordinate_names], float)
 

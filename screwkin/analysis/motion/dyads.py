@@ -118,7 +118,7 @@ class _Pose:
     def rotate(self, u: np.ndarray) -> tuple:
         return self.c * u[0] - self.s * u[1], self.s * u[0] + self.c * u[1]
 
-    def __call__(self, p: np.ndarray) -> tuple:
+    def __call__(self, p: np.ndarray | tuple) -> tuple:
         x, y = self.rotate(p)
         return x + self.tx, y + self.ty
 
@@ -197,7 +197,7 @@ class _Geometry:
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, g2: int, pa: _Pose | None, pc: _Pose, sigma: float, probe: bool=False, clamp: bool=False) -> float | tuple:
+def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, g2: int, pa: _Pose | None, pc: _Pose, sigma: float | str, probe: bool=False, clamp: bool=False) -> float | tuple:
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -256,7 +256,7 @@ def _root(disc: Jet, clamp: bool) -> Jet:
         return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
 
 
-def _evaluate(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, branch: str, clamp: int | None = None) -> tuple:
+def _evaluate(geo: _Geometry, p: DyadPlan, xs: np.ndarray | list, start: float, branch: str, clamp: int | None = None) -> tuple:
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
     clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
     Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
@@ -304,7 +304,7 @@ class _Layout:
         self.geo, self.q0, self.nq, self.nv = geo, q0, model.nq, model.nv
         self.wrapped = [(iq, iv) for iq, nq, iv, kind, _, _, _ in self.rows if kind == "R" and nq == 1]
 
-    def __call__(self, poses: dict, N: int) -> tuple:
+    def __call__(self, poses: dict | tuple, N: int) -> tuple:
         """(Q (N, nq) with the one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2 (N, nv))."""
         geo, q0 = self.geo, self.q0
         Q = np.tile(q0, (N, 1))
@@ -346,7 +346,7 @@ class _Unwrap:
         self.last = None  # (raw, slope, x, turns) of the last sample
         self.ambiguous = False
 
-    def __call__(self, Q: np.ndarray, D: np.ndarray, xs: np.ndarray) -> np.ndarray:
+    def __call__(self, Q: np.ndarray | tuple, D: np.ndarray, xs: np.ndarray):
         """Q with its angles unwrapped; D (N, nv): dq/dx."""
         if not len(self.cols) or not len(xs):
             return Q
@@ -424,7 +424,7 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs: list, branch: list | None=None, clamp: int | None = None) -> tuple:
+    def predict(self, xs: list | np.ndarray, branch: list | None=None, clamp: int | None = None) -> tuple:
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
@@ -579,5 +579,5 @@ def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, s
     return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 
-def _take(j: int, n: int) -> Jet:
+def _take(j, n: int) -> Jet:
     return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))

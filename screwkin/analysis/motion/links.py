@@ -107,7 +107,7 @@ class MotionAlong:
     normal: tuple | None = None  # planar mechanisms: the plane's normal omega and alpha are about
 
 
-def motion_along(mech: Mechanism, Q: np.ndarray, V: np.ndarray, A: np.ndarray, points: tuple=(), angles: LinkAngles | None = None, normal: np.ndarray | None = None) -> MotionAlong:
+def motion_along(mech: Mechanism, Q: np.ndarray, V: np.ndarray, A: np.ndarray, points: tuple | list=(), angles: LinkAngles | None = None, normal: np.ndarray | None = None) -> MotionAlong:
     """The absolute motion at each configuration Q[k] with rates V[k] and accelerations A[k];
     ``angles``: a callable q -> link angles (LinkAngles) for planar mechanisms, with ``normal``.
 

@@ -188,7 +188,7 @@ class ModeLabels:
         return float((p - state.joint_placement(self.model.parents[jid]).translation)
                      @ (state.joint_placement(jid).rotation @ axis))
 
-    def __call__(self, q: np.ndarray, outside: tuple) -> tuple:
+    def __call__(self, q: np.ndarray | tuple, outside: tuple) -> tuple:
         """Why the solution at q is not reached by moving from the reference configuration."""
         labels = [f"outside the joint limits: {', '.join(outside)}"] if outside else []
         if not self.active:

@@ -110,7 +110,7 @@ class PositionSolver:
         return self.mech.closure.accelerated
 
     # --------------------------------------------------------------- generic data
-    def generic(self, hint: np.ndarray | None=None) -> Generic:
+    def generic(self, hint: np.ndarray | None=None):
         """Generic ranks for these inputs and output (screwkin.analysis.singularities.singular.Generic) over the
         mechanism's generic configurations; ``hint``: an assembled configuration to start
         from when the mechanism's own assembly search has not been made."""
@@ -120,7 +120,7 @@ class PositionSolver:
             self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
         return self._generic
 
-    def reference(self) -> np.ndarray:
+    def reference(self):
         """The reference configuration (the mechanism's assembled one), or None when the
         assembly search finds none (the solutions for the inputs then stand in)."""
         try:
@@ -254,7 +254,7 @@ class PositionSolver:
                           f"{'each is an input' if len(names) > 1 else 'it is an input'} that only its own value "
                           f"decides; give {'them' if len(names) > 1 else 'it'} with --set (the file's values: {hint})")
 
-    def track(self, values: dict, q: np.ndarray) -> Assembly:
+    def track(self, values: dict, q) -> Assembly:
         """The configuration that damped Newton reaches from the configuration ``q`` with the
         named inputs moved to ``values`` (inputs not named keep their values in q): the
         closed-loop forward kinematics of a control or simulation loop, in the assembly

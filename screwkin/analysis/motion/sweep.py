@@ -185,7 +185,7 @@ def _refined(f, start: float, h, k: int):
 
 def sweep(solver: PositionSolver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
-          max_steps: int | None = None, q_start: Callable | None=None, closed_form: bool = True, batch: bool = True,
+          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True,
           branch: str = "continue", prior=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).

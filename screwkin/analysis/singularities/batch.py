@@ -191,7 +191,7 @@ class SerialJacobians:
             return J.transpose(2, 0, 1), np.stack(Re, axis=1).transpose(2, 0, 1), pe.T
         return J.transpose(2, 0, 1)
 
-    def __call__(self, Q: np.ndarray) -> np.ndarray:
+    def __call__(self, Q: np.ndarray | tuple) -> np.ndarray:
         """(N, 6, nv) Jacobians for the configurations in the rows of Q (N, nq)."""
         Q = np.atleast_2d(np.asarray(Q, float))
         if Q.ndim != 2 or Q.shape[1] != self.model.nq:

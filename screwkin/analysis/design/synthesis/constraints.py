@@ -173,7 +173,7 @@ class Constraints:
             out += np.maximum(t - lo, 0) + np.maximum(hi - (math.pi - t), 0)
         return out
 
-    def unmet(self, A0: np.ndarray, B0: np.ndarray, g, a, b, c, mu, equal: float, tol: float) -> list:
+    def unmet(self, A0: np.ndarray | tuple, B0: np.ndarray | tuple, g, a, b, c, mu, equal: float, tol: float) -> list:
         """What one finished design does not meet (words; empty when it meets them all): ``mu`` its
         (min, max) transmission angle over the motion [rad] or None, ``tol`` [m] the slack on
         positions and lengths."""

@@ -46,7 +46,7 @@ def pose_matrix(pose) -> tuple:
     return rotate(pose[2]), np.array(pose[:2], float)
 
 
-def branch(A, B, B0: np.ndarray):
+def branch(A, B, B0: np.ndarray | tuple):
     """sigma: +1 when B lies left of the line A -> B0, -1 right (arrays broadcast)."""
     A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
     return np.sign(cross2(B0 - A, B - A))

@@ -187,7 +187,7 @@ def synthesize_function(text: str, x_range, input_range, output_range, points: i
     return function_result(task, freudenstein(task["phi"], task["psi"]))
 
 
-def function_result(task, K: np.ndarray, d: float | None = None, sigma: float | None = None, offset: tuple = (0.0, 0.0),
+def function_result(task, K: np.ndarray | tuple, d: float | None = None, sigma: float | None = None, offset: tuple = (0.0, 0.0),
                     search=None) -> FunctionResult:
     """The FunctionResult of the four-bar with Freudenstein coefficients K and ground ``d`` (default the
     task's), on branch ``sigma`` (default: the branch nearest the first precision point), its rocker's
