@@ -309,7 +309,7 @@ def analyze_mobility(mech: Mechanism, output: str | None=None, seed: int = 0, po
     return mech.cache[key]
 
 
-def _local_notes(local, where: str, M_generic, generic_rank, samples: int) -> tuple:
+def _local_notes(local: LocalAnalysis, where: str, M_generic: int, generic_rank: int, samples: int) -> tuple:
     """Why the mobility reported (the local analysis' finite mobility at ``where``) is not the generic one."""
     if local.finite_mobility is None or local.finite_mobility == M_generic:
         return ()

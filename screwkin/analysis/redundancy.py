@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.model.cuts import CutJoint
     from screwkin.tolerances import Tolerances
+    from screwkin.analysis.loop_series import LoopSystem
 
 __all__ = ["JointRedundancy", "Suggestion", "Redundancy", "redundancy", "suggest", "CANONICAL"]
 
@@ -179,7 +180,7 @@ def _describe_span(W: np.ndarray | list, at: np.ndarray, dirs: tuple, L: float, 
     return (), "; ".join(words)
 
 
-def _and(items: list):
+def _and(items: list) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
@@ -290,7 +291,7 @@ def _per_joint(mech: Mechanism, q: np.ndarray, state: KinematicState, Lam: np.nd
     return tuple(out)
 
 
-def _canonical_wrenches(named, dirs, p) -> np.ndarray:
+def _canonical_wrenches(named: tuple, dirs: tuple, p: np.ndarray) -> np.ndarray:
     e1, e2, e3, labels = dirs
     out = []
     for n in named:
@@ -300,11 +301,11 @@ def _canonical_wrenches(named, dirs, p) -> np.ndarray:
     return np.array(out)
 
 
-def _rotation_twist(u, p):
+def _rotation_twist(u: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.r_[np.cross(p, u), u]
 
 
-def _options(mech: Mechanism, state: KinematicState, name: str, kind: str, axis, point, axes: list) -> list:
+def _options(mech: Mechanism, state: KinematicState, name: str, kind: str, axis: np.ndarray | tuple, point: np.ndarray, axes: list) -> list:
     """(new type, [(world twist, words)], replacement) for each way to free more at one joint; ``axes``:
     the directions a universal joint's second axis may take ((world vector, letter or None))."""
     opts = []
@@ -321,7 +322,7 @@ def _options(mech: Mechanism, state: KinematicState, name: str, kind: str, axis,
     return opts
 
 
-def _candidates(mech: Mechanism, state: KinematicState):
+def _candidates(mech: Mechanism, state: KinematicState) -> list:
     """The joints a suggestion may change, in the order it tries them: cut joints, then unactuated tree
     joints on the ground, then the other unactuated ones, then the actuated ones; each (name, is a cut,
     options)."""
@@ -367,7 +368,7 @@ def _candidates(mech: Mechanism, state: KinematicState):
                   for _, (n, _, opts) in tree]
 
 
-def _column(system, mech: Mechanism, name: str, is_cut, twist) -> np.ndarray:
+def _column(system: LoopSystem, mech: Mechanism, name: str, is_cut: bool, twist: np.ndarray) -> np.ndarray:
     """The column of A (unreduced loop system) that a new freedom ``twist`` (world) at joint ``name`` adds."""
     t = np.asarray(twist, float).copy()
     t[:3] /= system.length
@@ -433,7 +434,7 @@ def suggest(mech: Mechanism, q: np.ndarray, count: int | None = None) -> Suggest
     return Suggestion(changes, text, M, over, checked)
 
 
-def _change_words(mech: Mechanism, chosen) -> list:
+def _change_words(mech: Mechanism, chosen: list) -> list:
     kinds = _cut_words(mech)
     out = []
     for name, is_cut, new_type, twists, letter in chosen:
@@ -447,7 +448,7 @@ def _change_words(mech: Mechanism, chosen) -> list:
     return out
 
 
-def _check(mech: Mechanism, q: np.ndarray, chosen) -> tuple:
+def _check(mech: Mechanism, q: np.ndarray, chosen: list) -> tuple:
     """(mobility, overconstraint, words) of the mechanism with the chosen joints, built and analysed:
     the largest rank of K over its generic configurations."""
     spec = copy.deepcopy(mech.spec)

@@ -7,6 +7,10 @@ import argparse
 
 from ..present.jsonout import json_of
 from ._output_frame import add_point_option
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["add_common", "add_scaled", "emit", "EXPLAIN_HELP"]
 
@@ -46,7 +50,7 @@ def add_scaled(sp, point: bool=True) -> None:
                              "instead of its full motion")
 
 
-def emit(args: argparse.Namespace, data, text) -> int:
+def emit(args: argparse.Namespace, data: Callable, text: Callable) -> int:
     """Print ``data`` as one JSON object (--json; written by present/jsonout.json_of, the one writer) or
     ``text`` (a string, or a callable making it, so that text-only work is skipped for --json); exit code 0."""
     if getattr(args, "json", False):

@@ -73,7 +73,7 @@ BOUNDS = {
 SECONDS = {"timeout": (0.1, 3600.0), "design_timeout": (0.1, 86400.0)}
 
 
-def seconds(what: str):
+def seconds(what: str) -> Callable:
     """argparse type of a duration in seconds bounded by ``SECONDS[what]`` (a finite number)."""
     lo, hi = SECONDS[what]
 
@@ -142,7 +142,7 @@ def _matplotlib_formats() -> tuple:
     return tuple(sorted("." + k for k in FigureCanvasBase.get_supported_filetypes() if "." + k not in _NOT_MATPLOTLIB))
 
 
-def check_picture(path: str, option: str, formats) -> None:
+def check_picture(path: str, option: str, formats: str | tuple) -> None:
     """Refuse a picture file whose suffix names a format its writer does not write (sweep --plot o.xml),
     naming the formats it does.  A device or a pipe (/dev/stdout) takes the writer's first format;
     a matplotlib figure without a suffix is a PNG."""

@@ -14,12 +14,13 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 NAME = "equations"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="the loop equations in symbols: vector loops, velocity and acceleration "
                                    "matrices, det A and its singular conditions")
     common(sp)
@@ -29,7 +30,7 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--output", help="spatial mechanisms: also the chain to this link")
 
 
-def _input_names(mech: Mechanism, args: argparse.Namespace, values, held):
+def _input_names(mech: Mechanism, args: argparse.Namespace, values: dict, held: dict) -> list:
     """The input joints: --input, else those set (``values``: --set, --set-angle of a link pinned to the
     ground), else -- unless a floating link's angle is given (``held``: an input of its own) -- the
     actuated ones."""

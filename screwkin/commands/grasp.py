@@ -16,12 +16,13 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 NAME = "grasp"
 NEEDS_MECHANISM = False
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="grasp analysis: grasp map, form and force closure, internal forces, quality")
     sp.add_argument("file", metavar="GRASP.yaml", help="contacts on one object (docs/format.md, 'Grasps')")
     common(sp, mechanism=False)

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -19,7 +20,7 @@ NAME = "info"
 NEEDS_MECHANISM = "optional"  # --joint-types needs no FILE
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="topology table: links, joints, loops (--joint-types: the joint vocabulary)")
     common(sp, optional_file=True)
     sp.add_argument("--joint-types", action="store_true",

@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     import argparse
     import numpy as np
     from collections.abc import Callable
+    from screwkin.analysis.course.newton import NewtonResult
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -106,7 +107,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------ solve --start
-def _solved_near(mech: Mechanism, loops: VectorLoops, solver, values, q: np.ndarray, res, starts: int, skip: set | tuple = ()) -> tuple:
+def _solved_near(mech: Mechanism, loops: VectorLoops, solver, values: dict, q: np.ndarray, res: NewtonResult, starts: int, skip: set | tuple = ()) -> tuple:
     """solve's configuration near q (Newton's root), the loop symbols there, and the unknowns
     in which it differs from Newton's root."""
     near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}
@@ -115,7 +116,7 @@ def _solved_near(mech: Mechanism, loops: VectorLoops, solver, values, q: np.ndar
     return pres, got, differing(mech, loops, got, res.values)
 
 
-def _solve_from_start(mech: Mechanism, args: argparse.Namespace, values, held=None) -> int:
+def _solve_from_start(mech: Mechanism, args: argparse.Namespace, values: dict, held: dict | None=None) -> int:
     """``solve --start ...``: Newton on the loop equations from the estimates typed.  ``held``: links
     whose absolute angle is given (--set-angle of a floating link) -> angle [rad], known in the equations."""
     held = dict(held or {})

@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.design.synthesis.designs import Design
+    from collections.abc import Callable
 
 NAME = "synthesize"
 NEEDS_MECHANISM = False
@@ -67,7 +68,7 @@ _OPTIONS = {  # which options each kind takes (dest names)
 }
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("synthesize", help="synthesize a planar linkage (motion, function, path) or enumerate "
                                            "kinematic chains; writes URDF checked with screwkin")
     sp.add_argument("kind", choices=KINDS, help="what to synthesize")
@@ -131,7 +132,7 @@ def add_parser(sub, common, scaled) -> None:
     c.add_argument("--planar", action="store_true", help="planar chains (the only kind enumerated)")
 
 
-def _given(args: argparse.Namespace, dest) -> bool:
+def _given(args: argparse.Namespace, dest: str) -> bool:
     defaults = {"candidates": 24, "spacing": "chebyshev", "ground": "0.1", "starts": 24, "seed": 0,
                 "tolerance": "1e-6", "prismatic": 0, "planar": False, "timeout": 10.0}
     return getattr(args, dest) not in (None, defaults.get(dest))
@@ -163,7 +164,7 @@ def _range(text: str, option: str) -> tuple:
     return parse_value(parts[0]), parse_value(parts[1])
 
 
-def _plausible(design: Design, kind: str):
+def _plausible(design: Design, kind: str) -> None:
     """A linkage whose numbers a file can hold: finite, and within the 10 km the reader accepts."""
     fb = design.fourbar
     values = [*fb.A0, *fb.A, *fb.B, *fb.B0, *(fb.tool or ())]
@@ -176,7 +177,7 @@ def _plausible(design: Design, kind: str):
                                                    f"the {LIMITS.length:g} m a mechanism file may hold")
 
 
-def _realize(design: Design, out, tolerance=None) -> tuple:
+def _realize(design: Design, out: str, tolerance=None) -> tuple:
     """Write design's URDF under a temporary name beside ``out``, check it there; returns
     (check, temporary path)."""
     _plausible(design, design.kind)
@@ -196,7 +197,7 @@ def _realize(design: Design, out, tolerance=None) -> tuple:
         raise
 
 
-def _keep(tmp, out):
+def _keep(tmp: str, out: str) -> None:
     """The checked design at ``out``: the temporary file renamed there, or written through a link, a
     device or a pipe that ``out`` names (a rename would replace it)."""
     try:

@@ -89,7 +89,7 @@ def _orientation(text: str):
     return pin.rpy.rpyToMatrix(np.array([parse_value(p, "angle", "--orientation") for p in parts]))
 
 
-def _mode(mech: Mechanism, args: argparse.Namespace):
+def _mode(mech: Mechanism, args: argparse.Namespace) -> np.ndarray | None:
     """The assembled configuration of the mode whose workspace is asked (--mode K of the actuated joints'
     values in the file's assembled configuration, said as every command says it); None for a chain
     without loops, whose joint values are one configuration."""

@@ -20,6 +20,10 @@ from ..errors import MechanismFileError, quote
 from .description import LIMITS
 from .urdf import Problems
 from .xmlsafe import load_yaml_text, read_regular_file
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 __all__ = ["MODELS", "MAX_CONTACTS", "MAX_MU", "Contact", "GraspSpec", "read_grasp", "parse_grasp"]
 
@@ -60,11 +64,11 @@ class GraspSpec:
     path: str = "<grasp>"
 
 
-def _is_number(x) -> bool:
+def _is_number(x: str | float) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
-def _vector(value, what: str, planar, problems: Problems) -> tuple | None:
+def _vector(value: list, what: str, planar: bool, problems: Problems) -> tuple | None:
     """A 3-tuple of floats from a YAML list (planar: 2 numbers, or 3 with z = 0), or None."""
     sizes = "2 or 3" if planar else "3"
     if not isinstance(value, list):
@@ -96,7 +100,7 @@ def _vector(value, what: str, planar, problems: Problems) -> tuple | None:
     return tuple(v)
 
 
-def _coefficient(c, key: str, k: int, problems: Problems, bound, unit: str = "") -> float | None:
+def _coefficient(c: dict, key: str, k: int, problems: Problems, bound: float, unit: str = "") -> float | None:
     value = c.get(key)
     if not _is_number(value):
         problems.append(f"contact {k}: {key} must be a number, got {quote(value)}")
@@ -118,7 +122,7 @@ def _coefficient(c, key: str, k: int, problems: Problems, bound, unit: str = "")
     return x
 
 
-def _contact(c, k: int, planar, problems: Problems) -> Contact | None:
+def _contact(c: dict, k: int, planar: bool, problems: Problems) -> Contact | None:
     if not isinstance(c, dict):
         problems.append(f"contact {k} must be a mapping with point, normal, model, got {quote(c)}")
         return None
@@ -179,7 +183,7 @@ def _contact(c, k: int, planar, problems: Problems) -> Contact | None:
     return Contact(point, normal, model, mu, mu_t)
 
 
-def parse_grasp(content, path: str = "<grasp>") -> GraspSpec:
+def parse_grasp(content, path="<grasp>") -> GraspSpec:
     """A GraspSpec from the plain data of a grasp file (what the YAML loads to), every
     problem collected and raised at once as a MechanismFileError naming ``path``."""
     if content is None:
@@ -211,7 +215,7 @@ def parse_grasp(content, path: str = "<grasp>") -> GraspSpec:
     return GraspSpec(tuple(out), planar, str(path))
 
 
-def read_grasp(path) -> GraspSpec:
+def read_grasp(path: str | Path) -> GraspSpec:
     """Read a grasp file (see the module's notes); one-line MechanismFileError naming it
     for every problem."""
     raw = read_regular_file(path, LIMITS.yaml_bytes, "grasp file")

@@ -90,7 +90,7 @@ def _real(p: Path) -> Path | None:
         return None
 
 
-def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs) -> bool:
+def _allowed(uri: str, cand: Path, real: Path, base: Path, package_dirs: list) -> bool:
     """Whether the mesh candidate ``cand`` (``real`` once resolved) may be read: inside the file's folder,
     a --package-dir or ROS_PACKAGE_PATH folder, or the package the file is in; a ``package://NAME/``
     candidate also inside that package's folder (``package://NAME/../x`` does not leave it)."""

@@ -41,6 +41,10 @@ from .mjcf_transmission import ACTUATORS, read_actuators, read_tendons
 from .urdf import Problems, check_sizes, numbers, unit_axis
 from .writer import origin_text, quoteattr, vector_text
 from .xmlsafe import parse_xml_text
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 __all__ = ["read_mjcf"]
 
@@ -55,7 +59,7 @@ _PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor
 
 
 class _Reader:
-    def __init__(self, path, root) -> None:
+    def __init__(self, path: Path, root) -> None:
         self.path, self.root = path, root
         self.problems = Problems()
         self.warnings = []
@@ -123,13 +127,13 @@ class _Reader:
         return out
 
     # ---- numbers and frames ---------------------------------------------------------------
-    def vec(self, text: str, n: int, what: str, default: tuple, bound=LIMITS.length, unit: str = "m") -> np.ndarray:
+    def vec(self, text: str, n: int, what: str, default: tuple, bound: float=LIMITS.length, unit: str = "m") -> np.ndarray:
         return np.array(numbers(text, n, what, self.problems, default, bound, unit), float)
 
-    def angle(self, value):
+    def angle(self, value: float) -> float:
         return math.radians(value) if self.degree else value
 
-    def rotation(self, a, what: str) -> np.ndarray:
+    def rotation(self, a: dict, what: str) -> np.ndarray:
         given = [k for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis") if a.get(k) is not None]
         if len(given) > 1:
             self.problems.append(f"{what} gives more than one orientation ({', '.join(given)})")
@@ -185,11 +189,11 @@ class _Reader:
         walk(elem, pin.SE3.Identity(), cls, 0)
         return out
 
-    def frame(self, a, what: str) -> pin.SE3:
+    def frame(self, a: dict, what: str) -> pin.SE3:
         return pin.SE3(self.rotation(a, what), self.vec(a.get("pos"), 3, f"{what} pos", (0, 0, 0)))
 
 
-def read_mjcf(path, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
+def read_mjcf(path: Path, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
     """Read an MJCF file (already loaded as ``text``, parsed as ``root`` when given)."""
     if root is None:
         root = parse_xml_text(text, path)
@@ -418,7 +422,7 @@ def read_mjcf(path, text: str, root=None, package_dirs: list | tuple = ()) -> Me
                          package_dirs=[str(d) for d in package_dirs or ()], inputs=inputs, reference=reference)
 
 
-def _inertia_xml(com, mass, I) -> str:
+def _inertia_xml(com: np.ndarray, mass: float, I: np.ndarray) -> str:
     return (f"<inertial><origin xyz=\"{vector_text(*com)}\" rpy=\"0 0 0\"/><mass value=\"{mass:.17g}\"/><inertia "
             f"ixx=\"{I[0, 0]:.17g}\" iyy=\"{I[1, 1]:.17g}\" izz=\"{I[2, 2]:.17g}\" ixy=\"{I[0, 1]:.17g}\" "
             f"ixz=\"{I[0, 2]:.17g}\" iyz=\"{I[1, 2]:.17g}\"/></inertial>")

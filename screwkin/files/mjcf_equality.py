@@ -47,7 +47,7 @@ def _rpy(M) -> tuple:
     return tuple(pin.rpy.matrixToRpy(M.rotation))
 
 
-def read_equalities(r, world: dict, sites: dict, mjoints: dict, reference: dict, taken) -> tuple:
+def read_equalities(r, world: dict, sites: dict, mjoints: dict, reference: dict, taken: set) -> tuple:
     """(cut joints, couplings) of every <equality>.  world: body -> pose at qpos0; sites: name ->
     (body, placement); mjoints: joint -> (type, body); reference: joint -> ref; taken: the names of
     joints and bodies."""
@@ -142,7 +142,7 @@ def _connect_cuts(r, connects: list, world: dict) -> list:
     return out
 
 
-def _ends(r, a, what: str, world: dict, sites: dict) -> tuple | None:
+def _ends(r, a: dict, what: str, world: dict, sites: dict) -> tuple | None:
     """((body1, S1), (body2, S2), by_site) of a connect or weld; body2 omitted or "world" is the world."""
     p = r.problems
     if a.get("site1") or a.get("site2"):

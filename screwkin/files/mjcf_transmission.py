@@ -65,7 +65,7 @@ def read_tendons(r, mjoints: dict) -> dict:
     return out
 
 
-def _resolve(terms, couplings: dict) -> tuple:
+def _resolve(terms: tuple, couplings: dict) -> tuple:
     """(coordinate -> coefficient, offset) of sum coef * joint with coupled joints replaced by
     m * primary + o (couplings: joint -> Coupling, chains already resolved to the primary)."""
     coefs, offset = {}, 0.0
@@ -80,7 +80,7 @@ def _resolve(terms, couplings: dict) -> tuple:
     return {j: v for j, v in coefs.items() if abs(v) > DEFAULT.zero * scale}, offset
 
 
-def read_actuators(r, mjoints: dict, tendons, couplings: dict) -> tuple:
+def read_actuators(r, mjoints: dict, tendons: dict, couplings: dict) -> tuple:
     """(input joints in file order, Transmission of each actuator that is not a plain joint's,
     one line naming the actuators that are not inputs or None)."""
     p = r.problems

@@ -279,7 +279,7 @@ def _radius(text: str, what: str, problems: Problems, allow_inf: bool=False):
     return value
 
 
-def _pair_parameters(elem, jtype, what: str, axis, problems: Problems) -> dict | None:
+def _pair_parameters(elem, jtype: str, what: str, axis: tuple, problems: Problems) -> dict | None:
     """The parameters of a rolling, gear, contact or helical loop joint, checked."""
     n0 = len(problems)
     out = {}

@@ -108,7 +108,7 @@ def quoteattr(data: str) -> str:
     return '"%s"' % data.replace('"', "&quot;")
 
 
-def number_text(x) -> str:
+def number_text(x: float) -> str:
     x = float(x)
     return repr(0.0 if x == 0 else x)
 
@@ -117,12 +117,12 @@ def vector_text(*xs: Any) -> str:
     return " ".join(number_text(x) for x in xs)
 
 
-def origin_text(M) -> str:
+def origin_text(M: pin.SE3) -> str:
     """The URDF ``<origin>`` of a placement M (pinocchio.SE3): its translation and its rotation as rpy."""
     return f'<origin xyz="{vector_text(*M.translation)}" rpy="{vector_text(*pin.rpy.matrixToRpy(M.rotation))}"/>'
 
 
-def _bars(points) -> list:
+def _bars(points: tuple) -> list:
     """Pairs of points drawn as bars: the one segment of two points, the closed polygon of
     more (points in order of angle about their centroid)."""
     pts = [tuple(map(float, p)) for p in points]
@@ -136,7 +136,7 @@ def _bars(points) -> list:
     return [(ring[k], ring[(k + 1) % len(ring)]) for k in range(len(ring))]
 
 
-def _check_linkage(linkage: PlanarLinkage):
+def _check_linkage(linkage: PlanarLinkage) -> None:
     names = [lk.name for lk in linkage.links]
     if len(set(names)) != len(names):
         raise ValueError("link names repeat")
@@ -246,7 +246,7 @@ def _attribute(text: str) -> str:
     return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def targets_text(targets) -> list:
+def targets_text(targets: tuple) -> list:
     """The lines of the <screwkin:targets> element of ``targets`` (TargetSpec); none when empty."""
     if not targets:
         return []

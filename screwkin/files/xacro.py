@@ -50,6 +50,10 @@ from ..units import parse_value
 from .description import LIMITS
 from .xacro_eval import MAX_STRING, XacroEvaluationError, check_expression, evaluate
 from .xmlsafe import inside_folder, parse_xml_text, read_regular_file
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["MAX_INCLUDES", "XacroInternalError", "declared_args", "expand", "is_xacro", "normalize_args", "parse_args"]
 
@@ -71,7 +75,7 @@ _GLOB = re.compile(r"[*?\[]")
 _LOCK = threading.Lock()
 
 
-def _xacro_tag(tag: str):
+def _xacro_tag(tag: str) -> str | None:
     """The local name of an element in the xacro namespace (ElementTree's ``{uri}name``), or None."""
     if tag.startswith("{"):
         uri, _, local = tag[1:].partition("}")
@@ -86,7 +90,7 @@ def is_xacro(path: Path | str, text: str) -> bool:
 
 
 # ------------------------------------------------------------------ arguments
-def _arg_value(name: str, value, where: str) -> str:
+def _arg_value(name: str, value: str | float, where: str) -> str:
     """The text xacro receives for an argument: numbers as typed, values with a unit in SI
     (``30mm`` -> ``0.03``), other text as it is (bounded, printable)."""
     if isinstance(value, bool):
@@ -147,7 +151,7 @@ class _State:
     calls: int = 0
 
 
-def _check_text(text: str, path, state: _State) -> None:
+def _check_text(text: str, path: Path, state: _State) -> None:
     """Every ``${...}`` and ``$(...)`` of an attribute or text."""
     if not text or "$" not in text:
         return
@@ -167,7 +171,7 @@ def _check_text(text: str, path, state: _State) -> None:
             raise MechanismFileError(path, str(exc)) from None
 
 
-def _check_extension(token: str, path) -> None:
+def _check_extension(token: str, path: Path) -> None:
     inner = token[2:-1]
     if _ARG.match(inner):
         return
@@ -229,7 +233,7 @@ def _check_tree(root, path: Path, state: _State, follow: bool = True) -> None:
             _check_tree(sub, target, state)
 
 
-def _prepare(path, text: str, root=None) -> _State:
+def _prepare(path: Path, text: str, root=None) -> _State:
     path = Path(path)
     state = _State(path, Path(os.path.realpath(path.parent if str(path.parent) else ".")))
     state.files.append(path)
@@ -261,7 +265,7 @@ def _one_line(exc) -> str:
     return " when evaluating expression ".join(parts[:2]) or type(exc).__name__
 
 
-def _patched(xacro, state: _State, path, evaluator=None) -> tuple:
+def _patched(xacro, state: _State, path: Path, evaluator=None) -> tuple:
     """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
     macro calls while expanding."""
     original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",
@@ -389,7 +393,7 @@ class XacroInternalError(RuntimeError):
     mistakes are): a bug, reported as an internal error (exit 3), not as the file's fault."""
 
 
-def _dom(text: str, path):
+def _dom(text: str, path: Path):
     """A minidom document of checked text (defusedxml: no entities, no external references)."""
     # lazily: only xacro files need it; defusedxml.minidom.parseString's own parser, without the
     # import of defusedxml.minidom (its pulldom brings xml.sax, urllib, http, ssl and email: 18 ms)
@@ -404,7 +408,7 @@ def _dom(text: str, path):
         raise MechanismFileError(path, f"malformed XML: {shorten(_one_line(exc), 100)}") from None
 
 
-def expand(path, text: str, args=None, root=None, warn=None, evaluator=None, read=None) -> str:
+def expand(path: Path, text: str, args: dict | None=None, root=None, warn: Callable | None=None, evaluator=None, read: list | None=None) -> str:
     """The URDF text of xacro file ``path`` (whose text is ``text``) with arguments
     ``args`` ({name: value}; see :func:`normalize_args`).  Raises MechanismFileError (the
     file's problem, one line) or UsageError (an argument the file does not declare).

@@ -145,11 +145,11 @@ def check_expression(expr: str) -> None:
         raise ValueError(f"xacro expression {quote(expr, 60)} uses {exc}: only {_ALLOWED} are allowed") from None
 
 
-def _number(x) -> bool:
+def _number(x: str | float) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, complex)
 
 
-def _bounded(x):
+def _bounded(x: str | float) -> str | float:
     if isinstance(x, bool):
         return x
     if isinstance(x, int) and abs(x) > MAX_INT:
@@ -167,7 +167,7 @@ def _power(a, b):
     return float(a) ** float(b)  # OverflowError when too large
 
 
-def _call(name: str, args):
+def _call(name: str, args: list):
     if not all(_number(a) for a in args):
         raise _Refused(f"{name}() of text")
     if name == "abs":
@@ -191,7 +191,7 @@ class _Interpreter:
     def __init__(self, symbols) -> None:
         self.symbols = symbols
 
-    def value(self, node):
+    def value(self, node) -> str | float:
         if isinstance(node, ast.Expression):
             return self.value(node.body)
         if isinstance(node, ast.Constant):
@@ -249,7 +249,7 @@ class XacroEvaluationError(Exception):
     """An expression xacro asked to evaluate is refused or fails (xacro adds its context)."""
 
 
-def evaluate(expr: str, symbols=None, interpreter=None):
+def evaluate(expr: str, symbols=None, interpreter=None) -> str | float:
     """The value of a ``${...}`` expression (its inside) with names from ``symbols`` (a
     mapping; xacro's symbol table while expanding): the subset of :func:`check_expression`,
     evaluated without ``eval`` (by ``interpreter(symbols)``, default this module's; files.xacro_batch

@@ -121,7 +121,7 @@ class Assembly:
     starts: int = 1
 
 
-def in_plane(axis) -> tuple:
+def in_plane(axis: tuple) -> tuple:
     """(a, u, n): the unit axis a, the unit direction of x projected into the plane normal to
     a, and a x u (the plane of a rolling or gear pair: u is its line's direction in F1) --
     geometry.plane_basis(axis) in the order (normal, e1, e2)."""

@@ -270,7 +270,7 @@ def _finish_model(spec: MechanismSpec, model: pin.Model) -> pin.Model:
     return model
 
 
-def rebuild(spec, actuated: list | None = None, tolerances: Tolerances = DEFAULT, cls=Mechanism) -> Mechanism:
+def rebuild(spec: MechanismSpec, actuated: list | None = None, tolerances: Tolerances = DEFAULT, cls=Mechanism) -> Mechanism:
     """A Mechanism from a description already read (and changed: other joint replacements, other cut
     joint types -- analysis.redundancy builds the exactly constrained model it suggests this way)."""
     with _native_stderr([]):

@@ -60,7 +60,7 @@ def _pairs(mech: Mechanism):
     return out
 
 
-def plan(mech: Mechanism, inputs: list, name: str):
+def plan(mech: Mechanism, inputs: list, name: str) -> DyadPlan | str:
     """The DyadPlan of ``mech`` swept along input ``name`` with the other ``inputs`` held, or a
     string saying why it does not decompose into the input and RRR/RRP/PRR/RPR dyads."""
     if mech.couplings or mech.extra_rows:

@@ -51,7 +51,7 @@ def _neighbours(edges: list):
     return out
 
 
-def six_bar_chain(edges) -> str | None:
+def six_bar_chain(edges: list) -> str | None:
     """"Watt" or "Stephenson" for the graph of a six-bar chain (6 links, 7 joints, 4 binary and 2
     ternary links; ``edges`` the joints as (link, link) pairs), else None."""
     nb = _neighbours(list(edges))
@@ -63,7 +63,7 @@ def six_bar_chain(edges) -> str | None:
     return "Watt" if t2 in nb[t1] else "Stephenson"
 
 
-def six_bar_inversion(edges, ground) -> str | None:
+def six_bar_inversion(edges: list, ground: str) -> str | None:
     """The inversion of a six-bar with link ``ground`` fixed: "Watt I", "Watt II", "Stephenson I",
     "Stephenson II" or "Stephenson III" (the module docstring); None when the graph is not a
     six-bar chain or ``ground`` is not one of its links."""

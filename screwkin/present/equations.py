@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.course.newton import NewtonResult
+    from screwkin.analysis.course.equations import SpatialEquations
 
 __all__ = ["equations_dict", "equations_text", "newton_dict", "newton_text", "greek", "Units"]
 
@@ -27,7 +28,7 @@ def greek(text: str) -> str:
     return text.replace("**", "^")
 
 
-def _matrix_text(name: str, rows, indent: str = "  ") -> list:
+def _matrix_text(name: str, rows: list | tuple, indent: str = "  ") -> list:
     """A matrix of expressions, one row a line."""
     lines = []
     for i, row in enumerate(rows):
@@ -36,7 +37,7 @@ def _matrix_text(name: str, rows, indent: str = "  ") -> list:
     return lines
 
 
-def _numbers_text(name: str, M, indent: str = "    ") -> list:
+def _numbers_text(name: str, M: np.ndarray, indent: str = "    ") -> list:
     M = np.atleast_2d(np.asarray(M, float))
     lines = []
     for i, row in enumerate(M):
@@ -45,7 +46,7 @@ def _numbers_text(name: str, M, indent: str = "    ") -> list:
     return lines
 
 
-def _vector_equation(terms):
+def _vector_equation(terms: tuple) -> str:
     out = ""
     for k, t in enumerate(terms):
         neg = t.startswith("-")
@@ -54,12 +55,12 @@ def _vector_equation(terms):
     return (out or "0") + " = 0"
 
 
-def _pair_vectors(res) -> set:
+def _pair_vectors(res: PlanarEquations) -> set:
     """The unit vectors named in the loops' terms by rolling and gear pairs (u32 of a rack's pitch line)."""
     return {f"u{res.numbers[p.links[0]]}{res.numbers[p.links[1]]}" for p in res.pairs if p.kind == "rack"}
 
 
-def _pairs_text(res) -> list:
+def _pairs_text(res: PlanarEquations) -> list:
     lines = []
     for p in res.pairs:
         a, b = (res.numbers[lk] for lk in p.links)
@@ -78,7 +79,7 @@ def _pairs_text(res) -> list:
     return lines
 
 
-def equations_dict(res) -> dict:
+def equations_dict(res: PlanarEquations | SpatialEquations) -> dict:
     if not isinstance(res, PlanarEquations):
         return {"file": res.path, "motion_space": res.motion_space, "chains": screws_dict(res.chains),
                 "constraint_jacobian": {"rows": res.rows, "columns": res.columns, "rank": res.rank,
@@ -200,18 +201,18 @@ class Units:
         self.degrees = degrees
         self.lengths = lengths or {}  # symbol -> unit ("mm"); m when not given
 
-    def value(self, name: str, kind: str, v) -> str:
+    def value(self, name: str, kind: str, v: float) -> str:
         if kind == "angle":
             return unit_text(v, "deg" if self.degrees else "rad")
         return unit_text(v, self.lengths.get(name, "m"))
 
-    def step(self, name: str, kind: str, v):
+    def step(self, name: str, kind: str, v: float) -> str:
         if kind == "angle":
             return unit_text(v, "rad") + (f" = {unit_text(v, 'deg')}" if self.degrees else "")
         return unit_text(v, self.lengths.get(name, "m"))
 
 
-def newton_text(res: NewtonResult, symbols, units: Units, path: str) -> str:
+def newton_text(res: NewtonResult, symbols: dict, units: Units, path: str) -> str:
     kinds = {n: symbols[n].kind for n in symbols}
     z = ", ".join(greek(n) for n in res.unknowns)
     ins = ", ".join(f"{greek(n)} = {units.value(n, kinds[n], v)}" for n, v in res.inputs.items())

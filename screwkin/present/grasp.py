@@ -26,11 +26,11 @@ def _vector_text(v) -> str:
     return "(" + ", ".join(shown_text(x) for x in v) + ")"
 
 
-def _wrench_labels(planar) -> list:
+def _wrench_labels(planar: bool) -> list:
     return ["fx", "fy", "mz"] if planar else ["fx", "fy", "fz", "mx", "my", "mz"]
 
 
-def pure_moment(w, planar: bool) -> np.ndarray:
+def pure_moment(w: np.ndarray, planar: bool) -> np.ndarray:
     """The wrench with a force below the motion tolerance (relative to the wrench) set to zero: a
     force of 3e-7 N beside a moment of 1 N m is round-off, and its line of action (through a point
     144 km away) is no answer: it is a pure moment."""
@@ -41,7 +41,7 @@ def pure_moment(w, planar: bool) -> np.ndarray:
     return w
 
 
-def wrench_axis(w, planar: bool) -> dict:
+def wrench_axis(w: np.ndarray | list, planar: bool) -> dict:
     """The line of action of a wrench (force, moment): direction of the force, the point of the
     line nearest the origin, pitch = f . m / |f|^2 [m]; a pure moment (no force) has direction
     the moment's, no point and pitch inf.  Planar wrenches (fx, fy, mz) as spatial ones."""
@@ -101,11 +101,11 @@ def grasp_dict(r: GraspResult) -> dict:
     })
 
 
-def _yes(b) -> str:
+def _yes(b: bool) -> str:
     return "undecided" if b is None else ("YES" if b else "no")
 
 
-def _percent(x) -> str:
+def _percent(x: float | None) -> str:
     return "-" if x is None else f"{100 * (0.0 if x < SHOWN_ZERO else x):.3g}%"
 
 
@@ -157,7 +157,7 @@ def grasp_text(r: GraspResult) -> str:
     return "\n".join(lines)
 
 
-def _certificate_lines(r: GraspResult):
+def _certificate_lines(r: GraspResult) -> list:
     c = r.certificate
     if c is None:
         return []

@@ -13,12 +13,13 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.analysis.mobility import MobilityResult
     from screwkin.model.topology import Topology
+    from screwkin.model.topology import Joint
 
 __all__ = ["topology_dict", "mobility_dict", "JOINT_COLUMNS", "joint_rows", "topology_text", "count_rows",
            "screw_theory_rows", "mobility_text"]
 
 
-def _joint_dict(j) -> dict:
+def _joint_dict(j: Joint) -> dict:
     return {
         "name": j.name,
         "type": j.type,

@@ -37,6 +37,7 @@ from types import TracebackType
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from pathlib import Path
     from typing import Any
 
 __all__ = ["write_output", "OutputFile", "WholeOrNothing", "write_figure", "output_failed", "remove_partial", "os_reason", "PARTIAL", "open_partial"]
@@ -110,7 +111,7 @@ class OutputFile(WholeOrNothing):
     closing it fails with OutputError (the partial file removed); leaving the ``with`` block on any
     other exception (the work failed, or was interrupted) removes the partial file too."""
 
-    def __init__(self, path, mode: str = "w") -> None:
+    def __init__(self, path: str, mode: str = "w") -> None:
         self.path = str(path)
         self._partial = None
         encoding = None if "b" in mode else "utf-8"
@@ -131,7 +132,7 @@ class OutputFile(WholeOrNothing):
         except OSError as exc:
             raise OutputError(self.path, os_reason(exc)) from None
 
-    def write(self, data) -> int:
+    def write(self, data: str | bytes) -> int:
         if self._f is None:
             raise ValueError(f"{self.path} is closed")
         try:
@@ -192,7 +193,7 @@ class OutputFile(WholeOrNothing):
                 remove_partial(self._partial)
 
 
-def write_output(path, data) -> None:
+def write_output(path: str | Path, data: str | bytes) -> None:
     """Write ``data`` (str, as UTF-8, or bytes) to ``path`` whole (OutputError when it cannot be)."""
     with OutputFile(path, "wb" if isinstance(data, (bytes, bytearray, memoryview)) else "w") as f:
         f.write(data)
@@ -202,7 +203,7 @@ def write_output(path, data) -> None:
 _METADATA = ("png", "pdf", "svg", "svgz", "ps", "eps")
 
 
-def write_figure(fig, path, **savefig: Any) -> None:
+def write_figure(fig, path: str, **savefig: Any) -> None:
     """A matplotlib figure into ``path``, in the format of its suffix (PNG without one), rendered in
     memory first: matplotlib itself does not report every failed write (``/dev/full`` passed).  A title
     in ``metadata`` is written where the format has room for one, left out elsewhere."""

@@ -58,8 +58,8 @@ def _rate_scales(units: RateUnits) -> list:
             (units.acceleration(False), units.acceleration(True))]
 
 
-def sweep_figure(res: SweepResult, mus=None, singularities: tuple=(), title: str | None = None, linear: np.ndarray | None=None, paths: dict | None = None, absolute: bool=False,
-                 rate_words=None, units=None):
+def sweep_figure(res: SweepResult, mus: list | None=None, singularities: tuple | list=(), title: str | None = None, linear: np.ndarray | None=None, paths: dict | None = None, absolute: bool=False,
+                 rate_words: str | None=None, units=None):
     """The figure of :func:`sweep_plot` (matplotlib, not yet saved): three rows -- joint values,
     rates, accelerations -- against the input.  Angles are unwrapped along the motion and drawn
     in degrees on the left axis, lengths in mm on a right axis of their own (dashed); every
@@ -177,8 +177,8 @@ def absolute_series(res: SweepResult, motion: MotionAlong, linear: np.ndarray | 
                    accelerations=stack(accs)), np.array(lengths, bool)
 
 
-def motion_figure(res, mus=None, singularities=(), title: str | None = None, linear=None, motion: MotionAlong | None = None, normal=None,
-                  rate_words=None, units=None):
+def motion_figure(res: SweepResult, mus: list | None=None, singularities: list=(), title: str | None = None, linear: np.ndarray | None=None, motion: MotionAlong | None = None, normal=None,
+                  rate_words: str | None=None, units=None):
     """The figure of a sweep (matplotlib, not yet saved; see :func:`sweep_figure` for what is drawn): for
     a planar mechanism with ``motion`` (analysis.motion.links.MotionAlong) the links' absolute angle,
     omega and alpha and the sliders' coordinates, else the joint values; the named points' paths in a
@@ -195,8 +195,8 @@ def motion_figure(res, mus=None, singularities=(), title: str | None = None, lin
                         rate_words=rate_words, units=units)
 
 
-def sweep_plot(res, path, mus=None, singularities=(), title: str | None = None, linear=None, motion=None, normal=None,
-               rate_words=None, units=None) -> None:
+def sweep_plot(res: SweepResult, path: str, mus: list | None=None, singularities: list=(), title: str | None = None, linear: np.ndarray | None=None, motion: MotionAlong | None=None, normal=None,
+               rate_words: str | None=None, units=None) -> None:
     """A sweep into a PNG: :func:`motion_figure`, saved."""
     plt = pyplot("--plot")
     fig = motion_figure(res, mus, singularities, title, linear, motion, normal, rate_words, units)
@@ -206,7 +206,7 @@ def sweep_plot(res, path, mus=None, singularities=(), title: str | None = None, 
         plt.close(fig)
 
 
-def _axis_values(values, unit: str):
+def _axis_values(values: np.ndarray, unit: str):
     """SI values in ``unit`` (a unit of screwkin.units as typed, any case: 'deg', 'MM'; bare: SI)."""
     return in_unit(np.asarray(values, float), unit) if unit else np.asarray(values, float)
 
@@ -260,7 +260,7 @@ def map_figure(res: SingularityMap, x_unit: str = "rad", y_unit: str = "rad", ti
     return fig
 
 
-def map_png(res, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None) -> None:
+def map_png(res: SingularityMap, path: str, x_unit: str = "rad", y_unit: str = "rad", title: str | None = None) -> None:
     """A singularity map (SingularityMap) as a heat map with the singular curves (see :func:`map_figure`)."""
     plt = pyplot("--png")
     fig = map_figure(res, x_unit, y_unit, title)

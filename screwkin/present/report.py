@@ -442,7 +442,7 @@ def _condition_lines(rep: SingularityReport) -> list:
 
 
 # ------------------------------------------------------------------ results as dictionaries
-def _gram_dict(loops) -> dict:
+def _gram_dict(loops: tuple) -> dict:
     """gram_loops: every loop's cofactors; gram_cofactors, gram_zero, gram_loop: those of the first
     loop with one freedom of its own (the single loop of a one-loop mechanism)."""
     first = next((g for g in loops if g.cofactors), None)
@@ -599,7 +599,7 @@ def to_dict(result) -> dict:
 
 
 # ------------------------------------------------------------------ the joint vocabulary
-def joint_types_dict(types) -> list:
+def joint_types_dict(types: tuple) -> list:
     """``info --joint-types --json``: one object per kinematic pair screwkin knows."""
     return [{"name": t.name, "symbol": t.symbol, "dof": t.dof, "motion": t.motion, "pair": t.pair,
              "contact": t.contact, "type": t.type, "written": t.written} for t in types]

@@ -18,7 +18,7 @@ def screw_dict(s: Screw) -> dict:
             "pitch": s.pitch}  # infinite for a translation: "inf" (present/jsonout.py)
 
 
-def screws_dict(structure: list, normal: tuple | None=None) -> list:
+def screws_dict(structure: list | tuple, normal: tuple | None=None) -> list:
     out = []
     for st in structure:
         ch = st["chain"]

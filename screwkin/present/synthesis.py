@@ -27,21 +27,21 @@ if TYPE_CHECKING:
     from screwkin.analysis.design.synthesis.designs import Candidate
     from screwkin.analysis.design.synthesis.designs import Design
     from screwkin.analysis.design.synthesis.designs import Dyad
-    from screwkin.analysis.design.synthesis.search import SearchReport
+    from screwkin.analysis.design.synthesis.designs import Target
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
 
-def _deg(x):
+def _deg(x: float | None) -> float | None:
     """Degrees; None where there is no value (None, or NaN: the linkage does not assemble there)."""
     return None if x is None or x != x else math.degrees(x)
 
 
-def _pt(p) -> list:
+def _pt(p: tuple) -> list:
     return [float(p[0]), float(p[1])]
 
 
-def _target_dict(t) -> dict:
+def _target_dict(t: Target) -> dict:
     if t.kind == "pose":
         return {"x": t.value[0], "y": t.value[1], "theta_deg": _deg(t.value[2])}
     if t.kind == "point":
@@ -49,7 +49,7 @@ def _target_dict(t) -> dict:
     return {"psi_deg": _deg(t.value[0])}
 
 
-def _value_dict(kind: str, v) -> dict | None:
+def _value_dict(kind: str, v: tuple) -> dict | None:
     if not v:
         return None
     if kind == "pose":
@@ -59,7 +59,7 @@ def _value_dict(kind: str, v) -> dict | None:
     return {"psi_deg": _deg(v[0])}
 
 
-def _core(kind: str, design: Design, check: Check, file) -> dict:
+def _core(kind: str, design: Design, check: Check, file: str) -> dict:
     fb = design.fourbar
     L = fb.lengths
     links = {"ground": {"length": L["ground"]}, "crank": {"length": L["crank"]},
@@ -121,7 +121,7 @@ def _candidate_dict(k: int, c: Candidate) -> dict:
             "point": None if u is None else [u, v], "run": c.run}
 
 
-def _search_dict(report: SearchReport, constraints: list) -> dict:
+def _search_dict(report, constraints: list) -> dict:
     return {"method": report.method, "runs": report.runs, "evaluations": report.evaluations,
             "seconds": report.seconds, "where": report.where, "seed": report.seed, "constraints": constraints,
             "searched_within": report.box, "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
@@ -132,7 +132,7 @@ def _dyad_dict(k: int, d: Dyad) -> dict:
             "length": d.length}
 
 
-def synthesis_dict(result, check: Check, file, constraints=()) -> dict:
+def synthesis_dict(result: MotionResult, check: Check, file: str, constraints: tuple | list=()) -> dict:
     """The JSON object of a motion, function or path result and its check (``constraints``: the
     constrained search's, in words)."""
     design = result.design

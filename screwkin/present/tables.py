@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     import numpy as np
+    from collections.abc import Iterator
 
 __all__ = ["table", "shown", "shown_text", "fmt_vec", "column_text", "csv_cell", "csv_text", "SHOWN_ZERO", "RateUnits",
            "input_rate_words"]
@@ -103,7 +104,7 @@ def input_rate_words(name: str, rate: Quantity | None, linear: bool) -> str:
 _FORMULA = ("=", "+", "-", "@", "\t", "\r")
 
 
-def csv_cell(value):
+def csv_cell(value: str) -> str:
     """A cell for a CSV written from untrusted names: numbers as they are, but a value that does not
     exist (NaN: an effort redundant actuation leaves undetermined) empty, as a missing one (None); a
     text that a spreadsheet would run as a formula (=, +, -, @, tab, CR first) gets a leading apostrophe."""
@@ -117,7 +118,7 @@ def csv_cell(value):
     return value
 
 
-def csv_text(header, rows) -> str:
+def csv_text(header: list, rows: Iterator | list) -> str:
     """CSV text (csv.writer: names with commas, quotes or newlines are quoted) with every cell through
     :func:`csv_cell`; one line per row."""
     out = io.StringIO()

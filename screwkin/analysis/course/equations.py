@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import numpy as np
+    from screwkin.analysis.course.symbols import PlanarEquations
 
 __all__ = ["SpatialEquations", "equations"]
 
@@ -42,7 +43,7 @@ class SpatialEquations:
     length: float
 
 
-def _spatial(mech: Mechanism, q: np.ndarray, inputs, output) -> SpatialEquations:
+def _spatial(mech: Mechanism, q: np.ndarray, inputs: list, output) -> SpatialEquations:
     topo = mech.topology(q)
     if not mech.cuts and not output:
         raise UsageError(f"{mech.path}: the mechanism has no loops: give --output LINK for the chain to a link")
@@ -65,7 +66,7 @@ def _spatial(mech: Mechanism, q: np.ndarray, inputs, output) -> SpatialEquations
                             sigma, singular, tuple(conds), float(S.L))
 
 
-def equations(mech: Mechanism, q: np.ndarray, inputs=None, output=None, links: list | tuple = ()):
+def equations(mech: Mechanism, q: np.ndarray, inputs: list | None=None, output=None, links: list | tuple = ()) -> PlanarEquations | SpatialEquations:
     """The equations at the assembled configuration q: :class:`PlanarEquations` for planar
     mechanisms of revolute and prismatic joints, rolling and gear pairs (the no-slip law
     substituted: screwkin.analysis.course.rolling), :class:`SpatialEquations` for spatial and

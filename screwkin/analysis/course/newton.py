@@ -92,7 +92,7 @@ def textbook_newton(loops: VectorLoops, inputs: dict, start: dict, iterations: i
                         closes and iterations is None, stopped)
 
 
-def start_estimates(mech: Mechanism, loops: VectorLoops, solver, q_in: np.ndarray, values: dict, typed) -> tuple:
+def start_estimates(mech: Mechanism, loops: VectorLoops, solver, q_in: np.ndarray, values: dict, typed: list) -> tuple:
     """The estimates of every unknown of the loop equations from ``--start`` items (units.parse_typed_assignments):
     symbols, link names (their angles) or passive joint values (placed at q_in, the inputs set);
     returns (symbol -> estimate, symbol -> the units.Quantity typed)."""
@@ -161,7 +161,7 @@ def _as_symbol(name: str) -> str:
     return name
 
 
-def _needed_joints(loops: VectorLoops, name: str):
+def _needed_joints(loops: VectorLoops, name: str) -> set:
     """The tree joints whose values place the quantity ``name`` (the joints from the ground to the
     links it is measured on)."""
     mech = loops.mech

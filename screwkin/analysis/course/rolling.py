@@ -36,6 +36,10 @@ import numpy as np
 
 from ...model.cuts import in_plane, pair_contact
 from ...model.geometry import nearest_turn
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.state import KinematicState
 
 __all__ = ["HIGHER", "RollingPair", "measure_pairs", "pair_term", "substitute_pairs", "turns_through_pairs",
            "unwrapped", "drop_constant_rows", "virtual_coordinates"]
@@ -59,7 +63,7 @@ class RollingPair:
     in_system: bool  # the law is one of the equations F (theta_ab constant)
 
 
-def measure_pairs(loops, state) -> dict:
+def measure_pairs(loops, state: KinematicState) -> dict:
     """Per rolling/gear loop joint of ``loops`` (a VectorLoops being built; ``state``: its
     model.state.KinematicState at loops.q): the anchors of its two centres on its two links
     (loops.keep) and a dict of what the loop terms need."""
@@ -291,7 +295,7 @@ def substitute_pairs(loops, number, rows: list, crossed: list, twists=()) -> tup
     return (out if tk is not None else rows), twists
 
 
-def unwrapped(loops, link: str, angle, q: np.ndarray):
+def unwrapped(loops, link: str, angle, q: np.ndarray) -> float | np.ndarray:
     """A link's angle at q counted in turns from the configuration the equations were built at
     (the no-slip law of a rolling pair is not periodic in one link's angle): its value there
     plus the turns of the revolute joints from the ground to it, ``angle`` (its value at q)

@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.files.description import CutJointSpec
     from screwkin.model.topology import Topology
+    from screwkin.model.topology import Joint
 
 __all__ = [
     "ChainEdge",
@@ -193,11 +194,11 @@ def letters(k: int) -> str:
     return s
 
 
-def _is_input(joint, inputs) -> bool:
+def _is_input(joint: Joint, inputs: set | list) -> bool:
     return any(m in inputs for m in joint.members)
 
 
-def numbering(topo: Topology, inputs=()) -> tuple:
+def numbering(topo: Topology, inputs: list=()) -> tuple:
     """(link name -> number, joint name -> letter, joints in letter order) for a topology:
     ground 1 and a depth-first walk from it (see the module docstring).  A joint whose name is at
     most SHORT_NAME letters and digits, the first a capital (A, B, O2), keeps it as its letter; the others are lettered

@@ -70,7 +70,7 @@ _SUFFIX = "abcdefghijklmnopqrstuvwxyz"
 LENGTH_FLOOR = 1e-9
 
 
-def _exact_angle(sp, value, tol):
+def _exact_angle(sp, value: float | np.ndarray, tol: float):
     """An exact multiple of pi/2 when ``value`` is one (within tol [rad]: the closure tolerance,
     to which the configuration measured is closed), else None."""
     k = round(value / (np.pi / 2))
@@ -85,7 +85,7 @@ class VectorLoops:
     joints.  Holds the sympy expressions and their numerical forms; ``result()`` gives the
     plain :class:`PlanarEquations`."""
 
-    def __init__(self, mech: Mechanism, q: np.ndarray, inputs=None, links=()) -> None:
+    def __init__(self, mech: Mechanism, q: np.ndarray, inputs: list | None=None, links: list | tuple=()) -> None:
         """Every command that writes these equations (equations, solve --start, singularities
         --symbolic, report) builds them here: rolling and gear pairs included.  ``links``: links
         whose absolute angle is an input too (--set-angle of a floating link): their theta is known."""
@@ -132,7 +132,7 @@ class VectorLoops:
 
     # ------------------------------------------------------------------ geometry
     @staticmethod
-    def wrap(a):
+    def wrap(a) -> float | np.ndarray:
         return _wrap(a)
 
     def exact_angle(self, value):
@@ -143,7 +143,7 @@ class VectorLoops:
         """The constant symbols made so far -> their values (the loops are still being built)."""
         return {self.sym[n]: s.value for n, s in self.symbol_info.items() if s.role == "constant"}
 
-    def _p2(self, v) -> np.ndarray:
+    def _p2(self, v: np.ndarray | tuple) -> np.ndarray:
         v = np.asarray(v, float)
         return np.array([v @ self.e1, v @ self.e2])
 
@@ -223,7 +223,7 @@ class VectorLoops:
         self.pair_geometry = measure_pairs(self, state)  # rolling and gear pairs: their centres, radii
 
     # ------------------------------------------------------------------ symbols
-    def _new_symbol(self, name: str, link: str, kind: str, value, role: str, meaning):
+    def _new_symbol(self, name: str, link: str, kind: str, value: float | np.ndarray, role: str, meaning: str):
         sym = self.sp.Symbol(name, real=True)
         self.symbol_info[name] = Symbol(name, link, kind, float(value), role, meaning)
         self.sym[name] = sym
@@ -242,7 +242,7 @@ class VectorLoops:
             self.variables.append(name)
         return self.sym[name]
 
-    def _suffix(self, k: int, used):
+    def _suffix(self, k: int, used: dict) -> str:
         n = used.get(k, 0)
         used[k] = n + 1
         return "" if n == 0 else _SUFFIX[n]
@@ -298,7 +298,7 @@ class VectorLoops:
         self.vec[key] = v
         return v, sign
 
-    def _slide(self, joint):
+    def _slide(self, joint: str) -> dict:
         """The slider term's symbols of a prismatic joint (created on first use)."""
         if joint in self.slide_terms:
             return self.slide_terms[joint]
@@ -419,7 +419,7 @@ class VectorLoops:
             self.loop_twists.append(twists)
             self.F += rows
 
-    def _build_inputs(self):
+    def _build_inputs(self) -> None:
         """The symbol each input joint sets, and d symbol / d joint value."""
         topo, mech = self.topo, self.mech
         joints = {j.name: j for j in topo.joints}
@@ -524,22 +524,22 @@ class VectorLoops:
             out[t["x"].name] = float(self._p2(B - A) @ (u / np.linalg.norm(u)))
         return out
 
-    def _vectors(self, values) -> tuple:
+    def _vectors(self, values: dict) -> tuple:
         z = np.array([values[n] for n in self.unknowns], float)
         w = np.array([values[n] for n in self.input_syms], float)
         return z, w
 
-    def residual(self, values) -> np.ndarray:
+    def residual(self, values: dict) -> np.ndarray:
         return np.asarray(self._F(*self._vectors(values)), float).reshape(-1)
 
-    def matrices(self, values) -> tuple:
+    def matrices(self, values: dict) -> tuple:
         """A and B evaluated at ``values`` (symbol name -> value)."""
         z, w = self._vectors(values)
         A = np.asarray(self._A(z, w), float).reshape(len(self.F), len(self.unknowns))
         B = np.asarray(self._B(z, w), float).reshape(len(self.F), len(self.input_syms))
         return A, B
 
-    def acceleration_terms(self, values, unknown_rates, input_rates) -> np.ndarray:
+    def acceleration_terms(self, values: dict, unknown_rates: np.ndarray, input_rates: list) -> np.ndarray:
         z, w = self._vectors(values)
         return np.asarray(self._c(z, w, np.asarray(unknown_rates, float), np.asarray(input_rates, float)),
                           float).reshape(-1)

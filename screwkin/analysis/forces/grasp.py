@@ -177,7 +177,7 @@ class GraspResult:
     notes: tuple = ()
 
 
-def _linprog(c, tol: GraspTolerances, **kw: Any):
+def _linprog(c: np.ndarray, tol: GraspTolerances, **kw: Any) -> np.ndarray | None:
     """scipy's HiGHS; the solution x, or None when infeasible or when the solver gives up."""
     from scipy.optimize import linprog
 
@@ -186,7 +186,7 @@ def _linprog(c, tol: GraspTolerances, **kw: Any):
     return res.x if res.status == 0 and res.x is not None else None
 
 
-def _relative_rank(A: np.ndarray, rtol) -> int:
+def _relative_rank(A: np.ndarray, rtol: float) -> int:
     s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
     return int(np.sum(s > rtol * s[0])) if s.size and s[0] > 0 else 0
 
@@ -241,7 +241,7 @@ def _separator(W: np.ndarray, tol: GraspTolerances) -> tuple:
 
 
 # ------------------------------------------------------------------ exact cone checks
-def _contact_forces(spec: GraspSpec, G: np.ndarray, blocks, f) -> tuple:
+def _contact_forces(spec: GraspSpec, G: np.ndarray, blocks: tuple, f: np.ndarray) -> tuple:
     out = []
     for k, (c, b) in enumerate(zip(spec.contacts, blocks), 1):
         fi = f[b]
@@ -260,7 +260,7 @@ def _contact_forces(spec: GraspSpec, G: np.ndarray, blocks, f) -> tuple:
     return tuple(out)
 
 
-def _force_margin(spec: GraspSpec, forces, tol: GraspTolerances):
+def _force_margin(spec: GraspSpec, forces: tuple, tol: GraspTolerances) -> float:
     """How far inside the circular cones the contact forces are (1 - the largest ratio), or a
     negative number when one is not strictly inside (a normal force <= 0, or a tangential or
     torsion component where the coefficient is 0)."""
@@ -279,7 +279,7 @@ def _force_margin(spec: GraspSpec, forces, tol: GraspTolerances):
     return worst
 
 
-def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks, u: np.ndarray):
+def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks: tuple, u: np.ndarray) -> float:
     """min over contacts of the smallest u . (G_s f) over the circular cone's section f_n = 1:
     u_n - mu |u_t| - mu_torsion |u_torsion| (>= 0: u separates the cone)."""
     worst = math.inf
@@ -298,7 +298,7 @@ def _dual_margin(spec: GraspSpec, Gs: np.ndarray, blocks, u: np.ndarray):
 
 
 # ------------------------------------------------------------------ closure
-def _internal_certificate(spec: GraspSpec, G: np.ndarray, Gs: np.ndarray, blocks, W: np.ndarray, parts, lam, cones: str, tol: GraspTolerances) -> Certificate:
+def _internal_certificate(spec: GraspSpec, G: np.ndarray, Gs: np.ndarray, blocks: tuple, W: np.ndarray, parts: list, lam: np.ndarray, cones: str, tol: GraspTolerances) -> Certificate:
     f = np.zeros(G.shape[1])
     for (sl, C), b in zip(parts, blocks):
         f[b] = C @ lam[sl]
@@ -313,7 +313,7 @@ def _internal_certificate(spec: GraspSpec, G: np.ndarray, Gs: np.ndarray, blocks
                        residual=float(np.linalg.norm(G @ f)), margin=margin, cones=cones)
 
 
-def _wrench_certificate(spec: GraspSpec, Gs: np.ndarray, blocks, u, both, L, cones: str) -> Certificate:
+def _wrench_certificate(spec: GraspSpec, Gs: np.ndarray, blocks: tuple, u: np.ndarray, both: bool, L: float, cones: str) -> Certificate:
     p = Gs.shape[0]
     w = u.copy()  # the scaled wrench (f, m / L) = u as (f, m)
     w[3 if p == 6 else 2:] *= L
@@ -321,7 +321,7 @@ def _wrench_certificate(spec: GraspSpec, Gs: np.ndarray, blocks, u, both, L, con
                        margin=_dual_margin(spec, Gs, blocks, u), cones=cones)
 
 
-def _closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, W: np.ndarray, parts, cones: str, tol: GraspTolerances, L) -> tuple:
+def _closure(spec: GraspSpec, G: np.ndarray, Gs: np.ndarray, blocks: tuple, W: np.ndarray, parts: list, cones: str, tol: GraspTolerances, L: float) -> tuple:
     """(closed, certificate) for one set of polyhedral cones (exact or a pyramid)."""
     p = W.shape[0]
     if _relative_rank(W, tol.rank_rtol) == p:
@@ -334,7 +334,7 @@ def _closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, W: np.ndarray, parts, c
     return False, _wrench_certificate(spec, Gs, blocks, u, both, L, cones)
 
 
-def _decide_closure(spec: GraspSpec, G, Gs: np.ndarray, blocks, facets: int, tol: GraspTolerances, L) -> tuple:
+def _decide_closure(spec: GraspSpec, G: np.ndarray, Gs: np.ndarray, blocks: tuple, facets: int, tol: GraspTolerances, L: float) -> tuple:
     """(force_closure, certificate, how, facets used, notes)."""
     notes = []
     if all(exact_cones(c, spec.planar) for c in spec.contacts):
@@ -382,7 +382,7 @@ def _qhull(X: np.ndarray):
         return ConvexHull(X, qhull_options="QJ")
 
 
-def _epsilon(W, tol: GraspTolerances) -> tuple:
+def _epsilon(W: np.ndarray, tol: GraspTolerances) -> tuple:
     """(lower, upper, reason): bounds on the distance epsilon from the origin to the boundary of
     the hull of W's columns (0 when the origin is not strictly inside); equal unless the work
     bound stopped the search (reason says so).
@@ -446,7 +446,7 @@ def _epsilon(W, tol: GraspTolerances) -> tuple:
         S += added
 
 
-def _quality(spec: GraspSpec, Gs: np.ndarray, blocks, facets, exact, closed, tol: GraspTolerances, L) -> GraspQuality:
+def _quality(spec: GraspSpec, Gs: np.ndarray, blocks: tuple, facets: int, exact: bool, closed: bool | None, tol: GraspTolerances, L: float) -> GraspQuality:
     W_in, _ = generator_matrix(spec, Gs, blocks, facets)
     eps, upper, reason = _epsilon(W_in, tol)
     if not exact:

@@ -44,7 +44,7 @@ _SPATIAL_BASIS = {"frictionless": ([2], ["n"]), "point_friction": ([0, 1, 2], ["
                   "soft_finger": ([0, 1, 2, 5], ["t1", "t2", "n", "torsion"])}
 
 
-def contact_columns(c: Contact, planar) -> tuple:
+def contact_columns(c: Contact, planar: bool) -> tuple:
     """(G_i, labels) of one contact."""
     p = np.asarray(c.point, float)
     n = np.asarray(c.normal, float)
@@ -91,7 +91,7 @@ def grasp_characteristic_length(spec: GraspSpec) -> tuple:
     return L, "the mean distance of the contacts from their centroid"
 
 
-def scaled_points(p, L) -> np.ndarray:
+def scaled_points(p: int, L: float) -> np.ndarray:
     """The weights of a wrench's p rows (3 planar, 6 spatial) that make it dimensionless: 1 on the
     forces, 1 / L on the moments (L the characteristic length [m])."""
     d = np.ones(p)
@@ -106,12 +106,12 @@ def cone_error(facets: int) -> float:
     return 1.0 - math.cos(math.pi / facets)
 
 
-def exact_cones(c: Contact, planar) -> bool:
+def exact_cones(c: Contact, planar: bool) -> bool:
     """Whether the contact's cone is polyhedral (then its generators are exact)."""
     return planar or c.model == "frictionless" or c.mu == 0.0
 
 
-def generators(c: Contact, planar, facets: int = 8, circumscribed: bool = False) -> np.ndarray:
+def generators(c: Contact, planar: bool, facets: int = 8, circumscribed: bool = False) -> np.ndarray:
     """The generators of the contact's cone (or of the N-facet pyramid inscribed in it, or
     circumscribed about it) in the contact's coordinates (columns of G_i), each with unit
     normal force: frictionless (1); planar (t, n): (+-mu, 1); point contact (t1, t2, n):
@@ -137,7 +137,7 @@ def generators(c: Contact, planar, facets: int = 8, circumscribed: bool = False)
     return C
 
 
-def generator_matrix(spec: GraspSpec, Gs: np.ndarray, blocks, facets, circumscribed: bool=False, frictionless: bool=False) -> tuple:
+def generator_matrix(spec: GraspSpec, Gs: np.ndarray, blocks: tuple, facets: int, circumscribed: bool=False, frictionless: bool=False) -> tuple:
     """W = G_s C (scaled primitive wrenches, columns) and, per contact, its columns' slice and C_i."""
     cols, parts, start = [], [], 0
     for c, b in zip(spec.contacts, blocks):

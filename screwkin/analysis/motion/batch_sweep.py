@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from collections.abc import Callable
 
 __all__ = ["batch_closure", "BatchedCurve", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
 
@@ -50,27 +51,27 @@ def batch_closure(mech: Mechanism) -> BatchClosure:
 class BatchedCurve(Curve):
     """The Curve's engine on stacks of configurations (one per row), its closure batched."""
 
-    def __init__(self, solver, name: str, bc) -> None:
+    def __init__(self, solver, name: str, bc: BatchClosure) -> None:
         super().__init__(solver, name)
         self.bc = bc
 
-    def tangents(self, Q: np.ndarray, previous):
+    def tangents(self, Q: np.ndarray, previous: np.ndarray) -> np.ndarray:
         """Unit tangents at the configurations Q, each oriented like the row before it, the first
         like ``previous`` (``choose_branch``); a zero row where the input cannot move."""
         U = self.input_directions(self.bc.constraint_jacobians(Q))
         n = np.linalg.norm(U, axis=1)
         return self.choose_branch(U / np.where(n > TINY, n, 1.0)[:, None], previous)
 
-    def predict(self, q: np.ndarray, t, sigma: float):
+    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float) -> np.ndarray:
         return q[None] + (self.scale * t)[None] * sigma[:, None]  # (nq == nv: integrate is a sum)
 
-    def correct(self, predicted, held) -> tuple:
+    def correct(self, predicted: np.ndarray, held: int) -> tuple:
         Qc, ok, _, _ = self.bc.solve(predicted, frozen=self.frozen(held))
         ok &= np.all(np.isfinite(Qc), axis=1)
         Qc[~ok] = predicted[~ok]  # (refused by accept; finite for the tangents)
         return Qc, ok
 
-    def accept(self, predicted, corrected, sigma: float, t=None, T=None):
+    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float, t: np.ndarray | None=None, T: np.ndarray | None=None):
         """Rows that pass the jump test and, given the tangent t before the stack and the stack's T,
         have no limit position between them and the row before."""
         ok = ~jumped(np.linalg.norm((corrected - predicted) / self.scale, axis=1), sigma, self.tol)
@@ -79,7 +80,7 @@ class BatchedCurve(Curve):
         return ok
 
 
-def batched_motion(solver, curve, q0: np.ndarray, t0, start: float, stop: float, steps: int, fallback, progress=None):
+def batched_motion(solver, curve: Curve, q0: np.ndarray, t0: np.ndarray, start: float, stop: float, steps: int, fallback: Callable, progress=None):
     """The grid values from start to stop (steps steps) on q0's branch, batched (see the module
     docstring).  curve: the sweep's Curve; t0: its oriented tangent at q0 (the input's component
     along the motion); fallback(q, x_from, x_to, n): the tracker's Motion of n steps;

@@ -45,6 +45,7 @@ if TYPE_CHECKING:
     from typing import Any
     from screwkin.model.mechanism import Mechanism
     from screwkin.tolerances import Tolerances
+    from collections.abc import Callable
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -106,7 +107,7 @@ class Engine(Protocol):
         """The limit position bracketed between two configurations (input values), by ``locate``."""
 
 
-def projections(K: np.ndarray, V, scale, free, tol: Tolerances) -> np.ndarray:
+def projections(K: np.ndarray, V: np.ndarray, scale: np.ndarray, free: np.ndarray, tol: Tolerances) -> np.ndarray:
     """The vectors V (N, nv) projected onto the null space of the scaled constraint Jacobians K
     (N, m, nv) -- columns times ``scale`` (characteristic lengths for sliding joints), restricted to
     the ``free`` columns (the held inputs have no part) -- with the rank rule of model.linalg (singular
@@ -136,7 +137,7 @@ def projections(K: np.ndarray, V, scale, free, tol: Tolerances) -> np.ndarray:
     return out
 
 
-def orient(t, previous: np.ndarray):
+def orient(t: np.ndarray, previous: np.ndarray) -> np.ndarray:
     """The branch rule: t, or -t, whichever continues ``previous`` (a non-negative dot product);
     t itself without a previous one.  Rows of a stack are oriented each like the row before it,
     the first like ``previous``."""
@@ -151,7 +152,7 @@ def orient(t, previous: np.ndarray):
     return t * np.cumprod(d)[:, None]
 
 
-def passes_limit(ta, tb, ix) -> bool:
+def passes_limit(ta: np.ndarray, tb: np.ndarray, ix: int) -> bool:
     """A limit position between two configurations (oriented tangents ta, tb: ``orient``): the
     input's share of the tangent does not keep its sign (rows of stacks compared pairwise)."""
     return np.asarray(ta)[..., ix] * np.asarray(tb)[..., ix] <= 0
@@ -169,14 +170,14 @@ def keeps_orientation(Ks_from, Ks_new: np.ndarray, r) -> bool:
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss, sigma: float, tol: Tolerances):
+def jumped(miss, sigma: float, tol: Tolerances) -> np.ndarray | bool:
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""
     return ~(np.asarray(miss) <= np.maximum(tol.jump * np.abs(sigma), tol.jump_floor))
 
 
-def locate(f, lo, hi, xtol: float = 1e-14, maxiter: int = 100) -> float:
+def locate(f: Callable, lo: float, hi: float, xtol: float = 1e-14, maxiter: int = 100) -> float:
     """The root of f bracketed in [lo, hi] (f changes sign there) by Brent's method, to xtol and
     four units of round-off: where every engine locates its limit positions (the tangent's input
     share, a closed form's discriminant) and the input values on an arc near them."""
@@ -185,7 +186,7 @@ def locate(f, lo, hi, xtol: float = 1e-14, maxiter: int = 100) -> float:
     return brentq(f, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=maxiter)
 
 
-def returned(mech: Mechanism, x, start, h, q: np.ndarray, q0: np.ndarray, scale) -> bool:
+def returned(mech: Mechanism, x: float, start: float, h: float, q: np.ndarray, q0: np.ndarray, scale: np.ndarray) -> bool:
     """The motion is back at its start: the input at ``start`` (Tolerances.equal relative to the grid
     step h) and the configuration q at q0 (Tolerances.geometry, dimensionless)."""
     tol = mech.tolerances
@@ -239,7 +240,7 @@ class Curve:
         """The unnormalized tangents P e at configurations of constraint Jacobians K (N, m, nv)."""
         return projections(K, self.e[None].repeat(len(K), 0), self.scale, self.free, self.tol)
 
-    def tangent(self, q: np.ndarray, previous=None):
+    def tangent(self, q: np.ndarray, previous: np.ndarray | None=None) -> np.ndarray:
         """Unit tangent of the curve at q in scaled coordinates (nv; zero on the held inputs),
         oriented like ``previous`` (``choose_branch``): the input's direction projected onto the null
         space of K; at a limit position itself (tol.limit_share), ``previous`` projected instead."""
@@ -253,39 +254,39 @@ class Curve:
             raise Stuck("the mechanism cannot move along this input here")
         return self.choose_branch(t / n, previous)
 
-    def choose_branch(self, t, previous):
+    def choose_branch(self, t: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
         return orient(t, previous)
 
-    def along(self, q: np.ndarray, direction):
+    def along(self, q: np.ndarray, direction: float) -> np.ndarray:
         """The unit tangent at q oriented so that the input moves the way of ``direction`` (its sign;
         zero: increasing) -- where a motion starts."""
         t = self.tangent(q)
         return -t if t[self.ix] * (np.sign(direction) or 1.0) < 0 else t
 
-    def hold(self, t):
+    def hold(self, t: np.ndarray) -> int:
         """The velocity index of the joint to hold for a step along t: the input when it has a
         large share of the tangent, else the one-DOF joint with the largest share."""
         scores = np.where(self.holdable, np.abs(t), -1.0)
         best = int(np.argmax(scores))
         return self.ix if abs(t[self.ix]) >= 0.5 * scores[best] else best
 
-    def frozen(self, held) -> tuple:
+    def frozen(self, held: int) -> tuple:
         return tuple(sorted(set(self.frozen_other) | {held}))
 
-    def predict(self, q: np.ndarray, t, sigma: float):
+    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float) -> np.ndarray:
         return pin.integrate(self.model, q, self.scale * t * sigma)
 
-    def correct(self, predicted, held):
+    def correct(self, predicted: np.ndarray, held: int) -> np.ndarray:
         try:
             return self.closure.solve(predicted, frozen=self.frozen(held)).q
         except AssemblyError:
             raise Stuck("the loops cannot be closed") from None
 
-    def accept(self, predicted, corrected, sigma: float) -> bool:
+    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float) -> bool:
         miss = np.linalg.norm(pin.difference(self.model, predicted, corrected) / self.scale)
         return not jumped(miss, sigma, self.tol)
 
-    def step(self, q: np.ndarray, t, sigma: float, held):
+    def step(self, q: np.ndarray, t: np.ndarray, sigma: float, held: int) -> np.ndarray:
         """Move sigma (scaled) along t, hold joint ``held`` there, close the loops again."""
         pred = self.predict(q, t, sigma)
         q_new = self.correct(pred, held)
@@ -293,7 +294,7 @@ class Curve:
             raise Stuck("the correction jumps away from the curve")
         return q_new
 
-    def at_input(self, q_from: np.ndarray, x_from, x, t):
+    def at_input(self, q_from: np.ndarray, x_from: float, x: float, t: np.ndarray) -> np.ndarray:
         """The configuration at input value x, predicted from q_from (input x_from) along t."""
         dx = (x - x_from) / self.scale[self.ix]
         if abs(t[self.ix]) < self.tol.zero:
@@ -303,7 +304,7 @@ class Curve:
     def input_change(self, q0: np.ndarray, q1: np.ndarray) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
 
-    def _arc(self, qa: np.ndarray, qb: np.ndarray, held, message: str):
+    def _arc(self, qa: np.ndarray, qb: np.ndarray, held: int, message: str) -> Callable:
         """The configuration a share u of the way from qa to qb with joint ``held`` as the parameter."""
         delta = pin.difference(self.model, qa, qb)
         frozen, cache = self.frozen(held), {0.0: qa, 1.0: qb}
@@ -349,7 +350,7 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed at this input value") from None
 
-    def locate_limit(self, qa: np.ndarray, ta, qb: np.ndarray, held) -> tuple:
+    def locate_limit(self, qa: np.ndarray, ta: np.ndarray, qb: np.ndarray, held: int) -> tuple:
         """The limit position between qa and qb (the input's tangent component changes sign),
         with joint ``held`` as the parameter: (configuration, input offset from qa)."""
         at = self._arc(qa, qb, held, None)

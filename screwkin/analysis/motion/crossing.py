@@ -234,7 +234,7 @@ def _measure(mech: Mechanism, q: np.ndarray, rank: int) -> float:
     return float(constraint_profile(mech, [q], rank)[0][0])
 
 
-def _again(solver: PositionSolver, out: list, res, k: int, lo_k, hi_k, bounds: list) -> tuple | None:
+def _again(solver: PositionSolver, out: list, res, k: int, lo_k: int, hi_k: int, bounds: list) -> tuple | None:
     """(x, configuration, measure) of a change point already found (in ``out``) that this dip is another
     pass of (a motion through limit positions passes one point again and again): its input within the
     dip's bounds, its joint centres nearer the recorded configuration k than the neighbours are; else None."""
@@ -246,7 +246,7 @@ def _again(solver: PositionSolver, out: list, res, k: int, lo_k, hi_k, bounds: l
     return None
 
 
-def _least(solver: PositionSolver, res, q: np.ndarray, bounds: list | tuple, rank, tight) -> tuple | None:
+def _least(solver: PositionSolver, res, q: np.ndarray, bounds: list | tuple, rank: int, tight: Tolerances) -> tuple | None:
     """(x, configuration, measure) where the constraint measure is least for the input within bounds, the
     loops closed again from q at each value (bounded minimization, to the closure tolerance); None
     where they cannot be closed there."""

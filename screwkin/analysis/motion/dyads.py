@@ -264,7 +264,7 @@ def _evaluate(geo: _Geometry, p: DyadPlan, xs: np.ndarray | list, start: float, 
         return _evaluate_all(geo, p, xs, start, branch, clamp)
 
 
-def _evaluate_all(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, branch: str, clamp) -> tuple:
+def _evaluate_all(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, branch: str, clamp: int | None) -> tuple:
     xs = np.asarray(xs, float)
     zero = Jet(np.zeros(len(xs)))
     poses = {p.groups[0]: _Pose(zero, zero, zero)}
@@ -446,7 +446,7 @@ class ClosedFormCurve:
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
-    def locate_limit(self, lo, hi) -> tuple | None:
+    def locate_limit(self, lo: float, hi: float) -> tuple | None:
         """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
         position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
         on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
@@ -579,5 +579,5 @@ def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, s
     return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 
-def _take(j, n: int) -> Jet:
+def _take(j: Jet, n: int) -> Jet:
     return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))

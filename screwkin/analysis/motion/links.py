@@ -195,7 +195,7 @@ def sweep_motion(mech: Mechanism, res, points: tuple=()) -> MotionAlong:
 
 
 
-def _frame_motions(model: pin.Model, data, frames: list, Q: np.ndarray, V, A) -> tuple:
+def _frame_motions(model: pin.Model, data, frames: list, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> tuple:
     """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
     (a, alpha) of the frames' origins in world axes (N, F, 6) -- what pin.getFrameVelocity and
     pin.getFrameClassicalAcceleration give in LOCAL_WORLD_ALIGNED -- from one forwardKinematics a

@@ -385,7 +385,7 @@ class LinkAngles:
             return {link: np.array([r[link] for r in rows]) for link in self.links}
         return out
 
-    def check(self, link: str):
+    def check(self, link: str) -> None:
         """A usage error unless ``link`` is a moving link of the mechanism (the ground's angle is fixed)."""
         moving = [k for k in self.links if k != self.ground]
         if link == self.ground:

@@ -466,7 +466,7 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q: np.ndarray, a: Assembly, rates: dict | None = None, accels: dict | None = None, points: tuple=(), typed: dict | None=None, sets: int | None=None, simple=None) -> Solution:
+    def solution(self, q: np.ndarray, a: Assembly, rates: dict | None = None, accels: dict | None = None, points: tuple=(), typed: dict | None=None, sets: int | None=None, simple: bool | None=None) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here

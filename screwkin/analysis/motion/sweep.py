@@ -171,7 +171,7 @@ REFINE = 8
 ON_GRID = 1e-6  # a value within this fraction of a fine step of a fine grid value is on that grid
 
 
-def _refined(f, start: float, h, k: int):
+def _refined(f, start: float, h: float, k: int):
     """The closed-form sweep ``f`` of a grid k times finer (step h / k) at the values of the grid of step h
     (and its located limit position, off both grids); None for None."""
     if f is None:
@@ -185,7 +185,7 @@ def _refined(f, start: float, h, k: int):
 
 def sweep(solver: PositionSolver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
-          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True,
+          max_steps: int | None = None, q_start: Callable | np.ndarray | None=None, closed_form: bool = True, batch: bool = True,
           branch: str = "continue", prior=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
@@ -285,7 +285,7 @@ def _closed_form(solver: PositionSolver, name: str, q0: np.ndarray, start: float
                        method="closed form")
 
 
-def _fallback(solver, curve, fixed):
+def _fallback(solver: PositionSolver, curve: Curve, fixed: dict) -> Callable:
     """The batched engine's fallback: the per-step tracker's Motion of n steps from qa (input xa) to xb,
     qa closed again at xa first (as a sweep started from it)."""
 
@@ -299,7 +299,7 @@ def _fallback(solver, curve, fixed):
     return fallback
 
 
-def _trackable(mech: Mechanism, name: str, start: float, stop: float, steps: int):
+def _trackable(mech: Mechanism, name: str, start: float, stop: float, steps: int) -> None:
     """A range the per-step tracker takes more than MAX_TRACKED steps over (and more than its grid
     values) is a usage error naming the count."""
     needed = continuation_steps(mech, name, stop - start)
@@ -309,7 +309,7 @@ def _trackable(mech: Mechanism, name: str, start: float, stop: float, steps: int
                          f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
 
 
-def _start_tangent(curve, q0: np.ndarray, h) -> tuple:
+def _start_tangent(curve: Curve, q0: np.ndarray, h: float) -> tuple:
     """(the tangent at q0 oriented along the grid step h, None) or (None, why the input cannot move)."""
     try:
         return curve.along(q0, h), None
@@ -317,7 +317,7 @@ def _start_tangent(curve, q0: np.ndarray, h) -> tuple:
         return None, str(exc)
 
 
-def _finish(solver: PositionSolver, name: str, motion: Motion, rate, requested, turn, unit: str, method: str = "tracker") -> SweepResult:
+def _finish(solver: PositionSolver, name: str, motion: Motion, rate: float, requested: tuple, turn: bool, unit: str, method: str = "tracker") -> SweepResult:
     """The SweepResult of an engine's Motion: rates and accelerations at each configuration."""
     X, Q = motion.X, motion.Q
     mech = solver.mech

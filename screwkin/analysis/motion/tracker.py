@@ -23,6 +23,10 @@ from __future__ import annotations
 import numpy as np
 
 from .continuation import CHANGE_REASON, LIMIT_REASON, Motion, Stuck, at_change_point, passes_limit, returned
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 __all__ = ["Tracker", "CONTINUATION_ROUNDS"]
 
@@ -36,7 +40,7 @@ class Tracker:
     """One motion of ``curve`` from q0 (input ``start``, oriented tangent t) over the grid of ``steps``
     steps to ``stop``; ``run`` returns the Motion.  The state of the walk is its attributes."""
 
-    def __init__(self, curve, q0: np.ndarray, t, start, stop, steps: int, turn: bool=False, max_steps: int | None = None, progress=None) -> None:
+    def __init__(self, curve, q0: np.ndarray, t: np.ndarray, start: float, stop: float, steps: int, turn: bool=False, max_steps: int | None = None, progress=None) -> None:
         self.c, self.q0, self.start, self.stop, self.steps = curve, q0, float(start), float(stop), steps
         self.turn, self.progress = turn, progress
         self.max_steps = max_steps or 20 * steps + 100
@@ -50,7 +54,7 @@ class Tracker:
         """The input runs the way of the range (not back after a limit position)."""
         return self.direction * np.sign(self.h) > 0
 
-    def grid_between(self, xa, xb) -> list:
+    def grid_between(self, xa: float, xb: float) -> list:
         """Grid values strictly after xa up to xb (inclusive) in the direction of motion, within the range."""
         h, start = self.h, self.start
         if h == 0:
@@ -60,12 +64,12 @@ class Tracker:
             range(int(np.ceil(lo_k - GRID_SLACK)) - 1, int(np.ceil(hi_k - GRID_SLACK)) - 1, -1)
         return [start + j * h for j in ks]
 
-    def past_end(self, x) -> bool:
+    def past_end(self, x: float) -> bool:
         """x lies past the end of the range (going forward), beyond round-off."""
         return self.forward() and (x - self.stop) * self.direction > self.c.tol.zero * max(1.0, abs(self.stop))
 
     # -- recording grid values -------------------------------------------------------------------------
-    def solved(self, g, first, arc):
+    def solved(self, g: float, first: Callable, arc: tuple):
         """The configuration at grid value g: ``first()`` (the tangent predictor), else the arc of
         the step it lies on (``arc``: (qa, xa, qb, held), near a limit position), else None."""
         try:
@@ -79,17 +83,17 @@ class Tracker:
                 pass
         return None
 
-    def keep(self, g, qg) -> None:
+    def keep(self, g: float, qg: np.ndarray) -> None:
         if qg is None:
             self.m.skipped.append(float(g))  # said in the result: never a hole in a motion marked complete
         else:
             self.m.X.append(g)
             self.m.Q.append(qg)
 
-    def arc(self, qa: np.ndarray, xa, qb: np.ndarray, held) -> tuple | None:
+    def arc(self, qa: np.ndarray, xa: float, qb: np.ndarray, held: int) -> tuple | None:
         return (qa, xa, qb, held) if held is not None and held != self.c.ix else None
 
-    def record(self, qa: np.ndarray, xa, ta, qb: np.ndarray, xb, tb=None, held=None) -> None:
+    def record(self, qa: np.ndarray, xa: float, ta: np.ndarray, qb: np.ndarray, xb: float, tb: np.ndarray | None=None, held: int | None=None) -> None:
         """Record the grid values between configurations qa (input xa) and qb (xb), with no limit
         position between them, each predicted from the nearer end (not from a limit position:
         there the input does not move, pass tb=None for such an end); where the predictor fails
@@ -102,7 +106,7 @@ class Tracker:
             self.keep(g, self.solved(g, (lambda g=g: c.at_input(qb, xb, g, tb)) if near_b else
                                      (lambda g=g: c.at_input(qa, xa, g, ta)), arc))
 
-    def record_back(self, q_lim, x_lim, qb: np.ndarray, xb, tb, held=None) -> None:
+    def record_back(self, q_lim: np.ndarray, x_lim: float, qb: np.ndarray, xb: float, tb: np.ndarray, held: int | None=None) -> None:
         """After a limit position: the grid values between it and qb, predicted from qb."""
         arc = self.arc(q_lim, x_lim, qb, held)
         for g in self.grid_between(x_lim, xb):
@@ -194,7 +198,7 @@ class Tracker:
         self.sigma = min(self.sigma * 1.5, self.longest)
         return None
 
-    def arc_step(self, held) -> bool | None:
+    def arc_step(self, held: int) -> bool | None:
         """A step with the passive joint ``held`` held (a limit position located and passed on the way):
         True when the motion ends here, False when it goes on, None when the step was refused (the
         next one shorter)."""

@@ -174,7 +174,7 @@ def _measures(S: Scaled, g: Generic) -> dict:
     return out
 
 
-def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=None, length=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:
+def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output: str | None=None, length: float | None=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:
     """Classify the configuration q (assembled) for the given inputs and output link.
     length: the characteristic length [m] (default ``mech.length``); point: the output
     link's origin as a point (its 3 translations) instead of its full motion."""
@@ -246,7 +246,7 @@ def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=
                              L, tuple(twists), tuple(inputs), output, point, gram_cofactors(mech, q, L))
 
 
-def named_types(rep: SingularityReport, local=None, tol=DEFAULT) -> tuple:
+def named_types(rep: SingularityReport, local=None, tol: Tolerances=DEFAULT) -> tuple:
     """The kinds that meet at the configuration in the standard vocabularies: (vocabulary, name, what it
     means here) for Gosselin and Angeles 1990 (type I: the output loses a direction, type II: it moves with
     the inputs locked, type III: both) and Zlatanov, Fenton and Benhabib 1995 (redundant input: the inputs
@@ -310,7 +310,7 @@ class GramLoop:
 STATIONARY = DEFAULT.stationary
 
 
-def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length=None) -> tuple:
+def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length: float | None=None) -> tuple:
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
     says why) when the loop has a higher pair or a joint without one twist per coordinate."""
@@ -384,7 +384,7 @@ def pair_rate(mech: Mechanism, cut, state) -> float:
     return float((state.frame_twist(f2)[3:] - state.frame_twist(f1)[3:]) @ a)
 
 
-def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
+def gram_cofactors(mech: Mechanism, q: np.ndarray, length: float | None=None) -> tuple:
     """GramLoop for each loop (one per cut joint: the fundamental loops of the spanning tree)."""
     tol = mech.tolerances
     out = []
@@ -410,7 +410,7 @@ def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
     return tuple(out)
 
 
-def lost_direction(JV: np.ndarray, out_dim: int, normal=None) -> np.ndarray:
+def lost_direction(JV: np.ndarray, out_dim: int, normal: tuple | None=None) -> np.ndarray:
     """The output direction lost at a serial singularity, as a unit (6,) twist (v, w) in the rows' scaled
     coordinates (a point's output: v only, w zero): the left singular vector of the output's motion map
     JV (rows (v, w) or v, columns the mechanism's motions) for its ``out_dim``-th singular value, the one
@@ -435,7 +435,7 @@ def lost_direction(JV: np.ndarray, out_dim: int, normal=None) -> np.ndarray:
     return out
 
 
-def _motion_twist(kind: str, x, names, J: np.ndarray, tol: Tolerances) -> SingularTwist:
+def _motion_twist(kind: str, x: np.ndarray, names: list, J: np.ndarray, tol: Tolerances) -> SingularTwist:
     """The motion x (any length) as a SingularTwist: its rates (those not zero next to the unit
     vector: above Tolerances.equal), its twist and screw (none for a zero twist)."""
     x = x / np.linalg.norm(x)

@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.design.synthesis.designs import Target
 
 __all__ = ["check_design", "check_chain_file", "TOLERANCE"]
 
@@ -73,7 +74,7 @@ class _Probe:
             return (float(M.translation[0]), float(M.translation[1]))
         return (float(math.atan2(M.rotation[1, 0], M.rotation[0, 0])),)
 
-    def error(self, q: np.ndarray, target) -> tuple:
+    def error(self, q: np.ndarray, target: Target) -> tuple:
         v = self.value(q)
         t = target.value
         if target.kind == "pose":
@@ -95,7 +96,7 @@ class _Probe:
         return state.centre(("joint", self.jA))[:2], state.centre(("frame", self.fB))[:2]
 
 
-def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target) -> float:
+def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target: Target) -> float:
     """Distance between the file's moving pivots (and guided frame) at q and the closed-form
     four-bar at the same crank angle, on the branch that is nearer."""
     fb = design.fourbar
@@ -112,7 +113,7 @@ def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target) -> 
     return float(best)
 
 
-def check_design(design: Design, path, tolerance: float | None = None, steps: int = 360, warn=None) -> Check:
+def check_design(design: Design, path: str, tolerance: float | None = None, steps: int = 360, warn=None) -> Check:
     """Check the four-bar ``design`` written at ``path`` (see the module docstring)."""
     mech = load(path, warn=warn or (lambda _m: None))
     tol = tolerance if tolerance is not None else TOLERANCE * max(1.0, mech.length)
@@ -172,7 +173,7 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
                  tuple(travel), tol, letters)
 
 
-def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x, q_target: np.ndarray) -> bool:
+def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x: float, q_target: np.ndarray) -> bool:
     """Whether the branch followed by sweep ``res`` is, at input value x, in the configuration
     q_target (the solution found for that precision position): same moving pivots."""
     if q_target is None:
@@ -189,7 +190,7 @@ def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x, q_tar
     return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
-def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs, steps: int) -> tuple:
+def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list, steps: int) -> tuple:
     """(direction, travel per position, transmission angles along the motion, defects)."""
     name = design.input_joint
     tol = probe.mech.tolerances

@@ -32,16 +32,16 @@ __all__ = ["angle", "rotate", "pose_matrix", "branch", "tool_local", "positions"
 TWO_PI = 2 * math.pi
 
 
-def angle(v) -> float:
+def angle(v: np.ndarray) -> float:
     return float(math.atan2(v[1], v[0]))
 
 
-def rotate(theta) -> np.ndarray:
+def rotate(theta: float | np.ndarray) -> np.ndarray:
     c, s = math.cos(theta), math.sin(theta)
     return np.array([[c, -s], [s, c]])
 
 
-def pose_matrix(pose) -> tuple:
+def pose_matrix(pose: tuple) -> tuple:
     """(R, p) of a pose (x, y, theta)."""
     return rotate(pose[2]), np.array(pose[:2], float)
 
@@ -66,7 +66,7 @@ def tool_local(fb: FourBar) -> tuple[float, float, float]:
     return float(u), float(v), float(t[2] - phi)
 
 
-def positions(fb: FourBar, theta, sigma: float) -> dict:
+def positions(fb: FourBar, theta: float, sigma: float) -> dict:
     """Closed-form positions at crank angles theta (absolute, array): dict with A, B, the tool
     pose (x, y, angle) arrays, h2 (< 0: not assembled) and mu."""
     theta = np.asarray(theta, float)

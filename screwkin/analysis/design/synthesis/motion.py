@@ -45,14 +45,14 @@ __all__ = ["moving_pivot", "fixed_pivot", "poles", "centre_point_curve", "dyad_c
 WHAT = "synthesize motion"
 
 
-def scale_of(poses) -> float:
+def scale_of(poses: list) -> float:
     """The size of the task: the largest distance between two pose origins (or 1 m)."""
     P = np.array([p[:2] for p in poses], float)
     d = max((float(np.hypot(*(P[i] - P[j]))) for i in range(len(P)) for j in range(i)), default=0.0)
     return d if d > 0 else 1.0
 
 
-def _burmester_rows(poses, A0: np.ndarray) -> np.ndarray:
+def _burmester_rows(poses: list, A0: np.ndarray) -> np.ndarray:
     """The rows [2 g_i, rhs_i] (i = 2..n) at fixed pivots A0 (..., 2): shape (..., n-1, 3)."""
     A0 = np.asarray(A0, float)
     R1, p1 = pose_matrix(poses[0])
@@ -90,7 +90,7 @@ def fixed_pivot(poses: list, local, what: str = WHAT) -> np.ndarray:
     return np.linalg.solve(M, r)
 
 
-def poles(poses) -> list:
+def poles(poses: list) -> list:
     """(i, j, P) for each pair of positions whose displacement turns (a translation has its
     pole at infinity): P is the point that T_j T_i^-1 leaves in place."""
     out = []
@@ -246,7 +246,7 @@ def burmester_points(poses: list, seeds: int = 360) -> tuple:
     return tuple(out)
 
 
-def fourbar_from_dyads(poses, crank: Dyad, rocker: Dyad) -> FourBar:
+def fourbar_from_dyads(poses: list, crank: Dyad, rocker: Dyad) -> FourBar:
     return FourBar(tuple(crank.fixed), tuple(crank.moving), tuple(rocker.moving), tuple(rocker.fixed),
                    tuple(float(x) for x in poses[0]))
 
@@ -263,7 +263,7 @@ def _positions_of(poses: list, crank: Dyad, rocker: Dyad) -> tuple[np.ndarray, n
     return np.array(thetas), np.array(sigmas)
 
 
-def targets_of(poses, crank: Dyad) -> tuple:
+def targets_of(poses: list, crank: Dyad) -> tuple:
     thetas = []
     for pose in poses:
         R, p = pose_matrix(pose)
@@ -296,7 +296,7 @@ def rank_pairs(poses: list, dyads: list, limit: int | None = None) -> list:
     return [(i, j, d, mu) for _, _, i, j, d, mu in scored[:limit]]
 
 
-def motion_design(poses, crank: Dyad, rocker: Dyad, name: str = "synthesized_motion", notes=()) -> Design:
+def motion_design(poses: list | tuple, crank: Dyad, rocker: Dyad, name: str = "synthesized_motion", notes: tuple=()) -> Design:
     """The four-bar of two dyads drawn at the first pose, with its targets."""
     fb = fourbar_from_dyads(poses, crank, rocker)
     L = fb.lengths
@@ -312,7 +312,7 @@ def motion_design(poses, crank: Dyad, rocker: Dyad, name: str = "synthesized_mot
                          tuple(notes)))
 
 
-def _check_poses(poses: list):
+def _check_poses(poses: list) -> None:
     L = scale_of(poses)
     for i, j in itertools.combinations(range(len(poses)), 2):
         a, b = poses[i], poses[j]
@@ -321,7 +321,7 @@ def _check_poses(poses: list):
             raise UsageError(f"--poses: positions {i + 1} and {j + 1} are the same pose: give distinct poses")
 
 
-def synthesize_motion(poses, pivots=None, moving=None, pick=None, count: int = 24) -> MotionResult:
+def synthesize_motion(poses: list, pivots: list | None=None, moving=None, pick=None, count: int = 24) -> MotionResult:
     """Dyads for the poses and the pair to build: three poses with ``pivots`` (two fixed
     pivots) or ``moving`` (two moving pivots in the coupler frame); four or five poses by
     Burmester theory, the pair ``pick`` (indices into the candidates, crank first) or, when
