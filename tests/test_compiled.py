@@ -1,5 +1,5 @@
-"""The compiled inner loop (screwkin.model.compiled, numba) gives the numpy loop's numbers: the same
-model.newton.iterate with the rows, the step and the verdict compiled."""
+"""The compiled inner loop (screwkin.model.kernel.compiled, numba) gives the numpy loop's numbers: the same
+model.kernel.newton.iterate with the rows, the step and the verdict compiled."""
 
 import dataclasses
 
@@ -10,7 +10,7 @@ from conftest import CORPUS, ROBOTS, fourbar
 
 import screwkin
 from screwkin.analysis.motion.position import PositionSolver
-from screwkin.model import compiled, newton
+from screwkin.model.kernel import compiled, newton
 
 pytest.importorskip("numba")
 

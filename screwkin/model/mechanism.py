@@ -21,7 +21,7 @@ from ..errors import AssemblyError, MechanismFileError, UsageError, quote
 from ..files.description import MechanismSpec, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from .closability import closure_gap, closure_obstacle
-from .closure import ClosureSystem
+from .kernel.closure import ClosureSystem
 from .cuts import Assembly, bind_cut
 from .geometry import wrap_angle
 from .linalg import null_space, rank
@@ -58,7 +58,7 @@ class Mechanism:
     spec:       the :class:`~screwkin.files.description.MechanismSpec` read from the file.
     model:      ``pinocchio.Model`` of the spanning tree (with frames F1, F2 of every cut joint).
     cuts:       list of :class:`~screwkin.model.cuts.CutJoint`.
-    closure:    the :class:`~screwkin.model.closure.ClosureSystem` r(q) = 0.
+    closure:    the :class:`~screwkin.model.kernel.closure.ClosureSystem` r(q) = 0.
     coordinates: list of :class:`Coordinate`, one per tree joint with coordinates.
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """

@@ -10,7 +10,7 @@ Two methods:
   mechanism).  From the output's position in the mechanism's assembled configuration the
   grid is filled outwards, wave by wave: each new point is solved (loop closures, the target,
   joint limits) from the solution at a neighbour, all points of a wave in one batched Newton
-  solve (analysis.motion.batch_closure.BatchClosure).  A solution must continue its neighbour's: it may not
+  solve (model.kernel.stacks.BatchClosure).  A solution must continue its neighbour's: it may not
   jump to another working mode (another branch of a leg), so the workspace is the one of
   the assembly mode the file is drawn in.  Along the grid's last axis every run of reached
   points is extended to the boundary by bisection (solved too), and the volume is the sum of
@@ -44,7 +44,7 @@ from ...errors import AssemblyError, UsageError
 from ...model.linalg import rank
 from ...model.state import KinematicState
 from ..singularities.batch import SerialJacobians
-from ..motion.batch_closure import BatchClosure, Unbatchable
+from ...model.kernel.stacks import BatchClosure, Unbatchable
 from ...model.limits import within_limits
 from ..singularities.singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions

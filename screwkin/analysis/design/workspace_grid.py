@@ -1,6 +1,6 @@
 """The grid a workspace is grown on (analysis.design.workspace's ``grid`` method): positions of the
 output on axes spanning its translations, filled outwards wave by wave from the assembled
-configuration by batched inverse kinematics (analysis.motion.batch_closure.BatchClosure), each point
+configuration by batched inverse kinematics (model.kernel.stacks.BatchClosure), each point
 from a neighbour's solution along a first-order predictor, kept only when it continues that
 neighbour's branch (the one continuation's jump test and branch rule, analysis.motion.continuation:
 the sign of the rows' Jacobian determinant on the parent's row space), with
@@ -14,8 +14,8 @@ import time
 import numpy as np
 
 from ...model.linalg import rank
-from ...model.newton import damped_steps
-from ..motion.batch_closure import BatchClosure
+from ...model.kernel.newton import damped_steps
+from ...model.kernel.stacks import BatchClosure
 from ..motion.continuation import jumped, keeps_orientation
 from ...model.limits import within_limits
 

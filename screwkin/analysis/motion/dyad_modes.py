@@ -14,7 +14,7 @@ system of k quadratics; a dyad's two circles are never concentric where the plan
 The real set is therefore complete by construction -- no search, no trace test.  The placing is
 analysis.motion.dyads' own (its continuation engine, ``ClosedFormCurve``, predicting every branch
 vector at once); each configuration is checked by its closure residual on Pinocchio's closure
-(model.closure) after the same undamped Newton polish as the homotopy's modes.  Where the plan does
+(model.kernel.closure) after the same undamped Newton polish as the homotopy's modes.  Where the plan does
 not apply, or a check fails, the caller (analysis.motion.certified) takes the homotopy.
 """
 
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...model import newton
+from ...model.kernel import newton
 from ...model.cuts import Assembly
 from ...model.manifold import continuous_angle
 from .dyads import ClosedFormCurve, cached_plan

@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...files import generic_cache
-from ...model import newton
+from ...model.kernel import newton
 from ...model.cuts import Assembly
 from ...model.distances import SixDistances, chain_angles
 from ...model.legs import chain_distance

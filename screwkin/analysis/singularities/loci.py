@@ -16,7 +16,7 @@ Its locus is the curve of S where A v = 0 for a unit v: the solutions z = (q, v)
 one equation short of the unknowns.  Each curve is followed by pseudo-arclength predictor-corrector
 continuation in z (tangent: the null vector of dF; corrector: Newton with the step's hyperplane),
 every point converged until |F| is round-off; its trace in the plane is read off q.  The derivative of
-A(q) v is central differences of A (A itself comes from the analytic Jacobians of model.closure and
+A(q) v is central differences of A (A itself comes from the analytic Jacobians of model.kernel.closure and
 model.state); Newton's limit is the root of F, which is evaluated exactly.
 
 Seeds: the assembly modes at the box's centre (the project's all-modes solve), each continued over a

@@ -1,8 +1,8 @@
 """The one damped-Newton (Levenberg-Marquardt) loop of every closure solver, and its step.
 
 ``iterate`` is the loop, written once for a stack of N configurations; the single solve
-(``solve``: model.closure.ClosureSystem.solve) runs it on a stack of one, the batched one
-(analysis.motion.batch_closure.BatchClosure.solve) on many, the compiled path (model.compiled) with
+(``solve``: model.kernel.closure.ClosureSystem.solve) runs it on a stack of one, the batched one
+(model.kernel.stacks.BatchClosure.solve) on many, the compiled path (model.kernel.compiled) with
 the rows, the step and the verdict compiled by numba from the same definitions.  Whoever wants to
 change how Newton iterates changes it here:
 
@@ -37,8 +37,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import AssemblyError
-from .cuts import Assembly
+from ...errors import AssemblyError
+from ..cuts import Assembly
 
 __all__ = ["TRACE_FLOOR", "NU", "damped_step", "damped_steps", "stacked_steps", "one_at_a_time", "one_step", "judge",
            "Iterates", "iterate", "solve", "polish"]
@@ -100,7 +100,7 @@ def stacked_steps(K, r, free, mu):
 def one_at_a_time(step):
     """The step of ``iterate`` for stacks from a step of one configuration,
     ``step(K (rows, nv), r, free, mu) -> (step on the free columns, squared linear residual)``
-    (damped_step, or model.compiled.damped_step): one call per configuration."""
+    (damped_step, or model.kernel.compiled.damped_step): one call per configuration."""
 
     def steps(K, r, free, mu):
         if len(K) == 1:  # (the squared residual as a float: it broadcasts)
@@ -127,7 +127,7 @@ def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
     below mu_min, and nu = 2; after a refused one, mu nu and 2 nu.  A configuration goes on while
     its residual norm is at least ``closure`` and no refused step has taken its damping past
     mu_max.  Returns (accepted, residual norms after, mu, nu, going on).  Plain numpy on arrays:
-    model.compiled compiles this same function."""
+    model.kernel.compiled compiles this same function."""
     new_norm = np.sqrt((r_new * r_new).sum(axis=1))
     accepted = new_norm < norm
     count = np.count_nonzero(accepted)
@@ -240,7 +240,7 @@ def _norms(r):
 
 
 def solve(system, q0, frozen, tol, trace=None) -> Assembly:
-    """``iterate`` on one configuration of a model.closure.ClosureSystem from q0 with the velocity
+    """``iterate`` on one configuration of a model.kernel.closure.ClosureSystem from q0 with the velocity
     indices ``frozen`` held (Tolerances ``tol``: closure, max_iterations and the lm_ fields);
     trace: None or callable(iteration, q, r, K, dq, accepted) (ClosureSystem.solve).  Raises
     AssemblyError with the residual reached when it does not converge, or when the solution
@@ -264,7 +264,7 @@ def solve(system, q0, frozen, tol, trace=None) -> Assembly:
 
 
 def polish(system, q0, frozen=(), iterations: int = 8) -> Assembly:
-    """Undamped Newton from q0, which is already near a root of ``system`` (a model.closure.ClosureSystem),
+    """Undamped Newton from q0, which is already near a root of ``system`` (a model.kernel.closure.ClosureSystem),
     with the velocity indices ``frozen`` held: the minimum-norm step on the free columns of the
     solver's rows (least squares: the rows are redundant), while the residual keeps falling.  A simple
     root is reached to round-off in two or three steps.  Returns the configuration with the smallest

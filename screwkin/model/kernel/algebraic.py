@@ -18,7 +18,7 @@ Rows (world vectors; o1, o2 the origins of the cut joint's frames F1, F2, R1, R2
                                    prismatic -- with det R = 1 these make R1 = R2)
     dotd: (R1 u) . (o2 - o1)      (u perpendicular to the axis: prismatic, cylindrical; the axis: planar)
     dot:  (R1 a) . (R2 a2)        (universal)
-Their real zeros are exactly the closed configurations of model.closure (a revolute's axes aligned,
+Their real zeros are exactly the closed configurations of model.kernel.closure (a revolute's axes aligned,
 never antiparallel: the vector row R1 a = R2 a, not the perpendicularity rows).  Rows that vanish
 identically on the constraint variety (a planar mechanism's out-of-plane rows) are dropped.
 
@@ -32,8 +32,8 @@ those coordinates is the geometric one: a revolute's column moves a point p by w
 vector v by w x v (w its world axis, o its origin), a prismatic's moves points by its world axis, a
 quaternion's are three revolutes about its frame's axes through its centre.
 Everything is evaluated for a stack of points at once in complex arithmetic: in numpy by
-model.algebraic_numpy (the stack's index last inside; 3 x 3 products as sums of broadcast products,
-four times numpy's stacked matmul), or by the compiled kernel of model.algebraic_compiled.
+model.kernel.algebraic_numpy (the stack's index last inside; 3 x 3 products as sums of broadcast products,
+four times numpy's stacked matmul), or by the compiled kernel of model.kernel.algebraic_compiled.
 """
 
 from __future__ import annotations
@@ -43,8 +43,8 @@ import pinocchio as pin
 
 from . import algebraic_compiled, compiled as numba_kernels
 from .algebraic_numpy import Placed, rows_all
-from .geometry import perpendicular_basis, quaternion_matrix, quaternion_product, skew
-from .legs import distance_legs
+from ..geometry import perpendicular_basis, quaternion_matrix, quaternion_product, skew
+from ..legs import distance_legs
 
 __all__ = ["PolynomialClosure", "algebraic_obstacle"]
 
@@ -98,7 +98,7 @@ class PolynomialClosure:
 
     def __init__(self, model, cuts, frozen, length: float, points=(), output=None, compiled: bool | None = None,
                  eliminate: bool = True):
-        """compiled: evaluate the rows with the numba kernel of model.algebraic_compiled (True), with
+        """compiled: evaluate the rows with the numba kernel of model.kernel.algebraic_compiled (True), with
         numpy (False), or with the kernel when numba imports (None); eliminate: the legs that are
         distance constraints (model.legs) become one row each, their joints no unknowns."""
         self.model, self.cuts, self.L = model, list(cuts), float(length)

@@ -22,12 +22,12 @@ import threading
 import numpy as np
 import pinocchio as pin
 
-from ..tolerances import DEFAULT, Tolerances
+from ...tolerances import DEFAULT, Tolerances
 from . import compiled, newton
-from .manifold import Integrator
-from .cuts import Assembly, CouplingRow
-from .geometry import cross3, perpendicular_basis, skew, skews, skews_batch
-from ._pin import frame_jacobian
+from ..manifold import Integrator
+from ..cuts import Assembly, CouplingRow
+from ..geometry import cross3, perpendicular_basis, skew, skews, skews_batch
+from .._pin import frame_jacobian
 
 __all__ = ["ClosureSystem"]
 
@@ -116,7 +116,7 @@ class ClosureSystem:
 
     # ------------------------------------------------------------------ compiled inner loop
     def accelerate(self, on: bool = True) -> bool:
-        """Solve with the compiled kernels of screwkin.model.compiled (numba) when it is installed
+        """Solve with the compiled kernels of screwkin.model.kernel.compiled (numba) when it is installed
         and every cut joint is fixed or spherical; returns whether they are in use."""
 
         self._compiled = None
@@ -571,7 +571,7 @@ class ClosureSystem:
 
     # ------------------------------------------------------------------ solving
     def solve(self, q0, frozen=(), tolerances: Tolerances | None = None, trace=None) -> Assembly:
-        """Solve r(q) = 0 from q0 by damped Newton (model.newton.solve: Levenberg-Marquardt,
+        """Solve r(q) = 0 from q0 by damped Newton (model.kernel.newton.solve: Levenberg-Marquardt,
         minimum-norm steps).  frozen: velocity indices that must not move (the inputs); trace:
         optional callable(iteration, q, r, K, dq, accepted) recording the iterations (r and K in
         the solver's rows, see ``row_labels``).  Raises AssemblyError with the smallest residual
@@ -588,9 +588,9 @@ class ClosureSystem:
         return free
 
     def solver_pass(self):
-        """What model.newton.iterate needs to solve one configuration (a stack of one):
+        """What model.kernel.newton.iterate needs to solve one configuration (a stack of one):
         (evaluate(Q (1, nq), which, jacobian) -> (r (1, rows), K (1, rows, nv) or None) in the solver's
-        rows, step, verdict): compiled when accelerate() is on (model.compiled), else numpy
+        rows, step, verdict): compiled when accelerate() is on (model.kernel.compiled), else numpy
         (newton.damped_step, newton.judge)."""
         if self._compiled:
             return self._stack_of_one, compiled.one_step, self._compiled[0].judge

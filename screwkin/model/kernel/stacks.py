@@ -1,8 +1,8 @@
 """Loop-closure rows and damped Newton for stacks of configurations (the workspace's inverse
 kinematics, batched continuation): ``TreeKinematics`` computes the placements and Jacobians of
 frames of a tree of 1-DOF joints for N configurations in one pass down the tree, and
-``BatchClosure`` builds on them the same rows, in the same order, as model.closure.ClosureSystem
-and solves them with the one damped-Newton loop of model/newton.py (``iterate``), all configurations
+``BatchClosure`` builds on them the same rows, in the same order, as model.kernel.closure.ClosureSystem
+and solves them with the one damped-Newton loop of model/kernel/newton.py (``iterate``), all configurations
 at once.
 """
 
@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ...model import newton
-from ...model.closure import ClosureSystem
-from ...model.cuts import CouplingRow, CutJoint
-from ...model.state import frame_parent, model_with_output
+from . import newton
+from .closure import ClosureSystem
+from ..cuts import CouplingRow, CutJoint
+from ..state import frame_parent, model_with_output
 
 __all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 
@@ -22,7 +22,7 @@ __all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 class Unbatchable(Exception):
     """The mechanism holds something the batched closure does not represent (joints of more
     than one coordinate, <mimic> joints, helical joints, sliding contacts): the caller solves
-    one configuration at a time with model.closure.ClosureSystem instead."""
+    one configuration at a time with model.kernel.closure.ClosureSystem instead."""
 
 
 def tree_kinematics(mech):
@@ -225,7 +225,7 @@ _TARGET_KINDS = {"pose": ("fixed", 0), "point": ("spherical", 3)}
 
 class BatchClosure:
     """The loop-closure rows of ``mech`` (the same rows, in the same order, as its
-    model.closure.ClosureSystem) for many configurations at once, and a damped-Newton solver
+    model.kernel.closure.ClosureSystem) for many configurations at once, and a damped-Newton solver
     that moves all of them together: every iteration is a few numpy calls on the whole stack
     instead of one Pinocchio pass and one linear solve per configuration.
 
@@ -444,7 +444,7 @@ class BatchClosure:
 
     # ------------------------------------------------------------------ solving
     def solve(self, Q0, targets=None, frozen=(), tolerances=None, iterations: int | None = None):
-        """Damped Newton from every row of Q0 at once: model.newton.iterate (the loop of
+        """Damped Newton from every row of Q0 at once: model.kernel.newton.iterate (the loop of
         ClosureSystem.solve, each configuration with its own damping) on these rows.  frozen:
         velocity indices that do not move (inputs).  Returns (Q, converged (N,), residual norms
         (N,), iterations (N,)); a configuration that converges with a reversed revolute cut joint

@@ -5,16 +5,16 @@ joints -- the 6d and 3d closures of Extended-URDF files -- costs about 38 us in
 numpy for one weld, of which Pinocchio's own calls are 3 us: the rest is the
 overhead of numpy calls on 3-vectors.  Here the rows, their Jacobian and the damped step are
 loops compiled by numba (cached on disk after the first use): the same numbers
-as ``ClosureSystem.evaluate(q, solver=True)`` and model.newton.damped_step (tests check
+as ``ClosureSystem.evaluate(q, solver=True)`` and model.kernel.newton.damped_step (tests check
 both), about 2.5 times faster per solve (benchmarks/README.md).  Pinocchio still computes every
-placement and frame Jacobian, and the Newton loop is model.newton.iterate, the numpy solver's own:
-the rows, the step and the loop's verdict (model.newton.judge, compiled from its one definition)
+placement and frame Jacobian, and the Newton loop is model.kernel.newton.iterate, the numpy solver's own:
+the rows, the step and the loop's verdict (model.kernel.newton.judge, compiled from its one definition)
 are what is compiled.
 
 The step's linear solve is numba's np.linalg.solve, which raises np.linalg.LinAlgError where
 LAPACK finds the damped system singular in floating point ("Matrix is singular to machine
 precision") or where K or r holds an inf or a NaN ("Array must not contain infs or NaNs"); nothing
-else in the kernels raises.  ``damped_step`` then takes model.newton.damped_step, whose solve falls
+else in the kernels raises.  ``damped_step`` then takes model.kernel.newton.damped_step, whose solve falls
 back to least squares (and which gives NaN, as numpy does, for a NaN row).
 
 Used only when asked (``PositionSolver(mech, compiled=True)`` or
@@ -113,7 +113,7 @@ def _compile_kernels():
 
     @nb.njit(cache=cache)
     def damped_step(K, r, free, mu):
-        """model.newton.damped_step, compiled: the minimum-norm damped step on the free columns
+        """model.kernel.newton.damped_step, compiled: the minimum-norm damped step on the free columns
         (the smaller of the two normal systems) and |r + K_f dq_f|^2 (the linear model's residual)."""
         m, nf = K.shape[0], free.shape[0]
         Kf = np.empty((m, nf))
@@ -145,7 +145,7 @@ def _compile_kernels():
 
 
 def damped_step(K, r, free, mu):
-    """model.newton.damped_step through the compiled kernel (K C-contiguous, free int64), with
+    """model.kernel.newton.damped_step through the compiled kernel (K C-contiguous, free int64), with
     the numpy step where numba's solve raises np.linalg.LinAlgError (a singular damped system:
     the numpy step's least-squares fallback; an inf or NaN in K or r: NaN, as numpy gives)."""
     try:
@@ -154,7 +154,7 @@ def damped_step(K, r, free, mu):
         return newton.damped_step(K, r, free, mu)
 
 
-#: damped_step as the step of model.newton.iterate (the single solve's, compiled).
+#: damped_step as the step of model.kernel.newton.iterate (the single solve's, compiled).
 one_step = newton.one_at_a_time(damped_step)
 
 

@@ -1,4 +1,4 @@
-"""The rows of model.algebraic.PolynomialClosure and their Jacobian, in numpy: world placements of the
+"""The rows of model.kernel.algebraic.PolynomialClosure and their Jacobian, in numpy: world placements of the
 joints and frames at a stack of complex points (the stack's index last inside), then the rows.
 
 A homotopy evaluates the rows thousands of times on stacks of a few to a few hundred points, so the
@@ -10,14 +10,14 @@ work per call is what counts (numpy's overhead is about a microsecond a call, wh
 - each joint's rotation is folded with its placement in its parent: Lr R(c, s) = K0 + c K1 + s K2
   for a revolute, constants precomputed, so a level of the tree costs one 3 x 3 product and one
   product with a vector, whatever its joints.
-The numbers are those of the compiled kernel (model.algebraic_compiled; tests compare them).
+The numbers are those of the compiled kernel (model.kernel.algebraic_compiled; tests compare them).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .geometry import quaternion_matrix, stack_cross, stack_mm, stack_mv
+from ..geometry import quaternion_matrix, stack_cross, stack_mm, stack_mv
 
 __all__ = ["Placed", "rows_all"]
 

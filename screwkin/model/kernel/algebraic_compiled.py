@@ -1,4 +1,4 @@
-"""The rows of model.algebraic.PolynomialClosure and their Jacobian, compiled (numba; optional).
+"""The rows of model.kernel.algebraic.PolynomialClosure and their Jacobian, compiled (numba; optional).
 
 The same numbers as the numpy evaluation (tests compare the two at random complex points), one
 path at a time in compiled loops (one core): a homotopy
@@ -22,7 +22,7 @@ _KIND = {"": 0, "R": 1, "P": 2, "S": 3, "F": 4}
 
 
 def pack(closure) -> tuple:
-    """The closure's constants as the kernel's arrays (layout of model.algebraic, stack axes first)."""
+    """The closure's constants as the kernel's arrays (layout of model.kernel.algebraic, stack axes first)."""
     nj = closure.nj
     xs = np.full(nj, -1, np.int64)
     ts = np.full(nj, -1, np.int64)
