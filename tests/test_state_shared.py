@@ -213,6 +213,8 @@ PINOCCHIO_KINEMATICS = {
     "model/state.py": "the state itself",
     "model/_pin.py": "the shape-fixing wrappers of Pinocchio's calls",
     "model/kernel/closure.py": "the closure's residual and Jacobian (the Newton loops' inner loop)",
+    "model/kernel/contacts.py": "the sliding contacts' rows of the closure, in the closure's own Data",
+    "model/kernel/wrenches.py": "each closure row's constraint wrench, in the closure's own Data",
     "analysis/motion/position.py": "the position solver's mode signature, at every start",
     "analysis/motion/links.py": "frame motions of a stack of configurations (Pinocchio a step)",
     "model/kernel/stacks.py": "batched kinematics and closure, their self-checks against Pinocchio",

@@ -32,6 +32,7 @@ import numpy as np
 from ..errors import ScrewkinError
 from ..model._pin import joint_axis
 from ..model.geometry import perpendicular_basis
+from ..model.kernel.scaling import dimensionless
 from ..model.linalg import null_space, rank
 from ..model.loader import rebuild
 from ..model.state import KinematicState
@@ -97,9 +98,7 @@ def _left_null(mech, q):
     K = mech.closure.jacobian(q)
     L = mech.length
     rows = mech.closure.position_rows
-    Ks = K.copy()
-    Ks[rows] /= L
-    Ks[:, mech.translational] *= L
+    Ks = dimensionless(K, rows, mech.translational, L)
     Lam = null_space(Ks.T, mech.tolerances, Ks.shape[0]) if Ks.size else np.zeros((Ks.shape[0], 0))
     Lam = Lam.copy()
     Lam[rows] /= L  # lambda^T K = 0 in K's own units

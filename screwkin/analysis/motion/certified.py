@@ -329,7 +329,7 @@ def _best_twin(solver, problem, closure, elements, x):
         key = (bad, dist)
         if best is None or key < best[0]:
             best = (key, q)
-    a = newton.polish(problem.system, best[1], problem.frozen)
+    a = newton.polish(problem.system.pinocchio, best[1], problem.frozen)
     return solver._wrap(a.q), Assembly(solver._wrap(a.q), a.residual, a.iterations, "a homotopy's endpoint")
 
 

@@ -107,7 +107,7 @@ def dyad_modes(solver, values: dict) -> DyadModes | str:
             return "a dyad's discriminant changed sign when another's limit position was placed exactly"
         Q = curve.correct(poses, len(cols))[0]
         for q in Q:
-            a = newton.polish(mech.closure, solver._wrap(q), solver.frozen)
+            a = newton.polish(mech.closure.pinocchio, solver._wrap(q), solver.frozen)
             if not a.residual <= mech.tolerances.closure:
                 return (f"a branch vector's configuration does not close the loops (residual {a.residual:.2g}): "
                         "the dyads' geometry was not read as Pinocchio places the links")

@@ -406,7 +406,7 @@ class PositionSolver:
             except AssemblyError as exc:
                 best = min(best, exc.residual)
                 continue
-            p = newton.polish(system, a.q, frozen)  # undamped at the end: round-off, not the damped tolerance
+            p = newton.polish(system.pinocchio, a.q, frozen)  # undamped at the end: round-off, not the damped tolerance
             a = Assembly(p.q, p.residual, a.iterations + p.iterations, a.start, a.starts)
             q = self._wrap(a.q)
             if len(starts) == 1:  # nothing to tell apart

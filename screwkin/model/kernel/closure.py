@@ -18,18 +18,23 @@ Row kinds (world vectors; o1, o2 frame origins, d = o2 - o1):
 from __future__ import annotations
 
 import threading
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from ...tolerances import DEFAULT, Tolerances
 from . import compiled, newton
+from .contract import ClosureKernel, Step, Verdict
+from .contacts import contact_bias, contact_row
+from .scaling import sliding_columns
+from .wrenches import row_wrenches
 from ..manifold import Integrator
 from ..cuts import Assembly, CouplingRow
 from ..geometry import cross3, perpendicular_basis, skew, skews, skews_batch
 from .._pin import frame_jacobian
 
-__all__ = ["ClosureSystem"]
+__all__ = ["ClosureSystem", "PinocchioKernel", "CompiledKernel"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -67,6 +72,7 @@ class ClosureSystem:
         self._owner = threading.get_ident()
         self._position_rows = None
         self.integrator = Integrator(model)  # q (+) dq on the model's configuration manifold, for stacks
+        self._kernels: tuple[ClosureKernel, ...] = (PinocchioKernel(self),)
 
     # ------------------------------------------------------------------ per-thread workspace
     def _workspace(self):
@@ -123,33 +129,12 @@ class ClosureSystem:
         kinds = compiled.kinds_of(self.cuts) if on and not self.extra else None
         if kinds is not None and compiled.available():
             self._compiled = (compiled.kernels(), kinds)
+            self._kernels = (self._kernels[0], CompiledKernel(self))
         return self._compiled is not None
 
     @property
     def accelerated(self) -> bool:
         return self._compiled is not None
-
-    def _evaluate_compiled(self, q, jacobian: bool = True):
-        """evaluate(q, jacobian, solver=True) through the compiled kernel (same rows)."""
-        kernels, kinds = self._compiled
-        ws = self._workspace()
-        if ws.buffers is None:  # this thread's buffers for the kernel
-            n, nv = len(self.cuts), self.model.nv
-            ws.buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
-                          np.empty((n, 6, nv)), np.empty((n, 6, nv)))
-        R1, R2, t1, t2, J1, J2 = ws.buffers
-        model, data = self.model, ws.data
-        self._kinematics(q, jacobian, data)
-        for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, ws.placements)):
-            R1[j], R2[j], t1[j], t2[j] = a, b, c, d
-            if jacobian:
-                J1[j] = frame_jacobian(model, data, cut.frame1, LWA)
-                J2[j] = frame_jacobian(model, data, cut.frame2, LWA)
-        nrows = self._rows(True)
-        r = np.empty(nrows)
-        K = np.empty((nrows, model.nv)) if jacobian else np.empty((0, model.nv))
-        kernels.cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian)
-        return r, (K if jacobian else None)
 
     def _kinematics(self, q, jacobian: bool, data):
         """Pinocchio's pass for q in ``data`` (this thread's): frame placements, and the joint
@@ -322,61 +307,10 @@ class ClosureSystem:
                     for _, iv, c in e.terms:
                         K[k, iv] += c
                 continue
-            value, grad = self._contact(e, K is not None)
+            value, grad = contact_row(self.model, self.data, e, K is not None)
             r[k] = value
             if K is not None:
                 K[k] = grad
-
-    def _contact(self, e, jacobian):
-        """(value, Jacobian row or None) of a ContactRow at the placements in self.data."""
-        model, data = self.model, self.data
-        M1, M2 = data.oMf[e.frame1], data.oMf[e.frame2]
-        J1 = frame_jacobian(model, data, e.frame1, LWA) if jacobian else None
-        J2 = frame_jacobian(model, data, e.frame2, LWA) if jacobian else None
-        if "line" in (e.shape1, e.shape2):
-            # s = (o_a - o_b) . m_b, the line on frame b (its normal m_b turns with it), the other at a
-            on2 = e.shape2 == "line"
-            Ma, Mb = (M1, M2) if on2 else (M2, M1)
-            Ja, Jb = (J1, J2) if on2 else (J2, J1)
-            m = Mb.rotation @ np.asarray(e.normal)
-            delta = Ma.translation - Mb.translation
-            s = float(delta @ m)
-            point = (e.shape1 if on2 else e.shape2) == "point"
-            sign = 1.0 if point or s >= 0 else -1.0
-            value = sign * s - (0.0 if point else e.target())
-            if not jacobian:
-                return value, None
-            return value, sign * (m @ (Ja[:3] - Jb[:3]) + cross3(m, delta) @ Jb[3:])
-        delta = M2.translation - M1.translation
-        dist = float(np.sqrt(delta @ delta))
-        value = dist - e.target()
-        if not jacobian:
-            return value, None
-        return value, (delta / max(dist, 1e-300)) @ (J2[:3] - J1[:3])
-
-    def _contact_bias(self, e):
-        """d2/dt2 of a ContactRow along the motion in self.data (velocities, classical accelerations)."""
-        model, data = self.model, self.data
-        M = (data.oMf[e.frame1], data.oMf[e.frame2])
-        V = [pin.getFrameVelocity(model, data, f, LWA) for f in (e.frame1, e.frame2)]
-        A = [pin.getFrameClassicalAcceleration(model, data, f, LWA) for f in (e.frame1, e.frame2)]
-        if "line" in (e.shape1, e.shape2):
-            a, b = (0, 1) if e.shape2 == "line" else (1, 0)
-            m = M[b].rotation @ np.asarray(e.normal)
-            w, al = V[b].angular, A[b].angular
-            delta = M[a].translation - M[b].translation
-            dd = V[a].linear - V[b].linear
-            ddd = A[a].linear - A[b].linear
-            md = cross3(w, m)
-            mdd = cross3(al, m) + cross3(w, md)
-            s2 = ddd @ m + 2 * dd @ md + delta @ mdd
-            point = (e.shape1 if b == 1 else e.shape2) == "point"
-            return s2 if point or delta @ m >= 0 else -s2
-        delta = M[1].translation - M[0].translation
-        dd = V[1].linear - V[0].linear
-        ddd = A[1].linear - A[0].linear
-        d = float(np.sqrt(delta @ delta))
-        return (ddd @ delta + dd @ dd) / d - (delta @ dd) ** 2 / d**3
 
     def _evaluate_one(self, g, j, r, K, solver, data):
         """The rows of cut joint j of a group (the same rows as the stacked code, with 2-D
@@ -457,7 +391,7 @@ class ClosureSystem:
                 out[i] = udd @ w + 2 * ud @ wd + u @ wdd
                 i += 1
         for e in self.extra:  # a coupling is linear in the coordinates: nothing
-            out[i] = 0.0 if isinstance(e, CouplingRow) else self._contact_bias(e)
+            out[i] = 0.0 if isinstance(e, CouplingRow) else contact_bias(self.model, self.data, e)
             i += 1
         return out
 
@@ -500,52 +434,9 @@ class ClosureSystem:
         """The inputs that rows hold (CouplingRow.input: links whose absolute angle is given), in row order."""
         return tuple(e.input for e in self.extra if getattr(e, "input", None) is not None)
 
-    def row_wrenches(self, q) -> list:
-        """What a unit force in each minimal row exerts, row by row: (frame a, wrench on a's body,
-        frame b, wrench on b's body), each wrench (force, moment) at the frame's origin in world
-        axes, so that the row's Jacobian is w_a^T J_a + w_b^T J_b (J: LOCAL_WORLD_ALIGNED frame
-        Jacobians) -- the constraint wrenches of screw theory; or (None, coupling row) for a
-        coupling of coordinates (a force between joints inside a higher pair's virtual chain)."""
-        pin.framesForwardKinematics(self.model, self.data, q)
-        data = self.data
-        out = []
-        zero = np.zeros(3)
-
-        def pair(f1, w1, f2, w2):
-            out.append((f1, np.asarray(w1, float), f2, np.asarray(w2, float)))
-
-        for cut, (P, pairs, _, rotation) in zip(self.cuts, self._plans):
-            M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
-            R1, R2 = M1.rotation, M2.rotation
-            d = M2.translation - M1.translation
-            for e in P @ R1.T:  # e . d, e fixed in F1: d(e . d) = e . (v2 - v1) + (e x d) . w1
-                pair(cut.frame1, np.r_[-e, cross3(e, d)], cut.frame2, np.r_[e, zero])
-            if rotation:  # log3(R1^T R2): Jlog3 R2^T (w2 - w1)
-                C = pin.Jlog3(R1.T @ R2) @ R2.T
-                for c in C:
-                    pair(cut.frame1, np.r_[zero, -c], cut.frame2, np.r_[zero, c])
-                continue
-            for u, w in pairs:  # u . w: (w x u) . (w2 - w1)
-                c = cross3(R2 @ w, R1 @ u)
-                pair(cut.frame1, np.r_[zero, -c], cut.frame2, np.r_[zero, c])
-        for e in self.extra:
-            if isinstance(e, CouplingRow):
-                out.append((None, e, None, None))
-                continue
-            M1, M2 = data.oMf[e.frame1], data.oMf[e.frame2]
-            if "line" in (e.shape1, e.shape2):
-                on2 = e.shape2 == "line"
-                (fa, Ma), (fb, Mb) = ((e.frame1, M1), (e.frame2, M2)) if on2 else ((e.frame2, M2), (e.frame1, M1))
-                m = Mb.rotation @ np.asarray(e.normal)
-                delta = Ma.translation - Mb.translation
-                point = (e.shape1 if on2 else e.shape2) == "point"
-                sign = 1.0 if point or delta @ m >= 0 else -1.0
-                pair(fa, sign * np.r_[m, zero], fb, sign * np.r_[-m, cross3(m, delta)])
-                continue
-            delta = M2.translation - M1.translation
-            u = delta / max(float(np.linalg.norm(delta)), 1e-300)
-            pair(e.frame1, np.r_[-u, zero], e.frame2, np.r_[u, zero])
-        return out
+    def row_wrenches(self, q: np.ndarray) -> list:
+        """What a unit force in each minimal row exerts (model.kernel.wrenches.row_wrenches)."""
+        return row_wrenches(self.model, self.data, self.cuts, self._plans, self.extra, q)
 
     def residual(self, q) -> np.ndarray:
         return self.evaluate(q, jacobian=False)[0]
@@ -576,7 +467,7 @@ class ClosureSystem:
         optional callable(iteration, q, r, K, dq, accepted) recording the iterations (r and K in
         the solver's rows, see ``row_labels``).  Raises AssemblyError with the smallest residual
         reached when it fails, or when the solution assembles a cut joint upside down."""
-        return newton.solve(self, q0, frozen, tolerances or self.tol, trace)
+        return newton.solve(self.kernel, q0, frozen, tolerances or self.tol, trace)
 
     def free_columns(self, frozen) -> np.ndarray:
         """The velocity indices not in ``frozen`` (a sequence of indices; cached per set of frozen ones)."""
@@ -587,15 +478,78 @@ class ClosureSystem:
             free = self._free[key] = np.setdiff1d(np.arange(self.model.nv), frozen)
         return free
 
-    def solver_pass(self):
-        """What model.kernel.newton.iterate needs to solve one configuration (a stack of one):
-        (evaluate(Q (1, nq), which, jacobian) -> (r (1, rows), K (1, rows, nv) or None) in the solver's
-        rows, step, verdict): compiled when accelerate() is on (model.kernel.compiled), else numpy
-        (newton.damped_step, newton.judge)."""
-        if self._compiled:
-            return self._stack_of_one, compiled.one_step, self._compiled[0].judge
-        return self._stack_of_one, newton.one_step, newton.judge
+    @property
+    def kernel(self) -> ClosureKernel:
+        """The solver's rows through the kernels' contract (what ``solve`` iterates on): compiled when
+        accelerate() is on (model.kernel.compiled), else Pinocchio's, a configuration at a time."""
+        return self._kernels[1 if self._compiled else 0]
 
-    def _stack_of_one(self, Q, which, jacobian):
-        r, K = self._evaluate_compiled(Q[0], jacobian) if self._compiled else self.evaluate(Q[0], jacobian, True)
-        return r[None], (None if K is None else K[None])
+    @property
+    def pinocchio(self) -> ClosureKernel:
+        """The solver's rows through the contract, evaluated by Pinocchio (never compiled)."""
+        return self._kernels[0]
+
+    @property
+    def solver_position_rows(self) -> np.ndarray:
+        """Mask of the solver's rows (``evaluate(solver=True)``) that are lengths [m] (positions; the
+        couplings of rolling and screw pairs); the others are dimensionless."""
+        mask = []
+        for c, (P, pairs, vectors, _) in zip(self.cuts, self._plans):
+            rest = self._cut_rows(c, (P, pairs, vectors, None), True) - len(P)
+            mask += [True] * len(P) + [False] * rest
+        return np.array(mask + [True] * len(self.extra), bool)
+
+
+class PinocchioKernel(ClosureKernel):
+    """A ClosureSystem's solver rows under the kernels' contract: Pinocchio's pass, one configuration
+    of the stack at a time (a stack of one: the single solve)."""
+
+    def __init__(self, system: ClosureSystem) -> None:
+        self.system = system
+        self.nq, self.nv, self.m = system.model.nq, system.model.nv, system._rows(True)
+        self.length_rows = system.solver_position_rows
+        self.sliding = sliding_columns(system.model)
+
+    def _one(self, q: np.ndarray, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        return self.system.evaluate(q, jacobian, True)
+
+    def evaluate(self, Q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        if len(Q) == 1:
+            r, K = self._one(Q[0], jacobian)
+            return r[None], (None if K is None else K[None])
+        rows = [self._one(q, jacobian) for q in Q]
+        return np.array([r for r, _ in rows]), (np.array([K for _, K in rows]) if jacobian else None)
+
+    def integrate(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        return self.system.integrator(Q, V)
+
+    def constraint_jacobian(self, Q: np.ndarray) -> np.ndarray:
+        return np.array([self.system.jacobian(q) for q in Q]).reshape(len(Q), self.system.nrows, self.nv)
+
+    def bias(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        return np.array([self.system.bias(q, v) for q, v in zip(Q, V)]).reshape(len(Q), self.system.nrows)
+
+    def free_columns(self, frozen: Any) -> np.ndarray:
+        return self.system.free_columns(frozen)
+
+    def reversed_joints(self, q: np.ndarray, placed: bool = False) -> list[str]:
+        return self.system.wrong_branch(q, placed)
+
+    def newton_parts(self) -> tuple[Step, Verdict]:
+        return newton.one_step, newton.judge
+
+    @property
+    def name(self) -> str:
+        return self.system.path
+
+
+class CompiledKernel(PinocchioKernel):
+    """The same rows through numba's kernels (model.kernel.compiled: fixed and spherical cut joints),
+    with the compiled step and verdict."""
+
+    def _one(self, q: np.ndarray, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        return compiled.cut_rows(self.system, q, jacobian)
+
+    def newton_parts(self) -> tuple[Step, Verdict]:
+        assert self.system._compiled is not None
+        return compiled.one_step, self.system._compiled[0].judge

@@ -25,6 +25,8 @@ use compiles for about 15 s (8 s of it the rows and the step; loaded from the ca
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 try:
@@ -32,10 +34,13 @@ try:
 except ImportError:  # not a POSIX system
     resource = None
 
+import pinocchio as pin
+
+from .._pin import frame_jacobian
 from . import newton
 from .newton import TRACE_FLOOR
 
-__all__ = ["available", "kernels", "kinds_of", "damped_step", "one_step", "SPHERICAL", "FIXED"]
+__all__ = ["available", "kernels", "kinds_of", "damped_step", "one_step", "SPHERICAL", "FIXED", "cut_rows"]
 
 SPHERICAL, FIXED = 0, 1  # the cut joint types the kernels know (3 and 12 solver rows)
 _KERNELS = None
@@ -165,3 +170,29 @@ def kinds_of(cuts):
     if not cuts or any(c.type not in codes for c in cuts):
         return None
     return np.array([codes[c.type] for c in cuts], np.int64)
+
+
+def cut_rows(system: Any, q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """system.evaluate(q, jacobian, solver=True) of a model.kernel.closure.ClosureSystem through the
+    compiled kernel (the same rows; after system.accelerate())."""
+    LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    assert system._compiled is not None
+    kernels, kinds = system._compiled
+    ws = system._workspace()
+    if ws.buffers is None:  # this thread's buffers for the kernel
+        n, nv = len(system.cuts), system.model.nv
+        ws.buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+                      np.empty((n, 6, nv)), np.empty((n, 6, nv)))
+    R1, R2, t1, t2, J1, J2 = ws.buffers
+    model, data = system.model, ws.data
+    system._kinematics(q, jacobian, data)
+    for j, (cut, (a, b, c, d)) in enumerate(zip(system.cuts, ws.placements)):
+        R1[j], R2[j], t1[j], t2[j] = a, b, c, d
+        if jacobian:
+            J1[j] = frame_jacobian(model, data, cut.frame1, LWA)
+            J2[j] = frame_jacobian(model, data, cut.frame2, LWA)
+    nrows = system._rows(True)
+    r = np.empty(nrows)
+    K = np.empty((nrows, model.nv)) if jacobian else np.empty((0, model.nv))
+    kernels.cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian)
+    return r, (K if jacobian else None)

@@ -33,15 +33,20 @@ does not at run time.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ...errors import AssemblyError
+from ...tolerances import Tolerances
 from ..cuts import Assembly
+from .contract import ClosureKernel
+
+Array = NDArray[Any]
 
 __all__ = ["TRACE_FLOOR", "NU", "damped_step", "damped_steps", "stacked_steps", "one_at_a_time", "one_step", "judge",
-           "Iterates", "iterate", "solve", "polish"]
+           "Iterates", "iterate", "solve", "undamped", "polish"]
 
 #: Division guard: the damping is relative to the mean squared row norm, which is never taken
 #: below this (a zero Jacobian) [same units as K^2].
@@ -239,48 +244,61 @@ def _norms(r):
     return np.sqrt(np.add.reduce(r * r, axis=1))
 
 
-def solve(system, q0, frozen, tol, trace=None) -> Assembly:
-    """``iterate`` on one configuration of a model.kernel.closure.ClosureSystem from q0 with the velocity
-    indices ``frozen`` held (Tolerances ``tol``: closure, max_iterations and the lm_ fields);
-    trace: None or callable(iteration, q, r, K, dq, accepted) (ClosureSystem.solve).  Raises
-    AssemblyError with the residual reached when it does not converge, or when the solution
-    assembles a cut joint upside down."""
+def solve(kernel: ClosureKernel, q0: Array, frozen: Any, tol: Tolerances,
+          trace: Callable[..., None] | None = None) -> Assembly:
+    """``iterate`` on one configuration of a kernel (a ClosureSystem's: ``ClosureSystem.kernel``) from
+    q0 (nq,) with the velocity indices ``frozen`` held (Tolerances ``tol``: closure, max_iterations and
+    the lm_ fields); trace: None or callable(iteration, q, r, K, dq, accepted) (ClosureSystem.solve).
+    Raises AssemblyError with the residual reached when it does not converge, or when the solution
+    assembles a cut joint upside down (``kernel.reversed_joints``)."""
     q = np.array(q0, float)
-    if system.nrows == 0:
+    if kernel.m == 0:
         return Assembly(q, 0.0, 0)
-    evaluate, step, verdict = system.solver_pass()
+    step, verdict = kernel.newton_parts() or (stacked_steps, judge)
+    evaluate = kernel.evaluate
     hook = None if trace is None else (
         lambda which, k, Q, r, K, dQ, ok: trace(k, Q[0], r[0], K[0], dQ[0], bool(ok[0])))
-    out = iterate(evaluate, q[None], system.free_columns(frozen), tol, system.integrator, step, trace=hook,
-                  verdict=verdict)
+    out = iterate(lambda Q, which, jacobian: evaluate(Q, jacobian), q[None], kernel.free_columns(frozen), tol,
+                  kernel.integrate, step, trace=hook, verdict=verdict)
     q, norm, it = out.q[0], float(out.residual[0]), int(out.iterations[0])
     if not out.converged[0]:
-        raise AssemblyError(system.path, norm, it)
-    bad = system.wrong_branch(q, placed=bool(out.placed[0]))
+        raise AssemblyError(kernel.name, norm, it)
+    bad = kernel.reversed_joints(q, placed=bool(out.placed[0]))
     if bad:
-        raise AssemblyError(system.path, norm, it,
+        raise AssemblyError(kernel.name, norm, it,
                             detail=f"the solution found assembles {', '.join(bad)} with a reversed axis")
     return Assembly(q, norm, it)
 
 
-def polish(system, q0, frozen=(), iterations: int = 8) -> Assembly:
-    """Undamped Newton from q0, which is already near a root of ``system`` (a model.kernel.closure.ClosureSystem),
-    with the velocity indices ``frozen`` held: the minimum-norm step on the free columns of the
-    solver's rows (least squares: the rows are redundant), while the residual keeps falling.  A simple
-    root is reached to round-off in two or three steps.  Returns the configuration with the smallest
-    residual seen (its norm, the steps taken)."""
-    model = system.model
-    free = system.free_columns(tuple(int(f) for f in np.asarray(frozen, int).ravel()))
+def undamped(kernel: ClosureKernel, q0: Array, free: Array, iterations: int, closure: float | None = None) -> Assembly:
+    """Newton's own step (undamped, the minimum-norm least-squares step on the free columns (k,): the
+    rows may be redundant) from q0 (nq,) on ``kernel``'s rows, at most ``iterations`` steps.  Without
+    ``closure``: while the residual keeps falling (the polish: a simple root to round-off in two or
+    three steps; the configuration with the smallest residual seen is kept); with it: until the
+    residual norm is below ``closure``, whether or not each step lowers it (Gauss-Newton; the caller
+    reads the residual to know whether it converged).  Returns (q, its residual norm, steps taken)."""
     q = np.array(q0, float)
-    r, K = system.evaluate(q, jacobian=True, solver=True)
-    best_q, best, it = q, float(np.linalg.norm(r)), 0
+    r, K = kernel.evaluate(q[None], True)
+    norm, it = float(np.linalg.norm(r[0])), 0
     for it in range(1, iterations + 1):
-        dq = np.zeros(model.nv)
-        dq[free] = -np.linalg.lstsq(K[:, free], r, rcond=None)[0]
-        q_new = system.integrator(q[None], dq[None])[0]  # q (+) dq on the manifold, as the loop moves
-        r, K = system.evaluate(q_new, jacobian=True, solver=True)
-        norm = float(np.linalg.norm(r))
-        if not norm < best:
+        if closure is not None and norm < closure:
+            it -= 1
             break
-        best_q, best, q = q_new, norm, q_new
-    return Assembly(best_q, best, it)
+        dq = np.zeros(kernel.nv)
+        dq[free] = -np.linalg.lstsq(K[0][:, free], r[0], rcond=None)[0]
+        q_new = kernel.integrate(q[None], dq[None])[0]  # q (+) dq on the manifold, as the loop moves
+        r, K = kernel.evaluate(q_new[None], True)
+        new = float(np.linalg.norm(r[0]))
+        if closure is None and not new < norm:
+            break
+        q, norm = q_new, new
+    return Assembly(q, norm, it)
+
+
+def polish(kernel: ClosureKernel, q0: Array, frozen: Any = (), iterations: int = 8) -> Assembly:
+    """Undamped Newton (``undamped``) from q0, which is already near a root of ``kernel``'s rows (a
+    ClosureSystem's: ``ClosureSystem.pinocchio``), with the velocity indices ``frozen`` held, while
+    the residual keeps falling.  Returns the configuration with the smallest residual seen (its
+    norm, the steps taken)."""
+    free = kernel.free_columns(tuple(int(f) for f in np.asarray(frozen, int).ravel()))
+    return undamped(kernel, q0, free, iterations)

@@ -8,13 +8,20 @@ at once.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
+from numpy.typing import NDArray
 
 from . import newton
 from .closure import ClosureSystem
+from .contract import ClosureKernel, NotProvided
+from .scaling import sliding_columns
 from ..cuts import CouplingRow, CutJoint
 from ..state import frame_parent, model_with_output
+
+Array = NDArray[Any]
 
 __all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 
@@ -223,7 +230,7 @@ class TreeKinematics:
 _TARGET_KINDS = {"pose": ("fixed", 0), "point": ("spherical", 3)}
 
 
-class BatchClosure:
+class BatchClosure(ClosureKernel):
     """The loop-closure rows of ``mech`` (the same rows, in the same order, as its
     model.kernel.closure.ClosureSystem) for many configurations at once, and a damped-Newton solver
     that moves all of them together: every iteration is a few numpy calls on the whole stack
@@ -270,13 +277,10 @@ class BatchClosure:
                                     extra=mech.extra_rows)
         self.nrows = self.system.nrows
         self.solver_rows = self.system._rows(True)
-        # which of the solver's rows are lengths [m] (positions; the couplings of rolling and screw
-        # pairs), the others dimensionless
-        mask = []
-        for c, (P, pairs, vectors, _) in zip(cuts, self.system.plans):
-            rest = self.system._cut_rows(c, (P, pairs, vectors, None), True) - len(P)
-            mask += [True] * len(P) + [False] * rest
-        self.solver_position_rows = np.array(mask + [True] * len(mech.extra_rows), bool)
+        self.nq, self.nv, self.m = model.nq, model.nv, self.solver_rows
+        # which of the solver's rows are lengths [m] (positions; the couplings of rolling and screw pairs)
+        self.solver_position_rows = self.length_rows = self.system.solver_position_rows
+        self.sliding = sliding_columns(model)
         frames = []
         for c in cuts:
             for f in (c.frame1, c.frame2):
@@ -308,10 +312,26 @@ class BatchClosure:
         return first + frames[c.frame2]
 
     # ------------------------------------------------------------------ rows
-    def evaluate(self, Q, targets=None, jacobian: bool = True):
-        """The solver's rows (ClosureSystem.evaluate(solver=True)) of every configuration:
-        r (N, rows) and K (N, rows, nv) (None without ``jacobian``)."""
+    def evaluate(self, Q: Array, jacobian: bool = True, targets: Any = None) -> tuple[Array, Array | None]:
+        """The solver's rows (ClosureSystem.evaluate(solver=True)) of every configuration of Q (N, nq):
+        r (N, m) and K (N, m, nv) (None without ``jacobian``); targets: the target's placements
+        (origins (N, 3), rotation (3, 3)) of a closure with a target."""
         return self._rows(Q, targets, jacobian, solver=True)
+
+    def integrate(self, Q: Array, V: Array) -> Array:
+        return self.system.integrator(Q, V)
+
+    def constraint_jacobian(self, Q: Array) -> Array:
+        return self.constraint_jacobians(Q)
+
+    def reversed_joints(self, q: Array, placed: bool = False) -> list[str]:
+        frames = self._frames(np.asarray(q, float)[None], jacobian=False)
+        return [self.cuts[k].name for k, a in self._revolute_cuts
+                if (frames[self.cuts[k].frame1][0][0] @ a) @ (frames[self.cuts[k].frame2][0][0] @ a) < 0]
+
+    @property
+    def name(self) -> str:
+        return self.mech.path
 
     def constraint_jacobians(self, Q, targets=None) -> np.ndarray:
         """The minimal rows' Jacobian K (N, rows, nv) (ClosureSystem.jacobian) of configurations
@@ -393,7 +413,7 @@ class BatchClosure:
         derivative of log3 at the identity, as constraint_jacobians does (the configurations close
         the loops: R1^T R2 = I within the closure tolerance); a coupling's row is linear: 0."""
         if self.target is not None:
-            raise ValueError("bias of a closure with a target is not defined")
+            raise NotProvided("bias of a closure with a target is not defined")
         Q, V = np.atleast_2d(np.asarray(Q, float)), np.atleast_2d(np.asarray(V, float))
         N = len(Q)
         ids = self._frame_ids
@@ -456,10 +476,10 @@ class BatchClosure:
             return Q, np.ones(N, bool), np.zeros(N), np.zeros(N, int)
 
         def evaluate(Q_, which, jacobian):
-            return self.evaluate(Q_, None if targets is None else (targets[0][which], targets[1]), jacobian)
+            return self.evaluate(Q_, jacobian, None if targets is None else (targets[0][which], targets[1]))
 
         free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
-        out = newton.iterate(evaluate, Q, free, tol, self.system.integrator, newton.stacked_steps, iterations)
+        out = newton.iterate(evaluate, Q, free, tol, self.integrate, newton.stacked_steps, iterations)
         converged = out.converged.copy()
         if converged.any():
             c = np.flatnonzero(converged)
@@ -491,7 +511,7 @@ class BatchClosure:
                 if is_closed:
                     ours, ref = self.constraint_jacobians(q[None], targets)[0], system.jacobian(q)
                 else:
-                    r, K = self.evaluate(q[None], targets)
+                    r, K = self.evaluate(q[None], True, targets)
                     r_ref, K_ref = system.evaluate(q, True, solver=True)
                     ours, ref = np.hstack([r[0][:, None], K[0]]), np.hstack([r_ref[:, None], K_ref])
                 err = float(np.abs(ours - ref).max()) if ref.size else 0.0
