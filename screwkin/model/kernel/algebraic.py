@@ -43,6 +43,7 @@ import pinocchio as pin
 
 from . import algebraic_compiled, compiled as numba_kernels
 from .algebraic_numpy import Placed, rows_all
+from .contract import ClosureKernel
 from ..geometry import perpendicular_basis, quaternion_matrix, quaternion_product, skew
 from ..legs import distance_legs
 
@@ -88,7 +89,7 @@ def algebraic_obstacle(model, cuts, extra=(), couplings=()) -> str | None:
     return None
 
 
-class PolynomialClosure:
+class PolynomialClosure(ClosureKernel):
     """The closure rows of a model's cut joints as polynomials in the passive joints' unknowns.
 
     model, cuts: the Pinocchio model and model.cuts.CutJoint list (a model copy with a target frame
@@ -171,6 +172,8 @@ class PolynomialClosure:
         self.keep = np.ones(self._nrows_all, bool)
         self.keep = self._nonzero_rows()
         self.m = int(self.keep.sum())
+        self.nq, self.nv = self.n, self.nt  # the contract's: unknowns and tangent coordinates
+        self.length_rows, self.sliding = np.zeros(self.m, bool), np.zeros(0, int)  # (lengths already over L)
         self._kernel = None
         if compiled or (compiled is None and numba_kernels.available()):
             self._kernel, self._packed = algebraic_compiled.kernel(), algebraic_compiled.pack(self)
@@ -424,6 +427,15 @@ class PolynomialClosure:
             return r, (J if jacobian else None)
         r, J = rows_all(self, self.placed("rows")(X, jacobian), jacobian)
         return r[self.keep].T, (J[self.keep].transpose(2, 0, 1) if jacobian else None)
+
+    def evaluate(self, Q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """The contract's rows: ``rows`` at the complex points Q (N, n) (lengths over L: dimensionless),
+        their Jacobian along the tangent coordinates (N, m, nt)."""
+        return self.rows(Q, jacobian)
+
+    def integrate(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        """The contract's step on the variety: ``retract`` of the points Q (N, n) by V (N, nt)."""
+        return self.retract(Q, V)
 
     def constraints(self, X):
         """c^2 + s^2 - 1 per revolute, q.q - 1 per quaternion, at X (P, n): (P, k)."""
