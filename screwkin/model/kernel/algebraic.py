@@ -38,6 +38,8 @@ four times numpy's stacked matmul), or by the compiled kernel of model.kernel.al
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
 
@@ -63,7 +65,7 @@ _SERIES = 1e-8
 _TANGENT = {"R": 1, "P": 1, "S": 3, "F": 6}
 
 
-def algebraic_obstacle(model, cuts, extra=(), couplings=()) -> str | None:
+def algebraic_obstacle(model: Any, cuts: Any, extra: Any = (), couplings: Any = ()) -> str | None:
     """Why the closure of these cut joints and rows is not polynomial in the unknowns above (a
     sentence), or None when it is."""
     for j in range(1, model.njoints):
@@ -97,8 +99,8 @@ class PolynomialClosure(ClosureKernel):
     length: L [m]; points: frame ids whose origins the signature holds; output: a frame id whose
     pose it holds."""
 
-    def __init__(self, model, cuts, frozen, length: float, points=(), output=None, compiled: bool | None = None,
-                 eliminate: bool = True):
+    def __init__(self, model: Any, cuts: Any, frozen: Any, length: float, points: Any = (), output: Any = None,
+                 compiled: bool | None = None, eliminate: bool = True) -> None:
         """compiled: evaluate the rows with the numba kernel of model.kernel.algebraic_compiled (True), with
         numpy (False), or with the kernel when numba imports (None); eliminate: the legs that are
         distance constraints (model.legs) become one row each, their joints no unknowns."""
@@ -184,14 +186,14 @@ class PolynomialClosure(ClosureKernel):
         return self._kernel is not None
 
     # ------------------------------------------------------------------ layout
-    def _ancestors(self, j) -> set:
+    def _ancestors(self, j: int) -> set:
         out = set()
         while j > 0:
             out.add(j)
             j = self.parent[j]
         return out
 
-    def _row_plan(self):
+    def _row_plan(self) -> None:
         """Per cut joint its rows: ("pos", f1, f2), ("vec", f1, u1, f2, u2), ("dotd", f1, u, f2),
         ("dot", f1, u, f2, w), u in F1 and w in F2 (axes of the cut joint's frames)."""
         plan, frames, self.row_cut = [], [], []
@@ -230,11 +232,11 @@ class PolynomialClosure(ClosureKernel):
         self.row_frames = list(dict.fromkeys(frames))
         self._nrows_all = len(self.row_cut)
 
-    def _row_index(self):
+    def _row_index(self) -> None:
         """Index arrays of the rows by kind: the frames and world vectors each reads, its row numbers."""
         vq, vq_key = [], {}
 
-        def vector(f, u):
+        def vector(f: Any, u: np.ndarray) -> Any:
             key = (f, tuple(np.round(u, 15)))
             if key not in vq_key:
                 vq_key[key] = len(vq)
@@ -266,7 +268,7 @@ class PolynomialClosure(ClosureKernel):
         self.vq_f = np.array([f for f, _ in vq], int)
         self.vq_u = np.array([u for _, u in vq]).reshape(-1, 3).T
 
-    def set_inputs(self, q):
+    def set_inputs(self, q: np.ndarray) -> None:
         """Take the input joints' (constant) motions from the real configuration q, and the eliminated
         legs' lengths there (their frame's distance from their centre: any leg angles give it)."""
         if self.legs:
@@ -286,7 +288,7 @@ class PolynomialClosure(ClosureKernel):
         for placed in self._placed.values():
             placed.refresh()
 
-    def _from_joint(self, j, qj):
+    def _from_joint(self, j: int, qj: np.ndarray) -> np.ndarray:
         kind = self.kind[j]
         if kind == "R":
             return np.array([np.cos(qj[0]), np.sin(qj[0])]) if len(qj) == 1 else np.array(qj, float)
@@ -296,7 +298,7 @@ class PolynomialClosure(ClosureKernel):
             return np.r_[qj[:3] / self.L, qj[3:]]
         return np.array(qj, float)
 
-    def from_q(self, q) -> np.ndarray:
+    def from_q(self, q: np.ndarray) -> np.ndarray:
         """The unknowns x (n,) of a real configuration q."""
         q = np.asarray(q, float)
         x = np.zeros(self.n)
@@ -305,7 +307,7 @@ class PolynomialClosure(ClosureKernel):
             x[sl] = self._from_joint(j, q[jm.idx_q:jm.idx_q + jm.nq])
         return x
 
-    def to_q(self, x, q_inputs) -> np.ndarray:
+    def to_q(self, x: np.ndarray, q_inputs: np.ndarray) -> np.ndarray:
         """The real configuration with the passive joints at the real parts of x and the inputs of q_inputs."""
         q = np.array(q_inputs, float)
         x = np.real(np.asarray(x))
@@ -323,7 +325,7 @@ class PolynomialClosure(ClosureKernel):
                 q[jm.idx_q + 3:jm.idx_q + 7] = v[3:] / np.linalg.norm(v[3:])
         return q
 
-    def random_points(self, rng, P: int) -> np.ndarray:
+    def random_points(self, rng: np.random.Generator, P: int) -> np.ndarray:
         """P random complex points on the constraint variety (circles, unit quaternions)."""
         X = np.empty((P, self.n), complex)
         for j, sl in self.slices.items():
@@ -343,7 +345,7 @@ class PolynomialClosure(ClosureKernel):
         return X
 
     # ------------------------------------------------------------------ moving on the variety
-    def retract(self, X, dT):
+    def retract(self, X: np.ndarray, dT: np.ndarray) -> np.ndarray:
         """The points X (P, n) moved by the tangent steps dT (P, nt) (see the module)."""
         X = np.array(X, complex)
         if self.rev.size:
@@ -369,7 +371,7 @@ class PolynomialClosure(ClosureKernel):
                 X[:, sl.start:sl.start + 3] += dT[:, tl][:, :3]
         return X
 
-    def tangent(self, X) -> np.ndarray:
+    def tangent(self, X: np.ndarray) -> np.ndarray:
         """dx/dt (P, n, nt): how the unknowns move along each tangent coordinate at X."""
         P = len(X)
         T = np.zeros((P, self.n, self.nt), complex)
@@ -390,7 +392,7 @@ class PolynomialClosure(ClosureKernel):
         return T
 
     # ------------------------------------------------------------------ kinematics
-    def _motion(self, j, xj):
+    def _motion(self, j: int, xj: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(R_E, t_E) of joint j at its unknowns xj (P, width): (P, 3, 3), (P, 3)."""
         P, kind = len(xj), self.kind[j]
         t = np.zeros((P, 3), complex)
@@ -405,20 +407,20 @@ class PolynomialClosure(ClosureKernel):
             R, t = quaternion_matrix(xj[:, 3:]), xj[:, :3].copy()
         return R, t
 
-    def placed(self, which=None) -> Placed:
+    def placed(self, which: Any = None) -> Placed:
         """How the numpy evaluation places the frames: every joint and frame (None) or the rows' ("rows")."""
         if which not in self._placed:
             self._placed[which] = Placed(self, None if which is None else np.arange(len(self.row_frames)))
         return self._placed[which]
 
-    def kinematics(self, X, jacobian: bool = True):
+    def kinematics(self, X: np.ndarray, jacobian: bool = True) -> dict:
         """World placements (stack axis last) of every joint frame (oR (3, 3, nj, P), op (3, nj, P))
         and of the frames the rows and points read (fR, fp); with ``jacobian`` each tangent
         coordinate's world axis w (3, nt, P), origin o and translation direction e (the module)."""
         return self.placed()(X, jacobian)
 
     # ------------------------------------------------------------------ equations
-    def rows(self, X, jacobian: bool = True):
+    def rows(self, X: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """The closure rows kept (P, m) and their Jacobian in tangent coordinates (P, m, nt)."""
         if self._kernel is not None:
             r, J = self._kernel(np.ascontiguousarray(X, complex), np.ascontiguousarray(self.Rc.transpose(2, 0, 1)),
@@ -437,7 +439,7 @@ class PolynomialClosure(ClosureKernel):
         """The contract's step on the variety: ``retract`` of the points Q (N, n) by V (N, nt)."""
         return self.retract(Q, V)
 
-    def constraints(self, X):
+    def constraints(self, X: np.ndarray) -> np.ndarray:
         """c^2 + s^2 - 1 per revolute, q.q - 1 per quaternion, at X (P, n): (P, k)."""
         X = np.asarray(X, complex)
         out = []
@@ -456,11 +458,11 @@ class PolynomialClosure(ClosureKernel):
         size = np.abs(r).max(axis=1)
         return size > _ZERO_ROW * max(size.max(initial=0.0), 1.0)
 
-    def residual_all(self, X):
+    def residual_all(self, X: np.ndarray) -> np.ndarray:
         """Every planned row at X (P, rows) (the dropped ones too: they vanish identically)."""
         return rows_all(self, self.placed("rows")(X, jacobian=False), jacobian=False)[0].T
 
-    def signature(self, X) -> np.ndarray:
+    def signature(self, X: np.ndarray) -> np.ndarray:
         """What tells assembly modes apart (analysis.motion.position.PositionSolver.signature, in
         units of L, complex): every joint frame's origin (but the eliminated legs', which their ends
         fix), the points' and the output frame's pose."""

@@ -23,7 +23,7 @@ POS, VEC, DOTD, DOT, DIST = 0, 1, 2, 3, 4
 _KIND = {"": 0, "R": 1, "P": 2, "S": 3, "F": 4}
 
 
-def pack(closure) -> tuple:
+def pack(closure: Any) -> tuple:
     """The closure's constants as the kernel's arrays (layout of model.kernel.algebraic, stack axes first)."""
     nj = closure.nj
     xs = np.full(nj, -1, np.int64)
@@ -60,7 +60,7 @@ def pack(closure) -> tuple:
             np.ascontiguousarray(closure.above), rk, ra, rb, rc, ru, rw)
 
 
-def kernel():
+def kernel() -> Any:
     """The compiled function rows(X, Rc, tc, r2, *pack(closure), nt, jacobian) -> (r (P, m), J (P, m, nt))."""
     global _KERNEL
     if _KERNEL is None:
@@ -81,8 +81,11 @@ def _build() -> Any:
     derivative = jit(_row_jacobian)
 
     @jit
-    def one(x, Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
-            nt, jacobian, r, J):
+    def one(x: np.ndarray, Rc: np.ndarray, tc: np.ndarray, r2: np.ndarray, parent: np.ndarray, kind: np.ndarray,
+            passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
+            fj: np.ndarray, fR: np.ndarray, ft: np.ndarray, above: np.ndarray, rk: np.ndarray, ra: np.ndarray,
+            rb: np.ndarray, rc: np.ndarray, ru: np.ndarray, rw: np.ndarray, nt: int, jacobian: bool, r: np.ndarray,
+            J: np.ndarray) -> None:
         oR, op, wv, ov, ev = place(x, Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, nt, jacobian)
         fp, fRw = frames(oR, op, fj, fR, ft)
         ua = np.zeros(3, np.complex128)
@@ -99,8 +102,11 @@ def _build() -> Any:
                 derivative(i, rk[i], rc[i], fa, fb, fp, ua, ub, d, wv, ov, ev, above, nt, J)
 
     @jit
-    def rows(X, Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
-             nt, jacobian):
+    def rows(X: np.ndarray, Rc: np.ndarray, tc: np.ndarray, r2: np.ndarray, parent: np.ndarray, kind: np.ndarray,
+             passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
+             fj: np.ndarray, fR: np.ndarray, ft: np.ndarray, above: np.ndarray, rk: np.ndarray, ra: np.ndarray,
+             rb: np.ndarray, rc: np.ndarray, ru: np.ndarray, rw: np.ndarray, nt: int, jacobian: bool
+            ) -> tuple[np.ndarray, np.ndarray]:
         P, m = X.shape[0], rk.shape[0]
         r = np.empty((P, m), np.complex128)
         J = np.empty((P, m, nt if jacobian else 0), np.complex128)
@@ -186,7 +192,9 @@ def _place_joints(jit: Any, motion: Any, axes: Any) -> Any:
     with ``jacobian``, the world axes of the tangent coordinates (wv, ov, ev (nt, 3))."""
 
     @jit
-    def place(x, Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, nt, jacobian):
+    def place(x: np.ndarray, Rc: np.ndarray, tc: np.ndarray, parent: np.ndarray, kind: np.ndarray,
+              passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
+              nt: int, jacobian: bool) -> tuple:
         nj = parent.shape[0]
         oR = np.zeros((nj, 3, 3), np.complex128)
         op = np.zeros((nj, 3), np.complex128)

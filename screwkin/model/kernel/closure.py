@@ -18,7 +18,7 @@ Row kinds (world vectors; o1, o2 frame origins, d = o2 - o1):
 from __future__ import annotations
 
 import threading
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import pinocchio as pin
@@ -44,15 +44,15 @@ class _Workspace:
 
     __slots__ = ("data", "placements", "groups", "buffers")
 
-    def __init__(self, data, placements):
+    def __init__(self, data: Any, placements: Any) -> None:
         self.data, self.placements, self.groups, self.buffers = data, placements, None, None
 
 
 class ClosureSystem:
     """The loop-closure equations r(q) = 0 of a model with cut joints."""
 
-    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>", data=None,
-                 extra=()):
+    def __init__(self, model: Any, cuts: Any, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>",
+                 data: Any = None, extra: Any = ()) -> None:
         """data: the pinocchio.Data the building thread computes in (a new one when None; every other
         thread makes its own: ``_workspace``);
         extra: CouplingRow and ContactRow of higher pairs, after the cut joints' rows."""
@@ -75,7 +75,7 @@ class ClosureSystem:
         self._kernels: tuple[ClosureKernel, ...] = (PinocchioKernel(self),)
 
     # ------------------------------------------------------------------ per-thread workspace
-    def _workspace(self):
+    def _workspace(self) -> _Workspace:
         """This thread's Data, the views of its cut frames' placements and the row groups built
         on them: threads may share a mechanism (each computes in a Data of its own; the thread that
         built the system uses the Data it was given).  Pinocchio hands out its frame placements by
@@ -93,16 +93,16 @@ class ClosureSystem:
         return ws
 
     @property
-    def data(self):
+    def data(self) -> Any:
         """The pinocchio.Data this thread computes in."""
         return self._workspace().data
 
     @property
-    def _placements(self):
+    def _placements(self) -> list:
         return self._workspace().placements
 
     @property
-    def _groups(self):
+    def _groups(self) -> list:
         return self._workspace().groups
 
     @property
@@ -136,7 +136,7 @@ class ClosureSystem:
     def accelerated(self) -> bool:
         return self._compiled is not None
 
-    def _kinematics(self, q, jacobian: bool, data):
+    def _kinematics(self, q: np.ndarray, jacobian: bool, data: Any) -> None:
         """Pinocchio's pass for q in ``data`` (this thread's): frame placements, and the joint
         Jacobians if asked."""
         if jacobian:
@@ -154,7 +154,7 @@ class ClosureSystem:
             self._solver_rows += len(self.extra)
         return self._solver_rows
 
-    def _plan(self, cut, b1, b2):
+    def _plan(self, cut: Any, b1: np.ndarray, b2: np.ndarray) -> tuple:
         """Constant parts of a cut joint's rows, in its frames: position axes P (rows, in F1),
         alignment pairs (u in F1, w in F2), the vectors the solver rows compare, and
         whether the minimal rows hold a rotation vector."""
@@ -180,7 +180,7 @@ class ClosureSystem:
             vectors = np.eye(3) if t in ("fixed", "prismatic") else a[None, :]
         return P, pairs, vectors, t in ("fixed", "prismatic")
 
-    def _group(self, placements):
+    def _group(self, placements: Any) -> list:
         """Cut joints of one type share the layout of their rows: each group is evaluated
         with stacked arrays (a few numpy calls per group, not per cut joint)."""
         offsets = {False: 0, True: 0}
@@ -220,7 +220,7 @@ class ClosureSystem:
         return out
 
     @staticmethod
-    def _cut_rows(cut, plan, solver):
+    def _cut_rows(cut: Any, plan: tuple, solver: bool) -> int:
         """Rows of one cut joint: 6 - dof minimal ones, or the solver's (positions, then three
         per shared vector, or the alignments of a universal joint), read from its plan."""
         if not solver:
@@ -228,7 +228,8 @@ class ClosureSystem:
         P, pairs, vectors, _ = plan
         return len(P) + (len(pairs) if vectors is None else 3 * len(vectors))
 
-    def evaluate(self, q, jacobian: bool = True, solver: bool = False):
+    def evaluate(self, q: np.ndarray, jacobian: bool = True, solver: bool = False
+                ) -> tuple[np.ndarray, np.ndarray | None]:
         """Residual r(q) and, if asked, its Jacobian (rows x nv).
 
         With ``solver=False`` (default) the rows are the minimal ones (6 - dof per
@@ -297,7 +298,7 @@ class ClosureSystem:
             self._evaluate_extra(q, r, K, nrows - len(self.extra))
         return r, K
 
-    def _evaluate_extra(self, q, r, K, i):
+    def _evaluate_extra(self, q: np.ndarray, r: np.ndarray, K: np.ndarray, i: int) -> None:
         """The rows of the higher pairs (CouplingRow, ContactRow) from row i on."""
         for k, e in enumerate(self.extra, i):
             if isinstance(e, CouplingRow):
@@ -312,7 +313,7 @@ class ClosureSystem:
             if K is not None:
                 K[k] = grad
 
-    def _evaluate_one(self, g, j, r, K, solver, data):
+    def _evaluate_one(self, g: dict, j: int, r: np.ndarray, K: np.ndarray, solver: bool, data: Any) -> None:
         """The rows of cut joint j of a group (the same rows as the stacked code, with 2-D
         arrays: a test checks that both give the same numbers), placements in ``data``."""
         model = self.model
@@ -351,7 +352,7 @@ class ClosureSystem:
                 for c in range(p):
                     K[i + c] = cross3(w[:, c], u[:, c]) @ (w2 - w1)
 
-    def bias(self, q, v) -> np.ndarray:
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """K'(q, v) v: the second time derivative of the (minimal) residual rows
         along a motion with joint velocity v and zero joint acceleration, from
         Pinocchio's classical frame accelerations.  Exact for position and
@@ -362,7 +363,8 @@ class ClosureSystem:
         out = np.empty(self.nrows)
         i = 0
 
-        def second(u, w, al):  # (d/dt u, d2/dt2 u) for u fixed in a frame turning at w with acceleration al
+        # (d/dt u, d2/dt2 u) for u fixed in a frame turning at w with acceleration al
+        def second(u: np.ndarray, w: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             ud = cross3(w, u)
             return ud, cross3(al, u) + cross3(w, ud)
 
@@ -438,13 +440,13 @@ class ClosureSystem:
         """What a unit force in each minimal row exerts (model.kernel.wrenches.row_wrenches)."""
         return row_wrenches(self.model, self.data, self.cuts, self._plans, self.extra, q)
 
-    def residual(self, q) -> np.ndarray:
+    def residual(self, q: np.ndarray) -> np.ndarray:
         return self.evaluate(q, jacobian=False)[0]
 
-    def jacobian(self, q) -> np.ndarray:
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
         return self.evaluate(q, jacobian=True)[1]
 
-    def wrong_branch(self, q, placed: bool = False) -> list:
+    def wrong_branch(self, q: np.ndarray, placed: bool = False) -> list:
         """Cut joints whose aligned axes are antiparallel (a spurious root of the
         alignment rows: the joint would be assembled upside down).  placed: the
         frame placements in self.data are already those of q."""
@@ -461,7 +463,8 @@ class ClosureSystem:
         return bad
 
     # ------------------------------------------------------------------ solving
-    def solve(self, q0, frozen=(), tolerances: Tolerances | None = None, trace=None) -> Assembly:
+    def solve(self, q0: np.ndarray, frozen: Any = (), tolerances: Tolerances | None = None,
+              trace: Callable[..., None] | None = None) -> Assembly:
         """Solve r(q) = 0 from q0 by damped Newton (model.kernel.newton.solve: Levenberg-Marquardt,
         minimum-norm steps).  frozen: velocity indices that must not move (the inputs); trace:
         optional callable(iteration, q, r, K, dq, accepted) recording the iterations (r and K in
@@ -469,7 +472,7 @@ class ClosureSystem:
         reached when it fails, or when the solution assembles a cut joint upside down."""
         return newton.solve(self.kernel, q0, frozen, tolerances or self.tol, trace)
 
-    def free_columns(self, frozen) -> np.ndarray:
+    def free_columns(self, frozen: Any) -> np.ndarray:
         """The velocity indices not in ``frozen`` (a sequence of indices; cached per set of frozen ones)."""
         frozen = np.asarray(frozen, int).ravel()
         key = frozen.tobytes()

@@ -64,7 +64,7 @@ def cache_on_disk() -> bool:
     return resource.getrlimit(resource.RLIMIT_FSIZE)[0] == resource.RLIM_INFINITY
 
 
-def kernels():
+def kernels() -> Any:
     """The compiled functions (compiled or loaded from the cache at the first call)."""
     global _KERNELS
     if _KERNELS is None:
@@ -72,13 +72,14 @@ def kernels():
     return _KERNELS
 
 
-def _compile_kernels():
+def _compile_kernels() -> Any:
     import numba as nb
 
     cache = cache_on_disk()
 
     @nb.njit(cache=cache)
-    def cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian):
+    def cut_rows(kinds: np.ndarray, R1: np.ndarray, R2: np.ndarray, t1: np.ndarray, t2: np.ndarray, J1: np.ndarray,
+                 J2: np.ndarray, r: np.ndarray, K: np.ndarray, jacobian: bool) -> None:
         """Solver rows of each cut joint c, in order: F2's origin along F1's axes
         (e . d, e fixed in F1), then for welds R2 e - R1 e for the three axes e.
         Their derivative: e . (v2 - v1) + (e x d) . w1 and [R1 e]x w1 - [R2 e]x w2."""
@@ -117,7 +118,7 @@ def _compile_kernels():
         return i
 
     @nb.njit(cache=cache)
-    def damped_step(K, r, free, mu):
+    def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:
         """model.kernel.newton.damped_step, compiled: the minimum-norm damped step on the free columns
         (the smaller of the two normal systems) and |r + K_f dq_f|^2 (the linear model's residual)."""
         m, nf = K.shape[0], free.shape[0]
@@ -149,7 +150,7 @@ def _compile_kernels():
     return k
 
 
-def damped_step(K, r, free, mu):
+def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:
     """model.kernel.newton.damped_step through the compiled kernel (K C-contiguous, free int64), with
     the numpy step where numba's solve raises np.linalg.LinAlgError (a singular damped system:
     the numpy step's least-squares fallback; an inf or NaN in K or r: NaN, as numpy gives)."""
@@ -163,7 +164,7 @@ def damped_step(K, r, free, mu):
 one_step = newton.one_at_a_time(damped_step)
 
 
-def kinds_of(cuts):
+def kinds_of(cuts: Any) -> np.ndarray | None:
     """The kernel code of each cut joint, or None when one of them is of a type the kernels
     do not know."""
     codes = {"spherical": SPHERICAL, "fixed": FIXED}

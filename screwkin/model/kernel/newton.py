@@ -56,7 +56,7 @@ TRACE_FLOOR = 1e-12
 NU = 2.0
 
 
-def damped_step(K, r, free, mu):
+def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, float]:
     """The damped step of one configuration on the free columns of K (rows, nv): the step on
     those columns and the squared residual of the linear model |r + K_f dq_f|^2."""
     Kf = K[:, free]
@@ -75,7 +75,7 @@ def damped_step(K, r, free, mu):
     return dqf, float(lin @ lin)
 
 
-def damped_steps(Kf, r, mu):
+def damped_steps(Kf: np.ndarray, r: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """damped_step for a stack, on columns already chosen: Kf (N, m, n), r (N, m), mu (N,) ->
     (steps (N, n), squared residuals of the linear model (N,))."""
     N, m, n = Kf.shape
@@ -95,19 +95,19 @@ def damped_steps(Kf, r, mu):
     return dq, np.einsum("ni,ni->n", lin, lin)
 
 
-def stacked_steps(K, r, free, mu):
+def stacked_steps(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """damped_steps on the free columns of a stack: K (N, rows, nv), r (N, rows), mu (N,) ->
     (steps on the free columns (N, free), squared residuals of the linear model (N,)): the step
     of ``iterate`` for stacks."""
     return damped_steps(K[:, :, free], r, mu)
 
 
-def one_at_a_time(step):
+def one_at_a_time(step: Callable[..., tuple[np.ndarray, Any]]) -> Callable[..., tuple[np.ndarray, Any]]:
     """The step of ``iterate`` for stacks from a step of one configuration,
     ``step(K (rows, nv), r, free, mu) -> (step on the free columns, squared linear residual)``
     (damped_step, or model.kernel.compiled.damped_step): one call per configuration."""
 
-    def steps(K, r, free, mu):
+    def steps(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:
         if len(K) == 1:  # (the squared residual as a float: it broadcasts)
             dq, lin = step(K[0], r[0], free, float(mu[0]))
             return dq[None], lin
@@ -121,7 +121,8 @@ def one_at_a_time(step):
 one_step = one_at_a_time(damped_step)
 
 
-def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
+def judge(norm: np.ndarray, r_new: np.ndarray, linear_squared: np.ndarray, mu: np.ndarray, nu: np.ndarray,
+          closure: float, mu_min: float, mu_max: float) -> tuple:
     """The verdict on one step of each configuration of a stack: residual norms before (n,), the
     residual rows after (n, rows), squared residual of the linear model, damping and Nielsen's
     factor nu (n,); Tolerances.closure, lm_damping_min, lm_damping_max.
@@ -165,8 +166,10 @@ class Iterates(NamedTuple):
     placed: np.ndarray  #: (N,) the last configuration evaluated is q (no step tried, or the last accepted)
 
 
-def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=None, trace=None,
-            verdict=judge) -> Iterates:
+def iterate(evaluate: Callable[..., tuple[np.ndarray, np.ndarray | None]], Q0: np.ndarray, free: np.ndarray,
+            tol: Tolerances, integrate: Callable[[np.ndarray, np.ndarray], np.ndarray],
+            step: Callable[..., tuple[np.ndarray, Any]] = stacked_steps, iterations: int | None = None,
+            trace: Callable[..., None] | None = None, verdict: Callable[..., tuple] = judge) -> Iterates:
     """The damped-Newton loop, for a stack of N configurations (N = 1: one configuration).
 
     evaluate(Q (n, nq), which (n,), jacobian) -> (r (n, rows), K (n, rows, nv) or None): the rows
@@ -239,7 +242,7 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
     return Iterates(Q, norm, its, norm < closure, ~refused)
 
 
-def _norms(r):
+def _norms(r: np.ndarray) -> np.ndarray:
     """The residual norm of each row of a stack."""
     return np.sqrt(np.add.reduce(r * r, axis=1))
 

@@ -14,6 +14,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import NDArray
 
+from ...tolerances import Tolerances
 from . import newton
 from .closure import ClosureSystem
 from .contract import ClosureKernel, NotProvided
@@ -32,7 +33,7 @@ class Unbatchable(Exception):
     one configuration at a time with model.kernel.closure.ClosureSystem instead."""
 
 
-def tree_kinematics(mech):
+def tree_kinematics(mech: Any) -> TreeKinematics | None:
     """The mechanism's TreeKinematics, made once (mech.cache), None when its joints are not all 1-DOF
     revolute or prismatic (its users then run Pinocchio a configuration at a time)."""
     key = "links.tree"
@@ -56,7 +57,7 @@ class TreeKinematics:
     _AXES = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1),
              "JointModelPX": (1, 0, 0), "JointModelPY": (0, 1, 0), "JointModelPZ": (0, 0, 1)}
 
-    def __init__(self, mech):
+    def __init__(self, mech: Any) -> None:
         model = mech.model
         self.mech, self.model = mech, model
         if model.nq != model.nv:
@@ -85,7 +86,7 @@ class TreeKinematics:
         self.supports = {}
         self._frames = {}
 
-    def _support(self, jid):
+    def _support(self, jid: int) -> Any:
         """(joint ids, which are revolute, velocity columns) of the joints moving joint jid."""
         if jid not in self.supports:
             sup = [int(j) for j in self.model.supports[jid] if j > 0]
@@ -93,7 +94,7 @@ class TreeKinematics:
                                   np.array([self.model.idx_vs[j] for j in sup], int)) if sup else None
         return self.supports[jid]
 
-    def _frame(self, f):
+    def _frame(self, f: Any) -> Any:
         """(parent joint, [R | t]^T of the frame's placement) of frame f (model.state.frame_parent: the output
         frame where place_tool put it)."""
         if f in self._frames:
@@ -104,7 +105,7 @@ class TreeKinematics:
             self._frames[f] = out
         return out
 
-    def _pass(self, Q):
+    def _pass(self, Q: np.ndarray) -> Any:
         """(RTs, ps, ws) of every joint (index 0 the ground) for the configurations Q (N, nq):
         rotations transposed and flattened (3, 3N), origins (N, 3), axes in the world (N, 3)."""
         model = self.model
@@ -131,7 +132,7 @@ class TreeKinematics:
             RTs[j], ps[j], ws[j] = RT, pos, w
         return RTs, ps, ws
 
-    def motions(self, Q, V, A, frame_ids):
+    def motions(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, frame_ids: Any) -> tuple:
         """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
         (a, alpha) of the frames' origins in world axes (N, F, 6) for joint positions Q, rates V and
         accelerations A (N, nv): links._frame_motions' result (Pinocchio's forwardKinematics a step,
@@ -171,7 +172,7 @@ class TreeKinematics:
             ac[:, i, 3:] = al[jid]
         return R, t, tw, ac
 
-    def centres(self, Q, refs) -> dict:
+    def centres(self, Q: np.ndarray, refs: Any) -> dict:
         """{ref: (N, 3)} the world positions [m] KinematicState.centre reads -- ("joint", i) joint i's
         centre, ("mount", i) where joint i sits on its parent, ("frame", f) frame f's origin -- at every
         row of Q: its stacked form, from one pass down the tree."""
@@ -191,7 +192,7 @@ class TreeKinematics:
             out[(kind, i)] = ps[jid] + _thin(t, RTs[jid])[0].reshape(N, 3)
         return out
 
-    def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
+    def frames(self, Q: np.ndarray, frame_ids: Any, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
         frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
         velocity columns ``cols`` of the joints that move it (J and cols None for a frame
@@ -250,7 +251,7 @@ class BatchClosure(ClosureKernel):
     Raises Unbatchable for what it does not represent.
     """
 
-    def __init__(self, mech, target=None, check: int = 0):
+    def __init__(self, mech: Any, target: Any = None, check: int = 0) -> None:
         # with a target, a copy of the model with the output frame placed (model.state.model_with_output): the
         # target's cut joint is a frame of it, and the self-check moves the target frame in it, not in the mechanism's
         model = mech.model if target is None else model_with_output(mech)
@@ -296,13 +297,13 @@ class BatchClosure(ClosureKernel):
             self._check(np.random.default_rng(0), check)
 
     # ------------------------------------------------------------------ frames
-    def _frames(self, Q, jacobian: bool = True):
+    def _frames(self, Q: np.ndarray, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n) LOCAL_WORLD_ALIGNED on the chain's
         columns, columns (n,))}; J and the columns None for a frame on the ground (and for
         every frame without ``jacobian``)."""
         return self.tree.frames(Q, self._frame_ids, jacobian)
 
-    def _placements(self, c, frames, targets, N):
+    def _placements(self, c: Any, frames: Any, targets: Any, N: int) -> tuple:
         """(R1, t1, J1, cols1, R2, t2, J2, cols2) of cut joint c (J None: the frame does not move)."""
         if c.frame1 == self.mech.target_frame:
             t, Rt = targets
@@ -333,13 +334,13 @@ class BatchClosure(ClosureKernel):
     def name(self) -> str:
         return self.mech.path
 
-    def constraint_jacobians(self, Q, targets=None) -> np.ndarray:
+    def constraint_jacobians(self, Q: np.ndarray, targets: Any = None) -> np.ndarray:
         """The minimal rows' Jacobian K (N, rows, nv) (ClosureSystem.jacobian) of configurations
         that close the loops: a rotation vector's rows use the derivative of log3 at the
         identity, which they are at within the closure tolerance."""
         return self._rows(Q, targets, True, solver=False)[1]
 
-    def _rows(self, Q, targets, jacobian, solver):
+    def _rows(self, Q: np.ndarray, targets: Any, jacobian: bool, solver: bool) -> tuple[np.ndarray, np.ndarray | None]:
         Q = np.atleast_2d(np.asarray(Q, float))
         N, nv = len(Q), self.model.nv
         if self.target is not None and targets is None:
@@ -349,7 +350,7 @@ class BatchClosure(ClosureKernel):
         r = np.empty((N, nrows))
         K = np.zeros((N, nrows, nv)) if jacobian else None
 
-        def add(rows, cols, A):  # K[:, rows, cols] += A (N, len(rows), len(cols))
+        def add(rows: Any, cols: Any, A: np.ndarray) -> None:  # K[:, rows, cols] += A (N, len(rows), len(cols))
             if cols is not None:
                 K[:, rows, cols] += A
 
@@ -406,7 +407,7 @@ class BatchClosure(ClosureKernel):
             i += 1
         return r, K
 
-    def bias(self, Q, V) -> np.ndarray:
+    def bias(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
         """K'(q, v) v of every configuration (N, rows): ClosureSystem.bias's minimal rows (zero joint
         accelerations) for stacks, from the frames' classical accelerations (TreeKinematics.motions)
         instead of Pinocchio's a configuration at a time.  A rotation vector's rows take the
@@ -422,7 +423,7 @@ class BatchClosure(ClosureKernel):
         out = np.zeros((N, self.nrows))
         i = 0
 
-        def world(R_, u):  # R u for a stack of rotations and a constant vector
+        def world(R_: np.ndarray, u: np.ndarray) -> np.ndarray:  # R u for a stack of rotations and a constant vector
             return np.einsum("nij,j->ni", R_, np.asarray(u, float))
 
         for cut, (P, pairs, _, rotation) in zip(self.cuts, self.system.plans):
@@ -448,7 +449,7 @@ class BatchClosure(ClosureKernel):
                 i += 1
         return out
 
-    def reversed_axes(self, Q) -> np.ndarray:
+    def reversed_axes(self, Q: np.ndarray) -> np.ndarray:
         """(N,) True where a revolute (cylindrical, planar) cut joint is assembled with its two
         axes opposed: a root of the rows that is not the joint (ClosureSystem.wrong_branch)."""
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -463,7 +464,8 @@ class BatchClosure(ClosureKernel):
         return bad
 
     # ------------------------------------------------------------------ solving
-    def solve(self, Q0, targets=None, frozen=(), tolerances=None, iterations: int | None = None):
+    def solve(self, Q0: np.ndarray, targets: Any = None, frozen: Any = (), tolerances: Tolerances | None = None,
+              iterations: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Damped Newton from every row of Q0 at once: model.kernel.newton.iterate (the loop of
         ClosureSystem.solve, each configuration with its own damping) on these rows.  frozen:
         velocity indices that do not move (inputs).  Returns (Q, converged (N,), residual norms
@@ -475,7 +477,7 @@ class BatchClosure(ClosureKernel):
         if self.solver_rows == 0 or N == 0:
             return Q, np.ones(N, bool), np.zeros(N), np.zeros(N, int)
 
-        def evaluate(Q_, which, jacobian):
+        def evaluate(Q_: np.ndarray, which: Any, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
             return self.evaluate(Q_, jacobian, None if targets is None else (targets[0][which], targets[1]))
 
         free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
@@ -487,7 +489,7 @@ class BatchClosure(ClosureKernel):
         return out.q, converged, out.residual, out.iterations
 
     # ------------------------------------------------------------------ self-check
-    def _check(self, rng, count):
+    def _check(self, rng: np.random.Generator, count: int) -> None:
         """Our rows against ClosureSystem's: at random configurations (solver rows) and at the
         mechanism's closed configurations (constraint Jacobian)."""
         mech, model, system = self.mech, self.model, self.system
@@ -522,7 +524,7 @@ class BatchClosure(ClosureKernel):
             model.frames[mech.target_frame] = frame
 
 
-def _thin(C, RT, block: int = 4096) -> np.ndarray:
+def _thin(C: np.ndarray, RT: np.ndarray, block: int = 4096) -> np.ndarray:
     """C @ RT for a small constant C (k <= 11, 3) and a long RT (3, 3N), a block of columns at a time.
     OpenBLAS threads the whole product (over 262,144 multiply-adds), and in a process that has
     imported pinocchio, on 2 busy cores, its threads wait for each other: 10-16 ms instead of 0.1
@@ -537,29 +539,29 @@ def _thin(C, RT, block: int = 4096) -> np.ndarray:
     return out
 
 
-def _stacked_products(A, B) -> np.ndarray:
+def _stacked_products(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """A @ B for stacks A (N, k, 3), B (N, 3, n): three broadcast products (numpy's stacked
     matmul on 3-long inner products costs several times more)."""
     return A[:, :, 0, None] * B[:, None, 0] + A[:, :, 1, None] * B[:, None, 1] + A[:, :, 2, None] * B[:, None, 2]
 
 
-def _rows_times(P, Rt) -> np.ndarray:
+def _rows_times(P: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     """P @ Rt for a constant P (k, 3) and a stack Rt (N, 3, 3)."""
     return np.einsum("ki,nij->nkj", P, Rt)
 
 
-def _apply_rows(E, d) -> np.ndarray:
+def _apply_rows(E: np.ndarray, d: np.ndarray) -> np.ndarray:
     """E @ d for stacks E (N, k, 3), d (N, 3)."""
     return E[:, :, 0] * d[:, 0, None] + E[:, :, 1] * d[:, 1, None] + E[:, :, 2] * d[:, 2, None]
 
 
-def _cross_columns(a, W) -> np.ndarray:
+def _cross_columns(a: np.ndarray, W: np.ndarray) -> np.ndarray:
     """a x w for every column w of W: a (N, 3), W (N, 3, n) -> (N, 3, n)."""
     a0, a1, a2 = a[:, 0, None], a[:, 1, None], a[:, 2, None]
     return np.stack([a1 * W[:, 2] - a2 * W[:, 1], a2 * W[:, 0] - a0 * W[:, 2], a0 * W[:, 1] - a1 * W[:, 0]], axis=1)
 
 
-def _log3(R) -> np.ndarray:
+def _log3(R: np.ndarray) -> np.ndarray:
     """Rotation vectors of a stack of rotations (N, 3, 3) (pinocchio.log3 for each; angles
     below pi)."""
     c = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)

@@ -14,7 +14,8 @@ from ..geometry import cross3
 __all__ = ["row_wrenches"]
 
 
-def row_wrenches(model: Any, data: Any, cuts: list, plans: list, extra: list, q: np.ndarray) -> list[tuple[Any, Any, Any, Any]]:
+def row_wrenches(model: Any, data: Any, cuts: list, plans: list, extra: list, q: np.ndarray
+                ) -> list[tuple[Any, Any, Any, Any]]:
     """What a unit force in each minimal row exerts, row by row: (frame a, wrench on a's body,
     frame b, wrench on b's body), each wrench (force, moment) at the frame's origin in world
     axes, so that the row's Jacobian is w_a^T J_a + w_b^T J_b (J: LOCAL_WORLD_ALIGNED frame
