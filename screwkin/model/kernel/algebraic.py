@@ -169,7 +169,7 @@ class PolynomialClosure(ClosureKernel):
         self._row_index()
         self.Rc = np.broadcast_to(np.eye(3, dtype=complex)[:, :, None], (3, 3, nj)).copy()
         self.tc = np.zeros((3, nj), complex)
-        self._placed = {}  # frames placed (None: all, "rows": the rows') -> algebraic_numpy.Placed
+        self._placed: dict[Any, Placed] = {}  # frames placed (None: all, "rows": the rows') -> algebraic_numpy.Placed
         self.set_inputs(pin.neutral(model))
         self.keep = np.ones(self._nrows_all, bool)
         self.keep = self._nonzero_rows()
@@ -196,7 +196,9 @@ class PolynomialClosure(ClosureKernel):
     def _row_plan(self) -> None:
         """Per cut joint its rows: ("pos", f1, f2), ("vec", f1, u1, f2, u2), ("dotd", f1, u, f2),
         ("dot", f1, u, f2, w), u in F1 and w in F2 (axes of the cut joint's frames)."""
-        plan, frames, self.row_cut = [], [], []
+        plan: list[tuple] = []
+        frames: list = []
+        self.row_cut: list[str] = []
         legs = {leg.cut: k for k, leg in enumerate(self.legs)}
         for cut in self.cuts:
             if cut.name in legs:  # a leg that is a distance: |p - O|^2 - r^2
@@ -212,7 +214,7 @@ class PolynomialClosure(ClosureKernel):
             frames += [f1, f2]
             t = cut.type
             ex, ey = np.eye(3)[0], np.eye(3)[1]
-            rows = []
+            rows: list[tuple] = []
             if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
                 rows.append(("pos", f1, f2))
             if t in ("fixed", "prismatic"):
@@ -234,7 +236,8 @@ class PolynomialClosure(ClosureKernel):
 
     def _row_index(self) -> None:
         """Index arrays of the rows by kind: the frames and world vectors each reads, its row numbers."""
-        vq, vq_key = [], {}
+        vq: list[tuple[int, np.ndarray]] = []
+        vq_key: dict[tuple, int] = {}
 
         def vector(f: Any, u: np.ndarray) -> Any:
             key = (f, tuple(np.round(u, 15)))
@@ -243,7 +246,7 @@ class PolynomialClosure(ClosureKernel):
                 vq.append((self.f_index[f], np.asarray(u, float)))
             return vq_key[key]
 
-        idx = {k: {"rows": [], "a": [], "b": [], "q1": [], "q2": []} for k in ("pos", "vec", "dotd", "dot", "dist")}
+        idx: dict[str, dict[str, list]] = {k: {"rows": [], "a": [], "b": [], "q1": [], "q2": []} for k in ("pos", "vec", "dotd", "dot", "dist")}
         i = 0
         for row in self.plan:
             kind = row[0]
@@ -252,18 +255,24 @@ class PolynomialClosure(ClosureKernel):
             d["rows"].append(list(range(i, i + width)))
             i += width
             if kind == "dist":
-                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[2]]), d["q1"].append(row[3])
+                d["a"].append(self.f_index[row[1]])
+                d["b"].append(self.f_index[row[2]])
+                d["q1"].append(row[3])
             elif kind == "pos":
-                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[2]])
+                d["a"].append(self.f_index[row[1]])
+                d["b"].append(self.f_index[row[2]])
             elif kind == "vec":
-                d["q1"].append(vector(row[1], row[2])), d["q2"].append(vector(row[3], row[4]))
+                d["q1"].append(vector(row[1], row[2]))
+                d["q2"].append(vector(row[3], row[4]))
             elif kind == "dotd":
-                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[3]])
+                d["a"].append(self.f_index[row[1]])
+                d["b"].append(self.f_index[row[3]])
                 d["q1"].append(vector(row[1], row[2]))
             else:
-                d["q1"].append(vector(row[1], row[2])), d["q2"].append(vector(row[3], row[4]))
-        width = {"pos": 3, "vec": 3, "dotd": 1, "dot": 1, "dist": 1}
-        self.rix = {k: {n: np.array(v, int).reshape(len(v), width[k]) if n == "rows" else np.array(v, int)
+                d["q1"].append(vector(row[1], row[2]))
+                d["q2"].append(vector(row[3], row[4]))
+        widths = {"pos": 3, "vec": 3, "dotd": 1, "dot": 1, "dist": 1}
+        self.rix = {k: {n: np.array(v, int).reshape(len(v), widths[k]) if n == "rows" else np.array(v, int)
                         for n, v in d.items()} for k, d in idx.items()}
         self.vq_f = np.array([f for f, _ in vq], int)
         self.vq_u = np.array([u for _, u in vq]).reshape(-1, 3).T
@@ -427,8 +436,8 @@ class PolynomialClosure(ClosureKernel):
                                 np.ascontiguousarray(self.tc.T), np.asarray(self.r2, complex), *self._packed, self.nt,
                                 jacobian)
             return r, (J if jacobian else None)
-        r, J = rows_all(self, self.placed("rows")(X, jacobian), jacobian)
-        return r[self.keep].T, (J[self.keep].transpose(2, 0, 1) if jacobian else None)
+        r, Jall = rows_all(self, self.placed("rows")(X, jacobian), jacobian)
+        return r[self.keep].T, (Jall[self.keep].transpose(2, 0, 1) if Jall is not None else None)
 
     def evaluate(self, Q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """The contract's rows: ``rows`` at the complex points Q (N, n) (lengths over L: dimensionless),

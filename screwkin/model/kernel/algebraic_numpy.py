@@ -160,7 +160,7 @@ def rows_all(c: Any, kin: dict, jacobian: bool) -> tuple[np.ndarray, np.ndarray 
     fR, fp = kin["fR"], kin["fp"]
     P, nt = fp.shape[-1], c.nt
     r = np.empty((c._nrows_all, P), complex)
-    J = np.empty((c._nrows_all, nt, P), complex) if jacobian else None
+    J: Any = np.empty((c._nrows_all, nt, P), complex) if jacobian else None
     v = stack_mv(fR[:, :, c.vq_f], c.vq_u[..., None])  # (3, vectors, P)
     if jacobian:
         w, o, e = kin["w"], kin["o"], kin["e"]

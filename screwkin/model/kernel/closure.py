@@ -45,7 +45,9 @@ class _Workspace:
     __slots__ = ("data", "placements", "groups", "buffers")
 
     def __init__(self, data: Any, placements: Any) -> None:
-        self.data, self.placements, self.groups, self.buffers = data, placements, None, None
+        self.data, self.placements = data, placements
+        self.groups: Any = None
+        self.buffers: Any = None
 
 
 class ClosureSystem:
@@ -65,12 +67,12 @@ class ClosureSystem:
         self.path = path
         self.nrows = sum(c.rows for c in self.cuts) + len(self.extra)
         self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
-        self._solver_rows = None
-        self._compiled = None  # (kernels, cut kinds) when accelerate() is on; each thread's buffers in its workspace
-        self._free = {}  # free velocity indices for each set of frozen ones
+        self._solver_rows: int | None = None
+        self._compiled: tuple[Any, np.ndarray] | None = None  # (kernels, cut kinds) when accelerate() is on; each thread's buffers in its workspace
+        self._free: dict[bytes, np.ndarray] = {}  # free velocity indices for each set of frozen ones
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         self._owner = threading.get_ident()
-        self._position_rows = None
+        self._position_rows: np.ndarray | None = None
         self.integrator = Integrator(model)  # q (+) dq on the model's configuration manifold, for stacks
         self._kernels: tuple[ClosureKernel, ...] = (PinocchioKernel(self),)
 
@@ -167,7 +169,7 @@ class ClosureSystem:
         else:  # planar
             P = a[None, :]
         if t in ("revolute", "continuous", "cylindrical", "planar"):
-            pairs = ((b1, a), (b2, a))
+            pairs: tuple = ((b1, a), (b2, a))
         elif t == "universal":
             pairs = ((a, np.asarray(cut.axis2, float)),)
         else:
@@ -184,7 +186,7 @@ class ClosureSystem:
         """Cut joints of one type share the layout of their rows: each group is evaluated
         with stacked arrays (a few numpy calls per group, not per cut joint)."""
         offsets = {False: 0, True: 0}
-        groups = {}
+        groups: dict[str, dict] = {}
         for c, cut in enumerate(self.cuts):
             P, pairs, vectors, rotation = self._plans[c]
             g = groups.setdefault(cut.type, {"members": [], "P": [], "U": [], "W": [], "V": [],
@@ -247,7 +249,7 @@ class ClosureSystem:
         self._kinematics(q, jacobian, data)
         nrows = self._rows(solver)
         r = np.empty(nrows)
-        K = np.empty((nrows, model.nv)) if jacobian else None
+        K: Any = np.empty((nrows, model.nv)) if jacobian else None
         for g in ws.groups:
             views = g["views"]
             n = len(views)
@@ -444,7 +446,9 @@ class ClosureSystem:
         return self.evaluate(q, jacobian=False)[0]
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        return self.evaluate(q, jacobian=True)[1]
+        K = self.evaluate(q, jacobian=True)[1]
+        assert K is not None
+        return K
 
     def wrong_branch(self, q: np.ndarray, placed: bool = False) -> list:
         """Cut joints whose aligned axes are antiparallel (a spurious root of the

@@ -25,6 +25,7 @@ use compiles for about 15 s (8 s of it the rows and the step; loaded from the ca
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -32,7 +33,7 @@ import numpy as np
 try:
     import resource
 except ImportError:  # not a POSIX system
-    resource = None
+    resource = None  # type: ignore[assignment]
 
 import pinocchio as pin
 
@@ -79,7 +80,7 @@ def _compile_kernels() -> Any:
 
     @nb.njit(cache=cache)
     def cut_rows(kinds: np.ndarray, R1: np.ndarray, R2: np.ndarray, t1: np.ndarray, t2: np.ndarray, J1: np.ndarray,
-                 J2: np.ndarray, r: np.ndarray, K: np.ndarray, jacobian: bool) -> None:
+                 J2: np.ndarray, r: np.ndarray, K: np.ndarray, jacobian: bool) -> int:
         """Solver rows of each cut joint c, in order: F2's origin along F1's axes
         (e . d, e fixed in F1), then for welds R2 e - R1 e for the three axes e.
         Their derivative: e . (v2 - v1) + (e x d) . w1 and [R1 e]x w1 - [R2 e]x w2."""
@@ -141,13 +142,8 @@ def _compile_kernels() -> Any:
         lin = r + Kf @ dqf
         return dqf, lin @ lin
 
-    class Kernels:
-        pass
-
-    k = Kernels()
-    k.cut_rows, k.damped_step = cut_rows, damped_step
-    k.judge = nb.njit(cache=cache)(newton.judge)  # the loop's verdict, compiled from its one definition
-    return k
+    # the loop's verdict, compiled from its one definition
+    return SimpleNamespace(cut_rows=cut_rows, damped_step=damped_step, judge=nb.njit(cache=cache)(newton.judge))
 
 
 def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:

@@ -20,8 +20,8 @@ LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 def contact_row(model: Any, data: Any, e: Any, jacobian: bool) -> tuple[float, np.ndarray | None]:
     """(value, Jacobian row (nv,) or None) of a ContactRow (model.cuts) at the placements in ``data``."""
     M1, M2 = data.oMf[e.frame1], data.oMf[e.frame2]
-    J1 = frame_jacobian(model, data, e.frame1, LWA) if jacobian else None
-    J2 = frame_jacobian(model, data, e.frame2, LWA) if jacobian else None
+    J1: Any = frame_jacobian(model, data, e.frame1, LWA) if jacobian else None
+    J2: Any = frame_jacobian(model, data, e.frame2, LWA) if jacobian else None
     if "line" in (e.shape1, e.shape2):
         # s = (o_a - o_b) . m_b, the line on frame b (its normal m_b turns with it), the other at a
         on2 = e.shape2 == "line"

@@ -166,7 +166,7 @@ class Iterates(NamedTuple):
     placed: np.ndarray  #: (N,) the last configuration evaluated is q (no step tried, or the last accepted)
 
 
-def iterate(evaluate: Callable[..., tuple[np.ndarray, np.ndarray | None]], Q0: np.ndarray, free: np.ndarray,
+def iterate(evaluate: Callable[..., tuple[np.ndarray, Any]], Q0: np.ndarray, free: np.ndarray,
             tol: Tolerances, integrate: Callable[[np.ndarray, np.ndarray], np.ndarray],
             step: Callable[..., tuple[np.ndarray, Any]] = stacked_steps, iterations: int | None = None,
             trace: Callable[..., None] | None = None, verdict: Callable[..., tuple] = judge) -> Iterates:
@@ -282,6 +282,7 @@ def undamped(kernel: ClosureKernel, q0: Array, free: Array, iterations: int, clo
     reads the residual to know whether it converged).  Returns (q, its residual norm, steps taken)."""
     q = np.array(q0, float)
     r, K = kernel.evaluate(q[None], True)
+    assert K is not None
     norm, it = float(np.linalg.norm(r[0])), 0
     for it in range(1, iterations + 1):
         if closure is not None and norm < closure:
@@ -291,6 +292,7 @@ def undamped(kernel: ClosureKernel, q0: Array, free: Array, iterations: int, clo
         dq[free] = -np.linalg.lstsq(K[0][:, free], r[0], rcond=None)[0]
         q_new = kernel.integrate(q[None], dq[None])[0]  # q (+) dq on the manifold, as the loop moves
         r, K = kernel.evaluate(q_new[None], True)
+        assert K is not None
         new = float(np.linalg.norm(r[0]))
         if closure is None and not new < norm:
             break

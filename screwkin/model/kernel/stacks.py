@@ -83,8 +83,8 @@ class TreeKinematics:
             C = np.hstack([M.rotation, M.rotation @ K, M.rotation @ K @ K, M.translation[:, None],
                            (M.rotation @ axis)[:, None]])
             self.joints.append((model.parents[j], kind, C.T.copy(), model.idx_qs[j]))
-        self.supports = {}
-        self._frames = {}
+        self.supports: dict[int, Any] = {}
+        self._frames: dict[Any, Any] = {}
 
     def _support(self, jid: int) -> Any:
         """(joint ids, which are revolute, velocity columns) of the joints moving joint jid."""
@@ -156,7 +156,10 @@ class TreeKinematics:
             else:
                 o, alpha = wp, alp
                 v, a = v + wqd, a + wqdd + 2.0 * np.cross(wp, wqd)
-            om.append(o), vel.append(v), al.append(alpha), acc.append(a)
+            om.append(o)
+            vel.append(v)
+            al.append(alpha)
+            acc.append(a)
         F = len(frame_ids)
         R, t = np.empty((N, F, 3, 3)), np.empty((N, F, 3))
         tw, ac = np.empty((N, F, 6)), np.empty((N, F, 6))
@@ -202,7 +205,7 @@ class TreeKinematics:
         RTs, ps, ws = self._pass(Q)
         Wall = np.stack([np.zeros((N, 3))] + ws[1:], axis=2)  # (N, 3, njoints)
         Pall = np.stack(ps, axis=2)
-        out = {}
+        out: dict[Any, tuple] = {}
         for f in frame_ids:
             jid, CfT = self._frame(f)
             XT = _thin(CfT, RTs[jid])
@@ -210,7 +213,7 @@ class TreeKinematics:
             pf = ps[jid] + XT[3].reshape(N, 3)
             support = self._support(jid) if jacobian else None
             if not support:
-                out[f] = (Rf, pf, None, None)
+                out[f] = (Rf, pf, None, None)  # (a frame on the ground)
                 continue
             sup, revolute, cols = support
             W = Wall[:, :, sup]  # (N, 3, n) the joints' axes
@@ -338,7 +341,9 @@ class BatchClosure(ClosureKernel):
         """The minimal rows' Jacobian K (N, rows, nv) (ClosureSystem.jacobian) of configurations
         that close the loops: a rotation vector's rows use the derivative of log3 at the
         identity, which they are at within the closure tolerance."""
-        return self._rows(Q, targets, True, solver=False)[1]
+        K = self._rows(Q, targets, True, solver=False)[1]
+        assert K is not None
+        return K
 
     def _rows(self, Q: np.ndarray, targets: Any, jacobian: bool, solver: bool) -> tuple[np.ndarray, np.ndarray | None]:
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -348,7 +353,7 @@ class BatchClosure(ClosureKernel):
         frames = self._frames(Q, jacobian)
         nrows = self.solver_rows if solver else self.nrows
         r = np.empty((N, nrows))
-        K = np.zeros((N, nrows, nv)) if jacobian else None
+        K: Any = np.zeros((N, nrows, nv)) if jacobian else None
 
         def add(rows: Any, cols: Any, A: np.ndarray) -> None:  # K[:, rows, cols] += A (N, len(rows), len(cols))
             if cols is not None:
@@ -514,7 +519,9 @@ class BatchClosure(ClosureKernel):
                     ours, ref = self.constraint_jacobians(q[None], targets)[0], system.jacobian(q)
                 else:
                     r, K = self.evaluate(q[None], True, targets)
+                    assert K is not None
                     r_ref, K_ref = system.evaluate(q, True, solver=True)
+                    assert K_ref is not None
                     ours, ref = np.hstack([r[0][:, None], K[0]]), np.hstack([r_ref[:, None], K_ref])
                 err = float(np.abs(ours - ref).max()) if ref.size else 0.0
                 if err > 1e-8 * max(1.0, float(np.abs(ref).max()) if ref.size else 1.0):  # pragma: no cover - a bug

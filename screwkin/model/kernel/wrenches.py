@@ -24,7 +24,7 @@ def row_wrenches(model: Any, data: Any, cuts: list, plans: list, extra: list, q:
     data: Pinocchio's (placed at q here); cuts, plans, extra: a ClosureSystem's cut joints, their row
     plans and higher-pair rows."""
     pin.framesForwardKinematics(model, data, q)
-    out = []
+    out: list[tuple[Any, Any, Any, Any]] = []
     zero = np.zeros(3)
 
     def pair(f1: Any, w1: Any, f2: Any, w2: Any) -> None:
