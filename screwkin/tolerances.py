@@ -35,7 +35,7 @@ class Tolerances:
                     the largest twist of the same analysis [-].
     max_iterations: iteration limit of the closure solver [-].
     lm_damping:     initial damping of the damped-Newton (Levenberg-Marquardt) step, relative to
-                    the mean squared row norm of the Jacobian (model/newton.py): small, so that
+                    the mean squared row norm of the Jacobian (model/kernel/newton.py): small, so that
                     Newton converges quadratically from a good start [-].
     lm_damping_min: the damping is never lowered below this by accepted steps [-].
     lm_damping_max: a solver whose damping grows past this (every step refused) gives up [-].

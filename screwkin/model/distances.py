@@ -12,7 +12,7 @@ offsets of analysis.motion.monodromy, so the family's generic solution set (mono
 complex c0, certified by the trace test or the published count) is carried to any leg lengths by
 one straight segment in c (Morgan and Sommese 1989).  A step moves the platform in tangent
 coordinates: a translation and a rotation vector d in the world (q -> exp(d / 2) q), as
-model.algebraic moves a free flyer.
+model.kernel.algebraic moves a free flyer.
 
 ``chain_angles``: the joint angles of a leg that carries the platform (two revolutes meeting at the
 ground point, inputs, three revolutes meeting at the platform point) that put the platform at a

@@ -253,7 +253,7 @@ def skews_batch(U, m=None):
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
 
 
-# -- stacks of small complex matrices, the stack's axes last (model.algebraic) --------------------------
+# -- stacks of small complex matrices, the stack's axes last (model.kernel.algebraic) --------------------------
 
 def quaternion_matrix(q):
     """Q(q) for quaternions q (..., 4) in Pinocchio's order (x, y, z, w): the homogeneous quadratic

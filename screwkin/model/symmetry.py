@@ -1,4 +1,4 @@
-"""Discrete symmetries of a polynomial closure (model.algebraic): sign maps of the unknowns that
+"""Discrete symmetries of a polynomial closure (model.kernel.algebraic): sign maps of the unknowns that
 leave every closure row and every joint centre where it was, so that a root's images are roots of
 the same assembly mode (several joint-angle sets of one placement of the links).
 
@@ -7,7 +7,7 @@ mirrored (c, s) -> (-c, s) or reversed (c, -s), on runs of up to three consecuti
 revolutes (a universal or spherical joint written as revolutes through massless links, a
 spherical wrist: (t1 + pi, pi - t2) of a universal joint whose leg lies on the line through its
 centre; the two Euler sets of a spherical joint), and q -> -q of a quaternion.  A candidate is kept
-when the rows and the signature (model.algebraic.PolynomialClosure.signature) do not change at
+when the rows and the signature (model.kernel.algebraic.PolynomialClosure.signature) do not change at
 random complex points: both sides are polynomials, so a candidate that holds there holds everywhere
 (with probability one).  The kept ones generate an abelian group of sign vectors (a basis over
 GF(2)); ``features`` are functions the group leaves alone (the unknowns it never changes, and the
@@ -135,7 +135,7 @@ def candidates(closure) -> np.ndarray:
 
 
 def find_symmetries(closure, rng, tol: float = 1e-9) -> SignGroup:
-    """The sign symmetries of ``closure`` (a model.algebraic.PolynomialClosure) among the candidates."""
+    """The sign symmetries of ``closure`` (a model.kernel.algebraic.PolynomialClosure) among the candidates."""
     C = candidates(closure)
     if not len(C):
         return SignGroup(closure.n)

@@ -14,7 +14,7 @@ A path fails when its step falls below ``min_step`` or it takes ``max_steps`` st
 A homotopy is any object with ``n`` (its equations and tangent coordinates), ``evaluate(X, T,
 index, jacobian)`` returning H (P, n) and its Jacobian in tangent coordinates (P, n, n),
 ``dt(X, T, index)`` returning H_t (P, n), and ``retract(X, dT)``, the points X moved by tangent steps
-dT (x + dT in a vector space; along circles and spheres for model.algebraic), where ``index`` says
+dT (x + dT in a vector space; along circles and spheres for model.kernel.algebraic), where ``index`` says
 which of the homotopy's paths the rows X are (paths may have their own start and end parameters).
 ``Segment`` is the one used by the assembly-mode search: a system G(x) = c moved along straight
 segments of its offset c, per path.

@@ -39,7 +39,7 @@ SIX_R = KnownCount(16, "angle sets", "the inverse kinematics of a six-revolute s
 
 
 def known_count(closure, frozen, target: bool = False) -> KnownCount | None:
-    """The published bound that applies to this polynomial closure (model.algebraic.PolynomialClosure,
+    """The published bound that applies to this polynomial closure (model.kernel.algebraic.PolynomialClosure,
     its legs eliminated), or None.  ``target``: the last cut joint is an inverse-kinematics target."""
     model = closure.model
     kinds = [closure.kind[j] for j in closure.slices]

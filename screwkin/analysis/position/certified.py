@@ -1,13 +1,13 @@
 """Every assembly mode of a mechanism with polynomial loop closure, and how complete the set is.
 
-For the inputs given, the closure of the passive joints (model.algebraic: cosines and sines of
+For the inputs given, the closure of the passive joints (model.kernel.algebraic: cosines and sines of
 revolute angles, prismatic lengths, quaternions) is solved over the complex numbers by monodromy,
 certified by the trace test (analysis.motion.monodromy), then carried to the inputs by one parameter
 homotopy.  Of the roots reached:
 - a root that does not make every closure row vanish is a root of the random combination of rows
   only (spurious) and is dropped;
 - a real root is an assembly mode: its configuration is polished by undamped Newton on Pinocchio's
-  closure (model.newton.polish, the reference), then reported as solve reports every mode;
+  closure (model.kernel.newton.polish, the reference), then reported as solve reports every mode;
 - the others are complex: no real assembly, counted.
 Roots that differ only by the closure's sign symmetries (model.symmetry: a universal joint
 flipped, the other Euler set of a spherical joint) are one placement of the links, so one mode;
@@ -28,8 +28,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...errors import AssemblyError
-from ...model import newton
-from ...model.algebraic import PolynomialClosure, algebraic_obstacle
+from ...model.kernel import newton
+from ...model.kernel.algebraic import PolynomialClosure, algebraic_obstacle
 from ...model.square import SquareSystem
 from ...model.cuts import Assembly
 from ...model.linalg import rank
@@ -78,7 +78,7 @@ class ModeCount:
 
 @dataclass
 class Certified:
-    """Real modes found (each (q, model.closure.Assembly, angle sets, simple)) and the count."""
+    """Real modes found (each (q, model.kernel.closure.Assembly, angle sets, simple)) and the count."""
 
     modes: list
     count: ModeCount
@@ -100,7 +100,7 @@ def obstacle(solver) -> str | None:
 @dataclass
 class Problem:
     """What the homotopy solves: the model and cut joints (an inverse-kinematics target among them),
-    the Pinocchio closure that polishes and lifts (model.closure.ClosureSystem), the velocity indices
+    the Pinocchio closure that polishes and lifts (model.kernel.closure.ClosureSystem), the velocity indices
     held (inputs), the configuration that holds their values and the reference one."""
 
     model: object
@@ -329,7 +329,7 @@ def _best_twin(solver, problem, closure, elements, x):
         key = (bad, dist)
         if best is None or key < best[0]:
             best = (key, q)
-    a = newton.polish(problem.system, best[1], problem.frozen)
+    a = newton.polish(problem.system.pinocchio, best[1], problem.frozen)
     return solver._wrap(a.q), Assembly(solver._wrap(a.q), a.residual, a.iterations, "a homotopy's endpoint")
 
 

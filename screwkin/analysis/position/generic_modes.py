@@ -28,7 +28,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...files import generic_cache
-from ...model import newton
+from ...model.kernel import newton
 from ...model.cuts import Assembly
 from ...model.distances import SixDistances, chain_angles
 from ...model.legs import chain_distance
@@ -243,7 +243,7 @@ def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
         full = lift_legs(closure.from_q(q))
         if full is None:
             continue
-        a = newton.polish(problem.system, full, problem.frozen)
+        a = newton.polish(problem.system.pinocchio, full, problem.frozen)
         if a.residual > solver.mech.tolerances.closure or not _same_pose(solver.mech, a.q, arch, R, t):
             continue
         q = solver._wrap(a.q)
