@@ -286,8 +286,8 @@ def test_a_failed_path_is_no_certificate(tmp_path, shipped_cache):
     """Paths cut short (a tracker allowed 10 steps): the count is not called certified, and the reason
     says how many paths failed -- the certificate is checked, not assumed."""
     from dataclasses import replace
-    from screwkin.analysis.motion.monodromy import MonodromyOptions
-    from screwkin.model import tracking
+    from screwkin.model.homotopy.monodromy import MonodromyOptions
+    from screwkin.model.homotopy import tracking
     base, plat, lengths, phc = sf.dietmaier()
     R, t = phc[0]
     path = tmp_path / "d.urdf"

@@ -14,9 +14,9 @@ from screwkin.analysis.motion import certified
 from screwkin.analysis.motion.ik import inverse_kinematics
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
-from screwkin.model import tracking
+from screwkin.model.homotopy import tracking
 from screwkin.model.algebraic import PolynomialClosure
-from screwkin.model.symmetry import find_symmetries
+from screwkin.model.homotopy.symmetry import find_symmetries
 
 FILES = ["fourbar_crank_rocker", "slider_crank_offset", "planar_3rpr", "bennett", "tsai_3upu", "sarrus",
          "gough_stewart_6ups", "rssr", "delta_parallelogram", "spherical_fourbar"]

@@ -1,5 +1,5 @@
 """Two rigid bodies joined by six distances (a Stewart-Gough platform), in the platform's own pose:
-the system a coefficient-parameter homotopy tracks (analysis.motion.generic_modes), the same whether
+the system a coefficient-parameter homotopy tracks (model.homotopy.parameter), the same whether
 the file writes the platform on a floating joint or carried by one leg in the tree.
 
 Unknowns x = (t / L, q): the translation of the platform's frame and its quaternion (Pinocchio's
@@ -8,7 +8,7 @@ order x, y, z, w) on q.q = 1 (q and -q are one pose: a sign symmetry).  Rows, on
     G_k(x) = |t + Q(q) B_k - A_k|^2 / L^2            (A_k on the ground, B_k on the platform)
 
 and the family G(x) = c: c_k = r_k^2 / L^2 the legs' squared lengths.  These are exactly the linear
-offsets of analysis.motion.monodromy, so the family's generic solution set (monodromy at a random
+offsets of model.homotopy.monodromy, so the family's generic solution set (monodromy at a random
 complex c0, certified by the trace test or the published count) is carried to any leg lengths by
 one straight segment in c (Morgan and Sommese 1989).  A step moves the platform in tangent
 coordinates: a translation and a rotation vector d in the world (q -> exp(d / 2) q), as

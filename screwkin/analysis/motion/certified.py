@@ -2,14 +2,14 @@
 
 For the inputs given, the closure of the passive joints (model.algebraic: cosines and sines of
 revolute angles, prismatic lengths, quaternions) is solved over the complex numbers by monodromy,
-certified by the trace test (analysis.motion.monodromy), then carried to the inputs by one parameter
+certified by the trace test (model.homotopy.monodromy), then carried to the inputs by one parameter
 homotopy.  Of the roots reached:
 - a root that does not make every closure row vanish is a root of the random combination of rows
   only (spurious) and is dropped;
 - a real root is an assembly mode: its configuration is polished by undamped Newton on Pinocchio's
   closure (model.newton.polish, the reference), then reported as solve reports every mode;
 - the others are complex: no real assembly, counted.
-Roots that differ only by the closure's sign symmetries (model.symmetry: a universal joint
+Roots that differ only by the closure's sign symmetries (model.homotopy.symmetry: a universal joint
 flipped, the other Euler set of a spherical joint) are one placement of the links, so one mode;
 roots with the same joint centres and output pose (PositionSolver.signature) are one mode too.  Of
 each mode's joint-angle sets the one within the joint limits and nearest the reference
@@ -30,15 +30,16 @@ import numpy as np
 from ...errors import AssemblyError
 from ...model import newton
 from ...model.algebraic import PolynomialClosure, algebraic_obstacle
-from ...model.square import SquareSystem
+from ...model.homotopy.known_counts import STEWART, known_count
+from ...model.homotopy.monodromy import MonodromyOptions, all_roots, to_target
+from ...model.homotopy.parameter import architecture
+from ...model.homotopy.square import SquareSystem
+from ...model.homotopy.symmetry import find_symmetries
 from ...model.cuts import Assembly
 from ...model.linalg import rank
-from ...model.symmetry import find_symmetries
 from .dyad_modes import dyad_modes
 from . import generic_modes
 from .modes import continuum_words
-from .known_counts import STEWART, known_count
-from .monodromy import MonodromyOptions, all_roots, to_target
 
 NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
@@ -138,7 +139,7 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
                 + ": positive-dimensional solution sets are not tracked")
     known = known_count(closure, problem.frozen, problem.target)
     if known is STEWART:  # a parameter homotopy from the architecture's generic solution set
-        arch = generic_modes.architecture(problem, closure, mech)
+        arch = architecture(problem, closure, mech)
         if arch is not None:
             modes, *counts = generic_modes.platform_modes(solver, problem, closure, arch, seed, options,
                                                           lambda x: _lift(solver, problem, closure, x))

@@ -22,7 +22,7 @@ with it, and ``Neighbour`` takes a map's steps with it), ``BatchedCurve`` (analy
 a chunk of grid values at once), ``ClosedFormCurve`` (analysis.motion.dyads: every value at once, its
 limit positions located by ``locate``, its return to the start by ``returned``), the workspace's grid
 growth (analysis.design.workspace_grid: the jump test, and ``keeps_orientation``, the branch rule in
-several parameters), and the certified mode search's homotopy paths (model.tracking.Paths: predict,
+several parameters), and the certified mode search's homotopy paths (model.homotopy.tracking.Paths: predict,
 correct, accept -- in complex space there is no branch to choose nor limit to locate; the layers keep
 that engine below this module, which it matches by its methods).  analysis.motion.sweep chooses among
 the first three.

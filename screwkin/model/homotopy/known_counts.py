@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ...model.legs import chain_distance
+from ..legs import chain_distance
 
 __all__ = ["KnownCount", "known_count"]
 

@@ -1,4 +1,4 @@
-"""The closure's rows made a square system: as many equations as unknowns (the analysis.motion.monodromy
+"""The closure's rows made a square system: as many equations as unknowns (the model.homotopy.monodromy
 family G(x) = c, with c = 0 the closed mechanism).
 
 Rows beyond the count (a revolute cut joint's three alignment rows where two are independent, a
@@ -18,7 +18,7 @@ class SquareSystem:
     """As many equations as tangent coordinates: the m rows of a PolynomialClosure taken down to nt
     by a random complex combination A (none when m = nt).  Roots of the combination that are not
     roots of every row (spurious) are told apart by ``closes``.  The equations are offsets in the
-    sense of analysis.motion.monodromy: G(x) = c with c = 0 the closed mechanism."""
+    sense of model.homotopy.monodromy: G(x) = c with c = 0 the closed mechanism."""
 
     def __init__(self, closure: PolynomialClosure, rng):
         self.closure = closure

@@ -7,7 +7,7 @@ x0 random on the constraints, c0 = r(x0).  The family's solution set is the grap
 constraint variety, irreducible, so moving c around loops permutes the roots at c0 transitively
 (Duff, Hill, Jensen, Lee, Leykin, Sommars, IMA J. Numer. Anal. 2019): monodromy tracks every known
 root around triangles c0 -> c1 -> c2 -> c0 through random complex offsets and keeps the new
-endpoints.  Roots are kept one per orbit of the system's sign symmetries (model.symmetry).
+endpoints.  Roots are kept one per orbit of the system's sign symmetries (model.homotopy.symmetry).
 
 The certificate.  The trace test (Leykin, Rodriguez, Sottile, Arnold Math. J. 4, 2018), in the form
 of HomotopyContinuation.jl's verify_solution_completeness (del Campo and Rodriguez 2017): in (x, l),
@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...model import tracking
-from ...model.symmetry import SignGroup
+from . import tracking
+from .symmetry import SignGroup
 
 #: Features of points count as independent above this relative singular value (fitting ell).
 _INDEPENDENT = 1e-8
@@ -61,7 +61,7 @@ class MonodromyOptions:
     it is a root of the random combination only; real: |Im x| below this (relative to 1 + |x|) is a
     real root; cauchy: the equations at a Cauchy endgame's estimate below this (relative) make it a
     finite endpoint;
-    same: two roots closer than this (relative) are one; tracker: model.tracking.TrackerOptions."""
+    same: two roots closer than this (relative) are one; tracker: model.homotopy.tracking.TrackerOptions."""
 
     max_rounds: int = 40
     patience: int = 2
