@@ -196,10 +196,12 @@ def test_the_tangent_and_the_jump_test_are_defined_in_one_place():
     tangent coordinates (model/homotopy/square.py, model/algebraic.py: the certified mode search's charts, a
     different space), BatchedCurve.tangents (Curve's on stacks, calling projections), and sweep's
     _start_tangent (Curve.tangent, oriented along the grid); model/distances.py's tangent (the platform
-    homotopy's chart: a pose's translation and quaternion, the space of model/homotopy/square.py's); and the singular
+    homotopy's chart: a pose's translation and quaternion, the space of model/homotopy/square.py's; declared in
+    model/homotopy/monodromy.py's Closure protocol); and the singular
     locus's tangent (analysis/singularities/loci.py: the null vector of the augmented system [closure;
     A v = 0; |v| = 1], another curve than an input's motion, oriented by continuation.orient)."""
     allowed = {("model/homotopy/square.py", "tangent"), ("model/algebraic.py", "tangent"), ("model/distances.py", "tangent"),
+               ("model/homotopy/monodromy.py", "tangent"),  # the Closure protocol: those charts' tangent, declared
                ("analysis/singularities/loci.py", "tangent"),
                ("analysis/motion/batch_sweep.py", "tangents"), ("analysis/motion/sweep.py", "_start_tangent")}
     words = ("tangent", "jump", "orient", "passes_limit", "on_arc", "brentq")

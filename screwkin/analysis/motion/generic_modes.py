@@ -21,9 +21,9 @@ import pinocchio as pin
 from ...model import newton
 from ...model.cuts import Assembly
 from ...model.distances import chain_angles
-from ...model.homotopy.monodromy import MonodromyOptions
 from ...model.homotopy.parameter import BOUND, Architecture, generic_set, to_query
 from ...model.state import KinematicState
+from ...tolerances import Tolerances
 
 __all__ = ["platform_modes"]
 
@@ -31,16 +31,16 @@ __all__ = ["platform_modes"]
 _MOVED = 1e-6
 
 
-def platform_modes(solver, problem, closure, arch: Architecture, seed: int, options: MonodromyOptions, lift_legs):
+def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol: Tolerances, lift_legs):
     """The modes of a platform (see the module): (modes [(q, Assembly, angle sets, simple)], found, real,
     complex, certificate or None, reason, detail, check) -- analysis.motion.certified makes them a
     Certified.  ``lift_legs(x)``: the configuration with the eliminated legs' angles solved from the
     closure's unknowns x, or None."""
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
-    roots, how, path, reused = generic_set(arch, rng, options)
+    roots, how, path, reused = generic_set(arch, rng, tol)
     t1 = time.perf_counter()
-    query = to_query(arch, roots, options)
+    query = to_query(arch, roots, tol)
     ends, real, distinct, meets, lone = query.ends, query.real, query.distinct, query.meets, query.lone
     X, status = ends.X, ends.status
     closes = query.closes

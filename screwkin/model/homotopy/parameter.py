@@ -26,7 +26,8 @@ from ...files import generic_cache
 from ..distances import SixDistances
 from ..legs import chain_distance
 from ..state import KinematicState
-from .monodromy import Endpoints, MonodromyOptions, Roots, all_roots, to_target
+from ...tolerances import Tolerances
+from .monodromy import Endpoints, Roots, all_roots, to_target
 from .symmetry import SignGroup
 
 if TYPE_CHECKING:
@@ -120,25 +121,25 @@ def platform_group() -> SignGroup:
 
 
 def generic_set(arch: Architecture, rng: np.random.Generator,
-                options: MonodromyOptions) -> tuple[Roots, str | None, Path | None, bool]:
+                tol: Tolerances) -> tuple[Roots, str | None, Path | None, bool]:
     """(Roots at generic c0, how its completeness is known or None, where it is kept or None, reused)."""
     system, group = arch.system, platform_group()
     got = generic_cache.read(arch.key, 7, 6)
     if got is not None:
         c0, X, how, kept = got
         ok = (system.residual(X, c0) <= _CACHED_ROOT * (1 + np.abs(c0).max())) & system.on_variety(X, 1e-8)
-        distinct = all(group.match(X[i][None], X[:i], options.same)[0] < 0 for i in range(len(X)))
+        distinct = all(group.match(X[i][None], X[:i], tol.homotopy_same)[0] < 0 for i in range(len(X)))
         whole = len(X) == BOUND if how.startswith("the published bound") else len(X) <= BOUND
         if ok.all() and distinct and whole:
             roots = Roots(X, c0, True, None, "", 0, 0, 0, 0, 0.0, group)
             return roots, how, kept, True
     x0 = system.random_points(rng, 1)
-    roots = all_roots(system, group, x0, rng, options, trace_test=False, stop_at=BOUND)
+    roots = all_roots(system, group, x0, rng, tol, trace_test=False, stop_at=BOUND)
     how = None
     if len(roots.X) == BOUND:
         how = f"the published bound ({SOURCE})"
     elif len(roots.X) < BOUND:
-        roots = all_roots(system, group, roots.X[:1], rng, replace(options, budget=options.fallback_budget),
+        roots = all_roots(system, group, roots.X[:1], rng, replace(tol, homotopy_budget=tol.homotopy_fallback_budget),
                           seeds=roots.X, trace_test=True, trace_limit=None)
         if roots.complete and len(roots.X) <= BOUND:
             how = f"the trace test (relative singular value {roots.trace:.1g})"
@@ -165,21 +166,21 @@ class QueryEnds:
     lone: int
 
 
-def to_query(arch: Architecture, roots: Roots, options: MonodromyOptions) -> QueryEnds:
+def to_query(arch: Architecture, roots: Roots, tol: Tolerances) -> QueryEnds:
     """The generic set ``roots`` carried to the leg lengths of ``arch`` (its ``r2``) and sorted."""
     target = arch.r2 / arch.L ** 2
-    ends = to_target(arch.system, roots, target, options)
+    ends = to_target(arch.system, roots, target, tol)
     group, system = platform_group(), arch.system
     X, status = ends.X, ends.status
     finite = np.isin(status, ("regular", "singular"))
     safe = np.where(np.isfinite(X), X, 0)
     scale = 1.0 + np.abs(safe).max(axis=1)
-    closes = finite & (system.residual(safe, target) <= options.closes * scale ** 2)
-    real = closes & (np.abs(safe.imag).max(axis=1) <= options.real * scale)
+    closes = finite & (system.residual(safe, target) <= tol.homotopy_closes * scale ** 2)
+    real = closes & (np.abs(safe.imag).max(axis=1) <= tol.homotopy_real * scale)
     distinct: list[int] = []
     meets = np.zeros(len(X), bool)
     for i in np.flatnonzero(closes):
-        j = group.match(X[i][None], X[distinct], options.same)[0] if distinct else -1
+        j = group.match(X[i][None], X[distinct], tol.homotopy_same)[0] if distinct else -1
         if j >= 0:
             meets[i] = meets[distinct[j]] = True
         else:
