@@ -483,6 +483,7 @@ def to_target(system: Family, roots: Roots, target: Array, tol: Tolerances = DEF
     regular = res.ok.copy()
     if regular.any():
         _, J = seg.evaluate(X[regular], np.ones(int(regular.sum())), np.flatnonzero(regular))
+        assert J is not None
         good = np.isfinite(J).reshape(len(J), -1).all(axis=1)
         cond = np.full(len(J), np.inf)
         if good.any():

@@ -77,7 +77,7 @@ class Homotopy(Protocol):
 
     n: int
 
-    def evaluate(self, X: Array, T: Array, index: Array, jacobian: bool = True) -> tuple[Array, Array]: ...
+    def evaluate(self, X: Array, T: Array, index: Array, jacobian: bool = True) -> tuple[Array, Array | None]: ...
 
     def dt(self, X: Array, T: Array, index: Array) -> Array: ...
 
@@ -110,9 +110,9 @@ class Segment:
         self.a = np.asarray(a, complex)
         self.d = np.asarray(b, complex) - self.a
 
-    def evaluate(self, X: Array, T: Array, index: Array, jacobian: bool = True) -> tuple[Array, Array]:
+    def evaluate(self, X: Array, T: Array, index: Array, jacobian: bool = True) -> tuple[Array, Array | None]:
         G, J = self.system.equations(X, jacobian)
-        return G - (self.a[index] + np.asarray(T)[:, None] * self.d[index]), J  # type: ignore[return-value]
+        return G - (self.a[index] + np.asarray(T)[:, None] * self.d[index]), J
 
     def dt(self, X: Array, T: Array, index: Array) -> Array:
         return -self.d[index]
@@ -208,7 +208,7 @@ def newton(hom: Homotopy, X: Array, T: Array, index: Array, iterations: int, ste
     if not P or iterations <= 0:
         return Polished(X, last_step, before, np.ones(P, bool))
 
-    def evaluate(Q: Array, which: Array, jacobian: bool) -> tuple[Array, Array]:
+    def evaluate(Q: Array, which: Array, jacobian: bool) -> tuple[Array, Array | None]:
         return hom.evaluate(Q, T[which], index[which], jacobian)
 
     def trace(which: Array, k: int, Q: Array, r: Array, K: Array, dQ: Array, ok: Array) -> None:
@@ -278,6 +278,7 @@ class Paths:
     def field(self, x: Array, t: Array, idx: Array) -> Array:
         """dx/dt = -H_x^-1 H_t at the points x (parameter t)."""
         _, J = self.hom.evaluate(x, t, idx)
+        assert J is not None
         return -_solve(J, self.hom.dt(x, t, idx)[..., None])[..., 0]
 
     def predict(self, x: Array, t: Array, hh: Array, k1: Array, idx: Array) -> Array:
@@ -294,6 +295,7 @@ class Paths:
         norms, the inverse Jacobian at the prediction)."""
         hom = self.hom
         H, J = hom.evaluate(xp, tn, idx)
+        assert J is not None
         Ji = _inverse(J)
         dx1 = np.einsum("pij,pj->pi", Ji, H)
         x1 = hom.retract(xp, -dx1)
@@ -396,7 +398,7 @@ class _Chord:
     def __init__(self, hom: Homotopy, ta: complex, tb: complex) -> None:
         self.hom, self.n, self.ta, self.dtb = hom, hom.n, ta, tb - ta
 
-    def evaluate(self, X: Array, S: Array, index: Array, jacobian: bool = True) -> tuple[Array, Array]:
+    def evaluate(self, X: Array, S: Array, index: Array, jacobian: bool = True) -> tuple[Array, Array | None]:
         return self.hom.evaluate(X, self.ta + np.asarray(S) * self.dtb, index, jacobian)
 
     def dt(self, X: Array, S: Array, index: Array) -> Array:
