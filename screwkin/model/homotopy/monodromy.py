@@ -205,19 +205,28 @@ class _WithLine:
             last, dx, dl = e, de, np.zeros(len(Y), complex)
         else:
             last, dx, dl = (e - 1.0) * lam, de * lam[:, None], e - 1.0
-        Gout = np.concatenate([G, last[:, None]], 1)
+        P, n = len(Y), self.n
+        Gout = np.empty((P, n), complex)  # (filled in place: no concatenation of temporaries)
+        Gout[:, :-1] = G
+        Gout[:, -1] = last
         if not jacobian:
             return Gout, None
-        dx = np.einsum("pi,pij->pj", dx, self.system.tangent(X))
-        top = np.concatenate([J, np.broadcast_to(-self.v[None, :, None], (len(Y), len(self.v), 1))], 2)
-        bottom = np.concatenate([dx, dl[:, None]], 1)[:, None, :]
-        return Gout, np.concatenate([top, bottom], 1)
+        assert J is not None
+        out = np.empty((P, n, n), complex)
+        out[:, :-1, :-1] = J
+        out[:, :-1, -1] = -self.v
+        out[:, -1, :-1] = np.einsum("pi,pij->pj", dx, self.system.tangent(X))
+        out[:, -1, -1] = dl
+        return Gout, out
 
     def offsets(self, Y: Array) -> Array:
         return self.equations(Y, jacobian=False)[0]
 
     def retract(self, Y: Array, dT: Array) -> Array:
-        return np.c_[self.system.retract(Y[:, :-1], dT[:, :-1]), Y[:, -1] + dT[:, -1]]
+        out = np.empty(Y.shape, complex)
+        out[:, :-1] = self.system.retract(Y[:, :-1], dT[:, :-1])
+        out[:, -1] = Y[:, -1] + dT[:, -1]
+        return out
 
     def on_variety(self, Y: Array) -> Array:
         return self.system.on_variety(Y[:, :-1])
@@ -238,6 +247,10 @@ class _Ell:
 
     def __call__(self, X: Array) -> tuple[Array, Array]:
         value = self.features(X) @ self.alpha
+        if (self.J < 0).all():  # linear: the gradient is alpha on the unknowns it reads, at every point
+            grad = np.zeros((1, self.n), complex)
+            grad[0, self.I] = self.alpha
+            return value, np.broadcast_to(grad, (len(X), self.n))
         grad = np.zeros((len(X), self.n), complex)
         for k, (i, j) in enumerate(zip(self.I, self.J)):
             if j < 0:
