@@ -87,7 +87,11 @@ class SixDistances:
         z = np.einsum("pi,pi->p", d, d)
         r = np.sqrt(z)
         small = np.abs(z) < _SERIES
-        sinc = np.where(small, 1 - z / 6, np.sin(np.where(small, 1.0, r)) / np.where(small, 1.0, r))
+        if small.any():
+            safe = np.where(small, 1.0, r)
+            sinc = np.where(small, 1 - z / 6, np.sin(safe) / safe)
+        else:  # (the same numbers, in fewer operations)
+            sinc = np.sin(r) / r
         e = np.empty((len(X), 4), complex)  # exp(d / 2) as a quaternion, (x, y, z, w)
         e[:, :3] = d * sinc[:, None]
         e[:, 3] = np.cos(r)
