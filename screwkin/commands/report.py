@@ -21,7 +21,7 @@ from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
-from ..analysis.motion.modes import choose_mode
+from ..analysis.position.modes import choose_mode
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton

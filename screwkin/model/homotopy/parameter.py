@@ -11,7 +11,7 @@ the legs' lengths of the inputs -- is one straight segment from c0 to c (``to_qu
 of coefficient-parameter homotopy every isolated pose of the query is the end of one of these paths
 (some paths end at infinity, or at a singular pose).  Here the endpoints are sorted (closing, real,
 distinct up to q -> -q, shared by several paths, complex without their conjugate); carrying the real
-ones back to the file's joints and the certificate are analysis.motion.generic_modes'.
+ones back to the file's joints and the certificate are analysis.position.generic_modes'.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ _CONJUGATE = 1e-6
 
 class PlatformProblem(Protocol):
     """What ``architecture`` reads of the problem the certified search solves
-    (analysis.motion.certified.Problem)."""
+    (analysis.position.certified.Problem)."""
 
     model: Any  # a pinocchio.Model
     frozen: np.ndarray

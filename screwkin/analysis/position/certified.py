@@ -55,7 +55,7 @@ class ModeCount:
 
     found:       modes found, real and complex (distinct placements of the links);
     complete:    every mode is found (certified: ``certificate`` says how);
-    method:      "closed form (dyads)" (a planar mechanism made of dyads: analysis.motion.dyad_modes),
+    method:      "closed form (dyads)" (a planar mechanism made of dyads: analysis.position.dyad_modes),
                  "monodromy" (homotopy continuation) or "random starts" (damped Newton);
     real:        modes with real joint values: the mechanism's assembly modes, reported;
     complex:     modes with complex joint values (no real assembly), None when not known;
@@ -354,7 +354,7 @@ class Search:
 
 
 def closed_form(solver, values: dict):
-    """The modes of a planar mechanism made of dyads (analysis.motion.dyad_modes) as a Certified, or
+    """The modes of a planar mechanism made of dyads (analysis.position.dyad_modes) as a Certified, or
     why the closed form does not apply (a string)."""
     got = dyad_modes(solver, values)
     if isinstance(got, str):

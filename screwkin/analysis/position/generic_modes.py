@@ -33,7 +33,7 @@ _MOVED = 1e-6
 
 def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol: Tolerances, lift_legs):
     """The modes of a platform (see the module): (modes [(q, Assembly, angle sets, simple)], found, real,
-    complex, certificate or None, reason, detail, check) -- analysis.motion.certified makes them a
+    complex, certificate or None, reason, detail, check) -- analysis.position.certified makes them a
     Certified.  ``lift_legs(x)``: the configuration with the eliminated legs' angles solved from the
     closure's unknowns x, or None."""
     t0 = time.perf_counter()
