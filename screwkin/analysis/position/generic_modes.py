@@ -60,7 +60,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol:
     failed = int(np.sum(status == "failed"))
     singular = int(np.sum(closes & (status == "singular")))
     check = {"method": "coefficient-parameter homotopy", "generic_set": len(roots.X),
-             "generic_set_certified_by": how, "paths": int(len(roots.X)), "failed_paths": failed,
+             "generic_set_certified_by": how, "paths": len(roots.X), "failed_paths": failed,
              "at_infinity": int(np.sum(status == "infinity")), "singular_endpoints": singular,
              "paths_meeting": int(meets.sum()), "bound": BOUND, "distinct_poses": len(distinct),
              "real_not_polished": lost, "complex_without_conjugate": int(lone),
@@ -84,7 +84,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol:
         certificate = (f"{len(distinct)} poses, a parameter homotopy from this architecture's generic solution set "
                        f"({len(roots.X)} poses, complete by {how}): {len(roots.X)} paths, none failed, "
                        f"{len(distinct)} distinct simple poses, at most {BOUND}")
-    detail = {"roots": int(len(roots.X)), "paths": int(roots.paths + ends.paths), "failed": int(roots.failed + failed),
+    detail = {"roots": len(roots.X), "paths": int(roots.paths + ends.paths), "failed": int(roots.failed + failed),
               "at_infinity": check["at_infinity"], "generic_set": str(path) if path else None,
               "generic_set_reused": reused, "generic_seconds": round(t1 - t0, 3),
               "seconds": round(time.perf_counter() - t0, 3), "lost_polishing": lost}

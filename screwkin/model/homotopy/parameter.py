@@ -23,10 +23,10 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 from ...files import generic_cache
+from ...tolerances import Tolerances
 from ..distances import SixDistances
 from ..legs import chain_distance
 from ..state import KinematicState
-from ...tolerances import Tolerances
 from .monodromy import Endpoints, Roots, all_roots, to_target
 from .symmetry import SignGroup
 

@@ -33,8 +33,9 @@ number), and averages the samples (the trapezoid rule of Cauchy's integral formu
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, NamedTuple, Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
