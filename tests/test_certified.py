@@ -14,9 +14,9 @@ from screwkin.analysis.position import certified
 from screwkin.analysis.position.ik import inverse_kinematics
 from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
-from screwkin.model import tracking
+from screwkin.model.homotopy import tracking
 from screwkin.model.kernel.algebraic import PolynomialClosure
-from screwkin.model.symmetry import find_symmetries
+from screwkin.model.homotopy.symmetry import find_symmetries
 
 FILES = ["fourbar_crank_rocker", "slider_crank_offset", "planar_3rpr", "bennett", "tsai_3upu", "sarrus",
          "gough_stewart_6ups", "rssr", "delta_parallelogram", "spherical_fourbar"]

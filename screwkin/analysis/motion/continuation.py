@@ -22,7 +22,7 @@ with it, and ``Neighbour`` takes a map's steps with it), ``BatchedCurve`` (analy
 a chunk of grid values at once), ``ClosedFormCurve`` (analysis.motion.dyads: every value at once, its
 limit positions located by ``locate``, its return to the start by ``returned``), the workspace's grid
 growth (analysis.design.workspace_grid: the jump test, and ``keeps_orientation``, the branch rule in
-several parameters), and the certified mode search's homotopy paths (model.tracking.Paths: predict,
+several parameters), and the certified mode search's homotopy paths (model.homotopy.tracking.Paths: predict,
 correct, accept -- in complex space there is no branch to choose nor limit to locate; the layers keep
 that engine below this module, which it matches by its methods).  analysis.motion.sweep chooses among
 the first three.
@@ -80,7 +80,7 @@ class Engine(Protocol):
     velocity index; ``BatchedCurve`` (analysis.motion.batch_sweep) for a stack, one configuration per
     row (sigma (N,), the corrections (N, nq) with a flag per row).  ``ClosedFormCurve``
     (analysis.motion.dyads: input values instead of steps, a sign per dyad for the branch) and the
-    homotopy's ``Paths`` (model.tracking: complex paths) answer the same questions with signatures of
+    homotopy's ``Paths`` (model.homotopy.tracking: complex paths) answer the same questions with signatures of
     their own: they are not Engines."""
 
     def predict(self, q: np.ndarray, t: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:

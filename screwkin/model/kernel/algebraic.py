@@ -7,7 +7,7 @@ Unknowns x (dimensionless), per passive joint of the spanning tree:
 - prismatic: u = (value) / L (L: the characteristic length);
 - ball (Pinocchio's spherical joint): its quaternion q = (x, y, z, w) on q.q = 1; its rotation, the
   homogeneous quadratic form Q(q), is quadratic, so q and -q are one placement (a symmetry,
-  model.symmetry);
+  model.homotopy.symmetry);
 - free flyer: three translations / L and a quaternion.
 Input joints are constants (``set_inputs``).  Translations are divided by L, so every row is
 dimensionless.

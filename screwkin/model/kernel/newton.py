@@ -181,12 +181,15 @@ def iterate(evaluate: Callable[..., tuple[np.ndarray, Any]], Q0: np.ndarray, fre
     accepted) called after the k-th step with the configurations it started from (the loop's own
     arrays: a trace copies what it keeps); verdict: ``judge`` (or its compiled form).
 
+    Q0 may be complex (the homotopy's Newton, model.homotopy.tracking.newton: its step undamped and its
+    verdict accepting every finite step): the stack and its steps stay complex, the norms are moduli.
+
     Each configuration has its own damping and its own end (see the module).  When every
     configuration still iterating is about to converge quadratically (residual below
     0.1 sqrt(closure): the next one near its square) the residual alone is computed first, and the
     residual and Jacobian again, for the active stack, only when some step there is accepted without
     converging."""
-    Q = np.array(Q0, float)
+    Q = np.array(Q0, complex if np.iscomplexobj(Q0) else float)  # complex: the homotopy's (model.homotopy)
     N = len(Q)
     every = np.arange(N)
     r, K = evaluate(Q, every, True)
@@ -208,7 +211,7 @@ def iterate(evaluate: Callable[..., tuple[np.ndarray, Any]], Q0: np.ndarray, fre
         else:
             idx = active.nonzero()[0]
             Qa, ra, Ka, na, mua, nua = Q[idx], r[idx], K[idx], norm[idx], mu[idx], nu[idx]
-        dQ = np.zeros((n, nv))
+        dQ = np.zeros((n, nv), Q.dtype)
         dQ[:, free], lin2 = step(Ka, ra, free, mua)
         Qn = integrate(Qa, dQ)
         final = np.maximum.reduce(na) < near
@@ -243,7 +246,9 @@ def iterate(evaluate: Callable[..., tuple[np.ndarray, Any]], Q0: np.ndarray, fre
 
 
 def _norms(r: np.ndarray) -> np.ndarray:
-    """The residual norm of each row of a stack."""
+    """The residual norm of each row of a stack (real or complex)."""
+    if np.iscomplexobj(r):
+        return np.sqrt(np.add.reduce(r.real * r.real + r.imag * r.imag, axis=1))
     return np.sqrt(np.add.reduce(r * r, axis=1))
 
 
