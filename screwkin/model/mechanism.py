@@ -110,7 +110,7 @@ class Mechanism:
         self._assembly = None
         self._limits = None
         self._generic = None
-        self._generic_cache = {}  # (hint, seed) -> generic_configurations' result
+        self._generic_cache = {}  # (hint, seed, starts) -> generic_configurations' result
         self._length = None
         self._layout = None
         self.cache = {}  # results analyses derive from this mechanism (cleared when actuation or length change)
@@ -458,10 +458,12 @@ class Mechanism:
         tol = self.tolerances
         hint = self.neutral() if q0 is None else np.array(q0, float)
         given = "the file's configuration" if q0 is None else "the given configuration"
-        rng = np.random.default_rng(seed)
+        rng = None  # (numpy.random made when a start needs it: its first import takes 10 ms)
         total = max(int(tol.assembly_starts), 1) if self.closure.nrows else 1
         best, best_it = np.inf, 0
         for k in range(total):
+            if k and rng is None:
+                rng = np.random.default_rng(seed)
             if k == 0:
                 q, what = hint, given
             elif k <= tol.perturbations:
@@ -511,7 +513,7 @@ class Mechanism:
         """Whether generic_configurations() has been computed (with any hint or seed)."""
         return self._generic is not None
 
-    def generic_configurations(self, hint=None, seed: int = 0) -> tuple:
+    def generic_configurations(self, hint=None, seed: int = 0, starts: int | None = None) -> tuple:
         """(assembly, configurations): assembled configurations where generic ranks are taken.
 
         The first configuration the assembly search closes (:meth:`assemble`, from ``hint``
@@ -521,8 +523,11 @@ class Mechanism:
         ``sample_step`` along the motion the loops allow, closed again) and at the
         configurations that ``tolerances.generic_starts`` further random starts close; the
         configurations of the largest rank are returned, the one nearest the first assembly
-        first (``assembly`` is that first one, with where it came from).  Cached."""
-        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed))
+        first (``assembly`` is that first one, with where it came from).  ``starts``: how many
+        further random starts (default ``tolerances.generic_starts``; 0 where a closed form has
+        every branch already, analysis.motion.closed_ik).  Cached."""
+        starts = self.tolerances.generic_starts if starts is None else int(starts)
+        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed), starts)
         if key in self._generic_cache:  # keyed on its arguments: another hint or seed is another search
             return self._generic_cache[key][:2]
         a = self.assemble() if hint is None else self.assemble(hint)
@@ -540,7 +545,7 @@ class Mechanism:
                     configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
                 except AssemblyError:
                     continue
-            for _ in range(tol.generic_starts if closure.nrows else 0):  # (for the branches of loops)
+            for _ in range(starts if closure.nrows else 0):  # (for the branches of loops)
                 try:
                     configs.append(closure.solve(self.random_configuration(rng)).q)
                 except AssemblyError:

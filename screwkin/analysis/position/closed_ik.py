@@ -108,7 +108,9 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
                 set_leg(model, q2, poses[i], best_set(mech, ref, poses[i]))
         if _residual(mech, q2, out_frame, pose) <= tol.closure * 100 + tol.closed_form:
             qs.append(q2)
-    solver.generic(hint=q)  # the reference configuration's search starts from the physical solution
+    # the reference configuration's search starts from the physical solution, and no random starts: every
+    # branch of the legs is in the closed form, and away from singularities each has the same generic ranks
+    solver.generic(hint=q, starts=0)
     sols = [_solution(solver, qq, out_frame, _residual(mech, qq, out_frame, pose)) for qq in qs]
     ref_sig = solver.signature(ref)
     if combos <= LISTED:  # all of them: nearest the reference first (each leg's other branch: in leg order)
