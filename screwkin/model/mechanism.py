@@ -569,8 +569,14 @@ class Mechanism:
 
     def topology(self, q=None):
         """The :class:`~screwkin.model.topology.Topology` (links, joints, compound joints, loops)
-        at q (default: a generic assembled configuration)."""
-        return build_topology(self, self.generic_configurations()[1][0] if q is None else q)
+        at q (default: a generic assembled configuration).  The last one is kept: a solver's labels and
+        link angles both read it at the reference configuration."""
+        q = np.asarray(self.generic_configurations()[1][0] if q is None else q, float)
+        key = q.tobytes()
+        last = self.cache.get("topology")
+        if last is None or last[0] != key:
+            last = self.cache["topology"] = (key, build_topology(self, q))
+        return last[1]
 
     def __repr__(self):
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "

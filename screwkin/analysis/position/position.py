@@ -464,22 +464,26 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None) -> Solution:
+    def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None,
+                 spelled: bool = False) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here
-        when its measure is below the singular tolerance, modes.simple_root)."""
+        when its measure is below the singular tolerance, modes.simple_root); ``spelled``: q is already
+        in the angle set within the limits where one exists (a closed form chose each leg's with
+        model.leg_chains.best_set), not looked for again."""
         mech, tol = self.mech, self.mech.tolerances
-        q = spelled_within_limits(mech, q)  # the pose's angle set within the limits, where one exists
+        if not spelled:
+            q = spelled_within_limits(mech, q)  # the pose's angle set within the limits, where one exists
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
         if sigma < tol.singular and simple is None:
             simple = modes.simple_root(self, q)
         singular = sigma < tol.singular and not simple  # an ill-conditioned simple root is determined
-        K = mech.closure.jacobian(q)
         pose = twist = acc = qd = qdd = None
         rate_d = acc_d = None
         if rates is not None:
+            K = mech.closure.jacobian(q)
             solve, _ = self.passive_solver(K)
             qd = self.rates(q, K, rates, solve)
             rate_d = self._named(qd)
