@@ -9,6 +9,7 @@ mobility, and later position, velocity and singularity analysis) work on it.
 from __future__ import annotations
 
 import copy
+import random
 import threading
 
 from dataclasses import dataclass
@@ -47,6 +48,12 @@ class Coordinate:
 #: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data, and every
 #: KinematicState of them: model.state).
 SHARED_DATA_NV = 120
+
+
+def _std_normal(seed: int):
+    """size -> that many standard normal deviates, from the standard library's generator seeded with ``seed``."""
+    r = random.Random(seed)
+    return lambda size: np.array([r.gauss(0.0, 1.0) for _ in range(size)])
 
 
 class Mechanism:
@@ -525,21 +532,21 @@ class Mechanism:
         configurations of the largest rank are returned, the one nearest the first assembly
         first (``assembly`` is that first one, with where it came from).  ``starts``: how many
         further random starts (default ``tolerances.generic_starts``; 0 where a closed form has
-        every branch already, analysis.motion.closed_ik).  Cached."""
+        every branch already, analysis.motion.closed_ik: then the samples' steps are drawn from the
+        standard library's generator, numpy.random's first import taking 10 ms).  Cached."""
         starts = self.tolerances.generic_starts if starts is None else int(starts)
         key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed), starts)
         if key in self._generic_cache:  # keyed on its arguments: another hint or seed is another search
             return self._generic_cache[key][:2]
         a = self.assemble() if hint is None else self.assemble(hint)
         tol, closure = self.tolerances, self.closure
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(seed) if starts else None
+        normal = rng.normal if starts else _std_normal(seed)
         configs = [a.q]
         if self.nv:  # a serial chain too: its file configuration may be singular for an output
-            for _ in range(tol.samples):
-                V = null_space(closure.jacobian(a.q), tol, self.nv)
-                if V.shape[1] == 0:
-                    break
-                step = V @ rng.normal(size=V.shape[1])
+            V = null_space(closure.jacobian(a.q), tol, self.nv)  # the motion the loops allow at the first one
+            for _ in range(tol.samples if V.shape[1] else 0):
+                step = V @ normal(size=V.shape[1])
                 step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
                 try:
                     configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
