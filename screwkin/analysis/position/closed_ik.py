@@ -158,6 +158,7 @@ def _arm(solver, output, out_frame, arm, pose, start):
         raise AssemblyError(mech.path, np.inf, 0, starts=0,
                             message=f"the pose of '{output}' at ({xyz}) is unreachable: all {BOUND} joint solutions "
                                     "of the closed form (Pieper: the last three axes meet) are complex; no search")
+    solver.generic(starts=0)  # an arm has no loops: no random starts for their branches
     sols = [_solution(solver, q, out_frame, _residual(mech, q, out_frame, pose)) for q in qs]
     sols = [replace(s, continuum=True, singular=True) if st else s for s, st in zip(sols, stretched)]
     ref_sig = solver.signature(mech.neutral())
