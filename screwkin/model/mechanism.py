@@ -579,11 +579,10 @@ class Mechanism:
         at q (default: a generic assembled configuration).  The last one is kept: a solver's labels and
         link angles both read it at the reference configuration."""
         q = np.asarray(self.generic_configurations()[1][0] if q is None else q, float)
-        key = q.tobytes()
-        last = self.cache.get("topology")
-        if last is None or last[0] != key:
-            last = self.cache["topology"] = (key, build_topology(self, q))
-        return last[1]
+        key, last = q.tobytes(), self.cache.get("topology")
+        if last is None or last[0] != key or last[1] is not self.tolerances:
+            last = self.cache["topology"] = (key, self.tolerances, build_topology(self, q))
+        return last[2]
 
     def __repr__(self):
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "
