@@ -418,7 +418,7 @@ def test_closed_form_singularity_measures_are_those_of_the_full_generic_search()
     """The closed form takes the generic ranks at the physical solution and samples near it, without the
     random starts (its branches are all in the closed form): every solution's measures are those
     singular.measures gives with the ranks of the mechanism's own full search (random starts included)."""
-    from screwkin.analysis.singularities.singular import Generic, measures
+    from screwkin.analysis.singular import Generic, measures
 
     for name, link, pose in _ik_cases():
         mech = screwkin.load(ROBOTS / name)
