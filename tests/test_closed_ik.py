@@ -8,6 +8,10 @@ kinematics of every arm solution; the PUMA's published count of 8 (Pieper 1968; 
 Robotics, 4.7) on the PUMA 560's published Denavit-Hartenberg parameters.
 """
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -389,3 +393,65 @@ def test_random_platforms_in_closed_form(tmp_path):
             for i in range(6):
                 home = np.linalg.norm(C_HOME + R_HOME @ plat[i] - base[i])
                 assert abs(first.joints[f"leg{i + 1}"] - (np.linalg.norm(c + R @ plat[i] - base[i]) - home)) < 1e-12
+
+
+# ------------------------------------------------------------------ its speed: nothing computed it does not need
+
+def _ik_cases():
+    """(mechanism file, output link, a pose of it off the drawn one): the bundled platforms and the 6R arm."""
+    moved = [("gough_stewart_6ups.urdf", "platform", [0.01, -0.02, 0.015], [0.03, 0.05, -0.04]),
+             ("planar_3rpr.urdf", "platform", [0.01, -0.02, 0.0], [0.0, 0.0, 0.1]),
+             ("tsai_3upu.urdf", "platform", [0.01, -0.02, 0.03], [0.0, 0.0, 0.0])]
+    for name, link, dx, rpy in moved:
+        mech = screwkin.load(ROBOTS / name)
+        data = mech.model.createData()
+        pin.framesForwardKinematics(mech.model, data, mech.neutral())
+        home = data.oMf[mech.link_frame(link)]
+        yield name, link, pin.SE3(pin.rpy.rpyToMatrix(np.array(rpy)) @ home.rotation, home.translation + dx)
+    mech = screwkin.load(ROBOTS / "arm_6r.urdf")
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, np.array([0.3, -0.6, 0.4, 0.5, 0.7, -0.2]))
+    yield "arm_6r.urdf", "flange", pin.SE3(data.oMf[mech.link_frame("flange")])
+
+
+def test_closed_form_singularity_measures_are_those_of_the_full_generic_search():
+    """The closed form takes the generic ranks at the physical solution and samples near it, without the
+    random starts (its branches are all in the closed form): every solution's measures are those
+    singular.measures gives with the ranks of the mechanism's own full search (random starts included)."""
+    from screwkin.analysis.singular import Generic, measures
+
+    for name, link, pose in _ik_cases():
+        mech = screwkin.load(ROBOTS / name)
+        res = inverse_kinematics(mech, link, pose)
+        assert res.modes.method.startswith("closed form")
+        other = screwkin.load(ROBOTS / name)
+        full = Generic(other, list(other.actuated), link, configurations=other.generic_configurations()[1])
+        for s in res.solutions:
+            m = measures(other, s.q, full)
+            assert set(m) == set(s.sigmas), name
+            for key, v in m.items():
+                assert abs(v - s.sigmas[key]) < 1e-12, (name, key)
+
+
+def test_closed_form_ik_imports_no_more_of_numpy():
+    """numpy.random, numpy.ma (numpy.unique's first call) and numpy.fft take 2 to 20 ms each to import: more
+    than the closed form itself.  The command's answer (its text and JSON) needs none of them."""
+    code = ("import sys, io, contextlib\nfrom screwkin import cli\nnew = set()\n"
+            "for argv in %r:\n"
+            "    args = cli._parser(argv).parse_args(argv)\n"
+            "    mech = cli.load(args.file)\n"
+            "    before = set(sys.modules)\n"
+            "    with contextlib.redirect_stdout(io.StringIO()):\n"
+            "        cli.command_module('ik').run(mech, args)\n"
+            "    new |= set(sys.modules) - before\n"
+            "print(sorted(m for m in new if m.startswith('numpy')))")
+    runs = []
+    for name, link, pose in _ik_cases():
+        xyz, rpy = pose.translation, pin.rpy.matrixToRpy(pose.rotation)
+        text = " ".join(f"{v:.15g}" for v in [*xyz, *rpy])
+        runs += [["ik", str(ROBOTS / name), "--output", link, "--pose", text],
+                 ["ik", str(ROBOTS / name), "--output", link, "--pose", text, "--json"]]
+    root = ROBOTS.parent
+    out = subprocess.run([sys.executable, "-c", code % (runs,)], capture_output=True, text=True, cwd=root,
+                         env={**os.environ, "PYTHONPATH": str(root)}, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]"

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..model.linalg import null_space, rank
+from ..model.linalg import complement, null_space, rank
 from ..model.cuts import in_plane, pair_contact
 from ..model.geometry import plane_basis
 from ..model.kernel.scaling import dimensionless, dimensionless_twists
@@ -127,7 +127,7 @@ class Generic:
         self.inputs = list(inputs)
         self.output, self.point = output, point
         self.a = mech.velocity_indices(self.inputs)
-        self.p = np.setdiff1d(np.arange(mech.nv), self.a)
+        self.p = complement(mech.nv, self.a)
         self.rank_K = self.rank_Kp = 0
         self.out_dim = 0 if output is not None else None
         self.out_rotations = 0 if output is not None else None

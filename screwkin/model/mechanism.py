@@ -9,6 +9,7 @@ mobility, and later position, velocity and singularity analysis) work on it.
 from __future__ import annotations
 
 import copy
+import random
 import threading
 
 from dataclasses import dataclass
@@ -48,6 +49,12 @@ class Coordinate:
 #: Models with more velocity coordinates than this share one pinocchio.Data (Mechanism.scratch_data, and every
 #: KinematicState of them: model.state).
 SHARED_DATA_NV = 120
+
+
+def _std_normal(seed: int):
+    """size -> that many standard normal deviates, from the standard library's generator seeded with ``seed``."""
+    r = random.Random(seed)
+    return lambda size: np.array([r.gauss(0.0, 1.0) for _ in range(size)])
 
 
 class Mechanism:
@@ -111,7 +118,7 @@ class Mechanism:
         self._assembly = None
         self._limits = None
         self._generic = None
-        self._generic_cache = {}  # (hint, seed) -> generic_configurations' result
+        self._generic_cache = {}  # (hint, seed, starts) -> generic_configurations' result
         self._length = None
         self._layout = None
         self.cache = {}  # results analyses derive from this mechanism (cleared when actuation or length change)
@@ -449,10 +456,12 @@ class Mechanism:
         tol = self.tolerances
         hint = self.neutral() if q0 is None else np.array(q0, float)
         given = "the file's configuration" if q0 is None else "the given configuration"
-        rng = np.random.default_rng(seed)
+        rng = None  # (numpy.random made when a start needs it: its first import takes 10 ms)
         total = max(int(tol.assembly_starts), 1) if self.closure.nrows else 1
         best, best_it = np.inf, 0
         for k in range(total):
+            if k and rng is None:
+                rng = np.random.default_rng(seed)
             if k == 0:
                 q, what = hint, given
             elif k <= tol.perturbations:
@@ -502,7 +511,7 @@ class Mechanism:
         """Whether generic_configurations() has been computed (with any hint or seed)."""
         return self._generic is not None
 
-    def generic_configurations(self, hint=None, seed: int = 0) -> tuple:
+    def generic_configurations(self, hint=None, seed: int = 0, starts: int | None = None) -> tuple:
         """(assembly, configurations): assembled configurations where generic ranks are taken.
 
         The first configuration the assembly search closes (:meth:`assemble`, from ``hint``
@@ -512,26 +521,29 @@ class Mechanism:
         ``sample_step`` along the motion the loops allow, closed again) and at the
         configurations that ``tolerances.generic_starts`` further random starts close; the
         configurations of the largest rank are returned, the one nearest the first assembly
-        first (``assembly`` is that first one, with where it came from).  Cached."""
-        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed))
+        first (``assembly`` is that first one, with where it came from).  ``starts``: how many
+        further random starts (default ``tolerances.generic_starts``; 0 where a closed form has
+        every branch already, analysis.motion.closed_ik: then the samples' steps are drawn from the
+        standard library's generator, numpy.random's first import taking 10 ms).  Cached."""
+        starts = self.tolerances.generic_starts if starts is None else int(starts)
+        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed), starts)
         if key in self._generic_cache:  # keyed on its arguments: another hint or seed is another search
             return self._generic_cache[key][:2]
         a = self.assemble() if hint is None else self.assemble(hint)
         tol, closure = self.tolerances, self.closure
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(seed) if starts else None
+        normal = rng.normal if starts else _std_normal(seed)
         configs = [a.q]
         if self.nv:  # a serial chain too: its file configuration may be singular for an output
-            for _ in range(tol.samples):
-                V = null_space(closure.jacobian(a.q), tol, self.nv)
-                if V.shape[1] == 0:
-                    break
-                step = V @ rng.normal(size=V.shape[1])
+            V = null_space(closure.jacobian(a.q), tol, self.nv)  # the motion the loops allow at the first one
+            for _ in range(tol.samples if V.shape[1] else 0):
+                step = V @ normal(size=V.shape[1])
                 step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
                 try:
                     configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
                 except AssemblyError:
                     continue
-            for _ in range(tol.generic_starts if closure.nrows else 0):  # (for the branches of loops)
+            for _ in range(starts if closure.nrows else 0):  # (for the branches of loops)
                 try:
                     configs.append(closure.solve(self.random_configuration(rng)).q)
                 except AssemblyError:
@@ -555,8 +567,13 @@ class Mechanism:
 
     def topology(self, q=None):
         """The :class:`~screwkin.model.topology.Topology` (links, joints, compound joints, loops)
-        at q (default: a generic assembled configuration)."""
-        return build_topology(self, self.generic_configurations()[1][0] if q is None else q)
+        at q (default: a generic assembled configuration).  The last one is kept: a solver's labels and
+        link angles both read it at the reference configuration."""
+        q = np.asarray(self.generic_configurations()[1][0] if q is None else q, float)
+        key, last = q.tobytes(), self.cache.get("topology")
+        if last is None or last[0] != key or last[1] is not self.tolerances:
+            last = self.cache["topology"] = (key, self.tolerances, build_topology(self, q))
+        return last[2]
 
     def __repr__(self):
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "

@@ -57,9 +57,11 @@ def _result(solver, output, pose, sols, count):
                           modes=count)
 
 
-def _solution(solver, q, out_frame, residual):
+def _solution(solver, q, out_frame, residual, spelled=False):
     mech = solver.mech
-    sol = solver.solution(q, Assembly(q, residual, 0), simple=True)
+    sol = solver.solution(q, Assembly(q, residual, 0), simple=True, spelled=spelled)
+    if solver.output_frame == out_frame and sol.output_pose is not None:  # read there already
+        return replace(sol, simple=True)
     return replace(sol, output_pose=KinematicState(mech, sol.q).frame_pose(out_frame), simple=True)
 
 
@@ -100,16 +102,20 @@ def _platform(solver, output, out_frame, platform, P, pose, start):
     else:  # each leg's other branches beside the physical solution
         picks = [tuple(i if m == k else 0 for m in range(len(legs))) for k, p in enumerate(legs)
                  for i in range(1, len(p))]
-    qs = [q]
+    qs = [(q, res)]
     for pick in picks:
         q2 = np.array(q)
         for i, poses in zip(pick, legs):
             if i:
                 set_leg(model, q2, poses[i], best_set(mech, ref, poses[i]))
-        if _residual(mech, q2, out_frame, pose) <= tol.closure * 100 + tol.closed_form:
-            qs.append(q2)
-    solver.generic(hint=q)  # the reference configuration's search starts from the physical solution
-    sols = [_solution(solver, qq, out_frame, _residual(mech, qq, out_frame, pose)) for qq in qs]
+        r2 = _residual(mech, q2, out_frame, pose)
+        if r2 <= tol.closure * 100 + tol.closed_form:
+            qs.append((q2, r2))
+    # the reference configuration's search starts from the physical solution, and no random starts: every
+    # branch of the legs is in the closed form, and away from singularities each has the same generic ranks
+    solver.generic(hint=q, starts=0)
+    # each leg in its angle set with the fewest joints outside the limits (best_set): spelled already
+    sols = [_solution(solver, qq, out_frame, r, spelled=True) for qq, r in qs]
     ref_sig = solver.signature(ref)
     if combos <= LISTED:  # all of them: nearest the reference first (each leg's other branch: in leg order)
         sols[1:] = sorted(sols[1:], key=lambda s: (not s.physical,
@@ -152,6 +158,7 @@ def _arm(solver, output, out_frame, arm, pose, start):
         raise AssemblyError(mech.path, np.inf, 0, starts=0,
                             message=f"the pose of '{output}' at ({xyz}) is unreachable: all {BOUND} joint solutions "
                                     "of the closed form (Pieper: the last three axes meet) are complex; no search")
+    solver.generic(starts=0)  # an arm has no loops: no random starts for their branches
     sols = [_solution(solver, q, out_frame, _residual(mech, q, out_frame, pose)) for q in qs]
     sols = [replace(s, continuum=True, singular=True) if st else s for s, st in zip(sols, stretched)]
     ref_sig = solver.signature(mech.neutral())

@@ -191,7 +191,8 @@ def _trig_roots(F, degree: int, tol: Tolerances):
     Newton) and how many roots are complex."""
     n = 8
     ts = 2 * np.pi * np.arange(n) / n
-    f = np.fft.fft([F(t) for t in ts]) / n
+    k = np.arange(n)  # the discrete Fourier transform of 8 samples (numpy.fft's first import: 2 ms)
+    f = np.exp(-2j * np.pi * np.outer(k, k) / n) @ np.array([F(t) for t in ts], complex) / n
     coeffs = np.array([f[k % n] for k in range(-degree, degree + 1)])  # coefficient of e^{ikt}, k = -d..d
     big = np.abs(coeffs).max()
     if big == 0:

@@ -34,6 +34,7 @@ from ...errors import AssemblyError, UsageError
 from ...model.kernel import newton
 from ...model.cuts import Assembly
 from ...model.geometry import wrap_angle
+from ...model.linalg import complement
 from ...model.manifold import set_continuous_angle
 from ...model.state import KinematicState, angular_loop_joints, frame_parent
 from ...model.limits import outside_limits, spelled_within_limits
@@ -85,7 +86,7 @@ class PositionSolver:
         self._kept_q = np.concatenate([np.arange(c.idx_q, c.idx_q + c.nq) for c in loose if c.nv > 1]).astype(int) \
             if self.kept else np.zeros(0, int)
         self.frozen = mech.velocity_indices(names)
-        self.passive = np.setdiff1d(np.arange(mech.nv), self.frozen)
+        self.passive = complement(mech.nv, self.frozen)
         self.output = output
         self.output_frame = mech.link_frame(output) if output else None
         # (joint, placement in it) of the output frame: a tool or named point is no frame of the model
@@ -104,13 +105,16 @@ class PositionSolver:
         return self.mech.closure.accelerated
 
     # --------------------------------------------------------------- generic data
-    def generic(self, hint=None) -> Generic:
+    def generic(self, hint=None, starts: int | None = None) -> Generic:
         """Generic ranks for these inputs and output (screwkin.analysis.singular.Generic) over the
         mechanism's generic configurations; ``hint``: an assembled configuration to start
-        from when the mechanism's own assembly search has not been made."""
+        from when the mechanism's own assembly search has not been made (``starts``: its random
+        starts, Mechanism.generic_configurations)."""
         if self._generic is None:
             # the hint only starts a search not made yet (the mechanism's own result is reused when it exists)
-            configs = self.mech.generic_configurations(hint=None if self.mech.generic_known else hint)[1]
+            known = self.mech.generic_known
+            configs = self.mech.generic_configurations(hint=None if known else hint,
+                                                       starts=None if known else starts)[1]
             self._generic = Generic(self.mech, self.inputs, self.output, configurations=configs)
         return self._generic
 
@@ -460,22 +464,26 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None) -> Solution:
+    def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None,
+                 spelled: bool = False) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
         the joint-angle sets that reach it; ``simple``: whether it is a simple root (None: tested here
-        when its measure is below the singular tolerance, modes.simple_root)."""
+        when its measure is below the singular tolerance, modes.simple_root); ``spelled``: q is already
+        in the angle set within the limits where one exists (a closed form chose each leg's with
+        model.leg_chains.best_set), not looked for again."""
         mech, tol = self.mech, self.mech.tolerances
-        q = spelled_within_limits(mech, q)  # the pose's angle set within the limits, where one exists
+        if not spelled:
+            q = spelled_within_limits(mech, q)  # the pose's angle set within the limits, where one exists
         m = measures(mech, q, self.generic())
         sigma = min(m["actuator"], m["constraint"]) if self.generic().rank_K or self.generic().rank_Kp else 1.0
         if sigma < tol.singular and simple is None:
             simple = modes.simple_root(self, q)
         singular = sigma < tol.singular and not simple  # an ill-conditioned simple root is determined
-        K = mech.closure.jacobian(q)
         pose = twist = acc = qd = qdd = None
         rate_d = acc_d = None
         if rates is not None:
+            K = mech.closure.jacobian(q)
             solve, _ = self.passive_solver(K)
             qd = self.rates(q, K, rates, solve)
             rate_d = self._named(qd)

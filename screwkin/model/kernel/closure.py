@@ -32,6 +32,7 @@ from .wrenches import row_wrenches
 from ..manifold import Integrator
 from ..cuts import Assembly, CouplingRow
 from ..geometry import cross3, perpendicular_basis, skew, skews, skews_batch
+from ..linalg import complement
 from .._pin import frame_jacobian
 
 __all__ = ["ClosureSystem", "PinocchioKernel", "CompiledKernel"]
@@ -482,7 +483,7 @@ class ClosureSystem:
         key = frozen.tobytes()
         free = self._free.get(key)
         if free is None:
-            free = self._free[key] = np.setdiff1d(np.arange(self.model.nv), frozen)
+            free = self._free[key] = complement(self.model.nv, frozen)
         return free
 
     @property

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .scaling import dimensionless
+from ..linalg import complement
 
 __all__ = ["ClosureKernel", "NotProvided", "Step", "Verdict"]
 
@@ -78,7 +79,7 @@ class ClosureKernel(abc.ABC):
 
     def free_columns(self, frozen: Any) -> Array:
         """The velocity indices (k,) not in ``frozen`` (a sequence of indices): the columns a solve moves."""
-        return np.setdiff1d(np.arange(self.nv), np.asarray(frozen, int).ravel())
+        return complement(self.nv, frozen)
 
     def dimensionless(self, K: Array, length: float) -> Array:
         """K (..., m, nv) of ``evaluate`` made dimensionless with the characteristic length [m]

@@ -20,6 +20,7 @@ from .closure import ClosureSystem
 from .contract import ClosureKernel, NotProvided
 from .scaling import sliding_columns
 from ..cuts import CouplingRow, CutJoint
+from ..linalg import complement
 from ..state import frame_parent, model_with_output
 
 Array = NDArray[Any]
@@ -485,7 +486,7 @@ class BatchClosure(ClosureKernel):
         def evaluate(Q_: np.ndarray, which: Any, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
             return self.evaluate(Q_, jacobian, None if targets is None else (targets[0][which], targets[1]))
 
-        free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
+        free = complement(nv, frozen)
         out = newton.iterate(evaluate, Q, free, tol, self.integrate, newton.stacked_steps, iterations)
         converged = out.converged.copy()
         if converged.any():
