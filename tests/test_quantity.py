@@ -1,7 +1,9 @@
 """A typed value travels as one units.Quantity from parsing to the table (issue 37 item 4): parsed once,
 with its SI value, its kind and the unit typed; shown back in that unit by one rule (units.shown_unit)
 and one conversion (units.in_unit).  The references are the units' definitions (1 deg = pi/180 rad,
-1 rpm = 2 pi/60 rad/s, 1 mm = 1e-3 m) and the number a person typed coming back."""
+1 rpm = 2 pi/60 rad/s, 1 mm = 1e-3 m) and the number a person typed coming back.
+
+units.in_unit: an SI value written in a unit people type (parse_value's inverse)."""
 
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ import pytest
 from conftest import ROBOTS
 
 from screwkin.cli import main
-from screwkin.units import Quantity, in_unit, parse_quantity, parse_typed_assignments, shown_unit
+from screwkin.units import Quantity, in_unit, parse_quantity, parse_typed_assignments, parse_value, shown_unit
 
 ROOT = Path(__file__).resolve().parents[1]
 FOURBAR = str(ROBOTS / "fourbar_crank_rocker.urdf")
@@ -99,3 +101,19 @@ def test_the_tables_answer_in_the_units_typed(capsys):
                  "--rate", "1turn"]) == 0
     out = capsys.readouterr().out
     assert "at crank_joint 6.28319 rad/s" in out and "input [deg]" in out  # --to 90deg: the input in degrees
+
+
+# ---------------------------------------------------------------- folded in from test_in_unit.py
+@pytest.mark.parametrize("si, unit, expected", [
+    (math.pi, "deg", 180.0),  # pi rad is half a turn
+    (0.03, "mm", 30.0),
+    (2 * math.pi, "rpm", 60.0),  # one turn a second
+    (0.5, "rad", 0.5),
+])
+def test_in_unit_by_definition(si, unit, expected):
+    assert in_unit(si, unit) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("number, unit", [("45", "deg"), ("30", "mm"), ("60", "rpm"), ("1.5", "in")])
+def test_in_unit_undoes_parse_value(number, unit):
+    assert in_unit(parse_value(number + unit), unit) == pytest.approx(float(number), rel=1e-12)

@@ -26,7 +26,7 @@ import pytest
 
 from conftest import ROBOTS, no_hang
 from test_fuzz import HOSTILE, SCALE, check_contract
-from test_hostile_round4 import folded_loop
+from test_security import folded_loop
 
 SEED = 20261206
 MUTANTS = 84 * SCALE

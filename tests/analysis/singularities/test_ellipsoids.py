@@ -1,5 +1,9 @@
-"""Velocity and force ellipsoids (issue 15 part 4) against closed forms."""
+"""Velocity and force ellipsoids (issue 15 part 4) against closed forms.
 
+singularities --ellipsoids: the numbers of screwkin.analysis.singularities.ellipsoids on the command line,
+checked on a planar 2R arm against the singular values of its closed-form Jacobian."""
+
+import json
 import math
 
 import numpy as np
@@ -7,7 +11,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import LINK, fourbar, rev
+from conftest import ARM, LINK, ROBOTS, fourbar, rev, screwkin_cli
 from screwkin.analysis.singularities.ellipsoids import ellipsoids, ellipsoids_of
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.errors import UsageError
@@ -97,3 +101,34 @@ def test_an_open_configuration_and_unknown_inputs_are_refused(four_bar):
     q = PositionSolver(four_bar, ["crank_joint"]).solve({"crank_joint": 1.0}).solutions[0].q
     with pytest.raises(UsageError, match="no moving joint named"):
         ellipsoids(four_bar, q, "coupler", inputs=["nothing"])
+
+
+# ---------------------------------------------------------------- folded in from test_ellipsoids_cli.py
+
+
+def test_planar_2r_point_ellipsoid_against_closed_form(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM)
+    t1, t2 = 0.3, 1.1
+    out = screwkin_cli("singularities", str(path), "--set", f"shoulder={t1}", "--set", f"elbow={t2}", "--output", "hand",
+              "--point", "--ellipsoids", "--length", "0.5", "--json")
+    assert out.returncode == 0, out.stderr
+    e = json.loads(out.stdout)["ellipsoids"]
+    l1, l2, L = 0.4, 0.25, 0.5
+    J = np.array([[-l1 * np.sin(t1) - l2 * np.sin(t1 + t2), -l2 * np.sin(t1 + t2)],
+                  [l1 * np.cos(t1) + l2 * np.cos(t1 + t2), l2 * np.cos(t1 + t2)]]) / L
+    s = np.linalg.svd(J, compute_uv=False)
+    assert e["rank"] == 2
+    assert np.allclose(sorted(e["velocity_semi_axes"])[-2:], sorted(s), rtol=1e-9)
+    finite = [f for f in e["force_semi_axes"] if f != "inf"]  # the z direction loads no input: "inf"
+    assert e["force_semi_axes"].count("inf") == 1
+    assert np.allclose(sorted(finite), sorted(1 / s), rtol=1e-9)
+    assert e["isotropy"] == pytest.approx(0.0)  # the z direction is not reached: rank 2 of 3
+    text = screwkin_cli("singularities", str(path), "--set", f"shoulder={t1}", "--set", f"elbow={t2}", "--output", "hand",
+               "--point", "--ellipsoids", "--length", "0.5")
+    assert "velocity and force ellipsoids" in text.stdout and "inf" in text.stdout
+
+
+def test_ellipsoids_need_an_output():
+    out = screwkin_cli("singularities", str(ROBOTS / "gough_stewart_6ups.urdf"), "--ellipsoids")
+    assert out.returncode == 2 and "--output" in out.stderr and len(out.stderr.strip().splitlines()) == 1
