@@ -17,9 +17,9 @@ from screwkin.model.linalg import null_space
 from screwkin.model.loader import rebuild
 from screwkin.model.state import KinematicState, value_for_leg_length
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ROBOTS = ROOT / "robots"
-DATA = Path(__file__).resolve().parent / "data" / "local"
+DATA = Path(__file__).resolve().parents[1] / "data" / "local"
 FOURBAR = ROBOTS / "fourbar.urdf.xacro"
 FOLDED = {"ground": 0.2, "crank": 0.1, "coupler": 0.2, "rocker": 0.1, "theta": 0.0}
 FOLDED_ARGS = ["--arg", "ground=0.2", "--arg", "crank=0.1", "--arg", "coupler=0.2", "--arg", "rocker=0.1"]

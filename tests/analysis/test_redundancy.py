@@ -16,9 +16,9 @@ from screwkin.cli import main
 from screwkin.model.state import KinematicState
 from screwkin.analysis.screws import cut_twists
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ROBOTS = ROOT / "robots"
-MJCF = Path(__file__).resolve().parent / "data" / "mjcf" / "fourbar.xml"
+MJCF = Path(__file__).resolve().parents[1] / "data" / "mjcf" / "fourbar.xml"
 
 
 def loop_twists(mech, q):

@@ -1,23 +1,14 @@
 """Every bundled mechanism against the literature values listed in robots/README.md."""
 
-import re
-
 import pytest
 
 import screwkin
-from conftest import ROBOTS
+from conftest import ROBOTS, robots_table
 
-ROW = re.compile(r"^\| `(?P<file>[^`]+)` \| [^|]+ \| (?P<N>-?\d+) \| (?P<J>-?\d+) \| (?P<crit>\w+) (?P<count>-?\d+) \| "
-                 r"(?P<M>-?\d+) \| (?P<idle>\d+) \| (?P<eff>\d+) \| (?P<out>\S+) (?P<motion>\S+) \|")
+TABLE = robots_table()
 SPACE = {"Gruebler": "planar", "spherical": "spherical", "Kutzbach": "spatial"}
 
 
-def table():
-    rows = [ROW.match(line) for line in (ROBOTS / "README.md").read_text().splitlines()]
-    return {m["file"]: m for m in rows if m}
-
-
-TABLE = table()
 
 
 def test_the_table_lists_every_robot():

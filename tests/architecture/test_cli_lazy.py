@@ -12,7 +12,7 @@ from conftest import ROBOTS
 from screwkin import cli
 from screwkin.commands._common import add_common, add_scaled
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def full_parser():

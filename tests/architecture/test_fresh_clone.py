@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 pytestmark = pytest.mark.skipif(shutil.which("git") is None or not (ROOT / ".git").exists(),
                                 reason="not a git checkout")
@@ -54,7 +54,7 @@ def test_the_readme_analysis_command_runs_in_the_clone(clone):
 
 
 def test_tests_on_bundled_data_pass_in_the_clone(clone):
-    p = run(clone, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/test_robots.py", "tests/test_corpus.py",
-            "tests/test_as_written.py", "-x")
+    p = run(clone, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/analysis/test_robots.py",
+            "tests/files/test_corpus.py", "tests/analysis/position/test_as_written.py", "-x")
     assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-2000:]
     assert re.search(r"\d+ passed", p.stdout)

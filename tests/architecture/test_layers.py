@@ -5,7 +5,7 @@ all of them.  An ast walk over screwkin/ finds every import, module level or not
 import ast
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
+PACKAGE = Path(__file__).resolve().parents[2] / "screwkin"
 LAYERS = {"errors": 0, "tolerances": 0, "units": 0, "files": 1, "model": 2, "analysis": 3, "present": 4,
           "parallel": 4, "commands": 5, "cli": 5, "__main__": 6, "__init__": 6}
 # third-party imports a function may make lazily: optional, or heavy and needed by one command

@@ -8,7 +8,7 @@ go below its count (lower the count then), never above it."""
 import ast
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
+PACKAGE = Path(__file__).resolve().parents[2] / "screwkin"
 SMALL = 1e-3
 
 #: file (relative to screwkin/) -> comparisons with a bare small literal still allowed there.

@@ -14,7 +14,7 @@ import pytest
 
 from conftest import CI_MODULES, CI_PROVIDES, ROOT, SLOW_TESTS
 
-TESTS = Path(__file__).resolve().parent
+TESTS = Path(__file__).resolve().parents[1]
 #: Skip reasons that are about the platform, not about what CI installs: these may skip anywhere.
 PLATFORM = ("no named pipes here", "needs bash", "not a git checkout")
 
@@ -35,10 +35,11 @@ def test_every_slow_node_id_names_a_test_that_exists():
     """SLOW_TESTS is a list of node ids as strings: one left behind by a rename (or misspelt) would mark
     nothing and leave a slow test in the fast subset."""
     stale = []
+    files = {path.name: path for path in TESTS.rglob("test_*.py")}
     for node in sorted(SLOW_TESTS):
         file, sep, name = node.partition("::")
-        path = TESTS / file
-        if not sep or not path.is_file() or name not in _defined(path):
+        path = files.get(file)
+        if not sep or path is None or name not in _defined(path):
             stale.append(node)
     assert not stale, f"SLOW_TESTS names tests that do not exist: {stale}"
 
@@ -60,7 +61,7 @@ def _string(node) -> str | None:
 def _skips():
     """(file:line, what, text) of every skip in tests/: ('module', M) of pytest.importorskip(M) without
     a reason, ('reason', R) of importorskip's, pytest.skip's and skipif's reasons."""
-    for path in sorted(TESTS.glob("test_*.py")):
+    for path in sorted(TESTS.rglob("test_*.py")):
         for node in ast.walk(ast.parse(path.read_text())):
             if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Attribute):
                 continue
@@ -107,10 +108,10 @@ def test_under_ci_a_missing_mujoco_viser_pyarrow_ffmpeg_or_check_urdf_fails_the_
     for module in ("mujoco", "viser", "pyarrow", "imageio_ffmpeg"):
         (shadow / module).mkdir(parents=True)
         (shadow / module / "__init__.py").write_text(f"raise ModuleNotFoundError(\"No module named '{module}' (hidden)\")\n")
-    tests = ["tests/test_mjcf.py", "tests/test_sweep_stream.py::test_cli_parquet_has_the_csv_columns",
-             "tests/test_view_server.py::test_sigterm_stops_the_interactive_view_too",
-             "tests/test_draw_animate.py::test_an_mp4_through_imageio_ffmpeg",
-             "tests/test_synthesis_drawing.py::test_check_urdf_parses_the_file_with_its_targets"]
+    tests = ["tests/files/test_mjcf.py", "tests/analysis/motion/test_sweep_stream.py::test_cli_parquet_has_the_csv_columns",
+             "tests/present/test_view_server.py::test_sigterm_stops_the_interactive_view_too",
+             "tests/present/test_draw_animate.py::test_an_mp4_through_imageio_ffmpeg",
+             "tests/present/test_synthesis_drawing.py::test_check_urdf_parses_the_file_with_its_targets"]
     nothing = tmp_path / "bin"  # PATH: no check_urdf (the venv's bin has one too)
     nothing.mkdir()
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(shadow), str(ROOT)]), PATH=str(nothing))

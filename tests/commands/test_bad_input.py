@@ -212,8 +212,8 @@ def test_urdf_parser_complaints_become_the_one_line(tmp_path, capfd):
 # ---------------------------------------------------------------------------------------------
 # Regressions of the fuzzing campaign (3,815 runs on 1,682 mutated files): one test per signature.
 
-CORPUS_5BAR = Path(__file__).resolve().parents[1] / "robots" / "corpus" / "example-parallel-robots" / "5bar_linkage"
-FOURBAR = Path(__file__).resolve().parents[1] / "robots" / "fourbar_crank_rocker.urdf"
+CORPUS_5BAR = Path(__file__).resolve().parents[2] / "robots" / "corpus" / "example-parallel-robots" / "5bar_linkage"
+FOURBAR = Path(__file__).resolve().parents[2] / "robots" / "fourbar_crank_rocker.urdf"
 
 
 def five_bar(tmp_path, sidecar: str | bytes):

@@ -23,13 +23,13 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import ROBOTS
+from conftest import ROBOTS, robots_table
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
-from test_robots import TABLE
 
 #: The bundled mechanisms (robots/, not the corpus): their output link from robots/README.md's table; the
 #: two xacro families have the outputs of the files they write with their defaults.
+TABLE = robots_table()
 OUTPUT = {**{name: row["out"] for name, row in TABLE.items()}, "fourbar.urdf.xacro": TABLE["fourbar_crank_rocker.urdf"]["out"],
           "delta.urdf.xacro": TABLE["delta_parallelogram.urdf"]["out"]}
 MECHANISMS = sorted(OUTPUT)

@@ -10,11 +10,10 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import DATA, ROBOTS, check_urdf
+from conftest import DATA, ROBOT_DATA, ROBOTS, check_urdf
 from screwkin.analysis.forces.dynamics import dynamics
 from screwkin.analysis.forces.statics import statics
 from screwkin.cli import main
-from test_couplings import ROBOT_DATA
 from test_mjcf import random_qpos, screwkin_q
 
 mujoco = pytest.importorskip("mujoco")

@@ -12,7 +12,7 @@ import pytest
 
 import screwkin
 from screwkin.cli import main
-from test_couplings import ROBOT_DATA
+from conftest import ROBOT_DATA
 
 mujoco = pytest.importorskip("mujoco")
 pytestmark = [pytest.mark.slow,

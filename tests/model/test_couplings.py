@@ -1,16 +1,14 @@
 """URDF <mimic> joints are couplings, not degrees of freedom: against Pinocchio's own mimic
 model, closed-form gear ratios, and real robot files when example-robot-data is installed."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import ROBOTS
+from conftest import ROBOT_DATA, ROBOTS
 from screwkin.model._pin import compute_frame_jacobian
 from screwkin.cli import main
 from screwkin.analysis.motion.position import PositionSolver
@@ -134,18 +132,6 @@ def test_a_transmission_of_a_mimic_joint_is_a_warning(tmp_path):
 
 
 # ------------------------------------------------------------------ real robots (optional data package)
-def _robot_data():
-    spec = importlib.util.find_spec("example_robot_data")
-    if spec is None:
-        for base in map(Path, __import__("sys").path):
-            cand = base / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-            if cand.is_dir():
-                return cand
-        return None
-    return Path(spec.submodule_search_locations[0]).parent / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-
-
-ROBOT_DATA = _robot_data()
 
 
 @pytest.mark.skipif(ROBOT_DATA is None, reason="example-robot-data is not installed (pip install example-robot-data)")

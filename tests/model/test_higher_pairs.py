@@ -267,7 +267,7 @@ def test_gear_train_output_is_the_ratio_times_the_input(deg):
     counted its turn differently: no start reached the counted angles of the motion from the file's drawing)."""
     import math
 
-    m = screwkin.load(Path(__file__).resolve().parents[1] / "robots" / "gear_train_idler.urdf")
+    m = screwkin.load(Path(__file__).resolve().parents[2] / "robots" / "gear_train_idler.urdf")
     res = screwkin.PositionSolver(m).solve({"input_joint": math.radians(deg)})
     (sol,) = res.solutions
     out = math.degrees(sol.joints["output_joint"])

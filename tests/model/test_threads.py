@@ -16,7 +16,7 @@ import screwkin
 from screwkin.analysis.singularities.singular import classify
 from screwkin.model.state import KinematicState
 
-ROBOTS = Path(__file__).resolve().parents[1] / "robots"
+ROBOTS = Path(__file__).resolve().parents[2] / "robots"
 
 
 def _work(mech, q, start):

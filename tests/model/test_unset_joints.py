@@ -14,11 +14,10 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import ROBOTS
+from conftest import ROBOT_DATA, ROBOTS
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.cli import main
 from screwkin.model.topology import open_joints
-from test_couplings import ROBOT_DATA
 
 GRIPPER = ROBOTS / "gripper_arm_mimic.urdf"
 PANDA = None if ROBOT_DATA is None else ROBOT_DATA / "panda_description" / "urdf" / "panda.urdf"

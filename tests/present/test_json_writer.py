@@ -19,12 +19,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROBOTS
-from test_ellipsoids_cli import ARM  # the planar 2R arm of the ellipsoid's closed form
+from conftest import ARM, ROBOTS
 
 from screwkin.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SLIDER = str(ROBOTS / "slider_crank_offset.urdf")
 
 

@@ -14,7 +14,7 @@ from screwkin.analysis.singularities.maps import singularity_map
 from conftest import screwkin_cli
 
 pytest.importorskip("matplotlib")
-ROBOTS = Path(__file__).resolve().parents[1] / "robots"
+ROBOTS = Path(__file__).resolve().parents[2] / "robots"
 
 
 def test_map_png_is_titled_in_the_typed_units(wide_five_bar, tmp_path):
@@ -71,7 +71,7 @@ def test_map_seams_join_neighbours_on_different_sheets():
 
 
 def _panda():
-    from test_couplings import ROBOT_DATA
+    from conftest import ROBOT_DATA
 
     if ROBOT_DATA is None:
         pytest.skip("example-robot-data is not installed (pip install example-robot-data)")

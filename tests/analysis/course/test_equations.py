@@ -17,7 +17,7 @@ from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 from screwkin.model.loader import load
 
-ROBOTS = Path(__file__).resolve().parents[1] / "robots"
+ROBOTS = Path(__file__).resolve().parents[3] / "robots"
 PLANAR = ["fourbar_crank_rocker", "fourbar_non_grashof", "slider_crank_offset", "five_bar", "watt_sixbar",
           "stephenson_sixbar", "planar_3rrr", "planar_3rpr"]
 _BUILT = {}

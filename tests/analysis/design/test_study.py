@@ -39,7 +39,7 @@ from screwkin.files.xacro import expand
 from screwkin.present.study import study_csv, study_text
 from screwkin.present.progress import Progress
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 GROUND = 0.1
 CRANKS, COUPLERS, ROCKERS = [0.021, 0.047, 0.093, 0.152], [0.052, 0.117, 0.198], [0.032, 0.081, 0.187]
 FAMILY = {

@@ -30,7 +30,7 @@ from screwkin.analysis.motion.continuation import (Curve, Neighbour, jumped, loc
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 A_, B_, C_, D_ = 0.04, 0.12, 0.08, 0.10
 THETA2_0 = np.pi / 3  # the crank as drawn
 THETA4_0 = np.arctan2(0.07247123666099901, 0.03388096599604964)  # the rocker as drawn (B - O2)

@@ -4,12 +4,11 @@ import numpy as np
 import pytest
 
 import screwkin
-from conftest import fourbar
+from conftest import A, B, C, G, fourbar, rocker_angles, world_angles
 from screwkin.cli import main
 from screwkin.analysis.motion.planar import identify
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
-from test_position import A, B, C, G, rocker_angles, world_angles
 
 STEPS = 360
 
@@ -154,7 +153,7 @@ def test_grid_values_next_to_a_limit_position_are_reached(tmp_path):
     pivot (the law of cosines' bound); at the last value every bar keeps its length."""
     import pinocchio as pin
     from pathlib import Path
-    robots = Path(__file__).resolve().parents[1] / "robots"
+    robots = Path(__file__).resolve().parents[3] / "robots"
     m = screwkin.load(robots / "fourbar.urdf.xacro", args={"crank": "0.04", "coupler": "0.12", "rocker": "0.19"})
     solver = PositionSolver(m, ["crank_joint"])
     first = sweep(solver, "crank_joint", 0.0, 6.0, 60)
@@ -189,7 +188,7 @@ def test_a_coarse_grid_follows_the_same_branch_and_ends():
 
     from conftest import no_hang
 
-    m = screwkin.load(Path(__file__).resolve().parents[1] / "robots" / "fourbar_non_grashof.urdf")
+    m = screwkin.load(Path(__file__).resolve().parents[3] / "robots" / "fourbar_non_grashof.urdf")
     solver = PositionSolver(m, ["output_joint"])
     for a, b, turn in ((-2.1, 2.1, False), (-4.2, 0.0, False), (1.0, 5.2, False), (2.0, 6.2, True)):
         with no_hang(30):

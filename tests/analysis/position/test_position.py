@@ -7,43 +7,15 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import fourbar
+from conftest import A, B, C, G, fourbar, rocker_angles, world_angles
 from screwkin.cli import main
 from screwkin.analysis.motion.position import PositionSolver
-
-G, A, B, C = 0.10, 0.04, 0.12, 0.08  # ground, crank, coupler, rocker of conftest.fourbar()
-
-
-def rocker_angles(theta):
-    """Both rocker angles of the four-bar for crank angle theta: the two
-    intersections of the circles |X - B(theta)| = B and |X - D| = C."""
-    b = A * np.array([np.cos(theta), np.sin(theta)])
-    d = np.array([G, 0.0])
-    dist = np.linalg.norm(d - b)
-    along = (B**2 - C**2 + dist**2) / (2 * dist)
-    h = np.sqrt(B**2 - along**2)
-    u = (d - b) / dist
-    out = []
-    for sign in (1, -1):
-        x = b + along * u + sign * h * np.array([-u[1], u[0]])
-        out.append(np.arctan2(x[1] - d[1], x[0] - d[0]))
-    return sorted(out)
-
 
 @pytest.fixture
 def mech(tmp_path):
     p = tmp_path / "fb.urdf"
     p.write_text(fourbar())
     return screwkin.load(p)
-
-
-def world_angles(mech, sol):
-    """Crank and rocker angles from the solved placements (Pinocchio FK)."""
-    data = mech.model.createData()
-    pin.framesForwardKinematics(mech.model, data, sol.q)
-    R_crank = data.oMf[mech.link_frame("crank")].rotation
-    R_rocker = data.oMf[mech.link_frame("rocker")].rotation
-    return np.arctan2(R_crank[1, 0], R_crank[0, 0]), np.arctan2(R_rocker[1, 0], R_rocker[0, 0])
 
 
 @pytest.mark.parametrize("theta_deg", [0, 35, 90, 160, 250])

@@ -18,7 +18,7 @@ from screwkin.analysis.singularities.maps import singularity_map
 
 from conftest import screwkin_cli
 
-ROBOTS = Path(__file__).resolve().parents[1] / "robots"
+ROBOTS = Path(__file__).resolve().parents[3] / "robots"
 R1, R2 = 0.1, 0.15  # proximal and distal lengths of robots/five_bar.urdf
 
 

@@ -7,13 +7,12 @@ import pytest
 
 import screwkin
 from screwkin.present.report import map_csv
-from conftest import fourbar, planar_3r, slider_crank
+from conftest import A, B, C, G, fourbar, planar_3r, slider_crank
 from screwkin.cli import main
 from screwkin.analysis.motion.position import PositionSolver
 from screwkin.analysis.singularities.singular import classify
 from screwkin.analysis.motion.singular_points import locate_singularities
 from screwkin.analysis.motion.sweep import sweep
-from test_position import A, B, C, G
 
 
 def load(tmp_path, text, **kw):
