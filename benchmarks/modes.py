@@ -3,7 +3,7 @@ screwkin's random-start search at equal coverage.
 
     python benchmarks/modes.py
 
-The platform is tests/test_certified.py's of random geometry, seed 5 (40 complex assembly modes, 6 real).
+The platform is tests/model/homotopy/test_certified.py's of random geometry, seed 5 (40 complex assembly modes, 6 real).
 Measured in one run, on the same machine, one after the other:
 - ``solve`` by homotopy continuation (the default): time to every mode and its certificate (the
   published count of 40 reached), with the numba kernel and with numpy alone;

@@ -1,6 +1,6 @@
 """One way to each thing (issue 37): a helper is defined once, a name has one import path, and commands
 share code through the layers below them, never through each other.  An ast walk over the source, as
-tests/test_layers.py does; each failure names the places to fold into one (or to rename, where the two
+tests/architecture/test_layers.py does; each failure names the places to fold into one (or to rename, where the two
 are different things)."""
 
 import ast
@@ -13,14 +13,14 @@ COMMANDS = PACKAGE / "commands"
 
 #: Names more than one module defines on purpose, with the modules allowed and why.
 SAME_NAME = {
-    # the protocol every command module keeps (README, "How the code is laid out"; tests/test_cli_lazy.py)
+    # the protocol every command module keeps (README, "How the code is laid out"; tests/architecture/test_cli_lazy.py)
     "add_parser": {f"screwkin.commands.{p.stem}" for p in COMMANDS.glob("*.py") if not p.stem.startswith("_")},
     "run": {f"screwkin.commands.{p.stem}" for p in COMMANDS.glob("*.py") if not p.stem.startswith("_")},
     # screwkin.load is the public API's (README's Python section): model.loader.load binding screwkin.Mechanism
     "load": {"screwkin", "screwkin.model.loader"},
     # the entry points of processes: the command line, and the meshcat server's own process
     "main": {"screwkin.cli", "screwkin.present.viewserver"},
-    # the compiled (numba) form of model.newton's step under its name: tests/test_compiled.py compares the
+    # the compiled (numba) form of model.newton's step under its name: tests/model/kernel/test_compiled.py compares the
     # two and puts one in the other's place
     "damped_step": {"screwkin.model.newton", "screwkin.model.compiled"},
 }

@@ -213,7 +213,7 @@ def five_bar_with(tmp_path, yaml_text):
 
 
 def test_the_five_bar_sidecar_gives_mobility_3(tmp_path, capsys):
-    # the collection's 5bar_linkage (tests/test_corpus.py): planar, Gruebler 3(6-1-6)+6 = 3 with its
+    # the collection's 5bar_linkage (tests/files/test_corpus.py): planar, Gruebler 3(6-1-6)+6 = 3 with its
     # loop; without the loop the open tree has its 6 joints free (M = 6)
     path = five_bar_with(tmp_path, "closed_loop: [['closedloop1_A', 'closedloop1_B']]\nname_mot: ['mot1', 'mot2']\n")
     result = cli_json(capsys, ["mobility", str(path), "--json"])
@@ -305,7 +305,7 @@ FOURBAR = ROBOTS / "fourbar_crank_rocker.urdf"
 
 def _one_line_error(err: str) -> str:
     """The one error line (the `note:` lines a command says as it goes -- the assembly mode it chose --
-    may come before it, as tests/test_fuzz.py's contract allows)."""
+    may come before it, as tests/commands/test_fuzz.py's contract allows)."""
     lines = [ln for ln in err.strip().splitlines() if not ln.startswith("note: ")]
     assert len(lines) == 1 and lines[0].startswith("screwkin: error: ") and "Traceback" not in err, err
     return lines[0]

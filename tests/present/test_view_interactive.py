@@ -401,7 +401,7 @@ class _Client:
 
 def test_the_view_is_framed_for_each_browser_report_until_the_person_moves_it(page):
     """Issue 43 item 2: the first camera report raised KeyError: 'dist' and nothing was framed.  The reports are
-    those Chromium sent (tests/test_view_interactive_chromium.py): the whole window at viser's default camera, then
+    those Chromium sent (tests/present/test_view_interactive_chromium.py): the whole window at viser's default camera, then
     the view beside the docked panel at the first view's position (the browser applied it after the first framing):
     each is framed with fit_camera for its aspect; a camera elsewhere was moved by the person and is kept."""
     from screwkin.present.camera import fit_camera

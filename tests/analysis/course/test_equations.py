@@ -308,7 +308,7 @@ def test_spatial_mechanisms_get_the_structure_equations(capsys):
     ("gripper_arm_mimic", 1, "<mimic>"),
 ])
 def test_planar_mechanisms_beyond_the_vector_loops_are_one_line_errors(capsys, robot, code, words):
-    # rolling and gear pairs are taken now: tests/test_course_rolling.py
+    # rolling and gear pairs are taken now: tests/analysis/course/test_course_rolling.py
     got, out, err = run_cli(["equations", str(ROBOTS / f"{robot}.urdf")], capsys)
     assert got == code and words in err and _error_lines(err) == 1
 

@@ -95,7 +95,7 @@ def test_inputs_as_absolute_link_angles_match_joint_values(capsys):
         T = np.array(a["output_pose"])
         np.testing.assert_allclose(a["output_position"], T[:3, 3], atol=1e-15)
         np.testing.assert_allclose(pin.rpy.rpyToMatrix(np.array(a["output_rpy"])), T[:3, :3], atol=1e-12)
-    # a floating link's angle is an input too (tests/test_set_angle_floating.py); the ground's is not
+    # a floating link's angle is an input too (tests/analysis/position/test_set_angle_floating.py); the ground's is not
     code = main(["solve", path, "--set-angle", "ground=10deg"])
     assert code == 2 and "is the ground" in capsys.readouterr().err
 

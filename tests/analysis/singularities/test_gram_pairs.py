@@ -1,7 +1,7 @@
 """The numeric Gram cofactors of loops through rolling and gear pairs (issue 25, points 5 and 6): the
 pair is one column, a revolute about the plane's normal through the contact point (pure rolling turns
 one link about it relative to the other), as singularities --symbolic takes it.  Against formulas the
-test writes itself from the files' dimensions (the symbolic ones of tests/test_course_rolling.py, with
+test writes itself from the files' dimensions (the symbolic ones of tests/analysis/course/test_course_rolling.py, with
 numbers put in).  The numeric table is dimensionless: twists (y/L, -x/L, 1) of revolutes, a slide's
 (cos b, sin b, 0) (linear part / L, column x L), so each hand formula is written with every length over L."""
 
@@ -32,7 +32,7 @@ def wheels_by_hand(theta2, L):
     """The friction wheels' cofactors at theta2: C2 = |O2C2| (cos, sin)(theta2 + 45 deg), disc 3's centre at
     x4 = C2x + sqrt((R2 + R3)^2 - C2y^2) (the branch drawn), t the line of centres' angle; the symbolic formulas
     C_wheel2 = rho3^2 cos^2 t, C_slide = rho3^2 x4^2 sin^2 t, C_wheel3 = (x4 - rho3 cos t)^2, C_wheels = x4^2
-    (derived in tests/test_course_rolling.py) with lengths over L."""
+    (derived in tests/analysis/course/test_course_rolling.py) with lengths over L."""
     c2 = np.hypot(0.008, 0.008) * np.array([np.cos(theta2 + np.pi / 4), np.sin(theta2 + np.pi / 4)])
     x4 = c2[0] + np.sqrt((R2 + R3) ** 2 - c2[1] ** 2)
     t = np.arctan2(-c2[1], x4 - c2[0])

@@ -101,7 +101,7 @@ def test_sign_symmetries_of_the_six_ups():
 # ------------------------------------------------------------------ counts
 def test_four_bar_has_two_modes_certified():
     """A crank-rocker four-bar at 30 deg: two modes, certified by the trace test (the homotopy itself:
-    solve places a mechanism made of dyads in closed form, tests/test_dyad_modes.py compares the two)."""
+    solve places a mechanism made of dyads in closed form, tests/analysis/position/test_dyad_modes.py compares the two)."""
     solver = PositionSolver(screwkin.load(ROBOTS / "fourbar_crank_rocker.urdf"))
     c = certified.certified_modes(solver, {"crank_joint": np.radians(30)}).count
     assert c.complete and c.certificate == "trace test" and c.method == "monodromy"
