@@ -8,8 +8,6 @@ units.in_unit: an SI value written in a unit people type (parse_value's inverse)
 from __future__ import annotations
 
 import math
-import re
-from pathlib import Path
 
 import pytest
 from conftest import ROBOTS
@@ -17,7 +15,6 @@ from conftest import ROBOTS
 from screwkin.cli import main
 from screwkin.units import Quantity, in_unit, parse_quantity, parse_typed_assignments, parse_value, shown_unit
 
-ROOT = Path(__file__).resolve().parents[1]
 FOURBAR = str(ROBOTS / "fourbar_crank_rocker.urdf")
 
 
@@ -69,23 +66,6 @@ def test_assignments_keep_each_quantity():
     assert [(n, q.unit, q.kind) for n, q in got] == [("a", "deg", "angle"), ("b", "mm", "length"),
                                                       ("c", "mm", "length"), ("d", "", None)]
     assert got[0][1].value == pytest.approx(math.pi / 4) and got[1][1].value == pytest.approx(0.002)
-
-
-def test_no_module_reads_a_unit_again_after_parsing():
-    """The unit of a value is read where the value is parsed (units.parse_quantity, through the
-    commands' joint_quantities and joint_value): no module asks units.py for the unit of a text again,
-    and none holds a table of unit factors or display units of its own."""
-    found = []
-    for path in sorted((ROOT / "screwkin").rglob("*.py")):
-        rel = path.relative_to(ROOT).as_posix()
-        if rel == "screwkin/units.py":
-            continue
-        text = path.read_text()
-        for pattern in (r"\bparse_typed_value\b", r"\bunit_kind\(", r"\bUNITS\[", r"_RATE = \{", r"_ACCEL = \{",
-                        r"_LENGTH_UNITS\b"):
-            if re.search(pattern, text):
-                found.append(f"{rel}: {pattern}")
-    assert not found, found
 
 
 def test_the_tables_answer_in_the_units_typed(capsys):

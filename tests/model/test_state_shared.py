@@ -205,33 +205,3 @@ def test_place_tool_leaves_the_model_as_it_was():
     np.testing.assert_allclose(KinematicState(mech, q).link_pose(other), there, rtol=0, atol=1e-12)
     _, p, _, _ = tree.frames(q[None], [mech.tool_frame], jacobian=False)[mech.tool_frame]
     np.testing.assert_allclose(p[0], there[:3, 3], rtol=0, atol=1e-12)
-
-
-#: The modules that may call Pinocchio's kinematics themselves, by the rule of model/state.py's docstring:
-#: an algorithm's inner loop on a Data it keeps, a stack of configurations at once, a dynamics algorithm.
-PINOCCHIO_KINEMATICS = {
-    "model/state.py": "the state itself",
-    "model/_pin.py": "the shape-fixing wrappers of Pinocchio's calls",
-    "model/closure.py": "the closure's residual and Jacobian (the Newton loops' inner loop)",
-    "analysis/motion/position.py": "the position solver's mode signature, at every start",
-    "analysis/motion/links.py": "frame motions of a stack of configurations (Pinocchio a step)",
-    "analysis/motion/batch_closure.py": "batched kinematics and closure, their self-checks against Pinocchio",
-    "analysis/singularities/batch.py": "frame Jacobians of a stack of configurations",
-    "analysis/forces/dynamics.py": "the energies' own pass (CRBA, the potential energy with couplings)",
-    "model/algebraic.py": "the polynomial closure's reference placements and leg lengths, on a bare model",
-    "model/legs.py": "which legs are distances, probed on a bare model's joint centres",
-}
-
-
-def test_only_the_named_rooms_call_pinocchios_kinematics():
-    """Whatever reads one configuration's quantities reads a KinematicState (model/state.py's rule)."""
-    import re
-    from pathlib import Path
-
-    root = Path(screwkin.__file__).parent
-    calls = re.compile(r"framesForwardKinematics|forwardKinematics\(|updateFramePlacements|computeJointJacobians?\("
-                       r"|computeFrameJacobian|getFrameJacobian|getFrameVelocity|getFrameClassicalAcceleration"
-                       r"|\.oMf\[|\.oMi\[")
-    found = {p.relative_to(root).as_posix() for p in root.rglob("*.py") if calls.search(p.read_text())}
-    outside = sorted(found - set(PINOCCHIO_KINEMATICS))
-    assert not outside, f"forward kinematics outside the state (read a KinematicState): {outside}"

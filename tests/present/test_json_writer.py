@@ -14,7 +14,6 @@ import csv
 import io
 import json
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -48,23 +47,6 @@ def _leaves(obj):
             yield from _leaves(v)
     else:
         yield obj
-
-
-def test_no_module_but_the_writer_writes_json():
-    """json.dumps and json.dump are called in present/jsonout.py alone: a newcomer who changes how JSON
-    is written finds one place."""
-    # files/generic_cache.py stores screwkin's own numbers (a generic solution set and its digest) for
-    # screwkin to read back, not an answer for a person: it is a file format of the files/ layer, which
-    # cannot import present/
-    own = {"screwkin/present/jsonout.py", "screwkin/files/generic_cache.py"}
-    found = []
-    for path in sorted((ROOT / "screwkin").rglob("*.py")):
-        if path.relative_to(ROOT).as_posix() in own:
-            continue
-        for k, line in enumerate(path.read_text().splitlines(), 1):
-            if re.search(r"\bjson\.dumps?\(", line):
-                found.append(f"{path.relative_to(ROOT)}:{k}")
-    assert not found, found
 
 
 def test_the_rule_in_values_arrays_and_numpy_scalars():

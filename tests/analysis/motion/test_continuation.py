@@ -15,7 +15,6 @@ The rocker's extreme angles (a rocker-driven crank-rocker's limit positions): cr
 cos theta4 = (L^2 - d^2 - c^2) / (2 d c).
 """
 
-import ast
 from pathlib import Path
 
 import numpy as np
@@ -188,38 +187,6 @@ def test_a_neighbour_step_is_refused_across_a_limit(mech):
     assert q is not None
     assert abs(q[mech.coordinate("rocker_joint").idx_q] - 0.5 * extended) < 1e-12
     assert step(q0, 0.0, extended - 0.05) is None
-
-
-def test_the_tangent_and_the_jump_test_are_defined_in_one_place():
-    """No module but continuation.py defines a tangent, a jump test, a branch rule or a limit locator of
-    the continuation by name; the engines subclass or call it.  Allowed: the homotopy trackers' own
-    tangent coordinates (model/square.py, model/algebraic.py: the certified mode search's charts, a
-    different space), BatchedCurve.tangents (Curve's on stacks, calling projections), and sweep's
-    _start_tangent (Curve.tangent, oriented along the grid); model/distances.py's tangent (the platform
-    homotopy's chart: a pose's translation and quaternion, the space of model/square.py's); and the singular
-    locus's tangent (analysis/singularities/loci.py: the null vector of the augmented system [closure;
-    A v = 0; |v| = 1], another curve than an input's motion, oriented by continuation.orient)."""
-    allowed = {("model/square.py", "tangent"), ("model/algebraic.py", "tangent"), ("model/distances.py", "tangent"),
-               ("analysis/singularities/loci.py", "tangent"),
-               ("analysis/motion/batch_sweep.py", "tangents"), ("analysis/motion/sweep.py", "_start_tangent")}
-    words = ("tangent", "jump", "orient", "passes_limit", "on_arc", "brentq")
-    found = []
-    package = ROOT / "screwkin"
-    for path in sorted(package.rglob("*.py")):
-        rel = path.relative_to(package).as_posix()
-        if rel == "analysis/motion/continuation.py":
-            continue
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and any(w in node.name for w in words[:-1]) \
-                    and (rel, node.name) not in allowed and not node.name.startswith("_orientation"):
-                found.append(f"{rel}: {node.name}")
-    assert not found, found
-    # every Brent's method of the continuation goes through continuation.locate
-    for rel in ("analysis/motion/sweep.py", "analysis/motion/tracker.py", "analysis/motion/dyads.py",
-                "analysis/motion/batch_sweep.py"):
-        assert "brentq" not in (package / rel).read_text(), rel
-    # the private tracker is gone
-    assert "_Tracker" not in (package / "analysis/motion/sweep.py").read_text()
 
 
 def test_every_engine_has_the_interface():
