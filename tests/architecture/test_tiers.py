@@ -5,6 +5,7 @@ Chromium, ...) fails the run instead of skipping without a word (tests/conftest.
 from __future__ import annotations
 
 import ast
+import functools
 import os
 import subprocess
 import sys
@@ -19,6 +20,7 @@ TESTS = Path(__file__).resolve().parents[1]
 PLATFORM = ("no named pipes here", "needs bash", "not a git checkout")
 
 
+@functools.cache
 def _defined(path: Path) -> set:
     """'name' of every top-level test function and 'Class::name' of every method in a class."""
     tree = ast.parse(path.read_text())
