@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "tests" / "model" / "homotopy")]  # conftest, test_certified
 
 import screwkin  # noqa: E402
 from screwkin.analysis.motion.position import PositionSolver  # noqa: E402
