@@ -2,7 +2,7 @@
 
 All analyses take a :class:`Tolerances` object; nothing else in the package
 hard-codes a threshold.  Division guards (``max(x, TINY)``) and display cut-offs are named
-module constants where they are used; tests/test_literals.py fails on a new comparison
+module constants where they are used; tests/architecture/test_literals.py fails on a new comparison
 against a bare small literal.
 """
 

@@ -523,7 +523,7 @@ class Mechanism:
         configurations of the largest rank are returned, the one nearest the first assembly
         first (``assembly`` is that first one, with where it came from).  ``starts``: how many
         further random starts (default ``tolerances.generic_starts``; 0 where a closed form has
-        every branch already, analysis.motion.closed_ik: then the samples' steps are drawn from the
+        every branch already, analysis.position.closed_ik: then the samples' steps are drawn from the
         standard library's generator, numpy.random's first import taking 10 ms).  Cached."""
         starts = self.tolerances.generic_starts if starts is None else int(starts)
         key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed), starts)

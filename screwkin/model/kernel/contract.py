@@ -6,7 +6,7 @@ model.kernel.stacks: numpy, a stack of configurations in one pass; model.kernel.
 polynomials in complex unknowns), and the loops take it (model.kernel.newton: the damped solve and
 the undamped polish; the local analysis's confirmation, rows plus held rows).  What a backend
 cannot give it says by raising ``NotProvided`` (a ``NotImplementedError``), never by lacking the
-method.  tests/test_kernel_contract.py checks every backend against Pinocchio's.
+method.  tests/model/kernel/test_kernel_contract.py checks every backend against Pinocchio's.
 
 Shapes: N configurations in a stack; nq coordinates and nv velocity columns per configuration
 (the polynomial backend: its complex unknowns and their tangent coordinates); m rows.

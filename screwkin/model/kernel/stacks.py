@@ -53,7 +53,7 @@ class TreeKinematics:
     joint costs one matrix product of its parent's N rotations with a constant 3 x 11 matrix
     (Rodrigues' formula split into constant parts, the placement's translation and the axis)
     and a few elementwise operations.  Joint axes and placements are Pinocchio's; the rows
-    BatchClosure builds on them equal ClosureSystem's (tests/test_newton.py)."""
+    BatchClosure builds on them equal ClosureSystem's (tests/model/kernel/test_newton.py)."""
 
     _AXES = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1),
              "JointModelPX": (1, 0, 0), "JointModelPY": (0, 1, 0), "JointModelPZ": (0, 0, 1)}
@@ -243,7 +243,7 @@ class BatchClosure(ClosureKernel):
 
     Frame placements and Jacobians come from the product-of-exponentials structure equations
     of the chains from the ground to each cut-joint frame (SerialJacobians).  The rows equal
-    ClosureSystem.evaluate's (tests/test_newton.py compares them on every batchable robot);
+    ClosureSystem.evaluate's (tests/model/kernel/test_newton.py compares them on every batchable robot);
     ``check=N`` compares them again at N random configurations when the object is built (a
     debugging aid: the program does not check at run time).
 
