@@ -17,6 +17,8 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE / "_ext"))
 sys.path.insert(0, str(ROOT))  # the screwkin of this checkout, whatever is installed
 os.environ.setdefault("MPLBACKEND", "Agg")
+# the gallery's scripts run `python -m screwkin`: the same checkout's screwkin in their subprocesses
+os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
 
 import screwkin  # noqa: E402
 
@@ -60,6 +62,7 @@ sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples" / "gallery"),
     "gallery_dirs": "auto_examples",
     "filename_pattern": r"/plot_",  # every plot_*.py runs at build time
+    "ignore_pattern": r"__init__\.py|_screwkin_cli\.py",  # _screwkin_cli.py: the helper they share
     "download_all_examples": False,
     "remove_config_comments": True,
     "matplotlib_animations": (True, "jshtml"),

@@ -31,7 +31,16 @@ def parser(name: str):
 
     top = _parser([name])
     sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
-    return sub.choices[name]
+    command = sub.choices[name]
+    for action in command._actions:  # the help is plain text; sphinx-argparse reads it as reStructuredText
+        if action.help and action.help is not argparse.SUPPRESS:
+            action.help = _plain(action.help)
+    return command
+
+
+def _plain(text: str) -> str:
+    """``text`` with reStructuredText's inline markup characters escaped (``N*m``, ``**``, backquotes)."""
+    return text.replace("\\", "\\\\").replace("*", "\\*").replace("`", "\\`").replace("|", "\\|")
 
 
 def __getattr__(attr):  # parser_NAME, for sphinx-argparse's :func:
