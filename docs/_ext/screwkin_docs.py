@@ -77,11 +77,39 @@ def index() -> str:
     return "\n".join(lines)
 
 
+def api() -> str:
+    """The API page: every public name of screwkin/__init__.py (its ``__all__``), with its docstring."""
+    import inspect
+
+    import screwkin
+
+    lines = ["# Python API", "",
+             "Generated from the docstrings of the public names of `screwkin/__init__.py` (its `__all__`), in "
+             "its order; [Python](python.md) shows them at work.  Every other module is internal: its names "
+             "may move.", "", "```{eval-rst}", ".. currentmodule:: screwkin", ""]
+    for name in screwkin.__all__:
+        obj = getattr(screwkin, name)
+        if inspect.isclass(obj):
+            lines += [f".. autoclass:: {name}", "   :members:" if name in API_MEMBERS else "", ""]
+        else:
+            lines += [f".. autofunction:: {name}", ""]
+    lines += ["```", ""]
+    return "\n".join(lines)
+
+
+#: Classes whose methods are documented with them (the others: their docstring, fields in it).
+API_MEMBERS = {"Mechanism", "PositionSolver", "SerialJacobians"}
+
+
 def write_pages(app=None) -> list[Path]:
-    """Write reference/commands/*.md (only those whose text changed); return their paths."""
+    """Write reference/commands/*.md and reference/api.md (only those whose text changed); return their
+    paths."""
     out = HERE / "reference" / "commands"
     out.mkdir(parents=True, exist_ok=True)
     written = []
+    api_page = HERE / "reference" / "api.md"
+    if not api_page.is_file() or api_page.read_text() != api():
+        api_page.write_text(api())
     wanted = {"index.md": index(), **{f"{name}.md": page(name, help) for name, help in commands()}}
     for file, text in wanted.items():
         path = out / file
@@ -94,6 +122,22 @@ def write_pages(app=None) -> list[Path]:
     return written
 
 
+def plain_docstrings(app, what, name, obj, options, lines):
+    """A docstring that is not valid reStructuredText (screwkin's are plain text with indented lists and
+    ``|x|`` for norms) is shown as it is written, a literal block, rather than mis-rendered with warnings."""
+    import docutils.core
+    import docutils.nodes
+
+    text = "\n".join(lines)
+    if not text.strip():
+        return
+    tree = docutils.core.publish_doctree(text, settings_overrides={"report_level": 5, "halt_level": 5,
+                                                                     "warning_stream": False, "env": app.env})
+    if any(m["level"] >= 2 for m in tree.findall(docutils.nodes.system_message)):
+        lines[:] = ["::", "", *("    " + line for line in text.split("\n")), ""]
+
+
 def setup(app):
     app.connect("builder-inited", write_pages)
+    app.connect("autodoc-process-docstring", plain_docstrings)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
