@@ -32,8 +32,11 @@ pytestmark = pytest.mark.slow
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
-    for module in ("sphinx", "sphinx_gallery", "sphinxarg", "myst_parser", "pydata_sphinx_theme"):
-        pytest.importorskip(module)
+    pytest.importorskip("sphinx")  # the docs packages come with the test extra
+    pytest.importorskip("sphinx_gallery")
+    pytest.importorskip("sphinxarg")
+    pytest.importorskip("myst_parser")
+    pytest.importorskip("pydata_sphinx_theme")
     out = tmp_path_factory.mktemp("site") / "html"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
                MPLBACKEND="Agg")
