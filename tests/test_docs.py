@@ -9,8 +9,8 @@ repository's root), so one block can read the file another wrote.  A block prece
 both) and skips naming it elsewhere.  ```text and ```console blocks are shown, never run (install lines,
 a server that waits, output).
 
-The fast part runs one short page (howto/units.md); every page is the slow part (minutes: synthesis,
-studies and homotopies among the commands).  The site's own build --
+The fast part runs one short page (howto/units.md); every page is the slow part: 44 bash blocks (65
+`screwkin` commands) and 12 Python blocks, 390 s on the loaded 2-core machine (141 s of CPU).  The site's own build --
 the gallery's scripts run by sphinx-gallery, the command pages generated from the parser, warnings as
 errors -- and what Chromium shows of it are tests/test_docs_site.py.
 """
