@@ -146,6 +146,7 @@ def no_hang(seconds):
 #: Modules .ci/run installs (pyproject.toml's test extra) that some tests import or skip without.
 CI_MODULES = ("numba", "matplotlib", "PIL", "mujoco", "viser", "pyarrow", "imageio_ffmpeg", "modern_robotics",
               "pylinkage", "example_robot_data", "hypothesis",
+              "sphinx", "sphinx_gallery", "sphinxarg", "myst_parser", "pydata_sphinx_theme",  # the test extra: the docs site
               "websockets")  # (viser's own dependency: the interactive view's Chromium test drives the page with it)
 #: Skip reasons that mean "something .ci/run installs is missing": under CI=true such a skip fails the run.
 #: pytest.importorskip says "could not import 'M...'" (M or a submodule: 'pyarrow.parquet'), an import
