@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import MechanismFileError, UsageError
 from .xacro import expand
-from .xacro_eval import _COMPARE, FUNCTIONS, _call, _function_name, _Interpreter, _power, _Refused, evaluate
+from .xacro_eval import COMPARE, FUNCTIONS, Interpreter, Refused, call_function, evaluate, function_name, power
 from .xmlsafe import parse_xml_text
 
 __all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch"]
@@ -154,7 +154,7 @@ def _truth(x):
     return np.asarray(x.v, bool) if isinstance(x, Batch) else bool(x)
 
 
-class _BatchInterpreter(_Interpreter):
+class _BatchInterpreter(Interpreter):
     """xacro_eval's interpreter with Batch values: what it does with a number, it does with each
     design's number."""
 
@@ -193,14 +193,14 @@ class _BatchInterpreter(_Interpreter):
             a, b = self.value(node.left), self.value(node.right)
             if isinstance(a, Batch) or isinstance(b, Batch):
                 return a._bin(b, np.power) if isinstance(a, Batch) else b._bin(a, np.power, True)
-            return _power(a, b)
+            return power(a, b)
         if isinstance(node, ast.Call):
-            name = _function_name(node.func)
+            name = function_name(node.func)
             args = [self.value(a) for a in node.args]
             if not any(isinstance(a, Batch) for a in args):
-                return _call(name, args)
+                return call_function(name, args)
             if any(isinstance(a, str) for a in args):
-                raise _Refused(f"{name}() of text")
+                raise Refused(f"{name}() of text")
             vals = [(a.v, a.bad) if isinstance(a, Batch) else (a, False) for a in args]
             bad = np.logical_or.reduce([np.broadcast_to(b, (ctx.n,)) for _, b in vals])
             with np.errstate(all="ignore"):
@@ -239,7 +239,7 @@ class _BatchInterpreter(_Interpreter):
                 if (isinstance(left, Batch) or isinstance(right, Batch)) and (isinstance(left, str)
                                                                                or isinstance(right, str)):
                     ctx.refuse("a parameter compared with text")
-                r = _COMPARE[type(op)](left, right)
+                r = COMPARE[type(op)](left, right)
                 if not isinstance(r, Batch) and not r:
                     return False
                 results.append(r)
