@@ -24,15 +24,18 @@ from __future__ import annotations
 import ast
 import re
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import MechanismFileError, UsageError
+from .description import MechanismSpec
+from .urdf import read_urdf
 from .xacro import expand
 from .xacro_eval import COMPARE, FUNCTIONS, Interpreter, Refused, call_function, evaluate, function_name, power
 from .xmlsafe import parse_xml_text
 
-__all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch"]
+__all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch", "read_designs"]
 
 TOKEN = re.compile(r"skwbatch([0-9]+)x")
 #: (element, attribute) pairs a parameter may reach: numbers of placements, axes, inertials, geometry, colour.
@@ -327,3 +330,24 @@ def expand_batch(path, text: str, args: dict, parameters: dict) -> BatchExpansio
     for k in set(slots):  # a value written into the file that is not finite: the design's file is refused
         bad |= ctx.batches[k].bad
     return BatchExpansion(parts, slots, rows, bad)
+
+
+def read_designs(path: str | Path, text: str, args: dict, parameters: dict) -> tuple[
+        list[MechanismSpec | None], dict[int, str]]:
+    """Every design of the xacro family ``path`` (``parameters``: {name: array of SI values, one per design},
+    as for expand_batch), expanded at once and each design's URDF read and checked as any file is
+    (files.urdf.read_urdf): (its description, None where it is not read; position -> why it was not: to be
+    expanded and read alone for the file's own message).  Unbatchable when the family cannot be expanded at
+    once."""
+    be = expand_batch(path, text, args, parameters)
+    specs: list[MechanismSpec | None] = [None] * len(be.bad)
+    why = {}
+    for k in range(len(be.bad)):
+        if be.bad[k]:
+            why[k] = "its expansion fails (xacro's message)"
+            continue
+        try:
+            specs[k] = read_urdf(path, be.design(k))
+        except (MechanismFileError, UsageError):
+            why[k] = "its file is refused (the reader's message)"
+    return specs, why
