@@ -165,9 +165,10 @@ def _rates(mech: Mechanism, args: argparse.Namespace, names: list[str], held: di
     return typed, rates, accels
 
 
-def _solve(mech: Mechanism, args: argparse.Namespace, values: dict[str, float], near: dict[str, float],
-           given: dict[str, float], held: dict[str, float], rates: dict[str, float],
-           accels: dict[str, float] | None, points: dict, data: dict) -> tuple[PositionResult, np.ndarray]:
+def _solve_configuration(mech: Mechanism, args: argparse.Namespace, values: dict[str, float],
+                         near: dict[str, float], given: dict[str, float], held: dict[str, float],
+                         rates: dict[str, float], accels: dict[str, float] | None, points: dict,
+                         data: dict) -> tuple[PositionResult, np.ndarray]:
     """The configuration solved for the inputs' ``values``, in the mode analysed (--mode K, chosen and said as
     every command chooses and says it): (its position result, q)."""
     q0 = mech.generic_configurations()[0].q
@@ -241,7 +242,7 @@ def _equations(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names: 
     return loops, eq, equations_section(eq)
 
 
-def _motion(mech: Mechanism, pres: PositionResult | None, typed: dict[str, dict], rates: dict[str, float],
+def _motion_section(mech: Mechanism, pres: PositionResult | None, typed: dict[str, dict], rates: dict[str, float],
             accels: dict[str, float] | None, points: dict, data: dict) -> Section:
     """The positions, velocities and accelerations section."""
     if pres is None:
@@ -301,7 +302,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     pres, q = None, q0
     values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
     if names or held:
-        pres, q = _solve(mech, args, values, near, given, held, rates, accels, points, data)
+        pres, q = _solve_configuration(mech, args, values, near, given, held, rates, accels, points, data)
     topo = mech.topology(q)
     configuration = _configuration_text(mech, names, values, given, held)
     data["configuration"] = values
@@ -309,7 +310,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     loops, eq, section = _equations(mech, args, q, names, held, topo, notes, data)
     sections.append(section)
     sections.append(_newton(mech, args, loops, q, values, names, notes, data, held))  # from an estimate
-    sections.append(_motion(mech, pres, typed, rates, accels, points, data))
+    sections.append(_motion_section(mech, pres, typed, rates, accels, points, data))
     sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held,
                                     typed_rates={pivots[k][0] if k in pivots else k: v
                                                  for k, v in typed["rate"].items()})

@@ -448,7 +448,7 @@ class _Tree:
                      f"{', ...' if len(n) > 3 else ''}) give several numbers: the first is read, as MuJoCo reads it")
 
 
-def _couplings(path: str | Path, r: _Reader, couplings: list) -> list:
+def _joint_couplings(path: str | Path, r: _Reader, couplings: list) -> list:
     """The <equality><joint> couplings, each joint's chain resolved to a joint that moves on its own."""
     p = r.problems
     chains = {}
@@ -481,7 +481,7 @@ def read_mjcf(path: str | Path, text: str, root: Element | None = None,
     p.fail_if_any(path)
     cuts, couplings = read_equalities(r, tree.world, tree.sites, tree.mjoints, tree.reference,
                                       set(tree.mjoints) | set(tree.links))
-    couplings = _couplings(path, r, couplings)
+    couplings = _joint_couplings(path, r, couplings)
     tendons = read_tendons(r, tree.mjoints)
     transmissions, inputs, unused = read_actuators(r, tree.mjoints, tendons, {c.joint: c for c in couplings})
     p.fail_if_any(path)

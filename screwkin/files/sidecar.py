@@ -129,7 +129,7 @@ def _read_loops(spec: MechanismSpec, content: dict, yaml_path: Path, frame_names
         )
 
 
-def _read_joints(spec: MechanismSpec, content: dict, problems: Problems) -> None:
+def _read_actuation(spec: MechanismSpec, content: dict, problems: Problems) -> None:
     """The actuated joints (name_mot) and the joint replacements (joint_name, joint_type) of ``spec``."""
     joint_types = {j.name: j.type for j in spec.joints}
     names = _string_list(content, "name_mot", problems)
@@ -180,7 +180,7 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: Iterabl
     problems = Problems()
     unknown = _unknown_keys(content, problems)
     _read_loops(spec, content, yaml_path, frame_names, frame_body, problems)
-    _read_joints(spec, content, problems)
+    _read_actuation(spec, content, problems)
     if problems:  # the misspelt key is likely the cause (closed_loops: then "0 pairs but type has 1")
         problems[:0] = unknown
     problems.fail_if_any(yaml_path)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os.path
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -30,9 +30,6 @@ from ._pin import frame_id
 from .geometry import lines_point
 from .six_bar import six_bar_inversion
 from .state import KinematicState
-
-if TYPE_CHECKING:
-    from .mechanism import Mechanism
 
 __all__ = ["Joint", "Topology", "build_topology", "frame_link", "UnionFind", "open_joints"]
 
@@ -448,7 +445,7 @@ def _compound_joint(chain: list[_Edge], kind: str, links: tuple[str, str]) -> Jo
     )
 
 
-def _bodies(mech: Mechanism, welds: list) -> tuple[UnionFind, str, dict[str, list[str]], dict[str, str]]:
+def _bodies(mech: Any, welds: list) -> tuple[UnionFind, str, dict[str, list[str]], dict[str, str]]:
     """The rigid bodies the welds make of the links: (their union-find, the ground's root, root -> its links,
     root -> the body's name: its first URDF link, the ground's the root link)."""
     spec = mech.spec
@@ -463,8 +460,9 @@ def _bodies(mech: Mechanism, welds: list) -> tuple[UnionFind, str, dict[str, lis
     return uf, ground_root, groups, body_name
 
 
-def build_topology(mech: Mechanism, q: np.ndarray) -> Topology:
-    """Links, joints (with compound joints recognized) and motion space at configuration q."""
+def build_topology(mech: Any, q: np.ndarray) -> Topology:
+    """Links, joints (with compound joints recognized) and motion space at configuration q (``mech``: a
+    model.mechanism.Mechanism, which imports this module)."""
     tol = mech.tolerances.geometry
     spec = mech.spec
     edges, welds = _edges(mech, q)
