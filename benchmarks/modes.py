@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 import screwkin  # noqa: E402
-from screwkin.analysis.motion.position import PositionSolver  # noqa: E402
+from screwkin.analysis.position.position import PositionSolver  # noqa: E402
 from screwkin.model import algebraic  # noqa: E402
 from test_certified import stewart_urdf  # noqa: E402
 

@@ -168,7 +168,7 @@ def closed_loop_fk(names, solves):
     import yaml
 
     from screwkin.model.linalg import null_space
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     tb = _toolbox()
     rows = []
@@ -253,7 +253,7 @@ def closed_loop_fk(names, solves):
 
 # ---------------------------------------------------------------- 3. sweep throughput
 def sweep_throughput(steps):
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     rows = []

@@ -89,7 +89,7 @@ class Tolerances:
                     on one tangent space (an irreducible quadric cone on a kernel of dimension d has
                     about d^2 / 4: 361 for a 40-joint loop folded flat, all continued); beyond, an even
                     spread of them, and the answer says so (mobility --local-samples N) [-].
-    closed_form:    closed forms (model/subproblems.py, model/leg_chains.py, analysis/motion/pieper.py): lines
+    closed_form:    closed forms (model/subproblems.py, model/leg_chains.py, analysis/position/pieper.py): lines
                     meet at a point, a pivot lies on its axis, a discriminant is not negative, a rotation
                     matrix is not singular, two axes are not parallel, when within this, relative to the
                     scale (the characteristic length for lengths, 1 for directions) [-].

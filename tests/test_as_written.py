@@ -15,8 +15,8 @@ from conftest import DATA, circles
 from scipy.optimize import brentq
 
 import screwkin
-from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.position.position import PositionSolver
+from screwkin.analysis.singular import classify
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 
@@ -378,7 +378,7 @@ def test_3rpr_inverse_kinematics_labels_reversed_legs():
     mech = screwkin.load(DATA.parent.parent / "robots" / "planar_3rpr.urdf")
     home = mech.model.createData()
     pin.framesForwardKinematics(mech.model, home, mech.neutral())
-    from screwkin.analysis.motion.ik import inverse_kinematics
+    from screwkin.analysis.position.ik import inverse_kinematics
 
     res = inverse_kinematics(mech, "platform", home.oMf[mech.link_frame("platform")])
     first = res.solutions[0]
@@ -440,7 +440,7 @@ def test_loop_joint_written_like_a_joint(tmp_path):
     import numpy as np
 
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     path = tmp_path / "fourbar.urdf"
     path.write_text(JOINT_STYLE_LOOP)

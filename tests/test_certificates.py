@@ -24,8 +24,8 @@ import pytest
 import screwkin
 import stewart_forms as sf
 from conftest import ROBOTS
-from screwkin.analysis.motion import certified
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position import certified
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.files import generic_cache
 
 ZERO = {f"leg{k}": 0.0 for k in range(1, 7)}

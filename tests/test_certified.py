@@ -10,9 +10,9 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion import certified
-from screwkin.analysis.motion.ik import inverse_kinematics
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position import certified
+from screwkin.analysis.position.ik import inverse_kinematics
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 from screwkin.model import tracking
 from screwkin.model.algebraic import PolynomialClosure

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import screwkin
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 

@@ -88,7 +88,7 @@ def test_a_sweep_imports_no_other_analysis():
     code = ("import sys\nfrom screwkin import cli\ncode = cli.main(['sweep', %r, '--input', 'crank_joint', "
             "'--from', '0', '--to', '1', '--steps', '3', '--json'])\n"
             "print(code, sorted(m for m in ('screwkin.analysis.forces.dynamics', 'screwkin.analysis.design.study', "
-            "'screwkin.parallel.study', 'screwkin.analysis.motion.ik') if m in sys.modules))" % str(fourbar))
+            "'screwkin.parallel.study', 'screwkin.analysis.position.ik') if m in sys.modules))" % str(fourbar))
     assert _last_line(code) == "0 []"
 
 

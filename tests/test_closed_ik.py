@@ -14,8 +14,8 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.ik import branches, inverse_kinematics
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.ik import branches, inverse_kinematics
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.model.leg_chains import leg_poses, platform_of, set_leg
 from screwkin.model.limits import outside_limits
 

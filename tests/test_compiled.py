@@ -9,7 +9,7 @@ import pytest
 from conftest import CORPUS, ROBOTS, fourbar
 
 import screwkin
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.model import compiled, newton
 
 pytest.importorskip("numba")

@@ -14,7 +14,7 @@ import pytest
 import screwkin
 from conftest import ROBOTS, screwkin_cli
 from screwkin.analysis.singularities.ellipsoids import with_input_output_condition
-from screwkin.analysis.singularities.singular import classify as classify_only
+from screwkin.analysis.singular import classify as classify_only
 
 
 def classify(mech, q, output):

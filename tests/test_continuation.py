@@ -27,7 +27,7 @@ import screwkin
 from screwkin.analysis.motion.batch_sweep import BatchedCurve, batch_closure
 from screwkin.analysis.motion.continuation import (Curve, Neighbour, jumped, locate, orient, passes_limit,
                                                    projections)
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 
 ROOT = Path(__file__).resolve().parents[1]

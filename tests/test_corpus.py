@@ -147,7 +147,7 @@ def test_corpus_solves_for_motor_inputs(name):
     A motor step is not used: several of these files assemble next to an
     actuator singularity, where some motor steps cannot be followed at all."""
     from screwkin.model.linalg import null_space
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     # a tight closure tolerance so that a small finite-difference step is not drowned in it:
     # wl16_like assembles next to a singularity, where the motion curves sharply

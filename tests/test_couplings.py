@@ -13,7 +13,7 @@ import screwkin
 from conftest import ROBOTS
 from screwkin.model._pin import compute_frame_jacobian
 from screwkin.cli import main
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 
 GRIPPER = ROBOTS / "gripper_arm_mimic.urdf"

@@ -10,7 +10,7 @@ import pytest
 
 from screwkin import load
 from screwkin.analysis.course.vector_loops import VectorLoops
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 
 WHEELS, RACK, GEARS = "robots/friction_wheels.urdf", "robots/rack_pinion.urdf", "robots/gear_train_idler.urdf"

@@ -1,5 +1,5 @@
-"""Every assembly mode of a planar mechanism made of dyads, in closed form (analysis.motion.dyad_modes):
-the same modes as the homotopy continuation it stands in for (analysis.motion.certified.certified_modes,
+"""Every assembly mode of a planar mechanism made of dyads, in closed form (analysis.position.dyad_modes):
+the same modes as the homotopy continuation it stands in for (analysis.position.certified.certified_modes,
 an independent method: monodromy and the trace test on the polynomial closure), the same counts of
 real and complex solutions, and the textbook's closed forms written here (the slider-crank's
 circle-line intersection, the non-Grashof four-bar's limit positions by the law of cosines)."""
@@ -12,8 +12,8 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion import certified
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position import certified
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 from screwkin.errors import AssemblyError
 

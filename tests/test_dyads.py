@@ -16,7 +16,7 @@ import screwkin
 from conftest import CORPUS, ROBOTS
 from screwkin.analysis.motion.dyads import planar_sweep
 from screwkin.analysis.motion.links import Point, motion_along
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.model.planar_graph import DyadPlan, plan
 from screwkin.tolerances import Tolerances
@@ -331,7 +331,7 @@ def test_closed_form_up_to_a_range_end_next_to_a_limit_position():
     Now it keeps the closed form, and agrees with the tracker (whose passive joints converge only to about
     the square root of the closure tolerance at the last, nearly singular, value)."""
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     mech = screwkin.load(ROBOTS / "fourbar.urdf.xacro",
@@ -353,7 +353,7 @@ def test_a_grid_too_coarse_to_unwrap_is_read_from_a_finer_closed_form():
     samples) are computed on a grid 8 times finer and read at the three values: still the closed form,
     and the tracker's answer (which takes steps of at most Tolerances.max_step between the values)."""
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     mech = screwkin.load(ROBOTS / "fourbar_crank_rocker.urdf")

@@ -9,7 +9,7 @@ import pytest
 import screwkin
 from conftest import LINK, fourbar, rev
 from screwkin.analysis.singularities.ellipsoids import ellipsoids, ellipsoids_of
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.errors import UsageError
 
 L1, L2 = 0.3, 0.2

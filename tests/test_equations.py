@@ -12,7 +12,7 @@ import sympy
 
 from screwkin.analysis.course.equations import equations
 from screwkin.analysis.course.vector_loops import VectorLoops
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main
 from screwkin.model.loader import load

@@ -10,7 +10,7 @@ import pytest
 
 import screwkin
 from conftest import CORPUS, ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 
 mujoco = pytest.importorskip("mujoco")

@@ -8,8 +8,8 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.singularities.singular import STATIONARY, classify, gram_cofactors, loop_twists
+from screwkin.analysis.position.position import PositionSolver
+from screwkin.analysis.singular import STATIONARY, classify, gram_cofactors, loop_twists
 from screwkin.cli import main
 from screwkin.files.description import CUT_JOINT_DOF
 from screwkin.model.joint_types import JOINT_TYPES, joint_type

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from screwkin import load
-from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.singularities.singular import classify, gram_cofactors
+from screwkin.analysis.position.position import PositionSolver
+from screwkin.analysis.singular import classify, gram_cofactors
 from screwkin.cli import main
 
 WHEELS, RACK, GEARS = "robots/friction_wheels.urdf", "robots/rack_pinion.urdf", "robots/gear_train_idler.urdf"
@@ -181,7 +181,7 @@ def test_pair_rate_is_the_relative_turning_and_the_gram_null_vector_agrees():
     slider that does not turn), the rates here by central differences of solved configurations; the loop's null
     vector v (adj G = c v v^T) has v_wheels / v_wheel2 = the same rate over theta2'."""
     import pinocchio as pin
-    from screwkin.analysis.singularities.singular import loop_twists, pair_rate
+    from screwkin.analysis.singular import loop_twists, pair_rate
     from screwkin.model.state import KinematicState
     t, dt = np.radians(30.0), 1e-6
     mech, q = solved(WHEELS, "wheel2_joint", t)

@@ -1,5 +1,5 @@
 """singularities --symbolic (issue 25 item 5): each planar loop's Gram cofactors in the symbols of
-screwkin equations, checked against the numeric cofactors of analysis.singularities.singular.gram_cofactors (an SVD-free
+screwkin equations, checked against the numeric cofactors of analysis.singular.gram_cofactors (an SVD-free
 determinant of the twist matrix from Pinocchio's Jacobians) at solved configurations, and against the
 four-bar's textbook fact that its rocker is stationary when crank and coupler are collinear."""
 
@@ -14,8 +14,8 @@ from conftest import DATA, ROBOTS
 from screwkin import load
 from screwkin.analysis.course.vector_loops import VectorLoops
 from screwkin.analysis.singularities.gram_symbolic import symbolic_gram
-from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.singularities.singular import gram_cofactors
+from screwkin.analysis.position.position import PositionSolver
+from screwkin.analysis.singular import gram_cofactors
 from screwkin.cli import main
 
 CASES = [(ROBOTS / "fourbar_crank_rocker.urdf", "crank_joint", (0.4, 1.9, -2.2)),

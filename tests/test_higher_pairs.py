@@ -10,7 +10,7 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.singular_points import locate_singularities
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main

@@ -13,7 +13,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from screwkin.analysis.motion.ik import branches, inverse_kinematics
+from screwkin.analysis.position.ik import branches, inverse_kinematics
 
 from conftest import ROBOTS
 

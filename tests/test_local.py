@@ -201,7 +201,7 @@ def test_bennett_and_sarrus_move_with_one_freedom_everywhere(name, kutzbach, row
     again with rank(K) = nv - 1 there: finite mobility 1, said to order 6, not more."""
     mech = screwkin.load(ROBOTS / name)
     assert mech.topology().kutzbach == kutzbach
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     inp = mech.actuated[0]
@@ -217,7 +217,7 @@ def test_bennett_and_sarrus_move_with_one_freedom_everywhere(name, kutzbach, row
 def tsai_singular():
     """Tsai's 3-UPU with the platform centre at (0.2, 0, 0.3), not turned (legs from value_for_leg_length)."""
     mech = screwkin.load(ROBOTS / "tsai_3upu.urdf")
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     P = np.array([0.2, 0.0, 0.3])
     values = {}

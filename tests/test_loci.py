@@ -12,7 +12,7 @@ from loci_robots import FIVE_BAR, RPR_BASE, five_bar, rpr3, rpr3_cusp, rpr3_poly
 from numpy.polynomial import Polynomial
 
 import screwkin
-from screwkin.analysis.motion.connect import loop, wedge_direction
+from screwkin.analysis.position.connect import loop, wedge_direction
 from screwkin.analysis.singularities.loci import trace_loci
 from screwkin.analysis.singularities.regions import regions
 

@@ -24,7 +24,7 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 from test_robots import TABLE
 
@@ -169,7 +169,7 @@ def test_default_solve_falls_back_to_the_search_where_newton_fails(monkeypatch):
     """Newton from the file's configuration made to fail (rssr: a polynomial closure, no dyads): solve says
     so in a note and searches every mode, as --all does."""
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.errors import AssemblyError
 
     mech = screwkin.load(ROBOTS / "rssr.urdf")

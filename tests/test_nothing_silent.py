@@ -8,7 +8,7 @@ import pytest
 
 from conftest import ROBOTS
 from screwkin import load
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.present.report import sweep_dict, sweep_text
 

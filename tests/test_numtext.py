@@ -7,7 +7,7 @@ import pytest
 
 import screwkin
 from conftest import fourbar
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.present.numtext import W, csv_rows, g12_bytes
 from screwkin.present.report import sweep_columns, sweep_csv

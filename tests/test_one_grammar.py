@@ -92,7 +92,7 @@ def test_a_sweep_says_what_its_rates_are_for(tmp_path, capsys):
 def test_the_sweep_plot_says_the_input_rate(tmp_path):
     pytest.importorskip("matplotlib")
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
     from screwkin.present.plots import motion_figure
 

@@ -218,7 +218,7 @@ def _virtual_work_torque(mech, theta, output="link3", wrench=BENNETT_LOAD, h=1e-
     at theta +- h (the same assembly mode: the solutions nearest), the output frame's
     displacement twist by central differences of log6 from the middle placement, turned to world
     axes at the frame's origin (the load's convention), and power balance tau h + w . twist = 0."""
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     solver = PositionSolver(mech, ["joint1"])
     q0 = solver.solve({"joint1": theta}).solutions[0].q

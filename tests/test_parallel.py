@@ -15,10 +15,10 @@ from scipy.optimize import brentq
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.ik import inverse_kinematics
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.ik import inverse_kinematics
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.screws import split_jacobians
-from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.singular import classify
 from screwkin.analysis.motion.sweep import sweep
 
 

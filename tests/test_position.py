@@ -9,7 +9,7 @@ import pytest
 import screwkin
 from conftest import fourbar
 from screwkin.cli import main
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 
 G, A, B, C = 0.10, 0.04, 0.12, 0.08  # ground, crank, coupler, rocker of conftest.fourbar()
 

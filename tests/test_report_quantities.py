@@ -19,7 +19,7 @@ from conftest import ROBOTS
 
 import screwkin
 from screwkin.analysis.motion.planar import LinkAngles
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 
 SLIDER_CRANK = str(ROBOTS / "slider_crank_offset.urdf")

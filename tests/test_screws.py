@@ -55,7 +55,7 @@ def test_revolute_twist_and_planar_form(tmp_path):
 
 
 def test_forward_jacobian_of_a_four_bar_against_finite_differences(tmp_path):
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     p = tmp_path / "fb.urdf"
     p.write_text(fourbar())
@@ -104,7 +104,7 @@ def test_every_joint_of_a_loop_the_cut_joint_included(capsys):
     import pinocchio as pin
 
     from screwkin import load
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.screws import loop_product, loop_screws
     from screwkin.cli import main
     from screwkin.model.state import KinematicState

@@ -13,7 +13,7 @@ from conftest import DATA, ROBOTS, circles
 
 import screwkin
 from screwkin.analysis.motion.link_inputs import holding_angles
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 
 FIVE = ROBOTS / "five_bar.urdf"

@@ -9,8 +9,8 @@ import screwkin
 from screwkin.present.report import map_csv
 from conftest import fourbar, planar_3r, slider_crank
 from screwkin.cli import main
-from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.position.position import PositionSolver
+from screwkin.analysis.singular import classify
 from screwkin.analysis.motion.singular_points import locate_singularities
 from screwkin.analysis.motion.sweep import sweep
 from test_position import A, B, C, G

@@ -17,7 +17,7 @@ import sympy as sp
 
 from conftest import ROBOTS, circles
 from screwkin import load
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 from screwkin.model.state import KinematicState
 

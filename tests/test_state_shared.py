@@ -20,7 +20,7 @@ import screwkin.model.mechanism as mechanism
 from conftest import ROBOTS
 from screwkin.analysis.forces.statics import statics
 from screwkin.analysis.motion.batch_closure import TreeKinematics
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.model.state import KinematicState, model_with_output, place_tool
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -213,7 +213,7 @@ PINOCCHIO_KINEMATICS = {
     "model/state.py": "the state itself",
     "model/_pin.py": "the shape-fixing wrappers of Pinocchio's calls",
     "model/closure.py": "the closure's residual and Jacobian (the Newton loops' inner loop)",
-    "analysis/motion/position.py": "the position solver's mode signature, at every start",
+    "analysis/position/position.py": "the position solver's mode signature, at every start",
     "analysis/motion/links.py": "frame motions of a stack of configurations (Pinocchio a step)",
     "analysis/motion/batch_closure.py": "batched kinematics and closure, their self-checks against Pinocchio",
     "analysis/singularities/batch.py": "frame Jacobians of a stack of configurations",

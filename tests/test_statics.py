@@ -9,7 +9,7 @@ import pytest
 
 import screwkin
 from conftest import DATA, ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.forces.statics import legs, statics
 from screwkin.cli import main
 from screwkin.model.linalg import null_space

@@ -7,7 +7,7 @@ import screwkin
 from conftest import fourbar
 from screwkin.cli import main
 from screwkin.analysis.motion.planar import identify
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.sweep import sweep
 from test_position import A, B, C, G, rocker_angles, world_angles
 

@@ -7,7 +7,7 @@ import pytest
 
 import screwkin
 from conftest import fourbar
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.stream import sweep_chunks
 from screwkin.analysis.motion.sweep import sweep
 from screwkin.cli import main

@@ -13,7 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 import screwkin
-from screwkin.analysis.singularities.singular import classify
+from screwkin.analysis.singular import classify
 from screwkin.model.state import KinematicState
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"

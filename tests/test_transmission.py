@@ -6,7 +6,7 @@ import pytest
 import screwkin
 from conftest import ROBOTS
 from screwkin.analysis.motion.planar import identify, transmission_angles
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 
 DRAWN = np.radians(60)  # both files are drawn with the crank at 60 deg from the world x axis
 CRANKS = np.radians([0.0, 30.0, 75.0, 140.0, 200.0, 260.0, 330.0])  # crank_joint values

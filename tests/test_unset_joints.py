@@ -15,7 +15,7 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
 from screwkin.model.topology import open_joints
 from test_couplings import ROBOT_DATA

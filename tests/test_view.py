@@ -39,7 +39,7 @@ def test_scene_contents_and_colours(delta):
 def test_every_drawn_transform_matches_the_solved_configuration(delta):
     """What is sent to meshcat for each object equals Pinocchio's placement of its
     joint at the solved configuration times the object's placement on it."""
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     mech, _ = delta
     s = PositionSolver(mech).solve({"arm1": 0.2, "arm2": -0.1, "arm3": 0.05}).solutions[0]
@@ -58,7 +58,7 @@ def test_every_drawn_transform_matches_the_solved_configuration(delta):
 
 
 def test_motion_becomes_a_meshcat_animation(delta):
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     mech, q = delta

@@ -1,4 +1,4 @@
-"""view --interactive (issue 27.1): the state behind the controls (screwkin.analysis.motion.interactive)
+"""view --interactive (issue 27.1): the state behind the controls (screwkin.analysis.position.interactive)
 and the viser page wired to it.  A control moved gives the configuration `solve` gives at that
 input, on the assembly mode the mechanism was in (the sign of the triangle B C D of the
 four-bar, written here); switching modes keeps every loop closed (the two frames of each cut
@@ -14,9 +14,9 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.interactive import Interactive
+from screwkin.analysis.position.interactive import Interactive
 from screwkin.analysis.motion.links import Point
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 
 FOURBAR = ROBOTS / "fourbar_crank_rocker.urdf"
 NON_GRASHOF = ROBOTS / "fourbar_non_grashof.urdf"  # input 0.08 drawn at 70 deg, ground 0.1, coupler 0.09, output 0.075
@@ -280,7 +280,7 @@ def test_a_points_traced_path_holds_solves_positions_at_the_inputs_passed(fourba
 
 
 def test_the_path_is_bounded(fourbar, monkeypatch):
-    import screwkin.analysis.motion.interactive as mod
+    import screwkin.analysis.position.interactive as mod
 
     monkeypatch.setattr(mod, "MAX_PATH", 7)
     live = Interactive(fourbar, points=[Point("P", "coupler", (0.06, 0.02, 0.0))])

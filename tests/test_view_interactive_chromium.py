@@ -26,7 +26,7 @@ import pytest
 
 import screwkin
 from conftest import readme_fourbar
-from screwkin.analysis.motion.interactive import Interactive
+from screwkin.analysis.position.interactive import Interactive
 from screwkin.present.view import chromium
 
 pytestmark = [pytest.mark.chromium, pytest.mark.slow,

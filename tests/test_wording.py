@@ -11,8 +11,8 @@ import pytest
 
 import screwkin
 from conftest import ROBOTS
-from screwkin.analysis.motion.position import PositionSolver
-from screwkin.analysis.singularities.singular import classify, lost_direction
+from screwkin.analysis.position.position import PositionSolver
+from screwkin.analysis.singular import classify, lost_direction
 from screwkin.cli import main
 from screwkin.model._pin import joint_axis
 from screwkin.model.state import KinematicState

@@ -18,7 +18,7 @@ from conftest import ROBOTS, screwkin_cli
 
 import screwkin
 from screwkin.analysis.motion.batch_closure import BatchClosure
-from screwkin.analysis.motion.ik import inverse_kinematics
+from screwkin.analysis.position.ik import inverse_kinematics
 from screwkin.analysis.design.workspace import workspace
 from screwkin.errors import UsageError
 

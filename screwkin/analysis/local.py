@@ -33,7 +33,7 @@ mobility cross: a change point), "kinematotropic" (branches of different mobilit
 rigid; or a branch along which the instantaneous mobility stays above the finite one, Mueller's shaky
 linkage), "singular" (one branch with more instantaneous than finite mobility here only, or a cone
 point), "rigid" (no motion at all: ker K = 0), "undecided" (the series alone cannot tell).
-Ranks are decided as analysis.singularities.singular decides a constraint singularity: singular
+Ranks are decided as analysis.singular decides a constraint singularity: singular
 values of the dimensionless K below ``Tolerances.singular`` times the largest are lost.
 """
 
@@ -47,7 +47,7 @@ import pinocchio as pin
 from ..errors import AssemblyError
 from ..model.linalg import rank
 from .loop_series import Series, loop_system
-from .singularities.singular import scaled_jacobians
+from .singular import scaled_jacobians
 
 __all__ = ["Branch", "LocalAnalysis", "local_analysis", "KINDS", "quadratic_forms", "rates_of"]
 

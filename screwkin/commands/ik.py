@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pinocchio as pin
 
-from ..analysis.motion.ik import branches, inverse_kinematics
+from ..analysis.position.ik import branches, inverse_kinematics
 from ..errors import UsageError, quote
 from ..present.jsonout import json_of
 from ..present.report import position_dict, position_text
@@ -93,7 +93,7 @@ def run(mech, args) -> int:
 
 
 def _closed_text(mech, res, count) -> str:
-    """The search line of a closed-form answer (analysis.motion.closed_ik), and for a platform whose
+    """The search line of a closed-form answer (analysis.position.closed_ik), and for a platform whose
     combinations are not all listed each leg's other branch beside the first solution."""
     c = res.modes
     ms = f" ({c.detail.get('seconds', 0) * 1e3:.3g} ms)"

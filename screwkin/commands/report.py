@@ -23,7 +23,7 @@ from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
-from ..analysis.motion.modes import choose_mode
+from ..analysis.position.modes import choose_mode
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
@@ -70,7 +70,7 @@ from ._values import check_rate_names, joint_quantities, link_rates, rate_items,
 from ._options import check_writable, count, screwkin_version
 
 if TYPE_CHECKING:
-    from ..analysis.motion.solution import PositionResult
+    from ..analysis.position.solution import PositionResult
     from ..model.mechanism import Mechanism
     from ..model.topology import Topology
     from ..present.document import Section

@@ -6,7 +6,7 @@ from __future__ import annotations
 from ..analysis.singularities.ellipsoids import ellipsoids, with_input_output_condition
 from ..analysis.singularities.gram_symbolic import symbolic_gram
 from ..analysis.local import local_analysis
-from ..analysis.singularities.singular import classify, named_types
+from ..analysis.singular import classify, named_types
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text

@@ -45,7 +45,7 @@ from ._values import check_rate_names, joint_quantities, joint_value, names_list
 from ._options import BOUNDS, count
 
 if TYPE_CHECKING:
-    from ..analysis.motion.position import PositionSolver
+    from ..analysis.position.position import PositionSolver
     from ..analysis.motion.sweep import SweepResult
     from ..model.mechanism import Mechanism
 

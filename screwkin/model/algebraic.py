@@ -1,5 +1,5 @@
 """The loop-closure equations as polynomials, for complex coordinates: what the certified
-assembly-mode search (analysis.motion.certified) tracks.
+assembly-mode search (analysis.position.certified) tracks.
 
 Unknowns x (dimensionless), per passive joint of the spanning tree:
 - revolute or continuous: (c, s), the cosine and sine of its angle, on the circle c^2 + s^2 = 1;
@@ -449,7 +449,7 @@ class PolynomialClosure:
         return rows_all(self, self.placed("rows")(X, jacobian=False), jacobian=False)[0].T
 
     def signature(self, X) -> np.ndarray:
-        """What tells assembly modes apart (analysis.motion.position.PositionSolver.signature, in
+        """What tells assembly modes apart (analysis.position.position.PositionSolver.signature, in
         units of L, complex): every joint frame's origin (but the eliminated legs', which their ends
         fix), the points' and the output frame's pose."""
         kin = self.kinematics(X, jacobian=False)

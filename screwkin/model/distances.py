@@ -1,5 +1,5 @@
 """Two rigid bodies joined by six distances (a Stewart-Gough platform), in the platform's own pose:
-the system a coefficient-parameter homotopy tracks (analysis.motion.generic_modes), the same whether
+the system a coefficient-parameter homotopy tracks (analysis.position.generic_modes), the same whether
 the file writes the platform on a floating joint or carried by one leg in the tree.
 
 Unknowns x = (t / L, q): the translation of the platform's frame and its quaternion (Pinocchio's

@@ -11,11 +11,11 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
-from ..analysis.motion.modes import continuum_words
-from ..analysis.motion.solution import NEWTON_FROM_FILE, PositionResult, search_method
+from ..analysis.position.modes import continuum_words
+from ..analysis.position.solution import NEWTON_FROM_FILE, PositionResult, search_method
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
-from ..analysis.singularities.singular import SingularityReport
+from ..analysis.singular import SingularityReport
 from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from ..units import in_unit
@@ -84,7 +84,7 @@ def position_dict(res) -> dict:
 
 
 def modes_dict(c) -> dict:
-    """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
+    """analysis.position.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
             "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail),

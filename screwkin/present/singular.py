@@ -1,4 +1,4 @@
-"""A singularity report (analysis.singularities.singular.SingularityReport) as text and as a JSON-ready
+"""A singularity report (analysis.singular.SingularityReport) as text and as a JSON-ready
 dictionary: the singularities present, the stationary joints, the loops' Gram cofactors, the condition
 numbers and the singular directions."""
 
@@ -8,7 +8,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from ..analysis.singularities.singular import SingularityReport
+from ..analysis.singular import SingularityReport
 from .screws import screw_dict
 from .tables import fmt_vec as _fmt_vec
 from .tables import table

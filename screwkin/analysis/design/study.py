@@ -36,8 +36,8 @@ from ...files.xmlsafe import read_regular_file
 from ...model.loader import load
 from ..mobility import analyze_mobility
 from ..motion.planar import identify
-from ..motion.modes import choose_mode
-from ..motion.position import PositionSolver
+from ..position.modes import choose_mode
+from ..position.position import PositionSolver
 from .workspace import DEFAULT_THRESHOLD, workspace
 
 __all__ = [
@@ -182,7 +182,7 @@ class StudyTask:
     point: bool
     workspace: dict
     timeout: float = 120.0  # seconds per design
-    mode: int | None = None  # the K-th assembly mode (motion.modes.choose_mode); None: the first
+    mode: int | None = None  # the K-th assembly mode (position.modes.choose_mode); None: the first
 
 
 class StudyDesign:

@@ -21,7 +21,7 @@ Two methods:
   measure of ``scan`` (smallest over largest singular value of the point's Jacobian).  A
   cell's measure is the best of its samples (the posture the arm would choose).
 
-The measures at each point are those of analysis.singularities.singular, made dimensionless with the
+The measures at each point are those of analysis.singular, made dimensionless with the
 mechanism's one characteristic length: ``actuator`` (relative smallest singular value of the
 passive columns of K), ``serial`` (of the output's motion J_o V, relative to |J_o|), and the
 ``conditioning`` of the map from input rates to the output's motion (smallest over largest
@@ -47,7 +47,7 @@ from ...model.state import KinematicState
 from ..singularities.batch import SerialJacobians
 from ..motion.batch_closure import BatchClosure, Unbatchable
 from ...model.limits import within_limits
-from ..singularities.singular import Generic
+from ..singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions
 
 if TYPE_CHECKING:

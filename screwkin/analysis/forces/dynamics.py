@@ -46,7 +46,7 @@ from ...errors import MechanismFileError, UsageError, quote
 from ...model.geometry import cross3
 from ...model.state import KinematicState
 from ...tolerances import DEFAULT
-from ..motion.position import PositionSolver
+from ..position.position import PositionSolver
 from .joint_dynamics import JointDynamics, joint_dynamics, left_out_note, names_text as _names
 from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
                       reaction_joint_id, reaction_table)

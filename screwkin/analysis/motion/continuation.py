@@ -38,7 +38,7 @@ import pinocchio as pin
 
 from ...errors import AssemblyError
 from ...model.geometry import TINY
-from ..singularities.singular import measures
+from ..singular import measures
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -188,7 +188,7 @@ def returned(mech, x, start, h, q, q0, scale) -> bool:
 
 
 def at_change_point(solver, q) -> dict:
-    """The singularity measures at a located limit position q (analysis.singularities.singular.measures),
+    """The singularity measures at a located limit position q (analysis.singular.measures),
     with "change": whether K itself loses rank there (a change point, not a limit position: the input
     passes it on a branch that goes on)."""
     m = measures(solver.mech, q, solver.generic())

@@ -1,6 +1,6 @@
 """Published bounds on the number of isolated solutions of classes of mechanism problems, and how a
 mechanism is recognized as one: a second certificate for a homotopy's result, where the trace test
-would cost too much (analysis.motion.certified).  A result that reaches the bound has found them all.
+would cost too much (analysis.position.certified).  A result that reaches the bound has found them all.
 
 - Stewart-Gough platforms: two rigid bodies joined by six distances (legs whose passive joints are
   revolutes meeting at a point at each end, written as universal and spherical joints, their length

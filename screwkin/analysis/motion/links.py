@@ -295,7 +295,7 @@ def _stroke_end(solver, res, name, coordinate, x, guess):
 def strokes(res, motion, mech, solver=None) -> list:
     """A Stroke for each slider coordinate (prismatic tree joint or prismatic loop joint) of a sweep
     ``res`` (analysis.motion.sweep.SweepResult) with its MotionAlong.  With the sweep's ``solver``
-    (analysis.motion.position.PositionSolver) each end is located on the mechanism (Brent's method on
+    (analysis.position.position.PositionSolver) each end is located on the mechanism (Brent's method on
     the slider's rate); without, on the cubic interpolant of the samples (O(h^4))."""
     series = []
     for k, name in enumerate(res.names):

@@ -1,5 +1,5 @@
 """Every isolated root of a square polynomial system, with a certificate: monodromy and the trace
-test on its linear-offset family (analysis.motion.certified builds the system from a mechanism).
+test on its linear-offset family (analysis.position.certified builds the system from a mechanism).
 
 The family.  A system G(x) = [g(x); r(x)] (k constraints, never moved -- a revolute's circle, a
 quaternion's norm --, then n - k rows) is solved for every offset c: r(x) = c.  A start pair is free:

@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...errors import AssemblyError
-from ..singularities.singular import Generic, measures, scaled_jacobians
+from ..singular import Generic, measures, scaled_jacobians
 from .links import LOCATE_XTOL
 from .crossing import dips, reclosing
 from .sweep import SweepResult, SweepSingularity

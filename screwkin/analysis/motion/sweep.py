@@ -27,7 +27,7 @@ from .crossing import START, crossing, follow, passed
 from .dyads import cached_plan, planar_sweep
 from ...model.limits import outside_limits
 from .tracker import Tracker
-from ..singularities.singular import scaled_jacobians
+from ..singular import scaled_jacobians
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
 

@@ -22,9 +22,9 @@ import numpy as np
 
 from ...errors import UsageError
 from ...tolerances import DEFAULT, Tolerances
-from ..motion.position import PositionSolver
+from ..position.position import PositionSolver
 from ...model.linalg import null_space, rank
-from .singular import SingularityReport, scaled_jacobians
+from ..singular import SingularityReport, scaled_jacobians
 
 __all__ = ["Ellipsoid", "Ellipsoids", "ellipsoids_of", "ellipsoids", "with_input_output_condition"]
 

@@ -8,7 +8,7 @@ singularity is the rank drop of a matrix A(q) whose columns are independent at g
 - serial (inverse kinematic, type I; needs an output): A = [K; J_o]: the joints move, loops closed,
   with the output at rest;
 
-both dimensionless as in analysis.singularities.singular (lengths over the characteristic length L).
+both dimensionless as in analysis.singular (lengths over the characteristic length L).
 Its locus is the curve of S where A v = 0 for a unit v: the solutions z = (q, v) of the augmented system
 
     F(z) = [closure rows r(q); held inputs - their values; A(q) v; (v.v - 1)/2] = 0,
@@ -43,7 +43,7 @@ from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
 from ..motion.continuation import locate, orient
 from .loci_seeds import crossings, refine_node, seed_configurations, sheets, unexplained_folds
-from .singular import LWA, Generic
+from ..singular import LWA, Generic
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
 

@@ -17,10 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError, quote, shorten
-from .singular import Generic, measures
+from ..singular import Generic, measures
 from ..motion.continuation import Neighbour
+from ..position.connect import apart
 
-__all__ = ["SingularityMap", "singularity_map", "seams", "apart"]
+__all__ = ["SingularityMap", "singularity_map", "seams"]
 
 
 @dataclass(frozen=True)
@@ -93,14 +94,6 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
                   f"configurations differ by more than {mech.tolerances.near_far:g} rad: continuation from one "
                   "does not arrive at the other): a seam between them",)
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
-
-
-def apart(mech, q1, q2) -> float:
-    """How far apart two configurations are: the norm of their difference, lengths over the
-    characteristic length (rad and characteristic lengths) [-]."""
-    d = mech.difference(q1, q2)
-    d[mech.translational] /= mech.length
-    return float(np.linalg.norm(d))
 
 
 def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.ndarray:

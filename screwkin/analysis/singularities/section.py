@@ -20,7 +20,7 @@ import numpy as np
 from ...errors import UsageError
 from ...model.state import KinematicState
 from .loci import Loci, LocusSystem, trace_kind
-from .singular import LWA
+from ..singular import LWA
 
 __all__ = ["Section", "SectionSystem", "trace_section"]
 

@@ -35,7 +35,7 @@ from ....model.loader import load
 from ....model.state import KinematicState
 from ...mobility import analyze_mobility
 from ...motion.planar import identify, transmission_angles
-from ...motion.position import PositionSolver
+from ...position.position import PositionSolver
 from ...motion.sweep import sweep
 from ...course.skeleton import numbering
 from ..targets import polished

@@ -34,7 +34,7 @@ from ...model.distances import SixDistances, chain_angles
 from ...model.legs import chain_distance
 from ...model.state import KinematicState
 from ...model.symmetry import SignGroup
-from .monodromy import MonodromyOptions, Roots, all_roots, to_target
+from ..motion.monodromy import MonodromyOptions, Roots, all_roots, to_target
 
 __all__ = ["platform_modes", "Architecture", "architecture", "generic_set"]
 
@@ -139,7 +139,7 @@ def generic_set(arch: Architecture, rng, options: MonodromyOptions):
 
 def platform_modes(solver, problem, closure, arch: Architecture, seed: int, options: MonodromyOptions, lift_legs):
     """The modes of a platform (see the module): (modes [(q, Assembly, angle sets, simple)], found, real,
-    complex, certificate or None, reason, detail, check) -- analysis.motion.certified makes them a
+    complex, certificate or None, reason, detail, check) -- analysis.position.certified makes them a
     Certified.  ``lift_legs(x)``: the configuration with the eliminated legs' angles solved from the
     closure's unknowns x, or None."""
     t0 = time.perf_counter()

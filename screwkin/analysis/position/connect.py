@@ -5,7 +5,7 @@ in the plane of two inputs (McAree & Daniel 1999; Zein, Wenger & Chablat 2008). 
 configuration round an ellipse of the inputs x and y (the other inputs held) by small steps, each a damped
 Newton solve from the last configuration (PositionSolver.track), and checks the path as a sweep would:
 every step short (no jump to another branch: at most JUMP, dimensionless, lengths over L) and the actuator
-measure (analysis.singularities.singular.measures) above Tolerances.singular all along, its smallest value
+measure (analysis.singular.measures) above Tolerances.singular all along, its smallest value
 reported.  ``joined`` says whether it came back to another mode of the start's inputs.
 """
 
@@ -16,16 +16,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import AssemblyError
-from ..singularities.maps import apart
-from ..singularities.singular import Generic, measures
+from ..singular import Generic, measures
 
-__all__ = ["CuspLoop", "Loop", "cusp_loops", "loop", "wedge_direction"]
+__all__ = ["CuspLoop", "Loop", "apart", "cusp_loops", "loop", "wedge_direction"]
 
 #: A step of the loop that moves the configuration further than this (dimensionless) jumped branches.
 JUMP = 0.05
 #: A loop's end this near its start (dimensionless) is its start again: the steps close the loops to
 #: Tolerances.closure (1e-10), and modes near a cusp differ by about the square root of the loop's size.
 SAME = 1e-6
+
+
+def apart(mech, q1, q2) -> float:
+    """How far apart two configurations are: the norm of their difference, lengths over the
+    characteristic length (rad and characteristic lengths) [-]."""
+    d = mech.difference(q1, q2)
+    d[mech.translational] /= mech.length
+    return float(np.linalg.norm(d))
 
 
 @dataclass(frozen=True)

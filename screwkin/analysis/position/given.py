@@ -10,7 +10,7 @@ evaluated there (the solver's rows, as model.newton judges convergence):
   metres, its misalignment in radians), and how to let the loops solve for a joint instead.
 
 Where something is unknown and solve's default answers only the mode asked for (Newton from the file's
-configuration, analysis.motion.position), ``first_count`` says so in the counts every solve carries.
+configuration, analysis.position.position), ``first_count`` says so in the counts every solve carries.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """What a position solve answers: one assembly mode (``Solution``: every coordinate, its closure,
 how singular, rates and accelerations, absolute link motion, why it may not be reachable), the set of
 them for the inputs given (``PositionResult``, with how complete the set is: ``modes``), and a Newton
-iteration as ``--trace`` shows it (``TraceStep``).  Plain frozen data; analysis.motion.position
+iteration as ``--trace`` shows it (``TraceStep``).  Plain frozen data; analysis.position.position
 computes them, present/ writes them.
 
 Units: SI (m, rad, s); twists and accelerations (linear, angular), world axes.
@@ -17,7 +17,7 @@ import pinocchio as pin
 __all__ = ["Solution", "PositionResult", "TraceStep", "NEWTON_FROM_FILE", "search_method"]
 
 #: PositionResult.method where solve's default answered the mode Newton reaches from the file's
-#: configuration, and searched nothing (analysis.motion.position).
+#: configuration, and searched nothing (analysis.position.position).
 NEWTON_FROM_FILE = "newton from the file's configuration"
 
 
@@ -50,7 +50,7 @@ class Solution:
     residual: closure residual norm [m, rad]; iterations: Newton iterations;
     singular: the passive joints are not determined to first order (a double
               root, e.g. a limit position; or a constraint singularity): the
-              actuator or constraint measure of screwkin.analysis.singularities.singular.measures is
+              actuator or constraint measure of screwkin.analysis.singular.measures is
               below the singular tolerance;
     sigma_min: the smaller of those two measures (relative singular values);
     output_pose: 4x4 world pose of the output link, or None;
@@ -82,7 +82,7 @@ class Solution:
     continuum: bool = False
     merged: int = 1  # how many distinct solver results this solution stands for
     link_angles: dict | None = None
-    sigmas: dict | None = None  # screwkin.analysis.singularities.singular.measures at this configuration
+    sigmas: dict | None = None  # screwkin.analysis.singular.measures at this configuration
     coupled: dict | None = None  # <mimic> joints' values [rad or m] (they have no coordinate)
     loop_joints: dict | None = None  # one-coordinate loop (cut) joints: value [rad or m] (model/state.py)
     loop_rates: dict | None = None  # ... their rates [rad/s or m/s]
@@ -125,7 +125,7 @@ class PositionResult:
     angular_loop: tuple = ()  # names of the loop (cut) joints with a coordinate that is an angle
     notes: tuple = ()  # what the solver chose that the user should know (a --near value it missed)
     held: dict | None = None  # links held at an absolute angle (--set-angle of a floating link) -> angle [rad]
-    modes: object | None = None  # analysis.motion.certified.ModeCount: how many modes and how that is known
+    modes: object | None = None  # analysis.position.certified.ModeCount: how many modes and how that is known
     #: how the solutions were found: "every joint given", "newton from the file's configuration", "newton from
     #: --near's configuration", "closed form (dyads)", "homotopy search", "random starts", "no loops"
     method: str = ""

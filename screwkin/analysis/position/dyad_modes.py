@@ -15,7 +15,7 @@ The real set is therefore complete by construction -- no search, no trace test. 
 analysis.motion.dyads' own (its continuation engine, ``ClosedFormCurve``, predicting every branch
 vector at once); each configuration is checked by its closure residual on Pinocchio's closure
 (model.closure) after the same undamped Newton polish as the homotopy's modes.  Where the plan does
-not apply, or a check fails, the caller (analysis.motion.certified) takes the homotopy.
+not apply, or a check fails, the caller (analysis.position.certified) takes the homotopy.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import numpy as np
 from ...model import newton
 from ...model.cuts import Assembly
 from ...model.manifold import continuous_angle
-from .dyads import ClosedFormCurve, cached_plan
+from ..motion.dyads import ClosedFormCurve, cached_plan
 
 __all__ = ["DyadModes", "dyad_modes", "MAX_DYADS"]
 

@@ -30,12 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ...model.linalg import null_space, rank
-from ...model.cuts import in_plane, pair_contact
-from ...model.geometry import plane_basis
-from ...model.state import KinematicState, loop_coordinate_cuts
-from ...tolerances import DEFAULT
-from ..screws import cut_twists, screw_of
+from ..model.linalg import null_space, rank
+from ..model.cuts import in_plane, pair_contact
+from ..model.geometry import plane_basis
+from ..model.state import KinematicState, loop_coordinate_cuts
+from ..tolerances import DEFAULT
+from .screws import cut_twists, screw_of
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]

@@ -35,9 +35,9 @@ def inverse_kinematics(mech, output: str, pose, starts: int = 16, seed: int = 0,
     AssemblyError (saying how close it got) when the pose is unreachable.
     Solutions are labelled and ordered as those of PositionSolver.solve.  ``method`` "auto": in closed
     form where the mechanism gives one (a full pose of a platform whose legs' lengths follow from it, a
-    6R arm whose last three axes meet: analysis.motion.closed_ik; its ``modes.method`` starts with
+    6R arm whose last three axes meet: analysis.position.closed_ik; its ``modes.method`` starts with
     "closed form"), else every solution by homotopy continuation where the closure is polynomial
-    (analysis.motion.certified: certified by the trace test or a published count), random starts added where it is not
+    (analysis.position.certified: certified by the trace test or a published count), random starts added where it is not
     certified; "starts": damped Newton from random starts only.
     """
     out_frame = mech.link_frame(output)

@@ -25,11 +25,11 @@ import numpy as np
 
 from ...errors import AssemblyError, UsageError
 from ...model.state import KinematicState
-from .links import point_motions
+from ..motion.links import point_motions
 from .modes import choose_mode
 from .position import PositionSolver
-from ..singularities.singular import measures
-from .sweep import sweep
+from ..singular import measures
+from ..motion.sweep import sweep
 
 __all__ = ["Control", "LiveState", "Interactive", "MAX_STEP", "MAX_PATH"]
 
@@ -57,7 +57,7 @@ class LiveState:
     q: the configuration; inputs: input name -> value [rad or m] (as moved: not wrapped);
     mode: its index (1-based) among the ``modes`` assembly modes solve finds at these inputs
     (0: none of them matched); sigma: the relative smallest singular value of the actuator and
-    constraint measures (analysis.singularities.singular.measures), singular when below Tolerances.singular;
+    constraint measures (analysis.singular.measures), singular when below Tolerances.singular;
     output_pose: 4x4 world pose of the output link (or None); points: name -> world position [m];
     moved: the last request was carried out; message: why not (a limit position, an input the
     loops cannot reach), or None."""
@@ -80,7 +80,7 @@ class Interactive:
     inputs: the input joints (default: the actuated ones); values: their starting values, all or some
     (default, for each input not given: the file's value when the file's configuration assembles with
     them, else the value in the first configuration the assembly search closes; ``opened`` says which);
-    mode: the starting assembly mode (1-based, as solve lists them: analysis.motion.modes.choose_mode);
+    mode: the starting assembly mode (1-based, as solve lists them: analysis.position.modes.choose_mode);
     output: the output link whose pose is read out; points: analysis.motion.links.Point objects read out."""
 
     def __init__(self, mech, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,

@@ -43,13 +43,13 @@ from ...model.limits import outside_limits, spelled_within_limits
 from ...model.topology import open_joints
 from ...model.algebraic import algebraic_obstacle
 from . import certified, given, modes
-from .dyads import cached_plan
+from ..motion.dyads import cached_plan
 from ..mobility import analyze_mobility
-from .links import link_motions, point_motions
+from ..motion.links import link_motions, point_motions
 from .turns import engaged, turn_on, whole_turns
-from .planar import LinkAngles, identify
+from ..motion.planar import LinkAngles, identify
 from .solution import NEWTON_FROM_FILE, PositionResult, Solution, TraceStep, search_method
-from ..singularities.singular import Generic, measures
+from ..singular import Generic, measures
 
 __all__ = ["PositionSolver"]
 
@@ -108,7 +108,7 @@ class PositionSolver:
 
     # --------------------------------------------------------------- generic data
     def generic(self, hint=None) -> Generic:
-        """Generic ranks for these inputs and output (screwkin.analysis.singularities.singular.Generic) over the
+        """Generic ranks for these inputs and output (screwkin.analysis.singular.Generic) over the
         mechanism's generic configurations; ``hint``: an assembled configuration to start
         from when the mechanism's own assembly search has not been made."""
         if self._generic is None:
@@ -269,13 +269,13 @@ class PositionSolver:
         """Every assembly mode for the input ``values`` (see the class).  ``points``: motion.Point
         objects whose position (and velocity, acceleration with ``rates``) each solution reports.
         ``method``: "auto" -- homotopy continuation, certified, where the closure is polynomial
-        (analysis.motion.certified), with ``starts`` random starts added where it is not certified
+        (analysis.position.certified), with ``starts`` random starts added where it is not certified
         --, "starts" (damped Newton from random starts only, as with --trace or --near), or "nearest"
         (solve's default on the command line): every mode where they come at once (a mechanism of dyads,
         in closed form; random starts where the closure is not polynomial), else only the mode damped
         Newton reaches from the file's configuration, nothing searched -- "auto" when Newton fails there,
         said in the notes.  Every joint given (nothing unknown): that configuration, the closure
-        evaluated there and nothing solved (analysis.motion.given), whatever the method.
+        evaluated there and nothing solved (analysis.position.given), whatever the method.
         ``PositionResult.method`` says which way the solutions came."""
         mech = self.mech
         self._check_inputs(values)
@@ -387,7 +387,7 @@ class PositionSolver:
     def _at_once(self, values):
         """solve's default (method "nearest"): every mode where they come at once, as a certified.Search --
         a closure that is not polynomial or inputs that leave a continuum (an empty Search: solve's random
-        starts find them, or samples of the continuum; no homotopy to spare), a mechanism of dyads (their closed form, analysis.motion.certified.closed_form) -- or None
+        starts find them, or samples of the continuum; no homotopy to spare), a mechanism of dyads (their closed form, analysis.position.certified.closed_form) -- or None
         where only the homotopy would list them (Newton then answers the mode asked for)."""
         mech = self.mech
         if algebraic_obstacle(mech.model, mech.cuts, mech.closure.extra, mech.couplings) or self.free_dofs:
@@ -444,7 +444,7 @@ class PositionSolver:
 
     # --------------------------------------------------------------- one answer per mode
     def _merge(self, sols):
-        """Solutions that are one root merged (analysis.motion.modes.merge)."""
+        """Solutions that are one root merged (analysis.position.modes.merge)."""
         return modes.merge(self, sols)
 
     def _distance(self, q1, q2):
@@ -452,7 +452,7 @@ class PositionSolver:
 
     def _labels(self, q, outside) -> tuple:
         """Why a solution is not reached by moving from the reference configuration
-        (analysis.motion.modes.ModeLabels)."""
+        (analysis.position.modes.ModeLabels)."""
         if self._labelling is None:
             self._labelling = modes.ModeLabels(self)
         return self._labelling(q, outside)

@@ -1,4 +1,4 @@
-"""Telling assembly modes apart (analysis.motion.position's solver): which solutions are one root (a
+"""Telling assembly modes apart (analysis.position.position's solver): which solutions are one root (a
 double root computed from several starts, or solutions joined by a motion with the inputs held:
 a continuum), and why a mode is not one the mechanism reaches by moving from its reference
 configuration (outside the joint limits, a prismatic leg reversed through its pivot, a link that
@@ -16,7 +16,7 @@ import pinocchio as pin
 from ...errors import AssemblyError, UsageError
 from ...model.linalg import null_space, rank
 from ...model.state import KinematicState
-from ..singularities.singular import scaled_jacobians
+from ..singular import scaled_jacobians
 
 __all__ = ["merge", "moves", "connected", "ModeLabels", "choose_mode", "simple_root", "continuum_words"]
 
@@ -134,7 +134,7 @@ def connected(solver, q1, q2, pieces: int = 12) -> bool:
 
 
 class ModeLabels:
-    """The labels of analysis.motion.solution.Solution.labels for one solver: built once (the prismatic
+    """The labels of analysis.position.solution.Solution.labels for one solver: built once (the prismatic
     legs between a pivot and a far joint, with their signed length at the reference configuration,
     and the links that only translate, with their reference orientation), then read at each
     solution.  Nothing is labelled for mechanisms without loops or without a reference."""

@@ -37,8 +37,8 @@ from ...model.symmetry import find_symmetries
 from .dyad_modes import dyad_modes
 from . import generic_modes
 from .modes import continuum_words
-from .known_counts import STEWART, known_count
-from .monodromy import MonodromyOptions, all_roots, to_target
+from ..motion.known_counts import STEWART, known_count
+from ..motion.monodromy import MonodromyOptions, all_roots, to_target
 
 NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
@@ -53,7 +53,7 @@ class ModeCount:
 
     found:       modes found, real and complex (distinct placements of the links);
     complete:    every mode is found (certified: ``certificate`` says how);
-    method:      "closed form (dyads)" (a planar mechanism made of dyads: analysis.motion.dyad_modes),
+    method:      "closed form (dyads)" (a planar mechanism made of dyads: analysis.position.dyad_modes),
                  "monodromy" (homotopy continuation) or "random starts" (damped Newton);
     real:        modes with real joint values: the mechanism's assembly modes, reported;
     complex:     modes with complex joint values (no real assembly), None when not known;
@@ -350,7 +350,7 @@ class Search:
 
 
 def closed_form(solver, values: dict):
-    """The modes of a planar mechanism made of dyads (analysis.motion.dyad_modes) as a Certified, or
+    """The modes of a planar mechanism made of dyads (analysis.position.dyad_modes) as a Certified, or
     why the closed form does not apply (a string)."""
     got = dyad_modes(solver, values)
     if isinstance(got, str):

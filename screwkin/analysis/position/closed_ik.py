@@ -1,7 +1,7 @@
 """Inverse kinematics in closed form, where the mechanism's structure gives one: a parallel platform whose
 every leg's length follows from the platform's pose (model.leg_chains: the leg lengths, then each leg's
 joint angles from its direction), and a six-revolute arm whose last three axes meet (Pieper:
-analysis.motion.pieper).  None where neither applies: analysis.motion.ik then searches.
+analysis.position.pieper).  None where neither applies: analysis.position.ik then searches.
 
 A platform's answer is the physical solution first (every leg extended, each leg's angle set within the
 joint limits where one exists), then each leg's other branch beside it (that leg reversed through its
