@@ -26,19 +26,21 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import ScrewkinError, UsageError, one_line, quote
-from ...files.description import LIMITS
-from ...files.study import StudySpec
-from ...files.xmlsafe import read_regular_file
+from ...files.study import StudySpec, read_mechanism_text
 from ...model.loader import load
 from ..mobility import analyze_mobility
 from ..motion.planar import identify
 from ..position.modes import choose_mode
 from ..position.position import PositionSolver
 from .workspace import DEFAULT_THRESHOLD, workspace
+
+if TYPE_CHECKING:
+    from ...model.mechanism import Mechanism
 
 __all__ = [
     "COLUMNS",
@@ -188,7 +190,7 @@ class StudyTask:
 class StudyDesign:
     """One loaded design and what its metrics share (assembly, linkage, workspace)."""
 
-    def __init__(self, task: StudyTask, mech, clock: _Clock):
+    def __init__(self, task: StudyTask, mech: Mechanism, clock: _Clock) -> None:
         self.task, self.mech, self.clock = task, mech, clock
         self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
         clock.check()
@@ -331,7 +333,7 @@ def design_args(task: StudyTask, values: tuple) -> dict:
     return args
 
 
-def evaluate_design(task: StudyTask, index: int, values: tuple, keep=None) -> dict:
+def evaluate_design(task: StudyTask, index: int, values: tuple, keep: list | None = None) -> dict:
     """The row of one design, from its values alone; ``keep`` (a list): the analysed design is appended
     to it (the family path reads its mechanism)."""
     row = {"design": index, **dict(zip(task.parameters, values))}
@@ -358,7 +360,7 @@ def evaluate_design(task: StudyTask, index: int, values: tuple, keep=None) -> di
     return row
 
 
-def run_chunk(task: StudyTask, chunk) -> list:
+def run_chunk(task: StudyTask, chunk: list[tuple[int, tuple]]) -> list:
     """The rows of a chunk of designs [(index, values), ...], each design evaluated alone (what a Dask
     task computes when the family path does not apply: screwkin.analysis.design.family.chunk_rows)."""
     with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -399,12 +401,7 @@ class StudyResult:
 
 
 def study_task(spec: StudySpec) -> StudyTask:
-    raw = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
-    return StudyTask(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
+    return StudyTask(str(spec.file), read_mechanism_text(spec), dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
                  spec.input, spec.output, spec.point, dict(spec.workspace), spec.timeout, spec.mode)
 
 
