@@ -26,7 +26,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 import screwkin  # noqa: E402
 from screwkin.analysis.position.position import PositionSolver  # noqa: E402
-from screwkin.model import algebraic  # noqa: E402
+from screwkin.model.kernel import algebraic  # noqa: E402
 from test_certified import stewart_urdf  # noqa: E402
 
 

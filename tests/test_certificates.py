@@ -285,16 +285,13 @@ def test_bundled_six_ups_from_its_shipped_generic_set():
 def test_a_failed_path_is_no_certificate(tmp_path, shipped_cache):
     """Paths cut short (a tracker allowed 10 steps): the count is not called certified, and the reason
     says how many paths failed -- the certificate is checked, not assumed."""
-    from dataclasses import replace
-    from screwkin.analysis.motion.monodromy import MonodromyOptions
-    from screwkin.model import tracking
     base, plat, lengths, phc = sf.dietmaier()
     R, t = phc[0]
     path = tmp_path / "d.urdf"
     path.write_text(sf.urdf(base, plat, R, t, "floating"))
     solver = PositionSolver(screwkin.load(path))
-    short = MonodromyOptions(tracker=replace(tracking.DEFAULT_OPTIONS, max_steps=10))
-    got = certified.certified_modes(solver, ZERO, options=short)
+    short = screwkin.Tolerances(track_max_steps=10)
+    got = certified.certified_modes(solver, ZERO, tolerances=short)
     c = got.count
     assert not c.complete and c.certificate is None and not c.check["checked"]
     assert c.check["failed_paths"] > 0 and f"{c.check['failed_paths']} of 40 paths failed" in c.reason

@@ -14,9 +14,9 @@ from screwkin.analysis.position import certified
 from screwkin.analysis.position.ik import inverse_kinematics
 from screwkin.analysis.position.position import PositionSolver
 from screwkin.cli import main
-from screwkin.model import tracking
-from screwkin.model.algebraic import PolynomialClosure
-from screwkin.model.symmetry import find_symmetries
+from screwkin.model.homotopy import tracking
+from screwkin.model.kernel.algebraic import PolynomialClosure
+from screwkin.model.homotopy.symmetry import find_symmetries
 
 FILES = ["fourbar_crank_rocker", "slider_crank_offset", "planar_3rpr", "bennett", "tsai_3upu", "sarrus",
          "gough_stewart_6ups", "rssr", "delta_parallelogram", "spherical_fourbar"]
@@ -57,7 +57,7 @@ def test_rows_vanish_where_pinocchio_closes_and_only_there(name):
 @pytest.mark.parametrize("name", FILES)
 def test_jacobian_is_the_derivative_along_the_variety(name):
     """The rows' Jacobian in tangent coordinates against central differences along the same steps
-    (model.algebraic.PolynomialClosure.retract) at random complex points."""
+    (model.kernel.algebraic.PolynomialClosure.retract) at random complex points."""
     _, _, pc, _ = closure_of(name)
     rng = np.random.default_rng(2)
     X = pc.random_points(rng, 3)

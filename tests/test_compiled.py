@@ -1,5 +1,5 @@
-"""The compiled inner loop (screwkin.model.compiled, numba) gives the numpy loop's numbers: the same
-model.newton.iterate with the rows, the step and the verdict compiled."""
+"""The compiled inner loop (screwkin.model.kernel.compiled, numba) gives the numpy loop's numbers: the same
+model.kernel.newton.iterate with the rows, the step and the verdict compiled."""
 
 import dataclasses
 
@@ -10,7 +10,7 @@ from conftest import CORPUS, ROBOTS, fourbar
 
 import screwkin
 from screwkin.analysis.position.position import PositionSolver
-from screwkin.model import compiled, newton
+from screwkin.model.kernel import compiled, newton
 
 pytest.importorskip("numba")
 
@@ -25,11 +25,11 @@ def test_rows_equal_the_numpy_rows(name):
     rng = np.random.default_rng(0)
     for _ in range(5):
         q = pin.integrate(mech.model, pin.neutral(mech.model), rng.normal(size=mech.nv))
-        r, K = closure._evaluate_compiled(q)
+        r, K = compiled.cut_rows(closure, q)
         r0, K0 = closure.evaluate(q, solver=True)
         np.testing.assert_allclose(r, r0, rtol=0, atol=1e-15)
         np.testing.assert_allclose(K, K0, rtol=0, atol=1e-14)
-        r1, none = closure._evaluate_compiled(q, jacobian=False)
+        r1, none = compiled.cut_rows(closure, q, jacobian=False)
         assert none is None
         np.testing.assert_allclose(r1, r0, rtol=0, atol=1e-15)
 

@@ -145,7 +145,7 @@ def test_many_cut_joints_of_mixed_types_are_each_their_own_rows(tmp_path):
     (fewer, one at a time with 2-D arrays): three of every type, in mixed order and with
     different axes and frames, give for each cut joint the rows it gives alone, and a
     Jacobian equal to finite differences."""
-    from screwkin.model.closure import ClosureSystem
+    from screwkin.model.kernel.closure import ClosureSystem
 
     rng = np.random.default_rng(11)
     loops = []

@@ -193,13 +193,15 @@ def test_a_neighbour_step_is_refused_across_a_limit(mech):
 def test_the_tangent_and_the_jump_test_are_defined_in_one_place():
     """No module but continuation.py defines a tangent, a jump test, a branch rule or a limit locator of
     the continuation by name; the engines subclass or call it.  Allowed: the homotopy trackers' own
-    tangent coordinates (model/square.py, model/algebraic.py: the certified mode search's charts, a
+    tangent coordinates (model/homotopy/square.py, model/kernel/algebraic.py: the certified mode search's charts, a
     different space), BatchedCurve.tangents (Curve's on stacks, calling projections), and sweep's
     _start_tangent (Curve.tangent, oriented along the grid); model/distances.py's tangent (the platform
-    homotopy's chart: a pose's translation and quaternion, the space of model/square.py's); and the singular
+    homotopy's chart: a pose's translation and quaternion, the space of model/homotopy/square.py's; declared in
+    model/homotopy/monodromy.py's Closure protocol); and the singular
     locus's tangent (analysis/singularities/loci.py: the null vector of the augmented system [closure;
     A v = 0; |v| = 1], another curve than an input's motion, oriented by continuation.orient)."""
-    allowed = {("model/square.py", "tangent"), ("model/algebraic.py", "tangent"), ("model/distances.py", "tangent"),
+    allowed = {("model/homotopy/square.py", "tangent"), ("model/kernel/algebraic.py", "tangent"), ("model/distances.py", "tangent"),
+               ("model/homotopy/monodromy.py", "tangent"),  # the Closure protocol: those charts' tangent, declared
                ("analysis/singularities/loci.py", "tangent"),
                ("analysis/motion/batch_sweep.py", "tangents"), ("analysis/motion/sweep.py", "_start_tangent")}
     words = ("tangent", "jump", "orient", "passes_limit", "on_arc", "brentq")
@@ -232,6 +234,6 @@ def test_every_engine_has_the_interface():
     for engine in (Curve, BatchedCurve, ClosedFormCurve):
         assert all(callable(getattr(engine, n, None)) for n in questions), engine
     # the certified mode search's homotopy paths: predict, correct, accept (no branch nor limit in C^n)
-    from screwkin.model.tracking import Paths
+    from screwkin.model.homotopy.tracking import Paths
 
     assert all(callable(getattr(Paths, n, None)) for n in ("predict", "correct", "accept"))

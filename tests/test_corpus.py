@@ -14,7 +14,7 @@ import pytest
 
 import screwkin
 from conftest import CORPUS
-from screwkin.model.closure import ClosureSystem
+from screwkin.model.kernel.closure import ClosureSystem
 from screwkin.tolerances import Tolerances
 
 # name: (N, J, count, motion space, M, idle, actuated count, classification start, reason)

@@ -17,10 +17,10 @@ SMALL = 1e-3
 #: own (collinear precision points, Newton's step, two roots the same, a circle's spread);
 #: loader.py (MJCF), view.py and draw.py are in other hands this round.
 ALLOWED = {
-    "model/closure.py": 0,
+    "model/kernel/closure.py": 0,
     "analysis/singularities/batch.py": 4,
-    "analysis/motion/batch_closure.py": 2,
-    "model/compiled.py": 0,
+    "model/kernel/stacks.py": 2,
+    "model/kernel/compiled.py": 0,
     "analysis/motion/sweep.py": 0,
     "analysis/motion/singular_points.py": 1,
     "analysis/singularities/maps.py": 0,

@@ -1,4 +1,4 @@
-"""The one damped-Newton step and verdict (model/newton.py) of the single, batched and compiled
+"""The one damped-Newton step and verdict (model/kernel/newton.py) of the single, batched and compiled
 solvers: the three give the same step as the damped normal equations written here, the verdict
 (numpy and compiled) follows Nielsen's rule as published, and the batched closure rows equal
 ClosureSystem's (the program no longer compares them at run time: this test does).  The loop
@@ -13,8 +13,8 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from screwkin.analysis.motion.batch_closure import BatchClosure, Unbatchable
-from screwkin.model import compiled, newton
+from screwkin.model.kernel.stacks import BatchClosure, Unbatchable
+from screwkin.model.kernel import compiled, newton
 from screwkin.tolerances import DEFAULT
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"

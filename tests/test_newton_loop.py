@@ -1,4 +1,4 @@
-"""The one damped-Newton loop (model.newton.iterate) for one configuration and for stacks: each
+"""The one damped-Newton loop (model.kernel.newton.iterate) for one configuration and for stacks: each
 configuration of a stack iterates as it would alone (its own damping, acceptance and end), on the
 configuration manifold (continuous joints' (cos, sin), quaternions), the trace and the residual-only
 last evaluation of the single solve, and the give-up rule counted by hand."""
@@ -14,7 +14,7 @@ from conftest import DATA
 
 import screwkin
 from screwkin.errors import AssemblyError
-from screwkin.model import newton
+from screwkin.model.kernel import newton
 from screwkin.model.manifold import Integrator
 from screwkin.tolerances import DEFAULT
 

@@ -20,9 +20,9 @@ SAME_NAME = {
     "load": {"screwkin", "screwkin.model.loader"},
     # the entry points of processes: the command line, and the meshcat server's own process
     "main": {"screwkin.cli", "screwkin.present.viewserver"},
-    # the compiled (numba) form of model.newton's step under its name: tests/test_compiled.py compares the
+    # the compiled (numba) form of model.kernel.newton's step under its name: tests/test_compiled.py compares the
     # two and puts one in the other's place
-    "damped_step": {"screwkin.model.newton", "screwkin.model.compiled"},
+    "damped_step": {"screwkin.model.kernel.newton", "screwkin.model.kernel.compiled"},
 }
 
 

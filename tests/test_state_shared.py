@@ -19,7 +19,7 @@ import screwkin
 import screwkin.model.mechanism as mechanism
 from conftest import ROBOTS
 from screwkin.analysis.forces.statics import statics
-from screwkin.analysis.motion.batch_closure import TreeKinematics
+from screwkin.model.kernel.stacks import TreeKinematics
 from screwkin.analysis.position.position import PositionSolver
 from screwkin.model.state import KinematicState, model_with_output, place_tool
 
@@ -212,13 +212,15 @@ def test_place_tool_leaves_the_model_as_it_was():
 PINOCCHIO_KINEMATICS = {
     "model/state.py": "the state itself",
     "model/_pin.py": "the shape-fixing wrappers of Pinocchio's calls",
-    "model/closure.py": "the closure's residual and Jacobian (the Newton loops' inner loop)",
+    "model/kernel/closure.py": "the closure's residual and Jacobian (the Newton loops' inner loop)",
+    "model/kernel/contacts.py": "the sliding contacts' rows of the closure, in the closure's own Data",
+    "model/kernel/wrenches.py": "each closure row's constraint wrench, in the closure's own Data",
     "analysis/position/position.py": "the position solver's mode signature, at every start",
     "analysis/motion/links.py": "frame motions of a stack of configurations (Pinocchio a step)",
-    "analysis/motion/batch_closure.py": "batched kinematics and closure, their self-checks against Pinocchio",
+    "model/kernel/stacks.py": "batched kinematics and closure, their self-checks against Pinocchio",
     "analysis/singularities/batch.py": "frame Jacobians of a stack of configurations",
     "analysis/forces/dynamics.py": "the energies' own pass (CRBA, the potential energy with couplings)",
-    "model/algebraic.py": "the polynomial closure's reference placements and leg lengths, on a bare model",
+    "model/kernel/algebraic.py": "the polynomial closure's reference placements and leg lengths, on a bare model",
     "model/legs.py": "which legs are distances, probed on a bare model's joint centres",
 }
 

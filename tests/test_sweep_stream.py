@@ -196,7 +196,7 @@ def test_frame_motions_on_stacks_are_pinocchios(robot):
     forwardKinematics a configuration at a time (links._frame_motions) at random joint positions,
     rates and accelerations: placements, velocities, classical accelerations of every frame."""
     from conftest import ROBOTS
-    from screwkin.analysis.motion.batch_closure import TreeKinematics
+    from screwkin.model.kernel.stacks import TreeKinematics
     from screwkin.analysis.motion.links import _frame_motions
 
     mech = screwkin.load(ROBOTS / robot)

@@ -17,7 +17,7 @@ import pytest
 from conftest import ROBOTS, screwkin_cli
 
 import screwkin
-from screwkin.analysis.motion.batch_closure import BatchClosure
+from screwkin.model.kernel.stacks import BatchClosure
 from screwkin.analysis.position.ik import inverse_kinematics
 from screwkin.analysis.design.workspace import workspace
 from screwkin.errors import UsageError

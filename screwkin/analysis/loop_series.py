@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
+from ..model.kernel.scaling import dimensionless_twists
 from ..model.cuts import ContactRow
 from ..model.geometry import cross_last, perpendicular_basis
 from ..model.state import KinematicState
@@ -352,9 +353,9 @@ def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> Lo
     scale = np.where(np.array(slide, bool), L, 1.0)
     column = np.array([u[1] for u in units], int)
     mult = np.array([u[2] for u in units], float)
-    screws = np.array([u[0] for u in units], float).reshape(n_units, 6)
-    screws[:, :3] /= L  # dimensionless: v / L, sliding columns times L
-    screws *= scale[column][:, None]
+    screws = np.array([u[0] for u in units], float).reshape(n_units, 6)  # one screw (twist) a row
+    # dimensionless: v / L, sliding columns times L (model.kernel.scaling)
+    screws = np.ascontiguousarray(dimensionless_twists(screws.T, np.array(slide, bool)[column], L).T)
     carrier = np.zeros((n_units, n_units))
     for u, cs in enumerate(carriers):
         carrier[u, sorted(cs)] = 1.0

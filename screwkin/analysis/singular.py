@@ -33,6 +33,7 @@ import pinocchio as pin
 from ..model.linalg import null_space, rank
 from ..model.cuts import in_plane, pair_contact
 from ..model.geometry import plane_basis
+from ..model.kernel.scaling import dimensionless, dimensionless_twists
 from ..model.state import KinematicState, loop_coordinate_cuts
 from ..tolerances import DEFAULT
 from .screws import cut_twists, screw_of
@@ -102,17 +103,13 @@ def scaled_jacobians(mech, q, output=None, point: bool = False, length: float | 
     slide = mech.translational
     K = mech.closure.jacobian(q)
     if K.size:
-        K = K.copy()
-        K[mech.closure.position_rows] /= L
-        K[:, slide] *= L
+        K = dimensionless(K, mech.closure.position_rows, slide, L)
         V = null_space(K, mech.tolerances, mech.nv)
     else:
         K, V = np.zeros((0, mech.nv)), np.eye(mech.nv)
     J = None
     if output is not None:
-        J = KinematicState(mech, q).link_jacobian(output, LWA)
-        J[:3] /= L
-        J[:, slide] *= L
+        J = dimensionless_twists(KinematicState(mech, q).link_jacobian(output, LWA), slide, L)
         if point:
             J = J[:3]
     return Scaled(K, J, V, L)
@@ -335,9 +332,7 @@ def loop_twists(mech, q, cut, length=None):
         names.append(name)
         cols.append(t)
         slide.append(sl)
-    S = np.array(cols, float).T.reshape(6, len(cols))
-    S[:3] /= L
-    S[:, np.array(slide, bool)] *= L
+    S = dimensionless_twists(np.array(cols, float).T.reshape(6, len(cols)), np.array(slide, bool), L)
     return names, S, None
 
 

@@ -21,7 +21,8 @@ from ..errors import AssemblyError, MechanismFileError, UsageError, quote
 from ..files.description import MechanismSpec, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from .closability import closure_gap, closure_obstacle
-from .closure import ClosureSystem
+from .kernel.closure import ClosureSystem
+from .kernel.scaling import sliding_columns
 from .cuts import Assembly, bind_cut
 from .geometry import wrap_angle
 from .linalg import null_space, rank
@@ -58,7 +59,7 @@ class Mechanism:
     spec:       the :class:`~screwkin.files.description.MechanismSpec` read from the file.
     model:      ``pinocchio.Model`` of the spanning tree (with frames F1, F2 of every cut joint).
     cuts:       list of :class:`~screwkin.model.cuts.CutJoint`.
-    closure:    the :class:`~screwkin.model.closure.ClosureSystem` r(q) = 0.
+    closure:    the :class:`~screwkin.model.kernel.closure.ClosureSystem` r(q) = 0.
     coordinates: list of :class:`Coordinate`, one per tree joint with coordinates.
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """
@@ -354,18 +355,8 @@ class Mechanism:
         self.cache.clear()
 
     def _translational_coordinates(self) -> np.ndarray:
-        """Mask of the velocity coordinates that are lengths (prismatic joints, the translations
-        of planar, translation and free-flyer joints)."""
-        mask = np.zeros(self.model.nv, bool)
-        for c in self.coordinates:
-            short = self.model.joints[c.joint_id].shortname()
-            if "JointModelP" in short and "Planar" not in short:
-                mask[c.idx_v:c.idx_v + c.nv] = True
-            elif short in ("JointModelPlanar",):
-                mask[c.idx_v:c.idx_v + 2] = True
-            elif short in ("JointModelTranslation", "JointModelFreeFlyer"):
-                mask[c.idx_v:c.idx_v + 3] = True
-        return mask
+        """Mask of the velocity coordinates that are lengths (model.kernel.scaling.sliding_columns)."""
+        return sliding_columns(self.model)
 
     @property
     def translational(self) -> np.ndarray:

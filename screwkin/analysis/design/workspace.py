@@ -10,7 +10,7 @@ Two methods:
   mechanism).  From the output's position in the mechanism's assembled configuration the
   grid is filled outwards, wave by wave: each new point is solved (loop closures, the target,
   joint limits) from the solution at a neighbour, all points of a wave in one batched Newton
-  solve (analysis.motion.batch_closure.BatchClosure).  A solution must continue its neighbour's: it may not
+  solve (model.kernel.stacks.BatchClosure).  A solution must continue its neighbour's: it may not
   jump to another working mode (another branch of a leg), so the workspace is the one of
   the assembly mode the file is drawn in.  Along the grid's last axis every run of reached
   points is extended to the boundary by bisection (solved too), and the volume is the sum of
@@ -45,7 +45,8 @@ from ...errors import AssemblyError, UsageError
 from ...model.linalg import rank
 from ...model.state import KinematicState
 from ..singularities.batch import SerialJacobians
-from ..motion.batch_closure import BatchClosure, Unbatchable
+from ...model.kernel.scaling import dimensionless, dimensionless_twists
+from ...model.kernel.stacks import BatchClosure, Unbatchable
 from ...model.limits import within_limits
 from ..singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions
@@ -129,15 +130,12 @@ class _Measures:
         N, nv = len(Q), mech.nv
         J = np.zeros((N, 6, nv))
         J[:, :, self.cols] = self.out.poses(Q)[2]
-        J[:, :3] /= L
-        J[:, :, self.slide] *= L
+        J = dimensionless_twists(J, self.slide, L)
         if self.point:
             J = J[:, :3]
         actuator = np.ones(N)
         if self.closure is not None and self.closure.nrows:
-            K = self.closure.constraint_jacobians(Q)
-            K[:, self.position_rows] /= L
-            K[:, :, self.slide] *= L
+            K = dimensionless(self.closure.constraint_jacobians(Q), self.position_rows, self.slide, L)
             vt = np.linalg.svd(K, full_matrices=True)[2]
             V = vt[:, g.rank_K:].transpose(0, 2, 1)  # (N, nv, nv - rank)
             if g.rank_Kp:
@@ -245,7 +243,7 @@ def _seed(mech, output, point, orientation, q_start=None):
     best = None
     for q in [assembly.q] + list(generic) if q_start is None else [np.asarray(q_start, float)]:
         M = KinematicState(mech, q).frame_placement(fid)
-        K = bc.evaluate(q[None], (M.translation[None], M.rotation))[1][0]
+        K = bc.evaluate(q[None], targets=(M.translation[None], M.rotation))[1][0]
         k = rank(K, mech.tolerances)
         if best is None or k > best[0]:
             best = (k, q, M.translation.copy(), M.rotation.copy())

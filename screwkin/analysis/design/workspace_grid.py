@@ -1,6 +1,6 @@
 """The grid a workspace is grown on (analysis.design.workspace's ``grid`` method): positions of the
 output on axes spanning its translations, filled outwards wave by wave from the assembled
-configuration by batched inverse kinematics (analysis.motion.batch_closure.BatchClosure), each point
+configuration by batched inverse kinematics (model.kernel.stacks.BatchClosure), each point
 from a neighbour's solution along a first-order predictor, kept only when it continues that
 neighbour's branch (the one continuation's jump test and branch rule, analysis.motion.continuation:
 the sign of the rows' Jacobian determinant on the parent's row space), with
@@ -14,8 +14,9 @@ import time
 import numpy as np
 
 from ...model.linalg import rank
-from ...model.newton import damped_steps
-from ..motion.batch_closure import BatchClosure
+from ...model.kernel.newton import damped_steps
+from ...model.kernel.scaling import dimensionless
+from ...model.kernel.stacks import BatchClosure
 from ..motion.continuation import jumped, keeps_orientation
 from ...model.limits import within_limits
 
@@ -70,7 +71,7 @@ class Grid:
         self.q_seed = q_seed
         self.L, self.slide = float(mech.length), mech.translational
         # the rank of the rows' Jacobian (loops and target) in the working mode: at the seed
-        K = self.closure.evaluate(q_seed[None], (self.position(np.zeros(len(axes)))[None], self.R))[1][0]
+        K = self.closure.evaluate(q_seed[None], targets=(self.position(np.zeros(len(axes)))[None], self.R))[1][0]
         self.rank = rank(K, mech.tolerances)
         Ks = self._scaled(K[None])[0]
         sv = np.linalg.svd(Ks, compute_uv=False)
@@ -98,17 +99,14 @@ class Grid:
         """First-order predictor: the joint steps that move the target from P_from to P_to
         (minimum norm through the solver's rows: K dq = -(change of the target rows)), and
         the rows' Jacobian at Q (it does not depend on where the target is)."""
-        r0, K = self.closure.evaluate(Q, (P_to, self.R))
-        r1 = self.closure.evaluate(Q, (P_from, self.R), jacobian=False)[0]
+        r0, K = self.closure.evaluate(Q, targets=(P_to, self.R))
+        r1 = self.closure.evaluate(Q, False, (P_from, self.R))[0]
         dr = r0 - r1  # the rows' change from moving the target alone
         return Q + damped_steps(K, dr, np.full(len(Q), self.mech.tolerances.lm_damping))[0], K
 
     def _scaled(self, K):
-        """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L."""
-        K = K.copy()
-        K[:, self.closure.solver_position_rows] /= self.L
-        K[:, :, self.slide] *= self.L
-        return K
+        """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L (model.kernel.scaling)."""
+        return dimensionless(K, self.closure.solver_position_rows, self.slide, self.L)
 
     def kept(self, Q_from, K_from, Q_pred, Q_new, P_new):
         """(kept, sigma) for new solutions solved from Q_from: kept when it continues the old
@@ -119,7 +117,7 @@ class Grid:
         how far it is from a fold (``substeps``)."""
         step = np.linalg.norm(Q_pred - Q_from, axis=1)
         ok = ~jumped(np.linalg.norm(Q_new - Q_pred, axis=1), step, self.mech.tolerances)
-        K_new = self._scaled(self.closure.evaluate(Q_new, (P_new, self.R))[1])
+        K_new = self._scaled(self.closure.evaluate(Q_new, targets=(P_new, self.R))[1])
         r = self.rank
         if not r:
             return ok, np.ones(len(ok))

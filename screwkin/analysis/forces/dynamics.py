@@ -14,7 +14,7 @@ motor added to the mass matrix's diagonal; damping * v, the force that overcomes
 passive force; frictionloss * sign(v), the dry friction overcome while the joint moves -- at rest
 it lies anywhere in +-frictionloss, which the notes say), the loads w_k (force, moment at their link frame's origin, world
 axes; J_k that origin's frame Jacobian, LOCAL_WORLD_ALIGNED), the loop constraint forces lambda
-of the closure rows K (model/closure.py) and the actuator efforts tau_a (torques of revolute,
+of the closure rows K (model/kernel/closure.py) and the actuator efforts tau_a (torques of revolute,
 forces of prismatic inputs).  It is solved as statics solves it (analysis.forces.statics.balance):
 least squares, minimum norm; where the constraint rows are redundant (an overconstrained
 linkage, a planar loop's out-of-plane rows) the null space of [E, K^T] holds self-stresses of

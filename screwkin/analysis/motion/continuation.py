@@ -22,7 +22,7 @@ with it, and ``Neighbour`` takes a map's steps with it), ``BatchedCurve`` (analy
 a chunk of grid values at once), ``ClosedFormCurve`` (analysis.motion.dyads: every value at once, its
 limit positions located by ``locate``, its return to the start by ``returned``), the workspace's grid
 growth (analysis.design.workspace_grid: the jump test, and ``keeps_orientation``, the branch rule in
-several parameters), and the certified mode search's homotopy paths (model.tracking.Paths: predict,
+several parameters), and the certified mode search's homotopy paths (model.homotopy.tracking.Paths: predict,
 correct, accept -- in complex space there is no branch to choose nor limit to locate; the layers keep
 that engine below this module, which it matches by its methods).  analysis.motion.sweep chooses among
 the first three.
@@ -74,30 +74,38 @@ class Motion:
 
 
 class Engine(Protocol):
-    """The interface of a continuation engine (see the module docstring): five questions, each engine
-    answering them on its own state.  ``Curve``: q one configuration, t its oriented unit tangent (nv),
-    sigma a dimensionless step, ``held`` a velocity index; ``BatchedCurve``: the same on a stack of
-    configurations (one per row, sigma one per row); ``ClosedFormCurve`` (analysis.motion.dyads): input
-    values instead of steps (its prediction is exact), a sign per dyad for the branch."""
+    """The interface of a continuation engine along an input (see the module docstring): five questions,
+    each engine answering them on its own state.  ``Curve`` answers them for one configuration: q (nq,),
+    t its oriented unit tangent (nv,) in scaled coordinates, sigma a dimensionless step, ``held`` a
+    velocity index; ``BatchedCurve`` (analysis.motion.batch_sweep) for a stack, one configuration per
+    row (sigma (N,), the corrections (N, nq) with a flag per row).  ``ClosedFormCurve``
+    (analysis.motion.dyads: input values instead of steps, a sign per dyad for the branch) and the
+    homotopy's ``Paths`` (model.homotopy.tracking: complex paths) answer the same questions with signatures of
+    their own: they are not Engines."""
 
-    def predict(self, *args):
-        """Where the next configuration(s) should be: a step along the tangent (the closed form: its
-        placement at the input values)."""
+    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
+        """Where the next configuration(s) should be: q moved sigma along t on the configuration
+        manifold -- (nq,), or (N, nq) for sigma (N,)."""
+        ...
 
-    def correct(self, *args):
-        """The configuration(s) closing the loops from the prediction, with one joint held (the closed
-        form: the joint coordinates of its placement)."""
+    def correct(self, predicted: np.ndarray, held: int) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """The configuration closing the loops from the prediction with velocity index ``held`` held
+        (nq,) (raises Stuck); for a stack (N, nq) and whether each row closed (N,) bool."""
+        ...
 
-    def accept(self, *args):
-        """Which corrections stayed on the curve: ``jumped`` and, for a stack, ``passes_limit`` (the
-        closed form: every discriminant non-negative)."""
+    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float | np.ndarray) -> bool | np.ndarray:
+        """Whether the correction stayed on the curve (``jumped``; for a stack one flag per row (N,),
+        and ``passes_limit``)."""
+        ...
 
-    def choose_branch(self, *args):
-        """The branch that continues the motion: ``orient`` (the closed form: past a dyad's limit
-        position, its other sign)."""
+    def choose_branch(self, t: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+        """The tangent(s) t oriented to continue the motion of ``previous`` (``orient``)."""
+        ...
 
-    def locate_limit(self, *args):
-        """The limit position bracketed between two configurations (input values), by ``locate``."""
+    def locate_limit(self, qa: np.ndarray, ta: np.ndarray, qb: np.ndarray, held: int) -> tuple[np.ndarray, float]:
+        """The limit position bracketed between qa (tangent ta) and qb, with ``held`` the parameter
+        (``locate``): (its configuration (nq,), its input offset from qa)."""
+        ...
 
 
 def projections(K, V, scale, free, tol) -> np.ndarray:

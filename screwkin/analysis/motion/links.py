@@ -26,7 +26,7 @@ import pinocchio as pin
 
 from ...errors import ScrewkinError, UsageError
 from ...model.state import KinematicState, loop_coordinate_cuts
-from .batch_closure import tree_kinematics
+from ...model.kernel.stacks import tree_kinematics
 from .planar import LinkAngles
 
 __all__ = ["Point", "link_motions", "point_motions", "MotionAlong", "motion_along", "sweep_motion", "moving_links",

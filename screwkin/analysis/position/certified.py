@@ -1,15 +1,15 @@
 """Every assembly mode of a mechanism with polynomial loop closure, and how complete the set is.
 
-For the inputs given, the closure of the passive joints (model.algebraic: cosines and sines of
+For the inputs given, the closure of the passive joints (model.kernel.algebraic: cosines and sines of
 revolute angles, prismatic lengths, quaternions) is solved over the complex numbers by monodromy,
-certified by the trace test (analysis.motion.monodromy), then carried to the inputs by one parameter
+certified by the trace test (model.homotopy.monodromy), then carried to the inputs by one parameter
 homotopy.  Of the roots reached:
 - a root that does not make every closure row vanish is a root of the random combination of rows
   only (spurious) and is dropped;
 - a real root is an assembly mode: its configuration is polished by undamped Newton on Pinocchio's
-  closure (model.newton.polish, the reference), then reported as solve reports every mode;
+  closure (model.kernel.newton.polish, the reference), then reported as solve reports every mode;
 - the others are complex: no real assembly, counted.
-Roots that differ only by the closure's sign symmetries (model.symmetry: a universal joint
+Roots that differ only by the closure's sign symmetries (model.homotopy.symmetry: a universal joint
 flipped, the other Euler set of a spherical joint) are one placement of the links, so one mode;
 roots with the same joint centres and output pose (PositionSolver.signature) are one mode too.  Of
 each mode's joint-angle sets the one within the joint limits and nearest the reference
@@ -28,17 +28,19 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...errors import AssemblyError
-from ...model import newton
-from ...model.algebraic import PolynomialClosure, algebraic_obstacle
-from ...model.square import SquareSystem
+from ...model.kernel import newton
+from ...model.kernel.algebraic import PolynomialClosure, algebraic_obstacle
+from ...model.homotopy.known_counts import STEWART, known_count
+from ...model.homotopy.monodromy import all_roots, to_target
+from ...model.homotopy.parameter import architecture
+from ...model.homotopy.square import SquareSystem
+from ...model.homotopy.symmetry import find_symmetries
 from ...model.cuts import Assembly
 from ...model.linalg import rank
-from ...model.symmetry import find_symmetries
+from ...tolerances import Tolerances
 from .dyad_modes import dyad_modes
 from . import generic_modes
 from .modes import continuum_words
-from ..motion.known_counts import STEWART, known_count
-from ..motion.monodromy import MonodromyOptions, all_roots, to_target
 
 NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
@@ -78,7 +80,7 @@ class ModeCount:
 
 @dataclass
 class Certified:
-    """Real modes found (each (q, model.closure.Assembly, angle sets, simple)) and the count."""
+    """Real modes found (each (q, model.kernel.closure.Assembly, angle sets, simple)) and the count."""
 
     modes: list
     count: ModeCount
@@ -100,7 +102,7 @@ def obstacle(solver) -> str | None:
 @dataclass
 class Problem:
     """What the homotopy solves: the model and cut joints (an inverse-kinematics target among them),
-    the Pinocchio closure that polishes and lifts (model.closure.ClosureSystem), the velocity indices
+    the Pinocchio closure that polishes and lifts (model.kernel.closure.ClosureSystem), the velocity indices
     held (inputs), the configuration that holds their values and the reference one."""
 
     model: object
@@ -112,12 +114,14 @@ class Problem:
     target: bool = False
 
 
-def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptions = MonodromyOptions(),
+def certified_modes(solver, values: dict, seed: int = 0, tolerances: Tolerances | None = None,
                     problem: Problem | None = None):
     """The assembly modes for the input ``values`` by homotopy continuation (see the module): a
     Certified, or the reason (a string) why the method does not apply.  ``problem``: another system
-    to solve (inverse kinematics); by default the solver's loops with its inputs held."""
+    to solve (inverse kinematics); by default the solver's loops with its inputs held.  ``tolerances``:
+    the homotopy's settings (the ``homotopy_`` and ``track_`` fields), the mechanism's by default."""
     mech = solver.mech
+    options = mech.tolerances if tolerances is None else tolerances
     if problem is None:
         why = obstacle(solver)
         if why:
@@ -138,7 +142,7 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
                 + ": positive-dimensional solution sets are not tracked")
     known = known_count(closure, problem.frozen, problem.target)
     if known is STEWART:  # a parameter homotopy from the architecture's generic solution set
-        arch = generic_modes.architecture(problem, closure, mech)
+        arch = architecture(problem, closure, mech)
         if arch is not None:
             modes, *counts = generic_modes.platform_modes(solver, problem, closure, arch, seed, options,
                                                           lambda x: _lift(solver, problem, closure, x))
@@ -148,12 +152,12 @@ def certified_modes(solver, values: dict, seed: int = 0, options: MonodromyOptio
     group = find_symmetries(closure, rng)
     system = SquareSystem(closure, rng)
     roots = all_roots(system, group, closure.random_points(rng, 1), rng, options, trace_test=known is None,
-                      trace_limit=options.trace_limit)
+                      trace_limit=options.homotopy_trace_limit)
     ends = to_target(system, roots, np.zeros(system.n), options)
     got = _classify(solver, problem, closure, system, group, roots, ends, known, time.perf_counter() - t0, options)
-    if known is not None and not got.count.complete and len(roots.X) <= options.trace_limit:
+    if known is not None and not got.count.complete and len(roots.X) <= options.homotopy_trace_limit:
         # fewer than the class's bound (a special geometry): the trace test decides, within a budget
-        roots = all_roots(system, group, roots.X[:1], rng, replace(options, budget=options.fallback_budget),
+        roots = all_roots(system, group, roots.X[:1], rng, replace(options, homotopy_budget=options.homotopy_fallback_budget),
                           seeds=roots.X, trace_test=True)
         ends = to_target(system, roots, np.zeros(system.n), options)
         got = _classify(solver, problem, closure, system, group, roots, ends, None, time.perf_counter() - t0,
@@ -201,7 +205,7 @@ def _rank(closure, rng) -> int:
     return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
 
 
-def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: MonodromyOptions,
+def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: Tolerances,
               also: str = "") -> Certified:
     """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
     mech, tol = solver.mech, solver.mech.tolerances
@@ -210,8 +214,8 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
     scale = 1.0 + np.abs(np.where(np.isfinite(X), X, 0)).max(axis=1)
     closes = np.zeros(len(X), bool)
     if finite.any():
-        closes[finite] = system.closes(X[finite]) <= o.closes * scale[finite] ** 2
-    real = closes & (np.abs(X.imag).max(axis=1) <= o.real * scale)
+        closes[finite] = system.closes(X[finite]) <= o.homotopy_closes * scale[finite] ** 2
+    real = closes & (np.abs(X.imag).max(axis=1) <= o.homotopy_real * scale)
     modes = []  # [signature, q, assembly, angle sets, simple]
     full = closure if not closure.legs else PolynomialClosure(
         problem.model, problem.cuts, problem.frozen, mech.length, points=solver._points,
@@ -219,7 +223,7 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
     full_group = group if full is closure else find_symmetries(full, np.random.default_rng(1))
     elements = full_group.elements()
     lost = 0
-    multiple = _coinciding(X, real, group, o.same)  # paths that met: a multiple root
+    multiple = _coinciding(X, real, group, o.homotopy_same)  # paths that met: a multiple root
     for i in np.flatnonzero(real):
         q = _lift(solver, problem, closure, X[i].real)
         if q is None:
@@ -244,7 +248,7 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
     sigs = closure.signature(X[cplx]) if cplx.size else np.zeros((0, 0))
     distinct = []
     for s in sigs:
-        if not any(np.max(np.abs(s - d)) < o.same * (1 + np.abs(s).max()) for d in distinct):
+        if not any(np.max(np.abs(s - d)) < o.homotopy_same * (1 + np.abs(s).max()) for d in distinct):
             distinct.append(s)
     failed = int(np.sum(ends.status == "failed"))
     sets = int(np.sum(group.orbit_sizes(np.where(np.isfinite(X[closes]), X[closes], 0), 1e-9))) if closes.any() else 0
@@ -329,7 +333,7 @@ def _best_twin(solver, problem, closure, elements, x):
         key = (bad, dist)
         if best is None or key < best[0]:
             best = (key, q)
-    a = newton.polish(problem.system, best[1], problem.frozen)
+    a = newton.polish(problem.system.pinocchio, best[1], problem.frozen)
     return solver._wrap(a.q), Assembly(solver._wrap(a.q), a.residual, a.iterations, "a homotopy's endpoint")
 
 

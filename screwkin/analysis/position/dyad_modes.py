@@ -14,7 +14,7 @@ system of k quadratics; a dyad's two circles are never concentric where the plan
 The real set is therefore complete by construction -- no search, no trace test.  The placing is
 analysis.motion.dyads' own (its continuation engine, ``ClosedFormCurve``, predicting every branch
 vector at once); each configuration is checked by its closure residual on Pinocchio's closure
-(model.closure) after the same undamped Newton polish as the homotopy's modes.  Where the plan does
+(model.kernel.closure) after the same undamped Newton polish as the homotopy's modes.  Where the plan does
 not apply, or a check fails, the caller (analysis.position.certified) takes the homotopy.
 """
 
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...model import newton
+from ...model.kernel import newton
 from ...model.cuts import Assembly
 from ...model.manifold import continuous_angle
 from ..motion.dyads import ClosedFormCurve, cached_plan
@@ -107,7 +107,7 @@ def dyad_modes(solver, values: dict) -> DyadModes | str:
             return "a dyad's discriminant changed sign when another's limit position was placed exactly"
         Q = curve.correct(poses, len(cols))[0]
         for q in Q:
-            a = newton.polish(mech.closure, solver._wrap(q), solver.frozen)
+            a = newton.polish(mech.closure.pinocchio, solver._wrap(q), solver.frozen)
             if not a.residual <= mech.tolerances.closure:
                 return (f"a branch vector's configuration does not close the loops (residual {a.residual:.2g}): "
                         "the dyads' geometry was not read as Pinocchio places the links")

@@ -2,7 +2,7 @@
 
 When the input values name every coordinate the loops could move (the usual way to ask about one
 pose: every joint of the tree given), the configuration is the one those values set.  The closure is
-evaluated there (the solver's rows, as model.newton judges convergence):
+evaluated there (the solver's rows, as model.kernel.newton judges convergence):
 - the loops close -- within the geometry tolerance, scaled by the mechanism's size where it is over
   a metre (values typed to nine digits close to about 1e-9) -- and that configuration is the one
   answer, said with its residual;
@@ -35,7 +35,7 @@ def unknowns(solver) -> np.ndarray:
 
 def gaps(mech, q) -> list:
     """[(loop joint or higher pair, position gap [m], misalignment [rad])] of the rows of q's closure that
-    are open, the largest first: the minimal rows grouped by the joint they close (model.closure's
+    are open, the largest first: the minimal rows grouped by the joint they close (model.kernel.closure's
     row labels: ``pos`` rows are distances, the others angles)."""
     r = mech.closure.evaluate(q, jacobian=False)[0]
     out = {}

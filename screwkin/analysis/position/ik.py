@@ -8,8 +8,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ...errors import AssemblyError, UsageError
-from ...model.algebraic import algebraic_obstacle
-from ...model.closure import ClosureSystem
+from ...model.kernel.algebraic import algebraic_obstacle
+from ...model.kernel.closure import ClosureSystem
 from ...model.cuts import CutJoint
 from ...model.geometry import wrap_angle
 from ...model.linalg import rank

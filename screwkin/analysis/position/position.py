@@ -34,14 +34,14 @@ import numpy as np
 import pinocchio as pin
 
 from ...errors import AssemblyError, UsageError
-from ...model import newton
+from ...model.kernel import newton
 from ...model.cuts import Assembly
 from ...model.geometry import wrap_angle
 from ...model.manifold import set_continuous_angle
 from ...model.state import KinematicState, angular_loop_joints, frame_parent
 from ...model.limits import outside_limits, spelled_within_limits
 from ...model.topology import open_joints
-from ...model.algebraic import algebraic_obstacle
+from ...model.kernel.algebraic import algebraic_obstacle
 from . import certified, given, modes
 from ..motion.dyads import cached_plan
 from ..mobility import analyze_mobility
@@ -61,7 +61,7 @@ class PositionSolver:
 
     def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None):
         """compiled: True to solve the closure equations with the compiled kernels of
-        screwkin.model.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
+        screwkin.model.kernel.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
         joints are all fixed or spherical, False for numpy, None to leave the mechanism's
         setting; ``self.compiled`` says which is used."""
         self.mech = mech
@@ -426,7 +426,7 @@ class PositionSolver:
             except AssemblyError as exc:
                 best = min(best, exc.residual)
                 continue
-            p = newton.polish(system, a.q, frozen)  # undamped at the end: round-off, not the damped tolerance
+            p = newton.polish(system.pinocchio, a.q, frozen)  # undamped at the end: round-off, not the damped tolerance
             a = Assembly(p.q, p.residual, a.iterations + p.iterations, a.start, a.starts)
             q = self._wrap(a.q)
             if len(starts) == 1:  # nothing to tell apart

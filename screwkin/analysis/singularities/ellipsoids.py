@@ -25,6 +25,7 @@ from ...tolerances import DEFAULT, Tolerances
 from ..position.position import PositionSolver
 from ...model.linalg import null_space, rank
 from ..singular import SingularityReport, scaled_jacobians
+from ...model.kernel.scaling import dimensionless
 
 __all__ = ["Ellipsoid", "Ellipsoids", "ellipsoids_of", "ellipsoids", "with_input_output_condition"]
 
@@ -89,10 +90,8 @@ def ellipsoids_of(J, length: float = 1.0, linear: int = 3, sliding=None, inputs=
         raise ValueError("J must be a matrix whose first `linear` rows are linear velocities")
     if not (np.isfinite(length) and length > 0):
         raise ValueError("the characteristic length must be positive")
-    M = J.copy()
-    M[:linear] /= length
-    if sliding is not None:
-        M[:, np.asarray(sliding, bool)] *= length
+    M = dimensionless(J, slice(0, linear), np.zeros(J.shape[1], bool) if sliding is None else np.asarray(sliding, bool),
+                      length)
     names = tuple(inputs) if inputs is not None else tuple(f"q{k + 1}" for k in range(J.shape[1]))
     return _of_scaled(M, length, names, tol, linear)
 

@@ -16,7 +16,7 @@ Its locus is the curve of S where A v = 0 for a unit v: the solutions z = (q, v)
 one equation short of the unknowns.  Each curve is followed by pseudo-arclength predictor-corrector
 continuation in z (tangent: the null vector of dF; corrector: Newton with the step's hyperplane),
 every point converged until |F| is round-off; its trace in the plane is read off q.  The derivative of
-A(q) v is central differences of A (A itself comes from the analytic Jacobians of model.closure and
+A(q) v is central differences of A (A itself comes from the analytic Jacobians of model.kernel.closure and
 model.state); Newton's limit is the root of F, which is evaluated exactly.
 
 Seeds: the assembly modes at the box's centre (the project's all-modes solve), each continued over a
@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import AssemblyError
+from ...model.kernel.scaling import dimensionless, dimensionless_rows, dimensionless_twists
 from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
 from ..motion.continuation import locate, orient
@@ -110,14 +111,10 @@ class LocusSystem:
         mech = self.mech
         K = np.zeros((0, self.nv))
         if mech.closure.nrows:
-            K = np.array(mech.closure.jacobian(q), float)
-            K[self.pos] /= self.L
-            K *= self.scale
+            K = dimensionless(mech.closure.jacobian(q), self.pos, mech.translational, self.L)
         if self.kind == "actuator":
             return K[:, self.p]
-        J = KinematicState(mech, q).link_jacobian(self.output, LWA)
-        J[:3] /= self.L
-        J = J * self.scale
+        J = dimensionless_twists(KinematicState(mech, q).link_jacobian(self.output, LWA), mech.translational, self.L)
         return np.vstack([K, J[:3] if self.point else J])
 
     def integrate(self, q, u) -> np.ndarray:
@@ -127,8 +124,7 @@ class LocusSystem:
         mech = self.mech
         parts = []
         if mech.closure.nrows:
-            r = mech.closure.residual(q).copy()
-            r[self.pos] /= self.L
+            r = dimensionless_rows(mech.closure.residual(q), self.pos, self.L)
             parts.append(r)
         held = []
         for c, target, _ in self.held:
@@ -145,9 +141,8 @@ class LocusSystem:
         A = self.A(q) if A is None else A
         blocks = []
         if mech.closure.nrows:
-            K = np.array(mech.closure.jacobian(q), float)
-            K[self.pos] /= self.L
-            blocks.append(np.hstack([K * self.scale, np.zeros((len(K), len(v)))]))
+            K = dimensionless(mech.closure.jacobian(q), self.pos, mech.translational, self.L)
+            blocks.append(np.hstack([K, np.zeros((len(K), len(v)))]))
         return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
 
     def _held_kind_norm_rows(self, q, v, A) -> list:

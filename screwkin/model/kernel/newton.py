@@ -1,8 +1,8 @@
 """The one damped-Newton (Levenberg-Marquardt) loop of every closure solver, and its step.
 
 ``iterate`` is the loop, written once for a stack of N configurations; the single solve
-(``solve``: model.closure.ClosureSystem.solve) runs it on a stack of one, the batched one
-(analysis.motion.batch_closure.BatchClosure.solve) on many, the compiled path (model.compiled) with
+(``solve``: model.kernel.closure.ClosureSystem.solve) runs it on a stack of one, the batched one
+(model.kernel.stacks.BatchClosure.solve) on many, the compiled path (model.kernel.compiled) with
 the rows, the step and the verdict compiled by numba from the same definitions.  Whoever wants to
 change how Newton iterates changes it here:
 
@@ -33,15 +33,20 @@ does not at run time.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
-from ..errors import AssemblyError
-from .cuts import Assembly
+from ...errors import AssemblyError
+from ...tolerances import Tolerances
+from ..cuts import Assembly
+from .contract import ClosureKernel
+
+Array = NDArray[Any]
 
 __all__ = ["TRACE_FLOOR", "NU", "damped_step", "damped_steps", "stacked_steps", "one_at_a_time", "one_step", "judge",
-           "Iterates", "iterate", "solve", "polish"]
+           "Iterates", "iterate", "solve", "undamped", "polish"]
 
 #: Division guard: the damping is relative to the mean squared row norm, which is never taken
 #: below this (a zero Jacobian) [same units as K^2].
@@ -51,7 +56,7 @@ TRACE_FLOOR = 1e-12
 NU = 2.0
 
 
-def damped_step(K, r, free, mu):
+def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, float]:
     """The damped step of one configuration on the free columns of K (rows, nv): the step on
     those columns and the squared residual of the linear model |r + K_f dq_f|^2."""
     Kf = K[:, free]
@@ -70,7 +75,7 @@ def damped_step(K, r, free, mu):
     return dqf, float(lin @ lin)
 
 
-def damped_steps(Kf, r, mu):
+def damped_steps(Kf: np.ndarray, r: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """damped_step for a stack, on columns already chosen: Kf (N, m, n), r (N, m), mu (N,) ->
     (steps (N, n), squared residuals of the linear model (N,))."""
     N, m, n = Kf.shape
@@ -90,19 +95,19 @@ def damped_steps(Kf, r, mu):
     return dq, np.einsum("ni,ni->n", lin, lin)
 
 
-def stacked_steps(K, r, free, mu):
+def stacked_steps(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """damped_steps on the free columns of a stack: K (N, rows, nv), r (N, rows), mu (N,) ->
     (steps on the free columns (N, free), squared residuals of the linear model (N,)): the step
     of ``iterate`` for stacks."""
     return damped_steps(K[:, :, free], r, mu)
 
 
-def one_at_a_time(step):
+def one_at_a_time(step: Callable[..., tuple[np.ndarray, Any]]) -> Callable[..., tuple[np.ndarray, Any]]:
     """The step of ``iterate`` for stacks from a step of one configuration,
     ``step(K (rows, nv), r, free, mu) -> (step on the free columns, squared linear residual)``
-    (damped_step, or model.compiled.damped_step): one call per configuration."""
+    (damped_step, or model.kernel.compiled.damped_step): one call per configuration."""
 
-    def steps(K, r, free, mu):
+    def steps(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:
         if len(K) == 1:  # (the squared residual as a float: it broadcasts)
             dq, lin = step(K[0], r[0], free, float(mu[0]))
             return dq[None], lin
@@ -116,7 +121,8 @@ def one_at_a_time(step):
 one_step = one_at_a_time(damped_step)
 
 
-def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
+def judge(norm: np.ndarray, r_new: np.ndarray, linear_squared: np.ndarray, mu: np.ndarray, nu: np.ndarray,
+          closure: float, mu_min: float, mu_max: float) -> tuple:
     """The verdict on one step of each configuration of a stack: residual norms before (n,), the
     residual rows after (n, rows), squared residual of the linear model, damping and Nielsen's
     factor nu (n,); Tolerances.closure, lm_damping_min, lm_damping_max.
@@ -127,7 +133,7 @@ def judge(norm, r_new, linear_squared, mu, nu, closure, mu_min, mu_max):
     below mu_min, and nu = 2; after a refused one, mu nu and 2 nu.  A configuration goes on while
     its residual norm is at least ``closure`` and no refused step has taken its damping past
     mu_max.  Returns (accepted, residual norms after, mu, nu, going on).  Plain numpy on arrays:
-    model.compiled compiles this same function."""
+    model.kernel.compiled compiles this same function."""
     new_norm = np.sqrt((r_new * r_new).sum(axis=1))
     accepted = new_norm < norm
     count = np.count_nonzero(accepted)
@@ -160,8 +166,10 @@ class Iterates(NamedTuple):
     placed: np.ndarray  #: (N,) the last configuration evaluated is q (no step tried, or the last accepted)
 
 
-def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=None, trace=None,
-            verdict=judge) -> Iterates:
+def iterate(evaluate: Callable[..., tuple[np.ndarray, Any]], Q0: np.ndarray, free: np.ndarray,
+            tol: Tolerances, integrate: Callable[[np.ndarray, np.ndarray], np.ndarray],
+            step: Callable[..., tuple[np.ndarray, Any]] = stacked_steps, iterations: int | None = None,
+            trace: Callable[..., None] | None = None, verdict: Callable[..., tuple] = judge) -> Iterates:
     """The damped-Newton loop, for a stack of N configurations (N = 1: one configuration).
 
     evaluate(Q (n, nq), which (n,), jacobian) -> (r (n, rows), K (n, rows, nv) or None): the rows
@@ -173,12 +181,15 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
     accepted) called after the k-th step with the configurations it started from (the loop's own
     arrays: a trace copies what it keeps); verdict: ``judge`` (or its compiled form).
 
+    Q0 may be complex (the homotopy's Newton, model.homotopy.tracking.newton: its step undamped and its
+    verdict accepting every finite step): the stack and its steps stay complex, the norms are moduli.
+
     Each configuration has its own damping and its own end (see the module).  When every
     configuration still iterating is about to converge quadratically (residual below
     0.1 sqrt(closure): the next one near its square) the residual alone is computed first, and the
     residual and Jacobian again, for the active stack, only when some step there is accepted without
     converging."""
-    Q = np.array(Q0, float)
+    Q = np.array(Q0, complex if np.iscomplexobj(Q0) else float)  # complex: the homotopy's (model.homotopy)
     N = len(Q)
     every = np.arange(N)
     r, K = evaluate(Q, every, True)
@@ -200,7 +211,7 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
         else:
             idx = active.nonzero()[0]
             Qa, ra, Ka, na, mua, nua = Q[idx], r[idx], K[idx], norm[idx], mu[idx], nu[idx]
-        dQ = np.zeros((n, nv))
+        dQ = np.zeros((n, nv), Q.dtype)
         dQ[:, free], lin2 = step(Ka, ra, free, mua)
         Qn = integrate(Qa, dQ)
         final = np.maximum.reduce(na) < near
@@ -234,53 +245,70 @@ def iterate(evaluate, Q0, free, tol, integrate, step=stacked_steps, iterations=N
     return Iterates(Q, norm, its, norm < closure, ~refused)
 
 
-def _norms(r):
-    """The residual norm of each row of a stack."""
+def _norms(r: np.ndarray) -> np.ndarray:
+    """The residual norm of each row of a stack (real or complex)."""
+    if np.iscomplexobj(r):
+        return np.sqrt(np.add.reduce(r.real * r.real + r.imag * r.imag, axis=1))
     return np.sqrt(np.add.reduce(r * r, axis=1))
 
 
-def solve(system, q0, frozen, tol, trace=None) -> Assembly:
-    """``iterate`` on one configuration of a model.closure.ClosureSystem from q0 with the velocity
-    indices ``frozen`` held (Tolerances ``tol``: closure, max_iterations and the lm_ fields);
-    trace: None or callable(iteration, q, r, K, dq, accepted) (ClosureSystem.solve).  Raises
-    AssemblyError with the residual reached when it does not converge, or when the solution
-    assembles a cut joint upside down."""
+def solve(kernel: ClosureKernel, q0: Array, frozen: Any, tol: Tolerances,
+          trace: Callable[..., None] | None = None) -> Assembly:
+    """``iterate`` on one configuration of a kernel (a ClosureSystem's: ``ClosureSystem.kernel``) from
+    q0 (nq,) with the velocity indices ``frozen`` held (Tolerances ``tol``: closure, max_iterations and
+    the lm_ fields); trace: None or callable(iteration, q, r, K, dq, accepted) (ClosureSystem.solve).
+    Raises AssemblyError with the residual reached when it does not converge, or when the solution
+    assembles a cut joint upside down (``kernel.reversed_joints``)."""
     q = np.array(q0, float)
-    if system.nrows == 0:
+    if kernel.m == 0:
         return Assembly(q, 0.0, 0)
-    evaluate, step, verdict = system.solver_pass()
+    step, verdict = kernel.newton_parts() or (stacked_steps, judge)
+    evaluate = kernel.evaluate
     hook = None if trace is None else (
         lambda which, k, Q, r, K, dQ, ok: trace(k, Q[0], r[0], K[0], dQ[0], bool(ok[0])))
-    out = iterate(evaluate, q[None], system.free_columns(frozen), tol, system.integrator, step, trace=hook,
-                  verdict=verdict)
+    out = iterate(lambda Q, which, jacobian: evaluate(Q, jacobian), q[None], kernel.free_columns(frozen), tol,
+                  kernel.integrate, step, trace=hook, verdict=verdict)
     q, norm, it = out.q[0], float(out.residual[0]), int(out.iterations[0])
     if not out.converged[0]:
-        raise AssemblyError(system.path, norm, it)
-    bad = system.wrong_branch(q, placed=bool(out.placed[0]))
+        raise AssemblyError(kernel.name, norm, it)
+    bad = kernel.reversed_joints(q, placed=bool(out.placed[0]))
     if bad:
-        raise AssemblyError(system.path, norm, it,
+        raise AssemblyError(kernel.name, norm, it,
                             detail=f"the solution found assembles {', '.join(bad)} with a reversed axis")
     return Assembly(q, norm, it)
 
 
-def polish(system, q0, frozen=(), iterations: int = 8) -> Assembly:
-    """Undamped Newton from q0, which is already near a root of ``system`` (a model.closure.ClosureSystem),
-    with the velocity indices ``frozen`` held: the minimum-norm step on the free columns of the
-    solver's rows (least squares: the rows are redundant), while the residual keeps falling.  A simple
-    root is reached to round-off in two or three steps.  Returns the configuration with the smallest
-    residual seen (its norm, the steps taken)."""
-    model = system.model
-    free = system.free_columns(tuple(int(f) for f in np.asarray(frozen, int).ravel()))
+def undamped(kernel: ClosureKernel, q0: Array, free: Array, iterations: int, closure: float | None = None) -> Assembly:
+    """Newton's own step (undamped, the minimum-norm least-squares step on the free columns (k,): the
+    rows may be redundant) from q0 (nq,) on ``kernel``'s rows, at most ``iterations`` steps.  Without
+    ``closure``: while the residual keeps falling (the polish: a simple root to round-off in two or
+    three steps; the configuration with the smallest residual seen is kept); with it: until the
+    residual norm is below ``closure``, whether or not each step lowers it (Gauss-Newton; the caller
+    reads the residual to know whether it converged).  Returns (q, its residual norm, steps taken)."""
     q = np.array(q0, float)
-    r, K = system.evaluate(q, jacobian=True, solver=True)
-    best_q, best, it = q, float(np.linalg.norm(r)), 0
+    r, K = kernel.evaluate(q[None], True)
+    assert K is not None
+    norm, it = float(np.linalg.norm(r[0])), 0
     for it in range(1, iterations + 1):
-        dq = np.zeros(model.nv)
-        dq[free] = -np.linalg.lstsq(K[:, free], r, rcond=None)[0]
-        q_new = system.integrator(q[None], dq[None])[0]  # q (+) dq on the manifold, as the loop moves
-        r, K = system.evaluate(q_new, jacobian=True, solver=True)
-        norm = float(np.linalg.norm(r))
-        if not norm < best:
+        if closure is not None and norm < closure:
+            it -= 1
             break
-        best_q, best, q = q_new, norm, q_new
-    return Assembly(best_q, best, it)
+        dq = np.zeros(kernel.nv)
+        dq[free] = -np.linalg.lstsq(K[0][:, free], r[0], rcond=None)[0]
+        q_new = kernel.integrate(q[None], dq[None])[0]  # q (+) dq on the manifold, as the loop moves
+        r, K = kernel.evaluate(q_new[None], True)
+        assert K is not None
+        new = float(np.linalg.norm(r[0]))
+        if closure is None and not new < norm:
+            break
+        q, norm = q_new, new
+    return Assembly(q, norm, it)
+
+
+def polish(kernel: ClosureKernel, q0: Array, frozen: Any = (), iterations: int = 8) -> Assembly:
+    """Undamped Newton (``undamped``) from q0, which is already near a root of ``kernel``'s rows (a
+    ClosureSystem's: ``ClosureSystem.pinocchio``), with the velocity indices ``frozen`` held, while
+    the residual keeps falling.  Returns the configuration with the smallest residual seen (its
+    norm, the steps taken)."""
+    free = kernel.free_columns(tuple(int(f) for f in np.asarray(frozen, int).ravel()))
+    return undamped(kernel, q0, free, iterations)

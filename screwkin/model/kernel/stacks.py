@@ -1,20 +1,28 @@
 """Loop-closure rows and damped Newton for stacks of configurations (the workspace's inverse
 kinematics, batched continuation): ``TreeKinematics`` computes the placements and Jacobians of
 frames of a tree of 1-DOF joints for N configurations in one pass down the tree, and
-``BatchClosure`` builds on them the same rows, in the same order, as model.closure.ClosureSystem
-and solves them with the one damped-Newton loop of model/newton.py (``iterate``), all configurations
+``BatchClosure`` builds on them the same rows, in the same order, as model.kernel.closure.ClosureSystem
+and solves them with the one damped-Newton loop of model/kernel/newton.py (``iterate``), all configurations
 at once.
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
+from numpy.typing import NDArray
 
-from ...model import newton
-from ...model.closure import ClosureSystem
-from ...model.cuts import CouplingRow, CutJoint
-from ...model.state import frame_parent, model_with_output
+from ...tolerances import Tolerances
+from . import newton
+from .closure import ClosureSystem
+from .contract import ClosureKernel, NotProvided
+from .scaling import sliding_columns
+from ..cuts import CouplingRow, CutJoint
+from ..state import frame_parent, model_with_output
+
+Array = NDArray[Any]
 
 __all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 
@@ -22,10 +30,10 @@ __all__ = ["TreeKinematics", "tree_kinematics", "BatchClosure", "Unbatchable"]
 class Unbatchable(Exception):
     """The mechanism holds something the batched closure does not represent (joints of more
     than one coordinate, <mimic> joints, helical joints, sliding contacts): the caller solves
-    one configuration at a time with model.closure.ClosureSystem instead."""
+    one configuration at a time with model.kernel.closure.ClosureSystem instead."""
 
 
-def tree_kinematics(mech):
+def tree_kinematics(mech: Any) -> TreeKinematics | None:
     """The mechanism's TreeKinematics, made once (mech.cache), None when its joints are not all 1-DOF
     revolute or prismatic (its users then run Pinocchio a configuration at a time)."""
     key = "links.tree"
@@ -49,7 +57,7 @@ class TreeKinematics:
     _AXES = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1),
              "JointModelPX": (1, 0, 0), "JointModelPY": (0, 1, 0), "JointModelPZ": (0, 0, 1)}
 
-    def __init__(self, mech):
+    def __init__(self, mech: Any) -> None:
         model = mech.model
         self.mech, self.model = mech, model
         if model.nq != model.nv:
@@ -75,10 +83,10 @@ class TreeKinematics:
             C = np.hstack([M.rotation, M.rotation @ K, M.rotation @ K @ K, M.translation[:, None],
                            (M.rotation @ axis)[:, None]])
             self.joints.append((model.parents[j], kind, C.T.copy(), model.idx_qs[j]))
-        self.supports = {}
-        self._frames = {}
+        self.supports: dict[int, Any] = {}
+        self._frames: dict[Any, Any] = {}
 
-    def _support(self, jid):
+    def _support(self, jid: int) -> Any:
         """(joint ids, which are revolute, velocity columns) of the joints moving joint jid."""
         if jid not in self.supports:
             sup = [int(j) for j in self.model.supports[jid] if j > 0]
@@ -86,7 +94,7 @@ class TreeKinematics:
                                   np.array([self.model.idx_vs[j] for j in sup], int)) if sup else None
         return self.supports[jid]
 
-    def _frame(self, f):
+    def _frame(self, f: Any) -> Any:
         """(parent joint, [R | t]^T of the frame's placement) of frame f (model.state.frame_parent: the output
         frame where place_tool put it)."""
         if f in self._frames:
@@ -97,7 +105,7 @@ class TreeKinematics:
             self._frames[f] = out
         return out
 
-    def _pass(self, Q):
+    def _pass(self, Q: np.ndarray) -> Any:
         """(RTs, ps, ws) of every joint (index 0 the ground) for the configurations Q (N, nq):
         rotations transposed and flattened (3, 3N), origins (N, 3), axes in the world (N, 3)."""
         model = self.model
@@ -124,7 +132,7 @@ class TreeKinematics:
             RTs[j], ps[j], ws[j] = RT, pos, w
         return RTs, ps, ws
 
-    def motions(self, Q, V, A, frame_ids):
+    def motions(self, Q: np.ndarray, V: np.ndarray, A: np.ndarray, frame_ids: Any) -> tuple:
         """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
         (a, alpha) of the frames' origins in world axes (N, F, 6) for joint positions Q, rates V and
         accelerations A (N, nv): links._frame_motions' result (Pinocchio's forwardKinematics a step,
@@ -148,7 +156,10 @@ class TreeKinematics:
             else:
                 o, alpha = wp, alp
                 v, a = v + wqd, a + wqdd + 2.0 * np.cross(wp, wqd)
-            om.append(o), vel.append(v), al.append(alpha), acc.append(a)
+            om.append(o)
+            vel.append(v)
+            al.append(alpha)
+            acc.append(a)
         F = len(frame_ids)
         R, t = np.empty((N, F, 3, 3)), np.empty((N, F, 3))
         tw, ac = np.empty((N, F, 6)), np.empty((N, F, 6))
@@ -164,7 +175,7 @@ class TreeKinematics:
             ac[:, i, 3:] = al[jid]
         return R, t, tw, ac
 
-    def centres(self, Q, refs) -> dict:
+    def centres(self, Q: np.ndarray, refs: Any) -> dict:
         """{ref: (N, 3)} the world positions [m] KinematicState.centre reads -- ("joint", i) joint i's
         centre, ("mount", i) where joint i sits on its parent, ("frame", f) frame f's origin -- at every
         row of Q: its stacked form, from one pass down the tree."""
@@ -184,7 +195,7 @@ class TreeKinematics:
             out[(kind, i)] = ps[jid] + _thin(t, RTs[jid])[0].reshape(N, 3)
         return out
 
-    def frames(self, Q, frame_ids, jacobian: bool = True) -> dict:
+    def frames(self, Q: np.ndarray, frame_ids: Any, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n), cols (n,))}: rotation, origin and the
         frame's Jacobian (linear velocity of its origin, angular velocity; world axes) on the
         velocity columns ``cols`` of the joints that move it (J and cols None for a frame
@@ -194,7 +205,7 @@ class TreeKinematics:
         RTs, ps, ws = self._pass(Q)
         Wall = np.stack([np.zeros((N, 3))] + ws[1:], axis=2)  # (N, 3, njoints)
         Pall = np.stack(ps, axis=2)
-        out = {}
+        out: dict[Any, tuple] = {}
         for f in frame_ids:
             jid, CfT = self._frame(f)
             XT = _thin(CfT, RTs[jid])
@@ -202,7 +213,7 @@ class TreeKinematics:
             pf = ps[jid] + XT[3].reshape(N, 3)
             support = self._support(jid) if jacobian else None
             if not support:
-                out[f] = (Rf, pf, None, None)
+                out[f] = (Rf, pf, None, None)  # (a frame on the ground)
                 continue
             sup, revolute, cols = support
             W = Wall[:, :, sup]  # (N, 3, n) the joints' axes
@@ -223,9 +234,9 @@ class TreeKinematics:
 _TARGET_KINDS = {"pose": ("fixed", 0), "point": ("spherical", 3)}
 
 
-class BatchClosure:
+class BatchClosure(ClosureKernel):
     """The loop-closure rows of ``mech`` (the same rows, in the same order, as its
-    model.closure.ClosureSystem) for many configurations at once, and a damped-Newton solver
+    model.kernel.closure.ClosureSystem) for many configurations at once, and a damped-Newton solver
     that moves all of them together: every iteration is a few numpy calls on the whole stack
     instead of one Pinocchio pass and one linear solve per configuration.
 
@@ -243,7 +254,7 @@ class BatchClosure:
     Raises Unbatchable for what it does not represent.
     """
 
-    def __init__(self, mech, target=None, check: int = 0):
+    def __init__(self, mech: Any, target: Any = None, check: int = 0) -> None:
         # with a target, a copy of the model with the output frame placed (model.state.model_with_output): the
         # target's cut joint is a frame of it, and the self-check moves the target frame in it, not in the mechanism's
         model = mech.model if target is None else model_with_output(mech)
@@ -270,13 +281,10 @@ class BatchClosure:
                                     extra=mech.extra_rows)
         self.nrows = self.system.nrows
         self.solver_rows = self.system._rows(True)
-        # which of the solver's rows are lengths [m] (positions; the couplings of rolling and screw
-        # pairs), the others dimensionless
-        mask = []
-        for c, (P, pairs, vectors, _) in zip(cuts, self.system.plans):
-            rest = self.system._cut_rows(c, (P, pairs, vectors, None), True) - len(P)
-            mask += [True] * len(P) + [False] * rest
-        self.solver_position_rows = np.array(mask + [True] * len(mech.extra_rows), bool)
+        self.nq, self.nv, self.m = model.nq, model.nv, self.solver_rows
+        # which of the solver's rows are lengths [m] (positions; the couplings of rolling and screw pairs)
+        self.solver_position_rows = self.length_rows = self.system.solver_position_rows
+        self.sliding = sliding_columns(model)
         frames = []
         for c in cuts:
             for f in (c.frame1, c.frame2):
@@ -292,13 +300,13 @@ class BatchClosure:
             self._check(np.random.default_rng(0), check)
 
     # ------------------------------------------------------------------ frames
-    def _frames(self, Q, jacobian: bool = True):
+    def _frames(self, Q: np.ndarray, jacobian: bool = True) -> dict:
         """{frame id: (R (N, 3, 3), p (N, 3), J (N, 6, n) LOCAL_WORLD_ALIGNED on the chain's
         columns, columns (n,))}; J and the columns None for a frame on the ground (and for
         every frame without ``jacobian``)."""
         return self.tree.frames(Q, self._frame_ids, jacobian)
 
-    def _placements(self, c, frames, targets, N):
+    def _placements(self, c: Any, frames: Any, targets: Any, N: int) -> tuple:
         """(R1, t1, J1, cols1, R2, t2, J2, cols2) of cut joint c (J None: the frame does not move)."""
         if c.frame1 == self.mech.target_frame:
             t, Rt = targets
@@ -308,18 +316,36 @@ class BatchClosure:
         return first + frames[c.frame2]
 
     # ------------------------------------------------------------------ rows
-    def evaluate(self, Q, targets=None, jacobian: bool = True):
-        """The solver's rows (ClosureSystem.evaluate(solver=True)) of every configuration:
-        r (N, rows) and K (N, rows, nv) (None without ``jacobian``)."""
+    def evaluate(self, Q: Array, jacobian: bool = True, targets: Any = None) -> tuple[Array, Array | None]:
+        """The solver's rows (ClosureSystem.evaluate(solver=True)) of every configuration of Q (N, nq):
+        r (N, m) and K (N, m, nv) (None without ``jacobian``); targets: the target's placements
+        (origins (N, 3), rotation (3, 3)) of a closure with a target."""
         return self._rows(Q, targets, jacobian, solver=True)
 
-    def constraint_jacobians(self, Q, targets=None) -> np.ndarray:
+    def integrate(self, Q: Array, V: Array) -> Array:
+        return self.system.integrator(Q, V)
+
+    def constraint_jacobian(self, Q: Array) -> Array:
+        return self.constraint_jacobians(Q)
+
+    def reversed_joints(self, q: Array, placed: bool = False) -> list[str]:
+        frames = self._frames(np.asarray(q, float)[None], jacobian=False)
+        return [self.cuts[k].name for k, a in self._revolute_cuts
+                if (frames[self.cuts[k].frame1][0][0] @ a) @ (frames[self.cuts[k].frame2][0][0] @ a) < 0]
+
+    @property
+    def name(self) -> str:
+        return self.mech.path
+
+    def constraint_jacobians(self, Q: np.ndarray, targets: Any = None) -> np.ndarray:
         """The minimal rows' Jacobian K (N, rows, nv) (ClosureSystem.jacobian) of configurations
         that close the loops: a rotation vector's rows use the derivative of log3 at the
         identity, which they are at within the closure tolerance."""
-        return self._rows(Q, targets, True, solver=False)[1]
+        K = self._rows(Q, targets, True, solver=False)[1]
+        assert K is not None
+        return K
 
-    def _rows(self, Q, targets, jacobian, solver):
+    def _rows(self, Q: np.ndarray, targets: Any, jacobian: bool, solver: bool) -> tuple[np.ndarray, np.ndarray | None]:
         Q = np.atleast_2d(np.asarray(Q, float))
         N, nv = len(Q), self.model.nv
         if self.target is not None and targets is None:
@@ -327,9 +353,9 @@ class BatchClosure:
         frames = self._frames(Q, jacobian)
         nrows = self.solver_rows if solver else self.nrows
         r = np.empty((N, nrows))
-        K = np.zeros((N, nrows, nv)) if jacobian else None
+        K: Any = np.zeros((N, nrows, nv)) if jacobian else None
 
-        def add(rows, cols, A):  # K[:, rows, cols] += A (N, len(rows), len(cols))
+        def add(rows: Any, cols: Any, A: np.ndarray) -> None:  # K[:, rows, cols] += A (N, len(rows), len(cols))
             if cols is not None:
                 K[:, rows, cols] += A
 
@@ -386,14 +412,14 @@ class BatchClosure:
             i += 1
         return r, K
 
-    def bias(self, Q, V) -> np.ndarray:
+    def bias(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
         """K'(q, v) v of every configuration (N, rows): ClosureSystem.bias's minimal rows (zero joint
         accelerations) for stacks, from the frames' classical accelerations (TreeKinematics.motions)
         instead of Pinocchio's a configuration at a time.  A rotation vector's rows take the
         derivative of log3 at the identity, as constraint_jacobians does (the configurations close
         the loops: R1^T R2 = I within the closure tolerance); a coupling's row is linear: 0."""
         if self.target is not None:
-            raise ValueError("bias of a closure with a target is not defined")
+            raise NotProvided("bias of a closure with a target is not defined")
         Q, V = np.atleast_2d(np.asarray(Q, float)), np.atleast_2d(np.asarray(V, float))
         N = len(Q)
         ids = self._frame_ids
@@ -402,7 +428,7 @@ class BatchClosure:
         out = np.zeros((N, self.nrows))
         i = 0
 
-        def world(R_, u):  # R u for a stack of rotations and a constant vector
+        def world(R_: np.ndarray, u: np.ndarray) -> np.ndarray:  # R u for a stack of rotations and a constant vector
             return np.einsum("nij,j->ni", R_, np.asarray(u, float))
 
         for cut, (P, pairs, _, rotation) in zip(self.cuts, self.system.plans):
@@ -428,7 +454,7 @@ class BatchClosure:
                 i += 1
         return out
 
-    def reversed_axes(self, Q) -> np.ndarray:
+    def reversed_axes(self, Q: np.ndarray) -> np.ndarray:
         """(N,) True where a revolute (cylindrical, planar) cut joint is assembled with its two
         axes opposed: a root of the rows that is not the joint (ClosureSystem.wrong_branch)."""
         Q = np.atleast_2d(np.asarray(Q, float))
@@ -443,8 +469,9 @@ class BatchClosure:
         return bad
 
     # ------------------------------------------------------------------ solving
-    def solve(self, Q0, targets=None, frozen=(), tolerances=None, iterations: int | None = None):
-        """Damped Newton from every row of Q0 at once: model.newton.iterate (the loop of
+    def solve(self, Q0: np.ndarray, targets: Any = None, frozen: Any = (), tolerances: Tolerances | None = None,
+              iterations: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Damped Newton from every row of Q0 at once: model.kernel.newton.iterate (the loop of
         ClosureSystem.solve, each configuration with its own damping) on these rows.  frozen:
         velocity indices that do not move (inputs).  Returns (Q, converged (N,), residual norms
         (N,), iterations (N,)); a configuration that converges with a reversed revolute cut joint
@@ -455,11 +482,11 @@ class BatchClosure:
         if self.solver_rows == 0 or N == 0:
             return Q, np.ones(N, bool), np.zeros(N), np.zeros(N, int)
 
-        def evaluate(Q_, which, jacobian):
-            return self.evaluate(Q_, None if targets is None else (targets[0][which], targets[1]), jacobian)
+        def evaluate(Q_: np.ndarray, which: Any, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+            return self.evaluate(Q_, jacobian, None if targets is None else (targets[0][which], targets[1]))
 
         free = np.setdiff1d(np.arange(nv), np.asarray(frozen, int))
-        out = newton.iterate(evaluate, Q, free, tol, self.system.integrator, newton.stacked_steps, iterations)
+        out = newton.iterate(evaluate, Q, free, tol, self.integrate, newton.stacked_steps, iterations)
         converged = out.converged.copy()
         if converged.any():
             c = np.flatnonzero(converged)
@@ -467,7 +494,7 @@ class BatchClosure:
         return out.q, converged, out.residual, out.iterations
 
     # ------------------------------------------------------------------ self-check
-    def _check(self, rng, count):
+    def _check(self, rng: np.random.Generator, count: int) -> None:
         """Our rows against ClosureSystem's: at random configurations (solver rows) and at the
         mechanism's closed configurations (constraint Jacobian)."""
         mech, model, system = self.mech, self.model, self.system
@@ -491,8 +518,10 @@ class BatchClosure:
                 if is_closed:
                     ours, ref = self.constraint_jacobians(q[None], targets)[0], system.jacobian(q)
                 else:
-                    r, K = self.evaluate(q[None], targets)
+                    r, K = self.evaluate(q[None], True, targets)
+                    assert K is not None
                     r_ref, K_ref = system.evaluate(q, True, solver=True)
+                    assert K_ref is not None
                     ours, ref = np.hstack([r[0][:, None], K[0]]), np.hstack([r_ref[:, None], K_ref])
                 err = float(np.abs(ours - ref).max()) if ref.size else 0.0
                 if err > 1e-8 * max(1.0, float(np.abs(ref).max()) if ref.size else 1.0):  # pragma: no cover - a bug
@@ -502,7 +531,7 @@ class BatchClosure:
             model.frames[mech.target_frame] = frame
 
 
-def _thin(C, RT, block: int = 4096) -> np.ndarray:
+def _thin(C: np.ndarray, RT: np.ndarray, block: int = 4096) -> np.ndarray:
     """C @ RT for a small constant C (k <= 11, 3) and a long RT (3, 3N), a block of columns at a time.
     OpenBLAS threads the whole product (over 262,144 multiply-adds), and in a process that has
     imported pinocchio, on 2 busy cores, its threads wait for each other: 10-16 ms instead of 0.1
@@ -517,29 +546,29 @@ def _thin(C, RT, block: int = 4096) -> np.ndarray:
     return out
 
 
-def _stacked_products(A, B) -> np.ndarray:
+def _stacked_products(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """A @ B for stacks A (N, k, 3), B (N, 3, n): three broadcast products (numpy's stacked
     matmul on 3-long inner products costs several times more)."""
     return A[:, :, 0, None] * B[:, None, 0] + A[:, :, 1, None] * B[:, None, 1] + A[:, :, 2, None] * B[:, None, 2]
 
 
-def _rows_times(P, Rt) -> np.ndarray:
+def _rows_times(P: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     """P @ Rt for a constant P (k, 3) and a stack Rt (N, 3, 3)."""
     return np.einsum("ki,nij->nkj", P, Rt)
 
 
-def _apply_rows(E, d) -> np.ndarray:
+def _apply_rows(E: np.ndarray, d: np.ndarray) -> np.ndarray:
     """E @ d for stacks E (N, k, 3), d (N, 3)."""
     return E[:, :, 0] * d[:, 0, None] + E[:, :, 1] * d[:, 1, None] + E[:, :, 2] * d[:, 2, None]
 
 
-def _cross_columns(a, W) -> np.ndarray:
+def _cross_columns(a: np.ndarray, W: np.ndarray) -> np.ndarray:
     """a x w for every column w of W: a (N, 3), W (N, 3, n) -> (N, 3, n)."""
     a0, a1, a2 = a[:, 0, None], a[:, 1, None], a[:, 2, None]
     return np.stack([a1 * W[:, 2] - a2 * W[:, 1], a2 * W[:, 0] - a0 * W[:, 2], a0 * W[:, 1] - a1 * W[:, 0]], axis=1)
 
 
-def _log3(R) -> np.ndarray:
+def _log3(R: np.ndarray) -> np.ndarray:
     """Rotation vectors of a stack of rotations (N, 3, 3) (pinocchio.log3 for each; angles
     below pi)."""
     c = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)

@@ -15,8 +15,14 @@ would cost too much (analysis.position.certified).  A result that reaches the bo
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from ...model.legs import chain_distance
+import numpy as np
+
+from ..legs import chain_distance
+
+if TYPE_CHECKING:
+    from ..kernel.algebraic import PolynomialClosure
 
 __all__ = ["KnownCount", "known_count"]
 
@@ -38,8 +44,8 @@ SIX_R = KnownCount(16, "angle sets", "the inverse kinematics of a six-revolute s
                    "Lee and Liang 1988; Raghavan and Roth 1993: at most 16")
 
 
-def known_count(closure, frozen, target: bool = False) -> KnownCount | None:
-    """The published bound that applies to this polynomial closure (model.algebraic.PolynomialClosure,
+def known_count(closure: PolynomialClosure, frozen: np.ndarray, target: bool = False) -> KnownCount | None:
+    """The published bound that applies to this polynomial closure (model.kernel.algebraic.PolynomialClosure,
     its legs eliminated), or None.  ``target``: the last cut joint is an inverse-kinematics target."""
     model = closure.model
     kinds = [closure.kind[j] for j in closure.slices]

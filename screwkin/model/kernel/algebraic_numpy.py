@@ -1,4 +1,4 @@
-"""The rows of model.algebraic.PolynomialClosure and their Jacobian, in numpy: world placements of the
+"""The rows of model.kernel.algebraic.PolynomialClosure and their Jacobian, in numpy: world placements of the
 joints and frames at a stack of complex points (the stack's index last inside), then the rows.
 
 A homotopy evaluates the rows thousands of times on stacks of a few to a few hundred points, so the
@@ -10,14 +10,16 @@ work per call is what counts (numpy's overhead is about a microsecond a call, wh
 - each joint's rotation is folded with its placement in its parent: Lr R(c, s) = K0 + c K1 + s K2
   for a revolute, constants precomputed, so a level of the tree costs one 3 x 3 product and one
   product with a vector, whatever its joints.
-The numbers are those of the compiled kernel (model.algebraic_compiled; tests compare them).
+The numbers are those of the compiled kernel (model.kernel.algebraic_compiled; tests compare them).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from .geometry import quaternion_matrix, stack_cross, stack_mm, stack_mv
+from ..geometry import quaternion_matrix, stack_cross, stack_mm, stack_mv
 
 __all__ = ["Placed", "rows_all"]
 
@@ -27,7 +29,7 @@ class Placed:
     every joint and frame (``frames`` None): the joints to place, level by level, and the constant
     ones placed once."""
 
-    def __init__(self, closure, frames=None):
+    def __init__(self, closure: Any, frames: Any = None) -> None:
         c = self.closure = closure
         nj = c.nj
         self.frames = np.arange(len(c.frames)) if frames is None else np.asarray(frames, int)
@@ -57,7 +59,7 @@ class Placed:
         self.La = stack_mv(c.Lr, c.axis.T)  # each joint's axis in its parent's frame
         self.refresh()
 
-    def refresh(self):
+    def refresh(self) -> None:
         """The constant parts after closure.set_inputs: the constant joints' motions folded with
         their placements, and the world placements of the joints that are constant all the way up."""
         c = self.closure
@@ -71,7 +73,7 @@ class Placed:
             op[:, j] = op[:, p] + oR[:, :, p] @ self.tcp[:, j]
         self.oRc, self.opc = oR, op
 
-    def __call__(self, X, jacobian: bool = True) -> dict:
+    def __call__(self, X: np.ndarray, jacobian: bool = True) -> dict:
         """World placements at the points X (P, n) (stack axis last): oR (3, 3, nj, P), op (3, nj, P)
         of the joints placed (the others are not filled in), fR, fp of the frames asked for (in
         their order); with ``jacobian`` each tangent coordinate's world rotation axis w (3, nt, P),
@@ -124,7 +126,7 @@ class Placed:
             out.update(w=w, o=o, e=e)
         return out
 
-    def _mixed(self, lv, Xt):
+    def _mixed(self, lv: dict, Xt: np.ndarray) -> Any:
         """(L, t) of a level with joints of several kinds: each joint's folded motion Lr R and its
         translation Lt + Lr t in its parent's frame, (3, 3, joints, P) and (3, joints, P)."""
         c, js = self.closure, lv["js"]
@@ -151,14 +153,14 @@ class Placed:
         return L, t
 
 
-def rows_all(c, kin, jacobian: bool):
+def rows_all(c: Any, kin: dict, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
     """Every planned row of the closure c (before dropping the identically zero ones), (rows, P), and
     its Jacobian in tangent coordinates (rows, nt, P), from placements ``kin`` (Placed's) of the
     frames the rows read (the first of c.frames)."""
     fR, fp = kin["fR"], kin["fp"]
     P, nt = fp.shape[-1], c.nt
     r = np.empty((c._nrows_all, P), complex)
-    J = np.empty((c._nrows_all, nt, P), complex) if jacobian else None
+    J: Any = np.empty((c._nrows_all, nt, P), complex) if jacobian else None
     v = stack_mv(fR[:, :, c.vq_f], c.vq_u[..., None])  # (3, vectors, P)
     if jacobian:
         w, o, e = kin["w"], kin["o"], kin["e"]

@@ -18,18 +18,23 @@ Row kinds (world vectors; o1, o2 frame origins, d = o2 - o1):
 from __future__ import annotations
 
 import threading
+from typing import Any, Callable
 
 import numpy as np
 import pinocchio as pin
 
-from ..tolerances import DEFAULT, Tolerances
+from ...tolerances import DEFAULT, Tolerances
 from . import compiled, newton
-from .manifold import Integrator
-from .cuts import Assembly, CouplingRow
-from .geometry import cross3, perpendicular_basis, skew, skews, skews_batch
-from ._pin import frame_jacobian
+from .contract import ClosureKernel, Step, Verdict
+from .contacts import contact_bias, contact_row
+from .scaling import sliding_columns
+from .wrenches import row_wrenches
+from ..manifold import Integrator
+from ..cuts import Assembly, CouplingRow
+from ..geometry import cross3, perpendicular_basis, skew, skews, skews_batch
+from .._pin import frame_jacobian
 
-__all__ = ["ClosureSystem"]
+__all__ = ["ClosureSystem", "PinocchioKernel", "CompiledKernel"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -39,15 +44,17 @@ class _Workspace:
 
     __slots__ = ("data", "placements", "groups", "buffers")
 
-    def __init__(self, data, placements):
-        self.data, self.placements, self.groups, self.buffers = data, placements, None, None
+    def __init__(self, data: Any, placements: Any) -> None:
+        self.data, self.placements = data, placements
+        self.groups: Any = None
+        self.buffers: Any = None
 
 
 class ClosureSystem:
     """The loop-closure equations r(q) = 0 of a model with cut joints."""
 
-    def __init__(self, model, cuts, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>", data=None,
-                 extra=()):
+    def __init__(self, model: Any, cuts: Any, tolerances: Tolerances = DEFAULT, path: str = "<mechanism>",
+                 data: Any = None, extra: Any = ()) -> None:
         """data: the pinocchio.Data the building thread computes in (a new one when None; every other
         thread makes its own: ``_workspace``);
         extra: CouplingRow and ContactRow of higher pairs, after the cut joints' rows."""
@@ -60,16 +67,17 @@ class ClosureSystem:
         self.path = path
         self.nrows = sum(c.rows for c in self.cuts) + len(self.extra)
         self._basis = [perpendicular_basis(c.axis) for c in self.cuts]
-        self._solver_rows = None
-        self._compiled = None  # (kernels, cut kinds) when accelerate() is on; each thread's buffers in its workspace
-        self._free = {}  # free velocity indices for each set of frozen ones
+        self._solver_rows: int | None = None
+        self._compiled: tuple[Any, np.ndarray] | None = None  # (kernels, cut kinds) when accelerate() is on; each thread's buffers in its workspace
+        self._free: dict[bytes, np.ndarray] = {}  # free velocity indices for each set of frozen ones
         self._plans = [self._plan(c, b1, b2) for c, (b1, b2) in zip(self.cuts, self._basis)]
         self._owner = threading.get_ident()
-        self._position_rows = None
+        self._position_rows: np.ndarray | None = None
         self.integrator = Integrator(model)  # q (+) dq on the model's configuration manifold, for stacks
+        self._kernels: tuple[ClosureKernel, ...] = (PinocchioKernel(self),)
 
     # ------------------------------------------------------------------ per-thread workspace
-    def _workspace(self):
+    def _workspace(self) -> _Workspace:
         """This thread's Data, the views of its cut frames' placements and the row groups built
         on them: threads may share a mechanism (each computes in a Data of its own; the thread that
         built the system uses the Data it was given).  Pinocchio hands out its frame placements by
@@ -87,16 +95,16 @@ class ClosureSystem:
         return ws
 
     @property
-    def data(self):
+    def data(self) -> Any:
         """The pinocchio.Data this thread computes in."""
         return self._workspace().data
 
     @property
-    def _placements(self):
+    def _placements(self) -> list:
         return self._workspace().placements
 
     @property
-    def _groups(self):
+    def _groups(self) -> list:
         return self._workspace().groups
 
     @property
@@ -116,42 +124,21 @@ class ClosureSystem:
 
     # ------------------------------------------------------------------ compiled inner loop
     def accelerate(self, on: bool = True) -> bool:
-        """Solve with the compiled kernels of screwkin.model.compiled (numba) when it is installed
+        """Solve with the compiled kernels of screwkin.model.kernel.compiled (numba) when it is installed
         and every cut joint is fixed or spherical; returns whether they are in use."""
 
         self._compiled = None
         kinds = compiled.kinds_of(self.cuts) if on and not self.extra else None
         if kinds is not None and compiled.available():
             self._compiled = (compiled.kernels(), kinds)
+            self._kernels = (self._kernels[0], CompiledKernel(self))
         return self._compiled is not None
 
     @property
     def accelerated(self) -> bool:
         return self._compiled is not None
 
-    def _evaluate_compiled(self, q, jacobian: bool = True):
-        """evaluate(q, jacobian, solver=True) through the compiled kernel (same rows)."""
-        kernels, kinds = self._compiled
-        ws = self._workspace()
-        if ws.buffers is None:  # this thread's buffers for the kernel
-            n, nv = len(self.cuts), self.model.nv
-            ws.buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
-                          np.empty((n, 6, nv)), np.empty((n, 6, nv)))
-        R1, R2, t1, t2, J1, J2 = ws.buffers
-        model, data = self.model, ws.data
-        self._kinematics(q, jacobian, data)
-        for j, (cut, (a, b, c, d)) in enumerate(zip(self.cuts, ws.placements)):
-            R1[j], R2[j], t1[j], t2[j] = a, b, c, d
-            if jacobian:
-                J1[j] = frame_jacobian(model, data, cut.frame1, LWA)
-                J2[j] = frame_jacobian(model, data, cut.frame2, LWA)
-        nrows = self._rows(True)
-        r = np.empty(nrows)
-        K = np.empty((nrows, model.nv)) if jacobian else np.empty((0, model.nv))
-        kernels.cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian)
-        return r, (K if jacobian else None)
-
-    def _kinematics(self, q, jacobian: bool, data):
+    def _kinematics(self, q: np.ndarray, jacobian: bool, data: Any) -> None:
         """Pinocchio's pass for q in ``data`` (this thread's): frame placements, and the joint
         Jacobians if asked."""
         if jacobian:
@@ -169,7 +156,7 @@ class ClosureSystem:
             self._solver_rows += len(self.extra)
         return self._solver_rows
 
-    def _plan(self, cut, b1, b2):
+    def _plan(self, cut: Any, b1: np.ndarray, b2: np.ndarray) -> tuple:
         """Constant parts of a cut joint's rows, in its frames: position axes P (rows, in F1),
         alignment pairs (u in F1, w in F2), the vectors the solver rows compare, and
         whether the minimal rows hold a rotation vector."""
@@ -182,7 +169,7 @@ class ClosureSystem:
         else:  # planar
             P = a[None, :]
         if t in ("revolute", "continuous", "cylindrical", "planar"):
-            pairs = ((b1, a), (b2, a))
+            pairs: tuple = ((b1, a), (b2, a))
         elif t == "universal":
             pairs = ((a, np.asarray(cut.axis2, float)),)
         else:
@@ -195,11 +182,11 @@ class ClosureSystem:
             vectors = np.eye(3) if t in ("fixed", "prismatic") else a[None, :]
         return P, pairs, vectors, t in ("fixed", "prismatic")
 
-    def _group(self, placements):
+    def _group(self, placements: Any) -> list:
         """Cut joints of one type share the layout of their rows: each group is evaluated
         with stacked arrays (a few numpy calls per group, not per cut joint)."""
         offsets = {False: 0, True: 0}
-        groups = {}
+        groups: dict[str, dict] = {}
         for c, cut in enumerate(self.cuts):
             P, pairs, vectors, rotation = self._plans[c]
             g = groups.setdefault(cut.type, {"members": [], "P": [], "U": [], "W": [], "V": [],
@@ -235,7 +222,7 @@ class ClosureSystem:
         return out
 
     @staticmethod
-    def _cut_rows(cut, plan, solver):
+    def _cut_rows(cut: Any, plan: tuple, solver: bool) -> int:
         """Rows of one cut joint: 6 - dof minimal ones, or the solver's (positions, then three
         per shared vector, or the alignments of a universal joint), read from its plan."""
         if not solver:
@@ -243,7 +230,8 @@ class ClosureSystem:
         P, pairs, vectors, _ = plan
         return len(P) + (len(pairs) if vectors is None else 3 * len(vectors))
 
-    def evaluate(self, q, jacobian: bool = True, solver: bool = False):
+    def evaluate(self, q: np.ndarray, jacobian: bool = True, solver: bool = False
+                ) -> tuple[np.ndarray, np.ndarray | None]:
         """Residual r(q) and, if asked, its Jacobian (rows x nv).
 
         With ``solver=False`` (default) the rows are the minimal ones (6 - dof per
@@ -261,7 +249,7 @@ class ClosureSystem:
         self._kinematics(q, jacobian, data)
         nrows = self._rows(solver)
         r = np.empty(nrows)
-        K = np.empty((nrows, model.nv)) if jacobian else None
+        K: Any = np.empty((nrows, model.nv)) if jacobian else None
         for g in ws.groups:
             views = g["views"]
             n = len(views)
@@ -312,7 +300,7 @@ class ClosureSystem:
             self._evaluate_extra(q, r, K, nrows - len(self.extra))
         return r, K
 
-    def _evaluate_extra(self, q, r, K, i):
+    def _evaluate_extra(self, q: np.ndarray, r: np.ndarray, K: np.ndarray, i: int) -> None:
         """The rows of the higher pairs (CouplingRow, ContactRow) from row i on."""
         for k, e in enumerate(self.extra, i):
             if isinstance(e, CouplingRow):
@@ -322,63 +310,12 @@ class ClosureSystem:
                     for _, iv, c in e.terms:
                         K[k, iv] += c
                 continue
-            value, grad = self._contact(e, K is not None)
+            value, grad = contact_row(self.model, self.data, e, K is not None)
             r[k] = value
             if K is not None:
                 K[k] = grad
 
-    def _contact(self, e, jacobian):
-        """(value, Jacobian row or None) of a ContactRow at the placements in self.data."""
-        model, data = self.model, self.data
-        M1, M2 = data.oMf[e.frame1], data.oMf[e.frame2]
-        J1 = frame_jacobian(model, data, e.frame1, LWA) if jacobian else None
-        J2 = frame_jacobian(model, data, e.frame2, LWA) if jacobian else None
-        if "line" in (e.shape1, e.shape2):
-            # s = (o_a - o_b) . m_b, the line on frame b (its normal m_b turns with it), the other at a
-            on2 = e.shape2 == "line"
-            Ma, Mb = (M1, M2) if on2 else (M2, M1)
-            Ja, Jb = (J1, J2) if on2 else (J2, J1)
-            m = Mb.rotation @ np.asarray(e.normal)
-            delta = Ma.translation - Mb.translation
-            s = float(delta @ m)
-            point = (e.shape1 if on2 else e.shape2) == "point"
-            sign = 1.0 if point or s >= 0 else -1.0
-            value = sign * s - (0.0 if point else e.target())
-            if not jacobian:
-                return value, None
-            return value, sign * (m @ (Ja[:3] - Jb[:3]) + cross3(m, delta) @ Jb[3:])
-        delta = M2.translation - M1.translation
-        dist = float(np.sqrt(delta @ delta))
-        value = dist - e.target()
-        if not jacobian:
-            return value, None
-        return value, (delta / max(dist, 1e-300)) @ (J2[:3] - J1[:3])
-
-    def _contact_bias(self, e):
-        """d2/dt2 of a ContactRow along the motion in self.data (velocities, classical accelerations)."""
-        model, data = self.model, self.data
-        M = (data.oMf[e.frame1], data.oMf[e.frame2])
-        V = [pin.getFrameVelocity(model, data, f, LWA) for f in (e.frame1, e.frame2)]
-        A = [pin.getFrameClassicalAcceleration(model, data, f, LWA) for f in (e.frame1, e.frame2)]
-        if "line" in (e.shape1, e.shape2):
-            a, b = (0, 1) if e.shape2 == "line" else (1, 0)
-            m = M[b].rotation @ np.asarray(e.normal)
-            w, al = V[b].angular, A[b].angular
-            delta = M[a].translation - M[b].translation
-            dd = V[a].linear - V[b].linear
-            ddd = A[a].linear - A[b].linear
-            md = cross3(w, m)
-            mdd = cross3(al, m) + cross3(w, md)
-            s2 = ddd @ m + 2 * dd @ md + delta @ mdd
-            point = (e.shape1 if b == 1 else e.shape2) == "point"
-            return s2 if point or delta @ m >= 0 else -s2
-        delta = M[1].translation - M[0].translation
-        dd = V[1].linear - V[0].linear
-        ddd = A[1].linear - A[0].linear
-        d = float(np.sqrt(delta @ delta))
-        return (ddd @ delta + dd @ dd) / d - (delta @ dd) ** 2 / d**3
-
-    def _evaluate_one(self, g, j, r, K, solver, data):
+    def _evaluate_one(self, g: dict, j: int, r: np.ndarray, K: np.ndarray, solver: bool, data: Any) -> None:
         """The rows of cut joint j of a group (the same rows as the stacked code, with 2-D
         arrays: a test checks that both give the same numbers), placements in ``data``."""
         model = self.model
@@ -417,7 +354,7 @@ class ClosureSystem:
                 for c in range(p):
                     K[i + c] = cross3(w[:, c], u[:, c]) @ (w2 - w1)
 
-    def bias(self, q, v) -> np.ndarray:
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         """K'(q, v) v: the second time derivative of the (minimal) residual rows
         along a motion with joint velocity v and zero joint acceleration, from
         Pinocchio's classical frame accelerations.  Exact for position and
@@ -428,7 +365,8 @@ class ClosureSystem:
         out = np.empty(self.nrows)
         i = 0
 
-        def second(u, w, al):  # (d/dt u, d2/dt2 u) for u fixed in a frame turning at w with acceleration al
+        # (d/dt u, d2/dt2 u) for u fixed in a frame turning at w with acceleration al
+        def second(u: np.ndarray, w: np.ndarray, al: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             ud = cross3(w, u)
             return ud, cross3(al, u) + cross3(w, ud)
 
@@ -457,7 +395,7 @@ class ClosureSystem:
                 out[i] = udd @ w + 2 * ud @ wd + u @ wdd
                 i += 1
         for e in self.extra:  # a coupling is linear in the coordinates: nothing
-            out[i] = 0.0 if isinstance(e, CouplingRow) else self._contact_bias(e)
+            out[i] = 0.0 if isinstance(e, CouplingRow) else contact_bias(self.model, self.data, e)
             i += 1
         return out
 
@@ -500,60 +438,19 @@ class ClosureSystem:
         """The inputs that rows hold (CouplingRow.input: links whose absolute angle is given), in row order."""
         return tuple(e.input for e in self.extra if getattr(e, "input", None) is not None)
 
-    def row_wrenches(self, q) -> list:
-        """What a unit force in each minimal row exerts, row by row: (frame a, wrench on a's body,
-        frame b, wrench on b's body), each wrench (force, moment) at the frame's origin in world
-        axes, so that the row's Jacobian is w_a^T J_a + w_b^T J_b (J: LOCAL_WORLD_ALIGNED frame
-        Jacobians) -- the constraint wrenches of screw theory; or (None, coupling row) for a
-        coupling of coordinates (a force between joints inside a higher pair's virtual chain)."""
-        pin.framesForwardKinematics(self.model, self.data, q)
-        data = self.data
-        out = []
-        zero = np.zeros(3)
+    def row_wrenches(self, q: np.ndarray) -> list:
+        """What a unit force in each minimal row exerts (model.kernel.wrenches.row_wrenches)."""
+        return row_wrenches(self.model, self.data, self.cuts, self._plans, self.extra, q)
 
-        def pair(f1, w1, f2, w2):
-            out.append((f1, np.asarray(w1, float), f2, np.asarray(w2, float)))
-
-        for cut, (P, pairs, _, rotation) in zip(self.cuts, self._plans):
-            M1, M2 = data.oMf[cut.frame1], data.oMf[cut.frame2]
-            R1, R2 = M1.rotation, M2.rotation
-            d = M2.translation - M1.translation
-            for e in P @ R1.T:  # e . d, e fixed in F1: d(e . d) = e . (v2 - v1) + (e x d) . w1
-                pair(cut.frame1, np.r_[-e, cross3(e, d)], cut.frame2, np.r_[e, zero])
-            if rotation:  # log3(R1^T R2): Jlog3 R2^T (w2 - w1)
-                C = pin.Jlog3(R1.T @ R2) @ R2.T
-                for c in C:
-                    pair(cut.frame1, np.r_[zero, -c], cut.frame2, np.r_[zero, c])
-                continue
-            for u, w in pairs:  # u . w: (w x u) . (w2 - w1)
-                c = cross3(R2 @ w, R1 @ u)
-                pair(cut.frame1, np.r_[zero, -c], cut.frame2, np.r_[zero, c])
-        for e in self.extra:
-            if isinstance(e, CouplingRow):
-                out.append((None, e, None, None))
-                continue
-            M1, M2 = data.oMf[e.frame1], data.oMf[e.frame2]
-            if "line" in (e.shape1, e.shape2):
-                on2 = e.shape2 == "line"
-                (fa, Ma), (fb, Mb) = ((e.frame1, M1), (e.frame2, M2)) if on2 else ((e.frame2, M2), (e.frame1, M1))
-                m = Mb.rotation @ np.asarray(e.normal)
-                delta = Ma.translation - Mb.translation
-                point = (e.shape1 if on2 else e.shape2) == "point"
-                sign = 1.0 if point or delta @ m >= 0 else -1.0
-                pair(fa, sign * np.r_[m, zero], fb, sign * np.r_[-m, cross3(m, delta)])
-                continue
-            delta = M2.translation - M1.translation
-            u = delta / max(float(np.linalg.norm(delta)), 1e-300)
-            pair(e.frame1, np.r_[-u, zero], e.frame2, np.r_[u, zero])
-        return out
-
-    def residual(self, q) -> np.ndarray:
+    def residual(self, q: np.ndarray) -> np.ndarray:
         return self.evaluate(q, jacobian=False)[0]
 
-    def jacobian(self, q) -> np.ndarray:
-        return self.evaluate(q, jacobian=True)[1]
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        K = self.evaluate(q, jacobian=True)[1]
+        assert K is not None
+        return K
 
-    def wrong_branch(self, q, placed: bool = False) -> list:
+    def wrong_branch(self, q: np.ndarray, placed: bool = False) -> list:
         """Cut joints whose aligned axes are antiparallel (a spurious root of the
         alignment rows: the joint would be assembled upside down).  placed: the
         frame placements in self.data are already those of q."""
@@ -570,15 +467,16 @@ class ClosureSystem:
         return bad
 
     # ------------------------------------------------------------------ solving
-    def solve(self, q0, frozen=(), tolerances: Tolerances | None = None, trace=None) -> Assembly:
-        """Solve r(q) = 0 from q0 by damped Newton (model.newton.solve: Levenberg-Marquardt,
+    def solve(self, q0: np.ndarray, frozen: Any = (), tolerances: Tolerances | None = None,
+              trace: Callable[..., None] | None = None) -> Assembly:
+        """Solve r(q) = 0 from q0 by damped Newton (model.kernel.newton.solve: Levenberg-Marquardt,
         minimum-norm steps).  frozen: velocity indices that must not move (the inputs); trace:
         optional callable(iteration, q, r, K, dq, accepted) recording the iterations (r and K in
         the solver's rows, see ``row_labels``).  Raises AssemblyError with the smallest residual
         reached when it fails, or when the solution assembles a cut joint upside down."""
-        return newton.solve(self, q0, frozen, tolerances or self.tol, trace)
+        return newton.solve(self.kernel, q0, frozen, tolerances or self.tol, trace)
 
-    def free_columns(self, frozen) -> np.ndarray:
+    def free_columns(self, frozen: Any) -> np.ndarray:
         """The velocity indices not in ``frozen`` (a sequence of indices; cached per set of frozen ones)."""
         frozen = np.asarray(frozen, int).ravel()
         key = frozen.tobytes()
@@ -587,15 +485,78 @@ class ClosureSystem:
             free = self._free[key] = np.setdiff1d(np.arange(self.model.nv), frozen)
         return free
 
-    def solver_pass(self):
-        """What model.newton.iterate needs to solve one configuration (a stack of one):
-        (evaluate(Q (1, nq), which, jacobian) -> (r (1, rows), K (1, rows, nv) or None) in the solver's
-        rows, step, verdict): compiled when accelerate() is on (model.compiled), else numpy
-        (newton.damped_step, newton.judge)."""
-        if self._compiled:
-            return self._stack_of_one, compiled.one_step, self._compiled[0].judge
-        return self._stack_of_one, newton.one_step, newton.judge
+    @property
+    def kernel(self) -> ClosureKernel:
+        """The solver's rows through the kernels' contract (what ``solve`` iterates on): compiled when
+        accelerate() is on (model.kernel.compiled), else Pinocchio's, a configuration at a time."""
+        return self._kernels[1 if self._compiled else 0]
 
-    def _stack_of_one(self, Q, which, jacobian):
-        r, K = self._evaluate_compiled(Q[0], jacobian) if self._compiled else self.evaluate(Q[0], jacobian, True)
-        return r[None], (None if K is None else K[None])
+    @property
+    def pinocchio(self) -> ClosureKernel:
+        """The solver's rows through the contract, evaluated by Pinocchio (never compiled)."""
+        return self._kernels[0]
+
+    @property
+    def solver_position_rows(self) -> np.ndarray:
+        """Mask of the solver's rows (``evaluate(solver=True)``) that are lengths [m] (positions; the
+        couplings of rolling and screw pairs); the others are dimensionless."""
+        mask = []
+        for c, (P, pairs, vectors, _) in zip(self.cuts, self._plans):
+            rest = self._cut_rows(c, (P, pairs, vectors, None), True) - len(P)
+            mask += [True] * len(P) + [False] * rest
+        return np.array(mask + [True] * len(self.extra), bool)
+
+
+class PinocchioKernel(ClosureKernel):
+    """A ClosureSystem's solver rows under the kernels' contract: Pinocchio's pass, one configuration
+    of the stack at a time (a stack of one: the single solve)."""
+
+    def __init__(self, system: ClosureSystem) -> None:
+        self.system = system
+        self.nq, self.nv, self.m = system.model.nq, system.model.nv, system._rows(True)
+        self.length_rows = system.solver_position_rows
+        self.sliding = sliding_columns(system.model)
+
+    def _one(self, q: np.ndarray, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        return self.system.evaluate(q, jacobian, True)
+
+    def evaluate(self, Q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        if len(Q) == 1:
+            r, K = self._one(Q[0], jacobian)
+            return r[None], (None if K is None else K[None])
+        rows = [self._one(q, jacobian) for q in Q]
+        return np.array([r for r, _ in rows]), (np.array([K for _, K in rows]) if jacobian else None)
+
+    def integrate(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        return self.system.integrator(Q, V)
+
+    def constraint_jacobian(self, Q: np.ndarray) -> np.ndarray:
+        return np.array([self.system.jacobian(q) for q in Q]).reshape(len(Q), self.system.nrows, self.nv)
+
+    def bias(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        return np.array([self.system.bias(q, v) for q, v in zip(Q, V)]).reshape(len(Q), self.system.nrows)
+
+    def free_columns(self, frozen: Any) -> np.ndarray:
+        return self.system.free_columns(frozen)
+
+    def reversed_joints(self, q: np.ndarray, placed: bool = False) -> list[str]:
+        return self.system.wrong_branch(q, placed)
+
+    def newton_parts(self) -> tuple[Step, Verdict]:
+        return newton.one_step, newton.judge
+
+    @property
+    def name(self) -> str:
+        return self.system.path
+
+
+class CompiledKernel(PinocchioKernel):
+    """The same rows through numba's kernels (model.kernel.compiled: fixed and spherical cut joints),
+    with the compiled step and verdict."""
+
+    def _one(self, q: np.ndarray, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        return compiled.cut_rows(self.system, q, jacobian)
+
+    def newton_parts(self) -> tuple[Step, Verdict]:
+        assert self.system._compiled is not None
+        return compiled.one_step, self.system._compiled[0].judge

@@ -5,16 +5,16 @@ joints -- the 6d and 3d closures of Extended-URDF files -- costs about 38 us in
 numpy for one weld, of which Pinocchio's own calls are 3 us: the rest is the
 overhead of numpy calls on 3-vectors.  Here the rows, their Jacobian and the damped step are
 loops compiled by numba (cached on disk after the first use): the same numbers
-as ``ClosureSystem.evaluate(q, solver=True)`` and model.newton.damped_step (tests check
+as ``ClosureSystem.evaluate(q, solver=True)`` and model.kernel.newton.damped_step (tests check
 both), about 2.5 times faster per solve (benchmarks/README.md).  Pinocchio still computes every
-placement and frame Jacobian, and the Newton loop is model.newton.iterate, the numpy solver's own:
-the rows, the step and the loop's verdict (model.newton.judge, compiled from its one definition)
+placement and frame Jacobian, and the Newton loop is model.kernel.newton.iterate, the numpy solver's own:
+the rows, the step and the loop's verdict (model.kernel.newton.judge, compiled from its one definition)
 are what is compiled.
 
 The step's linear solve is numba's np.linalg.solve, which raises np.linalg.LinAlgError where
 LAPACK finds the damped system singular in floating point ("Matrix is singular to machine
 precision") or where K or r holds an inf or a NaN ("Array must not contain infs or NaNs"); nothing
-else in the kernels raises.  ``damped_step`` then takes model.newton.damped_step, whose solve falls
+else in the kernels raises.  ``damped_step`` then takes model.kernel.newton.damped_step, whose solve falls
 back to least squares (and which gives NaN, as numpy does, for a NaN row).
 
 Used only when asked (``PositionSolver(mech, compiled=True)`` or
@@ -25,17 +25,23 @@ use compiles for about 15 s (8 s of it the rows and the step; loaded from the ca
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+from typing import Any
+
 import numpy as np
 
 try:
     import resource
 except ImportError:  # not a POSIX system
-    resource = None
+    resource = None  # type: ignore[assignment]
 
+import pinocchio as pin
+
+from .._pin import frame_jacobian
 from . import newton
 from .newton import TRACE_FLOOR
 
-__all__ = ["available", "kernels", "kinds_of", "damped_step", "one_step", "SPHERICAL", "FIXED"]
+__all__ = ["available", "kernels", "kinds_of", "damped_step", "one_step", "SPHERICAL", "FIXED", "cut_rows"]
 
 SPHERICAL, FIXED = 0, 1  # the cut joint types the kernels know (3 and 12 solver rows)
 _KERNELS = None
@@ -59,7 +65,7 @@ def cache_on_disk() -> bool:
     return resource.getrlimit(resource.RLIMIT_FSIZE)[0] == resource.RLIM_INFINITY
 
 
-def kernels():
+def kernels() -> Any:
     """The compiled functions (compiled or loaded from the cache at the first call)."""
     global _KERNELS
     if _KERNELS is None:
@@ -67,13 +73,14 @@ def kernels():
     return _KERNELS
 
 
-def _compile_kernels():
+def _compile_kernels() -> Any:
     import numba as nb
 
     cache = cache_on_disk()
 
     @nb.njit(cache=cache)
-    def cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian):
+    def cut_rows(kinds: np.ndarray, R1: np.ndarray, R2: np.ndarray, t1: np.ndarray, t2: np.ndarray, J1: np.ndarray,
+                 J2: np.ndarray, r: np.ndarray, K: np.ndarray, jacobian: bool) -> int:
         """Solver rows of each cut joint c, in order: F2's origin along F1's axes
         (e . d, e fixed in F1), then for welds R2 e - R1 e for the three axes e.
         Their derivative: e . (v2 - v1) + (e x d) . w1 and [R1 e]x w1 - [R2 e]x w2."""
@@ -112,8 +119,8 @@ def _compile_kernels():
         return i
 
     @nb.njit(cache=cache)
-    def damped_step(K, r, free, mu):
-        """model.newton.damped_step, compiled: the minimum-norm damped step on the free columns
+    def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:
+        """model.kernel.newton.damped_step, compiled: the minimum-norm damped step on the free columns
         (the smaller of the two normal systems) and |r + K_f dq_f|^2 (the linear model's residual)."""
         m, nf = K.shape[0], free.shape[0]
         Kf = np.empty((m, nf))
@@ -135,17 +142,12 @@ def _compile_kernels():
         lin = r + Kf @ dqf
         return dqf, lin @ lin
 
-    class Kernels:
-        pass
-
-    k = Kernels()
-    k.cut_rows, k.damped_step = cut_rows, damped_step
-    k.judge = nb.njit(cache=cache)(newton.judge)  # the loop's verdict, compiled from its one definition
-    return k
+    # the loop's verdict, compiled from its one definition
+    return SimpleNamespace(cut_rows=cut_rows, damped_step=damped_step, judge=nb.njit(cache=cache)(newton.judge))
 
 
-def damped_step(K, r, free, mu):
-    """model.newton.damped_step through the compiled kernel (K C-contiguous, free int64), with
+def damped_step(K: np.ndarray, r: np.ndarray, free: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, Any]:
+    """model.kernel.newton.damped_step through the compiled kernel (K C-contiguous, free int64), with
     the numpy step where numba's solve raises np.linalg.LinAlgError (a singular damped system:
     the numpy step's least-squares fallback; an inf or NaN in K or r: NaN, as numpy gives)."""
     try:
@@ -154,14 +156,40 @@ def damped_step(K, r, free, mu):
         return newton.damped_step(K, r, free, mu)
 
 
-#: damped_step as the step of model.newton.iterate (the single solve's, compiled).
+#: damped_step as the step of model.kernel.newton.iterate (the single solve's, compiled).
 one_step = newton.one_at_a_time(damped_step)
 
 
-def kinds_of(cuts):
+def kinds_of(cuts: Any) -> np.ndarray | None:
     """The kernel code of each cut joint, or None when one of them is of a type the kernels
     do not know."""
     codes = {"spherical": SPHERICAL, "fixed": FIXED}
     if not cuts or any(c.type not in codes for c in cuts):
         return None
     return np.array([codes[c.type] for c in cuts], np.int64)
+
+
+def cut_rows(system: Any, q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """system.evaluate(q, jacobian, solver=True) of a model.kernel.closure.ClosureSystem through the
+    compiled kernel (the same rows; after system.accelerate())."""
+    LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    assert system._compiled is not None
+    kernels, kinds = system._compiled
+    ws = system._workspace()
+    if ws.buffers is None:  # this thread's buffers for the kernel
+        n, nv = len(system.cuts), system.model.nv
+        ws.buffers = (np.empty((n, 3, 3)), np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3)),
+                      np.empty((n, 6, nv)), np.empty((n, 6, nv)))
+    R1, R2, t1, t2, J1, J2 = ws.buffers
+    model, data = system.model, ws.data
+    system._kinematics(q, jacobian, data)
+    for j, (cut, (a, b, c, d)) in enumerate(zip(system.cuts, ws.placements)):
+        R1[j], R2[j], t1[j], t2[j] = a, b, c, d
+        if jacobian:
+            J1[j] = frame_jacobian(model, data, cut.frame1, LWA)
+            J2[j] = frame_jacobian(model, data, cut.frame2, LWA)
+    nrows = system._rows(True)
+    r = np.empty(nrows)
+    K = np.empty((nrows, model.nv)) if jacobian else np.empty((0, model.nv))
+    kernels.cut_rows(kinds, R1, R2, t1, t2, J1, J2, r, K, jacobian)
+    return r, (K if jacobian else None)

@@ -7,7 +7,7 @@ Unknowns x (dimensionless), per passive joint of the spanning tree:
 - prismatic: u = (value) / L (L: the characteristic length);
 - ball (Pinocchio's spherical joint): its quaternion q = (x, y, z, w) on q.q = 1; its rotation, the
   homogeneous quadratic form Q(q), is quadratic, so q and -q are one placement (a symmetry,
-  model.symmetry);
+  model.homotopy.symmetry);
 - free flyer: three translations / L and a quaternion.
 Input joints are constants (``set_inputs``).  Translations are divided by L, so every row is
 dimensionless.
@@ -18,7 +18,7 @@ Rows (world vectors; o1, o2 the origins of the cut joint's frames F1, F2, R1, R2
                                    prismatic -- with det R = 1 these make R1 = R2)
     dotd: (R1 u) . (o2 - o1)      (u perpendicular to the axis: prismatic, cylindrical; the axis: planar)
     dot:  (R1 a) . (R2 a2)        (universal)
-Their real zeros are exactly the closed configurations of model.closure (a revolute's axes aligned,
+Their real zeros are exactly the closed configurations of model.kernel.closure (a revolute's axes aligned,
 never antiparallel: the vector row R1 a = R2 a, not the perpendicularity rows).  Rows that vanish
 identically on the constraint variety (a planar mechanism's out-of-plane rows) are dropped.
 
@@ -32,19 +32,22 @@ those coordinates is the geometric one: a revolute's column moves a point p by w
 vector v by w x v (w its world axis, o its origin), a prismatic's moves points by its world axis, a
 quaternion's are three revolutes about its frame's axes through its centre.
 Everything is evaluated for a stack of points at once in complex arithmetic: in numpy by
-model.algebraic_numpy (the stack's index last inside; 3 x 3 products as sums of broadcast products,
-four times numpy's stacked matmul), or by the compiled kernel of model.algebraic_compiled.
+model.kernel.algebraic_numpy (the stack's index last inside; 3 x 3 products as sums of broadcast products,
+four times numpy's stacked matmul), or by the compiled kernel of model.kernel.algebraic_compiled.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from . import algebraic_compiled, compiled as numba_kernels
 from .algebraic_numpy import Placed, rows_all
-from .geometry import perpendicular_basis, quaternion_matrix, quaternion_product, skew
-from .legs import distance_legs
+from .contract import ClosureKernel
+from ..geometry import perpendicular_basis, quaternion_matrix, quaternion_product, skew
+from ..legs import distance_legs
 
 __all__ = ["PolynomialClosure", "algebraic_obstacle"]
 
@@ -62,7 +65,7 @@ _SERIES = 1e-8
 _TANGENT = {"R": 1, "P": 1, "S": 3, "F": 6}
 
 
-def algebraic_obstacle(model, cuts, extra=(), couplings=()) -> str | None:
+def algebraic_obstacle(model: Any, cuts: Any, extra: Any = (), couplings: Any = ()) -> str | None:
     """Why the closure of these cut joints and rows is not polynomial in the unknowns above (a
     sentence), or None when it is."""
     for j in range(1, model.njoints):
@@ -88,7 +91,7 @@ def algebraic_obstacle(model, cuts, extra=(), couplings=()) -> str | None:
     return None
 
 
-class PolynomialClosure:
+class PolynomialClosure(ClosureKernel):
     """The closure rows of a model's cut joints as polynomials in the passive joints' unknowns.
 
     model, cuts: the Pinocchio model and model.cuts.CutJoint list (a model copy with a target frame
@@ -96,9 +99,9 @@ class PolynomialClosure:
     length: L [m]; points: frame ids whose origins the signature holds; output: a frame id whose
     pose it holds."""
 
-    def __init__(self, model, cuts, frozen, length: float, points=(), output=None, compiled: bool | None = None,
-                 eliminate: bool = True):
-        """compiled: evaluate the rows with the numba kernel of model.algebraic_compiled (True), with
+    def __init__(self, model: Any, cuts: Any, frozen: Any, length: float, points: Any = (), output: Any = None,
+                 compiled: bool | None = None, eliminate: bool = True) -> None:
+        """compiled: evaluate the rows with the numba kernel of model.kernel.algebraic_compiled (True), with
         numpy (False), or with the kernel when numba imports (None); eliminate: the legs that are
         distance constraints (model.legs) become one row each, their joints no unknowns."""
         self.model, self.cuts, self.L = model, list(cuts), float(length)
@@ -166,11 +169,13 @@ class PolynomialClosure:
         self._row_index()
         self.Rc = np.broadcast_to(np.eye(3, dtype=complex)[:, :, None], (3, 3, nj)).copy()
         self.tc = np.zeros((3, nj), complex)
-        self._placed = {}  # frames placed (None: all, "rows": the rows') -> algebraic_numpy.Placed
+        self._placed: dict[Any, Placed] = {}  # frames placed (None: all, "rows": the rows') -> algebraic_numpy.Placed
         self.set_inputs(pin.neutral(model))
         self.keep = np.ones(self._nrows_all, bool)
         self.keep = self._nonzero_rows()
         self.m = int(self.keep.sum())
+        self.nq, self.nv = self.n, self.nt  # the contract's: unknowns and tangent coordinates
+        self.length_rows, self.sliding = np.zeros(self.m, bool), np.zeros(0, int)  # (lengths already over L)
         self._kernel = None
         if compiled or (compiled is None and numba_kernels.available()):
             self._kernel, self._packed = algebraic_compiled.kernel(), algebraic_compiled.pack(self)
@@ -181,17 +186,19 @@ class PolynomialClosure:
         return self._kernel is not None
 
     # ------------------------------------------------------------------ layout
-    def _ancestors(self, j) -> set:
+    def _ancestors(self, j: int) -> set:
         out = set()
         while j > 0:
             out.add(j)
             j = self.parent[j]
         return out
 
-    def _row_plan(self):
+    def _row_plan(self) -> None:
         """Per cut joint its rows: ("pos", f1, f2), ("vec", f1, u1, f2, u2), ("dotd", f1, u, f2),
         ("dot", f1, u, f2, w), u in F1 and w in F2 (axes of the cut joint's frames)."""
-        plan, frames, self.row_cut = [], [], []
+        plan: list[tuple] = []
+        frames: list = []
+        self.row_cut: list[str] = []
         legs = {leg.cut: k for k, leg in enumerate(self.legs)}
         for cut in self.cuts:
             if cut.name in legs:  # a leg that is a distance: |p - O|^2 - r^2
@@ -207,7 +214,7 @@ class PolynomialClosure:
             frames += [f1, f2]
             t = cut.type
             ex, ey = np.eye(3)[0], np.eye(3)[1]
-            rows = []
+            rows: list[tuple] = []
             if t in ("fixed", "revolute", "continuous", "universal", "spherical"):
                 rows.append(("pos", f1, f2))
             if t in ("fixed", "prismatic"):
@@ -227,18 +234,19 @@ class PolynomialClosure:
         self.row_frames = list(dict.fromkeys(frames))
         self._nrows_all = len(self.row_cut)
 
-    def _row_index(self):
+    def _row_index(self) -> None:
         """Index arrays of the rows by kind: the frames and world vectors each reads, its row numbers."""
-        vq, vq_key = [], {}
+        vq: list[tuple[int, np.ndarray]] = []
+        vq_key: dict[tuple, int] = {}
 
-        def vector(f, u):
+        def vector(f: Any, u: np.ndarray) -> Any:
             key = (f, tuple(np.round(u, 15)))
             if key not in vq_key:
                 vq_key[key] = len(vq)
                 vq.append((self.f_index[f], np.asarray(u, float)))
             return vq_key[key]
 
-        idx = {k: {"rows": [], "a": [], "b": [], "q1": [], "q2": []} for k in ("pos", "vec", "dotd", "dot", "dist")}
+        idx: dict[str, dict[str, list]] = {k: {"rows": [], "a": [], "b": [], "q1": [], "q2": []} for k in ("pos", "vec", "dotd", "dot", "dist")}
         i = 0
         for row in self.plan:
             kind = row[0]
@@ -247,23 +255,29 @@ class PolynomialClosure:
             d["rows"].append(list(range(i, i + width)))
             i += width
             if kind == "dist":
-                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[2]]), d["q1"].append(row[3])
+                d["a"].append(self.f_index[row[1]])
+                d["b"].append(self.f_index[row[2]])
+                d["q1"].append(row[3])
             elif kind == "pos":
-                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[2]])
+                d["a"].append(self.f_index[row[1]])
+                d["b"].append(self.f_index[row[2]])
             elif kind == "vec":
-                d["q1"].append(vector(row[1], row[2])), d["q2"].append(vector(row[3], row[4]))
+                d["q1"].append(vector(row[1], row[2]))
+                d["q2"].append(vector(row[3], row[4]))
             elif kind == "dotd":
-                d["a"].append(self.f_index[row[1]]), d["b"].append(self.f_index[row[3]])
+                d["a"].append(self.f_index[row[1]])
+                d["b"].append(self.f_index[row[3]])
                 d["q1"].append(vector(row[1], row[2]))
             else:
-                d["q1"].append(vector(row[1], row[2])), d["q2"].append(vector(row[3], row[4]))
-        width = {"pos": 3, "vec": 3, "dotd": 1, "dot": 1, "dist": 1}
-        self.rix = {k: {n: np.array(v, int).reshape(len(v), width[k]) if n == "rows" else np.array(v, int)
+                d["q1"].append(vector(row[1], row[2]))
+                d["q2"].append(vector(row[3], row[4]))
+        widths = {"pos": 3, "vec": 3, "dotd": 1, "dot": 1, "dist": 1}
+        self.rix = {k: {n: np.array(v, int).reshape(len(v), widths[k]) if n == "rows" else np.array(v, int)
                         for n, v in d.items()} for k, d in idx.items()}
         self.vq_f = np.array([f for f, _ in vq], int)
         self.vq_u = np.array([u for _, u in vq]).reshape(-1, 3).T
 
-    def set_inputs(self, q):
+    def set_inputs(self, q: np.ndarray) -> None:
         """Take the input joints' (constant) motions from the real configuration q, and the eliminated
         legs' lengths there (their frame's distance from their centre: any leg angles give it)."""
         if self.legs:
@@ -283,7 +297,7 @@ class PolynomialClosure:
         for placed in self._placed.values():
             placed.refresh()
 
-    def _from_joint(self, j, qj):
+    def _from_joint(self, j: int, qj: np.ndarray) -> np.ndarray:
         kind = self.kind[j]
         if kind == "R":
             return np.array([np.cos(qj[0]), np.sin(qj[0])]) if len(qj) == 1 else np.array(qj, float)
@@ -293,7 +307,7 @@ class PolynomialClosure:
             return np.r_[qj[:3] / self.L, qj[3:]]
         return np.array(qj, float)
 
-    def from_q(self, q) -> np.ndarray:
+    def from_q(self, q: np.ndarray) -> np.ndarray:
         """The unknowns x (n,) of a real configuration q."""
         q = np.asarray(q, float)
         x = np.zeros(self.n)
@@ -302,7 +316,7 @@ class PolynomialClosure:
             x[sl] = self._from_joint(j, q[jm.idx_q:jm.idx_q + jm.nq])
         return x
 
-    def to_q(self, x, q_inputs) -> np.ndarray:
+    def to_q(self, x: np.ndarray, q_inputs: np.ndarray) -> np.ndarray:
         """The real configuration with the passive joints at the real parts of x and the inputs of q_inputs."""
         q = np.array(q_inputs, float)
         x = np.real(np.asarray(x))
@@ -320,7 +334,7 @@ class PolynomialClosure:
                 q[jm.idx_q + 3:jm.idx_q + 7] = v[3:] / np.linalg.norm(v[3:])
         return q
 
-    def random_points(self, rng, P: int) -> np.ndarray:
+    def random_points(self, rng: np.random.Generator, P: int) -> np.ndarray:
         """P random complex points on the constraint variety (circles, unit quaternions)."""
         X = np.empty((P, self.n), complex)
         for j, sl in self.slices.items():
@@ -340,7 +354,7 @@ class PolynomialClosure:
         return X
 
     # ------------------------------------------------------------------ moving on the variety
-    def retract(self, X, dT):
+    def retract(self, X: np.ndarray, dT: np.ndarray) -> np.ndarray:
         """The points X (P, n) moved by the tangent steps dT (P, nt) (see the module)."""
         X = np.array(X, complex)
         if self.rev.size:
@@ -366,7 +380,7 @@ class PolynomialClosure:
                 X[:, sl.start:sl.start + 3] += dT[:, tl][:, :3]
         return X
 
-    def tangent(self, X) -> np.ndarray:
+    def tangent(self, X: np.ndarray) -> np.ndarray:
         """dx/dt (P, n, nt): how the unknowns move along each tangent coordinate at X."""
         P = len(X)
         T = np.zeros((P, self.n, self.nt), complex)
@@ -387,7 +401,7 @@ class PolynomialClosure:
         return T
 
     # ------------------------------------------------------------------ kinematics
-    def _motion(self, j, xj):
+    def _motion(self, j: int, xj: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(R_E, t_E) of joint j at its unknowns xj (P, width): (P, 3, 3), (P, 3)."""
         P, kind = len(xj), self.kind[j]
         t = np.zeros((P, 3), complex)
@@ -402,30 +416,39 @@ class PolynomialClosure:
             R, t = quaternion_matrix(xj[:, 3:]), xj[:, :3].copy()
         return R, t
 
-    def placed(self, which=None) -> Placed:
+    def placed(self, which: Any = None) -> Placed:
         """How the numpy evaluation places the frames: every joint and frame (None) or the rows' ("rows")."""
         if which not in self._placed:
             self._placed[which] = Placed(self, None if which is None else np.arange(len(self.row_frames)))
         return self._placed[which]
 
-    def kinematics(self, X, jacobian: bool = True):
+    def kinematics(self, X: np.ndarray, jacobian: bool = True) -> dict:
         """World placements (stack axis last) of every joint frame (oR (3, 3, nj, P), op (3, nj, P))
         and of the frames the rows and points read (fR, fp); with ``jacobian`` each tangent
         coordinate's world axis w (3, nt, P), origin o and translation direction e (the module)."""
         return self.placed()(X, jacobian)
 
     # ------------------------------------------------------------------ equations
-    def rows(self, X, jacobian: bool = True):
+    def rows(self, X: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """The closure rows kept (P, m) and their Jacobian in tangent coordinates (P, m, nt)."""
         if self._kernel is not None:
             r, J = self._kernel(np.ascontiguousarray(X, complex), np.ascontiguousarray(self.Rc.transpose(2, 0, 1)),
                                 np.ascontiguousarray(self.tc.T), np.asarray(self.r2, complex), *self._packed, self.nt,
                                 jacobian)
             return r, (J if jacobian else None)
-        r, J = rows_all(self, self.placed("rows")(X, jacobian), jacobian)
-        return r[self.keep].T, (J[self.keep].transpose(2, 0, 1) if jacobian else None)
+        r, Jall = rows_all(self, self.placed("rows")(X, jacobian), jacobian)
+        return r[self.keep].T, (Jall[self.keep].transpose(2, 0, 1) if Jall is not None else None)
 
-    def constraints(self, X):
+    def evaluate(self, Q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """The contract's rows: ``rows`` at the complex points Q (N, n) (lengths over L: dimensionless),
+        their Jacobian along the tangent coordinates (N, m, nt)."""
+        return self.rows(Q, jacobian)
+
+    def integrate(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        """The contract's step on the variety: ``retract`` of the points Q (N, n) by V (N, nt)."""
+        return self.retract(Q, V)
+
+    def constraints(self, X: np.ndarray) -> np.ndarray:
         """c^2 + s^2 - 1 per revolute, q.q - 1 per quaternion, at X (P, n): (P, k)."""
         X = np.asarray(X, complex)
         out = []
@@ -444,11 +467,11 @@ class PolynomialClosure:
         size = np.abs(r).max(axis=1)
         return size > _ZERO_ROW * max(size.max(initial=0.0), 1.0)
 
-    def residual_all(self, X):
+    def residual_all(self, X: np.ndarray) -> np.ndarray:
         """Every planned row at X (P, rows) (the dropped ones too: they vanish identically)."""
         return rows_all(self, self.placed("rows")(X, jacobian=False), jacobian=False)[0].T
 
-    def signature(self, X) -> np.ndarray:
+    def signature(self, X: np.ndarray) -> np.ndarray:
         """What tells assembly modes apart (analysis.position.position.PositionSolver.signature, in
         units of L, complex): every joint frame's origin (but the eliminated legs', which their ends
         fix), the points' and the output frame's pose."""
