@@ -323,14 +323,14 @@ def _local_notes(local, where, M_generic, generic_rank, samples):
 
 
 def _sample(mech: Mechanism, q: np.ndarray, output: str | None, out_frame: int | None, point: bool,
-            act_idx: list[int], tol: Tolerances) -> tuple:
+            act_idx: np.ndarray, tol: Tolerances) -> tuple:
     """One assembled configuration's ranks: ((rank of K, the output's motion's dimension, the inputs' effective
     rank), q, K, rank of K, V (K's null space), the output's motion, the inputs' effective rank)."""
     K = mech.closure.jacobian(q)
     rk = rank(K, tol)
     V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
     out = None
-    if output is not None:
+    if output is not None and out_frame is not None:
         state = KinematicState(mech, q)
         T = state.frame_jacobian(out_frame, LWA) @ V
         out = _point_motion(output, T, tol) if point else _output_motion(
@@ -352,6 +352,7 @@ def _generic(mech: Mechanism, candidates: list[tuple], frames: dict, output_link
         idle, idle_total, I = _idle(mech, mech.topology(q), frames, q, V, output_link, tol)
         if best is None or idle_total < best[6]:
             best = (q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
+    assert best is not None  # (the candidates of the top ranks are never none)
     return best
 
 

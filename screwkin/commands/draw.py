@@ -144,7 +144,8 @@ def _draw_singular(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, giv
     search = singular_configurations(mech, name, output=args.output, q=q, steps=args.steps,
                                      fixed={k: v for k, v in given.items() if k != name})
     found = []
-    same, seen = {}, {}  # configurations found at one input value: the modes of another loop, said so
+    same: dict[float, list] = {}  # configurations found at one input value: the modes of another loop, said so
+    seen: dict[float, int] = {}
     for s in search.found:
         same.setdefault(round(float(s.input), 9), []).append(s)
     for k, s in enumerate(search.found, 1):

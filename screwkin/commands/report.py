@@ -166,8 +166,8 @@ def _rates(mech: Mechanism, args: argparse.Namespace, names: list[str], held: di
 
 
 def _solve_configuration(mech: Mechanism, args: argparse.Namespace, values: dict[str, float],
-                         near: dict[str, float], given: dict[str, float], held: dict[str, float],
-                         rates: dict[str, float], accels: dict[str, float] | None, points: dict,
+                         near: dict[str, float] | None, given: dict[str, float], held: dict[str, float],
+                         rates: dict[str, float], accels: dict[str, float] | None, points: tuple,
                          data: dict) -> tuple[PositionResult, np.ndarray]:
     """The configuration solved for the inputs' ``values``, in the mode analysed (--mode K, chosen and said as
     every command chooses and says it): (its position result, q)."""
@@ -243,7 +243,7 @@ def _equations(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names: 
 
 
 def _motion_section(mech: Mechanism, pres: PositionResult | None, typed: dict[str, dict], rates: dict[str, float],
-            accels: dict[str, float] | None, points: dict, data: dict) -> Section:
+            accels: dict[str, float] | None, points: tuple, data: dict) -> Section:
     """The positions, velocities and accelerations section."""
     if pres is None:
         return note_section("motion", "Positions, velocities and accelerations",

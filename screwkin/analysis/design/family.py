@@ -311,8 +311,8 @@ class _ClosedForms:
             excess = sides.max(axis=1) - (sides.sum(axis=1) - sides.max(axis=1))
             margin_ok &= np.abs(excess - tol.geometry) > tol.equal * size  # clear of the test's own threshold
             for m in np.flatnonzero(excess > tol.geometry):
-                if m not in self.proved:
-                    self.proved[m] = obstacle_of(cut, names, list(map(float, sides[m])), tol.geometry)
+                if int(m) not in self.proved:
+                    self.proved[int(m)] = obstacle_of(cut, names, list(map(float, sides[m])), tol.geometry)
         closes = -(np.maximum.reduce([g, a, b, c]) - (g + a + b + c - longest))  # others - longest
         ok = planar & margin_ok & (np.minimum.reduce([g, a, b, c]) > SHORT_LINK * longest)
         ok &= (closes > tol.equal * size) | np.isin(np.arange(members), list(self.proved))
@@ -378,30 +378,34 @@ def _family(task: StudyTask, chunk: list[tuple[int, tuple]], index: list[int], v
     specs, alone = read_designs(task.file, task.text, task.args,
                                 {p: values[:, k] for k, p in enumerate(task.parameters)})
     rows, ref, d = _reference(task, chunk, index, specs, alone)
+    spec, reference = specs[ref], rows[ref]
+    assert spec is not None and reference is not None  # the reference's file was read and its row evaluated
     members = [ref] + _same_structure(specs, ref, d.mech.tolerances.dummy_mass, alone)
     try:
-        fb = _Fourbar(d, specs[ref])
+        fb = _Fourbar(d, spec)
     except UsageError as exc:  # not a four-bar (its own evaluation says so when it computes grashof)
         raise Unbatchable(str(exc)) from None
     placed = _Placed([specs[k] for k in members])
-    _check_reference(d, fb, placed, specs[ref])
-    cf = _ClosedForms(fb, placed, specs[ref], d.mech.tolerances, len(members))
-    made = _made_rows(task, chunk, index, members, ref, rows[ref], cf, alone)
-    _vouch(task, chunk, index, ref, rows[ref], cf, made)
-    out, reasons = [], Counter()
+    _check_reference(d, fb, placed, spec)
+    cf = _ClosedForms(fb, placed, spec, d.mech.tolerances, len(members))
+    made = _made_rows(task, chunk, index, members, ref, reference, cf, alone)
+    _vouch(task, chunk, index, ref, reference, cf, made)
+    out: list[dict] = []
+    reasons: Counter[str] = Counter()
     for k in range(n):
         if k in made:
             out.append(made[k])
             continue
-        if rows[k] is None:
-            rows[k] = evaluate_design(task, index[k], chunk[k][1])
-        out.append(rows[k])
+        row = rows[k]
+        if row is None:
+            row = rows[k] = evaluate_design(task, index[k], chunk[k][1])
+        out.append(row)
         reasons[alone.get(k, "the reference")] += 1
     notes = [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" for why, c in reasons.most_common()]
     return ChunkRows(out, {"family": len(made), "design": n - len(made)}, notes)
 
 
-def _row_of(task: StudyTask, i: int, values: tuple, columns: list[str], reference: dict, code: int, margin: float,
+def _row_of(task: StudyTask, i: int, values: tuple, columns: tuple[str, ...], reference: dict, code: int, margin: float,
             lo: float, hi: float, turns: bool, dead: int) -> dict:
     """The family path's row of one design from its closed-form numbers (the reference's recomputed)."""
     row = {"design": i, **dict(zip(task.parameters, values))}

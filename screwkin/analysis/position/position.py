@@ -336,7 +336,9 @@ class PositionSolver:
         """How one answer comes without a search, where it does: (found, the best residual, how it came or None,
         the notes it leads with, the modes found at once or None)."""
         mech = self.mech
-        found, best, first, lead, done = [], np.inf, None, (), None
+        found: list = []
+        best, first, done = np.inf, None, None
+        lead: tuple[str, ...] = ()
         if not given.unknowns(self).size:  # every joint given: the closure evaluated there, nothing solved
             q, a, line = given.given_configuration(self, self.set_inputs(self._drawn(), values))
             found, first, lead = [(None, q, a)], "every joint given", (line,)
