@@ -38,6 +38,7 @@ automorphism of se(3)), sliding columns multiplied by it.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -47,6 +48,9 @@ from ..model.cuts import ContactRow
 from ..model.geometry import cross_last, perpendicular_basis
 from ..model.state import KinematicState
 from .screws import cut_twists
+
+if TYPE_CHECKING:
+    from ..model.mechanism import Mechanism
 
 __all__ = ["LoopSystem", "Series", "loop_system", "ad", "split", "subalgebra", "BODY_JOINTS", "SEQUENTIAL_JOINTS"]
 
@@ -276,28 +280,12 @@ def _cut_units(mech, cut, state, kind, where, L):
     return free
 
 
-def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> LoopSystem:
-    """The LoopSystem of ``mech`` at the assembled configuration q.
-
-    With ``reduce``, when every tree screw lies in se(2) (a planar mechanism) or so(3) (a spherical
-    one), and each cut joint's freedoms outside that algebra have independent parts in its
-    complement m (so the loops hold them at zero at every order: the equations' m-part involves
-    them alone), those freedoms are dropped and each loop is written in the algebra's coordinates:
-    its m-rows vanish identically along every motion (they are the redundancy the plane or the
-    sphere makes: ``dropped_rows`` counts them)."""
+def _add_cut_units(mech: Mechanism, state: KinematicState, kind: str, where_world: np.ndarray | None, L: float,
+                   units: list, carriers: list, by_joint: dict, names: list[str],
+                   slide: list[bool]) -> tuple[list[list[set[int]]], list[list[int]]]:
+    """Append each cut joint's freedoms to the units (with their names, whether they slide, and the units that
+    carry them): (each cut's two sides (the tree units under its frames), each cut's own units)."""
     model = mech.model
-    L = float(length or mech.length)
-    tol = mech.tolerances
-    state = KinematicState(mech, q)
-    units, carriers, by_joint, note = _units(mech, state)
-    nv = mech.nv
-    tree_units = len(units)
-    tree_screws = np.array([u[0] for u in units], float).reshape(tree_units, 6)
-    tree_screws[:, :3] /= L
-    kind, where = subalgebra(tree_screws, tol.geometry) if reduce and tree_units else ("se(3)", None)
-    where_world = None if where is None else (where if kind == "se(2)" else where * L)
-    names = list(mech.coordinate_names)
-    slide = list(mech.translational.astype(bool))
     sides_of, own_of = [], []
     for cut in mech.cuts:
         sides = []
@@ -312,6 +300,55 @@ def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> Lo
             carriers.append(set(sides[0]) | set(range(first, first + k)))
         sides_of.append(sides)
         own_of.append(list(range(first, len(units))))
+    return sides_of, own_of
+
+
+def _extra_rows(mech: Mechanism, q: np.ndarray, ncols: int, scale: np.ndarray,
+                L: float) -> tuple[np.ndarray, np.ndarray | None, str | None]:
+    """The closure's rows beyond the loops, dimensionless, in the ``ncols`` columns: (the couplings' rows, the
+    sliding contacts' rows of K (first order only) or None, the note a sliding contact makes or None)."""
+    nv = mech.nv
+    couplings, contacts = [], []
+    note = None
+    K = None
+    for i, e in enumerate(mech.closure.extra, mech.closure.nrows - len(mech.closure.extra)):
+        if isinstance(e, ContactRow):  # first order only: its row of K, in the tree's columns
+            note = note or f"'{e.name}' is a sliding contact (cam, pin in a slot): its series is not written here"
+            K = mech.closure.jacobian(q) if K is None else K
+            row = np.zeros(ncols)
+            row[:nv] = K[i] * scale[:nv] / L
+            contacts.append(row)
+            continue
+        row = np.zeros(ncols)
+        for _, iv, cval in e.terms:
+            row[iv] += cval
+        couplings.append(row * scale / (1.0 if e.kind == "angle" else L))
+    return (np.array(couplings, float).reshape(len(couplings), ncols),
+            np.array(contacts, float).reshape(len(contacts), ncols) if contacts else None, note)
+
+
+def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> LoopSystem:
+    """The LoopSystem of ``mech`` at the assembled configuration q.
+
+    With ``reduce``, when every tree screw lies in se(2) (a planar mechanism) or so(3) (a spherical
+    one), and each cut joint's freedoms outside that algebra have independent parts in its
+    complement m (so the loops hold them at zero at every order: the equations' m-part involves
+    them alone), those freedoms are dropped and each loop is written in the algebra's coordinates:
+    its m-rows vanish identically along every motion (they are the redundancy the plane or the
+    sphere makes: ``dropped_rows`` counts them)."""
+    L = float(length or mech.length)
+    tol = mech.tolerances
+    state = KinematicState(mech, q)
+    units, carriers, by_joint, note = _units(mech, state)
+    nv = mech.nv
+    tree_units = len(units)
+    tree_screws = np.array([u[0] for u in units], float).reshape(tree_units, 6)
+    tree_screws[:, :3] /= L
+    kind, where = subalgebra(tree_screws, tol.geometry) if reduce and tree_units else ("se(3)", None)
+    where_world = None if where is None else (where if kind == "se(2)" else where * L)
+    names = list(mech.coordinate_names)
+    slide = list(mech.translational.astype(bool))
+    sides_of, own_of = _add_cut_units(mech, state, kind, where_world, L, units, carriers, by_joint, names, slide)
     n_units = len(units)
     scale = np.where(np.array(slide, bool), L, 1.0)
     column = np.array([u[1] for u in units], int)
@@ -327,22 +364,8 @@ def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> Lo
         sigma[c, sorted(sides[1] - sides[0])] = 1.0
         sigma[c, sorted(sides[0] - sides[1])] = -1.0
         sigma[c, own] = -1.0
-    couplings, contacts = [], []
-    K = None
-    for i, e in enumerate(mech.closure.extra, mech.closure.nrows - len(mech.closure.extra)):
-        if isinstance(e, ContactRow):  # first order only: its row of K, in the tree's columns
-            note = note or f"'{e.name}' is a sliding contact (cam, pin in a slot): its series is not written here"
-            K = mech.closure.jacobian(q) if K is None else K
-            row = np.zeros(len(names))
-            row[:nv] = K[i] * scale[:nv] / L
-            contacts.append(row)
-            continue
-        row = np.zeros(len(names))
-        for _, iv, cval in e.terms:
-            row[iv] += cval
-        couplings.append(row * scale / (1.0 if e.kind == "angle" else L))
-    couplings = np.array(couplings, float).reshape(len(couplings), len(names))
-    contacts = np.array(contacts, float).reshape(len(contacts), len(names)) if contacts else None
+    couplings, contacts, contact = _extra_rows(mech, q, len(names), scale, L)
+    note = note or contact
     keep = list(range(n_units))
     dropped = ()
     rows = [coordinates("se(3)", None)] * len(mech.cuts)

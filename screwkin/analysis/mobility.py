@@ -11,7 +11,9 @@ file drawn in a singular pose does not change the answer.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -21,6 +23,10 @@ from ..model.state import KinematicState
 from ..model.topology import Topology
 from .local import LocalAnalysis, local_analysis, words as local_words
 from .redundancy import Redundancy, redundancy
+
+if TYPE_CHECKING:
+    from ..model.mechanism import Mechanism
+    from ..tolerances import Tolerances
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility"]
 
@@ -316,30 +322,27 @@ def _local_notes(local, where, M_generic, generic_rank, samples):
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech, output, seed, point, at=None, suggest=False, names=False, progress=None) -> MobilityResult:
-    tol = mech.tolerances
-    if output is not None:
-        out_frame = mech.link_frame(output)
-    assembly, configs = mech.generic_configurations(seed=seed)
-    topo = mech.topology(configs[0])
-    frames = _body_frames(mech, topo)
-    output_link = None
-    if output is not None:
-        output_link = next((l for l, m in topo.link_members.items() if output in m), output)
-    act_idx = mech.velocity_indices(mech.actuated)
-    candidates = []
-    for q in configs:
-        K = mech.closure.jacobian(q)
-        rk = rank(K, tol)
-        V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
-        out = None
-        if output is not None:
-            state = KinematicState(mech, q)
-            T = state.frame_jacobian(out_frame, LWA) @ V
-            out = _point_motion(output, T, tol) if point else _output_motion(
-                output, T, tol, state.frame_placement(out_frame).translation)
-        eff = rank(V[act_idx], tol) if len(act_idx) else None
-        candidates.append(((rk, out.dimension if out else 0, eff or 0), q, K, rk, V, out, eff))
+def _sample(mech: Mechanism, q: np.ndarray, output: str | None, out_frame: int | None, point: bool,
+            act_idx: np.ndarray, tol: Tolerances) -> tuple:
+    """One assembled configuration's ranks: ((rank of K, the output's motion's dimension, the inputs' effective
+    rank), q, K, rank of K, V (K's null space), the output's motion, the inputs' effective rank)."""
+    K = mech.closure.jacobian(q)
+    rk = rank(K, tol)
+    V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
+    out = None
+    if output is not None and out_frame is not None:
+        state = KinematicState(mech, q)
+        T = state.frame_jacobian(out_frame, LWA) @ V
+        out = _point_motion(output, T, tol) if point else _output_motion(
+            output, T, tol, state.frame_placement(out_frame).translation)
+    eff = rank(V[act_idx], tol) if len(act_idx) else None
+    return (rk, out.dimension if out else 0, eff or 0), q, K, rk, V, out, eff
+
+
+def _generic(mech: Mechanism, candidates: list[tuple], frames: dict, output_link: str | None,
+             tol: Tolerances) -> tuple:
+    """Of the sampled configurations, one of the largest ranks with the fewest idle motions: (q, K, rank of K,
+    mobility, V, idle motions, their count, their basis, the output's motion, the inputs' effective rank)."""
     top = max(c[0] for c in candidates)
     candidates = [c for c in candidates if c[0] == top]
     if mech.nv > _FEW_COORDINATES:  # the idle motions of a big mechanism: at one generic configuration
@@ -347,9 +350,46 @@ def _analyze(mech, output, seed, point, at=None, suggest=False, names=False, pro
     best = None
     for _, q, K, rk, V, out, eff in candidates:
         idle, idle_total, I = _idle(mech, mech.topology(q), frames, q, V, output_link, tol)
-        if best is None or idle_total < best[7]:
-            best = (None, q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
-    _, q, K, rk, M, V, idle, idle_total, I, out, eff = best
+        if best is None or idle_total < best[6]:
+            best = (q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
+    assert best is not None  # (the candidates of the top ranks are never none)
+    return best
+
+
+def _analysis_notes(mech: Mechanism, local: LocalAnalysis, where: str, M_generic: int, rk: int, samples: int,
+                    assembly: Any, at: np.ndarray | None, own: bool) -> tuple[str, ...]:
+    """The notes on the transmissions, the local analysis (where it is not the generic one) and an assembly
+    that first closed at a singular configuration."""
+    notes: tuple[str, ...] = ()
+    for t in mech.transmissions():
+        notes += (f"Input {t.text()}: its coordinate is {t.joint}.",)
+    if local.kind != "regular" or local.rank_drop or local.finite_mobility != M_generic:
+        notes += _local_notes(local, where, M_generic, rk, samples)
+        if local.rank_drop:
+            notes += ("The idle motions, the output's motion and the counts use assembled configurations of the "
+                      "generic rank.",)
+    first_singular, first_rank, generic_rank = mech.first_assembly_singular
+    if first_singular and at is None and not own:
+        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
+                  f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
+                  f"there); the analysis uses assembled configurations of the generic rank.",)
+    return notes
+
+
+def _analyze(mech: Mechanism, output: str | None, seed: int | None, point: bool, at: np.ndarray | None = None,
+             suggest: bool = False, names: bool = False,
+             progress: Callable[..., object] | None = None) -> MobilityResult:
+    tol = mech.tolerances
+    out_frame = mech.link_frame(output) if output is not None else None
+    assembly, configs = mech.generic_configurations(seed=seed)
+    topo = mech.topology(configs[0])
+    frames = _body_frames(mech, topo)
+    output_link = None
+    if output is not None:
+        output_link = next((l for l, m in topo.link_members.items() if output in m), output)
+    act_idx = mech.velocity_indices(mech.actuated)
+    candidates = [_sample(mech, q, output, out_frame, point, act_idx, tol) for q in configs]
+    q, K, rk, M, V, idle, idle_total, I, out, eff = _generic(mech, candidates, frames, output_link, tol)
     M_generic = M
     # where the mobility is decided: the configuration given; else the file's own configuration when it closes
     # the loops; else (the search closed them from another start, an arbitrary point of any branch) the
@@ -377,18 +417,7 @@ def _analyze(mech, output, seed, point, at=None, suggest=False, names=False, pro
                 f"instantaneous degree{'s' if local.infinitesimal_mobility > 1 else ''} of freedom), finitely rigid")
     if m and locked:
         notes += (f"With the inputs locked the mechanism can still move ({locked} degree{'s' if locked > 1 else ''} of freedom).",)
-    for t in mech.transmissions():
-        notes += (f"Input {t.text()}: its coordinate is {t.joint}.",)
-    if local.kind != "regular" or local.rank_drop or local.finite_mobility != M_generic:
-        notes += _local_notes(local, where, M_generic, rk, len(configs))
-        if local.rank_drop:
-            notes += ("The idle motions, the output's motion and the counts use assembled configurations of the "
-                      "generic rank.",)
-    first_singular, first_rank, generic_rank = mech.first_assembly_singular
-    if first_singular and at is None and not own:
-        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
-                  f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
-                  f"there); the analysis uses assembled configurations of the generic rank.",)
+    notes += _analysis_notes(mech, local, where, M_generic, rk, len(configs), assembly, at, own)
     found = redundancy(mech, q, suggest_fix=suggest) if names or suggest else None
     return MobilityResult(
         path=mech.path,

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,6 +45,9 @@ from ._configuration import (
 from ._output_frame import add_point_option, named_points
 from ._values import inputs, joint_value, split_inputs
 from ._options import BOUNDS, count
+
+if TYPE_CHECKING:
+    from ..model.mechanism import Mechanism
 
 NAME = "draw"
 NEEDS_MECHANISM = True
@@ -132,7 +136,76 @@ def _traces(mech, args, q, input_names, given, skel) -> dict:
     return out
 
 
-def run(mech, args) -> int:
+def _draw_singular(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, given: dict[str, float],
+                   input_names: list[str], targets: list[str], written: list[str]) -> dict:
+    """draw --singular: the skeleton at each singular configuration along the input, one file each; the JSON
+    report."""
+    name = args.input or (input_names[0] if input_names else None)
+    search = singular_configurations(mech, name, output=args.output, q=q, steps=args.steps,
+                                     fixed={k: v for k, v in given.items() if k != name})
+    found = []
+    same: dict[float, list] = {}  # configurations found at one input value: the modes of another loop, said so
+    seen: dict[float, int] = {}
+    for s in search.found:
+        same.setdefault(round(float(s.input), 9), []).append(s)
+    for k, s in enumerate(search.found, 1):
+        skel = skeleton(mech, s.q, [search.input, *search.fixed])
+        at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
+        key = round(float(s.input), 9)
+        seen[key] = seen.get(key, 0) + 1
+        mode = f", assembly mode {seen[key]} of the {len(same[key])} at this input" if len(same[key]) > 1 else ""
+        title = f"singular configuration {k} of {len(search.found)} at {at}{mode}"
+        fig = draw_mechanism(skel, title=drawing_title(mech, title), angles=args.angles,
+                             subtitle=singularity_kind_text(s))
+        files = []
+        for path in targets:
+            out = _suffixed(path, k)
+            save_figure(fig, out, close=path == targets[-1])
+            files.append(out)
+        written += files
+        found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
+                      "input_wrapped": wrapped_value(s.input, search.unit), "sigma": s.sigma, "files": files,
+                      "description": singularity_kind_text(s), "title": title})
+        if getattr(s, "point", None) is not None:
+            found[-1].update({k: v for k, v in change_point_dict(s.point).items() if k not in ("input", "sigma")})
+        if not args.json:
+            print(f"{singularity_kind_text(s)} at {at}: wrote {', '.join(files)}")
+    report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
+              "output": search.output, "singular_configurations": found}
+    if not args.json and not found:
+        lo, hi = (value_label(search.input, v, search.unit).split(" = ")[1] for v in (search.start, search.stop))
+        print(f"no singular configuration along {search.input} from {lo} to {hi}: nothing written")
+    return report
+
+
+def _draw_skeleton(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, given: dict[str, float],
+                   input_names: list[str], targets: list[str], written: list[str]) -> dict:
+    """draw: the skeleton at the configuration, with the traced points' paths and a design's targets; the JSON
+    report."""
+    skel = skeleton(mech, q, input_names)
+    space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
+    traces = _traces(mech, args, q, input_names, given, skel)
+    marks, curve = (None, None)
+    if mech.spec.targets and args.targets:
+        marks, curve = design_drawing(mech, q, input_names, skel, args.steps, None if args.json else print,
+                               "; --no-targets leaves them out")
+    if curve is not None:
+        traces[curve[0]] = curve[1:]
+    for path in targets:
+        fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), angles=args.angles,
+                             subtitle=("" if skel.planar else space.strip(" ()")) or None,
+                             traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
+        save_figure(fig, path)
+        written.append(path)
+    report = with_mode(args, skeleton_dict(skel))
+    if traces:
+        report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
+    if marks:
+        report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
+    return report
+
+
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.animate:
         return _animate(mech, args)
     if args.start is not None or args.stop is not None:
@@ -158,61 +231,9 @@ def run(mech, args) -> int:
             written.append(path)
         report = chain_dict(chain)
     elif args.singular:
-        name = args.input or (input_names[0] if input_names else None)
-        search = singular_configurations(mech, name, output=args.output, q=q, steps=args.steps,
-                                         fixed={k: v for k, v in given.items() if k != name})
-        found = []
-        same, seen = {}, {}  # configurations found at one input value: the modes of another loop, said so
-        for s in search.found:
-            same.setdefault(round(float(s.input), 9), []).append(s)
-        for k, s in enumerate(search.found, 1):
-            skel = skeleton(mech, s.q, [search.input, *search.fixed])
-            at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
-            key = round(float(s.input), 9)
-            seen[key] = seen.get(key, 0) + 1
-            mode = f", assembly mode {seen[key]} of the {len(same[key])} at this input" if len(same[key]) > 1 else ""
-            title = f"singular configuration {k} of {len(search.found)} at {at}{mode}"
-            fig = draw_mechanism(skel, title=drawing_title(mech, title), angles=args.angles,
-                                 subtitle=singularity_kind_text(s))
-            files = []
-            for path in targets:
-                out = _suffixed(path, k)
-                save_figure(fig, out, close=path == targets[-1])
-                files.append(out)
-            written += files
-            found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
-                          "input_wrapped": wrapped_value(s.input, search.unit), "sigma": s.sigma, "files": files,
-                          "description": singularity_kind_text(s), "title": title})
-            if getattr(s, "point", None) is not None:
-                found[-1].update({k: v for k, v in change_point_dict(s.point).items() if k not in ("input", "sigma")})
-            if not args.json:
-                print(f"{singularity_kind_text(s)} at {at}: wrote {', '.join(files)}")
-        report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
-                  "output": search.output, "singular_configurations": found}
-        if not args.json and not found:
-            lo, hi = (value_label(search.input, v, search.unit).split(" = ")[1] for v in (search.start, search.stop))
-            print(f"no singular configuration along {search.input} from {lo} to {hi}: nothing written")
+        report = _draw_singular(mech, args, q, given, input_names, targets, written)
     else:
-        skel = skeleton(mech, q, input_names)
-        space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
-        traces = _traces(mech, args, q, input_names, given, skel)
-        marks, curve = (None, None)
-        if mech.spec.targets and args.targets:
-            marks, curve = design_drawing(mech, q, input_names, skel, args.steps, None if args.json else print,
-                                   "; --no-targets leaves them out")
-        if curve is not None:
-            traces[curve[0]] = curve[1:]
-        for path in targets:
-            fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), angles=args.angles,
-                                 subtitle=("" if skel.planar else space.strip(" ()")) or None,
-                                 traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
-            save_figure(fig, path)
-            written.append(path)
-        report = with_mode(args, skeleton_dict(skel))
-        if traces:
-            report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
-        if marks:
-            report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
+        report = _draw_skeleton(mech, args, q, given, input_names, targets, written)
     if args.json:
         report["files"] = written
         print(json_of(report))

@@ -42,8 +42,11 @@ import math
 import os
 import re
 import threading
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 import defusedxml
 
@@ -52,6 +55,9 @@ from ..units import parse_value
 from .description import LIMITS
 from .xacro_eval import MAX_STRING, XacroEvaluationError, check_expression, evaluate
 from .xmlsafe import inside_folder, parse_xml_text, read_regular_file
+
+if TYPE_CHECKING:
+    from xml.dom.minidom import Element as MinidomElement
 
 __all__ = ["MAX_INCLUDES", "XacroInternalError", "declared_args", "expand", "is_xacro", "normalize_args", "parse_args"]
 
@@ -263,103 +269,119 @@ def _one_line(exc) -> str:
     return " when evaluating expression ".join(parts[:2]) or type(exc).__name__
 
 
-def _patched(xacro, state: _State, path, evaluator=None):
-    """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
-    macro calls while expanding."""
-    original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",
-                                                "handle_macro_call", "eval_all", "eval_text", "reqd_attrs")}
-    evaluator = evaluator or evaluate
+def _block_named(name: str, symbols: dict) -> MinidomElement | None:
+    """The block ``xacro:insert_block name=...`` inserts (a property block or a macro's block
+    parameter), or None."""
+    for key in ("**" + name, "*" + name):
+        if key in symbols:
+            block = symbols[key]
+            return block if hasattr(block, "getElementsByTagName") else None
+    return None
 
-    def safe_eval(expr, globals, locals=None):
+
+def _block_size(block: MinidomElement, symbols: dict, seen: frozenset[int], memo: dict[int, int]) -> int:
+    """Elements one copy of ``block`` expands to, its own insert_blocks expanded (capped)."""
+    size = 0
+    for elem in [block, *block.getElementsByTagName("*")] if block.nodeType == block.ELEMENT_NODE else []:
+        if elem.tagName != "xacro:insert_block":
+            size += 1
+            continue
+        inner = _block_named(elem.getAttribute("name"), symbols)
+        if inner is None or id(inner) in seen:
+            continue  # undefined (xacro says so) or inserted in itself (nested too deeply)
+        if id(inner) not in memo:
+            memo[id(inner)] = _block_size(inner, symbols, seen | {id(inner)}, memo)
+        size += memo[id(inner)]
+        if size > LIMITS.elements:
+            break
+    return size
+
+
+class _Patches:
+    """xacro's functions replaced while expanding ``path``: its evaluator (``evaluator``), substitutions,
+    includes and macro calls, each bounded and checked (the originals in ``original``)."""
+
+    NAMES = ("safe_eval", "eval_extension", "get_include_files", "parse", "handle_macro_call", "eval_all",
+             "eval_text", "reqd_attrs")
+
+    def __init__(self, xacro: ModuleType, state: _State, path: str | Path,
+                 evaluator: Callable[..., Any]) -> None:
+        self.xacro, self.state, self.path, self.evaluator = xacro, state, path, evaluator
+        self.original = {k: getattr(xacro, k) for k in self.NAMES}
+
+    def replaced(self) -> dict[str, Callable[..., Any]]:
+        """Name -> the function that replaces xacro's."""
+        return {k: getattr(self, k) for k in self.NAMES}
+
+    def safe_eval(self, expr: str, globals: dict, locals: dict | None = None) -> Any:
         try:
-            return evaluator(expr, globals)
+            return self.evaluator(expr, globals)
         except XacroEvaluationError as exc:  # xacro wraps it with "when evaluating expression ..."
-            raise xacro.XacroException(str(exc)) from None
+            raise self.xacro.XacroException(str(exc)) from None
 
-    def eval_extension(s):
+    def eval_extension(self, s: str) -> str:
+        path = self.path
         m = _ARG.match(s[2:-1])
         if not m:
             raise MechanismFileError(path, f"xacro substitution {quote(s, 60)} is refused: only $(arg NAME) is "
                                            "allowed")
-        known = xacro.substitution_args_context.get("arg", {})
+        known = self.xacro.substitution_args_context.get("arg", {})
         if m.group(1) not in known:
             raise MechanismFileError(path, f"xacro argument {quote(m.group(1))} has no value: give it "
                                            f"(--arg {m.group(1)}=VALUE) or declare it first with "
                                            f"<xacro:arg name=\"{m.group(1)}\" default=\"...\"/>")
         return known[m.group(1)]
 
-    def get_include_files(filename_spec, symbols):
+    def get_include_files(self, filename_spec: str, symbols: dict) -> Iterator[str]:
+        xacro, state = self.xacro, self.state
         spec = str(xacro.eval_text(filename_spec, symbols))
         current = Path(xacro.filestack[-1]) if xacro.filestack and xacro.filestack[-1] else state.top
-        yield str(_include_path(spec, current, path, state))
+        yield str(_include_path(spec, current, self.path, state))
 
-    def parse(inp, filename=None):
+    def parse(self, inp: Any, filename: str | None = None) -> Any:
         if inp is not None:
-            return original["parse"](inp, filename)
+            return self.original["parse"](inp, filename)
         target = Path(filename)
-        if not inside_folder(target, state.folder):  # pragma: no cover - get_include_files checked it
-            raise MechanismFileError(path, f"xacro:include {quote(str(filename), 60)} is outside the file's folder")
-        text, root = _read_file(target, path, state)
-        _check_tree(root, target, state, follow=False)
+        if not inside_folder(target, self.state.folder):  # pragma: no cover - get_include_files checked it
+            raise MechanismFileError(self.path, f"xacro:include {quote(str(filename), 60)} is outside the file's "
+                                                "folder")
+        text, root = _read_file(target, self.path, self.state)
+        _check_tree(root, target, self.state, follow=False)
         return _dom(text, target)
 
-    def block_named(name, symbols):
-        """The block ``xacro:insert_block name=...`` inserts (a property block or a macro's block
-        parameter), or None."""
-        for key in ("**" + name, "*" + name):
-            if key in symbols:
-                block = symbols[key]
-                return block if hasattr(block, "getElementsByTagName") else None
-        return None
-
-    def block_size(block, symbols, seen, memo):
-        """Elements one copy of ``block`` expands to, its own insert_blocks expanded (capped)."""
-        size = 0
-        for elem in [block, *block.getElementsByTagName("*")] if block.nodeType == block.ELEMENT_NODE else []:
-            if elem.tagName != "xacro:insert_block":
-                size += 1
-                continue
-            inner = block_named(elem.getAttribute("name"), symbols)
-            if inner is None or id(inner) in seen:
-                continue  # undefined (xacro says so) or inserted in itself (nested too deeply)
-            if id(inner) not in memo:
-                memo[id(inner)] = block_size(inner, symbols, seen | {id(inner)}, memo)
-            size += memo[id(inner)]
-            if size > LIMITS.elements:
-                break
-        return size
-
-    def eval_all(node, macros, symbols):
+    def eval_all(self, node: MinidomElement, macros: dict, symbols: dict) -> Any:
+        state = self.state
         child = node.firstChild
         while child is not None:
             if child.nodeType == child.ELEMENT_NODE and child.tagName == "xacro:insert_block":
-                block = block_named(child.getAttribute("name"), symbols)
+                block = _block_named(child.getAttribute("name"), symbols)
                 if block is not None:
-                    state.copied += block_size(block, symbols, frozenset({id(block)}), {})
+                    state.copied += _block_size(block, symbols, frozenset({id(block)}), {})
                     if state.copied > LIMITS.elements:
-                        raise MechanismFileError(path, f"xacro:insert_block copies expand to more than "
-                                                       f"{LIMITS.elements} elements (refused: blocks inserted in "
-                                                       "blocks double at each level)")
+                        raise MechanismFileError(self.path, f"xacro:insert_block copies expand to more than "
+                                                            f"{LIMITS.elements} elements (refused: blocks inserted "
+                                                            "in blocks double at each level)")
             child = child.nextSibling
-        return original["eval_all"](node, macros, symbols)
+        return self.original["eval_all"](node, macros, symbols)
 
-    def eval_text(text, symbols):
+    def eval_text(self, text: str, symbols: dict) -> Any:
         # xacro joins the values of a text's ${...} and $(...) outside the evaluator: bound them here
         # (a property "${s}${s}" of a property "${s}${s}" of ... doubles at each level)
-        result = original["eval_text"](text, symbols)
+        result = self.original["eval_text"](text, symbols)
         if isinstance(result, str) and len(result) > max(MAX_STRING, len(text)):  # grown by substitution
-            raise xacro.XacroException(f"refused: a text of more than {MAX_STRING} characters (properties "
-                                       "joining copies of each other?)")
+            raise self.xacro.XacroException(f"refused: a text of more than {MAX_STRING} characters (properties "
+                                            "joining copies of each other?)")
         return result
 
-    def reqd_attrs(tag, names):
+    def reqd_attrs(self, tag: MinidomElement, names: list[str]) -> Any:
         # xacro's xmlutils raises RuntimeError for a missing attribute: the file's mistake, not a bug
         try:
-            return original["reqd_attrs"](tag, names)
+            return self.original["reqd_attrs"](tag, names)
         except RuntimeError as exc:
-            raise xacro.XacroException(str(exc)) from None
+            raise self.xacro.XacroException(str(exc)) from None
 
-    def handle_macro_call(node, macros, symbols):
+    def handle_macro_call(self, node: MinidomElement, macros: dict, symbols: dict) -> Any:
+        xacro, state, path = self.xacro, self.state, self.path
         if node.tagName.startswith("xacro:"):
             state.calls += 1
             if state.calls > MAX_MACRO_CALLS:
@@ -378,12 +400,15 @@ def _patched(xacro, state: _State, path, evaluator=None):
                 if state.copied > LIMITS.elements:
                     raise MechanismFileError(path, f"the macros expand to more than {LIMITS.elements} elements "
                                                    "(refused)")
-        return original["handle_macro_call"](node, macros, symbols)
+        return self.original["handle_macro_call"](node, macros, symbols)
 
-    replaced = {"safe_eval": safe_eval, "eval_extension": eval_extension, "get_include_files": get_include_files,
-                "parse": parse, "handle_macro_call": handle_macro_call, "eval_all": eval_all,
-                "eval_text": eval_text, "reqd_attrs": reqd_attrs}
-    return original, replaced
+
+def _patched(xacro: ModuleType, state: _State, path: str | Path,
+             evaluator: Callable[..., Any] | None = None) -> tuple[dict[str, Any], dict[str, Callable[..., Any]]]:
+    """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
+    macro calls while expanding: (xacro's originals, their replacements)."""
+    patches = _Patches(xacro, state, path, evaluator or evaluate)
+    return patches.original, patches.replaced()
 
 
 class XacroInternalError(RuntimeError):

@@ -18,9 +18,11 @@ import subprocess
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from html import escape
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -35,6 +37,9 @@ from .viewplanar import colour_links, link_colours, planar_basis, top_view
 from .viewserver import ViewerServer
 from .camera import BACKGROUND, PICTURE, fit_camera, view_direction
 from .outfile import write_output
+
+if TYPE_CHECKING:
+    from ..model.mechanism import Mechanism
 
 __all__ = ["COLORS", "build_scene", "show", "page", "legend_entries", "view", "RecordingViewer", "screenshot"]
 
@@ -254,30 +259,18 @@ def _visual_geometry(mech, warn=None):
             warn(f"mesh {quote(bad, 120)} cannot be read as a mesh: its link is drawn as a stand-in")
 
 
-def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
-    """The scene at configuration q (used for the characteristic size of the marks).
+#: How build_scene's parts add a geometry object (None: nothing) with its role.
+_Add = Callable[[Any, str], None]
 
-    singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
-    output link's origin, and the singular screw axis as a line with an arrow.
-    warn: callable receiving each warning (a mesh that cannot be read); default: stderr."""
+
+def _joint_marks(mech: Mechanism, add: _Add, r_axis: float, L_axis: float) -> None:
+    """Each moving joint's axis (drawn on its child side) and centre; a prismatic joint's with an arrow head; each
+    cut joint's axis on its F1 side, a higher pair's profiles."""
     model = mech.model
-    geom = _visual_geometry(mech, warn)
-    roles = {o.name: "link" for o in geom.geometryObjects}
-    state = KinematicState(mech, q)
-    pts = np.array([state.centre(("joint", j)) for j in range(model.njoints)])
-    scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
-    center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
-    r_axis, L_axis = 0.004 * scale, 0.08 * scale
-
-    def add(obj, role):
-        if obj is not None:
-            geom.addGeometryObject(obj)
-            roles[obj.name] = role
-
     actuated = set(mech.actuated)
     axis_of = {j.name: np.asarray(j.axis) for j in mech.spec.joints}
     virtual = {n for names in mech.virtual_joints.values() for n in names}
-    for c in mech.coordinates:  # joint axes, drawn on the child side of each moving joint
+    for c in mech.coordinates:
         if c.joint in virtual:
             continue  # the equivalent linkage of a higher pair: drawn as the pair below
         jid = c.joint_id
@@ -312,6 +305,51 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
         else:
             add(_segment(f"screwkin/cut/{cut.name}", f.parentJoint, cut.frame1, p - L_axis * a, p + L_axis * a,
                          1.5 * r_axis, COLORS["cut"]), "axis:cut")
+
+
+def _singular_marks(mech: Mechanism, output: str | None, singular: Iterable, add: _Add, r_axis: float,
+                    L_axis: float) -> None:
+    """At each singular configuration: a ball at the output link's origin, and the singular screw axis as a
+    line with an arrow."""
+    for k, (qs, twist) in enumerate(singular):
+        if output is not None:
+            at = KinematicState(mech, qs).frame_placement(mech.link_frame(output)).translation
+            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, at, 4 * r_axis,
+                      COLORS["marker"]), "singular:marker")
+        if twist is not None and twist.screw is not None and twist.screw.point is not None:
+            s = twist.screw
+            p, u = np.asarray(s.point), np.asarray(s.direction)
+            add(_segment(f"screwkin/singular/{k}/axis", 0, 0, p - 3 * L_axis * u, p + 3 * L_axis * u, r_axis,
+                         COLORS["screw"]), "singular:axis")
+            cone = pin.GeometryObject(f"screwkin/singular/{k}/arrow", 0, 0, pin.SE3(
+                _segment("t", 0, 0, p, p + u, 1, COLORS["screw"]).placement.rotation, p + 3 * L_axis * u),
+                _coal().Cone(3 * r_axis, 6 * r_axis))
+            cone.meshColor = COLORS["screw"]
+            add(cone, "singular:arrow")
+
+
+def build_scene(mech: Mechanism, q: np.ndarray, output: str | None = None, singular: Iterable = (),
+                warn: Callable[[str], object] | None = None) -> Scene:
+    """The scene at configuration q (used for the characteristic size of the marks).
+
+    singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
+    output link's origin, and the singular screw axis as a line with an arrow.
+    warn: callable receiving each warning (a mesh that cannot be read); default: stderr."""
+    model = mech.model
+    geom = _visual_geometry(mech, warn)
+    roles = {o.name: "link" for o in geom.geometryObjects}
+    state = KinematicState(mech, q)
+    pts = np.array([state.centre(("joint", j)) for j in range(model.njoints)])
+    scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
+    center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    r_axis, L_axis = 0.004 * scale, 0.08 * scale
+
+    def add(obj: Any, role: str) -> None:
+        if obj is not None:
+            geom.addGeometryObject(obj)
+            roles[obj.name] = role
+
+    _joint_marks(mech, add, r_axis, L_axis)
     # stand-ins for links without any visual: a ball at the link frame (its parent joint's centre) and bars
     # to the centres of its child joints and to its loop-joint frames
     with_visual = {model.frames[o.parentFrame].name for o in geom.geometryObjects if roles[o.name] == "link"}
@@ -336,21 +374,7 @@ def build_scene(mech, q, output=None, singular=(), warn=None) -> Scene:
             end = fr.placement.translation + 2 * L_axis * fr.placement.rotation[:, k]
             add(_segment(f"screwkin/output/{axis}", fr.parentJoint, fid, fr.placement.translation, end, r_axis,
                          COLORS[axis]), f"output:{axis}")
-    for k, (qs, twist) in enumerate(singular):
-        if output is not None:
-            at = KinematicState(mech, qs).frame_placement(mech.link_frame(output)).translation
-            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, at, 4 * r_axis,
-                      COLORS["marker"]), "singular:marker")
-        if twist is not None and twist.screw is not None and twist.screw.point is not None:
-            s = twist.screw
-            p, u = np.asarray(s.point), np.asarray(s.direction)
-            add(_segment(f"screwkin/singular/{k}/axis", 0, 0, p - 3 * L_axis * u, p + 3 * L_axis * u, r_axis,
-                         COLORS["screw"]), "singular:axis")
-            cone = pin.GeometryObject(f"screwkin/singular/{k}/arrow", 0, 0, pin.SE3(
-                _segment("t", 0, 0, p, p + u, 1, COLORS["screw"]).placement.rotation, p + 3 * L_axis * u),
-                _coal().Cone(3 * r_axis, 6 * r_axis))
-            cone.meshColor = COLORS["screw"]
-            add(cone, "singular:arrow")
+    _singular_marks(mech, output, singular, add, r_axis, L_axis)
     return Scene(geom, roles, scale, center, _corner_points(state, geom),
                  declared=mech.actuation_source is not None)
 

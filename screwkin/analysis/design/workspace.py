@@ -36,6 +36,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -49,6 +50,9 @@ from ...model.kernel.stacks import BatchClosure, Unbatchable
 from ...model.limits import within_limits
 from ..singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions
+
+if TYPE_CHECKING:
+    from ...model.mechanism import Mechanism
 
 __all__ = ["WorkspaceResult", "workspace", "DEFAULT_THRESHOLD", "MAX_ESTIMATE"]
 
@@ -281,8 +285,96 @@ def _index_bounds(bounds, p_seed, axes, h, dim):
     return list(lo), list(hi)
 
 
-def _grid(mech, output, point, orientation, measures, resolution, bounds, threshold, L, inputs,
-          deadline=None, q_start=None) -> WorkspaceResult:
+def _choose_resolution(mech: Mechanism, output: str, point: bool, R: np.ndarray | None, q_seed: np.ndarray,
+                       p_seed: np.ndarray, axes: np.ndarray, bounds: Any, resolution: float | None, L: float,
+                       deadline: float | None, notes: list[str]) -> float:
+    """The grid's step: the one given, checked against the work a first pass at L/4 says it would take, or
+    (None) ~24 (3-D) or ~120 (2-D) steps across the extent that pass reaches (said in ``notes``)."""
+    dim = axes.shape[0]
+    h0 = L / 4.0
+    if resolution is not None and resolution >= h0:
+        return resolution
+    lo, hi = _index_bounds(bounds, p_seed, axes, h0, dim)
+    coarse = Grid(mech, output, point, R, q_seed, p_seed, axes, h0, lo, hi)
+    coarse.deadline = deadline
+    idx = np.array(list(coarse.fill()), int)
+    if resolution is None:
+        extent = (idx.max(axis=0) - idx.min(axis=0) + 2) * h0
+        resolution = float(extent.max()) / (24.0 if dim == 3 else 120.0)
+        notes.append(f"resolution {resolution:.4g} m chosen from a first pass at {h0:.4g} m")
+        return resolution
+    estimate = len(idx) * (h0 / resolution) ** dim
+    if estimate > MAX_ESTIMATE:
+        least = h0 * (len(idx) / MAX_ESTIMATE) ** (1.0 / dim)
+        least = float(f"{least * 1.05:.2g}")
+        raise UsageError(f"--resolution {resolution:.4g} m would solve about {estimate:.2g} grid points "
+                         f"(a first pass at {h0:.3g} m reached {len(idx)}), limit {MAX_ESTIMATE:,}: use "
+                         f"--resolution {least:g} or more, or --bounds")
+    return resolution
+
+
+def _runs(grid: Grid, solved: dict, axes: np.ndarray, lo: list[int], hi: list[int]) -> tuple[
+        np.ndarray, np.ndarray, dict[tuple[int, int], tuple[float, np.ndarray]], list[np.ndarray]]:
+    """The runs along the last axis, completed and extended to the boundary by bisection: (the grid indices
+    solved, their configurations, (point k, +1 | -1) -> (fraction of a step, configuration) of each located
+    end, the boundary points)."""
+    dim, h = axes.shape[0], grid.h
+    last = np.zeros(dim, int)
+    last[-1] = 1
+    for a in range(dim - 1):  # the band along the boundary where it runs across the last axis
+        step = np.zeros(dim, int)
+        step[a] = 1
+        grid.march(solved, step)
+        grid.march(solved, -step)
+    run_ends = {1: grid.march(solved, last), -1: grid.march(solved, -last)}
+    index = np.array(list(solved), int).reshape(-1, dim)
+    Q = np.array(list(solved.values()))
+    key = {tuple(i): k for k, i in enumerate(index)}
+    ends = {}
+    boundary = []
+    for sign, found in run_ends.items():
+        for i, (f, qb) in found.items():
+            k = key[i]
+            ends[(k, sign)] = (f, qb)
+            if f > 0 or lo[-1] <= i[-1] + sign <= hi[-1]:
+                boundary.append(grid.position(index[k]) + sign * f * h * axes[-1])
+    return index, Q, ends, boundary
+
+
+def _run_lengths(grid: Grid, index: np.ndarray, ends: dict, worst: np.ndarray, end_min: dict, threshold: float,
+                 axes: np.ndarray) -> tuple[float, float, list[np.ndarray]]:
+    """(the runs' total length, their free length, the points where the free part ends) along the last axis."""
+    h = grid.h
+    volume_len = 0.0
+    free_len = 0.0
+    free_boundary: list[np.ndarray] = []
+    columns: dict[tuple, list[tuple[int, int]]] = {}
+    for k, i in enumerate(index):
+        columns.setdefault(tuple(i[:-1]), []).append((int(i[-1]), k))
+    for col in columns.values():
+        col.sort()
+        for n, (z, k) in enumerate(col):
+            up = ends.get((k, 1))
+            down = ends.get((k, -1))
+            if down is not None:  # a run starts here
+                volume_len += down[0] * h
+                free_len += _free_part(worst[k], end_min[(k, -1)], down[0] * h, threshold, grid.position(index[k]),
+                                       -axes[-1], free_boundary)
+            if up is not None:
+                volume_len += up[0] * h
+                free_len += _free_part(worst[k], end_min[(k, 1)], up[0] * h, threshold, grid.position(index[k]),
+                                       axes[-1], free_boundary)
+            elif n + 1 < len(col) and col[n + 1][0] == z + 1:
+                k2 = col[n + 1][1]
+                volume_len += h
+                free_len += _free_part(worst[k], worst[k2], h, threshold, grid.position(index[k]), axes[-1],
+                                       free_boundary)
+    return volume_len, free_len, free_boundary
+
+
+def _grid(mech: Mechanism, output: str, point: bool, orientation: Any, measures: _Measures,
+          resolution: float | None, bounds: Any, threshold: float, L: float, inputs: list[str],
+          deadline: float | None = None, q_start: np.ndarray | None = None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
     except Unbatchable as e:
@@ -304,81 +396,22 @@ def _grid(mech, output, point, orientation, measures, resolution, bounds, thresh
                          f"({dim} translation{'s' if dim != 1 else ''}), not over an area or a volume: "
                          "use sweep" + ("" if point else ", or --point"))
     axes = grid_axes(directions)
-    notes = []
-    h0 = L / 4.0
-    if resolution is None or resolution < h0:  # a coarse pass: the extent, or the work a fine grid would be
-        lo, hi = _index_bounds(bounds, p_seed, axes, h0, dim)
-        coarse = Grid(mech, output, point, R, q_seed, p_seed, axes, h0, lo, hi)
-        coarse.deadline = deadline
-        idx = np.array(list(coarse.fill()), int)
-        if resolution is None:  # ~24 (3-D) or ~120 (2-D) steps across the extent
-            extent = (idx.max(axis=0) - idx.min(axis=0) + 2) * h0
-            resolution = float(extent.max()) / (24.0 if dim == 3 else 120.0)
-            notes.append(f"resolution {resolution:.4g} m chosen from a first pass at {h0:.4g} m")
-        else:
-            estimate = len(idx) * (h0 / resolution) ** dim
-            if estimate > MAX_ESTIMATE:
-                least = h0 * (len(idx) / MAX_ESTIMATE) ** (1.0 / dim)
-                least = float(f"{least * 1.05:.2g}")
-                raise UsageError(f"--resolution {resolution:.4g} m would solve about {estimate:.2g} grid points "
-                                 f"(a first pass at {h0:.3g} m reached {len(idx)}), limit {MAX_ESTIMATE:,}: use "
-                                 f"--resolution {least:g} or more, or --bounds")
+    notes: list[str] = []
+    h = resolution = _choose_resolution(mech, output, point, R, q_seed, p_seed, axes, bounds, resolution, L,
+                                        deadline, notes)
     lo, hi = _index_bounds(bounds, p_seed, axes, resolution, dim)
     grid = Grid(mech, output, point, R, q_seed, p_seed, axes, resolution, lo, hi)
     grid.deadline = deadline
     solved = grid.fill()
-    # runs along the last axis, completed and extended to the boundary by bisection
-    h = resolution
-    last = np.zeros(dim, int)
-    last[-1] = 1
-    for a in range(dim - 1):  # the band along the boundary where it runs across the last axis
-        step = np.zeros(dim, int)
-        step[a] = 1
-        grid.march(solved, step)
-        grid.march(solved, -step)
-    run_ends = {1: grid.march(solved, last), -1: grid.march(solved, -last)}
-    index = np.array(list(solved), int).reshape(-1, dim)
-    Q = np.array(list(solved.values()))
-    key = {tuple(i): k for k, i in enumerate(index)}
-    ends = {}  # (point k, +1 | -1) -> (fraction, configuration)
-    boundary = []
-    for sign, found in run_ends.items():
-        for i, (f, qb) in found.items():
-            k = key[i]
-            ends[(k, sign)] = (f, qb)
-            if f > 0 or lo[-1] <= i[-1] + sign <= hi[-1]:
-                boundary.append(grid.position(index[k]) + sign * f * h * axes[-1])
+    index, Q, ends, boundary = _runs(grid, solved, axes, lo, hi)
     m = measures(Q)
     free = (m["actuator"] >= threshold) & (m["serial"] >= threshold)
     # measures at the located ends, for the free runs
     end_keys = list(ends)
     end_measures = measures(np.array([ends[e][1] for e in end_keys])) if end_keys else None
     end_min = {e: min(end_measures["actuator"][n], end_measures["serial"][n]) for n, e in enumerate(end_keys)}
-    volume_len = 0.0
-    free_len = 0.0
-    free_boundary = []
     worst = np.minimum(m["actuator"], m["serial"])
-    columns = {}
-    for k, i in enumerate(index):
-        columns.setdefault(tuple(i[:-1]), []).append((int(i[-1]), k))
-    for col in columns.values():
-        col.sort()
-        for n, (z, k) in enumerate(col):
-            up = ends.get((k, 1))
-            down = ends.get((k, -1))
-            if down is not None:  # a run starts here
-                volume_len += down[0] * h
-                free_len += _free_part(worst[k], end_min[(k, -1)], down[0] * h, threshold, grid.position(index[k]),
-                                       -axes[-1], free_boundary)
-            if up is not None:
-                volume_len += up[0] * h
-                free_len += _free_part(worst[k], end_min[(k, 1)], up[0] * h, threshold, grid.position(index[k]),
-                                       axes[-1], free_boundary)
-            elif n + 1 < len(col) and col[n + 1][0] == z + 1:
-                k2 = col[n + 1][1]
-                volume_len += h
-                free_len += _free_part(worst[k], worst[k2], h, threshold, grid.position(index[k]), axes[-1],
-                                       free_boundary)
+    volume_len, free_len, free_boundary = _run_lengths(grid, index, ends, worst, end_min, threshold, axes)
     cell = h ** (dim - 1)
     cond = m["conditioning"][free]
     truncated = grid.truncated and bounds is not None or len(index) >= MAX_POINTS

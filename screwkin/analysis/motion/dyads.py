@@ -481,6 +481,27 @@ def _residuals_ok(mech, Q) -> bool:
     return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
 
 
+def _next_values(start: float, stop: float, steps: int, h: float, k_pos: float, forward: bool, first: bool,
+                 budget: int) -> np.ndarray | None:
+    """The input values of the next pass of planar_sweep: the grid values after grid position ``k_pos``
+    (forward; from the first on the ``first`` pass) or before it (back, after a limit position), at most
+    ``budget``, the last forward one at ``stop``; None when none is left forward."""
+    if forward:
+        j0 = int(np.floor(k_pos + 1e-9)) + 1
+        js = np.arange(0 if first else j0, steps + 1)[:budget]
+        if not len(js):
+            return None
+    else:
+        j0 = int(np.ceil(k_pos - 1e-9)) - 1
+        js = np.arange(j0, j0 - budget, -1)
+    xs = start + js * h
+    if forward and js[-1] == steps and (xs[-1] - stop) * np.sign(h) > 0:
+        xs[-1] = stop
+    if h == 0:
+        xs = xs[:1]
+    return xs
+
+
 def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
@@ -505,20 +526,9 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
             break
         if h == 0 and not first:
             break
-        budget = max_steps - count
-        if forward:
-            j0 = int(np.floor(k_pos + 1e-9)) + 1
-            js = np.arange(0 if first else j0, steps + 1)[:budget]
-            if not len(js):
-                break
-        else:
-            j0 = int(np.ceil(k_pos - 1e-9)) - 1
-            js = np.arange(j0, j0 - budget, -1)
-        xs = start + js * h
-        if forward and js[-1] == steps and (xs[-1] - stop) * np.sign(h) > 0:
-            xs[-1] = stop
-        if h == 0:
-            xs = xs[:1]
+        xs = _next_values(start, stop, steps, h, k_pos, forward, first, max_steps - count)
+        if xs is None:
+            break
         poses, discs = curve.predict(xs)
         n_ok = curve.accept(discs)
         if first and n_ok == 0:

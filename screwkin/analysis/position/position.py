@@ -27,6 +27,9 @@ frame accelerations.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
 
@@ -291,23 +294,7 @@ class PositionSolver:
         if near:
             ref = self.reference()
             near_q = self.set_inputs(mech.neutral() if ref is None else ref, near)
-        found, best, first, lead, done = [], np.inf, None, (), None  # first: how one answer came without a search
-        if not given.unknowns(self).size:  # every joint given: the closure evaluated there, nothing solved
-            q, a, line = given.given_configuration(self, self.set_inputs(self._drawn(), values))
-            found, first, lead = [(None, q, a)], "every joint given", (line,)
-        elif near_q is not None:  # the mode reached from the given configuration, when Newton gets there
-            found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
-                                        first_trace=recorder if trace else None)
-            first = "newton from --near's configuration" if found else None
-        elif method == "nearest" and not trace:  # the mode asked for, at once, where listing every one is not
-            done = self._at_once(values)
-            if done is None:
-                found, best = self.distinct(mech.closure, [self.set_inputs(self._drawn(), values)], frozen=self.frozen)
-                first = NEWTON_FROM_FILE if found else None
-                lead = () if found else ((f"Newton from the file's configuration did not converge (residual "
-                                          f"{best:.2g}): every mode searched"),)
-            else:
-                found = list(done.found)
+        found, best, first, lead, done = self._first_answer(values, near_q, method, trace, recorder)
         start_list = [found[0][1]] if first else ([near_q] if near_q is not None else []) + self._starts(starts, seed)
         if self.kept:  # joints of several coordinates no loop passes through: the file's values, not random ones
             neutral, start_list = mech.neutral(), [np.array(q0, float) for q0 in start_list]
@@ -325,16 +312,7 @@ class PositionSolver:
                  if first and first != "newton from --near's configuration" else None if first else
                  certified.count_after_starts(done, found, len(start_list)))
         if not found:
-            # certified: said first (a long message is cut at its end)
-            certain = ((f"none of the {done.count.complex} complex solutions is real" if done.count.complex != 1 else
-                        "its one solution is complex") + f" (certified: {done.count.certificate})") \
-                if done is not None and done.complete else None
-            raise AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=len(start_list),
-                                detail="the inputs " + ", ".join(
-                                           [self._describe(values)] * bool(values)
-                                           + [f"the angle of {k}" for k in mech.closure.row_inputs])
-                                       + " cannot be reached from "
-                                       f"{len(start_list)} starting configurations", reason=certain)
+            raise self._unreached(values, best, len(start_list), done)
         if mech.counted_turns:  # the nut on the thread (the gear's tooth) the file's configuration engages
             found = engaged(self, found, values)
         if whole:
@@ -343,12 +321,7 @@ class PositionSolver:
         info = dict(enumerate(done.info)) if done is not None else {}
         sols = [self.solution(q, a, rates, accels, points, typed=typed, sets=info.get(k, (None, None))[0],
                               simple=info.get(k, (None, None))[1]) for k, (_, q, a) in enumerate(found)]
-        sols = self._merge(sols)
-        ref = near_q if near_q is not None else self.reference()
-        if len(sols) > 1:
-            ref_sig = self.signature(ref if ref is not None else sols[0].q)
-            sols.sort(key=lambda s: (not s.physical, s.singular,
-                                     float(np.linalg.norm(self.signature(s.q) - ref_sig))))
+        sols = self._ordered(self._merge(sols), near_q)
         notes = lead + tuple(f"{j} keeps the file's value: no loop passes through it and its "
                              f"{mech.coordinate(j).nq} coordinates are not inputs" for j in self.kept)
         if near_q is not None:
@@ -361,6 +334,55 @@ class PositionSolver:
                               tuple(steps), self.output, self._angular, self._angular_coupled(),
                               angular_loop_joints(self.mech), notes, held, count,
                               first or search_method(count))
+
+    def _first_answer(self, values: dict, near_q: np.ndarray | None, method: str, trace: bool,
+                      recorder: Callable[..., None] | None) -> tuple[list, float, str | None, tuple[str, ...], Any]:
+        """How one answer comes without a search, where it does: (found, the best residual, how it came or None,
+        the notes it leads with, the modes found at once or None)."""
+        mech = self.mech
+        found: list = []
+        best, first, done = np.inf, None, None
+        lead: tuple[str, ...] = ()
+        if not given.unknowns(self).size:  # every joint given: the closure evaluated there, nothing solved
+            q, a, line = given.given_configuration(self, self.set_inputs(self._drawn(), values))
+            found, first, lead = [(None, q, a)], "every joint given", (line,)
+        elif near_q is not None:  # the mode reached from the given configuration, when Newton gets there
+            found, best = self.distinct(mech.closure, [self.set_inputs(near_q, values)], frozen=self.frozen,
+                                        first_trace=recorder if trace else None)
+            first = "newton from --near's configuration" if found else None
+        elif method == "nearest" and not trace:  # the mode asked for, at once, where listing every one is not
+            done = self._at_once(values)
+            if done is None:
+                found, best = self.distinct(mech.closure, [self.set_inputs(self._drawn(), values)], frozen=self.frozen)
+                first = NEWTON_FROM_FILE if found else None
+                lead = () if found else ((f"Newton from the file's configuration did not converge (residual "
+                                          f"{best:.2g}): every mode searched"),)
+            else:
+                found = list(done.found)
+        return found, best, first, lead, done
+
+    def _unreached(self, values: dict, best: float, starts: int, done: Any) -> AssemblyError:
+        """The error of inputs no start reached: certified (no real solution) said first, where it is."""
+        mech = self.mech
+        certain = ((f"none of the {done.count.complex} complex solutions is real" if done.count.complex != 1 else
+                    "its one solution is complex") + f" (certified: {done.count.certificate})") \
+            if done is not None and done.complete else None
+        return AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=starts,
+                             detail="the inputs " + ", ".join(
+                                 [self._describe(values)] * bool(values)
+                                 + [f"the angle of {k}" for k in mech.closure.row_inputs])
+                             + " cannot be reached from "
+                             f"{starts} starting configurations", reason=certain)
+
+    def _ordered(self, sols: list, near_q: np.ndarray | None) -> list:
+        """The solutions in order: physical first, then regular, then nearest the reference (--near's
+        configuration, else the file's)."""
+        ref = near_q if near_q is not None else self.reference()
+        if len(sols) > 1:
+            ref_sig = self.signature(ref if ref is not None else sols[0].q)
+            sols.sort(key=lambda s: (not s.physical, s.singular,
+                                     float(np.linalg.norm(self.signature(s.q) - ref_sig))))
+        return sols
 
     def _drawn(self):
         """The configuration the values are set on where nothing is searched: the reference (the file's,

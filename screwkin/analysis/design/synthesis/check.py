@@ -25,6 +25,7 @@ The file is loaded as any mechanism file is (screwkin.model.loader.load), then:
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -40,6 +41,9 @@ from ...course.skeleton import numbering
 from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions
+
+if TYPE_CHECKING:
+    from ...motion.sweep import SweepResult
 
 __all__ = ["check_design", "check_chain_file", "TOLERANCE"]
 
@@ -185,70 +189,84 @@ def _locate(design, solver, probe, res, x, q_target):
     return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
-def _follow(design: Design, solver, probe, configs, steps):
-    """(direction, travel per position, transmission angles along the motion, defects)."""
-    name = design.input_joint
-    tol = probe.mech.tolerances
-    targets = design.targets
-    n = len(targets)
-    label = [t.label or f"position {k + 1}" for k, t in enumerate(targets)]
-    near = {name: targets[0].input}
-    u1 = targets[0].input
+class _Follower:
+    """The motion of a design's crank from its first precision position, followed by sweep, and where the
+    other positions lie along it."""
 
-    def follow(direction, reach):
-        count = max(int(round(steps * reach / TWO_PI)), 4)
-        res = sweep(solver, name, u1, u1 + direction * reach, count, near=near)
+    def __init__(self, design: Design, solver: PositionSolver, probe: _Probe, configs: list, steps: int) -> None:
+        self.design, self.solver, self.probe, self.configs, self.steps = design, solver, probe, configs, steps
+        self.name = design.input_joint
+        self.tol = probe.mech.tolerances
+        self.targets = design.targets
+        self.n = len(self.targets)
+        self.label = [t.label or f"position {k + 1}" for k, t in enumerate(self.targets)]
+        self.u1 = self.targets[0].input
+
+    def follow(self, direction: int, reach: float) -> tuple[SweepResult, float]:
+        """The sweep from the first position ``reach`` [rad] one way round, and how far it got."""
+        u1 = self.u1
+        count = max(int(round(self.steps * reach / TWO_PI)), 4)
+        res = sweep(self.solver, self.name, u1, u1 + direction * reach, count, near={self.name: u1})
         covered = float(np.max(direction * (res.values - u1))) if len(res.values) else 0.0
         if res.stopped_at is not None:  # up to the located limit position, not only the last grid value before it
             covered = max(covered, float(direction * (res.stopped_at - u1)))
         return res, covered
 
-    def typed(x):  # function generation: the crank's angle as typed beside the file's
-        return "" if design.input_offset is None else f" (phi {math.degrees(x + design.input_offset):.6g} deg as typed)"
+    def typed(self, x: float) -> str:
+        """Function generation: the crank's angle as typed beside the file's."""
+        offset = self.design.input_offset
+        return "" if offset is None else f" (phi {math.degrees(x + offset):.6g} deg as typed)"
 
-    if design.span is not None:  # the motion is the input range: both ways from the first position
-        defects, travel, mus = [], [0.0] + [None] * (n - 1), []
+    def locate(self, res: SweepResult, x: float, k: int) -> bool:
+        return _locate(self.design, self.solver, self.probe, res, x, self.configs[k])
+
+    def over_span(self) -> tuple[int, list, list[float], list[str]]:
+        """The motion over the design's input range, both ways from the first position."""
+        design, tol, targets, name, u1, label = self.design, self.tol, self.targets, self.name, self.u1, self.label
+        defects, travel, mus = [], [0.0] + [None] * (self.n - 1), []
         runs = {}
         for direction, reach in ((1, design.span[1] - u1), (-1, u1 - design.span[0])):
             if reach <= tol.zero:
                 continue
-            res, covered = follow(direction, reach)
+            res, covered = self.follow(direction, reach)
             runs[direction] = (res, covered)
-            mus += probe.mus(res.q)  # the sweep's grid ends at the range's ends
+            mus += self.probe.mus(res.q)  # the sweep's grid ends at the range's ends
             if res.stopped_at is not None and covered < reach - tol.equal:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
-                               f"{math.degrees(res.stopped_at):.6g} deg{typed(res.stopped_at)}: the linkage cannot "
-                               "run through it")
-        for k in range(1, n):
+                               f"{math.degrees(res.stopped_at):.6g} deg{self.typed(res.stopped_at)}: the linkage "
+                               "cannot run through it")
+        for k in range(1, self.n):
             d = targets[k].input - u1
             direction = 1 if d >= 0 else -1
             res, covered = runs.get(direction, (None, 0.0))
             if res is None or abs(d) > covered + tol.equal:
                 defects.append(f"{label[k]} lies beyond a limit position: the input stops before "
-                               f"{math.degrees(targets[k].input):.6g} deg{typed(targets[k].input)}")
-            elif _locate(design, solver, probe, res, targets[k].input, configs[k]):
+                               f"{math.degrees(targets[k].input):.6g} deg{self.typed(targets[k].input)}")
+            elif self.locate(res, targets[k].input, k):
                 travel[k] = abs(d)
             else:
                 defects.append(f"branch (circuit) defect: {label[k]} is on another assembly mode than "
                                f"{label[0]}")
         return 0, travel, mus, defects
-    outcomes = []
-    for direction in (1, -1):
+
+    def one_way(self, direction: int) -> tuple[tuple[int, bool], int, list, list, list[float]]:
+        """Turning the crank one way round: ((positions missed, out of order), direction, each position's
+        status, travel to each, the transmission angles along)."""
+        tol, targets, u1, configs = self.tol, self.targets, self.u1, self.configs
         # as far as the farthest position this way round (a full turn when one sits at the start's input)
         travels = [float(np.mod(direction * (t.input - u1), TWO_PI)) for t in targets[1:]]
         reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > tol.equal else TWO_PI
-        res, covered = follow(direction, reach)
+        res, covered = self.follow(direction, reach)
         status, travel = [], [0.0]
-        for k in range(1, n):
+        for k in range(1, self.n):
             d = float(np.mod(direction * (targets[k].input - u1), TWO_PI))
             if d > covered + tol.equal:
                 status.append(("limit", res.stopped_at))
                 travel.append(None)
-            elif _locate(design, solver, probe, res, u1 + direction * d, configs[k]):
+            elif self.locate(res, u1 + direction * d, k):
                 status.append(("reached", d))
                 travel.append(d)
-            elif d < tol.equal and covered >= TWO_PI - tol.equal \
-                    and _locate(design, solver, probe, res, u1 + direction * TWO_PI, configs[k]):
+            elif d < tol.equal and covered >= TWO_PI - tol.equal and self.locate(res, u1 + direction * TWO_PI, k):
                 status.append(("reached", TWO_PI))
                 travel.append(TWO_PI)
             else:
@@ -257,17 +275,16 @@ def _follow(design: Design, solver, probe, configs, steps):
         got = [t for t in travel if t is not None]
         ordered = all(a < b for a, b in zip(got, got[1:]))
         far = max(got)
-        mus = probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + tol.zero])
-        mus += probe.mus([configs[k] for k, t in enumerate(travel) if t is not None])  # the ends exactly
+        mus = self.probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + tol.zero])
+        mus += self.probe.mus([configs[k] for k, t in enumerate(travel) if t is not None])  # the ends exactly
         missing = sum(t is None for t in travel)
-        outcomes.append(((missing, not ordered), direction, status, travel, mus))
-        if not missing and ordered:  # every position, in order: the other way round is not needed
-            break
-    outcomes.sort(key=lambda o: o[0])
-    (missing, disordered), direction, status, travel, mus = outcomes[0]
-    defects = []
-    if missing:
-        for k in range(1, n):
+        return (missing, not ordered), direction, status, travel, mus
+
+    def missing_defects(self, outcomes: list, status: list) -> list[str]:
+        """Why positions are missed: another branch, beyond a limit position, or reached only the other way."""
+        label, targets, u1 = self.label, self.targets, self.u1
+        defects = []
+        for k in range(1, self.n):
             seen = [o[2][k - 1] for o in outcomes]
             if any(s[0] == "reached" for s in seen):  # reached the other way round: the order is the defect
                 continue
@@ -284,12 +301,30 @@ def _follow(design: Design, solver, probe, configs, steps):
                 defects.append(f"{label[k]} lies beyond a limit position{where}: the crank cannot turn from "
                                f"{label[0]} to it")
         if any(any(s[0] == "reached" for s in [o[2][k - 1] for o in outcomes]) and status[k - 1][0] != "reached"
-               for k in range(1, n)):
+               for k in range(1, self.n)):
             defects.append("order defect: the positions are reached only by turning the crank both ways")
+        return defects
+
+
+def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list,
+            steps: int) -> tuple[int, list, list[float], list[str]]:
+    """(direction, travel per position, transmission angles along the motion, defects)."""
+    f = _Follower(design, solver, probe, configs, steps)
+    if design.span is not None:  # the motion is the input range: both ways from the first position
+        return f.over_span()
+    outcomes = []
+    for direction in (1, -1):
+        outcome = f.one_way(direction)
+        outcomes.append(outcome)
+        if not any(outcome[0]):  # every position, in order: the other way round is not needed
+            break
+    outcomes.sort(key=lambda o: o[0])
+    (missing, disordered), direction, status, travel, mus = outcomes[0]
+    defects = f.missing_defects(outcomes, status) if missing else []
     if disordered:
         got = sorted((t, k) for k, t in enumerate(travel) if t is not None)
         defects.append("order defect: turning the crank " + ("counterclockwise" if direction > 0 else "clockwise")
-                       + " from " + label[0] + " reaches the positions in the order "
+                       + " from " + f.label[0] + " reaches the positions in the order "
                        + ", ".join(str(k + 1) for _, k in got))
     return direction, travel, mus, defects
 
