@@ -8,7 +8,7 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parents[1] / "screwkin"
+PACKAGE = Path(__file__).resolve().parents[2] / "screwkin"
 LONG_FUNCTION = 90  # lines
 MOST_LONG_FUNCTIONS = 5
 LONG_MODULE = 600  # lines
