@@ -3,7 +3,7 @@ screwkin's random-start search at equal coverage.
 
     python benchmarks/modes.py
 
-The platform is tests/test_certified.py's of random geometry, seed 5 (40 complex assembly modes, 6 real).
+The platform is tests/model/homotopy/test_certified.py's of random geometry, seed 5 (40 complex assembly modes, 6 real).
 Measured in one run, on the same machine, one after the other:
 - ``solve`` by homotopy continuation (the default): time to every mode and its certificate (the
   published count of 40 reached), with the numba kernel and with numpy alone;
@@ -22,11 +22,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "tests" / "model" / "homotopy")]  # conftest, test_certified
 
 import screwkin  # noqa: E402
-from screwkin.analysis.motion.position import PositionSolver  # noqa: E402
-from screwkin.model import algebraic  # noqa: E402
+from screwkin.analysis.position.position import PositionSolver  # noqa: E402
+from screwkin.model.kernel import algebraic  # noqa: E402
 from test_certified import stewart_urdf  # noqa: E402
 
 

@@ -114,7 +114,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     fb = screwkin.load(ROOT / "robots" / "fourbar.urdf.xacro", args=FOURBAR)

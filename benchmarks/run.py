@@ -168,7 +168,7 @@ def closed_loop_fk(names, solves):
     import yaml
 
     from screwkin.model.linalg import null_space
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
     tb = _toolbox()
     rows = []
@@ -194,7 +194,7 @@ def closed_loop_fk(names, solves):
             return [solver.solve(t, near=near, starts=0).solutions[0].q for t in targets]
 
         functions = {"track": ours_track, "solve": ours_solve}
-        # the same with the compiled inner loop (screwkin.model.compiled, numba), on its own copy of the mechanism
+        # the same with the compiled inner loop (screwkin.model.kernel.compiled, numba), on its own copy of the mechanism
         fast_mech = screwkin.load(urdf, warn=lambda m: None)
         fast = PositionSolver(fast_mech, compiled=True)
         if fast.compiled:
@@ -253,7 +253,7 @@ def closed_loop_fk(names, solves):
 
 # ---------------------------------------------------------------- 3. sweep throughput
 def sweep_throughput(steps):
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     rows = []

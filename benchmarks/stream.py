@@ -62,7 +62,7 @@ def speed(quick):
     import numpy as np
 
     import screwkin
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.motion.sweep import sweep
 
     cases = [("bennett.urdf", "joint1", 0.0, 2 * np.pi, 2000), ("rssr.urdf", "crank_joint", 0.0, 0.36, 1000),

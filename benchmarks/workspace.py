@@ -18,7 +18,7 @@ import pinocchio as pin
 
 import screwkin
 import screwkin.errors
-from screwkin.analysis.motion.batch_closure import BatchClosure
+from screwkin.model.kernel.stacks import BatchClosure
 from screwkin.analysis.design.workspace import workspace
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"

@@ -14,7 +14,7 @@ import numpy as np
 
 import screwkin
 from screwkin.analysis.motion.planar import identify
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.motion.singular_points import locate_singularities
 from screwkin.analysis.motion.sweep import sweep
 

@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 import screwkin
-from screwkin.analysis.motion.position import PositionSolver
+from screwkin.analysis.position.position import PositionSolver
 
 ROBOTS = Path(__file__).resolve().parents[1] / "robots"
 steps = int(sys.argv[1]) if len(sys.argv) > 1 else 500

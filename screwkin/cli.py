@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["main", "COMMANDS", "command_module"]
 
 #: The commands, in the order `screwkin` lists them, each with its one-line help (the same text as
-#: its module's ``add_parser`` gives: tests/test_cli_lazy.py).  A command's module
+#: its module's ``add_parser`` gives: tests/architecture/test_cli_lazy.py).  A command's module
 #: (screwkin/commands/NAME.py, with the analysis and presentation it imports) is imported only
 #: when that command runs or shows its own --help: ``screwkin`` and ``screwkin --help`` list them
 #: from this table, and ``screwkin sweep ...`` imports sweep's module alone.

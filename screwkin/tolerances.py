@@ -2,7 +2,7 @@
 
 All analyses take a :class:`Tolerances` object; nothing else in the package
 hard-codes a threshold.  Division guards (``max(x, TINY)``) and display cut-offs are named
-module constants where they are used; tests/test_literals.py fails on a new comparison
+module constants where they are used; tests/architecture/test_literals.py fails on a new comparison
 against a bare small literal.
 """
 
@@ -35,7 +35,7 @@ class Tolerances:
                     the largest twist of the same analysis [-].
     max_iterations: iteration limit of the closure solver [-].
     lm_damping:     initial damping of the damped-Newton (Levenberg-Marquardt) step, relative to
-                    the mean squared row norm of the Jacobian (model/newton.py): small, so that
+                    the mean squared row norm of the Jacobian (model/kernel/newton.py): small, so that
                     Newton converges quadratically from a good start [-].
     lm_damping_min: the damping is never lowered below this by accepted steps [-].
     lm_damping_max: a solver whose damping grows past this (every step refused) gives up [-].
@@ -89,7 +89,7 @@ class Tolerances:
                     on one tangent space (an irreducible quadric cone on a kernel of dimension d has
                     about d^2 / 4: 361 for a 40-joint loop folded flat, all continued); beyond, an even
                     spread of them, and the answer says so (mobility --local-samples N) [-].
-    closed_form:    closed forms (model/subproblems.py, model/leg_chains.py, analysis/motion/pieper.py): lines
+    closed_form:    closed forms (model/subproblems.py, model/leg_chains.py, analysis/position/pieper.py): lines
                     meet at a point, a pivot lies on its axis, a discriminant is not negative, a rotation
                     matrix is not singular, two axes are not parallel, when within this, relative to the
                     scale (the characteristic length for lengths, 1 for directions) [-].
@@ -104,6 +104,42 @@ class Tolerances:
                     singular value below this relative to the largest [-].
     cusp:           a point of a singular curve is a cusp where the plane's velocity along the curve is
                     below this relative to its size on either side [-].
+
+    The homotopy (model/homotopy/: the certified mode search), its path tracker (``track_``, tracking.py)
+    and its monodromy and trace test (``homotopy_``, monodromy.py, parameter.py); all dimensionless,
+    in the complex coordinates of the polynomial closure [-]:
+    track_tol:      a corrected point's last Newton step, relative to 1 + |x|, below which it converged.
+    track_target:   the predictor error (the first Newton step, relative) the step size aims at.
+    track_contraction: the most the corrector's second Newton step may be of its first (no path jumping).
+    track_first_step, track_min_step, track_max_step: step sizes in t (a path whose step falls below
+                    track_min_step fails); track_max_steps: steps per path, accepted and refused.
+    track_diverge:  |x| beyond which a path goes to infinity.
+    track_polish:   Newton iterations at t = 1; track_root_tol: |H| there (before the last), relative to
+                    1 + |x|, below which a path has arrived at a root.
+    track_max_jump: the most a step may move a point, relative to 1 + |x|.
+    track_closed:   a Cauchy endgame's loop has closed when a path is back within this of its start.
+    track_endgame:  the Cauchy endgame's radius around t = 1 (a path not arriving at a regular root is
+                    tracked to 1 - this, then around the circle).
+    homotopy_max_rounds: monodromy rounds in all; homotopy_patience: rounds without a new root before
+                    the trace test is tried; homotopy_tries: trace tests before giving up.
+    homotopy_trace_tol: the trace test's threshold (a relative singular value).
+    homotopy_max_roots: the most roots (orbits) kept, a bound on the work.
+    homotopy_newton_starts: random starts of damped Newton added to the trace test's witnesses after a
+                    test that did not close.
+    homotopy_loop_scale: the monodromy loops' random offsets, relative to the base offset's size;
+                    homotopy_loops: new loops a round makes at least.
+    homotopy_budget: paths tracked in all, past which the search stops; homotopy_count_budget: the
+                    budget of a search a published count settles (no trace test); homotopy_fallback_budget:
+                    the budget of a trace test run where a published count was not reached.
+    homotopy_trace_limit: the most roots (orbits) the trace test is tried for.
+    homotopy_redraws: how many times the trace test may start again with another line and slice.
+    homotopy_root:  |G(x) - c0| below which (relative to 1 + |c0|) a point is a root at the base.
+    homotopy_closes: every closure row and constraint below this (relative to (1 + |x|)^2) at a target
+                    root, or it is a root of the random combination only.
+    homotopy_real:  |Im x| below this (relative to 1 + |x|) is a real root.
+    homotopy_cauchy: the equations at a Cauchy endgame's estimate below this (relative) make it a
+                    finite endpoint.
+    homotopy_same:  two roots closer than this (relative) are one.
     """
 
     closure: float = 1e-10
@@ -146,6 +182,37 @@ class Tolerances:
     stalled: float = 1e-6
     crossing_rank: float = 1e-6
     cusp: float = 1e-6
+    track_tol: float = 1e-7
+    track_target: float = 1e-4
+    track_contraction: float = 0.25
+    track_first_step: float = 0.05
+    track_min_step: float = 1e-9
+    track_max_step: float = 0.3
+    track_max_steps: int = 3000
+    track_diverge: float = 1e8
+    track_polish: int = 3
+    track_root_tol: float = 1e-9
+    track_max_jump: float = 2.0
+    track_closed: float = 1e-6
+    track_endgame: float = 0.01
+    homotopy_max_rounds: int = 40
+    homotopy_patience: int = 2
+    homotopy_tries: int = 6
+    homotopy_trace_tol: float = 1e-10
+    homotopy_max_roots: int = 4000
+    homotopy_newton_starts: int = 400
+    homotopy_loop_scale: float = 10.0
+    homotopy_loops: int = 1
+    homotopy_budget: int = 4000
+    homotopy_count_budget: int = 30000
+    homotopy_fallback_budget: int = 8000
+    homotopy_trace_limit: int = 24
+    homotopy_redraws: int = 1
+    homotopy_root: float = 1e-10
+    homotopy_closes: float = 1e-8
+    homotopy_real: float = 1e-7
+    homotopy_cauchy: float = 1e-6
+    homotopy_same: float = 1e-7
 
 
 DEFAULT = Tolerances()

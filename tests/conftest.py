@@ -1,5 +1,7 @@
 import contextlib
+import importlib.util
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -144,6 +146,7 @@ def no_hang(seconds):
 #: Modules .ci/run installs (pyproject.toml's test extra) that some tests import or skip without.
 CI_MODULES = ("numba", "matplotlib", "PIL", "mujoco", "viser", "pyarrow", "imageio_ffmpeg", "modern_robotics",
               "pylinkage", "example_robot_data", "hypothesis",
+              "sphinx", "sphinx_gallery", "sphinxarg", "myst_parser", "pydata_sphinx_theme",  # the test extra: the docs site
               "websockets")  # (viser's own dependency: the interactive view's Chromium test drives the page with it)
 #: Skip reasons that mean "something .ci/run installs is missing": under CI=true such a skip fails the run.
 #: pytest.importorskip says "could not import 'M...'" (M or a submodule: 'pyarrow.parquet'), an import
@@ -182,7 +185,8 @@ def pytest_sessionfinish(session, exitstatus):
 
 
 # ---- markers: a fast subset of about a minute is `pytest -m "not slow"` (issue 23 item 7)
-#: Tests of several seconds each (measured with --durations on the 2-core machine), by node id.
+#: Tests of several seconds each (measured with --durations on the 2-core machine), by node id with the file's
+#: name alone (test files' names are unique in tests/, whatever folder holds them).
 SLOW_TESTS = {
     "test_study.py::test_workspace_metrics_equal_screwkin_workspace",
     "test_workspace.py::test_delta_volume_against_monte_carlo_on_the_closed_form",
@@ -206,15 +210,21 @@ SLOW_TESTS = {
     "test_points_tools.py::test_workspace_of_a_named_point_is_its_annulus",
     "test_points_tools.py::test_statics_of_a_load_at_a_point_is_the_load_moved_to_the_origin",
 }
+#: The costliest tests of the fast subset by measured CPU time (tests/slow_tests.txt: a node id a line with the
+#: seconds it took, a test's name alone marking every parameter of it), run in the slow tier so that the fast
+#: subset keeps about a minute while every test file keeps its cheapest tests there (issue 42 item 5).
+SLOW_TESTS |= {line.split("#", 1)[0].strip() for line in (Path(__file__).parent / "slow_tests.txt").read_text().splitlines()
+               if line.split("#", 1)[0].strip()}
 #: Fuzz mutants beyond the first of each kind run in the slow tier (the first ones keep every operation).
 FAST_MUTANTS = 20
 
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        node = item.nodeid.split("tests/", 1)[-1]
+        file, sep, name = item.nodeid.partition("::")
+        node = file.rsplit("/", 1)[-1] + sep + name  # test_x.py::test_y[...], the folder left out
         base = node.split("[", 1)[0]
-        if base in SLOW_TESTS:
+        if base in SLOW_TESTS or node in SLOW_TESTS:
             item.add_marker(pytest.mark.slow)
         if "local" in getattr(item, "fixturenames", ()) or base.endswith(("separate_scheduler_and_workers_give_the"
                                                                           "_same_table",
@@ -241,3 +251,69 @@ def wide_five_bar(tmp_path_factory):
     path.write_text(text.replace('<origin xyz="0.1 0 0" rpy="0 0 0"/>', '<origin xyz="0.3 0 0" rpy="0 0 0"/>'))
     return path
 
+
+# ---- shared by test modules of several folders (they imported them from each other while tests/ was flat)
+G, A, B, C = 0.10, 0.04, 0.12, 0.08  # ground, crank, coupler, rocker of fourbar() above
+
+
+def rocker_angles(theta):
+    """Both rocker angles of the four-bar for crank angle theta: the two
+    intersections of the circles |X - B(theta)| = B and |X - D| = C."""
+    b = A * np.array([np.cos(theta), np.sin(theta)])
+    d = np.array([G, 0.0])
+    dist = np.linalg.norm(d - b)
+    along = (B**2 - C**2 + dist**2) / (2 * dist)
+    h = np.sqrt(B**2 - along**2)
+    u = (d - b) / dist
+    out = []
+    for sign in (1, -1):
+        x = b + along * u + sign * h * np.array([-u[1], u[0]])
+        out.append(np.arctan2(x[1] - d[1], x[0] - d[0]))
+    return sorted(out)
+
+
+def world_angles(mech, sol):
+    """Crank and rocker angles from the solved placements (Pinocchio FK)."""
+    import pinocchio as pin
+
+    data = mech.model.createData()
+    pin.framesForwardKinematics(mech.model, data, sol.q)
+    R_crank = data.oMf[mech.link_frame("crank")].rotation
+    R_rocker = data.oMf[mech.link_frame("rocker")].rotation
+    return np.arctan2(R_crank[1, 0], R_crank[0, 0]), np.arctan2(R_rocker[1, 0], R_rocker[0, 0])
+
+
+#: The planar 2R arm (0.4 m and 0.25 m to the hand) of the ellipsoids' closed form (test_ellipsoids, test_json_writer).
+ARM = """<robot name="arm2r">
+  <link name="base"/><link name="upper"/><link name="fore"/><link name="hand"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.4 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="wrist" type="fixed"><parent link="fore"/><child link="hand"/><origin xyz="0.25 0 0"/></joint>
+</robot>"""
+
+
+#: robots/README.md's table of the bundled mechanisms, a row per file (test_robots, test_matrix).
+ROW = re.compile(r"^\| `(?P<file>[^`]+)` \| [^|]+ \| (?P<N>-?\d+) \| (?P<J>-?\d+) \| (?P<crit>\w+) (?P<count>-?\d+) \| "
+                 r"(?P<M>-?\d+) \| (?P<idle>\d+) \| (?P<eff>\d+) \| (?P<out>\S+) (?P<motion>\S+) \|")
+
+
+def robots_table():
+    rows = [ROW.match(line) for line in (ROBOTS / "README.md").read_text().splitlines()]
+    return {m["file"]: m for m in rows if m}
+
+
+def _robot_data():
+    spec = importlib.util.find_spec("example_robot_data")
+    if spec is None:
+        for base in map(Path, sys.path):
+            cand = base / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+            if cand.is_dir():
+                return cand
+        return None
+    return Path(spec.submodule_search_locations[0]).parent / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+
+
+#: example-robot-data's robots folder, None when the package is not installed (test_couplings, test_published, ...).
+ROBOT_DATA = _robot_data()

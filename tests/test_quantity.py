@@ -1,21 +1,20 @@
 """A typed value travels as one units.Quantity from parsing to the table (issue 37 item 4): parsed once,
 with its SI value, its kind and the unit typed; shown back in that unit by one rule (units.shown_unit)
 and one conversion (units.in_unit).  The references are the units' definitions (1 deg = pi/180 rad,
-1 rpm = 2 pi/60 rad/s, 1 mm = 1e-3 m) and the number a person typed coming back."""
+1 rpm = 2 pi/60 rad/s, 1 mm = 1e-3 m) and the number a person typed coming back.
+
+units.in_unit: an SI value written in a unit people type (parse_value's inverse)."""
 
 from __future__ import annotations
 
 import math
-import re
-from pathlib import Path
 
 import pytest
 from conftest import ROBOTS
 
 from screwkin.cli import main
-from screwkin.units import Quantity, in_unit, parse_quantity, parse_typed_assignments, shown_unit
+from screwkin.units import Quantity, in_unit, parse_quantity, parse_typed_assignments, parse_value, shown_unit
 
-ROOT = Path(__file__).resolve().parents[1]
 FOURBAR = str(ROBOTS / "fourbar_crank_rocker.urdf")
 
 
@@ -69,23 +68,6 @@ def test_assignments_keep_each_quantity():
     assert got[0][1].value == pytest.approx(math.pi / 4) and got[1][1].value == pytest.approx(0.002)
 
 
-def test_no_module_reads_a_unit_again_after_parsing():
-    """The unit of a value is read where the value is parsed (units.parse_quantity, through the
-    commands' joint_quantities and joint_value): no module asks units.py for the unit of a text again,
-    and none holds a table of unit factors or display units of its own."""
-    found = []
-    for path in sorted((ROOT / "screwkin").rglob("*.py")):
-        rel = path.relative_to(ROOT).as_posix()
-        if rel == "screwkin/units.py":
-            continue
-        text = path.read_text()
-        for pattern in (r"\bparse_typed_value\b", r"\bunit_kind\(", r"\bUNITS\[", r"_RATE = \{", r"_ACCEL = \{",
-                        r"_LENGTH_UNITS\b"):
-            if re.search(pattern, text):
-                found.append(f"{rel}: {pattern}")
-    assert not found, found
-
-
 def test_the_tables_answer_in_the_units_typed(capsys):
     """solve --rate crank_joint=90deg: omega in deg/s, alpha in deg/s^2 (the crank's own omega is the 90
     typed); sweep --to 90deg: the input in degrees; --rate 1turn (no turn/s): SI, said in words."""
@@ -99,3 +81,19 @@ def test_the_tables_answer_in_the_units_typed(capsys):
                  "--rate", "1turn"]) == 0
     out = capsys.readouterr().out
     assert "at crank_joint 6.28319 rad/s" in out and "input [deg]" in out  # --to 90deg: the input in degrees
+
+
+# ---------------------------------------------------------------- folded in from test_in_unit.py
+@pytest.mark.parametrize("si, unit, expected", [
+    (math.pi, "deg", 180.0),  # pi rad is half a turn
+    (0.03, "mm", 30.0),
+    (2 * math.pi, "rpm", 60.0),  # one turn a second
+    (0.5, "rad", 0.5),
+])
+def test_in_unit_by_definition(si, unit, expected):
+    assert in_unit(si, unit) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("number, unit", [("45", "deg"), ("30", "mm"), ("60", "rpm"), ("1.5", "in")])
+def test_in_unit_undoes_parse_value(number, unit):
+    assert in_unit(parse_value(number + unit), unit) == pytest.approx(float(number), rel=1e-12)

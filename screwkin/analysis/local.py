@@ -33,7 +33,7 @@ mobility cross: a change point), "kinematotropic" (branches of different mobilit
 rigid; or a branch along which the instantaneous mobility stays above the finite one, Mueller's shaky
 linkage), "singular" (one branch with more instantaneous than finite mobility here only, or a cone
 point), "rigid" (no motion at all: ker K = 0), "undecided" (the series alone cannot tell).
-Ranks are decided as analysis.singularities.singular decides a constraint singularity: singular
+Ranks are decided as analysis.singular decides a constraint singularity: singular
 values of the dimensionless K below ``Tolerances.singular`` times the largest are lost.
 """
 
@@ -45,9 +45,12 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import AssemblyError
+from ..model.kernel.contract import ClosureKernel
+from ..model.kernel.newton import undamped
+from ..model.kernel.scaling import dimensionless, dimensionless_rows
 from ..model.linalg import rank
 from .loop_series import Series, loop_system
-from .singularities.singular import scaled_jacobians
+from .singular import scaled_jacobians
 
 __all__ = ["Branch", "LocalAnalysis", "local_analysis", "KINDS", "quadratic_forms", "rates_of"]
 
@@ -273,14 +276,29 @@ def _continue(system, x, Ainv, N, U, order, tol, lookahead=True):
     return None, s.X, residuals
 
 
-def _scaled_residual(mech, q, L):
-    r, K = mech.closure.evaluate(q, jacobian=True)
-    rows = mech.closure.position_rows
-    r, K = r.copy(), K.copy()
-    r[rows] /= L
-    K[rows] /= L
-    K[:, mech.translational] *= L
-    return r, K
+class _HeldRows(ClosureKernel):
+    """The minimal closure rows made dimensionless (model.kernel.scaling), and below them the held
+    rows B^T (q - q0) / scale - target: a step's component along a branch's tangent space B (nv, k)
+    kept.  Steps are in the scaled columns (sliding ones times L): q moves by step * scale."""
+
+    def __init__(self, mech, q0: np.ndarray, B: np.ndarray, target: np.ndarray, scale: np.ndarray, L: float) -> None:
+        self.mech, self.q0, self.B, self.target, self.scale, self.L = mech, q0, B, target, scale, L
+        self.nq, self.nv = mech.model.nq, mech.nv
+        self.m = mech.closure.nrows + B.shape[1]
+        self.length_rows = np.r_[mech.closure.position_rows, np.zeros(B.shape[1], bool)]
+        self.sliding = np.flatnonzero(mech.translational)
+
+    def evaluate(self, Q: np.ndarray, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        mech, q = self.mech, Q[0]
+        r, K = mech.closure.evaluate(q, jacobian=True)
+        rows = mech.closure.position_rows
+        r, K = dimensionless_rows(r, rows, self.L), dimensionless(K, rows, mech.translational, self.L)
+        hold = self.B.T @ (pin.difference(mech.model, self.q0, q) / self.scale) - self.target
+        J = np.vstack([K, self.B.T]) if K.size else self.B.T
+        return np.concatenate([r, hold])[None], J[None]
+
+    def integrate(self, Q: np.ndarray, V: np.ndarray) -> np.ndarray:
+        return np.array([pin.integrate(self.mech.model, q, v * self.scale) for q, v in zip(Q, V)])
 
 
 def _confirm(mech, q0, system, X, B, h):
@@ -292,19 +310,9 @@ def _confirm(mech, q0, system, X, B, h):
     scale = system.scale[:nv]
     x = X[0][:nv]
     predicted = pin.integrate(mech.model, q0, h * x * scale)  # the tangent alone: the series is not used
-    q = predicted
-    target = h * (B.T @ x)
-    norm = np.inf
-    for _ in range(tol.max_iterations):
-        r, K = _scaled_residual(mech, q, L)
-        hold = B.T @ (pin.difference(mech.model, q0, q) / scale) - target
-        F = np.concatenate([r, hold])
-        norm = float(np.linalg.norm(F))
-        if norm < tol.closure:
-            break
-        J = np.vstack([K, B.T]) if K.size else B.T
-        step = -np.linalg.lstsq(J, F, rcond=None)[0]
-        q = pin.integrate(mech.model, q, step * scale)
+    rows = _HeldRows(mech, q0, B, h * (B.T @ x), scale, L)  # Gauss-Newton: the undamped step of model.kernel.newton
+    closed = undamped(rows, predicted, np.arange(nv), tol.max_iterations - 1, closure=tol.closure)
+    q, norm = closed.q, closed.residual
     if not norm < tol.closure:
         return None, None, norm
     deviation = float(np.linalg.norm(pin.difference(mech.model, predicted, q) / scale))
@@ -481,7 +489,7 @@ def _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sam
     notes = list(notes)
     common = {k: v for k, v in base.items()}
     regular_roots = all(c.regular for c in candidates) and c2 > 0
-    for cand, at in failed:
+    for _cand, at in failed:
         notes.append(f"a candidate tangent of the quadratic cone does not continue: its series leaves a residual at "
                      f"order {at}")
     unconfirmed = [b for b in branches if not b.confirmed]

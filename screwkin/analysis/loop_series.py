@@ -38,19 +38,19 @@ automorphism of se(3)), sliding columns multiplied by it.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
+from ..model.kernel.scaling import dimensionless_twists
 from ..model.cuts import ContactRow
 from ..model.geometry import cross_last, perpendicular_basis
 from ..model.state import KinematicState
 from .screws import cut_twists
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.model.cuts import CutJoint
+    from ..model.mechanism import Mechanism
 
 __all__ = ["LoopSystem", "Series", "loop_system", "ad", "split", "subalgebra", "BODY_JOINTS", "SEQUENTIAL_JOINTS"]
 
@@ -60,7 +60,7 @@ BODY_JOINTS = ("JointModelSpherical", "JointModelFreeFlyer", "JointModelPlanar",
 SEQUENTIAL_JOINTS = ("JointModelUniversal", "JointModelSphericalZYX")
 
 
-def ad(W, S) -> np.ndarray:
+def ad(W, S):
     """ad_W S for twists (v, w) in the last axis of W and S (arrays (..., 6))."""
     vW, wW, vS, wS = W[..., :3], W[..., 3:], S[..., :3], S[..., 3:]
     return np.concatenate([cross_last(wW, vS) + cross_last(vW, wS), cross_last(wW, wS)], axis=-1)
@@ -112,7 +112,7 @@ class LoopSystem:
     def columns(self) -> int:
         return len(self.names)
 
-    def stack(self, P: np.ndarray) -> np.ndarray:
+    def stack(self, P) -> np.ndarray:
         """The constraint rows of P (units, 6): each cut's sum of sigma P in its algebra."""
         blocks = [E @ (s @ P) for E, s in zip(self.basis, self.sigma)]
         return np.concatenate(blocks) if blocks else np.zeros(0)
@@ -127,7 +127,7 @@ class LoopSystem:
             A[:, k] = self.coupled(self.stack(self.screws * y[:, None]), np.eye(n)[k])
         return A
 
-    def coupled(self, loops: np.ndarray, x: np.ndarray) -> np.ndarray:
+    def coupled(self, loops, x) -> np.ndarray:
         """The loop rows followed by the coupling rows of the column rates x (and, for A only, the
         contacts' first-order rows)."""
         out = np.concatenate([loops, self.couplings @ x]) if len(self.couplings) else loops
@@ -138,16 +138,16 @@ class Series:
     """The Taylor coefficients of a motion's column rates X[0], X[1], ... and of the units' screws
     along it; ``residual()`` is R_k for the next order k (Phi[k] with X[k] = 0)."""
 
-    def __init__(self, system: LoopSystem, x0) -> None:
+    def __init__(self, system: LoopSystem, x0):
         self.sys = system
         self.X = [np.asarray(x0, float)]
         self.S = [system.screws]
         self.P = []  # P[m] (units, 6): sum_l S[l] y[m-l], up to the order pushed
 
-    def _y(self, k: int):
+    def _y(self, k):
         return self.sys.multiplier * self.X[k][self.sys.column]
 
-    def _p(self, m: int, with_last: bool=True):
+    def _p(self, m, with_last=True):
         terms = [self.S[l] * self._y(m - l)[:, None] for l in range(m + 1) if with_last or l > 0]
         return np.sum(terms, axis=0) if terms else np.zeros_like(self.sys.screws)
 
@@ -195,7 +195,7 @@ class Series:
         return other
 
 
-def _units(mech: Mechanism, state: KinematicState) -> tuple:
+def _units(mech, state):
     """Every unit of the tree: (screw (v, w) at the world origin, column, multiplier), the carriers
     of each (a set of unit indices), the units of each joint, and a note when a joint has no closed
     form here.  A Pinocchio mimic joint is a unit of its primary's column (its motion subspace holds
@@ -222,7 +222,7 @@ def _units(mech: Mechanism, state: KinematicState) -> tuple:
     return units, carriers, by_joint, note
 
 
-def subalgebra(screws: np.ndarray, tol: float) -> tuple:
+def subalgebra(screws, tol):
     """("se(2)", normal) when every screw (v, w) lies in the planar motions normal to one direction,
     ("so(3)", point) when every one is a rotation about one point, else ("se(3)", None)."""
     rot = [s for s in screws if np.linalg.norm(s[3:]) > tol]
@@ -241,7 +241,7 @@ def subalgebra(screws: np.ndarray, tol: float) -> tuple:
     return "se(3)", None
 
 
-def split(kind: str, where: str, S: np.ndarray) -> tuple:
+def split(kind, where, S):
     """(the part of twists S (..., 6) in the algebra, the part in its complement m): se(2) normal to
     n: (v - (v.n) n, (w.n) n) and ((v.n) n, w - (w.n) n); so(3) about p: (p x w, w) and (v - p x w, 0).
     m is invariant under the algebra's brackets, so motions of units in the algebra stay in it."""
@@ -255,7 +255,7 @@ def split(kind: str, where: str, S: np.ndarray) -> tuple:
     return inside, S - inside
 
 
-def coordinates(kind: str, where: str) -> np.ndarray:
+def coordinates(kind, where) -> np.ndarray:
     """The (rows, 6) map from a twist of the algebra to its coordinates: se(2) (v.e1, v.e2, w.n), so(3) w."""
     if kind == "se(2)":
         n = where
@@ -267,7 +267,7 @@ def coordinates(kind: str, where: str) -> np.ndarray:
     return np.eye(6)
 
 
-def _cut_units(mech: Mechanism, cut: CutJoint, state: KinematicState, kind: str, where: str, L: float) -> list:
+def _cut_units(mech, cut, state, kind, where, L):
     """The cut joint's freedoms as world twists [(name, twist, sliding)] (screws.cut_twists); a ball's
     three rotations about axes that put the algebra's own rotation last (e1, e2, n in a plane)."""
     # a sliding contact closes through a planar cut joint (its contact row apart); a rolling, gear or screw
@@ -280,28 +280,12 @@ def _cut_units(mech: Mechanism, cut: CutJoint, state: KinematicState, kind: str,
     return free
 
 
-def loop_system(mech: Mechanism, q: np.ndarray, length: float | None = None, reduce: bool = True) -> LoopSystem:
-    """The LoopSystem of ``mech`` at the assembled configuration q.
-
-    With ``reduce``, when every tree screw lies in se(2) (a planar mechanism) or so(3) (a spherical
-    one), and each cut joint's freedoms outside that algebra have independent parts in its
-    complement m (so the loops hold them at zero at every order: the equations' m-part involves
-    them alone), those freedoms are dropped and each loop is written in the algebra's coordinates:
-    its m-rows vanish identically along every motion (they are the redundancy the plane or the
-    sphere makes: ``dropped_rows`` counts them)."""
+def _add_cut_units(mech: Mechanism, state: KinematicState, kind: str, where_world: np.ndarray | None, L: float,
+                   units: list, carriers: list, by_joint: dict, names: list[str],
+                   slide: list[bool]) -> tuple[list[list[set[int]]], list[list[int]]]:
+    """Append each cut joint's freedoms to the units (with their names, whether they slide, and the units that
+    carry them): (each cut's two sides (the tree units under its frames), each cut's own units)."""
     model = mech.model
-    L = float(length or mech.length)
-    tol = mech.tolerances
-    state = KinematicState(mech, q)
-    units, carriers, by_joint, note = _units(mech, state)
-    nv = mech.nv
-    tree_units = len(units)
-    tree_screws = np.array([u[0] for u in units], float).reshape(tree_units, 6)
-    tree_screws[:, :3] /= L
-    kind, where = subalgebra(tree_screws, tol.geometry) if reduce and tree_units else ("se(3)", None)
-    where_world = None if where is None else (where if kind == "se(2)" else where * L)
-    names = list(mech.coordinate_names)
-    slide = list(mech.translational.astype(bool))
     sides_of, own_of = [], []
     for cut in mech.cuts:
         sides = []
@@ -316,13 +300,62 @@ def loop_system(mech: Mechanism, q: np.ndarray, length: float | None = None, red
             carriers.append(set(sides[0]) | set(range(first, first + k)))
         sides_of.append(sides)
         own_of.append(list(range(first, len(units))))
+    return sides_of, own_of
+
+
+def _extra_rows(mech: Mechanism, q: np.ndarray, ncols: int, scale: np.ndarray,
+                L: float) -> tuple[np.ndarray, np.ndarray | None, str | None]:
+    """The closure's rows beyond the loops, dimensionless, in the ``ncols`` columns: (the couplings' rows, the
+    sliding contacts' rows of K (first order only) or None, the note a sliding contact makes or None)."""
+    nv = mech.nv
+    couplings, contacts = [], []
+    note = None
+    K = None
+    for i, e in enumerate(mech.closure.extra, mech.closure.nrows - len(mech.closure.extra)):
+        if isinstance(e, ContactRow):  # first order only: its row of K, in the tree's columns
+            note = note or f"'{e.name}' is a sliding contact (cam, pin in a slot): its series is not written here"
+            K = mech.closure.jacobian(q) if K is None else K
+            row = np.zeros(ncols)
+            row[:nv] = K[i] * scale[:nv] / L
+            contacts.append(row)
+            continue
+        row = np.zeros(ncols)
+        for _, iv, cval in e.terms:
+            row[iv] += cval
+        couplings.append(row * scale / (1.0 if e.kind == "angle" else L))
+    return (np.array(couplings, float).reshape(len(couplings), ncols),
+            np.array(contacts, float).reshape(len(contacts), ncols) if contacts else None, note)
+
+
+def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> LoopSystem:
+    """The LoopSystem of ``mech`` at the assembled configuration q.
+
+    With ``reduce``, when every tree screw lies in se(2) (a planar mechanism) or so(3) (a spherical
+    one), and each cut joint's freedoms outside that algebra have independent parts in its
+    complement m (so the loops hold them at zero at every order: the equations' m-part involves
+    them alone), those freedoms are dropped and each loop is written in the algebra's coordinates:
+    its m-rows vanish identically along every motion (they are the redundancy the plane or the
+    sphere makes: ``dropped_rows`` counts them)."""
+    L = float(length or mech.length)
+    tol = mech.tolerances
+    state = KinematicState(mech, q)
+    units, carriers, by_joint, note = _units(mech, state)
+    nv = mech.nv
+    tree_units = len(units)
+    tree_screws = np.array([u[0] for u in units], float).reshape(tree_units, 6)
+    tree_screws[:, :3] /= L
+    kind, where = subalgebra(tree_screws, tol.geometry) if reduce and tree_units else ("se(3)", None)
+    where_world = None if where is None else (where if kind == "se(2)" else where * L)
+    names = list(mech.coordinate_names)
+    slide = list(mech.translational.astype(bool))
+    sides_of, own_of = _add_cut_units(mech, state, kind, where_world, L, units, carriers, by_joint, names, slide)
     n_units = len(units)
     scale = np.where(np.array(slide, bool), L, 1.0)
     column = np.array([u[1] for u in units], int)
     mult = np.array([u[2] for u in units], float)
-    screws = np.array([u[0] for u in units], float).reshape(n_units, 6)
-    screws[:, :3] /= L  # dimensionless: v / L, sliding columns times L
-    screws *= scale[column][:, None]
+    screws = np.array([u[0] for u in units], float).reshape(n_units, 6)  # one screw (twist) a row
+    # dimensionless: v / L, sliding columns times L (model.kernel.scaling)
+    screws = np.ascontiguousarray(dimensionless_twists(screws.T, np.array(slide, bool)[column], L).T)
     carrier = np.zeros((n_units, n_units))
     for u, cs in enumerate(carriers):
         carrier[u, sorted(cs)] = 1.0
@@ -331,22 +364,8 @@ def loop_system(mech: Mechanism, q: np.ndarray, length: float | None = None, red
         sigma[c, sorted(sides[1] - sides[0])] = 1.0
         sigma[c, sorted(sides[0] - sides[1])] = -1.0
         sigma[c, own] = -1.0
-    couplings, contacts = [], []
-    K = None
-    for i, e in enumerate(mech.closure.extra, mech.closure.nrows - len(mech.closure.extra)):
-        if isinstance(e, ContactRow):  # first order only: its row of K, in the tree's columns
-            note = note or f"'{e.name}' is a sliding contact (cam, pin in a slot): its series is not written here"
-            K = mech.closure.jacobian(q) if K is None else K
-            row = np.zeros(len(names))
-            row[:nv] = K[i] * scale[:nv] / L
-            contacts.append(row)
-            continue
-        row = np.zeros(len(names))
-        for _, iv, cval in e.terms:
-            row[iv] += cval
-        couplings.append(row * scale / (1.0 if e.kind == "angle" else L))
-    couplings = np.array(couplings, float).reshape(len(couplings), len(names))
-    contacts = np.array(contacts, float).reshape(len(contacts), len(names)) if contacts else None
+    couplings, contacts, contact = _extra_rows(mech, q, len(names), scale, L)
+    note = note or contact
     keep = list(range(n_units))
     dropped = ()
     rows = [coordinates("se(3)", None)] * len(mech.cuts)

@@ -11,7 +11,9 @@ file drawn in a singular pose does not change the answer.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -21,11 +23,10 @@ from ..model.state import KinematicState
 from ..model.topology import Topology
 from .local import LocalAnalysis, local_analysis, words as local_words
 from .redundancy import Redundancy, redundancy
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.tolerances import Tolerances
+    from ..model.mechanism import Mechanism
+    from ..tolerances import Tolerances
 
 __all__ = ["MobilityResult", "OutputMotion", "analyze_mobility"]
 
@@ -109,7 +110,7 @@ class MobilityResult:
         return self.topology.motion_space
 
 
-def _body_frames(mech: Mechanism, topo: Topology) -> dict:
+def _body_frames(mech, topo):
     """One body frame per link of the topology (not the ground)."""
     frames = {}
     for link in topo.links:
@@ -119,7 +120,7 @@ def _body_frames(mech: Mechanism, topo: Topology) -> dict:
     return frames
 
 
-def _joint_geometry_rows(mech: Mechanism, topo: Topology, frames: dict, jac: dict, state: KinematicState) -> list:
+def _joint_geometry_rows(mech, topo, frames, jac, state):
     """Rows whose null space is the set of motions keeping every joint's geometry still.
 
     For each joint and each of its two links: the velocity (seen from that link)
@@ -170,7 +171,7 @@ def _joint_geometry_rows(mech: Mechanism, topo: Topology, frames: dict, jac: dic
     return rows
 
 
-def _idle(mech: Mechanism, topo: Topology, frames: dict, q: np.ndarray, V: np.ndarray, output_link: str | None, tol: Tolerances) -> tuple:
+def _idle(mech, topo, frames, q, V, output_link, tol):
     """Idle motions: motions that change no joint's geometry.
 
     Links joined to the rest by a single joint (free tips such as a serial
@@ -206,7 +207,7 @@ def _idle(mech: Mechanism, topo: Topology, frames: dict, q: np.ndarray, V: np.nd
     return idle, I.shape[1], I
 
 
-def _point_motion(link: str, T, tol) -> OutputMotion:
+def _point_motion(link, T, tol) -> OutputMotion:
     """What the origin of a link can do as a point: the rank of its velocities."""
     dim = rank(T[:3], tol)
     if dim == 0:
@@ -215,7 +216,7 @@ def _point_motion(link: str, T, tol) -> OutputMotion:
     return OutputMotion(link, dim, dim, 0, f"{dim}T", None, tuple(tuple(c) for c in U[:, :dim].T), True)
 
 
-def _output_motion(link: str, T: np.ndarray, tol: Tolerances, origin: np.ndarray) -> OutputMotion:
+def _output_motion(link, T, tol, origin) -> OutputMotion:
     dim = rank(T, tol)
     if dim == 0:
         return OutputMotion(link, 0, 0, 0, "0 (immobile)", None, ())
@@ -246,7 +247,7 @@ def _output_motion(link: str, T: np.ndarray, tol: Tolerances, origin: np.ndarray
     return OutputMotion(link, dim, t, r, label, center, tuple(tuple(col) for col in basis.T))
 
 
-def _classification(n: int, m: int, eff: int, overconstraint: int, topo: Topology, M: int) -> tuple:
+def _classification(n, m, eff, overconstraint, topo, M):
     """The classification and notes; a structure (no effective DOF) is statically determinate
     or not in its detected motion space: a planar triangle is determinate in the plane
     (Gruebler 0 = M), although 3 of its 5 spatial constraint rows are redundant."""
@@ -293,7 +294,7 @@ def _classification(n: int, m: int, eff: int, overconstraint: int, topo: Topolog
     return kind, tuple(notes)
 
 
-def analyze_mobility(mech: Mechanism, output: str | None=None, seed: int = 0, point: bool = False, at=None,
+def analyze_mobility(mech, output=None, seed: int = 0, point: bool = False, at=None,
                      suggest: bool = False, names: bool = False, progress=None) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
     its origin as a point (3 translations) instead of its full motion.  The mobility reported is the
@@ -309,7 +310,7 @@ def analyze_mobility(mech: Mechanism, output: str | None=None, seed: int = 0, po
     return mech.cache[key]
 
 
-def _local_notes(local: LocalAnalysis, where: str, M_generic: int, generic_rank: int, samples: int) -> tuple:
+def _local_notes(local, where, M_generic, generic_rank, samples):
     """Why the mobility reported (the local analysis' finite mobility at ``where``) is not the generic one."""
     if local.finite_mobility is None or local.finite_mobility == M_generic:
         return ()
@@ -321,30 +322,27 @@ def _local_notes(local: LocalAnalysis, where: str, M_generic: int, generic_rank:
                " (this configuration is on a branch of higher mobility than the generic one)") + ".",)
 
 
-def _analyze(mech: Mechanism, output: str | None, seed: int, point: bool, at=None, suggest: bool=False, names: bool=False, progress=None) -> MobilityResult:
-    tol = mech.tolerances
-    if output is not None:
-        out_frame = mech.link_frame(output)
-    assembly, configs = mech.generic_configurations(seed=seed)
-    topo = mech.topology(configs[0])
-    frames = _body_frames(mech, topo)
-    output_link = None
-    if output is not None:
-        output_link = next((l for l, m in topo.link_members.items() if output in m), output)
-    act_idx = mech.velocity_indices(mech.actuated)
-    candidates = []
-    for q in configs:
-        K = mech.closure.jacobian(q)
-        rk = rank(K, tol)
-        V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
-        out = None
-        if output is not None:
-            state = KinematicState(mech, q)
-            T = state.frame_jacobian(out_frame, LWA) @ V
-            out = _point_motion(output, T, tol) if point else _output_motion(
-                output, T, tol, state.frame_placement(out_frame).translation)
-        eff = rank(V[act_idx], tol) if len(act_idx) else None
-        candidates.append(((rk, out.dimension if out else 0, eff or 0), q, K, rk, V, out, eff))
+def _sample(mech: Mechanism, q: np.ndarray, output: str | None, out_frame: int | None, point: bool,
+            act_idx: np.ndarray, tol: Tolerances) -> tuple:
+    """One assembled configuration's ranks: ((rank of K, the output's motion's dimension, the inputs' effective
+    rank), q, K, rank of K, V (K's null space), the output's motion, the inputs' effective rank)."""
+    K = mech.closure.jacobian(q)
+    rk = rank(K, tol)
+    V = null_space(K, tol, mech.nv) if K.size else np.eye(mech.nv)
+    out = None
+    if output is not None and out_frame is not None:
+        state = KinematicState(mech, q)
+        T = state.frame_jacobian(out_frame, LWA) @ V
+        out = _point_motion(output, T, tol) if point else _output_motion(
+            output, T, tol, state.frame_placement(out_frame).translation)
+    eff = rank(V[act_idx], tol) if len(act_idx) else None
+    return (rk, out.dimension if out else 0, eff or 0), q, K, rk, V, out, eff
+
+
+def _generic(mech: Mechanism, candidates: list[tuple], frames: dict, output_link: str | None,
+             tol: Tolerances) -> tuple:
+    """Of the sampled configurations, one of the largest ranks with the fewest idle motions: (q, K, rank of K,
+    mobility, V, idle motions, their count, their basis, the output's motion, the inputs' effective rank)."""
     top = max(c[0] for c in candidates)
     candidates = [c for c in candidates if c[0] == top]
     if mech.nv > _FEW_COORDINATES:  # the idle motions of a big mechanism: at one generic configuration
@@ -352,9 +350,46 @@ def _analyze(mech: Mechanism, output: str | None, seed: int, point: bool, at=Non
     best = None
     for _, q, K, rk, V, out, eff in candidates:
         idle, idle_total, I = _idle(mech, mech.topology(q), frames, q, V, output_link, tol)
-        if best is None or idle_total < best[7]:
-            best = (None, q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
-    _, q, K, rk, M, V, idle, idle_total, I, out, eff = best
+        if best is None or idle_total < best[6]:
+            best = (q, K, rk, V.shape[1], V, idle, idle_total, I, out, eff)
+    assert best is not None  # (the candidates of the top ranks are never none)
+    return best
+
+
+def _analysis_notes(mech: Mechanism, local: LocalAnalysis, where: str, M_generic: int, rk: int, samples: int,
+                    assembly: Any, at: np.ndarray | None, own: bool) -> tuple[str, ...]:
+    """The notes on the transmissions, the local analysis (where it is not the generic one) and an assembly
+    that first closed at a singular configuration."""
+    notes: tuple[str, ...] = ()
+    for t in mech.transmissions():
+        notes += (f"Input {t.text()}: its coordinate is {t.joint}.",)
+    if local.kind != "regular" or local.rank_drop or local.finite_mobility != M_generic:
+        notes += _local_notes(local, where, M_generic, rk, samples)
+        if local.rank_drop:
+            notes += ("The idle motions, the output's motion and the counts use assembled configurations of the "
+                      "generic rank.",)
+    first_singular, first_rank, generic_rank = mech.first_assembly_singular
+    if first_singular and at is None and not own:
+        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
+                  f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
+                  f"there); the analysis uses assembled configurations of the generic rank.",)
+    return notes
+
+
+def _analyze(mech: Mechanism, output: str | None, seed: int | None, point: bool, at: np.ndarray | None = None,
+             suggest: bool = False, names: bool = False,
+             progress: Callable[..., object] | None = None) -> MobilityResult:
+    tol = mech.tolerances
+    out_frame = mech.link_frame(output) if output is not None else None
+    assembly, configs = mech.generic_configurations(seed=seed)
+    topo = mech.topology(configs[0])
+    frames = _body_frames(mech, topo)
+    output_link = None
+    if output is not None:
+        output_link = next((l for l, m in topo.link_members.items() if output in m), output)
+    act_idx = mech.velocity_indices(mech.actuated)
+    candidates = [_sample(mech, q, output, out_frame, point, act_idx, tol) for q in configs]
+    q, K, rk, M, V, idle, idle_total, I, out, eff = _generic(mech, candidates, frames, output_link, tol)
     M_generic = M
     # where the mobility is decided: the configuration given; else the file's own configuration when it closes
     # the loops; else (the search closed them from another start, an arbitrary point of any branch) the
@@ -382,18 +417,7 @@ def _analyze(mech: Mechanism, output: str | None, seed: int, point: bool, at=Non
                 f"instantaneous degree{'s' if local.infinitesimal_mobility > 1 else ''} of freedom), finitely rigid")
     if m and locked:
         notes += (f"With the inputs locked the mechanism can still move ({locked} degree{'s' if locked > 1 else ''} of freedom).",)
-    for t in mech.transmissions():
-        notes += (f"Input {t.text()}: its coordinate is {t.joint}.",)
-    if local.kind != "regular" or local.rank_drop or local.finite_mobility != M_generic:
-        notes += _local_notes(local, where, M_generic, rk, len(configs))
-        if local.rank_drop:
-            notes += ("The idle motions, the output's motion and the counts use assembled configurations of the "
-                      "generic rank.",)
-    first_singular, first_rank, generic_rank = mech.first_assembly_singular
-    if first_singular and at is None and not own:
-        notes += (f"At {assembly.start}, where the loops first closed, the mechanism is singular or on another "
-                  f"branch (rank of K {first_rank} < {generic_rank}: instantaneous mobility {mech.nv - first_rank} "
-                  f"there); the analysis uses assembled configurations of the generic rank.",)
+    notes += _analysis_notes(mech, local, where, M_generic, rk, len(configs), assembly, at, own)
     found = redundancy(mech, q, suggest_fix=suggest) if names or suggest else None
     return MobilityResult(
         path=mech.path,

@@ -2,7 +2,7 @@
 cannot determine, which rows of K they are, and which joints would make the model exactly constrained.
 
 At an assembled configuration the rows of the constraint Jacobian K are constraint wrenches
-(model.closure: each row's wrench on F2's link is ``row_wrenches``).  A left null vector lambda of
+(model.kernel.closure: each row's wrench on F2's link is ``row_wrenches``).  A left null vector lambda of
 K (lambda^T K = 0) is a set of loads the cut joints can carry against each other with no load
 applied and no effort at any joint: a self-stress, statically indeterminate.  The left null space
 (SVD, with screwkin's rank tolerance) gives a basis; each vector's rows of one cut joint sum to the
@@ -11,7 +11,7 @@ ground frame, and in words in the joint's own directions (its axis and the world
 
 The rows a simulator would remove are named as Chrono does: a column-pivoted QR of K^T
 (scipy.linalg.qr, pivoting) puts rank(K) independent rows first; the rest are the redundant rows
-(their labels as model.closure.row_labels writes them).  Their number is the left null space's.
+(their labels as model.kernel.closure.row_labels writes them).  Their number is the left null space's.
 
 A suggestion makes the model exactly constrained as designers do in Adams: each redundant wrench is
 released by giving a joint a freedom it does work against (a revolute made spherical, universal or
@@ -32,6 +32,7 @@ import numpy as np
 from ..errors import ScrewkinError
 from ..model._pin import joint_axis
 from ..model.geometry import perpendicular_basis
+from ..model.kernel.scaling import dimensionless
 from ..model.linalg import null_space, rank
 from ..model.loader import rebuild
 from ..model.state import KinematicState
@@ -104,9 +105,7 @@ def _left_null(mech: Mechanism, q: np.ndarray) -> tuple:
     K = mech.closure.jacobian(q)
     L = mech.length
     rows = mech.closure.position_rows
-    Ks = K.copy()
-    Ks[rows] /= L
-    Ks[:, mech.translational] *= L
+    Ks = dimensionless(K, rows, mech.translational, L)
     Lam = null_space(Ks.T, mech.tolerances, Ks.shape[0]) if Ks.size else np.zeros((Ks.shape[0], 0))
     Lam = Lam.copy()
     Lam[rows] /= L  # lambda^T K = 0 in K's own units

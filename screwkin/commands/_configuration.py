@@ -7,9 +7,9 @@ import math
 import sys
 
 from ..analysis.motion.link_inputs import holding_angles
-from ..analysis.motion.modes import choose_mode
-from ..analysis.motion.position import PositionSolver
-from ..analysis.motion.solution import NEWTON_FROM_FILE
+from ..analysis.position.modes import choose_mode
+from ..analysis.position.position import PositionSolver
+from ..analysis.position.solution import NEWTON_FROM_FILE
 from ..analysis.motion.sweep import BRANCHES
 from ..errors import UsageError, quote
 from ..model.topology import open_joints

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,15 +45,14 @@ from ._configuration import (
 from ._output_frame import add_point_option, named_points
 from ._values import inputs, joint_value, split_inputs
 from ._options import BOUNDS, count
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
+    from ..model.mechanism import Mechanism
 
 NAME = "draw"
 NEEDS_MECHANISM = True
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
     common(sp)
     add_configuration_options(sp)
@@ -95,7 +95,7 @@ def frame_rate(text: str) -> float:
     return fps
 
 
-def _targets(mech: Mechanism, args: argparse.Namespace) -> list:
+def _targets(mech, args) -> list:
     out = []
     for option, ext in (("png", ".png"), ("svg", ".svg")):
         path = getattr(args, option)
@@ -109,12 +109,12 @@ def _targets(mech: Mechanism, args: argparse.Namespace) -> list:
     return out
 
 
-def _suffixed(path, k: int) -> str:
+def _suffixed(path, k) -> str:
     stem, ext = os.path.splitext(path)
     return f"{stem}-singular-{k}{ext}"
 
 
-def _traces(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, input_names, given, skel) -> dict:
+def _traces(mech, args, q, input_names, given, skel) -> dict:
     """--trace NAME: name -> (the point's path in the drawing's plane (N, 2) [m], where the input stopped)."""
     if not args.trace:
         return {}
@@ -134,6 +134,75 @@ def _traces(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, input_name
         if res.stopped_at is not None and not args.json:
             print(f"path of {name}: {input_names[0]} stopped at {res.stopped_at:.6g} ({res.stop_reason})")
     return out
+
+
+def _draw_singular(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, given: dict[str, float],
+                   input_names: list[str], targets: list[str], written: list[str]) -> dict:
+    """draw --singular: the skeleton at each singular configuration along the input, one file each; the JSON
+    report."""
+    name = args.input or (input_names[0] if input_names else None)
+    search = singular_configurations(mech, name, output=args.output, q=q, steps=args.steps,
+                                     fixed={k: v for k, v in given.items() if k != name})
+    found = []
+    same: dict[float, list] = {}  # configurations found at one input value: the modes of another loop, said so
+    seen: dict[float, int] = {}
+    for s in search.found:
+        same.setdefault(round(float(s.input), 9), []).append(s)
+    for k, s in enumerate(search.found, 1):
+        skel = skeleton(mech, s.q, [search.input, *search.fixed])
+        at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
+        key = round(float(s.input), 9)
+        seen[key] = seen.get(key, 0) + 1
+        mode = f", assembly mode {seen[key]} of the {len(same[key])} at this input" if len(same[key]) > 1 else ""
+        title = f"singular configuration {k} of {len(search.found)} at {at}{mode}"
+        fig = draw_mechanism(skel, title=drawing_title(mech, title), angles=args.angles,
+                             subtitle=singularity_kind_text(s))
+        files = []
+        for path in targets:
+            out = _suffixed(path, k)
+            save_figure(fig, out, close=path == targets[-1])
+            files.append(out)
+        written += files
+        found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
+                      "input_wrapped": wrapped_value(s.input, search.unit), "sigma": s.sigma, "files": files,
+                      "description": singularity_kind_text(s), "title": title})
+        if getattr(s, "point", None) is not None:
+            found[-1].update({k: v for k, v in change_point_dict(s.point).items() if k not in ("input", "sigma")})
+        if not args.json:
+            print(f"{singularity_kind_text(s)} at {at}: wrote {', '.join(files)}")
+    report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
+              "output": search.output, "singular_configurations": found}
+    if not args.json and not found:
+        lo, hi = (value_label(search.input, v, search.unit).split(" = ")[1] for v in (search.start, search.stop))
+        print(f"no singular configuration along {search.input} from {lo} to {hi}: nothing written")
+    return report
+
+
+def _draw_skeleton(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, given: dict[str, float],
+                   input_names: list[str], targets: list[str], written: list[str]) -> dict:
+    """draw: the skeleton at the configuration, with the traced points' paths and a design's targets; the JSON
+    report."""
+    skel = skeleton(mech, q, input_names)
+    space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
+    traces = _traces(mech, args, q, input_names, given, skel)
+    marks, curve = (None, None)
+    if mech.spec.targets and args.targets:
+        marks, curve = design_drawing(mech, q, input_names, skel, args.steps, None if args.json else print,
+                               "; --no-targets leaves them out")
+    if curve is not None:
+        traces[curve[0]] = curve[1:]
+    for path in targets:
+        fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), angles=args.angles,
+                             subtitle=("" if skel.planar else space.strip(" ()")) or None,
+                             traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
+        save_figure(fig, path)
+        written.append(path)
+    report = with_mode(args, skeleton_dict(skel))
+    if traces:
+        report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
+    if marks:
+        report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
+    return report
 
 
 def run(mech: Mechanism, args: argparse.Namespace) -> int:
@@ -162,61 +231,9 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
             written.append(path)
         report = chain_dict(chain)
     elif args.singular:
-        name = args.input or (input_names[0] if input_names else None)
-        search = singular_configurations(mech, name, output=args.output, q=q, steps=args.steps,
-                                         fixed={k: v for k, v in given.items() if k != name})
-        found = []
-        same, seen = {}, {}  # configurations found at one input value: the modes of another loop, said so
-        for s in search.found:
-            same.setdefault(round(float(s.input), 9), []).append(s)
-        for k, s in enumerate(search.found, 1):
-            skel = skeleton(mech, s.q, [search.input, *search.fixed])
-            at = value_label(search.input, wrapped_value(s.input, search.unit), search.unit)
-            key = round(float(s.input), 9)
-            seen[key] = seen.get(key, 0) + 1
-            mode = f", assembly mode {seen[key]} of the {len(same[key])} at this input" if len(same[key]) > 1 else ""
-            title = f"singular configuration {k} of {len(search.found)} at {at}{mode}"
-            fig = draw_mechanism(skel, title=drawing_title(mech, title), angles=args.angles,
-                                 subtitle=singularity_kind_text(s))
-            files = []
-            for path in targets:
-                out = _suffixed(path, k)
-                save_figure(fig, out, close=path == targets[-1])
-                files.append(out)
-            written += files
-            found.append({"kind": s.kind, "limit": s.limit, "output": s.output, "input": s.input,
-                          "input_wrapped": wrapped_value(s.input, search.unit), "sigma": s.sigma, "files": files,
-                          "description": singularity_kind_text(s), "title": title})
-            if getattr(s, "point", None) is not None:
-                found[-1].update({k: v for k, v in change_point_dict(s.point).items() if k not in ("input", "sigma")})
-            if not args.json:
-                print(f"{singularity_kind_text(s)} at {at}: wrote {', '.join(files)}")
-        report = {"input": search.input, "unit": search.unit, "range": [search.start, search.stop],
-                  "output": search.output, "singular_configurations": found}
-        if not args.json and not found:
-            lo, hi = (value_label(search.input, v, search.unit).split(" = ")[1] for v in (search.start, search.stop))
-            print(f"no singular configuration along {search.input} from {lo} to {hi}: nothing written")
+        report = _draw_singular(mech, args, q, given, input_names, targets, written)
     else:
-        skel = skeleton(mech, q, input_names)
-        space = "" if skel.planar else f" (schematic projection of a {skel.motion_space} mechanism)"
-        traces = _traces(mech, args, q, input_names, given, skel)
-        marks, curve = (None, None)
-        if mech.spec.targets and args.targets:
-            marks, curve = design_drawing(mech, q, input_names, skel, args.steps, None if args.json else print,
-                                   "; --no-targets leaves them out")
-        if curve is not None:
-            traces[curve[0]] = curve[1:]
-        for path in targets:
-            fig = draw_mechanism(skel, title=drawing_title(mech, configuration_text(skel)), angles=args.angles,
-                                 subtitle=("" if skel.planar else space.strip(" ()")) or None,
-                                 traces={n: xy for n, (xy, _) in traces.items()}, marks=marks)
-            save_figure(fig, path)
-            written.append(path)
-        report = with_mode(args, skeleton_dict(skel))
-        if traces:
-            report["traces"] = {n: {"path": xy.tolist(), "stopped_at": stop} for n, (xy, stop) in traces.items()}
-        if marks:
-            report["targets"] = [{k: v for k, v in m.items() if k != "ghost"} for m in marks]
+        report = _draw_skeleton(mech, args, q, given, input_names, targets, written)
     if args.json:
         report["files"] = written
         print(json_of(report))
@@ -229,12 +246,12 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _typed(name: str, value, unit: str) -> str:
+def _typed(name, value, unit) -> str:
     """'crank = 30 deg' in the unit the person typed (``unit``: rad or m when bare)."""
     return f"{name} = {unit_text(value, unit, 5)}"
 
 
-def _animate(mech: Mechanism, args: argparse.Namespace) -> int:
+def _animate(mech, args) -> int:
     """draw --animate OUT: the skeleton along a sweep of --input from --from to --to."""
     ext = animation_format(args.animate)
     if args.png or args.svg or args.chain or args.singular or args.trace:

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.motion.connect import cusp_loops
+from ..analysis.position.connect import cusp_loops
 from ..analysis.motion.continuation import continuation_steps
-from ..analysis.motion.position import PositionSolver
+from ..analysis.position.position import PositionSolver
 from ..analysis.singularities.loci import trace_loci
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.singularities.regions import regions

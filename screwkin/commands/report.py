@@ -10,9 +10,11 @@ instead, and the rest is still written."""
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 import tempfile
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,7 +23,7 @@ from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..analysis.mobility import analyze_mobility
 from ..analysis.motion.links import strokes, sweep_motion
-from ..analysis.motion.modes import choose_mode
+from ..analysis.position.modes import choose_mode
 from ..analysis.motion.planar import identify, transmission_angles
 from ..analysis.course.figures import default_output, singular_configurations
 from ..analysis.course.skeleton import kinematic_chain, skeleton
@@ -66,12 +68,12 @@ from ._configuration import add_configuration_options, input_solver, mode_line, 
 from ._output_frame import add_point_option, named_points
 from ._values import check_rate_names, joint_quantities, link_rates, rate_items, split_inputs, value_kind
 from ._options import check_writable, count, screwkin_version
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    import argparse
-    from screwkin.present.document import Section
+    from ..analysis.position.solution import PositionResult
+    from ..model.mechanism import Mechanism
+    from ..model.topology import Topology
+    from ..present.document import Section
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -82,7 +84,7 @@ START_ANGLE = np.radians(10.0)
 START_FRACTION = 0.10
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common, scaled):
     sp = sub.add_parser(NAME, help="one self-contained document (HTML and/or Markdown): topology, counts, equations, "
                                    "Newton iterations, motion, singular configurations with drawings, sweep, view")
     common(sp)
@@ -108,13 +110,13 @@ def add_parser(sub, common, scaled) -> None:
     sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
 
 
-def _writable(path, option: str):
+def _writable(path, option):
     if not path:
         raise UsageError(f"{option} needs a file name")
     check_writable(path, option)
 
 
-def _report_inputs(mech: Mechanism, args: argparse.Namespace, given):
+def _report_inputs(mech, args, given):
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     names = names or list(given) or list(mech.actuated)
     for n in names:
@@ -125,7 +127,7 @@ def _report_inputs(mech: Mechanism, args: argparse.Namespace, given):
     return names
 
 
-def _attempt(notes, what: str, fn):
+def _attempt(notes, what, fn):
     """fn() or None, the reason it could not be made kept in notes[what]."""
     try:
         return fn()
@@ -134,7 +136,8 @@ def _attempt(notes, what: str, fn):
         return None
 
 
-def run(mech: Mechanism, args: argparse.Namespace) -> int:
+def _check_args(mech: Mechanism, args: argparse.Namespace) -> None:
+    """Usage errors before any work: a document to write, writable, and steps and iterations in range."""
     targets = [(p, o) for p, o in ((args.html, "--html"), (args.md, "--md")) if p is not None]
     if not targets:
         raise UsageError(f"{mech.path}: report writes a document: give --html F.html and/or --md F.md")
@@ -144,15 +147,12 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
         raise UsageError(f"{mech.path}: --steps must be at least 4")
     if args.iterations is not None and args.iterations < 1:
         raise UsageError("--iterations must be 1 or more")
-    # --set-angle of a link pinned to the ground is its joint's value; of a floating link (held), one more
-    # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
-    given, held, pivots = split_inputs(mech, args)
-    names = _report_inputs(mech, args, given)
-    near = near_values(mech, args)
-    q0 = mech.generic_configurations()[0].q
-    if args.output:
-        mech.link_frame(args.output)
-    points = named_points(mech, args)
+
+
+def _rates(mech: Mechanism, args: argparse.Namespace, names: list[str], held: dict[str, float],
+           pivots: dict) -> tuple[dict[str, dict], dict[str, float], dict[str, float] | None]:
+    """(the --rate and --accel quantities as typed, the input rates (default 1 each), the input accelerations or
+    None)."""
     links = (*held, *pivots)
     args.rate, args.accel = (rate_items(getattr(args, o), [*names, *held], f"--{o}") or None for o in ("rate", "accel"))
     typed = {o: joint_quantities(mech, getattr(args, o), f"--{o}", order=k, links=links)
@@ -162,33 +162,45 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     accels = link_rates({n: q.value for n, q in typed["accel"].items()}, pivots, "--accel") or None
     check_rate_names(rates, [*names, *held], "--rate")
     check_rate_names(accels, [*names, *held], "--accel")
-    notes, data, sections = {}, {"file": str(mech.path), "screwkin": screwkin_version()}, []
+    return typed, rates, accels
 
-    # ---- the configuration: solved for the inputs (their file values when none are set)
-    pres, q = None, q0
-    values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
-    if names or held:
-        solver = input_solver(mech, values, held, output=args.output)
-        # the mode analysed (--mode K), chosen and said as every command chooses and says it
-        q, k, n, pres = choose_mode(solver, values, args.mode, near=near if (near or given or held) else
-                                    mech.joint_values(q0), rates=rates, accels=accels, points=points)
-        if n > 1:
-            data["mode"] = {"index": k, "of": n}
-            print(f"note: {mode_line(k, n)}", file=sys.stderr)
-        if pres.free_dofs:  # a continuum: a sample of it, said as choose_mode says it
-            data["continuum"] = {"free_dofs": pres.free_dofs}
-            print(f"note: {pres.notes[-1]}", file=sys.stderr)
-        data["solve"] = position_dict(pres)
-        data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
-    topo = mech.topology(q)
+
+def _solve_configuration(mech: Mechanism, args: argparse.Namespace, values: dict[str, float],
+                         near: dict[str, float] | None, given: dict[str, float], held: dict[str, float],
+                         rates: dict[str, float], accels: dict[str, float] | None, points: tuple,
+                         data: dict) -> tuple[PositionResult, np.ndarray]:
+    """The configuration solved for the inputs' ``values``, in the mode analysed (--mode K, chosen and said as
+    every command chooses and says it): (its position result, q)."""
+    q0 = mech.generic_configurations()[0].q
+    solver = input_solver(mech, values, held, output=args.output)
+    q, k, n, pres = choose_mode(solver, values, args.mode, near=near if (near or given or held) else
+                                mech.joint_values(q0), rates=rates, accels=accels, points=points)
+    if n > 1:
+        data["mode"] = {"index": k, "of": n}
+        print(f"note: {mode_line(k, n)}", file=sys.stderr)
+    if pres.free_dofs:  # a continuum: a sample of it, said as choose_mode says it
+        data["continuum"] = {"free_dofs": pres.free_dofs}
+        print(f"note: {pres.notes[-1]}", file=sys.stderr)
+    data["solve"] = position_dict(pres)
+    data["solve"]["characteristic_length"] = mech.length  # as solve --json writes it
+    return pres, q
+
+
+def _configuration_text(mech: Mechanism, names: list[str], values: dict[str, float], given: dict[str, float],
+                        held: dict[str, float]) -> str:
+    """The configuration analysed in words ('crank = 30 deg, angle of coupler = ...')."""
+    if not (names or held):
+        return "the file's assembled configuration"
     units = {n: ("rad" if not mech.translational[mech.coordinate_names.index(n)] else "m") for n in names}
-    configuration = (", ".join([value_label(n, v, units[n]) for n, v in values.items()]
-                               + [f"angle of {value_label(k, v, 'rad')}" for k, v in held.items()])
-                     + ("" if given or held else " (the file's values)")) if names or held \
-        else "the file's assembled configuration"
-    data["configuration"] = values
+    return (", ".join([value_label(n, v, units[n]) for n, v in values.items()]
+                      + [f"angle of {value_label(k, v, 'rad')}" for k, v in held.items()])
+            + ("" if given or held else " (the file's values)"))
 
-    # ---- topology, counts, mobility, drawings of the configuration
+
+def _topology(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names: list[str], configuration: str,
+              topo: Topology, notes: dict[str, str], data: dict) -> Section:
+    """The topology section: the counts and mobility, the skeleton at the configuration (and a synthesized
+    design's targets), the kinematic chain."""
     mob = _attempt(notes, "mobility", lambda: analyze_mobility(mech, output=args.output, suggest=True))
     if mob is not None:
         data["mobility"] = mobility_dict(mob)
@@ -211,9 +223,12 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if chain is not None:
         figures.append(Figure(figure_bytes(draw_chain(chain)), "svg", "kinematic chain: links as nodes, joints as "
                                                                       "edges", "chain"))
-    sections.append(topology_section(topo, mob, figures))
+    return topology_section(topo, mob, figures)
 
-    # ---- equations
+
+def _equations(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names: list[str], held: dict[str, float],
+               topo: Topology, notes: dict[str, str], data: dict) -> tuple[VectorLoops | None, object, Section]:
+    """(the planar vector loops or None, the equations or None, their section)."""
     loops = eq = None
     if topo.motion_space == "planar":
         loops = _attempt(notes, "equations", lambda: VectorLoops(mech, q, names or None, links=list(held)))
@@ -221,34 +236,85 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     else:
         output = args.output or (default_output(mech, names[0], q) if names and not mech.cuts else None)
         eq = _attempt(notes, "equations", lambda: equations(mech, q, names, output=output))
-    if eq is not None:
-        sections.append(equations_section(eq))
-        data["equations"] = equations_dict(eq)
-    else:
-        sections.append(note_section("equations", "Equations", f"no equations: {notes.get('equations')}"))
+    if eq is None:
+        return loops, eq, note_section("equations", "Equations", f"no equations: {notes.get('equations')}")
+    data["equations"] = equations_dict(eq)
+    return loops, eq, equations_section(eq)
 
-    # ---- Newton from an estimate
-    sections.append(_newton(mech, args, loops, q, values, names, notes, data, held))
 
-    # ---- positions, velocities, accelerations
-    if pres is not None:
-        given_rates = "input rates " + _input_rates_text(mech, typed["rate"], rates) + \
-                      (", input accelerations as given" if accels else ", input accelerations 0")
-        rate_units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())  # the units typed
-        sections.append(motion_section(pres, given_rates, mech.length, rate_units, data.get("mode", {}).get("index", 1)))
-    else:
-        sections.append(note_section("motion", "Positions, velocities and accelerations",
-                                     "no input joint (none declared actuated, none given with --input or --set): "
-                                     "nothing to solve for" + (" (the --point values need a solution)" if points else "")))
+def _motion_section(mech: Mechanism, pres: PositionResult | None, typed: dict[str, dict], rates: dict[str, float],
+            accels: dict[str, float] | None, points: tuple, data: dict) -> Section:
+    """The positions, velocities and accelerations section."""
+    if pres is None:
+        return note_section("motion", "Positions, velocities and accelerations",
+                            "no input joint (none declared actuated, none given with --input or --set): "
+                            "nothing to solve for" + (" (the --point values need a solution)" if points else ""))
+    given_rates = "input rates " + _input_rates_text(mech, typed["rate"], rates) + \
+                  (", input accelerations as given" if accels else ", input accelerations 0")
+    rate_units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())  # the units typed
+    return motion_section(pres, given_rates, mech.length, rate_units, data.get("mode", {}).get("index", 1))
 
-    # ---- singular configurations and the sweep
+
+def _write_markdown(path: str, doc: Document) -> None:
+    """The Markdown document and its pictures in ``STEM_files/`` beside it: all or nothing (its pictures, and
+    their folder when made here, go when one cannot be written)."""
+    stem = os.path.splitext(os.path.basename(path))[0] or "report"
+    folder = f"{stem}_files"
+    text, files = markdown(doc, folder)
+    where = os.path.join(os.path.dirname(path), folder)
+    made = not os.path.isdir(where)
+    try:
+        os.makedirs(where, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(where, os_reason(exc)) from None
+    pictures = []
+    try:
+        for name, blob in files.items():
+            pictures.append(os.path.join(where, name))
+            write_output(pictures[-1], blob)
+        write_output(path, text.encode("utf-8"))
+    except OutputError:
+        for picture in pictures:
+            remove_partial(picture)
+        if made:
+            try:
+                os.rmdir(where)
+            except OSError:
+                pass
+        raise
+
+
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
+    _check_args(mech, args)
+    # --set-angle of a link pinned to the ground is its joint's value; of a floating link (held), one more
+    # loop equation: its angle is an input of the positions, the equations and Newton (not of the sweep)
+    given, held, pivots = split_inputs(mech, args)
+    names = _report_inputs(mech, args, given)
+    near = near_values(mech, args)
+    q0 = mech.generic_configurations()[0].q
+    if args.output:
+        mech.link_frame(args.output)
+    points = named_points(mech, args)
+    typed, rates, accels = _rates(mech, args, names, held, pivots)
+    notes: dict[str, str] = {}
+    data: dict = {"file": str(mech.path), "screwkin": screwkin_version()}
+    # ---- the configuration: solved for the inputs (their file values when none are set)
+    pres, q = None, q0
+    values = {n: given.get(n, mech.joint_values(q0)[n]) for n in names}
+    if names or held:
+        pres, q = _solve_configuration(mech, args, values, near, given, held, rates, accels, points, data)
+    topo = mech.topology(q)
+    configuration = _configuration_text(mech, names, values, given, held)
+    data["configuration"] = values
+    sections = [_topology(mech, args, q, names, configuration, topo, notes, data)]
+    loops, eq, section = _equations(mech, args, q, names, held, topo, notes, data)
+    sections.append(section)
+    sections.append(_newton(mech, args, loops, q, values, names, notes, data, held))  # from an estimate
+    sections.append(_motion_section(mech, pres, typed, rates, accels, points, data))
     sections += _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held,
                                     typed_rates={pivots[k][0] if k in pivots else k: v
                                                  for k, v in typed["rate"].items()})
-
-    # ---- the view
     sections.append(_view(mech, args, q, data))
-
     facts = [("file", str(mech.path)), ("screwkin", screwkin_version()), ("configuration", configuration),
              ("inputs", ", ".join(names) or "none"), ("motion space", topo.motion_space)]
     if args.output:
@@ -260,30 +326,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
         write_output(args.html, html(doc).encode("utf-8"))
         written.append(args.html)
     if args.md:
-        stem = os.path.splitext(os.path.basename(args.md))[0] or "report"
-        folder = f"{stem}_files"
-        text, files = markdown(doc, folder)
-        where = os.path.join(os.path.dirname(args.md), folder)
-        made = not os.path.isdir(where)
-        try:
-            os.makedirs(where, exist_ok=True)
-        except OSError as exc:
-            raise OutputError(where, os_reason(exc)) from None
-        pictures = []
-        try:
-            for name, blob in files.items():
-                pictures.append(os.path.join(where, name))
-                write_output(pictures[-1], blob)
-            write_output(args.md, text.encode("utf-8"))
-        except OutputError:  # a document is all or nothing: its pictures, and their folder when made here, go too
-            for path in pictures:
-                remove_partial(path)
-            if made:
-                try:
-                    os.rmdir(where)
-                except OSError:
-                    pass
-            raise
+        _write_markdown(args.md, doc)
         written.append(args.md)
     if args.json:
         print(json_of({"file": str(mech.path), "written": written, "sections": [s.id for s in sections],
@@ -296,14 +339,14 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
+def _input_rates_text(mech, typed: dict, rates) -> str:
     """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``; ``typed``: joint_quantities of
     --rate), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
     if not typed:
         return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
 
-    def shown(n: int, v) -> str:
+    def shown(n, v):
         q = typed.get(n)
         if q is None or q.shown_unit in ("", si[n]):
             return f"{n} = {v:.6g} {si[n]}"
@@ -312,7 +355,7 @@ def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np.ndarray, values: dict, names, notes, data, held=None) -> Section:
+def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
@@ -350,7 +393,7 @@ def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates: dict | None = None) -> list:
+def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held=None, typed_rates=None):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -410,7 +453,7 @@ def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray
     return out
 
 
-def _view(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, data) -> Section:
+def _view(mech, args, q, data):
     if args.no_view:
         return view_section(None, "the view is left out (--no-view)")
     if chromium() is None:

@@ -6,12 +6,12 @@ from __future__ import annotations
 from ..analysis.singularities.ellipsoids import ellipsoids, with_input_output_condition
 from ..analysis.singularities.gram_symbolic import symbolic_gram
 from ..analysis.local import local_analysis
-from ..analysis.singularities.singular import classify, named_types
+from ..analysis.singular import classify, named_types
 from ..errors import UsageError
 from ..present.jsonout import json_of
 from ..present.ellipsoids import ellipsoids_dict, ellipsoids_text
 from ..present.local import local_dict, local_lines, types_lines
-from ..present.report import singularity_dict, singularity_text
+from ..present.singular import singularity_dict, singularity_text
 from ..present.screws import gram_symbolic_dict, gram_symbolic_text
 from ._configuration import add_configuration_options, configuration, with_mode
 from ._output_frame import add_tool_option, output_frame, output_frame_dict, output_frame_line

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+from typing import TYPE_CHECKING, Any
 
 from ..analysis.motion.links import motion_along, strokes, sweep_motion
 from ..analysis.motion.planar import LinkAngles, identify, transmission_angles
@@ -42,11 +43,11 @@ from ._configuration import (
 from ._output_frame import named_points
 from ._values import check_rate_names, joint_quantities, joint_value, names_list, rate_items, split_inputs
 from ._options import BOUNDS, count
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from collections.abc import Callable
+    from ..analysis.position.position import PositionSolver
+    from ..analysis.motion.sweep import SweepResult
+    from ..model.mechanism import Mechanism
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -54,7 +55,7 @@ NAME = "sweep"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub, common, scaled):
     sp = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint to move")
@@ -90,7 +91,7 @@ def add_parser(sub, common: Callable, scaled: Callable) -> None:
     scaled(sp)
 
 
-def _steps(text: str) -> int:
+def _steps(text):
     """--steps: within BOUNDS["steps"], or BOUNDS["streamed_steps"] for a streamed sweep (checked again in run)."""
     lo, hi = BOUNDS["steps"]
     try:
@@ -107,7 +108,7 @@ _NOT_STREAMED = (("json", "--json"), ("plot", "--plot"), ("singularities", "--si
                  ("rows", "--rows"))
 
 
-def _streamed(args: argparse.Namespace) -> bool:
+def _streamed(args) -> bool:
     """Whether this sweep is computed and written in chunks; refuses what a streamed sweep cannot do."""
     lo, hi = BOUNDS["steps"]
     if args.chunk is None and args.steps <= hi:
@@ -123,7 +124,7 @@ def _streamed(args: argparse.Namespace) -> bool:
     return True
 
 
-def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop, fixed, q_start, rate) -> int:
+def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None
@@ -165,7 +166,7 @@ def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop
     return 0
 
 
-def _rates_line(args: argparse.Namespace) -> str:
+def _rates_line(args) -> str:
     """The line that says what the rates and accelerations written are for (the input's rate)."""
     if args.rate:
         return f"rates and accelerations {args.rate_words}, held constant"
@@ -173,13 +174,78 @@ def _rates_line(args: argparse.Namespace) -> str:
             "another speed), at a constant input rate")
 
 
-def _rows_option(text: str) -> str:
+def _rows_option(text):
     if text is None or text.strip().lower() == "all":
         return None if text is None else "all"
     try:
         return count("figure_steps")(text)
     except argparse.ArgumentTypeError as exc:
         raise UsageError(f"--rows: {exc} (or all)") from None
+
+
+def _singularities(args: argparse.Namespace, solver: PositionSolver, res: SweepResult) -> list:
+    """The limit positions met, and with --singularities every singularity along the motion located (the
+    configuration space's own, change points and shaky points, from analysis.local)."""
+    sing = list(res.limits)  # the limit positions met are always listed
+    if args.singularities:
+        sing = locate_singularities(solver, res, output=args.output, point=args.point)
+        sing = sorted(sing + [SweepSingularity("constraint", p.input, p.sigma, p.q, point=p)
+                              for p in change_points(solver, res, sing) if p.located], key=lambda x: x.input)
+    return sing
+
+
+def _sweep_json(mech: Mechanism, args: argparse.Namespace, res: SweepResult, info: Any, mus: list | None,
+                sing: list, motion: Any, slider_strokes: Any, held: dict[str, float], rate: float) -> dict:
+    """sweep --json's object."""
+    d = with_mode(args, sweep_dict(res, mech))
+    d["input_rate"], d["rates_are"] = rate, args.rate_words  # SI; "per 1 rad/s of crank" or "at crank 60 rpm"
+    if info is not None:
+        d["linkage"] = linkage_dict(info)
+        d["transmission_angles"] = mus
+    d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
+    for entry, x in zip(d["singularities"], sing):  # what the configuration space does there
+        if x.point is not None:
+            entry.update({k: v for k, v in change_point_dict(x.point).items() if k not in ("input", "sigma")})
+    # the change points passed: where, what the configuration space does there, the branch taken
+    d["change_points"] = [{**change_point_dict(cp), "branch": "other" if cp.switched else "continue", "note": line}
+                          for cp, line in zip(res.change_points, res.change_point_notes)]
+    d["characteristic_length"] = mech.length
+    d.update(motion_dict(motion))
+    d["strokes"] = strokes_dict(slider_strokes)
+    if held:
+        d["held_angles"] = held  # as solve --json: link -> absolute angle [rad] held along the motion
+    return d
+
+
+def _print_text(mech: Mechanism, args: argparse.Namespace, res: SweepResult, info: Any, mus: list | None,
+                sing: list, motion: Any, slider_strokes: Any, held: dict[str, float], typed_range: list,
+                units: RateUnits | None) -> None:
+    """sweep's text: the table of the motion, the rates, strokes, notes, the links' motion and the singularities."""
+    rows = sweep_rows(len(res.values), _rows_option(args.rows))
+    typed_deg = any(q.kind == "angle" and q.shown_unit == "deg" for q in typed_range)
+    linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
+        else []
+    for link, angle in held.items():
+        print(f"held along the motion: the angle of {link} = {angle:.9g} rad ({math.degrees(angle):.6g} deg)")
+    print(sweep_text(res, info, mus, rows=_rows_option(args.rows), degrees=typed_deg and res.unit == "rad",
+                     linear_names=linear_names))
+    print(_rates_line(args))
+    for line in strokes_text(slider_strokes, res.unit == "rad"):
+        print(line)
+    for n in res.notes:
+        print(f"note: {n}")
+    table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad", units)
+    if table_text:
+        print()
+        print(table_text)
+    if args.singularities:
+        print(f"\nsingularities along the motion (L = {mech.length:.4g} m):" if sing
+              else "\nno singularity along the motion")
+        for x in sing:
+            print(f"  {x.kind:<10} at {res.input} = {value_text(res.input, x.input, res.unit == 'rad')}, "
+                  f"relative sigma {x.sigma:.2g}" + ("  (limit position)" if x.limit else ""))
+            if x.point is not None:
+                print("\n".join(change_point_lines(x.point, "this configuration")))
 
 
 def run(mech: Mechanism, args: argparse.Namespace) -> int:
@@ -220,12 +286,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     mus = None
     if info is not None:
         mus = transmission_angles(mech, info, res.q).tolist()
-    sing = list(res.limits)  # the limit positions met are always listed
-    if args.singularities:
-        sing = locate_singularities(solver, res, output=args.output, point=args.point)
-        # the configuration space's own singularities (change points, shaky points): analysis.local
-        sing = sorted(sing + [SweepSingularity("constraint", p.input, p.sigma, p.q, point=p)
-                              for p in change_points(solver, res, sing) if p.located], key=lambda x: x.input)
+    sing = _singularities(args, solver, res)
     if args.csv or args.parquet:
         with SweepWriter(args.csv, args.parquet) as out:
             out.write(res, motion)
@@ -236,48 +297,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
                    title=f"{os.path.basename(mech.path)}: {args.input} from {args.start} to {args.stop}, "
                          f"{args.rate_words}", rate_words=args.rate_words, units=units)
     if args.json:
-        d = with_mode(args, sweep_dict(res, mech))
-        d["input_rate"], d["rates_are"] = rate, args.rate_words  # SI; "per 1 rad/s of crank" or "at crank 60 rpm"
-        if info is not None:
-            d["linkage"] = linkage_dict(info)
-            d["transmission_angles"] = mus
-        d["singularities"] = [sweep_singularity_dict(x, mech) for x in sing]
-        for entry, x in zip(d["singularities"], sing):  # what the configuration space does there
-            if x.point is not None:
-                entry.update({k: v for k, v in change_point_dict(x.point).items() if k not in ("input", "sigma")})
-        # the change points passed: where, what the configuration space does there, the branch taken
-        d["change_points"] = [{**change_point_dict(cp), "branch": "other" if cp.switched else "continue", "note": line}
-                              for cp, line in zip(res.change_points, res.change_point_notes)]
-        d["characteristic_length"] = mech.length
-        d.update(motion_dict(motion))
-        d["strokes"] = strokes_dict(slider_strokes)
-        if held:
-            d["held_angles"] = held  # as solve --json: link -> absolute angle [rad] held along the motion
-        print(json_of(d))
+        print(json_of(_sweep_json(mech, args, res, info, mus, sing, motion, slider_strokes, held, rate)))
     else:
-        rows = sweep_rows(len(res.values), _rows_option(args.rows))
-        typed_deg = any(q.kind == "angle" and q.shown_unit == "deg" for q in typed_range)
-        linear_names = [n for k, n in enumerate(res.names) if mech.translational[k]] if len(res.names) == mech.nv \
-            else []
-        for link, angle in held.items():
-            print(f"held along the motion: the angle of {link} = {angle:.9g} rad ({math.degrees(angle):.6g} deg)")
-        print(sweep_text(res, info, mus, rows=_rows_option(args.rows), degrees=typed_deg and res.unit == "rad",
-                         linear_names=linear_names))
-        print(_rates_line(args))
-        for line in strokes_text(slider_strokes, res.unit == "rad"):
-            print(line)
-        for n in res.notes:
-            print(f"note: {n}")
-        table_text = motion_rows_text(res, motion, rows, typed_deg and res.unit == "rad", units)
-        if table_text:
-            print()
-            print(table_text)
-        if args.singularities:
-            print(f"\nsingularities along the motion (L = {mech.length:.4g} m):" if sing
-                  else "\nno singularity along the motion")
-            for x in sing:
-                print(f"  {x.kind:<10} at {res.input} = {value_text(res.input, x.input, res.unit == 'rad')}, "
-                      f"relative sigma {x.sigma:.2g}" + ("  (limit position)" if x.limit else ""))
-                if x.point is not None:
-                    print("\n".join(change_point_lines(x.point, "this configuration")))
+        _print_text(mech, args, res, info, mus, sing, motion, slider_strokes, held, typed_range, units)
     return 0

@@ -10,9 +10,9 @@ import signal
 import sys
 import tempfile
 
-from ..analysis.motion.interactive import Interactive
-from ..analysis.motion.position import PositionSolver
-from ..analysis.singularities.singular import classify
+from ..analysis.position.interactive import Interactive
+from ..analysis.position.position import PositionSolver
+from ..analysis.singular import classify
 from ..analysis.motion.singular_points import locate_singularities
 from ..analysis.motion.sweep import sweep, sweep_inputs
 from ..present.outfile import write_output

@@ -1,5 +1,5 @@
 """Where screwkin keeps the generic solution sets of the mechanisms it has solved (the start systems of
-analysis.motion.generic_modes' parameter homotopy), and how they are read back.
+model.homotopy.parameter's homotopy), and how they are read back.
 
 The folder: ``$SCREWKIN_CACHE`` if set, else ``$XDG_CACHE_HOME/screwkin/generic`` (``~/.cache/screwkin/
 generic`` when XDG_CACHE_HOME is not set).  One JSON file per architecture, named by the SHA-256 of the

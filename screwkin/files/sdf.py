@@ -14,6 +14,10 @@ with ``use_parent_model_frame`` / ``expressed_in="__model__"``).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pinocchio as pin
 
@@ -26,12 +30,15 @@ from .xmlsafe import parse_xml_text
 
 __all__ = ["read_sdf"]
 
+if TYPE_CHECKING:
+    from xml.etree.ElementTree import Element
+
 _TYPES = {"revolute", "continuous", "prismatic", "fixed", "ball", "universal", "revolute2"}
 _CUT = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed",
         "ball": "spherical", "universal": "universal", "revolute2": "universal"}
 
 
-def _pose(elem, what: str, problems: list):
+def _pose(elem, what, problems):
     if elem is None or not (elem.text or "").strip():
         return pin.SE3.Identity()
     rel = elem.get("relative_to")
@@ -49,7 +56,7 @@ def _pose(elem, what: str, problems: list):
     return pin.SE3(pin.rpy.rpyToMatrix(np.array(rpy)), np.array(xyz))
 
 
-def _vec(text: str, what: str, problems: list) -> np.ndarray:
+def _vec(text, what, problems):
     before = len(problems)
     v = numbers((text or "").strip() or "?", 3, what, problems, (1.0, 0, 0))
     if len(problems) > before:
@@ -57,7 +64,7 @@ def _vec(text: str, what: str, problems: list) -> np.ndarray:
     return np.array(unit_axis(v, what, problems))
 
 
-def _axis_element(joint, tag: str, name: str, X_joint, problems: list):
+def _axis_element(joint, tag, name, X_joint, problems):
     a = joint.find(tag)
     if a is None:
         return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])
@@ -68,7 +75,7 @@ def _axis_element(joint, tag: str, name: str, X_joint, problems: list):
     return X_joint.rotation.T @ v if model_frame else v
 
 
-def _spanning_tree(links: dict, edges: list, ground) -> dict:
+def _spanning_tree(links, edges, ground) -> dict:
     """The breadth-first spanning tree from ``ground`` of the graph of ``links`` joined by
     ``edges`` (parent, child) (a multigraph: two joints may join the same links): joint
     index -> (link towards the ground, link away from it), in the order reached; of parallel
@@ -82,20 +89,8 @@ def _spanning_tree(links: dict, edges: list, ground) -> dict:
     return {min(graph[link][other]): (link, other) for link, other in nx.bfs_edges(graph, ground)}
 
 
-def read_sdf(path, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
-    """Read an SDF file (already loaded as ``text``, parsed as ``root`` when given)."""
-    if root is None:
-        root = parse_xml_text(text, path)
-    if root.tag != "sdf":
-        raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>")
-    model = root.find("model")
-    if model is None:
-        model = root.find("world/model")
-    if model is None:
-        raise MechanismFileError(path, "the SDF file has no <model>")
-    link_elems, joint_elems = model.findall("link"), model.findall("joint")
-    check_sizes(path, len(link_elems), len(joint_elems), 0)
-    problems = []
+def _read_links(link_elems: list[Element], problems: list[str]) -> tuple[dict[str, LinkSpec], dict[str, pin.SE3]]:
+    """(link name -> its LinkSpec, link name -> its pose in the model) of the <link>s."""
     links, poses = {}, {}
     for e in link_elems:
         name = e.get("name")
@@ -108,6 +103,13 @@ def read_sdf(path, text: str, root=None, package_dirs: list | tuple = ()) -> Mec
                            "kg", low=0.0)[0]
         links[name] = LinkSpec(name, mass, e.find("visual") is not None or e.find("collision") is not None)
         poses[name] = _pose(e.find("pose"), f"link {quote(name)}", problems)
+    return links, poses
+
+
+def _read_joints(joint_elems: list[Element], links: dict[str, LinkSpec],
+                 problems: list[str]) -> list[tuple[str, str, str, str, Element]]:
+    """(name, type, parent, child, element) of every well-formed <joint>; what is wrong with the others in
+    ``problems``."""
     raw = []
     seen = set()
     for e in joint_elems:
@@ -137,6 +139,63 @@ def read_sdf(path, text: str, root=None, package_dirs: list | tuple = ()) -> Mec
             bad = True
         if not bad:
             raw.append((name, jtype, parent, child, e))
+    return raw
+
+
+def _tree_joint(n: str, jt: str, parent: str, child: str, origin: pin.SE3, a1: np.ndarray, a2: np.ndarray,
+                spec_links: dict[str, LinkSpec], out: list[str], joints: list[JointSpec]) -> None:
+    """A joint of the spanning tree (oriented from ``parent`` to ``child``, at ``origin`` in the parent) as URDF
+    text and JointSpecs: a ball, universal or revolute2 joint as a chain of revolutes through dummy links."""
+    if jt in ("ball", "universal", "revolute2"):
+        chain = [np.eye(3)[0], np.eye(3)[1], np.eye(3)[2]] if jt == "ball" else [a1, a2]
+        prev = parent
+        for i, ax in enumerate(chain):
+            nxt = child if i == len(chain) - 1 else f"{n}__dummy{i}"
+            if nxt != child:
+                spec_links[nxt] = LinkSpec(nxt, None, False)
+                out.append(f"<link name={quoteattr(nxt)}/>")
+            o = origin_text(origin) if i == 0 else '<origin xyz="0 0 0" rpy="0 0 0"/>'
+            jn = f"{n}__{i}"
+            out.append(f'<joint name={quoteattr(jn)} type="revolute"><parent link={quoteattr(prev)}/>'
+                       f'<child link={quoteattr(nxt)}/>{o}<axis xyz="{vector_text(*ax)}"/>'
+                       f'<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/></joint>')
+            joints.append(JointSpec(jn, "revolute", prev, nxt, tuple(origin.translation) if i == 0 else (0, 0, 0),
+                                    tuple(pin.rpy.matrixToRpy(origin.rotation)) if i == 0 else (0, 0, 0), tuple(ax)))
+            prev = nxt
+        return
+    urdf_type = "revolute" if jt == "continuous" else jt
+    limit = '<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/>' if jt != "fixed" else ""
+    out.append(f'<joint name={quoteattr(n)} type="{urdf_type}"><parent link={quoteattr(parent)}/>'
+               f'<child link={quoteattr(child)}/>{origin_text(origin)}<axis xyz="{vector_text(*a1)}"/>{limit}</joint>')
+    joints.append(JointSpec(n, urdf_type, parent, child, tuple(origin.translation),
+                            tuple(pin.rpy.matrixToRpy(origin.rotation)), tuple(a1)))
+
+
+def _link_xml(link: LinkSpec) -> str:
+    """A link's URDF text, with its mass (a tiny inertia: the SDF's is not read)."""
+    mass = link.mass
+    inertial = (f'<inertial><mass value="{mass:.17g}"/><inertia ixx="1e-9" iyy="1e-9" izz="1e-9" '
+                f'ixy="0" ixz="0" iyz="0"/></inertial>') if mass else ""
+    return f"<link name={quoteattr(link.name)}>{inertial}</link>"
+
+
+def read_sdf(path: str | Path, text: str, root: Element | None = None,
+             package_dirs: Iterable[str | Path] = ()) -> MechanismSpec:
+    """Read an SDF file (already loaded as ``text``, parsed as ``root`` when given)."""
+    if root is None:
+        root = parse_xml_text(text, path)
+    if root.tag != "sdf":
+        raise MechanismFileError(path, f"not an SDF file: the root element is <{shorten(root.tag, 40)}>")
+    model = root.find("model")
+    if model is None:
+        model = root.find("world/model")
+    if model is None:
+        raise MechanismFileError(path, "the SDF file has no <model>")
+    link_elems, joint_elems = model.findall("link"), model.findall("joint")
+    check_sizes(path, len(link_elems), len(joint_elems), 0)
+    problems: list[str] = []
+    links, poses = _read_links(link_elems, problems)
+    raw = _read_joints(joint_elems, links, problems)
     if problems:
         raise MechanismFileError(path, problems)
     if any(p == "world" for _, _, p, _, _ in raw):
@@ -163,44 +222,13 @@ def read_sdf(path, text: str, root=None, package_dirs: list | tuple = ()) -> Mec
     check_sizes(path, len(links), len(raw), len(raw) - len(tree), sum(dof[raw[k][1]] for k in tree))
     out = [f'<robot name={quoteattr(model.get("name") or "sdf_model")}>']
     spec_links = dict(links)
-    joints, cuts = [], []
-
-    def link_xml(name: str) -> str:
-        mass = spec_links[name].mass
-        inertial = (f'<inertial><mass value="{mass:.17g}"/><inertia ixx="1e-9" iyy="1e-9" izz="1e-9" '
-                    f'ixy="0" ixz="0" iyz="0"/></inertial>') if mass else ""
-        return f"<link name={quoteattr(name)}>{inertial}</link>"
-
-    for name in links:
-        out.append(link_xml(name))
+    joints: list[JointSpec] = []
+    cuts = []
+    out.extend(_link_xml(link) for link in links.values())
     for k in sorted(tree):
-        n, jt, p, c, _ = raw[k]
+        n, jt = raw[k][:2]
         parent, child = tree[k]  # oriented away from the ground
-        origin = frame[parent].inverse() * joint_pose[n]
-        a1, a2 = axes[n]
-        if jt in ("ball", "universal", "revolute2"):
-            chain = [np.eye(3)[0], np.eye(3)[1], np.eye(3)[2]] if jt == "ball" else [a1, a2]
-            prev = parent
-            for i, ax in enumerate(chain):
-                nxt = child if i == len(chain) - 1 else f"{n}__dummy{i}"
-                if nxt != child:
-                    spec_links[nxt] = LinkSpec(nxt, None, False)
-                    out.append(f"<link name={quoteattr(nxt)}/>")
-                o = origin_text(origin) if i == 0 else '<origin xyz="0 0 0" rpy="0 0 0"/>'
-                jn = f"{n}__{i}"
-                out.append(f'<joint name={quoteattr(jn)} type="revolute"><parent link={quoteattr(prev)}/>'
-                           f'<child link={quoteattr(nxt)}/>{o}<axis xyz="{vector_text(*ax)}"/>'
-                           f'<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/></joint>')
-                joints.append(JointSpec(jn, "revolute", prev, nxt, tuple(origin.translation) if i == 0 else (0, 0, 0),
-                                        tuple(pin.rpy.matrixToRpy(origin.rotation)) if i == 0 else (0, 0, 0), tuple(ax)))
-                prev = nxt
-            continue
-        urdf_type = "revolute" if jt == "continuous" else jt
-        limit = '<limit lower="-1e9" upper="1e9" effort="0" velocity="0"/>' if jt != "fixed" else ""
-        out.append(f'<joint name={quoteattr(n)} type="{urdf_type}"><parent link={quoteattr(parent)}/>'
-                   f'<child link={quoteattr(child)}/>{origin_text(origin)}<axis xyz="{vector_text(*a1)}"/>{limit}</joint>')
-        joints.append(JointSpec(n, urdf_type, parent, child, tuple(origin.translation),
-                                tuple(pin.rpy.matrixToRpy(origin.rotation)), tuple(a1)))
+        _tree_joint(n, jt, parent, child, frame[parent].inverse() * joint_pose[n], *axes[n], spec_links, out, joints)
     for k, (n, jt, p, c, _) in enumerate(raw):
         if k in tree:
             continue
@@ -211,7 +239,7 @@ def read_sdf(path, text: str, root=None, package_dirs: list | tuple = ()) -> Mec
                                  tuple(P2.translation), tuple(pin.rpy.matrixToRpy(P2.rotation)), tuple(a1),
                                  tuple(a2) if _CUT[jt] == "universal" else None, source="sdf"))
     out.append("</robot>")
-    meshes = []
+    meshes: list[str] = []
     warnings = check_meshes(path, model, package_dirs, meshes)
     return MechanismSpec(path=str(path), name=model.get("name") or "sdf_model", format="sdf", files_read=meshes,
                          urdf_text="\n".join(out), links=spec_links, joints=joints, cut_joints=cuts,

@@ -8,6 +8,7 @@ and nesting, and every field's type is checked before it is used.
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +40,7 @@ def _replacement_type(t) -> str | None:
     return None
 
 
-def _string_list(content: dict, key: str, problems: Problems, what: str = "joint names") -> list | None:
+def _string_list(content, key, problems, what="joint names"):
     """content[key] as a list of strings (None when absent), with a problem for anything else."""
     value = content.get(key)
     if value is None:
@@ -56,17 +57,8 @@ def _string_list(content: dict, key: str, problems: Problems, what: str = "joint
     return out
 
 
-def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, frame_body: dict | None=None) -> None:
-    """Add the loops, actuation and joint replacements of an Extended-URDF sidecar.
-
-    ``frame_names`` are the frames of the Pinocchio model of the tree: the YAML
-    names frames, not links.  ``frame_body`` (optional) maps a frame name to the
-    Pinocchio joint that carries it: a pair of frames on the same body closes no loop.
-
-    The YAML is untrusted: at most ``LIMITS.yaml_bytes``, UTF-8, no aliases (no
-    "billion laughs"), no tags beyond plain data, and every field's type checked.
-    """
-
+def _load_mapping(yaml_path: Path) -> dict:
+    """The sidecar's content: a mapping (empty for an empty file), read bounded and without aliases."""
     raw = read_regular_file(yaml_path, LIMITS.yaml_bytes, "YAML sidecar")
     try:
         text = raw.decode("utf-8-sig")
@@ -77,8 +69,12 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, f
         content = {}
     if not isinstance(content, dict):
         raise MechanismFileError(yaml_path, f"expected a mapping with closed_loop, type, name_mot, got {quote(content)}")
-    problems = Problems()
-    unknown = []  # notes on keys that are not the format's
+    return content
+
+
+def _unknown_keys(content: dict, problems: Problems) -> list[str]:
+    """Notes on the keys that are not the format's (a key that is not a name: a problem)."""
+    unknown = []
     known = ("closed_loop", "type", "name_mot", "joint_name", "joint_type")
     for key in content:
         if not isinstance(key, str):
@@ -88,6 +84,12 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, f
             close = difflib.get_close_matches(key, known, n=1)
             hint = f"did you mean {quote(close[0])}?" if close else f"known keys: {', '.join(known)}"
             unknown.append(f"unknown key {quote(key, 40)} ({hint})")
+    return unknown
+
+
+def _read_loops(spec: MechanismSpec, content: dict, yaml_path: Path, frame_names: Iterable[str],
+                frame_body: dict | None, problems: Problems) -> None:
+    """The closed_loop pairs (with their type) as cut joints of ``spec``."""
     pairs = content.get("closed_loop")
     pairs = [] if pairs is None else pairs
     if not isinstance(pairs, list):
@@ -125,6 +127,10 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, f
         spec.cut_joints.append(
             CutJointSpec(name=f"{a}~{b}", type=_YAML_TYPES[ctype.lower()], frame1=a, frame2=b, source="yaml")
         )
+
+
+def _read_actuation(spec: MechanismSpec, content: dict, problems: Problems) -> None:
+    """The actuated joints (name_mot) and the joint replacements (joint_name, joint_type) of ``spec``."""
     joint_types = {j.name: j.type for j in spec.joints}
     names = _string_list(content, "name_mot", problems)
     if names is not None:
@@ -157,6 +163,24 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, f
                                 "must name a moving joint")
             continue
         spec.replacements.append((n, canonical))
+
+
+def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: Iterable[str],
+                      frame_body: dict | None = None) -> None:
+    """Add the loops, actuation and joint replacements of an Extended-URDF sidecar.
+
+    ``frame_names`` are the frames of the Pinocchio model of the tree: the YAML
+    names frames, not links.  ``frame_body`` (optional) maps a frame name to the
+    Pinocchio joint that carries it: a pair of frames on the same body closes no loop.
+
+    The YAML is untrusted: at most ``LIMITS.yaml_bytes``, UTF-8, no aliases (no
+    "billion laughs"), no tags beyond plain data, and every field's type checked.
+    """
+    content = _load_mapping(yaml_path)
+    problems = Problems()
+    unknown = _unknown_keys(content, problems)
+    _read_loops(spec, content, yaml_path, frame_names, frame_body, problems)
+    _read_actuation(spec, content, problems)
     if problems:  # the misspelt key is likely the cause (closed_loops: then "0 pairs but type has 1")
         problems[:0] = unknown
     problems.fail_if_any(yaml_path)
@@ -164,8 +188,7 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: list, f
     spec.yaml_path = str(yaml_path)
 
 
-
-def axis_letters(t: str) -> tuple[np.ndarray, np.ndarray]:
+def axis_letters(t: str):
     unit = {"X": (1.0, 0, 0), "Y": (0, 1.0, 0), "Z": (0, 0, 1.0)}
     letters = t.split("_", 1)[1] if "_" in t else "XY"
     if len(letters) != 2 or any(c not in unit for c in letters):

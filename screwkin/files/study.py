@@ -33,7 +33,7 @@ from .xacro import declared_args, normalize_args
 from .xmlsafe import load_yaml_text, read_regular_file
 
 __all__ = ["DESIGN_TIMEOUT", "MAX_DESIGNS", "METRICS", "SAMPLINGS", "WORKSPACE_METRICS", "Parameter", "StudySpec",
-           "read_study_spec", "study_spec"]
+           "read_mechanism_text", "read_study_spec", "study_spec"]
 
 #: The metrics a study may ask for (what each computes: screwkin.analysis.design.study).
 METRICS = ("mobility", "grashof", "transmission_angle", "workspace_volume", "singularity_free_volume",
@@ -371,3 +371,13 @@ def read_study_spec(path) -> StudySpec:
     except MechanismFileError as exc:  # no such file, too big, malformed YAML: the request is at fault
         raise UsageError(str(exc)) from None
     return study_spec(data, str(path), path.parent)
+
+
+def read_mechanism_text(spec: StudySpec) -> str:
+    """The text of the study's mechanism file, read once (every design of the study sees the same file): a
+    regular file within LIMITS.file_bytes, UTF-8; a usage error naming the study otherwise."""
+    raw = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None

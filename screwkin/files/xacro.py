@@ -42,18 +42,21 @@ import math
 import os
 import re
 import threading
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
 
 from ..errors import MechanismFileError, UsageError, quote, shorten
 from ..units import parse_value
 from .description import LIMITS
 from .xacro_eval import MAX_STRING, XacroEvaluationError, check_expression, evaluate
 from .xmlsafe import inside_folder, parse_xml_text, read_regular_file
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from xml.dom.minidom import Element as MinidomElement
 
 __all__ = ["MAX_INCLUDES", "XacroInternalError", "declared_args", "expand", "is_xacro", "normalize_args", "parse_args"]
 
@@ -75,7 +78,7 @@ _GLOB = re.compile(r"[*?\[]")
 _LOCK = threading.Lock()
 
 
-def _xacro_tag(tag: str) -> str | None:
+def _xacro_tag(tag: str):
     """The local name of an element in the xacro namespace (ElementTree's ``{uri}name``), or None."""
     if tag.startswith("{"):
         uri, _, local = tag[1:].partition("}")
@@ -84,13 +87,13 @@ def _xacro_tag(tag: str) -> str | None:
     return None
 
 
-def is_xacro(path: Path | str, text: str) -> bool:
+def is_xacro(path, text: str) -> bool:
     """A xacro file: its name ends in ``.xacro`` or it declares the ``xacro`` namespace."""
     return str(path).lower().endswith(".xacro") or re.search(r"xmlns:xacro\s*=", text) is not None
 
 
 # ------------------------------------------------------------------ arguments
-def _arg_value(name: str, value: str | float, where: str) -> str:
+def _arg_value(name: str, value, where: str) -> str:
     """The text xacro receives for an argument: numbers as typed, values with a unit in SI
     (``30mm`` -> ``0.03``), other text as it is (bounded, printable)."""
     if isinstance(value, bool):
@@ -114,7 +117,7 @@ def _arg_value(name: str, value: str | float, where: str) -> str:
     return repr(number)
 
 
-def normalize_args(args: dict, where: str = "arguments") -> dict:
+def normalize_args(args, where: str = "arguments") -> dict:
     """{name: value} (numbers, text with units) -> {name: text for xacro}, names checked."""
     out = {}
     for name, value in dict(args or {}).items():
@@ -151,7 +154,7 @@ class _State:
     calls: int = 0
 
 
-def _check_text(text: str, path: Path, state: _State) -> None:
+def _check_text(text: str, path, state: _State) -> None:
     """Every ``${...}`` and ``$(...)`` of an attribute or text."""
     if not text or "$" not in text:
         return
@@ -171,7 +174,7 @@ def _check_text(text: str, path: Path, state: _State) -> None:
             raise MechanismFileError(path, str(exc)) from None
 
 
-def _check_extension(token: str, path: Path) -> None:
+def _check_extension(token: str, path) -> None:
     inner = token[2:-1]
     if _ARG.match(inner):
         return
@@ -191,7 +194,7 @@ def _include_path(spec: str, current: Path, path, state: _State) -> Path:
     return target
 
 
-def _read_file(target: Path, path, state: _State) -> tuple:
+def _read_file(target: Path, path, state: _State):
     """(text, ElementTree root) of an included file: bounded, checked, counted."""
     if len(state.files) >= MAX_INCLUDES:
         raise MechanismFileError(path, f"more than {MAX_INCLUDES} files included (refused)")
@@ -233,7 +236,7 @@ def _check_tree(root, path: Path, state: _State, follow: bool = True) -> None:
             _check_tree(sub, target, state)
 
 
-def _prepare(path: Path, text: str, root=None) -> _State:
+def _prepare(path, text, root=None) -> _State:
     path = Path(path)
     state = _State(path, Path(os.path.realpath(path.parent if str(path.parent) else ".")))
     state.files.append(path)
@@ -265,103 +268,119 @@ def _one_line(exc) -> str:
     return " when evaluating expression ".join(parts[:2]) or type(exc).__name__
 
 
-def _patched(xacro, state: _State, path: Path, evaluator=None) -> tuple:
-    """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
-    macro calls while expanding."""
-    original = {k: getattr(xacro, k) for k in ("safe_eval", "eval_extension", "get_include_files", "parse",
-                                                "handle_macro_call", "eval_all", "eval_text", "reqd_attrs")}
-    evaluator = evaluator or evaluate
+def _block_named(name: str, symbols: dict) -> MinidomElement | None:
+    """The block ``xacro:insert_block name=...`` inserts (a property block or a macro's block
+    parameter), or None."""
+    for key in ("**" + name, "*" + name):
+        if key in symbols:
+            block = symbols[key]
+            return block if hasattr(block, "getElementsByTagName") else None
+    return None
 
-    def safe_eval(expr, globals, locals=None):
+
+def _block_size(block: MinidomElement, symbols: dict, seen: frozenset[int], memo: dict[int, int]) -> int:
+    """Elements one copy of ``block`` expands to, its own insert_blocks expanded (capped)."""
+    size = 0
+    for elem in [block, *block.getElementsByTagName("*")] if block.nodeType == block.ELEMENT_NODE else []:
+        if elem.tagName != "xacro:insert_block":
+            size += 1
+            continue
+        inner = _block_named(elem.getAttribute("name"), symbols)
+        if inner is None or id(inner) in seen:
+            continue  # undefined (xacro says so) or inserted in itself (nested too deeply)
+        if id(inner) not in memo:
+            memo[id(inner)] = _block_size(inner, symbols, seen | {id(inner)}, memo)
+        size += memo[id(inner)]
+        if size > LIMITS.elements:
+            break
+    return size
+
+
+class _Patches:
+    """xacro's functions replaced while expanding ``path``: its evaluator (``evaluator``), substitutions,
+    includes and macro calls, each bounded and checked (the originals in ``original``)."""
+
+    NAMES = ("safe_eval", "eval_extension", "get_include_files", "parse", "handle_macro_call", "eval_all",
+             "eval_text", "reqd_attrs")
+
+    def __init__(self, xacro: ModuleType, state: _State, path: str | Path,
+                 evaluator: Callable[..., Any]) -> None:
+        self.xacro, self.state, self.path, self.evaluator = xacro, state, path, evaluator
+        self.original = {k: getattr(xacro, k) for k in self.NAMES}
+
+    def replaced(self) -> dict[str, Callable[..., Any]]:
+        """Name -> the function that replaces xacro's."""
+        return {k: getattr(self, k) for k in self.NAMES}
+
+    def safe_eval(self, expr: str, globals: dict, locals: dict | None = None) -> Any:
         try:
-            return evaluator(expr, globals)
+            return self.evaluator(expr, globals)
         except XacroEvaluationError as exc:  # xacro wraps it with "when evaluating expression ..."
-            raise xacro.XacroException(str(exc)) from None
+            raise self.xacro.XacroException(str(exc)) from None
 
-    def eval_extension(s):
+    def eval_extension(self, s: str) -> str:
+        path = self.path
         m = _ARG.match(s[2:-1])
         if not m:
             raise MechanismFileError(path, f"xacro substitution {quote(s, 60)} is refused: only $(arg NAME) is "
                                            "allowed")
-        known = xacro.substitution_args_context.get("arg", {})
+        known = self.xacro.substitution_args_context.get("arg", {})
         if m.group(1) not in known:
             raise MechanismFileError(path, f"xacro argument {quote(m.group(1))} has no value: give it "
                                            f"(--arg {m.group(1)}=VALUE) or declare it first with "
                                            f"<xacro:arg name=\"{m.group(1)}\" default=\"...\"/>")
         return known[m.group(1)]
 
-    def get_include_files(filename_spec, symbols):
+    def get_include_files(self, filename_spec: str, symbols: dict) -> Iterator[str]:
+        xacro, state = self.xacro, self.state
         spec = str(xacro.eval_text(filename_spec, symbols))
         current = Path(xacro.filestack[-1]) if xacro.filestack and xacro.filestack[-1] else state.top
-        yield str(_include_path(spec, current, path, state))
+        yield str(_include_path(spec, current, self.path, state))
 
-    def parse(inp, filename=None):
+    def parse(self, inp: Any, filename: str | None = None) -> Any:
         if inp is not None:
-            return original["parse"](inp, filename)
+            return self.original["parse"](inp, filename)
         target = Path(filename)
-        if not inside_folder(target, state.folder):  # pragma: no cover - get_include_files checked it
-            raise MechanismFileError(path, f"xacro:include {quote(str(filename), 60)} is outside the file's folder")
-        text, root = _read_file(target, path, state)
-        _check_tree(root, target, state, follow=False)
+        if not inside_folder(target, self.state.folder):  # pragma: no cover - get_include_files checked it
+            raise MechanismFileError(self.path, f"xacro:include {quote(str(filename), 60)} is outside the file's "
+                                                "folder")
+        text, root = _read_file(target, self.path, self.state)
+        _check_tree(root, target, self.state, follow=False)
         return _dom(text, target)
 
-    def block_named(name: str, symbols):
-        """The block ``xacro:insert_block name=...`` inserts (a property block or a macro's block
-        parameter), or None."""
-        for key in ("**" + name, "*" + name):
-            if key in symbols:
-                block = symbols[key]
-                return block if hasattr(block, "getElementsByTagName") else None
-        return None
-
-    def block_size(block, symbols, seen, memo):
-        """Elements one copy of ``block`` expands to, its own insert_blocks expanded (capped)."""
-        size = 0
-        for elem in [block, *block.getElementsByTagName("*")] if block.nodeType == block.ELEMENT_NODE else []:
-            if elem.tagName != "xacro:insert_block":
-                size += 1
-                continue
-            inner = block_named(elem.getAttribute("name"), symbols)
-            if inner is None or id(inner) in seen:
-                continue  # undefined (xacro says so) or inserted in itself (nested too deeply)
-            if id(inner) not in memo:
-                memo[id(inner)] = block_size(inner, symbols, seen | {id(inner)}, memo)
-            size += memo[id(inner)]
-            if size > LIMITS.elements:
-                break
-        return size
-
-    def eval_all(node, macros, symbols):
+    def eval_all(self, node: MinidomElement, macros: dict, symbols: dict) -> Any:
+        state = self.state
         child = node.firstChild
         while child is not None:
             if child.nodeType == child.ELEMENT_NODE and child.tagName == "xacro:insert_block":
-                block = block_named(child.getAttribute("name"), symbols)
+                block = _block_named(child.getAttribute("name"), symbols)
                 if block is not None:
-                    state.copied += block_size(block, symbols, frozenset({id(block)}), {})
+                    state.copied += _block_size(block, symbols, frozenset({id(block)}), {})
                     if state.copied > LIMITS.elements:
-                        raise MechanismFileError(path, f"xacro:insert_block copies expand to more than "
-                                                       f"{LIMITS.elements} elements (refused: blocks inserted in "
-                                                       "blocks double at each level)")
+                        raise MechanismFileError(self.path, f"xacro:insert_block copies expand to more than "
+                                                            f"{LIMITS.elements} elements (refused: blocks inserted "
+                                                            "in blocks double at each level)")
             child = child.nextSibling
-        return original["eval_all"](node, macros, symbols)
+        return self.original["eval_all"](node, macros, symbols)
 
-    def eval_text(text: str, symbols):
+    def eval_text(self, text: str, symbols: dict) -> Any:
         # xacro joins the values of a text's ${...} and $(...) outside the evaluator: bound them here
         # (a property "${s}${s}" of a property "${s}${s}" of ... doubles at each level)
-        result = original["eval_text"](text, symbols)
+        result = self.original["eval_text"](text, symbols)
         if isinstance(result, str) and len(result) > max(MAX_STRING, len(text)):  # grown by substitution
-            raise xacro.XacroException(f"refused: a text of more than {MAX_STRING} characters (properties "
-                                       "joining copies of each other?)")
+            raise self.xacro.XacroException(f"refused: a text of more than {MAX_STRING} characters (properties "
+                                            "joining copies of each other?)")
         return result
 
-    def reqd_attrs(tag, names):
+    def reqd_attrs(self, tag: MinidomElement, names: list[str]) -> Any:
         # xacro's xmlutils raises RuntimeError for a missing attribute: the file's mistake, not a bug
         try:
-            return original["reqd_attrs"](tag, names)
+            return self.original["reqd_attrs"](tag, names)
         except RuntimeError as exc:
-            raise xacro.XacroException(str(exc)) from None
+            raise self.xacro.XacroException(str(exc)) from None
 
-    def handle_macro_call(node, macros, symbols):
+    def handle_macro_call(self, node: MinidomElement, macros: dict, symbols: dict) -> Any:
+        xacro, state, path = self.xacro, self.state, self.path
         if node.tagName.startswith("xacro:"):
             state.calls += 1
             if state.calls > MAX_MACRO_CALLS:
@@ -380,12 +399,15 @@ def _patched(xacro, state: _State, path: Path, evaluator=None) -> tuple:
                 if state.copied > LIMITS.elements:
                     raise MechanismFileError(path, f"the macros expand to more than {LIMITS.elements} elements "
                                                    "(refused)")
-        return original["handle_macro_call"](node, macros, symbols)
+        return self.original["handle_macro_call"](node, macros, symbols)
 
-    replaced = {"safe_eval": safe_eval, "eval_extension": eval_extension, "get_include_files": get_include_files,
-                "parse": parse, "handle_macro_call": handle_macro_call, "eval_all": eval_all,
-                "eval_text": eval_text, "reqd_attrs": reqd_attrs}
-    return original, replaced
+
+def _patched(xacro: ModuleType, state: _State, path: str | Path,
+             evaluator: Callable[..., Any] | None = None) -> tuple[dict[str, Any], dict[str, Callable[..., Any]]]:
+    """Replace xacro's evaluator (``evaluator``, default :func:`evaluate`), substitutions, includes and
+    macro calls while expanding: (xacro's originals, their replacements)."""
+    patches = _Patches(xacro, state, path, evaluator or evaluate)
+    return patches.original, patches.replaced()
 
 
 class XacroInternalError(RuntimeError):
@@ -393,7 +415,7 @@ class XacroInternalError(RuntimeError):
     mistakes are): a bug, reported as an internal error (exit 3), not as the file's fault."""
 
 
-def _dom(text: str, path: Path):
+def _dom(text: str, path):
     """A minidom document of checked text (defusedxml: no entities, no external references)."""
     # lazily: only xacro files need it; defusedxml.minidom.parseString's own parser, without the
     # import of defusedxml.minidom (its pulldom brings xml.sax, urllib, http, ssl and email: 18 ms)
@@ -408,7 +430,7 @@ def _dom(text: str, path: Path):
         raise MechanismFileError(path, f"malformed XML: {shorten(_one_line(exc), 100)}") from None
 
 
-def expand(path: Path, text: str, args: dict | None=None, root=None, warn: Callable | None=None, evaluator=None, read: list | None=None) -> str:
+def expand(path, text: str, args=None, root=None, warn=None, evaluator=None, read=None) -> str:
     """The URDF text of xacro file ``path`` (whose text is ``text``) with arguments
     ``args`` ({name: value}; see :func:`normalize_args`).  Raises MechanismFileError (the
     file's problem, one line) or UsageError (an argument the file does not declare).

@@ -24,19 +24,22 @@ from __future__ import annotations
 import ast
 import re
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import MechanismFileError, UsageError
+from .description import MechanismSpec
+from .urdf import read_urdf
 from .xacro import expand
-from .xacro_eval import _COMPARE, FUNCTIONS, _call, _function_name, _Interpreter, _power, _Refused, evaluate
+from .xacro_eval import COMPARE, FUNCTIONS, Interpreter, Refused, call_function, evaluate, function_name, power
 from .xmlsafe import parse_xml_text
 from typing import TYPE_CHECKING, NoReturn
 
 if TYPE_CHECKING:
     from typing import Any
 
-__all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch"]
+__all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch", "read_designs"]
 
 TOKEN = re.compile(r"skwbatch([0-9]+)x")
 #: (element, attribute) pairs a parameter may reach: numbers of placements, axes, inertials, geometry, colour.
@@ -158,7 +161,7 @@ def _truth(x) -> bool | np.ndarray:
     return np.asarray(x.v, bool) if isinstance(x, Batch) else bool(x)
 
 
-class _BatchInterpreter(_Interpreter):
+class _BatchInterpreter(Interpreter):
     """xacro_eval's interpreter with Batch values: what it does with a number, it does with each
     design's number."""
 
@@ -197,14 +200,14 @@ class _BatchInterpreter(_Interpreter):
             a, b = self.value(node.left), self.value(node.right)
             if isinstance(a, Batch) or isinstance(b, Batch):
                 return a._bin(b, np.power) if isinstance(a, Batch) else b._bin(a, np.power, True)
-            return _power(a, b)
+            return power(a, b)
         if isinstance(node, ast.Call):
-            name = _function_name(node.func)
+            name = function_name(node.func)
             args = [self.value(a) for a in node.args]
             if not any(isinstance(a, Batch) for a in args):
-                return _call(name, args)
+                return call_function(name, args)
             if any(isinstance(a, str) for a in args):
-                raise _Refused(f"{name}() of text")
+                raise Refused(f"{name}() of text")
             vals = [(a.v, a.bad) if isinstance(a, Batch) else (a, False) for a in args]
             bad = np.logical_or.reduce([np.broadcast_to(b, (ctx.n,)) for _, b in vals])
             with np.errstate(all="ignore"):
@@ -243,7 +246,7 @@ class _BatchInterpreter(_Interpreter):
                 if (isinstance(left, Batch) or isinstance(right, Batch)) and (isinstance(left, str)
                                                                                or isinstance(right, str)):
                     ctx.refuse("a parameter compared with text")
-                r = _COMPARE[type(op)](left, right)
+                r = COMPARE[type(op)](left, right)
                 if not isinstance(r, Batch) and not r:
                     return False
                 results.append(r)
@@ -331,3 +334,24 @@ def expand_batch(path, text: str, args: dict, parameters: dict) -> BatchExpansio
     for k in set(slots):  # a value written into the file that is not finite: the design's file is refused
         bad |= ctx.batches[k].bad
     return BatchExpansion(parts, slots, rows, bad)
+
+
+def read_designs(path: str | Path, text: str, args: dict, parameters: dict) -> tuple[
+        list[MechanismSpec | None], dict[int, str]]:
+    """Every design of the xacro family ``path`` (``parameters``: {name: array of SI values, one per design},
+    as for expand_batch), expanded at once and each design's URDF read and checked as any file is
+    (files.urdf.read_urdf): (its description, None where it is not read; position -> why it was not: to be
+    expanded and read alone for the file's own message).  Unbatchable when the family cannot be expanded at
+    once."""
+    be = expand_batch(path, text, args, parameters)
+    specs: list[MechanismSpec | None] = [None] * len(be.bad)
+    why = {}
+    for k in range(len(be.bad)):
+        if be.bad[k]:
+            why[k] = "its expansion fails (xacro's message)"
+            continue
+        try:
+            specs[k] = read_urdf(path, be.design(k))
+        except (MechanismFileError, UsageError):
+            why[k] = "its file is refused (the reader's message)"
+    return specs, why

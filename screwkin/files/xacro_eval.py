@@ -12,11 +12,12 @@ from __future__ import annotations
 import ast
 import math
 import operator
+from typing import Any
 
 from ..errors import quote, shorten
 
-__all__ = ["CONSTANTS", "FUNCTIONS", "MAX_EXPRESSION", "MAX_INT", "MAX_STRING", "XacroEvaluationError",
-           "check_expression", "evaluate"]
+__all__ = ["COMPARE", "CONSTANTS", "FUNCTIONS", "MAX_EXPRESSION", "MAX_INT", "MAX_STRING", "Interpreter", "Refused",
+           "XacroEvaluationError", "call_function", "check_expression", "evaluate", "function_name", "power"]
 
 #: Most characters of one ``${...}`` expression, and of a string an expression computes.
 MAX_EXPRESSION = 2000
@@ -38,17 +39,18 @@ CONSTANTS = {"pi": math.pi, "e": math.e, "tau": math.tau}
 # ------------------------------------------------------------------ the expression subset
 _BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
            ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod, ast.Pow: None}
-_COMPARE = {ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le,
+#: The comparisons an expression may make (files.xacro_batch compares Batch values with them too).
+COMPARE = {ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le,
             ast.Gt: operator.gt, ast.GtE: operator.ge}
 _UNARY = {ast.UAdd: operator.pos, ast.USub: operator.neg, ast.Not: operator.not_}
 _ALLOWED = "numbers, names, arithmetic, comparisons, and/or/not, 'a if c else b' and math functions"
 
 
-class _Refused(Exception):
-    pass
+class Refused(Exception):
+    """An expression that is well formed but computes what xacro's ``${...}`` may not (text where a number goes)."""
 
 
-def _function_name(node):
+def function_name(node: ast.expr) -> str | None:
     """The name of the function a call may call (``sin`` or ``math.sin``), or None."""
     if isinstance(node, ast.Name) and node.id in FUNCTIONS:
         return node.id
@@ -74,21 +76,21 @@ def _describe(node) -> str:
     return type(node).__name__
 
 
-def _check_node(node):
+def _check_node(node) -> None:
     if isinstance(node, ast.Expression):
         return _check_node(node.body)
     if isinstance(node, ast.Constant):
         if not isinstance(node.value, (int, float, str, bool)) or isinstance(node.value, complex):
-            raise _Refused(f"the constant {shorten(repr(node.value), 30)}")
+            raise Refused(f"the constant {shorten(repr(node.value), 30)}")
         return None
     if isinstance(node, ast.Name):
         if node.id.startswith("_"):
-            raise _Refused(f"the name '{shorten(node.id, 30)}' (names starting with _ are refused)")
+            raise Refused(f"the name '{shorten(node.id, 30)}' (names starting with _ are refused)")
         return None
     if isinstance(node, ast.Attribute):
         if isinstance(node.value, ast.Name) and node.value.id == "math" and node.attr in CONSTANTS:
             return None
-        raise _Refused(_describe(node))
+        raise Refused(_describe(node))
     if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
         _check_node(node.left)
         return _check_node(node.right)
@@ -98,7 +100,7 @@ def _check_node(node):
         for v in node.values:
             _check_node(v)
         return None
-    if isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
+    if isinstance(node, ast.Compare) and all(type(op) in COMPARE for op in node.ops):
         _check_node(node.left)
         for c in node.comparators:
             _check_node(c)
@@ -108,32 +110,32 @@ def _check_node(node):
             _check_node(v)
         return None
     if isinstance(node, ast.Call):
-        if _function_name(node.func) is None:
-            raise _Refused(_describe(node))
+        if function_name(node.func) is None:
+            raise Refused(_describe(node))
         if node.keywords or any(isinstance(a, ast.Starred) for a in node.args):
-            raise _Refused("keyword or starred arguments")
+            raise Refused("keyword or starred arguments")
         for a in node.args:
             _check_node(a)
         return None
-    raise _Refused(_describe(node))
+    raise Refused(_describe(node))
 
 
 def _parse_expression(expr: str):
-    """The checked syntax tree of an expression (raises _Refused)."""
+    """The checked syntax tree of an expression (raises Refused)."""
     if len(expr) > MAX_EXPRESSION:
-        raise _Refused(f"an expression of {len(expr)} characters (at most {MAX_EXPRESSION})")
+        raise Refused(f"an expression of {len(expr)} characters (at most {MAX_EXPRESSION})")
     if "load_yaml" in expr:
-        raise _Refused("load_yaml (xacro's YAML loading)")
+        raise Refused("load_yaml (xacro's YAML loading)")
     try:
         tree = ast.parse(expr.strip(), mode="eval")
     except SyntaxError as exc:
-        raise _Refused(f"invalid syntax ({shorten(exc.msg or '', 60)})") from None
+        raise Refused(f"invalid syntax ({shorten(exc.msg or '', 60)})") from None
     except (RecursionError, MemoryError, ValueError):
-        raise _Refused("an expression nested too deeply") from None
+        raise Refused("an expression nested too deeply") from None
     try:
         _check_node(tree)
     except RecursionError:
-        raise _Refused("an expression nested too deeply") from None
+        raise Refused("an expression nested too deeply") from None
     return tree
 
 
@@ -141,35 +143,37 @@ def check_expression(expr: str) -> None:
     """Raise ValueError (with what is refused) unless ``expr`` is in the subset."""
     try:
         _parse_expression(expr)
-    except _Refused as exc:
+    except Refused as exc:
         raise ValueError(f"xacro expression {quote(expr, 60)} uses {exc}: only {_ALLOWED} are allowed") from None
 
 
-def _number(x: str | float) -> bool:
+def _number(x):
     return isinstance(x, (int, float)) and not isinstance(x, complex)
 
 
-def _bounded(x: str | float) -> str | float:
+def _bounded(x):
     if isinstance(x, bool):
         return x
     if isinstance(x, int) and abs(x) > MAX_INT:
         return float(x)
     if isinstance(x, str) and len(x) > MAX_STRING:
-        raise _Refused(f"a string of more than {MAX_STRING} characters")
+        raise Refused(f"a string of more than {MAX_STRING} characters")
     return x
 
 
-def _power(a, b):
+def power(a: Any, b: Any) -> int | float:
+    """``a ** b`` as xacro computes it: a bounded int for small int powers, else a float."""
     if not (_number(a) and _number(b)):
-        raise _Refused("** on text")
+        raise Refused("** on text")
     if isinstance(a, int) and isinstance(b, int) and not isinstance(a, bool) and 0 <= b <= 64:
         return _bounded(a ** b)
     return float(a) ** float(b)  # OverflowError when too large
 
 
-def _call(name: str, args: list):
+def call_function(name: str, args: list) -> Any:
+    """The math function ``name`` (of FUNCTIONS, min, max, pow, abs) of ``args``, numbers only."""
     if not all(_number(a) for a in args):
-        raise _Refused(f"{name}() of text")
+        raise Refused(f"{name}() of text")
     if name == "abs":
         if len(args) != 1:
             raise TypeError("abs() takes one argument")
@@ -181,17 +185,17 @@ def _call(name: str, args: list):
     if name == "pow":
         if len(args) != 2:
             raise TypeError("pow() takes two arguments")
-        return _power(*args)
+        return power(*args)
     return _bounded(FUNCTIONS[name](*args))
 
 
-class _Interpreter:
+class Interpreter:
     """Evaluates a checked tree with names looked up in xacro's symbol table."""
 
-    def __init__(self, symbols) -> None:
+    def __init__(self, symbols):
         self.symbols = symbols
 
-    def value(self, node) -> str | float:
+    def value(self, node):
         if isinstance(node, ast.Expression):
             return self.value(node.body)
         if isinstance(node, ast.Constant):
@@ -203,22 +207,22 @@ class _Interpreter:
                 raise NameError(f"name '{node.id}' is not defined") from None
             if isinstance(v, bool) or _number(v) or isinstance(v, str):
                 return v
-            raise _Refused(f"the name '{shorten(node.id, 30)}', which is not a number or text")
+            raise Refused(f"the name '{shorten(node.id, 30)}', which is not a number or text")
         if isinstance(node, ast.Attribute):  # math.pi, math.e, math.tau (checked)
             return CONSTANTS[node.attr]
         if isinstance(node, ast.BinOp):
             a, b = self.value(node.left), self.value(node.right)
             if isinstance(node.op, ast.Pow):
-                return _power(a, b)
+                return power(a, b)
             if isinstance(a, str) or isinstance(b, str):
                 if isinstance(node.op, ast.Add) and isinstance(a, str) and isinstance(b, str):
                     return _bounded(a + b)
-                raise _Refused(f"the operator {type(node.op).__name__} on text (text is only joined with +)")
+                raise Refused(f"the operator {type(node.op).__name__} on text (text is only joined with +)")
             return _bounded(_BINARY[type(node.op)](a, b))
         if isinstance(node, ast.UnaryOp):
             v = self.value(node.operand)
             if isinstance(v, str) and not isinstance(node.op, ast.Not):
-                raise _Refused("a sign on text")
+                raise Refused("a sign on text")
             return _UNARY[type(node.op)](v)
         if isinstance(node, ast.BoolOp):
             and_ = isinstance(node.op, ast.And)
@@ -233,31 +237,31 @@ class _Interpreter:
             for op, right_node in zip(node.ops, node.comparators):
                 right = self.value(right_node)
                 if isinstance(left, str) != isinstance(right, str) and type(op) not in (ast.Eq, ast.NotEq):
-                    raise _Refused("an order comparison of text with a number")
-                if not _COMPARE[type(op)](left, right):
+                    raise Refused("an order comparison of text with a number")
+                if not COMPARE[type(op)](left, right):
                     return False
                 left = right
             return True
         if isinstance(node, ast.IfExp):
             return self.value(node.body) if self.value(node.test) else self.value(node.orelse)
         if isinstance(node, ast.Call):
-            return _call(_function_name(node.func), [self.value(a) for a in node.args])
-        raise _Refused(_describe(node))  # pragma: no cover - checked before
+            return call_function(function_name(node.func), [self.value(a) for a in node.args])
+        raise Refused(_describe(node))  # pragma: no cover - checked before
 
 
 class XacroEvaluationError(Exception):
     """An expression xacro asked to evaluate is refused or fails (xacro adds its context)."""
 
 
-def evaluate(expr: str, symbols=None, interpreter=None) -> str | float:
+def evaluate(expr: str, symbols=None, interpreter=None):
     """The value of a ``${...}`` expression (its inside) with names from ``symbols`` (a
     mapping; xacro's symbol table while expanding): the subset of :func:`check_expression`,
     evaluated without ``eval`` (by ``interpreter(symbols)``, default this module's; files.xacro_batch
     gives one that computes with arrays)."""
     try:
         tree = _parse_expression(expr)
-        return (interpreter or _Interpreter)({} if symbols is None else symbols).value(tree)
-    except _Refused as exc:
+        return (interpreter or Interpreter)({} if symbols is None else symbols).value(tree)
+    except Refused as exc:
         raise XacroEvaluationError(f"refused: {exc} (only {_ALLOWED} are allowed)") from None
     except RecursionError:
         raise XacroEvaluationError("properties defined through each other too deeply") from None

@@ -1,7 +1,7 @@
 """What a closure system closes: the cut joints bound to a model (frames F1, F2 and axes), the
 linear couplings of rolling and screw pairs, the contacts of profiles in a plane, and the closed
 configuration a solve returns.  Plain frozen data (bind_cut makes it from a description's loop joint);
-model.closure evaluates their rows.  Also where
+model.kernel.closure evaluates their rows.  Also where
 a rolling or gear pair's pitch curves touch (pair_contact: the one place that computes it).
 """
 

@@ -1,5 +1,5 @@
 """Two rigid bodies joined by six distances (a Stewart-Gough platform), in the platform's own pose:
-the system a coefficient-parameter homotopy tracks (analysis.motion.generic_modes), the same whether
+the system a coefficient-parameter homotopy tracks (model.homotopy.parameter), the same whether
 the file writes the platform on a floating joint or carried by one leg in the tree.
 
 Unknowns x = (t / L, q): the translation of the platform's frame and its quaternion (Pinocchio's
@@ -8,11 +8,11 @@ order x, y, z, w) on q.q = 1 (q and -q are one pose: a sign symmetry).  Rows, on
     G_k(x) = |t + Q(q) B_k - A_k|^2 / L^2            (A_k on the ground, B_k on the platform)
 
 and the family G(x) = c: c_k = r_k^2 / L^2 the legs' squared lengths.  These are exactly the linear
-offsets of analysis.motion.monodromy, so the family's generic solution set (monodromy at a random
+offsets of model.homotopy.monodromy, so the family's generic solution set (monodromy at a random
 complex c0, certified by the trace test or the published count) is carried to any leg lengths by
 one straight segment in c (Morgan and Sommese 1989).  A step moves the platform in tangent
 coordinates: a translation and a rotation vector d in the world (q -> exp(d / 2) q), as
-model.algebraic moves a free flyer.
+model.kernel.algebraic moves a free flyer.
 
 ``chain_angles``: the joint angles of a leg that carries the platform (two revolutes meeting at the
 ground point, inputs, three revolutes meeting at the platform point) that put the platform at a
@@ -37,80 +37,94 @@ class SixDistances:
 
     n, width = 6, 7
 
-    def __init__(self, A, B) -> None:
+    def __init__(self, A, B):
         self.A = np.asarray(A, float)
         self.B = np.asarray(B, float)
         self.closure = self  # the trace test draws its random points from ``closure``
 
-    def _v(self, X: np.ndarray) -> tuple:
-        """(v, RB): per leg the vector from A_k to the platform point, and R B_k; each a list of three
-        (P, 6) arrays (component-wise arithmetic: these stacks are small, numpy's calls dominate)."""
+    def _v(self, X):
+        """(v, RB): per leg the vector from A_k to the platform point, and R B_k; each (P, 3, 6)
+        (component-wise arithmetic on the stack of rotations: these stacks are small, numpy's calls
+        dominate)."""
         x, y, z, w = X[:, 3], X[:, 4], X[:, 5], X[:, 6]
         xx, yy, zz, ww = x * x, y * y, z * z, w * w
         xy, xz, xw, yz, yw, zw = x * y, x * z, x * w, y * z, y * w, z * w
-        R = ((ww + xx - yy - zz, 2 * (xy - zw), 2 * (xz + yw)),
-             (2 * (xy + zw), ww - xx + yy - zz, 2 * (yz - xw)),
-             (2 * (xz - yw), 2 * (yz + xw), ww - xx - yy + zz))
-        B, A = self.B, self.A
-        RB = [R[i][0][:, None] * B[:, 0] + R[i][1][:, None] * B[:, 1] + R[i][2][:, None] * B[:, 2] for i in range(3)]
-        v = [X[:, i, None] + RB[i] - A[:, i] for i in range(3)]
+        R = np.empty((len(X), 3, 3, 1), complex)
+        R[:, 0, 0, 0], R[:, 0, 1, 0], R[:, 0, 2, 0] = ww + xx - yy - zz, 2 * (xy - zw), 2 * (xz + yw)
+        R[:, 1, 0, 0], R[:, 1, 1, 0], R[:, 1, 2, 0] = 2 * (xy + zw), ww - xx + yy - zz, 2 * (yz - xw)
+        R[:, 2, 0, 0], R[:, 2, 1, 0], R[:, 2, 2, 0] = 2 * (xz - yw), 2 * (yz + xw), ww - xx - yy + zz
+        B = self.B
+        RB = R[:, :, 0] * B[:, 0] + R[:, :, 1] * B[:, 1] + R[:, :, 2] * B[:, 2]
+        v = X[:, :3, None] + RB - self.A.T
         return v, RB
 
-    def equations(self, X: np.ndarray, jacobian: bool = True) -> tuple:
+    def equations(self, X, jacobian: bool = True):
         X = np.asarray(X, complex)
         v, RB = self._v(X)
-        G = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+        v0, v1, v2 = v[:, 0], v[:, 1], v[:, 2]
+        G = v0 * v0 + v1 * v1 + v2 * v2
         if not jacobian:
             return G, None
-        J = np.stack([2 * v[0], 2 * v[1], 2 * v[2], 2 * (RB[1] * v[2] - RB[2] * v[1]),
-                      2 * (RB[2] * v[0] - RB[0] * v[2]), 2 * (RB[0] * v[1] - RB[1] * v[0])], axis=2)
+        J = np.empty(G.shape + (6,), complex)  # (filled column by column: no stack of temporaries)
+        np.multiply(v.transpose(0, 2, 1), 2, out=J[:, :, :3])
+        R0, R1, R2 = RB[:, 0], RB[:, 1], RB[:, 2]
+        J[:, :, 3] = 2 * (R1 * v2 - R2 * v1)
+        J[:, :, 4] = 2 * (R2 * v0 - R0 * v2)
+        J[:, :, 5] = 2 * (R0 * v1 - R1 * v0)
         return G, J
 
-    def offsets(self, X: np.ndarray):
+    def offsets(self, X):
         return self.equations(X, jacobian=False)[0]
 
-    def residual(self, X: np.ndarray, c):
+    def residual(self, X, c):
         """(P,) the largest |G(x) - c|."""
         return np.abs(self.offsets(X) - np.asarray(c)).max(axis=1)
 
-    def retract(self, X: np.ndarray, dT):
+    def retract(self, X, dT):
         X = np.array(X, complex)
         X[:, :3] += dT[:, :3]
         d = dT[:, 3:] * 0.5
         z = np.einsum("pi,pi->p", d, d)
         r = np.sqrt(z)
         small = np.abs(z) < _SERIES
-        sinc = np.where(small, 1 - z / 6, np.sin(np.where(small, 1.0, r)) / np.where(small, 1.0, r))
-        qn = quaternion_product(np.c_[d * sinc[:, None], np.cos(r)], X[:, 3:])
+        if small.any():
+            safe = np.where(small, 1.0, r)
+            sinc = np.where(small, 1 - z / 6, np.sin(safe) / safe)
+        else:  # (the same numbers, in fewer operations)
+            sinc = np.sin(r) / r
+        e = np.empty((len(X), 4), complex)  # exp(d / 2) as a quaternion, (x, y, z, w)
+        e[:, :3] = d * sinc[:, None]
+        e[:, 3] = np.cos(r)
+        qn = quaternion_product(e, X[:, 3:])
         X[:, 3:] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
         return X
 
-    def tangent(self, X: np.ndarray) -> np.ndarray:
+    def tangent(self, X):
         P = len(X)
         T = np.zeros((P, 7, 6), complex)
         T[:, np.arange(3), np.arange(3)] = 1.0
         x, y, z, w = (0.5 * X[:, 3 + k] for k in range(4))
         # d/dd_k of exp(d / 2) q at d = 0: the Hamilton product (e_k / 2) q, (x, y, z, w) order
-        T[:, 3:, 3] = np.stack([w, -z, y, -x], 1)
-        T[:, 3:, 4] = np.stack([z, w, -x, -y], 1)
-        T[:, 3:, 5] = np.stack([-y, x, w, -z], 1)
+        for k, column in enumerate(((w, -z, y, -x), (z, w, -x, -y), (-y, x, w, -z))):
+            for i, value in enumerate(column):
+                T[:, 3 + i, 3 + k] = value
         return T
 
-    def constraints(self, X: np.ndarray):
+    def constraints(self, X):
         q = np.asarray(X)[:, 3:]
         return (np.einsum("pi,pi->p", q, q) - 1.0)[:, None]
 
-    def on_variety(self, X: np.ndarray, tol: float = 1e-10) -> np.ndarray:
+    def on_variety(self, X, tol: float = 1e-10) -> np.ndarray:
         return np.abs(self.constraints(X)[:, 0]) <= tol * (1.0 + np.abs(X).max(axis=1)) ** 2
 
-    def random_points(self, rng: np.random.Generator, P: int) -> np.ndarray:
+    def random_points(self, rng, P: int) -> np.ndarray:
         q = rng.normal(size=(P, 4)) + 1j * rng.normal(size=(P, 4)) * 0.5
         q = q / np.sqrt(np.einsum("pi,pi->p", q, q))[:, None]
         t = (rng.normal(size=(P, 3)) + 1j * rng.normal(size=(P, 3))) * 0.5
         return np.c_[t, q]
 
 
-def chain_angles(head_axes: list, tail_axes: list, A, p0, R0: np.ndarray, p, R: np.ndarray) -> list:
+def chain_angles(head_axes, tail_axes, A, p0, R0, p, R) -> list:
     """Every real (theta_head (2,), theta_tail (3,)) of a leg (see the module): world axes at the
     angles' zero (head through the ground point A, tail through the platform point, which is at p0
     with the platform at rotation R0), the platform point wanted at p and the platform's rotation R

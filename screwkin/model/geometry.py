@@ -253,7 +253,7 @@ def skews_batch(U: np.ndarray, m=None) -> np.ndarray:
     return U.transpose(0, 2, 1).reshape(n, 3 * k)[:, index] * sign
 
 
-# -- stacks of small complex matrices, the stack's axes last (model.algebraic) --------------------------
+# -- stacks of small complex matrices, the stack's axes last (model.kernel.algebraic) --------------------------
 
 def quaternion_matrix(q: np.ndarray) -> np.ndarray:
     """Q(q) for quaternions q (..., 4) in Pinocchio's order (x, y, z, w): the homogeneous quadratic
@@ -284,5 +284,9 @@ def quaternion_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton products a b of stacks (P, 4) of quaternions in (x, y, z, w) order (real or complex)."""
     ax, ay, az, aw = a.T
     bx, by, bz, bw = b.T
-    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by + ay * bw + az * bx - ax * bz,
-                     aw * bz + az * bw + ax * by - ay * bx, aw * bw - ax * bx - ay * by - az * bz], axis=1)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))  # (no stack of temporaries)
+    out[:, 0] = aw * bx + ax * bw + ay * bz - az * by
+    out[:, 1] = aw * by + ay * bw + az * bx - ax * bz
+    out[:, 2] = aw * bz + az * bw + ax * by - ay * bx
+    out[:, 3] = aw * bw - ax * bx - ay * by - az * bz
+    return out

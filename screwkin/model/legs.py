@@ -1,4 +1,4 @@
-"""Legs that are distance constraints: what model.algebraic eliminates before a homotopy tracks.
+"""Legs that are distance constraints: what model.kernel.algebraic eliminates before a homotopy tracks.
 
 A leg here is a chain of the spanning tree that hangs off one link and carries, at its end, one
 frame of a spherical cut joint and nothing else the loops or the modes read: the U-P-S legs of a

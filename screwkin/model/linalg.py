@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.tolerances import Tolerances
 
-__all__ = ["rank", "null_space", "singular_values"]
+__all__ = ["rank", "null_space", "singular_values", "complement"]
 
 
 def _square(A: np.ndarray):
@@ -51,3 +51,11 @@ def null_space(A: np.ndarray, tol: Tolerances, n: int | None = None) -> np.ndarr
         return np.eye(n)
     r = int(np.sum(s > max(tol.rank_rtol * s[0], tol.rank_atol)))
     return vt[r:].T.copy()
+
+
+def complement(n: int, idx) -> np.ndarray:
+    """The indices 0 .. n-1 not in ``idx``, ascending: numpy.setdiff1d(numpy.arange(n), idx), without
+    numpy.unique (its first call imports numpy.ma: 15 ms of a command's time)."""
+    keep = np.ones(n, bool)
+    keep[np.asarray(idx, int).ravel()] = False
+    return np.flatnonzero(keep)

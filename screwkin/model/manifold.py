@@ -8,7 +8,7 @@ written as Pinocchio writes them (its liegroup/*.hxx, version 4): coordinates of
 joint's (cos, sin) turns by the angle and is renormalized to first order; a ball joint's
 quaternion (x, y, z, w) is multiplied by exp3 of the rotation; a free flyer's placement by exp6
 of the twist (rotation then translation in the body's axes); a planar joint's (x, y, cos, sin) by
-the planar exponential.  tests/test_manifold.py compares the result with pin.integrate on random
+the planar exponential.  tests/model/test_manifold.py compares the result with pin.integrate on random
 stacks of every joint type (to 1e-15).  A joint of another kind (a composite or mimic joint)
 integrates the whole stack one configuration at a time with pin.integrate, as does a stack of one
 (one call to Pinocchio costs less than the numpy operations).

@@ -9,6 +9,7 @@ mobility, and later position, velocity and singularity analysis) work on it.
 from __future__ import annotations
 
 import copy
+import random
 import threading
 
 from dataclasses import dataclass
@@ -21,7 +22,8 @@ from ..errors import AssemblyError, MechanismFileError, UsageError, quote
 from ..files.description import MechanismSpec, resolve_actuation
 from ..tolerances import DEFAULT, Tolerances
 from .closability import closure_gap, closure_obstacle
-from .closure import ClosureSystem
+from .kernel.closure import ClosureSystem
+from .kernel.scaling import sliding_columns
 from .cuts import Assembly, bind_cut
 from .geometry import wrap_angle
 from .linalg import null_space, rank
@@ -53,6 +55,12 @@ class Coordinate:
 SHARED_DATA_NV = 120
 
 
+def _std_normal(seed: int):
+    """size -> that many standard normal deviates, from the standard library's generator seeded with ``seed``."""
+    r = random.Random(seed)
+    return lambda size: np.array([r.gauss(0.0, 1.0) for _ in range(size)])
+
+
 class Mechanism:
     """A mechanism: Pinocchio model of the spanning tree, cut joints, actuation.
 
@@ -62,7 +70,7 @@ class Mechanism:
     spec:       the :class:`~screwkin.files.description.MechanismSpec` read from the file.
     model:      ``pinocchio.Model`` of the spanning tree (with frames F1, F2 of every cut joint).
     cuts:       list of :class:`~screwkin.model.cuts.CutJoint`.
-    closure:    the :class:`~screwkin.model.closure.ClosureSystem` r(q) = 0.
+    closure:    the :class:`~screwkin.model.kernel.closure.ClosureSystem` r(q) = 0.
     coordinates: list of :class:`Coordinate`, one per tree joint with coordinates.
     actuated:   actuated joint names; ``actuation_source`` says where they came from.
     """
@@ -114,7 +122,7 @@ class Mechanism:
         self._assembly = None
         self._limits = None
         self._generic = None
-        self._generic_cache = {}  # (hint, seed) -> generic_configurations' result
+        self._generic_cache = {}  # (hint, seed, starts) -> generic_configurations' result
         self._length = None
         self._layout = None
         self.cache = {}  # results analyses derive from this mechanism (cleared when actuation or length change)
@@ -358,18 +366,8 @@ class Mechanism:
         self.cache.clear()
 
     def _translational_coordinates(self) -> np.ndarray:
-        """Mask of the velocity coordinates that are lengths (prismatic joints, the translations
-        of planar, translation and free-flyer joints)."""
-        mask = np.zeros(self.model.nv, bool)
-        for c in self.coordinates:
-            short = self.model.joints[c.joint_id].shortname()
-            if "JointModelP" in short and "Planar" not in short:
-                mask[c.idx_v:c.idx_v + c.nv] = True
-            elif short in ("JointModelPlanar",):
-                mask[c.idx_v:c.idx_v + 2] = True
-            elif short in ("JointModelTranslation", "JointModelFreeFlyer"):
-                mask[c.idx_v:c.idx_v + 3] = True
-        return mask
+        """Mask of the velocity coordinates that are lengths (model.kernel.scaling.sliding_columns)."""
+        return sliding_columns(self.model)
 
     @property
     def translational(self) -> np.ndarray:
@@ -462,10 +460,12 @@ class Mechanism:
         tol = self.tolerances
         hint = self.neutral() if q0 is None else np.array(q0, float)
         given = "the file's configuration" if q0 is None else "the given configuration"
-        rng = np.random.default_rng(seed)
+        rng = None  # (numpy.random made when a start needs it: its first import takes 10 ms)
         total = max(int(tol.assembly_starts), 1) if self.closure.nrows else 1
         best, best_it = np.inf, 0
         for k in range(total):
+            if k and rng is None:
+                rng = np.random.default_rng(seed)
             if k == 0:
                 q, what = hint, given
             elif k <= tol.perturbations:
@@ -515,7 +515,7 @@ class Mechanism:
         """Whether generic_configurations() has been computed (with any hint or seed)."""
         return self._generic is not None
 
-    def generic_configurations(self, hint=None, seed: int = 0) -> tuple:
+    def generic_configurations(self, hint=None, seed: int = 0, starts: int | None = None) -> tuple:
         """(assembly, configurations): assembled configurations where generic ranks are taken.
 
         The first configuration the assembly search closes (:meth:`assemble`, from ``hint``
@@ -525,26 +525,29 @@ class Mechanism:
         ``sample_step`` along the motion the loops allow, closed again) and at the
         configurations that ``tolerances.generic_starts`` further random starts close; the
         configurations of the largest rank are returned, the one nearest the first assembly
-        first (``assembly`` is that first one, with where it came from).  Cached."""
-        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed))
+        first (``assembly`` is that first one, with where it came from).  ``starts``: how many
+        further random starts (default ``tolerances.generic_starts``; 0 where a closed form has
+        every branch already, analysis.position.closed_ik: then the samples' steps are drawn from the
+        standard library's generator, numpy.random's first import taking 10 ms).  Cached."""
+        starts = self.tolerances.generic_starts if starts is None else int(starts)
+        key = (None if hint is None else np.asarray(hint, float).tobytes(), int(seed), starts)
         if key in self._generic_cache:  # keyed on its arguments: another hint or seed is another search
             return self._generic_cache[key][:2]
         a = self.assemble() if hint is None else self.assemble(hint)
         tol, closure = self.tolerances, self.closure
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(seed) if starts else None
+        normal = rng.normal if starts else _std_normal(seed)
         configs = [a.q]
         if self.nv:  # a serial chain too: its file configuration may be singular for an output
-            for _ in range(tol.samples):
-                V = null_space(closure.jacobian(a.q), tol, self.nv)
-                if V.shape[1] == 0:
-                    break
-                step = V @ rng.normal(size=V.shape[1])
+            V = null_space(closure.jacobian(a.q), tol, self.nv)  # the motion the loops allow at the first one
+            for _ in range(tol.samples if V.shape[1] else 0):
+                step = V @ normal(size=V.shape[1])
                 step *= tol.sample_step / max(np.linalg.norm(step), 1e-300)
                 try:
                     configs.append(closure.solve(pin.integrate(self.model, a.q, step)).q)
                 except AssemblyError:
                     continue
-            for _ in range(tol.generic_starts if closure.nrows else 0):  # (for the branches of loops)
+            for _ in range(starts if closure.nrows else 0):  # (for the branches of loops)
                 try:
                     configs.append(closure.solve(self.random_configuration(rng)).q)
                 except AssemblyError:
@@ -568,8 +571,13 @@ class Mechanism:
 
     def topology(self, q: np.ndarray | None = None) -> Topology:
         """The :class:`~screwkin.model.topology.Topology` (links, joints, compound joints, loops)
-        at q (default: a generic assembled configuration)."""
-        return build_topology(self, self.generic_configurations()[1][0] if q is None else q)
+        at q (default: a generic assembled configuration).  The last one is kept: a solver's labels and
+        link angles both read it at the reference configuration."""
+        q = np.asarray(self.generic_configurations()[1][0] if q is None else q, float)
+        key, last = q.tobytes(), self.cache.get("topology")
+        if last is None or last[0] != key or last[1] is not self.tolerances:
+            last = self.cache["topology"] = (key, self.tolerances, build_topology(self, q))
+        return last[2]
 
     def __repr__(self) -> str:
         return (f"Mechanism({Path(self.path).name!r}: {len(self.spec.links)} links, "

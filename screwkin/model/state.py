@@ -25,11 +25,11 @@ SHARED_DATA_NV coordinates) reads the mechanism's one Data, its pass run again a
 The rule: whatever reads the kinematic quantities of one configuration reads them from a
 KinematicState.  Pinocchio's kinematics are called directly only (1) inside an algorithm's inner
 loop, on a Data it keeps: the closure's residual and Jacobian and the Newton loops on them
-(model.closure, model.newton, the position solver's mode signature); (2) for a stack of
-configurations at once (analysis.motion.links, batch_closure's TreeKinematics and BatchClosure,
+(model.kernel.closure, model.kernel.newton, the position solver's mode signature); (2) for a stack of
+configurations at once (analysis.motion.links, model.kernel.stacks's TreeKinematics and BatchClosure,
 singularities.batch); (3) by a dynamics algorithm that runs its own pass (RNEA, CRBA, the energies
 in analysis.forces) or a viewer that places the geometry (present); (4) on a bare Pinocchio model
-that has no mechanism yet (model.legs probing which legs are distances, model.algebraic's
+that has no mechanism yet (model.legs probing which legs are distances, model.kernel.algebraic's
 reference placements for the homotopy).
 
 Units: m, rad, s.
@@ -297,7 +297,7 @@ class KinematicState:
     @cached_property
     def constraint_jacobian(self) -> np.ndarray:
         """K (rows of the loops and higher pairs, nv): K q' = 0 for the motions they allow
-        (model.closure, computed in the closure's own Data and copied here)."""
+        (model.kernel.closure, computed in the closure's own Data and copied here)."""
         return np.array(self.mech.closure.jacobian(self.q), float)
 
     def frame_pose(self, fid: int) -> np.ndarray:

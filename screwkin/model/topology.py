@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import os.path
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -190,16 +191,16 @@ class UnionFind:
     """Disjoint sets of ``items`` (union-find with path halving): find(x) its set's representative,
     join(a, b) puts b's set under a's representative."""
 
-    def __init__(self, items: range | list) -> None:
+    def __init__(self, items):
         self.parent = {i: i for i in items}
 
-    def find(self, x: str | int) -> str | int:
+    def find(self, x):
         while self.parent[x] != x:
             self.parent[x] = self.parent[self.parent[x]]
             x = self.parent[x]
         return x
 
-    def join(self, a: str | int, b: str | int) -> None:
+    def join(self, a, b):
         ra, rb = self.find(a), self.find(b)
         if ra != rb:
             self.parent[rb] = ra
@@ -260,7 +261,7 @@ class _Edge:
     profile: str | None = None
 
 
-def _edges(mech, q: np.ndarray) -> tuple:
+def _edges(mech, q):
     """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
     model = mech.model
     state = KinematicState(mech, q)
@@ -315,15 +316,15 @@ def _edges(mech, q: np.ndarray) -> tuple:
     return edges, welds
 
 
-def _unit_vector(v: np.ndarray) -> np.ndarray:
+def _unit_vector(v):
     return v / np.linalg.norm(v)
 
 
-def _parallel(d1: np.ndarray, d2: np.ndarray, tol: float):
+def _parallel(d1, d2, tol):
     return np.linalg.norm(np.cross(_unit_vector(d1), _unit_vector(d2))) < tol
 
 
-def _line_distance(p1: np.ndarray, d1: np.ndarray, p2: np.ndarray, d2: np.ndarray, tol: float):
+def _line_distance(p1, d1, p2, d2, tol):
     n = np.cross(_unit_vector(d1), _unit_vector(d2))
     if np.linalg.norm(n) < tol:  # parallel: distance between the lines
         w = p2 - p1
@@ -331,7 +332,7 @@ def _line_distance(p1: np.ndarray, d1: np.ndarray, p2: np.ndarray, d2: np.ndarra
     return abs((p2 - p1) @ _unit_vector(n))
 
 
-def _compound_name(members: list, kind: str) -> str:
+def _compound_name(members, kind) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
 
     prefix = os.path.commonprefix(members)
@@ -343,7 +344,7 @@ def _compound_name(members: list, kind: str) -> str:
     return "+".join(members)
 
 
-def _classify_chain(chain: list, tol: float, scale, coupled: frozenset=frozenset()) -> str | None:
+def _classify_chain(chain, tol, scale, coupled=frozenset()):
     """The compound type of a chain of 1-DOF edges through massless links, or None.
     coupled: the pairs of joint names one of which mimics the other."""
     kinds = [e.type for e in chain]
@@ -374,32 +375,110 @@ def _classify_chain(chain: list, tol: float, scale, coupled: frozenset=frozenset
     return None
 
 
-def build_topology(mech, q: np.ndarray) -> Topology:
-    """Links, joints (with compound joints recognized) and motion space at configuration q."""
-    tol = mech.tolerances.geometry
+def _chain_through(start: str, candidates: set[str], incident: dict[str, list[int]], edges: list[_Edge],
+                   body_name: dict[str, str]) -> tuple[set[str], list[_Edge], str, str] | None:
+    """The run of candidate bodies through ``start`` and the chain of edges through it, in order from one end
+    to the other: (run, chain, the body at its first end, the body at its last), or None when the run does not
+    have exactly two ends."""
+    run = {start}
+    stack = [start]
+    while stack:
+        r = stack.pop()
+        for k in incident[r]:
+            other = edges[k].b if edges[k].a == r else edges[k].a
+            if other in candidates and other not in run:
+                run.add(other)
+                stack.append(other)
+    ends = []
+    for r in sorted(run, key=lambda r: body_name[r]):  # not set order: the same output whatever the hash seed
+        for k in incident[r]:
+            other = edges[k].b if edges[k].a == r else edges[k].a
+            if other not in run:
+                ends.append((r, k))
+    if len(ends) != 2:
+        return None
+    # walk from one end to the other
+    chain, r, k = [], ends[0][0], ends[0][1]
+    chain.append(edges[k])
+    prev = k
+    while True:
+        nxt = [x for x in incident[r] if x != prev]
+        k = nxt[0]
+        chain.append(edges[k])
+        other = edges[k].b if edges[k].a == r else edges[k].a
+        if other not in run:
+            break
+        r, prev = other, k
+    outer = [edges[ends[0][1]], edges[ends[1][1]]]
+    end_a = outer[0].a if outer[0].a not in run else outer[0].b
+    end_b = outer[1].a if outer[1].a not in run else outer[1].b
+    return run, chain, end_a, end_b
+
+
+def _compound_joint(chain: list[_Edge], kind: str, links: tuple[str, str]) -> Joint:
+    """The compound joint of type ``kind`` a chain of edges makes between ``links``: its centre and axes."""
+    point = chain[0].point
+    direction = direction2 = None
+    if kind == "cylindrical":
+        direction = next(e.direction for e in chain if e.type != "prismatic")
+    elif kind == "spherical":
+        point, _ = lines_point([e.point for e in chain], [e.direction for e in chain], DEFAULT.equal)
+    elif kind == "universal":
+        a, b = chain
+        n = np.cross(_unit_vector(a.direction), _unit_vector(b.direction))
+        # intersection point of the two axes
+        A = np.stack([_unit_vector(a.direction), -_unit_vector(b.direction), n], axis=1)
+        s = np.linalg.lstsq(A, b.point - a.point, rcond=None)[0]
+        point = a.point + s[0] * _unit_vector(a.direction)
+        # the first axis turns with the link at the start of the chain, the second with the end
+        direction, direction2 = a.direction, b.direction
+    return Joint(
+        name=_compound_name([e.name for e in chain], kind),
+        type=kind,
+        dof=sum(e.dof for e in chain) - (1 if kind == "helical" else 0),
+        links=links,
+        members=tuple(e.name for e in chain),
+        cut=any(e.cut for e in chain),
+        point=tuple(point) if point is not None else None,
+        direction=tuple(direction) if direction is not None else None,
+        direction2=tuple(direction2) if direction2 is not None else None,
+    )
+
+
+def _bodies(mech: Any, welds: list) -> tuple[UnionFind, str, dict[str, list[str]], dict[str, str]]:
+    """The rigid bodies the welds make of the links: (their union-find, the ground's root, root -> its links,
+    root -> the body's name: its first URDF link, the ground's the root link)."""
     spec = mech.spec
-    edges, welds = _edges(mech, q)
     uf = UnionFind(list(spec.links))
     for a, b, _ in welds:
         uf.join(a, b)
     ground_root = uf.find(spec.root)
-    groups = {}
+    groups: dict[str, list[str]] = {}
     for name in spec.links:
         groups.setdefault(uf.find(name), []).append(name)
-    # name each rigid body after its first URDF link (the ground after the root link)
     body_name = {r: (spec.root if r == ground_root else members[0]) for r, members in groups.items()}
+    return uf, ground_root, groups, body_name
+
+
+def build_topology(mech: Any, q: np.ndarray) -> Topology:
+    """Links, joints (with compound joints recognized) and motion space at configuration q (``mech``: a
+    model.mechanism.Mechanism, which imports this module)."""
+    tol = mech.tolerances.geometry
+    spec = mech.spec
+    edges, welds = _edges(mech, q)
+    uf, ground_root, groups, body_name = _bodies(mech, welds)
     for e in edges:
         e.a, e.b = uf.find(e.a), uf.find(e.b)
     scale = max([np.linalg.norm(e.point) for e in edges if e.point is not None] + [1e-3])
 
     # massless bodies of degree 2 between 1-DOF joints may be the inside of a compound joint
-    incident = {r: [] for r in groups}
+    incident: dict[str, list[int]] = {r: [] for r in groups}
     for k, e in enumerate(edges):
         incident[e.a].append(k)
         incident[e.b].append(k)
     dm = mech.tolerances.dummy_mass
 
-    def massless(r) -> bool:
+    def massless(r: str) -> bool:
         return r != ground_root and all(spec.links[m].is_massless(dm) for m in groups[r])
 
     def one_dof(k: int) -> bool:
@@ -408,78 +487,24 @@ def build_topology(mech, q: np.ndarray) -> Topology:
     candidates = {r for r in groups if massless(r) and len(incident[r]) == 2 and all(one_dof(k) for k in incident[r])}
     coupled = frozenset(frozenset((c.joint, c.mimics)) for c in mech.couplings)
     consumed = set()
-    used_edges, dummies, compounds = set(), set(), []
+    used_edges: set[int] = set()
+    dummies: set[str] = set()
+    compounds = []
     for start in sorted(candidates, key=lambda r: body_name[r]):
         if start in dummies:
             continue
-        # grow the run of candidate bodies through start, then read the chain of edges in order
-        run = {start}
-        stack = [start]
-        while stack:
-            r = stack.pop()
-            for k in incident[r]:
-                other = edges[k].b if edges[k].a == r else edges[k].a
-                if other in candidates and other not in run:
-                    run.add(other)
-                    stack.append(other)
-        ends = []
-        for r in sorted(run, key=lambda r: body_name[r]):  # not set order: the same output whatever the hash seed
-            for k in incident[r]:
-                other = edges[k].b if edges[k].a == r else edges[k].a
-                if other not in run:
-                    ends.append((r, k))
-        if len(ends) != 2:
+        found = _chain_through(start, candidates, incident, edges, body_name)
+        if found is None:
             continue
-        # walk from one end to the other
-        chain, r, k = [], ends[0][0], ends[0][1]
-        chain.append(edges[k])
-        prev = k
-        while True:
-            nxt = [x for x in incident[r] if x != prev]
-            k = nxt[0]
-            chain.append(edges[k])
-            other = edges[k].b if edges[k].a == r else edges[k].a
-            if other not in run:
-                break
-            r, prev = other, k
-        outer = [edges[ends[0][1]], edges[ends[1][1]]]
-        end_a = outer[0].a if outer[0].a not in run else outer[0].b
-        end_b = outer[1].a if outer[1].a not in run else outer[1].b
+        run, chain, end_a, end_b = found
         kind = _classify_chain(chain, tol, scale, coupled)
         if kind is None:
             continue
         dummies |= run
         used_edges |= {id(e) for e in chain}
-        point = chain[0].point
-        direction = direction2 = None
-        if kind == "cylindrical":
-            direction = next(e.direction for e in chain if e.type != "prismatic")
-        elif kind == "spherical":
-            point, _ = lines_point([e.point for e in chain], [e.direction for e in chain], DEFAULT.equal)
-        elif kind == "universal":
-            a, b = chain
-            n = np.cross(_unit_vector(a.direction), _unit_vector(b.direction))
-            # intersection point of the two axes
-            A = np.stack([_unit_vector(a.direction), -_unit_vector(b.direction), n], axis=1)
-            s = np.linalg.lstsq(A, b.point - a.point, rcond=None)[0]
-            point = a.point + s[0] * _unit_vector(a.direction)
-            # the first axis turns with the link at the start of the chain, the second with the end
-            direction, direction2 = a.direction, b.direction
         if kind == "helical":  # its coupling is the screw's lead: counted in the pair, not again
             consumed |= {c for c in mech.couplings if {c.joint, c.mimics} == {e.name for e in chain}}
-        compounds.append(
-            Joint(
-                name=_compound_name([e.name for e in chain], kind),
-                type=kind,
-                dof=sum(e.dof for e in chain) - (1 if kind == "helical" else 0),
-                links=(body_name[end_a], body_name[end_b]),
-                members=tuple(e.name for e in chain),
-                cut=any(e.cut for e in chain),
-                point=tuple(point) if point is not None else None,
-                direction=tuple(direction) if direction is not None else None,
-                direction2=tuple(direction2) if direction2 is not None else None,
-            )
-        )
+        compounds.append(_compound_joint(chain, kind, (body_name[end_a], body_name[end_b])))
     joints = []
     for e in edges:
         if id(e) in used_edges:
@@ -500,7 +525,7 @@ def build_topology(mech, q: np.ndarray) -> Topology:
                     normal, tuple(c for c in mech.couplings if c not in consumed))
 
 
-def _motion_space(joints: list, tol: float, scale) -> tuple:
+def _motion_space(joints, tol, scale):
     """'planar' when every revolute axis is parallel to one normal and every
     prismatic axis perpendicular to it; 'spherical' when every joint is a
     rotation about one common point; 'spatial' otherwise."""

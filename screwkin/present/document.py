@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     from screwkin.analysis.course.figures import SingularSearch
     from screwkin.analysis.course.newton import NewtonResult
     from screwkin.analysis.mobility import MobilityResult
-    from screwkin.analysis.motion.solution import PositionResult
+    from screwkin.analysis.position.solution import PositionResult
     from screwkin.model.topology import Topology
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",

@@ -16,6 +16,7 @@ and ``edge:X``.  The artists' labels say the symbol's kind ("bar", "polygon", "s
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,12 +25,12 @@ from ..model.geometry import wrap_angle
 from .draw_targets import design_drawing, draw_targets
 from .plots import pyplot
 from .outfile import write_figure
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.course.skeleton import KinematicChain
-    from screwkin.analysis.course.skeleton import Skeleton
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..analysis.course.skeleton import Skeleton, SkeletonJoint
 
 __all__ = ["chain_dict", "draw_chain", "draw_mechanism", "draw_design", "save_figure", "skeleton_dict", "value_label",
            "wrapped_value", "configuration_text", "drawing_title", "number_colours"]
@@ -43,14 +44,14 @@ def _plt():
     return pyplot("drawing")
 
 
-def value_label(name: str, value, unit: str) -> str:
+def value_label(name, value, unit) -> str:
     """'crank = 30 deg' or 'slide = 12.5 mm': a value as a person reads it."""
     if unit == "m":
         return f"{name} = {value * 1000:.4g} mm"
     return f"{name} = {np.degrees(value):.5g} deg"
 
 
-def wrapped_value(value, unit: str):
+def wrapped_value(value, unit):
     """A coordinate's value as a drawing names it: a length [m] as it is, an angle in [-pi, pi)."""
     return value if unit == "m" else wrap_angle(value)
 
@@ -62,16 +63,16 @@ def configuration_text(skel) -> str:
     return ", ".join(value_label(k, v, skel.units[k]) for k, v in skel.inputs.items())
 
 
-def drawing_title(mech: Mechanism, what: str) -> str:
+def drawing_title(mech, what) -> str:
     """A drawing's title: the file's name, then ``what``."""
     return f"{os.path.basename(str(mech.path))}: {what}"
 
 
-def _short(name: str, n: int = 26):
+def _short(name, n=26):
     return name if len(name) <= n else name[: n - 1] + "~"
 
 
-def number_colours(n: int) -> dict:
+def number_colours(n):
     """Link number -> colour (2 .. n + 1; the ground, 1, is drawn grey): the colours drawings and the
     planar view share."""
     cycle = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
@@ -84,7 +85,7 @@ def _direction_2d(v):
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _fit_axes(fig, ax, points, r, limits=None) -> None:
+def _fit_axes(fig, ax, points, r, limits=None):
     """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
     ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
@@ -97,32 +98,26 @@ def _fit_axes(fig, ax, points, r, limits=None) -> None:
     ax.set_axis_off()
 
 
-def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = False, subtitle: str | None = None,
-                   traces: dict | None = None, size: float | None = None, limits=None, marks=None):
-    """The skeleton diagram of a :class:`~screwkin.analysis.course.skeleton.Skeleton` as a matplotlib
-    Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
-    higher pairs as their profiles, binary links as bars, ternary and larger links as filled
-    polygons, links numbered (ground 1) and joints lettered with a legend to the file's
-    names, the input joints marked with a curved arrow (a straight one for a sliding input),
-    and with ``angles`` the absolute link angles (planar mechanisms).  ``size`` [m] (default the
-    skeleton's) sets the symbols' scale and ``limits`` ((x0, x1), (y0, y1)) [m] the framing: the
-    frames of an animation share both.  ``marks``: a synthesized design's targets
-    (present.draw_targets.target_marks), drawn with the linkage ghosted at each."""
-    plt = _plt()
-    from matplotlib.patches import Arc, Circle, FancyArrowPatch, Polygon, Rectangle
+class _Sheet:
+    """A skeleton diagram being drawn: its axes, the symbols' unit ``r`` (a pin's radius), the links' colours,
+    and every point drawn so far (the framing takes them all)."""
 
-    fig = plt.figure(figsize=(10, 6.4))
-    ax = fig.add_axes([0.03, 0.06, 0.66, 0.82])
-    r = 0.022 * (size or skel.size)  # pin radius: the unit of every symbol
-    colour = number_colours(len(skel.links))
-    links = {lk.number: lk for lk in skel.links}
-    points = []
+    def __init__(self, ax: Axes, skel: Skeleton, r: float) -> None:
+        self.ax, self.skel, self.r = ax, skel, r
+        self.colour = number_colours(len(skel.links))
+        self.links = {lk.number: lk for lk in skel.links}
+        self.points: list[tuple[float, ...]] = []
 
-    def col(n: int):
-        return "0.25" if n == 1 else colour[n]
+    def col(self, n: int) -> str:
+        """Link ``n``'s colour (the ground grey)."""
+        return "0.25" if n == 1 else self.colour[n]
 
-    # ground symbol under a point (a pivot) or along a guide
-    def ground_at(letter, p, down=None, along=None) -> None:
+    def ground_at(self, letter: str, p: np.ndarray, down: np.ndarray | None = None,
+                  along: np.ndarray | None = None) -> None:
+        """The ground symbol under a point (a pivot) or along a guide (direction ``along``)."""
+        from matplotlib.patches import Polygon
+
+        ax, r = self.ax, self.r
         p = np.asarray(p, float)
         down = np.array([0.0, -1.0]) if down is None else down
         side = np.array([-down[1], down[0]]) if along is None else np.asarray(along, float)
@@ -139,12 +134,17 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
                  base - width * side + 1.2 * r * down]
         ax.add_patch(Polygon(hatch, closed=True, facecolor="none", edgecolor="0.2", hatch="////", lw=0, zorder=2,
                              gid=f"hatch:{letter}", label="hatch"))
-        points.extend([tuple(base + width * side), tuple(base - width * side), tuple(base + 1.5 * r * down)])
+        self.points.extend([tuple(base + width * side), tuple(base - width * side), tuple(base + 1.5 * r * down)])
 
-    # links
+
+def _draw_links(s: _Sheet) -> None:
+    """Every link: the ground's frame line, bars, polygons, blocks; each numbered."""
+    from matplotlib.patches import Polygon, Rectangle
+
+    ax, r, col, skel = s.ax, s.r, s.col, s.skel
     for lk in skel.links:
         pts = [tuple(p) for p in lk.outline]
-        points.extend(pts)
+        s.points.extend(pts)
         n = lk.number
         if lk.shape == "ground":
             xs, ys = zip(*pts) if pts else ((), ())
@@ -175,45 +175,59 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
             ax.text(*c, str(n), ha="center", va="center", fontsize=10, fontweight="bold", color=col(n), zorder=7,
                     gid=f"linklabel:{n}", bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": col(n), "lw": 0.8})
 
-    # joints
+
+def _draw_joint(s: _Sheet, j: SkeletonJoint, p: np.ndarray) -> None:
+    """A joint's symbol at ``p``: a prismatic pair's guide (and block), a contact point, or a pin with its kind's
+    mark, with the ground symbol under a ground pivot or along a ground guide."""
+    from matplotlib.patches import Circle, Rectangle
+
+    ax, r, col = s.ax, s.r, s.col
+    kind = j.type
+    if kind == "prismatic":
+        d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
+        guide_link = j.links[0]
+        length = 9 * r if guide_link == 1 else 4.5 * r
+        a, b = p - length * d, p + length * d
+        ax.plot(*zip(a, b), color=col(guide_link), lw=1.3, zorder=1.5, gid=f"joint:{j.letter}", label="guide")
+        s.points.extend([tuple(a), tuple(b)])
+        if all(s.links[n].shape != "block" for n in j.links):
+            _block(ax, Rectangle, p, d, r, col(j.links[1]), f"slider:{j.letter}", alpha=0.5)
+        if guide_link == 1:
+            down = np.array([d[1], -d[0]])
+            if down[1] > 0 or (down[1] == 0 and down[0] > 0):
+                down = -down
+            s.ground_at(j.letter, p, down, along=d)
+    elif kind in ("rolling", "gear", "contact"):
+        ax.plot(*p, "o", color="black", ms=4.5, zorder=6, gid=f"joint:{j.letter}", label="contact")
+    else:
+        ax.add_patch(Circle(tuple(p), r, facecolor="white", edgecolor="black", lw=1.3, zorder=5,
+                            gid=f"joint:{j.letter}", label="pin"))
+        if kind == "spherical":
+            ax.add_patch(Circle(tuple(p), 0.45 * r, facecolor="black", zorder=5.5, label="ball"))
+        elif kind == "universal":
+            ax.plot([p[0] - r, p[0] + r], [p[1], p[1]], color="black", lw=0.8, zorder=5.5, label="cross")
+            ax.plot([p[0], p[0]], [p[1] - r, p[1] + r], color="black", lw=0.8, zorder=5.5, label="cross")
+        elif kind not in ("revolute", "continuous"):
+            ax.text(*p, j.symbol, ha="center", va="center", fontsize=6, zorder=6, label="symbol")
+        if j.direction is not None and kind != "prismatic":  # a tilted axis, projected (spatial)
+            d = _direction_2d(j.direction) * 2.6 * r * np.sin(j.tilt)
+            ax.plot(*zip(p - d, p + d), color="0.35", lw=1.0, ls="--", zorder=4.5, label="axis")
+        if j.ground and kind in ("revolute", "continuous", "spherical", "universal", "cylindrical", "helical"):
+            s.ground_at(j.letter, p)
+
+
+def _draw_joints(s: _Sheet) -> None:
+    """Every joint's symbol and letter (in the free corner farthest from the labels and pins placed so far), the
+    ground's number 1 and the input arrows."""
+    from matplotlib.patches import FancyArrowPatch
+
+    ax, r, skel = s.ax, s.r, s.skel
     ground_labelled = False
     taken = [np.asarray(t.get_position(), float) for t in ax.texts]
     for j in skel.joints:
         p = np.asarray(j.point, float)
-        points.append(tuple(p))
-        kind = j.type
-        if kind == "prismatic":
-            d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
-            guide_link = j.links[0]
-            length = 9 * r if guide_link == 1 else 4.5 * r
-            a, b = p - length * d, p + length * d
-            ax.plot(*zip(a, b), color=col(guide_link), lw=1.3, zorder=1.5, gid=f"joint:{j.letter}", label="guide")
-            points.extend([tuple(a), tuple(b)])
-            if all(links[n].shape != "block" for n in j.links):
-                _block(ax, Rectangle, p, d, r, col(j.links[1]), f"slider:{j.letter}", alpha=0.5)
-            if guide_link == 1:
-                down = np.array([d[1], -d[0]])
-                if down[1] > 0 or (down[1] == 0 and down[0] > 0):
-                    down = -down
-                ground_at(j.letter, p, down, along=d)
-        elif kind in ("rolling", "gear", "contact"):
-            ax.plot(*p, "o", color="black", ms=4.5, zorder=6, gid=f"joint:{j.letter}", label="contact")
-        else:
-            ax.add_patch(Circle(tuple(p), r, facecolor="white", edgecolor="black", lw=1.3, zorder=5,
-                                gid=f"joint:{j.letter}", label="pin"))
-            if kind == "spherical":
-                ax.add_patch(Circle(tuple(p), 0.45 * r, facecolor="black", zorder=5.5, label="ball"))
-            elif kind == "universal":
-                ax.plot([p[0] - r, p[0] + r], [p[1], p[1]], color="black", lw=0.8, zorder=5.5, label="cross")
-                ax.plot([p[0], p[0]], [p[1] - r, p[1] + r], color="black", lw=0.8, zorder=5.5, label="cross")
-            elif kind not in ("revolute", "continuous"):
-                ax.text(*p, j.symbol, ha="center", va="center", fontsize=6, zorder=6, label="symbol")
-            if j.direction is not None and kind != "prismatic":  # a tilted axis, projected (spatial)
-                d = _direction_2d(j.direction) * 2.6 * r * np.sin(j.tilt)
-                ax.plot(*zip(p - d, p + d), color="0.35", lw=1.0, ls="--", zorder=4.5, label="axis")
-            if j.ground and kind in ("revolute", "continuous", "spherical", "universal", "cylindrical", "helical"):
-                ground_at(j.letter, p)
-        # its letter: the free corner farthest from the labels and pins placed so far
+        s.points.append(tuple(p))
+        _draw_joint(s, j, p)
         cands = [np.array(v) * 2.0 * r for v in ((1, 1), (-1, 1), (1, -1), (-1, -1), (0, 1.3), (1.3, 0), (-1.3, 0))]
         others = taken + [np.asarray(o.point, float) for o in skel.joints if o is not j]
         best = max(cands, key=lambda c: min([np.linalg.norm(p + c - t) for t in others] + [np.inf]))
@@ -221,20 +235,25 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
         ax.text(*(p + best), j.letter, fontsize=9, style="italic", ha="center", va="center", zorder=8,
                 gid=f"jointlabel:{j.letter}",
                 bbox={"boxstyle": "round,pad=0.05", "fc": "white", "ec": "none", "alpha": 0.8})
-        if j.ground and not ground_labelled and kind != "prismatic":
+        if j.ground and not ground_labelled and j.type != "prismatic":
             ax.text(*(p + np.array([2.6 * r, -2.4 * r])), "1", ha="center", va="center", fontsize=10,
                     fontweight="bold", color="0.25", zorder=7, gid="linklabel:1",
                     bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": "0.25", "lw": 0.8})
             ground_labelled = True
         if j.input:
             _input_arrow(ax, FancyArrowPatch, j, p, r)
-    if not ground_labelled and links[1].outline:
-        p = np.asarray(links[1].outline[0], float)
+    if not ground_labelled and s.links[1].outline:
+        p = np.asarray(s.links[1].outline[0], float)
         ax.text(*(p + np.array([2.6 * r, -3.6 * r])), "1", ha="center", va="center", fontsize=10,
                 fontweight="bold", color="0.25", zorder=7, gid="linklabel:1",
                 bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": "0.25", "lw": 0.8})
 
-    # higher pairs' profiles
+
+def _draw_profiles(s: _Sheet) -> None:
+    """The higher pairs' profiles: circles, lines, points."""
+    from matplotlib.patches import Circle
+
+    ax, r, col, skel = s.ax, s.r, s.col, s.skel
     for pr in skel.profiles:
         c = np.asarray(pr.centre, float)
         gid = f"profile:{pr.joint}:{pr.link}"
@@ -247,47 +266,81 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
             if pair != "gear":
                 ax.add_patch(Circle(tuple(c), pr.radius, facecolor="none", edgecolor=col(pr.link), lw=1.6, zorder=1.9,
                                     label="profile edge"))
-            points.extend([tuple(c + pr.radius), tuple(c - pr.radius)])
+            s.points.extend([tuple(c + pr.radius), tuple(c - pr.radius)])
         elif pr.shape == "line":
             d = _direction_2d(pr.direction)
             contact = np.asarray(skel.joint(pr.joint).point, float)
-            s = (contact - c) @ d
-            lo, hi = min(0.0, s) - 6 * r, max(0.0, s) + 6 * r
+            t = (contact - c) @ d
+            lo, hi = min(0.0, t) - 6 * r, max(0.0, t) + 6 * r
             a, b = c + lo * d, c + hi * d
             ax.plot(*zip(a, b), color=col(pr.link), lw=2.0, ls="-." if pair == "gear" else "-", zorder=1.8, gid=gid,
                     label="profile")
-            points.extend([tuple(a), tuple(b)])
+            s.points.extend([tuple(a), tuple(b)])
         else:
             ax.add_patch(Circle(tuple(c), 0.5 * r, facecolor=col(pr.link), edgecolor="black", lw=0.8, zorder=5.2,
                                 gid=gid, label="profile"))
 
-    if angles and skel.angles:
-        for n, th in sorted(skel.angles.items()):
-            if n == 1 and abs(th) < 1e-12:
-                continue
-            o = np.asarray(skel.angle_origins[n], float)
-            rad = 4.5 * r
-            ax.plot(*zip(o, o + np.array([1.5 * rad, 0.0])), color=col(n), lw=0.7, ls=":", zorder=4,
-                    label="angle reference")
-            t1, t2 = (0.0, np.degrees(th)) if th >= 0 else (np.degrees(th), 0.0)
-            ax.add_patch(Arc(tuple(o), 2 * rad, 2 * rad, theta1=t1, theta2=t2, color=col(n), lw=1.0, zorder=4,
-                             gid=f"angle:{n}", label="angle"))
-            m = np.radians((t1 + t2) / 2)
-            u = np.array([np.cos(m), np.sin(m)])
-            ax.text(*(o + 1.15 * rad * u), f"θ{n} = {np.degrees(th):.1f}°", fontsize=7.5, color=col(n),
-                    ha="left" if u[0] >= 0 else "right", va="bottom" if u[1] >= 0 else "top", zorder=7,
-                    gid=f"anglelabel:{n}")
 
-    for k, (name, xy) in enumerate((traces or {}).items()):  # named points' paths (draw --trace)
+def _draw_angles(s: _Sheet) -> None:
+    """The absolute link angles, each an arc from its reference line with its value."""
+    from matplotlib.patches import Arc
+
+    ax, col = s.ax, s.col
+    for n, th in sorted(s.skel.angles.items()):
+        if n == 1 and abs(th) < 1e-12:
+            continue
+        o = np.asarray(s.skel.angle_origins[n], float)
+        rad = 4.5 * s.r
+        ax.plot(*zip(o, o + np.array([1.5 * rad, 0.0])), color=col(n), lw=0.7, ls=":", zorder=4,
+                label="angle reference")
+        t1, t2 = (0.0, np.degrees(th)) if th >= 0 else (np.degrees(th), 0.0)
+        ax.add_patch(Arc(tuple(o), 2 * rad, 2 * rad, theta1=t1, theta2=t2, color=col(n), lw=1.0, zorder=4,
+                         gid=f"angle:{n}", label="angle"))
+        m = np.radians((t1 + t2) / 2)
+        u = np.array([np.cos(m), np.sin(m)])
+        ax.text(*(o + 1.15 * rad * u), f"θ{n} = {np.degrees(th):.1f}°", fontsize=7.5, color=col(n),
+                ha="left" if u[0] >= 0 else "right", va="bottom" if u[1] >= 0 else "top", zorder=7,
+                gid=f"anglelabel:{n}")
+
+
+def _draw_traces(s: _Sheet, traces: dict[str, np.ndarray]) -> None:
+    """Named points' paths (draw --trace), each from its first point."""
+    for k, (name, xy) in enumerate(traces.items()):
         xy = np.asarray(xy, float)
-        ax.plot(xy[:, 0], xy[:, 1], color=f"C{k}", lw=1.2, ls="--", zorder=2.5, gid=f"trace:{name}",
-                label=f"path of {name}")
-        ax.plot(*xy[0], "o", color=f"C{k}", markersize=4, zorder=6, gid=f"tracepoint:{name}")
-        ax.annotate(name, xy[0], xytext=(4, 4), textcoords="offset points", fontsize=8, color=f"C{k}")
-        points += [tuple(p) for p in xy]
+        s.ax.plot(xy[:, 0], xy[:, 1], color=f"C{k}", lw=1.2, ls="--", zorder=2.5, gid=f"trace:{name}",
+                  label=f"path of {name}")
+        s.ax.plot(*xy[0], "o", color=f"C{k}", markersize=4, zorder=6, gid=f"tracepoint:{name}")
+        s.ax.annotate(name, xy[0], xytext=(4, 4), textcoords="offset points", fontsize=8, color=f"C{k}")
+        s.points += [tuple(p) for p in xy]
+
+
+def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = False, subtitle: str | None = None,
+                   traces: dict | None = None, size: float | None = None,
+                   limits: tuple[tuple[float, float], tuple[float, float]] | None = None,
+                   marks: list | None = None) -> Figure:
+    """The skeleton diagram of a :class:`~screwkin.analysis.course.skeleton.Skeleton` as a matplotlib
+    Figure: ground hatched, pins as small circles, sliders as blocks on their guide lines,
+    higher pairs as their profiles, binary links as bars, ternary and larger links as filled
+    polygons, links numbered (ground 1) and joints lettered with a legend to the file's
+    names, the input joints marked with a curved arrow (a straight one for a sliding input),
+    and with ``angles`` the absolute link angles (planar mechanisms).  ``size`` [m] (default the
+    skeleton's) sets the symbols' scale and ``limits`` ((x0, x1), (y0, y1)) [m] the framing: the
+    frames of an animation share both.  ``marks``: a synthesized design's targets
+    (present.draw_targets.target_marks), drawn with the linkage ghosted at each."""
+    plt = _plt()
+    fig = plt.figure(figsize=(10, 6.4))
+    ax = fig.add_axes([0.03, 0.06, 0.66, 0.82])
+    r = 0.022 * (size or skel.size)  # pin radius: the unit of every symbol
+    s = _Sheet(ax, skel, r)
+    _draw_links(s)
+    _draw_joints(s)
+    _draw_profiles(s)
+    if angles and skel.angles:
+        _draw_angles(s)
+    _draw_traces(s, traces or {})
     if marks:
-        points += draw_targets(ax, marks, r, size or skel.size, col)
-    _fit_axes(fig, ax, points, r, limits)
+        s.points += draw_targets(ax, marks, r, size or skel.size, s.col)
+    _fit_axes(fig, ax, s.points, r, limits)
     fig.suptitle(title or os.path.basename(skel.path), fontsize=11, x=0.36, y=0.97)
     if subtitle:
         fig.text(0.36, 0.905, subtitle, ha="center", va="center", fontsize=8.5, color="0.3")
@@ -295,14 +348,14 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
     return fig
 
 
-def _block_direction(skel: Skeleton, lk):
+def _block_direction(skel, lk):
     for j in skel.joints:
         if lk.number in j.links and j.type in ("prismatic", "cylindrical") and j.direction is not None:
             return _direction_2d(j.direction)
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float = 0.85) -> None:
+def _block(ax, Rectangle, p, d, r, colour, gid, alpha=0.85):
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -311,7 +364,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float = 0.85) -> Non
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j, p, r) -> None:
+def _input_arrow(ax, FancyArrowPatch, j, p, r):
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
@@ -336,7 +389,7 @@ def _input_arrow(ax, FancyArrowPatch, j, p, r) -> None:
                                  label="input"))
 
 
-def _legend(fig, links, joints, marks=None) -> None:
+def _legend(fig, links, joints, marks=None):
     lines = ["links"]
     lines += [f" {lk.number:>2}  {_short(lk.name)}" + ("  (ground)" if lk.ground else "") for lk in links]
     lines.append("")
@@ -359,7 +412,7 @@ def _legend(fig, links, joints, marks=None) -> None:
     fig.text(0.71, 0.88, "\n".join(lines), ha="left", va="top", family="monospace", fontsize=size, gid="legend")
 
 
-def draw_chain(chain: KinematicChain, title: str | None = None):
+def draw_chain(chain, title: str | None = None):
     """The kinematic chain (:class:`~screwkin.analysis.course.skeleton.KinematicChain`) as a Figure: a
     node per link (a circle for a link with at most two joints, a triangle for a ternary link,
     a square for a quaternary one ...; the ground hatched), an edge per joint labelled with its
@@ -425,7 +478,7 @@ def draw_chain(chain: KinematicChain, title: str | None = None):
     return fig
 
 
-def _layout(chain: KinematicChain) -> dict:
+def _layout(chain):
     """Node positions in a unit box: networkx's Kamada-Kawai layout, else a circle; the ground
     at the bottom."""
     numbers = [nd.number for nd in chain.nodes]
@@ -495,7 +548,7 @@ def save_figure(fig, path: str, close: bool = True):
         plt.close(fig)
 
 
-def draw_design(mech: Mechanism, paths: list, steps: int = 360, say=None) -> list:
+def draw_design(mech, paths, steps: int = 360, say=None) -> list:
     """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
     ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
     q = mech.assemble().q
@@ -509,7 +562,7 @@ def draw_design(mech: Mechanism, paths: list, steps: int = 360, say=None) -> lis
     return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
-def skeleton_dict(skel: Skeleton) -> dict:
+def skeleton_dict(skel) -> dict:
     """The numbering and symbols of a drawing, for --json."""
     return {
         "planar": skel.planar,
@@ -523,7 +576,7 @@ def skeleton_dict(skel: Skeleton) -> dict:
     }
 
 
-def chain_dict(chain: KinematicChain) -> dict:
+def chain_dict(chain) -> dict:
     return {
         "nodes": [{"number": nd.number, "name": nd.name, "degree": nd.degree, "ground": nd.ground}
                   for nd in chain.nodes],

@@ -8,7 +8,7 @@ GeometryModel (screwkin's scene) into it; meshcat would need a hand-written page
 channel for the controls.
 
 The logic (inputs -> configuration, modes, singularity, limit positions) is
-:class:`screwkin.analysis.motion.interactive.Interactive`; this module only wires it to the controls:
+:class:`screwkin.analysis.position.interactive.Interactive`; this module only wires it to the controls:
 a slider per input labelled with the joint's name over its range (degrees or millimetres), a
 dropdown of the assembly modes at the current inputs, a status line (a warning near a
 singularity, the reason a move was refused: the slider goes back), a readout of the output
@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.motion.interactive import Interactive
+    from screwkin.analysis.position.interactive import Interactive
     from screwkin.present.view import Scene
 
 __all__ = ["InteractiveView", "viser_module"]

@@ -23,7 +23,7 @@ _KIND = {
 
 
 def types_lines(types) -> list:
-    """The singularity types that meet (analysis.singularities.singular.named_types) as text lines."""
+    """The singularity types that meet (analysis.singular.named_types) as text lines."""
     if not types:
         return ["singularity types: none (no singularity here)"]
     return ["singularity types here:"] + [f"  {v}: {n} -- {w}" for v, n, w in types]

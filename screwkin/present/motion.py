@@ -1,5 +1,5 @@
 """Absolute motion in the user's quantities as text and JSON: links, named points, loop joints
-(the results of analysis/motion/links.py and the solutions of analysis/motion/position.py)."""
+(the results of analysis/motion/links.py and the solutions of analysis/position/position.py)."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 Only a terminal sees it: when stderr is a file or a pipe (a log, a test, CI) nothing is written
 but what the caller prints when the work is done, so that captured output stays the answer
 alone.  The analyses report their progress through a callable ``progress(done, total)`` (they
-never print: tests/test_layers.py); an instance of :class:`Progress` is that callable.
+never print: tests/architecture/test_layers.py); an instance of :class:`Progress` is that callable.
 """
 
 from __future__ import annotations

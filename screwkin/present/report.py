@@ -11,11 +11,11 @@ import numpy as np
 from ..analysis.singularities.maps import SingularityMap
 from ..analysis.mobility import MobilityResult
 from ..analysis.motion.planar import LinkageInfo
-from ..analysis.motion.modes import continuum_words
-from ..analysis.motion.solution import NEWTON_FROM_FILE, PositionResult, search_method
+from ..analysis.position.modes import continuum_words
+from ..analysis.position.solution import NEWTON_FROM_FILE, PositionResult, search_method
 from ..analysis.singularities.scan import ScanResult
 from ..analysis.screws import Screw
-from ..analysis.singularities.singular import SingularityReport
+from ..analysis.singular import SingularityReport
 from ..analysis.motion.sweep import SweepResult, SweepSingularity
 from ..model.topology import Topology
 from ..units import in_unit
@@ -27,18 +27,13 @@ from ..tolerances import DEFAULT
 from .numtext import csv_rows
 from .jsonout import to_jsonable
 from .mobility import mobility_dict, topology_dict
-from typing import TYPE_CHECKING
+from .singular import singularity_dict
 
-if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.motion.solution import Solution
-
-__all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "singularity_dict",
-           "singularity_text", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
+__all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "slide_note"]
 
 
-def position_dict(res: PositionResult) -> dict:
+def position_dict(res) -> dict:
     sols = []
     for s in res.solutions:
         # every coordinate under its name, loop joints too (also kept apart under "loop_joints")
@@ -89,14 +84,14 @@ def position_dict(res: PositionResult) -> dict:
 
 
 def modes_dict(c) -> dict:
-    """analysis.motion.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
+    """analysis.position.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
             "certificate": c.certificate, "reason": c.reason or None, "search": dict(c.detail),
             "certificate_check": dict(c.check) or None}
 
 
-def modes_line(res: PositionResult, n: int) -> str:
+def modes_line(res, n: int) -> str:
     """How many assembly modes, and how that is known: "all 4 assembly modes (certified: trace test);
     36 more solutions are complex", or "3 found ...; completeness not certified because ..."."""
     c = res.modes
@@ -141,14 +136,14 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name: str | int, value: float, angular: bool) -> str:
+def value_text(name, value, angular) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
     return f"{value:.9g} m"
 
 
-def trace_text(res, row_labels, passive_names: list) -> str:
+def trace_text(res, row_labels, passive_names) -> str:
     lines = ["Newton iterations from the first start (rows: closure residual; columns: passive joints)"]
     for st in res.trace:
         lines.append(f"\niteration {st.iteration}: |r| = {np.linalg.norm(st.residual):.3e}"
@@ -161,7 +156,7 @@ def trace_text(res, row_labels, passive_names: list) -> str:
     return "\n".join(lines)
 
 
-def solution_rows(res: PositionResult, s: Solution, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
+def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
     """(headers, rows) of one solution's coordinates -- every tree joint, then every loop (cut) joint
     as ``NAME (loop)`` -- with value [rad or m], the angle in deg (a slide not along the ground's x
     axis: its guide's angle), rate and acceleration when solved with rates, in ``units`` (those typed
@@ -173,7 +168,7 @@ def solution_rows(res: PositionResult, s: Solution, degrees: bool = True, units:
 
     placed = s.guide_positions or {}
 
-    def along(name: str | np.ndarray) -> str:
+    def along(name):
         where = f"d = {placed[name]:.9g} m" if name in placed else ""
         at = f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
         return ", ".join(w for w in (where, at) if w)
@@ -206,7 +201,7 @@ def solution_rows(res: PositionResult, s: Solution, degrees: bool = True, units:
     return headers, rows
 
 
-def slide_note(res: PositionResult, s: Solution) -> str | None:
+def slide_note(res, s) -> str | None:
     """The footnote of a joint table with slides: what a slide's value is measured from, and its ``d``."""
     if all(n in res.angular for n in s.joints) and all(n in res.angular_loop for n in (s.loop_joints or {})):
         return None
@@ -217,7 +212,7 @@ def slide_note(res: PositionResult, s: Solution) -> str | None:
     return note
 
 
-def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False, length: float | None=None, units: RateUnits = RateUnits(),
+def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits(),
                   leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
@@ -225,7 +220,7 @@ def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False,
     as leg lengths (--set-length), said as typed beside the joint's value."""
     legs = leg_lengths or {}
 
-    def given(k: int, v) -> str:
+    def given(k, v):
         text = value_text(k, v, k in res.angular)
         return f"{k} = {legs[k]:.9g} m long (joint {text})" if k in legs else f"{k} = {text}"
 
@@ -291,7 +286,7 @@ def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False,
     return "\n".join(lines)
 
 
-def sweep_rows(n: int, rows: str | None=None) -> list:
+def sweep_rows(n: int, rows=None) -> list:
     """The steps a sweep's tables show: ``rows`` None -> about 11 evenly spaced (the last included),
     "all" -> every step, a number -> about that many."""
     if rows == "all":
@@ -303,7 +298,7 @@ def sweep_rows(n: int, rows: str | None=None) -> list:
     return idx
 
 
-def sweep_text(res: SweepResult, info: LinkageInfo | None = None, mus: list | None=None, rows: str | None=None, degrees: bool = False, linear_names: list=()) -> str:
+def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linear_names=()) -> str:
     """The sweep's summary and a table of joint values (``rows``: see sweep_rows; ``degrees``: the
     input and the angles in deg, the coordinates in ``linear_names`` staying in m)."""
     angular = res.unit == "rad"
@@ -362,115 +357,7 @@ def sweep_text(res: SweepResult, info: LinkageInfo | None = None, mus: list | No
     return "\n".join(lines)
 
 
-def singularity_text(rep: SingularityReport) -> str:
-    def yes(b) -> str:
-        return "YES" if b else "no"
-
-    out = f"   output: {rep.output}" + (" (its origin as a point)" if rep.point else "") if rep.output else ""
-    lines = [f"inputs: {', '.join(rep.inputs) or 'none declared'}" + out,
-             f"(measures of dimensionless matrices: lengths divided by the characteristic length "
-             f"L = {rep.length:.4g} m)",
-             table(["singularity", "present", "relative sigma_min"], [
-                 ("serial / inverse-kinematic (output loses a direction)", yes(rep.serial),
-                  f"{rep.sigmas['serial']:.3g}" if rep.output else "- (no --output)"),
-                 ("actuator / direct-kinematic (moves with inputs locked)", yes(rep.actuator),
-                  f"{rep.sigmas['actuator']:.3g}"),
-                 ("constraint (rank of K drops)", yes(rep.constraint), f"{rep.sigmas['constraint']:.3g}"),
-             ])]
-    lines.append(f"stationary joints (rate forced to zero by the loops): {', '.join(rep.stationary_joints) or 'none'}")
-    gram = tuple(getattr(rep, "gram", ()))
-    free = [g for g in gram if not g.cofactors and g.nullity > 1]  # adj(G) = 0: said once, for all such loops
-    if len(free) > 1:
-        lines.append(f"\nloops closed by {', '.join(f'{g.loop} ({len(g.joints)} joint twists, loop mobility {g.nullity})' for g in free)}: "
-                     f"Gram matrix G = S^T S of each loop's joint twists (dimensionless, L = {rep.length:.4g} m)")
-        lines.append("  cofactors: each loop has more than one freedom of its own, so adj(G) = 0 and every cofactor "
-                     "vanishes identically (the cofactors tell the stationary joints of a loop with one freedom)")
-    for g in gram:
-        if len(free) > 1 and g in free:
-            continue
-        lines.append(f"\nloop closed by {g.loop}: Gram matrix G = S^T S of its {len(g.joints)} joint twists "
-                     f"(dimensionless, L = {rep.length:.4g} m)" + (f", loop mobility {g.nullity}" if g.nullity >= 0 else ""))
-        if not g.cofactors:
-            lines.append(f"  cofactors: {g.note}")
-            continue
-        lines.append(table(["joint", "cofactor C_ii", "C_ii / sum C_jj (= v_i^2)", "stationary"],
-                           [(n, f"{g.cofactors[n]:.6g}", f"{g.relative[n]:.6g}", "YES (C_ii = 0)" if n in g.zero else
-                             "no") for n in g.joints]))
-    lines += _condition_lines(rep)
-    for t in rep.singular_twists:
-        lines.append(f"\n{t.kind} singular direction:")
-        if t.joint_rates:
-            lines.append("  joints moving: " + ", ".join(f"{n} {v:+.4g}" for n, v in t.joint_rates.items()))
-        if t.screw is not None and np.linalg.norm(t.screw.direction) > 0:
-            s = t.screw
-            pitch = f"{s.pitch:.4g} m/rad" if np.isfinite(s.pitch) else "inf (a translation)"
-            lines.append(f"  screw: axis direction {_fmt_vec(s.direction, 0)}, through "
-                         f"{_fmt_vec(s.point, 0) if s.point is not None else '-'}, pitch {pitch}")
-        elif t.twist is not None:  # never a zero twist written as a screw
-            lines.append(f"  the output '{rep.output}' does not move in it (a zero twist: no screw)")
-    return "\n".join(lines)
-
-
-def _condition_meaning(rep: SingularityReport) -> str | None:
-    """What ``rep.condition`` is the condition number of (it is not the input -> output map's)."""
-    if rep.condition is None:
-        return None
-    if rep.manipulability is not None:
-        return ("J_o V: the output's twist over an orthonormal basis of the mechanism's joint-rate motions "
-                "(not over the input rates)")
-    return "K_p: the loops' Jacobian in the passive joints (how well the inputs fix them)"
-
-
-def _condition_lines(rep: SingularityReport) -> list:
-    """The two condition numbers, each saying what it is of: the input -> output map's first (Merlet's, what a
-    parallel robot's user means), then the one of J_o V or K_p."""
-    io = getattr(rep, "condition_input_output", None)
-    note = getattr(rep, "input_output_note", None)
-    value = f"{io:.4g}" if io is not None else "-"
-    if io is None:
-        lines = [f"condition number of the input -> output map (Merlet's): - ({note})"]
-    else:
-        lines = [f"condition number of the input -> output map (Merlet's): {value}"
-                 + (f" ({note})" if note else "")
-                 + f"  (of J: the input rates -> {rep.output}'s twist (v/L, w) at its origin, = of J^-1; "
-                   f"L = {rep.length:.4g} m)"]
-    if rep.condition is not None:
-        lines.append(f"condition number {rep.condition:.4g}" + (
-            f", manipulability {rep.manipulability:.4g}" if rep.manipulability is not None else "")
-            + f" (L = {rep.length:.4g} m) of {_condition_meaning(rep)}")
-    return lines
-
-
 # ------------------------------------------------------------------ results as dictionaries
-def _gram_dict(loops: tuple) -> dict:
-    """gram_loops: every loop's cofactors; gram_cofactors, gram_zero, gram_loop: those of the first
-    loop with one freedom of its own (the single loop of a one-loop mechanism)."""
-    first = next((g for g in loops if g.cofactors), None)
-    return {"gram_loops": [{"loop": g.loop, "joints": list(g.joints), "nullity": g.nullity, "cofactors": g.cofactors,
-                            "relative": g.relative, "zero": list(g.zero), "note": g.note} for g in loops],
-            "gram_loop": first.loop if first else None,
-            "gram_cofactors": dict(first.cofactors) if first else {},
-            "gram_zero": list(first.zero) if first else []}
-
-
-def singularity_dict(rep: SingularityReport) -> dict:
-    return {
-        "serial": rep.serial, "actuator": rep.actuator, "constraint": rep.constraint,
-        "stationary_joints": list(rep.stationary_joints), "sigma_min": rep.sigma_min,
-        "sigmas": rep.sigmas, "condition": rep.condition, "manipulability": rep.manipulability,
-        "condition_of": _condition_meaning(rep),
-        "condition_input_output": getattr(rep, "condition_input_output", None),
-        "condition_input_output_note": getattr(rep, "input_output_note", None),
-        "characteristic_length": rep.length, "inputs": list(rep.inputs), "output": rep.output,
-        "point": rep.point,
-        **_gram_dict(getattr(rep, "gram", ())),
-        "singular_twists": [{"kind": t.kind, "joint_rates": t.joint_rates,
-                             "twist": list(t.twist) if t.twist is not None else None,
-                             "screw": screw_dict(t.screw) if t.screw is not None else None}
-                            for t in rep.singular_twists],
-    }
-
-
 def linkage_dict(info: LinkageInfo) -> dict:
     d = {"kind": info.kind, "lengths": info.lengths, "grashof": info.grashof, "input_joint": info.input_joint,
          "input_range": list(info.input_range) if info.input_range else None,
@@ -483,14 +370,14 @@ def linkage_dict(info: LinkageInfo) -> dict:
     return d
 
 
-def sweep_singularity_dict(s: SweepSingularity, mech: Mechanism | None = None) -> dict:
+def sweep_singularity_dict(s: SweepSingularity, mech=None) -> dict:
     d = {"kind": s.kind, "input": s.input, "sigma": s.sigma, "limit": s.limit}
     if mech is not None:
         d["joints"] = mech.joint_values(s.q)
     return d
 
 
-def sweep_dict(res: SweepResult, mech: Mechanism | None = None) -> dict:
+def sweep_dict(res: SweepResult, mech=None) -> dict:
     return {
         "input": res.input, "input_unit": res.unit,
         "from": res.requested[0], "to": res.requested[1], "steps": res.requested[2],
@@ -599,7 +486,7 @@ def to_dict(result) -> dict:
 
 
 # ------------------------------------------------------------------ the joint vocabulary
-def joint_types_dict(types: tuple) -> list:
+def joint_types_dict(types) -> list:
     """``info --joint-types --json``: one object per kinematic pair screwkin knows."""
     return [{"name": t.name, "symbol": t.symbol, "dof": t.dof, "motion": t.motion, "pair": t.pair,
              "contact": t.contact, "type": t.type, "written": t.written} for t in types]

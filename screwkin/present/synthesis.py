@@ -12,6 +12,7 @@ angles of --input-range/--output-range (``target``/``value`` keep the file's roc
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -222,15 +223,9 @@ def _search_lines(result, constraints) -> list:
     return out
 
 
-def synthesis_text(result, check: Check, file, constraints=()) -> str:
-    """A readable report of a motion, function or path result and its check."""
-    d = synthesis_dict(result, check, file, constraints)
-    design = result.design
+def _method_lines(result: MotionResult | FunctionResult | PathResult) -> list[str]:
+    """How the design was synthesized: the dyads chosen, the function's precision points, the path's fit."""
     out = []
-    kind = design.kind
-    title = {"motion": "Motion generation (rigid-body guidance)", "function": "Function generation (Freudenstein)",
-             "path": "Path generation"}[kind]
-    out.append(f"{title}: wrote {file}")
     if isinstance(result, MotionResult):
         out.append(f"method: {result.method}")
         if len(result.candidates) > 2 or result.ranked:
@@ -262,8 +257,13 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
         else:
             out.append(f"{len(result.points)} points, {timing}; {result.converged} of the designs refined reach every "
                        f"point within {_shown_number(result.tolerance, 3)} m")
-    if getattr(result, "search", None) is not None:
-        out += _search_lines(result, constraints)
+    return out
+
+
+def _linkage_lines(d: dict) -> list[str]:
+    """The linkage written: its links, coupler frame or point, joints (lettered as draw letters them), Grashof
+    class and transmission angle (``d``: synthesis_dict's)."""
+    out = []
     links = d["links"]
     out.append("links [m]: " + ", ".join(f"{n} {_shown_number(v['length'])}" for n, v in links.items()))
     named = {role: (v["letter"] or role) for role, v in d["pivot_joints"].items()}  # draw's letters
@@ -281,10 +281,11 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
     out.append("transmission angle from the first position to the farthest (screwkin's sweep): "
                + (f"{mu[0]:.4g} .. {mu[1]:.4g} deg" if mu else "not measured")
                + (f" (crank turning {d['check']['direction']})" if d["check"]["direction"] else ""))
-    out.append("")
-    out.append(f"checked with screwkin on {file} (loaded, solved at each precision position, followed by sweep):")
-    out.append(f"  drawn closed: {'yes' if check.assembled_iterations == 0 else 'no'} (assembly Newton iterations "
-               f"{check.assembled_iterations})")
+    return out
+
+
+def _precision_rows(result: MotionResult | FunctionResult | PathResult, check: Check) -> list[list]:
+    """The check's table: each precision position, its target, whether it is reached, its errors and travel."""
     rows = []
     typed = _as_typed(result, check) if isinstance(result, FunctionResult) else [None] * len(check.precision)
     for p, travel, as_typed in zip(check.precision, list(check.travel) + [None] * len(check.precision), typed):
@@ -306,6 +307,25 @@ def synthesis_text(result, check: Check, file, constraints=()) -> str:
         rows.append([t.label, f"{_shown_number(math.degrees(t.input))}", want, "yes" if p.reached else "NO", err,
                      f"{p.residual:.2g}", f"{p.closed_form_error:.2g}" if math.isfinite(p.closed_form_error) else "-",
                      "-" if travel is None else _shown_number(math.degrees(travel), 5)])
+    return rows
+
+
+def synthesis_text(result: MotionResult | FunctionResult | PathResult, check: Check, file: str,
+                   constraints: Iterable = ()) -> str:
+    """A readable report of a motion, function or path result and its check."""
+    d = synthesis_dict(result, check, file, constraints)
+    title = {"motion": "Motion generation (rigid-body guidance)", "function": "Function generation (Freudenstein)",
+             "path": "Path generation"}[result.design.kind]
+    out = [f"{title}: wrote {file}"]
+    out += _method_lines(result)
+    if getattr(result, "search", None) is not None:
+        out += _search_lines(result, constraints)
+    out += _linkage_lines(d)
+    out.append("")
+    out.append(f"checked with screwkin on {file} (loaded, solved at each precision position, followed by sweep):")
+    out.append(f"  drawn closed: {'yes' if check.assembled_iterations == 0 else 'no'} (assembly Newton iterations "
+               f"{check.assembled_iterations})")
+    rows = _precision_rows(result, check)
     # "reached" is at the position itself, within the check's tolerance (the header says it): a function
     # generator's structural error between the positions is another number, on its own line above
     within = f"{check.tolerance:.0e} rad" if isinstance(result, FunctionResult) else (

@@ -18,9 +18,11 @@ import subprocess
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from html import escape
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -35,12 +37,9 @@ from .viewplanar import colour_links, link_colours, planar_basis, top_view
 from .viewserver import ViewerServer
 from .camera import BACKGROUND, PICTURE, fit_camera, view_direction
 from .outfile import write_output
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from typing import Any
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.files.description import CutJointSpec
+    from ..model.mechanism import Mechanism
 
 __all__ = ["COLORS", "build_scene", "show", "page", "legend_entries", "view", "RecordingViewer", "screenshot"]
 
@@ -64,7 +63,7 @@ def _coal():
     return coal
 
 
-def _visual_urdf(mech: Mechanism, unreadable: set | tuple = ()) -> str:
+def _visual_urdf(mech, unreadable=()) -> str:
     """The URDF text with every mesh resolved to an absolute path, and visuals
     whose mesh cannot be found (or is in ``unreadable``) dropped (their links get stand-ins)."""
     root = parse_xml_text(mech.spec.urdf_text, mech.path)
@@ -87,20 +86,20 @@ def _visual_urdf(mech: Mechanism, unreadable: set | tuple = ()) -> str:
 _JOINT_FIRST = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.BODY, pin.FrameType.OP_FRAME)
 
 
-def _body_frame(model, name: str):
+def _body_frame(model, name):
     """The BODY frame of link ``name`` (a joint may have the same name), or None."""
     fid = frame_id(model, name)
     return fid if fid is not None and model.frames[fid].type == pin.FrameType.BODY else None
 
 
-def _owner_link(mech: Mechanism, frame_name: str):
+def _owner_link(mech, frame_name):
     """The link a cut joint's side is on: the link itself, or the child link of a joint named so (sidecars)."""
     if frame_name in mech.spec.links:
         return frame_name
     return next((j.child for j in mech.spec.joints if j.name == frame_name), None)
 
 
-def _standin_points(mech: Mechanism) -> dict:
+def _standin_points(mech) -> dict:
     """link -> (its BODY frame id, [(target, point)]): the centres of its child joints and its loop-joint
     frames, expressed like the frame's placement (in the frame of the Pinocchio joint carrying the link)."""
     model = mech.model
@@ -121,7 +120,7 @@ def _standin_points(mech: Mechanism) -> dict:
     return out
 
 
-def _segment(name: str, joint, frame, a, b, radius, color):
+def _segment(name, joint, frame, a, b, radius, color):
     """A cylinder between points a and b (in the frame of joint ``joint``)."""
     coal = _coal()
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -136,13 +135,13 @@ def _segment(name: str, joint, frame, a, b, radius, color):
     return obj
 
 
-def _ball(name: str, joint, frame, p, radius, color):
+def _ball(name, joint, frame, p, radius, color):
     obj = pin.GeometryObject(name, joint, frame, pin.SE3(np.eye(3), np.asarray(p, float)), _coal().Sphere(radius))
     obj.meshColor = np.asarray(color, float)
     return obj
 
 
-def _disc(name: str, joint, frame, M, radius, color, alpha: float = 0.35):
+def _disc(name, joint, frame, M, radius, color, alpha=0.35):
     """A thin disc of ``radius`` whose normal is the z axis of the placement M (a pitch circle or
     a circular profile), see-through so the links stay visible."""
     obj = pin.GeometryObject(name, joint, frame, M, _coal().Cylinder(radius, 0.05 * radius))
@@ -150,7 +149,7 @@ def _disc(name: str, joint, frame, M, radius, color, alpha: float = 0.35):
     return obj
 
 
-def _pair_geometry(mech: Mechanism, cut, spec: CutJointSpec, r_axis, L_axis) -> list:
+def _pair_geometry(mech, cut, spec, r_axis, L_axis):
     """What a higher pair looks like: pitch circles (rolling, gears; a pitch line for a rack),
     profiles (circles as discs, lines as slots, points as pins) and a screw's helix of its lead."""
     model = mech.model
@@ -160,7 +159,7 @@ def _pair_geometry(mech: Mechanism, cut, spec: CutJointSpec, r_axis, L_axis) -> 
     a = np.asarray(cut.axis, float) / np.linalg.norm(cut.axis)
     turn = _segment("t", 0, 0, np.zeros(3), a, 1.0, color).placement.rotation  # z along the axis
 
-    def side(k: int) -> tuple:
+    def side(k):
         f = model.frames[frames[k]]
         return f.parentJoint, frames[k], f.placement
 
@@ -217,7 +216,7 @@ class Scene:
         return np.array([pts.min(axis=0), pts.max(axis=0)])
 
 
-def _corner_points(state: KinematicState, geom) -> np.ndarray:
+def _corner_points(state, geom) -> np.ndarray:
     """Points that bound the drawn geometry at the configuration of ``state`` (a KinematicState): the
     joint centres and the corners of each object's own bounding box placed where its joint puts it
     (meshes as loaded, scale included)."""
@@ -239,7 +238,7 @@ def _corner_points(state: KinematicState, geom) -> np.ndarray:
     return np.asarray(pts)
 
 
-def _visual_geometry(mech: Mechanism, warn=None):
+def _visual_geometry(mech, warn=None):
     """Pinocchio's visual GeometryModel of the links; a mesh file that exists but cannot be
     read (not a mesh, truncated) is a warning and its link is drawn as a stand-in."""
 
@@ -260,30 +259,18 @@ def _visual_geometry(mech: Mechanism, warn=None):
             warn(f"mesh {quote(bad, 120)} cannot be read as a mesh: its link is drawn as a stand-in")
 
 
-def build_scene(mech: Mechanism, q: np.ndarray, output=None, singular=(), warn=None) -> Scene:
-    """The scene at configuration q (used for the characteristic size of the marks).
+#: How build_scene's parts add a geometry object (None: nothing) with its role.
+_Add = Callable[[Any, str], None]
 
-    singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
-    output link's origin, and the singular screw axis as a line with an arrow.
-    warn: callable receiving each warning (a mesh that cannot be read); default: stderr."""
+
+def _joint_marks(mech: Mechanism, add: _Add, r_axis: float, L_axis: float) -> None:
+    """Each moving joint's axis (drawn on its child side) and centre; a prismatic joint's with an arrow head; each
+    cut joint's axis on its F1 side, a higher pair's profiles."""
     model = mech.model
-    geom = _visual_geometry(mech, warn)
-    roles = {o.name: "link" for o in geom.geometryObjects}
-    state = KinematicState(mech, q)
-    pts = np.array([state.centre(("joint", j)) for j in range(model.njoints)])
-    scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
-    center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
-    r_axis, L_axis = 0.004 * scale, 0.08 * scale
-
-    def add(obj, role: str) -> None:
-        if obj is not None:
-            geom.addGeometryObject(obj)
-            roles[obj.name] = role
-
     actuated = set(mech.actuated)
     axis_of = {j.name: np.asarray(j.axis) for j in mech.spec.joints}
     virtual = {n for names in mech.virtual_joints.values() for n in names}
-    for c in mech.coordinates:  # joint axes, drawn on the child side of each moving joint
+    for c in mech.coordinates:
         if c.joint in virtual:
             continue  # the equivalent linkage of a higher pair: drawn as the pair below
         jid = c.joint_id
@@ -318,6 +305,51 @@ def build_scene(mech: Mechanism, q: np.ndarray, output=None, singular=(), warn=N
         else:
             add(_segment(f"screwkin/cut/{cut.name}", f.parentJoint, cut.frame1, p - L_axis * a, p + L_axis * a,
                          1.5 * r_axis, COLORS["cut"]), "axis:cut")
+
+
+def _singular_marks(mech: Mechanism, output: str | None, singular: Iterable, add: _Add, r_axis: float,
+                    L_axis: float) -> None:
+    """At each singular configuration: a ball at the output link's origin, and the singular screw axis as a
+    line with an arrow."""
+    for k, (qs, twist) in enumerate(singular):
+        if output is not None:
+            at = KinematicState(mech, qs).frame_placement(mech.link_frame(output)).translation
+            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, at, 4 * r_axis,
+                      COLORS["marker"]), "singular:marker")
+        if twist is not None and twist.screw is not None and twist.screw.point is not None:
+            s = twist.screw
+            p, u = np.asarray(s.point), np.asarray(s.direction)
+            add(_segment(f"screwkin/singular/{k}/axis", 0, 0, p - 3 * L_axis * u, p + 3 * L_axis * u, r_axis,
+                         COLORS["screw"]), "singular:axis")
+            cone = pin.GeometryObject(f"screwkin/singular/{k}/arrow", 0, 0, pin.SE3(
+                _segment("t", 0, 0, p, p + u, 1, COLORS["screw"]).placement.rotation, p + 3 * L_axis * u),
+                _coal().Cone(3 * r_axis, 6 * r_axis))
+            cone.meshColor = COLORS["screw"]
+            add(cone, "singular:arrow")
+
+
+def build_scene(mech: Mechanism, q: np.ndarray, output: str | None = None, singular: Iterable = (),
+                warn: Callable[[str], object] | None = None) -> Scene:
+    """The scene at configuration q (used for the characteristic size of the marks).
+
+    singular: (q_singular, SingularTwist or None) pairs to mark: a ball at the
+    output link's origin, and the singular screw axis as a line with an arrow.
+    warn: callable receiving each warning (a mesh that cannot be read); default: stderr."""
+    model = mech.model
+    geom = _visual_geometry(mech, warn)
+    roles = {o.name: "link" for o in geom.geometryObjects}
+    state = KinematicState(mech, q)
+    pts = np.array([state.centre(("joint", j)) for j in range(model.njoints)])
+    scale = float(max(np.ptp(pts, axis=0).max(), 0.05))
+    center = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    r_axis, L_axis = 0.004 * scale, 0.08 * scale
+
+    def add(obj: Any, role: str) -> None:
+        if obj is not None:
+            geom.addGeometryObject(obj)
+            roles[obj.name] = role
+
+    _joint_marks(mech, add, r_axis, L_axis)
     # stand-ins for links without any visual: a ball at the link frame (its parent joint's centre) and bars
     # to the centres of its child joints and to its loop-joint frames
     with_visual = {model.frames[o.parentFrame].name for o in geom.geometryObjects if roles[o.name] == "link"}
@@ -342,21 +374,7 @@ def build_scene(mech: Mechanism, q: np.ndarray, output=None, singular=(), warn=N
             end = fr.placement.translation + 2 * L_axis * fr.placement.rotation[:, k]
             add(_segment(f"screwkin/output/{axis}", fr.parentJoint, fid, fr.placement.translation, end, r_axis,
                          COLORS[axis]), f"output:{axis}")
-    for k, (qs, twist) in enumerate(singular):
-        if output is not None:
-            at = KinematicState(mech, qs).frame_placement(mech.link_frame(output)).translation
-            add(_ball(f"screwkin/singular/{k}/marker", 0, 0, at, 4 * r_axis,
-                      COLORS["marker"]), "singular:marker")
-        if twist is not None and twist.screw is not None and twist.screw.point is not None:
-            s = twist.screw
-            p, u = np.asarray(s.point), np.asarray(s.direction)
-            add(_segment(f"screwkin/singular/{k}/axis", 0, 0, p - 3 * L_axis * u, p + 3 * L_axis * u, r_axis,
-                         COLORS["screw"]), "singular:axis")
-            cone = pin.GeometryObject(f"screwkin/singular/{k}/arrow", 0, 0, pin.SE3(
-                _segment("t", 0, 0, p, p + u, 1, COLORS["screw"]).placement.rotation, p + 3 * L_axis * u),
-                _coal().Cone(3 * r_axis, 6 * r_axis))
-            cone.meshColor = COLORS["screw"]
-            add(cone, "singular:arrow")
+    _singular_marks(mech, output, singular, add, r_axis, L_axis)
     return Scene(geom, roles, scale, center, _corner_points(state, geom),
                  declared=mech.actuation_source is not None)
 
@@ -364,7 +382,7 @@ def build_scene(mech: Mechanism, q: np.ndarray, output=None, singular=(), warn=N
 class RecordingViewer:
     """A stand-in for meshcat.Visualizer that records what is sent to it."""
 
-    def __init__(self, root=None, path: str = "") -> None:
+    def __init__(self, root=None, path=""):
         import meshcat.path
 
         self._root = root or self
@@ -373,36 +391,36 @@ class RecordingViewer:
         if root is None:
             self.objects, self.transforms, self.properties, self.animation = {}, {}, {}, None
 
-    def __getitem__(self, path) -> RecordingViewer:
+    def __getitem__(self, path):
         path = path if path.startswith("/") else f"{self._path}/{path}"
         return RecordingViewer(self._root, path)
 
-    def set_object(self, geometry, material=None) -> None:
+    def set_object(self, geometry, material=None):
         self._root.objects[self._path] = (geometry, material)
 
-    def set_transform(self, matrix: np.ndarray | None = None) -> None:
-        self._root.transforms[self._path] = np.eye(4) if matrix is None else np.asarray(matrix)
+    def set_transform(self, matrix=np.eye(4)):
+        self._root.transforms[self._path] = np.asarray(matrix)
 
-    def set_property(self, key, value) -> None:
+    def set_property(self, key, value):
         self._root.properties[(self._path, key)] = value
 
-    def delete(self) -> None:
+    def delete(self):
         self._root.objects.pop(self._path, None)
 
-    def set_animation(self, animation, play: bool=True, repetitions: int = 1) -> None:
+    def set_animation(self, animation, play=True, repetitions=1):
         self._root.animation = animation
 
-    def get_image(self, *args: Any):  # pragma: no cover - present so Pinocchio does not warn
+    def get_image(self, *args):  # pragma: no cover - present so Pinocchio does not warn
         raise NotImplementedError
 
 
-def _translation(p) -> np.ndarray:
+def _translation(p):
     T = np.eye(4)
     T[:3, 3] = p
     return T
 
 
-def show(mech: Mechanism, scene: Scene, viewer, q: np.ndarray, motion=None, fps: int = 30):
+def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
     """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
     with ``motion`` (a sequence of configurations) also set a meshcat animation.  A planar
     mechanism is seen along its plane's normal, orthographic, a colour per link (viewplanar)."""
@@ -516,7 +534,7 @@ def page(html: str, scene: Scene, title: str | None = None, controls: bool = Tru
     return html[:at] + style + legend + html[at:]
 
 
-def chromium() -> str | None:
+def chromium():
     for name in ("chromium", "chromium-browser", "google-chrome"):
         for d in os.environ.get("PATH", "").split(os.pathsep):
             p = Path(d) / name
@@ -525,7 +543,7 @@ def chromium() -> str | None:
     return None
 
 
-def screenshot(html_path, png_path, size=PICTURE, budget_ms: int = 8000):
+def screenshot(html_path, png_path, size=PICTURE, budget_ms=8000):
     """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
     exe = chromium()
     if exe is None:
@@ -547,7 +565,7 @@ def screenshot(html_path, png_path, size=PICTURE, budget_ms: int = 8000):
 _servers = []  # servers started by view(): they live as long as the Python session (a notebook)
 
 
-def view(mech: Mechanism, q: np.ndarray | None = None, output=None, motion=None, viewer=None):
+def view(mech, q=None, output=None, motion=None, viewer=None):
     """Show a mechanism (at q, default its assembled configuration) and return the
     meshcat viewer; in a notebook, ``view(mech, s.q).jupyter_cell()`` embeds it.
     Without ``viewer`` a loopback-only server is started and kept for the session."""

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from ...errors import UsageError
 from ...model.linalg import rank
 from ..screws import structure
-from ..singularities.singular import Generic, classify, scaled_jacobians
+from ..singular import Generic, classify, scaled_jacobians
 from .vector_loops import VectorLoops
 from typing import TYPE_CHECKING
 

@@ -12,7 +12,7 @@ import numpy as np
 from ...errors import UsageError
 from ..motion.link_inputs import holding_angles
 from ..motion.links import motion_along
-from ..motion.position import PositionSolver
+from ..position.position import PositionSolver
 from ..motion.change_points import change_points
 from ..motion.singular_points import locate_singularities
 from ..motion.sweep import SweepSingularity, sweep

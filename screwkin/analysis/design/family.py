@@ -4,7 +4,7 @@ over all of them at once.
 
 For a chunk of designs (chunk_rows, what a Dask task runs):
 
-1. the xacro file is expanded once with the parameters as arrays (files.xacro_batch); each design's
+1. the xacro file is expanded once with the parameters as arrays (files.xacro_batch.read_designs); each design's
    URDF is that template with its numbers, read and checked as any file is (files.urdf.read_urdf:
    the same problems refuse it); a design whose expansion or file fails, or whose structure (links,
    joints, loop joints, their types and links, which links are massless) differs from the others,
@@ -35,23 +35,22 @@ from __future__ import annotations
 import math
 import warnings
 from collections import Counter
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import AssemblyError, MechanismFileError, UsageError
-from ...files.urdf import read_urdf
+from ...errors import AssemblyError, UsageError
 from ...files.xacro import is_xacro
-from ...files.xacro_batch import Unbatchable, expand_batch
+from ...files.xacro_batch import Unbatchable, read_designs
 from ...model.closability import obstacle_of, planar_loops
 from ...model.state import KinematicState
 from ..motion.transmission import FOUR_BAR_CLASSES, four_bar_classes, four_bar_transmission
-from .study import _GRASHOF, COLUMNS, evaluate_design, _reason, metric_columns, run_chunk
-from typing import TYPE_CHECKING
+from .study import (COLUMNS, StudyDesign, StudyTask, evaluate_design, failed_row, failure_reason, grashof_short,
+                    metric_columns, run_chunk)
 
 if TYPE_CHECKING:
-    from screwkin.analysis.design.study import _Design
-    from screwkin.analysis.design.study import _Task
-    from screwkin.files.description import MechanismSpec
+    from ...files.description import MechanismSpec
+    from ...tolerances import Tolerances
 
 __all__ = ["ChunkRows", "FAMILY_CHUNK", "FAMILY_METRICS", "chunk_rows", "eligible", "family_rows"]
 
@@ -69,13 +68,13 @@ class ChunkRows(list):
     """A chunk's rows, with ``paths`` ({"family": n, "design": m}) and ``notes`` (why designs were
     evaluated alone), sent back with them from the worker."""
 
-    def __init__(self, rows=(), paths=None, notes=()) -> None:
+    def __init__(self, rows=(), paths=None, notes=()):
         super().__init__(rows)
         self.paths = dict(paths or {})
         self.notes = list(notes)
 
 
-def eligible(task: _Task) -> str | None:
+def eligible(task) -> str | None:
     """Why the family path does not apply to a study (None: it may)."""
     other = [m for m in task.metrics if m not in FAMILY_METRICS]
     if other:
@@ -85,7 +84,7 @@ def eligible(task: _Task) -> str | None:
     return None
 
 
-def chunk_rows(task, chunk: int) -> ChunkRows:
+def chunk_rows(task, chunk) -> ChunkRows:
     """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes.  A family
     whose structure does not change with its parameters takes the family path (family_rows); other
     studies, and the designs the family path cannot vouch for, are evaluated one by one
@@ -98,7 +97,7 @@ def chunk_rows(task, chunk: int) -> ChunkRows:
     return ChunkRows(run_chunk(task, chunk), {"design": len(chunk)})
 
 
-def _rpy_matrices(rpy: np.ndarray) -> np.ndarray:
+def _rpy_matrices(rpy):
     """Rotation matrices (n, 3, 3) of URDF rpy angles (n, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy[:, 0], rpy[:, 1], rpy[:, 2]
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
@@ -107,7 +106,7 @@ def _rpy_matrices(rpy: np.ndarray) -> np.ndarray:
                      np.stack([-sp, cp * sr, cp * cr], -1)], -2)
 
 
-def _signature(spec: MechanismSpec, dummy_mass) -> tuple:
+def _signature(spec, dummy_mass) -> tuple:
     """What must be the same for two designs to share a structure."""
     return (tuple((k, v.is_massless(dummy_mass), v.has_geometry) for k, v in spec.links.items()),
             tuple((j.name, j.type, j.parent, j.child, j.mimic) for j in spec.joints),
@@ -120,7 +119,7 @@ class _Placed:
     """Every design's tree joint frames and loop-joint frames at the file's configuration (all joints
     at zero), composed from their files' origins: world (R (n, 3, 3), p (n, 3))."""
 
-    def __init__(self, specs) -> None:
+    def __init__(self, specs):
         first = specs[0]
         n = len(specs)
         links = {first.root: (np.broadcast_to(np.eye(3), (n, 3, 3)), np.zeros((n, 3)))}
@@ -177,7 +176,7 @@ class _Fourbar:
     """The reference design's four-bar: which joint centres and loop frames each link's length joins,
     and the sides of its loop (model.closability.planar_loops)."""
 
-    def __init__(self, d: _Design, spec) -> None:
+    def __init__(self, d, spec):
         mech, info = d.mech, d.linkage()
         if info.kind != "four-bar":
             raise Unbatchable("the family path analyses four-bars (this one is a slider-crank)")
@@ -187,10 +186,10 @@ class _Fourbar:
         inp = joints[info.input_joint]
         ground = topo.ground
 
-        def other(link: str, joint):
+        def other(link, joint):
             return next(j for j in topo.joints if j is not joint and link in j.links)
 
-        def far(joint, link: str):
+        def far(joint, link):
             return joint.links[1] if joint.links[0] == link else joint.links[0]
 
         moving = far(inp, ground)
@@ -216,7 +215,7 @@ class _Fourbar:
             self.frames[c.frame2] = (c.name, 1)
         self.lengths = info.lengths
 
-    def point(self, placed: _Placed, joint, link: str):
+    def point(self, placed, joint, link):
         """The joint's centre (a loop joint: its frame on ``link``) at every design: (n, 3)."""
         if joint in self.cut_names:
             c = self.cut_names[joint]
@@ -226,7 +225,7 @@ class _Fourbar:
             return placed.cuts[joint][side][1]
         return placed.joints[joint][1]
 
-    def ref_point(self, placed: _Placed, ref):
+    def ref_point(self, placed, ref):
         kind, ident = ref
         if kind == "frame":
             name, side = self.frames[ident]
@@ -234,128 +233,130 @@ class _Fourbar:
         return placed.joints[self.names[ident]][1]
 
 
-def _flat(P, n: int):
+def _flat(P, n):
     return P - np.einsum("ni,ni->n", P, n)[:, None] * n
 
 
-def family_rows(task, chunk) -> ChunkRows | None:
+def family_rows(task: StudyTask, chunk: list[tuple[int, tuple]]) -> ChunkRows | None:
     """The rows of ``chunk`` ([(index, values), ...]) by the family path (module docstring), a
     ChunkRows; None when the study is not one it applies to (its metrics, a plain file)."""
     if eligible(task) is not None:
         return None
     index = [i for i, _ in chunk]
     values = np.array([v for _, v in chunk], float)
-    alone = {}  # position in chunk -> why it is evaluated alone
     try:
-        return _family(task, chunk, index, values, alone)
+        return _family(task, chunk, index, values)
     except Unbatchable as exc:
         rows = [evaluate_design(task, i, v) for i, v in chunk]
         return ChunkRows(rows, {"design": len(chunk)}, [f"designs {index[0]}-{index[-1]} evaluated one by one: "
                                                         f"{exc}"])
 
 
-def _family(task: _Task, chunk, index: int | list, values: np.ndarray, alone: dict) -> ChunkRows:
-    n = len(chunk)
-    be = expand_batch(task.file, task.text, task.args, {p: values[:, k] for k, p in enumerate(task.parameters)})
-    specs = [None] * n
-    for k in range(n):
-        if be.bad[k]:
-            alone[k] = "its expansion fails (xacro's message)"
-            continue
-        try:
-            specs[k] = read_urdf(task.file, be.design(k))
-        except (MechanismFileError, UsageError):
-            alone[k] = "its file is refused (the reader's message)"
-    # the reference: the first design whose own evaluation analyses it
-    rows = [None] * n
-    ref = None
-    for k in range(n):
+def _reference(task: StudyTask, chunk: list[tuple[int, tuple]], index: list[int], specs: list,
+               alone: dict[int, str]) -> tuple[list[dict | None], int, StudyDesign]:
+    """(the rows evaluated alone so far, the reference's position, the reference design): the reference is the
+    first design whose own evaluation analyses it."""
+    rows: list[dict | None] = [None] * len(chunk)
+    for k in range(len(chunk)):
         if specs[k] is None:
             continue
-        kept = []
+        kept: list[StudyDesign] = []
         rows[k] = evaluate_design(task, index[k], chunk[k][1], keep=kept)
         if kept:
-            ref = k
-            d = kept[0]
-            break
+            return rows, k, kept[0]
         alone[k] = "its own evaluation fails (its row says why)"
         if sum(1 for r in rows if r is not None) >= 3:
             raise Unbatchable("three designs in a row could not be analysed alone")
-    if ref is None:
-        raise Unbatchable("no design of the chunk could be analysed")
-    dummy = d.mech.tolerances.dummy_mass
+    raise Unbatchable("no design of the chunk could be analysed")
+
+
+def _same_structure(specs: list, ref: int, dummy: float, alone: dict[int, str]) -> list[int]:
+    """The designs besides the reference that share its structure (the others: in ``alone``, with why)."""
     sig = _signature(specs[ref], dummy)
-    fast = [k for k in range(n) if specs[k] is not None and k not in alone and k != ref]
+    fast = [k for k in range(len(specs)) if specs[k] is not None and k not in alone and k != ref]
     for k in fast:
         if _signature(specs[k], dummy) != sig:
             alone[k] = "its structure differs (links, joints, their types or massless links)"
-    fast = [k for k in fast if k not in alone]
-    try:
-        fb = _Fourbar(d, specs[ref])
-    except UsageError as exc:  # not a four-bar (its own evaluation says so when it computes grashof)
-        raise Unbatchable(str(exc)) from None
-    members = [ref] + fast
-    placed = _Placed([specs[k] for k in members])
-    _check_reference(d, fb, placed, specs[ref])
-    tol = d.mech.tolerances
-    n_in = placed.axes[fb.input_name]
-    n_in = n_in / np.linalg.norm(n_in, axis=1)[:, None]
-    planar = np.ones(len(members), bool)
-    for name, a in placed.axes.items():
-        kind = next((j.type for j in specs[ref].joints if j.name == name), None) or \
-            next(c.type for c in specs[ref].cut_joints if c.name == name)
-        if kind in ("revolute", "continuous"):
-            planar &= np.linalg.norm(np.cross(a / np.linalg.norm(a, axis=1)[:, None], n_in), axis=1) <= tol.geometry
-    L = {}
-    for name, ((ja, la), (jb, lb)) in fb.sides.items():
-        L[name] = np.linalg.norm(_flat(fb.point(placed, ja, la), n_in) - _flat(fb.point(placed, jb, lb), n_in), axis=1)
-    g, a, b, c = L["ground"], L["input"], L["coupler"], L["output"]
-    longest = np.maximum.reduce([g, a, b, c])
-    size = np.maximum(longest, 1.0)
-    # the loop's sides as model.closability measures them, and whether it closes
-    proved = {}
-    margin_ok = np.ones(len(members), bool)
-    for cut, names, points in fb.loops:
-        P = [_flat(fb.ref_point(placed, r), n_in) for r in points]
-        sides = np.stack([np.linalg.norm(P[k + 1] - P[k], axis=1) for k in range(len(P) - 1)], axis=1)
-        excess = sides.max(axis=1) - (sides.sum(axis=1) - sides.max(axis=1))
-        margin_ok &= np.abs(excess - tol.geometry) > tol.equal * size  # clear of the test's own threshold
-        for m in np.flatnonzero(excess > tol.geometry):
-            if m not in proved:
-                proved[m] = obstacle_of(cut, names, list(map(float, sides[m])), tol.geometry)
-    closes = -(np.maximum.reduce([g, a, b, c]) - (g + a + b + c - longest))  # others - longest
-    ok = planar & margin_ok & (np.minimum.reduce([g, a, b, c]) > SHORT_LINK * longest)
-    ok &= (closes > tol.equal * size) | np.isin(np.arange(len(members)), list(proved))
-    codes = four_bar_classes(g, a, b, c, tol.equal)
-    mu_lo, mu_hi, turns, dead = four_bar_transmission(g, a, b, c, tol.equal)
-    srt = np.sort(np.stack([g, a, b, c]), axis=0)
-    margin = srt[1] + srt[2] - srt[0] - srt[3]
-    short = {s: next(x for prefix, x in _GRASHOF if s.startswith(prefix)) for s in FOUR_BAR_CLASSES}
-    reference = rows[ref]
-    columns = metric_columns(task.metrics)
+    return [k for k in fast if k not in alone]
+
+
+class _ClosedForms:
+    """The four-bar's closed forms at every member design (the reference first): whether its axes are parallel
+    (``planar``), its link lengths in the plane of motion, the loops proved not to close (``proved``: position ->
+    (reason, gap)), which designs the closed forms vouch for (``ok``), the Grashof class codes and margins and
+    the transmission angle's extremes."""
+
+    def __init__(self, fb: _Fourbar, placed: _Placed, spec: MechanismSpec, tol: Tolerances, members: int) -> None:
+        n_in = placed.axes[fb.input_name]
+        n_in = n_in / np.linalg.norm(n_in, axis=1)[:, None]
+        planar = np.ones(members, bool)
+        for name, a in placed.axes.items():
+            kind = next((j.type for j in spec.joints if j.name == name), None) or \
+                next(c.type for c in spec.cut_joints if c.name == name)
+            if kind in ("revolute", "continuous"):
+                planar &= np.linalg.norm(np.cross(a / np.linalg.norm(a, axis=1)[:, None], n_in), axis=1) <= tol.geometry
+        L = {}
+        for name, ((ja, la), (jb, lb)) in fb.sides.items():
+            L[name] = np.linalg.norm(_flat(fb.point(placed, ja, la), n_in) - _flat(fb.point(placed, jb, lb), n_in),
+                                     axis=1)
+        g, a, b, c = L["ground"], L["input"], L["coupler"], L["output"]
+        longest = np.maximum.reduce([g, a, b, c])
+        size = np.maximum(longest, 1.0)
+        # the loop's sides as model.closability measures them, and whether it closes
+        self.proved: dict[int, tuple[str, float]] = {}
+        margin_ok = np.ones(members, bool)
+        for cut, names, points in fb.loops:
+            P = [_flat(fb.ref_point(placed, r), n_in) for r in points]
+            sides = np.stack([np.linalg.norm(P[k + 1] - P[k], axis=1) for k in range(len(P) - 1)], axis=1)
+            excess = sides.max(axis=1) - (sides.sum(axis=1) - sides.max(axis=1))
+            margin_ok &= np.abs(excess - tol.geometry) > tol.equal * size  # clear of the test's own threshold
+            for m in np.flatnonzero(excess > tol.geometry):
+                if int(m) not in self.proved:
+                    self.proved[int(m)] = obstacle_of(cut, names, list(map(float, sides[m])), tol.geometry)
+        closes = -(np.maximum.reduce([g, a, b, c]) - (g + a + b + c - longest))  # others - longest
+        ok = planar & margin_ok & (np.minimum.reduce([g, a, b, c]) > SHORT_LINK * longest)
+        ok &= (closes > tol.equal * size) | np.isin(np.arange(members), list(self.proved))
+        self.planar, self.ok = planar, ok
+        self.codes = four_bar_classes(g, a, b, c, tol.equal)
+        self.mu_lo, self.mu_hi, self.turns, self.dead = four_bar_transmission(g, a, b, c, tol.equal)
+        srt = np.sort(np.stack([g, a, b, c]), axis=0)
+        self.margin = srt[1] + srt[2] - srt[0] - srt[3]
+
+    def row(self, m: int, task: StudyTask, i: int, values: tuple, reference: dict) -> dict:
+        """The family path's row of member ``m`` (design ``i`` of ``values``)."""
+        return _row_of(task, i, values, metric_columns(task.metrics), reference, self.codes[m], self.margin[m],
+                       self.mu_lo[m], self.mu_hi[m], self.turns[m], self.dead[m])
+
+
+def _made_rows(task: StudyTask, chunk: list[tuple[int, tuple]], index: list[int], members: list[int], ref: int,
+               reference: dict, cf: _ClosedForms, alone: dict[int, str]) -> dict[int, dict]:
+    """The rows the closed forms give (position -> row), the reference's not yet; the designs they cannot vouch
+    for in ``alone``, with why."""
     made = {}
     for m, k in enumerate(members):
         if k == ref:
             continue
-        if not ok[m]:
-            alone[k] = ("its axes are not parallel" if not planar[m] else
+        if not cf.ok[m]:
+            alone[k] = ("its axes are not parallel" if not cf.planar[m] else
                         "its loop is within the tolerance of closing or not, or a link is nearly zero")
             continue
-        if m in proved:  # the failed row of a loop that cannot close: the single commands' sentence
-            row = {"design": index[k], **dict(zip(task.parameters, chunk[k][1]))}
-            row.update(dict.fromkeys(columns))
-            reason, gap = proved[m]
-            row["error"] = _reason(AssemblyError(task.file, gap, 0, starts=0, reason=reason, proved=True), task.file)
+        if m in cf.proved:  # the failed row of a loop that cannot close: the single commands' sentence
+            reason, gap = cf.proved[m]
+            made[k] = failed_row(task, index[k], chunk[k][1], failure_reason(
+                AssemblyError(task.file, gap, 0, starts=0, reason=reason, proved=True), task.file))
         else:
-            row = _row_of(task, index[k], chunk[k][1], columns, reference, codes[m], margin[m], mu_lo[m], mu_hi[m],
-                          turns[m], dead[m], short)
-        made[k] = row
-    # the family path's rows must be the designs' own: the reference's recomputed, and one drawn at random.
-    # Every design the family path covers reports its closed-form row (the reference and the drawn one too),
-    # so that a design's row does not depend on which chunk it fell in.
-    if reference["error"] is None and ok[0]:
-        mine = _row_of(task, index[ref], chunk[ref][1], columns, reference, codes[0], margin[0], mu_lo[0], mu_hi[0],
-                       turns[0], dead[0], short)
+            made[k] = cf.row(m, task, index[k], chunk[k][1], reference)
+    return made
+
+
+def _vouch(task: StudyTask, chunk: list[tuple[int, tuple]], index: list[int], ref: int, reference: dict,
+           cf: _ClosedForms, made: dict[int, dict]) -> None:
+    """The family path's rows must be the designs' own: the reference's recomputed, and one drawn at random
+    (Unbatchable when one differs).  Every design the family path covers reports its closed-form row (the
+    reference and the drawn one too), so that a design's row does not depend on which chunk it fell in."""
+    columns = metric_columns(task.metrics)
+    if reference["error"] is None and cf.ok[0]:
+        mine = cf.row(0, task, index[ref], chunk[ref][1], reference)
         col = _differs(mine, reference, columns)
         if col is not None:
             raise Unbatchable(f"the closed form's {col} of design {index[ref]} ({mine[col]!r}) is not its own "
@@ -370,20 +371,42 @@ def _family(task: _Task, chunk, index: int | list, values: np.ndarray, alone: di
         if col is not None:
             raise Unbatchable(f"the family path's {col} of design {index[k]} ({made[k][col]!r}) is not its own "
                               f"evaluation's ({own[col]!r})")
-    out, reasons = [], Counter()
+
+
+def _family(task: StudyTask, chunk: list[tuple[int, tuple]], index: list[int], values: np.ndarray) -> ChunkRows:
+    n = len(chunk)
+    specs, alone = read_designs(task.file, task.text, task.args,
+                                {p: values[:, k] for k, p in enumerate(task.parameters)})
+    rows, ref, d = _reference(task, chunk, index, specs, alone)
+    spec, reference = specs[ref], rows[ref]
+    assert spec is not None and reference is not None  # the reference's file was read and its row evaluated
+    members = [ref] + _same_structure(specs, ref, d.mech.tolerances.dummy_mass, alone)
+    try:
+        fb = _Fourbar(d, spec)
+    except UsageError as exc:  # not a four-bar (its own evaluation says so when it computes grashof)
+        raise Unbatchable(str(exc)) from None
+    placed = _Placed([specs[k] for k in members])
+    _check_reference(d, fb, placed, spec)
+    cf = _ClosedForms(fb, placed, spec, d.mech.tolerances, len(members))
+    made = _made_rows(task, chunk, index, members, ref, reference, cf, alone)
+    _vouch(task, chunk, index, ref, reference, cf, made)
+    out: list[dict] = []
+    reasons: Counter[str] = Counter()
     for k in range(n):
         if k in made:
             out.append(made[k])
             continue
-        if rows[k] is None:
-            rows[k] = evaluate_design(task, index[k], chunk[k][1])
-        out.append(rows[k])
+        row = rows[k]
+        if row is None:
+            row = rows[k] = evaluate_design(task, index[k], chunk[k][1])
+        out.append(row)
         reasons[alone.get(k, "the reference")] += 1
     notes = [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" for why, c in reasons.most_common()]
     return ChunkRows(out, {"family": len(made), "design": n - len(made)}, notes)
 
 
-def _row_of(task: _Task, i: int, values, columns, reference, code, margin, lo, hi, turns, dead, short: dict) -> dict:
+def _row_of(task: StudyTask, i: int, values: tuple, columns: tuple[str, ...], reference: dict, code: int, margin: float,
+            lo: float, hi: float, turns: bool, dead: int) -> dict:
     """The family path's row of one design from its closed-form numbers (the reference's recomputed)."""
     row = {"design": i, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(columns))
@@ -391,7 +414,8 @@ def _row_of(task: _Task, i: int, values, columns, reference, code, margin, lo, h
     if "mobility" in task.metrics:
         row.update({col: reference[col] for col in COLUMNS["mobility"]})
     if "grashof" in task.metrics:
-        row.update({"linkage": "four-bar", "grashof": short[FOUR_BAR_CLASSES[int(code)]], "grashof_margin": float(margin)})
+        row.update({"linkage": "four-bar", "grashof": grashof_short(FOUR_BAR_CLASSES[int(code)]),
+                    "grashof_margin": float(margin)})
     if "transmission_angle" in task.metrics:
         lo, hi = float(lo), float(hi)
         row.update({"transmission_angle_min": lo, "transmission_angle_max": hi, "transmission_restarts": 0,
@@ -400,7 +424,7 @@ def _row_of(task: _Task, i: int, values, columns, reference, code, margin, lo, h
     return row
 
 
-def _check_reference(d, fb: _Fourbar, placed: _Placed, spec) -> None:
+def _check_reference(d, fb, placed, spec) -> None:
     """The composed placements of the reference design (the first of ``placed``) are Pinocchio's at the
     file's configuration, to 1e-9 of the mechanism's size: the template and its reading are right."""
     mech = d.mech

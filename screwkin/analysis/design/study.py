@@ -26,23 +26,21 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import ScrewkinError, UsageError, one_line, quote
-from ...files.description import LIMITS
-from ...files.study import StudySpec
-from ...files.xmlsafe import read_regular_file
+from ...files.study import StudySpec, read_mechanism_text
 from ...model.loader import load
 from ..mobility import analyze_mobility
 from ..motion.planar import identify
-from ..motion.modes import choose_mode
-from ..motion.position import PositionSolver
+from ..position.modes import choose_mode
+from ..position.position import PositionSolver
 from .workspace import DEFAULT_THRESHOLD, workspace
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
+    from ...model.mechanism import Mechanism
 
 __all__ = [
     "COLUMNS",
@@ -57,6 +55,10 @@ __all__ = [
     "study_task",
     "check_pareto",
     "failed_row",
+    "failure_reason",
+    "StudyDesign",
+    "StudyTask",
+    "grashof_short",
     "metric_columns",
     "DEFAULT_REQUIRE",
     "REQUIREMENTS_COLUMN",
@@ -89,6 +91,12 @@ _GRASHOF = (("change point", "change-point"), ("non-Grashof", "non-Grashof"),
             ("Grashof double rocker", "double-rocker"), ("Grashof rocker-crank", "rocker-crank"),
             ("crank turns fully", "crank-turns"), ("crank cannot turn fully", "crank-rocks"))
 
+
+def grashof_short(sentence: str) -> str | None:
+    """The short Grashof class of a row (``crank-rocker``) of analysis.motion.planar's class sentence (None: a
+    sentence this table does not know)."""
+    return next((s for prefix, s in _GRASHOF if sentence.startswith(prefix)), None)
+
 class DesignTimeout(ScrewkinError):
     """A design ran past the study's timeout (its row is failed, its metrics empty)."""
 
@@ -96,7 +104,7 @@ class DesignTimeout(ScrewkinError):
 class _Clock:
     """The deadline of one design, checked between its steps (loading, assembly, each metric)."""
 
-    def __init__(self, seconds: float) -> None:
+    def __init__(self, seconds: float):
         self.seconds = seconds
         self.end = time.perf_counter() + seconds
 
@@ -163,7 +171,7 @@ def designs(spec: StudySpec) -> list:
 
 # ------------------------------------------------------------------ one design
 @dataclass(frozen=True)
-class _Task:
+class StudyTask:
     """What a worker needs for the designs of a study (picklable: sent with every chunk)."""
 
     file: str
@@ -176,13 +184,13 @@ class _Task:
     point: bool
     workspace: dict
     timeout: float = 120.0  # seconds per design
-    mode: int | None = None  # the K-th assembly mode (motion.modes.choose_mode); None: the first
+    mode: int | None = None  # the K-th assembly mode (position.modes.choose_mode); None: the first
 
 
-class _Design:
+class StudyDesign:
     """One loaded design and what its metrics share (assembly, linkage, workspace)."""
 
-    def __init__(self, task: _Task, mech: Mechanism, clock: _Clock) -> None:
+    def __init__(self, task: StudyTask, mech: Mechanism, clock: _Clock) -> None:
         self.task, self.mech, self.clock = task, mech, clock
         self.q = mech.generic_configurations()[1][0]  # assembled (AssemblyError otherwise)
         clock.check()
@@ -193,7 +201,7 @@ class _Design:
             self._choose_mode()
             clock.check()
 
-    def _choose_mode(self) -> None:
+    def _choose_mode(self):
         """The assembly mode the design's motion and workspace follow: the task's ``mode`` K (default 1) of the
         inputs (the study's input, else the actuated joints) at their values in the assembled configuration,
         as ``solve`` lists them (the one rule of every command's --mode); ``self.q`` becomes its
@@ -242,16 +250,16 @@ class _Design:
         return self._workspace
 
 
-def _mobility(d: _Design) -> dict:
+def _mobility(d: StudyDesign) -> dict:
     r = analyze_mobility(d.mech, output=d.task.output, point=d.task.point)
     return {"mobility": r.mobility, "mobility_count": r.topology.count_in_motion_space,
             "motion_space": r.motion_space, "overconstraint": r.overconstraint, "idle_dofs": r.idle_dofs,
             "effective_mobility": r.effective_mobility, "output_motion": r.output.label if r.output else None}
 
 
-def _grashof(d: _Design) -> dict:
+def _grashof(d: StudyDesign) -> dict:
     info = d.linkage()
-    short = next((s for prefix, s in _GRASHOF if info.grashof.startswith(prefix)), None)
+    short = grashof_short(info.grashof)
     if short is None:  # pragma: no cover - a class sentence of planar.py this table does not know
         raise RuntimeError(f"unknown Grashof class {info.grashof!r}")
     L = info.lengths
@@ -263,7 +271,7 @@ def _grashof(d: _Design) -> dict:
     return {"linkage": info.kind, "grashof": short, "grashof_margin": float(margin)}
 
 
-def _transmission_angle(d: _Design) -> dict:
+def _transmission_angle(d: StudyDesign) -> dict:
     """The transmission angle over the input's whole motion (a full turn, or from limit position to
     limit position on the assembled configuration's circuit), its extremes located in closed form
     from the identified linkage's lengths (analysis.motion.transmission: the extremes of a
@@ -277,20 +285,20 @@ def _transmission_angle(d: _Design) -> dict:
             "transmission_deviation": r.deviation, "input_turns": r.turns, "dead_points": r.dead_points}
 
 
-def _workspace_volume(d: _Design) -> dict:
+def _workspace_volume(d: StudyDesign) -> dict:
     w = d.workspace()
     # truncated: MAX_POINTS cut the grid (a resolution too fine for the workspace): the volumes are lower bounds
     return {"workspace_dimension": w.dimension, "workspace_volume": w.volume, "workspace_truncated": w.truncated,
             **d.mode_columns()}
 
 
-def _singularity_free_volume(d: _Design) -> dict:
+def _singularity_free_volume(d: StudyDesign) -> dict:
     w = d.workspace()
     return {"workspace_dimension": w.dimension, "singularity_free_volume": w.free_volume,
             "workspace_truncated": w.truncated, **d.mode_columns()}
 
 
-def _conditioning(d: _Design) -> dict:
+def _conditioning(d: StudyDesign) -> dict:
     w = d.workspace()
     return {"conditioning_min": w.conditioning_min, "conditioning_mean": w.conditioning_mean, **d.mode_columns()}
 
@@ -309,7 +317,7 @@ def metric_columns(metrics) -> tuple:
     return tuple(out)
 
 
-def _reason(exc, path: str) -> str:
+def failure_reason(exc: BaseException, path: str) -> str:
     """The one-line reason of a design's failure, without the file's path every row shares."""
     text = str(exc)
     for prefix in (f"{path}: ", f"{Path(path).name}: "):
@@ -317,7 +325,7 @@ def _reason(exc, path: str) -> str:
     return one_line(text, 400)
 
 
-def design_args(task: _Task, values: tuple) -> dict:
+def design_args(task: StudyTask, values: tuple) -> dict:
     """The xacro arguments of one design, as text: what ``--arg NAME=VALUE`` gives the file (a
     parameter's SI value written as repr(float), so the single commands reproduce a row exactly)."""
     args = dict(task.args)
@@ -325,7 +333,7 @@ def design_args(task: _Task, values: tuple) -> dict:
     return args
 
 
-def evaluate_design(task: _Task, index: int, values: tuple, keep: list | None = None) -> dict:
+def evaluate_design(task: StudyTask, index: int, values: tuple, keep: list | None = None) -> dict:
     """The row of one design, from its values alone; ``keep`` (a list): the analysed design is appended
     to it (the family path reads its mechanism)."""
     row = {"design": index, **dict(zip(task.parameters, values))}
@@ -337,7 +345,7 @@ def evaluate_design(task: _Task, index: int, values: tuple, keep: list | None = 
         with _alarm(task.timeout):
             mech = load(task.file, text=task.text, args=design_args(task, values), warn=lambda m: None)
             clock.check()
-            d = _Design(task, mech, clock)
+            d = StudyDesign(task, mech, clock)
             computed = {}
             for m in task.metrics:
                 computed.update(METRICS[m](d))
@@ -346,13 +354,13 @@ def evaluate_design(task: _Task, index: int, values: tuple, keep: list | None = 
         if keep is not None:
             keep.append(d)
     except ScrewkinError as exc:
-        row["error"] = _reason(exc, task.file)
+        row["error"] = failure_reason(exc, task.file)
     except Exception as exc:  # noqa: BLE001 - a bug (or a missing module on a worker): the row says it, the run goes on
         row["error"] = f"internal error: {type(exc).__name__}: {one_line(str(exc), 300)}"
     return row
 
 
-def run_chunk(task: _Task, chunk: int) -> list:
+def run_chunk(task: StudyTask, chunk: list[tuple[int, tuple]]) -> list:
     """The rows of a chunk of designs [(index, values), ...], each design evaluated alone (what a Dask
     task computes when the family path does not apply: screwkin.analysis.design.family.chunk_rows)."""
     with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -392,17 +400,12 @@ class StudyResult:
         return tuple(r for r in self.rows if r["error"] is None)
 
 
-def study_task(spec: StudySpec) -> _Task:
-    raw = read_regular_file(spec.file, LIMITS.file_bytes, "mechanism file")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise UsageError(f"{spec.path}: file {quote(str(spec.file), 200)} is not a text file (not UTF-8)") from None
-    return _Task(str(spec.file), text, dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
+def study_task(spec: StudySpec) -> StudyTask:
+    return StudyTask(str(spec.file), read_mechanism_text(spec), dict(spec.args), tuple(p.name for p in spec.parameters), spec.metrics,
                  spec.input, spec.output, spec.point, dict(spec.workspace), spec.timeout, spec.mode)
 
 
-def _row_key(name: str, keys: tuple) -> str | None:
+def _row_key(name: str, keys) -> str | None:
     """The row key of a column named as in the rows or as in the table (``..._deg``, ``..._m``)."""
     for cand in (name, name.removesuffix("_deg"), name.removesuffix("_m")):
         if cand in keys:
@@ -506,7 +509,7 @@ def requirements(spec: StudySpec) -> tuple:
     return tuple(out), default
 
 
-def apply_requirements(spec: StudySpec, rows: tuple) -> tuple:
+def apply_requirements(spec: StudySpec, rows) -> tuple:
     """(rows with REQUIREMENTS_COLUMN, the column added or None, {design: what it does not meet}).
     Nothing is added when there is no requirement."""
     reqs, _ = requirements(spec)
@@ -526,7 +529,7 @@ def apply_requirements(spec: StudySpec, rows: tuple) -> tuple:
     return tuple(out), REQUIREMENTS_COLUMN, unmet
 
 
-def failed_row(task, index: int, values, reason) -> dict:
+def failed_row(task, index, values, reason) -> dict:
     row = {"design": index, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(metric_columns(task.metrics)))
     row["error"] = reason

@@ -16,7 +16,7 @@ from ...model.geometry import wrap_angle
 from ...model.state import KinematicState
 from ..course.figures import trace_points
 from ..motion.links import Point, motion_along
-from ..motion.position import PositionSolver
+from ..position.position import PositionSolver
 from ..motion.sweep import sweep
 from typing import TYPE_CHECKING
 

@@ -10,7 +10,7 @@ Two methods:
   mechanism).  From the output's position in the mechanism's assembled configuration the
   grid is filled outwards, wave by wave: each new point is solved (loop closures, the target,
   joint limits) from the solution at a neighbour, all points of a wave in one batched Newton
-  solve (analysis.motion.batch_closure.BatchClosure).  A solution must continue its neighbour's: it may not
+  solve (model.kernel.stacks.BatchClosure).  A solution must continue its neighbour's: it may not
   jump to another working mode (another branch of a leg), so the workspace is the one of
   the assembly mode the file is drawn in.  Along the grid's last axis every run of reached
   points is extended to the boundary by bisection (solved too), and the volume is the sum of
@@ -21,7 +21,7 @@ Two methods:
   measure of ``scan`` (smallest over largest singular value of the point's Jacobian).  A
   cell's measure is the best of its samples (the posture the arm would choose).
 
-The measures at each point are those of analysis.singularities.singular, made dimensionless with the
+The measures at each point are those of analysis.singular, made dimensionless with the
 mechanism's one characteristic length: ``actuator`` (relative smallest singular value of the
 passive columns of K), ``serial`` (of the output's motion J_o V, relative to |J_o|), and the
 ``conditioning`` of the map from input rates to the output's motion (smallest over largest
@@ -36,6 +36,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -44,14 +45,14 @@ from ...errors import AssemblyError, UsageError
 from ...model.linalg import rank
 from ...model.state import KinematicState
 from ..singularities.batch import SerialJacobians
-from ..motion.batch_closure import BatchClosure, Unbatchable
+from ...model.kernel.scaling import dimensionless, dimensionless_twists
+from ...model.kernel.stacks import BatchClosure, Unbatchable
 from ...model.limits import within_limits
-from ..singularities.singular import Generic
+from ..singular import Generic
 from .workspace_grid import MAX_POINTS, Grid, grid_axes, null_motions
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
+    from ...model.mechanism import Mechanism
 
 __all__ = ["WorkspaceResult", "workspace", "DEFAULT_THRESHOLD", "MAX_ESTIMATE"]
 
@@ -106,7 +107,7 @@ class WorkspaceResult:
 class _Measures:
     """The workspace measures for stacks of assembled configurations."""
 
-    def __init__(self, mech: Mechanism, output, point, inputs, length) -> None:
+    def __init__(self, mech, output, point, inputs, length):
         self.mech, self.point, self.L = mech, point, float(length or mech.length)
         self.closure = BatchClosure(mech, check=0) if (mech.cuts or mech.extra_rows) else None
         self.out = SerialJacobians(mech, output, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, check=0)
@@ -116,7 +117,7 @@ class _Measures:
         self.slide = mech.translational
         self.position_rows = mech.closure.position_rows
 
-    def __call__(self, Q: np.ndarray | tuple) -> dict:
+    def __call__(self, Q) -> dict:
         out = {"actuator": np.empty(len(Q)), "serial": np.empty(len(Q)), "conditioning": np.empty(len(Q))}
         for s in range(0, len(Q), _BLOCK):
             part = self._block(Q[s:s + _BLOCK])
@@ -124,20 +125,17 @@ class _Measures:
                 out[k][s:s + _BLOCK] = part[k]
         return out
 
-    def _block(self, Q: np.ndarray) -> dict:
+    def _block(self, Q) -> dict:
         mech, g, L = self.mech, self.generic, self.L
         N, nv = len(Q), mech.nv
         J = np.zeros((N, 6, nv))
         J[:, :, self.cols] = self.out.poses(Q)[2]
-        J[:, :3] /= L
-        J[:, :, self.slide] *= L
+        J = dimensionless_twists(J, self.slide, L)
         if self.point:
             J = J[:, :3]
         actuator = np.ones(N)
         if self.closure is not None and self.closure.nrows:
-            K = self.closure.constraint_jacobians(Q)
-            K[:, self.position_rows] /= L
-            K[:, :, self.slide] *= L
+            K = dimensionless(self.closure.constraint_jacobians(Q), self.position_rows, self.slide, L)
             vt = np.linalg.svd(K, full_matrices=True)[2]
             V = vt[:, g.rank_K:].transpose(0, 2, 1)  # (N, nv, nv - rank)
             if g.rank_Kp:
@@ -163,7 +161,7 @@ class _Measures:
         return {"actuator": actuator, "serial": serial, "conditioning": conditioning}
 
 
-def _translations(mech: Mechanism, q: np.ndarray, output, point: bool) -> np.ndarray:
+def _translations(mech, q, output, point) -> np.ndarray:
     """(3, k) directions the output (its origin for a point) can translate in at q, at a
     constant orientation unless ``point``: the linear part of the output twists that the loops
     allow with no rotation."""
@@ -183,7 +181,7 @@ def _translations(mech: Mechanism, q: np.ndarray, output, point: bool) -> np.nda
     return U[:, :k]
 
 
-def workspace(mech: Mechanism, output: str, point: bool = False, orientation=None, resolution: float | None = None,
+def workspace(mech, output: str, point: bool = False, orientation=None, resolution: float | None = None,
               bounds=None, threshold: float = DEFAULT_THRESHOLD, length: float | None = None,
               method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None,
               timeout: float | None = None, q_start=None) -> WorkspaceResult:
@@ -233,7 +231,7 @@ def workspace(mech: Mechanism, output: str, point: bool = False, orientation=Non
                  q_start)
 
 
-def _seed(mech: Mechanism, output, point: bool, orientation, q_start=None) -> tuple:
+def _seed(mech, output, point, orientation, q_start=None):
     """The assembled configuration the grid starts from (``q_start`` when given), the output's position
     and the grid's orientation there (continued from the file's orientation to the one asked)."""
     assembly, generic = mech.generic_configurations()
@@ -245,7 +243,7 @@ def _seed(mech: Mechanism, output, point: bool, orientation, q_start=None) -> tu
     best = None
     for q in [assembly.q] + list(generic) if q_start is None else [np.asarray(q_start, float)]:
         M = KinematicState(mech, q).frame_placement(fid)
-        K = bc.evaluate(q[None], (M.translation[None], M.rotation))[1][0]
+        K = bc.evaluate(q[None], targets=(M.translation[None], M.rotation))[1][0]
         k = rank(K, mech.tolerances)
         if best is None or k > best[0]:
             best = (k, q, M.translation.copy(), M.rotation.copy())
@@ -271,7 +269,7 @@ def _seed(mech: Mechanism, output, point: bool, orientation, q_start=None) -> tu
     return q, p, R
 
 
-def _index_bounds(bounds, p_seed: np.ndarray, axes: np.ndarray, h, dim) -> tuple:
+def _index_bounds(bounds, p_seed, axes, h, dim):
     """Index ranges (lo, hi) per axis for world-coordinate bounds (dimension, 2), or None."""
     if bounds is None:
         return [-(10**9)] * dim, [10**9] * dim
@@ -287,8 +285,96 @@ def _index_bounds(bounds, p_seed: np.ndarray, axes: np.ndarray, h, dim) -> tuple
     return list(lo), list(hi)
 
 
-def _grid(mech: Mechanism, output, point: bool, orientation, measures: _Measures, resolution, bounds, threshold, L, inputs,
-          deadline=None, q_start=None) -> WorkspaceResult:
+def _choose_resolution(mech: Mechanism, output: str, point: bool, R: np.ndarray | None, q_seed: np.ndarray,
+                       p_seed: np.ndarray, axes: np.ndarray, bounds: Any, resolution: float | None, L: float,
+                       deadline: float | None, notes: list[str]) -> float:
+    """The grid's step: the one given, checked against the work a first pass at L/4 says it would take, or
+    (None) ~24 (3-D) or ~120 (2-D) steps across the extent that pass reaches (said in ``notes``)."""
+    dim = axes.shape[0]
+    h0 = L / 4.0
+    if resolution is not None and resolution >= h0:
+        return resolution
+    lo, hi = _index_bounds(bounds, p_seed, axes, h0, dim)
+    coarse = Grid(mech, output, point, R, q_seed, p_seed, axes, h0, lo, hi)
+    coarse.deadline = deadline
+    idx = np.array(list(coarse.fill()), int)
+    if resolution is None:
+        extent = (idx.max(axis=0) - idx.min(axis=0) + 2) * h0
+        resolution = float(extent.max()) / (24.0 if dim == 3 else 120.0)
+        notes.append(f"resolution {resolution:.4g} m chosen from a first pass at {h0:.4g} m")
+        return resolution
+    estimate = len(idx) * (h0 / resolution) ** dim
+    if estimate > MAX_ESTIMATE:
+        least = h0 * (len(idx) / MAX_ESTIMATE) ** (1.0 / dim)
+        least = float(f"{least * 1.05:.2g}")
+        raise UsageError(f"--resolution {resolution:.4g} m would solve about {estimate:.2g} grid points "
+                         f"(a first pass at {h0:.3g} m reached {len(idx)}), limit {MAX_ESTIMATE:,}: use "
+                         f"--resolution {least:g} or more, or --bounds")
+    return resolution
+
+
+def _runs(grid: Grid, solved: dict, axes: np.ndarray, lo: list[int], hi: list[int]) -> tuple[
+        np.ndarray, np.ndarray, dict[tuple[int, int], tuple[float, np.ndarray]], list[np.ndarray]]:
+    """The runs along the last axis, completed and extended to the boundary by bisection: (the grid indices
+    solved, their configurations, (point k, +1 | -1) -> (fraction of a step, configuration) of each located
+    end, the boundary points)."""
+    dim, h = axes.shape[0], grid.h
+    last = np.zeros(dim, int)
+    last[-1] = 1
+    for a in range(dim - 1):  # the band along the boundary where it runs across the last axis
+        step = np.zeros(dim, int)
+        step[a] = 1
+        grid.march(solved, step)
+        grid.march(solved, -step)
+    run_ends = {1: grid.march(solved, last), -1: grid.march(solved, -last)}
+    index = np.array(list(solved), int).reshape(-1, dim)
+    Q = np.array(list(solved.values()))
+    key = {tuple(i): k for k, i in enumerate(index)}
+    ends = {}
+    boundary = []
+    for sign, found in run_ends.items():
+        for i, (f, qb) in found.items():
+            k = key[i]
+            ends[(k, sign)] = (f, qb)
+            if f > 0 or lo[-1] <= i[-1] + sign <= hi[-1]:
+                boundary.append(grid.position(index[k]) + sign * f * h * axes[-1])
+    return index, Q, ends, boundary
+
+
+def _run_lengths(grid: Grid, index: np.ndarray, ends: dict, worst: np.ndarray, end_min: dict, threshold: float,
+                 axes: np.ndarray) -> tuple[float, float, list[np.ndarray]]:
+    """(the runs' total length, their free length, the points where the free part ends) along the last axis."""
+    h = grid.h
+    volume_len = 0.0
+    free_len = 0.0
+    free_boundary: list[np.ndarray] = []
+    columns: dict[tuple, list[tuple[int, int]]] = {}
+    for k, i in enumerate(index):
+        columns.setdefault(tuple(i[:-1]), []).append((int(i[-1]), k))
+    for col in columns.values():
+        col.sort()
+        for n, (z, k) in enumerate(col):
+            up = ends.get((k, 1))
+            down = ends.get((k, -1))
+            if down is not None:  # a run starts here
+                volume_len += down[0] * h
+                free_len += _free_part(worst[k], end_min[(k, -1)], down[0] * h, threshold, grid.position(index[k]),
+                                       -axes[-1], free_boundary)
+            if up is not None:
+                volume_len += up[0] * h
+                free_len += _free_part(worst[k], end_min[(k, 1)], up[0] * h, threshold, grid.position(index[k]),
+                                       axes[-1], free_boundary)
+            elif n + 1 < len(col) and col[n + 1][0] == z + 1:
+                k2 = col[n + 1][1]
+                volume_len += h
+                free_len += _free_part(worst[k], worst[k2], h, threshold, grid.position(index[k]), axes[-1],
+                                       free_boundary)
+    return volume_len, free_len, free_boundary
+
+
+def _grid(mech: Mechanism, output: str, point: bool, orientation: Any, measures: _Measures,
+          resolution: float | None, bounds: Any, threshold: float, L: float, inputs: list[str],
+          deadline: float | None = None, q_start: np.ndarray | None = None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
     except Unbatchable as e:
@@ -310,81 +396,22 @@ def _grid(mech: Mechanism, output, point: bool, orientation, measures: _Measures
                          f"({dim} translation{'s' if dim != 1 else ''}), not over an area or a volume: "
                          "use sweep" + ("" if point else ", or --point"))
     axes = grid_axes(directions)
-    notes = []
-    h0 = L / 4.0
-    if resolution is None or resolution < h0:  # a coarse pass: the extent, or the work a fine grid would be
-        lo, hi = _index_bounds(bounds, p_seed, axes, h0, dim)
-        coarse = Grid(mech, output, point, R, q_seed, p_seed, axes, h0, lo, hi)
-        coarse.deadline = deadline
-        idx = np.array(list(coarse.fill()), int)
-        if resolution is None:  # ~24 (3-D) or ~120 (2-D) steps across the extent
-            extent = (idx.max(axis=0) - idx.min(axis=0) + 2) * h0
-            resolution = float(extent.max()) / (24.0 if dim == 3 else 120.0)
-            notes.append(f"resolution {resolution:.4g} m chosen from a first pass at {h0:.4g} m")
-        else:
-            estimate = len(idx) * (h0 / resolution) ** dim
-            if estimate > MAX_ESTIMATE:
-                least = h0 * (len(idx) / MAX_ESTIMATE) ** (1.0 / dim)
-                least = float(f"{least * 1.05:.2g}")
-                raise UsageError(f"--resolution {resolution:.4g} m would solve about {estimate:.2g} grid points "
-                                 f"(a first pass at {h0:.3g} m reached {len(idx)}), limit {MAX_ESTIMATE:,}: use "
-                                 f"--resolution {least:g} or more, or --bounds")
+    notes: list[str] = []
+    h = resolution = _choose_resolution(mech, output, point, R, q_seed, p_seed, axes, bounds, resolution, L,
+                                        deadline, notes)
     lo, hi = _index_bounds(bounds, p_seed, axes, resolution, dim)
     grid = Grid(mech, output, point, R, q_seed, p_seed, axes, resolution, lo, hi)
     grid.deadline = deadline
     solved = grid.fill()
-    # runs along the last axis, completed and extended to the boundary by bisection
-    h = resolution
-    last = np.zeros(dim, int)
-    last[-1] = 1
-    for a in range(dim - 1):  # the band along the boundary where it runs across the last axis
-        step = np.zeros(dim, int)
-        step[a] = 1
-        grid.march(solved, step)
-        grid.march(solved, -step)
-    run_ends = {1: grid.march(solved, last), -1: grid.march(solved, -last)}
-    index = np.array(list(solved), int).reshape(-1, dim)
-    Q = np.array(list(solved.values()))
-    key = {tuple(i): k for k, i in enumerate(index)}
-    ends = {}  # (point k, +1 | -1) -> (fraction, configuration)
-    boundary = []
-    for sign, found in run_ends.items():
-        for i, (f, qb) in found.items():
-            k = key[i]
-            ends[(k, sign)] = (f, qb)
-            if f > 0 or lo[-1] <= i[-1] + sign <= hi[-1]:
-                boundary.append(grid.position(index[k]) + sign * f * h * axes[-1])
+    index, Q, ends, boundary = _runs(grid, solved, axes, lo, hi)
     m = measures(Q)
     free = (m["actuator"] >= threshold) & (m["serial"] >= threshold)
     # measures at the located ends, for the free runs
     end_keys = list(ends)
     end_measures = measures(np.array([ends[e][1] for e in end_keys])) if end_keys else None
     end_min = {e: min(end_measures["actuator"][n], end_measures["serial"][n]) for n, e in enumerate(end_keys)}
-    volume_len = 0.0
-    free_len = 0.0
-    free_boundary = []
     worst = np.minimum(m["actuator"], m["serial"])
-    columns = {}
-    for k, i in enumerate(index):
-        columns.setdefault(tuple(i[:-1]), []).append((int(i[-1]), k))
-    for col in columns.values():
-        col.sort()
-        for n, (z, k) in enumerate(col):
-            up = ends.get((k, 1))
-            down = ends.get((k, -1))
-            if down is not None:  # a run starts here
-                volume_len += down[0] * h
-                free_len += _free_part(worst[k], end_min[(k, -1)], down[0] * h, threshold, grid.position(index[k]),
-                                       -axes[-1], free_boundary)
-            if up is not None:
-                volume_len += up[0] * h
-                free_len += _free_part(worst[k], end_min[(k, 1)], up[0] * h, threshold, grid.position(index[k]),
-                                       axes[-1], free_boundary)
-            elif n + 1 < len(col) and col[n + 1][0] == z + 1:
-                k2 = col[n + 1][1]
-                volume_len += h
-                free_len += _free_part(worst[k], worst[k2], h, threshold, grid.position(index[k]), axes[-1],
-                                       free_boundary)
+    volume_len, free_len, free_boundary = _run_lengths(grid, index, ends, worst, end_min, threshold, axes)
     cell = h ** (dim - 1)
     cond = m["conditioning"][free]
     truncated = grid.truncated and bounds is not None or len(index) >= MAX_POINTS
@@ -405,7 +432,7 @@ def _grid(mech: Mechanism, output, point: bool, orientation, measures: _Measures
         tuple(inputs), rng, bool(truncated), grid.solves, 0, tuple(notes))
 
 
-def _free_part(m0, m1, length, threshold, p0, direction, crossings: list) -> float:
+def _free_part(m0, m1, length, threshold, p0, direction, crossings) -> float:
     """The free length of a segment from a point of measure m0 to one of m1 (linear between),
     recording a crossing of the threshold."""
     a, b = m0 >= threshold, m1 >= threshold
@@ -419,7 +446,7 @@ def _free_part(m0, m1, length, threshold, p0, direction, crossings: list) -> flo
 
 
 # ----------------------------------------------------------------------------------- sampling
-def _sampling(mech: Mechanism, output: str, measures: _Measures, resolution: float | None, bounds, threshold: float, L: float, samples: int, seed: int, inputs: list) -> WorkspaceResult:
+def _sampling(mech, output, measures, resolution, bounds, threshold, L, samples, seed, inputs) -> WorkspaceResult:
     samples = int(samples)
     if samples < 1:
         raise UsageError(f"the number of samples must be positive, got {samples}")

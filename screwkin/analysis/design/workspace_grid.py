@@ -1,6 +1,6 @@
 """The grid a workspace is grown on (analysis.design.workspace's ``grid`` method): positions of the
 output on axes spanning its translations, filled outwards wave by wave from the assembled
-configuration by batched inverse kinematics (analysis.motion.batch_closure.BatchClosure), each point
+configuration by batched inverse kinematics (model.kernel.stacks.BatchClosure), each point
 from a neighbour's solution along a first-order predictor, kept only when it continues that
 neighbour's branch (the one continuation's jump test and branch rule, analysis.motion.continuation:
 the sign of the rows' Jacobian determinant on the parent's row space), with
@@ -14,14 +14,11 @@ import time
 import numpy as np
 
 from ...model.linalg import rank
-from ...model.newton import damped_steps
-from ..motion.batch_closure import BatchClosure
+from ...model.kernel.newton import damped_steps
+from ...model.kernel.scaling import dimensionless
+from ...model.kernel.stacks import BatchClosure
 from ..motion.continuation import jumped, keeps_orientation
 from ...model.limits import within_limits
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Grid", "grid_axes", "null_motions", "MAX_POINTS"]
 
@@ -36,7 +33,7 @@ _ITERATIONS = 8  # Newton from a neighbour's solution and the predictor converge
 #                   takes more lies beyond the boundary (or across a singularity) from that neighbour
 
 
-def null_motions(A: np.ndarray, mech: Mechanism):
+def null_motions(A, mech):
     if not A.size:
         return np.eye(A.shape[1])
     _, s, vt = np.linalg.svd(A)
@@ -44,7 +41,7 @@ def null_motions(A: np.ndarray, mech: Mechanism):
     return vt[k:].T
 
 
-def grid_axes(directions: np.ndarray) -> np.ndarray:
+def grid_axes(directions) -> np.ndarray:
     """Grid axes spanning the translation directions: the world axes in 3-D; in a plane the two
     world axes of a coordinate plane, else an orthonormal basis of the plane."""
     k = directions.shape[1]
@@ -63,7 +60,7 @@ def grid_axes(directions: np.ndarray) -> np.ndarray:
 class Grid:
     """Batched inverse kinematics on a grid (see the module's text)."""
 
-    def __init__(self, mech: Mechanism, output, point, orientation, q_seed: np.ndarray, p_seed, axes, h, lo, hi, frozen=()) -> None:
+    def __init__(self, mech, output, point, orientation, q_seed, p_seed, axes, h, lo, hi, frozen=()):
         self.mech, self.axes, self.h = mech, axes, float(h)
         self.deadline = None  # time.monotonic() past which the growth stops (the result marked truncated)
         self.timed_out = False
@@ -74,7 +71,7 @@ class Grid:
         self.q_seed = q_seed
         self.L, self.slide = float(mech.length), mech.translational
         # the rank of the rows' Jacobian (loops and target) in the working mode: at the seed
-        K = self.closure.evaluate(q_seed[None], (self.position(np.zeros(len(axes)))[None], self.R))[1][0]
+        K = self.closure.evaluate(q_seed[None], targets=(self.position(np.zeros(len(axes)))[None], self.R))[1][0]
         self.rank = rank(K, mech.tolerances)
         Ks = self._scaled(K[None])[0]
         sv = np.linalg.svd(Ks, compute_uv=False)
@@ -85,7 +82,7 @@ class Grid:
     def position(self, index) -> np.ndarray:
         return self.p_seed + (np.asarray(index, float) * self.h) @ self.axes
 
-    def solve(self, Q0: np.ndarray, P) -> tuple:
+    def solve(self, Q0, P):
         """Solve from Q0 (N, nq) for targets P (N, 3): (Q, ok) with ok: converged and within
         the joint limits."""
         Q = np.empty_like(Q0)
@@ -98,23 +95,20 @@ class Grid:
             ok[ok] &= within_limits(self.mech, Q[ok])
         return Q, ok
 
-    def predict(self, Q: np.ndarray, P_from, P_to) -> tuple:
+    def predict(self, Q, P_from, P_to):
         """First-order predictor: the joint steps that move the target from P_from to P_to
         (minimum norm through the solver's rows: K dq = -(change of the target rows)), and
         the rows' Jacobian at Q (it does not depend on where the target is)."""
-        r0, K = self.closure.evaluate(Q, (P_to, self.R))
-        r1 = self.closure.evaluate(Q, (P_from, self.R), jacobian=False)[0]
+        r0, K = self.closure.evaluate(Q, targets=(P_to, self.R))
+        r1 = self.closure.evaluate(Q, False, (P_from, self.R))[0]
         dr = r0 - r1  # the rows' change from moving the target alone
         return Q + damped_steps(K, dr, np.full(len(Q), self.mech.tolerances.lm_damping))[0], K
 
-    def _scaled(self, K: np.ndarray):
-        """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L."""
-        K = K.copy()
-        K[:, self.closure.solver_position_rows] /= self.L
-        K[:, :, self.slide] *= self.L
-        return K
+    def _scaled(self, K):
+        """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L (model.kernel.scaling)."""
+        return dimensionless(K, self.closure.solver_position_rows, self.slide, self.L)
 
-    def kept(self, Q_from, K_from, Q_pred, Q_new, P_new) -> tuple:
+    def kept(self, Q_from, K_from, Q_pred, Q_new, P_new):
         """(kept, sigma) for new solutions solved from Q_from: kept when it continues the old
         solution -- near the predicted configuration, and on the same branch: the rows'
         Jacobian (loops and target) restricted to the old one's range and row space keeps the
@@ -123,7 +117,7 @@ class Grid:
         how far it is from a fold (``substeps``)."""
         step = np.linalg.norm(Q_pred - Q_from, axis=1)
         ok = ~jumped(np.linalg.norm(Q_new - Q_pred, axis=1), step, self.mech.tolerances)
-        K_new = self._scaled(self.closure.evaluate(Q_new, (P_new, self.R))[1])
+        K_new = self._scaled(self.closure.evaluate(Q_new, targets=(P_new, self.R))[1])
         r = self.rank
         if not r:
             return ok, np.ones(len(ok))
@@ -131,7 +125,7 @@ class Grid:
         ev = np.sqrt(np.maximum(np.linalg.eigvalsh(K_new.transpose(0, 2, 1) @ K_new), 0.0))[:, ::-1]
         return ok, np.where(ev[:, 0] > 0, ev[:, r - 1] / np.where(ev[:, 0] > 0, ev[:, 0], 1.0), 0.0)
 
-    def substeps(self, sigma: float | np.ndarray) -> np.ndarray:
+    def substeps(self, sigma) -> np.ndarray:
         """Substeps for a grid step from points of relative singular value sigma: two branches
         of a fold a distance d inside it differ by about sqrt(d / L) in the joints, and so does
         sigma there, so a step of h may land on either below about sqrt(h / L): the step is cut
@@ -143,7 +137,7 @@ class Grid:
         n = np.minimum(2 ** np.ceil(np.log2(np.clip(need, 1.0, _SUBSTEPS))), _SUBSTEPS)
         return np.where(sigma >= _SINGULAR, n, 0).astype(int)
 
-    def advance(self, Q: np.ndarray, P_from, P_to, n) -> tuple:
+    def advance(self, Q, P_from, P_to, n):
         """Solve from Q at P_from to P_to in n equal substeps (n: an int, or one per point,
         all advanced together): (Q, ok, sigma, jumped) -- jumped: a substep converged within
         the limits but ``kept`` refused it (another branch, or far from the prediction)."""
@@ -166,7 +160,7 @@ class Grid:
             Qc[sel[good]], Pc[sel[good]], sigma[sel] = Qn[good], Pk[good], sig
         return Qc, ok, sigma, jumped
 
-    def advance_all(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: np.ndarray, retry: bool=True) -> tuple:
+    def advance_all(self, Q, P_from, P_to, n, retry=True):
         """advance for points with each their number of substeps n (> 0), in blocks; with
         ``retry``, a step refused as a jump to another branch is tried again in twice as many
         substeps, up to _SUBSTEPS (a step that does not converge -- past the boundary -- is not)."""
@@ -188,7 +182,7 @@ class Grid:
             self.truncated = self.timed_out = True
         return self.timed_out
 
-    def fill(self) -> dict:
+    def fill(self):
         """{grid index: configuration} of the points reached, filled wave by wave (also
         ``self.sigma``: index -> relative singular value of the rows' Jacobian there)."""
         d = len(self.axes)
@@ -283,7 +277,7 @@ class Grid:
             current = following
         return ends
 
-    def extend(self, starts: np.ndarray, Q: np.ndarray, direction: np.ndarray) -> tuple:
+    def extend(self, starts, Q, direction):
         """Bisection from the reached points ``starts`` (m, d) (configurations Q) towards their
         unreached neighbours along ``direction`` (a unit index vector): the reached fraction of
         the step (0..1) and the configurations there."""

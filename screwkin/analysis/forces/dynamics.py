@@ -14,7 +14,7 @@ motor added to the mass matrix's diagonal; damping * v, the force that overcomes
 passive force; frictionloss * sign(v), the dry friction overcome while the joint moves -- at rest
 it lies anywhere in +-frictionloss, which the notes say), the loads w_k (force, moment at their link frame's origin, world
 axes; J_k that origin's frame Jacobian, LOCAL_WORLD_ALIGNED), the loop constraint forces lambda
-of the closure rows K (model/closure.py) and the actuator efforts tau_a (torques of revolute,
+of the closure rows K (model/kernel/closure.py) and the actuator efforts tau_a (torques of revolute,
 forces of prismatic inputs).  It is solved as statics solves it (analysis.forces.statics.balance):
 least squares, minimum norm; where the constraint rows are redundant (an overconstrained
 linkage, a planar loop's out-of-plane rows) the null space of [E, K^T] holds self-stresses of
@@ -35,7 +35,9 @@ I = dE / (Cs omega^2).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -44,15 +46,15 @@ from ...errors import MechanismFileError, UsageError, quote
 from ...model.geometry import cross3
 from ...model.state import KinematicState
 from ...tolerances import DEFAULT
-from ..motion.position import PositionSolver
-from .joint_dynamics import joint_dynamics, left_out_note, names_text as _names
+from ..position.position import PositionSolver
+from .joint_dynamics import JointDynamics, joint_dynamics, left_out_note, names_text as _names
 from .statics import (actuator_efforts, balance, compound_joints, coupled_efforts, coupled_units,
                       reaction_joint_id, reaction_table)
 from ..motion.sweep import sweep, sweep_inputs
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
+    from ...model.mechanism import Mechanism
+    from ..motion.sweep import SweepResult
 
 __all__ = ["CS_RANGE", "Load", "Flywheel", "DynamicsResult", "dynamics", "check_inertias"]
 
@@ -126,7 +128,7 @@ class DynamicsResult:
     transmissions: tuple = ()  # files.description.Transmission of those actuators
 
 
-def check_inertias(mech: Mechanism) -> tuple:
+def check_inertias(mech) -> tuple:
     """Each moving body needs a mass and an inertia a rigid body can have (files/inertia.py: a link
     breaking it is a MechanismFileError naming it), and an SDF file's inertias are not read (refused): a moving
     link without <inertial> on a body none of whose links has one is a MechanismFileError naming
@@ -165,7 +167,7 @@ def check_inertias(mech: Mechanism) -> tuple:
     return ()
 
 
-def _load_wrenches(mech: Mechanism, loads, state: KinematicState) -> list:
+def _load_wrenches(mech, loads, state) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the configuration of
     ``state`` (a KinematicState; the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []
@@ -179,7 +181,7 @@ def _load_wrenches(mech: Mechanism, loads, state: KinematicState) -> list:
     return out
 
 
-def _ground_sides(mech: Mechanism) -> tuple:
+def _ground_sides(mech) -> tuple:
     """(tree joints whose parent is the ground, {cut joint: +1 when its link2 is on the ground,
     -1 when its link1 is})."""
     model = mech.model
@@ -199,7 +201,7 @@ def _ground_sides(mech: Mechanism) -> tuple:
     return tree, cuts
 
 
-def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v: np.ndarray) -> tuple:
+def _energies(mech, gmodel, data, q, v) -> tuple:
     """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
     energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
     model = mech.model
@@ -213,7 +215,7 @@ def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v: np.ndarray) -> tu
     return 0.5 * float(v @ M @ v), float(V)
 
 
-def _flywheel(values, tau, speed: float, unit: str, cs: float, completed) -> Flywheel:
+def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
     """The flywheel figure from the input effort tau over the input values (see the module)."""
     omega = abs(speed)
     span = abs(values[-1] - values[0]) if len(values) > 1 else 0.0
@@ -241,9 +243,125 @@ def _range_mean(values, y) -> float:
     return float(np.trapezoid(y, values) / (values[-1] - values[0]))
 
 
-def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: float, steps: int, inputs=None,
-             fixed: dict | None = None, near: dict | None = None, gravity=(0.0, 0.0, 0.0), loads=(),
-             cs: float = 0.05, progress=None, q_start=None, branch: str = "continue") -> DynamicsResult:
+def _joint_notes(mech: Mechanism) -> tuple[list[str], JointDynamics]:
+    """(the notes on the inertias and on the joints' own dynamics, those dynamics or None)."""
+    notes = list(check_inertias(mech))
+    own, left = joint_dynamics(mech)
+    if own:
+        notes.append(f"the armature, damping and friction loss the file gives {len(own)} joints ("
+                     f"{_names(list(own))}) are in these efforts, as MuJoCo applies them (per degree of freedom: "
+                     "armature * a + damping * v + frictionloss * sign(v)"
+                     + (f"; the springs of {_names(list(own.springs))}: stiffness * (x - springref), their energy in "
+                        "the potential energy" if own.springs else "") + ")")
+    if left:
+        notes.append(left_out_note(left))
+    return notes, own
+
+
+class _Series:
+    """The balance at every step of a motion, gathered step by step (:meth:`step`)."""
+
+    def __init__(self, mech: Mechanism, inputs: list[str], own: JointDynamics, loads: Iterable[Load],
+                 g: np.ndarray, n: int) -> None:
+        self.mech, self.own, self.loads, self.g = mech, own, loads, g
+        self.data = mech.scratch_data()
+        self.a_idx = mech.velocity_indices(inputs)
+        m = self.m = len(self.a_idx)
+        self.n = n
+        self.efforts = np.full((n, m), np.nan)
+        self.reactions: dict[str, np.ndarray] = {}
+        self.kinds: dict[str, str] = {}
+        self.open_: dict[str, np.ndarray] = {}
+        self.coupled: dict[str, np.ndarray] = {}
+        self.shaking_f, self.shaking_m = np.zeros((n, 3)), np.zeros((n, 3))
+        self.T, self.V, self.P_in, self.P_load, self.unbalanced, self.scale = (np.zeros(n) for _ in range(6))
+        self.indeterminate = 0
+        self.friction_at_rest: set[str] = set()
+        self.ground_tree, self.ground_cuts = _ground_sides(mech)
+        self.gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
+
+    def step(self, k: int, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> None:
+        """Step ``k``'s balance at (q, v, a): the efforts, the reactions, the shaking wrench, energies and powers."""
+        mech, own, m, n = self.mech, self.own, self.m, self.n
+        b = pin.rnea(self.gmodel, self.data, q, v, a).copy()
+        own_coupled = {}
+        if own:
+            joint_force, own_coupled = own.forces(q, v, a)
+            b += joint_force
+            self.friction_at_rest |= own.friction_at_rest(v)
+        state = KinematicState(mech, q)
+        frames = _load_wrenches(mech, self.loads, state)
+        for fid, w in frames:
+            J = state.frame_jacobian(fid, LWA)
+            b -= J.T @ w
+            self.P_load[k] += float(w @ (J @ v))
+        K = mech.closure.jacobian(q)
+        tau, lam, N, self.unbalanced[k], self.scale[k] = balance(mech, K, self.a_idx, b)
+        free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
+        self.efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
+        self.indeterminate = max(self.indeterminate, int(N.shape[1]) if N.size else 0)
+        table = reaction_table(mech, q, lam, frames, self.g, N[m:] if N.size else None, v, a)
+        for name, value in coupled_efforts(mech, q, {k: x[1] for k, x in table.items() if x[0] == "coupled"}).items():
+            self.coupled.setdefault(name, np.zeros(n))[k] = value + own_coupled.get(name, 0.0)
+        for name, (kind, wrench, is_open) in table.items():
+            self.reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
+            self.kinds[name] = kind
+            self.open_[name] = self.open_.get(name, np.zeros(6, bool)) | is_open
+        self._shaking(k, table, state)
+        self.T[k], self.V[k] = _energies(mech, self.gmodel, self.data, q, v)
+        if own:
+            self.T[k] += own.kinetic(v)
+            self.V[k] += own.potential(q)
+        self.P_in[k] = float(np.nan_to_num(self.efforts[k]) @ v[self.a_idx])
+
+    def _shaking(self, k: int, table: dict, state: KinematicState) -> None:
+        """Step ``k``'s shaking wrench: the reactions of the joints at the ground, moments about the world origin."""
+        for name, (kind, wrench, _) in table.items():
+            if kind in ("tree", "coupled") and name in self.ground_tree:
+                jid = self.mech.model.getJointId(name) if kind == "coupled" else reaction_joint_id(self.mech, name)
+                sign, origin = -1.0, state.centre(("joint", jid))
+            elif kind == "cut" and name in self.ground_cuts:
+                cut = next(c for c in self.mech.cuts if c.name == name)
+                sign, origin = self.ground_cuts[name], state.centre(("frame", cut.frame2))
+            else:
+                continue
+            self.shaking_f[k] += sign * wrench[:3]
+            self.shaking_m[k] += sign * (wrench[3:] + cross3(origin, wrench[:3]))
+
+
+def _motion_notes(s: _Series, input: str, res: SweepResult, peak: dict[str, float | None],
+                  open_names: dict[str, tuple[str, ...]]) -> list[str]:
+    """What the figures along the motion leave undetermined or out, and where the inputs cannot drive it."""
+    notes = []
+    if s.friction_at_rest:
+        notes.append(f"where {_names(sorted(s.friction_at_rest))} stand still the dry friction lies anywhere in "
+                     "+-frictionloss: the efforts there take it as 0")
+    if not np.any(s.g):
+        notes.append("gravity: none (give --gravity 0,0,-9.81 for the links' weights)")
+    if s.indeterminate:
+        varying = "; ".join(f"{name} {' '.join(c)}" for name, c in open_names.items() if c)
+        notes.append(f"the loop constraints are redundant: the balance has a null space of dimension "
+                     f"{s.indeterminate} (self-stresses of the loops); the efforts are unique where given, the "
+                     f"reactions are the minimum-norm ones" + (f", these components are not determined: {varying}"
+                                                                if varying else ""))
+    if any(v is None for v in peak.values()):
+        notes.append("redundant actuation: the efforts marked nan are not determined (minimum-norm split not given)")
+    if res.stopped_at is not None:
+        notes.append(f"the motion stopped at {input} = {res.stopped_at:.6g} {res.unit}: {res.stop_reason}")
+    if res.skipped:
+        notes.append(f"{len(res.skipped)} input value(s) of the grid could not be solved and are left out")
+    stuck = s.unbalanced > s.mech.tolerances.balanced * s.scale
+    if np.any(stuck):
+        notes.append(f"at {int(np.sum(stuck))} step(s) the inputs cannot drive the motion "
+                     f"(largest unbalanced generalized force {s.unbalanced.max():.3g}): near a singularity")
+    return notes
+
+
+def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: float, steps: int,
+             inputs: Iterable[str] | None = None, fixed: dict | None = None, near: dict | None = None,
+             gravity: Iterable[float] = (0.0, 0.0, 0.0), loads: Iterable[Load] = (), cs: float = 0.05,
+             progress: Callable[[int, int], object] | None = None, q_start: np.ndarray | None = None,
+             branch: str = "continue") -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).
 
@@ -259,16 +377,7 @@ def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: floa
     g = np.asarray(gravity, float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise UsageError("gravity must be 3 finite numbers gx, gy, gz [m/s^2]")
-    notes = list(check_inertias(mech))
-    own, left = joint_dynamics(mech)
-    if own:
-        notes.append(f"the armature, damping and friction loss the file gives {len(own)} joints ("
-                     f"{_names(list(own))}) are in these efforts, as MuJoCo applies them (per degree of freedom: "
-                     "armature * a + damping * v + frictionloss * sign(v)"
-                     + (f"; the springs of {_names(list(own.springs))}: stiffness * (x - springref), their energy in "
-                        "the potential energy" if own.springs else "") + ")")
-    if left:
-        notes.append(left_out_note(left))
+    notes, own = _joint_notes(mech)
     fixed = dict(fixed or {})
     inputs = sweep_inputs(mech, input, fixed) if inputs is None else list(inputs)
     for ld in loads:
@@ -277,96 +386,26 @@ def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: floa
     res = sweep(solver, input, start, stop, steps, fixed={k: v for k, v in fixed.items() if k != input},
                 near=None if q_start is not None else near, rate=speed, q_start=q_start, branch=branch)
     notes += res.change_point_notes  # the change points passed, and the branch taken at each
-    model = mech.model
-    data = mech.scratch_data()
-    a_idx = mech.velocity_indices(inputs)
-    m = len(a_idx)
     n = len(res.values)
-    efforts = np.full((n, m), np.nan)
-    reactions, kinds, open_, coupled = {}, {}, {}, {}
-    shaking_f, shaking_m = np.zeros((n, 3)), np.zeros((n, 3))
-    T, V, P_in, P_load, unbalanced, scale = (np.zeros(n) for _ in range(6))
-    indeterminate = 0
-    friction_at_rest = set()
-    ground_tree, ground_cuts = _ground_sides(mech)
-    gmodel = mech.model_with_gravity(g)  # the model with this gravity (RNEA and the potential energy read it)
+    s = _Series(mech, inputs, own, loads, g, n)
     for k in range(n):
         if progress is not None:
             progress(k, n)
-        q, v, a = res.q[k], res.rates[k], res.accelerations[k]
-        b = pin.rnea(gmodel, data, q, v, a).copy()
-        own_coupled = {}
-        if own:
-            joint_force, own_coupled = own.forces(q, v, a)
-            b += joint_force
-            friction_at_rest |= own.friction_at_rest(v)
-        state = KinematicState(mech, q)
-        frames = _load_wrenches(mech, loads, state)
-        for fid, w in frames:
-            J = state.frame_jacobian(fid, LWA)
-            b -= J.T @ w
-            P_load[k] += float(w @ (J @ v))
-        K = mech.closure.jacobian(q)
-        tau, lam, N, unbalanced[k], scale[k] = balance(mech, K, a_idx, b)
-        free_tau = np.linalg.norm(N[:m], axis=1) if N.size else np.zeros(m)
-        efforts[k] = np.where(free_tau > mech.tolerances.indeterminate, np.nan, tau)
-        indeterminate = max(indeterminate, int(N.shape[1]) if N.size else 0)
-        table = reaction_table(mech, q, lam, frames, g, N[m:] if N.size else None, v, a)
-        for name, value in coupled_efforts(mech, q, {k: x[1] for k, x in table.items() if x[0] == "coupled"}).items():
-            coupled.setdefault(name, np.zeros(n))[k] = value + own_coupled.get(name, 0.0)
-        for name, (kind, wrench, is_open) in table.items():
-            reactions.setdefault(name, np.zeros((n, 6)))[k] = wrench
-            kinds[name] = kind
-            open_[name] = open_.get(name, np.zeros(6, bool)) | is_open
-        for name, (kind, wrench, _) in table.items():
-            if kind in ("tree", "coupled") and name in ground_tree:
-                jid = model.getJointId(name) if kind == "coupled" else reaction_joint_id(mech, name)
-                sign, origin = -1.0, state.centre(("joint", jid))
-            elif kind == "cut" and name in ground_cuts:
-                cut = next(c for c in mech.cuts if c.name == name)
-                sign, origin = ground_cuts[name], state.centre(("frame", cut.frame2))
-            else:
-                continue
-            shaking_f[k] += sign * wrench[:3]
-            shaking_m[k] += sign * (wrench[3:] + cross3(origin, wrench[:3]))
-        T[k], V[k] = _energies(mech, gmodel, data, q, v)
-        if own:
-            T[k] += own.kinetic(v)
-            V[k] += own.potential(q)
-        P_in[k] = float(np.nan_to_num(efforts[k]) @ v[a_idx])
-    units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, a_idx)}
+        s.step(k, res.q[k], res.rates[k], res.accelerations[k])
+    units = {name: "N" if mech.translational[iv] else "N m" for name, iv in zip(inputs, s.a_idx)}
     units.update(coupled_units(mech))
-    eff = {name: efforts[:, j] for j, name in enumerate(inputs)}
+    eff = {name: s.efforts[:, j] for j, name in enumerate(inputs)}
     peak = {name: float(np.max(np.abs(y))) if np.all(np.isfinite(y)) else None for name, y in eff.items()}
     rms = {name: float(np.sqrt(_range_mean(res.values, y**2))) if np.all(np.isfinite(y)) else None
            for name, y in eff.items()}
     mean = {name: _range_mean(res.values, y) if np.all(np.isfinite(y)) else None for name, y in eff.items()}
     completed = res.completed
     fly = _flywheel(res.values, eff.get(input), speed, res.unit, cs, completed)
-    if friction_at_rest:
-        notes.append(f"where {_names(sorted(friction_at_rest))} stand still the dry friction lies anywhere in "
-                     "+-frictionloss: the efforts there take it as 0")
-    if not np.any(g):
-        notes.append("gravity: none (give --gravity 0,0,-9.81 for the links' weights)")
-    open_names = {name: tuple(c for c, o in zip(COMPONENTS, mask) if o) for name, mask in open_.items()}
-    if indeterminate:
-        varying = "; ".join(f"{name} {' '.join(c)}" for name, c in open_names.items() if c)
-        notes.append(f"the loop constraints are redundant: the balance has a null space of dimension {indeterminate} "
-                     f"(self-stresses of the loops); the efforts are unique where given, the reactions are the "
-                     f"minimum-norm ones" + (f", these components are not determined: {varying}" if varying else ""))
-    if any(v is None for v in peak.values()):
-        notes.append("redundant actuation: the efforts marked nan are not determined (minimum-norm split not given)")
-    if res.stopped_at is not None:
-        notes.append(f"the motion stopped at {input} = {res.stopped_at:.6g} {res.unit}: {res.stop_reason}")
-    if res.skipped:
-        notes.append(f"{len(res.skipped)} input value(s) of the grid could not be solved and are left out")
-    stuck = unbalanced > mech.tolerances.balanced * scale
-    if np.any(stuck):
-        notes.append(f"at {int(np.sum(stuck))} step(s) the inputs cannot drive the motion "
-                     f"(largest unbalanced generalized force {unbalanced.max():.3g}): near a singularity")
+    open_names = {name: tuple(c for c, o in zip(COMPONENTS, mask) if o) for name, mask in s.open_.items()}
+    notes += _motion_notes(s, input, res, peak, open_names)
     return DynamicsResult(input, res.unit, float(speed), res.values, res.q, res.rates, res.accelerations,
-                          tuple(inputs), eff, units, reactions, kinds, open_names, indeterminate, shaking_f,
-                          shaking_m, T, V, P_in, P_load, unbalanced, peak, mean, rms, fly, tuple(map(float, g)),
-                          tuple(loads), completed, tuple(notes),
-                          {k: np.asarray(v, float) for k, v in actuator_efforts(mech, inputs, eff).items()}, coupled,
-                          mech.transmissions(inputs))
+                          tuple(inputs), eff, units, s.reactions, s.kinds, open_names, s.indeterminate, s.shaking_f,
+                          s.shaking_m, s.T, s.V, s.P_in, s.P_load, s.unbalanced, peak, mean, rms, fly,
+                          tuple(map(float, g)), tuple(loads), completed, tuple(notes),
+                          {k: np.asarray(v, float) for k, v in actuator_efforts(mech, inputs, eff).items()},
+                          s.coupled, mech.transmissions(inputs))

@@ -38,7 +38,7 @@ from ...model.geometry import cross3
 from ...model.linalg import null_space, rank
 from ...model.state import KinematicState, frame_parent
 from ..screws import Screw, cut_twists, screw_of
-from ..singularities.singular import Generic, measures
+from ..singular import Generic, measures
 from .joint_dynamics import joint_dynamics, left_out_note, names_text
 from typing import TYPE_CHECKING
 
@@ -79,7 +79,7 @@ class StaticsResult:
     reactions: tuple  # Reaction
     indeterminate: int  # dimension of the statically indeterminate part (redundant constraints and inputs)
     singular: bool  # near an actuator singularity: efforts grow without bound
-    sigma_actuator: float  # the actuator measure (screwkin.analysis.singularities.singular.measures)
+    sigma_actuator: float  # the actuator measure (screwkin.analysis.singular.measures)
     amplification: float | None  # |efforts| / |load| with lengths made dimensionless by L (N m both)
     length: float  # the characteristic length L [m]
     constraint_forces: tuple  # (row label, lambda) of the closure rows

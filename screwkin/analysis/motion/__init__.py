@@ -1,1 +1,1 @@
-"""Where a mechanism is and how it moves: assembly modes, inverse kinematics, the one continuation (sweeps), absolute link and point motion."""
+"""How a mechanism moves along an input: the one continuation (sweeps: closed form, batched, step by step, streamed), change points, absolute link and point motion."""

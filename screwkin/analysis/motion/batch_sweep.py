@@ -8,7 +8,7 @@ input are taken a chunk at a time by ``BatchedCurve``, the batched engine of the
 - predict every value of the chunk from the last configuration reached, along its tangent
   (the input held at each grid value);
 - correct them all at once with BatchClosure.solve (the one damped-Newton step of
-  model/newton.py, each configuration its own damping);
+  model/kernel/newton.py, each configuration its own damping);
 - accept each that is on the branch, as the per-step tracker does: it converged, the correction
   passes the jump test, and no limit position lies between it and the previous one (the input's
   share of the tangent, oriented along the chunk, keeps its sign).
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .batch_closure import BatchClosure, Unbatchable
+from ...model.kernel.stacks import BatchClosure, Unbatchable
 from ...model.geometry import TINY
 from .continuation import Curve, Motion, jumped, passes_limit
 from typing import TYPE_CHECKING

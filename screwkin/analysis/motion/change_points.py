@@ -3,7 +3,7 @@ where branches of another mobility meet -- located, analysed (analysis.local) an
 motion comes in on and the one it continues on.
 
 A sweep that meets a change point may go on along either branch (a four-bar folded flat: from the
-parallelogram onto the anti-parallelogram): the constraint measure (analysis.singularities.singular)
+parallelogram onto the anti-parallelogram): the constraint measure (analysis.singular)
 dips to zero there without changing sign, so it is not among the sign changes that
 analysis.motion.singular_points locates.  Here every local minimum of the constraint measure along the
 recorded sweep (crossing.dips: below LOOK_BELOW, lower than both neighbours) is refined by
@@ -23,12 +23,12 @@ import numpy as np
 
 from ...errors import AssemblyError
 from ..local import local_analysis
-from ..singularities.singular import Generic, measures
+from ..singular import Generic, measures
 from .crossing import TIGHT_CLOSURE, ChangePoint, dips, nearest_branch, reclosing
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["change_points"]
 

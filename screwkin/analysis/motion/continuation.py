@@ -22,7 +22,7 @@ with it, and ``Neighbour`` takes a map's steps with it), ``BatchedCurve`` (analy
 a chunk of grid values at once), ``ClosedFormCurve`` (analysis.motion.dyads: every value at once, its
 limit positions located by ``locate``, its return to the start by ``returned``), the workspace's grid
 growth (analysis.design.workspace_grid: the jump test, and ``keeps_orientation``, the branch rule in
-several parameters), and the certified mode search's homotopy paths (model.tracking.Paths: predict,
+several parameters), and the certified mode search's homotopy paths (model.homotopy.tracking.Paths: predict,
 correct, accept -- in complex space there is no branch to choose nor limit to locate; the layers keep
 that engine below this module, which it matches by its methods).  analysis.motion.sweep chooses among
 the first three.
@@ -38,14 +38,7 @@ import pinocchio as pin
 
 from ...errors import AssemblyError
 from ...model.geometry import TINY
-from ..singularities.singular import measures
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from typing import Any
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.tolerances import Tolerances
-    from collections.abc import Callable
+from ..singular import measures
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -81,33 +74,41 @@ class Motion:
 
 
 class Engine(Protocol):
-    """The interface of a continuation engine (see the module docstring): five questions, each engine
-    answering them on its own state.  ``Curve``: q one configuration, t its oriented unit tangent (nv),
-    sigma a dimensionless step, ``held`` a velocity index; ``BatchedCurve``: the same on a stack of
-    configurations (one per row, sigma one per row); ``ClosedFormCurve`` (analysis.motion.dyads): input
-    values instead of steps (its prediction is exact), a sign per dyad for the branch."""
+    """The interface of a continuation engine along an input (see the module docstring): five questions,
+    each engine answering them on its own state.  ``Curve`` answers them for one configuration: q (nq,),
+    t its oriented unit tangent (nv,) in scaled coordinates, sigma a dimensionless step, ``held`` a
+    velocity index; ``BatchedCurve`` (analysis.motion.batch_sweep) for a stack, one configuration per
+    row (sigma (N,), the corrections (N, nq) with a flag per row).  ``ClosedFormCurve``
+    (analysis.motion.dyads: input values instead of steps, a sign per dyad for the branch) and the
+    homotopy's ``Paths`` (model.homotopy.tracking: complex paths) answer the same questions with signatures of
+    their own: they are not Engines."""
 
-    def predict(self, *args: Any) -> None:
-        """Where the next configuration(s) should be: a step along the tangent (the closed form: its
-        placement at the input values)."""
+    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float | np.ndarray) -> np.ndarray:
+        """Where the next configuration(s) should be: q moved sigma along t on the configuration
+        manifold -- (nq,), or (N, nq) for sigma (N,)."""
+        ...
 
-    def correct(self, *args: Any) -> None:
-        """The configuration(s) closing the loops from the prediction, with one joint held (the closed
-        form: the joint coordinates of its placement)."""
+    def correct(self, predicted: np.ndarray, held: int) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """The configuration closing the loops from the prediction with velocity index ``held`` held
+        (nq,) (raises Stuck); for a stack (N, nq) and whether each row closed (N,) bool."""
+        ...
 
-    def accept(self, *args: Any) -> None:
-        """Which corrections stayed on the curve: ``jumped`` and, for a stack, ``passes_limit`` (the
-        closed form: every discriminant non-negative)."""
+    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float | np.ndarray) -> bool | np.ndarray:
+        """Whether the correction stayed on the curve (``jumped``; for a stack one flag per row (N,),
+        and ``passes_limit``)."""
+        ...
 
-    def choose_branch(self, *args: Any) -> None:
-        """The branch that continues the motion: ``orient`` (the closed form: past a dyad's limit
-        position, its other sign)."""
+    def choose_branch(self, t: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+        """The tangent(s) t oriented to continue the motion of ``previous`` (``orient``)."""
+        ...
 
-    def locate_limit(self, *args: Any) -> None:
-        """The limit position bracketed between two configurations (input values), by ``locate``."""
+    def locate_limit(self, qa: np.ndarray, ta: np.ndarray, qb: np.ndarray, held: int) -> tuple[np.ndarray, float]:
+        """The limit position bracketed between qa (tangent ta) and qb, with ``held`` the parameter
+        (``locate``): (its configuration (nq,), its input offset from qa)."""
+        ...
 
 
-def projections(K: np.ndarray, V: np.ndarray, scale: np.ndarray, free: np.ndarray, tol: Tolerances) -> np.ndarray:
+def projections(K, V, scale, free, tol) -> np.ndarray:
     """The vectors V (N, nv) projected onto the null space of the scaled constraint Jacobians K
     (N, m, nv) -- columns times ``scale`` (characteristic lengths for sliding joints), restricted to
     the ``free`` columns (the held inputs have no part) -- with the rank rule of model.linalg (singular
@@ -137,7 +138,7 @@ def projections(K: np.ndarray, V: np.ndarray, scale: np.ndarray, free: np.ndarra
     return out
 
 
-def orient(t: np.ndarray, previous: np.ndarray) -> np.ndarray:
+def orient(t, previous):
     """The branch rule: t, or -t, whichever continues ``previous`` (a non-negative dot product);
     t itself without a previous one.  Rows of a stack are oriented each like the row before it,
     the first like ``previous``."""
@@ -152,13 +153,13 @@ def orient(t: np.ndarray, previous: np.ndarray) -> np.ndarray:
     return t * np.cumprod(d)[:, None]
 
 
-def passes_limit(ta: np.ndarray, tb: np.ndarray, ix: int) -> bool:
+def passes_limit(ta, tb, ix):
     """A limit position between two configurations (oriented tangents ta, tb: ``orient``): the
     input's share of the tangent does not keep its sign (rows of stacks compared pairwise)."""
     return np.asarray(ta)[..., ix] * np.asarray(tb)[..., ix] <= 0
 
 
-def keeps_orientation(Ks_from, Ks_new: np.ndarray, r) -> bool:
+def keeps_orientation(Ks_from, Ks_new, r):
     """The branch rule of a continuation in several parameters (a workspace's grid growth): each new
     Jacobian (N, m, n; dimensionless) restricted to the old one's range and row space (rank r) keeps the
     sign of its determinant -- a jump across a fold to another working mode flips it.  With one
@@ -170,14 +171,14 @@ def keeps_orientation(Ks_from, Ks_new: np.ndarray, r) -> bool:
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss, sigma: float, tol: Tolerances) -> np.ndarray | bool:
+def jumped(miss, sigma, tol):
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""
     return ~(np.asarray(miss) <= np.maximum(tol.jump * np.abs(sigma), tol.jump_floor))
 
 
-def locate(f: Callable, lo: float, hi: float, xtol: float = 1e-14, maxiter: int = 100) -> float:
+def locate(f, lo, hi, xtol=1e-14, maxiter=100) -> float:
     """The root of f bracketed in [lo, hi] (f changes sign there) by Brent's method, to xtol and
     four units of round-off: where every engine locates its limit positions (the tangent's input
     share, a closed form's discriminant) and the input values on an arc near them."""
@@ -186,7 +187,7 @@ def locate(f: Callable, lo: float, hi: float, xtol: float = 1e-14, maxiter: int 
     return brentq(f, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=maxiter)
 
 
-def returned(mech: Mechanism, x: float, start: float, h: float, q: np.ndarray, q0: np.ndarray, scale: np.ndarray) -> bool:
+def returned(mech, x, start, h, q, q0, scale) -> bool:
     """The motion is back at its start: the input at ``start`` (Tolerances.equal relative to the grid
     step h) and the configuration q at q0 (Tolerances.geometry, dimensionless)."""
     tol = mech.tolerances
@@ -194,15 +195,15 @@ def returned(mech: Mechanism, x: float, start: float, h: float, q: np.ndarray, q
                 and np.linalg.norm(pin.difference(mech.model, q, q0) / scale) < tol.geometry)
 
 
-def at_change_point(solver, q: np.ndarray) -> dict:
-    """The singularity measures at a located limit position q (analysis.singularities.singular.measures),
+def at_change_point(solver, q) -> dict:
+    """The singularity measures at a located limit position q (analysis.singular.measures),
     with "change": whether K itself loses rank there (a change point, not a limit position: the input
     passes it on a branch that goes on)."""
     m = measures(solver.mech, q, solver.generic())
     return {**m, "change": solver.generic().rank_K > 0 and m["constraint"] < solver.mech.tolerances.singular}
 
 
-def continuation_steps(mech: Mechanism, name: str, dx: float) -> int:
+def continuation_steps(mech, name: str, dx: float) -> int:
     """How many steps a continuation takes to move input ``name`` by ``dx`` [rad or m]: steps of at most
     Tolerances.max_step (scaled: characteristic lengths for a sliding input), as the sweep takes them."""
     c = mech.coordinate(name)
@@ -213,7 +214,7 @@ def continuation_steps(mech: Mechanism, name: str, dx: float) -> int:
 class Curve:
     """The curve along input ``name`` of a PositionSolver, one configuration at a time: an ``Engine``."""
 
-    def __init__(self, solver, name: str) -> None:
+    def __init__(self, solver, name):
         mech = self.mech = solver.mech
         self.solver, self.model, self.closure = solver, solver.model, mech.closure
         self.name = name
@@ -236,11 +237,11 @@ class Curve:
     def unit(self) -> str:
         return "m" if self.mech.translational[self.ix] else "rad"
 
-    def input_directions(self, K: np.ndarray) -> np.ndarray:
+    def input_directions(self, K):
         """The unnormalized tangents P e at configurations of constraint Jacobians K (N, m, nv)."""
         return projections(K, self.e[None].repeat(len(K), 0), self.scale, self.free, self.tol)
 
-    def tangent(self, q: np.ndarray, previous: np.ndarray | None=None) -> np.ndarray:
+    def tangent(self, q, previous=None):
         """Unit tangent of the curve at q in scaled coordinates (nv; zero on the held inputs),
         oriented like ``previous`` (``choose_branch``): the input's direction projected onto the null
         space of K; at a limit position itself (tol.limit_share), ``previous`` projected instead."""
@@ -254,39 +255,39 @@ class Curve:
             raise Stuck("the mechanism cannot move along this input here")
         return self.choose_branch(t / n, previous)
 
-    def choose_branch(self, t: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
+    def choose_branch(self, t, previous):
         return orient(t, previous)
 
-    def along(self, q: np.ndarray, direction: float) -> np.ndarray:
+    def along(self, q, direction):
         """The unit tangent at q oriented so that the input moves the way of ``direction`` (its sign;
         zero: increasing) -- where a motion starts."""
         t = self.tangent(q)
         return -t if t[self.ix] * (np.sign(direction) or 1.0) < 0 else t
 
-    def hold(self, t: np.ndarray) -> int:
+    def hold(self, t):
         """The velocity index of the joint to hold for a step along t: the input when it has a
         large share of the tangent, else the one-DOF joint with the largest share."""
         scores = np.where(self.holdable, np.abs(t), -1.0)
         best = int(np.argmax(scores))
         return self.ix if abs(t[self.ix]) >= 0.5 * scores[best] else best
 
-    def frozen(self, held: int) -> tuple:
+    def frozen(self, held):
         return tuple(sorted(set(self.frozen_other) | {held}))
 
-    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float) -> np.ndarray:
+    def predict(self, q, t, sigma):
         return pin.integrate(self.model, q, self.scale * t * sigma)
 
-    def correct(self, predicted: np.ndarray, held: int) -> np.ndarray:
+    def correct(self, predicted, held):
         try:
             return self.closure.solve(predicted, frozen=self.frozen(held)).q
         except AssemblyError:
             raise Stuck("the loops cannot be closed") from None
 
-    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float) -> bool:
+    def accept(self, predicted, corrected, sigma):
         miss = np.linalg.norm(pin.difference(self.model, predicted, corrected) / self.scale)
         return not jumped(miss, sigma, self.tol)
 
-    def step(self, q: np.ndarray, t: np.ndarray, sigma: float, held: int) -> np.ndarray:
+    def step(self, q, t, sigma, held):
         """Move sigma (scaled) along t, hold joint ``held`` there, close the loops again."""
         pred = self.predict(q, t, sigma)
         q_new = self.correct(pred, held)
@@ -294,17 +295,17 @@ class Curve:
             raise Stuck("the correction jumps away from the curve")
         return q_new
 
-    def at_input(self, q_from: np.ndarray, x_from: float, x: float, t: np.ndarray) -> np.ndarray:
+    def at_input(self, q_from, x_from, x, t):
         """The configuration at input value x, predicted from q_from (input x_from) along t."""
         dx = (x - x_from) / self.scale[self.ix]
         if abs(t[self.ix]) < self.tol.zero:
             raise Stuck("the input does not move here")
         return self.step(q_from, t, dx / t[self.ix], self.ix)
 
-    def input_change(self, q0: np.ndarray, q1: np.ndarray) -> float:
+    def input_change(self, q0, q1) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
 
-    def _arc(self, qa: np.ndarray, qb: np.ndarray, held: int, message: str) -> Callable:
+    def _arc(self, qa, qb, held, message):
         """The configuration a share u of the way from qa to qb with joint ``held`` as the parameter."""
         delta = pin.difference(self.model, qa, qb)
         frozen, cache = self.frozen(held), {0.0: qa, 1.0: qb}
@@ -321,7 +322,7 @@ class Curve:
 
         return at
 
-    def on_arc(self, qa: np.ndarray, xa, qb: np.ndarray, held, x):
+    def on_arc(self, qa, xa, qb, held, x):
         """The configuration at input value x on the arc from qa (input xa) to qb, followed with
         joint ``held`` as the parameter (the input changes monotonically along it: no limit
         position strictly between): Brent's method on the held joint's share of the way.  Near a
@@ -350,12 +351,12 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed at this input value") from None
 
-    def locate_limit(self, qa: np.ndarray, ta: np.ndarray, qb: np.ndarray, held: int) -> tuple:
+    def locate_limit(self, qa, ta, qb, held):
         """The limit position between qa and qb (the input's tangent component changes sign),
         with joint ``held`` as the parameter: (configuration, input offset from qa)."""
         at = self._arc(qa, qb, held, None)
 
-        def f(s) -> float:
+        def f(s):
             return float(self.tangent(at(s), ta)[self.ix])
 
         fa, fb = float(ta[self.ix]), f(1.0)
@@ -373,10 +374,10 @@ class Neighbour:
     its corrector and its branch tests (a correction that jumps away from the curve, or a
     limit position between the two values, refuses the step).  Maps walk their grids with it."""
 
-    def __init__(self, solver, name: str) -> None:
+    def __init__(self, solver, name: str):
         self.curve = Curve(solver, name)
 
-    def __call__(self, q: np.ndarray | tuple, x_from: float, x_to: float):
+    def __call__(self, q, x_from: float, x_to: float):
         """The configuration at input value x_to on q's branch (q at x_from), or None."""
         c = self.curve
         direction = np.sign(x_to - x_from)

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.continuation import Curve
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
     from screwkin.tolerances import Tolerances
     from collections.abc import Callable
     from collections.abc import Iterator
@@ -130,7 +130,7 @@ class Crossing:
 
 def constraint_profile(mech: Mechanism, Q: np.ndarray | list, rank: int | None = None) -> tuple:
     """(the relative smallest singular value of the scaled K at each configuration of Q (N,), the rank
-    it is taken at): analysis.singularities.singular.measures' "constraint", with ``rank`` (default the
+    it is taken at): analysis.singular.measures' "constraint", with ``rank`` (default the
     largest rank met along Q: a motion's configurations are generic but for isolated ones) for the
     generic one; the Jacobians batched where the closure is (analysis.motion.batch_sweep.batch_closure)."""
     Q = np.atleast_2d(np.asarray(Q, float))

@@ -38,10 +38,6 @@ from ...model.planar_graph import DyadPlan, plan
 from ...model.state import KinematicState
 from .batch_sweep import batch_closure
 from .continuation import CHANGE_REASON, LIMIT_REASON, at_change_point, locate, returned
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Jet", "ClosedFormSweep", "ClosedFormCurve", "planar_sweep", "cached_plan"]
 
@@ -54,53 +50,53 @@ class Jet:
 
     __slots__ = ("v", "d", "dd")
 
-    def __init__(self, v: np.ndarray, d: float = 0.0, dd: float = 0.0) -> None:
+    def __init__(self, v, d=0.0, dd=0.0):
         self.v, self.d, self.dd = v, d, dd
 
-    def __add__(self, o: Jet) -> Jet:
+    def __add__(self, o):
         if isinstance(o, Jet):
             return Jet(self.v + o.v, self.d + o.d, self.dd + o.dd)
         return Jet(self.v + o, self.d, self.dd)
 
     __radd__ = __add__
 
-    def __neg__(self) -> Jet:
+    def __neg__(self):
         return Jet(-self.v, -self.d, -self.dd)
 
-    def __sub__(self, o: Jet | float) -> Jet:
+    def __sub__(self, o):
         return self + (-o)
 
     def __rsub__(self, o):
         return (-self) + o
 
-    def __mul__(self, o: Jet) -> Jet:
+    def __mul__(self, o):
         if isinstance(o, Jet):
             return Jet(self.v * o.v, self.d * o.v + self.v * o.d, self.dd * o.v + 2 * self.d * o.d + self.v * o.dd)
         return Jet(self.v * o, self.d * o, self.dd * o)
 
     __rmul__ = __mul__
 
-    def inverse(self) -> Jet:
+    def inverse(self):
         f = 1.0 / self.v
         return Jet(f, -self.d * f * f, (2 * self.d * self.d * f - self.dd) * f * f)
 
-    def __truediv__(self, o: Jet) -> Jet:
+    def __truediv__(self, o):
         return self * o.inverse() if isinstance(o, Jet) else self * (1.0 / o)
 
-    def sqrt(self) -> Jet:
+    def sqrt(self):
         f = np.sqrt(self.v)
         return Jet(f, self.d / (2 * f), self.dd / (2 * f) - self.d * self.d / (4 * f ** 3))
 
-    def cos(self) -> Jet:
+    def cos(self):
         c, s = np.cos(self.v), np.sin(self.v)
         return Jet(c, -s * self.d, -c * self.d * self.d - s * self.dd)
 
-    def sin(self) -> Jet:
+    def sin(self):
         c, s = np.cos(self.v), np.sin(self.v)
         return Jet(s, c * self.d, -s * self.d * self.d + c * self.dd)
 
     @staticmethod
-    def atan2(y: Jet, x: Jet) -> Jet:
+    def atan2(y, x):
         r2 = x.v * x.v + y.v * y.v
         num = x.v * y.d - y.v * x.d
         dr2 = 2 * (x.v * x.d + y.v * y.d)
@@ -112,24 +108,24 @@ class _Pose:
 
     __slots__ = ("th", "c", "s", "tx", "ty")
 
-    def __init__(self, th: Jet, tx: Jet, ty: Jet) -> None:
+    def __init__(self, th, tx, ty):
         self.th, self.c, self.s, self.tx, self.ty = th, th.cos(), th.sin(), tx, ty
 
-    def rotate(self, u: np.ndarray) -> tuple:
+    def rotate(self, u):
         return self.c * u[0] - self.s * u[1], self.s * u[0] + self.c * u[1]
 
-    def __call__(self, p: np.ndarray | tuple) -> tuple:
+    def __call__(self, p):
         x, y = self.rotate(p)
         return x + self.tx, y + self.ty
 
     @classmethod
-    def through(cls, th: Jet, point: tuple, p0: np.ndarray) -> _Pose:
+    def through(cls, th, point, p0):
         """The displacement turning by th that takes the q0 point p0 to ``point``."""
         c, s = th.cos(), th.sin()
         return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
 
 
-def _turn_from(u0: np.ndarray, u: tuple) -> Jet:
+def _turn_from(u0, u):
     """The angle from the constant vector u0 to the jet vector u, in (-pi, pi]."""
     return Jet.atan2(u[1] * u0[0] - u[0] * u0[1], u[0] * u0[0] + u[1] * u0[1])
 
@@ -139,7 +135,7 @@ class _Geometry:
     coordinates, axis signs, the branch of each dyad (``probe``; without it ``branch`` is None:
     the caller chooses the branches, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech: Mechanism, p: DyadPlan, q0: np.ndarray, probe: bool = True) -> None:
+    def __init__(self, mech, p: DyadPlan, q0, probe: bool = True):
         state = KinematicState(mech, q0)
         axes, points = [], []  # per pair: (on the side of its first group, of its second)
         for pr in p.pairs:
@@ -184,20 +180,20 @@ class _Geometry:
                 return
             self.branch.append(float(np.sign(d)))
 
-    def point(self, i: int, g: int) -> np.ndarray:
+    def point(self, i, g):
         """Pair i's point (plane coordinates at q0) on the link of group g."""
         return self._points[i][self.pairs[i].groups.index(g)]
 
-    def other(self, i: int, g: int) -> np.ndarray:
+    def other(self, i, g):
         """Pair i's point on the link of its group other than g."""
         return self._points[i][1 - self.pairs[i].groups.index(g)]
 
-    def dir(self, i: int, g: int) -> np.ndarray:
+    def dir(self, i, g):
         """Pair i's axis (a slide's direction, plane coordinates at q0) on the link of group g."""
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, g2: int, pa: _Pose | None, pc: _Pose, sigma: float | str, probe: bool=False, clamp: bool=False) -> float | tuple:
+def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clamp=False):
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -249,14 +245,14 @@ def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, 
     return (_Pose.through(th, A, A1), _Pose.through(th, C, C2)), disc.v / v0s
 
 
-def _root(disc: Jet, clamp: bool) -> Jet:
+def _root(disc, clamp):
     """The square root of a discriminant (NaN where it is negative); clamp: of max(disc, 0),
     values only (at a limit position, where the derivatives are infinite)."""
     with np.errstate(invalid="ignore", divide="ignore"):
         return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
 
 
-def _evaluate(geo: _Geometry, p: DyadPlan, xs: np.ndarray | list, start: float, branch: str, clamp: int | None = None) -> tuple:
+def _evaluate(geo, p: DyadPlan, xs, start, branch, clamp=None):
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
     clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
     Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
@@ -264,7 +260,7 @@ def _evaluate(geo: _Geometry, p: DyadPlan, xs: np.ndarray | list, start: float, 
         return _evaluate_all(geo, p, xs, start, branch, clamp)
 
 
-def _evaluate_all(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, branch: str, clamp: int | None) -> tuple:
+def _evaluate_all(geo, p, xs, start, branch, clamp):
     xs = np.asarray(xs, float)
     zero = Jet(np.zeros(len(xs)))
     poses = {p.groups[0]: _Pose(zero, zero, zero)}
@@ -293,7 +289,7 @@ def _evaluate_all(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, bra
 class _Layout:
     """Where each tree joint's coordinate comes from: the groups of its two links, its kind."""
 
-    def __init__(self, mech: Mechanism, p: DyadPlan, geo: _Geometry, q0: np.ndarray) -> None:
+    def __init__(self, mech, p: DyadPlan, geo, q0):
         model = mech.model
         self.rows = []  # (idx_q, nq, idx_v, kind, parent group, child group, pair index or None)
         by_tree = {pr.tree: i for i, pr in enumerate(p.pairs) if pr.tree is not None}
@@ -304,7 +300,7 @@ class _Layout:
         self.geo, self.q0, self.nq, self.nv = geo, q0, model.nq, model.nv
         self.wrapped = [(iq, iv) for iq, nq, iv, kind, _, _, _ in self.rows if kind == "R" and nq == 1]
 
-    def __call__(self, poses: dict | tuple, N: int) -> tuple:
+    def __call__(self, poses, N):
         """(Q (N, nq) with the one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2 (N, nv))."""
         geo, q0 = self.geo, self.q0
         Q = np.tile(q0, (N, 1))
@@ -340,13 +336,13 @@ class _Unwrap:
     _SAFE = np.pi / 2  # the largest turn between two samples taken as unambiguous [rad]
     _SLACK = 0.01  # relative slack of the bounds |s| dx on a monotone step
 
-    def __init__(self, wrapped: list) -> None:
+    def __init__(self, wrapped):
         self.cols = np.array([iq for iq, _ in wrapped], int)
         self._iv = np.array([iv for _, iv in wrapped], int)
         self.last = None  # (raw, slope, x, turns) of the last sample
         self.ambiguous = False
 
-    def __call__(self, Q: np.ndarray | tuple, D: np.ndarray, xs: np.ndarray):
+    def __call__(self, Q, D, xs):
         """Q with its angles unwrapped; D (N, nv): dq/dx."""
         if not len(self.cols) or not len(xs):
             return Q
@@ -400,7 +396,7 @@ class ClosedFormSweep:
     unit: str
 
 
-def cached_plan(solver, name: str) -> DyadPlan:
+def cached_plan(solver, name):
     """model.planar_graph.plan of the solver's mechanism swept along ``name`` with its other inputs
     held (a DyadPlan, or why not), kept in the mechanism's cache."""
     mech = solver.mech
@@ -416,7 +412,7 @@ class ClosedFormCurve:
     False (``reason`` why) when the geometry does not apply; probe=False: no branch is read off q0 (the
     caller passes its branch vectors, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech: Mechanism, p: DyadPlan, q0: np.ndarray, start: float, probe: bool = True) -> None:
+    def __init__(self, mech, p: DyadPlan, q0, start, probe: bool = True):
         self.mech, self.p, self.start = mech, p, start
         self.geo = _Geometry(mech, p, q0, probe)
         self.ok, self.reason = self.geo.ok, getattr(self.geo, "reason", None)
@@ -424,34 +420,34 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs: list | np.ndarray, branch: list | None=None, clamp: int | None = None) -> tuple:
+    def predict(self, xs, branch=None, clamp=None):
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
         return _evaluate(self.geo, self.p, xs, self.start, self.branch if branch is None else branch, clamp)
 
     @staticmethod
-    def accept(discs: np.ndarray) -> int:
+    def accept(discs) -> int:
         """How many leading values are placed: every discriminant non-negative (past a limit the branch
         does not exist; its values are NaN)."""
         bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(discs) else np.zeros(0, int)
         return int(bad[0]) if len(bad) else discs.shape[1]
 
-    def correct(self, poses: dict, n: int) -> tuple:
+    def correct(self, poses, n):
         """The closed form is exact: the poses of the first n values as joint coordinates
         (Q with its one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2)."""
         return self.layout({g: _Pose(_take(q.th, n), _take(q.tx, n), _take(q.ty, n)) for g, q in poses.items()}, n)
 
-    def choose_branch(self, which) -> None:
+    def choose_branch(self, which):
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
-    def locate_limit(self, lo: float, hi: float) -> tuple | None:
+    def locate_limit(self, lo, hi):
         """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
         position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
         on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
 
-        def worst(x) -> float:
+        def worst(x):
             d = self.predict([x])[1][:, 0]
             return float(np.min(np.where(np.isnan(d), -1.0, d)))
 
@@ -464,7 +460,7 @@ class ClosedFormCurve:
         return x_lim, Q, D, which
 
 
-def _ready(solver, name: str, q0: np.ndarray, start: float) -> ClosedFormCurve | None:
+def _ready(solver, name, q0, start):
     """The ClosedFormCurve for sweeping ``name`` from q0, or None when the closed form does not apply."""
     p = cached_plan(solver, name)
     if isinstance(p, str):
@@ -473,7 +469,7 @@ def _ready(solver, name: str, q0: np.ndarray, start: float) -> ClosedFormCurve |
     return curve if curve.ok else None
 
 
-def _residuals_ok(mech: Mechanism, Q: np.ndarray) -> bool:
+def _residuals_ok(mech, Q) -> bool:
     """Every configuration closes the loops within the closure tolerance (batched where it can be)."""
     tol = mech.tolerances.closure
     if not len(Q) or not mech.cuts:
@@ -485,7 +481,28 @@ def _residuals_ok(mech: Mechanism, Q: np.ndarray) -> bool:
     return bool(np.all(np.sqrt(np.einsum("ij,ij->i", r, r)) <= tol))
 
 
-def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float = 1.0, turn: bool=False, max_steps: int | None = None) -> ClosedFormSweep | None:
+def _next_values(start: float, stop: float, steps: int, h: float, k_pos: float, forward: bool, first: bool,
+                 budget: int) -> np.ndarray | None:
+    """The input values of the next pass of planar_sweep: the grid values after grid position ``k_pos``
+    (forward; from the first on the ``first`` pass) or before it (back, after a limit position), at most
+    ``budget``, the last forward one at ``stop``; None when none is left forward."""
+    if forward:
+        j0 = int(np.floor(k_pos + 1e-9)) + 1
+        js = np.arange(0 if first else j0, steps + 1)[:budget]
+        if not len(js):
+            return None
+    else:
+        j0 = int(np.ceil(k_pos - 1e-9)) - 1
+        js = np.arange(j0, j0 - budget, -1)
+    xs = start + js * h
+    if forward and js[-1] == steps and (xs[-1] - stop) * np.sign(h) > 0:
+        xs[-1] = stop
+    if h == 0:
+        xs = xs[:1]
+    return xs
+
+
+def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
     (two limits between grid values, a configuration not closing the loops)."""
@@ -509,20 +526,9 @@ def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, s
             break
         if h == 0 and not first:
             break
-        budget = max_steps - count
-        if forward:
-            j0 = int(np.floor(k_pos + 1e-9)) + 1
-            js = np.arange(0 if first else j0, steps + 1)[:budget]
-            if not len(js):
-                break
-        else:
-            j0 = int(np.ceil(k_pos - 1e-9)) - 1
-            js = np.arange(j0, j0 - budget, -1)
-        xs = start + js * h
-        if forward and js[-1] == steps and (xs[-1] - stop) * np.sign(h) > 0:
-            xs[-1] = stop
-        if h == 0:
-            xs = xs[:1]
+        xs = _next_values(start, stop, steps, h, k_pos, forward, first, max_steps - count)
+        if xs is None:
+            break
         poses, discs = curve.predict(xs)
         n_ok = curve.accept(discs)
         if first and n_ok == 0:
@@ -579,5 +585,5 @@ def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, s
     return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 
-def _take(j: Jet, n: int) -> Jet:
+def _take(j, n):
     return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))

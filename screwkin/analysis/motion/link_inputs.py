@@ -20,7 +20,7 @@ from ...errors import UsageError
 from ...model._pin import joint_axis
 from ...model.cuts import CouplingRow
 from ...model.state import KinematicState
-from ..singularities.singular import Generic
+from ..singular import Generic
 from .planar import LinkAngles
 from typing import TYPE_CHECKING
 

@@ -26,7 +26,7 @@ import pinocchio as pin
 
 from ...errors import ScrewkinError, UsageError
 from ...model.state import KinematicState, loop_coordinate_cuts
-from .batch_closure import tree_kinematics
+from ...model.kernel.stacks import tree_kinematics
 from .planar import LinkAngles
 from typing import TYPE_CHECKING
 
@@ -301,7 +301,7 @@ def _stroke_end(solver, res, name: str, coordinate: Coordinate, x: np.ndarray, g
 def strokes(res, motion: MotionAlong, mech: Mechanism, solver=None) -> list:
     """A Stroke for each slider coordinate (prismatic tree joint or prismatic loop joint) of a sweep
     ``res`` (analysis.motion.sweep.SweepResult) with its MotionAlong.  With the sweep's ``solver``
-    (analysis.motion.position.PositionSolver) each end is located on the mechanism (Brent's method on
+    (analysis.position.position.PositionSolver) each end is located on the mechanism (Brent's method on
     the slider's rate); without, on the cubic interpolant of the samples (O(h^4))."""
     series = []
     for k, name in enumerate(res.names):

@@ -37,7 +37,7 @@ from ...model.geometry import (
     plane_basis,
     vector_angle,
 )
-from .batch_closure import tree_kinematics
+from ...model.kernel.stacks import tree_kinematics
 from .transmission import (FOUR_BAR_CLASSES, four_bar_classes, slide_transmission_angle, transmission_angle,
                            transmission_range)
 from typing import TYPE_CHECKING

@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...errors import AssemblyError
-from ..singularities.singular import Generic, measures, scaled_jacobians
+from ..singular import Generic, measures, scaled_jacobians
 from .links import LOCATE_XTOL
 from .crossing import dips, reclosing
 from .sweep import SweepResult, SweepSingularity
@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["locate_singularities"]
 

@@ -9,7 +9,7 @@ Two ways to the Jacobians of a stack of configurations:
   placement read from Pinocchio), evaluated for thousands of configurations per
   numpy call.  Python pays its overhead once per joint per block of
   configurations instead of once per configuration.  Its Jacobians equal
-  Pinocchio's (tests/test_batch.py; ``check=N`` compares them again when it is
+  Pinocchio's (tests/analysis/singularities/test_batch.py; ``check=N`` compares them again when it is
   built), and it refuses chains it cannot represent (joints with more than one
   DOF, helical joints).
 

@@ -22,13 +22,10 @@ import numpy as np
 
 from ...errors import UsageError
 from ...tolerances import DEFAULT, Tolerances
-from ..motion.position import PositionSolver
+from ..position.position import PositionSolver
 from ...model.linalg import null_space, rank
-from .singular import SingularityReport, scaled_jacobians
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
+from ..singular import SingularityReport, scaled_jacobians
+from ...model.kernel.scaling import dimensionless
 
 __all__ = ["Ellipsoid", "Ellipsoids", "ellipsoids_of", "ellipsoids", "with_input_output_condition"]
 
@@ -60,7 +57,7 @@ class Ellipsoids:
     point: bool = False
 
 
-def _axis_labels(d: int, linear: int) -> tuple:
+def _axis_labels(d: int, linear: int):
     lin = ("vx/L", "vy/L", "vz/L")[:linear]
     ang = ("wx", "wy", "wz")[: d - linear]
     flin = ("L fx", "L fy", "L fz")[:linear]
@@ -68,7 +65,7 @@ def _axis_labels(d: int, linear: int) -> tuple:
     return lin + ang, flin + fang
 
 
-def _of_scaled(M: np.ndarray, L: float, inputs: list | tuple, tol: Tolerances, linear: int, output: str | None = None, point: bool=False) -> Ellipsoids:
+def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point=False) -> Ellipsoids:
     d = M.shape[0]
     U, s, _ = np.linalg.svd(M, full_matrices=True) if M.size else (np.eye(d), np.zeros(0), None)
     vel = np.zeros(d)
@@ -82,7 +79,7 @@ def _of_scaled(M: np.ndarray, L: float, inputs: list | tuple, tol: Tolerances, l
                       int(keep.sum()), output, point)
 
 
-def ellipsoids_of(J: np.ndarray, length: float = 1.0, linear: int = 3, sliding=None, inputs=None,
+def ellipsoids_of(J, length: float = 1.0, linear: int = 3, sliding=None, inputs=None,
                   tol: Tolerances = DEFAULT) -> Ellipsoids:
     """The ellipsoids of a Jacobian J (d x n) from input rates [rad/s, m/s] to an output twist
     whose first ``linear`` rows are linear velocities [m/s] (6 rows (v, w); 3 for a point:
@@ -93,15 +90,13 @@ def ellipsoids_of(J: np.ndarray, length: float = 1.0, linear: int = 3, sliding=N
         raise ValueError("J must be a matrix whose first `linear` rows are linear velocities")
     if not (np.isfinite(length) and length > 0):
         raise ValueError("the characteristic length must be positive")
-    M = J.copy()
-    M[:linear] /= length
-    if sliding is not None:
-        M[:, np.asarray(sliding, bool)] *= length
+    M = dimensionless(J, slice(0, linear), np.zeros(J.shape[1], bool) if sliding is None else np.asarray(sliding, bool),
+                      length)
     names = tuple(inputs) if inputs is not None else tuple(f"q{k + 1}" for k in range(J.shape[1]))
     return _of_scaled(M, length, names, tol, linear)
 
 
-def ellipsoids(mech: Mechanism, q: np.ndarray, output: str, inputs: list | None=None, point: bool = False, length: float | None = None) -> Ellipsoids:
+def ellipsoids(mech, q, output: str, inputs=None, point: bool = False, length: float | None = None) -> Ellipsoids:
     """The velocity and force ellipsoids of link ``output``'s origin at the assembled
     configuration q (its twist (v, w) in world axes; ``point``: its velocity only).
 
@@ -134,7 +129,7 @@ def ellipsoids(mech: Mechanism, q: np.ndarray, output: str, inputs: list | None=
     return _of_scaled(M, L, names, tol, 3, output, point)
 
 
-def with_input_output_condition(mech: Mechanism, q: np.ndarray, rep: SingularityReport) -> SingularityReport:
+def with_input_output_condition(mech, q, rep: SingularityReport) -> SingularityReport:
     """``rep`` (singular.classify at q) with the condition number of the map from the input rates to the output's
     twist: Merlet's for a parallel robot, of its Jacobian J (input rates -> twist), = that of J^-1 (twist -> leg
     rates), dimensionless as every measure here -- the twist (v/L, w) at the output frame's origin, a sliding
@@ -146,7 +141,7 @@ def with_input_output_condition(mech: Mechanism, q: np.ndarray, rep: Singularity
     return replace(rep, condition_input_output=io, input_output_note=note)
 
 
-def _input_output_condition(mech: Mechanism, q: np.ndarray, rep: SingularityReport) -> tuple:
+def _input_output_condition(mech, q, rep) -> tuple:
     tol = mech.tolerances
     if rep.output is None:
         return None, "give --output LINK, the moving platform"

@@ -6,7 +6,7 @@ as a sum of the loop's link vectors from its first joint, each prismatic joint's
 along its guide, each rolling or gear pair's (y, -x, 1) at its contact point (rolling without slip
 turns one link about it relative to the other; the no-slip law put in, as equations does).  With S the 3 x n matrix of a loop's twists and G = S^T S, the cofactor
 C_i = det(G without row and column i) vanishes exactly where joint i is stationary in the loop's
-one-freedom motion (see analysis.singularities.singular.GramLoop); for n = 4 it is det(S without column i)^2.
+one-freedom motion (see analysis.singular.GramLoop); for n = 4 it is det(S without column i)^2.
 A loop of three joints through a gear or rolling pair (two gears pinned to one link: the pair's
 contact on the line of their centres) has one freedom too: its C_i are the 2 x 2 Gram determinants.
 The loop's freedoms are n - rank S at the configuration measured.

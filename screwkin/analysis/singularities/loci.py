@@ -8,7 +8,7 @@ singularity is the rank drop of a matrix A(q) whose columns are independent at g
 - serial (inverse kinematic, type I; needs an output): A = [K; J_o]: the joints move, loops closed,
   with the output at rest;
 
-both dimensionless as in analysis.singularities.singular (lengths over the characteristic length L).
+both dimensionless as in analysis.singular (lengths over the characteristic length L).
 Its locus is the curve of S where A v = 0 for a unit v: the solutions z = (q, v) of the augmented system
 
     F(z) = [closure rows r(q); held inputs - their values; A(q) v; (v.v - 1)/2] = 0,
@@ -16,7 +16,7 @@ Its locus is the curve of S where A v = 0 for a unit v: the solutions z = (q, v)
 one equation short of the unknowns.  Each curve is followed by pseudo-arclength predictor-corrector
 continuation in z (tangent: the null vector of dF; corrector: Newton with the step's hyperplane),
 every point converged until |F| is round-off; its trace in the plane is read off q.  The derivative of
-A(q) v is central differences of A (A itself comes from the analytic Jacobians of model.closure and
+A(q) v is central differences of A (A itself comes from the analytic Jacobians of model.kernel.closure and
 model.state); Newton's limit is the root of F, which is evaluated exactly.
 
 Seeds: the assembly modes at the box's centre (the project's all-modes solve), each continued over a
@@ -39,17 +39,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import AssemblyError
+from ...model.kernel.scaling import dimensionless, dimensionless_rows, dimensionless_twists
 from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
 from ..motion.continuation import locate, orient
 from .loci_seeds import crossings, refine_node, seed_configurations, sheets, unexplained_folds
-from .singular import LWA, Generic
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.motion.position import PositionSolver
-    from screwkin.model.mechanism import Coordinate
+from ..singular import LWA, Generic
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
 
@@ -87,7 +82,7 @@ class Loci:
 class LocusSystem:
     """The augmented system F of one kind on S (see the module)."""
 
-    def __init__(self, mech: Mechanism, inputs, x_name: str, y_name: str, fixed, kind: str, output=None, point: bool=False, generic=None) -> None:
+    def __init__(self, mech, inputs, x_name, y_name, fixed, kind, output=None, point=False, generic=None):
         self.mech, self.kind, self.output, self.point = mech, kind, output, point
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)  # dq = scale * u: u dimensionless
@@ -103,38 +98,33 @@ class LocusSystem:
                                  for n in names], bool)
 
     # ----------------------------------------------------------------- pieces
-    def value(self, q: np.ndarray, c: Coordinate) -> float:
+    def value(self, q, c) -> float:
         """The coordinate's value [rad or m] (continuous joints: their unwrapped angle's atan2)."""
         return float(continuous_angle(q[None], c.idx_q)[0]) if c.nq == 2 else float(q[c.idx_q])
 
-    def xy(self, q: np.ndarray) -> np.ndarray:
+    def xy(self, q) -> np.ndarray:
         return np.array([self.value(q, self.cx), self.value(q, self.cy)])
 
-    def A(self, q: np.ndarray) -> np.ndarray:
+    def A(self, q) -> np.ndarray:
         """The kind's matrix at q, dimensionless (the scaling of singular.scaled_jacobians, without its
         null space: K's position rows over L, sliding columns times L)."""
         mech = self.mech
         K = np.zeros((0, self.nv))
         if mech.closure.nrows:
-            K = np.array(mech.closure.jacobian(q), float)
-            K[self.pos] /= self.L
-            K *= self.scale
+            K = dimensionless(mech.closure.jacobian(q), self.pos, mech.translational, self.L)
         if self.kind == "actuator":
             return K[:, self.p]
-        J = KinematicState(mech, q).link_jacobian(self.output, LWA)
-        J[:3] /= self.L
-        J = J * self.scale
+        J = dimensionless_twists(KinematicState(mech, q).link_jacobian(self.output, LWA), mech.translational, self.L)
         return np.vstack([K, J[:3] if self.point else J])
 
-    def integrate(self, q: np.ndarray, u) -> np.ndarray:
+    def integrate(self, q, u) -> np.ndarray:
         return self.mech.closure.integrator(q[None], (self.scale * u)[None])[0]
 
-    def residual(self, q: np.ndarray, v: np.ndarray, A=None) -> np.ndarray:
+    def residual(self, q, v, A=None) -> np.ndarray:
         mech = self.mech
         parts = []
         if mech.closure.nrows:
-            r = mech.closure.residual(q).copy()
-            r[self.pos] /= self.L
+            r = dimensionless_rows(mech.closure.residual(q), self.pos, self.L)
             parts.append(r)
         held = []
         for c, target, _ in self.held:
@@ -145,18 +135,17 @@ class LocusSystem:
         parts += [A @ v, [0.5 * (v @ v - 1.0)]]
         return np.concatenate(parts)
 
-    def jacobian(self, q: np.ndarray, v, A=None) -> np.ndarray:
+    def jacobian(self, q, v, A=None) -> np.ndarray:
         """dF/d(u, v) (rows of F, nv + columns of A); d(A v)/du by forward differences."""
         mech = self.mech
         A = self.A(q) if A is None else A
         blocks = []
         if mech.closure.nrows:
-            K = np.array(mech.closure.jacobian(q), float)
-            K[self.pos] /= self.L
-            blocks.append(np.hstack([K * self.scale, np.zeros((len(K), len(v)))]))
+            K = dimensionless(mech.closure.jacobian(q), self.pos, mech.translational, self.L)
+            blocks.append(np.hstack([K, np.zeros((len(K), len(v)))]))
         return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
 
-    def _held_kind_norm_rows(self, q: np.ndarray, v: np.ndarray, A: np.ndarray) -> list:
+    def _held_kind_norm_rows(self, q, v, A) -> list:
         """The Jacobian's rows after the loops' (a section's too): the held inputs, d(A v)/d(u, v) (d/du by
         forward differences of step FD) and |v| = 1."""
         H = np.zeros((len(self.held), self.nv + len(v)))
@@ -170,7 +159,7 @@ class LocusSystem:
             D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / FD
         return [H, np.hstack([D, A]), np.concatenate([np.zeros(self.nv), v])[None]]
 
-    def relative(self, q: np.ndarray, v: np.ndarray | None = None) -> float:
+    def relative(self, q, v=None) -> float:
         """|A v| / |A| (v: A's smallest right singular vector when None): the point's distance from the
         kind's singular condition, relative."""
         A = self.A(q)
@@ -179,14 +168,14 @@ class LocusSystem:
             return float(s[-1] / s[0]) if s[0] > 0 else 0.0
         return float(np.linalg.norm(A @ v) / s[0]) if s[0] > 0 else 0.0
 
-    def kernel(self, q: np.ndarray) -> np.ndarray:
+    def kernel(self, q) -> np.ndarray:
         return np.linalg.svd(self.A(q))[2][-1]
 
     def edge(self, axis: int, bound: float):
         """The extra row of ``newton`` that holds the plane's coordinate ``axis`` (0: x, 1: y) at ``bound``."""
         c = (self.cx, self.cy)[axis]
 
-        def row(qc, vc) -> tuple:
+        def row(qc, vc):
             r = np.zeros(self.nv + len(vc))
             r[c.idx_v] = 1.0
             return r[None], np.array([(bound - self.value(qc, c)) / self.scale[c.idx_v]])
@@ -194,7 +183,7 @@ class LocusSystem:
         return row
 
     # ------------------------------------------------------------ Newton, tangent
-    def newton(self, q: np.ndarray, v, extra=None, iterations: int = 30, max_step: float = 0.3, J: np.ndarray | None = None) -> tuple | None:
+    def newton(self, q, v, extra=None, iterations: int = 30, max_step: float = 0.3, J=None):
         """Newton (least squares, steps capped at max_step; the Jacobian kept while the residual falls
         fast: a chord step) on F, with ``extra`` rows (function (q, v) -> (rows, rhs), linear in the
         step): (q, v) converged (|F| < RESIDUAL), or None."""
@@ -223,39 +212,39 @@ class LocusSystem:
         F = self.residual(q, v)
         return (q, v) if float(np.linalg.norm(F)) < RESIDUAL else None
 
-    def tangent(self, q: np.ndarray, v, previous=None, J: np.ndarray | None = None) -> np.ndarray:
+    def tangent(self, q, v, previous=None, J=None) -> np.ndarray:
         """Unit null vector of dF in (u, v) (J: dF at (q, v) when already computed), oriented along ``previous``."""
         t = np.linalg.svd(self.jacobian(q, v) if J is None else J)[2][-1]
         return orient(t, previous)  # the continuation's one branch rule
 
-    def nullity_ok(self, q: np.ndarray, v) -> bool:
+    def nullity_ok(self, q, v) -> bool:
         s = np.linalg.svd(self.jacobian(q, v), compute_uv=False)
         return len(s) >= self.nv + len(v) - 1 and s[self.nv + len(v) - 2] > self.mech.tolerances.crossing_rank * s[0]
 
-    def projected(self, q: np.ndarray, t) -> np.ndarray:
+    def projected(self, q, t) -> np.ndarray:
         """The plane's velocity (dx, dy) [SI] along the tangent t of the curve."""
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q: np.ndarray, v, t: np.ndarray, h, J: np.ndarray | None = None) -> tuple | None:
+    def along(self, q, v, t, h, J=None):
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q
 
-        def plane(qc, vc) -> tuple:
+        def plane(qc, vc):
             d = np.concatenate([self.mech.difference(q0, qc) / self.scale, vc - v])
             return t[None], np.array([h - t @ d])
 
         return self.newton(qp, vp, plane, iterations=8, max_step=max(h, 1e-3), J=J)
 
 
-def _in_box(p, box, margin: float = 0.0) -> bool:
+def _in_box(p, box, margin=0.0):
     (x0, x1), (y0, y1) = box
     mx, my = margin * (x1 - x0), margin * (y1 - y0)
     return x0 - mx <= p[0] <= x1 + mx and y0 - my <= p[1] <= y1 + my
 
 
-def _trace_one_way(sys, q: np.ndarray, v, box: tuple, direction) -> tuple:
+def _trace_one_way(sys, q, v, box, direction):
     """Points from (q, v) along +-tangent until the box's edge, the start again, or MAX_POINTS.
     Returns (qs, vs, closed, truncated)."""
     J = sys.jacobian(q, v)
@@ -288,11 +277,11 @@ def _trace_one_way(sys, q: np.ndarray, v, box: tuple, direction) -> tuple:
     return qs, vs, ts, False, True
 
 
-def _dist(sys, q1: np.ndarray, q2: np.ndarray) -> float:
+def _dist(sys, q1, q2) -> float:
     return float(np.linalg.norm(sys.mech.difference(q1, q2) / sys.scale))
 
 
-def _clip(sys, qs, vs, box: tuple) -> tuple:
+def _clip(sys, qs, vs, box):
     """The points in the box; an end outside is replaced by the curve's crossing of the box's edge
     (Newton with the coordinate held at the edge)."""
     out_q, out_v = list(qs), list(vs)
@@ -322,7 +311,7 @@ def _clip(sys, qs, vs, box: tuple) -> tuple:
     return out_q, out_v
 
 
-def _onto_edge(sys, q: np.ndarray, v, box):
+def _onto_edge(sys, q, v, box):
     """A locus point outside the box moved along the curve onto the box's edge: Newton on F with the
     coordinate outside held at the nearer bound (x, then y).  None when the curve does not reach it."""
     for axis in (0, 1):
@@ -337,7 +326,7 @@ def _onto_edge(sys, q: np.ndarray, v, box):
     return None
 
 
-def _cusps(sys, qs, vs, ts) -> list:
+def _cusps(sys, qs, vs, ts):
     """Cusps on one traced curve: reversals of the plane's velocity between neighbouring points,
     each located by Brent's method on the arclength from the first point of the bracket."""
     out = []
@@ -352,7 +341,7 @@ def _cusps(sys, qs, vs, ts) -> list:
         ref = a / na
         cache = {}
 
-        def phi(s, ref=ref, a=a, q0=q0, v0=v0, t0=t0, cache=cache) -> float:
+        def phi(s, ref=ref, a=a, q0=q0, v0=v0, t0=t0, cache=cache):
             if s == 0:
                 return float(ref @ a)
             res = sys.along(q0, v0, t0, s)
@@ -381,8 +370,8 @@ def _cusps(sys, qs, vs, ts) -> list:
     return out
 
 
-def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, output=None, point: bool=False, kinds=None, grid: int = 9,
-               starts: int | None = None) -> Loci:
+def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, kinds=None, grid: int = 9,
+               starts=None) -> Loci:
     """The singular loci of each kind in the box xs[0]..xs[-1] x ys[0]..ys[-1] (see the module).
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""
     mech = solver.mech
@@ -424,7 +413,7 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
 
 
-def trace_kind(sys, kind: str, seeds, box: tuple, notes) -> tuple:
+def trace_kind(sys, kind, seeds, box, notes):
     """The curves of one kind (sys: a LocusSystem or one like it) from the configurations ``seeds``, each
     brought onto the locus by Newton (onto the box's edge when outside) unless near a curve already traced:
     (loci, cusps ((x, y), kind), their configurations, nodes ((x, y), kind)); notes gets what it left."""
@@ -490,7 +479,7 @@ def trace_kind(sys, kind: str, seeds, box: tuple, notes) -> tuple:
     return loci, cusps, cusp_q, nodes
 
 
-def _modes_in_box(solver: PositionSolver, x_name: str, y_name: str, box: tuple, fixed: dict) -> tuple[list, str]:
+def _modes_in_box(solver, x_name, y_name, box, fixed):
     """(configurations, in words): every mode the solver finds at the box's centre; where none assembles
     there, at the first of the other nodes of a 3 x 3 grid of the box that assembles."""
     (x0, x1), (y0, y1) = box
@@ -509,7 +498,7 @@ def _modes_in_box(solver: PositionSolver, x_name: str, y_name: str, box: tuple, 
     return [], "no assembly mode at the centre, corners or edge midpoints of the box"
 
 
-def _near(sys, q: np.ndarray, Q: np.ndarray) -> float:
+def _near(sys, q, Q) -> float:
     """The distance (dimensionless: lengths over L) from q to the nearest of the configurations Q, by
     their joint values (angles the short way round)."""
     rows = sys.mech.joint_value_rows(np.vstack([q[None], Q]))
@@ -519,7 +508,7 @@ def _near(sys, q: np.ndarray, Q: np.ndarray) -> float:
     return float(np.sqrt((D * D).sum(axis=1)).min())
 
 
-def _untraceable(mech: Mechanism, g: Generic, kind: str, output, inputs) -> str | None:
+def _untraceable(mech, g, kind, output, inputs):
     if kind == "actuator":
         if not mech.closure.nrows or not len(g.p):
             return "no loop, no passive joint"

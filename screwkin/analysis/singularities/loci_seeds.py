@@ -11,7 +11,7 @@ from ..motion.continuation import Neighbour
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexplained_folds"]
 

@@ -17,16 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError, quote, shorten
-from .singular import Generic, measures
+from ..singular import Generic, measures
 from ..motion.continuation import Neighbour
-from typing import TYPE_CHECKING
+from ..position.connect import apart
 
-if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.motion.position import PositionSolver
-    from collections.abc import Callable
-
-__all__ = ["SingularityMap", "singularity_map", "seams", "apart"]
+__all__ = ["SingularityMap", "singularity_map", "seams"]
 
 
 @dataclass(frozen=True)
@@ -48,8 +43,8 @@ class SingularityMap:
         return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
 
 
-def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict | None=None, output: str | None=None, point: bool = False,
-                    q_start: Callable | None=None) -> SingularityMap:
+def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False,
+                    q_start=None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
     if x_name == y_name:
@@ -101,15 +96,7 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
 
 
-def apart(mech: Mechanism, q1: np.ndarray, q2: np.ndarray) -> float:
-    """How far apart two configurations are: the norm of their difference, lengths over the
-    characteristic length (rad and characteristic lengths) [-]."""
-    d = mech.difference(q1, q2)
-    d[mech.translational] /= mech.length
-    return float(np.linalg.norm(d))
-
-
-def seams(mech: Mechanism, qs: np.ndarray, reached: np.ndarray, step_x: Neighbour | None=None, step_y: Neighbour | None=None, xs: np.ndarray | None = None, ys: np.ndarray | None = None) -> np.ndarray:
+def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
     characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and

@@ -7,7 +7,7 @@ a cell, so that of the two ends of any grid edge or cell diagonal a curve crosse
 edges and diagonals are the regions.  Two curves closer than about a cell and a
 half leave no node between them: a region that narrow is not seen (``Regions.resolution`` says so).
 Each region's sample is its node farthest from the blocked ones, where the project's all-modes solve
-counts its real assembly modes (analysis.motion.position.PositionSolver.solve, with how it knows the
+counts its real assembly modes (analysis.position.position.PositionSolver.solve, with how it knows the
 count: a certified one or a search).
 """
 
@@ -21,7 +21,7 @@ from ...errors import AssemblyError
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.analysis.motion.position import PositionSolver
+    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["Region", "Regions", "regions"]
 

@@ -25,6 +25,7 @@ The file is loaded as any mechanism file is (screwkin.model.loader.load), then:
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,17 +35,15 @@ from ....model.loader import load
 from ....model.state import KinematicState
 from ...mobility import analyze_mobility
 from ...motion.planar import identify, transmission_angles
-from ...motion.position import PositionSolver
+from ...position.position import PositionSolver
 from ...motion.sweep import sweep
 from ...course.skeleton import numbering
 from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.design.synthesis.designs import Target
+    from ...motion.sweep import SweepResult
 
 __all__ = ["check_design", "check_chain_file", "TOLERANCE"]
 
@@ -56,7 +55,7 @@ TWO_PI = 2 * math.pi
 class _Probe:
     """What the check reads off a configuration of the written four-bar."""
 
-    def __init__(self, mech: Mechanism, design: Design) -> None:
+    def __init__(self, mech, design: Design):
         self.mech = mech
         self.design = design
         self.out = mech.link_frame(design.output_link)
@@ -65,7 +64,7 @@ class _Probe:
         self.fB = mech.cuts[0].frame1 if mech.cuts else None
         self.linkage = None  # analysis.motion.planar.identify's LinkageInfo, set at the first position
 
-    def value(self, q: np.ndarray) -> tuple:
+    def value(self, q):
         M = KinematicState(self.mech, q).frame_placement(self.out)
         kind = self.design.targets[0].kind
         if kind == "pose":
@@ -74,7 +73,7 @@ class _Probe:
             return (float(M.translation[0]), float(M.translation[1]))
         return (float(math.atan2(M.rotation[1, 0], M.rotation[0, 0])),)
 
-    def error(self, q: np.ndarray, target: Target) -> tuple:
+    def error(self, q, target):
         v = self.value(q)
         t = target.value
         if target.kind == "pose":
@@ -83,7 +82,7 @@ class _Probe:
             return math.hypot(v[0] - t[0], v[1] - t[1]), 0.0
         return abs(float(wrap_angle(v[0] - t[0], upper=True))), 0.0
 
-    def mus(self, Q: np.ndarray | list) -> list:
+    def mus(self, Q) -> list:
         """Transmission angles [rad] at the configurations Q (analysis.motion.planar.transmission_angles
         of the file's four-bar as identified at the first position); none when it was not
         identified (the check then says the angle was not measured)."""
@@ -91,12 +90,12 @@ class _Probe:
             return []
         return transmission_angles(self.mech, self.linkage, Q).tolist()
 
-    def pins(self, q: np.ndarray) -> tuple:
+    def pins(self, q):
         state = KinematicState(self.mech, q)
         return state.centre(("joint", self.jA))[:2], state.centre(("frame", self.fB))[:2]
 
 
-def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target: Target) -> float:
+def _closed_form_error(design: Design, probe: _Probe, q, target) -> float:
     """Distance between the file's moving pivots (and guided frame) at q and the closed-form
     four-bar at the same crank angle, on the branch that is nearer."""
     fb = design.fourbar
@@ -113,7 +112,7 @@ def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target: Tar
     return float(best)
 
 
-def check_design(design: Design, path: str, tolerance: float | None = None, steps: int = 360, warn=None) -> Check:
+def check_design(design: Design, path, tolerance: float | None = None, steps: int = 360, warn=None) -> Check:
     """Check the four-bar ``design`` written at ``path`` (see the module docstring)."""
     mech = load(path, warn=warn or (lambda _m: None))
     tol = tolerance if tolerance is not None else TOLERANCE * max(1.0, mech.length)
@@ -173,7 +172,7 @@ def check_design(design: Design, path: str, tolerance: float | None = None, step
                  tuple(travel), tol, letters)
 
 
-def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x: float, q_target: np.ndarray) -> bool:
+def _locate(design, solver, probe, res, x, q_target):
     """Whether the branch followed by sweep ``res`` is, at input value x, in the configuration
     q_target (the solution found for that precision position): same moving pivots."""
     if q_target is None:
@@ -190,70 +189,84 @@ def _locate(design: Design, solver: PositionSolver, probe: _Probe, res, x: float
     return max(float(np.hypot(*(A - A_t))), float(np.hypot(*(B - B_t)))) < probe.mech.tolerances.geometry * size
 
 
-def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list, steps: int) -> tuple:
-    """(direction, travel per position, transmission angles along the motion, defects)."""
-    name = design.input_joint
-    tol = probe.mech.tolerances
-    targets = design.targets
-    n = len(targets)
-    label = [t.label or f"position {k + 1}" for k, t in enumerate(targets)]
-    near = {name: targets[0].input}
-    u1 = targets[0].input
+class _Follower:
+    """The motion of a design's crank from its first precision position, followed by sweep, and where the
+    other positions lie along it."""
 
-    def follow(direction, reach) -> tuple:
-        count = max(int(round(steps * reach / TWO_PI)), 4)
-        res = sweep(solver, name, u1, u1 + direction * reach, count, near=near)
+    def __init__(self, design: Design, solver: PositionSolver, probe: _Probe, configs: list, steps: int) -> None:
+        self.design, self.solver, self.probe, self.configs, self.steps = design, solver, probe, configs, steps
+        self.name = design.input_joint
+        self.tol = probe.mech.tolerances
+        self.targets = design.targets
+        self.n = len(self.targets)
+        self.label = [t.label or f"position {k + 1}" for k, t in enumerate(self.targets)]
+        self.u1 = self.targets[0].input
+
+    def follow(self, direction: int, reach: float) -> tuple[SweepResult, float]:
+        """The sweep from the first position ``reach`` [rad] one way round, and how far it got."""
+        u1 = self.u1
+        count = max(int(round(self.steps * reach / TWO_PI)), 4)
+        res = sweep(self.solver, self.name, u1, u1 + direction * reach, count, near={self.name: u1})
         covered = float(np.max(direction * (res.values - u1))) if len(res.values) else 0.0
         if res.stopped_at is not None:  # up to the located limit position, not only the last grid value before it
             covered = max(covered, float(direction * (res.stopped_at - u1)))
         return res, covered
 
-    def typed(x) -> str:  # function generation: the crank's angle as typed beside the file's
-        return "" if design.input_offset is None else f" (phi {math.degrees(x + design.input_offset):.6g} deg as typed)"
+    def typed(self, x: float) -> str:
+        """Function generation: the crank's angle as typed beside the file's."""
+        offset = self.design.input_offset
+        return "" if offset is None else f" (phi {math.degrees(x + offset):.6g} deg as typed)"
 
-    if design.span is not None:  # the motion is the input range: both ways from the first position
-        defects, travel, mus = [], [0.0] + [None] * (n - 1), []
+    def locate(self, res: SweepResult, x: float, k: int) -> bool:
+        return _locate(self.design, self.solver, self.probe, res, x, self.configs[k])
+
+    def over_span(self) -> tuple[int, list, list[float], list[str]]:
+        """The motion over the design's input range, both ways from the first position."""
+        design, tol, targets, name, u1, label = self.design, self.tol, self.targets, self.name, self.u1, self.label
+        defects, travel, mus = [], [0.0] + [None] * (self.n - 1), []
         runs = {}
         for direction, reach in ((1, design.span[1] - u1), (-1, u1 - design.span[0])):
             if reach <= tol.zero:
                 continue
-            res, covered = follow(direction, reach)
+            res, covered = self.follow(direction, reach)
             runs[direction] = (res, covered)
-            mus += probe.mus(res.q)  # the sweep's grid ends at the range's ends
+            mus += self.probe.mus(res.q)  # the sweep's grid ends at the range's ends
             if res.stopped_at is not None and covered < reach - tol.equal:
                 defects.append(f"the input range is cut short by a limit position at {name} = "
-                               f"{math.degrees(res.stopped_at):.6g} deg{typed(res.stopped_at)}: the linkage cannot "
-                               "run through it")
-        for k in range(1, n):
+                               f"{math.degrees(res.stopped_at):.6g} deg{self.typed(res.stopped_at)}: the linkage "
+                               "cannot run through it")
+        for k in range(1, self.n):
             d = targets[k].input - u1
             direction = 1 if d >= 0 else -1
             res, covered = runs.get(direction, (None, 0.0))
             if res is None or abs(d) > covered + tol.equal:
                 defects.append(f"{label[k]} lies beyond a limit position: the input stops before "
-                               f"{math.degrees(targets[k].input):.6g} deg{typed(targets[k].input)}")
-            elif _locate(design, solver, probe, res, targets[k].input, configs[k]):
+                               f"{math.degrees(targets[k].input):.6g} deg{self.typed(targets[k].input)}")
+            elif self.locate(res, targets[k].input, k):
                 travel[k] = abs(d)
             else:
                 defects.append(f"branch (circuit) defect: {label[k]} is on another assembly mode than "
                                f"{label[0]}")
         return 0, travel, mus, defects
-    outcomes = []
-    for direction in (1, -1):
+
+    def one_way(self, direction: int) -> tuple[tuple[int, bool], int, list, list, list[float]]:
+        """Turning the crank one way round: ((positions missed, out of order), direction, each position's
+        status, travel to each, the transmission angles along)."""
+        tol, targets, u1, configs = self.tol, self.targets, self.u1, self.configs
         # as far as the farthest position this way round (a full turn when one sits at the start's input)
         travels = [float(np.mod(direction * (t.input - u1), TWO_PI)) for t in targets[1:]]
         reach = min(max(max(travels) + 0.05, 0.5), TWO_PI) if min(travels) > tol.equal else TWO_PI
-        res, covered = follow(direction, reach)
+        res, covered = self.follow(direction, reach)
         status, travel = [], [0.0]
-        for k in range(1, n):
+        for k in range(1, self.n):
             d = float(np.mod(direction * (targets[k].input - u1), TWO_PI))
             if d > covered + tol.equal:
                 status.append(("limit", res.stopped_at))
                 travel.append(None)
-            elif _locate(design, solver, probe, res, u1 + direction * d, configs[k]):
+            elif self.locate(res, u1 + direction * d, k):
                 status.append(("reached", d))
                 travel.append(d)
-            elif d < tol.equal and covered >= TWO_PI - tol.equal \
-                    and _locate(design, solver, probe, res, u1 + direction * TWO_PI, configs[k]):
+            elif d < tol.equal and covered >= TWO_PI - tol.equal and self.locate(res, u1 + direction * TWO_PI, k):
                 status.append(("reached", TWO_PI))
                 travel.append(TWO_PI)
             else:
@@ -262,17 +275,16 @@ def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list
         got = [t for t in travel if t is not None]
         ordered = all(a < b for a, b in zip(got, got[1:]))
         far = max(got)
-        mus = probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + tol.zero])
-        mus += probe.mus([configs[k] for k, t in enumerate(travel) if t is not None])  # the ends exactly
+        mus = self.probe.mus([q for q, x in zip(res.q, res.values) if direction * (x - u1) <= far + tol.zero])
+        mus += self.probe.mus([configs[k] for k, t in enumerate(travel) if t is not None])  # the ends exactly
         missing = sum(t is None for t in travel)
-        outcomes.append(((missing, not ordered), direction, status, travel, mus))
-        if not missing and ordered:  # every position, in order: the other way round is not needed
-            break
-    outcomes.sort(key=lambda o: o[0])
-    (missing, disordered), direction, status, travel, mus = outcomes[0]
-    defects = []
-    if missing:
-        for k in range(1, n):
+        return (missing, not ordered), direction, status, travel, mus
+
+    def missing_defects(self, outcomes: list, status: list) -> list[str]:
+        """Why positions are missed: another branch, beyond a limit position, or reached only the other way."""
+        label, targets, u1 = self.label, self.targets, self.u1
+        defects = []
+        for k in range(1, self.n):
             seen = [o[2][k - 1] for o in outcomes]
             if any(s[0] == "reached" for s in seen):  # reached the other way round: the order is the defect
                 continue
@@ -289,12 +301,30 @@ def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list
                 defects.append(f"{label[k]} lies beyond a limit position{where}: the crank cannot turn from "
                                f"{label[0]} to it")
         if any(any(s[0] == "reached" for s in [o[2][k - 1] for o in outcomes]) and status[k - 1][0] != "reached"
-               for k in range(1, n)):
+               for k in range(1, self.n)):
             defects.append("order defect: the positions are reached only by turning the crank both ways")
+        return defects
+
+
+def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list,
+            steps: int) -> tuple[int, list, list[float], list[str]]:
+    """(direction, travel per position, transmission angles along the motion, defects)."""
+    f = _Follower(design, solver, probe, configs, steps)
+    if design.span is not None:  # the motion is the input range: both ways from the first position
+        return f.over_span()
+    outcomes = []
+    for direction in (1, -1):
+        outcome = f.one_way(direction)
+        outcomes.append(outcome)
+        if not any(outcome[0]):  # every position, in order: the other way round is not needed
+            break
+    outcomes.sort(key=lambda o: o[0])
+    (missing, disordered), direction, status, travel, mus = outcomes[0]
+    defects = f.missing_defects(outcomes, status) if missing else []
     if disordered:
         got = sorted((t, k) for k, t in enumerate(travel) if t is not None)
         defects.append("order defect: turning the crank " + ("counterclockwise" if direction > 0 else "clockwise")
-                       + " from " + label[0] + " reaches the positions in the order "
+                       + " from " + f.label[0] + " reaches the positions in the order "
                        + ", ".join(str(k + 1) for _, k in got))
     return direction, travel, mus, defects
 
