@@ -398,8 +398,8 @@ class RecordingViewer:
     def set_object(self, geometry, material=None):
         self._root.objects[self._path] = (geometry, material)
 
-    def set_transform(self, matrix=np.eye(4)):
-        self._root.transforms[self._path] = np.asarray(matrix)
+    def set_transform(self, matrix: np.ndarray | None = None) -> None:
+        self._root.transforms[self._path] = np.eye(4) if matrix is None else np.asarray(matrix)
 
     def set_property(self, key, value):
         self._root.properties[(self._path, key)] = value
