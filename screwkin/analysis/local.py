@@ -51,6 +51,10 @@ from ..model.kernel.scaling import dimensionless, dimensionless_rows
 from ..model.linalg import rank
 from .loop_series import Series, loop_system
 from .singular import scaled_jacobians
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Branch", "LocalAnalysis", "local_analysis", "KINDS", "quadratic_forms", "rates_of"]
 
@@ -123,7 +127,7 @@ class LocalAnalysis:
     notes: tuple = ()
 
 
-def rates_of(mech, x, scale) -> dict:
+def rates_of(mech: Mechanism, x, scale) -> dict:
     """The tree part of a dimensionless direction x as joint rates (sliding ones times L), shown with the
     first joint moving at least SHOWN_REFERENCE of the largest at rate 1."""
     v = np.asarray(x[:mech.nv], float) * scale[:mech.nv]
@@ -166,7 +170,7 @@ def _orth(M, tol):
     return U[:, s > tol * max(s[0], 1.0)] if s.size else M[:, :0]
 
 
-def _one_form(Q, zero):
+def _one_form(Q: np.ndarray, zero):
     """The zero set of one quadratic form y^T Q y on R^d, as candidates."""
     lam, V = np.linalg.eigh(Q)
     pos, neg = V[:, lam > zero], V[:, lam < -zero]
@@ -197,7 +201,7 @@ def _one_form(Q, zero):
     return [_Candidate(T, samples, False, True)]
 
 
-def _sampled_zeros(F, zero, starts, tol, seed=0):
+def _sampled_zeros(F, zero, starts: int, tol, seed: int=0):
     """Common zeros of the forms F (c, d, d) on the unit sphere, refined by Gauss-Newton from
     ``starts`` directions, as candidates grouped by their tangent spaces."""
     c, d, _ = F.shape
@@ -235,7 +239,7 @@ def _sampled_zeros(F, zero, starts, tol, seed=0):
     return groups
 
 
-def _cone(F, zero, starts, tol):
+def _cone(F, zero, starts: int, tol):
     """Candidates: the real zeros of the forms F (c2, d, d) (none identically zero)."""
     c, d, _ = F.shape
     if d == 1:
@@ -253,7 +257,7 @@ def _cone(F, zero, starts, tol):
     return _sampled_zeros(F, zero, starts, tol)
 
 
-def _continue(system, x, Ainv, N, U, order, tol, lookahead=True):
+def _continue(system, x, Ainv, N, U, order, tol, lookahead: bool=True) -> tuple:
     """Continue the series from X[0] = x to ``order``: each X[k] = -A^+ R_k + N y, y chosen (least
     squares) so that the next order's residual in coker K is least (0 without ``lookahead``).  Returns (the first order whose
     residual stays -- None when every order to ``order`` holds --, X coefficients, residuals)."""
@@ -281,7 +285,7 @@ class _HeldRows(ClosureKernel):
     rows B^T (q - q0) / scale - target: a step's component along a branch's tangent space B (nv, k)
     kept.  Steps are in the scaled columns (sliding ones times L): q moves by step * scale."""
 
-    def __init__(self, mech, q0: np.ndarray, B: np.ndarray, target: np.ndarray, scale: np.ndarray, L: float) -> None:
+    def __init__(self, mech: Mechanism, q0: np.ndarray, B: np.ndarray, target: np.ndarray, scale: np.ndarray, L: float) -> None:
         self.mech, self.q0, self.B, self.target, self.scale, self.L = mech, q0, B, target, scale, L
         self.nq, self.nv = mech.model.nq, mech.nv
         self.m = mech.closure.nrows + B.shape[1]
@@ -301,7 +305,7 @@ class _HeldRows(ClosureKernel):
         return np.array([pin.integrate(self.mech.model, q, v * self.scale) for q, v in zip(Q, V)])
 
 
-def _confirm(mech, q0, system, X, B, h):
+def _confirm(mech: Mechanism, q0: np.ndarray, system, X: np.ndarray, B, h) -> tuple:
     """Close the loops again at a step h along the branch of tangent X[0] (dimensionless, column space)
     with tangent space B (tree part, orthonormal): Gauss-Newton from q0 + h x with B^T (q - q0) = h B^T x
     held.  Returns (configuration or None, its distance from q0 + h x -- O(h^2) on a branch --, residual)."""
@@ -319,7 +323,7 @@ def _confirm(mech, q0, system, X, B, h):
     return q, deviation, norm
 
 
-def local_analysis(mech, q, inputs=None, generic_rank=None, progress=None) -> LocalAnalysis:
+def local_analysis(mech: Mechanism, q: np.ndarray, inputs=None, generic_rank=None, progress=None) -> LocalAnalysis:
     """The local analysis of ``mech`` at the assembled configuration q (see the module docstring);
     inputs: the joints held for ``inputs_held`` (default the actuated ones); generic_rank: the rank of
     K at generic configurations (default: the largest over mech.generic_configurations()); progress: a
@@ -441,7 +445,7 @@ def local_analysis(mech, q, inputs=None, generic_rank=None, progress=None) -> Lo
     return _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled)
 
 
-def _at_most_samples(candidates, cap):
+def _at_most_samples(candidates, cap) -> tuple:
     """The candidates with at most ``cap`` samples each (an irreducible quadric cone on a kernel of dimension d
     has up to d^2 / 4 sampled generators, each continued at a cost growing with d: a 40-joint loop folded flat
     has 361), spread evenly over the list and always its first; and the note that says so (None when
@@ -461,7 +465,7 @@ def _at_most_samples(candidates, cap):
                  f"at most {cap} a tangent space: Tolerances.local_samples, mobility --local-samples N raises it)")
 
 
-def _mixes(d, count=2, seed=0):
+def _mixes(d, count: int=2, seed: int=0) -> list:
     """A few fixed random unit directions in R^d (more directions checked than the basis)."""
     if d < 2:
         return []
@@ -469,7 +473,7 @@ def _mixes(d, count=2, seed=0):
     return [v / np.linalg.norm(v) for v in rng.normal(size=(count, d))]
 
 
-def _branch(mech, q, system, N, cand, X, order) -> Branch:
+def _branch(mech: Mechanism, q: np.ndarray, system, N, cand, X: np.ndarray, order) -> Branch:
     tol = mech.tolerances
     nv = mech.nv
     T = N @ cand.T
@@ -483,7 +487,7 @@ def _branch(mech, q, system, N, cand, X, order) -> Branch:
                   confirmed, float(tol.local_step), deviation, residual)
 
 
-def _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled):
+def _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled) -> LocalAnalysis:
     """The kind, finite mobility, order and words from the surviving branches (``sampled``: the number of
     starting directions the quadratic cone's zeros were searched from, 0 where they are found exactly)."""
     notes = list(notes)

@@ -60,7 +60,7 @@ BODY_JOINTS = ("JointModelSpherical", "JointModelFreeFlyer", "JointModelPlanar",
 SEQUENTIAL_JOINTS = ("JointModelUniversal", "JointModelSphericalZYX")
 
 
-def ad(W, S):
+def ad(W, S) -> np.ndarray:
     """ad_W S for twists (v, w) in the last axis of W and S (arrays (..., 6))."""
     vW, wW, vS, wS = W[..., :3], W[..., 3:], S[..., :3], S[..., 3:]
     return np.concatenate([cross_last(wW, vS) + cross_last(vW, wS), cross_last(wW, wS)], axis=-1)
@@ -138,16 +138,16 @@ class Series:
     """The Taylor coefficients of a motion's column rates X[0], X[1], ... and of the units' screws
     along it; ``residual()`` is R_k for the next order k (Phi[k] with X[k] = 0)."""
 
-    def __init__(self, system: LoopSystem, x0):
+    def __init__(self, system: LoopSystem, x0) -> None:
         self.sys = system
         self.X = [np.asarray(x0, float)]
         self.S = [system.screws]
         self.P = []  # P[m] (units, 6): sum_l S[l] y[m-l], up to the order pushed
 
-    def _y(self, k):
+    def _y(self, k: int):
         return self.sys.multiplier * self.X[k][self.sys.column]
 
-    def _p(self, m, with_last=True):
+    def _p(self, m, with_last: bool=True):
         terms = [self.S[l] * self._y(m - l)[:, None] for l in range(m + 1) if with_last or l > 0]
         return np.sum(terms, axis=0) if terms else np.zeros_like(self.sys.screws)
 
@@ -195,7 +195,7 @@ class Series:
         return other
 
 
-def _units(mech, state):
+def _units(mech: Mechanism, state) -> tuple:
     """Every unit of the tree: (screw (v, w) at the world origin, column, multiplier), the carriers
     of each (a set of unit indices), the units of each joint, and a note when a joint has no closed
     form here.  A Pinocchio mimic joint is a unit of its primary's column (its motion subspace holds
@@ -222,7 +222,7 @@ def _units(mech, state):
     return units, carriers, by_joint, note
 
 
-def subalgebra(screws, tol):
+def subalgebra(screws, tol) -> tuple:
     """("se(2)", normal) when every screw (v, w) lies in the planar motions normal to one direction,
     ("so(3)", point) when every one is a rotation about one point, else ("se(3)", None)."""
     rot = [s for s in screws if np.linalg.norm(s[3:]) > tol]
@@ -241,7 +241,7 @@ def subalgebra(screws, tol):
     return "se(3)", None
 
 
-def split(kind, where, S):
+def split(kind: str, where: str, S) -> tuple:
     """(the part of twists S (..., 6) in the algebra, the part in its complement m): se(2) normal to
     n: (v - (v.n) n, (w.n) n) and ((v.n) n, w - (w.n) n); so(3) about p: (p x w, w) and (v - p x w, 0).
     m is invariant under the algebra's brackets, so motions of units in the algebra stay in it."""
@@ -255,7 +255,7 @@ def split(kind, where, S):
     return inside, S - inside
 
 
-def coordinates(kind, where) -> np.ndarray:
+def coordinates(kind: str, where: str) -> np.ndarray:
     """The (rows, 6) map from a twist of the algebra to its coordinates: se(2) (v.e1, v.e2, w.n), so(3) w."""
     if kind == "se(2)":
         n = where
@@ -267,7 +267,7 @@ def coordinates(kind, where) -> np.ndarray:
     return np.eye(6)
 
 
-def _cut_units(mech, cut, state, kind, where, L):
+def _cut_units(mech: Mechanism, cut, state, kind: str, where: str, L):
     """The cut joint's freedoms as world twists [(name, twist, sliding)] (screws.cut_twists); a ball's
     three rotations about axes that put the algebra's own rotation last (e1, e2, n in a plane)."""
     # a sliding contact closes through a planar cut joint (its contact row apart); a rolling, gear or screw
@@ -327,7 +327,7 @@ def _extra_rows(mech: Mechanism, q: np.ndarray, ncols: int, scale: np.ndarray,
             np.array(contacts, float).reshape(len(contacts), ncols) if contacts else None, note)
 
 
-def loop_system(mech, q, length: float | None = None, reduce: bool = True) -> LoopSystem:
+def loop_system(mech: Mechanism, q: np.ndarray, length: float | None = None, reduce: bool = True) -> LoopSystem:
     """The LoopSystem of ``mech`` at the assembled configuration q.
 
     With ``reduce``, when every tree screw lies in se(2) (a planar mechanism) or so(3) (a spherical

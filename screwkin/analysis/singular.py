@@ -37,6 +37,10 @@ from ..model.kernel.scaling import dimensionless, dimensionless_twists
 from ..model.state import KinematicState, loop_coordinate_cuts
 from ..tolerances import DEFAULT
 from .screws import cut_twists, screw_of
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
@@ -75,7 +79,7 @@ class SingularityReport:
     input_output_note: str | None = None
 
 
-def _rel(s, k):
+def _rel(s, k: int) -> float:
     """k-th singular value (1-based) relative to the largest; 0 when missing."""
     if k <= 0:
         return 1.0
@@ -97,7 +101,7 @@ class Scaled:
     L: float
 
 
-def scaled_jacobians(mech, q, output=None, point: bool = False, length: float | None = None) -> Scaled:
+def scaled_jacobians(mech: Mechanism, q: np.ndarray, output=None, point: bool = False, length: float | None = None) -> Scaled:
     """The matrices of :class:`Scaled` at q (assembled)."""
     L = float(length or mech.length)
     slide = mech.translational
@@ -121,7 +125,7 @@ class Generic:
     joints that move there (a joint whose rate the loops force to zero everywhere is not
     "stationary" at any one configuration)."""
 
-    def __init__(self, mech, inputs, output=None, point: bool = False, configurations=None):
+    def __init__(self, mech: Mechanism, inputs, output=None, point: bool = False, configurations=None) -> None:
         tol = mech.tolerances
         configs = configurations if configurations is not None else mech.generic_configurations()[1]
         self.inputs = list(inputs)
@@ -145,7 +149,7 @@ class Generic:
         self.configurations = tuple(configs)
 
 
-def measures(mech, q, g: Generic, length: float | None = None) -> dict:
+def measures(mech: Mechanism, q: np.ndarray, g: Generic, length: float | None = None) -> dict:
     """The relative smallest singular values that decide each kind of singularity at q
     (1 = far from it, 0 = singular): ``constraint`` of K, ``actuator`` of K_p (the passive
     columns), ``serial`` of J_o V relative to |J_o| (only with an output).  One function for
@@ -165,7 +169,7 @@ def _measures(S: Scaled, g: Generic) -> dict:
     return out
 
 
-def classify(mech, q, inputs=None, output=None, length=None, generic=None, point: bool = False) -> SingularityReport:
+def classify(mech: Mechanism, q: np.ndarray, inputs=None, output=None, length=None, generic=None, point: bool = False) -> SingularityReport:
     """Classify the configuration q (assembled) for the given inputs and output link.
     length: the characteristic length [m] (default ``mech.length``); point: the output
     link's origin as a point (its 3 translations) instead of its full motion."""
@@ -301,7 +305,7 @@ class GramLoop:
 STATIONARY = DEFAULT.stationary
 
 
-def loop_twists(mech, q, cut, length=None):
+def loop_twists(mech: Mechanism, q: np.ndarray, cut, length=None) -> tuple:
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
     says why) when the loop has a higher pair or a joint without one twist per coordinate."""
@@ -341,13 +345,13 @@ def loop_twists(mech, q, cut, length=None):
 ONE_TWIST = ("rolling", "gear", "helical")
 
 
-def _pair_frames(mech, cut):
+def _pair_frames(mech: Mechanism, cut) -> tuple:
     """(the file's loop joint, frame id of F1, of F2) of the rolling or gear pair closed by ``cut``."""
     spec = next(c for c in mech.spec.cut_joints if c.name == cut.name)
     return spec, mech.model.getFrameId(f"{cut.name}@F1"), cut.frame2
 
 
-def _pair_axis(mech, cut, state):
+def _pair_axis(mech: Mechanism, cut, state) -> tuple:
     """(spec, F1, F2, p, a): a point p of the pair's one-twist axis and its unit direction a, world."""
     spec, f1, f2 = _pair_frames(mech, cut)
     M1 = state.frame_placement(f1)
@@ -356,7 +360,7 @@ def _pair_axis(mech, cut, state):
     return (spec, f1, f2, *pair_contact(spec, M1, state.frame_placement(f2)))
 
 
-def pair_twist(mech, cut, state):
+def pair_twist(mech: Mechanism, cut, state) -> list:
     """[(name, twist, False)]: the pair closed by ``cut`` as one twist (v at the world origin, w) at a
     unit rate of turning of F2's link relative to F1's.  A rolling or gear pair: a revolute about
     its axis through the contact point (model.cuts.pair_contact; pure rolling is that rotation);
@@ -366,14 +370,14 @@ def pair_twist(mech, cut, state):
     return [(cut.name, np.concatenate([v, a]), False)]
 
 
-def pair_rate(mech, cut, state) -> float:
+def pair_rate(mech: Mechanism, cut, state) -> float:
     """The rate [rad/s] of the pair's column in pair_twist in the motion of ``state`` (with rates):
     F2's angular velocity relative to F1's about the pair's axis."""
     _, f1, f2, _, a = _pair_axis(mech, cut, state)
     return float((state.frame_twist(f2)[3:] - state.frame_twist(f1)[3:]) @ a)
 
 
-def gram_cofactors(mech, q, length=None) -> tuple:
+def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
     """GramLoop for each loop (one per cut joint: the fundamental loops of the spanning tree)."""
     tol = mech.tolerances
     out = []
@@ -424,7 +428,7 @@ def lost_direction(JV, out_dim: int, normal=None) -> np.ndarray:
     return out
 
 
-def _motion_twist(kind, x, names, J, tol):
+def _motion_twist(kind: str, x, names, J: np.ndarray, tol) -> SingularTwist:
     """The motion x (any length) as a SingularTwist: its rates (those not zero next to the unit
     vector: above Tolerances.equal), its twist and screw (none for a zero twist)."""
     x = x / np.linalg.norm(x)

@@ -52,7 +52,7 @@ if TYPE_CHECKING:
 NAME = "draw"
 NEEDS_MECHANISM = True
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
     common(sp)
     add_configuration_options(sp)
@@ -95,7 +95,7 @@ def frame_rate(text: str) -> float:
     return fps
 
 
-def _targets(mech, args) -> list:
+def _targets(mech: Mechanism, args: argparse.Namespace) -> list:
     out = []
     for option, ext in (("png", ".png"), ("svg", ".svg")):
         path = getattr(args, option)
@@ -109,12 +109,12 @@ def _targets(mech, args) -> list:
     return out
 
 
-def _suffixed(path, k) -> str:
+def _suffixed(path, k: int) -> str:
     stem, ext = os.path.splitext(path)
     return f"{stem}-singular-{k}{ext}"
 
 
-def _traces(mech, args, q, input_names, given, skel) -> dict:
+def _traces(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, input_names, given, skel) -> dict:
     """--trace NAME: name -> (the point's path in the drawing's plane (N, 2) [m], where the input stopped)."""
     if not args.trace:
         return {}
@@ -246,12 +246,12 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _typed(name, value, unit) -> str:
+def _typed(name: str, value, unit: str) -> str:
     """'crank = 30 deg' in the unit the person typed (``unit``: rad or m when bare)."""
     return f"{name} = {unit_text(value, unit, 5)}"
 
 
-def _animate(mech, args) -> int:
+def _animate(mech: Mechanism, args: argparse.Namespace) -> int:
     """draw --animate OUT: the skeleton along a sweep of --input from --from to --to."""
     ext = animation_format(args.animate)
     if args.png or args.svg or args.chain or args.singular or args.trace:

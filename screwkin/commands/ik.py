@@ -14,6 +14,11 @@ from ..present.report import position_dict, position_text
 from ..units import parse_value
 from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
 from ._options import count
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
+    import argparse
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -21,7 +26,7 @@ NAME = "ik"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(sp)
     sp.add_argument("--output", help="the link to place (or its --tool; or give a named --point)")
@@ -37,7 +42,7 @@ def add_parser(sub, common, scaled):
                    help="show every assembly mode, also those the mechanism cannot reach by moving")
 
 
-def run(mech, args) -> int:
+def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if (args.pose is None) == (args.position is None):
         raise UsageError("give one target: --pose \"x y z roll pitch yaw\" or --position x,y,z")
     if args.points and args.pose is not None:
@@ -92,7 +97,7 @@ def run(mech, args) -> int:
     return 0
 
 
-def _closed_text(mech, res, count) -> str:
+def _closed_text(mech: Mechanism, res, count: int) -> str:
     """The search line of a closed-form answer (analysis.position.closed_ik), and for a platform whose
     combinations are not all listed each leg's other branch beside the first solution."""
     c = res.modes
@@ -115,7 +120,7 @@ def _closed_text(mech, res, count) -> str:
     return text
 
 
-def _found_text(count, free: int, certified: bool = False) -> str:
+def _found_text(count: int, free: int, certified: bool = False) -> str:
     """'8 distinct branches found (legs: 2 x 2 x 2) of at most 8 (why): all of them', or how far from it
     (``certified``: the homotopy has them all, whatever the legs' bound)."""
     n = count.found

@@ -84,7 +84,7 @@ START_ANGLE = np.radians(10.0)
 START_FRACTION = 0.10
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser(NAME, help="one self-contained document (HTML and/or Markdown): topology, counts, equations, "
                                    "Newton iterations, motion, singular configurations with drawings, sweep, view")
     common(sp)
@@ -110,13 +110,13 @@ def add_parser(sub, common, scaled):
     sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
 
 
-def _writable(path, option):
+def _writable(path, option: str):
     if not path:
         raise UsageError(f"{option} needs a file name")
     check_writable(path, option)
 
 
-def _report_inputs(mech, args, given):
+def _report_inputs(mech: Mechanism, args: argparse.Namespace, given):
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     names = names or list(given) or list(mech.actuated)
     for n in names:
@@ -127,7 +127,7 @@ def _report_inputs(mech, args, given):
     return names
 
 
-def _attempt(notes, what, fn):
+def _attempt(notes, what: str, fn):
     """fn() or None, the reason it could not be made kept in notes[what]."""
     try:
         return fn()
@@ -339,14 +339,14 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _input_rates_text(mech, typed: dict, rates) -> str:
+def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
     """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``; ``typed``: joint_quantities of
     --rate), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
     if not typed:
         return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
 
-    def shown(n, v):
+    def shown(n: int, v) -> str:
         q = typed.get(n)
         if q is None or q.shown_unit in ("", si[n]):
             return f"{n} = {v:.6g} {si[n]}"
@@ -355,7 +355,7 @@ def _input_rates_text(mech, typed: dict, rates) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech, args, loops, q, values, names, notes, data, held=None):
+def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, values, names, notes, data, held=None):
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
@@ -393,7 +393,7 @@ def _newton(mech, args, loops, q, values, names, notes, data, held=None):
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, held=None, typed_rates=None):
+def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates=None):
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -453,7 +453,7 @@ def _singular_and_sweep(mech, args, q, names, given, eq, notes, data, rates, hel
     return out
 
 
-def _view(mech, args, q, data):
+def _view(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, data):
     if args.no_view:
         return view_section(None, "the view is left out (--no-view)")
     if chromium() is None:

@@ -43,6 +43,8 @@ from ._configuration import (
 from ._output_frame import named_points
 from ._values import check_rate_names, joint_quantities, joint_value, names_list, rate_items, split_inputs
 from ._options import BOUNDS, count
+if TYPE_CHECKING:
+    pass
 
 if TYPE_CHECKING:
     from ..analysis.position.position import PositionSolver
@@ -55,7 +57,7 @@ NAME = "sweep"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled):
+def add_parser(sub, common, scaled) -> None:
     sp = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint to move")
@@ -91,7 +93,7 @@ def add_parser(sub, common, scaled):
     scaled(sp)
 
 
-def _steps(text):
+def _steps(text: str):
     """--steps: within BOUNDS["steps"], or BOUNDS["streamed_steps"] for a streamed sweep (checked again in run)."""
     lo, hi = BOUNDS["steps"]
     try:
@@ -108,7 +110,7 @@ _NOT_STREAMED = (("json", "--json"), ("plot", "--plot"), ("singularities", "--si
                  ("rows", "--rows"))
 
 
-def _streamed(args) -> bool:
+def _streamed(args: argparse.Namespace) -> bool:
     """Whether this sweep is computed and written in chunks; refuses what a streamed sweep cannot do."""
     lo, hi = BOUNDS["steps"]
     if args.chunk is None and args.steps <= hi:
@@ -124,7 +126,7 @@ def _streamed(args) -> bool:
     return True
 
 
-def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
+def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop, fixed, q_start, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None
@@ -166,7 +168,7 @@ def _run_streamed(mech, args, solver, start, stop, fixed, q_start, rate) -> int:
     return 0
 
 
-def _rates_line(args) -> str:
+def _rates_line(args: argparse.Namespace) -> str:
     """The line that says what the rates and accelerations written are for (the input's rate)."""
     if args.rate:
         return f"rates and accelerations {args.rate_words}, held constant"
@@ -174,7 +176,7 @@ def _rates_line(args) -> str:
             "another speed), at a constant input rate")
 
 
-def _rows_option(text):
+def _rows_option(text: str):
     if text is None or text.strip().lower() == "all":
         return None if text is None else "all"
     try:

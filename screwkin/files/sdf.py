@@ -38,7 +38,7 @@ _CUT = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismati
         "ball": "spherical", "universal": "universal", "revolute2": "universal"}
 
 
-def _pose(elem, what, problems):
+def _pose(elem, what: str, problems):
     if elem is None or not (elem.text or "").strip():
         return pin.SE3.Identity()
     rel = elem.get("relative_to")
@@ -56,7 +56,7 @@ def _pose(elem, what, problems):
     return pin.SE3(pin.rpy.rpyToMatrix(np.array(rpy)), np.array(xyz))
 
 
-def _vec(text, what, problems):
+def _vec(text: str, what: str, problems) -> np.ndarray:
     before = len(problems)
     v = numbers((text or "").strip() or "?", 3, what, problems, (1.0, 0, 0))
     if len(problems) > before:
@@ -64,7 +64,7 @@ def _vec(text, what, problems):
     return np.array(unit_axis(v, what, problems))
 
 
-def _axis_element(joint, tag, name, X_joint, problems):
+def _axis_element(joint, tag, name: str, X_joint, problems):
     a = joint.find(tag)
     if a is None:
         return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])

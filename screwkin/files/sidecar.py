@@ -40,7 +40,7 @@ def _replacement_type(t) -> str | None:
     return None
 
 
-def _string_list(content, key, problems, what="joint names"):
+def _string_list(content, key, problems, what: str="joint names"):
     """content[key] as a list of strings (None when absent), with a problem for anything else."""
     value = content.get(key)
     if value is None:
@@ -188,7 +188,7 @@ def read_yaml_sidecar(spec: MechanismSpec, yaml_path: Path, frame_names: Iterabl
     spec.yaml_path = str(yaml_path)
 
 
-def axis_letters(t: str):
+def axis_letters(t: str) -> tuple[np.ndarray, np.ndarray]:
     unit = {"X": (1.0, 0, 0), "Y": (0, 1.0, 0), "Z": (0, 0, 1.0)}
     letters = t.split("_", 1)[1] if "_" in t else "XY"
     if len(letters) != 2 or any(c not in unit for c in letters):

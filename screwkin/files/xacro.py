@@ -194,7 +194,7 @@ def _include_path(spec: str, current: Path, path, state: _State) -> Path:
     return target
 
 
-def _read_file(target: Path, path, state: _State):
+def _read_file(target: Path, path, state: _State) -> tuple:
     """(text, ElementTree root) of an included file: bounded, checked, counted."""
     if len(state.files) >= MAX_INCLUDES:
         raise MechanismFileError(path, f"more than {MAX_INCLUDES} files included (refused)")
@@ -236,7 +236,7 @@ def _check_tree(root, path: Path, state: _State, follow: bool = True) -> None:
             _check_tree(sub, target, state)
 
 
-def _prepare(path, text, root=None) -> _State:
+def _prepare(path, text: str, root=None) -> _State:
     path = Path(path)
     state = _State(path, Path(os.path.realpath(path.parent if str(path.parent) else ".")))
     state.files.append(path)

@@ -147,7 +147,7 @@ def check_expression(expr: str) -> None:
         raise ValueError(f"xacro expression {quote(expr, 60)} uses {exc}: only {_ALLOWED} are allowed") from None
 
 
-def _number(x):
+def _number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, complex)
 
 
@@ -192,7 +192,7 @@ def call_function(name: str, args: list) -> Any:
 class Interpreter:
     """Evaluates a checked tree with names looked up in xacro's symbol table."""
 
-    def __init__(self, symbols):
+    def __init__(self, symbols) -> None:
         self.symbols = symbols
 
     def value(self, node):

@@ -37,12 +37,12 @@ class SixDistances:
 
     n, width = 6, 7
 
-    def __init__(self, A, B):
+    def __init__(self, A, B) -> None:
         self.A = np.asarray(A, float)
         self.B = np.asarray(B, float)
         self.closure = self  # the trace test draws its random points from ``closure``
 
-    def _v(self, X):
+    def _v(self, X: np.ndarray) -> tuple:
         """(v, RB): per leg the vector from A_k to the platform point, and R B_k; each (P, 3, 6)
         (component-wise arithmetic on the stack of rotations: these stacks are small, numpy's calls
         dominate)."""
@@ -58,7 +58,7 @@ class SixDistances:
         v = X[:, :3, None] + RB - self.A.T
         return v, RB
 
-    def equations(self, X, jacobian: bool = True):
+    def equations(self, X: np.ndarray, jacobian: bool = True) -> tuple:
         X = np.asarray(X, complex)
         v, RB = self._v(X)
         v0, v1, v2 = v[:, 0], v[:, 1], v[:, 2]
@@ -73,14 +73,14 @@ class SixDistances:
         J[:, :, 5] = 2 * (R0 * v1 - R1 * v0)
         return G, J
 
-    def offsets(self, X):
+    def offsets(self, X: np.ndarray):
         return self.equations(X, jacobian=False)[0]
 
-    def residual(self, X, c):
+    def residual(self, X: np.ndarray, c):
         """(P,) the largest |G(x) - c|."""
         return np.abs(self.offsets(X) - np.asarray(c)).max(axis=1)
 
-    def retract(self, X, dT):
+    def retract(self, X: np.ndarray, dT):
         X = np.array(X, complex)
         X[:, :3] += dT[:, :3]
         d = dT[:, 3:] * 0.5
@@ -99,7 +99,7 @@ class SixDistances:
         X[:, 3:] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
         return X
 
-    def tangent(self, X):
+    def tangent(self, X: np.ndarray):
         P = len(X)
         T = np.zeros((P, 7, 6), complex)
         T[:, np.arange(3), np.arange(3)] = 1.0
@@ -110,14 +110,14 @@ class SixDistances:
                 T[:, 3 + i, 3 + k] = value
         return T
 
-    def constraints(self, X):
+    def constraints(self, X: np.ndarray):
         q = np.asarray(X)[:, 3:]
         return (np.einsum("pi,pi->p", q, q) - 1.0)[:, None]
 
-    def on_variety(self, X, tol: float = 1e-10) -> np.ndarray:
+    def on_variety(self, X: np.ndarray, tol: float = 1e-10) -> np.ndarray:
         return np.abs(self.constraints(X)[:, 0]) <= tol * (1.0 + np.abs(X).max(axis=1)) ** 2
 
-    def random_points(self, rng, P: int) -> np.ndarray:
+    def random_points(self, rng: np.random.Generator, P: int) -> np.ndarray:
         q = rng.normal(size=(P, 4)) + 1j * rng.normal(size=(P, 4)) * 0.5
         q = q / np.sqrt(np.einsum("pi,pi->p", q, q))[:, None]
         t = (rng.normal(size=(P, 3)) + 1j * rng.normal(size=(P, 3))) * 0.5

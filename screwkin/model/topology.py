@@ -191,7 +191,7 @@ class UnionFind:
     """Disjoint sets of ``items`` (union-find with path halving): find(x) its set's representative,
     join(a, b) puts b's set under a's representative."""
 
-    def __init__(self, items):
+    def __init__(self, items) -> None:
         self.parent = {i: i for i in items}
 
     def find(self, x):
@@ -200,7 +200,7 @@ class UnionFind:
             x = self.parent[x]
         return x
 
-    def join(self, a, b):
+    def join(self, a, b) -> None:
         ra, rb = self.find(a), self.find(b)
         if ra != rb:
             self.parent[rb] = ra
@@ -261,7 +261,7 @@ class _Edge:
     profile: str | None = None
 
 
-def _edges(mech, q):
+def _edges(mech, q: np.ndarray) -> tuple:
     """Every non-fixed joint as an edge between URDF links, with its world axis at q."""
     model = mech.model
     state = KinematicState(mech, q)
@@ -320,7 +320,7 @@ def _unit_vector(v):
     return v / np.linalg.norm(v)
 
 
-def _parallel(d1, d2, tol):
+def _parallel(d1, d2, tol) -> bool:
     return np.linalg.norm(np.cross(_unit_vector(d1), _unit_vector(d2))) < tol
 
 
@@ -332,7 +332,7 @@ def _line_distance(p1, d1, p2, d2, tol):
     return abs((p2 - p1) @ _unit_vector(n))
 
 
-def _compound_name(members, kind) -> str:
+def _compound_name(members, kind: str) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
 
     prefix = os.path.commonprefix(members)
@@ -344,7 +344,7 @@ def _compound_name(members, kind) -> str:
     return "+".join(members)
 
 
-def _classify_chain(chain, tol, scale, coupled=frozenset()):
+def _classify_chain(chain, tol, scale, coupled=frozenset()) -> str | None:
     """The compound type of a chain of 1-DOF edges through massless links, or None.
     coupled: the pairs of joint names one of which mimics the other."""
     kinds = [e.type for e in chain]
@@ -525,7 +525,7 @@ def build_topology(mech: Any, q: np.ndarray) -> Topology:
                     normal, tuple(c for c in mech.couplings if c not in consumed))
 
 
-def _motion_space(joints, tol, scale):
+def _motion_space(joints, tol, scale) -> tuple:
     """'planar' when every revolute axis is parallel to one normal and every
     prismatic axis perpendicular to it; 'spherical' when every joint is a
     rotation about one common point; 'spatial' otherwise."""

@@ -25,6 +25,8 @@ from ..model.geometry import wrap_angle
 from .draw_targets import design_drawing, draw_targets
 from .plots import pyplot
 from .outfile import write_figure
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -44,14 +46,14 @@ def _plt():
     return pyplot("drawing")
 
 
-def value_label(name, value, unit) -> str:
+def value_label(name: str, value, unit: str) -> str:
     """'crank = 30 deg' or 'slide = 12.5 mm': a value as a person reads it."""
     if unit == "m":
         return f"{name} = {value * 1000:.4g} mm"
     return f"{name} = {np.degrees(value):.5g} deg"
 
 
-def wrapped_value(value, unit):
+def wrapped_value(value, unit: str):
     """A coordinate's value as a drawing names it: a length [m] as it is, an angle in [-pi, pi)."""
     return value if unit == "m" else wrap_angle(value)
 
@@ -63,16 +65,16 @@ def configuration_text(skel) -> str:
     return ", ".join(value_label(k, v, skel.units[k]) for k, v in skel.inputs.items())
 
 
-def drawing_title(mech, what) -> str:
+def drawing_title(mech: Mechanism, what: str) -> str:
     """A drawing's title: the file's name, then ``what``."""
     return f"{os.path.basename(str(mech.path))}: {what}"
 
 
-def _short(name, n=26):
+def _short(name: str, n: int=26):
     return name if len(name) <= n else name[: n - 1] + "~"
 
 
-def number_colours(n):
+def number_colours(n: int) -> dict:
     """Link number -> colour (2 .. n + 1; the ground, 1, is drawn grey): the colours drawings and the
     planar view share."""
     cycle = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
@@ -85,7 +87,7 @@ def _direction_2d(v):
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _fit_axes(fig, ax, points, r, limits=None):
+def _fit_axes(fig, ax, points, r, limits=None) -> None:
     """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
     ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
@@ -355,7 +357,7 @@ def _block_direction(skel, lk):
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid, alpha=0.85):
+def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float=0.85) -> None:
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -364,7 +366,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid, alpha=0.85):
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j, p, r):
+def _input_arrow(ax, FancyArrowPatch, j: int, p, r) -> None:
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
@@ -389,7 +391,7 @@ def _input_arrow(ax, FancyArrowPatch, j, p, r):
                                  label="input"))
 
 
-def _legend(fig, links, joints, marks=None):
+def _legend(fig, links, joints, marks=None) -> None:
     lines = ["links"]
     lines += [f" {lk.number:>2}  {_short(lk.name)}" + ("  (ground)" if lk.ground else "") for lk in links]
     lines.append("")
@@ -478,7 +480,7 @@ def draw_chain(chain, title: str | None = None):
     return fig
 
 
-def _layout(chain):
+def _layout(chain) -> dict:
     """Node positions in a unit box: networkx's Kamada-Kawai layout, else a circle; the ground
     at the bottom."""
     numbers = [nd.number for nd in chain.nodes]
@@ -548,7 +550,7 @@ def save_figure(fig, path: str, close: bool = True):
         plt.close(fig)
 
 
-def draw_design(mech, paths, steps: int = 360, say=None) -> list:
+def draw_design(mech: Mechanism, paths, steps: int = 360, say=None) -> list:
     """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
     ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
     q = mech.assemble().q

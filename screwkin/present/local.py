@@ -120,7 +120,7 @@ def redundancy_lines(r: Redundancy, title: str = "redundant constraints", explai
     ``explain`` one line: how many, at which joints and why (--explain names them and the way out)."""
     if not r.count:
         return []
-    def who(j):
+    def who(j: int):
         return f"{j.what} '{j.joint}'" if j.what in ("connect", "weld", "coupling") else j.joint
 
     if not explain:

@@ -28,6 +28,10 @@ from .numtext import csv_rows
 from .jsonout import to_jsonable
 from .mobility import mobility_dict, topology_dict
 from .singular import singularity_dict
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "slide_note"]
@@ -136,7 +140,7 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name, value, angular) -> str:
+def value_text(name: str, value, angular) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
@@ -168,7 +172,7 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
 
     placed = s.guide_positions or {}
 
-    def along(name):
+    def along(name: str) -> str:
         where = f"d = {placed[name]:.9g} m" if name in placed else ""
         at = f"along the guide at {np.degrees(guides[name]):.6g} deg" if name in guides else ""
         return ", ".join(w for w in (where, at) if w)
@@ -212,7 +216,7 @@ def slide_note(res, s) -> str | None:
     return note
 
 
-def position_text(res, degrees=True, show_all=False, length=None, units: RateUnits = RateUnits(),
+def position_text(res, degrees: bool=True, show_all: bool=False, length=None, units: RateUnits = RateUnits(),
                   leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
@@ -220,7 +224,7 @@ def position_text(res, degrees=True, show_all=False, length=None, units: RateUni
     as leg lengths (--set-length), said as typed beside the joint's value."""
     legs = leg_lengths or {}
 
-    def given(k, v):
+    def given(k: int, v) -> str:
         text = value_text(k, v, k in res.angular)
         return f"{k} = {legs[k]:.9g} m long (joint {text})" if k in legs else f"{k} = {text}"
 
@@ -370,14 +374,14 @@ def linkage_dict(info: LinkageInfo) -> dict:
     return d
 
 
-def sweep_singularity_dict(s: SweepSingularity, mech=None) -> dict:
+def sweep_singularity_dict(s: SweepSingularity, mech: Mechanism | None=None) -> dict:
     d = {"kind": s.kind, "input": s.input, "sigma": s.sigma, "limit": s.limit}
     if mech is not None:
         d["joints"] = mech.joint_values(s.q)
     return d
 
 
-def sweep_dict(res: SweepResult, mech=None) -> dict:
+def sweep_dict(res: SweepResult, mech: Mechanism | None=None) -> dict:
     return {
         "input": res.input, "input_unit": res.unit,
         "from": res.requested[0], "to": res.requested[1], "steps": res.requested[2],

@@ -63,7 +63,7 @@ def _coal():
     return coal
 
 
-def _visual_urdf(mech, unreadable=()) -> str:
+def _visual_urdf(mech: Mechanism, unreadable=()) -> str:
     """The URDF text with every mesh resolved to an absolute path, and visuals
     whose mesh cannot be found (or is in ``unreadable``) dropped (their links get stand-ins)."""
     root = parse_xml_text(mech.spec.urdf_text, mech.path)
@@ -86,20 +86,20 @@ def _visual_urdf(mech, unreadable=()) -> str:
 _JOINT_FIRST = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.BODY, pin.FrameType.OP_FRAME)
 
 
-def _body_frame(model, name):
+def _body_frame(model, name: str):
     """The BODY frame of link ``name`` (a joint may have the same name), or None."""
     fid = frame_id(model, name)
     return fid if fid is not None and model.frames[fid].type == pin.FrameType.BODY else None
 
 
-def _owner_link(mech, frame_name):
+def _owner_link(mech: Mechanism, frame_name: str):
     """The link a cut joint's side is on: the link itself, or the child link of a joint named so (sidecars)."""
     if frame_name in mech.spec.links:
         return frame_name
     return next((j.child for j in mech.spec.joints if j.name == frame_name), None)
 
 
-def _standin_points(mech) -> dict:
+def _standin_points(mech: Mechanism) -> dict:
     """link -> (its BODY frame id, [(target, point)]): the centres of its child joints and its loop-joint
     frames, expressed like the frame's placement (in the frame of the Pinocchio joint carrying the link)."""
     model = mech.model
@@ -120,7 +120,7 @@ def _standin_points(mech) -> dict:
     return out
 
 
-def _segment(name, joint, frame, a, b, radius, color):
+def _segment(name: str, joint, frame, a, b, radius, color):
     """A cylinder between points a and b (in the frame of joint ``joint``)."""
     coal = _coal()
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -135,13 +135,13 @@ def _segment(name, joint, frame, a, b, radius, color):
     return obj
 
 
-def _ball(name, joint, frame, p, radius, color):
+def _ball(name: str, joint, frame, p, radius, color):
     obj = pin.GeometryObject(name, joint, frame, pin.SE3(np.eye(3), np.asarray(p, float)), _coal().Sphere(radius))
     obj.meshColor = np.asarray(color, float)
     return obj
 
 
-def _disc(name, joint, frame, M, radius, color, alpha=0.35):
+def _disc(name: str, joint, frame, M, radius, color, alpha: float=0.35):
     """A thin disc of ``radius`` whose normal is the z axis of the placement M (a pitch circle or
     a circular profile), see-through so the links stay visible."""
     obj = pin.GeometryObject(name, joint, frame, M, _coal().Cylinder(radius, 0.05 * radius))
@@ -149,7 +149,7 @@ def _disc(name, joint, frame, M, radius, color, alpha=0.35):
     return obj
 
 
-def _pair_geometry(mech, cut, spec, r_axis, L_axis):
+def _pair_geometry(mech: Mechanism, cut, spec, r_axis, L_axis):
     """What a higher pair looks like: pitch circles (rolling, gears; a pitch line for a rack),
     profiles (circles as discs, lines as slots, points as pins) and a screw's helix of its lead."""
     model = mech.model
@@ -159,7 +159,7 @@ def _pair_geometry(mech, cut, spec, r_axis, L_axis):
     a = np.asarray(cut.axis, float) / np.linalg.norm(cut.axis)
     turn = _segment("t", 0, 0, np.zeros(3), a, 1.0, color).placement.rotation  # z along the axis
 
-    def side(k):
+    def side(k: int) -> tuple:
         f = model.frames[frames[k]]
         return f.parentJoint, frames[k], f.placement
 
@@ -238,7 +238,7 @@ def _corner_points(state, geom) -> np.ndarray:
     return np.asarray(pts)
 
 
-def _visual_geometry(mech, warn=None):
+def _visual_geometry(mech: Mechanism, warn=None):
     """Pinocchio's visual GeometryModel of the links; a mesh file that exists but cannot be
     read (not a mesh, truncated) is a warning and its link is drawn as a stand-in."""
 
@@ -382,7 +382,7 @@ def build_scene(mech: Mechanism, q: np.ndarray, output: str | None = None, singu
 class RecordingViewer:
     """A stand-in for meshcat.Visualizer that records what is sent to it."""
 
-    def __init__(self, root=None, path=""):
+    def __init__(self, root=None, path: str="") -> None:
         import meshcat.path
 
         self._root = root or self
@@ -391,26 +391,26 @@ class RecordingViewer:
         if root is None:
             self.objects, self.transforms, self.properties, self.animation = {}, {}, {}, None
 
-    def __getitem__(self, path):
+    def __getitem__(self, path) -> RecordingViewer:
         path = path if path.startswith("/") else f"{self._path}/{path}"
         return RecordingViewer(self._root, path)
 
-    def set_object(self, geometry, material=None):
+    def set_object(self, geometry, material=None) -> None:
         self._root.objects[self._path] = (geometry, material)
 
     def set_transform(self, matrix: np.ndarray | None = None) -> None:
         self._root.transforms[self._path] = np.eye(4) if matrix is None else np.asarray(matrix)
 
-    def set_property(self, key, value):
+    def set_property(self, key, value) -> None:
         self._root.properties[(self._path, key)] = value
 
-    def delete(self):
+    def delete(self) -> None:
         self._root.objects.pop(self._path, None)
 
-    def set_animation(self, animation, play=True, repetitions=1):
+    def set_animation(self, animation, play: bool=True, repetitions: int=1) -> None:
         self._root.animation = animation
 
-    def get_image(self, *args):  # pragma: no cover - present so Pinocchio does not warn
+    def get_image(self, *args: Any):  # pragma: no cover - present so Pinocchio does not warn
         raise NotImplementedError
 
 
@@ -420,7 +420,7 @@ def _translation(p):
     return T
 
 
-def show(mech, scene: Scene, viewer, q, motion=None, fps=30):
+def show(mech: Mechanism, scene: Scene, viewer, q: np.ndarray, motion=None, fps: int=30):
     """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
     with ``motion`` (a sequence of configurations) also set a meshcat animation.  A planar
     mechanism is seen along its plane's normal, orthographic, a colour per link (viewplanar)."""
@@ -534,7 +534,7 @@ def page(html: str, scene: Scene, title: str | None = None, controls: bool = Tru
     return html[:at] + style + legend + html[at:]
 
 
-def chromium():
+def chromium() -> str | None:
     for name in ("chromium", "chromium-browser", "google-chrome"):
         for d in os.environ.get("PATH", "").split(os.pathsep):
             p = Path(d) / name
@@ -543,7 +543,7 @@ def chromium():
     return None
 
 
-def screenshot(html_path, png_path, size=PICTURE, budget_ms=8000):
+def screenshot(html_path, png_path, size=PICTURE, budget_ms: int=8000):
     """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
     exe = chromium()
     if exe is None:
@@ -565,7 +565,7 @@ def screenshot(html_path, png_path, size=PICTURE, budget_ms=8000):
 _servers = []  # servers started by view(): they live as long as the Python session (a notebook)
 
 
-def view(mech, q=None, output=None, motion=None, viewer=None):
+def view(mech: Mechanism, q: np.ndarray | None=None, output=None, motion=None, viewer=None):
     """Show a mechanism (at q, default its assembled configuration) and return the
     meshcat viewer; in a notebook, ``view(mech, s.q).jupyter_cell()`` embeds it.
     Without ``viewer`` a loopback-only server is started and kept for the session."""

@@ -68,7 +68,7 @@ class ChunkRows(list):
     """A chunk's rows, with ``paths`` ({"family": n, "design": m}) and ``notes`` (why designs were
     evaluated alone), sent back with them from the worker."""
 
-    def __init__(self, rows=(), paths=None, notes=()):
+    def __init__(self, rows=(), paths=None, notes=()) -> None:
         super().__init__(rows)
         self.paths = dict(paths or {})
         self.notes = list(notes)
@@ -84,7 +84,7 @@ def eligible(task) -> str | None:
     return None
 
 
-def chunk_rows(task, chunk) -> ChunkRows:
+def chunk_rows(task, chunk: int) -> ChunkRows:
     """The rows of a chunk of designs [(index, values), ...]: what one Dask task computes.  A family
     whose structure does not change with its parameters takes the family path (family_rows); other
     studies, and the designs the family path cannot vouch for, are evaluated one by one
@@ -97,7 +97,7 @@ def chunk_rows(task, chunk) -> ChunkRows:
     return ChunkRows(run_chunk(task, chunk), {"design": len(chunk)})
 
 
-def _rpy_matrices(rpy):
+def _rpy_matrices(rpy) -> np.ndarray:
     """Rotation matrices (n, 3, 3) of URDF rpy angles (n, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy[:, 0], rpy[:, 1], rpy[:, 2]
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
@@ -119,7 +119,7 @@ class _Placed:
     """Every design's tree joint frames and loop-joint frames at the file's configuration (all joints
     at zero), composed from their files' origins: world (R (n, 3, 3), p (n, 3))."""
 
-    def __init__(self, specs):
+    def __init__(self, specs) -> None:
         first = specs[0]
         n = len(specs)
         links = {first.root: (np.broadcast_to(np.eye(3), (n, 3, 3)), np.zeros((n, 3)))}
@@ -176,7 +176,7 @@ class _Fourbar:
     """The reference design's four-bar: which joint centres and loop frames each link's length joins,
     and the sides of its loop (model.closability.planar_loops)."""
 
-    def __init__(self, d, spec):
+    def __init__(self, d, spec) -> None:
         mech, info = d.mech, d.linkage()
         if info.kind != "four-bar":
             raise Unbatchable("the family path analyses four-bars (this one is a slider-crank)")
@@ -186,10 +186,10 @@ class _Fourbar:
         inp = joints[info.input_joint]
         ground = topo.ground
 
-        def other(link, joint):
+        def other(link: str, joint):
             return next(j for j in topo.joints if j is not joint and link in j.links)
 
-        def far(joint, link):
+        def far(joint, link: str):
             return joint.links[1] if joint.links[0] == link else joint.links[0]
 
         moving = far(inp, ground)
@@ -215,7 +215,7 @@ class _Fourbar:
             self.frames[c.frame2] = (c.name, 1)
         self.lengths = info.lengths
 
-    def point(self, placed, joint, link):
+    def point(self, placed, joint, link: str):
         """The joint's centre (a loop joint: its frame on ``link``) at every design: (n, 3)."""
         if joint in self.cut_names:
             c = self.cut_names[joint]
@@ -233,7 +233,7 @@ class _Fourbar:
         return placed.joints[self.names[ident]][1]
 
 
-def _flat(P, n):
+def _flat(P, n: int):
     return P - np.einsum("ni,ni->n", P, n)[:, None] * n
 
 

@@ -104,7 +104,7 @@ class DesignTimeout(ScrewkinError):
 class _Clock:
     """The deadline of one design, checked between its steps (loading, assembly, each metric)."""
 
-    def __init__(self, seconds: float):
+    def __init__(self, seconds: float) -> None:
         self.seconds = seconds
         self.end = time.perf_counter() + seconds
 
@@ -201,7 +201,7 @@ class StudyDesign:
             self._choose_mode()
             clock.check()
 
-    def _choose_mode(self):
+    def _choose_mode(self) -> None:
         """The assembly mode the design's motion and workspace follow: the task's ``mode`` K (default 1) of the
         inputs (the study's input, else the actuated joints) at their values in the assembled configuration,
         as ``solve`` lists them (the one rule of every command's --mode); ``self.q`` becomes its
@@ -529,7 +529,7 @@ def apply_requirements(spec: StudySpec, rows) -> tuple:
     return tuple(out), REQUIREMENTS_COLUMN, unmet
 
 
-def failed_row(task, index, values, reason) -> dict:
+def failed_row(task, index: int, values, reason) -> dict:
     row = {"design": index, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(metric_columns(task.metrics)))
     row["error"] = reason

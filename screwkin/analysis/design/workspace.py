@@ -107,7 +107,7 @@ class WorkspaceResult:
 class _Measures:
     """The workspace measures for stacks of assembled configurations."""
 
-    def __init__(self, mech, output, point, inputs, length):
+    def __init__(self, mech: Mechanism, output, point, inputs, length) -> None:
         self.mech, self.point, self.L = mech, point, float(length or mech.length)
         self.closure = BatchClosure(mech, check=0) if (mech.cuts or mech.extra_rows) else None
         self.out = SerialJacobians(mech, output, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, check=0)
@@ -117,7 +117,7 @@ class _Measures:
         self.slide = mech.translational
         self.position_rows = mech.closure.position_rows
 
-    def __call__(self, Q) -> dict:
+    def __call__(self, Q: np.ndarray) -> dict:
         out = {"actuator": np.empty(len(Q)), "serial": np.empty(len(Q)), "conditioning": np.empty(len(Q))}
         for s in range(0, len(Q), _BLOCK):
             part = self._block(Q[s:s + _BLOCK])
@@ -125,7 +125,7 @@ class _Measures:
                 out[k][s:s + _BLOCK] = part[k]
         return out
 
-    def _block(self, Q) -> dict:
+    def _block(self, Q: np.ndarray) -> dict:
         mech, g, L = self.mech, self.generic, self.L
         N, nv = len(Q), mech.nv
         J = np.zeros((N, 6, nv))
@@ -161,7 +161,7 @@ class _Measures:
         return {"actuator": actuator, "serial": serial, "conditioning": conditioning}
 
 
-def _translations(mech, q, output, point) -> np.ndarray:
+def _translations(mech: Mechanism, q: np.ndarray, output, point) -> np.ndarray:
     """(3, k) directions the output (its origin for a point) can translate in at q, at a
     constant orientation unless ``point``: the linear part of the output twists that the loops
     allow with no rotation."""
@@ -181,7 +181,7 @@ def _translations(mech, q, output, point) -> np.ndarray:
     return U[:, :k]
 
 
-def workspace(mech, output: str, point: bool = False, orientation=None, resolution: float | None = None,
+def workspace(mech: Mechanism, output: str, point: bool = False, orientation=None, resolution: float | None = None,
               bounds=None, threshold: float = DEFAULT_THRESHOLD, length: float | None = None,
               method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None,
               timeout: float | None = None, q_start=None) -> WorkspaceResult:
@@ -231,7 +231,7 @@ def workspace(mech, output: str, point: bool = False, orientation=None, resoluti
                  q_start)
 
 
-def _seed(mech, output, point, orientation, q_start=None):
+def _seed(mech: Mechanism, output, point, orientation, q_start=None) -> tuple:
     """The assembled configuration the grid starts from (``q_start`` when given), the output's position
     and the grid's orientation there (continued from the file's orientation to the one asked)."""
     assembly, generic = mech.generic_configurations()
@@ -269,7 +269,7 @@ def _seed(mech, output, point, orientation, q_start=None):
     return q, p, R
 
 
-def _index_bounds(bounds, p_seed, axes, h, dim):
+def _index_bounds(bounds, p_seed, axes, h, dim) -> tuple:
     """Index ranges (lo, hi) per axis for world-coordinate bounds (dimension, 2), or None."""
     if bounds is None:
         return [-(10**9)] * dim, [10**9] * dim
@@ -374,7 +374,7 @@ def _run_lengths(grid: Grid, index: np.ndarray, ends: dict, worst: np.ndarray, e
 
 def _grid(mech: Mechanism, output: str, point: bool, orientation: Any, measures: _Measures,
           resolution: float | None, bounds: Any, threshold: float, L: float, inputs: list[str],
-          deadline: float | None = None, q_start: np.ndarray | None = None) -> WorkspaceResult:
+          deadline: float | None = None, q_start=None) -> WorkspaceResult:
     try:
         BatchClosure(mech, target=(output, "point" if point else "pose"))  # raises Unbatchable
     except Unbatchable as e:
@@ -446,7 +446,7 @@ def _free_part(m0, m1, length, threshold, p0, direction, crossings) -> float:
 
 
 # ----------------------------------------------------------------------------------- sampling
-def _sampling(mech, output, measures, resolution, bounds, threshold, L, samples, seed, inputs) -> WorkspaceResult:
+def _sampling(mech: Mechanism, output, measures, resolution, bounds, threshold, L, samples, seed: int, inputs) -> WorkspaceResult:
     samples = int(samples)
     if samples < 1:
         raise UsageError(f"the number of samples must be positive, got {samples}")

@@ -19,6 +19,10 @@ from ...model.kernel.scaling import dimensionless
 from ...model.kernel.stacks import BatchClosure
 from ..motion.continuation import jumped, keeps_orientation
 from ...model.limits import within_limits
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Grid", "grid_axes", "null_motions", "MAX_POINTS"]
 
@@ -33,7 +37,7 @@ _ITERATIONS = 8  # Newton from a neighbour's solution and the predictor converge
 #                   takes more lies beyond the boundary (or across a singularity) from that neighbour
 
 
-def null_motions(A, mech):
+def null_motions(A, mech: Mechanism):
     if not A.size:
         return np.eye(A.shape[1])
     _, s, vt = np.linalg.svd(A)
@@ -60,7 +64,7 @@ def grid_axes(directions) -> np.ndarray:
 class Grid:
     """Batched inverse kinematics on a grid (see the module's text)."""
 
-    def __init__(self, mech, output, point, orientation, q_seed, p_seed, axes, h, lo, hi, frozen=()):
+    def __init__(self, mech: Mechanism, output, point, orientation, q_seed: np.ndarray, p_seed, axes, h, lo, hi, frozen=()) -> None:
         self.mech, self.axes, self.h = mech, axes, float(h)
         self.deadline = None  # time.monotonic() past which the growth stops (the result marked truncated)
         self.timed_out = False
@@ -79,10 +83,10 @@ class Grid:
         self.solves = 0
         self.truncated = False
 
-    def position(self, index) -> np.ndarray:
+    def position(self, index: int) -> np.ndarray:
         return self.p_seed + (np.asarray(index, float) * self.h) @ self.axes
 
-    def solve(self, Q0, P):
+    def solve(self, Q0: np.ndarray, P) -> tuple:
         """Solve from Q0 (N, nq) for targets P (N, 3): (Q, ok) with ok: converged and within
         the joint limits."""
         Q = np.empty_like(Q0)
@@ -95,7 +99,7 @@ class Grid:
             ok[ok] &= within_limits(self.mech, Q[ok])
         return Q, ok
 
-    def predict(self, Q, P_from, P_to):
+    def predict(self, Q: np.ndarray, P_from, P_to) -> tuple:
         """First-order predictor: the joint steps that move the target from P_from to P_to
         (minimum norm through the solver's rows: K dq = -(change of the target rows)), and
         the rows' Jacobian at Q (it does not depend on where the target is)."""
@@ -104,11 +108,11 @@ class Grid:
         dr = r0 - r1  # the rows' change from moving the target alone
         return Q + damped_steps(K, dr, np.full(len(Q), self.mech.tolerances.lm_damping))[0], K
 
-    def _scaled(self, K):
+    def _scaled(self, K: np.ndarray):
         """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L (model.kernel.scaling)."""
         return dimensionless(K, self.closure.solver_position_rows, self.slide, self.L)
 
-    def kept(self, Q_from, K_from, Q_pred, Q_new, P_new):
+    def kept(self, Q_from, K_from, Q_pred, Q_new, P_new) -> tuple:
         """(kept, sigma) for new solutions solved from Q_from: kept when it continues the old
         solution -- near the predicted configuration, and on the same branch: the rows'
         Jacobian (loops and target) restricted to the old one's range and row space keeps the
@@ -125,7 +129,7 @@ class Grid:
         ev = np.sqrt(np.maximum(np.linalg.eigvalsh(K_new.transpose(0, 2, 1) @ K_new), 0.0))[:, ::-1]
         return ok, np.where(ev[:, 0] > 0, ev[:, r - 1] / np.where(ev[:, 0] > 0, ev[:, 0], 1.0), 0.0)
 
-    def substeps(self, sigma) -> np.ndarray:
+    def substeps(self, sigma: float) -> np.ndarray:
         """Substeps for a grid step from points of relative singular value sigma: two branches
         of a fold a distance d inside it differ by about sqrt(d / L) in the joints, and so does
         sigma there, so a step of h may land on either below about sqrt(h / L): the step is cut
@@ -137,7 +141,7 @@ class Grid:
         n = np.minimum(2 ** np.ceil(np.log2(np.clip(need, 1.0, _SUBSTEPS))), _SUBSTEPS)
         return np.where(sigma >= _SINGULAR, n, 0).astype(int)
 
-    def advance(self, Q, P_from, P_to, n):
+    def advance(self, Q: np.ndarray, P_from, P_to, n: int) -> tuple:
         """Solve from Q at P_from to P_to in n equal substeps (n: an int, or one per point,
         all advanced together): (Q, ok, sigma, jumped) -- jumped: a substep converged within
         the limits but ``kept`` refused it (another branch, or far from the prediction)."""
@@ -160,7 +164,7 @@ class Grid:
             Qc[sel[good]], Pc[sel[good]], sigma[sel] = Qn[good], Pk[good], sig
         return Qc, ok, sigma, jumped
 
-    def advance_all(self, Q, P_from, P_to, n, retry=True):
+    def advance_all(self, Q: np.ndarray, P_from, P_to, n: int, retry: bool=True) -> tuple:
         """advance for points with each their number of substeps n (> 0), in blocks; with
         ``retry``, a step refused as a jump to another branch is tried again in twice as many
         substeps, up to _SUBSTEPS (a step that does not converge -- past the boundary -- is not)."""
@@ -277,7 +281,7 @@ class Grid:
             current = following
         return ends
 
-    def extend(self, starts, Q, direction):
+    def extend(self, starts: int, Q: np.ndarray, direction) -> tuple:
         """Bisection from the reached points ``starts`` (m, d) (configurations Q) towards their
         unreached neighbours along ``direction`` (a unit index vector): the reached fraction of
         the step (0..1) and the configurations there."""

@@ -128,7 +128,7 @@ class DynamicsResult:
     transmissions: tuple = ()  # files.description.Transmission of those actuators
 
 
-def check_inertias(mech) -> tuple:
+def check_inertias(mech: Mechanism) -> tuple:
     """Each moving body needs a mass and an inertia a rigid body can have (files/inertia.py: a link
     breaking it is a MechanismFileError naming it), and an SDF file's inertias are not read (refused): a moving
     link without <inertial> on a body none of whose links has one is a MechanismFileError naming
@@ -167,7 +167,7 @@ def check_inertias(mech) -> tuple:
     return ()
 
 
-def _load_wrenches(mech, loads, state) -> list:
+def _load_wrenches(mech: Mechanism, loads, state) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the configuration of
     ``state`` (a KinematicState; the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []
@@ -181,7 +181,7 @@ def _load_wrenches(mech, loads, state) -> list:
     return out
 
 
-def _ground_sides(mech) -> tuple:
+def _ground_sides(mech: Mechanism) -> tuple:
     """(tree joints whose parent is the ground, {cut joint: +1 when its link2 is on the ground,
     -1 when its link1 is})."""
     model = mech.model
@@ -201,7 +201,7 @@ def _ground_sides(mech) -> tuple:
     return tree, cuts
 
 
-def _energies(mech, gmodel, data, q, v) -> tuple:
+def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v) -> tuple:
     """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
     energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
     model = mech.model
@@ -215,7 +215,7 @@ def _energies(mech, gmodel, data, q, v) -> tuple:
     return 0.5 * float(v @ M @ v), float(V)
 
 
-def _flywheel(values, tau, speed, unit, cs, completed) -> Flywheel:
+def _flywheel(values, tau, speed, unit: str, cs, completed) -> Flywheel:
     """The flywheel figure from the input effort tau over the input values (see the module)."""
     omega = abs(speed)
     span = abs(values[-1] - values[0]) if len(values) > 1 else 0.0
@@ -360,7 +360,7 @@ def _motion_notes(s: _Series, input: str, res: SweepResult, peak: dict[str, floa
 def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: float, steps: int,
              inputs: Iterable[str] | None = None, fixed: dict | None = None, near: dict | None = None,
              gravity: Iterable[float] = (0.0, 0.0, 0.0), loads: Iterable[Load] = (), cs: float = 0.05,
-             progress: Callable[[int, int], object] | None = None, q_start: np.ndarray | None = None,
+             progress: Callable[[int, int], object] | None = None, q_start=None,
              branch: str = "continue") -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).

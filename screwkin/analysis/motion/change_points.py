@@ -25,16 +25,13 @@ from ...errors import AssemblyError
 from ..local import local_analysis
 from ..singular import Generic, measures
 from .crossing import TIGHT_CLOSURE, ChangePoint, dips, nearest_branch, reclosing
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["change_points"]
 
 
 
-def change_points(solver: PositionSolver, res, located: list=(), xtol: float | None = None) -> tuple:
+def change_points(solver, res, located: list=(), xtol: float | None = None) -> tuple:
     """ChangePoint for each constraint singularity along the sweep ``res`` of ``solver``: those of
     ``located`` (SweepSingularity of kind "constraint" from singular_points) and the dips found here."""
     from scipy.optimize import minimize_scalar

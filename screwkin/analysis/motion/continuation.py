@@ -39,6 +39,10 @@ import pinocchio as pin
 from ...errors import AssemblyError
 from ...model.geometry import TINY
 from ..singular import measures
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -108,7 +112,7 @@ class Engine(Protocol):
         ...
 
 
-def projections(K, V, scale, free, tol) -> np.ndarray:
+def projections(K: np.ndarray, V, scale, free, tol) -> np.ndarray:
     """The vectors V (N, nv) projected onto the null space of the scaled constraint Jacobians K
     (N, m, nv) -- columns times ``scale`` (characteristic lengths for sliding joints), restricted to
     the ``free`` columns (the held inputs have no part) -- with the rank rule of model.linalg (singular
@@ -153,13 +157,13 @@ def orient(t, previous):
     return t * np.cumprod(d)[:, None]
 
 
-def passes_limit(ta, tb, ix):
+def passes_limit(ta, tb, ix) -> bool:
     """A limit position between two configurations (oriented tangents ta, tb: ``orient``): the
     input's share of the tangent does not keep its sign (rows of stacks compared pairwise)."""
     return np.asarray(ta)[..., ix] * np.asarray(tb)[..., ix] <= 0
 
 
-def keeps_orientation(Ks_from, Ks_new, r):
+def keeps_orientation(Ks_from, Ks_new, r) -> bool:
     """The branch rule of a continuation in several parameters (a workspace's grid growth): each new
     Jacobian (N, m, n; dimensionless) restricted to the old one's range and row space (rank r) keeps the
     sign of its determinant -- a jump across a fold to another working mode flips it.  With one
@@ -171,14 +175,14 @@ def keeps_orientation(Ks_from, Ks_new, r):
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss, sigma, tol):
+def jumped(miss, sigma: float, tol):
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""
     return ~(np.asarray(miss) <= np.maximum(tol.jump * np.abs(sigma), tol.jump_floor))
 
 
-def locate(f, lo, hi, xtol=1e-14, maxiter=100) -> float:
+def locate(f, lo, hi, xtol: float=1e-14, maxiter: int=100) -> float:
     """The root of f bracketed in [lo, hi] (f changes sign there) by Brent's method, to xtol and
     four units of round-off: where every engine locates its limit positions (the tangent's input
     share, a closed form's discriminant) and the input values on an arc near them."""
@@ -187,7 +191,7 @@ def locate(f, lo, hi, xtol=1e-14, maxiter=100) -> float:
     return brentq(f, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=maxiter)
 
 
-def returned(mech, x, start, h, q, q0, scale) -> bool:
+def returned(mech: Mechanism, x, start, h, q: np.ndarray, q0: np.ndarray, scale) -> bool:
     """The motion is back at its start: the input at ``start`` (Tolerances.equal relative to the grid
     step h) and the configuration q at q0 (Tolerances.geometry, dimensionless)."""
     tol = mech.tolerances
@@ -195,7 +199,7 @@ def returned(mech, x, start, h, q, q0, scale) -> bool:
                 and np.linalg.norm(pin.difference(mech.model, q, q0) / scale) < tol.geometry)
 
 
-def at_change_point(solver, q) -> dict:
+def at_change_point(solver, q: np.ndarray) -> dict:
     """The singularity measures at a located limit position q (analysis.singular.measures),
     with "change": whether K itself loses rank there (a change point, not a limit position: the input
     passes it on a branch that goes on)."""
@@ -203,7 +207,7 @@ def at_change_point(solver, q) -> dict:
     return {**m, "change": solver.generic().rank_K > 0 and m["constraint"] < solver.mech.tolerances.singular}
 
 
-def continuation_steps(mech, name: str, dx: float) -> int:
+def continuation_steps(mech: Mechanism, name: str, dx: float) -> int:
     """How many steps a continuation takes to move input ``name`` by ``dx`` [rad or m]: steps of at most
     Tolerances.max_step (scaled: characteristic lengths for a sliding input), as the sweep takes them."""
     c = mech.coordinate(name)
@@ -214,7 +218,7 @@ def continuation_steps(mech, name: str, dx: float) -> int:
 class Curve:
     """The curve along input ``name`` of a PositionSolver, one configuration at a time: an ``Engine``."""
 
-    def __init__(self, solver, name):
+    def __init__(self, solver, name: str) -> None:
         mech = self.mech = solver.mech
         self.solver, self.model, self.closure = solver, solver.model, mech.closure
         self.name = name
@@ -237,11 +241,11 @@ class Curve:
     def unit(self) -> str:
         return "m" if self.mech.translational[self.ix] else "rad"
 
-    def input_directions(self, K):
+    def input_directions(self, K: np.ndarray):
         """The unnormalized tangents P e at configurations of constraint Jacobians K (N, m, nv)."""
         return projections(K, self.e[None].repeat(len(K), 0), self.scale, self.free, self.tol)
 
-    def tangent(self, q, previous=None):
+    def tangent(self, q: np.ndarray, previous=None):
         """Unit tangent of the curve at q in scaled coordinates (nv; zero on the held inputs),
         oriented like ``previous`` (``choose_branch``): the input's direction projected onto the null
         space of K; at a limit position itself (tol.limit_share), ``previous`` projected instead."""
@@ -258,7 +262,7 @@ class Curve:
     def choose_branch(self, t, previous):
         return orient(t, previous)
 
-    def along(self, q, direction):
+    def along(self, q: np.ndarray, direction):
         """The unit tangent at q oriented so that the input moves the way of ``direction`` (its sign;
         zero: increasing) -- where a motion starts."""
         t = self.tangent(q)
@@ -271,10 +275,10 @@ class Curve:
         best = int(np.argmax(scores))
         return self.ix if abs(t[self.ix]) >= 0.5 * scores[best] else best
 
-    def frozen(self, held):
+    def frozen(self, held) -> tuple:
         return tuple(sorted(set(self.frozen_other) | {held}))
 
-    def predict(self, q, t, sigma):
+    def predict(self, q: np.ndarray, t, sigma: float):
         return pin.integrate(self.model, q, self.scale * t * sigma)
 
     def correct(self, predicted, held):
@@ -283,11 +287,11 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed") from None
 
-    def accept(self, predicted, corrected, sigma):
+    def accept(self, predicted, corrected, sigma: float) -> bool:
         miss = np.linalg.norm(pin.difference(self.model, predicted, corrected) / self.scale)
         return not jumped(miss, sigma, self.tol)
 
-    def step(self, q, t, sigma, held):
+    def step(self, q: np.ndarray, t, sigma: float, held):
         """Move sigma (scaled) along t, hold joint ``held`` there, close the loops again."""
         pred = self.predict(q, t, sigma)
         q_new = self.correct(pred, held)
@@ -295,17 +299,17 @@ class Curve:
             raise Stuck("the correction jumps away from the curve")
         return q_new
 
-    def at_input(self, q_from, x_from, x, t):
+    def at_input(self, q_from: np.ndarray, x_from, x, t):
         """The configuration at input value x, predicted from q_from (input x_from) along t."""
         dx = (x - x_from) / self.scale[self.ix]
         if abs(t[self.ix]) < self.tol.zero:
             raise Stuck("the input does not move here")
         return self.step(q_from, t, dx / t[self.ix], self.ix)
 
-    def input_change(self, q0, q1) -> float:
+    def input_change(self, q0: np.ndarray, q1: np.ndarray) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
 
-    def _arc(self, qa, qb, held, message):
+    def _arc(self, qa: np.ndarray, qb: np.ndarray, held, message: str):
         """The configuration a share u of the way from qa to qb with joint ``held`` as the parameter."""
         delta = pin.difference(self.model, qa, qb)
         frozen, cache = self.frozen(held), {0.0: qa, 1.0: qb}
@@ -322,7 +326,7 @@ class Curve:
 
         return at
 
-    def on_arc(self, qa, xa, qb, held, x):
+    def on_arc(self, qa: np.ndarray, xa, qb: np.ndarray, held, x):
         """The configuration at input value x on the arc from qa (input xa) to qb, followed with
         joint ``held`` as the parameter (the input changes monotonically along it: no limit
         position strictly between): Brent's method on the held joint's share of the way.  Near a
@@ -351,12 +355,12 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed at this input value") from None
 
-    def locate_limit(self, qa, ta, qb, held):
+    def locate_limit(self, qa: np.ndarray, ta, qb: np.ndarray, held):
         """The limit position between qa and qb (the input's tangent component changes sign),
         with joint ``held`` as the parameter: (configuration, input offset from qa)."""
         at = self._arc(qa, qb, held, None)
 
-        def f(s):
+        def f(s) -> float:
             return float(self.tangent(at(s), ta)[self.ix])
 
         fa, fb = float(ta[self.ix]), f(1.0)
@@ -374,10 +378,10 @@ class Neighbour:
     its corrector and its branch tests (a correction that jumps away from the curve, or a
     limit position between the two values, refuses the step).  Maps walk their grids with it."""
 
-    def __init__(self, solver, name: str):
+    def __init__(self, solver, name: str) -> None:
         self.curve = Curve(solver, name)
 
-    def __call__(self, q, x_from: float, x_to: float):
+    def __call__(self, q: np.ndarray, x_from: float, x_to: float):
         """The configuration at input value x_to on q's branch (q at x_from), or None."""
         c = self.curve
         direction = np.sign(x_to - x_from)

@@ -32,7 +32,6 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.continuation import Curve
-    from screwkin.analysis.position.position import PositionSolver
     from screwkin.tolerances import Tolerances
     from collections.abc import Callable
     from collections.abc import Iterator
@@ -57,7 +56,7 @@ def dips(m: np.ndarray, xs: np.ndarray) -> Iterator:
             yield k, max(k - 1, 0), min(k + 1, len(xs) - 1)
 
 
-def reclosing(solver: PositionSolver, res, q_k: np.ndarray, tight: Tolerances) -> Callable:
+def reclosing(solver, res, q_k: np.ndarray, tight: Tolerances) -> Callable:
     """x -> the configuration at input value x closed from the sweep's q_k (tolerances ``tight`` when
     Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
     mech, frozen = solver.mech, solver.frozen
@@ -155,7 +154,7 @@ def constraint_profile(mech: Mechanism, Q: np.ndarray | list, rank: int | None =
     return np.where(top[:, 0] > 0, s[:, r - 1] / np.where(top[:, 0] > 0, top[:, 0], 1.0), 0.0), r
 
 
-def passed(solver: PositionSolver, res) -> list:
+def passed(solver, res) -> list:
     """The change points the recorded motion ``res`` (a SweepResult) meets, in the order of the motion
     (Crossing each): a configuration where the constraint measure (``constraint_profile``) is below
     Tolerances.singular -- at the start, at a dip between two recorded configurations (refined by
@@ -234,7 +233,7 @@ def _measure(mech: Mechanism, q: np.ndarray, rank: int) -> float:
     return float(constraint_profile(mech, [q], rank)[0][0])
 
 
-def _again(solver: PositionSolver, out: list, res, k: int, lo_k: int, hi_k: int, bounds: list) -> tuple | None:
+def _again(solver, out: list, res, k: int, lo_k: int, hi_k: int, bounds: list) -> tuple | None:
     """(x, configuration, measure) of a change point already found (in ``out``) that this dip is another
     pass of (a motion through limit positions passes one point again and again): its input within the
     dip's bounds, its joint centres nearer the recorded configuration k than the neighbours are; else None."""
@@ -246,7 +245,7 @@ def _again(solver: PositionSolver, out: list, res, k: int, lo_k: int, hi_k: int,
     return None
 
 
-def _least(solver: PositionSolver, res, q: np.ndarray, bounds: list | tuple, rank: int, tight: Tolerances) -> tuple | None:
+def _least(solver, res, q: np.ndarray, bounds: list | tuple, rank: int, tight: Tolerances) -> tuple | None:
     """(x, configuration, measure) where the constraint measure is least for the input within bounds, the
     loops closed again from q at each value (bounded minimization, to the closure tolerance); None
     where they cannot be closed there."""
@@ -281,7 +280,7 @@ def _limit_index(xs: np.ndarray, x) -> int:
     return len(xs) - 1
 
 
-def _branch_rates(mech: Mechanism, branch) -> np.ndarray:
+def _branch_rates(mech: Mechanism, branch: str) -> np.ndarray:
     """A branch's tangent as joint rates (nv), in the order of the coordinates."""
     return np.array([branch.tangent.get(n, 0.0) for n in mech.coordinate_names], float)
 
@@ -315,7 +314,7 @@ def follow(curve: Curve, q: np.ndarray, x, rates, x_to):
     return Neighbour(curve.solver, curve.name)(q1, x1, x_to)
 
 
-def crossing(solver: PositionSolver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
+def crossing(solver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -> tuple:
     """At the change point c of the motion res: (ChangePoint, the followed branch's tangent as joint
     rates oriented along the motion or None, why-not text or None).  The incoming branch is the one
     whose line, followed back from c (``follow``), reaches nearest the configuration recorded before
@@ -366,7 +365,7 @@ def crossing(solver: PositionSolver, curve: Curve, res, c: Crossing, switch: boo
     return ChangePoint(c.x, c.sigma, c.q, local, incoming, goes, True, switched=goes != came), v, why
 
 
-def _starting(solver: PositionSolver, curve: Curve, local, branches: list, moving: list, c: Crossing, direction) -> tuple:
+def _starting(solver, curve: Curve, local, branches: list, moving: list, c: Crossing, direction) -> tuple:
     """(the branch a motion starting on the change point c takes, the rule in words): of the branches
     that move the input, the one the file's configuration lies on (followed from c to its input value,
     it reaches the drawing: solve's first mode is the one nearest the drawing); where none does (the
@@ -396,7 +395,7 @@ def _starting(solver: PositionSolver, curve: Curve, local, branches: list, movin
     return came, f"{START}: taking the branch nearest the input's own direction (projected on ker K)"
 
 
-def _reaches(solver: PositionSolver, curve: Curve, c: Crossing, rates, x, drawn) -> bool:
+def _reaches(solver, curve: Curve, c: Crossing, rates, x, drawn) -> bool:
     """Whether the branch of tangent ``rates`` at the change point c, followed to input value x, reaches the
     configuration whose signature (PositionSolver.signature) is ``drawn``."""
     q = follow(curve, c.q, c.x, rates, x)
@@ -408,7 +407,7 @@ def _reaches(solver: PositionSolver, curve: Curve, c: Crossing, rates, x, drawn)
 START = "the motion starts on it"
 
 
-def _local(solver: PositionSolver, c: Crossing) -> LocalAnalysis:
+def _local(solver, c: Crossing) -> LocalAnalysis:
     """The local analysis at the change point c, kept in the mechanism's cache by its configuration (to
     Tolerances.geometry): a motion through limit positions (``turn``) passes the same point again and again."""
     mech = solver.mech

@@ -38,6 +38,10 @@ from ...model.planar_graph import DyadPlan, plan
 from ...model.state import KinematicState
 from .batch_sweep import batch_closure
 from .continuation import CHANGE_REASON, LIMIT_REASON, at_change_point, locate, returned
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Jet", "ClosedFormSweep", "ClosedFormCurve", "planar_sweep", "cached_plan"]
 
@@ -50,17 +54,17 @@ class Jet:
 
     __slots__ = ("v", "d", "dd")
 
-    def __init__(self, v, d=0.0, dd=0.0):
+    def __init__(self, v, d: float=0.0, dd: float=0.0) -> None:
         self.v, self.d, self.dd = v, d, dd
 
-    def __add__(self, o):
+    def __add__(self, o) -> Jet:
         if isinstance(o, Jet):
             return Jet(self.v + o.v, self.d + o.d, self.dd + o.dd)
         return Jet(self.v + o, self.d, self.dd)
 
     __radd__ = __add__
 
-    def __neg__(self):
+    def __neg__(self) -> Jet:
         return Jet(-self.v, -self.d, -self.dd)
 
     def __sub__(self, o):
@@ -69,34 +73,34 @@ class Jet:
     def __rsub__(self, o):
         return (-self) + o
 
-    def __mul__(self, o):
+    def __mul__(self, o) -> Jet:
         if isinstance(o, Jet):
             return Jet(self.v * o.v, self.d * o.v + self.v * o.d, self.dd * o.v + 2 * self.d * o.d + self.v * o.dd)
         return Jet(self.v * o, self.d * o, self.dd * o)
 
     __rmul__ = __mul__
 
-    def inverse(self):
+    def inverse(self) -> Jet:
         f = 1.0 / self.v
         return Jet(f, -self.d * f * f, (2 * self.d * self.d * f - self.dd) * f * f)
 
     def __truediv__(self, o):
         return self * o.inverse() if isinstance(o, Jet) else self * (1.0 / o)
 
-    def sqrt(self):
+    def sqrt(self) -> Jet:
         f = np.sqrt(self.v)
         return Jet(f, self.d / (2 * f), self.dd / (2 * f) - self.d * self.d / (4 * f ** 3))
 
-    def cos(self):
+    def cos(self) -> Jet:
         c, s = np.cos(self.v), np.sin(self.v)
         return Jet(c, -s * self.d, -c * self.d * self.d - s * self.dd)
 
-    def sin(self):
+    def sin(self) -> Jet:
         c, s = np.cos(self.v), np.sin(self.v)
         return Jet(s, c * self.d, -s * self.d * self.d + c * self.dd)
 
     @staticmethod
-    def atan2(y, x):
+    def atan2(y, x) -> Jet:
         r2 = x.v * x.v + y.v * y.v
         num = x.v * y.d - y.v * x.d
         dr2 = 2 * (x.v * x.d + y.v * y.d)
@@ -108,13 +112,13 @@ class _Pose:
 
     __slots__ = ("th", "c", "s", "tx", "ty")
 
-    def __init__(self, th, tx, ty):
+    def __init__(self, th, tx, ty) -> None:
         self.th, self.c, self.s, self.tx, self.ty = th, th.cos(), th.sin(), tx, ty
 
-    def rotate(self, u):
+    def rotate(self, u) -> tuple:
         return self.c * u[0] - self.s * u[1], self.s * u[0] + self.c * u[1]
 
-    def __call__(self, p):
+    def __call__(self, p) -> tuple:
         x, y = self.rotate(p)
         return x + self.tx, y + self.ty
 
@@ -135,7 +139,7 @@ class _Geometry:
     coordinates, axis signs, the branch of each dyad (``probe``; without it ``branch`` is None:
     the caller chooses the branches, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech, p: DyadPlan, q0, probe: bool = True):
+    def __init__(self, mech: Mechanism, p: DyadPlan, q0: np.ndarray, probe: bool = True) -> None:
         state = KinematicState(mech, q0)
         axes, points = [], []  # per pair: (on the side of its first group, of its second)
         for pr in p.pairs:
@@ -180,20 +184,20 @@ class _Geometry:
                 return
             self.branch.append(float(np.sign(d)))
 
-    def point(self, i, g):
+    def point(self, i: int, g):
         """Pair i's point (plane coordinates at q0) on the link of group g."""
         return self._points[i][self.pairs[i].groups.index(g)]
 
-    def other(self, i, g):
+    def other(self, i: int, g):
         """Pair i's point on the link of its group other than g."""
         return self._points[i][1 - self.pairs[i].groups.index(g)]
 
-    def dir(self, i, g):
+    def dir(self, i: int, g):
         """Pair i's axis (a slide's direction, plane coordinates at q0) on the link of group g."""
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma, probe=False, clamp=False):
+def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma: float, probe: bool=False, clamp: bool=False):
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -252,7 +256,7 @@ def _root(disc, clamp):
         return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
 
 
-def _evaluate(geo, p: DyadPlan, xs, start, branch, clamp=None):
+def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp=None):
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
     clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
     Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
@@ -260,7 +264,7 @@ def _evaluate(geo, p: DyadPlan, xs, start, branch, clamp=None):
         return _evaluate_all(geo, p, xs, start, branch, clamp)
 
 
-def _evaluate_all(geo, p, xs, start, branch, clamp):
+def _evaluate_all(geo, p, xs: np.ndarray, start, branch: str, clamp) -> tuple:
     xs = np.asarray(xs, float)
     zero = Jet(np.zeros(len(xs)))
     poses = {p.groups[0]: _Pose(zero, zero, zero)}
@@ -289,7 +293,7 @@ def _evaluate_all(geo, p, xs, start, branch, clamp):
 class _Layout:
     """Where each tree joint's coordinate comes from: the groups of its two links, its kind."""
 
-    def __init__(self, mech, p: DyadPlan, geo, q0):
+    def __init__(self, mech: Mechanism, p: DyadPlan, geo, q0: np.ndarray) -> None:
         model = mech.model
         self.rows = []  # (idx_q, nq, idx_v, kind, parent group, child group, pair index or None)
         by_tree = {pr.tree: i for i, pr in enumerate(p.pairs) if pr.tree is not None}
@@ -300,7 +304,7 @@ class _Layout:
         self.geo, self.q0, self.nq, self.nv = geo, q0, model.nq, model.nv
         self.wrapped = [(iq, iv) for iq, nq, iv, kind, _, _, _ in self.rows if kind == "R" and nq == 1]
 
-    def __call__(self, poses, N):
+    def __call__(self, poses, N) -> tuple:
         """(Q (N, nq) with the one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2 (N, nv))."""
         geo, q0 = self.geo, self.q0
         Q = np.tile(q0, (N, 1))
@@ -336,13 +340,13 @@ class _Unwrap:
     _SAFE = np.pi / 2  # the largest turn between two samples taken as unambiguous [rad]
     _SLACK = 0.01  # relative slack of the bounds |s| dx on a monotone step
 
-    def __init__(self, wrapped):
+    def __init__(self, wrapped) -> None:
         self.cols = np.array([iq for iq, _ in wrapped], int)
         self._iv = np.array([iv for _, iv in wrapped], int)
         self.last = None  # (raw, slope, x, turns) of the last sample
         self.ambiguous = False
 
-    def __call__(self, Q, D, xs):
+    def __call__(self, Q: np.ndarray, D, xs: np.ndarray):
         """Q with its angles unwrapped; D (N, nv): dq/dx."""
         if not len(self.cols) or not len(xs):
             return Q
@@ -396,7 +400,7 @@ class ClosedFormSweep:
     unit: str
 
 
-def cached_plan(solver, name):
+def cached_plan(solver, name: str):
     """model.planar_graph.plan of the solver's mechanism swept along ``name`` with its other inputs
     held (a DyadPlan, or why not), kept in the mechanism's cache."""
     mech = solver.mech
@@ -412,7 +416,7 @@ class ClosedFormCurve:
     False (``reason`` why) when the geometry does not apply; probe=False: no branch is read off q0 (the
     caller passes its branch vectors, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech, p: DyadPlan, q0, start, probe: bool = True):
+    def __init__(self, mech: Mechanism, p: DyadPlan, q0: np.ndarray, start, probe: bool = True) -> None:
         self.mech, self.p, self.start = mech, p, start
         self.geo = _Geometry(mech, p, q0, probe)
         self.ok, self.reason = self.geo.ok, getattr(self.geo, "reason", None)
@@ -420,7 +424,7 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs, branch=None, clamp=None):
+    def predict(self, xs: np.ndarray, branch: str | None=None, clamp=None):
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
@@ -433,12 +437,12 @@ class ClosedFormCurve:
         bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(discs) else np.zeros(0, int)
         return int(bad[0]) if len(bad) else discs.shape[1]
 
-    def correct(self, poses, n):
+    def correct(self, poses, n: int):
         """The closed form is exact: the poses of the first n values as joint coordinates
         (Q with its one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2)."""
         return self.layout({g: _Pose(_take(q.th, n), _take(q.tx, n), _take(q.ty, n)) for g, q in poses.items()}, n)
 
-    def choose_branch(self, which):
+    def choose_branch(self, which) -> None:
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
@@ -447,7 +451,7 @@ class ClosedFormCurve:
         position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
         on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
 
-        def worst(x):
+        def worst(x) -> float:
             d = self.predict([x])[1][:, 0]
             return float(np.min(np.where(np.isnan(d), -1.0, d)))
 
@@ -460,7 +464,7 @@ class ClosedFormCurve:
         return x_lim, Q, D, which
 
 
-def _ready(solver, name, q0, start):
+def _ready(solver, name: str, q0: np.ndarray, start):
     """The ClosedFormCurve for sweeping ``name`` from q0, or None when the closed form does not apply."""
     p = cached_plan(solver, name)
     if isinstance(p, str):
@@ -469,7 +473,7 @@ def _ready(solver, name, q0, start):
     return curve if curve.ok else None
 
 
-def _residuals_ok(mech, Q) -> bool:
+def _residuals_ok(mech: Mechanism, Q: np.ndarray) -> bool:
     """Every configuration closes the loops within the closure tolerance (batched where it can be)."""
     tol = mech.tolerances.closure
     if not len(Q) or not mech.cuts:
@@ -502,7 +506,7 @@ def _next_values(start: float, stop: float, steps: int, h: float, k_pos: float, 
     return xs
 
 
-def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max_steps=None):
+def planar_sweep(solver, name: str, q0: np.ndarray, start, stop, steps: int, rate: float=1.0, turn: bool=False, max_steps: int | None=None) -> ClosedFormSweep | None:
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
     (two limits between grid values, a configuration not closing the loops)."""
@@ -585,5 +589,5 @@ def planar_sweep(solver, name, q0, start, stop, steps, rate=1.0, turn=False, max
     return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 
-def _take(j, n):
+def _take(j: int, n: int) -> Jet:
     return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))

@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["locate_singularities"]
 
@@ -35,7 +34,7 @@ def _matrix(mech: Mechanism, q: np.ndarray, kind: str, g: Generic, V_ref: np.nda
     return S.J @ V
 
 
-def locate_singularities(solver: PositionSolver, res: SweepResult, output: str | None=None, xtol: float = LOCATE_XTOL, point: bool = False) -> list:
+def locate_singularities(solver, res: SweepResult, output: str | None=None, xtol: float = LOCATE_XTOL, point: bool = False) -> list:
     """Singular input values along a sweep, each refined to about 1e-9 or better: the limit
     positions the sweep located, and the other singularities.
 

@@ -28,6 +28,10 @@ from .dyads import cached_plan, planar_sweep
 from ...model.limits import outside_limits
 from .tracker import Tracker
 from ..singular import scaled_jacobians
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
 
@@ -87,7 +91,7 @@ class SweepResult:
         return self.stopped_at is None and not self.skipped
 
 
-def sweep_inputs(mech, name: str, fixed) -> list:
+def sweep_inputs(mech: Mechanism, name: str, fixed) -> list:
     """The input joints of a motion of ``name`` with the joints ``fixed`` names held (a sweep's, the
     dynamics'): the actuated ones when ``name`` is one of them, else ``name`` and the held ones."""
     if name in mech.actuated:
@@ -164,7 +168,7 @@ REFINE = 8
 ON_GRID = 1e-6  # a value within this fraction of a fine step of a fine grid value is on that grid
 
 
-def _refined(f, start, h, k):
+def _refined(f, start, h, k: int):
     """The closed-form sweep ``f`` of a grid k times finer (step h / k) at the values of the grid of step h
     (and its located limit position, off both grids); None for None."""
     if f is None:
@@ -213,7 +217,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     return _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior)
 
 
-def _engine(solver, name, q0, start, stop, steps, fixed, rate, progress, turn, max_steps, closed_form, batch):
+def _engine(solver, name: str, q0: np.ndarray, start, stop, steps: int, fixed, rate, progress, turn, max_steps: int, closed_form, batch):
     """The SweepResult of the engine that applies (see ``sweep``), started from q0."""
     curve, requested = Curve(solver, name), (start, stop, steps)
     if closed_form:
@@ -236,7 +240,7 @@ def _engine(solver, name, q0, start, stop, steps, fixed, rate, progress, turn, m
     return _finish(solver, name, motion, rate, requested, turn, curve.unit)
 
 
-def _other_inputs(solver, name, steps, fixed) -> dict:
+def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
     """The other inputs' values (a copy of ``fixed``), once the arguments are checked."""
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -249,7 +253,7 @@ def _other_inputs(solver, name, steps, fixed) -> dict:
     return fixed
 
 
-def _start(solver, name, start, fixed, near, q_start):
+def _start(solver, name: str, start, fixed, near, q_start):
     """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
     may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
     drawing when it is solve's first mode there, else solve's first (near ``near``)."""
@@ -263,7 +267,7 @@ def _start(solver, name, start, fixed, near, q_start):
     return q0
 
 
-def _closed_form(solver, name, q0, start, stop, steps, rate, turn, max_steps):
+def _closed_form(solver, name: str, q0: np.ndarray, start, stop, steps: int, rate, turn, max_steps: int) -> SweepResult | None:
     """The SweepResult of the closed-form engine (analysis.motion.dyads; on a finer grid read at this
     one's values where this one is too coarse for it), or None where it does not apply."""
     f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
@@ -282,7 +286,7 @@ def _fallback(solver, curve, fixed):
     """The batched engine's fallback: the per-step tracker's Motion of n steps from qa (input xa) to xb,
     qa closed again at xa first (as a sweep started from it)."""
 
-    def fallback(qa, xa, xb, n):
+    def fallback(qa: np.ndarray, xa, xb, n: int):
         qa = solver.track({curve.name: xa, **fixed}, qa).q
         ta, why = _start_tangent(curve, qa, (xb - xa) / n)
         if ta is None:
@@ -292,7 +296,7 @@ def _fallback(solver, curve, fixed):
     return fallback
 
 
-def _trackable(mech, name, start, stop, steps):
+def _trackable(mech: Mechanism, name: str, start, stop, steps: int):
     """A range the per-step tracker takes more than MAX_TRACKED steps over (and more than its grid
     values) is a usage error naming the count."""
     needed = continuation_steps(mech, name, stop - start)
@@ -302,7 +306,7 @@ def _trackable(mech, name, start, stop, steps):
                          f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
 
 
-def _start_tangent(curve, q0, h):
+def _start_tangent(curve, q0: np.ndarray, h) -> tuple:
     """(the tangent at q0 oriented along the grid step h, None) or (None, why the input cannot move)."""
     try:
         return curve.along(q0, h), None
@@ -310,7 +314,7 @@ def _start_tangent(curve, q0, h):
         return None, str(exc)
 
 
-def _finish(solver, name, motion, rate, requested, turn, unit, method="tracker"):
+def _finish(solver, name: str, motion, rate, requested, turn, unit: str, method: str="tracker") -> SweepResult:
     """The SweepResult of an engine's Motion: rates and accelerations at each configuration."""
     X, Q = motion.X, motion.Q
     mech = solver.mech
@@ -341,7 +345,7 @@ def _finish(solver, name, motion, rate, requested, turn, unit, method="tracker")
 
 
 
-def _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior=None):
+def _through_change_points(solver, res, fixed, progress, max_steps: int, closed_form, batch, branch: str, prior=None):
     """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it
@@ -445,7 +449,7 @@ def _engine_took(solver, curve, res, k0, after, h) -> bool:
 GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index counts as on it
 
 
-def _change_point_note(solver, name, unit, cp, why, branch) -> str:
+def _change_point_note(solver, name: str, unit: str, cp, why, branch: str) -> str:
     """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
     # (located where the constraint measure is least: to about the square root of the closure's round-off)
     at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
@@ -470,7 +474,7 @@ def _change_point_note(solver, name, unit, cp, why, branch) -> str:
 _WORDS = {2: "two", 3: "three", 4: "four"}
 
 
-def _slice(res, n):
+def _slice(res, n: int):
     """The first n configurations of res (n >= 0), its limits before them."""
     xs = res.values[:n]
     lim = tuple(s for s in res.limits if n and _between(s.input, res.values[0], res.values[n - 1]))

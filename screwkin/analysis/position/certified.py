@@ -197,7 +197,7 @@ def _reference_check(solver, problem, got: Certified) -> Certified:
     return Certified(got.modes, count)
 
 
-def _rank(closure, rng) -> int:
+def _rank(closure, rng: np.random.Generator) -> int:
     """The generic rank of the closure rows' Jacobian (at random complex points of the variety)."""
     if closure.nt == 0 or closure.m == 0:
         return 0
@@ -289,7 +289,7 @@ def _classify(solver, problem, closure, system, group, roots, ends, known, secon
     return Certified([(q, a, n, None if simple else False) for _, q, a, n, simple in modes], count)
 
 
-def _coinciding(X, mask, group, tol) -> np.ndarray:
+def _coinciding(X: np.ndarray, mask, group, tol) -> np.ndarray:
     """(P,) where an endpoint of ``mask`` lies on another's orbit (two paths ended together)."""
     out = np.zeros(len(X), bool)
     idx = np.flatnonzero(mask)
@@ -320,7 +320,7 @@ def _lift(solver, problem, closure, x):
     return None
 
 
-def _best_twin(solver, problem, closure, elements, x):
+def _best_twin(solver, problem, closure, elements, x) -> tuple:
     """(q, Assembly) of the joint-angle set of this root to report: of its twins under the symmetry group
     (which place the links alike), the one within the joint limits nearest the reference configuration,
     polished on Pinocchio's closure."""

@@ -27,6 +27,10 @@ from ...model.state import KinematicState, angular_loop_joints, frame_parent
 from .certified import ModeCount
 from .pieper import BOUND, pieper, wrist_arm
 from .solution import PositionResult
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["closed_form_ik", "LISTED"]
 
@@ -50,14 +54,14 @@ def closed_form_ik(solver, output: str, pose):
     return None
 
 
-def _result(solver, output, pose, sols, count):
+def _result(solver, output, pose, sols, count: int) -> PositionResult:
     mech = solver.mech
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), 0, 0, (),
                           output, solver.angular_names(), solver._angular_coupled(), angular_loop_joints(mech),
                           modes=count)
 
 
-def _solution(solver, q, out_frame, residual, spelled=False):
+def _solution(solver, q: np.ndarray, out_frame, residual, spelled: bool=False):
     mech = solver.mech
     sol = solver.solution(q, Assembly(q, residual, 0), simple=True, spelled=spelled)
     if solver.output_frame == out_frame and sol.output_pose is not None:  # read there already
@@ -65,7 +69,7 @@ def _solution(solver, q, out_frame, residual, spelled=False):
     return replace(sol, output_pose=KinematicState(mech, sol.q).frame_pose(out_frame), simple=True)
 
 
-def _residual(mech, q, out_frame, pose) -> float:
+def _residual(mech: Mechanism, q: np.ndarray, out_frame, pose) -> float:
     """The loops' residual and the output frame's distance from the pose (m and rad together)."""
     loops = float(np.linalg.norm(mech.closure.residual(q))) if mech.cuts else 0.0
     at = KinematicState(mech, q).frame_pose(out_frame)

@@ -17,6 +17,10 @@ import numpy as np
 
 from ...errors import AssemblyError
 from ..singular import Generic, measures
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["CuspLoop", "Loop", "apart", "cusp_loops", "loop", "wedge_direction"]
 
@@ -27,7 +31,7 @@ JUMP = 0.05
 SAME = 1e-6
 
 
-def apart(mech, q1, q2) -> float:
+def apart(mech: Mechanism, q1: np.ndarray, q2: np.ndarray) -> float:
     """How far apart two configurations are: the norm of their difference, lengths over the
     characteristic length (rad and characteristic lengths) [-]."""
     d = mech.difference(q1, q2)
@@ -45,7 +49,7 @@ class Loop:
     why: str  # in words
 
 
-def loop(solver, x_name, y_name, fixed, centre, radius, q0, steps: int = 720, start: float = 0.0,
+def loop(solver, x_name: str, y_name: str, fixed, centre, radius, q0: np.ndarray, steps: int = 720, start: float = 0.0,
          turn: int = 1) -> Loop:
     """Follow q0 (at the angle ``start`` of the ellipse) once round the ellipse of the inputs with ``centre``
     and semi-axes ``radius``, counter-clockwise (turn 1) or clockwise (turn -1), in ``steps`` steps."""
@@ -97,7 +101,7 @@ class CuspLoop:
     loop: Loop
 
 
-def cusp_loops(solver, loci, x_name, y_name, fixed, box, size: float = 0.02, steps: int = 720) -> tuple:
+def cusp_loops(solver, loci, x_name: str, y_name: str, fixed, box, size: float = 0.02, steps: int = 720) -> tuple:
     """For each cusp of the actuator loci (analysis.singularities.loci.Loci): every mode at a point inside
     its wedge, followed once round the cusp each way on an ellipse of semi-axes ``size`` times the box's
     sides (``loop``).  Returns (CuspLoop of every regular loop that ends on another mode, loops tried)."""

@@ -24,6 +24,10 @@ from ...model.distances import chain_angles
 from ...model.homotopy.parameter import BOUND, Architecture, generic_set, to_query
 from ...model.state import KinematicState
 from ...tolerances import Tolerances
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["platform_modes"]
 
@@ -31,7 +35,7 @@ __all__ = ["platform_modes"]
 _MOVED = 1e-6
 
 
-def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol: Tolerances, lift_legs):
+def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol: Tolerances, lift_legs) -> tuple:
     """The modes of a platform (see the module): (modes [(q, Assembly, angle sets, simple)], found, real,
     complex, certificate or None, reason, detail, check) -- analysis.position.certified makes them a
     Certified.  ``lift_legs(x)``: the configuration with the eliminated legs' angles solved from the
@@ -91,7 +95,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol:
     return modes, len(distinct), len(modes), n_complex, certificate, "; ".join(why), detail, check
 
 
-def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
+def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs) -> tuple | None:
     """(q, Assembly) of the real pose x = (t / L, q) on the file's joints -- of its angle sets the one
     within the joint limits nearest the reference configuration -- or None."""
     model, L = problem.model, arch.L
@@ -111,7 +115,7 @@ def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
     names = {model.names[j] for j in (arch.carrier[0] + arch.carrier[1] if arch.carrier else ())}
     ref = problem.ref
 
-    def rank(q):
+    def rank(q: np.ndarray) -> tuple:
         outside = any(n in names for n in solver.outside(solver._wrap(q)))
         dist = float(np.linalg.norm(solver.mech.difference(ref, q))) if ref is not None else 0.0
         return (outside, dist)
@@ -128,18 +132,18 @@ def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs):
     return None
 
 
-def _wxyz(q):
+def _wxyz(q: np.ndarray):
     """pin.Quaternion's constructor order (w, x, y, z) from Pinocchio's coefficient order (x, y, z, w)."""
     q = np.asarray(q, float) / np.linalg.norm(q)
     return pin.Quaternion(q[3], q[0], q[1], q[2])
 
 
-def _same_pose(mech, q, arch, R, t) -> bool:
+def _same_pose(mech: Mechanism, q: np.ndarray, arch, R, t) -> bool:
     M = KinematicState(mech, q).joint_placement(arch.joint)
     return (np.abs(M.translation - t).max() <= _MOVED * arch.L and np.abs(M.rotation - R).max() <= _MOVED)
 
 
-def _carried(mech, problem, arch: Architecture, R, t) -> list:
+def _carried(mech: Mechanism, problem, arch: Architecture, R, t) -> list:
     """Configurations with the carrying leg's angles putting the platform's joint frame at (R, t)."""
     model = problem.model
     head, tail = arch.carrier
@@ -163,7 +167,7 @@ def _carried(mech, problem, arch: Architecture, R, t) -> list:
     return out
 
 
-def _set_angle(model, q, j, angle):
+def _set_angle(model: pin.Model, q: np.ndarray, j: int, angle) -> None:
     jm = model.joints[j]
     if jm.nq == 1:
         q[jm.idx_q] = angle

@@ -30,6 +30,10 @@ from .modes import choose_mode
 from .position import PositionSolver
 from ..singular import measures
 from ..motion.sweep import sweep
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Control", "LiveState", "Interactive", "MAX_STEP", "MAX_PATH"]
 
@@ -83,8 +87,8 @@ class Interactive:
     mode: the starting assembly mode (1-based, as solve lists them: analysis.position.modes.choose_mode);
     output: the output link whose pose is read out; points: analysis.motion.links.Point objects read out."""
 
-    def __init__(self, mech, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,
-                 points=()):
+    def __init__(self, mech: Mechanism, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,
+                 points=()) -> None:
         self.mech = mech
         self.solver = PositionSolver(mech, list(inputs) if inputs else None, output=output)
         self.inputs = tuple(self.solver.inputs)
@@ -123,7 +127,7 @@ class Interactive:
         self._record(self.state.inputs, self.state.points)
 
     # ------------------------------------------------------------------ traced paths
-    def _record(self, inputs, points):
+    def _record(self, inputs, points) -> None:
         if self.points:
             self._trace.append((dict(inputs), {n: np.array(p, float) for n, p in points.items()}))
 
@@ -139,12 +143,12 @@ class Interactive:
         """The input values (name -> value [rad or m]) at each position of :meth:`path`."""
         return [dict(inputs) for inputs, _ in self._trace]
 
-    def _positions(self, q) -> dict:
+    def _positions(self, q: np.ndarray) -> dict:
         return {n: np.asarray(p["position"], float)
                 for n, p in point_motions(KinematicState(self.mech, q), self.points).items()}
 
     # ------------------------------------------------------------------ controls
-    def _control(self, name, start) -> Control:
+    def _control(self, name: str, start) -> Control:
         mech = self.mech
         c = mech.coordinate(name)
         linear = bool(mech.translational[c.idx_v])
@@ -156,7 +160,7 @@ class Interactive:
             lo, hi = start - span, start + span  # no usable <limit>: a turn (or a characteristic length) around
         return Control(name, "m" if linear else "rad", lo, hi, float(start))
 
-    def control(self, name) -> Control:
+    def control(self, name: str) -> Control:
         found = next((c for c in self.controls if c.name == name), None)
         if found is None:
             raise UsageError(f"{self.mech.path}: '{name}' is not an input ({', '.join(self.inputs)})")
@@ -169,7 +173,7 @@ class Interactive:
             self._modes = [s.q for s in self.solver.solve(dict(self._values)).solutions]
         return self._modes
 
-    def _mode_of(self, q, modes) -> int:
+    def _mode_of(self, q: np.ndarray, modes) -> int:
         """The index (1-based) of the mode whose joint centres and cut-joint frames are where q's are
         (PositionSolver's signature: idle spins aside); 0 when none is."""
         c = self.solver.signature(q)
@@ -178,7 +182,7 @@ class Interactive:
         return k + 1 if k >= 0 and d[k] <= self.mech.tolerances.geometry * self.mech.length * math.sqrt(max(len(c), 1)) else 0
 
     # ------------------------------------------------------------------ state
-    def _state(self, q, mode=None) -> LiveState:
+    def _state(self, q: np.ndarray, mode=None) -> LiveState:
         mech = self.mech
         modes = self.modes()
         g = self.solver.generic()
@@ -191,7 +195,7 @@ class Interactive:
         return LiveState(np.array(q, float), dict(self._values), self._mode_of(q, modes) if mode is None else mode,
                          len(modes), sigma, sigma < mech.tolerances.singular, pose, points)
 
-    def _refused(self, message) -> LiveState:
+    def _refused(self, message: str) -> LiveState:
         self.state = replace(self.state, moved=False, message=message)
         return self.state
 

@@ -17,6 +17,10 @@ from ...errors import AssemblyError, UsageError
 from ...model.linalg import null_space, rank
 from ...model.state import KinematicState
 from ..singular import scaled_jacobians
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["merge", "moves", "connected", "ModeLabels", "choose_mode", "simple_root", "continuum_words"]
 
@@ -24,7 +28,7 @@ LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 def choose_mode(solver, values: dict, k: int | None = None, near: dict | None = None, starts: int = 24,
-                **options) -> tuple:
+                **options: Any) -> tuple:
     """The assembly mode a configuration is analysed in, or a motion starts from: the ``k``-th of
     ``solver.solve(values, near=near, **options)``'s solutions (default 1: the one nearest the reference
     configuration, or ``near``'s), as (q, k, n, result) with n the modes found and result solve's
@@ -82,7 +86,7 @@ def merge(solver, sols):
     return out
 
 
-def moves(solver, q, step: float = 1e-3) -> bool:
+def moves(solver, q: np.ndarray, step: float = 1e-3) -> bool:
     """Whether the mechanism can move a finite distance from q with the inputs held (a
     continuum), not only to first order (a double root): a step of ``step`` (dimensionless)
     along each direction the passive joints lost at q, closed again with the inputs frozen,
@@ -111,7 +115,7 @@ def moves(solver, q, step: float = 1e-3) -> bool:
     return False
 
 
-def connected(solver, q1, q2, pieces: int = 12) -> bool:
+def connected(solver, q1: np.ndarray, q2: np.ndarray, pieces: int = 12) -> bool:
     """Whether q2 is reached from q1 by a motion with the inputs held: a walk of small steps
     toward q2, each closed again with the inputs frozen, whose corrections stay small next
     to the step (between two distinct roots the correction pulls the walk back)."""
@@ -139,7 +143,7 @@ class ModeLabels:
     and the links that only translate, with their reference orientation), then read at each
     solution.  Nothing is labelled for mechanisms without loops or without a reference."""
 
-    def __init__(self, solver):
+    def __init__(self, solver) -> None:
         mech, model = solver.mech, solver.model
         self.mech, self.model = mech, model
         self.legs, self.turned = [], []
@@ -184,7 +188,7 @@ class ModeLabels:
         return float((p - state.joint_placement(self.model.parents[jid]).translation)
                      @ (state.joint_placement(jid).rotation @ axis))
 
-    def __call__(self, q, outside) -> tuple:
+    def __call__(self, q: np.ndarray, outside) -> tuple:
         """Why the solution at q is not reached by moving from the reference configuration."""
         labels = [f"outside the joint limits: {', '.join(outside)}"] if outside else []
         if not self.active:
@@ -203,7 +207,7 @@ class ModeLabels:
         return tuple(labels)
 
 
-def simple_root(solver, q, step: float = 1e-7) -> bool:
+def simple_root(solver, q: np.ndarray, step: float = 1e-7) -> bool:
     """Whether the closed configuration q is a simple root of the closure with the inputs held (isolated,
     its passive Jacobian of the generic rank however ill-conditioned): from q moved by ``step``
     (dimensionless) along the passive direction the Jacobian resolves worst, one undamped Newton step

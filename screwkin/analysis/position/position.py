@@ -51,6 +51,10 @@ from .turns import engaged, turn_on, whole_turns
 from ..motion.planar import LinkAngles, identify
 from .solution import NEWTON_FROM_FILE, PositionResult, Solution, TraceStep, search_method
 from ..singular import Generic, measures
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["PositionSolver"]
 
@@ -60,7 +64,7 @@ class PositionSolver:
     """Solves a mechanism for given input joints; reuses the model and data
     between calls (build once, solve many times)."""
 
-    def __init__(self, mech, input_joints=None, output=None, compiled: bool | None = None):
+    def __init__(self, mech: Mechanism, input_joints=None, output=None, compiled: bool | None = None) -> None:
         """compiled: True to solve the closure equations with the compiled kernels of
         screwkin.model.kernel.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
         joints are all fixed or spherical, False for numpy, None to leave the mechanism's
@@ -162,7 +166,7 @@ class PositionSolver:
     def _angular_coupled(self) -> tuple:
         return tuple(c.joint for c in self.mech.couplings if self.mech._revolute_like(c.joint))
 
-    def set_inputs(self, q, values: dict):
+    def set_inputs(self, q: np.ndarray, values: dict):
         """q with the named coordinates set: joint names of 1-DOF joints [rad or m], and the
         'joint[qk]' names that joint_values gives to the coordinates of multi-DOF joints."""
         q = np.array(q, float)
@@ -186,15 +190,15 @@ class PositionSolver:
                                  f"{name}[q0] ... {name}[q{c.nq - 1}]")
         return pin.normalize(self.model, q) if multi else q
 
-    def outside(self, q) -> tuple:
+    def outside(self, q: np.ndarray) -> tuple:
         """The joints of q outside the file's limits (outside_limits)."""
         return outside_limits(self.mech, q)
 
-    def joint_values(self, q) -> dict:
+    def joint_values(self, q: np.ndarray) -> dict:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
 
-    def _wrap(self, q):
+    def _wrap(self, q: np.ndarray):
         q = np.array(q, float)
         _, _, _, _, idx, wrap = self.mech._value_layout()
         w = idx[wrap]
@@ -202,7 +206,7 @@ class PositionSolver:
             q[w] = wrap_angle(q[w])
         return q
 
-    def signature(self, q):
+    def signature(self, q: np.ndarray) -> np.ndarray:
         """World positions of every joint centre (and the output pose): equal for
         configurations that differ only by idle spins."""
         pin.framesForwardKinematics(self.model, self.data, q)
@@ -219,7 +223,7 @@ class PositionSolver:
         return bool(np.max(np.abs(sig_a - sig_b), initial=0.0)
                     < self.mech.tolerances.geometry * max(self.mech.length, 1.0))
 
-    def _starts(self, count, seed):
+    def _starts(self, count: int, seed: int):
         """The reference configuration (when there is one), the file's configuration, and
         ``count`` random configurations within the joint limits."""
         rng = np.random.default_rng(seed)
@@ -255,7 +259,7 @@ class PositionSolver:
                           f"{'each is an input' if len(names) > 1 else 'it is an input'} that only its own value "
                           f"decides; give {'them' if len(names) > 1 else 'it'} with --set (the file's values: {hint})")
 
-    def track(self, values: dict, q) -> Assembly:
+    def track(self, values: dict, q: np.ndarray) -> Assembly:
         """The configuration that damped Newton reaches from the configuration ``q`` with the
         named inputs moved to ``values`` (inputs not named keep their values in q): the
         closed-loop forward kinematics of a control or simulation loop, in the assembly
@@ -421,7 +425,7 @@ class PositionSolver:
                            f"(the nearest these inputs allow; the joints --near does not name were free)")
         return tuple(out)
 
-    def distinct(self, system, starts, frozen=(), first_trace=None):
+    def distinct(self, system, starts: int, frozen=(), first_trace=None) -> tuple:
         """Solve ``system`` from every start; keep one solution per assembly mode.
 
         Returns ([(signature, q, Assembly)], smallest residual of the failures)."""
@@ -445,7 +449,7 @@ class PositionSolver:
         return found, best
 
     @staticmethod
-    def _describe(values):
+    def _describe(values) -> str:
         return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
 
     # --------------------------------------------------------------- one answer per mode
@@ -453,17 +457,17 @@ class PositionSolver:
         """Solutions that are one root merged (analysis.position.modes.merge)."""
         return modes.merge(self, sols)
 
-    def _distance(self, q1, q2):
+    def _distance(self, q1: np.ndarray, q2: np.ndarray) -> float:
         return float(np.linalg.norm(self.signature(q1) - self.signature(q2)))
 
-    def _labels(self, q, outside) -> tuple:
+    def _labels(self, q: np.ndarray, outside) -> tuple:
         """Why a solution is not reached by moving from the reference configuration
         (analysis.position.modes.ModeLabels)."""
         if self._labelling is None:
             self._labelling = modes.ModeLabels(self)
         return self._labelling(q, outside)
 
-    def _linkage(self, q):
+    def _linkage(self, q: np.ndarray):
         """A four-bar's or slider-crank's textbook construction at q (planar.identify), or None."""
         if len(self.inputs) != 1 or self._plane_normal() is None or len(self.mech.cuts) != 1:
             return None
@@ -475,7 +479,7 @@ class PositionSolver:
             self._link_angles(self.mech.neutral())
         return None if self._angles is None else self._angles.n
 
-    def _link_angles(self, q, state=None):
+    def _link_angles(self, q: np.ndarray, state=None):
         if self._angles is False:
             self._angles = None
             ref = self.reference()
@@ -486,7 +490,7 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None,
+    def solution(self, q: np.ndarray, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None,
                  spelled: bool = False) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
@@ -543,7 +547,7 @@ class PositionSolver:
             x[k] = values.get(name, 0.0)
         return x
 
-    def passive_solver(self, K):
+    def passive_solver(self, K: np.ndarray) -> tuple:
         """(solve, s): one SVD of the passive columns of K, reused for rates and accelerations.
         solve(b) is the minimum-norm least-squares x of K_p x = b (as numpy.linalg.lstsq);
         s are the singular values of K_p, largest first."""
@@ -555,7 +559,7 @@ class PositionSolver:
         U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
         return (lambda b: Vt.T @ (inv * (U.T @ b))), s
 
-    def rates(self, q, K, values: dict, solve=None):
+    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None):
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
         the passive joints, so idle spins are zero).  A link held at an angle (link_inputs)
         turns at the rate ``values`` gives its name (0 when none): its row's K q' is that rate.
@@ -567,7 +571,7 @@ class PositionSolver:
             qd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qd[self.frozen])
         return qd
 
-    def accelerations(self, q, K, qd, values: dict, solve=None):
+    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None):
         """Joint accelerations from K q'' = -K' q' with the input accelerations given (a held link's
         angular acceleration as its row's, as in ``rates``)."""
         qdd = np.zeros(self.mech.nv)

@@ -26,6 +26,10 @@ from ..position.position import PositionSolver
 from ...model.linalg import null_space, rank
 from ..singular import SingularityReport, scaled_jacobians
 from ...model.kernel.scaling import dimensionless
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Ellipsoid", "Ellipsoids", "ellipsoids_of", "ellipsoids", "with_input_output_condition"]
 
@@ -57,7 +61,7 @@ class Ellipsoids:
     point: bool = False
 
 
-def _axis_labels(d: int, linear: int):
+def _axis_labels(d: int, linear: int) -> tuple:
     lin = ("vx/L", "vy/L", "vz/L")[:linear]
     ang = ("wx", "wy", "wz")[: d - linear]
     flin = ("L fx", "L fy", "L fz")[:linear]
@@ -65,7 +69,7 @@ def _axis_labels(d: int, linear: int):
     return lin + ang, flin + fang
 
 
-def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point=False) -> Ellipsoids:
+def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point: bool=False) -> Ellipsoids:
     d = M.shape[0]
     U, s, _ = np.linalg.svd(M, full_matrices=True) if M.size else (np.eye(d), np.zeros(0), None)
     vel = np.zeros(d)
@@ -79,7 +83,7 @@ def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point=Fa
                       int(keep.sum()), output, point)
 
 
-def ellipsoids_of(J, length: float = 1.0, linear: int = 3, sliding=None, inputs=None,
+def ellipsoids_of(J: np.ndarray, length: float = 1.0, linear: int = 3, sliding=None, inputs=None,
                   tol: Tolerances = DEFAULT) -> Ellipsoids:
     """The ellipsoids of a Jacobian J (d x n) from input rates [rad/s, m/s] to an output twist
     whose first ``linear`` rows are linear velocities [m/s] (6 rows (v, w); 3 for a point:
@@ -96,7 +100,7 @@ def ellipsoids_of(J, length: float = 1.0, linear: int = 3, sliding=None, inputs=
     return _of_scaled(M, length, names, tol, linear)
 
 
-def ellipsoids(mech, q, output: str, inputs=None, point: bool = False, length: float | None = None) -> Ellipsoids:
+def ellipsoids(mech: Mechanism, q: np.ndarray, output: str, inputs=None, point: bool = False, length: float | None = None) -> Ellipsoids:
     """The velocity and force ellipsoids of link ``output``'s origin at the assembled
     configuration q (its twist (v, w) in world axes; ``point``: its velocity only).
 
@@ -129,7 +133,7 @@ def ellipsoids(mech, q, output: str, inputs=None, point: bool = False, length: f
     return _of_scaled(M, L, names, tol, 3, output, point)
 
 
-def with_input_output_condition(mech, q, rep: SingularityReport) -> SingularityReport:
+def with_input_output_condition(mech: Mechanism, q: np.ndarray, rep: SingularityReport) -> SingularityReport:
     """``rep`` (singular.classify at q) with the condition number of the map from the input rates to the output's
     twist: Merlet's for a parallel robot, of its Jacobian J (input rates -> twist), = that of J^-1 (twist -> leg
     rates), dimensionless as every measure here -- the twist (v/L, w) at the output frame's origin, a sliding
@@ -141,7 +145,7 @@ def with_input_output_condition(mech, q, rep: SingularityReport) -> SingularityR
     return replace(rep, condition_input_output=io, input_output_note=note)
 
 
-def _input_output_condition(mech, q, rep) -> tuple:
+def _input_output_condition(mech: Mechanism, q: np.ndarray, rep) -> tuple:
     tol = mech.tolerances
     if rep.output is None:
         return None, "give --output LINK, the moving platform"

@@ -45,6 +45,10 @@ from ...model.state import KinematicState
 from ..motion.continuation import locate, orient
 from .loci_seeds import crossings, refine_node, seed_configurations, sheets, unexplained_folds
 from ..singular import LWA, Generic
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
 
@@ -82,7 +86,7 @@ class Loci:
 class LocusSystem:
     """The augmented system F of one kind on S (see the module)."""
 
-    def __init__(self, mech, inputs, x_name, y_name, fixed, kind, output=None, point=False, generic=None):
+    def __init__(self, mech: Mechanism, inputs, x_name: str, y_name: str, fixed, kind: str, output=None, point: bool=False, generic=None) -> None:
         self.mech, self.kind, self.output, self.point = mech, kind, output, point
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)  # dq = scale * u: u dimensionless
@@ -98,14 +102,14 @@ class LocusSystem:
                                  for n in names], bool)
 
     # ----------------------------------------------------------------- pieces
-    def value(self, q, c) -> float:
+    def value(self, q: np.ndarray, c) -> float:
         """The coordinate's value [rad or m] (continuous joints: their unwrapped angle's atan2)."""
         return float(continuous_angle(q[None], c.idx_q)[0]) if c.nq == 2 else float(q[c.idx_q])
 
-    def xy(self, q) -> np.ndarray:
+    def xy(self, q: np.ndarray) -> np.ndarray:
         return np.array([self.value(q, self.cx), self.value(q, self.cy)])
 
-    def A(self, q) -> np.ndarray:
+    def A(self, q: np.ndarray) -> np.ndarray:
         """The kind's matrix at q, dimensionless (the scaling of singular.scaled_jacobians, without its
         null space: K's position rows over L, sliding columns times L)."""
         mech = self.mech
@@ -117,10 +121,10 @@ class LocusSystem:
         J = dimensionless_twists(KinematicState(mech, q).link_jacobian(self.output, LWA), mech.translational, self.L)
         return np.vstack([K, J[:3] if self.point else J])
 
-    def integrate(self, q, u) -> np.ndarray:
+    def integrate(self, q: np.ndarray, u) -> np.ndarray:
         return self.mech.closure.integrator(q[None], (self.scale * u)[None])[0]
 
-    def residual(self, q, v, A=None) -> np.ndarray:
+    def residual(self, q: np.ndarray, v, A=None) -> np.ndarray:
         mech = self.mech
         parts = []
         if mech.closure.nrows:
@@ -135,7 +139,7 @@ class LocusSystem:
         parts += [A @ v, [0.5 * (v @ v - 1.0)]]
         return np.concatenate(parts)
 
-    def jacobian(self, q, v, A=None) -> np.ndarray:
+    def jacobian(self, q: np.ndarray, v, A=None) -> np.ndarray:
         """dF/d(u, v) (rows of F, nv + columns of A); d(A v)/du by forward differences."""
         mech = self.mech
         A = self.A(q) if A is None else A
@@ -145,7 +149,7 @@ class LocusSystem:
             blocks.append(np.hstack([K, np.zeros((len(K), len(v)))]))
         return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
 
-    def _held_kind_norm_rows(self, q, v, A) -> list:
+    def _held_kind_norm_rows(self, q: np.ndarray, v, A) -> list:
         """The Jacobian's rows after the loops' (a section's too): the held inputs, d(A v)/d(u, v) (d/du by
         forward differences of step FD) and |v| = 1."""
         H = np.zeros((len(self.held), self.nv + len(v)))
@@ -159,7 +163,7 @@ class LocusSystem:
             D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / FD
         return [H, np.hstack([D, A]), np.concatenate([np.zeros(self.nv), v])[None]]
 
-    def relative(self, q, v=None) -> float:
+    def relative(self, q: np.ndarray, v=None) -> float:
         """|A v| / |A| (v: A's smallest right singular vector when None): the point's distance from the
         kind's singular condition, relative."""
         A = self.A(q)
@@ -168,14 +172,14 @@ class LocusSystem:
             return float(s[-1] / s[0]) if s[0] > 0 else 0.0
         return float(np.linalg.norm(A @ v) / s[0]) if s[0] > 0 else 0.0
 
-    def kernel(self, q) -> np.ndarray:
+    def kernel(self, q: np.ndarray) -> np.ndarray:
         return np.linalg.svd(self.A(q))[2][-1]
 
     def edge(self, axis: int, bound: float):
         """The extra row of ``newton`` that holds the plane's coordinate ``axis`` (0: x, 1: y) at ``bound``."""
         c = (self.cx, self.cy)[axis]
 
-        def row(qc, vc):
+        def row(qc, vc) -> tuple:
             r = np.zeros(self.nv + len(vc))
             r[c.idx_v] = 1.0
             return r[None], np.array([(bound - self.value(qc, c)) / self.scale[c.idx_v]])
@@ -183,7 +187,7 @@ class LocusSystem:
         return row
 
     # ------------------------------------------------------------ Newton, tangent
-    def newton(self, q, v, extra=None, iterations: int = 30, max_step: float = 0.3, J=None):
+    def newton(self, q: np.ndarray, v, extra=None, iterations: int = 30, max_step: float = 0.3, J: np.ndarray | None=None) -> tuple | None:
         """Newton (least squares, steps capped at max_step; the Jacobian kept while the residual falls
         fast: a chord step) on F, with ``extra`` rows (function (q, v) -> (rows, rhs), linear in the
         step): (q, v) converged (|F| < RESIDUAL), or None."""
@@ -212,39 +216,39 @@ class LocusSystem:
         F = self.residual(q, v)
         return (q, v) if float(np.linalg.norm(F)) < RESIDUAL else None
 
-    def tangent(self, q, v, previous=None, J=None) -> np.ndarray:
+    def tangent(self, q: np.ndarray, v, previous=None, J: np.ndarray | None=None) -> np.ndarray:
         """Unit null vector of dF in (u, v) (J: dF at (q, v) when already computed), oriented along ``previous``."""
         t = np.linalg.svd(self.jacobian(q, v) if J is None else J)[2][-1]
         return orient(t, previous)  # the continuation's one branch rule
 
-    def nullity_ok(self, q, v) -> bool:
+    def nullity_ok(self, q: np.ndarray, v) -> bool:
         s = np.linalg.svd(self.jacobian(q, v), compute_uv=False)
         return len(s) >= self.nv + len(v) - 1 and s[self.nv + len(v) - 2] > self.mech.tolerances.crossing_rank * s[0]
 
-    def projected(self, q, t) -> np.ndarray:
+    def projected(self, q: np.ndarray, t) -> np.ndarray:
         """The plane's velocity (dx, dy) [SI] along the tangent t of the curve."""
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q, v, t, h, J=None):
+    def along(self, q: np.ndarray, v, t, h, J: np.ndarray | None=None):
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q
 
-        def plane(qc, vc):
+        def plane(qc, vc) -> tuple:
             d = np.concatenate([self.mech.difference(q0, qc) / self.scale, vc - v])
             return t[None], np.array([h - t @ d])
 
         return self.newton(qp, vp, plane, iterations=8, max_step=max(h, 1e-3), J=J)
 
 
-def _in_box(p, box, margin=0.0):
+def _in_box(p, box, margin: float=0.0) -> bool:
     (x0, x1), (y0, y1) = box
     mx, my = margin * (x1 - x0), margin * (y1 - y0)
     return x0 - mx <= p[0] <= x1 + mx and y0 - my <= p[1] <= y1 + my
 
 
-def _trace_one_way(sys, q, v, box, direction):
+def _trace_one_way(sys, q: np.ndarray, v, box, direction) -> tuple:
     """Points from (q, v) along +-tangent until the box's edge, the start again, or MAX_POINTS.
     Returns (qs, vs, closed, truncated)."""
     J = sys.jacobian(q, v)
@@ -277,11 +281,11 @@ def _trace_one_way(sys, q, v, box, direction):
     return qs, vs, ts, False, True
 
 
-def _dist(sys, q1, q2) -> float:
+def _dist(sys, q1: np.ndarray, q2: np.ndarray) -> float:
     return float(np.linalg.norm(sys.mech.difference(q1, q2) / sys.scale))
 
 
-def _clip(sys, qs, vs, box):
+def _clip(sys, qs, vs, box) -> tuple:
     """The points in the box; an end outside is replaced by the curve's crossing of the box's edge
     (Newton with the coordinate held at the edge)."""
     out_q, out_v = list(qs), list(vs)
@@ -311,7 +315,7 @@ def _clip(sys, qs, vs, box):
     return out_q, out_v
 
 
-def _onto_edge(sys, q, v, box):
+def _onto_edge(sys, q: np.ndarray, v, box):
     """A locus point outside the box moved along the curve onto the box's edge: Newton on F with the
     coordinate outside held at the nearer bound (x, then y).  None when the curve does not reach it."""
     for axis in (0, 1):
@@ -341,7 +345,7 @@ def _cusps(sys, qs, vs, ts):
         ref = a / na
         cache = {}
 
-        def phi(s, ref=ref, a=a, q0=q0, v0=v0, t0=t0, cache=cache):
+        def phi(s, ref=ref, a=a, q0=q0, v0=v0, t0=t0, cache=cache) -> float:
             if s == 0:
                 return float(ref @ a)
             res = sys.along(q0, v0, t0, s)
@@ -370,8 +374,8 @@ def _cusps(sys, qs, vs, ts):
     return out
 
 
-def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, kinds=None, grid: int = 9,
-               starts=None) -> Loci:
+def trace_loci(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed, output=None, point: bool=False, kinds=None, grid: int = 9,
+               starts: int | None=None) -> Loci:
     """The singular loci of each kind in the box xs[0]..xs[-1] x ys[0]..ys[-1] (see the module).
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""
     mech = solver.mech
@@ -413,7 +417,7 @@ def trace_loci(solver, x_name, xs, y_name, ys, fixed, output=None, point=False, 
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
 
 
-def trace_kind(sys, kind, seeds, box, notes):
+def trace_kind(sys, kind: str, seeds, box, notes) -> tuple:
     """The curves of one kind (sys: a LocusSystem or one like it) from the configurations ``seeds``, each
     brought onto the locus by Newton (onto the box's edge when outside) unless near a curve already traced:
     (loci, cusps ((x, y), kind), their configurations, nodes ((x, y), kind)); notes gets what it left."""
@@ -479,7 +483,7 @@ def trace_kind(sys, kind, seeds, box, notes):
     return loci, cusps, cusp_q, nodes
 
 
-def _modes_in_box(solver, x_name, y_name, box, fixed):
+def _modes_in_box(solver, x_name: str, y_name: str, box, fixed) -> tuple[list, str]:
     """(configurations, in words): every mode the solver finds at the box's centre; where none assembles
     there, at the first of the other nodes of a 3 x 3 grid of the box that assembles."""
     (x0, x1), (y0, y1) = box
@@ -498,7 +502,7 @@ def _modes_in_box(solver, x_name, y_name, box, fixed):
     return [], "no assembly mode at the centre, corners or edge midpoints of the box"
 
 
-def _near(sys, q, Q) -> float:
+def _near(sys, q: np.ndarray, Q: np.ndarray) -> float:
     """The distance (dimensionless: lengths over L) from q to the nearest of the configurations Q, by
     their joint values (angles the short way round)."""
     rows = sys.mech.joint_value_rows(np.vstack([q[None], Q]))
@@ -508,7 +512,7 @@ def _near(sys, q, Q) -> float:
     return float(np.sqrt((D * D).sum(axis=1)).min())
 
 
-def _untraceable(mech, g, kind, output, inputs):
+def _untraceable(mech: Mechanism, g, kind: str, output, inputs) -> str | None:
     if kind == "actuator":
         if not mech.closure.nrows or not len(g.p):
             return "no loop, no passive joint"

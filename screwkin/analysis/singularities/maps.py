@@ -20,6 +20,10 @@ from ...errors import UsageError, quote, shorten
 from ..singular import Generic, measures
 from ..motion.continuation import Neighbour
 from ..position.connect import apart
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["SingularityMap", "singularity_map", "seams"]
 
@@ -43,7 +47,7 @@ class SingularityMap:
         return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
 
 
-def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, point: bool = False,
+def singularity_map(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed=None, output=None, point: bool = False,
                     q_start=None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
@@ -96,7 +100,7 @@ def singularity_map(solver, x_name, xs, y_name, ys, fixed=None, output=None, poi
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
 
 
-def seams(mech, qs, reached, step_x=None, step_y=None, xs=None, ys=None) -> np.ndarray:
+def seams(mech: Mechanism, qs, reached, step_x=None, step_y=None, xs: np.ndarray | None=None, ys: np.ndarray | None=None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
     characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and

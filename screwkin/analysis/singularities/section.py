@@ -21,6 +21,10 @@ from ...errors import UsageError
 from ...model.state import KinematicState
 from .loci import Loci, LocusSystem, trace_kind
 from ..singular import LWA
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 __all__ = ["Section", "SectionSystem", "trace_section"]
 
@@ -30,7 +34,7 @@ AXES = {"x": 0, "y": 1, "z": 2}
 class SectionSystem(LocusSystem):
     """The augmented system of the serial singularity of ``output``'s origin in a workspace section."""
 
-    def __init__(self, mech, output, x_axis, y_axis, level, fixed):  # (LocusSystem's own set-up is for inputs)
+    def __init__(self, mech: Mechanism, output, x_axis, y_axis, level, fixed) -> None:  # (LocusSystem's own set-up is for inputs)
         self.mech, self.kind, self.output, self.point = mech, "serial", output, True
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)
@@ -49,19 +53,19 @@ class SectionSystem(LocusSystem):
         self.angular = np.array([n in mech.coordinate_names and not mech.translational[mech.coordinate_names.index(n)]
                                  for n in names], bool)
 
-    def _pose(self, q):
+    def _pose(self, q: np.ndarray) -> tuple:
         st = KinematicState(self.mech, q)
         J = st.frame_jacobian(self.fid, LWA)[:3] * self.scale / self.L  # d(p / L)/du
         return st.frame_placement(self.fid).translation.copy(), J
 
-    def xy(self, q) -> np.ndarray:
+    def xy(self, q: np.ndarray) -> np.ndarray:
         p, _ = self._pose(q)
         return np.array([p[self.axes[0]], p[self.axes[1]]])
 
-    def A(self, q) -> np.ndarray:
+    def A(self, q: np.ndarray) -> np.ndarray:
         return self._pose(q)[1][:, self.free]
 
-    def residual(self, q, v, A=None) -> np.ndarray:
+    def residual(self, q: np.ndarray, v, A=None) -> np.ndarray:
         p, J = self._pose(q)
         A = J[:, self.free] if A is None else A
         held = []
@@ -70,18 +74,18 @@ class SectionSystem(LocusSystem):
             held.append(np.arctan2(np.sin(d), np.cos(d)) if not self.mech.translational[c.idx_v] else d / self.L)
         return np.concatenate([[(p[self.h] - self.level) / self.L], held, A @ v, [0.5 * (v @ v - 1.0)]])
 
-    def jacobian(self, q, v, A=None) -> np.ndarray:
+    def jacobian(self, q: np.ndarray, v, A=None) -> np.ndarray:
         _, J = self._pose(q)
         A = J[:, self.free] if A is None else A
         rows = [np.concatenate([J[self.h], np.zeros(len(v))])[None]]
         return np.vstack(rows + self._held_kind_norm_rows(q, v, A))
 
-    def projected(self, q, t) -> np.ndarray:
+    def projected(self, q: np.ndarray, t) -> np.ndarray:
         _, J = self._pose(q)
         return self.L * (J[list(self.axes)] @ t[:self.nv])
 
     def edge(self, axis: int, bound: float):
-        def row(qc, vc):
+        def row(qc, vc) -> tuple:
             p, J = self._pose(qc)
             return (np.concatenate([J[self.axes[axis]], np.zeros(len(vc))])[None],
                     np.array([(bound - p[self.axes[axis]]) / self.L]))
@@ -96,7 +100,7 @@ class Section:
     why: str
 
 
-def trace_section(mech, output, x_axis: str, xs, y_axis: str, ys, level: float = 0.0, fixed=None,
+def trace_section(mech: Mechanism, output, x_axis: str, xs: np.ndarray, y_axis: str, ys: np.ndarray, level: float = 0.0, fixed=None,
                   samples: int = 400, seed: int = 0) -> Section:
     """The serial singular curves of ``output``'s origin in the section (x_axis, y_axis) of its workspace, the
     third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes and

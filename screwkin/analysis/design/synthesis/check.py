@@ -41,6 +41,8 @@ from ...course.skeleton import numbering
 from ..targets import polished
 from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions
+if TYPE_CHECKING:
+    from screwkin.model.mechanism import Mechanism
 
 if TYPE_CHECKING:
     from ...motion.sweep import SweepResult
@@ -55,7 +57,7 @@ TWO_PI = 2 * math.pi
 class _Probe:
     """What the check reads off a configuration of the written four-bar."""
 
-    def __init__(self, mech, design: Design):
+    def __init__(self, mech: Mechanism, design: Design) -> None:
         self.mech = mech
         self.design = design
         self.out = mech.link_frame(design.output_link)
@@ -64,7 +66,7 @@ class _Probe:
         self.fB = mech.cuts[0].frame1 if mech.cuts else None
         self.linkage = None  # analysis.motion.planar.identify's LinkageInfo, set at the first position
 
-    def value(self, q):
+    def value(self, q: np.ndarray) -> tuple:
         M = KinematicState(self.mech, q).frame_placement(self.out)
         kind = self.design.targets[0].kind
         if kind == "pose":
@@ -73,7 +75,7 @@ class _Probe:
             return (float(M.translation[0]), float(M.translation[1]))
         return (float(math.atan2(M.rotation[1, 0], M.rotation[0, 0])),)
 
-    def error(self, q, target):
+    def error(self, q: np.ndarray, target) -> tuple:
         v = self.value(q)
         t = target.value
         if target.kind == "pose":
@@ -82,7 +84,7 @@ class _Probe:
             return math.hypot(v[0] - t[0], v[1] - t[1]), 0.0
         return abs(float(wrap_angle(v[0] - t[0], upper=True))), 0.0
 
-    def mus(self, Q) -> list:
+    def mus(self, Q: np.ndarray) -> list:
         """Transmission angles [rad] at the configurations Q (analysis.motion.planar.transmission_angles
         of the file's four-bar as identified at the first position); none when it was not
         identified (the check then says the angle was not measured)."""
@@ -90,12 +92,12 @@ class _Probe:
             return []
         return transmission_angles(self.mech, self.linkage, Q).tolist()
 
-    def pins(self, q):
+    def pins(self, q: np.ndarray) -> tuple:
         state = KinematicState(self.mech, q)
         return state.centre(("joint", self.jA))[:2], state.centre(("frame", self.fB))[:2]
 
 
-def _closed_form_error(design: Design, probe: _Probe, q, target) -> float:
+def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target) -> float:
     """Distance between the file's moving pivots (and guided frame) at q and the closed-form
     four-bar at the same crank angle, on the branch that is nearer."""
     fb = design.fourbar
@@ -172,7 +174,7 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
                  tuple(travel), tol, letters)
 
 
-def _locate(design, solver, probe, res, x, q_target):
+def _locate(design, solver, probe, res, x, q_target: np.ndarray) -> bool:
     """Whether the branch followed by sweep ``res`` is, at input value x, in the configuration
     q_target (the solution found for that precision position): same moving pivots."""
     if q_target is None:
