@@ -55,6 +55,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.loop_series import LoopSystem
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["Branch", "LocalAnalysis", "local_analysis", "KINDS", "quadratic_forms", "rates_of"]
 
@@ -127,7 +129,7 @@ class LocalAnalysis:
     notes: tuple = ()
 
 
-def rates_of(mech: Mechanism, x, scale) -> dict:
+def rates_of(mech: Mechanism, x: np.ndarray, scale: np.ndarray) -> dict:
     """The tree part of a dimensionless direction x as joint rates (sliding ones times L), shown with the
     first joint moving at least SHOWN_REFERENCE of the largest at rate 1."""
     v = np.asarray(x[:mech.nv], float) * scale[:mech.nv]
@@ -139,7 +141,7 @@ def rates_of(mech: Mechanism, x, scale) -> dict:
     return {n: float(r) for n, r in zip(names, v)}
 
 
-def quadratic_forms(system, N, U) -> np.ndarray:
+def quadratic_forms(system: LoopSystem, N: np.ndarray, U: np.ndarray) -> np.ndarray:
     """(c, d, d): the quadratic forms y -> U^T R_1(N y) of the second-order term, by polarization."""
     d, c = N.shape[1], U.shape[1]
     F = np.zeros((c, d, d))
@@ -163,14 +165,14 @@ class _Candidate:
     regular: bool  # the forms' Jacobian has full rank at its zeros (decided at order 2)
 
 
-def _orth(M, tol):
+def _orth(M: np.ndarray, tol: float) -> np.ndarray:
     if M.size == 0:
         return M.reshape(M.shape[0], 0)
     U, s, _ = np.linalg.svd(M, full_matrices=False)
     return U[:, s > tol * max(s[0], 1.0)] if s.size else M[:, :0]
 
 
-def _one_form(Q: np.ndarray, zero):
+def _one_form(Q: np.ndarray, zero) -> list:
     """The zero set of one quadratic form y^T Q y on R^d, as candidates."""
     lam, V = np.linalg.eigh(Q)
     pos, neg = V[:, lam > zero], V[:, lam < -zero]
@@ -201,7 +203,7 @@ def _one_form(Q: np.ndarray, zero):
     return [_Candidate(T, samples, False, True)]
 
 
-def _sampled_zeros(F, zero, starts: int, tol, seed: int=0):
+def _sampled_zeros(F: np.ndarray, zero, starts: int, tol: Tolerances, seed: int=0) -> list:
     """Common zeros of the forms F (c, d, d) on the unit sphere, refined by Gauss-Newton from
     ``starts`` directions, as candidates grouped by their tangent spaces."""
     c, d, _ = F.shape
@@ -239,7 +241,7 @@ def _sampled_zeros(F, zero, starts: int, tol, seed: int=0):
     return groups
 
 
-def _cone(F, zero, starts: int, tol):
+def _cone(F: np.ndarray, zero, starts: int, tol) -> list:
     """Candidates: the real zeros of the forms F (c2, d, d) (none identically zero)."""
     c, d, _ = F.shape
     if d == 1:
@@ -257,7 +259,7 @@ def _cone(F, zero, starts: int, tol):
     return _sampled_zeros(F, zero, starts, tol)
 
 
-def _continue(system, x, Ainv, N, U, order, tol, lookahead: bool=True) -> tuple:
+def _continue(system: LoopSystem, x: np.ndarray, Ainv: np.ndarray, N: np.ndarray, U: np.ndarray, order: int, tol: Tolerances, lookahead: bool=True) -> tuple:
     """Continue the series from X[0] = x to ``order``: each X[k] = -A^+ R_k + N y, y chosen (least
     squares) so that the next order's residual in coker K is least (0 without ``lookahead``).  Returns (the first order whose
     residual stays -- None when every order to ``order`` holds --, X coefficients, residuals)."""
@@ -305,7 +307,7 @@ class _HeldRows(ClosureKernel):
         return np.array([pin.integrate(self.mech.model, q, v * self.scale) for q, v in zip(Q, V)])
 
 
-def _confirm(mech: Mechanism, q0: np.ndarray, system, X: np.ndarray, B, h) -> tuple:
+def _confirm(mech: Mechanism, q0: np.ndarray, system: LoopSystem, X: np.ndarray, B: np.ndarray, h: float) -> tuple:
     """Close the loops again at a step h along the branch of tangent X[0] (dimensionless, column space)
     with tangent space B (tree part, orthonormal): Gauss-Newton from q0 + h x with B^T (q - q0) = h B^T x
     held.  Returns (configuration or None, its distance from q0 + h x -- O(h^2) on a branch --, residual)."""
@@ -323,7 +325,7 @@ def _confirm(mech: Mechanism, q0: np.ndarray, system, X: np.ndarray, B, h) -> tu
     return q, deviation, norm
 
 
-def local_analysis(mech: Mechanism, q: np.ndarray, inputs=None, generic_rank=None, progress=None) -> LocalAnalysis:
+def local_analysis(mech: Mechanism, q: np.ndarray, inputs=None, generic_rank: int | None=None, progress=None) -> LocalAnalysis:
     """The local analysis of ``mech`` at the assembled configuration q (see the module docstring);
     inputs: the joints held for ``inputs_held`` (default the actuated ones); generic_rank: the rank of
     K at generic configurations (default: the largest over mech.generic_configurations()); progress: a
@@ -445,7 +447,7 @@ def local_analysis(mech: Mechanism, q: np.ndarray, inputs=None, generic_rank=Non
     return _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled)
 
 
-def _at_most_samples(candidates, cap) -> tuple:
+def _at_most_samples(candidates: list, cap: int) -> tuple:
     """The candidates with at most ``cap`` samples each (an irreducible quadric cone on a kernel of dimension d
     has up to d^2 / 4 sampled generators, each continued at a cost growing with d: a 40-joint loop folded flat
     has 361), spread evenly over the list and always its first; and the note that says so (None when
@@ -465,7 +467,7 @@ def _at_most_samples(candidates, cap) -> tuple:
                  f"at most {cap} a tangent space: Tolerances.local_samples, mobility --local-samples N raises it)")
 
 
-def _mixes(d, count: int=2, seed: int=0) -> list:
+def _mixes(d: int, count: int=2, seed: int=0) -> list:
     """A few fixed random unit directions in R^d (more directions checked than the basis)."""
     if d < 2:
         return []
@@ -473,7 +475,7 @@ def _mixes(d, count: int=2, seed: int=0) -> list:
     return [v / np.linalg.norm(v) for v in rng.normal(size=(count, d))]
 
 
-def _branch(mech: Mechanism, q: np.ndarray, system, N, cand, X: np.ndarray, order) -> Branch:
+def _branch(mech: Mechanism, q: np.ndarray, system: LoopSystem, N: np.ndarray, cand: _Candidate, X: np.ndarray, order: int) -> Branch:
     tol = mech.tolerances
     nv = mech.nv
     T = N @ cand.T
@@ -487,7 +489,7 @@ def _branch(mech: Mechanism, q: np.ndarray, system, N, cand, X: np.ndarray, orde
                   confirmed, float(tol.local_step), deviation, residual)
 
 
-def _decide(base, branches, failed, c2, c0, candidates, order_max, notes, d, sampled) -> LocalAnalysis:
+def _decide(base: dict, branches: list, failed: list, c2: int, c0: int, candidates: list, order_max: int, notes: list, d: int, sampled: int) -> LocalAnalysis:
     """The kind, finite mobility, order and words from the surviving branches (``sampled``: the number of
     starting directions the quadratic cone's zeros were searched from, 0 where they are found exactly)."""
     notes = list(notes)

@@ -51,6 +51,7 @@ from .screws import cut_twists
 
 if TYPE_CHECKING:
     from ..model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
 
 __all__ = ["LoopSystem", "Series", "loop_system", "ad", "split", "subalgebra", "BODY_JOINTS", "SEQUENTIAL_JOINTS"]
 
@@ -60,7 +61,7 @@ BODY_JOINTS = ("JointModelSpherical", "JointModelFreeFlyer", "JointModelPlanar",
 SEQUENTIAL_JOINTS = ("JointModelUniversal", "JointModelSphericalZYX")
 
 
-def ad(W, S) -> np.ndarray:
+def ad(W: np.ndarray, S: np.ndarray) -> np.ndarray:
     """ad_W S for twists (v, w) in the last axis of W and S (arrays (..., 6))."""
     vW, wW, vS, wS = W[..., :3], W[..., 3:], S[..., :3], S[..., 3:]
     return np.concatenate([cross_last(wW, vS) + cross_last(vW, wS), cross_last(wW, wS)], axis=-1)
@@ -112,7 +113,7 @@ class LoopSystem:
     def columns(self) -> int:
         return len(self.names)
 
-    def stack(self, P) -> np.ndarray:
+    def stack(self, P: np.ndarray) -> np.ndarray:
         """The constraint rows of P (units, 6): each cut's sum of sigma P in its algebra."""
         blocks = [E @ (s @ P) for E, s in zip(self.basis, self.sigma)]
         return np.concatenate(blocks) if blocks else np.zeros(0)
@@ -127,7 +128,7 @@ class LoopSystem:
             A[:, k] = self.coupled(self.stack(self.screws * y[:, None]), np.eye(n)[k])
         return A
 
-    def coupled(self, loops, x) -> np.ndarray:
+    def coupled(self, loops: np.ndarray, x: np.ndarray) -> np.ndarray:
         """The loop rows followed by the coupling rows of the column rates x (and, for A only, the
         contacts' first-order rows)."""
         out = np.concatenate([loops, self.couplings @ x]) if len(self.couplings) else loops
@@ -138,20 +139,20 @@ class Series:
     """The Taylor coefficients of a motion's column rates X[0], X[1], ... and of the units' screws
     along it; ``residual()`` is R_k for the next order k (Phi[k] with X[k] = 0)."""
 
-    def __init__(self, system: LoopSystem, x0) -> None:
+    def __init__(self, system: LoopSystem, x0: np.ndarray) -> None:
         self.sys = system
         self.X = [np.asarray(x0, float)]
         self.S = [system.screws]
         self.P = []  # P[m] (units, 6): sum_l S[l] y[m-l], up to the order pushed
 
-    def _y(self, k: int):
+    def _y(self, k: int) -> np.ndarray:
         return self.sys.multiplier * self.X[k][self.sys.column]
 
-    def _p(self, m, with_last: bool=True):
+    def _p(self, m: int, with_last: bool=True) -> np.ndarray:
         terms = [self.S[l] * self._y(m - l)[:, None] for l in range(m + 1) if with_last or l > 0]
         return np.sum(terms, axis=0) if terms else np.zeros_like(self.sys.screws)
 
-    def _next_screws(self):
+    def _next_screws(self) -> np.ndarray:
         """S[k] for k = len(self.S), from X[0..k-1]."""
         k = len(self.S)
         while len(self.P) < k:
@@ -183,7 +184,7 @@ class Series:
         zero = np.zeros(sys_.columns)
         return np.stack([sys_.coupled(sys_.stack(d), zero) for d in D], axis=1)
 
-    def push(self, xk) -> None:
+    def push(self, xk: np.ndarray) -> None:
         """Take X[k] = xk for the next order k."""
         if len(self.S) <= len(self.X):
             self.S.append(self._next_screws())
@@ -195,7 +196,7 @@ class Series:
         return other
 
 
-def _units(mech: Mechanism, state) -> tuple:
+def _units(mech: Mechanism, state: KinematicState) -> tuple:
     """Every unit of the tree: (screw (v, w) at the world origin, column, multiplier), the carriers
     of each (a set of unit indices), the units of each joint, and a note when a joint has no closed
     form here.  A Pinocchio mimic joint is a unit of its primary's column (its motion subspace holds
@@ -222,7 +223,7 @@ def _units(mech: Mechanism, state) -> tuple:
     return units, carriers, by_joint, note
 
 
-def subalgebra(screws, tol) -> tuple:
+def subalgebra(screws: np.ndarray, tol: float) -> tuple:
     """("se(2)", normal) when every screw (v, w) lies in the planar motions normal to one direction,
     ("so(3)", point) when every one is a rotation about one point, else ("se(3)", None)."""
     rot = [s for s in screws if np.linalg.norm(s[3:]) > tol]
@@ -241,7 +242,7 @@ def subalgebra(screws, tol) -> tuple:
     return "se(3)", None
 
 
-def split(kind: str, where: str, S) -> tuple:
+def split(kind: str, where: str, S: np.ndarray) -> tuple:
     """(the part of twists S (..., 6) in the algebra, the part in its complement m): se(2) normal to
     n: (v - (v.n) n, (w.n) n) and ((v.n) n, w - (w.n) n); so(3) about p: (p x w, w) and (v - p x w, 0).
     m is invariant under the algebra's brackets, so motions of units in the algebra stay in it."""
@@ -267,7 +268,7 @@ def coordinates(kind: str, where: str) -> np.ndarray:
     return np.eye(6)
 
 
-def _cut_units(mech: Mechanism, cut, state, kind: str, where: str, L):
+def _cut_units(mech: Mechanism, cut: CutJoint, state: KinematicState, kind: str, where: str, L: float) -> list:
     """The cut joint's freedoms as world twists [(name, twist, sliding)] (screws.cut_twists); a ball's
     three rotations about axes that put the algebra's own rotation last (e1, e2, n in a plane)."""
     # a sliding contact closes through a planar cut joint (its contact row apart); a rolling, gear or screw

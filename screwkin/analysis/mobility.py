@@ -110,7 +110,7 @@ class MobilityResult:
         return self.topology.motion_space
 
 
-def _body_frames(mech: Mechanism, topo):
+def _body_frames(mech: Mechanism, topo: Topology) -> dict:
     """One body frame per link of the topology (not the ground)."""
     frames = {}
     for link in topo.links:
@@ -120,7 +120,7 @@ def _body_frames(mech: Mechanism, topo):
     return frames
 
 
-def _joint_geometry_rows(mech: Mechanism, topo, frames, jac, state):
+def _joint_geometry_rows(mech: Mechanism, topo: Topology, frames: dict, jac: dict, state: KinematicState) -> list:
     """Rows whose null space is the set of motions keeping every joint's geometry still.
 
     For each joint and each of its two links: the velocity (seen from that link)
@@ -171,7 +171,7 @@ def _joint_geometry_rows(mech: Mechanism, topo, frames, jac, state):
     return rows
 
 
-def _idle(mech: Mechanism, topo, frames, q: np.ndarray, V, output_link, tol) -> tuple:
+def _idle(mech: Mechanism, topo: Topology, frames: dict, q: np.ndarray, V: np.ndarray, output_link: str | None, tol: Tolerances) -> tuple:
     """Idle motions: motions that change no joint's geometry.
 
     Links joined to the rest by a single joint (free tips such as a serial
@@ -207,7 +207,7 @@ def _idle(mech: Mechanism, topo, frames, q: np.ndarray, V, output_link, tol) -> 
     return idle, I.shape[1], I
 
 
-def _point_motion(link: str, T, tol) -> OutputMotion:
+def _point_motion(link: str, T, tol: Tolerances) -> OutputMotion:
     """What the origin of a link can do as a point: the rank of its velocities."""
     dim = rank(T[:3], tol)
     if dim == 0:
@@ -216,7 +216,7 @@ def _point_motion(link: str, T, tol) -> OutputMotion:
     return OutputMotion(link, dim, dim, 0, f"{dim}T", None, tuple(tuple(c) for c in U[:, :dim].T), True)
 
 
-def _output_motion(link: str, T, tol, origin) -> OutputMotion:
+def _output_motion(link: str, T: np.ndarray, tol: Tolerances, origin: np.ndarray) -> OutputMotion:
     dim = rank(T, tol)
     if dim == 0:
         return OutputMotion(link, 0, 0, 0, "0 (immobile)", None, ())
@@ -247,7 +247,7 @@ def _output_motion(link: str, T, tol, origin) -> OutputMotion:
     return OutputMotion(link, dim, t, r, label, center, tuple(tuple(col) for col in basis.T))
 
 
-def _classification(n: int, m, eff, overconstraint, topo, M) -> tuple:
+def _classification(n: int, m: int, eff: int, overconstraint: int, topo: Topology, M: int) -> tuple:
     """The classification and notes; a structure (no effective DOF) is statically determinate
     or not in its detected motion space: a planar triangle is determinate in the plane
     (Gruebler 0 = M), although 3 of its 5 spatial constraint rows are redundant."""
@@ -294,7 +294,7 @@ def _classification(n: int, m, eff, overconstraint, topo, M) -> tuple:
     return kind, tuple(notes)
 
 
-def analyze_mobility(mech: Mechanism, output=None, seed: int = 0, point: bool = False, at=None,
+def analyze_mobility(mech: Mechanism, output: str | None=None, seed: int = 0, point: bool = False, at=None,
                      suggest: bool = False, names: bool = False, progress=None) -> MobilityResult:
     """Mobility of ``mech`` (see the module docstring); output names a link, point analyses
     its origin as a point (3 translations) instead of its full motion.  The mobility reported is the
@@ -310,7 +310,7 @@ def analyze_mobility(mech: Mechanism, output=None, seed: int = 0, point: bool = 
     return mech.cache[key]
 
 
-def _local_notes(local, where: str, M_generic, generic_rank, samples) -> tuple:
+def _local_notes(local: LocalAnalysis, where: str, M_generic: int, generic_rank: int, samples: int) -> tuple:
     """Why the mobility reported (the local analysis' finite mobility at ``where``) is not the generic one."""
     if local.finite_mobility is None or local.finite_mobility == M_generic:
         return ()

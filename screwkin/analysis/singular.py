@@ -41,6 +41,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.cuts import CutJoint
+    from screwkin.tolerances import Tolerances
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
@@ -169,7 +171,7 @@ def _measures(S: Scaled, g: Generic) -> dict:
     return out
 
 
-def classify(mech: Mechanism, q: np.ndarray, inputs=None, output=None, length=None, generic=None, point: bool = False) -> SingularityReport:
+def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=None, length=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:
     """Classify the configuration q (assembled) for the given inputs and output link.
     length: the characteristic length [m] (default ``mech.length``); point: the output
     link's origin as a point (its 3 translations) instead of its full motion."""
@@ -305,7 +307,7 @@ class GramLoop:
 STATIONARY = DEFAULT.stationary
 
 
-def loop_twists(mech: Mechanism, q: np.ndarray, cut, length=None) -> tuple:
+def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length=None) -> tuple:
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
     says why) when the loop has a higher pair or a joint without one twist per coordinate."""
@@ -360,7 +362,7 @@ def _pair_axis(mech: Mechanism, cut, state) -> tuple:
     return (spec, f1, f2, *pair_contact(spec, M1, state.frame_placement(f2)))
 
 
-def pair_twist(mech: Mechanism, cut, state) -> list:
+def pair_twist(mech: Mechanism, cut, state: KinematicState) -> list:
     """[(name, twist, False)]: the pair closed by ``cut`` as one twist (v at the world origin, w) at a
     unit rate of turning of F2's link relative to F1's.  A rolling or gear pair: a revolute about
     its axis through the contact point (model.cuts.pair_contact; pure rolling is that rotation);
@@ -403,7 +405,7 @@ def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
     return tuple(out)
 
 
-def lost_direction(JV, out_dim: int, normal=None) -> np.ndarray:
+def lost_direction(JV: np.ndarray, out_dim: int, normal=None) -> np.ndarray:
     """The output direction lost at a serial singularity, as a unit (6,) twist (v, w) in the rows' scaled
     coordinates (a point's output: v only, w zero): the left singular vector of the output's motion map
     JV (rows (v, w) or v, columns the mechanism's motions) for its ``out_dim``-th singular value, the one
@@ -428,7 +430,7 @@ def lost_direction(JV, out_dim: int, normal=None) -> np.ndarray:
     return out
 
 
-def _motion_twist(kind: str, x, names, J: np.ndarray, tol) -> SingularTwist:
+def _motion_twist(kind: str, x, names, J: np.ndarray, tol: Tolerances) -> SingularTwist:
     """The motion x (any length) as a SingularTwist: its rates (those not zero next to the unit
     vector: above Tolerances.equal), its twist and screw (none for a zero twist)."""
     x = x / np.linalg.norm(x)

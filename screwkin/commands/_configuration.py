@@ -66,7 +66,7 @@ def add_branch_option(sp: argparse.ArgumentParser, what: str = "the motion") -> 
                          "default: the parallelogram stays a parallelogram) or along the other one (other)")
 
 
-def input_solver(mech: Mechanism, inputs: dict | list, held: dict | None = None, output=None) -> PositionSolver:
+def input_solver(mech: Mechanism, inputs: dict | list, held: dict | None = None, output: str | None=None) -> PositionSolver:
     """The PositionSolver of these input joints (names, or split_inputs' values: their keys), with the
     ``held`` links' angles held by their loop equations (a copy of the mechanism:
     analysis.motion.link_inputs.holding_angles); none held, the plain solver of ``mech``."""

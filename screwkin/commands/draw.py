@@ -114,7 +114,7 @@ def _suffixed(path, k: int) -> str:
     return f"{stem}-singular-{k}{ext}"
 
 
-def _traces(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, input_names, given, skel) -> dict:
+def _traces(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, input_names: list, given: dict, skel) -> dict:
     """--trace NAME: name -> (the point's path in the drawing's plane (N, 2) [m], where the input stopped)."""
     if not args.trace:
         return {}

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -30,7 +31,7 @@ NAME = "dynamics"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="input efforts, joint reactions, shaking forces and flywheel at constant input speed")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint driven at constant speed")
@@ -69,7 +70,7 @@ def _gravity(text: str) -> tuple:
     return tuple(parse_value(p, "linear acceleration", "--gravity") for p in parts)
 
 
-def _loads(mech: Mechanism, items, points) -> tuple:
+def _loads(mech: Mechanism, items: list | None, points: tuple) -> tuple:
     by_name = {p.name: p for p in points}
     out = []
     for text in items or []:

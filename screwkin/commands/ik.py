@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from screwkin.analysis.position.solution import PositionResult
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -97,7 +98,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _closed_text(mech: Mechanism, res, count: int) -> str:
+def _closed_text(mech: Mechanism, res: PositionResult, count: int) -> str:
     """The search line of a closed-form answer (analysis.position.closed_ik), and for a platform whose
     combinations are not all listed each leg's other branch beside the first solution."""
     c = res.modes

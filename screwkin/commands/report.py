@@ -339,7 +339,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
+def _input_rates_text(mech: Mechanism, typed: dict, rates: dict) -> str:
     """The input rates as typed (``crank_joint = 10 rpm (1.0472 rad/s)``; ``typed``: joint_quantities of
     --rate), or the default 1 in SI."""
     si = {n: "m/s" if value_kind(mech, n) == "length" else "rad/s" for n in rates}
@@ -355,7 +355,7 @@ def _input_rates_text(mech: Mechanism, typed: dict, rates) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, values, names, notes, data, held=None):
+def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np.ndarray, values: dict, names, notes, data, held=None) -> Section:
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
@@ -393,7 +393,7 @@ def _newton(mech: Mechanism, args: argparse.Namespace, loops, q: np.ndarray, val
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates=None):
+def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates: dict | None = None) -> list:
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -453,7 +453,7 @@ def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray
     return out
 
 
-def _view(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, data):
+def _view(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, data) -> Section:
     if args.no_view:
         return view_section(None, "the view is left out (--no-view)")
     if chromium() is None:

@@ -44,12 +44,10 @@ from ._output_frame import named_points
 from ._values import check_rate_names, joint_quantities, joint_value, names_list, rate_items, split_inputs
 from ._options import BOUNDS, count
 if TYPE_CHECKING:
-    pass
-
-if TYPE_CHECKING:
     from ..analysis.position.position import PositionSolver
     from ..analysis.motion.sweep import SweepResult
     from ..model.mechanism import Mechanism
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -57,7 +55,7 @@ NAME = "sweep"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint to move")
@@ -93,7 +91,7 @@ def add_parser(sub, common, scaled) -> None:
     scaled(sp)
 
 
-def _steps(text: str):
+def _steps(text: str) -> int:
     """--steps: within BOUNDS["steps"], or BOUNDS["streamed_steps"] for a streamed sweep (checked again in run)."""
     lo, hi = BOUNDS["steps"]
     try:
@@ -176,7 +174,7 @@ def _rates_line(args: argparse.Namespace) -> str:
             "another speed), at a constant input rate")
 
 
-def _rows_option(text: str):
+def _rows_option(text: str) -> str | None:
     if text is None or text.strip().lower() == "all":
         return None if text is None else "all"
     try:

@@ -64,7 +64,7 @@ _PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor
 
 
 class _Reader:
-    def __init__(self, path, root) -> None:
+    def __init__(self, path: Path, root) -> None:
         self.path, self.root = path, root
         self.problems = Problems()
         self.warnings = []
@@ -97,7 +97,7 @@ class _Reader:
             self._default(d, "main", {})
 
     # ---- defaults -------------------------------------------------------------------------
-    def _default(self, elem, name: str, inherited) -> None:
+    def _default(self, elem, name: str, inherited: dict) -> None:
         own = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in elem:
             if child.tag == "default":
@@ -111,7 +111,7 @@ class _Reader:
                 continue
             self._default(child, child.get("class"), own)
 
-    def attrs(self, elem, cls):
+    def attrs(self, elem, cls) -> dict:
         """The element's attributes over those of its default class."""
         cls = elem.get("class", cls)
         if cls not in self.defaults and cls != "main":
@@ -120,7 +120,7 @@ class _Reader:
         out.update(elem.attrib)
         return out
 
-    def actuator_attrs(self, elem):
+    def actuator_attrs(self, elem) -> dict:
         """An actuator's attributes over its class's: MuJoCo's actuator shortcuts share one default."""
         cls = elem.get("class", "main")
         if cls not in self.defaults and cls != "main":
@@ -132,13 +132,13 @@ class _Reader:
         return out
 
     # ---- numbers and frames ---------------------------------------------------------------
-    def vec(self, text: str, n: int, what: str, default, bound=LIMITS.length, unit: str="m") -> np.ndarray:
+    def vec(self, text: str, n: int, what: str, default: tuple, bound: float=LIMITS.length, unit: str="m") -> np.ndarray:
         return np.array(numbers(text, n, what, self.problems, default, bound, unit), float)
 
-    def angle(self, value):
+    def angle(self, value: float) -> float:
         return math.radians(value) if self.degree else value
 
-    def rotation(self, a, what: str) -> np.ndarray:
+    def rotation(self, a: dict, what: str) -> np.ndarray:
         given = [k for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis") if a.get(k) is not None]
         if len(given) > 1:
             self.problems.append(f"{what} gives more than one orientation ({', '.join(given)})")
@@ -177,7 +177,7 @@ class _Reader:
         return _z_to(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
                                self.problems, (0.0, 0.0, 1.0)))
 
-    def content(self, elem, cls):
+    def content(self, elem, cls) -> list:
         """(child, T, class) of every child of a body (or <worldbody>) with its <frame>s opened: T the
         frames' placement in the body, class the frames' childclass over ``cls``."""
         out = []
@@ -194,7 +194,7 @@ class _Reader:
         walk(elem, pin.SE3.Identity(), cls, 0)
         return out
 
-    def frame(self, a, what: str) -> pin.SE3:
+    def frame(self, a: dict, what: str) -> pin.SE3:
         return pin.SE3(self.rotation(a, what), self.vec(a.get("pos"), 3, f"{what} pos", (0, 0, 0)))
 
 
@@ -498,13 +498,13 @@ def read_mjcf(path: str | Path, text: str, root: Element | None = None,
                          reference=tree.reference)
 
 
-def _inertia_xml(com, mass, I) -> str:
+def _inertia_xml(com: np.ndarray, mass: float, I: np.ndarray) -> str:
     return (f"<inertial><origin xyz=\"{vector_text(*com)}\" rpy=\"0 0 0\"/><mass value=\"{mass:.17g}\"/><inertia "
             f"ixx=\"{I[0, 0]:.17g}\" iyy=\"{I[1, 1]:.17g}\" izz=\"{I[2, 2]:.17g}\" ixy=\"{I[0, 1]:.17g}\" "
             f"ixz=\"{I[0, 2]:.17g}\" iyz=\"{I[1, 2]:.17g}\"/></inertial>")
 
 
-def _geom_inertial(r, geoms, what: str) -> tuple:
+def _geom_inertial(r: _Reader, geoms: list, what: str) -> tuple:
     """(mass, URDF <inertial>, has meshes) of a body from its geoms, as MuJoCo computes them
     (screwkin.files.mjcf_inertia)."""
     p = r.problems
@@ -574,7 +574,7 @@ def _z_to(d) -> np.ndarray:
     return pin.exp3(c / s * math.atan2(s, z[2]))
 
 
-def _inertial(r, e, what: str) -> tuple:
+def _inertial(r: _Reader, e, what: str) -> tuple:
     """(mass, URDF <inertial>) of an MJCF ``<inertial pos quat mass diaginertia|fullinertia>``, refused
     where MuJoCo refuses it (a negative mass, a tensor no body has)."""
     p = r.problems

@@ -38,7 +38,7 @@ _CUT = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismati
         "ball": "spherical", "universal": "universal", "revolute2": "universal"}
 
 
-def _pose(elem, what: str, problems):
+def _pose(elem, what: str, problems: list) -> pin.SE3:
     if elem is None or not (elem.text or "").strip():
         return pin.SE3.Identity()
     rel = elem.get("relative_to")
@@ -56,7 +56,7 @@ def _pose(elem, what: str, problems):
     return pin.SE3(pin.rpy.rpyToMatrix(np.array(rpy)), np.array(xyz))
 
 
-def _vec(text: str, what: str, problems) -> np.ndarray:
+def _vec(text: str, what: str, problems: list) -> np.ndarray:
     before = len(problems)
     v = numbers((text or "").strip() or "?", 3, what, problems, (1.0, 0, 0))
     if len(problems) > before:
@@ -64,7 +64,7 @@ def _vec(text: str, what: str, problems) -> np.ndarray:
     return np.array(unit_axis(v, what, problems))
 
 
-def _axis_element(joint, tag, name: str, X_joint, problems):
+def _axis_element(joint, tag: str, name: str, X_joint: pin.SE3, problems: list) -> np.ndarray:
     a = joint.find(tag)
     if a is None:
         return np.array([1.0, 0, 0]) if tag == "axis" else np.array([0, 1.0, 0])
@@ -75,7 +75,7 @@ def _axis_element(joint, tag, name: str, X_joint, problems):
     return X_joint.rotation.T @ v if model_frame else v
 
 
-def _spanning_tree(links, edges, ground) -> dict:
+def _spanning_tree(links: dict, edges: list, ground: str) -> dict:
     """The breadth-first spanning tree from ``ground`` of the graph of ``links`` joined by
     ``edges`` (parent, child) (a multigraph: two joints may join the same links): joint
     index -> (link towards the ground, link away from it), in the order reached; of parallel

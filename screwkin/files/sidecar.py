@@ -40,7 +40,7 @@ def _replacement_type(t) -> str | None:
     return None
 
 
-def _string_list(content, key, problems, what: str="joint names"):
+def _string_list(content: dict, key: str, problems: Problems, what: str="joint names") -> list | None:
     """content[key] as a list of strings (None when absent), with a problem for anything else."""
     value = content.get(key)
     if value is None:

@@ -78,7 +78,7 @@ _GLOB = re.compile(r"[*?\[]")
 _LOCK = threading.Lock()
 
 
-def _xacro_tag(tag: str):
+def _xacro_tag(tag: str) -> str | None:
     """The local name of an element in the xacro namespace (ElementTree's ``{uri}name``), or None."""
     if tag.startswith("{"):
         uri, _, local = tag[1:].partition("}")
@@ -87,13 +87,13 @@ def _xacro_tag(tag: str):
     return None
 
 
-def is_xacro(path, text: str) -> bool:
+def is_xacro(path: Path, text: str) -> bool:
     """A xacro file: its name ends in ``.xacro`` or it declares the ``xacro`` namespace."""
     return str(path).lower().endswith(".xacro") or re.search(r"xmlns:xacro\s*=", text) is not None
 
 
 # ------------------------------------------------------------------ arguments
-def _arg_value(name: str, value, where: str) -> str:
+def _arg_value(name: str, value: str | float, where: str) -> str:
     """The text xacro receives for an argument: numbers as typed, values with a unit in SI
     (``30mm`` -> ``0.03``), other text as it is (bounded, printable)."""
     if isinstance(value, bool):
@@ -117,7 +117,7 @@ def _arg_value(name: str, value, where: str) -> str:
     return repr(number)
 
 
-def normalize_args(args, where: str = "arguments") -> dict:
+def normalize_args(args: dict | None, where: str = "arguments") -> dict:
     """{name: value} (numbers, text with units) -> {name: text for xacro}, names checked."""
     out = {}
     for name, value in dict(args or {}).items():
@@ -154,7 +154,7 @@ class _State:
     calls: int = 0
 
 
-def _check_text(text: str, path, state: _State) -> None:
+def _check_text(text: str, path: Path, state: _State) -> None:
     """Every ``${...}`` and ``$(...)`` of an attribute or text."""
     if not text or "$" not in text:
         return
@@ -174,7 +174,7 @@ def _check_text(text: str, path, state: _State) -> None:
             raise MechanismFileError(path, str(exc)) from None
 
 
-def _check_extension(token: str, path) -> None:
+def _check_extension(token: str, path: Path) -> None:
     inner = token[2:-1]
     if _ARG.match(inner):
         return
@@ -236,7 +236,7 @@ def _check_tree(root, path: Path, state: _State, follow: bool = True) -> None:
             _check_tree(sub, target, state)
 
 
-def _prepare(path, text: str, root=None) -> _State:
+def _prepare(path: Path, text: str, root=None) -> _State:
     path = Path(path)
     state = _State(path, Path(os.path.realpath(path.parent if str(path.parent) else ".")))
     state.files.append(path)
@@ -415,7 +415,7 @@ class XacroInternalError(RuntimeError):
     mistakes are): a bug, reported as an internal error (exit 3), not as the file's fault."""
 
 
-def _dom(text: str, path):
+def _dom(text: str, path: Path):
     """A minidom document of checked text (defusedxml: no entities, no external references)."""
     # lazily: only xacro files need it; defusedxml.minidom.parseString's own parser, without the
     # import of defusedxml.minidom (its pulldom brings xml.sax, urllib, http, ssl and email: 18 ms)
@@ -430,7 +430,7 @@ def _dom(text: str, path):
         raise MechanismFileError(path, f"malformed XML: {shorten(_one_line(exc), 100)}") from None
 
 
-def expand(path, text: str, args=None, root=None, warn=None, evaluator=None, read=None) -> str:
+def expand(path: Path, text: str, args: dict | None = None, root=None, warn: Callable | None=None, evaluator=None, read: list | None=None) -> str:
     """The URDF text of xacro file ``path`` (whose text is ``text``) with arguments
     ``args`` ({name: value}; see :func:`normalize_args`).  Raises MechanismFileError (the
     file's problem, one line) or UsageError (an argument the file does not declare).

@@ -76,7 +76,7 @@ def _describe(node) -> str:
     return type(node).__name__
 
 
-def _check_node(node) -> None:
+def _check_node(node):
     if isinstance(node, ast.Expression):
         return _check_node(node.body)
     if isinstance(node, ast.Constant):
@@ -147,11 +147,11 @@ def check_expression(expr: str) -> None:
         raise ValueError(f"xacro expression {quote(expr, 60)} uses {exc}: only {_ALLOWED} are allowed") from None
 
 
-def _number(x) -> bool:
+def _number(x: str | float) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, complex)
 
 
-def _bounded(x):
+def _bounded(x: str | float) -> str | float:
     if isinstance(x, bool):
         return x
     if isinstance(x, int) and abs(x) > MAX_INT:
@@ -253,7 +253,7 @@ class XacroEvaluationError(Exception):
     """An expression xacro asked to evaluate is refused or fails (xacro adds its context)."""
 
 
-def evaluate(expr: str, symbols=None, interpreter=None):
+def evaluate(expr: str, symbols=None, interpreter=None) -> str | float:
     """The value of a ``${...}`` expression (its inside) with names from ``symbols`` (a
     mapping; xacro's symbol table while expanding): the subset of :func:`check_expression`,
     evaluated without ``eval`` (by ``interpreter(symbols)``, default this module's; files.xacro_batch

@@ -42,7 +42,7 @@ def inside_folder(path: Path, folder: Path) -> bool:
         return False
 
 
-def read_regular_file(path, max_bytes: int, what: str = "file") -> bytes:
+def read_regular_file(path: Path | str, max_bytes: int, what: str = "file") -> bytes:
     """The bytes of ``path``, refusing what is not a regular file and files over ``max_bytes``.
 
     The file is opened without blocking and checked with fstat, so a named pipe is
@@ -169,7 +169,7 @@ def _safe_loader() -> type:
     return _NoAliasLoader
 
 
-def load_yaml_text(text: str, path) -> dict:
+def load_yaml_text(text: str, path: Path | str) -> dict:
     """The plain data of a YAML document from a user (see the module's notes)."""
     import yaml  # lazily: only sidecars and study specs are YAML (7 ms)
 

@@ -99,7 +99,7 @@ class SixDistances:
         X[:, 3:] = qn / np.sqrt(np.einsum("pi,pi->p", qn, qn))[:, None]
         return X
 
-    def tangent(self, X: np.ndarray):
+    def tangent(self, X: np.ndarray) -> np.ndarray:
         P = len(X)
         T = np.zeros((P, 7, 6), complex)
         T[:, np.arange(3), np.arange(3)] = 1.0
@@ -124,7 +124,7 @@ class SixDistances:
         return np.c_[t, q]
 
 
-def chain_angles(head_axes, tail_axes, A, p0, R0, p, R) -> list:
+def chain_angles(head_axes: list, tail_axes: list, A, p0, R0: np.ndarray, p, R: np.ndarray) -> list:
     """Every real (theta_head (2,), theta_tail (3,)) of a leg (see the module): world axes at the
     angles' zero (head through the ground point A, tail through the platform point, which is at p0
     with the platform at rotation R0), the platform point wanted at p and the platform's rotation R

@@ -96,7 +96,7 @@ def frame_parent(mech, fid: int) -> tuple:
     return f.parentJoint, f.placement
 
 
-def model_with_output(mech, model: pin.Model | None = None):
+def model_with_output(mech, model: pin.Model | None = None) -> pin.Model:
     """A copy of the mechanism's model (or ``model``, itself a copy, changed in place) with the output
     frame placed where place_tool put it, for a closure system that holds it as a cut joint's frame
     (inverse kinematics, a workspace's targets); the mechanism's own model is never changed."""

@@ -166,7 +166,7 @@ class Topology:
         return self.count(6)
 
     @property
-    def gruebler(self):
+    def gruebler(self) -> int:
         return self.count(3) if self.motion_space == "planar" else None
 
     @property
@@ -191,16 +191,16 @@ class UnionFind:
     """Disjoint sets of ``items`` (union-find with path halving): find(x) its set's representative,
     join(a, b) puts b's set under a's representative."""
 
-    def __init__(self, items) -> None:
+    def __init__(self, items: range | list) -> None:
         self.parent = {i: i for i in items}
 
-    def find(self, x):
+    def find(self, x: int | str) -> int | str:
         while self.parent[x] != x:
             self.parent[x] = self.parent[self.parent[x]]
             x = self.parent[x]
         return x
 
-    def join(self, a, b) -> None:
+    def join(self, a: int | str, b: int | str) -> None:
         ra, rb = self.find(a), self.find(b)
         if ra != rb:
             self.parent[rb] = ra
@@ -316,15 +316,15 @@ def _edges(mech, q: np.ndarray) -> tuple:
     return edges, welds
 
 
-def _unit_vector(v):
+def _unit_vector(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _parallel(d1, d2, tol) -> bool:
+def _parallel(d1: np.ndarray, d2: np.ndarray, tol: float) -> bool:
     return np.linalg.norm(np.cross(_unit_vector(d1), _unit_vector(d2))) < tol
 
 
-def _line_distance(p1, d1, p2, d2, tol):
+def _line_distance(p1: np.ndarray, d1: np.ndarray, p2: np.ndarray, d2: np.ndarray, tol: float) -> float:
     n = np.cross(_unit_vector(d1), _unit_vector(d2))
     if np.linalg.norm(n) < tol:  # parallel: distance between the lines
         w = p2 - p1
@@ -332,7 +332,7 @@ def _line_distance(p1, d1, p2, d2, tol):
     return abs((p2 - p1) @ _unit_vector(n))
 
 
-def _compound_name(members, kind: str) -> str:
+def _compound_name(members: list, kind: str) -> str:
     """A readable name: the members' common prefix (e.g. 'ankle_rod_rev0..2' -> 'ankle_rod'), or all names."""
 
     prefix = os.path.commonprefix(members)
@@ -344,7 +344,7 @@ def _compound_name(members, kind: str) -> str:
     return "+".join(members)
 
 
-def _classify_chain(chain, tol, scale, coupled=frozenset()) -> str | None:
+def _classify_chain(chain: list, tol: float, scale: float, coupled: frozenset=frozenset()) -> str | None:
     """The compound type of a chain of 1-DOF edges through massless links, or None.
     coupled: the pairs of joint names one of which mimics the other."""
     kinds = [e.type for e in chain]
@@ -525,7 +525,7 @@ def build_topology(mech: Any, q: np.ndarray) -> Topology:
                     normal, tuple(c for c in mech.couplings if c not in consumed))
 
 
-def _motion_space(joints, tol, scale) -> tuple:
+def _motion_space(joints: list, tol: float, scale: float) -> tuple:
     """'planar' when every revolute axis is parallel to one normal and every
     prismatic axis perpendicular to it; 'spherical' when every joint is a
     rotation about one common point; 'spatial' otherwise."""

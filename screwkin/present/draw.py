@@ -27,6 +27,7 @@ from .plots import pyplot
 from .outfile import write_figure
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.course.skeleton import KinematicChain
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -87,7 +88,7 @@ def _direction_2d(v):
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _fit_axes(fig, ax, points, r, limits=None) -> None:
+def _fit_axes(fig, ax, points, r, limits: tuple | None = None) -> None:
     """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
     ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
@@ -357,7 +358,7 @@ def _block_direction(skel, lk):
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float=0.85) -> None:
+def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float=0.85) -> None:
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -366,7 +367,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid, alpha: float=0.85) -> None:
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j: int, p, r) -> None:
+def _input_arrow(ax, FancyArrowPatch, j: int, p: np.ndarray, r) -> None:
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
@@ -391,7 +392,7 @@ def _input_arrow(ax, FancyArrowPatch, j: int, p, r) -> None:
                                  label="input"))
 
 
-def _legend(fig, links, joints, marks=None) -> None:
+def _legend(fig, links, joints, marks: list | None = None) -> None:
     lines = ["links"]
     lines += [f" {lk.number:>2}  {_short(lk.name)}" + ("  (ground)" if lk.ground else "") for lk in links]
     lines.append("")
@@ -414,7 +415,7 @@ def _legend(fig, links, joints, marks=None) -> None:
     fig.text(0.71, 0.88, "\n".join(lines), ha="left", va="top", family="monospace", fontsize=size, gid="legend")
 
 
-def draw_chain(chain, title: str | None = None):
+def draw_chain(chain: KinematicChain, title: str | None = None):
     """The kinematic chain (:class:`~screwkin.analysis.course.skeleton.KinematicChain`) as a Figure: a
     node per link (a circle for a link with at most two joints, a triangle for a ternary link,
     a square for a quaternary one ...; the ground hatched), an edge per joint labelled with its
@@ -480,7 +481,7 @@ def draw_chain(chain, title: str | None = None):
     return fig
 
 
-def _layout(chain) -> dict:
+def _layout(chain: KinematicChain) -> dict:
     """Node positions in a unit box: networkx's Kamada-Kawai layout, else a circle; the ground
     at the bottom."""
     numbers = [nd.number for nd in chain.nodes]
@@ -550,7 +551,7 @@ def save_figure(fig, path: str, close: bool = True):
         plt.close(fig)
 
 
-def draw_design(mech: Mechanism, paths, steps: int = 360, say=None) -> list:
+def draw_design(mech: Mechanism, paths: list, steps: int = 360, say=None) -> list:
     """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
     ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
     q = mech.assemble().q
@@ -564,7 +565,7 @@ def draw_design(mech: Mechanism, paths, steps: int = 360, say=None) -> list:
     return [{k: v for k, v in m.items() if k != "ghost"} for m in marks or ()]
 
 
-def skeleton_dict(skel) -> dict:
+def skeleton_dict(skel: Skeleton) -> dict:
     """The numbering and symbols of a drawing, for --json."""
     return {
         "planar": skel.planar,
@@ -578,7 +579,7 @@ def skeleton_dict(skel) -> dict:
     }
 
 
-def chain_dict(chain) -> dict:
+def chain_dict(chain: KinematicChain) -> dict:
     return {
         "nodes": [{"number": nd.number, "name": nd.name, "degree": nd.degree, "ground": nd.ground}
                   for nd in chain.nodes],

@@ -29,7 +29,7 @@ TARGET_COLOUR = "#6a3d9a"
 NUMBERED = 12
 
 
-def design_marks(mech: Mechanism, q: np.ndarray, skel, inputs=None, steps: int = 360) -> tuple:
+def design_marks(mech: Mechanism, q: np.ndarray, skel, inputs: list | None = None, steps: int = 360) -> tuple:
     """(analysis.design.targets.DesignTargets, marks) of ``mech``'s file drawn at ``q`` as ``skel``:
     the marks (target_marks) with the linkage's skeleton at each precision position other than the
     one drawn (in skel's plane, ``inputs`` marked)."""
@@ -53,7 +53,7 @@ def design_marks(mech: Mechanism, q: np.ndarray, skel, inputs=None, steps: int =
     return found, marks
 
 
-def design_drawing(mech: Mechanism, q: np.ndarray, input_names, skel, steps: int, say=None, hint: str = "") -> tuple:
+def design_drawing(mech: Mechanism, q: np.ndarray, input_names: list, skel, steps: int, say=None, hint: str = "") -> tuple:
     """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
     precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
     ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
@@ -113,7 +113,7 @@ def target_marks(design, basis, skeletons: dict | None = None) -> list:
     return out
 
 
-def draw_targets(ax, marks, r, size, colour_of) -> list:
+def draw_targets(ax, marks: list | None, r, size, colour_of) -> list:
     """Draw ``marks`` (target_marks) on ``ax``; ``r``: the pin radius (the symbols' unit),
     ``size``: the drawing's length scale [m]; colour_of(link number) the links' colours.
     Returns the points drawn (for the framing)."""

@@ -29,7 +29,7 @@ def _input_values(r: DynamicsResult, shown: str | None) -> tuple:
     return r.values, r.unit
 
 
-def _list(a):
+def _list(a: np.ndarray) -> list:
     """A flat list of numbers, NaN where the analysis leaves a value undetermined (an effort of
     redundant actuation: null in the JSON, by present/jsonout.py's rule)."""
     return np.asarray(a, float).ravel().tolist()

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.motion.links import MotionAlong
+    from screwkin.analysis.motion.sweep import SweepResult
 
 __all__ = ["along_text", "along_line", "strokes_text", "strokes_dict", "motion_rows_text", "links_rows", "links_table", "points_rows",
            "points_table", "motion_dict", "linkage_construction_text"]
@@ -139,7 +140,7 @@ def strokes_text(strokes: list, angular: bool) -> list:
     return lines
 
 
-def motion_rows_text(res, motion: MotionAlong, rows: list, degrees: bool, units: RateUnits | None = None) -> str:
+def motion_rows_text(res: SweepResult, motion: MotionAlong, rows: list, degrees: bool, units: RateUnits | None = None) -> str:
     """The sweep's absolute quantities at the rows shown: the input (in deg when typed so), each turning
     link's angle [deg] (with ``units``, the rate's units typed: its omega and alpha in them too), each
     slider (loop) coordinate [mm] and each point's position [mm]."""

@@ -32,12 +32,14 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.position.certified import ModeCount
+    from screwkin.analysis.position.solution import Solution
 
 __all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
            "scan_dict", "scan_csv", "map_csv", "slide_note"]
 
 
-def position_dict(res) -> dict:
+def position_dict(res: PositionResult) -> dict:
     sols = []
     for s in res.solutions:
         # every coordinate under its name, loop joints too (also kept apart under "loop_joints")
@@ -87,7 +89,7 @@ def position_dict(res) -> dict:
             "complete": bool(res.modes is not None and res.modes.complete)}
 
 
-def modes_dict(c) -> dict:
+def modes_dict(c: ModeCount) -> dict:
     """analysis.position.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
@@ -95,7 +97,7 @@ def modes_dict(c) -> dict:
             "certificate_check": dict(c.check) or None}
 
 
-def modes_line(res, n: int) -> str:
+def modes_line(res: PositionResult, n: int) -> str:
     """How many assembly modes, and how that is known: "all 4 assembly modes (certified: trace test);
     36 more solutions are complex", or "3 found ...; completeness not certified because ..."."""
     c = res.modes
@@ -140,14 +142,14 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name: str, value, angular) -> str:
+def value_text(name: str, value: float, angular: bool) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"
     return f"{value:.9g} m"
 
 
-def trace_text(res, row_labels, passive_names) -> str:
+def trace_text(res: PositionResult, row_labels: list, passive_names: list) -> str:
     lines = ["Newton iterations from the first start (rows: closure residual; columns: passive joints)"]
     for st in res.trace:
         lines.append(f"\niteration {st.iteration}: |r| = {np.linalg.norm(st.residual):.3e}"
@@ -160,7 +162,7 @@ def trace_text(res, row_labels, passive_names) -> str:
     return "\n".join(lines)
 
 
-def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
+def solution_rows(res: PositionResult, s: Solution, degrees: bool = True, units: RateUnits = RateUnits()) -> tuple:
     """(headers, rows) of one solution's coordinates -- every tree joint, then every loop (cut) joint
     as ``NAME (loop)`` -- with value [rad or m], the angle in deg (a slide not along the ground's x
     axis: its guide's angle), rate and acceleration when solved with rates, in ``units`` (those typed
@@ -205,7 +207,7 @@ def solution_rows(res, s, degrees: bool = True, units: RateUnits = RateUnits()) 
     return headers, rows
 
 
-def slide_note(res, s) -> str | None:
+def slide_note(res: PositionResult, s: Solution) -> str | None:
     """The footnote of a joint table with slides: what a slide's value is measured from, and its ``d``."""
     if all(n in res.angular for n in s.joints) and all(n in res.angular_loop for n in (s.loop_joints or {})):
         return None
@@ -216,7 +218,7 @@ def slide_note(res, s) -> str | None:
     return note
 
 
-def position_text(res, degrees: bool=True, show_all: bool=False, length=None, units: RateUnits = RateUnits(),
+def position_text(res: PositionResult, degrees: bool=True, show_all: bool=False, length: float | None=None, units: RateUnits = RateUnits(),
                   leg_lengths: dict | None = None) -> str:
     """The solutions of a position analysis; without ``show_all`` only the physically meaningful
     ones (no labels) when there are any, with a line saying how many more exist; rates and
@@ -290,7 +292,7 @@ def position_text(res, degrees: bool=True, show_all: bool=False, length=None, un
     return "\n".join(lines)
 
 
-def sweep_rows(n: int, rows=None) -> list:
+def sweep_rows(n: int, rows: str | None=None) -> list:
     """The steps a sweep's tables show: ``rows`` None -> about 11 evenly spaced (the last included),
     "all" -> every step, a number -> about that many."""
     if rows == "all":
@@ -302,7 +304,7 @@ def sweep_rows(n: int, rows=None) -> list:
     return idx
 
 
-def sweep_text(res, info=None, mus=None, rows=None, degrees: bool = False, linear_names=()) -> str:
+def sweep_text(res: SweepResult, info: LinkageInfo | None = None, mus: list | None = None, rows: str | None=None, degrees: bool = False, linear_names: list=()) -> str:
     """The sweep's summary and a table of joint values (``rows``: see sweep_rows; ``degrees``: the
     input and the angles in deg, the coordinates in ``linear_names`` staying in m)."""
     angular = res.unit == "rad"
@@ -490,7 +492,7 @@ def to_dict(result) -> dict:
 
 
 # ------------------------------------------------------------------ the joint vocabulary
-def joint_types_dict(types) -> list:
+def joint_types_dict(types: tuple) -> list:
     """``info --joint-types --json``: one object per kinematic pair screwkin knows."""
     return [{"name": t.name, "symbol": t.symbol, "dof": t.dof, "motion": t.motion, "pair": t.pair,
              "contact": t.contact, "type": t.type, "written": t.written} for t in types]

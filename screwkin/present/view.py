@@ -40,6 +40,7 @@ from .outfile import write_output
 
 if TYPE_CHECKING:
     from ..model.mechanism import Mechanism
+    from screwkin.files.description import CutJointSpec
 
 __all__ = ["COLORS", "build_scene", "show", "page", "legend_entries", "view", "RecordingViewer", "screenshot"]
 
@@ -63,7 +64,7 @@ def _coal():
     return coal
 
 
-def _visual_urdf(mech: Mechanism, unreadable=()) -> str:
+def _visual_urdf(mech: Mechanism, unreadable: set | tuple = ()) -> str:
     """The URDF text with every mesh resolved to an absolute path, and visuals
     whose mesh cannot be found (or is in ``unreadable``) dropped (their links get stand-ins)."""
     root = parse_xml_text(mech.spec.urdf_text, mech.path)
@@ -149,7 +150,7 @@ def _disc(name: str, joint, frame, M, radius, color, alpha: float=0.35):
     return obj
 
 
-def _pair_geometry(mech: Mechanism, cut, spec, r_axis, L_axis):
+def _pair_geometry(mech: Mechanism, cut, spec: CutJointSpec, r_axis: float, L_axis: float) -> list:
     """What a higher pair looks like: pitch circles (rolling, gears; a pitch line for a rack),
     profiles (circles as discs, lines as slots, points as pins) and a screw's helix of its lead."""
     model = mech.model
@@ -216,7 +217,7 @@ class Scene:
         return np.array([pts.min(axis=0), pts.max(axis=0)])
 
 
-def _corner_points(state, geom) -> np.ndarray:
+def _corner_points(state: KinematicState, geom) -> np.ndarray:
     """Points that bound the drawn geometry at the configuration of ``state`` (a KinematicState): the
     joint centres and the corners of each object's own bounding box placed where its joint puts it
     (meshes as loaded, scale included)."""
@@ -414,7 +415,7 @@ class RecordingViewer:
         raise NotImplementedError
 
 
-def _translation(p):
+def _translation(p) -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = p
     return T

@@ -74,7 +74,7 @@ class ChunkRows(list):
         self.notes = list(notes)
 
 
-def eligible(task) -> str | None:
+def eligible(task: StudyTask) -> str | None:
     """Why the family path does not apply to a study (None: it may)."""
     other = [m for m in task.metrics if m not in FAMILY_METRICS]
     if other:
@@ -97,7 +97,7 @@ def chunk_rows(task, chunk: int) -> ChunkRows:
     return ChunkRows(run_chunk(task, chunk), {"design": len(chunk)})
 
 
-def _rpy_matrices(rpy) -> np.ndarray:
+def _rpy_matrices(rpy: np.ndarray) -> np.ndarray:
     """Rotation matrices (n, 3, 3) of URDF rpy angles (n, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy[:, 0], rpy[:, 1], rpy[:, 2]
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
@@ -106,7 +106,7 @@ def _rpy_matrices(rpy) -> np.ndarray:
                      np.stack([-sp, cp * sr, cp * cr], -1)], -2)
 
 
-def _signature(spec, dummy_mass) -> tuple:
+def _signature(spec: MechanismSpec, dummy_mass: float) -> tuple:
     """What must be the same for two designs to share a structure."""
     return (tuple((k, v.is_massless(dummy_mass), v.has_geometry) for k, v in spec.links.items()),
             tuple((j.name, j.type, j.parent, j.child, j.mimic) for j in spec.joints),
@@ -176,7 +176,7 @@ class _Fourbar:
     """The reference design's four-bar: which joint centres and loop frames each link's length joins,
     and the sides of its loop (model.closability.planar_loops)."""
 
-    def __init__(self, d, spec) -> None:
+    def __init__(self, d: StudyDesign, spec) -> None:
         mech, info = d.mech, d.linkage()
         if info.kind != "four-bar":
             raise Unbatchable("the family path analyses four-bars (this one is a slider-crank)")
@@ -215,7 +215,7 @@ class _Fourbar:
             self.frames[c.frame2] = (c.name, 1)
         self.lengths = info.lengths
 
-    def point(self, placed, joint, link: str):
+    def point(self, placed: _Placed, joint, link: str):
         """The joint's centre (a loop joint: its frame on ``link``) at every design: (n, 3)."""
         if joint in self.cut_names:
             c = self.cut_names[joint]
@@ -225,7 +225,7 @@ class _Fourbar:
             return placed.cuts[joint][side][1]
         return placed.joints[joint][1]
 
-    def ref_point(self, placed, ref):
+    def ref_point(self, placed: _Placed, ref):
         kind, ident = ref
         if kind == "frame":
             name, side = self.frames[ident]
@@ -424,7 +424,7 @@ def _row_of(task: StudyTask, i: int, values: tuple, columns: tuple[str, ...], re
     return row
 
 
-def _check_reference(d, fb, placed, spec) -> None:
+def _check_reference(d, fb: _Fourbar, placed: _Placed, spec) -> None:
     """The composed placements of the reference design (the first of ``placed``) are Pinocchio's at the
     file's configuration, to 1e-9 of the mechanism's size: the template and its reading are right."""
     mech = d.mech

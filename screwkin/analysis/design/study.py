@@ -405,7 +405,7 @@ def study_task(spec: StudySpec) -> StudyTask:
                  spec.input, spec.output, spec.point, dict(spec.workspace), spec.timeout, spec.mode)
 
 
-def _row_key(name: str, keys) -> str | None:
+def _row_key(name: str, keys: tuple) -> str | None:
     """The row key of a column named as in the rows or as in the table (``..._deg``, ``..._m``)."""
     for cand in (name, name.removesuffix("_deg"), name.removesuffix("_m")):
         if cand in keys:
@@ -509,7 +509,7 @@ def requirements(spec: StudySpec) -> tuple:
     return tuple(out), default
 
 
-def apply_requirements(spec: StudySpec, rows) -> tuple:
+def apply_requirements(spec: StudySpec, rows: tuple) -> tuple:
     """(rows with REQUIREMENTS_COLUMN, the column added or None, {design: what it does not meet}).
     Nothing is added when there is no requirement."""
     reqs, _ = requirements(spec)

@@ -107,7 +107,7 @@ class WorkspaceResult:
 class _Measures:
     """The workspace measures for stacks of assembled configurations."""
 
-    def __init__(self, mech: Mechanism, output, point, inputs, length) -> None:
+    def __init__(self, mech: Mechanism, output: str, point: bool, inputs: list, length: float) -> None:
         self.mech, self.point, self.L = mech, point, float(length or mech.length)
         self.closure = BatchClosure(mech, check=0) if (mech.cuts or mech.extra_rows) else None
         self.out = SerialJacobians(mech, output, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, check=0)
@@ -161,7 +161,7 @@ class _Measures:
         return {"actuator": actuator, "serial": serial, "conditioning": conditioning}
 
 
-def _translations(mech: Mechanism, q: np.ndarray, output, point) -> np.ndarray:
+def _translations(mech: Mechanism, q: np.ndarray, output: str, point: bool) -> np.ndarray:
     """(3, k) directions the output (its origin for a point) can translate in at q, at a
     constant orientation unless ``point``: the linear part of the output twists that the loops
     allow with no rotation."""
@@ -181,7 +181,7 @@ def _translations(mech: Mechanism, q: np.ndarray, output, point) -> np.ndarray:
     return U[:, :k]
 
 
-def workspace(mech: Mechanism, output: str, point: bool = False, orientation=None, resolution: float | None = None,
+def workspace(mech: Mechanism, output: str, point: bool = False, orientation: np.ndarray | None=None, resolution: float | None = None,
               bounds=None, threshold: float = DEFAULT_THRESHOLD, length: float | None = None,
               method: str | None = None, samples: int = 200_000, seed: int = 0, inputs=None,
               timeout: float | None = None, q_start=None) -> WorkspaceResult:
@@ -231,7 +231,7 @@ def workspace(mech: Mechanism, output: str, point: bool = False, orientation=Non
                  q_start)
 
 
-def _seed(mech: Mechanism, output, point, orientation, q_start=None) -> tuple:
+def _seed(mech: Mechanism, output: str, point: bool, orientation: np.ndarray | None, q_start=None) -> tuple:
     """The assembled configuration the grid starts from (``q_start`` when given), the output's position
     and the grid's orientation there (continued from the file's orientation to the one asked)."""
     assembly, generic = mech.generic_configurations()
@@ -269,7 +269,7 @@ def _seed(mech: Mechanism, output, point, orientation, q_start=None) -> tuple:
     return q, p, R
 
 
-def _index_bounds(bounds, p_seed, axes, h, dim) -> tuple:
+def _index_bounds(bounds, p_seed: np.ndarray, axes: np.ndarray, h: float, dim: int) -> tuple:
     """Index ranges (lo, hi) per axis for world-coordinate bounds (dimension, 2), or None."""
     if bounds is None:
         return [-(10**9)] * dim, [10**9] * dim
@@ -432,7 +432,7 @@ def _grid(mech: Mechanism, output: str, point: bool, orientation: Any, measures:
         tuple(inputs), rng, bool(truncated), grid.solves, 0, tuple(notes))
 
 
-def _free_part(m0, m1, length, threshold, p0, direction, crossings) -> float:
+def _free_part(m0: float, m1: float, length: float, threshold: float, p0: np.ndarray, direction: np.ndarray, crossings: list) -> float:
     """The free length of a segment from a point of measure m0 to one of m1 (linear between),
     recording a crossing of the threshold."""
     a, b = m0 >= threshold, m1 >= threshold
@@ -446,7 +446,7 @@ def _free_part(m0, m1, length, threshold, p0, direction, crossings) -> float:
 
 
 # ----------------------------------------------------------------------------------- sampling
-def _sampling(mech: Mechanism, output, measures, resolution, bounds, threshold, L, samples, seed: int, inputs) -> WorkspaceResult:
+def _sampling(mech: Mechanism, output: str, measures: _Measures, resolution: float | None, bounds, threshold: float, L: float, samples: int, seed: int, inputs: list) -> WorkspaceResult:
     samples = int(samples)
     if samples < 1:
         raise UsageError(f"the number of samples must be positive, got {samples}")

@@ -37,7 +37,7 @@ _ITERATIONS = 8  # Newton from a neighbour's solution and the predictor converge
 #                   takes more lies beyond the boundary (or across a singularity) from that neighbour
 
 
-def null_motions(A, mech: Mechanism):
+def null_motions(A: np.ndarray, mech: Mechanism) -> np.ndarray:
     if not A.size:
         return np.eye(A.shape[1])
     _, s, vt = np.linalg.svd(A)
@@ -45,7 +45,7 @@ def null_motions(A, mech: Mechanism):
     return vt[k:].T
 
 
-def grid_axes(directions) -> np.ndarray:
+def grid_axes(directions: np.ndarray) -> np.ndarray:
     """Grid axes spanning the translation directions: the world axes in 3-D; in a plane the two
     world axes of a coordinate plane, else an orthonormal basis of the plane."""
     k = directions.shape[1]
@@ -64,7 +64,7 @@ def grid_axes(directions) -> np.ndarray:
 class Grid:
     """Batched inverse kinematics on a grid (see the module's text)."""
 
-    def __init__(self, mech: Mechanism, output, point, orientation, q_seed: np.ndarray, p_seed, axes, h, lo, hi, frozen=()) -> None:
+    def __init__(self, mech: Mechanism, output: str, point: bool, orientation, q_seed: np.ndarray, p_seed: np.ndarray, axes: np.ndarray, h: float, lo: list, hi: list, frozen: tuple=()) -> None:
         self.mech, self.axes, self.h = mech, axes, float(h)
         self.deadline = None  # time.monotonic() past which the growth stops (the result marked truncated)
         self.timed_out = False
@@ -86,7 +86,7 @@ class Grid:
     def position(self, index: int) -> np.ndarray:
         return self.p_seed + (np.asarray(index, float) * self.h) @ self.axes
 
-    def solve(self, Q0: np.ndarray, P) -> tuple:
+    def solve(self, Q0: np.ndarray, P: np.ndarray) -> tuple:
         """Solve from Q0 (N, nq) for targets P (N, 3): (Q, ok) with ok: converged and within
         the joint limits."""
         Q = np.empty_like(Q0)
@@ -99,7 +99,7 @@ class Grid:
             ok[ok] &= within_limits(self.mech, Q[ok])
         return Q, ok
 
-    def predict(self, Q: np.ndarray, P_from, P_to) -> tuple:
+    def predict(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray) -> tuple:
         """First-order predictor: the joint steps that move the target from P_from to P_to
         (minimum norm through the solver's rows: K dq = -(change of the target rows)), and
         the rows' Jacobian at Q (it does not depend on where the target is)."""
@@ -108,11 +108,11 @@ class Grid:
         dr = r0 - r1  # the rows' change from moving the target alone
         return Q + damped_steps(K, dr, np.full(len(Q), self.mech.tolerances.lm_damping))[0], K
 
-    def _scaled(self, K: np.ndarray):
+    def _scaled(self, K: np.ndarray) -> np.ndarray:
         """The rows' Jacobians made dimensionless: lengths / L, sliding columns * L (model.kernel.scaling)."""
         return dimensionless(K, self.closure.solver_position_rows, self.slide, self.L)
 
-    def kept(self, Q_from, K_from, Q_pred, Q_new, P_new) -> tuple:
+    def kept(self, Q_from: np.ndarray, K_from: np.ndarray, Q_pred: np.ndarray, Q_new: np.ndarray, P_new: np.ndarray) -> tuple:
         """(kept, sigma) for new solutions solved from Q_from: kept when it continues the old
         solution -- near the predicted configuration, and on the same branch: the rows'
         Jacobian (loops and target) restricted to the old one's range and row space keeps the
@@ -141,7 +141,7 @@ class Grid:
         n = np.minimum(2 ** np.ceil(np.log2(np.clip(need, 1.0, _SUBSTEPS))), _SUBSTEPS)
         return np.where(sigma >= _SINGULAR, n, 0).astype(int)
 
-    def advance(self, Q: np.ndarray, P_from, P_to, n: int) -> tuple:
+    def advance(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: int) -> tuple:
         """Solve from Q at P_from to P_to in n equal substeps (n: an int, or one per point,
         all advanced together): (Q, ok, sigma, jumped) -- jumped: a substep converged within
         the limits but ``kept`` refused it (another branch, or far from the prediction)."""
@@ -164,7 +164,7 @@ class Grid:
             Qc[sel[good]], Pc[sel[good]], sigma[sel] = Qn[good], Pk[good], sig
         return Qc, ok, sigma, jumped
 
-    def advance_all(self, Q: np.ndarray, P_from, P_to, n: int, retry: bool=True) -> tuple:
+    def advance_all(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: int, retry: bool=True) -> tuple:
         """advance for points with each their number of substeps n (> 0), in blocks; with
         ``retry``, a step refused as a jump to another branch is tried again in twice as many
         substeps, up to _SUBSTEPS (a step that does not converge -- past the boundary -- is not)."""
@@ -186,7 +186,7 @@ class Grid:
             self.truncated = self.timed_out = True
         return self.timed_out
 
-    def fill(self):
+    def fill(self) -> dict:
         """{grid index: configuration} of the points reached, filled wave by wave (also
         ``self.sigma``: index -> relative singular value of the rows' Jacobian there)."""
         d = len(self.axes)
@@ -233,7 +233,7 @@ class Grid:
                     failed[t] = failed.get(t, 0) + 1
         return solved
 
-    def march(self, solved: dict, direction) -> dict:
+    def march(self, solved: dict, direction: np.ndarray) -> dict:
         """Complete the runs along ``direction`` (a unit index vector): from every solved point
         whose neighbour that way is not solved (and within the bounds), step on point by point
         (each solved from the last, kept on its branch) until a step fails, then bisect that
@@ -281,7 +281,7 @@ class Grid:
             current = following
         return ends
 
-    def extend(self, starts: int, Q: np.ndarray, direction) -> tuple:
+    def extend(self, starts: int, Q: np.ndarray, direction: np.ndarray) -> tuple:
         """Bisection from the reached points ``starts`` (m, d) (configurations Q) towards their
         unreached neighbours along ``direction`` (a unit index vector): the reached fraction of
         the step (0..1) and the configurations there."""

@@ -167,7 +167,7 @@ def check_inertias(mech: Mechanism) -> tuple:
     return ()
 
 
-def _load_wrenches(mech: Mechanism, loads, state) -> list:
+def _load_wrenches(mech: Mechanism, loads: tuple, state: KinematicState) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the configuration of
     ``state`` (a KinematicState; the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []
@@ -201,7 +201,7 @@ def _ground_sides(mech: Mechanism) -> tuple:
     return tree, cuts
 
 
-def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v) -> tuple:
+def _energies(mech: Mechanism, gmodel: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> tuple:
     """(kinetic, potential) energy [J] at (q, v): Pinocchio's; with couplings (mimic joints, which its
     energy algorithms refuse) 1/2 v^T M v from its CRBA and -sum m g . c over the bodies."""
     model = mech.model
@@ -215,7 +215,7 @@ def _energies(mech: Mechanism, gmodel, data, q: np.ndarray, v) -> tuple:
     return 0.5 * float(v @ M @ v), float(V)
 
 
-def _flywheel(values, tau, speed, unit: str, cs, completed) -> Flywheel:
+def _flywheel(values: np.ndarray, tau: np.ndarray, speed: float, unit: str, cs: float, completed: bool) -> Flywheel:
     """The flywheel figure from the input effort tau over the input values (see the module)."""
     omega = abs(speed)
     span = abs(values[-1] - values[0]) if len(values) > 1 else 0.0
@@ -235,7 +235,7 @@ def _flywheel(values, tau, speed, unit: str, cs, completed) -> Flywheel:
     return Flywheel(cs, omega, de, de / (cs * omega**2))
 
 
-def _range_mean(values, y) -> float:
+def _range_mean(values: np.ndarray, y: np.ndarray) -> float:
     """The mean of y over the input range (trapezoid rule: a sample at each end of a whole
     turn counts once); the plain mean for a single value."""
     if len(values) < 2 or values[-1] == values[0]:
@@ -360,7 +360,7 @@ def _motion_notes(s: _Series, input: str, res: SweepResult, peak: dict[str, floa
 def dynamics(mech: Mechanism, input: str, speed: float, start: float, stop: float, steps: int,
              inputs: Iterable[str] | None = None, fixed: dict | None = None, near: dict | None = None,
              gravity: Iterable[float] = (0.0, 0.0, 0.0), loads: Iterable[Load] = (), cs: float = 0.05,
-             progress: Callable[[int, int], object] | None = None, q_start=None,
+             progress: Callable[[int, int], object] | None = None, q_start: Callable | None=None,
              branch: str = "continue") -> DynamicsResult:
     """Inverse dynamics along the motion of input ``input`` from ``start`` to ``stop`` [rad or m]
     in ``steps`` steps at the constant ``speed`` [rad/s or m/s] (see the module docstring).

@@ -189,7 +189,7 @@ def _reactions(mech: Mechanism, q: np.ndarray, lam: np.ndarray, w: np.ndarray | 
     return tuple(out)
 
 
-def reaction_table(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list, gravity: bool | np.ndarray, N_lam: np.ndarray, v=None, a=None) -> dict:
+def reaction_table(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list, gravity: bool | np.ndarray, N_lam: np.ndarray, v: np.ndarray | None = None, a: np.ndarray | None = None) -> dict:
     """joint name -> (kind, wrench, open): the reaction of every joint (see joint_wrenches) for
     constraint forces lam, and the mask of its components that change along the null
     directions N_lam of the constraint forces (not determined by the balance)."""
@@ -205,7 +205,7 @@ def reaction_table(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list,
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity: bool=False, v=None, a=None, rows: tuple | None = None) -> dict:
+def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity: bool=False, v: np.ndarray | None = None, a: np.ndarray | None = None, rows: tuple | None = None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial

@@ -27,6 +27,7 @@ from ..singular import Generic, measures
 from .crossing import TIGHT_CLOSURE, ChangePoint, dips, nearest_branch, reclosing
 
 
+
 __all__ = ["change_points"]
 
 

@@ -43,6 +43,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.tolerances import Tolerances
+    from collections.abc import Callable
 
 __all__ = ["Engine", "Curve", "Stuck", "Motion", "Neighbour", "projections", "orient", "passes_limit", "keeps_orientation", "jumped",
            "locate", "returned", "continuation_steps",
@@ -112,7 +114,7 @@ class Engine(Protocol):
         ...
 
 
-def projections(K: np.ndarray, V, scale, free, tol) -> np.ndarray:
+def projections(K: np.ndarray, V: np.ndarray, scale: np.ndarray, free: np.ndarray, tol: Tolerances) -> np.ndarray:
     """The vectors V (N, nv) projected onto the null space of the scaled constraint Jacobians K
     (N, m, nv) -- columns times ``scale`` (characteristic lengths for sliding joints), restricted to
     the ``free`` columns (the held inputs have no part) -- with the rank rule of model.linalg (singular
@@ -142,7 +144,7 @@ def projections(K: np.ndarray, V, scale, free, tol) -> np.ndarray:
     return out
 
 
-def orient(t, previous):
+def orient(t: np.ndarray, previous: np.ndarray) -> np.ndarray:
     """The branch rule: t, or -t, whichever continues ``previous`` (a non-negative dot product);
     t itself without a previous one.  Rows of a stack are oriented each like the row before it,
     the first like ``previous``."""
@@ -157,13 +159,13 @@ def orient(t, previous):
     return t * np.cumprod(d)[:, None]
 
 
-def passes_limit(ta, tb, ix) -> bool:
+def passes_limit(ta: np.ndarray, tb: np.ndarray, ix: int) -> bool:
     """A limit position between two configurations (oriented tangents ta, tb: ``orient``): the
     input's share of the tangent does not keep its sign (rows of stacks compared pairwise)."""
     return np.asarray(ta)[..., ix] * np.asarray(tb)[..., ix] <= 0
 
 
-def keeps_orientation(Ks_from, Ks_new, r) -> bool:
+def keeps_orientation(Ks_from: np.ndarray, Ks_new: np.ndarray, r: int) -> bool:
     """The branch rule of a continuation in several parameters (a workspace's grid growth): each new
     Jacobian (N, m, n; dimensionless) restricted to the old one's range and row space (rank r) keeps the
     sign of its determinant -- a jump across a fold to another working mode flips it.  With one
@@ -175,14 +177,14 @@ def keeps_orientation(Ks_from, Ks_new, r) -> bool:
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss, sigma: float, tol):
+def jumped(miss: np.ndarray | float, sigma: float, tol: Tolerances) -> np.ndarray | bool:
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""
     return ~(np.asarray(miss) <= np.maximum(tol.jump * np.abs(sigma), tol.jump_floor))
 
 
-def locate(f, lo, hi, xtol: float=1e-14, maxiter: int=100) -> float:
+def locate(f, lo: float, hi: float, xtol: float=1e-14, maxiter: int=100) -> float:
     """The root of f bracketed in [lo, hi] (f changes sign there) by Brent's method, to xtol and
     four units of round-off: where every engine locates its limit positions (the tangent's input
     share, a closed form's discriminant) and the input values on an arc near them."""
@@ -191,7 +193,7 @@ def locate(f, lo, hi, xtol: float=1e-14, maxiter: int=100) -> float:
     return brentq(f, lo, hi, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=maxiter)
 
 
-def returned(mech: Mechanism, x, start, h, q: np.ndarray, q0: np.ndarray, scale) -> bool:
+def returned(mech: Mechanism, x: float, start: float, h: float, q: np.ndarray, q0: np.ndarray, scale: np.ndarray) -> bool:
     """The motion is back at its start: the input at ``start`` (Tolerances.equal relative to the grid
     step h) and the configuration q at q0 (Tolerances.geometry, dimensionless)."""
     tol = mech.tolerances
@@ -241,11 +243,11 @@ class Curve:
     def unit(self) -> str:
         return "m" if self.mech.translational[self.ix] else "rad"
 
-    def input_directions(self, K: np.ndarray):
+    def input_directions(self, K: np.ndarray) -> np.ndarray:
         """The unnormalized tangents P e at configurations of constraint Jacobians K (N, m, nv)."""
         return projections(K, self.e[None].repeat(len(K), 0), self.scale, self.free, self.tol)
 
-    def tangent(self, q: np.ndarray, previous=None):
+    def tangent(self, q: np.ndarray, previous: np.ndarray | None=None) -> np.ndarray:
         """Unit tangent of the curve at q in scaled coordinates (nv; zero on the held inputs),
         oriented like ``previous`` (``choose_branch``): the input's direction projected onto the null
         space of K; at a limit position itself (tol.limit_share), ``previous`` projected instead."""
@@ -259,39 +261,39 @@ class Curve:
             raise Stuck("the mechanism cannot move along this input here")
         return self.choose_branch(t / n, previous)
 
-    def choose_branch(self, t, previous):
+    def choose_branch(self, t: np.ndarray, previous: np.ndarray | None) -> np.ndarray:
         return orient(t, previous)
 
-    def along(self, q: np.ndarray, direction):
+    def along(self, q: np.ndarray, direction: float) -> np.ndarray:
         """The unit tangent at q oriented so that the input moves the way of ``direction`` (its sign;
         zero: increasing) -- where a motion starts."""
         t = self.tangent(q)
         return -t if t[self.ix] * (np.sign(direction) or 1.0) < 0 else t
 
-    def hold(self, t):
+    def hold(self, t: np.ndarray) -> int:
         """The velocity index of the joint to hold for a step along t: the input when it has a
         large share of the tangent, else the one-DOF joint with the largest share."""
         scores = np.where(self.holdable, np.abs(t), -1.0)
         best = int(np.argmax(scores))
         return self.ix if abs(t[self.ix]) >= 0.5 * scores[best] else best
 
-    def frozen(self, held) -> tuple:
+    def frozen(self, held: int) -> tuple:
         return tuple(sorted(set(self.frozen_other) | {held}))
 
-    def predict(self, q: np.ndarray, t, sigma: float):
+    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float) -> np.ndarray:
         return pin.integrate(self.model, q, self.scale * t * sigma)
 
-    def correct(self, predicted, held):
+    def correct(self, predicted: np.ndarray, held: int) -> np.ndarray:
         try:
             return self.closure.solve(predicted, frozen=self.frozen(held)).q
         except AssemblyError:
             raise Stuck("the loops cannot be closed") from None
 
-    def accept(self, predicted, corrected, sigma: float) -> bool:
+    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float) -> bool:
         miss = np.linalg.norm(pin.difference(self.model, predicted, corrected) / self.scale)
         return not jumped(miss, sigma, self.tol)
 
-    def step(self, q: np.ndarray, t, sigma: float, held):
+    def step(self, q: np.ndarray, t: np.ndarray, sigma: float, held: int) -> np.ndarray:
         """Move sigma (scaled) along t, hold joint ``held`` there, close the loops again."""
         pred = self.predict(q, t, sigma)
         q_new = self.correct(pred, held)
@@ -299,7 +301,7 @@ class Curve:
             raise Stuck("the correction jumps away from the curve")
         return q_new
 
-    def at_input(self, q_from: np.ndarray, x_from, x, t):
+    def at_input(self, q_from: np.ndarray, x_from: float, x: float, t: np.ndarray) -> np.ndarray:
         """The configuration at input value x, predicted from q_from (input x_from) along t."""
         dx = (x - x_from) / self.scale[self.ix]
         if abs(t[self.ix]) < self.tol.zero:
@@ -309,7 +311,7 @@ class Curve:
     def input_change(self, q0: np.ndarray, q1: np.ndarray) -> float:
         return float(pin.difference(self.model, q0, q1)[self.ix])
 
-    def _arc(self, qa: np.ndarray, qb: np.ndarray, held, message: str):
+    def _arc(self, qa: np.ndarray, qb: np.ndarray, held: int, message: str) -> Callable:
         """The configuration a share u of the way from qa to qb with joint ``held`` as the parameter."""
         delta = pin.difference(self.model, qa, qb)
         frozen, cache = self.frozen(held), {0.0: qa, 1.0: qb}
@@ -355,7 +357,7 @@ class Curve:
         except AssemblyError:
             raise Stuck("the loops cannot be closed at this input value") from None
 
-    def locate_limit(self, qa: np.ndarray, ta, qb: np.ndarray, held):
+    def locate_limit(self, qa: np.ndarray, ta: np.ndarray, qb: np.ndarray, held: int) -> tuple:
         """The limit position between qa and qb (the input's tangent component changes sign),
         with joint ``held`` as the parameter: (configuration, input offset from qa)."""
         at = self._arc(qa, qb, held, None)
@@ -381,7 +383,7 @@ class Neighbour:
     def __init__(self, solver, name: str) -> None:
         self.curve = Curve(solver, name)
 
-    def __call__(self, q: np.ndarray, x_from: float, x_to: float):
+    def __call__(self, q: np.ndarray, x_from: float, x_to: float) -> np.ndarray | None:
         """The configuration at input value x_to on q's branch (q at x_from), or None."""
         c = self.curve
         direction = np.sign(x_to - x_from)

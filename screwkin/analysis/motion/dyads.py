@@ -54,10 +54,10 @@ class Jet:
 
     __slots__ = ("v", "d", "dd")
 
-    def __init__(self, v, d: float=0.0, dd: float=0.0) -> None:
+    def __init__(self, v: np.ndarray, d: float=0.0, dd: float=0.0) -> None:
         self.v, self.d, self.dd = v, d, dd
 
-    def __add__(self, o) -> Jet:
+    def __add__(self, o: Jet) -> Jet:
         if isinstance(o, Jet):
             return Jet(self.v + o.v, self.d + o.d, self.dd + o.dd)
         return Jet(self.v + o, self.d, self.dd)
@@ -67,13 +67,13 @@ class Jet:
     def __neg__(self) -> Jet:
         return Jet(-self.v, -self.d, -self.dd)
 
-    def __sub__(self, o):
+    def __sub__(self, o: Jet | float) -> Jet:
         return self + (-o)
 
     def __rsub__(self, o):
         return (-self) + o
 
-    def __mul__(self, o) -> Jet:
+    def __mul__(self, o: Jet) -> Jet:
         if isinstance(o, Jet):
             return Jet(self.v * o.v, self.d * o.v + self.v * o.d, self.dd * o.v + 2 * self.d * o.d + self.v * o.dd)
         return Jet(self.v * o, self.d * o, self.dd * o)
@@ -84,7 +84,7 @@ class Jet:
         f = 1.0 / self.v
         return Jet(f, -self.d * f * f, (2 * self.d * self.d * f - self.dd) * f * f)
 
-    def __truediv__(self, o):
+    def __truediv__(self, o: Jet) -> Jet:
         return self * o.inverse() if isinstance(o, Jet) else self * (1.0 / o)
 
     def sqrt(self) -> Jet:
@@ -100,7 +100,7 @@ class Jet:
         return Jet(s, c * self.d, -s * self.d * self.d + c * self.dd)
 
     @staticmethod
-    def atan2(y, x) -> Jet:
+    def atan2(y: Jet, x: Jet) -> Jet:
         r2 = x.v * x.v + y.v * y.v
         num = x.v * y.d - y.v * x.d
         dr2 = 2 * (x.v * x.d + y.v * y.d)
@@ -112,24 +112,24 @@ class _Pose:
 
     __slots__ = ("th", "c", "s", "tx", "ty")
 
-    def __init__(self, th, tx, ty) -> None:
+    def __init__(self, th: Jet, tx: Jet, ty: Jet) -> None:
         self.th, self.c, self.s, self.tx, self.ty = th, th.cos(), th.sin(), tx, ty
 
-    def rotate(self, u) -> tuple:
+    def rotate(self, u: np.ndarray | tuple) -> tuple:
         return self.c * u[0] - self.s * u[1], self.s * u[0] + self.c * u[1]
 
-    def __call__(self, p) -> tuple:
+    def __call__(self, p: np.ndarray | tuple) -> tuple:
         x, y = self.rotate(p)
         return x + self.tx, y + self.ty
 
     @classmethod
-    def through(cls, th, point, p0):
+    def through(cls, th: Jet, point: tuple, p0: np.ndarray) -> _Pose:
         """The displacement turning by th that takes the q0 point p0 to ``point``."""
         c, s = th.cos(), th.sin()
         return cls(th, point[0] - (c * p0[0] - s * p0[1]), point[1] - (s * p0[0] + c * p0[1]))
 
 
-def _turn_from(u0, u):
+def _turn_from(u0: np.ndarray, u: tuple) -> Jet:
     """The angle from the constant vector u0 to the jet vector u, in (-pi, pi]."""
     return Jet.atan2(u[1] * u0[0] - u[0] * u0[1], u[0] * u0[0] + u[1] * u0[1])
 
@@ -184,20 +184,20 @@ class _Geometry:
                 return
             self.branch.append(float(np.sign(d)))
 
-    def point(self, i: int, g):
+    def point(self, i: int, g: int) -> np.ndarray:
         """Pair i's point (plane coordinates at q0) on the link of group g."""
         return self._points[i][self.pairs[i].groups.index(g)]
 
-    def other(self, i: int, g):
+    def other(self, i: int, g: int) -> np.ndarray:
         """Pair i's point on the link of its group other than g."""
         return self._points[i][1 - self.pairs[i].groups.index(g)]
 
-    def dir(self, i: int, g):
+    def dir(self, i: int, g: int) -> np.ndarray:
         """Pair i's axis (a slide's direction, plane coordinates at q0) on the link of group g."""
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma: float, probe: bool=False, clamp: bool=False):
+def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, g2: int, pa: _Pose | None, pc: _Pose, sigma: float, probe: bool=False, clamp: bool=False) -> float | tuple:
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -249,14 +249,14 @@ def _solve_dyad(geo, kinds, ia, ib, ic, g1, g2, pa, pc, sigma: float, probe: boo
     return (_Pose.through(th, A, A1), _Pose.through(th, C, C2)), disc.v / v0s
 
 
-def _root(disc, clamp):
+def _root(disc: Jet, clamp: bool) -> Jet:
     """The square root of a discriminant (NaN where it is negative); clamp: of max(disc, 0),
     values only (at a limit position, where the derivatives are infinite)."""
     with np.errstate(invalid="ignore", divide="ignore"):
         return Jet(np.sqrt(np.maximum(disc.v, 0.0))) if clamp else disc.sqrt()
 
 
-def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp=None):
+def _evaluate(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, branch: str, clamp: int | None = None) -> tuple:
     """(pose of every group, discriminants (dyads, N)) at input values xs on the given branches;
     clamp: the index of a dyad whose discriminant is taken as max(disc, 0) (at its limit).
     Past a limit the values are NaN; at it the derivatives are infinite (never reported)."""
@@ -264,7 +264,7 @@ def _evaluate(geo, p: DyadPlan, xs: np.ndarray, start, branch: str, clamp=None):
         return _evaluate_all(geo, p, xs, start, branch, clamp)
 
 
-def _evaluate_all(geo, p, xs: np.ndarray, start, branch: str, clamp) -> tuple:
+def _evaluate_all(geo: _Geometry, p: DyadPlan, xs: np.ndarray, start: float, branch: str, clamp: int | None) -> tuple:
     xs = np.asarray(xs, float)
     zero = Jet(np.zeros(len(xs)))
     poses = {p.groups[0]: _Pose(zero, zero, zero)}
@@ -293,7 +293,7 @@ def _evaluate_all(geo, p, xs: np.ndarray, start, branch: str, clamp) -> tuple:
 class _Layout:
     """Where each tree joint's coordinate comes from: the groups of its two links, its kind."""
 
-    def __init__(self, mech: Mechanism, p: DyadPlan, geo, q0: np.ndarray) -> None:
+    def __init__(self, mech: Mechanism, p: DyadPlan, geo: _Geometry, q0: np.ndarray) -> None:
         model = mech.model
         self.rows = []  # (idx_q, nq, idx_v, kind, parent group, child group, pair index or None)
         by_tree = {pr.tree: i for i, pr in enumerate(p.pairs) if pr.tree is not None}
@@ -304,7 +304,7 @@ class _Layout:
         self.geo, self.q0, self.nq, self.nv = geo, q0, model.nq, model.nv
         self.wrapped = [(iq, iv) for iq, nq, iv, kind, _, _, _ in self.rows if kind == "R" and nq == 1]
 
-    def __call__(self, poses, N) -> tuple:
+    def __call__(self, poses: dict, N: int) -> tuple:
         """(Q (N, nq) with the one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2 (N, nv))."""
         geo, q0 = self.geo, self.q0
         Q = np.tile(q0, (N, 1))
@@ -340,13 +340,13 @@ class _Unwrap:
     _SAFE = np.pi / 2  # the largest turn between two samples taken as unambiguous [rad]
     _SLACK = 0.01  # relative slack of the bounds |s| dx on a monotone step
 
-    def __init__(self, wrapped) -> None:
+    def __init__(self, wrapped: list) -> None:
         self.cols = np.array([iq for iq, _ in wrapped], int)
         self._iv = np.array([iv for _, iv in wrapped], int)
         self.last = None  # (raw, slope, x, turns) of the last sample
         self.ambiguous = False
 
-    def __call__(self, Q: np.ndarray, D, xs: np.ndarray):
+    def __call__(self, Q: np.ndarray, D: np.ndarray, xs: np.ndarray) -> np.ndarray:
         """Q with its angles unwrapped; D (N, nv): dq/dx."""
         if not len(self.cols) or not len(xs):
             return Q
@@ -400,7 +400,7 @@ class ClosedFormSweep:
     unit: str
 
 
-def cached_plan(solver, name: str):
+def cached_plan(solver, name: str) -> DyadPlan | str:
     """model.planar_graph.plan of the solver's mechanism swept along ``name`` with its other inputs
     held (a DyadPlan, or why not), kept in the mechanism's cache."""
     mech = solver.mech
@@ -416,7 +416,7 @@ class ClosedFormCurve:
     False (``reason`` why) when the geometry does not apply; probe=False: no branch is read off q0 (the
     caller passes its branch vectors, as dyad_modes does for every one of them)."""
 
-    def __init__(self, mech: Mechanism, p: DyadPlan, q0: np.ndarray, start, probe: bool = True) -> None:
+    def __init__(self, mech: Mechanism, p: DyadPlan, q0: np.ndarray, start: float, probe: bool = True) -> None:
         self.mech, self.p, self.start = mech, p, start
         self.geo = _Geometry(mech, p, q0, probe)
         self.ok, self.reason = self.geo.ok, getattr(self.geo, "reason", None)
@@ -424,20 +424,20 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs: np.ndarray, branch: str | None=None, clamp=None):
+    def predict(self, xs: np.ndarray, branch: str | None=None, clamp: int | None = None) -> tuple:
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
         return _evaluate(self.geo, self.p, xs, self.start, self.branch if branch is None else branch, clamp)
 
     @staticmethod
-    def accept(discs) -> int:
+    def accept(discs: np.ndarray) -> int:
         """How many leading values are placed: every discriminant non-negative (past a limit the branch
         does not exist; its values are NaN)."""
         bad = np.flatnonzero(~(discs.min(axis=0) >= 0)) if len(discs) else np.zeros(0, int)
         return int(bad[0]) if len(bad) else discs.shape[1]
 
-    def correct(self, poses, n: int):
+    def correct(self, poses: dict, n: int) -> tuple:
         """The closed form is exact: the poses of the first n values as joint coordinates
         (Q with its one-coordinate angles not yet unwrapped, dq/dx, d2q/dx2)."""
         return self.layout({g: _Pose(_take(q.th, n), _take(q.tx, n), _take(q.ty, n)) for g, q in poses.items()}, n)
@@ -446,7 +446,7 @@ class ClosedFormCurve:
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
-    def locate_limit(self, lo, hi):
+    def locate_limit(self, lo: float, hi: float) -> tuple:
         """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
         position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
         on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
@@ -464,7 +464,7 @@ class ClosedFormCurve:
         return x_lim, Q, D, which
 
 
-def _ready(solver, name: str, q0: np.ndarray, start):
+def _ready(solver, name: str, q0: np.ndarray, start: float) -> ClosedFormCurve | None:
     """The ClosedFormCurve for sweeping ``name`` from q0, or None when the closed form does not apply."""
     p = cached_plan(solver, name)
     if isinstance(p, str):
@@ -506,7 +506,7 @@ def _next_values(start: float, stop: float, steps: int, h: float, k_pos: float, 
     return xs
 
 
-def planar_sweep(solver, name: str, q0: np.ndarray, start, stop, steps: int, rate: float=1.0, turn: bool=False, max_steps: int | None=None) -> ClosedFormSweep | None:
+def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float=1.0, turn: bool=False, max_steps: int | None=None) -> ClosedFormSweep | None:
     """``sweep``'s result from the closed form, started from q0 (its assembly mode); None when
     the mechanism does not decompose into dyads, or where the result would not be sweep's
     (two limits between grid values, a configuration not closing the loops)."""

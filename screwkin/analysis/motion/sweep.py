@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.motion.crossing import ChangePoint
+    from collections.abc import Callable
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
 
@@ -91,7 +93,7 @@ class SweepResult:
         return self.stopped_at is None and not self.skipped
 
 
-def sweep_inputs(mech: Mechanism, name: str, fixed) -> list:
+def sweep_inputs(mech: Mechanism, name: str, fixed: dict) -> list:
     """The input joints of a motion of ``name`` with the joints ``fixed`` names held (a sweep's, the
     dynamics'): the actuated ones when ``name`` is one of them, else ``name`` and the held ones."""
     if name in mech.actuated:
@@ -99,7 +101,7 @@ def sweep_inputs(mech: Mechanism, name: str, fixed) -> list:
     return [name, *(n for n in fixed if n != name)]
 
 
-def _drawn_regular(solver, values: dict):
+def _drawn_regular(solver, values: dict) -> np.ndarray | None:
     """The file's drawn configuration, when it is closed as drawn, at the input ``values``, within the
     joint limits, and regular by its own ranks for a mechanism the inputs determine by dyads (the plan of
     analysis.motion.dyads exists: its passive joints follow from the inputs, so the generic ranks of K
@@ -135,7 +137,7 @@ def _drawn_regular(solver, values: dict):
     return a.q
 
 
-def drawn_start(solver, values: dict):
+def drawn_start(solver, values: dict) -> np.ndarray | None:
     """The configuration the file is drawn in, when it is already at the input ``values`` and is the
     mode ``solver.solve(values)`` puts first (one the mechanism reaches, not singular: the nearest to
     the drawing of those), found without solve's search from random starts (a sweep from the drawn
@@ -168,7 +170,7 @@ REFINE = 8
 ON_GRID = 1e-6  # a value within this fraction of a fine step of a fine grid value is on that grid
 
 
-def _refined(f, start, h, k: int):
+def _refined(f, start: float, h: float, k: int):
     """The closed-form sweep ``f`` of a grid k times finer (step h / k) at the values of the grid of step h
     (and its located limit position, off both grids); None for None."""
     if f is None:
@@ -182,7 +184,7 @@ def _refined(f, start, h, k: int):
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
           near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
-          max_steps: int | None = None, q_start=None, closed_form: bool = True, batch: bool = True,
+          max_steps: int | None = None, q_start: np.ndarray | Callable | None=None, closed_form: bool = True, batch: bool = True,
           branch: str = "continue", prior=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
@@ -217,7 +219,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     return _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior)
 
 
-def _engine(solver, name: str, q0: np.ndarray, start, stop, steps: int, fixed, rate, progress, turn, max_steps: int, closed_form, batch):
+def _engine(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, fixed: dict, rate: float, progress, turn: bool, max_steps: int, closed_form: bool, batch: bool) -> SweepResult:
     """The SweepResult of the engine that applies (see ``sweep``), started from q0."""
     curve, requested = Curve(solver, name), (start, stop, steps)
     if closed_form:
@@ -240,7 +242,7 @@ def _engine(solver, name: str, q0: np.ndarray, start, stop, steps: int, fixed, r
     return _finish(solver, name, motion, rate, requested, turn, curve.unit)
 
 
-def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
+def _other_inputs(solver, name: str, steps: int, fixed: dict | None) -> dict:
     """The other inputs' values (a copy of ``fixed``), once the arguments are checked."""
     if steps < 1:
         raise UsageError("a sweep needs at least 1 step")
@@ -253,7 +255,7 @@ def _other_inputs(solver, name: str, steps: int, fixed) -> dict:
     return fixed
 
 
-def _start(solver, name: str, start, fixed, near, q_start):
+def _start(solver, name: str, start: float, fixed: dict, near: dict | None, q_start: np.ndarray | Callable | None) -> np.ndarray:
     """The configuration the sweep starts from: q_start's mode closed at the first input value (q_start
     may be a function giving it, called now: a command's --mode K, said as it is chosen), else the
     drawing when it is solve's first mode there, else solve's first (near ``near``)."""
@@ -267,7 +269,7 @@ def _start(solver, name: str, start, fixed, near, q_start):
     return q0
 
 
-def _closed_form(solver, name: str, q0: np.ndarray, start, stop, steps: int, rate, turn, max_steps: int) -> SweepResult | None:
+def _closed_form(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, rate: float, turn: bool, max_steps: int) -> SweepResult | None:
     """The SweepResult of the closed-form engine (analysis.motion.dyads; on a finer grid read at this
     one's values where this one is too coarse for it), or None where it does not apply."""
     f = planar_sweep(solver, name, q0, start, stop, steps, rate, turn, max_steps)
@@ -282,7 +284,7 @@ def _closed_form(solver, name: str, q0: np.ndarray, start, stop, steps: int, rat
                        method="closed form")
 
 
-def _fallback(solver, curve, fixed):
+def _fallback(solver, curve: Curve, fixed: dict) -> Callable:
     """The batched engine's fallback: the per-step tracker's Motion of n steps from qa (input xa) to xb,
     qa closed again at xa first (as a sweep started from it)."""
 
@@ -296,7 +298,7 @@ def _fallback(solver, curve, fixed):
     return fallback
 
 
-def _trackable(mech: Mechanism, name: str, start, stop, steps: int):
+def _trackable(mech: Mechanism, name: str, start: float, stop: float, steps: int) -> None:
     """A range the per-step tracker takes more than MAX_TRACKED steps over (and more than its grid
     values) is a usage error naming the count."""
     needed = continuation_steps(mech, name, stop - start)
@@ -306,7 +308,7 @@ def _trackable(mech: Mechanism, name: str, start, stop, steps: int):
                          f"values, more than the {MAX_TRACKED:,} a sweep tracks: give a smaller range")
 
 
-def _start_tangent(curve, q0: np.ndarray, h) -> tuple:
+def _start_tangent(curve: Curve, q0: np.ndarray, h: float) -> tuple:
     """(the tangent at q0 oriented along the grid step h, None) or (None, why the input cannot move)."""
     try:
         return curve.along(q0, h), None
@@ -314,7 +316,7 @@ def _start_tangent(curve, q0: np.ndarray, h) -> tuple:
         return None, str(exc)
 
 
-def _finish(solver, name: str, motion, rate, requested, turn, unit: str, method: str="tracker") -> SweepResult:
+def _finish(solver, name: str, motion: Motion, rate: float, requested: tuple, turn: bool, unit: str, method: str="tracker") -> SweepResult:
     """The SweepResult of an engine's Motion: rates and accelerations at each configuration."""
     X, Q = motion.X, motion.Q
     mech = solver.mech
@@ -345,7 +347,7 @@ def _finish(solver, name: str, motion, rate, requested, turn, unit: str, method:
 
 
 
-def _through_change_points(solver, res, fixed, progress, max_steps: int, closed_form, batch, branch: str, prior=None):
+def _through_change_points(solver, res: SweepResult, fixed: dict, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None) -> SweepResult:
     """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it
@@ -430,7 +432,7 @@ def _once(notes) -> tuple:
     return tuple(dict.fromkeys(notes))
 
 
-def _engine_took(solver, curve, res, k0, after, h) -> bool:
+def _engine_took(solver, curve: Curve, res, k0, after, h) -> bool:
     """Whether the engine's recorded configurations from index k0 are ``after`` ((input value,
     configuration) each, the branch followed), the input running the way of h."""
     tol = solver.mech.tolerances
@@ -449,7 +451,7 @@ def _engine_took(solver, curve, res, k0, after, h) -> bool:
 GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index counts as on it
 
 
-def _change_point_note(solver, name: str, unit: str, cp, why, branch: str) -> str:
+def _change_point_note(solver, name: str, unit: str, cp: ChangePoint, why, branch: str) -> str:
     """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
     # (located where the constraint measure is least: to about the square root of the closure's round-off)
     at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
@@ -474,7 +476,7 @@ def _change_point_note(solver, name: str, unit: str, cp, why, branch: str) -> st
 _WORDS = {2: "two", 3: "three", 4: "four"}
 
 
-def _slice(res, n: int):
+def _slice(res: SweepResult, n: int):
     """The first n configurations of res (n >= 0), its limits before them."""
     xs = res.values[:n]
     lim = tuple(s for s in res.limits if n and _between(s.input, res.values[0], res.values[n - 1]))
@@ -488,7 +490,7 @@ def _between(x, a, b) -> bool:
     return min(a, b) <= x <= max(a, b)
 
 
-def _joined(solver, res, head, middle, tail, named, notes, c):
+def _joined(solver, res: SweepResult, head: SweepResult, middle, tail: SweepResult, named, notes, c):
     """head + middle + tail (SweepResults; middle or tail may be None): one motion."""
     parts = [p for p in (head, middle, tail) if p is not None and len(p.values)]
     cat = (lambda f: np.concatenate([getattr(p, f) for p in parts])) if parts else (lambda f: getattr(head, f))

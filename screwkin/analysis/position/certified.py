@@ -41,6 +41,12 @@ from ...tolerances import Tolerances
 from .dyad_modes import dyad_modes
 from . import generic_modes
 from .modes import continuum_words
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from screwkin.model.homotopy.known_counts import KnownCount
+    from screwkin.model.homotopy.monodromy import Endpoints
+    from screwkin.model.homotopy.monodromy import Roots
 
 NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
@@ -165,7 +171,7 @@ def certified_modes(solver, values: dict, seed: int = 0, tolerances: Tolerances 
     return _reference_check(solver, problem, got)
 
 
-def _reference_check(solver, problem, got: Certified) -> Certified:
+def _reference_check(solver, problem: Problem, got: Certified) -> Certified:
     """A certificate held against one root found another way before it is given: damped Newton from the
     reference configuration (the file's drawing, the inputs set) on Pinocchio's closure.  A real root there
     that the certified set does not hold, or one where the closure's Jacobian in the unknowns loses rank (a
@@ -197,7 +203,7 @@ def _reference_check(solver, problem, got: Certified) -> Certified:
     return Certified(got.modes, count)
 
 
-def _rank(closure, rng: np.random.Generator) -> int:
+def _rank(closure: PolynomialClosure, rng: np.random.Generator) -> int:
     """The generic rank of the closure rows' Jacobian (at random complex points of the variety)."""
     if closure.nt == 0 or closure.m == 0:
         return 0
@@ -205,7 +211,7 @@ def _rank(closure, rng: np.random.Generator) -> int:
     return int(max(np.linalg.matrix_rank(j, tol=_RANK * np.abs(j).max(initial=0.0)) for j in J))
 
 
-def _classify(solver, problem, closure, system, group, roots, ends, known, seconds, o: Tolerances,
+def _classify(solver, problem: Problem, closure: PolynomialClosure, system: SquareSystem, group, roots: Roots, ends: Endpoints, known: KnownCount, seconds, o: Tolerances,
               also: str = "") -> Certified:
     """The real modes (polished, one angle set each) and the counts, from the target's endpoints."""
     mech, tol = solver.mech, solver.mech.tolerances
@@ -300,7 +306,7 @@ def _coinciding(X: np.ndarray, mask, group, tol) -> np.ndarray:
     return out
 
 
-def _lift(solver, problem, closure, x):
+def _lift(solver, problem: Problem, closure: PolynomialClosure, x):
     """The real configuration of a real root x of the closure: its joints, and the eliminated legs'
     angles (model.legs) solved by damped Newton with every other joint held -- from the inputs'
     configuration, then from random angles -- or None."""
@@ -320,7 +326,7 @@ def _lift(solver, problem, closure, x):
     return None
 
 
-def _best_twin(solver, problem, closure, elements, x) -> tuple:
+def _best_twin(solver, problem: Problem, closure, elements, x) -> tuple:
     """(q, Assembly) of the joint-angle set of this root to report: of its twins under the symmetry group
     (which place the links alike), the one within the joint limits nearest the reference configuration,
     polished on Pinocchio's closure."""

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["CuspLoop", "Loop", "apart", "cusp_loops", "loop", "wedge_direction"]
 
@@ -49,7 +50,7 @@ class Loop:
     why: str  # in words
 
 
-def loop(solver, x_name: str, y_name: str, fixed, centre, radius, q0: np.ndarray, steps: int = 720, start: float = 0.0,
+def loop(solver: PositionSolver, x_name: str, y_name: str, fixed: dict, centre: tuple, radius: tuple, q0: np.ndarray, steps: int = 720, start: float = 0.0,
          turn: int = 1) -> Loop:
     """Follow q0 (at the angle ``start`` of the ellipse) once round the ellipse of the inputs with ``centre``
     and semi-axes ``radius``, counter-clockwise (turn 1) or clockwise (turn -1), in ``steps`` steps."""
@@ -78,7 +79,7 @@ def loop(solver, x_name: str, y_name: str, fixed, centre, radius, q0: np.ndarray
     return Loop(xy, np.array(Q), smallest, regular, joined, why)
 
 
-def wedge_direction(points, cusp, radius) -> float:
+def wedge_direction(points, cusp: tuple, radius: float) -> float:
     """The angle of the direction in which a cusp's two branches leave it (its wedge, where three modes
     meet), from a traced locus (points (n, 2)): the mean direction of its points between half and three
     times ``radius`` from the cusp."""
@@ -101,7 +102,7 @@ class CuspLoop:
     loop: Loop
 
 
-def cusp_loops(solver, loci, x_name: str, y_name: str, fixed, box, size: float = 0.02, steps: int = 720) -> tuple:
+def cusp_loops(solver: PositionSolver, loci, x_name: str, y_name: str, fixed: dict, box: tuple, size: float = 0.02, steps: int = 720) -> tuple:
     """For each cusp of the actuator loci (analysis.singularities.loci.Loci): every mode at a point inside
     its wedge, followed once round the cusp each way on an ellipse of semi-axes ``size`` times the box's
     sides (``loop``).  Returns (CuspLoop of every regular loop that ends on another mode, loops tried)."""

@@ -138,12 +138,12 @@ def _wxyz(q: np.ndarray):
     return pin.Quaternion(q[3], q[0], q[1], q[2])
 
 
-def _same_pose(mech: Mechanism, q: np.ndarray, arch, R, t) -> bool:
+def _same_pose(mech: Mechanism, q: np.ndarray, arch: Architecture, R, t) -> bool:
     M = KinematicState(mech, q).joint_placement(arch.joint)
     return (np.abs(M.translation - t).max() <= _MOVED * arch.L and np.abs(M.rotation - R).max() <= _MOVED)
 
 
-def _carried(mech: Mechanism, problem, arch: Architecture, R, t) -> list:
+def _carried(mech: Mechanism, problem, arch: Architecture, R: np.ndarray, t) -> list:
     """Configurations with the carrying leg's angles putting the platform's joint frame at (R, t)."""
     model = problem.model
     head, tail = arch.carrier

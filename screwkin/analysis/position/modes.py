@@ -59,7 +59,7 @@ def continuum_words(free: int) -> str:
     return f"these inputs leave {free} degree{'s' if free != 1 else ''} of freedom free (a continuum)"
 
 
-def merge(solver, sols):
+def merge(solver, sols) -> list:
     """Solutions that are one root: a singular solution and others within the accuracy a
     double root can be computed to (about the square root of the closure tolerance), or
     joined to it by a motion with the inputs held (a continuum)."""
@@ -182,7 +182,7 @@ class ModeLabels:
             if not any(rank(st.frame_jacobian(fid, LWA)[3:] @ V, mech.tolerances) for st, V in zip(states, Vs)):
                 self.turned.append((link, fid, state.frame_placement(fid).rotation.copy()))
 
-    def _signed_length(self, state, jid, far, axis) -> float:
+    def _signed_length(self, state: KinematicState, jid, far, axis: np.ndarray) -> float:
         kind, i = far
         p = state.joint_placement(i).translation if kind == "joint" else state.frame_placement(i).translation
         return float((p - state.joint_placement(self.model.parents[jid]).translation)

@@ -55,6 +55,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.model.kernel.closure import ClosureSystem
+    from screwkin.analysis.mobility import MobilityResult
 
 __all__ = ["PositionSolver"]
 
@@ -150,7 +152,7 @@ class PositionSolver:
         free = len(self.passive) - g.rank_Kp - kept
         return max(free - self.idle_dofs, 0) if free > 0 else 0  # (idle DOFs, a mobility analysis: only if any is left)
 
-    def _mobility(self):
+    def _mobility(self) -> MobilityResult:
         self.generic()  # the assembly the mobility analysis starts from
         return analyze_mobility(self.mech)
 
@@ -198,7 +200,7 @@ class PositionSolver:
         """Every joint coordinate name -> value [rad or m] (Mechanism.joint_values)."""
         return self.mech.joint_values(q)
 
-    def _wrap(self, q: np.ndarray):
+    def _wrap(self, q: np.ndarray) -> np.ndarray:
         q = np.array(q, float)
         _, _, _, _, idx, wrap = self.mech._value_layout()
         w = idx[wrap]
@@ -240,7 +242,7 @@ class PositionSolver:
             raise UsageError(f"{self.mech.path}: give a value for each input joint ({', '.join(self.inputs)})"
                              + (f"; not inputs: {', '.join(unknown)}" if unknown else ""))
 
-    def file_values_hint(self, names=None) -> str:
+    def file_values_hint(self, names: list | None = None) -> str:
         """--set options that give the joints ``names`` (default: the inputs) the file's values (SI:
         rad, m), as a way to name them in an error: one option where the values are equal."""
         names = list(self.inputs if names is None else names)
@@ -394,7 +396,7 @@ class PositionSolver:
         ref = self.reference()
         return self.mech.neutral() if ref is None else ref
 
-    def _at_once(self, values):
+    def _at_once(self, values: dict):
         """solve's default (method "nearest"): every mode where they come at once, as a certified.Search --
         a closure that is not polynomial or inputs that leave a continuum (an empty Search: solve's random
         starts find them, or samples of the continuum; no homotopy to spare), a mechanism of dyads (their closed form, analysis.position.certified.closed_form) -- or None
@@ -425,7 +427,7 @@ class PositionSolver:
                            f"(the nearest these inputs allow; the joints --near does not name were free)")
         return tuple(out)
 
-    def distinct(self, system, starts: int, frozen=(), first_trace=None) -> tuple:
+    def distinct(self, system: ClosureSystem, starts: int, frozen=(), first_trace=None) -> tuple:
         """Solve ``system`` from every start; keep one solution per assembly mode.
 
         Returns ([(signature, q, Assembly)], smallest residual of the failures)."""
@@ -449,7 +451,7 @@ class PositionSolver:
         return found, best
 
     @staticmethod
-    def _describe(values) -> str:
+    def _describe(values: dict) -> str:
         return ", ".join(f"{k}={v:.6g}" for k, v in values.items())
 
     # --------------------------------------------------------------- one answer per mode
@@ -479,7 +481,7 @@ class PositionSolver:
             self._link_angles(self.mech.neutral())
         return None if self._angles is None else self._angles.n
 
-    def _link_angles(self, q: np.ndarray, state=None):
+    def _link_angles(self, q: np.ndarray, state: KinematicState | None = None):
         if self._angles is False:
             self._angles = None
             ref = self.reference()
@@ -490,7 +492,7 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q: np.ndarray, a, rates=None, accels=None, points=(), typed=None, sets=None, simple=None,
+    def solution(self, q: np.ndarray, a, rates: dict | None = None, accels: dict | None = None, points=(), typed=None, sets=None, simple=None,
                  spelled: bool = False) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
@@ -541,7 +543,7 @@ class PositionSolver:
     def _named(self, v) -> dict:
         return dict(zip(self.mech.coordinate_names, map(float, v)))
 
-    def _input_vector(self, values: dict):
+    def _input_vector(self, values: dict) -> np.ndarray:
         x = np.zeros(len(self.frozen))
         for k, name in enumerate(self.inputs):
             x[k] = values.get(name, 0.0)
@@ -559,7 +561,7 @@ class PositionSolver:
         U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
         return (lambda b: Vt.T @ (inv * (U.T @ b))), s
 
-    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None):
+    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None) -> np.ndarray:
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
         the passive joints, so idle spins are zero).  A link held at an angle (link_inputs)
         turns at the rate ``values`` gives its name (0 when none): its row's K q' is that rate.
@@ -571,7 +573,7 @@ class PositionSolver:
             qd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qd[self.frozen])
         return qd
 
-    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None):
+    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None) -> np.ndarray:
         """Joint accelerations from K q'' = -K' q' with the input accelerations given (a held link's
         angular acceleration as its row's, as in ``rates``)."""
         qdd = np.zeros(self.mech.nv)

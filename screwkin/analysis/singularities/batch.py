@@ -61,7 +61,7 @@ class SerialJacobians:
     >>> J = sj(Q)            # (N, 6, nv), Q: (N, nq) Pinocchio configurations
     """
 
-    def __init__(self, mech: Mechanism, link: str | None, reference=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
+    def __init__(self, mech: Mechanism, link: str | None, reference: pin.ReferenceFrame=pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, block: int = 8192,
                  check: int = 0, chain=None) -> None:
         """chain: a screws.Chain to any frame instead of the one to ``link``'s body frame."""
 
@@ -120,7 +120,7 @@ class SerialJacobians:
             th[k] = Q[:, iq] - zero if kind == "linear" else continuous_angle(Q, iq)
         return th
 
-    def _block(self, th: np.ndarray, pose: bool = False):
+    def _block(self, th: np.ndarray, pose: bool = False) -> tuple:
         """(N, 6, n) Jacobians of a block of configurations; arrays are laid out with the
         configurations last so that every operation is one numpy call on N numbers.
         pose: also the frame's rotations (N, 3, 3) and origins (N, 3)."""
@@ -281,7 +281,7 @@ class SerialJacobians:
                 raise RuntimeError(f"batched Jacobian differs from Pinocchio's by {err:.1e}")
 
 
-def _apply(R: np.ndarray, x) -> np.ndarray:
+def _apply(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     """R x for a stack of rotations stored by columns (R[b]: (3, N)) and a constant 3-vector x."""
     out = None
     for b in range(3):

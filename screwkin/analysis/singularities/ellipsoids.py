@@ -69,7 +69,7 @@ def _axis_labels(d: int, linear: int) -> tuple:
     return lin + ang, flin + fang
 
 
-def _of_scaled(M, L, inputs, tol: Tolerances, linear: int, output=None, point: bool=False) -> Ellipsoids:
+def _of_scaled(M: np.ndarray, L: float, inputs: list | tuple, tol: Tolerances, linear: int, output: str | None = None, point: bool=False) -> Ellipsoids:
     d = M.shape[0]
     U, s, _ = np.linalg.svd(M, full_matrices=True) if M.size else (np.eye(d), np.zeros(0), None)
     vel = np.zeros(d)
@@ -100,7 +100,7 @@ def ellipsoids_of(J: np.ndarray, length: float = 1.0, linear: int = 3, sliding=N
     return _of_scaled(M, length, names, tol, linear)
 
 
-def ellipsoids(mech: Mechanism, q: np.ndarray, output: str, inputs=None, point: bool = False, length: float | None = None) -> Ellipsoids:
+def ellipsoids(mech: Mechanism, q: np.ndarray, output: str, inputs: list | None=None, point: bool = False, length: float | None = None) -> Ellipsoids:
     """The velocity and force ellipsoids of link ``output``'s origin at the assembled
     configuration q (its twist (v, w) in world axes; ``point``: its velocity only).
 
@@ -145,7 +145,7 @@ def with_input_output_condition(mech: Mechanism, q: np.ndarray, rep: Singularity
     return replace(rep, condition_input_output=io, input_output_note=note)
 
 
-def _input_output_condition(mech: Mechanism, q: np.ndarray, rep) -> tuple:
+def _input_output_condition(mech: Mechanism, q: np.ndarray, rep: SingularityReport) -> tuple:
     tol = mech.tolerances
     if rep.output is None:
         return None, "give --output LINK, the moving platform"

@@ -49,6 +49,10 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.position.position import PositionSolver
+    from screwkin.model.mechanism import Coordinate
+    from collections.abc import Callable
+    from collections.abc import Iterator
 
 __all__ = ["Loci", "Locus", "LocusSystem", "trace_loci"]
 
@@ -86,7 +90,7 @@ class Loci:
 class LocusSystem:
     """The augmented system F of one kind on S (see the module)."""
 
-    def __init__(self, mech: Mechanism, inputs, x_name: str, y_name: str, fixed, kind: str, output=None, point: bool=False, generic=None) -> None:
+    def __init__(self, mech: Mechanism, inputs: list, x_name: str, y_name: str, fixed: dict, kind: str, output: str | None=None, point: bool=False, generic: Generic | None=None) -> None:
         self.mech, self.kind, self.output, self.point = mech, kind, output, point
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)  # dq = scale * u: u dimensionless
@@ -102,7 +106,7 @@ class LocusSystem:
                                  for n in names], bool)
 
     # ----------------------------------------------------------------- pieces
-    def value(self, q: np.ndarray, c) -> float:
+    def value(self, q: np.ndarray, c: Coordinate) -> float:
         """The coordinate's value [rad or m] (continuous joints: their unwrapped angle's atan2)."""
         return float(continuous_angle(q[None], c.idx_q)[0]) if c.nq == 2 else float(q[c.idx_q])
 
@@ -121,10 +125,10 @@ class LocusSystem:
         J = dimensionless_twists(KinematicState(mech, q).link_jacobian(self.output, LWA), mech.translational, self.L)
         return np.vstack([K, J[:3] if self.point else J])
 
-    def integrate(self, q: np.ndarray, u) -> np.ndarray:
+    def integrate(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
         return self.mech.closure.integrator(q[None], (self.scale * u)[None])[0]
 
-    def residual(self, q: np.ndarray, v, A=None) -> np.ndarray:
+    def residual(self, q: np.ndarray, v: np.ndarray, A: np.ndarray | None=None) -> np.ndarray:
         mech = self.mech
         parts = []
         if mech.closure.nrows:
@@ -139,7 +143,7 @@ class LocusSystem:
         parts += [A @ v, [0.5 * (v @ v - 1.0)]]
         return np.concatenate(parts)
 
-    def jacobian(self, q: np.ndarray, v, A=None) -> np.ndarray:
+    def jacobian(self, q: np.ndarray, v: np.ndarray, A: np.ndarray | None=None) -> np.ndarray:
         """dF/d(u, v) (rows of F, nv + columns of A); d(A v)/du by forward differences."""
         mech = self.mech
         A = self.A(q) if A is None else A
@@ -149,7 +153,7 @@ class LocusSystem:
             blocks.append(np.hstack([K, np.zeros((len(K), len(v)))]))
         return np.vstack(blocks + self._held_kind_norm_rows(q, v, A))
 
-    def _held_kind_norm_rows(self, q: np.ndarray, v, A) -> list:
+    def _held_kind_norm_rows(self, q: np.ndarray, v: np.ndarray, A: np.ndarray) -> list:
         """The Jacobian's rows after the loops' (a section's too): the held inputs, d(A v)/d(u, v) (d/du by
         forward differences of step FD) and |v| = 1."""
         H = np.zeros((len(self.held), self.nv + len(v)))
@@ -163,7 +167,7 @@ class LocusSystem:
             D[:, k] = (self.A(self.integrate(q, e)) @ v - Av) / FD
         return [H, np.hstack([D, A]), np.concatenate([np.zeros(self.nv), v])[None]]
 
-    def relative(self, q: np.ndarray, v=None) -> float:
+    def relative(self, q: np.ndarray, v: np.ndarray | None = None) -> float:
         """|A v| / |A| (v: A's smallest right singular vector when None): the point's distance from the
         kind's singular condition, relative."""
         A = self.A(q)
@@ -175,7 +179,7 @@ class LocusSystem:
     def kernel(self, q: np.ndarray) -> np.ndarray:
         return np.linalg.svd(self.A(q))[2][-1]
 
-    def edge(self, axis: int, bound: float):
+    def edge(self, axis: int, bound: float) -> Callable:
         """The extra row of ``newton`` that holds the plane's coordinate ``axis`` (0: x, 1: y) at ``bound``."""
         c = (self.cx, self.cy)[axis]
 
@@ -187,7 +191,7 @@ class LocusSystem:
         return row
 
     # ------------------------------------------------------------ Newton, tangent
-    def newton(self, q: np.ndarray, v, extra=None, iterations: int = 30, max_step: float = 0.3, J: np.ndarray | None=None) -> tuple | None:
+    def newton(self, q: np.ndarray, v: np.ndarray, extra: Callable | None=None, iterations: int = 30, max_step: float = 0.3, J: np.ndarray | None=None) -> tuple | None:
         """Newton (least squares, steps capped at max_step; the Jacobian kept while the residual falls
         fast: a chord step) on F, with ``extra`` rows (function (q, v) -> (rows, rhs), linear in the
         step): (q, v) converged (|F| < RESIDUAL), or None."""
@@ -216,21 +220,21 @@ class LocusSystem:
         F = self.residual(q, v)
         return (q, v) if float(np.linalg.norm(F)) < RESIDUAL else None
 
-    def tangent(self, q: np.ndarray, v, previous=None, J: np.ndarray | None=None) -> np.ndarray:
+    def tangent(self, q: np.ndarray, v: np.ndarray, previous: np.ndarray | None=None, J: np.ndarray | None=None) -> np.ndarray:
         """Unit null vector of dF in (u, v) (J: dF at (q, v) when already computed), oriented along ``previous``."""
         t = np.linalg.svd(self.jacobian(q, v) if J is None else J)[2][-1]
         return orient(t, previous)  # the continuation's one branch rule
 
-    def nullity_ok(self, q: np.ndarray, v) -> bool:
+    def nullity_ok(self, q: np.ndarray, v: np.ndarray) -> bool:
         s = np.linalg.svd(self.jacobian(q, v), compute_uv=False)
         return len(s) >= self.nv + len(v) - 1 and s[self.nv + len(v) - 2] > self.mech.tolerances.crossing_rank * s[0]
 
-    def projected(self, q: np.ndarray, t) -> np.ndarray:
+    def projected(self, q: np.ndarray, t: np.ndarray) -> np.ndarray:
         """The plane's velocity (dx, dy) [SI] along the tangent t of the curve."""
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q: np.ndarray, v, t, h, J: np.ndarray | None=None):
+    def along(self, q: np.ndarray, v: np.ndarray, t: np.ndarray, h: float, J: np.ndarray | None=None) -> tuple:
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q
@@ -242,13 +246,13 @@ class LocusSystem:
         return self.newton(qp, vp, plane, iterations=8, max_step=max(h, 1e-3), J=J)
 
 
-def _in_box(p, box, margin: float=0.0) -> bool:
+def _in_box(p: np.ndarray, box: tuple, margin: float=0.0) -> bool:
     (x0, x1), (y0, y1) = box
     mx, my = margin * (x1 - x0), margin * (y1 - y0)
     return x0 - mx <= p[0] <= x1 + mx and y0 - my <= p[1] <= y1 + my
 
 
-def _trace_one_way(sys, q: np.ndarray, v, box, direction) -> tuple:
+def _trace_one_way(sys: LocusSystem, q: np.ndarray, v: np.ndarray, box: tuple, direction: int) -> tuple:
     """Points from (q, v) along +-tangent until the box's edge, the start again, or MAX_POINTS.
     Returns (qs, vs, closed, truncated)."""
     J = sys.jacobian(q, v)
@@ -281,11 +285,11 @@ def _trace_one_way(sys, q: np.ndarray, v, box, direction) -> tuple:
     return qs, vs, ts, False, True
 
 
-def _dist(sys, q1: np.ndarray, q2: np.ndarray) -> float:
+def _dist(sys: LocusSystem, q1: np.ndarray, q2: np.ndarray) -> float:
     return float(np.linalg.norm(sys.mech.difference(q1, q2) / sys.scale))
 
 
-def _clip(sys, qs, vs, box) -> tuple:
+def _clip(sys: LocusSystem, qs: list, vs: list, box: tuple) -> tuple:
     """The points in the box; an end outside is replaced by the curve's crossing of the box's edge
     (Newton with the coordinate held at the edge)."""
     out_q, out_v = list(qs), list(vs)
@@ -315,7 +319,7 @@ def _clip(sys, qs, vs, box) -> tuple:
     return out_q, out_v
 
 
-def _onto_edge(sys, q: np.ndarray, v, box):
+def _onto_edge(sys: LocusSystem, q: np.ndarray, v: np.ndarray, box: tuple) -> tuple | None:
     """A locus point outside the box moved along the curve onto the box's edge: Newton on F with the
     coordinate outside held at the nearer bound (x, then y).  None when the curve does not reach it."""
     for axis in (0, 1):
@@ -330,7 +334,7 @@ def _onto_edge(sys, q: np.ndarray, v, box):
     return None
 
 
-def _cusps(sys, qs, vs, ts):
+def _cusps(sys: LocusSystem, qs: list, vs: list, ts: list) -> list:
     """Cusps on one traced curve: reversals of the plane's velocity between neighbouring points,
     each located by Brent's method on the arclength from the first point of the bracket."""
     out = []
@@ -374,7 +378,7 @@ def _cusps(sys, qs, vs, ts):
     return out
 
 
-def trace_loci(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed, output=None, point: bool=False, kinds=None, grid: int = 9,
+def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, output: str | None=None, point: bool=False, kinds=None, grid: int = 9,
                starts: int | None=None) -> Loci:
     """The singular loci of each kind in the box xs[0]..xs[-1] x ys[0]..ys[-1] (see the module).
     starts: configurations to seed from (default: every mode the solver finds at the box's centre)."""
@@ -417,7 +421,7 @@ def trace_loci(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray,
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
 
 
-def trace_kind(sys, kind: str, seeds, box, notes) -> tuple:
+def trace_kind(sys: LocusSystem, kind: str, seeds: Iterator, box: tuple, notes: list) -> tuple:
     """The curves of one kind (sys: a LocusSystem or one like it) from the configurations ``seeds``, each
     brought onto the locus by Newton (onto the box's edge when outside) unless near a curve already traced:
     (loci, cusps ((x, y), kind), their configurations, nodes ((x, y), kind)); notes gets what it left."""
@@ -483,7 +487,7 @@ def trace_kind(sys, kind: str, seeds, box, notes) -> tuple:
     return loci, cusps, cusp_q, nodes
 
 
-def _modes_in_box(solver, x_name: str, y_name: str, box, fixed) -> tuple[list, str]:
+def _modes_in_box(solver: PositionSolver, x_name: str, y_name: str, box: tuple, fixed: dict) -> tuple[list, str]:
     """(configurations, in words): every mode the solver finds at the box's centre; where none assembles
     there, at the first of the other nodes of a 3 x 3 grid of the box that assembles."""
     (x0, x1), (y0, y1) = box
@@ -502,7 +506,7 @@ def _modes_in_box(solver, x_name: str, y_name: str, box, fixed) -> tuple[list, s
     return [], "no assembly mode at the centre, corners or edge midpoints of the box"
 
 
-def _near(sys, q: np.ndarray, Q: np.ndarray) -> float:
+def _near(sys: LocusSystem, q: np.ndarray, Q: np.ndarray) -> float:
     """The distance (dimensionless: lengths over L) from q to the nearest of the configurations Q, by
     their joint values (angles the short way round)."""
     rows = sys.mech.joint_value_rows(np.vstack([q[None], Q]))
@@ -512,7 +516,7 @@ def _near(sys, q: np.ndarray, Q: np.ndarray) -> float:
     return float(np.sqrt((D * D).sum(axis=1)).min())
 
 
-def _untraceable(mech: Mechanism, g, kind: str, output, inputs) -> str | None:
+def _untraceable(mech: Mechanism, g: Generic, kind: str, output: str, inputs: list) -> str | None:
     if kind == "actuator":
         if not mech.closure.nrows or not len(g.p):
             return "no loop, no passive joint"

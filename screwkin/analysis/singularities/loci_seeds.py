@@ -18,7 +18,7 @@ __all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexpla
 TINY = 1e-300  # division guard: two segments parallel
 
 
-def unexplained_folds(sheets, loci, box: tuple, n: int) -> list:
+def unexplained_folds(sheets: list, loci: list, box: tuple, n: int) -> list:
     """Notes for the grid nodes a continuation step was refused from (a fold lies within a cell) with no
     traced actuator curve within a cell and a half: a component the seeds missed."""
     span = np.array([box[0][1] - box[0][0], box[1][1] - box[1][0]], float)
@@ -84,7 +84,7 @@ def sheets(solver: PositionSolver, x_name: str, y_name: str, box: tuple, starts:
     return out
 
 
-def seed_configurations(sys, sheets) -> list:
+def seed_configurations(sys, sheets: list) -> list:
     """Grid configurations to seed Newton from, most singular first: next to a refused step, or a local
     minimum of the kind's relative singular value along a grid line."""
     cands = []
@@ -148,7 +148,7 @@ def crossings(curves: list, box: tuple) -> list:
     return out
 
 
-def refine_node(sys, one, k1, f1, other, k2, f2, span):
+def refine_node(sys, one: tuple, k1: int, f1: float, other: tuple, k2: int, f2: float, span: float) -> np.ndarray | None:
     """The crossing of two traces near their segments k1 and k2 (at fractions f1, f2 of them): Newton on
     the two arclengths s1, s2 from the segments' first points, xy(curve1(s1)) = xy(curve2(s2)), each
     point converged on F (LocusSystem.along).  None when it does not converge."""

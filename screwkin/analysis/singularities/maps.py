@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.position.position import PositionSolver
+    from collections.abc import Callable
 
 __all__ = ["SingularityMap", "singularity_map", "seams"]
 
@@ -47,8 +49,8 @@ class SingularityMap:
         return int(self.reached.size - self.reached.sum()) if self.reached is not None else 0
 
 
-def singularity_map(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed=None, output=None, point: bool = False,
-                    q_start=None) -> SingularityMap:
+def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict | None=None, output: str | None=None, point: bool = False,
+                    q_start: Callable | None=None) -> SingularityMap:
     mech = solver.mech
     fixed = dict(fixed or {})
     if x_name == y_name:
@@ -100,7 +102,7 @@ def singularity_map(solver, x_name: str, xs: np.ndarray, y_name: str, ys: np.nda
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
 
 
-def seams(mech: Mechanism, qs, reached, step_x=None, step_y=None, xs: np.ndarray | None=None, ys: np.ndarray | None=None) -> np.ndarray:
+def seams(mech: Mechanism, qs: np.ndarray, reached: np.ndarray, step_x: Neighbour | None=None, step_y: Neighbour | None=None, xs: np.ndarray | None=None, ys: np.ndarray | None=None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
     characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.position.position import PositionSolver
+    from screwkin.analysis.singularities.loci import Loci
 
 __all__ = ["Region", "Regions", "regions"]
 
@@ -65,7 +66,7 @@ def _blocked(curves: list, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return mask
 
 
-def regions(solver: PositionSolver, loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, count: bool = True, max_counted: int = 24) -> Regions:
+def regions(solver: PositionSolver, loci: Loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, count: bool = True, max_counted: int = 24) -> Regions:
     """The regions of the grid xs x ys cut by ``loci`` (analysis.singularities.loci.Loci), each with its sample
     and (count) its number of real assembly modes there."""
     from scipy import ndimage

@@ -65,7 +65,7 @@ class SectionSystem(LocusSystem):
     def A(self, q: np.ndarray) -> np.ndarray:
         return self._pose(q)[1][:, self.free]
 
-    def residual(self, q: np.ndarray, v, A=None) -> np.ndarray:
+    def residual(self, q: np.ndarray, v: np.ndarray, A=None) -> np.ndarray:
         p, J = self._pose(q)
         A = J[:, self.free] if A is None else A
         held = []

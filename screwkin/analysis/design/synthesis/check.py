@@ -43,6 +43,7 @@ from .designs import Check, ChainFile, Design, PrecisionCheck
 from .fourbar import positions
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from screwkin.analysis.design.synthesis.designs import Target
 
 if TYPE_CHECKING:
     from ...motion.sweep import SweepResult
@@ -75,7 +76,7 @@ class _Probe:
             return (float(M.translation[0]), float(M.translation[1]))
         return (float(math.atan2(M.rotation[1, 0], M.rotation[0, 0])),)
 
-    def error(self, q: np.ndarray, target) -> tuple:
+    def error(self, q: np.ndarray, target: Target) -> tuple:
         v = self.value(q)
         t = target.value
         if target.kind == "pose":
@@ -97,7 +98,7 @@ class _Probe:
         return state.centre(("joint", self.jA))[:2], state.centre(("frame", self.fB))[:2]
 
 
-def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target) -> float:
+def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target: Target) -> float:
     """Distance between the file's moving pivots (and guided frame) at q and the closed-form
     four-bar at the same crank angle, on the branch that is nearer."""
     fb = design.fourbar
@@ -114,7 +115,7 @@ def _closed_form_error(design: Design, probe: _Probe, q: np.ndarray, target) -> 
     return float(best)
 
 
-def check_design(design: Design, path, tolerance: float | None = None, steps: int = 360, warn=None) -> Check:
+def check_design(design: Design, path: str, tolerance: float | None = None, steps: int = 360, warn=None) -> Check:
     """Check the four-bar ``design`` written at ``path`` (see the module docstring)."""
     mech = load(path, warn=warn or (lambda _m: None))
     tol = tolerance if tolerance is not None else TOLERANCE * max(1.0, mech.length)
@@ -174,7 +175,7 @@ def check_design(design: Design, path, tolerance: float | None = None, steps: in
                  tuple(travel), tol, letters)
 
 
-def _locate(design, solver, probe, res, x, q_target: np.ndarray) -> bool:
+def _locate(design: Design, solver: PositionSolver, probe: _Probe, res: SweepResult, x: float, q_target: np.ndarray) -> bool:
     """Whether the branch followed by sweep ``res`` is, at input value x, in the configuration
     q_target (the solution found for that precision position): same moving pivots."""
     if q_target is None:
