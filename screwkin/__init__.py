@@ -114,7 +114,7 @@ class Mechanism(_mechanism.Mechanism):
 
 
 def load(path: str | Path, yaml=None, actuated: list | None=None, tolerances: Tolerances = _loader.DEFAULT, warn: Callable | None=None,
-         package_dirs=None, args: dict | None=None) -> Mechanism:
+         package_dirs=None, args: dict | None=None):
     """Read a mechanism file (URDF with <loop_joint> or a YAML sidecar, SDF, or a xacro file
     with its arguments ``args``, e.g. ``{"crank": "30mm"}``) into a :class:`Mechanism`; see
     screwkin.model.loader.load for the arguments."""

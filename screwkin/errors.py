@@ -60,7 +60,7 @@ def shorten(value: str, limit: int = QUOTE_LIMIT) -> str:
     return "".join(out) + ("..." if len(text) > limit + 1 else "")
 
 
-def quote(value: list | str | float | None, limit: int = QUOTE_LIMIT) -> str:
+def quote(value, limit: int = QUOTE_LIMIT) -> str:
     """``'value'`` for a message: :func:`shorten` between single quotes; a value that is
     not a string (a YAML list, None) as its bounded repr, without quotes."""
     return f"'{shorten(value, limit)}'" if isinstance(value, str) else shorten(value, limit)

@@ -87,7 +87,7 @@ _CASE = {k: v[0] if len(v) == 1 else tuple(v) for k, v in _CASE.items()}
 LENGTH_RANGE = (1e-9, 1e4)
 
 
-def _canonical(unit: str) -> str:
+def _canonical(unit: str):
     if unit in UNIT_TABLE:
         return unit
     u = _CASE.get(unit.lower()) if unit.isascii() else None
@@ -130,7 +130,7 @@ def unit_kind(unit: str) -> str | None:
 _NUMBER = re.compile(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*\Z")
 
 
-def _unit(text: str) -> float:
+def _unit(text: str):
     """The factor of a unit as typed (case-insensitive for ASCII units), or None."""
     if not text:
         return 1.0

@@ -152,7 +152,7 @@ class Series:
         terms = [self.S[l] * self._y(m - l)[:, None] for l in range(m + 1) if with_last or l > 0]
         return np.sum(terms, axis=0) if terms else np.zeros_like(self.sys.screws)
 
-    def _next_screws(self) -> np.ndarray:
+    def _next_screws(self):
         """S[k] for k = len(self.S), from X[0..k-1]."""
         k = len(self.S)
         while len(self.P) < k:

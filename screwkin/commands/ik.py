@@ -98,7 +98,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _closed_text(mech: Mechanism, res: PositionResult, count: int) -> str:
+def _closed_text(mech: Mechanism, res: PositionResult, count) -> str:
     """The search line of a closed-form answer (analysis.position.closed_ik), and for a platform whose
     combinations are not all listed each leg's other branch beside the first solution."""
     c = res.modes
@@ -121,7 +121,7 @@ def _closed_text(mech: Mechanism, res: PositionResult, count: int) -> str:
     return text
 
 
-def _found_text(count: int, free: int, certified: bool = False) -> str:
+def _found_text(count, free: int, certified: bool = False) -> str:
     """'8 distinct branches found (legs: 2 x 2 x 2) of at most 8 (why): all of them', or how far from it
     (``certified``: the homotopy has them all, whatever the legs' bound)."""
     n = count.found

@@ -302,7 +302,7 @@ def _search(args: argparse.Namespace):
                      where=f"{where}, {used} worker{'s' if used != 1 else ''}")
 
 
-def _motion(args: argparse.Namespace) -> tuple:
+def _motion(args: argparse.Namespace):
     if not args.poses:
         raise UsageError('synthesize motion needs --poses "x,y,theta; x,y,theta; x,y,theta"')
     poses = _number_groups(args.poses, "--poses", 3)

@@ -250,7 +250,7 @@ def helper_names(pm: PlacedMechanism) -> dict:
     return out
 
 
-def _mj_joint(j: int) -> str:
+def _mj_joint(j) -> str:
     dyn = "".join(f' {k}="{number_text(v)}"' for k, v in j.dynamics)
     if j.type == "free" and not dyn:
         return f"<freejoint name={quoteattr(j.name)}/>"

@@ -24,7 +24,7 @@ from .xmlsafe import MAX_DEPTH, inside_folder, parse_xml_text, read_regular_file
 __all__ = ["expand_includes"]
 
 
-def expand_includes(root, path: Path, read: list | None = None) -> int:
+def expand_includes(root, path, read: list | None = None) -> int:
     """Replace every ``<include>`` under ``root`` (the main file's ``<mujoco>``, read from ``path``)
     by the included file's content, in place.  Returns the number of files included; ``read`` (a list),
     when given, gets the path of each file included."""

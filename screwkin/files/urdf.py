@@ -265,7 +265,7 @@ def _loop_joint(elem, links: dict, problems: Problems, warnings: list) -> CutJoi
     return CutJointSpec(name, jtype, l1, l2, xyz1, rpy1, xyz2, rpy2, axis, axis2, source="loop_joint", **extra)
 
 
-def _radius(text: str, what: str, problems: Problems, allow_inf: bool=False) -> float:
+def _radius(text: str, what: str, problems: Problems, allow_inf: bool=False):
     """A radius [m]: a positive number, or (a straight line) 'inf' where allowed."""
     if text is None:
         problems.append(f"{what} is missing")
@@ -358,7 +358,7 @@ def check_sizes(path: str | Path, links: int, joints: int, loop_joints: int, coo
                   f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
-def check_tree(path: Path, links: dict, joints: list, problems: Problems) -> None:
+def check_tree(path, links: dict, joints: list, problems: Problems) -> None:
     """Record problems that keep the joints from forming one tree over the links."""
     parent_of = {}
     for j in joints:

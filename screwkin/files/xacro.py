@@ -87,7 +87,7 @@ def _xacro_tag(tag: str) -> str | None:
     return None
 
 
-def is_xacro(path: Path, text: str) -> bool:
+def is_xacro(path: Path | str, text: str) -> bool:
     """A xacro file: its name ends in ``.xacro`` or it declares the ``xacro`` namespace."""
     return str(path).lower().endswith(".xacro") or re.search(r"xmlns:xacro\s*=", text) is not None
 

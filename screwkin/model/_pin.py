@@ -32,7 +32,7 @@ FRAME_PREFERENCE = (pin.FrameType.BODY, pin.FrameType.JOINT, pin.FrameType.FIXED
                     pin.FrameType.SENSOR)
 
 
-def frame_id(model: pin.Model, name: str, prefer: tuple=FRAME_PREFERENCE) -> int:
+def frame_id(model: pin.Model, name: str, prefer: tuple=FRAME_PREFERENCE):
     """Id of the frame named ``name`` (None when there is none).  When several frames
     share the name, the first of the types in ``prefer`` wins -- by default the BODY
     frame (the link), where ``model.getFrameId(name)`` raises "Several frames match"."""

@@ -69,7 +69,7 @@ class CouplingRow:
     input: str | None = None
     pairs: frozenset = frozenset()  # q indices of continuous joints (cos, sin) in an angle row's terms
 
-    def value(self, q: np.ndarray) -> float:
+    def value(self, q: np.ndarray):
         """The row's residual at q: sum c_k q_k + c0, or for an angle row the joints' angles (a
         continuous joint's atan2(sin, cos)) so summed, taken into [-pi, pi) (geometry.wrap_angle)."""
         if self.kind != "angle":

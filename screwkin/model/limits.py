@@ -25,7 +25,7 @@ def outside_limits(mech: Mechanism, q: np.ndarray) -> tuple:
     return tuple(n for n, o in zip(names, out) if o)
 
 
-def within_limits(mech: Mechanism, Q: np.ndarray) -> np.ndarray:
+def within_limits(mech: Mechanism, Q: np.ndarray):
     """(N,) True where every joint of the configurations Q (N, nq) is within its limits (an
     angle may sit in its range modulo a turn): outside_limits for a stack."""
     Q = np.atleast_2d(np.asarray(Q, float))

@@ -11,7 +11,7 @@ if TYPE_CHECKING:
 __all__ = ["rank", "null_space", "singular_values", "complement"]
 
 
-def _square(A: np.ndarray) -> np.ndarray:
+def _square(A: np.ndarray):
     """A matrix with the singular values and right singular vectors of A: A itself, or for a
     tall A (m > 2n rows) the triangular factor R of its QR factorization (A^T A = R^T R),
     several times cheaper to decompose than A (the idle-motion rows of a 500-joint chain:

@@ -205,7 +205,7 @@ class Mechanism:
             idx.extend(range(c.idx_v, c.idx_v + c.nv))
         return np.asarray(idx, int)
 
-    def _value_layout(self) -> tuple:
+    def _value_layout(self):
         """(1-coordinate joints (name, q index, wrap), continuous joints (name, q index), the
         coordinates of multi-DOF joints (name, q index), order of the names)."""
         if self._layout is None:
@@ -297,7 +297,7 @@ class Mechanism:
             names += [c.joint] if c.nv == 1 else [f"{c.joint}[{k}]" for k in range(c.nv)]
         return names
 
-    def limited_coordinates(self) -> tuple:
+    def limited_coordinates(self):
         """(names, q indices, lower, upper, is an angle) of the one-coordinate joints with a
         finite <limit> range, as arrays (for checking many configurations quickly)."""
         if self._limits is None:

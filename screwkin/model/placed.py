@@ -138,7 +138,7 @@ def _spec_joint(spec, name: str):
     return next(j for j in spec.joints if j.name == name)
 
 
-def _placed_joint(mech: Mechanism, q: np.ndarray, j: int, kind: str, values, empty, axis=None, pos=(0.0, 0.0, 0.0)) -> PlacedJoint:
+def _placed_joint(mech: Mechanism, q: np.ndarray, j, kind: str, values, empty, axis=None, pos=(0.0, 0.0, 0.0)) -> PlacedJoint:
     """The PlacedJoint of tree joint ``j`` (a hinge or slide keeps its range about q; ``values``
     and ``empty`` collect its value and an empty range)."""
     model = mech.model
@@ -245,7 +245,7 @@ def _angle_about(n: int, v, w) -> float:
     return float(np.arctan2(n @ np.cross(v, w), v @ w))
 
 
-def davenport(R: np.ndarray, axes: list) -> tuple:
+def davenport(R: np.ndarray, axes: list):
     """(a, b, c) with R = R(n1, a) R(n2, b) R(n3, c) for unit axes n1, n2, n3 (n2 not parallel to
     either other), the solution nearest zero in b.  n1 . R n3 = n1 . R(n2, b) n3 = A cos b + B sin b + C
     with A = n1.n3 - (n1.n2)(n2.n3), B = n1.(n2 x n3), C = (n1.n2)(n2.n3) gives b; a turns R(n2, b) n3

@@ -43,7 +43,7 @@ class DyadPlan:
     order: tuple  # per op: the groups it places: (known, placed) for the input, (g1, g2) for a dyad
 
 
-def _pairs(mech: Mechanism) -> list:
+def _pairs(mech: Mechanism):
     """The tree and cut joints as (name, kind, body1, body2, tree index), or a reason they are not R/P."""
     model, out = mech.model, []
     for j in range(1, model.njoints):

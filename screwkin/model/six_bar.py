@@ -37,7 +37,7 @@ INVERSIONS = {
 }
 
 
-def _neighbours(edges: list) -> dict:
+def _neighbours(edges: list):
     """link -> the links it is jointed to, or None when two joints join the same two links (or a
     link to itself: not a six-bar's graph)."""
     out, seen = {}, set()

@@ -166,7 +166,7 @@ class Topology:
         return self.count(6)
 
     @property
-    def gruebler(self) -> int:
+    def gruebler(self):
         return self.count(3) if self.motion_space == "planar" else None
 
     @property
@@ -320,11 +320,11 @@ def _unit_vector(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _parallel(d1: np.ndarray, d2: np.ndarray, tol: float) -> bool:
+def _parallel(d1: np.ndarray, d2: np.ndarray, tol: float):
     return np.linalg.norm(np.cross(_unit_vector(d1), _unit_vector(d2))) < tol
 
 
-def _line_distance(p1: np.ndarray, d1: np.ndarray, p2: np.ndarray, d2: np.ndarray, tol: float) -> float:
+def _line_distance(p1: np.ndarray, d1: np.ndarray, p2: np.ndarray, d2: np.ndarray, tol: float):
     n = np.cross(_unit_vector(d1), _unit_vector(d2))
     if np.linalg.norm(n) < tol:  # parallel: distance between the lines
         w = p2 - p1
@@ -344,7 +344,7 @@ def _compound_name(members: list, kind: str) -> str:
     return "+".join(members)
 
 
-def _classify_chain(chain: list, tol: float, scale: float, coupled: frozenset=frozenset()) -> str | None:
+def _classify_chain(chain: list, tol: float, scale, coupled: frozenset=frozenset()) -> str | None:
     """The compound type of a chain of 1-DOF edges through massless links, or None.
     coupled: the pairs of joint names one of which mimics the other."""
     kinds = [e.type for e in chain]
@@ -525,7 +525,7 @@ def build_topology(mech: Any, q: np.ndarray) -> Topology:
                     normal, tuple(c for c in mech.couplings if c not in consumed))
 
 
-def _motion_space(joints: list, tol: float, scale: float) -> tuple:
+def _motion_space(joints: list, tol: float, scale) -> tuple:
     """'planar' when every revolute axis is parallel to one normal and every
     prismatic axis perpendicular to it; 'spherical' when every joint is a
     rotation about one common point; 'spatial' otherwise."""

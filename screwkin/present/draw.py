@@ -367,7 +367,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float=0.85) -> None:
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j: int, p: np.ndarray, r) -> None:
+def _input_arrow(ax, FancyArrowPatch, j, p: np.ndarray, r) -> None:
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])

@@ -120,7 +120,7 @@ def equations_dict(res: PlanarEquations | SpatialEquations) -> dict:
     }
 
 
-def equations_text(res: PlanarEquations, explain: bool = True) -> str:
+def equations_text(res, explain: bool = True) -> str:
     """The equations as text; without ``explain`` (the command's default, --explain for all) the values at the
     configuration are det A and the rates A^-1 B on one line, without the matrices A and B in numbers."""
     if not isinstance(res, PlanarEquations):

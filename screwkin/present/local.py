@@ -120,7 +120,7 @@ def redundancy_lines(r: Redundancy, title: str = "redundant constraints", explai
     ``explain`` one line: how many, at which joints and why (--explain names them and the way out)."""
     if not r.count:
         return []
-    def who(j: int):
+    def who(j):
         return f"{j.what} '{j.joint}'" if j.what in ("connect", "weld", "coupling") else j.joint
 
     if not explain:
@@ -160,7 +160,7 @@ def change_point_dict(cp: ChangePoint, mech: Mechanism | None = None) -> dict:
     return d
 
 
-def change_point_lines(cp: ChangePoint, where: str) -> list:
+def change_point_lines(cp, where: str) -> list:
     """What a constraint singularity met along a motion is, and which branch the motion takes there."""
     lines = [f"  at {where}: {words(cp.local)}"]
     if cp.local.branches and (cp.came is not None or cp.goes is not None):

@@ -206,7 +206,7 @@ def sweep_plot(res: SweepResult, path: str, mus: list | None=None, singularities
         plt.close(fig)
 
 
-def _axis_values(values: np.ndarray, unit: str) -> np.ndarray:
+def _axis_values(values: np.ndarray, unit: str):
     """SI values in ``unit`` (a unit of screwkin.units as typed, any case: 'deg', 'MM'; bare: SI)."""
     return in_unit(np.asarray(values, float), unit) if unit else np.asarray(values, float)
 

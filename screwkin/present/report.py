@@ -32,7 +32,6 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
-    from screwkin.analysis.position.certified import ModeCount
     from screwkin.analysis.position.solution import Solution
 
 __all__ = ["to_dict", "position_dict", "position_text", "modes_dict", "modes_line", "joint_types_dict", "joint_types_text", "sweep_dict", "sweep_csv", "sweep_text",
@@ -89,7 +88,7 @@ def position_dict(res: PositionResult) -> dict:
             "complete": bool(res.modes is not None and res.modes.complete)}
 
 
-def modes_dict(c: ModeCount) -> dict:
+def modes_dict(c) -> dict:
     """analysis.position.certified.ModeCount as JSON: found, complete, method, real, complex, certificate,
     reason (null when certified) and what the search did."""
     return {"found": c.found, "complete": c.complete, "method": c.method, "real": c.real, "complex": c.complex,
@@ -142,7 +141,7 @@ def _with_loop(tree: dict, loop: dict | None) -> dict:
     return {**tree, **{k: v for k, v in (loop or {}).items() if k not in tree}}
 
 
-def value_text(name: str, value: float, angular: bool) -> str:
+def value_text(name: str | int, value: float, angular: bool) -> str:
     """A coordinate value in its own unit: angles in rad and deg, lengths in m."""
     if angular:
         return f"{value:.9g} rad ({np.degrees(value):.8g} deg)"

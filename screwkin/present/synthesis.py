@@ -29,7 +29,6 @@ if TYPE_CHECKING:
     from screwkin.analysis.design.synthesis.designs import Design
     from screwkin.analysis.design.synthesis.designs import Dyad
     from screwkin.analysis.design.synthesis.designs import Target
-    from screwkin.analysis.design.synthesis.search import SearchReport
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
@@ -123,7 +122,7 @@ def _candidate_dict(k: int, c: Candidate) -> dict:
             "point": None if u is None else [u, v], "run": c.run}
 
 
-def _search_dict(report: SearchReport, constraints: list) -> dict:
+def _search_dict(report, constraints: list) -> dict:
     return {"method": report.method, "runs": report.runs, "evaluations": report.evaluations,
             "seconds": report.seconds, "where": report.where, "seed": report.seed, "constraints": constraints,
             "searched_within": report.box, "designs": [_candidate_dict(k, c) for k, c in enumerate(report.candidates)]}
@@ -134,7 +133,7 @@ def _dyad_dict(k: int, d: Dyad) -> dict:
             "length": d.length}
 
 
-def synthesis_dict(result: MotionResult, check: Check, file: str, constraints: tuple | list=()) -> dict:
+def synthesis_dict(result, check: Check, file: str, constraints=()) -> dict:
     """The JSON object of a motion, function or path result and its check (``constraints``: the
     constrained search's, in words)."""
     design = result.design

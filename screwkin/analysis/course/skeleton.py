@@ -213,7 +213,7 @@ def numbering(topo: Topology, inputs: list=()) -> tuple:
     own = {j.name for j in joints if re.fullmatch(rf"[A-Z][A-Za-z0-9]{{0,{SHORT_NAME - 1}}}", j.name)}
     taken, next_letter = set(own), [0]
 
-    def mark(j: int) -> None:
+    def mark(j) -> None:
         if j.name not in letter:
             if j.name in own:
                 letter[j.name] = j.name
@@ -224,7 +224,7 @@ def numbering(topo: Topology, inputs: list=()) -> tuple:
                 taken.add(letter[j.name])
             lettered.append(j)
 
-    def visit(link: str) -> None:
+    def visit(link: str | int) -> None:
         for j in joints:
             if link not in j.links:
                 continue
@@ -248,7 +248,7 @@ def _frame_point(state: KinematicState, name: str):
     return state.frame_placement(state.mech.model.getFrameId(name))
 
 
-def _joint_ends(state: KinematicState, j: int) -> tuple:
+def _joint_ends(state: KinematicState, j) -> tuple:
     """(point on links[0], point on links[1], axis or None) of a topology joint, in the world, at
     the configuration of ``state`` (a model.state.KinematicState)."""
     model = state.mech.model

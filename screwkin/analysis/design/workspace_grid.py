@@ -83,7 +83,7 @@ class Grid:
         self.solves = 0
         self.truncated = False
 
-    def position(self, index: int) -> np.ndarray:
+    def position(self, index) -> np.ndarray:
         return self.p_seed + (np.asarray(index, float) * self.h) @ self.axes
 
     def solve(self, Q0: np.ndarray, P: np.ndarray) -> tuple:
@@ -99,7 +99,7 @@ class Grid:
             ok[ok] &= within_limits(self.mech, Q[ok])
         return Q, ok
 
-    def predict(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray) -> tuple:
+    def predict(self, Q: np.ndarray | list, P_from: np.ndarray | list, P_to: np.ndarray) -> tuple:
         """First-order predictor: the joint steps that move the target from P_from to P_to
         (minimum norm through the solver's rows: K dq = -(change of the target rows)), and
         the rows' Jacobian at Q (it does not depend on where the target is)."""
@@ -129,7 +129,7 @@ class Grid:
         ev = np.sqrt(np.maximum(np.linalg.eigvalsh(K_new.transpose(0, 2, 1) @ K_new), 0.0))[:, ::-1]
         return ok, np.where(ev[:, 0] > 0, ev[:, r - 1] / np.where(ev[:, 0] > 0, ev[:, 0], 1.0), 0.0)
 
-    def substeps(self, sigma: float) -> np.ndarray:
+    def substeps(self, sigma: float | np.ndarray) -> np.ndarray:
         """Substeps for a grid step from points of relative singular value sigma: two branches
         of a fold a distance d inside it differ by about sqrt(d / L) in the joints, and so does
         sigma there, so a step of h may land on either below about sqrt(h / L): the step is cut
@@ -141,7 +141,7 @@ class Grid:
         n = np.minimum(2 ** np.ceil(np.log2(np.clip(need, 1.0, _SUBSTEPS))), _SUBSTEPS)
         return np.where(sigma >= _SINGULAR, n, 0).astype(int)
 
-    def advance(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: int) -> tuple:
+    def advance(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n) -> tuple:
         """Solve from Q at P_from to P_to in n equal substeps (n: an int, or one per point,
         all advanced together): (Q, ok, sigma, jumped) -- jumped: a substep converged within
         the limits but ``kept`` refused it (another branch, or far from the prediction)."""
@@ -164,7 +164,7 @@ class Grid:
             Qc[sel[good]], Pc[sel[good]], sigma[sel] = Qn[good], Pk[good], sig
         return Qc, ok, sigma, jumped
 
-    def advance_all(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: int, retry: bool=True) -> tuple:
+    def advance_all(self, Q: np.ndarray, P_from: np.ndarray, P_to: np.ndarray, n: int | np.ndarray, retry: bool=True) -> tuple:
         """advance for points with each their number of substeps n (> 0), in blocks; with
         ``retry``, a step refused as a jump to another branch is tried again in twice as many
         substeps, up to _SUBSTEPS (a step that does not converge -- past the boundary -- is not)."""
@@ -281,7 +281,7 @@ class Grid:
             current = following
         return ends
 
-    def extend(self, starts: int, Q: np.ndarray, direction: np.ndarray) -> tuple:
+    def extend(self, starts: int | np.ndarray, Q: np.ndarray, direction: np.ndarray) -> tuple:
         """Bisection from the reached points ``starts`` (m, d) (configurations Q) towards their
         unreached neighbours along ``direction`` (a unit index vector): the reached fraction of
         the step (0..1) and the configurations there."""

@@ -167,7 +167,7 @@ def check_inertias(mech: Mechanism) -> tuple:
     return ()
 
 
-def _load_wrenches(mech: Mechanism, loads: tuple, state: KinematicState) -> list:
+def _load_wrenches(mech: Mechanism, loads, state: KinematicState) -> list:
     """(frame id, wrench at the frame's origin, world axes) of each load at the configuration of
     ``state`` (a KinematicState; the force at a point moved to the frame's origin: m_o = m + (p - o) x f)."""
     out = []

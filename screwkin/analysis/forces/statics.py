@@ -205,7 +205,7 @@ def reaction_table(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list,
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity: bool=False, v: np.ndarray | None = None, a: np.ndarray | None = None, rows: tuple | None = None) -> dict:
+def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity=False, v: np.ndarray | None = None, a: np.ndarray | None = None, rows: tuple | None = None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial

@@ -62,7 +62,7 @@ class BatchedCurve(Curve):
         n = np.linalg.norm(U, axis=1)
         return self.choose_branch(U / np.where(n > TINY, n, 1.0)[:, None], previous)
 
-    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float) -> np.ndarray:
+    def predict(self, q: np.ndarray | list, t: np.ndarray | list, sigma: float) -> np.ndarray:
         return q[None] + (self.scale * t)[None] * sigma[:, None]  # (nq == nv: integrate is a sum)
 
     def correct(self, predicted: np.ndarray, held: int) -> tuple:
@@ -71,7 +71,7 @@ class BatchedCurve(Curve):
         Qc[~ok] = predicted[~ok]  # (refused by accept; finite for the tangents)
         return Qc, ok
 
-    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float, t: np.ndarray | None=None, T: np.ndarray | None=None) -> np.ndarray:
+    def accept(self, predicted: np.ndarray, corrected: np.ndarray, sigma: float, t: np.ndarray | None=None, T: np.ndarray | None=None):
         """Rows that pass the jump test and, given the tangent t before the stack and the stack's T,
         have no limit position between them and the row before."""
         ok = ~jumped(np.linalg.norm((corrected - predicted) / self.scale, axis=1), sigma, self.tol)
@@ -80,7 +80,7 @@ class BatchedCurve(Curve):
         return ok
 
 
-def batched_motion(solver, curve: Curve, q0: np.ndarray, t0: np.ndarray, start: float, stop: float, steps: int, fallback: Callable, progress=None) -> Motion:
+def batched_motion(solver, curve: Curve, q0: np.ndarray, t0: np.ndarray, start: float, stop: float, steps: int, fallback: Callable, progress=None):
     """The grid values from start to stop (steps steps) on q0's branch, batched (see the module
     docstring).  curve: the sweep's Curve; t0: its oriented tangent at q0 (the input's component
     along the motion); fallback(q, x_from, x_to, n): the tracker's Motion of n steps;

@@ -177,7 +177,7 @@ def keeps_orientation(Ks_from: np.ndarray, Ks_new: np.ndarray, r: int) -> bool:
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss: np.ndarray | float, sigma: float, tol: Tolerances) -> np.ndarray | bool:
+def jumped(miss, sigma: float, tol: Tolerances) -> np.ndarray | bool:
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""
@@ -280,7 +280,7 @@ class Curve:
     def frozen(self, held: int) -> tuple:
         return tuple(sorted(set(self.frozen_other) | {held}))
 
-    def predict(self, q: np.ndarray, t: np.ndarray, sigma: float) -> np.ndarray:
+    def predict(self, q: np.ndarray | list, t: np.ndarray | list, sigma: float) -> np.ndarray:
         return pin.integrate(self.model, q, self.scale * t * sigma)
 
     def correct(self, predicted: np.ndarray, held: int) -> np.ndarray:

@@ -280,7 +280,7 @@ def _limit_index(xs: np.ndarray, x) -> int:
     return len(xs) - 1
 
 
-def _branch_rates(mech: Mechanism, branch: str) -> np.ndarray:
+def _branch_rates(mech: Mechanism, branch) -> np.ndarray:
     """A branch's tangent as joint rates (nv), in the order of the coordinates."""
     return np.array([branch.tangent.get(n, 0.0) for n in mech.coordinate_names], float)
 

@@ -197,7 +197,7 @@ class _Geometry:
         return self._dirs[i][self.pairs[i].groups.index(g)]
 
 
-def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, g2: int, pa: _Pose | None, pc: _Pose, sigma: float, probe: bool=False, clamp: bool=False) -> float | tuple:
+def _solve_dyad(geo: _Geometry, kinds: str, ia: int, ib: int, ic: int, g1: int, g2: int, pa: _Pose | None, pc: _Pose, sigma: float | str, probe: bool=False, clamp: bool=False) -> float | tuple:
     """((pose of link 1, pose of link 2), relative discriminant) of one dyad on groups g1, g2;
     pa, pc: the poses of the links its outer joints A (on g1) and C (on g2) join.  probe: the
     signed branch value at q0 instead (no poses)."""
@@ -424,7 +424,7 @@ class ClosedFormCurve:
             self.layout = _Layout(mech, p, self.geo, q0)
             self.branch = None if self.geo.branch is None else list(self.geo.branch)
 
-    def predict(self, xs: np.ndarray, branch: str | None=None, clamp: int | None = None) -> tuple:
+    def predict(self, xs: np.ndarray | list, branch: str | list | None=None, clamp: int | None = None) -> tuple:
         """(pose of every group, discriminants (dyads, N)) at the input values xs, on ``branch`` (a
         sign per dyad, or per dyad an array of them; default the branch followed); clamp: the dyad
         at its limit (its discriminant taken as max(disc, 0))."""
@@ -446,7 +446,7 @@ class ClosedFormCurve:
         """Past the limit position of dyad ``which`` the motion goes on along its other branch."""
         self.branch[which] = -self.branch[which]
 
-    def locate_limit(self, lo: float, hi: float) -> tuple:
+    def locate_limit(self, lo: float, hi: float):
         """(input value, joint coordinates Q (1, nq; angles not yet unwrapped), dq/dx, dyad) of the limit
         position between the input values lo (placed) and hi (not): Brent's method (continuation.locate)
         on the smallest discriminant; None when lo's is not positive (two limit positions in one step)."""
@@ -589,5 +589,5 @@ def planar_sweep(solver, name: str, q0: np.ndarray, start: float, stop: float, s
     return ClosedFormSweep(X, Q, mech.joint_value_rows(Q), V, A, stopped, reason, tuple(limits), closed, unit)
 
 
-def _take(j: int, n: int) -> Jet:
+def _take(j, n: int) -> Jet:
     return Jet(*(np.broadcast_to(a, np.shape(j.v))[:n] if np.ndim(a) else a for a in (j.v, j.d, j.dd)))

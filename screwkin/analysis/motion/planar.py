@@ -187,7 +187,7 @@ def transmission_angles(mech: Mechanism, info: LinkageInfo, Q: np.ndarray) -> np
                          None if info.slide is None else np.asarray(info.slide, float))
 
 
-def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide: np.ndarray | None=None) -> np.ndarray:
+def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide: np.ndarray | None=None):
     """mu [rad] from the joint centres P (..., 4, 3) = A, B, C, D projected on the plane with
     unit normal n (slide: the slide's unit direction, slider-crank)."""
     P = P - (P @ n)[..., None] * n
@@ -197,7 +197,7 @@ def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide: np.ndarray | N
     return slide_transmission_angle(B, C, np.cross(n, slide))
 
 
-def _four_bar(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, a: float, b: float, tol: Tolerances) -> LinkageInfo:
+def _four_bar(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, a, b, tol: Tolerances) -> LinkageInfo:
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     cls = FOUR_BAR_CLASSES[int(four_bar_classes(g, a, b, c, tol.equal))]
@@ -234,7 +234,7 @@ def _four_bar(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray,
                        input_value=float(q_in), input_angle=float(phi_now))
 
 
-def _slider_crank(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, s: np.ndarray, a: float, b: float) -> LinkageInfo:
+def _slider_crank(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, s: np.ndarray, a, b) -> LinkageInfo:
     nrm = np.array([-s[1], s[0]])
     e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
     lengths = {"crank": a, "rod": b, "offset": abs(e)}

@@ -69,7 +69,7 @@ class Tracker:
         return self.forward() and (x - self.stop) * self.direction > self.c.tol.zero * max(1.0, abs(self.stop))
 
     # -- recording grid values -------------------------------------------------------------------------
-    def solved(self, g: float, first: Callable, arc: tuple) -> np.ndarray:
+    def solved(self, g: float, first: Callable, arc: tuple):
         """The configuration at grid value g: ``first()`` (the tangent predictor), else the arc of
         the step it lies on (``arc``: (qa, xa, qb, held), near a limit position), else None."""
         try:

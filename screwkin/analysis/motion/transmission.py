@@ -51,7 +51,7 @@ FOUR_BAR_CLASSES = (
 _BY_SHORTEST = np.array([3, 2, 4, 5])  # shortest link ground, input, coupler, output -> class code
 
 
-def four_bar_classes(g: np.ndarray | float, a: float, b: float, c: np.ndarray | float, equal: float) -> np.ndarray:
+def four_bar_classes(g, a: float, b: float, c, equal: float) -> np.ndarray:
     """Grashof class codes (indices into FOUR_BAR_CLASSES) of four-bars with ground g, input a,
     coupler b and output c: s + l against p + q (a change point within ``equal`` times the longest
     link), and, for a Grashof linkage, which link is the shortest (the first of ground, input,
@@ -156,7 +156,7 @@ class TransmissionRange:
         return float(max(math.pi / 2 - self.low, self.high - math.pi / 2))
 
 
-def _mu_at(info, phi: np.ndarray) -> np.ndarray:
+def _mu_at(info, phi: np.ndarray):
     """mu [rad] at input angles phi (from the ground line, or the slide's direction)."""
     L = info.lengths
     if info.kind == "four-bar":

@@ -56,7 +56,7 @@ def closed_form_ik(solver: PositionSolver, output: str, pose):
     return None
 
 
-def _result(solver: PositionSolver, output: str, pose, sols: list, count: int) -> PositionResult:
+def _result(solver: PositionSolver, output: str, pose, sols: list, count) -> PositionResult:
     mech = solver.mech
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), 0, 0, (),
                           output, solver.angular_names(), solver._angular_coupled(), angular_loop_joints(mech),

@@ -427,7 +427,7 @@ class PositionSolver:
                            f"(the nearest these inputs allow; the joints --near does not name were free)")
         return tuple(out)
 
-    def distinct(self, system: ClosureSystem, starts: int, frozen=(), first_trace=None) -> tuple:
+    def distinct(self, system: ClosureSystem, starts: int | list, frozen=(), first_trace=None) -> tuple:
         """Solve ``system`` from every start; keep one solution per assembly mode.
 
         Returns ([(signature, q, Assembly)], smallest residual of the failures)."""

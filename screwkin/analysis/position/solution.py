@@ -21,7 +21,7 @@ __all__ = ["Solution", "PositionResult", "TraceStep", "NEWTON_FROM_FILE", "searc
 NEWTON_FROM_FILE = "newton from the file's configuration"
 
 
-def search_method(count: int) -> str:
+def search_method(count) -> str:
     """How a search found its modes, from its certified.ModeCount (None: damped Newton from random starts),
     in the words of PositionResult.method: "closed form (dyads)", "homotopy search" (with random starts
     where it did not settle every mode), "random starts" or "no loops"."""

@@ -296,7 +296,7 @@ def stack_singular_values(J: np.ndarray) -> np.ndarray:
     return np.linalg.svd(np.asarray(J), compute_uv=False)
 
 
-def smallest_singular_values(J: np.ndarray, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
+def smallest_singular_values(J: np.ndarray | tuple, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
     """(N,) smallest singular value of each Jacobian in the stack, translations divided by a
     characteristic length ``scale_translation`` [m] (and the columns of sliding joints, the
     mask ``slide``, multiplied by it) so that the values are dimensionless.
@@ -309,7 +309,7 @@ def smallest_singular_values(J: np.ndarray, scale_translation: float = 1.0, meth
     return _extreme_singular_values(J, scale_translation, method, slide)[0]
 
 
-def singular_value_ratios(J: np.ndarray, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
+def singular_value_ratios(J: np.ndarray | tuple, scale_translation: float = 1.0, method: str = "svd", slide=None) -> np.ndarray:
     """(N,) smallest over largest singular value of each Jacobian (translations divided by
     ``scale_translation``, see ``smallest_singular_values``); methods as there."""
     low, high = _extreme_singular_values(J, scale_translation, method, slide)

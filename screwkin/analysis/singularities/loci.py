@@ -234,7 +234,7 @@ class LocusSystem:
         du = self.scale * t[:self.nv]
         return np.array([du[self.cx.idx_v], du[self.cy.idx_v]])
 
-    def along(self, q: np.ndarray, v: np.ndarray, t: np.ndarray, h: float, J: np.ndarray | None=None) -> tuple:
+    def along(self, q: np.ndarray, v: np.ndarray, t: np.ndarray, h: float, J: np.ndarray | None=None):
         """The point at arclength h along t from (q, v): predictor and corrector (hyperplane t . dz = h)."""
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q

@@ -247,7 +247,7 @@ def _drawing_numbers(ground: int, joints) -> dict:
     then tree joints, then loop joints)."""
     number = {ground: 1}
 
-    def visit(link: str) -> None:
+    def visit(link: str | int) -> None:
         for u, v in joints:
             if link in (u, v):
                 other = v if link == u else u

@@ -85,7 +85,7 @@ class _Probe:
             return math.hypot(v[0] - t[0], v[1] - t[1]), 0.0
         return abs(float(wrap_angle(v[0] - t[0], upper=True))), 0.0
 
-    def mus(self, Q: np.ndarray) -> list:
+    def mus(self, Q: np.ndarray | list) -> list:
         """Transmission angles [rad] at the configurations Q (analysis.motion.planar.transmission_angles
         of the file's four-bar as identified at the first position); none when it was not
         identified (the check then says the angle was not measured)."""
