@@ -111,24 +111,24 @@ class Batch:
             r = np.asarray(f(ov, self.v) if reverse else f(self.v, ov))
         return Batch(r, _finite_bad(r, self.bad | ob), self.ctx)
 
-    def __add__(self, o) -> Batch: return self._bin(o, np.add)  # noqa: E704
-    def __radd__(self, o) -> Batch: return self._bin(o, np.add, True)  # noqa: E704
-    def __sub__(self, o) -> Batch: return self._bin(o, np.subtract)  # noqa: E704
-    def __rsub__(self, o) -> Batch: return self._bin(o, np.subtract, True)  # noqa: E704
-    def __mul__(self, o) -> Batch: return self._bin(o, np.multiply)  # noqa: E704
-    def __rmul__(self, o) -> Batch: return self._bin(o, np.multiply, True)  # noqa: E704
-    def __truediv__(self, o) -> Batch: return self._bin(o, np.true_divide)  # noqa: E704
-    def __rtruediv__(self, o) -> Batch: return self._bin(o, np.true_divide, True)  # noqa: E704
-    def __floordiv__(self, o) -> Batch: return self._bin(o, np.floor_divide)  # noqa: E704
-    def __rfloordiv__(self, o) -> Batch: return self._bin(o, np.floor_divide, True)  # noqa: E704
-    def __mod__(self, o) -> Batch: return self._bin(o, np.mod)  # noqa: E704
-    def __rmod__(self, o) -> Batch: return self._bin(o, np.mod, True)  # noqa: E704
-    def __lt__(self, o) -> Batch: return self._bin(o, np.less)  # noqa: E704
-    def __le__(self, o) -> Batch: return self._bin(o, np.less_equal)  # noqa: E704
-    def __gt__(self, o) -> Batch: return self._bin(o, np.greater)  # noqa: E704
-    def __ge__(self, o) -> Batch: return self._bin(o, np.greater_equal)  # noqa: E704
-    def __eq__(self, o) -> Batch: return self._bin(o, np.equal)  # noqa: E704
-    def __ne__(self, o) -> Batch: return self._bin(o, np.not_equal)  # noqa: E704
+    def __add__(self, o) -> Batch: return self._bin(o, np.add)
+    def __radd__(self, o) -> Batch: return self._bin(o, np.add, True)
+    def __sub__(self, o) -> Batch: return self._bin(o, np.subtract)
+    def __rsub__(self, o) -> Batch: return self._bin(o, np.subtract, True)
+    def __mul__(self, o) -> Batch: return self._bin(o, np.multiply)
+    def __rmul__(self, o) -> Batch: return self._bin(o, np.multiply, True)
+    def __truediv__(self, o) -> Batch: return self._bin(o, np.true_divide)
+    def __rtruediv__(self, o) -> Batch: return self._bin(o, np.true_divide, True)
+    def __floordiv__(self, o) -> Batch: return self._bin(o, np.floor_divide)
+    def __rfloordiv__(self, o) -> Batch: return self._bin(o, np.floor_divide, True)
+    def __mod__(self, o) -> Batch: return self._bin(o, np.mod)
+    def __rmod__(self, o) -> Batch: return self._bin(o, np.mod, True)
+    def __lt__(self, o) -> Batch: return self._bin(o, np.less)
+    def __le__(self, o) -> Batch: return self._bin(o, np.less_equal)
+    def __gt__(self, o) -> Batch: return self._bin(o, np.greater)
+    def __ge__(self, o) -> Batch: return self._bin(o, np.greater_equal)
+    def __eq__(self, o) -> Batch: return self._bin(o, np.equal)
+    def __ne__(self, o) -> Batch: return self._bin(o, np.not_equal)
     __hash__ = object.__hash__
 
     def __neg__(self) -> Batch:
