@@ -31,7 +31,7 @@ _CODES = {"change-point": 0, "non-Grashof": 1, "crank-rocker": 2, "double-crank"
 _SHORTEST = {"double-crank": 0, "crank-rocker": 1, "double-rocker": 2, "rocker-crank": 3}  # ground, crank, coupler, rocker
 
 
-def grashof_type(g, a, b, c, equal: float) -> list:
+def grashof_type(g: float | np.ndarray, a: float | np.ndarray, b: float | np.ndarray, c: float | np.ndarray, equal: float) -> list:
     """The short Grashof type names (as GRASHOF_TYPES) of four-bars with ground g, crank a, coupler b,
     rocker c (arrays broadcast)."""
     names = {v: k for k, v in _CODES.items()}
@@ -39,14 +39,14 @@ def grashof_type(g, a, b, c, equal: float) -> list:
     return [names[int(k)] for k in codes]
 
 
-def mu_over(g, a, b, c, phi0, travel) -> tuple:
+def mu_over(g: float | np.ndarray, a: float | np.ndarray, b: float | np.ndarray, c: float | np.ndarray, phi0: float | np.ndarray, travel: float | np.ndarray) -> tuple:
     """(mu_min, mu_max) [rad] of four-bars over the crank's motion from phi0 (its angle from the ground
     line A0 -> B0) through ``travel`` (signed, [rad]; |travel| >= 2 pi: a full turn): at the two ends and
     at phi = 0 and pi when the motion passes them.  Arrays broadcast; NaN where z leaves [|b - c|, b + c]
     (the linkage does not assemble there)."""
     g, a, b, c, phi0, travel = np.broadcast_arrays(*(np.asarray(v, float) for v in (g, a, b, c, phi0, travel)))
 
-    def mu(phi) -> np.ndarray:
+    def mu(phi: float | np.ndarray) -> np.ndarray:
         with np.errstate(invalid="ignore", divide="ignore"):
             cos = four_bar_cos_mu(g, a, b, c, phi)
         return np.where(np.abs(cos) <= 1, np.arccos(np.clip(cos, -1, 1)), np.nan)
@@ -65,7 +65,7 @@ def mu_over(g, a, b, c, phi0, travel) -> tuple:
     return np.where(bad, np.nan, low), np.where(bad, np.nan, high)
 
 
-def motion_mu(g, a, b, c, phi0, travel, equal: float) -> tuple[np.ndarray, np.ndarray]:
+def motion_mu(g: float | np.ndarray, a: float | np.ndarray, b: float | np.ndarray, c: float | np.ndarray, phi0: float | np.ndarray, travel: float | np.ndarray, equal: float) -> tuple[np.ndarray, np.ndarray]:
     """(mu_min, mu_max) [rad] over the motion a design runs: the whole turn when its input turns fully
     (a motor keeps turning it: four_bar_transmission's located extremes), else the crank's travel from
     phi0 (mu_over).  Arrays broadcast."""
@@ -110,7 +110,7 @@ class Constraints:
         t = None if self.min_transmission is None else self.min_transmission + angle
         return Constraints(bounds, lengths, self.grashof, t)
 
-    def pivot_box(self, centre, size: float) -> tuple:
+    def pivot_box(self, centre: np.ndarray, size: float) -> tuple:
         """(low, high) corners [m] of where a search puts the fixed pivots: the bounds, else ``centre``
         +- 2 ``size`` (the task's own size: its points' or poses')."""
         if self.bounds is not None:
@@ -138,7 +138,7 @@ class Constraints:
             out.append(f"transmission angle {t:.6g} .. {180 - t:.6g} deg over the motion")
         return out
 
-    def penalty(self, A0: np.ndarray, B0: np.ndarray, g, a, b, c, mu_lo, mu_hi, scale: float):
+    def penalty(self, A0: np.ndarray, B0: np.ndarray, g: float | np.ndarray, a: float | np.ndarray, b: float | np.ndarray, c: float | np.ndarray, mu_lo: np.ndarray, mu_hi: np.ndarray, scale: float):
         """How far each design is from meeting the constraints (0 where it meets them): lengths over
         ``scale`` plus angles in rad, summed; arrays of designs (A0, B0 (n, 2), the rest (n,))."""
         g, a, b, c = (np.asarray(v, float) for v in (g, a, b, c))
@@ -173,7 +173,7 @@ class Constraints:
             out += np.maximum(t - lo, 0) + np.maximum(hi - (math.pi - t), 0)
         return out
 
-    def unmet(self, A0: np.ndarray | tuple, B0: np.ndarray | tuple, g, a, b, c, mu, equal: float, tol: float) -> list:
+    def unmet(self, A0: np.ndarray | tuple, B0: np.ndarray | tuple, g: float | np.ndarray, a: float | np.ndarray, b: float | np.ndarray, c: float | np.ndarray, mu: tuple[float, float] | None, equal: float, tol: float) -> list:
         """What one finished design does not meet (words; empty when it meets them all): ``mu`` its
         (min, max) transmission angle over the motion [rad] or None, ``tol`` [m] the slack on
         positions and lengths."""

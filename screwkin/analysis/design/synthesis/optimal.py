@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.analysis.design.synthesis.constraints import Constraints
     from screwkin.analysis.design.synthesis.search import Search
+    from collections.abc import Callable
 
 __all__ = ["optimal_path", "PENALTY", "SAMPLES"]
 
@@ -62,7 +63,7 @@ SEARCHED = 24
 TWO_PI = 2 * math.pi
 
 
-def _path_box(pts: np.ndarray, constraints: Constraints, L) -> tuple[np.ndarray, np.ndarray]:
+def _path_box(pts: np.ndarray, constraints: Constraints, L: float) -> tuple[np.ndarray, np.ndarray]:
     """The search's box: the pivots inside the bounds (else 2 path sizes around the points), the links
     within the length range (else 2 % of the path's size to 4 times it), the coupler point within 3 sizes."""
     plo, phi = constraints.pivot_box(pts.mean(axis=0), L)
@@ -72,13 +73,13 @@ def _path_box(pts: np.ndarray, constraints: Constraints, L) -> tuple[np.ndarray,
     return np.array(lower, float), np.array(upper, float)
 
 
-def _box(pts: np.ndarray, constraints, L) -> str:
+def _box(pts: np.ndarray, constraints: Constraints, L: float) -> str:
     """_path_box in words."""
     lower, upper = _path_box(pts, constraints, L)
     return box_text(constraints, (lower[0:2], upper[0:2]), (lower[4], upper[4])) + f"; coupler point within {3 * L:.4g} m"
 
 
-def _free_cost(X: np.ndarray, pts: np.ndarray, sigma: float, direction, constraints, L, equal) -> tuple:
+def _free_cost(X: np.ndarray, pts: np.ndarray, sigma: float, direction: float, constraints: Constraints, L: float, equal: float) -> tuple:
     """The search's cost of designs X (m, 9) without timing (module docstring), and each point's
     nearest sample (m, n)."""
     A0, B0 = X[:, 0:2], X[:, 2:4]
@@ -114,7 +115,7 @@ def _free_cost(X: np.ndarray, pts: np.ndarray, sigma: float, direction, constrai
     return np.where(np.isfinite(cost), cost, 1e3), j
 
 
-def _timed_cost(X: np.ndarray, pts: np.ndarray, timing, sigma: float, constraints, L, equal) -> np.ndarray:
+def _timed_cost(X: np.ndarray, pts: np.ndarray, timing: np.ndarray | None, sigma: float, constraints: Constraints, L: float, equal: float) -> np.ndarray:
     """The search's cost of designs X (m, 10) with the crank angles prescribed."""
     A0, B0, a, b, c, p, q, th = _unpack(X, timing, 1.0)
     R = _residuals(X, pts, timing, 1.0, sigma, L)
@@ -130,7 +131,7 @@ def _timed_cost(X: np.ndarray, pts: np.ndarray, timing, sigma: float, constraint
     return np.where(np.isfinite(cost), cost, 1e3)
 
 
-def refined(residuals, x0, lower, upper, scale, weights=(PENALTY, PENALTY_REFINED)):
+def refined(residuals: Callable[..., np.ndarray], x0: np.ndarray, lower: np.ndarray, upper: np.ndarray, scale: float, weights: tuple[float, ...]=(PENALTY, PENALTY_REFINED)):
     """Least squares of ``residuals(X, weight)`` (designs X (m, d) -> (m, r), the penalty residual weighted)
     from x0 within [lower, upper]: first with the search's weight, then, when a constraint is still missed,
     again from there with a heavy one (a design that settles on a constraint's edge then stays on its side,
@@ -139,10 +140,10 @@ def refined(residuals, x0, lower, upper, scale, weights=(PENALTY, PENALTY_REFINE
 
     x = np.clip(x0, lower + 1e-12 * scale, upper - 1e-12 * scale)
     for k, w in enumerate(weights):
-        def fun(x_, w=w):
+        def fun(x_: np.ndarray, w: float=w):
             return residuals(x_[None], w)[0]
 
-        def jac(x_, w=w):
+        def jac(x_: np.ndarray, w: float=w):
             h = 1e-7 * np.maximum(np.abs(x_), scale)
             E = np.diag(h)
             R = residuals(np.concatenate([x_ + E, x_ - E]), w)
@@ -157,13 +158,13 @@ def refined(residuals, x0, lower, upper, scale, weights=(PENALTY, PENALTY_REFINE
     return x
 
 
-def _refine(x0, pts: np.ndarray, timing, direction, sigma: float, constraints, L, lower, upper, equal):
+def _refine(x0: np.ndarray, pts: np.ndarray, timing: np.ndarray | None, direction: float, sigma: float, constraints: Constraints, L: float, lower: np.ndarray, upper: np.ndarray, equal: float):
     """path.py's least squares from x0 (its parameter order), with the constraints' penalty as one more
     residual; the pivots and links kept in the search's box."""
     n = len(pts)
     constraints = constraints.tightened(MARGIN * L, MARGIN)  # on the right side of a constraint it settles on
 
-    def residuals(X: np.ndarray, weight) -> np.ndarray:
+    def residuals(X: np.ndarray, weight: float) -> np.ndarray:
         R = _residuals(X, pts, timing, direction, sigma, L)
         A0, B0, a, b, c, _, _, th = _unpack(X, timing, direction)
         g = np.hypot(*(B0 - A0).T)
@@ -178,7 +179,7 @@ def _refine(x0, pts: np.ndarray, timing, direction, sigma: float, constraints, L
     return refined(residuals, x0, lo, hi, L)
 
 
-def _path_run(task) -> tuple:
+def _path_run(task: tuple) -> tuple:
     """One run of the path search (picklable: what a Dask worker computes): differential evolution (on
     at most SEARCHED points, evenly chosen, when there are more), then the refinement of its best
     distinct members on all the points.  Returns ([(x, sigma, direction)], generations)."""
@@ -208,7 +209,7 @@ def _path_run(task) -> tuple:
     return out, nfev
 
 
-def _judge(pts: np.ndarray, x, sigma: float, direction, timing, constraints, L, tol: float, equal: float, run) -> tuple | None:
+def _judge(pts: np.ndarray, x: np.ndarray, sigma: float, direction: float, timing: np.ndarray | None, constraints: Constraints, L: float, tol: float, equal: float, run: str) -> tuple | None:
     """A refined design as a Candidate (closed form: errors, motion, defects, constraints)."""
     A0, B0, a, b, c, p, q, th = _unpack(x, timing, direction)
     P, h2, A, B = (v[0] for v in coupler_points(A0, B0, a, b, c, p, q, th, sigma))
@@ -231,7 +232,7 @@ def _judge(pts: np.ndarray, x, sigma: float, direction, timing, constraints, L, 
                      run), errors, rel
 
 
-def _defect_words(d) -> str:
+def _defect_words(d: tuple) -> str:
     kind, k, detail = d
     if kind == "branch":
         return f"branch: point {k + 1} is on another branch"
@@ -249,7 +250,7 @@ def rank_key(cand: Candidate, tol: float) -> tuple:
     return (not cand.feasible, len(cand.defects), max(cand.error - tol, 0.0), deviation, cand.error)
 
 
-def optimal_path(points, timing, constraints, search: Search, tolerance: float = 1e-6, equal: float = 1e-9) -> PathResult:
+def optimal_path(points, timing: np.ndarray | None, constraints: Constraints, search: Search, tolerance: float = 1e-6, equal: float = 1e-9) -> PathResult:
     """The best four-bars whose coupler point passes through ``points`` (with the crank angles
     ``timing`` when given) that meet ``constraints``, found by ``search`` (module docstring); the
     PathResult of the best, its ``search`` report listing the best few (Candidates)."""

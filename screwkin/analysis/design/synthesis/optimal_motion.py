@@ -50,14 +50,14 @@ BETWEEN = 8
 TWO_PI = 2 * math.pi
 
 
-def _frames(poses) -> tuple:
+def _frames(poses: list) -> tuple:
     R = np.array([pose_matrix(p)[0] for p in poses])
     p = np.array([p[:2] for p in poses], float)
     th = np.array([p[2] for p in poses], float)
     return R, p, th
 
 
-def _driven(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints, L, equal) -> tuple:
+def _driven(A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, poses: list, direction: float, constraints: Constraints, L: float, equal: float) -> tuple:
     """(miss residuals (m, 2n): origin's miss over L and angle's miss per pose, penalties (m,), mu (lo, hi),
     the crank angles (m, n)) of designs A0, a, B0, b (m, 2) driven through the poses."""
     R, P, TH = _frames(poses)
@@ -73,7 +73,7 @@ def _driven(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints,
     rel = np.mod(direction * (th - th[:, :1]), TWO_PI)  # travel from the first pose, the crank turning one way
     order = np.maximum(-np.diff(rel, axis=1), 0).sum(axis=1) / TWO_PI  # the poses met in another order
 
-    def at(theta) -> tuple:
+    def at(theta: float | np.ndarray) -> tuple:
         A = A0[:, None, :] + crank[:, None, None] * np.stack([np.cos(theta), np.sin(theta)], -1)
         B, h2 = circle_circle(A, coupler[:, None], B0[:, None, :], rocker[:, None], sigma[:, None])
         return A, B, h2
@@ -99,7 +99,7 @@ def _driven(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints,
     return res, pen, (mu_lo, mu_hi), th
 
 
-def _cost(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints, L, equal) -> np.ndarray:
+def _cost(A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, poses: list, direction: float, constraints: Constraints, L: float, equal: float) -> np.ndarray:
     res, pen, (lo, hi), _ = _driven(A0, a, B0, b, poses, direction, constraints, L, equal)
     err = np.sqrt((res ** 2).mean(axis=1))
     deviation = np.where(np.isnan(lo), math.pi / 2, np.maximum(math.pi / 2 - lo, hi - math.pi / 2))
@@ -107,7 +107,7 @@ def _cost(A0: np.ndarray, a, B0: np.ndarray, b, poses, direction, constraints, L
     return np.where(np.isfinite(cost), cost, 1e3)
 
 
-def _solve2(G, r) -> np.ndarray:
+def _solve2(G: np.ndarray, r: np.ndarray) -> np.ndarray:
     """Batched 2 x 2 (or least-squares) solves, NaN where singular."""
     if G.shape[-2] != 2:
         G, r = np.einsum("mki,mkj->mij", G, G), np.einsum("mki,mk->mi", G, r)
@@ -118,14 +118,14 @@ def _solve2(G, r) -> np.ndarray:
     return np.where(np.isfinite(x), x, np.nan)
 
 
-def _moving(poses, A0: np.ndarray) -> np.ndarray:
+def _moving(poses: list, A0: np.ndarray) -> np.ndarray:
     """The moving pivots (m, 2) of the dyads with fixed pivots A0 (m, 2) through the poses (3: exactly;
     4: on the centre-point curve, exactly)."""
     M = _burmester_rows(poses, A0)
     return _solve2(M[..., :2], M[..., 2])
 
 
-def _curve_points(poses, alpha, root, L):
+def _curve_points(poses: list, alpha: np.ndarray, root: int, L: float):
     """Points (m, 2) of the centre-point curve of four poses on the lines through the base pole at
     angles alpha (m,), the other root ``root`` (0 or 1) of each line's cubic; NaN where complex."""
     P = _base_pole(poses)
@@ -142,7 +142,7 @@ def _curve_points(poses, alpha, root, L):
     return P + t[:, None] * e
 
 
-def _dyads_of(kind: str, X: np.ndarray, poses, L, root=None) -> tuple:
+def _dyads_of(kind: str, X: np.ndarray, poses: list, L: float, root: tuple[int, int] | None=None) -> tuple:
     """(A0, a, B0, b) of designs X for a kind of run: "pivots" (3 poses), "curve" (4), "free" (6+)."""
     if kind == "pivots":
         A0, B0 = X[:, 0:2], X[:, 2:4]
@@ -154,7 +154,7 @@ def _dyads_of(kind: str, X: np.ndarray, poses, L, root=None) -> tuple:
     return X[:, 0:2], X[:, 2:4], X[:, 4:6], X[:, 6:8]
 
 
-def _motion_box(kind: str, poses, constraints, L) -> tuple[np.ndarray, np.ndarray]:
+def _motion_box(kind: str, poses: list, constraints: Constraints, L: float) -> tuple[np.ndarray, np.ndarray]:
     """The search's box of a kind of run: the pivots inside the bounds (else 2 sizes around the poses),
     the curve parameters in [0, pi], the moving pivots within 3 sizes."""
     plo, phi = constraints.pivot_box(np.mean([p[:2] for p in poses], axis=0), L)
@@ -165,7 +165,7 @@ def _motion_box(kind: str, poses, constraints, L) -> tuple[np.ndarray, np.ndarra
     return np.array([*plo, -3 * L, -3 * L, *plo, -3 * L, -3 * L]), np.array([*phi, 3 * L, 3 * L, *phi, 3 * L, 3 * L])
 
 
-def _motion_run(task) -> tuple:
+def _motion_run(task: tuple) -> tuple:
     """One run (picklable: what a Dask worker computes): differential evolution, then the refinement of
     its best distinct members (Nelder-Mead on the cost for exact kinds, least squares on the misses
     for free pivots).  Returns ([(A0, a, B0, b, direction)], generations)."""
@@ -183,7 +183,7 @@ def _motion_run(task) -> tuple:
     for k in distinct_best(pop, costs, lower, upper, REFINED):
         x = pop[k]
         if kind == "free":
-            def residuals(X: np.ndarray, weight) -> np.ndarray:
+            def residuals(X: np.ndarray, weight: float) -> np.ndarray:
                 res, pen, _, _ = _driven(*_dyads_of(kind, X, poses, L), poses, direction, tight, L, equal)
                 return np.concatenate([res, weight * pen[:, None]], axis=1)
             x = refined(residuals, x, lower, upper, L)
@@ -198,7 +198,7 @@ def _motion_run(task) -> tuple:
     return out, nfev
 
 
-def _judge_motion(poses: list, A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, direction, constraints: Constraints, L, tol, equal: float, run, exact: bool) -> tuple | None:
+def _judge_motion(poses: list, A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b: np.ndarray, direction: float, constraints: Constraints, L: float, tol: float, equal: float, run: str, exact: bool) -> tuple | None:
     R1, p1 = pose_matrix(poses[0])
     crank, rocker = Dyad(tuple(map(float, A0)), tuple(map(float, R1 @ a + p1)), tuple(map(float, a))), \
         Dyad(tuple(map(float, B0)), tuple(map(float, R1 @ b + p1)), tuple(map(float, b)))
@@ -224,7 +224,7 @@ def _judge_motion(poses: list, A0: np.ndarray, a: np.ndarray, B0: np.ndarray, b:
     return Candidate(design, err, float(np.sqrt(np.mean(miss ** 2))), mu, kind, defects, unmet, run), (crank, rocker)
 
 
-def optimal_motion(poses, constraints: Constraints, search: Search, tolerance: float = 1e-9, equal: float = 1e-9) -> MotionResult:
+def optimal_motion(poses: list, constraints: Constraints, search: Search, tolerance: float = 1e-9, equal: float = 1e-9) -> MotionResult:
     """The best four-bars guiding the coupler frame through ``poses`` that meet ``constraints`` (module
     docstring): the MotionResult of the best, its ``search`` report listing the best few."""
     poses = [tuple(float(x) for x in p) for p in poses]
