@@ -20,7 +20,7 @@ EXPLAIN_HELP = ("also print the explanations: how each answer was decided, the r
                 "four-bar; --json and report always have everything)")
 
 
-def add_common(sp, mechanism: bool = True, optional_file: bool = False) -> None:
+def add_common(sp: argparse.ArgumentParser, mechanism: bool = True, optional_file: bool = False) -> None:
     """The options every command takes (with mechanism=False: no FILE and no mechanism options)."""
     sp.add_argument("--explain", action="store_true", help=EXPLAIN_HELP)
     if not mechanism:
@@ -41,7 +41,7 @@ def add_common(sp, mechanism: bool = True, optional_file: bool = False) -> None:
                          "ROS_PACKAGE_PATH; repeatable")
 
 
-def add_scaled(sp, point: bool=True) -> None:
+def add_scaled(sp: argparse.ArgumentParser, point: bool=True) -> None:
     """--length (the characteristic length of the dimensionless measures) and --point."""
     sp.add_argument("--length", help="characteristic length that makes the measures dimensionless "
                                      "(default: the mean link length; printed with every measure)")

@@ -33,7 +33,7 @@ class PointOption(argparse.Action):
             namespace.points = [*(getattr(namespace, "points", None) or []), value]
 
 
-def add_point_option(sp, origin_help: str | None = None) -> None:
+def add_point_option(sp: argparse.ArgumentParser, origin_help: str | None = None) -> None:
     """--point: named points NAME=LINK:x,y,z (and, with ``origin_help``, --point alone as before)."""
     sp.set_defaults(point=False, points=None)
     help = ("a point on a link, NAME=LINK:x,y,z in the link's frame (units allowed: P=coupler:60mm,20mm,0); "
@@ -63,7 +63,7 @@ def named_points(mech: Mechanism, args: argparse.Namespace) -> tuple:
     return tuple(out)
 
 
-def add_tool_option(sp) -> None:
+def add_tool_option(sp: argparse.ArgumentParser) -> None:
     """--tool x,y,z[,roll,pitch,yaw]: the output frame moved on the output link."""
     sp.add_argument("--tool", metavar="x,y,z[,roll,pitch,yaw]",
                     help="a tool frame on the --output link, placed in the link's frame (units allowed: "

@@ -48,11 +48,12 @@ from ._options import BOUNDS, count
 
 if TYPE_CHECKING:
     from ..model.mechanism import Mechanism
+    from collections.abc import Callable
 
 NAME = "draw"
 NEEDS_MECHANISM = True
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser(NAME, help="skeleton diagram (PNG/SVG), kinematic chain graph, singular configurations")
     common(sp)
     add_configuration_options(sp)

@@ -31,7 +31,7 @@ NAME = "dynamics"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="input efforts, joint reactions, shaking forces and flywheel at constant input speed")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint driven at constant speed")

@@ -20,7 +20,7 @@ NAME = "equations"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="the loop equations in symbols: vector loops, velocity and acceleration "
                                    "matrices, det A and its singular conditions")
     common(sp)

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -25,7 +26,7 @@ NAME = "export"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser(NAME, help="write the mechanism as MJCF (MuJoCo) or URDF, assembled (loops closed in the file)")
     common(sp)
     sp.add_argument("--mjcf", metavar="OUT.xml", help="write MJCF here: loops as <equality> connect/weld")

@@ -22,7 +22,7 @@ NAME = "grasp"
 NEEDS_MECHANISM = False
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="grasp analysis: grasp map, form and force closure, internal forces, quality")
     sp.add_argument("file", metavar="GRASP.yaml", help="contacts on one object (docs/format.md, 'Grasps')")
     common(sp, mechanism=False)

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
     from screwkin.analysis.position.solution import PositionResult
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -27,7 +28,7 @@ NAME = "ik"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser("ik", help="inverse kinematics: joint values that place an output link at a pose")
     common(sp)
     sp.add_argument("--output", help="the link to place (or its --tool; or give a named --point)")

@@ -20,7 +20,7 @@ NAME = "info"
 NEEDS_MECHANISM = "optional"  # --joint-types needs no FILE
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="topology table: links, joints, loops (--joint-types: the joint vocabulary)")
     common(sp, optional_file=True)
     sp.add_argument("--joint-types", action="store_true",

@@ -35,7 +35,7 @@ NAME = "map"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
     common(sp)
     sp.add_argument("--x", required=True, metavar="NAME=A:B:N", help="first input, from A to B in N values")

@@ -24,7 +24,7 @@ NAME = "mobility"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="degrees of freedom: counts and screw-theory mobility")
     common(sp)
     sp.add_argument("--output", help="link whose motion to characterize (e.g. the platform)")

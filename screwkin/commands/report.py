@@ -74,6 +74,7 @@ if TYPE_CHECKING:
     from ..model.mechanism import Mechanism
     from ..model.topology import Topology
     from ..present.document import Section
+    from collections.abc import Callable
 
 NAME = "report"
 NEEDS_MECHANISM = True
@@ -84,7 +85,7 @@ START_ANGLE = np.radians(10.0)
 START_FRACTION = 0.10
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser(NAME, help="one self-contained document (HTML and/or Markdown): topology, counts, equations, "
                                    "Newton iterations, motion, singular configurations with drawings, sweep, view")
     common(sp)

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -22,7 +23,7 @@ NAME = "scan"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser("scan", help="singularity scan of a serial chain over random configurations")
     common(sp)
     sp.add_argument("--output", help="the chain's last link (e.g. the flange; or give a named --point)")

@@ -26,7 +26,7 @@ NAME = "screws"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("screws", help="product-of-exponentials structure equations and joint screws")
     common(sp)
     add_configuration_options(sp)

@@ -29,7 +29,7 @@ NAME = "singularities"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("singularities", help="classify the singularities of a configuration")
     common(sp)
     add_configuration_options(sp)

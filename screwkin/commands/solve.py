@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     import numpy as np
     from collections.abc import Callable
     from screwkin.analysis.course.newton import NewtonResult
+    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -37,7 +38,7 @@ NAME = "solve"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("solve", help="position, velocity and acceleration for given input values")
     common(sp)
     sp.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -107,7 +108,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------ solve --start
-def _solved_near(mech: Mechanism, loops: VectorLoops, solver, values: dict, q: np.ndarray, res: NewtonResult, starts: int, skip: set | tuple = ()) -> tuple:
+def _solved_near(mech: Mechanism, loops: VectorLoops, solver: PositionSolver, values: dict, q: np.ndarray, res: NewtonResult, starts: int, skip: set | tuple = ()) -> tuple:
     """solve's configuration near q (Newton's root), the loop symbols there, and the unknowns
     in which it differs from Newton's root."""
     near = {n: v for n, v in mech.joint_values(q).items() if n not in skip}

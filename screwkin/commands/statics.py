@@ -27,7 +27,7 @@ NAME = "statics"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser(NAME, help="actuator efforts and joint reactions holding a load; legs' wrenches")
     common(sp)
     add_configuration_options(sp)

@@ -25,12 +25,13 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 NAME = "study"
 NEEDS_MECHANISM = False
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser(NAME, help="design-space study of a family of mechanisms (a xacro file) on Dask")
     sp.add_argument("spec", metavar="SPEC.yaml", help="the study: file, parameters, sampling, metrics (docs/format.md)")
     common(sp, mechanism=False)

@@ -55,7 +55,7 @@ NAME = "sweep"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("sweep", help="track one assembly mode along an input motion")
     common(sp)
     sp.add_argument("--input", required=True, help="the input joint to move")
@@ -124,7 +124,7 @@ def _streamed(args: argparse.Namespace) -> bool:
     return True
 
 
-def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver, start, stop, fixed, q_start, rate) -> int:
+def _run_streamed(mech: Mechanism, args: argparse.Namespace, solver: PositionSolver, start, stop, fixed, q_start, rate) -> int:
     chunk = args.chunk or DEFAULT_CHUNK
     angles, points = None, named_points(mech, args)  # (a bad --point refused before the file is opened)
     topo = None

@@ -68,7 +68,7 @@ _OPTIONS = {  # which options each kind takes (dest names)
 }
 
 
-def add_parser(sub, common: Callable, scaled: Callable) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("synthesize", help="synthesize a planar linkage (motion, function, path) or enumerate "
                                            "kinematic chains; writes URDF checked with screwkin")
     sp.add_argument("kind", choices=KINDS, help="what to synthesize")

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from typing import Any
     from screwkin.model.mechanism import Mechanism
+    from collections.abc import Callable
 
 __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
@@ -40,7 +41,7 @@ NAME = "view"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser("view", help="show the mechanism in meshcat (server on 127.0.0.1, or --html/--png)")
     common(sp)
     add_configuration_options(sp)

@@ -31,12 +31,13 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     import argparse
+    from collections.abc import Callable
 
 NAME = "workspace"
 NEEDS_MECHANISM = True
 
 
-def add_parser(sub, common, scaled) -> None:
+def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], scaled: Callable[..., None]) -> None:
     sp = sub.add_parser(NAME, help="workspace of an output link: volume, singularity-free part, conditioning")
     common(sp)
     sp.add_argument("--output", help="the link whose workspace to find (e.g. the platform; or its --tool frame's)")
