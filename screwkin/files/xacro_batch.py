@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, NoReturn
 
 if TYPE_CHECKING:
     from typing import Any
+    from collections.abc import Callable
 
 __all__ = ["Batch", "BatchExpansion", "Unbatchable", "expand_batch", "read_designs"]
 
@@ -71,7 +72,7 @@ class _Context:
         self.reason = self.reason or why
         raise Unbatchable(why)
 
-    def token(self, b) -> str:
+    def token(self, b: Batch) -> str:
         k = self._ids.get(id(b))
         if k is None:
             k = self._ids[id(b)] = len(self.batches)
@@ -83,7 +84,7 @@ class _Context:
         return self.batches[int(m.group(1))] if m and int(m.group(1)) < len(self.batches) else None
 
 
-def _finite_bad(values: np.ndarray, bad):
+def _finite_bad(values: np.ndarray, bad: np.ndarray):
     if values.dtype == bool:
         return bad
     return bad | ~np.isfinite(values)
@@ -95,7 +96,7 @@ class Batch:
 
     __slots__ = ("v", "bad", "ctx")
 
-    def __init__(self, v, bad, ctx: _Context) -> None:
+    def __init__(self, v: float | np.ndarray, bad: np.ndarray, ctx: _Context) -> None:
         self.v, self.bad, self.ctx = np.asarray(v), bad, ctx
 
     def _other(self, o: Batch) -> tuple:
@@ -105,30 +106,30 @@ class Batch:
             return o, False
         self.ctx.refuse("a parameter combined with text")
 
-    def _bin(self, o, f, reverse: bool=False) -> Batch:
+    def _bin(self, o: object, f: Callable[..., np.ndarray], reverse: bool=False) -> Batch:
         ov, ob = self._other(o)
         with np.errstate(all="ignore"):
             r = np.asarray(f(ov, self.v) if reverse else f(self.v, ov))
         return Batch(r, _finite_bad(r, self.bad | ob), self.ctx)
 
-    def __add__(self, o) -> Batch: return self._bin(o, np.add)
-    def __radd__(self, o) -> Batch: return self._bin(o, np.add, True)
-    def __sub__(self, o) -> Batch: return self._bin(o, np.subtract)
-    def __rsub__(self, o) -> Batch: return self._bin(o, np.subtract, True)
-    def __mul__(self, o) -> Batch: return self._bin(o, np.multiply)
-    def __rmul__(self, o) -> Batch: return self._bin(o, np.multiply, True)
-    def __truediv__(self, o) -> Batch: return self._bin(o, np.true_divide)
-    def __rtruediv__(self, o) -> Batch: return self._bin(o, np.true_divide, True)
-    def __floordiv__(self, o) -> Batch: return self._bin(o, np.floor_divide)
-    def __rfloordiv__(self, o) -> Batch: return self._bin(o, np.floor_divide, True)
-    def __mod__(self, o) -> Batch: return self._bin(o, np.mod)
-    def __rmod__(self, o) -> Batch: return self._bin(o, np.mod, True)
-    def __lt__(self, o) -> Batch: return self._bin(o, np.less)
-    def __le__(self, o) -> Batch: return self._bin(o, np.less_equal)
-    def __gt__(self, o) -> Batch: return self._bin(o, np.greater)
-    def __ge__(self, o) -> Batch: return self._bin(o, np.greater_equal)
-    def __eq__(self, o) -> Batch: return self._bin(o, np.equal)
-    def __ne__(self, o) -> Batch: return self._bin(o, np.not_equal)
+    def __add__(self, o: object) -> Batch: return self._bin(o, np.add)
+    def __radd__(self, o: object) -> Batch: return self._bin(o, np.add, True)
+    def __sub__(self, o: object) -> Batch: return self._bin(o, np.subtract)
+    def __rsub__(self, o: object) -> Batch: return self._bin(o, np.subtract, True)
+    def __mul__(self, o: object) -> Batch: return self._bin(o, np.multiply)
+    def __rmul__(self, o: object) -> Batch: return self._bin(o, np.multiply, True)
+    def __truediv__(self, o: object) -> Batch: return self._bin(o, np.true_divide)
+    def __rtruediv__(self, o: object) -> Batch: return self._bin(o, np.true_divide, True)
+    def __floordiv__(self, o: object) -> Batch: return self._bin(o, np.floor_divide)
+    def __rfloordiv__(self, o: object) -> Batch: return self._bin(o, np.floor_divide, True)
+    def __mod__(self, o: object) -> Batch: return self._bin(o, np.mod)
+    def __rmod__(self, o: object) -> Batch: return self._bin(o, np.mod, True)
+    def __lt__(self, o: object) -> Batch: return self._bin(o, np.less)
+    def __le__(self, o: object) -> Batch: return self._bin(o, np.less_equal)
+    def __gt__(self, o: object) -> Batch: return self._bin(o, np.greater)
+    def __ge__(self, o: object) -> Batch: return self._bin(o, np.greater_equal)
+    def __eq__(self, o: object) -> Batch: return self._bin(o, np.equal)
+    def __ne__(self, o: object) -> Batch: return self._bin(o, np.not_equal)
     __hash__ = object.__hash__
 
     def __neg__(self) -> Batch:
@@ -157,7 +158,7 @@ class Batch:
     __int__ = __float__ = __index__ = _refuse_number
 
 
-def _truth(x) -> bool | np.ndarray:
+def _truth(x: object) -> bool | np.ndarray:
     return np.asarray(x.v, bool) if isinstance(x, Batch) else bool(x)
 
 
@@ -165,11 +166,11 @@ class _BatchInterpreter(Interpreter):
     """xacro_eval's interpreter with Batch values: what it does with a number, it does with each
     design's number."""
 
-    def __init__(self, symbols, ctx: _Context) -> None:
+    def __init__(self, symbols: dict, ctx: _Context) -> None:
         super().__init__(symbols)
         self.ctx = ctx
 
-    def _where(self, test: Batch, a, b) -> Batch:
+    def _where(self, test: Batch, a: object, b: object) -> Batch:
         """``a if test else b``, design by design (each design's failures from its own branch and the test)."""
         ctx = self.ctx
         t = np.asarray(test.v, bool) if isinstance(test, Batch) else np.full(ctx.n, bool(test))
@@ -182,7 +183,7 @@ class _BatchInterpreter(Interpreter):
         tb = test.bad if isinstance(test, Batch) else False
         return Batch(np.where(t, av, bv), np.where(t, ab, bb) | tb, ctx)
 
-    def value(self, node):
+    def value(self, node: ast.AST):
         ctx = self.ctx
         if isinstance(node, ast.Constant) and isinstance(node.value, str) and TOKEN.search(node.value):
             ctx.refuse("a parameter inside quotes (compared or joined as text)")
@@ -295,7 +296,7 @@ class BatchExpansion:
         return "".join(out)
 
 
-def _check_places(text: str, path) -> None:
+def _check_places(text: str, path: str | Path) -> None:
     """Tokens only in the numbers of ALLOWED attributes (anything else: the structure may change)."""
     root = parse_xml_text(text, path)
     for elem in root.iter():
@@ -308,7 +309,7 @@ def _check_places(text: str, path) -> None:
                                   "geometry sizes may vary for the family to be expanded once)")
 
 
-def expand_batch(path, text: str, args: dict, parameters: dict) -> BatchExpansion:
+def expand_batch(path: str | Path, text: str, args: dict, parameters: dict) -> BatchExpansion:
     """The template of xacro file ``path`` with the fixed ``args`` (as for expand) and the varied
     ``parameters`` ({name: array of SI values, one per design}); Unbatchable when the family cannot
     be expanded at once (the reason)."""

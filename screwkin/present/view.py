@@ -41,6 +41,7 @@ from .outfile import write_output
 if TYPE_CHECKING:
     from ..model.mechanism import Mechanism
     from screwkin.files.description import CutJointSpec
+    from collections.abc import Sequence
 
 __all__ = ["COLORS", "build_scene", "show", "page", "legend_entries", "view", "RecordingViewer", "screenshot"]
 
@@ -87,7 +88,7 @@ def _visual_urdf(mech: Mechanism, unreadable: set | tuple = ()) -> str:
 _JOINT_FIRST = (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT, pin.FrameType.BODY, pin.FrameType.OP_FRAME)
 
 
-def _body_frame(model, name: str):
+def _body_frame(model: pin.Model, name: str):
     """The BODY frame of link ``name`` (a joint may have the same name), or None."""
     fid = frame_id(model, name)
     return fid if fid is not None and model.frames[fid].type == pin.FrameType.BODY else None
@@ -121,7 +122,7 @@ def _standin_points(mech: Mechanism) -> dict:
     return out
 
 
-def _segment(name: str, joint, frame, a, b, radius, color):
+def _segment(name: str, joint: int, frame: int, a: np.ndarray, b: np.ndarray, radius: float, color: Sequence[float]):
     """A cylinder between points a and b (in the frame of joint ``joint``)."""
     coal = _coal()
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -136,13 +137,13 @@ def _segment(name: str, joint, frame, a, b, radius, color):
     return obj
 
 
-def _ball(name: str, joint, frame, p, radius, color):
+def _ball(name: str, joint: int, frame: int, p: np.ndarray, radius: float, color: Sequence[float]):
     obj = pin.GeometryObject(name, joint, frame, pin.SE3(np.eye(3), np.asarray(p, float)), _coal().Sphere(radius))
     obj.meshColor = np.asarray(color, float)
     return obj
 
 
-def _disc(name: str, joint, frame, M, radius, color, alpha: float=0.35):
+def _disc(name: str, joint: int, frame: int, M: pin.SE3, radius: float, color: Sequence[float], alpha: float=0.35):
     """A thin disc of ``radius`` whose normal is the z axis of the placement M (a pitch circle or
     a circular profile), see-through so the links stay visible."""
     obj = pin.GeometryObject(name, joint, frame, M, _coal().Cylinder(radius, 0.05 * radius))
@@ -239,7 +240,7 @@ def _corner_points(state: KinematicState, geom) -> np.ndarray:
     return np.asarray(pts)
 
 
-def _visual_geometry(mech: Mechanism, warn=None):
+def _visual_geometry(mech: Mechanism, warn: Callable[[str], object] | None=None):
     """Pinocchio's visual GeometryModel of the links; a mesh file that exists but cannot be
     read (not a mesh, truncated) is a warning and its link is drawn as a stand-in."""
 
@@ -392,36 +393,36 @@ class RecordingViewer:
         if root is None:
             self.objects, self.transforms, self.properties, self.animation = {}, {}, {}, None
 
-    def __getitem__(self, path) -> RecordingViewer:
+    def __getitem__(self, path: str) -> RecordingViewer:
         path = path if path.startswith("/") else f"{self._path}/{path}"
         return RecordingViewer(self._root, path)
 
-    def set_object(self, geometry, material=None) -> None:
+    def set_object(self, geometry: object, material: object | None=None) -> None:
         self._root.objects[self._path] = (geometry, material)
 
     def set_transform(self, matrix: np.ndarray | None = None) -> None:
         self._root.transforms[self._path] = np.eye(4) if matrix is None else np.asarray(matrix)
 
-    def set_property(self, key, value) -> None:
+    def set_property(self, key: str, value: object) -> None:
         self._root.properties[(self._path, key)] = value
 
     def delete(self) -> None:
         self._root.objects.pop(self._path, None)
 
-    def set_animation(self, animation, play: bool=True, repetitions: int=1) -> None:
+    def set_animation(self, animation: object, play: bool=True, repetitions: int=1) -> None:
         self._root.animation = animation
 
     def get_image(self, *args: Any):  # pragma: no cover - present so Pinocchio does not warn
         raise NotImplementedError
 
 
-def _translation(p) -> np.ndarray:
+def _translation(p: np.ndarray) -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = p
     return T
 
 
-def show(mech: Mechanism, scene: Scene, viewer, q: np.ndarray, motion=None, fps: int=30):
+def show(mech: Mechanism, scene: Scene, viewer, q: np.ndarray, motion: Sequence[np.ndarray] | None=None, fps: int=30):
     """Draw the scene at q into a meshcat viewer with Pinocchio's MeshcatVisualizer;
     with ``motion`` (a sequence of configurations) also set a meshcat animation.  A planar
     mechanism is seen along its plane's normal, orthographic, a colour per link (viewplanar)."""
@@ -481,7 +482,7 @@ LEGEND = (
 )
 
 
-def _css(color) -> str:
+def _css(color: Sequence[float]) -> str:
     r, g, b = (int(round(255 * float(c))) for c in color[:3])
     return f"rgb({r},{g},{b})"
 
@@ -494,7 +495,7 @@ def legend_entries(scene: Scene) -> list:
             for label, key, roles in LEGEND if present & set(roles)]
 
 
-def page(html: str, scene: Scene, title: str | None = None, controls: bool = True, size=None) -> str:
+def page(html: str, scene: Scene, title: str | None = None, controls: bool = True, size: tuple[int, int] | None=None) -> str:
     """meshcat's static page with screwkin's legend (a small box, bottom left: a coloured marker
     per kind of thing drawn, and ``title`` above them); ``controls=False`` hides meshcat's
     control panel and ``size`` (width, height) [px] fixes the drawing's size, for pictures
@@ -544,7 +545,7 @@ def chromium() -> str | None:
     return None
 
 
-def screenshot(html_path, png_path, size=PICTURE, budget_ms: int=8000):
+def screenshot(html_path: str | Path, png_path: str | Path, size: tuple[int, int]=PICTURE, budget_ms: int=8000):
     """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
     exe = chromium()
     if exe is None:
@@ -566,7 +567,7 @@ def screenshot(html_path, png_path, size=PICTURE, budget_ms: int=8000):
 _servers = []  # servers started by view(): they live as long as the Python session (a notebook)
 
 
-def view(mech: Mechanism, q: np.ndarray | None=None, output=None, motion=None, viewer=None):
+def view(mech: Mechanism, q: np.ndarray | None=None, output=None, motion: Sequence[np.ndarray] | None=None, viewer=None):
     """Show a mechanism (at q, default its assembled configuration) and return the
     meshcat viewer; in a notebook, ``view(mech, s.q).jupyter_cell()`` embeds it.
     Without ``viewer`` a loopback-only server is started and kept for the session."""

@@ -34,6 +34,8 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.motion.crossing import ChangePoint
     from collections.abc import Callable
+    from screwkin.analysis.motion.crossing import Crossing
+    from collections.abc import Sequence
 
 __all__ = ["sweep_inputs", "SweepResult", "SweepSingularity", "sweep", "MAX_TRACKED", "drawn_start", "BRANCHES"]
 
@@ -170,7 +172,7 @@ REFINE = 8
 ON_GRID = 1e-6  # a value within this fraction of a fine step of a fine grid value is on that grid
 
 
-def _refined(f, start: float, h: float, k: int):
+def _refined(f: Callable[..., np.ndarray], start: float, h: float, k: int):
     """The closed-form sweep ``f`` of a grid k times finer (step h / k) at the values of the grid of step h
     (and its located limit position, off both grids); None for None."""
     if f is None:
@@ -183,9 +185,9 @@ def _refined(f, start: float, h: float, k: int):
 
 
 def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict | None = None,
-          near: dict | None = None, rate: float = 1.0, progress=None, turn: bool = False,
+          near: dict | None = None, rate: float = 1.0, progress: Callable[[int, int], object] | None=None, turn: bool = False,
           max_steps: int | None = None, q_start: np.ndarray | Callable | None=None, closed_form: bool = True, batch: bool = True,
-          branch: str = "continue", prior=None) -> SweepResult:
+          branch: str = "continue", prior: tuple[float, np.ndarray] | None=None) -> SweepResult:
     """Follow one assembly mode while input ``name`` goes from start to stop in ``steps``
     steps of the input (see the module docstring).
 
@@ -219,7 +221,7 @@ def sweep(solver, name: str, start: float, stop: float, steps: int, fixed: dict 
     return _through_change_points(solver, res, fixed, progress, max_steps, closed_form, batch, branch, prior)
 
 
-def _engine(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, fixed: dict, rate: float, progress, turn: bool, max_steps: int, closed_form: bool, batch: bool) -> SweepResult:
+def _engine(solver, name: str, q0: np.ndarray, start: float, stop: float, steps: int, fixed: dict, rate: float, progress: Callable[[int, int], object] | None, turn: bool, max_steps: int, closed_form: bool, batch: bool) -> SweepResult:
     """The SweepResult of the engine that applies (see ``sweep``), started from q0."""
     curve, requested = Curve(solver, name), (start, stop, steps)
     if closed_form:
@@ -288,7 +290,7 @@ def _fallback(solver, curve: Curve, fixed: dict) -> Callable:
     """The batched engine's fallback: the per-step tracker's Motion of n steps from qa (input xa) to xb,
     qa closed again at xa first (as a sweep started from it)."""
 
-    def fallback(qa: np.ndarray, xa, xb, n: int):
+    def fallback(qa: np.ndarray, xa: float, xb: float, n: int):
         qa = solver.track({curve.name: xa, **fixed}, qa).q
         ta, why = _start_tangent(curve, qa, (xb - xa) / n)
         if ta is None:
@@ -347,7 +349,7 @@ def _finish(solver, name: str, motion: Motion, rate: float, requested: tuple, tu
 
 
 
-def _through_change_points(solver, res: SweepResult, fixed: dict, progress, max_steps: int, closed_form: bool, batch: bool, branch: str, prior=None) -> SweepResult:
+def _through_change_points(solver, res: SweepResult, fixed: dict, progress: Callable[[int, int], object] | None, max_steps: int, closed_form: bool, batch: bool, branch: str, prior: tuple[float, np.ndarray] | None=None) -> SweepResult:
     """The motion res carried through the change points it meets (analysis.motion.crossing: passed,
     crossing, follow): at each, the branch chosen by the tangent cone (``branch``), followed from the
     change point to the grid values after it; where the engine's own result is not that branch (it
@@ -427,12 +429,12 @@ def _through_change_points(solver, res: SweepResult, fixed: dict, progress, max_
     return replace(res, change_points=res.change_points + tuple(named), notes=_once(res.notes + tuple(notes)))
 
 
-def _once(notes) -> tuple:
+def _once(notes: tuple) -> tuple:
     """The notes, each said once (a motion through limit positions passes one change point again and again)."""
     return tuple(dict.fromkeys(notes))
 
 
-def _engine_took(solver, curve: Curve, res, k0, after, h) -> bool:
+def _engine_took(solver, curve: Curve, res: SweepResult, k0: int, after: list, h: float) -> bool:
     """Whether the engine's recorded configurations from index k0 are ``after`` ((input value,
     configuration) each, the branch followed), the input running the way of h."""
     tol = solver.mech.tolerances
@@ -451,7 +453,7 @@ def _engine_took(solver, curve: Curve, res, k0, after, h) -> bool:
 GRID_ON = 1e-9  # a value this fraction of a grid step short of a grid index counts as on it
 
 
-def _change_point_note(solver, name: str, unit: str, cp: ChangePoint, why, branch: str) -> str:
+def _change_point_note(solver, name: str, unit: str, cp: ChangePoint, why: str | None, branch: str) -> str:
     """change point at crank = 180 deg: two branches cross; continuing on ... (the other: --branch other)."""
     # (located where the constraint measure is least: to about the square root of the closure's round-off)
     at = f"{cp.input:.7g} m" if unit == "m" else f"{cp.input:.7g} rad ({np.degrees(cp.input):.6g} deg)"
@@ -486,11 +488,11 @@ def _slice(res: SweepResult, n: int):
                    skipped=tuple(x for x in res.skipped if n and _between(x, res.values[0], res.values[n - 1])))
 
 
-def _between(x, a, b) -> bool:
+def _between(x: float, a: float, b: float) -> bool:
     return min(a, b) <= x <= max(a, b)
 
 
-def _joined(solver, res: SweepResult, head: SweepResult, middle, tail: SweepResult, named, notes, c):
+def _joined(solver, res: SweepResult, head: SweepResult, middle: SweepResult | None, tail: SweepResult, named: Sequence, notes: Sequence, c: Crossing):
     """head + middle + tail (SweepResults; middle or tail may be None): one motion."""
     parts = [p for p in (head, middle, tail) if p is not None and len(p.values)]
     cat = (lambda f: np.concatenate([getattr(p, f) for p in parts])) if parts else (lambda f: getattr(head, f))
