@@ -28,6 +28,10 @@ from .outfile import write_figure
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.course.skeleton import KinematicChain
+    from collections.abc import Callable
+    from collections.abc import Iterable
+    from collections.abc import Sequence
+    from screwkin.analysis.course.skeleton import SkeletonLink
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -47,19 +51,19 @@ def _plt():
     return pyplot("drawing")
 
 
-def value_label(name: str, value, unit: str) -> str:
+def value_label(name: str, value: float, unit: str) -> str:
     """'crank = 30 deg' or 'slide = 12.5 mm': a value as a person reads it."""
     if unit == "m":
         return f"{name} = {value * 1000:.4g} mm"
     return f"{name} = {np.degrees(value):.5g} deg"
 
 
-def wrapped_value(value, unit: str):
+def wrapped_value(value: float, unit: str):
     """A coordinate's value as a drawing names it: a length [m] as it is, an angle in [-pi, pi)."""
     return value if unit == "m" else wrap_angle(value)
 
 
-def configuration_text(skel) -> str:
+def configuration_text(skel: Skeleton) -> str:
     """The inputs a skeleton is drawn at ('crank = 30 deg, ...'), or 'assembled configuration'."""
     if not skel.inputs:
         return "assembled configuration"
@@ -82,13 +86,13 @@ def number_colours(n: int) -> dict:
     return {k: cycle[(k - 2) % len(cycle)] for k in range(2, n + 2)}
 
 
-def _direction_2d(v):
+def _direction_2d(v: Sequence[float] | np.ndarray):
     v = np.asarray(v, float)
     n = np.linalg.norm(v)
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
 
 
-def _fit_axes(fig, ax, points, r, limits: tuple | None = None) -> None:
+def _fit_axes(fig: Figure, ax: Axes, points: np.ndarray, r: float, limits: tuple | None = None) -> None:
     """Equal aspect ratio and a margin of 8 % of the drawing's extent around every symbol (or the
     ``limits`` ((x0, x1), (y0, y1)) given: the frames of an animation share one)."""
     P = np.array(points) if points else np.zeros((1, 2))
@@ -351,14 +355,14 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
     return fig
 
 
-def _block_direction(skel, lk):
+def _block_direction(skel: Skeleton, lk: SkeletonLink):
     for j in skel.joints:
         if lk.number in j.links and j.type in ("prismatic", "cylindrical") and j.direction is not None:
             return _direction_2d(j.direction)
     return np.array([1.0, 0.0])
 
 
-def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float=0.85) -> None:
+def _block(ax: Axes, Rectangle, p: np.ndarray, d: np.ndarray, r: float, colour: str, gid: str, alpha: float=0.85) -> None:
     w, h = 4.2 * r, 2.6 * r
     p = np.asarray(p, float)
     n = np.array([-d[1], d[0]])
@@ -367,7 +371,7 @@ def _block(ax, Rectangle, p, d, r, colour, gid: str, alpha: float=0.85) -> None:
                            alpha=alpha, edgecolor="black", lw=1.2, zorder=3.5, gid=gid, label="slider"))
 
 
-def _input_arrow(ax, FancyArrowPatch, j, p: np.ndarray, r) -> None:
+def _input_arrow(ax: Axes, FancyArrowPatch, j: SkeletonJoint, p: np.ndarray, r: float) -> None:
     if j.type == "prismatic":
         d = _direction_2d(j.direction if j.direction is not None else (1.0, 0.0))
         n = np.array([-d[1], d[0]])
@@ -392,7 +396,7 @@ def _input_arrow(ax, FancyArrowPatch, j, p: np.ndarray, r) -> None:
                                  label="input"))
 
 
-def _legend(fig, links, joints, marks: list | None = None) -> None:
+def _legend(fig: Figure, links: Sequence[SkeletonLink], joints: Sequence[SkeletonJoint], marks: list | None = None) -> None:
     lines = ["links"]
     lines += [f" {lk.number:>2}  {_short(lk.name)}" + ("  (ground)" if lk.ground else "") for lk in links]
     lines.append("")
@@ -521,11 +525,11 @@ def _layout(chain: KinematicChain) -> dict:
     return {k: P[i] for i, k in enumerate(numbers)}
 
 
-def _crossings(pos, edges) -> bool:
+def _crossings(pos: dict, edges: Iterable[tuple]) -> bool:
     """Whether two edges without a common node cross in the layout."""
     edges = list(edges)
 
-    def ccw(a, b, c):
+    def ccw(a: np.ndarray, b: np.ndarray, c: np.ndarray):
         return (c[1] - a[1]) * (b[0] - a[0]) - (b[1] - a[1]) * (c[0] - a[0])
 
     for i, (a, b) in enumerate(edges):
@@ -538,7 +542,7 @@ def _crossings(pos, edges) -> bool:
     return False
 
 
-def save_figure(fig, path: str, close: bool = True):
+def save_figure(fig: Figure, path: str, close: bool = True):
     """Write a Figure to ``path`` (PNG or SVG by its suffix; present/outfile.write_figure) and close it
     (unless ``close`` is False: the same figure written to another file next)."""
     plt = _plt()
@@ -551,7 +555,7 @@ def save_figure(fig, path: str, close: bool = True):
         plt.close(fig)
 
 
-def draw_design(mech: Mechanism, paths: list, steps: int = 360, say=None) -> list:
+def draw_design(mech: Mechanism, paths: list, steps: int = 360, say: Callable[[str], object] | None=None) -> list:
     """``mech`` (a synthesized file) drawn at its own configuration with its targets into each of
     ``paths`` (.png or .svg), as ``screwkin draw FILE --png F`` draws it: the marks (as --json)."""
     q = mech.assemble().q

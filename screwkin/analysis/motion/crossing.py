@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     from screwkin.tolerances import Tolerances
     from collections.abc import Callable
     from collections.abc import Iterator
+    from screwkin.analysis.local import Branch
 
 __all__ = ["ChangePoint", "Crossing", "passed", "crossing", "follow", "constraint_profile", "dips", "reclosing",
            "LOOK_BELOW", "TIGHT_CLOSURE", "START", "nearest_branch"]
@@ -61,7 +62,7 @@ def reclosing(solver, res, q_k: np.ndarray, tight: Tolerances) -> Callable:
     Newton gets there, the mechanism's otherwise); raises AssemblyError when neither closes."""
     mech, frozen = solver.mech, solver.frozen
 
-    def q_at(x):
+    def q_at(x: float):
         q0 = solver.set_inputs(q_k, {res.input: x})
         try:
             return mech.closure.solve(q0, frozen=frozen, tolerances=tight).q
@@ -87,14 +88,14 @@ class ChangePoint:
     switched: bool = False  # a motion passing it took the other branch, as asked (sweep's branch="other")
 
 
-def _direction(mech: Mechanism, rates):
+def _direction(mech: Mechanism, rates: np.ndarray):
     v = np.asarray(rates, float).copy()
     v[mech.translational] /= mech.length
     n = np.linalg.norm(v)
     return v / n if n > 0 else None
 
 
-def nearest_branch(mech: Mechanism, local, rates):
+def nearest_branch(mech: Mechanism, local: LocalAnalysis, rates: np.ndarray):
     """The branch whose tangent is nearest the direction of ``rates`` (joint rates), or None."""
     u = _direction(mech, rates)
     if u is None or not local.branches:
@@ -254,7 +255,7 @@ def _least(solver, res, q: np.ndarray, bounds: list | tuple, rank: int, tight: T
     mech = solver.mech
     q_at = reclosing(solver, res, q, tight)
 
-    def sigma(x):
+    def sigma(x: float):
         try:
             return _measure(mech, q_at(x), rank)
         except AssemblyError:
@@ -268,7 +269,7 @@ def _least(solver, res, q: np.ndarray, bounds: list | tuple, rank: int, tight: T
     return x, q, _measure(mech, q, rank)
 
 
-def _limit_index(xs: np.ndarray, x) -> int:
+def _limit_index(xs: np.ndarray, x: float) -> int:
     """The index of the recorded configuration a located limit position comes after: the first place
     near it where the input turns back (or repeats a value: the grid value before a limit, recorded
     going and coming back), else the last configuration (a motion that stopped there)."""
@@ -280,12 +281,12 @@ def _limit_index(xs: np.ndarray, x) -> int:
     return len(xs) - 1
 
 
-def _branch_rates(mech: Mechanism, branch) -> np.ndarray:
+def _branch_rates(mech: Mechanism, branch: Branch) -> np.ndarray:
     """A branch's tangent as joint rates (nv), in the order of the coordinates."""
     return np.array([branch.tangent.get(n, 0.0) for n in mech.coordinate_names], float)
 
 
-def follow(curve: Curve, q: np.ndarray, x, rates, x_to):
+def follow(curve: Curve, q: np.ndarray, x: float, rates: np.ndarray, x_to: float):
     """The configuration at input value x_to reached from the configuration q (input x) along the
     branch of tangent ``rates`` (joint rates): a first step of Tolerances.local_step along it (where
     the local analysis confirms its branches), then the continuation's steps (Neighbour) to x_to.
@@ -365,7 +366,7 @@ def crossing(solver, curve: Curve, res, c: Crossing, switch: bool, prior=None) -
     return ChangePoint(c.x, c.sigma, c.q, local, incoming, goes, True, switched=goes != came), v, why
 
 
-def _starting(solver, curve: Curve, local, branches: list, moving: list, c: Crossing, direction) -> tuple:
+def _starting(solver, curve: Curve, local: LocalAnalysis, branches: list, moving: list, c: Crossing, direction: float) -> tuple:
     """(the branch a motion starting on the change point c takes, the rule in words): of the branches
     that move the input, the one the file's configuration lies on (followed from c to its input value,
     it reaches the drawing: solve's first mode is the one nearest the drawing); where none does (the
@@ -395,7 +396,7 @@ def _starting(solver, curve: Curve, local, branches: list, moving: list, c: Cros
     return came, f"{START}: taking the branch nearest the input's own direction (projected on ker K)"
 
 
-def _reaches(solver, curve: Curve, c: Crossing, rates, x, drawn) -> bool:
+def _reaches(solver, curve: Curve, c: Crossing, rates: np.ndarray, x: float, drawn) -> bool:
     """Whether the branch of tangent ``rates`` at the change point c, followed to input value x, reaches the
     configuration whose signature (PositionSolver.signature) is ``drawn``."""
     q = follow(curve, c.q, c.x, rates, x)
@@ -418,7 +419,7 @@ def _local(solver, c: Crossing) -> LocalAnalysis:
     return mech.cache[key]
 
 
-def _arriving(xs: np.ndarray, c: Crossing, requested) -> float:
+def _arriving(xs: np.ndarray, c: Crossing, requested: tuple) -> float:
     """The sign of the input's motion at the change point c (+1 or -1)."""
     if c.before >= 0:
         d = c.x - xs[c.before]

@@ -29,6 +29,9 @@ from ....model.geometry import circle_circle, wrap_angle
 from ....tolerances import DEFAULT
 from .designs import Design, FourBar, PathResult, SynthesisError, Target
 from .fourbar import fourbar_linkage, stored, travel_analysis
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 __all__ = ["synthesize_path", "coupler_points", "path_points", "path_design", "MAX_POINTS"]
 
@@ -40,7 +43,7 @@ TWO_PI = 2 * math.pi
 _BETWEEN = np.array([0.25, 0.5, 0.75])
 
 
-def _unpack(x, timing, direction) -> tuple:
+def _unpack(x: np.ndarray, timing: np.ndarray | None, direction: float) -> tuple:
     """The parameters of one design (x: (n,)) or of many (x: (m, n)), as arrays with the design
     index first: A0, B0 (m, 2), a, b, c, p, q (m,), crank angles th (m, N)."""
     X = np.atleast_2d(x)
@@ -54,7 +57,7 @@ def _unpack(x, timing, direction) -> tuple:
     return A0, B0, a, b, c, p, q, th
 
 
-def coupler_points(A0: np.ndarray, B0: np.ndarray, a, b, c, p, q: np.ndarray, th, sigma: float) -> tuple:
+def coupler_points(A0: np.ndarray, B0: np.ndarray, a: float | np.ndarray, b: float | np.ndarray, c: float | np.ndarray, p: float | np.ndarray, q: np.ndarray, th: np.ndarray, sigma: float) -> tuple:
     """Coupler point at crank angles th (..., N) of designs whose parameters (A0, B0 (..., 2); a,
     b, c, p, q scalars or (...,)) broadcast against them: (P (..., N, 2), h2 (..., N): < 0 where
     the linkage does not assemble, A, B)."""
@@ -66,7 +69,7 @@ def coupler_points(A0: np.ndarray, B0: np.ndarray, a, b, c, p, q: np.ndarray, th
     return A + p[..., None] * u + q[..., None] * n, h2, A, B
 
 
-def _residuals(X: np.ndarray, pts: np.ndarray, timing, direction, sigma: float, L) -> np.ndarray:
+def _residuals(X: np.ndarray, pts: np.ndarray, timing: np.ndarray | None, direction: float, sigma: float, L: float) -> np.ndarray:
     """Residuals of designs X (m, n) -> (m, residuals): the distances to the points (over L),
     how far apart the circles are at and between the points (weighted), a turn exceeded."""
     A0, B0, a, b, c, p, q, th = _unpack(X, timing, direction)
@@ -81,12 +84,12 @@ def _residuals(X: np.ndarray, pts: np.ndarray, timing, direction, sigma: float, 
     return np.concatenate([r, 10 * apart / L, np.maximum(travel - 0.98 * TWO_PI, 0.0)[:, None]], axis=1)
 
 
-def _problem(pts: np.ndarray, timing, direction, sigma: float, L) -> tuple:
+def _problem(pts: np.ndarray, timing: np.ndarray | None, direction: float, sigma: float, L: float) -> tuple:
     """(fun, jac) for scipy: the Jacobian by central differences, all 2n designs in one call."""
-    def fun(x):
+    def fun(x: np.ndarray):
         return _residuals(x[None], pts, timing, direction, sigma, L)[0]
 
-    def jac(x):
+    def jac(x: np.ndarray):
         h = 1e-7 * np.maximum(np.abs(x), L)
         E = np.diag(h)
         R = _residuals(np.concatenate([x + E, x - E]), pts, timing, direction, sigma, L)
@@ -95,7 +98,7 @@ def _problem(pts: np.ndarray, timing, direction, sigma: float, L) -> tuple:
     return fun, jac
 
 
-def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolerance: float = 1e-6,
+def synthesize_path(points: Sequence[Sequence[float]] | np.ndarray, timing: np.ndarray | None=None, starts: int = 24, seed: int = 0, tolerance: float = 1e-6,
                     name: str = "synthesized_path", polish: int = 6) -> PathResult:
     """A four-bar whose coupler point passes through ``points`` ((x, y) [m]), in that order,
     with the crank angles ``timing`` (relative to the first point [rad]) when given."""
@@ -150,7 +153,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
         raise SynthesisError(WHAT, f"no start out of {starts} gave a four-bar that assembles at every point")
     good = [r for r in results if r[0] <= tolerance]
 
-    def quality(r) -> tuple:
+    def quality(r: tuple) -> tuple:
         _, x, sigma, direction, errors, A, B, P, th = r
         fb = FourBar(tuple(x[0:2]), tuple(A[0]), tuple(B[0]), tuple(x[2:4]), (*P[0], 0.0))
         res = travel_analysis(fb, th, np.full(len(th), sigma))
@@ -166,7 +169,7 @@ def synthesize_path(points, timing=None, starts: int = 24, seed: int = 0, tolera
                       tuple(map(float, errors)), starts, len(good), tolerance, design)
 
 
-def path_points(points, timing=None) -> tuple:
+def path_points(points: Sequence[Sequence[float]] | np.ndarray, timing: np.ndarray | None=None) -> tuple:
     """(points (n, 2), timing relative to the first point or None, the path's size L [m]), checked:
     3 to MAX_POINTS distinct points; one crank angle per point running one way within a turn."""
     pts = np.array(points, float)
@@ -194,7 +197,7 @@ def path_points(points, timing=None) -> tuple:
     return pts, timing, L
 
 
-def path_design(pts: np.ndarray, x, sigma: float, A, B, P, th, errors, name: str = "synthesized_path", exact: bool = True) -> tuple:
+def path_design(pts: np.ndarray, x: np.ndarray, sigma: float, A: np.ndarray, B: np.ndarray, P: np.ndarray, th: np.ndarray, errors: np.ndarray, name: str = "synthesized_path", exact: bool = True) -> tuple:
     """(the Design of the four-bar x (A0, B0, ...: path._unpack's order) drawn at the first point, its
     crank angles from the first point): A, B, P the moving pivots and coupler point at each point;
     ``exact`` False: the points are approximated (least squares), a miss is not a defect."""
