@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.model.cuts import CutJoint
     from screwkin.tolerances import Tolerances
+    from collections.abc import Iterable
 
 __all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
@@ -81,7 +82,7 @@ class SingularityReport:
     input_output_note: str | None = None
 
 
-def _rel(s, k: int) -> float:
+def _rel(s: np.ndarray, k: int) -> float:
     """k-th singular value (1-based) relative to the largest; 0 when missing."""
     if k <= 0:
         return 1.0
@@ -103,7 +104,7 @@ class Scaled:
     L: float
 
 
-def scaled_jacobians(mech: Mechanism, q: np.ndarray, output=None, point: bool = False, length: float | None = None) -> Scaled:
+def scaled_jacobians(mech: Mechanism, q: np.ndarray, output: str | None=None, point: bool = False, length: float | None = None) -> Scaled:
     """The matrices of :class:`Scaled` at q (assembled)."""
     L = float(length or mech.length)
     slide = mech.translational
@@ -127,7 +128,7 @@ class Generic:
     joints that move there (a joint whose rate the loops force to zero everywhere is not
     "stationary" at any one configuration)."""
 
-    def __init__(self, mech: Mechanism, inputs, output=None, point: bool = False, configurations=None) -> None:
+    def __init__(self, mech: Mechanism, inputs: Iterable[str], output: str | None=None, point: bool = False, configurations=None) -> None:
         tol = mech.tolerances
         configs = configurations if configurations is not None else mech.generic_configurations()[1]
         self.inputs = list(inputs)
@@ -171,7 +172,7 @@ def _measures(S: Scaled, g: Generic) -> dict:
     return out
 
 
-def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=None, length=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:
+def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output: str | None=None, length: float | None=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:
     """Classify the configuration q (assembled) for the given inputs and output link.
     length: the characteristic length [m] (default ``mech.length``); point: the output
     link's origin as a point (its 3 translations) instead of its full motion."""
@@ -195,7 +196,7 @@ def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=
         J_world = state.frame_jacobian(fid, pin.ReferenceFrame.WORLD)
         origin = state.frame_placement(fid).translation
 
-    def unscale(x):  # scaled rates -> joint rates [rad/s, m/s]
+    def unscale(x: np.ndarray):  # scaled rates -> joint rates [rad/s, m/s]
         x = x.copy()
         x[slide] *= L
         return x
@@ -243,7 +244,7 @@ def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output=
                              L, tuple(twists), tuple(inputs), output, point, gram_cofactors(mech, q, L))
 
 
-def named_types(rep: SingularityReport, local=None, tol=DEFAULT) -> tuple:
+def named_types(rep: SingularityReport, local=None, tol: Tolerances=DEFAULT) -> tuple:
     """The kinds that meet at the configuration in the standard vocabularies: (vocabulary, name, what it
     means here) for Gosselin and Angeles 1990 (type I: the output loses a direction, type II: it moves with
     the inputs locked, type III: both) and Zlatanov, Fenton and Benhabib 1995 (redundant input: the inputs
@@ -307,7 +308,7 @@ class GramLoop:
 STATIONARY = DEFAULT.stationary
 
 
-def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length=None) -> tuple:
+def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length: float | None=None) -> tuple:
     """(names, S, note) of the loop closed by ``cut`` at q: S the dimensionless 6 x n matrix of
     its joint twists (see GramLoop), F2's side negated so that S theta' = 0; S is None (and note
     says why) when the loop has a higher pair or a joint without one twist per coordinate."""
@@ -347,13 +348,13 @@ def loop_twists(mech: Mechanism, q: np.ndarray, cut: CutJoint, length=None) -> t
 ONE_TWIST = ("rolling", "gear", "helical")
 
 
-def _pair_frames(mech: Mechanism, cut) -> tuple:
+def _pair_frames(mech: Mechanism, cut: CutJoint) -> tuple:
     """(the file's loop joint, frame id of F1, of F2) of the rolling or gear pair closed by ``cut``."""
     spec = next(c for c in mech.spec.cut_joints if c.name == cut.name)
     return spec, mech.model.getFrameId(f"{cut.name}@F1"), cut.frame2
 
 
-def _pair_axis(mech: Mechanism, cut, state) -> tuple:
+def _pair_axis(mech: Mechanism, cut: CutJoint, state: KinematicState) -> tuple:
     """(spec, F1, F2, p, a): a point p of the pair's one-twist axis and its unit direction a, world."""
     spec, f1, f2 = _pair_frames(mech, cut)
     M1 = state.frame_placement(f1)
@@ -362,7 +363,7 @@ def _pair_axis(mech: Mechanism, cut, state) -> tuple:
     return (spec, f1, f2, *pair_contact(spec, M1, state.frame_placement(f2)))
 
 
-def pair_twist(mech: Mechanism, cut, state: KinematicState) -> list:
+def pair_twist(mech: Mechanism, cut: CutJoint, state: KinematicState) -> list:
     """[(name, twist, False)]: the pair closed by ``cut`` as one twist (v at the world origin, w) at a
     unit rate of turning of F2's link relative to F1's.  A rolling or gear pair: a revolute about
     its axis through the contact point (model.cuts.pair_contact; pure rolling is that rotation);
@@ -372,14 +373,14 @@ def pair_twist(mech: Mechanism, cut, state: KinematicState) -> list:
     return [(cut.name, np.concatenate([v, a]), False)]
 
 
-def pair_rate(mech: Mechanism, cut, state) -> float:
+def pair_rate(mech: Mechanism, cut: CutJoint, state: KinematicState) -> float:
     """The rate [rad/s] of the pair's column in pair_twist in the motion of ``state`` (with rates):
     F2's angular velocity relative to F1's about the pair's axis."""
     _, f1, f2, _, a = _pair_axis(mech, cut, state)
     return float((state.frame_twist(f2)[3:] - state.frame_twist(f1)[3:]) @ a)
 
 
-def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
+def gram_cofactors(mech: Mechanism, q: np.ndarray, length: float | None=None) -> tuple:
     """GramLoop for each loop (one per cut joint: the fundamental loops of the spanning tree)."""
     tol = mech.tolerances
     out = []
@@ -405,7 +406,7 @@ def gram_cofactors(mech: Mechanism, q: np.ndarray, length=None) -> tuple:
     return tuple(out)
 
 
-def lost_direction(JV: np.ndarray, out_dim: int, normal=None) -> np.ndarray:
+def lost_direction(JV: np.ndarray, out_dim: int, normal: np.ndarray | None=None) -> np.ndarray:
     """The output direction lost at a serial singularity, as a unit (6,) twist (v, w) in the rows' scaled
     coordinates (a point's output: v only, w zero): the left singular vector of the output's motion map
     JV (rows (v, w) or v, columns the mechanism's motions) for its ``out_dim``-th singular value, the one
@@ -430,7 +431,7 @@ def lost_direction(JV: np.ndarray, out_dim: int, normal=None) -> np.ndarray:
     return out
 
 
-def _motion_twist(kind: str, x, names, J: np.ndarray, tol: Tolerances) -> SingularTwist:
+def _motion_twist(kind: str, x: np.ndarray, names: list[str], J: np.ndarray, tol: Tolerances) -> SingularTwist:
     """The motion x (any length) as a SingularTwist: its rates (those not zero next to the unit
     vector: above Tolerances.equal), its twist and screw (none for a zero twist)."""
     x = x / np.linalg.norm(x)

@@ -111,13 +111,13 @@ def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], sca
     sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
 
 
-def _writable(path, option: str):
+def _writable(path: str | None, option: str):
     if not path:
         raise UsageError(f"{option} needs a file name")
     check_writable(path, option)
 
 
-def _report_inputs(mech: Mechanism, args: argparse.Namespace, given):
+def _report_inputs(mech: Mechanism, args: argparse.Namespace, given: dict[str, float]):
     names = [n.strip() for item in (args.input or []) for n in item.split(",") if n.strip()]
     names = names or list(given) or list(mech.actuated)
     for n in names:
@@ -128,7 +128,7 @@ def _report_inputs(mech: Mechanism, args: argparse.Namespace, given):
     return names
 
 
-def _attempt(notes, what: str, fn):
+def _attempt(notes: dict[str, str], what: str, fn: Callable[[], object]):
     """fn() or None, the reason it could not be made kept in notes[what]."""
     try:
         return fn()
@@ -347,7 +347,7 @@ def _input_rates_text(mech: Mechanism, typed: dict, rates: dict) -> str:
     if not typed:
         return ", ".join(f"{n} = {v:g} {si[n]}" for n, v in rates.items()) + " (default: 1 each)"
 
-    def shown(n: int, v) -> str:
+    def shown(n: int, v: float) -> str:
         q = typed.get(n)
         if q is None or q.shown_unit in ("", si[n]):
             return f"{n} = {v:.6g} {si[n]}"
@@ -356,7 +356,7 @@ def _input_rates_text(mech: Mechanism, typed: dict, rates: dict) -> str:
     return ", ".join(shown(n, v) for n, v in rates.items())
 
 
-def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np.ndarray, values: dict, names, notes, data, held=None) -> Section:
+def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np.ndarray, values: dict, names: list[str], notes: dict[str, str], data: dict, held: dict[str, float] | None=None) -> Section:
     title = "Newton iterations"
     if loops is None:
         why = notes.get("equations") or "the mechanism is not planar: Newton's iterations are shown on the planar " \
@@ -394,7 +394,7 @@ def _newton(mech: Mechanism, args: argparse.Namespace, loops: VectorLoops, q: np
     return newton_section(res, loops.symbol_info, how, str(mech.path))
 
 
-def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names, given, eq, notes, data, rates, held=None, typed_rates: dict | None = None) -> list:
+def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, names: list[str], given: dict[str, float], eq, notes: dict[str, str], data: dict, rates: dict[str, float], held: dict[str, float] | None=None, typed_rates: dict | None = None) -> list:
     conditions = eq.singular_conditions if hasattr(eq, "det_A") else ()  # planar: det A = 0 where
     moved = args.sweep or (names[0] if len(names) == 1 else None)
     if moved is None:
@@ -454,7 +454,7 @@ def _singular_and_sweep(mech: Mechanism, args: argparse.Namespace, q: np.ndarray
     return out
 
 
-def _view(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, data) -> Section:
+def _view(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, data: dict) -> Section:
     if args.no_view:
         return view_section(None, "the view is left out (--no-view)")
     if chromium() is None:

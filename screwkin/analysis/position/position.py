@@ -66,7 +66,7 @@ class PositionSolver:
     """Solves a mechanism for given input joints; reuses the model and data
     between calls (build once, solve many times)."""
 
-    def __init__(self, mech: Mechanism, input_joints=None, output=None, compiled: bool | None = None) -> None:
+    def __init__(self, mech: Mechanism, input_joints: list[str] | None=None, output: str | None=None, compiled: bool | None = None) -> None:
         """compiled: True to solve the closure equations with the compiled kernels of
         screwkin.model.kernel.compiled (numba, ``pip install -e '.[fast]'``) when the mechanism's cut
         joints are all fixed or spherical, False for numpy, None to leave the mechanism's
@@ -114,7 +114,7 @@ class PositionSolver:
         return self.mech.closure.accelerated
 
     # --------------------------------------------------------------- generic data
-    def generic(self, hint=None, starts: int | None = None) -> Generic:
+    def generic(self, hint: np.ndarray | None=None, starts: int | None = None) -> Generic:
         """Generic ranks for these inputs and output (screwkin.analysis.singular.Generic) over the
         mechanism's generic configurations; ``hint``: an assembled configuration to start
         from when the mechanism's own assembly search has not been made (``starts``: its random
@@ -492,7 +492,7 @@ class PositionSolver:
         return self._angles(q, state) if self._angles is not None else None
 
     # --------------------------------------------------------------- one solution
-    def solution(self, q: np.ndarray, a, rates: dict | None = None, accels: dict | None = None, points=(), typed=None, sets=None, simple=None,
+    def solution(self, q: np.ndarray, a: Assembly, rates: dict | None = None, accels: dict | None = None, points=(), typed=None, sets=None, simple=None,
                  spelled: bool = False) -> Solution:
         """One assembly mode at the closed configuration q (a: its model.cuts.Assembly), every quantity
         read from one KinematicState; rates and accelerations when input rates are given.  ``sets``:
@@ -561,7 +561,7 @@ class PositionSolver:
         U, inv, Vt = U[:, keep], 1.0 / s[keep], Vt[keep]
         return (lambda b: Vt.T @ (inv * (U.T @ b))), s
 
-    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve=None) -> np.ndarray:
+    def rates(self, q: np.ndarray, K: np.ndarray, values: dict, solve: Callable | None=None) -> np.ndarray:
         """Joint rates from K q' = 0 with the input rates given (minimum norm in
         the passive joints, so idle spins are zero).  A link held at an angle (link_inputs)
         turns at the rate ``values`` gives its name (0 when none): its row's K q' is that rate.
@@ -573,7 +573,7 @@ class PositionSolver:
             qd[self.passive] = solve(self.mech.closure.row_rates(values) - K[:, self.frozen] @ qd[self.frozen])
         return qd
 
-    def accelerations(self, q: np.ndarray, K: np.ndarray, qd, values: dict, solve=None) -> np.ndarray:
+    def accelerations(self, q: np.ndarray, K: np.ndarray, qd: np.ndarray, values: dict, solve: Callable | None=None) -> np.ndarray:
         """Joint accelerations from K q'' = -K' q' with the input accelerations given (a held link's
         angular acceleration as its row's, as in ``rates``)."""
         qdd = np.zeros(self.mech.nv)
