@@ -43,6 +43,9 @@ from .description import Coupling
 from .inertia import inertia_problem
 from .mjcf_equality import matrix_quat, quat_matrix
 from .writer import number_text, origin_text, quoteattr, vector_text
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 __all__ = ["PlacedJoint", "PlacedBody", "PlacedCompound", "PlacedCut", "PlacedMechanism", "write_mjcf",
            "write_placed_urdf", "TINY_MASS", "DEFAULT_DENSITY", "ROD_RATIO", "coupling_about", "default_solid",
@@ -145,11 +148,11 @@ class PlacedMechanism:
     compounds: tuple = ()  # PlacedCompound: the tree's compound joints written as one body's joints
 
 
-def _placement(pos, quat):
+def _placement(pos: np.ndarray, quat: Sequence[float]):
     return pin.SE3(quat_matrix(quat), np.asarray(pos, float))
 
 
-def _quat(M) -> tuple:
+def _quat(M: pin.SE3) -> tuple:
     return matrix_quat(M.rotation)
 
 
@@ -169,7 +172,7 @@ def _comment(text: str):
     return "<!--\n" + text.rstrip() + "\n-->"
 
 
-def default_solid(points, length: float) -> tuple:
+def default_solid(points: Sequence[np.ndarray], length: float) -> tuple:
     """(mass, centre of mass, (ixx, iyy, izz, ixy, ixz, iyz)) of the solid a moving body without mass
     gets: a rod of DEFAULT_DENSITY from its origin to the farthest of ``points`` (its joints, in its
     frame), radius ROD_RATIO of that length; a sphere of radius ROD_RATIO * ``length`` when no point is
@@ -189,7 +192,7 @@ def default_solid(points, length: float) -> tuple:
     return m, tuple(far / 2), (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
 
 
-def mujoco_refuses(mass, inertia) -> bool:
+def mujoco_refuses(mass: float, inertia: Sequence[float]) -> bool:
     """Whether MuJoCo refuses this mass and inertia (ixx, iyy, izz, ixy, ixz, iyz) of a body with mass:
     principal moments not all positive, or breaking A + B >= C (a point mass, a URDF's zero inertia)."""
     xx, yy, zz, xy, xz, yz = inertia
@@ -198,7 +201,7 @@ def mujoco_refuses(mass, inertia) -> bool:
     return mass > 0 and (moments[0] <= DEFAULT.zero * scale or inertia_problem(mass, inertia) is not None)
 
 
-def _mj_inertial(mass, com, inertia, moving, points=(), length: float = 0.1) -> str:
+def _mj_inertial(mass: float, com: Sequence[float], inertia: Sequence[float], moving: bool, points: Sequence[np.ndarray]=(), length: float = 0.1) -> str:
     if mass <= 0:
         if not moving:
             return ""
@@ -229,7 +232,7 @@ def helper_names(pm: PlacedMechanism) -> dict:
     taken = joints | {c.name for c in pm.cuts} | {cp.joint for cp in pm.couplings}
     out = {}
 
-    def fresh(base):
+    def fresh(base: str):
         name = base
         k = 1
         while name in taken:
@@ -299,7 +302,7 @@ def write_mjcf(pm: PlacedMechanism) -> str:
             out.append(f"{pad}  {_mj_inertial(0, 0, 0, True, (), pm.length)}")
             out.append(f"{pad}</body>")
 
-    def body(b, depth) -> None:
+    def body(b, depth: int) -> None:
         pad = "  " * depth
         out.append(f'{pad}<body name={quoteattr(b.name)} pos="{vector_text(*b.pos)}" quat="{vector_text(*b.quat)}">')
         moving = b.joint is not None and b.joint.type != "fixed"

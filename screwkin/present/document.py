@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     from screwkin.analysis.mobility import MobilityResult
     from screwkin.analysis.position.solution import PositionResult
     from screwkin.model.topology import Topology
+    from collections.abc import Sequence
 
 __all__ = ["Code", "Document", "Figure", "Note", "Section", "Table", "Text", "figure_bytes", "html", "markdown",
            "topology_section", "equations_section", "newton_section", "motion_section", "singular_section",
@@ -119,11 +120,11 @@ def figure_bytes(fig, fmt: str = "svg") -> bytes:
 
 
 # ------------------------------------------------------------------ numbers as people read them
-def _g(x, digits: int = 6) -> str:
+def _g(x: float, digits: int = 6) -> str:
     return f"{shown(x):.{digits}g}"
 
 
-def _reading(value, angular: bool) -> str:
+def _reading(value: float, angular: bool) -> str:
     return f"{np.degrees(value):.6g} deg" if angular else f"{value * 1000:.6g} mm"
 
 
@@ -231,7 +232,7 @@ def motion_section(pres: PositionResult, rates_text: str, length: float, units: 
     return s
 
 
-def singular_section(search: SingularSearch, figures, descriptions, conditions=()) -> Section:
+def singular_section(search: SingularSearch, figures: list, descriptions: list, conditions: Sequence[str]=()) -> Section:
     """The singular configurations located along the input's range, each with its drawing."""
     s = Section("singular", "Singular configurations")
     if conditions:
@@ -252,7 +253,7 @@ def singular_section(search: SingularSearch, figures, descriptions, conditions=(
     return s
 
 
-def sweep_section(search: SingularSearch, figure: Figure, lines=(), rate_words=None) -> Section:
+def sweep_section(search: SingularSearch, figure: Figure, lines: Sequence[str]=(), rate_words: str | None=None) -> Section:
     """The input moved over its range: the figure, and ``lines`` (each slider's stroke and time ratio,
     present/motion.strokes_text, as sweep prints them); ``rate_words``: the input's rate as typed
     (tables.input_rate_words, "at crank 120 rpm"; default: the sweep's rate in SI)."""
@@ -270,7 +271,7 @@ def sweep_section(search: SingularSearch, figure: Figure, lines=(), rate_words=N
     return s
 
 
-def view_section(png, note: str | None = None) -> Section:
+def view_section(png: bytes | None, note: str | None = None) -> Section:
     s = Section("view", "View")
     if png is not None:
         s.blocks.append(Figure(png, "png", "the mechanism at the configuration analysed (screwkin view, headless "
@@ -342,7 +343,7 @@ def html(doc: Document) -> str:
 
 
 # ------------------------------------------------------------------ Markdown
-def _md_text(t) -> str:
+def _md_text(t: str) -> str:
     """Text for Markdown: HTML escaped (a Markdown viewer renders raw HTML: a link named
     ``<script>`` must stay text) and Markdown's emphasis, code and link characters escaped."""
     return escape(re.sub(r"([*`\\\[\]])", r"\\\1", str(t)), quote=False)
@@ -357,7 +358,7 @@ def _fence(text: str) -> str:
     return "`" * max(3, 1 + max((len(r) for r in re.findall(r"`+", text)), default=0))
 
 
-def _md_table(headers, rows) -> str:
+def _md_table(headers: Sequence[str], rows: Sequence[Sequence]) -> str:
     out = ["| " + " | ".join(_md_cell(h) for h in headers) + " |", "|" + "---|" * len(headers)]
     out += ["| " + " | ".join(_md_cell(c) for c in r) + " |" for r in rows]
     return "\n".join(out)

@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from screwkin.files.description import CutJointSpec
     from screwkin.model.topology import Topology
     from screwkin.model.topology import Joint
+    from collections.abc import Callable
 
 __all__ = [
     "ChainEdge",
@@ -273,7 +274,7 @@ def _hull(points: list):
     if len(pts) <= 2:
         return pts
 
-    def cross(o, a, b):
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]):
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
     lower, upper = [], []
@@ -288,7 +289,7 @@ def _hull(points: list):
     return lower[:-1] + upper[:-1]
 
 
-def _distinct(points, tol) -> list:
+def _distinct(points: list, tol: float) -> list:
     out = []
     for p in points:
         if all(np.hypot(p[0] - r[0], p[1] - r[1]) > tol for r in out):
@@ -313,7 +314,7 @@ def _basis(mech: Mechanism, topo: Topology, centres: list) -> tuple:
     return (e1, e2, n), False
 
 
-def skeleton(mech: Mechanism, q: np.ndarray, inputs=None, basis=None) -> Skeleton:
+def skeleton(mech: Mechanism, q: np.ndarray, inputs: list[str] | None=None, basis=None) -> Skeleton:
     """The :class:`Skeleton` of ``mech`` at configuration ``q``; ``inputs``: the input joints
     (default: the actuated ones), marked and listed with their values; ``basis``: the drawing
     plane (e1, e2, n) of another skeleton (the frames of an animation: a spatial mechanism's
@@ -329,7 +330,7 @@ def skeleton(mech: Mechanism, q: np.ndarray, inputs=None, basis=None) -> Skeleto
     if basis is not None:
         e1, e2, n = (np.asarray(v, float) for v in basis)
 
-    def p2(v) -> tuple[float, float]:
+    def p2(v: np.ndarray) -> tuple[float, float]:
         return (float(np.asarray(v) @ e1), float(np.asarray(v) @ e2))
 
     values = mech.joint_values(q)
@@ -402,7 +403,7 @@ def skeleton(mech: Mechanism, q: np.ndarray, inputs=None, basis=None) -> Skeleto
                     tuple(joints), tuple(profiles), {k: values[k] for k in inputs}, units, size, angles, origins)
 
 
-def _area(hull):
+def _area(hull: list):
     x = np.array([p[0] for p in hull])
     y = np.array([p[1] for p in hull])
     return 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))
@@ -416,7 +417,7 @@ def _extremes(pts: np.ndarray | list) -> tuple[tuple, tuple]:
     return (tuple(P[int(np.argmin(s))]), tuple(P[int(np.argmax(s))]))
 
 
-def _stub(state: KinematicState, name: str, pts: np.ndarray | list, p2, tol) -> tuple[str, tuple]:
+def _stub(state: KinematicState, name: str, pts: np.ndarray | list, p2: Callable[[np.ndarray], tuple[float, float]], tol: float) -> tuple[str, tuple]:
     """A link with one joint centre: drawn to its frame's origin, else its centre of mass,
     else a short stub along its frame's x axis."""
     mech = state.mech
@@ -433,7 +434,7 @@ def _stub(state: KinematicState, name: str, pts: np.ndarray | list, p2, tol) -> 
     return "stub", (pts[0], end)
 
 
-def _higher_pair(state: KinematicState, spec: CutJointSpec, letter, nums: tuple, p2, e1: np.ndarray, e2: np.ndarray) -> tuple:
+def _higher_pair(state: KinematicState, spec: CutJointSpec, letter: str, nums: tuple, p2: Callable[[np.ndarray], tuple[float, float]], e1: np.ndarray, e2: np.ndarray) -> tuple:
     """(contact point, profiles) of a rolling, gear or contact pair in the plane."""
     F1, F2 = _frame_point(state, f"{spec.name}@F1"), _frame_point(state, f"{spec.name}@F2")
     c1, c2 = np.array(p2(F1.translation)), np.array(p2(F2.translation))
@@ -475,7 +476,7 @@ def _contact_point(a: Profile, b: Profile):
     return ca + a.radius * u  # on circle 1 towards circle 2's centre (outside, or inside it: internal)
 
 
-def kinematic_chain(mech: Mechanism, q: np.ndarray | None = None, inputs=None) -> KinematicChain:
+def kinematic_chain(mech: Mechanism, q: np.ndarray | None = None, inputs: list[str] | None=None) -> KinematicChain:
     """The kinematic chain of ``mech`` (numbered as :func:`skeleton` numbers it)."""
     inputs = list(inputs) if inputs else list(mech.actuated)
     topo = mech.topology(q)

@@ -51,6 +51,7 @@ from .study import (COLUMNS, StudyDesign, StudyTask, evaluate_design, failed_row
 if TYPE_CHECKING:
     from ...files.description import MechanismSpec
     from ...tolerances import Tolerances
+    from collections.abc import Sequence
 
 __all__ = ["ChunkRows", "FAMILY_CHUNK", "FAMILY_METRICS", "chunk_rows", "eligible", "family_rows"]
 
@@ -68,7 +69,7 @@ class ChunkRows(list):
     """A chunk's rows, with ``paths`` ({"family": n, "design": m}) and ``notes`` (why designs were
     evaluated alone), sent back with them from the worker."""
 
-    def __init__(self, rows=(), paths=None, notes=()) -> None:
+    def __init__(self, rows=(), paths=None, notes: tuple=()) -> None:
         super().__init__(rows)
         self.paths = dict(paths or {})
         self.notes = list(notes)
@@ -159,13 +160,13 @@ class _Placed:
             self.axes[c.name] = np.einsum("nij,nj->ni", frames[0][0], axis / np.linalg.norm(axis, axis=1)[:, None])
 
 
-def _equal(a, b) -> bool:
+def _equal(a: object, b: object) -> bool:
     if isinstance(a, float) and isinstance(b, float):
         return abs(a - b) <= AGREE * max(1.0, abs(a), abs(b))
     return a == b and type(a) is type(b)
 
 
-def _differs(row, other, columns):
+def _differs(row: dict, other: dict, columns: Sequence[str]):
     for c in ("error", *columns):
         if not _equal(row[c], other[c]):
             return c
@@ -233,7 +234,7 @@ class _Fourbar:
         return placed.joints[self.names[ident]][1]
 
 
-def _flat(P, n: int):
+def _flat(P: np.ndarray, n: int):
     return P - np.einsum("ni,ni->n", P, n)[:, None] * n
 
 

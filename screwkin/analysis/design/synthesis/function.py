@@ -57,7 +57,7 @@ def parse_function(text: str):
     if len(nodes) > _MAX_NODES:
         raise UsageError(f"--function: the formula is too long ({len(nodes)} parts, at most {_MAX_NODES})")
 
-    def build(node):
+    def build(node: ast.AST):
         if isinstance(node, ast.Expression):
             return build(node.body)
         if isinstance(node, ast.Constant) and type(node.value) in (int, float):
@@ -89,7 +89,7 @@ def parse_function(text: str):
 
     f = build(tree)
 
-    def evaluate(x) -> np.ndarray:
+    def evaluate(x: np.ndarray) -> np.ndarray:
         with np.errstate(all="ignore"):
             return np.asarray(f(np.asarray(x, float)), float)
 
@@ -106,7 +106,7 @@ def precision_points(x0: float, x1: float, n: int, spacing: str = "chebyshev") -
     return (x0 + x1) / 2 - (x1 - x0) / 2 * np.cos((2 * j - 1) * np.pi / (2 * n))
 
 
-def freudenstein(phi, psi) -> tuple:
+def freudenstein(phi: np.ndarray, psi: np.ndarray) -> tuple:
     """(K1, K2, K3) from the rows [cos phi, -cos psi, 1] K = cos(phi - psi): solved for three
     points, least squares for more."""
     phi, psi = np.asarray(phi, float), np.asarray(psi, float)
@@ -122,7 +122,7 @@ def freudenstein(phi, psi) -> tuple:
     return tuple(float(k) for k in K)
 
 
-def _generated(K: np.ndarray, d, phi, sigma: float) -> tuple:
+def _generated(K: np.ndarray, d: float, phi: np.ndarray, sigma: float) -> tuple:
     """psi generated at crank angles phi (the crank's own angle offset applied), on branch sigma;
     nan where the linkage does not assemble."""
     K1, K2, K3 = K
@@ -134,7 +134,7 @@ def _generated(K: np.ndarray, d, phi, sigma: float) -> tuple:
     return np.where(h2 >= 0, psi, np.nan), A, B
 
 
-def function_task(text: str, x_range, input_range, output_range, points: int = 3, spacing: str = "chebyshev",
+def function_task(text: str, x_range: tuple[float, float], input_range: tuple[float, float], output_range: tuple[float, float], points: int = 3, spacing: str = "chebyshev",
                   ground: float = 0.1, samples: int = 721) -> dict:
     """The task of function generation, checked: the function, its ranges, the precision points
     ``xs`` and their crank and rocker angles ``phi``, ``psi`` [rad], a dense ``sample`` of x with the
@@ -166,10 +166,10 @@ def function_task(text: str, x_range, input_range, output_range, points: int = 3
         raise UsageError(f"--function {quote(text)} has the same value at both ends of the range: the output "
                          "range cannot be mapped onto it")
 
-    def phi_of(x):
+    def phi_of(x: float | np.ndarray):
         return p0 + (np.asarray(x) - x0) / (x1 - x0) * (p1 - p0)
 
-    def psi_of(y):
+    def psi_of(y: float | np.ndarray):
         return s0 + (np.asarray(y) - y_ends[0]) / (y_ends[1] - y_ends[0]) * (s1 - s0)
 
     return {"text": text, "x0": x0, "x1": x1, "p0": p0, "p1": p1, "s0": s0, "s1": s1, "points": points,
@@ -177,7 +177,7 @@ def function_task(text: str, x_range, input_range, output_range, points: int = 3
             "phi_sample": phi_of(sample), "psi_sample": psi_of(y_sample)}
 
 
-def synthesize_function(text: str, x_range, input_range, output_range, points: int = 3, spacing: str = "chebyshev",
+def synthesize_function(text: str, x_range: tuple[float, float], input_range: tuple[float, float], output_range: tuple[float, float], points: int = 3, spacing: str = "chebyshev",
                         ground: float = 0.1, samples: int = 721) -> FunctionResult:
     """A four-bar whose rocker angle psi follows f(x) while the crank turns through the input
     range: the Freudenstein coefficients through ``points`` precision points, the link lengths
@@ -187,7 +187,7 @@ def synthesize_function(text: str, x_range, input_range, output_range, points: i
     return function_result(task, freudenstein(task["phi"], task["psi"]))
 
 
-def function_result(task, K: np.ndarray | tuple, d: float | None = None, sigma: float | None = None, offset: tuple = (0.0, 0.0),
+def function_result(task: dict, K: np.ndarray | tuple, d: float | None = None, sigma: float | None = None, offset: tuple = (0.0, 0.0),
                     search=None) -> FunctionResult:
     """The FunctionResult of the four-bar with Freudenstein coefficients K and ground ``d`` (default the
     task's), on branch ``sigma`` (default: the branch nearest the first precision point), its rocker's

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
 __all__ = ["optimal_function"]
 
 
-def _unknowns(task, constraints) -> tuple:
+def _unknowns(task: dict, constraints: Constraints) -> tuple:
     """(names of the unknowns, lower, upper): a, b, c (and d with --lengths, B0's x, y with --bounds)."""
     d = task["ground"]
     lo, hi = constraints.lengths if constraints.lengths is not None else (0.05 * d, 10 * d)
@@ -49,7 +49,7 @@ def _unknowns(task, constraints) -> tuple:
     return names, np.array(lower, float), np.array(upper, float)
 
 
-def _parts(X: np.ndarray, names, task, bounds=None) -> tuple:
+def _parts(X: np.ndarray, names: list[str], task: dict, bounds: tuple | None=None) -> tuple:
     """a, b, c, d (m,) and B0 (m, 2): at the origin, or, with ``bounds``, the ground line centred in the box."""
     get = {n: X[:, k] for k, n in enumerate(names)}
     d = get.get("d", np.full(len(X), task["ground"]))
@@ -61,7 +61,7 @@ def _parts(X: np.ndarray, names, task, bounds=None) -> tuple:
     return get["a"], get["b"], get["c"], d, B0
 
 
-def _errors(X: np.ndarray, names, task, signs, constraints: Constraints, equal, phi, psi) -> tuple:
+def _errors(X: np.ndarray, names: list[str], task: dict, signs: tuple, constraints: Constraints, equal: float, phi: np.ndarray, psi: np.ndarray) -> tuple:
     """(structural errors (m, n) [rad], penalties (m,), mu (lo, hi)) of designs X at the angles phi, psi;
     ``signs`` (branch, crank's, rocker's): Freudenstein's signed crank and rocker (a link pointing the
     other way from its angle, as function.py's negative a or c)."""
@@ -79,7 +79,7 @@ def _errors(X: np.ndarray, names, task, signs, constraints: Constraints, equal, 
     return err, pen, (mu_lo, mu_hi)
 
 
-def _function_run(job) -> tuple:
+def _function_run(job: tuple) -> tuple:
     """One run (picklable: what a Dask worker computes): differential evolution on the precision points,
     then least squares from its best distinct members.  Returns ([(x, signs)], generations)."""
     task, names, constraints, signs, seed, generations, popsize, equal = job
@@ -95,7 +95,7 @@ def _function_run(job) -> tuple:
     pop, costs, nfev = evolve(cost, lower, upper, seed, generations, popsize)
     tight = constraints.tightened(MARGIN * task["ground"], MARGIN)
     out = []
-    def residuals(X: np.ndarray, weight) -> np.ndarray:
+    def residuals(X: np.ndarray, weight: float) -> np.ndarray:
         err, pen, _ = _errors(X, names, task, signs, tight, equal, phi, psi)
         return np.concatenate([err, weight * pen[:, None]], axis=1)
 
@@ -104,7 +104,7 @@ def _function_run(job) -> tuple:
     return out, nfev
 
 
-def optimal_function(text: str, x_range, input_range, output_range, points, spacing, ground, constraints: Constraints, search: Search,
+def optimal_function(text: str, x_range: tuple[float, float], input_range: tuple[float, float], output_range: tuple[float, float], points: int, spacing: str, ground: float, constraints: Constraints, search: Search,
                      equal: float = 1e-9) -> FunctionResult:
     """The best function generators that meet ``constraints`` (module docstring): the FunctionResult of
     the best, its ``search`` report listing the best few."""
