@@ -64,7 +64,7 @@ _PASSIVE = ("option", "size", "visual", "statistic", "asset", "contact", "sensor
 
 
 class _Reader:
-    def __init__(self, path: Path, root) -> None:
+    def __init__(self, path: Path, root: Element) -> None:
         self.path, self.root = path, root
         self.problems = Problems()
         self.warnings = []
@@ -97,7 +97,7 @@ class _Reader:
             self._default(d, "main", {})
 
     # ---- defaults -------------------------------------------------------------------------
-    def _default(self, elem, name: str, inherited: dict) -> None:
+    def _default(self, elem: Element, name: str, inherited: dict) -> None:
         own = {tag: dict(attrs) for tag, attrs in inherited.items()}
         for child in elem:
             if child.tag == "default":
@@ -111,7 +111,7 @@ class _Reader:
                 continue
             self._default(child, child.get("class"), own)
 
-    def attrs(self, elem, cls) -> dict:
+    def attrs(self, elem: Element, cls) -> dict:
         """The element's attributes over those of its default class."""
         cls = elem.get("class", cls)
         if cls not in self.defaults and cls != "main":
@@ -120,7 +120,7 @@ class _Reader:
         out.update(elem.attrib)
         return out
 
-    def actuator_attrs(self, elem) -> dict:
+    def actuator_attrs(self, elem: Element) -> dict:
         """An actuator's attributes over its class's: MuJoCo's actuator shortcuts share one default."""
         cls = elem.get("class", "main")
         if cls not in self.defaults and cls != "main":
@@ -177,12 +177,12 @@ class _Reader:
         return _z_to(unit_axis(self.vec(a[k], 3, f"{what} zaxis", (0, 0, 1), 1e6, ""), f"{what} zaxis",
                                self.problems, (0.0, 0.0, 1.0)))
 
-    def content(self, elem, cls) -> list:
+    def content(self, elem: Element, cls) -> list:
         """(child, T, class) of every child of a body (or <worldbody>) with its <frame>s opened: T the
         frames' placement in the body, class the frames' childclass over ``cls``."""
         out = []
 
-        def walk(e, T, c, depth) -> None:
+        def walk(e: Element, T: pin.SE3, c: str | None, depth: int) -> None:
             for child in e:
                 if child.tag == "frame":
                     if depth > LIMITS.elements:  # pragma: no cover - the element count bounds it first
@@ -555,12 +555,12 @@ def _geom_inertial(r: _Reader, geoms: list, what: str) -> tuple:
     return mass, _inertia_xml(com, mass, I), meshes
 
 
-def _in_range(value, bounds) -> bool:
+def _in_range(value: float, bounds: tuple[float, float]) -> bool:
     """Whether ``value`` lies in the closed range ``bounds`` (lo, hi)."""
     return bounds[0] <= value <= bounds[1]
 
 
-def _z_to(d) -> np.ndarray:
+def _z_to(d: np.ndarray) -> np.ndarray:
     """MuJoCo's rotation taking z onto the direction d (the smallest turn; a half turn about x for -z)."""
     d = np.asarray(d, float)
     n = float(np.linalg.norm(d))
@@ -574,7 +574,7 @@ def _z_to(d) -> np.ndarray:
     return pin.exp3(c / s * math.atan2(s, z[2]))
 
 
-def _inertial(r: _Reader, e, what: str) -> tuple:
+def _inertial(r: _Reader, e: Element, what: str) -> tuple:
     """(mass, URDF <inertial>) of an MJCF ``<inertial pos quat mass diaginertia|fullinertia>``, refused
     where MuJoCo refuses it (a negative mass, a tensor no body has)."""
     p = r.problems

@@ -31,6 +31,9 @@ from ..units import Quantity, parse_quantity
 from .description import LIMITS
 from .xacro import declared_args, normalize_args
 from .xmlsafe import load_yaml_text, read_regular_file
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 __all__ = ["DESIGN_TIMEOUT", "MAX_DESIGNS", "METRICS", "SAMPLINGS", "WORKSPACE_METRICS", "Parameter", "StudySpec",
            "read_mechanism_text", "read_study_spec", "study_spec"]
@@ -66,7 +69,7 @@ class Parameter:
     unit: str = ""  # the unit its values were typed in (the first one typed: "mm", "deg"), "" when bare
 
 
-def _first_unit(quantities) -> str:
+def _first_unit(quantities: Sequence[Quantity]) -> str:
     """The first unit typed among a parameter's values ("" when every value is a bare number)."""
     return next((q.unit for q in quantities if q.unit), "")
 
@@ -101,7 +104,7 @@ def _fail(where: str, message: str):
     raise UsageError(f"{where}: {message}")
 
 
-def _quantity(v, where: str, what: str) -> Quantity:
+def _quantity(v: object, where: str, what: str) -> Quantity:
     """A number, or a number with a unit (text): its units.Quantity (SI value, the unit typed)."""
     if isinstance(v, bool) or not isinstance(v, (int, float, str)):
         _fail(where, f"{what} must be a number (units allowed, e.g. 30mm), got {quote(v)}")
@@ -115,18 +118,18 @@ def _quantity(v, where: str, what: str) -> Quantity:
     return Quantity(float(v))
 
 
-def _value(v, where: str, what: str) -> float:
+def _value(v: object, where: str, what: str) -> float:
     """A number, or a number with a unit (text), in SI."""
     return _quantity(v, where, what).value
 
 
-def _count(v, where: str, what: str, low: int = 1, high=MAX_DESIGNS):
+def _count(v: object, where: str, what: str, low: int = 1, high: int=MAX_DESIGNS):
     if isinstance(v, bool) or not isinstance(v, int) or not low <= v <= high:
         _fail(where, f"{what} must be a whole number from {low} to {high}, got {quote(v)}")
     return v
 
 
-def _parameter(name: str, item, where: str, sampling) -> Parameter:
+def _parameter(name: str, item: object, where: str, sampling) -> Parameter:
     what = f"parameter {quote(name)}"
     if not isinstance(item, dict):
         q = _quantity(item, where, what)
@@ -162,7 +165,7 @@ def _parameter(name: str, item, where: str, sampling) -> Parameter:
     return Parameter(name, low=low, high=high, samples=samples, unit=_first_unit(typed))
 
 
-def _metrics(value, where: str) -> tuple:
+def _metrics(value: object, where: str) -> tuple:
     if isinstance(value, str):
         value = [value]
     if not isinstance(value, list) or not value:
@@ -177,7 +180,7 @@ def _metrics(value, where: str) -> tuple:
     return tuple(out)
 
 
-def _spec_pareto(value, where: str) -> tuple | None:
+def _spec_pareto(value: object, where: str) -> tuple | None:
     """``{maximize: [a], minimize: [b]}`` (two metrics in all) -> ((a, "max"), (b, "min"))."""
     if value is None:
         return None
@@ -196,7 +199,7 @@ def _spec_pareto(value, where: str) -> tuple | None:
     return tuple(picked)
 
 
-def _require(value, where: str) -> tuple | None:
+def _require(value: object, where: str) -> tuple | None:
     """``{column: value, column: {min: x, max: y}}`` -> ((column, "equal", value, False), (column, "min", x,
     unit typed), ...); the columns are checked against the study's in screwkin.analysis.design.study."""
     if value is None:
@@ -225,7 +228,7 @@ def _require(value, where: str) -> tuple | None:
     return tuple(out)
 
 
-def _workspace(value, where: str) -> dict:
+def _workspace(value: object, where: str) -> dict:
     if value is None:
         return {}
     if not isinstance(value, dict):
@@ -245,7 +248,7 @@ def _workspace(value, where: str) -> dict:
     return out
 
 
-def study_spec(data, where: str = "<dict>", base: Path | None = None) -> StudySpec:
+def study_spec(data: object, where: str = "<dict>", base: Path | None = None) -> StudySpec:
     """Check a study given as plain data (the YAML document, or a dict in Python); ``base``
     is the folder ``file`` is relative to (default: the current folder)."""
     if not isinstance(data, dict):
@@ -359,7 +362,7 @@ def _check_arguments(spec: StudySpec, where: str) -> None:
                      "parameters or args")
 
 
-def read_study_spec(path) -> StudySpec:
+def read_study_spec(path: str | Path) -> StudySpec:
     """Read and check a study spec file (YAML; see the module docstring)."""
     path = Path(path)
     try:

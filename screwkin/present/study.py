@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.design.study import StudyResult
+    from collections.abc import Sequence
 
 __all__ = [
     "DISPLAY",
@@ -56,7 +57,7 @@ DISPLAY = {
 }
 
 
-def _display(key) -> tuple:
+def _display(key: str) -> tuple:
     """(column name, factor from SI) of a row key."""
     name, unit = DISPLAY.get(key, (key, ""))
     return name, si_factor(unit)
@@ -68,7 +69,7 @@ def table_columns(result: StudyResult) -> list:
     return [(k, *_display(k)) for k in keys]
 
 
-def _cell(v, factor):
+def _cell(v: object, factor: float):
     if v is None:
         return None
     if isinstance(v, (bool, np.bool_)):
@@ -81,12 +82,12 @@ def _cell(v, factor):
     return v
 
 
-def _table_rows(result) -> tuple[list, list]:
+def _table_rows(result: StudyResult) -> tuple[list, list]:
     cols = table_columns(result)
     return [[_cell(r[k], f) for k, _, f in cols] for r in result.rows], [name for _, name, _ in cols]
 
 
-def study_csv(result) -> str:
+def study_csv(result: StudyResult) -> str:
     """The table as CSV: one row per design, in design order; empty cells for missing values;
     floats written exactly (shortest round-trip form)."""
     rows, names = _table_rows(result)
@@ -95,7 +96,7 @@ def study_csv(result) -> str:
                             for row in rows))
 
 
-def check_table_path(path) -> None:
+def check_table_path(path: str) -> None:
     """Refuse an output the table cannot be written to, before the study runs."""
     suffix = Path(path).suffix.lower()
     if suffix not in (".csv", ".parquet"):
@@ -107,7 +108,7 @@ def check_table_path(path) -> None:
         raise UsageError(f"-o {quote(str(path))}: the folder {quote(str(folder), 200)} does not exist")
 
 
-def write_table(result, path) -> None:
+def write_table(result: StudyResult, path: str) -> None:
     """The table into ``path``: CSV, or Parquet (``.parquet``, needs pyarrow)."""
     check_table_path(path)
     if Path(path).suffix.lower() == ".csv":
@@ -204,7 +205,7 @@ def _workspace_metrics(result: StudyResult) -> bool:
     return any(m in WORKSPACE_METRICS for m in result.spec.metrics)
 
 
-def _cell_text(v) -> str:
+def _cell_text(v: object) -> str:
     if v is None:
         return "-"
     if isinstance(v, float):
@@ -216,7 +217,7 @@ def _cell_text(v) -> str:
 TEXT_ROWS = 40
 
 
-def study_text(result: StudyResult, table_path=None) -> str:
+def study_text(result: StudyResult, table_path: str | None=None) -> str:
     """A summary: counts, the failures' reasons, each metric's range and the design reaching
     each end; the rows themselves when there are few."""
     spec = result.spec
@@ -321,7 +322,7 @@ LABELS = {
 FAILED_COLOR = "crimson"
 
 
-def _label(key, result: StudyResult | None = None) -> tuple:
+def _label(key: str, result: StudyResult | None = None) -> tuple:
     """(axis label, factor from SI) of a metric column; a volume's unit from the designs' workspace
     dimension (m^2 or m^3; m^d when they differ)."""
     if key in LABELS:
@@ -408,7 +409,7 @@ def metrics_figure(result: StudyResult):
     return fig
 
 
-def metrics_png(result, path: str) -> None:
+def metrics_png(result: StudyResult, path: str) -> None:
     """Each numeric metric against each parameter (see :func:`metrics_figure`)."""
     plt = pyplot("--plot")
     fig = metrics_figure(result)
@@ -418,7 +419,7 @@ def metrics_png(result, path: str) -> None:
         plt.close(fig)
 
 
-def pareto_figure(result: StudyResult, goals=None):
+def pareto_figure(result: StudyResult, goals: Sequence[tuple[str, str]] | None=None):
     """The figure of :func:`pareto_png` (not yet saved): the designs in the plane of two columns with
     their units, coloured by Grashof class (when the study has it), the Pareto front drawn over them;
     the failed designs, which have no place in this plane, counted in the title."""
@@ -460,7 +461,7 @@ def pareto_figure(result: StudyResult, goals=None):
     return fig
 
 
-def pareto_png(result, path: str, goals=None) -> None:
+def pareto_png(result: StudyResult, path: str, goals: Sequence[tuple[str, str]] | None=None) -> None:
     """The designs in the plane of two columns, the Pareto front drawn over them (see :func:`pareto_figure`)."""
     plt = pyplot("--plot")
     fig = pareto_figure(result, goals)

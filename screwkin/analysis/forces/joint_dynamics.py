@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from collections.abc import Sequence
 
 __all__ = ["JointDynamics", "joint_dynamics", "left_out_note", "names_text"]
 
@@ -57,10 +58,10 @@ class JointDynamics(dict):
         self._angular = lambda name: (self.coupled[name][2].type in ("revolute", "continuous") if name in self.coupled
                                       else not mech.translational[mech.coordinate(name).idx_v])
 
-    def _terms(self, arm, damp, fl, v, a):
+    def _terms(self, arm, damp, fl, v: np.ndarray, a: np.ndarray):
         return arm * a + damp * v + fl * np.where(np.abs(v) > self._zero, np.sign(v), 0.0)
 
-    def coupled_forces(self, q: np.ndarray, v, a) -> dict:
+    def coupled_forces(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> dict:
         """Each mimic joint's own force at (q, v, a) (its rate and acceleration: multiplier x its leader's),
         its spring's with it."""
         stretch = self.spring_stretch(q) if any(n in self.springs for n in self.coupled) else {}
@@ -75,7 +76,7 @@ class JointDynamics(dict):
         return {n: (wrap_angle(values[n] - ref) if self._angular(n) else values[n] - ref)
                 for n, (_, _, ref) in self.springs.items()}
 
-    def forces(self, q: np.ndarray, v, a) -> tuple:
+    def forces(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> tuple:
         """(the generalized force that drives them at (q, v, a), each mimic joint's own force): armature a +
         damping v + frictionloss sign(v) + stiffness (x - springref), sign(v) 0 where the joint stands
         still (|v| within the tolerance ``equal``); a mimic joint's, times its multiplier, on its leader's
@@ -91,7 +92,7 @@ class JointDynamics(dict):
             out[iv] += m * f
         return out, coupled
 
-    def friction_at_rest(self, v) -> set:
+    def friction_at_rest(self, v: np.ndarray) -> set:
         """The joints with friction loss that stand still at v (their dry friction not determined)."""
         fl = {n: self.coupled[n][2].frictionloss if n in self.coupled else self.frictionloss[idx].max()
               for n, idx in self.items()}
@@ -101,7 +102,7 @@ class JointDynamics(dict):
         """The springs' energy 1/2 sum stiffness (x - springref)^2 [J]."""
         return 0.5 * sum(self.springs[n][1] * x * x for n, x in self.spring_stretch(q).items())
 
-    def kinetic(self, v) -> float:
+    def kinetic(self, v: np.ndarray) -> float:
         """The armature's kinetic energy 1/2 sum armature v^2 [J] (MuJoCo's mass matrix holds it)."""
         return 0.5 * (float(self.armature @ (v * v))
                       + sum(j.armature * (m * v[iv]) ** 2 for m, iv, j in self.coupled.values()))
@@ -118,12 +119,12 @@ def joint_dynamics(mech: Mechanism) -> tuple:
             [j.name for j in given if j.name not in names and j.name not in couplings])
 
 
-def names_text(names) -> str:
+def names_text(names: Sequence[str]) -> str:
     """Up to three names, quoted, and ', ...' for more."""
     return f"{', '.join(quote(n, 30) for n in names[:3])}{', ...' if len(names) > 3 else ''}"
 
 
-def left_out_note(left) -> str | None:
+def left_out_note(left: Sequence[str]) -> str | None:
     """The note naming the loop joints whose own dynamics no balance holds (joint_dynamics' second part)."""
     if not left:
         return None

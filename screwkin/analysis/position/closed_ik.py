@@ -39,7 +39,7 @@ __all__ = ["closed_form_ik", "LISTED"]
 LISTED = 8  # a platform's combinations of leg branches listed in full up to this many
 
 
-def closed_form_ik(solver: PositionSolver, output: str, pose):
+def closed_form_ik(solver: PositionSolver, output: str, pose: pin.SE3):
     """The PositionResult of ``output``'s frame at ``pose`` (a pinocchio.SE3) in closed form, or None
     where the mechanism has none (see the module).  Raises AssemblyError where the closed form shows the
     pose unreachable (a leg too short, a pivot's plane left)."""
@@ -56,14 +56,14 @@ def closed_form_ik(solver: PositionSolver, output: str, pose):
     return None
 
 
-def _result(solver: PositionSolver, output: str, pose, sols: list, count) -> PositionResult:
+def _result(solver: PositionSolver, output: str, pose: pin.SE3, sols: list, count: int) -> PositionResult:
     mech = solver.mech
     return PositionResult({"pose": pose.homogeneous.tolist()}, tuple(mech.actuated), tuple(sols), 0, 0, (),
                           output, solver.angular_names(), solver._angular_coupled(), angular_loop_joints(mech),
                           modes=count)
 
 
-def _solution(solver: PositionSolver, q: np.ndarray, out_frame, residual, spelled: bool=False):
+def _solution(solver: PositionSolver, q: np.ndarray, out_frame: int, residual: float, spelled: bool=False):
     mech = solver.mech
     sol = solver.solution(q, Assembly(q, residual, 0), simple=True, spelled=spelled)
     if solver.output_frame == out_frame and sol.output_pose is not None:  # read there already
@@ -71,7 +71,7 @@ def _solution(solver: PositionSolver, q: np.ndarray, out_frame, residual, spelle
     return replace(sol, output_pose=KinematicState(mech, sol.q).frame_pose(out_frame), simple=True)
 
 
-def _residual(mech: Mechanism, q: np.ndarray, out_frame, pose) -> float:
+def _residual(mech: Mechanism, q: np.ndarray, out_frame: int, pose: pin.SE3) -> float:
     """The loops' residual and the output frame's distance from the pose (m and rad together)."""
     loops = float(np.linalg.norm(mech.closure.residual(q))) if mech.cuts else 0.0
     at = KinematicState(mech, q).frame_pose(out_frame)
@@ -79,7 +79,7 @@ def _residual(mech: Mechanism, q: np.ndarray, out_frame, pose) -> float:
     return max(loops, float(np.linalg.norm(err)))
 
 
-def _platform(solver: PositionSolver, output: str, out_frame, platform: Platform, P, pose, start) -> PositionResult | None:
+def _platform(solver: PositionSolver, output: str, out_frame: int, platform: Platform, P: pin.SE3, pose: pin.SE3, start: float) -> PositionResult | None:
     mech, model = solver.mech, solver.mech.model
     legs = []
     for leg in platform.legs:
@@ -138,7 +138,7 @@ def _platform(solver: PositionSolver, output: str, out_frame, platform: Platform
     return _result(solver, output, pose, sols, count)
 
 
-def _arm(solver: PositionSolver, output: str, out_frame, arm, pose, start):
+def _arm(solver: PositionSolver, output: str, out_frame: int, arm, pose: pin.SE3, start: float):
     mech, model = solver.mech, solver.mech.model
     sets, _, why, stretched = pieper(arm, pose, mech.tolerances)
     if why:

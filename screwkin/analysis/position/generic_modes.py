@@ -95,7 +95,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol:
     return modes, len(distinct), len(modes), n_complex, certificate, "; ".join(why), detail, check
 
 
-def _onto_joints(solver, problem, closure, arch: Architecture, x, lift_legs) -> tuple | None:
+def _onto_joints(solver, problem, closure, arch: Architecture, x: np.ndarray, lift_legs) -> tuple | None:
     """(q, Assembly) of the real pose x = (t / L, q) on the file's joints -- of its angle sets the one
     within the joint limits nearest the reference configuration -- or None."""
     model, L = problem.model, arch.L
@@ -138,12 +138,12 @@ def _wxyz(q: np.ndarray):
     return pin.Quaternion(q[3], q[0], q[1], q[2])
 
 
-def _same_pose(mech: Mechanism, q: np.ndarray, arch: Architecture, R, t) -> bool:
+def _same_pose(mech: Mechanism, q: np.ndarray, arch: Architecture, R: np.ndarray, t: np.ndarray) -> bool:
     M = KinematicState(mech, q).joint_placement(arch.joint)
     return (np.abs(M.translation - t).max() <= _MOVED * arch.L and np.abs(M.rotation - R).max() <= _MOVED)
 
 
-def _carried(mech: Mechanism, problem, arch: Architecture, R: np.ndarray, t) -> list:
+def _carried(mech: Mechanism, problem, arch: Architecture, R: np.ndarray, t: np.ndarray) -> list:
     """Configurations with the carrying leg's angles putting the platform's joint frame at (R, t)."""
     model = problem.model
     head, tail = arch.carrier
@@ -167,7 +167,7 @@ def _carried(mech: Mechanism, problem, arch: Architecture, R: np.ndarray, t) -> 
     return out
 
 
-def _set_angle(model: pin.Model, q: np.ndarray, j: int, angle) -> None:
+def _set_angle(model: pin.Model, q: np.ndarray, j: int, angle: float) -> None:
     jm = model.joints[j]
     if jm.nq == 1:
         q[jm.idx_q] = angle

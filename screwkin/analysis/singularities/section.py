@@ -34,7 +34,7 @@ AXES = {"x": 0, "y": 1, "z": 2}
 class SectionSystem(LocusSystem):
     """The augmented system of the serial singularity of ``output``'s origin in a workspace section."""
 
-    def __init__(self, mech: Mechanism, output, x_axis, y_axis, level, fixed) -> None:  # (LocusSystem's own set-up is for inputs)
+    def __init__(self, mech: Mechanism, output: str, x_axis: str, y_axis: str, level: float, fixed: dict | None) -> None:  # (LocusSystem's own set-up is for inputs)
         self.mech, self.kind, self.output, self.point = mech, "serial", output, True
         self.L = mech.length
         self.scale = np.where(mech.translational, self.L, 1.0)
@@ -65,7 +65,7 @@ class SectionSystem(LocusSystem):
     def A(self, q: np.ndarray) -> np.ndarray:
         return self._pose(q)[1][:, self.free]
 
-    def residual(self, q: np.ndarray, v: np.ndarray, A=None) -> np.ndarray:
+    def residual(self, q: np.ndarray, v: np.ndarray, A: np.ndarray | None=None) -> np.ndarray:
         p, J = self._pose(q)
         A = J[:, self.free] if A is None else A
         held = []
@@ -74,18 +74,18 @@ class SectionSystem(LocusSystem):
             held.append(np.arctan2(np.sin(d), np.cos(d)) if not self.mech.translational[c.idx_v] else d / self.L)
         return np.concatenate([[(p[self.h] - self.level) / self.L], held, A @ v, [0.5 * (v @ v - 1.0)]])
 
-    def jacobian(self, q: np.ndarray, v, A=None) -> np.ndarray:
+    def jacobian(self, q: np.ndarray, v: np.ndarray, A: np.ndarray | None=None) -> np.ndarray:
         _, J = self._pose(q)
         A = J[:, self.free] if A is None else A
         rows = [np.concatenate([J[self.h], np.zeros(len(v))])[None]]
         return np.vstack(rows + self._held_kind_norm_rows(q, v, A))
 
-    def projected(self, q: np.ndarray, t) -> np.ndarray:
+    def projected(self, q: np.ndarray, t: np.ndarray) -> np.ndarray:
         _, J = self._pose(q)
         return self.L * (J[list(self.axes)] @ t[:self.nv])
 
     def edge(self, axis: int, bound: float):
-        def row(qc, vc) -> tuple:
+        def row(qc: np.ndarray, vc: np.ndarray) -> tuple:
             p, J = self._pose(qc)
             return (np.concatenate([J[self.axes[axis]], np.zeros(len(vc))])[None],
                     np.array([(bound - p[self.axes[axis]]) / self.L]))
@@ -100,7 +100,7 @@ class Section:
     why: str
 
 
-def trace_section(mech: Mechanism, output, x_axis: str, xs: np.ndarray, y_axis: str, ys: np.ndarray, level: float = 0.0, fixed=None,
+def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_axis: str, ys: np.ndarray, level: float = 0.0, fixed: dict | None=None,
                   samples: int = 400, seed: int = 0) -> Section:
     """The serial singular curves of ``output``'s origin in the section (x_axis, y_axis) of its workspace, the
     third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes and
