@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from collections.abc import Sequence
 
 __all__ = ["LegChain", "Platform", "platform_of", "LegPose", "leg_poses", "set_leg", "set_free", "best_set",
            "respell"]
@@ -160,7 +161,7 @@ def _joints_from_ground(model: pin.Model, j: int) -> list:
     return out[::-1]
 
 
-def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | None, scale, tol: float) -> LegChain | None:
+def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | None, scale: float, tol: float) -> LegChain | None:
     """The LegChain of the joints ``path`` (see the module), read in ``state``, or None when they are no leg."""
     kinds = [_joint_letter(model, j) for j in path]
     if kinds.count("P") != 1:
@@ -175,7 +176,7 @@ def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | 
     def axis(j: int):
         return state.joint_placement(j).rotation @ joint_axis(model.joints[j])
 
-    def centre(js):
+    def centre(js: Sequence[int]):
         if len(js) == 1:
             return np.array(state.joint_placement(js[0]).translation)
         o, off = lines_point([state.joint_placement(j).translation for j in js], [axis(j) for j in js], TINY)
@@ -202,7 +203,7 @@ def _leg_chain(model: pin.Model, state: KinematicState, path, cut, end: tuple | 
                     tuple(float(v) for v in b_local), cut)
 
 
-def leg_poses(platform: Platform, leg: LegChain, P, tol: float = DEFAULT.closed_form) -> tuple:
+def leg_poses(platform: Platform, leg: LegChain, P: pin.SE3, tol: float = DEFAULT.closed_form) -> tuple:
     """(poses, why, gap): the leg's LegPoses (extended root first) for the output joint at world
     placement P (a pinocchio.SE3); when it has none, why (else "") and how far it stays from the pose
     [m]."""
@@ -266,7 +267,7 @@ def set_leg(model: pin.Model, q: np.ndarray, pose: LegPose, angles: dict) -> np.
     return q
 
 
-def set_free(platform: Platform, model: pin.Model, q: np.ndarray, P) -> np.ndarray:
+def set_free(platform: Platform, model: pin.Model, q: np.ndarray, P: pin.SE3) -> np.ndarray:
     """q with the floating joint holding the platform at the output joint's world placement P."""
     if platform.free is not None:
         jm = model.joints[platform.free]
@@ -274,7 +275,7 @@ def set_free(platform: Platform, model: pin.Model, q: np.ndarray, P) -> np.ndarr
     return q
 
 
-def best_set(mech: Mechanism, q: np.ndarray, pose: LegPose, near=None):
+def best_set(mech: Mechanism, q: np.ndarray, pose: LegPose, near: np.ndarray | None=None):
     """The angle set of ``pose`` to report: the fewest of its joints outside the file's limits, then
     the nearest ``near`` (a configuration; default the file's), angles compared modulo a turn."""
     model = mech.model

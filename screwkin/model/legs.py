@@ -23,6 +23,9 @@ import pinocchio as pin
 
 from ..tolerances import DEFAULT
 from .geometry import lines_point
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 __all__ = ["Leg", "distance_legs", "chain_distance"]
 
@@ -75,7 +78,7 @@ def _passive_revolute(model: pin.Model, j: int, frozen: set) -> bool:
     return passive and jm.nv == 1 and jm.shortname().startswith("JointModelR")
 
 
-def _leg(model: pin.Model, data, q0: np.ndarray, name: str, f, other, used: dict, frozen: set, length: float, taken, tol: float) -> Leg | None:
+def _leg(model: pin.Model, data: pin.Data, q0: np.ndarray, name: str, f, other, used: dict, frozen: set, length: float, taken, tol: float) -> Leg | None:
     """The leg ending at frame f, or None."""
     chain = []
     j = model.frames[f].parentJoint
@@ -98,7 +101,7 @@ def _leg(model: pin.Model, data, q0: np.ndarray, name: str, f, other, used: dict
     return None
 
 
-def _common_point(model: pin.Model, data, revs, length: float, tol: float):
+def _common_point(model: pin.Model, data: pin.Data, revs: list, length: float, tol: float):
     """The point where the revolutes' axes meet (at the neutral configuration), or None when there are
     fewer than two independent axes or they do not meet."""
     if len(revs) < 2:
@@ -183,7 +186,7 @@ def _passive(model: pin.Model, j: int, frozen: set) -> bool:
     return not any(jm.idx_v + k in frozen for k in range(jm.nv))
 
 
-def _turn(model: pin.Model, q: np.ndarray, joints, rng: np.random.Generator) -> None:
+def _turn(model: pin.Model, q: np.ndarray, joints: Sequence[int], rng: np.random.Generator) -> None:
     """q with the revolutes ``joints`` turned to random angles (in place)."""
     for k in joints:
         jm = model.joints[k]

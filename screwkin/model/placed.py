@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from collections.abc import Sequence
 
 __all__ = ["placed", "check_closed", "WRITABLE_CUTS", "ball_values", "davenport"]
 
@@ -37,7 +38,7 @@ WRITABLE_CUTS = ("fixed", "revolute", "continuous", "prismatic", "cylindrical", 
 _NO_LIMIT = 1e6
 
 
-def _inertia(I) -> tuple:
+def _inertia(I: pin.Inertia) -> tuple:
     m = I.inertia
     return (m[0, 0], m[1, 1], m[2, 2], m[0, 1], m[0, 2], m[1, 2])
 
@@ -138,7 +139,7 @@ def _spec_joint(spec, name: str):
     return next(j for j in spec.joints if j.name == name)
 
 
-def _placed_joint(mech: Mechanism, q: np.ndarray, j, kind: str, values, empty, axis=None, pos=(0.0, 0.0, 0.0)) -> PlacedJoint:
+def _placed_joint(mech: Mechanism, q: np.ndarray, j, kind: str, values: dict, empty, axis=None, pos=(0.0, 0.0, 0.0)) -> PlacedJoint:
     """The PlacedJoint of tree joint ``j`` (a hinge or slide keeps its range about q; ``values``
     and ``empty`` collect its value and an empty range)."""
     model = mech.model
@@ -212,7 +213,7 @@ def _compounds(mech: Mechanism, q: np.ndarray, state: KinematicState, world: dic
     return out
 
 
-def _compound_joints(mech: Mechanism, q: np.ndarray, state: KinematicState, c: PlacedCompound, values, empty) -> list:
+def _compound_joints(mech: Mechanism, q: np.ndarray, state: KinematicState, c: PlacedCompound, values: dict, empty) -> list:
     """The PlacedJoints of compound ``c`` in its body (``state``: the KinematicState at q): one ball at
     the members' common point, or the members' own joints with their axes and points in the body's frame."""
     C = state.frame_placement(mech.link_frame(c.body))
@@ -229,7 +230,7 @@ def _compound_joints(mech: Mechanism, q: np.ndarray, state: KinematicState, c: P
             for m, axis, p in zip(ms, c.axes, points)]
 
 
-def ball_values(c: PlacedCompound, quat) -> dict:
+def ball_values(c: PlacedCompound, quat: Sequence[float]) -> dict:
     """The member joints' values [rad] of an exported ball ``c`` whose quaternion (MuJoCo's w, x, y, z)
     is ``quat``: Q = R(a0, d0) R(a1, d1) R(a2, d2) about its axes (Davenport angles, the branch through
     zero), the members at c.values + d."""
@@ -238,7 +239,7 @@ def ball_values(c: PlacedCompound, quat) -> dict:
     return {m: v + dv for m, v, dv in zip(c.members, c.values, d)}
 
 
-def _angle_about(n: int, v, w) -> float:
+def _angle_about(n: int, v: np.ndarray, w: np.ndarray) -> float:
     """The angle [rad] about unit axis n taking v's projection on n's plane to w's."""
     v = v - (n @ v) * n
     w = w - (n @ w) * n

@@ -57,8 +57,8 @@ def _chunks(items: list, size: int) -> list:
     return [items[i:i + size] for i in range(0, len(items), size)]
 
 
-def run_study(spec, scheduler: str | None = None, workers: int | None = None, progress: Progress | None = None,
-              timeout: float = 10.0, base=None) -> StudyResult:
+def run_study(spec: StudySpec | dict, scheduler: str | None = None, workers: int | None = None, progress: Progress | None = None,
+              timeout: float = 10.0, base: str | Path | None=None) -> StudyResult:
     """Run a study: ``spec`` a StudySpec, a spec file's path, or a dict (its ``file``
     relative to ``base``, default the current folder).
 
@@ -132,7 +132,7 @@ def _merged(notes: Counter) -> list:
     return [f"{c} design{'s' if c != 1 else ''} evaluated alone: {why}" if c else why for why, c in out.most_common()]
 
 
-def _on_dask(task, chunks, total: int, scheduler: str | None, workers, timeout: float, progress: Progress | None) -> tuple:
+def _on_dask(task, chunks: list, total: int, scheduler: str | None, workers: int, timeout: float, progress: Progress | None) -> tuple:
     """Run the chunks on a LocalCluster or the scheduler's cluster: (results per chunk,
     workers, where)."""
     from distributed import as_completed  # 0.4-0.9 s to import: only studies need it
@@ -153,7 +153,7 @@ def _on_dask(task, chunks, total: int, scheduler: str | None, workers, timeout: 
                     pass
 
 
-def _collect(client, task, chunks, futures, total, progress, as_completed, grace: float = STALL_GRACE,
+def _collect(client, task, chunks: list, futures: list, total: int, progress: Progress | None, as_completed, grace: float = STALL_GRACE,
              poll: float = 0.05) -> list:
     """The rows of every chunk's future, in chunk order.  A chunk whose task failed as a whole
     (its worker died) is rows with that reason.  When no chunk finishes for the longest

@@ -20,6 +20,9 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
+    from matplotlib.axes import Axes
+    from collections.abc import Callable
+    from screwkin.analysis.course.skeleton import Skeleton
 
 __all__ = ["design_marks", "design_drawing", "target_marks", "draw_targets", "NUMBERED"]
 
@@ -29,7 +32,7 @@ TARGET_COLOUR = "#6a3d9a"
 NUMBERED = 12
 
 
-def design_marks(mech: Mechanism, q: np.ndarray, skel, inputs: list | None = None, steps: int = 360) -> tuple:
+def design_marks(mech: Mechanism, q: np.ndarray, skel: Skeleton, inputs: list | None = None, steps: int = 360) -> tuple:
     """(analysis.design.targets.DesignTargets, marks) of ``mech``'s file drawn at ``q`` as ``skel``:
     the marks (target_marks) with the linkage's skeleton at each precision position other than the
     one drawn (in skel's plane, ``inputs`` marked)."""
@@ -53,7 +56,7 @@ def design_marks(mech: Mechanism, q: np.ndarray, skel, inputs: list | None = Non
     return found, marks
 
 
-def design_drawing(mech: Mechanism, q: np.ndarray, input_names: list, skel, steps: int, say=None, hint: str = "") -> tuple:
+def design_drawing(mech: Mechanism, q: np.ndarray, input_names: list, skel: Skeleton, steps: int, say: Callable[[str], object] | None=None, hint: str = "") -> tuple:
     """A synthesized file's targets (<screwkin:targets>) as the drawing's marks, the linkage at each
     precision position ghosted, and a path's coupler curve: (marks, (name, xy, stopped_at) or None).
     ``say``: where the lines that tell what was drawn go (None: nowhere, for --json)."""
@@ -87,18 +90,18 @@ def design_drawing(mech: Mechanism, q: np.ndarray, input_names: list, skel, step
     return marks, curve
 
 
-def target_marks(design, basis, skeletons: dict | None = None) -> list:
+def target_marks(design, basis: tuple, skeletons: dict | None = None) -> list:
     """The drawing's data of an analysis.design.targets.DesignTargets in the plane (e1, e2, n) of
     the skeleton: one dict per target with number, kind, label, target (x, y), direction (a unit
     vector or None), reached (x, y) and reached_direction (None where the file does not
     assemble), and ``ghost`` (the Skeleton at that position, from ``skeletons``, or None)."""
     e1, e2 = (np.asarray(v, float) for v in basis[:2])
 
-    def plane(v) -> list:
+    def plane(v: np.ndarray) -> list:
         v = np.asarray(v, float)
         return [float(v @ e1), float(v @ e2)]
 
-    def heading(yaw):
+    def heading(yaw: float):
         return None if yaw is None else plane((np.cos(yaw), np.sin(yaw), 0.0))
 
     out = []
@@ -113,7 +116,7 @@ def target_marks(design, basis, skeletons: dict | None = None) -> list:
     return out
 
 
-def draw_targets(ax, marks: list | None, r, size, colour_of) -> list:
+def draw_targets(ax: Axes, marks: list | None, r: float, size: float, colour_of) -> list:
     """Draw ``marks`` (target_marks) on ``ax``; ``r``: the pin radius (the symbols' unit),
     ``size``: the drawing's length scale [m]; colour_of(link number) the links' colours.
     Returns the points drawn (for the framing)."""

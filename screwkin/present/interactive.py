@@ -84,13 +84,13 @@ CANVAS_ASPECT = 1.0
 CAMERA_MOVED = 1e-4
 
 
-def _moved(position, eye, dist) -> bool:
+def _moved(position: np.ndarray, eye: np.ndarray, dist: float) -> bool:
     """Whether a camera reported at ``position`` is no longer where the view put it (``eye``, at ``dist`` from its
     target): farther than CAMERA_MOVED of that distance."""
     return float(np.linalg.norm(np.asarray(position, float) - eye)) > CAMERA_MOVED * dist
 
 
-def _shown(value, unit: str) -> float:
+def _shown(value: float, unit: str) -> float:
     return value * 1000.0 if unit == "m" else math.degrees(value)
 
 
@@ -157,7 +157,7 @@ class InteractiveView:
         else:  # viser before 1.1: a fixed sidebar
             gui.configure_theme(control_layout="fixed")
 
-    def _camera(self, scene: Scene, basis) -> None:
+    def _camera(self, scene: Scene, basis: tuple) -> None:
         """The first view: the mechanism framed (fit_camera, as view's pictures), along the plane's
         normal for a planar mechanism (its drawing's y up), else from view's usual direction; for the
         view's shape before a browser says it (then _frame_client frames it for that browser's)."""

@@ -15,13 +15,14 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.singularities.loci import Loci
     from screwkin.analysis.singularities.regions import Regions
+    from collections.abc import Sequence
 
 __all__ = ["loci_dict", "loci_lines", "loci_png"]
 
 _COLOURS = {"actuator": "tab:red", "serial": "tab:blue", "constraint": "tab:purple"}
 
 
-def _xy(p, xu, yu) -> list:
+def _xy(p: Sequence[float], xu: str, yu: str) -> list:
     return [float(in_unit(p[0], xu)), float(in_unit(p[1], yu))]
 
 
@@ -62,7 +63,7 @@ def loci_dict(loci: Loci, regions: Regions, x_unit: str, y_unit: str, loops=None
 
 def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: str, y_unit: str, loops=None) -> list:
     """Text lines: each curve, the cusps, nodes and regions, and how they were found."""
-    def pt(p) -> str:
+    def pt(p: Sequence[float]) -> str:
         a, b = _xy(p, x_unit, y_unit)
         return f"({x_name} = {a:.9g} {x_unit}, {y_name} = {b:.9g} {y_unit})"
 
@@ -102,7 +103,7 @@ def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: s
     return lines
 
 
-def loci_png(loci: Loci, regions, path, xs: np.ndarray, ys: np.ndarray, x_name: str, y_name: str, x_unit, y_unit, title: str | None = None) -> None:
+def loci_png(loci: Loci, regions: Regions, path: str, xs: np.ndarray, ys: np.ndarray, x_name: str, y_name: str, x_unit: str, y_unit: str, title: str | None = None) -> None:
     """Loci by kind, cusps and nodes, regions shaded by their number of assembly modes."""
     plt = pyplot("--png")
     fig, ax = plt.subplots(figsize=(7, 6))

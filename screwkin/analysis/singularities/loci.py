@@ -183,7 +183,7 @@ class LocusSystem:
         """The extra row of ``newton`` that holds the plane's coordinate ``axis`` (0: x, 1: y) at ``bound``."""
         c = (self.cx, self.cy)[axis]
 
-        def row(qc, vc) -> tuple:
+        def row(qc: np.ndarray, vc: np.ndarray) -> tuple:
             r = np.zeros(self.nv + len(vc))
             r[c.idx_v] = 1.0
             return r[None], np.array([(bound - self.value(qc, c)) / self.scale[c.idx_v]])
@@ -239,7 +239,7 @@ class LocusSystem:
         qp, vp = self.integrate(q, h * t[:self.nv]), v + h * t[self.nv:]
         q0 = q
 
-        def plane(qc, vc) -> tuple:
+        def plane(qc: np.ndarray, vc: np.ndarray) -> tuple:
             d = np.concatenate([self.mech.difference(q0, qc) / self.scale, vc - v])
             return t[None], np.array([h - t @ d])
 
@@ -349,7 +349,7 @@ def _cusps(sys: LocusSystem, qs: list, vs: list, ts: list) -> list:
         ref = a / na
         cache = {}
 
-        def phi(s, ref=ref, a=a, q0=q0, v0=v0, t0=t0, cache=cache) -> float:
+        def phi(s: float, ref=ref, a=a, q0=q0, v0=v0, t0=t0, cache=cache) -> float:
             if s == 0:
                 return float(ref @ a)
             res = sys.along(q0, v0, t0, s)

@@ -50,6 +50,9 @@ from ....errors import UsageError
 from ....files.writer import PlanarJoint, PlanarLink, PlanarLinkage, PlanarLoopJoint
 from ....model.six_bar import INVERSIONS, six_bar_chain, six_bar_inversion
 from .designs import Chain, ChainsResult
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 __all__ = ["enumerate_chains", "chain_linkage", "guides_of", "MAX_LINKS"]
 
@@ -69,7 +72,7 @@ def _joints_for(links: int, dof: int) -> int:
     return twice // 2
 
 
-def _graph(n: int, edges):
+def _graph(n: int, edges: Sequence[tuple[int, int]]):
     import networkx as nx
 
     g = nx.Graph()
@@ -178,7 +181,7 @@ def _orbits(n: int, autos) -> tuple:
     return tuple(orbits)
 
 
-def _name(links: int, degrees: tuple, edges, kinds) -> str:
+def _name(links: int, degrees: tuple, edges: Sequence[tuple[int, int]], kinds) -> str:
     prismatic = sum(1 for k in kinds.values() if k == "P")
     counts = {}
     for d in degrees:

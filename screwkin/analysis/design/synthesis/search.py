@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.design.synthesis.constraints import Constraints
+    from collections.abc import Callable
 
 __all__ = ["box_text", "Search", "SearchReport", "evolve", "distinct_best", "task_seed"]
 
@@ -62,7 +63,7 @@ class SearchReport:
     box: str = ""  # where the search looked, as chosen (box_text): what the constraints left to the search
 
 
-def box_text(constraints: Constraints, pivots=None, lengths: tuple | None = None) -> str:
+def box_text(constraints: Constraints, pivots: tuple | None=None, lengths: tuple | None = None) -> str:
     """Where a search looks, in words: the fixed pivots' box ((low, high) corners [m]) and the links'
     lengths ((low, high) [m]), each said to be the search's own choice where ``constraints`` (a
     Constraints) does not give it (--bounds, --lengths)."""
@@ -82,13 +83,13 @@ def task_seed(seed: int, index: int) -> int:
     return int(np.random.SeedSequence([int(seed), int(index)]).generate_state(1)[0])
 
 
-def evolve(cost, lower, upper, seed: int, generations: int = GENERATIONS, popsize: int = POPSIZE) -> tuple:
+def evolve(cost: Callable[[np.ndarray], np.ndarray], lower: np.ndarray, upper: np.ndarray, seed: int, generations: int = GENERATIONS, popsize: int = POPSIZE) -> tuple:
     """Differential evolution (scipy, best1bin, Latin-hypercube start, deferred updating) of the
     vectorized ``cost`` (X (n, d) -> (n,)) over the box [lower, upper]: (population (m, d), costs (m,),
     evaluations)."""
     from scipy.optimize import differential_evolution
 
-    def f(x):  # scipy gives the population as (d, n)
+    def f(x: np.ndarray):  # scipy gives the population as (d, n)
         return cost(np.asarray(x, float).T)
 
     res = differential_evolution(f, list(zip(lower, upper)), strategy="best1bin", maxiter=generations,
@@ -98,7 +99,7 @@ def evolve(cost, lower, upper, seed: int, generations: int = GENERATIONS, popsiz
     return np.asarray(res.population), np.asarray(res.population_energies), int(res.nfev)
 
 
-def distinct_best(population, costs, lower, upper, count: int, apart: float = 0.05) -> list:
+def distinct_best(population: np.ndarray, costs: np.ndarray, lower: np.ndarray, upper: np.ndarray, count: int, apart: float = 0.05) -> list:
     """Indices of up to ``count`` of the best members, each at least ``apart`` (of the box's size, in
     every dimension's scale) from those taken before."""
     span = np.maximum(np.asarray(upper, float) - np.asarray(lower, float), 1e-300)
@@ -114,7 +115,7 @@ def distinct_best(population, costs, lower, upper, count: int, apart: float = 0.
     return taken
 
 
-def run_all(search: Search, function, tasks: list) -> tuple:
+def run_all(search: Search, function: Callable[..., object], tasks: list) -> tuple:
     """(the tasks' results in order, seconds): ``function`` mapped over ``tasks`` by the search's mapper."""
     t0 = time.perf_counter()
     mapper = search.mapper or map
