@@ -37,6 +37,9 @@ from .inertia import inertia_problem, inertia_warnings
 from .meshes import check_meshes
 from .urdf_transmission import read_transmissions
 from .xmlsafe import parse_xml_text
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from xml.etree.ElementTree import Element
 
 __all__ = ["read_urdf", "numbers", "unit_axis", "check_tree", "check_sizes", "Problems"]
 
@@ -103,7 +106,7 @@ def unit_axis(values: tuple | np.ndarray, what: str, problems: Problems | list, 
     return tuple(u / np.linalg.norm(u))
 
 
-def _axis(elem, what: str, problems: Problems, default: tuple=(1.0, 0.0, 0.0)) -> tuple:
+def _axis(elem: Element | None, what: str, problems: Problems, default: tuple=(1.0, 0.0, 0.0)) -> tuple:
     if elem is None or elem.get("xyz") is None:  # urdfdom's default: the x axis
         return tuple(default)
     before = len(problems)
@@ -113,7 +116,7 @@ def _axis(elem, what: str, problems: Problems, default: tuple=(1.0, 0.0, 0.0)) -
     return unit_axis(values, what, problems, default)
 
 
-def _origin(elem, what: str, problems: Problems) -> tuple:
+def _origin(elem: Element | None, what: str, problems: Problems) -> tuple:
     """xyz and rpy of an ``<origin>`` (or of any element carrying them), checked."""
     get = (lambda k: elem.get(k)) if elem is not None else (lambda k: None)
     xyz = numbers(get("xyz"), 3, f"{what} xyz>", problems, (0.0, 0.0, 0.0), LIMITS.length, "m")
@@ -125,7 +128,7 @@ _GEOMETRY = {"box": (("size", 3),), "cylinder": (("radius", 1), ("length", 1)), 
              "capsule": (("radius", 1), ("length", 1)), "mesh": (("scale", 3),)}
 
 
-def _link(elem, problems: Problems) -> LinkSpec:
+def _link(elem: Element, problems: Problems) -> LinkSpec:
     name = elem.get("name")
     what = f"link {quote(name)}"
     mass = None
@@ -151,7 +154,7 @@ def _link(elem, problems: Problems) -> LinkSpec:
     return LinkSpec(name=name, mass=mass, has_geometry=has_geometry, inertia_problem=impossible)
 
 
-def _name_and_type(elem, tag: str, kind: str, types: dict, problems: Problems) -> tuple | None:
+def _name_and_type(elem: Element, tag: str, kind: str, types: dict, problems: Problems) -> tuple | None:
     """(name, type, 'kind NAME') of a <joint> or <loop_joint>, or None after recording why."""
     name = elem.get("name")
     if not name:
@@ -165,7 +168,7 @@ def _name_and_type(elem, tag: str, kind: str, types: dict, problems: Problems) -
     return name, jtype, what
 
 
-def _joint(elem, links: dict, problems: Problems) -> JointSpec | None:
+def _joint(elem: Element, links: dict, problems: Problems) -> JointSpec | None:
     head = _name_and_type(elem, "joint", "joint", TREE_JOINT_DOF, problems)
     if head is None:
         return None
@@ -210,7 +213,7 @@ def _joint(elem, links: dict, problems: Problems) -> JointSpec | None:
     return JointSpec(name, jtype, ends["parent"], ends["child"], xyz, rpy, axis, mimic, **dyn)
 
 
-def _loop_joint(elem, links: dict, problems: Problems, warnings: list) -> CutJointSpec | None:
+def _loop_joint(elem: Element, links: dict, problems: Problems, warnings: list) -> CutJointSpec | None:
     head = _name_and_type(elem, "loop_joint", "loop joint", CUT_JOINT_DOF, problems)
     if head is None:
         return None
@@ -279,7 +282,7 @@ def _radius(text: str, what: str, problems: Problems, allow_inf: bool=False):
     return value
 
 
-def _pair_parameters(elem, jtype: str, what: str, axis: tuple, problems: Problems) -> dict | None:
+def _pair_parameters(elem: Element, jtype: str, what: str, axis: tuple, problems: Problems) -> dict | None:
     """The parameters of a rolling, gear, contact or helical loop joint, checked."""
     n0 = len(problems)
     out = {}
@@ -358,7 +361,7 @@ def check_sizes(path: str | Path, links: int, joints: int, loop_joints: int, coo
                   f"{data_bytes(coordinates) / 1e9:.3g} GB)")
 
 
-def check_tree(path, links: dict, joints: list, problems: Problems) -> None:
+def check_tree(path: str | Path, links: dict, joints: list, problems: Problems) -> None:
     """Record problems that keep the joints from forming one tree over the links."""
     parent_of = {}
     for j in joints:
@@ -400,7 +403,7 @@ def _coordinates(joints: list) -> int:
     return sum(TREE_JOINT_DOF[j.type] for j in joints)
 
 
-def read_urdf(path: Path | str, text: str, root=None, package_dirs: list | tuple = ()) -> MechanismSpec:
+def read_urdf(path: Path | str, text: str, root: Element | None=None, package_dirs: list | tuple = ()) -> MechanismSpec:
     """Read a URDF file (already loaded as ``text``, and parsed as ``root`` when given)
     into a :class:`MechanismSpec`.  package_dirs: folders searched for ``package://`` meshes."""
     if root is None:
@@ -505,7 +508,7 @@ def _couplings(joints: list, problems: Problems, warnings: list) -> list:
         f"the <mimic> couplings of joint {quote(name)} go round in a circle: ignored"))
 
 
-def _read_targets(root, links: dict, joint_names: set, problems: Problems) -> tuple:
+def _read_targets(root: Element, links: dict, joint_names: set, problems: Problems) -> tuple:
     """The TargetSpec of every <screwkin:target> under <screwkin:targets> of the URDF ``root``;
     a problem recorded (the file refused, as for any element) for an unknown kind, link or
     joint, a missing or implausible number."""

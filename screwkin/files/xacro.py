@@ -260,7 +260,7 @@ def declared_args(path, text: str | None = None) -> dict:
 
 
 # ------------------------------------------------------------------ expansion
-def _one_line(exc) -> str:
+def _one_line(exc: BaseException) -> str:
     """xacro's message on one line, with only the innermost of its nested "when evaluating
     expression" contexts (a property defined through others repeats each)."""
     text = " ".join(str(exc).split())

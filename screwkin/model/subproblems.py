@@ -24,12 +24,12 @@ from ..tolerances import DEFAULT
 __all__ = ["rotation", "rotation_to", "two_rotations", "run_angles"]
 
 
-def rotation(w, t):
+def rotation(w: np.ndarray, t: float):
     """R(w, t) (w a unit vector)."""
     return pin.exp3(np.asarray(w, float) * float(t))
 
 
-def rotation_to(w, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_form) -> float | None:
+def rotation_to(w: np.ndarray, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_form) -> float | None:
     """The angle t in (-pi, pi] with R(w, t) p = q (subproblem 1), None when p lies on the axis
     (any angle: a continuum)."""
     w = np.asarray(w, float)
@@ -40,7 +40,7 @@ def rotation_to(w, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_for
     return float(np.arctan2(w @ _cross(pp, qq), pp @ qq))
 
 
-def two_rotations(w1, w2, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_form) -> tuple:
+def two_rotations(w1: np.ndarray, w2: np.ndarray, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.closed_form) -> tuple:
     """(solutions, complex): every real (t1, t2) with R(w1, t1) R(w2, t2) p = q (subproblem 2:
     z = R(w2, t2) p = R(w1, -t1) q lies on both circles), and whether the pair is complex (the
     circles miss).  A solution whose intermediate point lies on an axis (a continuum) is left out."""
@@ -67,7 +67,7 @@ def two_rotations(w1, w2, p: np.ndarray, q: np.ndarray, tol: float = DEFAULT.clo
     return out, False
 
 
-def run_angles(axes: list, R, tol: float = DEFAULT.closed_form) -> list:
+def run_angles(axes: list, R: np.ndarray, tol: float = DEFAULT.closed_form) -> list:
     """Every real (t1, ..., tk) with R(w1, t1) ... R(wk, tk) = R for k = 1, 2, 3 unit axes (see the
     module); each set checked against R (a rotation not of that form gives []).  A continuum (a
     spherical wrist with its outer axes aligned) gives []: the caller says so."""
@@ -105,12 +105,12 @@ def run_angles(axes: list, R, tol: float = DEFAULT.closed_form) -> list:
     return out
 
 
-def _cross(a, b) -> np.ndarray:
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """a x b of two 3-vectors (np.cross costs ten times more at this size)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _perpendicular(w):
+def _perpendicular(w: np.ndarray):
     """A unit vector perpendicular to w."""
     e = np.eye(3)[int(np.argmin(np.abs(w)))]
     v = _cross(w, e)

@@ -16,6 +16,12 @@ from ..errors import OutputError, UsageError, quote
 from .draw import draw_mechanism
 from .outfile import write_output
 from .plots import pyplot
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from matplotlib.figure import Figure
+    from collections.abc import Sequence
+    from screwkin.analysis.course.skeleton import Skeleton
 
 __all__ = ["FORMATS", "animation_format", "write_animation"]
 
@@ -43,7 +49,7 @@ def animation_format(path: str) -> str:
     return ext
 
 
-def _limits(skeletons, titles, traces, size, angles, progress=None) -> tuple[tuple, tuple]:
+def _limits(skeletons: Sequence[Skeleton], titles: Sequence[str], traces: dict | None, size, angles: bool, progress: Callable[[int, int], object] | None=None) -> tuple[tuple, tuple]:
     """The framing of the whole motion: the union of the limits each frame would take alone
     (whole paths drawn), so that every frame is drawn in the same window."""
     plt = pyplot("--animate")
@@ -59,14 +65,14 @@ def _limits(skeletons, titles, traces, size, angles, progress=None) -> tuple[tup
     return (lo[0], hi[0]), (lo[1], hi[1])
 
 
-def _pixels(fig) -> np.ndarray:
+def _pixels(fig: Figure) -> np.ndarray:
     fig.set_dpi(DPI)
     fig.canvas.draw()
     return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
 
 
-def write_animation(path: str, skeletons, titles, traces: dict | None = None, fps: float = 20.0,
-                    angles: bool = False, subtitle: str | None = None, progress=None) -> int:
+def write_animation(path: str, skeletons: Sequence[Skeleton], titles: Sequence[str], traces: dict | None = None, fps: float = 20.0,
+                    angles: bool = False, subtitle: str | None = None, progress: Callable[[int, int], object] | None=None) -> int:
     """Write the animation of ``skeletons`` (one per frame, each with its title) to ``path`` (.gif or
     .mp4) at ``fps`` frames per second; ``traces``: name -> (len(skeletons), 2) path of a point in
     the drawing plane [m], drawn up to the current frame (backwards: the point is marked where it is

@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from screwkin.analysis.design.synthesis.designs import Design
     from screwkin.analysis.design.synthesis.designs import Dyad
     from screwkin.analysis.design.synthesis.designs import Target
+    from collections.abc import Sequence
 
 __all__ = ["synthesis_dict", "synthesis_text", "chains_dict", "chains_text"]
 
@@ -133,7 +134,7 @@ def _dyad_dict(k: int, d: Dyad) -> dict:
             "length": d.length}
 
 
-def synthesis_dict(result, check: Check, file: str, constraints=()) -> dict:
+def synthesis_dict(result, check: Check, file: str, constraints: Sequence[str]=()) -> dict:
     """The JSON object of a motion, function or path result and its check (``constraints``: the
     constrained search's, in words)."""
     design = result.design
@@ -191,12 +192,12 @@ def _as_typed(result: FunctionResult, check: Check) -> list:
 SYNTHESIS_ZERO = 1e-15
 
 
-def _shown_number(x, digits: int = 6) -> str:
+def _shown_number(x: float, digits: int = 6) -> str:
     """tables.shown_text with synthesis' own round-off (SYNTHESIS_ZERO)."""
     return shown_text(x, digits, SYNTHESIS_ZERO)
 
 
-def _search_lines(result, constraints) -> list:
+def _search_lines(result, constraints: Sequence[str]) -> list:
     """The constrained search: how, what it had to meet, and its best designs (closed form), best first."""
     report = result.search
     out = [f"constrained search: {report.method}; {report.runs} run{'s' if report.runs != 1 else ''} "
@@ -350,7 +351,7 @@ def synthesis_text(result: MotionResult | FunctionResult | PathResult, check: Ch
     return "\n".join(out)
 
 
-def chains_dict(result: ChainsResult, directory=None) -> dict:
+def chains_dict(result: ChainsResult, directory: str | None=None) -> dict:
     files = {(f.chain, f.ground): f for f in result.files}
     chains = []
     for c in result.chains:
@@ -380,7 +381,7 @@ def chains_dict(result: ChainsResult, directory=None) -> dict:
     })
 
 
-def chains_text(result: ChainsResult, directory=None) -> str:
+def chains_text(result: ChainsResult, directory: str | None=None) -> str:
     d = chains_dict(result, directory)
     kinds = f", {result.prismatic} of them prismatic" if result.prismatic else ""
     out = [f"planar kinematic chains of {result.links} links and {result.dof} DOF: {result.joints} one-DOF joints"

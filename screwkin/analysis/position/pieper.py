@@ -52,7 +52,7 @@ class Wrist:
     M0: object
 
 
-def wrist_arm(mech: Mechanism, out_frame: int, placement) -> Wrist | None:
+def wrist_arm(mech: Mechanism, out_frame: int, placement: pin.SE3) -> Wrist | None:
     """The Wrist of the arm whose output frame is on the joint ``out_frame``'s parent chain at
     ``placement`` (pinocchio.SE3 in the last joint's frame), or None when the mechanism is not a serial
     6R arm whose last three axes meet (the model's joint screws at the file's configuration)."""
@@ -80,7 +80,7 @@ def wrist_arm(mech: Mechanism, out_frame: int, placement) -> Wrist | None:
     return Wrist(tuple(path), axes, points, c0, placements[-1] * placement)
 
 
-def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT) -> tuple:
+def pieper(arm: Wrist, T: pin.SE3, tol: Tolerances = DEFAULT) -> tuple:
     """(sets, complex, why, stretched): every real joint solution (t1, ..., t6) placing the output frame at
     T (a pinocchio.SE3), how many of the 8 are complex, why the closed form does not answer ("" when it
     does: the wrist centre on axis 1 or 2 -- a continuum -- or a degenerate first pair of axes leave it
@@ -170,7 +170,7 @@ def pieper(arm: Wrist, T, tol: Tolerances = DEFAULT) -> tuple:
     return sets, n_complex * 2, ("" if sets else why), stretched
 
 
-def _stretched(axes, R: np.ndarray, tol: Tolerances) -> list:
+def _stretched(axes: list, R: np.ndarray, tol: Tolerances) -> list:
     """A stretched wrist (its last axis turned onto its first: joints 4 and 6 turn about one line, only their
     sum is fixed): [(None, t5, t6)] for each t5 that turns w6 onto +-w4, t6 with joint 4 at 0, else []."""
     w4, w5, w6 = axes
@@ -225,7 +225,7 @@ def _trig_roots(F, degree: int, tol: Tolerances) -> tuple:
     return real, n_complex
 
 
-def _closest(p1, w1: np.ndarray, p2, w2: np.ndarray, parallel: float) -> tuple:
+def _closest(p1: np.ndarray, w1: np.ndarray, p2: np.ndarray, w2: np.ndarray, parallel: float) -> tuple:
     """Points of the two lines nearest each other (the foot of p2 on line 1 where they are parallel: the
     sine of their angle below ``parallel``)."""
     n = np.cross(w1, w2)
