@@ -132,7 +132,7 @@ class VectorLoops:
 
     # ------------------------------------------------------------------ geometry
     @staticmethod
-    def wrap(a) -> float | np.ndarray:
+    def wrap(a: float | np.ndarray) -> float | np.ndarray:
         return _wrap(a)
 
     def exact_angle(self, value):

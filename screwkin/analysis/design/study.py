@@ -41,6 +41,7 @@ from .workspace import DEFAULT_THRESHOLD, workspace
 
 if TYPE_CHECKING:
     from ...model.mechanism import Mechanism
+    from collections.abc import Sequence
 
 __all__ = [
     "COLUMNS",
@@ -123,7 +124,7 @@ def _alarm(seconds: float):
         yield
         return
 
-    def fire(signum, frame):
+    def fire(signum: int, frame: object):
         raise DesignTimeout(f"timed out: the design took more than {seconds:g} s (the study's timeout per design)")
 
     previous = signal.signal(signal.SIGALRM, fire)
@@ -309,7 +310,7 @@ METRICS = {"mobility": _mobility, "grashof": _grashof, "transmission_angle": _tr
            "conditioning": _conditioning}
 
 
-def metric_columns(metrics) -> tuple:
+def metric_columns(metrics: Sequence[str]) -> tuple:
     """The metric columns of a study, in order, each once."""
     out = []
     for m in metrics:
@@ -413,7 +414,7 @@ def _row_key(name: str, keys: tuple) -> str | None:
     return None
 
 
-def pareto_front(result: StudyResult, goals=None) -> list:
+def pareto_front(result: StudyResult, goals: Sequence[tuple[str, str]] | None=None) -> list:
     """Indices (into result.rows) of the designs on the Pareto front of two columns:
     ``goals`` ((column, "max" | "min"), (column, "max" | "min")), default the spec's
     ``pareto``.  Rows without both values, and rows that do not meet the study's requirements
@@ -468,7 +469,7 @@ class Requirement:
     value: object
     text: str
 
-    def met(self, v) -> bool:
+    def met(self, v: object) -> bool:
         if v is None:
             return False
         if self.kind == "equal":
@@ -478,7 +479,7 @@ class Requirement:
         return v >= self.value if self.kind == "min" else v <= self.value
 
 
-def _spec_text(v) -> str:
+def _spec_text(v: object) -> str:
     """A cell as the spec writes it (YAML's true and false)."""
     return str(v).lower() if isinstance(v, bool) else repr(v) if isinstance(v, str) else f"{v:.6g}" \
         if isinstance(v, float) else str(v)
@@ -529,7 +530,7 @@ def apply_requirements(spec: StudySpec, rows: tuple) -> tuple:
     return tuple(out), REQUIREMENTS_COLUMN, unmet
 
 
-def failed_row(task, index: int, values, reason) -> dict:
+def failed_row(task, index: int, values: Sequence[float], reason: str) -> dict:
     row = {"design": index, **dict(zip(task.parameters, values))}
     row.update(dict.fromkeys(metric_columns(task.metrics)))
     row["error"] = reason

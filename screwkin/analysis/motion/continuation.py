@@ -177,14 +177,14 @@ def keeps_orientation(Ks_from: np.ndarray, Ks_new: np.ndarray, r: int) -> bool:
     return np.linalg.det(KC.transpose(0, 2, 1) @ Ks_new @ C) > 0
 
 
-def jumped(miss, sigma: float, tol: Tolerances) -> np.ndarray | bool:
+def jumped(miss: float | np.ndarray, sigma: float, tol: Tolerances) -> np.ndarray | bool:
     """The jump test: a correction of (dimensionless) length ``miss`` after a predicted step of
     length sigma left the curve when it is more than tol.jump * |sigma| and tol.jump_floor (NaN:
     it did)."""
     return ~(np.asarray(miss) <= np.maximum(tol.jump * np.abs(sigma), tol.jump_floor))
 
 
-def locate(f, lo: float, hi: float, xtol: float=1e-14, maxiter: int=100) -> float:
+def locate(f: Callable[[float], float], lo: float, hi: float, xtol: float=1e-14, maxiter: int=100) -> float:
     """The root of f bracketed in [lo, hi] (f changes sign there) by Brent's method, to xtol and
     four units of round-off: where every engine locates its limit positions (the tangent's input
     share, a closed form's discriminant) and the input values on an arc near them."""
@@ -316,7 +316,7 @@ class Curve:
         delta = pin.difference(self.model, qa, qb)
         frozen, cache = self.frozen(held), {0.0: qa, 1.0: qb}
 
-        def at(u):
+        def at(u: float):
             if u not in cache:
                 try:
                     cache[u] = self.closure.solve(pin.integrate(self.model, qa, u * delta), frozen=frozen).q
@@ -328,7 +328,7 @@ class Curve:
 
         return at
 
-    def on_arc(self, qa: np.ndarray, xa, qb: np.ndarray, held, x):
+    def on_arc(self, qa: np.ndarray, xa: float, qb: np.ndarray, held, x: float):
         """The configuration at input value x on the arc from qa (input xa) to qb, followed with
         joint ``held`` as the parameter (the input changes monotonically along it: no limit
         position strictly between): Brent's method on the held joint's share of the way.  Near a
@@ -339,7 +339,7 @@ class Curve:
             raise Stuck("the value is not on this arc")
         at = self._arc(qa, qb, held, "the loops cannot be closed on the arc")
 
-        def f(u):
+        def f(u: float):
             return xa + self.input_change(qa, at(u)) - x
 
         fa, fb = f(0.0), f(1.0)
@@ -362,7 +362,7 @@ class Curve:
         with joint ``held`` as the parameter: (configuration, input offset from qa)."""
         at = self._arc(qa, qb, held, None)
 
-        def f(s) -> float:
+        def f(s: float) -> float:
             return float(self.tangent(at(s), ta)[self.ix])
 
         fa, fb = float(ta[self.ix]), f(1.0)

@@ -150,7 +150,7 @@ def motion_along(mech: Mechanism, Q: np.ndarray, V: np.ndarray, A: np.ndarray, p
                        "velocity": tw[:, i, :3] + np.cross(w, r),
                        "acceleration": ac[:, i, :3] + np.cross(al, r) + np.cross(w, np.cross(w, r))}
 
-    def dot(x, y):
+    def dot(x: np.ndarray, y: np.ndarray):
         return np.einsum("ij,ij->i", x, y)
 
     loops, loop_rates, loop_accs = {}, {}, {}
@@ -195,7 +195,7 @@ def sweep_motion(mech: Mechanism, res, points: tuple=()) -> MotionAlong:
 
 
 
-def _frame_motions(model: pin.Model, data, frames: list, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> tuple:
+def _frame_motions(model: pin.Model, data: pin.Data, frames: list, Q: np.ndarray, V: np.ndarray, A: np.ndarray) -> tuple:
     """Placements (R (N, F, 3, 3), t (N, F, 3)), velocities (v, w) and classical accelerations
     (a, alpha) of the frames' origins in world axes (N, F, 6) -- what pin.getFrameVelocity and
     pin.getFrameClassicalAcceleration give in LOCAL_WORLD_ALIGNED -- from one forwardKinematics a
@@ -277,7 +277,7 @@ def _stroke_end(solver, res, name: str, coordinate: Coordinate, x: np.ndarray, g
     k = int(np.clip(np.searchsorted(x, guess[0]) - 1, 0, len(x) - 2))
     mech, q0, cache = solver.mech, res.q[k], {}
 
-    def at(v) -> float:
+    def at(v: float) -> float:
         a = solver.track({res.input: v}, q0)
         qd = solver.rates(a.q, mech.closure.jacobian(a.q), {res.input: 1.0})
         if coordinate is not None:

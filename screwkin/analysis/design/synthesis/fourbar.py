@@ -46,7 +46,7 @@ def pose_matrix(pose: tuple) -> tuple:
     return rotate(pose[2]), np.array(pose[:2], float)
 
 
-def branch(A, B, B0: np.ndarray | tuple):
+def branch(A: np.ndarray, B: np.ndarray, B0: np.ndarray | tuple):
     """sigma: +1 when B lies left of the line A -> B0, -1 right (arrays broadcast)."""
     A, B, B0 = (np.asarray(v, float) for v in (A, B, B0))
     return np.sign(cross2(B0 - A, B - A))
@@ -82,7 +82,7 @@ def positions(fb: FourBar, theta: float, sigma: float) -> dict:
     return {"A": A, "B": B, "x": x, "y": y, "angle": phi + gamma, "h2": h2, "mu": transmission_angle(A, B, fb.B0)}
 
 
-def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
+def travel_analysis(fb: FourBar, thetas: np.ndarray, sigmas: np.ndarray, steps: int = 720, span=None):
     """Closed-form counterpart of the check (screwkin.analysis.design.synthesis.check): from the
     first position (crank angle thetas[0], branch sigmas[0]) the crank turns one way; the
     positions k are reached at travel (sign * (theta_k - theta_0)) mod 2 pi when the branch
@@ -96,7 +96,7 @@ def travel_analysis(fb: FourBar, thetas, sigmas, steps: int = 720, span=None):
     sigmas = np.asarray(sigmas, float)
     s1 = sigmas[0]
 
-    def along(direction, reach) -> tuple:
+    def along(direction: float, reach: float) -> tuple:
         t = np.linspace(0.0, reach, max(int(steps * reach / TWO_PI), 2) + 1)
         pos = positions(fb, thetas[0] + direction * t, s1)
         bad = np.nonzero(pos["h2"] < 0)[0]

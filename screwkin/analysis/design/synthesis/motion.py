@@ -105,7 +105,7 @@ def poles(poses: list) -> list:
     return out
 
 
-def _base_pole(poses) -> np.ndarray:
+def _base_pole(poses: list) -> np.ndarray:
     """A pole P_1k (on the centre-point curve of these positions: its row vanishes), the one
     of the largest turn."""
     best = None
@@ -122,7 +122,7 @@ def _base_pole(poses) -> np.ndarray:
     return np.linalg.solve(np.eye(2) - R, pk - R @ p1)
 
 
-def centre_point_curve(poses, directions: int = 360, bound: float | None = None) -> tuple:
+def centre_point_curve(poses: list, directions: int = 360, bound: float | None = None) -> tuple:
     """Points of the centre-point curve of four poses and their circle points (world, first
     position): (centre points (m, 2), circle points (m, 2), local moving pivots (m, 2),
     direction index (m,)), ordered by the direction of the line through the base pole and,
@@ -155,7 +155,7 @@ def centre_point_curve(poses, directions: int = 360, bound: float | None = None)
     return C[keep], circle[keep], local[keep], np.array(out_idx, int)[keep]
 
 
-def _circle_points(poses, C) -> tuple:
+def _circle_points(poses: list, C: np.ndarray) -> tuple:
     """Moving pivots (local, and world at the first position) of the dyads with fixed pivots C
     (least squares of the linear equations; exact on the curve)."""
     if len(C) == 0:
@@ -184,7 +184,7 @@ def dyad_candidates(poses: list, count: int = 24, bound: float | None = None) ->
     return tuple(out)
 
 
-def _D(poses4, X: np.ndarray):
+def _D(poses4: list, X: np.ndarray):
     return np.linalg.det(_burmester_rows(poses4, X))
 
 
