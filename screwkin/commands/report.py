@@ -111,7 +111,7 @@ def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], sca
     sp.add_argument("--no-view", action="store_true", help="leave the 3D view (headless Chromium) out")
 
 
-def _writable(path: str | None, option: str):
+def _writable(path: str | None, option: str) -> None:
     if not path:
         raise UsageError(f"{option} needs a file name")
     check_writable(path, option)

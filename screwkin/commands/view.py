@@ -85,7 +85,7 @@ class _Stop:
         self.interrupting = True
         self.wake = None
 
-    def _handle(self, signum, frame):
+    def _handle(self, signum, frame) -> None:
         if self.signum is None:
             self.signum = signum
             if self.interrupting:

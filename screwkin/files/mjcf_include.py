@@ -69,7 +69,7 @@ def expand_includes(root, path, read: list | None = None) -> int:
         expand(sub, chain + (real,), depth)  # its root's children take the place of the <include>
         return list(sub)
 
-    def expand(elem, chain, depth):  # depth: elem's, in the whole model (the main file's root: 1)
+    def expand(elem, chain, depth) -> None:  # depth: elem's, in the whole model (the main file's root: 1)
         k = 0
         while k < len(elem):
             child = elem[k]

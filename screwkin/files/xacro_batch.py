@@ -135,7 +135,7 @@ class Batch:
     def __neg__(self) -> Batch:
         return Batch(-self.v, self.bad, self.ctx)
 
-    def __pos__(self):
+    def __pos__(self) -> Batch:
         return self
 
     def __bool__(self) -> bool:

@@ -359,7 +359,7 @@ class Mechanism:
         return self._length if self._length is not None else self._rule_length
 
     @length.setter
-    def length(self, value):
+    def length(self, value) -> None:
         if value is not None and not (np.isfinite(value) and value > 0):
             raise UsageError(f"{self.path}: the characteristic length must be a positive length, got {value!r}")
         self._length = None if value is None else float(value)

@@ -24,7 +24,7 @@ from ..tolerances import DEFAULT
 __all__ = ["rotation", "rotation_to", "two_rotations", "run_angles"]
 
 
-def rotation(w: np.ndarray, t: float):
+def rotation(w: np.ndarray, t: float) -> np.ndarray:
     """R(w, t) (w a unit vector)."""
     return pin.exp3(np.asarray(w, float) * float(t))
 
@@ -110,7 +110,7 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _perpendicular(w: np.ndarray):
+def _perpendicular(w: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to w."""
     e = np.eye(3)[int(np.argmin(np.abs(w)))]
     v = _cross(w, e)

@@ -86,7 +86,7 @@ def number_colours(n: int) -> dict:
     return {k: cycle[(k - 2) % len(cycle)] for k in range(2, n + 2)}
 
 
-def _direction_2d(v: Sequence[float] | np.ndarray):
+def _direction_2d(v: Sequence[float] | np.ndarray) -> np.ndarray:
     v = np.asarray(v, float)
     n = np.linalg.norm(v)
     return v / n if n > 1e-300 else np.array([1.0, 0.0])
@@ -355,7 +355,7 @@ def draw_mechanism(skel: Skeleton, title: str | None = None, angles: bool = Fals
     return fig
 
 
-def _block_direction(skel: Skeleton, lk: SkeletonLink):
+def _block_direction(skel: Skeleton, lk: SkeletonLink) -> np.ndarray:
     for j in skel.joints:
         if lk.number in j.links and j.type in ("prismatic", "cylindrical") and j.direction is not None:
             return _direction_2d(j.direction)
@@ -529,7 +529,7 @@ def _crossings(pos: dict, edges: Iterable[tuple]) -> bool:
     """Whether two edges without a common node cross in the layout."""
     edges = list(edges)
 
-    def ccw(a: np.ndarray, b: np.ndarray, c: np.ndarray):
+    def ccw(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
         return (c[1] - a[1]) * (b[0] - a[0]) - (b[1] - a[1]) * (c[0] - a[0])
 
     for i, (a, b) in enumerate(edges):
@@ -542,7 +542,7 @@ def _crossings(pos: dict, edges: Iterable[tuple]) -> bool:
     return False
 
 
-def save_figure(fig: Figure, path: str, close: bool = True):
+def save_figure(fig: Figure, path: str, close: bool = True) -> None:
     """Write a Figure to ``path`` (PNG or SVG by its suffix; present/outfile.write_figure) and close it
     (unless ``close`` is False: the same figure written to another file next)."""
     plt = _plt()

@@ -545,7 +545,7 @@ def chromium() -> str | None:
     return None
 
 
-def screenshot(html_path: str | Path, png_path: str | Path, size: tuple[int, int]=PICTURE, budget_ms: int=8000):
+def screenshot(html_path: str | Path, png_path: str | Path, size: tuple[int, int]=PICTURE, budget_ms: int=8000) -> None:
     """Render a static meshcat page with headless Chromium (software WebGL) into a PNG."""
     exe = chromium()
     if exe is None:

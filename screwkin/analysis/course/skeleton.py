@@ -268,13 +268,13 @@ def _joint_ends(state: KinematicState, j) -> tuple:
     return p, p, axis
 
 
-def _hull(points: list):
+def _hull(points: list) -> list:
     """Convex hull corners of 2-D points, counterclockwise (monotone chain)."""
     pts = sorted(set(points))
     if len(pts) <= 2:
         return pts
 
-    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]):
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
     lower, upper = [], []
@@ -403,7 +403,7 @@ def skeleton(mech: Mechanism, q: np.ndarray, inputs: list[str] | None=None, basi
                     tuple(joints), tuple(profiles), {k: values[k] for k in inputs}, units, size, angles, origins)
 
 
-def _area(hull: list):
+def _area(hull: list) -> float:
     x = np.array([p[0] for p in hull])
     y = np.array([p[1] for p in hull])
     return 0.5 * abs(float(x @ np.roll(y, -1) - y @ np.roll(x, -1)))

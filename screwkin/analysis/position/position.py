@@ -235,7 +235,7 @@ class PositionSolver:
         return starts
 
     # --------------------------------------------------------------- solving
-    def _check_inputs(self, values: dict, every: bool = True):
+    def _check_inputs(self, values: dict, every: bool = True) -> None:
         unknown = [n for n in values if n not in self.inputs]
         missing = [n for n in self.inputs if n not in values] if every else []
         if unknown or missing:

@@ -266,7 +266,7 @@ class SerialJacobians:
                 run(start)
         return out
 
-    def _check(self, rng: np.random.Generator, count: int):
+    def _check(self, rng: np.random.Generator, count: int) -> None:
         model = self.model
         data = self.mech.scratch_data()
         lo = np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi)
