@@ -26,6 +26,9 @@ if TYPE_CHECKING:  # the return types of the methods below, imported lazily at r
     from .analysis.mobility import MobilityResult
     from collections.abc import Callable
     from pathlib import Path
+    from screwkin.present.progress import Progress
+    from collections.abc import Sequence
+    from screwkin.files.study import StudySpec
 
 #: The rest of the public API, imported when first used (``screwkin.sweep``, ``from screwkin import
 #: scan``): ``import screwkin`` (and the command line, which imports it) loads the model layer
@@ -105,7 +108,7 @@ class Mechanism(_mechanism.Mechanism):
     """A mechanism (screwkin.model.mechanism.Mechanism) with the analysis asked most often
     as a method: ``mech.mobility()``."""
 
-    def mobility(self, actuated=None, output: str | None=None, seed: int = 0, point: bool = False) -> MobilityResult:
+    def mobility(self, actuated: list[str] | None=None, output: str | None=None, seed: int = 0, point: bool = False) -> MobilityResult:
         """Mobility analysis (screwkin.analysis.mobility.analyze_mobility); actuated: actuated
         joint names overriding the file's; point: the output link's origin as a point."""
         if actuated is not None:
@@ -114,7 +117,7 @@ class Mechanism(_mechanism.Mechanism):
 
 
 def load(path: str | Path, yaml=None, actuated: list | None=None, tolerances: Tolerances = _loader.DEFAULT, warn: Callable | None=None,
-         package_dirs=None, args: dict | None=None):
+         package_dirs: Sequence[str] | None=None, args: dict | None=None):
     """Read a mechanism file (URDF with <loop_joint> or a YAML sidecar, SDF, or a xacro file
     with its arguments ``args``, e.g. ``{"crank": "30mm"}``) into a :class:`Mechanism`; see
     screwkin.model.loader.load for the arguments."""
@@ -122,7 +125,7 @@ def load(path: str | Path, yaml=None, actuated: list | None=None, tolerances: To
                         package_dirs=package_dirs, cls=Mechanism, args=args)
 
 
-def study(spec, scheduler=None, workers=None, progress=None, timeout: float = 10.0, base=None) -> StudyResult:
+def study(spec: StudySpec | dict, scheduler: str | None=None, workers: int | None=None, progress: Progress | None=None, timeout: float = 10.0, base: str | Path | None=None) -> StudyResult:
     """Run a design-space study (what ``screwkin study`` runs): ``spec`` a spec file's path or
     a dict as the YAML (its ``file`` relative to ``base``); on a LocalCluster of ``workers``
     processes, or on the dask.distributed cluster at ``scheduler`` (``tcp://host:port``);

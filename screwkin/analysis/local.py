@@ -57,6 +57,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.loop_series import LoopSystem
     from screwkin.tolerances import Tolerances
+    from collections.abc import Callable
 
 __all__ = ["Branch", "LocalAnalysis", "local_analysis", "KINDS", "quadratic_forms", "rates_of"]
 
@@ -172,7 +173,7 @@ def _orth(M: np.ndarray, tol: float) -> np.ndarray:
     return U[:, s > tol * max(s[0], 1.0)] if s.size else M[:, :0]
 
 
-def _one_form(Q: np.ndarray, zero) -> list:
+def _one_form(Q: np.ndarray, zero: float) -> list:
     """The zero set of one quadratic form y^T Q y on R^d, as candidates."""
     lam, V = np.linalg.eigh(Q)
     pos, neg = V[:, lam > zero], V[:, lam < -zero]
@@ -203,7 +204,7 @@ def _one_form(Q: np.ndarray, zero) -> list:
     return [_Candidate(T, samples, False, True)]
 
 
-def _sampled_zeros(F: np.ndarray, zero, starts: int, tol: Tolerances, seed: int=0) -> list:
+def _sampled_zeros(F: np.ndarray, zero: float, starts: int, tol: Tolerances, seed: int=0) -> list:
     """Common zeros of the forms F (c, d, d) on the unit sphere, refined by Gauss-Newton from
     ``starts`` directions, as candidates grouped by their tangent spaces."""
     c, d, _ = F.shape
@@ -241,7 +242,7 @@ def _sampled_zeros(F: np.ndarray, zero, starts: int, tol: Tolerances, seed: int=
     return groups
 
 
-def _cone(F: np.ndarray, zero, starts: int, tol) -> list:
+def _cone(F: np.ndarray, zero: float, starts: int, tol) -> list:
     """Candidates: the real zeros of the forms F (c2, d, d) (none identically zero)."""
     c, d, _ = F.shape
     if d == 1:
@@ -325,7 +326,7 @@ def _confirm(mech: Mechanism, q0: np.ndarray, system: LoopSystem, X: np.ndarray,
     return q, deviation, norm
 
 
-def local_analysis(mech: Mechanism, q: np.ndarray, inputs=None, generic_rank: int | None=None, progress=None) -> LocalAnalysis:
+def local_analysis(mech: Mechanism, q: np.ndarray, inputs: list[str] | None=None, generic_rank: int | None=None, progress: Callable[[int, int], object] | None=None) -> LocalAnalysis:
     """The local analysis of ``mech`` at the assembled configuration q (see the module docstring);
     inputs: the joints held for ``inputs_held`` (default the actuated ones); generic_rank: the rank of
     K at generic configurations (default: the largest over mech.generic_configurations()); progress: a

@@ -106,7 +106,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _loci(mech: Mechanism, args: argparse.Namespace, inputs, xn, xs: np.ndarray, yn, ys: np.ndarray, fixed, output, point) -> tuple:
+def _loci(mech: Mechanism, args: argparse.Namespace, inputs: list[str], xn: str, xs: np.ndarray, yn: str, ys: np.ndarray, fixed: dict, output: str | None, point: bool) -> tuple:
     """(Loci, Regions or None, (cusp loops, tried) or None) of map --loci: every input other than --x and
     --y held by --set."""
     held = [n for n in inputs if n not in (xn, yn)]

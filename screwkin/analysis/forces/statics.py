@@ -205,7 +205,7 @@ def reaction_table(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list,
     return {name: (kind, wrench, free[name] > mech.tolerances.indeterminate * size) for name, (kind, wrench) in base.items()}
 
 
-def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity=False, v: np.ndarray | None = None, a: np.ndarray | None = None, rows: tuple | None = None) -> dict:
+def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list | tuple=(), gravity: bool=False, v: np.ndarray | None = None, a: np.ndarray | None = None, rows: tuple | None = None) -> dict:
     """joint name -> (kind, wrench at its origin in world axes) for constraint forces lam, the
     ``loads`` ((frame id, wrench (force, moment) at the frame's origin, world axes) each), the
     links' weights with ``gravity`` (True: model.gravity; or a vector (gx, gy, gz)) and, with v and a, the motion's inertial
@@ -219,7 +219,7 @@ def joint_wrenches(mech: Mechanism, q: np.ndarray, lam: np.ndarray, loads: list 
 
     placed = {}  # frame -> (its body's joint, that joint's placement, the frame's origin): read once
 
-    def apply(frame, wrench_at_origin) -> None:
+    def apply(frame: int, wrench_at_origin: np.ndarray) -> None:
         """Add a wrench (force, moment about the frame's origin, world axes) to the frame's body."""
         if frame not in placed:
             joint = frame_parent(mech, frame)[0]
@@ -367,7 +367,7 @@ def wrench_screw(wrench: np.ndarray, point: np.ndarray) -> Screw:
     return screw_of(np.r_[m0, f])
 
 
-def legs(mech: Mechanism, q: np.ndarray, output: str, inputs=None) -> tuple:
+def legs(mech: Mechanism, q: np.ndarray, output: str, inputs: list[str] | None=None) -> tuple:
     """The legs between the ground and the ``output`` link (see Leg), at the assembled q.
 
     A leg is the set of tree joints on the branches that reach the platform -- the platform's
@@ -384,10 +384,10 @@ def legs(mech: Mechanism, q: np.ndarray, output: str, inputs=None) -> tuple:
     o = state.frame_placement(fid).translation
     coords = {c.joint_id: c for c in mech.coordinates}
 
-    def support(joint) -> list:
+    def support(joint: int) -> list:
         return [j for j in model.supports[joint] if j in coords]
 
-    def at_platform(frame):  # frame Jacobian as the twist of the frame's body at the platform origin
+    def at_platform(frame: int):  # frame Jacobian as the twist of the frame's body at the platform origin
         J = state.frame_jacobian(frame, LWA)
         J[:3] += np.cross(J[3:].T, o - state.frame_placement(frame).translation).T  # v_o = v_p + w x (o - p)
         return J

@@ -117,7 +117,7 @@ def identify(mech: Mechanism, topo: Topology, q: np.ndarray, input_joint: str) -
     n = np.asarray(inp.direction) / np.linalg.norm(inp.direction)
     e1, e2 = perpendicular_basis(n)  # (e1, e2, n) right-handed: positive joint rotation is counterclockwise
 
-    def p2(v) -> np.ndarray:
+    def p2(v: np.ndarray) -> np.ndarray:
         v = np.asarray(v)
         return np.array([v @ e1, v @ e2])
 
@@ -197,7 +197,7 @@ def _transmission(kind: str, P: np.ndarray, n: np.ndarray, slide: np.ndarray | N
     return slide_transmission_angle(B, C, np.cross(n, slide))
 
 
-def _four_bar(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, a, b, tol: Tolerances) -> LinkageInfo:
+def _four_bar(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, a: float, b: float, tol: Tolerances) -> LinkageInfo:
     g, c = np.linalg.norm(D - A), np.linalg.norm(D - C)
     lengths = {"ground": g, "input": a, "coupler": b, "output": c}
     cls = FOUR_BAR_CLASSES[int(four_bar_classes(g, a, b, c, tol.equal))]
@@ -234,7 +234,7 @@ def _four_bar(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray,
                        input_value=float(q_in), input_angle=float(phi_now))
 
 
-def _slider_crank(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, s: np.ndarray, a, b) -> LinkageInfo:
+def _slider_crank(name: str, q_in: np.ndarray | float, A: np.ndarray, B: np.ndarray, C: np.ndarray, s: np.ndarray, a: float, b: float) -> LinkageInfo:
     nrm = np.array([-s[1], s[0]])
     e = float((C - A) @ nrm)  # offset of the slide line from the crank pivot
     lengths = {"crank": a, "rod": b, "offset": abs(e)}

@@ -87,7 +87,7 @@ class Interactive:
     mode: the starting assembly mode (1-based, as solve lists them: analysis.position.modes.choose_mode);
     output: the output link whose pose is read out; points: analysis.motion.links.Point objects read out."""
 
-    def __init__(self, mech: Mechanism, inputs=None, values: dict | None = None, mode: int = 1, output: str | None = None,
+    def __init__(self, mech: Mechanism, inputs: list[str] | None=None, values: dict | None = None, mode: int = 1, output: str | None = None,
                  points=()) -> None:
         self.mech = mech
         self.solver = PositionSolver(mech, list(inputs) if inputs else None, output=output)
@@ -127,7 +127,7 @@ class Interactive:
         self._record(self.state.inputs, self.state.points)
 
     # ------------------------------------------------------------------ traced paths
-    def _record(self, inputs, points) -> None:
+    def _record(self, inputs: dict, points: dict) -> None:
         if self.points:
             self._trace.append((dict(inputs), {n: np.array(p, float) for n, p in points.items()}))
 
@@ -148,7 +148,7 @@ class Interactive:
                 for n, p in point_motions(KinematicState(self.mech, q), self.points).items()}
 
     # ------------------------------------------------------------------ controls
-    def _control(self, name: str, start) -> Control:
+    def _control(self, name: str, start: float) -> Control:
         mech = self.mech
         c = mech.coordinate(name)
         linear = bool(mech.translational[c.idx_v])
@@ -182,7 +182,7 @@ class Interactive:
         return k + 1 if k >= 0 and d[k] <= self.mech.tolerances.geometry * self.mech.length * math.sqrt(max(len(c), 1)) else 0
 
     # ------------------------------------------------------------------ state
-    def _state(self, q: np.ndarray, mode=None) -> LiveState:
+    def _state(self, q: np.ndarray, mode: int | None=None) -> LiveState:
         mech = self.mech
         modes = self.modes()
         g = self.solver.generic()
