@@ -3,4 +3,3 @@ has ``NAME``, ``NEEDS_MECHANISM`` (whether FILE is a mechanism the CLI loads fir
 ``add_parser(sub, common, scaled)`` (its subparser; ``common(sp)`` adds the options every
 command takes, ``scaled(sp)`` --length and --point) and ``run(mech, args) -> int``.
 They sit with cli.py, above every other layer, and print what present/ formats."""
-from __future__ import annotations
