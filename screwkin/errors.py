@@ -13,6 +13,9 @@ break the one-line contract.
 from __future__ import annotations
 
 import reprlib
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from pathlib import Path
 
 __all__ = [
     "ScrewkinError",
@@ -148,7 +151,7 @@ class OutputError(ScrewkinError):
     became of a partial file (``partial``: "removed", or None when nothing was left).  Exit 1:
     the command line was right, the place it named could not take the file."""
 
-    def __init__(self, path, reason: str, partial: str | None = None) -> None:
+    def __init__(self, path: str | Path, reason: str, partial: str | None = None) -> None:
         self.path, self.reason, self.partial = str(path), str(reason), partial
         tail = f" (the partial file was {partial})" if partial else ""
         super().__init__(f"cannot write {quote(self.path, 200)}: {reason}{tail}")

@@ -238,7 +238,7 @@ def planar_form(xi: np.ndarray, normal: list | tuple) -> np.ndarray:
     return np.array([xi[:3] @ e1, xi[:3] @ e2, xi[3:] @ n])
 
 
-def split_jacobians(mech: Mechanism, q: np.ndarray, output: str, inputs=None) -> dict:
+def split_jacobians(mech: Mechanism, q: np.ndarray, output: str, inputs: list[str] | None=None) -> dict:
     """Constraint Jacobian split into input and passive columns, and the forward
     (output twist from input rates) and inverse (input rates from output twist)
     Jacobians at q.  Output twists are (v, w) of the output frame origin in

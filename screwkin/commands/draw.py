@@ -110,7 +110,7 @@ def _targets(mech: Mechanism, args: argparse.Namespace) -> list:
     return out
 
 
-def _suffixed(path, k: int) -> str:
+def _suffixed(path: str, k: int) -> str:
     stem, ext = os.path.splitext(path)
     return f"{stem}-singular-{k}{ext}"
 

@@ -183,7 +183,7 @@ def _contact(c: dict, k: int, planar: bool, problems: Problems) -> Contact | Non
     return Contact(point, normal, model, mu, mu_t)
 
 
-def parse_grasp(content, path="<grasp>") -> GraspSpec:
+def parse_grasp(content, path: str="<grasp>") -> GraspSpec:
     """A GraspSpec from the plain data of a grasp file (what the YAML loads to), every
     problem collected and raised at once as a MechanismFileError naming ``path``."""
     if content is None:

@@ -131,7 +131,7 @@ def find_mesh(uri: str, base: Path, package_dirs=(), roots=None):
     return locate_mesh(uri, base, package_dirs, roots)[0]
 
 
-def check_meshes(path, root, package_dirs=(), found_list: list | None = None) -> list:
+def check_meshes(path: str | Path, root, package_dirs=(), found_list: list | None = None) -> list:
     """Warnings for mesh files that cannot be found (missing meshes do not fail a load); ``found_list``
     (a list), when given, gets the path of each mesh file found."""
     meshes = list(root.iter("mesh"))

@@ -20,11 +20,14 @@ from ..errors import MechanismFileError, quote, shorten
 from .description import LIMITS
 from .xacro import MAX_INCLUDES
 from .xmlsafe import MAX_DEPTH, inside_folder, parse_xml_text, read_regular_file
+from typing import TYPE_CHECKING
+if TYPE_CHECKING:
+    from xml.etree.ElementTree import Element
 
 __all__ = ["expand_includes"]
 
 
-def expand_includes(root, path, read: list | None = None) -> int:
+def expand_includes(root: Element, path: str | Path, read: list | None = None) -> int:
     """Replace every ``<include>`` under ``root`` (the main file's ``<mujoco>``, read from ``path``)
     by the included file's content, in place.  Returns the number of files included; ``read`` (a list),
     when given, gets the path of each file included."""

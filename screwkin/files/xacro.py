@@ -247,7 +247,7 @@ def _prepare(path: Path, text: str, root=None) -> _State:
     return state
 
 
-def declared_args(path, text: str | None = None) -> dict:
+def declared_args(path: str | Path, text: str | None = None) -> dict:
     """The arguments a xacro file declares (``xacro:arg``, its literal includes' too):
     {name: default text, or None when it has none}.  The file is checked as for :func:`expand`."""
     if text is None:

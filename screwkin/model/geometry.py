@@ -21,7 +21,7 @@ TINY = 1e-300  # division guard
 AXIS_IN_PLANE = 1e-6
 
 
-def perpendicular_basis(a) -> tuple:
+def perpendicular_basis(a: np.ndarray) -> tuple:
     """Two unit vectors (b1, b2) completing the unit vector ``a`` to a right-handed basis
     (b1, b2, a): b1 = a x h / |a x h| with h the world x axis (y when a is near x), b2 = a x b1.
 
@@ -80,7 +80,7 @@ def circle_circle(p: np.ndarray | list, r: float, c: np.ndarray | list | tuple, 
     return p + along[..., None] * u + (side * h)[..., None] * n, h2
 
 
-def circle_intersections(p: np.ndarray | list, r: float, c: np.ndarray | list, s, slack: float = 0.0, concentric: float = 0.0) -> list:
+def circle_intersections(p: np.ndarray | list, r: float, c: np.ndarray | list, s: float, slack: float = 0.0, concentric: float = 0.0) -> list:
     """The points where the circles (p, r) and (c, s) in the plane meet: [left of p -> c,
     right], the same point twice where they touch, [] where they do not meet (the centres
     closer than ``concentric``, or farther than r + s + slack, or nearer than |r - s| - slack).
@@ -275,7 +275,7 @@ def stack_mv(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     return A[:, 0] * v[0] + A[:, 1] * v[1] + A[:, 2] * v[2]
 
 
-def stack_cross(a, b) -> np.ndarray:
+def stack_cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """a x b over the leading axis (3, ...)."""
     return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 

@@ -85,7 +85,7 @@ def remove_partial(path: str) -> str | None:
         return "left"
 
 
-def output_failed(path, exc: BaseException, partial=None) -> OutputError:
+def output_failed(path: str, exc: BaseException, partial=None) -> OutputError:
     """The error of a write to ``path`` that failed with ``exc``: the file being written (``partial``,
     default ``path``) removed, which the message says."""
     return OutputError(path, os_reason(exc), remove_partial(str(partial or path)))

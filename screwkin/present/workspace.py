@@ -105,7 +105,7 @@ def _value_text(x) -> str:
     return "-" if x is None else f"{x:.4g}"
 
 
-def workspace_csv(r: WorkspaceResult, path, joint_columns: list | None = None) -> None:
+def workspace_csv(r: WorkspaceResult, path: str, joint_columns: list | None = None) -> None:
     """One row per reached point (cell): world position, grid index, measures, free; with
     ``joint_columns`` ((name, q index) pairs) the joint values of the grid's solutions."""
     joint_columns = list(joint_columns or []) if r.configurations is not None else []

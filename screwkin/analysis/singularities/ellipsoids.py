@@ -83,7 +83,7 @@ def _of_scaled(M: np.ndarray, L: float, inputs: list | tuple, tol: Tolerances, l
                       int(keep.sum()), output, point)
 
 
-def ellipsoids_of(J: np.ndarray, length: float = 1.0, linear: int = 3, sliding=None, inputs=None,
+def ellipsoids_of(J: np.ndarray, length: float = 1.0, linear: int = 3, sliding=None, inputs: list[str] | None=None,
                   tol: Tolerances = DEFAULT) -> Ellipsoids:
     """The ellipsoids of a Jacobian J (d x n) from input rates [rad/s, m/s] to an output twist
     whose first ``linear`` rows are linear velocities [m/s] (6 rows (v, w); 3 for a point:

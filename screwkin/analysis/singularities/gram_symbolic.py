@@ -59,7 +59,7 @@ def _loop_rank(mech: Mechanism, S, here: dict) -> int:
     return rank(M, mech.tolerances)
 
 
-def symbolic_gram(mech: Mechanism, q: np.ndarray, inputs=None) -> tuple:
+def symbolic_gram(mech: Mechanism, q: np.ndarray, inputs: list[str] | None=None) -> tuple:
     """A SymbolicGramLoop for each independent loop of a planar mechanism of revolute and
     prismatic joints, rolling and gear pairs (the loops of screwkin equations), at the assembled
     configuration q."""

@@ -44,6 +44,7 @@ from .fourbar import positions
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.design.synthesis.designs import Target
+    from pathlib import Path
 
 if TYPE_CHECKING:
     from ...motion.sweep import SweepResult
@@ -332,7 +333,7 @@ def _follow(design: Design, solver: PositionSolver, probe: _Probe, configs: list
     return direction, travel, mus, defects
 
 
-def check_chain_file(path, chain: int, ground: int, dof: int) -> ChainFile:
+def check_chain_file(path: str | Path, chain: int, ground: int, dof: int) -> ChainFile:
     """A written chain: it must load, be drawn closed, and have screwkin's mobility ``dof``."""
     try:
         mech = load(path, warn=lambda _m: None)
