@@ -7,7 +7,7 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[2] / "screwkin"
 GOAL = 0.90
-FLOOR = {"parameters": 0.90, "returns": 0.90}  # measured 0.907 and 0.903 (issue 42, the annotation round)
+FLOOR = {"parameters": 0.90, "returns": 0.90}  # measured 0.910 and 0.903 (issue 42, the annotation round)
 
 
 def annotation_counts(root: Path = PACKAGE) -> dict:
