@@ -237,16 +237,24 @@ def test_the_page_loads_offline_in_chromium_with_a_control_per_input(tmp_path):
     mech = screwkin.load(ROBOTS / "five_bar.urdf")
     live = Interactive(mech, output="tip")
     view = InteractiveView(mech, live, build_scene(mech, live.state.q), port=free_port())
+    names = ("motor1", "motor2", "assembly mode", "relative sigma_min", "tip")
+    dom = ""
     try:
-        p = subprocess.run([chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-                            "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
-                            "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
-                            f"--user-data-dir={tmp_path}", "--virtual-time-budget=15000", "--dump-dom", view.url],
-                           capture_output=True, text=True, timeout=120)
+        # The controls come over the page's websocket from the server's thread; on a loaded machine one
+        # dump can be taken before they arrive (seen once in a full run, 1 of 3,145), so a page that has
+        # not yet built them is loaded again, three times at most -- what it must show is unchanged.
+        for attempt in range(3):
+            p = subprocess.run([chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+                                "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
+                                "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
+                                f"--user-data-dir={tmp_path / str(attempt)}", "--virtual-time-budget=15000",
+                                "--dump-dom", view.url], capture_output=True, text=True, timeout=120)
+            dom = p.stdout
+            if all(name in dom for name in names):
+                break
     finally:
         view.close()
-    dom = p.stdout
-    for name in ("motor1", "motor2", "assembly mode", "relative sigma_min", "tip"):
+    for name in names:
         assert name in dom, name
 
 
