@@ -1,4 +1,7 @@
 import contextlib
+import urllib.request
+import time
+import json
 import importlib.util
 import os
 import re
@@ -317,3 +320,65 @@ def _robot_data():
 
 #: example-robot-data's robots folder, None when the package is not installed (test_couplings, test_published, ...).
 ROBOT_DATA = _robot_data()
+
+
+def _chromium_path():
+    from screwkin.present.view import chromium
+
+    return chromium()
+
+
+class DevTools:
+    """Headless Chromium and one page, over the DevTools protocol (the interactive view's Chromium tests and
+    the docs site's): ``call`` a method, ``evaluate`` an expression, ``open`` a page and wait for it."""
+
+    def __init__(self, profile, size=(1000, 700)):
+        from websockets.sync.client import connect
+
+        self.proc = subprocess.Popen(
+            [_chromium_path(), "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+             "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
+             "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1", f"--user-data-dir={profile}",
+             f"--window-size={size[0]},{size[1]}", "--remote-debugging-port=0",
+             "--allow-file-access-from-files", "about:blank"],
+            stderr=subprocess.PIPE, text=True)
+        port = None
+        deadline = time.monotonic() + 60
+        while port is None and time.monotonic() < deadline:
+            line = self.proc.stderr.readline()
+            m = re.search(r"DevTools listening on ws://127\.0\.0\.1:(\d+)/", line)
+            port = int(m.group(1)) if m else None
+        assert port, "Chromium did not open its DevTools port"
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
+            page = next(t for t in json.load(r) if t["type"] == "page")
+        self.ws = connect(page["webSocketDebuggerUrl"], max_size=None, open_timeout=20)
+        self.next_id = 0
+
+    def call(self, method, **params):
+        self.next_id += 1
+        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
+        while True:
+            msg = json.loads(self.ws.recv(timeout=60))
+            if msg.get("id") == self.next_id:
+                assert "error" not in msg, msg
+                return msg.get("result", {})
+
+    def evaluate(self, expression):
+        return self.call("Runtime.evaluate", expression=expression, returnByValue=True)["result"].get("value")
+
+    def open(self, url, timeout=60):
+        """Navigate to ``url`` and wait until it and its pictures have loaded."""
+        self.call("Page.navigate", url=url)
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.evaluate("document.readyState === 'complete' && location.href") == url:
+                return
+            time.sleep(0.2)
+        raise AssertionError(f"{url} did not load")
+
+    def close(self):
+        try:
+            self.ws.close()
+        finally:
+            self.proc.terminate()
+            self.proc.wait(timeout=30)

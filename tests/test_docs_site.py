@@ -19,11 +19,11 @@ import re
 import subprocess
 import sys
 import time
-import urllib.request
 from pathlib import Path
 
 import pytest
 
+from conftest import DevTools
 from screwkin.cli import COMMANDS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -75,59 +75,6 @@ def _chromium():
     return chromium()
 
 
-class DevTools:
-    """Headless Chromium and one page, over the DevTools protocol (as test_view_interactive_chromium.py)."""
-
-    def __init__(self, profile, size=(1200, 900)):
-        from websockets.sync.client import connect
-
-        self.proc = subprocess.Popen(
-            [_chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-             "--disable-background-networking", "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
-             f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}", "--remote-debugging-port=0",
-             "--allow-file-access-from-files", "about:blank"],
-            stderr=subprocess.PIPE, text=True)
-        port = None
-        deadline = time.monotonic() + 60
-        while port is None and time.monotonic() < deadline:
-            m = re.search(r"DevTools listening on ws://127\.0\.0\.1:(\d+)/", self.proc.stderr.readline())
-            port = int(m.group(1)) if m else None
-        assert port, "Chromium did not open its DevTools port"
-        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
-            page = next(t for t in json.load(r) if t["type"] == "page")
-        self.ws = connect(page["webSocketDebuggerUrl"], max_size=None, open_timeout=20)
-        self.next_id = 0
-
-    def call(self, method, **params):
-        self.next_id += 1
-        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
-        while True:
-            msg = json.loads(self.ws.recv(timeout=60))
-            if msg.get("id") == self.next_id:
-                assert "error" not in msg, msg
-                return msg.get("result", {})
-
-    def evaluate(self, expression):
-        return self.call("Runtime.evaluate", expression=expression, returnByValue=True)["result"].get("value")
-
-    def open(self, url, timeout=60):
-        """Navigate to ``url`` and wait until it and its pictures have loaded."""
-        self.call("Page.navigate", url=url)
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.evaluate("document.readyState === 'complete' && location.href") == url:
-                return
-            time.sleep(0.2)
-        raise AssertionError(f"{url} did not load")
-
-    def close(self):
-        try:
-            self.ws.close()
-        finally:
-            self.proc.terminate()
-            self.proc.wait(timeout=30)
-
-
 PICTURES = """JSON.stringify(Array.from(document.images).map(i => [i.getAttribute('src'), i.complete, i.naturalWidth,
     i.getBoundingClientRect().width]))"""
 
@@ -136,7 +83,7 @@ PICTURES = """JSON.stringify(Array.from(document.images).map(i => [i.getAttribut
 @pytest.mark.skipif(_chromium() is None, reason="Chromium is not installed (.ci/run installs it)")
 def test_the_site_as_a_person_sees_it_in_chromium(site, tmp_path):
     pytest.importorskip("websockets.sync.client")
-    browser = DevTools(tmp_path / "profile")
+    browser = DevTools(tmp_path / "profile", size=(1200, 900))
     try:
         browser.call("Page.enable")
         browser.open((site / "index.html").as_uri())

@@ -15,17 +15,15 @@ import base64
 import io
 import json
 import math
-import re
 import socket
 import subprocess
 import time
-import urllib.request
 
 import numpy as np
 import pytest
 
 import screwkin
-from conftest import readme_fourbar
+from conftest import DevTools, readme_fourbar
 from screwkin.analysis.position.interactive import Interactive
 from screwkin.present.view import chromium
 
@@ -50,50 +48,6 @@ RECTS = """(() => {
   out.size = [window.innerWidth, window.innerHeight, window.devicePixelRatio];
   return JSON.stringify(out);
 })()"""
-
-
-class DevTools:
-    """Headless Chromium and one page, over the DevTools protocol."""
-
-    def __init__(self, profile, size=(1000, 700)):
-        from websockets.sync.client import connect
-
-        self.proc = subprocess.Popen(
-            [chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-             "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
-             "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1", f"--user-data-dir={profile}",
-             f"--window-size={size[0]},{size[1]}", "--remote-debugging-port=0", "about:blank"],
-            stderr=subprocess.PIPE, text=True)
-        port = None
-        deadline = time.monotonic() + 60
-        while port is None and time.monotonic() < deadline:
-            line = self.proc.stderr.readline()
-            m = re.search(r"DevTools listening on ws://127\.0\.0\.1:(\d+)/", line)
-            port = int(m.group(1)) if m else None
-        assert port, "Chromium did not open its DevTools port"
-        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
-            page = next(t for t in json.load(r) if t["type"] == "page")
-        self.ws = connect(page["webSocketDebuggerUrl"], max_size=None, open_timeout=20)
-        self.next_id = 0
-
-    def call(self, method, **params):
-        self.next_id += 1
-        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
-        while True:
-            msg = json.loads(self.ws.recv(timeout=60))
-            if msg.get("id") == self.next_id:
-                assert "error" not in msg, msg
-                return msg.get("result", {})
-
-    def evaluate(self, expression):
-        return self.call("Runtime.evaluate", expression=expression, returnByValue=True)["result"].get("value")
-
-    def close(self):
-        try:
-            self.ws.close()
-        finally:
-            self.proc.terminate()
-            self.proc.wait(timeout=30)
 
 
 def _free_port() -> int:
