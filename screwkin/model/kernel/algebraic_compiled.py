@@ -19,6 +19,8 @@ from .compiled import cache_on_disk
 __all__ = ["kernel", "pack"]
 
 _KERNEL = None
+#: The compiled helpers, set by _build (module globals: numba resolves them when it compiles a caller).
+_MOTION = _AXES = _PLACE = _FRAMES = _VALUE = _DERIVATIVE = _ONE = None
 POS, VEC, DOTD, DOT, DIST = 0, 1, 2, 3, 4
 _KIND = {"": 0, "R": 1, "P": 2, "S": 3, "F": 4}
 
@@ -69,53 +71,59 @@ def kernel() -> Any:
 
 
 def _build() -> Any:
-    """Compile the kernel's functions (numba; loaded from the disk cache after the first time)."""
+    """Compile the kernel's functions (numba; loaded from the disk cache after the first time).  Each is
+    a module-level function that calls the others through module globals set here, so that numba's
+    cache finds it again in the next process (a closure over dispatchers would be compiled anew in
+    every process, and its cache would grow by an entry each time)."""
     import numba as nb
 
+    global _MOTION, _AXES, _PLACE, _FRAMES, _VALUE, _DERIVATIVE, _ONE
     jit = nb.njit(cache=cache_on_disk())
-    motion = jit(_joint_motion)
-    axes = jit(_joint_axes)
-    place = _place_joints(jit, motion, axes)
-    frames = jit(_place_frames)
-    value = jit(_row_value)
-    derivative = jit(_row_jacobian)
+    _MOTION = jit(_joint_motion)
+    _AXES = jit(_joint_axes)
+    _PLACE = jit(_place_joints)
+    _FRAMES = jit(_place_frames)
+    _VALUE = jit(_row_value)
+    _DERIVATIVE = jit(_row_jacobian)
+    _ONE = jit(_one)
+    return jit(_every_point)
 
-    @jit
-    def one(x: np.ndarray, Rc: np.ndarray, tc: np.ndarray, r2: np.ndarray, parent: np.ndarray, kind: np.ndarray,
-            passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
-            fj: np.ndarray, fR: np.ndarray, ft: np.ndarray, above: np.ndarray, rk: np.ndarray, ra: np.ndarray,
-            rb: np.ndarray, rc: np.ndarray, ru: np.ndarray, rw: np.ndarray, nt: int, jacobian: bool, r: np.ndarray,
-            J: np.ndarray) -> None:
-        oR, op, wv, ov, ev = place(x, Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, nt, jacobian)
-        fp, fRw = frames(oR, op, fj, fR, ft)
-        ua = np.zeros(3, np.complex128)
-        ub = np.zeros(3, np.complex128)
-        d = np.zeros(3, np.complex128)
-        for i in range(rk.shape[0]):
-            fa, fb = ra[i], rb[i]
-            for a in range(3):
-                ua[a] = fRw[fa, a, 0] * ru[i, 0] + fRw[fa, a, 1] * ru[i, 1] + fRw[fa, a, 2] * ru[i, 2]
-                ub[a] = fRw[fb, a, 0] * rw[i, 0] + fRw[fb, a, 1] * rw[i, 1] + fRw[fb, a, 2] * rw[i, 2]
-                d[a] = fp[fb, a] - fp[fa, a]
-            r[i] = value(rk[i], rc[i], ua, ub, d, r2)
-            if jacobian:
-                derivative(i, rk[i], rc[i], fa, fb, fp, ua, ub, d, wv, ov, ev, above, nt, J)
 
-    @jit
-    def rows(X: np.ndarray, Rc: np.ndarray, tc: np.ndarray, r2: np.ndarray, parent: np.ndarray, kind: np.ndarray,
-             passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
-             fj: np.ndarray, fR: np.ndarray, ft: np.ndarray, above: np.ndarray, rk: np.ndarray, ra: np.ndarray,
-             rb: np.ndarray, rc: np.ndarray, ru: np.ndarray, rw: np.ndarray, nt: int, jacobian: bool
-            ) -> tuple[np.ndarray, np.ndarray]:
-        P, m = X.shape[0], rk.shape[0]
-        r = np.empty((P, m), np.complex128)
-        J = np.empty((P, m, nt if jacobian else 0), np.complex128)
-        for p in range(P):
-            one(X[p], Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
-                nt, jacobian, r[p], J[p])
-        return r, J
+def _one(x: np.ndarray, Rc: np.ndarray, tc: np.ndarray, r2: np.ndarray, parent: np.ndarray, kind: np.ndarray,
+         passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
+         fj: np.ndarray, fR: np.ndarray, ft: np.ndarray, above: np.ndarray, rk: np.ndarray, ra: np.ndarray,
+         rb: np.ndarray, rc: np.ndarray, ru: np.ndarray, rw: np.ndarray, nt: int, jacobian: bool, r: np.ndarray,
+         J: np.ndarray) -> None:
+    """The rows (and Jacobian) of one point x into r (m,) and J (m, nt)."""
+    oR, op, wv, ov, ev = _PLACE(x, Rc, tc, parent, kind, passive, xs, ts, axis, Lr, Lt, nt, jacobian)
+    fp, fRw = _FRAMES(oR, op, fj, fR, ft)
+    ua = np.zeros(3, np.complex128)
+    ub = np.zeros(3, np.complex128)
+    d = np.zeros(3, np.complex128)
+    for i in range(rk.shape[0]):
+        fa, fb = ra[i], rb[i]
+        for a in range(3):
+            ua[a] = fRw[fa, a, 0] * ru[i, 0] + fRw[fa, a, 1] * ru[i, 1] + fRw[fa, a, 2] * ru[i, 2]
+            ub[a] = fRw[fb, a, 0] * rw[i, 0] + fRw[fb, a, 1] * rw[i, 1] + fRw[fb, a, 2] * rw[i, 2]
+            d[a] = fp[fb, a] - fp[fa, a]
+        r[i] = _VALUE(rk[i], rc[i], ua, ub, d, r2)
+        if jacobian:
+            _DERIVATIVE(i, rk[i], rc[i], fa, fb, fp, ua, ub, d, wv, ov, ev, above, nt, J)
 
-    return rows
+
+def _every_point(X: np.ndarray, Rc: np.ndarray, tc: np.ndarray, r2: np.ndarray, parent: np.ndarray, kind: np.ndarray,
+          passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
+          fj: np.ndarray, fR: np.ndarray, ft: np.ndarray, above: np.ndarray, rk: np.ndarray, ra: np.ndarray,
+          rb: np.ndarray, rc: np.ndarray, ru: np.ndarray, rw: np.ndarray, nt: int, jacobian: bool
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of every point of X (P, n): r (P, m), J (P, m, nt)."""
+    P, m = X.shape[0], rk.shape[0]
+    r = np.empty((P, m), np.complex128)
+    J = np.empty((P, m, nt if jacobian else 0), np.complex128)
+    for p in range(P):
+        _ONE(X[p], Rc, tc, r2, parent, kind, passive, xs, ts, axis, Lr, Lt, fj, fR, ft, above, rk, ra, rb, rc, ru, rw,
+             nt, jacobian, r[p], J[p])
+    return r, J
 
 
 def _joint_motion(x: Any, j: int, k: int, xs: Any, axis: Any, passive: Any, Rc: Any, tc: Any, R: Any, t: Any) -> None:
@@ -187,51 +195,46 @@ def _joint_axes(j: int, k: int, v: int, A: Any, oj: Any, op: Any, axis: Any, wv:
                     ev[v + m, a] = A[a, m]
 
 
-def _place_joints(jit: Any, motion: Any, axes: Any) -> Any:
-    """The compiled pass down the tree: every joint's world placement (oR (nj, 3, 3), op (nj, 3)) and,
-    with ``jacobian``, the world axes of the tangent coordinates (wv, ov, ev (nt, 3))."""
-
-    @jit
-    def place(x: np.ndarray, Rc: np.ndarray, tc: np.ndarray, parent: np.ndarray, kind: np.ndarray,
-              passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray, Lt: np.ndarray,
-              nt: int, jacobian: bool) -> tuple:
-        nj = parent.shape[0]
-        oR = np.zeros((nj, 3, 3), np.complex128)
-        op = np.zeros((nj, 3), np.complex128)
+def _place_joints(x: np.ndarray, Rc: np.ndarray, tc: np.ndarray, parent: np.ndarray, kind: np.ndarray,
+                  passive: np.ndarray, xs: np.ndarray, ts: np.ndarray, axis: np.ndarray, Lr: np.ndarray,
+                  Lt: np.ndarray, nt: int, jacobian: bool) -> tuple:
+    """The pass down the tree: every joint's world placement (oR (nj, 3, 3), op (nj, 3)) and, with
+    ``jacobian``, the world axes of the tangent coordinates (wv, ov, ev (nt, 3))."""
+    nj = parent.shape[0]
+    oR = np.zeros((nj, 3, 3), np.complex128)
+    op = np.zeros((nj, 3), np.complex128)
+    for a in range(3):
+        oR[0, a, a] = 1.0
+    wv = np.zeros((nt, 3), np.complex128)
+    ov = np.zeros((nt, 3), np.complex128)
+    ev = np.zeros((nt, 3), np.complex128)
+    R = np.zeros((3, 3), np.complex128)
+    t = np.zeros(3, np.complex128)
+    A = np.zeros((3, 3), np.complex128)
+    oj = np.zeros(3, np.complex128)
+    for j in range(1, nj):
+        p = parent[j]
         for a in range(3):
-            oR[0, a, a] = 1.0
-        wv = np.zeros((nt, 3), np.complex128)
-        ov = np.zeros((nt, 3), np.complex128)
-        ev = np.zeros((nt, 3), np.complex128)
-        R = np.zeros((3, 3), np.complex128)
-        t = np.zeros(3, np.complex128)
-        A = np.zeros((3, 3), np.complex128)
-        oj = np.zeros(3, np.complex128)
-        for j in range(1, nj):
-            p = parent[j]
-            for a in range(3):
-                oj[a] = op[p, a]
-                for b in range(3):
-                    oj[a] += oR[p, a, b] * Lt[j, b]
-                    s = 0.0 + 0.0j
-                    for c in range(3):
-                        s += oR[p, a, c] * Lr[j, c, b]
-                    A[a, b] = s
-            k = kind[j]
-            motion(x, j, k, xs, axis, passive, Rc, tc, R, t)
-            for a in range(3):
-                op[j, a] = oj[a]
-                for b in range(3):
-                    op[j, a] += A[a, b] * t[b]
-                    s = 0.0 + 0.0j
-                    for c in range(3):
-                        s += A[a, c] * R[c, b]
-                    oR[j, a, b] = s
-            if jacobian and passive[j]:
-                axes(j, k, ts[j], A, oj, op, axis, wv, ov, ev)
-        return oR, op, wv, ov, ev
-
-    return place
+            oj[a] = op[p, a]
+            for b in range(3):
+                oj[a] += oR[p, a, b] * Lt[j, b]
+                s = 0.0 + 0.0j
+                for c in range(3):
+                    s += oR[p, a, c] * Lr[j, c, b]
+                A[a, b] = s
+        k = kind[j]
+        _MOTION(x, j, k, xs, axis, passive, Rc, tc, R, t)
+        for a in range(3):
+            op[j, a] = oj[a]
+            for b in range(3):
+                op[j, a] += A[a, b] * t[b]
+                s = 0.0 + 0.0j
+                for c in range(3):
+                    s += A[a, c] * R[c, b]
+                oR[j, a, b] = s
+        if jacobian and passive[j]:
+            _AXES(j, k, ts[j], A, oj, op, axis, wv, ov, ev)
+    return oR, op, wv, ov, ev
 
 
 def _place_frames(oR: Any, op: Any, fj: Any, fR: Any, ft: Any) -> tuple[Any, Any]:
