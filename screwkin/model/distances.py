@@ -23,12 +23,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import quaternion_product
+from .geometry import quaternion_matrix, quaternion_product
 from .subproblems import rotation, run_angles, two_rotations
 
-__all__ = ["SixDistances", "chain_angles"]
+__all__ = ["SixDistances", "chain_angles", "rotated", "rotations"]
 
 _SERIES = 1e-8
+
+
+def rotations(X: np.ndarray) -> np.ndarray:
+    """(P, 3, 3, 1) the rotations of the quaternions X[:, 3:7] (model.geometry.quaternion_matrix: the
+    polynomial form, so the rows stay polynomial off the unit sphere), a trailing axis for the legs."""
+    return quaternion_matrix(np.asarray(X)[:, 3:7])[..., None]
+
+
+def rotated(R: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """(P, 3, 6): R B_k for the stack R of ``rotations`` and points B (6, 3), or one set per rotation
+    (P, 6, 3)."""
+    cols = [B[..., j] if B.ndim == 2 else B[:, None, :, j] for j in range(3)]
+    return R[:, :, 0] * cols[0] + R[:, :, 1] * cols[1] + R[:, :, 2] * cols[2]
 
 
 class SixDistances:
@@ -38,29 +51,28 @@ class SixDistances:
     n, width = 6, 7
 
     def __init__(self, A, B) -> None:
-        self.A = np.asarray(A, float)
-        self.B = np.asarray(B, float)
+        # real for a platform's own geometry; complex for the general platform's generic parameters
+        kind = complex if np.iscomplexobj(A) or np.iscomplexobj(B) else float
+        self.A = np.asarray(A, kind)
+        self.B = np.asarray(B, kind)
         self.closure = self  # the trace test draws its random points from ``closure``
 
-    def _v(self, X: np.ndarray) -> tuple:
+    def _v(self, X: np.ndarray, A: np.ndarray | None = None, B: np.ndarray | None = None) -> tuple:
         """(v, RB): per leg the vector from A_k to the platform point, and R B_k; each (P, 3, 6)
         (component-wise arithmetic on the stack of rotations: these stacks are small, numpy's calls
-        dominate)."""
-        x, y, z, w = X[:, 3], X[:, 4], X[:, 5], X[:, 6]
-        xx, yy, zz, ww = x * x, y * y, z * z, w * w
-        xy, xz, xw, yz, yw, zw = x * y, x * z, x * w, y * z, y * w, z * w
-        R = np.empty((len(X), 3, 3, 1), complex)
-        R[:, 0, 0, 0], R[:, 0, 1, 0], R[:, 0, 2, 0] = ww + xx - yy - zz, 2 * (xy - zw), 2 * (xz + yw)
-        R[:, 1, 0, 0], R[:, 1, 1, 0], R[:, 1, 2, 0] = 2 * (xy + zw), ww - xx + yy - zz, 2 * (yz - xw)
-        R[:, 2, 0, 0], R[:, 2, 1, 0], R[:, 2, 2, 0] = 2 * (xz - yw), 2 * (yz + xw), ww - xx - yy + zz
-        B = self.B
-        RB = R[:, :, 0] * B[:, 0] + R[:, :, 1] * B[:, 1] + R[:, :, 2] * B[:, 2]
-        v = X[:, :3, None] + RB - self.A.T
+        dominate).  ``A``, ``B``: other points than the system's, (6, 3) or one per point (P, 6, 3)."""
+        R = rotations(X)
+        A = self.A if A is None else A
+        B = self.B if B is None else B
+        RB = rotated(R, B)
+        v = X[:, :3, None] + RB - np.swapaxes(A, -1, -2)
         return v, RB
 
-    def equations(self, X: np.ndarray, jacobian: bool = True) -> tuple:
+    def equations(self, X: np.ndarray, jacobian: bool = True, A: np.ndarray | None = None,
+                  B: np.ndarray | None = None) -> tuple:
+        """G (P, 6) and its Jacobian in tangent coordinates (P, 6, 6); ``A``, ``B`` as ``_v``'s."""
         X = np.asarray(X, complex)
-        v, RB = self._v(X)
+        v, RB = self._v(X, A, B)
         v0, v1, v2 = v[:, 0], v[:, 1], v[:, 2]
         G = v0 * v0 + v1 * v1 + v2 * v2
         if not jacobian:
@@ -72,6 +84,15 @@ class SixDistances:
         J[:, :, 4] = 2 * (R2 * v0 - R0 * v2)
         J[:, :, 5] = 2 * (R0 * v1 - R1 * v0)
         return G, J
+
+    def moved(self, X: np.ndarray, dA: np.ndarray, dB: np.ndarray, A: np.ndarray | None = None,
+              B: np.ndarray | None = None) -> np.ndarray:
+        """(P, 6) the rows' rate as the points move at rates dA, dB (6, 3) (from A, B as ``_v``'s):
+        d|v_k|^2 = 2 v_k . (R dB_k - dA_k)."""
+        X = np.asarray(X, complex)
+        v, _ = self._v(X, A, B)
+        w = rotated(rotations(X), np.asarray(dB, complex)) - np.swapaxes(np.asarray(dA, complex), -1, -2)
+        return 2 * (v[:, 0] * w[:, 0] + v[:, 1] * w[:, 1] + v[:, 2] * w[:, 2])
 
     def offsets(self, X: np.ndarray):
         return self.equations(X, jacobian=False)[0]

@@ -44,7 +44,7 @@ def platform_modes(solver, problem, closure, arch: Architecture, seed: int, tol:
     rng = np.random.default_rng(seed)
     roots, how, path, reused = generic_set(arch, rng, tol)
     t1 = time.perf_counter()
-    query = to_query(arch, roots, tol)
+    query = to_query(arch, roots, tol, rng)
     ends, real, distinct, meets, lone = query.ends, query.real, query.distinct, query.meets, query.lone
     X, status = ends.X, ends.status
     closes = query.closes

@@ -84,7 +84,7 @@ class Closure(Family, Protocol):
 
     def tangent(self, X: Array) -> Array: ...
 
-__all__ = ["Roots", "all_roots", "to_target", "Endpoints"]
+__all__ = ["carry", "Roots", "all_roots", "to_target", "Endpoints"]
 
 
 @dataclass
@@ -482,11 +482,19 @@ def to_target(system: Family, roots: Roots, target: Array, tol: Tolerances = DEF
     not arrive at a regular root (Newton settles, the Jacobian's condition number below 1e10) is
     tracked again to t = 1 - ``tol.track_endgame`` and finished by the Cauchy endgame: a finite endpoint (the
     mean of the loop closes the system) is singular, one that does not is at infinity."""
-    X0 = roots.X
-    P = len(X0)
+    P = len(roots.X)
     a = np.broadcast_to(roots.c0, (P, len(roots.c0)))
     b = np.broadcast_to(np.asarray(target, complex), a.shape)
-    seg = tracking.Segment(system, a, b)
+    return carry(tracking.Segment(system, a, b), roots.X, tol)
+
+
+def carry(seg: tracking.Homotopy, X0: Array, tol: Tolerances = DEFAULT, zone: float | None = None) -> Endpoints:
+    """The roots X0 of ``seg`` at t = 0 carried to t = 1, finished as ``to_target`` says (any homotopy
+    of the tracker's protocol: an offset segment, or one that moves the system's coefficients).
+    ``zone``: a path the tracker lost before t = 1 - zone that the endgame would put at infinity is
+    called failed instead -- the trouble it met lies inside the endgame's loop but away from its
+    centre (another branch point), where Cauchy's formula does not hold."""
+    P = len(X0)
     status = np.full(P, "regular", dtype=object)
     cycles = np.ones(P, int)
     radius = tol.track_endgame
@@ -518,4 +526,7 @@ def to_target(system: Family, roots: Roots, target: Array, tol: Tolerances = DEF
             status[idx[ok & closes]] = "singular"
             status[idx[ok & ~closes]] = "infinity"
             status[idx[~ok]] = "failed"
+            if zone is not None:
+                early = idx[res.T[idx] < 1.0 - zone]
+                status[early[status[early] == "infinity"]] = "failed"
     return Endpoints(X, status, cycles, P)
