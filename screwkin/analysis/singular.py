@@ -182,7 +182,7 @@ def actuator_det_rows(mech: Mechanism, g: Generic) -> tuple:
     size = np.zeros(mech.closure.nrows)
     for q in g.configurations:
         size = np.maximum(size, np.abs(scaled_jacobians(mech, q).K[:, g.p]).max(axis=1))
-    rows = np.flatnonzero(size > mech.tolerances.rank_rtol * max(size.max(), 1e-300))
+    rows = np.flatnonzero(size > mech.tolerances.rank_rtol * size.max())
     if g.rank_Kp != len(g.p) or len(rows) != len(g.p):
         return None, (f"the actuator Jacobian K_p has {len(rows)} rows that move and {len(g.p)} passive columns "
                       f"(rank {g.rank_Kp}): not square, its determinant's sign is no argument")

@@ -9,7 +9,7 @@ import pinocchio as pin
 
 from ..analysis.position.ik import branches, inverse_kinematics
 from ..errors import UsageError, quote
-from ..analysis.position.mode_connect import serial_connections
+from ..analysis.singularities.mode_connect import serial_connections
 from ..present.jsonout import json_of
 from ..present.loci import connections_dict, connections_lines
 from ..present.report import position_dict, position_text

@@ -10,8 +10,10 @@ from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..present.equations import Units, greek, newton_dict, newton_text
-from ..analysis.position.mode_connect import connect_modes
-from ..present.animate import animation_format
+from ..analysis.singularities.mode_connect import connect_modes
+from ..analysis.course.skeleton import skeleton
+from ..present.animate import animation_format, write_animation
+from ..present.draw import drawing_title
 from ..present.jsonout import json_of
 from ..present.loci import connections_dict, connections_lines
 from ..present.report import (
@@ -117,7 +119,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
         if conns is not None:
             d.update(connections_dict(conns, mech, solver.output_frame))
         if args.animate:
-            d["animation"] = animated
+            d["animation"] = {k: v for k, v in animated.items() if k != "said"}
         print(json_of(d))
         return 0
     if args.trace:
@@ -138,10 +140,6 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
 
 def _animate_connection(mech: Mechanism, args: argparse.Namespace, conns) -> dict:
     """solve --connect --animate OUT: the skeleton along the first path that joins two modes."""
-    from ..analysis.course.skeleton import skeleton
-    from ..present.animate import write_animation
-    from ..present.draw import drawing_title
-
     c = next((c for c in conns.connections if c.joined), None)
     if c is None:
         return {"file": None, "modes": None, "frames": 0, "said": f"--animate: no path joins two modes; {args.animate} not written"}

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.state import KinematicState
 from ..units import in_unit
 from .outfile import write_figure
 from .plots import pyplot
@@ -154,8 +155,6 @@ def connections_dict(conns, mech: Mechanism, output_frame: int | None = None) ->
     """The keys ``solve``/``ik --all --connect --json`` add: connections [{modes: [i, j] (numbered as the
     listing, from 1), joined, proved, why, plane, sigma_min, path: [{joints, output_pose (with an output)}]}],
     det_signs (each mode's, null where no argument), connections_how, connections_notes."""
-    from ..model.state import KinematicState
-
     out = []
     for c in conns.connections:
         path = []

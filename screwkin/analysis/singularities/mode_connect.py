@@ -7,7 +7,7 @@ For every pair of the modes found at the given inputs:
   configurations and changes sign only where it vanishes);
 - same sign: a search for a path.  In the plane of two inputs (the others held at their values) the actuator
   loci are traced in a box round the given values (analysis.singularities.loci.trace_loci) and each mode is
-  followed (connect.follow) round each cusp found, nearest first, both ways: on the ellipse centred on the
+  followed (connect.follow_inputs) round each cusp found, nearest first, both ways: on the ellipse centred on the
   cusp through the given inputs, then out to the cusp's wedge, once round it close by and back.  A loop that
   ends on another listed mode joins the two; loops chain (mode a to b, b to c joins a and c).  Nothing found
   is no proof: ``proved`` stays False.
@@ -25,8 +25,9 @@ from itertools import combinations
 import numpy as np
 
 from ...errors import AssemblyError
-from ..singular import Generic, actuator_det_rows, actuator_det_sign, measures
-from .connect import JUMP, SAME, apart, follow, wedge_direction
+from ..singular import Generic, actuator_det_rows, actuator_det_sign, measures, scaled_jacobians
+from .loci import trace_loci
+from ..position.connect import JUMP, SAME, apart, follow_inputs, wedge_direction
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -91,7 +92,7 @@ def check_path(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray
             d = values[n] - v
             if not mech.translational[mech.coordinate(n).idx_v]:
                 d = np.arctan2(np.sin(d), np.cos(d))
-            if abs(d) > 1e-7 * (mech.length if mech.translational[mech.coordinate(n).idx_v] else 1.0):
+            if abs(d) > tol.equal * (mech.length if mech.translational[mech.coordinate(n).idx_v] else 1.0):
                 return False, worst, f"input {n} off its value at point {k}"
         if k and apart(mech, Q[k - 1], q) > JUMP:
             return False, worst, f"step {k} jumps (another branch)"
@@ -101,7 +102,7 @@ def check_path(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray
     return True, float(worst), ""
 
 
-def _box(mech, name: str, value: float) -> tuple:
+def _search_box(mech, name: str, value: float) -> tuple:
     c = mech.coordinate(name)
     w = BOX_LENGTH * mech.length if mech.translational[c.idx_v] else BOX_ANGLE
     lo, hi = value - w, value + w
@@ -138,7 +139,7 @@ def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps) -> list:
         a = th0 + turn * np.linspace(0.0, 2 * np.pi, n + 1)
         xy = np.column_stack([c[0] + rho * span[0] * np.cos(a), c[1] + rho * span[1] * np.sin(a)])
         xy[0] = xy[-1] = u0
-        lp = follow(solver, *plane, fixed, xy, q)
+        lp = follow_inputs(solver, *plane, fixed, xy, q)
         if lp.regular and lp.joined:
             out.append((xy, lp.q))
     if out:
@@ -147,17 +148,17 @@ def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps) -> list:
     s = c + LOOP * span * np.array([np.cos(wedge), np.sin(wedge)])
     k = max(10, int(np.ceil(np.hypot(*((s - u0) / span)) / (2 * np.pi * LOOP / steps))))
     seg = u0 + np.linspace(0.0, 1.0, min(k, 4 * steps) + 1)[:, None] * (s - u0)
-    there = follow(solver, *plane, fixed, seg, q)
+    there = follow_inputs(solver, *plane, fixed, seg, q)
     if not there.regular:
         return out
     for turn in (1, -1):
         a = wedge + turn * np.linspace(0.0, 2 * np.pi, steps + 1)
         ring = np.column_stack([c[0] + LOOP * span[0] * np.cos(a), c[1] + LOOP * span[1] * np.sin(a)])
         ring[0] = ring[-1] = s
-        lp = follow(solver, *plane, fixed, ring, there.q[-1])
+        lp = follow_inputs(solver, *plane, fixed, ring, there.q[-1])
         if not (lp.regular and lp.joined):
             continue
-        back = follow(solver, *plane, fixed, seg[::-1], lp.q[-1])
+        back = follow_inputs(solver, *plane, fixed, seg[::-1], lp.q[-1])
         if back.regular:
             out.append((np.vstack([seg, ring[1:], seg[::-1][1:]]), np.vstack([there.q, lp.q[1:], back.q[1:]])))
     return out
@@ -166,8 +167,6 @@ def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps) -> list:
 def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) -> Connections:
     """Which of the configurations qs (the modes listed at the inputs ``values``) can be joined without a
     singularity, and how (see the module)."""
-    from ..singularities.loci import trace_loci
-
     mech = solver.mech
     g = Generic(mech, solver.inputs, configurations=solver.generic().configurations)
     notes = []
@@ -196,11 +195,11 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) 
         notes.append("one input: no plane of two inputs to loop in")
     u = {n: float(v) for n, v in values.items()}
     for plane in (_planes(list(solver.inputs)) if pending and len(solver.inputs) >= 2 else []):
-        if all(_joined(edges, i, j) for i, j in pending):
+        if all(_chained(edges, i, j) for i, j in pending):
             break
         fixed = {n: v for n, v in u.items() if n not in plane}
         u0 = np.array([u[plane[0]], u[plane[1]]])
-        (x0, x1), (y0, y1) = _box(mech, plane[0], u0[0]), _box(mech, plane[1], u0[1])
+        (x0, x1), (y0, y1) = _search_box(mech, plane[0], u0[0]), _search_box(mech, plane[1], u0[1])
         span = np.array([x1 - x0, y1 - y0])
         if (span <= 0).any():
             continue
@@ -221,7 +220,7 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) 
             searched.append(f"({plane[0]}, {plane[1]}) = ({c[0]:.6g}, {c[1]:.6g})")
             wedge = wedge_direction(P, c / span, LOOP) if len(P) else 0.0
             for a in sorted({m for pair in pending for m in pair}):
-                if all(_joined(edges, i, j) for i, j in pending):
+                if all(_chained(edges, i, j) for i, j in pending):
                     break
                 for xy, Q in _loops_round(solver, plane, fixed, u0, c, span, wedge, qs[a], steps):
                     b = _match(mech, Q[-1], qs)
@@ -294,7 +293,7 @@ def _route(edges: dict, i: int, j: int) -> list | None:
     return route[::-1]
 
 
-def _joined(edges: dict, i: int, j: int) -> bool:
+def _chained(edges: dict, i: int, j: int) -> bool:
     return _route(edges, i, j) is not None
 
 
@@ -304,8 +303,6 @@ def serial_connections(mech, output: str, qs, point: bool) -> Connections:
     solution: opposite signs prove every joint-space path between them meets a serial singularity.  Same
     signs are not searched (a path round a cusp of a workspace section, which a cuspidal robot has, is not
     built here): said so, not proved either way."""
-    from ..singular import scaled_jacobians
-
     tol = mech.tolerances
     qs = [np.asarray(q, float) for q in qs][:MAX_MODES]
     signs, why_none = [], ""
