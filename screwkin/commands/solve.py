@@ -10,7 +10,7 @@ from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..present.equations import Units, greek, newton_dict, newton_text
-from ..analysis.singularities.mode_connect import connect_modes
+from ..analysis.singularities.mode_connect import Connections, connect_modes
 from ..analysis.course.skeleton import skeleton
 from ..present.animate import animation_format, write_animation
 from ..present.draw import drawing_title
@@ -111,7 +111,10 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     solver = input_solver(mech, values, held, output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
                        points=named_points(mech, args), method="auto" if args.all else "nearest")
-    conns = connect_modes(solver, values, [s.q for s in res.solutions]) if args.connect else None
+    conns = None
+    if args.connect:
+        conns = connect_modes(solver, values, [s.q for s in res.solutions]) if not res.free_dofs else Connections(
+            (), (), "not compared: the inputs leave a continuum of configurations (the solutions listed are samples)")
     animated = _animate_connection(mech, args, conns) if args.animate else None
     if args.json:
         d = position_dict(res)

@@ -38,6 +38,8 @@ __all__ = ["Connection", "Connections", "check_path", "connect_modes", "det_sign
 #: Bounds of the search: planes of two inputs, cusps per plane (nearest first), modes compared (pairs:
 #: MAX_MODES (MAX_MODES - 1) / 2), steps of a loop round a cusp close by.
 MAX_PLANES, MAX_CUSPS, MAX_MODES, STEPS = 3, 4, 8, 720
+#: Steps followed in all (each a damped Newton solve, about a millisecond): the search stops there and says so.
+MAX_STEPS = 100_000
 #: The box round the given inputs where the cusps are looked for: half-widths, lengths as a fraction of the
 #: characteristic length, angles [rad]; kept within the joint limits.
 BOX_LENGTH, BOX_ANGLE = 0.25, 0.5
@@ -125,10 +127,15 @@ def _planes(inputs: list) -> list:
     return (pairs[::-1])[:MAX_PLANES]
 
 
-def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps) -> list:
+def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps, budget: list) -> list:
     """The closed input paths from u0 round the cusp, each way, and where mode q ends: [(xy, Q)] of the
-    regular ones that end on another configuration."""
+    regular ones that end on another configuration.  budget: [steps left, whether it ran out], spent here."""
     out = []
+
+    def spend(xy, q0):
+        budget[0] -= len(xy)
+        return follow_inputs(solver, *plane, fixed, xy, q0)
+
     c = np.asarray(cusp, float)
     d = (u0 - c) / span
     rho = float(np.hypot(*d))
@@ -136,10 +143,13 @@ def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps) -> list:
     # 1. the ellipse centred on the cusp through u0
     n = int(np.clip(steps * rho / LOOP, steps, 4 * steps))
     for turn in (1, -1):
+        if budget[0] < n:
+            budget[1] = True
+            return out
         a = th0 + turn * np.linspace(0.0, 2 * np.pi, n + 1)
         xy = np.column_stack([c[0] + rho * span[0] * np.cos(a), c[1] + rho * span[1] * np.sin(a)])
         xy[0] = xy[-1] = u0
-        lp = follow_inputs(solver, *plane, fixed, xy, q)
+        lp = spend(xy, q)
         if lp.regular and lp.joined:
             out.append((xy, lp.q))
     if out:
@@ -148,17 +158,20 @@ def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps) -> list:
     s = c + LOOP * span * np.array([np.cos(wedge), np.sin(wedge)])
     k = max(10, int(np.ceil(np.hypot(*((s - u0) / span)) / (2 * np.pi * LOOP / steps))))
     seg = u0 + np.linspace(0.0, 1.0, min(k, 4 * steps) + 1)[:, None] * (s - u0)
-    there = follow_inputs(solver, *plane, fixed, seg, q)
+    if budget[0] < 2 * len(seg) + 2 * steps:
+        budget[1] = True
+        return out
+    there = spend(seg, q)
     if not there.regular:
         return out
     for turn in (1, -1):
         a = wedge + turn * np.linspace(0.0, 2 * np.pi, steps + 1)
         ring = np.column_stack([c[0] + LOOP * span[0] * np.cos(a), c[1] + LOOP * span[1] * np.sin(a)])
         ring[0] = ring[-1] = s
-        lp = follow_inputs(solver, *plane, fixed, ring, there.q[-1])
+        lp = spend(ring, there.q[-1])
         if not (lp.regular and lp.joined):
             continue
-        back = follow_inputs(solver, *plane, fixed, seg[::-1], lp.q[-1])
+        back = spend(seg[::-1], lp.q[-1])
         if back.regular:
             out.append((np.vstack([seg, ring[1:], seg[::-1][1:]]), np.vstack([there.q, lp.q[1:], back.q[1:]])))
     return out
@@ -194,6 +207,7 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) 
     if pending and len(solver.inputs) < 2:
         notes.append("one input: no plane of two inputs to loop in")
     u = {n: float(v) for n, v in values.items()}
+    budget = [MAX_STEPS, False]
     for plane in (_planes(list(solver.inputs)) if pending and len(solver.inputs) >= 2 else []):
         if all(_chained(edges, i, j) for i, j in pending):
             break
@@ -222,10 +236,12 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) 
             for a in sorted({m for pair in pending for m in pair}):
                 if all(_chained(edges, i, j) for i, j in pending):
                     break
-                for xy, Q in _loops_round(solver, plane, fixed, u0, c, span, wedge, qs[a], steps):
+                for xy, Q in _loops_round(solver, plane, fixed, u0, c, span, wedge, qs[a], steps, budget):
                     b = _match(mech, Q[-1], qs)
                     if b is not None and b != a and (a, b) not in edges:
                         edges[a, b] = (plane, xy, Q)
+    if budget[1]:
+        notes.append(f"the search stopped at its bound of {MAX_STEPS:,} steps followed")
     for i, j in pending:
         route = _route(edges, i, j)
         if route is None:
@@ -258,7 +274,8 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) 
     how = (f"det K_p's sign at each mode; pairs of the same sign: loops of two inputs round the cusps of the "
            f"actuator singular curve traced in a box round the given inputs (half-widths {BOX_LENGTH:g} L for "
            f"lengths, {BOX_ANGLE:g} rad for angles, within the joint limits), at most {MAX_PLANES} planes, the "
-           f"{MAX_CUSPS} nearest cusps each, loops of at least {steps} steps, each path checked again point by point")
+           f"{MAX_CUSPS} nearest cusps each, loops of at least {steps} steps, {MAX_STEPS:,} steps in all, each path "
+           "checked again point by point")
     if tried_planes:
         notes.insert(0, "planes of two inputs (the others held at their values): " + "; ".join(tried_planes))
     return Connections(tuple(result[k] for k in sorted(result)), tuple(signs), how, tuple(notes))
