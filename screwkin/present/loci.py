@@ -173,7 +173,6 @@ def connections_dict(conns, mech: Mechanism, output_frame: int | None = None) ->
 def connections_lines(conns, what: str = "modes") -> list:
     """Text: one line per pair, then how and the notes."""
     lines = [f"{what} {c.modes[0] + 1} and {c.modes[1] + 1}: "
-             + ("joined" if c.joined else "not joined" if c.proved else "not joined (not proved impossible)"
-                if c.why.startswith("same sign") else "unknown") + f" -- {c.why.removeprefix('unknown: ')}"
+             + (c.why if c.joined or c.why.startswith("unknown") else f"not joined: {c.why}")
              for c in conns.connections]
     return lines + [f"connections: {conns.how}"] + list(conns.notes)
