@@ -71,7 +71,8 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     conns = None
     if args.connect:
         plain = mech.tool is None and not args.points  # the link's own origin: its Jacobian is the one compared
-        conns = serial_connections(mech, output, [s.q for s in res.solutions], point=n == 3) if plain else \
+        conns = serial_connections(mech, output, [s.q for s in res.solutions], point=n == 3,
+                                   target=v[:3] if n == 3 else None) if plain else \
             replace(serial_connections(mech, output, [], False), notes=(
                 "--tool or --point: the det J of the tool frame is not compared; give the output link alone",))
     if args.json:

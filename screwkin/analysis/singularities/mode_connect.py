@@ -23,10 +23,13 @@ from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np
+import pinocchio as pin
 
 from ...errors import AssemblyError
-from ..singular import Generic, actuator_det_rows, actuator_det_sign, measures, scaled_jacobians
+from ...model.state import KinematicState
+from ..singular import LWA, Generic, actuator_det_rows, actuator_det_sign, measures, scaled_jacobians
 from .loci import trace_loci
+from .section import trace_section
 from ..position.connect import JUMP, SAME, apart, follow_inputs, wedge_direction
 from typing import TYPE_CHECKING
 
@@ -314,12 +317,15 @@ def _chained(edges: dict, i: int, j: int) -> bool:
     return _route(edges, i, j) is not None
 
 
-def serial_connections(mech, output: str, qs, point: bool) -> Connections:
+def serial_connections(mech, output: str, qs, point: bool, target=None) -> Connections:
     """``ik --all --connect``: for a chain without loops whose output's motion (its origin's with ``point``)
     has as many rows as the joints, the sign of det J (dimensionless, analysis.singular's scaling) at each
     solution: opposite signs prove every joint-space path between them meets a serial singularity.  Same
-    signs are not searched (a path round a cusp of a workspace section, which a cuspidal robot has, is not
-    built here): said so, not proved either way."""
+    signs, for three joints placing a point (``target``, [m]): a search as ``connect_modes``'s, in the section
+    of the workspace through the target (x, z; y held, analysis.singularities.section): each solution
+    followed with the point moved on an ellipse centred on a cusp of the section's serial singular curve
+    through the target, both ways; a loop ending on another listed solution joins them, checked again point
+    by point.  Otherwise same signs are said not searched."""
     tol = mech.tolerances
     qs = [np.asarray(q, float) for q in qs][:MAX_MODES]
     signs, why_none = [], ""
@@ -339,6 +345,12 @@ def serial_connections(mech, output: str, qs, point: bool) -> Connections:
         signs.append(0 if s[-1] < tol.singular * s[0] else int(np.sign(np.linalg.det(J))))
     if why_none:
         signs = [None] * len(qs)
+    pending = [(i, j) for i, j in combinations(range(len(qs)), 2) if signs[i] is not None and signs[i] != 0
+               and signs[i] == signs[j]]
+    searchable = point and target is not None and mech.nv == 3 and not mech.closure.nrows
+    edges, notes, searched = {}, [], 0
+    if pending and searchable:
+        edges, notes, searched = _section_search(mech, output, qs, np.asarray(target, float), pending)
     out = []
     for i, j in combinations(range(len(qs)), 2):
         si, sj = signs[i], signs[j]
@@ -351,11 +363,133 @@ def serial_connections(mech, output: str, qs, point: bool) -> Connections:
             out.append(Connection((i, j), False, True, f"det J of opposite signs ({'+' if si > 0 else '-'} at "
                                   f"solution {i + 1}, {'+' if sj > 0 else '-'} at solution {j + 1}): every joint "
                                   "path between them meets a serial singularity"))
-        else:
+        elif not searchable:
             out.append(Connection((i, j), False, False, (
-                "unknown: same sign of det J; ik --connect does not search a path round a cusp of the workspace "
-                "section (a cuspidal robot can change solution so; map --output traces the section's cusps): "
-                "not proved impossible")))
-    how = ("the sign of det J (the output's Jacobian over the joints, dimensionless) at each solution; paths "
-           "between solutions of the same sign are not searched")
-    return Connections(tuple(out), tuple(signs), how, ())
+                "unknown: same sign of det J; ik --connect searches a path only for three joints placing a point "
+                "(--position): not proved impossible")))
+        else:
+            out.append(_serial_pair(mech, output, edges, i, j, target, searched))
+    how = ("the sign of det J (the output's Jacobian over the joints, dimensionless) at each solution"
+           + (f"; pairs of the same sign: the point moved round the cusps of the serial singular curve of the "
+              f"workspace section y = {float(target[1]):.6g} m through the target (x, z within {SECTION_BOX:g} L of "
+              f"it, the {MAX_CUSPS} nearest cusps), each path checked again point by point" if searchable else
+              "; paths between solutions of the same sign are searched only for three joints placing a point"))
+    return Connections(tuple(out), tuple(signs), how, tuple(notes))
+
+
+#: The workspace section searched by ik --connect: half-widths round the target, a fraction of L.
+SECTION_BOX = 1.0
+
+
+def _section_search(mech, output: str, qs, target: np.ndarray, pending: list) -> tuple:
+    """(edges (a, b) -> (("x", "z"), xy, Q), notes, cusps tried): the solutions followed round the cusps of the
+    section y = target's y."""
+    L = mech.length
+    u0 = np.array([target[0], target[2]])
+    w = SECTION_BOX * L
+    xs, zs = np.linspace(u0[0] - w, u0[0] + w, 41), np.linspace(u0[1] - w, u0[1] + w, 41)
+    sec = trace_section(mech, output, "x", xs, "z", zs, float(target[1]), samples=200)
+    span = np.array([2 * w, 2 * w])
+    cusps = sorted((np.array(p) for p, _ in sec.loci.cusps), key=lambda p: float(np.hypot(*((p - u0) / span))))
+    notes = [f"the section y = {target[1]:.6g} m: {len(cusps)} cusps of its serial singular curve within "
+             f"{w:.6g} m of the target ({sec.loci.how.split('. ')[0]})"]
+    fid = mech.link_frame(output)
+    edges, budget = {}, [MAX_STEPS]
+    for c in cusps[:MAX_CUSPS]:
+        d = (u0 - c) / span
+        rho, th0 = float(np.hypot(*d)), float(np.arctan2(d[1], d[0]))
+        n = int(np.clip(STEPS * rho / LOOP, STEPS, 4 * STEPS))
+        for a in sorted({m for pair in pending for m in pair}):
+            if all(_chained(edges, i, j) for i, j in pending) or budget[0] < n:
+                break
+            for turn in (1, -1):
+                ang = th0 + turn * np.linspace(0.0, 2 * np.pi, n + 1)
+                xy = np.column_stack([c[0] + rho * span[0] * np.cos(ang), c[1] + rho * span[1] * np.sin(ang)])
+                xy[0] = xy[-1] = u0
+                budget[0] -= len(xy)
+                Q = _follow_point(mech, fid, float(target[1]), xy, qs[a])
+                if Q is None:
+                    continue
+                b = _match(mech, Q[-1], qs)
+                if b is not None and b != a and (a, b) not in edges:
+                    edges[a, b] = (("x", "z"), xy, Q)
+    if budget[0] <= 0:
+        notes.append(f"the search stopped at its bound of {MAX_STEPS:,} steps followed")
+    return edges, notes, min(len(cusps), MAX_CUSPS)
+
+
+def _point_at(mech, fid: int, q: np.ndarray, level: float, x: float, z: float) -> np.ndarray | None:
+    """q moved by Newton on the three joints until the point is at (x, level, z), or None."""
+    goal = np.array([x, level, z])
+    for _ in range(30):
+        st = KinematicState(mech, q)
+        e = goal - st.frame_placement(fid).translation
+        if float(np.linalg.norm(e)) < mech.tolerances.closure * max(1.0, mech.length):
+            return q
+        J = st.frame_jacobian(fid, LWA)[:3]
+        q = pin.integrate(mech.model, q, np.linalg.lstsq(J, e, rcond=None)[0])
+    return None
+
+
+def _follow_point(mech, fid: int, level: float, xy: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
+    """The configurations along the point's path xy (x, z) from q0, each by Newton from the last: None where a
+    step fails, jumps (connect.JUMP) or meets a serial singularity (measure below Tolerances.singular)."""
+    Q = [np.asarray(q0, float)]
+    for x, z in xy[1:]:
+        q = _point_at(mech, fid, Q[-1], level, x, z)
+        if q is None or apart(mech, Q[-1], q) > JUMP:
+            return None
+        Q.append(q)
+    Q = np.array(Q)
+    return Q if _serial_smallest(mech, fid, Q) > mech.tolerances.singular else None
+
+
+def _serial_smallest(mech, fid: int, Q: np.ndarray) -> float:
+    """The smallest relative singular value of the point's Jacobian (dimensionless) along Q."""
+    worst = np.inf
+    for q in Q:
+        J = KinematicState(mech, q).frame_jacobian(fid, LWA)[:3] * np.where(mech.translational, mech.length, 1.0)
+        s = np.linalg.svd(J / mech.length, compute_uv=False)
+        worst = min(worst, float(s[-1] / s[0]))
+    return worst
+
+
+def check_point_path(mech, fid: int, level: float, xy: np.ndarray, Q: np.ndarray) -> tuple:
+    """(ok, smallest serial measure, why): the point of every configuration of Q at (x, level, z) of xy (to
+    Tolerances.equal relative to L), every step at most JUMP, the point's Jacobian's relative smallest singular
+    value above Tolerances.singular all along."""
+    tol = mech.tolerances
+    for k, q in enumerate(Q):
+        p = KinematicState(mech, q).frame_placement(fid).translation
+        if float(np.linalg.norm(p - [xy[k, 0], level, xy[k, 1]])) > tol.equal * mech.length:
+            return False, np.nan, f"the point is off its path at point {k}"
+        if k and apart(mech, Q[k - 1], q) > JUMP:
+            return False, np.nan, f"step {k} jumps (another branch)"
+    smallest = _serial_smallest(mech, fid, Q)
+    if smallest < tol.singular:
+        return False, smallest, f"the serial measure falls below {tol.singular:g}"
+    return True, smallest, ""
+
+
+def _serial_pair(mech, output: str, edges: dict, i: int, j: int, target, searched: int) -> Connection:
+    route = _route(edges, i, j)
+    if route is None:
+        return Connection((i, j), False, False, (
+            f"same sign of det J, but no loop of the point round a cusp of the workspace section joins them (cusps "
+            f"tried: {searched}): not proved impossible"))
+    pieces = [edges[a, b] if (a, b) in edges else _reversed(edges[b, a]) for a, b in route]
+    fid = mech.link_frame(output)
+    smallest = np.inf
+    for _, xy, Q in pieces:
+        ok, s, why = check_point_path(mech, fid, float(target[1]), xy, Q)
+        if not ok:
+            return Connection((i, j), False, False, f"a loop was found but its check failed: {why}")
+        smallest = min(smallest, s)
+    Q = np.vstack([pieces[0][2]] + [p[2][1:] for p in pieces[1:]])
+    xy = np.vstack([pieces[0][1]] + [p[1][1:] for p in pieces[1:]])
+    keep = np.unique(np.linspace(0, len(Q) - 1, min(THIN, len(Q))).round().astype(int))
+    return Connection((i, j), True, True, (
+        f"joined without a singularity: the tool point moved {len(route)} time{'s' if len(route) > 1 else ''} "
+        f"round a cusp of the workspace section y = {float(target[1]):.6g} m and back to the target (path of "
+        f"{len(Q)} points checked; smallest serial measure {smallest:.3g})"), Q[keep], xy[keep], ("x", "z"),
+        float(smallest))
