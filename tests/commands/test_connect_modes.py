@@ -156,3 +156,70 @@ def test_3rpr_modes_of_the_same_sign_joined_round_a_cusp(tmp_path):
             v = sols[k]["joints"][name]
             assert abs(end["joints"][name] - v) < 1e-6, (name, end["joints"][name], v)
     assert d["animation"]["modes"] == c["modes"] and gif.read_bytes()[:6] == b"GIF89a"
+
+
+def _o3r_point(params, th):
+    """The orthogonal 3R's tool point by plain numpy from the URDF's frames (tests/loci_robots.orthogonal_3r):
+    Rz(theta1), then (d2, 0, 0) rolled -90 deg, Rz(theta2), then (d3, 0, r2) rolled 90 deg, Rz(theta3), the point
+    (d4, 0, r3)."""
+    d2, d3, d4, r2, r3 = params
+
+    def rz(t):
+        c, s = np.cos(t), np.sin(t)
+        return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+    def fixed(xyz, roll):
+        c, s = np.cos(roll), np.sin(roll)
+        return np.array([[1, 0, 0, xyz[0]], [0, c, -s, xyz[1]], [0, s, c, xyz[2]], [0, 0, 0, 1.0]])
+
+    T = rz(th[0]) @ fixed((d2, 0, 0), -np.pi / 2) @ rz(th[1]) @ fixed((d3, 0, r2), np.pi / 2) @ rz(th[2])
+    return (T @ np.array([d4, 0, r3, 1.0]))[:3]
+
+
+def _o3r_det(params, th, h=1e-6):
+    J = np.column_stack([(_o3r_point(params, th + h * e) - _o3r_point(params, th - h * e)) / (2 * h)
+                         for e in np.eye(3)])
+    return np.linalg.det(J)
+
+
+@pytest.mark.slow
+def test_ik_connect_joins_two_solutions_of_a_cuspidal_3r(tmp_path):
+    """The cuspidal orthogonal 3R of test_loci.py (d2 = 1, d3 = 2, d4 = 1.5, r2 = 1, r3 = 0; Baili, Wenger &
+    Chablat), its tool point 0.1 m from a cusp of the section y = 0, inside the cusp's wedge: four solutions,
+    each tan(theta3 / 2) a real root of the independent quartic; a pair of the same sign of det J (numpy finite
+    differences of the numpy forward kinematics) joined by a joint path whose tool point stays in the section,
+    leaves the target and comes back, det J keeping its sign away from zero; pairs of opposite signs proved apart."""
+    from loci_robots import orthogonal_3r, orthogonal_3r_quartic
+
+    params = (1.0, 2.0, 1.5, 1.0, 0.0)
+    path = tmp_path / "o3r.urdf"
+    path.write_text(orthogonal_3r(*params))
+    target = np.array([1.45208637, 0.0, 0.47878859])
+    p = screwkin_cli("ik", str(path), "--output", "tool", "--position", ",".join(repr(float(v)) for v in target),
+                     "--all", "--connect", "--json", timeout=900)
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    roots = orthogonal_3r_quartic(*params, target[0], target[2]).roots()
+    real = np.sort(roots[abs(roots.imag) < 1e-9].real)
+    assert len(real) == 4 and len(d["solutions"]) == 4
+    th = [np.array([s["joints"][f"theta{k}"] for k in (1, 2, 3)]) for s in d["solutions"]]
+    for t in th:
+        assert np.abs(real - np.tan(t[2] / 2)).min() < 1e-6
+        assert np.allclose(_o3r_point(params, t), target, atol=1e-9)
+    dets = [_o3r_det(params, t) for t in th]
+    joined = [c for c in d["connections"] if c["joined"]]
+    assert len(joined) >= 1
+    for c in d["connections"]:
+        i, j = (k - 1 for k in c["modes"])
+        if np.sign(dets[i]) != np.sign(dets[j]):
+            assert not c["joined"] and c["proved"] and "det J of opposite signs" in c["why"]
+    for c in joined:
+        i, j = (k - 1 for k in c["modes"])
+        assert np.sign(dets[i]) == np.sign(dets[j]) and c["sigma_min"] > 1e-4
+        pts = [np.array([pt["joints"][f"theta{k}"] for k in (1, 2, 3)]) for pt in c["path"]]
+        assert np.allclose(pts[0], th[i], atol=1e-6) and np.allclose(pts[-1], th[j], atol=1e-6)
+        tool = np.array([_o3r_point(params, t) for t in pts])
+        assert np.abs(tool[:, 1]).max() < 1e-9  # in the section y = 0
+        assert np.linalg.norm(tool - target, axis=1).max() > 0.05  # it leaves the target and comes back
+        for t in pts:
+            assert np.sign(_o3r_det(params, t)) == np.sign(dets[i]) and abs(_o3r_det(params, t)) > 1e-3

@@ -15,6 +15,9 @@ For every pair of the modes found at the given inputs:
 Every path returned is checked again point by point (``check_path``): the loops closed, the held and the
 plane's inputs at their values, no step longer than connect.JUMP, the actuator measure above
 Tolerances.singular; its smallest value is reported.  The work is bounded (planes, cusps, steps) and says so.
+
+``serial_connections`` (``ik --all --connect``) does the same for a chain without loops: det J's sign, and for
+three joints placing a point, loops of the point round the cusps of a workspace section (section.py).
 """
 
 from __future__ import annotations
