@@ -175,4 +175,6 @@ def connections_lines(conns, what: str = "modes") -> list:
     lines = [f"{what} {c.modes[0] + 1} and {c.modes[1] + 1}: "
              + (c.why if c.joined or c.why.startswith("unknown") else f"not joined: {c.why}")
              for c in conns.connections]
+    if not conns.connections and conns.signs:
+        lines.append(f"no pair of {what} to compare: {len(conns.signs)} listed")
     return lines + [f"connections: {conns.how}"] + list(conns.notes)
