@@ -45,7 +45,7 @@ if TYPE_CHECKING:
     from screwkin.tolerances import Tolerances
     from collections.abc import Iterable
 
-__all__ = ["SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
+__all__ = ["actuator_det_rows", "actuator_det_sign", "SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -170,6 +170,31 @@ def _measures(S: Scaled, g: Generic) -> dict:
         scale = np.linalg.norm(S.J, 2)  # V is orthonormal: s <= |J|, meaningful when the output stops
         out["serial"] = float(s[g.out_dim - 1] / scale) if len(s) >= g.out_dim and scale > 0 else 0.0
     return out
+
+
+def actuator_det_rows(mech: Mechanism, g: Generic) -> tuple:
+    """(rows, why): the rows of K (minimal, dimensionless) that are not zero at every generic configuration,
+    when they make K_p square (as many as the passive joints, of full rank): det K_p[rows] is then a
+    continuous function on the configurations whose sign changes only where K_p is singular (an actuator
+    or constraint singularity).  rows None and why in words where K_p is not square so."""
+    if not mech.closure.nrows or not len(g.p):
+        return None, "no loop closed by passive joints: no actuator Jacobian"
+    size = np.zeros(mech.closure.nrows)
+    for q in g.configurations:
+        size = np.maximum(size, np.abs(scaled_jacobians(mech, q).K[:, g.p]).max(axis=1))
+    rows = np.flatnonzero(size > mech.tolerances.rank_rtol * size.max())
+    if g.rank_Kp != len(g.p) or len(rows) != len(g.p):
+        return None, (f"the actuator Jacobian K_p has {len(rows)} rows that move and {len(g.p)} passive columns "
+                      f"(rank {g.rank_Kp}): not square, its determinant's sign is no argument")
+    return rows, ""
+
+
+def actuator_det_sign(mech: Mechanism, q: np.ndarray, g: Generic, rows: np.ndarray) -> int:
+    """The sign of det K_p[rows] at q (dimensionless; rows from actuator_det_rows): +1, -1, or 0 where the
+    actuator measure is below Tolerances.singular (too near a singularity for its sign to say anything)."""
+    if measures(mech, q, g)["actuator"] < mech.tolerances.singular:
+        return 0
+    return int(np.sign(np.linalg.det(scaled_jacobians(mech, q).K[np.ix_(rows, g.p)])))
 
 
 def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output: str | None=None, length: float | None=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:

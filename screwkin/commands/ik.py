@@ -9,7 +9,9 @@ import pinocchio as pin
 
 from ..analysis.position.ik import branches, inverse_kinematics
 from ..errors import UsageError, quote
+from ..analysis.singularities.mode_connect import serial_connections
 from ..present.jsonout import json_of
+from ..present.loci import connections_dict, connections_lines
 from ..present.report import position_dict, position_text
 from ..units import parse_value
 from ._output_frame import add_point_option, add_tool_option, output_frame, output_frame_dict, output_frame_line
@@ -42,6 +44,9 @@ def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], sca
     sp.add_argument("--starts", type=count("starts"), default=16, help="random starting configurations (default 16)")
     sp.add_argument("--all", action="store_true",
                    help="show every assembly mode, also those the mechanism cannot reach by moving")
+    sp.add_argument("--connect", action="store_true",
+                    help="with --all: for each pair of the solutions, whether det J's signs prove every path between "
+                         "them meets a singularity (paths of the same sign are not searched: said so)")
 
 
 def run(mech: Mechanism, args: argparse.Namespace) -> int:
@@ -56,13 +61,24 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
                          f"--position expects x,y,z, got {quote(args.position, 80)}")
     v = [parse_value(p, "length" if k < 3 else "angle", option) for k, p in enumerate(parts)] + [0.0] * (6 - n)
     pose = pin.SE3(pin.rpy.rpyToMatrix(np.array(v[3:])), np.array(v[:3]))
+    if args.connect and not args.all:
+        raise UsageError("--connect needs --all: it compares the solutions --all lists")
     output, _ = output_frame(mech, args, required=True)
     res = inverse_kinematics(mech, output, pose, starts=args.starts, position_only=n == 3)
     # the output frame (point, tool) on its link; each solution's output_pose is that frame's
     frame = output_frame_dict(mech, res.solutions[0].q) if mech.tool is not None else None
     count = branches(mech, res)
+    conns = None
+    if args.connect:
+        plain = mech.tool is None and not args.points  # the link's own origin: its Jacobian is the one compared
+        conns = serial_connections(mech, output, [s.q for s in res.solutions], point=n == 3,
+                                   target=v[:3] if n == 3 else None) if plain else \
+            replace(serial_connections(mech, output, [], False), notes=(
+                "--tool or --point: the det J of the tool frame is not compared; give the output link alone",))
     if args.json:
         d = position_dict(res)
+        if conns is not None:
+            d.update(connections_dict(conns, mech))
         d["branches"] = {"found": count.found, "at_most": count.at_most, "why": count.why or None,
                          "legs": [{"joints": list(j), "found": k, "at_most": m} for j, k, m in count.legs]}
         if frame is not None:
@@ -96,6 +112,9 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
                 print(f"solution {k} actuated: " + ", ".join(f"{n} = {s.joints[n]:.9g}" for n in mech.actuated))
         # the continuum was said first: not again in the table's header
         print(position_text(replace(res, free_dofs=0), show_all=args.all).split("\n", 1)[1])
+        if conns is not None:
+            print()
+            print("\n".join(connections_lines(conns, "solutions")))
     return 0
 
 

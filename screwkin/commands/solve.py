@@ -10,7 +10,12 @@ from ..analysis.course.newton import differing, start_estimates, textbook_newton
 from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..present.equations import Units, greek, newton_dict, newton_text
+from ..analysis.singularities.mode_connect import Connections, connect_modes
+from ..analysis.course.skeleton import skeleton
+from ..present.animate import animation_format, write_animation
+from ..present.draw import drawing_title
 from ..present.jsonout import json_of
+from ..present.loci import connections_dict, connections_lines
 from ..present.report import (
     position_dict,
     position_text,
@@ -66,6 +71,11 @@ def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callab
     sp.add_argument("--iterations", type=count("iterations"), metavar="K",
                    help="with --start: exactly K Newton iterations, each printed (residual, Jacobian, step, "
                         "estimates); without it Newton goes on to convergence")
+    sp.add_argument("--connect", action="store_true",
+                    help="with --all: for each pair of the modes listed, whether a path joins them without a singularity "
+                         "(det J's sign; a loop of two inputs round a cusp of the actuator singular curve), the path or why not")
+    sp.add_argument("--animate", metavar="OUT.gif|OUT.mp4",
+                    help="with --connect: write an animation of the first path that joins two modes")
     scaled(sp, point=False)
 
 
@@ -86,14 +96,33 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
         check_rate_names(given, [*values, *held], option)
     if args.starts < 0:
         raise UsageError("--starts must be 0 or more")
+    if (args.connect or args.animate) and not args.all:
+        raise UsageError("--connect needs --all: it compares the modes --all lists"
+                         if args.connect else "--animate needs --all --connect: it animates a path between two modes")
+    if args.animate and not args.connect:
+        raise UsageError("--animate needs --connect: it animates a path between two modes")
+    if args.connect and (held or pivots or args.start or args.iterations is not None or args.near):
+        raise UsageError("--connect compares the modes of --set (and --set-length) inputs; leave out --set-angle, "
+                         "--start, --iterations and --near")
+    if args.animate:
+        animation_format(args.animate)  # checked before the work
     if args.start or args.iterations is not None:
         return _solve_from_start(mech, args, values, held)
     solver = input_solver(mech, values, held, output=args.output)
     res = solver.solve(values, near=near, rates=rates, accels=accels, starts=args.starts, trace=args.trace,
                        points=named_points(mech, args), method="auto" if args.all else "nearest")
+    conns = None
+    if args.connect:
+        conns = connect_modes(solver, values, [s.q for s in res.solutions]) if not res.free_dofs else Connections(
+            (), (), "not compared: the inputs leave a continuum of configurations (the solutions listed are samples)")
+    animated = _animate_connection(mech, args, conns) if args.animate else None
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length
+        if conns is not None:
+            d.update(connections_dict(conns, mech, solver.output_frame))
+        if args.animate:
+            d["animation"] = {k: v for k, v in animated.items() if k != "said"}
         print(json_of(d))
         return 0
     if args.trace:
@@ -104,7 +133,27 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
         else None
     units = RateUnits.typed(typed["rate"].values(), typed["accel"].values())
     print(position_text(res, show_all=args.all, length=mech.length, units=units, leg_lengths=legs))
+    if conns is not None:
+        print()
+        print("\n".join(connections_lines(conns)))
+    if args.animate:
+        print(animated["said"])
     return 0
+
+
+def _animate_connection(mech: Mechanism, args: argparse.Namespace, conns) -> dict:
+    """solve --connect --animate OUT: the skeleton along the first path that joins two modes."""
+    c = next((c for c in conns.connections if c.joined), None)
+    if c is None:
+        return {"file": None, "modes": None, "frames": 0, "said": f"--animate: no path joins two modes; {args.animate} not written"}
+    first = skeleton(mech, c.path[0], list(mech.actuated) or None)
+    skels = [first, *(skeleton(mech, q, list(mech.actuated) or None, basis=first.basis) for q in c.path[1:])]
+    i, j = c.modes[0] + 1, c.modes[1] + 1
+    titles = [drawing_title(mech, f"mode {i} to mode {j} without a singularity ({k + 1}/{len(skels)})")
+              for k in range(len(skels))]
+    n = write_animation(args.animate, skels, titles, fps=10.0)
+    return {"file": args.animate, "modes": [i, j], "frames": n,
+            "said": f"wrote {args.animate}: the path from mode {i} to mode {j}, {n} frames (the first joined pair)"}
 
 
 # ------------------------------------------------------------------ solve --start

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.state import KinematicState
 from ..units import in_unit
 from .outfile import write_figure
 from .plots import pyplot
@@ -17,7 +18,7 @@ if TYPE_CHECKING:
     from screwkin.analysis.singularities.regions import Regions
     from collections.abc import Sequence
 
-__all__ = ["loci_dict", "loci_lines", "loci_png"]
+__all__ = ["connections_dict", "connections_lines", "loci_dict", "loci_lines", "loci_png"]
 
 _COLOURS = {"actuator": "tab:red", "serial": "tab:blue", "constraint": "tab:purple"}
 
@@ -148,3 +149,32 @@ def loci_png(loci: Loci, regions: Regions, path: str, xs: np.ndarray, ys: np.nda
         write_figure(fig, path, dpi=100, metadata={"Title": ax.get_title()})
     finally:
         plt.close(fig)
+
+
+def connections_dict(conns, mech: Mechanism, output_frame: int | None = None) -> dict:
+    """The keys ``solve``/``ik --all --connect --json`` add: connections [{modes: [i, j] (numbered as the
+    listing, from 1), joined, proved, why, plane, sigma_min, path: [{joints, output_pose (with an output)}]}],
+    det_signs (each mode's, null where no argument), connections_how, connections_notes."""
+    out = []
+    for c in conns.connections:
+        path = []
+        for q in (c.path if c.path is not None else []):
+            point = {"joints": mech.joint_values(q)}
+            if output_frame is not None:
+                point["output_pose"] = KinematicState(mech, q).frame_pose(output_frame).tolist()
+            path.append(point)
+        out.append({"modes": [c.modes[0] + 1, c.modes[1] + 1], "joined": c.joined, "proved": c.proved,
+                    "why": c.why, "plane": list(c.plane) if c.plane else None, "sigma_min": c.sigma_min,
+                    "path": path})
+    return {"connections": out, "det_signs": list(conns.signs), "connections_how": conns.how,
+            "connections_notes": list(conns.notes)}
+
+
+def connections_lines(conns, what: str = "modes") -> list:
+    """Text: one line per pair, then how and the notes."""
+    lines = [f"{what} {c.modes[0] + 1} and {c.modes[1] + 1}: "
+             + (c.why if c.joined or c.why.startswith("unknown") else f"not joined: {c.why}")
+             for c in conns.connections]
+    if not conns.connections and conns.signs:
+        lines.append(f"no pair of {what} to compare: {len(conns.signs)} listed")
+    return lines + [f"connections: {conns.how}"] + list(conns.notes)

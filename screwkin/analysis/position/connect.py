@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from screwkin.analysis.position.position import PositionSolver
 
-__all__ = ["CuspLoop", "Loop", "apart", "cusp_loops", "loop", "wedge_direction"]
+__all__ = ["CuspLoop", "Loop", "apart", "cusp_loops", "follow_inputs", "loop", "wedge_direction"]
 
 #: A step of the loop that moves the configuration further than this (dimensionless) jumped branches.
 JUMP = 0.05
@@ -54,11 +54,17 @@ def loop(solver: PositionSolver, x_name: str, y_name: str, fixed: dict, centre: 
          turn: int = 1) -> Loop:
     """Follow q0 (at the angle ``start`` of the ellipse) once round the ellipse of the inputs with ``centre``
     and semi-axes ``radius``, counter-clockwise (turn 1) or clockwise (turn -1), in ``steps`` steps."""
+    angles = start + turn * np.linspace(0.0, 2 * np.pi, steps + 1)
+    xy = np.column_stack([centre[0] + radius[0] * np.cos(angles), centre[1] + radius[1] * np.sin(angles)])
+    return follow_inputs(solver, x_name, y_name, fixed, xy, q0)
+
+
+def follow_inputs(solver: PositionSolver, x_name: str, y_name: str, fixed: dict, xy: np.ndarray, q0: np.ndarray) -> Loop:
+    """Follow q0 (at the inputs xy[0]) along the inputs xy (n, 2) of x and y (the others held at ``fixed``),
+    each step a damped Newton solve from the last configuration, checked as a sweep is (see the module)."""
     mech = solver.mech
     tol = mech.tolerances
     g = Generic(mech, solver.inputs, configurations=solver.generic().configurations)
-    angles = start + turn * np.linspace(0.0, 2 * np.pi, steps + 1)
-    xy = np.column_stack([centre[0] + radius[0] * np.cos(angles), centre[1] + radius[1] * np.sin(angles)])
     Q = [np.array(q0, float)]
     sig = [measures(mech, Q[0], g)["actuator"]]
     for k in range(1, len(xy)):
