@@ -34,6 +34,7 @@ from ..model.linalg import complement, null_space, rank
 from ..model.cuts import in_plane, pair_contact
 from ..model.geometry import plane_basis
 from ..model.kernel.scaling import dimensionless, dimensionless_twists
+from ..model.kernel.stacks import tree_kinematics
 from ..model.state import KinematicState, loop_coordinate_cuts
 from ..tolerances import DEFAULT
 from .screws import cut_twists, screw_of
@@ -178,8 +179,6 @@ def stacked_measures(mech: Mechanism, Q: np.ndarray, g: Generic, K: np.ndarray) 
     model.kernel.stacks.BatchClosure's); the output's Jacobian from model.kernel.stacks.TreeKinematics.
     The same numbers as ``measures`` row by row, to round-off (stacked SVDs); None when the output's
     Jacobian cannot be stacked (a joint TreeKinematics does not take)."""
-    from ..model.kernel.stacks import tree_kinematics
-
     Q = np.atleast_2d(np.asarray(Q, float))
     N, L, tol = len(Q), float(mech.length), mech.tolerances
     slide = mech.translational

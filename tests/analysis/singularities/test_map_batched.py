@@ -25,13 +25,13 @@ from screwkin.analysis.singularities.maps import singularity_map
 ROBOTS = Path(__file__).resolve().parents[3] / "robots"
 
 
-def _point_by_point(solver, xn, xs, yn, ys, fixed, q_first):
+def _point_by_point(solver, xn, xs, yn, ys, fixed, q_first, output=None, point=False):
     """The map's breadth-first walk with one continuation step at a time (maps._grow: the walk before the
     batches) and the measures one configuration at a time."""
     mech = solver.mech
     steps = {xn: Neighbour(solver, xn), yn: Neighbour(solver, yn)}
     qs, reached = maps._grow(steps, mech.nq, xn, xs, yn, ys, q_first)
-    g = Generic(mech, solver.inputs, None, False, configurations=solver.generic().configurations)
+    g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
     logs = np.full(reached.shape, np.nan)
     for j, i in zip(*np.nonzero(reached)):
         m = measures(mech, qs[j, i], g)
@@ -70,6 +70,18 @@ def test_the_batched_five_bar_map_is_the_point_by_point_walk_and_the_solvers_mod
         assert gap[k] < 1e-7, (j, i, gap)
         m = measures(mech, modes[k], g)
         assert abs(np.log10(max(min(m.values()), 1e-16)) - res.log_sigma[j, i]) < 1e-6
+
+
+@pytest.mark.parametrize("point", [True, False])
+def test_the_batched_map_with_an_output_measures_its_serial_singularities_as_one_at_a_time(point):
+    """With --output the stacked measures take the output link's Jacobian from the batched tree (serial kind)."""
+    mech = screwkin.load(ROBOTS / "five_bar.urdf")
+    solver = screwkin.PositionSolver(mech)
+    xs, ys = np.linspace(-1.2, 1.4, 9), np.linspace(-1.0, 1.3, 8)
+    q_first = solver.solve({"motor1": xs[0], "motor2": ys[0]}).solutions[0].q
+    res = singularity_map(solver, "motor1", xs, "motor2", ys, {}, "tip", point, q_start=q_first)
+    assert "serial" in set(res.kind[res.reached])
+    _compare(mech, res, _point_by_point(solver, "motor1", xs, "motor2", ys, {}, q_first, "tip", point))
 
 
 @pytest.mark.slow
