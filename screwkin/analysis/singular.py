@@ -34,6 +34,7 @@ from ..model.linalg import complement, null_space, rank
 from ..model.cuts import in_plane, pair_contact
 from ..model.geometry import plane_basis
 from ..model.kernel.scaling import dimensionless, dimensionless_twists
+from ..model.kernel.stacks import tree_kinematics
 from ..model.state import KinematicState, loop_coordinate_cuts
 from ..tolerances import DEFAULT
 from .screws import cut_twists, screw_of
@@ -45,7 +46,8 @@ if TYPE_CHECKING:
     from screwkin.tolerances import Tolerances
     from collections.abc import Iterable
 
-__all__ = ["actuator_det_rows", "actuator_det_sign", "SingularityReport", "SingularTwist", "Generic", "classify", "measures", "scaled_jacobians", "lost_direction",
+__all__ = ["actuator_det_rows", "actuator_det_sign", "SingularityReport", "SingularTwist", "Generic", "classify", "measures",
+           "stacked_measures", "scaled_jacobians", "lost_direction",
            "KINDS", "named_types", "GramLoop", "loop_twists", "gram_cofactors", "pair_twist", "pair_rate"]
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -195,6 +197,62 @@ def actuator_det_sign(mech: Mechanism, q: np.ndarray, g: Generic, rows: np.ndarr
     if measures(mech, q, g)["actuator"] < mech.tolerances.singular:
         return 0
     return int(np.sign(np.linalg.det(scaled_jacobians(mech, q).K[np.ix_(rows, g.p)])))
+
+
+def stacked_measures(mech: Mechanism, Q: np.ndarray, g: Generic, K: np.ndarray) -> dict:
+    """``measures`` of every row of the closed configurations Q (N, nq) at once: {kind: (N,)}, the kinds in
+    measures' order.  K (N, rows, nv): their constraint Jacobians, the rows of ClosureSystem.jacobian (a
+    model.kernel.stacks.BatchClosure's); the output's Jacobian from model.kernel.stacks.TreeKinematics.
+    The same numbers as ``measures`` row by row, to round-off (stacked SVDs); None when the output's
+    Jacobian cannot be stacked (a joint TreeKinematics does not take)."""
+    Q = np.atleast_2d(np.asarray(Q, float))
+    N, L, tol = len(Q), float(mech.length), mech.tolerances
+    slide = mech.translational
+    ones = np.ones(N)
+
+    def rel(S: np.ndarray, k: int) -> np.ndarray:  # _rel of every row
+        if k <= 0:
+            return ones.copy()
+        if S.shape[1] < k:
+            return np.zeros(N)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(S[:, 0] > 0, S[:, k - 1] / np.where(S[:, 0] > 0, S[:, 0], 1.0), 0.0)
+
+    Ks = dimensionless(K, mech.closure.position_rows, slide, L) if K.shape[1] else np.zeros((N, 0, mech.nv))
+    out = {"constraint": rel(np.linalg.svd(Ks, compute_uv=False), g.rank_K) if Ks.shape[1] else ones.copy()}
+    out["actuator"] = (rel(np.linalg.svd(Ks[:, :, g.p], compute_uv=False), g.rank_Kp)
+                       if Ks.shape[1] and len(g.p) and g.rank_Kp else ones.copy())
+    if g.output is None or not g.out_dim:
+        return out
+    tree = tree_kinematics(mech)
+    if tree is None:
+        return None
+    fid = mech.link_frame(g.output)
+    J = np.zeros((N, 6, mech.nv))
+    _, _, Jc, cols = tree.frames(Q, [fid])[fid]
+    if Jc is not None:
+        J[:, :, cols] = Jc
+    J = dimensionless_twists(J, slide, L)
+    J = J[:, :3] if g.point else J
+    serial = np.zeros(N)
+    norms = np.linalg.norm(J, 2, axis=(1, 2))
+    if Ks.shape[1]:  # V: the null space of K, by null_space's rank rule, row by row
+        _, s, vt = np.linalg.svd(Ks, full_matrices=True)
+        r = np.sum(s > np.maximum(tol.rank_rtol * s[:, :1], tol.rank_atol), axis=1)
+        r[s[:, 0] <= tol.rank_atol] = 0
+    else:
+        vt, r = np.broadcast_to(np.eye(mech.nv), (N, mech.nv, mech.nv)), np.zeros(N, int)
+    for rk in np.unique(r):
+        rows = np.flatnonzero(r == rk)
+        T = J[rows] @ vt[rows, rk:].transpose(0, 2, 1)
+        if T.shape[2] == 0:
+            continue
+        sv = np.linalg.svd(T, compute_uv=False)
+        if sv.shape[1] >= g.out_dim:
+            ok = norms[rows] > 0
+            serial[rows] = np.where(ok, sv[:, g.out_dim - 1] / np.where(ok, norms[rows], 1.0), 0.0)
+    out["serial"] = serial
+    return out
 
 
 def classify(mech: Mechanism, q: np.ndarray, inputs: list | None = None, output: str | None=None, length: float | None=None, generic: Generic | None = None, point: bool = False) -> SingularityReport:

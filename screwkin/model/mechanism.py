@@ -262,12 +262,16 @@ class Mechanism:
 
     def difference(self, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
         """The velocity-space step from q0 to q1 (pinocchio.difference), with the angles of
-        bounded revolute joints taken the short way round [-pi, pi)."""
-        d = pin.difference(self.model, q0, q1)
+        bounded revolute joints taken the short way round [-pi, pi).  Stacks (N, nq) give (N, nv)."""
+        if np.ndim(q0) == 2 or np.ndim(q1) == 2:  # (nq == nv: every joint a vector space, the plain difference)
+            d = (np.asarray(q1, float) - np.asarray(q0, float) if self.model.nq == self.model.nv else
+                 np.array([pin.difference(self.model, a, b) for a, b in zip(*np.broadcast_arrays(q0, q1))]))
+        else:
+            d = pin.difference(self.model, q0, q1)
         _, _, _, _, idx, wrap = self._value_layout()
         if wrap.any():
             v = self._angle_v
-            d[v] = wrap_angle(d[v])
+            d[..., v] = wrap_angle(d[..., v])
         return d
 
     def joint_values(self, q: np.ndarray) -> dict:

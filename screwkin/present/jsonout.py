@@ -64,7 +64,28 @@ def _of(obj: np.ndarray, indent: int, sort_keys: bool, level: int) -> str:
         if obj.ndim == 1:
             return "[\n" + inner + (",\n" + inner).join(values) + "\n" + pad + "]"
         return _rows_text(values, *obj.shape, pad, inner, " " * indent)
+    if isinstance(obj, np.ndarray) and obj.ndim in (1, 2) and obj.size:
+        values = _texts(obj)
+        if values is not None:  # (a map's grids: NaN cells, flags, kinds -- a join, not a dumps a value)
+            pad, inner = " " * (indent * level), " " * (indent * (level + 1))
+            if obj.ndim == 1:
+                return "[\n" + inner + (",\n" + inner).join(values) + "\n" + pad + "]"
+            return _rows_text(values, *obj.shape, pad, inner, " " * indent)
     return json_text(to_jsonable(obj), indent, sort_keys, level)
+
+
+def _texts(obj: np.ndarray) -> list | None:
+    """The JSON texts of an array's values (row by row) when they are all NaN-or-finite floats, booleans or
+    strings; else None."""
+    flat = obj.ravel()
+    if obj.dtype.kind == "f" and not np.isinf(flat).any():
+        return ["null" if v != v else float.__repr__(v) for v in flat.tolist()]
+    if obj.dtype.kind == "b":
+        return ["true" if v else "false" for v in flat.tolist()]
+    values = flat.tolist()
+    if obj.dtype.kind in "OU" and all(type(v) is str for v in values):
+        return [json.dumps(v) for v in values]
+    return None
 
 
 def _items(d: dict, sort_keys: bool):

@@ -25,14 +25,14 @@ import numpy as np
 
 from ...model.kernel.stacks import BatchClosure, Unbatchable
 from ...model.geometry import TINY
-from .continuation import Curve, Motion, jumped, passes_limit
+from .continuation import Curve, Motion, jumped, passes_limit, projections
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
     from collections.abc import Callable
 
-__all__ = ["batch_closure", "BatchedCurve", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
+__all__ = ["batch_closure", "BatchedCurve", "GridNeighbours", "batched_motion", "motion_rates", "SMALLEST", "LARGEST"]
 
 SMALLEST, LARGEST = 4, 256  # grid values a chunk: it starts at 16 and doubles while it goes well
 
@@ -78,6 +78,84 @@ class BatchedCurve(Curve):
         if T is not None:
             ok &= ~passes_limit(np.vstack([t[None], T[:-1]]), T, self.ix)
         return ok
+
+
+class GridNeighbours:
+    """continuation.Neighbour along either of two inputs, for a stack: row k taken from input value
+    x_from[k] to x_to[k] of input ``names[axis[k]]`` on the branch of configuration Q[k], by the same
+    pieces (continuation_steps), tangent (Curve.along, Curve.tangent), corrector, jump test and limit test
+    as Neighbour takes them one configuration at a time -- the same answers to round-off.  Both inputs'
+    steps hold every input (the one moved at its new value), so the rows of both are corrected together
+    (BatchClosure.solve: the one Newton loop, each row its own damping and its own end).  A map walks its
+    grid with it a wavefront at a time (analysis.singularities.maps)."""
+
+    def __init__(self, solver, names: tuple, bc: BatchClosure) -> None:
+        self.curves = [BatchedCurve(solver, n, bc) for n in names]
+        self.bc, self.mech, self.tol = bc, solver.mech, solver.mech.tolerances
+        self.scale = self.curves[0].scale
+
+    def directions(self, Q: np.ndarray) -> np.ndarray:
+        """(N, 2, nv) each input's unnormalized tangent at Q (Curve.input_directions), and (N, rows, nv) K."""
+        K = self.bc.constraint_jacobians(Q) if self.bc.nrows else np.zeros((len(Q), 0, self.mech.nv))
+        return np.stack([c.input_directions(K) for c in self.curves], axis=1), K
+
+    def __call__(self, Q: np.ndarray, axis: np.ndarray, x_from: np.ndarray, x_to: np.ndarray,
+                 U: np.ndarray | None = None) -> tuple:
+        """(configurations (N, nq), reached (N,) bool, their directions (N, 2, nv)): each row at input value
+        x_to on its branch (rows not reached keep their start; their directions are NaN).  U: the
+        directions at Q when known (``directions``)."""
+        Q = np.array(np.atleast_2d(Q), float)
+        N, tol, scale = len(Q), self.tol, self.scale
+        axis = np.asarray(axis, int)
+        x_from, x_to = np.asarray(x_from, float), np.asarray(x_to, float)
+        ix = np.array([c.ix for c in self.curves])[axis]
+        rows = np.arange(N)
+        U = self.directions(Q)[0] if U is None else np.array(U, float)
+        direction = np.sign(x_to - x_from)
+        pieces = np.ceil(np.abs(x_to - x_from) / (tol.max_step * scale[ix])).astype(int)  # continuation_steps
+        out, ok, U_out = Q.copy(), np.ones(N, bool), U.copy()
+        t = U[rows, axis]
+        n = np.linalg.norm(t, axis=1)
+        good = (n >= TINY) | (direction == 0)  # Curve.along: the unit tangent, the input moving the way of x_to
+        t = t / np.where(n >= TINY, n, 1.0)[:, None]
+        t *= np.where(t[rows, ix] * np.where(direction == 0, 1.0, direction) < 0, -1.0, 1.0)[:, None]
+        live = rows[(direction != 0) & good]
+        ok[~good] = False
+        q, x, t = Q[live], x_from[live], t[live]
+        for k in range(1, int(pieces.max(initial=0)) + 1):
+            keep = k <= pieces[live]
+            live, q, x, t = live[keep], q[keep], x[keep], t[keep]
+            if not len(live):
+                break
+            a, b, m, i, ax = x_from[live], x_to[live], pieces[live], ix[live], axis[live]
+            x_next = np.where(k == m, b, a + (b - a) * k / m)
+            share = t[np.arange(len(live)), i]
+            moves = np.abs(share) >= tol.zero  # Curve.at_input: the input moves here
+            sigma = (x_next - x) / scale[i] / np.where(moves, share, 1.0)
+            pred = q + scale * t * sigma[:, None]  # (nq == nv: integrate is a sum)
+            Qc, good = self.curves[0].correct(pred, self.curves[0].ix)  # (every input held: either curve's)
+            good &= moves & ~jumped(np.linalg.norm((Qc - pred) / scale, axis=1), sigma, tol)
+            Un, K = self.directions(Qc)
+            T = Un[np.arange(len(live)), ax]
+            nt = np.linalg.norm(T, axis=1)
+            low = nt < tol.limit_share  # Curve.tangent at a limit position itself: the previous one projected
+            for c in (0, 1):
+                sel = low & (ax == c)
+                if sel.any():
+                    cv = self.curves[c]
+                    T[sel] = projections(K[sel], t[sel], scale, cv.free, tol)
+                    nt[sel] = np.linalg.norm(T[sel], axis=1)
+            good &= nt >= TINY
+            T = T / np.where(nt >= TINY, nt, 1.0)[:, None]
+            T *= np.where(np.einsum("ij,ij->i", T, t) < 0, -1.0, 1.0)[:, None]  # orient
+            r = np.arange(len(live))
+            good &= ~passes_limit(t[r, i][:, None], T[r, i][:, None], 0)
+            ok[live[~good]] = False
+            out[live[good]], U_out[live[good]] = Qc[good], Un[good]
+            live, q, x, t = live[good], Qc[good], x_next[good], T[good]
+        out[~ok] = Q[~ok]
+        U_out[~ok] = np.nan
+        return out, ok, U_out
 
 
 def batched_motion(solver, curve: Curve, q0: np.ndarray, t0: np.ndarray, start: float, stop: float, steps: int, fallback: Callable, progress=None):

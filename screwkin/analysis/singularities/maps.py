@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError, quote, shorten
-from ..singular import Generic, measures
+from ..singular import Generic, measures, stacked_measures
+from ..motion.batch_sweep import GridNeighbours, batch_closure
 from ..motion.continuation import Neighbour
 from ..position.connect import apart
 from typing import TYPE_CHECKING
@@ -69,29 +70,31 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
     g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
     logs = np.full((len(ys), len(xs)), np.nan)
     kinds = np.full((len(ys), len(xs)), "", dtype=object)
-    qs = np.full((len(ys), len(xs), mech.nq), np.nan)
-    reached = np.zeros((len(ys), len(xs)), bool)
     steps = {x_name: Neighbour(solver, x_name), y_name: Neighbour(solver, y_name)}
-    grids = {x_name: xs, y_name: ys}
-    queue = deque([(0, 0)])
-    qs[0, 0], reached[0, 0] = q_first, True
-    while queue:  # breadth first: each cell from its nearest reached neighbour
-        j, i = queue.popleft()
-        for dj, di in ((0, 1), (1, 0), (0, -1), (-1, 0)):
-            jn, in_ = j + dj, i + di
-            if not (0 <= jn < len(ys) and 0 <= in_ < len(xs)) or reached[jn, in_]:
-                continue
-            name, a, b = (x_name, i, in_) if di else (y_name, j, jn)
-            q = steps[name](qs[j, i], float(grids[name][a]), float(grids[name][b]))
-            if q is not None:
-                qs[jn, in_], reached[jn, in_] = q, True
-                queue.append((jn, in_))
-    for j, i in zip(*np.nonzero(reached)):
-        m = measures(mech, qs[j, i], g)
-        kind = min(m, key=m.get)
-        logs[j, i] = np.log10(max(m[kind], 1e-16))
-        kinds[j, i] = kind
-    seam = seams(mech, qs, reached, steps[x_name], steps[y_name], xs, ys)
+    bc = batch_closure(mech)
+    batched = None
+    if bc is not None and bc.target is None and mech.model.nq == mech.model.nv:
+        batched = GridNeighbours(solver, (x_name, y_name), bc)
+        qs, reached = _grow_batched(batched, mech.nq, xs, ys, q_first)
+    else:
+        qs, reached = _grow(steps, mech.nq, x_name, xs, y_name, ys, q_first)
+    J, I = np.nonzero(reached)
+    table = None
+    if bc is not None and len(J):
+        table = stacked_measures(mech, qs[J, I], g, bc.constraint_jacobians(qs[J, I]))
+    if table is not None:
+        names = list(table)
+        M = np.column_stack([table[k] for k in names])
+        best = np.argmin(M, axis=1)  # (the first of equal ones, as min over the dict)
+        logs[J, I] = np.log10(np.maximum(M[np.arange(len(J)), best], 1e-16))
+        kinds[J, I] = np.array(names, dtype=object)[best]
+    else:
+        for j, i in zip(J, I):
+            m = measures(mech, qs[j, i], g)
+            kind = min(m, key=m.get)
+            logs[j, i] = np.log10(max(m[kind], 1e-16))
+            kinds[j, i] = kind
+    seam = seams(mech, qs, reached, steps[x_name], steps[y_name], xs, ys, batched=batched)
     off = int(reached.size - reached.sum())
     notes = (f"{off} of {reached.size} points are not reached from the first one by continuation on its "
              "assembly mode (another mode, past a limit position, or not assembled): left blank",) if off else ()
@@ -102,26 +105,117 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
     return SingularityMap(x_name, y_name, xs, ys, logs, kinds, qs, reached, notes, seam)
 
 
-def seams(mech: Mechanism, qs: np.ndarray, reached: np.ndarray, step_x: Neighbour | None=None, step_y: Neighbour | None=None, xs: np.ndarray | None=None, ys: np.ndarray | None=None) -> np.ndarray:
+_DIRECTIONS = ((0, 1), (1, 0), (0, -1), (-1, 0))  # the order each cell tries its neighbours in
+
+
+def _grow(steps: dict, nq: int, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, q_first: np.ndarray) -> tuple:
+    """The map's cells reached from the first corner, breadth first, each from its first reached neighbour
+    (in queue order, neighbours in _DIRECTIONS' order) whose step (continuation.Neighbour) arrives:
+    (qs (ny, nx, nq) NaN where not reached, reached (ny, nx))."""
+    qs = np.full((len(ys), len(xs), nq), np.nan)
+    reached = np.zeros((len(ys), len(xs)), bool)
+    grids = {x_name: xs, y_name: ys}
+    queue = deque([(0, 0)])
+    qs[0, 0], reached[0, 0] = q_first, True
+    while queue:
+        j, i = queue.popleft()
+        for dj, di in _DIRECTIONS:
+            jn, in_ = j + dj, i + di
+            if not (0 <= jn < len(ys) and 0 <= in_ < len(xs)) or reached[jn, in_]:
+                continue
+            name, a, b = (x_name, i, in_) if di else (y_name, j, jn)
+            q = steps[name](qs[j, i], float(grids[name][a]), float(grids[name][b]))
+            if q is not None:
+                qs[jn, in_], reached[jn, in_] = q, True
+                queue.append((jn, in_))
+    return qs, reached
+
+
+def _grow_batched(steps: GridNeighbours, nq: int, xs: np.ndarray, ys: np.ndarray, q_first: np.ndarray) -> tuple:
+    """``_grow``'s breadth-first walk a wavefront at a time, its steps batched (motion.batch_sweep.
+    GridNeighbours): the same cells from the same neighbours in the same order.  Breadth first, the
+    cells of one level are all taken before any of the next, and a cell of the next is reached by the
+    first of its tries (its neighbours of this level in queue order, each's directions in _DIRECTIONS'
+    order) that arrives; a try's answer depends only on its start and its two input values.  So every
+    cell's first try is taken at once, then the second of those whose first failed, and so on; the next
+    level's queue order is the order of the tries that reached its cells."""
+    ny, nx = len(ys), len(xs)
+    qs = np.full((ny, nx, nq), np.nan)
+    U = np.full((ny, nx, 2, nq), np.nan)  # each reached cell's tangent directions (GridNeighbours.directions)
+    reached = np.zeros((ny, nx), bool)
+    qs[0, 0], U[0, 0], reached[0, 0] = q_first, steps.directions(q_first[None])[0][0], True
+    level = [(0, 0)]
+    while level:
+        tries = {}  # cell -> its tries ((position of the source in the level, direction), ...) in order
+        for pos, (j, i) in enumerate(level):
+            for d, (dj, di) in enumerate(_DIRECTIONS):
+                jn, in_ = j + dj, i + di
+                if 0 <= jn < ny and 0 <= in_ < nx and not reached[jn, in_]:
+                    tries.setdefault((jn, in_), []).append((pos, d))
+        won = {}  # cell -> the try that reached it
+        which = dict.fromkeys(tries, 0)
+        while which:
+            cells = list(which)
+            pick = [tries[c][which[c]] for c in cells]
+            S = np.array([level[pos] for pos, _ in pick])
+            C = np.array(cells)
+            axis = np.array([0 if _DIRECTIONS[d][1] else 1 for _, d in pick])
+            a = np.where(axis == 0, xs[np.where(axis == 0, S[:, 1], 0)], ys[np.where(axis == 1, S[:, 0], 0)])
+            b = np.where(axis == 0, xs[np.where(axis == 0, C[:, 1], 0)], ys[np.where(axis == 1, C[:, 0], 0)])
+            Qn, ok, Un = steps(qs[S[:, 0], S[:, 1]], axis, a, b, U[S[:, 0], S[:, 1]])
+            for k, c in enumerate(cells):
+                if ok[k]:
+                    won[c] = pick[k]
+                    qs[c], U[c] = Qn[k], Un[k]
+                    del which[c]
+                else:
+                    which[c] += 1
+                    if which[c] == len(tries[c]):
+                        del which[c]
+        level = sorted(won, key=won.get)
+        for c in level:
+            reached[c] = True
+    return qs, reached
+
+
+def seams(mech: Mechanism, qs: np.ndarray, reached: np.ndarray, step_x: Neighbour | None=None, step_y: Neighbour | None=None, xs: np.ndarray | None=None, ys: np.ndarray | None=None,
+          batched: tuple | None = None) -> np.ndarray:
     """Neighbouring reached cells (one input step apart) on different sheets of the mapped mode:
     their configurations differ by more than Tolerances.near_far (rad; lengths over the
     characteristic length) and -- when the steps (analysis.motion.continuation.Neighbour along x and y) and
     grids are given -- continuation from one does not arrive at the other (a steep but continuous
     stretch near a singular point is no seam).  Continuation round a singular point can come back on
-    another sheet: the map's mode is one sheet only up to these seams.  (k, 4) int rows j, i, j2, i2."""
+    another sheet: the map's mode is one sheet only up to these seams.  (k, 4) int rows j, i, j2, i2.
+    batched: the steps as motion.batch_sweep.GridNeighbours, taken all at once (the same answers)."""
     out = []
     tol = mech.tolerances.near_far
-    for (dj, di), step, grid in (((0, 1), step_x, xs), ((1, 0), step_y, ys)):
-        for j, i in zip(*np.nonzero(reached)):
-            jn, in_ = j + dj, i + di
-            if jn >= reached.shape[0] or in_ >= reached.shape[1] or not reached[jn, in_]:
-                continue
-            if apart(mech, qs[j, i], qs[jn, in_]) <= tol:
-                continue
-            if step is not None:
-                a, b = (i, in_) if di else (j, jn)
-                q = step(qs[j, i], float(grid[a]), float(grid[b]))
-                if q is not None and apart(mech, q, qs[jn, in_]) <= tol:
-                    continue
-            out.append((j, i, jn, in_))
+    for axis, ((dj, di), step, grid) in enumerate((((0, 1), step_x, xs), ((1, 0), step_y, ys))):
+        ny, nx = reached.shape
+        both = reached[:ny - dj, :nx - di] & reached[dj:, di:]
+        J, I = np.nonzero(both)
+        if not len(J):
+            continue
+        far = _apart(mech, qs[J, I], qs[J + dj, I + di]) > tol
+        J, I = J[far], I[far]
+        if step is not None and len(J):
+            a, b = (I, I + di) if di else (J, J + dj)
+            if batched is not None:
+                Q, ok, _ = batched(qs[J, I], np.full(len(J), axis), grid[a], grid[b])
+                joined = ok & (_apart(mech, Q, qs[J + dj, I + di]) <= tol)
+            else:
+                joined = np.zeros(len(J), bool)
+                for k, (j, i) in enumerate(zip(J, I)):
+                    q = step(qs[j, i], float(grid[a[k]]), float(grid[b[k]]))
+                    joined[k] = q is not None and apart(mech, q, qs[j + dj, i + di]) <= tol
+            J, I = J[~joined], I[~joined]
+        out += [(j, i, j + dj, i + di) for j, i in zip(J, I)]
     return np.array(out, int).reshape(-1, 4)
+
+
+def _apart(mech: Mechanism, Q1: np.ndarray, Q2: np.ndarray) -> np.ndarray:
+    """position.connect.apart of every row pair (N,)."""
+    if len(Q1) == 0:
+        return np.zeros(0)
+    D = mech.difference(Q1, Q2)
+    D[:, mech.translational] /= mech.length
+    return np.sqrt((D * D).sum(axis=1))

@@ -233,6 +233,11 @@ class TreeKinematics:
 
 
 _TARGET_KINDS = {"pose": ("fixed", 0), "point": ("spherical", 3)}
+#: A stack this short is evaluated a configuration at a time by Pinocchio (ClosureSystem.evaluate, the same rows
+#: to round-off): a stack's numpy pass costs about a millisecond whatever its length, Pinocchio's a tenth of that a
+#: configuration -- the few configurations Newton still iterates on after the others converged (past a fold,
+#: where it gives up only after tens of steps).
+FEW = 4
 
 
 class BatchClosure(ClosureKernel):
@@ -484,6 +489,9 @@ class BatchClosure(ClosureKernel):
             return Q, np.ones(N, bool), np.zeros(N), np.zeros(N, int)
 
         def evaluate(Q_: np.ndarray, which: Any, jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+            if targets is None and len(Q_) <= FEW:  # (the last few still iterating: Pinocchio's pass, the same rows)
+                rows = [self.system.evaluate(q, jacobian, True) for q in Q_]
+                return np.array([r for r, _ in rows]), (np.array([K for _, K in rows]) if jacobian else None)
             return self.evaluate(Q_, jacobian, None if targets is None else (targets[0][which], targets[1]))
 
         free = complement(nv, frozen)
