@@ -8,7 +8,10 @@ plane through that axis).  Its serial singular curve is traced like the loci in 
 J_p the point's Jacobian over the three free joints, dimensionless), seeded by Newton from random joint
 configurations.  A cusp of that curve, where three inverse-kinematic solutions meet, makes a generic 3R
 robot cuspidal -- it can change solution without a singularity -- and its absence makes it not
-(Salunkhe, Spartalis, Capco, Chablat & Wenger 2022; for orthogonal robots Baili, Wenger & Chablat 2004).
+(Salunkhe, Spartalis, Capco, Chablat & Wenger 2022; for orthogonal robots Baili, Wenger & Chablat 2004);
+a non-generic one (det J factoring) is decided by its aspects, and the verdict is None where nothing
+establishes it (analysis.singularities.cuspidal).  The regions the curves cut the box into are counted by
+the closed-form inverse kinematics at their samples.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 from ...errors import UsageError
 from ...model.state import KinematicState
 from .loci import Loci, LocusSystem, trace_kind
+from .regions import Regions, regions
 from ..singular import LWA
 from typing import TYPE_CHECKING
 
@@ -96,15 +100,22 @@ class SectionSystem(LocusSystem):
 @dataclass(frozen=True)
 class Section:
     loci: Loci
-    cuspidal: bool
-    why: str
+    cuspidal: bool | None  # None: not established (why says so)
+    why: str  # what the verdict rests on
+    regions: Regions | None = None  # the box's regions, each with its number of real IK solutions
+    generic: bool | None = None  # det J's zero set in joint space has no singular point
+    aspects: int = 0  # connected parts of det J != 0 on the (t2, t3) torus
+    extent: tuple | None = None  # the workspace section's (xmin, xmax, ymin, ymax) [m], where known
 
 
 def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_axis: str, ys: np.ndarray, level: float = 0.0, fixed: dict | None=None,
-                  samples: int = 400, seed: int = 0) -> Section:
+                  samples: int = 400, seed: int = 0, count: bool = True) -> Section:
     """The serial singular curves of ``output``'s origin in the section (x_axis, y_axis) of its workspace, the
-    third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes and
-    whether the robot is cuspidal (see the module)."""
+    third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes, the
+    regions they cut the box xs x ys into with their numbers of real IK solutions (``count``), and whether
+    the robot is cuspidal (analysis.singularities.cuspidal: True, False or None with the reason)."""
+    from .cuspidal import arm3r, aspects, point_ik, section_extent, verdict
+
     fixed = dict(fixed or {})
     sys = SectionSystem(mech, output, AXES[x_axis], AXES[y_axis], level, fixed)
     box = ((min(xs[0], xs[-1]), max(xs[0], xs[-1])), (min(ys[0], ys[-1]), max(ys[0], ys[-1])))
@@ -124,10 +135,37 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
            "component no random configuration converges to is missed, so completeness is not claimed")
     result = Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how.replace("{seed}", str(seed)),
                   tuple(dict.fromkeys(notes)), tuple(cusp_q), ("serial",))
-    if cusps:
-        why = (f"{len(cusps)} cusps of the serial singular curve in the section: three inverse-kinematic "
-               "solutions meet there, and a generic 3R with a cusp is cuspidal (Salunkhe et al. 2022)")
-    else:
-        why = ("no cusp on the traced curves: a generic 3R without one is not cuspidal (Salunkhe et al. 2022); "
-               "the curves were seeded from random configurations, so a missed component is possible")
-    return Section(result, bool(cusps), why)
+    q0 = mech.neutral()
+    for c, v, _ in sys.held:
+        q0[c.idx_q] = v
+    arm, why_not = arm3r(mech, sys.fid, sys.free, q0)
+    ax = (AXES[x_axis], AXES[y_axis])
+
+    def world(p) -> np.ndarray:
+        c = np.zeros(3)
+        c[ax[0]], c[ax[1]], c[sys.h] = p[0], p[1], level
+        return c
+
+    def counter(p) -> tuple:
+        sols, why = point_ik(arm, world(p))
+        if why:
+            return None, False, f"not counted: {why}"
+        return len(sols), True, "closed form: the real roots of the position quartic (Pieper's first stage)"
+
+    cut = regions(None, result, x_axis, xs, y_axis, ys, {}, count=count and arm is not None, counter=counter)
+    if arm is None:
+        return Section(result, None, f"not decided: {why_not}", cut)
+    asp = aspects(arm)
+    extent, covers = section_extent(arm, asp, sys.h, level, ax)
+    if not covers and extent is not None:
+        out = (extent[0] < box[0][0] - 1e-9 * mech.length or extent[1] > box[0][1] + 1e-9 * mech.length
+               or extent[2] < box[1][0] - 1e-9 * mech.length or extent[3] > box[1][1] + 1e-9 * mech.length)
+        if out:
+            covers = (f"the box holds only part of the workspace's section ({x_axis} from {extent[0]:.4g} to "
+                      f"{extent[1]:.4g} m, {y_axis} from {extent[2]:.4g} to {extent[3]:.4g} m)")
+    points = [world(r.sample) for r in cut.regions]
+    points += [world((a, b)) for a in np.linspace(*box[0], 21) for b in np.linspace(*box[1], 21)]
+    counted = all(r.modes is not None for r in cut.regions)
+    v = verdict(arm, asp, points, len(cusps), covers, counted)
+    return Section(result, v.cuspidal, v.rests_on, cut, v.generic, v.aspects,
+                   None if extent is None else tuple(float(e) for e in extent))
