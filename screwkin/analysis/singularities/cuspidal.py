@@ -294,8 +294,8 @@ class Verdict:
 
 
 def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, counted_all: bool) -> Verdict:
-    """The verdict (see the module) from the IK at ``points`` (world, the region samples first), the number of
-    cusps traced, ``covers`` ("" where the section holds the whole workspace through the first axis, else
+    """The verdict (see the module) from the IK at ``points`` (world: the region samples, a grid, rings round the
+    cusps traced), the number of cusps traced, ``covers`` ("" where the section holds the whole workspace through the first axis, else
     why not) and whether every region was counted."""
     if asp.identically_zero:
         return Verdict(None, "det J of the point over the three joints is zero everywhere: they never move it in "
@@ -336,22 +336,24 @@ def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, cou
                              f"keeping |det J| above {AWAY:g} of its largest joins them; {grid}; the robot is {shape}",
                        generic, asp.count)
     if cusps:
-        return Verdict(None, f"{cusps} cusps traced but no two IK solutions found in one aspect, and the robot is {shape}",
-                       generic, asp.count)
+        note = (f"; the {cusps} 'cusps' traced are where its non-generic singular curves meet, not three solutions "
+                "meeting: no two solutions share an aspect on a ring round each")
+    else:
+        note = ""
     if covers:
         return Verdict(None, f"no two IK solutions in one aspect at {checked} points of the section, but {covers}",
                        generic, asp.count)
     if not counted_all:
         return Verdict(None, "some regions of the section were not counted, so not every part of the workspace was "
                              "checked", generic, asp.count)
-    base = (f"at {checked} points of the section (the sample of every region and a grid), each holding the whole "
-            f"workspace through the first axis, every IK solution (closed form) lies in an aspect of its own ({grid}), "
-            "so none reaches another without a singularity (sampled, not proved)")
+    base = (f"the section holds the whole workspace (through the first axis); at {checked} points of it (every region's "
+            f"sample, a grid, rings round any traced cusp) every IK solution (closed form) lies in an aspect of its own "
+            f"({grid}), so none reaches another without a singularity (sampled, not proved)")
     if generic:
         return Verdict(False, f"{base}; the robot is {shape} and no cusp was traced, which agrees (Salunkhe et al. 2022)",
                        generic, asp.count)
     return Verdict(False, f"{base}; the robot is {shape} (e.g. det J factoring into posture terms of constant sign on "
-                          f"each solution: Wenger 1997; Baili, Wenger & Chablat 2004)", generic, asp.count)
+                          f"each solution: Wenger 1997; Baili, Wenger & Chablat 2004){note}", generic, asp.count)
 
 
 def _pt(c) -> str:

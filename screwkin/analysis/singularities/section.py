@@ -165,6 +165,10 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
                       f"{extent[1]:.4g} m, {y_axis} from {extent[2]:.4g} to {extent[3]:.4g} m)")
     points = [world(r.sample) for r in cut.regions]
     points += [world((a, b)) for a in np.linspace(*box[0], 21) for b in np.linspace(*box[1], 21)]
+    span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
+    ring = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    points += [world((p[0] + r * np.cos(a), p[1] + r * np.sin(a))) for p, _ in cusps for r in (0.003 * span, 0.01 * span, 0.03 * span)
+               for a in ring]
     counted = all(r.modes is not None for r in cut.regions)
     v = verdict(arm, asp, points, len(cusps), covers, counted)
     return Section(result, v.cuspidal, v.rests_on, cut, v.generic, v.aspects,
