@@ -97,6 +97,34 @@ class SectionSystem(LocusSystem):
         return row
 
 
+def _overlapping(p: np.ndarray, curves: list, span: float) -> bool:
+    """Whether the curves run together at p (one curve of the plane traced twice, by two curves or two passes
+    of one) rather than cross there: the directions from p of the points at 0.25 to 1 % of the box's span of the
+    curves through p fall in at most two bundles 10 deg apart (a crossing gives four)."""
+    R = 0.01 * span
+
+    def through(P: np.ndarray) -> bool:
+        if len(P) < 2:
+            return False
+        A, d = P[:-1], np.diff(P, axis=0)
+        t = np.clip(((p - A) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-300), 0.0, 1.0)
+        return float(np.linalg.norm(A + t[:, None] * d - p, axis=1).min()) < 1e-4 * span
+
+    def dense(P: np.ndarray) -> np.ndarray:  # the polyline with points at most R / 8 apart
+        d = np.diff(P, axis=0)
+        k = np.maximum(1, np.ceil(np.linalg.norm(d, axis=1) / (R / 8))).astype(int)
+        return np.vstack([P[i] + np.outer(np.arange(k[i]) / k[i], d[i]) for i in range(len(d))] + [P[-1:]])
+
+    X = np.vstack([dense(P) for P in curves if through(P)] or [np.zeros((0, 2))])
+    r = np.linalg.norm(X - p, axis=1)
+    X = X[(r > R / 4) & (r < R)]
+    if len(X) < 2:
+        return False
+    ang = np.sort(np.arctan2(X[:, 1] - p[1], X[:, 0] - p[0]))
+    gaps = np.diff(np.concatenate([ang, ang[:1] + 2 * np.pi]))
+    return int((gaps > np.radians(10.0)).sum()) <= 2
+
+
 @dataclass(frozen=True)
 class Section:
     loci: Loci
@@ -129,6 +157,12 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     starts.sort(key=lambda s: s[0])
     notes = []
     loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", (q for _, q in starts), box, notes)
+    span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
+    kept = [n for n in nodes if not _overlapping(np.array(n[0]), [lc.points for lc in loci], span)]
+    if len(kept) < len(nodes):
+        notes.append(f"{len(nodes) - len(kept)} meetings of traces that run together (one curve of the plane traced "
+                     "twice, as where det J factors, or a closed trace's overlap at its start) are not nodes")
+    nodes = kept
     how = (f"seeds: Newton on [held coordinate; J_p v = 0; |v| = 1] from {samples} random joint configurations "
            "(seed {seed}), most singular first; every curve followed by pseudo-arclength continuation to the "
            "box's edges or round to its start; cusps located by Brent's method where the trace reverses. A "

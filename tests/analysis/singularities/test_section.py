@@ -74,6 +74,14 @@ def test_the_cuspidal_orthogonal_3r_is_cuspidal_with_cusps_at_the_quartics_tripl
     for r in sec.regions.regions:
         real, _ = _real_roots(CUSPIDAL, *r.sample)
         assert r.modes == len(real) and r.certain, r
+    # every node of a region (a share of them): the same count as its sample, by the quartic
+    for k, r in enumerate(sec.regions.regions):
+        J, I = np.nonzero(sec.regions.labels == k + 1)
+        for j, i in list(zip(J, I))[:: max(1, len(J) // 40)]:
+            real, spread = _real_roots(CUSPIDAL, grid[i], grid[j])
+            assert len(real) == r.modes, (grid[i], grid[j], r)
+    # the nodes: where the curves meet on the first axis (x = 0, a self-motion), no other
+    assert all(abs(x) < 1e-3 for (x, _), _ in sec.loci.nodes), sec.loci.nodes
 
 
 @pytest.mark.slow
@@ -83,6 +91,8 @@ def test_the_orthogonal_3r_with_r2_zero_is_not_cuspidal_its_postures_told_by_det
     sec = trace_section(mech, "tool", "x", grid, "z", grid, 0.0, samples=100)
     assert sec.cuspidal is False and sec.generic is False, sec.why
     assert "not generic" in sec.why
+    # its curves are traced twice (the +-theta3 branches meet the same points): their meetings are no nodes
+    assert all(abs(x) < 1e-3 for (x, _), _ in sec.loci.nodes), sec.loci.nodes
     for r in sec.regions.regions:
         real, _ = _real_roots(POSTURES, *r.sample)
         assert r.modes == len(real), r
