@@ -12,9 +12,10 @@ from ..analysis.position.position import PositionSolver
 from ..analysis.singularities.loci import trace_loci
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.singularities.regions import regions
+from ..analysis.singularities.section import trace_section
 from ..errors import UsageError, quote
 from ..present.jsonout import json_of
-from ..units import in_unit
+from ..units import in_unit, parse_quantity
 from ..present.loci import loci_dict, loci_lines, loci_png
 from ..present.outfile import write_output
 from ..present.plots import map_png
@@ -137,9 +138,6 @@ def _section(mech: Mechanism, args: argparse.Namespace, named: list, joints: set
     """map --x x=A:B:N --y z=A:B:N --output LINK --loci: the serial singular curves of the output origin in a
     section of its workspace (the third coordinate held), their cusps and nodes, the regions with their
     numbers of real IK solutions, and whether the robot is cuspidal (analysis.singularities.section)."""
-    from ..analysis.singularities.section import trace_section
-    from ..units import parse_quantity
-
     if not all(n in COORDINATES and n not in joints for n in named) or named[0] == named[1]:
         raise UsageError(f"--x {quote(named[0], 40)} and --y {quote(named[1], 40)}: a workspace section takes two "
                          "different coordinates of x, y, z (a map over inputs two joints)")

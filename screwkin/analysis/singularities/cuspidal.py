@@ -36,6 +36,7 @@ import pinocchio as pin
 
 from ...model._pin import joint_axis
 from ...model.state import KinematicState
+from ...tolerances import Tolerances
 from ..position.pieper import arm_positions
 from ..singular import LWA
 from typing import TYPE_CHECKING
@@ -193,18 +194,17 @@ def aspects(arm: Arm3R) -> Aspects:
     pad[np.ix_(fk[keep] % FINE, fk[keep] % FINE)] = coef[np.ix_(keep, keep)]
     F = np.fft.ifft2(pad).real * FINE**2
     top = float(np.abs(F).max())
-    scale = max(float(np.abs(V).max()), 1e-300)
-    if top <= 1e-12 * arm.mech.length**3 or np.abs(V).max() <= 1e-12 * max(arm.mech.length, 1e-9) ** 3:
+    if np.abs(V).max() <= arm.mech.tolerances.zero * arm.mech.length**3:  # (L^3: det J's size)
         return Aspects(coef, top, np.zeros((FINE, FINE), int), 0, (), True, F)
     zero = np.abs(F) <= ZERO * top
     pos, npos = _label_periodic((F > 0) & ~zero)
     neg, nneg = _label_periodic((F < 0) & ~zero)
     labels = np.where(pos > 0, pos, np.where(neg > 0, neg + npos, 0))
     asp = Aspects(coef, top, labels, npos + nneg, (), False, F)
-    return Aspects(coef, top, labels, npos + nneg, _singular_points(asp, F, scale), False, F)
+    return Aspects(coef, top, labels, npos + nneg, _singular_points(asp, F, arm.mech.tolerances), False, F)
 
 
-def _singular_points(asp: Aspects, F: np.ndarray, scale: float) -> tuple:
+def _singular_points(asp: Aspects, F: np.ndarray, tol: Tolerances) -> tuple:
     """The points of the torus where det J and its gradient vanish together: Newton on grad det J = 0 from
     the fine grid's nodes where both are small and |grad| is least among its neighbours."""
     h = 2 * np.pi / FINE
@@ -232,12 +232,12 @@ def _singular_points(asp: Aspects, F: np.ndarray, scale: float) -> tuple:
             except np.linalg.LinAlgError:
                 break
             t = t + np.clip(step, -0.1, 0.1)
-            if np.abs(step).max() < 1e-13:
+            if np.abs(step).max() < tol.zero:
                 break
         gv = np.hypot(asp.value(*t, 1, 0)[0], asp.value(*t, 0, 1)[0])
-        if gv < 1e-8 * gtop and abs(asp.value(*t)[0]) < 1e-8 * asp.top:
+        if gv < tol.cusp * gtop and abs(asp.value(*t)[0]) < tol.cusp * asp.top:
             t = np.angle(np.exp(1j * t))
-            if all(np.abs(np.angle(np.exp(1j * (t - s)))).max() > 1e-4 for s in found):
+            if all(np.abs(np.angle(np.exp(1j * (t - s)))).max() > tol.singular for s in found):
                 found.append(t)
     # a singular set of dimension one (a squared factor) gives many: a few stand for it
     return tuple(tuple(float(v) for v in s) for s in found[:8])
@@ -321,7 +321,7 @@ def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, cou
                 if labs[i] and labs[i] == labs[j]:
                     m = witness(asp, sols[i], sols[j])
                     if m is not None:
-                        return Verdict(True, f"two inverse-kinematic solutions of the point {_pt(c)} are joined in joint "
+                        return Verdict(True, f"two inverse-kinematic solutions of the point {_world_point(c)} are joined in joint "
                                              f"space with det J of one sign all along (|det J| at least {m:.2g} of its "
                                              f"largest, checked densely on its exact trigonometric polynomial): one "
                                              f"aspect holds both; {cusps} cusps traced; {grid}; the robot is {shape}",
@@ -332,7 +332,7 @@ def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, cou
                              f"at each: a generic 3R with a cusp is cuspidal (Salunkhe et al. 2022); {grid}",
                        generic, asp.count)
     if shared is not None:
-        return Verdict(None, f"two IK solutions of the point {_pt(shared)} fall in one part of the grid but no path "
+        return Verdict(None, f"two IK solutions of the point {_world_point(shared)} fall in one part of the grid but no path "
                              f"keeping |det J| above {AWAY:g} of its largest joins them; {grid}; the robot is {shape}",
                        generic, asp.count)
     if cusps:
@@ -356,7 +356,7 @@ def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, cou
                           f"each solution: Wenger 1997; Baili, Wenger & Chablat 2004){note}", generic, asp.count)
 
 
-def _pt(c) -> str:
+def _world_point(c) -> str:
     return "(" + ", ".join(f"{v:.6g}" for v in c) + ") m"
 
 
@@ -366,7 +366,8 @@ def section_extent(arm: Arm3R, asp: Aspects, h_axis: int, level: float, axes: tu
     along it over a 90 x 90 grid of (t2, t3)."""
     w1, r1 = arm.axes[0], arm.points[0]
     L = arm.mech.length
-    if abs(w1[h_axis]) > 1e-9 or abs(r1[h_axis] - level) > 1e-9 * max(L, 1.0):
+    tol = arm.mech.tolerances.closed_form
+    if abs(w1[h_axis]) > tol or abs(r1[h_axis] - level) > tol * max(L, 1.0):
         return None, "the section's plane does not contain the first joint's axis, so it does not meet every orbit of the workspace"
     g = np.linspace(0, 2 * np.pi, 90, endpoint=False)
     P = np.array([KinematicState(arm.mech, arm.q((0.0, a, b))).frame_placement(arm.fid).translation for a in g for b in g])

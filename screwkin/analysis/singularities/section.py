@@ -23,6 +23,7 @@ import numpy as np
 from ...errors import UsageError
 from ...model.state import KinematicState
 from .loci import Loci, LocusSystem, trace_kind
+from .cuspidal import arm3r, aspects, point_ik, section_extent, verdict
 from .regions import Regions, regions
 from ..singular import LWA
 from typing import TYPE_CHECKING
@@ -97,9 +98,9 @@ class SectionSystem(LocusSystem):
         return row
 
 
-def _overlapping(p: np.ndarray, curves: list, span: float) -> bool:
+def _overlapping(p: np.ndarray, curves: list, span: float, near: float) -> bool:
     """Whether the curves run together at p (one curve of the plane traced twice, by two curves or two passes
-    of one) rather than cross there: the directions from p of the points at 0.25 to 1 % of the box's span of the
+    of one) rather than cross there (a curve through p: within ``near`` of the span): the directions from p of the points at 0.25 to 1 % of the box's span of the
     curves through p fall in at most two bundles 10 deg apart (a crossing gives four)."""
     R = 0.01 * span
 
@@ -108,7 +109,7 @@ def _overlapping(p: np.ndarray, curves: list, span: float) -> bool:
             return False
         A, d = P[:-1], np.diff(P, axis=0)
         t = np.clip(((p - A) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-300), 0.0, 1.0)
-        return float(np.linalg.norm(A + t[:, None] * d - p, axis=1).min()) < 1e-4 * span
+        return float(np.linalg.norm(A + t[:, None] * d - p, axis=1).min()) < near * span
 
     def dense(P: np.ndarray) -> np.ndarray:  # the polyline with points at most R / 8 apart
         d = np.diff(P, axis=0)
@@ -142,7 +143,6 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes, the
     regions they cut the box xs x ys into with their numbers of real IK solutions (``count``), and whether
     the robot is cuspidal (analysis.singularities.cuspidal: True, False or None with the reason)."""
-    from .cuspidal import arm3r, aspects, point_ik, section_extent, verdict
 
     fixed = dict(fixed or {})
     sys = SectionSystem(mech, output, AXES[x_axis], AXES[y_axis], level, fixed)
@@ -158,7 +158,7 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     notes = []
     loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", (q for _, q in starts), box, notes)
     span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
-    kept = [n for n in nodes if not _overlapping(np.array(n[0]), [lc.points for lc in loci], span)]
+    kept = [n for n in nodes if not _overlapping(np.array(n[0]), [lc.points for lc in loci], span, mech.tolerances.singular)]
     if len(kept) < len(nodes):
         notes.append(f"{len(nodes) - len(kept)} meetings of traces that run together (one curve of the plane traced "
                      "twice, as where det J factors, or a closed trace's overlap at its start) are not nodes")
@@ -192,8 +192,9 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     asp = aspects(arm)
     extent, covers = section_extent(arm, asp, sys.h, level, ax)
     if not covers and extent is not None:
-        out = (extent[0] < box[0][0] - 1e-9 * mech.length or extent[1] > box[0][1] + 1e-9 * mech.length
-               or extent[2] < box[1][0] - 1e-9 * mech.length or extent[3] > box[1][1] + 1e-9 * mech.length)
+        slack = mech.tolerances.equal * mech.length
+        out = (extent[0] < box[0][0] - slack or extent[1] > box[0][1] + slack
+               or extent[2] < box[1][0] - slack or extent[3] > box[1][1] + slack)
         if out:
             covers = (f"the box holds only part of the workspace's section ({x_axis} from {extent[0]:.4g} to "
                       f"{extent[1]:.4g} m, {y_axis} from {extent[2]:.4g} to {extent[3]:.4g} m)")

@@ -198,6 +198,11 @@ def test_map_section_usage_errors(tmp_path):
     p = screwkin_cli("map", str(path), "--output", "tool", "--x", "x=-1:1:5", "--y", "z=-1:1:5", "--loci",
                      "--set", "x=0")
     assert p.returncode == 2 and "held coordinate is y" in p.stderr
+
+
+@pytest.mark.slow
+def test_map_section_of_a_point_on_the_third_axis_says_cuspidal_null(tmp_path):
+    path, _ = _load(tmp_path, FLAT, "o3r_null")
     p = screwkin_cli("map", str(path), "--output", "tool", "--x", "x=-1:1:5", "--y", "z=-1:1:5", "--loci", "--json",
                      "--no-regions")
     assert p.returncode == 0, p.stderr
