@@ -91,6 +91,11 @@ def test_the_orthogonal_3r_with_r2_zero_is_not_cuspidal_its_postures_told_by_det
     sec = trace_section(mech, "tool", "x", grid, "z", grid, 0.0, samples=100)
     assert sec.cuspidal is False and sec.generic is False, sec.why
     assert "not generic" in sec.why
+    # the "cusps" traced are where its factors' curves meet: four IK solutions there (a quadruple root of the
+    # quartic, theta3 = 0 twice over), not three
+    for (x, z), _ in sec.loci.cusps:
+        r = orthogonal_3r_quartic(*POSTURES, x, z).roots()
+        assert np.abs(r - r.mean()).max() < 1e-3, r
     # its curves are traced twice (the +-theta3 branches meet the same points): their meetings are no nodes
     assert all(abs(x) < 1e-3 for (x, _), _ in sec.loci.nodes), sec.loci.nodes
     for r in sec.regions.regions:
