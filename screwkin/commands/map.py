@@ -148,6 +148,8 @@ def _section(mech: Mechanism, args: argparse.Namespace, named: list, joints: set
         raise UsageError("a workspace section is mapped with --loci (its singular curves, cusps and regions)")
     if args.connect:
         raise UsageError("--connect goes round the cusps of a map over inputs, not of a workspace section")
+    if args.csv:
+        raise UsageError("--csv writes the map of sigma_min over inputs; a workspace section's answer is --json")
     ranges = []
     for text, option in ((args.x, "--x"), (args.y, "--y")):
         name, _, rest = text.partition("=")
