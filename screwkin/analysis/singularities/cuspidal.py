@@ -326,7 +326,7 @@ def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, cou
                                              f"largest, checked densely on its exact trigonometric polynomial): one "
                                              f"aspect holds both; {cusps} cusps traced; {grid}; the robot is {shape}",
                                        generic, asp.count)
-                    shared = shared or c
+                    shared = c if shared is None else shared
     if cusps and generic:
         return Verdict(True, f"{cusps} cusps of the serial singular curve in the section, three IK solutions meeting "
                              f"at each: a generic 3R with a cusp is cuspidal (Salunkhe et al. 2022); {grid}",

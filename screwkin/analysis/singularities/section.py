@@ -145,6 +145,9 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     the robot is cuspidal (analysis.singularities.cuspidal: True, False or None with the reason)."""
 
     fixed = dict(fixed or {})
+    if mech.cuts or mech.couplings or getattr(mech, "extra_rows", None):
+        raise UsageError(f"{mech.path}: a workspace section is a serial chain's; this mechanism has loops, couplings "
+                         "or contacts (map it over its inputs instead)")
     sys = SectionSystem(mech, output, AXES[x_axis], AXES[y_axis], level, fixed)
     box = ((min(xs[0], xs[-1]), max(xs[0], xs[-1])), (min(ys[0], ys[-1]), max(ys[0], ys[-1])))
     rng = np.random.default_rng(seed)
