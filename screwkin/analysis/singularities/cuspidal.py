@@ -8,7 +8,9 @@ turns everything after it rigidly), so the aspects are those of the torus of (t2
 joint's circle.  det J there is a trigonometric polynomial of degree at most 4 in t2 and 3 in t3: it is
 sampled on a 32 x 32 grid (Pinocchio's Jacobian), its Fourier coefficients are exact, and it is evaluated
 from them anywhere (a fine grid by zero-padded FFT).  The aspects are the connected same-sign parts of that
-fine grid (periodic).  The inverse kinematics at a point is the position stage of Pieper's closed form
+fine grid (periodic), two nodes joined where det J keeps its sign at 17 points of the edge between them, the
+nodes next to a singular point of det J = 0 (where its factors' curves cross, the wedges between them too
+thin for the grid) left out.  The inverse kinematics at a point is the position stage of Pieper's closed form
 (analysis.position.pieper.arm_positions: the real roots of a quartic), so the count of solutions at a point
 is complete where it answers.
 
@@ -50,6 +52,9 @@ SAMPLES = 32  # the det J samples per turn: degree <= 4 in t2, 3 in t3, exact be
 FINE = 360  # the aspects' grid per turn (1 deg)
 ZERO = 1e-9  # |det J| below this share of its largest: zero (a node on the singular set)
 AWAY = 1e-3  # a witness path keeps |det J| above this share of its largest
+EDGE = 16  # det J's values checked along each grid edge
+TINY = 1e-300  # division guard
+BLOCK = 3  # the cells round a singular point of det J's zero set left out of the aspects
 
 
 @dataclass(frozen=True)
@@ -196,31 +201,72 @@ def aspects(arm: Arm3R) -> Aspects:
     top = float(np.abs(F).max())
     if np.abs(V).max() <= arm.mech.tolerances.zero * arm.mech.length**3:  # (L^3: det J's size)
         return Aspects(coef, top, np.zeros((FINE, FINE), int), 0, (), True, F)
-    zero = np.abs(F) <= ZERO * top
-    pos, npos = _label_periodic((F > 0) & ~zero)
-    neg, nneg = _label_periodic((F < 0) & ~zero)
-    labels = np.where(pos > 0, pos, np.where(neg > 0, neg + npos, 0))
-    asp = Aspects(coef, top, labels, npos + nneg, (), False, F)
-    return Aspects(coef, top, labels, npos + nneg, _singular_points(asp, F, arm.mech.tolerances), False, F)
+    asp = Aspects(coef, top, np.zeros((FINE, FINE), int), 0, (), False, F)
+    singular = _singular_points(asp, F, arm.mech.tolerances)
+    labels, n = _label_aspects(asp, F, singular)
+    return Aspects(coef, top, labels, n, singular, False, F)
+
+
+def _edge_values(asp: Aspects, along: int) -> np.ndarray:
+    """det J at EDGE points of every grid edge (endpoints included) along t2 (along = 0) or t3 (1): (FINE,
+    FINE, EDGE + 1), [i, j] the edge from node (i, j) to its next neighbour (periodic), exact (the
+    polynomial's terms: separable sums)."""
+    k = _freqs(SAMPLES)
+    nodes = 2 * np.pi * np.arange(FINE) / FINE
+    fine = 2 * np.pi * np.arange(FINE * EDGE + 1) / (FINE * EDGE)
+    En, Ef = np.exp(1j * np.outer(nodes, k)), np.exp(1j * np.outer(fine, k))
+    V = (En @ asp.coef @ Ef.T).real if along == 1 else (Ef @ asp.coef @ En.T).real.T  # (FINE, FINE * EDGE + 1)
+    idx = np.arange(FINE)[:, None] * EDGE + np.arange(EDGE + 1)[None, :]
+    out = V[:, idx]  # (FINE nodes across, FINE edges, EDGE + 1)
+    return out if along == 1 else out.transpose(1, 0, 2)
+
+
+def _label_aspects(asp: Aspects, F: np.ndarray, singular: tuple) -> tuple[np.ndarray, int]:
+    """The aspects on the grid: nodes where det J is not zero and not within BLOCK cells of a singular point
+    of its zero set, joined through grid edges along which det J keeps its sign (EDGE + 1 exact values each:
+    a shallow crossing's thin wedge is seen where it is wider than a sixteenth of a cell, and the nodes next
+    to the crossing, where it is thinner, are left out); labelled on the doubled periodic grid."""
+    top = asp.top
+    node_ok = np.abs(F) > ZERO * top
+    h = 2 * np.pi / FINE
+    g = np.arange(FINE) * h
+    for a, b in singular:
+        da = np.abs(np.angle(np.exp(1j * (g - a))))[:, None]
+        db = np.abs(np.angle(np.exp(1j * (g - b))))[None, :]
+        node_ok &= np.hypot(da, db) > BLOCK * h
+    big = np.zeros((2 * FINE, 2 * FINE), bool)
+    big[::2, ::2] = node_ok
+    for along in (0, 1):
+        E = _edge_values(asp, along)
+        keeps = (np.all(E > ZERO * top, axis=2) | np.all(E < -ZERO * top, axis=2))
+        nxt = np.roll(node_ok, -1, axis=along)
+        if along == 0:
+            big[1::2, ::2] = keeps & node_ok & nxt
+        else:
+            big[::2, 1::2] = keeps & node_ok & nxt
+    lab, n = _label_periodic(big)
+    return lab[::2, ::2], n
 
 
 def _singular_points(asp: Aspects, F: np.ndarray, tol: Tolerances) -> tuple:
     """The points of the torus where det J and its gradient vanish together: Newton on grad det J = 0 from
-    the fine grid's nodes where both are small and |grad| is least among its neighbours."""
+    every node of the grid where det J is small and |grad det J| least among its eight neighbours."""
+    from scipy import ndimage
+
     h = 2 * np.pi / FINE
     g = np.arange(FINE) * h
     T2, T3 = np.meshgrid(g, g, indexing="ij")
-    small = np.abs(F) < 0.05 * asp.top
-    if not small.any():
-        return ()
-    i, j = np.nonzero(small)
-    G2 = asp.value(T2[i, j], T3[i, j], 1, 0)
-    G3 = asp.value(T2[i, j], T3[i, j], 0, 1)
+    k = _freqs(SAMPLES)
+    En = np.exp(1j * np.outer(g, k))
+    G2 = (En @ (asp.coef * (1j * k)[:, None]) @ En.T).real
+    G3 = (En @ (asp.coef * (1j * k)[None, :]) @ En.T).real
     grad = np.hypot(G2, G3)
-    gtop = max(float(grad.max()), 1e-300)
+    gtop = max(float(grad.max()), TINY)
+    seeds = (np.abs(F) < 0.05 * asp.top) & (grad <= ndimage.minimum_filter(grad, size=3, mode="wrap"))
+    i, j = np.nonzero(seeds)
     found = []
-    for n in np.argsort(grad)[:200]:
-        if grad[n] > 0.1 * gtop:
+    for n in np.argsort(grad[i, j])[:400]:
+        if grad[i[n], j[n]] > 0.1 * gtop:
             break
         t = np.array([T2[i[n], j[n]], T3[i[n], j[n]]])
         for _ in range(30):
@@ -240,7 +286,7 @@ def _singular_points(asp: Aspects, F: np.ndarray, tol: Tolerances) -> tuple:
             if all(np.abs(np.angle(np.exp(1j * (t - s)))).max() > tol.singular for s in found):
                 found.append(t)
     # a singular set of dimension one (a squared factor) gives many: a few stand for it
-    return tuple(tuple(float(v) for v in s) for s in found[:8])
+    return tuple(tuple(float(v) for v in s) for s in found[:64])
 
 
 def witness(asp: Aspects, a: np.ndarray, b: np.ndarray) -> float | None:
@@ -305,7 +351,8 @@ def verdict(arm: Arm3R, asp: Aspects, points: list, cusps: int, covers: str, cou
              "not generic: det J's zero set on the (t2, t3) torus is singular at (t2, t3) = "
              + ", ".join(f"({np.degrees(a):.4g} deg, {np.degrees(b):.4g} deg)" for a, b in asp.singular_points[:4])
              + " (it factors or crosses itself), so the cusp criterion does not apply and the aspects decide")
-    grid = f"{asp.count} aspects: the same-sign parts of det J on a {FINE} x {FINE} grid of the (t2, t3) torus"
+    grid = (f"{asp.count} aspects: the same-sign parts of det J on a {FINE} x {FINE} grid of the (t2, t3) torus, its "
+            f"edges checked at {EDGE + 1} points each, {BLOCK} cells round each singular point of det J = 0 left out")
     shared, checked = None, 0
     for c in points:
         sols, why = point_ik(arm, c)

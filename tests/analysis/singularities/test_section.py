@@ -145,6 +145,21 @@ def _position(params, t1, t2, t3):
     return (M @ np.array([d4, 0, r3, 1.0]))[:3]
 
 
+@pytest.mark.slow
+def test_the_bundled_arm_with_its_wrist_held_is_not_cuspidal():
+    """robots/arm_6r.urdf's first three joints (axes 2 and 3 parallel, axis 2 off axis 1 by 0.05 m: a
+    PUMA-like arm) moving the flange with the wrist held: a 3R with two parallel axes is not cuspidal (Wenger
+    1997: its inverse kinematics reduces to quadratics, det J to an elbow and a shoulder factor); its det J
+    zero set crosses itself (not generic), the wedges at the crossings thinner than the grid near them."""
+    from pathlib import Path
+
+    mech = screwkin.load(Path(__file__).resolve().parents[3] / "robots" / "arm_6r.urdf")
+    xs, ys = np.linspace(-1.5, 1.5, 21), np.linspace(-1, 2, 21)
+    sec = trace_section(mech, "flange", "x", xs, "z", ys, 0.0, {"joint4": 0.0, "joint5": 0.3, "joint6": 0.0},
+                        samples=100)
+    assert sec.cuspidal is False and sec.generic is False and sec.aspects == 4, sec.why
+
+
 def test_a_point_on_the_third_axis_has_no_verdict(tmp_path):
     _, mech = _load(tmp_path, FLAT, "o3r_flat")
     grid = np.linspace(-4, 4, 9)
