@@ -16,9 +16,10 @@ the closed-form inverse kinematics at their samples.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+import pinocchio as pin
 
 from ...errors import UsageError
 from ...model.state import KinematicState
@@ -208,6 +209,21 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     points += [world((p[0] + r * np.cos(a), p[1] + r * np.sin(a))) for p, _ in cusps for r in (0.003 * span, 0.01 * span, 0.03 * span)
                for a in ring]
     counted = all(r.modes is not None for r in cut.regions)
-    v = verdict(arm, asp, points, len(cusps), covers, counted)
+    # a reversal of the trace at a singular point of det J = 0 (its factors' curves meeting: four solutions
+    # there) is no cusp: a cusp lies on a smooth part of the singular set
+    model = mech.model
+    real, meets = [], []
+    for (c, qc) in zip(result.cusps, result.cusp_q):
+        t = pin.difference(model, q0, qc)[arm.free]
+        near = any(np.abs(np.angle(np.exp(1j * (np.array(t[1:]) - np.array(sp))))).max() < mech.tolerances.singular
+                   for sp in asp.singular_points)
+        (meets if near else real).append((c, qc))
+    if meets:
+        result = replace(result, cusps=tuple(c for c, _ in real), cusp_q=tuple(q for _, q in real),
+                         notes=result.notes + (f"{len(meets)} reversals of the trace at "
+                                               + ", ".join(f"({c[0][0][0]:.12g}, {c[0][0][1]:.12g})" for c in meets)
+                                               + " lie where det J's factors' curves meet (four solutions there): "
+                                               "not cusps",))
+    v = verdict(arm, asp, points, len(real), covers, counted)
     return Section(result, v.cuspidal, v.rests_on, cut, v.generic, v.aspects,
                    None if extent is None else tuple(float(e) for e in extent))
