@@ -12,14 +12,16 @@ from ..analysis.position.position import PositionSolver
 from ..analysis.singularities.loci import trace_loci
 from ..analysis.singularities.maps import singularity_map
 from ..analysis.singularities.regions import regions
-from ..errors import UsageError
+from ..analysis.singularities.section import trace_section
+from ..errors import UsageError, quote
 from ..present.jsonout import json_of
+from ..units import in_unit, parse_quantity
 from ..present.loci import loci_dict, loci_lines, loci_png
 from ..present.outfile import write_output
 from ..present.plots import map_png
 from ..present.report import map_csv, map_dict
 from ._configuration import add_mode_option, configuration, with_mode
-from ._options import BOUNDS
+from ._options import BOUNDS, count
 from ._output_frame import output_frame
 from ._values import joint_assignments, parse_range
 from typing import TYPE_CHECKING
@@ -33,14 +35,18 @@ __all__ = ["NAME", "NEEDS_MECHANISM", "add_parser", "run"]
 
 NAME = "map"
 NEEDS_MECHANISM = True
+COORDINATES = ("x", "y", "z")  # --x x=A:B:N: the output origin's world coordinates (a workspace section)
 
 
 def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callable) -> None:
     sp = sub.add_parser("map", help="map of the smallest singular value over two inputs")
     common(sp)
-    sp.add_argument("--x", required=True, metavar="NAME=A:B:N", help="first input, from A to B in N values")
-    sp.add_argument("--y", required=True, metavar="NAME=A:B:N", help="second input")
-    sp.add_argument("--set", action="append", metavar="NAME=VALUE", help="values of the other inputs")
+    sp.add_argument("--x", required=True, metavar="NAME=A:B:N",
+                    help="first input, from A to B in N values; x, y or z (not a joint's name) with --output and "
+                         "--loci: a section of the output origin's workspace")
+    sp.add_argument("--y", required=True, metavar="NAME=A:B:N", help="second input (or coordinate)")
+    sp.add_argument("--set", action="append", metavar="NAME=VALUE",
+                    help="values of the other inputs (a section: the held coordinate, y=0 by default, and joints)")
     add_mode_option(sp, "the inputs at the map's first corner (the first values of --x and --y)")
     sp.add_argument("--output", help="output link (serial singularities)")
     sp.add_argument("--png", help="heat map with the singular curves, PNG (needs matplotlib)")
@@ -58,6 +64,10 @@ def add_parser(sub: argparse._SubParsersAction, common: Callable, scaled: Callab
 
 
 def run(mech: Mechanism, args: argparse.Namespace) -> int:
+    joints = {c.joint for c in mech.coordinates}
+    named = [t.partition("=")[0].strip() for t in (args.x, args.y)]
+    if any(n in COORDINATES and n not in joints for n in named):  # a joint named x is the joint
+        return _section(mech, args, named, joints)
     xn, xs, x_unit = parse_range(args.x, "--x", mech)
     yn, ys, y_unit = parse_range(args.y, "--y", mech)
     if xs.size * ys.size > BOUNDS["grid_total"][1]:
@@ -122,3 +132,71 @@ def _loci(mech: Mechanism, args: argparse.Namespace, inputs: list[str], xn: str,
     loops = cusp_loops(solver, traced, xn, yn, held_values, box) if args.connect else None
     return traced, cut, loops
 
+
+
+def _section(mech: Mechanism, args: argparse.Namespace, named: list, joints: set) -> int:
+    """map --x x=A:B:N --y z=A:B:N --output LINK --loci: the serial singular curves of the output origin in a
+    section of its workspace (the third coordinate held), their cusps and nodes, the regions with their
+    numbers of real IK solutions, and whether the robot is cuspidal (analysis.singularities.section)."""
+    if not all(n in COORDINATES and n not in joints for n in named) or named[0] == named[1]:
+        raise UsageError(f"--x {quote(named[0], 40)} and --y {quote(named[1], 40)}: a workspace section takes two "
+                         "different coordinates of x, y, z (a map over inputs two joints)")
+    output, _ = output_frame(mech, args)
+    if not output:
+        raise UsageError("--x/--y x, y or z map a section of the workspace of a point: give --output LINK")
+    if not args.loci:
+        raise UsageError("a workspace section is mapped with --loci (its singular curves, cusps and regions)")
+    if args.connect:
+        raise UsageError("--connect goes round the cusps of a map over inputs, not of a workspace section")
+    if args.csv:
+        raise UsageError("--csv writes the map of sigma_min over inputs; a workspace section's answer is --json")
+    ranges = []
+    for text, option in ((args.x, "--x"), (args.y, "--y")):
+        name, _, rest = text.partition("=")
+        parts = rest.split(":")
+        if len(parts) != 3:
+            raise UsageError(f"{option} expects NAME=A:B:N, got {quote(text, 80)}")
+        try:
+            n = count("grid")(parts[2])
+        except argparse.ArgumentTypeError as exc:
+            raise UsageError(f"{option}: N {exc}") from None
+        a, b = (parse_quantity(p, "length", option) for p in parts[:2])
+        ranges.append((name.strip(), np.linspace(a.value, b.value, n), (a if a.unit else b).shown_unit or "m"))
+    (xn, xs, x_unit), (yn, ys, y_unit) = ranges
+    if xs.size * ys.size > BOUNDS["grid_total"][1]:
+        raise UsageError(f"--x and --y: {xs.size * ys.size:,} points, at most {BOUNDS['grid_total'][1]:,}")
+    held = ({"x", "y", "z"} - {xn, yn}).pop()
+    coords, rest = [], []
+    for item in args.set or []:
+        (coords if item.partition("=")[0].strip() in COORDINATES and item.partition("=")[0].strip() not in joints
+         else rest).append(item)
+    level, lines = 0.0, []
+    for item in coords:
+        name, _, text = item.partition("=")
+        if name.strip() != held:
+            raise UsageError(f"--set {quote(item, 60)}: {name.strip()} is mapped; the held coordinate is {held}")
+        level = parse_quantity(text.strip(), "length", "--set").value
+    if not coords:
+        lines.append(f"{held} held at 0 m (give --set {held}=VALUE for another section)")
+    fixed = joint_assignments(mech, rest, "--set")
+    sec = trace_section(mech, output, xn, xs, yn, ys, level, fixed, count=args.regions)
+    if args.png:
+        title = f"{mech.spec.name or Path(mech.path).stem}: workspace section of {output} ({held} = {level:.4g} m)"
+        loci_png(sec.loci, sec.regions, args.png, xs, ys, xn, yn, x_unit, y_unit, title=title)
+    if args.json:
+        print(json_of({"section": {"output": output, "plane": [xn, yn], "held": {held: level},
+                                   "extent": None if sec.extent is None else [float(in_unit(v, u)) for v, u in
+                                                                             zip(sec.extent, (x_unit, x_unit, y_unit, y_unit))]},
+                       "characteristic_length": mech.length,
+                       **loci_dict(sec.loci, sec.regions, x_unit, y_unit, None, mech),
+                       "regions_count": "real inverse-kinematic solutions of the point (modes), closed form",
+                       "cuspidal": sec.cuspidal, "cuspidal_rests_on": sec.why, "generic": sec.generic,
+                       "aspects": sec.aspects, "section_notes": lines}))
+        return 0
+    lines.append(f"workspace section of {output}'s origin over {xn} and {yn} ({held} = {level:.6g} m); the regions' "
+                 "counts are real inverse-kinematic solutions")
+    lines += loci_lines(sec.loci, sec.regions, xn, yn, x_unit, y_unit, modes="inverse-kinematic solutions")
+    verdict = {True: "yes", False: "no", None: "not established"}[sec.cuspidal]
+    lines.append(f"cuspidal: {verdict} -- {sec.why}")
+    print("\n".join(lines))
+    return 0

@@ -62,8 +62,9 @@ def loci_dict(loci: Loci, regions: Regions, x_unit: str, y_unit: str, loops=None
     return out
 
 
-def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: str, y_unit: str, loops=None) -> list:
-    """Text lines: each curve, the cusps, nodes and regions, and how they were found."""
+def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: str, y_unit: str, loops=None,
+               modes: str = "assembly modes") -> list:
+    """Text lines: each curve, the cusps, nodes and regions (``modes``: what they count), and how they were found."""
     def pt(p: Sequence[float]) -> str:
         a, b = _xy(p, x_unit, y_unit)
         return f"({x_name} = {a:.9g} {x_unit}, {y_name} = {b:.9g} {y_unit})"
@@ -82,13 +83,13 @@ def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: s
         lines.append(f"no {' or '.join(loci.traced)} singular locus found in the box" if loci.traced else
                      "no singular locus traced (see below)")
     for p, kind in loci.cusps:
-        lines.append(f"cusp ({kind}: three assembly modes meet) at {pt(p)}")
+        lines.append(f"cusp ({kind}: three {modes} meet) at {pt(p)}")
     for p, kind in loci.nodes:
         lines.append(f"node ({kind} loci cross) at {pt(p)}")
     if regions is not None:
         for r in regions.regions:
-            modes = "not counted" if r.modes is None else f"{r.modes} assembly modes ({r.how})"
-            lines.append(f"region of {r.nodes} grid points, sample {pt(r.sample)}: {modes}")
+            count = "not counted" if r.modes is None else f"{r.modes} {modes} ({r.how})"
+            lines.append(f"region of {r.nodes} grid points, sample {pt(r.sample)}: {count}")
         lines.append(regions.resolution)
         lines += list(regions.notes)
     if loops is not None:

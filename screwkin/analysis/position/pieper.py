@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.model.mechanism import Mechanism
 
-__all__ = ["Wrist", "wrist_arm", "pieper"]
+__all__ = ["Wrist", "wrist_arm", "pieper", "arm_positions"]
 
 BOUND = 8  # real and complex solutions of a 6R arm with a spherical wrist (Pieper 1968)
 TINY = 1e-12  # scale guard: the size of a matrix's rows, never zero
@@ -90,6 +90,30 @@ def pieper(arm: Wrist, T: pin.SE3, tol: Tolerances = DEFAULT) -> tuple:
     w, r = arm.axes, arm.points
     g = T * arm.M0.inverse()
     c = g.act(arm.centre)
+    scale = max(float(np.abs(r).max()), float(np.abs(c).max()), 1e-3)
+    positions, n_complex, why = arm_positions(w[:3], r[:3], arm.centre, c, tol, scale)
+    if why == "the first two axes are one line":
+        return [], 0, why
+    sets, stretched = [], []
+    for t1, t2, t3 in positions:
+        R3 = rotation(w[0], t1) @ rotation(w[1], t2) @ rotation(w[2], t3)
+        wrist = run_angles(list(w[3:]), R3.T @ g.rotation) or _stretched(w[3:], R3.T @ g.rotation, tol)
+        for ts in wrist:
+            sets.append(tuple(float(np.angle(np.exp(1j * t))) for t in (t1, t2, t3) + tuple(0.0 if t is None else t
+                                                                                           for t in ts)))
+            stretched.append(ts[0] is None)
+        if not wrist:
+            why = "the wrist cannot take the orientation (numerically degenerate)"
+    return sets, n_complex * 2, ("" if sets else why), stretched
+
+
+def arm_positions(w: np.ndarray, r: np.ndarray, centre: np.ndarray, c: np.ndarray, tol: Tolerances = DEFAULT,
+                  scale: float | None = None) -> tuple:
+    """(positions, complex, why): every real (t1, t2, t3) of three revolutes about the world lines (w[i], r[i])
+    at their zero that takes the point ``centre`` to ``c`` (the position stage of :func:`pieper`: a quartic in
+    e^{i t3}), how many of its roots are complex, and why some are left out ("" when none: a point on
+    axis 1 or 2 -- a continuum --, or "the first two axes are one line").  ``scale``: the lengths the
+    tolerances are relative to (default: the largest coordinate of r and c)."""
     r1, r2 = _closest(r[0], w[0], r[1], w[1], tol.closed_form)
     delta = r2 - r1
     e1 = np.cross(w[1], _perp(w[1]))
@@ -97,10 +121,11 @@ def pieper(arm: Wrist, T: pin.SE3, tol: Tolerances = DEFAULT) -> tuple:
     e2 = np.cross(w[1], e1)
     M = np.array([[w[0] @ e1, w[0] @ e2], [delta @ e1, delta @ e2]])
     h1, h2 = float(w[0] @ (c - r1)), float((c - r1) @ (c - r1))
-    scale = max(float(np.abs(r).max()), float(np.abs(c).max()), 1e-3)
+    if scale is None:
+        scale = max(float(np.abs(r).max()), float(np.abs(c).max()), 1e-3)
 
     def parts(t3) -> tuple:
-        q3 = r[2] + rotation(w[2], t3) @ (arm.centre - r[2])
+        q3 = r[2] + rotation(w[2], t3) @ (centre - r[2])
         v = q3 - r2  # from the point of axis 2 that delta reaches
         vpar = w[1] * (w[1] @ v)
         xy = np.array([(v - vpar) @ e1, (v - vpar) @ e2])
@@ -157,17 +182,7 @@ def pieper(arm: Wrist, T: pin.SE3, tol: Tolerances = DEFAULT) -> tuple:
             if np.linalg.norm(rotation(w[0], t1) @ (p - r1) - (c - r1)) > tol.closed_check * scale:
                 continue
             positions.append((t1, t2, t3))
-    sets, stretched = [], []
-    for t1, t2, t3 in positions:
-        R3 = rotation(w[0], t1) @ rotation(w[1], t2) @ rotation(w[2], t3)
-        wrist = run_angles(list(w[3:]), R3.T @ g.rotation) or _stretched(w[3:], R3.T @ g.rotation, tol)
-        for ts in wrist:
-            sets.append(tuple(float(np.angle(np.exp(1j * t))) for t in (t1, t2, t3) + tuple(0.0 if t is None else t
-                                                                                           for t in ts)))
-            stretched.append(ts[0] is None)
-        if not wrist:
-            why = "the wrist cannot take the orientation (numerically degenerate)"
-    return sets, n_complex * 2, ("" if sets else why), stretched
+    return positions, n_complex, why
 
 
 def _stretched(axes: list, R: np.ndarray, tol: Tolerances) -> list:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from screwkin.analysis.position.position import PositionSolver
     from screwkin.analysis.singularities.loci import Loci
+    from collections.abc import Callable
 
 __all__ = ["Region", "Regions", "regions"]
 
@@ -66,9 +67,11 @@ def _blocked(curves: list, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return mask
 
 
-def regions(solver: PositionSolver, loci: Loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, count: bool = True, max_counted: int = 24) -> Regions:
+def regions(solver: PositionSolver | None, loci: Loci, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, fixed: dict, count: bool = True, max_counted: int = 24,
+            counter: Callable | None = None) -> Regions:
     """The regions of the grid xs x ys cut by ``loci`` (analysis.singularities.loci.Loci), each with its sample
-    and (count) its number of real assembly modes there."""
+    and (count) its number of real assembly modes there: ``counter(sample) -> (modes, certain, how)`` where
+    given (a workspace section's inverse kinematics), else ``solver``'s all-modes solve."""
     from scipy import ndimage
 
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
@@ -89,7 +92,9 @@ def regions(solver: PositionSolver, loci: Loci, x_name: str, xs: np.ndarray, y_n
         j, i = where[k]
         sample = (float(xs[i]), float(ys[j]))
         modes, certain, how = None, False, "not counted"
-        if count and rank < max_counted:
+        if count and rank < max_counted and counter is not None:
+            modes, certain, how = counter(sample)
+        elif count and rank < max_counted:
             try:
                 res = solver.solve({x_name: sample[0], y_name: sample[1], **fixed})
                 modes = len(res.solutions)

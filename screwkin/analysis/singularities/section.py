@@ -8,18 +8,24 @@ plane through that axis).  Its serial singular curve is traced like the loci in 
 J_p the point's Jacobian over the three free joints, dimensionless), seeded by Newton from random joint
 configurations.  A cusp of that curve, where three inverse-kinematic solutions meet, makes a generic 3R
 robot cuspidal -- it can change solution without a singularity -- and its absence makes it not
-(Salunkhe, Spartalis, Capco, Chablat & Wenger 2022; for orthogonal robots Baili, Wenger & Chablat 2004).
+(Salunkhe, Spartalis, Capco, Chablat & Wenger 2022; for orthogonal robots Baili, Wenger & Chablat 2004);
+a non-generic one (det J factoring) is decided by its aspects, and the verdict is None where nothing
+establishes it (analysis.singularities.cuspidal).  The regions the curves cut the box into are counted by
+the closed-form inverse kinematics at their samples.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+import pinocchio as pin
 
 from ...errors import UsageError
 from ...model.state import KinematicState
 from .loci import Loci, LocusSystem, trace_kind
+from .cuspidal import arm3r, aspects, point_ik, section_extent, verdict
+from .regions import Regions, regions
 from ..singular import LWA
 from typing import TYPE_CHECKING
 
@@ -93,19 +99,56 @@ class SectionSystem(LocusSystem):
         return row
 
 
+def _overlapping(p: np.ndarray, curves: list, span: float, near: float) -> bool:
+    """Whether the curves run together at p (one curve of the plane traced twice, by two curves or two passes
+    of one) rather than cross there (a curve through p: within ``near`` of the span): the directions from p of the points at 0.25 to 1 % of the box's span of the
+    curves through p fall in at most two bundles 10 deg apart (a crossing gives four)."""
+    R = 0.01 * span
+
+    def through(P: np.ndarray) -> bool:
+        if len(P) < 2:
+            return False
+        A, d = P[:-1], np.diff(P, axis=0)
+        t = np.clip(((p - A) * d).sum(axis=1) / np.maximum((d * d).sum(axis=1), 1e-300), 0.0, 1.0)
+        return float(np.linalg.norm(A + t[:, None] * d - p, axis=1).min()) < near * span
+
+    def dense(P: np.ndarray) -> np.ndarray:  # the polyline with points at most R / 8 apart
+        d = np.diff(P, axis=0)
+        k = np.maximum(1, np.ceil(np.linalg.norm(d, axis=1) / (R / 8))).astype(int)
+        return np.vstack([P[i] + np.outer(np.arange(k[i]) / k[i], d[i]) for i in range(len(d))] + [P[-1:]])
+
+    X = np.vstack([dense(P) for P in curves if through(P)] or [np.zeros((0, 2))])
+    r = np.linalg.norm(X - p, axis=1)
+    X = X[(r > R / 4) & (r < R)]
+    if len(X) < 2:
+        return False
+    ang = np.sort(np.arctan2(X[:, 1] - p[1], X[:, 0] - p[0]))
+    gaps = np.diff(np.concatenate([ang, ang[:1] + 2 * np.pi]))
+    return int((gaps > np.radians(10.0)).sum()) <= 2
+
+
 @dataclass(frozen=True)
 class Section:
     loci: Loci
-    cuspidal: bool
-    why: str
+    cuspidal: bool | None  # None: not established (why says so)
+    why: str  # what the verdict rests on
+    regions: Regions | None = None  # the box's regions, each with its number of real IK solutions
+    generic: bool | None = None  # det J's zero set in joint space has no singular point
+    aspects: int = 0  # connected parts of det J != 0 on the (t2, t3) torus
+    extent: tuple | None = None  # the workspace section's (xmin, xmax, ymin, ymax) [m], where known
 
 
 def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_axis: str, ys: np.ndarray, level: float = 0.0, fixed: dict | None=None,
-                  samples: int = 400, seed: int = 0) -> Section:
+                  samples: int = 400, seed: int = 0, count: bool = True) -> Section:
     """The serial singular curves of ``output``'s origin in the section (x_axis, y_axis) of its workspace, the
-    third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes and
-    whether the robot is cuspidal (see the module)."""
+    third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes, the
+    regions they cut the box xs x ys into with their numbers of real IK solutions (``count``), and whether
+    the robot is cuspidal (analysis.singularities.cuspidal: True, False or None with the reason)."""
+
     fixed = dict(fixed or {})
+    if mech.cuts or mech.couplings or getattr(mech, "extra_rows", None):
+        raise UsageError(f"{mech.path}: a workspace section is a serial chain's; this mechanism has loops, couplings "
+                         "or contacts (map it over its inputs instead)")
     sys = SectionSystem(mech, output, AXES[x_axis], AXES[y_axis], level, fixed)
     box = ((min(xs[0], xs[-1]), max(xs[0], xs[-1])), (min(ys[0], ys[-1]), max(ys[0], ys[-1])))
     rng = np.random.default_rng(seed)
@@ -118,16 +161,69 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
     starts.sort(key=lambda s: s[0])
     notes = []
     loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", (q for _, q in starts), box, notes)
+    span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
+    kept = [n for n in nodes if not _overlapping(np.array(n[0]), [lc.points for lc in loci], span, mech.tolerances.singular)]
+    if len(kept) < len(nodes):
+        notes.append(f"{len(nodes) - len(kept)} meetings of traces that run together (one curve of the plane traced "
+                     "twice, as where det J factors, or a closed trace's overlap at its start) are not nodes")
+    nodes = kept
     how = (f"seeds: Newton on [held coordinate; J_p v = 0; |v| = 1] from {samples} random joint configurations "
            "(seed {seed}), most singular first; every curve followed by pseudo-arclength continuation to the "
            "box's edges or round to its start; cusps located by Brent's method where the trace reverses. A "
            "component no random configuration converges to is missed, so completeness is not claimed")
     result = Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how.replace("{seed}", str(seed)),
                   tuple(dict.fromkeys(notes)), tuple(cusp_q), ("serial",))
-    if cusps:
-        why = (f"{len(cusps)} cusps of the serial singular curve in the section: three inverse-kinematic "
-               "solutions meet there, and a generic 3R with a cusp is cuspidal (Salunkhe et al. 2022)")
-    else:
-        why = ("no cusp on the traced curves: a generic 3R without one is not cuspidal (Salunkhe et al. 2022); "
-               "the curves were seeded from random configurations, so a missed component is possible")
-    return Section(result, bool(cusps), why)
+    q0 = mech.neutral()
+    for c, v, _ in sys.held:
+        q0[c.idx_q] = v
+    arm, why_not = arm3r(mech, sys.fid, sys.free, q0)
+    ax = (AXES[x_axis], AXES[y_axis])
+
+    def world(p) -> np.ndarray:
+        c = np.zeros(3)
+        c[ax[0]], c[ax[1]], c[sys.h] = p[0], p[1], level
+        return c
+
+    def counter(p) -> tuple:
+        sols, why = point_ik(arm, world(p))
+        if why:
+            return None, False, f"not counted: {why}"
+        return len(sols), True, "closed form: the real roots of the position quartic (Pieper's first stage)"
+
+    cut = regions(None, result, x_axis, xs, y_axis, ys, {}, count=count and arm is not None, counter=counter)
+    if arm is None:
+        return Section(result, None, f"not decided: {why_not}", cut)
+    asp = aspects(arm)
+    extent, covers = section_extent(arm, asp, sys.h, level, ax)
+    if not covers and extent is not None:
+        slack = mech.tolerances.equal * mech.length
+        out = (extent[0] < box[0][0] - slack or extent[1] > box[0][1] + slack
+               or extent[2] < box[1][0] - slack or extent[3] > box[1][1] + slack)
+        if out:
+            covers = (f"the box holds only part of the workspace's section ({x_axis} from {extent[0]:.4g} to "
+                      f"{extent[1]:.4g} m, {y_axis} from {extent[2]:.4g} to {extent[3]:.4g} m)")
+    points = [world(r.sample) for r in cut.regions]
+    points += [world((a, b)) for a in np.linspace(*box[0], 21) for b in np.linspace(*box[1], 21)]
+    span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
+    ring = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    points += [world((p[0] + r * np.cos(a), p[1] + r * np.sin(a))) for p, _ in cusps for r in (0.003 * span, 0.01 * span, 0.03 * span)
+               for a in ring]
+    counted = all(r.modes is not None for r in cut.regions)
+    # a reversal of the trace at a singular point of det J = 0 (its factors' curves meeting: four solutions
+    # there) is no cusp: a cusp lies on a smooth part of the singular set
+    model = mech.model
+    real, meets = [], []
+    for (c, qc) in zip(result.cusps, result.cusp_q):
+        t = pin.difference(model, q0, qc)[arm.free]
+        near = any(np.abs(np.angle(np.exp(1j * (np.array(t[1:]) - np.array(sp))))).max() < mech.tolerances.singular
+                   for sp in asp.singular_points)
+        (meets if near else real).append((c, qc))
+    if meets:
+        result = replace(result, cusps=tuple(c for c, _ in real), cusp_q=tuple(q for _, q in real),
+                         notes=result.notes + (f"{len(meets)} reversals of the trace at "
+                                               + ", ".join(f"({c[0][0][0]:.12g}, {c[0][0][1]:.12g})" for c in meets)
+                                               + " lie where det J's factors' curves meet (four solutions there): "
+                                               "not cusps",))
+    v = verdict(arm, asp, points, len(real), covers, counted)
+    return Section(result, v.cuspidal, v.rests_on, cut, v.generic, v.aspects,
+                   None if extent is None else tuple(float(e) for e in extent))
