@@ -11,13 +11,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..analysis.motion.links import motion_along
 from ..analysis.motion.sweep import sweep
 from ..analysis.course.figures import singular_configurations, trace_points
 from ..analysis.course.skeleton import kinematic_chain, skeleton
 from ..errors import UsageError, quote
 from ..present.jsonout import json_of
-from ..present.animate import animation_format, write_animation
+from ..analysis.singularities.mode_connect import Connections, connect_modes
+from ..present.animate import animate_configurations, animate_connection, animation_format
+from ..present.loci import connections_dict, connections_lines
 from ..present.progress import EVERY, Progress
 from ..present.draw import (
     chain_dict,
@@ -43,7 +44,7 @@ from ._configuration import (
     with_mode,
 )
 from ._output_frame import add_point_option, named_points
-from ._values import inputs, joint_value, split_inputs
+from ._values import inputs, joint_quantities, joint_value, split_inputs
 from ._options import BOUNDS, count
 
 if TYPE_CHECKING:
@@ -83,6 +84,10 @@ def add_parser(sub: argparse._SubParsersAction, common: Callable[..., None], sca
     sp.add_argument("--from", dest="start", help="--animate: the input's first value (units allowed: -30deg, 5mm)")
     sp.add_argument("--to", dest="stop", help="--animate: the input's last value")
     sp.add_argument("--fps", type=frame_rate, default=20.0, help="--animate: frames per second (default 20, 1 to 60)")
+    sp.add_argument("--connect", type=mode_pair, metavar="I:J",
+                    help="with --animate: the path joining assembly modes I and J (numbered as solve --all lists "
+                         "them at the --set inputs) without a singularity, as solve --all --connect finds it; "
+                         "when none is found, why (and no file)")
 
 
 def frame_rate(text: str) -> float:
@@ -94,6 +99,19 @@ def frame_rate(text: str) -> float:
     if not 1.0 <= fps <= 60.0:  # nan fails both comparisons
         raise argparse.ArgumentTypeError(f"must be from 1 to 60 frames per second, got {quote(text, 20)}")
     return fps
+
+
+def mode_pair(text: str) -> tuple[int, int]:
+    """argparse type of --connect I:J: two different assembly modes, numbered from 1."""
+    parts = str(text).replace(",", ":").split(":")
+    try:
+        i, j = (int(p.strip()) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected two mode numbers I:J (as solve --all lists them), got "
+                                         f"{quote(text, 20)}") from None
+    if i < 1 or j < 1 or i == j:
+        raise argparse.ArgumentTypeError(f"expected two different mode numbers from 1, got {quote(text, 20)}")
+    return i, j
 
 
 def _targets(mech: Mechanism, args: argparse.Namespace) -> list:
@@ -207,8 +225,11 @@ def _draw_skeleton(mech: Mechanism, args: argparse.Namespace, q: np.ndarray, giv
 
 
 def run(mech: Mechanism, args: argparse.Namespace) -> int:
+    if args.connect and not args.animate:
+        raise UsageError(f"{mech.path}: --connect I:J goes with --animate OUT.gif (it animates the path joining the "
+                         "two modes)")
     if args.animate:
-        return _animate(mech, args)
+        return _animate_connection(mech, args) if args.connect else _animate(mech, args)
     if args.start is not None or args.stop is not None:
         raise UsageError(f"{mech.path}: --from and --to go with --animate OUT.gif")
     untraced = [p.name for p in named_points(mech, args) if p.name not in (args.trace or ())]  # said at the end
@@ -295,23 +316,12 @@ def _animate(mech: Mechanism, args: argparse.Namespace) -> int:
               f"{len(qs)} frames, not the {steps + 1} asked")
     if res.skipped and not args.json:
         print(f"{len(res.skipped)} input value(s) on the way could not be solved: no frame for them")
-    first = skeleton(mech, qs[0], input_names)
-    skels = [first, *(skeleton(mech, q, input_names, basis=first.basis) for q in qs[1:])]
-    points = named_points(mech, args)
-    traces = {}
-    if points:
-        motion = motion_along(mech, np.asarray(qs), np.zeros((len(qs), mech.nv)), np.zeros((len(qs), mech.nv)), points)
-        e1, e2, _ = (np.asarray(v) for v in first.basis)
-        for p in points:
-            P = np.asarray(motion.points[p.name]["position"])
-            traces[p.name] = np.stack([P @ e1, P @ e2], axis=1)
     titles = [drawing_title(mech, _typed(name, x, unit)) for x in values]
     if limit is not None:
         titles[-1] += " (limit position)"
-    space = None if first.planar else f"schematic projection of a {first.motion_space} mechanism"
     with Progress(label="animate", unit="frame draws (each framed, then drawn)", every=EVERY) as progress:  # a terminal
-        n = write_animation(args.animate, skels, titles, traces, fps=args.fps, angles=args.angles, subtitle=space,
-                            progress=progress)
+        n, traces = animate_configurations(args.animate, mech, qs, input_names, titles, named_points(mech, args),
+                                           fps=args.fps, angles=args.angles, progress=progress)
     if args.json:
         print(json_of({"file": args.animate, "format": ext[1:], "frames": n, "fps": args.fps,
                        "input": name, "unit": res.unit, "values": values,
@@ -321,4 +331,55 @@ def _animate(mech: Mechanism, args: argparse.Namespace) -> int:
     else:
         print(f"wrote {args.animate}: {n} frames at {args.fps:g} fps, {_typed(name, values[0], unit)} "
               f"to {_typed(name, values[-1], unit).split(' = ')[1]}")
+    return 0
+
+
+def _animate_connection(mech: Mechanism, args: argparse.Namespace) -> int:
+    """draw --connect I:J --animate OUT: the skeleton along the path joining modes I and J of the --set inputs
+    without a singularity (mode_connect, as solve --all --connect), or why there is none: said, no file, exit 0."""
+    ext = animation_format(args.animate)
+    given = [o for o, v in (("--png", args.png), ("--svg", args.svg), ("--chain", args.chain),
+                            ("--singular", args.singular), ("--trace", args.trace), ("--from", args.start),
+                            ("--to", args.stop), ("--input", args.input), ("--steps", args.steps),
+                            ("--near", args.near), ("--mode", args.mode), ("--set-angle", args.set_angle),
+                            ("--output", args.output)) if v]
+    if given:
+        raise UsageError(f"{mech.path}: --connect animates the path between two modes of the --set inputs; leave out "
+                         f"{', '.join(given)}")
+    values, held, _ = split_inputs(mech, args)
+    if not values:
+        raise UsageError(f"{mech.path}: --connect needs the inputs' values: --set NAME=VALUE (the modes are those "
+                         "solve --all lists there)")
+    if mech.spec.targets and not args.json:
+        print(f"the file's {len(mech.spec.targets)} targets (<screwkin:targets>) are drawn on the skeleton "
+              "(draw --png/--svg), not in the animation")
+    i, j = args.connect
+    solver = input_solver(mech, values)
+    res = solver.solve(values, method="auto")  # the list solve --all gives (the same call, the same order)
+    if res.free_dofs:
+        raise UsageError(f"{mech.path}: --connect: these inputs leave {res.free_dofs} degree(s) of freedom (a "
+                         "continuum of configurations, not a list of modes); give every input")
+    n = len(res.solutions)
+    if max(i, j) > n:
+        raise UsageError(f"{mech.path}: --connect {i}:{j}: solve --all lists {n} assembly mode{'s' if n != 1 else ''} "
+                         "at these inputs")
+    conns = connect_modes(solver, values, [s.q for s in res.solutions], pairs=[(i - 1, j - 1)])  # from I to J
+    c = conns.connections[0]
+    units = {n: q.shown_unit for n, q in joint_quantities(mech, args.set, "--set").items()}
+    report = {**connections_dict(Connections((c,), conns.signs, conns.how, conns.notes), mech),
+              "file": None, "format": ext[1:], "frames": 0, "fps": args.fps, "sigma_so_far": []}
+    if c.joined:
+        with Progress(label="animate", unit="frame draws (each framed, then drawn)", every=EVERY) as progress:
+            report["frames"] = animate_connection(args.animate, mech, c, list(values), units, named_points(mech, args),
+                                                  fps=args.fps, angles=args.angles, progress=progress)
+        report["file"] = args.animate
+        report["sigma_so_far"] = [float(v) for v in c.sigma_so_far]  # each frame's title: the smallest measure so far
+    if args.json:
+        print(json_of(report))
+        return 0
+    print("\n".join(connections_lines(Connections((c,), conns.signs, conns.how, conns.notes))))
+    if c.joined:
+        print(f"wrote {args.animate}: the path from mode {i} to mode {j}, {report['frames']} frames at {args.fps:g} fps")
+    else:
+        print(f"no path from mode {i} to mode {j} to animate: {args.animate} not written")
     return 0

@@ -11,9 +11,7 @@ from ..analysis.course.vector_loops import VectorLoops
 from ..errors import AssemblyError, UsageError
 from ..present.equations import Units, greek, newton_dict, newton_text
 from ..analysis.singularities.mode_connect import Connections, connect_modes
-from ..analysis.course.skeleton import skeleton
-from ..present.animate import animation_format, write_animation
-from ..present.draw import drawing_title
+from ..present.animate import animate_connection, animation_format
 from ..present.jsonout import json_of
 from ..present.loci import connections_dict, connections_lines
 from ..present.report import (
@@ -115,7 +113,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.connect:
         conns = connect_modes(solver, values, [s.q for s in res.solutions]) if not res.free_dofs else Connections(
             (), (), "not compared: the inputs leave a continuum of configurations (the solutions listed are samples)")
-    animated = _animate_connection(mech, args, conns) if args.animate else None
+    animated = _animate_connection(mech, args, conns, values) if args.animate else None
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length
@@ -141,19 +139,18 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _animate_connection(mech: Mechanism, args: argparse.Namespace, conns) -> dict:
-    """solve --connect --animate OUT: the skeleton along the first path that joins two modes."""
+def _animate_connection(mech: Mechanism, args: argparse.Namespace, conns, values: dict) -> dict:
+    """solve --connect --animate OUT: the skeleton along the first path that joins two modes (drawn as draw
+    --connect I:J --animate draws it: present.animate.animate_connection)."""
     c = next((c for c in conns.connections if c.joined), None)
     if c is None:
         return {"file": None, "modes": None, "frames": 0, "said": f"--animate: no path joins two modes; {args.animate} not written"}
-    first = skeleton(mech, c.path[0], list(mech.actuated) or None)
-    skels = [first, *(skeleton(mech, q, list(mech.actuated) or None, basis=first.basis) for q in c.path[1:])]
     i, j = c.modes[0] + 1, c.modes[1] + 1
-    titles = [drawing_title(mech, f"mode {i} to mode {j} without a singularity ({k + 1}/{len(skels)})")
-              for k in range(len(skels))]
-    n = write_animation(args.animate, skels, titles, fps=10.0)
+    units = {n: q.shown_unit for n, q in joint_quantities(mech, args.set, "--set").items()}
+    n = animate_connection(args.animate, mech, c, list(values), units, named_points(mech, args))
     return {"file": args.animate, "modes": [i, j], "frames": n,
-            "said": f"wrote {args.animate}: the path from mode {i} to mode {j}, {n} frames (the first joined pair)"}
+            "said": f"wrote {args.animate}: the path from mode {i} to mode {j}, {n} frames (the first joined pair; "
+                    f"draw --connect I:J --animate for another)"}
 
 
 # ------------------------------------------------------------------ solve --start

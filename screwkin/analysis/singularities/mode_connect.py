@@ -65,6 +65,8 @@ class Connection:
     inputs: np.ndarray | None = None  # (n, 2) the plane's two inputs along the path [SI]
     plane: tuple | None = None  # (x, y) names of the two inputs moved
     sigma_min: float | None = None  # smallest actuator measure along the whole path (re-checked)
+    sigma_so_far: np.ndarray | None = None  # (n,) at each point of path: the smallest measure from the start to it
+    #  (over every point followed, not only those kept)
 
 
 @dataclass(frozen=True)
@@ -87,13 +89,19 @@ def check_path(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray
     """(ok, smallest actuator measure, why): every configuration of Q closed (residual below
     Tolerances.closure, relative to L for lengths), with the plane's inputs at xy and the held ones at their
     values, every step at most JUMP, the actuator measure above Tolerances.singular all along."""
+    ok, each, why = _checked(solver, plane, fixed, xy, Q)
+    return ok, float(min(each, default=np.inf)), why
+
+
+def _checked(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray, Q: np.ndarray) -> tuple:
+    """check_path's work: (ok, the actuator measure at each point checked, why)."""
     mech = solver.mech
     tol = mech.tolerances
     g = Generic(mech, solver.inputs, configurations=solver.generic().configurations)
-    worst = np.inf
+    each = []
     for k, q in enumerate(Q):
         if mech.closure.nrows and float(np.linalg.norm(mech.closure.residual(q))) > 10 * tol.closure * max(1.0, mech.length):
-            return False, worst, f"the loops do not close at point {k}"
+            return False, each, f"the loops do not close at point {k}"
         values = mech.joint_values(q)
         want = {plane[0]: xy[k, 0], plane[1]: xy[k, 1], **fixed}
         for n, v in want.items():
@@ -101,13 +109,13 @@ def check_path(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray
             if not mech.translational[mech.coordinate(n).idx_v]:
                 d = np.arctan2(np.sin(d), np.cos(d))
             if abs(d) > tol.equal * (mech.length if mech.translational[mech.coordinate(n).idx_v] else 1.0):
-                return False, worst, f"input {n} off its value at point {k}"
+                return False, each, f"input {n} off its value at point {k}"
         if k and apart(mech, Q[k - 1], q) > JUMP:
-            return False, worst, f"step {k} jumps (another branch)"
-        worst = min(worst, measures(mech, q, g)["actuator"])
-        if worst < tol.singular:
-            return False, worst, f"the actuator measure falls below {tol.singular:g} at point {k}"
-    return True, float(worst), ""
+            return False, each, f"step {k} jumps (another branch)"
+        each.append(float(measures(mech, q, g)["actuator"]))
+        if each[-1] < tol.singular:
+            return False, each, f"the actuator measure falls below {tol.singular:g} at point {k}"
+    return True, each, ""
 
 
 def _search_box(mech, name: str, value: float) -> tuple:
@@ -183,19 +191,20 @@ def _loops_round(solver, plane, fixed, u0, cusp, span, wedge, q, steps, budget: 
     return out
 
 
-def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) -> Connections:
+def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS, pairs=None) -> Connections:
     """Which of the configurations qs (the modes listed at the inputs ``values``) can be joined without a
-    singularity, and how (see the module)."""
+    singularity, and how (see the module).  ``pairs``: the (i, j) (0-based) answered, a path from mode i to
+    mode j (default: every pair, i < j); every mode listed may be a step of a chain of loops between them."""
     mech = solver.mech
     g = Generic(mech, solver.inputs, configurations=solver.generic().configurations)
     notes = []
     qs = [np.asarray(q, float) for q in qs]
-    if len(qs) > MAX_MODES:
+    if pairs is None and len(qs) > MAX_MODES:
         notes.append(f"only the first {MAX_MODES} of the {len(qs)} modes compared")
         qs = qs[:MAX_MODES]
     signs, why_none = det_signs(mech, g, qs)
     pending, result = [], {}
-    for i, j in combinations(range(len(qs)), 2):
+    for i, j in (combinations(range(len(qs)), 2) if pairs is None else pairs):
         si, sj = signs[i], signs[j]
         if si is None:
             result[i, j] = Connection((i, j), False, False, f"unknown: {why_none}")
@@ -256,27 +265,29 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS) 
                 f"same sign of det J, but no loop round a cusp joins them (cusps tried: {len(searched)}; planes "
                 f"{where}): not proved impossible"))
             continue
-        plane = edges[route[0]][0]
         pieces = [edges[a, b] if (a, b) in edges else _reversed(edges[b, a]) for a, b in route]
+        plane = pieces[0][0]  # (the first loop may have been found the other way: edges[b, a])
         planes = [pl for pl, _, _ in pieces]
         Q = np.vstack([pieces[0][2]] + [p[2][1:] for p in pieces[1:]])
         xy_all = np.vstack([pieces[0][1]] + [p[1][1:] for p in pieces[1:]])
-        ok, smallest, why = True, np.inf, ""
-        for pl, xy, Qp in pieces:
+        ok, each, why = True, [], ""
+        for k, (pl, xy, Qp) in enumerate(pieces):
             fixed = {n: v for n, v in u.items() if n not in pl}
-            ok, s, why = check_path(solver, pl, fixed, xy, Qp)
-            smallest = min(smallest, s)
+            ok, e, why = _checked(solver, pl, fixed, xy, Qp)
+            each += e if k == 0 else e[1:]  # (a piece starts where the last one ended)
             if not ok:
                 break
         if not ok:
             result[i, j] = Connection((i, j), False, False, f"a loop was found but its check failed: {why}")
             continue
+        so_far = np.minimum.accumulate(np.asarray(each))
+        smallest = float(so_far[-1])
         keep = np.unique(np.linspace(0, len(Q) - 1, min(THIN, len(Q))).round().astype(int))
         via = " then ".join(f"({p[0]}, {p[1]})" for p in planes)
         result[i, j] = Connection((i, j), True, True, (
             f"joined without a singularity: {len(route)} loop{'s' if len(route) > 1 else ''} of the inputs {via} "
             f"round a cusp of the actuator singular curve (path of {len(Q)} points checked; smallest actuator "
-            f"measure {smallest:.3g})"), Q[keep], xy_all[keep] if len(planes) == 1 else None, plane, float(smallest))
+            f"measure {smallest:.3g})"), Q[keep], xy_all[keep] if len(planes) == 1 else None, plane, smallest, so_far[keep])
     how = (f"det K_p's sign at each mode; pairs of the same sign: loops of two inputs round the cusps of the "
            f"actuator singular curve traced in a box round the given inputs (half-widths {BOX_LENGTH:g} L for "
            f"lengths, {BOX_ANGLE:g} rad for angles, within the joint limits), at most {MAX_PLANES} planes, the "
