@@ -229,7 +229,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
         raise UsageError(f"{mech.path}: --connect I:J goes with --animate OUT.gif (it animates the path joining the "
                          "two modes)")
     if args.animate:
-        return _animate_connection(mech, args) if args.connect else _animate(mech, args)
+        return _animate_pair(mech, args) if args.connect else _animate(mech, args)
     if args.start is not None or args.stop is not None:
         raise UsageError(f"{mech.path}: --from and --to go with --animate OUT.gif")
     untraced = [p.name for p in named_points(mech, args) if p.name not in (args.trace or ())]  # said at the end
@@ -334,7 +334,7 @@ def _animate(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _animate_connection(mech: Mechanism, args: argparse.Namespace) -> int:
+def _animate_pair(mech: Mechanism, args: argparse.Namespace) -> int:
     """draw --connect I:J --animate OUT: the skeleton along the path joining modes I and J of the --set inputs
     without a singularity (mode_connect, as solve --all --connect), or why there is none: said, no file, exit 0."""
     ext = animation_format(args.animate)

@@ -113,7 +113,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     if args.connect:
         conns = connect_modes(solver, values, [s.q for s in res.solutions]) if not res.free_dofs else Connections(
             (), (), "not compared: the inputs leave a continuum of configurations (the solutions listed are samples)")
-    animated = _animate_connection(mech, args, conns, values) if args.animate else None
+    animated = _animate_first_joined(mech, args, conns, values) if args.animate else None
     if args.json:
         d = position_dict(res)
         d["characteristic_length"] = mech.length
@@ -139,7 +139,7 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     return 0
 
 
-def _animate_connection(mech: Mechanism, args: argparse.Namespace, conns, values: dict) -> dict:
+def _animate_first_joined(mech: Mechanism, args: argparse.Namespace, conns, values: dict) -> dict:
     """solve --connect --animate OUT: the skeleton along the first path that joins two modes (drawn as draw
     --connect I:J --animate draws it: present.animate.animate_connection)."""
     c = next((c for c in conns.connections if c.joined), None)

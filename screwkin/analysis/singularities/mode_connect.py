@@ -89,11 +89,11 @@ def check_path(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray
     """(ok, smallest actuator measure, why): every configuration of Q closed (residual below
     Tolerances.closure, relative to L for lengths), with the plane's inputs at xy and the held ones at their
     values, every step at most JUMP, the actuator measure above Tolerances.singular all along."""
-    ok, each, why = _checked(solver, plane, fixed, xy, Q)
+    ok, each, why = _checked_path(solver, plane, fixed, xy, Q)
     return ok, float(min(each, default=np.inf)), why
 
 
-def _checked(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray, Q: np.ndarray) -> tuple:
+def _checked_path(solver: PositionSolver, plane: tuple, fixed: dict, xy: np.ndarray, Q: np.ndarray) -> tuple:
     """check_path's work: (ok, the actuator measure at each point checked, why)."""
     mech = solver.mech
     tol = mech.tolerances
@@ -258,7 +258,7 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS, 
     if budget[1]:
         notes.append(f"the search stopped at its bound of {MAX_STEPS:,} steps followed")
     for i, j in pending:
-        route = _route(edges, i, j)
+        route = _loop_route(edges, i, j)
         if route is None:
             where = "; ".join(tried_planes) or "no plane"
             result[i, j] = Connection((i, j), False, False, (
@@ -273,7 +273,7 @@ def connect_modes(solver: PositionSolver, values: dict, qs, steps: int = STEPS, 
         ok, each, why = True, [], ""
         for k, (pl, xy, Qp) in enumerate(pieces):
             fixed = {n: v for n, v in u.items() if n not in pl}
-            ok, e, why = _checked(solver, pl, fixed, xy, Qp)
+            ok, e, why = _checked_path(solver, pl, fixed, xy, Qp)
             each += e if k == 0 else e[1:]  # (a piece starts where the last one ended)
             if not ok:
                 break
@@ -303,7 +303,7 @@ def _reversed(edge: tuple) -> tuple:
     return plane, xy[::-1], Q[::-1]
 
 
-def _route(edges: dict, i: int, j: int) -> list | None:
+def _loop_route(edges: dict, i: int, j: int) -> list | None:
     """The shortest chain of loops (either way) from mode i to mode j: [(a, b), ...], or None."""
     nbr = {}
     for a, b in edges:
@@ -328,7 +328,7 @@ def _route(edges: dict, i: int, j: int) -> list | None:
 
 
 def _chained(edges: dict, i: int, j: int) -> bool:
-    return _route(edges, i, j) is not None
+    return _loop_route(edges, i, j) is not None
 
 
 def serial_connections(mech, output: str, qs, point: bool, target=None) -> Connections:
@@ -486,7 +486,7 @@ def check_point_path(mech, fid: int, level: float, xy: np.ndarray, Q: np.ndarray
 
 
 def _serial_pair(mech, output: str, edges: dict, i: int, j: int, target, searched: int) -> Connection:
-    route = _route(edges, i, j)
+    route = _loop_route(edges, i, j)
     if route is None:
         return Connection((i, j), False, False, (
             f"same sign of det J, but no loop of the point round a cusp of the workspace section joins them (cusps "
