@@ -30,10 +30,6 @@ from ...model.leg_chains import Platform, best_set, common_output, leg_poses, pl
 from ...model.planar_distances import PlanarRoots, planar_poses
 from ...model.state import KinematicState
 from ...model.subproblems import rotation
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from screwkin.analysis.position.position import PositionSolver
 
 __all__ = ["PlanarPlatform", "ThreeDistanceModes", "planar_platform", "three_distance_modes"]
 
@@ -67,7 +63,7 @@ class ThreeDistanceModes:
     seconds: float
 
 
-def planar_platform(solver: PositionSolver) -> PlanarPlatform | None:
+def planar_platform(solver) -> PlanarPlatform | None:
     """The planar platform on three distances of ``solver``'s mechanism with its inputs (the three slides,
     nothing else held), or None when it is no such mechanism (see the module).  Read once per inputs."""
     mech = solver.mech
@@ -77,7 +73,7 @@ def planar_platform(solver: PositionSolver) -> PlanarPlatform | None:
     return mech.cache[key]
 
 
-def _recognized(solver: PositionSolver) -> PlanarPlatform | None:
+def _recognized(solver) -> PlanarPlatform | None:
     mech, tol = solver.mech, solver.mech.tolerances
     if not mech.cuts or mech.closure.row_inputs:
         return None
@@ -122,7 +118,7 @@ def _recognized(solver: PositionSolver) -> PlanarPlatform | None:
                           np.array([leg.u0 for leg in platform.legs], float), (B - A) @ n)
 
 
-def three_distance_modes(solver: PositionSolver, values: dict) -> ThreeDistanceModes | str | None:
+def three_distance_modes(solver, values: dict) -> ThreeDistanceModes | str | None:
     """Every assembly mode at the input ``values`` (see the module); None where the mechanism is no planar
     platform on three distances, a sentence where it is one but the closed form does not settle it."""
     t0 = time.perf_counter()
@@ -151,7 +147,7 @@ def three_distance_modes(solver: PositionSolver, values: dict) -> ThreeDistanceM
         return f"{lone} complex pose(s) of the polynomial in tan(phi/2) without their conjugate"
     found = []  # [signature, q, Assembly, roots, simple]
     for pose in roots.real:
-        got = _onto_joints(solver, pp, q_in, x, float(pose.phi.real), pose.u.real, ref)
+        got = _pose_onto_joints(solver, pp, q_in, x, float(pose.phi.real), pose.u.real, ref)
         if isinstance(got, str):
             return got
         q, a = got
@@ -174,7 +170,7 @@ def _lone(roots: PlanarRoots, tol: float) -> int:
                for i, p in enumerate(cplx))
 
 
-def _onto_joints(solver: PositionSolver, pp: PlanarPlatform, q_in: np.ndarray, x: np.ndarray, phi: float,
+def _pose_onto_joints(solver, pp: PlanarPlatform, q_in: np.ndarray, x: np.ndarray, phi: float,
                  u: np.ndarray, ref: np.ndarray | None) -> tuple | str:
     """(q, Assembly) of the real pose (phi, u = B_1 - A_1 in the plane) on the file's joints, polished, or
     why not."""

@@ -207,3 +207,19 @@ def test_the_homotopy_finds_the_same_modes(which, tmp_path):
     H = [solver.signature(m[0]) for m in homotopy.modes]
     assert all(min(np.abs(x - y).max() for y in H) < tol for x in A)
     assert all(min(np.abs(x - y).max() for y in A) < tol for x in H)
+
+
+@pytest.mark.slow  # about 4 s: the loci's tracing
+def test_map_regions_count_the_modes_in_closed_form(capsys):
+    """Each region of the bundled 3-RPR's (leg2, leg3) map is counted by the closed form, certain, its count
+    the real poses of the independent polynomial at its sample (none real: certain too)."""
+    A, w, u, b = legs_of(BUNDLED)
+    rho0 = np.linalg.norm(w, axis=1)
+    assert main(["map", str(BUNDLED), "--x", "leg2=0.15:-0.08:12", "--y", "leg3=0.15:-0.08:12", "--set", "leg1=0",
+                 "--loci", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["regions"]
+    for r in d["regions"]:
+        roots, _ = genuine_roots(A, b - b[0], rho0 + np.array([0.0, *r["sample"]]))
+        assert r["certain"] and r["modes"] == int(np.sum(np.abs(roots.imag) < 1e-9)), r
+        assert r["how"] == METHOD if r["modes"] else "every solution is complex (certified)" in r["how"]
