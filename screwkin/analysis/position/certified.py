@@ -390,10 +390,11 @@ def planar_closed_form(solver, values: dict):
         return got
     r = got.roots
     n, real, cplx = r.degree, len(r.real), len(r.complex)
-    parts = [f"{sum(p.roots for p in r.real)} real ({real} pose{'s' if real != 1 else ''})",
-             f"{sum(p.roots for p in r.complex)} complex ({cplx // 2} conjugate pair{'s' if cplx != 2 else ''})"]
+    n_real, n_cplx = sum(p.roots for p in r.real), sum(p.roots for p in r.complex)
+    parts = [f"{n_real} real" + (f" ({real} pose{'s' if real != 1 else ''}, some multiple)" if n_real != real else ""),
+             f"{n_cplx} complex" + (f" ({cplx // 2} conjugate pair{'s' if cplx != 2 else ''})" if cplx else "")]
     if r.spurious:
-        parts.append(f"{r.spurious} where det M = 0 and the linear equations have no solution (no pose)")
+        parts.append(f"{r.spurious} where det M = 0 and the linear equations have no solution (a pose at infinity)")
     certificate = (f"closed form, a polynomial of degree {n} in tan(phi/2) of three distances in the plane, every "
                    f"root accounted for: {', '.join(parts)}" + (f"; {r.at_pi} at phi = pi" if r.at_pi else "")
                    + (f"; the factor (1 + t^2)^{r.circular} (t = +-i, no angle) taken out" if r.circular else ""))

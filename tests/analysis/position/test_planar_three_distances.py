@@ -102,7 +102,7 @@ def test_the_bundled_3rpr_has_two_real_and_two_complex_modes_in_closed_form():
     np.testing.assert_allclose(got, real, atol=1e-12)
     # base and platform are equilateral (similar triangles): two roots of the sextic are where det M = 0
     assert c.detail["roots_spurious"] == 2 and c.detail["degree"] == 6 and c.detail["circular_factors"] == 1
-    assert "every root accounted for: 2 real (2 poses), 2 complex (1 conjugate pair), 2 where det M = 0" in c.certificate
+    assert "every root accounted for: 2 real, 2 complex (1 conjugate pair), 2 where det M = 0" in c.certificate
 
 
 def test_solve_all_says_closed_form_in_text_and_json(capsys):
@@ -223,3 +223,34 @@ def test_map_regions_count_the_modes_in_closed_form(capsys):
         roots, _ = genuine_roots(A, b - b[0], rho0 + np.array([0.0, *r["sample"]]))
         assert r["certain"] and r["modes"] == int(np.sum(np.abs(roots.imag) < 1e-9)), r
         assert r["how"] == METHOD if r["modes"] else "every solution is complex (certified)" in r["how"]
+
+
+def test_at_a_fold_two_poses_meet_in_one_double_root(tmp_path):
+    """Innocenti's 3-RPR at rho1, rho2 = 14.98, 15.38 with rho3 where two real roots of the independent
+    sextic meet (bisected between 4 and 6 real roots): 5 real modes, one a double root (simple False,
+    singular); a little to either side, 4 real and 2 complex, or 6 real -- all simple."""
+    text, rho0 = rpr3()
+    (tmp_path / "r.urdf").write_text(text)
+    solver = PositionSolver(screwkin.load(tmp_path / "r.urdf"))
+
+    def real_roots(r3):
+        return int(sum(abs(t.imag) < 1e-7 for t in rpr3_polynomial(np.array([0.1498, 0.1538, r3])).roots()))
+
+    lo, hi = 0.11, 0.116
+    assert (real_roots(lo), real_roots(hi)) == (4, 6)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if real_roots(mid) == 4 else (lo, mid)
+
+    def solve(r3):
+        rho = np.array([0.1498, 0.1538, r3])
+        return solver.solve({f"leg{k + 1}": rho[k] - rho0[k] for k in range(3)})
+
+    res = solve(lo)
+    assert res.method == METHOD and (res.modes.real, res.modes.complex) == (5, 0) and res.modes.complete
+    (double,) = [s for s in res.solutions if s.simple is False]
+    assert double.singular and double.residual < 1e-12
+    assert res.modes.detail["multiple_poses"] == 1 and "(5 poses, some multiple)" in res.modes.certificate
+    for r3, want in ((lo - 1e-7, (4, 2)), (hi + 1e-7, (6, 0))):
+        res = solve(r3)
+        assert (res.modes.real, res.modes.complex) == want and all(s.simple is not False for s in res.solutions)
