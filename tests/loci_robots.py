@@ -66,23 +66,25 @@ RPR_PLATFORM = np.array([[0.0, 0.0], [_d12, 0.0], [_bx, np.sqrt(_d13**2 - _bx**2
 RPR_HOME = (np.array([0.05, 0.06]), np.radians(30.0))  # B1's position and the platform's angle, drawn
 
 
-def rpr3():
-    """(URDF text, the home leg lengths rho0 (3,)): a leg's joint value is its length minus rho0."""
-    c, s = np.cos(RPR_HOME[1]), np.sin(RPR_HOME[1])
+def rpr3(base=RPR_BASE, platform=RPR_PLATFORM, home=RPR_HOME):
+    """(URDF text, the home leg lengths rho0 (3,)): a leg's joint value is its length minus rho0.  Another
+    3-RPR: its ``base`` and ``platform`` points (3, 2) and ``home`` (B1's position, the platform's angle)."""
+    base, platform = np.asarray(base, float), np.asarray(platform, float)
+    c, s = np.cos(home[1]), np.sin(home[1])
     R = np.array([[c, -s], [s, c]])
-    B = RPR_HOME[0] + RPR_PLATFORM @ R.T
-    rho0 = np.linalg.norm(B - RPR_BASE, axis=1)
+    B = home[0] + platform @ R.T
+    rho0 = np.linalg.norm(B - base, axis=1)
     names = ["ground", "platform"] + [f"{k}{i}" for i in (1, 2, 3) for k in ("cylinder", "piston")]
     body = "".join(_LINK.format(n=n) for n in names)
     for i in range(3):
-        u = (B[i] - RPR_BASE[i]) / rho0[i]
-        body += _joint(f"base{i + 1}", "revolute", "ground", f"cylinder{i + 1}", RPR_BASE[i])
+        u = (B[i] - base[i]) / rho0[i]
+        body += _joint(f"base{i + 1}", "revolute", "ground", f"cylinder{i + 1}", base[i])
         body += _joint(f"leg{i + 1}", "prismatic", f"cylinder{i + 1}", f"piston{i + 1}", (0.0, 0.0),
                        axis=f"{float(u[0])!r} {float(u[1])!r} 0", lower=-0.3, upper=0.3)
-    body += _joint("wrist1", "revolute", "piston1", "platform", B[0] - RPR_BASE[0])
+    body += _joint("wrist1", "revolute", "piston1", "platform", B[0] - base[0])
     # the platform's frame at B1, turned like the ground's at home: B_i - B1 in it are R (B_i - B1 in the drawing)
     for i in (1, 2):
-        body += _loop(f"wrist{i + 1}", f"piston{i + 1}", B[i] - RPR_BASE[i], "platform", B[i] - B[0])
+        body += _loop(f"wrist{i + 1}", f"piston{i + 1}", B[i] - base[i], "platform", B[i] - B[0])
     text = f'<?xml version="1.0"?><robot name="rpr3_innocenti">{body}{_actuated("leg1", "leg2", "leg3")}</robot>'
     return text, rho0
 

@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
 __all__ = ["LegChain", "Platform", "platform_of", "LegPose", "leg_poses", "set_leg", "set_free", "best_set",
-           "respell"]
+           "respell", "common_output"]
 
 TINY = 1e-12  # guard: the square of a leg's length (m^2) and lines_point's parallel test, never zero
 
@@ -297,7 +297,7 @@ def best_set(mech: Mechanism, q: np.ndarray, pose: LegPose, near: np.ndarray | N
     return min(pose.sets, key=key)
 
 
-def _common_output(mech: Mechanism):
+def common_output(mech: Mechanism):
     """The joint carrying the link every loop joint closes on (a platform's), or None."""
     model = mech.model
     common = None
@@ -314,7 +314,7 @@ def respell(mech: Mechanism, q: np.ndarray) -> np.ndarray:
     limits or not."""
     key = "respell_joint"
     if key not in mech.cache:
-        j = _common_output(mech) if mech.cuts else None
+        j = common_output(mech) if mech.cuts else None
         mech.cache[key] = j
     j = mech.cache[key]
     platform = platform_of(mech, j) if j else None

@@ -39,6 +39,7 @@ from ...model.cuts import Assembly
 from ...model.linalg import rank
 from ...tolerances import Tolerances
 from .dyad_modes import dyad_modes
+from .three_distances import three_distance_modes
 from . import generic_modes
 from .modes import continuum_words
 from typing import TYPE_CHECKING
@@ -52,7 +53,8 @@ NO_LOOPS = "no loops"
 #: Singular values below this, relative to the Jacobian's largest entry, count as zero (its generic rank).
 _RANK = 1e-9
 
-__all__ = ["ModeCount", "Certified", "Search", "Problem", "certified_modes", "search", "join", "count_after_starts"]
+__all__ = ["ModeCount", "Certified", "Search", "Problem", "certified_modes", "search", "join", "count_after_starts",
+           "closed_form", "planar_closed_form"]
 
 
 @dataclass(frozen=True)
@@ -62,7 +64,9 @@ class ModeCount:
     found:       modes found, real and complex (distinct placements of the links);
     complete:    every mode is found (certified: ``certificate`` says how);
     method:      "closed form (dyads)" (a planar mechanism made of dyads: analysis.position.dyad_modes),
-                 "monodromy" (homotopy continuation) or "random starts" (damped Newton);
+                 "closed form (a univariate polynomial of degree n in tan(phi/2))" (a planar platform on
+                 three distances: analysis.position.three_distances), "monodromy" (homotopy
+                 continuation) or "random starts" (damped Newton);
     real:        modes with real joint values: the mechanism's assembly modes, reported;
     complex:     modes with complex joint values (no real assembly), None when not known;
     certificate: how completeness is known ("closed form, 2 dyads, 4 branch vectors", "trace test", a
@@ -377,19 +381,51 @@ def closed_form(solver, values: dict):
     return Certified(got.modes, count)
 
 
+def planar_closed_form(solver, values: dict):
+    """The modes of a planar platform on three distances (analysis.position.three_distances) as a
+    Certified; None where the mechanism is no such platform, a sentence where the closed form does not
+    settle it (the polynomial vanishes identically, a root or a pose not accounted for)."""
+    got = three_distance_modes(solver, values)
+    if got is None or isinstance(got, str):
+        return got
+    r = got.roots
+    n, real, cplx = r.degree, len(r.real), len(r.complex)
+    n_real, n_cplx = sum(p.roots for p in r.real), sum(p.roots for p in r.complex)
+    parts = [f"{n_real} real" + (f" ({real} pose{'s' if real != 1 else ''}, some multiple)" if n_real != real else ""),
+             f"{n_cplx} complex" + (f" ({cplx // 2} conjugate pair{'s' if cplx != 2 else ''})" if cplx else "")]
+    if r.spurious:
+        parts.append(f"{r.spurious} where det M = 0 and the linear equations have no solution (a pose at infinity)")
+    certificate = (f"closed form, a polynomial of degree {n} in tan(phi/2) of three distances in the plane, every "
+                   f"root accounted for: {', '.join(parts)}" + (f"; {r.at_pi} at phi = pi" if r.at_pi else "")
+                   + (f"; the factor (1 + t^2)^{r.circular} (t = +-i, no angle) taken out" if r.circular else ""))
+    multiple = sum(p.roots > 1 for p in r.poses)
+    detail = {"degree": n, "roots_real": sum(p.roots for p in r.real), "roots_complex": sum(p.roots for p in r.complex),
+              "roots_spurious": r.spurious, "roots_at_pi": r.at_pi, "circular_factors": r.circular,
+              "multiple_poses": multiple, "t_real": [round(t, 12) + 0.0 for t in got.t_real],
+              "polynomial": [float(v) for v in r.coefficients], "seconds": round(float(got.seconds), 4)}
+    check = {"method": "closed form (polynomial in tan(phi/2))", "degree": n, "accounted": r.accounted,
+             "real_poses": real, "complex_poses": cplx, "spurious_roots": r.spurious, "checked": True}
+    count = ModeCount(len(got.modes) + cplx, True, f"closed form (a univariate polynomial of degree {n} in tan(phi/2))",
+                      len(got.modes), cplx, certificate, "", detail, check)
+    return Certified(got.modes, count)
+
+
 def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) -> Search:
     """Every mode for solve (and ik, with its ``problem``): in closed form where the mechanism is made
-    of dyads (``closed_form``), else by certified_modes; its modes as the (signature, q, Assembly) of
-    PositionSolver.distinct."""
-    got, dyads = None, ""
+    of dyads (``closed_form``) or is a planar platform on three distances (``planar_closed_form``), else
+    by certified_modes; its modes as the (signature, q, Assembly) of PositionSolver.distinct."""
+    got, why = None, {}
     if problem is None and not obstacle(solver):
         got = closed_form(solver, values)
         if isinstance(got, str):
-            got, dyads = None, got
+            got, why["closed_form"] = None, got
+            got = planar_closed_form(solver, values)
+            if isinstance(got, str):
+                got, why["three_distances"] = None, got
     if got is None:
         got = certified_modes(solver, values, seed=seed, problem=problem)
-        if dyads and not isinstance(got, str):
-            got.count = replace(got.count, detail={**got.count.detail, "closed_form": dyads})
+        if why and not isinstance(got, str):
+            got.count = replace(got.count, detail={**got.count.detail, **why})
     if isinstance(got, str):
         return Search([], [], None, got)
     found = [(solver.signature(q), q, a) for q, a, _, _ in got.modes]

@@ -23,7 +23,8 @@ NEWTON_FROM_FILE = "newton from the file's configuration"
 
 def search_method(count) -> str:
     """How a search found its modes, from its certified.ModeCount (None: damped Newton from random starts),
-    in the words of PositionResult.method: "closed form (dyads)", "homotopy search" (with random starts
+    in the words of PositionResult.method: "closed form (dyads)", "closed form (a univariate polynomial of
+    degree n in tan(phi/2))" (a planar platform on three distances), "homotopy search" (with random starts
     where it did not settle every mode), "random starts" or "no loops"."""
     if count is None:
         return "random starts"
@@ -127,7 +128,8 @@ class PositionResult:
     held: dict | None = None  # links held at an absolute angle (--set-angle of a floating link) -> angle [rad]
     modes: object | None = None  # analysis.position.certified.ModeCount: how many modes and how that is known
     #: how the solutions were found: "every joint given", "newton from the file's configuration", "newton from
-    #: --near's configuration", "closed form (dyads)", "homotopy search", "random starts", "no loops"
+    #: --near's configuration", "closed form (dyads)", "closed form (a univariate polynomial of degree n in
+    #: tan(phi/2))", "homotopy search", "random starts", "no loops"
     method: str = ""
 
     @property

@@ -101,8 +101,9 @@ def regions(solver: PositionSolver | None, loci: Loci, x_name: str, xs: np.ndarr
                 mc = res.modes
                 certain = bool(mc is not None and mc.complete)
                 how = (mc.method if mc is not None else "search") + ("" if certain else ": maybe not all")
-            except AssemblyError:
-                modes, how = 0, "no assembly mode found"
+            except AssemblyError as exc:  # a reason: every solution complex, certified (a closed form's count)
+                modes, certain = 0, exc.reason is not None
+                how = "no assembly mode: every solution is complex (certified)" if certain else "no assembly mode found"
         out[k] = Region(sample, modes, certain, how, int(sizes[k]))
     if count and n > max_counted:
         notes.append(f"{n - max_counted} of the {n} regions (the smallest) were not counted")

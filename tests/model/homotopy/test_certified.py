@@ -294,17 +294,18 @@ def test_planar_3rpr_counts():
     """The bundled 3-RPR at its drawn leg lengths: at most 6 complex solutions (Hunt 1983; Gosselin
     and Sefrioui 1991: a sextic); here 2 real and 2 complex, the other 2 of a general geometry at
     infinity -- every one of its finite solutions certified by the trace test (retried with other
-    random choices: the test's witnesses may sit near infinity for one draw)."""
+    random choices: the test's witnesses may sit near infinity for one draw).  The homotopy itself:
+    solve takes the closed form (tests/analysis/position/test_planar_three_distances.py)."""
     mech = screwkin.load(ROBOTS / "planar_3rpr.urdf")
     solver = PositionSolver(mech)
     for seed in range(3):
-        res = solver.solve({n: 0.0 for n in solver.inputs}, seed=seed)
-        if res.modes.complete:
+        got = certified.certified_modes(solver, {n: 0.0 for n in solver.inputs}, seed=seed)
+        if got.count.complete:
             break
-    c = res.modes
+    c = got.count
     assert c.complete and (c.real, c.complex) == (2, 2) and c.detail["roots"] == 6
-    for s in res.solutions:
-        assert np.abs(mech.closure.residual(s.q)).max() < 1e-12
+    for q, _, _, _ in got.modes:
+        assert np.abs(mech.closure.residual(q)).max() < 1e-12
 
 
 # ------------------------------------------------------------------ what solve says
