@@ -136,7 +136,7 @@ def _kept(system: SixDistances, c0: np.ndarray, X: np.ndarray, tol: Tolerances) 
     two are one pose."""
     group = platform_group()
     ok = (system.residual(X, c0) <= _CACHED_ROOT * (1 + np.abs(c0).max())) & system.on_variety(X, 1e-8)
-    return bool(ok.all()) and all(group.match(X[i][None], X[:i], tol.homotopy_same)[0] < 0 for i in range(len(X)))
+    return bool(ok.all()) and len(group.distinct(X, tol.homotopy_same)) == len(X)
 
 
 def general_set(rng: np.random.Generator, tol: Tolerances) -> tuple[tuple, np.ndarray, Path | None] | None:
@@ -214,8 +214,8 @@ def _from_general(arch: Architecture, rng: np.random.Generator, tol: Tolerances)
     for route in range(_TRIES):
         X, bad, n = _route(system, p0, X0, p1, rng if route else None, tol)
         paths, failed = paths + n, failed + bad
-        new = [x for x in X if not len(union) or group.match(x[None], union, tol.homotopy_same)[0] < 0]
-        union = np.concatenate([union, np.array(new, complex).reshape(-1, 7)])
+        both = np.concatenate([union, X])
+        union = both[group.distinct(both, tol.homotopy_same)]
         if len(X) and not _kept(system, c1, X, tol):
             why = "the endpoints do not close"
             break
@@ -250,7 +250,7 @@ def _route(system: SixDistances, p0: tuple, X0: np.ndarray, p1: tuple, rng: np.r
         regular = ends.status == "regular"
         bad += int(np.sum(ends.status == "failed")) if k == 0 else int(np.sum(~regular))
         found = ends.X[regular]
-        keep = [i for i in range(len(found)) if group.match(found[i][None], found[:i], tol.homotopy_same)[0] < 0]
+        keep = group.distinct(found, tol.homotopy_same)
         bad += len(found) - len(keep)  # two paths on one pose: one went astray
         X = found[keep]
     return X, bad, paths

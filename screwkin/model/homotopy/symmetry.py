@@ -89,6 +89,11 @@ class SignGroup:
                     break
         return out
 
+    def distinct(self, X: np.ndarray, tol: float) -> list[int]:
+        """The indices of the points of X (P, n) that no earlier point shares an orbit with (one per
+        orbit, in order)."""
+        return [i for i in range(len(X)) if self.match(X[i][None], X[:i], tol)[0] < 0]
+
 
 def _gf2_basis(M: np.ndarray) -> np.ndarray:
     """Rows of the boolean matrix M reduced to a basis of their span over GF(2)."""
