@@ -248,7 +248,9 @@ def _route(system: SixDistances, p0: tuple, X0: np.ndarray, p1: tuple, rng: np.r
         ends = carry(GeometrySegment(system, a, b), X, tol, zone=_ZONE * tol.track_endgame)
         paths += len(X)
         regular = ends.status == "regular"
-        bad += int(np.sum(ends.status == "failed")) if k == 0 else int(np.sum(~regular))
+        # on the first leg a path may end at infinity (fewer poses than 40), never failed or at a singular
+        # point: the set's words ("N finite, the rest at infinity") are then true
+        bad += int(np.sum(np.isin(ends.status, ("failed", "singular")))) if k == 0 else int(np.sum(~regular))
         found = ends.X[regular]
         keep = group.distinct(found, tol.homotopy_same)
         bad += len(found) - len(keep)  # two paths on one pose: one went astray
