@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 
 import screwkin
-from conftest import DATA, ROBOTS
+from conftest import ARM, DATA, ROBOTS
 from screwkin.analysis.position.position import PositionSolver
 from screwkin.analysis.forces.statics import legs, statics
 from screwkin.cli import main
@@ -167,17 +167,11 @@ def test_statics_command(capsys):
     assert "not determined by statics" in capsys.readouterr().out
 
 
-ARM_SHOULDER_ONLY = """<robot name="arm2r">
-  <link name="base"/><link name="upper"/><link name="fore"/><link name="hand"/>
-  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
-    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.4 0 0"/>
-    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
-  <joint name="wrist" type="fixed"><parent link="fore"/><child link="hand"/><origin xyz="0.25 0 0"/></joint>
-  <transmission name="t"><type>transmission_interface/SimpleTransmission</type>
+#: conftest's planar 2R arm with only its shoulder driven (a transmission on it).
+ARM_SHOULDER_ONLY = ARM.replace("</robot>", """  <transmission name="t"><type>transmission_interface/SimpleTransmission</type>
     <joint name="shoulder"><hardwareInterface>EffortJointInterface</hardwareInterface></joint>
     <actuator name="m"><mechanicalReduction>1</mechanicalReduction></actuator></transmission>
-</robot>"""
+</robot>""")
 
 
 def test_no_equilibrium_shows_no_reactions_as_a_solution(tmp_path, capsys):
