@@ -150,6 +150,9 @@ def _section(mech: Mechanism, args: argparse.Namespace, named: list, joints: set
         raise UsageError("--connect goes round the cusps of a map over inputs, not of a workspace section")
     if args.csv:
         raise UsageError("--csv writes the map of sigma_min over inputs; a workspace section's answer is --json")
+    if args.mode is not None:
+        raise UsageError("--mode picks an assembly mode of a map over inputs; a workspace section counts every "
+                         "inverse-kinematic solution of each point")
     ranges = []
     for text, option in ((args.x, "--x"), (args.y, "--y")):
         name, _, rest = text.partition("=")

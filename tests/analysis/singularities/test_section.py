@@ -225,6 +225,8 @@ def test_map_section_usage_errors(tmp_path):
     p = screwkin_cli("map", str(path), "--output", "tool", "--x", "x=-1:1:5", "--y", "z=-1:1:5", "--loci",
                      "--set", "x=0")
     assert p.returncode == 2 and "held coordinate is y" in p.stderr
+    p = screwkin_cli("map", str(path), "--output", "tool", "--x", "x=-1:1:5", "--y", "z=-1:1:5", "--loci", "--mode", "2")
+    assert p.returncode == 2 and "--mode" in p.stderr and "Traceback" not in p.stderr
 
 
 @pytest.mark.slow
