@@ -22,8 +22,10 @@ model.state); Newton's limit is the root of F, which is evaluated exactly.
 Seeds: the assembly modes at the box's centre (the project's all-modes solve), each continued over a
 coarse grid of the box (analysis.motion.continuation.Neighbour, the map's step); Newton on F from every
 grid configuration next to a refused step (a fold lies between) or where the kind's relative singular
-value has a local minimum along a grid line.  A component is missed when no mode found at the centre
-reaches a grid node near it: ``complete`` stays False and ``how`` says this.
+value has a local minimum along a grid line; then, where the modes come in closed form, the points of
+each edge of the box where the mode count changes (loci_seeds.edge_seeds: a component that bounds a part
+of the box no grid node's mode reaches, such as the corner of a 3-RPR's box where nothing assembles).
+A component is missed when neither reaches it: ``complete`` stays False and ``how`` says this.
 
 Cusps (where three assembly modes meet): points of a traced curve where its trace in the plane
 reverses (the curve's tangent lies in the kernel of the projection onto the plane: the kernel vector
@@ -34,6 +36,7 @@ refined by Newton on the two arclengths.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,7 +46,7 @@ from ...model.kernel.scaling import dimensionless, dimensionless_rows, dimension
 from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
 from ..motion.continuation import locate, orient
-from .loci_seeds import crossings, refine_node, seed_configurations, sheets, unexplained_folds
+from .loci_seeds import crossings, edge_seeds, refine_node, seed_configurations, sheets, unexplained_folds
 from ..singular import LWA, Generic
 from typing import TYPE_CHECKING
 
@@ -401,7 +404,10 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
             continue
         traced_kinds.append(kind)
         sys = LocusSystem(mech, solver.inputs, x_name, y_name, fixed, kind, output, point, g)
-        found = trace_kind(sys, kind, (q0 for q0, _ in seed_configurations(sys, grown)), box, notes)
+        edged = edge_seeds(solver, sys, x_name, y_name, box, fixed) if kind == "actuator" else []
+        # the grid's seeds first, then the edges' (a component none of the grid's reached)
+        found = trace_kind(sys, kind, itertools.chain((q0 for q0, _ in seed_configurations(sys, grown)), edged),
+                           box, notes)
         loci += found[0]
         cusps += found[1]
         cusp_q += found[2]
@@ -414,10 +420,11 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
     notes = list(dict.fromkeys(notes))
     how = (f"seeds: Newton on [closure; A v = 0; |v| = 1] from the configurations of {mode_how}, each continued "
            f"over a {grid} x {grid} grid of the box, at the nodes next to a fold and where the kind's relative "
-           "singular value has a local minimum along a grid line; every curve then followed by pseudo-arclength "
+           "singular value has a local minimum along a grid line, and (where the modes come in closed form) from "
+           "the points of the box's edges where the mode count changes; every curve then followed by pseudo-arclength "
            "continuation to the box's edges or round to its start; cusps located by Brent's method where the trace "
-           f"reverses, nodes by Newton on the two arclengths. {checked}. A component no mode at the centre "
-           "reaches near a grid node is missed, so completeness is not claimed")
+           f"reverses, nodes by Newton on the two arclengths. {checked}. A component none of the seeds "
+           "reaches is missed, so completeness is not claimed")
     return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
 
 

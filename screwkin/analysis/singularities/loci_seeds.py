@@ -8,14 +8,67 @@ from __future__ import annotations
 import numpy as np
 
 from ..motion.continuation import Neighbour
+from ..position.certified import search
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from screwkin.analysis.position.position import PositionSolver
 
-__all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexplained_folds"]
+__all__ = ["seed_configurations", "crossings", "refine_node", "sheets", "unexplained_folds", "edge_seeds"]
 
 TINY = 1e-300  # division guard: two segments parallel
+#: Points per edge of the box where edge_seeds counts the modes, and bisections of a change between two
+#: (Newton on the locus, with the edge held, finishes from there).
+EDGE_SAMPLES, EDGE_BISECTIONS = 41, 12
+
+
+def _complete_count(solver: PositionSolver, values: dict) -> tuple | None:
+    """(number of real modes, their configurations) where every mode comes in closed form (0 where that
+    proves none assembles), else None (the homotopy would be a search per point: not walked)."""
+    done = search(solver, values)
+    if not done.complete or not done.count.method.startswith("closed form"):
+        return None
+    return len(done.found), [q for _, q, _ in done.found]
+
+
+def edge_seeds(solver: PositionSolver, sys, x_name: str, y_name: str, box: tuple, fixed: dict) -> list:
+    """Points of the actuator locus on the box's edges, where the modes come in closed form: along each edge at EDGE_SAMPLES points, every change of the count (two
+    modes meet between) bisected to EDGE_BISECTIONS, the mode of the larger count with the smallest measure
+    taken onto the locus by Newton with the edge held.  A component that crosses an edge between two
+    samples where the count is the same on both sides (two crossings, or a tangency) is not seen here."""
+    out = []
+    (x0, x1), (y0, y1) = box
+    for axis, bound, (a, b) in ((0, x0, (y0, y1)), (0, x1, (y0, y1)), (1, y0, (x0, x1)), (1, y1, (x0, x1))):
+        def at(u: float, axis=axis, bound=bound) -> tuple | None:
+            x, y = (bound, u) if axis == 0 else (u, bound)
+            return _complete_count(solver, {x_name: x, y_name: y, **fixed})
+        us = np.linspace(a, b, EDGE_SAMPLES)
+        counts = [at(us[0])]
+        if counts[0] is None:
+            return out  # no closed form here: no walk
+        counts += [at(u) for u in us[1:]]
+        for k in range(EDGE_SAMPLES - 1):
+            lo, hi = counts[k], counts[k + 1]
+            if lo is None or hi is None or lo[0] == hi[0]:
+                continue
+            ua, ub = us[k], us[k + 1]
+            for _ in range(EDGE_BISECTIONS):
+                um = 0.5 * (ua + ub)
+                mid = at(um)
+                if mid is None:
+                    break
+                if mid[0] == lo[0]:
+                    ua, lo = um, mid
+                else:
+                    ub, hi = um, mid
+            more = lo if lo[0] > hi[0] else hi
+            if not more[1]:
+                continue
+            q = min(more[1], key=sys.relative)
+            res = sys.newton(q, sys.kernel(q), sys.edge(axis, bound))
+            if res is not None:
+                out.append(res[0])
+    return out
 
 
 def unexplained_folds(sheets: list, loci: list, box: tuple, n: int) -> list:

@@ -192,6 +192,39 @@ def test_3rpr_loci_have_concurrent_legs_and_cusps_that_are_triple_roots(rpr):
         assert rel[3] > 1e-4, rel  # and not a quadruple one
 
 
+def _real_roots(rho):
+    """The real roots of the independent polynomial (its factor 1 + t^2 aside) at the leg lengths rho."""
+    q, _ = divmod(rpr3_polynomial(rho), Polynomial([1.0, 0.0, 1.0]))
+    z = q.roots()
+    return np.sort(z[np.abs(z.imag) < 1e-7 * (1 + np.abs(z))].real)
+
+
+@pytest.mark.slow
+def test_the_3rpr_workspace_boundary_in_the_corner_is_traced_from_the_box_edges(rpr):
+    """The component that bounds the corner of the box where no mode assembles, from (0.02, 0.0503) to
+    (0.1044, 0.02) m: no grid seed reaches it (the tracer missed it before the box's edges were walked).
+    Across each of its ends, along the edge, the independent polynomial's real roots go from 0 to 2; along
+    it, two of them coincide."""
+    _, _, _, rho0, rho1, traced = rpr
+    lo = (0.02 - rho0[1], 0.02 - rho0[2])
+    corner = [lc for lc in traced.loci if {round(float(lc.points[k][a] - lo[a]), 9) for k in (0, -1) for a in (0, 1)}
+              >= {0.0} and lc.points[:, 0].max() + rho0[1] < 0.12 and lc.points[:, 1].max() + rho0[2] < 0.06]
+    assert len(corner) == 1, [lc.points[[0, -1]] + rho0[1:] for lc in traced.loci]
+    P = corner[0].points + rho0[1:]
+    ends = sorted([P[0], P[-1]], key=lambda p: p[0])
+    assert abs(ends[0][0] - 0.02) < 1e-12 and abs(ends[1][1] - 0.02) < 1e-12
+    for (x, y), along in ((ends[0], 1), (ends[1], 0)):
+        d = np.array([0.0, 1e-4]) if along else np.array([1e-4, 0.0])
+        counts = [len(_real_roots((rho1, *(np.array([x, y]) + s * d)))) for s in (-1, 1)]
+        assert sorted(counts) == [0, 2], ((x, y), counts)
+    for x, y in P[::3]:  # a double root splits by round-off into a near pair, real or complex
+        q, _ = divmod(rpr3_polynomial((rho1, x, y)), Polynomial([1.0, 0.0, 1.0]))
+        z = q.roots()
+        gap = np.where(np.eye(len(z), dtype=bool), np.inf, np.abs(z[:, None] - z[None]))
+        i, j = np.unravel_index(np.argmin(gap), gap.shape)
+        assert gap[i, j] < 1e-6 * (1 + abs(z[i])) and abs((z[i] + z[j]).imag) < 1e-6, ((x, y), z)
+
+
 @pytest.mark.slow
 def test_a_loop_round_a_cusp_changes_the_3rpr_mode_without_a_singularity(rpr):
     """McAree & Daniel 1999, Zein, Wenger & Chablat 2008: from inside a cusp's wedge (three of the modes
