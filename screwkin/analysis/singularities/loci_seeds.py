@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..motion.continuation import Neighbour
-from ..position.certified import search
+from ..position.certified import closed_form, obstacle, planar_closed_form
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -23,18 +23,24 @@ EDGE_SAMPLES, EDGE_BISECTIONS = 41, 12
 
 
 def _complete_count(solver: PositionSolver, values: dict) -> tuple | None:
-    """(number of real modes, their configurations) where every mode comes in closed form (0 where that
-    proves none assembles), else None (the homotopy would be a search per point: not walked)."""
-    done = search(solver, values)
-    if not done.complete or not done.count.method.startswith("closed form"):
+    """(number of real modes, their configurations) where every mode comes in closed form (dyads, or a
+    planar platform on three distances; 0 where that proves none assembles), else None: no homotopy is run
+    here (it would be a search per point)."""
+    if obstacle(solver):
         return None
-    return len(done.found), [q for _, q, _ in done.found]
+    got = closed_form(solver, values)
+    if isinstance(got, str):
+        got = planar_closed_form(solver, values)
+    if got is None or isinstance(got, str) or not got.count.complete:
+        return None
+    return len(got.modes), [m[0] for m in got.modes]
 
 
 def edge_seeds(solver: PositionSolver, sys, x_name: str, y_name: str, box: tuple, fixed: dict) -> list:
-    """Points of the actuator locus on the box's edges, where the modes come in closed form: along each edge at EDGE_SAMPLES points, every change of the count (two
-    modes meet between) bisected to EDGE_BISECTIONS, the mode of the larger count with the smallest measure
-    taken onto the locus by Newton with the edge held.  A component that crosses an edge between two
+    """Points of the actuator locus on the box's edges, where the modes come in closed form: along each
+    edge at EDGE_SAMPLES points, every change of the count (two modes meet between) bisected
+    EDGE_BISECTIONS times, the mode of the larger count with the smallest measure taken onto the locus by
+    Newton with the edge held.  A component that crosses an edge between two
     samples where the count is the same on both sides (two crossings, or a tangency) is not seen here."""
     out = []
     (x0, x1), (y0, y1) = box
