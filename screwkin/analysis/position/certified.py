@@ -410,18 +410,27 @@ def planar_closed_form(solver, values: dict):
     return Certified(got.modes, count)
 
 
+def closed_forms(solver, values: dict) -> tuple:
+    """(every mode in closed form as a Certified, or None; why each closed form did not apply, by name): the
+    one order of them, dyads (``closed_form``) then the planar platform on three distances
+    (``planar_closed_form``); nothing is searched."""
+    why: dict = {}
+    if obstacle(solver):
+        return None, why
+    got = closed_form(solver, values)
+    if isinstance(got, str):
+        got, why["closed_form"] = None, got
+        got = planar_closed_form(solver, values)
+        if isinstance(got, str):
+            got, why["three_distances"] = None, got
+    return got, why
+
+
 def search(solver, values: dict, seed: int = 0, problem: Problem | None = None) -> Search:
     """Every mode for solve (and ik, with its ``problem``): in closed form where the mechanism is made
     of dyads (``closed_form``) or is a planar platform on three distances (``planar_closed_form``), else
     by certified_modes; its modes as the (signature, q, Assembly) of PositionSolver.distinct."""
-    got, why = None, {}
-    if problem is None and not obstacle(solver):
-        got = closed_form(solver, values)
-        if isinstance(got, str):
-            got, why["closed_form"] = None, got
-            got = planar_closed_form(solver, values)
-            if isinstance(got, str):
-                got, why["three_distances"] = None, got
+    got, why = closed_forms(solver, values) if problem is None else (None, {})
     if got is None:
         got = certified_modes(solver, values, seed=seed, problem=problem)
         if why and not isinstance(got, str):

@@ -309,7 +309,10 @@ class PositionSolver:
         if not found and done is None and near_q is None and not trace and method != "starts":
             done = certified.search(self, values, seed)  # homotopy continuation: every mode, certified
             found = list(done.found)
-        if not first and not (done is not None and done.complete and found):
+        settled = done is not None and done.complete  # every mode certified: none left to search for
+        if settled:
+            start_list = []
+        if not first and not settled:
             more_found, more = self.distinct(
                 mech.closure, [self.set_inputs(q0, values) for q0 in start_list], frozen=self.frozen,
                 first_trace=recorder if trace and near_q is None else None)
@@ -373,12 +376,13 @@ class PositionSolver:
         certain = ((f"none of the {done.count.complex} complex solutions is real" if done.count.complex != 1 else
                     "its one solution is complex") + f" (certified: {done.count.certificate})") \
             if done is not None and done.complete else None
+        inputs = "the inputs " + ", ".join([self._describe(values)] * bool(values)
+                                           + [f"the angle of {k}" for k in mech.closure.row_inputs])
+        if certain and not starts:  # the certificate settles it: nothing was searched
+            return AssemblyError(mech.path, np.inf, 0, reason=certain, message=(
+                f"cannot assemble the mechanism at {inputs}: {certain}; nothing searched"))
         return AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=starts,
-                             detail="the inputs " + ", ".join(
-                                 [self._describe(values)] * bool(values)
-                                 + [f"the angle of {k}" for k in mech.closure.row_inputs])
-                             + " cannot be reached from "
-                             f"{starts} starting configurations", reason=certain)
+                             detail=f"{inputs} cannot be reached from {starts} starting configurations", reason=certain)
 
     def _ordered(self, sols: list, near_q: np.ndarray | None) -> list:
         """The solutions in order: physical first, then regular, then nearest the reference (--near's

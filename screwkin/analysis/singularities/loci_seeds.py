@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..motion.continuation import Neighbour
-from ..position.certified import closed_form, obstacle, planar_closed_form
+from ..position.certified import closed_forms
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -26,12 +26,8 @@ def _complete_count(solver: PositionSolver, values: dict) -> tuple | None:
     """(number of real modes, their configurations) where every mode comes in closed form (dyads, or a
     planar platform on three distances; 0 where that proves none assembles), else None: no homotopy is run
     here (it would be a search per point)."""
-    if obstacle(solver):
-        return None
-    got = closed_form(solver, values)
-    if isinstance(got, str):
-        got = planar_closed_form(solver, values)
-    if got is None or isinstance(got, str) or not got.count.complete:
+    got, _ = closed_forms(solver, values)
+    if got is None or not got.count.complete:
         return None
     return len(got.modes), [m[0] for m in got.modes]
 

@@ -110,8 +110,14 @@ def test_where_the_loop_cannot_close_none_is_real_certified(capsys):
     solver = solver_of("fourbar_non_grashof")
     with pytest.raises(AssemblyError) as e:
         solver.solve({"input_joint": 1.5})
-    assert "cannot assemble the mechanism: none of the 2 complex solutions is real (certified: closed form, 1 dyad " \
-           "(RRR), 2 branch vectors, 2 with a negative discriminant); the loop-closure residual" in str(e.value)
+    assert "cannot assemble the mechanism at the inputs input_joint=1.5: none of the 2 complex solutions is real " \
+           "(certified: closed form, 1 dyad (RRR), 2 branch vectors, 2 with a negative discriminant); nothing searched" \
+           in str(e.value)
+    # the certificate is the answer, and no start was tried: by the law of cosines the input's pivot B is
+    # farther from the output's pivot D than coupler and output reach together
+    phi = 1.5 + np.radians(70)
+    assert np.sqrt(0.08 ** 2 + 0.1 ** 2 - 2 * 0.08 * 0.1 * np.cos(phi)) > 0.165 + 0.01
+    assert e.value.starts is None and e.value.iterations == 0
     assert main(["solve", str(ROBOTS / "fourbar_non_grashof.urdf"), "--set", "input_joint=1.5"]) == 1
     assert "certified: closed form" in capsys.readouterr().err
 
