@@ -29,7 +29,7 @@ def _xy(p: Sequence[float], xu: str, yu: str) -> list:
 
 def loci_dict(loci: Loci, regions: Regions, x_unit: str, y_unit: str, loops=None, mech: Mechanism | None = None) -> dict:
     """The keys ``map --loci --json`` adds: loci [{kind, points, closed, sigma_max}], cusps, nodes,
-    regions [{sample, modes, certain, how}], complete, how, loci_notes; with --connect, connections
+    regions [{sample, modes, certain, how}], complete, cusps_complete, how, loci_notes; with --connect, connections
     [{cusp, start, radius, modes, joined, turn, sigma_min, path: [{inputs, joints}]}] (modes: the indices
     of the start's solutions, 0-based) and connections_tried."""
     out = {
@@ -40,6 +40,7 @@ def loci_dict(loci: Loci, regions: Regions, x_unit: str, y_unit: str, loops=None
         "nodes": [_xy(p, x_unit, y_unit) for p, _ in loci.nodes],
         "node_kinds": [k for _, k in loci.nodes],
         "complete": loci.complete,
+        "cusps_complete": loci.cusps_complete,
         "loci_kinds": list(loci.traced),
         "how": loci.how,
         "loci_notes": list(loci.notes),
@@ -100,7 +101,8 @@ def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: s
                          f"{'counter-clockwise' if c.turn > 0 else 'clockwise'} from {pt(c.start)} "
                          f"(smallest actuator measure {c.loop.sigma_min:.2g})")
         lines.append(f"{len(found)} of {tried} loops round the cusps change the assembly mode without a singularity")
-    lines.append(f"complete: {'yes' if loci.complete else 'not claimed'}; {loci.how}")
+    lines.append(f"complete: {'yes' if loci.complete else 'not claimed'}; cusps complete: "
+                 f"{'yes' if loci.cusps_complete else 'not claimed'}; {loci.how}")
     lines += list(loci.notes)
     return lines
 

@@ -31,7 +31,7 @@ from ...model.planar_distances import PlanarRoots, planar_poses
 from ...model.state import KinematicState
 from ...model.subproblems import rotation
 
-__all__ = ["PlanarPlatform", "ThreeDistanceModes", "planar_platform", "three_distance_modes"]
+__all__ = ["PlanarPlatform", "ThreeDistanceModes", "planar_platform", "pose_onto_joints", "three_distance_modes"]
 
 
 @dataclass(frozen=True)
@@ -147,7 +147,7 @@ def three_distance_modes(solver, values: dict) -> ThreeDistanceModes | str | Non
         return f"{lone} complex pose(s) of the polynomial in tan(phi/2) without their conjugate"
     found = []  # [signature, q, Assembly, roots, simple]
     for pose in roots.real:
-        got = _pose_onto_joints(solver, pp, q_in, x, float(pose.phi.real), pose.u.real, ref)
+        got = pose_onto_joints(solver, pp, q_in, x, float(pose.phi.real), pose.u.real, ref)
         if isinstance(got, str):
             return got
         q, a = got
@@ -170,7 +170,7 @@ def _lone(roots: PlanarRoots, tol: float) -> int:
                for i, p in enumerate(cplx))
 
 
-def _pose_onto_joints(solver, pp: PlanarPlatform, q_in: np.ndarray, x: np.ndarray, phi: float,
+def pose_onto_joints(solver, pp: PlanarPlatform, q_in: np.ndarray, x: np.ndarray, phi: float,
                  u: np.ndarray, ref: np.ndarray | None) -> tuple | str:
     """(q, Assembly) of the real pose (phi, u = B_1 - A_1 in the plane) on the file's joints, polished, or
     why not."""

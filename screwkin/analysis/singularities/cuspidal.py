@@ -37,6 +37,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...model._pin import joint_axis
+from ...model.krawczyk import TrigPoly
 from ...model.state import KinematicState
 from ...tolerances import Tolerances
 from ..position.pieper import arm_positions
@@ -112,13 +113,9 @@ def point_ik(arm: Arm3R, c: np.ndarray) -> tuple[list, str]:
     return [np.array(p) for p in positions], why
 
 
-def _freqs(n: int) -> np.ndarray:
-    return np.fft.fftfreq(n, 1.0 / n).astype(int)
-
-
 @dataclass(frozen=True)
 class Aspects:
-    coef: np.ndarray  # (SAMPLES, SAMPLES) complex: det J's Fourier coefficients over (t2, t3)
+    poly: TrigPoly  # det J over (t2, t3): its Fourier coefficients, exact
     top: float  # the largest |det J| on the fine grid
     labels: np.ndarray  # (FINE, FINE): aspect k + 1 at each node, 0 where det J is zero
     count: int
@@ -128,11 +125,8 @@ class Aspects:
 
     def value(self, t2, t3, d2: int = 0, d3: int = 0) -> np.ndarray:
         """det J (or its derivative d2 times in t2, d3 in t3) at arrays of (t2, t3)."""
-        k = _freqs(SAMPLES)
         t2, t3 = np.atleast_1d(np.asarray(t2, float)), np.atleast_1d(np.asarray(t3, float))
-        E2 = np.exp(1j * np.outer(t2, k)) * (1j * k) ** d2
-        E3 = np.exp(1j * np.outer(t3, k)) * (1j * k) ** d3
-        return np.einsum("pk,kl,pl->p", E2, self.coef, E3).real
+        return self.poly.d(d2, d3).at(t2, t3)
 
     def node(self, t2: float, t3: float) -> tuple[int, int]:
         h = 2 * np.pi / FINE
@@ -190,13 +184,9 @@ def _label_periodic(mask: np.ndarray) -> tuple[np.ndarray, int]:
 def aspects(arm: Arm3R) -> Aspects:
     """det J over the torus of (t2, t3), its aspects and the singular points of its zero set."""
     V = _det_grid(arm)
-    coef = np.fft.fft2(V) / SAMPLES**2
-    k = np.abs(_freqs(SAMPLES))
-    coef[(k[:, None] > 6) | (k[None, :] > 6)] = 0.0  # degree <= 4 and 3: the rest is round-off
+    coef = TrigPoly.from_samples(V, (6, 6), check=None)  # degree <= 4 and 3: the rest is round-off
     pad = np.zeros((FINE, FINE), complex)
-    fk = _freqs(SAMPLES)
-    keep = np.abs(fk) <= 6
-    pad[np.ix_(fk[keep] % FINE, fk[keep] % FINE)] = coef[np.ix_(keep, keep)]
+    pad[np.ix_(coef.m % FINE, coef.n % FINE)] = coef.C
     F = np.fft.ifft2(pad).real * FINE**2
     top = float(np.abs(F).max())
     if np.abs(V).max() <= arm.mech.tolerances.zero * arm.mech.length**3:  # (L^3: det J's size)
@@ -211,11 +201,14 @@ def _edge_values(asp: Aspects, along: int) -> np.ndarray:
     """det J at EDGE points of every grid edge (endpoints included) along t2 (along = 0) or t3 (1): (FINE,
     FINE, EDGE + 1), [i, j] the edge from node (i, j) to its next neighbour (periodic), exact (the
     polynomial's terms: separable sums)."""
-    k = _freqs(SAMPLES)
+    p = asp.poly
     nodes = 2 * np.pi * np.arange(FINE) / FINE
     fine = 2 * np.pi * np.arange(FINE * EDGE + 1) / (FINE * EDGE)
-    En, Ef = np.exp(1j * np.outer(nodes, k)), np.exp(1j * np.outer(fine, k))
-    V = (En @ asp.coef @ Ef.T).real if along == 1 else (Ef @ asp.coef @ En.T).real.T  # (FINE, FINE * EDGE + 1)
+    if along == 1:
+        V = (np.exp(1j * np.outer(nodes, p.m)) @ p.C @ np.exp(1j * np.outer(fine, p.n)).T).real
+    else:
+        V = (np.exp(1j * np.outer(fine, p.m)) @ p.C @ np.exp(1j * np.outer(nodes, p.n)).T).real.T
+    # (FINE, FINE * EDGE + 1)
     idx = np.arange(FINE)[:, None] * EDGE + np.arange(EDGE + 1)[None, :]
     out = V[:, idx]  # (FINE nodes across, FINE edges, EDGE + 1)
     return out if along == 1 else out.transpose(1, 0, 2)
@@ -256,10 +249,10 @@ def _singular_points(asp: Aspects, F: np.ndarray, tol: Tolerances) -> tuple:
     h = 2 * np.pi / FINE
     g = np.arange(FINE) * h
     T2, T3 = np.meshgrid(g, g, indexing="ij")
-    k = _freqs(SAMPLES)
-    En = np.exp(1j * np.outer(g, k))
-    G2 = (En @ (asp.coef * (1j * k)[:, None]) @ En.T).real
-    G3 = (En @ (asp.coef * (1j * k)[None, :]) @ En.T).real
+    p = asp.poly
+    Em, En = np.exp(1j * np.outer(g, p.m)), np.exp(1j * np.outer(g, p.n))
+    G2 = (Em @ p.d(1, 0).C @ En.T).real
+    G3 = (Em @ p.d(0, 1).C @ En.T).real
     grad = np.hypot(G2, G3)
     gtop = max(float(grad.max()), TINY)
     seeds = (np.abs(F) < 0.05 * asp.top) & (grad <= ndimage.minimum_filter(grad, size=3, mode="wrap"))

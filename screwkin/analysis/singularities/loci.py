@@ -25,7 +25,10 @@ grid configuration next to a refused step (a fold lies between) or where the kin
 value has a local minimum along a grid line; then, where the modes come in closed form, the points of
 each edge of the box where the mode count changes (loci_seeds.edge_seeds: a component that bounds a part
 of the box no grid node's mode reaches, such as the corner of a 3-RPR's box where nothing assembles).
-A component is missed when neither reaches it: ``complete`` stays False and ``how`` says this.
+A component is missed when neither reaches it: ``complete`` stays False and ``how`` says this -- except
+for a platform on three distances mapped over two legs (loci_witness): there witness points, every root of
+seven systems on a torus proved by the Krawczyk test, seed the tracer last, and when each lies on a traced
+curve the actuator loci are complete, proved.
 
 Cusps (where three assembly modes meet): points of a traced curve where its trace in the plane
 reverses (the curve's tangent lies in the kernel of the projection onto the plane: the kernel vector
@@ -47,6 +50,7 @@ from ...model.manifold import continuous_angle
 from ...model.state import KinematicState
 from ..motion.continuation import locate, orient
 from .loci_seeds import crossings, edge_seeds, refine_node, seed_configurations, sheets, unexplained_folds
+from .loci_witness import unmatched, witnesses
 from ..singular import LWA, Generic
 from typing import TYPE_CHECKING
 
@@ -67,6 +71,8 @@ STEP, STEP_MIN, STEP_MAX = 0.02, 1e-7, 0.06
 MAX_POINTS, MAX_CURVES = 20000, 64
 #: Central-difference step for d(A v)/dq.
 FD = 1e-7
+#: A traced cusp is the certificate's within this share of the box's span.
+CUSP_MATCH = 1e-7
 
 
 @dataclass(frozen=True)
@@ -88,6 +94,7 @@ class Loci:
     notes: tuple = ()
     cusp_q: tuple = field(default=(), repr=False)
     traced: tuple = ()  # the kinds traced (the others: a note says why not)
+    cusps_complete: bool = False  # every cusp in the box is among ``cusps``, proved (a 3-RPR's witnesses)
 
 
 class LocusSystem:
@@ -396,6 +403,7 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
     grown = sheets(solver, x_name, y_name, box, starts, grid)
     wanted = kinds or ("actuator", "serial")
     loci, cusps, cusp_q, nodes, traced_kinds = [], [], [], [], []
+    proof, left, cusps_complete = None, [], False
     for kind in wanted:
         why = _untraceable(mech, g, kind, output, solver.inputs)
         if why:
@@ -405,27 +413,68 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
         traced_kinds.append(kind)
         sys = LocusSystem(mech, solver.inputs, x_name, y_name, fixed, kind, output, point, g)
         edged = edge_seeds(solver, sys, x_name, y_name, box, fixed) if kind == "actuator" else []
-        # the grid's seeds first, then the edges' (a component none of the grid's reached)
-        found = trace_kind(sys, kind, itertools.chain((q0 for q0, _ in seed_configurations(sys, grown)), edged),
-                           box, notes)
+        if kind == "actuator":
+            proof = witnesses(solver, x_name, y_name, box, fixed)
+        # the grid's seeds first, then the edges' (a component none of the grid's reached), then the witnesses
+        found = trace_kind(sys, kind, itertools.chain((q0 for q0, _ in seed_configurations(sys, grown)), edged,
+                                                      (w.q for w in proof.points if w.q is not None)
+                                                      if kind == "actuator" else ()), box, notes)
+        if kind == "actuator" and proof.certified:
+            left = unmatched(proof, found[0])
+            if left:
+                notes.append(f"actuator: {len(left)} witness point(s) of the certificate lie on no traced curve, at "
+                             + ", ".join(f"({w.xy[0]:.6g}, {w.xy[1]:.6g})" for w in left[:4]))
         loci += found[0]
         cusps += found[1]
         cusp_q += found[2]
         nodes += found[3]
-    unexplained = unexplained_folds(grown, loci, box, grid) if "actuator" in traced_kinds else []
-    notes += unexplained
+    complete = proof is not None and proof.certified and not left and traced_kinds == ["actuator"]
+    missed = unexplained_folds(grown, loci, box, grid) if "actuator" in traced_kinds else 0
+    if missed:
+        steps = f"{missed} refused grid step{'s' if missed != 1 else ''} (a fold within a cell, or the corrector's jump)"
+        notes.append(f"{steps} with no traced actuator curve within a cell and a half: " + (
+            "not a missing component (the witnesses prove every one traced)" if complete else
+            "a component of the locus may be missing"))
+    unexplained = missed
     checked = ("No fold check (no actuator loci traced)" if "actuator" not in traced_kinds else
-               "Not every grid step refused by a fold has an actuator curve near it (see the notes)" if unexplained
-               else "Checked: every grid step refused by a fold has an actuator curve within a cell and a half")
+               "Not every refused grid step has an actuator curve within a cell and a half (see the notes)"
+               if unexplained
+               else "Checked: every refused grid step has an actuator curve within a cell and a half")
     notes = list(dict.fromkeys(notes))
     how = (f"seeds: Newton on [closure; A v = 0; |v| = 1] from the configurations of {mode_how}, each continued "
            f"over a {grid} x {grid} grid of the box, at the nodes next to a fold and where the kind's relative "
            "singular value has a local minimum along a grid line, and (where the modes come in closed form) from "
            "the points of the box's edges where the mode count changes; every curve then followed by pseudo-arclength "
            "continuation to the box's edges or round to its start; cusps located by Brent's method where the trace "
-           f"reverses, nodes by Newton on the two arclengths. {checked}. A component none of the seeds "
-           "reaches is missed, so completeness is not claimed")
-    return Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how, tuple(notes), tuple(cusp_q), tuple(traced_kinds))
+           f"reverses, nodes by Newton on the two arclengths. {checked}. ")
+    if complete:
+        how += (f"Complete: {proof.how}; each of the {len(proof.points)} witnesses lies on a traced curve (a traced point "
+                "in a box about it where the locus is one arc through it, or the curve's end on that bound)")
+        said, cusps_complete = _cusps_checked(proof, [c for c in cusps if c[1] == "actuator"], box, notes)
+        how += said
+    else:
+        why = "" if proof is None else f" ({proof.how}" + (
+            f"; {len(left)} of them on no traced curve" if left else
+            "; it covers the actuator loci only" if proof.certified and len(traced_kinds) > 1 else "") + ")"
+        how += "A component none of the seeds reaches is missed, so completeness is not claimed" + why
+    return Loci(tuple(loci), tuple(cusps), tuple(nodes), complete, how, tuple(notes), tuple(cusp_q),
+                tuple(traced_kinds), cusps_complete)
+
+
+def _cusps_checked(proof, traced: list, box: tuple, notes: list) -> tuple:
+    """The sentence on the cusps where the witnesses settle them: every cusp of the certificate among the traced
+    ones and no other (within CUSP_MATCH of the box's span), else a note."""
+    if proof.cusps is None:
+        return f". Cusps: not certified ({proof.cusp_how})", False
+    span = max(box[0][1] - box[0][0], box[1][1] - box[1][0], 1e-300)
+    mine = [np.array(p) for p, _ in traced]
+    missing = [c for c in proof.cusps if not any(np.abs(np.array(c) - p).max() <= CUSP_MATCH * span for p in mine)]
+    extra = [p for p in mine if not any(np.abs(np.array(c) - p).max() <= CUSP_MATCH * span for c in proof.cusps)]
+    if missing or extra:
+        notes.append(f"actuator: the traced cusps differ from the certificate's ({len(missing)} of its "
+                     f"{len(proof.cusps)} not traced, {len(extra)} traced not among them)")
+        return f". Cusps: not certified (the traced ones differ from the {proof.cusp_how})", False
+    return f". Cusps complete: {proof.cusp_how}; each is a traced cusp", True
 
 
 def trace_kind(sys: LocusSystem, kind: str, seeds: Iterator, box: tuple, notes: list) -> tuple:

@@ -73,9 +73,9 @@ def edge_seeds(solver: PositionSolver, sys, x_name: str, y_name: str, box: tuple
     return out
 
 
-def unexplained_folds(sheets: list, loci: list, box: tuple, n: int) -> list:
-    """Notes for the grid nodes a continuation step was refused from (a fold lies within a cell) with no
-    traced actuator curve within a cell and a half: a component the seeds missed."""
+def unexplained_folds(sheets: list, loci: list, box: tuple, n: int) -> int:
+    """How many grid nodes a continuation step was refused from (a fold within a cell, or the corrector's
+    jump away from the curve) have no traced actuator curve within a cell and a half."""
     span = np.array([box[0][1] - box[0][0], box[1][1] - box[1][0]], float)
     span[span == 0] = 1.0
     cell = 1.0 / max(n - 1, 1)
@@ -87,10 +87,7 @@ def unexplained_folds(sheets: list, loci: list, box: tuple, n: int) -> list:
             node = np.array([i, j], float) * cell
             if not len(P) or np.abs(P - node).max(axis=1).min() > 1.5 * cell:
                 missed += 1
-    if missed:
-        return [(f"{missed} grid steps refused by a fold (a limit position) have no traced actuator curve near "
-                 "them: a component of the locus may be missing")]
-    return []
+    return missed
 
 
 def sheets(solver: PositionSolver, x_name: str, y_name: str, box: tuple, starts: int | None, n: int) -> list:

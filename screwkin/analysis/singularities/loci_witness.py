@@ -1,0 +1,320 @@
+"""Witness points that prove every component of a planar platform's actuator locus was traced (issue 44).
+
+For a platform on three distances (analysis.position.three_distances: a 3-RPR and its kin) mapped over two
+legs' slides x, y with the third leg k held, every configuration is fixed by two angles: theta, the held
+leg's direction in the plane, and phi, the platform's turn from its drawn pose (B_k = A_k + rho_k (cos
+theta, sin theta), B_i = B_k + R(phi) (b_i - b_k)).  The actuator singularity is where the three legs'
+lines meet in one point (or are parallel):
+
+    G(theta, phi) = det [ e_i, (B_i - B_k) x e_i ]_(i = 1..3) = 0,   e_i = B_i - A_i,
+
+a trigonometric polynomial of degree 3 in each angle, on a torus: no spurious factor, no angle at
+infinity.  The box of the map is the region D of the torus where each mapped leg's squared length
+|e_i|^2 lies between its values at the box's bounds (each slide moves its leg's length one way over the
+box; checked).  A connected component of {G = 0} in D either meets D's boundary, where a leg is at a
+bound of the box (G = 0 with |e_x|^2 or |e_y|^2 at a bound), or is a closed curve inside D: then it
+either goes round the torus and crosses one of the circles theta = 0 (or pi) or phi = 0 (or pi), or it
+bounds a disc and has a point where theta is largest (G = G_phi = 0).  So every component holds a real
+root in D of one of these seven systems of two equations in two angles, each solved by model.krawczyk:
+every root proved, or the boxes left undecided said (then nothing is certified).
+
+A witness is on a traced curve when a point of the curve lies in its *arc box*: a box about it inside D
+where G's gradient keeps one component away from zero and G keeps away from zero on the two faces across
+it, so that {G = 0} in the box is one arc, through the witness (proved with the same enclosures); a
+witness on the boundary, when the tracer's end on that bound lies in the Krawczyk box that proved the
+witness the only root there.  Every witness on a traced curve: the locus is complete.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...model.geometry import wrap_angle
+from ...model.krawczyk import TrigPoly, bounds, torus_roots
+from ...model.state import KinematicState
+from ..position.three_distances import planar_platform, pose_onto_joints
+
+__all__ = ["Witnesses", "witnesses", "unmatched"]
+
+#: Arc boxes tried, half-width in radians, each half the one before, down to this.
+ARC_START, ARC_MIN = 0.2, 1e-6
+#: A traced point is on the locus to this (|G| relative to the sum of its coefficients' sizes).
+ON = 1e-8
+#: A root of the slide's quadratic is real below this imaginary part (relative); a leading coefficient below
+#: TINY is none.
+REAL, TINY = 1e-9, 1e-300
+#: G's coefficients all below this (relative to L^4): the legs' lines meet everywhere.
+FLAT = 1e-12
+#: A root is inside a constraint's interval to this (squared lengths over L^2).
+MARGIN = 1e-12
+#: The tracer's end on a bound is the edge witness when this close (rad, on the torus).
+END = 1e-7
+#: A root of the cusp system is a cusp where y's rate is below CUSP (relative to the sum of its coefficients'
+#: sizes), a turn where its enclosure over CLOSE (rad) about the root keeps away from zero.
+CUSP, CLOSE = 1e-10, 1e-9
+
+
+@dataclass(frozen=True)
+class Witness:
+    """One root: (theta, phi), its system ("theta largest", "theta = 0 or pi", "phi = 0 or pi", "edge"),
+    its point in the plane (x, y) [the user's inputs, SI], its configuration q (None where it does not
+    lift), and its arc box's half-width and axis (0: G = 0 a graph over phi) or, for an edge point, the
+    half-widths of the box where it is the only root."""
+
+    angles: np.ndarray
+    system: str
+    xy: tuple
+    q: np.ndarray | None
+    box: tuple | None
+
+
+@dataclass(frozen=True)
+class Witnesses:
+    points: tuple
+    certified: bool
+    how: str
+    G: TrigPoly | None = None
+    torus: object = None  # q -> (theta, phi)
+    cusps: tuple | None = None  # ((x, y), ...) every cusp in the box, None where not settled
+    cusp_how: str = ""
+
+
+def _quadratic(pp, k: int) -> tuple:
+    """(a, b, c): leg k's squared length in the plane is a s^2 + b s + c at slide s."""
+    d0, u0, n = pp.d0[k], pp.u0[k], pp.basis[2]
+    return (float(u0 @ u0 - (u0 @ n) ** 2), float(2 * (d0 @ u0 - (d0 @ n) * (u0 @ n))),
+            float(d0 @ d0 - (d0 @ n) ** 2))
+
+
+def _leg_length2(pp, k: int, s: float) -> float:
+    a, b, c = _quadratic(pp, k)
+    return a * s * s + b * s + c
+
+
+def _one_way(pp, k: int, lo: float, hi: float) -> bool:
+    """Whether leg k's length moves one way as its slide goes from lo to hi, never zero: the quadratic's
+    vertex not inside (lo, hi), its values at both ends positive."""
+    a, b, _ = _quadratic(pp, k)
+    vertex = -b / (2 * a) if abs(a) > TINY else np.inf
+    return not lo < vertex < hi and min(_leg_length2(pp, k, lo), _leg_length2(pp, k, hi)) > 0
+
+
+def _slide_for(pp, k: int, r2: float, lo: float, hi: float) -> float:
+    """The slide of leg k in [lo, hi] at which its squared length is r2 (one: the length is monotone)."""
+    a, b, c = _quadratic(pp, k)
+    roots = np.roots([a, b, c - r2]) if abs(a) > TINY else np.array([(r2 - c) / b])
+    roots = roots[np.abs(roots.imag) <= REAL * (1 + np.abs(roots))].real
+    return float(min(roots, key=lambda s: max(lo - s, s - hi, 0.0)))
+
+
+def witnesses(solver, x_name: str, y_name: str, box: tuple, fixed: dict) -> Witnesses:
+    """The witness points of the module for the map of ``solver``'s mechanism over (x_name, y_name) in
+    ``box`` with ``fixed`` held, or why none (certified False, ``how`` says why)."""
+    mech = solver.mech
+    pp = planar_platform(solver)
+    if pp is None:
+        return Witnesses((), False, "no certificate: witness points are built for a planar platform on three "
+                                     "distances (a 3-RPR)")
+    idx = {mech.coordinate(name).idx_q: name for name in (x_name, y_name, *fixed)}
+    if set(idx) != set(pp.slides) or len(fixed) != 1:
+        return Witnesses((), False, "no certificate: witness points are built for a map over two legs' slides "
+                                     "with the third held")
+    legs = {name: pp.slides.index(mech.coordinate(name).idx_q) for name in (x_name, y_name, *fixed)}
+    names = {i: name for name, i in legs.items()}
+    ix, iy, k = legs[x_name], legs[y_name], legs[next(iter(fixed))]
+    ranges = []
+    for i, (lo, hi) in ((ix, box[0]), (iy, box[1])):
+        if not _one_way(pp, i, lo, hi):
+            return Witnesses((), False, "no certificate: a mapped leg's length does not move one way over the box")
+        ends = _leg_length2(pp, i, lo), _leg_length2(pp, i, hi)
+        ranges.append((min(ends), max(ends)))
+    rho_k = np.sqrt(_leg_length2(pp, k, float(next(iter(fixed.values())))))
+    a, b = pp.a, pp.b
+
+    def parts(theta, phi):
+        c, s = np.cos(phi), np.sin(phi)
+        Bk = (a[k][0] + rho_k * np.cos(theta), a[k][1] + rho_k * np.sin(theta))
+        out = []
+        for i in range(3):
+            d = b[i] - b[k]
+            r = (c * d[0] - s * d[1], s * d[0] + c * d[1])
+            e = (Bk[0] + r[0] - a[i][0], Bk[1] + r[1] - a[i][1])
+            out.append((e, r[0] * e[1] - r[1] * e[0]))
+        return out
+
+    L = max(mech.length, 1e-3)
+
+    def G(theta, phi):
+        (e0, m0), (e1, m1), (e2, m2) = parts(theta, phi)
+        return (e0[0] * (e1[1] * m2 - m1 * e2[1]) - e0[1] * (e1[0] * m2 - m1 * e2[0])
+                + m0 * (e1[0] * e2[1] - e1[1] * e2[0])) / L ** 4
+
+    def length2(i):
+        return lambda theta, phi: (parts(theta, phi)[i][0][0] ** 2 + parts(theta, phi)[i][0][1] ** 2) / L ** 2
+
+    try:
+        g = TrigPoly.fit(G, (3, 3))
+        lx, ly = TrigPoly.fit(length2(ix), (1, 1)), TrigPoly.fit(length2(iy), (1, 1))
+    except ValueError as e:
+        return Witnesses((), False, f"no certificate: {e}")
+    if np.abs(g.C).max() < FLAT:
+        return Witnesses((), False, "no certificate: the legs' lines meet at every configuration")
+    Ix, Iy = (ranges[0][0] / L ** 2, ranges[0][1] / L ** 2), (ranges[1][0] / L ** 2, ranges[1][1] / L ** 2)
+    inside = ((lx, *Ix), (ly, *Iy))
+    # sin(theta) = Re(-i/2 e^{i theta} + i/2 e^{-i theta}); sin(phi) the same in the second angle
+    sin_t = TrigPoly(np.array([[0.5j], [0.0], [-0.5j]]), np.array([-1, 0, 1]), np.array([0]))
+    sin_p = TrigPoly(np.array([[0.5j, 0.0, -0.5j]]), np.array([0]), np.array([-1, 0, 1]))
+    systems = [("theta largest", (g, g.d(0, 1)), inside), ("theta = 0 or pi", (g, sin_t), inside),
+               ("phi = 0 or pi", (g, sin_p), inside)]
+    edges = [(lx - Ix[0], inside[1]), (lx - Ix[1], inside[1]), (ly - Iy[0], inside[0]), (ly - Iy[1], inside[0])]
+    systems += [("edge", (g, e), (other,)) for e, other in edges]
+    found, undecided, examined = [], 0, 0
+    for name, F, within in systems:
+        got = torus_roots(F, within)
+        examined += got.boxes
+        undecided += len(got.undecided)
+        for x in got.points:
+            v = np.array([bounds(p, x[None], np.zeros((1, 2)))[0][0] for p, _, _ in within])
+            if any(val < lo - MARGIN or val > hi + MARGIN for val, (_, lo, hi) in zip(v, within)):
+                continue
+            found.append((name, x, got.radii[np.abs(got.points - x).max(axis=1).argmin()]))
+    torus = _torus_coordinates(mech, pp, k)
+    points = []
+    for name, x, radius in found:
+        r2 = {ix: lx.at(*x) * L ** 2, iy: ly.at(*x) * L ** 2}
+        s = {ix: _slide_for(pp, ix, r2[ix], *box[0]), iy: _slide_for(pp, iy, r2[iy], *box[1]),
+             k: float(next(iter(fixed.values())))}
+        e0 = parts(*x)[0][0]
+        q = _witness_configuration(solver, pp, {names[i]: v for i, v in s.items()}, [s[i] for i in range(3)], x[1], np.array(e0))
+        box_w = radius if name == "edge" else _arc_box(g, x, inside)
+        points.append(Witness(np.array(x), name, (s[ix], s[iy]), q, box_w))
+    certified = not undecided and all(w.q is not None and w.box is not None for w in points)
+    counts = {n: sum(w.system == n for w in points) for n in ("theta largest", "theta = 0 or pi", "phi = 0 or pi",
+                                                              "edge")}
+    how = (f"witnesses: every component of the locus in the box holds a root of one of seven systems on the torus of "
+           f"the held leg's direction and the platform's turn (G = 0, the legs' lines meeting: with G_phi = 0, "
+           f"{counts['theta largest']}; with theta = 0 or pi, {counts['theta = 0 or pi']}; with phi = 0 or pi, "
+           f"{counts['phi = 0 or pi']}; with a mapped leg at a bound of the box, {counts['edge']}), every root proved "
+           f"by the Krawczyk test in {examined} boxes")
+    if undecided:
+        how += f", but {undecided} boxes were left undecided (a singular point of the locus?): no certificate"
+    elif not certified:
+        how += ", but a witness could not be put on the joints or boxed: no certificate"
+    cusps, cusp_how = _certified_cusps(g, lx, ly, inside, lambda x: (_slide_for(pp, ix, lx.at(*x) * L ** 2, *box[0]),
+                                                          _slide_for(pp, iy, ly.at(*x) * L ** 2, *box[1])))
+    return Witnesses(tuple(points), certified, how, g, torus, cusps, cusp_how)
+
+
+def _rate_along(g: TrigPoly, length: TrigPoly) -> TrigPoly:
+    """The rate of ``length`` along G = 0 (grad length . (-G_phi, G_theta)): zero where the curve's image turns."""
+    degree = (int(np.abs(g.m).max() + np.abs(length.m).max()), int(np.abs(g.n).max() + np.abs(length.n).max()))
+    return TrigPoly.fit(lambda u, w: -length.d(1, 0).at(u, w) * g.d(0, 1).at(u, w)
+                        + length.d(0, 1).at(u, w) * g.d(1, 0).at(u, w), degree)
+
+
+def _certified_cusps(g: TrigPoly, lx: TrigPoly, ly: TrigPoly, inside: tuple, plane) -> tuple:
+    """(the cusps in the plane, or None where not settled; in words): where three modes meet the locus's image
+    turns back, both mapped lengths stationary along G = 0.  Every root of G = H = 0 in the box (H: x's rate
+    along the curve; its image's x turns) is proved by model.krawczyk; each is a cusp where y's rate K
+    vanishes to round-off there, and not one where K's enclosure over the root's neighbourhood keeps away
+    from zero."""
+    H, K = _rate_along(g, lx), _rate_along(g, ly)
+    got = torus_roots((g, H), inside)
+    if not got.complete:
+        return None, f"the cusps are not settled ({len(got.undecided)} boxes undecided)"
+    cusps, turns = [], 0
+    scale = np.abs(K.C).sum()
+    for x in got.points:
+        if not all(lo - MARGIN <= p.at(*x) <= hi + MARGIN for p, lo, hi in inside):
+            continue
+        v, e = bounds(K, x[None], np.full((1, 2), CLOSE))
+        if abs(v[0]) > e[0]:
+            turns += 1
+        elif abs(v[0]) <= CUSP * scale:
+            cusps.append(tuple(float(c) for c in plane(x)))
+        else:
+            return None, "a root of the cusp system is neither a cusp nor a turn to round-off"
+    return tuple(cusps), (f"{len(cusps)} cusps: every root of G = 0 with x stationary along it (G = H = 0) proved by "
+                          f"the Krawczyk test in {got.boxes} boxes, {len(cusps)} with y stationary too (to round-off), "
+                          f"{turns} where the curve only turns (y's rate proved away from zero)")
+
+
+def _witness_configuration(solver, pp, values: dict, slides: list, phi: float, u: np.ndarray) -> np.ndarray | None:
+    """The configuration at the slides ``values`` with the platform turned by phi and leg 1 along u (three
+    distances' own lift onto the file's joints), or None where it does not lift."""
+    ref = solver.reference()
+    q_in = solver.set_inputs(solver.mech.neutral() if ref is None else ref, values)
+    got = pose_onto_joints(solver, pp, q_in, np.array(slides, float), phi, u, ref)
+    return None if isinstance(got, str) else got[0]
+
+
+def _torus_coordinates(mech, pp, k: int):
+    """q -> (theta, phi) of the module: the held leg's direction and the platform's turn, read off the
+    platform's placement."""
+    e1, e2, _ = pp.basis
+    inverse = pp.platform.M0.inverse()
+
+    def at(q: np.ndarray) -> np.ndarray:
+        g = KinematicState(mech, q).joint_placement(pp.platform.out_joint) * inverse
+        R, t = g.rotation, g.translation
+        phi = np.arctan2(e2 @ R @ e1, e1 @ R @ e1)
+        c, s = np.cos(phi), np.sin(phi)
+        bk = pp.b[k]
+        B = np.array([c * bk[0] - s * bk[1] + t @ e1, s * bk[0] + c * bk[1] + t @ e2])
+        return np.array([np.arctan2(*(B - pp.a[k])[::-1]), phi])
+    return at
+
+
+def _subboxes(c: np.ndarray, r: np.ndarray, n: tuple) -> tuple:
+    """The box (centre c, half-widths r) cut into n[0] x n[1] boxes (a zero half-width: one)."""
+    us = c[0] + r[0] * ((2 * np.arange(n[0]) + 1) / n[0] - 1)
+    ws = c[1] + r[1] * ((2 * np.arange(n[1]) + 1) / n[1] - 1)
+    U, W = np.meshgrid(us, ws, indexing="ij")
+    cs = np.stack([U.ravel(), W.ravel()], axis=1)
+    return cs, np.tile([r[0] / n[0], r[1] / n[1]], (len(cs), 1))
+
+
+def _arc_box(g: TrigPoly, x: np.ndarray, inside: tuple) -> tuple | None:
+    """(half-width, axis) of the largest arc box about the witness x (see the module): axis 0 where G = 0
+    is a graph over phi in it (G_theta away from zero, G away from zero on the faces theta = x0 +- r), 1
+    the other way round; None where none is found down to ARC_MIN."""
+    r = ARC_START
+    while r >= ARC_MIN:
+        if all(np.all((v - e >= lo) & (v + e <= hi)) for p, lo, hi in inside
+               for v, e in [bounds(p, *_subboxes(x, np.array([r, r]), (4, 4)))]):
+            for axis in (0, 1):
+                v, e = bounds(g.d(1 - axis, axis), *_subboxes(x, np.array([r, r]), (4, 4)))
+                if not (np.all(v - e > 0) or np.all(v + e < 0)):
+                    continue
+                clear = True
+                for side in (-1, 1):
+                    c = x.copy()
+                    c[axis] += side * r
+                    half = np.array([0.0, r]) if axis == 0 else np.array([r, 0.0])
+                    v, e = bounds(g, *_subboxes(c, half, (16, 1) if axis else (1, 16)))
+                    clear &= bool(np.all(np.abs(v) > e))
+                if clear:
+                    return (r, axis)
+        r /= 2
+    return None
+
+
+def unmatched(w: Witnesses, loci: list) -> list:
+    """The witnesses no traced curve of ``loci`` passes through (see the module)."""
+    if not w.points:
+        return []
+    g, scale = w.G, np.abs(w.G.C).sum()
+    pts = np.vstack([np.array([w.torus(q) for q in lc.q]) for lc in loci]) if loci else np.zeros((0, 2))
+    on = np.abs(g.at(pts[:, 0], pts[:, 1])) <= ON * scale if len(pts) else np.zeros(0, bool)
+    left = []
+    for wt in w.points:
+        d = np.abs(wrap_angle(pts - wt.angles))
+        reach = np.array(wt.box[0] if wt.system != "edge" else wt.box, float)
+        hit = on & np.all(d < reach, axis=1)
+        if wt.system == "edge":  # the tracer's end on that bound: the one root of the edge's system there
+            hit &= np.all(d < END, axis=1)
+        if not hit.any():
+            left.append(wt)
+    return left

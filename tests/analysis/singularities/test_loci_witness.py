@@ -1,0 +1,119 @@
+"""The certificate that every component of a 3-RPR's actuator locus in the box was traced
+(analysis.singularities.loci_witness), against the forward-kinematics polynomial built independently with numpy
+(tests/loci_robots.py): each witness where two of its real roots meet, the edge witnesses exactly where the
+number of its real roots changes along the box's edges (an independent dense scan), and the curves found again
+from the witnesses alone when the grid's seeds are too few."""
+
+import numpy as np
+import pytest
+from loci_robots import rpr3, rpr3_cusp, rpr3_polynomial
+from numpy.polynomial import Polynomial
+
+import screwkin
+from screwkin.analysis.singularities.loci import trace_loci
+from screwkin.analysis.singularities.loci_witness import witnesses
+
+RHO1, LO, HI = 0.17, 0.02, 0.40  # the section rho1 = 0.17 m, rho2 and rho3 from 0.02 to 0.40 m
+
+
+@pytest.fixture(scope="module")
+def rpr(tmp_path_factory):
+    text, rho0 = rpr3()
+    path = tmp_path_factory.mktemp("witness") / "rpr3.urdf"
+    path.write_text(text)
+    solver = screwkin.PositionSolver(screwkin.load(path))
+    box = ((LO - rho0[1], HI - rho0[1]), (LO - rho0[2], HI - rho0[2]))
+    fixed = {"leg1": RHO1 - rho0[0]}
+    return solver, rho0, box, fixed, witnesses(solver, "leg2", "leg3", box, fixed)
+
+
+def _reduced(rho):
+    q, _ = divmod(rpr3_polynomial(rho), Polynomial([1.0, 0.0, 1.0]))
+    return q
+
+
+def _real_count(rho) -> int:
+    z = _reduced(rho).roots()
+    return int(np.sum(np.abs(z.imag) < 1e-7 * (1 + np.abs(z))))
+
+
+@pytest.mark.slow
+def test_each_witness_is_where_two_modes_of_the_independent_polynomial_meet(rpr):
+    _, rho0, _, _, w = rpr
+    assert w.certified and "no certificate" not in w.how
+    assert len(w.points) == 22
+    for p in w.points:
+        rho = (RHO1, p.xy[0] + rho0[1], p.xy[1] + rho0[2])
+        P = _reduced(rho)
+        t = np.tan(0.5 * (p.angles[1] + np.radians(30.0)))  # the polynomial's angle: from the platform's frame
+        # P and P' vanish there (relative to their largest coefficient times (1 + |t|)^degree): a double root
+        for D in (P, P.deriv(1)):
+            assert abs(D(t)) <= 1e-9 * np.abs(D.coef).max() * (1 + abs(t)) ** D.degree(), (p.system, rho, t)
+
+
+@pytest.mark.slow
+def test_the_edge_witnesses_are_where_the_mode_count_changes_along_the_edges(rpr):
+    """A dense scan of each edge with the independent polynomial: the real roots' count changes at as many
+    places as there are edge witnesses, each within a scan step of one."""
+    _, rho0, _, _, w = rpr
+    edge = [p for p in w.points if p.system == "edge"]
+    s = np.linspace(LO, HI, 1201)
+    changes = []
+    for axis in (0, 1):
+        for bound in (LO, HI):
+            counts = []
+            for v in s:
+                r2, r3 = (bound, v) if axis == 0 else (v, bound)
+                counts.append(_real_count((RHO1, r2, r3)))
+            for k in np.nonzero(np.diff(counts))[0]:
+                changes.append((axis, bound, 0.5 * (s[k] + s[k + 1])))
+    assert len(changes) == len(edge) == 10
+    step = s[1] - s[0]
+    for axis, bound, v in changes:
+        hit = [p for p in edge if abs(p.xy[axis] + rho0[1 + axis] - bound) < 1e-9
+               and abs(p.xy[1 - axis] + rho0[2 - axis] - v) <= step]
+        assert len(hit) == 1, (axis, bound, v)
+
+
+@pytest.mark.slow
+def test_the_witnesses_alone_find_every_curve_and_the_trace_is_complete(rpr):
+    """With a 2 x 2 grid of seeds (the box's corners), the grid's seeds miss curves; the witnesses seed them:
+    the same five curves, with the same ends on the box's edges, as with the 9 x 9 grid, and complete."""
+    solver, rho0, box, fixed, _ = rpr
+    xs, ys = np.linspace(*box[0], 41), np.linspace(*box[1], 41)
+    fine = trace_loci(solver, "leg2", xs, "leg3", ys, fixed)
+    coarse = trace_loci(solver, "leg2", xs, "leg3", ys, fixed, grid=2)
+    for traced in (fine, coarse):
+        assert traced.complete and "Krawczyk" in traced.how and "Complete:" in traced.how
+        assert len(traced.loci) == 5
+        assert traced.cusps_complete and len(traced.cusps) == 6 and "Cusps complete: 6 cusps" in traced.how
+
+    def ends(traced):
+        return sorted(tuple(np.round(p, 9)) for lc in traced.loci for p in (lc.points[0], lc.points[-1]))
+    np.testing.assert_allclose(ends(fine), ends(coarse), atol=1e-9)
+
+
+@pytest.mark.slow
+def test_the_certified_cusps_are_the_triple_roots_of_the_independent_polynomial(rpr):
+    """Six cusps in the box, each where three real roots of the independent polynomial meet: its own Newton on
+    P = P' = P'' = 0 lands within 1e-8 m of it."""
+    _, rho0, _, _, w = rpr
+    assert w.cusps is not None and len(w.cusps) == 6, w.cusp_how
+    assert "3 where the curve only turns" in w.cusp_how
+    for x, y in w.cusps:
+        rho = (RHO1, x + rho0[1], y + rho0[2])
+        roots = _reduced(rho).roots()
+        t = min(roots, key=lambda z: np.sort(np.abs(roots - z))[2]).real  # the middle of the tightest three
+        r2, r3, _ = rpr3_cusp(RHO1, rho[1], rho[2], t)
+        assert abs(r2 - rho[1]) < 1e-8 and abs(r3 - rho[2]) < 1e-8, (rho, r2, r3)
+
+
+def test_no_certificate_where_the_witnesses_do_not_apply(tmp_path):
+    """A five-bar is no platform on three distances: the trace says why it claims nothing."""
+    from loci_robots import FIVE_BAR, five_bar
+    text, _ = five_bar(**FIVE_BAR)
+    path = tmp_path / "five_bar.urdf"
+    path.write_text(text)
+    solver = screwkin.PositionSolver(screwkin.load(path))
+    w = witnesses(solver, "motor1", "motor2", ((0.0, 1.0), (0.0, 1.0)), {})
+    assert not w.certified and "no certificate" in w.how and not w.points
