@@ -138,9 +138,10 @@ def _polish(F: tuple, x: np.ndarray) -> np.ndarray:
 
 
 def torus_roots(F: tuple[TrigPoly, TrigPoly], within: tuple = (), start: tuple = (32, 32),
-                domain: tuple = ((-np.pi, np.pi), (-np.pi, np.pi))) -> Roots:
+                domain: tuple = ((-np.pi, np.pi), (-np.pi, np.pi)), max_boxes: int = MAX_BOXES) -> Roots:
     """Every root of F = (f1, f2) = 0 in ``domain`` where each constraint (g, lo, hi) of ``within`` has
-    lo <= g <= hi (see the module): the domain cut into ``start`` boxes, then pruned and halved.  The whole
+    lo <= g <= hi (see the module): the domain cut into ``start`` boxes, then pruned and halved, at most
+    ``max_boxes`` examined.  The whole
     torus (the default domain): roots are given in [-pi, pi) and found once."""
     (u0, u1), (w0, w1) = domain
     whole = np.allclose([u1 - u0, w1 - w0], 2 * np.pi)
@@ -154,7 +155,7 @@ def torus_roots(F: tuple[TrigPoly, TrigPoly], within: tuple = (), start: tuple =
     found, undecided, examined = [], [], 0
     while len(c):
         examined += len(c)
-        if examined > MAX_BOXES:
+        if examined > max_boxes:
             undecided += [np.stack([ci, ri]) for ci, ri in zip(c, r)]
             break
         keep = np.ones(len(c), bool)

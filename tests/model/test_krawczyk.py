@@ -56,7 +56,7 @@ def test_a_curve_of_roots_is_left_undecided_not_counted():
     holds one root only, so the boxes there are left undecided and the roots are not complete."""
     f1 = TrigPoly.fit(lambda u, w: np.cos(u) - np.cos(w), (1, 1))
     f2 = TrigPoly.fit(lambda u, w: np.sin(u) - np.sin(w), (1, 1))
-    got = torus_roots((f1, f2), start=(8, 8))
+    got = torus_roots((f1, f2), start=(8, 8), max_boxes=20_000)
     assert not got.complete and len(got.undecided)
     assert not len(got.points)  # no root proved: none is isolated
     for c, r in got.undecided:  # each box left is at the line (those not examined when the count ran out, next to it)
