@@ -10,7 +10,7 @@ from ..analysis.position.connect import cusp_loops
 from ..analysis.motion.continuation import continuation_steps
 from ..analysis.position.position import PositionSolver
 from ..analysis.singularities.loci import trace_loci
-from ..analysis.singularities.maps import singularity_map
+from ..analysis.singularities.maps import first_assembled, singularity_map
 from ..analysis.singularities.regions import regions
 from ..analysis.singularities.section import trace_section
 from ..errors import UsageError, quote
@@ -86,8 +86,12 @@ def run(mech: Mechanism, args: argparse.Namespace) -> int:
     output, point = output_frame(mech, args)  # a named --point is the output
     if point and not output:
         raise UsageError("--point needs --output LINK")
-    # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs
-    mode = lambda: configuration(mech, args, moved={xn: float(xs[0]), yn: float(ys[0])}, inputs=inputs)  # noqa: E731
+    # the mode mapped (--mode K), chosen and said once singularity_map has checked the inputs: at the first corner,
+    # else at the first of the box's centre, other corners and edge midpoints where something assembles
+
+    def mode() -> tuple:
+        return first_assembled(len(xs), len(ys), lambda j, i: configuration(
+            mech, args, moved={xn: float(xs[i]), yn: float(ys[j])}, inputs=inputs))
     res = singularity_map(PositionSolver(mech, inputs), xn, xs, yn, ys, fixed, output, point, q_start=mode)
     if args.connect and not args.loci:
         raise UsageError("--connect needs --loci: the loops go round the cusps of the traced loci")

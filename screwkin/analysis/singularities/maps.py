@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import UsageError, quote, shorten
+from ...errors import AssemblyError, UsageError, quote, shorten
 from ..singular import Generic, measures, stacked_measures
 from ..motion.batch_sweep import GridNeighbours, batch_closure
 from ..motion.continuation import Neighbour
@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from screwkin.analysis.position.position import PositionSolver
     from collections.abc import Callable
 
-__all__ = ["SingularityMap", "singularity_map", "seams"]
+__all__ = ["SingularityMap", "singularity_map", "seams", "start_cells", "first_assembled"]
 
 
 @dataclass(frozen=True)
@@ -63,10 +63,18 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
         if n not in solver.inputs:
             raise UsageError(f"{mech.path}: {quote(n, 40)} is not an input ({', '.join(shorten(i, 40) for i in solver.inputs)})")
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
-    first = {x_name: xs[0], y_name: ys[0], **fixed}
-    # the mode mapped: the one of q_start (a command's --mode K), else solve's first at the first corner
+    # the mode mapped: the one of q_start (a command's --mode K), else solve's first at the first corner; where
+    # the first corner does not assemble, at the first of the box's centre, other corners and edge midpoints
+    # that does (q_start may say which: (configuration, (j, i)))
     q_start = q_start() if callable(q_start) else q_start  # (a function: called once the arguments are checked)
-    q_first = solver.solve(first).solutions[0].q if q_start is None else solver.track(first, q_start).q
+    start = (0, 0)
+    if isinstance(q_start, tuple):
+        q_start, start = q_start
+    if q_start is None:
+        q_first, start = first_assembled(len(xs), len(ys), lambda j, i: solver.solve(
+            {x_name: xs[i], y_name: ys[j], **fixed}).solutions[0].q)
+    else:
+        q_first = solver.track({x_name: xs[start[1]], y_name: ys[start[0]], **fixed}, q_start).q
     g = Generic(mech, solver.inputs, output, point, configurations=solver.generic().configurations)
     logs = np.full((len(ys), len(xs)), np.nan)
     kinds = np.full((len(ys), len(xs)), "", dtype=object)
@@ -75,9 +83,9 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
     batched = None
     if bc is not None and bc.target is None and mech.model.nq == mech.model.nv:
         batched = GridNeighbours(solver, (x_name, y_name), bc)
-        qs, reached = _grow_batched(batched, mech.nq, xs, ys, q_first)
+        qs, reached = _grow_batched(batched, mech.nq, xs, ys, q_first, start)
     else:
-        qs, reached = _grow(steps, mech.nq, x_name, xs, y_name, ys, q_first)
+        qs, reached = _grow(steps, mech.nq, x_name, xs, y_name, ys, q_first, start)
     J, I = np.nonzero(reached)
     table = None
     if bc is not None and len(J):
@@ -96,8 +104,15 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
             kinds[j, i] = kind
     seam = seams(mech, qs, reached, steps[x_name], steps[y_name], xs, ys, batched=batched)
     off = int(reached.size - reached.sum())
-    notes = (f"{off} of {reached.size} points are not reached from the first one by continuation on its "
-             "assembly mode (another mode, past a limit position, or not assembled): left blank",) if off else ()
+    notes = ()
+    if start != (0, 0):
+        notes += (f"nothing assembles at the first corner ({x_name} = {xs[0]:.6g}, {y_name} = {ys[0]:.6g}): the map "
+                  f"starts at ({x_name} = {xs[start[1]]:.6g}, {y_name} = {ys[start[0]]:.6g}), the first of the box's "
+                  "centre, corners and edge midpoints where it does",)
+    if off:
+        notes += (f"{off} of {reached.size} points are not reached from the "
+                  f"{'first one' if start == (0, 0) else 'starting point'} by continuation on its assembly mode "
+                  "(another mode, past a limit position, or not assembled): left blank",)
     if len(seam):
         notes += (f"{len(seam)} pairs of neighbouring points lie on different sheets of the mode (their "
                   f"configurations differ by more than {mech.tolerances.near_far:g} rad: continuation from one "
@@ -108,15 +123,35 @@ def singularity_map(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name:
 _DIRECTIONS = ((0, 1), (1, 0), (0, -1), (-1, 0))  # the order each cell tries its neighbours in
 
 
-def _grow(steps: dict, nq: int, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, q_first: np.ndarray) -> tuple:
-    """The map's cells reached from the first corner, breadth first, each from its first reached neighbour
-    (in queue order, neighbours in _DIRECTIONS' order) whose step (continuation.Neighbour) arrives:
-    (qs (ny, nx, nq) NaN where not reached, reached (ny, nx))."""
+def start_cells(nx: int, ny: int) -> list:
+    """The cells (j, i) a map may start from, in order: the first corner, the centre, the other corners, the
+    edges' midpoints."""
+    return list(dict.fromkeys([(0, 0), (ny // 2, nx // 2), (0, nx - 1), (ny - 1, 0), (ny - 1, nx - 1),
+                               (0, nx // 2), (ny // 2, 0), (ny // 2, nx - 1), (ny - 1, nx // 2)]))
+
+
+def first_assembled(nx: int, ny: int, attempt: Callable) -> tuple:
+    """(attempt(j, i), (j, i)) for the first of start_cells where attempt -- a configuration there -- does not
+    raise AssemblyError; the first corner's AssemblyError where every one does."""
+    first_error = None
+    for j, i in start_cells(nx, ny):
+        try:
+            return attempt(j, i), (j, i)
+        except AssemblyError as e:
+            first_error = first_error or e
+    raise first_error
+
+
+def _grow(steps: dict, nq: int, x_name: str, xs: np.ndarray, y_name: str, ys: np.ndarray, q_first: np.ndarray,
+          start: tuple = (0, 0)) -> tuple:
+    """The map's cells reached from the start cell (j, i) (the first corner), breadth first, each from its first
+    reached neighbour (in queue order, neighbours in _DIRECTIONS' order) whose step (continuation.Neighbour)
+    arrives: (qs (ny, nx, nq) NaN where not reached, reached (ny, nx))."""
     qs = np.full((len(ys), len(xs), nq), np.nan)
     reached = np.zeros((len(ys), len(xs)), bool)
     grids = {x_name: xs, y_name: ys}
-    queue = deque([(0, 0)])
-    qs[0, 0], reached[0, 0] = q_first, True
+    queue = deque([start])
+    qs[start], reached[start] = q_first, True
     while queue:
         j, i = queue.popleft()
         for dj, di in _DIRECTIONS:
@@ -131,7 +166,8 @@ def _grow(steps: dict, nq: int, x_name: str, xs: np.ndarray, y_name: str, ys: np
     return qs, reached
 
 
-def _grow_batched(steps: GridNeighbours, nq: int, xs: np.ndarray, ys: np.ndarray, q_first: np.ndarray) -> tuple:
+def _grow_batched(steps: GridNeighbours, nq: int, xs: np.ndarray, ys: np.ndarray, q_first: np.ndarray,
+                  start: tuple = (0, 0)) -> tuple:
     """``_grow``'s breadth-first walk a wavefront at a time, its steps batched (motion.batch_sweep.
     GridNeighbours): the same cells from the same neighbours in the same order.  Breadth first, the
     cells of one level are all taken before any of the next, and a cell of the next is reached by the
@@ -143,8 +179,8 @@ def _grow_batched(steps: GridNeighbours, nq: int, xs: np.ndarray, ys: np.ndarray
     qs = np.full((ny, nx, nq), np.nan)
     U = np.full((ny, nx, 2, nq), np.nan)  # each reached cell's tangent directions (GridNeighbours.directions)
     reached = np.zeros((ny, nx), bool)
-    qs[0, 0], U[0, 0], reached[0, 0] = q_first, steps.directions(q_first[None])[0][0], True
-    level = [(0, 0)]
+    qs[start], U[start], reached[start] = q_first, steps.directions(q_first[None])[0][0], True
+    level = [start]
     while level:
         tries = {}  # cell -> its tries ((position of the source in the level, direction), ...) in order
         for pos, (j, i) in enumerate(level):

@@ -97,3 +97,25 @@ def test_a_map_needs_two_different_inputs(wide_five_bar):
     assert p.returncode == 2 and "name the same input 'motor1'" in p.stderr
     p = screwkin_cli("map", str(wide_five_bar), "--x", "motor1=0:1:3", "--y", "motor2=0:1:3", "--set", "motor2=0.1")
     assert p.returncode == 2 and "given by --x/--y and by --set" in p.stderr
+
+
+def test_a_map_whose_first_corner_does_not_assemble_starts_where_the_box_does(wide_five_bar):
+    """The first corner (motor1 = 0, motor2 = 0) has the elbows 0.4 m apart, more than the distal links reach
+    (0.3 m): nothing assembles there.  The map starts at the box's centre (0.127 m apart), says so, and every
+    cell it reports assembles (the closed form above); before, it stopped with an error."""
+    p = screwkin_cli("map", str(wide_five_bar), "--x", "motor1=0deg:-180deg:13", "--y", "motor2=0deg:180deg:13",
+                     "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert any("nothing assembles at the first corner" in n and "the map starts at" in n for n in d["notes"])
+    reached = np.array(d["reached"])
+    xs, ys = np.radians(np.linspace(0, -180, 13)), np.radians(np.linspace(0, 180, 13))
+    B1, B2 = elbows(xs[0], ys[0])
+    assert np.linalg.norm(B2 - B1) > 2 * R2 and not reached[0, 0] and reached[6, 6]
+    for j, i in zip(*np.nonzero(reached)):
+        B1, B2 = elbows(xs[i], ys[j])
+        assert np.linalg.norm(B2 - B1) <= 2 * R2 + 1e-9
+    # the Python API the same way
+    solver = screwkin.PositionSolver(screwkin.load(wide_five_bar))
+    res = singularity_map(solver, "motor1", xs, "motor2", ys)
+    assert np.array_equal(res.reached, reached) and "nothing assembles at the first corner" in res.notes[0]
