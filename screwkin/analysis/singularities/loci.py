@@ -26,9 +26,9 @@ value has a local minimum along a grid line; then, where the modes come in close
 each edge of the box where the mode count changes (loci_seeds.edge_seeds: a component that bounds a part
 of the box no grid node's mode reaches, such as the corner of a 3-RPR's box where nothing assembles).
 A component is missed when neither reaches it: ``complete`` stays False and ``how`` says this -- except
-for a platform on three distances mapped over two legs (loci_witness): there witness points, every root of
-seven systems on a torus proved by the Krawczyk test, seed the tracer last, and when each lies on a traced
-curve the actuator loci are complete, proved.
+for a platform on three distances mapped over two legs, or one RRR dyad on the two inputs (loci_witness):
+there witness points, every root of a few systems on a torus proved by the Krawczyk test, seed the tracer
+last, and when each lies on a traced curve the actuator loci are complete, proved.
 
 Cusps (where three assembly modes meet): points of a traced curve where its trace in the plane
 reverses (the curve's tangent lies in the kernel of the projection onto the plane: the kernel vector
@@ -474,7 +474,7 @@ def _cusps_checked(proof, traced: list, box: tuple, notes: list) -> tuple:
         notes.append(f"actuator: the traced cusps differ from the certificate's ({len(missing)} of its "
                      f"{len(proof.cusps)} not traced, {len(extra)} traced not among them)")
         return f". Cusps: not certified (the traced ones differ from the {proof.cusp_how})", False
-    return f". Cusps complete: {proof.cusp_how}; each is a traced cusp", True
+    return (f". Cusps complete: {proof.cusp_how}" + ("; each is a traced cusp" if proof.cusps else "; none traced")), True
 
 
 def trace_kind(sys: LocusSystem, kind: str, seeds: Iterator, box: tuple, notes: list) -> tuple:
@@ -533,6 +533,9 @@ def trace_kind(sys: LocusSystem, kind: str, seeds: Iterator, box: tuple, notes: 
             notes.append(f"{kind}: at ({pts[0][0]:.9g}, {pts[0][1]:.9g}) the mechanism moves with the inputs "
                          "held (a self-motion through the singular configurations): a point of the locus")
             pts, Q, closed = pts[:1], Q[:1], False
+            if any(len(lc.points) == 1 and np.abs(lc.points[0] - pts[0]).max() < sys.mech.tolerances.equal * span
+                   for lc in loci):
+                continue  # another seed's configuration on the same self-motion: one point of the locus, once
         loci.append(Locus(kind, pts, Q, bool(closed), worst))
         mine.append((pts, Q, V))
     for c, k, c2, k2, f1, f2, p in crossings([m[0] for m in mine], box):

@@ -34,9 +34,11 @@ import numpy as np
 from ...model.geometry import wrap_angle
 from ...model.krawczyk import TrigPoly, bounds, torus_roots
 from ...model.state import KinematicState
+from ..motion.dyads import ClosedFormCurve, cached_plan
+from ..position.certified import closed_form
 from ..position.three_distances import planar_platform, pose_onto_joints
 
-__all__ = ["Witnesses", "witnesses", "unmatched"]
+__all__ = ["Witnesses", "witnesses", "dyad_witnesses", "unmatched"]
 
 #: Arc boxes tried, half-width in radians, each half the one before, down to this.
 ARC_START, ARC_MIN = 0.2, 1e-6
@@ -111,12 +113,16 @@ def _slide_for(pp, k: int, r2: float, lo: float, hi: float) -> float:
 
 def witnesses(solver, x_name: str, y_name: str, box: tuple, fixed: dict) -> Witnesses:
     """The witness points of the module for the map of ``solver``'s mechanism over (x_name, y_name) in
-    ``box`` with ``fixed`` held, or why none (certified False, ``how`` says why)."""
-    mech = solver.mech
+    ``box`` with ``fixed`` held, or why none (certified False, ``how`` says why): a platform on three
+    distances, or one RRR dyad on links the two inputs turn (a five-bar)."""
     pp = planar_platform(solver)
-    if pp is None:
-        return Witnesses((), False, "no certificate: witness points are built for a planar platform on three "
-                                     "distances (a 3-RPR)")
+    if pp is not None:
+        return _platform_witnesses(solver, pp, x_name, y_name, box, fixed)
+    return dyad_witnesses(solver, x_name, y_name, box, fixed)
+
+
+def _platform_witnesses(solver, pp, x_name: str, y_name: str, box: tuple, fixed: dict) -> Witnesses:
+    mech = solver.mech
     idx = {mech.coordinate(name).idx_q: name for name in (x_name, y_name, *fixed)}
     if set(idx) != set(pp.slides) or len(fixed) != 1:
         return Witnesses((), False, "no certificate: witness points are built for a map over two legs' slides "
@@ -276,14 +282,17 @@ def _subboxes(c: np.ndarray, r: np.ndarray, n: tuple) -> tuple:
     return cs, np.tile([r[0] / n[0], r[1] / n[1]], (len(cs), 1))
 
 
-def _arc_box(g: TrigPoly, x: np.ndarray, inside: tuple) -> tuple | None:
+def _arc_box(g: TrigPoly, x: np.ndarray, inside) -> tuple | None:
     """(half-width, axis) of the largest arc box about the witness x (see the module): axis 0 where G = 0
     is a graph over phi in it (G_theta away from zero, G away from zero on the faces theta = x0 +- r), 1
-    the other way round; None where none is found down to ARC_MIN."""
+    the other way round; None where none is found down to ARC_MIN.  ``inside``: the constraints (p, lo, hi)
+    of the region, or a function (centre, half-width) -> whether the box lies in it."""
     r = ARC_START
     while r >= ARC_MIN:
-        if all(np.all((v - e >= lo) & (v + e <= hi)) for p, lo, hi in inside
-               for v, e in [bounds(p, *_subboxes(x, np.array([r, r]), (4, 4)))]):
+        fits = inside(x, r) if callable(inside) else all(
+            np.all((v - e >= lo) & (v + e <= hi)) for p, lo, hi in inside
+            for v, e in [bounds(p, *_subboxes(x, np.array([r, r]), (4, 4)))])
+        if fits:
             for axis in (0, 1):
                 v, e = bounds(g.d(1 - axis, axis), *_subboxes(x, np.array([r, r]), (4, 4)))
                 if not (np.all(v - e > 0) or np.all(v + e < 0)):
@@ -318,3 +327,103 @@ def unmatched(w: Witnesses, loci: list) -> list:
         if not hit.any():
             left.append(wt)
     return left
+
+
+def _first_dyad_ends(curve: ClosedFormCurve, xs: np.ndarray) -> tuple | None:
+    """For a closed form whose first dyad is an RRR (placed on links the inputs alone move): its outer joints
+    A and C (N, 2) in plane coordinates at the input values xs and its links' lengths (r1, r2) -- it folds
+    where |C - A| = r1 + r2 or |r1 - r2|; None for another kind."""
+    p, geo = curve.p, curve.geo
+    kinds, ia, ib, ic = p.dyads[0]
+    if kinds != "RRR":
+        return None
+    g1, g2 = p.order[1]
+    poses, _ = curve.predict(xs, [1.0] * len(p.dyads))
+    pa = poses[next(g for g in p.pairs[ia].groups if g != g1)]
+    pc = poses[next(g for g in p.pairs[ic].groups if g != g2)]
+    A, C = pa(geo.other(ia, g1)), pc(geo.other(ic, g2))
+    r1 = float(np.linalg.norm(geo.point(ib, g1) - geo.point(ia, g1)))
+    r2 = float(np.linalg.norm(geo.point(ib, g2) - geo.point(ic, g2)))
+    return np.stack([A[0].v, A[1].v], axis=1), np.stack([C[0].v, C[1].v], axis=1), r1, r2
+
+
+def dyad_witnesses(solver, x_name: str, y_name: str, box: tuple, fixed: dict) -> Witnesses:
+    """The witnesses of a mechanism of one RRR dyad whose outer joints A and C the two mapped inputs (revolute)
+    move (a five-bar; other inputs held): in the plane of the inputs themselves it folds where
+    G(x, y) = (|C - A|^2 - (r1 + r2)^2) (|C - A|^2 - (r1 - r2)^2) = 0, a trigonometric polynomial of degree
+    2 in each.  A component in the box either meets an edge (G = 0 with x or y at a bound) or is closed
+    inside it and has a point where x is largest (G = G_y = 0).  With one dyad at most two modes meet: no
+    cusp."""
+    mech = solver.mech
+    plan = cached_plan(solver, x_name)
+    if isinstance(plan, str) or len(plan.dyads) != 1 or plan.dyads[0][0] != "RRR":
+        return Witnesses((), False, "no certificate: witness points are built for a planar platform on three "
+                                     "distances (a 3-RPR) or one RRR dyad on two turning inputs (a five-bar)")
+    if any(mech.translational[mech.coordinate(n).idx_v] for n in (x_name, y_name)) or \
+            max(box[0][1] - box[0][0], box[1][1] - box[1][0]) > 2 * np.pi:
+        return Witnesses((), False, "no certificate: the mapped inputs are not both turns within one turn")
+    ref = solver.reference()
+    c = mech.coordinate(x_name)
+    L = max(mech.length, 1e-3)
+    k = 8  # samples per turn: degree 2 in each input, checked by the fit
+
+    def G(xs: np.ndarray, y: float) -> np.ndarray | None:
+        q0 = solver.set_inputs(mech.neutral() if ref is None else ref, {y_name: y, **fixed})
+        start = float(q0[c.idx_q]) if c.nq == 1 else float(np.arctan2(q0[c.idx_q + 1], q0[c.idx_q]))
+        curve = ClosedFormCurve(mech, plan, q0, start, probe=False)
+        got = _first_dyad_ends(curve, xs) if curve.ok else None
+        if got is None:
+            return None
+        A, C, r1, r2 = got
+        d2 = ((C - A) ** 2).sum(axis=1)
+        return (d2 - (r1 + r2) ** 2) * (d2 - (r1 - r2) ** 2) / L ** 4
+
+    turns = 2 * np.pi * np.arange(k) / k
+    columns = [G(turns, y) for y in turns]
+    if any(col is None for col in columns):
+        return Witnesses((), False, "no certificate: the dyad's outer joints could not be placed")
+    try:
+        g = TrigPoly.from_samples(np.stack(columns, axis=1), (2, 2))
+    except ValueError as e:
+        return Witnesses((), False, f"no certificate: the dyad's fold is {e}")
+    (x0, x1), (y0, y1) = box
+    h = min(1e-3, 0.25 * (x1 - x0), 0.25 * (y1 - y0))
+    systems = [("x largest", (g, g.d(0, 1)), box)]
+    for axis, bound in ((0, x0), (0, x1), (1, y0), (1, y1)):
+        line = TrigPoly.fit(lambda u, w, a=axis, b=bound: np.sin((u if a == 0 else w) - b), (1 - axis, axis))
+        domain = ((bound - h, bound + h), box[1]) if axis == 0 else (box[0], (bound - h, bound + h))
+        systems.append(("edge", (g, line), domain))
+    found, undecided, examined = [], 0, 0
+    for name, F, domain in systems:
+        got = torus_roots(F, (), domain=domain)
+        examined += got.boxes
+        undecided += len(got.undecided)
+        for x, radius in zip(got.points, got.radii):
+            if x0 - MARGIN <= x[0] <= x1 + MARGIN and y0 - MARGIN <= x[1] <= y1 + MARGIN:
+                found.append((name, x, radius))
+
+    def fits(x: np.ndarray, r: float) -> bool:
+        return x0 <= x[0] - r and x[0] + r <= x1 and y0 <= x[1] - r and x[1] + r <= y1
+
+    points = []
+    for name, x, radius in found:
+        modes = closed_form(solver, {x_name: float(x[0]), y_name: float(x[1]), **fixed})
+        q = modes.modes[0][0] if not isinstance(modes, str) and modes.modes else None
+        points.append(Witness(np.array(x), name, (float(x[0]), float(x[1])), q,
+                              radius if name == "edge" else _arc_box(g, x, fits)))
+    certified = not undecided and all(w.q is not None and w.box is not None for w in points)
+    counts = {n: sum(w.system == n for w in points) for n in ("x largest", "edge")}
+    how = (f"witnesses: every component of the locus in the box holds a root of one of five systems in the plane of "
+           f"the inputs (G = 0, the dyad's links in line: with G_y = 0, {counts['x largest']}; with an input at a "
+           f"bound of the box, {counts['edge']}), every root proved by the Krawczyk test in {examined} boxes")
+    if undecided:
+        how += f", but {undecided} boxes were left undecided (a singular point of the locus?): no certificate"
+    elif not certified:
+        how += ", but a witness could not be put on the joints or boxed: no certificate"
+    values = mech.joint_values
+
+    def plane(q: np.ndarray) -> np.ndarray:
+        v = values(q)
+        return np.array([v[x_name], v[y_name]])
+    return Witnesses(tuple(points), certified, how, g, plane, (),
+                     "no cusps: one dyad, so at most two modes meet")

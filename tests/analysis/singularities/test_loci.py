@@ -179,7 +179,7 @@ def test_3rpr_loci_have_concurrent_legs_and_cusps_that_are_triple_roots(rpr):
                 rows.append([n[0], n[1], n @ RPR_BASE[i] / 0.2])
             assert abs(np.linalg.det(np.array(rows))) < REL
     assert len(traced.cusps) >= 2
-    for (x, y), kind in traced.cusps:
+    for (x, y), _kind in traced.cusps:
         rho = (rho1, x + rho0[1], y + rho0[2])
         roots = rpr3_polynomial(rho).roots()
         t = min(roots, key=lambda z: np.sort(np.abs(roots - z))[2]).real  # the middle of the tightest three

@@ -6,7 +6,8 @@ from the witnesses alone when the grid's seeds are too few."""
 
 import numpy as np
 import pytest
-from loci_robots import rpr3, rpr3_cusp, rpr3_polynomial
+from conftest import ROBOTS
+from loci_robots import FIVE_BAR, five_bar, rpr3, rpr3_cusp, rpr3_polynomial
 from numpy.polynomial import Polynomial
 
 import screwkin
@@ -108,12 +109,43 @@ def test_the_certified_cusps_are_the_triple_roots_of_the_independent_polynomial(
         assert abs(r2 - rho[1]) < 1e-8 and abs(r3 - rho[2]) < 1e-8, (rho, r2, r3)
 
 
-def test_no_certificate_where_the_witnesses_do_not_apply(tmp_path):
-    """A five-bar is no platform on three distances: the trace says why it claims nothing."""
-    from loci_robots import FIVE_BAR, five_bar
-    text, _ = five_bar(**FIVE_BAR)
+def test_the_five_bars_witnesses_are_on_its_closed_form_and_its_trace_is_complete(tmp_path):
+    """The five-bar (one RRR dyad on the two motors): each witness where the distal links are in line, |B1 B2| =
+    b1 + b2 or b1 - b2 (the closed form, from the elbows placed here), the edge witnesses exactly where that
+    closed form's mode count (2 between, 0 outside) changes along the box's edges, and the trace complete."""
+    text, elbows = five_bar(**FIVE_BAR)
     path = tmp_path / "five_bar.urdf"
     path.write_text(text)
     solver = screwkin.PositionSolver(screwkin.load(path))
-    w = witnesses(solver, "motor1", "motor2", ((0.0, 1.0), (0.0, 1.0)), {})
+    b1, b2 = FIVE_BAR["b1"], FIVE_BAR["b2"]
+    lo, hi = np.radians(-90.0), np.radians(90.0)
+    w = witnesses(solver, "motor1", "motor2", ((lo, hi), (lo, hi)), {})
+    assert w.certified and w.cusps == () and len(w.points) == 4
+
+    def apart(m1, m2):
+        _, _, B1, B2 = elbows(m1, m2)
+        return np.linalg.norm(B2 - B1)
+    for p in w.points:
+        d = apart(*p.angles)
+        assert min(abs(d - (b1 + b2)), abs(d - (b1 - b2))) < 1e-12, (p.system, d)
+    s = np.linspace(lo, hi, 1801)
+    changes = []
+    for axis in (0, 1):
+        for bound in (lo, hi):
+            count = [2 if b1 - b2 < apart(*((bound, v) if axis == 0 else (v, bound))) < b1 + b2 else 0 for v in s]
+            changes += [(axis, bound, 0.5 * (s[k] + s[k + 1])) for k in np.nonzero(np.diff(count))[0]]
+    edge = [p for p in w.points if p.system == "edge"]
+    assert len(changes) == len(edge) == 2
+    for axis, bound, v in changes:
+        assert sum(abs(p.xy[axis] - bound) < 1e-12 and abs(p.xy[1 - axis] - v) <= s[1] - s[0] for p in edge) == 1
+    traced = trace_loci(solver, "motor1", np.linspace(lo, hi, 19), "motor2", np.linspace(lo, hi, 19), {})
+    assert traced.complete and traced.cusps_complete and not traced.cusps and len(traced.loci) == 2
+
+
+def test_no_certificate_where_the_witnesses_do_not_apply():
+    """The Stephenson six-bar has two dyads: no witnesses are built for it, and the trace says why it claims
+    nothing."""
+    mech = screwkin.load(ROBOTS / "stephenson_sixbar.urdf")
+    solver = screwkin.PositionSolver(mech)
+    w = witnesses(solver, solver.inputs[0], solver.inputs[-1], ((0.0, 1.0), (0.0, 1.0)), {})
     assert not w.certified and "no certificate" in w.how and not w.points

@@ -100,11 +100,13 @@ def test_the_batched_3rpr_map_is_the_point_by_point_walk():
         assert abs(v["leg2"] - xs[i]) < 1e-12 and abs(v["leg3"] - ys[j]) < 1e-12 and abs(v["leg1"]) < 1e-12
 
 
-def test_loci_do_not_claim_completeness_they_have_not_certified(tmp_path):
+def test_a_small_oval_inside_one_grid_cell_is_proved_found_and_serial_loci_are_not_claimed(tmp_path):
     """map --loci seeds its curves from a coarse grid (analysis.singularities.loci): a component between the grid's
-    nodes may be missed, and no certificate says otherwise, so ``complete`` stays false and ``how`` says why --
-    even where, as here, the one component in the box is a small oval (the distal links folded onto each other,
-    |B1 B2| = b1 - b2, a few degrees across) lying inside one cell of the 9 x 9 seed grid and is found."""
+    nodes may be missed.  Here the one component in the box is a small oval (the distal links folded onto each
+    other, |B1 B2| = b1 - b2, a few degrees across) inside one cell of the 9 x 9 seed grid; it is found, and the
+    witnesses prove nothing else is there (loci_witness: one RRR dyad on two motors) -- its two points where
+    motor1 is largest or least among them.  With the serial loci too (--output) completeness is not claimed:
+    the certificate covers the actuator loci only."""
     dims = dict(FIVE_BAR, b2=0.145)
     text, elbows = five_bar(**dims)
     path = tmp_path / "five_bar_oval.urdf"
@@ -113,8 +115,11 @@ def test_loci_do_not_claim_completeness_they_have_not_certified(tmp_path):
     solver = screwkin.PositionSolver(mech)
     xs, ys = np.radians(np.linspace(-100, -10, 9)), np.radians(np.linspace(20, 110, 9))
     traced = trace_loci(solver, "motor1", xs, "motor2", ys, {})
-    assert traced.complete is False
-    assert "completeness is not claimed" in traced.how and "missed" in traced.how
+    assert traced.complete is True and traced.cusps_complete is True
+    assert "Complete: witnesses" in traced.how and "with G_y = 0, 2; with an input at a bound of the box, 0" in traced.how
+    both = trace_loci(solver, "motor1", xs, "motor2", ys, {}, output="tip", kinds=("actuator", "serial"))
+    assert both.complete is False and "completeness is not claimed" in both.how
+    assert "it covers the actuator loci only" in both.how
     # the oval: |B1 B2| = b1 - b2 at every point, closed, strictly inside one grid cell (no node inside it)
     (oval,) = [lc for lc in traced.loci if lc.kind == "actuator"]
     assert oval.closed
