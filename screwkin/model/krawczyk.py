@@ -1,10 +1,10 @@
-"""Every real root of two trigonometric polynomials in two angles inside a region of the torus, each one
-proved by the Krawczyk test (interval Newton), or the boxes left undecided.
+"""Every real root of n trigonometric polynomials in n angles (two or three) inside a region of the torus,
+each one proved by the Krawczyk test (interval Newton), or the boxes left undecided.
 
-A trigonometric polynomial f(u, w) = Re sum_mn C_mn exp(i (m u + n w)) is kept by its coefficients (TrigPoly,
-from samples by the FFT, its degree checked by the coefficients it leaves out).  Over a box of centre c and
-half-widths r its values lie in f(c) +- (|f_u(c)| r_u + |f_w(c)| r_w + S(r) / 2 + eps), S(r) the bound
-sum_mn |C_mn| (|m| r_u + |n| r_w)^2 of the second derivative along any direction in the box, eps the
+A trigonometric polynomial f(t) = Re sum C_m exp(i m . t) is kept by its coefficients (TrigPoly, from samples
+by the FFT, its degree checked by the coefficients it leaves out).  Over a box of centre c and half-widths r
+its values lie in f(c) +- (sum_j |f_j(c)| r_j + S(r) / 2 + eps), S(r) = sum_m |C_m| (sum_j |m_j| r_j)^2 the
+bound of the second derivative along any direction in the box, eps the
 rounding allowance (``ROUNDING`` times sum |C_mn|, far above the floating-point error of the sums).  Each
 box of the region is then
 
@@ -12,7 +12,7 @@ box of the region is then
 - decided: Krawczyk's operator K(X) = m - Y F(m) + (I - Y F'(X)) (X - m), Y = F'(m)^-1, lies in the
   interior of X (inflated by ``INFLATE``): X holds exactly one root, polished by Newton; or K(X) misses X:
   none,
-- or halved across its wider side, down to ``MIN_HALF_WIDTH``; a box still undecided there (a singular
+- or halved across its widest side, down to ``MIN_HALF_WIDTH``; a box still undecided there (a singular
   root: two roots meeting, a curve of roots) is reported, and the roots are then not all proved.
 
 Roots found twice (in two inflated boxes) are one when Newton brings them to the same point.  This is the
@@ -42,74 +42,103 @@ MAX_BOXES = 400_000
 POLISHED, SAME = 1e-15, 1e-10
 #: A Jacobian determinant below this is singular (no Krawczyk test: the box is halved).
 SINGULAR = 1e-300
+#: Points evaluated at once (the memory of a contraction: this many times the coefficients).
+CHUNK = 20_000
 
 
 @dataclass(frozen=True)
 class TrigPoly:
-    """f(u, w) = Re sum C[a, b] exp(i (m[a] u + n[b] w)): ``C`` (len(m), len(n)) complex, ``m``, ``n`` the
-    frequencies (integers)."""
+    """f(t) = Re sum C[a, b, ...] exp(i (m0[a] t0 + m1[b] t1 + ...)) in n angles t: ``C`` complex with one axis
+    per angle, ``freqs`` the frequencies (integers) along each; ``m``, ``n`` the first two."""
 
     C: np.ndarray
-    m: np.ndarray
-    n: np.ndarray
+    freqs: tuple
+
+    @property
+    def m(self) -> np.ndarray:
+        return self.freqs[0]
+
+    @property
+    def n(self) -> np.ndarray:
+        return self.freqs[1]
 
     @staticmethod
-    def fit(f, degree: tuple[int, int], check: float | None = 1e-11) -> TrigPoly:
-        """The trigonometric polynomial of degree ``degree`` (in u, in w) that the vectorised f(u, w) is:
-        sampled on a grid twice as fine as needed (``from_samples``)."""
-        k1, k2 = 2 * degree[0] + 4, 2 * degree[1] + 4
-        u, w = np.meshgrid(2 * np.pi * np.arange(k1) / k1, 2 * np.pi * np.arange(k2) / k2, indexing="ij")
-        return TrigPoly.from_samples(np.asarray(f(u, w), float), degree, check)
+    def fit(f, degree: tuple, check: float | None = 1e-11) -> TrigPoly:
+        """The trigonometric polynomial of degree ``degree`` (in each angle) that the vectorised f(t0, t1, ...)
+        is: sampled on a grid twice as fine as needed (``from_samples``)."""
+        ks = [2 * d + 4 for d in degree]
+        grids = np.meshgrid(*[2 * np.pi * np.arange(k) / k for k in ks], indexing="ij")
+        return TrigPoly.from_samples(np.asarray(f(*grids), float), degree, check)
 
     @staticmethod
-    def from_samples(V: np.ndarray, degree: tuple[int, int], check: float | None = 1e-11) -> TrigPoly:
-        """The trigonometric polynomial of degree ``degree`` through the samples V[a, b] at u = 2 pi a / k1,
-        w = 2 pi b / k2 (k > 2 degree): the FFT's coefficients, those beyond the degree dropped -- they must
-        vanish (relative to the largest, ``check``; None: round-off, not checked), else ValueError."""
-        k1, k2 = V.shape
-        F = np.fft.fft2(V) / (k1 * k2)
-        m, n = np.fft.fftfreq(k1, 1.0 / k1).astype(int), np.fft.fftfreq(k2, 1.0 / k2).astype(int)
-        keep_m, keep_n = np.abs(m) <= degree[0], np.abs(n) <= degree[1]
+    def from_samples(V: np.ndarray, degree: tuple, check: float | None = 1e-11) -> TrigPoly:
+        """The trigonometric polynomial of degree ``degree`` through the samples V[a, b, ...] at t_j = 2 pi a_j
+        / k_j (k_j > 2 degree_j): the FFT's coefficients, those beyond the degree dropped -- they must vanish
+        (relative to the largest, ``check``; None: round-off, not checked), else ValueError."""
+        F = np.fft.fftn(V) / V.size
+        freqs = [np.fft.fftfreq(k, 1.0 / k).astype(int) for k in V.shape]
+        keep = [np.abs(f) <= d for f, d in zip(freqs, degree)]
         big = max(np.abs(F).max(), SINGULAR)
-        left = np.abs(F[~keep_m]).max(initial=0.0), np.abs(F[:, ~keep_n]).max(initial=0.0)
-        if check is not None and max(left) > check * big:
-            raise ValueError(f"not a trigonometric polynomial of degree {degree}: {max(left) / big:.2g} left over")
-        return TrigPoly(F[np.ix_(keep_m, keep_n)], m[keep_m], n[keep_n])
+        inside = np.ix_(*keep)
+        left = np.abs(F).copy()
+        left[inside] = 0.0
+        if check is not None and left.max() > check * big:
+            raise ValueError(f"not a trigonometric polynomial of degree {tuple(degree)}: {left.max() / big:.2g} "
+                             "left over")
+        return TrigPoly(F[inside], tuple(f[k] for f, k in zip(freqs, keep)))
 
-    def d(self, du: int = 0, dw: int = 0) -> TrigPoly:
-        """The partial derivative (du times in u, dw times in w)."""
-        return TrigPoly(self.C * (1j * self.m[:, None]) ** du * (1j * self.n[None, :]) ** dw, self.m, self.n)
+    def d(self, *orders: int) -> TrigPoly:
+        """The partial derivative (orders[j] times in angle j)."""
+        C = self.C
+        for j, o in enumerate(orders):
+            if o:
+                shape = [1] * C.ndim
+                shape[j] = -1
+                C = C * ((1j * self.freqs[j]) ** o).reshape(shape)
+        return TrigPoly(C, self.freqs)
 
     def __sub__(self, other: float) -> TrigPoly:
         C = self.C.copy()
-        C[(self.m == 0).argmax(), (self.n == 0).argmax()] -= other
-        return TrigPoly(C, self.m, self.n)
+        C[tuple(int((f == 0).argmax()) for f in self.freqs)] -= other
+        return TrigPoly(C, self.freqs)
 
-    def at(self, u: np.ndarray, w: np.ndarray) -> np.ndarray:
-        u, w = np.asarray(u, float), np.asarray(w, float)
-        Eu, Ew = np.exp(1j * np.multiply.outer(u, self.m)), np.exp(1j * np.multiply.outer(w, self.n))
-        return np.einsum("...a,ab,...b->...", Eu, self.C, Ew).real
+    def at(self, *t: np.ndarray) -> np.ndarray:
+        """The values at the points (one array of each angle, broadcast together)."""
+        t = np.broadcast_arrays(*[np.asarray(x, float) for x in t])
+        shape, flat = t[0].shape, [x.ravel() for x in t]
+        out = np.empty(len(flat[0]))
+        for s in range(0, len(out), CHUNK):  # one angle contracted at a time, a chunk of points at once
+            part = np.einsum("pa,a...->p...", np.exp(1j * np.multiply.outer(flat[0][s:s + CHUNK], self.freqs[0])),
+                             self.C)
+            for x, f in zip(flat[1:], self.freqs[1:]):
+                part = np.einsum("pa,pa...->p...", np.exp(1j * np.multiply.outer(x[s:s + CHUNK], f)), part)
+            out[s:s + CHUNK] = part.real
+        return out.reshape(shape)
 
     def curvature(self) -> tuple:
-        """(sum |C| m^2, sum |C| |m n|, sum |C| n^2, sum |C|): S(r) = a r_u^2 + 2 b r_u r_w + c r_w^2."""
-        A, M, N = np.abs(self.C), np.abs(self.m)[:, None], np.abs(self.n)[None, :]
-        return float((A * M * M).sum()), float((A * M * N).sum()), float((A * N * N).sum()), float(A.sum())
+        """(Q, sum |C|): Q[j, k] = sum |C| |m_j m_k|, so that the second derivative along any direction in a
+        box of half-widths r is at most r Q r."""
+        A = np.abs(self.C)
+        grids = np.meshgrid(*[np.abs(f) for f in self.freqs], indexing="ij")
+        Q = np.array([[float((A * a * b).sum()) for b in grids] for a in grids])
+        return Q, float(A.sum())
 
 
 def bounds(p: TrigPoly, c: np.ndarray, r: np.ndarray) -> tuple:
-    """(value at the centres, half-width of the enclosure) of p over the boxes (centres c (k, 2), half-widths
-    r (k, 2)); see the module."""
-    a, b, cc, total = p.curvature()
-    f = p.at(c[:, 0], c[:, 1])
-    fu, fw = p.d(1, 0).at(c[:, 0], c[:, 1]), p.d(0, 1).at(c[:, 0], c[:, 1])
-    S = a * r[:, 0] ** 2 + 2 * b * r[:, 0] * r[:, 1] + cc * r[:, 1] ** 2
-    return f, np.abs(fu) * r[:, 0] + np.abs(fw) * r[:, 1] + 0.5 * S + ROUNDING * total
+    """(value at the centres, half-width of the enclosure) of p over the boxes (centres c (k, n), half-widths
+    r (k, n)); see the module."""
+    Q, total = p.curvature()
+    cols = [c[:, j] for j in range(c.shape[1])]
+    f = p.at(*cols)
+    slope = sum(np.abs(p.d(*[int(k == j) for k in range(c.shape[1])]).at(*cols)) * r[:, j] for j in range(c.shape[1]))
+    S = np.einsum("kj,jl,kl->k", r, Q, r)
+    return f, slope + 0.5 * S + ROUNDING * total
 
 
 @dataclass(frozen=True)
 class Roots:
-    """``points`` (k, 2) the proved roots (polished), ``radii`` (k, 2) the half-widths of the box about each
-    that proved it the only root there, ``undecided`` (j, 2, 2) the boxes left ([centre, half-widths]),
+    """``points`` (k, n) the proved roots (polished), ``radii`` (k, n) the half-widths of the box about each
+    that proved it the only root there, ``undecided`` (j, 2, n) the boxes left ([centre, half-widths]),
     ``boxes`` examined."""
 
     points: np.ndarray
@@ -122,8 +151,13 @@ class Roots:
         return not len(self.undecided)
 
 
+def _unit_orders(n: int, j: int) -> list:
+    return [int(k == j) for k in range(n)]
+
+
 def _polish(F: tuple, x: np.ndarray) -> np.ndarray:
-    J = [[f.d(1, 0), f.d(0, 1)] for f in F]
+    n = len(x)
+    J = [[f.d(*_unit_orders(n, j)) for j in range(n)] for f in F]
     for _ in range(8):
         v = np.array([f.at(*x) for f in F])
         M = np.array([[g.at(*x) for g in row] for row in J])
@@ -137,21 +171,38 @@ def _polish(F: tuple, x: np.ndarray) -> np.ndarray:
     return x
 
 
-def torus_roots(F: tuple[TrigPoly, TrigPoly], within: tuple = (), start: tuple = (32, 32),
-                domain: tuple = ((-np.pi, np.pi), (-np.pi, np.pi)), max_boxes: int = MAX_BOXES) -> Roots:
-    """Every root of F = (f1, f2) = 0 in ``domain`` where each constraint (g, lo, hi) of ``within`` has
-    lo <= g <= hi (see the module): the domain cut into ``start`` boxes, then pruned and halved, at most
-    ``max_boxes`` examined.  The whole
-    torus (the default domain): roots are given in [-pi, pi) and found once."""
-    (u0, u1), (w0, w1) = domain
-    whole = np.allclose([u1 - u0, w1 - w0], 2 * np.pi)
-    periodic = np.array([u0, w0]) if whole else None
-    nu, nw = start
-    hu, hw = (u1 - u0) / (2 * nu), (w1 - w0) / (2 * nw)
-    cu, cw = np.meshgrid(u0 + hu * (2 * np.arange(nu) + 1), w0 + hw * (2 * np.arange(nw) + 1), indexing="ij")
-    c = np.stack([cu.ravel(), cw.ravel()], axis=1)
-    r = np.tile([hu, hw], (len(c), 1))
-    J = [[f.d(1, 0), f.d(0, 1)] for f in F]
+def _inverses(Jc: np.ndarray) -> tuple:
+    """(the inverses of the stacked square matrices, which are invertible): zero where singular."""
+    n = Jc.shape[1]
+    Y = np.zeros_like(Jc)
+    scale = np.abs(Jc).max(axis=(1, 2)) ** n
+    ok = np.abs(np.linalg.det(Jc)) > SINGULAR * np.maximum(scale, SINGULAR)
+    for k in np.flatnonzero(ok):  # (one at a time: a nearly singular one raises alone)
+        try:
+            Y[k] = np.linalg.inv(Jc[k])
+        except np.linalg.LinAlgError:
+            ok[k] = False
+    return Y, ok
+
+
+def torus_roots(F: tuple, within: tuple = (), start: tuple | None = None, domain: tuple | None = None,
+                max_boxes: int = MAX_BOXES) -> Roots:
+    """Every root of F = (f1, ..., fn) = 0 (n trigonometric polynomials in n angles, n = 2 or 3) in ``domain``
+    (default the whole torus) where each constraint (g, lo, hi) of ``within`` has lo <= g <= hi (see the
+    module): the domain cut into ``start`` boxes (default 32 a side in two angles, 16 in three), then pruned
+    and halved, at most ``max_boxes`` examined.  On the whole torus roots are given in [-pi, pi) and found
+    once."""
+    n = len(F)
+    domain = domain or ((-np.pi, np.pi),) * n
+    start = start or ((32,) * n if n == 2 else (16,) * n)
+    lo_d = np.array([a for a, _ in domain], float)
+    span = np.array([b - a for a, b in domain], float)
+    periodic = lo_d if np.allclose(span, 2 * np.pi) else None
+    half = span / (2 * np.array(start))
+    grids = np.meshgrid(*[lo_d[j] + half[j] * (2 * np.arange(start[j]) + 1) for j in range(n)], indexing="ij")
+    c = np.stack([g.ravel() for g in grids], axis=1)
+    r = np.tile(half, (len(c), 1))
+    J = [[f.d(*_unit_orders(n, j)) for j in range(n)] for f in F]
     found, undecided, examined = [], [], 0
     while len(c):
         examined += len(c)
@@ -163,27 +214,24 @@ def torus_roots(F: tuple[TrigPoly, TrigPoly], within: tuple = (), start: tuple =
             v, e = bounds(g, c, r)
             keep &= (v + e >= lo) & (v - e <= hi)
         for f in F:
-            v, e = bounds(f, c, r)
-            keep &= np.abs(v) <= e
+            v, e = bounds(f, c[keep], r[keep])
+            keep[keep] = np.abs(v) <= e
         c, r = c[keep], r[keep]
         if not len(c):
             break
         R = INFLATE * r
-        Fm = np.stack([f.at(c[:, 0], c[:, 1]) for f in F], axis=1)
-        Fe = np.stack([np.full(len(c), ROUNDING * f.curvature()[3]) for f in F], axis=1)
-        Jc = np.empty((len(c), 2, 2))
-        Jr = np.empty((len(c), 2, 2))
-        for i in range(2):
-            for k in range(2):
+        cols = [c[:, j] for j in range(n)]
+        Fm = np.stack([f.at(*cols) for f in F], axis=1)
+        Fe = np.stack([np.full(len(c), ROUNDING * f.curvature()[1]) for f in F], axis=1)
+        Jc = np.empty((len(c), n, n))
+        Jr = np.empty((len(c), n, n))
+        for i in range(n):
+            for k in range(n):
                 Jc[:, i, k], Jr[:, i, k] = bounds(J[i][k], c, R)
-        det = Jc[:, 0, 0] * Jc[:, 1, 1] - Jc[:, 0, 1] * Jc[:, 1, 0]
-        ok = np.abs(det) > SINGULAR
-        Y = np.zeros_like(Jc)  # the 2 x 2 inverse by its adjugate (no exception where nearly singular)
-        Y[ok, 0, 0], Y[ok, 1, 1] = Jc[ok, 1, 1] / det[ok], Jc[ok, 0, 0] / det[ok]
-        Y[ok, 0, 1], Y[ok, 1, 0] = -Jc[ok, 0, 1] / det[ok], -Jc[ok, 1, 0] / det[ok]
+        Y, ok = _inverses(Jc)
         Kc = c - np.einsum("kij,kj->ki", Y, Fm)
         # I - Y J(X) lies in (I - Y Jc) +- |Y| Jr (Jc the centre's Jacobian: I - Y Jc is round-off)
-        rest = np.abs(np.eye(2) - np.einsum("kij,kjl->kil", Y, Jc)) + np.einsum("kij,kjl->kil", np.abs(Y), Jr)
+        rest = np.abs(np.eye(n) - np.einsum("kij,kjl->kil", Y, Jc)) + np.einsum("kij,kjl->kil", np.abs(Y), Jr)
         Kr = np.einsum("kij,kj->ki", rest, R) + np.einsum("kij,kj->ki", np.abs(Y), Fe)
         inside = ok & np.all(np.abs(Kc - c) + Kr < R, axis=1)
         away = ok & np.any(np.abs(Kc - c) - Kr > R, axis=1)
@@ -191,7 +239,7 @@ def torus_roots(F: tuple[TrigPoly, TrigPoly], within: tuple = (), start: tuple =
             x = _polish(F, ci)
             if np.any(np.abs(x - ci) >= Ri):
                 continue  # Newton left the box it was proved in (it cannot: the root is there): not trusted
-            x = x if periodic is None else (x - periodic[0]) % (2 * np.pi) + periodic[0]
+            x = x if periodic is None else (x - periodic) % (2 * np.pi) + periodic
             if not any(np.abs(x - y if periodic is None else wrap_angle(x - y)).max() < SAME for y, _ in found):
                 found.append((x, Ri))
         split = ~inside & ~away
@@ -199,12 +247,13 @@ def torus_roots(F: tuple[TrigPoly, TrigPoly], within: tuple = (), start: tuple =
         small = r.max(axis=1) < MIN_HALF_WIDTH
         undecided += [np.stack([ci, ri]) for ci, ri in zip(c[small], r[small])]
         c, r = c[~small], r[~small]
-        wide = (r[:, 1] > r[:, 0]).astype(int)  # the wider side
+        wide = r.argmax(axis=1)  # the widest side, halved
+        rows = np.arange(len(r))
         step = np.zeros_like(r)
-        step[np.arange(len(r)), wide] = r[np.arange(len(r)), wide] / 2
-        half = r.copy()
-        half[np.arange(len(r)), wide] /= 2
-        c, r = np.vstack([c - step, c + step]), np.vstack([half, half])
-    pts = np.array([x for x, _ in found]).reshape(-1, 2)
-    radii = np.array([R for _, R in found]).reshape(-1, 2)
-    return Roots(pts, radii, np.array(undecided).reshape(-1, 2, 2), examined)
+        step[rows, wide] = r[rows, wide] / 2
+        halves = r.copy()
+        halves[rows, wide] /= 2
+        c, r = np.vstack([c - step, c + step]), np.vstack([halves, halves])
+    pts = np.array([x for x, _ in found]).reshape(-1, n)
+    radii = np.array([R for _, R in found]).reshape(-1, n)
+    return Roots(pts, radii, np.array(undecided).reshape(-1, 2, n), examined)

@@ -74,3 +74,17 @@ def test_the_enclosure_holds_the_values_and_the_degree_is_checked():
         assert np.all(np.abs(x - vi) <= ei)
     with pytest.raises(ValueError, match="not a trigonometric polynomial of degree"):
         TrigPoly.fit(lambda u, w: np.cos(3 * u), (2, 2))
+
+
+def test_three_angles_every_root_of_a_closed_form():
+    """sin t0 = a, sin t1 = b, cos(t0 + t1 + t2) = c: t0 in {asin a, pi - asin a}, t1 the same with b, and
+    t2 = +-acos c - t0 - t1 -- eight roots, each found once and to round-off."""
+    a, b, c = 0.3, -0.6, 0.45
+    F = (TrigPoly.fit(lambda u, v, w: np.sin(u) - a, (1, 0, 0)), TrigPoly.fit(lambda u, v, w: np.sin(v) - b, (0, 1, 0)),
+         TrigPoly.fit(lambda u, v, w: np.cos(u + v + w) - c, (1, 1, 1)))
+    got = torus_roots(F)
+    assert got.complete and len(got.points) == 8
+    want = [(u, v, s * np.arccos(c) - u - v) for u in (np.arcsin(a), np.pi - np.arcsin(a))
+            for v in (np.arcsin(b), np.pi - np.arcsin(b)) for s in (1, -1)]
+    for p in want:
+        assert min(np.abs(_wrapped(np.array(p) - g)).max() for g in got.points) < 1e-13

@@ -170,8 +170,8 @@ def _platform_witnesses(solver, pp, x_name: str, y_name: str, box: tuple, fixed:
     Ix, Iy = (ranges[0][0] / L ** 2, ranges[0][1] / L ** 2), (ranges[1][0] / L ** 2, ranges[1][1] / L ** 2)
     inside = ((lx, *Ix), (ly, *Iy))
     # sin(theta) = Re(-i/2 e^{i theta} + i/2 e^{-i theta}); sin(phi) the same in the second angle
-    sin_t = TrigPoly(np.array([[0.5j], [0.0], [-0.5j]]), np.array([-1, 0, 1]), np.array([0]))
-    sin_p = TrigPoly(np.array([[0.5j, 0.0, -0.5j]]), np.array([0]), np.array([-1, 0, 1]))
+    sin_t = TrigPoly(np.array([[0.5j], [0.0], [-0.5j]]), (np.array([-1, 0, 1]), np.array([0])))
+    sin_p = TrigPoly(np.array([[0.5j, 0.0, -0.5j]]), (np.array([0]), np.array([-1, 0, 1])))
     systems = [("theta largest", (g, g.d(0, 1)), inside), ("theta = 0 or pi", (g, sin_t), inside),
                ("phi = 0 or pi", (g, sin_p), inside)]
     edges = [(lx - Ix[0], inside[1]), (lx - Ix[1], inside[1]), (ly - Iy[0], inside[0]), (ly - Iy[1], inside[0])]
@@ -315,8 +315,9 @@ def unmatched(w: Witnesses, loci: list) -> list:
     if not w.points:
         return []
     g, scale = w.G, np.abs(w.G.C).sum()
-    pts = np.vstack([np.array([w.torus(q) for q in lc.q]) for lc in loci]) if loci else np.zeros((0, 2))
-    on = np.abs(g.at(pts[:, 0], pts[:, 1])) <= ON * scale if len(pts) else np.zeros(0, bool)
+    n = g.C.ndim
+    pts = np.vstack([np.array([w.torus(q) for q in lc.q]) for lc in loci]) if loci else np.zeros((0, n))
+    on = np.abs(g.at(*pts.T)) <= ON * scale if len(pts) else np.zeros(0, bool)
     left = []
     for wt in w.points:
         d = np.abs(wrap_angle(pts - wt.angles))
