@@ -94,7 +94,7 @@ class Loci:
     notes: tuple = ()
     cusp_q: tuple = field(default=(), repr=False)
     traced: tuple = ()  # the kinds traced (the others: a note says why not)
-    cusps_complete: bool = False  # every cusp in the box is among ``cusps``, proved (a 3-RPR's witnesses)
+    cusps_complete: bool = False  # every cusp in the box is among ``cusps``, proved (loci_witness)
 
 
 class LocusSystem:

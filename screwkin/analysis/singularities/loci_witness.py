@@ -1,4 +1,5 @@
-"""Witness points that prove every component of a planar platform's actuator locus was traced (issue 44).
+"""Witness points that prove every component of an actuator locus in the box was traced (issue 44): a planar
+platform on three distances here, a five-bar (one RRR dyad on its two motors) in ``dyad_witnesses``.
 
 For a platform on three distances (analysis.position.three_distances: a 3-RPR and its kin) mapped over two
 legs' slides x, y with the third leg k held, every configuration is fixed by two angles: theta, the held
