@@ -149,3 +149,32 @@ def test_no_certificate_where_the_witnesses_do_not_apply():
     solver = screwkin.PositionSolver(mech)
     w = witnesses(solver, solver.inputs[0], solver.inputs[-1], ((0.0, 1.0), (0.0, 1.0)), {})
     assert not w.certified and "no certificate" in w.how and not w.points
+
+
+@pytest.mark.slow
+def test_a_certified_trace_leaves_no_change_of_the_independent_count_unexplained(rpr):
+    """Another section (rho1 = 0.25 m): the trace is complete, and on a 121 x 121 grid every pair of neighbours
+    where the independent polynomial's real-root count differs has a traced curve within a cell and a half."""
+    solver, rho0, _, _, _ = rpr
+    rho1 = 0.25
+    xs, ys = np.linspace(LO, HI, 41) - rho0[1], np.linspace(LO, HI, 41) - rho0[2]
+    traced = trace_loci(solver, "leg2", xs, "leg3", ys, {"leg1": rho1 - rho0[0]})
+    assert traced.complete and traced.cusps_complete
+    g = np.linspace(LO, HI, 121)
+    cell = g[1] - g[0]
+    counts = np.array([[_real_count((rho1, a, b)) for a in g] for b in g])  # [y, x]
+    dense = []
+    for lc in traced.loci:
+        pts = lc.points + rho0[1:]
+        for a, b in zip(pts[:-1], pts[1:]):
+            dense.append(a + np.outer(np.linspace(0, 1, int(np.ceil(np.linalg.norm(b - a) / (cell / 4))) + 1), b - a))
+    dense = np.vstack(dense)
+    changes = 0
+    for j in range(len(g)):
+        for i in range(len(g)):
+            for dj, di in ((0, 1), (1, 0)):
+                if j + dj < len(g) and i + di < len(g) and counts[j, i] != counts[j + dj, i + di]:
+                    changes += 1
+                    mid = np.array([(g[i] + g[i + di]) / 2, (g[j] + g[j + dj]) / 2])
+                    assert np.abs(dense - mid).max(axis=1).min() <= 1.5 * cell, mid
+    assert changes > 100  # the curves cross the grid's cells
