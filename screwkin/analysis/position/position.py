@@ -380,7 +380,7 @@ class PositionSolver:
                                            + [f"the angle of {k}" for k in mech.closure.row_inputs])
         if certain and not starts:  # the certificate settles it: nothing was searched
             return AssemblyError(mech.path, np.inf, 0, reason=certain, message=(
-                f"cannot assemble the mechanism at {inputs}: {certain}; nothing searched"))
+                f"cannot assemble the mechanism: {inputs} cannot be reached: {certain}; nothing searched"))
         return AssemblyError(mech.path, best, mech.tolerances.max_iterations, starts=starts,
                              detail=f"{inputs} cannot be reached from {starts} starting configurations", reason=certain)
 

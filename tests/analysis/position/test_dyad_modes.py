@@ -110,7 +110,8 @@ def test_where_the_loop_cannot_close_none_is_real_certified(capsys):
     solver = solver_of("fourbar_non_grashof")
     with pytest.raises(AssemblyError) as e:
         solver.solve({"input_joint": 1.5})
-    assert "cannot assemble the mechanism at the inputs input_joint=1.5: none of the 2 complex solutions is real " \
+    assert "cannot assemble the mechanism: the inputs input_joint=1.5 cannot be reached: none of the 2 complex " \
+           "solutions is real " \
            "(certified: closed form, 1 dyad (RRR), 2 branch vectors, 2 with a negative discriminant); nothing searched" \
            in str(e.value)
     # the certificate is the answer, and no start was tried: by the law of cosines the input's pivot B is
