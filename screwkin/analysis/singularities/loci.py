@@ -444,7 +444,8 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
     how = (f"seeds: Newton on [closure; A v = 0; |v| = 1] from the configurations of {mode_how}, each continued "
            f"over a {grid} x {grid} grid of the box, at the nodes next to a fold and where the kind's relative "
            "singular value has a local minimum along a grid line, and (where the modes come in closed form) from "
-           "the points of the box's edges where the mode count changes; every curve then followed by pseudo-arclength "
+           "the points of the box's edges where the mode count changes, then (where a certificate applies: a 3-RPR, "
+           "a five-bar) from its witness points; every curve then followed by pseudo-arclength "
            "continuation to the box's edges or round to its start; cusps located by Brent's method where the trace "
            f"reverses, nodes by Newton on the two arclengths. {checked}. ")
     if complete:
