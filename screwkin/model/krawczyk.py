@@ -104,16 +104,25 @@ class TrigPoly:
 
     def at(self, *t: np.ndarray) -> np.ndarray:
         """The values at the points (one array of each angle, broadcast together)."""
+        return self._stacked(self.C[None], t)[0]
+
+    def with_gradient(self, *t: np.ndarray) -> np.ndarray:
+        """The values and the n partial derivatives at the points, stacked (n + 1, ...): one pass."""
+        n = self.C.ndim
+        shapes = [[-1 if k == j else 1 for k in range(n)] for j in range(n)]
+        return self._stacked(np.stack([self.C] + [self.C * (1j * self.freqs[j]).reshape(shapes[j]) for j in range(n)]), t)
+
+    def _stacked(self, Cs: np.ndarray, t: tuple) -> np.ndarray:
+        """The values at the points of the polynomials of coefficients Cs[k] (these frequencies), stacked."""
         t = np.broadcast_arrays(*[np.asarray(x, float) for x in t])
         shape, flat = t[0].shape, [x.ravel() for x in t]
-        out = np.empty(len(flat[0]))
-        for s in range(0, len(out), CHUNK):  # one angle contracted at a time, a chunk of points at once
-            part = np.einsum("pa,a...->p...", np.exp(1j * np.multiply.outer(flat[0][s:s + CHUNK], self.freqs[0])),
-                             self.C)
+        out = np.empty((len(Cs), len(flat[0])))
+        for s in range(0, len(flat[0]), CHUNK):  # one angle contracted at a time, a chunk of points at once
+            part = np.einsum("pa,ka...->kp...", np.exp(1j * np.multiply.outer(flat[0][s:s + CHUNK], self.freqs[0])), Cs)
             for x, f in zip(flat[1:], self.freqs[1:]):
-                part = np.einsum("pa,pa...->p...", np.exp(1j * np.multiply.outer(x[s:s + CHUNK], f)), part)
-            out[s:s + CHUNK] = part.real
-        return out.reshape(shape)
+                part = np.einsum("pa,kpa...->kp...", np.exp(1j * np.multiply.outer(x[s:s + CHUNK], f)), part)
+            out[:, s:s + CHUNK] = part.real
+        return out.reshape((len(Cs),) + shape)
 
     def curvature(self) -> tuple:
         """(Q, sum |C|): Q[j, k] = sum |C| |m_j m_k|, so that the second derivative along any direction in a
@@ -128,9 +137,9 @@ def bounds(p: TrigPoly, c: np.ndarray, r: np.ndarray) -> tuple:
     """(value at the centres, half-width of the enclosure) of p over the boxes (centres c (k, n), half-widths
     r (k, n)); see the module."""
     Q, total = p.curvature()
-    cols = [c[:, j] for j in range(c.shape[1])]
-    f = p.at(*cols)
-    slope = sum(np.abs(p.d(*[int(k == j) for k in range(c.shape[1])]).at(*cols)) * r[:, j] for j in range(c.shape[1]))
+    V = p.with_gradient(*c.T)
+    f = V[0]
+    slope = sum(np.abs(V[1 + j]) * r[:, j] for j in range(c.shape[1]))
     S = np.einsum("kj,jl,kl->k", r, Q, r)
     return f, slope + 0.5 * S + ROUNDING * total
 
