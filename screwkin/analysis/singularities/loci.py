@@ -451,7 +451,7 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
     if complete:
         how += (f"Complete: {proof.how}; each of the {len(proof.points)} witnesses lies on a traced curve (a traced point "
                 "in a box about it where the locus is one arc through it, or the curve's end on that bound)")
-        said, cusps_complete = _cusps_checked(proof, [c for c in cusps if c[1] == "actuator"], box, notes)
+        said, cusps_complete = cusps_checked(proof, [c for c in cusps if c[1] == "actuator"], box, notes)
         how += said
     else:
         why = "" if proof is None else f" ({proof.how}" + (
@@ -462,7 +462,7 @@ def trace_loci(solver: PositionSolver, x_name: str, xs: np.ndarray, y_name: str,
                 tuple(traced_kinds), cusps_complete)
 
 
-def _cusps_checked(proof, traced: list, box: tuple, notes: list) -> tuple:
+def cusps_checked(proof, traced: list, box: tuple, notes: list, kind: str = "actuator") -> tuple:
     """The sentence on the cusps where the witnesses settle them: every cusp of the certificate among the traced
     ones and no other (within CUSP_MATCH of the box's span), else a note."""
     if proof.cusps is None:
@@ -472,7 +472,7 @@ def _cusps_checked(proof, traced: list, box: tuple, notes: list) -> tuple:
     missing = [c for c in proof.cusps if not any(np.abs(np.array(c) - p).max() <= CUSP_MATCH * span for p in mine)]
     extra = [p for p in mine if not any(np.abs(np.array(c) - p).max() <= CUSP_MATCH * span for c in proof.cusps)]
     if missing or extra:
-        notes.append(f"actuator: the traced cusps differ from the certificate's ({len(missing)} of its "
+        notes.append(f"{kind}: the traced cusps differ from the certificate's ({len(missing)} of its "
                      f"{len(proof.cusps)} not traced, {len(extra)} traced not among them)")
         return f". Cusps: not certified (the traced ones differ from the {proof.cusp_how})", False
     return (f". Cusps complete: {proof.cusp_how}" + ("; each is a traced cusp" if proof.cusps else "; none traced")), True

@@ -54,6 +54,9 @@ FLAT = 1e-12
 MARGIN = 1e-12
 #: The tracer's end on a bound is the edge witness when this close (rad, on the torus).
 END = 1e-7
+#: A chord between two traced points is brought onto the curve at points this fraction of an arc box apart,
+#: at most CHORD_POINTS of them, by CHORD_STEPS Gauss-Newton steps.
+CHORD, CHORD_POINTS, CHORD_STEPS = 0.25, 4096, 8
 #: A root of the cusp system is a cusp where y's rate is below CUSP (relative to the sum of its coefficients'
 #: sizes), a turn where its enclosure over CLOSE (rad) about the root keeps away from zero.
 CUSP, CLOSE = 1e-10, 1e-9
@@ -82,6 +85,8 @@ class Witnesses:
     torus: object = None  # q -> (theta, phi)
     cusps: tuple | None = None  # ((x, y), ...) every cusp in the box, None where not settled
     cusp_how: str = ""
+    scale: float = 1.0  # the length the witnesses' lengths are over [m]
+    curve: tuple = ()  # the equations of the curve on the torus (default (G,))
 
 
 def _quadratic(pp, k: int) -> tuple:
@@ -311,21 +316,63 @@ def _arc_box(g: TrigPoly, x: np.ndarray, inside) -> tuple | None:
     return None
 
 
+def _onto(eqs: tuple, X: np.ndarray) -> np.ndarray:
+    """The points X (m, n) brought onto eqs = 0 by Gauss-Newton's least change (a few steps)."""
+    n = X.shape[1]
+    grads = [[f.d(*[int(k == j) for k in range(n)]) for j in range(n)] for f in eqs]
+    for _ in range(CHORD_STEPS):
+        F = np.stack([f.at(*X.T) for f in eqs], axis=1)
+        J = np.stack([np.stack([d.at(*X.T) for d in row], axis=1) for row in grads], axis=1)  # (m, k, n)
+        JJ = np.einsum("mkn,mln->mkl", J, J)
+        ok = np.abs(np.linalg.det(JJ)) > TINY
+        step = np.zeros_like(X)
+        step[ok] = -np.einsum("mkn,mk->mn", J[ok], np.linalg.solve(JJ[ok], F[ok][..., None])[..., 0])
+        X = X + step
+    return X
+
+
+def _on_a_chord(eqs: tuple, scale: list, curves: list, wt: Witness, reach: np.ndarray) -> bool:
+    """Whether a point of the curve between two traced points next to the witness (their chord, at points a
+    CHORD of its arc box apart, brought onto the curve) lies in its arc box."""
+    for T in curves:
+        if len(T) < 2:
+            continue
+        d = np.abs(wrap_angle(T - wt.angles)).max(axis=1)
+        for i in np.argsort(d)[:3]:
+            for j in (i - 1, i + 1):
+                if not 0 <= j < len(T):
+                    continue
+                chord = wrap_angle(T[j] - T[i])
+                m = int(min(CHORD_POINTS, np.ceil(np.abs(chord).max() / (CHORD * reach.min())) + 1))
+                X = _onto(eqs, T[i] + np.outer(np.linspace(0.0, 1.0, m + 1), chord))
+                on = np.all([np.abs(f.at(*X.T)) <= ON * s for f, s in zip(eqs, scale)], axis=0)
+                if np.any(on & np.all(np.abs(wrap_angle(X - wt.angles)) < reach, axis=1)):
+                    return True
+    return False
+
+
 def unmatched(w: Witnesses, loci: list) -> list:
-    """The witnesses no traced curve of ``loci`` passes through (see the module)."""
+    """The witnesses no traced curve of ``loci`` passes through (see the module): a traced point in the
+    witness's arc box, or a point between two traced ones brought onto the curve (_on_a_chord); an edge
+    witness, the tracer's end on that bound."""
     if not w.points:
         return []
-    g, scale = w.G, np.abs(w.G.C).sum()
-    n = g.C.ndim
-    pts = np.vstack([np.array([w.torus(q) for q in lc.q]) for lc in loci]) if loci else np.zeros((0, n))
-    on = np.abs(g.at(*pts.T)) <= ON * scale if len(pts) else np.zeros(0, bool)
+    eqs = w.curve or (w.G,)
+    scale = [np.abs(f.C).sum() for f in eqs]
+    n = w.G.C.ndim
+    curves = [np.array([w.torus(q) for q in lc.q]).reshape(-1, n) for lc in loci]
+    pts = np.vstack(curves) if curves else np.zeros((0, n))
+    on = np.all([np.abs(f.at(*pts.T)) <= ON * s for f, s in zip(eqs, scale)], axis=0) if len(pts) else \
+        np.zeros(0, bool)
     left = []
     for wt in w.points:
         d = np.abs(wrap_angle(pts - wt.angles))
-        reach = np.array(wt.box[0] if wt.system != "edge" else wt.box, float)
+        reach = np.broadcast_to(np.array(wt.box[0] if wt.system != "edge" else wt.box, float), (n,))
         hit = on & np.all(d < reach, axis=1)
         if wt.system == "edge":  # the tracer's end on that bound: the one root of the edge's system there
             hit &= np.all(d < END, axis=1)
+        elif not hit.any():
+            hit = np.array([_on_a_chord(eqs, scale, curves, wt, reach)])
         if not hit.any():
             left.append(wt)
     return left
