@@ -168,9 +168,20 @@ def orthogonal_3r_quartic(d2, d3, d4, r2, r3, x, z):
     (numpy, independent of screwkin): with R^2 = x^2 + z^2, the tool point's distance from the base and its
     height give (K - 2 d3 d4 c3 - 2 r2 d4 s3)^2 + 4 d2^2 (z^2 - (d3 + d4 c3)^2 - r3^2) = 0,
     K = R^2 - d2^2 - d3^2 - d4^2 - r2^2 - r3^2; each real root is one solution (theta2 and theta1 follow)."""
-    from numpy.polynomial import Polynomial as P
-    one, c, s = P([1, 0, 1]), P([1, 0, -1]), P([0, 2])
+    from numpy.polynomial import Polynomial
+    return Polynomial(orthogonal_3r_quartic_coefficients(d2, d3, d4, r2, r3, x, z))
+
+
+def orthogonal_3r_quartic_coefficients(d2, d3, d4, r2, r3, x, z):
+    """The coefficients (5, ...) of orthogonal_3r_quartic, lowest first, at points x, z (arrays alike)."""
+    x, z = np.broadcast_arrays(np.asarray(x, float), np.asarray(z, float))
+    one, c, s = np.array([1.0, 0, 1]), np.array([1.0, 0, -1]), np.array([0.0, 2, 0])
     K = x * x + z * z - d2**2 - d3**2 - d4**2 - r2**2 - r3**2
-    first = K * one - 2 * d3 * d4 * c - 2 * r2 * d4 * s
+    first = K[None] * one.reshape(3, *[1] * K.ndim) + (-2 * d3 * d4 * c - 2 * r2 * d4 * s).reshape(3, *[1] * K.ndim)
     ux = d3 * one + d4 * c
-    return first**2 + 4 * d2**2 * ((z * z - r3**2) * one**2 - ux**2)
+
+    def times(a, b):  # the product of two quadratics in t (coefficients first)
+        return np.stack([sum(a[i] * b[k - i] for i in range(3) if 0 <= k - i < 3) for k in range(5)])
+
+    ones = np.broadcast_to(times(one, one).reshape(5, *[1] * K.ndim), (5,) + K.shape)
+    return times(first, first) + 4 * d2**2 * ((z * z - r3**2)[None] * ones - times(ux, ux).reshape(5, *[1] * K.ndim))

@@ -16,6 +16,7 @@ the closed-form inverse kinematics at their samples.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -23,7 +24,9 @@ import pinocchio as pin
 
 from ...errors import UsageError
 from ...model.state import KinematicState
-from .loci import Loci, LocusSystem, trace_kind
+from .loci import Loci, LocusSystem, cusps_checked, trace_kind
+from .loci_witness import unmatched
+from .section_witness import section_witnesses
 from .cuspidal import arm3r, aspects, point_ik, section_extent, verdict
 from .regions import Regions, regions
 from ..singular import LWA
@@ -127,6 +130,23 @@ def _overlapping(p: np.ndarray, curves: list, span: float, near: float) -> bool:
     return int((gaps > np.radians(10.0)).sum()) <= 2
 
 
+def _proved(proof, loci: list, cusps: list, box: tuple, notes: list) -> tuple:
+    """(complete, cusps complete, the sentence) the witnesses (section_witness) prove of the traced curves."""
+    if proof is None:
+        return False, False, ". A component no random configuration converges to is missed, so completeness is not claimed"
+    left = unmatched(proof, loci) if proof.certified else []
+    if not proof.certified or left:
+        if left:
+            notes.append(f"serial: {len(left)} witness point(s) of the certificate lie on no traced curve, at "
+                         + ", ".join(f"({w.xy[0]:.6g}, {w.xy[1]:.6g})" for w in left[:4]))
+        return False, False, (". A component no seed converges to is missed, so completeness is not claimed ("
+                              + proof.how + (f"; {len(left)} of them on no traced curve" if left else "") + ")")
+    said, cusps_complete = cusps_checked(proof, cusps, box, notes, "serial")
+    return True, cusps_complete, (f". Complete: {proof.how}; each of the {len(proof.points)} witnesses lies on a traced "
+                                  "curve (a point of it in a box about the witness where the curve is one arc "
+                                  "through it, or the curve's end on that bound)" + said)
+
+
 @dataclass(frozen=True)
 class Section:
     loci: Loci
@@ -160,24 +180,27 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
         starts.append((sys.relative(q), q))
     starts.sort(key=lambda s: s[0])
     notes = []
-    loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", (q for _, q in starts), box, notes)
+    q0 = mech.neutral()
+    for c, v, _ in sys.held:
+        q0[c.idx_q] = v
+    arm, why_not = arm3r(mech, sys.fid, sys.free, q0)
+    ax = (AXES[x_axis], AXES[y_axis])
+    proof = section_witnesses(arm, ax, sys.h, level, box) if arm is not None else None
+    seeds = itertools.chain((q for _, q in starts), (w.q for w in proof.points) if proof is not None else ())
+    loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", seeds, box, notes)
     span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
     kept = [n for n in nodes if not _overlapping(np.array(n[0]), [lc.points for lc in loci], span, mech.tolerances.singular)]
     if len(kept) < len(nodes):
         notes.append(f"{len(nodes) - len(kept)} meetings of traces that run together (one curve of the plane traced "
                      "twice, as where det J factors, or a closed trace's overlap at its start) are not nodes")
     nodes = kept
+    complete, cusps_complete, said = _proved(proof, loci, cusps, box, notes)
     how = (f"seeds: Newton on [held coordinate; J_p v = 0; |v| = 1] from {samples} random joint configurations "
-           "(seed {seed}), most singular first; every curve followed by pseudo-arclength continuation to the "
-           "box's edges or round to its start; cusps located by Brent's method where the trace reverses. A "
-           "component no random configuration converges to is missed, so completeness is not claimed")
-    result = Loci(tuple(loci), tuple(cusps), tuple(nodes), False, how.replace("{seed}", str(seed)),
-                  tuple(dict.fromkeys(notes)), tuple(cusp_q), ("serial",))
-    q0 = mech.neutral()
-    for c, v, _ in sys.held:
-        q0[c.idx_q] = v
-    arm, why_not = arm3r(mech, sys.fid, sys.free, q0)
-    ax = (AXES[x_axis], AXES[y_axis])
+           "(seed {seed}), most singular first, then (for three revolutes) from the certificate's witness points; "
+           "every curve followed by pseudo-arclength continuation to the box's edges or round to its start; cusps "
+           "located by Brent's method where the trace reverses") + said
+    result = Loci(tuple(loci), tuple(cusps), tuple(nodes), complete, how.replace("{seed}", str(seed)),
+                  tuple(dict.fromkeys(notes)), tuple(cusp_q), ("serial",), cusps_complete)
 
     def world(p) -> np.ndarray:
         c = np.zeros(3)

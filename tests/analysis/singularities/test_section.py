@@ -11,7 +11,7 @@ import re
 import numpy as np
 import pytest
 from conftest import screwkin_cli
-from loci_robots import orthogonal_3r, orthogonal_3r_quartic
+from loci_robots import orthogonal_3r, orthogonal_3r_quartic, orthogonal_3r_quartic_coefficients
 
 import screwkin
 from screwkin.analysis.singularities.section import trace_section
@@ -83,6 +83,79 @@ def test_the_cuspidal_orthogonal_3r_is_cuspidal_with_cusps_at_the_quartics_tripl
             assert len(real) == r.modes, (grid[i], grid[j], r)
     # the nodes: where the curves meet on the first axis (x = 0, a self-motion), no other
     assert all(abs(x) < 1e-3 for (x, _), _ in sec.loci.nodes), sec.loci.nodes
+    # the certificate: every component and every cusp, the plane holding the first axis (a tube about it)
+    assert sec.loci.complete and sec.loci.cusps_complete, sec.loci.how
+    assert "the plane holds the first axis" in sec.loci.how and "8 cusps" in sec.loci.how
+    _witnesses_are_double_roots(mech, 0.0, 5.0)
+
+
+def _witnesses_are_double_roots(mech, level, half):
+    """Each witness of the certificate is a singular point of the section: the independent quartic at the
+    point's distance from the first axis has a double real root there."""
+    from screwkin.analysis.singularities.cuspidal import arm3r
+    from screwkin.analysis.singularities.section import SectionSystem
+    from screwkin.analysis.singularities.section_witness import section_witnesses
+
+    sys = SectionSystem(mech, "tool", 0, 2, level, {})
+    arm, _ = arm3r(mech, sys.fid, sys.free, mech.neutral())
+    w = section_witnesses(arm, (0, 2), 1, level, ((-half, half), (-half, half)))
+    assert w.certified and w.points, w.how
+    for wt in w.points:
+        x, z = wt.xy
+        P = orthogonal_3r_quartic(*CUSPIDAL, np.hypot(x, level), z)
+        scale = np.abs(P.coef).max()
+        r = P.roots()
+        t = r[np.argmin(np.abs(P.deriv()(r)) + np.abs(P(r)))]
+        assert abs(t.imag) < 1e-4 and abs(P(t.real)) < 1e-9 * scale and abs(P.deriv()(t.real)) < 1e-6 * scale, wt
+    return w
+
+
+def test_a_section_off_the_first_axis_is_certified_complete_against_the_independent_quartic(tmp_path):
+    """y = 0.7, a plane the first axis (z) does not lie in: the arm turns about z, so the solutions at
+    (x, 0.7, z) are those at (hypot(x, 0.7), 0, z) turned -- the independent quartic counts them.  The trace
+    is proved complete; every change of that count between neighbours of a 161 x 161 grid has a traced curve
+    within a cell and a half; every certified cusp is a triple root (Newton on P = P' = P'' = 0, to 1e-8)."""
+    _, mech = _load(tmp_path, CUSPIDAL, "o3r_off")
+    level, grid = 0.7, np.linspace(-5, 5, 31)
+    sec = trace_section(mech, "tool", "x", grid, "z", grid, level, samples=100, count=False)
+    assert sec.loci.complete and sec.loci.cusps_complete, sec.loci.how
+    assert "the first joint's circle touching the plane" in sec.loci.how
+    assert len(sec.loci.cusps) == 8
+    for (x, z), _ in sec.loci.cusps:
+        R, Z, _ = _quartic_cusp(CUSPIDAL, np.hypot(x, level), z)
+        assert abs(R - np.hypot(x, level)) < 1e-8 and abs(Z - z) < 1e-8
+    w = _witnesses_are_double_roots(mech, level, 5.0)
+    assert {p.system for p in w.points} >= {"t2 = 0 or pi", "circle touching"}
+    fine = np.linspace(-5, 5, 161)
+    X, Z = np.meshgrid(fine, fine, indexing="ij")
+    A = np.moveaxis(orthogonal_3r_quartic_coefficients(*CUSPIDAL, np.hypot(X, level), Z), 0, -1).reshape(-1, 5)
+    M = np.zeros((len(A), 4, 4))  # companion matrices: the quartic's roots as eigenvalues (numpy)
+    M[:, 1:, :-1] = np.eye(3)
+    M[:, :, -1] = -A[:, :4] / A[:, 4:]
+    r = np.linalg.eigvals(M)
+    counts = (np.abs(r.imag) < 1e-6 * np.maximum(1.0, np.abs(r))).sum(axis=1).reshape(X.shape)
+    u = np.linspace(0, 1, 20, endpoint=False)[:, None, None]  # the traced polylines, densely
+    pts = np.vstack([(P[:-1] + u * np.diff(P, axis=0)).reshape(-1, 2) for P in (lc.points for lc in sec.loci.loci)])
+    cell = fine[1] - fine[0]
+    changes = [((fine[i] + fine[i + di]) / 2, (fine[j] + fine[j + dj]) / 2)
+               for di, dj in ((1, 0), (0, 1)) for i in range(len(fine) - di) for j in range(len(fine) - dj)
+               if counts[i, j] != counts[i + di, j + dj]]
+    assert changes
+    far = [c for c in changes if np.abs(pts - c).max(axis=1).min() > 1.5 * cell]
+    assert not far, far[:5]
+
+
+def test_a_non_generic_arm_gets_no_section_certificate(tmp_path):
+    """r2 = 0: det J = d4 (d2 + d3 c2)(d3 + d4 c3) s3 factors, its curves cross: no certificate, said."""
+    from screwkin.analysis.singularities.cuspidal import arm3r
+    from screwkin.analysis.singularities.section import SectionSystem
+    from screwkin.analysis.singularities.section_witness import section_witnesses
+
+    _, mech = _load(tmp_path, POSTURES, "o3r_nocert")
+    sys = SectionSystem(mech, "tool", 0, 2, 0.0, {})
+    arm, _ = arm3r(mech, sys.fid, sys.free, mech.neutral())
+    w = section_witnesses(arm, (0, 2), 1, 0.0, ((-5, 5), (-5, 5)))
+    assert not w.certified and w.cusps is None and "singular point" in w.how
 
 
 @pytest.mark.slow
@@ -206,7 +279,7 @@ def test_map_of_a_workspace_section_json(tmp_path):
     d = json.loads(p.stdout)
     assert d["cuspidal"] is True and "aspect" in d["cuspidal_rests_on"]
     assert d["section"]["held"] == {"y": 0.0} and "y held at 0 m" in d["section_notes"][0]
-    assert len(d["cusps"]) == 8 and d["complete"] is False
+    assert len(d["cusps"]) == 8 and d["complete"] is True and d["cusps_complete"] is True
     for x, z in d["cusps"]:  # x in mm as typed
         assert abs(x) > 1000 and _real_roots(CUSPIDAL, x / 1000, z)[1] < 1e-3
     for r in d["regions"]:
