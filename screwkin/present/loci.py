@@ -74,7 +74,7 @@ def loci_lines(loci: Loci, regions: Regions, x_name: str, y_name: str, x_unit: s
     kinds = sorted({lc.kind for lc in loci.loci})
     for kind in kinds:
         curves = [lc for lc in loci.loci if lc.kind == kind]
-        lines.append(f"{kind} singular loci: {len(curves)} curves traced, "
+        lines.append(f"{kind} singular loci: {len(curves)} curve{'s' if len(curves) != 1 else ''} traced, "
                      f"{sum(len(c.points) for c in curves)} points, each on the singular condition "
                      f"(relative sigma_min at most {max(c.residual for c in curves):.1e})")
         for c in curves:
