@@ -159,11 +159,13 @@ class Section:
 
 
 def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_axis: str, ys: np.ndarray, level: float = 0.0, fixed: dict | None=None,
-                  samples: int = 400, seed: int = 0, count: bool = True) -> Section:
+                  samples: int = 400, seed: int = 0, count: bool = True, certify: bool = True) -> Section:
     """The serial singular curves of ``output``'s origin in the section (x_axis, y_axis) of its workspace, the
     third coordinate held at ``level`` [m] and the joints in ``fixed`` at their values; cusps, nodes, the
     regions they cut the box xs x ys into with their numbers of real IK solutions (``count``), and whether
-    the robot is cuspidal (analysis.singularities.cuspidal: True, False or None with the reason)."""
+    the robot is cuspidal (analysis.singularities.cuspidal: True, False or None with the reason).  ``certify``:
+    for three revolutes, prove the trace complete and its cusps all (section_witness; ik --connect, which uses
+    the cusps only, leaves it)."""
 
     fixed = dict(fixed or {})
     if mech.cuts or mech.couplings or getattr(mech, "extra_rows", None):
@@ -185,7 +187,7 @@ def trace_section(mech: Mechanism, output: str, x_axis: str, xs: np.ndarray, y_a
         q0[c.idx_q] = v
     arm, why_not = arm3r(mech, sys.fid, sys.free, q0)
     ax = (AXES[x_axis], AXES[y_axis])
-    proof = section_witnesses(arm, ax, sys.h, level, box) if arm is not None else None
+    proof = section_witnesses(arm, ax, sys.h, level, box) if arm is not None and certify else None
     seeds = itertools.chain((q for _, q in starts), (w.q for w in proof.points) if proof is not None else ())
     loci, cusps, cusp_q, nodes = trace_kind(sys, "serial", seeds, box, notes)
     span = max(box[0][1] - box[0][0], box[1][1] - box[1][0])
