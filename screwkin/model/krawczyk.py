@@ -28,7 +28,7 @@ import numpy as np
 
 from .geometry import wrap_angle
 
-__all__ = ["TrigPoly", "Roots", "torus_roots", "bounds"]
+__all__ = ["TrigPoly", "Roots", "torus_roots", "bounds", "halve_widest"]
 
 #: The rounding allowance: a value's enclosure is widened by this times the sum of its coefficients' sizes.
 ROUNDING = 1e-12
@@ -144,6 +144,17 @@ def bounds(p: TrigPoly, c: np.ndarray, r: np.ndarray) -> tuple:
     return f, slope + 0.5 * S + ROUNDING * total
 
 
+def halve_widest(c: np.ndarray, r: np.ndarray) -> tuple:
+    """The boxes (centres c, half-widths r) each cut in two across its widest side: (centres, half-widths)."""
+    wide = r.argmax(axis=1)
+    rows = np.arange(len(r))
+    step = np.zeros_like(r)
+    step[rows, wide] = r[rows, wide] / 2
+    halves = r.copy()
+    halves[rows, wide] /= 2
+    return np.vstack([c - step, c + step]), np.vstack([halves, halves])
+
+
 @dataclass(frozen=True)
 class Roots:
     """``points`` (k, n) the proved roots (polished), ``radii`` (k, n) the half-widths of the box about each
@@ -256,13 +267,7 @@ def torus_roots(F: tuple, within: tuple = (), start: tuple | None = None, domain
         small = r.max(axis=1) < MIN_HALF_WIDTH
         undecided += [np.stack([ci, ri]) for ci, ri in zip(c[small], r[small])]
         c, r = c[~small], r[~small]
-        wide = r.argmax(axis=1)  # the widest side, halved
-        rows = np.arange(len(r))
-        step = np.zeros_like(r)
-        step[rows, wide] = r[rows, wide] / 2
-        halves = r.copy()
-        halves[rows, wide] /= 2
-        c, r = np.vstack([c - step, c + step]), np.vstack([halves, halves])
+        c, r = halve_widest(c, r)
     pts = np.array([x for x, _ in found]).reshape(-1, n)
     radii = np.array([R for _, R in found]).reshape(-1, n)
     return Roots(pts, radii, np.array(undecided).reshape(-1, 2, n), examined)

@@ -88,3 +88,21 @@ def test_three_angles_every_root_of_a_closed_form():
             for v in (np.arcsin(b), np.pi - np.arcsin(b)) for s in (1, -1)]
     for p in want:
         assert min(np.abs(_wrapped(np.array(p) - g)).max() for g in got.points) < 1e-13
+
+
+def test_value_and_gradient_in_one_pass_against_finite_differences():
+    """with_gradient (one contraction of the stacked coefficients) against the closed form and central
+    differences of it, in three angles."""
+    def f(a, b, c):
+        return np.cos(2 * a + 3 * b - c) + 0.5 * np.sin(a) * np.cos(4 * b) * np.sin(2 * c) - 0.2
+
+    p = TrigPoly.fit(f, (2, 4, 2))
+    rng = np.random.default_rng(3)
+    t = rng.uniform(-np.pi, np.pi, (3, 50))
+    V = p.with_gradient(*t)
+    assert np.abs(V[0] - f(*t)).max() < 1e-12
+    h = 1e-6
+    for j in range(3):
+        e = np.zeros((3, 1))
+        e[j] = h
+        assert np.abs(V[1 + j] - (f(*(t + e)) - f(*(t - e))) / (2 * h)).max() < 1e-8

@@ -44,7 +44,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ...model.krawczyk import TrigPoly, bounds, torus_roots
+from ...model.krawczyk import TrigPoly, bounds, halve_widest, torus_roots
 from ...model.state import KinematicState
 from .loci_witness import ARC_MIN, ARC_START, CLOSE, CUSP, FLAT, MARGIN, Witness, Witnesses
 
@@ -88,14 +88,7 @@ def _clear(E: TrigPoly, G: TrigPoly, c: np.ndarray, r: np.ndarray, depth: int = 
         left = ~((np.abs(vE) > eE) | (np.abs(vG) > eG))
         if not left.any():
             return True
-        c, r = c[left], r[left]
-        wide = r.argmax(axis=1)
-        rows = np.arange(len(r))
-        step = np.zeros_like(r)
-        step[rows, wide] = r[rows, wide] / 2
-        half = r.copy()
-        half[rows, wide] /= 2
-        c, r = np.vstack([c - step, c + step]), np.vstack([half, half])
+        c, r = halve_widest(c[left], r[left])
     return False
 
 
