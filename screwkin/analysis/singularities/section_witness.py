@@ -235,6 +235,17 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
     px, py = P[axes[0]], P[axes[1]]
     o, a = arm.points[0] / L, arm.axes[0] / np.linalg.norm(arm.axes[0])
     tube = abs(a[h]) <= ALONG and abs(o[h] - level / L) <= ALONG
+    if abs(abs(a[h]) - 1.0) <= ALONG:
+        return Witnesses((), False, "no certificate: the plane is square to the first axis, so the point's height "
+                                    "does not depend on the first joint and the curve there is circles about that axis "
+                                    "(whole circles of t1 on the joints' torus), which these witnesses do not take")
+    for k, (lo, hi) in zip(axes, box):
+        on = [b for b in (lo, hi) if tube and abs(a[k]) <= ALONG and abs(o[k] - b / L) <= ALONG]
+        if on:
+            return Witnesses((), False, f"no certificate: the box's edge {'xyz'[k]} = {on[0]:.6g} m lies on the first "
+                                        "axis, where the point stays for a whole turn of the first joint (the edge's "
+                                        "witnesses would be circles, not points); a box whose edges are off the axis "
+                                        "can be certified")
     # the point's offset from the first axis at t1 = 0 across it (along u and v, a x u), over (t2, t3)
     u = np.cross(a, np.eye(3)[int(np.argmin(np.abs(a)))])
     u /= np.linalg.norm(u)
@@ -249,11 +260,12 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
     systems += [("t2 = 0 or pi", (E, G, sin2), inside), ("turn of det J", (E, G, G.d(0, 0, 1)), inside)]
     if not tube:  # (a circle about the first axis touches a plane through that axis only where it is a point)
         systems.append(("circle touching", (E, G, E.d(1, 0, 0)), inside))
-    found, undecided, examined, why = [], 0, 0, ""
+    found, undecided, examined, why, stuck = [], 0, 0, "", []
     for name, F, within in systems:
         got = torus_roots(F, within, max_boxes=SECTION_BOXES)
         examined += got.boxes
         undecided += len(got.undecided)
+        stuck += [name] if len(got.undecided) else []
         for x, radius in zip(got.points, got.radii):
             if all(lo - MARGIN <= p.at(*x) <= hi + MARGIN for p, lo, hi in within):
                 found.append((name, x, radius))
@@ -267,6 +279,7 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
         crossing = torus_roots((g, r2 - AXIS), max_boxes=SECTION_BOXES)
         examined += crossing.boxes
         undecided += len(crossing.undecided)
+        stuck += ["tube"] if len(crossing.undecided) else []
         for s in crossing.points:
             for t1 in _lifts(E, s) or []:
                 x = np.array([t1, *s])
@@ -301,7 +314,11 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
                 "point) and meets the axis at isolated points")
     how += f"), every root proved by the Krawczyk test in {examined} boxes"
     if undecided:
-        how += f", but {undecided} boxes were left undecided (det J's curves meeting: a non-generic arm?): no certificate"
+        names = {"edge": "an edge's", "t2 = 0 or pi": "t2 = 0 or pi", "turn of det J": "det J = 0 turning in t2",
+                 "circle touching": "the circle touching the plane", "tube": "the tube's boundary"}
+        how += (f", but {undecided} boxes were left undecided in the system" + ("s" if len(set(stuck)) > 1 else "")
+                + " of " + ", ".join(dict.fromkeys(names[n] for n in stuck)) + " (a singular point of the curve there: "
+                "the section tangent to the singular surface, or a curve of roots): no certificate")
     elif why:
         how += f", but {why}: no certificate"
     elif not certified:

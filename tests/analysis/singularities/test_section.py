@@ -309,3 +309,19 @@ def test_map_section_of_a_point_on_the_third_axis_says_cuspidal_null(tmp_path):
                      "--no-regions")
     assert p.returncode == 0, p.stderr
     assert json.loads(p.stdout)["cuspidal"] is None
+
+
+def test_sections_the_certificate_does_not_take_say_why(tmp_path):
+    """The plane z = 0 is square to the first axis (z): the curve there is circles about it; the box's edge
+    x = 0 of the plane y = 0 lies on the first axis, where the point stays for a whole turn of joint 1."""
+    from screwkin.analysis.singularities.cuspidal import arm3r
+    from screwkin.analysis.singularities.section import SectionSystem
+    from screwkin.analysis.singularities.section_witness import section_witnesses
+
+    _, mech = _load(tmp_path, CUSPIDAL, "o3r_why")
+    sys = SectionSystem(mech, "tool", 0, 1, 0.0, {})
+    arm, _ = arm3r(mech, sys.fid, sys.free, mech.neutral())
+    w = section_witnesses(arm, (0, 1), 2, 0.0, ((-5, 5), (-5, 5)))
+    assert not w.certified and "square to the first axis" in w.how
+    w = section_witnesses(arm, (0, 2), 1, 0.0, ((0, 5), (-5, 5)))
+    assert not w.certified and "edge x = 0 m lies on the first axis" in w.how
