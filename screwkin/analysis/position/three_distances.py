@@ -50,6 +50,19 @@ class PlanarPlatform:
     u0: np.ndarray
     heights: np.ndarray
 
+    def quadratics(self) -> np.ndarray:
+        """(3, 3): leg k's squared length in the plane, |v|^2 - (v . n)^2 with v = d0 + s u0, is
+        Q[k, 0] s^2 + Q[k, 1] s + Q[k, 2] at its slide s."""
+        d0, u0, n = self.d0, self.u0, self.basis[2]
+        dn, un = d0 @ n, u0 @ n
+        return np.stack([np.sum(u0 * u0, axis=1) - un ** 2, 2 * (np.sum(d0 * u0, axis=1) - dn * un),
+                         np.sum(d0 * d0, axis=1) - dn ** 2], axis=1)
+
+    def length2(self, s: np.ndarray) -> np.ndarray:
+        """The three legs' squared lengths in the plane at their slides s (3,)."""
+        Q = self.quadratics()
+        return Q[:, 0] * s * s + Q[:, 1] * s + Q[:, 2]
+
 
 @dataclass(frozen=True)
 class ThreeDistanceModes:
@@ -135,7 +148,7 @@ def three_distance_modes(solver, values: dict) -> ThreeDistanceModes | str | Non
     rise = v @ n
     if np.abs(rise - pp.heights).max() > tol.closed_check * L:
         return "a leg's end and its platform point are not at one height along the plane's normal"
-    roots = planar_poses(pp.a, pp.b, np.sum(v * v, axis=1) - rise ** 2, tol)
+    roots = planar_poses(pp.a, pp.b, pp.length2(x), tol)
     if isinstance(roots, str):
         return roots
     if roots.unexplained:

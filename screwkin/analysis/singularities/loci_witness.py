@@ -90,10 +90,9 @@ class Witnesses:
 
 
 def _quadratic(pp, k: int) -> tuple:
-    """(a, b, c): leg k's squared length in the plane is a s^2 + b s + c at slide s."""
-    d0, u0, n = pp.d0[k], pp.u0[k], pp.basis[2]
-    return (float(u0 @ u0 - (u0 @ n) ** 2), float(2 * (d0 @ u0 - (d0 @ n) * (u0 @ n))),
-            float(d0 @ d0 - (d0 @ n) ** 2))
+    """(a, b, c): leg k's squared length in the plane is a s^2 + b s + c at slide s (PlanarPlatform.quadratics)."""
+    a, b, c = pp.quadratics()[k]
+    return float(a), float(b), float(c)
 
 
 def _leg_length2(pp, k: int, s: float) -> float:
