@@ -23,8 +23,11 @@ G = 0 neither turns in t2 nor has a singular point there (no root of (G, G_t3) w
 is two graphs t1 = alpha - phi(s), alpha + pi - phi(s) (the point's turn about the axis onto the plane) that
 meet the circles over the axis points, and every component of C in the tube reaches its boundary.
 
-Every root of these systems is proved by model.krawczyk, or the boxes left undecided are said (then no
-certificate: det J's curves crossing, a non-generic arm).
+Every root of these systems is proved by model.krawczyk, or the boxes left undecided are said, naming the
+system (then no certificate: det J's curves crossing -- a non-generic arm, checked first in (t2, t3) --, the
+section tangent to the singular surface).  Two sections are refused before any search, said: a plane square
+to the first axis (the point's height does not depend on t1, so the curve is circles about the axis) and a
+box whose edge lies on the first axis (the edge's roots would be whole circles of t1).
 
 A witness is on a traced curve (loci_witness.unmatched) when a traced configuration, or a point of C
 between two traced ones (their chord brought onto C by Newton), lies in its arc box: a box about it in
