@@ -85,7 +85,6 @@ class Witnesses:
     torus: object = None  # q -> (theta, phi)
     cusps: tuple | None = None  # ((x, y), ...) every cusp in the box, None where not settled
     cusp_how: str = ""
-    scale: float = 1.0  # the length the witnesses' lengths are over [m]
     curve: tuple = ()  # the equations of the curve on the torus (default (G,))
 
 

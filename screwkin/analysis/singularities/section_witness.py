@@ -263,7 +263,7 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
     systems += [("t2 = 0 or pi", (E, G, sin2), inside), ("turn of det J", (E, G, G.d(0, 0, 1)), inside)]
     if not tube:  # (a circle about the first axis touches a plane through that axis only where it is a point)
         systems.append(("circle touching", (E, G, E.d(1, 0, 0)), inside))
-    found, undecided, examined, why, stuck = [], 0, 0, "", []
+    found, undecided, examined, why, stuck = [], 0, crossing_curves.boxes, "", []
     for name, F, within in systems:
         got = torus_roots(F, within, max_boxes=SECTION_BOXES)
         examined += got.boxes
@@ -274,9 +274,15 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
                 found.append((name, x, radius))
     if tube and not undecided:
         on_axis = torus_roots(tuple(perp), max_boxes=SECTION_BOXES)
-        plain = [torus_roots((g, g.d(*d)), ((r2, -np.inf, AXIS),), max_boxes=SECTION_BOXES) for d in ((0, 1), (1, 0))]
-        examined += on_axis.boxes + sum(p.boxes for p in plain)
-        if len(on_axis.undecided) or not any(p.complete and not len(p.points) for p in plain):
+        # no turn in t2 inside the tube: no root of (G, G_t3) there -- every root on the torus is known already
+        # (crossing_curves, complete), or else none of (G, G_t2) there
+        plain = not any(r2.at(*x) <= AXIS + MARGIN for x in crossing_curves.points)
+        if not plain:
+            other = torus_roots((g, g.d(1, 0)), ((r2, -np.inf, AXIS),), max_boxes=SECTION_BOXES)
+            examined += other.boxes
+            plain = other.complete and not len(other.points)
+        examined += on_axis.boxes
+        if len(on_axis.undecided) or not plain:
             why = ("the arm's point meets the first axis along a curve, or det J = 0 turns inside the tube about it"
                    if len(on_axis.undecided) else "det J = 0 turns inside the tube about the first axis")
         crossing = torus_roots((g, r2 - AXIS), max_boxes=SECTION_BOXES)
@@ -332,4 +338,4 @@ def section_witnesses(arm, axes: tuple, h: int, level: float, box: tuple) -> Wit
 
     def torus(q: np.ndarray) -> np.ndarray:
         return pin.difference(model, arm.q0, q)[arm.free]
-    return Witnesses(tuple(points), certified, how, G, torus, cusps, cusp_how, L, (E, G))
+    return Witnesses(tuple(points), certified, how, G, torus, cusps, cusp_how, curve=(E, G))
